@@ -1,0 +1,42 @@
+// stereorig: one binary, table-registered subcommands (apps/commands.cc).
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+#include "apps/command.h"
+
+namespace {
+
+void PrintUsage(FILE* out) {
+  std::fprintf(out,
+               "stereorig: calibrate a multi-module active stereo rig and reconstruct one-shot captures.\n\n"
+               "Usage: stereorig <command> [options]    (stereorig <command> --help for each)\n\n"
+               "Commands:\n");
+  for (const auto& c : stereorig::Commands()) std::fprintf(out, "  %-12s %s\n", c.name, c.summary);
+  std::fprintf(out,
+               "\nExit codes: 0 ok; 1 a check that ran and failed (verify, check); 2 bad usage or input.\n"
+               "Start with:  stereorig demo --out /tmp/stereorig-demo\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    PrintUsage(stderr);
+    return stereorig::kExitBadInput;
+  }
+  const std::string name = argv[1];
+  if (name == "--help" || name == "-h" || name == "help") {
+    PrintUsage(stdout);
+    return stereorig::kExitOk;
+  }
+  if (name == "--version") {
+    std::printf("stereorig %s\n", STEREORIG_VERSION);
+    return stereorig::kExitOk;
+  }
+  for (const auto& c : stereorig::Commands()) {
+    if (name == c.name) return stereorig::RunCommand(c, argc - 1, argv + 1);
+  }
+  std::fprintf(stderr, "stereorig: unknown command '%s' (stereorig --help lists them)\n", name.c_str());
+  return stereorig::kExitBadInput;
+}

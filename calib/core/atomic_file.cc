@@ -1,0 +1,57 @@
+#include "atomic_file.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+#include "input_error.h"
+
+namespace stereorig {
+
+namespace {
+
+std::string MakeTempPath(const std::string& path) {
+  static std::atomic<int> counter{0};
+  const std::filesystem::path p(path);
+  const std::string stem = ".tmp-" + std::to_string(getpid()) + "-" + std::to_string(counter++) + "-";
+  return (p.parent_path() / (stem + p.filename().string())).string();
+}
+
+}  // namespace
+
+AtomicOutput::AtomicOutput(const std::string& path) : path_(path), temp_path_(MakeTempPath(path)) {
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
+    throw InputError(path, "output folder '" + parent.string() + "' does not exist");
+  }
+}
+
+AtomicOutput::~AtomicOutput() {
+  if (!committed_) std::remove(temp_path_.c_str());
+}
+
+void AtomicOutput::Commit() {
+  if (std::rename(temp_path_.c_str(), path_.c_str()) != 0) {
+    const std::string err = std::strerror(errno);
+    std::remove(temp_path_.c_str());
+    throw InputError(path_, "cannot write: " + err);
+  }
+  committed_ = true;
+}
+
+void WriteFileAtomically(const std::string& path, const std::string& bytes) {
+  AtomicOutput out(path);
+  FILE* f = std::fopen(out.temp_path().c_str(), "wb");
+  if (!f) throw InputError(path, std::string("cannot write: ") + std::strerror(errno));
+  const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size() && std::fflush(f) == 0 &&
+                  fsync(fileno(f)) == 0;
+  const bool closed = std::fclose(f) == 0;
+  if (!ok || !closed) throw InputError(path, "write failed (disk full?)");
+  out.Commit();
+}
+
+}  // namespace stereorig

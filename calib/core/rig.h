@@ -1,0 +1,91 @@
+// The rig: every camera, every stereo module, and the M x M S matrix.
+//
+// Frames (docs/conventions.md):
+//   - a camera frame: x right, y down, z forward along the optical axis, mm;
+//   - a module frame IS its left (reference) camera's frame;
+//   - the rig's reference frame is module 0's frame.
+// S[i][j] = module_i_from_module_j. The rig enforces S_ii = I,
+// S_ji = S_ij^-1 and S_ij * S_jk = S_ik within the tolerances below.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "camera.h"
+#include "pose.h"
+
+namespace stereorig {
+
+struct StereoModule {
+  std::string name;          // e.g. "module0"
+  int left_camera = -1;      // index into Rig::cameras(); the module's reference camera
+  int right_camera = -1;     // index into Rig::cameras()
+  Pose right_from_left;      // right camera from left camera (= module) frame, mm
+};
+
+// Where a rig came from. The same structure serves a calibration result and
+// the simulator's ground truth.
+struct Provenance {
+  std::string tool;          // e.g. "stereorig 0.1.0"
+  std::string date_utc;      // ISO 8601, e.g. "2026-11-23T13:00:00Z"
+  std::string input;         // the dataset or capture folder it was made from
+  // Per-stage RMS residuals, e.g. {"intrinsics_rms_px": 0.2, ...}.
+  std::map<std::string, double> residuals;
+  // 1-sigma uncertainties, e.g. {"S_0_1_translation_mm": 0.01, ...}.
+  std::map<std::string, double> uncertainties;
+};
+
+// Tolerances of the S invariants. A rig file written with %.17g and composed
+// in double precision holds them to ~1e-13 (translations of ~1e3 mm); these
+// leave margin for a file edited by another tool that prints ~12 digits,
+// while still catching any inconsistency of metrological size (1 nm, 1e-9 rad).
+inline constexpr double kSRotationTolerance = 1e-9;   // max |element| difference of R
+inline constexpr double kSTranslationToleranceMm = 1e-6;
+
+class Rig {
+ public:
+  Rig() = default;
+  // Builds a consistent S from each module's pose in the reference frame:
+  // module0_from_module[i] (module0_from_module[0] must be identity).
+  Rig(std::vector<Camera> cameras, std::vector<std::string> camera_names,
+      std::vector<StereoModule> modules, const std::vector<Pose>& module0_from_module);
+  // Takes a full S as given; throws InputError(`where`, ...) if it breaks an
+  // invariant, or if modules name cameras that do not exist.
+  Rig(std::vector<Camera> cameras, std::vector<std::string> camera_names,
+      std::vector<StereoModule> modules, std::vector<std::vector<Pose>> S,
+      const std::string& where);
+
+  int num_modules() const { return static_cast<int>(modules_.size()); }
+  int num_cameras() const { return static_cast<int>(cameras_.size()); }
+  const std::vector<Camera>& cameras() const { return cameras_; }
+  const std::vector<std::string>& camera_names() const { return camera_names_; }
+  const std::vector<StereoModule>& modules() const { return modules_; }
+  const Camera& camera(int i) const { return cameras_.at(i); }
+  const StereoModule& module(int i) const { return modules_.at(i); }
+
+  // S[i][j] = module_i_from_module_j.
+  const Pose& S(int i, int j) const { return S_.at(i).at(j); }
+  const std::vector<std::vector<Pose>>& S() const { return S_; }
+  // A camera's pose relative to the reference frame (module 0):
+  // cam_from_module0 = cam_from_module_i * module_i_from_module0.
+  Pose CamFromReference(int camera_index) const;
+
+  Provenance& provenance() { return provenance_; }
+  const Provenance& provenance() const { return provenance_; }
+
+  // Checks S_ii = I, S_ji = S_ij^-1, S_ij S_jk = S_ik and rigidity. On failure
+  // returns false and names the entry in `why`.
+  bool CheckS(std::string* why) const;
+
+ private:
+  void CheckTopology(const std::string& where) const;
+
+  std::vector<Camera> cameras_;
+  std::vector<std::string> camera_names_;
+  std::vector<StereoModule> modules_;
+  std::vector<std::vector<Pose>> S_;
+  Provenance provenance_;
+};
+
+}  // namespace stereorig

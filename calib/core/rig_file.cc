@@ -1,0 +1,189 @@
+#include "rig_file.h"
+
+#include <cstdio>
+#include <ctime>
+#include <sstream>
+
+#include "atomic_file.h"
+#include "input_error.h"
+#include "yaml_reader.h"
+
+namespace stereorig {
+
+namespace {
+
+// A YAML double-quoted scalar: safe for any text in provenance.
+std::string Quote(const std::string& s) {
+  std::string out = "\"";
+  for (unsigned char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += static_cast<char>(c);
+    } else if (c < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out + "\"";
+}
+
+std::string Matrix4ToYaml(const Eigen::Matrix4d& m) {
+  std::string s = "[";
+  for (int r = 0; r < 4; ++r) {
+    s += r ? ", [" : "[";
+    for (int c = 0; c < 4; ++c) s += (c ? ", " : "") + FormatDouble(m(r, c));
+    s += "]";
+  }
+  return s + "]";
+}
+
+Pose ReadRigidPose(const YAML::Node& n, const std::string& where) {
+  const Eigen::Matrix4d m = YamlMap::ToMatrix4(n, where);
+  std::string why;
+  if (!IsRigid(m, kSRotationTolerance, &why)) throw InputError(where, why);
+  return Pose::FromMatrix4(m);
+}
+
+std::map<std::string, double> ReadNumberMap(YamlMap map) {
+  std::map<std::string, double> out;
+  for (const std::string& key : map.Keys()) out[key] = map.GetDouble(key);
+  return out;
+}
+
+Rig ParseRig(YamlMap root) {
+  const std::string format = root.GetString("format");
+  if (format != "stereorig-rig") throw InputError(root.Where("format"), "expected 'stereorig-rig', got '" + format + "'");
+  const int version = root.GetInt("version");
+  if (version != kRigFileVersion) {
+    throw InputError(root.Where("version"), "unsupported version " + std::to_string(version) +
+                                                " (this build reads version " + std::to_string(kRigFileVersion) + ")");
+  }
+  const std::string units = root.GetString("units");
+  if (units != "mm") throw InputError(root.Where("units"), "expected 'mm', got '" + units + "'");
+
+  Provenance prov;
+  {
+    YamlMap p = root.GetMap("provenance");
+    prov.tool = p.GetString("tool");
+    prov.date_utc = p.GetString("date_utc");
+    prov.input = p.GetString("input");
+    prov.residuals = ReadNumberMap(p.GetMap("residuals"));
+    prov.uncertainties = ReadNumberMap(p.GetMap("uncertainties"));
+    p.Finish();
+  }
+
+  std::vector<Camera> cameras;
+  std::vector<std::string> names;
+  for (YamlMap c : root.GetMaps("cameras")) {
+    names.push_back(c.GetString("name"));
+    const std::string model = c.GetString("lensmodel");
+    std::vector<double> intrinsics = c.GetDoubles("intrinsics");
+    const std::vector<int> size = c.GetInts("imagersize", 2);
+    cameras.emplace_back(model, std::move(intrinsics), size[0], size[1], c.Where());
+    c.Finish();
+  }
+
+  std::vector<StereoModule> modules;
+  for (YamlMap m : root.GetMaps("modules")) {
+    StereoModule mod;
+    mod.name = m.GetString("name");
+    mod.left_camera = m.GetInt("left");
+    mod.right_camera = m.GetInt("right");
+    mod.right_from_left = ReadRigidPose(m.GetNode("right_from_left"), m.Where("right_from_left"));
+    m.Finish();
+    modules.push_back(mod);
+  }
+
+  const YAML::Node s = root.GetNode("S");
+  const std::string where_s = root.Where("S");
+  if (!s.IsSequence()) throw InputError(where_s, "expected M rows of M 4x4 matrices");
+  std::vector<std::vector<Pose>> S;
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (!s[i].IsSequence()) throw InputError(where_s, "expected M rows of M 4x4 matrices");
+    S.emplace_back();
+    for (size_t j = 0; j < s[i].size(); ++j) {
+      S.back().push_back(ReadRigidPose(s[i][j], where_s + "[" + std::to_string(i) + "][" + std::to_string(j) + "]"));
+    }
+  }
+  root.Finish();
+  Rig rig(std::move(cameras), std::move(names), std::move(modules), std::move(S), root.file());
+  rig.provenance() = prov;
+  return rig;
+}
+
+}  // namespace
+
+std::string FormatDouble(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
+}
+
+std::string NowUtcIso8601() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm;
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+std::string ToolVersion() { return std::string("stereorig ") + STEREORIG_VERSION; }
+
+Rig ReadRigFile(const std::string& path) { return ParseRig(YamlMap::LoadFile(path)); }
+
+Rig ParseRigYaml(const std::string& text, const std::string& where) {
+  return ParseRig(YamlMap::LoadString(text, where));
+}
+
+std::string RigToYaml(const Rig& rig) {
+  std::ostringstream o;
+  const Provenance& p = rig.provenance();
+  o << "# stereorig rig file: cameras, stereo modules and the S matrix.\n"
+    << "# Units: mm. Format: docs/formats.md. S[i][j] = module_i_from_module_j.\n"
+    << "format: stereorig-rig\n"
+    << "version: " << kRigFileVersion << "\n"
+    << "units: mm\n"
+    << "provenance:\n"
+    << "  tool: " << Quote(p.tool) << "\n"
+    << "  date_utc: " << Quote(p.date_utc) << "\n"
+    << "  input: " << Quote(p.input) << "\n";
+  for (const auto* section : {&p.residuals, &p.uncertainties}) {
+    o << (section == &p.residuals ? "  residuals:" : "  uncertainties:");
+    if (section->empty()) o << " {}";
+    o << "\n";
+    for (const auto& [k, v] : *section) o << "    " << Quote(k) << ": " << FormatDouble(v) << "\n";
+  }
+  o << "cameras:\n";
+  for (int i = 0; i < rig.num_cameras(); ++i) {
+    const Camera& c = rig.camera(i);
+    o << "  - name: " << Quote(rig.camera_names()[i]) << "\n"
+      << "    lensmodel: " << Quote(c.lensmodel_name()) << "\n"
+      << "    intrinsics: [";
+    for (size_t k = 0; k < c.intrinsics().size(); ++k) o << (k ? ", " : "") << FormatDouble(c.intrinsics()[k]);
+    o << "]\n"
+      << "    imagersize: [" << c.imager_width_px() << ", " << c.imager_height_px() << "]\n";
+  }
+  o << "modules:\n";
+  for (const StereoModule& m : rig.modules()) {
+    o << "  - name: " << Quote(m.name) << "\n"
+      << "    left: " << m.left_camera << "\n"
+      << "    right: " << m.right_camera << "\n"
+      << "    right_from_left: " << Matrix4ToYaml(m.right_from_left.ToMatrix4()) << "\n";
+  }
+  o << "S:\n";
+  for (int i = 0; i < rig.num_modules(); ++i) {
+    o << "  -\n";
+    for (int j = 0; j < rig.num_modules(); ++j) {
+      o << "    - " << Matrix4ToYaml(rig.S(i, j).ToMatrix4()) << "  # module" << i << "_from_module" << j << "\n";
+    }
+  }
+  return o.str();
+}
+
+void WriteRigFile(const Rig& rig, const std::string& path) { WriteFileAtomically(path, RigToYaml(rig)); }
+
+}  // namespace stereorig

@@ -1,0 +1,34 @@
+// The rig file: the calibration result (and the simulator's ground truth) as
+// plain, versioned YAML in millimetres. docs/formats.md defines it.
+//
+// Round trip is lossless: doubles are written with %.17g, so
+// ReadRigFile(WriteRigFile(rig)) reproduces every bit, and writing it again
+// gives the same bytes.
+#pragma once
+
+#include <string>
+
+#include "rig.h"
+
+namespace stereorig {
+
+inline constexpr int kRigFileVersion = 1;
+
+// Throws InputError naming the file and key on: a missing file, bad YAML,
+// unknown or missing keys, wrong types, NaN/Inf, non-orthonormal rotations,
+// an unknown lens model, the wrong number of intrinsics, an inconsistent S.
+Rig ReadRigFile(const std::string& path);
+Rig ParseRigYaml(const std::string& text, const std::string& where);
+
+std::string RigToYaml(const Rig& rig);
+// Atomic: temp file and rename.
+void WriteRigFile(const Rig& rig, const std::string& path);
+
+// "%.17g": the shortest printf format that round-trips every double.
+std::string FormatDouble(double x);
+// Current UTC time as ISO 8601 ("2026-11-23T13:00:00Z"), for provenance.
+std::string NowUtcIso8601();
+// "stereorig <version>".
+std::string ToolVersion();
+
+}  // namespace stereorig

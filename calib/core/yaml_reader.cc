@@ -1,0 +1,181 @@
+#include "yaml_reader.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include "input_error.h"
+
+namespace stereorig {
+
+YamlMap YamlMap::LoadFile(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) throw InputError(path, "no such file");
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw InputError(path, "not valid YAML: " + e.msg + " (line " + std::to_string(e.mark.line + 1) + ")");
+  }
+  if (!root.IsMap()) throw InputError(path, "expected a YAML mapping at the top level");
+  return YamlMap(root, path, "");
+}
+
+YamlMap YamlMap::LoadString(const std::string& text, const std::string& where) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw InputError(where, "not valid YAML: " + e.msg);
+  }
+  if (!root.IsMap()) throw InputError(where, "expected a YAML mapping at the top level");
+  return YamlMap(root, where, "");
+}
+
+YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string key_path)
+    : node_(node), file_(std::move(file)), key_path_(std::move(key_path)) {
+  if (!node_.IsMap()) throw InputError(Where(), "expected a mapping");
+}
+
+std::string YamlMap::Where(const std::string& key) const {
+  std::string path = key_path_;
+  if (!key.empty()) path = path.empty() ? key : path + "." + key;
+  return path.empty() ? file_ : file_ + ": " + path;
+}
+
+bool YamlMap::Has(const std::string& key) const { return static_cast<bool>(node_[key]); }
+
+std::vector<std::string> YamlMap::Keys() const {
+  std::vector<std::string> keys;
+  for (const auto& kv : node_) keys.push_back(kv.first.as<std::string>());
+  return keys;
+}
+
+YAML::Node YamlMap::Require(const std::string& key) {
+  read_.insert(key);
+  YAML::Node n = node_[key];
+  if (!n) throw InputError(Where(key), "missing key");
+  return n;
+}
+
+double YamlMap::ToDouble(const YAML::Node& n, const std::string& where) {
+  if (!n.IsScalar()) throw InputError(where, "expected a number");
+  double v;
+  try {
+    v = n.as<double>();
+  } catch (const YAML::Exception&) {
+    throw InputError(where, "expected a number, got '" + n.Scalar() + "'");
+  }
+  if (!std::isfinite(v)) throw InputError(where, "NaN or Inf is not allowed");
+  return v;
+}
+
+Eigen::Matrix4d YamlMap::ToMatrix4(const YAML::Node& n, const std::string& where) {
+  if (!n.IsSequence() || n.size() != 4) throw InputError(where, "expected a 4x4 matrix (4 rows of 4 numbers)");
+  Eigen::Matrix4d m;
+  for (int r = 0; r < 4; ++r) {
+    if (!n[r].IsSequence() || n[r].size() != 4) {
+      throw InputError(where, "expected a 4x4 matrix (4 rows of 4 numbers)");
+    }
+    for (int c = 0; c < 4; ++c) m(r, c) = ToDouble(n[r][c], where);
+  }
+  return m;
+}
+
+double YamlMap::GetDouble(const std::string& key) { return ToDouble(Require(key), Where(key)); }
+double YamlMap::GetDouble(const std::string& key, double default_value) {
+  return Has(key) ? GetDouble(key) : (read_.insert(key), default_value);
+}
+
+int YamlMap::GetInt(const std::string& key) {
+  YAML::Node n = Require(key);
+  try {
+    if (n.IsScalar()) return n.as<int>();
+  } catch (const YAML::Exception&) {
+  }
+  throw InputError(Where(key), "expected an integer");
+}
+int YamlMap::GetInt(const std::string& key, int default_value) {
+  return Has(key) ? GetInt(key) : (read_.insert(key), default_value);
+}
+
+bool YamlMap::GetBool(const std::string& key, bool default_value) {
+  if (!Has(key)) {
+    read_.insert(key);
+    return default_value;
+  }
+  YAML::Node n = Require(key);
+  try {
+    if (n.IsScalar()) return n.as<bool>();
+  } catch (const YAML::Exception&) {
+  }
+  throw InputError(Where(key), "expected true or false");
+}
+
+std::string YamlMap::GetString(const std::string& key) {
+  YAML::Node n = Require(key);
+  if (!n.IsScalar()) throw InputError(Where(key), "expected a string");
+  return n.Scalar();
+}
+std::string YamlMap::GetString(const std::string& key, const std::string& default_value) {
+  return Has(key) ? GetString(key) : (read_.insert(key), default_value);
+}
+
+std::vector<double> YamlMap::GetDoubles(const std::string& key, int expected_size) {
+  YAML::Node n = Require(key);
+  if (!n.IsSequence()) throw InputError(Where(key), "expected a list of numbers");
+  if (expected_size >= 0 && static_cast<int>(n.size()) != expected_size) {
+    throw InputError(Where(key), "expected " + std::to_string(expected_size) + " numbers, got " +
+                                     std::to_string(n.size()));
+  }
+  std::vector<double> out;
+  for (const auto& x : n) out.push_back(ToDouble(x, Where(key)));
+  return out;
+}
+
+std::vector<int> YamlMap::GetInts(const std::string& key, int expected_size) {
+  YAML::Node n = Require(key);
+  if (!n.IsSequence()) throw InputError(Where(key), "expected a list of integers");
+  if (expected_size >= 0 && static_cast<int>(n.size()) != expected_size) {
+    throw InputError(Where(key), "expected " + std::to_string(expected_size) + " integers, got " +
+                                     std::to_string(n.size()));
+  }
+  std::vector<int> out;
+  for (const auto& x : n) {
+    try {
+      out.push_back(x.as<int>());
+    } catch (const YAML::Exception&) {
+      throw InputError(Where(key), "expected integers");
+    }
+  }
+  return out;
+}
+
+Eigen::Matrix4d YamlMap::GetMatrix4(const std::string& key) { return ToMatrix4(Require(key), Where(key)); }
+
+YamlMap YamlMap::GetMap(const std::string& key) {
+  YAML::Node n = Require(key);
+  if (!n.IsMap()) throw InputError(Where(key), "expected a mapping");
+  return YamlMap(n, file_, key_path_.empty() ? key : key_path_ + "." + key);
+}
+
+std::vector<YamlMap> YamlMap::GetMaps(const std::string& key) {
+  YAML::Node n = Require(key);
+  if (!n.IsSequence()) throw InputError(Where(key), "expected a list");
+  std::vector<YamlMap> out;
+  for (size_t i = 0; i < n.size(); ++i) {
+    const std::string path = (key_path_.empty() ? key : key_path_ + "." + key) + "[" + std::to_string(i) + "]";
+    if (!n[i].IsMap()) throw InputError(file_ + ": " + path, "expected a mapping");
+    out.emplace_back(n[i], file_, path);
+  }
+  return out;
+}
+
+YAML::Node YamlMap::GetNode(const std::string& key) { return Require(key); }
+
+void YamlMap::Finish() const {
+  for (const auto& kv : node_) {
+    const std::string key = kv.first.as<std::string>();
+    if (!read_.count(key)) throw InputError(Where(key), "unknown key");
+  }
+}
+
+}  // namespace stereorig

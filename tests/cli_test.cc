@@ -1,0 +1,160 @@
+// The CLI contract (docs/formats.md, "CLI"): exit codes, one-line errors that
+// name the file and key, and no output left behind on failure. Runs the real
+// `stereorig` binary.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace {
+
+const std::string kBin = std::string(STEREORIG_BINARY_DIR) + "/stereorig";
+
+struct Result {
+  int code;
+  std::string out, err;
+};
+
+Result RunCli(const std::string& args) {
+  const std::string dir = ::testing::TempDir();
+  const std::string o = dir + "/cli_out.txt", e = dir + "/cli_err.txt";
+  const int status = std::system((kBin + " " + args + " >" + o + " 2>" + e).c_str());
+  auto slurp = [](const std::string& p) {
+    std::ifstream f(p);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+  };
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(o), slurp(e)};
+}
+
+int Lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+
+std::string GoodRigText() {
+  const std::string dir = ::testing::TempDir() + "/cli_demo";
+  const Result r = RunCli("demo --out " + dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  std::ifstream f(dir + "/truth_rig.yaml");
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+std::string Replace(std::string text, const std::string& from, const std::string& to) {
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+TEST(Cli, HelpListsEveryCommandAndExitsZero) {
+  const Result r = RunCli("--help");
+  EXPECT_EQ(r.code, 0);
+  for (const char* c : {"simulate", "target", "calibrate", "reconstruct", "match", "verify", "check", "bench", "demo"})
+    EXPECT_NE(r.out.find(c), std::string::npos) << c;
+  const Result sub = RunCli("rig --help");
+  EXPECT_EQ(sub.code, 0);
+  EXPECT_NE(sub.out.find("Example"), std::string::npos);
+}
+
+TEST(Cli, UnknownCommandAndBadFlagsExitTwoWithOneLine) {
+  Result r = RunCli("frobnicate");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(Lines(r.err), 1);
+  r = RunCli("rig --no-such-flag");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+}
+
+TEST(Cli, GoodRigFileIsAccepted) {
+  const std::string path = ::testing::TempDir() + "/good_rig.yaml";
+  std::ofstream(path) << GoodRigText();
+  const Result r = RunCli("rig --rig " + path);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("2 module(s)"), std::string::npos);
+}
+
+// Every malformed case of the rig-file contract: exit 2, one line on stderr
+// naming the file and the offending key.
+TEST(Cli, EveryMalformedRigFileExitsTwoNamingTheKey) {
+  const std::string good = GoodRigText();
+  struct Case {
+    const char* name;
+    std::string text;
+    const char* expect_in_message;
+  };
+  const std::string cam0_intr = "intrinsics: [";
+  const std::vector<Case> cases = {
+      {"unknown key", Replace(good, "units: mm\n", "units: mm\ncolour: blue\n"), "colour: unknown key"},
+      {"unknown nested key", Replace(good, "    left: 0\n", "    left: 0\n    lefty: 1\n"), "lefty: unknown key"},
+      {"missing key", Replace(good, "units: mm\n", ""), "units: missing key"},
+      {"missing camera key", Replace(good, "    imagersize: [752, 582]\n", "\n"), "imagersize: missing key"},
+      {"wrong type", Replace(good, "    left: 0\n", "    left: zero\n"), "left: expected an integer"},
+      {"NaN", Replace(good, cam0_intr, cam0_intr + std::string(".nan, ")), "NaN or Inf"},
+      {"Inf", Replace(good, "[[1, 0, 0, 0]", "[[1, 0, 0, .inf]"), "NaN or Inf"},
+      {"non-orthonormal rotation", Replace(good, "[[1, 0, 0, 0]", "[[1.01, 0, 0, 0]"), "orthonormal"},
+      {"unknown lens model", Replace(good, "LENSMODEL_OPENCV8", "LENSMODEL_FISHEYE9"), "unknown lens model"},
+      {"wrong number of intrinsics", Replace(good, cam0_intr, cam0_intr + std::string("1.5, ")), "takes 12 intrinsics"},
+      {"inconsistent S", Replace(good, "[[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]  # module1_from_module1",
+                                 "[[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 2.5], [0, 0, 0, 1]]  # module1_from_module1"),
+       "S[1][1] is not the identity"},
+      {"not YAML", "format: [unclosed\n", "not valid YAML"},
+      {"wrong version", Replace(good, "version: 1", "version: 99"), "unsupported version 99"},
+  };
+  for (const Case& c : cases) {
+    const std::string path = ::testing::TempDir() + "/bad_rig.yaml";
+    std::ofstream(path) << c.text;
+    const Result r = RunCli("rig --rig " + path);
+    EXPECT_EQ(r.code, 2) << c.name;
+    EXPECT_EQ(Lines(r.err), 1) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(path), std::string::npos) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(c.expect_in_message), std::string::npos) << c.name << ": " << r.err;
+  }
+  const Result missing = RunCli("rig --rig /nonexistent/rig.yaml");
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_NE(missing.err.find("no such file"), std::string::npos);
+}
+
+TEST(Cli, AnInconsistentOffDiagonalSIsRejected) {
+  // Shift S[0][1]'s translation by 1 mm while S[1][0] stays: S_10 != S_01^-1.
+  const std::string good = GoodRigText();
+  const size_t s_at = good.find("\nS:\n");
+  ASSERT_NE(s_at, std::string::npos);
+  const size_t row = good.find("# module0_from_module1", s_at);
+  ASSERT_NE(row, std::string::npos);
+  const size_t line_start = good.rfind("\n", row) + 1;
+  std::string line = good.substr(line_start, row - line_start);
+  const size_t first_t = line.find("], [") ;  // end of the first row of the 4x4
+  const size_t comma = line.rfind(", ", first_t);
+  line.replace(comma + 2, first_t - comma - 2, "123.456");
+  std::string bad = good;
+  bad.replace(line_start, row - line_start, line);
+  const std::string path = ::testing::TempDir() + "/bad_s.yaml";
+  std::ofstream(path) << bad;
+  const Result r = RunCli("rig --rig " + path);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(Lines(r.err), 1);
+  EXPECT_NE(r.err.find("is not the inverse of"), std::string::npos) << r.err;
+}
+
+TEST(Cli, NotYetBuiltCommandsSaySoAndExitTwo) {
+  const Result r = RunCli("bench");
+  if (r.err.find("not built yet") == std::string::npos) GTEST_SKIP() << "bench is built";
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(Lines(r.err), 1);
+}
+
+TEST(Cli, RigExportWritesCameramodelsThatRoundTrip) {
+  const std::string dir = ::testing::TempDir() + "/cli_export";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string path = dir + "/rig.yaml";
+  std::ofstream(path) << GoodRigText();
+  const Result r = RunCli("rig --rig " + path + " --export-cameramodels " + dir);
+  EXPECT_EQ(r.code, 0) << r.err;
+  for (int i = 0; i < 4; ++i) EXPECT_TRUE(std::filesystem::exists(dir + "/cam" + std::to_string(i) + ".cameramodel"));
+}
+
+}  // namespace
