@@ -49,7 +49,7 @@ ProjectionUncertaintyEvaluator::ProjectionUncertaintyEvaluator(const MrcalProble
   m.Jt = cholmod_allocate_sparse(m.num_states, m.num_measurements, nnz, 1, 1, 0, CHOLMOD_REAL, &m.common);
   std::vector<double> b(m.num_states), x(m.num_measurements);
   const mrcal_problem_constants_t constants = {.point_min_range = -1.0, .point_max_range = -1.0};
-  if (!mrcal_optimizer_callback(b.data(), m.num_states, x.data(), m.num_measurements, m.Jt, p.intrinsics.data(),
+  if (!mrcal_optimizer_callback(b.data(), m.num_states * static_cast<int>(sizeof(double)), x.data(), m.num_measurements * static_cast<int>(sizeof(double)), m.Jt, p.intrinsics.data(),
                                 p.extrinsics_fromref.data(), p.frames_toref.data(), nullptr, nullptr,
                                 p.num_intrinsics_cameras, p.num_extrinsics(), p.num_frames(), 0, 0,
                                 p.observations.data(), nullptr, p.num_observations(), 0, p.pool.data(), &p.lensmodel,
