@@ -91,7 +91,45 @@ double ModuleAgreementRms(const Rig& truth, const Rig& calibrated, const Pose& i
 namespace stereorig::testing {
 
 DefaultScene MakeDefaultScene(unsigned seed, int captures, double noise_px) {
-  DefaultScene s{MakeDefaultRig(), Pose(), Pose(), {}};
+  return MakeScene(MakeDefaultRig(), seed, captures, noise_px);
+}
+
+SimulatedRig MakeOneModuleRig() {
+  const SimulatedRig d = MakeDefaultRig();
+  std::vector<Camera> cams = {d.rig.camera(0), d.rig.camera(1)};
+  SimulatedRig out{Rig(cams, {"cam0", "cam1"}, {d.rig.module(0)}, std::vector<Pose>{Pose::Identity()}),
+                   d.world_from_module0};
+  return out;
+}
+
+SimulatedRig MakeThreeModuleRig() {
+  const SimulatedRig d = MakeDefaultRig();
+  std::vector<Camera> cams = d.rig.cameras();
+  // Two more cameras: the default's, with their own small differences.
+  for (int c : {0, 1}) {
+    std::vector<double> intr = d.rig.camera(c).intrinsics();
+    intr[0] += 2.5, intr[1] += 2.2, intr[2] -= 3.0, intr[3] += 2.0, intr[4] += 0.01;
+    cams.emplace_back(d.rig.camera(c).lensmodel_name(), intr, d.rig.camera(c).imager_width_px(),
+                      d.rig.camera(c).imager_height_px());
+  }
+  std::vector<StereoModule> modules = d.rig.modules();
+  StereoModule m2 = modules[0];
+  m2.name = "module2";
+  m2.left_camera = 4;
+  m2.right_camera = 5;
+  modules.push_back(m2);
+  const Pose turn(Eigen::AngleAxisd(-30.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix(),
+                  Eigen::Vector3d::Zero());
+  const Pose world_from_module2 = turn * d.world_from_module0;
+  const std::vector<Pose> module0_from_module = {Pose::Identity(), d.rig.S(0, 1),
+                                                 d.world_from_module0.Inverse() * world_from_module2};
+  SimulatedRig out{Rig(cams, {"cam0", "cam1", "cam2", "cam3", "cam4", "cam5"}, modules, module0_from_module),
+                   d.world_from_module0};
+  return out;
+}
+
+DefaultScene MakeScene(const SimulatedRig& rig, unsigned seed, int captures, double noise_px) {
+  DefaultScene s{rig, Pose(), Pose(), {}};
   s.ref_from_volume = DefaultVolume(s.truth.world_from_module0);
   TargetGeometry told = DefaultTestTarget();
   s.true_back_from_front = told.back_from_front;

@@ -59,5 +59,13 @@ struct DefaultScene {
   SyntheticData data;
 };
 DefaultScene MakeDefaultScene(unsigned seed, int captures, double noise_px);
+// The same for any simulated rig whose volume sits at the world origin.
+DefaultScene MakeScene(const SimulatedRig& rig, unsigned seed, int captures, double noise_px);
+
+// Variants of the default rig for the module-count tests: module 0 alone, and
+// the default two plus a third module beside module 0, turned 30 deg about
+// the world's y axis (it sees the front face, as module 0 does).
+SimulatedRig MakeOneModuleRig();
+SimulatedRig MakeThreeModuleRig();
 
 }  // namespace stereorig::testing

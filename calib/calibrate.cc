@@ -170,7 +170,9 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
   std::vector<Pose> module0_from_module(M);
   if (M > 1) {
     Progress(options.progress, "stage 3: Horn + bundle adjustment over " + std::to_string(M) + " modules");
-    result.stage3 = CalibrateSystem(in, modules, options.system);
+    double s2 = 0;
+    for (const StereoReport& s : rep.stereo) s2 += s.rms_px * s.rms_px;
+    result.stage3 = CalibrateSystem(in, modules, std::sqrt(s2 / rep.stereo.size()), options.system);
     modules = result.stage3.modules;
     module0_from_module = result.stage3.module0_from_module;
     rep.system = result.stage3.report;

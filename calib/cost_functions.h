@@ -64,19 +64,25 @@ class CornerReprojectionCost : public ceres::CostFunction {
   int num_intrinsics_;
 };
 
-// Prior on back_from_front: residual (6,) = [dr (deg) / sigma_r, (t - t_measured) / sigma_t],
+// Prior on back_from_front: residual (6,) = corner_sigma_px * [dr (deg) / sigma_r, (t - t_measured) / sigma_t],
 // dr being the block's rotation perturbation around the measured rotation.
+// The reprojection residuals are in px with noise corner_sigma_px; scaling the
+// whitened prior by it weighs prior and data as a MAP estimate does, and keeps
+// the covariance right when it is scaled by the pixel variance.
 struct BackFromFrontPrior {
   Eigen::Vector3d t_measured_mm;
   Eigen::Matrix<double, 6, 1> sigma;  // [rx, ry, rz (deg), tx, ty, tz (mm)]
+  double corner_sigma_px;
   template <typename T>
   bool operator()(const T* bff, T* r) const {
-    for (int i = 0; i < 3; ++i) r[i] = bff[i] * T(180.0 / M_PI) / T(sigma(i));
-    for (int i = 0; i < 3; ++i) r[3 + i] = (bff[3 + i] - T(t_measured_mm(i))) / T(sigma(3 + i));
+    for (int i = 0; i < 3; ++i) r[i] = T(corner_sigma_px) * bff[i] * T(180.0 / M_PI) / T(sigma(i));
+    for (int i = 0; i < 3; ++i) r[3 + i] = T(corner_sigma_px) * (bff[3 + i] - T(t_measured_mm(i))) / T(sigma(3 + i));
     return true;
   }
-  static ceres::CostFunction* Create(const Eigen::Vector3d& t_measured_mm, const Eigen::Matrix<double, 6, 1>& sigma) {
-    return new ceres::AutoDiffCostFunction<BackFromFrontPrior, 6, 6>(new BackFromFrontPrior{t_measured_mm, sigma});
+  static ceres::CostFunction* Create(const Eigen::Vector3d& t_measured_mm, const Eigen::Matrix<double, 6, 1>& sigma,
+                                     double corner_sigma_px) {
+    return new ceres::AutoDiffCostFunction<BackFromFrontPrior, 6, 6>(
+        new BackFromFrontPrior{t_measured_mm, sigma, corner_sigma_px});
   }
 };
 

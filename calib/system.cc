@@ -71,7 +71,8 @@ std::vector<std::map<int, ModuleCaptureView>> PoseBoardsByTriangulation(const Ca
 }
 
 SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<ModuleCameras>& modules,
-                             const SystemOptions& options) {
+                             double corner_sigma_px, const SystemOptions& options) {
+  STEREORIG_CHECK(corner_sigma_px > 0);
   const int M = static_cast<int>(modules.size());
   const TargetGeometry& target = input.target;
   SystemResult result;
@@ -202,13 +203,25 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
     }
   }
   rep.num_residual_corners = static_cast<int>(corner_blocks.size());
+  // Without mrcal's regularisation, only the well-determined intrinsics are
+  // freed: the core and OPENCV's k1..k3, p1, p2. OPENCV8's rational k4..k6 and
+  // a spline's control points stay at their stage-2 values.
+  for (auto& [cam, v] : intrinsics) {
+    if (!problem.HasParameterBlock(v.data())) continue;
+    const std::string& model = camera_of[cam]->lensmodel_name();
+    std::vector<int> fixed;
+    const int n = static_cast<int>(v.size());
+    const int first_fixed = model == "LENSMODEL_OPENCV8" ? 9 : model.rfind("LENSMODEL_OPENCV", 0) == 0 ? n : 4;
+    for (int i = first_fixed; i < n; ++i) fixed.push_back(i);
+    if (!fixed.empty()) problem.SetManifold(v.data(), new ceres::SubsetManifold(n, fixed));
+  }
   for (PoseBlock* p : {&identity_module, &identity_bff, &identity_rl}) {
     if (problem.HasParameterBlock(p->params)) problem.SetParameterBlockConstant(p->params);
   }
   const bool bff_free = any_back && options.refine_back_from_front && target.double_sided;
   if (any_back && bff_free) {
     problem.AddResidualBlock(BackFromFrontPrior::Create(target.back_from_front.translation_mm(),
-                                                        target.back_from_front_sigma),
+                                                        target.back_from_front_sigma, corner_sigma_px),
                              nullptr, bff_block.params);
   }
 

@@ -30,7 +30,12 @@ namespace stereorig {
 struct SystemOptions {
   double huber_px = 1.0;            // Huber loss scale, px; default 1
   bool refine_stereo = true;        // free each module's right_from_left in the adjustment; default true
-  bool refine_intrinsics = false;   // free every camera's intrinsics (no regularisation here); default false
+  // Free every camera's intrinsics: the core and OPENCV's k1..k3, p1, p2 (not
+  // OPENCV8's k4..k6 nor spline knots, which need mrcal's regularisation).
+  // With them free, the covariance of S includes the lens uncertainty, which
+  // moves each module's frame (a calibrated camera's frame trades rotation
+  // against its centre). Default true.
+  bool refine_intrinsics = true;
   bool refine_back_from_front = true;  // free back_from_front under its prior; default true
   int min_triangulated_corners = 6; // a module's board pose needs this many corners both cameras saw; default 6
   int max_iterations = 100;         // Ceres; default 100
@@ -76,10 +81,12 @@ struct SystemResult {
   SystemReport report;
 };
 
-// `modules`: stage-2 results per module. Throws InputError if a module shares
-// no capture with the others (the S matrix would be undetermined).
+// `modules`: stage-2 results per module. `corner_sigma_px`: the corner noise
+// (stage 2's residual RMS), which weighs back_from_front's prior against the
+// reprojection residuals. Throws InputError if a module shares no capture
+// with the others (the S matrix would be undetermined).
 SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<ModuleCameras>& modules,
-                             const SystemOptions& options);
+                             double corner_sigma_px, const SystemOptions& options);
 
 // Board poses: for each capture, module_from_front of one module, from its
 // triangulated corners (Horn). Also the triangulated points themselves.
