@@ -7,6 +7,7 @@ namespace stereorig {
 
 int RunDemo(int argc, char** argv);
 int RunRig(int argc, char** argv);
+int RunVerify(int argc, char** argv);
 
 namespace {
 
@@ -24,9 +25,6 @@ int RunReconstruct(int argc, char** argv) {
 }
 int RunMatch(int argc, char** argv) {
   return NotBuiltYet("match", "The correspondence stage alone, on a rectified pair -> disparity (PFM).", argc, argv);
-}
-int RunVerify(int argc, char** argv) {
-  return NotBuiltYet("verify", "A reconstruction of a reference artifact -> accuracy figures, pass/fail.", argc, argv);
 }
 int RunCheck(int argc, char** argv) {
   return NotBuiltYet("check", "Nightly check: fresh target captures + rig file -> drift verdict, history.", argc,

@@ -37,12 +37,6 @@ void CalibrationOptions::Check() const {
   system.Check();
 }
 
-namespace {
-
-const char* FaceName(Face f) { return f == Face::kFront ? "front" : "back"; }
-
-}  // namespace
-
 void ValidateInput(const CalibrationInput& in) {
   const std::string& src = in.source;
   in.target.Check(src + ": target");
@@ -198,18 +192,19 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
   pv.tool = std::string("stereorig ") + STEREORIG_VERSION;
   pv.date_utc = NowUtc();
   pv.input = in.source;
+  // Keys as docs/formats.md fixes them (stereorig check reads them).
   for (const IntrinsicsReport& r : rep.intrinsics) {
-    pv.residuals["intrinsics_rms_px_cam" + std::to_string(r.camera)] = r.rms_px;
+    pv.residuals["cam" + std::to_string(r.camera) + "_rms_px"] = r.rms_px;
     for (const PixelUncertainty& u : r.uncertainty)
-      if (u.where == "centre") pv.uncertainties["projection_centre_px_cam" + std::to_string(r.camera)] = u.rms_stdev_px;
+      if (u.where == "centre") pv.uncertainties["cam" + std::to_string(r.camera) + "_projection_center_px"] = u.rms_stdev_px;
   }
   for (const StereoReport& s : rep.stereo) {
-    pv.residuals["stereo_rms_px_module" + std::to_string(s.module)] = s.rms_px;
-    pv.residuals["rectified_row_rms_px_module" + std::to_string(s.module)] = s.rectified_row_rms_px;
+    pv.residuals["module" + std::to_string(s.module) + "_stereo_rms_px"] = s.rms_px;
+    pv.residuals["module" + std::to_string(s.module) + "_rectified_row_rms_px"] = s.rectified_row_rms_px;
   }
   if (M > 1) {
-    pv.residuals["system_horn_rms_px"] = rep.system.horn_reprojection_rms_px;
-    pv.residuals["system_refined_rms_px"] = rep.system.refined_reprojection_rms_px;
+    pv.residuals["rig_rms_px"] = rep.system.refined_reprojection_rms_px;
+    pv.residuals["rig_horn_only_rms_px"] = rep.system.horn_reprojection_rms_px;
     for (const STransformSigma& s : rep.system.sigma) {
       const std::string k = "S_0_" + std::to_string(s.module);
       pv.uncertainties[k + "_translation_mm"] = s.translation_mm.norm();

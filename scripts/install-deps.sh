@@ -9,7 +9,7 @@ packages=(
   libmrcal-dev mrcal python3 python3-mrcal python3-numpy
   libopencv-dev python3-opencv
   libapriltag-dev
-  libyaml-cpp-dev libcli11-dev libsqlite3-dev libnanoflann-dev
+  libyaml-cpp-dev libcli11-dev libsqlite3-dev libnanoflann-dev nlohmann-json3-dev
   googletest libgtest-dev
 )
 

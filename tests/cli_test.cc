@@ -8,29 +8,13 @@
 #include <fstream>
 #include <sstream>
 
+#include "tests/cli_runner.h"
+
 namespace {
 
-const std::string kBin = std::string(STEREORIG_BINARY_DIR) + "/stereorig";
-
-struct Result {
-  int code;
-  std::string out, err;
-};
-
-Result RunCli(const std::string& args) {
-  const std::string dir = ::testing::TempDir();
-  const std::string o = dir + "/cli_out.txt", e = dir + "/cli_err.txt";
-  const int status = std::system((kBin + " " + args + " >" + o + " 2>" + e).c_str());
-  auto slurp = [](const std::string& p) {
-    std::ifstream f(p);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-  };
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(o), slurp(e)};
-}
-
-int Lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+using stereorig::testing::Lines;
+using stereorig::testing::Result;
+using stereorig::testing::RunCli;
 
 std::string GoodRigText() {
   const std::string dir = ::testing::TempDir() + "/cli_demo";

@@ -1,0 +1,113 @@
+#include "reconstruct/metrology/artifact.h"
+
+#include <sstream>
+
+#include "calib/core/input_error.h"
+#include "calib/core/rig_file.h"
+#include "calib/core/yaml_reader.h"
+
+namespace stereorig {
+
+const char* ArtifactTypeName(ArtifactType type) {
+  switch (type) {
+    case ArtifactType::kSphere: return "sphere";
+    case ArtifactType::kBallBar: return "ballbar";
+    case ArtifactType::kPlate: return "plate";
+  }
+  return "?";
+}
+
+namespace {
+
+double Positive(YamlMap& m, const std::string& key) {
+  const double v = m.GetDouble(key);
+  if (!(v > 0)) throw InputError(m.Where(key), "must be positive");
+  return v;
+}
+
+double NonNegative(YamlMap& m, const std::string& key) {
+  const double v = m.GetDouble(key, 0.0);
+  if (v < 0) throw InputError(m.Where(key), "must not be negative");
+  return v;
+}
+
+Artifact Parse(YamlMap m) {
+  if (m.GetString("format") != "stereorig-artifact") throw InputError(m.Where("format"), "expected 'stereorig-artifact'");
+  if (m.GetInt("version") != 1) throw InputError(m.Where("version"), "unsupported version (this build reads 1)");
+  if (m.GetString("units") != "mm") throw InputError(m.Where("units"), "expected 'mm'");
+  Artifact a;
+  a.name = m.GetString("name", "");
+  const std::string type = m.GetString("type");
+  if (type == "sphere") {
+    a.type = ArtifactType::kSphere;
+    a.sphere_diameter_mm = Positive(m, "diameter_mm");
+    a.sphere_diameter_uncertainty_mm = NonNegative(m, "diameter_uncertainty_mm");
+  } else if (type == "ballbar") {
+    a.type = ArtifactType::kBallBar;
+    a.sphere_diameter_mm = Positive(m, "sphere_diameter_mm");
+    a.sphere_diameter_uncertainty_mm = NonNegative(m, "sphere_diameter_uncertainty_mm");
+    a.center_distance_mm = Positive(m, "center_distance_mm");
+    a.center_distance_uncertainty_mm = NonNegative(m, "center_distance_uncertainty_mm");
+    if (a.center_distance_mm <= a.sphere_diameter_mm) {
+      throw InputError(m.Where("center_distance_mm"), "must exceed the sphere diameter (the balls would overlap)");
+    }
+  } else if (type == "plate") {
+    a.type = ArtifactType::kPlate;
+    a.plate_length_mm = Positive(m, "length_mm");
+    a.plate_width_mm = Positive(m, "width_mm");
+    a.flatness_uncertainty_mm = NonNegative(m, "flatness_uncertainty_mm");
+  } else {
+    throw InputError(m.Where("type"), "expected sphere, ballbar or plate, got '" + type + "'");
+  }
+  if (m.Has("mpe_mm")) {
+    YamlMap e = m.GetMap("mpe_mm");
+    a.mpe.probing_form_mm = e.GetDouble("P_F", a.mpe.probing_form_mm);
+    a.mpe.probing_size_mm = e.GetDouble("P_S", a.mpe.probing_size_mm);
+    a.mpe.sphere_spacing_mm = e.GetDouble("SD", a.mpe.sphere_spacing_mm);
+    a.mpe.flatness_mm = e.GetDouble("F", a.mpe.flatness_mm);
+    for (double v : {a.mpe.probing_form_mm, a.mpe.probing_size_mm, a.mpe.sphere_spacing_mm, a.mpe.flatness_mm})
+      if (!(v > 0)) throw InputError(e.Where(), "every MPE must be positive");
+    e.Finish();
+  } else {
+    m.GetString("mpe_mm", "");  // absent: defaults; mark as read
+  }
+  m.Finish();
+  return a;
+}
+
+}  // namespace
+
+Artifact ReadArtifactFile(const std::string& path) { return Parse(YamlMap::LoadFile(path)); }
+Artifact ParseArtifactYaml(const std::string& text, const std::string& where) {
+  return Parse(YamlMap::LoadString(text, where));
+}
+
+std::string ArtifactToYaml(const Artifact& a) {
+  std::ostringstream o;
+  o << "# stereorig reference artifact (VDI/VDE 2634-2). Units: mm.\n"
+    << "format: stereorig-artifact\nversion: 1\nunits: mm\n"
+    << "name: \"" << a.name << "\"\n"
+    << "type: " << ArtifactTypeName(a.type) << "\n";
+  switch (a.type) {
+    case ArtifactType::kSphere:
+      o << "diameter_mm: " << FormatDouble(a.sphere_diameter_mm) << "\n"
+        << "diameter_uncertainty_mm: " << FormatDouble(a.sphere_diameter_uncertainty_mm) << "\n";
+      break;
+    case ArtifactType::kBallBar:
+      o << "sphere_diameter_mm: " << FormatDouble(a.sphere_diameter_mm) << "\n"
+        << "sphere_diameter_uncertainty_mm: " << FormatDouble(a.sphere_diameter_uncertainty_mm) << "\n"
+        << "center_distance_mm: " << FormatDouble(a.center_distance_mm) << "\n"
+        << "center_distance_uncertainty_mm: " << FormatDouble(a.center_distance_uncertainty_mm) << "\n";
+      break;
+    case ArtifactType::kPlate:
+      o << "length_mm: " << FormatDouble(a.plate_length_mm) << "\n"
+        << "width_mm: " << FormatDouble(a.plate_width_mm) << "\n"
+        << "flatness_uncertainty_mm: " << FormatDouble(a.flatness_uncertainty_mm) << "\n";
+      break;
+  }
+  o << "mpe_mm: {P_F: " << FormatDouble(a.mpe.probing_form_mm) << ", P_S: " << FormatDouble(a.mpe.probing_size_mm)
+    << ", SD: " << FormatDouble(a.mpe.sphere_spacing_mm) << ", F: " << FormatDouble(a.mpe.flatness_mm) << "}\n";
+  return o.str();
+}
+
+}  // namespace stereorig

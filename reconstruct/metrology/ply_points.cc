@@ -1,0 +1,150 @@
+#include "reconstruct/metrology/ply_points.h"
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "calib/core/input_error.h"
+
+namespace stereorig {
+
+namespace {
+
+enum class Encoding { kAscii, kLittle, kBig };
+
+struct Property {
+  std::string name;
+  std::string type;        // scalar type, or the item type of a list
+  std::string count_type;  // non-empty for a list
+};
+
+int SizeOf(const std::string& t) {
+  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+  if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32") return 4;
+  if (t == "double" || t == "float64") return 8;
+  return 0;
+}
+
+double ReadBinary(std::istream& in, const std::string& t, bool swap, const std::string& path) {
+  unsigned char b[8];
+  const int n = SizeOf(t);
+  if (!in.read(reinterpret_cast<char*>(b), n)) throw InputError(path, "truncated PLY body");
+  if (swap) std::reverse(b, b + n);
+  auto get = [&](auto v) {
+    std::memcpy(&v, b, sizeof v);
+    return static_cast<double>(v);
+  };
+  if (t == "char" || t == "int8") return get(int8_t{});
+  if (t == "uchar" || t == "uint8") return get(uint8_t{});
+  if (t == "short" || t == "int16") return get(int16_t{});
+  if (t == "ushort" || t == "uint16") return get(uint16_t{});
+  if (t == "int" || t == "int32") return get(int32_t{});
+  if (t == "uint" || t == "uint32") return get(uint32_t{});
+  if (t == "float" || t == "float32") return get(float{});
+  return get(double{});
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> ReadPlyPoints(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "cannot open");
+  std::string line;
+  if (!std::getline(in, line) || line.rfind("ply", 0) != 0) throw InputError(path, "not a PLY file");
+  Encoding enc = Encoding::kAscii;
+  long long num_vertices = -1;
+  bool in_vertex = false, seen_vertex = false;
+  std::vector<Property> props;
+  while (true) {
+    if (!std::getline(in, line)) throw InputError(path, "PLY header has no end_header");
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream s(line);
+    std::string word;
+    s >> word;
+    if (word == "end_header") break;
+    if (word == "format") {
+      std::string f;
+      s >> f;
+      if (f == "ascii") enc = Encoding::kAscii;
+      else if (f == "binary_little_endian") enc = Encoding::kLittle;
+      else if (f == "binary_big_endian") enc = Encoding::kBig;
+      else throw InputError(path, "unknown PLY format '" + f + "'");
+    } else if (word == "element") {
+      std::string name;
+      long long count;
+      s >> name >> count;
+      if (seen_vertex && !in_vertex) {
+        // an element after the vertices: ignored
+      }
+      in_vertex = name == "vertex";
+      if (in_vertex) {
+        if (seen_vertex) throw InputError(path, "two vertex elements");
+        if (!props.empty() || !s) throw InputError(path, "vertex must be the first element");
+        seen_vertex = true;
+        num_vertices = count;
+      }
+    } else if (word == "property" && in_vertex) {
+      Property p;
+      std::string t;
+      s >> t;
+      if (t == "list") {
+        s >> p.count_type >> p.type;
+      } else {
+        p.type = t;
+      }
+      s >> p.name;
+      if (!SizeOf(p.type) || (!p.count_type.empty() && !SizeOf(p.count_type))) {
+        throw InputError(path, "unknown PLY property type in '" + line + "'");
+      }
+      props.push_back(p);
+    }
+  }
+  if (!seen_vertex || num_vertices < 0) throw InputError(path, "PLY has no vertex element");
+  int ix = -1, iy = -1, iz = -1;
+  for (int i = 0; i < static_cast<int>(props.size()); ++i) {
+    if (!props[i].count_type.empty()) continue;
+    if (props[i].name == "x") ix = i;
+    if (props[i].name == "y") iy = i;
+    if (props[i].name == "z") iz = i;
+  }
+  if (ix < 0 || iy < 0 || iz < 0) throw InputError(path, "PLY vertices have no x, y, z");
+  const bool swap = (enc == Encoding::kBig) == (std::endian::native == std::endian::little);
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(static_cast<size_t>(num_vertices));
+  std::vector<double> v(props.size());
+  for (long long k = 0; k < num_vertices; ++k) {
+    if (enc == Encoding::kAscii) {
+      for (size_t i = 0; i < props.size(); ++i) {
+        if (!props[i].count_type.empty()) {
+          double n;
+          if (!(in >> n)) throw InputError(path, "truncated PLY body");
+          for (int j = 0; j < static_cast<int>(n); ++j) {
+            double skip;
+            in >> skip;
+          }
+        } else if (!(in >> v[i])) {
+          throw InputError(path, "truncated or malformed PLY body at vertex " + std::to_string(k));
+        }
+      }
+    } else {
+      for (size_t i = 0; i < props.size(); ++i) {
+        if (!props[i].count_type.empty()) {
+          const int n = static_cast<int>(ReadBinary(in, props[i].count_type, swap, path));
+          for (int j = 0; j < n; ++j) ReadBinary(in, props[i].type, swap, path);
+        } else {
+          v[i] = ReadBinary(in, props[i].type, swap, path);
+        }
+      }
+    }
+    const Eigen::Vector3d p(v[ix], v[iy], v[iz]);
+    if (!p.allFinite()) throw InputError(path, "vertex " + std::to_string(k) + " is not finite");
+    points.push_back(p);
+  }
+  return points;
+}
+
+}  // namespace stereorig

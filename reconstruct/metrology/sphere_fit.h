@@ -1,0 +1,41 @@
+// Robust least-squares sphere fit: RANSAC on 4-point spheres to find the
+// inliers, then Gauss-Newton on the geometric (orthogonal) distance over all
+// inliers, radius free. This is the fit VDI/VDE 2634-2 asks for (probing
+// error P_F, P_S) and the one hole filling uses for a spherical prior.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace stereorig {
+
+struct SphereFitOptions {
+  int ransac_iterations = 500;           // 4-point hypotheses
+  double inlier_threshold_mm = 0.5;      // |distance to sphere| for a RANSAC inlier
+  // If > 0, RANSAC hypotheses whose radius differs from this by more than
+  // radius_tolerance_mm are skipped (a known artifact size narrows the search).
+  double expected_radius_mm = 0;
+  double radius_tolerance_mm = 0;
+  int max_iterations = 50;               // Gauss-Newton
+  unsigned seed = 1;                     // RANSAC sampling; fixed => deterministic
+  void Check() const;                    // throws InputError
+};
+
+struct SphereFit {
+  bool ok = false;
+  std::string message;                   // why not ok
+  Eigen::Vector3d center_mm = Eigen::Vector3d::Zero();
+  double radius_mm = 0;
+  std::vector<int> inliers;              // indices into the input points
+  std::vector<double> residuals_mm;      // signed |p - c| - r, parallel to `inliers`
+  double rms_mm = 0;
+};
+
+// points: (N) in mm.
+SphereFit FitSphereRobust(const std::vector<Eigen::Vector3d>& points, const SphereFitOptions& options);
+// Gauss-Newton only, from `initial`, on exactly these points (no rejection).
+SphereFit RefineSphere(const std::vector<Eigen::Vector3d>& points, const std::vector<int>& indices,
+                       const Eigen::Vector3d& initial_center_mm, double initial_radius_mm, int max_iterations);
+
+}  // namespace stereorig

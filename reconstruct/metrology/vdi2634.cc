@@ -1,0 +1,183 @@
+#include "reconstruct/metrology/vdi2634.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+
+#include "calib/core/input_error.h"
+#include "reconstruct/metrology/plane_fit.h"
+#include "reconstruct/metrology/sphere_fit.h"
+
+namespace stereorig {
+
+void VerifyOptions::Check() const {
+  if (excluded_fraction_max < 0 || excluded_fraction_max > 0.05) {
+    throw InputError("verify options", "excluded_fraction_max must be in [0, 0.05]");
+  }
+  if (min_points < 10) throw InputError("verify options", "min_points must be >= 10");
+}
+
+bool ArtifactEvaluation::pass() const {
+  return std::all_of(figures.begin(), figures.end(), [](const Figure& f) { return f.pass; });
+}
+
+namespace {
+
+Figure MakeFigure(const std::string& name, double value, double mpe) {
+  return {name, value, mpe, std::abs(value) <= mpe};
+}
+
+// Drops the largest-|residual| points, at most `fraction` of them, and
+// returns the kept indices.
+std::vector<int> ExcludeWorst(const std::vector<int>& indices, const std::vector<double>& residuals, double fraction,
+                              int* excluded) {
+  const int n = static_cast<int>(indices.size());
+  *excluded = static_cast<int>(std::floor(fraction * n));
+  std::vector<int> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return std::abs(residuals[a]) < std::abs(residuals[b]); });
+  std::vector<int> kept;
+  for (int k = 0; k < n - *excluded; ++k) kept.push_back(indices[order[k]]);
+  std::sort(kept.begin(), kept.end());
+  return kept;
+}
+
+void ResidualStats(const std::vector<double>& r, ArtifactEvaluation* e) {
+  double sa = 0, s = 0, ss = 0;
+  for (double x : r) {
+    sa += std::abs(x);
+    s += x;
+    ss += x * x;
+  }
+  const double n = static_cast<double>(r.size());
+  e->residual_mean_abs_mm = sa / n;
+  e->residual_std_mm = std::sqrt(std::max(0.0, ss / n - (s / n) * (s / n)));
+}
+
+double Range(const std::vector<double>& r) {
+  const auto [lo, hi] = std::minmax_element(r.begin(), r.end());
+  return *hi - *lo;
+}
+
+// One sphere of known nominal radius: segment, fit, exclude, refit.
+SphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, double nominal_radius, double band,
+                            const VerifyOptions& o, int* excluded) {
+  SphereFitOptions so;
+  so.inlier_threshold_mm = band;
+  so.expected_radius_mm = nominal_radius;
+  so.radius_tolerance_mm = std::max(band, 0.1 * nominal_radius);
+  so.ransac_iterations = 1000;
+  so.seed = o.seed;
+  SphereFit fit = FitSphereRobust(pts, so);
+  if (!fit.ok) return fit;
+  const std::vector<int> kept = ExcludeWorst(fit.inliers, fit.residuals_mm, o.excluded_fraction_max, excluded);
+  return RefineSphere(pts, kept, fit.center_mm, fit.radius_mm, 50);
+}
+
+}  // namespace
+
+ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::Vector3d>& pts, const VerifyOptions& o,
+                                    const std::string& where) {
+  o.Check();
+  ArtifactEvaluation e;
+  e.type = a.type;
+  e.points_total = static_cast<int>(pts.size());
+  if (e.points_total < o.min_points) {
+    throw InputError(where, "only " + std::to_string(e.points_total) + " points; at least " +
+                                std::to_string(o.min_points) + " are needed on the artifact");
+  }
+  auto require_points = [&](int n, const char* what) {
+    if (n < o.min_points) {
+      throw InputError(where, std::string("only ") + std::to_string(n) + " points lie on the " + what +
+                                  "; at least " + std::to_string(o.min_points) + " are needed");
+    }
+  };
+  switch (a.type) {
+    case ArtifactType::kSphere: {
+      const double band = o.segmentation_band_mm > 0 ? o.segmentation_band_mm : a.mpe.probing_form_mm;
+      int excluded = 0;
+      const SphereFit fit = FitArtifactSphere(pts, 0.5 * a.sphere_diameter_mm, band, o, &excluded);
+      if (!fit.ok) throw InputError(where, "no sphere of the certified size found in the cloud: " + fit.message);
+      require_points(static_cast<int>(fit.inliers.size()) + excluded, "sphere");
+      e.points_on_artifact = static_cast<int>(fit.inliers.size()) + excluded;
+      e.points_excluded = excluded;
+      e.sphere_centers_mm = {fit.center_mm};
+      e.sphere_diameters_mm = {2 * fit.radius_mm};
+      e.figures = {MakeFigure("P_F", Range(fit.residuals_mm), a.mpe.probing_form_mm),
+                   MakeFigure("P_S", 2 * fit.radius_mm - a.sphere_diameter_mm, a.mpe.probing_size_mm)};
+      ResidualStats(fit.residuals_mm, &e);
+      break;
+    }
+    case ArtifactType::kBallBar: {
+      const double band = o.segmentation_band_mm > 0 ? o.segmentation_band_mm : a.mpe.sphere_spacing_mm;
+      const double r = 0.5 * a.sphere_diameter_mm;
+      std::vector<double> all_residuals;
+      std::vector<Eigen::Vector3d> remaining = pts;
+      int excluded_total = 0, on_artifact = 0;
+      for (int ball = 0; ball < 2; ++ball) {
+        int excluded = 0;
+        const SphereFit fit = FitArtifactSphere(remaining, r, band, o, &excluded);
+        if (!fit.ok) {
+          throw InputError(where, "ball " + std::to_string(ball + 1) + " of the ball bar not found: " + fit.message);
+        }
+        require_points(static_cast<int>(fit.inliers.size()) + excluded, "ball bar's spheres");
+        excluded_total += excluded;
+        on_artifact += static_cast<int>(fit.inliers.size()) + excluded;
+        e.sphere_centers_mm.push_back(fit.center_mm);
+        e.sphere_diameters_mm.push_back(2 * fit.radius_mm);
+        all_residuals.insert(all_residuals.end(), fit.residuals_mm.begin(), fit.residuals_mm.end());
+        // Remove everything near this ball before looking for the other one.
+        std::vector<Eigen::Vector3d> rest;
+        for (const auto& p : remaining)
+          if ((p - fit.center_mm).norm() > fit.radius_mm + band) rest.push_back(p);
+        remaining.swap(rest);
+      }
+      e.points_on_artifact = on_artifact;
+      e.points_excluded = excluded_total;
+      const double distance = (e.sphere_centers_mm[0] - e.sphere_centers_mm[1]).norm();
+      e.figures = {MakeFigure("SD", distance - a.center_distance_mm, a.mpe.sphere_spacing_mm)};
+      ResidualStats(all_residuals, &e);
+      break;
+    }
+    case ArtifactType::kPlate: {
+      const double band = o.segmentation_band_mm > 0 ? o.segmentation_band_mm : a.mpe.flatness_mm;
+      PlaneFitOptions po;
+      po.inlier_threshold_mm = band;
+      po.seed = o.seed;
+      PlaneFit fit = FitPlaneRobust(pts, po);
+      if (!fit.ok) throw InputError(where, "no plane found in the cloud: " + fit.message);
+      require_points(static_cast<int>(fit.inliers.size()), "plate");
+      int excluded = 0;
+      const std::vector<int> kept = ExcludeWorst(fit.inliers, fit.residuals_mm, o.excluded_fraction_max, &excluded);
+      fit = FitPlaneLeastSquares(pts, kept);
+      e.points_on_artifact = static_cast<int>(kept.size()) + excluded;
+      e.points_excluded = excluded;
+      e.plane_normal = fit.normal;
+      e.plane_offset_mm = fit.offset_mm;
+      e.figures = {MakeFigure("F", Range(fit.residuals_mm), a.mpe.flatness_mm)};
+      ResidualStats(fit.residuals_mm, &e);
+      break;
+    }
+  }
+  return e;
+}
+
+VerifySummary Summarise(const std::vector<ArtifactEvaluation>& positions) {
+  VerifySummary s;
+  std::map<std::string, Figure> worst;
+  for (const auto& p : positions) {
+    for (const Figure& f : p.figures) {
+      auto it = worst.find(f.name);
+      if (it == worst.end() || std::abs(f.value_mm) > std::abs(it->second.value_mm)) worst[f.name] = f;
+    }
+  }
+  s.pass = !positions.empty();
+  for (const auto& [name, f] : worst) {
+    s.worst.push_back(f);
+    s.pass = s.pass && f.pass;
+  }
+  return s;
+}
+
+}  // namespace stereorig
