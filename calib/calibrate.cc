@@ -17,7 +17,7 @@ void TargetGeometry::Check(const std::string& where) const {
   if (corners_x < 2 || corners_y < 2) throw InputError(where, "the board needs at least 2x2 inner corners");
   if (!(square_size_mm > 0)) throw InputError(where, "square size must be > 0 mm");
   for (int i = 0; i < 6; ++i)
-    if (!(back_from_front_sigma(i) > 0)) throw InputError(where, "back_from_front sigma must be > 0");
+    if (!(back_from_front_sigma(i) >= 0)) throw InputError(where, "back_from_front sigma must be >= 0");
 }
 
 TargetGeometry TargetGeometryFromTarget(const Target& t) {

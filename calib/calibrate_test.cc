@@ -193,6 +193,25 @@ void CheckRig(const SimulatedRig& rig, unsigned seed) {
     }
 }
 
+// The targets library's default board (11x9 corners of 9 mm) through the
+// adapter, on the default rig: the same figures hold.
+TEST(CalibrateE2E, DefaultTargetOfTheTargetsLibrary) {
+  const SimulatedRig rig = MakeDefaultRig();
+  const Pose volume = testing::DefaultVolume(rig.world_from_module0);
+  const TargetGeometry target = TargetGeometryFromTarget(DefaultTarget());
+  SyntheticOptions o;
+  o.seed = 8;
+  o.num_captures = kCaptures;
+  o.noise_px = kNoisePx;
+  const SyntheticData data = MakeSyntheticCaptures(rig.rig, target, target.back_from_front, volume, o);
+  const CalibrationResult r = Calibrate(data.input, CalibrationOptions());
+  for (const IntrinsicsReport& ir : r.report.intrinsics) EXPECT_NEAR(ir.rms_px, kNoisePx, 0.1 * kNoisePx);
+  const auto points = VolumePoints(volume, Eigen::Vector3d(75, 75, 50), 500, 8);
+  const double a = testing::ModuleAgreementRms(rig.rig, r.rig, r.rig.S(0, 1), 0, 1, points);
+  std::printf("default target: agreement %.4f mm\n", a);
+  EXPECT_LT(a, 0.05);
+}
+
 TEST(CalibrateE2E, OneModuleRig) { CheckRig(testing::MakeOneModuleRig(), 7); }
 TEST(CalibrateE2E, ThreeModuleRig) { CheckRig(testing::MakeThreeModuleRig(), 7); }
 

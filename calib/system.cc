@@ -218,7 +218,8 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   for (PoseBlock* p : {&identity_module, &identity_bff, &identity_rl}) {
     if (problem.HasParameterBlock(p->params)) problem.SetParameterBlockConstant(p->params);
   }
-  const bool bff_free = any_back && options.refine_back_from_front && target.double_sided;
+  const bool bff_free = any_back && options.refine_back_from_front && target.double_sided &&
+                        (target.back_from_front_sigma.array() > 0).all();
   if (any_back && bff_free) {
     problem.AddResidualBlock(BackFromFrontPrior::Create(target.back_from_front.translation_mm(),
                                                         target.back_from_front_sigma, corner_sigma_px),
