@@ -7,6 +7,7 @@ namespace stereorig {
 
 int RunDemo(int argc, char** argv);
 int RunRig(int argc, char** argv);
+int RunMatch(int argc, char** argv);
 int RunVerify(int argc, char** argv);
 
 namespace {
@@ -22,9 +23,6 @@ int RunCalibrate(int argc, char** argv) {
 }
 int RunReconstruct(int argc, char** argv) {
   return NotBuiltYet("reconstruct", "Rig file + capture -> point cloud, mesh, report.", argc, argv);
-}
-int RunMatch(int argc, char** argv) {
-  return NotBuiltYet("match", "The correspondence stage alone, on a rectified pair -> disparity (PFM).", argc, argv);
 }
 int RunCheck(int argc, char** argv) {
   return NotBuiltYet("check", "Nightly check: fresh target captures + rig file -> drift verdict, history.", argc,

@@ -1,0 +1,49 @@
+// Census transform and semi-global matching (SGM) on a rectified 8-bit pair,
+// our own implementation, written so the compiler vectorises the hot loops:
+// costs are uint8 Hamming distances of 62-bit census signatures (9x7 window),
+// path costs are uint16, one contiguous run of disparities per pixel.
+//
+// Disparity convention everywhere in reconstruct/: a left pixel x matches the
+// right pixel x - d (rectified rows are aligned, so d >= 0 for points in
+// front of a parallel rig).
+#pragma once
+
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <vector>
+
+namespace stereorig {
+
+// 62-bit census signatures of a grey image: bit k says whether neighbour k of
+// the 9x7 window is darker than the centre. Borders replicate the edge pixel.
+struct CensusImage {
+  int width = 0;
+  int height = 0;
+  std::vector<uint64_t> bits;  // (height, width), row-major
+  const uint64_t* row(int y) const { return bits.data() + size_t(y) * width; }
+};
+
+// Computes signatures for rows [row_begin, row_end) only (others stay 0), on
+// `num_threads` threads. `grey` is CV_8UC1.
+CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int num_threads);
+
+inline constexpr int kCensusMaxCost = 62;  // bits in a signature
+
+struct SgmOptions {
+  int p1 = 8;                 // penalty for a 1 px disparity step, census bits; default 8
+  int p2 = 80;                // penalty for a larger step, census bits (> p1); default 80
+  int num_paths = 4;          // 3 (left, right, top: one pass, no volume kept) or 4 (+bottom); default 4
+  int uniqueness_percent = 5; // best cost must beat every cost off the best+-1 by this %; default 5
+  int lr_max_diff_px = 1;     // left-right consistency tolerance, whole px; default 1
+  void Check() const;         // throws InputError naming the bad field
+};
+
+// SGM over `region` (left image px) for integer disparities
+// [min_disparity, min_disparity + num_disparities). Returns a CV_32FC1 image
+// of region.size(): the disparity refined by an equiangular (symmetric V) fit
+// of the aggregated cost, or NaN where the left-right check or the
+// uniqueness test failed, or the best cost sits at the edge of the range.
+cv::Mat SgmMatch(const CensusImage& left, const CensusImage& right, const cv::Rect& region,
+                 int min_disparity, int num_disparities, const SgmOptions& options);
+
+}  // namespace stereorig

@@ -1,0 +1,229 @@
+#include "reconstruct/matcher.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "calib/core/input_error.h"
+#include "reconstruct/parallel_for.h"
+
+namespace stereorig {
+
+MatcherKind ParseMatcherKind(const std::string& name, const std::string& where) {
+  if (name == "census_sgm") return MatcherKind::kCensusSgm;
+  if (name == "opencv_sgbm_3way") return MatcherKind::kOpenCvSgbm3Way;
+  throw InputError(where, "unknown matcher '" + name + "' (census_sgm or opencv_sgbm_3way)");
+}
+
+const char* MatcherKindName(MatcherKind kind) {
+  return kind == MatcherKind::kCensusSgm ? "census_sgm" : "opencv_sgbm_3way";
+}
+
+void MatchOptions::Check() const {
+  if (num_disparities < 2 || num_disparities > 1024) throw InputError("num_disparities", "must be in [2, 1024]");
+  if (min_disparity_px < -1024 || min_disparity_px > 2048) throw InputError("min_disparity", "must be in [-1024, 2048]");
+  if (roi.width < 0 || roi.height < 0) throw InputError("roi", "must have a non-negative size");
+  if (pyramid_levels < 0 || pyramid_levels > 3) throw InputError("pyramid_levels", "must be in [0, 3]");
+  if (refine_radius_px < 1 || refine_radius_px > 8) throw InputError("refine_radius_px", "must be in [1, 8]");
+  if (refine_half_window_px < 0 || refine_half_window_px > 5)
+    throw InputError("refine_half_window_px", "must be in [0, 5]");
+  sgm.Check();
+  subpixel.Check();
+  if (!(min_zncc >= -1 && min_zncc < 1)) throw InputError("min_zncc", "must be in [-1, 1)");
+  if (!(min_texture_dn >= 0)) throw InputError("min_texture_dn", "must be >= 0");
+  if (speckle_window_px < 0) throw InputError("speckle_window_px", "must be >= 0 (0 = off)");
+  if (!(speckle_range_px > 0)) throw InputError("speckle_range_px", "must be > 0");
+  if (sgbm_block_size < 1 || sgbm_block_size % 2 == 0 || sgbm_block_size > 11)
+    throw InputError("sgbm_block_size", "must be odd, in [1, 11]");
+  if (num_threads < 1 || num_threads > 64) throw InputError("num_threads", "must be in [1, 64]");
+}
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+cv::Rect ClampRoi(const cv::Rect& roi, const cv::Size& size) {
+  if (roi.width == 0 || roi.height == 0) return cv::Rect(0, 0, size.width, size.height);
+  return roi & cv::Rect(0, 0, size.width, size.height);
+}
+
+// Disparities of `region` at one pyramid level: CV_32FC1 of region.size(),
+// NaN = invalid. Recurses to the coarser level first when levels_left > 0.
+cv::Mat MatchLevel(const cv::Mat& left, const cv::Mat& right, const cv::Rect& region, int dmin, int num,
+                   int levels_left, const MatchOptions& o) {
+  // Rows beyond the region too: the fine level's cost box reaches past it.
+  const int margin = o.refine_half_window_px;
+  const CensusImage cl = CensusTransform(left, region.y - margin, region.y + region.height + margin, o.num_threads);
+  const CensusImage cr = CensusTransform(right, region.y - margin, region.y + region.height + margin, o.num_threads);
+  if (levels_left == 0) return SgmMatch(cl, cr, region, dmin, num, o.sgm);
+
+  cv::Mat left_half, right_half;
+  cv::resize(left, left_half, cv::Size(left.cols / 2, left.rows / 2), 0, 0, cv::INTER_AREA);
+  cv::resize(right, right_half, cv::Size(right.cols / 2, right.rows / 2), 0, 0, cv::INTER_AREA);
+  const int x0 = region.x / 2, y0 = region.y / 2;
+  const int x1 = std::min(left_half.cols, (region.x + region.width + 1) / 2);
+  const int y1 = std::min(left_half.rows, (region.y + region.height + 1) / 2);
+  const cv::Rect half_region(x0, y0, std::max(1, x1 - x0), std::max(1, y1 - y0));
+  // Coarse range covers the fine one; +1 so a fine disparity at the range's
+  // top is not at the coarse edge (where SGM rejects it).
+  const int half_min = int(std::floor(dmin / 2.0)) - 1;
+  const int half_num = (num + 1) / 2 + 3;
+  const cv::Mat coarse = MatchLevel(left_half, right_half, half_region, half_min, half_num, levels_left - 1, o);
+
+  cv::Mat fine(region.size(), CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  const int r = o.refine_radius_px, bw = o.refine_half_window_px;
+  const int ncand = 2 * r + 1;
+  ParallelForChunks(region.height, o.num_threads, [&](int b, int e) {
+    std::vector<int> costs(ncand);
+    for (int yy = b; yy < e; ++yy) {
+      const int y = region.y + yy;
+      const int cy = std::min(y / 2 - y0, coarse.rows - 1);
+      if (cy < 0) continue;
+      float* out = fine.ptr<float>(yy);
+      for (int xx = 0; xx < region.width; ++xx) {
+        const int x = region.x + xx;
+        const int cx = std::min(x / 2 - x0, coarse.cols - 1);
+        if (cx < 0) continue;
+        const float dc = coarse.at<float>(cy, cx);
+        if (std::isnan(dc)) continue;
+        const int centre = int(std::lround(2.0 * dc));
+        if (y - bw < 0 || y + bw >= left.rows || x - bw < 0 || x + bw >= left.cols) continue;
+        for (int k = 0; k < ncand; ++k) {
+          const int d = centre - r + k;
+          int c = 0;
+          for (int v = -bw; v <= bw; ++v) {
+            const uint64_t* lrow = cl.row(y + v);
+            const uint64_t* rrow = cr.row(y + v);
+            for (int u = -bw; u <= bw; ++u) {
+              const int xr = x + u - d;
+              c += (xr >= 0 && xr < cr.width) ? __builtin_popcountll(lrow[x + u] ^ rrow[xr]) : kCensusMaxCost;
+            }
+          }
+          costs[k] = c;
+        }
+        const int best = int(std::min_element(costs.begin(), costs.end()) - costs.begin());
+        if (best == 0 || best == ncand - 1) continue;  // the coarse level was off by more than r
+        const double c0 = costs[best - 1], c1 = costs[best], c2 = costs[best + 1];
+        const double slope = std::max(c0, c2) - c1;
+        const double delta = slope > 0 ? 0.5 * (c0 - c2) / slope : 0.0;
+        const double d = centre - r + best + delta;
+        if (d < dmin || d > dmin + num - 1) continue;
+        out[xx] = float(d);
+      }
+    }
+  });
+  return fine;
+}
+
+// Removes connected blobs of similar disparity smaller than the window, on a
+// 1/16 px fixed-point copy (OpenCV's filterSpeckles does the labelling).
+void RemoveSpeckles(cv::Mat& disparity_px, const MatchOptions& o) {
+  if (o.speckle_window_px <= 0) return;
+  constexpr int16_t kInvalid = std::numeric_limits<int16_t>::min();
+  cv::Mat fixed(disparity_px.size(), CV_16SC1);
+  for (int y = 0; y < disparity_px.rows; ++y) {
+    const float* d = disparity_px.ptr<float>(y);
+    int16_t* f = fixed.ptr<int16_t>(y);
+    for (int x = 0; x < disparity_px.cols; ++x)
+      f[x] = std::isfinite(d[x]) ? int16_t(std::clamp(std::lround(d[x] * 16.0), -32000L, 32000L)) : kInvalid;
+  }
+  cv::filterSpeckles(fixed, kInvalid, o.speckle_window_px, int(std::lround(o.speckle_range_px * 16)));
+  for (int y = 0; y < disparity_px.rows; ++y) {
+    float* d = disparity_px.ptr<float>(y);
+    const int16_t* f = fixed.ptr<int16_t>(y);
+    for (int x = 0; x < disparity_px.cols; ++x)
+      if (f[x] == kInvalid) d[x] = kInf;
+  }
+}
+
+MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const MatchOptions& o) {
+  const cv::Mat coarse_to_fine =
+      MatchLevel(left, right, roi, o.min_disparity_px, o.num_disparities, o.pyramid_levels, o);
+  MatchResult result;
+  result.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
+  result.confidence = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
+  const double dmax = o.min_disparity_px + o.num_disparities - 1;
+  ParallelForChunks(roi.height, o.num_threads, [&](int b, int e) {
+    for (int yy = b; yy < e; ++yy) {
+      const int y = roi.y + yy;
+      const float* in = coarse_to_fine.ptr<float>(yy);
+      float* out = result.disparity_px.ptr<float>(y);
+      float* conf = result.confidence.ptr<float>(y);
+      for (int xx = 0; xx < roi.width; ++xx) {
+        if (std::isnan(in[xx])) continue;
+        const int x = roi.x + xx;
+        double d = in[xx];
+        float confidence = 1.0f;
+        if (o.intensity_refinement) {
+          const SubpixelResult s = RefineDisparity(left, right, x, y, d, o.subpixel);
+          if (!s.ok || s.zncc < o.min_zncc || s.std_dn < o.min_texture_dn) continue;
+          d = s.disparity_px;
+          confidence = float(std::clamp(s.zncc, 0.0, 1.0));
+        }
+        if (d < o.min_disparity_px || d > dmax) continue;  // range filter
+        out[x] = float(d);
+        conf[x] = confidence;
+      }
+    }
+  });
+  RemoveSpeckles(result.disparity_px, o);
+  for (int y = 0; y < left.rows; ++y) {
+    const float* d = result.disparity_px.ptr<float>(y);
+    float* c = result.confidence.ptr<float>(y);
+    for (int x = 0; x < left.cols; ++x)
+      if (!std::isfinite(d[x])) c[x] = 0;
+  }
+  return result;
+}
+
+MatchResult MatchOpenCvSgbm(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const MatchOptions& o) {
+  // SGBM needs the right image at the same column indices, so both images
+  // are cut to the ROI widened on the left by the largest disparity; those
+  // extra columns are the margin SGBM leaves invalid anyway.
+  const int num16 = (o.num_disparities + 15) / 16 * 16;
+  const int dmax = o.min_disparity_px + num16;
+  const int x0 = std::max(0, roi.x - std::max(0, dmax));
+  const int x1 = std::min(left.cols, roi.x + roi.width + std::max(0, -o.min_disparity_px));
+  const cv::Rect cut(x0, roi.y, x1 - x0, roi.height);
+  const int bs = o.sgbm_block_size;
+  cv::Ptr<cv::StereoSGBM> sgbm =
+      cv::StereoSGBM::create(o.min_disparity_px, num16, bs, 8 * bs * bs, 32 * bs * bs, o.sgm.lr_max_diff_px, 63, 10,
+                             o.speckle_window_px, std::max(1, int(std::lround(o.speckle_range_px))),
+                             cv::StereoSGBM::MODE_SGBM_3WAY);
+  cv::Mat fixed;
+  sgbm->compute(left(cut), right(cut), fixed);
+  MatchResult result;
+  result.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
+  result.confidence = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
+  const double dmax_valid = o.min_disparity_px + o.num_disparities - 1;
+  for (int y = 0; y < cut.height; ++y) {
+    const int16_t* f = fixed.ptr<int16_t>(y);
+    float* d = result.disparity_px.ptr<float>(roi.y + y);
+    float* c = result.confidence.ptr<float>(roi.y + y);
+    for (int x = std::max(roi.x, x0); x < roi.x + roi.width; ++x) {
+      const int16_t v = f[x - x0];
+      if (v < o.min_disparity_px * 16) continue;  // SGBM's invalid marker
+      const double disp = v / 16.0;
+      if (disp > dmax_valid) continue;
+      d[x] = float(disp);
+      c[x] = 1.0f;
+    }
+  }
+  return result;
+}
+
+}  // namespace
+
+MatchResult Match(const cv::Mat& left, const cv::Mat& right, const MatchOptions& options) {
+  options.Check();
+  if (left.type() != CV_8UC1 || right.type() != CV_8UC1) throw InputError("match", "images must be 8-bit grey");
+  if (left.size() != right.size()) throw InputError("match", "left and right images differ in size");
+  const cv::Rect roi = ClampRoi(options.roi, left.size());
+  if (roi.width <= 0 || roi.height <= 0) throw InputError("roi", "does not overlap the image");
+  if (options.matcher == MatcherKind::kOpenCvSgbm3Way) return MatchOpenCvSgbm(left, right, roi, options);
+  return MatchCensusSgm(left, right, roi, options);
+}
+
+}  // namespace stereorig

@@ -1,0 +1,65 @@
+// Dense correspondence on a rectified 8-bit pair: the `match` stage of the
+// runtime, filtering and sub-pixel refinement included.
+//
+// Our matcher (MatcherKind::kCensusSgm) is coarse-to-fine:
+//   1. at the coarsest pyramid level (images halved `pyramid_levels` times),
+//      census + 4-path SGM over the whole disparity range, with the
+//      left-right check and the uniqueness test;
+//   2. at each finer level, only +-refine_radius_px around twice the coarser
+//      disparity is searched, with box-aggregated census costs. The laser grid
+//      period (~8 px) is far wider than that window, so the coarse level
+//      decides which line is which and the fine level cannot jump a period;
+//   3. sub-pixel: an equiangular fit of the cost, then a gain/offset
+//      Lucas-Kanade fit on the intensities (subpixel_refine.h), which removes
+//      the cost fit's peak-locking bias;
+//   4. filters: ZNCC and texture thresholds, speckle removal (connected
+//      components of similar disparity smaller than speckle_window_px), range.
+// MatcherKind::kOpenCvSgbm3Way runs OpenCV's StereoSGBM (MODE_SGBM_3WAY) on
+// the same region and range: the baseline every figure is compared against.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "reconstruct/census_sgm.h"
+#include "reconstruct/subpixel_refine.h"
+
+namespace stereorig {
+
+enum class MatcherKind { kCensusSgm, kOpenCvSgbm3Way };
+MatcherKind ParseMatcherKind(const std::string& name, const std::string& where);  // "census_sgm" | "opencv_sgbm_3way"
+const char* MatcherKindName(MatcherKind kind);
+
+struct MatchOptions {
+  MatcherKind matcher = MatcherKind::kCensusSgm;  // default census_sgm
+  int min_disparity_px = 0;     // smallest disparity searched, px; default 0
+  int num_disparities = 64;     // disparities searched: [min, min + num), px; default 64
+  cv::Rect roi;                 // left-image region to match; empty = whole image; default empty
+  int pyramid_levels = 1;       // census_sgm: halvings before the full-range SGM; default 1
+  int refine_radius_px = 2;     // census_sgm: fine-level search +-radius around 2x coarse; default 2
+  int refine_half_window_px = 1;  // census_sgm: fine-level cost box half size; default 1 (3x3)
+  SgmOptions sgm;               // census_sgm: penalties, paths, uniqueness, left-right check
+  bool intensity_refinement = true;  // census_sgm: Lucas-Kanade sub-pixel step; default true
+  SubpixelOptions subpixel;     // its window and limits
+  double min_zncc = 0.5;        // reject matches whose refined window correlates less; default 0.5
+  double min_texture_dn = 1.5;  // reject windows with a grey-level std below this; default 1.5 DN
+  int speckle_window_px = 100;  // remove disparity blobs smaller than this, px (0 = off); default 100
+  double speckle_range_px = 1.0;  // neighbours within this disparity are one blob, px; default 1
+  int sgbm_block_size = 5;      // opencv_sgbm_3way: block size, px (odd); default 5
+  int num_threads = 2;          // threads for row-parallel steps; default 2
+  void Check() const;           // throws InputError naming the bad field
+};
+
+struct MatchResult {
+  // CV_32FC1, the left image's size: disparity in px (x_right = x_left - d),
+  // +inf where no valid match (outside the ROI included).
+  cv::Mat disparity_px;
+  // CV_32FC1, same size: confidence in [0, 1] (ZNCC of the refined window
+  // for census_sgm, 1 for any valid SGBM pixel), 0 where invalid.
+  cv::Mat confidence;
+};
+
+// left, right: CV_8UC1, same size, rectified. Stateless and thread-safe.
+MatchResult Match(const cv::Mat& left, const cv::Mat& right, const MatchOptions& options);
+
+}  // namespace stereorig
