@@ -63,7 +63,8 @@ double RigidAlignedRms(const std::vector<Eigen::Vector3d>& a, const std::vector<
   }
   const Eigen::Matrix4d T = Eigen::umeyama(B, A, false);  // maps b onto a
   double s2 = 0;
-  for (size_t i = 0; i < a.size(); ++i) s2 += (a[i] - (T.topLeftCorner<3, 3>() * b[i] + T.topRightCorner<3, 1>())).squaredNorm();
+  for (size_t i = 0; i < a.size(); ++i)
+    s2 += (a[i] - (T.topLeftCorner<3, 3>() * b[i] + T.topRightCorner<3, 1>())).squaredNorm();
   return std::sqrt(s2 / a.size());
 }
 

@@ -49,8 +49,9 @@ void ValidateInput(const CalibrationInput& in) {
     const std::string w = src + ": layout module " + std::to_string(k) + " (" + m.name + ")";
     for (int c : {m.left_camera, m.right_camera}) {
       if (c < 0 || c >= nc) throw InputError(w, "names camera " + std::to_string(c) + ", which does not exist");
-      if (module_of[c] >= 0) throw InputError(w, "camera " + std::to_string(c) + " already belongs to module " +
-                                                     std::to_string(module_of[c]));
+      if (module_of[c] >= 0)
+        throw InputError(w,
+                         "camera " + std::to_string(c) + " already belongs to module " + std::to_string(module_of[c]));
       module_of[c] = static_cast<int>(k);
     }
   }
@@ -81,8 +82,8 @@ void ValidateInput(const CalibrationInput& in) {
       const Eigen::Vector2d& q = o.q_px[i];
       if (!q.allFinite() || q.x() < -0.5 || q.y() < -0.5 || q.x() > cs.width_px - 0.5 || q.y() > cs.height_px - 0.5) {
         char b[200];
-        std::snprintf(b, sizeof b, "corner at (%.1f, %.1f) px lies outside the %dx%d imager (wrong image size?)",
-                      q.x(), q.y(), cs.width_px, cs.height_px);
+        std::snprintf(b, sizeof b, "corner at (%.1f, %.1f) px lies outside the %dx%d imager (wrong image size?)", q.x(),
+                      q.y(), cs.width_px, cs.height_px);
         throw InputError(w, b);
       }
     }
@@ -183,8 +184,8 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
   for (int k = 0; k < M; ++k) {
     cameras[modules[k].left_camera] = modules[k].left;
     cameras[modules[k].right_camera] = modules[k].right;
-    rig_modules.push_back({in.modules[k].name, modules[k].left_camera, modules[k].right_camera,
-                           modules[k].right_from_left});
+    rig_modules.push_back(
+        {in.modules[k].name, modules[k].left_camera, modules[k].right_camera, modules[k].right_from_left});
   }
   for (int c = 0; c < nc; ++c) names[c] = in.cameras[c].name;
   result.rig = Rig(std::move(cameras), std::move(names), std::move(rig_modules), module0_from_module);
@@ -196,7 +197,8 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
   for (const IntrinsicsReport& r : rep.intrinsics) {
     pv.residuals["cam" + std::to_string(r.camera) + "_rms_px"] = r.rms_px;
     for (const PixelUncertainty& u : r.uncertainty)
-      if (u.where == "centre") pv.uncertainties["cam" + std::to_string(r.camera) + "_projection_center_px"] = u.rms_stdev_px;
+      if (u.where == "centre")
+        pv.uncertainties["cam" + std::to_string(r.camera) + "_projection_center_px"] = u.rms_stdev_px;
   }
   for (const StereoReport& s : rep.stereo) {
     pv.residuals["module" + std::to_string(s.module) + "_stereo_rms_px"] = s.rms_px;
@@ -259,12 +261,12 @@ std::string CalibrationReport::ToJson() const {
     j.BeginObject().Int("module", s.module).String("name", s.module_name);
     j.Int("shared_views", s.num_shared_views).Int("frames", s.num_frames).Number("rms_px", s.rms_px);
     j.Int("outliers", s.num_outliers).Number("baseline_mm", s.baseline_mm).Number("rotation_deg", s.rotation_deg);
-    j.Numbers("right_from_left_rotation_vector_deg", {s.right_from_left_rotation_vector_deg.x(),
-                                                       s.right_from_left_rotation_vector_deg.y(),
-                                                       s.right_from_left_rotation_vector_deg.z()});
-    j.Numbers("right_from_left_translation_mm", {s.right_from_left_translation_mm.x(),
-                                                  s.right_from_left_translation_mm.y(),
-                                                  s.right_from_left_translation_mm.z()});
+    j.Numbers("right_from_left_rotation_vector_deg",
+              {s.right_from_left_rotation_vector_deg.x(), s.right_from_left_rotation_vector_deg.y(),
+               s.right_from_left_rotation_vector_deg.z()});
+    j.Numbers("right_from_left_translation_mm",
+              {s.right_from_left_translation_mm.x(), s.right_from_left_translation_mm.y(),
+               s.right_from_left_translation_mm.z()});
     j.Number("rectified_row_rms_px", s.rectified_row_rms_px).Number("rectified_row_max_px", s.rectified_row_max_px);
     j.Int("corner_pairs", s.num_corner_pairs);
     j.BeginArray("cameras_joint_solve");
@@ -282,14 +284,18 @@ std::string CalibrationReport::ToJson() const {
       j.BeginObject().Int("parent", a).Int("child", b).Number("horn_rms_mm", s.horn_rms_mm.at({a, b})).EndObject();
     }
     j.EndArray();
-    j.BeginObject("horn_only").Number("reprojection_rms_px", s.horn_reprojection_rms_px).BeginArray("module0_from_module");
+    j.BeginObject("horn_only")
+        .Number("reprojection_rms_px", s.horn_reprojection_rms_px)
+        .BeginArray("module0_from_module");
     for (const Pose& p : s.module0_from_module_horn) {
       j.BeginObject();
       WritePose(j, "pose", p);
       j.EndObject();
     }
     j.EndArray().EndObject();
-    j.BeginObject("refined").Number("reprojection_rms_px", s.refined_reprojection_rms_px).BeginArray("module0_from_module");
+    j.BeginObject("refined")
+        .Number("reprojection_rms_px", s.refined_reprojection_rms_px)
+        .BeginArray("module0_from_module");
     for (const Pose& p : s.module0_from_module) {
       j.BeginObject();
       WritePose(j, "pose", p);

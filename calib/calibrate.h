@@ -25,7 +25,7 @@ struct CalibrationOptions {
   IntrinsicsOptions intrinsics;
   StereoOptions stereo;
   SystemOptions system;
-  bool progress = false;   // one line per step on stderr; default false
+  bool progress = false;  // one line per step on stderr; default false
   void Check() const;
 };
 

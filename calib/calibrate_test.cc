@@ -27,9 +27,9 @@ std::string Fmt(const Eigen::Vector3d& v) {
 }
 
 struct SeedFigures {
-  double max_stage1_rms_dev = 0;   // max |rms - noise| / noise over cameras
-  std::vector<double> e2_centre, s2_centre;   // per camera: |e|^2 and predicted sigma^2 at the centre
-  std::vector<double> module_3d_rms;          // per module, mm
+  double max_stage1_rms_dev = 0;                     // max |rms - noise| / noise over cameras
+  std::vector<double> e2_centre, s2_centre;          // per camera: |e|^2 and predicted sigma^2 at the centre
+  std::vector<double> module_3d_rms;                 // per module, mm
   double agreement_refined = 0, agreement_horn = 0;  // mm
   Eigen::Matrix<double, 6, 1> s_z = Eigen::Matrix<double, 6, 1>::Zero();  // S[0][1] error / sigma
   double seconds = 0;
@@ -81,10 +81,14 @@ SeedFigures RunSeed(unsigned seed, CalibrationResult* out = nullptr) {
   if (!r.report.system.sigma.empty()) {
     const STransformSigma& s = r.report.system.sigma[0];
     // Rotation error in the reference frame (left perturbation), as sigma is.
-    const Eigen::Vector3d dr = Pose(r.rig.S(0, 1).rotation() * truth.S(0, 1).rotation().transpose(),
-                                    Eigen::Vector3d::Zero()).RotationVector() * 180.0 / M_PI;
+    const Eigen::Vector3d dr =
+        Pose(r.rig.S(0, 1).rotation() * truth.S(0, 1).rotation().transpose(), Eigen::Vector3d::Zero())
+            .RotationVector() *
+        180.0 / M_PI;
     const Eigen::Vector3d dt = r.rig.S(0, 1).translation_mm() - truth.S(0, 1).translation_mm();
-    if (std::getenv("VERBOSE_S")) std::printf("  dr %s sr %s dt %s st %s\n", Fmt(dr).c_str(), Fmt(s.rotation_deg).c_str(), Fmt(dt).c_str(), Fmt(s.translation_mm).c_str());
+    if (std::getenv("VERBOSE_S"))
+      std::printf("  dr %s sr %s dt %s st %s\n", Fmt(dr).c_str(), Fmt(s.rotation_deg).c_str(), Fmt(dt).c_str(),
+                  Fmt(s.translation_mm).c_str());
     for (int i = 0; i < 3; ++i) {
       f.s_z(i) = dr(i) / s.rotation_deg(i);
       f.s_z(3 + i) = dt(i) / s.translation_mm(i);
@@ -101,9 +105,10 @@ TEST(CalibrateE2E, DefaultRigOverSeeds) {
   for (int s = 0; s < kSeeds; ++s) {
     all.push_back(RunSeed(100 + s));
     const SeedFigures& f = all.back();
-    std::printf("seed %d: %.2fs rmsdev %.3f 3d %.4f %.4f agree refined %.4f horn %.4f z [%.1f %.1f %.1f %.1f %.1f %.1f]\n",
-                s, f.seconds, f.max_stage1_rms_dev, f.module_3d_rms[0], f.module_3d_rms[1], f.agreement_refined,
-                f.agreement_horn, f.s_z(0), f.s_z(1), f.s_z(2), f.s_z(3), f.s_z(4), f.s_z(5));
+    std::printf(
+        "seed %d: %.2fs rmsdev %.3f 3d %.4f %.4f agree refined %.4f horn %.4f z [%.1f %.1f %.1f %.1f %.1f %.1f]\n", s,
+        f.seconds, f.max_stage1_rms_dev, f.module_3d_rms[0], f.module_3d_rms[1], f.agreement_refined, f.agreement_horn,
+        f.s_z(0), f.s_z(1), f.s_z(2), f.s_z(3), f.s_z(4), f.s_z(5));
   }
   // Residuals: every camera's stage-1 RMS within 10% of the injected noise.
   for (const auto& f : all) EXPECT_LT(f.max_stage1_rms_dev, 0.10);
@@ -120,7 +125,8 @@ TEST(CalibrateE2E, DefaultRigOverSeeds) {
       ++n;
     }
   const double honesty = std::sqrt(e2 / s2);
-  std::printf("uncertainty honesty at the centre: actual/predicted = %.3f; within 3 sigma %d/%d\n", honesty, within3, n);
+  std::printf("uncertainty honesty at the centre: actual/predicted = %.3f; within 3 sigma %d/%d\n", honesty, within3,
+              n);
   EXPECT_GE(honesty, 0.7);
   EXPECT_LE(honesty, 1.4);
   EXPECT_GE(within3, 0.95 * n);
@@ -269,8 +275,8 @@ TEST(CalibrateReport, JsonHoldsEveryStage) {
   const CalibrationResult r = Calibrate(s.data.input, CalibrationOptions());
   const std::string j = r.report.ToJson();
   for (const char* key : {"stage1_intrinsics", "projection_uncertainty", "coverage", "worst_views", "stage2_stereo",
-                          "rectified_row_rms_px", "baseline_mm", "stage3_system", "horn_only", "refined",
-                          "sigma_S_0_k", "back_from_front_refined"}) {
+                          "rectified_row_rms_px", "baseline_mm", "stage3_system", "horn_only", "refined", "sigma_S_0_k",
+                          "back_from_front_refined"}) {
     EXPECT_NE(j.find(std::string("\"") + key + "\""), std::string::npos) << key;
   }
   // The stereo figures against the truth: 90 mm baseline, 6 deg verging.

@@ -96,8 +96,8 @@ bool CornerReprojectionCost::Evaluate(double const* const* parameters, double* r
     // (2,6) row-major = dq_dp (2,3) * dp_dblock (3,6) row-major
     for (int r = 0; r < 2; ++r)
       for (int c = 0; c < 6; ++c) {
-        jacobians[b][r * 6 + c] = dq_dp[r].x * jp[b][0 * 6 + c] + dq_dp[r].y * jp[b][1 * 6 + c] +
-                                  dq_dp[r].z * jp[b][2 * 6 + c];
+        jacobians[b][r * 6 + c] =
+            dq_dp[r].x * jp[b][0 * 6 + c] + dq_dp[r].y * jp[b][1 * 6 + c] + dq_dp[r].z * jp[b][2 * 6 + c];
       }
   }
   if (need_intr_j) std::copy(dq_dintr.begin(), dq_dintr.end(), jacobians[4]);

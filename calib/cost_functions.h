@@ -37,7 +37,7 @@ struct CornerPointFunctor {
   Eigen::Vector3d x_face;  // corner in its face's frame, mm
   bool back_face = false;
   bool right_camera = false;
-  Eigen::Matrix3d R0[4];   // seed rotations of the four blocks
+  Eigen::Matrix3d R0[4];  // seed rotations of the four blocks
 
   template <typename T>
   bool operator()(const T* board, const T* module, const T* bff, const T* rl, T* p_cam) const;

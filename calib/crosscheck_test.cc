@@ -33,8 +33,8 @@ TEST(Crosscheck, Stage1AgainstOpencvAndMrcalCalibrateCameras) {
   o.lateral_mm = 10.0;
   o.depth_mm = 20.0;
   const TargetGeometry target = DefaultTestTarget();
-  const SyntheticData data =
-      MakeSyntheticCaptures(rig.rig, target, target.back_from_front, Pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 200)), o);
+  const SyntheticData data = MakeSyntheticCaptures(rig.rig, target, target.back_from_front,
+                                                   Pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 200)), o);
   const CalibrationInput& in = data.input;
   const int cam = 0;
   // mrcal-calibrate-cameras is made for whole boards (mrgingham finds only
@@ -45,7 +45,8 @@ TEST(Crosscheck, Stage1AgainstOpencvAndMrcalCalibrateCameras) {
     if (static_cast<int>(v->corner_ids.size()) == in.target.num_corners()) views.push_back(v);
   std::printf("%zu whole-board views\n", views.size());
   ASSERT_GE(views.size(), 10u);
-  const IntrinsicsResult ours = CalibrateIntrinsics(cam, in.cameras[cam], in.target, views, IntrinsicsOptions(), "test");
+  const IntrinsicsResult ours =
+      CalibrateIntrinsics(cam, in.cameras[cam], in.target, views, IntrinsicsOptions(), "test");
 
   // OpenCV: its RMS is sqrt(sum |e|^2 / Npoints) (2D); ours is per coordinate.
   std::vector<std::vector<cv::Point3f>> obj;
@@ -61,7 +62,8 @@ TEST(Crosscheck, Stage1AgainstOpencvAndMrcalCalibrateCameras) {
   }
   cv::Mat K, dist;
   std::vector<cv::Mat> rv, tv;
-  const double opencv_rms_2d = cv::calibrateCamera(obj, img, cv::Size(752, 582), K, dist, rv, tv, cv::CALIB_RATIONAL_MODEL);
+  const double opencv_rms_2d =
+      cv::calibrateCamera(obj, img, cv::Size(752, 582), K, dist, rv, tv, cv::CALIB_RATIONAL_MODEL);
   const double opencv_rms = opencv_rms_2d / std::sqrt(2.0);
   std::printf("stage 1 rms: ours %.5f px, OpenCV %.5f px (per coordinate)\n", ours.report.rms_px, opencv_rms);
   // mrcal regularises the distortions lightly, which may cost a hair of RMS.

@@ -52,7 +52,7 @@ HornResult HornAbsoluteOrientation(const std::vector<Eigen::Vector3d>& a, const 
       Sxy - Syx, Szx + Sxz, Syz + Szy, -Sxx - Syy + Szz;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eig(N);
   const Eigen::Vector4d e = eig.eigenvectors().col(3);  // eigenvalues ascend: the largest is last
-  const Eigen::Quaterniond q(e(0), e(1), e(2), e(3));    // (w, x, y, z)
+  const Eigen::Quaterniond q(e(0), e(1), e(2), e(3));   // (w, x, y, z)
   const Eigen::Matrix3d R = q.normalized().toRotationMatrix();
   out.a_from_b = Pose(R, ca - R * cb);
   double s2 = 0;

@@ -19,10 +19,10 @@
 namespace stereorig {
 
 struct HornResult {
-  bool ok = false;           // false: fewer than 3 points, or they are (nearly) collinear
+  bool ok = false;  // false: fewer than 3 points, or they are (nearly) collinear
   std::string message;
   Pose a_from_b;
-  double rms_mm = 0.0;       // RMS of |a_i - a_from_b * b_i|
+  double rms_mm = 0.0;  // RMS of |a_i - a_from_b * b_i|
 };
 
 // points_a, points_b: (N,) corresponding points. weights: (N,) or empty (all 1).

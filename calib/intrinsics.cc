@@ -11,7 +11,8 @@
 namespace stereorig {
 
 void IntrinsicsOptions::Check() const {
-  if (Camera::NumIntrinsics(lensmodel) < 0) throw InputError("options.lensmodel", "unknown lens model '" + lensmodel + "'");
+  if (Camera::NumIntrinsics(lensmodel) < 0)
+    throw InputError("options.lensmodel", "unknown lens model '" + lensmodel + "'");
   if (lensmodel.rfind("LENSMODEL_OPENCV", 0) != 0 && lensmodel.rfind("LENSMODEL_SPLINED_STEREOGRAPHIC", 0) != 0 &&
       lensmodel != "LENSMODEL_PINHOLE") {
     throw InputError("options.lensmodel", "use LENSMODEL_OPENCV5, LENSMODEL_OPENCV8 or a splined stereographic model");
@@ -124,8 +125,8 @@ void FillCoverageAndUncertainty(const MrcalProblem& p, int icam, const Intrinsic
     for (int i = 0; i < n; ++i) {
       const mrcal_point3_t& q = p.pool[o * n + i];
       if (q.z <= 0) continue;
-      const int cx = std::clamp(static_cast<int>((q.x + 0.5) / width * options.coverage_cells_x), 0,
-                                options.coverage_cells_x - 1);
+      const int cx =
+          std::clamp(static_cast<int>((q.x + 0.5) / width * options.coverage_cells_x), 0, options.coverage_cells_x - 1);
       const int cy = std::clamp(static_cast<int>((q.y + 0.5) / height * options.coverage_cells_y), 0,
                                 options.coverage_cells_y - 1);
       ++r->coverage[cy * options.coverage_cells_x + cx];
@@ -139,12 +140,11 @@ void FillCoverageAndUncertainty(const MrcalProblem& p, int icam, const Intrinsic
   ProjectionUncertaintyEvaluator eval(p);
   if (!eval.ok()) return;  // leaves the uncertainty empty; the caller reports it
   r->observed_sigma_px = eval.observed_pixel_sigma_px();
-  const std::vector<std::pair<std::string, Eigen::Vector2d>> at = {
-      {"centre", {0.5 * (width - 1), 0.5 * (height - 1)}},
-      {"top-left", {0, 0}},
-      {"top-right", {width - 1.0, 0}},
-      {"bottom-left", {0, height - 1.0}},
-      {"bottom-right", {width - 1.0, height - 1.0}}};
+  const std::vector<std::pair<std::string, Eigen::Vector2d>> at = {{"centre", {0.5 * (width - 1), 0.5 * (height - 1)}},
+                                                                   {"top-left", {0, 0}},
+                                                                   {"top-right", {width - 1.0, 0}},
+                                                                   {"bottom-left", {0, height - 1.0}},
+                                                                   {"bottom-right", {width - 1.0, height - 1.0}}};
   for (const auto& [name, q] : at) {
     const ProjectionUncertainty u = eval.AtPixel(icam, q, options.uncertainty_range_mm);
     r->uncertainty.push_back({name, q, u.rms_stdev_px, u.worst_direction_stdev_px});
@@ -210,9 +210,13 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraSpec& spec, const T
 
   // Step 1: the board poses alone. Step 2: with the lens core. Step 3: all,
   // distortions regularised, outliers rejected.
-  p.selections = {.do_optimize_intrinsics_core = false, .do_optimize_intrinsics_distortions = false,
-                  .do_optimize_extrinsics = true, .do_optimize_frames = true, .do_optimize_calobject_warp = false,
-                  .do_apply_regularization = false, .do_apply_outlier_rejection = false};
+  p.selections = {.do_optimize_intrinsics_core = false,
+                  .do_optimize_intrinsics_distortions = false,
+                  .do_optimize_extrinsics = true,
+                  .do_optimize_frames = true,
+                  .do_optimize_calobject_warp = false,
+                  .do_apply_regularization = false,
+                  .do_apply_outlier_rejection = false};
   p.Optimize(options.verbose);
   p.selections.do_optimize_intrinsics_core = true;
   p.Optimize(options.verbose);

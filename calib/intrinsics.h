@@ -24,28 +24,28 @@ struct IntrinsicsOptions {
   // LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=16_Ny=12_fov_x_deg=50.
   // Default LENSMODEL_OPENCV8.
   std::string lensmodel = "LENSMODEL_OPENCV8";
-  double seed_focal_px = 0.0;        // rough focal length for the PnP seed, px; 0 (default): from the views' homographies
-  int min_corners_per_view = 8;      // views with fewer corners are not used; default 8
-  int min_views = 5;                 // fewer usable views is an input error; default 5
-  double min_tilt_deg = 10.0;        // if no view tilts the board more than this, the set is degenerate; default 10 deg
+  double seed_focal_px = 0.0;    // rough focal length for the PnP seed, px; 0 (default): from the views' homographies
+  int min_corners_per_view = 8;  // views with fewer corners are not used; default 8
+  int min_views = 5;             // fewer usable views is an input error; default 5
+  double min_tilt_deg = 10.0;    // if no view tilts the board more than this, the set is degenerate; default 10 deg
   double uncertainty_range_mm = 200.0;  // range of the points whose projection uncertainty is reported; default 200 mm
-  int coverage_cells_x = 8;          // coverage map columns; default 8
-  int coverage_cells_y = 6;          // coverage map rows; default 6
-  int worst_views_reported = 3;      // default 3
-  bool verbose = false;              // mrcal's solver output to stderr; default false
-  void Check() const;                // throws InputError naming the bad option
+  int coverage_cells_x = 8;             // coverage map columns; default 8
+  int coverage_cells_y = 6;             // coverage map rows; default 6
+  int worst_views_reported = 3;         // default 3
+  bool verbose = false;                 // mrcal's solver output to stderr; default false
+  void Check() const;                   // throws InputError naming the bad option
 };
 
 struct ViewResidual {
   int capture = -1;
-  double rms_px = 0.0;    // RMS of the view's inlier residual coordinates (x and y pooled), px
-  int num_corners = 0;    // inliers
+  double rms_px = 0.0;  // RMS of the view's inlier residual coordinates (x and y pooled), px
+  int num_corners = 0;  // inliers
 };
 
 struct PixelUncertainty {
-  std::string where;      // "centre", "top-left", ...
+  std::string where;  // "centre", "top-left", ...
   Eigen::Vector2d q_px = Eigen::Vector2d::Zero();
-  double rms_stdev_px = 0.0;             // 1 sigma, sqrt(trace(Var q) / 2)
+  double rms_stdev_px = 0.0;  // 1 sigma, sqrt(trace(Var q) / 2)
   double worst_direction_stdev_px = 0.0;
 };
 
@@ -53,28 +53,28 @@ struct IntrinsicsReport {
   int camera = -1;
   std::string camera_name;
   std::string lensmodel;
-  int num_views = 0;                // used in the solve
-  int num_views_dropped = 0;        // too few corners
-  int num_corners = 0;              // inliers in the final solve
-  int num_outliers = 0;             // corners rejected by the solver
-  double rms_px = 0.0;              // RMS of the inlier residual coordinates (x and y pooled), px
-  double observed_sigma_px = 0.0;   // std of the residuals (the noise the uncertainty assumes)
-  double max_tilt_deg = 0.0;        // largest board tilt among the views
+  int num_views = 0;               // used in the solve
+  int num_views_dropped = 0;       // too few corners
+  int num_corners = 0;             // inliers in the final solve
+  int num_outliers = 0;            // corners rejected by the solver
+  double rms_px = 0.0;             // RMS of the inlier residual coordinates (x and y pooled), px
+  double observed_sigma_px = 0.0;  // std of the residuals (the noise the uncertainty assumes)
+  double max_tilt_deg = 0.0;       // largest board tilt among the views
   std::vector<ViewResidual> worst_views;
   int coverage_cells_x = 0, coverage_cells_y = 0;
-  std::vector<int> coverage;        // (cells_y, cells_x) row-major: inlier corners per cell
-  double coverage_fraction = 0.0;   // cells holding at least one corner
+  std::vector<int> coverage;                  // (cells_y, cells_x) row-major: inlier corners per cell
+  double coverage_fraction = 0.0;             // cells holding at least one corner
   std::vector<PixelUncertainty> uncertainty;  // centre and the four image corners
   double uncertainty_range_mm = 0.0;
 };
 
 struct IntrinsicsResult {
   Camera camera;
-  std::vector<int> captures;          // (Nviews,) the capture of each view used
-  std::vector<Face> faces;            // (Nviews,)
-  std::vector<Pose> cam_from_face;    // (Nviews,) solved board poses
+  std::vector<int> captures;        // (Nviews,) the capture of each view used
+  std::vector<Face> faces;          // (Nviews,)
+  std::vector<Pose> cam_from_face;  // (Nviews,) solved board poses
   IntrinsicsReport report;
-  MrcalProblem problem;               // the solved problem (for uncertainty and cross-checks)
+  MrcalProblem problem;  // the solved problem (for uncertainty and cross-checks)
 };
 
 // `views`: this camera's observations (all of the same camera). Throws

@@ -53,11 +53,12 @@ TEST(Intrinsics, Opencv8RecoversTheTruthWithinItsUncertainty) {
 
 TEST(Intrinsics, LensModelsAreSelectable) {
   const auto s = testing::MakeDefaultScene(21, 20, 0.2);
-  for (const std::string model : {"LENSMODEL_OPENCV5", "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=8_Ny=6_fov_x_deg=45"}) {
+  for (const std::string model :
+       {"LENSMODEL_OPENCV5", "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=8_Ny=6_fov_x_deg=45"}) {
     IntrinsicsOptions opt;
     opt.lensmodel = model;
-    const auto r = CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, ViewsOf(s.data.input, 0), opt,
-                                       "test");
+    const auto r =
+        CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, ViewsOf(s.data.input, 0), opt, "test");
     EXPECT_EQ(r.camera.lensmodel_name(), model);
     // Both models can represent this mild OPENCV8 lens within noise here.
     EXPECT_NEAR(r.report.rms_px, 0.2, 0.03) << model;
@@ -86,8 +87,8 @@ TEST(Intrinsics, RefusesFrontoParallelViews) {
   o.max_roll_deg = 20.0;
   s.data = MakeSyntheticCaptures(s.truth.rig, s.data.input.target, s.true_back_from_front, s.ref_from_volume, o);
   try {
-    CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, ViewsOf(s.data.input, 0),
-                        IntrinsicsOptions(), "test");
+    CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, ViewsOf(s.data.input, 0), IntrinsicsOptions(),
+                        "test");
     FAIL() << "fronto-parallel views accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("fronto-parallel"), std::string::npos) << e.what();

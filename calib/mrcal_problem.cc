@@ -39,10 +39,10 @@ std::vector<double> MrcalProblem::Residuals() const {
   const mrcal_problem_constants_t constants = {.point_min_range = -1.0, .point_max_range = -1.0};
   std::vector<double> b(num_states()), x(num_measurements());
   const bool ok = mrcal_optimizer_callback(
-      b.data(), static_cast<int>(b.size() * sizeof(double)), x.data(), static_cast<int>(x.size() * sizeof(double)), nullptr, intrinsics.data(),
-      extrinsics_fromref.data(), frames_toref.data(), nullptr, nullptr, num_intrinsics_cameras, num_extrinsics(),
-      num_frames(), 0, 0, observations.data(), nullptr, num_observations(), 0, pool.data(), &lensmodel,
-      imagersizes.data(), selections, &constants, spacing_mm, corners_x, corners_y, false);
+      b.data(), static_cast<int>(b.size() * sizeof(double)), x.data(), static_cast<int>(x.size() * sizeof(double)),
+      nullptr, intrinsics.data(), extrinsics_fromref.data(), frames_toref.data(), nullptr, nullptr,
+      num_intrinsics_cameras, num_extrinsics(), num_frames(), 0, 0, observations.data(), nullptr, num_observations(), 0,
+      pool.data(), &lensmodel, imagersizes.data(), selections, &constants, spacing_mm, corners_x, corners_y, false);
   STEREORIG_CHECK(ok);
   return x;
 }

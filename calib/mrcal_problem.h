@@ -17,17 +17,17 @@
 namespace stereorig {
 
 struct MrcalProblem {
-  std::string lensmodel_name;                       // as mrcal spells it
+  std::string lensmodel_name;  // as mrcal spells it
   mrcal_lensmodel_t lensmodel{};
-  int corners_x = 0, corners_y = 0;                 // board grid (width_n, height_n)
-  double spacing_mm = 0.0;                          // board pitch
+  int corners_x = 0, corners_y = 0;  // board grid (width_n, height_n)
+  double spacing_mm = 0.0;           // board pitch
   int num_intrinsics_cameras = 0;
-  std::vector<double> intrinsics;                   // (Ncameras_intrinsics, Nparams)
-  std::vector<int> imagersizes;                     // (Ncameras_intrinsics, 2)
-  std::vector<mrcal_pose_t> extrinsics_fromref;     // (Ncameras_extrinsics,) rt_cam_ref
-  std::vector<mrcal_pose_t> frames_toref;           // (Nframes,) rt_ref_frame
+  std::vector<double> intrinsics;                       // (Ncameras_intrinsics, Nparams)
+  std::vector<int> imagersizes;                         // (Ncameras_intrinsics, 2)
+  std::vector<mrcal_pose_t> extrinsics_fromref;         // (Ncameras_extrinsics,) rt_cam_ref
+  std::vector<mrcal_pose_t> frames_toref;               // (Nframes,) rt_ref_frame
   std::vector<mrcal_observation_board_t> observations;  // (Nobservations,)
-  std::vector<mrcal_point3_t> pool;                 // (Nobservations, corners_y, corners_x): x, y, weight
+  std::vector<mrcal_point3_t> pool;                     // (Nobservations, corners_y, corners_x): x, y, weight
   mrcal_problem_selections_t selections{};
 
   // Sets the lens model; returns false if mrcal does not know the name.

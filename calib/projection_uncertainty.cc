@@ -34,7 +34,8 @@ struct ProjectionUncertaintyEvaluator::Impl {
   }
 };
 
-ProjectionUncertaintyEvaluator::ProjectionUncertaintyEvaluator(const MrcalProblem& p) : impl_(std::make_unique<Impl>()) {
+ProjectionUncertaintyEvaluator::ProjectionUncertaintyEvaluator(const MrcalProblem& p)
+    : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.problem = &p;
   cholmod_start(&m.common);
@@ -49,12 +50,12 @@ ProjectionUncertaintyEvaluator::ProjectionUncertaintyEvaluator(const MrcalProble
   m.Jt = cholmod_allocate_sparse(m.num_states, m.num_measurements, nnz, 1, 1, 0, CHOLMOD_REAL, &m.common);
   std::vector<double> b(m.num_states), x(m.num_measurements);
   const mrcal_problem_constants_t constants = {.point_min_range = -1.0, .point_max_range = -1.0};
-  if (!mrcal_optimizer_callback(b.data(), m.num_states * static_cast<int>(sizeof(double)), x.data(), m.num_measurements * static_cast<int>(sizeof(double)), m.Jt, p.intrinsics.data(),
-                                p.extrinsics_fromref.data(), p.frames_toref.data(), nullptr, nullptr,
-                                p.num_intrinsics_cameras, p.num_extrinsics(), p.num_frames(), 0, 0,
-                                p.observations.data(), nullptr, p.num_observations(), 0, p.pool.data(), &p.lensmodel,
-                                p.imagersizes.data(), p.selections, &constants, p.spacing_mm, p.corners_x, p.corners_y,
-                                false)) {
+  if (!mrcal_optimizer_callback(
+          b.data(), m.num_states * static_cast<int>(sizeof(double)), x.data(),
+          m.num_measurements * static_cast<int>(sizeof(double)), m.Jt, p.intrinsics.data(), p.extrinsics_fromref.data(),
+          p.frames_toref.data(), nullptr, nullptr, p.num_intrinsics_cameras, p.num_extrinsics(), p.num_frames(), 0, 0,
+          p.observations.data(), nullptr, p.num_observations(), 0, p.pool.data(), &p.lensmodel, p.imagersizes.data(),
+          p.selections, &constants, p.spacing_mm, p.corners_x, p.corners_y, false)) {
     m.message = "mrcal_optimizer_callback failed";
     return;
   }
@@ -101,8 +102,8 @@ ProjectionUncertainty ProjectionUncertaintyEvaluator::AtPoint(int icam_intrinsic
 
   int icam_extrinsics = -1;
   STEREORIG_CHECK(mrcal_corresponding_icam_extrinsics(&icam_extrinsics, icam_intrinsics, p.num_intrinsics_cameras,
-                                                      p.num_extrinsics(), p.num_observations(),
-                                                      p.observations.data(), 0, nullptr));
+                                                      p.num_extrinsics(), p.num_observations(), p.observations.data(),
+                                                      0, nullptr));
 
   // dq/db, shape (2, Nstate), in full (unpacked) units first.
   Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::RowMajor> dq_db =
@@ -150,27 +151,26 @@ ProjectionUncertainty ProjectionUncertaintyEvaluator::AtPoint(int icam_intrinsic
     const int Ncore = meta.has_core ? 4 : 0;
     const int i0 = (meta.has_core && !p.selections.do_optimize_intrinsics_core) ? Ncore : 0;
     const int i1 = p.selections.do_optimize_intrinsics_distortions ? Nparams : Ncore;
-    const int istate = mrcal_state_index_intrinsics(icam_intrinsics, p.num_intrinsics_cameras, p.num_extrinsics(),
-                                                    p.num_frames(), 0, 0, p.num_observations(), p.selections,
-                                                    &p.lensmodel);
+    const int istate =
+        mrcal_state_index_intrinsics(icam_intrinsics, p.num_intrinsics_cameras, p.num_extrinsics(), p.num_frames(), 0,
+                                     0, p.num_observations(), p.selections, &p.lensmodel);
     for (int r = 0; r < 2; ++r)
       for (int i = i0; i < i1; ++i) dq_db(r, istate + i - i0) = dq_dintr[r * Nparams + i];
   }
 
-  const int istate_frames = frames_optimized
-                                ? mrcal_state_index_frames(0, p.num_intrinsics_cameras, p.num_extrinsics(),
-                                                           p.num_frames(), 0, 0, p.num_observations(), p.selections,
-                                                           &p.lensmodel)
-                                : -1;
+  const int istate_frames =
+      frames_optimized ? mrcal_state_index_frames(0, p.num_intrinsics_cameras, p.num_extrinsics(), p.num_frames(), 0, 0,
+                                                  p.num_observations(), p.selections, &p.lensmodel)
+                       : -1;
   if (icam_extrinsics >= 0) {
     Eigen::Vector3d p_cam2;
     Eigen::Matrix<double, 3, 6, Eigen::RowMajor> dpcam_drt;
     Eigen::Matrix<double, 3, 3, Eigen::RowMajor> dpcam_dpref;
     mrcal_transform_point_rt(p_cam2.data(), dpcam_drt.data(), dpcam_dpref.data(), rt_cam_ref, p_ref.data());
     if (p.selections.do_optimize_extrinsics) {
-      const int istate_ext = mrcal_state_index_extrinsics(icam_extrinsics, p.num_intrinsics_cameras,
-                                                          p.num_extrinsics(), p.num_frames(), 0, 0,
-                                                          p.num_observations(), p.selections, &p.lensmodel);
+      const int istate_ext =
+          mrcal_state_index_extrinsics(icam_extrinsics, p.num_intrinsics_cameras, p.num_extrinsics(), p.num_frames(), 0,
+                                       0, p.num_observations(), p.selections, &p.lensmodel);
       dq_db.block(0, istate_ext, 2, 6) = dq_dpcam * dpcam_drt;
     }
     if (frames_optimized) {
@@ -182,8 +182,8 @@ ProjectionUncertainty ProjectionUncertaintyEvaluator::AtPoint(int icam_intrinsic
 
   // To the packed state: d/db* = d/db D. mrcal's "unpack" multiplies by D.
   for (int r = 0; r < 2; ++r) {
-    mrcal_unpack_solver_state_vector(dq_db.row(r).data(), p.num_intrinsics_cameras, p.num_extrinsics(),
-                                     p.num_frames(), 0, 0, p.selections, &p.lensmodel);
+    mrcal_unpack_solver_state_vector(dq_db.row(r).data(), p.num_intrinsics_cameras, p.num_extrinsics(), p.num_frames(),
+                                     0, 0, p.selections, &p.lensmodel);
   }
 
   // A = inv(J'J) dq_db' : (Nstate, 2).

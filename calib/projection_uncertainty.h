@@ -23,7 +23,7 @@ namespace stereorig {
 
 struct ProjectionUncertainty {
   Eigen::Matrix2d covariance_px2 = Eigen::Matrix2d::Zero();  // Var(q), px^2
-  double rms_stdev_px = 0.0;              // sqrt(trace / 2): mrcal's 'rms-stdev'
+  double rms_stdev_px = 0.0;                                 // sqrt(trace / 2): mrcal's 'rms-stdev'
   double worst_direction_stdev_px = 0.0;  // sqrt of the larger eigenvalue: mrcal's 'worstdirection-stdev'
 };
 

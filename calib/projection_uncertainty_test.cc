@@ -34,7 +34,8 @@ std::string DumpProblem(const MrcalProblem& p, const std::vector<std::pair<int, 
   for (const auto& f : p.frames_toref) v.insert(v.end(), &f.r.x, &f.r.x + 6);
   j.Numbers("frames", v);
   v.clear();
-  for (const auto& o : p.observations) v.insert(v.end(), {double(o.iframe), double(o.icam.intrinsics), double(o.icam.extrinsics)});
+  for (const auto& o : p.observations)
+    v.insert(v.end(), {double(o.iframe), double(o.icam.intrinsics), double(o.icam.extrinsics)});
   j.Numbers("indices", v);
   v.clear();
   for (const auto& q : p.pool) v.insert(v.end(), {q.x, q.y, q.z});

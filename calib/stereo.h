@@ -17,34 +17,34 @@
 namespace stereorig {
 
 struct StereoOptions {
-  int min_shared_views = 3;   // fewer views seen by both cameras is an input error; default 3
-  bool verbose = false;       // mrcal's solver output; default false
+  int min_shared_views = 3;  // fewer views seen by both cameras is an input error; default 3
+  bool verbose = false;      // mrcal's solver output; default false
   void Check() const;
 };
 
 struct StereoReport {
   int module = -1;
   std::string module_name;
-  int num_shared_views = 0;        // captures both cameras saw
-  int num_frames = 0;              // captures either camera saw
-  double rms_px = 0.0;             // joint solve, RMS of residual coordinates
+  int num_shared_views = 0;  // captures both cameras saw
+  int num_frames = 0;        // captures either camera saw
+  double rms_px = 0.0;       // joint solve, RMS of residual coordinates
   int num_outliers = 0;
-  double baseline_mm = 0.0;        // |t| of right_from_left
-  double rotation_deg = 0.0;       // angle of right_from_left
+  double baseline_mm = 0.0;   // |t| of right_from_left
+  double rotation_deg = 0.0;  // angle of right_from_left
   Eigen::Vector3d right_from_left_rotation_vector_deg = Eigen::Vector3d::Zero();
   Eigen::Vector3d right_from_left_translation_mm = Eigen::Vector3d::Zero();
-  double rectified_row_rms_px = 0.0;   // over corners both cameras saw
+  double rectified_row_rms_px = 0.0;  // over corners both cameras saw
   double rectified_row_max_px = 0.0;
   int num_corner_pairs = 0;
-  IntrinsicsReport left, right;    // per-camera figures of the joint solve (uncertainty, coverage)
+  IntrinsicsReport left, right;  // per-camera figures of the joint solve (uncertainty, coverage)
 };
 
 struct StereoResult {
   Camera left, right;
   Pose right_from_left;
-  std::vector<int> captures;        // (Nframes,) captures in the joint solve
-  std::vector<Face> faces;          // (Nframes,)
-  std::vector<Pose> left_from_face; // (Nframes,) board poses in the module (= left camera) frame
+  std::vector<int> captures;         // (Nframes,) captures in the joint solve
+  std::vector<Face> faces;           // (Nframes,)
+  std::vector<Pose> left_from_face;  // (Nframes,) board poses in the module (= left camera) frame
   StereoReport report;
   MrcalProblem problem;
 };

@@ -77,7 +77,8 @@ std::vector<Eigen::Vector3d> VolumePoints(const Pose& ref_from_volume, const Eig
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::vector<Eigen::Vector3d> p;
-  for (int i = 0; i < n; ++i) p.push_back(ref_from_volume * Eigen::Vector3d(half.x() * u(rng), half.y() * u(rng), half.z() * u(rng)));
+  for (int i = 0; i < n; ++i)
+    p.push_back(ref_from_volume * Eigen::Vector3d(half.x() * u(rng), half.y() * u(rng), half.z() * u(rng)));
   return p;
 }
 

@@ -14,15 +14,15 @@
 namespace stereorig {
 
 struct SyntheticOptions {
-  int num_captures = 25;         // default 25
-  double noise_px = 0.2;         // 1 sigma per pixel coordinate; default 0.2
+  int num_captures = 25;  // default 25
+  double noise_px = 0.2;  // 1 sigma per pixel coordinate; default 0.2
   unsigned seed = 1;
-  double max_tilt_deg = 35.0;    // board tilt about its x and y axes, uniform in +-; default 35
-  double max_roll_deg = 20.0;    // about the board normal; default 20
-  double lateral_mm = 25.0;      // board centre offset across the volume, uniform in +-; default 25
-  double depth_mm = 30.0;        // along the volume's z, uniform in +-; default 30
-  int min_corners = 8;           // a view with fewer corners on the imager is dropped; default 8
-  double edge_margin_px = 2.0;   // corners this close to the imager edge are not detected; default 2
+  double max_tilt_deg = 35.0;   // board tilt about its x and y axes, uniform in +-; default 35
+  double max_roll_deg = 20.0;   // about the board normal; default 20
+  double lateral_mm = 25.0;     // board centre offset across the volume, uniform in +-; default 25
+  double depth_mm = 30.0;       // along the volume's z, uniform in +-; default 30
+  int min_corners = 8;          // a view with fewer corners on the imager is dropped; default 8
+  double edge_margin_px = 2.0;  // corners this close to the imager edge are not detected; default 2
 };
 
 struct SyntheticData {

@@ -94,12 +94,14 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
         ++shared;
         // Module i's triangulated corners, and where module j's board pose puts them.
         for (size_t k = 0; k < vi.corner_ids.size(); ++k) {
-          const Eigen::Vector3d x_front = target.FaceFromFront(vi.face).Inverse() * target.CornerInFace(vi.corner_ids[k]);
+          const Eigen::Vector3d x_front =
+              target.FaceFromFront(vi.face).Inverse() * target.CornerInFace(vi.corner_ids[k]);
           in_i.push_back(vi.p_module[k]);
           in_j.push_back(vj.module_from_front * x_front);
         }
         for (size_t k = 0; k < vj.corner_ids.size(); ++k) {
-          const Eigen::Vector3d x_front = target.FaceFromFront(vj.face).Inverse() * target.CornerInFace(vj.corner_ids[k]);
+          const Eigen::Vector3d x_front =
+              target.FaceFromFront(vj.face).Inverse() * target.CornerInFace(vj.corner_ids[k]);
           in_i.push_back(vi.module_from_front * x_front);
           in_j.push_back(vj.p_module[k]);
         }
@@ -229,7 +231,8 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   auto set_free = [&](bool s, bool rl, bool bff, bool intr) {
     for (int k = 1; k < M; ++k)
       if (problem.HasParameterBlock(s_blocks[k].params)) {
-        s ? problem.SetParameterBlockVariable(s_blocks[k].params) : problem.SetParameterBlockConstant(s_blocks[k].params);
+        s ? problem.SetParameterBlockVariable(s_blocks[k].params)
+          : problem.SetParameterBlockConstant(s_blocks[k].params);
       }
     for (int k = 0; k < M; ++k)
       if (problem.HasParameterBlock(rl_blocks[k].params)) {
@@ -287,7 +290,8 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   rep.back_from_front = bff_block.ToPose();
   const Pose change = target.back_from_front.Inverse() * rep.back_from_front;
   rep.back_from_front_change_deg = change.AngleDeg();
-  rep.back_from_front_change_mm = (rep.back_from_front.translation_mm() - target.back_from_front.translation_mm()).norm();
+  rep.back_from_front_change_mm =
+      (rep.back_from_front.translation_mm() - target.back_from_front.translation_mm()).norm();
 
   // 1 sigma of S[0][k] from the covariance of the adjustment, scaled by the
   // residual variance (Ceres assumes unit-variance residuals).

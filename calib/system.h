@@ -28,8 +28,8 @@
 namespace stereorig {
 
 struct SystemOptions {
-  double huber_px = 1.0;            // Huber loss scale, px; default 1
-  bool refine_stereo = true;        // free each module's right_from_left in the adjustment; default true
+  double huber_px = 1.0;      // Huber loss scale, px; default 1
+  bool refine_stereo = true;  // free each module's right_from_left in the adjustment; default true
   // Free every camera's intrinsics: the core and OPENCV's k1..k3, p1, p2 (not
   // OPENCV8's k4..k6 nor spline knots, which need mrcal's regularisation).
   // With them free, the covariance of S includes the lens uncertainty, which
@@ -37,9 +37,9 @@ struct SystemOptions {
   // against its centre). Default true.
   bool refine_intrinsics = true;
   bool refine_back_from_front = true;  // free back_from_front under its prior; default true
-  int min_triangulated_corners = 6; // a module's board pose needs this many corners both cameras saw; default 6
-  int max_iterations = 100;         // Ceres; default 100
-  bool compute_covariance = true;   // 1 sigma of S; default true
+  int min_triangulated_corners = 6;    // a module's board pose needs this many corners both cameras saw; default 6
+  int max_iterations = 100;            // Ceres; default 100
+  bool compute_covariance = true;      // 1 sigma of S; default true
   void Check() const;
 };
 
@@ -51,33 +51,33 @@ struct ModuleCameras {
 };
 
 struct STransformSigma {
-  int module = -1;                                      // S[0][module] = module0_from_module
+  int module = -1;                                         // S[0][module] = module0_from_module
   Eigen::Vector3d rotation_deg = Eigen::Vector3d::Zero();  // 1 sigma of a rotation about the reference's x, y, z
   Eigen::Vector3d translation_mm = Eigen::Vector3d::Zero();
 };
 
 struct SystemReport {
-  int num_captures = 0;              // captures seen by at least one module with a board pose
-  std::map<std::pair<int, int>, int> shared_captures;   // (i, j) -> captures both modules posed
-  std::vector<std::pair<int, int>> spanning_tree;       // (parent, child) edges used for Horn
-  std::map<std::pair<int, int>, double> horn_rms_mm;    // Horn fit RMS of each tree edge
-  double horn_reprojection_rms_px = 0.0;    // S and stereo held at Horn/stage 2, board poses solved
-  double refined_reprojection_rms_px = 0.0; // after the full adjustment
+  int num_captures = 0;                                // captures seen by at least one module with a board pose
+  std::map<std::pair<int, int>, int> shared_captures;  // (i, j) -> captures both modules posed
+  std::vector<std::pair<int, int>> spanning_tree;      // (parent, child) edges used for Horn
+  std::map<std::pair<int, int>, double> horn_rms_mm;   // Horn fit RMS of each tree edge
+  double horn_reprojection_rms_px = 0.0;               // S and stereo held at Horn/stage 2, board poses solved
+  double refined_reprojection_rms_px = 0.0;            // after the full adjustment
   int num_residual_corners = 0;
-  std::vector<Pose> module0_from_module_horn;   // (M,)
-  std::vector<Pose> module0_from_module;        // (M,) refined
-  std::vector<STransformSigma> sigma;           // for modules 1..M-1
-  std::string covariance_status;                // "ok" or why it is missing
-  Pose back_from_front;                         // as refined
-  double back_from_front_change_deg = 0.0;      // refined vs measured
+  std::vector<Pose> module0_from_module_horn;  // (M,)
+  std::vector<Pose> module0_from_module;       // (M,) refined
+  std::vector<STransformSigma> sigma;          // for modules 1..M-1
+  std::string covariance_status;               // "ok" or why it is missing
+  Pose back_from_front;                        // as refined
+  double back_from_front_change_deg = 0.0;     // refined vs measured
   double back_from_front_change_mm = 0.0;
-  std::string solver_summary;                   // Ceres BriefReport
+  std::string solver_summary;  // Ceres BriefReport
 };
 
 struct SystemResult {
-  std::vector<Pose> module0_from_module;        // (M,) refined; [0] = identity
-  std::vector<Pose> module0_from_module_horn;   // (M,)
-  std::vector<ModuleCameras> modules;           // refined stereo/intrinsics (unchanged if not refined)
+  std::vector<Pose> module0_from_module;       // (M,) refined; [0] = identity
+  std::vector<Pose> module0_from_module_horn;  // (M,)
+  std::vector<ModuleCameras> modules;          // refined stereo/intrinsics (unchanged if not refined)
   SystemReport report;
 };
 
@@ -93,8 +93,8 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
 struct ModuleCaptureView {
   Face face = Face::kFront;
   Pose module_from_front;
-  std::vector<int> corner_ids;             // (N,)
-  std::vector<Eigen::Vector3d> p_module;   // (N,) triangulated, module frame, mm
+  std::vector<int> corner_ids;            // (N,)
+  std::vector<Eigen::Vector3d> p_module;  // (N,) triangulated, module frame, mm
 };
 // views[k][capture]: module k's posed captures.
 std::vector<std::map<int, ModuleCaptureView>> PoseBoardsByTriangulation(const CalibrationInput& input,
