@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 
+#include "calib/core/cameramodel_export.h"
 #include "calib/core/input_error.h"
 #include "calib/json_writer.h"
 
@@ -316,6 +317,15 @@ std::string CalibrationReport::ToJson() const {
   }
   j.EndObject();
   return j.str() + "\n";
+}
+
+std::vector<std::string> ExportCameramodels(const Rig& rig, const std::string& dir) {
+  std::vector<std::string> paths;
+  for (int c = 0; c < rig.num_cameras(); ++c) {
+    paths.push_back(dir + "/" + rig.camera_names()[c] + ".cameramodel");
+    WriteCameramodel(rig.camera(c), rig.CamFromReference(c), paths.back());
+  }
+  return paths;
 }
 
 }  // namespace stereorig

@@ -52,4 +52,9 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
 // The input checks alone (throws InputError on the first problem).
 void ValidateInput(const CalibrationInput& input);
 
+// Writes every camera of `rig` as DIR/<camera name>.cameramodel (mrcal's
+// format, %.17g), with extrinsics = cam_from_module0. Each file is written
+// atomically. Returns the paths written.
+std::vector<std::string> ExportCameramodels(const Rig& rig, const std::string& dir);
+
 }  // namespace stereorig

@@ -13,6 +13,7 @@
 
 #include "calib/calib_test_util.h"
 #include "calib/core/input_error.h"
+#include "calib/core/mrcal_c.h"
 
 namespace stereorig {
 namespace {
@@ -268,6 +269,26 @@ TEST(CalibrateRefuses, AllViewsFrontoParallel) {
   o.max_tilt_deg = 0.0;
   s.data = MakeSyntheticCaptures(s.truth.rig, s.data.input.target, s.true_back_from_front, s.ref_from_volume, o);
   ExpectRefused(s.data.input, "fronto-parallel");
+}
+
+TEST(CalibrateReport, ExportsCameramodelsThatMrcalReads) {
+  const auto s = testing::MakeDefaultScene(67, 12, kNoisePx);
+  const CalibrationResult r = Calibrate(s.data.input, CalibrationOptions());
+  const std::string dir = ::testing::TempDir();
+  const auto paths = ExportCameramodels(r.rig, dir);
+  ASSERT_EQ(paths.size(), 4u);
+  for (int c = 0; c < 4; ++c) {
+    mrcal_cameramodel_t* m = mrcal_read_cameramodel_file(paths[c].c_str());
+    ASSERT_NE(m, nullptr) << paths[c];
+    const Camera read(r.rig.camera(c).lensmodel_name(),
+                      std::vector<double>(m->intrinsics, m->intrinsics + r.rig.camera(c).intrinsics().size()),
+                      m->imagersize[0], m->imagersize[1]);
+    const Eigen::Vector3d p(10, -20, 210);
+    EXPECT_LT((read.Project(p) - r.rig.camera(c).Project(p)).norm(), 1e-9);
+    const Pose cam_from_ref = r.rig.CamFromReference(c);
+    EXPECT_NEAR(m->rt_cam_ref[3], cam_from_ref.translation_mm().x(), 1e-9);
+    mrcal_free_cameramodel(&m);
+  }
 }
 
 TEST(CalibrateReport, JsonHoldsEveryStage) {

@@ -37,7 +37,7 @@ HornResult HornAbsoluteOrientation(const std::vector<Eigen::Vector3d>& a, const 
   }
   // Collinear (or coincident) points leave the rotation about their line free.
   Eigen::JacobiSVD<Eigen::Matrix3d> svd_b(M);
-  const Eigen::Vector3d sv = svd_b.singularValues();
+  const Eigen::Vector3d& sv = svd_b.singularValues();
   if (sv(1) <= 1e-12 * std::max(1.0, sv(0))) {
     out.message = "points are collinear";
     return out;

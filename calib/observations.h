@@ -41,7 +41,8 @@ struct TargetGeometry {
   int num_corners() const { return corners_x * corners_y; }
   // Corner `id` in its face's frame, mm: (col * s, row * s, 0).
   Eigen::Vector3d CornerInFace(int id) const {
-    return Eigen::Vector3d((id % corners_x) * square_size_mm, (id / corners_x) * square_size_mm, 0.0);
+    const int col = id % corners_x, row = id / corners_x;  // integer division: the row
+    return Eigen::Vector3d(col * square_size_mm, row * square_size_mm, 0.0);
   }
   // face_from_front: identity for the front face, back_from_front for the back.
   Pose FaceFromFront(Face face) const { return face == Face::kFront ? Pose::Identity() : back_from_front; }

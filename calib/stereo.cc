@@ -32,7 +32,7 @@ std::vector<double> RectifiedRowErrors(const Camera& left, const Camera& right, 
                                        const std::vector<Eigen::Vector2d>& q_left,
                                        const std::vector<Eigen::Vector2d>& q_right) {
   const Pose left_from_right = right_from_left.Inverse();
-  const Eigen::Vector3d baseline = left_from_right.translation_mm();  // right camera centre, left frame
+  const Eigen::Vector3d& baseline = left_from_right.translation_mm();  // right camera centre, left frame
   const Eigen::Vector3d ex = baseline.normalized();
   const Eigen::Vector3d z_mean = (Eigen::Vector3d::UnitZ() + left_from_right.rotation().col(2)).normalized();
   const Eigen::Vector3d ey = z_mean.cross(ex).normalized();

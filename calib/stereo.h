@@ -52,7 +52,7 @@ struct StereoResult {
 StereoResult CalibrateStereo(int module, const ModuleLayout& layout, const IntrinsicsResult& left,
                              const IntrinsicsResult& right, const std::vector<const BoardObservation*>& left_views,
                              const std::vector<const BoardObservation*>& right_views, const CalibrationInput& input,
-                             const StereoOptions& options, const IntrinsicsOptions& intrinsics_options);
+                             const StereoOptions& options, const IntrinsicsOptions& iopt);
 
 // Rectified-row differences (px) of corresponding pixels of a calibrated
 // pair: both rays are turned into a common rectified frame whose x axis runs

@@ -44,7 +44,7 @@ SyntheticData MakeSyntheticCaptures(const Rig& rig, const TargetGeometry& target
     const Pose ref_from_front = ref_from_volume * Pose(R, t) * Pose(Eigen::Matrix3d::Identity(), -centre_in_front);
     out.ref_from_front.push_back(ref_from_front);
     const Eigen::Vector3d normal_ref = ref_from_front.rotation().col(2);  // front face's z: away from its viewers
-    const Eigen::Vector3d origin_ref = ref_from_front.translation_mm();
+    const Eigen::Vector3d& origin_ref = ref_from_front.translation_mm();
     for (int cam = 0; cam < rig.num_cameras(); ++cam) {
       const Pose cam_from_ref = rig.CamFromReference(cam);
       const Eigen::Vector3d cam_centre_ref = cam_from_ref.Inverse().translation_mm();

@@ -34,8 +34,8 @@ struct SyntheticData {
 // reference frame; at tilt 0 the board's front face lies in the volume's xy
 // plane facing -z (its own z along the volume's z). `target` is what the
 // engine is told; `true_back_from_front` is how the board really is.
-SyntheticData MakeSyntheticCaptures(const Rig& rig, const TargetGeometry& target, const Pose& true_back_from_front,
-                                    const Pose& ref_from_volume, const SyntheticOptions& options);
+SyntheticData MakeSyntheticCaptures(const Rig& rig, const TargetGeometry& target, const Pose& true_bff,
+                                    const Pose& ref_from_volume, const SyntheticOptions& o);
 
 // Points filling a box (mm, half-sizes) around `ref_from_volume`, in the
 // reference frame: for the 3D accuracy checks.

@@ -12,7 +12,7 @@ bool TriangulatePair(const Camera& left, const Camera& right, const Pose& right_
   if (!left.Unproject(q_left, &vl) || !right.Unproject(q_right, &vr)) return false;
   const Pose left_from_right = right_from_left.Inverse();
   const Eigen::Vector3d vr_in_left = left_from_right.rotation() * vr;
-  const Eigen::Vector3d t = left_from_right.translation_mm();
+  const Eigen::Vector3d& t = left_from_right.translation_mm();
   const mrcal_point3_t v0 = {.xyz = {vl.x(), vl.y(), vl.z()}};
   const mrcal_point3_t v1 = {.xyz = {vr_in_left.x(), vr_in_left.y(), vr_in_left.z()}};
   const mrcal_point3_t t01 = {.xyz = {t.x(), t.y(), t.z()}};
