@@ -1,0 +1,120 @@
+#include "targets/board_svg.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+
+#include "calib/core/input_error.h"
+
+namespace stereorig {
+namespace {
+
+std::string ReadAll(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::map<std::string, std::string> Attributes(const std::string& element) {
+  std::map<std::string, std::string> a;
+  static const std::regex attr("([a-zA-Z-]+)=\"([^\"]*)\"");
+  for (std::sregex_iterator it(element.begin(), element.end(), attr), end; it != end; ++it) a[(*it)[1]] = (*it)[2];
+  return a;
+}
+
+TEST(BoardSvg, SquaresScaleBarAndPageAreInTrueMillimetres) {
+  const Target target = DefaultTarget();
+  const std::string path = (std::filesystem::temp_directory_path() / "stereorig_board_svg_test.svg").string();
+  const BoardSvg svg = MakeBoardSvg(target);
+  WriteBoardSvg(svg, path);
+  const std::string text = ReadAll(path);
+  ASSERT_EQ(text, svg.text);
+
+  // Well-formed XML, by an independent parser.
+  const std::string cmd = "/usr/bin/python3 -c \"import sys, xml.etree.ElementTree as E; E.parse(sys.argv[1])\" " + path;
+  EXPECT_EQ(std::system(cmd.c_str()), 0);
+
+  // The root: width and height in mm, and a viewBox of the same numbers, so
+  // a user unit is a millimetre.
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(text, m, std::regex("<svg [^>]*>")));
+  auto root = Attributes(m.str());
+  const double w = std::stod(root["width"]), h = std::stod(root["height"]);
+  EXPECT_EQ(root["width"], root["width"].substr(0, root["width"].size() - 2) + "mm");
+  EXPECT_EQ(root["height"].substr(root["height"].size() - 2), "mm");
+  std::istringstream vb(root["viewBox"]);
+  double x0, y0, vw, vh;
+  vb >> x0 >> y0 >> vw >> vh;
+  EXPECT_EQ(x0, 0);
+  EXPECT_EQ(y0, 0);
+  EXPECT_DOUBLE_EQ(vw, w);
+  EXPECT_DOUBLE_EQ(vh, h);
+
+  // Each face: squares of 9 mm, on a 9 mm lattice, exactly the black ones.
+  int expected_black = 0;
+  for (int j = -1; j < target.corners_y(); ++j)
+    for (int i = -1; i < target.corners_x(); ++i)
+      expected_black += target.IsBlack(Face::kFront, (i + 0.5) * 9.0, (j + 0.5) * 9.0);
+  for (const char* face : {"front", "back"}) {
+    SCOPED_TRACE(face);
+    const size_t begin = text.find(std::string("id=\"") + face + "\"");
+    ASSERT_NE(begin, std::string::npos);
+    const size_t end = text.find(" </g>\n", begin);
+    const std::string group = text.substr(begin, end - begin);
+    int squares = 0;
+    double min_x = 1e9, min_y = 1e9;
+    std::vector<std::pair<double, double>> corners;
+    static const std::regex square("<rect class=\"square\"[^>]*>");
+    for (std::sregex_iterator it(group.begin(), group.end(), square), e; it != e; ++it) {
+      auto a = Attributes(it->str());
+      EXPECT_DOUBLE_EQ(std::stod(a["width"]), 9.0);
+      EXPECT_DOUBLE_EQ(std::stod(a["height"]), 9.0);
+      corners.emplace_back(std::stod(a["x"]), std::stod(a["y"]));
+      min_x = std::min(min_x, corners.back().first);
+      min_y = std::min(min_y, corners.back().second);
+      ++squares;
+    }
+    EXPECT_EQ(squares, expected_black);
+    for (const auto& [x, y] : corners) {
+      // On the lattice: a whole number of squares from the leftmost/topmost.
+      EXPECT_NEAR(std::remainder(x - min_x, 9.0), 0.0, 1e-4);
+      EXPECT_NEAR(std::remainder(y - min_y, 9.0), 0.0, 1e-4);
+    }
+    // The tags' cells are there too, smaller than a square.
+    EXPECT_NE(group.find("class=\"tag-cell\""), std::string::npos);
+  }
+
+  // The scale bar: 100 mm, and its label says so.
+  ASSERT_TRUE(std::regex_search(text, m, std::regex("<rect class=\"scale-bar\"[^>]*>")));
+  EXPECT_DOUBLE_EQ(std::stod(Attributes(m.str())["width"]), 100.0);
+  EXPECT_NE(text.find("check: this bar is 100.0 mm"), std::string::npos);
+  // The page holds the two plates side by side.
+  const double plate_w = target.max_x_mm() - target.min_x_mm();
+  EXPECT_GT(w, 2 * plate_w);
+  std::filesystem::remove(path);
+}
+
+TEST(BoardSvg, PlainBoardHasOneFaceAndNoBack) {
+  const Target plain = PlainTarget(9, 6, 25.0);
+  const BoardSvg svg = MakeBoardSvg(plain);
+  EXPECT_NE(svg.text.find("id=\"front\""), std::string::npos);
+  EXPECT_EQ(svg.text.find("id=\"back\""), std::string::npos);
+  EXPECT_EQ(svg.text.find("tag-cell"), std::string::npos);
+  BoardSvgOptions back;
+  back.faces = SvgFaces::kBack;
+  EXPECT_THROW(MakeBoardSvg(plain, back), InputError);
+  // 10x7 squares of 25 mm, alternating: 35 black.
+  size_t n = 0, pos = 0;
+  while ((pos = svg.text.find("class=\"square\"", pos)) != std::string::npos) ++n, ++pos;
+  EXPECT_EQ(n, 35u);
+}
+
+}  // namespace
+}  // namespace stereorig
