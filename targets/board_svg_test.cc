@@ -10,7 +10,10 @@
 #include <regex>
 #include <sstream>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include "calib/core/input_error.h"
+#include "targets/detect.h"
 
 namespace stereorig {
 namespace {
@@ -114,6 +117,54 @@ TEST(BoardSvg, PlainBoardHasOneFaceAndNoBack) {
   size_t n = 0, pos = 0;
   while ((pos = svg.text.find("class=\"square\"", pos)) != std::string::npos) ++n, ++pos;
   EXPECT_EQ(n, 35u);
+}
+
+// The print, as an independent rasteriser (python3, rects only) sees it,
+// is a target the detector reads: the right face, every corner, each where
+// the target file puts it. 4 px per mm: a 9 mm square is 36 px.
+TEST(BoardSvg, RasterisedPrintIsDetectedWhereTheTargetSaysItsCornersAre) {
+  const Target target = DefaultTarget();
+  const double px_per_mm = 4.0;
+  const std::string dir = std::filesystem::temp_directory_path().string();
+  for (SvgFaces which : {SvgFaces::kFront, SvgFaces::kBack, SvgFaces::kBoth}) {
+    BoardSvgOptions options;
+    options.faces = which;
+    const BoardSvg svg = MakeBoardSvg(target, options);
+    const std::string svg_path = dir + "/stereorig_raster_test.svg", png_path = dir + "/stereorig_raster_test.png";
+    WriteBoardSvg(svg, svg_path);
+    const std::string cmd = "/usr/bin/python3 " STEREORIG_SOURCE_DIR "/targets/testdata/rasterize_svg_rects.py " +
+                            svg_path + " " + png_path + " " + std::to_string(px_per_mm);
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    const cv::Mat grey = cv::imread(png_path, cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(grey.empty());
+    const DetectResult r = TargetDetector(target, DetectOptions()).Detect(grey);
+    if (which == SvgFaces::kBoth) {
+      EXPECT_EQ(r.reason, RejectReason::kBothFaces) << r.message;  // both faces on one sheet
+      continue;
+    }
+    const Face face = which == SvgFaces::kFront ? Face::kFront : Face::kBack;
+    ASSERT_EQ(r.faces.size(), 1u) << r.message;
+    EXPECT_EQ(r.faces[0].face, face);
+    ASSERT_EQ(r.faces[0].quality.num_corners, target.num_corners());
+    // Where corner id must be: the plate's top-left on the page, read from the
+    // SVG's plate outline, plus the corner's face position; then pixels with
+    // (0,0) at the centre of the top-left pixel.
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(svg.text, m, std::regex("<rect class=\"plate\"[^>]*>")));
+    auto plate = Attributes(m.str());
+    const double ox = std::stod(plate["x"]) - target.min_x_mm(), oy = std::stod(plate["y"]) - target.min_y_mm();
+    double sum_sq = 0;
+    for (size_t i = 0; i < r.faces[0].corner_ids.size(); ++i) {
+      const Eigen::Vector3d p = target.CornerInFace(r.faces[0].corner_ids[i]);
+      const Eigen::Vector2d expected((ox + p.x()) * px_per_mm - 0.5, (oy + p.y()) * px_per_mm - 0.5);
+      sum_sq += (r.faces[0].q_px[i] - expected).squaredNorm();
+    }
+    // Edges fall on pixel boundaries here (axis-aligned, 4 px per mm), the
+    // easy case: a few hundredths of a px; a wrong id would be 36 px off.
+    EXPECT_LT(std::sqrt(sum_sq / target.num_corners()), 0.05);
+    std::filesystem::remove(png_path);
+    std::filesystem::remove(svg_path);
+  }
 }
 
 }  // namespace
