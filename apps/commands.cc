@@ -9,14 +9,12 @@ int RunDemo(int argc, char** argv);
 int RunRig(int argc, char** argv);
 int RunMatch(int argc, char** argv);
 int RunVerify(int argc, char** argv);
+int RunTarget(int argc, char** argv);
 
 namespace {
 
 int RunSimulate(int argc, char** argv) {
   return NotBuiltYet("simulate", "Render a rig spec into a dataset with ground truth.", argc, argv);
-}
-int RunTarget(int argc, char** argv) {
-  return NotBuiltYet("target", "Write a printable double-sided target at true scale.", argc, argv);
 }
 int RunCalibrate(int argc, char** argv) {
   return NotBuiltYet("calibrate", "Images + target + layout -> rig file + report.", argc, argv);
