@@ -7,6 +7,7 @@ namespace stereorig {
 
 int RunDemo(int argc, char** argv);
 int RunRig(int argc, char** argv);
+int RunCalibrate(int argc, char** argv);
 int RunMatch(int argc, char** argv);
 int RunVerify(int argc, char** argv);
 
@@ -17,9 +18,6 @@ int RunSimulate(int argc, char** argv) {
 }
 int RunTarget(int argc, char** argv) {
   return NotBuiltYet("target", "Write a printable double-sided target at true scale.", argc, argv);
-}
-int RunCalibrate(int argc, char** argv) {
-  return NotBuiltYet("calibrate", "Images + target + layout -> rig file + report.", argc, argv);
 }
 int RunReconstruct(int argc, char** argv) {
   return NotBuiltYet("reconstruct", "Rig file + capture -> point cloud, mesh, report.", argc, argv);
