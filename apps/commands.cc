@@ -8,6 +8,8 @@ namespace stereorig {
 int RunDemo(int argc, char** argv);
 int RunRig(int argc, char** argv);
 int RunMatch(int argc, char** argv);
+int RunReconstruct(int argc, char** argv);
+int RunBench(int argc, char** argv);
 int RunVerify(int argc, char** argv);
 
 namespace {
@@ -21,15 +23,8 @@ int RunTarget(int argc, char** argv) {
 int RunCalibrate(int argc, char** argv) {
   return NotBuiltYet("calibrate", "Images + target + layout -> rig file + report.", argc, argv);
 }
-int RunReconstruct(int argc, char** argv) {
-  return NotBuiltYet("reconstruct", "Rig file + capture -> point cloud, mesh, report.", argc, argv);
-}
 int RunCheck(int argc, char** argv) {
   return NotBuiltYet("check", "Nightly check: fresh target captures + rig file -> drift verdict, history.", argc,
-                     argv);
-}
-int RunBench(int argc, char** argv) {
-  return NotBuiltYet("bench", "Throughput of the runtime, side by side with an OpenCV StereoSGBM pipeline.", argc,
                      argv);
 }
 
