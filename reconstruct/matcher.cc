@@ -35,6 +35,7 @@ void MatchOptions::Check() const {
   sgm.Check();
   subpixel.Check();
   if (!(min_zncc >= -1 && min_zncc < 1)) throw InputError("min_zncc", "must be in [-1, 1)");
+  if (!(max_plane_deviation_px >= 0)) throw InputError("max_plane_deviation_px", "must be >= 0 (0 = off)");
   if (!(min_texture_dn >= 0)) throw InputError("min_texture_dn", "must be >= 0");
   if (speckle_window_px < 0) throw InputError("speckle_window_px", "must be >= 0 (0 = off)");
   if (!(speckle_range_px > 0)) throw InputError("speckle_range_px", "must be > 0");
@@ -147,7 +148,7 @@ void RemoveSpeckles(cv::Mat& disparity_px, const MatchOptions& o) {
 // pixels of a 9x9 window (box filters of masked moments). Averaging 81
 // samples of the ~0.1 px noisy integer-level field gives slopes good to
 // ~0.005 px/px, so the sub-pixel window's model error is negligible.
-void DisparitySlopes(const cv::Mat& disparity, cv::Mat* slope_x, cv::Mat* slope_y) {
+void DisparitySlopes(const cv::Mat& disparity, cv::Mat* slope_x, cv::Mat* slope_y, cv::Mat* plane) {
   const cv::Size k(9, 9);
   cv::Mat m(disparity.size(), CV_32FC1), md(disparity.size(), CV_32FC1), xs(disparity.size(), CV_32FC1),
       ys(disparity.size(), CV_32FC1);
@@ -173,6 +174,7 @@ void DisparitySlopes(const cv::Mat& disparity, cv::Mat* slope_x, cv::Mat* slope_
                 s_xy = box(mx.mul(ys));
   *slope_x = cv::Mat(disparity.size(), CV_32FC1, cv::Scalar(0));
   *slope_y = cv::Mat(disparity.size(), CV_32FC1, cv::Scalar(0));
+  *plane = cv::Mat(disparity.size(), CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
   for (int y = 0; y < disparity.rows; ++y)
     for (int x = 0; x < disparity.cols; ++x) {
       const double n = s_m.at<float>(y, x);
@@ -187,6 +189,7 @@ void DisparitySlopes(const cv::Mat& disparity, cv::Mat* slope_x, cv::Mat* slope_
       if (std::abs(gx) > 1.5 || std::abs(gy) > 1.5) continue;  // a depth edge, not a surface
       slope_x->at<float>(y, x) = float(gx);
       slope_y->at<float>(y, x) = float(gy);
+      plane->at<float>(y, x) = float(md_ + gx * (x - mxv) + gy * (y - myv));
     }
 }
 
@@ -224,8 +227,8 @@ MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::
   result.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
   result.confidence = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
   const double dmax = o.min_disparity_px + o.num_disparities - 1;
-  cv::Mat slope_x, slope_y;
-  DisparitySlopes(coarse_to_fine, &slope_x, &slope_y);
+  cv::Mat slope_x, slope_y, plane;
+  DisparitySlopes(coarse_to_fine, &slope_x, &slope_y, &plane);
   ParallelForChunks(roi.height, o.num_threads, [&](int b, int e) {
     for (int yy = b; yy < e; ++yy) {
       const int y = roi.y + yy;
@@ -244,6 +247,12 @@ MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::
           confidence = float(std::clamp(s.zncc, 0.0, 1.0));
         }
         if (d < o.min_disparity_px || d > dmax) continue;  // range filter
+        // Consistency with the neighbourhood: the refined disparity must lie
+        // within max_plane_deviation_px of the plane fitted to the 9x9
+        // integer-level disparities around it (isolated mismatches and the
+        // edges of mismatched patches fail this).
+        const float pl = plane.at<float>(yy, xx);
+        if (o.max_plane_deviation_px > 0 && (std::isnan(pl) || std::abs(d - pl) > o.max_plane_deviation_px)) continue;
         out[x] = float(d);
         conf[x] = confidence;
       }

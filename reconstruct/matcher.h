@@ -12,8 +12,9 @@
 //   3. sub-pixel: an equiangular fit of the cost, then a gain/offset
 //      Lucas-Kanade fit on the intensities (subpixel_refine.h), which removes
 //      the cost fit's peak-locking bias;
-//   4. filters: ZNCC and texture thresholds, speckle removal (connected
-//      components of similar disparity smaller than speckle_window_px), range.
+//   4. filters: ZNCC and texture thresholds, consistency with the local
+//      disparity plane, speckle removal (connected components of similar
+//      disparity smaller than speckle_window_px), range.
 // MatcherKind::kOpenCvSgbm3Way runs OpenCV's StereoSGBM (MODE_SGBM_3WAY) on
 // the same region and range: the baseline every figure is compared against.
 #pragma once
@@ -50,6 +51,7 @@ struct MatchOptions {
   bool intensity_refinement = true;  // census_sgm: Lucas-Kanade sub-pixel step; default true
   SubpixelOptions subpixel;     // its window and limits
   double min_zncc = 0.8;        // reject matches whose refined window correlates less; default 0.8
+  double max_plane_deviation_px = 0.7;  // reject d farther than this from the local 9x9 disparity plane (0 = off); default 0.7
   double min_texture_dn = 1.5;  // reject windows with a grey-level std below this; default 1.5 DN
   int speckle_window_px = 100;  // remove disparity blobs smaller than this, px (0 = off); default 100
   double speckle_range_px = 1.0;  // neighbours within this disparity are one blob, px; default 1
