@@ -1,0 +1,331 @@
+#include "calib/calibrate.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <iostream>
+#include <map>
+#include <set>
+
+#include "calib/core/cameramodel_export.h"
+#include "calib/core/input_error.h"
+#include "calib/json_writer.h"
+
+namespace stereorig {
+
+void TargetGeometry::Check(const std::string& where) const {
+  if (corners_x < 2 || corners_y < 2) throw InputError(where, "the board needs at least 2x2 inner corners");
+  if (!(square_size_mm > 0)) throw InputError(where, "square size must be > 0 mm");
+  for (int i = 0; i < 6; ++i)
+    if (!(back_from_front_sigma(i) >= 0)) throw InputError(where, "back_from_front sigma must be >= 0");
+}
+
+TargetGeometry TargetGeometryFromTarget(const Target& t) {
+  TargetGeometry g;
+  g.corners_x = t.corners_x();
+  g.corners_y = t.corners_y();
+  g.square_size_mm = t.square_size_mm();
+  g.double_sided = t.double_sided();
+  g.back_from_front = t.back_from_front();
+  g.back_from_front_sigma = t.back_from_front_sigma();
+  return g;
+}
+
+void CalibrationOptions::Check() const {
+  intrinsics.Check();
+  stereo.Check();
+  system.Check();
+}
+
+void ValidateInput(const CalibrationInput& in) {
+  const std::string& src = in.source;
+  in.target.Check(src + ": target");
+  if (in.cameras.empty()) throw InputError(src, "no cameras in the layout");
+  if (in.modules.empty()) throw InputError(src, "no modules in the layout");
+  const int nc = static_cast<int>(in.cameras.size());
+  std::vector<int> module_of(nc, -1);
+  for (size_t k = 0; k < in.modules.size(); ++k) {
+    const ModuleLayout& m = in.modules[k];
+    const std::string w = src + ": layout module " + std::to_string(k) + " (" + m.name + ")";
+    for (int c : {m.left_camera, m.right_camera}) {
+      if (c < 0 || c >= nc) throw InputError(w, "names camera " + std::to_string(c) + ", which does not exist");
+      if (module_of[c] >= 0)
+        throw InputError(w,
+                         "camera " + std::to_string(c) + " already belongs to module " + std::to_string(module_of[c]));
+      module_of[c] = static_cast<int>(k);
+    }
+  }
+  for (int c = 0; c < nc; ++c) {
+    if (module_of[c] < 0) throw InputError(src, "camera " + std::to_string(c) + " belongs to no module");
+    if (in.cameras[c].width_px <= 0 || in.cameras[c].height_px <= 0) {
+      throw InputError(src, "camera " + std::to_string(c) + " has no imager size");
+    }
+  }
+  std::set<std::pair<int, int>> seen;
+  std::map<std::pair<int, int>, Face> module_face;  // (capture, module)
+  std::vector<int> views(nc, 0);
+  for (const BoardObservation& o : in.observations) {
+    const std::string w = src + ": capture " + std::to_string(o.capture) + ", camera " + std::to_string(o.camera);
+    if (o.camera < 0 || o.camera >= nc) throw InputError(w, "no such camera in the layout");
+    if (!seen.insert({o.capture, o.camera}).second) throw InputError(w, "observed twice");
+    if (o.corner_ids.size() != o.q_px.size()) throw InputError(w, "corner ids and pixels differ in number");
+    std::set<int> ids;
+    const CameraSpec& cs = in.cameras[o.camera];
+    for (size_t i = 0; i < o.corner_ids.size(); ++i) {
+      const int id = o.corner_ids[i];
+      if (id < 0 || id >= in.target.num_corners()) {
+        throw InputError(w, "corner id " + std::to_string(id) + " is not on the " +
+                                std::to_string(in.target.corners_x) + "x" + std::to_string(in.target.corners_y) +
+                                " board");
+      }
+      if (!ids.insert(id).second) throw InputError(w, "corner id " + std::to_string(id) + " appears twice");
+      const Eigen::Vector2d& q = o.q_px[i];
+      if (!q.allFinite() || q.x() < -0.5 || q.y() < -0.5 || q.x() > cs.width_px - 0.5 || q.y() > cs.height_px - 0.5) {
+        char b[200];
+        std::snprintf(b, sizeof b, "corner at (%.1f, %.1f) px lies outside the %dx%d imager (wrong image size?)", q.x(),
+                      q.y(), cs.width_px, cs.height_px);
+        throw InputError(w, b);
+      }
+    }
+    if (o.face == Face::kBack && !in.target.double_sided) {
+      throw InputError(w, "sees the back face of a one-sided target");
+    }
+    const int k = module_of[o.camera];
+    const ModuleLayout& m = in.modules[k];
+    if (m.face && *m.face != o.face) {
+      throw InputError(w, std::string("face seen by the wrong module: module ") + std::to_string(k) + " (" + m.name +
+                              ") sees only the " + FaceName(*m.face) + " face, but this view is of the " +
+                              FaceName(o.face) + " face");
+    }
+    auto [it, fresh] = module_face.insert({{o.capture, k}, o.face});
+    if (!fresh && it->second != o.face) {
+      throw InputError(w, "the two cameras of module " + std::to_string(k) + " saw different faces in one capture");
+    }
+    if (!o.corner_ids.empty()) ++views[o.camera];
+  }
+  for (int c = 0; c < nc; ++c) {
+    if (views[c] == 0) {
+      throw InputError(src, "camera " + std::to_string(c) + " (" + in.cameras[c].name + ") never sees the board");
+    }
+  }
+}
+
+namespace {
+
+std::string NowUtc() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char b[32];
+  std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return b;
+}
+
+void Progress(bool on, const std::string& msg) {
+  if (on) std::cerr << "calibrate: " << msg << std::endl;
+}
+
+}  // namespace
+
+CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions& options) {
+  options.Check();
+  ValidateInput(in);
+  const int nc = static_cast<int>(in.cameras.size());
+  const int M = static_cast<int>(in.modules.size());
+  std::vector<std::vector<const BoardObservation*>> by_camera(nc);
+  for (const BoardObservation& o : in.observations)
+    if (!o.corner_ids.empty()) by_camera[o.camera].push_back(&o);
+
+  CalibrationResult result{Rig(), {}, {}, {}, {}};
+  CalibrationReport& rep = result.report;
+  rep.source = in.source;
+  rep.num_modules = M;
+
+  // Stage 1.
+  for (int c = 0; c < nc; ++c) {
+    Progress(options.progress, "stage 1: intrinsics of camera " + std::to_string(c) + " (" +
+                                   std::to_string(by_camera[c].size()) + " views)");
+    result.stage1.push_back(
+        CalibrateIntrinsics(c, in.cameras[c], in.target, by_camera[c], options.intrinsics, in.source));
+    rep.intrinsics.push_back(result.stage1.back().report);
+  }
+  // Stage 2.
+  std::vector<ModuleCameras> modules;
+  for (int k = 0; k < M; ++k) {
+    const ModuleLayout& m = in.modules[k];
+    Progress(options.progress, "stage 2: stereo extrinsics of module " + std::to_string(k));
+    result.stage2.push_back(CalibrateStereo(k, m, result.stage1[m.left_camera], result.stage1[m.right_camera],
+                                            by_camera[m.left_camera], by_camera[m.right_camera], in, options.stereo,
+                                            options.intrinsics));
+    rep.stereo.push_back(result.stage2.back().report);
+    const StereoResult& s = result.stage2.back();
+    modules.push_back({m.left_camera, m.right_camera, s.left, s.right, s.right_from_left});
+  }
+  // Stage 3.
+  std::vector<Pose> module0_from_module(M);
+  if (M > 1) {
+    Progress(options.progress, "stage 3: Horn + bundle adjustment over " + std::to_string(M) + " modules");
+    double s2 = 0;
+    for (const StereoReport& s : rep.stereo) s2 += s.rms_px * s.rms_px;
+    result.stage3 = CalibrateSystem(in, modules, std::sqrt(s2 / rep.stereo.size()), options.system);
+    modules = result.stage3.modules;
+    module0_from_module = result.stage3.module0_from_module;
+    rep.system = result.stage3.report;
+  } else {
+    result.stage3.module0_from_module = module0_from_module;
+    result.stage3.module0_from_module_horn = module0_from_module;
+    result.stage3.modules = modules;
+  }
+
+  // The rig.
+  std::vector<Camera> cameras(nc, Camera("LENSMODEL_PINHOLE", {1, 1, 0, 0}, 1, 1));
+  std::vector<std::string> names(nc);
+  std::vector<StereoModule> rig_modules;
+  for (int k = 0; k < M; ++k) {
+    cameras[modules[k].left_camera] = modules[k].left;
+    cameras[modules[k].right_camera] = modules[k].right;
+    rig_modules.push_back(
+        {in.modules[k].name, modules[k].left_camera, modules[k].right_camera, modules[k].right_from_left});
+  }
+  for (int c = 0; c < nc; ++c) names[c] = in.cameras[c].name;
+  result.rig = Rig(std::move(cameras), std::move(names), std::move(rig_modules), module0_from_module);
+  Provenance& pv = result.rig.provenance();
+  pv.tool = std::string("stereorig ") + STEREORIG_VERSION;
+  pv.date_utc = NowUtc();
+  pv.input = in.source;
+  // Keys as docs/formats.md fixes them (stereorig check reads them).
+  for (const IntrinsicsReport& r : rep.intrinsics) {
+    pv.residuals["cam" + std::to_string(r.camera) + "_rms_px"] = r.rms_px;
+    for (const PixelUncertainty& u : r.uncertainty)
+      if (u.where == "centre")
+        pv.uncertainties["cam" + std::to_string(r.camera) + "_projection_center_px"] = u.rms_stdev_px;
+  }
+  for (const StereoReport& s : rep.stereo) {
+    pv.residuals["module" + std::to_string(s.module) + "_stereo_rms_px"] = s.rms_px;
+    pv.residuals["module" + std::to_string(s.module) + "_rectified_row_rms_px"] = s.rectified_row_rms_px;
+  }
+  if (M > 1) {
+    pv.residuals["rig_rms_px"] = rep.system.refined_reprojection_rms_px;
+    pv.residuals["rig_horn_only_rms_px"] = rep.system.horn_reprojection_rms_px;
+    for (const STransformSigma& s : rep.system.sigma) {
+      const std::string k = "S_0_" + std::to_string(s.module);
+      pv.uncertainties[k + "_translation_mm"] = s.translation_mm.norm();
+      pv.uncertainties[k + "_rotation_deg"] = s.rotation_deg.norm();
+    }
+  }
+  return result;
+}
+
+namespace {
+
+void WriteIntrinsics(JsonWriter& j, const IntrinsicsReport& r) {
+  j.BeginObject();
+  j.Int("camera", r.camera).String("name", r.camera_name).String("lensmodel", r.lensmodel);
+  j.Int("views", r.num_views).Int("views_dropped", r.num_views_dropped).Int("corners", r.num_corners);
+  j.Int("outliers", r.num_outliers).Number("rms_px", r.rms_px).Number("observed_sigma_px", r.observed_sigma_px);
+  j.Number("max_tilt_deg", r.max_tilt_deg);
+  j.BeginArray("worst_views");
+  for (const ViewResidual& v : r.worst_views) {
+    j.BeginObject().Int("capture", v.capture).Number("rms_px", v.rms_px).Int("corners", v.num_corners).EndObject();
+  }
+  j.EndArray();
+  j.BeginObject("coverage").Int("cells_x", r.coverage_cells_x).Int("cells_y", r.coverage_cells_y);
+  j.Number("fraction", r.coverage_fraction).BeginArray("counts");
+  for (int c : r.coverage) j.Int(c);
+  j.EndArray().EndObject();
+  j.BeginObject("projection_uncertainty").Number("range_mm", r.uncertainty_range_mm).BeginArray("at");
+  for (const PixelUncertainty& u : r.uncertainty) {
+    j.BeginObject().String("where", u.where).Numbers("q_px", {u.q_px.x(), u.q_px.y()});
+    j.Number("sigma_px", u.rms_stdev_px).Number("worst_direction_sigma_px", u.worst_direction_stdev_px).EndObject();
+  }
+  j.EndArray().EndObject();
+  j.EndObject();
+}
+
+void WritePose(JsonWriter& j, const std::string& key, const Pose& p) {
+  const Eigen::Vector3d r = p.RotationVector() * 180.0 / M_PI;
+  j.BeginObject(key).Numbers("rotation_vector_deg", {r.x(), r.y(), r.z()});
+  j.Numbers("translation_mm", {p.translation_mm().x(), p.translation_mm().y(), p.translation_mm().z()}).EndObject();
+}
+
+}  // namespace
+
+std::string CalibrationReport::ToJson() const {
+  JsonWriter j;
+  j.BeginObject().String("source", source).Int("modules", num_modules);
+  j.BeginArray("stage1_intrinsics");
+  for (const IntrinsicsReport& r : intrinsics) WriteIntrinsics(j, r);
+  j.EndArray();
+  j.BeginArray("stage2_stereo");
+  for (const StereoReport& s : stereo) {
+    j.BeginObject().Int("module", s.module).String("name", s.module_name);
+    j.Int("shared_views", s.num_shared_views).Int("frames", s.num_frames).Number("rms_px", s.rms_px);
+    j.Int("outliers", s.num_outliers).Number("baseline_mm", s.baseline_mm).Number("rotation_deg", s.rotation_deg);
+    j.Numbers("right_from_left_rotation_vector_deg",
+              {s.right_from_left_rotation_vector_deg.x(), s.right_from_left_rotation_vector_deg.y(),
+               s.right_from_left_rotation_vector_deg.z()});
+    j.Numbers("right_from_left_translation_mm",
+              {s.right_from_left_translation_mm.x(), s.right_from_left_translation_mm.y(),
+               s.right_from_left_translation_mm.z()});
+    j.Number("rectified_row_rms_px", s.rectified_row_rms_px).Number("rectified_row_max_px", s.rectified_row_max_px);
+    j.Int("corner_pairs", s.num_corner_pairs);
+    j.BeginArray("cameras_joint_solve");
+    WriteIntrinsics(j, s.left);
+    WriteIntrinsics(j, s.right);
+    j.EndArray();
+    j.EndObject();
+  }
+  j.EndArray();
+  if (num_modules > 1) {
+    const SystemReport& s = system;
+    j.BeginObject("stage3_system").Int("captures", s.num_captures).Int("corner_residuals", s.num_residual_corners);
+    j.BeginArray("spanning_tree");
+    for (const auto& [a, b] : s.spanning_tree) {
+      j.BeginObject().Int("parent", a).Int("child", b).Number("horn_rms_mm", s.horn_rms_mm.at({a, b})).EndObject();
+    }
+    j.EndArray();
+    j.BeginObject("horn_only")
+        .Number("reprojection_rms_px", s.horn_reprojection_rms_px)
+        .BeginArray("module0_from_module");
+    for (const Pose& p : s.module0_from_module_horn) {
+      j.BeginObject();
+      WritePose(j, "pose", p);
+      j.EndObject();
+    }
+    j.EndArray().EndObject();
+    j.BeginObject("refined")
+        .Number("reprojection_rms_px", s.refined_reprojection_rms_px)
+        .BeginArray("module0_from_module");
+    for (const Pose& p : s.module0_from_module) {
+      j.BeginObject();
+      WritePose(j, "pose", p);
+      j.EndObject();
+    }
+    j.EndArray().EndObject();
+    j.String("covariance", s.covariance_status).BeginArray("sigma_S_0_k");
+    for (const STransformSigma& x : s.sigma) {
+      j.BeginObject().Int("module", x.module);
+      j.Numbers("rotation_deg", {x.rotation_deg.x(), x.rotation_deg.y(), x.rotation_deg.z()});
+      j.Numbers("translation_mm", {x.translation_mm.x(), x.translation_mm.y(), x.translation_mm.z()}).EndObject();
+    }
+    j.EndArray();
+    WritePose(j, "back_from_front_refined", s.back_from_front);
+    j.Number("back_from_front_change_deg", s.back_from_front_change_deg);
+    j.Number("back_from_front_change_mm", s.back_from_front_change_mm);
+    j.String("solver", s.solver_summary).EndObject();
+  }
+  j.EndObject();
+  return j.str() + "\n";
+}
+
+std::vector<std::string> ExportCameramodels(const Rig& rig, const std::string& dir) {
+  std::vector<std::string> paths;
+  for (int c = 0; c < rig.num_cameras(); ++c) {
+    paths.push_back(dir + "/" + rig.camera_names()[c] + ".cameramodel");
+    WriteCameramodel(rig.camera(c), rig.CamFromReference(c), paths.back());
+  }
+  return paths;
+}
+
+}  // namespace stereorig

@@ -1,0 +1,60 @@
+// The calibration engine's entry point: corner observations -> a Rig (with
+// provenance) and a report holding every figure of the three stages.
+//
+//   Stage 1: each camera's intrinsics (intrinsics.h).
+//   Stage 2: each module's right_from_left, joint with both lenses (stereo.h).
+//   Stage 3: the S matrix: Horn, then one bundle adjustment (system.h).
+//
+// Bad input (too few views, a degenerate set, a camera that never sees the
+// board, a corner outside its imager, a face seen by the wrong module, ...) is
+// refused with an InputError that names the problem.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "calib/core/rig.h"
+#include "calib/intrinsics.h"
+#include "calib/observations.h"
+#include "calib/stereo.h"
+#include "calib/system.h"
+
+namespace stereorig {
+
+struct CalibrationOptions {
+  IntrinsicsOptions intrinsics;
+  StereoOptions stereo;
+  SystemOptions system;
+  bool progress = false;  // one line per step on stderr; default false
+  void Check() const;
+};
+
+struct CalibrationReport {
+  std::string source;
+  std::vector<IntrinsicsReport> intrinsics;  // stage 1, per camera
+  std::vector<StereoReport> stereo;          // stage 2, per module
+  SystemReport system;                       // stage 3 (empty for a 1-module rig)
+  int num_modules = 0;
+  std::string ToJson() const;
+};
+
+struct CalibrationResult {
+  Rig rig;
+  CalibrationReport report;
+  std::vector<IntrinsicsResult> stage1;  // per camera
+  std::vector<StereoResult> stage2;      // per module
+  SystemResult stage3;
+};
+
+// Validates `input` (throws InputError) and runs the three stages.
+CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOptions& options);
+
+// The input checks alone (throws InputError on the first problem).
+void ValidateInput(const CalibrationInput& input);
+
+// Writes every camera of `rig` as DIR/<camera name>.cameramodel (mrcal's
+// format, %.17g), with extrinsics = cam_from_module0. Each file is written
+// atomically. Returns the paths written.
+std::vector<std::string> ExportCameramodels(const Rig& rig, const std::string& dir);
+
+}  // namespace stereorig

@@ -1,0 +1,176 @@
+#include "calib/check/board_pose.h"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <opencv2/calib3d.hpp>
+
+namespace stereorig {
+
+Eigen::Vector3d CornerInFront(const Target& target, Face face, int id) {
+  const Eigen::Vector3d p = target.CornerInFace(id);
+  return face == Face::kFront ? p : target.back_from_front().Inverse() * p;
+}
+
+namespace {
+
+// Residual of one corner: Project(cam_from_ref * ref_from_front(params) * p_front) - q.
+// mrcal's projection is not templated, so Ceres differentiates numerically
+// (central differences; 6 parameters, ~1e-9 px accuracy is plenty).
+struct CornerResidual {
+  const Camera* camera;
+  Pose cam_from_ref;
+  Eigen::Vector3d p_front;
+  Eigen::Vector2d q;
+  bool operator()(const double* rt, double* residual) const {
+    const Pose ref_from_front = Pose::FromRotationVector({rt[0], rt[1], rt[2]}, {rt[3], rt[4], rt[5]});
+    const Eigen::Vector3d p_cam = cam_from_ref * (ref_from_front * p_front);
+    if (p_cam.z() <= 0) return false;
+    const Eigen::Vector2d e = camera->Project(p_cam) - q;
+    residual[0] = e.x();
+    residual[1] = e.y();
+    return true;
+  }
+  static ceres::CostFunction* Create(const Camera* camera, const Pose& cam_from_ref, const Eigen::Vector3d& p_front,
+                                     const Eigen::Vector2d& q) {
+    return new ceres::NumericDiffCostFunction<CornerResidual, ceres::CENTRAL, 2, 6>(
+        new CornerResidual{camera, cam_from_ref, p_front, q});
+  }
+};
+
+bool SeedWithPnp(const Rig& rig, const Target& target, const CornerView& view, Pose* ref_from_front) {
+  if (view.corner_ids.size() < 6) return false;
+  const Camera& cam = rig.camera(view.camera);
+  std::vector<cv::Point3d> object;
+  std::vector<cv::Point2d> normalized;
+  for (size_t k = 0; k < view.corner_ids.size(); ++k) {
+    Eigen::Vector3d v;
+    if (!cam.Unproject(view.q_px[k], &v) || v.z() <= 0) continue;
+    const Eigen::Vector3d p = target.CornerInFace(view.corner_ids[k]);
+    object.emplace_back(p.x(), p.y(), p.z());
+    normalized.emplace_back(v.x() / v.z(), v.y() / v.z());
+  }
+  if (object.size() < 6) return false;
+  cv::Mat rvec, tvec;
+  // Normalised image coordinates: identity camera matrix, no distortion (the
+  // lens was removed by mrcal's unprojection).
+  if (!cv::solvePnP(object, normalized, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvec, tvec, false,
+                    cv::SOLVEPNP_IPPE)) {
+    return false;
+  }
+  const Pose cam_from_face = Pose::FromRotationVector({rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2)},
+                                                      {tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2)});
+  const Pose face_from_front = view.face == Face::kFront ? Pose::Identity() : target.back_from_front();
+  *ref_from_front = rig.CamFromReference(view.camera).Inverse() * cam_from_face * face_from_front;
+  return true;
+}
+
+// d q / d (r, t) of ref_from_front for one corner seen by `camera`. (2x6)
+Eigen::Matrix<double, 2, 6> PoseJacobian(const Camera& camera, const Pose& cam_from_ref, const Pose& ref_from_front,
+                                         const Eigen::Vector3d& p_front) {
+  const Eigen::Vector3d r = ref_from_front.RotationVector();
+  const Eigen::Vector3d t = ref_from_front.translation_mm();
+  Eigen::Matrix<double, 2, 6> j;
+  for (int k = 0; k < 6; ++k) {
+    const double h = k < 3 ? 1e-7 : 1e-5;  // rad, mm
+    Eigen::Matrix<double, 6, 1> plus, minus;
+    plus << r, t;
+    minus = plus;
+    plus[k] += h;
+    minus[k] -= h;
+    const auto project = [&](const Eigen::Matrix<double, 6, 1>& x) {
+      const Pose pose = Pose::FromRotationVector(x.head<3>(), x.tail<3>());
+      return camera.Project(cam_from_ref * (pose * p_front));
+    };
+    j.col(k) = (project(plus) - project(minus)) / (2 * h);
+  }
+  return j;
+}
+
+}  // namespace
+
+PredictionStatistics PredictionErrorStatistics(const Rig& rig, const Target& target,
+                                               const std::vector<const CornerView*>& pose_views,
+                                               const std::vector<double>& sigma_px, const CornerView& view,
+                                               const Pose& ref_from_front) {
+  // Information of the pose from the views it came from, each corner
+  // weighted by its camera's noise.
+  Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
+  for (const CornerView* v : pose_views) {
+    const Camera& cam = rig.camera(v->camera);
+    const Pose cam_from_ref = rig.CamFromReference(v->camera);
+    const double w = 1.0 / (sigma_px[v->camera] * sigma_px[v->camera]);
+    for (int id : v->corner_ids) {
+      const auto j = PoseJacobian(cam, cam_from_ref, ref_from_front, CornerInFront(target, v->face, id));
+      information += w * j.transpose() * j;
+    }
+  }
+  const Eigen::Matrix<double, 6, 6> covariance = information.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
+  const Camera& cam = rig.camera(view.camera);
+  const Pose cam_from_ref = rig.CamFromReference(view.camera);
+  Eigen::Matrix<double, 6, 6> a = Eigen::Matrix<double, 6, 6>::Zero();
+  for (int id : view.corner_ids) {
+    const auto j = PoseJacobian(cam, cam_from_ref, ref_from_front, CornerInFront(target, view.face, id));
+    a += j.transpose() * j;
+  }
+  const Eigen::Matrix<double, 6, 6> a_sigma = a * covariance;
+  return {a_sigma.trace(), 2.0 * (a_sigma * a_sigma).trace()};
+}
+
+std::vector<Eigen::Vector2d> ReprojectionErrors(const Rig& rig, const Target& target, const CornerView& view,
+                                       const Pose& ref_from_front) {
+  const Camera& cam = rig.camera(view.camera);
+  const Pose cam_from_front = rig.CamFromReference(view.camera) * ref_from_front;
+  std::vector<Eigen::Vector2d> e;
+  for (size_t k = 0; k < view.corner_ids.size(); ++k) {
+    e.push_back(cam.Project(cam_from_front * CornerInFront(target, view.face, view.corner_ids[k])) - view.q_px[k]);
+  }
+  return e;
+}
+
+BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target, const std::vector<const CornerView*>& views) {
+  BoardPoseEstimate out;
+  const CornerView* seed = nullptr;
+  for (const CornerView* v : views)
+    if (!seed || v->corner_ids.size() > seed->corner_ids.size()) seed = v;
+  if (!seed || !SeedWithPnp(rig, target, *seed, &out.ref_from_front)) return out;
+
+  const Eigen::Vector3d r0 = out.ref_from_front.RotationVector();
+  const Eigen::Vector3d t0 = out.ref_from_front.translation_mm();
+  double rt[6] = {r0.x(), r0.y(), r0.z(), t0.x(), t0.y(), t0.z()};
+  ceres::Problem problem;
+  for (const CornerView* v : views) {
+    const Pose cam_from_ref = rig.CamFromReference(v->camera);
+    for (size_t k = 0; k < v->corner_ids.size(); ++k) {
+      problem.AddResidualBlock(
+          CornerResidual::Create(&rig.camera(v->camera), cam_from_ref, CornerInFront(target, v->face, v->corner_ids[k]),
+                                 v->q_px[k]),
+          nullptr, rt);
+    }
+  }
+  ceres::Solver::Options options;
+  options.max_num_iterations = 100;
+  // A pose from one camera has a flat direction (depth against tilt); stop
+  // on parameters, not on a relative cost change, or it stops short there.
+  options.function_tolerance = 1e-14;
+  options.gradient_tolerance = 1e-14;
+  options.parameter_tolerance = 1e-12;
+  options.num_threads = 1;
+  options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  if (!summary.IsSolutionUsable()) return out;
+  out.ref_from_front = Pose::FromRotationVector({rt[0], rt[1], rt[2]}, {rt[3], rt[4], rt[5]});
+  double ss = 0;
+  for (const CornerView* v : views)
+    for (const Eigen::Vector2d& e : ReprojectionErrors(rig, target, *v, out.ref_from_front)) {
+      ss += e.squaredNorm();
+      ++out.num_corners;
+    }
+  // Per-axis RMS, as mrcal reports it.
+  out.rms_px = std::sqrt(ss / (2.0 * std::max(1, out.num_corners)));
+  out.ok = true;
+  return out;
+}
+
+}  // namespace stereorig

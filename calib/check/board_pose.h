@@ -1,0 +1,52 @@
+// The target's pose from any set of calibrated cameras with the calibration
+// held fixed: ref_from_front, the board's front-face frame in the rig's
+// reference frame. Back-face corners enter through back_from_front.
+#pragma once
+
+#include <vector>
+
+#include "calib/check/corner_view.h"
+#include "calib/core/rig.h"
+#include "targets/target.h"
+
+namespace stereorig {
+
+struct BoardPoseEstimate {
+  bool ok = false;
+  Pose ref_from_front;
+  double rms_px = 0;  // per axis (as mrcal reports), over every corner of the views used
+  int num_corners = 0;
+};
+
+// `views` are all of one capture. Seeds with PnP from the view with the most
+// corners, then minimises reprojection error over every view (Ceres).
+BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target, const std::vector<const CornerView*>& views);
+
+// Reprojection residuals q_predicted - q (px, per corner) of `view` for a
+// given board pose.
+std::vector<Eigen::Vector2d> ReprojectionErrors(const Rig& rig, const Target& target, const CornerView& view,
+                                       const Pose& ref_from_front);
+
+// Linearised statistics of the prediction error that a pose's own
+// uncertainty puts on the corners of `view`. The pose was estimated from
+// `pose_views`, each corner with its camera's per-axis noise sigma_px[camera].
+// With J_k the 2x6 Jacobian of corner k's pixel by the pose, Sigma the pose
+// covariance and A = sum_k J_k^T J_k, the sum over the view's corners of
+// |prediction error|^2 is a quadratic form in a 6-D Gaussian:
+//   mean = tr(A Sigma),  variance = 2 tr((A Sigma)^2).
+// All corners share one pose error, so this variance is far larger than that
+// of independent per-corner errors. Jacobians are numeric (central
+// differences on the pose's rotation vector and translation).
+struct PredictionStatistics {
+  double mean_ss_px2 = 0;
+  double var_ss_px4 = 0;
+};
+PredictionStatistics PredictionErrorStatistics(const Rig& rig, const Target& target,
+                                               const std::vector<const CornerView*>& pose_views,
+                                               const std::vector<double>& sigma_px, const CornerView& view,
+                                               const Pose& ref_from_front);
+
+// A face's corner in the front-face frame.
+Eigen::Vector3d CornerInFront(const Target& target, Face face, int id);
+
+}  // namespace stereorig

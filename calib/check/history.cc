@@ -1,0 +1,170 @@
+#include "calib/check/history.h"
+
+#include <sqlite3.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <memory>
+
+#include "calib/core/input_error.h"
+
+namespace stereorig {
+
+namespace {
+
+struct DbCloser {
+  void operator()(sqlite3* db) const { sqlite3_close(db); }
+};
+using Db = std::unique_ptr<sqlite3, DbCloser>;
+struct StmtFinalizer {
+  void operator()(sqlite3_stmt* s) const { sqlite3_finalize(s); }
+};
+using Stmt = std::unique_ptr<sqlite3_stmt, StmtFinalizer>;
+
+constexpr const char* kSchema =
+    "CREATE TABLE IF NOT EXISTS stereorig_check_runs ("
+    "  id INTEGER PRIMARY KEY AUTOINCREMENT, date_utc TEXT NOT NULL, rig_file TEXT NOT NULL,"
+    "  captures TEXT NOT NULL, verdict TEXT NOT NULL, explanation TEXT NOT NULL);"
+    "CREATE TABLE IF NOT EXISTS stereorig_check_figures ("
+    "  run_id INTEGER NOT NULL REFERENCES stereorig_check_runs(id), name TEXT NOT NULL,"
+    "  value REAL NOT NULL, threshold REAL NOT NULL, pass INTEGER NOT NULL, samples INTEGER NOT NULL);";
+
+Db Open(const std::string& path, bool create) {
+  if (!create && !std::filesystem::exists(path)) throw InputError(path, "no such history database");
+  sqlite3* raw = nullptr;
+  const int flags = create ? SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE : SQLITE_OPEN_READONLY;
+  if (sqlite3_open_v2(path.c_str(), &raw, flags, nullptr) != SQLITE_OK) {
+    const std::string msg = raw ? sqlite3_errmsg(raw) : "cannot open";
+    sqlite3_close(raw);
+    throw InputError(path, "cannot open history database: " + msg);
+  }
+  sqlite3_busy_timeout(raw, 5000);
+  return Db(raw);
+}
+
+void Exec(sqlite3* db, const std::string& sql, const std::string& path) {
+  char* err = nullptr;
+  if (sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &err) != SQLITE_OK) {
+    const std::string msg = err ? err : "error";
+    sqlite3_free(err);
+    throw InputError(path, "history database: " + msg);
+  }
+}
+
+Stmt Prepare(sqlite3* db, const char* sql, const std::string& path) {
+  sqlite3_stmt* s = nullptr;
+  if (sqlite3_prepare_v2(db, sql, -1, &s, nullptr) != SQLITE_OK) {
+    throw InputError(path, std::string("history database: ") + sqlite3_errmsg(db));
+  }
+  return Stmt(s);
+}
+
+std::string Text(sqlite3_stmt* s, int col) {
+  const unsigned char* t = sqlite3_column_text(s, col);
+  return t ? reinterpret_cast<const char*>(t) : "";
+}
+
+}  // namespace
+
+long long AppendToHistory(const std::string& path, const HistoryRun& run, const CheckResult& result) {
+  Db db = Open(path, true);
+  Exec(db.get(), "BEGIN IMMEDIATE;", path);
+  try {
+    Exec(db.get(), kSchema, path);
+    Stmt ins = Prepare(db.get(),
+                       "INSERT INTO stereorig_check_runs (date_utc, rig_file, captures, verdict, explanation) "
+                       "VALUES (?, ?, ?, ?, ?);",
+                       path);
+    const std::string verdict = result.Verdict(), explanation = result.Explanation();
+    sqlite3_bind_text(ins.get(), 1, run.date_utc.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(ins.get(), 2, run.rig_file.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(ins.get(), 3, run.captures.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(ins.get(), 4, verdict.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(ins.get(), 5, explanation.c_str(), -1, SQLITE_TRANSIENT);
+    if (sqlite3_step(ins.get()) != SQLITE_DONE) throw InputError(path, std::string("history: ") + sqlite3_errmsg(db.get()));
+    const long long id = sqlite3_last_insert_rowid(db.get());
+    Stmt fig = Prepare(db.get(),
+                       "INSERT INTO stereorig_check_figures (run_id, name, value, threshold, pass, samples) "
+                       "VALUES (?, ?, ?, ?, ?, ?);",
+                       path);
+    for (const CheckFigure& f : result.figures) {
+      sqlite3_reset(fig.get());
+      sqlite3_bind_int64(fig.get(), 1, id);
+      sqlite3_bind_text(fig.get(), 2, f.name.c_str(), -1, SQLITE_TRANSIENT);
+      sqlite3_bind_double(fig.get(), 3, f.value);
+      sqlite3_bind_double(fig.get(), 4, f.threshold);
+      sqlite3_bind_int(fig.get(), 5, f.pass ? 1 : 0);
+      sqlite3_bind_int(fig.get(), 6, f.samples);
+      if (sqlite3_step(fig.get()) != SQLITE_DONE) {
+        throw InputError(path, std::string("history: ") + sqlite3_errmsg(db.get()));
+      }
+    }
+    Exec(db.get(), "COMMIT;", path);
+    return id;
+  } catch (...) {
+    sqlite3_exec(db.get(), "ROLLBACK;", nullptr, nullptr, nullptr);
+    throw;
+  }
+}
+
+std::vector<HistoryRun> ReadHistoryRuns(const std::string& path) {
+  Db db = Open(path, false);
+  Stmt s = Prepare(db.get(),
+                   "SELECT id, date_utc, rig_file, captures, verdict, explanation FROM stereorig_check_runs "
+                   "ORDER BY id;",
+                   path);
+  std::vector<HistoryRun> runs;
+  while (sqlite3_step(s.get()) == SQLITE_ROW) {
+    runs.push_back({sqlite3_column_int64(s.get(), 0), Text(s.get(), 1), Text(s.get(), 2), Text(s.get(), 3),
+                    Text(s.get(), 4), Text(s.get(), 5)});
+  }
+  return runs;
+}
+
+std::vector<FigureTrend> ReadHistoryTrends(const std::string& path) {
+  Db db = Open(path, false);
+  Stmt s = Prepare(db.get(),
+                   "SELECT f.name, r.id, r.date_utc, f.value, f.threshold, f.pass FROM stereorig_check_figures f "
+                   "JOIN stereorig_check_runs r ON r.id = f.run_id ORDER BY f.name, r.id;",
+                   path);
+  std::vector<FigureTrend> trends;
+  while (sqlite3_step(s.get()) == SQLITE_ROW) {
+    const std::string name = Text(s.get(), 0);
+    if (trends.empty() || trends.back().name != name) trends.push_back({name, {}});
+    trends.back().points.push_back({sqlite3_column_int64(s.get(), 1), Text(s.get(), 2),
+                                    sqlite3_column_double(s.get(), 3), sqlite3_column_double(s.get(), 4),
+                                    sqlite3_column_int(s.get(), 5) != 0});
+  }
+  return trends;
+}
+
+std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<FigureTrend>& trends) {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line, "%zu run(s)", runs.size());
+  out += line;
+  if (!runs.empty()) out += ", " + runs.front().date_utc + " .. " + runs.back().date_utc + "; last verdict: " +
+                            runs.back().verdict + " (" + runs.back().explanation + ")";
+  out += "\n";
+  std::snprintf(line, sizeof line, "%-40s %5s %10s %10s %10s %10s %10s %6s\n", "figure", "runs", "first", "last",
+                "min", "max", "threshold", "fails");
+  out += line;
+  for (const FigureTrend& t : trends) {
+    double lo = t.points.front().value, hi = lo;
+    int fails = 0;
+    for (const auto& p : t.points) {
+      lo = std::min(lo, p.value);
+      hi = std::max(hi, p.value);
+      fails += !p.pass;
+    }
+    std::snprintf(line, sizeof line, "%-40s %5zu %10.4f %10.4f %10.4f %10.4f %10.4f %6d\n", t.name.c_str(),
+                  t.points.size(), t.points.front().value, t.points.back().value, lo, hi, t.points.back().threshold,
+                  fails);
+    out += line;
+  }
+  return out;
+}
+
+}  // namespace stereorig

@@ -1,0 +1,340 @@
+#include "calib/check/nightly_check.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "calib/check/board_pose.h"
+#include "calib/core/input_error.h"
+
+namespace stereorig {
+
+void CheckOptions::Check() const {
+  if (!(k_sigma > 0)) throw InputError("check options", "k_sigma must be positive");
+  if (min_captures < 1) throw InputError("check options", "min_captures must be >= 1");
+  if (min_corners_per_view < 4) throw InputError("check options", "min_corners_per_view must be >= 4");
+}
+
+bool CheckResult::ok() const {
+  return std::all_of(figures.begin(), figures.end(), [](const CheckFigure& f) { return f.pass; });
+}
+
+std::string CheckResult::Explanation() const {
+  if (ok()) return "every figure within its threshold";
+  std::ostringstream s;
+  for (int c : moved_cameras) s << "camera " << c << " moved; ";
+  for (int m : moved_modules) s << "module " << m << " moved; ";
+  if (moved_cameras.empty() && moved_modules.empty()) s << "figures exceed their thresholds; ";
+  std::string out = s.str();
+  return out.substr(0, out.size() - 2);
+}
+
+namespace {
+
+// sqrt of the chi-square quantile with `dof` degrees of freedom at the
+// one-sided tail of a Gaussian z-score (Wilson-Hilferty approximation).
+double ChiFactor(int dof, double z) {
+  const double a = 2.0 / (9.0 * dof);
+  const double q = dof * std::pow(1.0 - a + z * std::sqrt(a), 3.0);
+  return std::sqrt(q);
+}
+
+double Lookup(const std::map<std::string, double>& m, const std::string& key, double fallback) {
+  auto it = m.find(key);
+  return it == m.end() ? fallback : it->second;
+}
+
+struct Inputs {
+  const Rig& rig;
+  const Target& target;
+  const CheckOptions& options;
+  std::map<int, std::vector<const CornerView*>> by_capture;
+  std::vector<double> sigma_px;        // per camera: calibration RMS
+  std::vector<double> u_px;            // per camera: projection uncertainty, 1 sigma
+};
+
+int ModuleOf(const Rig& rig, int camera) {
+  for (int m = 0; m < rig.num_modules(); ++m)
+    if (rig.module(m).left_camera == camera || rig.module(m).right_camera == camera) return m;
+  return -1;
+}
+
+struct Consistency {
+  double rms_px = 0;
+  int corners = 0;
+  double threshold_px = 0;
+};
+
+// Camera c's corners through board poses estimated from the cameras in
+// `trusted` other than c.
+Consistency CameraConsistency(const Inputs& in, int c, const std::set<int>& trusted) {
+  Consistency out;
+  double ss = 0, expected_ss = 0, var_ss = 0, depth_sum = 0;
+  int captures = 0;
+  for (const auto& [capture, views] : in.by_capture) {
+    std::vector<const CornerView*> mine, others;
+    for (const CornerView* v : views) {
+      if (v->camera == c) mine.push_back(v);
+      else if (trusted.count(v->camera)) others.push_back(v);
+    }
+    if (mine.empty() || others.empty()) continue;
+    const BoardPoseEstimate pose = EstimateBoardPose(in.rig, in.target, others);
+    if (!pose.ok) continue;
+    for (const CornerView* v : mine) {
+      for (const Eigen::Vector2d& e : ReprojectionErrors(in.rig, in.target, *v, pose.ref_from_front)) {
+        ss += e.squaredNorm();
+        ++out.corners;
+      }
+      // H0: the camera's own noise (2 components per corner, each with
+      // E[e^2] = s^2 and var(e^2) = 2 s^4), plus the prediction error the
+      // pose's uncertainty puts on the view (shared by all its corners), plus
+      // their cross term (variance 4 s^2 E[pred^2]).
+      const PredictionStatistics p =
+          PredictionErrorStatistics(in.rig, in.target, others, in.sigma_px, *v, pose.ref_from_front);
+      const double s2 = in.sigma_px[c] * in.sigma_px[c];
+      const double n = static_cast<double>(v->corner_ids.size());
+      expected_ss += 2 * n * s2 + p.mean_ss_px2;
+      var_ss += 2 * n * 2 * s2 * s2 + p.var_ss_px4 + 4 * s2 * p.mean_ss_px2;
+    }
+    depth_sum += (in.rig.CamFromReference(c) * pose.ref_from_front).translation_mm().z();
+    ++captures;
+  }
+  if (out.corners == 0) return out;
+  out.rms_px = std::sqrt(ss / (2.0 * out.corners));
+  // The stored calibration's own 1-sigma errors, in px: the camera's
+  // projection uncertainty, and S (which stage 3 estimated jointly with the
+  // target's back_from_front) at the board's depth.
+  const double k = in.options.k_sigma;
+  const double depth_mm = depth_sum / captures;
+  const double fx = in.rig.camera(c).fx();
+  double s_px = 0;
+  for (int i = 0; i < in.rig.num_modules(); ++i)
+    for (int j = i + 1; j < in.rig.num_modules(); ++j) {
+      const std::string key = "S_" + std::to_string(i) + "_" + std::to_string(j);
+      const double t = Lookup(in.rig.provenance().uncertainties, key + "_translation_mm", 0);
+      const double r = Lookup(in.rig.provenance().uncertainties, key + "_rotation_deg", 0) * M_PI / 180;
+      s_px = std::max(s_px, fx * (t / depth_mm + r));
+    }
+  const double systematic = std::hypot(in.u_px[c], s_px);
+  // Threshold on the mean square: its H0 expectation plus k standard
+  // deviations, plus the systematic terms at k sigma.
+  out.threshold_px =
+      std::sqrt((expected_ss + k * std::sqrt(var_ss)) / (2.0 * out.corners) + std::pow(k * systematic, 2));
+  return out;
+}
+
+}  // namespace
+
+CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vector<CornerView>& views,
+                            const CheckOptions& options, const std::string& where) {
+  options.Check();
+  Inputs in{rig, target, options, {}, {}, {}};
+  for (int c = 0; c < rig.num_cameras(); ++c) {
+    const std::string key = "cam" + std::to_string(c) + "_rms_px";
+    auto it = rig.provenance().residuals.find(key);
+    if (it == rig.provenance().residuals.end() || !(it->second > 0)) {
+      throw InputError(where, "the rig file has no provenance.residuals." + key +
+                                  "; the check sets its thresholds from a calibration's residuals "
+                                  "(use a rig written by stereorig calibrate)");
+    }
+    in.sigma_px.push_back(it->second);
+    in.u_px.push_back(Lookup(rig.provenance().uncertainties, "cam" + std::to_string(c) + "_projection_center_px", 0));
+  }
+  for (const CornerView& v : views) {
+    if (v.camera < 0 || v.camera >= rig.num_cameras()) {
+      throw InputError(where, "a capture has camera " + std::to_string(v.camera) + ", which the rig does not have");
+    }
+    if (static_cast<int>(v.corner_ids.size()) >= options.min_corners_per_view) in.by_capture[v.capture].push_back(&v);
+  }
+  if (static_cast<int>(in.by_capture.size()) < options.min_captures) {
+    throw InputError(where, "only " + std::to_string(in.by_capture.size()) + " captures show the target; the check needs " +
+                                std::to_string(options.min_captures));
+  }
+
+  CheckResult result;
+  const double k = options.k_sigma;
+
+  // --- Cameras: each one's corners through the pose the others imply. ---
+  std::set<int> all;
+  for (int c = 0; c < rig.num_cameras(); ++c) all.insert(c);
+  std::map<int, CheckFigure> camera_figures;
+  for (int c = 0; c < rig.num_cameras(); ++c) {
+    const Consistency con = CameraConsistency(in, c, all);
+    if (con.corners == 0) continue;
+    camera_figures[c] = {"cam" + std::to_string(c) + "_consistency_rms_px", con.rms_px, con.threshold_px,
+                         con.rms_px <= con.threshold_px, con.corners};
+  }
+  // Captures from another rig fit no camera at all.
+  int fitted = 0;
+  for (const auto& [c, f] : camera_figures) fitted += f.value < 20 * in.sigma_px[c] + 2.0;
+  if (!camera_figures.empty() && fitted == 0) {
+    throw InputError(where, "the captures do not fit this rig at all (every camera is off by > 2 px): "
+                            "captures of another rig, or the wrong rig file?");
+  }
+  for (auto& [c, f] : camera_figures) result.figures.push_back(f);
+
+  // --- Modules: stereo consistency (each camera through its partner's pose). ---
+  std::set<int> inconsistent_modules;
+  for (int m = 0; m < rig.num_modules(); ++m) {
+    const StereoModule& mod = rig.module(m);
+    double worst_ratio = 0;
+    CheckFigure f{"module" + std::to_string(m) + "_stereo_consistency_rms_px", 0, 0, true, 0};
+    for (auto [c, partner] : {std::pair{mod.left_camera, mod.right_camera}, std::pair{mod.right_camera, mod.left_camera}}) {
+      const Consistency con = CameraConsistency(in, c, {partner});
+      if (con.corners == 0) continue;
+      if (con.rms_px / con.threshold_px > worst_ratio) {
+        worst_ratio = con.rms_px / con.threshold_px;
+        f.value = con.rms_px;
+        f.threshold = con.threshold_px;
+        f.samples = con.corners;
+      }
+    }
+    if (f.samples == 0) continue;
+    f.pass = f.value <= f.threshold;
+    if (!f.pass) inconsistent_modules.insert(m);
+    result.figures.push_back(f);
+  }
+
+  // --- Modules: rectified-row error with the stored right_from_left. ---
+  for (int m = 0; m < rig.num_modules(); ++m) {
+    const StereoModule& mod = rig.module(m);
+    const Camera& left = rig.camera(mod.left_camera);
+    const Camera& right = rig.camera(mod.right_camera);
+    const Pose left_from_right = mod.right_from_left.Inverse();
+    // Rectified frame: x along the baseline, z the mean optical axis.
+    const Eigen::Vector3d e1 = left_from_right.translation_mm().normalized();
+    const Eigen::Vector3d z_mean = (Eigen::Vector3d::UnitZ() + left_from_right.rotation().col(2)).normalized();
+    const Eigen::Vector3d e2 = z_mean.cross(e1).normalized();
+    const Eigen::Vector3d e3 = e1.cross(e2);
+    const double f = 0.5 * (left.fy() + right.fy());
+    double ss = 0;
+    int n = 0;
+    for (const auto& [capture, vs] : in.by_capture) {
+      for (const CornerView* l : vs) {
+        if (l->camera != mod.left_camera) continue;
+        for (const CornerView* r : vs) {
+          if (r->camera != mod.right_camera || r->face != l->face) continue;
+          std::map<int, Eigen::Vector2d> right_q;
+          for (size_t i = 0; i < r->corner_ids.size(); ++i) right_q[r->corner_ids[i]] = r->q_px[i];
+          for (size_t i = 0; i < l->corner_ids.size(); ++i) {
+            auto it = right_q.find(l->corner_ids[i]);
+            if (it == right_q.end()) continue;
+            Eigen::Vector3d vl, vr;
+            if (!left.Unproject(l->q_px[i], &vl) || !right.Unproject(it->second, &vr)) continue;
+            vr = left_from_right.rotation() * vr;
+            const double row_error = f * (e2.dot(vl) / e3.dot(vl) - e2.dot(vr) / e3.dot(vr));
+            ss += row_error * row_error;
+            ++n;
+          }
+        }
+      }
+    }
+    if (n == 0) continue;
+    const double sl = in.sigma_px[mod.left_camera], sr = in.sigma_px[mod.right_camera];
+    const double ul = in.u_px[mod.left_camera], ur = in.u_px[mod.right_camera];
+    const double threshold = std::sqrt(sl * sl + sr * sr + std::pow(k * std::hypot(ul, ur), 2)) *
+                             (1.0 + k / std::sqrt(2.0 * n));
+    const double rms = std::sqrt(ss / n);
+    result.figures.push_back({"module" + std::to_string(m) + "_rectified_row_rms_px", rms, threshold,
+                              rms <= threshold, n});
+    if (rms > threshold) inconsistent_modules.insert(m);
+  }
+
+  // A module whose two cameras disagree: the camera that also disagrees with
+  // the other modules is the one that moved. With one module there is no
+  // outside view, so the module is named.
+  for (int m : inconsistent_modules) {
+    const StereoModule& mod = rig.module(m);
+    std::set<int> outside;
+    for (int c = 0; c < rig.num_cameras(); ++c)
+      if (ModuleOf(rig, c) != m) outside.insert(c);
+    double best_ratio = 0;
+    int named = -1;
+    for (int c : {mod.left_camera, mod.right_camera}) {
+      const Consistency con = outside.empty() ? Consistency{} : CameraConsistency(in, c, outside);
+      if (con.corners > 0 && con.rms_px / con.threshold_px > best_ratio) {
+        best_ratio = con.rms_px / con.threshold_px;
+        named = c;
+      }
+    }
+    if (named >= 0 && best_ratio > 1.0) result.moved_cameras.push_back(named);
+    else result.moved_modules.push_back(m);
+  }
+
+  // --- Module pairs: closure through the target. ---
+  const Eigen::Vector3d board_center((target.corners_x() - 1) * 0.5 * target.square_size_mm(),
+                                     (target.corners_y() - 1) * 0.5 * target.square_size_mm(), 0.0);
+  std::map<int, int> failed_pairs_of;  // module -> number of failing pairs it is in
+  for (int i = 0; i < rig.num_modules(); ++i) {
+    for (int j = i + 1; j < rig.num_modules(); ++j) {
+      std::vector<Eigen::Vector3d> dt, dr;
+      for (const auto& [capture, vs] : in.by_capture) {
+        std::vector<const CornerView*> vi, vj;
+        for (const CornerView* v : vs) {
+          const int m = ModuleOf(rig, v->camera);
+          if (m == i) vi.push_back(v);
+          if (m == j) vj.push_back(v);
+        }
+        if (vi.empty() || vj.empty()) continue;
+        const BoardPoseEstimate pi = EstimateBoardPose(rig, target, vi);
+        const BoardPoseEstimate pj = EstimateBoardPose(rig, target, vj);
+        if (!pi.ok || !pj.ok) continue;
+        dt.push_back(pi.ref_from_front * board_center - pj.ref_from_front * board_center);
+        dr.push_back(Pose(pi.ref_from_front.rotation() * pj.ref_from_front.rotation().transpose(),
+                          Eigen::Vector3d::Zero())
+                         .RotationVector() *
+                     180.0 / M_PI);
+      }
+      const int n = static_cast<int>(dt.size());
+      if (n < 2) continue;
+      auto mean_and_se = [n](const std::vector<Eigen::Vector3d>& d, Eigen::Vector3d* mean) {
+        *mean = Eigen::Vector3d::Zero();
+        for (const auto& x : d) *mean += x;
+        *mean /= n;
+        double var = 0;
+        for (const auto& x : d) var += (x - *mean).squaredNorm();
+        var /= 3.0 * (n - 1);  // per axis
+        // Student-t inflation of a variance estimated from few captures.
+        const double t_inflation = n > 3 ? (n - 1.0) / (n - 3.0) : 3.0;
+        return std::sqrt(var * t_inflation / n);
+      };
+      Eigen::Vector3d mean_t, mean_r;
+      const double se_t = mean_and_se(dt, &mean_t), se_r = mean_and_se(dr, &mean_r);
+      const std::string key = "S_" + std::to_string(i) + "_" + std::to_string(j);
+      const double s_t = Lookup(rig.provenance().uncertainties, key + "_translation_mm", 0);
+      const double s_r = Lookup(rig.provenance().uncertainties, key + "_rotation_deg", 0);
+      // As above, S's 1-sigma covers the board's back_from_front (estimated
+      // jointly in stage 3).
+      const double chi3 = ChiFactor(3, k);
+      const double thr_t = chi3 * std::sqrt(se_t * se_t + s_t * s_t);
+      const double thr_r = chi3 * std::sqrt(se_r * se_r + s_r * s_r);
+      const bool pass_t = mean_t.norm() <= thr_t, pass_r = mean_r.norm() <= thr_r;
+      result.figures.push_back({"pair_" + std::to_string(i) + "_" + std::to_string(j) + "_closure_mm", mean_t.norm(),
+                                thr_t, pass_t, n});
+      result.figures.push_back({"pair_" + std::to_string(i) + "_" + std::to_string(j) + "_closure_deg", mean_r.norm(),
+                                thr_r, pass_r, n});
+      if ((!pass_t || !pass_r) && !inconsistent_modules.count(i) && !inconsistent_modules.count(j)) {
+        ++failed_pairs_of[i];
+        ++failed_pairs_of[j];
+      }
+    }
+  }
+  // Whole modules that moved: their pairs fail while each module is
+  // consistent in itself. A pair's closure only shows relative motion: with
+  // two modules, which one moved cannot be told, and since module 0 defines
+  // the reference frame the other one is named. With three or more, the
+  // module in the most failing pairs is named.
+  int most = 0;
+  for (const auto& [m, count] : failed_pairs_of) most = std::max(most, count);
+  for (const auto& [m, count] : failed_pairs_of) {
+    const bool name = rig.num_modules() == 2 ? m != 0 : (count == most && count >= 2);
+    if (name && std::find(result.moved_modules.begin(), result.moved_modules.end(), m) == result.moved_modules.end())
+      result.moved_modules.push_back(m);
+  }
+  std::sort(result.moved_modules.begin(), result.moved_modules.end());
+  return result;
+}
+
+}  // namespace stereorig

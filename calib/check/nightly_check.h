@@ -1,0 +1,62 @@
+// The nightly recalibration check: a few fresh captures of the target, the
+// stored rig held fixed, only board poses re-estimated. It answers "has
+// anything moved since calibration?", names what moved, and sets every
+// threshold from the stored calibration's own residuals and uncertainties.
+//
+// Figures (docs/verify-and-check.md):
+//   - per camera, the consistency RMS: the camera's corners reprojected
+//     through a board pose estimated from the OTHER cameras (leave one out),
+//     so a moved camera cannot hide by pulling the pose towards itself;
+//   - per module, the rectified-row (epipolar) error of corners both its
+//     cameras see, with the stored right_from_left;
+//   - per module pair, the closure through the double-sided target: the board
+//     pose from module i alone against the one from module j alone, mean over
+//     captures, in mm (at the board centre) and degrees.
+// Cameras are named by elimination: the worst camera over its threshold is
+// set aside and the rest re-evaluated without it, until all that remain agree.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "calib/check/corner_view.h"
+#include "calib/core/rig.h"
+#include "targets/target.h"
+
+namespace stereorig {
+
+struct CheckOptions {
+  // Coverage factor of every threshold: a figure fails when it exceeds its
+  // H0 expectation by this many standard errors. 3.5 gives a per-figure false
+  // alarm rate near 2e-4 for Gaussian noise.
+  double k_sigma = 3.5;
+  int min_captures = 5;                 // fewer: bad input
+  int min_corners_per_view = 6;         // views with fewer are ignored
+  void Check() const;
+};
+
+struct CheckFigure {
+  std::string name;       // e.g. "cam2_consistency_rms_px", "pair_0_1_closure_mm"
+  double value = 0;
+  double threshold = 0;
+  bool pass = true;
+  int samples = 0;        // corners or captures behind the figure
+};
+
+struct CheckResult {
+  std::vector<CheckFigure> figures;
+  std::vector<int> moved_cameras;       // named by elimination, global indices
+  std::vector<int> moved_modules;       // both cameras moved, or a pair closure failed
+  bool ok() const;
+  std::string Verdict() const { return ok() ? "ok" : "recalibrate"; }
+  std::string Explanation() const;      // one line naming what moved
+};
+
+// Throws InputError(`where`, ...) when the rig file lacks the calibration
+// residuals the thresholds need, when there are too few captures, when a view
+// names a camera the rig does not have, or when the captures do not fit the
+// rig at all (another rig's captures).
+CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vector<CornerView>& views,
+                            const CheckOptions& options, const std::string& where);
+
+}  // namespace stereorig

@@ -1,0 +1,89 @@
+// Ceres cost functions of stage 3's bundle adjustment.
+//
+// Every pose parameter block is 6 numbers (dr: rotation vector, rad; t: mm)
+// meaning a_from_b = (Exp(dr) * R0, t) around a fixed seed rotation R0 held by
+// the cost function. The block stays small, away from the angle-axis
+// singularity at pi (module 1 of a facing rig is turned by pi), and its
+// covariance is directly a rotation perturbation in frame a (rad) and a
+// translation (mm).
+#pragma once
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Core>
+#include <memory>
+
+#include "calib/core/camera.h"
+#include "calib/core/pose.h"
+
+namespace stereorig {
+
+// A pose parameter block and its seed rotation.
+struct PoseBlock {
+  Eigen::Matrix3d R0 = Eigen::Matrix3d::Identity();
+  double params[6] = {0, 0, 0, 0, 0, 0};  // dr (rad), t (mm)
+  PoseBlock() = default;
+  explicit PoseBlock(const Pose& a_from_b);
+  Pose ToPose() const;
+};
+
+// The point of one target corner in a camera's frame, as a function of
+//   [0] ref_from_front   (the board pose of the capture, reference frame)
+//   [1] ref_from_module  (S[0][k]; a constant identity for module 0)
+//   [2] back_from_front  (used only for a back-face corner)
+//   [3] right_from_left  (used only for a right camera)
+// Output (3,): p_cam, mm.
+struct CornerPointFunctor {
+  Eigen::Vector3d x_face;  // corner in its face's frame, mm
+  bool back_face = false;
+  bool right_camera = false;
+  Eigen::Matrix3d R0[4];  // seed rotations of the four blocks
+
+  template <typename T>
+  bool operator()(const T* board, const T* module, const T* bff, const T* rl, T* p_cam) const;
+};
+
+// Reprojection residual (2,) = project(p_cam) - q_observed, px. Parameter
+// blocks: the four poses of CornerPointFunctor (6 each), then the camera's
+// intrinsics (Nintrinsics). The pose chain is differentiated automatically;
+// the projection's Jacobian (wrt p_cam and the intrinsics) is mrcal's,
+// analytic, chained by hand here.
+class CornerReprojectionCost : public ceres::CostFunction {
+ public:
+  CornerReprojectionCost(const CornerPointFunctor& geometry, const Camera& camera, const Eigen::Vector2d& q_observed);
+  static ceres::CostFunction* Create(const CornerPointFunctor& geometry, const Camera& camera,
+                                     const Eigen::Vector2d& q_observed) {
+    return new CornerReprojectionCost(geometry, camera, q_observed);
+  }
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
+
+ private:
+  std::unique_ptr<ceres::CostFunction> point_;  // AutoDiff of CornerPointFunctor, (3; 6,6,6,6)
+  Camera camera_;                               // lens model (its intrinsics come from the parameter block)
+  Eigen::Vector2d q_observed_;
+  int num_intrinsics_;
+};
+
+// Prior on back_from_front: residual (6,) = corner_sigma_px * [dr (deg) / sigma_r, (t - t_measured) / sigma_t],
+// dr being the block's rotation perturbation around the measured rotation.
+// The reprojection residuals are in px with noise corner_sigma_px; scaling the
+// whitened prior by it weighs prior and data as a MAP estimate does, and keeps
+// the covariance right when it is scaled by the pixel variance.
+struct BackFromFrontPrior {
+  Eigen::Vector3d t_measured_mm;
+  Eigen::Matrix<double, 6, 1> sigma;  // [rx, ry, rz (deg), tx, ty, tz (mm)]
+  double corner_sigma_px;
+  template <typename T>
+  bool operator()(const T* bff, T* r) const {
+    for (int i = 0; i < 3; ++i) r[i] = T(corner_sigma_px) * bff[i] * T(180.0 / M_PI) / T(sigma(i));
+    for (int i = 0; i < 3; ++i) r[3 + i] = T(corner_sigma_px) * (bff[3 + i] - T(t_measured_mm(i))) / T(sigma(3 + i));
+    return true;
+  }
+  static ceres::CostFunction* Create(const Eigen::Vector3d& t_measured_mm, const Eigen::Matrix<double, 6, 1>& sigma,
+                                     double corner_sigma_px) {
+    return new ceres::AutoDiffCostFunction<BackFromFrontPrior, 6, 6>(
+        new BackFromFrontPrior{t_measured_mm, sigma, corner_sigma_px});
+  }
+};
+
+}  // namespace stereorig

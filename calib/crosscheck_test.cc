@@ -1,0 +1,124 @@
+// Stage 1 against independent implementations on the same detections:
+// OpenCV's calibrateCamera (same OPENCV8 = rational model) and Debian's
+// mrcal-calibrate-cameras (fed a corners cache). Our residual RMS must not
+// exceed theirs, and our projection must agree with mrcal's within our
+// reported 1-sigma uncertainty.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <opencv2/calib3d.hpp>
+#include <sstream>
+
+#include "calib/calib_test_util.h"
+#include "calib/intrinsics.h"
+
+namespace stereorig {
+namespace {
+
+std::vector<const BoardObservation*> ViewsOf(const CalibrationInput& in, int cam) {
+  std::vector<const BoardObservation*> v;
+  for (const auto& o : in.observations)
+    if (o.camera == cam) v.push_back(&o);
+  return v;
+}
+
+TEST(Crosscheck, Stage1AgainstOpencvAndMrcalCalibrateCameras) {
+  // Boards kept near camera 0's optical axis, 200 mm away (+-10 mm), so that
+  // most views are whole.
+  const SimulatedRig rig = MakeDefaultRig();
+  SyntheticOptions o;
+  o.seed = 9;
+  o.num_captures = 30;
+  o.lateral_mm = 10.0;
+  o.depth_mm = 20.0;
+  const TargetGeometry target = DefaultTestTarget();
+  const SyntheticData data = MakeSyntheticCaptures(rig.rig, target, target.back_from_front,
+                                                   Pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 200)), o);
+  const CalibrationInput& in = data.input;
+  const int cam = 0;
+  // mrcal-calibrate-cameras is made for whole boards (mrgingham finds only
+  // those); on this set's partial views its seeding falls into a local
+  // minimum (4.4 px RMS, measured). So all three run on the whole-board views.
+  std::vector<const BoardObservation*> views;
+  for (const BoardObservation* v : ViewsOf(in, cam))
+    if (static_cast<int>(v->corner_ids.size()) == in.target.num_corners()) views.push_back(v);
+  std::printf("%zu whole-board views\n", views.size());
+  ASSERT_GE(views.size(), 10u);
+  const IntrinsicsResult ours =
+      CalibrateIntrinsics(cam, in.cameras[cam], in.target, views, IntrinsicsOptions(), "test");
+
+  // OpenCV: its RMS is sqrt(sum |e|^2 / Npoints) (2D); ours is per coordinate.
+  std::vector<std::vector<cv::Point3f>> obj;
+  std::vector<std::vector<cv::Point2f>> img;
+  for (const BoardObservation* v : views) {
+    obj.emplace_back();
+    img.emplace_back();
+    for (size_t k = 0; k < v->corner_ids.size(); ++k) {
+      const Eigen::Vector3d p = in.target.CornerInFace(v->corner_ids[k]);
+      obj.back().emplace_back(p.x(), p.y(), 0.f);
+      img.back().emplace_back(v->q_px[k].x(), v->q_px[k].y());
+    }
+  }
+  cv::Mat K, dist;
+  std::vector<cv::Mat> rv, tv;
+  const double opencv_rms_2d =
+      cv::calibrateCamera(obj, img, cv::Size(752, 582), K, dist, rv, tv, cv::CALIB_RATIONAL_MODEL);
+  const double opencv_rms = opencv_rms_2d / std::sqrt(2.0);
+  std::printf("stage 1 rms: ours %.5f px, OpenCV %.5f px (per coordinate)\n", ours.report.rms_px, opencv_rms);
+  // mrcal regularises the distortions lightly, which may cost a hair of RMS.
+  EXPECT_LE(ours.report.rms_px, opencv_rms * 1.001);
+
+  // mrcal-calibrate-cameras on a corners cache of the same detections.
+  const std::string dir = ::testing::TempDir() + "/mrcal_cc";
+  ASSERT_EQ(std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str()), 0);
+  {
+    std::ofstream f(dir + "/corners.vnl");
+    f << "# filename x y level\n";
+    for (const BoardObservation* v : views) {
+      char name[64];
+      std::snprintf(name, sizeof name, "cam0-%03d.png", v->capture);
+      std::vector<std::string> rows(in.target.num_corners(), std::string(name) + " - - -");
+      for (size_t k = 0; k < v->corner_ids.size(); ++k) {
+        char b[128];
+        std::snprintf(b, sizeof b, "%s %.17g %.17g 0", name, v->q_px[k].x(), v->q_px[k].y());
+        rows[v->corner_ids[k]] = b;
+      }
+      for (const auto& r : rows) f << r << "\n";
+    }
+  }
+  const std::string cmd = "cd " + dir +
+                          " && /usr/bin/python3 /usr/bin/mrcal-calibrate-cameras --corners-cache corners.vnl "
+                          "--lensmodel LENSMODEL_OPENCV8 --focal 1000 --imagersize 752 582 --object-spacing 12 "
+                          "--object-width-n 9 --object-height-n 7 --skip-calobject-warp-solve --outdir . "
+                          "'cam0-*.png' > log.txt 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  const std::string ref = dir + "/ref.txt";
+  ASSERT_EQ(std::system(("/usr/bin/python3 " + std::string(STEREORIG_SOURCE_DIR) +
+                         "/calib/testdata/mrcal_model_rms.py " + dir + "/camera-0.cameramodel > " + ref)
+                            .c_str()),
+            0);
+  std::ifstream f(ref);
+  double mrcal_rms;
+  int mrcal_outliers;
+  ASSERT_TRUE(f >> mrcal_rms >> mrcal_outliers);
+  std::vector<double> intr;
+  double x;
+  while (f >> x) intr.push_back(x);
+  ASSERT_EQ(intr.size(), 12u);
+  std::printf("stage 1 rms: ours %.5f px, mrcal-calibrate-cameras %.5f px\n", ours.report.rms_px, mrcal_rms);
+  EXPECT_LE(ours.report.rms_px, mrcal_rms * 1.001);
+  // Same data, same model and method: the two solutions project alike; at
+  // the image centre (200 mm) the difference is within our 1 sigma there.
+  const Camera theirs("LENSMODEL_OPENCV8", intr, 752, 582);
+  const Eigen::Vector2d qc = ours.report.uncertainty[0].q_px;
+  Eigen::Vector3d v;
+  ASSERT_TRUE(ours.camera.Unproject(qc, &v));
+  const double dq = (theirs.Project(v * 200.0) - qc).norm();
+  std::printf("projection difference at the centre: %.5f px; our 1 sigma %.5f px\n", dq,
+              ours.report.uncertainty[0].rms_stdev_px);
+  EXPECT_LT(dq, ours.report.uncertainty[0].rms_stdev_px);
+}
+
+}  // namespace
+}  // namespace stereorig

@@ -1,0 +1,251 @@
+#include "calib/intrinsics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+
+#include "calib/core/input_error.h"
+#include "calib/projection_uncertainty.h"
+
+namespace stereorig {
+
+void IntrinsicsOptions::Check() const {
+  if (Camera::NumIntrinsics(lensmodel) < 0)
+    throw InputError("options.lensmodel", "unknown lens model '" + lensmodel + "'");
+  if (lensmodel.rfind("LENSMODEL_OPENCV", 0) != 0 && lensmodel.rfind("LENSMODEL_SPLINED_STEREOGRAPHIC", 0) != 0 &&
+      lensmodel != "LENSMODEL_PINHOLE") {
+    throw InputError("options.lensmodel", "use LENSMODEL_OPENCV5, LENSMODEL_OPENCV8 or a splined stereographic model");
+  }
+  if (seed_focal_px < 0) throw InputError("options.seed_focal_px", "must be >= 0");
+  if (min_corners_per_view < 4) throw InputError("options.min_corners_per_view", "must be >= 4");
+  if (min_views < 2) throw InputError("options.min_views", "must be >= 2");
+  if (min_tilt_deg < 0 || min_tilt_deg > 80) throw InputError("options.min_tilt_deg", "must be in [0, 80]");
+  if (uncertainty_range_mm <= 0) throw InputError("options.uncertainty_range_mm", "must be > 0");
+  if (coverage_cells_x < 1 || coverage_cells_y < 1) throw InputError("options.coverage_cells", "must be >= 1");
+  if (worst_views_reported < 0) throw InputError("options.worst_views_reported", "must be >= 0");
+}
+
+void FillPoolBlock(const BoardObservation& obs, const TargetGeometry& target, mrcal_point3_t* block) {
+  const int n = target.num_corners();
+  for (int i = 0; i < n; ++i) block[i] = {.xyz = {0.0, 0.0, -1.0}};
+  for (size_t k = 0; k < obs.corner_ids.size(); ++k) {
+    block[obs.corner_ids[k]] = {.xyz = {obs.q_px[k].x(), obs.q_px[k].y(), 1.0}};
+  }
+}
+
+namespace {
+
+// The seed pose of one view from PnP through a distortion-free pinhole with
+// focal `f_px` and the centre at the middle of the imager.
+Pose SeedPose(const BoardObservation& obs, const TargetGeometry& target, double f_px, int width, int height) {
+  std::vector<cv::Point3d> object;
+  std::vector<cv::Point2d> image;
+  for (size_t k = 0; k < obs.corner_ids.size(); ++k) {
+    const Eigen::Vector3d p = target.CornerInFace(obs.corner_ids[k]);
+    object.emplace_back(p.x(), p.y(), p.z());
+    image.emplace_back(obs.q_px[k].x(), obs.q_px[k].y());
+  }
+  const cv::Matx33d K(f_px, 0, 0.5 * (width - 1), 0, f_px, 0.5 * (height - 1), 0, 0, 1);
+  cv::Mat rvec, tvec;
+  cv::solvePnP(object, image, K, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_IPPE);
+  Pose pose = Pose::FromRotationVector(Eigen::Vector3d(rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2)),
+                                       Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2)));
+  return pose;
+}
+
+double EstimateFocal(const std::vector<const BoardObservation*>& views, const TargetGeometry& target, int width,
+                     int height) {
+  std::vector<std::vector<cv::Point3f>> objects;
+  std::vector<std::vector<cv::Point2f>> images;
+  for (const BoardObservation* v : views) {
+    std::vector<cv::Point3f> o;
+    std::vector<cv::Point2f> q;
+    for (size_t k = 0; k < v->corner_ids.size(); ++k) {
+      const Eigen::Vector3d p = target.CornerInFace(v->corner_ids[k]);
+      o.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), 0.f);
+      q.emplace_back(static_cast<float>(v->q_px[k].x()), static_cast<float>(v->q_px[k].y()));
+    }
+    objects.push_back(o);
+    images.push_back(q);
+  }
+  const cv::Mat K = cv::initCameraMatrix2D(objects, images, cv::Size(width, height));
+  const double f = 0.5 * (K.at<double>(0, 0) + K.at<double>(1, 1));
+  return std::isfinite(f) && f > 0 ? f : width;  // a 53 deg lens if the estimate fails
+}
+
+// Angle between the board normal and the camera's optical axis, degrees.
+double TiltDeg(const Pose& cam_from_face) {
+  const Eigen::Vector3d n = cam_from_face.rotation().col(2);
+  return std::acos(std::min(1.0, std::abs(n.z()))) * 180.0 / M_PI;
+}
+
+}  // namespace
+
+double BoardResidualRms(const MrcalProblem& p, const std::vector<double>& x) {
+  const int n = p.corners_x * p.corners_y * p.num_observations();
+  double s2 = 0;
+  int count = 0;
+  for (int i = 0; i < n; ++i) {
+    if (p.pool[i].z <= 0) continue;
+    s2 += x[2 * i] * x[2 * i] + x[2 * i + 1] * x[2 * i + 1];
+    count += 2;
+  }
+  return count ? std::sqrt(s2 / count) : 0.0;
+}
+
+std::vector<ViewResidual> ViewResiduals(const MrcalProblem& p, const std::vector<double>& x,
+                                        const std::vector<int>& view_capture, int icam_intrinsics) {
+  const int n = p.corners_x * p.corners_y;
+  std::vector<ViewResidual> out;
+  for (int o = 0; o < p.num_observations(); ++o) {
+    if (p.observations[o].icam.intrinsics != icam_intrinsics) continue;
+    ViewResidual v;
+    v.capture = view_capture[p.observations[o].iframe];
+    double s2 = 0;
+    for (int i = 0; i < n; ++i) {
+      if (p.pool[o * n + i].z <= 0) continue;
+      s2 += x[2 * (o * n + i)] * x[2 * (o * n + i)] + x[2 * (o * n + i) + 1] * x[2 * (o * n + i) + 1];
+      ++v.num_corners;
+    }
+    v.rms_px = v.num_corners ? std::sqrt(s2 / (2.0 * v.num_corners)) : 0.0;
+    out.push_back(v);
+  }
+  return out;
+}
+
+void FillCoverageAndUncertainty(const MrcalProblem& p, int icam, const IntrinsicsOptions& options, int width,
+                                int height, IntrinsicsReport* r) {
+  r->coverage_cells_x = options.coverage_cells_x;
+  r->coverage_cells_y = options.coverage_cells_y;
+  r->coverage.assign(options.coverage_cells_x * options.coverage_cells_y, 0);
+  const int n = p.corners_x * p.corners_y;
+  for (int o = 0; o < p.num_observations(); ++o) {
+    if (p.observations[o].icam.intrinsics != icam) continue;
+    for (int i = 0; i < n; ++i) {
+      const mrcal_point3_t& q = p.pool[o * n + i];
+      if (q.z <= 0) continue;
+      const int cx =
+          std::clamp(static_cast<int>((q.x + 0.5) / width * options.coverage_cells_x), 0, options.coverage_cells_x - 1);
+      const int cy = std::clamp(static_cast<int>((q.y + 0.5) / height * options.coverage_cells_y), 0,
+                                options.coverage_cells_y - 1);
+      ++r->coverage[cy * options.coverage_cells_x + cx];
+    }
+  }
+  r->coverage_fraction =
+      static_cast<double>(std::count_if(r->coverage.begin(), r->coverage.end(), [](int c) { return c > 0; })) /
+      r->coverage.size();
+
+  r->uncertainty_range_mm = options.uncertainty_range_mm;
+  ProjectionUncertaintyEvaluator eval(p);
+  if (!eval.ok()) return;  // leaves the uncertainty empty; the caller reports it
+  r->observed_sigma_px = eval.observed_pixel_sigma_px();
+  const std::vector<std::pair<std::string, Eigen::Vector2d>> at = {{"centre", {0.5 * (width - 1), 0.5 * (height - 1)}},
+                                                                   {"top-left", {0, 0}},
+                                                                   {"top-right", {width - 1.0, 0}},
+                                                                   {"bottom-left", {0, height - 1.0}},
+                                                                   {"bottom-right", {width - 1.0, height - 1.0}}};
+  for (const auto& [name, q] : at) {
+    const ProjectionUncertainty u = eval.AtPixel(icam, q, options.uncertainty_range_mm);
+    r->uncertainty.push_back({name, q, u.rms_stdev_px, u.worst_direction_stdev_px});
+  }
+}
+
+IntrinsicsResult CalibrateIntrinsics(int camera, const CameraSpec& spec, const TargetGeometry& target,
+                                     const std::vector<const BoardObservation*>& all_views,
+                                     const IntrinsicsOptions& options, const std::string& where) {
+  const std::string cam_where = where + ": camera " + std::to_string(camera) + " (" + spec.name + ")";
+  std::vector<const BoardObservation*> views;
+  int dropped = 0;
+  for (const BoardObservation* v : all_views) {
+    STEREORIG_CHECK(v->camera == camera);
+    if (static_cast<int>(v->corner_ids.size()) >= options.min_corners_per_view) {
+      views.push_back(v);
+    } else {
+      ++dropped;
+    }
+  }
+  if (views.empty()) throw InputError(cam_where, "never sees the board (no view with enough corners)");
+  if (static_cast<int>(views.size()) < options.min_views) {
+    throw InputError(cam_where, "too few views: " + std::to_string(views.size()) + " usable, need at least " +
+                                    std::to_string(options.min_views));
+  }
+
+  const double f_seed =
+      options.seed_focal_px > 0 ? options.seed_focal_px : EstimateFocal(views, target, spec.width_px, spec.height_px);
+
+  MrcalProblem p;
+  STEREORIG_CHECK(p.SetLensmodel(options.lensmodel));
+  p.corners_x = target.corners_x;
+  p.corners_y = target.corners_y;
+  p.spacing_mm = target.square_size_mm;
+  p.num_intrinsics_cameras = 1;
+  p.imagersizes = {spec.width_px, spec.height_px};
+  p.intrinsics.assign(p.num_params(), 0.0);
+  p.intrinsics[0] = p.intrinsics[1] = f_seed;
+  p.intrinsics[2] = 0.5 * (spec.width_px - 1);
+  p.intrinsics[3] = 0.5 * (spec.height_px - 1);
+
+  IntrinsicsResult result{Camera("LENSMODEL_PINHOLE", {1, 1, 0, 0}, 1, 1), {}, {}, {}, {}, {}};
+  const int n = target.num_corners();
+  p.pool.resize(views.size() * n);
+  double max_tilt = 0;
+  for (size_t k = 0; k < views.size(); ++k) {
+    const Pose seed = SeedPose(*views[k], target, f_seed, spec.width_px, spec.height_px);
+    max_tilt = std::max(max_tilt, TiltDeg(seed));
+    p.frames_toref.push_back(MrcalProblem::ToMrcal(seed));
+    p.observations.push_back({.icam = {.intrinsics = 0, .extrinsics = -1}, .iframe = static_cast<int>(k)});
+    FillPoolBlock(*views[k], target, &p.pool[k * n]);
+    result.captures.push_back(views[k]->capture);
+    result.faces.push_back(views[k]->face);
+  }
+  if (max_tilt < options.min_tilt_deg) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf,
+                  "degenerate views: all %zu are fronto-parallel (largest board tilt %.1f deg < %.1f); tilt the board",
+                  views.size(), max_tilt, options.min_tilt_deg);
+    throw InputError(cam_where, buf);
+  }
+  const int missing = p.CountNonPositiveWeights();
+
+  // Step 1: the board poses alone. Step 2: with the lens core. Step 3: all,
+  // distortions regularised, outliers rejected.
+  p.selections = {.do_optimize_intrinsics_core = false,
+                  .do_optimize_intrinsics_distortions = false,
+                  .do_optimize_extrinsics = true,
+                  .do_optimize_frames = true,
+                  .do_optimize_calobject_warp = false,
+                  .do_apply_regularization = false,
+                  .do_apply_outlier_rejection = false};
+  p.Optimize(options.verbose);
+  p.selections.do_optimize_intrinsics_core = true;
+  p.Optimize(options.verbose);
+  p.selections.do_optimize_intrinsics_distortions = true;
+  p.selections.do_apply_regularization = true;
+  p.selections.do_apply_outlier_rejection = true;
+  const mrcal_stats_t stats = p.Optimize(options.verbose);
+
+  result.camera = Camera(options.lensmodel, p.intrinsics, spec.width_px, spec.height_px, cam_where);
+  for (const mrcal_pose_t& f : p.frames_toref) result.cam_from_face.push_back(MrcalProblem::FromMrcal(f));
+
+  IntrinsicsReport& r = result.report;
+  r.camera = camera;
+  r.camera_name = spec.name;
+  r.lensmodel = options.lensmodel;
+  r.num_views = static_cast<int>(views.size());
+  r.num_views_dropped = dropped;
+  r.num_outliers = stats.Noutliers - missing;
+  r.num_corners = static_cast<int>(p.pool.size()) - stats.Noutliers;
+  r.max_tilt_deg = max_tilt;
+  const std::vector<double> x = p.Residuals();
+  r.rms_px = BoardResidualRms(p, x);
+  std::vector<ViewResidual> per_view = ViewResiduals(p, x, result.captures, 0);
+  std::sort(per_view.begin(), per_view.end(), [](const auto& a, const auto& b) { return a.rms_px > b.rms_px; });
+  per_view.resize(std::min<size_t>(per_view.size(), options.worst_views_reported));
+  r.worst_views = per_view;
+  FillCoverageAndUncertainty(p, 0, options, spec.width_px, spec.height_px, &r);
+  result.problem = std::move(p);
+  return result;
+}
+
+}  // namespace stereorig

@@ -1,0 +1,99 @@
+// Stage 1: the intrinsics of one camera, solved with mrcal's C API.
+//
+// As mrcal-calibrate-cameras does: every board pose is seeded with PnP from a
+// rough focal length (OpenCV), then mrcal solves in steps: the board poses
+// alone, then with the lens core, then everything with the distortions under
+// regularisation and with outlier rejection. The report carries the residual
+// RMS, the worst views, the outliers, a coverage map and the projection
+// uncertainty (a port of mrcal's, see projection_uncertainty.h).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "calib/core/camera.h"
+#include "calib/core/pose.h"
+#include "calib/mrcal_problem.h"
+#include "calib/observations.h"
+
+namespace stereorig {
+
+struct IntrinsicsOptions {
+  // Lens model as mrcal spells it: LENSMODEL_OPENCV5, LENSMODEL_OPENCV8, or a
+  // splined stereographic one such as
+  // LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=16_Ny=12_fov_x_deg=50.
+  // Default LENSMODEL_OPENCV8.
+  std::string lensmodel = "LENSMODEL_OPENCV8";
+  double seed_focal_px = 0.0;    // rough focal length for the PnP seed, px; 0 (default): from the views' homographies
+  int min_corners_per_view = 8;  // views with fewer corners are not used; default 8
+  int min_views = 5;             // fewer usable views is an input error; default 5
+  double min_tilt_deg = 10.0;    // if no view tilts the board more than this, the set is degenerate; default 10 deg
+  double uncertainty_range_mm = 200.0;  // range of the points whose projection uncertainty is reported; default 200 mm
+  int coverage_cells_x = 8;             // coverage map columns; default 8
+  int coverage_cells_y = 6;             // coverage map rows; default 6
+  int worst_views_reported = 3;         // default 3
+  bool verbose = false;                 // mrcal's solver output to stderr; default false
+  void Check() const;                   // throws InputError naming the bad option
+};
+
+struct ViewResidual {
+  int capture = -1;
+  double rms_px = 0.0;  // RMS of the view's inlier residual coordinates (x and y pooled), px
+  int num_corners = 0;  // inliers
+};
+
+struct PixelUncertainty {
+  std::string where;  // "centre", "top-left", ...
+  Eigen::Vector2d q_px = Eigen::Vector2d::Zero();
+  double rms_stdev_px = 0.0;  // 1 sigma, sqrt(trace(Var q) / 2)
+  double worst_direction_stdev_px = 0.0;
+};
+
+struct IntrinsicsReport {
+  int camera = -1;
+  std::string camera_name;
+  std::string lensmodel;
+  int num_views = 0;               // used in the solve
+  int num_views_dropped = 0;       // too few corners
+  int num_corners = 0;             // inliers in the final solve
+  int num_outliers = 0;            // corners rejected by the solver
+  double rms_px = 0.0;             // RMS of the inlier residual coordinates (x and y pooled), px
+  double observed_sigma_px = 0.0;  // std of the residuals (the noise the uncertainty assumes)
+  double max_tilt_deg = 0.0;       // largest board tilt among the views
+  std::vector<ViewResidual> worst_views;
+  int coverage_cells_x = 0, coverage_cells_y = 0;
+  std::vector<int> coverage;                  // (cells_y, cells_x) row-major: inlier corners per cell
+  double coverage_fraction = 0.0;             // cells holding at least one corner
+  std::vector<PixelUncertainty> uncertainty;  // centre and the four image corners
+  double uncertainty_range_mm = 0.0;
+};
+
+struct IntrinsicsResult {
+  Camera camera;
+  std::vector<int> captures;        // (Nviews,) the capture of each view used
+  std::vector<Face> faces;          // (Nviews,)
+  std::vector<Pose> cam_from_face;  // (Nviews,) solved board poses
+  IntrinsicsReport report;
+  MrcalProblem problem;  // the solved problem (for uncertainty and cross-checks)
+};
+
+// `views`: this camera's observations (all of the same camera). Throws
+// InputError (`where` names the input) on too few views or a degenerate set.
+IntrinsicsResult CalibrateIntrinsics(int camera, const CameraSpec& spec, const TargetGeometry& target,
+                                     const std::vector<const BoardObservation*>& views,
+                                     const IntrinsicsOptions& options, const std::string& where);
+
+// Shared helpers for the mrcal problems of stages 1 and 2.
+// Fills one observation's (corners_y, corners_x) pool block: seen corners
+// with weight 1, the others with weight -1.
+void FillPoolBlock(const BoardObservation& obs, const TargetGeometry& target, mrcal_point3_t* block);
+// RMS of the inlier board residual coordinates (x and y pooled), px: directly
+// comparable with a per-coordinate corner noise sigma.
+double BoardResidualRms(const MrcalProblem& problem, const std::vector<double>& x);
+// Reports for a solved problem: per-view residuals, coverage, uncertainty.
+std::vector<ViewResidual> ViewResiduals(const MrcalProblem& problem, const std::vector<double>& x,
+                                        const std::vector<int>& view_capture, int icam_intrinsics);
+void FillCoverageAndUncertainty(const MrcalProblem& problem, int icam_intrinsics, const IntrinsicsOptions& options,
+                                int width_px, int height_px, IntrinsicsReport* report);
+
+}  // namespace stereorig

@@ -1,0 +1,106 @@
+// Stage 1 on synthetic captures of the default rig (corners projected through
+// the true cameras, 0.2 px Gaussian noise per coordinate), judged against the
+// truth. The statistical versions over many seeds are in calibrate_test.cc.
+#include "calib/intrinsics.h"
+
+#include <gtest/gtest.h>
+
+#include "calib/calib_test_util.h"
+#include "calib/core/input_error.h"
+
+namespace stereorig {
+namespace {
+
+std::vector<const BoardObservation*> ViewsOf(const CalibrationInput& in, int cam) {
+  std::vector<const BoardObservation*> v;
+  for (const auto& o : in.observations)
+    if (o.camera == cam) v.push_back(&o);
+  return v;
+}
+
+// True cam_from_face of each view the solve used.
+std::vector<Pose> TrueCamFromFace(const testing::DefaultScene& s, int cam, const IntrinsicsResult& r) {
+  std::vector<Pose> out;
+  for (size_t k = 0; k < r.captures.size(); ++k) {
+    const Pose face_from_front = r.faces[k] == Face::kFront ? Pose::Identity() : s.true_back_from_front;
+    out.push_back(s.truth.rig.CamFromReference(cam) * s.data.ref_from_front[r.captures[k]] * face_from_front.Inverse());
+  }
+  return out;
+}
+
+TEST(Intrinsics, Opencv8RecoversTheTruthWithinItsUncertainty) {
+  const double noise = 0.2;
+  for (unsigned seed : {11u, 12u}) {
+    const auto s = testing::MakeDefaultScene(seed, 20, noise);
+    for (int cam : {0, 3}) {
+      const auto r = CalibrateIntrinsics(cam, s.data.input.cameras[cam], s.data.input.target,
+                                         ViewsOf(s.data.input, cam), IntrinsicsOptions(), "test");
+      // Residual RMS per coordinate: the noise, less the fitted dof; 10%.
+      EXPECT_NEAR(r.report.rms_px, noise, 0.1 * noise) << seed << " cam " << cam;
+      EXPECT_EQ(r.report.num_outliers, 0);
+      ASSERT_EQ(r.report.uncertainty.size(), 5u);
+      // Projection at the image centre against the truth: within 4 sigma of
+      // the predicted uncertainty (2D: |e|^2 / sigma^2 ~ chi2(2) / 2 scaled).
+      const auto truth = TrueCamFromFace(s, cam, r);
+      const Eigen::Vector2d e = testing::MeanFramesProjectionError(
+          s.truth.rig.camera(cam), truth, r.camera, r.cam_from_face, r.report.uncertainty[0].q_px, 200.0);
+      EXPECT_LT(e.norm(), 4.0 * std::sqrt(2.0) * r.report.uncertainty[0].rms_stdev_px) << seed << " cam " << cam;
+      EXPECT_LT(r.report.uncertainty[0].rms_stdev_px, 0.2);  // the centre is well covered
+      EXPECT_GT(r.report.coverage_fraction, 0.2);
+    }
+  }
+}
+
+TEST(Intrinsics, LensModelsAreSelectable) {
+  const auto s = testing::MakeDefaultScene(21, 20, 0.2);
+  for (const std::string model :
+       {"LENSMODEL_OPENCV5", "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=8_Ny=6_fov_x_deg=45"}) {
+    IntrinsicsOptions opt;
+    opt.lensmodel = model;
+    const auto r =
+        CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, ViewsOf(s.data.input, 0), opt, "test");
+    EXPECT_EQ(r.camera.lensmodel_name(), model);
+    // Both models can represent this mild OPENCV8 lens within noise here.
+    EXPECT_NEAR(r.report.rms_px, 0.2, 0.03) << model;
+  }
+}
+
+TEST(Intrinsics, RejectsAnOutlierCorner) {
+  auto s = testing::MakeDefaultScene(31, 20, 0.2);
+  // Move one corner by 8 px: a bad detection.
+  for (auto& o : s.data.input.observations) {
+    if (o.camera == 0) {
+      o.q_px[3] += Eigen::Vector2d(8, -6);
+      break;
+    }
+  }
+  const auto r = CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, ViewsOf(s.data.input, 0),
+                                     IntrinsicsOptions(), "test");
+  EXPECT_GE(r.report.num_outliers, 1);
+  EXPECT_NEAR(r.report.rms_px, 0.2, 0.02);
+}
+
+TEST(Intrinsics, RefusesFrontoParallelViews) {
+  auto s = testing::MakeDefaultScene(41, 20, 0.2);
+  SyntheticOptions o;
+  o.max_tilt_deg = 0.0;
+  o.max_roll_deg = 20.0;
+  s.data = MakeSyntheticCaptures(s.truth.rig, s.data.input.target, s.true_back_from_front, s.ref_from_volume, o);
+  try {
+    CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, ViewsOf(s.data.input, 0), IntrinsicsOptions(),
+                        "test");
+    FAIL() << "fronto-parallel views accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("fronto-parallel"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Intrinsics, RefusesTooFewViews) {
+  const auto s = testing::MakeDefaultScene(51, 3, 0.2);
+  EXPECT_THROW(CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, ViewsOf(s.data.input, 0),
+                                   IntrinsicsOptions(), "test"),
+               InputError);
+}
+
+}  // namespace
+}  // namespace stereorig

@@ -1,0 +1,69 @@
+#include "calib/mrcal_problem.h"
+
+#include "calib/core/input_error.h"
+
+namespace stereorig {
+
+bool MrcalProblem::SetLensmodel(const std::string& name) {
+  if (!mrcal_lensmodel_from_name(&lensmodel, name.c_str())) return false;
+  if (!mrcal_lensmodel_type_is_valid(lensmodel.type)) return false;
+  lensmodel_name = name;
+  return true;
+}
+
+int MrcalProblem::num_states() const {
+  return mrcal_num_states(num_intrinsics_cameras, num_extrinsics(), num_frames(), 0, 0, num_observations(), selections,
+                          &lensmodel);
+}
+
+int MrcalProblem::num_measurements() const {
+  return mrcal_num_measurements(num_observations(), 0, corners_x, corners_y, num_intrinsics_cameras, num_extrinsics(),
+                                num_frames(), 0, 0, selections, &lensmodel);
+}
+
+int MrcalProblem::num_measurements_boards() const {
+  return mrcal_num_measurements_boards(num_observations(), corners_x, corners_y);
+}
+
+mrcal_stats_t MrcalProblem::Optimize(bool verbose) {
+  STEREORIG_CHECK(static_cast<int>(intrinsics.size()) == num_intrinsics_cameras * num_params());
+  STEREORIG_CHECK(static_cast<int>(pool.size()) == num_observations() * corners_x * corners_y);
+  const mrcal_problem_constants_t constants = {.point_min_range = -1.0, .point_max_range = -1.0};
+  return mrcal_optimize(nullptr, 0, nullptr, 0, intrinsics.data(), extrinsics_fromref.data(), frames_toref.data(),
+                        nullptr, nullptr, num_intrinsics_cameras, num_extrinsics(), num_frames(), 0, 0,
+                        observations.data(), nullptr, num_observations(), 0, pool.data(), &lensmodel,
+                        imagersizes.data(), selections, &constants, spacing_mm, corners_x, corners_y, verbose, false);
+}
+
+std::vector<double> MrcalProblem::Residuals() const {
+  const mrcal_problem_constants_t constants = {.point_min_range = -1.0, .point_max_range = -1.0};
+  std::vector<double> b(num_states()), x(num_measurements());
+  const bool ok = mrcal_optimizer_callback(
+      b.data(), static_cast<int>(b.size() * sizeof(double)), x.data(), static_cast<int>(x.size() * sizeof(double)),
+      nullptr, intrinsics.data(), extrinsics_fromref.data(), frames_toref.data(), nullptr, nullptr,
+      num_intrinsics_cameras, num_extrinsics(), num_frames(), 0, 0, observations.data(), nullptr, num_observations(), 0,
+      pool.data(), &lensmodel, imagersizes.data(), selections, &constants, spacing_mm, corners_x, corners_y, false);
+  STEREORIG_CHECK(ok);
+  return x;
+}
+
+int MrcalProblem::CountNonPositiveWeights() const {
+  int n = 0;
+  for (const auto& p : pool) n += p.z <= 0.0;
+  return n;
+}
+
+mrcal_pose_t MrcalProblem::ToMrcal(const Pose& a_from_b) {
+  const Eigen::Vector3d r = a_from_b.RotationVector();
+  const Eigen::Vector3d& t = a_from_b.translation_mm();
+  mrcal_pose_t out;
+  out.r = {.xyz = {r.x(), r.y(), r.z()}};
+  out.t = {.xyz = {t.x(), t.y(), t.z()}};
+  return out;
+}
+
+Pose MrcalProblem::FromMrcal(const mrcal_pose_t& rt) {
+  return Pose::FromRotationVector(Eigen::Vector3d(rt.r.x, rt.r.y, rt.r.z), Eigen::Vector3d(rt.t.x, rt.t.y, rt.t.z));
+}
+
+}  // namespace stereorig

@@ -1,0 +1,58 @@
+// Projection uncertainty of a solved mrcal problem: a port of mrcal 2.2's
+// Python `mrcal.projection_uncertainty` (model_analysis.py), which the C API
+// lacks.
+//
+// The method ("mean-frames"): the noise on the observed corners (sigma, px,
+// estimated as the standard deviation of the chessboard residuals, as mrcal
+// does) propagates to the optimized state b through the linearised solve,
+//   Var(b*) = sigma^2 inv(J*'J*) J*obs' J*obs inv(J*'J*)     (b* = packed state)
+// and from b to the projection q of a point p_cam fixed in the space of the
+// calibration boards: p_cam is mapped into every frame's coordinates, each
+// frame maps it back to the reference, the results are averaged, and the mean
+// is projected. dq/db therefore involves the intrinsics, the camera's
+// extrinsics and every frame. J' is factorised with CHOLMOD, as mrcal does.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+
+#include "calib/mrcal_problem.h"
+
+namespace stereorig {
+
+struct ProjectionUncertainty {
+  Eigen::Matrix2d covariance_px2 = Eigen::Matrix2d::Zero();  // Var(q), px^2
+  double rms_stdev_px = 0.0;                                 // sqrt(trace / 2): mrcal's 'rms-stdev'
+  double worst_direction_stdev_px = 0.0;  // sqrt of the larger eigenvalue: mrcal's 'worstdirection-stdev'
+};
+
+class ProjectionUncertaintyEvaluator {
+ public:
+  // Evaluates J at the problem's current (solved) state and factorises J'J.
+  // `problem` must outlive this object and not change. ok() is false if the
+  // factorisation failed (e.g. a frame nobody observes); message() says why.
+  explicit ProjectionUncertaintyEvaluator(const MrcalProblem& problem);
+  ~ProjectionUncertaintyEvaluator();
+  ProjectionUncertaintyEvaluator(const ProjectionUncertaintyEvaluator&) = delete;
+  ProjectionUncertaintyEvaluator& operator=(const ProjectionUncertaintyEvaluator&) = delete;
+
+  bool ok() const;
+  const std::string& message() const;
+  // The noise assumed on every observed corner coordinate: the standard
+  // deviation of the non-outlier chessboard residuals, px.
+  double observed_pixel_sigma_px() const;
+
+  // Uncertainty of projecting `p_cam` (mm, in the frame of intrinsics camera
+  // `icam_intrinsics`) through that camera.
+  ProjectionUncertainty AtPoint(int icam_intrinsics, const Eigen::Vector3d& p_cam) const;
+  // The same for the point that the solved camera sees at pixel `q_px`, at
+  // `range_mm` from the camera centre.
+  ProjectionUncertainty AtPixel(int icam_intrinsics, const Eigen::Vector2d& q_px, double range_mm) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace stereorig

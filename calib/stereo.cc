@@ -1,0 +1,204 @@
+#include "calib/stereo.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "calib/core/input_error.h"
+
+namespace stereorig {
+
+void StereoOptions::Check() const {
+  if (min_shared_views < 1) throw InputError("options.min_shared_views", "must be >= 1");
+}
+
+Pose AveragePoses(const std::vector<Pose>& poses) {
+  STEREORIG_CHECK(!poses.empty());
+  const Eigen::Quaterniond q0 = poses[0].quaternion();
+  Eigen::Vector4d acc = Eigen::Vector4d::Zero();
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  for (const Pose& p : poses) {
+    Eigen::Quaterniond q = p.quaternion();
+    if (q.dot(q0) < 0) q.coeffs() = -q.coeffs();
+    acc += q.coeffs();
+    t += p.translation_mm();
+  }
+  Eigen::Quaterniond mean;
+  mean.coeffs() = acc.normalized();
+  return Pose(mean, t / poses.size());
+}
+
+std::vector<double> RectifiedRowErrors(const Camera& left, const Camera& right, const Pose& right_from_left,
+                                       const std::vector<Eigen::Vector2d>& q_left,
+                                       const std::vector<Eigen::Vector2d>& q_right) {
+  const Pose left_from_right = right_from_left.Inverse();
+  const Eigen::Vector3d& baseline = left_from_right.translation_mm();  // right camera centre, left frame
+  const Eigen::Vector3d ex = baseline.normalized();
+  const Eigen::Vector3d z_mean = (Eigen::Vector3d::UnitZ() + left_from_right.rotation().col(2)).normalized();
+  const Eigen::Vector3d ey = z_mean.cross(ex).normalized();
+  const Eigen::Vector3d ez = ex.cross(ey);
+  Eigen::Matrix3d rect_from_left;
+  rect_from_left << ex.transpose(), ey.transpose(), ez.transpose();
+  const double f = 0.5 * (left.fy() + right.fy());
+  std::vector<double> out;
+  for (size_t i = 0; i < q_left.size(); ++i) {
+    Eigen::Vector3d vl, vr;
+    if (!left.Unproject(q_left[i], &vl) || !right.Unproject(q_right[i], &vr)) continue;
+    const Eigen::Vector3d al = rect_from_left * vl;
+    const Eigen::Vector3d ar = rect_from_left * (left_from_right.rotation() * vr);
+    out.push_back(f * (al.y() / al.z() - ar.y() / ar.z()));
+  }
+  return out;
+}
+
+StereoResult CalibrateStereo(int module, const ModuleLayout& layout, const IntrinsicsResult& left,
+                             const IntrinsicsResult& right, const std::vector<const BoardObservation*>& left_views,
+                             const std::vector<const BoardObservation*>& right_views, const CalibrationInput& input,
+                             const StereoOptions& options, const IntrinsicsOptions& iopt) {
+  const std::string where = input.source + ": module " + std::to_string(module) + " (" + layout.name + ")";
+  const TargetGeometry& target = input.target;
+  // Stage-1 views by capture.
+  std::map<int, int> left_view, right_view;
+  for (size_t k = 0; k < left.captures.size(); ++k) left_view[left.captures[k]] = static_cast<int>(k);
+  for (size_t k = 0; k < right.captures.size(); ++k) right_view[right.captures[k]] = static_cast<int>(k);
+  std::vector<Pose> rl;
+  for (const auto& [capture, kl] : left_view) {
+    auto it = right_view.find(capture);
+    if (it == right_view.end()) continue;
+    if (left.faces[kl] != right.faces[it->second]) {
+      throw InputError(where, "capture " + std::to_string(capture) + ": its two cameras saw different faces");
+    }
+    rl.push_back(right.cam_from_face[it->second] * left.cam_from_face[kl].Inverse());
+  }
+  if (static_cast<int>(rl.size()) < options.min_shared_views) {
+    throw InputError(where, "too few views shared by both cameras: " + std::to_string(rl.size()) + ", need " +
+                                std::to_string(options.min_shared_views));
+  }
+  const Pose right_from_left_seed = AveragePoses(rl);
+
+  // The joint problem: camera 0 = left (reference), camera 1 = right.
+  MrcalProblem p;
+  STEREORIG_CHECK(p.SetLensmodel(iopt.lensmodel));
+  p.corners_x = target.corners_x;
+  p.corners_y = target.corners_y;
+  p.spacing_mm = target.square_size_mm;
+  p.num_intrinsics_cameras = 2;
+  p.intrinsics = left.camera.intrinsics();
+  p.intrinsics.insert(p.intrinsics.end(), right.camera.intrinsics().begin(), right.camera.intrinsics().end());
+  p.imagersizes = {left.camera.imager_width_px(), left.camera.imager_height_px(), right.camera.imager_width_px(),
+                   right.camera.imager_height_px()};
+  p.extrinsics_fromref = {MrcalProblem::ToMrcal(right_from_left_seed)};
+
+  StereoResult result{left.camera, right.camera, {}, {}, {}, {}, {}, {}};
+  std::map<int, const BoardObservation*> lobs, robs;
+  for (const BoardObservation* o : left_views) lobs[o->capture] = o;
+  for (const BoardObservation* o : right_views) robs[o->capture] = o;
+  std::vector<int> captures;
+  for (const auto& kv : left_view) captures.push_back(kv.first);
+  for (const auto& kv : right_view)
+    if (!left_view.count(kv.first)) captures.push_back(kv.first);
+  std::sort(captures.begin(), captures.end());
+  const int n = target.num_corners();
+  for (int capture : captures) {
+    const int iframe = p.num_frames();
+    auto il = left_view.find(capture);
+    auto ir = right_view.find(capture);
+    const Pose left_from_face = il != left_view.end()
+                                    ? left.cam_from_face[il->second]
+                                    : right_from_left_seed.Inverse() * right.cam_from_face[ir->second];
+    p.frames_toref.push_back(MrcalProblem::ToMrcal(left_from_face));
+    result.captures.push_back(capture);
+    result.faces.push_back(il != left_view.end() ? left.faces[il->second] : right.faces[ir->second]);
+    for (int cam = 0; cam < 2; ++cam) {
+      const auto& seen = cam == 0 ? left_view : right_view;
+      if (!seen.count(capture)) continue;
+      const BoardObservation* o = (cam == 0 ? lobs : robs).at(capture);
+      p.observations.push_back({.icam = {.intrinsics = cam, .extrinsics = cam - 1}, .iframe = iframe});
+      p.pool.resize(p.pool.size() + n);
+      FillPoolBlock(*o, target, &p.pool[p.pool.size() - n]);
+    }
+  }
+  const int missing = p.CountNonPositiveWeights();
+  p.selections = {.do_optimize_intrinsics_core = false,
+                  .do_optimize_intrinsics_distortions = false,
+                  .do_optimize_extrinsics = true,
+                  .do_optimize_frames = true,
+                  .do_optimize_calobject_warp = false,
+                  .do_apply_regularization = false,
+                  .do_apply_outlier_rejection = false};
+  p.Optimize(options.verbose);
+  p.selections.do_optimize_intrinsics_core = true;
+  p.selections.do_optimize_intrinsics_distortions = true;
+  p.selections.do_apply_regularization = true;
+  p.selections.do_apply_outlier_rejection = true;
+  const mrcal_stats_t stats = p.Optimize(options.verbose);
+
+  const int np = p.num_params();
+  result.left = Camera(iopt.lensmodel, std::vector<double>(p.intrinsics.begin(), p.intrinsics.begin() + np),
+                       left.camera.imager_width_px(), left.camera.imager_height_px(), where);
+  result.right = Camera(iopt.lensmodel, std::vector<double>(p.intrinsics.begin() + np, p.intrinsics.end()),
+                        right.camera.imager_width_px(), right.camera.imager_height_px(), where);
+  result.right_from_left = MrcalProblem::FromMrcal(p.extrinsics_fromref[0]);
+  for (const mrcal_pose_t& f : p.frames_toref) result.left_from_face.push_back(MrcalProblem::FromMrcal(f));
+
+  StereoReport& r = result.report;
+  r.module = module;
+  r.module_name = layout.name;
+  r.num_shared_views = static_cast<int>(rl.size());
+  r.num_frames = p.num_frames();
+  const std::vector<double> x = p.Residuals();
+  r.rms_px = BoardResidualRms(p, x);
+  r.num_outliers = stats.Noutliers - missing;
+  r.baseline_mm = result.right_from_left.DistanceMm();
+  r.rotation_deg = result.right_from_left.AngleDeg();
+  r.right_from_left_rotation_vector_deg = result.right_from_left.RotationVector() * 180.0 / M_PI;
+  r.right_from_left_translation_mm = result.right_from_left.translation_mm();
+
+  // Corners both cameras saw (inliers in both), for the rectified-row error.
+  std::vector<Eigen::Vector2d> ql, qr;
+  for (int o = 0; o + 1 < p.num_observations(); ++o) {
+    if (p.observations[o].iframe != p.observations[o + 1].iframe) continue;
+    for (int i = 0; i < n; ++i) {
+      const mrcal_point3_t& a = p.pool[o * n + i];
+      const mrcal_point3_t& b = p.pool[(o + 1) * n + i];
+      if (a.z <= 0 || b.z <= 0) continue;
+      ql.emplace_back(a.x, a.y);
+      qr.emplace_back(b.x, b.y);
+    }
+  }
+  const std::vector<double> rows = RectifiedRowErrors(result.left, result.right, result.right_from_left, ql, qr);
+  double s2 = 0, mx = 0;
+  for (double d : rows) {
+    s2 += d * d;
+    mx = std::max(mx, std::abs(d));
+  }
+  r.num_corner_pairs = static_cast<int>(rows.size());
+  r.rectified_row_rms_px = rows.empty() ? 0.0 : std::sqrt(s2 / rows.size());
+  r.rectified_row_max_px = mx;
+
+  for (int cam = 0; cam < 2; ++cam) {
+    IntrinsicsReport& cr = cam == 0 ? r.left : r.right;
+    const IntrinsicsResult& stage1 = cam == 0 ? left : right;
+    cr.camera = stage1.report.camera;
+    cr.camera_name = stage1.report.camera_name;
+    cr.lensmodel = iopt.lensmodel;
+    std::vector<ViewResidual> per_view = ViewResiduals(p, x, result.captures, cam);
+    cr.num_views = static_cast<int>(per_view.size());
+    double sum2 = 0;
+    int count = 0;
+    for (const ViewResidual& v : per_view) {
+      sum2 += v.rms_px * v.rms_px * v.num_corners;  // per-coordinate mean square x corners
+      count += v.num_corners;
+    }
+    cr.num_corners = count;
+    cr.rms_px = count ? std::sqrt(sum2 / count) : 0.0;
+    std::sort(per_view.begin(), per_view.end(), [](const auto& a, const auto& b) { return a.rms_px > b.rms_px; });
+    per_view.resize(std::min<size_t>(per_view.size(), iopt.worst_views_reported));
+    cr.worst_views = per_view;
+    FillCoverageAndUncertainty(p, cam, iopt, stage1.camera.imager_width_px(), stage1.camera.imager_height_px(), &cr);
+  }
+  result.problem = std::move(p);
+  return result;
+}
+
+}  // namespace stereorig

@@ -1,0 +1,335 @@
+#include "calib/system.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "calib/core/input_error.h"
+#include "calib/cost_functions.h"
+#include "calib/horn.h"
+#include "calib/triangulation.h"
+
+namespace stereorig {
+
+void SystemOptions::Check() const {
+  if (!(huber_px > 0)) throw InputError("options.huber_px", "must be > 0");
+  if (min_triangulated_corners < 3) throw InputError("options.min_triangulated_corners", "must be >= 3");
+  if (max_iterations < 1) throw InputError("options.max_iterations", "must be >= 1");
+}
+
+namespace {
+
+using ObsIndex = std::map<std::pair<int, int>, const BoardObservation*>;  // (capture, camera)
+
+ObsIndex IndexObservations(const CalibrationInput& input) {
+  ObsIndex index;
+  for (const BoardObservation& o : input.observations) index[{o.capture, o.camera}] = &o;
+  return index;
+}
+
+}  // namespace
+
+std::vector<std::map<int, ModuleCaptureView>> PoseBoardsByTriangulation(const CalibrationInput& input,
+                                                                        const std::vector<ModuleCameras>& modules,
+                                                                        int min_corners) {
+  const ObsIndex index = IndexObservations(input);
+  const TargetGeometry& target = input.target;
+  std::vector<std::map<int, ModuleCaptureView>> views(modules.size());
+  std::set<int> captures;
+  for (const BoardObservation& o : input.observations) captures.insert(o.capture);
+  for (size_t k = 0; k < modules.size(); ++k) {
+    const ModuleCameras& m = modules[k];
+    for (int c : captures) {
+      auto il = index.find({c, m.left_camera});
+      auto ir = index.find({c, m.right_camera});
+      if (il == index.end() || ir == index.end()) continue;
+      const BoardObservation& l = *il->second;
+      const BoardObservation& r = *ir->second;
+      if (l.face != r.face) continue;
+      std::map<int, Eigen::Vector2d> qr;
+      for (size_t i = 0; i < r.corner_ids.size(); ++i) qr[r.corner_ids[i]] = r.q_px[i];
+      ModuleCaptureView v;
+      v.face = l.face;
+      std::vector<Eigen::Vector3d> x_face;
+      for (size_t i = 0; i < l.corner_ids.size(); ++i) {
+        auto it = qr.find(l.corner_ids[i]);
+        if (it == qr.end()) continue;
+        Eigen::Vector3d p;
+        if (!TriangulatePair(m.left, m.right, m.right_from_left, l.q_px[i], it->second, &p)) continue;
+        v.corner_ids.push_back(l.corner_ids[i]);
+        v.p_module.push_back(p);
+        x_face.push_back(target.CornerInFace(l.corner_ids[i]));
+      }
+      if (static_cast<int>(v.p_module.size()) < min_corners) continue;
+      const HornResult h = HornAbsoluteOrientation(v.p_module, x_face);
+      if (!h.ok) continue;
+      v.module_from_front = h.a_from_b * target.FaceFromFront(v.face);
+      views[k][c] = std::move(v);
+    }
+  }
+  return views;
+}
+
+SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<ModuleCameras>& modules,
+                             double corner_sigma_px, const SystemOptions& options) {
+  STEREORIG_CHECK(corner_sigma_px > 0);
+  const int M = static_cast<int>(modules.size());
+  const TargetGeometry& target = input.target;
+  SystemResult result;
+  result.modules = modules;
+  SystemReport& rep = result.report;
+
+  const auto views = PoseBoardsByTriangulation(input, modules, options.min_triangulated_corners);
+
+  // Pairwise Horn between modules that posed the same captures.
+  std::map<std::pair<int, int>, HornResult> pair_horn;
+  for (int i = 0; i < M; ++i) {
+    for (int j = i + 1; j < M; ++j) {
+      std::vector<Eigen::Vector3d> in_i, in_j;
+      int shared = 0;
+      for (const auto& [c, vi] : views[i]) {
+        auto it = views[j].find(c);
+        if (it == views[j].end()) continue;
+        const ModuleCaptureView& vj = it->second;
+        ++shared;
+        // Module i's triangulated corners, and where module j's board pose puts them.
+        for (size_t k = 0; k < vi.corner_ids.size(); ++k) {
+          const Eigen::Vector3d x_front =
+              target.FaceFromFront(vi.face).Inverse() * target.CornerInFace(vi.corner_ids[k]);
+          in_i.push_back(vi.p_module[k]);
+          in_j.push_back(vj.module_from_front * x_front);
+        }
+        for (size_t k = 0; k < vj.corner_ids.size(); ++k) {
+          const Eigen::Vector3d x_front =
+              target.FaceFromFront(vj.face).Inverse() * target.CornerInFace(vj.corner_ids[k]);
+          in_i.push_back(vi.module_from_front * x_front);
+          in_j.push_back(vj.p_module[k]);
+        }
+      }
+      if (shared == 0) continue;
+      rep.shared_captures[{i, j}] = shared;
+      pair_horn[{i, j}] = HornAbsoluteOrientation(in_i, in_j);
+    }
+  }
+
+  // Maximum spanning tree from module 0 (Prim), by shared captures.
+  std::vector<Pose> module0_from_module(M);
+  std::vector<bool> in_tree(M, false);
+  in_tree[0] = true;
+  for (int added = 1; added < M; ++added) {
+    int best = -1, bi = -1, bj = -1;
+    for (const auto& [ij, n] : rep.shared_captures) {
+      const auto [i, j] = ij;
+      if (in_tree[i] == in_tree[j] || !pair_horn[ij].ok) continue;
+      if (n > best) best = n, bi = i, bj = j;
+    }
+    if (best < 0) {
+      std::string missing;
+      for (int k = 0; k < M; ++k)
+        if (!in_tree[k]) missing += (missing.empty() ? "" : ", ") + std::to_string(k);
+      throw InputError(input.source, "module(s) " + missing +
+                                         " share no capture in which both they and an already-placed module posed "
+                                         "the target; the S matrix is undetermined");
+    }
+    const HornResult& h = pair_horn[{bi, bj}];  // bi_from_bj
+    const int parent = in_tree[bi] ? bi : bj, child = in_tree[bi] ? bj : bi;
+    const Pose parent_from_child = parent == bi ? h.a_from_b : h.a_from_b.Inverse();
+    module0_from_module[child] = module0_from_module[parent] * parent_from_child;
+    in_tree[child] = true;
+    rep.spanning_tree.emplace_back(parent, child);
+    rep.horn_rms_mm[{parent, child}] = h.rms_mm;
+  }
+  result.module0_from_module_horn = module0_from_module;
+  rep.module0_from_module_horn = module0_from_module;
+
+  // ---- The bundle adjustment.
+  ceres::Problem::Options popt;
+  popt.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  popt.loss_function_ownership = ceres::TAKE_OWNERSHIP;
+  ceres::Problem problem(popt);
+
+  std::vector<PoseBlock> s_blocks(M);
+  for (int k = 0; k < M; ++k) s_blocks[k] = PoseBlock(module0_from_module[k]);
+  std::vector<PoseBlock> rl_blocks(M);
+  for (int k = 0; k < M; ++k) rl_blocks[k] = PoseBlock(modules[k].right_from_left);
+  PoseBlock bff_block(target.back_from_front);
+  PoseBlock identity_module, identity_bff, identity_rl;
+  std::map<int, std::vector<double>> intrinsics;  // per global camera
+  std::map<int, const Camera*> camera_of;
+  std::map<int, std::pair<int, bool>> module_of;  // camera -> (module, is right)
+  for (int k = 0; k < M; ++k) {
+    intrinsics[modules[k].left_camera] = modules[k].left.intrinsics();
+    intrinsics[modules[k].right_camera] = modules[k].right.intrinsics();
+    camera_of[modules[k].left_camera] = &modules[k].left;
+    camera_of[modules[k].right_camera] = &modules[k].right;
+    module_of[modules[k].left_camera] = {k, false};
+    module_of[modules[k].right_camera] = {k, true};
+  }
+
+  // Board poses, seeded from the first module (in tree order) that posed them.
+  std::map<int, PoseBlock> boards;
+  std::vector<int> order = {0};
+  for (const auto& e : rep.spanning_tree) order.push_back(e.second);
+  for (int k : order) {
+    for (const auto& [c, v] : views[k]) {
+      if (!boards.count(c)) boards[c] = PoseBlock(module0_from_module[k] * v.module_from_front);
+    }
+  }
+  rep.num_captures = static_cast<int>(boards.size());
+
+  std::vector<ceres::ResidualBlockId> corner_blocks;
+  bool any_back = false;
+  for (const BoardObservation& o : input.observations) {
+    auto b = boards.find(o.capture);
+    auto mo = module_of.find(o.camera);
+    if (b == boards.end() || mo == module_of.end()) continue;
+    const auto [k, is_right] = mo->second;
+    const bool back = o.face == Face::kBack;
+    any_back |= back;
+    for (size_t i = 0; i < o.corner_ids.size(); ++i) {
+      CornerPointFunctor g;
+      g.x_face = target.CornerInFace(o.corner_ids[i]);
+      g.back_face = back;
+      g.right_camera = is_right;
+      PoseBlock* module_block = k == 0 ? &identity_module : &s_blocks[k];
+      PoseBlock* bff = back ? &bff_block : &identity_bff;
+      PoseBlock* rl = is_right ? &rl_blocks[k] : &identity_rl;
+      g.R0[0] = b->second.R0;
+      g.R0[1] = module_block->R0;
+      g.R0[2] = bff->R0;
+      g.R0[3] = rl->R0;
+      corner_blocks.push_back(problem.AddResidualBlock(
+          CornerReprojectionCost::Create(g, *camera_of[o.camera], o.q_px[i]), new ceres::HuberLoss(options.huber_px),
+          std::vector<double*>{b->second.params, module_block->params, bff->params, rl->params,
+                               intrinsics[o.camera].data()}));
+    }
+  }
+  rep.num_residual_corners = static_cast<int>(corner_blocks.size());
+  // Without mrcal's regularisation, only the well-determined intrinsics are
+  // freed: the core and OPENCV's k1..k3, p1, p2. OPENCV8's rational k4..k6 and
+  // a spline's control points stay at their stage-2 values.
+  for (auto& [cam, v] : intrinsics) {
+    if (!problem.HasParameterBlock(v.data())) continue;
+    const std::string& model = camera_of[cam]->lensmodel_name();
+    std::vector<int> fixed;
+    const int n = static_cast<int>(v.size());
+    const int first_fixed = model == "LENSMODEL_OPENCV8" ? 9 : model.rfind("LENSMODEL_OPENCV", 0) == 0 ? n : 4;
+    for (int i = first_fixed; i < n; ++i) fixed.push_back(i);
+    if (!fixed.empty()) problem.SetManifold(v.data(), new ceres::SubsetManifold(n, fixed));
+  }
+  for (PoseBlock* p : {&identity_module, &identity_bff, &identity_rl}) {
+    if (problem.HasParameterBlock(p->params)) problem.SetParameterBlockConstant(p->params);
+  }
+  const bool bff_free = any_back && options.refine_back_from_front && target.double_sided &&
+                        (target.back_from_front_sigma.array() > 0).all();
+  if (any_back && bff_free) {
+    problem.AddResidualBlock(BackFromFrontPrior::Create(target.back_from_front.translation_mm(),
+                                                        target.back_from_front_sigma, corner_sigma_px),
+                             nullptr, bff_block.params);
+  }
+
+  auto set_free = [&](bool s, bool rl, bool bff, bool intr) {
+    for (int k = 1; k < M; ++k)
+      if (problem.HasParameterBlock(s_blocks[k].params)) {
+        s ? problem.SetParameterBlockVariable(s_blocks[k].params)
+          : problem.SetParameterBlockConstant(s_blocks[k].params);
+      }
+    for (int k = 0; k < M; ++k)
+      if (problem.HasParameterBlock(rl_blocks[k].params)) {
+        rl ? problem.SetParameterBlockVariable(rl_blocks[k].params)
+           : problem.SetParameterBlockConstant(rl_blocks[k].params);
+      }
+    if (problem.HasParameterBlock(bff_block.params)) {
+      bff ? problem.SetParameterBlockVariable(bff_block.params) : problem.SetParameterBlockConstant(bff_block.params);
+    }
+    for (auto& [cam, v] : intrinsics)
+      if (problem.HasParameterBlock(v.data())) {
+        intr ? problem.SetParameterBlockVariable(v.data()) : problem.SetParameterBlockConstant(v.data());
+      }
+  };
+  auto corner_rms = [&]() {
+    ceres::Problem::EvaluateOptions eo;
+    eo.residual_blocks = corner_blocks;
+    eo.apply_loss_function = false;
+    std::vector<double> r;
+    problem.Evaluate(eo, nullptr, &r, nullptr, nullptr);
+    double s2 = 0;
+    for (double x : r) s2 += x * x;
+    return r.empty() ? 0.0 : std::sqrt(s2 / r.size());
+  };
+
+  ceres::Solver::Options sopt;
+  sopt.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  sopt.max_num_iterations = options.max_iterations;
+  sopt.num_threads = 1;
+  sopt.function_tolerance = 1e-12;
+  sopt.parameter_tolerance = 1e-12;
+  sopt.gradient_tolerance = 1e-14;
+  ceres::Solver::Summary summary;
+  // Horn-only: S and the stereo pairs held, the board poses solved.
+  set_free(false, false, false, false);
+  ceres::Solve(sopt, &problem, &summary);
+  rep.horn_reprojection_rms_px = corner_rms();
+  // The full adjustment.
+  set_free(true, options.refine_stereo, bff_free, options.refine_intrinsics);
+  ceres::Solve(sopt, &problem, &summary);
+  rep.refined_reprojection_rms_px = corner_rms();
+  rep.solver_summary = summary.BriefReport();
+
+  for (int k = 0; k < M; ++k) result.module0_from_module.push_back(k == 0 ? Pose::Identity() : s_blocks[k].ToPose());
+  rep.module0_from_module = result.module0_from_module;
+  for (int k = 0; k < M; ++k) {
+    result.modules[k].right_from_left = rl_blocks[k].ToPose();
+    if (options.refine_intrinsics) {
+      result.modules[k].left = Camera(modules[k].left.lensmodel_name(), intrinsics[modules[k].left_camera],
+                                      modules[k].left.imager_width_px(), modules[k].left.imager_height_px());
+      result.modules[k].right = Camera(modules[k].right.lensmodel_name(), intrinsics[modules[k].right_camera],
+                                       modules[k].right.imager_width_px(), modules[k].right.imager_height_px());
+    }
+  }
+  rep.back_from_front = bff_block.ToPose();
+  const Pose change = target.back_from_front.Inverse() * rep.back_from_front;
+  rep.back_from_front_change_deg = change.AngleDeg();
+  rep.back_from_front_change_mm =
+      (rep.back_from_front.translation_mm() - target.back_from_front.translation_mm()).norm();
+
+  // 1 sigma of S[0][k] from the covariance of the adjustment, scaled by the
+  // residual variance (Ceres assumes unit-variance residuals).
+  rep.covariance_status = "not computed";
+  if (options.compute_covariance && M > 1) {
+    ceres::Covariance::Options copt;
+    int num_free = 0;
+    std::vector<double*> blocks;
+    problem.GetParameterBlocks(&blocks);
+    for (double* b : blocks)
+      if (!problem.IsParameterBlockConstant(b)) num_free += problem.ParameterBlockSize(b);
+    copt.algorithm_type = num_free <= 3000 ? ceres::DENSE_SVD : ceres::SPARSE_QR;
+    copt.null_space_rank = -1;
+    copt.num_threads = 1;
+    ceres::Covariance cov(copt);
+    std::vector<std::pair<const double*, const double*>> pairs;
+    for (int k = 1; k < M; ++k) pairs.emplace_back(s_blocks[k].params, s_blocks[k].params);
+    if (cov.Compute(pairs, &problem)) {
+      const double n_res = 2.0 * corner_blocks.size();
+      const double rms = rep.refined_reprojection_rms_px;
+      const double sigma2 = rms * rms * n_res / std::max(1.0, n_res - num_free);
+      for (int k = 1; k < M; ++k) {
+        double c[36];
+        cov.GetCovarianceBlock(s_blocks[k].params, s_blocks[k].params, c);
+        STransformSigma s;
+        s.module = k;
+        for (int i = 0; i < 3; ++i) {
+          s.rotation_deg(i) = std::sqrt(sigma2 * c[i * 6 + i]) * 180.0 / M_PI;
+          s.translation_mm(i) = std::sqrt(sigma2 * c[(3 + i) * 6 + 3 + i]);
+        }
+        rep.sigma.push_back(s);
+      }
+      rep.covariance_status = "ok";
+    } else {
+      rep.covariance_status = "ceres::Covariance failed (rank-deficient problem)";
+    }
+  }
+  return result;
+}
+
+}  // namespace stereorig

@@ -1,0 +1,104 @@
+// Stage 3: the system, i.e. where every module sits in the reference frame
+// (module 0), giving the S matrix.
+//
+//  1. In each capture, each module triangulates the corners its two cameras
+//     both saw (in its own frame) and finds the board's pose by Horn's
+//     absolute orientation; a back face is mapped to the front face's frame
+//     through the target's back_from_front.
+//  2. For every pair of modules that saw the same captures, Horn's absolute
+//     orientation on the triangulated corners of each module, expressed in the
+//     other module through the other's board pose, gives
+//     module_i_from_module_j. A maximum spanning tree (by shared captures)
+//     from module 0 chains them: module0_from_module_k.
+//  3. One Ceres bundle adjustment over every capture and camera minimises the
+//     reprojection error with a robust (Huber) loss. Parameters: S (each
+//     module's pose in the reference), every board pose, optionally the
+//     stereo extrinsics and the intrinsics, and back_from_front under its
+//     measured prior. ceres::Covariance gives the 1 sigma of S.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "calib/core/camera.h"
+#include "calib/core/pose.h"
+#include "calib/observations.h"
+
+namespace stereorig {
+
+struct SystemOptions {
+  double huber_px = 1.0;      // Huber loss scale, px; default 1
+  bool refine_stereo = true;  // free each module's right_from_left in the adjustment; default true
+  // Free every camera's intrinsics: the core and OPENCV's k1..k3, p1, p2 (not
+  // OPENCV8's k4..k6 nor spline knots, which need mrcal's regularisation).
+  // With them free, the covariance of S includes the lens uncertainty, which
+  // moves each module's frame (a calibrated camera's frame trades rotation
+  // against its centre). Default true.
+  bool refine_intrinsics = true;
+  bool refine_back_from_front = true;  // free back_from_front under its prior; default true
+  int min_triangulated_corners = 6;    // a module's board pose needs this many corners both cameras saw; default 6
+  int max_iterations = 100;            // Ceres; default 100
+  bool compute_covariance = true;      // 1 sigma of S; default true
+  void Check() const;
+};
+
+// One module's calibrated stereo pair (from stage 2).
+struct ModuleCameras {
+  int left_camera = -1, right_camera = -1;  // global indices
+  Camera left, right;
+  Pose right_from_left;
+};
+
+struct STransformSigma {
+  int module = -1;                                         // S[0][module] = module0_from_module
+  Eigen::Vector3d rotation_deg = Eigen::Vector3d::Zero();  // 1 sigma of a rotation about the reference's x, y, z
+  Eigen::Vector3d translation_mm = Eigen::Vector3d::Zero();
+};
+
+struct SystemReport {
+  int num_captures = 0;                                // captures seen by at least one module with a board pose
+  std::map<std::pair<int, int>, int> shared_captures;  // (i, j) -> captures both modules posed
+  std::vector<std::pair<int, int>> spanning_tree;      // (parent, child) edges used for Horn
+  std::map<std::pair<int, int>, double> horn_rms_mm;   // Horn fit RMS of each tree edge
+  double horn_reprojection_rms_px = 0.0;               // S and stereo held at Horn/stage 2, board poses solved
+  double refined_reprojection_rms_px = 0.0;            // after the full adjustment
+  int num_residual_corners = 0;
+  std::vector<Pose> module0_from_module_horn;  // (M,)
+  std::vector<Pose> module0_from_module;       // (M,) refined
+  std::vector<STransformSigma> sigma;          // for modules 1..M-1
+  std::string covariance_status;               // "ok" or why it is missing
+  Pose back_from_front;                        // as refined
+  double back_from_front_change_deg = 0.0;     // refined vs measured
+  double back_from_front_change_mm = 0.0;
+  std::string solver_summary;  // Ceres BriefReport
+};
+
+struct SystemResult {
+  std::vector<Pose> module0_from_module;       // (M,) refined; [0] = identity
+  std::vector<Pose> module0_from_module_horn;  // (M,)
+  std::vector<ModuleCameras> modules;          // refined stereo/intrinsics (unchanged if not refined)
+  SystemReport report;
+};
+
+// `modules`: stage-2 results per module. `corner_sigma_px`: the corner noise
+// (stage 2's residual RMS), which weighs back_from_front's prior against the
+// reprojection residuals. Throws InputError if a module shares no capture
+// with the others (the S matrix would be undetermined).
+SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<ModuleCameras>& modules,
+                             double corner_sigma_px, const SystemOptions& options);
+
+// Board poses: for each capture, module_from_front of one module, from its
+// triangulated corners (Horn). Also the triangulated points themselves.
+struct ModuleCaptureView {
+  Face face = Face::kFront;
+  Pose module_from_front;
+  std::vector<int> corner_ids;            // (N,)
+  std::vector<Eigen::Vector3d> p_module;  // (N,) triangulated, module frame, mm
+};
+// views[k][capture]: module k's posed captures.
+std::vector<std::map<int, ModuleCaptureView>> PoseBoardsByTriangulation(const CalibrationInput& input,
+                                                                        const std::vector<ModuleCameras>& modules,
+                                                                        int min_corners);
+
+}  // namespace stereorig

@@ -1,0 +1,66 @@
+// Chessboard corners as OpenCV finds them: a rectangular grid in OpenCV's own
+// order, refined to sub-pixel precision. Which corner of the target each one
+// is gets decided later (detect.h), from the tags or the square colours.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace stereorig {
+
+struct ChessboardGridOptions {
+  // cv::findChessboardCornersSB's exhaustive search: finds boards in more
+  // views (steep tilts, blur) for ~20% more time. Default true.
+  bool exhaustive = true;
+  // cv::findChessboardCornersSB's CALIB_CB_ACCURACY (upsampled search).
+  // Default false: measured on rendered views of the default target
+  // (targets/detect_test.cc, RenderedCornerAccuracy) it is 3x slower and,
+  // once cornerSubPix refines the corners, no more accurate.
+  bool upsample = false;
+  // Refine each corner with cv::cornerSubPix in a window of half-size
+  // refine_window_fraction x (distance to its nearest neighbour corner),
+  // clamped to [refine_min_half_px, refine_max_half_px]. Default true.
+  // Measured: 0.078 px RMS (SB alone) -> 0.02 px (refined) on the same views.
+  bool refine = true;
+  double refine_window_fraction = 0.4;  // of the local corner spacing; default 0.4
+  int refine_min_half_px = 2;           // default 2
+  int refine_max_half_px = 16;          // default 16
+  // A refined corner that moved more than this from OpenCV's estimate keeps
+  // OpenCV's estimate (the refinement slid off the corner). px, default 1.0.
+  double refine_max_shift_px = 1.0;
+  void Check() const;  // throws InputError naming the bad field
+};
+
+// A grid of `cols` x `rows` corners in OpenCV's order (row-major: q_px[r *
+// cols + c]), pixels in mrcal's convention ((0,0) = centre of the top-left
+// pixel; OpenCV's corner coordinates already use it - measured, see
+// detect_test.cc).
+struct ChessboardGrid {
+  int cols = 0;
+  int rows = 0;
+  std::vector<Eigen::Vector2d> q_px;  // (rows * cols)
+  int num_refine_rejected = 0;        // corners whose refinement was not kept
+  const Eigen::Vector2d& at(int c, int r) const { return q_px[r * cols + c]; }
+};
+
+// Finds a chessboard in `grey` (CV_8UC1). If `partial`, any grid of at least
+// `min_size` corners each way is accepted (CALIB_CB_LARGER; the board may run
+// out of the image); else exactly `size` (cols x rows, either way round).
+// Returns false if none was found.
+bool FindChessboardGrid(const cv::Mat& grey, cv::Size size, bool partial, const ChessboardGridOptions& options,
+                        ChessboardGrid* grid);
+
+// OpenCV's cv::estimateChessboardSharpness on a found grid: the mean width
+// (px) of the 10%-90% black-to-white rise across the squares' edges (sharp is
+// below ~3 px), and the mean black and white levels (DN).
+struct ChessboardSharpness {
+  double edge_rise_px = 0;
+  double black_dn = 0;
+  double white_dn = 0;
+};
+ChessboardSharpness MeasureSharpness(const cv::Mat& grey, const ChessboardGrid& grid);
+
+}  // namespace stereorig
