@@ -19,7 +19,7 @@ void SgmOptions::Check() const {
 }
 
 CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int num_threads, int half_width,
-                            int half_height) {
+                            int half_height, int col_begin, int col_end) {
   STEREORIG_CHECK(half_width >= 1 && half_width <= 4 && half_height >= 1 && half_height <= 3);
   STEREORIG_CHECK(grey.type() == CV_8UC1);
   CensusImage out;
@@ -29,6 +29,7 @@ CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int
   row_begin = std::max(0, row_begin);
   row_end = std::min(grey.rows, row_end);
   const int w = grey.cols, h = grey.rows;
+  const int c0 = std::clamp(col_begin, 0, w), c1 = std::clamp(col_end, c0, w);
   ParallelForChunks(row_end - row_begin, num_threads, [&](int b, int e) {
     std::vector<uint8_t> padded(w + 8);
     for (int y = row_begin + b; y < row_begin + e; ++y) {
@@ -45,7 +46,7 @@ CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int
         for (int dx = -half_width; dx <= half_width; ++dx) {
           if (dx == 0 && dy == 0) continue;
           const uint8_t* nb = padded.data() + 4 + dx;
-          for (int x = 0; x < w; ++x) dst[x] = (dst[x] << 1) | uint64_t(nb[x] < centre[x]);
+          for (int x = c0; x < c1; ++x) dst[x] = (dst[x] << 1) | uint64_t(nb[x] < centre[x]);
         }
       }
     }

@@ -1,6 +1,7 @@
 #include "reconstruct/matcher.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <opencv2/calib3d.hpp>
@@ -58,11 +59,17 @@ cv::Rect ClampRoi(const cv::Rect& roi, const cv::Size& size) {
 cv::Mat MatchLevel(const cv::Mat& left, const cv::Mat& right, const cv::Rect& region, int dmin, int num,
                    int levels_left, const MatchOptions& o) {
   // Rows beyond the region too: the fine level's cost box reaches past it.
+  // Only the columns the search reads: the region in the left image, the
+  // region shifted by the disparity range in the right one.
   const int margin = o.refine_half_window_px;
+  const int reach = levels_left > 0 ? o.refine_radius_px + 2 : 0;  // fine level: +-radius around 2x coarse
   const CensusImage cl = CensusTransform(left, region.y - margin, region.y + region.height + margin, o.num_threads,
-                                         o.census_half_width_px, o.census_half_height_px);
+                                         o.census_half_width_px, o.census_half_height_px, region.x - margin,
+                                         region.x + region.width + margin);
   const CensusImage cr = CensusTransform(right, region.y - margin, region.y + region.height + margin, o.num_threads,
-                                         o.census_half_width_px, o.census_half_height_px);
+                                         o.census_half_width_px, o.census_half_height_px,
+                                         region.x - dmin - num - margin - reach,
+                                         region.x + region.width - dmin + margin + reach);
   if (levels_left == 0) return SgmMatch(cl, cr, region, dmin, num, o.sgm);
 
   cv::Mat left_half, right_half;
@@ -220,10 +227,18 @@ bool OccupiedBand(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
 }
 
 MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const MatchOptions& o) {
+  MatchResult result;
+  auto t = std::chrono::steady_clock::now();
+  auto lap = [&](const char* step) {
+    const auto now = std::chrono::steady_clock::now();
+    result.times_ms[step] = std::chrono::duration<double, std::milli>(now - t).count();
+    t = now;
+  };
   int dmin = o.min_disparity_px, num = o.num_disparities;
   if (o.narrow_range && o.pyramid_levels == 0) OccupiedBand(left, right, roi, o, &dmin, &num);
+  lap("band");
   const cv::Mat coarse_to_fine = MatchLevel(left, right, roi, dmin, num, o.pyramid_levels, o);
-  MatchResult result;
+  lap("sgm");
   result.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
   result.confidence = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
   const double dmax = o.min_disparity_px + o.num_disparities - 1;
@@ -258,6 +273,7 @@ MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::
       }
     }
   });
+  lap("subpixel");
   RemoveSpeckles(result.disparity_px, o);
   for (int y = 0; y < left.rows; ++y) {
     const float* d = result.disparity_px.ptr<float>(y);
@@ -265,6 +281,7 @@ MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::
     for (int x = 0; x < left.cols; ++x)
       if (!std::isfinite(d[x])) c[x] = 0;
   }
+  lap("speckle");
   return result;
 }
 
@@ -283,8 +300,10 @@ MatchResult MatchOpenCvSgbm(const cv::Mat& left, const cv::Mat& right, const cv:
                              o.speckle_window_px, std::max(1, int(std::lround(o.speckle_range_px))),
                              cv::StereoSGBM::MODE_SGBM_3WAY);
   cv::Mat fixed;
+  const auto t0 = std::chrono::steady_clock::now();
   sgbm->compute(left(cut), right(cut), fixed);
   MatchResult result;
+  result.times_ms["sgbm"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   result.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
   result.confidence = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
   const double dmax_valid = o.min_disparity_px + o.num_disparities - 1;

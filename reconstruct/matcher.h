@@ -19,6 +19,7 @@
 // the same region and range: the baseline every figure is compared against.
 #pragma once
 
+#include <map>
 #include <opencv2/core.hpp>
 #include <string>
 
@@ -67,6 +68,10 @@ struct MatchResult {
   // CV_32FC1, same size: confidence in [0, 1] (ZNCC of the refined window
   // for census_sgm, 1 for any valid SGBM pixel), 0 where invalid.
   cv::Mat confidence;
+  // Wall time of the sub-steps, ms: census_sgm: "band" (the half-resolution
+  // range pass), "sgm" (census + SGM + left-right/uniqueness), "subpixel"
+  // (slopes + Lucas-Kanade + filters), "speckle"; opencv_sgbm_3way: "sgbm".
+  std::map<std::string, double> times_ms;
 };
 
 // left, right: CV_8UC1, same size, rectified. Stateless and thread-safe.

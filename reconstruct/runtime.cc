@@ -139,6 +139,7 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
     mo.min_disparity_px = plan.min_disparity_px;
     mo.num_disparities = plan.num_disparities;
     match = Match(left, right, mo);
+    for (const auto& [step, ms] : match.times_ms) report->times_ms["match." + step] = ms;
   } else {
     match.disparity_px = cv::Mat(size, CV_32FC1, cv::Scalar(std::numeric_limits<float>::infinity()));
     match.confidence = cv::Mat(size, CV_32FC1, cv::Scalar(0));
