@@ -18,7 +18,9 @@ void SgmOptions::Check() const {
   if (lr_max_diff_px < 0) throw InputError("sgm.lr_max_diff_px", "must be >= 0 (0 = exact)");
 }
 
-CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int num_threads) {
+CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int num_threads, int half_width,
+                            int half_height, int col_begin, int col_end) {
+  STEREORIG_CHECK(half_width >= 1 && half_width <= 4 && half_height >= 1 && half_height <= 3);
   STEREORIG_CHECK(grey.type() == CV_8UC1);
   CensusImage out;
   out.width = grey.cols;
@@ -27,12 +29,13 @@ CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int
   row_begin = std::max(0, row_begin);
   row_end = std::min(grey.rows, row_end);
   const int w = grey.cols, h = grey.rows;
+  const int c0 = std::clamp(col_begin, 0, w), c1 = std::clamp(col_end, c0, w);
   ParallelForChunks(row_end - row_begin, num_threads, [&](int b, int e) {
     std::vector<uint8_t> padded(w + 8);
     for (int y = row_begin + b; y < row_begin + e; ++y) {
       const uint8_t* centre = grey.ptr<uint8_t>(y);
       uint64_t* dst = out.bits.data() + size_t(y) * w;
-      for (int dy = -3; dy <= 3; ++dy) {
+      for (int dy = -half_height; dy <= half_height; ++dy) {
         const uint8_t* src = grey.ptr<uint8_t>(std::clamp(y + dy, 0, h - 1));
         // Replicated border in a padded copy keeps the inner loop branch-free.
         for (int i = 0; i < 4; ++i) {
@@ -40,10 +43,10 @@ CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int
           padded[w + 4 + i] = src[w - 1];
         }
         std::copy(src, src + w, padded.begin() + 4);
-        for (int dx = -4; dx <= 4; ++dx) {
+        for (int dx = -half_width; dx <= half_width; ++dx) {
           if (dx == 0 && dy == 0) continue;
           const uint8_t* nb = padded.data() + 4 + dx;
-          for (int x = 0; x < w; ++x) dst[x] = (dst[x] << 1) | uint64_t(nb[x] < centre[x]);
+          for (int x = c0; x < c1; ++x) dst[x] = (dst[x] << 1) | uint64_t(nb[x] < centre[x]);
         }
       }
     }

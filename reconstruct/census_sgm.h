@@ -24,10 +24,14 @@ struct CensusImage {
 };
 
 // Computes signatures for rows [row_begin, row_end) only (others stay 0), on
-// `num_threads` threads. `grey` is CV_8UC1.
-CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int num_threads);
+// `num_threads` threads. `grey` is CV_8UC1. The window is (2*half_width+1) x
+// (2*half_height+1) px, at most 63 bits.
+// Columns outside [col_begin, col_end) are left 0 too (only the columns the
+// matcher reads need signatures).
+CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int num_threads, int half_width = 4,
+                            int half_height = 3, int col_begin = 0, int col_end = 1 << 30);
 
-inline constexpr int kCensusMaxCost = 62;  // bits in a signature
+inline constexpr int kCensusMaxCost = 62;  // bits in the largest (9x7) signature: the cost of "no match"
 
 struct SgmOptions {
   int p1 = 8;                 // penalty for a 1 px disparity step, census bits; default 8

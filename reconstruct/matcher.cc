@@ -1,6 +1,7 @@
 #include "reconstruct/matcher.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <opencv2/calib3d.hpp>
@@ -29,9 +30,13 @@ void MatchOptions::Check() const {
   if (refine_radius_px < 1 || refine_radius_px > 8) throw InputError("refine_radius_px", "must be in [1, 8]");
   if (refine_half_window_px < 0 || refine_half_window_px > 5)
     throw InputError("refine_half_window_px", "must be in [0, 5]");
+  if (census_half_width_px < 1 || census_half_width_px > 4) throw InputError("census_half_width_px", "must be in [1, 4]");
+  if (census_half_height_px < 1 || census_half_height_px > 3)
+    throw InputError("census_half_height_px", "must be in [1, 3]");
   sgm.Check();
   subpixel.Check();
   if (!(min_zncc >= -1 && min_zncc < 1)) throw InputError("min_zncc", "must be in [-1, 1)");
+  if (!(max_plane_deviation_px >= 0)) throw InputError("max_plane_deviation_px", "must be >= 0 (0 = off)");
   if (!(min_texture_dn >= 0)) throw InputError("min_texture_dn", "must be >= 0");
   if (speckle_window_px < 0) throw InputError("speckle_window_px", "must be >= 0 (0 = off)");
   if (!(speckle_range_px > 0)) throw InputError("speckle_range_px", "must be > 0");
@@ -54,9 +59,17 @@ cv::Rect ClampRoi(const cv::Rect& roi, const cv::Size& size) {
 cv::Mat MatchLevel(const cv::Mat& left, const cv::Mat& right, const cv::Rect& region, int dmin, int num,
                    int levels_left, const MatchOptions& o) {
   // Rows beyond the region too: the fine level's cost box reaches past it.
+  // Only the columns the search reads: the region in the left image, the
+  // region shifted by the disparity range in the right one.
   const int margin = o.refine_half_window_px;
-  const CensusImage cl = CensusTransform(left, region.y - margin, region.y + region.height + margin, o.num_threads);
-  const CensusImage cr = CensusTransform(right, region.y - margin, region.y + region.height + margin, o.num_threads);
+  const int reach = levels_left > 0 ? o.refine_radius_px + 2 : 0;  // fine level: +-radius around 2x coarse
+  const CensusImage cl = CensusTransform(left, region.y - margin, region.y + region.height + margin, o.num_threads,
+                                         o.census_half_width_px, o.census_half_height_px, region.x - margin,
+                                         region.x + region.width + margin);
+  const CensusImage cr = CensusTransform(right, region.y - margin, region.y + region.height + margin, o.num_threads,
+                                         o.census_half_width_px, o.census_half_height_px,
+                                         region.x - dmin - num - margin - reach,
+                                         region.x + region.width - dmin + margin + reach);
   if (levels_left == 0) return SgmMatch(cl, cr, region, dmin, num, o.sgm);
 
   cv::Mat left_half, right_half;
@@ -138,13 +151,99 @@ void RemoveSpeckles(cv::Mat& disparity_px, const MatchOptions& o) {
   }
 }
 
+// Local disparity slopes dd/dx, dd/dy: least-squares plane over the valid
+// pixels of a 9x9 window (box filters of masked moments). Averaging 81
+// samples of the ~0.1 px noisy integer-level field gives slopes good to
+// ~0.005 px/px, so the sub-pixel window's model error is negligible.
+void DisparitySlopes(const cv::Mat& disparity, cv::Mat* slope_x, cv::Mat* slope_y, cv::Mat* plane) {
+  const cv::Size k(9, 9);
+  cv::Mat m(disparity.size(), CV_32FC1), md(disparity.size(), CV_32FC1), xs(disparity.size(), CV_32FC1),
+      ys(disparity.size(), CV_32FC1);
+  for (int y = 0; y < disparity.rows; ++y)
+    for (int x = 0; x < disparity.cols; ++x) {
+      const float d = disparity.at<float>(y, x);
+      const bool valid = !std::isnan(d);
+      m.at<float>(y, x) = valid;
+      md.at<float>(y, x) = valid ? d : 0.f;
+      xs.at<float>(y, x) = float(x);
+      ys.at<float>(y, x) = float(y);
+    }
+  auto box = [&](const cv::Mat& a) {
+    cv::Mat out;
+    cv::boxFilter(a, out, CV_32F, k, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
+    return out;
+  };
+  // Coordinates relative to each window's centre keep the sums small.
+  const cv::Mat s_m = box(m), s_d = box(md);
+  cv::Mat mx = m.mul(xs), my = m.mul(ys);
+  const cv::Mat s_x = box(mx), s_y = box(my), s_xd = box(mx.mul(md) / cv::max(m, 1e-9f)),
+                s_yd = box(my.mul(md) / cv::max(m, 1e-9f)), s_xx = box(mx.mul(xs)), s_yy = box(my.mul(ys)),
+                s_xy = box(mx.mul(ys));
+  *slope_x = cv::Mat(disparity.size(), CV_32FC1, cv::Scalar(0));
+  *slope_y = cv::Mat(disparity.size(), CV_32FC1, cv::Scalar(0));
+  *plane = cv::Mat(disparity.size(), CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  for (int y = 0; y < disparity.rows; ++y)
+    for (int x = 0; x < disparity.cols; ++x) {
+      const double n = s_m.at<float>(y, x);
+      if (n < 12) continue;
+      const double mxv = s_x.at<float>(y, x) / n, myv = s_y.at<float>(y, x) / n, md_ = s_d.at<float>(y, x) / n;
+      const double cxx = s_xx.at<float>(y, x) / n - mxv * mxv, cyy = s_yy.at<float>(y, x) / n - myv * myv;
+      const double cxy = s_xy.at<float>(y, x) / n - mxv * myv;
+      const double cxd = s_xd.at<float>(y, x) / n - mxv * md_, cyd = s_yd.at<float>(y, x) / n - myv * md_;
+      const double det = cxx * cyy - cxy * cxy;
+      if (!(det > 1e-6)) continue;
+      const double gx = (cyy * cxd - cxy * cyd) / det, gy = (cxx * cyd - cxy * cxd) / det;
+      if (std::abs(gx) > 1.5 || std::abs(gy) > 1.5) continue;  // a depth edge, not a surface
+      slope_x->at<float>(y, x) = float(gx);
+      slope_y->at<float>(y, x) = float(gy);
+      plane->at<float>(y, x) = float(md_ + gx * (x - mxv) + gy * (y - myv));
+    }
+}
+
+// The band of disparities a half-resolution SGM finds in the ROI:
+// [2nd percentile - margin, 98th percentile + margin], within the given range.
+// Returns false (keep the full range) if too few pixels matched.
+bool OccupiedBand(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const MatchOptions& o, int* dmin,
+                  int* num) {
+  cv::Mat lh, rh;
+  cv::resize(left, lh, cv::Size(left.cols / 2, left.rows / 2), 0, 0, cv::INTER_AREA);
+  cv::resize(right, rh, cv::Size(right.cols / 2, right.rows / 2), 0, 0, cv::INTER_AREA);
+  const cv::Rect half(roi.x / 2, roi.y / 2, std::max(1, roi.width / 2), std::max(1, roi.height / 2));
+  const cv::Mat d = MatchLevel(lh, rh, half & cv::Rect(0, 0, lh.cols, lh.rows), int(std::floor(*dmin / 2.0)) - 1,
+                               (*num + 1) / 2 + 3, 0, o);
+  std::vector<float> v;
+  for (int y = 0; y < d.rows; ++y)
+    for (int x = 0; x < d.cols; ++x)
+      if (!std::isnan(d.at<float>(y, x))) v.push_back(d.at<float>(y, x));
+  if (v.size() < 200) return false;
+  std::sort(v.begin(), v.end());
+  const int lo = int(std::floor(2 * v[v.size() * 2 / 100])) - o.range_margin_px;
+  const int hi = int(std::ceil(2 * v[v.size() * 98 / 100])) + o.range_margin_px;
+  const int new_min = std::max(*dmin, lo), new_max = std::min(*dmin + *num - 1, hi);
+  if (new_max - new_min < 8) return false;
+  *dmin = new_min;
+  *num = new_max - new_min + 1;
+  return true;
+}
+
 MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const MatchOptions& o) {
-  const cv::Mat coarse_to_fine =
-      MatchLevel(left, right, roi, o.min_disparity_px, o.num_disparities, o.pyramid_levels, o);
   MatchResult result;
+  auto t = std::chrono::steady_clock::now();
+  auto lap = [&](const char* step) {
+    const auto now = std::chrono::steady_clock::now();
+    result.times_ms[step] = std::chrono::duration<double, std::milli>(now - t).count();
+    t = now;
+  };
+  int dmin = o.min_disparity_px, num = o.num_disparities;
+  if (o.narrow_range && o.pyramid_levels == 0) OccupiedBand(left, right, roi, o, &dmin, &num);
+  lap("band");
+  const cv::Mat coarse_to_fine = MatchLevel(left, right, roi, dmin, num, o.pyramid_levels, o);
+  lap("sgm");
   result.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
   result.confidence = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
   const double dmax = o.min_disparity_px + o.num_disparities - 1;
+  cv::Mat slope_x, slope_y, plane;
+  DisparitySlopes(coarse_to_fine, &slope_x, &slope_y, &plane);
   ParallelForChunks(roi.height, o.num_threads, [&](int b, int e) {
     for (int yy = b; yy < e; ++yy) {
       const int y = roi.y + yy;
@@ -157,17 +256,24 @@ MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::
         double d = in[xx];
         float confidence = 1.0f;
         if (o.intensity_refinement) {
-          const SubpixelResult s = RefineDisparity(left, right, x, y, d, o.subpixel);
+          const SubpixelResult s = RefineDisparity(left, right, x, y, d, slope_x.at<float>(yy, xx), slope_y.at<float>(yy, xx), o.subpixel);
           if (!s.ok || s.zncc < o.min_zncc || s.std_dn < o.min_texture_dn) continue;
           d = s.disparity_px;
           confidence = float(std::clamp(s.zncc, 0.0, 1.0));
         }
         if (d < o.min_disparity_px || d > dmax) continue;  // range filter
+        // Consistency with the neighbourhood: the refined disparity must lie
+        // within max_plane_deviation_px of the plane fitted to the 9x9
+        // integer-level disparities around it (isolated mismatches and the
+        // edges of mismatched patches fail this).
+        const float pl = plane.at<float>(yy, xx);
+        if (o.max_plane_deviation_px > 0 && (std::isnan(pl) || std::abs(d - pl) > o.max_plane_deviation_px)) continue;
         out[x] = float(d);
         conf[x] = confidence;
       }
     }
   });
+  lap("subpixel");
   RemoveSpeckles(result.disparity_px, o);
   for (int y = 0; y < left.rows; ++y) {
     const float* d = result.disparity_px.ptr<float>(y);
@@ -175,6 +281,7 @@ MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::
     for (int x = 0; x < left.cols; ++x)
       if (!std::isfinite(d[x])) c[x] = 0;
   }
+  lap("speckle");
   return result;
 }
 
@@ -193,8 +300,10 @@ MatchResult MatchOpenCvSgbm(const cv::Mat& left, const cv::Mat& right, const cv:
                              o.speckle_window_px, std::max(1, int(std::lround(o.speckle_range_px))),
                              cv::StereoSGBM::MODE_SGBM_3WAY);
   cv::Mat fixed;
+  const auto t0 = std::chrono::steady_clock::now();
   sgbm->compute(left(cut), right(cut), fixed);
   MatchResult result;
+  result.times_ms["sgbm"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   result.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
   result.confidence = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
   const double dmax_valid = o.min_disparity_px + o.num_disparities - 1;

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 
+#include "calib/core/atomic_file.h"
 #include "reconstruct/synthetic_pair.h"
 
 namespace stereorig {
@@ -73,6 +74,100 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
                 "--num-disparities 1 --out " + out),
             2);
   EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+}  // namespace
+}  // namespace stereorig
+
+#include "calib/core/rig_file.h"
+#include "datasets/default_rig.h"
+#include "reconstruct/metrology/ply_points.h"
+#include "reconstruct/synthetic_scene.h"
+
+namespace stereorig {
+namespace {
+
+class ReconstructCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = ::testing::TempDir() + "/reconstruct_cli";
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_ + "/capture");
+    const SimulatedRig sim = MakeDefaultRig();
+    WriteRigFile(sim.rig, dir_ + "/rig.yaml");
+    SphereSceneSpec spec;
+    spec.centre_mm = sim.world_from_module0.Inverse() * Eigen::Vector3d::Zero();
+    centre_ = spec.centre_mm;
+    const std::vector<cv::Mat> images = RenderSphereCapture(sim.rig, spec);
+    for (size_t k = 0; k < images.size(); ++k)
+      cv::imwrite(dir_ + "/capture/cam" + std::to_string(k) + ".png", images[k]);
+  }
+  // A copy of the good capture to break.
+  std::string BrokenCapture(const std::string& name) {
+    const std::string d = dir_ + "/" + name;
+    std::filesystem::remove_all(d);
+    std::filesystem::copy(dir_ + "/capture", d);
+    return d;
+  }
+  std::string Args(const std::string& capture, const std::string& extra = "") {
+    return "reconstruct --rig " + dir_ + "/rig.yaml --capture " + capture + " --out " + dir_ + "/out.ply --report " +
+           dir_ + "/out.json " + extra;
+  }
+  void ExpectNoOutput() {
+    EXPECT_FALSE(std::filesystem::exists(dir_ + "/out.ply"));
+    EXPECT_FALSE(std::filesystem::exists(dir_ + "/out.json"));
+    EXPECT_FALSE(std::filesystem::exists(dir_ + "/out.stl"));
+  }
+  void SetUp() override {
+    for (const char* f : {"/out.ply", "/out.json", "/out.stl"}) std::filesystem::remove(dir_ + f);
+  }
+  static std::string dir_;
+  static Eigen::Vector3d centre_;
+};
+std::string ReconstructCli::dir_;
+Eigen::Vector3d ReconstructCli::centre_;
+
+TEST_F(ReconstructCli, WritesACloudAnyPlyReaderReadsOnTheSphere) {
+  ASSERT_EQ(RunCli(Args(dir_ + "/capture", "--mesh " + dir_ + "/out.stl")), 0);
+  // The metrology library's PLY reader is independent of our writer.
+  const std::vector<Eigen::Vector3d> pts = ReadPlyPoints(dir_ + "/out.ply");
+  ASSERT_GT(pts.size(), 40000u);
+  int near = 0;
+  for (const auto& p : pts) near += std::abs((p - centre_).norm() - 25.0) < 0.3;
+  EXPECT_GT(near, 0.99 * pts.size());
+  EXPECT_TRUE(std::filesystem::exists(dir_ + "/out.json"));
+  // Binary STL: 80-byte header, count, 50 bytes per triangle.
+  const auto stl_size = std::filesystem::file_size(dir_ + "/out.stl");
+  EXPECT_GT(stl_size, 84u + 50u * 10000);
+  EXPECT_EQ((stl_size - 84) % 50, 0u);
+}
+
+TEST_F(ReconstructCli, MissingCameraExitsTwoAndWritesNothing) {
+  const std::string d = BrokenCapture("missing");
+  std::filesystem::remove(d + "/cam2.png");
+  EXPECT_EQ(RunCli(Args(d)), 2);
+  ExpectNoOutput();
+}
+
+TEST_F(ReconstructCli, WrongImageSizeExitsTwoAndWritesNothing) {
+  const std::string d = BrokenCapture("wrong_size");
+  cv::imwrite(d + "/cam1.png", cv::Mat(480, 640, CV_8UC1, cv::Scalar(10)));
+  EXPECT_EQ(RunCli(Args(d)), 2);
+  ExpectNoOutput();
+}
+
+TEST_F(ReconstructCli, CaptureFromALargerRigExitsTwo) {
+  const std::string d = BrokenCapture("extra_camera");
+  std::filesystem::copy(d + "/cam0.png", d + "/cam4.png");
+  EXPECT_EQ(RunCli(Args(d)), 2);
+  ExpectNoOutput();
+}
+
+TEST_F(ReconstructCli, BadOptionsOrMeshNameExitTwo) {
+  WriteFileAtomically(dir_ + "/bad.yaml", "object_size_mm: 80\nvolume_sise_mm: [1, 2, 3]\n");
+  EXPECT_EQ(RunCli(Args(dir_ + "/capture", "--options " + dir_ + "/bad.yaml")), 2);
+  EXPECT_EQ(RunCli(Args(dir_ + "/capture", "--mesh " + dir_ + "/out.obj")), 2);
+  ExpectNoOutput();
 }
 
 }  // namespace

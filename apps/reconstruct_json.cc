@@ -1,0 +1,30 @@
+#include "apps/reconstruct_json.h"
+
+namespace stereorig {
+
+nlohmann::json ReconstructionJson(const Reconstruction& rec) {
+  nlohmann::json j;
+  int lit = 0, filled = 0;
+  for (const ModuleReport& m : rec.modules) {
+    nlohmann::json mj = {{"module", m.module},
+                         {"points", m.points},
+                         {"lit_pixels", m.lit_pixels},
+                         {"lit_pixels_filled", m.lit_filled},
+                         {"fill_rate", m.fill_rate()},
+                         {"match_roi_px", {m.match_roi.x, m.match_roi.y, m.match_roi.width, m.match_roi.height}},
+                         {"disparity_range_px", {m.min_disparity_px, m.min_disparity_px + m.num_disparities}}};
+    for (const auto& [step, ms] : m.times_ms) mj["time_ms"][step] = ms;
+    j["modules"].push_back(mj);
+    lit += m.lit_pixels;
+    filled += m.lit_filled;
+  }
+  j["points"] = rec.cloud.size();
+  j["filled_points"] = rec.filled_points;
+  j["fill_rate"] = lit ? double(filled) / lit : 0.0;
+  j["mesh_triangles"] = rec.mesh.triangles.size();
+  for (const auto& [step, ms] : rec.times_ms) j["time_ms"][step] = ms;
+  j["shape_fit"] = rec.shape_fit;
+  return j;
+}
+
+}  // namespace stereorig

@@ -1,0 +1,89 @@
+#include "reconstruct/ply_io.h"
+
+#include <Eigen/Geometry>
+#include <bit>
+#include <cstdint>
+#include <cstring>
+
+#include "calib/core/atomic_file.h"
+#include "calib/core/input_error.h"
+
+namespace stereorig {
+namespace {
+
+// The project targets little-endian hosts (x86-64, arm64); PLY and STL here
+// are little-endian, so values are copied as they are in memory.
+static_assert(std::endian::native == std::endian::little, "little-endian host expected");
+
+template <typename T>
+void Put(std::string& out, T v) {
+  char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));
+  out.append(b, sizeof(T));
+}
+
+bool EndsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+}  // namespace
+
+std::string EncodeCloudPly(const PointCloud& c) {
+  std::string out =
+      "ply\nformat binary_little_endian 1.0\ncomment stereorig point cloud, reference frame (module 0), mm\n"
+      "element vertex " +
+      std::to_string(c.size()) +
+      "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar intensity\n"
+      "property float nx\nproperty float ny\nproperty float nz\nproperty uchar module\n"
+      "property float confidence\nend_header\n";
+  out.reserve(out.size() + c.size() * 34);
+  for (size_t i = 0; i < c.size(); ++i) {
+    for (int k = 0; k < 3; ++k) Put(out, c.xyz_mm[i][k]);
+    Put(out, c.intensity[i]);
+    for (int k = 0; k < 3; ++k) Put(out, c.normal[i][k]);
+    Put(out, c.module[i]);
+    Put(out, c.confidence[i]);
+  }
+  return out;
+}
+
+void WriteCloudPly(const PointCloud& cloud, const std::string& path) { WriteFileAtomically(path, EncodeCloudPly(cloud)); }
+
+void CheckMeshPath(const std::string& path) {
+  if (!EndsWith(path, ".ply") && !EndsWith(path, ".stl"))
+    throw InputError(path, "mesh output must end in .ply or .stl");
+}
+
+void WriteMesh(const Mesh& m, const std::string& path) {
+  CheckMeshPath(path);
+  std::string out;
+  if (EndsWith(path, ".stl")) {
+    out.assign(80, ' ');
+    out.replace(0, 40, "stereorig mesh, reference frame, mm     ");
+    Put(out, uint32_t(m.triangles.size()));
+    for (const Eigen::Vector3i& t : m.triangles) {
+      const Eigen::Vector3f a = m.vertices_mm[t[0]], b = m.vertices_mm[t[1]], c = m.vertices_mm[t[2]];
+      Eigen::Vector3f n = (b - a).cross(c - a);
+      if (n.norm() > 0) n.normalize();
+      for (int k = 0; k < 3; ++k) Put(out, n[k]);
+      for (const Eigen::Vector3f& v : {a, b, c})
+        for (int k = 0; k < 3; ++k) Put(out, v[k]);
+      Put(out, uint16_t(0));
+    }
+  } else {
+    out = "ply\nformat binary_little_endian 1.0\ncomment stereorig mesh, reference frame (module 0), mm\n"
+          "element vertex " +
+          std::to_string(m.vertices_mm.size()) +
+          "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+          std::to_string(m.triangles.size()) + "\nproperty list uchar int vertex_indices\nend_header\n";
+    for (const Eigen::Vector3f& v : m.vertices_mm)
+      for (int k = 0; k < 3; ++k) Put(out, v[k]);
+    for (const Eigen::Vector3i& t : m.triangles) {
+      Put(out, uint8_t(3));
+      for (int k = 0; k < 3; ++k) Put(out, int32_t(t[k]));
+    }
+  }
+  WriteFileAtomically(path, out);
+}
+
+}  // namespace stereorig

@@ -1,0 +1,23 @@
+// Writers for the runtime's outputs (docs/formats.md, docs/reconstruct.md).
+//
+// Cloud PLY, binary little-endian, one vertex element with the properties
+//   float x, y, z (mm); uchar intensity; float nx, ny, nz; uchar module;
+//   float confidence.
+// Mesh: PLY (float x y z; face list uchar/int vertex_indices) or binary STL
+// (chosen by the extension). All writes are atomic.
+#pragma once
+
+#include <string>
+
+#include "reconstruct/point_cloud.h"
+
+namespace stereorig {
+
+std::string EncodeCloudPly(const PointCloud& cloud);
+void WriteCloudPly(const PointCloud& cloud, const std::string& path);
+// `path` ending in .stl -> binary STL, .ply -> binary PLY; else InputError.
+void WriteMesh(const Mesh& mesh, const std::string& path);
+// Throws InputError unless `path` ends in .ply or .stl.
+void CheckMeshPath(const std::string& path);
+
+}  // namespace stereorig

@@ -1,0 +1,19 @@
+#include "reconstruct/point_cloud.h"
+
+namespace stereorig {
+
+void PointCloud::Append(const PointCloud& o) {
+  xyz_mm.insert(xyz_mm.end(), o.xyz_mm.begin(), o.xyz_mm.end());
+  normal.insert(normal.end(), o.normal.begin(), o.normal.end());
+  intensity.insert(intensity.end(), o.intensity.begin(), o.intensity.end());
+  module.insert(module.end(), o.module.begin(), o.module.end());
+  confidence.insert(confidence.end(), o.confidence.begin(), o.confidence.end());
+}
+
+void Mesh::Append(const Mesh& o) {
+  const int offset = int(vertices_mm.size());
+  vertices_mm.insert(vertices_mm.end(), o.vertices_mm.begin(), o.vertices_mm.end());
+  for (const Eigen::Vector3i& t : o.triangles) triangles.push_back(t + Eigen::Vector3i::Constant(offset));
+}
+
+}  // namespace stereorig

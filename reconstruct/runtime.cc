@@ -1,0 +1,343 @@
+#include "reconstruct/runtime.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <regex>
+#include <thread>
+
+#include "calib/core/input_error.h"
+#include "reconstruct/hole_fill.h"
+
+namespace stereorig {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double MsSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+std::vector<Eigen::Vector3d> VolumeCorners(const Eigen::Vector3d& centre, const Eigen::Vector3d& size) {
+  std::vector<Eigen::Vector3d> corners;
+  for (int i = 0; i < 8; ++i)
+    corners.push_back(centre + 0.5 * Eigen::Vector3d((i & 1 ? 1 : -1) * size.x(), (i & 2 ? 1 : -1) * size.y(),
+                                                     (i & 4 ? 1 : -1) * size.z()));
+  return corners;
+}
+
+// Grid-lit pixels: the local grey-level std over 9x9 exceeds the threshold.
+// The window is wider than the grid period, so the lit area is one solid
+// region, and uniform dark or ambient-lit areas are not.
+cv::Mat LitMask(const cv::Mat& grey, double contrast_dn) {
+  cv::Mat f, mean, mean2;
+  grey.convertTo(f, CV_32F);
+  cv::boxFilter(f, mean, CV_32F, cv::Size(9, 9));
+  cv::boxFilter(f.mul(f), mean2, CV_32F, cv::Size(9, 9));
+  cv::Mat var = mean2 - mean.mul(mean);
+  return var > float(contrast_dn * contrast_dn);
+}
+
+}  // namespace
+
+Eigen::Vector3d PointAhead(const Rig& rig, int m, double distance_mm) {
+  // Module frame = left camera frame: left axis +z from 0; right axis R^T z
+  // from the right camera's centre.
+  const Pose left_from_right = rig.module(m).right_from_left.Inverse();
+  const Eigen::Vector3d midpoint = 0.5 * left_from_right.translation_mm();
+  const Eigen::Vector3d axis = (Eigen::Vector3d::UnitZ() + left_from_right.rotation().col(2)).normalized();
+  return rig.S(0, m) * (midpoint + distance_mm * axis);
+}
+
+Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), options_(options) {
+  options_.Check();
+  volume_center_mm_ =
+      options_.volume_center_mm ? *options_.volume_center_mm : PointAhead(rig_, 0, options_.working_distance_mm);
+  const std::vector<Eigen::Vector3d> corners_ref = VolumeCorners(volume_center_mm_, options_.volume_size_mm);
+  for (int m = 0; m < rig_.num_modules(); ++m) {
+    const StereoModule& mod = rig_.module(m);
+    const Camera& left = rig_.camera(mod.left_camera);
+    const Camera& right = rig_.camera(mod.right_camera);
+    if (right.imager_width_px() != left.imager_width_px() || right.imager_height_px() != left.imager_height_px())
+      throw InputError("rig", mod.name + ": its two cameras' imagers differ in size (not supported)");
+    ModulePlan plan;
+    plan.module = m;
+    plan.reference_from_module = rig_.S(0, m);
+    const Pose module_from_reference = rig_.S(m, 0);
+    plan.camera_centre_reference_mm = plan.reference_from_module.translation_mm();
+    plan.geometry =
+        ComputeRectification(left, right, mod.right_from_left, module_from_reference * volume_center_mm_);
+    plan.maps = BuildRectifyMaps(plan.geometry, left, right);
+    // The volume's image: a box's central projection is bounded by its
+    // corners' (all in front), and Z, so the disparity, is extreme at corners.
+    double u0 = 1e9, u1 = -1e9, v0 = 1e9, v1 = -1e9, d0 = 1e9, d1 = -1e9;
+    for (const Eigen::Vector3d& c : corners_ref) {
+      const Eigen::Vector3d p_rect = plan.geometry.rect_from_left * (module_from_reference * c);
+      if (!(p_rect.z() > 1.0))
+        throw InputError("runtime options", "the measurement volume reaches behind " + mod.name +
+                                                "'s cameras: check volume_center_mm / volume_size_mm");
+      const Eigen::Vector3d q = plan.geometry.PixelAndDisparity(p_rect);
+      u0 = std::min(u0, q.x()), u1 = std::max(u1, q.x());
+      v0 = std::min(v0, q.y()), v1 = std::max(v1, q.y());
+      d0 = std::min(d0, q.z()), d1 = std::max(d1, q.z());
+    }
+    const cv::Rect image(0, 0, plan.geometry.size.width, plan.geometry.size.height);
+    plan.roi = cv::Rect(cv::Point(int(std::floor(u0)), int(std::floor(v0))),
+                        cv::Point(int(std::ceil(u1)) + 1, int(std::ceil(v1)) + 1)) &
+               image;
+    if (plan.roi.area() == 0) throw InputError("runtime options", "the measurement volume is not in " + mod.name + "'s view");
+    plan.min_disparity_px = int(std::floor(d0)) - 2;
+    plan.num_disparities = int(std::ceil(d1)) - int(std::floor(d0)) + 5;
+    plans_.push_back(std::move(plan));
+  }
+}
+
+void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& images, bool build_mesh,
+                            PointCloud* cloud, Mesh* mesh, ModuleReport* report) const {
+  const StereoModule& mod = rig_.module(plan.module);
+  report->module = plan.module;
+  auto t = Clock::now();
+  // Rectify the rows of the ROI (plus the matcher's window margins), full
+  // width: the right view needs columns left of the ROI.
+  const cv::Size size = plan.geometry.size;
+  const int margin = 8;
+  const cv::Rect band(0, std::max(0, plan.roi.y - margin), size.width,
+                      std::min(size.height, plan.roi.y + plan.roi.height + margin) - std::max(0, plan.roi.y - margin));
+  cv::Mat left = cv::Mat::zeros(size, CV_8UC1), right = cv::Mat::zeros(size, CV_8UC1);
+  {
+    cv::Mat l = left(band), r = right(band);
+    cv::remap(images[mod.left_camera], l, plan.maps.left_fixed(band), plan.maps.left_frac(band), cv::INTER_LINEAR,
+              cv::BORDER_CONSTANT, 0);
+    cv::remap(images[mod.right_camera], r, plan.maps.right_fixed(band), plan.maps.right_frac(band),
+              cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
+  }
+  report->times_ms["rectify"] = MsSince(t);
+
+  t = Clock::now();
+  const cv::Mat lit = LitMask(left(plan.roi), options_.lit_contrast_dn);
+  cv::Rect match_roi = plan.roi;
+  if (options_.crop_to_lit_region) {
+    const cv::Rect box = cv::boundingRect(lit);
+    match_roi = box.area() > 0 ? cv::Rect(box.x + plan.roi.x - margin, box.y + plan.roi.y - margin,
+                                          box.width + 2 * margin, box.height + 2 * margin) &
+                                     plan.roi
+                               : cv::Rect();
+  }
+  report->match_roi = match_roi;
+  report->min_disparity_px = plan.min_disparity_px;
+  report->num_disparities = plan.num_disparities;
+  report->times_ms["lit_region"] = MsSince(t);
+
+  t = Clock::now();
+  MatchResult match;
+  if (match_roi.area() > 0) {
+    MatchOptions mo = options_.match;
+    mo.roi = match_roi;
+    mo.min_disparity_px = plan.min_disparity_px;
+    mo.num_disparities = plan.num_disparities;
+    match = Match(left, right, mo);
+    for (const auto& [step, ms] : match.times_ms) report->times_ms["match." + step] = ms;
+  } else {
+    match.disparity_px = cv::Mat(size, CV_32FC1, cv::Scalar(std::numeric_limits<float>::infinity()));
+    match.confidence = cv::Mat(size, CV_32FC1, cv::Scalar(0));
+  }
+  report->times_ms["match"] = MsSince(t);
+
+  // Triangulate into an organised grid of reference-frame points (NaN = none).
+  t = Clock::now();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  cv::Mat grid(size, CV_32FC3, cv::Scalar(nan, nan, nan));
+  const Eigen::Vector3d lo = volume_center_mm_ - 0.5 * options_.volume_size_mm;
+  const Eigen::Vector3d hi = volume_center_mm_ + 0.5 * options_.volume_size_mm;
+  std::vector<Eigen::Vector3d> kept;
+  const Eigen::Matrix3d r_ref = plan.reference_from_module.rotation();
+  const Eigen::Vector3d t_ref = plan.reference_from_module.translation_mm();
+  for (int y = match_roi.y; y < match_roi.y + match_roi.height; ++y) {
+    const float* d = match.disparity_px.ptr<float>(y);
+    const float* c = match.confidence.ptr<float>(y);
+    cv::Vec3f* g = grid.ptr<cv::Vec3f>(y);
+    for (int x = match_roi.x; x < match_roi.x + match_roi.width; ++x) {
+      if (!std::isfinite(d[x]) || c[x] < options_.min_confidence) continue;
+      const Eigen::Vector3d p = r_ref * plan.geometry.Triangulate(x, y, d[x]) + t_ref;
+      if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;  // range: the volume
+      g[x] = cv::Vec3f(float(p.x()), float(p.y()), float(p.z()));
+    }
+  }
+  // Object size: drop points farther than object_size_mm from the cloud's
+  // per-axis median (background, gross mismatches).
+  {
+    std::vector<float> xs, ys, zs;
+    for (int y = match_roi.y; y < match_roi.y + match_roi.height; ++y)
+      for (int x = match_roi.x; x < match_roi.x + match_roi.width; ++x) {
+        const cv::Vec3f& p = grid.at<cv::Vec3f>(y, x);
+        if (std::isnan(p[0])) continue;
+        xs.push_back(p[0]), ys.push_back(p[1]), zs.push_back(p[2]);
+      }
+    if (!xs.empty()) {
+      auto median = [](std::vector<float>& v) {
+        std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+        return v[v.size() / 2];
+      };
+      const cv::Vec3f m(median(xs), median(ys), median(zs));
+      const float limit2 = float(options_.object_size_mm * options_.object_size_mm);
+      for (int y = match_roi.y; y < match_roi.y + match_roi.height; ++y)
+        for (int x = match_roi.x; x < match_roi.x + match_roi.width; ++x) {
+          cv::Vec3f& p = grid.at<cv::Vec3f>(y, x);
+          if (!std::isnan(p[0]) && (p - m).dot(p - m) > limit2) p = cv::Vec3f(nan, nan, nan);
+        }
+    }
+  }
+  report->times_ms["triangulate"] = MsSince(t);
+
+  // Normals from the depth grid (central differences +-step), oriented
+  // towards the camera; the point's intensity and confidence; the index map
+  // for the mesh.
+  t = Clock::now();
+  const int s = options_.normal_step_px;
+  cv::Mat index(size, CV_32SC1, cv::Scalar(-1));
+  const Eigen::Vector3f eye = plan.camera_centre_reference_mm.cast<float>();
+  auto at = [&](int x, int y) -> const cv::Vec3f* {
+    if (x < 0 || y < 0 || x >= size.width || y >= size.height) return nullptr;
+    const cv::Vec3f& p = grid.at<cv::Vec3f>(y, x);
+    return std::isnan(p[0]) ? nullptr : &p;
+  };
+  for (int y = match_roi.y; y < match_roi.y + match_roi.height; ++y) {
+    for (int x = match_roi.x; x < match_roi.x + match_roi.width; ++x) {
+      const cv::Vec3f* p = at(x, y);
+      if (!p) continue;
+      // Widest available symmetric or one-sided difference in each direction.
+      const cv::Vec3f *xa = at(x + s, y), *xb = at(x - s, y), *ya = at(x, y + s), *yb = at(x, y - s);
+      Eigen::Vector3f n(0, 0, 0);
+      if ((xa || xb) && (ya || yb)) {
+        const cv::Vec3f dx = (xa ? *xa : *p) - (xb ? *xb : *p);
+        const cv::Vec3f dy = (ya ? *ya : *p) - (yb ? *yb : *p);
+        n = Eigen::Vector3f(dx[0], dx[1], dx[2]).cross(Eigen::Vector3f(dy[0], dy[1], dy[2]));
+      }
+      const Eigen::Vector3f pe(( *p)[0], (*p)[1], (*p)[2]);
+      if (n.norm() > 0) {
+        n.normalize();
+        if (n.dot(eye - pe) < 0) n = -n;
+      } else {
+        n = (eye - pe).normalized();  // isolated point: face the camera
+      }
+      index.at<int>(y, x) = int(cloud->size());
+      cloud->xyz_mm.push_back(pe);
+      cloud->normal.push_back(n);
+      cloud->intensity.push_back(left.at<uint8_t>(y, x));
+      cloud->module.push_back(uint8_t(plan.module));
+      cloud->confidence.push_back(match.confidence.at<float>(y, x));
+    }
+  }
+  report->points = int(cloud->size());
+  for (int y = 0; y < lit.rows; ++y)
+    for (int x = 0; x < lit.cols; ++x) {
+      if (!lit.at<uint8_t>(y, x)) continue;
+      ++report->lit_pixels;
+      report->lit_filled += index.at<int>(y + plan.roi.y, x + plan.roi.x) >= 0;
+    }
+  report->times_ms["normals"] = MsSince(t);
+
+  if (!build_mesh) return;
+  // Organised mesh: two triangles per 2x2 cell of points, unless an edge is
+  // longer than mesh_max_edge_mm (a depth jump between surfaces). Vertex
+  // order makes them counter-clockwise seen from the camera.
+  t = Clock::now();
+  mesh->vertices_mm = cloud->xyz_mm;
+  const float max_edge2 = float(options_.mesh_max_edge_mm * options_.mesh_max_edge_mm);
+  auto short_edge = [&](int a, int b) { return (cloud->xyz_mm[a] - cloud->xyz_mm[b]).squaredNorm() <= max_edge2; };
+  for (int y = match_roi.y; y + 1 < match_roi.y + match_roi.height; ++y) {
+    const int* r0 = index.ptr<int>(y);
+    const int* r1 = index.ptr<int>(y + 1);
+    for (int x = match_roi.x; x + 1 < match_roi.x + match_roi.width; ++x) {
+      const int a = r0[x], b = r0[x + 1], c = r1[x], d = r1[x + 1];
+      if (a >= 0 && b >= 0 && c >= 0 && short_edge(a, b) && short_edge(a, c) && short_edge(b, c))
+        mesh->triangles.emplace_back(a, c, b);
+      if (b >= 0 && c >= 0 && d >= 0 && short_edge(b, d) && short_edge(c, d) && short_edge(b, c))
+        mesh->triangles.emplace_back(b, c, d);
+    }
+  }
+  report->times_ms["mesh"] = MsSince(t);
+}
+
+Reconstruction Runtime::Process(const std::vector<cv::Mat>& images, bool build_mesh) const {
+  if (int(images.size()) != rig_.num_cameras())
+    throw InputError("capture", "has " + std::to_string(images.size()) + " images, the rig has " +
+                                    std::to_string(rig_.num_cameras()) + " cameras");
+  for (int k = 0; k < rig_.num_cameras(); ++k) {
+    const Camera& cam = rig_.camera(k);
+    if (images[k].type() != CV_8UC1)
+      throw InputError("capture: cam" + std::to_string(k), "must be an 8-bit grey image");
+    if (images[k].cols != cam.imager_width_px() || images[k].rows != cam.imager_height_px())
+      throw InputError("capture: cam" + std::to_string(k),
+                       "is " + std::to_string(images[k].cols) + "x" + std::to_string(images[k].rows) +
+                           ", the rig says " + std::to_string(cam.imager_width_px()) + "x" +
+                           std::to_string(cam.imager_height_px()));
+  }
+  const auto t_total = Clock::now();
+  Reconstruction out;
+  const int nm = int(plans_.size());
+  std::vector<PointCloud> clouds(nm);
+  std::vector<Mesh> meshes(nm);
+  out.modules.resize(nm);
+  auto t = Clock::now();
+  if (options_.parallel_modules && nm > 1) {
+    std::vector<std::thread> threads;
+    for (int m = 1; m < nm; ++m)
+      threads.emplace_back([&, m] { ProcessModule(plans_[m], images, build_mesh, &clouds[m], &meshes[m], &out.modules[m]); });
+    ProcessModule(plans_[0], images, build_mesh, &clouds[0], &meshes[0], &out.modules[0]);
+    for (auto& th : threads) th.join();
+  } else {
+    for (int m = 0; m < nm; ++m) ProcessModule(plans_[m], images, build_mesh, &clouds[m], &meshes[m], &out.modules[m]);
+  }
+  out.times_ms["modules"] = MsSince(t);
+  t = Clock::now();
+  for (int m = 0; m < nm; ++m) out.cloud.Append(clouds[m]);
+  out.times_ms["merge"] = MsSince(t);
+  out.times_ms["total_point_cloud"] = MsSince(t_total);
+  if (!build_mesh) return out;
+  t = Clock::now();
+  for (int m = 0; m < nm; ++m) out.mesh.Append(meshes[m]);
+  out.times_ms["mesh_join"] = MsSince(t);
+  t = Clock::now();
+  if (options_.shape_model != ShapeModel::kNone) {
+    const HoleFillResult fill = FillHolesFromModel(out.cloud, options_, &out.cloud, &out.mesh);
+    out.filled_points = fill.added_points;
+    out.shape_fit = fill.message;
+  } else {
+    out.shape_fit = "no shape model (shape_model: none)";
+  }
+  out.times_ms["hole_fill"] = MsSince(t);
+  return out;
+}
+
+std::vector<cv::Mat> LoadCapture(const std::string& dir, const Rig& rig) {
+  namespace fs = std::filesystem;
+  if (!fs::is_directory(dir)) throw InputError(dir, "capture folder not found");
+  const std::regex cam_re("cam([0-9]+)\\.png");
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    std::smatch m;
+    const std::string name = entry.path().filename().string();
+    if (std::regex_match(name, m, cam_re) && std::stoi(m[1]) >= rig.num_cameras())
+      throw InputError(entry.path().string(), "the rig has only " + std::to_string(rig.num_cameras()) +
+                                                  " cameras: this capture does not match the rig");
+  }
+  std::vector<cv::Mat> images;
+  for (int k = 0; k < rig.num_cameras(); ++k) {
+    const std::string path = (fs::path(dir) / ("cam" + std::to_string(k) + ".png")).string();
+    if (!fs::exists(path)) throw InputError(path, "missing camera image (camera " + std::to_string(k) + ")");
+    cv::Mat img = cv::imread(path, cv::IMREAD_UNCHANGED);
+    if (img.empty()) throw InputError(path, "cannot read the image");
+    if (img.type() != CV_8UC1) throw InputError(path, "must be an 8-bit single-channel (grey) PNG");
+    const Camera& cam = rig.camera(k);
+    if (img.cols != cam.imager_width_px() || img.rows != cam.imager_height_px())
+      throw InputError(path, "is " + std::to_string(img.cols) + "x" + std::to_string(img.rows) + ", the rig says " +
+                                 std::to_string(cam.imager_width_px()) + "x" + std::to_string(cam.imager_height_px()));
+    images.push_back(std::move(img));
+  }
+  return images;
+}
+
+}  // namespace stereorig

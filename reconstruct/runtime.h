@@ -1,0 +1,100 @@
+// The one-shot reconstruction runtime: built once from a rig and runtime
+// options, then Process() turns one capture (one image per camera) into a
+// point cloud in the reference frame, and optionally a mesh.
+//
+// Built once (constructor): per module, the rectification (rectify.h) and its
+// remap tables, the disparity search range and the region of interest, both
+// derived from the measurement volume. Process() is const: it keeps no state
+// between captures and may be called from several threads at once. Modules
+// run on their own threads.
+//
+// Per module: rectify -> crop to the lit region -> match (matcher.h: census
+// SGM, filters, sub-pixel) -> triangulate to mm -> range filters (volume,
+// object size) -> intensity, confidence -> normals from the depth grid ->
+// organised mesh. Then: concatenation through S into the reference frame,
+// the joined mesh, and hole filling from a fitted shape model.
+#pragma once
+
+#include <map>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "calib/core/rig.h"
+#include "reconstruct/point_cloud.h"
+#include "reconstruct/rectify.h"
+#include "reconstruct/runtime_options.h"
+
+namespace stereorig {
+
+// What the runtime precomputes for one module.
+struct ModulePlan {
+  int module = 0;
+  RectifiedGeometry geometry;
+  RectifyMaps maps;
+  cv::Rect roi;               // rectified left px covered by the measurement volume
+  int min_disparity_px = 0;   // image disparity range of the volume (rectify.h), with 2 px margin
+  int num_disparities = 0;
+  Pose reference_from_module; // S[0][module]
+  Eigen::Vector3d camera_centre_reference_mm;  // the module's left camera centre
+};
+
+struct ModuleReport {
+  int module = 0;
+  cv::Rect match_roi;         // after cropping to the lit region
+  int min_disparity_px = 0, num_disparities = 0;
+  int points = 0;             // points kept
+  int lit_pixels = 0;         // grid-lit pixels of the rectified left image in the volume's ROI
+  int lit_filled = 0;         // of those, pixels with a kept point
+  double fill_rate() const { return lit_pixels ? double(lit_filled) / lit_pixels : 0.0; }
+  std::map<std::string, double> times_ms;  // rectify, lit_region, match, triangulate, normals, mesh
+};
+
+struct Reconstruction {
+  PointCloud cloud;           // all modules, then filled points; reference frame
+  Mesh mesh;                  // empty unless requested
+  std::vector<ModuleReport> modules;
+  std::map<std::string, double> times_ms;  // modules (wall), merge, mesh_join, hole_fill, total_point_cloud
+  int filled_points = 0;      // points added by hole filling
+  std::string shape_fit;      // one line: the fitted model, or why there is none
+};
+
+class Runtime {
+ public:
+  // Throws InputError if the options are bad or the volume is not in front
+  // of every module.
+  Runtime(const Rig& rig, const RuntimeOptions& options);
+
+  const Rig& rig() const { return rig_; }
+  const RuntimeOptions& options() const { return options_; }
+  const std::vector<ModulePlan>& plans() const { return plans_; }
+
+  // images[k]: camera k's 8-bit grey image (global camera index), each the
+  // size the rig says. `build_mesh` adds the organised meshes, the joined
+  // mesh and the model fill (timed separately). Throws InputError on images
+  // of the wrong number, type or size.
+  Reconstruction Process(const std::vector<cv::Mat>& images, bool build_mesh) const;
+
+  // The per-module work of Process(), exposed for tests: the module's cloud
+  // (reference frame) and its organised mesh (if build_mesh).
+  void ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& images, bool build_mesh, PointCloud* cloud,
+                     Mesh* mesh, ModuleReport* report) const;
+
+ private:
+  Rig rig_;
+  RuntimeOptions options_;
+  Eigen::Vector3d volume_center_mm_;
+  std::vector<ModulePlan> plans_;
+};
+
+// Loads a capture folder: DIR/camK.png for every camera K of the rig, 8-bit
+// grey, the rig's imager size. Throws InputError naming the file on a
+// missing camera, a wrong size or type, or a camK.png beyond the rig's
+// cameras (a capture made with another rig).
+std::vector<cv::Mat> LoadCapture(const std::string& dir, const Rig& rig);
+
+// The point `distance_mm` in front of module `m`'s baseline midpoint along
+// the mean of its two optical axes, in the reference frame.
+Eigen::Vector3d PointAhead(const Rig& rig, int module, double distance_mm);
+
+}  // namespace stereorig

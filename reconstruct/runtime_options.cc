@@ -1,0 +1,106 @@
+#include "reconstruct/runtime_options.h"
+
+#include "calib/core/input_error.h"
+#include "calib/core/yaml_reader.h"
+
+namespace stereorig {
+
+ShapeModel ParseShapeModel(const std::string& name, const std::string& where) {
+  if (name == "none") return ShapeModel::kNone;
+  if (name == "sphere") return ShapeModel::kSphere;
+  if (name == "cylinder") return ShapeModel::kCylinder;
+  if (name == "ellipsoid") return ShapeModel::kEllipsoid;
+  throw InputError(where, "unknown shape model '" + name + "' (none, sphere, cylinder or ellipsoid)");
+}
+
+const char* ShapeModelName(ShapeModel model) {
+  switch (model) {
+    case ShapeModel::kSphere: return "sphere";
+    case ShapeModel::kCylinder: return "cylinder";
+    case ShapeModel::kEllipsoid: return "ellipsoid";
+    default: return "none";
+  }
+}
+
+void RuntimeOptions::Check() const {
+  if (volume_center_mm && !volume_center_mm->allFinite()) throw InputError("volume_center_mm", "must be finite");
+  if (!(volume_size_mm.minCoeff() > 0)) throw InputError("volume_size_mm", "every side must be > 0 mm");
+  if (!(working_distance_mm > 0)) throw InputError("working_distance_mm", "must be > 0 mm");
+  if (!(object_size_mm > 0)) throw InputError("object_size_mm", "must be > 0 mm");
+  if (!(lit_contrast_dn > 0)) throw InputError("lit_contrast_dn", "must be > 0");
+  if (!(min_confidence >= 0 && min_confidence <= 1)) throw InputError("min_confidence", "must be in [0, 1]");
+  if (normal_step_px < 1 || normal_step_px > 10) throw InputError("normal_step_px", "must be in [1, 10]");
+  if (!(mesh_max_edge_mm > 0)) throw InputError("mesh_max_edge_mm", "must be > 0");
+  if (shape_model == ShapeModel::kCylinder || shape_model == ShapeModel::kEllipsoid)
+    throw InputError("shape_model", std::string(ShapeModelName(shape_model)) +
+                                        " hole filling is not built yet (use sphere or none)");
+  if (!(fill_spacing_mm > 0.05)) throw InputError("fill_spacing_mm", "must be > 0.05 mm");
+  match.Check();
+}
+
+namespace {
+
+RuntimeOptions FromYaml(YamlMap& y) {
+  RuntimeOptions o;
+  if (y.Has("volume_center_mm")) {
+    const auto v = y.GetDoubles("volume_center_mm", 3);
+    o.volume_center_mm = Eigen::Vector3d(v[0], v[1], v[2]);
+  }
+  if (y.Has("volume_size_mm")) {
+    const auto v = y.GetDoubles("volume_size_mm", 3);
+    o.volume_size_mm = Eigen::Vector3d(v[0], v[1], v[2]);
+  }
+  o.working_distance_mm = y.GetDouble("working_distance_mm", o.working_distance_mm);
+  o.object_size_mm = y.GetDouble("object_size_mm", o.object_size_mm);
+  o.crop_to_lit_region = y.GetBool("crop_to_lit_region", o.crop_to_lit_region);
+  o.lit_contrast_dn = y.GetDouble("lit_contrast_dn", o.lit_contrast_dn);
+  o.min_confidence = y.GetDouble("min_confidence", o.min_confidence);
+  o.normal_step_px = y.GetInt("normal_step_px", o.normal_step_px);
+  o.mesh_max_edge_mm = y.GetDouble("mesh_max_edge_mm", o.mesh_max_edge_mm);
+  o.shape_model = ParseShapeModel(y.GetString("shape_model", "none"), y.Where("shape_model"));
+  o.fill_spacing_mm = y.GetDouble("fill_spacing_mm", o.fill_spacing_mm);
+  o.parallel_modules = y.GetBool("parallel_modules", o.parallel_modules);
+  if (y.Has("match")) {
+    YamlMap m = y.GetMap("match");
+    MatchOptions& mo = o.match;
+    mo.matcher = ParseMatcherKind(m.GetString("matcher", "census_sgm"), m.Where("matcher"));
+    mo.pyramid_levels = m.GetInt("pyramid_levels", mo.pyramid_levels);
+    mo.refine_radius_px = m.GetInt("refine_radius_px", mo.refine_radius_px);
+    mo.sgm.p1 = m.GetInt("sgm_p1", mo.sgm.p1);
+    mo.sgm.p2 = m.GetInt("sgm_p2", mo.sgm.p2);
+    mo.sgm.num_paths = m.GetInt("sgm_paths", mo.sgm.num_paths);
+    mo.sgm.uniqueness_percent = m.GetInt("uniqueness_percent", mo.sgm.uniqueness_percent);
+    mo.sgm.lr_max_diff_px = m.GetInt("lr_max_diff_px", mo.sgm.lr_max_diff_px);
+    mo.intensity_refinement = m.GetBool("intensity_refinement", mo.intensity_refinement);
+    mo.subpixel.half_width_px = m.GetInt("subpixel_half_width_px", mo.subpixel.half_width_px);
+    mo.subpixel.half_height_px = m.GetInt("subpixel_half_height_px", mo.subpixel.half_height_px);
+    mo.min_zncc = m.GetDouble("min_zncc", mo.min_zncc);
+    mo.min_texture_dn = m.GetDouble("min_texture_dn", mo.min_texture_dn);
+    mo.speckle_window_px = m.GetInt("speckle_window_px", mo.speckle_window_px);
+    mo.speckle_range_px = m.GetDouble("speckle_range_px", mo.speckle_range_px);
+    mo.sgbm_block_size = m.GetInt("sgbm_block_size", mo.sgbm_block_size);
+    mo.num_threads = m.GetInt("num_threads", mo.num_threads);
+    m.Finish();
+  }
+  y.Finish();
+  try {
+    o.Check();
+  } catch (const InputError& e) {
+    throw InputError(y.file(), e.what());
+  }
+  return o;
+}
+
+}  // namespace
+
+RuntimeOptions ReadRuntimeOptions(const std::string& path) {
+  YamlMap y = YamlMap::LoadFile(path);
+  return FromYaml(y);
+}
+
+RuntimeOptions ParseRuntimeOptions(const std::string& text, const std::string& where) {
+  YamlMap y = YamlMap::LoadString(text, where);
+  return FromYaml(y);
+}
+
+}  // namespace stereorig

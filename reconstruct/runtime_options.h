@@ -1,0 +1,51 @@
+// Runtime options: what the runtime knows a priori about the scene, and how
+// hard it works. Read from YAML (docs/reconstruct.md lists every key); a
+// missing key takes the default below, an unknown key is an error.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+
+#include "reconstruct/matcher.h"
+
+namespace stereorig {
+
+enum class ShapeModel { kNone, kSphere, kCylinder, kEllipsoid };
+ShapeModel ParseShapeModel(const std::string& name, const std::string& where);
+const char* ShapeModelName(ShapeModel model);
+
+struct RuntimeOptions {
+  // The measurement volume: an axis-aligned box in the reference frame
+  // (module 0's frame), mm. Every module's disparity search range and region
+  // of interest are derived from it. Default centre: working_distance_mm in
+  // front of module 0's baseline midpoint, along the mean of its two
+  // optical axes.
+  std::optional<Eigen::Vector3d> volume_center_mm;               // default: see working_distance_mm
+  double working_distance_mm = 200.0;  // only used to place the default volume centre; default 200 (the seed's)
+  Eigen::Vector3d volume_size_mm = Eigen::Vector3d(150, 150, 100);  // default 150 x 150 x 100 (the seed's)
+  // Largest dimension of the objects measured, mm. Points farther than this
+  // from the robust centre of a module's cloud are rejected as background or
+  // gross mismatches, and the shape model's size is checked against it.
+  double object_size_mm = 100.0;  // default 100
+  // Crop each capture's ROI to the bounding box of the laser-lit area (active
+  // mode): the grid lights ~81x81 mm at 200 mm, a quarter of the image.
+  bool crop_to_lit_region = true;  // default true
+  double lit_contrast_dn = 12.0;   // a pixel is "lit" if its 9x9 grey-level std exceeds this; default 12 DN
+  MatchOptions match;              // matcher; its range and ROI are derived per module (ignored here)
+  // Per-point confidence below which a point is dropped, [0, 1].
+  double min_confidence = 0.5;     // default 0.5 (= match.min_zncc)
+  int normal_step_px = 2;          // normals from neighbours +-this many px in the depth grid; default 2
+  double mesh_max_edge_mm = 1.5;   // organised mesh: no triangle edge longer than this (depth jumps); default 1.5
+  ShapeModel shape_model = ShapeModel::kNone;  // hole filling model; default none
+  double fill_spacing_mm = 1.0;    // hole filling: sample spacing on the model surface; default 1.0 mm
+  bool parallel_modules = true;    // process modules on separate threads; default true
+
+  void Check() const;  // throws InputError naming the bad key
+};
+
+// Reads a runtime options YAML file (keys: docs/reconstruct.md).
+RuntimeOptions ReadRuntimeOptions(const std::string& path);
+RuntimeOptions ParseRuntimeOptions(const std::string& text, const std::string& where);
+
+}  // namespace stereorig

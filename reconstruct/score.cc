@@ -1,0 +1,126 @@
+#include "reconstruct/score.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+#include "reconstruct/kd_tree.h"
+
+namespace stereorig {
+namespace {
+
+// Plane through the k nearest truth samples of q: (centroid, unit normal).
+bool LocalPlane(const KdTree3& tree, const Eigen::Vector3d& q, Eigen::Vector3d* c, Eigen::Vector3d* n,
+                double* nearest) {
+  std::vector<int> idx;
+  std::vector<double> d2;
+  tree.Knn(q, 8, &idx, &d2);
+  if (idx.size() < 4) return false;
+  *nearest = std::sqrt(d2[0]);
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int i : idx) mean += tree.points()[i];
+  mean /= double(idx.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (int i : idx) cov += (tree.points()[i] - mean) * (tree.points()[i] - mean).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+  *c = mean;
+  *n = es.eigenvectors().col(0);
+  return true;
+}
+
+ErrorFigures Figures(std::vector<double> e) {
+  ErrorFigures f;
+  f.points = int(e.size());
+  if (e.empty()) return f;
+  double s = 0, s2 = 0, sa = 0;
+  for (double v : e) s += v, s2 += v * v, sa += std::abs(v);
+  f.mean_mm = s / e.size();
+  f.mean_abs_mm = sa / e.size();
+  f.rms_mm = std::sqrt(s2 / e.size());
+  f.std_mm = std::sqrt(std::max(0.0, s2 / e.size() - f.mean_mm * f.mean_mm));
+  for (double& v : e) v = std::abs(v);
+  const size_t k = std::min(e.size() - 1, size_t(0.95 * e.size()));
+  std::nth_element(e.begin(), e.begin() + k, e.end());
+  f.p95_abs_mm = e[k];
+  return f;
+}
+
+}  // namespace
+
+CloudScore ScoreAgainstTruth(const PointCloud& cloud, const std::vector<Eigen::Vector3d>& truth, int num_modules) {
+  CloudScore score;
+  score.per_module.resize(num_modules);
+  const KdTree3 tree(truth);
+  // ICP, point-to-plane, on up to 20k measured points.
+  std::vector<Eigen::Vector3d> sample;
+  std::vector<size_t> measured;
+  for (size_t i = 0; i < cloud.size(); ++i)
+    if (cloud.module[i] != kFilledModule) measured.push_back(i);
+  const size_t step = std::max<size_t>(1, measured.size() / 20000);
+  for (size_t i = 0; i < measured.size(); i += step) sample.push_back(cloud.xyz_mm[measured[i]].cast<double>());
+  Eigen::Matrix3d r = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  // Robust, damped Gauss-Newton: pairs whose plane distance exceeds 3x the
+  // median are ignored (mismatches), and a small Levenberg term keeps
+  // directions the surface cannot fix (a sphere's rotations about its
+  // centre) at zero motion instead of drifting.
+  for (int it = 0; it < 30 && !sample.empty(); ++it) {
+    std::vector<Eigen::Matrix<double, 6, 1>> js;
+    std::vector<double> rs;
+    for (const Eigen::Vector3d& p0 : sample) {
+      const Eigen::Vector3d p = r * p0 + t;
+      Eigen::Vector3d c, n;
+      double nearest;
+      if (!LocalPlane(tree, p, &c, &n, &nearest) || nearest > 2.0) continue;
+      Eigen::Matrix<double, 6, 1> j;
+      j << p.cross(n), n;
+      js.push_back(j);
+      rs.push_back((c - p).dot(n));
+    }
+    if (js.size() < 6) break;
+    std::vector<double> abs_r(rs.size());
+    for (size_t i = 0; i < rs.size(); ++i) abs_r[i] = std::abs(rs[i]);
+    std::nth_element(abs_r.begin(), abs_r.begin() + abs_r.size() / 2, abs_r.end());
+    const double cut = std::max(0.05, 3.0 * abs_r[abs_r.size() / 2]);
+    Eigen::Matrix<double, 6, 6> a = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::Zero();
+    for (size_t i = 0; i < js.size(); ++i) {
+      if (std::abs(rs[i]) > cut) continue;
+      a += js[i] * js[i].transpose();
+      b += js[i] * rs[i];
+    }
+    a.diagonal().array() += 1e-6 * a.trace() + 1e-9;
+    const Eigen::Matrix<double, 6, 1> x = a.ldlt().solve(b);
+    if (!x.allFinite()) break;
+    const Eigen::Vector3d w = x.head<3>();
+    const Eigen::Matrix3d dr =
+        w.norm() > 0 ? Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix() : Eigen::Matrix3d::Identity();
+    r = dr * r;
+    t = dr * t + x.tail<3>();
+    if (w.norm() < 1e-9 && x.tail<3>().norm() < 1e-7) break;
+  }
+  score.truth_from_cloud = Pose(r, t);
+  std::vector<double> all, filled;
+  std::vector<std::vector<double>> per(num_modules);
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3d p = r * cloud.xyz_mm[i].cast<double>() + t;
+    Eigen::Vector3d c, n;
+    double nearest;
+    if (!LocalPlane(tree, p, &c, &n, &nearest)) continue;
+    // Sign: positive on the side the cloud's normal points to (outwards).
+    const double sign = n.dot(r * cloud.normal[i].cast<double>()) >= 0 ? 1.0 : -1.0;
+    const double e = sign * (p - c).dot(n);
+    if (cloud.module[i] == kFilledModule) {
+      filled.push_back(e);
+    } else {
+      all.push_back(e);
+      if (cloud.module[i] < num_modules) per[cloud.module[i]].push_back(e);
+    }
+  }
+  score.all = Figures(std::move(all));
+  score.filled = Figures(std::move(filled));
+  for (int m = 0; m < num_modules; ++m) score.per_module[m] = Figures(std::move(per[m]));
+  return score;
+}
+
+}  // namespace stereorig

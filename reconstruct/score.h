@@ -1,0 +1,42 @@
+// Scoring a reconstructed cloud against a dense truth surface, independently
+// of how the cloud was made: one best rigid alignment (no scale) of the
+// whole cloud to the truth, then each point's distance to the truth surface.
+//
+// The truth is a set of dense surface samples (the simulator's surface.ply,
+// <= 0.2 mm apart). A point's distance to the surface is taken to the plane
+// fitted through its 8 nearest truth samples (k-d tree): the nearest sample
+// alone would add up to half the sample spacing to every error.
+// The alignment is point-to-plane ICP from the identity (the calibrated
+// reference frame differs from the truth by a small rigid motion), pairs
+// farther than 1 mm rejected.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "calib/core/pose.h"
+#include "reconstruct/point_cloud.h"
+
+namespace stereorig {
+
+struct ErrorFigures {
+  int points = 0;
+  double mean_abs_mm = 0;  // mean |distance|
+  double mean_mm = 0;      // signed (outside the surface = positive, along the truth normal's side)
+  double std_mm = 0;
+  double rms_mm = 0;
+  double p95_abs_mm = 0;
+};
+
+struct CloudScore {
+  Pose truth_from_cloud;             // the best rigid alignment
+  ErrorFigures all;                  // measured points (filled ones excluded)
+  std::vector<ErrorFigures> per_module;  // index = module
+  ErrorFigures filled;               // hole-filling points (module kFilledModule), if any
+};
+
+// `truth`: (N) samples in mm. `num_modules`: size of per_module.
+CloudScore ScoreAgainstTruth(const PointCloud& cloud, const std::vector<Eigen::Vector3d>& truth, int num_modules);
+
+}  // namespace stereorig
