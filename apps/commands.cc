@@ -7,12 +7,10 @@ namespace stereorig {
 
 int RunDemo(int argc, char** argv);
 int RunRig(int argc, char** argv);
+int RunSimulate(int argc, char** argv);
 
 namespace {
 
-int RunSimulate(int argc, char** argv) {
-  return NotBuiltYet("simulate", "Render a rig spec into a dataset with ground truth.", argc, argv);
-}
 int RunTarget(int argc, char** argv) {
   return NotBuiltYet("target", "Write a printable double-sided target at true scale.", argc, argv);
 }
