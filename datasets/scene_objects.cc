@@ -241,6 +241,18 @@ class BoxShape : public Shape {
   Eigen::Vector3d h_;
 };
 
+// sin(x) to ~6e-8 absolute, about 3x faster than libm's: the tuber's bump
+// field is evaluated millions of times per image. It DEFINES the shape (the
+// renderer and the ground-truth samples both use it), so its error is not an
+// error of the truth.
+inline double FastSin(double x) {
+  x -= 2 * M_PI * std::nearbyint(x * (0.5 / M_PI));  // [-pi, pi]
+  if (x > 0.5 * M_PI) x = M_PI - x;
+  if (x < -0.5 * M_PI) x = -M_PI - x;                 // [-pi/2, pi/2], same sine
+  const double x2 = x * x;
+  return x * (1 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880 + x2 * (-1.0 / 39916800))))));
+}
+
 class BumpyEllipsoidShape : public Shape {
  public:
   static constexpr int kTerms = 6;
@@ -255,11 +267,13 @@ class BumpyEllipsoidShape : public Shape {
     }
     // |grad h| <= bump * max f on the unit sphere; F = |u| - 1 - h(u/|u|)
     // changes along a unit step in u by at most lipschitz_.
-    lipschitz_ = 1.0 + bump_ * kMaxFreq / (1.0 - bump_);
+    double sum_f = 0;
+    for (int k = 0; k < kTerms; ++k) sum_f += f_[k];
+    lipschitz_ = 1.0 + bump_ * (sum_f / kTerms) / (1.0 - bump_);
   }
   double H(const Eigen::Vector3d& unit) const {
     double h = 0;
-    for (int k = 0; k < kTerms; ++k) h += std::sin(f_[k] * g_[k].dot(unit) + phase_[k]);
+    for (int k = 0; k < kTerms; ++k) h += FastSin(f_[k] * g_[k].dot(unit) + phase_[k]);
     return bump_ * h / kTerms;
   }
   double F(const Eigen::Vector3d& u) const {
@@ -277,10 +291,22 @@ class BumpyEllipsoidShape : public Shape {
     const double s_end = std::min(s1, t_max * dn);
     if (s >= s_end) return false;
     if (F(ou + s * du1) < 0) return false;  // starts inside: not a ray we cast
+    // Sphere tracing (never steps past the surface: |dF/ds| <= lipschitz_),
+    // sped up near the surface by secant steps, accepted only if they land
+    // within 1e-8 of the surface (u units, ~3e-7 mm) or short of it.
+    double s_prev = s, f_prev = -1;
     for (int it = 0; it < 600 && s < s_end; ++it) {
-      const double f = F(ou + s * du1);
+      double f = F(ou + s * du1);
+      if (f >= 1e-8 && f < 1e-3 && f_prev > f) {
+        const double s_sec = s + f * (s - s_prev) / (f_prev - f);
+        const double f_sec = F(ou + s_sec * du1);
+        if (std::abs(f_sec) < 1e-8 || f_sec > 0) {
+          s_prev = s, f_prev = f;
+          s = s_sec, f = f_sec;
+        }
+      }
       if (f < 1e-8) {
-        if (s <= t_min * dn) return false;
+        if (s <= t_min * dn || s >= s_end) return false;
         *t = s / dn;
         const Eigen::Vector3d u = ou + s * du1;
         const double e = 1e-6;
@@ -293,6 +319,7 @@ class BumpyEllipsoidShape : public Shape {
         *n = grad.cwiseQuotient(axes_).normalized();  // chain rule: dF/dp = dF/du / axes
         return true;
       }
+      s_prev = s, f_prev = f;
       s += f / lipschitz_;
     }
     return false;
@@ -519,6 +546,7 @@ Scene MakeScene(const std::string& name, const ScenesSpec& spec, const RenderSpe
     p << "semi_axes_mm: [" << Fmt(e->axes_.x()) << ", " << Fmt(e->axes_.y()) << ", " << Fmt(e->axes_.z()) << "]\n"
       << "bump: " << Fmt(e->bump_) << "\n"
       << "# h(w) = bump / " << BumpyEllipsoidShape::kTerms << " * sum_k sin(frequency_k * direction_k . w + phase_k)\n"
+      << "# (sin evaluated to ~6e-8, i.e. the shape is exact to ~1e-7 mm)\n"
       << "terms:\n";
     for (int k = 0; k < BumpyEllipsoidShape::kTerms; ++k) {
       p << "  - {direction: [" << Fmt(e->g_[k].x()) << ", " << Fmt(e->g_[k].y()) << ", " << Fmt(e->g_[k].z())
