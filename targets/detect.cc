@@ -125,7 +125,7 @@ bool WholeBoardInView(const Target& target, const Eigen::Matrix3d& image_from_fa
 }
 
 // cv::estimateChessboardSharpness needs a complete rectangular grid: use the
-// largest block of corners all found.
+// largest block of corners all found (OpenCV needs at least 3x3).
 ChessboardSharpness SharpnessOfLargestBlock(const Target& target, const cv::Mat& grey, const std::vector<int>& ids,
                                             const std::vector<Eigen::Vector2d>& q) {
   const int nx = target.corners_x(), ny = target.corners_y();
@@ -139,9 +139,9 @@ ChessboardSharpness SharpnessOfLargestBlock(const Target& target, const cv::Mat&
                                          have[(r + 1) * (nx + 1) + c] - have[r * (nx + 1) + c];
   int best_area = 0, bc0 = 0, br0 = 0, bw = 0, bh = 0;
   for (int r0 = 0; r0 < ny; ++r0)
-    for (int r1 = r0 + 2; r1 <= ny; ++r1)
+    for (int r1 = r0 + 3; r1 <= ny; ++r1)
       for (int c0 = 0; c0 < nx; ++c0)
-        for (int c1 = c0 + 2; c1 <= nx; ++c1) {
+        for (int c1 = c0 + 3; c1 <= nx; ++c1) {
           const int area = (r1 - r0) * (c1 - c0);
           const int count = have[r1 * (nx + 1) + c1] - have[r0 * (nx + 1) + c1] - have[r1 * (nx + 1) + c0] +
                             have[r0 * (nx + 1) + c0];
@@ -254,11 +254,11 @@ DetectResult TargetDetector::Detect(const cv::Mat& grey) const {
     quality.source = CornerSource::kOpenCvGrid;
     quality.grid_cols = grid.cols;
     quality.grid_rows = grid.rows;
-    quality.num_refine_rejected = grid.num_refine_rejected;
+    quality.num_dropped = grid.num_dropped;
     quality.tag_fit_rms_px = ids.tag_fit_rms_px;
     for (int r = 0; r < grid.rows; ++r) {
       for (int c = 0; c < grid.cols; ++c) {
-        if (!ids.keep[r * grid.cols + c]) continue;
+        if (!ids.keep[r * grid.cols + c] || !grid.usable[r * grid.cols + c]) continue;
         const Eigen::Vector2i id2 = ids.map(c, r);
         STEREORIG_CHECK(id2.x() >= 0 && id2.y() >= 0 && id2.x() < nx && id2.y() < ny);  // kept ones are on the board
         found.emplace_back(id2.y() * nx + id2.x(), grid.at(c, r));

@@ -88,9 +88,9 @@ struct DetectionQuality {
   // distortion. NaN if no corner has 8 neighbours.
   double local_fit_rms_px = 0;
   int local_fit_count = 0;          // corners that entered local_fit_rms_px
-  int num_refine_rejected = 0;      // corners left at OpenCV's own estimate
+  int num_dropped = 0;              // grid corners dropped by the refinement (at the image's edge, slid off)
   // OpenCV's edge-rise width and levels over the largest complete block of
-  // corners found; NaN when no 2x2 block is complete.
+  // corners found; NaN when no 3x3 block is complete.
   ChessboardSharpness sharpness;
 };
 
