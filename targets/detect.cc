@@ -124,6 +124,42 @@ bool WholeBoardInView(const Target& target, const Eigen::Matrix3d& image_from_fa
   return true;
 }
 
+// Each tag's corners against the homography of the detected corners alone.
+// *bad_tag: the worst tag's ID if it is off by more than max_tag_fit_squares
+// of a (local) square, else -1.
+void TagFitAgainstCorners(const Target& target, Face face, const std::vector<TagDetection>& tags,
+                          const std::vector<int>& ids, const std::vector<Eigen::Vector2d>& q,
+                          double max_fit_squares, DetectionQuality* quality, int* bad_tag) {
+  *bad_tag = -1;
+  std::vector<cv::Point2d> src, dst;
+  for (size_t i = 0; i < ids.size(); ++i) {
+    const Eigen::Vector3d p = target.CornerInFace(ids[i]);
+    src.emplace_back(p.x(), p.y());
+    dst.emplace_back(q[i].x(), q[i].y());
+  }
+  const cv::Mat m = cv::findHomography(src, dst, 0);
+  if (m.empty()) return;
+  Eigen::Matrix3d h;
+  cv::cv2eigen(m, h);
+  const double s = target.square_size_mm();
+  double sum_sq = 0, worst_ratio = 0;
+  for (const TagDetection& t : tags) {
+    const auto corners = TagCornersInFace(target, *target.FindTag(face, t.id));
+    double tag_sq = 0;
+    for (int k = 0; k < 4; ++k) tag_sq += (ApplyHomography(h, corners[k]) - t.q_px[k]).squaredNorm();
+    sum_sq += tag_sq;
+    const double tag_rms = std::sqrt(tag_sq / 4);
+    const Eigen::Vector2d centre = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
+    const double square_px = (ApplyHomography(h, centre + Eigen::Vector2d(s, 0)) - ApplyHomography(h, centre)).norm();
+    quality->worst_tag_fit_px = std::max(quality->worst_tag_fit_px, tag_rms);
+    if (tag_rms > max_fit_squares * square_px && tag_rms / square_px > worst_ratio) {
+      worst_ratio = tag_rms / square_px;
+      *bad_tag = t.id;
+    }
+  }
+  quality->tag_fit_rms_px = tags.empty() ? 0 : std::sqrt(sum_sq / (4 * tags.size()));
+}
+
 // cv::estimateChessboardSharpness needs a complete rectangular grid: use the
 // largest block of corners all found (OpenCV needs at least 3x3).
 ChessboardSharpness SharpnessOfLargestBlock(const Target& target, const cv::Mat& grey, const std::vector<int>& ids,
@@ -255,7 +291,6 @@ DetectResult TargetDetector::Detect(const cv::Mat& grey) const {
     quality.grid_cols = grid.cols;
     quality.grid_rows = grid.rows;
     quality.num_dropped = grid.num_dropped;
-    quality.tag_fit_rms_px = ids.tag_fit_rms_px;
     for (int r = 0; r < grid.rows; ++r) {
       for (int c = 0; c < grid.cols; ++c) {
         if (!ids.keep[r * grid.cols + c] || !grid.usable[r * grid.cols + c]) continue;
@@ -272,7 +307,6 @@ DetectResult TargetDetector::Detect(const cv::Mat& grey) const {
     for (size_t i = 0; i < grown.ids.size(); ++i) found.emplace_back(grown.ids[i], grown.q_px[i]);
     if (!found.empty()) {
       quality.source = CornerSource::kTagGuided;
-      quality.tag_fit_rms_px = grown.tag_fit_rms_px;
     }
   }
   if (found.empty()) {
@@ -298,6 +332,18 @@ DetectResult TargetDetector::Detect(const cv::Mat& grey) const {
     det.q_px.push_back(found[i].second);
   }
   quality.num_corners = static_cast<int>(det.corner_ids.size());
+  if (target_.double_sided() && quality.num_corners >= 4) {
+    int worst_tag = -1;
+    TagFitAgainstCorners(target_, face, face_tags, det.corner_ids, det.q_px, options_.max_tag_fit_squares, &quality,
+                         &worst_tag);
+    if (worst_tag >= 0) {
+      std::ostringstream m;
+      m << "tag " << worst_tag << " is " << quality.worst_tag_fit_px
+        << " px from where the chessboard puts it: the target file or the print is wrong";
+      Reject(&out, RejectReason::kAmbiguous, m.str());
+      return out;
+    }
+  }
   quality.sharpness = SharpnessOfLargestBlock(target_, grey, det.corner_ids, det.q_px);
   LocalFit(target_, det.corner_ids, det.q_px, &quality);
   if (quality.num_corners < options_.min_corners) {

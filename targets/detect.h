@@ -79,9 +79,13 @@ struct DetectionQuality {
   int num_tags = 0;                 // tags of the detected face used
   std::vector<int> tag_ids;         // their IDs
   int num_foreign_tags = 0;         // decoded tags whose IDs are not on this target
-  // RMS distance of the tags' corners from the homography fitted to tags and
-  // corners together, px. 0 for a plain board.
+  // The tags' corners against the homography fitted to the detected
+  // chessboard corners alone (face mm -> px): RMS over all tags, and the
+  // worst tag's RMS, px. A tag off by more than max_tag_fit_squares of a
+  // square rejects the view (a wrong target file or a damaged print). 0 for
+  // a plain board.
   double tag_fit_rms_px = 0;
+  double worst_tag_fit_px = 0;
   // Each corner with all 8 grid neighbours found is predicted from them by a
   // local homography; the RMS of (detected - predicted), px. Noise-like:
   // about 1.1x the per-corner noise for sharp corners, insensitive to lens

@@ -297,6 +297,23 @@ TEST_F(DefaultTargetDetection, WrongFaceNoTagsAndTooFewCornersAreRejected) {
   EXPECT_NE(why.find("corners"), std::string::npos);
 }
 
+// Tags that disagree with the target file (here: the file puts front tag 3
+// one square to the right of where it is printed) are refused as ambiguous
+// rather than trusted.
+TEST_F(DefaultTargetDetection, TagsThatDisagreeWithTheTargetFileAreRejected) {
+  Target::Layout moved = target_.layout();
+  for (TagPlacement& t : moved.faces[0].tags) {
+    if (t.id == 3) t.center_x_mm += 9.0;  // still in the top margin, off the squares
+  }
+  const Target wrong(moved, "moved tag");
+  const Pose cam_from_face = LookAtFace(target_, 280, 10, -15, 5);
+  ASSERT_EQ(VisibleTags(target_, Face::kFront, camera_, cam_from_face, 2), 8);
+  const DetectResult r =
+      TargetDetector(wrong, DetectOptions()).Detect(RenderFace(target_, Face::kFront, camera_, cam_from_face));
+  EXPECT_TRUE(r.faces.empty());
+  EXPECT_EQ(r.reason, RejectReason::kAmbiguous) << r.message;
+}
+
 // With sensor noise the error grows, but ids stay right.
 TEST_F(DefaultTargetDetection, NoisyImageKeepsIdsRight) {
   SyntheticViewOptions noisy;
