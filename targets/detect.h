@@ -98,6 +98,9 @@ struct DetectionQuality {
   ChessboardSharpness sharpness;
 };
 
+// With refinement on (the default), every corner returned was refined in a
+// window wholly inside the image and moved less than that window's half
+// size, so it lies at least 2 px inside the image.
 struct FaceDetection {
   Face face = Face::kFront;
   std::vector<int> corner_ids;          // (N) ascending; ids in `face`'s frame (Target::CornerInFace)

@@ -251,6 +251,9 @@ TEST_F(DefaultTargetDetection, RandomPartialViewsOfBothFacesGetRightIds) {
     const Errors e = CompareWithTruth(target_, r.faces[0], camera_, cam_from_face);
     EXPECT_LT(e.max_px, 0.3);
     EXPECT_GE(r.faces[0].quality.num_corners, RefinableCorners(target_, camera_, cam_from_face));
+    for (const Eigen::Vector2d& q : r.faces[0].q_px) {  // never a corner extrapolated out of the image
+      EXPECT_TRUE(q.x() >= 2 && q.y() >= 2 && q.x() <= camera_.width_px - 3 && q.y() <= camera_.height_px - 3) << q.transpose();
+    }
     ++accepted;
     corners += r.faces[0].quality.num_corners;
   }
