@@ -41,7 +41,8 @@ TEST(BoardSvg, SquaresScaleBarAndPageAreInTrueMillimetres) {
   ASSERT_EQ(text, svg.text);
 
   // Well-formed XML, by an independent parser.
-  const std::string cmd = "/usr/bin/python3 -c \"import sys, xml.etree.ElementTree as E; E.parse(sys.argv[1])\" " + path;
+  const std::string cmd =
+      "/usr/bin/python3 -c \"import sys, xml.etree.ElementTree as E; E.parse(sys.argv[1])\" " + path;
   EXPECT_EQ(std::system(cmd.c_str()), 0);
 
   // The root: width and height in mm, and a viewBox of the same numbers, so

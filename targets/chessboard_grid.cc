@@ -58,7 +58,8 @@ void Refine(const cv::Mat& grey, const ChessboardGridOptions& o, ChessboardGrid*
       cv::cornerSubPix(grey, p, cv::Size(half, half), cv::Size(-1, -1),
                        cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40, 1e-4));
       const Eigen::Vector2d q1(p[0].x, p[0].y);
-      if (!q1.allFinite() || (q1 - q0).norm() > o.refine_max_shift_fraction * spacing) {
+      if (!q1.allFinite() ||
+          (q1 - q0).norm() > std::min(o.refine_max_shift_fraction * spacing, static_cast<double>(half))) {
         g->usable[r * g->cols + c] = false;
         ++g->num_dropped;
         continue;

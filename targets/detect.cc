@@ -29,15 +29,24 @@ void DetectOptions::Check() const {
 
 const char* RejectReasonName(RejectReason reason) {
   switch (reason) {
-    case RejectReason::kNone: return "none";
-    case RejectReason::kNoChessboard: return "no_chessboard";
-    case RejectReason::kNoTags: return "no_tags";
-    case RejectReason::kBothFaces: return "both_faces";
-    case RejectReason::kWrongFace: return "wrong_face";
-    case RejectReason::kMirrored: return "mirrored";
-    case RejectReason::kAmbiguous: return "ambiguous";
-    case RejectReason::kGridMismatch: return "grid_mismatch";
-    case RejectReason::kTooFewCorners: return "too_few_corners";
+    case RejectReason::kNone:
+      return "none";
+    case RejectReason::kNoChessboard:
+      return "no_chessboard";
+    case RejectReason::kNoTags:
+      return "no_tags";
+    case RejectReason::kBothFaces:
+      return "both_faces";
+    case RejectReason::kWrongFace:
+      return "wrong_face";
+    case RejectReason::kMirrored:
+      return "mirrored";
+    case RejectReason::kAmbiguous:
+      return "ambiguous";
+    case RejectReason::kGridMismatch:
+      return "grid_mismatch";
+    case RejectReason::kTooFewCorners:
+      return "too_few_corners";
   }
   return "unknown";
 }
@@ -128,8 +137,8 @@ bool WholeBoardInView(const Target& target, const Eigen::Matrix3d& image_from_fa
 // *bad_tag: the worst tag's ID if it is off by more than max_tag_fit_squares
 // of a (local) square, else -1.
 void TagFitAgainstCorners(const Target& target, Face face, const std::vector<TagDetection>& tags,
-                          const std::vector<int>& ids, const std::vector<Eigen::Vector2d>& q,
-                          double max_fit_squares, DetectionQuality* quality, int* bad_tag) {
+                          const std::vector<int>& ids, const std::vector<Eigen::Vector2d>& q, double max_fit_squares,
+                          DetectionQuality* quality, int* bad_tag) {
   *bad_tag = -1;
   std::vector<cv::Point2d> src, dst;
   for (size_t i = 0; i < ids.size(); ++i) {
@@ -171,16 +180,16 @@ ChessboardSharpness SharpnessOfLargestBlock(const Target& target, const cv::Mat&
   std::vector<int> have((nx + 1) * (ny + 1), 0);
   for (int r = 0; r < ny; ++r)
     for (int c = 0; c < nx; ++c)
-      have[(r + 1) * (nx + 1) + c + 1] = (index[r * nx + c] >= 0) + have[r * (nx + 1) + c + 1] +
-                                         have[(r + 1) * (nx + 1) + c] - have[r * (nx + 1) + c];
+      have[(r + 1) * (nx + 1) + c + 1] =
+          (index[r * nx + c] >= 0) + have[r * (nx + 1) + c + 1] + have[(r + 1) * (nx + 1) + c] - have[r * (nx + 1) + c];
   int best_area = 0, bc0 = 0, br0 = 0, bw = 0, bh = 0;
   for (int r0 = 0; r0 < ny; ++r0)
     for (int r1 = r0 + 3; r1 <= ny; ++r1)
       for (int c0 = 0; c0 < nx; ++c0)
         for (int c1 = c0 + 3; c1 <= nx; ++c1) {
           const int area = (r1 - r0) * (c1 - c0);
-          const int count = have[r1 * (nx + 1) + c1] - have[r0 * (nx + 1) + c1] - have[r1 * (nx + 1) + c0] +
-                            have[r0 * (nx + 1) + c0];
+          const int count =
+              have[r1 * (nx + 1) + c1] - have[r0 * (nx + 1) + c1] - have[r1 * (nx + 1) + c0] + have[r0 * (nx + 1) + c0];
           if (count == area && area > best_area) {
             best_area = area;
             bc0 = c0, br0 = r0, bw = c1 - c0, bh = r1 - r0;
@@ -200,9 +209,12 @@ ChessboardSharpness SharpnessOfLargestBlock(const Target& target, const cv::Mat&
 
 const char* CornerSourceName(CornerSource source) {
   switch (source) {
-    case CornerSource::kNone: return "none";
-    case CornerSource::kOpenCvGrid: return "opencv_grid";
-    case CornerSource::kTagGuided: return "tag_guided";
+    case CornerSource::kNone:
+      return "none";
+    case CornerSource::kOpenCvGrid:
+      return "opencv_grid";
+    case CornerSource::kTagGuided:
+      return "tag_guided";
   }
   return "unknown";
 }
@@ -254,8 +266,7 @@ DetectResult TargetDetector::Detect(const cv::Mat& grey) const {
     }
     std::string problem;
     bool mirrored = false;
-    if (!TagHomography(target_, face, face_tags, options_.max_tag_fit_squares, &image_from_face, &problem,
-                       &mirrored)) {
+    if (!TagHomography(target_, face, face_tags, options_.max_tag_fit_squares, &image_from_face, &problem, &mirrored)) {
       Reject(&out, mirrored ? RejectReason::kMirrored : RejectReason::kAmbiguous, problem);
       return out;
     }
@@ -277,8 +288,8 @@ DetectResult TargetDetector::Detect(const cv::Mat& grey) const {
     if (!FindChessboardGrid(grey, size, partial, options_.chessboard, &grid)) continue;
     found_any_grid = true;
     const GridIds ids = target_.double_sided()
-                            ? GridIdsFromTags(target_, face, face_tags, image_from_face, grid,
-                                              options_.id_gate_squares, options_.min_agreeing_fraction)
+                            ? GridIdsFromTags(target_, face, face_tags, image_from_face, grid, options_.id_gate_squares,
+                                              options_.min_agreeing_fraction)
                             : GridIdsFromColours(target_, grey, grid);
     if (!ids.ok) {
       if (grid.q_px.size() > largest_failed) {
@@ -347,9 +358,9 @@ DetectResult TargetDetector::Detect(const cv::Mat& grey) const {
   quality.sharpness = SharpnessOfLargestBlock(target_, grey, det.corner_ids, det.q_px);
   LocalFit(target_, det.corner_ids, det.q_px, &quality);
   if (quality.num_corners < options_.min_corners) {
-    Reject(&out, RejectReason::kTooFewCorners,
-           "only " + std::to_string(quality.num_corners) + " corners (need " + std::to_string(options_.min_corners) +
-               ")");
+    Reject(
+        &out, RejectReason::kTooFewCorners,
+        "only " + std::to_string(quality.num_corners) + " corners (need " + std::to_string(options_.min_corners) + ")");
     return out;
   }
   det.quality = quality;

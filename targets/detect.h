@@ -74,11 +74,11 @@ const char* CornerSourceName(CornerSource source);
 // How good one detection is.
 struct DetectionQuality {
   CornerSource source = CornerSource::kNone;
-  int num_corners = 0;              // corners kept
-  int grid_cols = 0, grid_rows = 0; // size of OpenCV's corner grid
-  int num_tags = 0;                 // tags of the detected face used
-  std::vector<int> tag_ids;         // their IDs
-  int num_foreign_tags = 0;         // decoded tags whose IDs are not on this target
+  int num_corners = 0;               // corners kept
+  int grid_cols = 0, grid_rows = 0;  // size of OpenCV's corner grid
+  int num_tags = 0;                  // tags of the detected face used
+  std::vector<int> tag_ids;          // their IDs
+  int num_foreign_tags = 0;          // decoded tags whose IDs are not on this target
   // The tags' corners against the homography fitted to the detected
   // chessboard corners alone (face mm -> px): RMS over all tags, and the
   // worst tag's RMS, px. A tag off by more than max_tag_fit_squares of a
@@ -91,8 +91,8 @@ struct DetectionQuality {
   // about 1.1x the per-corner noise for sharp corners, insensitive to lens
   // distortion. NaN if no corner has 8 neighbours.
   double local_fit_rms_px = 0;
-  int local_fit_count = 0;          // corners that entered local_fit_rms_px
-  int num_dropped = 0;              // grid corners dropped by the refinement (at the image's edge, slid off)
+  int local_fit_count = 0;  // corners that entered local_fit_rms_px
+  int num_dropped = 0;      // grid corners dropped by the refinement (at the image's edge, slid off)
   // OpenCV's edge-rise width and levels over the largest complete block of
   // corners found; NaN when no 3x3 block is complete.
   ChessboardSharpness sharpness;
@@ -103,29 +103,29 @@ struct DetectionQuality {
 // size, so it lies at least 2 px inside the image.
 struct FaceDetection {
   Face face = Face::kFront;
-  std::vector<int> corner_ids;          // (N) ascending; ids in `face`'s frame (Target::CornerInFace)
-  std::vector<Eigen::Vector2d> q_px;    // (N) parallel to corner_ids
+  std::vector<int> corner_ids;        // (N) ascending; ids in `face`'s frame (Target::CornerInFace)
+  std::vector<Eigen::Vector2d> q_px;  // (N) parallel to corner_ids
   DetectionQuality quality;
 };
 
 enum class RejectReason {
-  kNone,             // accepted
-  kNoChessboard,     // no corner grid found
-  kNoTags,           // double-sided target, but no tag of it seen
-  kBothFaces,        // tags of both faces: which face is it?
-  kWrongFace,        // not DetectOptions::expected_face
-  kMirrored,         // the board appears mirrored
-  kAmbiguous,        // tags disagree, or the grid fits no single orientation
-  kGridMismatch,     // the grid does not fit this target (size, corners outside)
-  kTooFewCorners,    // fewer than DetectOptions::min_corners
+  kNone,           // accepted
+  kNoChessboard,   // no corner grid found
+  kNoTags,         // double-sided target, but no tag of it seen
+  kBothFaces,      // tags of both faces: which face is it?
+  kWrongFace,      // not DetectOptions::expected_face
+  kMirrored,       // the board appears mirrored
+  kAmbiguous,      // tags disagree, or the grid fits no single orientation
+  kGridMismatch,   // the grid does not fit this target (size, corners outside)
+  kTooFewCorners,  // fewer than DetectOptions::min_corners
 };
 const char* RejectReasonName(RejectReason reason);
 
 struct DetectResult {
   std::vector<FaceDetection> faces;  // at most one: a camera sees one face
   RejectReason reason = RejectReason::kNone;
-  std::string message;               // why it was rejected, for people
-  DetectionQuality quality;          // what was measured, even when rejected
+  std::string message;       // why it was rejected, for people
+  DetectionQuality quality;  // what was measured, even when rejected
 };
 
 // Holds the AprilTag detector, so detecting many images costs no set-up.

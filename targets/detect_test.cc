@@ -11,8 +11,8 @@
 
 #include <cmath>
 #include <cstdio>
-#include <random>
 #include <opencv2/core.hpp>
+#include <random>
 
 #include "targets/synthetic_view.h"
 
@@ -59,9 +59,8 @@ int RefinableCorners(const Target& target, const PinholeCamera& camera, const Po
   for (int id = 0; id < target.num_corners(); ++id) {
     const Eigen::Vector3d p = target.CornerInFace(id);
     const Eigen::Vector2d q = camera.Project(cam_from_face * p);
-    const double spacing =
-        std::min((camera.Project(cam_from_face * (p + Eigen::Vector3d(s, 0, 0))) - q).norm(),
-                 (camera.Project(cam_from_face * (p + Eigen::Vector3d(0, s, 0))) - q).norm());
+    const double spacing = std::min((camera.Project(cam_from_face * (p + Eigen::Vector3d(s, 0, 0))) - q).norm(),
+                                    (camera.Project(cam_from_face * (p + Eigen::Vector3d(0, s, 0))) - q).norm());
     const double margin_px = 0.25 * spacing + 3;
     if (q.x() >= margin_px && q.y() >= margin_px && q.x() <= camera.width_px - 1 - margin_px &&
         q.y() <= camera.height_px - 1 - margin_px) {
@@ -151,8 +150,8 @@ TEST_F(DefaultTargetDetection, TagCornersSitAtTheirTrueProjection) {
 // Both corner sources: grown from the tags (the default) and OpenCV's grid.
 void FrontFaceAccuracy(const Target& target, const PinholeCamera& camera, const DetectOptions& options,
                        CornerSource expected_source, int num_poses) {
-  const double poses[][4] = {{260, 20, -25, 10}, {280, -30, 15, -40}, {300, 10, 35, 75},
-                             {250, -15, -10, 200}, {290, 30, 25, 140}, {270, -5, -30, -110}};
+  const double poses[][4] = {{260, 20, -25, 10},   {280, -30, 15, -40}, {300, 10, 35, 75},
+                             {250, -15, -10, 200}, {290, 30, 25, 140},  {270, -5, -30, -110}};
   const TargetDetector detector(target, options);
   double sum_sq = 0;
   int n = 0;
@@ -179,7 +178,8 @@ void FrontFaceAccuracy(const Target& target, const PinholeCamera& camera, const 
     n += static_cast<int>(det.corner_ids.size());
   }
   const double rms_px = std::sqrt(sum_sq / std::max(n, 1));
-  std::printf("front face, %s: RMS %.4f px over %d corners (noise off)\n", CornerSourceName(expected_source), rms_px, n);
+  std::printf("front face, %s: RMS %.4f px over %d corners (noise off)\n", CornerSourceName(expected_source), rms_px,
+              n);
   EXPECT_LT(rms_px, 0.05);
 }
 
@@ -252,7 +252,8 @@ TEST_F(DefaultTargetDetection, RandomPartialViewsOfBothFacesGetRightIds) {
     EXPECT_LT(e.max_px, 0.3);
     EXPECT_GE(r.faces[0].quality.num_corners, RefinableCorners(target_, camera_, cam_from_face));
     for (const Eigen::Vector2d& q : r.faces[0].q_px) {  // never a corner extrapolated out of the image
-      EXPECT_TRUE(q.x() >= 2 && q.y() >= 2 && q.x() <= camera_.width_px - 3 && q.y() <= camera_.height_px - 3) << q.transpose();
+      EXPECT_TRUE(q.x() >= 2 && q.y() >= 2 && q.x() <= camera_.width_px - 3 && q.y() <= camera_.height_px - 3)
+          << q.transpose();
     }
     ++accepted;
     corners += r.faces[0].quality.num_corners;
