@@ -2,12 +2,16 @@
 // visible chessboard corner's id in that face's own frame, at sub-pixel
 // precision (docs/targets.md, "Detection").
 //
-// A double-sided target: OpenCV finds a (possibly partial) corner grid; the
-// AprilTags of one face say which face it is and, through a homography from
-// their corners (face frame, mm) to the image, which corner id each grid
-// corner is. A plain board (no tags): the whole board must be visible; the
+// A double-sided target: the AprilTags of one face say which face it is;
+// a homography from their corners (face frame, mm) to the image predicts
+// each corner id's pixel, and the corners are grown out from the tags
+// (tag_guided_corners.h), each refined with cv::cornerSubPix and checked to
+// be a saddle of the right colours. Optionally OpenCV's whole-board grid is
+// tried first and its ids decided by the tags (grid_ids.h). Partial boards
+// work as long as one tag is seen. A plain board (no tags): OpenCV's
+// findChessboardCornersSB on the whole board, which must be visible; the
 // ids follow from the board's shape, the colours of its squares and, where
-// those are symmetric, the image's up direction (docs/targets.md).
+// those are symmetric, the image's right direction (docs/targets.md).
 //
 // Pixels follow mrcal: (0,0) is the centre of the top-left pixel.
 #pragma once
@@ -56,7 +60,9 @@ struct DetectOptions {
   // fewer -> rejected as inconsistent. Default 0.9.
   double min_agreeing_fraction = 0.9;
   // The tags' corners must fit one board homography to within this RMS, in
-  // squares; else the tags disagree (a damaged or wrong target). Default 0.25.
+  // squares, and each tag must sit within it of where the detected corners
+  // put it; else the view is rejected as ambiguous (a damaged print or a
+  // wrong target file). Default 0.25.
   double max_tag_fit_squares = 0.25;
   // If set, a detection of the other face is rejected ("wrong face").
   std::optional<Face> expected_face;
