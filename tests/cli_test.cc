@@ -33,10 +33,12 @@ Result RunCli(const std::string& args) {
 int Lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
 
 std::string GoodRigText() {
-  const std::string dir = ::testing::TempDir() + "/cli_demo";
-  const Result r = RunCli("demo --out " + dir);
+  // The simulator's true default rig, without rendering anything (fast);
+  // `demo` now renders the whole default dataset.
+  const std::string dir = ::testing::TempDir() + "/cli_truth";
+  const Result r = RunCli("simulate --out " + dir + " --calibration-captures 0 --no-scenes");
   EXPECT_EQ(r.code, 0) << r.err;
-  std::ifstream f(dir + "/truth_rig.yaml");
+  std::ifstream f(dir + "/truth/rig.yaml");
   std::stringstream s;
   s << f.rdbuf();
   return s.str();

@@ -1,0 +1,124 @@
+#include "datasets/simulate.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "calib/core/input_error.h"
+#include "calib/core/rig_file.h"
+#include "calib/core/yaml_reader.h"
+#include "datasets/sim_test_util.h"
+
+namespace stereorig {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Slurp(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+std::string RunSim(const SimSpec& spec, const std::string& name, uint64_t seed, int threads, RigBump bump = {}) {
+  SimulateOptions o;
+  o.out_dir = ::testing::TempDir() + "/simtest_" + name;
+  o.seed = seed;
+  o.threads = threads;
+  o.bump = bump;
+  Simulate(spec, o);
+  return o.out_dir;
+}
+
+TEST(Simulate, SameSeedSameBytesWhateverTheThreads) {
+  SimSpec spec = SmallRingSpec(2, 4, 2);
+  spec.scenes.names = {"tuber"};  // the slowest shape: sphere tracing
+  const fs::path a = RunSim(spec, "det_a", 5, 1), b = RunSim(spec, "det_b", 5, 2), c = RunSim(spec, "det_c", 6, 2);
+  int files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(a)) {
+    if (!e.is_regular_file()) continue;
+    const fs::path rel = fs::relative(e.path(), a);
+    ASSERT_TRUE(fs::exists(b / rel)) << rel;
+    EXPECT_EQ(Slurp(e.path()), Slurp(b / rel)) << rel;
+    ++files;
+  }
+  EXPECT_GT(files, 25);
+  // Another seed: other poses, other noise.
+  EXPECT_NE(Slurp(a / "calibration/000/cam0.png"), Slurp(c / "calibration/000/cam0.png"));
+  EXPECT_NE(Slurp(a / "scenes/tuber/passive/cam0.png"), Slurp(c / "scenes/tuber/passive/cam0.png"));
+}
+
+// Any number of modules renders: the layout, the truth rig and every image.
+TEST(Simulate, OneTwoAndThreeModuleRigsRender) {
+  for (int m = 1; m <= 3; ++m) {
+    SimSpec spec = SmallRingSpec(m, 4, 2);
+    spec.scenes.names = {"sphere"};
+    const fs::path dir = RunSim(spec, "ring" + std::to_string(m), 1, 2);
+    const Rig rig = ReadRigFile((dir / "truth/rig.yaml").string());
+    EXPECT_EQ(rig.num_modules(), m);
+    YamlMap layout = YamlMap::LoadFile((dir / "layout.yaml").string());
+    EXPECT_EQ(layout.GetMaps("modules").size(), static_cast<size_t>(m));
+    for (int cam = 0; cam < 2 * m; ++cam) {
+      const std::string name = "cam" + std::to_string(cam) + ".png";
+      for (const char* k : {"000", "001"}) {
+        const cv::Mat im = cv::imread((dir / "calibration" / k / name).string(), cv::IMREAD_UNCHANGED);
+        ASSERT_EQ(im.type(), CV_8U) << dir / "calibration" / k / name;
+        EXPECT_EQ(im.cols, spec.modules[cam / 2].left.width_px);
+      }
+      const cv::Mat active = cv::imread((dir / "scenes/sphere/active" / name).string(), cv::IMREAD_UNCHANGED);
+      const cv::Mat passive = cv::imread((dir / "scenes/sphere/passive" / name).string(), cv::IMREAD_UNCHANGED);
+      const cv::Mat id = cv::imread((dir / "truth/scenes/sphere" / ("id_" + name)).string(),
+                                    cv::IMREAD_UNCHANGED);
+      ASSERT_FALSE(active.empty());
+      ASSERT_FALSE(id.empty());
+      // Every camera sees the sphere, and its own module's laser on it.
+      const cv::Mat on = id > 0;
+      EXPECT_GT(cv::countNonZero(on), 200);
+      EXPECT_GT(cv::mean(active, on)[0], cv::mean(passive, on)[0] + 5);
+    }
+  }
+}
+
+TEST(Simulate, RefusesToReplaceAFolderThatIsNotADatasetAndLeavesNoTemporaries) {
+  const fs::path dir = ::testing::TempDir() + "/simtest_precious";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "thesis.txt") << "do not lose";
+  SimulateOptions o;
+  o.out_dir = dir.string();
+  EXPECT_THROW(Simulate(SmallRingSpec(1, 4, 1), o), InputError);
+  EXPECT_EQ(Slurp(dir / "thesis.txt"), "do not lose");
+  for (const auto& e : fs::directory_iterator(dir.parent_path())) {
+    EXPECT_EQ(e.path().filename().string().find(".simtest_precious.tmp"), std::string::npos);
+  }
+}
+
+// The morning after a bump: the truth moves by exactly what was asked.
+TEST(Simulate, BumpsMoveTheTruthByTheRequestedAmount) {
+  SimSpec spec = SmallRingSpec(2, 4, 1);
+  spec.scenes.names.clear();
+  const Rig before = ReadRigFile(RunSim(spec, "bump0", 3, 2) + "/truth/rig.yaml");
+  RigBump cam;
+  cam.camera = 1;
+  cam.rotation_deg = 0.05;
+  const Rig after_cam = ReadRigFile(RunSim(spec, "bump1", 3, 2, cam) + "/truth/rig.yaml");
+  const Pose d = before.module(0).right_from_left * after_cam.module(0).right_from_left.Inverse();
+  EXPECT_NEAR(d.AngleDeg(), 0.05, 1e-9);
+  EXPECT_LT((before.S(0, 1).Inverse() * after_cam.S(0, 1)).AngleDeg(), 1e-12);  // other modules untouched
+  RigBump mod;
+  mod.module = 1;
+  mod.translation_mm = 0.1;
+  const Rig after_mod = ReadRigFile(RunSim(spec, "bump2", 3, 2, mod) + "/truth/rig.yaml");
+  const Pose m = before.S(0, 1).Inverse() * after_mod.S(0, 1);
+  EXPECT_NEAR(m.DistanceMm(), 0.1, 1e-9);
+  EXPECT_LT(m.AngleDeg(), 1e-9);
+  EXPECT_LT((before.module(1).right_from_left.Inverse() * after_mod.module(1).right_from_left).DistanceMm(), 1e-9);
+}
+
+}  // namespace
+}  // namespace stereorig
