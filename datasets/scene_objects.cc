@@ -498,7 +498,12 @@ Scene MakeScene(const std::string& name, const ScenesSpec& spec, const RenderSpe
                                      spec.artifact_albedo, render, &rng));
   } else if (name == "ballbar") {
     const double D = spec.ballbar_distance_mm, r = 0.5 * spec.ballbar_sphere_diameter_mm;
-    const Pose bar = ConveyorPose(Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), 20.0, spec, &rng);
+    // The default modules' two views overlap in only ~70 x 110 mm at the
+    // object (90 mm baseline, 6 degrees of verging), so the bar stands
+    // steeply, 60 +- 10 degrees from the belt, to keep both balls in all views.
+    const double lean = (60.0 + rng.Uniform(-10, 10)) * kDeg;
+    const Pose bar = ConveyorPose(Eigen::AngleAxisd(lean, Eigen::Vector3d::UnitZ()).toRotationMatrix(),
+                                  Eigen::Vector3d::Zero(), 15.0, spec, &rng);
     for (int k = 0; k < 2; ++k) {
       const Pose ball = bar * Pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d((k == 0 ? -0.5 : 0.5) * D, 0, 0));
       scene.objects.push_back(MakeBall(k + 1, k == 0 ? "ball bar: ball A" : "ball bar: ball B",
