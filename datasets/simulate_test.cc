@@ -122,3 +122,31 @@ TEST(Simulate, BumpsMoveTheTruthByTheRequestedAmount) {
 
 }  // namespace
 }  // namespace stereorig
+
+namespace stereorig {
+namespace {
+
+// Any mrcal lens model: a pinhole and a splined stereographic camera render
+// through their own unprojection.
+TEST(Simulate, OtherLensModelsRender) {
+  SimSpec spec = SmallRingSpec(1, 4, 1);
+  spec.scenes.names = {"sphere"};
+  CameraSpec& l = spec.modules[0].left;
+  l.lensmodel = "LENSMODEL_PINHOLE";
+  l.intrinsics.resize(4);
+  CameraSpec& r = spec.modules[0].right;
+  r.lensmodel = "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=8_Ny=6_fov_x_deg=50";
+  r.intrinsics.resize(4);
+  r.intrinsics.resize(4 + 2 * 8 * 6, 0.0);  // no deviation from a pure stereographic lens
+  const fs::path dir = RunSim(spec, "lenses", 2, 2);
+  for (const char* cam : {"cam0", "cam1"}) {
+    const cv::Mat id =
+        cv::imread((dir / "truth/scenes/sphere" / (std::string("id_") + cam + ".png")).string(), cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(id.empty());
+    EXPECT_GT(cv::countNonZero(id), 200) << cam;  // the sphere is in view of both lenses
+  }
+  EXPECT_EQ(ReadRigFile((dir / "truth/rig.yaml").string()).camera(1).lensmodel_name(), r.lensmodel);
+}
+
+}  // namespace
+}  // namespace stereorig
