@@ -57,4 +57,11 @@ void ValidateInput(const CalibrationInput& input);
 // atomically. Returns the paths written.
 std::vector<std::string> ExportCameramodels(const Rig& rig, const std::string& dir);
 
+// A readable summary of every stage (a few lines per camera and module).
+std::string SummaryText(const CalibrationReport& report);
+
+// Writes the rig file and the JSON report, each atomically.
+void WriteCalibrationOutputs(const CalibrationResult& result, const std::string& rig_path,
+                             const std::string& report_path);
+
 }  // namespace stereorig

@@ -19,7 +19,9 @@ void ChessboardGridOptions::Check() const {
   if (refine_min_half_px < 1 || refine_max_half_px < refine_min_half_px) {
     throw InputError(where, "need 1 <= refine_min_half_px <= refine_max_half_px");
   }
-  if (!(refine_max_shift_px > 0)) throw InputError(where, "refine_max_shift_px must be positive");
+  if (!(refine_max_shift_fraction > 0 && refine_max_shift_fraction <= 0.5)) {
+    throw InputError(where, "refine_max_shift_fraction must be in (0, 0.5]");
+  }
 }
 
 namespace {
@@ -42,12 +44,9 @@ void Refine(const cv::Mat& grey, const ChessboardGridOptions& o, ChessboardGrid*
     for (int c = 0; c < g->cols; ++c) {
       const double spacing = NearestNeighbourPx(*g, c, r);
       if (!std::isfinite(spacing)) continue;
-      const int half = std::clamp(static_cast<int>(std::floor(o.refine_window_fraction * spacing)),
-                                  o.refine_min_half_px, o.refine_max_half_px);
       const Eigen::Vector2d& q0 = g->at(c, r);
-      // Keep the window inside the image, or cornerSubPix reads garbage.
-      if (q0.x() - half - 2 < 0 || q0.y() - half - 2 < 0 || q0.x() + half + 2 > grey.cols - 1 ||
-          q0.y() + half + 2 > grey.rows - 1) {
+      const int half = RefineHalfWindow(o, spacing, q0, grey.size());
+      if (half < 0) {
         ++g->num_refine_rejected;
         continue;
       }
@@ -55,7 +54,7 @@ void Refine(const cv::Mat& grey, const ChessboardGridOptions& o, ChessboardGrid*
       cv::cornerSubPix(grey, p, cv::Size(half, half), cv::Size(-1, -1),
                        cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40, 1e-4));
       const Eigen::Vector2d q1(p[0].x, p[0].y);
-      if ((q1 - q0).norm() > o.refine_max_shift_px || !q1.allFinite()) {
+      if (!q1.allFinite() || (q1 - q0).norm() > o.refine_max_shift_fraction * spacing) {
         ++g->num_refine_rejected;
         continue;
       }
@@ -66,6 +65,19 @@ void Refine(const cv::Mat& grey, const ChessboardGridOptions& o, ChessboardGrid*
 }
 
 }  // namespace
+
+int RefineHalfWindow(const ChessboardGridOptions& options, double spacing_px, const Eigen::Vector2d& q_px,
+                     const cv::Size& image_size) {
+  const double to_edge = std::min({q_px.x(), q_px.y(), image_size.width - 1 - q_px.x(), image_size.height - 1 - q_px.y()});
+  const int half = std::min({static_cast<int>(std::floor(options.refine_window_fraction * spacing_px)),
+                             options.refine_max_half_px, static_cast<int>(std::floor(to_edge)) - 2});
+  if (half < options.refine_min_half_px) {
+    // Too close to the edge for the minimum window; a window larger than the
+    // spacing allows is not an option either.
+    return std::floor(to_edge) - 2 >= options.refine_min_half_px ? options.refine_min_half_px : -1;
+  }
+  return half;
+}
 
 bool FindChessboardGrid(const cv::Mat& grey, cv::Size size, bool partial, const ChessboardGridOptions& options,
                         ChessboardGrid* grid) {

@@ -28,9 +28,11 @@ struct ChessboardGridOptions {
   double refine_window_fraction = 0.4;  // of the local corner spacing; default 0.4
   int refine_min_half_px = 2;           // default 2
   int refine_max_half_px = 16;          // default 16
-  // A refined corner that moved more than this from OpenCV's estimate keeps
-  // OpenCV's estimate (the refinement slid off the corner). px, default 1.0.
-  double refine_max_shift_px = 1.0;
+  // A refinement that moves a corner further than this fraction of the
+  // local corner spacing is taken to have slid off it, and OpenCV's estimate
+  // is kept. Default 0.25 (OpenCV's own estimate is off by up to ~1 px on
+  // small, steeply tilted squares, where cornerSubPix is right).
+  double refine_max_shift_fraction = 0.25;
   void Check() const;  // throws InputError naming the bad field
 };
 
@@ -52,6 +54,13 @@ struct ChessboardGrid {
 // Returns false if none was found.
 bool FindChessboardGrid(const cv::Mat& grey, cv::Size size, bool partial, const ChessboardGridOptions& options,
                         ChessboardGrid* grid);
+
+// The cornerSubPix half-window for a corner at `q_px` whose nearest
+// neighbour is `spacing_px` away: options' fraction of the spacing, clamped
+// to [min, max] and shrunk so that the window stays 2 px inside the image;
+// -1 if even the minimum window does not fit.
+int RefineHalfWindow(const ChessboardGridOptions& options, double spacing_px, const Eigen::Vector2d& q_px,
+                     const cv::Size& image_size);
 
 // OpenCV's cv::estimateChessboardSharpness on a found grid: the mean width
 // (px) of the 10%-90% black-to-white rise across the squares' edges (sharp is

@@ -10,6 +10,7 @@
 
 #include "calib/core/input_error.h"
 #include "targets/grid_ids.h"
+#include "targets/tag_guided_corners.h"
 
 namespace stereorig {
 
@@ -62,7 +63,7 @@ std::string IdList(const std::vector<TagDetection>& tags) {
 // reject it and the next size is tried.
 std::vector<std::pair<cv::Size, bool>> GridAttempts(const Target& target, const DetectOptions& options) {
   std::vector<std::pair<cv::Size, bool>> attempts = {{cv::Size(target.corners_x(), target.corners_y()), false}};
-  if (target.double_sided()) {
+  if (target.double_sided() && options.opencv_partial_search) {
     const int largest = std::min({5, target.corners_x(), target.corners_y()});
     for (int k = largest; k >= options.min_partial_grid; --k) attempts.push_back({cv::Size(k, k), true});
   }
@@ -107,7 +108,68 @@ void LocalFit(const Target& target, const std::vector<int>& ids, const std::vect
   quality->local_fit_rms_px = n ? std::sqrt(sum_sq / n) : std::numeric_limits<double>::quiet_NaN();
 }
 
+// Whether every corner, as the tags' homography predicts it, lies at least
+// half a square inside the image.
+bool WholeBoardInView(const Target& target, const Eigen::Matrix3d& image_from_face, const cv::Size& image_size) {
+  const double s = target.square_size_mm();
+  for (int id = 0; id < target.num_corners(); ++id) {
+    const Eigen::Vector2d p = target.CornerInFace(id).head<2>();
+    const Eigen::Vector2d q = ApplyHomography(image_from_face, p);
+    const double half_square_px = 0.5 * (ApplyHomography(image_from_face, p + Eigen::Vector2d(s, 0)) - q).norm();
+    if (!q.allFinite() || q.x() < half_square_px || q.y() < half_square_px ||
+        q.x() > image_size.width - 1 - half_square_px || q.y() > image_size.height - 1 - half_square_px) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// cv::estimateChessboardSharpness needs a complete rectangular grid: use the
+// largest block of corners all found.
+ChessboardSharpness SharpnessOfLargestBlock(const Target& target, const cv::Mat& grey, const std::vector<int>& ids,
+                                            const std::vector<Eigen::Vector2d>& q) {
+  const int nx = target.corners_x(), ny = target.corners_y();
+  std::vector<int> index(target.num_corners(), -1);
+  for (size_t i = 0; i < ids.size(); ++i) index[ids[i]] = static_cast<int>(i);
+  // have[(r) * (nx + 1) + c]: found corners in rows < r, cols < c.
+  std::vector<int> have((nx + 1) * (ny + 1), 0);
+  for (int r = 0; r < ny; ++r)
+    for (int c = 0; c < nx; ++c)
+      have[(r + 1) * (nx + 1) + c + 1] = (index[r * nx + c] >= 0) + have[r * (nx + 1) + c + 1] +
+                                         have[(r + 1) * (nx + 1) + c] - have[r * (nx + 1) + c];
+  int best_area = 0, bc0 = 0, br0 = 0, bw = 0, bh = 0;
+  for (int r0 = 0; r0 < ny; ++r0)
+    for (int r1 = r0 + 2; r1 <= ny; ++r1)
+      for (int c0 = 0; c0 < nx; ++c0)
+        for (int c1 = c0 + 2; c1 <= nx; ++c1) {
+          const int area = (r1 - r0) * (c1 - c0);
+          const int count = have[r1 * (nx + 1) + c1] - have[r0 * (nx + 1) + c1] - have[r1 * (nx + 1) + c0] +
+                            have[r0 * (nx + 1) + c0];
+          if (count == area && area > best_area) {
+            best_area = area;
+            bc0 = c0, br0 = r0, bw = c1 - c0, bh = r1 - r0;
+          }
+        }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (best_area == 0) return {nan, nan, nan};
+  ChessboardGrid block;
+  block.cols = bw;
+  block.rows = bh;
+  for (int r = br0; r < br0 + bh; ++r)
+    for (int c = bc0; c < bc0 + bw; ++c) block.q_px.push_back(q[index[r * nx + c]]);
+  return MeasureSharpness(grey, block);
+}
+
 }  // namespace
+
+const char* CornerSourceName(CornerSource source) {
+  switch (source) {
+    case CornerSource::kNone: return "none";
+    case CornerSource::kOpenCvGrid: return "opencv_grid";
+    case CornerSource::kTagGuided: return "tag_guided";
+  }
+  return "unknown";
+}
 
 TargetDetector::TargetDetector(const Target& target, const DetectOptions& options)
     : target_(target), options_(options), tags_(target, options.tags) {
@@ -163,66 +225,80 @@ DetectResult TargetDetector::Detect(const cv::Mat& grey) const {
     }
   }
 
-  // 2. The corner grid, and each corner's id.
-  ChessboardGrid grid;
-  GridIds ids;
-  bool found_any = false;
+  // 2. The corners and their ids: OpenCV's grid first; for a tagged target
+  // whose grid is missing or wrong, corners grown out from the tags.
+  std::vector<std::pair<int, Eigen::Vector2d>> found;  // (id, q_px)
+  bool found_any_grid = false;
   std::string problem;  // from the largest grid that failed
   size_t largest_failed = 0;
+  // OpenCV's whole-board search costs most when it fails (~1 s on a partial
+  // view); with tags, the board's extent in the image is known beforehand.
+  const bool try_opencv = !target_.double_sided() || options_.opencv_partial_search ||
+                          (options_.opencv_whole_board && WholeBoardInView(target_, image_from_face, grey.size()));
   for (const auto& [size, partial] : GridAttempts(target_, options_)) {
-    ChessboardGrid g;
-    if (!FindChessboardGrid(grey, size, partial, options_.chessboard, &g)) continue;
-    found_any = true;
-    GridIds i = target_.double_sided()
-                    ? GridIdsFromTags(target_, face, face_tags, image_from_face, g, options_.id_gate_squares,
-                                      options_.min_agreeing_fraction)
-                    : GridIdsFromColours(target_, grey, g);
-    if (i.ok) {
-      grid = std::move(g);
-      ids = std::move(i);
-      break;
+    if (!try_opencv) break;
+    ChessboardGrid grid;
+    if (!FindChessboardGrid(grey, size, partial, options_.chessboard, &grid)) continue;
+    found_any_grid = true;
+    const GridIds ids = target_.double_sided()
+                            ? GridIdsFromTags(target_, face, face_tags, image_from_face, grid,
+                                              options_.id_gate_squares, options_.min_agreeing_fraction)
+                            : GridIdsFromColours(target_, grey, grid);
+    if (!ids.ok) {
+      if (grid.q_px.size() > largest_failed) {
+        largest_failed = grid.q_px.size();
+        problem = ids.problem;
+      }
+      continue;
     }
-    if (g.q_px.size() > largest_failed) {
-      largest_failed = g.q_px.size();
-      problem = i.problem;
+    quality.source = CornerSource::kOpenCvGrid;
+    quality.grid_cols = grid.cols;
+    quality.grid_rows = grid.rows;
+    quality.num_refine_rejected = grid.num_refine_rejected;
+    quality.tag_fit_rms_px = ids.tag_fit_rms_px;
+    for (int r = 0; r < grid.rows; ++r) {
+      for (int c = 0; c < grid.cols; ++c) {
+        if (!ids.keep[r * grid.cols + c]) continue;
+        const Eigen::Vector2i id2 = ids.map(c, r);
+        STEREORIG_CHECK(id2.x() >= 0 && id2.y() >= 0 && id2.x() < nx && id2.y() < ny);  // kept ones are on the board
+        found.emplace_back(id2.y() * nx + id2.x(), grid.at(c, r));
+      }
+    }
+    break;
+  }
+  if (found.empty() && target_.double_sided()) {
+    const TagGuidedCorners grown =
+        FindCornersFromTags(target_, face, face_tags, image_from_face, grey, options_.chessboard);
+    for (size_t i = 0; i < grown.ids.size(); ++i) found.emplace_back(grown.ids[i], grown.q_px[i]);
+    if (!found.empty()) {
+      quality.source = CornerSource::kTagGuided;
+      quality.tag_fit_rms_px = grown.tag_fit_rms_px;
     }
   }
-  if (!found_any) {
-    Reject(&out, RejectReason::kNoChessboard,
-           target_.double_sided() ? "no chessboard corners found"
-                                  : "no complete " + std::to_string(nx) + "x" + std::to_string(ny) +
-                                        " chessboard found (a plain board must be wholly visible)");
+  if (found.empty()) {
+    if (!target_.double_sided() && found_any_grid) {
+      Reject(&out, RejectReason::kGridMismatch, problem);
+    } else if (!target_.double_sided()) {
+      Reject(&out, RejectReason::kNoChessboard,
+             "no complete " + std::to_string(nx) + "x" + std::to_string(ny) +
+                 " chessboard found (a plain board must be wholly visible)");
+    } else {
+      Reject(&out, RejectReason::kNoChessboard, "no chessboard corners found next to the tags");
+    }
     return out;
   }
-  if (!ids.ok) {
-    Reject(&out, target_.double_sided() ? RejectReason::kAmbiguous : RejectReason::kGridMismatch, problem);
-    return out;
-  }
-  quality.grid_cols = grid.cols;
-  quality.grid_rows = grid.rows;
-  quality.num_refine_rejected = grid.num_refine_rejected;
-  quality.tag_fit_rms_px = ids.tag_fit_rms_px;
 
   // 3. The detection, in id order.
-  std::vector<std::pair<int, Eigen::Vector2d>> found;
-  for (int r = 0; r < grid.rows; ++r) {
-    for (int c = 0; c < grid.cols; ++c) {
-      if (!ids.keep[r * grid.cols + c]) continue;
-      const Eigen::Vector2i id2 = ids.map(c, r);
-      STEREORIG_CHECK(id2.x() >= 0 && id2.y() >= 0 && id2.x() < nx && id2.y() < ny);  // kept ones are on the board
-      found.emplace_back(id2.y() * nx + id2.x(), grid.at(c, r));
-    }
-  }
   std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   FaceDetection det;
   det.face = face;
   for (size_t i = 0; i < found.size(); ++i) {
-    STEREORIG_CHECK(i == 0 || found[i].first != found[i - 1].first);  // a symmetry is one-to-one
+    STEREORIG_CHECK(i == 0 || found[i].first != found[i - 1].first);  // one corner per id
     det.corner_ids.push_back(found[i].first);
     det.q_px.push_back(found[i].second);
   }
   quality.num_corners = static_cast<int>(det.corner_ids.size());
-  quality.sharpness = MeasureSharpness(grey, grid);
+  quality.sharpness = SharpnessOfLargestBlock(target_, grey, det.corner_ids, det.q_px);
   LocalFit(target_, det.corner_ids, det.q_px, &quality);
   if (quality.num_corners < options_.min_corners) {
     Reject(&out, RejectReason::kTooFewCorners,

@@ -10,6 +10,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <random>
 #include <opencv2/core.hpp>
 
 #include "targets/synthetic_view.h"
@@ -64,11 +66,17 @@ int VisibleTags(const Target& target, Face face, const PinholeCamera& camera, co
   return n;
 }
 
+DetectOptions WithOpenCvGrid() {
+  DetectOptions o;
+  o.opencv_whole_board = true;
+  return o;
+}
+
 class DefaultTargetDetection : public ::testing::Test {
  protected:
   const Target target_ = DefaultTarget();
   const PinholeCamera camera_;
-  const TargetDetector detector_{target_, DetectOptions()};
+  TargetDetector detector_{target_, DetectOptions()};
 
   // Renders `face` at `cam_from_face`, detects, and checks face, ids and
   // accuracy. Returns the detection.
@@ -119,25 +127,47 @@ TEST_F(DefaultTargetDetection, TagCornersSitAtTheirTrueProjection) {
 // right. Measured with these views: 0.03-0.05 px per view; views whose
 // edges run nearly along the pixel rows are the worst (aliasing of a 0.6 px
 // blur), hence the per-view bound of 0.07 px.
-TEST_F(DefaultTargetDetection, FrontFaceCornersAtTheirTrueProjection) {
+// Both corner sources: grown from the tags (the default) and OpenCV's grid.
+void FrontFaceAccuracy(const Target& target, const PinholeCamera& camera, const DetectOptions& options,
+                       CornerSource expected_source, int num_poses) {
   const double poses[][4] = {{260, 20, -25, 10}, {280, -30, 15, -40}, {300, 10, 35, 75},
                              {250, -15, -10, 200}, {290, 30, 25, 140}, {270, -5, -30, -110}};
+  const TargetDetector detector(target, options);
   double sum_sq = 0;
   int n = 0;
-  for (const auto& p : poses) {
+  for (int i = 0; i < num_poses; ++i) {
+    const double* p = poses[i];
     SCOPED_TRACE(::testing::Message() << "pose " << p[0] << " " << p[1] << " " << p[2] << " " << p[3]);
-    const Pose cam_from_face = LookAtFace(target_, p[0], p[1], p[2], p[3]);
-    const FaceDetection det = DetectAndCheck(Face::kFront, cam_from_face, 0.07, 0.2);
+    const Pose cam_from_face = LookAtFace(target, p[0], p[1], p[2], p[3]);
+    const DetectResult r = detector.Detect(RenderFace(target, Face::kFront, camera, cam_from_face));
+    ASSERT_EQ(r.faces.size(), 1u) << r.message;
+    const FaceDetection& det = r.faces[0];
+    EXPECT_EQ(det.face, Face::kFront);
+    EXPECT_EQ(det.quality.source, expected_source);
     EXPECT_EQ(det.quality.num_corners, 99);
-    EXPECT_EQ(det.quality.num_tags, VisibleTags(target_, Face::kFront, camera_, cam_from_face, 2));
+    EXPECT_EQ(det.quality.num_tags, VisibleTags(target, Face::kFront, camera, cam_from_face, 2));
     // The local 8-neighbour homography sees only the (tiny) corner error.
     EXPECT_LT(det.quality.local_fit_rms_px, 0.1);
     EXPECT_GT(det.quality.local_fit_count, 50);
-    const Errors e = CompareWithTruth(target_, det, camera_, cam_from_face);
+    EXPECT_GT(det.quality.sharpness.edge_rise_px, 1.0);  // 0.6-0.7 px blur: a ~2.3 px 10-90% rise
+    EXPECT_LT(det.quality.sharpness.edge_rise_px, 3.5);
+    const Errors e = CompareWithTruth(target, det, camera, cam_from_face);
+    EXPECT_LT(e.rms_px, 0.07);
+    EXPECT_LT(e.max_px, 0.2);
     sum_sq += e.rms_px * e.rms_px * det.corner_ids.size();
     n += static_cast<int>(det.corner_ids.size());
   }
-  EXPECT_LT(std::sqrt(sum_sq / std::max(n, 1)), 0.05);
+  const double rms_px = std::sqrt(sum_sq / std::max(n, 1));
+  std::printf("front face, %s: RMS %.4f px over %d corners (noise off)\n", CornerSourceName(expected_source), rms_px, n);
+  EXPECT_LT(rms_px, 0.05);
+}
+
+TEST_F(DefaultTargetDetection, FrontFaceCornersAtTheirTrueProjection) {
+  FrontFaceAccuracy(target_, camera_, DetectOptions(), CornerSource::kTagGuided, 6);
+}
+
+TEST_F(DefaultTargetDetection, FrontFaceCornersAtTheirTrueProjectionThroughOpenCvsGrid) {
+  FrontFaceAccuracy(target_, camera_, WithOpenCvGrid(), CornerSource::kOpenCvGrid, 4);
 }
 
 TEST_F(DefaultTargetDetection, UpsideDownAndQuarterTurnedViewsGetTheRightIds) {
@@ -157,16 +187,55 @@ TEST_F(DefaultTargetDetection, BackFaceIdsAreInTheBackFacesOwnFrame) {
 }
 
 // Part of the board outside the image: the corners in view, with right ids,
-// as long as one tag is seen.
+// when a single tag is seen.
 TEST_F(DefaultTargetDetection, PartialBoardWithOneTagInView) {
-  // Shifted right and down: the top-left of the board leaves the image.
-  const Pose cam_from_face = LookAtFace(target_, 200, 10, -10, 5, Eigen::Vector2d(-70, 40));
-  const FaceDetection det = DetectAndCheck(Face::kFront, cam_from_face, 0.05, 0.2);
+  // Slide the board right and down until one tag is left in view.
+  Pose cam_from_face;
+  bool found = false;
+  for (double dx = -40; dx >= -120 && !found; dx -= 10) {
+    cam_from_face = LookAtFace(target_, 200, 10, -10, 5, Eigen::Vector2d(dx, 55));
+    found = VisibleTags(target_, Face::kFront, camera_, cam_from_face, 3) == 1;
+  }
+  ASSERT_TRUE(found);
+  // Corners near the image's edge are refined in smaller windows (the
+  // window must stay inside the image), so the bound is looser than for
+  // whole boards: measured 0.054 px RMS here.
+  const FaceDetection det = DetectAndCheck(Face::kFront, cam_from_face, 0.07, 0.25);
   const int visible = VisibleCorners(target_, camera_, cam_from_face, 10);
-  EXPECT_LT(visible, 99);  // it really is partial
-  EXPECT_GE(det.quality.num_tags, 1);
-  EXPECT_GE(det.quality.num_corners, visible - 2);  // corners at the border may go either way
-  EXPECT_LT(det.quality.num_corners, 99);
+  EXPECT_LT(visible, 60);  // it really is partial
+  EXPECT_EQ(det.quality.num_tags, 1);
+  EXPECT_GE(det.quality.num_corners, visible);  // every corner 10 px inside, maybe some nearer the edge
+  EXPECT_LE(det.quality.num_corners, VisibleCorners(target_, camera_, cam_from_face, 0));
+}
+
+// A spread of random views like a calibration's (170-290 mm, tilts to 40
+// degrees, any turn, shifted so that many boards run out of the image),
+// both faces, 1 DN noise: every view with a tag in view is accepted and
+// every id is right (a wrong id is off by a square, > 25 px).
+TEST_F(DefaultTargetDetection, RandomPartialViewsOfBothFacesGetRightIds) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> distance(170, 290), tilt(-40, 40), turn(-180, 180), shift(-40, 40);
+  int accepted = 0, corners = 0;
+  for (int i = 0; i < 8; ++i) {
+    const Face face = i % 2 ? Face::kBack : Face::kFront;
+    const double d = distance(rng), rx = tilt(rng), ry = tilt(rng), rz = turn(rng), sx = shift(rng), sy = shift(rng);
+    const Pose cam_from_face = LookAtFace(target_, d, rx, ry, rz, Eigen::Vector2d(sx, sy));
+    SCOPED_TRACE(::testing::Message() << "view " << i);
+    SyntheticViewOptions noisy;
+    noisy.noise_sigma_dn = 1.0;
+    noisy.seed = i;
+    const DetectResult r = detector_.Detect(RenderFace(target_, face, camera_, cam_from_face, noisy));
+    if (VisibleTags(target_, face, camera_, cam_from_face, 3) == 0) continue;
+    ASSERT_EQ(r.faces.size(), 1u) << r.message;
+    EXPECT_EQ(r.faces[0].face, face);
+    const Errors e = CompareWithTruth(target_, r.faces[0], camera_, cam_from_face);
+    EXPECT_LT(e.max_px, 0.3);
+    EXPECT_GE(r.faces[0].quality.num_corners, VisibleCorners(target_, camera_, cam_from_face, 12));
+    ++accepted;
+    corners += r.faces[0].quality.num_corners;
+  }
+  EXPECT_GE(accepted, 6);
+  std::printf("random views: %d accepted, %d corners\n", accepted, corners);
 }
 
 TEST_F(DefaultTargetDetection, MirroredImageIsRejected) {

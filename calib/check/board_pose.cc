@@ -38,7 +38,7 @@ struct CornerResidual {
   }
 };
 
-bool SeedWithPnp(const Rig& rig, const Target& target, const CornerView& view, Pose* ref_from_front) {
+bool SeedWithPnp(const Rig& rig, const Target& target, const BoardObservation& view, Pose* ref_from_front) {
   if (view.corner_ids.size() < 6) return false;
   const Camera& cam = rig.camera(view.camera);
   std::vector<cv::Point3d> object;
@@ -90,13 +90,13 @@ Eigen::Matrix<double, 2, 6> PoseJacobian(const Camera& camera, const Pose& cam_f
 }  // namespace
 
 PredictionStatistics PredictionErrorStatistics(const Rig& rig, const Target& target,
-                                               const std::vector<const CornerView*>& pose_views,
-                                               const std::vector<double>& sigma_px, const CornerView& view,
+                                               const std::vector<const BoardObservation*>& pose_views,
+                                               const std::vector<double>& sigma_px, const BoardObservation& view,
                                                const Pose& ref_from_front) {
   // Information of the pose from the views it came from, each corner
   // weighted by its camera's noise.
   Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
-  for (const CornerView* v : pose_views) {
+  for (const BoardObservation* v : pose_views) {
     const Camera& cam = rig.camera(v->camera);
     const Pose cam_from_ref = rig.CamFromReference(v->camera);
     const double w = 1.0 / (sigma_px[v->camera] * sigma_px[v->camera]);
@@ -117,7 +117,7 @@ PredictionStatistics PredictionErrorStatistics(const Rig& rig, const Target& tar
   return {a_sigma.trace(), 2.0 * (a_sigma * a_sigma).trace()};
 }
 
-std::vector<Eigen::Vector2d> ReprojectionErrors(const Rig& rig, const Target& target, const CornerView& view,
+std::vector<Eigen::Vector2d> ReprojectionErrors(const Rig& rig, const Target& target, const BoardObservation& view,
                                        const Pose& ref_from_front) {
   const Camera& cam = rig.camera(view.camera);
   const Pose cam_from_front = rig.CamFromReference(view.camera) * ref_from_front;
@@ -128,10 +128,10 @@ std::vector<Eigen::Vector2d> ReprojectionErrors(const Rig& rig, const Target& ta
   return e;
 }
 
-BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target, const std::vector<const CornerView*>& views) {
+BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target, const std::vector<const BoardObservation*>& views) {
   BoardPoseEstimate out;
-  const CornerView* seed = nullptr;
-  for (const CornerView* v : views)
+  const BoardObservation* seed = nullptr;
+  for (const BoardObservation* v : views)
     if (!seed || v->corner_ids.size() > seed->corner_ids.size()) seed = v;
   if (!seed || !SeedWithPnp(rig, target, *seed, &out.ref_from_front)) return out;
 
@@ -139,7 +139,7 @@ BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target, const 
   const Eigen::Vector3d t0 = out.ref_from_front.translation_mm();
   double rt[6] = {r0.x(), r0.y(), r0.z(), t0.x(), t0.y(), t0.z()};
   ceres::Problem problem;
-  for (const CornerView* v : views) {
+  for (const BoardObservation* v : views) {
     const Pose cam_from_ref = rig.CamFromReference(v->camera);
     for (size_t k = 0; k < v->corner_ids.size(); ++k) {
       problem.AddResidualBlock(
@@ -162,7 +162,7 @@ BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target, const 
   if (!summary.IsSolutionUsable()) return out;
   out.ref_from_front = Pose::FromRotationVector({rt[0], rt[1], rt[2]}, {rt[3], rt[4], rt[5]});
   double ss = 0;
-  for (const CornerView* v : views)
+  for (const BoardObservation* v : views)
     for (const Eigen::Vector2d& e : ReprojectionErrors(rig, target, *v, out.ref_from_front)) {
       ss += e.squaredNorm();
       ++out.num_corners;

@@ -5,7 +5,7 @@
 
 #include <vector>
 
-#include "calib/check/corner_view.h"
+#include "calib/observations.h"
 #include "calib/core/rig.h"
 #include "targets/target.h"
 
@@ -20,11 +20,11 @@ struct BoardPoseEstimate {
 
 // `views` are all of one capture. Seeds with PnP from the view with the most
 // corners, then minimises reprojection error over every view (Ceres).
-BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target, const std::vector<const CornerView*>& views);
+BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target, const std::vector<const BoardObservation*>& views);
 
 // Reprojection residuals q_predicted - q (px, per corner) of `view` for a
 // given board pose.
-std::vector<Eigen::Vector2d> ReprojectionErrors(const Rig& rig, const Target& target, const CornerView& view,
+std::vector<Eigen::Vector2d> ReprojectionErrors(const Rig& rig, const Target& target, const BoardObservation& view,
                                        const Pose& ref_from_front);
 
 // Linearised statistics of the prediction error that a pose's own
@@ -42,8 +42,8 @@ struct PredictionStatistics {
   double var_ss_px4 = 0;
 };
 PredictionStatistics PredictionErrorStatistics(const Rig& rig, const Target& target,
-                                               const std::vector<const CornerView*>& pose_views,
-                                               const std::vector<double>& sigma_px, const CornerView& view,
+                                               const std::vector<const BoardObservation*>& pose_views,
+                                               const std::vector<double>& sigma_px, const BoardObservation& view,
                                                const Pose& ref_from_front);
 
 // A face's corner in the front-face frame.

@@ -50,7 +50,7 @@ struct Inputs {
   const Rig& rig;
   const Target& target;
   const CheckOptions& options;
-  std::map<int, std::vector<const CornerView*>> by_capture;
+  std::map<int, std::vector<const BoardObservation*>> by_capture;
   std::vector<double> sigma_px;        // per camera: calibration RMS
   std::vector<double> u_px;            // per camera: projection uncertainty, 1 sigma
 };
@@ -74,15 +74,15 @@ Consistency CameraConsistency(const Inputs& in, int c, const std::set<int>& trus
   double ss = 0, expected_ss = 0, var_ss = 0, depth_sum = 0;
   int captures = 0;
   for (const auto& [capture, views] : in.by_capture) {
-    std::vector<const CornerView*> mine, others;
-    for (const CornerView* v : views) {
+    std::vector<const BoardObservation*> mine, others;
+    for (const BoardObservation* v : views) {
       if (v->camera == c) mine.push_back(v);
       else if (trusted.count(v->camera)) others.push_back(v);
     }
     if (mine.empty() || others.empty()) continue;
     const BoardPoseEstimate pose = EstimateBoardPose(in.rig, in.target, others);
     if (!pose.ok) continue;
-    for (const CornerView* v : mine) {
+    for (const BoardObservation* v : mine) {
       for (const Eigen::Vector2d& e : ReprojectionErrors(in.rig, in.target, *v, pose.ref_from_front)) {
         ss += e.squaredNorm();
         ++out.corners;
@@ -127,7 +127,7 @@ Consistency CameraConsistency(const Inputs& in, int c, const std::set<int>& trus
 
 }  // namespace
 
-CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vector<CornerView>& views,
+CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vector<BoardObservation>& views,
                             const CheckOptions& options, const std::string& where) {
   options.Check();
   Inputs in{rig, target, options, {}, {}, {}};
@@ -142,7 +142,7 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
     in.sigma_px.push_back(it->second);
     in.u_px.push_back(Lookup(rig.provenance().uncertainties, "cam" + std::to_string(c) + "_projection_center_px", 0));
   }
-  for (const CornerView& v : views) {
+  for (const BoardObservation& v : views) {
     if (v.camera < 0 || v.camera >= rig.num_cameras()) {
       throw InputError(where, "a capture has camera " + std::to_string(v.camera) + ", which the rig does not have");
     }
@@ -212,9 +212,9 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
     double ss = 0;
     int n = 0;
     for (const auto& [capture, vs] : in.by_capture) {
-      for (const CornerView* l : vs) {
+      for (const BoardObservation* l : vs) {
         if (l->camera != mod.left_camera) continue;
-        for (const CornerView* r : vs) {
+        for (const BoardObservation* r : vs) {
           if (r->camera != mod.right_camera || r->face != l->face) continue;
           std::map<int, Eigen::Vector2d> right_q;
           for (size_t i = 0; i < r->corner_ids.size(); ++i) right_q[r->corner_ids[i]] = r->q_px[i];
@@ -271,8 +271,8 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
     for (int j = i + 1; j < rig.num_modules(); ++j) {
       std::vector<Eigen::Vector3d> dt, dr;
       for (const auto& [capture, vs] : in.by_capture) {
-        std::vector<const CornerView*> vi, vj;
-        for (const CornerView* v : vs) {
+        std::vector<const BoardObservation*> vi, vj;
+        for (const BoardObservation* v : vs) {
           const int m = ModuleOf(rig, v->camera);
           if (m == i) vi.push_back(v);
           if (m == j) vj.push_back(v);

@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "calib/check/corner_view.h"
+#include "calib/observations.h"
 #include "calib/core/rig.h"
 #include "targets/target.h"
 
@@ -56,7 +56,7 @@ struct CheckResult {
 // residuals the thresholds need, when there are too few captures, when a view
 // names a camera the rig does not have, or when the captures do not fit the
 // rig at all (another rig's captures).
-CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vector<CornerView>& views,
+CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vector<BoardObservation>& views,
                             const CheckOptions& options, const std::string& where);
 
 }  // namespace stereorig

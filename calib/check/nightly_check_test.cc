@@ -40,7 +40,7 @@ Rig StoredRig(const SimulatedRig& truth) {
 
 // Detections of `kCaptures` target poses between the modules, seen by the
 // (possibly bumped) true cameras.
-std::vector<CornerView> Observe(const SimulatedRig& truth, const Target& target, const Bump& bump, unsigned seed) {
+std::vector<BoardObservation> Observe(const SimulatedRig& truth, const Target& target, const Bump& bump, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0, kNoisePx);
   std::uniform_real_distribution<double> u(-1, 1);
@@ -61,7 +61,7 @@ std::vector<CornerView> Observe(const SimulatedRig& truth, const Target& target,
   }
   const Eigen::Vector3d center((target.corners_x() - 1) * 0.5 * target.square_size_mm(),
                                (target.corners_y() - 1) * 0.5 * target.square_size_mm(), 0);
-  std::vector<CornerView> views;
+  std::vector<BoardObservation> views;
   for (int k = 0; k < kCaptures; ++k) {
     // The board near the world origin, front face towards module 0, tilted.
     const Pose world_from_front =
@@ -71,7 +71,7 @@ std::vector<CornerView> Observe(const SimulatedRig& truth, const Target& target,
     const Pose ref_from_front = truth.world_from_module0.Inverse() * world_from_front;
     for (int c = 0; c < rig.num_cameras(); ++c) {
       const Face face = ModuleOfCameraIsZero(rig, c) ? Face::kFront : Face::kBack;
-      CornerView v{k, c, face, {}, {}};
+      BoardObservation v{k, c, face, {}, {}};
       const Pose face_from_front = face == Face::kFront ? Pose::Identity() : target.back_from_front();
       const Pose cam_from_face = cam_from_ref[c] * ref_from_front * face_from_front.Inverse();
       const Camera& cam = rig.camera(c);
@@ -156,7 +156,7 @@ TEST(NightlyCheck, BadInputIsRefused) {
   // The truth rig has no calibration residuals to set thresholds from.
   EXPECT_THROW(RunNightlyCheck(truth.rig, target, views, CheckOptions(), "rig.yaml"), InputError);
   // Too few captures.
-  std::vector<CornerView> few;
+  std::vector<BoardObservation> few;
   for (const auto& v : views)
     if (v.capture < 3) few.push_back(v);
   EXPECT_THROW(RunNightlyCheck(StoredRig(truth), target, few, CheckOptions(), "captures"), InputError);

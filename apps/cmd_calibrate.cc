@@ -1,0 +1,84 @@
+// `stereorig calibrate`: target captures + target file + layout -> rig file +
+// JSON report, through the three-stage engine (calib/calibrate.h). Exit 0 on
+// success, 2 on bad usage or bad input (one line naming the file and the
+// problem; nothing written).
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+
+#include "apps/cli_util.h"
+#include "apps/command.h"
+#include "calib/calibrate.h"
+#include "calib/capture_folder.h"
+#include "calib/layout_file.h"
+#include "targets/target_file.h"
+
+namespace stereorig {
+
+int RunCalibrate(int argc, char** argv) {
+  CLI::App app{
+      "Calibrate a multi-module stereo rig from captures of the (double-sided) target, in three stages: each "
+      "camera's intrinsics with mrcal (PnP seed, staged solve, outlier rejection, projection uncertainty), each "
+      "module's right_from_left as a joint solve, then the S matrix: Horn's absolute orientation between modules, "
+      "refined by one Ceres bundle adjustment over every capture and camera. A plain one-sided chessboard works "
+      "for a single module.\n\n"
+      "Captures: DIR/NNN/camK.png (or a dataset folder holding calibration/NNN/camK.png). Layout: which cameras "
+      "form each module, e.g.\n  modules:\n    - {name: module0, left: 0, right: 1, face: front}\n    - {name: "
+      "module1, left: 2, right: 3, face: back}\n('face' is optional; if given, a detection of the other face by "
+      "that module is refused).\n\n"
+      "Refuses with exit 2: too few views, all views fronto-parallel, a camera that never sees the board, images "
+      "of the wrong size, a face seen by the wrong module.\n\n"
+      "Example:\n  stereorig calibrate --captures data/calibration --target target.yaml --layout layout.yaml "
+      "--out rig.yaml --report report.json",
+      "stereorig calibrate"};
+  std::string captures, target_path, layout_path, out_path, report_path, cameramodels_dir;
+  CalibrationOptions options;
+  options.progress = true;
+  bool fixed_intrinsics = false;
+  app.add_option("--captures", captures, "captures folder: NNN/camK.png")->required();
+  app.add_option("--target", target_path, "target file (YAML, docs/targets.md)")->required();
+  app.add_option("--layout", layout_path, "layout file (YAML): the modules and their cameras")->required();
+  app.add_option("--out", out_path, "rig file to write (YAML)")->required();
+  app.add_option("--report", report_path, "JSON report to write (every figure of every stage)")->required();
+  app.add_option("--export-cameramodels", cameramodels_dir, "also write DIR/camK.cameramodel (mrcal format)");
+  app.add_option(
+         "--lensmodel", options.intrinsics.lensmodel,
+         "LENSMODEL_OPENCV5, LENSMODEL_OPENCV8 or LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=.._Ny=.._fov_x_deg=..")
+      ->capture_default_str();
+  app.add_option("--focal", options.intrinsics.seed_focal_px, "rough focal length for the PnP seed, px (0: estimate)")
+      ->capture_default_str();
+  app.add_option("--uncertainty-range", options.intrinsics.uncertainty_range_mm,
+                 "range of the points whose projection uncertainty is reported, mm")
+      ->capture_default_str();
+  app.add_option("--huber", options.system.huber_px, "stage 3 robust loss scale, px")->capture_default_str();
+  app.add_flag("--fixed-intrinsics", fixed_intrinsics, "hold the intrinsics at stage 2's values in stage 3");
+  if (auto rc = ParseArgs(app, argc, argv)) return *rc;
+  options.system.refine_intrinsics = !fixed_intrinsics;
+  options.Check();
+
+  const Target target = ReadTargetFile(target_path);
+  CalibrationInput input;
+  input.target = TargetGeometryFromTarget(target);
+  input.modules = ReadLayoutFile(layout_path);
+  input.source = captures;
+  int num_cameras = 0;
+  for (const ModuleLayout& m : input.modules)
+    num_cameras = std::max({num_cameras, m.left_camera + 1, m.right_camera + 1});
+  DetectedCaptures detected = DetectCaptureFolder(captures, target, num_cameras, DetectOptions(), true);
+  input.cameras = detected.cameras;
+  input.observations = std::move(detected.observations);
+  std::fprintf(stderr, "calibrate: %d captures, %zu accepted views\n", detected.num_captures,
+               input.observations.size());
+
+  const CalibrationResult result = Calibrate(input, options);
+  WriteCalibrationOutputs(result, out_path, report_path);
+  if (!cameramodels_dir.empty()) {
+    std::filesystem::create_directories(cameramodels_dir);
+    ExportCameramodels(result.rig, cameramodels_dir);
+  }
+  std::printf("%s", SummaryText(result.report).c_str());
+  std::printf("wrote %s and %s\n", out_path.c_str(), report_path.c_str());
+  return 0;
+}
+
+}  // namespace stereorig

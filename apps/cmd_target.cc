@@ -1,0 +1,47 @@
+// `stereorig target`: the printable target (SVG, true scale), and optionally
+// its target file to start from.
+#include <cstdio>
+
+#include "apps/cli_util.h"
+#include "apps/command.h"
+#include "calib/core/input_error.h"
+#include "targets/board_svg.h"
+#include "targets/target_file.h"
+
+namespace stereorig {
+
+int RunTarget(int argc, char** argv) {
+  CLI::App app{
+      "Write a printable target at true scale: an SVG in millimetres with both faces side by side (front left, "
+      "back right), each face's name and tag IDs, markers at corner 0's row and column, and a 100 mm scale bar. "
+      "Print at 100 % (actual size, no fit-to-page), then measure the bar and the squares (docs/targets.md).\n\n"
+      "Without --target, the embedded default target (11x9 inner corners of 9 mm, tag36h11, front IDs 0-7, back "
+      "IDs 100-107). --write-target saves the target file used, to edit and measure against.\n\n"
+      "Examples:\n"
+      "  stereorig target --out board.svg --write-target board.yaml\n"
+      "  stereorig target --target my_board.yaml --face back --out back.svg",
+      "stereorig target"};
+  std::string target_path, out_path, write_target, faces = "both";
+  app.add_option("--target", target_path, "target file (YAML, docs/targets.md); default: the embedded default");
+  app.add_option("--out", out_path, "SVG to write (atomically)")->required();
+  app.add_option("--face", faces, "which faces to draw: both, front or back")
+      ->check(CLI::IsMember({"both", "front", "back"}))
+      ->capture_default_str();
+  app.add_option("--write-target", write_target, "also write the target file used here (YAML)");
+  if (auto rc = ParseArgs(app, argc, argv)) return *rc;
+
+  const Target target = target_path.empty() ? DefaultTarget() : ReadTargetFile(target_path);
+  BoardSvgOptions options;
+  options.faces = faces == "front" ? SvgFaces::kFront : faces == "back" ? SvgFaces::kBack : SvgFaces::kBoth;
+  const BoardSvg svg = MakeBoardSvg(target, options);
+  WriteBoardSvg(svg, out_path);
+  std::printf("wrote %s: page %.1f x %.1f mm; print at 100 %% and check that the bar measures %.1f mm\n",
+              out_path.c_str(), svg.width_mm, svg.height_mm, options.scale_bar_mm);
+  if (!write_target.empty()) {
+    WriteTargetFile(target, write_target);
+    std::printf("wrote %s\n", write_target.c_str());
+  }
+  return kExitOk;
+}
+
+}  // namespace stereorig

@@ -1,0 +1,84 @@
+#include "calib/capture_folder.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+
+#include "calib/core/input_error.h"
+
+namespace stereorig {
+
+namespace fs = std::filesystem;
+
+DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& target, int num_cameras,
+                                     const DetectOptions& options, bool progress) {
+  fs::path dir(dir_in);
+  if (!fs::is_directory(dir)) throw InputError(dir_in, "no such captures folder");
+  if (fs::is_directory(dir / "calibration")) dir /= "calibration";
+  std::vector<fs::path> captures;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.is_directory()) captures.push_back(e.path());
+  std::sort(captures.begin(), captures.end());
+  if (captures.empty()) throw InputError(dir.string(), "holds no capture folders (expected NNN/camK.png)");
+
+  DetectedCaptures out;
+  out.num_captures = static_cast<int>(captures.size());
+  out.cameras.resize(num_cameras);
+  for (int c = 0; c < num_cameras; ++c) out.cameras[c].name = "cam" + std::to_string(c);
+  const TargetDetector detector(target, options);
+  for (size_t n = 0; n < captures.size(); ++n) {
+    const std::string name = captures[n].filename().string();
+    const bool numeric = !name.empty() && std::all_of(name.begin(), name.end(), ::isdigit);
+    const int capture = numeric ? std::stoi(name) : static_cast<int>(n);
+    std::string line = "detect " + name + ":";
+    for (int c = 0; c < num_cameras; ++c) {
+      const fs::path image = captures[n] / ("cam" + std::to_string(c) + ".png");
+      if (!fs::exists(image))
+        throw InputError(image.string(), "missing (each capture needs camK.png for every camera)");
+      const cv::Mat grey = cv::imread(image.string(), cv::IMREAD_GRAYSCALE);
+      if (grey.empty()) throw InputError(image.string(), "cannot be read as an image");
+      CameraSpec& spec = out.cameras[c];
+      if (spec.width_px == 0) {
+        spec.width_px = grey.cols;
+        spec.height_px = grey.rows;
+      } else if (spec.width_px != grey.cols || spec.height_px != grey.rows) {
+        throw InputError(image.string(), "image of the wrong size: " + std::to_string(grey.cols) + "x" +
+                                             std::to_string(grey.rows) + ", but cam" + std::to_string(c) +
+                                             "'s other images are " + std::to_string(spec.width_px) + "x" +
+                                             std::to_string(spec.height_px));
+      }
+      const DetectResult r = detector.Detect(grey);
+      ImageDetectionLog log{capture, c, image.string(), false, Face::kFront, 0, 0, r.message};
+      if (r.reason == RejectReason::kNone && !r.faces.empty()) {
+        const FaceDetection& f = r.faces[0];
+        // A corner reported outside the image cannot be a real detection
+        // (the detector extrapolated it): drop it, and say so.
+        BoardObservation obs{capture, c, f.face, {}, {}};
+        for (size_t i = 0; i < f.corner_ids.size(); ++i) {
+          const Eigen::Vector2d& q = f.q_px[i];
+          if (q.x() < -0.5 || q.y() < -0.5 || q.x() > grey.cols - 0.5 || q.y() > grey.rows - 0.5) {
+            ++log.num_outside;
+            continue;
+          }
+          obs.corner_ids.push_back(f.corner_ids[i]);
+          obs.q_px.push_back(q);
+        }
+        log.accepted = true;
+        log.face = f.face;
+        log.num_corners = static_cast<int>(obs.corner_ids.size());
+        log.reason.clear();
+        line += " cam" + std::to_string(c) + " " + FaceName(f.face) + " " + std::to_string(log.num_corners);
+        if (log.num_outside) line += " (" + std::to_string(log.num_outside) + " outside the image dropped)";
+        out.observations.push_back(std::move(obs));
+      } else {
+        line += " cam" + std::to_string(c) + " -(" + RejectReasonName(r.reason) + ")";
+      }
+      out.log.push_back(log);
+    }
+    if (progress) std::fprintf(stderr, "%s\n", line.c_str());
+  }
+  return out;
+}
+
+}  // namespace stereorig

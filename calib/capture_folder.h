@@ -1,0 +1,42 @@
+// Target captures on disk -> corner observations for the engine.
+//
+// A captures folder holds one sub-folder per capture (sorted by name; a
+// numeric name such as 007 is the capture's index), each with one 8-bit grey
+// image per camera named camK.png (K = global camera index), as
+// docs/formats.md fixes. A dataset folder written by `stereorig simulate`
+// works too: its calibration/ sub-folder is used.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "calib/observations.h"
+#include "targets/detect.h"
+
+namespace stereorig {
+
+struct ImageDetectionLog {
+  int capture = -1;
+  int camera = -1;
+  std::string path;
+  bool accepted = false;
+  Face face = Face::kFront;
+  int num_corners = 0;
+  int num_outside = 0;  // corners the detector placed outside the image, dropped here
+  std::string reason;   // why it was rejected (empty if accepted)
+};
+
+struct DetectedCaptures {
+  std::vector<CameraSpec> cameras;  // (num_cameras,) names camK and the images' size
+  std::vector<BoardObservation> observations;
+  std::vector<ImageDetectionLog> log;  // one entry per image
+  int num_captures = 0;
+};
+
+// Detects the target in every image. Throws InputError (naming the file) on
+// a missing folder or image, an unreadable image, or images of one camera
+// with different sizes. `progress`: one line per capture on stderr.
+DetectedCaptures DetectCaptureFolder(const std::string& dir, const Target& target, int num_cameras,
+                                     const DetectOptions& options, bool progress);
+
+}  // namespace stereorig

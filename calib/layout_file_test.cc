@@ -1,0 +1,31 @@
+#include "calib/layout_file.h"
+
+#include <gtest/gtest.h>
+
+#include "calib/core/input_error.h"
+
+namespace stereorig {
+namespace {
+
+TEST(LayoutFile, ReadsModulesAndFaces) {
+  const auto m = ParseLayoutYaml(
+      "modules:\n  - {name: module0, left: 0, right: 1}\n  - {name: module1, left: 2, right: 3, face: back}\n", "t");
+  ASSERT_EQ(m.size(), 2u);
+  EXPECT_EQ(m[0].name, "module0");
+  EXPECT_EQ(m[1].left_camera, 2);
+  EXPECT_EQ(m[1].right_camera, 3);
+  EXPECT_FALSE(m[0].face.has_value());
+  ASSERT_TRUE(m[1].face.has_value());
+  EXPECT_EQ(*m[1].face, Face::kBack);
+}
+
+TEST(LayoutFile, RejectsBadInput) {
+  EXPECT_THROW(ParseLayoutYaml("modules:\n  - {name: m, left: 0, right: 1, fcae: back}\n", "t"), InputError);
+  EXPECT_THROW(ParseLayoutYaml("modules:\n  - {name: m, left: 0, right: 1, face: side}\n", "t"), InputError);
+  EXPECT_THROW(ParseLayoutYaml("modules:\n  - {name: m, left: 1, right: 1}\n", "t"), InputError);
+  EXPECT_THROW(ParseLayoutYaml("modules: []\n", "t"), InputError);
+  EXPECT_THROW(ParseLayoutYaml("modules:\n  - {name: m, left: 0, right: 1}\nextra: 1\n", "t"), InputError);
+}
+
+}  // namespace
+}  // namespace stereorig

@@ -1,0 +1,91 @@
+#include "datasets/sim_spec.h"
+
+#include <gtest/gtest.h>
+
+#include "calib/core/input_error.h"
+#include "datasets/default_rig.h"
+#include "datasets/sim_test_util.h"
+
+namespace stereorig {
+namespace {
+
+std::string ErrorOf(const std::string& text) {
+  try {
+    ParseSimSpecYaml(text, "spec.yaml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string Replace(std::string text, const std::string& from, const std::string& to) {
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+TEST(SimSpec, DefaultSpecBuildsExactlyTheDefaultRig) {
+  const SpecRig built = BuildSpecRig(DefaultSimSpec());
+  const SimulatedRig ref = MakeDefaultRig();
+  ASSERT_EQ(built.sim.rig.num_cameras(), 4);
+  ASSERT_EQ(built.sim.rig.num_modules(), 2);
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(built.sim.rig.camera(i).intrinsics(), ref.rig.camera(i).intrinsics());
+  for (int m = 0; m < 2; ++m) {
+    const Pose d = ref.rig.module(m).right_from_left.Inverse() * built.sim.rig.module(m).right_from_left;
+    EXPECT_LT(d.AngleDeg(), 1e-12);
+    EXPECT_LT(d.DistanceMm(), 1e-12);
+  }
+  const Pose d01 = ref.rig.S(0, 1).Inverse() * built.sim.rig.S(0, 1);
+  EXPECT_LT(d01.AngleDeg(), 1e-9);
+  EXPECT_LT(d01.DistanceMm(), 1e-9);
+  // The seed's geometry: the left cameras' centres 400 mm apart along z,
+  // minus the verging offsets; the projector at 200 mm from the origin.
+  EXPECT_NEAR(built.projector_distance_mm[0], 200.0, 1e-12);
+}
+
+TEST(SimSpec, YamlRoundTripIsLossless) {
+  SimSpec s = SmallRingSpec(3, 4, 7);
+  s.render.noise = false;
+  s.scenes.names = {"tuber", "cup"};
+  s.calibration.scale_error_ppm = 150;
+  const std::string text = SimSpecToYaml(s);
+  const SimSpec back = ParseSimSpecYaml(text, "x");
+  EXPECT_EQ(SimSpecToYaml(back), text);
+  EXPECT_EQ(back.modules.size(), 3u);
+  EXPECT_EQ(back.calibration.captures, 7);
+  EXPECT_FALSE(back.render.noise);
+  EXPECT_EQ(back.scenes.names, (std::vector<std::string>{"tuber", "cup"}));
+}
+
+TEST(SimSpec, BadSpecsNameTheKey) {
+  const std::string good = SimSpecToYaml(DefaultSimSpec());
+  EXPECT_EQ(ErrorOf(good), "");
+  EXPECT_NE(ErrorOf(Replace(good, "render:\n", "render:\n  bogus_knob: 1\n")).find("bogus_knob"), std::string::npos);
+  EXPECT_NE(ErrorOf(Replace(good, "samples_per_axis: 2", "samples_per_axis: 1")).find("samples_per_axis"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(Replace(good, "lines: 51", "lines: many")).find("lines"), std::string::npos);
+  EXPECT_NE(ErrorOf(Replace(good, "fan_angle_deg: 23", "fan_angle_deg: -3")).find("fan_angle_deg"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(Replace(good, "names: [cup,", "names: [mug,")).find("mug"), std::string::npos);
+  // Wrong number of intrinsics for the model: names the camera.
+  EXPECT_NE(ErrorOf(Replace(good, "intrinsics: [1024.98", "intrinsics: [1, 1024.98")).find("left_camera"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(Replace(good, "format: stereorig-sim-spec", "format: other")).find("format"), std::string::npos);
+}
+
+TEST(SimSpec, RingsOfOneTwoThreeModulesBuild) {
+  for (int m = 1; m <= 3; ++m) {
+    const SpecRig r = BuildSpecRig(SmallRingSpec(m, 4, 1));
+    EXPECT_EQ(r.sim.rig.num_modules(), m);
+    EXPECT_EQ(r.sim.rig.num_cameras(), 2 * m);
+    std::string why;
+    EXPECT_TRUE(r.sim.rig.CheckS(&why)) << why;
+    if (m == 3) {
+      EXPECT_NEAR(r.sim.rig.S(0, 1).AngleDeg(), 120.0, 1e-9);  // modules at 120 degrees
+    }
+  }
+}
+
+}  // namespace
+}  // namespace stereorig

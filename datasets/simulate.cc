@@ -1,0 +1,414 @@
+#include "datasets/simulate.h"
+
+#include <unistd.h>
+
+#include <Eigen/Geometry>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <thread>
+
+#include "calib/core/input_error.h"
+#include "calib/core/rig_file.h"
+#include "datasets/calibration_poses.h"
+#include "datasets/camera_rays.h"
+#include "datasets/render.h"
+#include "datasets/rng.h"
+#include "datasets/scene_objects.h"
+#include "datasets/target_render.h"
+#include "targets/target_file.h"
+
+namespace stereorig {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Stream kinds: every random draw of the dataset comes from StreamKey({seed, kind, ...}).
+enum : uint64_t {
+  kKeyPoses = 1,
+  kKeyStray = 2,
+  kKeyCalibSensor = 3,
+  kKeyScene = 4,
+  kKeyPassiveSensor = 5,
+  kKeyActiveSensor = 6,
+  kKeySpeckle = 7,
+  kKeyBump = 8,
+};
+
+std::string Matrix4Yaml(const Pose& p, const std::string& indent) {
+  const Eigen::Matrix4d m = p.ToMatrix4();
+  std::string s;
+  for (int r = 0; r < 4; ++r) {
+    s += indent + "- [";
+    for (int c = 0; c < 4; ++c) s += (c ? ", " : "") + FormatDouble(m(r, c));
+    s += "]\n";
+  }
+  return s;
+}
+
+std::string Vec3Yaml(const Eigen::Vector3d& v) {
+  std::ostringstream o;
+  o << '[' << FormatDouble(v.x()) << ", " << FormatDouble(v.y()) << ", " << FormatDouble(v.z()) << ']';
+  return o.str();
+}
+
+void WriteText(const fs::path& path, const std::string& text) {
+  std::ofstream f(path, std::ios::binary);
+  f << text;
+  if (!f) throw InputError(path.string(), "cannot write");
+}
+
+void WriteImage(const fs::path& path, const cv::Mat& image) {
+  std::vector<int> params;
+  if (path.extension() == ".png") params = {cv::IMWRITE_PNG_COMPRESSION, 1};
+  if (!cv::imwrite(path.string(), image, params)) throw InputError(path.string(), "cannot write image");
+}
+
+void WritePly(const fs::path& path, const std::vector<Eigen::Vector3d>& points) {
+  std::ofstream f(path, std::ios::binary);
+  f << "ply\nformat binary_little_endian 1.0\ncomment stereorig simulator: true surface, reference frame "
+       "(module 0), mm\nelement vertex "
+    << points.size() << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  std::vector<float> buf(3 * points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    for (int a = 0; a < 3; ++a) buf[3 * i + a] = static_cast<float>(points[i][a]);
+  }
+  f.write(reinterpret_cast<const char*>(buf.data()), static_cast<std::streamsize>(buf.size() * sizeof(float)));
+  if (!f) throw InputError(path.string(), "cannot write");
+}
+
+// Runs f(0..n-1) on `threads` threads; rethrows the first exception.
+void ParallelFor(int n, int threads, const std::function<void(int)>& f) {
+  std::atomic<int> next{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  auto worker = [&] {
+    for (int i = next++; i < n; i = next++) {
+      try {
+        f(i);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+        next = n;
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 0; t < std::max(1, threads); ++t) pool.emplace_back(worker);
+  for (std::thread& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+}
+
+// The true rig from each camera's world pose (module frame = left camera).
+Rig RigFromWorldPoses(const Rig& like, const std::vector<Pose>& world_from_camera) {
+  std::vector<StereoModule> modules = like.modules();
+  std::vector<Pose> module0_from_module;
+  const Pose& world_from_module0 = world_from_camera[like.module(0).left_camera];
+  for (StereoModule& m : modules) {
+    m.right_from_left = world_from_camera[m.right_camera].Inverse() * world_from_camera[m.left_camera];
+    module0_from_module.push_back(world_from_module0.Inverse() * world_from_camera[m.left_camera]);
+  }
+  Rig rig(like.cameras(), like.camera_names(), modules, module0_from_module);
+  rig.provenance() = like.provenance();
+  return rig;
+}
+
+// A random unit vector from the bump stream.
+Eigen::Vector3d RandomAxis(Rng* rng) {
+  Eigen::Vector3d v;
+  do {
+    v = Eigen::Vector3d(rng->Uniform(-1, 1), rng->Uniform(-1, 1), rng->Uniform(-1, 1));
+  } while (v.norm() > 1 || v.norm() < 0.1);
+  return v.normalized();
+}
+
+std::string Num3(int i) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "%03d", i);
+  return buf;
+}
+
+class Progress {
+ public:
+  Progress(const std::function<void(const std::string&)>& sink, int total) : sink_(sink), total_(total) {}
+  void Done(const std::string& what) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++done_;
+    const int pct = total_ ? 100 * done_ / total_ : 100;
+    if (sink_ && (pct / 5 != last_ / 5 || done_ == total_)) {
+      last_ = pct;
+      sink_("[" + std::to_string(pct) + "%] " + std::to_string(done_) + "/" + std::to_string(total_) + " jobs (" +
+            what + ")");
+    }
+  }
+
+ private:
+  std::function<void(const std::string&)> sink_;
+  int total_, done_ = 0, last_ = -1;
+  std::mutex mutex_;
+};
+
+}  // namespace
+
+void SimulateOptions::Check() const {
+  if (out_dir.empty()) throw InputError("--out", "an output folder is required");
+  if (threads < 0) throw InputError("--threads", "must not be negative");
+  if (calibration_captures < -1 || calibration_captures > 999) {
+    throw InputError("--calibration-captures", "must be in [0, 999]");
+  }
+  if (!(surface_spacing_mm > 0 && surface_spacing_mm <= 0.2)) {
+    throw InputError("surface_spacing_mm", "must be in (0, 0.2]");
+  }
+  if (bump.camera >= 0 && bump.module >= 0) throw InputError("--bump-camera", "bump a camera or a module, not both");
+  if (std::abs(bump.rotation_deg) > 10) throw InputError("--bump-rotation-deg", "must be within +-10");
+  if (std::abs(bump.translation_mm) > 10) throw InputError("--bump-translation-mm", "must be within +-10");
+}
+
+SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options) {
+  const auto t_start = std::chrono::steady_clock::now();
+  options.Check();
+  SimSpec spec = spec_in;
+  if (options.calibration_captures >= 0) spec.calibration.captures = options.calibration_captures;
+  if (!options.scenes) spec.scenes.names.clear();
+  spec.Check();
+  const int threads =
+      options.threads > 0 ? options.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  auto say = [&](const std::string& s) {
+    if (options.progress) options.progress(s);
+  };
+  const uint64_t seed = options.seed;
+
+  // --- the true rig, bumped if asked
+  SpecRig sr = BuildSpecRig(spec);
+  const int num_cameras = sr.sim.rig.num_cameras();
+  std::string bump_yaml = "bump: none\n";
+  if (options.bump.Any()) {
+    const RigBump& b = options.bump;
+    Rng rng(StreamKey({seed, kKeyBump}));
+    const Eigen::Vector3d axis = RandomAxis(&rng), dir = RandomAxis(&rng);
+    const Pose delta(Eigen::AngleAxisd(b.rotation_deg * M_PI / 180.0, axis).toRotationMatrix(),
+                     b.translation_mm * dir);  // in the moved camera's / module's own frame
+    if (b.camera >= 0) {
+      if (b.camera >= num_cameras) throw InputError("--bump-camera", "no camera " + std::to_string(b.camera));
+      sr.world_from_camera[b.camera] = sr.world_from_camera[b.camera] * delta;
+    } else {
+      if (b.module >= sr.sim.rig.num_modules()) throw InputError("--bump-module", "no module " + std::to_string(b.module));
+      const StereoModule& m = sr.sim.rig.module(b.module);
+      const Pose world_from_module = sr.world_from_camera[m.left_camera];
+      const Pose moved = world_from_module * delta * world_from_module.Inverse();  // world_from_world'
+      sr.world_from_camera[m.left_camera] = moved * sr.world_from_camera[m.left_camera];
+      sr.world_from_camera[m.right_camera] = moved * sr.world_from_camera[m.right_camera];
+      sr.world_from_projector[b.module] = moved * sr.world_from_projector[b.module];
+    }
+    sr.sim.rig = RigFromWorldPoses(sr.sim.rig, sr.world_from_camera);
+    sr.sim.world_from_module0 = sr.world_from_camera[sr.sim.rig.module(0).left_camera];
+    std::ostringstream o;
+    o << "bump:\n"
+      << "  camera: " << b.camera << "\n  module: " << b.module << "\n"
+      << "  rotation_deg: " << FormatDouble(b.rotation_deg) << "\n  rotation_axis: " << Vec3Yaml(axis) << "\n"
+      << "  translation_mm: " << FormatDouble(b.translation_mm) << "\n  translation_direction: " << Vec3Yaml(dir)
+      << "\n  frame: \"the moved camera's (or the module's left camera's) own frame, before the move\"\n";
+    bump_yaml = o.str();
+  }
+  const Rig& rig = sr.sim.rig;
+  const Pose module0_from_world = sr.sim.world_from_module0.Inverse();
+  sr.sim.rig.provenance().input = "stereorig simulate, seed " + std::to_string(seed);
+
+  const Target target = spec.calibration.target == "default" ? DefaultTarget() : ReadTargetFile(spec.calibration.target);
+  const PhysicalBoard board = MakePhysicalBoard(target, spec.calibration);
+  const std::vector<LaserProjector> projectors =
+      MakeProjectors(spec, sr.world_from_projector, sr.projector_distance_mm);
+
+  // --- the output folder: a sibling temporary, renamed at the end
+  const fs::path out = fs::absolute(fs::path(options.out_dir)).lexically_normal();
+  const fs::path parent = out.parent_path();
+  std::error_code ec;
+  fs::create_directories(parent, ec);
+  if (ec) throw InputError(parent.string(), "cannot create folder: " + ec.message());
+  if (fs::exists(out)) {
+    if (!fs::is_directory(out)) throw InputError(out.string(), "exists and is not a folder");
+    if (!fs::is_empty(out) && !fs::exists(out / "spec.yaml")) {
+      throw InputError(out.string(), "exists and is not a stereorig dataset (no spec.yaml); refusing to replace it");
+    }
+  }
+  const fs::path tmp = parent / ("." + out.filename().string() + ".tmp-" + std::to_string(getpid()));
+  fs::remove_all(tmp, ec);
+  struct Cleanup {
+    fs::path path;
+    bool keep = false;
+    ~Cleanup() {
+      std::error_code e;
+      if (!keep) fs::remove_all(path, e);
+    }
+  } cleanup{tmp};
+  fs::create_directories(tmp / "truth", ec);
+  if (ec) throw InputError(tmp.string(), "cannot create folder: " + ec.message());
+
+  // --- ray tables
+  const auto t_rays = std::chrono::steady_clock::now();
+  say("unprojecting the ray tables of " + std::to_string(num_cameras) + " cameras");
+  std::vector<std::unique_ptr<CameraRays>> rays;
+  for (int i = 0; i < num_cameras; ++i) rays.push_back(std::make_unique<CameraRays>(rig.camera(i), threads));
+  const double rays_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_rays).count();
+  std::vector<cv::Mat> stray;
+  for (int i = 0; i < num_cameras; ++i) {
+    stray.push_back(StrayLight(rig.camera(i).imager_width_px(), rig.camera(i).imager_height_px(), spec.render,
+                               StreamKey({seed, kKeyStray, static_cast<uint64_t>(i)})));
+  }
+
+  // --- calibration poses and scenes
+  const int captures = spec.calibration.captures;
+  const std::vector<Pose> poses = MakeCalibrationPoses(spec.calibration, board, rig.cameras(), sr.world_from_camera,
+                                                       StreamKey({seed, kKeyPoses}));
+  std::vector<Scene> scenes;
+  for (size_t s = 0; s < spec.scenes.names.size(); ++s) {
+    scenes.push_back(MakeScene(spec.scenes.names[s], spec.scenes, spec.render,
+                               StreamKey({seed, kKeyScene, static_cast<uint64_t>(s)})));
+  }
+  for (int k = 0; k < captures; ++k) fs::create_directories(tmp / "calibration" / Num3(k));
+  for (const Scene& s : scenes) {
+    fs::create_directories(tmp / "scenes" / s.name / "active");
+    fs::create_directories(tmp / "scenes" / s.name / "passive");
+    fs::create_directories(tmp / "truth" / "scenes" / s.name);
+  }
+
+  // --- render: one job per (scene, camera), one per scene's surface truth,
+  // one per (capture, camera). Scenes first: they are the slowest.
+  const int num_scene_jobs = static_cast<int>(scenes.size()) * (num_cameras + 1);
+  const int num_jobs = num_scene_jobs + captures * num_cameras;
+  say("rendering " + std::to_string(captures) + " calibration captures and " + std::to_string(scenes.size()) +
+      " scenes x " + std::to_string(num_cameras) + " cameras on " + std::to_string(threads) + " threads");
+  Progress progress(options.progress, num_jobs);
+  std::atomic<int> images{0};
+  ParallelFor(num_jobs, threads, [&](int job) {
+    if (job < num_scene_jobs) {
+      const int s = job / (num_cameras + 1), cam = job % (num_cameras + 1) - 1;
+      const Scene& scene = scenes[s];
+      const fs::path truth = tmp / "truth" / "scenes" / scene.name;
+      if (cam < 0) {
+        std::vector<Eigen::Vector3d> pts = SampleSceneSurface(scene, options.surface_spacing_mm);
+        for (Eigen::Vector3d& p : pts) p = module0_from_world * p;
+        WritePly(truth / "surface.ply", pts);
+        progress.Done(scene.name + " surface");
+        return;
+      }
+      const std::string name = "cam" + std::to_string(cam);
+      const SceneRadiance rad = RenderScene(*rays[cam], sr.world_from_camera[cam], scene, projectors, spec.render);
+      const uint64_t c = static_cast<uint64_t>(cam), si = static_cast<uint64_t>(s);
+      const cv::Mat passive = SensorImage(rad.passive, stray[cam], spec.render, StreamKey({seed, kKeyPassiveSensor, si, c}));
+      const cv::Mat speckle = SpeckleField(rad.laser.cols, rad.laser.rows, spec.render, StreamKey({seed, kKeySpeckle, si, c}));
+      const cv::Mat active_radiance = rad.passive + rad.laser.mul(speckle);
+      const cv::Mat active = SensorImage(active_radiance, stray[cam], spec.render, StreamKey({seed, kKeyActiveSensor, si, c}));
+      WriteImage(tmp / "scenes" / scene.name / "passive" / (name + ".png"), passive);
+      WriteImage(tmp / "scenes" / scene.name / "active" / (name + ".png"), active);
+      WriteImage(truth / ("depth_" + name + ".tiff"), rad.depth);
+      WriteImage(truth / ("id_" + name + ".png"), rad.id);
+      images += 2;
+      progress.Done(scene.name + " " + name);
+      return;
+    }
+    const int k = (job - num_scene_jobs) / num_cameras, cam = (job - num_scene_jobs) % num_cameras;
+    const cv::Mat radiance = RenderTargetRadiance(*rays[cam], sr.world_from_camera[cam], poses[k], board, spec.render);
+    const cv::Mat image = SensorImage(radiance, stray[cam], spec.render,
+                                      StreamKey({seed, kKeyCalibSensor, static_cast<uint64_t>(k), static_cast<uint64_t>(cam)}));
+    WriteImage(tmp / "calibration" / Num3(k) / ("cam" + std::to_string(cam) + ".png"), image);
+    ++images;
+    progress.Done("calibration " + Num3(k));
+  });
+
+  // --- the small files
+  WriteText(tmp / "spec.yaml", SimSpecToYaml(spec));
+  WriteTargetFile(target, (tmp / "target.yaml").string());
+  {
+    std::ostringstream o;
+    o << "# stereorig layout: which cameras form each stereo module (global camera indices).\nmodules:\n";
+    for (const StereoModule& m : rig.modules()) {
+      o << "  - {name: " << m.name << ", left: " << m.left_camera << ", right: " << m.right_camera << "}\n";
+    }
+    WriteText(tmp / "layout.yaml", o.str());
+  }
+  WriteRigFile(sr.sim.rig, (tmp / "truth" / "rig.yaml").string());
+  {
+    std::ostringstream o;
+    o << "# True target poses of the calibration captures. Frame: module 0 (truth/rig.yaml), mm.\n"
+      << "format: stereorig-sim-calibration-poses\nversion: 1\n"
+      << "board:\n"
+      << "  scale: " << FormatDouble(board.scale) << "   # printed / nominal, about each face's first inner corner\n"
+      << "  bow_mm: " << FormatDouble(board.bow_mm) << "   # front face bulges towards its viewer at the centre\n"
+      << "  true_back_from_front:\n"
+      << Matrix4Yaml(board.true_back_from_front, "    ") << "captures:\n";
+    for (int k = 0; k < captures; ++k) {
+      o << "  - index: " << k << "\n    folder: calibration/" << Num3(k) << "\n    module0_from_front:\n"
+        << Matrix4Yaml(module0_from_world * poses[k], "      ") << "    cameras:\n";
+      for (int cam = 0; cam < num_cameras; ++cam) {
+        const Face face = target.double_sided() ? FaceSeen(sr.world_from_camera[cam], poses[k]) : Face::kFront;
+        o << "      - {camera: " << cam << ", face: " << FaceName(face)
+          << ", corners_in_view: " << CornersInView(rig.camera(cam), sr.world_from_camera[cam], poses[k], board)
+          << "}\n";
+      }
+    }
+    WriteText(tmp / "truth" / "calibration_poses.yaml", o.str());
+  }
+  for (const Scene& scene : scenes) {
+    std::ostringstream o;
+    o << "# Analytic truth of scene '" << scene.name << "'. Frame: module 0 (truth/rig.yaml), mm.\n"
+      << "format: stereorig-sim-object\nversion: 1\nscene: " << scene.name << "\nobjects:\n";
+    for (const SceneObject& obj : scene.objects) {
+      const Pose module0_from_object = module0_from_world * obj.world_from_object;
+      o << "  - id: " << obj.id << "\n    type: " << obj.type << "\n    description: \"" << obj.description
+        << "\"\n    albedo: " << FormatDouble(obj.albedo) << "\n    module0_from_object:\n"
+        << Matrix4Yaml(module0_from_object, "      ");
+      if (obj.type == "sphere") o << "    center_mm: " << Vec3Yaml(module0_from_object.translation_mm()) << "\n";
+      o << "    parameters:\n";
+      std::istringstream lines(obj.parameters_yaml);
+      for (std::string line; std::getline(lines, line);) o << "      " << line << "\n";
+    }
+    WriteText(tmp / "truth" / "scenes" / scene.name / "object.yaml", o.str());
+  }
+  {
+    std::ostringstream o;
+    o << "# How this dataset was made (what is not in spec.yaml).\nformat: stereorig-sim-info\nversion: 1\n"
+      << "tool: \"" << ToolVersion() << "\"\nseed: " << seed << "\ncalibration_captures: " << captures
+      << "\nscenes: [";
+    for (size_t s = 0; s < scenes.size(); ++s) o << (s ? ", " : "") << scenes[s].name;
+    o << "]\nsurface_spacing_mm: " << FormatDouble(options.surface_spacing_mm) << "\n"
+      << "depth_maps: \"float32 TIFF, z in the camera frame (mm) at the pixel centre, 0 = no surface\"\n"
+      << "world_from_module0:\n"
+      << Matrix4Yaml(sr.sim.world_from_module0, "  ") << bump_yaml;
+    WriteText(tmp / "truth" / "simulation.yaml", o.str());
+  }
+
+  // --- into place
+  if (fs::exists(out)) {
+    const fs::path old = parent / ("." + out.filename().string() + ".old-" + std::to_string(getpid()));
+    fs::rename(out, old, ec);
+    if (ec) throw InputError(out.string(), "cannot replace: " + ec.message());
+    fs::rename(tmp, out, ec);
+    if (ec) {
+      std::error_code e2;
+      fs::rename(old, out, e2);
+      throw InputError(out.string(), "cannot rename the finished dataset into place: " + ec.message());
+    }
+    fs::remove_all(old, ec);
+  } else {
+    fs::rename(tmp, out, ec);
+    if (ec) throw InputError(out.string(), "cannot rename the finished dataset into place: " + ec.message());
+  }
+  cleanup.keep = true;
+
+  SimulateSummary summary;
+  summary.images = images;
+  summary.rays_seconds = rays_seconds;
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return summary;
+}
+
+}  // namespace stereorig

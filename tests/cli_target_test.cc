@@ -1,0 +1,65 @@
+// `stereorig target`, run as the real binary: it writes a true-scale SVG
+// atomically, the target file it used, and refuses bad input with exit 2.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace {
+
+const std::string kBin = std::string(STEREORIG_BINARY_DIR) + "/stereorig";
+
+struct Result {
+  int code;
+  std::string out, err;
+};
+
+std::string Slurp(const std::string& p) {
+  std::ifstream f(p);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+Result RunStereorig(const std::string& args) {
+  const std::string dir = ::testing::TempDir();
+  const std::string o = dir + "/cli_target_out.txt", e = dir + "/cli_target_err.txt";
+  const int status = std::system((kBin + " " + args + " >" + o + " 2>" + e).c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(o), Slurp(e)};
+}
+
+TEST(CliTarget, WritesTheDefaultBoardAndItsTargetFile) {
+  const std::string dir = ::testing::TempDir() + "/cli_target";
+  std::filesystem::create_directories(dir);
+  const Result r = RunStereorig("target --out " + dir + "/board.svg --write-target " + dir + "/board.yaml");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string svg = Slurp(dir + "/board.svg");
+  EXPECT_NE(svg.find("viewBox=\"0 0 "), std::string::npos);
+  EXPECT_NE(svg.find("id=\"front\""), std::string::npos);
+  EXPECT_NE(svg.find("id=\"back\""), std::string::npos);
+  EXPECT_NE(svg.find("check: this bar is 100.0 mm"), std::string::npos);
+  EXPECT_NE(r.out.find("print at 100 %"), std::string::npos);
+  // The target file written reads back: draw its back face alone from it.
+  const Result back = RunStereorig("target --target " + dir + "/board.yaml --face back --out " + dir + "/back.svg");
+  ASSERT_EQ(back.code, 0) << back.err;
+  const std::string back_svg = Slurp(dir + "/back.svg");
+  EXPECT_EQ(back_svg.find("id=\"front\""), std::string::npos);
+  EXPECT_NE(back_svg.find("id=\"back\""), std::string::npos);
+}
+
+TEST(CliTarget, BadTargetFileExitsTwoAndWritesNothing) {
+  const std::string dir = ::testing::TempDir() + "/cli_target_bad";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/bad.yaml") << "format: stereorig-target\nversion: 1\nunits: mm\ncorners_x: 11\n";
+  const Result r = RunStereorig("target --target " + dir + "/bad.yaml --out " + dir + "/board.svg");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("bad.yaml"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/board.svg"));
+  EXPECT_EQ(RunStereorig("target --out " + dir + "/x.svg --face sideways").code, 2);
+  EXPECT_EQ(RunStereorig("target").code, 2);  // --out is required
+}
+
+}  // namespace
