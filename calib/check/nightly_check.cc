@@ -83,16 +83,16 @@ Consistency CameraConsistency(const Inputs& in, int c, const std::set<int>& trus
     const BoardPoseEstimate pose = EstimateBoardPose(in.rig, in.target, others, &in.seed.at(capture));
     if (!pose.ok) continue;
     for (const BoardObservation* v : mine) {
+      const PredictionStatistics p =
+          PredictionErrorStatistics(in.rig, in.target, others, in.sigma_px, *v, pose.ref_from_front);
+      // A view the pose predicts worse than the corners' own noise (a
+      // one-camera pose of a few corners, say) cannot test anything, and its
+      // linearised statistics are not to be trusted: skip it.
+      if (p.mean_ss_px2 > 2.0 * v->corner_ids.size() * in.sigma_px[c] * in.sigma_px[c]) continue;
       for (const Eigen::Vector2d& e : ReprojectionErrors(in.rig, in.target, *v, pose.ref_from_front)) {
         ss += e.squaredNorm();
         ++out.corners;
       }
-      // H0: the camera's own noise (2 components per corner, each with
-      // E[e^2] = s^2 and var(e^2) = 2 s^4), plus the prediction error the
-      // pose's uncertainty puts on the view (shared by all its corners), plus
-      // their cross term (variance 4 s^2 E[pred^2]).
-      const PredictionStatistics p =
-          PredictionErrorStatistics(in.rig, in.target, others, in.sigma_px, *v, pose.ref_from_front);
       const double s2 = in.sigma_px[c] * in.sigma_px[c];
       const double n = static_cast<double>(v->corner_ids.size());
       // The stored calibration's own error (S composed with the target's
