@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "calib/core/input_error.h"
@@ -48,7 +49,15 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
                                              "'s other images are " + std::to_string(spec.width_px) + "x" +
                                              std::to_string(spec.height_px));
       }
-      const DetectResult r = detector.Detect(grey);
+      DetectResult r;
+      try {
+        r = detector.Detect(grey);
+      } catch (const cv::Exception& e) {
+        // A detector failure on one image (e.g. OpenCV refusing a degenerate
+        // grid) loses that view, not the calibration; the log says so.
+        r.reason = RejectReason::kNoChessboard;
+        r.message = std::string("detector failed: ") + e.what();
+      }
       ImageDetectionLog log{capture, c, image.string(), false, Face::kFront, 0, 0, r.message};
       if (r.reason == RejectReason::kNone && !r.faces.empty()) {
         const FaceDetection& f = r.faces[0];
