@@ -73,7 +73,7 @@ void ValidateInput(const CalibrationInput& in) {
     if (!seen.insert({o.capture, o.camera}).second) throw InputError(w, "observed twice");
     if (o.corner_ids.size() != o.q_px.size()) throw InputError(w, "corner ids and pixels differ in number");
     std::set<int> ids;
-    const CameraSpec& cs = in.cameras[o.camera];
+    const CameraImager& cs = in.cameras[o.camera];
     for (size_t i = 0; i < o.corner_ids.size(); ++i) {
       const int id = o.corner_ids[i];
       if (id < 0 || id >= in.target.num_corners()) {

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -21,7 +22,9 @@ struct Result {
 
 inline Result RunCli(const std::string& args) {
   const std::string dir = ::testing::TempDir();
-  const std::string o = dir + "/cli_out.txt", e = dir + "/cli_err.txt";
+  // Per process: several checkouts' test suites may run at once on one machine.
+  const std::string tag = std::to_string(getpid());
+  const std::string o = dir + "/cli_out_" + tag + ".txt", e = dir + "/cli_err_" + tag + ".txt";
   const int status = std::system((kBin + " " + args + " >" + o + " 2>" + e).c_str());
   auto slurp = [](const std::string& p) {
     std::ifstream f(p);
