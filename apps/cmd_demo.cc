@@ -1,94 +1,128 @@
-// `stereorig demo`: every stage built so far, on the embedded default rig.
+// `stereorig demo`: the whole product on the embedded default rig. Each step
+// runs a real subcommand, through the same table and error handling, and
+// prints the exact command line, so a user can repeat any step by hand.
 #include <cstdio>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
-#include "calib/capture_folder.h"
-#include "calib/core/cameramodel_export.h"
 #include "calib/core/input_error.h"
-#include "calib/core/rig_file.h"
-#include "calib/rig_compare.h"
-#include "calib/synthetic.h"
-#include "datasets/default_rig.h"
-#include "datasets/sim_spec.h"
-#include "datasets/simulate.h"
 
 namespace stereorig {
 
-void PrintRigSummary(const Rig& rig, FILE* out);
+namespace {
+
+// Runs `stereorig <args...>` in-process. Returns its exit code.
+int Step(const std::vector<std::string>& args) {
+  std::string line = "$ stereorig";
+  for (const std::string& a : args) line += " " + a;
+  std::printf("\n%s\n", line.c_str());
+  std::fflush(stdout);
+  for (const Command& c : Commands()) {
+    if (args[0] != c.name) continue;
+    std::vector<std::string> storage = args;
+    storage[0] = "stereorig " + args[0];
+    std::vector<char*> argv;
+    for (std::string& s : storage) argv.push_back(s.data());
+    const int rc = RunCommand(c, static_cast<int>(argv.size()), argv.data());
+    std::fflush(stdout);
+    return rc;
+  }
+  STEREORIG_CHECK(false && "demo names an unknown subcommand");
+  return kExitBadInput;
+}
+
+std::string Join(const std::string& dir, const std::string& name) {
+  return (std::filesystem::path(dir) / name).string();
+}
+
+}  // namespace
 
 int RunDemo(int argc, char** argv) {
   CLI::App app{
-      "Run every stage built so far on the embedded default rig (2 facing modules, 752x582 cameras, 90 mm "
-      "baseline, 200 mm working distance) and print the figures.\n\n"
+      "The whole product on the embedded default rig (2 facing modules, 752x582 cameras, 90 mm baseline, "
+      "200 mm working distance, 51x51 laser grids): simulate a dataset, calibrate the rig from its target "
+      "captures, reconstruct the cup (active and passive), verify the sphere and the ball bar (VDI/VDE 2634-2), "
+      "and run the nightly check on fresh captures of the unmoved rig and of a bumped one. Every step prints the "
+      "command it runs, so each can be repeated by hand.\n\n"
+      "Exit code 0 when every step behaved as expected (including the check flagging the bump).\n\n"
       "Example:\n  stereorig demo --out /tmp/stereorig-demo",
       "stereorig demo"};
-  std::string out_dir = "stereorig-demo";
-  app.add_option("--out", out_dir, "folder for everything the demo writes (created if missing)")->capture_default_str();
+  std::string out = "stereorig-demo";
+  unsigned seed = 1;
+  app.add_option("--out", out, "folder for everything the demo writes (created if missing)")->capture_default_str();
+  app.add_option("--seed", seed, "simulator seed")->capture_default_str();
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 
   std::error_code ec;
-  std::filesystem::create_directories(out_dir, ec);
-  if (ec) throw InputError(out_dir, "cannot create folder: " + ec.message());
-
-  std::printf("== stage: the default rig (ground truth)\n");
-  SimulatedRig sim = MakeDefaultRig();
-  sim.rig.provenance().date_utc = NowUtcIso8601();
-  PrintRigSummary(sim.rig, stdout);
-
-  const std::string rig_path = (std::filesystem::path(out_dir) / "truth_rig.yaml").string();
-  WriteRigFile(sim.rig, rig_path);
-  const Rig back = ReadRigFile(rig_path);
-  const bool identical = RigToYaml(back) == RigToYaml(sim.rig);
-  std::printf("wrote %s; read back and re-written: %s\n", rig_path.c_str(),
-              identical ? "bit-identical" : "DIFFERENT (bug)");
-  for (int i = 0; i < back.num_cameras(); ++i) {
-    const std::string path = (std::filesystem::path(out_dir) / (back.camera_names()[i] + ".cameramodel")).string();
-    WriteCameramodel(back.camera(i), back.CamFromReference(i), path);
-  }
-  std::printf("exported %d .cameramodel files to %s\n", back.num_cameras(), out_dir.c_str());
-
-  std::printf("== stage: simulate the default dataset (stereorig simulate --out %s/dataset --seed 1)\n",
-              out_dir.c_str());
-  SimulateOptions sim_options;
-  sim_options.out_dir = (std::filesystem::path(out_dir) / "dataset").string();
-  sim_options.seed = 1;
-  sim_options.progress = [](const std::string& s) { std::fprintf(stderr, "simulate: %s\n", s.c_str()); };
-  const SimulateSummary summary = Simulate(DefaultSimSpec(), sim_options);
-  std::printf("wrote %s: %d images in %.1f s\n", sim_options.out_dir.c_str(), summary.images, summary.seconds);
-
-  const std::filesystem::path dataset(sim_options.out_dir);
-  const std::string calibrated_path = (std::filesystem::path(out_dir) / "rig.yaml").string();
-  const std::string report_path = (std::filesystem::path(out_dir) / "calibration_report.json").string();
-  std::printf(
-      "== stage: calibrate it (stereorig calibrate --captures %s --target %s --layout %s --out %s --report %s)\n",
-      dataset.string().c_str(), (dataset / "target.yaml").string().c_str(), (dataset / "layout.yaml").string().c_str(),
-      calibrated_path.c_str(), report_path.c_str());
-  CalibrationOptions calibration_options;
-  calibration_options.progress = true;
-  const FolderCalibration calibration = CalibrateCaptureFolder(dataset.string(), (dataset / "target.yaml").string(),
-                                                               (dataset / "layout.yaml").string(), calibration_options);
-  WriteCalibrationOutputs(calibration.result, calibrated_path, report_path);
-  std::printf("%s", SummaryText(calibration.result.report).c_str());
-  // Against the truth, by what users measure: each module's 3D error in the
-  // volume after rigid alignment, and the modules' agreement through S.
-  const Rig truth = ReadRigFile((dataset / "truth" / "rig.yaml").string());
-  const Rig& calibrated = calibration.result.rig;
-  const auto points = VolumePoints(sim.world_from_module0.Inverse(), Eigen::Vector3d(75, 75, 50), 2000, 1);
-  std::printf("against the truth (points filling the 150 x 150 x 100 mm volume):\n");
-  for (int k = 0; k < truth.num_modules(); ++k) {
-    std::vector<Eigen::Vector3d> pc, pt;
-    TriangulateThroughModule(truth, calibrated, k, points, &pc, &pt);
-    std::printf("  module %d: 3D error after rigid alignment %.4f mm RMS (%zu points)\n", k, RigidAlignedRms(pt, pc),
-                pc.size());
-  }
-  for (int i = 0; i < truth.num_modules(); ++i)
-    for (int j = i + 1; j < truth.num_modules(); ++j) {
-      std::printf("  modules %d-%d: agreement through S %.4f mm RMS\n", i, j,
-                  ModuleAgreementRms(truth, calibrated, calibrated.S(i, j), i, j, points));
+  std::filesystem::create_directories(out, ec);
+  if (ec) throw InputError(out, "cannot create folder: " + ec.message());
+  const std::string ds = Join(out, "dataset"), rig = Join(out, "rig.yaml");
+  const std::string s = std::to_string(seed);
+  int failures = 0;
+  auto expect = [&failures](int rc, int expected, const char* what) {
+    if (rc != expected) {
+      std::printf("demo: %s: exit %d, expected %d\n", what, rc, expected);
+      ++failures;
     }
-  return identical ? kExitOk : kExitCheckFailed;
+    return rc == expected;
+  };
+
+  std::printf("== 1. simulate the default rig: target captures, object scenes, ground truth\n");
+  if (!expect(Step({"simulate", "--out", ds, "--seed", s}), kExitOk, "simulate")) return kExitCheckFailed;
+
+  std::printf("\n== 2. calibrate: mrcal intrinsics, stereo extrinsics, Horn + Ceres across the modules\n");
+  if (!expect(Step({"calibrate", "--captures", ds, "--target", Join(ds, "target.yaml"), "--layout",
+                    Join(ds, "layout.yaml"), "--out", rig, "--report", Join(out, "calibration.json"),
+                    "--export-cameramodels", out}),
+              kExitOk, "calibrate"))
+    return kExitCheckFailed;
+
+  std::printf("\n== 3. reconstruct the cup, active (laser grids on) and passive, with the calibrated rig\n");
+  for (const char* mode : {"active", "passive"}) {
+    const std::string name = std::string("cup_") + mode;
+    expect(Step({"reconstruct", "--rig", rig, "--capture", Join(ds, std::string("scenes/cup/") + mode), "--out",
+                 Join(out, name + ".ply"), "--mesh", Join(out, name + "_mesh.ply"), "--report",
+                 Join(out, name + ".json")}),
+           kExitOk, "reconstruct");
+  }
+
+  std::printf("\n== 4. verify: VDI/VDE 2634-2 figures on the sphere and the ball bar\n");
+  // The simulator writes each artifact's certificate (its true dimensions)
+  // beside the dataset, as a calibration lab would deliver it.
+  const std::string artifacts = Join(ds, "artifacts");
+  for (const auto& [scene, artifact] : {std::pair{"sphere", "sphere.yaml"}, {"ballbar", "ballbar.yaml"}}) {
+    const std::string cloud = Join(out, std::string(scene) + ".ply");
+    expect(Step({"reconstruct", "--rig", rig, "--capture", Join(ds, std::string("scenes/") + scene + "/active"),
+                 "--out", cloud}),
+           kExitOk, "reconstruct");
+    expect(Step({"verify", "--artifact", artifacts + "/" + artifact, "--cloud", cloud, "--report",
+                 Join(out, std::string("verify_") + scene + ".json")}),
+           kExitOk, "verify");
+  }
+
+  std::printf("\n== 5. the nightly check: 8 fresh target captures of the unmoved rig, then after a bump\n");
+  const std::string night = Join(out, "night_ok"), bumped = Join(out, "night_bumped");
+  const std::string history = Join(out, "check-history.sqlite");
+  std::filesystem::remove(history, ec);
+  expect(Step({"simulate", "--out", night, "--seed", std::to_string(seed + 100), "--calibration-captures", "8",
+               "--no-scenes"}),
+         kExitOk, "simulate (night)");
+  expect(Step({"check", "--rig", rig, "--captures", night, "--target", Join(ds, "target.yaml"), "--history-db",
+               history, "--report", Join(out, "check_ok.json")}),
+         kExitOk, "check (unmoved rig)");
+  expect(Step({"simulate", "--out", bumped, "--seed", std::to_string(seed + 200), "--calibration-captures", "8",
+               "--no-scenes", "--bump-camera", "1", "--bump-rotation-deg", "0.05"}),
+         kExitOk, "simulate (bumped)");
+  expect(Step({"check", "--rig", rig, "--captures", bumped, "--target", Join(ds, "target.yaml"), "--history-db",
+               history, "--report", Join(out, "check_bumped.json")}),
+         kExitCheckFailed, "check (camera 1 bumped by 0.05 deg: must say recalibrate)");
+  Step({"check", "--history", "--history-db", history});
+
+  std::printf("\n== demo %s; everything is in %s\n", failures ? "FINISHED WITH SURPRISES" : "done", out.c_str());
+  return failures ? kExitCheckFailed : kExitOk;
 }
 
 }  // namespace stereorig

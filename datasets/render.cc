@@ -187,7 +187,7 @@ cv::Mat SensorImage(const cv::Mat& radiance_dn, const cv::Mat& stray_dn, const R
         // (> 50 e- wherever it matters); read noise: Gaussian.
         dn += std::sqrt(dn / e_per_dn) * rng.Normal() + read_dn * rng.Normal();
       }
-      o[c] = static_cast<uint8_t>(std::clamp(std::lround(dn), 0L, 255L));
+      o[c] = static_cast<uint8_t>(std::clamp(dn, 0.0, 255.0) + 0.5);  // round half up, clip
     }
   }
   return out;

@@ -38,19 +38,22 @@ class Rng {
   // Uniform in [0, 1).
   double Uniform() { return static_cast<double>(Next() >> 11) * 0x1.0p-53; }
   double Uniform(double lo, double hi) { return lo + (hi - lo) * Uniform(); }
-  // Standard normal (Box-Muller, both values used).
+  // Standard normal: Marsaglia's polar method (no trigonometry; both values used).
   double Normal() {
     if (has_spare_) {
       has_spare_ = false;
       return spare_;
     }
-    double u1 = Uniform();
-    while (u1 <= 0) u1 = Uniform();
-    const double u2 = Uniform();
-    const double r = std::sqrt(-2.0 * std::log(u1));
-    spare_ = r * std::sin(2.0 * M_PI * u2);
+    double u, v, s;
+    do {
+      u = 2.0 * Uniform() - 1.0;
+      v = 2.0 * Uniform() - 1.0;
+      s = u * u + v * v;
+    } while (s >= 1.0 || s == 0.0);
+    const double k = std::sqrt(-2.0 * std::log(s) / s);
+    spare_ = v * k;
     has_spare_ = true;
-    return r * std::cos(2.0 * M_PI * u2);
+    return u * k;
   }
 
  private:

@@ -256,7 +256,10 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
   const auto t_rays = std::chrono::steady_clock::now();
   say("unprojecting the ray tables of " + std::to_string(num_cameras) + " cameras");
   std::vector<std::unique_ptr<CameraRays>> rays;
-  for (int i = 0; i < num_cameras; ++i) rays.push_back(std::make_unique<CameraRays>(rig.camera(i), threads));
+  const bool render_anything = spec.calibration.captures > 0 || !spec.scenes.names.empty();
+  for (int i = 0; i < num_cameras && render_anything; ++i) {
+    rays.push_back(std::make_unique<CameraRays>(rig.camera(i), threads));
+  }
   const double rays_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_rays).count();
   std::vector<cv::Mat> stray;
   for (int i = 0; i < num_cameras; ++i) {

@@ -30,8 +30,8 @@ std::string Mm(double v) {
 }
 
 void Rect(std::ostringstream& o, const char* cls, double x, double y, double w, double h) {
-  o << "  <rect class=\"" << cls << "\" x=\"" << Mm(x) << "\" y=\"" << Mm(y) << "\" width=\"" << Mm(w)
-    << "\" height=\"" << Mm(h) << "\"/>\n";
+  o << "  <rect class=\"" << cls << "\" x=\"" << Mm(x) << "\" y=\"" << Mm(y) << "\" width=\"" << Mm(w) << "\" height=\""
+    << Mm(h) << "\"/>\n";
 }
 
 void Text(std::ostringstream& o, double x, double y, double size_mm, const std::string& text,
@@ -113,8 +113,8 @@ BoardSvg MakeBoardSvg(const Target& target, const BoardSvgOptions& options) {
   }
   const double plate_w = target.max_x_mm() - target.min_x_mm(), plate_h = target.max_y_mm() - target.min_y_mm();
   const double m = options.page_margin_mm;
-  const double top = m + 8.0;  // room for the markers above the plates
-  const double left = m + 8.0; // and to their left
+  const double top = m + 8.0;   // room for the markers above the plates
+  const double left = m + 8.0;  // and to their left
   const double faces_w = faces.size() * plate_w + (faces.size() - 1) * (options.face_gap_mm + 8.0);
   const double bar_y = top + plate_h + 14.0;
   BoardSvg out;
@@ -136,7 +136,8 @@ BoardSvg MakeBoardSvg(const Target& target, const BoardSvgOptions& options) {
   o << " <g class=\"scale\">\n";
   o << "  <rect class=\"scale-bar\" x=\"" << Mm(left) << "\" y=\"" << Mm(bar_y) << "\" width=\"" << Mm(bar)
     << "\" height=\"2\" fill=\"#000\"/>\n";
-  for (int k = 0; k * 10.0 <= bar + 1e-9; ++k) Line(o, left + k * 10.0, bar_y - 2.0, left + k * 10.0, bar_y, 0.2, "#000");
+  for (int k = 0; k * 10.0 <= bar + 1e-9; ++k)
+    Line(o, left + k * 10.0, bar_y - 2.0, left + k * 10.0, bar_y, 0.2, "#000");
   char label[96];
   std::snprintf(label, sizeof(label), "check: this bar is %.1f mm", bar);
   Text(o, left + bar + 4.0, bar_y + 2.0, 3.0, label);

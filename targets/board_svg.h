@@ -26,8 +26,8 @@ struct BoardSvgOptions {
 };
 
 struct BoardSvg {
-  std::string text;       // the SVG document
-  double width_mm = 0;    // page size
+  std::string text;     // the SVG document
+  double width_mm = 0;  // page size
   double height_mm = 0;
 };
 

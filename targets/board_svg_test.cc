@@ -41,7 +41,8 @@ TEST(BoardSvg, SquaresScaleBarAndPageAreInTrueMillimetres) {
   ASSERT_EQ(text, svg.text);
 
   // Well-formed XML, by an independent parser.
-  const std::string cmd = "/usr/bin/python3 -c \"import sys, xml.etree.ElementTree as E; E.parse(sys.argv[1])\" " + path;
+  const std::string cmd =
+      "/usr/bin/python3 -c \"import sys, xml.etree.ElementTree as E; E.parse(sys.argv[1])\" " + path;
   EXPECT_EQ(std::system(cmd.c_str()), 0);
 
   // The root: width and height in mm, and a viewBox of the same numbers, so
@@ -126,17 +127,28 @@ TEST(BoardSvg, RasterisedPrintIsDetectedWhereTheTargetSaysItsCornersAre) {
   const Target target = DefaultTarget();
   const double px_per_mm = 4.0;
   const std::string dir = std::filesystem::temp_directory_path().string();
-  for (SvgFaces which : {SvgFaces::kFront, SvgFaces::kBack, SvgFaces::kBoth}) {
+  // One python3 run rasterises the three prints (front, back, both).
+  const SvgFaces kinds[3] = {SvgFaces::kFront, SvgFaces::kBack, SvgFaces::kBoth};
+  std::vector<BoardSvg> svgs;
+  std::string cmd =
+      "/usr/bin/python3 " STEREORIG_SOURCE_DIR "/targets/testdata/rasterize_svg_rects.py " + std::to_string(px_per_mm);
+  for (int k = 0; k < 3; ++k) {
     BoardSvgOptions options;
-    options.faces = which;
-    const BoardSvg svg = MakeBoardSvg(target, options);
-    const std::string svg_path = dir + "/stereorig_raster_test.svg", png_path = dir + "/stereorig_raster_test.png";
-    WriteBoardSvg(svg, svg_path);
-    const std::string cmd = "/usr/bin/python3 " STEREORIG_SOURCE_DIR "/targets/testdata/rasterize_svg_rects.py " +
-                            svg_path + " " + png_path + " " + std::to_string(px_per_mm);
-    ASSERT_EQ(std::system(cmd.c_str()), 0);
-    const cv::Mat grey = cv::imread(png_path, cv::IMREAD_GRAYSCALE);
+    options.faces = kinds[k];
+    svgs.push_back(MakeBoardSvg(target, options));
+    const std::string stem = dir + "/stereorig_raster_test_" + std::to_string(k);
+    WriteBoardSvg(svgs.back(), stem + ".svg");
+    cmd += " " + stem + ".svg " + stem + ".png";
+  }
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  for (int k = 0; k < 3; ++k) {
+    const SvgFaces which = kinds[k];
+    const BoardSvg& svg = svgs[k];
+    const std::string stem = dir + "/stereorig_raster_test_" + std::to_string(k);
+    const cv::Mat grey = cv::imread(stem + ".png", cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(grey.empty());
+    std::filesystem::remove(stem + ".png");
+    std::filesystem::remove(stem + ".svg");
     const DetectResult r = TargetDetector(target, DetectOptions()).Detect(grey);
     if (which == SvgFaces::kBoth) {
       EXPECT_EQ(r.reason, RejectReason::kBothFaces) << r.message;  // both faces on one sheet
@@ -162,8 +174,6 @@ TEST(BoardSvg, RasterisedPrintIsDetectedWhereTheTargetSaysItsCornersAre) {
     // Edges fall on pixel boundaries here (axis-aligned, 4 px per mm), the
     // easy case: a few hundredths of a px; a wrong id would be 36 px off.
     EXPECT_LT(std::sqrt(sum_sq / target.num_corners()), 0.05);
-    std::filesystem::remove(png_path);
-    std::filesystem::remove(svg_path);
   }
 }
 

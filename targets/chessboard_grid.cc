@@ -19,6 +19,9 @@ void ChessboardGridOptions::Check() const {
   if (refine_min_half_px < 1 || refine_max_half_px < refine_min_half_px) {
     throw InputError(where, "need 1 <= refine_min_half_px <= refine_max_half_px");
   }
+  if (!(refine_min_window_fraction >= 0 && refine_min_window_fraction <= refine_window_fraction)) {
+    throw InputError(where, "refine_min_window_fraction must be in [0, refine_window_fraction]");
+  }
   if (!(refine_max_shift_fraction > 0 && refine_max_shift_fraction <= 0.5)) {
     throw InputError(where, "refine_max_shift_fraction must be in (0, 0.5]");
   }
@@ -47,15 +50,18 @@ void Refine(const cv::Mat& grey, const ChessboardGridOptions& o, ChessboardGrid*
       const Eigen::Vector2d& q0 = g->at(c, r);
       const int half = RefineHalfWindow(o, spacing, q0, grey.size());
       if (half < 0) {
-        ++g->num_refine_rejected;
+        g->usable[r * g->cols + c] = false;
+        ++g->num_dropped;
         continue;
       }
       std::vector<cv::Point2f> p = {cv::Point2f(static_cast<float>(q0.x()), static_cast<float>(q0.y()))};
       cv::cornerSubPix(grey, p, cv::Size(half, half), cv::Size(-1, -1),
                        cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40, 1e-4));
       const Eigen::Vector2d q1(p[0].x, p[0].y);
-      if (!q1.allFinite() || (q1 - q0).norm() > o.refine_max_shift_fraction * spacing) {
-        ++g->num_refine_rejected;
+      if (!q1.allFinite() ||
+          (q1 - q0).norm() > std::min(o.refine_max_shift_fraction * spacing, static_cast<double>(half))) {
+        g->usable[r * g->cols + c] = false;
+        ++g->num_dropped;
         continue;
       }
       refined[r * g->cols + c] = q1;
@@ -68,14 +74,11 @@ void Refine(const cv::Mat& grey, const ChessboardGridOptions& o, ChessboardGrid*
 
 int RefineHalfWindow(const ChessboardGridOptions& options, double spacing_px, const Eigen::Vector2d& q_px,
                      const cv::Size& image_size) {
-  const double to_edge = std::min({q_px.x(), q_px.y(), image_size.width - 1 - q_px.x(), image_size.height - 1 - q_px.y()});
+  const double to_edge =
+      std::min({q_px.x(), q_px.y(), image_size.width - 1 - q_px.x(), image_size.height - 1 - q_px.y()});
   const int half = std::min({static_cast<int>(std::floor(options.refine_window_fraction * spacing_px)),
                              options.refine_max_half_px, static_cast<int>(std::floor(to_edge)) - 2});
-  if (half < options.refine_min_half_px) {
-    // Too close to the edge for the minimum window; a window larger than the
-    // spacing allows is not an option either.
-    return std::floor(to_edge) - 2 >= options.refine_min_half_px ? options.refine_min_half_px : -1;
-  }
+  if (half < options.refine_min_half_px || half < options.refine_min_window_fraction * spacing_px) return -1;
   return half;
 }
 
@@ -100,12 +103,13 @@ bool FindChessboardGrid(const cv::Mat& grey, cv::Size size, bool partial, const 
   if (meta.empty() || static_cast<size_t>(meta.rows) * meta.cols != corners.size()) return false;
   grid->cols = meta.cols;
   grid->rows = meta.rows;
-  grid->num_refine_rejected = 0;
+  grid->num_dropped = 0;
   grid->q_px.clear();
   for (const cv::Point2f& p : corners) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y)) return false;
     grid->q_px.emplace_back(p.x, p.y);
   }
+  grid->usable.assign(grid->q_px.size(), true);
   if (options.refine) Refine(grey, options, grid);
   return true;
 }
@@ -113,8 +117,14 @@ bool FindChessboardGrid(const cv::Mat& grey, cv::Size size, bool partial, const 
 ChessboardSharpness MeasureSharpness(const cv::Mat& grey, const ChessboardGrid& grid) {
   std::vector<cv::Point2f> corners;
   for (const Eigen::Vector2d& q : grid.q_px) corners.emplace_back(static_cast<float>(q.x()), static_cast<float>(q.y()));
-  const cv::Scalar s = cv::estimateChessboardSharpness(grey, cv::Size(grid.cols, grid.rows), corners);
-  return {s[0], s[1], s[2]};
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (grid.cols < 3 || grid.rows < 3) return {nan, nan, nan};  // OpenCV's minimum
+  try {
+    const cv::Scalar s = cv::estimateChessboardSharpness(grey, cv::Size(grid.cols, grid.rows), corners);
+    return {s[0], s[1], s[2]};
+  } catch (const cv::Exception&) {
+    return {nan, nan, nan};  // a diagnostic only: never fail a detection for it
+  }
 }
 
 }  // namespace stereorig

@@ -16,22 +16,27 @@ struct ChessboardGridOptions {
   // views (steep tilts, blur) for ~20% more time. Default true.
   bool exhaustive = true;
   // cv::findChessboardCornersSB's CALIB_CB_ACCURACY (upsampled search).
-  // Default false: measured on rendered views of the default target
-  // (targets/detect_test.cc, RenderedCornerAccuracy) it is 3x slower and,
-  // once cornerSubPix refines the corners, no more accurate.
+  // Default false: measured on 20 rendered views of the default target it is
+  // ~2x slower and, once cornerSubPix refines the corners, no more accurate
+  // (0.031 vs 0.031 px RMS; docs/targets.md).
   bool upsample = false;
   // Refine each corner with cv::cornerSubPix in a window of half-size
   // refine_window_fraction x (distance to its nearest neighbour corner),
   // clamped to [refine_min_half_px, refine_max_half_px]. Default true.
-  // Measured: 0.078 px RMS (SB alone) -> 0.02 px (refined) on the same views.
+  // Measured: 0.064 px RMS (SB alone) -> 0.031 px (refined) on 20 views.
   bool refine = true;
   double refine_window_fraction = 0.4;  // of the local corner spacing; default 0.4
   int refine_min_half_px = 2;           // default 2
   int refine_max_half_px = 16;          // default 16
-  // A refinement that moves a corner further than this fraction of the
-  // local corner spacing is taken to have slid off it, and OpenCV's estimate
-  // is kept. Default 0.25 (OpenCV's own estimate is off by up to ~1 px on
-  // small, steeply tilted squares, where cornerSubPix is right).
+  // Near the image's edge the window shrinks to stay inside; a corner whose
+  // window would be smaller than this fraction of the spacing is dropped
+  // (measured on the simulator's images: a corner 6 px from the edge, refined
+  // in a 3 px window, was 3.5 px off). Default 0.25.
+  double refine_min_window_fraction = 0.25;
+  // A refinement that moves a corner further than this fraction of the local
+  // corner spacing has slid off it; the corner is dropped. Default 0.25
+  // (OpenCV's own estimate is off by up to ~1 px on small, steeply tilted
+  // squares, where cornerSubPix is right).
   double refine_max_shift_fraction = 0.25;
   void Check() const;  // throws InputError naming the bad field
 };
@@ -44,7 +49,8 @@ struct ChessboardGrid {
   int cols = 0;
   int rows = 0;
   std::vector<Eigen::Vector2d> q_px;  // (rows * cols)
-  int num_refine_rejected = 0;        // corners whose refinement was not kept
+  std::vector<bool> usable;           // (rows * cols) false: dropped by the refinement
+  int num_dropped = 0;                // corners the refinement dropped
   const Eigen::Vector2d& at(int c, int r) const { return q_px[r * cols + c]; }
 };
 
@@ -58,7 +64,8 @@ bool FindChessboardGrid(const cv::Mat& grey, cv::Size size, bool partial, const 
 // The cornerSubPix half-window for a corner at `q_px` whose nearest
 // neighbour is `spacing_px` away: options' fraction of the spacing, clamped
 // to [min, max] and shrunk so that the window stays 2 px inside the image;
-// -1 if even the minimum window does not fit.
+// -1 if what is left is below refine_min_window_fraction of the spacing or
+// refine_min_half_px.
 int RefineHalfWindow(const ChessboardGridOptions& options, double spacing_px, const Eigen::Vector2d& q_px,
                      const cv::Size& image_size);
 

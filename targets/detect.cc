@@ -29,15 +29,24 @@ void DetectOptions::Check() const {
 
 const char* RejectReasonName(RejectReason reason) {
   switch (reason) {
-    case RejectReason::kNone: return "none";
-    case RejectReason::kNoChessboard: return "no_chessboard";
-    case RejectReason::kNoTags: return "no_tags";
-    case RejectReason::kBothFaces: return "both_faces";
-    case RejectReason::kWrongFace: return "wrong_face";
-    case RejectReason::kMirrored: return "mirrored";
-    case RejectReason::kAmbiguous: return "ambiguous";
-    case RejectReason::kGridMismatch: return "grid_mismatch";
-    case RejectReason::kTooFewCorners: return "too_few_corners";
+    case RejectReason::kNone:
+      return "none";
+    case RejectReason::kNoChessboard:
+      return "no_chessboard";
+    case RejectReason::kNoTags:
+      return "no_tags";
+    case RejectReason::kBothFaces:
+      return "both_faces";
+    case RejectReason::kWrongFace:
+      return "wrong_face";
+    case RejectReason::kMirrored:
+      return "mirrored";
+    case RejectReason::kAmbiguous:
+      return "ambiguous";
+    case RejectReason::kGridMismatch:
+      return "grid_mismatch";
+    case RejectReason::kTooFewCorners:
+      return "too_few_corners";
   }
   return "unknown";
 }
@@ -124,8 +133,44 @@ bool WholeBoardInView(const Target& target, const Eigen::Matrix3d& image_from_fa
   return true;
 }
 
+// Each tag's corners against the homography of the detected corners alone.
+// *bad_tag: the worst tag's ID if it is off by more than max_tag_fit_squares
+// of a (local) square, else -1.
+void TagFitAgainstCorners(const Target& target, Face face, const std::vector<TagDetection>& tags,
+                          const std::vector<int>& ids, const std::vector<Eigen::Vector2d>& q, double max_fit_squares,
+                          DetectionQuality* quality, int* bad_tag) {
+  *bad_tag = -1;
+  std::vector<cv::Point2d> src, dst;
+  for (size_t i = 0; i < ids.size(); ++i) {
+    const Eigen::Vector3d p = target.CornerInFace(ids[i]);
+    src.emplace_back(p.x(), p.y());
+    dst.emplace_back(q[i].x(), q[i].y());
+  }
+  const cv::Mat m = cv::findHomography(src, dst, 0);
+  if (m.empty()) return;
+  Eigen::Matrix3d h;
+  cv::cv2eigen(m, h);
+  const double s = target.square_size_mm();
+  double sum_sq = 0, worst_ratio = 0;
+  for (const TagDetection& t : tags) {
+    const auto corners = TagCornersInFace(target, *target.FindTag(face, t.id));
+    double tag_sq = 0;
+    for (int k = 0; k < 4; ++k) tag_sq += (ApplyHomography(h, corners[k]) - t.q_px[k]).squaredNorm();
+    sum_sq += tag_sq;
+    const double tag_rms = std::sqrt(tag_sq / 4);
+    const Eigen::Vector2d centre = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
+    const double square_px = (ApplyHomography(h, centre + Eigen::Vector2d(s, 0)) - ApplyHomography(h, centre)).norm();
+    quality->worst_tag_fit_px = std::max(quality->worst_tag_fit_px, tag_rms);
+    if (tag_rms > max_fit_squares * square_px && tag_rms / square_px > worst_ratio) {
+      worst_ratio = tag_rms / square_px;
+      *bad_tag = t.id;
+    }
+  }
+  quality->tag_fit_rms_px = tags.empty() ? 0 : std::sqrt(sum_sq / (4 * tags.size()));
+}
+
 // cv::estimateChessboardSharpness needs a complete rectangular grid: use the
-// largest block of corners all found.
+// largest block of corners all found (OpenCV needs at least 3x3).
 ChessboardSharpness SharpnessOfLargestBlock(const Target& target, const cv::Mat& grey, const std::vector<int>& ids,
                                             const std::vector<Eigen::Vector2d>& q) {
   const int nx = target.corners_x(), ny = target.corners_y();
@@ -135,16 +180,16 @@ ChessboardSharpness SharpnessOfLargestBlock(const Target& target, const cv::Mat&
   std::vector<int> have((nx + 1) * (ny + 1), 0);
   for (int r = 0; r < ny; ++r)
     for (int c = 0; c < nx; ++c)
-      have[(r + 1) * (nx + 1) + c + 1] = (index[r * nx + c] >= 0) + have[r * (nx + 1) + c + 1] +
-                                         have[(r + 1) * (nx + 1) + c] - have[r * (nx + 1) + c];
+      have[(r + 1) * (nx + 1) + c + 1] =
+          (index[r * nx + c] >= 0) + have[r * (nx + 1) + c + 1] + have[(r + 1) * (nx + 1) + c] - have[r * (nx + 1) + c];
   int best_area = 0, bc0 = 0, br0 = 0, bw = 0, bh = 0;
   for (int r0 = 0; r0 < ny; ++r0)
-    for (int r1 = r0 + 2; r1 <= ny; ++r1)
+    for (int r1 = r0 + 3; r1 <= ny; ++r1)
       for (int c0 = 0; c0 < nx; ++c0)
-        for (int c1 = c0 + 2; c1 <= nx; ++c1) {
+        for (int c1 = c0 + 3; c1 <= nx; ++c1) {
           const int area = (r1 - r0) * (c1 - c0);
-          const int count = have[r1 * (nx + 1) + c1] - have[r0 * (nx + 1) + c1] - have[r1 * (nx + 1) + c0] +
-                            have[r0 * (nx + 1) + c0];
+          const int count =
+              have[r1 * (nx + 1) + c1] - have[r0 * (nx + 1) + c1] - have[r1 * (nx + 1) + c0] + have[r0 * (nx + 1) + c0];
           if (count == area && area > best_area) {
             best_area = area;
             bc0 = c0, br0 = r0, bw = c1 - c0, bh = r1 - r0;
@@ -164,9 +209,12 @@ ChessboardSharpness SharpnessOfLargestBlock(const Target& target, const cv::Mat&
 
 const char* CornerSourceName(CornerSource source) {
   switch (source) {
-    case CornerSource::kNone: return "none";
-    case CornerSource::kOpenCvGrid: return "opencv_grid";
-    case CornerSource::kTagGuided: return "tag_guided";
+    case CornerSource::kNone:
+      return "none";
+    case CornerSource::kOpenCvGrid:
+      return "opencv_grid";
+    case CornerSource::kTagGuided:
+      return "tag_guided";
   }
   return "unknown";
 }
@@ -218,8 +266,7 @@ DetectResult TargetDetector::Detect(const cv::Mat& grey) const {
     }
     std::string problem;
     bool mirrored = false;
-    if (!TagHomography(target_, face, face_tags, options_.max_tag_fit_squares, &image_from_face, &problem,
-                       &mirrored)) {
+    if (!TagHomography(target_, face, face_tags, options_.max_tag_fit_squares, &image_from_face, &problem, &mirrored)) {
       Reject(&out, mirrored ? RejectReason::kMirrored : RejectReason::kAmbiguous, problem);
       return out;
     }
@@ -241,8 +288,8 @@ DetectResult TargetDetector::Detect(const cv::Mat& grey) const {
     if (!FindChessboardGrid(grey, size, partial, options_.chessboard, &grid)) continue;
     found_any_grid = true;
     const GridIds ids = target_.double_sided()
-                            ? GridIdsFromTags(target_, face, face_tags, image_from_face, grid,
-                                              options_.id_gate_squares, options_.min_agreeing_fraction)
+                            ? GridIdsFromTags(target_, face, face_tags, image_from_face, grid, options_.id_gate_squares,
+                                              options_.min_agreeing_fraction)
                             : GridIdsFromColours(target_, grey, grid);
     if (!ids.ok) {
       if (grid.q_px.size() > largest_failed) {
@@ -254,11 +301,10 @@ DetectResult TargetDetector::Detect(const cv::Mat& grey) const {
     quality.source = CornerSource::kOpenCvGrid;
     quality.grid_cols = grid.cols;
     quality.grid_rows = grid.rows;
-    quality.num_refine_rejected = grid.num_refine_rejected;
-    quality.tag_fit_rms_px = ids.tag_fit_rms_px;
+    quality.num_dropped = grid.num_dropped;
     for (int r = 0; r < grid.rows; ++r) {
       for (int c = 0; c < grid.cols; ++c) {
-        if (!ids.keep[r * grid.cols + c]) continue;
+        if (!ids.keep[r * grid.cols + c] || !grid.usable[r * grid.cols + c]) continue;
         const Eigen::Vector2i id2 = ids.map(c, r);
         STEREORIG_CHECK(id2.x() >= 0 && id2.y() >= 0 && id2.x() < nx && id2.y() < ny);  // kept ones are on the board
         found.emplace_back(id2.y() * nx + id2.x(), grid.at(c, r));
@@ -272,7 +318,6 @@ DetectResult TargetDetector::Detect(const cv::Mat& grey) const {
     for (size_t i = 0; i < grown.ids.size(); ++i) found.emplace_back(grown.ids[i], grown.q_px[i]);
     if (!found.empty()) {
       quality.source = CornerSource::kTagGuided;
-      quality.tag_fit_rms_px = grown.tag_fit_rms_px;
     }
   }
   if (found.empty()) {
@@ -298,12 +343,24 @@ DetectResult TargetDetector::Detect(const cv::Mat& grey) const {
     det.q_px.push_back(found[i].second);
   }
   quality.num_corners = static_cast<int>(det.corner_ids.size());
+  if (target_.double_sided() && quality.num_corners >= 4) {
+    int worst_tag = -1;
+    TagFitAgainstCorners(target_, face, face_tags, det.corner_ids, det.q_px, options_.max_tag_fit_squares, &quality,
+                         &worst_tag);
+    if (worst_tag >= 0) {
+      std::ostringstream m;
+      m << "tag " << worst_tag << " is " << quality.worst_tag_fit_px
+        << " px from where the chessboard puts it: the target file or the print is wrong";
+      Reject(&out, RejectReason::kAmbiguous, m.str());
+      return out;
+    }
+  }
   quality.sharpness = SharpnessOfLargestBlock(target_, grey, det.corner_ids, det.q_px);
   LocalFit(target_, det.corner_ids, det.q_px, &quality);
   if (quality.num_corners < options_.min_corners) {
-    Reject(&out, RejectReason::kTooFewCorners,
-           "only " + std::to_string(quality.num_corners) + " corners (need " + std::to_string(options_.min_corners) +
-               ")");
+    Reject(
+        &out, RejectReason::kTooFewCorners,
+        "only " + std::to_string(quality.num_corners) + " corners (need " + std::to_string(options_.min_corners) + ")");
     return out;
   }
   det.quality = quality;

@@ -2,12 +2,16 @@
 // visible chessboard corner's id in that face's own frame, at sub-pixel
 // precision (docs/targets.md, "Detection").
 //
-// A double-sided target: OpenCV finds a (possibly partial) corner grid; the
-// AprilTags of one face say which face it is and, through a homography from
-// their corners (face frame, mm) to the image, which corner id each grid
-// corner is. A plain board (no tags): the whole board must be visible; the
+// A double-sided target: the AprilTags of one face say which face it is;
+// a homography from their corners (face frame, mm) to the image predicts
+// each corner id's pixel, and the corners are grown out from the tags
+// (tag_guided_corners.h), each refined with cv::cornerSubPix and checked to
+// be a saddle of the right colours. Optionally OpenCV's whole-board grid is
+// tried first and its ids decided by the tags (grid_ids.h). Partial boards
+// work as long as one tag is seen. A plain board (no tags): OpenCV's
+// findChessboardCornersSB on the whole board, which must be visible; the
 // ids follow from the board's shape, the colours of its squares and, where
-// those are symmetric, the image's up direction (docs/targets.md).
+// those are symmetric, the image's right direction (docs/targets.md).
 //
 // Pixels follow mrcal: (0,0) is the centre of the top-left pixel.
 #pragma once
@@ -56,7 +60,9 @@ struct DetectOptions {
   // fewer -> rejected as inconsistent. Default 0.9.
   double min_agreeing_fraction = 0.9;
   // The tags' corners must fit one board homography to within this RMS, in
-  // squares; else the tags disagree (a damaged or wrong target). Default 0.25.
+  // squares, and each tag must sit within it of where the detected corners
+  // put it; else the view is rejected as ambiguous (a damaged print or a
+  // wrong target file). Default 0.25.
   double max_tag_fit_squares = 0.25;
   // If set, a detection of the other face is rejected ("wrong face").
   std::optional<Face> expected_face;
@@ -74,51 +80,58 @@ const char* CornerSourceName(CornerSource source);
 // How good one detection is.
 struct DetectionQuality {
   CornerSource source = CornerSource::kNone;
-  int num_corners = 0;              // corners kept
-  int grid_cols = 0, grid_rows = 0; // size of OpenCV's corner grid
-  int num_tags = 0;                 // tags of the detected face used
-  std::vector<int> tag_ids;         // their IDs
-  int num_foreign_tags = 0;         // decoded tags whose IDs are not on this target
-  // RMS distance of the tags' corners from the homography fitted to tags and
-  // corners together, px. 0 for a plain board.
+  int num_corners = 0;               // corners kept
+  int grid_cols = 0, grid_rows = 0;  // size of OpenCV's corner grid
+  int num_tags = 0;                  // tags of the detected face used
+  std::vector<int> tag_ids;          // their IDs
+  int num_foreign_tags = 0;          // decoded tags whose IDs are not on this target
+  // The tags' corners against the homography fitted to the detected
+  // chessboard corners alone (face mm -> px): RMS over all tags, and the
+  // worst tag's RMS, px. A tag off by more than max_tag_fit_squares of a
+  // square rejects the view (a wrong target file or a damaged print). 0 for
+  // a plain board.
   double tag_fit_rms_px = 0;
+  double worst_tag_fit_px = 0;
   // Each corner with all 8 grid neighbours found is predicted from them by a
   // local homography; the RMS of (detected - predicted), px. Noise-like:
   // about 1.1x the per-corner noise for sharp corners, insensitive to lens
   // distortion. NaN if no corner has 8 neighbours.
   double local_fit_rms_px = 0;
-  int local_fit_count = 0;          // corners that entered local_fit_rms_px
-  int num_refine_rejected = 0;      // corners left at OpenCV's own estimate
+  int local_fit_count = 0;  // corners that entered local_fit_rms_px
+  int num_dropped = 0;      // grid corners dropped by the refinement (at the image's edge, slid off)
   // OpenCV's edge-rise width and levels over the largest complete block of
-  // corners found; NaN when no 2x2 block is complete.
+  // corners found; NaN when no 3x3 block is complete.
   ChessboardSharpness sharpness;
 };
 
+// With refinement on (the default), every corner returned was refined in a
+// window wholly inside the image and moved less than that window's half
+// size, so it lies at least 2 px inside the image.
 struct FaceDetection {
   Face face = Face::kFront;
-  std::vector<int> corner_ids;          // (N) ascending; ids in `face`'s frame (Target::CornerInFace)
-  std::vector<Eigen::Vector2d> q_px;    // (N) parallel to corner_ids
+  std::vector<int> corner_ids;        // (N) ascending; ids in `face`'s frame (Target::CornerInFace)
+  std::vector<Eigen::Vector2d> q_px;  // (N) parallel to corner_ids
   DetectionQuality quality;
 };
 
 enum class RejectReason {
-  kNone,             // accepted
-  kNoChessboard,     // no corner grid found
-  kNoTags,           // double-sided target, but no tag of it seen
-  kBothFaces,        // tags of both faces: which face is it?
-  kWrongFace,        // not DetectOptions::expected_face
-  kMirrored,         // the board appears mirrored
-  kAmbiguous,        // tags disagree, or the grid fits no single orientation
-  kGridMismatch,     // the grid does not fit this target (size, corners outside)
-  kTooFewCorners,    // fewer than DetectOptions::min_corners
+  kNone,           // accepted
+  kNoChessboard,   // no corner grid found
+  kNoTags,         // double-sided target, but no tag of it seen
+  kBothFaces,      // tags of both faces: which face is it?
+  kWrongFace,      // not DetectOptions::expected_face
+  kMirrored,       // the board appears mirrored
+  kAmbiguous,      // tags disagree, or the grid fits no single orientation
+  kGridMismatch,   // the grid does not fit this target (size, corners outside)
+  kTooFewCorners,  // fewer than DetectOptions::min_corners
 };
 const char* RejectReasonName(RejectReason reason);
 
 struct DetectResult {
   std::vector<FaceDetection> faces;  // at most one: a camera sees one face
   RejectReason reason = RejectReason::kNone;
-  std::string message;               // why it was rejected, for people
-  DetectionQuality quality;          // what was measured, even when rejected
+  std::string message;       // why it was rejected, for people
+  DetectionQuality quality;  // what was measured, even when rejected
 };
 
 // Holds the AprilTag detector, so detecting many images costs no set-up.

@@ -11,8 +11,8 @@
 
 #include <cmath>
 #include <cstdio>
-#include <random>
 #include <opencv2/core.hpp>
+#include <random>
 
 #include "targets/synthetic_view.h"
 
@@ -42,6 +42,26 @@ int VisibleCorners(const Target& target, const PinholeCamera& camera, const Pose
   int n = 0;
   for (int id = 0; id < target.num_corners(); ++id) {
     const Eigen::Vector2d q = camera.Project(cam_from_face * target.CornerInFace(id));
+    if (q.x() >= margin_px && q.y() >= margin_px && q.x() <= camera.width_px - 1 - margin_px &&
+        q.y() <= camera.height_px - 1 - margin_px) {
+      ++n;
+    }
+  }
+  return n;
+}
+
+// Corners the detector can refine: at least a quarter of the local corner
+// spacing plus 3 px inside the image (ChessboardGridOptions::
+// refine_min_window_fraction, and cornerSubPix's 2 px border).
+int RefinableCorners(const Target& target, const PinholeCamera& camera, const Pose& cam_from_face) {
+  int n = 0;
+  const double s = target.square_size_mm();
+  for (int id = 0; id < target.num_corners(); ++id) {
+    const Eigen::Vector3d p = target.CornerInFace(id);
+    const Eigen::Vector2d q = camera.Project(cam_from_face * p);
+    const double spacing = std::min((camera.Project(cam_from_face * (p + Eigen::Vector3d(s, 0, 0))) - q).norm(),
+                                    (camera.Project(cam_from_face * (p + Eigen::Vector3d(0, s, 0))) - q).norm());
+    const double margin_px = 0.25 * spacing + 3;
     if (q.x() >= margin_px && q.y() >= margin_px && q.x() <= camera.width_px - 1 - margin_px &&
         q.y() <= camera.height_px - 1 - margin_px) {
       ++n;
@@ -130,8 +150,8 @@ TEST_F(DefaultTargetDetection, TagCornersSitAtTheirTrueProjection) {
 // Both corner sources: grown from the tags (the default) and OpenCV's grid.
 void FrontFaceAccuracy(const Target& target, const PinholeCamera& camera, const DetectOptions& options,
                        CornerSource expected_source, int num_poses) {
-  const double poses[][4] = {{260, 20, -25, 10}, {280, -30, 15, -40}, {300, 10, 35, 75},
-                             {250, -15, -10, 200}, {290, 30, 25, 140}, {270, -5, -30, -110}};
+  const double poses[][4] = {{260, 20, -25, 10},   {280, -30, 15, -40}, {300, 10, 35, 75},
+                             {250, -15, -10, 200}, {290, 30, 25, 140},  {270, -5, -30, -110}};
   const TargetDetector detector(target, options);
   double sum_sq = 0;
   int n = 0;
@@ -158,7 +178,8 @@ void FrontFaceAccuracy(const Target& target, const PinholeCamera& camera, const 
     n += static_cast<int>(det.corner_ids.size());
   }
   const double rms_px = std::sqrt(sum_sq / std::max(n, 1));
-  std::printf("front face, %s: RMS %.4f px over %d corners (noise off)\n", CornerSourceName(expected_source), rms_px, n);
+  std::printf("front face, %s: RMS %.4f px over %d corners (noise off)\n", CornerSourceName(expected_source), rms_px,
+              n);
   EXPECT_LT(rms_px, 0.05);
 }
 
@@ -175,7 +196,7 @@ TEST_F(DefaultTargetDetection, UpsideDownAndQuarterTurnedViewsGetTheRightIds) {
     SCOPED_TRACE(::testing::Message() << "rz " << rz);
     const Pose cam_from_face = LookAtFace(target_, 280, 12, -18, rz + 7);
     const FaceDetection det = DetectAndCheck(Face::kFront, cam_from_face, 0.05, 0.2);
-    EXPECT_EQ(det.quality.num_corners, VisibleCorners(target_, camera_, cam_from_face, 8));
+    EXPECT_EQ(det.quality.num_corners, RefinableCorners(target_, camera_, cam_from_face));
   }
 }
 
@@ -201,10 +222,9 @@ TEST_F(DefaultTargetDetection, PartialBoardWithOneTagInView) {
   // window must stay inside the image), so the bound is looser than for
   // whole boards: measured 0.054 px RMS here.
   const FaceDetection det = DetectAndCheck(Face::kFront, cam_from_face, 0.07, 0.25);
-  const int visible = VisibleCorners(target_, camera_, cam_from_face, 10);
-  EXPECT_LT(visible, 60);  // it really is partial
+  EXPECT_LT(VisibleCorners(target_, camera_, cam_from_face, 0), 60);  // it really is partial
   EXPECT_EQ(det.quality.num_tags, 1);
-  EXPECT_GE(det.quality.num_corners, visible);  // every corner 10 px inside, maybe some nearer the edge
+  EXPECT_GE(det.quality.num_corners, RefinableCorners(target_, camera_, cam_from_face));
   EXPECT_LE(det.quality.num_corners, VisibleCorners(target_, camera_, cam_from_face, 0));
 }
 
@@ -230,7 +250,11 @@ TEST_F(DefaultTargetDetection, RandomPartialViewsOfBothFacesGetRightIds) {
     EXPECT_EQ(r.faces[0].face, face);
     const Errors e = CompareWithTruth(target_, r.faces[0], camera_, cam_from_face);
     EXPECT_LT(e.max_px, 0.3);
-    EXPECT_GE(r.faces[0].quality.num_corners, VisibleCorners(target_, camera_, cam_from_face, 12));
+    EXPECT_GE(r.faces[0].quality.num_corners, RefinableCorners(target_, camera_, cam_from_face));
+    for (const Eigen::Vector2d& q : r.faces[0].q_px) {  // never a corner extrapolated out of the image
+      EXPECT_TRUE(q.x() >= 2 && q.y() >= 2 && q.x() <= camera_.width_px - 3 && q.y() <= camera_.height_px - 3)
+          << q.transpose();
+    }
     ++accepted;
     corners += r.faces[0].quality.num_corners;
   }
@@ -275,6 +299,23 @@ TEST_F(DefaultTargetDetection, WrongFaceNoTagsAndTooFewCornersAreRejected) {
   std::string why;
   EXPECT_TRUE(DetectTarget(whole, target_, demanding, &why).empty());
   EXPECT_NE(why.find("corners"), std::string::npos);
+}
+
+// Tags that disagree with the target file (here: the file puts front tag 3
+// one square to the right of where it is printed) are refused as ambiguous
+// rather than trusted.
+TEST_F(DefaultTargetDetection, TagsThatDisagreeWithTheTargetFileAreRejected) {
+  Target::Layout moved = target_.layout();
+  for (TagPlacement& t : moved.faces[0].tags) {
+    if (t.id == 3) t.center_x_mm += 9.0;  // still in the top margin, off the squares
+  }
+  const Target wrong(moved, "moved tag");
+  const Pose cam_from_face = LookAtFace(target_, 280, 10, -15, 5);
+  ASSERT_EQ(VisibleTags(target_, Face::kFront, camera_, cam_from_face, 2), 8);
+  const DetectResult r =
+      TargetDetector(wrong, DetectOptions()).Detect(RenderFace(target_, Face::kFront, camera_, cam_from_face));
+  EXPECT_TRUE(r.faces.empty());
+  EXPECT_EQ(r.reason, RejectReason::kAmbiguous) << r.message;
 }
 
 // With sensor noise the error grows, but ids stay right.

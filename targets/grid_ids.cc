@@ -122,8 +122,8 @@ Agreement Vote(const Target& target, const ChessboardGrid& grid, const std::vect
   GridMap map;
   map.d = d;
   if (!votes.empty()) {
-    const auto best = std::max_element(votes.begin(), votes.end(),
-                                       [](const auto& x, const auto& y) { return x.second < y.second; });
+    const auto best =
+        std::max_element(votes.begin(), votes.end(), [](const auto& x, const auto& y) { return x.second < y.second; });
     map.offset = Eigen::Vector2i(static_cast<int>(best->first.first), static_cast<int>(best->first.second));
   }
   Agreement a = Agree(target, grid, g, map, gate);
@@ -246,8 +246,8 @@ GridIds GridIdsFromTags(const Target& target, Face face, const std::vector<TagDe
     if (best.count == before) break;
   }
   if (best.count < min_agreeing_fraction * n) {
-    out.problem = "only " + std::to_string(best.count) + " of " + std::to_string(n) +
-                  " corners sit where the tags put them";
+    out.problem =
+        "only " + std::to_string(best.count) + " of " + std::to_string(n) + " corners sit where the tags put them";
     return out;
   }
   double sum_sq = 0;
@@ -294,7 +294,8 @@ GridIds GridIdsFromColours(const Target& target, const cv::Mat& grey, const Ches
       for (int c = 0; c + 1 < grid.cols; ++c) {
         const Eigen::Vector2d centre_mm = 0.5 * (cand.map(c, r) + cand.map(c + 1, r + 1)).cast<double>() * s;
         const bool black = target.IsBlack(Face::kFront, centre_mm.x(), centre_mm.y());
-        const Eigen::Vector2d q = 0.25 * (grid.at(c, r) + grid.at(c + 1, r) + grid.at(c, r + 1) + grid.at(c + 1, r + 1));
+        const Eigen::Vector2d q =
+            0.25 * (grid.at(c, r) + grid.at(c + 1, r) + grid.at(c, r + 1) + grid.at(c + 1, r + 1));
         sum[black] += SampleBilinear(grey, q);
         ++count[black];
         cand.black.push_back(black);
@@ -309,9 +310,9 @@ GridIds GridIdsFromColours(const Target& target, const cv::Mat& grey, const Ches
   }
   // Colour twins sample the same squares with the same expectations, so
   // their contrasts are equal; the image's right direction breaks the tie.
-  const Candidate* best_colour = &*std::max_element(
-      candidates.begin(), candidates.end(),
-      [](const Candidate& x, const Candidate& y) { return x.contrast_dn < y.contrast_dn; });
+  const Candidate* best_colour =
+      &*std::max_element(candidates.begin(), candidates.end(),
+                         [](const Candidate& x, const Candidate& y) { return x.contrast_dn < y.contrast_dn; });
   const Candidate* chosen = best_colour;
   for (const Candidate& cand : candidates) {
     if (cand.black == best_colour->black && cand.rightwards > chosen->rightwards) chosen = &cand;

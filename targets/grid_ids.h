@@ -25,10 +25,10 @@ struct GridMap {
 
 struct GridIds {
   bool ok = false;
-  std::string problem;         // why not, when !ok
+  std::string problem;  // why not, when !ok
   GridMap map;
-  std::vector<bool> keep;      // (rows * cols) corners that agree with the map
-  double tag_fit_rms_px = 0;   // tags only
+  std::vector<bool> keep;     // (rows * cols) corners that agree with the map
+  double tag_fit_rms_px = 0;  // tags only
 };
 
 // Homography image_from_face (face mm, z = 0 -> px) through the tags'

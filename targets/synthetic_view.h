@@ -26,13 +26,13 @@ struct PinholeCamera {
 };
 
 struct SyntheticViewOptions {
-  int supersample = 4;             // samples per pixel along each axis (>= 1); default 4 (16 per pixel)
-  double blur_sigma_px = 0.7;      // Gaussian optical blur after sampling, px; 0 = none. Default 0.7
-  double black_dn = 30.0;          // grey level of black print. Default 30
-  double white_dn = 220.0;         // grey level of white paper. Default 220
-  double background_dn = 90.0;     // grey level off the plate. Default 90
-  double noise_sigma_dn = 0.0;     // additive Gaussian noise before 8-bit rounding, DN. Default 0
-  uint64_t seed = 1;               // noise seed
+  int supersample = 4;          // samples per pixel along each axis (>= 1); default 4 (16 per pixel)
+  double blur_sigma_px = 0.7;   // Gaussian optical blur after sampling, px; 0 = none. Default 0.7
+  double black_dn = 30.0;       // grey level of black print. Default 30
+  double white_dn = 220.0;      // grey level of white paper. Default 220
+  double background_dn = 90.0;  // grey level off the plate. Default 90
+  double noise_sigma_dn = 0.0;  // additive Gaussian noise before 8-bit rounding, DN. Default 0
+  uint64_t seed = 1;            // noise seed
 };
 
 // Renders `face` of `target` seen by `camera` at `cam_from_face` (mm).

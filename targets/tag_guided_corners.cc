@@ -79,7 +79,9 @@ TagGuidedCorners FindCornersFromTags(const Target& target, Face face, const std:
       cv::cornerSubPix(grey, pt, cv::Size(half, half), cv::Size(-1, -1),
                        cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40, 1e-4));
       const Eigen::Vector2d q1(pt[0].x, pt[0].y);
-      if (!q1.allFinite() || (q1 - q0).norm() > refine.refine_max_shift_fraction * spacing) continue;
+      if (!q1.allFinite() ||
+          (q1 - q0).norm() > std::min(refine.refine_max_shift_fraction * spacing, static_cast<double>(half)))
+        continue;
       // The saddle: the four squares around the corner, sampled 0.3 of a
       // square along each diagonal, have the target's colours.
       double black_max = -1, white_min = 1e9, black_sum = 0, white_sum = 0;
@@ -117,7 +119,8 @@ TagGuidedCorners FindCornersFromTags(const Target& target, Face face, const std:
       const int col = id % nx, row = id / nx;
       for (int dr = -1; dr <= 1; ++dr)
         for (int dc = -1; dc <= 1; ++dc)
-          if (col + dc >= 0 && col + dc < nx && row + dr >= 0 && row + dr < ny) candidate[(row + dr) * nx + col + dc] = true;
+          if (col + dc >= 0 && col + dc < nx && row + dr >= 0 && row + dr < ny)
+            candidate[(row + dr) * nx + col + dc] = true;
     }
     const cv::Mat m = cv::findHomography(src, dst, 0);
     if (!m.empty()) cv::cv2eigen(m, h);

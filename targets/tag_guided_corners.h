@@ -18,9 +18,9 @@
 namespace stereorig {
 
 struct TagGuidedCorners {
-  std::vector<int> ids;              // (N) ascending
-  std::vector<Eigen::Vector2d> q_px; // (N), mrcal pixel convention
-  double tag_fit_rms_px = 0;         // tags' corners against the final homography
+  std::vector<int> ids;               // (N) ascending
+  std::vector<Eigen::Vector2d> q_px;  // (N), mrcal pixel convention
+  double tag_fit_rms_px = 0;          // tags' corners against the final homography
 };
 
 // `image_from_face`: the tags' homography (grid_ids.h TagHomography).

@@ -21,10 +21,11 @@ struct Result {
 };
 
 inline Result RunCli(const std::string& args) {
-  const std::string dir = ::testing::TempDir();
-  // Per process: several checkouts' test suites may run at once on one machine.
-  const std::string tag = std::to_string(getpid());
-  const std::string o = dir + "/cli_out_" + tag + ".txt", e = dir + "/cli_err_" + tag + ".txt";
+  // Per process and call: ctest runs test cases in parallel processes that
+  // share TempDir().
+  static int calls = 0;
+  const std::string stem = ::testing::TempDir() + "/cli_" + std::to_string(getpid()) + "_" + std::to_string(calls++);
+  const std::string o = stem + "_out.txt", e = stem + "_err.txt";
   const int status = std::system((kBin + " " + args + " >" + o + " 2>" + e).c_str());
   auto slurp = [](const std::string& p) {
     std::ifstream f(p);
@@ -32,7 +33,10 @@ inline Result RunCli(const std::string& args) {
     s << f.rdbuf();
     return s.str();
   };
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(o), slurp(e)};
+  Result r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(o), slurp(e)};
+  std::remove(o.c_str());
+  std::remove(e.c_str());
+  return r;
 }
 
 inline int Lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }

@@ -8,6 +8,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "calib/core/rig_file.h"
+#include "datasets/default_rig.h"
 #include "tests/cli_runner.h"
 
 namespace {
@@ -16,14 +18,11 @@ using stereorig::testing::Lines;
 using stereorig::testing::Result;
 using stereorig::testing::RunCli;
 
+// The embedded default rig, as the simulator writes its truth.
 std::string GoodRigText() {
-  const std::string dir = ::testing::TempDir() + "/cli_demo";
-  const Result r = RunCli("demo --out " + dir);
-  EXPECT_EQ(r.code, 0) << r.err;
-  std::ifstream f(dir + "/truth_rig.yaml");
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
+  stereorig::SimulatedRig sim = stereorig::MakeDefaultRig();
+  sim.rig.provenance().date_utc = "2026-11-23T00:00:00Z";
+  return stereorig::RigToYaml(sim.rig);
 }
 
 std::string Replace(std::string text, const std::string& from, const std::string& to) {

@@ -1,0 +1,227 @@
+#include "datasets/simulate.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <unordered_map>
+
+#include "calib/core/input_error.h"
+#include "calib/core/rig_file.h"
+#include "calib/core/yaml_reader.h"
+#include "datasets/sim_test_util.h"
+
+namespace stereorig {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Slurp(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+std::string RunSim(const SimSpec& spec, const std::string& name, uint64_t seed, int threads, RigBump bump = {}) {
+  SimulateOptions o;
+  o.out_dir = ::testing::TempDir() + "/simtest_" + name;
+  o.seed = seed;
+  o.threads = threads;
+  o.bump = bump;
+  Simulate(spec, o);
+  return o.out_dir;
+}
+
+TEST(Simulate, SameSeedSameBytesWhateverTheThreads) {
+  SimSpec spec = SmallRingSpec(2, 4, 2);
+  spec.scenes.names = {"tuber"};  // the slowest shape: sphere tracing
+  const fs::path a = RunSim(spec, "det_a", 5, 1), b = RunSim(spec, "det_b", 5, 2), c = RunSim(spec, "det_c", 6, 2);
+  int files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(a)) {
+    if (!e.is_regular_file()) continue;
+    const fs::path rel = fs::relative(e.path(), a);
+    ASSERT_TRUE(fs::exists(b / rel)) << rel;
+    EXPECT_EQ(Slurp(e.path()), Slurp(b / rel)) << rel;
+    ++files;
+  }
+  EXPECT_GT(files, 25);
+  // Another seed: other poses, other noise.
+  EXPECT_NE(Slurp(a / "calibration/000/cam0.png"), Slurp(c / "calibration/000/cam0.png"));
+  EXPECT_NE(Slurp(a / "scenes/tuber/passive/cam0.png"), Slurp(c / "scenes/tuber/passive/cam0.png"));
+}
+
+// Any number of modules renders: the layout, the truth rig and every image.
+TEST(Simulate, OneTwoAndThreeModuleRigsRender) {
+  for (int m = 1; m <= 3; ++m) {
+    SimSpec spec = SmallRingSpec(m, 4, 2);
+    spec.scenes.names = {"sphere"};
+    const fs::path dir = RunSim(spec, "ring" + std::to_string(m), 1, 2);
+    const Rig rig = ReadRigFile((dir / "truth/rig.yaml").string());
+    EXPECT_EQ(rig.num_modules(), m);
+    YamlMap layout = YamlMap::LoadFile((dir / "layout.yaml").string());
+    EXPECT_EQ(layout.GetMaps("modules").size(), static_cast<size_t>(m));
+    for (int cam = 0; cam < 2 * m; ++cam) {
+      const std::string name = "cam" + std::to_string(cam) + ".png";
+      for (const char* k : {"000", "001"}) {
+        const cv::Mat im = cv::imread((dir / "calibration" / k / name).string(), cv::IMREAD_UNCHANGED);
+        ASSERT_EQ(im.type(), CV_8U) << dir / "calibration" / k / name;
+        EXPECT_EQ(im.cols, spec.modules[cam / 2].left.width_px);
+      }
+      const cv::Mat active = cv::imread((dir / "scenes/sphere/active" / name).string(), cv::IMREAD_UNCHANGED);
+      const cv::Mat passive = cv::imread((dir / "scenes/sphere/passive" / name).string(), cv::IMREAD_UNCHANGED);
+      const cv::Mat id = cv::imread((dir / "truth/scenes/sphere" / ("id_" + name)).string(),
+                                    cv::IMREAD_UNCHANGED);
+      ASSERT_FALSE(active.empty());
+      ASSERT_FALSE(id.empty());
+      // Every camera sees the sphere, and its own module's laser on it.
+      const cv::Mat on = id > 0;
+      EXPECT_GT(cv::countNonZero(on), 200);
+      EXPECT_GT(cv::mean(active, on)[0], cv::mean(passive, on)[0] + 5);
+    }
+  }
+}
+
+TEST(Simulate, RefusesToReplaceAFolderThatIsNotADatasetAndLeavesNoTemporaries) {
+  const fs::path dir = ::testing::TempDir() + "/simtest_precious";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "thesis.txt") << "do not lose";
+  SimulateOptions o;
+  o.out_dir = dir.string();
+  EXPECT_THROW(Simulate(SmallRingSpec(1, 4, 1), o), InputError);
+  EXPECT_EQ(Slurp(dir / "thesis.txt"), "do not lose");
+  for (const auto& e : fs::directory_iterator(dir.parent_path())) {
+    EXPECT_EQ(e.path().filename().string().find(".simtest_precious.tmp"), std::string::npos);
+  }
+}
+
+// The morning after a bump: the truth moves by exactly what was asked.
+TEST(Simulate, BumpsMoveTheTruthByTheRequestedAmount) {
+  SimSpec spec = SmallRingSpec(2, 4, 1);
+  spec.scenes.names.clear();
+  const Rig before = ReadRigFile(RunSim(spec, "bump0", 3, 2) + "/truth/rig.yaml");
+  RigBump cam;
+  cam.camera = 1;
+  cam.rotation_deg = 0.05;
+  const Rig after_cam = ReadRigFile(RunSim(spec, "bump1", 3, 2, cam) + "/truth/rig.yaml");
+  const Pose d = before.module(0).right_from_left * after_cam.module(0).right_from_left.Inverse();
+  EXPECT_NEAR(d.AngleDeg(), 0.05, 1e-9);
+  EXPECT_LT((before.S(0, 1).Inverse() * after_cam.S(0, 1)).AngleDeg(), 1e-12);  // other modules untouched
+  RigBump mod;
+  mod.module = 1;
+  mod.translation_mm = 0.1;
+  const Rig after_mod = ReadRigFile(RunSim(spec, "bump2", 3, 2, mod) + "/truth/rig.yaml");
+  const Pose m = before.S(0, 1).Inverse() * after_mod.S(0, 1);
+  EXPECT_NEAR(m.DistanceMm(), 0.1, 1e-9);
+  EXPECT_LT(m.AngleDeg(), 1e-9);
+  EXPECT_LT((before.module(1).right_from_left.Inverse() * after_mod.module(1).right_from_left).DistanceMm(), 1e-9);
+}
+
+}  // namespace
+}  // namespace stereorig
+
+namespace stereorig {
+namespace {
+
+// Any mrcal lens model: a pinhole and a splined stereographic camera render
+// through their own unprojection.
+TEST(Simulate, OtherLensModelsRender) {
+  SimSpec spec = SmallRingSpec(1, 4, 1);
+  spec.scenes.names = {"sphere"};
+  CameraSpec& l = spec.modules[0].left;
+  l.lensmodel = "LENSMODEL_PINHOLE";
+  l.intrinsics.resize(4);
+  CameraSpec& r = spec.modules[0].right;
+  r.lensmodel = "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=8_Ny=6_fov_x_deg=50";
+  r.intrinsics.resize(4);
+  r.intrinsics.resize(4 + 2 * 8 * 6, 0.0);  // no deviation from a pure stereographic lens
+  const fs::path dir = RunSim(spec, "lenses", 2, 2);
+  for (const char* cam : {"cam0", "cam1"}) {
+    const cv::Mat id =
+        cv::imread((dir / "truth/scenes/sphere" / (std::string("id_") + cam + ".png")).string(), cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(id.empty());
+    EXPECT_GT(cv::countNonZero(id), 200) << cam;  // the sphere is in view of both lenses
+  }
+  EXPECT_EQ(ReadRigFile((dir / "truth/rig.yaml").string()).camera(1).lensmodel_name(), r.lensmodel);
+}
+
+}  // namespace
+}  // namespace stereorig
+
+namespace stereorig {
+namespace {
+
+std::vector<Eigen::Vector3f> ReadPly(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::string line;
+  size_t n = 0;
+  while (std::getline(f, line) && line != "end_header") {
+    if (line.rfind("element vertex ", 0) == 0) n = std::stoul(line.substr(15));
+  }
+  std::vector<Eigen::Vector3f> pts(n);
+  f.read(reinterpret_cast<char*>(pts.data()), static_cast<std::streamsize>(n * sizeof(Eigen::Vector3f)));
+  EXPECT_TRUE(f.good()) << p;
+  return pts;
+}
+
+// Two independent truths agree: every depth-map pixel (ray intersection),
+// lifted to 3D, lies within 0.15 mm of a dense surface sample (parametric
+// sampling). A 0.2 mm grid leaves no surface point farther than 0.2/sqrt(2).
+TEST(Simulate, DepthMapsLieOnTheDenseSurface) {
+  SimSpec spec = SmallRingSpec(2, 4, 0);
+  spec.scenes.names = {"cup", "tuber", "ballbar"};
+  const fs::path dir = RunSim(spec, "surface", 4, 2);
+  const Rig rig = ReadRigFile((dir / "truth/rig.yaml").string());
+  for (const std::string scene : {"cup", "tuber", "ballbar"}) {
+    const std::vector<Eigen::Vector3f> pts = ReadPly(dir / "truth/scenes" / scene / "surface.ply");
+    ASSERT_GT(pts.size(), 10000u);
+    // A hash grid of 0.5 mm cells.
+    const float cell = 0.5f;
+    auto key = [&](const Eigen::Vector3f& p, int dx, int dy, int dz) {
+      const int64_t x = static_cast<int64_t>(std::floor(p.x() / cell)) + dx;
+      const int64_t y = static_cast<int64_t>(std::floor(p.y() / cell)) + dy;
+      const int64_t z = static_cast<int64_t>(std::floor(p.z() / cell)) + dz;
+      return (x * 73856093) ^ (y * 19349663) ^ (z * 83492791);
+    };
+    std::unordered_map<int64_t, std::vector<int>> grid;
+    for (size_t i = 0; i < pts.size(); ++i) grid[key(pts[i], 0, 0, 0)].push_back(static_cast<int>(i));
+    double worst = 0;
+    int checked = 0;
+    for (int cam = 0; cam < rig.num_cameras(); ++cam) {
+      const cv::Mat depth = cv::imread((dir / "truth/scenes" / scene / ("depth_cam" + std::to_string(cam) + ".tiff")).string(),
+                                       cv::IMREAD_UNCHANGED);
+      ASSERT_EQ(depth.type(), CV_32F);
+      const Pose ref_from_cam = rig.CamFromReference(cam).Inverse();
+      for (int r = 0; r < depth.rows; r += 2) {
+        for (int c = 0; c < depth.cols; c += 2) {
+          const float z = depth.at<float>(r, c);
+          if (!(z > 0)) continue;
+          Eigen::Vector3d v;
+          ASSERT_TRUE(rig.camera(cam).Unproject(Eigen::Vector2d(c, r), &v));
+          const Eigen::Vector3f p = (ref_from_cam * (v * (z / v.z()))).cast<float>();
+          double best = 1e9;
+          for (int dx = -1; dx <= 1; ++dx)
+            for (int dy = -1; dy <= 1; ++dy)
+              for (int dz = -1; dz <= 1; ++dz) {
+                auto it = grid.find(key(p, dx, dy, dz));
+                if (it == grid.end()) continue;
+                for (int i : it->second) best = std::min(best, static_cast<double>((pts[i] - p).norm()));
+              }
+          worst = std::max(worst, best);
+          ++checked;
+        }
+      }
+    }
+    EXPECT_GT(checked, 1000) << scene;
+    EXPECT_LT(worst, 0.15) << scene;
+    std::printf("%s: %zu surface samples; %d depth pixels, farthest from a sample %.3f mm\n", scene.c_str(), pts.size(),
+                checked, worst);
+  }
+}
+
+}  // namespace
+}  // namespace stereorig

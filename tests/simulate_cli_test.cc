@@ -1,0 +1,43 @@
+// `stereorig simulate` from the command line: the spec round trip through a
+// file, bad specs (exit 2, one line naming the key), and (label e2e) the
+// whole default dataset is in simulate_e2e_test.cc.
+#include <gtest/gtest.h>
+
+#include <chrono>
+
+#include "tests/sim_cli_util.h"
+
+namespace {
+
+using namespace sim_cli;
+
+TEST(SimulateCli, DefaultSpecFileRoundTripsAndBadKeysExitTwo) {
+  const std::string dir = ::testing::TempDir();
+  const std::string spec = dir + "/sim_default_spec.yaml";
+  ASSERT_EQ(RunCli("simulate --write-default-spec " + spec).code, 0);
+  const std::string text = Slurp(spec);
+  ASSERT_NE(text.find("lines: 51"), std::string::npos);
+  // The written default renders (one capture, no scenes).
+  Result r = RunCli("simulate --spec " + spec + " --out " + dir + "/sim_cli_ds --calibration-captures 1 --no-scenes");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir + "/sim_cli_ds/calibration/000/cam3.png"));
+  // A typo in a key: exit 2, one line naming the file and the key.
+  std::string bad = text;
+  bad.replace(bad.find("psf_sigma_px"), 12, "psf_sigma_pix");
+  std::ofstream(dir + "/sim_bad_spec.yaml") << bad;
+  r = RunCli("simulate --spec " + dir + "/sim_bad_spec.yaml --out " + dir + "/sim_cli_bad");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("psf_sigma_pix"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("sim_bad_spec.yaml"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/sim_cli_bad"));
+  // A bad value.
+  bad = text;
+  bad.replace(bad.find("captures: 50"), 12, "captures: -4");
+  std::ofstream(dir + "/sim_bad_spec2.yaml") << bad;
+  r = RunCli("simulate --spec " + dir + "/sim_bad_spec2.yaml --out " + dir + "/sim_cli_bad");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("captures"), std::string::npos) << r.err;
+}
+
+}  // namespace
