@@ -223,6 +223,26 @@ TEST(CalibrateE2E, DefaultTargetOfTheTargetsLibrary) {
 }
 
 TEST(CalibrateE2E, OneModuleRig) { CheckRig(testing::MakeOneModuleRig(), 7); }
+
+// A plain one-sided chessboard (what most labs own) serves stages 1 and 2 of
+// a one-module rig.
+TEST(CalibrateE2E, PlainBoardOneModule) {
+  const SimulatedRig rig = testing::MakeOneModuleRig();
+  TargetGeometry plain = DefaultTestTarget();
+  plain.double_sided = false;
+  SyntheticOptions o;
+  o.seed = 9;
+  o.num_captures = kCaptures;
+  o.noise_px = kNoisePx;
+  const Pose volume = testing::DefaultVolume(rig.world_from_module0);
+  const SyntheticData data = MakeSyntheticCaptures(rig.rig, plain, plain.back_from_front, volume, o);
+  const CalibrationResult r = Calibrate(data.input, CalibrationOptions());
+  for (const IntrinsicsReport& ir : r.report.intrinsics) EXPECT_NEAR(ir.rms_px, kNoisePx, 0.1 * kNoisePx);
+  std::vector<Eigen::Vector3d> pc, pt;
+  testing::TriangulateThroughModule(rig.rig, r.rig, 0, VolumePoints(volume, Eigen::Vector3d(75, 75, 50), 500, 9), &pc,
+                                    &pt);
+  EXPECT_LT(testing::RigidAlignedRms(pt, pc), 0.05);
+}
 TEST(CalibrateE2E, ThreeModuleRig) { CheckRig(testing::MakeThreeModuleRig(), 7); }
 
 // ---- Refusals: each an InputError naming the problem.
