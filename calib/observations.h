@@ -71,7 +71,7 @@ struct CameraImager {
 
 struct CalibrationInput {
   TargetGeometry target;
-  std::vector<CameraImager> cameras;    // indexed by global camera index
+  std::vector<CameraImager> cameras;  // indexed by global camera index
   std::vector<ModuleLayout> modules;  // module 0 is the reference
   std::vector<BoardObservation> observations;
   std::string source = "observations";  // for provenance and error messages

@@ -15,7 +15,7 @@ void TriangulateThroughModule(const Rig& truth, const Rig& calibrated, int k, co
   const StereoModule& cm = calibrated.module(k);
   const Camera& tl = truth.camera(tm.left_camera);
   const Camera& tr = truth.camera(tm.right_camera);
-  const Pose module_from_ref = truth.S(k, 0);
+  const Pose& module_from_ref = truth.S(k, 0);
   p_cal->clear();
   p_true->clear();
   if (used) used->clear();
@@ -52,7 +52,7 @@ double RigidAlignedRms(const std::vector<Eigen::Vector3d>& a, const std::vector<
   return std::sqrt(s2 / a.size());
 }
 
-double ModuleAgreementRms(const Rig& truth, const Rig& calibrated, const Pose& i_from_j, int i, int j,
+double ModuleAgreementRms(const Rig& truth, const Rig& calibrated, const Pose& module_i_from_module_j, int i, int j,
                           const std::vector<Eigen::Vector3d>& p_ref) {
   std::vector<Eigen::Vector3d> ci, ti, cj, tj;
   std::vector<int> ui, uj;
@@ -65,7 +65,7 @@ double ModuleAgreementRms(const Rig& truth, const Rig& calibrated, const Pose& i
   for (size_t n = 0; n < uj.size(); ++n) {
     auto it = by_point.find(uj[n]);
     if (it == by_point.end()) continue;
-    s2 += (it->second - i_from_j * cj[n]).squaredNorm();
+    s2 += (it->second - module_i_from_module_j * cj[n]).squaredNorm();
     ++count;
   }
   return count ? std::sqrt(s2 / count) : NAN;

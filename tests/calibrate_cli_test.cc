@@ -6,11 +6,11 @@
 // The refusals exit 2 with one line naming the problem.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
-#include <unistd.h>
 
 #include "calib/calib_test_util.h"
 #include "calib/core/rig_file.h"
