@@ -4,10 +4,12 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
@@ -42,6 +44,14 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// CPU time of the whole process (every thread), s. Only one pipeline runs at
+// a time, so its difference across a call is that call's CPU time.
+double CpuSeconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_utime.tv_sec + u.ru_stime.tv_sec + 1e-6 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
 double PeakMemoryMb() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
@@ -53,36 +63,48 @@ nlohmann::json FiguresJson(const ErrorFigures& f) {
           {"std_mm", f.std_mm},     {"rms_mm", f.rms_mm},           {"p95_abs_mm", f.p95_abs_mm}};
 }
 
-// Runs one pipeline `runs` times over every scene; returns its JSON section.
-nlohmann::json BenchPipeline(const Rig& rig, RuntimeOptions options, MatcherKind matcher,
-                             const std::vector<Scene>& scenes, int runs) {
-  options.match.matcher = matcher;
-  const auto t_build = Clock::now();
-  const Runtime runtime(rig, options);
-  const double build_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_build).count();
-  std::map<std::string, std::vector<double>> steps;
-  runtime.Process(scenes[0].images, false);  // warm-up (page faults, thread start)
-  const auto t0 = Clock::now();
+struct Pipeline {
+  MatcherKind matcher;
+  std::unique_ptr<Runtime> runtime;
+  double build_ms = 0;
+  double busy_s = 0;  // summed wall time of its Process() calls
+  double cpu_s = 0;   // summed CPU time (all threads) of its Process() calls
   int objects = 0;
+  std::map<std::string, std::vector<double>> steps;
+};
+
+// Both pipelines run interleaved (ours, baseline, ours, ...), capture by
+// capture, so a change in the machine's load hits both alike; objects/s is
+// objects over the summed wall time of each pipeline's own Process() calls.
+void BenchInterleaved(std::vector<Pipeline>& pipelines, const std::vector<Scene>& scenes, int runs) {
+  for (Pipeline& p : pipelines) p.runtime->Process(scenes[0].images, false);  // warm-up
   for (int r = 0; r < runs; ++r)
-    for (const Scene& s : scenes) {
-      const Reconstruction rec = runtime.Process(s.images, false);
-      ++objects;
-      for (const auto& [k, v] : rec.times_ms) steps[k].push_back(v);
-      for (const ModuleReport& m : rec.modules)
-        for (const auto& [k, v] : m.times_ms) steps["module" + std::to_string(m.module) + "." + k].push_back(v);
-    }
-  const double wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
-  nlohmann::json j = {{"matcher", MatcherKindName(matcher)},
-                      {"runtime_build_ms", build_ms},
-                      {"objects", objects},
-                      {"wall_s", wall_s},
-                      {"objects_per_s", objects / wall_s}};
-  for (const auto& [k, v] : steps) j["median_time_ms"][k] = Median(v);
-  // Meshing and hole filling, timed apart from the point-cloud path; and
-  // the accuracy of each scene's cloud.
+    for (const Scene& s : scenes)
+      for (Pipeline& p : pipelines) {
+        const auto t0 = Clock::now();
+        const double c0 = CpuSeconds();
+        const Reconstruction rec = p.runtime->Process(s.images, false);
+        p.busy_s += std::chrono::duration<double>(Clock::now() - t0).count();
+        p.cpu_s += CpuSeconds() - c0;
+        ++p.objects;
+        for (const auto& [k, v] : rec.times_ms) p.steps[k].push_back(v);
+        for (const ModuleReport& m : rec.modules)
+          for (const auto& [k, v] : m.times_ms) p.steps["module" + std::to_string(m.module) + "." + k].push_back(v);
+      }
+}
+
+// One pipeline's JSON section: speed, step medians; then, untimed by the
+// loop above, meshing and hole filling and each scene's accuracy.
+nlohmann::json PipelineJson(const Pipeline& p, const Rig& rig, const std::vector<Scene>& scenes) {
+  nlohmann::json j = {{"matcher", MatcherKindName(p.matcher)},
+                      {"runtime_build_ms", p.build_ms},
+                      {"objects", p.objects},
+                      {"busy_s", p.busy_s},
+                      {"objects_per_s", p.objects / p.busy_s},
+                      {"cpu_ms_per_object", 1e3 * p.cpu_s / p.objects}};
+  for (const auto& [k, v] : p.steps) j["median_time_ms"][k] = Median(v);
   for (const Scene& s : scenes) {
-    const Reconstruction rec = runtime.Process(s.images, true);
+    const Reconstruction rec = p.runtime->Process(s.images, true);
     nlohmann::json sj = ReconstructionJson(rec);
     sj["scene"] = s.name;
     if (!s.truth.empty()) {
@@ -103,8 +125,9 @@ nlohmann::json BenchPipeline(const Rig& rig, RuntimeOptions options, MatcherKind
 }
 
 void PrintPipeline(const nlohmann::json& j) {
-  std::printf("%-17s %6.1f objects/s  (median: total %.1f ms, modules %.1f ms, match m0 %.1f ms)\n",
+  std::printf("%-17s %6.1f objects/s, %.0f CPU ms/object  (median: total %.1f ms, modules %.1f ms, match m0 %.1f ms)\n",
               j["matcher"].get<std::string>().c_str(), j["objects_per_s"].get<double>(),
+              j["cpu_ms_per_object"].get<double>(),
               j["median_time_ms"]["total_point_cloud"].get<double>(), j["median_time_ms"]["modules"].get<double>(),
               j["median_time_ms"]["module0.match"].get<double>());
   for (const auto& s : j["scenes"]) {
@@ -182,16 +205,31 @@ int RunBench(int argc, char** argv) {
   std::printf("bench: %zu scene(s), %d run(s) each, %d modules, %u hardware threads\n", scenes.size(), runs,
               rig.num_modules(), std::thread::hardware_concurrency());
 
+  std::vector<Pipeline> pipelines;
+  for (MatcherKind kind : {MatcherKind::kCensusSgm, MatcherKind::kOpenCvSgbm3Way}) {
+    RuntimeOptions o = options;
+    o.match.matcher = kind;
+    const auto t0 = Clock::now();
+    pipelines.push_back(Pipeline{kind, std::make_unique<Runtime>(rig, o), 0, 0, 0, 0, {}});
+    pipelines.back().build_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  }
+  BenchInterleaved(pipelines, scenes, runs);
   nlohmann::json report;
-  report["ours"] = BenchPipeline(rig, options, MatcherKind::kCensusSgm, scenes, runs);
+  report["ours"] = PipelineJson(pipelines[0], rig, scenes);
   PrintPipeline(report["ours"]);
-  report["baseline"] = BenchPipeline(rig, options, MatcherKind::kOpenCvSgbm3Way, scenes, runs);
+  report["baseline"] = PipelineJson(pipelines[1], rig, scenes);
   PrintPipeline(report["baseline"]);
   const double ratio = report["ours"]["objects_per_s"].get<double>() / report["baseline"]["objects_per_s"].get<double>();
   report["speed_ratio_ours_over_sgbm"] = ratio;
+  const double cpu_ratio =
+      report["baseline"]["cpu_ms_per_object"].get<double>() / report["ours"]["cpu_ms_per_object"].get<double>();
+  report["cpu_ratio_sgbm_over_ours"] = cpu_ratio;
+  double load[3] = {0, 0, 0};
+  if (getloadavg(load, 3) > 0) report["machine_load_average_1min"] = load[0];
   report["peak_memory_mb"] = PeakMemoryMb();
-  std::printf("speed ratio (ours / SGBM pipeline): %.2fx; peak memory of this process: %.0f MB\n", ratio,
-              PeakMemoryMb());
+  std::printf("speed ratio (ours / SGBM pipeline): %.2fx wall, %.2fx CPU; peak memory of this process: %.0f MB; "
+              "machine load average %.1f (other processes slow both pipelines)\n",
+              ratio, cpu_ratio, PeakMemoryMb(), load[0]);
   if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
   return kExitOk;
 }

@@ -24,6 +24,7 @@
 #include "datasets/scene_objects.h"
 #include "datasets/target_render.h"
 #include "targets/target_file.h"
+#include "reconstruct/metrology/artifact.h"
 
 namespace stereorig {
 
@@ -375,6 +376,29 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
       for (std::string line; std::getline(lines, line);) o << "      " << line << "\n";
     }
     WriteText(tmp / "truth" / "scenes" / scene.name / "object.yaml", o.str());
+  }
+  // Certificates of the reference artifacts, as a calibration lab would
+  // deliver them (the simulator's true dimensions, certified uncertainty 0),
+  // for `stereorig verify --artifact DIR/artifacts/<scene>.yaml`.
+  for (const Scene& scene : scenes) {
+    Artifact a;
+    a.name = scene.name + " (simulated, seed " + std::to_string(seed) + ")";
+    if (scene.name == "sphere") {
+      a.type = ArtifactType::kSphere;
+      a.sphere_diameter_mm = spec.scenes.sphere_diameter_mm;
+    } else if (scene.name == "ballbar") {
+      a.type = ArtifactType::kBallBar;
+      a.sphere_diameter_mm = spec.scenes.ballbar_sphere_diameter_mm;
+      a.center_distance_mm = spec.scenes.ballbar_distance_mm;
+    } else if (scene.name == "plate") {
+      a.type = ArtifactType::kPlate;
+      a.plate_length_mm = spec.scenes.plate_size_mm.x();
+      a.plate_width_mm = spec.scenes.plate_size_mm.y();
+    } else {
+      continue;
+    }
+    fs::create_directories(tmp / "artifacts");
+    WriteText(tmp / "artifacts" / (scene.name + ".yaml"), ArtifactToYaml(a));
   }
   {
     std::ostringstream o;

@@ -123,10 +123,12 @@ cv::Mat SgmMatch(const CensusImage& left, const CensusImage& right, const cv::Re
       uint8_t* c = cost.data() + (size_t(y) * w + x) * n;
       const uint64_t l = cl[region.x + x];
       const int xr0 = region.x + x - min_disparity;  // right x at d index 0
-      for (int d = 0; d < n; ++d) {
-        const int xr = xr0 - d;
-        c[d] = (xr >= 0 && xr < rw) ? uint8_t(__builtin_popcountll(l ^ cr[xr])) : uint8_t(kCensusMaxCost);
-      }
+      // d indices whose right pixel xr0 - d lies in [0, rw): a branch-free run.
+      const int d_lo = std::clamp(xr0 - rw + 1, 0, n), d_hi = std::clamp(xr0 + 1, d_lo, n);
+      std::fill(c, c + d_lo, uint8_t(kCensusMaxCost));
+      const uint64_t* r = cr + xr0;
+      for (int d = d_lo; d < d_hi; ++d) c[d] = uint8_t(__builtin_popcountll(l ^ r[-d]));
+      std::fill(c + d_hi, c + n, uint8_t(kCensusMaxCost));
     }
   }
 

@@ -255,8 +255,15 @@ MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::
         const int x = roi.x + xx;
         double d = in[xx];
         float confidence = 1.0f;
+        const float pl = plane.at<float>(yy, xx);
+        // The plane test below, applied early to the cost-fit disparity (the
+        // refinement moves it by < max_shift_px): saves refining mismatches.
+        if (o.max_plane_deviation_px > 0 &&
+            (std::isnan(pl) || std::abs(d - pl) > o.max_plane_deviation_px + o.subpixel.max_shift_px))
+          continue;
         if (o.intensity_refinement) {
-          const SubpixelResult s = RefineDisparity(left, right, x, y, d, slope_x.at<float>(yy, xx), slope_y.at<float>(yy, xx), o.subpixel);
+          const SubpixelResult s = RefineDisparity(left, right, x, y, d, slope_x.at<float>(yy, xx),
+                                                   slope_y.at<float>(yy, xx), o.subpixel);
           if (!s.ok || s.zncc < o.min_zncc || s.std_dn < o.min_texture_dn) continue;
           d = s.disparity_px;
           confidence = float(std::clamp(s.zncc, 0.0, 1.0));
@@ -266,7 +273,6 @@ MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::
         // within max_plane_deviation_px of the plane fitted to the 9x9
         // integer-level disparities around it (isolated mismatches and the
         // edges of mismatched patches fail this).
-        const float pl = plane.at<float>(yy, xx);
         if (o.max_plane_deviation_px > 0 && (std::isnan(pl) || std::abs(d - pl) > o.max_plane_deviation_px)) continue;
         out[x] = float(d);
         conf[x] = confidence;

@@ -46,7 +46,7 @@ struct MatchOptions {
   int range_margin_px = 6;      // default 6 px
   int refine_radius_px = 2;     // census_sgm: fine-level search +-radius around 2x coarse; default 2
   int refine_half_window_px = 1;  // census_sgm: fine-level cost box half size; default 1 (3x3)
-  int census_half_width_px = 4;   // census_sgm: census window half width (<= 4); default 4 (9 px)
+  int census_half_width_px = 2;   // census_sgm: census window half width (<= 4); default 2 (5 px: tolerates foreshortening, cup fill 47% -> 73% vs 9 px)
   int census_half_height_px = 3;  // census_sgm: census window half height (<= 3); default 3 (7 px)
   SgmOptions sgm;               // census_sgm: penalties, paths, uniqueness, left-right check
   bool intensity_refinement = true;  // census_sgm: Lucas-Kanade sub-pixel step; default true

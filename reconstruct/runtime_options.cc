@@ -75,6 +75,11 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.subpixel.half_width_px = m.GetInt("subpixel_half_width_px", mo.subpixel.half_width_px);
     mo.subpixel.half_height_px = m.GetInt("subpixel_half_height_px", mo.subpixel.half_height_px);
     mo.min_zncc = m.GetDouble("min_zncc", mo.min_zncc);
+    mo.max_plane_deviation_px = m.GetDouble("max_plane_deviation_px", mo.max_plane_deviation_px);
+    mo.narrow_range = m.GetBool("narrow_range", mo.narrow_range);
+    mo.range_margin_px = m.GetInt("range_margin_px", mo.range_margin_px);
+    mo.census_half_width_px = m.GetInt("census_half_width_px", mo.census_half_width_px);
+    mo.census_half_height_px = m.GetInt("census_half_height_px", mo.census_half_height_px);
     mo.min_texture_dn = m.GetDouble("min_texture_dn", mo.min_texture_dn);
     mo.speckle_window_px = m.GetInt("speckle_window_px", mo.speckle_window_px);
     mo.speckle_range_px = m.GetDouble("speckle_range_px", mo.speckle_range_px);

@@ -13,6 +13,8 @@ void SubpixelOptions::Check() const {
   if (half_width_px < 1 || half_width_px > 30) throw InputError("subpixel.half_width_px", "must be in [1, 30]");
   if (half_height_px < 0 || half_height_px > 30) throw InputError("subpixel.half_height_px", "must be in [0, 30]");
   if (max_iterations < 1 || max_iterations > 50) throw InputError("subpixel.max_iterations", "must be in [1, 50]");
+  if (!(converged_step_px > 0 && converged_step_px < 0.5))
+    throw InputError("subpixel.converged_step_px", "must be in (0, 0.5) px");
   if (!(max_shift_px > 0 && max_shift_px <= 4)) throw InputError("subpixel.max_shift_px", "must be in (0, 4] px");
 }
 
@@ -142,8 +144,8 @@ SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x,
     offset += step[2];
     if (std::abs(d - start_px) > o.max_shift_px) return result;
     // The ZNCC below is that of the last pass, taken before this last step
-    // (< 0.01 px away when converged): close enough for a threshold.
-    if (std::abs(step[0]) < 1e-2) break;
+    // (< converged_step_px away): close enough for a threshold.
+    if (std::abs(step[0]) < o.converged_step_px) break;
   }
   if (!(gain > 0)) return result;
   const double rmean = rs / nwin;

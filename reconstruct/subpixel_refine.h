@@ -20,7 +20,11 @@ namespace stereorig {
 struct SubpixelOptions {
   int half_width_px = 4;    // window half width along the row; default 4 (9 px: > one grid period)
   int half_height_px = 1;   // window half height; default 1 (3 rows)
-  int max_iterations = 2;   // Gauss-Newton steps (stop when a step < 0.01 px); default 2 (the start is within ~0.2 px)
+  int max_iterations = 2;   // Gauss-Newton steps; default 2
+  // Stop after a step smaller than this: from a start within ~0.2 px one
+  // step leaves < 0.002 px of peak locking on the test pairs (measured), so
+  // a second pass is only paid for when the first moved far. Default 0.05 px.
+  double converged_step_px = 0.05;
   double max_shift_px = 1.0;  // refinement may move the start by at most this; default 1 px
   void Check() const;       // throws InputError naming the bad field
 };

@@ -128,12 +128,17 @@ std::vector<Eigen::Vector2d> ReprojectionErrors(const Rig& rig, const Target& ta
   return e;
 }
 
-BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target, const std::vector<const BoardObservation*>& views) {
+BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target, const std::vector<const BoardObservation*>& views,
+                                    const Pose* seed_pose) {
   BoardPoseEstimate out;
-  const BoardObservation* seed = nullptr;
-  for (const BoardObservation* v : views)
-    if (!seed || v->corner_ids.size() > seed->corner_ids.size()) seed = v;
-  if (!seed || !SeedWithPnp(rig, target, *seed, &out.ref_from_front)) return out;
+  if (seed_pose) {
+    out.ref_from_front = *seed_pose;
+  } else {
+    const BoardObservation* seed = nullptr;
+    for (const BoardObservation* v : views)
+      if (!seed || v->corner_ids.size() > seed->corner_ids.size()) seed = v;
+    if (!seed || !SeedWithPnp(rig, target, *seed, &out.ref_from_front)) return out;
+  }
 
   const Eigen::Vector3d r0 = out.ref_from_front.RotationVector();
   const Eigen::Vector3d t0 = out.ref_from_front.translation_mm();

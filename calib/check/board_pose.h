@@ -18,9 +18,12 @@ struct BoardPoseEstimate {
   int num_corners = 0;
 };
 
-// `views` are all of one capture. Seeds with PnP from the view with the most
-// corners, then minimises reprojection error over every view (Ceres).
-BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target, const std::vector<const BoardObservation*>& views);
+// `views` are all of one capture. Seeds with `seed` if given, else with PnP
+// from the view with the most corners, then minimises reprojection error over
+// every view (Ceres). A pose from one camera alone has a near-mirror twin;
+// seeding it from all cameras of the capture avoids converging there.
+BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target, const std::vector<const BoardObservation*>& views,
+                                    const Pose* seed = nullptr);
 
 // Reprojection residuals q_predicted - q (px, per corner) of `view` for a
 // given board pose.

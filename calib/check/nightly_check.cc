@@ -53,6 +53,7 @@ struct Inputs {
   std::map<int, std::vector<const BoardObservation*>> by_capture;
   std::vector<double> sigma_px;        // per camera: calibration RMS
   std::vector<double> u_px;            // per camera: projection uncertainty, 1 sigma
+  std::map<int, Pose> seed;            // per capture: the board pose from every camera
 };
 
 int ModuleOf(const Rig& rig, int camera) {
@@ -71,8 +72,7 @@ struct Consistency {
 // `trusted` other than c.
 Consistency CameraConsistency(const Inputs& in, int c, const std::set<int>& trusted) {
   Consistency out;
-  double ss = 0, expected_ss = 0, var_ss = 0, depth_sum = 0;
-  int captures = 0;
+  double ss = 0, expected_ss = 0, var_ss = 0;
   for (const auto& [capture, views] : in.by_capture) {
     std::vector<const BoardObservation*> mine, others;
     for (const BoardObservation* v : views) {
@@ -80,7 +80,7 @@ Consistency CameraConsistency(const Inputs& in, int c, const std::set<int>& trus
       else if (trusted.count(v->camera)) others.push_back(v);
     }
     if (mine.empty() || others.empty()) continue;
-    const BoardPoseEstimate pose = EstimateBoardPose(in.rig, in.target, others);
+    const BoardPoseEstimate pose = EstimateBoardPose(in.rig, in.target, others, &in.seed.at(capture));
     if (!pose.ok) continue;
     for (const BoardObservation* v : mine) {
       for (const Eigen::Vector2d& e : ReprojectionErrors(in.rig, in.target, *v, pose.ref_from_front)) {
@@ -95,29 +95,21 @@ Consistency CameraConsistency(const Inputs& in, int c, const std::set<int>& trus
           PredictionErrorStatistics(in.rig, in.target, others, in.sigma_px, *v, pose.ref_from_front);
       const double s2 = in.sigma_px[c] * in.sigma_px[c];
       const double n = static_cast<double>(v->corner_ids.size());
-      expected_ss += 2 * n * s2 + p.mean_ss_px2;
-      var_ss += 2 * n * 2 * s2 * s2 + p.var_ss_px4 + 4 * s2 * p.mean_ss_px2;
+      // The stored calibration's own error (S composed with the target's
+      // back_from_front, the other cameras' poses) is fixed, and it reaches
+      // camera c the same way tonight's pose error does. It was estimated
+      // from at least as many views as tonight's pose, so its share is
+      // bounded by the same prediction statistics: counted twice.
+      expected_ss += 2 * n * s2 + 2 * p.mean_ss_px2;
+      var_ss += 2 * n * 2 * s2 * s2 + 2 * p.var_ss_px4 + 4 * s2 * 2 * p.mean_ss_px2;
     }
-    depth_sum += (in.rig.CamFromReference(c) * pose.ref_from_front).translation_mm().z();
-    ++captures;
   }
   if (out.corners == 0) return out;
   out.rms_px = std::sqrt(ss / (2.0 * out.corners));
-  // The stored calibration's own 1-sigma errors, in px: the camera's
-  // projection uncertainty, and S (which stage 3 estimated jointly with the
-  // target's back_from_front) at the board's depth.
+  // The camera's own projection uncertainty (1 sigma, from the stored
+  // calibration) enters at k sigma.
   const double k = in.options.k_sigma;
-  const double depth_mm = depth_sum / captures;
-  const double fx = in.rig.camera(c).fx();
-  double s_px = 0;
-  for (int i = 0; i < in.rig.num_modules(); ++i)
-    for (int j = i + 1; j < in.rig.num_modules(); ++j) {
-      const std::string key = "S_" + std::to_string(i) + "_" + std::to_string(j);
-      const double t = Lookup(in.rig.provenance().uncertainties, key + "_translation_mm", 0);
-      const double r = Lookup(in.rig.provenance().uncertainties, key + "_rotation_deg", 0) * M_PI / 180;
-      s_px = std::max(s_px, fx * (t / depth_mm + r));
-    }
-  const double systematic = std::hypot(in.u_px[c], s_px);
+  const double systematic = in.u_px[c];
   // Threshold on the mean square: its H0 expectation plus k standard
   // deviations, plus the systematic terms at k sigma.
   out.threshold_px =
@@ -130,7 +122,7 @@ Consistency CameraConsistency(const Inputs& in, int c, const std::set<int>& trus
 CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vector<BoardObservation>& views,
                             const CheckOptions& options, const std::string& where) {
   options.Check();
-  Inputs in{rig, target, options, {}, {}, {}};
+  Inputs in{rig, target, options, {}, {}, {}, {}};
   for (int c = 0; c < rig.num_cameras(); ++c) {
     const std::string key = "cam" + std::to_string(c) + "_rms_px";
     auto it = rig.provenance().residuals.find(key);
@@ -151,6 +143,69 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   if (static_cast<int>(in.by_capture.size()) < options.min_captures) {
     throw InputError(where, "only " + std::to_string(in.by_capture.size()) + " captures show the target; the check needs " +
                                 std::to_string(options.min_captures));
+  }
+
+  // Outlier corners (a detector's occasional slip) are set aside as the
+  // calibration's own outlier rejection did, so that the noise it measured
+  // applies. Each view's residuals under the all-camera pose are compared with
+  // the view's own median residual: a moved camera shifts a whole view
+  // smoothly and is kept; a lone bad corner is not.
+  std::vector<BoardObservation> trimmed;
+  trimmed.reserve(views.size());
+  for (auto& [capture, vs] : in.by_capture) {
+    const BoardPoseEstimate all = EstimateBoardPose(rig, target, vs);
+    if (!all.ok) continue;
+    in.seed[capture] = all.ref_from_front;
+    for (const BoardObservation* v : vs) {
+      const std::vector<Eigen::Vector2d> e = ReprojectionErrors(rig, target, *v, all.ref_from_front);
+      std::vector<double> ex, ey;
+      for (const auto& r : e) {
+        ex.push_back(r.x());
+        ey.push_back(r.y());
+      }
+      auto median = [](std::vector<double> x) {
+        std::nth_element(x.begin(), x.begin() + x.size() / 2, x.end());
+        return x[x.size() / 2];
+      };
+      const Eigen::Vector2d med(median(ex), median(ey));
+      std::vector<double> dev;
+      for (const auto& r : e) dev.push_back((r - med).norm());
+      // 1.4826 * MAD of a 2-D deviation's norm is ~1.2 sigma per axis for
+      // Gaussian noise; the floor keeps a perfectly clean view from trimming.
+      const double scale = std::max(1.4826 * median(dev) / 1.18, in.sigma_px[v->camera]);
+      BoardObservation kept = *v;
+      kept.corner_ids.clear();
+      kept.q_px.clear();
+      for (size_t i = 0; i < e.size(); ++i) {
+        if (dev[i] <= 5.0 * scale) {
+          kept.corner_ids.push_back(v->corner_ids[i]);
+          kept.q_px.push_back(v->q_px[i]);
+        }
+      }
+      if (static_cast<int>(kept.corner_ids.size()) >= options.min_corners_per_view) trimmed.push_back(kept);
+    }
+  }
+  in.by_capture.clear();
+  for (const BoardObservation& v : trimmed)
+    if (in.seed.count(v.capture)) in.by_capture[v.capture].push_back(&v);
+
+  // Tonight's corner noise, per camera: each view fitted with its own pose.
+  // A camera that moved is fitted just as well (its own pose absorbs any
+  // motion), so this sees noise only: how sharp tonight's views are, which
+  // depends on the board's tilts. The thresholds use the larger of it and the
+  // calibration's RMS.
+  {
+    std::vector<double> ss(rig.num_cameras(), 0.0), dof(rig.num_cameras(), 0.0);
+    for (const auto& [capture, vs] : in.by_capture) {
+      for (const BoardObservation* v : vs) {
+        const BoardPoseEstimate own = EstimateBoardPose(rig, target, {v}, &in.seed.at(capture));
+        if (!own.ok) continue;
+        for (const Eigen::Vector2d& e : ReprojectionErrors(rig, target, *v, own.ref_from_front)) ss[v->camera] += e.squaredNorm();
+        dof[v->camera] += 2.0 * v->corner_ids.size() - 6.0;
+      }
+    }
+    for (int c = 0; c < rig.num_cameras(); ++c)
+      if (dof[c] > 0) in.sigma_px[c] = std::max(in.sigma_px[c], std::sqrt(ss[c] / dof[c]));
   }
 
   CheckResult result;
@@ -211,7 +266,10 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
     const double f = 0.5 * (left.fy() + right.fy());
     double ss = 0;
     int n = 0;
+    std::vector<std::pair<double, int>> per_capture;  // (sum of squares, count)
     for (const auto& [capture, vs] : in.by_capture) {
+      const double ss_before = ss;
+      const int n_before = n;
       for (const BoardObservation* l : vs) {
         if (l->camera != mod.left_camera) continue;
         for (const BoardObservation* r : vs) {
@@ -230,12 +288,30 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
           }
         }
       }
+      if (n > n_before) per_capture.emplace_back(ss - ss_before, n - n_before);
     }
     if (n == 0) continue;
     const double sl = in.sigma_px[mod.left_camera], sr = in.sigma_px[mod.right_camera];
     const double ul = in.u_px[mod.left_camera], ur = in.u_px[mod.right_camera];
-    const double threshold = std::sqrt(sl * sl + sr * sr + std::pow(k * std::hypot(ul, ur), 2)) *
-                             (1.0 + k / std::sqrt(2.0 * n));
+    // H0 mean square of a row error: both cameras' noise. Its spread: the
+    // Gaussian one of n independent squares (2 e^4 each), or, when larger,
+    // the spread seen between tonight's captures (errors within one capture
+    // share a board pose and the local calibration error, so they are not
+    // independent), as the standard error of a mean over captures with a
+    // Student-t inflation. A moved camera shifts every capture's rows alike:
+    // it raises the mean, not this spread.
+    const double e_ms = sl * sl + sr * sr;
+    double sd_ms = std::sqrt(2.0 / n) * e_ms;
+    const int nc_captures = static_cast<int>(per_capture.size());
+    if (nc_captures >= 3) {
+      const double mean_ms = ss / n;
+      double var = 0;
+      for (const auto& [sc, nc] : per_capture) var += nc * std::pow(sc / nc - mean_ms, 2);
+      var /= n;  // count-weighted variance of the per-capture mean squares
+      const double t_inflation = nc_captures > 3 ? (nc_captures - 1.0) / (nc_captures - 3.0) : 3.0;
+      sd_ms = std::max(sd_ms, std::sqrt(var * t_inflation / (nc_captures - 1)));
+    }
+    const double threshold = std::sqrt(e_ms + k * sd_ms + std::pow(k * std::hypot(ul, ur), 2));
     const double rms = std::sqrt(ss / n);
     result.figures.push_back({"module" + std::to_string(m) + "_rectified_row_rms_px", rms, threshold,
                               rms <= threshold, n});
@@ -278,8 +354,8 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
           if (m == j) vj.push_back(v);
         }
         if (vi.empty() || vj.empty()) continue;
-        const BoardPoseEstimate pi = EstimateBoardPose(rig, target, vi);
-        const BoardPoseEstimate pj = EstimateBoardPose(rig, target, vj);
+        const BoardPoseEstimate pi = EstimateBoardPose(rig, target, vi, &in.seed.at(capture));
+        const BoardPoseEstimate pj = EstimateBoardPose(rig, target, vj, &in.seed.at(capture));
         if (!pi.ok || !pj.ok) continue;
         dt.push_back(pi.ref_from_front * board_center - pj.ref_from_front * board_center);
         dr.push_back(Pose(pi.ref_from_front.rotation() * pj.ref_from_front.rotation().transpose(),
@@ -305,11 +381,17 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
       const std::string key = "S_" + std::to_string(i) + "_" + std::to_string(j);
       const double s_t = Lookup(rig.provenance().uncertainties, key + "_translation_mm", 0);
       const double s_r = Lookup(rig.provenance().uncertainties, key + "_rotation_deg", 0);
-      // As above, S's 1-sigma covers the board's back_from_front (estimated
-      // jointly in stage 3).
+      // What a closure tests is S composed with the target's back_from_front,
+      // which stage 3 estimates jointly; the marginal 1-sigma of S alone
+      // (s_t, s_r) is dominated by the board's prior and far exceeds the
+      // combination's. The combination was estimated from at least as many
+      // captures as tonight's, so its error is bounded by tonight's standard
+      // error: counted twice. s_t and s_r remain a cap, never a floor.
       const double chi3 = ChiFactor(3, k);
-      const double thr_t = chi3 * std::sqrt(se_t * se_t + s_t * s_t);
-      const double thr_r = chi3 * std::sqrt(se_r * se_r + s_r * s_r);
+      const double comb_t = s_t > 0 ? std::min(se_t, s_t) : se_t;
+      const double comb_r = s_r > 0 ? std::min(se_r, s_r) : se_r;
+      const double thr_t = chi3 * std::sqrt(se_t * se_t + comb_t * comb_t);
+      const double thr_r = chi3 * std::sqrt(se_r * se_r + comb_r * comb_r);
       const bool pass_t = mean_t.norm() <= thr_t, pass_r = mean_r.norm() <= thr_r;
       result.figures.push_back({"pair_" + std::to_string(i) + "_" + std::to_string(j) + "_closure_mm", mean_t.norm(),
                                 thr_t, pass_t, n});
