@@ -10,8 +10,6 @@
 #include "apps/command.h"
 #include "calib/calibrate.h"
 #include "calib/capture_folder.h"
-#include "calib/layout_file.h"
-#include "targets/target_file.h"
 
 namespace stereorig {
 
@@ -56,21 +54,8 @@ int RunCalibrate(int argc, char** argv) {
   options.system.refine_intrinsics = !fixed_intrinsics;
   options.Check();
 
-  const Target target = ReadTargetFile(target_path);
-  CalibrationInput input;
-  input.target = TargetGeometryFromTarget(target);
-  input.modules = ReadLayoutFile(layout_path);
-  input.source = captures;
-  int num_cameras = 0;
-  for (const ModuleLayout& m : input.modules)
-    num_cameras = std::max({num_cameras, m.left_camera + 1, m.right_camera + 1});
-  DetectedCaptures detected = DetectCaptureFolder(captures, target, num_cameras, DetectOptions(), true);
-  input.cameras = detected.cameras;
-  input.observations = std::move(detected.observations);
-  std::fprintf(stderr, "calibrate: %d captures, %zu accepted views\n", detected.num_captures,
-               input.observations.size());
-
-  const CalibrationResult result = Calibrate(input, options);
+  const FolderCalibration folder = CalibrateCaptureFolder(captures, target_path, layout_path, options);
+  const CalibrationResult& result = folder.result;
   WriteCalibrationOutputs(result, out_path, report_path);
   if (!cameramodels_dir.empty()) {
     std::filesystem::create_directories(cameramodels_dir);

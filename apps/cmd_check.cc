@@ -72,7 +72,7 @@ int RunCheck(int argc, char** argv) {
   std::fprintf(stderr, "check: detecting the target in %s\n", captures.c_str());
   const DetectedCaptures detected = DetectCaptureFolder(captures, target, rig.num_cameras(), DetectOptions(), true);
   for (int c = 0; c < rig.num_cameras(); ++c) {
-    const CameraSpec& seen = detected.cameras[c];
+    const CameraImager& seen = detected.cameras[c];
     const Camera& cam = rig.camera(c);
     if (seen.width_px != cam.imager_width_px() || seen.height_px != cam.imager_height_px()) {
       throw InputError(captures, "cam" + std::to_string(c) + " images are " + std::to_string(seen.width_px) + "x" +

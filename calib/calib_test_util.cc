@@ -24,69 +24,6 @@ Eigen::Vector2d MeanFramesProjectionError(const Camera& truth, const std::vector
   return solved.Project(mean) - q_px;
 }
 
-void TriangulateThroughModule(const Rig& truth, const Rig& calibrated, int k, const std::vector<Eigen::Vector3d>& p_ref,
-                              std::vector<Eigen::Vector3d>* p_cal, std::vector<Eigen::Vector3d>* p_true,
-                              std::vector<int>* used) {
-  const StereoModule& tm = truth.module(k);
-  const StereoModule& cm = calibrated.module(k);
-  const Camera& tl = truth.camera(tm.left_camera);
-  const Camera& tr = truth.camera(tm.right_camera);
-  const Pose module_from_ref = truth.S(k, 0);
-  p_cal->clear();
-  p_true->clear();
-  if (used) used->clear();
-  for (size_t i = 0; i < p_ref.size(); ++i) {
-    const Eigen::Vector3d pl = module_from_ref * p_ref[i];
-    const Eigen::Vector3d pr = tm.right_from_left * pl;
-    if (pl.z() <= 0 || pr.z() <= 0) continue;
-    const Eigen::Vector2d ql = tl.Project(pl), qr = tr.Project(pr);
-    auto inside = [](const Camera& c, const Eigen::Vector2d& q) {
-      return q.x() >= 0 && q.y() >= 0 && q.x() <= c.imager_width_px() - 1 && q.y() <= c.imager_height_px() - 1;
-    };
-    if (!inside(tl, ql) || !inside(tr, qr)) continue;
-    Eigen::Vector3d p;
-    if (!TriangulatePair(calibrated.camera(cm.left_camera), calibrated.camera(cm.right_camera), cm.right_from_left, ql,
-                         qr, &p)) {
-      continue;
-    }
-    p_cal->push_back(p);
-    p_true->push_back(pl);
-    if (used) used->push_back(static_cast<int>(i));
-  }
-}
-
-double RigidAlignedRms(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
-  Eigen::Matrix3Xd A(3, a.size()), B(3, b.size());
-  for (size_t i = 0; i < a.size(); ++i) {
-    A.col(i) = a[i];
-    B.col(i) = b[i];
-  }
-  const Eigen::Matrix4d T = Eigen::umeyama(B, A, false);  // maps b onto a
-  double s2 = 0;
-  for (size_t i = 0; i < a.size(); ++i)
-    s2 += (a[i] - (T.topLeftCorner<3, 3>() * b[i] + T.topRightCorner<3, 1>())).squaredNorm();
-  return std::sqrt(s2 / a.size());
-}
-
-double ModuleAgreementRms(const Rig& truth, const Rig& calibrated, const Pose& i_from_j, int i, int j,
-                          const std::vector<Eigen::Vector3d>& p_ref) {
-  std::vector<Eigen::Vector3d> ci, ti, cj, tj;
-  std::vector<int> ui, uj;
-  TriangulateThroughModule(truth, calibrated, i, p_ref, &ci, &ti, &ui);
-  TriangulateThroughModule(truth, calibrated, j, p_ref, &cj, &tj, &uj);
-  std::map<int, Eigen::Vector3d> by_point;
-  for (size_t n = 0; n < ui.size(); ++n) by_point[ui[n]] = ci[n];
-  double s2 = 0;
-  int count = 0;
-  for (size_t n = 0; n < uj.size(); ++n) {
-    auto it = by_point.find(uj[n]);
-    if (it == by_point.end()) continue;
-    s2 += (it->second - i_from_j * cj[n]).squaredNorm();
-    ++count;
-  }
-  return count ? std::sqrt(s2 / count) : NAN;
-}
-
 }  // namespace stereorig::testing
 
 namespace stereorig::testing {

@@ -9,8 +9,13 @@
 #include "calib/core/camera.h"
 #include "calib/core/pose.h"
 #include "calib/core/rig.h"
+#include "calib/rig_compare.h"
 
 namespace stereorig::testing {
+
+using stereorig::ModuleAgreementRms;
+using stereorig::RigidAlignedRms;
+using stereorig::TriangulateThroughModule;
 
 // The default rig's measurement volume in module 0's frame: the world origin,
 // world axes (module 0 looks along world +z).
@@ -23,24 +28,6 @@ Pose DefaultVolume(const Pose& world_from_module0);
 Eigen::Vector2d MeanFramesProjectionError(const Camera& truth, const std::vector<Pose>& true_cam_from_face,
                                           const Camera& solved, const std::vector<Pose>& solved_cam_from_face,
                                           const Eigen::Vector2d& q_px, double range_mm);
-
-// Triangulates each true point (reference frame) with module k of `calibrated`
-// from its noise-free projections through the TRUE cameras of module k of
-// `truth`. Points not seen by both cameras are skipped. Returns the points in
-// the calibrated module frame, and the matching true points in the true module
-// frame.
-void TriangulateThroughModule(const Rig& truth, const Rig& calibrated, int k, const std::vector<Eigen::Vector3d>& p_ref,
-                              std::vector<Eigen::Vector3d>* p_calibrated, std::vector<Eigen::Vector3d>* p_true,
-                              std::vector<int>* used = nullptr);
-
-// RMS (mm) of a - (R b + t) after the best rigid alignment (no scale), by
-// Eigen::umeyama.
-double RigidAlignedRms(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b);
-
-// Module agreement through S: points triangulated by module i and by module j
-// (as above), module j's mapped through module_i_from_module_j, RMS distance (mm).
-double ModuleAgreementRms(const Rig& truth, const Rig& calibrated, const Pose& module_i_from_module_j, int i, int j,
-                          const std::vector<Eigen::Vector3d>& p_ref);
 
 }  // namespace stereorig::testing
 

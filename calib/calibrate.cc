@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <ctime>
 #include <iostream>
@@ -73,7 +74,7 @@ void ValidateInput(const CalibrationInput& in) {
     if (!seen.insert({o.capture, o.camera}).second) throw InputError(w, "observed twice");
     if (o.corner_ids.size() != o.q_px.size()) throw InputError(w, "corner ids and pixels differ in number");
     std::set<int> ids;
-    const CameraSpec& cs = in.cameras[o.camera];
+    const CameraImager& cs = in.cameras[o.camera];
     for (size_t i = 0; i < o.corner_ids.size(); ++i) {
       const int id = o.corner_ids[i];
       if (id < 0 || id >= in.target.num_corners()) {
@@ -330,15 +331,24 @@ std::vector<std::string> ExportCameramodels(const Rig& rig, const std::string& d
   return paths;
 }
 
+namespace {
+
+// Appends one printf-formatted line (the compiler checks the format).
+__attribute__((format(printf, 2, 3))) void AppendLine(std::string* out, const char* fmt, ...) {
+  char b[512];
+  va_list args;
+  va_start(args, fmt);
+  std::vsnprintf(b, sizeof b, fmt, args);
+  va_end(args);
+  *out += b;
+  *out += '\n';
+}
+
+}  // namespace
+
 std::string SummaryText(const CalibrationReport& rep) {
   std::string out;
-  char b[512];
-  auto line = [&](const char* fmt, auto... args) {
-    std::snprintf(b, sizeof b, fmt, args...);
-    out += b;
-    out += '\n';
-  };
-  line("stage 1: intrinsics per camera");
+  AppendLine(&out, "stage 1: intrinsics per camera");
   for (const IntrinsicsReport& r : rep.intrinsics) {
     double worst_corner = 0;
     double centre = 0;
@@ -349,42 +359,43 @@ std::string SummaryText(const CalibrationReport& rep) {
         worst_corner = std::max(worst_corner, u.rms_stdev_px);
       }
     }
-    line(
-        "  %s (%s): %d views, %d corners, rms %.3f px, %d outliers, coverage %.0f%%, 1-sigma projection %.3f px "
-        "centre / %.3f px worst corner (at %.0f mm)",
-        r.camera_name.c_str(), r.lensmodel.c_str(), r.num_views, r.num_corners, r.rms_px, r.num_outliers,
-        100.0 * r.coverage_fraction, centre, worst_corner, r.uncertainty_range_mm);
+    AppendLine(&out,
+               "  %s (%s): %d views, %d corners, rms %.3f px, %d outliers, coverage %.0f%%, 1-sigma projection %.3f px "
+               "centre / %.3f px worst corner (at %.0f mm)",
+               r.camera_name.c_str(), r.lensmodel.c_str(), r.num_views, r.num_corners, r.rms_px, r.num_outliers,
+               100.0 * r.coverage_fraction, centre, worst_corner, r.uncertainty_range_mm);
     if (!r.worst_views.empty()) {
-      line("    worst view: capture %d, rms %.3f px", r.worst_views[0].capture, r.worst_views[0].rms_px);
+      AppendLine(&out, "    worst view: capture %d, rms %.3f px", r.worst_views[0].capture, r.worst_views[0].rms_px);
     }
   }
-  line("stage 2: stereo extrinsics per module");
+  AppendLine(&out, "stage 2: stereo extrinsics per module");
   for (const StereoReport& s : rep.stereo) {
-    line(
-        "  %s: baseline %.3f mm, rotation %.3f deg, rms %.3f px, %d outliers, rectified-row error %.3f px rms "
-        "(max %.3f) over %d corner pairs, %d shared views",
-        s.module_name.c_str(), s.baseline_mm, s.rotation_deg, s.rms_px, s.num_outliers, s.rectified_row_rms_px,
-        s.rectified_row_max_px, s.num_corner_pairs, s.num_shared_views);
+    AppendLine(&out,
+               "  %s: baseline %.3f mm, rotation %.3f deg, rms %.3f px, %d outliers, rectified-row error %.3f px rms "
+               "(max %.3f) over %d corner pairs, %d shared views",
+               s.module_name.c_str(), s.baseline_mm, s.rotation_deg, s.rms_px, s.num_outliers, s.rectified_row_rms_px,
+               s.rectified_row_max_px, s.num_corner_pairs, s.num_shared_views);
   }
   if (rep.num_modules > 1) {
     const SystemReport& s = rep.system;
-    line("stage 3: the S matrix (%d captures, %d corner residuals)", s.num_captures, s.num_residual_corners);
-    line("  reprojection rms: Horn only %.3f px, refined %.3f px", s.horn_reprojection_rms_px,
-         s.refined_reprojection_rms_px);
+    AppendLine(&out, "stage 3: the S matrix (%d captures, %d corner residuals)", s.num_captures,
+               s.num_residual_corners);
+    AppendLine(&out, "  reprojection rms: Horn only %.3f px, refined %.3f px", s.horn_reprojection_rms_px,
+               s.refined_reprojection_rms_px);
     for (size_t k = 1; k < s.module0_from_module.size(); ++k) {
       const Pose d = s.module0_from_module_horn[k].Inverse() * s.module0_from_module[k];
       const Eigen::Vector3d& t = s.module0_from_module[k].translation_mm();
-      line("  S[0][%zu]: t = (%.3f, %.3f, %.3f) mm; refined moved it %.4f deg, %.4f mm from Horn", k, t.x(), t.y(),
-           t.z(), d.AngleDeg(), d.DistanceMm());
+      AppendLine(&out, "  S[0][%zu]: t = (%.3f, %.3f, %.3f) mm; refined moved it %.4f deg, %.4f mm from Horn", k, t.x(),
+                 t.y(), t.z(), d.AngleDeg(), d.DistanceMm());
     }
     for (const STransformSigma& x : s.sigma) {
-      line("  1 sigma S[0][%d]: rotation (%.4f, %.4f, %.4f) deg, translation (%.4f, %.4f, %.4f) mm", x.module,
-           x.rotation_deg.x(), x.rotation_deg.y(), x.rotation_deg.z(), x.translation_mm.x(), x.translation_mm.y(),
-           x.translation_mm.z());
+      AppendLine(&out, "  1 sigma S[0][%d]: rotation (%.4f, %.4f, %.4f) deg, translation (%.4f, %.4f, %.4f) mm",
+                 x.module, x.rotation_deg.x(), x.rotation_deg.y(), x.rotation_deg.z(), x.translation_mm.x(),
+                 x.translation_mm.y(), x.translation_mm.z());
     }
-    if (s.sigma.empty()) line("  1 sigma of S: %s", s.covariance_status.c_str());
-    line("  back_from_front refined: moved %.4f deg, %.4f mm from the measured", s.back_from_front_change_deg,
-         s.back_from_front_change_mm);
+    if (s.sigma.empty()) AppendLine(&out, "  1 sigma of S: %s", s.covariance_status.c_str());
+    AppendLine(&out, "  back_from_front refined: moved %.4f deg, %.4f mm from the measured",
+               s.back_from_front_change_deg, s.back_from_front_change_mm);
   }
   return out;
 }

@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "calib/core/input_error.h"
+#include "calib/layout_file.h"
+#include "targets/target_file.h"
 
 namespace stereorig {
 
@@ -38,7 +41,7 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
         throw InputError(image.string(), "missing (each capture needs camK.png for every camera)");
       const cv::Mat grey = cv::imread(image.string(), cv::IMREAD_GRAYSCALE);
       if (grey.empty()) throw InputError(image.string(), "cannot be read as an image");
-      CameraSpec& spec = out.cameras[c];
+      CameraImager& spec = out.cameras[c];
       if (spec.width_px == 0) {
         spec.width_px = grey.cols;
         spec.height_px = grey.rows;
@@ -48,7 +51,15 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
                                              "'s other images are " + std::to_string(spec.width_px) + "x" +
                                              std::to_string(spec.height_px));
       }
-      const DetectResult r = detector.Detect(grey);
+      DetectResult r;
+      try {
+        r = detector.Detect(grey);
+      } catch (const cv::Exception& e) {
+        // A detector failure on one image (e.g. OpenCV refusing a degenerate
+        // grid) loses that view, not the calibration; the log says so.
+        r.reason = RejectReason::kNoChessboard;
+        r.message = std::string("detector failed: ") + e.what();
+      }
       ImageDetectionLog log{capture, c, image.string(), false, Face::kFront, 0, 0, r.message};
       if (r.reason == RejectReason::kNone && !r.faces.empty()) {
         const FaceDetection& f = r.faces[0];
@@ -78,6 +89,31 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
     }
     if (progress) std::fprintf(stderr, "%s\n", line.c_str());
   }
+  return out;
+}
+
+FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const std::string& target_path,
+                                         const std::string& layout_path, const CalibrationOptions& options) {
+  options.Check();
+  const Target target = ReadTargetFile(target_path);
+  CalibrationInput input;
+  input.target = TargetGeometryFromTarget(target);
+  input.modules = ReadLayoutFile(layout_path);
+  input.source = captures_dir;
+  int num_cameras = 0;
+  for (const ModuleLayout& m : input.modules) {
+    num_cameras = std::max({num_cameras, m.left_camera + 1, m.right_camera + 1});
+  }
+  DetectedCaptures detected = DetectCaptureFolder(captures_dir, target, num_cameras, DetectOptions(), options.progress);
+  input.cameras = detected.cameras;
+  input.observations = std::move(detected.observations);
+  FolderCalibration out;
+  out.num_captures = detected.num_captures;
+  out.num_views = static_cast<int>(input.observations.size());
+  if (options.progress) {
+    std::fprintf(stderr, "calibrate: %d captures, %d accepted views\n", out.num_captures, out.num_views);
+  }
+  out.result = Calibrate(input, options);
   return out;
 }
 

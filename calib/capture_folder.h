@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "calib/calibrate.h"
 #include "calib/observations.h"
 #include "targets/detect.h"
 
@@ -27,7 +28,7 @@ struct ImageDetectionLog {
 };
 
 struct DetectedCaptures {
-  std::vector<CameraSpec> cameras;  // (num_cameras,) names camK and the images' size
+  std::vector<CameraImager> cameras;  // (num_cameras,) names camK and the images' size
   std::vector<BoardObservation> observations;
   std::vector<ImageDetectionLog> log;  // one entry per image
   int num_captures = 0;
@@ -38,5 +39,15 @@ struct DetectedCaptures {
 // with different sizes. `progress`: one line per capture on stderr.
 DetectedCaptures DetectCaptureFolder(const std::string& dir, const Target& target, int num_cameras,
                                      const DetectOptions& options, bool progress);
+
+// The whole of `stereorig calibrate`: reads the target and layout files,
+// detects the target in every capture and runs the three stages.
+struct FolderCalibration {
+  CalibrationResult result;
+  int num_captures = 0;
+  int num_views = 0;  // images with an accepted detection
+};
+FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const std::string& target_path,
+                                         const std::string& layout_path, const CalibrationOptions& options);
 
 }  // namespace stereorig

@@ -151,7 +151,7 @@ void FillCoverageAndUncertainty(const MrcalProblem& p, int icam, const Intrinsic
   }
 }
 
-IntrinsicsResult CalibrateIntrinsics(int camera, const CameraSpec& spec, const TargetGeometry& target,
+IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const TargetGeometry& target,
                                      const std::vector<const BoardObservation*>& all_views,
                                      const IntrinsicsOptions& options, const std::string& where) {
   const std::string cam_where = where + ": camera " + std::to_string(camera) + " (" + spec.name + ")";

@@ -79,7 +79,7 @@ struct IntrinsicsResult {
 
 // `views`: this camera's observations (all of the same camera). Throws
 // InputError (`where` names the input) on too few views or a degenerate set.
-IntrinsicsResult CalibrateIntrinsics(int camera, const CameraSpec& spec, const TargetGeometry& target,
+IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const TargetGeometry& target,
                                      const std::vector<const BoardObservation*>& views,
                                      const IntrinsicsOptions& options, const std::string& where);
 

@@ -63,7 +63,7 @@ struct ModuleLayout {
   std::optional<Face> face;
 };
 
-struct CameraSpec {
+struct CameraImager {
   std::string name;  // e.g. "cam0"
   int width_px = 0;  // imager size
   int height_px = 0;
@@ -71,7 +71,7 @@ struct CameraSpec {
 
 struct CalibrationInput {
   TargetGeometry target;
-  std::vector<CameraSpec> cameras;    // indexed by global camera index
+  std::vector<CameraImager> cameras;  // indexed by global camera index
   std::vector<ModuleLayout> modules;  // module 0 is the reference
   std::vector<BoardObservation> observations;
   std::string source = "observations";  // for provenance and error messages

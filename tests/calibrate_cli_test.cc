@@ -6,6 +6,7 @@
 // The refusals exit 2 with one line naming the problem.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -43,7 +44,8 @@ Rig PinholeDefaultRig(Pose* world_from_module0) {
 
 RenderedSet Render(const std::string& name, int captures, unsigned seed) {
   RenderedSet set;
-  set.dir = ::testing::TempDir() + "/" + name;
+  // Unique per process: other checkouts may run this test at the same time.
+  set.dir = ::testing::TempDir() + "/" + name + "_" + std::to_string(getpid());
   fs::remove_all(set.dir);
   fs::create_directories(set.dir + "/captures");
   Pose world_from_module0;
@@ -58,7 +60,7 @@ RenderedSet Render(const std::string& name, int captures, unsigned seed) {
   const double s = target.square_size_mm();
   const Eigen::Vector3d centre(0.5 * (target.corners_x() - 1) * s, 0.5 * (target.corners_y() - 1) * s, 0);
   SyntheticViewOptions view;
-  view.supersample = 3;
+  view.supersample = 2;
   view.noise_sigma_dn = 2.0;
   for (int c = 0; c < captures; ++c) {
     const Eigen::Matrix3d R = (Eigen::AngleAxisd(0.35 * u(rng), Eigen::Vector3d::UnitZ()) *
