@@ -25,6 +25,7 @@ constexpr int kCaptures = 25;
 struct SeedFigures {
   double max_stage1_rms_dev = 0;                     // max |rms - noise| / noise over cameras
   std::vector<double> e2_centre, s2_centre;          // per camera: |e|^2 and predicted sigma^2 at the centre
+  std::vector<double> e2_corners, s2_corners;        // the same (|e|^2 / 2, sigma^2) at the four image corners
   std::vector<double> module_3d_rms;                 // per module, mm
   double agreement_refined = 0, agreement_horn = 0;  // mm
   Eigen::Matrix<double, 6, 1> s_z = Eigen::Matrix<double, 6, 1>::Zero();  // S[0][1] error / sigma
@@ -56,6 +57,14 @@ SeedFigures RunSeed(unsigned seed, CalibrationResult* out = nullptr) {
                                                                  s1.cam_from_face, u.q_px, 200.0);
     f.e2_centre.push_back(e.squaredNorm() / 2.0);
     f.s2_centre.push_back(u.rms_stdev_px * u.rms_stdev_px);
+    // The four image corners too (extrapolated beyond most of the corners seen).
+    for (size_t k = 1; k < s1.report.uncertainty.size(); ++k) {
+      const PixelUncertainty& uk = s1.report.uncertainty[k];
+      const Eigen::Vector2d ek = testing::MeanFramesProjectionError(truth.camera(cam), true_cam_from_face, s1.camera,
+                                                                    s1.cam_from_face, uk.q_px, 200.0);
+      f.e2_corners.push_back(ek.squaredNorm() / 2.0);
+      f.s2_corners.push_back(uk.rms_stdev_px * uk.rms_stdev_px);
+    }
   }
   const auto points = VolumePoints(scene.ref_from_volume, Eigen::Vector3d(75, 75, 50), 500, seed + 1000);
   for (int k = 0; k < 2; ++k) {
@@ -129,6 +138,14 @@ TEST(CalibrateE2E, DefaultRigOverSeeds) {
   EXPECT_GE(honesty, 0.7);
   EXPECT_LE(honesty, 1.4);
   EXPECT_GE(within3, 0.95 * n);
+  // At the image corners as well (pooled over 20 seeds x 4 cameras x 4 corners).
+  double e2c = 0, s2c = 0;
+  for (const auto& f : all)
+    for (size_t c = 0; c < f.e2_corners.size(); ++c) e2c += f.e2_corners[c], s2c += f.s2_corners[c];
+  const double honesty_corners = std::sqrt(e2c / s2c);
+  std::printf("uncertainty honesty at the image corners: actual/predicted = %.3f\n", honesty_corners);
+  EXPECT_GE(honesty_corners, 0.7);
+  EXPECT_LE(honesty_corners, 1.4);
   // A module's 3D error from calibration alone <= 0.05 mm in 95% of seeds x modules.
   int ok3d = 0, n3d = 0;
   for (const auto& f : all)
