@@ -1,5 +1,6 @@
 #include "reconstruct/metrology/vdi2634.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -16,6 +17,10 @@ void VerifyOptions::Check() const {
     throw InputError("verify options", "excluded_fraction_max must be in [0, 0.05]");
   }
   if (min_points < 10) throw InputError("verify options", "min_points must be >= 10");
+  if (ballbar_shaft_cone_deg < 0 || ballbar_shaft_cone_deg >= 90) {
+    throw InputError("verify options", "ballbar_shaft_cone_deg must be in [0, 90)");
+  }
+  if (plate_edge_margin_mm < 0) throw InputError("verify options", "plate_edge_margin_mm must not be negative");
 }
 
 bool ArtifactEvaluation::pass() const {
@@ -133,6 +138,39 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
           if ((p - fit.center_mm).norm() > fit.radius_mm + band) rest.push_back(p);
         remaining.swap(rest);
       }
+      // Second pass: with both centres known, drop each ball's points near
+      // the shaft (a cone around the bar axis) and refit each ball on its
+      // remaining cap, from its first-pass fit.
+      {
+        const double cos_cone = std::cos(o.ballbar_shaft_cone_deg * M_PI / 180.0);
+        all_residuals.clear();
+        excluded_total = 0;
+        on_artifact = 0;
+        const std::vector<Eigen::Vector3d> c0 = e.sphere_centers_mm;
+        for (int ball = 0; ball < 2; ++ball) {
+          const Eigen::Vector3d axis = (c0[1 - ball] - c0[ball]).normalized();
+          const double rb = 0.5 * e.sphere_diameters_mm[ball];
+          std::vector<int> idx;
+          std::vector<double> res;
+          for (int i = 0; i < static_cast<int>(pts.size()); ++i) {
+            const Eigen::Vector3d d = pts[i] - c0[ball];
+            const double rr = d.norm() - rb;
+            if (std::abs(rr) > band || d.norm() < 1e-9 || d.normalized().dot(axis) > cos_cone) continue;
+            idx.push_back(i);
+            res.push_back(rr);
+          }
+          require_points(static_cast<int>(idx.size()), "ball bar's spheres (outside the shaft cone)");
+          int excluded = 0;
+          const std::vector<int> kept = ExcludeWorst(idx, res, o.excluded_fraction_max, &excluded);
+          const SphereFit fit = RefineSphere(pts, kept, c0[ball], rb, 50);
+          if (!fit.ok) throw InputError(where, "ball " + std::to_string(ball + 1) + " refit failed: " + fit.message);
+          e.sphere_centers_mm[ball] = fit.center_mm;
+          e.sphere_diameters_mm[ball] = 2 * fit.radius_mm;
+          all_residuals.insert(all_residuals.end(), fit.residuals_mm.begin(), fit.residuals_mm.end());
+          excluded_total += excluded;
+          on_artifact += static_cast<int>(idx.size());
+        }
+      }
       e.points_on_artifact = on_artifact;
       e.points_excluded = excluded_total;
       const double distance = (e.sphere_centers_mm[0] - e.sphere_centers_mm[1]).norm();
@@ -147,6 +185,33 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       po.seed = o.seed;
       PlaneFit fit = FitPlaneRobust(pts, po);
       if (!fit.ok) throw InputError(where, "no plane found in the cloud: " + fit.message);
+      // The face only: erode the segmented points' in-plane extent (along
+      // their principal axes) by the edge margin.
+      {
+        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+        for (int i : fit.inliers) mean += pts[i];
+        mean /= static_cast<double>(fit.inliers.size());
+        Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+        for (int i : fit.inliers) scatter += (pts[i] - mean) * (pts[i] - mean).transpose();
+        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(scatter);
+        const Eigen::Vector3d u = es.eigenvectors().col(2), v = es.eigenvectors().col(1);
+        double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
+        for (int i : fit.inliers) {
+          const Eigen::Vector3d d = pts[i] - mean;
+          u0 = std::min(u0, d.dot(u));
+          u1 = std::max(u1, d.dot(u));
+          v0 = std::min(v0, d.dot(v));
+          v1 = std::max(v1, d.dot(v));
+        }
+        const double m = o.plate_edge_margin_mm;
+        std::vector<int> face;
+        for (int i : fit.inliers) {
+          const Eigen::Vector3d d = pts[i] - mean;
+          if (d.dot(u) > u0 + m && d.dot(u) < u1 - m && d.dot(v) > v0 + m && d.dot(v) < v1 - m) face.push_back(i);
+        }
+        fit = FitPlaneLeastSquares(pts, face);
+        if (!fit.ok) throw InputError(where, "the plate's face is too small after the edge margin: " + fit.message);
+      }
       require_points(static_cast<int>(fit.inliers.size()), "plate");
       int excluded = 0;
       const std::vector<int> kept = ExcludeWorst(fit.inliers, fit.residuals_mm, o.excluded_fraction_max, &excluded);

@@ -29,6 +29,12 @@ struct VerifyOptions {
   // farther than the MPE from the artifact cannot be part of a passing one).
   double segmentation_band_mm = 0;
   int min_points = 200;                  // fewer points on the artifact: bad input
+  // Ball bar: each ball's points within this angle of the bar axis (towards
+  // the other ball) belong to the shaft's neighbourhood and are not used.
+  double ballbar_shaft_cone_deg = 60.0;
+  // Plate: the face is evaluated inside its outline eroded by this border,
+  // so the edges and sides (chamfers, the plate's thickness) are not.
+  double plate_edge_margin_mm = 5.0;
   unsigned seed = 1;
   void Check() const;
 };
