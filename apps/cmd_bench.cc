@@ -4,9 +4,9 @@
 #include <sys/resource.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -59,8 +59,8 @@ double PeakMemoryMb() {
 }
 
 nlohmann::json FiguresJson(const ErrorFigures& f) {
-  return {{"points", f.points},     {"mean_abs_mm", f.mean_abs_mm}, {"mean_mm", f.mean_mm},
-          {"std_mm", f.std_mm},     {"rms_mm", f.rms_mm},           {"p95_abs_mm", f.p95_abs_mm}};
+  return {{"points", f.points}, {"mean_abs_mm", f.mean_abs_mm}, {"mean_mm", f.mean_mm},
+          {"std_mm", f.std_mm}, {"rms_mm", f.rms_mm},           {"p95_abs_mm", f.p95_abs_mm}};
 }
 
 struct Pipeline {
@@ -109,12 +109,13 @@ nlohmann::json PipelineJson(const Pipeline& p, const Rig& rig, const std::vector
     sj["scene"] = s.name;
     if (!s.truth.empty()) {
       const CloudScore score = ScoreAgainstTruth(rec.cloud, s.truth, rig.num_modules());
-      nlohmann::json acc = {{"merged", FiguresJson(score.all)},
-                            {"alignment_truth_from_cloud",
-                             {{"rotation_deg", score.truth_from_cloud.AngleDeg()},
-                              {"translation_mm",
-                               {score.truth_from_cloud.translation_mm().x(), score.truth_from_cloud.translation_mm().y(),
-                                score.truth_from_cloud.translation_mm().z()}}}}};
+      nlohmann::json acc = {
+          {"merged", FiguresJson(score.all)},
+          {"alignment_truth_from_cloud",
+           {{"rotation_deg", score.truth_from_cloud.AngleDeg()},
+            {"translation_mm",
+             {score.truth_from_cloud.translation_mm().x(), score.truth_from_cloud.translation_mm().y(),
+              score.truth_from_cloud.translation_mm().z()}}}}};
       for (size_t m = 0; m < score.per_module.size(); ++m) acc["module"].push_back(FiguresJson(score.per_module[m]));
       if (score.filled.points) acc["hole_fill"] = FiguresJson(score.filled);
       sj["accuracy"] = acc;
@@ -127,9 +128,8 @@ nlohmann::json PipelineJson(const Pipeline& p, const Rig& rig, const std::vector
 void PrintPipeline(const nlohmann::json& j) {
   std::printf("%-17s %6.1f objects/s, %.0f CPU ms/object  (median: total %.1f ms, modules %.1f ms, match m0 %.1f ms)\n",
               j["matcher"].get<std::string>().c_str(), j["objects_per_s"].get<double>(),
-              j["cpu_ms_per_object"].get<double>(),
-              j["median_time_ms"]["total_point_cloud"].get<double>(), j["median_time_ms"]["modules"].get<double>(),
-              j["median_time_ms"]["module0.match"].get<double>());
+              j["cpu_ms_per_object"].get<double>(), j["median_time_ms"]["total_point_cloud"].get<double>(),
+              j["median_time_ms"]["modules"].get<double>(), j["median_time_ms"]["module0.match"].get<double>());
   for (const auto& s : j["scenes"]) {
     std::printf("  %-10s %7d points, fill %.1f%%", s["scene"].get<std::string>().c_str(), s["points"].get<int>(),
                 100 * s["fill_rate"].get<double>());
@@ -145,9 +145,9 @@ void PrintPipeline(const nlohmann::json& j) {
                              a["alignment_truth_from_cloud"]["translation_mm"][1].get<double>(),
                              a["alignment_truth_from_cloud"]["translation_mm"][2].get<double>()));
     }
-    std::printf("; mesh+fill %.1f ms\n",
-                s["time_ms"]["mesh_join"].get<double>() + s["time_ms"]["hole_fill"].get<double>() +
-                    s["modules"][0]["time_ms"].value("mesh", 0.0));
+    std::printf("; mesh+fill %.1f ms\n", s["time_ms"]["mesh_join"].get<double>() +
+                                             s["time_ms"]["hole_fill"].get<double>() +
+                                             s["modules"][0]["time_ms"].value("mesh", 0.0));
   }
 }
 
@@ -184,8 +184,8 @@ int RunBench(int argc, char** argv) {
     SphereSceneSpec spec;
     spec.centre_mm = sim.world_from_module0.Inverse() * Eigen::Vector3d::Zero();
     spec.radius_mm = 25;
-    scenes.push_back({"sphere(builtin)", RenderSphereCapture(sim.rig, spec),
-                      SampleSphere(spec.centre_mm, spec.radius_mm, 0.2)});
+    scenes.push_back(
+        {"sphere(builtin)", RenderSphereCapture(sim.rig, spec), SampleSphere(spec.centre_mm, spec.radius_mm, 0.2)});
   } else {
     namespace fs = std::filesystem;
     rig = ReadRigFile(rig_path.empty() ? (fs::path(dataset) / "truth" / "rig.yaml").string() : rig_path);
@@ -219,7 +219,8 @@ int RunBench(int argc, char** argv) {
   PrintPipeline(report["ours"]);
   report["baseline"] = PipelineJson(pipelines[1], rig, scenes);
   PrintPipeline(report["baseline"]);
-  const double ratio = report["ours"]["objects_per_s"].get<double>() / report["baseline"]["objects_per_s"].get<double>();
+  const double ratio =
+      report["ours"]["objects_per_s"].get<double>() / report["baseline"]["objects_per_s"].get<double>();
   report["speed_ratio_ours_over_sgbm"] = ratio;
   const double cpu_ratio =
       report["baseline"]["cpu_ms_per_object"].get<double>() / report["ours"]["cpu_ms_per_object"].get<double>();
@@ -227,9 +228,10 @@ int RunBench(int argc, char** argv) {
   double load[3] = {0, 0, 0};
   if (getloadavg(load, 3) > 0) report["machine_load_average_1min"] = load[0];
   report["peak_memory_mb"] = PeakMemoryMb();
-  std::printf("speed ratio (ours / SGBM pipeline): %.2fx wall, %.2fx CPU; peak memory of this process: %.0f MB; "
-              "machine load average %.1f (other processes slow both pipelines)\n",
-              ratio, cpu_ratio, PeakMemoryMb(), load[0]);
+  std::printf(
+      "speed ratio (ours / SGBM pipeline): %.2fx wall, %.2fx CPU; peak memory of this process: %.0f MB; "
+      "machine load average %.1f (other processes slow both pipelines)\n",
+      ratio, cpu_ratio, PeakMemoryMb(), load[0]);
   if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
   return kExitOk;
 }

@@ -74,10 +74,10 @@ int RunDemo(int argc, char** argv) {
   if (!expect(Step({"simulate", "--out", ds, "--seed", s}), kExitOk, "simulate")) return kExitCheckFailed;
 
   std::printf("\n== 2. calibrate: mrcal intrinsics, stereo extrinsics, Horn + Ceres across the modules\n");
-  if (!expect(Step({"calibrate", "--captures", ds, "--target", Join(ds, "target.yaml"), "--layout",
-                    Join(ds, "layout.yaml"), "--out", rig, "--report", Join(out, "calibration.json"),
-                    "--export-cameramodels", out}),
-              kExitOk, "calibrate"))
+  if (!expect(
+          Step({"calibrate", "--captures", ds, "--target", Join(ds, "target.yaml"), "--layout", Join(ds, "layout.yaml"),
+                "--out", rig, "--report", Join(out, "calibration.json"), "--export-cameramodels", out}),
+          kExitOk, "calibrate"))
     return kExitCheckFailed;
 
   std::printf("\n== 3. reconstruct the cup, active (laser grids on) and passive, with the calibrated rig\n");
@@ -110,8 +110,8 @@ int RunDemo(int argc, char** argv) {
   expect(Step({"simulate", "--out", night, "--seed", std::to_string(seed + 100), "--calibration-captures", "8",
                "--no-scenes"}),
          kExitOk, "simulate (night)");
-  expect(Step({"check", "--rig", rig, "--captures", night, "--target", Join(ds, "target.yaml"), "--history-db",
-               history, "--report", Join(out, "check_ok.json")}),
+  expect(Step({"check", "--rig", rig, "--captures", night, "--target", Join(ds, "target.yaml"), "--history-db", history,
+               "--report", Join(out, "check_ok.json")}),
          kExitOk, "check (unmoved rig)");
   expect(Step({"simulate", "--out", bumped, "--seed", std::to_string(seed + 200), "--calibration-captures", "8",
                "--no-scenes", "--bump-camera", "1", "--bump-rotation-deg", "0.05"}),

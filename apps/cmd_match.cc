@@ -39,8 +39,7 @@ int RunMatch(int argc, char** argv) {
   app.add_option("--min-disparity", options.min_disparity_px, "smallest disparity searched, px")->required();
   app.add_option("--num-disparities", options.num_disparities, "number of disparities searched, px")->required();
   app.add_option("--out", out_path, "output disparity map (.pfm)")->required();
-  app.add_option("--roi", roi, "left-image region to match: x y width height (default: whole image)")
-      ->expected(4);
+  app.add_option("--roi", roi, "left-image region to match: x y width height (default: whole image)")->expected(4);
   app.add_option("--matcher", matcher, "census_sgm (ours) or opencv_sgbm_3way (baseline)")->capture_default_str();
   app.add_option("--pyramid-levels", options.pyramid_levels,
                  "census_sgm: halvings before the full-range SGM (0 = full-resolution SGM)")

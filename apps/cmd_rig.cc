@@ -15,8 +15,8 @@ void PrintRigSummary(const Rig& rig, FILE* out) {
   for (int i = 0; i < rig.num_cameras(); ++i) {
     const Camera& c = rig.camera(i);
     std::fprintf(out, "  camera %d %-6s %s %dx%d  fx %.2f fy %.2f cx %.2f cy %.2f px\n", i,
-                 rig.camera_names()[i].c_str(), c.lensmodel_name().c_str(), c.imager_width_px(),
-                 c.imager_height_px(), c.fx(), c.fy(), c.cx(), c.cy());
+                 rig.camera_names()[i].c_str(), c.lensmodel_name().c_str(), c.imager_width_px(), c.imager_height_px(),
+                 c.fx(), c.fy(), c.cx(), c.cy());
   }
   for (int i = 0; i < rig.num_modules(); ++i) {
     const StereoModule& m = rig.module(i);
@@ -26,8 +26,8 @@ void PrintRigSummary(const Rig& rig, FILE* out) {
   }
   for (int i = 0; i < rig.num_modules(); ++i) {
     for (int j = i + 1; j < rig.num_modules(); ++j) {
-      std::fprintf(out, "  S[%d][%d] module%d_from_module%d: %.4f mm, %.4f deg\n", i, j, i, j,
-                   rig.S(i, j).DistanceMm(), rig.S(i, j).AngleDeg());
+      std::fprintf(out, "  S[%d][%d] module%d_from_module%d: %.4f mm, %.4f deg\n", i, j, i, j, rig.S(i, j).DistanceMm(),
+                   rig.S(i, j).AngleDeg());
     }
   }
 }

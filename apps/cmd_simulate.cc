@@ -46,9 +46,7 @@ int RunSimulate(int argc, char** argv) {
   }
   o.scenes = !no_scenes;
   const SimSpec spec = spec_path.empty() ? DefaultSimSpec() : ReadSimSpecFile(spec_path);
-  o.progress = [](const std::string& s) {
-    std::fprintf(stderr, "simulate: %s\n", s.c_str());
-  };
+  o.progress = [](const std::string& s) { std::fprintf(stderr, "simulate: %s\n", s.c_str()); };
   const SimulateSummary s = Simulate(spec, o);
   std::printf("wrote %s: %d images in %.1f s (ray tables %.1f s)\n", o.out_dir.c_str(), s.images, s.seconds,
               s.rays_seconds);

@@ -54,8 +54,8 @@ int RunVerify(int argc, char** argv) {
   const VerifySummary summary = Summarise(positions);
 
   std::printf("artifact: %s (%s)\n", artifact.name.c_str(), ArtifactTypeName(artifact.type));
-  std::printf("%-10s %-6s %12s %10s %6s %10s %10s %10s\n", "position", "figure", "value_mm", "mpe_mm", "pass",
-              "points", "excluded", "mean|e|_mm");
+  std::printf("%-10s %-6s %12s %10s %6s %10s %10s %10s\n", "position", "figure", "value_mm", "mpe_mm", "pass", "points",
+              "excluded", "mean|e|_mm");
   nlohmann::json report = {{"artifact", artifact.name}, {"type", ArtifactTypeName(artifact.type)}};
   for (size_t i = 0; i < positions.size(); ++i) {
     const ArtifactEvaluation& e = positions[i];

@@ -17,8 +17,8 @@ Camera MakeCamera(const DefaultRigGeometry& g, int index) {
   const double cx = 0.5 * (g.imager_width_px - 1) + dcx;
   const double cy = 0.5 * (g.imager_height_px - 1) + dcy;
   // OPENCV8: fx fy cx cy k1 k2 p1 p2 k3 k4 k5 k6.
-  std::vector<double> intrinsics = {f_px + df, f_px + df + 0.4, cx, cy,
-                                    -0.11 + 0.01 * index, 0.09, 2e-4, -1e-4, -0.02, 0.0, 0.0, 0.0};
+  std::vector<double> intrinsics = {
+      f_px + df, f_px + df + 0.4, cx, cy, -0.11 + 0.01 * index, 0.09, 2e-4, -1e-4, -0.02, 0.0, 0.0, 0.0};
   return Camera("LENSMODEL_OPENCV8", intrinsics, g.imager_width_px, g.imager_height_px, "default rig");
 }
 
@@ -50,8 +50,7 @@ SimulatedRig MakeDefaultRig(const DefaultRigGeometry& g) {
     names.push_back("cam" + std::to_string(i));
   }
   std::vector<StereoModule> modules = {{"module0", 0, 1, right_from_left}, {"module1", 2, 3, right_from_left}};
-  const std::vector<Pose> module0_from_module = {Pose::Identity(),
-                                                 world_from_module0.Inverse() * world_from_module1};
+  const std::vector<Pose> module0_from_module = {Pose::Identity(), world_from_module0.Inverse() * world_from_module1};
   SimulatedRig out{Rig(std::move(cameras), std::move(names), std::move(modules), module0_from_module),
                    world_from_module0};
   out.rig.provenance().tool = "stereorig simulator (ground truth)";

@@ -14,7 +14,7 @@ namespace stereorig {
 
 struct DefaultRigGeometry {
   double baseline_mm = 90.0;
-  double verging_deg = 6.0;          // angle between the two optical axes
+  double verging_deg = 6.0;  // angle between the two optical axes
   double working_distance_mm = 200.0;
   double focal_length_mm = 8.5;
   double pixel_pitch_um = 8.3;

@@ -27,9 +27,9 @@ inline double AmbientIrradianceDn(const RenderSpec& r, const Eigen::Vector3d& n_
 struct LaserProjector {
   Pose projector_from_world;
   Eigen::Vector3d origin_world = Eigen::Vector3d::Zero();
-  double sin_half_fan = 0;   // sin(fan / 2)
+  double sin_half_fan = 0;  // sin(fan / 2)
   int lines = 0;
-  double sigma = 0;          // line 1-sigma in direction-cosine units (rad)
+  double sigma = 0;  // line 1-sigma in direction-cosine units (rad)
   double power_dn = 0;
   double ref_distance_mm = 200;  // where power_dn applies (1/r^2 falloff)
 

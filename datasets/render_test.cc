@@ -159,9 +159,10 @@ TEST(Render, LaserLinesFallWhereTheProjectorGeometrySays) {
   }
   ASSERT_GT(peaks, 2000);
   const double rms = std::sqrt(sum2 / peaks);
-  std::printf("%d laser peaks: %.4f mrad RMS, worst %.4f mrad off their line (line sigma %.2f mrad, spacing %.2f "
-              "mrad)\n",
-              peaks, rms * 1e3, worst * 1e3, sigma * 1e3, 2e3 * sin_half / (ps.lines - 1));
+  std::printf(
+      "%d laser peaks: %.4f mrad RMS, worst %.4f mrad off their line (line sigma %.2f mrad, spacing %.2f "
+      "mrad)\n",
+      peaks, rms * 1e3, worst * 1e3, sigma * 1e3, 2e3 * sin_half / (ps.lines - 1));
   // A parabola through three samples of a ~1 px Gaussian locates it to
   // ~0.05 px (~0.05 mrad); a wrong rotation, fan or origin would move the
   // lines by a good part of the 8 mrad spacing.
@@ -186,8 +187,8 @@ TEST(Render, LaserIsShadowed) {
   // faces projector 1 only; move projector 1 away: no light there.
   const Eigen::Vector3d p_back(0, 0, 0.5 * ss.sphere_diameter_mm);
   const LaserProjector& l0 = projectors[0];
-  EXPECT_TRUE(front.Occluded(p_back, (l0.origin_world - p_back).normalized(), 1e-3,
-                             (l0.origin_world - p_back).norm() - 1e-3));
+  EXPECT_TRUE(
+      front.Occluded(p_back, (l0.origin_world - p_back).normalized(), 1e-3, (l0.origin_world - p_back).norm() - 1e-3));
   const Eigen::Vector3d p_front(0, 0, -0.5 * ss.sphere_diameter_mm);
   EXPECT_FALSE(front.Occluded(p_front, (l0.origin_world - p_front).normalized(), 1e-3,
                               (l0.origin_world - p_front).norm() - 1e-3));

@@ -48,7 +48,8 @@ class SphereShape : public Shape {
       const int np = std::max(1, static_cast<int>(std::ceil(2 * M_PI * r_ * std::sin(th) / sp)));
       for (int j = 0; j < np; ++j) {
         const double ph = 2 * M_PI * j / np;
-        out->push_back(c_ + r_ * Eigen::Vector3d(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)));
+        out->push_back(c_ +
+                       r_ * Eigen::Vector3d(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)));
       }
     }
   }
@@ -60,7 +61,8 @@ class SphereShape : public Shape {
 
 class TubeShape : public Shape {
  public:
-  TubeShape(double r, double lo, double hi, int axis) : r_(r), lo_(lo), hi_(hi), a_(axis), i_((axis + 1) % 3), j_((axis + 2) % 3) {}
+  TubeShape(double r, double lo, double hi, int axis)
+      : r_(r), lo_(lo), hi_(hi), a_(axis), i_((axis + 1) % 3), j_((axis + 2) % 3) {}
   bool Intersect(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_min, double t_max, double* t,
                  Eigen::Vector3d* n) const override {
     const double A = d[i_] * d[i_] + d[j_] * d[j_];
@@ -248,9 +250,10 @@ class BoxShape : public Shape {
 inline double FastSin(double x) {
   x -= 2 * M_PI * std::nearbyint(x * (0.5 / M_PI));  // [-pi, pi]
   if (x > 0.5 * M_PI) x = M_PI - x;
-  if (x < -0.5 * M_PI) x = -M_PI - x;                 // [-pi/2, pi/2], same sine
+  if (x < -0.5 * M_PI) x = -M_PI - x;  // [-pi/2, pi/2], same sine
   const double x2 = x * x;
-  return x * (1 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880 + x2 * (-1.0 / 39916800))))));
+  return x *
+         (1 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880 + x2 * (-1.0 / 39916800))))));
 }
 
 class BumpyEllipsoidShape : public Shape {
@@ -298,9 +301,8 @@ class BumpyEllipsoidShape : public Shape {
     // default) is far below that; the surface is then the only root of F
     // between the start and the inner bound: Illinois regula falsi finds it.
     double si0, si1;
-    if (bump_ * kMaxFreq < 0.5 &&
-        SphereSpan(ou, du1, Eigen::Vector3d::Zero(), 1.0 - bump_, &si0, &si1) && si0 > s && si0 < s_end &&
-        std::abs(du1.dot(ou + si0 * du1)) > 0.5 * (1.0 - bump_)) {
+    if (bump_ * kMaxFreq < 0.5 && SphereSpan(ou, du1, Eigen::Vector3d::Zero(), 1.0 - bump_, &si0, &si1) && si0 > s &&
+        si0 < s_end && std::abs(du1.dot(ou + si0 * du1)) > 0.5 * (1.0 - bump_)) {
       double a = s, fa = f_start, b = si0, fb = F(ou + si0 * du1);
       int side = 0;
       for (int it = 0; it < 100 && fb < 0; ++it) {
@@ -455,16 +457,16 @@ Pose ConveyorPose(const Eigen::Matrix3d& base, const Eigen::Vector3d& center_obj
   const double tz = rng->Uniform(-spec.wobble_tilt_deg, spec.wobble_tilt_deg) * kDeg;
   const Eigen::Vector3d shift(rng->Uniform(-spec.wobble_shift_mm, spec.wobble_shift_mm), 0,
                               rng->Uniform(-spec.wobble_shift_mm, spec.wobble_shift_mm));
-  const Eigen::Matrix3d r = (Eigen::AngleAxisd(tx, Eigen::Vector3d::UnitX()) *
-                             Eigen::AngleAxisd(tz, Eigen::Vector3d::UnitZ()) *
-                             Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()))
-                                .toRotationMatrix() *
-                            base;
+  const Eigen::Matrix3d r =
+      (Eigen::AngleAxisd(tx, Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(tz, Eigen::Vector3d::UnitZ()) *
+       Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()))
+          .toRotationMatrix() *
+      base;
   return Pose(r, shift - r * center_object);
 }
 
-void Finish(SceneObject* obj, const Eigen::Vector3d& bound_center_object, double bound_radius,
-            const RenderSpec& render, Rng* rng) {
+void Finish(SceneObject* obj, const Eigen::Vector3d& bound_center_object, double bound_radius, const RenderSpec& render,
+            Rng* rng) {
   obj->object_from_world = obj->world_from_object.Inverse();
   obj->bound_center_world = obj->world_from_object * bound_center_object;
   obj->bound_radius_mm = bound_radius;
@@ -496,7 +498,8 @@ Scene MakeScene(const std::string& name, const ScenesSpec& spec, const RenderSpe
   Rng rng(seed);
   Scene scene;
   scene.name = name;
-  const Eigen::Matrix3d upright = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();  // object z -> world up (-y)
+  const Eigen::Matrix3d upright =
+      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();  // object z -> world up (-y)
   if (name == "cup") {
     const double R = 0.5 * spec.cup_diameter_mm, H = spec.cup_height_mm;
     const double wall = 3.0, bottom = 6.0, bead = 2.5;  // mm: wall, floor thickness, rim bead radius
@@ -527,8 +530,8 @@ Scene MakeScene(const std::string& name, const ScenesSpec& spec, const RenderSpe
     scene.objects.push_back(std::move(o));
   } else if (name == "sphere") {
     const Pose pose = ConveyorPose(Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), 180.0, spec, &rng);
-    scene.objects.push_back(MakeBall(1, "certified matte sphere", spec.sphere_diameter_mm, pose,
-                                     spec.artifact_albedo, render, &rng));
+    scene.objects.push_back(
+        MakeBall(1, "certified matte sphere", spec.sphere_diameter_mm, pose, spec.artifact_albedo, render, &rng));
   } else if (name == "ballbar") {
     const double D = spec.ballbar_distance_mm, r = 0.5 * spec.ballbar_sphere_diameter_mm;
     // The default modules' two views overlap in only ~70 x 110 mm at the

@@ -47,9 +47,9 @@ std::unique_ptr<Shape> MakeBox(const Eigen::Vector3d& half_size_mm);
 std::unique_ptr<Shape> MakeBumpyEllipsoid(const Eigen::Vector3d& semi_axes_mm, double bump, uint64_t seed);
 
 struct SceneObject {
-  int id = 0;                 // object-ID map value (1..255)
-  std::string type;           // "sphere", "cup", "box", "tube", "bumpy_ellipsoid"
-  std::string description;    // one line for object.yaml
+  int id = 0;                   // object-ID map value (1..255)
+  std::string type;             // "sphere", "cup", "box", "tube", "bumpy_ellipsoid"
+  std::string description;      // one line for object.yaml
   std::string parameters_yaml;  // "key: value" lines (object.yaml), indented by the writer
   Pose world_from_object;
   Pose object_from_world;
@@ -58,7 +58,7 @@ struct SceneObject {
   double albedo = 0.8;
   // Weak texture: albedo * (1 + contrast * T(p_object)), T in [-1, 1].
   double texture_contrast = 0;
-  Eigen::Vector3d texture_k[4];    // spatial frequency vectors (rad/mm)
+  Eigen::Vector3d texture_k[4];  // spatial frequency vectors (rad/mm)
   double texture_phase[4] = {0, 0, 0, 0};
   std::vector<std::unique_ptr<Shape>> shapes;
   // Ground-truth sampling drops samples that lie inside the solid of another
@@ -82,8 +82,7 @@ class Scene {
   std::vector<SceneObject> objects;
 
   // Closest hit along a world ray (unit d) with t in (t_min, t_max).
-  bool Intersect(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_min, double t_max,
-                 SceneHit* hit) const;
+  bool Intersect(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_min, double t_max, SceneHit* hit) const;
   // True if anything blocks the segment o + t d, t in (t_min, t_max).
   bool Occluded(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_min, double t_max) const;
 };

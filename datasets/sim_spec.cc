@@ -369,7 +369,8 @@ SpecRig BuildSpecRig(const SimSpec& spec) {
                                   Eigen::Vector3d(0.5 * s.baseline_mm, 0, 0));
     const int left = static_cast<int>(cameras.size());
     const std::string where = "spec: modules[" + std::to_string(m) + "]";
-    cameras.emplace_back(s.left.lensmodel, s.left.intrinsics, s.left.width_px, s.left.height_px, where + ".left_camera");
+    cameras.emplace_back(s.left.lensmodel, s.left.intrinsics, s.left.width_px, s.left.height_px,
+                         where + ".left_camera");
     cameras.emplace_back(s.right.lensmodel, s.right.intrinsics, s.right.width_px, s.right.height_px,
                          where + ".right_camera");
     names.push_back("cam" + std::to_string(left));

@@ -65,8 +65,7 @@ TEST(SimSpec, BadSpecsNameTheKey) {
   EXPECT_NE(ErrorOf(Replace(good, "samples_per_axis: 2", "samples_per_axis: 1")).find("samples_per_axis"),
             std::string::npos);
   EXPECT_NE(ErrorOf(Replace(good, "lines: 51", "lines: many")).find("lines"), std::string::npos);
-  EXPECT_NE(ErrorOf(Replace(good, "fan_angle_deg: 23", "fan_angle_deg: -3")).find("fan_angle_deg"),
-            std::string::npos);
+  EXPECT_NE(ErrorOf(Replace(good, "fan_angle_deg: 23", "fan_angle_deg: -3")).find("fan_angle_deg"), std::string::npos);
   EXPECT_NE(ErrorOf(Replace(good, "names: [cup,", "names: [mug,")).find("mug"), std::string::npos);
   // Wrong number of intrinsics for the model: names the camera.
   EXPECT_NE(ErrorOf(Replace(good, "intrinsics: [1024.98", "intrinsics: [1, 1024.98")).find("left_camera"),

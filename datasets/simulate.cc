@@ -23,8 +23,8 @@
 #include "datasets/rng.h"
 #include "datasets/scene_objects.h"
 #include "datasets/target_render.h"
-#include "targets/target_file.h"
 #include "reconstruct/metrology/artifact.h"
+#include "targets/target_file.h"
 
 namespace stereorig {
 
@@ -201,7 +201,8 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
       if (b.camera >= num_cameras) throw InputError("--bump-camera", "no camera " + std::to_string(b.camera));
       sr.world_from_camera[b.camera] = sr.world_from_camera[b.camera] * delta;
     } else {
-      if (b.module >= sr.sim.rig.num_modules()) throw InputError("--bump-module", "no module " + std::to_string(b.module));
+      if (b.module >= sr.sim.rig.num_modules())
+        throw InputError("--bump-module", "no module " + std::to_string(b.module));
       const StereoModule& m = sr.sim.rig.module(b.module);
       const Pose world_from_module = sr.world_from_camera[m.left_camera];
       const Pose moved = world_from_module * delta * world_from_module.Inverse();  // world_from_world'
@@ -223,7 +224,8 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
   const Pose module0_from_world = sr.sim.world_from_module0.Inverse();
   sr.sim.rig.provenance().input = "stereorig simulate, seed " + std::to_string(seed);
 
-  const Target target = spec.calibration.target == "default" ? DefaultTarget() : ReadTargetFile(spec.calibration.target);
+  const Target target =
+      spec.calibration.target == "default" ? DefaultTarget() : ReadTargetFile(spec.calibration.target);
   const PhysicalBoard board = MakePhysicalBoard(target, spec.calibration);
   const std::vector<LaserProjector> projectors =
       MakeProjectors(spec, sr.world_from_projector, sr.projector_distance_mm);
@@ -270,8 +272,8 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
 
   // --- calibration poses and scenes
   const int captures = spec.calibration.captures;
-  const std::vector<Pose> poses = MakeCalibrationPoses(spec.calibration, board, rig.cameras(), sr.world_from_camera,
-                                                       StreamKey({seed, kKeyPoses}));
+  const std::vector<Pose> poses =
+      MakeCalibrationPoses(spec.calibration, board, rig.cameras(), sr.world_from_camera, StreamKey({seed, kKeyPoses}));
   std::vector<Scene> scenes;
   for (size_t s = 0; s < spec.scenes.names.size(); ++s) {
     scenes.push_back(MakeScene(spec.scenes.names[s], spec.scenes, spec.render,
@@ -307,10 +309,13 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
       const std::string name = "cam" + std::to_string(cam);
       const SceneRadiance rad = RenderScene(*rays[cam], sr.world_from_camera[cam], scene, projectors, spec.render);
       const uint64_t c = static_cast<uint64_t>(cam), si = static_cast<uint64_t>(s);
-      const cv::Mat passive = SensorImage(rad.passive, stray[cam], spec.render, StreamKey({seed, kKeyPassiveSensor, si, c}));
-      const cv::Mat speckle = SpeckleField(rad.laser.cols, rad.laser.rows, spec.render, StreamKey({seed, kKeySpeckle, si, c}));
+      const cv::Mat passive =
+          SensorImage(rad.passive, stray[cam], spec.render, StreamKey({seed, kKeyPassiveSensor, si, c}));
+      const cv::Mat speckle =
+          SpeckleField(rad.laser.cols, rad.laser.rows, spec.render, StreamKey({seed, kKeySpeckle, si, c}));
       const cv::Mat active_radiance = rad.passive + rad.laser.mul(speckle);
-      const cv::Mat active = SensorImage(active_radiance, stray[cam], spec.render, StreamKey({seed, kKeyActiveSensor, si, c}));
+      const cv::Mat active =
+          SensorImage(active_radiance, stray[cam], spec.render, StreamKey({seed, kKeyActiveSensor, si, c}));
       WriteImage(tmp / "scenes" / scene.name / "passive" / (name + ".png"), passive);
       WriteImage(tmp / "scenes" / scene.name / "active" / (name + ".png"), active);
       WriteImage(truth / ("depth_" + name + ".tiff"), rad.depth);
@@ -321,8 +326,9 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
     }
     const int k = (job - num_scene_jobs) / num_cameras, cam = (job - num_scene_jobs) % num_cameras;
     const cv::Mat radiance = RenderTargetRadiance(*rays[cam], sr.world_from_camera[cam], poses[k], board, spec.render);
-    const cv::Mat image = SensorImage(radiance, stray[cam], spec.render,
-                                      StreamKey({seed, kKeyCalibSensor, static_cast<uint64_t>(k), static_cast<uint64_t>(cam)}));
+    const cv::Mat image =
+        SensorImage(radiance, stray[cam], spec.render,
+                    StreamKey({seed, kKeyCalibSensor, static_cast<uint64_t>(k), static_cast<uint64_t>(cam)}));
     WriteImage(tmp / "calibration" / Num3(k) / ("cam" + std::to_string(cam) + ".png"), image);
     ++images;
     progress.Done("calibration " + Num3(k));
@@ -403,8 +409,7 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
   {
     std::ostringstream o;
     o << "# How this dataset was made (what is not in spec.yaml).\nformat: stereorig-sim-info\nversion: 1\n"
-      << "tool: \"" << ToolVersion() << "\"\nseed: " << seed << "\ncalibration_captures: " << captures
-      << "\nscenes: [";
+      << "tool: \"" << ToolVersion() << "\"\nseed: " << seed << "\ncalibration_captures: " << captures << "\nscenes: [";
     for (size_t s = 0; s < scenes.size(); ++s) o << (s ? ", " : "") << scenes[s].name;
     o << "]\nsurface_spacing_mm: " << FormatDouble(options.surface_spacing_mm) << "\n"
       << "depth_maps: \"float32 TIFF, z in the camera frame (mm) at the pixel centre, 0 = no surface\"\n"

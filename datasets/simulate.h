@@ -24,21 +24,21 @@ namespace stereorig {
 
 // "The morning after a bump": the true rig moved before rendering.
 struct RigBump {
-  int camera = -1;               // global camera index to disturb, -1 = none
-  int module = -1;               // module index to move as a whole (its cameras and projector), -1 = none
-  double rotation_deg = 0.0;     // angle of the disturbance, about an axis drawn from the seed
-  double translation_mm = 0.0;   // length of the shift, along a direction drawn from the seed
+  int camera = -1;              // global camera index to disturb, -1 = none
+  int module = -1;              // module index to move as a whole (its cameras and projector), -1 = none
+  double rotation_deg = 0.0;    // angle of the disturbance, about an axis drawn from the seed
+  double translation_mm = 0.0;  // length of the shift, along a direction drawn from the seed
   bool Any() const { return (camera >= 0 || module >= 0) && (rotation_deg != 0 || translation_mm != 0); }
 };
 
 struct SimulateOptions {
-  std::string out_dir;             // the dataset folder; replaced only if it is empty or a dataset
+  std::string out_dir;  // the dataset folder; replaced only if it is empty or a dataset
   uint64_t seed = 1;
-  int threads = 0;                 // 0 = every hardware thread
-  bool scenes = true;              // false: calibration captures only
-  int calibration_captures = -1;   // -1 = the spec's count
+  int threads = 0;                // 0 = every hardware thread
+  bool scenes = true;             // false: calibration captures only
+  int calibration_captures = -1;  // -1 = the spec's count
   RigBump bump;
-  double surface_spacing_mm = 0.2;   // ground-truth surface samples (<= 0.2)
+  double surface_spacing_mm = 0.2;                   // ground-truth surface samples (<= 0.2)
   std::function<void(const std::string&)> progress;  // may be empty
 
   void Check() const;

@@ -73,8 +73,7 @@ TEST(Simulate, OneTwoAndThreeModuleRigsRender) {
       }
       const cv::Mat active = cv::imread((dir / "scenes/sphere/active" / name).string(), cv::IMREAD_UNCHANGED);
       const cv::Mat passive = cv::imread((dir / "scenes/sphere/passive" / name).string(), cv::IMREAD_UNCHANGED);
-      const cv::Mat id = cv::imread((dir / "truth/scenes/sphere" / ("id_" + name)).string(),
-                                    cv::IMREAD_UNCHANGED);
+      const cv::Mat id = cv::imread((dir / "truth/scenes/sphere" / ("id_" + name)).string(), cv::IMREAD_UNCHANGED);
       ASSERT_FALSE(active.empty());
       ASSERT_FALSE(id.empty());
       // Every camera sees the sphere, and its own module's laser on it.
@@ -192,8 +191,9 @@ TEST(Simulate, DepthMapsLieOnTheDenseSurface) {
     double worst = 0;
     int checked = 0;
     for (int cam = 0; cam < rig.num_cameras(); ++cam) {
-      const cv::Mat depth = cv::imread((dir / "truth/scenes" / scene / ("depth_cam" + std::to_string(cam) + ".tiff")).string(),
-                                       cv::IMREAD_UNCHANGED);
+      const cv::Mat depth =
+          cv::imread((dir / "truth/scenes" / scene / ("depth_cam" + std::to_string(cam) + ".tiff")).string(),
+                     cv::IMREAD_UNCHANGED);
       ASSERT_EQ(depth.type(), CV_32F);
       const Pose ref_from_cam = rig.CamFromReference(cam).Inverse();
       for (int r = 0; r < depth.rows; r += 2) {

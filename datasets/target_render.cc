@@ -36,9 +36,9 @@ PhysicalBoard MakePhysicalBoard(const Target& target, const CalibrationSpec& spe
   b.white_albedo = spec.white_albedo;
   b.black_albedo = spec.black_albedo;
   // Misaligned back print: turned and shifted in the back face's plane.
-  const Pose misalign(Eigen::AngleAxisd(spec.back_misalignment_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ())
-                          .toRotationMatrix(),
-                      Eigen::Vector3d(spec.back_misalignment_mm, 0, 0));
+  const Pose misalign(
+      Eigen::AngleAxisd(spec.back_misalignment_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix(),
+      Eigen::Vector3d(spec.back_misalignment_mm, 0, 0));
   b.true_back_from_front = misalign * target.back_from_front();
   return b;
 }
@@ -119,7 +119,8 @@ int CornersInView(const Camera& camera, const Pose& world_from_cam, const Pose& 
                   const PhysicalBoard& board) {
   const Face face = board.target->double_sided() ? FaceSeen(world_from_cam, world_from_front) : Face::kFront;
   const Pose cam_from_front = world_from_cam.Inverse() * world_from_front;
-  const Pose cam_from_face = face == Face::kFront ? cam_from_front : cam_from_front * board.true_back_from_front.Inverse();
+  const Pose cam_from_face =
+      face == Face::kFront ? cam_from_front : cam_from_front * board.true_back_from_front.Inverse();
   if (!board.target->double_sided() && cam_from_front.Inverse().translation_mm().z() > 0) return 0;
   int count = 0;
   for (int id = 0; id < board.target->num_corners(); ++id) {

@@ -186,9 +186,9 @@ cv::Mat SgmMatch(const CensusImage& left, const CensusImage& right, const cv::Re
     for (int x = 0; x < w; ++x) {
       uint16_t* cur = vert_cur.data() + size_t(x) * (n + 2) + 1;
       const uint8_t* c = crow + size_t(x) * n;
-      vert_cur_min[x] = y == 0 ? FirstStep(c, cur, n)
-                               : PathStep(c, vert_prev.data() + size_t(x) * (n + 2) + 1, vert_prev_min[x], cur,
-                                          n, p1, p2);
+      vert_cur_min[x] = y == 0
+                            ? FirstStep(c, cur, n)
+                            : PathStep(c, vert_prev.data() + size_t(x) * (n + 2) + 1, vert_prev_min[x], cur, n, p1, p2);
       std::copy(cur, cur + n, srow + size_t(x) * n);
     }
     std::swap(vert_prev, vert_cur);
@@ -220,9 +220,9 @@ cv::Mat SgmMatch(const CensusImage& left, const CensusImage& right, const cv::Re
     for (int x = 0; x < w; ++x) {
       uint16_t* cur = vert_cur.data() + size_t(x) * (n + 2) + 1;
       const uint8_t* c = crow + size_t(x) * n;
-      vert_cur_min[x] = y == h - 1 ? FirstStep(c, cur, n)
-                                   : PathStep(c, vert_prev.data() + size_t(x) * (n + 2) + 1, vert_prev_min[x],
-                                              cur, n, p1, p2);
+      vert_cur_min[x] = y == h - 1
+                            ? FirstStep(c, cur, n)
+                            : PathStep(c, vert_prev.data() + size_t(x) * (n + 2) + 1, vert_prev_min[x], cur, n, p1, p2);
       AddTo(srow + size_t(x) * n, cur, n);
     }
     std::swap(vert_prev, vert_cur);

@@ -34,12 +34,12 @@ CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int
 inline constexpr int kCensusMaxCost = 62;  // bits in the largest (9x7) signature: the cost of "no match"
 
 struct SgmOptions {
-  int p1 = 8;                 // penalty for a 1 px disparity step, census bits; default 8
-  int p2 = 80;                // penalty for a larger step, census bits (> p1); default 80
-  int num_paths = 4;          // 3 (left, right, top: one pass, no volume kept) or 4 (+bottom); default 4
-  int uniqueness_percent = 5; // best cost must beat every cost off the best+-1 by this %; default 5
-  int lr_max_diff_px = 1;     // left-right consistency tolerance, whole px; default 1
-  void Check() const;         // throws InputError naming the bad field
+  int p1 = 8;                  // penalty for a 1 px disparity step, census bits; default 8
+  int p2 = 80;                 // penalty for a larger step, census bits (> p1); default 80
+  int num_paths = 4;           // 3 (left, right, top: one pass, no volume kept) or 4 (+bottom); default 4
+  int uniqueness_percent = 5;  // best cost must beat every cost off the best+-1 by this %; default 5
+  int lr_max_diff_px = 1;      // left-right consistency tolerance, whole px; default 1
+  void Check() const;          // throws InputError naming the bad field
 };
 
 // SGM over `region` (left image px) for integer disparities
@@ -47,7 +47,7 @@ struct SgmOptions {
 // of region.size(): the disparity refined by an equiangular (symmetric V) fit
 // of the aggregated cost, or NaN where the left-right check or the
 // uniqueness test failed, or the best cost sits at the edge of the range.
-cv::Mat SgmMatch(const CensusImage& left, const CensusImage& right, const cv::Rect& region,
-                 int min_disparity, int num_disparities, const SgmOptions& options);
+cv::Mat SgmMatch(const CensusImage& left, const CensusImage& right, const cv::Rect& region, int min_disparity,
+                 int num_disparities, const SgmOptions& options);
 
 }  // namespace stereorig

@@ -74,8 +74,7 @@ HoleFillResult FillHolesFromModel(const PointCloud& measured, const RuntimeOptio
     }
   char buf[200];
   std::snprintf(buf, sizeof buf, "sphere centre (%.3f, %.3f, %.3f) mm, radius %.3f mm, fit rms %.3f mm, %zu inliers",
-                fit.center_mm.x(), fit.center_mm.y(), fit.center_mm.z(), fit.radius_mm, fit.rms_mm,
-                fit.inliers.size());
+                fit.center_mm.x(), fit.center_mm.y(), fit.center_mm.z(), fit.radius_mm, fit.rms_mm, fit.inliers.size());
   result.ok = true;
   result.added_points = added;
   result.message = buf;

@@ -24,13 +24,15 @@ const char* MatcherKindName(MatcherKind kind) {
 
 void MatchOptions::Check() const {
   if (num_disparities < 2 || num_disparities > 1024) throw InputError("num_disparities", "must be in [2, 1024]");
-  if (min_disparity_px < -1024 || min_disparity_px > 2048) throw InputError("min_disparity", "must be in [-1024, 2048]");
+  if (min_disparity_px < -1024 || min_disparity_px > 2048)
+    throw InputError("min_disparity", "must be in [-1024, 2048]");
   if (roi.width < 0 || roi.height < 0) throw InputError("roi", "must have a non-negative size");
   if (pyramid_levels < 0 || pyramid_levels > 3) throw InputError("pyramid_levels", "must be in [0, 3]");
   if (refine_radius_px < 1 || refine_radius_px > 8) throw InputError("refine_radius_px", "must be in [1, 8]");
   if (refine_half_window_px < 0 || refine_half_window_px > 5)
     throw InputError("refine_half_window_px", "must be in [0, 5]");
-  if (census_half_width_px < 1 || census_half_width_px > 4) throw InputError("census_half_width_px", "must be in [1, 4]");
+  if (census_half_width_px < 1 || census_half_width_px > 4)
+    throw InputError("census_half_width_px", "must be in [1, 4]");
   if (census_half_height_px < 1 || census_half_height_px > 3)
     throw InputError("census_half_height_px", "must be in [1, 3]");
   sgm.Check();
@@ -63,13 +65,12 @@ cv::Mat MatchLevel(const cv::Mat& left, const cv::Mat& right, const cv::Rect& re
   // region shifted by the disparity range in the right one.
   const int margin = o.refine_half_window_px;
   const int reach = levels_left > 0 ? o.refine_radius_px + 2 : 0;  // fine level: +-radius around 2x coarse
-  const CensusImage cl = CensusTransform(left, region.y - margin, region.y + region.height + margin, o.num_threads,
-                                         o.census_half_width_px, o.census_half_height_px, region.x - margin,
-                                         region.x + region.width + margin);
-  const CensusImage cr = CensusTransform(right, region.y - margin, region.y + region.height + margin, o.num_threads,
-                                         o.census_half_width_px, o.census_half_height_px,
-                                         region.x - dmin - num - margin - reach,
-                                         region.x + region.width - dmin + margin + reach);
+  const CensusImage cl =
+      CensusTransform(left, region.y - margin, region.y + region.height + margin, o.num_threads, o.census_half_width_px,
+                      o.census_half_height_px, region.x - margin, region.x + region.width + margin);
+  const CensusImage cr = CensusTransform(
+      right, region.y - margin, region.y + region.height + margin, o.num_threads, o.census_half_width_px,
+      o.census_half_height_px, region.x - dmin - num - margin - reach, region.x + region.width - dmin + margin + reach);
   if (levels_left == 0) return SgmMatch(cl, cr, region, dmin, num, o.sgm);
 
   cv::Mat left_half, right_half;
@@ -262,8 +263,8 @@ MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::
             (std::isnan(pl) || std::abs(d - pl) > o.max_plane_deviation_px + o.subpixel.max_shift_px))
           continue;
         if (o.intensity_refinement) {
-          const SubpixelResult s = RefineDisparity(left, right, x, y, d, slope_x.at<float>(yy, xx),
-                                                   slope_y.at<float>(yy, xx), o.subpixel);
+          const SubpixelResult s =
+              RefineDisparity(left, right, x, y, d, slope_x.at<float>(yy, xx), slope_y.at<float>(yy, xx), o.subpixel);
           if (!s.ok || s.zncc < o.min_zncc || s.std_dn < o.min_texture_dn) continue;
           d = s.disparity_px;
           confidence = float(std::clamp(s.zncc, 0.0, 1.0));
@@ -301,10 +302,9 @@ MatchResult MatchOpenCvSgbm(const cv::Mat& left, const cv::Mat& right, const cv:
   const int x1 = std::min(left.cols, roi.x + roi.width + std::max(0, -o.min_disparity_px));
   const cv::Rect cut(x0, roi.y, x1 - x0, roi.height);
   const int bs = o.sgbm_block_size;
-  cv::Ptr<cv::StereoSGBM> sgbm =
-      cv::StereoSGBM::create(o.min_disparity_px, num16, bs, 8 * bs * bs, 32 * bs * bs, o.sgm.lr_max_diff_px, 63, 10,
-                             o.speckle_window_px, std::max(1, int(std::lround(o.speckle_range_px))),
-                             cv::StereoSGBM::MODE_SGBM_3WAY);
+  cv::Ptr<cv::StereoSGBM> sgbm = cv::StereoSGBM::create(
+      o.min_disparity_px, num16, bs, 8 * bs * bs, 32 * bs * bs, o.sgm.lr_max_diff_px, 63, 10, o.speckle_window_px,
+      std::max(1, int(std::lround(o.speckle_range_px))), cv::StereoSGBM::MODE_SGBM_3WAY);
   cv::Mat fixed;
   const auto t0 = std::chrono::steady_clock::now();
   sgbm->compute(left(cut), right(cut), fixed);

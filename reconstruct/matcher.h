@@ -34,31 +34,34 @@ const char* MatcherKindName(MatcherKind kind);
 
 struct MatchOptions {
   MatcherKind matcher = MatcherKind::kCensusSgm;  // default census_sgm
-  int min_disparity_px = 0;     // smallest disparity searched, px; default 0
-  int num_disparities = 64;     // disparities searched: [min, min + num), px; default 64
-  cv::Rect roi;                 // left-image region to match; empty = whole image; default empty
-  int pyramid_levels = 0;       // census_sgm: halvings before the full-range SGM; default 0 (1 is ~2x faster, fills less on steep flanks)
+  int min_disparity_px = 0;                       // smallest disparity searched, px; default 0
+  int num_disparities = 64;                       // disparities searched: [min, min + num), px; default 64
+  cv::Rect roi;                                   // left-image region to match; empty = whole image; default empty
+  int pyramid_levels =
+      0;  // census_sgm: halvings before the full-range SGM; default 0 (1 is ~2x faster, fills less on steep flanks)
   // census_sgm: before the full-resolution search, a half-resolution SGM over
   // the whole range finds the band of disparities the scene occupies (2nd..98th
   // percentile + range_margin_px); only that band is searched at full
   // resolution. Cost: ~1/8 of a full search, saving most of a deep volume's range.
-  bool narrow_range = true;     // default true
-  int range_margin_px = 6;      // default 6 px
-  int refine_radius_px = 2;     // census_sgm: fine-level search +-radius around 2x coarse; default 2
-  int refine_half_window_px = 1;  // census_sgm: fine-level cost box half size; default 1 (3x3)
-  int census_half_width_px = 2;   // census_sgm: census window half width (<= 4); default 2 (5 px: tolerates foreshortening, cup fill 47% -> 73% vs 9 px)
-  int census_half_height_px = 3;  // census_sgm: census window half height (<= 3); default 3 (7 px)
-  SgmOptions sgm;               // census_sgm: penalties, paths, uniqueness, left-right check
+  bool narrow_range = true;          // default true
+  int range_margin_px = 6;           // default 6 px
+  int refine_radius_px = 2;          // census_sgm: fine-level search +-radius around 2x coarse; default 2
+  int refine_half_window_px = 1;     // census_sgm: fine-level cost box half size; default 1 (3x3)
+  int census_half_width_px = 2;      // census_sgm: census window half width (<= 4); default 2 (5 px: tolerates
+                                     // foreshortening, cup fill 47% -> 73% vs 9 px)
+  int census_half_height_px = 3;     // census_sgm: census window half height (<= 3); default 3 (7 px)
+  SgmOptions sgm;                    // census_sgm: penalties, paths, uniqueness, left-right check
   bool intensity_refinement = true;  // census_sgm: Lucas-Kanade sub-pixel step; default true
-  SubpixelOptions subpixel;     // its window and limits
-  double min_zncc = 0.8;        // reject matches whose refined window correlates less; default 0.8
-  double max_plane_deviation_px = 0.7;  // reject d farther than this from the local 9x9 disparity plane (0 = off); default 0.7
+  SubpixelOptions subpixel;          // its window and limits
+  double min_zncc = 0.8;             // reject matches whose refined window correlates less; default 0.8
+  double max_plane_deviation_px =
+      0.7;                      // reject d farther than this from the local 9x9 disparity plane (0 = off); default 0.7
   double min_texture_dn = 1.5;  // reject windows with a grey-level std below this; default 1.5 DN
   int speckle_window_px = 100;  // remove disparity blobs smaller than this, px (0 = off); default 100
   double speckle_range_px = 1.0;  // neighbours within this disparity are one blob, px; default 1
-  int sgbm_block_size = 5;      // opencv_sgbm_3way: block size, px (odd); default 5
-  int num_threads = 2;          // threads for row-parallel steps; default 2
-  void Check() const;           // throws InputError naming the bad field
+  int sgbm_block_size = 5;        // opencv_sgbm_3way: block size, px (odd); default 5
+  int num_threads = 2;            // threads for row-parallel steps; default 2
+  void Check() const;             // throws InputError naming the bad field
 };
 
 struct MatchResult {

@@ -62,8 +62,8 @@ ErrorStats Score(const MatchResult& m, const SyntheticPair& pair, int margin) {
 }
 
 void Print(const char* name, const ErrorStats& s) {
-  std::printf("%-22s fill %.3f  mean %+.4f px  rms %.4f px  max %.3f px  peak-lock (worst bin - mean) %.4f px\n",
-              name, s.fill(), s.mean, s.rms, s.max_abs, s.worst_bin());
+  std::printf("%-22s fill %.3f  mean %+.4f px  rms %.4f px  max %.3f px  peak-lock (worst bin - mean) %.4f px\n", name,
+              s.fill(), s.mean, s.rms, s.max_abs, s.worst_bin());
   std::printf("%-22s bins:", "");
   for (int i = 0; i < 10; ++i) std::printf(" %+.3f", s.bin_mean[i]);
   std::printf("\n");

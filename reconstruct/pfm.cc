@@ -84,9 +84,7 @@ cv::Mat DecodePfm(const std::string& bytes, const std::string& where) {
   return image;
 }
 
-void WritePfm(const cv::Mat& image_f32, const std::string& path) {
-  WriteFileAtomically(path, EncodePfm(image_f32));
-}
+void WritePfm(const cv::Mat& image_f32, const std::string& path) { WriteFileAtomically(path, EncodePfm(image_f32)); }
 
 cv::Mat ReadPfm(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

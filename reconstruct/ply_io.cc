@@ -47,7 +47,9 @@ std::string EncodeCloudPly(const PointCloud& c) {
   return out;
 }
 
-void WriteCloudPly(const PointCloud& cloud, const std::string& path) { WriteFileAtomically(path, EncodeCloudPly(cloud)); }
+void WriteCloudPly(const PointCloud& cloud, const std::string& path) {
+  WriteFileAtomically(path, EncodeCloudPly(cloud));
+}
 
 void CheckMeshPath(const std::string& path) {
   if (!EndsWith(path, ".ply") && !EndsWith(path, ".stl"))
@@ -71,11 +73,11 @@ void WriteMesh(const Mesh& m, const std::string& path) {
       Put(out, uint16_t(0));
     }
   } else {
-    out = "ply\nformat binary_little_endian 1.0\ncomment stereorig mesh, reference frame (module 0), mm\n"
-          "element vertex " +
-          std::to_string(m.vertices_mm.size()) +
-          "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
-          std::to_string(m.triangles.size()) + "\nproperty list uchar int vertex_indices\nend_header\n";
+    out =
+        "ply\nformat binary_little_endian 1.0\ncomment stereorig mesh, reference frame (module 0), mm\n"
+        "element vertex " +
+        std::to_string(m.vertices_mm.size()) + "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+        std::to_string(m.triangles.size()) + "\nproperty list uchar int vertex_indices\nend_header\n";
     for (const Eigen::Vector3f& v : m.vertices_mm)
       for (int k = 0; k < 3; ++k) Put(out, v[k]);
     for (const Eigen::Vector3i& t : m.triangles) {

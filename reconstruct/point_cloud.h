@@ -14,10 +14,10 @@ inline constexpr uint8_t kFilledModule = 255;
 
 struct PointCloud {
   std::vector<Eigen::Vector3f> xyz_mm;
-  std::vector<Eigen::Vector3f> normal;   // unit, towards the camera that saw the point
-  std::vector<uint8_t> intensity;        // grey level of the rectified left image
-  std::vector<uint8_t> module;           // module index, or kFilledModule
-  std::vector<float> confidence;         // [0, 1]
+  std::vector<Eigen::Vector3f> normal;  // unit, towards the camera that saw the point
+  std::vector<uint8_t> intensity;       // grey level of the rectified left image
+  std::vector<uint8_t> module;          // module index, or kFilledModule
+  std::vector<float> confidence;        // [0, 1]
   size_t size() const { return xyz_mm.size(); }
   void Append(const PointCloud& other);
 };

@@ -22,13 +22,13 @@
 namespace stereorig {
 
 struct RectifiedGeometry {
-  Eigen::Matrix3d rect_from_left = Eigen::Matrix3d::Identity();  // rotation: rectified frame from left camera
-  Eigen::Matrix3d right_from_rect = Eigen::Matrix3d::Identity(); // rotation: right camera from rectified frame
-  double focal_px = 0;            // both rectified cameras
+  Eigen::Matrix3d rect_from_left = Eigen::Matrix3d::Identity();   // rotation: rectified frame from left camera
+  Eigen::Matrix3d right_from_rect = Eigen::Matrix3d::Identity();  // rotation: right camera from rectified frame
+  double focal_px = 0;                                            // both rectified cameras
   double cx_left_px = 0, cy_px = 0;
-  double disparity_offset_px = 0; // cx_right = cx_left + offset
-  double baseline_mm = 0;         // |left -> right camera centre|
-  cv::Size size;                  // rectified image size, px
+  double disparity_offset_px = 0;  // cx_right = cx_left + offset
+  double baseline_mm = 0;          // |left -> right camera centre|
+  cv::Size size;                   // rectified image size, px
 
   // Rectified-frame point (mm) -> left rectified pixel and image disparity.
   Eigen::Vector3d PixelAndDisparity(const Eigen::Vector3d& p_rect) const;
@@ -48,7 +48,7 @@ RectifiedGeometry ComputeRectification(const Camera& left, const Camera& right, 
 // original pixel, for cv::remap. Pixels whose ray does not project (behind a
 // lens) get -1 (outside the image, so remap fills them with 0).
 struct RectifyMaps {
-  cv::Mat left_x, left_y, right_x, right_y;          // CV_32FC1
+  cv::Mat left_x, left_y, right_x, right_y;                // CV_32FC1
   cv::Mat left_fixed, left_frac, right_fixed, right_frac;  // the same, cv::convertMaps fixed point (fast remap)
 };
 RectifyMaps BuildRectifyMaps(const RectifiedGeometry& g, const Camera& left, const Camera& right);

@@ -23,8 +23,7 @@ double Lookup(const cv::Mat& m, double u, double v) {
 TEST(Rectify, VergedDistortedPairMapsEveryPointOntoOneRow) {
   // A verged pair (6 deg), OPENCV8 distortion, slightly different lenses.
   const Camera left("LENSMODEL_OPENCV8", {1020, 1021, 378, 290, -0.11, 0.09, 2e-4, -1e-4, -0.02, 0, 0, 0}, 752, 582);
-  const Camera right("LENSMODEL_OPENCV8", {1027, 1027.5, 371, 293, -0.10, 0.09, 1e-4, 2e-4, -0.02, 0, 0, 0}, 752,
-                     582);
+  const Camera right("LENSMODEL_OPENCV8", {1027, 1027.5, 371, 293, -0.10, 0.09, 1e-4, 2e-4, -0.02, 0, 0, 0}, 752, 582);
   const double verge = 6.0 * M_PI / 180;
   const Eigen::Matrix3d r = Eigen::AngleAxisd(-verge, Eigen::Vector3d::UnitY()).toRotationMatrix() *
                             Eigen::AngleAxisd(0.003, Eigen::Vector3d::UnitX()).toRotationMatrix();

@@ -17,9 +17,7 @@ namespace stereorig {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double MsSince(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
+double MsSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 std::vector<Eigen::Vector3d> VolumeCorners(const Eigen::Vector3d& centre, const Eigen::Vector3d& size) {
   std::vector<Eigen::Vector3d> corners;
@@ -68,8 +66,7 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
     plan.reference_from_module = rig_.S(0, m);
     const Pose module_from_reference = rig_.S(m, 0);
     plan.camera_centre_reference_mm = plan.reference_from_module.translation_mm();
-    plan.geometry =
-        ComputeRectification(left, right, mod.right_from_left, module_from_reference * volume_center_mm_);
+    plan.geometry = ComputeRectification(left, right, mod.right_from_left, module_from_reference * volume_center_mm_);
     plan.maps = BuildRectifyMaps(plan.geometry, left, right);
     // The volume's image: a box's central projection is bounded by its
     // corners' (all in front), and Z, so the disparity, is extreme at corners.
@@ -88,7 +85,8 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
     plan.roi = cv::Rect(cv::Point(int(std::floor(u0)), int(std::floor(v0))),
                         cv::Point(int(std::ceil(u1)) + 1, int(std::ceil(v1)) + 1)) &
                image;
-    if (plan.roi.area() == 0) throw InputError("runtime options", "the measurement volume is not in " + mod.name + "'s view");
+    if (plan.roi.area() == 0)
+      throw InputError("runtime options", "the measurement volume is not in " + mod.name + "'s view");
     plan.min_disparity_px = int(std::floor(d0)) - 2;
     plan.num_disparities = int(std::ceil(d1)) - int(std::floor(d0)) + 5;
     plans_.push_back(std::move(plan));
@@ -111,8 +109,8 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
     cv::Mat l = left(band), r = right(band);
     cv::remap(images[mod.left_camera], l, plan.maps.left_fixed(band), plan.maps.left_frac(band), cv::INTER_LINEAR,
               cv::BORDER_CONSTANT, 0);
-    cv::remap(images[mod.right_camera], r, plan.maps.right_fixed(band), plan.maps.right_frac(band),
-              cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
+    cv::remap(images[mod.right_camera], r, plan.maps.right_fixed(band), plan.maps.right_frac(band), cv::INTER_LINEAR,
+              cv::BORDER_CONSTANT, 0);
   }
   report->times_ms["rectify"] = MsSince(t);
 
@@ -216,7 +214,7 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
         const cv::Vec3f dy = (ya ? *ya : *p) - (yb ? *yb : *p);
         n = Eigen::Vector3f(dx[0], dx[1], dx[2]).cross(Eigen::Vector3f(dy[0], dy[1], dy[2]));
       }
-      const Eigen::Vector3f pe(( *p)[0], (*p)[1], (*p)[2]);
+      const Eigen::Vector3f pe((*p)[0], (*p)[1], (*p)[2]);
       if (n.norm() > 0) {
         n.normalize();
         if (n.dot(eye - pe) < 0) n = -n;
@@ -271,10 +269,10 @@ Reconstruction Runtime::Process(const std::vector<cv::Mat>& images, bool build_m
     if (images[k].type() != CV_8UC1)
       throw InputError("capture: cam" + std::to_string(k), "must be an 8-bit grey image");
     if (images[k].cols != cam.imager_width_px() || images[k].rows != cam.imager_height_px())
-      throw InputError("capture: cam" + std::to_string(k),
-                       "is " + std::to_string(images[k].cols) + "x" + std::to_string(images[k].rows) +
-                           ", the rig says " + std::to_string(cam.imager_width_px()) + "x" +
-                           std::to_string(cam.imager_height_px()));
+      throw InputError("capture: cam" + std::to_string(k), "is " + std::to_string(images[k].cols) + "x" +
+                                                               std::to_string(images[k].rows) + ", the rig says " +
+                                                               std::to_string(cam.imager_width_px()) + "x" +
+                                                               std::to_string(cam.imager_height_px()));
   }
   const auto t_total = Clock::now();
   Reconstruction out;
@@ -286,7 +284,8 @@ Reconstruction Runtime::Process(const std::vector<cv::Mat>& images, bool build_m
   if (options_.parallel_modules && nm > 1) {
     std::vector<std::thread> threads;
     for (int m = 1; m < nm; ++m)
-      threads.emplace_back([&, m] { ProcessModule(plans_[m], images, build_mesh, &clouds[m], &meshes[m], &out.modules[m]); });
+      threads.emplace_back(
+          [&, m] { ProcessModule(plans_[m], images, build_mesh, &clouds[m], &meshes[m], &out.modules[m]); });
     ProcessModule(plans_[0], images, build_mesh, &clouds[0], &meshes[0], &out.modules[0]);
     for (auto& th : threads) th.join();
   } else {

@@ -32,31 +32,31 @@ struct ModulePlan {
   int module = 0;
   RectifiedGeometry geometry;
   RectifyMaps maps;
-  cv::Rect roi;               // rectified left px covered by the measurement volume
-  int min_disparity_px = 0;   // image disparity range of the volume (rectify.h), with 2 px margin
+  cv::Rect roi;              // rectified left px covered by the measurement volume
+  int min_disparity_px = 0;  // image disparity range of the volume (rectify.h), with 2 px margin
   int num_disparities = 0;
-  Pose reference_from_module; // S[0][module]
+  Pose reference_from_module;                  // S[0][module]
   Eigen::Vector3d camera_centre_reference_mm;  // the module's left camera centre
 };
 
 struct ModuleReport {
   int module = 0;
-  cv::Rect match_roi;         // after cropping to the lit region
+  cv::Rect match_roi;  // after cropping to the lit region
   int min_disparity_px = 0, num_disparities = 0;
-  int points = 0;             // points kept
-  int lit_pixels = 0;         // grid-lit pixels of the rectified left image in the volume's ROI
-  int lit_filled = 0;         // of those, pixels with a kept point
+  int points = 0;      // points kept
+  int lit_pixels = 0;  // grid-lit pixels of the rectified left image in the volume's ROI
+  int lit_filled = 0;  // of those, pixels with a kept point
   double fill_rate() const { return lit_pixels ? double(lit_filled) / lit_pixels : 0.0; }
   std::map<std::string, double> times_ms;  // rectify, lit_region, match, triangulate, normals, mesh
 };
 
 struct Reconstruction {
-  PointCloud cloud;           // all modules, then filled points; reference frame
-  Mesh mesh;                  // empty unless requested
+  PointCloud cloud;  // all modules, then filled points; reference frame
+  Mesh mesh;         // empty unless requested
   std::vector<ModuleReport> modules;
   std::map<std::string, double> times_ms;  // modules (wall), merge, mesh_join, hole_fill, total_point_cloud
-  int filled_points = 0;      // points added by hole filling
-  std::string shape_fit;      // one line: the fitted model, or why there is none
+  int filled_points = 0;                   // points added by hole filling
+  std::string shape_fit;                   // one line: the fitted model, or why there is none
 };
 
 class Runtime {

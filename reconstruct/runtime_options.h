@@ -21,7 +21,7 @@ struct RuntimeOptions {
   // of interest are derived from it. Default centre: working_distance_mm in
   // front of module 0's baseline midpoint, along the mean of its two
   // optical axes.
-  std::optional<Eigen::Vector3d> volume_center_mm;               // default: see working_distance_mm
+  std::optional<Eigen::Vector3d> volume_center_mm;  // default: see working_distance_mm
   double working_distance_mm = 200.0;  // only used to place the default volume centre; default 200 (the seed's)
   Eigen::Vector3d volume_size_mm = Eigen::Vector3d(150, 150, 100);  // default 150 x 150 x 100 (the seed's)
   // Largest dimension of the objects measured, mm. Points farther than this
@@ -34,12 +34,12 @@ struct RuntimeOptions {
   double lit_contrast_dn = 12.0;   // a pixel is "lit" if its 9x9 grey-level std exceeds this; default 12 DN
   MatchOptions match;              // matcher; its range and ROI are derived per module (ignored here)
   // Per-point confidence below which a point is dropped, [0, 1].
-  double min_confidence = 0.5;     // default 0.5 (= match.min_zncc)
-  int normal_step_px = 2;          // normals from neighbours +-this many px in the depth grid; default 2
-  double mesh_max_edge_mm = 1.5;   // organised mesh: no triangle edge longer than this (depth jumps); default 1.5
+  double min_confidence = 0.5;    // default 0.5 (= match.min_zncc)
+  int normal_step_px = 2;         // normals from neighbours +-this many px in the depth grid; default 2
+  double mesh_max_edge_mm = 1.5;  // organised mesh: no triangle edge longer than this (depth jumps); default 1.5
   ShapeModel shape_model = ShapeModel::kNone;  // hole filling model; default none
-  double fill_spacing_mm = 1.0;    // hole filling: sample spacing on the model surface; default 1.0 mm
-  bool parallel_modules = true;    // process modules on separate threads; default true
+  double fill_spacing_mm = 1.0;                // hole filling: sample spacing on the model surface; default 1.0 mm
+  bool parallel_modules = true;                // process modules on separate threads; default true
 
   void Check() const;  // throws InputError naming the bad key
 };

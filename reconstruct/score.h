@@ -30,10 +30,10 @@ struct ErrorFigures {
 };
 
 struct CloudScore {
-  Pose truth_from_cloud;             // the best rigid alignment
-  ErrorFigures all;                  // measured points (filled ones excluded)
+  Pose truth_from_cloud;                 // the best rigid alignment
+  ErrorFigures all;                      // measured points (filled ones excluded)
   std::vector<ErrorFigures> per_module;  // index = module
-  ErrorFigures filled;               // hole-filling points (module kFilledModule), if any
+  ErrorFigures filled;                   // hole-filling points (module kFilledModule), if any
 };
 
 // `truth`: (N) samples in mm. `num_modules`: size of per_module.

@@ -87,8 +87,8 @@ inline void Sample(const uint8_t* row, float xr, const std::array<Taps, kSteps +
 
 }  // namespace
 
-SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x, int y, double start_px,
-                               double slope_x, double slope_y, const SubpixelOptions& o) {
+SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x, int y, double start_px, double slope_x,
+                               double slope_y, const SubpixelOptions& o) {
   SubpixelResult result;
   const int hw = o.half_width_px, hh = o.half_height_px;
   if (y - hh < 0 || y + hh >= left.rows || x - hw < 0 || x + hw >= left.cols) return result;

@@ -18,28 +18,28 @@
 namespace stereorig {
 
 struct SubpixelOptions {
-  int half_width_px = 4;    // window half width along the row; default 4 (9 px: > one grid period)
-  int half_height_px = 1;   // window half height; default 1 (3 rows)
-  int max_iterations = 2;   // Gauss-Newton steps; default 2
+  int half_width_px = 4;   // window half width along the row; default 4 (9 px: > one grid period)
+  int half_height_px = 1;  // window half height; default 1 (3 rows)
+  int max_iterations = 2;  // Gauss-Newton steps; default 2
   // Stop after a step smaller than this: from a start within ~0.2 px one
   // step leaves < 0.002 px of peak locking on the test pairs (measured), so
   // a second pass is only paid for when the first moved far. Default 0.05 px.
   double converged_step_px = 0.05;
   double max_shift_px = 1.0;  // refinement may move the start by at most this; default 1 px
-  void Check() const;       // throws InputError naming the bad field
+  void Check() const;         // throws InputError naming the bad field
 };
 
 struct SubpixelResult {
-  bool ok = false;     // converged inside the image and within max_shift_px
+  bool ok = false;  // converged inside the image and within max_shift_px
   double disparity_px = 0;
-  double zncc = 0;     // normalised correlation of the fitted window, [-1, 1]
-  double std_dn = 0;   // standard deviation of the left window, grey levels (texture)
+  double zncc = 0;    // normalised correlation of the fitted window, [-1, 1]
+  double std_dn = 0;  // standard deviation of the left window, grey levels (texture)
 };
 
 // left, right: CV_8UC1 rectified. (x, y): a left pixel; start_px: the
 // disparity to start from (an integer-level match refined by a cost fit);
 // slope_x, slope_y: dd/dx, dd/dy there (px/px).
-SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x, int y, double start_px,
-                               double slope_x, double slope_y, const SubpixelOptions& options);
+SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x, int y, double start_px, double slope_x,
+                               double slope_y, const SubpixelOptions& options);
 
 }  // namespace stereorig

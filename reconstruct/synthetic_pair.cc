@@ -28,8 +28,8 @@ class Radiance {
                         2 * M_PI * uni(rng), s.texture_contrast / std::sqrt(6.0) * (0.5 + uni(rng))});
     }
     const double a = s.grid_angle_deg * M_PI / 180.0;
-    normals_[0][0] = std::cos(a), normals_[0][1] = std::sin(a);    // near-vertical lines
-    normals_[1][0] = -std::sin(a), normals_[1][1] = std::cos(a);   // near-horizontal lines
+    normals_[0][0] = std::cos(a), normals_[0][1] = std::sin(a);   // near-vertical lines
+    normals_[1][0] = -std::sin(a), normals_[1][1] = std::cos(a);  // near-horizontal lines
     phases_[0] = 0.37 * s.grid_period_px;
     phases_[1] = 0.71 * s.grid_period_px;
   }

@@ -20,24 +20,24 @@
 namespace stereorig {
 
 struct SyntheticPairSpec {
-  int width = 320, height = 240;        // px
-  double d0_px = 40.0;                  // disparity at pixel (0, 0)
-  double du = 0.04, dv = 0.015;         // disparity gradient along x and y, px/px
-  double grid_period_px = 8.0;          // line spacing
-  double grid_sigma_px = 1.1;           // Gaussian line half width (1 sigma)
-  double grid_angle_deg = 2.6;          // angle of the grid against the rows
-  double grid_amplitude_dn = 150.0;     // peak of one line, grey levels
-  double ambient_dn = 40.0;             // mean ambient radiance, grey levels
-  double texture_contrast = 0.15;       // relative amplitude of the albedo texture
-  bool laser_on = true;                 // false: passive (ambient only)
-  double noise_sigma_dn = 2.0;          // sensor noise, grey levels (1 sigma)
+  int width = 320, height = 240;     // px
+  double d0_px = 40.0;               // disparity at pixel (0, 0)
+  double du = 0.04, dv = 0.015;      // disparity gradient along x and y, px/px
+  double grid_period_px = 8.0;       // line spacing
+  double grid_sigma_px = 1.1;        // Gaussian line half width (1 sigma)
+  double grid_angle_deg = 2.6;       // angle of the grid against the rows
+  double grid_amplitude_dn = 150.0;  // peak of one line, grey levels
+  double ambient_dn = 40.0;          // mean ambient radiance, grey levels
+  double texture_contrast = 0.15;    // relative amplitude of the albedo texture
+  bool laser_on = true;              // false: passive (ambient only)
+  double noise_sigma_dn = 2.0;       // sensor noise, grey levels (1 sigma)
   uint64_t seed = 1;
 };
 
 struct SyntheticPair {
-  cv::Mat left, right;          // CV_8UC1
-  cv::Mat left_clean;           // CV_64FC1, before noise and rounding
-  cv::Mat true_disparity_px;    // CV_64FC1: d at each left pixel centre
+  cv::Mat left, right;        // CV_8UC1
+  cv::Mat left_clean;         // CV_64FC1, before noise and rounding
+  cv::Mat true_disparity_px;  // CV_64FC1: d at each left pixel centre
 };
 
 SyntheticPair RenderSyntheticPair(const SyntheticPairSpec& spec);

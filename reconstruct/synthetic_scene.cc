@@ -7,15 +7,15 @@ namespace stereorig {
 
 std::vector<cv::Mat> RenderSphereCapture(const Rig& rig, const SphereSceneSpec& s) {
   struct Projector {
-    Eigen::Vector3d centre;   // reference frame
+    Eigen::Vector3d centre;  // reference frame
     Eigen::Matrix3d proj_from_ref;
   };
   std::vector<Projector> projectors;
   for (int m = 0; m < rig.num_modules(); ++m) {
     const Pose left_from_right = rig.module(m).right_from_left.Inverse();
     const Pose ref_from_module = rig.S(0, m);
-    projectors.push_back({ref_from_module * (0.5 * left_from_right.translation_mm()),
-                          ref_from_module.rotation().transpose()});
+    projectors.push_back(
+        {ref_from_module * (0.5 * left_from_right.translation_mm()), ref_from_module.rotation().transpose()});
   }
   const double ca = std::cos(s.grid_angle_deg * M_PI / 180), sa = std::sin(s.grid_angle_deg * M_PI / 180);
   const double fan = std::tan(s.fan_half_angle_deg * M_PI / 180);
@@ -37,7 +37,8 @@ std::vector<cv::Mat> RenderSphereCapture(const Rig& rig, const SphereSceneSpec& 
     // of its silhouette's bounding cube.
     double u0 = 1e9, u1 = -1e9, v0 = 1e9, v1 = -1e9;
     for (int i = 0; i < 8; ++i) {
-      const Eigen::Vector3d c = s.centre_mm + s.radius_mm * Eigen::Vector3d(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1);
+      const Eigen::Vector3d c =
+          s.centre_mm + s.radius_mm * Eigen::Vector3d(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1);
       const Eigen::Vector2d q = cam.Project(cam_from_ref * c);
       u0 = std::min(u0, q.x()), u1 = std::max(u1, q.x()), v0 = std::min(v0, q.y()), v1 = std::max(v1, q.y());
     }

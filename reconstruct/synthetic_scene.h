@@ -23,10 +23,10 @@ struct SphereSceneSpec {
   double radius_mm = 25.0;
   bool laser_on = true;
   double period_rad = 2 * 0.2034 / 50;  // tan(11.5 deg) * 2 / 50 periods: ~1.6 mm at 200 mm, ~8 px
-  double line_sigma_rad = 0.0011;      // ~0.22 mm at 200 mm, ~1.1 px
+  double line_sigma_rad = 0.0011;       // ~0.22 mm at 200 mm, ~1.1 px
   double grid_angle_deg = 2.6;
   double fan_half_angle_deg = 11.5;
-  double laser_dn = 170.0;             // peak of a line on a surface facing the projector
+  double laser_dn = 170.0;  // peak of a line on a surface facing the projector
   double ambient_dn = 35.0;
   double texture_contrast = 0.1;
   double noise_sigma_dn = 2.0;

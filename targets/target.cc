@@ -41,7 +41,8 @@ Target::Target(Layout layout, const std::string& where) : layout_(std::move(layo
                                       std::to_string(ncodes - 1) + ")");
         }
         if (!seen.insert(t.id).second) {
-          throw InputError(where, "tag id " + std::to_string(t.id) + " is used twice (the faces' ID ranges must be disjoint)");
+          throw InputError(where,
+                           "tag id " + std::to_string(t.id) + " is used twice (the faces' ID ranges must be disjoint)");
         }
         const double h = 0.5 * l.tag_size_mm;
         const double s = l.square_size_mm;

@@ -40,8 +40,8 @@ class Target {
     bool double_sided = true;     // false: a plain board, one face, no tags
     double margin_mm = 15.0;      // white border around the squares; holds the tags
     std::string tag_family = "tag36h11";
-    double tag_size_mm = 11.0;    // edge of a tag's black border square
-    TargetFace faces[2];          // [front, back]; back unused when !double_sided
+    double tag_size_mm = 11.0;  // edge of a tag's black border square
+    TargetFace faces[2];        // [front, back]; back unused when !double_sided
     // Maps front-face-frame points to back-face-frame points (mm).
     Pose back_from_front;
     // 1-sigma of back_from_front as measured: [rx, ry, rz] deg, [tx, ty, tz] mm.

@@ -90,8 +90,6 @@ std::string TargetToYaml(const Target& target) {
   return o.str();
 }
 
-void WriteTargetFile(const Target& target, const std::string& path) {
-  WriteFileAtomically(path, TargetToYaml(target));
-}
+void WriteTargetFile(const Target& target, const std::string& path) { WriteFileAtomically(path, TargetToYaml(target)); }
 
 }  // namespace stereorig

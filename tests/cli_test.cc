@@ -80,8 +80,9 @@ TEST(Cli, EveryMalformedRigFileExitsTwoNamingTheKey) {
       {"non-orthonormal rotation", Replace(good, "[[1, 0, 0, 0]", "[[1.01, 0, 0, 0]"), "orthonormal"},
       {"unknown lens model", Replace(good, "LENSMODEL_OPENCV8", "LENSMODEL_FISHEYE9"), "unknown lens model"},
       {"wrong number of intrinsics", Replace(good, cam0_intr, cam0_intr + std::string("1.5, ")), "takes 12 intrinsics"},
-      {"inconsistent S", Replace(good, "[[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]  # module1_from_module1",
-                                 "[[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 2.5], [0, 0, 0, 1]]  # module1_from_module1"),
+      {"inconsistent S",
+       Replace(good, "[[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]  # module1_from_module1",
+               "[[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 2.5], [0, 0, 0, 1]]  # module1_from_module1"),
        "S[1][1] is not the identity"},
       {"not YAML", "format: [unclosed\n", "not valid YAML"},
       {"wrong version", Replace(good, "version: 1", "version: 99"), "unsupported version 99"},
@@ -109,7 +110,7 @@ TEST(Cli, AnInconsistentOffDiagonalSIsRejected) {
   ASSERT_NE(row, std::string::npos);
   const size_t line_start = good.rfind("\n", row) + 1;
   std::string line = good.substr(line_start, row - line_start);
-  const size_t first_t = line.find("], [") ;  // end of the first row of the 4x4
+  const size_t first_t = line.find("], [");  // end of the first row of the 4x4
   const size_t comma = line.rfind(", ", first_t);
   line.replace(comma + 2, first_t - comma - 2, "123.456");
   std::string bad = good;
@@ -123,8 +124,8 @@ TEST(Cli, AnInconsistentOffDiagonalSIsRejected) {
 }
 
 TEST(Cli, EverySubcommandsHelpTeachesWithAnExample) {
-  for (const char* c : {"simulate", "target", "calibrate", "reconstruct", "match", "verify", "check", "bench", "rig",
-                        "demo"}) {
+  for (const char* c :
+       {"simulate", "target", "calibrate", "reconstruct", "match", "verify", "check", "bench", "rig", "demo"}) {
     const Result r = RunCli(std::string(c) + " --help");
     EXPECT_EQ(r.code, 0) << c;
     EXPECT_NE(r.out.find("xample"), std::string::npos) << c << " --help has no example";

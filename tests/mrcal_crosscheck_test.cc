@@ -55,9 +55,9 @@ std::vector<Eigen::Vector3d> RandomPoints(const Camera& cam, int n, std::mt19937
 Camera RandomOpencv8(std::mt19937* rng) {
   std::uniform_real_distribution<double> u(-1, 1);
   return Camera("LENSMODEL_OPENCV8",
-                {1024 + 5 * u(*rng), 1024 + 5 * u(*rng), 375.5 + 5 * u(*rng), 290.5 + 5 * u(*rng), -0.1 + 0.02 * u(*rng),
-                 0.09 + 0.02 * u(*rng), 1e-3 * u(*rng), 1e-3 * u(*rng), 0.02 * u(*rng), 0.01 * u(*rng),
-                 0.01 * u(*rng), 0.01 * u(*rng)},
+                {1024 + 5 * u(*rng), 1024 + 5 * u(*rng), 375.5 + 5 * u(*rng), 290.5 + 5 * u(*rng),
+                 -0.1 + 0.02 * u(*rng), 0.09 + 0.02 * u(*rng), 1e-3 * u(*rng), 1e-3 * u(*rng), 0.02 * u(*rng),
+                 0.01 * u(*rng), 0.01 * u(*rng), 0.01 * u(*rng)},
                 752, 582);
 }
 
@@ -118,7 +118,8 @@ TEST(MrcalCrossCheck, ExportedCameramodelLoadsInPythonAndCAndProjectsIdentically
     const auto points = RandomPoints(cam, 200, &rng);
     {
       std::ofstream f(pts);
-      for (const auto& p : points) f << FormatDouble(p.x()) << " " << FormatDouble(p.y()) << " " << FormatDouble(p.z()) << "\n";
+      for (const auto& p : points)
+        f << FormatDouble(p.x()) << " " << FormatDouble(p.y()) << " " << FormatDouble(p.z()) << "\n";
     }
     const std::string printed = RunShell(kPython + " " + kScript + " model " + model + " " + pts + " " + out);
     const auto q_ref = ReadQ(out);

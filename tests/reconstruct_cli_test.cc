@@ -29,8 +29,10 @@ TEST(MatchCli, WritesAPfmThatMatchesTheTruth) {
   ASSERT_TRUE(cv::imwrite(dir + "/R.png", pair.right));
   const std::string out = dir + "/disp.pfm";
   std::filesystem::remove(out);
-  ASSERT_EQ(RunCli("match --left " + dir + "/L.png --right " + dir + "/R.png --min-disparity 24 --num-disparities 64 "
-                "--out " + out),
+  ASSERT_EQ(RunCli("match --left " + dir + "/L.png --right " + dir +
+                   "/R.png --min-disparity 24 --num-disparities 64 "
+                   "--out " +
+                   out),
             0);
   const cv::Mat disp = cv::imread(out, cv::IMREAD_UNCHANGED);
   ASSERT_EQ(disp.type(), CV_32FC1);
@@ -64,14 +66,20 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
   std::filesystem::remove(out);
   cv::imwrite(dir + "/small.png", cv::Mat(10, 10, CV_8UC1, cv::Scalar(3)));
   cv::imwrite(dir + "/big.png", cv::Mat(12, 10, CV_8UC1, cv::Scalar(3)));
-  EXPECT_EQ(RunCli("match --left " + dir + "/missing.png --right " + dir + "/small.png --min-disparity 0 "
-                "--num-disparities 16 --out " + out),
+  EXPECT_EQ(RunCli("match --left " + dir + "/missing.png --right " + dir +
+                   "/small.png --min-disparity 0 "
+                   "--num-disparities 16 --out " +
+                   out),
             2);
-  EXPECT_EQ(RunCli("match --left " + dir + "/small.png --right " + dir + "/big.png --min-disparity 0 "
-                "--num-disparities 16 --out " + out),
+  EXPECT_EQ(RunCli("match --left " + dir + "/small.png --right " + dir +
+                   "/big.png --min-disparity 0 "
+                   "--num-disparities 16 --out " +
+                   out),
             2);
-  EXPECT_EQ(RunCli("match --left " + dir + "/small.png --right " + dir + "/small.png --min-disparity 0 "
-                "--num-disparities 1 --out " + out),
+  EXPECT_EQ(RunCli("match --left " + dir + "/small.png --right " + dir +
+                   "/small.png --min-disparity 0 "
+                   "--num-disparities 1 --out " +
+                   out),
             2);
   EXPECT_FALSE(std::filesystem::exists(out));
 }

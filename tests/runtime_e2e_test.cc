@@ -48,10 +48,11 @@ TEST(RuntimeE2e, SphereOnTheDefaultRigMeetsTheAccuracyTargets) {
   const Reconstruction rec = runtime.Process(images, /*build_mesh=*/true);
   for (const ModuleReport& m : rec.modules) {
     const SphereScore s = Score(rec.cloud, m.module, spec.centre_mm, spec.radius_mm);
-    std::printf("module %d: %d points, fill %.3f of %d lit px, match roi %dx%d; |e| %.4f mm, mean %+.4f, std %.4f;"
-                " match %.1f ms\n",
-                m.module, m.points, m.fill_rate(), m.lit_pixels, m.match_roi.width, m.match_roi.height, s.mean_abs,
-                s.mean, s.std, m.times_ms.at("match"));
+    std::printf(
+        "module %d: %d points, fill %.3f of %d lit px, match roi %dx%d; |e| %.4f mm, mean %+.4f, std %.4f;"
+        " match %.1f ms\n",
+        m.module, m.points, m.fill_rate(), m.lit_pixels, m.match_roi.width, m.match_roi.height, s.mean_abs, s.mean,
+        s.std, m.times_ms.at("match"));
     // Issue 5's one-module target is mean |e| <= 0.1 mm. The renderer's
     // noise is 2 DN and its one-ray-per-pixel sampling aliases the ~1 px
     // lines: measured ~0.07 px rms on good matches = 0.03 mm at 200 mm.
@@ -64,8 +65,8 @@ TEST(RuntimeE2e, SphereOnTheDefaultRigMeetsTheAccuracyTargets) {
     EXPECT_GT(m.fill_rate(), 0.6);
   }
   const SphereScore all = Score(rec.cloud, -1, spec.centre_mm, spec.radius_mm);
-  std::printf("merged: %d points |e| %.4f mm std %.4f; point cloud %.1f ms; mesh %zu triangles\n", all.n,
-              all.mean_abs, all.std, rec.times_ms.at("total_point_cloud"), rec.mesh.triangles.size());
+  std::printf("merged: %d points |e| %.4f mm std %.4f; point cloud %.1f ms; mesh %zu triangles\n", all.n, all.mean_abs,
+              all.std, rec.times_ms.at("total_point_cloud"), rec.mesh.triangles.size());
   EXPECT_LT(all.mean_abs, 0.15);
   EXPECT_GT(rec.mesh.triangles.size(), size_t(all.n));  // ~2 per point on a smooth grid
 }

@@ -69,16 +69,17 @@ double CornerRms(const CalibrationSpec& calibration, double* nominal_shift_px) {
     const CameraRays rays(cam, 2);
     for (size_t k = 0; k < tilts_deg.size(); ++k) {
       const Eigen::Vector3d a = tilts_deg[k] * M_PI / 180.0;
-      const Eigen::Matrix3d r = (Eigen::AngleAxisd(a.x(), Eigen::Vector3d::UnitX()) *
-                                 Eigen::AngleAxisd(a.y(), Eigen::Vector3d::UnitY()) *
-                                 Eigen::AngleAxisd(a.z(), Eigen::Vector3d::UnitZ()))
-                                    .toRotationMatrix();
+      const Eigen::Matrix3d r =
+          (Eigen::AngleAxisd(a.x(), Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(a.y(), Eigen::Vector3d::UnitY()) *
+           Eigen::AngleAxisd(a.z(), Eigen::Vector3d::UnitZ()))
+              .toRotationMatrix();
       // The board's centre on the camera's axis, 230 mm away: all of it in view.
       const Eigen::Vector3d c = world_from_cam * Eigen::Vector3d(0, 0, 230);
       const Pose world_from_front(r, c - r * center_front);
       const cv::Mat radiance = RenderTargetRadiance(rays, world_from_cam, world_from_front, board, spec.render);
       const cv::Mat image = SensorImage(radiance, cv::Mat::zeros(radiance.size(), CV_32F), spec.render, 1);
-      cv::imwrite(::testing::TempDir() + "/sim_board_" + std::to_string(k) + "_" + std::to_string(cam_index) + ".png", image);
+      cv::imwrite(::testing::TempDir() + "/sim_board_" + std::to_string(k) + "_" + std::to_string(cam_index) + ".png",
+                  image);
       std::vector<cv::Point2f> found;
       const bool ok = cv::findChessboardCornersSB(image, cv::Size(target.corners_x(), target.corners_y()), found,
                                                   cv::CALIB_CB_ACCURACY);
@@ -139,7 +140,7 @@ TEST(SimChessboard, OpenCvFindsCornersWhereMrcalProjectsThem) {
 // where its TRUE corners are, which lie well away from the nominal ones.
 TEST(SimChessboard, ImperfectBoardIsRenderedWhereItsTrueCornersAre) {
   CalibrationSpec c;
-  c.scale_error_ppm = 3000;       // 0.3 mm over the 99 mm board
+  c.scale_error_ppm = 3000;  // 0.3 mm over the 99 mm board
   c.back_misalignment_deg = 0.3;
   c.back_misalignment_mm = 0.3;
   c.nonflatness_mm = 0.5;

@@ -40,8 +40,9 @@ std::string WriteArtifact(const std::string& text) {
   return path;
 }
 
-const char* kSphere = "format: stereorig-artifact\nversion: 1\nunits: mm\nname: test sphere\ntype: sphere\n"
-                      "diameter_mm: 38.1\ndiameter_uncertainty_mm: 0.002\n";
+const char* kSphere =
+    "format: stereorig-artifact\nversion: 1\nunits: mm\nname: test sphere\ntype: sphere\n"
+    "diameter_mm: 38.1\ndiameter_uncertainty_mm: 0.002\n";
 
 TEST(VerifyCli, PassFailAndReport) {
   const std::string artifact = WriteArtifact(kSphere);

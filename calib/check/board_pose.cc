@@ -54,8 +54,7 @@ bool SeedWithPnp(const Rig& rig, const Target& target, const BoardObservation& v
   cv::Mat rvec, tvec;
   // Normalised image coordinates: identity camera matrix, no distortion (the
   // lens was removed by mrcal's unprojection).
-  if (!cv::solvePnP(object, normalized, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvec, tvec, false,
-                    cv::SOLVEPNP_IPPE)) {
+  if (!cv::solvePnP(object, normalized, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvec, tvec, false, cv::SOLVEPNP_IPPE)) {
     return false;
   }
   const Pose cam_from_face = Pose::FromRotationVector({rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2)},
@@ -118,7 +117,7 @@ PredictionStatistics PredictionErrorStatistics(const Rig& rig, const Target& tar
 }
 
 std::vector<Eigen::Vector2d> ReprojectionErrors(const Rig& rig, const Target& target, const BoardObservation& view,
-                                       const Pose& ref_from_front) {
+                                                const Pose& ref_from_front) {
   const Camera& cam = rig.camera(view.camera);
   const Pose cam_from_front = rig.CamFromReference(view.camera) * ref_from_front;
   std::vector<Eigen::Vector2d> e;
@@ -128,8 +127,8 @@ std::vector<Eigen::Vector2d> ReprojectionErrors(const Rig& rig, const Target& ta
   return e;
 }
 
-BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target, const std::vector<const BoardObservation*>& views,
-                                    const Pose* seed_pose) {
+BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target,
+                                    const std::vector<const BoardObservation*>& views, const Pose* seed_pose) {
   BoardPoseEstimate out;
   if (seed_pose) {
     out.ref_from_front = *seed_pose;
@@ -147,10 +146,9 @@ BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target, const 
   for (const BoardObservation* v : views) {
     const Pose cam_from_ref = rig.CamFromReference(v->camera);
     for (size_t k = 0; k < v->corner_ids.size(); ++k) {
-      problem.AddResidualBlock(
-          CornerResidual::Create(&rig.camera(v->camera), cam_from_ref, CornerInFront(target, v->face, v->corner_ids[k]),
-                                 v->q_px[k]),
-          nullptr, rt);
+      problem.AddResidualBlock(CornerResidual::Create(&rig.camera(v->camera), cam_from_ref,
+                                                      CornerInFront(target, v->face, v->corner_ids[k]), v->q_px[k]),
+                               nullptr, rt);
     }
   }
   ceres::Solver::Options options;

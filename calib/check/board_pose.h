@@ -5,8 +5,8 @@
 
 #include <vector>
 
-#include "calib/observations.h"
 #include "calib/core/rig.h"
+#include "calib/observations.h"
 #include "targets/target.h"
 
 namespace stereorig {
@@ -22,13 +22,13 @@ struct BoardPoseEstimate {
 // from the view with the most corners, then minimises reprojection error over
 // every view (Ceres). A pose from one camera alone has a near-mirror twin;
 // seeding it from all cameras of the capture avoids converging there.
-BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target, const std::vector<const BoardObservation*>& views,
-                                    const Pose* seed = nullptr);
+BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target,
+                                    const std::vector<const BoardObservation*>& views, const Pose* seed = nullptr);
 
 // Reprojection residuals q_predicted - q (px, per corner) of `view` for a
 // given board pose.
 std::vector<Eigen::Vector2d> ReprojectionErrors(const Rig& rig, const Target& target, const BoardObservation& view,
-                                       const Pose& ref_from_front);
+                                                const Pose& ref_from_front);
 
 // Linearised statistics of the prediction error that a pose's own
 // uncertainty puts on the corners of `view`. The pose was estimated from

@@ -83,7 +83,8 @@ long long AppendToHistory(const std::string& path, const HistoryRun& run, const 
     sqlite3_bind_text(ins.get(), 3, run.captures.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(ins.get(), 4, verdict.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(ins.get(), 5, explanation.c_str(), -1, SQLITE_TRANSIENT);
-    if (sqlite3_step(ins.get()) != SQLITE_DONE) throw InputError(path, std::string("history: ") + sqlite3_errmsg(db.get()));
+    if (sqlite3_step(ins.get()) != SQLITE_DONE)
+      throw InputError(path, std::string("history: ") + sqlite3_errmsg(db.get()));
     const long long id = sqlite3_last_insert_rowid(db.get());
     Stmt fig = Prepare(db.get(),
                        "INSERT INTO stereorig_check_figures (run_id, name, value, threshold, pass, samples) "
@@ -145,11 +146,12 @@ std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<
   char line[256];
   std::snprintf(line, sizeof line, "%zu run(s)", runs.size());
   out += line;
-  if (!runs.empty()) out += ", " + runs.front().date_utc + " .. " + runs.back().date_utc + "; last verdict: " +
-                            runs.back().verdict + " (" + runs.back().explanation + ")";
+  if (!runs.empty())
+    out += ", " + runs.front().date_utc + " .. " + runs.back().date_utc + "; last verdict: " + runs.back().verdict +
+           " (" + runs.back().explanation + ")";
   out += "\n";
-  std::snprintf(line, sizeof line, "%-40s %5s %10s %10s %10s %10s %10s %6s\n", "figure", "runs", "first", "last",
-                "min", "max", "threshold", "fails");
+  std::snprintf(line, sizeof line, "%-40s %5s %10s %10s %10s %10s %10s %6s\n", "figure", "runs", "first", "last", "min",
+                "max", "threshold", "fails");
   out += line;
   for (const FigureTrend& t : trends) {
     double lo = t.points.front().value, hi = lo;

@@ -15,7 +15,7 @@ struct HistoryRun {
   std::string date_utc;
   std::string rig_file;
   std::string captures;
-  std::string verdict;       // "ok" or "recalibrate"
+  std::string verdict;  // "ok" or "recalibrate"
   std::string explanation;
 };
 

@@ -51,9 +51,9 @@ struct Inputs {
   const Target& target;
   const CheckOptions& options;
   std::map<int, std::vector<const BoardObservation*>> by_capture;
-  std::vector<double> sigma_px;        // per camera: calibration RMS
-  std::vector<double> u_px;            // per camera: projection uncertainty, 1 sigma
-  std::map<int, Pose> seed;            // per capture: the board pose from every camera
+  std::vector<double> sigma_px;  // per camera: calibration RMS
+  std::vector<double> u_px;      // per camera: projection uncertainty, 1 sigma
+  std::map<int, Pose> seed;      // per capture: the board pose from every camera
 };
 
 int ModuleOf(const Rig& rig, int camera) {
@@ -76,8 +76,10 @@ Consistency CameraConsistency(const Inputs& in, int c, const std::set<int>& trus
   for (const auto& [capture, views] : in.by_capture) {
     std::vector<const BoardObservation*> mine, others;
     for (const BoardObservation* v : views) {
-      if (v->camera == c) mine.push_back(v);
-      else if (trusted.count(v->camera)) others.push_back(v);
+      if (v->camera == c)
+        mine.push_back(v);
+      else if (trusted.count(v->camera))
+        others.push_back(v);
     }
     if (mine.empty() || others.empty()) continue;
     const BoardPoseEstimate pose = EstimateBoardPose(in.rig, in.target, others, &in.seed.at(capture));
@@ -141,8 +143,8 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
     if (static_cast<int>(v.corner_ids.size()) >= options.min_corners_per_view) in.by_capture[v.capture].push_back(&v);
   }
   if (static_cast<int>(in.by_capture.size()) < options.min_captures) {
-    throw InputError(where, "only " + std::to_string(in.by_capture.size()) + " captures show the target; the check needs " +
-                                std::to_string(options.min_captures));
+    throw InputError(where, "only " + std::to_string(in.by_capture.size()) +
+                                " captures show the target; the check needs " + std::to_string(options.min_captures));
   }
 
   // Outlier corners (a detector's occasional slip) are set aside as the
@@ -200,7 +202,8 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
       for (const BoardObservation* v : vs) {
         const BoardPoseEstimate own = EstimateBoardPose(rig, target, {v}, &in.seed.at(capture));
         if (!own.ok) continue;
-        for (const Eigen::Vector2d& e : ReprojectionErrors(rig, target, *v, own.ref_from_front)) ss[v->camera] += e.squaredNorm();
+        for (const Eigen::Vector2d& e : ReprojectionErrors(rig, target, *v, own.ref_from_front))
+          ss[v->camera] += e.squaredNorm();
         dof[v->camera] += 2.0 * v->corner_ids.size() - 6.0;
       }
     }
@@ -225,8 +228,9 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   int fitted = 0;
   for (const auto& [c, f] : camera_figures) fitted += f.value < 20 * in.sigma_px[c] + 2.0;
   if (!camera_figures.empty() && fitted == 0) {
-    throw InputError(where, "the captures do not fit this rig at all (every camera is off by > 2 px): "
-                            "captures of another rig, or the wrong rig file?");
+    throw InputError(where,
+                     "the captures do not fit this rig at all (every camera is off by > 2 px): "
+                     "captures of another rig, or the wrong rig file?");
   }
   for (auto& [c, f] : camera_figures) result.figures.push_back(f);
 
@@ -236,7 +240,8 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
     const StereoModule& mod = rig.module(m);
     double worst_ratio = 0;
     CheckFigure f{"module" + std::to_string(m) + "_stereo_consistency_rms_px", 0, 0, true, 0};
-    for (auto [c, partner] : {std::pair{mod.left_camera, mod.right_camera}, std::pair{mod.right_camera, mod.left_camera}}) {
+    for (auto [c, partner] :
+         {std::pair{mod.left_camera, mod.right_camera}, std::pair{mod.right_camera, mod.left_camera}}) {
       const Consistency con = CameraConsistency(in, c, {partner});
       if (con.corners == 0) continue;
       if (con.rms_px / con.threshold_px > worst_ratio) {
@@ -313,8 +318,8 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
     }
     const double threshold = std::sqrt(e_ms + k * sd_ms + std::pow(k * std::hypot(ul, ur), 2));
     const double rms = std::sqrt(ss / n);
-    result.figures.push_back({"module" + std::to_string(m) + "_rectified_row_rms_px", rms, threshold,
-                              rms <= threshold, n});
+    result.figures.push_back(
+        {"module" + std::to_string(m) + "_rectified_row_rms_px", rms, threshold, rms <= threshold, n});
     if (rms > threshold) inconsistent_modules.insert(m);
   }
 
@@ -335,8 +340,10 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
         named = c;
       }
     }
-    if (named >= 0 && best_ratio > 1.0) result.moved_cameras.push_back(named);
-    else result.moved_modules.push_back(m);
+    if (named >= 0 && best_ratio > 1.0)
+      result.moved_cameras.push_back(named);
+    else
+      result.moved_modules.push_back(m);
   }
 
   // --- Module pairs: closure through the target. ---
@@ -358,10 +365,10 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
         const BoardPoseEstimate pj = EstimateBoardPose(rig, target, vj, &in.seed.at(capture));
         if (!pi.ok || !pj.ok) continue;
         dt.push_back(pi.ref_from_front * board_center - pj.ref_from_front * board_center);
-        dr.push_back(Pose(pi.ref_from_front.rotation() * pj.ref_from_front.rotation().transpose(),
-                          Eigen::Vector3d::Zero())
-                         .RotationVector() *
-                     180.0 / M_PI);
+        dr.push_back(
+            Pose(pi.ref_from_front.rotation() * pj.ref_from_front.rotation().transpose(), Eigen::Vector3d::Zero())
+                .RotationVector() *
+            180.0 / M_PI);
       }
       const int n = static_cast<int>(dt.size());
       if (n < 2) continue;
@@ -393,10 +400,10 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
       const double thr_t = chi3 * std::sqrt(se_t * se_t + comb_t * comb_t);
       const double thr_r = chi3 * std::sqrt(se_r * se_r + comb_r * comb_r);
       const bool pass_t = mean_t.norm() <= thr_t, pass_r = mean_r.norm() <= thr_r;
-      result.figures.push_back({"pair_" + std::to_string(i) + "_" + std::to_string(j) + "_closure_mm", mean_t.norm(),
-                                thr_t, pass_t, n});
-      result.figures.push_back({"pair_" + std::to_string(i) + "_" + std::to_string(j) + "_closure_deg", mean_r.norm(),
-                                thr_r, pass_r, n});
+      result.figures.push_back(
+          {"pair_" + std::to_string(i) + "_" + std::to_string(j) + "_closure_mm", mean_t.norm(), thr_t, pass_t, n});
+      result.figures.push_back(
+          {"pair_" + std::to_string(i) + "_" + std::to_string(j) + "_closure_deg", mean_r.norm(), thr_r, pass_r, n});
       if ((!pass_t || !pass_r) && !inconsistent_modules.count(i) && !inconsistent_modules.count(j)) {
         ++failed_pairs_of[i];
         ++failed_pairs_of[j];

@@ -19,8 +19,8 @@
 #include <string>
 #include <vector>
 
-#include "calib/observations.h"
 #include "calib/core/rig.h"
+#include "calib/observations.h"
 #include "targets/target.h"
 
 namespace stereorig {
@@ -30,26 +30,26 @@ struct CheckOptions {
   // H0 expectation by this many standard errors. 3.5 gives a per-figure false
   // alarm rate near 2e-4 for Gaussian noise.
   double k_sigma = 3.5;
-  int min_captures = 5;                 // fewer: bad input
-  int min_corners_per_view = 6;         // views with fewer are ignored
+  int min_captures = 5;          // fewer: bad input
+  int min_corners_per_view = 6;  // views with fewer are ignored
   void Check() const;
 };
 
 struct CheckFigure {
-  std::string name;       // e.g. "cam2_consistency_rms_px", "pair_0_1_closure_mm"
+  std::string name;  // e.g. "cam2_consistency_rms_px", "pair_0_1_closure_mm"
   double value = 0;
   double threshold = 0;
   bool pass = true;
-  int samples = 0;        // corners or captures behind the figure
+  int samples = 0;  // corners or captures behind the figure
 };
 
 struct CheckResult {
   std::vector<CheckFigure> figures;
-  std::vector<int> moved_cameras;       // named by elimination, global indices
-  std::vector<int> moved_modules;       // both cameras moved, or a pair closure failed
+  std::vector<int> moved_cameras;  // named by elimination, global indices
+  std::vector<int> moved_modules;  // both cameras moved, or a pair closure failed
   bool ok() const;
   std::string Verdict() const { return ok() ? "ok" : "recalibrate"; }
-  std::string Explanation() const;      // one line naming what moved
+  std::string Explanation() const;  // one line naming what moved
 };
 
 // Throws InputError(`where`, ...) when the rig file lacks the calibration

@@ -22,10 +22,10 @@ constexpr double kNoisePx = 0.2;
 constexpr int kCaptures = 8;
 
 struct Bump {
-  int camera = -1;               // rotate this camera ...
-  double rotation_deg = 0;       // ... by this much about a random axis
-  int module = -1;               // shift this module's cameras ...
-  double translation_mm = 0;     // ... by this much in a random direction
+  int camera = -1;            // rotate this camera ...
+  double rotation_deg = 0;    // ... by this much about a random axis
+  int module = -1;            // shift this module's cameras ...
+  double translation_mm = 0;  // ... by this much in a random direction
 };
 
 bool ModuleOfCameraIsZero(const Rig& rig, int c) {
@@ -34,13 +34,15 @@ bool ModuleOfCameraIsZero(const Rig& rig, int c) {
 
 Rig StoredRig(const SimulatedRig& truth) {
   Rig rig = truth.rig;
-  for (int c = 0; c < rig.num_cameras(); ++c) rig.provenance().residuals["cam" + std::to_string(c) + "_rms_px"] = kNoisePx;
+  for (int c = 0; c < rig.num_cameras(); ++c)
+    rig.provenance().residuals["cam" + std::to_string(c) + "_rms_px"] = kNoisePx;
   return rig;
 }
 
 // Detections of `kCaptures` target poses between the modules, seen by the
 // (possibly bumped) true cameras.
-std::vector<BoardObservation> Observe(const SimulatedRig& truth, const Target& target, const Bump& bump, unsigned seed) {
+std::vector<BoardObservation> Observe(const SimulatedRig& truth, const Target& target, const Bump& bump,
+                                      unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0, kNoisePx);
   std::uniform_real_distribution<double> u(-1, 1);
@@ -64,10 +66,9 @@ std::vector<BoardObservation> Observe(const SimulatedRig& truth, const Target& t
   std::vector<BoardObservation> views;
   for (int k = 0; k < kCaptures; ++k) {
     // The board near the world origin, front face towards module 0, tilted.
-    const Pose world_from_front =
-        Pose::FromRotationVector(Eigen::Vector3d(0.35 * u(rng), 0.35 * u(rng), 0.3 * u(rng)),
-                                 Eigen::Vector3d(15 * u(rng), 15 * u(rng), 20 * u(rng))) *
-        Pose(Eigen::Matrix3d::Identity(), -center);
+    const Pose world_from_front = Pose::FromRotationVector(Eigen::Vector3d(0.35 * u(rng), 0.35 * u(rng), 0.3 * u(rng)),
+                                                           Eigen::Vector3d(15 * u(rng), 15 * u(rng), 20 * u(rng))) *
+                                  Pose(Eigen::Matrix3d::Identity(), -center);
     const Pose ref_from_front = truth.world_from_module0.Inverse() * world_from_front;
     for (int c = 0; c < rig.num_cameras(); ++c) {
       const Face face = ModuleOfCameraIsZero(rig, c) ? Face::kFront : Face::kBack;
@@ -119,7 +120,8 @@ TEST(NightlyCheck, FlagsAndNamesACameraRotatedByFiveHundredthsOfADegree) {
     named += r.moved_cameras == std::vector<int>{bump.camera} && r.moved_modules.empty();
     if (!(r.moved_cameras == std::vector<int>{bump.camera} && r.moved_modules.empty())) {
       std::string s;
-      for (const auto& f : r.figures) s += f.name + "=" + std::to_string(f.value) + "/" + std::to_string(f.threshold) + " ";
+      for (const auto& f : r.figures)
+        s += f.name + "=" + std::to_string(f.value) + "/" + std::to_string(f.threshold) + " ";
       std::printf("seed %u bump cam %d: %s | %s\n", seed, bump.camera, r.Explanation().c_str(), s.c_str());
     }
   }
@@ -141,7 +143,8 @@ TEST(NightlyCheck, FlagsAndNamesAModuleShiftedByATenthOfAMillimetre) {
     named += r.moved_modules == std::vector<int>{1} && r.moved_cameras.empty();
     if (!(r.moved_modules == std::vector<int>{1} && r.moved_cameras.empty())) {
       std::string s;
-      for (const auto& f : r.figures) s += f.name + "=" + std::to_string(f.value) + "/" + std::to_string(f.threshold) + " ";
+      for (const auto& f : r.figures)
+        s += f.name + "=" + std::to_string(f.value) + "/" + std::to_string(f.threshold) + " ";
       std::printf("seed %u module bump: %s | %s\n", seed, r.Explanation().c_str(), s.c_str());
     }
   }

@@ -47,8 +47,8 @@ void WriteFileAtomically(const std::string& path, const std::string& bytes) {
   AtomicOutput out(path);
   FILE* f = std::fopen(out.temp_path().c_str(), "wb");
   if (!f) throw InputError(path, std::string("cannot write: ") + std::strerror(errno));
-  const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size() && std::fflush(f) == 0 &&
-                  fsync(fileno(f)) == 0;
+  const bool ok =
+      std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size() && std::fflush(f) == 0 && fsync(fileno(f)) == 0;
   const bool closed = std::fclose(f) == 0;
   if (!ok || !closed) throw InputError(path, "write failed (disk full?)");
   out.Commit();

@@ -26,8 +26,8 @@ int Camera::NumIntrinsics(const std::string& lensmodel_name) {
   return mrcal_lensmodel_num_params(&m);
 }
 
-Camera::Camera(const std::string& lensmodel_name, std::vector<double> intrinsics,
-               int imager_width_px, int imager_height_px, const std::string& where)
+Camera::Camera(const std::string& lensmodel_name, std::vector<double> intrinsics, int imager_width_px,
+               int imager_height_px, const std::string& where)
     : lensmodel_name_(lensmodel_name),
       intrinsics_(std::move(intrinsics)),
       imager_width_px_(imager_width_px),
@@ -83,7 +83,8 @@ Eigen::Vector2d Camera::Project(const Eigen::Vector3d& p_cam, Eigen::Matrix<doub
   return {q.x, q.y};
 }
 
-Eigen::Matrix<double, Eigen::Dynamic, 2> Camera::ProjectMany(const Eigen::Matrix<double, Eigen::Dynamic, 3>& p_cam) const {
+Eigen::Matrix<double, Eigen::Dynamic, 2> Camera::ProjectMany(
+    const Eigen::Matrix<double, Eigen::Dynamic, 3>& p_cam) const {
   const int n = static_cast<int>(p_cam.rows());
   std::vector<mrcal_point3_t> p(n);
   std::vector<mrcal_point2_t> q(n);
@@ -105,7 +106,8 @@ bool Camera::Unproject(const Eigen::Vector2d& q_px, Eigen::Vector3d* v_unit) con
   return true;
 }
 
-Eigen::Matrix<double, Eigen::Dynamic, 3> Camera::UnprojectMany(const Eigen::Matrix<double, Eigen::Dynamic, 2>& q_px) const {
+Eigen::Matrix<double, Eigen::Dynamic, 3> Camera::UnprojectMany(
+    const Eigen::Matrix<double, Eigen::Dynamic, 2>& q_px) const {
   const int n = static_cast<int>(q_px.rows());
   Eigen::Matrix<double, Eigen::Dynamic, 3> out(n, 3);
   for (int i = 0; i < n; ++i) {

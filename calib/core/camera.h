@@ -18,8 +18,8 @@ class Camera {
   // Validates the model name (as mrcal spells it, configuration included for
   // splined models) and the number of intrinsics. Throws InputError, whose
   // message starts with `where` (a file and key), on any problem.
-  Camera(const std::string& lensmodel_name, std::vector<double> intrinsics,
-         int imager_width_px, int imager_height_px, const std::string& where = "camera");
+  Camera(const std::string& lensmodel_name, std::vector<double> intrinsics, int imager_width_px, int imager_height_px,
+         const std::string& where = "camera");
   Camera(const Camera&);
   Camera& operator=(const Camera&);
   Camera(Camera&&) noexcept;

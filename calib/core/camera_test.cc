@@ -54,8 +54,7 @@ TEST(Camera, RejectsUnknownModelsAndWrongIntrinsicCounts) {
   EXPECT_THROW(Camera("LENSMODEL_PINHOLE", {1000, 1000, 300, 200}, 0, 480), InputError);
   // A splined model needs its configuration.
   EXPECT_EQ(Camera::NumIntrinsics("LENSMODEL_SPLINED_STEREOGRAPHIC"), -1);
-  EXPECT_EQ(Camera::NumIntrinsics("LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=10_Ny=8_fov_x_deg=60"),
-            4 + 2 * 10 * 8);
+  EXPECT_EQ(Camera::NumIntrinsics("LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=10_Ny=8_fov_x_deg=60"), 4 + 2 * 10 * 8);
   EXPECT_EQ(Camera::NumIntrinsics("LENSMODEL_OPENCV8"), 12);
 }
 

@@ -23,11 +23,10 @@ class InputError : public std::runtime_error {
 
 // An invariant of the code itself. Active in every build type, unlike
 // assert(), because a wrong number in a metrology tool is worse than a crash.
-#define STEREORIG_CHECK(cond)                                                 \
-  do {                                                                        \
-    if (!(cond)) {                                                            \
-      std::fprintf(stderr, "%s:%d: internal check failed: %s\n", __FILE__,    \
-                   __LINE__, #cond);                                          \
-      std::abort();                                                           \
-    }                                                                         \
+#define STEREORIG_CHECK(cond)                                                                \
+  do {                                                                                       \
+    if (!(cond)) {                                                                           \
+      std::fprintf(stderr, "%s:%d: internal check failed: %s\n", __FILE__, __LINE__, #cond); \
+      std::abort();                                                                          \
+    }                                                                                        \
   } while (0)

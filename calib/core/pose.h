@@ -36,9 +36,7 @@ class Pose {
 
   Pose Inverse() const;
   Pose operator*(const Pose& b_from_c) const;  // (a_from_b * b_from_c) = a_from_c
-  Eigen::Vector3d operator*(const Eigen::Vector3d& p_b) const {
-    return rotation_ * p_b + translation_mm_;
-  }
+  Eigen::Vector3d operator*(const Eigen::Vector3d& p_b) const { return rotation_ * p_b + translation_mm_; }
 
   // Rotation angle (degrees) and translation norm (mm) of this transform: the
   // size of a residual transform such as truth.Inverse() * estimate.

@@ -17,8 +17,8 @@ std::string Entry(int i, int j) { return "S[" + std::to_string(i) + "][" + std::
 
 }  // namespace
 
-Rig::Rig(std::vector<Camera> cameras, std::vector<std::string> camera_names,
-         std::vector<StereoModule> modules, const std::vector<Pose>& module0_from_module)
+Rig::Rig(std::vector<Camera> cameras, std::vector<std::string> camera_names, std::vector<StereoModule> modules,
+         const std::vector<Pose>& module0_from_module)
     : cameras_(std::move(cameras)), camera_names_(std::move(camera_names)), modules_(std::move(modules)) {
   CheckTopology("rig");
   const int m = num_modules();
@@ -32,8 +32,8 @@ Rig::Rig(std::vector<Camera> cameras, std::vector<std::string> camera_names,
   STEREORIG_CHECK(CheckS(&why));
 }
 
-Rig::Rig(std::vector<Camera> cameras, std::vector<std::string> camera_names,
-         std::vector<StereoModule> modules, std::vector<std::vector<Pose>> S, const std::string& where)
+Rig::Rig(std::vector<Camera> cameras, std::vector<std::string> camera_names, std::vector<StereoModule> modules,
+         std::vector<std::vector<Pose>> S, const std::string& where)
     : cameras_(std::move(cameras)),
       camera_names_(std::move(camera_names)),
       modules_(std::move(modules)),
@@ -59,8 +59,8 @@ void Rig::CheckTopology(const std::string& where) const {
     const StereoModule& m = modules_[i];
     for (int c : {m.left_camera, m.right_camera}) {
       if (c < 0 || c >= num_cameras()) {
-        throw InputError(where, "module " + std::to_string(i) + " names camera " + std::to_string(c) +
-                                    ", which does not exist");
+        throw InputError(
+            where, "module " + std::to_string(i) + " names camera " + std::to_string(c) + ", which does not exist");
       }
       if (!used.insert(c).second) {
         throw InputError(where, "camera " + std::to_string(c) + " belongs to more than one module slot");

@@ -18,18 +18,18 @@
 namespace stereorig {
 
 struct StereoModule {
-  std::string name;          // e.g. "module0"
-  int left_camera = -1;      // index into Rig::cameras(); the module's reference camera
-  int right_camera = -1;     // index into Rig::cameras()
-  Pose right_from_left;      // right camera from left camera (= module) frame, mm
+  std::string name;       // e.g. "module0"
+  int left_camera = -1;   // index into Rig::cameras(); the module's reference camera
+  int right_camera = -1;  // index into Rig::cameras()
+  Pose right_from_left;   // right camera from left camera (= module) frame, mm
 };
 
 // Where a rig came from. The same structure serves a calibration result and
 // the simulator's ground truth.
 struct Provenance {
-  std::string tool;          // e.g. "stereorig 0.1.0"
-  std::string date_utc;      // ISO 8601, e.g. "2026-11-23T13:00:00Z"
-  std::string input;         // the dataset or capture folder it was made from
+  std::string tool;      // e.g. "stereorig 0.1.0"
+  std::string date_utc;  // ISO 8601, e.g. "2026-11-23T13:00:00Z"
+  std::string input;     // the dataset or capture folder it was made from
   // Per-stage RMS residuals, e.g. {"intrinsics_rms_px": 0.2, ...}.
   std::map<std::string, double> residuals;
   // 1-sigma uncertainties, e.g. {"S_0_1_translation_mm": 0.01, ...}.
@@ -40,7 +40,7 @@ struct Provenance {
 // in double precision holds them to ~1e-13 (translations of ~1e3 mm); these
 // leave margin for a file edited by another tool that prints ~12 digits,
 // while still catching any inconsistency of metrological size (1 nm, 1e-9 rad).
-inline constexpr double kSRotationTolerance = 1e-9;   // max |element| difference of R
+inline constexpr double kSRotationTolerance = 1e-9;  // max |element| difference of R
 inline constexpr double kSTranslationToleranceMm = 1e-6;
 
 class Rig {
@@ -48,13 +48,12 @@ class Rig {
   Rig() = default;
   // Builds a consistent S from each module's pose in the reference frame:
   // module0_from_module[i] (module0_from_module[0] must be identity).
-  Rig(std::vector<Camera> cameras, std::vector<std::string> camera_names,
-      std::vector<StereoModule> modules, const std::vector<Pose>& module0_from_module);
+  Rig(std::vector<Camera> cameras, std::vector<std::string> camera_names, std::vector<StereoModule> modules,
+      const std::vector<Pose>& module0_from_module);
   // Takes a full S as given; throws InputError(`where`, ...) if it breaks an
   // invariant, or if modules name cameras that do not exist.
-  Rig(std::vector<Camera> cameras, std::vector<std::string> camera_names,
-      std::vector<StereoModule> modules, std::vector<std::vector<Pose>> S,
-      const std::string& where);
+  Rig(std::vector<Camera> cameras, std::vector<std::string> camera_names, std::vector<StereoModule> modules,
+      std::vector<std::vector<Pose>> S, const std::string& where);
 
   int num_modules() const { return static_cast<int>(modules_.size()); }
   int num_cameras() const { return static_cast<int>(cameras_.size()); }

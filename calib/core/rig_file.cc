@@ -55,7 +55,8 @@ std::map<std::string, double> ReadNumberMap(YamlMap map) {
 
 Rig ParseRig(YamlMap root) {
   const std::string format = root.GetString("format");
-  if (format != "stereorig-rig") throw InputError(root.Where("format"), "expected 'stereorig-rig', got '" + format + "'");
+  if (format != "stereorig-rig")
+    throw InputError(root.Where("format"), "expected 'stereorig-rig', got '" + format + "'");
   const int version = root.GetInt("version");
   if (version != kRigFileVersion) {
     throw InputError(root.Where("version"), "unsupported version " + std::to_string(version) +

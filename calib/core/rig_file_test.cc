@@ -19,11 +19,11 @@ Rig MakeRandomRig(unsigned seed) {
   std::vector<std::string> names;
   for (int i = 0; i < 4; ++i) {
     // Values with full 53-bit mantissas, so a lossy writer would show.
-    cams.emplace_back("LENSMODEL_OPENCV8",
-                      std::vector<double>{1024 + u(rng), 1024 + u(rng), 375.5 + u(rng), 290.5 + u(rng), 0.1 * u(rng),
-                                          0.1 * u(rng), 1e-3 * u(rng), 1e-3 * u(rng), 0.01 * u(rng), 1e-4 * u(rng),
-                                          0, -1e-17 * u(rng)},
-                      752, 582);
+    cams.emplace_back(
+        "LENSMODEL_OPENCV8",
+        std::vector<double>{1024 + u(rng), 1024 + u(rng), 375.5 + u(rng), 290.5 + u(rng), 0.1 * u(rng), 0.1 * u(rng),
+                            1e-3 * u(rng), 1e-3 * u(rng), 0.01 * u(rng), 1e-4 * u(rng), 0, -1e-17 * u(rng)},
+        752, 582);
     names.push_back("cam" + std::to_string(i));
   }
   const Pose rfl = Pose::FromRotationVector({0.01 * u(rng), -0.1047 + 0.01 * u(rng), 0.01 * u(rng)},
@@ -31,7 +31,10 @@ Rig MakeRandomRig(unsigned seed) {
   std::vector<StereoModule> mods = {{"module0", 0, 1, rfl}, {"module1", 2, 3, rfl}};
   Rig rig(cams, names, mods,
           {Pose::Identity(), Pose::FromRotationVector({0.01 * u(rng), M_PI - 0.01, 0.02 * u(rng)}, {90, 1, 400})});
-  rig.provenance() = {"stereorig test", "2026-11-23T00:00:00Z", "a \"quoted\" input\\path", {{"stage1_rms_px", 0.1 + u(rng)}},
+  rig.provenance() = {"stereorig test",
+                      "2026-11-23T00:00:00Z",
+                      "a \"quoted\" input\\path",
+                      {{"stage1_rms_px", 0.1 + u(rng)}},
                       {{"S_0_1_mm", 1e-3 * (2 + u(rng))}}};
   return rig;
 }

@@ -18,8 +18,8 @@ Rig MakeRig(int m) {
       cams.emplace_back("LENSMODEL_PINHOLE", std::vector<double>{1000, 1000, 320, 240}, 640, 480);
       names.push_back("cam" + std::to_string(2 * i + k));
     }
-    mods.push_back({"module" + std::to_string(i), 2 * i, 2 * i + 1,
-                    Pose::FromRotationVector({0, -0.1, 0}, {-90, 0, 5})});
+    mods.push_back(
+        {"module" + std::to_string(i), 2 * i, 2 * i + 1, Pose::FromRotationVector({0, -0.1, 0}, {-90, 0, 5})});
     module0_from_module.push_back(i == 0 ? Pose::Identity()
                                          : Pose::FromRotationVector({0.1 * i, 2.0 * i, -0.2}, {30.0 * i, -5, 400}));
   }

@@ -123,8 +123,8 @@ std::vector<double> YamlMap::GetDoubles(const std::string& key, int expected_siz
   YAML::Node n = Require(key);
   if (!n.IsSequence()) throw InputError(Where(key), "expected a list of numbers");
   if (expected_size >= 0 && static_cast<int>(n.size()) != expected_size) {
-    throw InputError(Where(key), "expected " + std::to_string(expected_size) + " numbers, got " +
-                                     std::to_string(n.size()));
+    throw InputError(Where(key),
+                     "expected " + std::to_string(expected_size) + " numbers, got " + std::to_string(n.size()));
   }
   std::vector<double> out;
   for (const auto& x : n) out.push_back(ToDouble(x, Where(key)));
@@ -135,8 +135,8 @@ std::vector<int> YamlMap::GetInts(const std::string& key, int expected_size) {
   YAML::Node n = Require(key);
   if (!n.IsSequence()) throw InputError(Where(key), "expected a list of integers");
   if (expected_size >= 0 && static_cast<int>(n.size()) != expected_size) {
-    throw InputError(Where(key), "expected " + std::to_string(expected_size) + " integers, got " +
-                                     std::to_string(n.size()));
+    throw InputError(Where(key),
+                     "expected " + std::to_string(expected_size) + " integers, got " + std::to_string(n.size()));
   }
   std::vector<int> out;
   for (const auto& x : n) {

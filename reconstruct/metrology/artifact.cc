@@ -10,9 +10,12 @@ namespace stereorig {
 
 const char* ArtifactTypeName(ArtifactType type) {
   switch (type) {
-    case ArtifactType::kSphere: return "sphere";
-    case ArtifactType::kBallBar: return "ballbar";
-    case ArtifactType::kPlate: return "plate";
+    case ArtifactType::kSphere:
+      return "sphere";
+    case ArtifactType::kBallBar:
+      return "ballbar";
+    case ArtifactType::kPlate:
+      return "plate";
   }
   return "?";
 }
@@ -32,7 +35,8 @@ double NonNegative(YamlMap& m, const std::string& key) {
 }
 
 Artifact Parse(YamlMap m) {
-  if (m.GetString("format") != "stereorig-artifact") throw InputError(m.Where("format"), "expected 'stereorig-artifact'");
+  if (m.GetString("format") != "stereorig-artifact")
+    throw InputError(m.Where("format"), "expected 'stereorig-artifact'");
   if (m.GetInt("version") != 1) throw InputError(m.Where("version"), "unsupported version (this build reads 1)");
   if (m.GetString("units") != "mm") throw InputError(m.Where("units"), "expected 'mm'");
   Artifact a;

@@ -21,9 +21,9 @@ struct PlaneFit {
   bool ok = false;
   std::string message;
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit
-  double offset_mm = 0;                                // plane: normal . p = offset_mm
+  double offset_mm = 0;                               // plane: normal . p = offset_mm
   std::vector<int> inliers;
-  std::vector<double> residuals_mm;                    // signed, parallel to `inliers`
+  std::vector<double> residuals_mm;  // signed, parallel to `inliers`
   double rms_mm = 0;
 };
 

@@ -69,10 +69,14 @@ std::vector<Eigen::Vector3d> ReadPlyPoints(const std::string& path) {
     if (word == "format") {
       std::string f;
       s >> f;
-      if (f == "ascii") enc = Encoding::kAscii;
-      else if (f == "binary_little_endian") enc = Encoding::kLittle;
-      else if (f == "binary_big_endian") enc = Encoding::kBig;
-      else throw InputError(path, "unknown PLY format '" + f + "'");
+      if (f == "ascii")
+        enc = Encoding::kAscii;
+      else if (f == "binary_little_endian")
+        enc = Encoding::kLittle;
+      else if (f == "binary_big_endian")
+        enc = Encoding::kBig;
+      else
+        throw InputError(path, "unknown PLY format '" + f + "'");
     } else if (word == "element") {
       std::string name;
       long long count;

@@ -11,24 +11,24 @@
 namespace stereorig {
 
 struct SphereFitOptions {
-  int ransac_iterations = 500;           // 4-point hypotheses
-  double inlier_threshold_mm = 0.5;      // |distance to sphere| for a RANSAC inlier
+  int ransac_iterations = 500;       // 4-point hypotheses
+  double inlier_threshold_mm = 0.5;  // |distance to sphere| for a RANSAC inlier
   // If > 0, RANSAC hypotheses whose radius differs from this by more than
   // radius_tolerance_mm are skipped (a known artifact size narrows the search).
   double expected_radius_mm = 0;
   double radius_tolerance_mm = 0;
-  int max_iterations = 50;               // Gauss-Newton
-  unsigned seed = 1;                     // RANSAC sampling; fixed => deterministic
-  void Check() const;                    // throws InputError
+  int max_iterations = 50;  // Gauss-Newton
+  unsigned seed = 1;        // RANSAC sampling; fixed => deterministic
+  void Check() const;       // throws InputError
 };
 
 struct SphereFit {
   bool ok = false;
-  std::string message;                   // why not ok
+  std::string message;  // why not ok
   Eigen::Vector3d center_mm = Eigen::Vector3d::Zero();
   double radius_mm = 0;
-  std::vector<int> inliers;              // indices into the input points
-  std::vector<double> residuals_mm;      // signed |p - c| - r, parallel to `inliers`
+  std::vector<int> inliers;          // indices into the input points
+  std::vector<double> residuals_mm;  // signed |p - c| - r, parallel to `inliers`
   double rms_mm = 0;
 };
 

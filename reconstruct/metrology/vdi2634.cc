@@ -94,8 +94,8 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
   }
   auto require_points = [&](int n, const char* what) {
     if (n < o.min_points) {
-      throw InputError(where, std::string("only ") + std::to_string(n) + " points lie on the " + what +
-                                  "; at least " + std::to_string(o.min_points) + " are needed");
+      throw InputError(where, std::string("only ") + std::to_string(n) + " points lie on the " + what + "; at least " +
+                                  std::to_string(o.min_points) + " are needed");
     }
   };
   switch (a.type) {

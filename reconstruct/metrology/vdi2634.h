@@ -28,7 +28,7 @@ struct VerifyOptions {
   // RANSAC inlier band, mm; <= 0 means "the MPE of the figure" (a point
   // farther than the MPE from the artifact cannot be part of a passing one).
   double segmentation_band_mm = 0;
-  int min_points = 200;                  // fewer points on the artifact: bad input
+  int min_points = 200;  // fewer points on the artifact: bad input
   // Ball bar: each ball's points within this angle of the bar axis (towards
   // the other ball) belong to the shaft's neighbourhood and are not used.
   double ballbar_shaft_cone_deg = 60.0;
@@ -40,17 +40,17 @@ struct VerifyOptions {
 };
 
 struct Figure {
-  std::string name;       // "P_F", "P_S", "SD", "F"
+  std::string name;  // "P_F", "P_S", "SD", "F"
   double value_mm = 0;
   double mpe_mm = 0;
-  bool pass = false;      // |value| <= mpe
+  bool pass = false;  // |value| <= mpe
 };
 
 struct ArtifactEvaluation {
   ArtifactType type = ArtifactType::kSphere;
-  int points_total = 0;             // in the cloud
-  int points_on_artifact = 0;       // after segmentation
-  int points_excluded = 0;          // the standard's <= 0.3%
+  int points_total = 0;        // in the cloud
+  int points_on_artifact = 0;  // after segmentation
+  int points_excluded = 0;     // the standard's <= 0.3%
   std::vector<Figure> figures;
   // Residuals to the fitted shape(s) after exclusion, as the seed reports them.
   double residual_mean_abs_mm = 0;
