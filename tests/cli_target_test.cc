@@ -7,14 +7,11 @@
 #include <fstream>
 #include <sstream>
 
+#include "tests/cli_runner.h"
+
 namespace {
 
-const std::string kBin = std::string(STEREORIG_BINARY_DIR) + "/stereorig";
-
-struct Result {
-  int code;
-  std::string out, err;
-};
+using stereorig::testing::Result;
 
 std::string Slurp(const std::string& p) {
   std::ifstream f(p);
@@ -23,12 +20,7 @@ std::string Slurp(const std::string& p) {
   return s.str();
 }
 
-Result RunStereorig(const std::string& args) {
-  const std::string dir = ::testing::TempDir();
-  const std::string o = dir + "/cli_target_out.txt", e = dir + "/cli_target_err.txt";
-  const int status = std::system((kBin + " " + args + " >" + o + " 2>" + e).c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(o), Slurp(e)};
-}
+Result RunStereorig(const std::string& args) { return stereorig::testing::RunCli(args); }
 
 TEST(CliTarget, WritesTheDefaultBoardAndItsTargetFile) {
   const std::string dir = ::testing::TempDir() + "/cli_target";
