@@ -1,5 +1,6 @@
 // `stereorig check`: the nightly recalibration check. Fresh target captures
 // + the stored rig file -> ok / recalibrate, what moved, and history.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -20,6 +21,24 @@ namespace {
 
 std::string DefaultHistoryPath(const std::string& rig_path) {
   return (std::filesystem::path(rig_path).parent_path() / "check-history.sqlite").string();
+}
+
+// A camK.png with K beyond the rig's cameras (in a capture folder, or a
+// dataset's calibration/NNN/) means the captures come from a larger rig.
+void RejectCamerasBeyondTheRig(const std::string& captures, int num_cameras) {
+  namespace fs = std::filesystem;
+  if (!fs::is_directory(captures)) return;  // the detector names a missing folder
+  for (auto it = fs::recursive_directory_iterator(captures); it != fs::recursive_directory_iterator(); ++it) {
+    if (it.depth() >= 2) it.disable_recursion_pending();
+    const std::string name = it->path().filename().string();
+    if (name.size() < 8 || name.compare(0, 3, "cam") != 0 || it->path().extension() != ".png") continue;
+    const std::string digits = name.substr(3, name.size() - 7);
+    if (digits.empty() || !std::all_of(digits.begin(), digits.end(), ::isdigit)) continue;
+    if (std::stoi(digits) >= num_cameras) {
+      throw InputError(it->path().string(), "camera " + digits + ", but the rig has " + std::to_string(num_cameras) +
+                                                " cameras: captures from another rig?");
+    }
+  }
 }
 
 int PrintHistory(const std::string& db) {
@@ -69,6 +88,10 @@ int RunCheck(int argc, char** argv) {
 
   const Rig rig = ReadRigFile(rig_path);
   const Target target = ReadTargetFile(target_path);
+  RejectCamerasBeyondTheRig(captures, rig.num_cameras());
+  // A history that is not ours is refused before any work, so a failed run
+  // leaves neither a report nor a half-recorded night.
+  if (std::filesystem::exists(history_db)) ReadHistoryRuns(history_db);
   std::fprintf(stderr, "check: detecting the target in %s\n", captures.c_str());
   const DetectedCaptures detected = DetectCaptureFolder(captures, target, rig.num_cameras(), DetectOptions(), true);
   for (int c = 0; c < rig.num_cameras(); ++c) {

@@ -34,8 +34,12 @@ std::string WriteSphere(const std::string& name, double radius_mm) {
   return path;
 }
 
+// A fresh file per call: ctest runs this file's tests in parallel processes
+// that share TempDir().
 std::string WriteArtifact(const std::string& text) {
-  const std::string path = ::testing::TempDir() + "/artifact.yaml";
+  static int calls = 0;
+  const std::string path =
+      ::testing::TempDir() + "/artifact_" + std::to_string(getpid()) + "_" + std::to_string(calls++) + ".yaml";
   std::ofstream(path) << text;
   return path;
 }
@@ -85,6 +89,50 @@ TEST(VerifyCli, BadInputExitsTwoAndWritesNoReport) {
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(Lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("tiny.ply"), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(report));
+}
+
+// The rest of issue 6's bad input: every artifact type with a field
+// missing, and a large cloud with only a few points on the artifact (a plane
+// of 6000 points and a 60-point patch of the sphere). Each: exit 2, one line
+// naming the file, no report.
+TEST(VerifyCli, MissingFieldsOfEveryTypeAndTooFewPointsOnTheArtifactExitTwo) {
+  const std::string good = WriteSphere("good3.ply", 19.05);
+  const std::string report = ::testing::TempDir() + "/verify_bad3.json";
+  std::filesystem::remove(report);
+  const std::string head = "format: stereorig-artifact\nversion: 1\nunits: mm\nname: x\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {head + "type: sphere\ndiameter_uncertainty_mm: 0.002\n", "diameter_mm: missing key"},
+      {head + "type: plate\nlength_mm: 130\n", "width_mm: missing key"},
+      {"format: stereorig-artifact\nversion: 1\ntype: sphere\ndiameter_mm: 38.1\n", "units: missing key"},
+      {head + "diameter_mm: 38.1\n", "type: missing key"},
+  };
+  for (const auto& [text, expect] : cases) {
+    const std::string artifact = WriteArtifact(text);
+    const auto r = RunCli("verify --artifact " + artifact + " --cloud " + good + " --report " + report);
+    EXPECT_EQ(r.code, 2) << text;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(artifact), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(expect), std::string::npos) << text << " -> " << r.err;
+    EXPECT_FALSE(std::filesystem::exists(report));
+  }
+  const std::string sparse = ::testing::TempDir() + "/sparse_sphere.ply";
+  {
+    std::vector<std::array<double, 3>> pts;
+    for (int i = 0; i < 6000; ++i) pts.push_back({-60 + 0.02 * i, 40 + (i % 77) * 0.3, 30.0});  // a plane patch
+    for (int i = 0; i < 60; ++i) {  // a small cap of the sphere at the origin
+      const double t = 0.3 * (i % 6) / 6, p = 2 * M_PI * (i / 6) / 10;
+      pts.push_back({19.05 * std::sin(t) * std::cos(p), 19.05 * std::sin(t) * std::sin(p), -19.05 * std::cos(t)});
+    }
+    std::ofstream f(sparse);
+    f << "ply\nformat ascii 1.0\nelement vertex " << pts.size()
+      << "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
+    for (const auto& q : pts) f << q[0] << " " << q[1] << " " << q[2] << "\n";
+  }
+  const auto r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + sparse + " --report " + report);
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("sparse_sphere.ply"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(report));
 }
 

@@ -65,6 +65,10 @@ double Range(const std::vector<double>& r) {
   return *hi - *lo;
 }
 
+// Segmentation rounds: a point set and its fit are iterated until the set
+// no longer changes (2-4 rounds in practice).
+constexpr int kMaxSegmentationRounds = 20;
+
 // One sphere of known nominal radius: segment, fit, exclude, refit.
 SphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, double nominal_radius, double band,
                             const VerifyOptions& o, int* excluded) {
@@ -76,6 +80,16 @@ SphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, double nomi
   so.seed = o.seed;
   SphereFit fit = FitSphereRobust(pts, so);
   if (!fit.ok) return fit;
+  // The artifact's points are those within the band of the fitted sphere:
+  // iterate to that fixed point, so the set does not depend on RANSAC's path.
+  for (int it = 0; it < kMaxSegmentationRounds; ++it) {
+    std::vector<int> in;
+    for (int i = 0; i < static_cast<int>(pts.size()); ++i)
+      if (std::abs((pts[i] - fit.center_mm).norm() - fit.radius_mm) < band) in.push_back(i);
+    if (in == fit.inliers) break;
+    fit = RefineSphere(pts, in, fit.center_mm, fit.radius_mm, 50);
+    if (!fit.ok) return fit;
+  }
   const std::vector<int> kept = ExcludeWorst(fit.inliers, fit.residuals_mm, o.excluded_fraction_max, excluded);
   return RefineSphere(pts, kept, fit.center_mm, fit.radius_mm, 50);
 }
@@ -138,37 +152,53 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
           if ((p - fit.center_mm).norm() > fit.radius_mm + band) rest.push_back(p);
         remaining.swap(rest);
       }
-      // Second pass: with both centres known, drop each ball's points near
-      // the shaft (a cone around the bar axis) and refit each ball on its
-      // remaining cap, from its first-pass fit.
+      // Second pass: with both centres known, each ball's points are those
+      // within the band of its sphere and outside the shaft's cone about the
+      // bar axis; the sets and fits are iterated to their fixed point, then
+      // the worst points are excluded and each ball is refitted.
       {
         const double cos_cone = std::cos(o.ballbar_shaft_cone_deg * M_PI / 180.0);
+        std::vector<Eigen::Vector3d> centers = e.sphere_centers_mm;
+        std::vector<double> radii = {0.5 * e.sphere_diameters_mm[0], 0.5 * e.sphere_diameters_mm[1]};
+        std::vector<int> idx[2];
+        for (int round = 0; round < kMaxSegmentationRounds; ++round) {
+          bool changed = false;
+          std::vector<int> next[2];
+          for (int ball = 0; ball < 2; ++ball) {
+            const Eigen::Vector3d axis = (centers[1 - ball] - centers[ball]).normalized();
+            for (int i = 0; i < static_cast<int>(pts.size()); ++i) {
+              const Eigen::Vector3d d = pts[i] - centers[ball];
+              if (std::abs(d.norm() - radii[ball]) >= band || d.norm() < 1e-9 || d.normalized().dot(axis) > cos_cone)
+                continue;
+              next[ball].push_back(i);
+            }
+            require_points(static_cast<int>(next[ball].size()), "ball bar's spheres (outside the shaft cone)");
+            changed = changed || next[ball] != idx[ball];
+          }
+          if (!changed) break;
+          for (int ball = 0; ball < 2; ++ball) {
+            idx[ball].swap(next[ball]);
+            const SphereFit fit = RefineSphere(pts, idx[ball], centers[ball], radii[ball], 50);
+            if (!fit.ok) throw InputError(where, "ball " + std::to_string(ball + 1) + " refit failed: " + fit.message);
+            centers[ball] = fit.center_mm;
+            radii[ball] = fit.radius_mm;
+          }
+        }
         all_residuals.clear();
         excluded_total = 0;
         on_artifact = 0;
-        const std::vector<Eigen::Vector3d> c0 = e.sphere_centers_mm;
         for (int ball = 0; ball < 2; ++ball) {
-          const Eigen::Vector3d axis = (c0[1 - ball] - c0[ball]).normalized();
-          const double rb = 0.5 * e.sphere_diameters_mm[ball];
-          std::vector<int> idx;
           std::vector<double> res;
-          for (int i = 0; i < static_cast<int>(pts.size()); ++i) {
-            const Eigen::Vector3d d = pts[i] - c0[ball];
-            const double rr = d.norm() - rb;
-            if (std::abs(rr) > band || d.norm() < 1e-9 || d.normalized().dot(axis) > cos_cone) continue;
-            idx.push_back(i);
-            res.push_back(rr);
-          }
-          require_points(static_cast<int>(idx.size()), "ball bar's spheres (outside the shaft cone)");
+          for (int i : idx[ball]) res.push_back((pts[i] - centers[ball]).norm() - radii[ball]);
           int excluded = 0;
-          const std::vector<int> kept = ExcludeWorst(idx, res, o.excluded_fraction_max, &excluded);
-          const SphereFit fit = RefineSphere(pts, kept, c0[ball], rb, 50);
+          const std::vector<int> kept = ExcludeWorst(idx[ball], res, o.excluded_fraction_max, &excluded);
+          const SphereFit fit = RefineSphere(pts, kept, centers[ball], radii[ball], 50);
           if (!fit.ok) throw InputError(where, "ball " + std::to_string(ball + 1) + " refit failed: " + fit.message);
           e.sphere_centers_mm[ball] = fit.center_mm;
           e.sphere_diameters_mm[ball] = 2 * fit.radius_mm;
           all_residuals.insert(all_residuals.end(), fit.residuals_mm.begin(), fit.residuals_mm.end());
           excluded_total += excluded;
-          on_artifact += static_cast<int>(idx.size());
+          on_artifact += static_cast<int>(idx[ball].size());
         }
       }
       e.points_on_artifact = on_artifact;

@@ -1,0 +1,179 @@
+// `stereorig check` on bad input, through the binary (issue 6): every case
+// exits 2 with one line on stderr that names the file, writes no report, and
+// leaves the SQLite history exactly as it was (same bytes, integrity "ok",
+// same number of runs). The cases: a corrupt image, an image of the wrong
+// size, captures from another rig (other cameras, more cameras, another
+// camera model), and a history path that is not a database.
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "calib/core/rig_file.h"
+#include "tests/cli_runner.h"
+
+namespace stereorig {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::Result;
+using testing::RunCli;
+
+std::string Bytes(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+std::string LastLine(const std::string& text) {
+  const size_t end = text.find_last_not_of('\n');
+  if (end == std::string::npos) return "";
+  const size_t start = text.rfind('\n', end);
+  return text.substr(start == std::string::npos ? 0 : start + 1,
+                     end - (start == std::string::npos ? 0 : start + 1) + 1);
+}
+
+int Occurrences(const std::string& text, const std::string& what) {
+  int n = 0;
+  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+// What an independent reader (the SQLite library itself) says about the
+// history: its integrity check and the number of runs.
+struct DbState {
+  std::string integrity;
+  int runs = -1;
+};
+DbState ReadDb(const std::string& path) {
+  DbState s;
+  sqlite3* db = nullptr;
+  if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
+    sqlite3_close(db);
+    return s;
+  }
+  auto one = [&](const char* sql) {
+    std::string v;
+    sqlite3_stmt* st = nullptr;
+    if (sqlite3_prepare_v2(db, sql, -1, &st, nullptr) == SQLITE_OK && sqlite3_step(st) == SQLITE_ROW)
+      v = reinterpret_cast<const char*>(sqlite3_column_text(st, 0));
+    sqlite3_finalize(st);
+    return v;
+  };
+  s.integrity = one("PRAGMA integrity_check");
+  const std::string n = one("SELECT COUNT(*) FROM stereorig_check_runs");
+  s.runs = n.empty() ? -1 : std::stoi(n);
+  sqlite3_close(db);
+  return s;
+}
+
+TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
+  const std::string dir = ::testing::TempDir() + "/check_cli_" + std::to_string(getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // Eight fresh captures of the default rig, lasers off.
+  Result r = RunCli("simulate --out " + dir + "/ds --seed 21 --calibration-captures 8 --no-scenes");
+  ASSERT_EQ(r.code, 0) << r.err;
+  // The stored rig: the true rig with the residuals a calibration would have
+  // written (the check derives its thresholds from them).
+  Rig rig = ReadRigFile(dir + "/ds/truth/rig.yaml");
+  for (int c = 0; c < rig.num_cameras(); ++c) rig.provenance().residuals["cam" + std::to_string(c) + "_rms_px"] = 0.2;
+  WriteRigFile(rig, dir + "/rig.yaml");
+  const std::string db = dir + "/history.sqlite", report = dir + "/check.json";
+  auto check = [&](const std::string& captures, const std::string& rig_path) {
+    return RunCli("check --rig " + rig_path + " --captures " + captures + " --target " + dir +
+                  "/ds/target.yaml --history-db " + db + " --report " + report);
+  };
+  // One good run makes the history.
+  r = check(dir + "/ds", dir + "/rig.yaml");
+  ASSERT_NE(r.code, 2) << r.err;
+  ASSERT_EQ(ReadDb(db).integrity, "ok");
+  ASSERT_EQ(ReadDb(db).runs, 1);
+  const std::string db_bytes = Bytes(db);
+  fs::remove(report);
+
+  // A copy of the good captures to break.
+  auto copy = [&](const std::string& name) {
+    const std::string d = dir + "/" + name;
+    fs::copy(dir + "/ds/calibration", d, fs::copy_options::recursive);
+    return d;
+  };
+  auto expect_refused = [&](const Result& res, const std::string& must_name, const char* what) {
+    EXPECT_EQ(res.code, 2) << what << ": " << res.out << res.err;
+    // Progress goes to stderr too; the reason is one line, the last.
+    const std::string last = LastLine(res.err);
+    EXPECT_EQ(last.rfind("stereorig check: ", 0), 0u) << what << ": " << res.err;
+    EXPECT_EQ(Occurrences(res.err, "stereorig check: "), 1) << what << ": " << res.err;
+    EXPECT_NE(last.find(must_name), std::string::npos) << what << ": " << res.err;
+    EXPECT_FALSE(fs::exists(report)) << what;
+    const DbState s = ReadDb(db);
+    EXPECT_EQ(s.integrity, "ok") << what;
+    EXPECT_EQ(s.runs, 1) << what;
+    EXPECT_EQ(Bytes(db), db_bytes) << what << ": the history changed";
+  };
+
+  {  // A corrupt (truncated, unreadable) image.
+    const std::string d = copy("corrupt");
+    const std::string bad = d + "/003/cam1.png";
+    const std::string png = Bytes(bad);
+    std::ofstream(bad, std::ios::binary | std::ios::trunc) << png.substr(0, 40);
+    expect_refused(check(d, dir + "/rig.yaml"), "003/cam1.png", "corrupt image");
+  }
+  {  // One image of the wrong size.
+    const std::string d = copy("wrong_size");
+    cv::imwrite(d + "/005/cam2.png", cv::Mat(480, 640, CV_8UC1, cv::Scalar(40)));
+    expect_refused(check(d, dir + "/rig.yaml"), "005/cam2.png", "wrong-size image");
+  }
+  {  // Captures from another rig whose camera 3 is another camera (half the pixels).
+    const std::string d = copy("other_camera");
+    for (const auto& capture : fs::directory_iterator(d)) {
+      const std::string p = (capture.path() / "cam3.png").string();
+      cv::Mat half;
+      cv::resize(cv::imread(p, cv::IMREAD_GRAYSCALE), half, cv::Size(376, 291), 0, 0, cv::INTER_AREA);
+      cv::imwrite(p, half);
+    }
+    expect_refused(check(d, dir + "/rig.yaml"), "another rig", "captures of other cameras");
+  }
+  {  // Captures from a rig with more cameras (a third module).
+    const std::string d = copy("more_cameras");
+    for (const auto& capture : fs::directory_iterator(d)) {
+      fs::copy_file(capture.path() / "cam0.png", capture.path() / "cam4.png");
+      fs::copy_file(capture.path() / "cam1.png", capture.path() / "cam5.png");
+    }
+    expect_refused(check(d, dir + "/rig.yaml"), "but the rig has 4 cameras", "captures of a larger rig");
+  }
+  {  // The right images with the rig file of another rig: every camera's
+     // focal length 20% longer and its centre 40 px away.
+    std::vector<Camera> cameras;
+    for (int c = 0; c < rig.num_cameras(); ++c) {
+      std::vector<double> p = rig.camera(c).intrinsics();
+      p[0] *= 1.2, p[1] *= 1.2, p[2] += 40;
+      cameras.emplace_back(rig.camera(c).lensmodel_name(), p, rig.camera(c).imager_width_px(),
+                           rig.camera(c).imager_height_px());
+    }
+    Rig other(cameras, rig.camera_names(), rig.modules(), std::vector<Pose>{rig.S(0, 0), rig.S(0, 1)});
+    other.provenance() = rig.provenance();
+    WriteRigFile(other, dir + "/other_rig.yaml");
+    expect_refused(check(dir + "/ds", dir + "/other_rig.yaml"), "another rig", "another rig's file");
+  }
+  {  // A history path that is not a database: refused, the file untouched.
+    const std::string not_db = dir + "/notes.txt";
+    std::ofstream(not_db) << "not a database\n";
+    r = RunCli("check --rig " + dir + "/rig.yaml --captures " + dir + "/ds --target " + dir +
+               "/ds/target.yaml --history-db " + not_db + " --report " + report);
+    EXPECT_FALSE(fs::exists(report));
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_EQ(Occurrences(r.err, "stereorig check: "), 1) << r.err;
+    EXPECT_NE(LastLine(r.err).find(not_db), std::string::npos) << r.err;
+    EXPECT_EQ(Bytes(not_db), "not a database\n");
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace stereorig
