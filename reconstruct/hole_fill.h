@@ -1,13 +1,18 @@
-// Hole filling from an a-priori shape model: the model is fitted robustly to
-// the merged cloud, and its surface closes what no module saw.
+// Hole filling from an a-priori shape model (RuntimeOptions::shape_model):
+// the model is fitted robustly to the merged cloud (reconstruct/metrology:
+// sphere, cylinder from oriented points, ellipsoid), and its surface closes
+// what no module saw.
 //
-// Sphere: RANSAC + geometric Gauss-Newton (metrology/sphere_fit.h). The
-// sphere is sampled on a (polar, azimuth) lattice at fill_spacing_mm; a
-// sample is kept where the cloud has no point within 2 spacings, and the
-// lattice cells whose four corners are kept become mesh triangles. Filled
+// The model's surface is sampled on a closed (row, column) lattice at
+// fill_spacing_mm: sphere and ellipsoid by (polar, azimuth), the cylinder's
+// lateral surface over the inliers' axial extent by (axial, angle). A sample
+// is kept where the cloud has no point within 2 spacings, and the lattice
+// cells whose corners are kept become outward-facing triangles. Filled
 // points carry module = kFilledModule and confidence 0.
-// Cylinder and ellipsoid models are not built yet (RuntimeOptions::Check
-// rejects them).
+//
+// A fit is not used (ok = false, message says why, nothing added) if it
+// fails, if the model is larger than object_size_mm, or if it explains less
+// than half of the measured points.
 #pragma once
 
 #include <string>

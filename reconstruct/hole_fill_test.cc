@@ -1,12 +1,15 @@
-// Hole filling against the analytic truth: a noisy half sphere goes in; the
-// filled points must lie on the true sphere and cover the unseen half.
+// Hole filling against the analytic truth: noisy partial clouds of a
+// sphere, a cylinder and an ellipsoid go in; the filled points must lie on
+// the true surface and cover what was not seen. Failed fits add nothing.
 #include "reconstruct/hole_fill.h"
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <functional>
 #include <random>
 
-#include "calib/core/input_error.h"
+#include "reconstruct/metrology/synthetic_shapes.h"
 
 namespace stereorig {
 namespace {
@@ -53,10 +56,135 @@ TEST(HoleFill, SphereClosesTheUnseenHalfOnTheTrueSurface) {
   EXPECT_GT(mesh.triangles.size(), size_t(fill.added_points));
 }
 
-TEST(HoleFill, UnbuiltModelsAreRejectedByTheOptions) {
+PointCloud ToCloud(const testing::NoisyCloud& noisy) {
+  PointCloud cloud;
+  for (size_t i = 0; i < noisy.points.size(); ++i) {
+    cloud.xyz_mm.push_back(noisy.points[i].cast<float>());
+    cloud.normal.push_back(noisy.normals[i].cast<float>());
+    cloud.intensity.push_back(100);
+    cloud.module.push_back(0);
+    cloud.confidence.push_back(1);
+  }
+  return cloud;
+}
+
+// The fill of `model` on `measured`: the filled points only (and the mesh).
+struct Fill {
+  HoleFillResult result;
+  std::vector<Eigen::Vector3d> points;
+  Mesh mesh;
+};
+Fill FillWith(ShapeModel model, const PointCloud& measured, double object_size_mm = 100) {
   RuntimeOptions o;
-  o.shape_model = ShapeModel::kCylinder;
-  EXPECT_THROW(o.Check(), InputError);
+  o.shape_model = model;
+  o.object_size_mm = object_size_mm;
+  o.Check();
+  PointCloud out = measured;
+  Fill f;
+  f.result = FillHolesFromModel(measured, o, &out, &f.mesh);
+  for (size_t i = measured.size(); i < out.size(); ++i) {
+    EXPECT_EQ(out.module[i], kFilledModule);
+    f.points.push_back(out.xyz_mm[i].cast<double>());
+  }
+  EXPECT_EQ(f.result.added_points, static_cast<int>(f.points.size()));
+  EXPECT_EQ(f.mesh.vertices_mm.size(), f.points.size());
+  return f;
+}
+
+// Every triangle faces away from `inside` (a point on the axis or the centre
+// nearest to the triangle): the lattice's orientation is right.
+int InwardTriangles(const Mesh& mesh, const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& inside) {
+  int inward = 0;
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d a = mesh.vertices_mm[t[0]].cast<double>(), b = mesh.vertices_mm[t[1]].cast<double>(),
+                          c = mesh.vertices_mm[t[2]].cast<double>();
+    const Eigen::Vector3d centroid = (a + b + c) / 3;
+    inward += (b - a).cross(c - a).dot(centroid - inside(centroid)) < 0;
+  }
+  return inward;
+}
+
+// Issue 5: "the filled surface lies within 0.5 mm of the truth". The cloud:
+// a cup-sized cylinder (r 37.5 mm, 70 mm long, axis tilted 4 degrees from
+// the vertical) as two facing modules see it, 0.05 mm noise along the
+// normal, normals 3 degrees off, 5% gross outliers.
+TEST(HoleFill, CylinderClosesTheUnseenSidesOnTheTrueSurface) {
+  const Eigen::Vector3d c(5, -3, 200), axis = Eigen::Vector3d(0.05, 1, 0.04).normalized();
+  const double r = 37.5, len = 70;
+  const PointCloud cloud =
+      ToCloud(testing::SeenByTwoFacingCameras(testing::CylinderSurface(c, axis, r, len), c, testing::NoiseSpec{}));
+  const Fill fill = FillWith(ShapeModel::kCylinder, cloud);
+  ASSERT_TRUE(fill.result.ok) << fill.result.message;
+  std::printf("%s: %d points added\n", fill.result.message.c_str(), fill.result.added_points);
+  double worst = 0;
+  int on_the_sides = 0;
+  for (const auto& p : fill.points) {
+    const Eigen::Vector3d v = p - c;
+    worst = std::max(worst, std::abs((v - v.dot(axis) * axis).norm() - r));
+    EXPECT_LT(std::abs(v.dot(axis)), 0.5 * len + 1.0);  // within the measured extent
+    on_the_sides += std::abs(v.x()) > 0.8 * r;          // the flanks no camera on the z axis faces
+  }
+  // The fit of ~19k points with 0.05 mm noise puts the radius and the axis
+  // to ~0.005 mm (shape_fit_test): 0.05 mm is 10x that, and the issue asks
+  // for 0.5 mm.
+  EXPECT_LT(worst, 0.05);
+  // The unseen flanks: at 70 degrees from grazing, each camera sees a
+  // +-70 degree strip, leaving 2 x 40 degrees: ~2 x 0.11 x 2 pi r x len at
+  // 1 mm spacing = 3700 samples, less the 2 mm band along the seen edges.
+  EXPECT_GT(fill.result.added_points, 2500);
+  EXPECT_GT(on_the_sides, 0.9 * fill.result.added_points);
+  EXPECT_GT(fill.mesh.triangles.size(), size_t(fill.result.added_points));
+  EXPECT_EQ(InwardTriangles(fill.mesh,
+                            [&](const Eigen::Vector3d& p) { return Eigen::Vector3d(c + (p - c).dot(axis) * axis); }),
+            0);
+}
+
+// The same for a tuber-sized ellipsoid (semi-axes 42, 30, 27 mm, turned).
+TEST(HoleFill, EllipsoidClosesTheUnseenRimOnTheTrueSurface) {
+  const Eigen::Vector3d c(-4, 6, 205), axes(42, 30, 27);
+  const Eigen::Matrix3d rot =
+      (Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 0, 1).normalized()))
+          .toRotationMatrix();
+  const PointCloud cloud =
+      ToCloud(testing::SeenByTwoFacingCameras(testing::EllipsoidSurface(c, rot, axes), c, testing::NoiseSpec{}));
+  const Fill fill = FillWith(ShapeModel::kEllipsoid, cloud);
+  ASSERT_TRUE(fill.result.ok) << fill.result.message;
+  std::printf("%s: %d points added\n", fill.result.message.c_str(), fill.result.added_points);
+  double worst = 0;
+  for (const auto& p : fill.points) worst = std::max(worst, testing::EllipsoidDistanceBound(c, rot, axes, p));
+  // Distance bound along the ray from the centre (>= the true distance).
+  // The caps pin the fit to ~0.01-0.02 mm (shape_fit_test); the unseen rim
+  // is an extrapolation, so 0.1 mm = 5x that; the issue asks for 0.5 mm.
+  EXPECT_LT(worst, 0.1);
+  EXPECT_GT(fill.result.added_points, 1000);
+  EXPECT_EQ(InwardTriangles(fill.mesh, [&](const Eigen::Vector3d&) { return c; }), 0);
+}
+
+// A fit that fails is reported and nothing is added: too few points, an
+// object larger than object_size_mm, a model of the wrong kind.
+TEST(HoleFill, AFailedFitIsReportedAndNotUsed) {
+  const Eigen::Vector3d c(5, -3, 200);
+  const PointCloud cup = ToCloud(testing::SeenByTwoFacingCameras(
+      testing::CylinderSurface(c, Eigen::Vector3d::UnitY(), 37.5, 70), c, testing::NoiseSpec{}));
+  PointCloud few;
+  for (size_t i = 0; i < 50; ++i) few.Append(PointCloud{{cup.xyz_mm[i]}, {cup.normal[i]}, {1}, {0}, {1}});
+  for (ShapeModel m : {ShapeModel::kSphere, ShapeModel::kCylinder, ShapeModel::kEllipsoid}) {
+    const Fill f = FillWith(m, few);
+    EXPECT_FALSE(f.result.ok) << ShapeModelName(m);
+    EXPECT_NE(f.result.message.find("too few points"), std::string::npos) << f.result.message;
+    EXPECT_TRUE(f.points.empty());
+  }
+  // A 75 mm cup when the options say objects are at most 50 mm.
+  Fill f = FillWith(ShapeModel::kCylinder, cup, 50);
+  EXPECT_FALSE(f.result.ok);
+  EXPECT_NE(f.result.message.find("exceeds object_size_mm"), std::string::npos) << f.result.message;
+  EXPECT_TRUE(f.points.empty() && f.mesh.triangles.empty());
+  // A cylinder sought in a sphere's cloud explains too little of it.
+  const PointCloud ball = ToCloud(testing::SeenByTwoFacingCameras(
+      testing::EllipsoidSurface(c, Eigen::Matrix3d::Identity(), Eigen::Vector3d(25, 25, 25)), c, testing::NoiseSpec{}));
+  f = FillWith(ShapeModel::kCylinder, ball);
+  EXPECT_FALSE(f.result.ok) << f.result.message;
+  EXPECT_TRUE(f.points.empty());
 }
 
 }  // namespace

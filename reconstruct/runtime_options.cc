@@ -35,9 +35,6 @@ void RuntimeOptions::Check() const {
   if (!(min_confidence >= 0 && min_confidence <= 1)) throw InputError("min_confidence", "must be in [0, 1]");
   if (normal_step_px < 1 || normal_step_px > 10) throw InputError("normal_step_px", "must be in [1, 10]");
   if (!(mesh_max_edge_mm > 0)) throw InputError("mesh_max_edge_mm", "must be > 0");
-  if (shape_model == ShapeModel::kCylinder || shape_model == ShapeModel::kEllipsoid)
-    throw InputError("shape_model",
-                     std::string(ShapeModelName(shape_model)) + " hole filling is not built yet (use sphere or none)");
   if (!(fill_spacing_mm > 0.05)) throw InputError("fill_spacing_mm", "must be > 0.05 mm");
   match.Check();
 }

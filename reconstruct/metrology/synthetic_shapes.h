@@ -1,0 +1,96 @@
+// Test support: noisy partial clouds of known shapes, as two facing
+// modules see them (cameras at the origin looking along +z, and at
+// z = 2 * centre.z looking along -z). A surface sample is kept if either
+// camera sees its front within 70 degrees of grazing; convex shapes hide
+// nothing else. Noise: Gaussian along the normal; normals tilted by a
+// Gaussian angle; plus uniform outliers in the shape's bounding box.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <functional>
+#include <random>
+#include <vector>
+
+namespace stereorig::testing {
+
+struct NoisyCloud {
+  std::vector<Eigen::Vector3d> points, normals;  // (N) each
+  int outliers = 0;                              // the last `outliers` entries
+};
+
+struct NoiseSpec {
+  int points = 20000;
+  double noise_mm = 0.05;          // along the normal, 1 sigma
+  double normal_noise_deg = 3.0;   // 1 sigma per axis
+  double outlier_fraction = 0.05;  // of `points`, uniform in the box
+  double box_half_size_mm = 50;    // about the shape's centre
+  double max_view_angle_deg = 70;  // from the camera's line of sight to the normal
+  unsigned seed = 1;
+};
+
+// surface(u, v, &normal) -> point, for u, v uniform in [0, 1).
+inline NoisyCloud SeenByTwoFacingCameras(
+    const std::function<Eigen::Vector3d(double, double, Eigen::Vector3d*)>& surface, const Eigen::Vector3d& centre,
+    const NoiseSpec& spec) {
+  NoisyCloud cloud;
+  std::mt19937 rng(spec.seed);
+  std::uniform_real_distribution<double> u(0, 1), box(-spec.box_half_size_mm, spec.box_half_size_mm);
+  std::normal_distribution<double> noise(0, spec.noise_mm), tilt(0, spec.normal_noise_deg * M_PI / 180);
+  const Eigen::Vector3d cameras[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 2 * centre.z())};
+  const double cos_max = std::cos(spec.max_view_angle_deg * M_PI / 180);
+  const int inliers = static_cast<int>(std::lround(spec.points * (1 - spec.outlier_fraction)));
+  while (static_cast<int>(cloud.points.size()) < inliers) {
+    Eigen::Vector3d n;
+    const Eigen::Vector3d p = surface(u(rng), u(rng), &n);
+    bool seen = false;
+    for (const auto& c : cameras) seen = seen || n.dot((c - p).normalized()) > cos_max;
+    if (!seen) continue;
+    cloud.points.push_back(p + noise(rng) * n);
+    cloud.normals.push_back((Eigen::AngleAxisd(tilt(rng), Eigen::Vector3d::UnitX()) *
+                             Eigen::AngleAxisd(tilt(rng), Eigen::Vector3d::UnitY()) * n)
+                                .normalized());
+  }
+  while (static_cast<int>(cloud.points.size()) < spec.points) {
+    cloud.points.push_back(centre + Eigen::Vector3d(box(rng), box(rng), box(rng)));
+    cloud.normals.push_back(Eigen::Vector3d(box(rng), box(rng), box(rng)).normalized());
+    ++cloud.outliers;
+  }
+  return cloud;
+}
+
+// A cylinder's lateral surface: axis through `centre` along `axis`, radius
+// r, length len (centred).
+inline std::function<Eigen::Vector3d(double, double, Eigen::Vector3d*)> CylinderSurface(const Eigen::Vector3d& centre,
+                                                                                        const Eigen::Vector3d& axis,
+                                                                                        double r, double len) {
+  const Eigen::Vector3d d = axis.normalized(), e1 = d.unitOrthogonal(), e2 = d.cross(e1);
+  return [=](double a, double b, Eigen::Vector3d* n) {
+    const double phi = 2 * M_PI * a;
+    *n = std::cos(phi) * e1 + std::sin(phi) * e2;
+    return Eigen::Vector3d(centre + (b - 0.5) * len * d + r * *n);
+  };
+}
+
+// An ellipsoid: centre, frame_from_ellipsoid rotation, semi-axes.
+inline std::function<Eigen::Vector3d(double, double, Eigen::Vector3d*)> EllipsoidSurface(
+    const Eigen::Vector3d& centre, const Eigen::Matrix3d& rotation, const Eigen::Vector3d& axes) {
+  return [=](double a, double b, Eigen::Vector3d* n) {
+    const double z = 2 * a - 1, phi = 2 * M_PI * b, s = std::sqrt(1 - z * z);
+    const Eigen::Vector3d w(s * std::cos(phi), s * std::sin(phi), z);
+    *n = (rotation * w.cwiseQuotient(axes)).normalized();
+    return Eigen::Vector3d(centre + rotation * axes.cwiseProduct(w));
+  };
+}
+
+// Upper bound on the distance from p to the ellipsoid: the distance to the
+// surface point on the ray from the centre through p (the true, orthogonal
+// distance is never larger).
+inline double EllipsoidDistanceBound(const Eigen::Vector3d& centre, const Eigen::Matrix3d& rotation,
+                                     const Eigen::Vector3d& axes, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d u = rotation.transpose() * (p - centre);
+  const double s = u.cwiseQuotient(axes).norm();  // 1 on the surface
+  return u.norm() * std::abs(1 - 1 / s);
+}
+
+}  // namespace stereorig::testing
