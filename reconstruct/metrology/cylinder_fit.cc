@@ -12,6 +12,7 @@ namespace stereorig {
 
 void CylinderFitOptions::Check() const {
   if (ransac_iterations < 1) throw InputError("cylinder fit", "ransac_iterations must be >= 1");
+  if (max_scoring_points < 10) throw InputError("cylinder fit", "max_scoring_points must be >= 10");
   if (!(inlier_threshold_mm > 0)) throw InputError("cylinder fit", "inlier_threshold_mm must be positive");
   if (!(max_normal_angle_deg > 0 && max_normal_angle_deg <= 90))
     throw InputError("cylinder fit", "max_normal_angle_deg must be in (0, 90]");
@@ -89,6 +90,9 @@ CylinderFit FitCylinderRobust(const std::vector<Eigen::Vector3d>& points, const 
     return std::abs(AxisDistance(a, points[i]) - a.radius) < o.inlier_threshold_mm &&
            std::abs(radial.normalized().dot(normals[i])) > cos_normal;
   };
+  // Hypotheses are scored on an even subsample (every score_step-th point):
+  // ranking them needs far fewer points than the final fit.
+  const int score_step = std::max(1, n / o.max_scoring_points);
   std::mt19937 rng(o.seed);
   std::uniform_int_distribution<int> pick(0, n - 1);
   int best_count = 0;
@@ -99,10 +103,10 @@ CylinderFit FitCylinderRobust(const std::vector<Eigen::Vector3d>& points, const 
     if (i == j || !CylinderFrom2(points[i], normals[i], points[j], normals[j], &a)) continue;
     if (o.max_radius_mm > 0 && a.radius > o.max_radius_mm) continue;
     int count = 0;
-    for (int k = 0; k < n; ++k) count += consistent(a, k);
+    for (int k = 0; k < n; k += score_step) count += consistent(a, k);
     if (count > best_count) best_count = count, best = a;
   }
-  if (best_count < 10) {
+  if (best_count * score_step < 10) {
     fit.message = "RANSAC found no cylinder with 10 or more inliers";
     return fit;
   }

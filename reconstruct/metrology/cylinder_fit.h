@@ -18,6 +18,7 @@ struct CylinderFitOptions {
   double max_normal_angle_deg = 30;  // RANSAC: a point's normal within this of the radial direction; default 30
   double max_radius_mm = 0;          // > 0: hypotheses with a larger radius are skipped; default 0 (none)
   double extent_quantile = 0.002;    // the axial extent runs between these quantiles of the inliers; default 0.2%
+  int max_scoring_points = 2000;     // RANSAC scores hypotheses on at most ~this many points; default 2000
   unsigned seed = 1;                 // RANSAC sampling; fixed => deterministic
   void Check() const;                // throws InputError
 };

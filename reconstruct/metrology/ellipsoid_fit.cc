@@ -1,6 +1,7 @@
 #include "reconstruct/metrology/ellipsoid_fit.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <random>
@@ -12,6 +13,7 @@ namespace stereorig {
 
 void EllipsoidFitOptions::Check() const {
   if (ransac_iterations < 1) throw InputError("ellipsoid fit", "ransac_iterations must be >= 1");
+  if (max_scoring_points < 10) throw InputError("ellipsoid fit", "max_scoring_points must be >= 10");
   if (sample_size < 9) throw InputError("ellipsoid fit", "sample_size must be >= 9");
   if (!(inlier_threshold_mm > 0)) throw InputError("ellipsoid fit", "inlier_threshold_mm must be positive");
   if (max_semi_axis_mm < 0) throw InputError("ellipsoid fit", "max_semi_axis_mm must not be negative");
@@ -126,6 +128,9 @@ EllipsoidFit FitEllipsoidRobust(const std::vector<Eigen::Vector3d>& points, cons
   auto in_band = [&](const Ellipsoid& e, int i) {
     return std::abs(SampsonDistance(e, points[i])) < o.inlier_threshold_mm;
   };
+  // Hypotheses are scored on an even subsample (every score_step-th point):
+  // ranking them needs far fewer points than the final fit.
+  const int score_step = std::max(1, n / o.max_scoring_points);
   std::mt19937 rng(o.seed);
   std::vector<int> all(n);
   std::iota(all.begin(), all.end(), 0);
@@ -138,10 +143,10 @@ EllipsoidFit FitEllipsoidRobust(const std::vector<Eigen::Vector3d>& points, cons
     if (!AlgebraicEllipsoid(points, sample, origin, scale, &e)) continue;
     if (o.max_semi_axis_mm > 0 && e.a.maxCoeff() > o.max_semi_axis_mm) continue;
     int count = 0;
-    for (int k = 0; k < n; ++k) count += in_band(e, k);
+    for (int k = 0; k < n; k += score_step) count += in_band(e, k);
     if (count > best_count) best_count = count, best = e;
   }
-  if (best_count < 20) {
+  if (best_count * score_step < 20) {
     fit.message = "RANSAC found no ellipsoid with 20 or more inliers";
     return fit;
   }

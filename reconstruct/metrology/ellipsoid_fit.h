@@ -17,6 +17,7 @@ struct EllipsoidFitOptions {
   int sample_size = 12;              // points per hypothesis (>= 9); default 12, steadier than 9 on noisy caps
   double inlier_threshold_mm = 0.5;  // |distance to the surface| for an inlier, mm; default 0.5
   double max_semi_axis_mm = 0;       // > 0: hypotheses with a longer semi-axis are skipped; default 0 (none)
+  int max_scoring_points = 2000;     // RANSAC scores hypotheses on at most ~this many points; default 2000
   unsigned seed = 1;                 // RANSAC sampling; fixed => deterministic
   void Check() const;                // throws InputError
 };
