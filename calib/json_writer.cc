@@ -1,106 +1,80 @@
 #include "calib/json_writer.h"
 
 #include <cmath>
-#include <cstdio>
+
+#include "calib/core/input_error.h"
 
 namespace stereorig {
 
-std::string JsonEscape(const std::string& s) {
-  std::string o(1, '"');
-  for (char c : s) {
-    switch (c) {
-      case '"':
-        o += "\\\"";
-        break;
-      case '\\':
-        o += "\\\\";
-        break;
-      case '\n':
-        o += "\\n";
-        break;
-      case '\t':
-        o += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char b[8];
-          std::snprintf(b, sizeof b, "\\u%04x", c);
-          o += b;
-        } else {
-          o += c;
-        }
-    }
+nlohmann::ordered_json* JsonWriter::Add(const std::string& key, nlohmann::ordered_json value) {
+  if (open_.empty()) {
+    STEREORIG_CHECK(root_.is_null() && key.empty());
+    root_ = std::move(value);
+    return &root_;
   }
-  o += '"';
-  return o;
-}
-
-void JsonWriter::Key(const std::string& key) {
-  if (!first_.empty()) {
-    if (!first_.back()) out_ += ",";
-    first_.back() = false;
-    out_ += '\n';
-    out_.append(2 * first_.size(), ' ');
+  nlohmann::ordered_json& parent = *open_.back();
+  if (parent.is_array()) {
+    STEREORIG_CHECK(key.empty());
+    parent.push_back(std::move(value));
+    return &parent.back();
   }
-  if (!key.empty()) out_ += JsonEscape(key) + ": ";
+  STEREORIG_CHECK(parent.is_object() && !key.empty());
+  parent[key] = std::move(value);
+  return &parent[key];
 }
 
 JsonWriter& JsonWriter::BeginObject(const std::string& key) {
-  Key(key);
-  out_ += "{";
-  first_.push_back(true);
+  open_.push_back(Add(key, nlohmann::ordered_json::object()));
   return *this;
 }
+
 JsonWriter& JsonWriter::EndObject() {
-  first_.pop_back();
-  out_ += '\n';
-  out_.append(2 * first_.size(), ' ');
-  out_ += '}';
+  STEREORIG_CHECK(!open_.empty() && open_.back()->is_object());
+  open_.pop_back();
   return *this;
 }
+
 JsonWriter& JsonWriter::BeginArray(const std::string& key) {
-  Key(key);
-  out_ += "[";
-  first_.push_back(true);
+  open_.push_back(Add(key, nlohmann::ordered_json::array()));
   return *this;
 }
+
 JsonWriter& JsonWriter::EndArray() {
-  first_.pop_back();
-  out_ += '\n';
-  out_.append(2 * first_.size(), ' ');
-  out_ += ']';
+  STEREORIG_CHECK(!open_.empty() && open_.back()->is_array());
+  open_.pop_back();
   return *this;
 }
+
 JsonWriter& JsonWriter::Number(const std::string& key, double v) {
-  Key(key);
-  if (!std::isfinite(v)) {
-    out_ += "null";
-  } else {
-    char b[32];
-    std::snprintf(b, sizeof b, "%.17g", v);
-    out_ += b;
-  }
+  Add(key, std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr));
   return *this;
 }
+
 JsonWriter& JsonWriter::Int(const std::string& key, long v) {
-  Key(key);
-  out_ += std::to_string(v);
+  Add(key, v);
   return *this;
 }
+
 JsonWriter& JsonWriter::String(const std::string& key, const std::string& v) {
-  Key(key);
-  out_ += JsonEscape(v);
+  Add(key, v);
   return *this;
 }
+
 JsonWriter& JsonWriter::Bool(const std::string& key, bool v) {
-  Key(key);
-  out_ += v ? "true" : "false";
+  Add(key, v);
   return *this;
 }
+
 JsonWriter& JsonWriter::Numbers(const std::string& key, const std::vector<double>& v) {
   BeginArray(key);
   for (double x : v) Number(x);
   return EndArray();
+}
+
+const std::string& JsonWriter::str() const {
+  STEREORIG_CHECK(open_.empty());
+  text_ = root_.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
+  return text_;
 }
 
 }  // namespace stereorig

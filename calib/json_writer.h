@@ -1,8 +1,11 @@
-// A minimal JSON writer for reports: objects, arrays, numbers (%.17g, NaN and
-// Inf as null), strings (escaped) and booleans. Keys are written in the order
-// given.
+// A streaming builder for the calibration report's JSON: objects, arrays,
+// numbers (NaN and Inf as null), strings and booleans, keys in the order
+// given. It builds an nlohmann::ordered_json document (nlohmann-json3-dev)
+// and lets that library do the escaping and number formatting; the builder
+// interface keeps the report code a flat list of keys and values.
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -10,6 +13,8 @@ namespace stereorig {
 
 class JsonWriter {
  public:
+  // `key` is the member name inside an object and must be empty inside an
+  // array or for the document itself.
   JsonWriter& BeginObject(const std::string& key = "");
   JsonWriter& EndObject();
   JsonWriter& BeginArray(const std::string& key = "");
@@ -21,14 +26,19 @@ class JsonWriter {
   JsonWriter& String(const std::string& key, const std::string& v);
   JsonWriter& Bool(const std::string& key, bool v);
   JsonWriter& Numbers(const std::string& key, const std::vector<double>& v);
-  const std::string& str() const { return out_; }
+  // The document, indented by 2 (invalid UTF-8 in strings is replaced).
+  const std::string& str() const;
+  const nlohmann::ordered_json& document() const { return root_; }
 
  private:
-  void Key(const std::string& key);
-  std::string out_;
-  std::vector<bool> first_;  // per open container: nothing written yet
+  // Adds `value` under `key` to the innermost open container (or as the
+  // document) and returns where it now lives.
+  nlohmann::ordered_json* Add(const std::string& key, nlohmann::ordered_json value);
+  nlohmann::ordered_json root_;
+  // The open containers, outermost first. Only the innermost one grows, so
+  // the pointers to its ancestors stay valid.
+  std::vector<nlohmann::ordered_json*> open_;
+  mutable std::string text_;
 };
-
-std::string JsonEscape(const std::string& s);
 
 }  // namespace stereorig
