@@ -12,8 +12,8 @@
 #include <filesystem>
 
 #include "calib/core/rig_file.h"
-#include "datasets/simulate.h"
 #include "reconstruct/runtime.h"
+#include "tests/sim_scene.h"
 
 namespace stereorig {
 namespace {
@@ -21,15 +21,7 @@ namespace {
 namespace fs = std::filesystem;
 
 TEST(HoleFillE2e, TheCupsCylinderFillLiesOnItsTrueSurface) {
-  const std::string dir = ::testing::TempDir() + "/hole_fill_e2e_" + std::to_string(getpid());
-  fs::remove_all(dir);
-  SimSpec spec = DefaultSimSpec();
-  spec.scenes.names = {"cup"};
-  SimulateOptions so;
-  so.out_dir = dir;
-  so.seed = 3;
-  so.calibration_captures = 0;
-  Simulate(spec, so);
+  const std::string dir = testing::SimulateOneScene("cup", 3, "hole_fill_e2e");
   const Rig rig = ReadRigFile(dir + "/truth/rig.yaml");
   RuntimeOptions o;
   o.shape_model = ShapeModel::kCylinder;

@@ -34,10 +34,10 @@
 #include <opencv2/core.hpp>
 
 #include "calib/core/rig_file.h"
-#include "datasets/simulate.h"
 #include "reconstruct/metrology/artifact.h"
 #include "reconstruct/metrology/vdi2634.h"
 #include "reconstruct/runtime.h"
+#include "tests/sim_scene.h"
 
 namespace stereorig {
 namespace {
@@ -198,15 +198,7 @@ class VerifyReconstruction : public ::testing::Test {
  protected:
   void TearDown() override { fs::remove_all(dir_); }
   Points Reconstruct(const std::string& scene) {
-    dir_ = ::testing::TempDir() + "/verify_reconstruction_" + scene + "_" + std::to_string(getpid());
-    fs::remove_all(dir_);
-    SimSpec spec = DefaultSimSpec();
-    spec.scenes.names = {scene};
-    SimulateOptions o;
-    o.out_dir = dir_;
-    o.seed = 3;
-    o.calibration_captures = 0;
-    Simulate(spec, o);
+    dir_ = testing::SimulateOneScene(scene, 3, "verify_reconstruction_" + scene);
     const Rig rig = ReadRigFile(dir_ + "/truth/rig.yaml");
     const Runtime runtime(rig, RuntimeOptions{});
     const Reconstruction rec = runtime.Process(LoadCapture(dir_ + "/scenes/" + scene + "/active", rig), false);

@@ -3,10 +3,12 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <random>
 
 #include "calib/core/input_error.h"
 #include "reconstruct/metrology/least_squares.h"
+#include "reconstruct/metrology/ransac.h"
 
 namespace stereorig {
 
@@ -90,37 +92,28 @@ CylinderFit FitCylinderRobust(const std::vector<Eigen::Vector3d>& points, const 
     return std::abs(AxisDistance(a, points[i]) - a.radius) < o.inlier_threshold_mm &&
            std::abs(radial.normalized().dot(normals[i])) > cos_normal;
   };
-  // Hypotheses are scored on an even subsample (every score_step-th point):
-  // ranking them needs far fewer points than the final fit.
-  const int score_step = std::max(1, n / o.max_scoring_points);
   std::mt19937 rng(o.seed);
   std::uniform_int_distribution<int> pick(0, n - 1);
-  int best_count = 0;
-  Axis best;
-  for (int it = 0; it < o.ransac_iterations; ++it) {
+  const std::function<bool(Axis*)> draw = [&](Axis* a) {
     const int i = pick(rng), j = pick(rng);
-    Axis a;
-    if (i == j || !CylinderFrom2(points[i], normals[i], points[j], normals[j], &a)) continue;
-    if (o.max_radius_mm > 0 && a.radius > o.max_radius_mm) continue;
-    int count = 0;
-    for (int k = 0; k < n; k += score_step) count += consistent(a, k);
-    if (count > best_count) best_count = count, best = a;
-  }
-  if (best_count * score_step < 10) {
+    return i != j && CylinderFrom2(points[i], normals[i], points[j], normals[j], a) &&
+           !(o.max_radius_mm > 0 && a->radius > o.max_radius_mm);
+  };
+  const std::function<bool(const Axis&, int)> agrees = consistent;
+  Axis best;
+  if (RansacBest(o.ransac_iterations, n, o.max_scoring_points, draw, agrees, &best) < 10) {
     fit.message = "RANSAC found no cylinder with 10 or more inliers";
     return fit;
   }
   // Refine on the consensus set, re-segment with the better cylinder (by
   // distance alone), refine again.
-  std::vector<int> inliers;
-  for (int k = 0; k < n; ++k)
-    if (consistent(best, k)) inliers.push_back(k);
+  std::vector<int> inliers = Inliers(n, best, agrees);
   bool converged = false;
   Axis a = Refine(points, inliers, best, &converged);
   for (int round = 0; round < 2 && converged; ++round) {
-    inliers.clear();
-    for (int k = 0; k < n; ++k)
-      if (std::abs(AxisDistance(a, points[k]) - a.radius) < o.inlier_threshold_mm) inliers.push_back(k);
+    inliers = Inliers<Axis>(n, a, [&](const Axis& c, int k) {
+      return std::abs(AxisDistance(c, points[k]) - c.radius) < o.inlier_threshold_mm;
+    });
     if (inliers.size() < 10) break;
     a = Refine(points, inliers, a, &converged);
   }

@@ -3,11 +3,13 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <numeric>
 #include <random>
 
 #include "calib/core/input_error.h"
 #include "reconstruct/metrology/least_squares.h"
+#include "reconstruct/metrology/ransac.h"
 
 namespace stereorig {
 
@@ -125,44 +127,32 @@ EllipsoidFit FitEllipsoidRobust(const std::vector<Eigen::Vector3d>& points, cons
     fit.message = "all points coincide";
     return fit;
   }
-  auto in_band = [&](const Ellipsoid& e, int i) {
+  const std::function<bool(const Ellipsoid&, int)> in_band = [&](const Ellipsoid& e, int i) {
     return std::abs(SampsonDistance(e, points[i])) < o.inlier_threshold_mm;
   };
-  // Hypotheses are scored on an even subsample (every score_step-th point):
-  // ranking them needs far fewer points than the final fit.
-  const int score_step = std::max(1, n / o.max_scoring_points);
   std::mt19937 rng(o.seed);
   std::vector<int> all(n);
   std::iota(all.begin(), all.end(), 0);
-  int best_count = 0;
-  Ellipsoid best;
-  for (int it = 0; it < o.ransac_iterations; ++it) {
+  const std::function<bool(Ellipsoid*)> draw = [&](Ellipsoid* e) {
     std::vector<int> sample;
     std::sample(all.begin(), all.end(), std::back_inserter(sample), o.sample_size, rng);
-    Ellipsoid e;
-    if (!AlgebraicEllipsoid(points, sample, origin, scale, &e)) continue;
-    if (o.max_semi_axis_mm > 0 && e.a.maxCoeff() > o.max_semi_axis_mm) continue;
-    int count = 0;
-    for (int k = 0; k < n; k += score_step) count += in_band(e, k);
-    if (count > best_count) best_count = count, best = e;
-  }
-  if (best_count * score_step < 20) {
+    return AlgebraicEllipsoid(points, sample, origin, scale, e) &&
+           !(o.max_semi_axis_mm > 0 && e->a.maxCoeff() > o.max_semi_axis_mm);
+  };
+  Ellipsoid best;
+  if (RansacBest(o.ransac_iterations, n, o.max_scoring_points, draw, in_band, &best) < 20) {
     fit.message = "RANSAC found no ellipsoid with 20 or more inliers";
     return fit;
   }
   // Refine: algebraic on the consensus set, then geometric, re-segmented.
-  std::vector<int> inliers;
-  for (int k = 0; k < n; ++k)
-    if (in_band(best, k)) inliers.push_back(k);
+  std::vector<int> inliers = Inliers(n, best, in_band);
   Ellipsoid e = best;
   AlgebraicEllipsoid(points, inliers, origin, scale, &e);
   bool converged = false;
   for (int round = 0; round < 3; ++round) {
     e = Refine(points, inliers, e, &converged);
     if (!converged) break;
-    inliers.clear();
-    for (int k = 0; k < n; ++k)
-      if (in_band(e, k)) inliers.push_back(k);
+    inliers = Inliers(n, e, in_band);
     if (inliers.size() < 20) break;
   }
   if (!converged || inliers.size() < 20) {
