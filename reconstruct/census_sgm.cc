@@ -152,7 +152,10 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
 
   auto winner_take_all = [&](int y, uint16_t* srow) {
     std::fill(right_best - 16, right_best - 16 + right_best_size, uint16_t(0xFFFF));
-    for (int x = 0; x < w; ++x) K::RightBest(srow + size_t(x) * stride, n, stride, right_best + x + n - 1);
+    // Pixels 16 apart in turn: neighbours' runs overlap shifted by one lane,
+    // and a load overlapping the previous store stalls store forwarding.
+    for (int phase = 0; phase < 16; ++phase)
+      for (int x = phase; x < w; x += 16) K::RightBest(srow + size_t(x) * stride, n, stride, right_best + x + n - 1);
     float* out = disparity.ptr<float>(y);
     for (int x = 0; x < w; ++x) {
       uint16_t* s = srow + size_t(x) * stride;

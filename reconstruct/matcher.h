@@ -16,7 +16,9 @@
 //      disparity plane, speckle removal (connected components of similar
 //      disparity smaller than speckle_window_px), range.
 // MatcherKind::kOpenCvSgbm3Way runs OpenCV's StereoSGBM (MODE_SGBM_3WAY) on
-// the same region and range: the baseline every figure is compared against.
+// the same region and the full range in place of steps 1-2, then the same
+// steps 3-4: the baseline every figure is compared against, differing from
+// ours in the correspondence step only.
 #pragma once
 
 #include <map>
@@ -68,12 +70,13 @@ struct MatchResult {
   // CV_32FC1, the left image's size: disparity in px (x_right = x_left - d),
   // +inf where no valid match (outside the ROI included).
   cv::Mat disparity_px;
-  // CV_32FC1, same size: confidence in [0, 1] (ZNCC of the refined window
-  // for census_sgm, 1 for any valid SGBM pixel), 0 where invalid.
+  // CV_32FC1, same size: confidence in [0, 1] (ZNCC of the refined window;
+  // 1 without intensity_refinement), 0 where invalid.
   cv::Mat confidence;
   // Wall time of the sub-steps, ms: census_sgm: "band" (the half-resolution
   // range pass), "sgm" (census + SGM + left-right/uniqueness), "subpixel"
-  // (slopes + Lucas-Kanade + filters), "speckle"; opencv_sgbm_3way: "sgbm".
+  // (slopes + Lucas-Kanade + filters), "speckle"; opencv_sgbm_3way: "sgbm"
+  // in place of "band" and "sgm".
   std::map<std::string, double> times_ms;
 };
 

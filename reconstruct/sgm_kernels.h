@@ -218,15 +218,20 @@ struct Avx2Kernels {
     return m;
   }
 
-  // Lanes best-1..best+1 are masked out in place and restored. With no lane
-  // left (n == 3) the padding's >= 3 kBig stands in for 0xFFFF: both pass
-  // any uniqueness test (uniqueness_percent <= 50).
+  // Lanes best-1..best+1 are masked out in registers (a scalar write then a
+  // vector read of the same bytes would stall store forwarding). With no
+  // lane left (n == 3) the padding's >= 3 kBig stands in for 0xFFFF: both
+  // pass any uniqueness test (uniqueness_percent <= 50).
   static uint16_t SecondBest(uint16_t* s, int /*n*/, int stride, int best) {
-    const uint16_t saved[3] = {s[best - 1], s[best], s[best + 1]};
-    s[best - 1] = s[best] = s[best + 1] = 0xFFFF;
-    const uint16_t m = Min(s, stride);
-    std::copy(saved, saved + 3, s + best - 1);
-    return m;
+    const __m256i lane = _mm256_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    const __m256i lo = _mm256_set1_epi16(int16_t(best - 2)), hi = _mm256_set1_epi16(int16_t(best + 2));
+    __m256i m = _mm256_set1_epi16(-1);
+    for (int d = 0; d < stride; d += 16) {
+      const __m256i index = _mm256_add_epi16(lane, _mm256_set1_epi16(int16_t(d)));
+      const __m256i near = _mm256_and_si256(_mm256_cmpgt_epi16(index, lo), _mm256_cmpgt_epi16(hi, index));
+      m = _mm256_min_epu16(m, _mm256_or_si256(Load(s + d), near));
+    }
+    return HorizontalMin(m);
   }
 };
 #endif  // __AVX2__
