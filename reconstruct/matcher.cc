@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "calib/core/input_error.h"
+#include "reconstruct/disparity_band.h"
 #include "reconstruct/parallel_for.h"
 
 namespace stereorig {
@@ -201,26 +202,30 @@ void DisparitySlopes(const cv::Mat& disparity, cv::Mat* slope_x, cv::Mat* slope_
     }
 }
 
-// The band of disparities a half-resolution SGM finds in the ROI:
-// [2nd percentile - margin, 98th percentile + margin], within the given range.
-// Returns false (keep the full range) if too few pixels matched.
+// The band of disparities a half-resolution SGM finds in the ROI
+// (disparity_band.h), within the given range. Returns false (keep the full
+// range) if too few pixels matched.
 bool OccupiedBand(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const MatchOptions& o, int* dmin,
                   int* num) {
   cv::Mat lh, rh;
   cv::resize(left, lh, cv::Size(left.cols / 2, left.rows / 2), 0, 0, cv::INTER_AREA);
   cv::resize(right, rh, cv::Size(right.cols / 2, right.rows / 2), 0, 0, cv::INTER_AREA);
   const cv::Rect half(roi.x / 2, roi.y / 2, std::max(1, roi.width / 2), std::max(1, roi.height / 2));
-  const cv::Mat d = MatchLevel(lh, rh, half & cv::Rect(0, 0, lh.cols, lh.rows), int(std::floor(*dmin / 2.0)) - 1,
-                               (*num + 1) / 2 + 3, 0, o);
-  std::vector<float> v;
+  cv::Mat d = MatchLevel(lh, rh, half & cv::Rect(0, 0, lh.cols, lh.rows), int(std::floor(*dmin / 2.0)) - 1,
+                         (*num + 1) / 2 + 3, 0, o);
+  // The coarse level's mismatches are mostly small blobs: removing them
+  // first leaves the band to the surfaces (disparity_band.h).
+  MatchOptions blobs = o;
+  blobs.speckle_window_px = kCoarseSpeckleWindowPx;
+  blobs.speckle_range_px = kCoarseSpeckleRangePx;
+  RemoveSpeckles(d, blobs);
+  std::vector<float> v;  // full-resolution px
   for (int y = 0; y < d.rows; ++y)
     for (int x = 0; x < d.cols; ++x)
-      if (!std::isnan(d.at<float>(y, x))) v.push_back(d.at<float>(y, x));
-  if (v.size() < 200) return false;
-  std::sort(v.begin(), v.end());
-  const int lo = int(std::floor(2 * v[v.size() * 2 / 100])) - o.range_margin_px;
-  const int hi = int(std::ceil(2 * v[v.size() * 98 / 100])) + o.range_margin_px;
-  const int new_min = std::max(*dmin, lo), new_max = std::min(*dmin + *num - 1, hi);
+      if (std::isfinite(d.at<float>(y, x))) v.push_back(2 * d.at<float>(y, x));
+  const std::optional<DisparityBand> band = OccupiedDisparityBand(v, o.range_margin_px);
+  if (!band) return false;
+  const int new_min = std::max(*dmin, band->min_px), new_max = std::min(*dmin + *num - 1, band->max_px);
   if (new_max - new_min < 8) return false;
   *dmin = new_min;
   *num = new_max - new_min + 1;
