@@ -77,9 +77,9 @@ struct SgmWorkspace {
   std::vector<uint16_t> sum;             // (h or 1, w, stride)
   std::vector<uint16_t> vert_a, vert_b;  // (w, stride + 2): top/bottom path, previous and current row
   std::vector<uint16_t> vert_min_a, vert_min_b;
-  std::vector<uint16_t> horiz_a, horiz_b;  // (stride + 2)
-  std::vector<uint16_t> right_best;        // (16 + w + n)
-  std::vector<uint64_t> right_reversed;    // (stride + right width + stride + 16)
+  std::vector<uint16_t> horiz_a, horiz_b, horiz_c, horiz_d;  // (stride + 2): left->right, right->left
+  std::vector<uint16_t> right_best;                          // (16 + w + n)
+  std::vector<uint64_t> right_reversed;                      // (stride + right width + stride + 16)
 };
 
 template <typename T>
@@ -143,6 +143,8 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   uint16_t* vert_cur_min = Grow(ws.vert_min_b, w);
   uint16_t* ha = PathBuffers(ws.horiz_a, 1, stride);
   uint16_t* hb = PathBuffers(ws.horiz_b, 1, stride);
+  uint16_t* hc = PathBuffers(ws.horiz_c, 1, stride);
+  uint16_t* hd = PathBuffers(ws.horiz_d, 1, stride);
   // Right-view best costs: right pixel xr_local = x - d + n - 1, stored at
   // [16 + xr_local] (the SIMD kernel writes padding lanes below index 0).
   const size_t right_best_size = 16 + size_t(w) + n;
@@ -196,17 +198,19 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
     std::swap(vert_prev, vert_cur);
     std::swap(vert_prev_min, vert_cur_min);
   };
+  // Left->right and right->left, interleaved: each step waits for the
+  // previous pixel's minimum, so two independent chains keep the core busy.
+  // (Sums are modulo 2^16 additions: their order does not change them.)
   auto horizontal = [&](const uint8_t* crow, uint16_t* srow) {
-    uint16_t m = K::First(crow, ha, srow, SumMode::kAdd, n, stride);
-    for (int x = 1; x < w; ++x) {
-      m = K::Step(crow + size_t(x) * stride, ha, m, hb, srow + size_t(x) * stride, SumMode::kAdd, n, stride, p1, p2);
-      std::swap(ha, hb);
-    }
     const size_t last = size_t(w - 1) * stride;
-    m = K::First(crow + last, ha, srow + last, SumMode::kAdd, n, stride);
-    for (int x = w - 2; x >= 0; --x) {
-      m = K::Step(crow + size_t(x) * stride, ha, m, hb, srow + size_t(x) * stride, SumMode::kAdd, n, stride, p1, p2);
+    uint16_t m_lr = K::First(crow, ha, srow, SumMode::kAdd, n, stride);
+    uint16_t m_rl = K::First(crow + last, hc, srow + last, SumMode::kAdd, n, stride);
+    for (int i = 1; i < w; ++i) {
+      const size_t xl = size_t(i) * stride, xr = size_t(w - 1 - i) * stride;
+      m_lr = K::Step(crow + xl, ha, m_lr, hb, srow + xl, SumMode::kAdd, n, stride, p1, p2);
+      m_rl = K::Step(crow + xr, hc, m_rl, hd, srow + xr, SumMode::kAdd, n, stride, p1, p2);
       std::swap(ha, hb);
+      std::swap(hc, hd);
     }
   };
 
