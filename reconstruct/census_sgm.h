@@ -3,7 +3,7 @@
 // signatures (up to 9x7 window, 62 bits), path costs are uint16, one
 // contiguous run of disparities per pixel. The inner loops (sgm_kernels.h)
 // run in AVX2 where the build has it, else portably; both give the same
-// disparities. Big buffers are kept per thread and reused across calls.
+// disparities.
 //
 // Disparity convention everywhere in reconstruct/: a left pixel x matches the
 // right pixel x - d (rectified rows are aligned, so d >= 0 for points in
