@@ -78,6 +78,7 @@ using sgm::SumMode;
 struct SgmWorkspace {
   std::vector<uint8_t> cost;             // (h, w, stride)
   std::vector<uint16_t> sum;             // (h or 1, w, stride)
+  std::vector<uint16_t> total_row;       // (w, stride): backward pass
   std::vector<uint16_t> vert_a, vert_b;  // (w, stride + 2): top/bottom path, previous and current row
   std::vector<uint16_t> vert_min_a, vert_min_b;
   std::vector<uint16_t> horiz_a, horiz_b, horiz_c, horiz_d;  // (stride + 2): left->right, right->left
@@ -228,11 +229,15 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   }
   if (!two_pass) return disparity;
 
-  // Backward pass: bottom -> top, then the winner per row.
+  // Backward pass: bottom -> top, then the winner per row. The row's total
+  // goes to a cache-resident copy, so the volume is only read, never
+  // written back (the pass is memory-bound).
+  uint16_t* total = Grow(ws.total_row, size_t(w) * stride);
   for (int y = h - 1; y >= 0; --y) {
-    uint16_t* srow = sum + size_t(y) * w * stride;
-    vertical(cost + size_t(y) * w * stride, srow, y == h - 1, SumMode::kAdd);
-    winner_take_all(y, srow);
+    const uint16_t* srow = sum + size_t(y) * w * stride;
+    std::copy(srow, srow + size_t(w) * stride, total);
+    vertical(cost + size_t(y) * w * stride, total, y == h - 1, SumMode::kAdd);
+    winner_take_all(y, total);
   }
   return disparity;
 }
