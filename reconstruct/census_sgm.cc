@@ -6,6 +6,7 @@
 
 #include "calib/core/input_error.h"
 #include "reconstruct/parallel_for.h"
+#include "reconstruct/sgm_kernels.h"
 
 namespace stereorig {
 
@@ -25,16 +26,17 @@ CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int
   CensusImage out;
   out.width = grey.cols;
   out.height = grey.rows;
-  out.bits.assign(size_t(grey.cols) * grey.rows, 0);
-  row_begin = std::max(0, row_begin);
-  row_end = std::min(grey.rows, row_end);
+  row_begin = std::clamp(row_begin, 0, grey.rows);
+  row_end = std::clamp(row_end, row_begin, grey.rows);
+  out.row_begin = row_begin;
+  out.bits.assign(size_t(grey.cols) * (row_end - row_begin), 0);
   const int w = grey.cols, h = grey.rows;
   const int c0 = std::clamp(col_begin, 0, w), c1 = std::clamp(col_end, c0, w);
   ParallelForChunks(row_end - row_begin, num_threads, [&](int b, int e) {
     std::vector<uint8_t> padded(w + 8);
     for (int y = row_begin + b; y < row_begin + e; ++y) {
       const uint8_t* centre = grey.ptr<uint8_t>(y);
-      uint64_t* dst = out.bits.data() + size_t(y) * w;
+      uint64_t* dst = out.bits.data() + size_t(y - row_begin) * w;
       for (int dy = -half_height; dy <= half_height; ++dy) {
         const uint8_t* src = grey.ptr<uint8_t>(std::clamp(y + dy, 0, h - 1));
         // Replicated border in a padded copy keeps the inner loop branch-free.
@@ -54,110 +56,120 @@ CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int
   return out;
 }
 
+bool SgmSimdAvailable() {
+#if defined(__AVX2__)
+  return true;
+#else
+  return false;
+#endif
+}
+
 namespace {
 
-constexpr uint16_t kBig = 0x3FFF;  // "impossible" path cost; + p1 cannot overflow
+using sgm::kBig;
+using sgm::SumMode;
 
-// One SGM recursion step along a path:
-//   cur[d] = c[d] + min(prev[d], prev[d-1]+p1, prev[d+1]+p1, prev_min+p2) - prev_min.
-// `prev` and `cur` point at element 0 of arrays padded with kBig at [-1] and
-// [n]. Returns min_d cur[d].
-inline uint16_t PathStep(const uint8_t* __restrict c, const uint16_t* __restrict prev, uint16_t prev_min,
-                         uint16_t* __restrict cur, int n, uint16_t p1, uint16_t p2) {
-  const uint16_t cap = uint16_t(prev_min + p2);
-  uint16_t m = 0xFFFF;
-  for (int d = 0; d < n; ++d) {
-    const uint16_t a = std::min(prev[d], cap);
-    const uint16_t b = std::min(uint16_t(prev[d - 1] + p1), uint16_t(prev[d + 1] + p1));
-    const uint16_t r = uint16_t(c[d] + std::min(a, b) - prev_min);
-    cur[d] = r;
-    m = std::min(m, r);
-  }
-  return m;
-}
-
-inline uint16_t FirstStep(const uint8_t* __restrict c, uint16_t* __restrict cur, int n) {
-  uint16_t m = 0xFFFF;
-  for (int d = 0; d < n; ++d) {
-    cur[d] = c[d];
-    m = std::min(m, cur[d]);
-  }
-  return m;
-}
-
-inline void AddTo(uint16_t* __restrict s, const uint16_t* __restrict l, int n) {
-  for (int d = 0; d < n; ++d) s[d] = uint16_t(s[d] + l[d]);
-}
-
-inline uint16_t MinOf(const uint16_t* __restrict v, int n) {
-  uint16_t m = 0xFFFF;
-  for (int i = 0; i < n; ++i) m = std::min(m, v[i]);
-  return m;
-}
-
-// A (D+2)-element path buffer with kBig sentinels; data() points at element 0.
-struct PathBuffer {
-  explicit PathBuffer(int n) : v(n + 2, kBig) {}
-  uint16_t* data() { return v.data() + 1; }
-  std::vector<uint16_t> v;
+// The big buffers of one SgmMatch call, allocated once per call (the band
+// pass and the full-resolution pass are separate calls). Keeping them per
+// thread across calls was tried: page faults stayed ~1.5 % of the runtime's
+// cycles either way (cv::Mat allocations dominate them), while the retained
+// volumes overlapped the sub-pixel step's buffers and raised the peak of
+// `reconstruct` on the plate from 230 to 293 MB.
+struct SgmWorkspace {
+  std::vector<uint8_t> cost;             // (h, w, stride)
+  std::vector<uint16_t> sum;             // (h or 1, w, stride)
+  std::vector<uint16_t> total_row;       // (w, stride): backward pass
+  std::vector<uint16_t> vert_a, vert_b;  // (w, stride + 2): top/bottom path, previous and current row
+  std::vector<uint16_t> vert_min_a, vert_min_b;
+  std::vector<uint16_t> horiz_a, horiz_b, horiz_c, horiz_d;  // (stride + 2): left->right, right->left
+  std::vector<uint16_t> right_best;                          // (16 + w + n)
+  std::vector<uint64_t> right_reversed;                      // (stride + right width + stride + 16)
 };
 
-}  // namespace
+// Room for n elements (contents unspecified).
+template <typename T>
+T* Grow(std::vector<T>& v, size_t n) {
+  if (v.size() < n) v.resize(n);
+  return v.data();
+}
 
-cv::Mat SgmMatch(const CensusImage& left, const CensusImage& right, const cv::Rect& region, int min_disparity,
-                 int num_disparities, const SgmOptions& options) {
-  STEREORIG_CHECK(region.width > 0 && region.height > 0 && num_disparities > 0);
-  STEREORIG_CHECK(region.x >= 0 && region.y >= 0 && region.x + region.width <= left.width &&
-                  region.y + region.height <= left.height);
-  const int w = region.width, h = region.height, n = num_disparities;
+// Path buffers for `count` pixels of `stride` lanes with kBig sentinels at
+// [-1] and [stride]; returns element 0 of pixel 0 (pixel i at i*(stride+2)).
+uint16_t* PathBuffers(std::vector<uint16_t>& v, int count, int stride) {
+  uint16_t* p = Grow(v, size_t(count) * (stride + 2));
+  for (int i = 0; i < count; ++i) {
+    p[size_t(i) * (stride + 2)] = kBig;
+    p[size_t(i) * (stride + 2) + stride + 1] = kBig;
+  }
+  return p + 1;
+}
+
+template <typename K>
+cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv::Rect& region, int min_disparity,
+                     int n, const SgmOptions& options) {
+  const int w = region.width, h = region.height;
+  const int stride = K::Stride(n), path_stride = stride + 2;
   const int rw = right.width;
   const uint16_t p1 = uint16_t(options.p1), p2 = uint16_t(options.p2);
+  SgmWorkspace ws;
 
-  // Cost volume (h, w, n), uint8. Disparities whose right pixel falls off the
-  // image get the maximum cost, so they are never preferred.
-  std::vector<uint8_t> cost(size_t(h) * w * n);
+  // Cost volume (h, w, stride), uint8. Disparities whose right pixel falls
+  // off the image get the maximum cost, so they are never preferred. The
+  // right row is reversed (with `stride` padding each side) so that each
+  // pixel's run of disparities reads it forwards.
+  uint8_t* cost = Grow(ws.cost, size_t(h) * w * stride);
+  uint64_t* reversed = Grow(ws.right_reversed, size_t(rw) + 2 * stride + 16);
+  std::fill(reversed, reversed + size_t(rw) + 2 * stride + 16, 0);
   for (int y = 0; y < h; ++y) {
     const uint64_t* cl = left.row(region.y + y);
     const uint64_t* cr = right.row(region.y + y);
+    std::reverse_copy(cr, cr + rw, reversed + stride);
     for (int x = 0; x < w; ++x) {
-      uint8_t* c = cost.data() + (size_t(y) * w + x) * n;
-      const uint64_t l = cl[region.x + x];
+      uint8_t* c = cost + (size_t(y) * w + x) * stride;
       const int xr0 = region.x + x - min_disparity;  // right x at d index 0
-      // d indices whose right pixel xr0 - d lies in [0, rw): a branch-free run.
+      // d indices whose right pixel xr0 - d lies in [0, rw).
       const int d_lo = std::clamp(xr0 - rw + 1, 0, n), d_hi = std::clamp(xr0 + 1, d_lo, n);
+      if (d_lo == d_hi) {
+        std::fill(c, c + stride, uint8_t(kCensusMaxCost));
+        continue;
+      }
+      K::Cost(cl[region.x + x], reversed + stride + rw - 1 - xr0, c, d_lo, d_hi, stride);
       std::fill(c, c + d_lo, uint8_t(kCensusMaxCost));
-      const uint64_t* r = cr + xr0;
-      for (int d = d_lo; d < d_hi; ++d) c[d] = uint8_t(__builtin_popcountll(l ^ r[-d]));
       std::fill(c + d_hi, c + n, uint8_t(kCensusMaxCost));
     }
   }
 
-  // Aggregated cost (h, w, n) when a second pass is needed; otherwise one row.
+  // Aggregated cost (h, w, stride) when a second pass is needed; otherwise one row.
   const bool two_pass = options.num_paths == 4;
-  std::vector<uint16_t> sum(size_t(two_pass ? h : 1) * w * n);
-  std::vector<uint16_t> vert_prev(size_t(w) * (n + 2), kBig), vert_cur(size_t(w) * (n + 2), kBig);
-  std::vector<uint16_t> vert_prev_min(w), vert_cur_min(w);
-  PathBuffer ha(n), hb(n);
+  uint16_t* sum = Grow(ws.sum, size_t(two_pass ? h : 1) * w * stride);
+  uint16_t* vert_prev = PathBuffers(ws.vert_a, w, stride);
+  uint16_t* vert_cur = PathBuffers(ws.vert_b, w, stride);
+  uint16_t* vert_prev_min = Grow(ws.vert_min_a, w);
+  uint16_t* vert_cur_min = Grow(ws.vert_min_b, w);
+  uint16_t* ha = PathBuffers(ws.horiz_a, 1, stride);
+  uint16_t* hb = PathBuffers(ws.horiz_b, 1, stride);
+  uint16_t* hc = PathBuffers(ws.horiz_c, 1, stride);
+  uint16_t* hd = PathBuffers(ws.horiz_d, 1, stride);
+  // Right-view best costs: right pixel xr_local = x - d + n - 1, stored at
+  // [16 + xr_local] (the SIMD kernel writes padding lanes below index 0).
+  const size_t right_best_size = 16 + size_t(w) + n;
+  uint16_t* right_best = Grow(ws.right_best, right_best_size) + 16;
 
   cv::Mat disparity(h, w, CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
-  std::vector<uint16_t> right_best(w + n);
 
-  auto winner_take_all = [&](int y, const uint16_t* srow) {
-    // Right-view best costs from the same volume: right pixel xr_local =
-    // x - d + n - 1 (>= 0). A reversed contiguous run, so it vectorises.
-    std::fill(right_best.begin(), right_best.end(), uint16_t(0xFFFF));
-    for (int x = 0; x < w; ++x) {
-      const uint16_t* s = srow + size_t(x) * n;
-      uint16_t* rb = right_best.data() + x + n - 1;
-      for (int d = 0; d < n; ++d) rb[-d] = std::min(rb[-d], s[d]);
-    }
+  auto winner_take_all = [&](int y, uint16_t* srow) {
+    std::fill(right_best - 16, right_best - 16 + right_best_size, uint16_t(0xFFFF));
+    // Pixels 16 apart in turn: neighbours' runs overlap shifted by one lane,
+    // and a load overlapping the previous store stalls store forwarding.
+    for (int phase = 0; phase < 16; ++phase)
+      for (int x = phase; x < w; x += 16) K::RightBest(srow + size_t(x) * stride, n, stride, right_best + x + n - 1);
     float* out = disparity.ptr<float>(y);
     for (int x = 0; x < w; ++x) {
-      const uint16_t* s = srow + size_t(x) * n;
-      const uint16_t best_cost = MinOf(s, n);
-      const int best = int(std::find(s, s + n, best_cost) - s);
+      uint16_t* s = srow + size_t(x) * stride;
+      int best = 0;
+      const uint16_t best_cost = K::Best(s, n, stride, &best);
       if (best == 0 || best == n - 1) continue;  // at the range's edge: not a true minimum
-      const uint16_t second = std::min(MinOf(s, best - 1), MinOf(s + best + 2, n - best - 2));
+      const uint16_t second = K::SecondBest(s, n, stride, best);
       if (int(second) * (100 - options.uniqueness_percent) < int(best_cost) * 100) continue;
       // Left-right check: the right pixel's own best disparity lies within
       // lr_max_diff_px of ours iff one of the left pixels x+k at disparity
@@ -166,7 +178,7 @@ cv::Mat SgmMatch(const CensusImage& left, const CensusImage& right, const cv::Re
       bool consistent = false;
       for (int k = -options.lr_max_diff_px; k <= options.lr_max_diff_px && !consistent; ++k) {
         const int xk = x + k, dk = best + k;
-        if (xk >= 0 && xk < w && dk >= 0 && dk < n) consistent = srow[size_t(xk) * n + dk] <= right_min;
+        if (xk >= 0 && xk < w && dk >= 0 && dk < n) consistent = srow[size_t(xk) * stride + dk] <= right_min;
       }
       if (!consistent) continue;
       const double c0 = s[best - 1], c1 = s[best], c2 = s[best + 1];
@@ -178,58 +190,69 @@ cv::Mat SgmMatch(const CensusImage& left, const CensusImage& right, const cv::Re
     }
   };
 
-  // Forward pass: left->right, right->left, top->bottom.
-  for (int y = 0; y < h; ++y) {
-    uint16_t* srow = sum.data() + (two_pass ? size_t(y) * w * n : 0);
-    const uint8_t* crow = cost.data() + size_t(y) * w * n;
-    // Top -> bottom: column buffers, double-buffered across rows.
+  // One row of the vertical path (top->bottom or bottom->top), then the two
+  // horizontal paths, all accumulated into srow.
+  auto vertical = [&](const uint8_t* crow, uint16_t* srow, bool first_row, SumMode mode) {
     for (int x = 0; x < w; ++x) {
-      uint16_t* cur = vert_cur.data() + size_t(x) * (n + 2) + 1;
-      const uint8_t* c = crow + size_t(x) * n;
-      vert_cur_min[x] = y == 0
-                            ? FirstStep(c, cur, n)
-                            : PathStep(c, vert_prev.data() + size_t(x) * (n + 2) + 1, vert_prev_min[x], cur, n, p1, p2);
-      std::copy(cur, cur + n, srow + size_t(x) * n);
+      uint16_t* cur = vert_cur + size_t(x) * path_stride;
+      const uint8_t* c = crow + size_t(x) * stride;
+      vert_cur_min[x] = first_row ? K::First(c, cur, srow + size_t(x) * stride, mode, n, stride)
+                                  : K::Step(c, vert_prev + size_t(x) * path_stride, vert_prev_min[x], cur,
+                                            srow + size_t(x) * stride, mode, n, stride, p1, p2);
     }
     std::swap(vert_prev, vert_cur);
     std::swap(vert_prev_min, vert_cur_min);
-    // Left -> right.
-    uint16_t m = FirstStep(crow, ha.data(), n);
-    AddTo(srow, ha.data(), n);
-    for (int x = 1; x < w; ++x) {
-      m = PathStep(crow + size_t(x) * n, ha.data(), m, hb.data(), n, p1, p2);
-      AddTo(srow + size_t(x) * n, hb.data(), n);
+  };
+  // Left->right and right->left, interleaved: each step waits for the
+  // previous pixel's minimum, so two independent chains keep the core busy.
+  // (Sums are modulo 2^16 additions: their order does not change them.)
+  auto horizontal = [&](const uint8_t* crow, uint16_t* srow) {
+    const size_t last = size_t(w - 1) * stride;
+    uint16_t m_lr = K::First(crow, ha, srow, SumMode::kAdd, n, stride);
+    uint16_t m_rl = K::First(crow + last, hc, srow + last, SumMode::kAdd, n, stride);
+    for (int i = 1; i < w; ++i) {
+      const size_t xl = size_t(i) * stride, xr = size_t(w - 1 - i) * stride;
+      m_lr = K::Step(crow + xl, ha, m_lr, hb, srow + xl, SumMode::kAdd, n, stride, p1, p2);
+      m_rl = K::Step(crow + xr, hc, m_rl, hd, srow + xr, SumMode::kAdd, n, stride, p1, p2);
       std::swap(ha, hb);
+      std::swap(hc, hd);
     }
-    // Right -> left.
-    m = FirstStep(crow + size_t(w - 1) * n, ha.data(), n);
-    AddTo(srow + size_t(w - 1) * n, ha.data(), n);
-    for (int x = w - 2; x >= 0; --x) {
-      m = PathStep(crow + size_t(x) * n, ha.data(), m, hb.data(), n, p1, p2);
-      AddTo(srow + size_t(x) * n, hb.data(), n);
-      std::swap(ha, hb);
-    }
+  };
+
+  // Forward pass: top->bottom, left->right, right->left.
+  for (int y = 0; y < h; ++y) {
+    uint16_t* srow = sum + (two_pass ? size_t(y) * w * stride : 0);
+    const uint8_t* crow = cost + size_t(y) * w * stride;
+    vertical(crow, srow, y == 0, SumMode::kStore);
+    horizontal(crow, srow);
     if (!two_pass) winner_take_all(y, srow);
   }
   if (!two_pass) return disparity;
 
-  // Backward pass: bottom -> top, then the winner per row.
+  // Backward pass: bottom -> top, then the winner per row. The row's total
+  // goes to a cache-resident copy, so the volume is only read, never
+  // written back (the pass is memory-bound).
+  uint16_t* total = Grow(ws.total_row, size_t(w) * stride);
   for (int y = h - 1; y >= 0; --y) {
-    uint16_t* srow = sum.data() + size_t(y) * w * n;
-    const uint8_t* crow = cost.data() + size_t(y) * w * n;
-    for (int x = 0; x < w; ++x) {
-      uint16_t* cur = vert_cur.data() + size_t(x) * (n + 2) + 1;
-      const uint8_t* c = crow + size_t(x) * n;
-      vert_cur_min[x] = y == h - 1
-                            ? FirstStep(c, cur, n)
-                            : PathStep(c, vert_prev.data() + size_t(x) * (n + 2) + 1, vert_prev_min[x], cur, n, p1, p2);
-      AddTo(srow + size_t(x) * n, cur, n);
-    }
-    std::swap(vert_prev, vert_cur);
-    std::swap(vert_prev_min, vert_cur_min);
-    winner_take_all(y, srow);
+    const uint16_t* srow = sum + size_t(y) * w * stride;
+    std::copy(srow, srow + size_t(w) * stride, total);
+    vertical(cost + size_t(y) * w * stride, total, y == h - 1, SumMode::kAdd);
+    winner_take_all(y, total);
   }
   return disparity;
+}
+
+}  // namespace
+
+cv::Mat SgmMatch(const CensusImage& left, const CensusImage& right, const cv::Rect& region, int min_disparity,
+                 int num_disparities, const SgmOptions& options) {
+  STEREORIG_CHECK(region.width > 0 && region.height > 0 && num_disparities > 0);
+  STEREORIG_CHECK(region.x >= 0 && region.y >= 0 && region.x + region.width <= left.width &&
+                  region.y + region.height <= left.height);
+#if defined(__AVX2__)
+  if (options.simd) return SgmMatchWith<sgm::Avx2Kernels>(left, right, region, min_disparity, num_disparities, options);
+#endif
+  return SgmMatchWith<sgm::ScalarKernels>(left, right, region, min_disparity, num_disparities, options);
 }
 
 }  // namespace stereorig

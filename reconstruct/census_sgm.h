@@ -1,7 +1,9 @@
 // Census transform and semi-global matching (SGM) on a rectified 8-bit pair,
-// our own implementation, written so the compiler vectorises the hot loops:
-// costs are uint8 Hamming distances of 62-bit census signatures (9x7 window),
-// path costs are uint16, one contiguous run of disparities per pixel.
+// our own implementation: costs are uint8 Hamming distances of census
+// signatures (up to 9x7 window, 62 bits), path costs are uint16, one
+// contiguous run of disparities per pixel. The inner loops (sgm_kernels.h)
+// run in AVX2 where the build has it, else portably; both give the same
+// disparities.
 //
 // Disparity convention everywhere in reconstruct/: a left pixel x matches the
 // right pixel x - d (rectified rows are aligned, so d >= 0 for points in
@@ -19,11 +21,13 @@ namespace stereorig {
 struct CensusImage {
   int width = 0;
   int height = 0;
-  std::vector<uint64_t> bits;  // (height, width), row-major
-  const uint64_t* row(int y) const { return bits.data() + size_t(y) * width; }
+  int row_begin = 0;           // first row held
+  std::vector<uint64_t> bits;  // (rows held, width), row-major
+  // Row y of the image; y must be one of the rows computed.
+  const uint64_t* row(int y) const { return bits.data() + size_t(y - row_begin) * width; }
 };
 
-// Computes signatures for rows [row_begin, row_end) only (others stay 0), on
+// Computes signatures for rows [row_begin, row_end) only (only those are held), on
 // `num_threads` threads. `grey` is CV_8UC1. The window is (2*half_width+1) x
 // (2*half_height+1) px, at most 63 bits.
 // Columns outside [col_begin, col_end) are left 0 too (only the columns the
@@ -39,6 +43,7 @@ struct SgmOptions {
   int num_paths = 4;           // 3 (left, right, top: one pass, no volume kept) or 4 (+bottom); default 4
   int uniqueness_percent = 5;  // best cost must beat every cost off the best+-1 by this %; default 5
   int lr_max_diff_px = 1;      // left-right consistency tolerance, whole px; default 1
+  bool simd = true;            // AVX2 kernels if the build has them (else scalar); false = scalar; default true
   void Check() const;          // throws InputError naming the bad field
 };
 
@@ -49,5 +54,8 @@ struct SgmOptions {
 // uniqueness test failed, or the best cost sits at the edge of the range.
 cv::Mat SgmMatch(const CensusImage& left, const CensusImage& right, const cv::Rect& region, int min_disparity,
                  int num_disparities, const SgmOptions& options);
+
+// True if this build has the AVX2 kernels (SgmOptions::simd uses them).
+bool SgmSimdAvailable();
 
 }  // namespace stereorig

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "calib/core/input_error.h"
+#include "reconstruct/disparity_band.h"
 #include "reconstruct/parallel_for.h"
 
 namespace stereorig {
@@ -201,33 +202,72 @@ void DisparitySlopes(const cv::Mat& disparity, cv::Mat* slope_x, cv::Mat* slope_
     }
 }
 
-// The band of disparities a half-resolution SGM finds in the ROI:
-// [2nd percentile - margin, 98th percentile + margin], within the given range.
-// Returns false (keep the full range) if too few pixels matched.
+// The band of disparities a half-resolution SGM finds in the ROI
+// (disparity_band.h), within the given range. Returns false (keep the full
+// range) if too few pixels matched.
 bool OccupiedBand(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const MatchOptions& o, int* dmin,
                   int* num) {
   cv::Mat lh, rh;
   cv::resize(left, lh, cv::Size(left.cols / 2, left.rows / 2), 0, 0, cv::INTER_AREA);
   cv::resize(right, rh, cv::Size(right.cols / 2, right.rows / 2), 0, 0, cv::INTER_AREA);
   const cv::Rect half(roi.x / 2, roi.y / 2, std::max(1, roi.width / 2), std::max(1, roi.height / 2));
-  const cv::Mat d = MatchLevel(lh, rh, half & cv::Rect(0, 0, lh.cols, lh.rows), int(std::floor(*dmin / 2.0)) - 1,
-                               (*num + 1) / 2 + 3, 0, o);
-  std::vector<float> v;
+  cv::Mat d = MatchLevel(lh, rh, half & cv::Rect(0, 0, lh.cols, lh.rows), int(std::floor(*dmin / 2.0)) - 1,
+                         (*num + 1) / 2 + 3, 0, o);
+  // The coarse level's mismatches are mostly small blobs: removing them
+  // first leaves the band to the surfaces (disparity_band.h).
+  MatchOptions blobs = o;
+  blobs.speckle_window_px = kCoarseSpeckleWindowPx;
+  blobs.speckle_range_px = kCoarseSpeckleRangePx;
+  RemoveSpeckles(d, blobs);
+  std::vector<float> v;  // full-resolution px
   for (int y = 0; y < d.rows; ++y)
     for (int x = 0; x < d.cols; ++x)
-      if (!std::isnan(d.at<float>(y, x))) v.push_back(d.at<float>(y, x));
-  if (v.size() < 200) return false;
-  std::sort(v.begin(), v.end());
-  const int lo = int(std::floor(2 * v[v.size() * 2 / 100])) - o.range_margin_px;
-  const int hi = int(std::ceil(2 * v[v.size() * 98 / 100])) + o.range_margin_px;
-  const int new_min = std::max(*dmin, lo), new_max = std::min(*dmin + *num - 1, hi);
+      if (std::isfinite(d.at<float>(y, x))) v.push_back(2 * d.at<float>(y, x));
+  const std::optional<DisparityBand> band = OccupiedDisparityBand(v, o.range_margin_px);
+  if (!band) return false;
+  const int new_min = std::max(*dmin, band->min_px), new_max = std::min(*dmin + *num - 1, band->max_px);
   if (new_max - new_min < 8) return false;
   *dmin = new_min;
   *num = new_max - new_min + 1;
   return true;
 }
 
-MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const MatchOptions& o) {
+// OpenCV StereoSGBM (MODE_SGBM_3WAY) over `roi` and the full range, in place
+// of census SGM only: the filters and the sub-pixel step after it are the
+// same as ours, so the baseline differs in the correspondence step alone.
+// Its own speckle filter is off (ours runs after), its uniqueness and
+// left-right tolerance are ours. Returns CV_32FC1 of roi.size(), NaN = invalid.
+cv::Mat SgbmRegion(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const MatchOptions& o) {
+  // SGBM needs the right image at the same column indices, so both images
+  // are cut to the ROI widened on the left by the largest disparity; those
+  // extra columns are the margin SGBM leaves invalid anyway.
+  const int num16 = (o.num_disparities + 15) / 16 * 16;
+  const int dmax = o.min_disparity_px + num16;
+  const int x0 = std::max(0, roi.x - std::max(0, dmax));
+  const int x1 = std::min(left.cols, roi.x + roi.width + std::max(0, -o.min_disparity_px));
+  const cv::Rect cut(x0, roi.y, x1 - x0, roi.height);
+  const int bs = o.sgbm_block_size;
+  cv::Ptr<cv::StereoSGBM> sgbm =
+      cv::StereoSGBM::create(o.min_disparity_px, num16, bs, 8 * bs * bs, 32 * bs * bs, o.sgm.lr_max_diff_px, 63,
+                             o.sgm.uniqueness_percent, 0, 0, cv::StereoSGBM::MODE_SGBM_3WAY);
+  cv::Mat fixed;
+  sgbm->compute(left(cut), right(cut), fixed);
+  cv::Mat out(roi.size(), CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  const double dmax_valid = o.min_disparity_px + o.num_disparities - 1;
+  for (int y = 0; y < cut.height; ++y) {
+    const int16_t* f = fixed.ptr<int16_t>(y);
+    float* d = out.ptr<float>(y);
+    for (int x = std::max(roi.x, x0); x < roi.x + roi.width; ++x) {
+      const int16_t v = f[x - x0];
+      if (v < o.min_disparity_px * 16) continue;  // SGBM's invalid marker
+      const double disp = v / 16.0;
+      if (disp <= dmax_valid) d[x - roi.x] = float(disp);
+    }
+  }
+  return out;
+}
+
+MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const MatchOptions& o) {
   MatchResult result;
   auto t = std::chrono::steady_clock::now();
   auto lap = [&](const char* step) {
@@ -236,10 +276,12 @@ MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::
     t = now;
   };
   int dmin = o.min_disparity_px, num = o.num_disparities;
-  if (o.narrow_range && o.pyramid_levels == 0) OccupiedBand(left, right, roi, o, &dmin, &num);
-  lap("band");
-  const cv::Mat coarse_to_fine = MatchLevel(left, right, roi, dmin, num, o.pyramid_levels, o);
-  lap("sgm");
+  const bool sgbm = o.matcher == MatcherKind::kOpenCvSgbm3Way;
+  if (!sgbm && o.narrow_range && o.pyramid_levels == 0) OccupiedBand(left, right, roi, o, &dmin, &num);
+  if (!sgbm) lap("band");
+  const cv::Mat coarse_to_fine =
+      sgbm ? SgbmRegion(left, right, roi, o) : MatchLevel(left, right, roi, dmin, num, o.pyramid_levels, o);
+  lap(sgbm ? "sgbm" : "sgm");
   result.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
   result.confidence = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
   const double dmax = o.min_disparity_px + o.num_disparities - 1;
@@ -292,43 +334,6 @@ MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::
   return result;
 }
 
-MatchResult MatchOpenCvSgbm(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const MatchOptions& o) {
-  // SGBM needs the right image at the same column indices, so both images
-  // are cut to the ROI widened on the left by the largest disparity; those
-  // extra columns are the margin SGBM leaves invalid anyway.
-  const int num16 = (o.num_disparities + 15) / 16 * 16;
-  const int dmax = o.min_disparity_px + num16;
-  const int x0 = std::max(0, roi.x - std::max(0, dmax));
-  const int x1 = std::min(left.cols, roi.x + roi.width + std::max(0, -o.min_disparity_px));
-  const cv::Rect cut(x0, roi.y, x1 - x0, roi.height);
-  const int bs = o.sgbm_block_size;
-  cv::Ptr<cv::StereoSGBM> sgbm = cv::StereoSGBM::create(
-      o.min_disparity_px, num16, bs, 8 * bs * bs, 32 * bs * bs, o.sgm.lr_max_diff_px, 63, 10, o.speckle_window_px,
-      std::max(1, int(std::lround(o.speckle_range_px))), cv::StereoSGBM::MODE_SGBM_3WAY);
-  cv::Mat fixed;
-  const auto t0 = std::chrono::steady_clock::now();
-  sgbm->compute(left(cut), right(cut), fixed);
-  MatchResult result;
-  result.times_ms["sgbm"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  result.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
-  result.confidence = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
-  const double dmax_valid = o.min_disparity_px + o.num_disparities - 1;
-  for (int y = 0; y < cut.height; ++y) {
-    const int16_t* f = fixed.ptr<int16_t>(y);
-    float* d = result.disparity_px.ptr<float>(roi.y + y);
-    float* c = result.confidence.ptr<float>(roi.y + y);
-    for (int x = std::max(roi.x, x0); x < roi.x + roi.width; ++x) {
-      const int16_t v = f[x - x0];
-      if (v < o.min_disparity_px * 16) continue;  // SGBM's invalid marker
-      const double disp = v / 16.0;
-      if (disp > dmax_valid) continue;
-      d[x] = float(disp);
-      c[x] = 1.0f;
-    }
-  }
-  return result;
-}
-
 }  // namespace
 
 MatchResult Match(const cv::Mat& left, const cv::Mat& right, const MatchOptions& options) {
@@ -337,8 +342,7 @@ MatchResult Match(const cv::Mat& left, const cv::Mat& right, const MatchOptions&
   if (left.size() != right.size()) throw InputError("match", "left and right images differ in size");
   const cv::Rect roi = ClampRoi(options.roi, left.size());
   if (roi.width <= 0 || roi.height <= 0) throw InputError("roi", "does not overlap the image");
-  if (options.matcher == MatcherKind::kOpenCvSgbm3Way) return MatchOpenCvSgbm(left, right, roi, options);
-  return MatchCensusSgm(left, right, roi, options);
+  return MatchRefineFilter(left, right, roi, options);
 }
 
 }  // namespace stereorig

@@ -1,0 +1,107 @@
+#include "reconstruct/census_sgm.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+
+namespace stereorig {
+namespace {
+
+// Bitwise equality of two CV_32FC1 disparity maps (NaN = NaN); counts the
+// valid pixels of the first.
+int ExpectIdentical(const cv::Mat& a, const cv::Mat& b, const std::string& what) {
+  EXPECT_EQ(a.size(), b.size()) << what;
+  int valid = 0, differ = 0;
+  for (int y = 0; y < a.rows; ++y)
+    for (int x = 0; x < a.cols; ++x) {
+      const float va = a.at<float>(y, x), vb = b.at<float>(y, x);
+      valid += !std::isnan(va);
+      differ += std::memcmp(&va, &vb, sizeof(float)) != 0;
+    }
+  EXPECT_EQ(differ, 0) << what;
+  return valid;
+}
+
+cv::Mat RandomImage(std::mt19937& rng, int w, int h) {
+  cv::Mat img(h, w, CV_8UC1);
+  std::uniform_int_distribution<int> grey(0, 255);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) img.at<uint8_t>(y, x) = uint8_t(grey(rng));
+  return img;
+}
+
+TEST(CensusSgm, SimdAndScalarPathsGiveIdenticalDisparities) {
+  if (!SgmSimdAvailable()) GTEST_SKIP() << "this build has no AVX2 kernels (STEREORIG_NATIVE off or no AVX2)";
+  std::mt19937 rng(5);
+  const int w = 120, h = 50;
+  int cases = 0, valid_total = 0;
+  // Random texture and a right view shifted by 7 px (so many pixels match
+  // and the valid path is exercised), and pure noise on both sides (so the
+  // uniqueness and left-right rejections are). Ranges: below, at and above
+  // multiples of 16 lanes, n = 3, negative minimum, regions at the borders
+  // where part of the range falls off the right image.
+  const cv::Mat left = RandomImage(rng, w, h);
+  cv::Mat shifted(h, w, CV_8UC1);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) shifted.at<uint8_t>(y, x) = left.at<uint8_t>(y, std::min(w - 1, x + 7));
+  const cv::Mat noise = RandomImage(rng, w, h);
+  for (const cv::Mat* right : std::vector<const cv::Mat*>{&shifted, &noise}) {
+    for (const int half_width : {2, 4}) {
+      const CensusImage cl = CensusTransform(left, 0, h, 1, half_width, 3);
+      const CensusImage cr = CensusTransform(*right, 0, h, 1, half_width, 3);
+      for (const int n : {3, 15, 16, 17, 33, 64})
+        for (const int min_d : {-5, 0, 4})
+          for (const cv::Rect& region : {cv::Rect(0, 0, w, h), cv::Rect(3, 5, 40, 30), cv::Rect(w - 30, 10, 30, 20)})
+            for (const int paths : {3, 4}) {
+              SgmOptions o;
+              o.num_paths = paths;
+              o.p1 = paths == 3 ? 8 : 11;
+              o.p2 = paths == 3 ? 80 : 1000;  // the largest p2 the options allow
+              o.simd = true;
+              const cv::Mat simd = SgmMatch(cl, cr, region, min_d, n, o);
+              o.simd = false;
+              const cv::Mat scalar = SgmMatch(cl, cr, region, min_d, n, o);
+              valid_total += ExpectIdentical(simd, scalar,
+                                             "n " + std::to_string(n) + " min " + std::to_string(min_d) + " paths " +
+                                                 std::to_string(paths) + " x " + std::to_string(region.x));
+              ++cases;
+            }
+    }
+  }
+  EXPECT_EQ(cases, 2 * 2 * 6 * 3 * 3 * 2);
+  // Not vacuous: the shifted cases match most pixels whose range holds 7.
+  EXPECT_GT(valid_total, 20000);
+}
+
+TEST(CensusSgm, FindsAKnownShiftOnRandomTexture) {
+  // Independent of the implementation: the right view is the left one moved
+  // by exactly 7 px, so every valid interior pixel must say 7 (+-0.5: the
+  // equiangular fit on a noise-free integer shift stays within the pixel).
+  std::mt19937 rng(7);
+  const int w = 100, h = 40;
+  const cv::Mat left = RandomImage(rng, w, h);
+  cv::Mat right(h, w, CV_8UC1);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) right.at<uint8_t>(y, x) = left.at<uint8_t>(y, std::min(w - 1, x + 7));
+  for (const bool simd : {true, false}) {
+    SgmOptions o;
+    o.simd = simd;
+    const cv::Rect region(20, 0, 70, h);
+    const cv::Mat d = SgmMatch(CensusTransform(left, 0, h, 2), CensusTransform(right, 0, h, 2), region, 0, 20, o);
+    int valid = 0, wrong = 0;
+    for (int y = 4; y < h - 4; ++y)
+      for (int x = 0; x < region.width - 6; ++x) {
+        const float v = d.at<float>(y, x);
+        if (std::isnan(v)) continue;
+        ++valid;
+        wrong += std::abs(v - 7.0f) > 0.5f;
+      }
+    EXPECT_GT(valid, 0.9 * (h - 8) * (region.width - 6)) << "simd " << simd;
+    EXPECT_EQ(wrong, 0) << "simd " << simd;
+  }
+}
+
+}  // namespace
+}  // namespace stereorig

@@ -1,0 +1,239 @@
+// The inner loops of census SGM (census_sgm.cc), twice: a portable scalar
+// version over exactly n disparities, and an AVX2 version (AVX-512
+// VPOPCNTDQ for the census costs where the CPU has it) over n rounded up to
+// a multiple of 16 lanes. Both give bit-identical disparities
+// (census_sgm_test.cc checks it on random data): the padding lanes of every
+// path cost are forced to kBig, so they never win a min and never feed a
+// real lane: they equal the kBig sentinel the scalar path reads at [n].
+//
+// Layout, shared with census_sgm.cc: per pixel one contiguous run of
+// `stride` disparities; path buffers have a kBig sentinel at [-1] and
+// [stride].
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
+namespace stereorig::sgm {
+
+inline constexpr uint16_t kBig = 0x3FFF;  // "impossible" path cost; 4 x kBig still fits uint16
+
+// What a path step does with the sum of paths: start it, or add to it.
+enum class SumMode { kStore, kAdd };
+
+inline void Accumulate(uint16_t* sum, uint16_t v, SumMode mode) {
+  *sum = mode == SumMode::kStore ? v : uint16_t(*sum + v);
+}
+
+struct ScalarKernels {
+  static int Stride(int n) { return n; }
+
+  // c[d] = popcount(l ^ r[d]) for d in [lo, hi); the caller fills the rest.
+  static void Cost(uint64_t l, const uint64_t* r, uint8_t* c, int lo, int hi, int /*stride*/) {
+    for (int d = lo; d < hi; ++d) c[d] = uint8_t(__builtin_popcountll(l ^ r[d]));
+  }
+
+  // One SGM recursion step along a path:
+  //   cur[d] = c[d] + min(prev[d], prev[d-1]+p1, prev[d+1]+p1, prev_min+p2) - prev_min,
+  // accumulated into sum[d]. Returns min_d cur[d].
+  static uint16_t Step(const uint8_t* __restrict c, const uint16_t* __restrict prev, uint16_t prev_min,
+                       uint16_t* __restrict cur, uint16_t* __restrict sum, SumMode mode, int n, int /*stride*/,
+                       uint16_t p1, uint16_t p2) {
+    const uint16_t cap = uint16_t(prev_min + p2);
+    uint16_t m = 0xFFFF;
+    for (int d = 0; d < n; ++d) {
+      const uint16_t a = std::min(prev[d], cap);
+      const uint16_t b = std::min(uint16_t(prev[d - 1] + p1), uint16_t(prev[d + 1] + p1));
+      const uint16_t r = uint16_t(c[d] + std::min(a, b) - prev_min);
+      cur[d] = r;
+      Accumulate(sum + d, r, mode);
+      m = std::min(m, r);
+    }
+    return m;
+  }
+
+  // The first pixel of a path: cur = c.
+  static uint16_t First(const uint8_t* __restrict c, uint16_t* __restrict cur, uint16_t* __restrict sum, SumMode mode,
+                        int n, int /*stride*/) {
+    uint16_t m = 0xFFFF;
+    for (int d = 0; d < n; ++d) {
+      cur[d] = c[d];
+      Accumulate(sum + d, c[d], mode);
+      m = std::min(m, cur[d]);
+    }
+    return m;
+  }
+
+  // rb[-d] = min(rb[-d], s[d]) for d in [0, n).
+  static void RightBest(const uint16_t* __restrict s, int n, int /*stride*/, uint16_t* rb) {
+    for (int d = 0; d < n; ++d) rb[-d] = std::min(rb[-d], s[d]);
+  }
+
+  static uint16_t Min(const uint16_t* s, int n) {
+    uint16_t m = 0xFFFF;
+    for (int i = 0; i < n; ++i) m = std::min(m, s[i]);
+    return m;
+  }
+
+  // The smallest cost and its first index.
+  static uint16_t Best(const uint16_t* s, int n, int /*stride*/, int* index) {
+    const uint16_t m = Min(s, n);
+    *index = int(std::find(s, s + n, m) - s);
+    return m;
+  }
+
+  // The smallest cost off best-1..best+1 (0xFFFF if there is none).
+  static uint16_t SecondBest(uint16_t* s, int n, int /*stride*/, int best) {
+    return std::min(Min(s, best - 1), Min(s + best + 2, n - best - 2));
+  }
+};
+
+#if defined(__AVX2__)
+struct Avx2Kernels {
+  static int Stride(int n) { return (n + 15) / 16 * 16; }
+
+  static __m256i Load(const uint16_t* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); }
+  static void Store(uint16_t* p, __m256i v) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), v); }
+
+  static uint16_t HorizontalMin(__m256i v) {
+    const __m128i m = _mm_min_epu16(_mm256_castsi256_si128(v), _mm256_extracti128_si256(v, 1));
+    return uint16_t(_mm_cvtsi128_si32(_mm_minpos_epu16(m)));
+  }
+
+  // kBig in lanes >= k, 0 below: max() with it pins the padding lanes.
+  static __m256i PadMask(int k) {
+    const __m256i lane = _mm256_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    return _mm256_and_si256(_mm256_cmpgt_epi16(lane, _mm256_set1_epi16(int16_t(k - 1))), _mm256_set1_epi16(kBig));
+  }
+
+  static void Accumulate(uint16_t* sum, __m256i v, SumMode mode) {
+    Store(sum, mode == SumMode::kStore ? v : _mm256_add_epi16(Load(sum), v));
+  }
+
+  // All `stride` lanes (lo, hi ignored: the caller overwrites lanes outside
+  // them, and r must be readable over [0, stride)).
+  static void Cost(uint64_t l, const uint64_t* r, uint8_t* c, int /*lo*/, int /*hi*/, int stride) {
+#if defined(__AVX512VPOPCNTDQ__) && defined(__AVX512F__)
+    const __m512i vl = _mm512_set1_epi64(int64_t(l));
+    for (int d = 0; d < stride; d += 16) {
+      const __m512i a = _mm512_popcnt_epi64(_mm512_xor_si512(vl, _mm512_loadu_si512(r + d)));
+      const __m512i b = _mm512_popcnt_epi64(_mm512_xor_si512(vl, _mm512_loadu_si512(r + d + 8)));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(c + d),
+                       _mm_unpacklo_epi64(_mm512_maskz_cvtepi64_epi8(0xFF, a), _mm512_maskz_cvtepi64_epi8(0xFF, b)));
+    }
+#else
+    // Nibble-table popcount (pshufb), summed per 64-bit lane (psadbw).
+    const __m256i table = _mm256_setr_epi8(0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4,  //
+                                           0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4);
+    const __m256i nibble = _mm256_set1_epi8(0x0F);
+    const __m256i vl = _mm256_set1_epi64x(int64_t(l));
+    auto count4 = [&](const uint64_t* p) {
+      const __m256i x = _mm256_xor_si256(vl, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)));
+      const __m256i lo = _mm256_shuffle_epi8(table, _mm256_and_si256(x, nibble));
+      const __m256i hi = _mm256_shuffle_epi8(table, _mm256_and_si256(_mm256_srli_epi16(x, 4), nibble));
+      return _mm256_sad_epu8(_mm256_add_epi8(lo, hi), _mm256_setzero_si256());  // 4 counts, one per qword
+    };
+    // After the shifts, qword q holds the counts of d = q, 4+q, 8+q, 12+q in
+    // its bytes 0..3; gather the low dwords, then transpose the 4x4 bytes.
+    const __m256i low_dwords = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);
+    const __m128i transpose = _mm_setr_epi8(0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15);
+    for (int d = 0; d < stride; d += 16) {
+      const __m256i t = _mm256_or_si256(
+          _mm256_or_si256(count4(r + d), _mm256_slli_epi64(count4(r + d + 4), 8)),
+          _mm256_or_si256(_mm256_slli_epi64(count4(r + d + 8), 16), _mm256_slli_epi64(count4(r + d + 12), 24)));
+      const __m128i packed = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(t, low_dwords));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(c + d), _mm_shuffle_epi8(packed, transpose));
+    }
+#endif
+  }
+
+  static uint16_t Step(const uint8_t* __restrict c, const uint16_t* __restrict prev, uint16_t prev_min,
+                       uint16_t* __restrict cur, uint16_t* __restrict sum, SumMode mode, int n, int stride, uint16_t p1,
+                       uint16_t p2) {
+    const __m256i vp1 = _mm256_set1_epi16(int16_t(p1));
+    const __m256i cap = _mm256_set1_epi16(int16_t(uint16_t(prev_min + p2)));
+    const __m256i vprev_min = _mm256_set1_epi16(int16_t(prev_min));
+    __m256i m = _mm256_set1_epi16(-1);
+    for (int d = 0; d < stride; d += 16) {
+      const __m256i cost = _mm256_cvtepu8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(c + d)));
+      const __m256i a = _mm256_min_epu16(Load(prev + d), cap);
+      const __m256i b =
+          _mm256_min_epu16(_mm256_add_epi16(Load(prev + d - 1), vp1), _mm256_add_epi16(Load(prev + d + 1), vp1));
+      __m256i r = _mm256_sub_epi16(_mm256_add_epi16(cost, _mm256_min_epu16(a, b)), vprev_min);
+      if (d + 16 > n) r = _mm256_max_epu16(r, PadMask(n - d));
+      Store(cur + d, r);
+      Accumulate(sum + d, r, mode);
+      m = _mm256_min_epu16(m, r);
+    }
+    return HorizontalMin(m);
+  }
+
+  static uint16_t First(const uint8_t* __restrict c, uint16_t* __restrict cur, uint16_t* __restrict sum, SumMode mode,
+                        int n, int stride) {
+    __m256i m = _mm256_set1_epi16(-1);
+    for (int d = 0; d < stride; d += 16) {
+      __m256i r = _mm256_cvtepu8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(c + d)));
+      if (d + 16 > n) r = _mm256_max_epu16(r, PadMask(n - d));
+      Store(cur + d, r);
+      Accumulate(sum + d, r, mode);
+      m = _mm256_min_epu16(m, r);
+    }
+    return HorizontalMin(m);
+  }
+
+  // rb[-d] = min(rb[-d], s[d]) over all lanes (padding lanes hold >= 3 kBig,
+  // above any real sum, so they change nothing a real lane reads); rb must
+  // be writable down to rb[-(stride-1)].
+  static void RightBest(const uint16_t* __restrict s, int /*n*/, int stride, uint16_t* rb) {
+    const __m256i reverse = _mm256_setr_epi8(14, 15, 12, 13, 10, 11, 8, 9, 6, 7, 4, 5, 2, 3, 0, 1,  //
+                                             14, 15, 12, 13, 10, 11, 8, 9, 6, 7, 4, 5, 2, 3, 0, 1);
+    for (int d = 0; d < stride; d += 16) {
+      const __m256i v = _mm256_permute4x64_epi64(_mm256_shuffle_epi8(Load(s + d), reverse), 0x4E);
+      uint16_t* dst = rb - d - 15;
+      Store(dst, _mm256_min_epu16(Load(dst), v));
+    }
+  }
+
+  static uint16_t Min(const uint16_t* s, int stride) {
+    __m256i m = _mm256_set1_epi16(-1);
+    for (int d = 0; d < stride; d += 16) m = _mm256_min_epu16(m, Load(s + d));
+    return HorizontalMin(m);
+  }
+
+  static uint16_t Best(const uint16_t* s, int /*n*/, int stride, int* index) {
+    const uint16_t m = Min(s, stride);
+    const __m256i vm = _mm256_set1_epi16(int16_t(m));
+    for (int d = 0; d < stride; d += 16) {
+      const unsigned mask = unsigned(_mm256_movemask_epi8(_mm256_cmpeq_epi16(Load(s + d), vm)));
+      if (mask) {
+        *index = d + __builtin_ctz(mask) / 2;
+        return m;
+      }
+    }
+    *index = 0;  // unreachable: m is one of the lanes
+    return m;
+  }
+
+  // Lanes best-1..best+1 are masked out in registers (a scalar write then a
+  // vector read of the same bytes would stall store forwarding). With no
+  // lane left (n == 3) the padding's >= 3 kBig stands in for 0xFFFF: both
+  // pass any uniqueness test (uniqueness_percent <= 50).
+  static uint16_t SecondBest(uint16_t* s, int /*n*/, int stride, int best) {
+    const __m256i lane = _mm256_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    const __m256i lo = _mm256_set1_epi16(int16_t(best - 2)), hi = _mm256_set1_epi16(int16_t(best + 2));
+    __m256i m = _mm256_set1_epi16(-1);
+    for (int d = 0; d < stride; d += 16) {
+      const __m256i index = _mm256_add_epi16(lane, _mm256_set1_epi16(int16_t(d)));
+      const __m256i near = _mm256_and_si256(_mm256_cmpgt_epi16(index, lo), _mm256_cmpgt_epi16(hi, index));
+      m = _mm256_min_epu16(m, _mm256_or_si256(Load(s + d), near));
+    }
+    return HorizontalMin(m);
+  }
+};
+#endif  // __AVX2__
+
+}  // namespace stereorig::sgm
