@@ -82,6 +82,22 @@ double TiltDeg(const Pose& cam_from_face) {
 
 }  // namespace
 
+bool LensmodelNeedsRegularization(const std::string& lensmodel) {
+  return lensmodel != "LENSMODEL_PINHOLE" && lensmodel != "LENSMODEL_OPENCV4" && lensmodel != "LENSMODEL_OPENCV5";
+}
+
+int SolveFinal(MrcalProblem* p, bool verbose) {
+  p->selections.do_apply_regularization = true;
+  p->selections.do_apply_outlier_rejection = true;
+  p->Optimize(verbose);
+  if (!LensmodelNeedsRegularization(p->lensmodel_name)) {
+    p->selections.do_apply_regularization = false;
+    p->selections.do_apply_outlier_rejection = false;
+    p->Optimize(verbose);
+  }
+  return p->CountNonPositiveWeights();
+}
+
 double BoardResidualRms(const MrcalProblem& p, const std::vector<double>& x) {
   const int n = p.corners_x * p.corners_y * p.num_observations();
   double s2 = 0;
@@ -209,7 +225,8 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
   const int missing = p.CountNonPositiveWeights();
 
   // Step 1: the board poses alone. Step 2: with the lens core. Step 3: all,
-  // distortions regularised, outliers rejected.
+  // distortions regularised, outliers rejected (then unregularised, see
+  // SolveFinal).
   p.selections = {.do_optimize_intrinsics_core = false,
                   .do_optimize_intrinsics_distortions = false,
                   .do_optimize_extrinsics = true,
@@ -221,9 +238,7 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
   p.selections.do_optimize_intrinsics_core = true;
   p.Optimize(options.verbose);
   p.selections.do_optimize_intrinsics_distortions = true;
-  p.selections.do_apply_regularization = true;
-  p.selections.do_apply_outlier_rejection = true;
-  const mrcal_stats_t stats = p.Optimize(options.verbose);
+  const int non_positive = SolveFinal(&p, options.verbose);
 
   result.camera = Camera(options.lensmodel, p.intrinsics, spec.width_px, spec.height_px, cam_where);
   for (const mrcal_pose_t& f : p.frames_toref) result.cam_from_face.push_back(MrcalProblem::FromMrcal(f));
@@ -234,8 +249,8 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
   r.lensmodel = options.lensmodel;
   r.num_views = static_cast<int>(views.size());
   r.num_views_dropped = dropped;
-  r.num_outliers = stats.Noutliers - missing;
-  r.num_corners = static_cast<int>(p.pool.size()) - stats.Noutliers;
+  r.num_outliers = non_positive - missing;
+  r.num_corners = static_cast<int>(p.pool.size()) - non_positive;
   r.max_tilt_deg = max_tilt;
   const std::vector<double> x = p.Residuals();
   r.rms_px = BoardResidualRms(p, x);

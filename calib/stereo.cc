@@ -129,9 +129,7 @@ StereoResult CalibrateStereo(int module, const ModuleLayout& layout, const Intri
   p.Optimize(options.verbose);
   p.selections.do_optimize_intrinsics_core = true;
   p.selections.do_optimize_intrinsics_distortions = true;
-  p.selections.do_apply_regularization = true;
-  p.selections.do_apply_outlier_rejection = true;
-  const mrcal_stats_t stats = p.Optimize(options.verbose);
+  const int non_positive = SolveFinal(&p, options.verbose);
 
   const int np = p.num_params();
   result.left = Camera(iopt.lensmodel, std::vector<double>(p.intrinsics.begin(), p.intrinsics.begin() + np),
@@ -148,7 +146,7 @@ StereoResult CalibrateStereo(int module, const ModuleLayout& layout, const Intri
   r.num_frames = p.num_frames();
   const std::vector<double> x = p.Residuals();
   r.rms_px = BoardResidualRms(p, x);
-  r.num_outliers = stats.Noutliers - missing;
+  r.num_outliers = non_positive - missing;
   r.baseline_mm = result.right_from_left.DistanceMm();
   r.rotation_deg = result.right_from_left.AngleDeg();
   r.right_from_left_rotation_vector_deg = result.right_from_left.RotationVector() * 180.0 / M_PI;
