@@ -153,8 +153,12 @@ void FillCoverageAndUncertainty(const MrcalProblem& p, int icam, const Intrinsic
       r->coverage.size();
 
   r->uncertainty_range_mm = options.uncertainty_range_mm;
+  const int np = p.num_params();
+  r->intrinsics.assign(p.intrinsics.begin() + icam * np, p.intrinsics.begin() + (icam + 1) * np);
   ProjectionUncertaintyEvaluator eval(p);
   if (!eval.ok()) return;  // leaves the uncertainty empty; the caller reports it
+  const Eigen::MatrixXd cov = eval.IntrinsicsCovariance(icam);
+  for (int i = 0; i < np; ++i) r->intrinsics_sigma.push_back(std::sqrt(std::max(0.0, cov(i, i))));
   r->observed_sigma_px = eval.observed_pixel_sigma_px();
   const std::vector<std::pair<std::string, Eigen::Vector2d>> at = {{"centre", {0.5 * (width - 1), 0.5 * (height - 1)}},
                                                                    {"top-left", {0, 0}},

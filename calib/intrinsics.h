@@ -68,6 +68,8 @@ struct IntrinsicsReport {
   double coverage_fraction = 0.0;             // cells holding at least one corner
   std::vector<PixelUncertainty> uncertainty;  // centre and the four image corners
   double uncertainty_range_mm = 0.0;
+  std::vector<double> intrinsics;        // (Nparams,) as solved, mrcal's order (fx fy cx cy k1 k2 p1 p2 k3 ...)
+  std::vector<double> intrinsics_sigma;  // (Nparams,) their 1 sigma from the solve's covariance; empty if none
 };
 
 struct IntrinsicsResult {
@@ -107,7 +109,8 @@ void FillPoolBlock(const BoardObservation& obs, const TargetGeometry& target, mr
 // RMS of the inlier board residual coordinates (x and y pooled), px: directly
 // comparable with a per-coordinate corner noise sigma.
 double BoardResidualRms(const MrcalProblem& problem, const std::vector<double>& x);
-// Reports for a solved problem: per-view residuals, coverage, uncertainty.
+// Reports for a solved problem: per-view residuals, coverage, uncertainty
+// (projection, and the intrinsics' own 1 sigma).
 std::vector<ViewResidual> ViewResiduals(const MrcalProblem& problem, const std::vector<double>& x,
                                         const std::vector<int>& view_capture, int icam_intrinsics);
 void FillCoverageAndUncertainty(const MrcalProblem& problem, int icam_intrinsics, const IntrinsicsOptions& options,
