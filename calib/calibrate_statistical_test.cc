@@ -29,6 +29,7 @@ struct SeedFigures {
   // Reported parameter error / reported 1 sigma (z-scores):
   std::vector<std::vector<double>> intrinsics_z;  // stage 1: (cameras, Nparams)
   std::vector<std::vector<double>> stereo_z;      // stage 2: (modules, kStereoParams)
+  std::vector<double> refined_baseline_z;         // the rig file's (stage 3) baseline error / stage 2's sigma
   double seconds = 0;
 };
 
@@ -94,6 +95,8 @@ SeedFigures RunSeed(unsigned seed, CalibrationResult* out = nullptr) {
                   st.right_from_left_translation_sigma_mm(i));
     }
     f.stereo_z.push_back(z);
+    f.refined_baseline_z.push_back((r.rig.module(st.module).right_from_left.DistanceMm() - t.DistanceMm()) /
+                                   st.baseline_sigma_mm);
   }
   const auto points = VolumePoints(scene.ref_from_volume, Eigen::Vector3d(75, 75, 50), 500, seed + 1000);
   for (int k = 0; k < 2; ++k) {

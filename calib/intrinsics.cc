@@ -48,7 +48,8 @@ Pose SeedPose(const BoardObservation& obs, const TargetGeometry& target, double 
   }
   const cv::Matx33d K(f_px, 0, 0.5 * (width - 1), 0, f_px, 0.5 * (height - 1), 0, 0, 1);
   cv::Mat rvec, tvec;
-  cv::solvePnP(object, image, K, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_IPPE);
+  const bool ok = cv::solvePnP(object, image, K, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_IPPE);
+  STEREORIG_CHECK(ok && rvec.total() == 3 && tvec.total() == 3);  // views span a plane (CornersSpanAPlane)
   Pose pose = Pose::FromRotationVector(Eigen::Vector3d(rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2)),
                                        Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2)));
   return pose;
@@ -81,6 +82,17 @@ double TiltDeg(const Pose& cam_from_face) {
 }
 
 }  // namespace
+
+bool CornersSpanAPlane(const std::vector<int>& corner_ids, int corners_x) {
+  if (corner_ids.empty()) return false;
+  bool two_rows = false, two_cols = false;
+  const int row0 = corner_ids[0] / corners_x, col0 = corner_ids[0] % corners_x;
+  for (int id : corner_ids) {
+    two_rows |= id / corners_x != row0;
+    two_cols |= id % corners_x != col0;
+  }
+  return two_rows && two_cols;
+}
 
 bool LensmodelNeedsRegularization(const std::string& lensmodel) {
   return lensmodel != "LENSMODEL_PINHOLE" && lensmodel != "LENSMODEL_OPENCV4" && lensmodel != "LENSMODEL_OPENCV5";
@@ -179,7 +191,10 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
   int dropped = 0;
   for (const BoardObservation* v : all_views) {
     STEREORIG_CHECK(v->camera == camera);
-    if (static_cast<int>(v->corner_ids.size()) >= options.min_corners_per_view) {
+    // A view whose corners lie on one row or column of the board is
+    // collinear: no pose follows from it (PnP fails), so it is dropped.
+    if (static_cast<int>(v->corner_ids.size()) >= options.min_corners_per_view &&
+        CornersSpanAPlane(v->corner_ids, target.corners_x)) {
       views.push_back(v);
     } else {
       ++dropped;

@@ -103,6 +103,9 @@ bool LensmodelNeedsRegularization(const std::string& lensmodel);
 // more without it (the outliers found stay out). Returns the number of pool
 // entries with weight <= 0 afterwards (missing corners + outliers).
 int SolveFinal(MrcalProblem* problem, bool verbose);
+// True if the corners span at least two rows and two columns of the board
+// (not all collinear), so that a board pose follows from them.
+bool CornersSpanAPlane(const std::vector<int>& corner_ids, int corners_x);
 // Fills one observation's (corners_y, corners_x) pool block: seen corners
 // with weight 1, the others with weight -1.
 void FillPoolBlock(const BoardObservation& obs, const TargetGeometry& target, mrcal_point3_t* block);
