@@ -4,6 +4,7 @@
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
+#include <optional>
 
 #include "calib/core/input_error.h"
 #include "calib/projection_uncertainty.h"
@@ -37,8 +38,10 @@ void FillPoolBlock(const BoardObservation& obs, const TargetGeometry& target, mr
 namespace {
 
 // The seed pose of one view from PnP through a distortion-free pinhole with
-// focal `f_px` and the centre at the middle of the imager.
-Pose SeedPose(const BoardObservation& obs, const TargetGeometry& target, double f_px, int width, int height) {
+// focal `f_px` and the centre at the middle of the imager; nullopt if PnP
+// fails (a nearly collinear view: seen in the target study, 13x11 board).
+std::optional<Pose> SeedPose(const BoardObservation& obs, const TargetGeometry& target, double f_px, int width,
+                             int height) {
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
   for (size_t k = 0; k < obs.corner_ids.size(); ++k) {
@@ -49,7 +52,7 @@ Pose SeedPose(const BoardObservation& obs, const TargetGeometry& target, double 
   const cv::Matx33d K(f_px, 0, 0.5 * (width - 1), 0, f_px, 0.5 * (height - 1), 0, 0, 1);
   cv::Mat rvec, tvec;
   const bool ok = cv::solvePnP(object, image, K, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_IPPE);
-  STEREORIG_CHECK(ok && rvec.total() == 3 && tvec.total() == 3);  // views span a plane (CornersSpanAPlane)
+  if (!ok || rvec.total() != 3 || tvec.total() != 3) return std::nullopt;
   Pose pose = Pose::FromRotationVector(Eigen::Vector3d(rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2)),
                                        Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2)));
   return pose;
@@ -208,6 +211,24 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
 
   const double f_seed =
       options.seed_focal_px > 0 ? options.seed_focal_px : EstimateFocal(views, target, spec.width_px, spec.height_px);
+  std::vector<Pose> seeds;
+  {
+    std::vector<const BoardObservation*> posed;
+    for (const BoardObservation* v : views) {
+      const std::optional<Pose> seed = SeedPose(*v, target, f_seed, spec.width_px, spec.height_px);
+      if (!seed) {
+        ++dropped;
+        continue;
+      }
+      posed.push_back(v);
+      seeds.push_back(*seed);
+    }
+    views = posed;
+  }
+  if (static_cast<int>(views.size()) < options.min_views) {
+    throw InputError(cam_where, "too few views with a board pose: " + std::to_string(views.size()) +
+                                    ", need at least " + std::to_string(options.min_views));
+  }
 
   MrcalProblem p;
   STEREORIG_CHECK(p.SetLensmodel(options.lensmodel));
@@ -226,7 +247,7 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
   p.pool.resize(views.size() * n);
   double max_tilt = 0;
   for (size_t k = 0; k < views.size(); ++k) {
-    const Pose seed = SeedPose(*views[k], target, f_seed, spec.width_px, spec.height_px);
+    const Pose& seed = seeds[k];
     max_tilt = std::max(max_tilt, TiltDeg(seed));
     p.frames_toref.push_back(MrcalProblem::ToMrcal(seed));
     p.observations.push_back({.icam = {.intrinsics = 0, .extrinsics = -1}, .iframe = static_cast<int>(k)});
