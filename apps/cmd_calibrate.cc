@@ -39,9 +39,9 @@ int RunCalibrate(int argc, char** argv) {
   app.add_option("--out", out_path, "rig file to write (YAML)")->required();
   app.add_option("--report", report_path, "JSON report to write (every figure of every stage)")->required();
   app.add_option("--export-cameramodels", cameramodels_dir, "also write DIR/camK.cameramodel (mrcal format)");
-  app.add_option(
-         "--lensmodel", options.intrinsics.lensmodel,
-         "LENSMODEL_OPENCV5, LENSMODEL_OPENCV8 or LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=.._Ny=.._fov_x_deg=..")
+  app.add_option("--lensmodel", options.intrinsics.lensmodel,
+                 "LENSMODEL_OPENCV5 (solved without regularisation), or LENSMODEL_OPENCV8 or "
+                 "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=.._Ny=.._fov_x_deg=.. (both keep mrcal's regularisation)")
       ->capture_default_str();
   app.add_option("--focal", options.intrinsics.seed_focal_px, "rough focal length for the PnP seed, px (0: estimate)")
       ->capture_default_str();

@@ -243,6 +243,7 @@ void WriteIntrinsics(JsonWriter& j, const IntrinsicsReport& r) {
     j.Number("sigma_px", u.rms_stdev_px).Number("worst_direction_sigma_px", u.worst_direction_stdev_px).EndObject();
   }
   j.EndArray().EndObject();
+  j.Numbers("intrinsics", r.intrinsics).Numbers("intrinsics_sigma", r.intrinsics_sigma);
   j.EndObject();
 }
 
@@ -271,6 +272,13 @@ std::string CalibrationReport::ToJson() const {
     j.Numbers("right_from_left_translation_mm",
               {s.right_from_left_translation_mm.x(), s.right_from_left_translation_mm.y(),
                s.right_from_left_translation_mm.z()});
+    j.Number("baseline_sigma_mm", s.baseline_sigma_mm).Number("rotation_sigma_deg", s.rotation_sigma_deg);
+    j.Numbers("right_from_left_rotation_vector_sigma_deg",
+              {s.right_from_left_rotation_vector_sigma_deg.x(), s.right_from_left_rotation_vector_sigma_deg.y(),
+               s.right_from_left_rotation_vector_sigma_deg.z()});
+    j.Numbers("right_from_left_translation_sigma_mm",
+              {s.right_from_left_translation_sigma_mm.x(), s.right_from_left_translation_sigma_mm.y(),
+               s.right_from_left_translation_sigma_mm.z()});
     j.Number("rectified_row_rms_px", s.rectified_row_rms_px).Number("rectified_row_max_px", s.rectified_row_max_px);
     j.Int("corner_pairs", s.num_corner_pairs);
     j.BeginArray("cameras_joint_solve");
@@ -364,6 +372,12 @@ std::string SummaryText(const CalibrationReport& rep) {
                "centre / %.3f px worst corner (at %.0f mm)",
                r.camera_name.c_str(), r.lensmodel.c_str(), r.num_views, r.num_corners, r.rms_px, r.num_outliers,
                100.0 * r.coverage_fraction, centre, worst_corner, r.uncertainty_range_mm);
+    if (r.intrinsics.size() >= 4 && r.intrinsics_sigma.size() == r.intrinsics.size()) {
+      const auto& v = r.intrinsics;
+      const auto& e = r.intrinsics_sigma;
+      AppendLine(&out, "    fx %.2f +- %.2f, fy %.2f +- %.2f, cx %.2f +- %.2f, cy %.2f +- %.2f px (1 sigma)", v[0],
+                 e[0], v[1], e[1], v[2], e[2], v[3], e[3]);
+    }
     if (!r.worst_views.empty()) {
       AppendLine(&out, "    worst view: capture %d, rms %.3f px", r.worst_views[0].capture, r.worst_views[0].rms_px);
     }
@@ -371,10 +385,11 @@ std::string SummaryText(const CalibrationReport& rep) {
   AppendLine(&out, "stage 2: stereo extrinsics per module");
   for (const StereoReport& s : rep.stereo) {
     AppendLine(&out,
-               "  %s: baseline %.3f mm, rotation %.3f deg, rms %.3f px, %d outliers, rectified-row error %.3f px rms "
-               "(max %.3f) over %d corner pairs, %d shared views",
-               s.module_name.c_str(), s.baseline_mm, s.rotation_deg, s.rms_px, s.num_outliers, s.rectified_row_rms_px,
-               s.rectified_row_max_px, s.num_corner_pairs, s.num_shared_views);
+               "  %s: baseline %.4f +- %.4f mm, rotation %.4f +- %.4f deg (1 sigma), rms %.3f px, %d outliers, "
+               "rectified-row error %.3f px rms (max %.3f) over %d corner pairs, %d shared views",
+               s.module_name.c_str(), s.baseline_mm, s.baseline_sigma_mm, s.rotation_deg, s.rotation_sigma_deg,
+               s.rms_px, s.num_outliers, s.rectified_row_rms_px, s.rectified_row_max_px, s.num_corner_pairs,
+               s.num_shared_views);
   }
   if (rep.num_modules > 1) {
     const SystemReport& s = rep.system;

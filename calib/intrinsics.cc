@@ -4,6 +4,7 @@
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
+#include <optional>
 
 #include "calib/core/input_error.h"
 #include "calib/projection_uncertainty.h"
@@ -37,8 +38,10 @@ void FillPoolBlock(const BoardObservation& obs, const TargetGeometry& target, mr
 namespace {
 
 // The seed pose of one view from PnP through a distortion-free pinhole with
-// focal `f_px` and the centre at the middle of the imager.
-Pose SeedPose(const BoardObservation& obs, const TargetGeometry& target, double f_px, int width, int height) {
+// focal `f_px` and the centre at the middle of the imager; nullopt if PnP
+// fails (a nearly collinear view: seen in the target study, 13x11 board).
+std::optional<Pose> SeedPose(const BoardObservation& obs, const TargetGeometry& target, double f_px, int width,
+                             int height) {
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
   for (size_t k = 0; k < obs.corner_ids.size(); ++k) {
@@ -48,7 +51,8 @@ Pose SeedPose(const BoardObservation& obs, const TargetGeometry& target, double 
   }
   const cv::Matx33d K(f_px, 0, 0.5 * (width - 1), 0, f_px, 0.5 * (height - 1), 0, 0, 1);
   cv::Mat rvec, tvec;
-  cv::solvePnP(object, image, K, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_IPPE);
+  const bool ok = cv::solvePnP(object, image, K, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_IPPE);
+  if (!ok || rvec.total() != 3 || tvec.total() != 3) return std::nullopt;
   Pose pose = Pose::FromRotationVector(Eigen::Vector3d(rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2)),
                                        Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2)));
   return pose;
@@ -81,6 +85,33 @@ double TiltDeg(const Pose& cam_from_face) {
 }
 
 }  // namespace
+
+bool CornersSpanAPlane(const std::vector<int>& corner_ids, int corners_x) {
+  if (corner_ids.empty()) return false;
+  bool two_rows = false, two_cols = false;
+  const int row0 = corner_ids[0] / corners_x, col0 = corner_ids[0] % corners_x;
+  for (int id : corner_ids) {
+    two_rows |= id / corners_x != row0;
+    two_cols |= id % corners_x != col0;
+  }
+  return two_rows && two_cols;
+}
+
+bool LensmodelNeedsRegularization(const std::string& lensmodel) {
+  return lensmodel != "LENSMODEL_PINHOLE" && lensmodel != "LENSMODEL_OPENCV4" && lensmodel != "LENSMODEL_OPENCV5";
+}
+
+int SolveFinal(MrcalProblem* p, bool verbose) {
+  p->selections.do_apply_regularization = true;
+  p->selections.do_apply_outlier_rejection = true;
+  p->Optimize(verbose);
+  if (!LensmodelNeedsRegularization(p->lensmodel_name)) {
+    p->selections.do_apply_regularization = false;
+    p->selections.do_apply_outlier_rejection = false;
+    p->Optimize(verbose);
+  }
+  return p->CountNonPositiveWeights();
+}
 
 double BoardResidualRms(const MrcalProblem& p, const std::vector<double>& x) {
   const int n = p.corners_x * p.corners_y * p.num_observations();
@@ -137,8 +168,12 @@ void FillCoverageAndUncertainty(const MrcalProblem& p, int icam, const Intrinsic
       r->coverage.size();
 
   r->uncertainty_range_mm = options.uncertainty_range_mm;
+  const int np = p.num_params();
+  r->intrinsics.assign(p.intrinsics.begin() + icam * np, p.intrinsics.begin() + (icam + 1) * np);
   ProjectionUncertaintyEvaluator eval(p);
   if (!eval.ok()) return;  // leaves the uncertainty empty; the caller reports it
+  const Eigen::MatrixXd cov = eval.IntrinsicsCovariance(icam);
+  for (int i = 0; i < np; ++i) r->intrinsics_sigma.push_back(std::sqrt(std::max(0.0, cov(i, i))));
   r->observed_sigma_px = eval.observed_pixel_sigma_px();
   const std::vector<std::pair<std::string, Eigen::Vector2d>> at = {{"centre", {0.5 * (width - 1), 0.5 * (height - 1)}},
                                                                    {"top-left", {0, 0}},
@@ -159,7 +194,10 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
   int dropped = 0;
   for (const BoardObservation* v : all_views) {
     STEREORIG_CHECK(v->camera == camera);
-    if (static_cast<int>(v->corner_ids.size()) >= options.min_corners_per_view) {
+    // A view whose corners lie on one row or column of the board is
+    // collinear: no pose follows from it (PnP fails), so it is dropped.
+    if (static_cast<int>(v->corner_ids.size()) >= options.min_corners_per_view &&
+        CornersSpanAPlane(v->corner_ids, target.corners_x)) {
       views.push_back(v);
     } else {
       ++dropped;
@@ -173,6 +211,24 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
 
   const double f_seed =
       options.seed_focal_px > 0 ? options.seed_focal_px : EstimateFocal(views, target, spec.width_px, spec.height_px);
+  std::vector<Pose> seeds;
+  {
+    std::vector<const BoardObservation*> posed;
+    for (const BoardObservation* v : views) {
+      const std::optional<Pose> seed = SeedPose(*v, target, f_seed, spec.width_px, spec.height_px);
+      if (!seed) {
+        ++dropped;
+        continue;
+      }
+      posed.push_back(v);
+      seeds.push_back(*seed);
+    }
+    views = posed;
+  }
+  if (static_cast<int>(views.size()) < options.min_views) {
+    throw InputError(cam_where, "too few views with a board pose: " + std::to_string(views.size()) +
+                                    ", need at least " + std::to_string(options.min_views));
+  }
 
   MrcalProblem p;
   STEREORIG_CHECK(p.SetLensmodel(options.lensmodel));
@@ -191,7 +247,7 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
   p.pool.resize(views.size() * n);
   double max_tilt = 0;
   for (size_t k = 0; k < views.size(); ++k) {
-    const Pose seed = SeedPose(*views[k], target, f_seed, spec.width_px, spec.height_px);
+    const Pose& seed = seeds[k];
     max_tilt = std::max(max_tilt, TiltDeg(seed));
     p.frames_toref.push_back(MrcalProblem::ToMrcal(seed));
     p.observations.push_back({.icam = {.intrinsics = 0, .extrinsics = -1}, .iframe = static_cast<int>(k)});
@@ -209,7 +265,8 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
   const int missing = p.CountNonPositiveWeights();
 
   // Step 1: the board poses alone. Step 2: with the lens core. Step 3: all,
-  // distortions regularised, outliers rejected.
+  // distortions regularised, outliers rejected (then unregularised, see
+  // SolveFinal).
   p.selections = {.do_optimize_intrinsics_core = false,
                   .do_optimize_intrinsics_distortions = false,
                   .do_optimize_extrinsics = true,
@@ -221,9 +278,7 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
   p.selections.do_optimize_intrinsics_core = true;
   p.Optimize(options.verbose);
   p.selections.do_optimize_intrinsics_distortions = true;
-  p.selections.do_apply_regularization = true;
-  p.selections.do_apply_outlier_rejection = true;
-  const mrcal_stats_t stats = p.Optimize(options.verbose);
+  const int non_positive = SolveFinal(&p, options.verbose);
 
   result.camera = Camera(options.lensmodel, p.intrinsics, spec.width_px, spec.height_px, cam_where);
   for (const mrcal_pose_t& f : p.frames_toref) result.cam_from_face.push_back(MrcalProblem::FromMrcal(f));
@@ -234,8 +289,8 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
   r.lensmodel = options.lensmodel;
   r.num_views = static_cast<int>(views.size());
   r.num_views_dropped = dropped;
-  r.num_outliers = stats.Noutliers - missing;
-  r.num_corners = static_cast<int>(p.pool.size()) - stats.Noutliers;
+  r.num_outliers = non_positive - missing;
+  r.num_corners = static_cast<int>(p.pool.size()) - non_positive;
   r.max_tilt_deg = max_tilt;
   const std::vector<double> x = p.Residuals();
   r.rms_px = BoardResidualRms(p, x);

@@ -22,8 +22,10 @@ struct IntrinsicsOptions {
   // Lens model as mrcal spells it: LENSMODEL_OPENCV5, LENSMODEL_OPENCV8, or a
   // splined stereographic one such as
   // LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=16_Ny=12_fov_x_deg=50.
-  // Default LENSMODEL_OPENCV8.
-  std::string lensmodel = "LENSMODEL_OPENCV8";
+  // Default LENSMODEL_OPENCV5: it holds a mild lens such as the default
+  // rig's, and it is the richest model that needs no regularisation (see
+  // LensmodelNeedsRegularization), so its fit and its sigma are unbiased.
+  std::string lensmodel = "LENSMODEL_OPENCV5";
   double seed_focal_px = 0.0;    // rough focal length for the PnP seed, px; 0 (default): from the views' homographies
   int min_corners_per_view = 8;  // views with fewer corners are not used; default 8
   int min_views = 5;             // fewer usable views is an input error; default 5
@@ -66,6 +68,8 @@ struct IntrinsicsReport {
   double coverage_fraction = 0.0;             // cells holding at least one corner
   std::vector<PixelUncertainty> uncertainty;  // centre and the four image corners
   double uncertainty_range_mm = 0.0;
+  std::vector<double> intrinsics;        // (Nparams,) as solved, mrcal's order (fx fy cx cy k1 k2 p1 p2 k3 ...)
+  std::vector<double> intrinsics_sigma;  // (Nparams,) their 1 sigma from the solve's covariance; empty if none
 };
 
 struct IntrinsicsResult {
@@ -84,13 +88,32 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
                                      const IntrinsicsOptions& options, const std::string& where);
 
 // Shared helpers for the mrcal problems of stages 1 and 2.
+// False for the lens models whose every parameter the boards determine
+// (PINHOLE, OPENCV4, OPENCV5): their final solve runs without
+// regularisation, so the result is the plain least-squares optimum (as
+// OpenCV's) and its covariance has no regularisation bias. True for the
+// others: a spline's knots outside the observed region, and the rational
+// k4..k6 of OPENCV8/12 (which trade off with k1..k3 over a lens's field),
+// are otherwise undetermined; measured on the default rig, an unregularised
+// OPENCV8 gave NaN uncertainties and 1e6-sigma S errors.
+bool LensmodelNeedsRegularization(const std::string& lensmodel);
+// The last step of a staged mrcal solve: everything selected for
+// optimisation is solved with the distortions regularised and outliers
+// rejected; then, for a model that does not need the regularisation, once
+// more without it (the outliers found stay out). Returns the number of pool
+// entries with weight <= 0 afterwards (missing corners + outliers).
+int SolveFinal(MrcalProblem* problem, bool verbose);
+// True if the corners span at least two rows and two columns of the board
+// (not all collinear), so that a board pose follows from them.
+bool CornersSpanAPlane(const std::vector<int>& corner_ids, int corners_x);
 // Fills one observation's (corners_y, corners_x) pool block: seen corners
 // with weight 1, the others with weight -1.
 void FillPoolBlock(const BoardObservation& obs, const TargetGeometry& target, mrcal_point3_t* block);
 // RMS of the inlier board residual coordinates (x and y pooled), px: directly
 // comparable with a per-coordinate corner noise sigma.
 double BoardResidualRms(const MrcalProblem& problem, const std::vector<double>& x);
-// Reports for a solved problem: per-view residuals, coverage, uncertainty.
+// Reports for a solved problem: per-view residuals, coverage, uncertainty
+// (projection, and the intrinsics' own 1 sigma).
 std::vector<ViewResidual> ViewResiduals(const MrcalProblem& problem, const std::vector<double>& x,
                                         const std::vector<int>& view_capture, int icam_intrinsics);
 void FillCoverageAndUncertainty(const MrcalProblem& problem, int icam_intrinsics, const IntrinsicsOptions& options,

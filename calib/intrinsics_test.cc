@@ -104,3 +104,18 @@ TEST(Intrinsics, RefusesTooFewViews) {
 
 }  // namespace
 }  // namespace stereorig
+
+namespace stereorig {
+namespace {
+
+// A view whose corners lie on one board row or column has no pose (PnP on
+// collinear points fails); such views are dropped before seeding.
+TEST(Intrinsics, CollinearCornersDoNotSpanAPlane) {
+  EXPECT_FALSE(CornersSpanAPlane({0, 1, 2, 3, 4, 5, 6, 7, 8}, 9));  // the first row of a 9-wide board
+  EXPECT_FALSE(CornersSpanAPlane({4, 13, 22, 31, 40, 49, 58}, 9));  // one column
+  EXPECT_TRUE(CornersSpanAPlane({0, 1, 2, 3, 4, 5, 6, 7, 17}, 9));  // one corner off the row
+  EXPECT_FALSE(CornersSpanAPlane({}, 9));
+}
+
+}  // namespace
+}  // namespace stereorig

@@ -106,8 +106,7 @@ ProjectionUncertainty ProjectionUncertaintyEvaluator::AtPoint(int icam_intrinsic
                                                       0, nullptr));
 
   // dq/db, shape (2, Nstate), in full (unpacked) units first.
-  Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::RowMajor> dq_db =
-      Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::RowMajor>::Zero(2, Nstate);
+  StateGradient dq_db = StateGradient::Zero(2, Nstate);
 
   // p_ref: the point in the reference frame.
   Eigen::Vector3d p_ref = p_cam;
@@ -180,55 +179,85 @@ ProjectionUncertainty ProjectionUncertaintyEvaluator::AtPoint(int icam_intrinsic
     dq_db.block(0, istate_frames, 2, dpref_dframes.cols()) = dq_dpcam * dpref_dframes;
   }
 
+  ProjectionUncertainty out;
+  out.covariance_px2 = Covariance(dq_db);
+  const double a = out.covariance_px2(0, 0), bb = out.covariance_px2(1, 0), cc = out.covariance_px2(1, 1);
+  out.rms_stdev_px = std::sqrt(0.5 * (a + cc));
+  out.worst_direction_stdev_px = std::sqrt(0.5 * (a + cc) + std::sqrt(0.25 * (a - cc) * (a - cc) + bb * bb));
+  return out;
+}
+
+Eigen::MatrixXd ProjectionUncertaintyEvaluator::Covariance(const StateGradient& dy_db_unpacked) const {
+  const Impl& m = *impl_;
+  STEREORIG_CHECK(m.ok);
+  STEREORIG_CHECK(dy_db_unpacked.cols() == m.num_states);
+  const MrcalProblem& p = *m.problem;
+  const int Nstate = m.num_states;
+  const int k = static_cast<int>(dy_db_unpacked.rows());
   // To the packed state: d/db* = d/db D. mrcal's "unpack" multiplies by D.
-  for (int r = 0; r < 2; ++r) {
-    mrcal_unpack_solver_state_vector(dq_db.row(r).data(), p.num_intrinsics_cameras, p.num_extrinsics(), p.num_frames(),
+  StateGradient dy_db = dy_db_unpacked;
+  for (int r = 0; r < k; ++r) {
+    mrcal_unpack_solver_state_vector(dy_db.row(r).data(), p.num_intrinsics_cameras, p.num_extrinsics(), p.num_frames(),
                                      0, 0, p.selections, &p.lensmodel);
   }
 
-  // A = inv(J'J) dq_db' : (Nstate, 2).
+  // A = inv(J'J) dy_db' : (Nstate, k), column-major.
   cholmod_common* c = &impl_->common;
-  cholmod_dense* B = cholmod_allocate_dense(Nstate, 2, Nstate, CHOLMOD_REAL, c);
+  cholmod_dense* B = cholmod_allocate_dense(Nstate, k, Nstate, CHOLMOD_REAL, c);
   double* Bx = static_cast<double*>(B->x);
-  for (int r = 0; r < 2; ++r)
-    for (int i = 0; i < Nstate; ++i) Bx[r * Nstate + i] = dq_db(r, i);
+  for (int r = 0; r < k; ++r)
+    for (int i = 0; i < Nstate; ++i) Bx[r * Nstate + i] = dy_db(r, i);
   cholmod_dense* A = cholmod_solve(CHOLMOD_A, m.factor, B, c);
   STEREORIG_CHECK(A != nullptr);
-  const double* Ax = static_cast<const double*>(A->x);
+  const Eigen::Map<const Eigen::MatrixXd> Am(static_cast<const double*>(A->x), Nstate, k);
 
-  Eigen::Matrix2d var = Eigen::Matrix2d::Zero();
+  Eigen::MatrixXd var = Eigen::MatrixXd::Zero(k, k);
   if (m.has_regularization) {
     // Var = A' J_obs' J_obs A: sum over the observation rows of J of the
     // outer product of (J_row . A).
     const int* Jp = static_cast<const int*>(m.Jt->p);
     const int* Ji = static_cast<const int*>(m.Jt->i);
     const double* Jx = static_cast<const double*>(m.Jt->x);
+    Eigen::VectorXd v(k);
     for (int row = 0; row < m.num_measurements_observations; ++row) {
-      Eigen::Vector2d v = Eigen::Vector2d::Zero();
-      for (int k = Jp[row]; k < Jp[row + 1]; ++k) {
-        v(0) += Jx[k] * Ax[Ji[k]];
-        v(1) += Jx[k] * Ax[Nstate + Ji[k]];
-      }
+      v.setZero();
+      for (int e = Jp[row]; e < Jp[row + 1]; ++e) v += Jx[e] * Am.row(Ji[e]).transpose();
       var += v * v.transpose();
     }
   } else {
-    for (int r = 0; r < 2; ++r)
-      for (int s = 0; s < 2; ++s) {
-        double acc = 0;
-        for (int i = 0; i < Nstate; ++i) acc += dq_db(r, i) * Ax[s * Nstate + i];
-        var(r, s) = acc;
-      }
+    var = dy_db * Am;
   }
   cholmod_free_dense(&A, c);
   cholmod_free_dense(&B, c);
+  return var * (m.sigma_px * m.sigma_px);
+}
 
-  ProjectionUncertainty out;
-  const double s2 = m.sigma_px * m.sigma_px;
-  out.covariance_px2 = var * s2;
-  const double a = out.covariance_px2(0, 0), bb = out.covariance_px2(1, 0), cc = out.covariance_px2(1, 1);
-  out.rms_stdev_px = std::sqrt(0.5 * (a + cc));
-  out.worst_direction_stdev_px = std::sqrt(0.5 * (a + cc) + std::sqrt(0.25 * (a - cc) * (a - cc) + bb * bb));
+Eigen::MatrixXd ProjectionUncertaintyEvaluator::IntrinsicsCovariance(int icam) const {
+  const MrcalProblem& p = *impl_->problem;
+  const int Nparams = p.num_params();
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(Nparams, Nparams);
+  const mrcal_lensmodel_metadata_t meta = mrcal_lensmodel_metadata(&p.lensmodel);
+  const int Ncore = meta.has_core ? 4 : 0;
+  const int i0 = (meta.has_core && !p.selections.do_optimize_intrinsics_core) ? Ncore : 0;
+  const int i1 = p.selections.do_optimize_intrinsics_distortions ? Nparams : Ncore;
+  if (i1 <= i0) return out;
+  const int istate = mrcal_state_index_intrinsics(icam, p.num_intrinsics_cameras, p.num_extrinsics(), p.num_frames(), 0,
+                                                  0, p.num_observations(), p.selections, &p.lensmodel);
+  StateGradient g = StateGradient::Zero(i1 - i0, impl_->num_states);
+  for (int i = 0; i < i1 - i0; ++i) g(i, istate + i) = 1.0;
+  out.block(i0, i0, i1 - i0, i1 - i0) = Covariance(g);
   return out;
+}
+
+Eigen::Matrix<double, 6, 6> ProjectionUncertaintyEvaluator::ExtrinsicsCovariance(int icam_extrinsics) const {
+  const MrcalProblem& p = *impl_->problem;
+  STEREORIG_CHECK(p.selections.do_optimize_extrinsics && icam_extrinsics >= 0 && icam_extrinsics < p.num_extrinsics());
+  const int istate =
+      mrcal_state_index_extrinsics(icam_extrinsics, p.num_intrinsics_cameras, p.num_extrinsics(), p.num_frames(), 0, 0,
+                                   p.num_observations(), p.selections, &p.lensmodel);
+  StateGradient g = StateGradient::Zero(6, impl_->num_states);
+  for (int i = 0; i < 6; ++i) g(i, istate + i) = 1.0;
+  return Covariance(g);
 }
 
 ProjectionUncertainty ProjectionUncertaintyEvaluator::AtPixel(int icam_intrinsics, const Eigen::Vector2d& q_px,

@@ -11,6 +11,10 @@
 // frame maps it back to the reference, the results are averaged, and the mean
 // is projected. dq/db therefore involves the intrinsics, the camera's
 // extrinsics and every frame. J' is factorised with CHOLMOD, as mrcal does.
+//
+// The same covariance gives the 1 sigma of the solved parameters themselves
+// (IntrinsicsCovariance, ExtrinsicsCovariance), or of any function of the
+// state through its gradient (Covariance).
 #pragma once
 
 #include <Eigen/Core>
@@ -26,6 +30,10 @@ struct ProjectionUncertainty {
   double rms_stdev_px = 0.0;                                 // sqrt(trace / 2): mrcal's 'rms-stdev'
   double worst_direction_stdev_px = 0.0;  // sqrt of the larger eigenvalue: mrcal's 'worstdirection-stdev'
 };
+
+// Gradients of k functions of the state, (k, Nstate), with respect to the
+// unpacked state (mrcal's units: intrinsics as stored, rt in rad and mm).
+using StateGradient = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 class ProjectionUncertaintyEvaluator {
  public:
@@ -49,6 +57,18 @@ class ProjectionUncertaintyEvaluator {
   // The same for the point that the solved camera sees at pixel `q_px`, at
   // `range_mm` from the camera centre.
   ProjectionUncertainty AtPixel(int icam_intrinsics, const Eigen::Vector2d& q_px, double range_mm) const;
+
+  // Var(y) (k, k) of y = f(state) with dy/db = `dy_db` (k, Nstate, unpacked),
+  // scaled by the observed noise: sigma^2 dy_db inv(J'J) dy_db' without
+  // regularisation, the sandwich above with it.
+  Eigen::MatrixXd Covariance(const StateGradient& dy_db) const;
+  // Covariance (Nparams, Nparams) of intrinsics camera `icam_intrinsics`'s
+  // parameters, in mrcal's order and units; rows and columns of parameters
+  // the solve did not optimise are 0.
+  Eigen::MatrixXd IntrinsicsCovariance(int icam_intrinsics) const;
+  // Covariance (6, 6) of extrinsics camera `icam_extrinsics`'s rt_cam_ref
+  // (r: rotation vector, rad; t: mm).
+  Eigen::Matrix<double, 6, 6> ExtrinsicsCovariance(int icam_extrinsics) const;
 
  private:
   struct Impl;

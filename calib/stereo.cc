@@ -5,6 +5,7 @@
 #include <map>
 
 #include "calib/core/input_error.h"
+#include "calib/projection_uncertainty.h"
 
 namespace stereorig {
 
@@ -129,9 +130,7 @@ StereoResult CalibrateStereo(int module, const ModuleLayout& layout, const Intri
   p.Optimize(options.verbose);
   p.selections.do_optimize_intrinsics_core = true;
   p.selections.do_optimize_intrinsics_distortions = true;
-  p.selections.do_apply_regularization = true;
-  p.selections.do_apply_outlier_rejection = true;
-  const mrcal_stats_t stats = p.Optimize(options.verbose);
+  const int non_positive = SolveFinal(&p, options.verbose);
 
   const int np = p.num_params();
   result.left = Camera(iopt.lensmodel, std::vector<double>(p.intrinsics.begin(), p.intrinsics.begin() + np),
@@ -148,11 +147,29 @@ StereoResult CalibrateStereo(int module, const ModuleLayout& layout, const Intri
   r.num_frames = p.num_frames();
   const std::vector<double> x = p.Residuals();
   r.rms_px = BoardResidualRms(p, x);
-  r.num_outliers = stats.Noutliers - missing;
+  r.num_outliers = non_positive - missing;
   r.baseline_mm = result.right_from_left.DistanceMm();
   r.rotation_deg = result.right_from_left.AngleDeg();
   r.right_from_left_rotation_vector_deg = result.right_from_left.RotationVector() * 180.0 / M_PI;
   r.right_from_left_translation_mm = result.right_from_left.translation_mm();
+  {
+    // right_from_left is mrcal's rt_cam_ref of the right camera (extrinsics 0).
+    const ProjectionUncertaintyEvaluator eval(p);
+    if (eval.ok()) {
+      const Eigen::Matrix<double, 6, 6> cov = eval.ExtrinsicsCovariance(0);
+      const Eigen::Vector3d rv(p.extrinsics_fromref[0].r.x, p.extrinsics_fromref[0].r.y, p.extrinsics_fromref[0].r.z);
+      const Eigen::Vector3d t = r.right_from_left_translation_mm;
+      const double deg = 180.0 / M_PI;
+      for (int i = 0; i < 3; ++i) {
+        r.right_from_left_rotation_vector_sigma_deg(i) = std::sqrt(cov(i, i)) * deg;
+        r.right_from_left_translation_sigma_mm(i) = std::sqrt(cov(3 + i, 3 + i));
+      }
+      // The baseline |t| and the angle |r|, through their gradients t/|t| and r/|r|.
+      const Eigen::Vector3d gt = t.normalized(), gr = rv.normalized();
+      r.baseline_sigma_mm = std::sqrt(gt.dot(cov.block<3, 3>(3, 3) * gt));
+      r.rotation_sigma_deg = std::sqrt(gr.dot(cov.block<3, 3>(0, 0) * gr)) * deg;
+    }
+  }
 
   // Corners both cameras saw (inliers in both), for the rectified-row error.
   std::vector<Eigen::Vector2d> ql, qr;

@@ -33,6 +33,12 @@ struct StereoReport {
   double rotation_deg = 0.0;  // angle of right_from_left
   Eigen::Vector3d right_from_left_rotation_vector_deg = Eigen::Vector3d::Zero();
   Eigen::Vector3d right_from_left_translation_mm = Eigen::Vector3d::Zero();
+  // 1 sigma of the above from the joint solve's covariance (mrcal's J'J,
+  // scaled by the observed corner noise); 0 if the covariance failed.
+  double baseline_sigma_mm = 0.0;
+  double rotation_sigma_deg = 0.0;
+  Eigen::Vector3d right_from_left_rotation_vector_sigma_deg = Eigen::Vector3d::Zero();
+  Eigen::Vector3d right_from_left_translation_sigma_mm = Eigen::Vector3d::Zero();
   double rectified_row_rms_px = 0.0;  // over corners both cameras saw
   double rectified_row_max_px = 0.0;
   int num_corner_pairs = 0;

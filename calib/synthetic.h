@@ -5,6 +5,7 @@
 // corners that land on its imager (partial views).
 #pragma once
 
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -36,6 +37,16 @@ struct SyntheticData {
 // engine is told; `true_back_from_front` is how the board really is.
 SyntheticData MakeSyntheticCaptures(const Rig& rig, const TargetGeometry& target, const Pose& true_bff,
                                     const Pose& ref_from_volume, const SyntheticOptions& o);
+
+// The corners of boards at the given poses (`ref_from_front`, one per
+// capture), seen through the TRUE cameras with the noise, margin and
+// minimum corner count of `o` (its pose fields are unused). A camera sees the
+// face its centre is in front of. `true_corner_in_front(face, id)`: where
+// that corner really is, in the front face's frame (mm) - the nominal corner
+// for a perfect board; a scaled, bowed or misaligned one for a study of those.
+using TrueCornerInFront = std::function<Eigen::Vector3d(Face face, int id)>;
+SyntheticData ObserveBoards(const Rig& rig, const TargetGeometry& target, const std::vector<Pose>& ref_from_front,
+                            const TrueCornerInFront& true_corner_in_front, const SyntheticOptions& o);
 
 // Points filling a box (mm, half-sizes) around `ref_from_volume`, in the
 // reference frame: for the 3D accuracy checks.

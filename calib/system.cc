@@ -7,6 +7,7 @@
 #include "calib/core/input_error.h"
 #include "calib/cost_functions.h"
 #include "calib/horn.h"
+#include "calib/intrinsics.h"
 #include "calib/triangulation.h"
 
 namespace stereorig {
@@ -60,7 +61,9 @@ std::vector<std::map<int, ModuleCaptureView>> PoseBoardsByTriangulation(const Ca
         v.p_module.push_back(p);
         x_face.push_back(target.CornerInFace(l.corner_ids[i]));
       }
-      if (static_cast<int>(v.p_module.size()) < min_corners) continue;
+      if (static_cast<int>(v.p_module.size()) < min_corners || !CornersSpanAPlane(v.corner_ids, target.corners_x)) {
+        continue;  // too few, or collinear: no board pose follows
+      }
       const HornResult h = HornAbsoluteOrientation(v.p_module, x_face);
       if (!h.ok) continue;
       v.module_from_front = h.a_from_b * target.FaceFromFront(v.face);

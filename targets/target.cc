@@ -114,8 +114,13 @@ Pose IdealBackFromFront(int corners_x, double square_size_mm, double thickness_m
   return front_from_back.Inverse();
 }
 
-Target DefaultTarget() {
+Target DefaultTarget() { return DoubleSidedTarget(11, 9, 9.0); }
+
+Target DoubleSidedTarget(int corners_x, int corners_y, double square_size_mm) {
   Target::Layout l;
+  l.corners_x = corners_x;
+  l.corners_y = corners_y;
+  l.square_size_mm = square_size_mm;
   l.back_from_front = IdealBackFromFront(l.corners_x, l.square_size_mm, 5.0);
   // As measured on a coordinate measuring machine: 0.01 deg, 0.01 mm (1 sigma).
   l.back_from_front_sigma << 0.01, 0.01, 0.01, 0.01, 0.01, 0.01;
@@ -134,7 +139,7 @@ Target DefaultTarget() {
       }
     }
   }
-  return Target(l, "default target");
+  return Target(l, "double-sided target");
 }
 
 Target PlainTarget(int corners_x, int corners_y, double square_size_mm) {

@@ -87,6 +87,9 @@ class Target {
 // The embedded default: 11x9 inner corners of 9 mm, tag36h11 in the margins
 // (front IDs 0-7, back IDs 100-107), 5 mm plate. docs/simulator.md says why.
 Target DefaultTarget();
+// The default's design at another size: corners_x x corners_y inner corners
+// of square_size_mm, the same tags, margins, plate and measured sigma.
+Target DoubleSidedTarget(int corners_x, int corners_y, double square_size_mm);
 // A plain one-sided chessboard (no tags), e.g. what most labs own.
 Target PlainTarget(int corners_x, int corners_y, double square_size_mm);
 // The ideal back_from_front of a plate of `thickness_mm`, both faces printed
