@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <fstream>
 #include <random>
+#include <unistd.h>
 #include <sstream>
 
 #include "calib/core/camera.h"
@@ -74,8 +75,9 @@ Camera RandomSplined(std::mt19937* rng) {
 void ExpectProjectionMatchesPython(const Camera& cam, unsigned seed) {
   std::mt19937 rng(seed);
   const auto points = RandomPoints(cam, 500, &rng);
-  const std::string dir = ::testing::TempDir();
-  const std::string in = dir + "/proj_in.json", out = dir + "/proj_out.txt";
+  // One file pair per process: ctest -j runs this binary's cases in parallel.
+  const std::string dir = ::testing::TempDir() + "proj_" + std::to_string(getpid());
+  const std::string in = dir + "_in.json", out = dir + "_out.txt";
   {
     std::ofstream f(in);
     f << "{\"lensmodel\": \"" << cam.lensmodel_name() << "\", \"intrinsics\": [";
