@@ -29,7 +29,6 @@ struct SeedFigures {
   // Reported parameter error / reported 1 sigma (z-scores):
   std::vector<std::vector<double>> intrinsics_z;  // stage 1: (cameras, Nparams)
   std::vector<std::vector<double>> stereo_z;      // stage 2: (modules, kStereoParams)
-  std::vector<double> refined_baseline_z;         // the rig file's (stage 3) baseline error / stage 2's sigma
   // The rig file's (stage 3's refined) values against stage 3's own sigma:
   std::vector<std::vector<double>> refined_stereo_z;      // (modules, kStereoParams)
   std::vector<std::vector<double>> refined_intrinsics_z;  // (cameras, Nparams)
@@ -98,8 +97,6 @@ SeedFigures RunSeed(unsigned seed, CalibrationResult* out = nullptr) {
                   st.right_from_left_translation_sigma_mm(i));
     }
     f.stereo_z.push_back(z);
-    f.refined_baseline_z.push_back((r.rig.module(st.module).right_from_left.DistanceMm() - t.DistanceMm()) /
-                                   st.baseline_sigma_mm);
   }
   // Stage 3's refined right_from_left and intrinsics (what the rig file
   // holds), checked on the rig itself, in stage 3's reported sigma.
