@@ -321,6 +321,27 @@ std::string CalibrationReport::ToJson() const {
       j.Numbers("translation_mm", {x.translation_mm.x(), x.translation_mm.y(), x.translation_mm.z()}).EndObject();
     }
     j.EndArray();
+    // The refined values the rig file holds, with their 1 sigma (keys as stage 2's).
+    j.BeginArray("refined_stereo");
+    for (const RefinedStereoSigma& x : s.stereo_sigma) {
+      j.BeginObject().Int("module", x.module);
+      j.Number("baseline_mm", x.baseline_mm).Number("baseline_sigma_mm", x.baseline_sigma_mm);
+      j.Number("rotation_deg", x.rotation_deg).Number("rotation_sigma_deg", x.rotation_sigma_deg);
+      j.Numbers("right_from_left_rotation_vector_deg",
+                {x.rotation_vector_deg.x(), x.rotation_vector_deg.y(), x.rotation_vector_deg.z()});
+      j.Numbers("right_from_left_rotation_vector_sigma_deg",
+                {x.rotation_vector_sigma_deg.x(), x.rotation_vector_sigma_deg.y(), x.rotation_vector_sigma_deg.z()});
+      j.Numbers("right_from_left_translation_mm", {x.translation_mm.x(), x.translation_mm.y(), x.translation_mm.z()});
+      j.Numbers("right_from_left_translation_sigma_mm",
+                {x.translation_sigma_mm.x(), x.translation_sigma_mm.y(), x.translation_sigma_mm.z()});
+      j.EndObject();
+    }
+    j.EndArray().BeginArray("refined_intrinsics");
+    for (const RefinedIntrinsicsSigma& x : s.intrinsics_sigma) {
+      j.BeginObject().Int("camera", x.camera).Numbers("intrinsics", x.intrinsics);
+      j.Numbers("intrinsics_sigma", x.sigma).EndObject();
+    }
+    j.EndArray();
     WritePose(j, "back_from_front_refined", s.back_from_front);
     j.Number("back_from_front_change_deg", s.back_from_front_change_deg);
     j.Number("back_from_front_change_mm", s.back_from_front_change_mm);
@@ -409,6 +430,16 @@ std::string SummaryText(const CalibrationReport& rep) {
                  x.translation_mm.y(), x.translation_mm.z());
     }
     if (s.sigma.empty()) AppendLine(&out, "  1 sigma of S: %s", s.covariance_status.c_str());
+    for (const RefinedStereoSigma& x : s.stereo_sigma) {
+      AppendLine(&out, "  refined module %d: baseline %.4f +- %.4f mm, rotation %.4f +- %.4f deg (1 sigma)", x.module,
+                 x.baseline_mm, x.baseline_sigma_mm, x.rotation_deg, x.rotation_sigma_deg);
+    }
+    for (const RefinedIntrinsicsSigma& x : s.intrinsics_sigma) {
+      const auto& v = x.intrinsics;
+      const auto& e = x.sigma;
+      AppendLine(&out, "  refined camera %d: fx %.2f +- %.2f, fy %.2f +- %.2f, cx %.2f +- %.2f, cy %.2f +- %.2f px",
+                 x.camera, v[0], e[0], v[1], e[1], v[2], e[2], v[3], e[3]);
+    }
     AppendLine(&out, "  back_from_front refined: moved %.4f deg, %.4f mm from the measured",
                s.back_from_front_change_deg, s.back_from_front_change_mm);
   }

@@ -1,6 +1,9 @@
 // End to end and statistical: the engine on synthetic captures of the
 // default rig, over 20 seeds, judged against the truth by the users' own
-// figures, and every reported parameter against its reported 1 sigma.
+// figures, and every reported parameter against its reported 1 sigma: stage 1's
+// intrinsics, stage 2's right_from_left, and stage 3's refined intrinsics and
+// right_from_left (the values the rig file holds, with ceres::Covariance's
+// sigma).
 // Noise: 0.2 px Gaussian per corner coordinate; 25 captures of a 9x7, 12 mm
 // double-sided board.
 #include <gtest/gtest.h>
@@ -29,7 +32,9 @@ struct SeedFigures {
   // Reported parameter error / reported 1 sigma (z-scores):
   std::vector<std::vector<double>> intrinsics_z;  // stage 1: (cameras, Nparams)
   std::vector<std::vector<double>> stereo_z;      // stage 2: (modules, kStereoParams)
-  std::vector<double> refined_baseline_z;         // the rig file's (stage 3) baseline error / stage 2's sigma
+  // The rig file's (stage 3's refined) values against stage 3's own sigma:
+  std::vector<std::vector<double>> refined_stereo_z;      // (modules, kStereoParams)
+  std::vector<std::vector<double>> refined_intrinsics_z;  // (cameras, Nparams)
   double seconds = 0;
 };
 
@@ -95,8 +100,28 @@ SeedFigures RunSeed(unsigned seed, CalibrationResult* out = nullptr) {
                   st.right_from_left_translation_sigma_mm(i));
     }
     f.stereo_z.push_back(z);
-    f.refined_baseline_z.push_back((r.rig.module(st.module).right_from_left.DistanceMm() - t.DistanceMm()) /
-                                   st.baseline_sigma_mm);
+  }
+  // Stage 3's refined right_from_left and intrinsics (what the rig file
+  // holds), checked on the rig itself, in stage 3's reported sigma.
+  for (const RefinedStereoSigma& x : r.report.system.stereo_sigma) {
+    const Pose& t = truth.module(x.module).right_from_left;
+    const Pose& est = r.rig.module(x.module).right_from_left;
+    const Eigen::Vector3d rv_deg = t.RotationVector() * 180.0 / M_PI;
+    const Eigen::Vector3d est_rv_deg = est.RotationVector() * 180.0 / M_PI;
+    std::vector<double> z = {(est.DistanceMm() - t.DistanceMm()) / x.baseline_sigma_mm,
+                             (est.AngleDeg() - t.AngleDeg()) / x.rotation_sigma_deg};
+    for (int i = 0; i < 3; ++i) z.push_back((est_rv_deg(i) - rv_deg(i)) / x.rotation_vector_sigma_deg(i));
+    for (int i = 0; i < 3; ++i) {
+      z.push_back((est.translation_mm()(i) - t.translation_mm()(i)) / x.translation_sigma_mm(i));
+    }
+    f.refined_stereo_z.push_back(z);
+  }
+  for (const RefinedIntrinsicsSigma& x : r.report.system.intrinsics_sigma) {
+    const std::vector<double>& t = truth.camera(x.camera).intrinsics();
+    const std::vector<double>& est = r.rig.camera(x.camera).intrinsics();
+    std::vector<double> z;
+    for (size_t i = 0; i < est.size(); ++i) z.push_back((est[i] - t[i]) / x.sigma[i]);
+    f.refined_intrinsics_z.push_back(z);
   }
   const auto points = VolumePoints(scene.ref_from_volume, Eigen::Vector3d(75, 75, 50), 500, seed + 1000);
   for (int k = 0; k < 2; ++k) {
@@ -262,6 +287,22 @@ TEST(CalibrateE2E, DefaultRigOverSeeds) {
   for (int i = 0; i < kNumStereoParams; ++i) {
     check(
         kStereoParams[i], [i](const SeedFigures& f, int m) { return f.stereo_z[m][i]; }, 2);
+  }
+  // The rig file's values: stage 3's refined intrinsics and right_from_left
+  // against stage 3's ceres::Covariance sigma, by the same rule.
+  for (const auto& f : all) {
+    ASSERT_EQ(f.refined_intrinsics_z.size(), 4u);
+    ASSERT_EQ(f.refined_stereo_z.size(), 2u);
+  }
+  std::printf("stage 3 refined intrinsics vs truth / reported sigma:\n");
+  for (int i = 0; i < 9; ++i) {
+    check(
+        kIntrinsicNames[i], [i](const SeedFigures& f, int cam) { return f.refined_intrinsics_z[cam][i]; }, 4);
+  }
+  std::printf("stage 3 refined right_from_left vs truth / reported sigma:\n");
+  for (int i = 0; i < kNumStereoParams; ++i) {
+    check(
+        kStereoParams[i], [i](const SeedFigures& f, int m) { return f.refined_stereo_z[m][i]; }, 2);
   }
 }
 

@@ -178,11 +178,28 @@ TEST(CalibrateReport, JsonHoldsEveryStage) {
   EXPECT_LT((back.S(0, 1).Inverse() * r.rig.S(0, 1)).DistanceMm(), 1e-9);
   EXPECT_EQ(back.provenance().residuals.count("cam0_rms_px"), 1u);
   EXPECT_EQ(back.provenance().uncertainties.count("S_0_1_translation_mm"), 1u);
-  for (const char* key :
-       {"stage1_intrinsics", "projection_uncertainty", "coverage", "worst_views", "stage2_stereo",
-        "rectified_row_rms_px", "baseline_mm", "stage3_system", "horn_only", "refined", "sigma_S_0_k",
-        "back_from_front_refined", "intrinsics_sigma", "baseline_sigma_mm", "right_from_left_translation_sigma_mm"}) {
+  for (const char* key : {"stage1_intrinsics", "projection_uncertainty", "coverage", "worst_views", "stage2_stereo",
+                          "rectified_row_rms_px", "baseline_mm", "stage3_system", "horn_only", "refined", "sigma_S_0_k",
+                          "back_from_front_refined", "intrinsics_sigma", "baseline_sigma_mm",
+                          "right_from_left_translation_sigma_mm", "refined_stereo", "refined_intrinsics"}) {
     EXPECT_NE(j.find(std::string("\"") + key + "\""), std::string::npos) << key;
+  }
+  // Stage 3's sigmas are of the values the rig file holds: one per module and
+  // camera, every free parameter's positive, OPENCV5 has none held.
+  ASSERT_EQ(r.report.system.stereo_sigma.size(), 2u);
+  for (const RefinedStereoSigma& x : r.report.system.stereo_sigma) {
+    const Pose& rl = r.rig.module(x.module).right_from_left;
+    EXPECT_NEAR(x.baseline_mm, rl.DistanceMm(), 1e-12);
+    EXPECT_NEAR(x.rotation_deg, rl.AngleDeg(), 1e-9);
+    EXPECT_GT(x.baseline_sigma_mm, 0);
+    EXPECT_GT(x.rotation_sigma_deg, 0);
+    EXPECT_GT(x.rotation_vector_sigma_deg.minCoeff(), 0);
+    EXPECT_GT(x.translation_sigma_mm.minCoeff(), 0);
+  }
+  ASSERT_EQ(r.report.system.intrinsics_sigma.size(), 4u);
+  for (const RefinedIntrinsicsSigma& x : r.report.system.intrinsics_sigma) {
+    EXPECT_EQ(x.intrinsics, r.rig.camera(x.camera).intrinsics());
+    for (double e : x.sigma) EXPECT_GT(e, 0);
   }
   // The stereo figures against the truth: 90 mm baseline, 6 deg verging.
   ASSERT_EQ(r.report.stereo.size(), 2u);
@@ -200,6 +217,21 @@ TEST(CalibrateReport, JsonHoldsEveryStage) {
 
 namespace stereorig {
 namespace {
+
+// With the stereo extrinsics and the intrinsics held at stage 2's values,
+// stage 3 reports no sigma for them (the rig file's values are stage 2's,
+// whose sigma stage 2 reports), and S's sigma is still there.
+TEST(CalibrateReport, NoRefinedSigmaForHeldParameters) {
+  const auto s = testing::MakeDefaultScene(67, 12, kNoisePx);
+  CalibrationOptions opt;
+  opt.system.refine_stereo = false;
+  opt.system.refine_intrinsics = false;
+  const CalibrationResult r = Calibrate(s.data.input, opt);
+  EXPECT_TRUE(r.report.system.stereo_sigma.empty());
+  EXPECT_TRUE(r.report.system.intrinsics_sigma.empty());
+  EXPECT_EQ(r.report.system.sigma.size(), 1u);
+  EXPECT_EQ(r.report.system.covariance_status, "ok");
+}
 
 // Judges a calibrated rig file against a simulated dataset's truth (not run
 // by default: it needs a dataset from `stereorig simulate` and a rig from

@@ -28,6 +28,41 @@ ObsIndex IndexObservations(const CalibrationInput& input) {
   return index;
 }
 
+// The refined right_from_left and its 1 sigma from the covariance `cov` (6x6)
+// of its block's (dr rad, t mm). The rotation vector r of Exp(dr) R0 and the
+// angle |r| are non-linear in dr: their Jacobian is taken by central
+// differences (step 1e-6 rad: truncation ~1e-12, far below any sigma).
+RefinedStereoSigma RightFromLeftSigma(int module, const PoseBlock& block, const Eigen::Matrix<double, 6, 6>& cov) {
+  RefinedStereoSigma s;
+  s.module = module;
+  const Pose p = block.ToPose();
+  const Eigen::Vector3d r = p.RotationVector(), t = p.translation_mm();
+  const double deg = 180.0 / M_PI;
+  Eigen::Matrix3d dr_ddr;  // d r / d dr
+  constexpr double kStep = 1e-6;
+  for (int i = 0; i < 3; ++i) {
+    PoseBlock plus = block, minus = block;
+    plus.params[i] += kStep;
+    minus.params[i] -= kStep;
+    dr_ddr.col(i) = (plus.ToPose().RotationVector() - minus.ToPose().RotationVector()) / (2 * kStep);
+  }
+  const Eigen::Matrix3d cov_r = dr_ddr * cov.block<3, 3>(0, 0) * dr_ddr.transpose();
+  const Eigen::Matrix3d cov_t = cov.block<3, 3>(3, 3);
+  s.baseline_mm = t.norm();
+  s.rotation_deg = r.norm() * deg;
+  s.rotation_vector_deg = r * deg;
+  s.translation_mm = t;
+  for (int i = 0; i < 3; ++i) {
+    s.rotation_vector_sigma_deg(i) = std::sqrt(cov_r(i, i)) * deg;
+    s.translation_sigma_mm(i) = std::sqrt(cov_t(i, i));
+  }
+  // The baseline |t| and the angle |r|, through their gradients t/|t|, r/|r|.
+  const Eigen::Vector3d gt = t.normalized(), gr = r.normalized();
+  s.baseline_sigma_mm = std::sqrt(gt.dot(cov_t * gt));
+  s.rotation_sigma_deg = std::sqrt(gr.dot(cov_r * gr)) * deg;
+  return s;
+}
+
 }  // namespace
 
 std::vector<std::map<int, ModuleCaptureView>> PoseBoardsByTriangulation(const CalibrationInput& input,
@@ -296,39 +331,79 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   rep.back_from_front_change_mm =
       (rep.back_from_front.translation_mm() - target.back_from_front.translation_mm()).norm();
 
-  // 1 sigma of S[0][k] from the covariance of the adjustment, scaled by the
+  // 1 sigma of S[0][k], of each free right_from_left and of each camera's
+  // free intrinsics, from the covariance of the adjustment, scaled by the
   // residual variance (Ceres assumes unit-variance residuals).
+  //
+  // Gauge: the problem has none left. Module 0's pose is a constant identity
+  // and its left camera's frame is the reference, every other block is tied
+  // to the corners, and back_from_front has its prior. The intrinsics blocks
+  // hold OPENCV8's k4..k6 (and a spline's knots) through a SubsetManifold, so
+  // their covariance is computed in the manifold's tangent space and returned
+  // in the ambient space with zero rows/columns for the held parameters.
+  // DENSE_SVD with null_space_rank = -1 would still return the pseudo-inverse
+  // (dropping directions whose eigenvalue ratio is below
+  // min_reciprocal_condition_number) if a data set left a direction
+  // undetermined, rather than failing.
   rep.covariance_status = "not computed";
-  if (options.compute_covariance && M > 1) {
+  if (options.compute_covariance) {
     ceres::Covariance::Options copt;
     int num_free = 0;
     std::vector<double*> blocks;
     problem.GetParameterBlocks(&blocks);
     for (double* b : blocks)
-      if (!problem.IsParameterBlockConstant(b)) num_free += problem.ParameterBlockSize(b);
+      if (!problem.IsParameterBlockConstant(b)) num_free += problem.ParameterBlockTangentSize(b);
     copt.algorithm_type = num_free <= 3000 ? ceres::DENSE_SVD : ceres::SPARSE_QR;
     copt.null_space_rank = -1;
     copt.num_threads = 1;
     ceres::Covariance cov(copt);
+    auto is_free = [&](const double* b) {
+      return problem.HasParameterBlock(b) && !problem.IsParameterBlockConstant(const_cast<double*>(b));
+    };
     std::vector<std::pair<const double*, const double*>> pairs;
-    for (int k = 1; k < M; ++k) pairs.emplace_back(s_blocks[k].params, s_blocks[k].params);
-    if (cov.Compute(pairs, &problem)) {
+    for (int k = 1; k < M; ++k)
+      if (is_free(s_blocks[k].params)) pairs.emplace_back(s_blocks[k].params, s_blocks[k].params);
+    for (int k = 0; k < M; ++k)
+      if (is_free(rl_blocks[k].params)) pairs.emplace_back(rl_blocks[k].params, rl_blocks[k].params);
+    for (const auto& [cam, v] : intrinsics)
+      if (is_free(v.data())) pairs.emplace_back(v.data(), v.data());
+    if (!pairs.empty() && cov.Compute(pairs, &problem)) {
       const double n_res = 2.0 * corner_blocks.size();
       const double rms = rep.refined_reprojection_rms_px;
       const double sigma2 = rms * rms * n_res / std::max(1.0, n_res - num_free);
+      const double deg = 180.0 / M_PI;
       for (int k = 1; k < M; ++k) {
+        if (!is_free(s_blocks[k].params)) continue;
         double c[36];
         cov.GetCovarianceBlock(s_blocks[k].params, s_blocks[k].params, c);
         STransformSigma s;
         s.module = k;
         for (int i = 0; i < 3; ++i) {
-          s.rotation_deg(i) = std::sqrt(sigma2 * c[i * 6 + i]) * 180.0 / M_PI;
+          s.rotation_deg(i) = std::sqrt(sigma2 * c[i * 6 + i]) * deg;
           s.translation_mm(i) = std::sqrt(sigma2 * c[(3 + i) * 6 + 3 + i]);
         }
         rep.sigma.push_back(s);
       }
+      for (int k = 0; k < M; ++k) {
+        if (!is_free(rl_blocks[k].params)) continue;
+        Eigen::Matrix<double, 6, 6, Eigen::RowMajor> c;
+        cov.GetCovarianceBlock(rl_blocks[k].params, rl_blocks[k].params, c.data());
+        c *= sigma2;
+        rep.stereo_sigma.push_back(RightFromLeftSigma(k, rl_blocks[k], c));
+      }
+      for (const auto& [cam, v] : intrinsics) {
+        if (!is_free(v.data())) continue;
+        const int n = static_cast<int>(v.size());
+        std::vector<double> c(n * n);
+        cov.GetCovarianceBlock(v.data(), v.data(), c.data());
+        RefinedIntrinsicsSigma s;
+        s.camera = cam;
+        s.intrinsics = v;
+        for (int i = 0; i < n; ++i) s.sigma.push_back(std::sqrt(std::max(0.0, sigma2 * c[i * n + i])));
+        rep.intrinsics_sigma.push_back(std::move(s));
+      }
       rep.covariance_status = "ok";
-    } else {
+    } else if (!pairs.empty()) {
       rep.covariance_status = "ceres::Covariance failed (rank-deficient problem)";
     }
   }

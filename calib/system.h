@@ -14,7 +14,8 @@
 //     reprojection error with a robust (Huber) loss. Parameters: S (each
 //     module's pose in the reference), every board pose, optionally the
 //     stereo extrinsics and the intrinsics, and back_from_front under its
-//     measured prior. ceres::Covariance gives the 1 sigma of S.
+//     measured prior. ceres::Covariance gives the 1 sigma of S and of the
+//     refined right_from_left and intrinsics (those the rig file holds).
 #pragma once
 
 #include <map>
@@ -39,7 +40,7 @@ struct SystemOptions {
   bool refine_back_from_front = true;  // free back_from_front under its prior; default true
   int min_triangulated_corners = 6;    // a module's board pose needs this many corners both cameras saw; default 6
   int max_iterations = 100;            // Ceres; default 100
-  bool compute_covariance = true;      // 1 sigma of S; default true
+  bool compute_covariance = true;      // 1 sigma of S, refined stereo and intrinsics; default true
   void Check() const;
 };
 
@@ -56,6 +57,24 @@ struct STransformSigma {
   Eigen::Vector3d translation_mm = Eigen::Vector3d::Zero();
 };
 
+// 1 sigma of one module's refined right_from_left (present when it was free).
+struct RefinedStereoSigma {
+  int module = -1;
+  double baseline_mm = 0, baseline_sigma_mm = 0;                  // |t| and its 1 sigma
+  double rotation_deg = 0, rotation_sigma_deg = 0;                // |r| and its 1 sigma
+  Eigen::Vector3d rotation_vector_deg = Eigen::Vector3d::Zero();  // r of right_from_left, and per-component sigma
+  Eigen::Vector3d rotation_vector_sigma_deg = Eigen::Vector3d::Zero();
+  Eigen::Vector3d translation_mm = Eigen::Vector3d::Zero();  // t of right_from_left, and per-component sigma
+  Eigen::Vector3d translation_sigma_mm = Eigen::Vector3d::Zero();
+};
+
+// 1 sigma of one camera's refined intrinsics (present when they were free).
+struct RefinedIntrinsicsSigma {
+  int camera = -1;                 // global index
+  std::vector<double> intrinsics;  // (Nintrinsics,) as refined, mrcal's order
+  std::vector<double> sigma;       // (Nintrinsics,) 1 sigma; 0 for a parameter held at its stage-2 value
+};
+
 struct SystemReport {
   int num_captures = 0;                                // captures seen by at least one module with a board pose
   std::map<std::pair<int, int>, int> shared_captures;  // (i, j) -> captures both modules posed
@@ -64,12 +83,14 @@ struct SystemReport {
   double horn_reprojection_rms_px = 0.0;               // S and stereo held at Horn/stage 2, board poses solved
   double refined_reprojection_rms_px = 0.0;            // after the full adjustment
   int num_residual_corners = 0;
-  std::vector<Pose> module0_from_module_horn;  // (M,)
-  std::vector<Pose> module0_from_module;       // (M,) refined
-  std::vector<STransformSigma> sigma;          // for modules 1..M-1
-  std::string covariance_status;               // "ok" or why it is missing
-  Pose back_from_front;                        // as refined
-  double back_from_front_change_deg = 0.0;     // refined vs measured
+  std::vector<Pose> module0_from_module_horn;            // (M,)
+  std::vector<Pose> module0_from_module;                 // (M,) refined
+  std::vector<STransformSigma> sigma;                    // for modules 1..M-1
+  std::vector<RefinedStereoSigma> stereo_sigma;          // (M,) when refine_stereo, else empty
+  std::vector<RefinedIntrinsicsSigma> intrinsics_sigma;  // (cameras,) when refine_intrinsics, else empty
+  std::string covariance_status;                         // "ok" or why it is missing
+  Pose back_from_front;                                  // as refined
+  double back_from_front_change_deg = 0.0;               // refined vs measured
   double back_from_front_change_mm = 0.0;
   std::string solver_summary;  // Ceres BriefReport
 };
