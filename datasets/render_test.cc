@@ -194,6 +194,65 @@ TEST(Render, LaserIsShadowed) {
                               (l0.origin_world - p_front).norm() - 1e-3));
 }
 
+// The grid-lit truth map: on the plate, a pixel is lit by projector 0 exactly
+// when its surface point (exact unprojection, closed-form plane, written
+// here) lies inside the square between projector 0's outermost lines (+2
+// line sigmas), as the spec's fan and the projector pose say. And no line
+// (laser light above a quarter of a line's peak: 2 sigma off a line's
+// centre is e^-2 = 0.14 of it) falls outside the lit map.
+TEST(Render, LitMapMarksTheGridEnvelope) {
+  DefaultSetup s;
+  const int cam_index = 0;
+  const Camera& cam = s.rig.sim.rig.camera(cam_index);
+  const CameraRays rays(cam, 2);
+  const Pose& world_from_cam = s.rig.world_from_camera[cam_index];
+  const Scene scene = MakeScene("plate", s.spec.scenes, s.spec.render, 5);
+  const std::vector<LaserProjector> projectors =
+      MakeProjectors(s.spec, s.rig.world_from_projector, s.rig.projector_distance_mm);
+  const SceneRadiance rad = RenderScene(rays, world_from_cam, scene, projectors, s.spec.render);
+  const SceneObject& obj = scene.objects[0];
+  const Pose obj_from_cam = obj.object_from_world * world_from_cam;
+  const Pose proj_from_cam = s.rig.world_from_projector[0].Inverse() * world_from_cam;
+  const ProjectorSpec& ps = s.spec.modules[0].projector;
+  const double sin_half = std::sin(0.5 * ps.fan_angle_deg * M_PI / 180.0) + 2e-3 * ps.line_sigma_mrad;
+  const Eigen::Vector3d half = 0.5 * s.spec.scenes.plate_size_mm;
+  int checked = 0, lit = 0, wrong = 0, dark_light = 0;
+  for (int r = 0; r < cam.imager_height_px(); r += 3) {
+    for (int c = 0; c < cam.imager_width_px(); c += 3) {
+      if (rad.id.at<uint8_t>(r, c) == 0) {
+        dark_light += rad.lit.at<uint8_t>(r, c) != 0;
+        continue;
+      }
+      Eigen::Vector3d v;
+      ASSERT_TRUE(cam.Unproject(Eigen::Vector2d(c, r), &v));
+      const Eigen::Vector3d o = obj_from_cam.translation_mm(), d = obj_from_cam.rotation() * v;
+      const double z = o.z() < 0 ? -half.z() : half.z();  // the face towards the camera
+      const Eigen::Vector3d p_obj = o + (z - o.z()) / d.z() * d;
+      // Skip pixels within 0.5 mm of the plate's edge or of the envelope's
+      // border (the pixel centre's ray and this one differ by ~1e-5 mm).
+      if (std::abs(p_obj.x()) > half.x() - 0.5 || std::abs(p_obj.y()) > half.y() - 0.5) continue;
+      const Eigen::Vector3d u = (proj_from_cam * (obj_from_cam.Inverse() * p_obj)).normalized();
+      const double margin = std::max(std::abs(u.x()), std::abs(u.y())) - sin_half;
+      if (std::abs(margin) < 1e-4) continue;
+      const bool inside = margin < 0;
+      const bool marked = rad.lit.at<uint8_t>(r, c) & 1;
+      wrong += inside != marked;
+      lit += marked;
+      ++checked;
+      // Light only where the map says lit (by projector 0 or 1).
+      if (rad.lit.at<uint8_t>(r, c) == 0) {
+        EXPECT_LT(rad.laser.at<float>(r, c), 0.25 * ps.power_dn) << c << "," << r;
+      }
+    }
+  }
+  std::printf("lit map: %d plate pixels checked, %d lit, %d disagree\n", checked, lit, wrong);
+  EXPECT_GT(checked, 5000);
+  EXPECT_GT(lit, 1000);
+  EXPECT_LT(lit, checked);  // the plate is larger than the grid: both cases are tested
+  EXPECT_EQ(wrong, 0);
+  EXPECT_EQ(dark_light, 0);  // background is never lit
+}
+
 TEST(Render, SensorNoiseHasTheModelledSpread) {
   RenderSpec r;
   r.psf_sigma_px = 0;

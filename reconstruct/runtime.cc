@@ -230,6 +230,7 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
     }
   }
   report->points = int(cloud->size());
+  report->valid = index >= 0;
   for (int y = 0; y < lit.rows; ++y)
     for (int x = 0; x < lit.cols; ++x) {
       if (!lit.at<uint8_t>(y, x)) continue;
