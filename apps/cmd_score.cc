@@ -2,6 +2,7 @@
 // truth, as issue 5 judges it: accuracy after one rigid alignment to the
 // dense truth surface, the fill of the object pixels both cameras of a
 // module see and a grid lights, and the active/passive valid-point ratio.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -25,8 +26,29 @@ nlohmann::json FiguresJson(const ErrorFigures& f) {
 }
 
 nlohmann::json FillJson(const FillFigures& f) {
-  return {
+  nlohmann::json j = {
       {"target_px", f.target_px}, {"filled_px", f.filled_px}, {"fill", f.fill()}, {"points_off_target", f.other_px}};
+  for (size_t k = 0; k < f.target_status.size(); ++k)
+    if (f.target_status[k] && k != size_t(PixelStatus::kPoint))
+      j["target_px_lost_by"][PixelStatusName(PixelStatus(k))] = f.target_status[k];
+  return j;
+}
+
+// "no_sgm_match 4.1%, low_zncc 2.0%, ...": the target pixels each test lost,
+// largest first.
+std::string LossLine(const FillFigures& f) {
+  std::vector<std::pair<int, size_t>> losses;
+  for (size_t k = 0; k < f.target_status.size(); ++k)
+    if (f.target_status[k] && k != size_t(PixelStatus::kPoint)) losses.push_back({f.target_status[k], k});
+  std::sort(losses.rbegin(), losses.rend());
+  std::string line;
+  char buf[64];
+  for (const auto& [n, k] : losses) {
+    std::snprintf(buf, sizeof buf, "%s%s %.1f%%", line.empty() ? "" : ", ", PixelStatusName(PixelStatus(k)),
+                  100.0 * n / std::max(1, f.target_px));
+    line += buf;
+  }
+  return line;
 }
 
 }  // namespace
@@ -100,6 +122,7 @@ int RunScore(int argc, char** argv) {
     }
     std::printf("; aligned by %.4f deg, %.4f mm\n", s.accuracy.truth_from_cloud.AngleDeg(),
                 s.accuracy.truth_from_cloud.translation_mm().norm());
+    for (size_t m = 0; m < s.fill.size(); ++m) std::printf("  m%zu lost: %s\n", m, LossLine(s.fill[m]).c_str());
     report["scenes"].push_back(sj);
   }
   if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");

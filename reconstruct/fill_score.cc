@@ -76,22 +76,27 @@ cv::Mat FillTargetMask(const Rig& truth_rig, int module, const CameraTruthMaps& 
   return target;
 }
 
-FillFigures ScoreFill(const cv::Mat& valid_rectified, const cv::Mat& left_x, const cv::Mat& left_y,
+FillFigures ScoreFill(const cv::Mat& status_rectified, const cv::Mat& left_x, const cv::Mat& left_y,
                       const cv::Mat& target_original) {
-  STEREORIG_CHECK(valid_rectified.type() == CV_8UC1 && left_x.type() == CV_32FC1 && left_y.type() == CV_32FC1);
-  STEREORIG_CHECK(valid_rectified.size() == left_x.size() && left_x.size() == left_y.size());
+  STEREORIG_CHECK(status_rectified.type() == CV_8UC1 && left_x.type() == CV_32FC1 && left_y.type() == CV_32FC1);
+  STEREORIG_CHECK(status_rectified.size() == left_x.size() && left_x.size() == left_y.size());
   FillFigures f;
-  for (int y = 0; y < valid_rectified.rows; ++y) {
-    const uint8_t* valid = valid_rectified.ptr<uint8_t>(y);
+  for (int y = 0; y < status_rectified.rows; ++y) {
+    const uint8_t* status = status_rectified.ptr<uint8_t>(y);
     const float* mx = left_x.ptr<float>(y);
     const float* my = left_y.ptr<float>(y);
-    for (int x = 0; x < valid_rectified.cols; ++x) {
+    for (int x = 0; x < status_rectified.cols; ++x) {
       const long c = std::lround(mx[x]), r = std::lround(my[x]);
       const bool target = c >= 0 && r >= 0 && c < target_original.cols && r < target_original.rows &&
                           target_original.at<uint8_t>(int(r), int(c));
-      f.target_px += target;
-      f.filled_px += target && valid[x];
-      f.other_px += !target && valid[x];
+      const bool point = status[x] == uint8_t(PixelStatus::kPoint);
+      if (target) {
+        ++f.target_px;
+        f.filled_px += point;
+        if (status[x] < f.target_status.size()) ++f.target_status[status[x]];
+      } else {
+        f.other_px += point;
+      }
     }
   }
   return f;

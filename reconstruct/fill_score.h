@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "calib/core/rig.h"
+#include "reconstruct/matcher.h"
 
 namespace stereorig {
 
@@ -45,14 +46,17 @@ struct FillFigures {
   int target_px = 0;  // rectified left pixels whose original pixel is a target
   int filled_px = 0;  // of those, pixels with a point
   int other_px = 0;   // points on non-target pixels (one camera only, unlit, background): not in the fill
+  // Of the target pixels, how many ended with each PixelStatus (index =
+  // the enum's value): where the fill is lost.
+  std::vector<int> target_status = std::vector<int>(size_t(PixelStatus::kNumStatus), 0);
   double fill() const { return target_px ? double(filled_px) / target_px : 0.0; }
 };
 
-// valid_rectified: CV_8UC1 on the module's rectified left grid, non-zero =
-// a point (ModuleReport::valid); left_x, left_y: CV_32FC1 rectification map
+// status_rectified: CV_8UC1 on the module's rectified left grid, the
+// PixelStatus of each pixel (ModuleReport::status); left_x, left_y: CV_32FC1 rectification map
 // of the same size (rectified px -> original left px, RectifyMaps);
 // target_original: FillTargetMask().
-FillFigures ScoreFill(const cv::Mat& valid_rectified, const cv::Mat& left_x, const cv::Mat& left_y,
+FillFigures ScoreFill(const cv::Mat& status_rectified, const cv::Mat& left_x, const cv::Mat& left_y,
                       const cv::Mat& target_original);
 
 }  // namespace stereorig

@@ -8,7 +8,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "calib/core/input_error.h"
+#include "reconstruct/line_index.h"
 #include "reconstruct/parallel_for.h"
+#include "reconstruct/region_grow.h"
 
 namespace stereorig {
 
@@ -37,6 +39,8 @@ void MatchOptions::Check() const {
     throw InputError("census_half_height_px", "must be in [1, 3]");
   sgm.Check();
   subpixel.Check();
+  line_index.Check();
+  grow.Check();
   if (!(min_zncc >= -1 && min_zncc < 1)) throw InputError("min_zncc", "must be in [-1, 1)");
   if (!(max_plane_deviation_px >= 0)) throw InputError("max_plane_deviation_px", "must be >= 0 (0 = off)");
   if (!(min_texture_dn >= 0)) throw InputError("min_texture_dn", "must be >= 0");
@@ -180,8 +184,10 @@ void DisparitySlopes(const cv::Mat& disparity, cv::Mat* slope_x, cv::Mat* slope_
   const cv::Mat s_x = box(mx), s_y = box(my), s_xd = box(mx.mul(md) / cv::max(m, 1e-9f)),
                 s_yd = box(my.mul(md) / cv::max(m, 1e-9f)), s_xx = box(mx.mul(xs)), s_yy = box(my.mul(ys)),
                 s_xy = box(mx.mul(ys));
-  *slope_x = cv::Mat(disparity.size(), CV_32FC1, cv::Scalar(0));
-  *slope_y = cv::Mat(disparity.size(), CV_32FC1, cv::Scalar(0));
+  // slope_x, slope_y: views of the caller's maps (region size), written in place.
+  STEREORIG_CHECK(slope_x->size() == disparity.size() && slope_y->size() == disparity.size());
+  slope_x->setTo(0);
+  slope_y->setTo(0);
   *plane = cv::Mat(disparity.size(), CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
   for (int y = 0; y < disparity.rows; ++y)
     for (int x = 0; x < disparity.cols; ++x) {
@@ -240,54 +246,98 @@ MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::
   lap("band");
   const cv::Mat coarse_to_fine = MatchLevel(left, right, roi, dmin, num, o.pyramid_levels, o);
   lap("sgm");
-  result.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
-  result.confidence = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
-  const double dmax = o.min_disparity_px + o.num_disparities - 1;
-  cv::Mat slope_x, slope_y, plane;
-  DisparitySlopes(coarse_to_fine, &slope_x, &slope_y, &plane);
+  DisparityState state;
+  state.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
+  state.confidence = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
+  state.status = cv::Mat(left.size(), CV_8UC1, cv::Scalar(uint8_t(PixelStatus::kNotSearched)));
+  state.slope_x = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
+  state.slope_y = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
+  RefineAcceptance accept;
+  accept.subpixel = o.subpixel;
+  accept.min_zncc = o.min_zncc;
+  accept.min_texture_dn = o.min_texture_dn;
+  accept.min_disparity_px = o.min_disparity_px;
+  accept.max_disparity_px = o.min_disparity_px + o.num_disparities - 1;
+  cv::Mat plane;
+  cv::Mat slope_x_roi = state.slope_x(roi), slope_y_roi = state.slope_y(roi);
+  DisparitySlopes(coarse_to_fine, &slope_x_roi, &slope_y_roi, &plane);
   ParallelForChunks(roi.height, o.num_threads, [&](int b, int e) {
     for (int yy = b; yy < e; ++yy) {
       const int y = roi.y + yy;
       const float* in = coarse_to_fine.ptr<float>(yy);
-      float* out = result.disparity_px.ptr<float>(y);
-      float* conf = result.confidence.ptr<float>(y);
+      const float* slope_x = state.slope_x.ptr<float>(y);
+      const float* slope_y = state.slope_y.ptr<float>(y);
+      float* out = state.disparity_px.ptr<float>(y);
+      float* conf = state.confidence.ptr<float>(y);
+      uint8_t* status = state.status.ptr<uint8_t>(y);
       for (int xx = 0; xx < roi.width; ++xx) {
-        if (std::isnan(in[xx])) continue;
         const int x = roi.x + xx;
+        auto reject = [&](PixelStatus why) { status[x] = uint8_t(why); };
+        if (std::isnan(in[xx])) {
+          reject(PixelStatus::kNoSgmMatch);
+          continue;
+        }
         double d = in[xx];
         float confidence = 1.0f;
         const float pl = plane.at<float>(yy, xx);
+        if (o.max_plane_deviation_px > 0 && std::isnan(pl)) {
+          reject(PixelStatus::kNoPlane);
+          continue;
+        }
         // The plane test below, applied early to the cost-fit disparity (the
         // refinement moves it by < max_shift_px): saves refining mismatches.
-        if (o.max_plane_deviation_px > 0 &&
-            (std::isnan(pl) || std::abs(d - pl) > o.max_plane_deviation_px + o.subpixel.max_shift_px))
+        if (o.max_plane_deviation_px > 0 && std::abs(d - pl) > o.max_plane_deviation_px + o.subpixel.max_shift_px) {
+          reject(PixelStatus::kOffPlaneCoarse);
           continue;
+        }
         if (o.intensity_refinement) {
-          const SubpixelResult s =
-              RefineDisparity(left, right, x, y, d, slope_x.at<float>(yy, xx), slope_y.at<float>(yy, xx), o.subpixel);
-          if (!s.ok || s.zncc < o.min_zncc || s.std_dn < o.min_texture_dn) continue;
+          const SubpixelResult s = RefineDisparity(left, right, x, y, d, slope_x[x], slope_y[x], o.subpixel);
+          const PixelStatus why = Accept(s, accept);
+          if (why != PixelStatus::kPoint) {
+            reject(why);
+            continue;
+          }
           d = s.disparity_px;
           confidence = float(std::clamp(s.zncc, 0.0, 1.0));
+        } else if (d < accept.min_disparity_px || d > accept.max_disparity_px) {  // range filter
+          reject(PixelStatus::kOutOfRange);
+          continue;
         }
-        if (d < o.min_disparity_px || d > dmax) continue;  // range filter
         // Consistency with the neighbourhood: the refined disparity must lie
         // within max_plane_deviation_px of the plane fitted to the 9x9
         // integer-level disparities around it (isolated mismatches and the
         // edges of mismatched patches fail this).
-        if (o.max_plane_deviation_px > 0 && (std::isnan(pl) || std::abs(d - pl) > o.max_plane_deviation_px)) continue;
+        if (o.max_plane_deviation_px > 0 && std::abs(d - pl) > o.max_plane_deviation_px) {
+          reject(PixelStatus::kOffPlane);
+          continue;
+        }
         out[x] = float(d);
         conf[x] = confidence;
+        status[x] = uint8_t(PixelStatus::kPoint);
       }
     }
   });
   lap("subpixel");
-  RemoveSpeckles(result.disparity_px, o);
-  for (int y = 0; y < left.rows; ++y) {
-    const float* d = result.disparity_px.ptr<float>(y);
-    float* c = result.confidence.ptr<float>(y);
-    for (int x = 0; x < left.cols; ++x)
-      if (!std::isfinite(d[x])) c[x] = 0;
+  if (o.intensity_refinement) {
+    CorrectLineIndex(left, right, roi, o.line_index, accept, &state);
+    lap("line_index");
+    GrowDisparity(left, right, roi, o.grow, accept, &state);
+    lap("grow");
   }
+  RemoveSpeckles(state.disparity_px, o);
+  for (int y = 0; y < left.rows; ++y) {
+    const float* d = state.disparity_px.ptr<float>(y);
+    float* c = state.confidence.ptr<float>(y);
+    uint8_t* status = state.status.ptr<uint8_t>(y);
+    for (int x = 0; x < left.cols; ++x)
+      if (!std::isfinite(d[x])) {
+        c[x] = 0;
+        if (status[x] == uint8_t(PixelStatus::kPoint)) status[x] = uint8_t(PixelStatus::kSpeckle);
+      }
+  }
+  result.disparity_px = state.disparity_px;
+  result.confidence = state.confidence;
+  result.status = state.status;
   lap("speckle");
   return result;
 }
@@ -312,6 +362,8 @@ MatchResult MatchOpenCvSgbm(const cv::Mat& left, const cv::Mat& right, const cv:
   result.times_ms["sgbm"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   result.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
   result.confidence = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
+  result.status = cv::Mat(left.size(), CV_8UC1, cv::Scalar(uint8_t(PixelStatus::kNotSearched)));
+  result.status(roi).setTo(uint8_t(PixelStatus::kNoSgmMatch));
   const double dmax_valid = o.min_disparity_px + o.num_disparities - 1;
   for (int y = 0; y < cut.height; ++y) {
     const int16_t* f = fixed.ptr<int16_t>(y);
@@ -324,6 +376,7 @@ MatchResult MatchOpenCvSgbm(const cv::Mat& left, const cv::Mat& right, const cv:
       if (disp > dmax_valid) continue;
       d[x] = float(disp);
       c[x] = 1.0f;
+      result.status.at<uint8_t>(roi.y + y, x) = uint8_t(PixelStatus::kPoint);
     }
   }
   return result;

@@ -24,6 +24,9 @@
 #include <string>
 
 #include "reconstruct/census_sgm.h"
+#include "reconstruct/disparity_state.h"
+#include "reconstruct/line_index.h"
+#include "reconstruct/region_grow.h"
 #include "reconstruct/subpixel_refine.h"
 
 namespace stereorig {
@@ -57,6 +60,8 @@ struct MatchOptions {
   double max_plane_deviation_px =
       0.7;                      // reject d farther than this from the local 9x9 disparity plane (0 = off); default 0.7
   double min_texture_dn = 1.5;  // reject windows with a grey-level std below this; default 1.5 DN
+  LineIndexOptions line_index;  // census_sgm: the component-wide grid-period test (line_index.h)
+  GrowOptions grow;             // census_sgm: growing into the pixels SGM left empty (region_grow.h)
   int speckle_window_px = 100;  // remove disparity blobs smaller than this, px (0 = off); default 100
   double speckle_range_px = 1.0;  // neighbours within this disparity are one blob, px; default 1
   int sgbm_block_size = 5;        // opencv_sgbm_3way: block size, px (odd); default 5
@@ -71,6 +76,9 @@ struct MatchResult {
   // CV_32FC1, same size: confidence in [0, 1] (ZNCC of the refined window
   // for census_sgm, 1 for any valid SGBM pixel), 0 where invalid.
   cv::Mat confidence;
+  // CV_8UC1, same size: PixelStatus of each pixel (census_sgm; SGBM:
+  // kPoint or kNoSgmMatch inside the ROI).
+  cv::Mat status;
   // Wall time of the sub-steps, ms: census_sgm: "band" (the half-resolution
   // range pass), "sgm" (census + SGM + left-right/uniqueness), "subpixel"
   // (slopes + Lucas-Kanade + filters), "speckle"; opencv_sgbm_3way: "sgbm".

@@ -28,11 +28,12 @@ SceneScore ScoreScene(const Runtime& runtime, const Reconstruction& rec, const S
   s.accuracy = ScoreAgainstTruth(rec.cloud, truth.surface_mm, nm);
   for (int m = 0; m < nm && m < int(truth.fill_target.size()); ++m) {
     const RectifyMaps& maps = runtime.plans()[m].maps;
-    const FillFigures f = ScoreFill(rec.modules[m].valid, maps.left_x, maps.left_y, truth.fill_target[m]);
+    const FillFigures f = ScoreFill(rec.modules[m].status, maps.left_x, maps.left_y, truth.fill_target[m]);
     s.fill.push_back(f);
     s.fill_all.target_px += f.target_px;
     s.fill_all.filled_px += f.filled_px;
     s.fill_all.other_px += f.other_px;
+    for (size_t k = 0; k < f.target_status.size(); ++k) s.fill_all.target_status[k] += f.target_status[k];
   }
   return s;
 }
