@@ -26,6 +26,8 @@ const char* PixelStatusName(PixelStatus status) {
       return "off_plane";
     case PixelStatus::kSpeckle:
       return "speckle";
+    case PixelStatus::kNotDistinct:
+      return "not_distinct";
     case PixelStatus::kLowConfidence:
       return "low_confidence";
     case PixelStatus::kOutsideVolume:

@@ -24,6 +24,7 @@ enum class PixelStatus : uint8_t {
   kOutOfRange,       // refined disparity outside the searched range
   kOffPlane,         // refined disparity off the local plane
   kSpeckle,          // in a blob smaller than speckle_window_px
+  kNotDistinct,      // region growing: correlates as well half a grid period off (region_grow.h)
   kLowConfidence,    // runtime: confidence below min_confidence
   kOutsideVolume,    // runtime: triangulated outside the measurement volume
   kObjectSize,       // runtime: farther than object_size_mm from the module cloud's median

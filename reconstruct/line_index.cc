@@ -148,15 +148,20 @@ int CorrectLineIndex(const cv::Mat& left, const cv::Mat& right, const cv::Rect& 
       }
       if (best_shift == 0) break;
       ++moved;
-      // Re-refine every pixel from its disparity + the sample's mean fitted
-      // shift; the few that fail are left to region growing.
+      // Re-refine every pixel: the period varies over a curved surface, so
+      // from starts 2 px either side of the sample's mean fitted shift (the
+      // other alignments are a period away), keeping the best correlation.
       for (int i : pixels) {
         const int y = i / cols, x = i % cols;
         float& d = state->disparity_px.at<float>(y, x);
         if (!std::isfinite(d)) continue;
-        const SubpixelResult r =
-            RefineDisparity(left, right, x, y, d + best.mean_shift_px, state->slope_x.at<float>(y, x),
-                            state->slope_y.at<float>(y, x), accept.subpixel);
+        SubpixelResult r;
+        for (int k = -2; k <= 2; ++k) {
+          const SubpixelResult rk =
+              RefineDisparity(left, right, x, y, d + best.mean_shift_px + k, state->slope_x.at<float>(y, x),
+                              state->slope_y.at<float>(y, x), accept.subpixel);
+          if (rk.ok && (!r.ok || rk.zncc > r.zncc)) r = rk;
+        }
         const PixelStatus why = Accept(r, accept);
         state->status.at<uint8_t>(y, x) = uint8_t(why);
         if (why == PixelStatus::kPoint) {

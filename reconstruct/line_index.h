@@ -27,7 +27,7 @@
 namespace stereorig {
 
 struct LineIndexOptions {
-  bool enabled = false;                 // default false (being tuned)
+  bool enabled = true;                  // default true
   int max_shift_px = 12;                // shifts tried: 2..max_shift_px either way, px; default 12 (> one ~8 px period)
   int min_component_px = 20;            // smaller components are left to the speckle filter; default 20 px
   int samples = 48;                     // pixels per component refined at each shift; default 48

@@ -318,13 +318,17 @@ MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::
     }
   });
   lap("subpixel");
-  if (o.intensity_refinement) {
+  // Seeds for the line-index test and growing: only the blobs the speckle
+  // filter keeps (a small mismatched blob would otherwise grow into a large
+  // wrong surface); the filter runs again on the grown map.
+  RemoveSpeckles(state.disparity_px, o);
+  if (o.intensity_refinement && (o.line_index.enabled || o.grow.enabled)) {
     CorrectLineIndex(left, right, roi, o.line_index, accept, &state);
     lap("line_index");
     GrowDisparity(left, right, roi, o.grow, accept, &state);
     lap("grow");
+    RemoveSpeckles(state.disparity_px, o);
   }
-  RemoveSpeckles(state.disparity_px, o);
   for (int y = 0; y < left.rows; ++y) {
     const float* d = state.disparity_px.ptr<float>(y);
     float* c = state.confidence.ptr<float>(y);

@@ -100,6 +100,9 @@ RuntimeOptions FromYaml(YamlMap& y) {
         m.GetDouble("line_index_min_row_offset_gain_px", mo.line_index.min_row_offset_gain_px);
     mo.grow.enabled = m.GetBool("grow", mo.grow.enabled);
     mo.grow.max_deviation_px = m.GetDouble("grow_max_deviation_px", mo.grow.max_deviation_px);
+    mo.grow.plane_radius_px = m.GetInt("grow_plane_radius_px", mo.grow.plane_radius_px);
+    mo.grow.min_distinctness = m.GetDouble("grow_min_distinctness", mo.grow.min_distinctness);
+    mo.grow.half_period_px = m.GetDouble("grow_half_period_px", mo.grow.half_period_px);
     m.Finish();
   }
   y.Finish();

@@ -42,6 +42,11 @@ struct SubpixelResult {
 SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x, int y, double start_px, double slope_x,
                                double slope_y, const SubpixelOptions& options);
 
+// ZNCC of the window at disparity d (no fit; the right window warped by the
+// slopes as above, Lanczos-3 sampled). -1 if the window leaves either image.
+double WindowZncc(const cv::Mat& left, const cv::Mat& right, int x, int y, double d, double slope_x, double slope_y,
+                  const SubpixelOptions& options);
+
 // The same fit with one more parameter: a vertical offset dy of the right
 // window (rows y + v + dy; rows interpolated by a cubic convolution). On a
 // correct match of a well rectified pair dy ~ 0. A match one laser-grid
