@@ -1,5 +1,7 @@
 #include "reconstruct/disparity_state.h"
 
+#include <algorithm>
+
 namespace stereorig {
 
 const char* PixelStatusName(PixelStatus status) {
@@ -40,11 +42,18 @@ const char* PixelStatusName(PixelStatus status) {
   return "?";
 }
 
-PixelStatus Accept(const SubpixelResult& r, const RefineAcceptance& a) {
+PixelStatus Accept(const cv::Mat& left, const cv::Mat& right, int x, int y, double slope_x, double slope_y,
+                   const SubpixelResult& r, const RefineAcceptance& a) {
   if (!r.ok) return PixelStatus::kRefineFailed;
   if (r.zncc < a.min_zncc) return PixelStatus::kLowZncc;
   if (r.std_dn < a.min_texture_dn) return PixelStatus::kLowTexture;
   if (r.disparity_px < a.min_disparity_px || r.disparity_px > a.max_disparity_px) return PixelStatus::kOutOfRange;
+  if (a.min_distinctness > 0) {
+    const double off =
+        std::max(WindowZncc(left, right, x, y, r.disparity_px - a.half_period_px, slope_x, slope_y, a.subpixel),
+                 WindowZncc(left, right, x, y, r.disparity_px + a.half_period_px, slope_x, slope_y, a.subpixel));
+    if (r.zncc - off < a.min_distinctness) return PixelStatus::kNotDistinct;
+  }
   return PixelStatus::kPoint;
 }
 

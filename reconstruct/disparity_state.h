@@ -24,7 +24,7 @@ enum class PixelStatus : uint8_t {
   kOutOfRange,       // refined disparity outside the searched range
   kOffPlane,         // refined disparity off the local plane
   kSpeckle,          // in a blob smaller than speckle_window_px
-  kNotDistinct,      // region growing: correlates as well half a grid period off (region_grow.h)
+  kNotDistinct,      // correlates about as well half a grid period off (RefineAcceptance)
   kLowConfidence,    // runtime: confidence below min_confidence
   kOutsideVolume,    // runtime: triangulated outside the measurement volume
   kObjectSize,       // runtime: farther than object_size_mm from the module cloud's median
@@ -48,9 +48,18 @@ struct RefineAcceptance {
   double min_texture_dn = 1.5;  // the matcher's min_texture_dn
   double min_disparity_px = 0;  // the searched range, px
   double max_disparity_px = 0;
+  // The match must be distinct: its ZNCC must beat the (unrefined) ZNCC
+  // half a grid period either side by min_distinctness. A smooth shading
+  // ramp (an unlit surface) correlates at any shift, and a window half off
+  // the lit region lines up its few lines about as well a few px off; a
+  // grid-lit window decorrelates half a period off. 0 = off.
+  double min_distinctness = 0.4;
+  double half_period_px = 4;  // the shift of that test, px (the default rig's grid: ~8 px period)
 };
 
-// kPoint if `r` is a match by `a`, else the test it fails.
-PixelStatus Accept(const SubpixelResult& r, const RefineAcceptance& a);
+// kPoint if the refinement `r` of left pixel (x, y) (slopes as refined) is a
+// match by `a`, else the test it fails.
+PixelStatus Accept(const cv::Mat& left, const cv::Mat& right, int x, int y, double slope_x, double slope_y,
+                   const SubpixelResult& r, const RefineAcceptance& a);
 
 }  // namespace stereorig

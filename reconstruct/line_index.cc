@@ -17,8 +17,8 @@ void LineIndexOptions::Check() const {
     throw InputError("line_index_window_half_height_px", "must be in [0, 30]");
   if (!(max_row_offset_px > 0 && max_row_offset_px < 1))
     throw InputError("line_index_max_row_offset_px", "must be in (0, 1)");
-  if (!(min_row_offset_gain_px > 0 && min_row_offset_gain_px < 1))
-    throw InputError("line_index_min_row_offset_gain_px", "must be in (0, 1)");
+  if (!(min_row_offset_step_px > 0 && min_row_offset_step_px < 1))
+    throw InputError("line_index_min_row_offset_step_px", "must be in (0, 1)");
 }
 
 cv::Mat LabelDisparityComponents(const cv::Mat& disparity_px, const cv::Rect& roi, double max_step_px,
@@ -129,24 +129,38 @@ int CorrectLineIndex(const cv::Mat& left, const cv::Mat& right, const cv::Rect& 
                      here.standard_error_px, here.fits);
       if (here.fits < 4 || here_abs <= std::max(o.max_row_offset_px, 3 * here.standard_error_px)) break;
       // The other alignments: on each side, the shift whose refinement
-      // correlates best.
-      Vernier best;
-      best.mean_row_offset_px = here_abs - o.min_row_offset_gain_px;
-      double best_shift = 0;
-      for (int sign : {-1, 1}) {
-        double best_z = -2, side_shift = 0;
+      // correlates best. Their row offsets step by about the same amount
+      // per period (the vernier): fit dy(k) = a + b k over k = -1, 0, +1 and
+      // move to the alignment nearest its zero crossing.
+      Vernier side[2];
+      double side_shift[2] = {0, 0};
+      for (int j = 0; j < 2; ++j) {
+        const int sign = j == 0 ? -1 : 1;
+        double best_z = -2;
         for (int s = 2; s <= o.max_shift_px; ++s) {
           const double z = mean_zncc(sample, sign * s);
-          if (z > best_z) best_z = z, side_shift = sign * s;
+          if (z > best_z) best_z = z, side_shift[j] = sign * s;
         }
-        const Vernier v = vernier(sample, side_shift);
+        side[j] = vernier(sample, side_shift[j]);
         if (getenv("LI_DEBUG"))
-          std::fprintf(stderr, "   shift %+.0f: zncc %.3f dy %+.3f se %.3f (%d fits) -> %+.2f\n", side_shift, best_z,
-                       v.mean_row_offset_px, v.standard_error_px, v.fits, v.mean_shift_px);
-        if (v.fits >= 4 && std::abs(v.mean_row_offset_px) < std::abs(best.mean_row_offset_px))
-          best = v, best_shift = side_shift;
+          std::fprintf(stderr, "   shift %+.0f: zncc %.3f dy %+.3f se %.3f (%d fits) -> %+.2f\n", side_shift[j], best_z,
+                       side[j].mean_row_offset_px, side[j].standard_error_px, side[j].fits, side[j].mean_shift_px);
       }
-      if (best_shift == 0) break;
+      double sw = 0, sk = 0, skk = 0, sd = 0, skd = 0;
+      const Vernier* points[3] = {&side[0], &here, &side[1]};
+      for (int k = -1; k <= 1; ++k) {
+        const Vernier& v = *points[k + 1];
+        if (v.fits < 4) continue;
+        const double w = 1.0 / (v.standard_error_px * v.standard_error_px + 1e-4);
+        sw += w, sk += w * k, skk += w * k * k, sd += w * v.mean_row_offset_px, skd += w * k * v.mean_row_offset_px;
+      }
+      const double det = sw * skk - sk * sk;
+      if (!(det > 0)) break;
+      const double a = (skk * sd - sk * skd) / det, b = (sw * skd - sk * sd) / det;
+      if (std::abs(b) < o.min_row_offset_step_px) break;  // no vernier to read
+      const int k = int(std::lround(std::clamp(-a / b, -1.0, 1.0)));
+      if (k == 0 || points[k + 1]->fits < 4) break;
+      const Vernier& best = *points[k + 1];
       ++moved;
       // Re-refine every pixel: the period varies over a curved surface, so
       // from starts 2 px either side of the sample's mean fitted shift (the
@@ -162,7 +176,8 @@ int CorrectLineIndex(const cv::Mat& left, const cv::Mat& right, const cv::Rect& 
                               state->slope_y.at<float>(y, x), accept.subpixel);
           if (rk.ok && (!r.ok || rk.zncc > r.zncc)) r = rk;
         }
-        const PixelStatus why = Accept(r, accept);
+        const PixelStatus why =
+            Accept(left, right, x, y, state->slope_x.at<float>(y, x), state->slope_y.at<float>(y, x), r, accept);
         state->status.at<uint8_t>(y, x) = uint8_t(why);
         if (why == PixelStatus::kPoint) {
           d = float(r.disparity_px);

@@ -33,7 +33,7 @@ struct LineIndexOptions {
   int samples = 48;                     // pixels per component refined at each shift; default 48
   int window_half_height_px = 4;        // the test window's half height, px; default 4 (9 rows: > one period)
   double max_row_offset_px = 0.1;       // a component whose mean row offset is within this is kept; default 0.1 px
-  double min_row_offset_gain_px = 0.1;  // a shift must reduce |mean row offset| by this; default 0.1 px
+  double min_row_offset_step_px = 0.1;  // the row offset must change by this per period to be read; default 0.1 px
   void Check() const;                   // throws InputError naming the bad field
 };
 

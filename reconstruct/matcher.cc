@@ -38,6 +38,9 @@ void MatchOptions::Check() const {
   if (census_half_height_px < 1 || census_half_height_px > 3)
     throw InputError("census_half_height_px", "must be in [1, 3]");
   sgm.Check();
+  if (!(min_distinctness >= 0 && min_distinctness <= 2)) throw InputError("min_distinctness", "must be in [0, 2]");
+  if (!(grid_half_period_px >= 1 && grid_half_period_px <= 32))
+    throw InputError("grid_half_period_px", "must be in [1, 32]");
   subpixel.Check();
   line_index.Check();
   grow.Check();
@@ -258,6 +261,8 @@ MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::
   accept.min_texture_dn = o.min_texture_dn;
   accept.min_disparity_px = o.min_disparity_px;
   accept.max_disparity_px = o.min_disparity_px + o.num_disparities - 1;
+  accept.min_distinctness = o.min_distinctness;
+  accept.half_period_px = o.grid_half_period_px;
   cv::Mat plane;
   cv::Mat slope_x_roi = state.slope_x(roi), slope_y_roi = state.slope_y(roi);
   DisparitySlopes(coarse_to_fine, &slope_x_roi, &slope_y_roi, &plane);
@@ -292,7 +297,7 @@ MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::
         }
         if (o.intensity_refinement) {
           const SubpixelResult s = RefineDisparity(left, right, x, y, d, slope_x[x], slope_y[x], o.subpixel);
-          const PixelStatus why = Accept(s, accept);
+          const PixelStatus why = Accept(left, right, x, y, slope_x[x], slope_y[x], s, accept);
           if (why != PixelStatus::kPoint) {
             reject(why);
             continue;
@@ -324,9 +329,12 @@ MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::
   RemoveSpeckles(state.disparity_px, o);
   if (o.intensity_refinement && (o.line_index.enabled || o.grow.enabled)) {
     CorrectLineIndex(left, right, roi, o.line_index, accept, &state);
-    lap("line_index");
     GrowDisparity(left, right, roi, o.grow, accept, &state);
-    lap("grow");
+    // Grown components are larger, so their vernier reads better; a
+    // component moved now leaves a gap that growing closes.
+    if (o.grow.enabled && CorrectLineIndex(left, right, roi, o.line_index, accept, &state) > 0)
+      GrowDisparity(left, right, roi, o.grow, accept, &state);
+    lap("line_index_grow");
     RemoveSpeckles(state.disparity_px, o);
   }
   for (int y = 0; y < left.rows; ++y) {

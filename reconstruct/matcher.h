@@ -58,15 +58,20 @@ struct MatchOptions {
   SubpixelOptions subpixel;          // its window and limits
   double min_zncc = 0.8;             // reject matches whose refined window correlates less; default 0.8
   double max_plane_deviation_px =
-      0.7;                      // reject d farther than this from the local 9x9 disparity plane (0 = off); default 0.7
-  double min_texture_dn = 1.5;  // reject windows with a grey-level std below this; default 1.5 DN
-  LineIndexOptions line_index;  // census_sgm: the component-wide grid-period test (line_index.h)
-  GrowOptions grow;             // census_sgm: growing into the pixels SGM left empty (region_grow.h)
-  int speckle_window_px = 100;  // remove disparity blobs smaller than this, px (0 = off); default 100
-  double speckle_range_px = 1.0;  // neighbours within this disparity are one blob, px; default 1
-  int sgbm_block_size = 5;        // opencv_sgbm_3way: block size, px (odd); default 5
-  int num_threads = 2;            // threads for row-parallel steps; default 2
-  void Check() const;             // throws InputError naming the bad field
+      0.7;  // reject d farther than this from the local 9x9 disparity plane (0 = off); default 0.7
+  // census_sgm: the refined match must beat the ZNCC half a grid period
+  // either side by this (RefineAcceptance, disparity_state.h; 0 = off);
+  // default 0.4. Passive captures: set 0.
+  double min_distinctness = 0.4;
+  double grid_half_period_px = 4;  // half the laser grid's period along the rows, px; default 4 (~8 px period)
+  double min_texture_dn = 1.5;     // reject windows with a grey-level std below this; default 1.5 DN
+  LineIndexOptions line_index;     // census_sgm: the component-wide grid-period test (line_index.h)
+  GrowOptions grow;                // census_sgm: growing into the pixels SGM left empty (region_grow.h)
+  int speckle_window_px = 100;     // remove disparity blobs smaller than this, px (0 = off); default 100
+  double speckle_range_px = 1.0;   // neighbours within this disparity are one blob, px; default 1
+  int sgbm_block_size = 5;         // opencv_sgbm_3way: block size, px (odd); default 5
+  int num_threads = 2;             // threads for row-parallel steps; default 2
+  void Check() const;              // throws InputError naming the bad field
 };
 
 struct MatchResult {

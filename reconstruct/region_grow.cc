@@ -10,9 +10,7 @@ namespace stereorig {
 
 void GrowOptions::Check() const {
   if (!(max_deviation_px > 0 && max_deviation_px <= 4)) throw InputError("grow_max_deviation_px", "must be in (0, 4]");
-  if (!(min_distinctness >= 0 && min_distinctness <= 2)) throw InputError("grow_min_distinctness", "must be in [0, 2]");
   if (plane_radius_px < 1 || plane_radius_px > 10) throw InputError("grow_plane_radius_px", "must be in [1, 10]");
-  if (!(half_period_px >= 1 && half_period_px <= 32)) throw InputError("grow_half_period_px", "must be in [1, 32]");
 }
 
 namespace {
@@ -67,15 +65,9 @@ int GrowDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
       double predicted = d + gx * (q.x - p.x) + gy * (q.y - p.y), qgx = gx, qgy = gy;
       LocalPlane(disparity, roi, q, o.plane_radius_px, &predicted, &qgx, &qgy);
       const SubpixelResult r = RefineDisparity(left, right, q.x, q.y, predicted, qgx, qgy, accept.subpixel);
-      PixelStatus why = Accept(r, accept);
+      PixelStatus why = Accept(left, right, q.x, q.y, qgx, qgy, r, accept);
       if (why == PixelStatus::kPoint && std::abs(r.disparity_px - predicted) > o.max_deviation_px)
         why = PixelStatus::kOffPlane;
-      if (why == PixelStatus::kPoint && o.min_distinctness > 0) {
-        const double off =
-            std::max(WindowZncc(left, right, q.x, q.y, r.disparity_px - o.half_period_px, qgx, qgy, accept.subpixel),
-                     WindowZncc(left, right, q.x, q.y, r.disparity_px + o.half_period_px, qgx, qgy, accept.subpixel));
-        if (r.zncc - off < o.min_distinctness) why = PixelStatus::kNotDistinct;
-      }
       if (why != PixelStatus::kPoint) {
         state->status.at<uint8_t>(q) = uint8_t(why);  // the reason growing could not reach it
         continue;

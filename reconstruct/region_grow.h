@@ -13,7 +13,7 @@
 // own tests (ZNCC, texture, range) and stays within max_deviation_px of the
 // prediction; then its neighbours are tried, breadth first. A depth edge or
 // an occlusion stops it (the prediction no longer correlates), and so does
-// the end of the lit surface (no grid: see min_distinctness).
+// the end of the lit surface (no grid: RefineAcceptance::min_distinctness).
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -26,13 +26,7 @@ struct GrowOptions {
   bool enabled = true;            // default true
   int plane_radius_px = 3;        // the prediction: plane through the valid pixels within this, px; default 3 (7x7)
   double max_deviation_px = 0.5;  // refined minus predicted disparity, px; default 0.5 (well below a ~8 px period)
-  // The match must be distinct: its ZNCC must beat the (unrefined) ZNCC
-  // half a grid period either side by this much. A smooth shading ramp
-  // (an unlit surface) correlates at any shift and fails; a grid-lit window
-  // decorrelates half a period off. Default 0.4.
-  double min_distinctness = 0.4;
-  double half_period_px = 4;  // the shift of that test, px; default 4 (the default rig's grid: ~8 px period)
-  void Check() const;         // throws InputError naming the bad field
+  void Check() const;             // throws InputError naming the bad field
 };
 
 // Grows `state` inside `roi`. Returns the number of pixels added.

@@ -96,13 +96,13 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.line_index.window_half_height_px =
         m.GetInt("line_index_window_half_height_px", mo.line_index.window_half_height_px);
     mo.line_index.max_row_offset_px = m.GetDouble("line_index_max_row_offset_px", mo.line_index.max_row_offset_px);
-    mo.line_index.min_row_offset_gain_px =
-        m.GetDouble("line_index_min_row_offset_gain_px", mo.line_index.min_row_offset_gain_px);
+    mo.line_index.min_row_offset_step_px =
+        m.GetDouble("line_index_min_row_offset_step_px", mo.line_index.min_row_offset_step_px);
     mo.grow.enabled = m.GetBool("grow", mo.grow.enabled);
     mo.grow.max_deviation_px = m.GetDouble("grow_max_deviation_px", mo.grow.max_deviation_px);
     mo.grow.plane_radius_px = m.GetInt("grow_plane_radius_px", mo.grow.plane_radius_px);
-    mo.grow.min_distinctness = m.GetDouble("grow_min_distinctness", mo.grow.min_distinctness);
-    mo.grow.half_period_px = m.GetDouble("grow_half_period_px", mo.grow.half_period_px);
+    mo.min_distinctness = m.GetDouble("min_distinctness", mo.min_distinctness);
+    mo.grid_half_period_px = m.GetDouble("grid_half_period_px", mo.grid_half_period_px);
     m.Finish();
   }
   y.Finish();
