@@ -34,13 +34,24 @@ struct LineIndexOptions {
   int window_half_height_px = 4;        // the test window's half height, px; default 4 (9 rows: > one period)
   double max_row_offset_px = 0.1;       // a component whose mean row offset is within this is kept; default 0.1 px
   double min_row_offset_step_px = 0.1;  // the row offset must change by this per period to be read; default 0.1 px
-  void Check() const;                   // throws InputError naming the bad field
+  int max_seam_gap_px = 8;  // JoinAcrossPeriodJumps: widest gap of invalid pixels a seam may span; default 8 px
+  int min_seam_px = 30;     // JoinAcrossPeriodJumps: shortest seam between two components it acts on; default 30 px
+  void Check() const;       // throws InputError naming the bad field
 };
 
 // Revises `state` (disparity, confidence, status) inside `roi`. Returns the
 // number of components moved. left, right: CV_8UC1 rectified.
 int CorrectLineIndex(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const LineIndexOptions& options,
                      const RefineAcceptance& accept, DisparityState* state);
+
+// Which line is which, by continuity: two components that meet along a seam
+// with a jump of about one grid period (a smooth surface has none, and a
+// depth edge's jump varies along it) cannot both be right. The one whose
+// move leaves the size-weighted vernier reading over both nearer 0 is moved;
+// if that is a tie, the smaller one.
+// Run it after growing (the components then meet). Returns the number moved.
+int JoinAcrossPeriodJumps(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi,
+                          const LineIndexOptions& options, const RefineAcceptance& accept, DisparityState* state);
 
 // Connected components of the valid disparities in `roi` (4-neighbours whose
 // disparities differ by <= max_step_px): CV_32SC1 label image (-1 = none),

@@ -332,7 +332,9 @@ MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::
     GrowDisparity(left, right, roi, o.grow, accept, &state);
     // Grown components are larger, so their vernier reads better; a
     // component moved now leaves a gap that growing closes.
-    if (o.grow.enabled && CorrectLineIndex(left, right, roi, o.line_index, accept, &state) > 0)
+    if (o.grow.enabled && CorrectLineIndex(left, right, roi, o.line_index, accept, &state) +
+                                  JoinAcrossPeriodJumps(left, right, roi, o.line_index, accept, &state) >
+                              0)
       GrowDisparity(left, right, roi, o.grow, accept, &state);
     lap("line_index_grow");
     RemoveSpeckles(state.disparity_px, o);

@@ -93,6 +93,8 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.line_index.max_shift_px = m.GetInt("line_index_max_shift_px", mo.line_index.max_shift_px);
     mo.line_index.min_component_px = m.GetInt("line_index_min_component_px", mo.line_index.min_component_px);
     mo.line_index.samples = m.GetInt("line_index_samples", mo.line_index.samples);
+    mo.line_index.min_seam_px = m.GetInt("line_index_min_seam_px", mo.line_index.min_seam_px);
+    mo.line_index.max_seam_gap_px = m.GetInt("line_index_max_seam_gap_px", mo.line_index.max_seam_gap_px);
     mo.line_index.window_half_height_px =
         m.GetInt("line_index_window_half_height_px", mo.line_index.window_half_height_px);
     mo.line_index.max_row_offset_px = m.GetDouble("line_index_max_row_offset_px", mo.line_index.max_row_offset_px);
