@@ -49,9 +49,11 @@ PixelStatus Accept(const cv::Mat& left, const cv::Mat& right, int x, int y, doub
   if (r.std_dn < a.min_texture_dn) return PixelStatus::kLowTexture;
   if (r.disparity_px < a.min_disparity_px || r.disparity_px > a.max_disparity_px) return PixelStatus::kOutOfRange;
   if (a.min_distinctness > 0) {
-    const double off =
-        std::max(WindowZncc(left, right, x, y, r.disparity_px - a.half_period_px, slope_x, slope_y, a.subpixel),
-                 WindowZncc(left, right, x, y, r.disparity_px + a.half_period_px, slope_x, slope_y, a.subpixel));
+    // The grid's period in the right view shrinks or grows with the
+    // foreshortening: 1 - dd/dx of the left one's.
+    const double half = a.half_period_px * std::clamp(1.0 - slope_x, 0.3, 1.7);
+    const double off = std::max(WindowZncc(left, right, x, y, r.disparity_px - half, slope_x, slope_y, a.subpixel),
+                                WindowZncc(left, right, x, y, r.disparity_px + half, slope_x, slope_y, a.subpixel));
     if (r.zncc - off < a.min_distinctness) return PixelStatus::kNotDistinct;
   }
   return PixelStatus::kPoint;

@@ -10,6 +10,7 @@ namespace stereorig {
 
 void GrowOptions::Check() const {
   if (!(max_deviation_px > 0 && max_deviation_px <= 4)) throw InputError("grow_max_deviation_px", "must be in (0, 4]");
+  if (max_tries < 1 || max_tries > 8) throw InputError("grow_max_tries", "must be in [1, 8]");
   if (plane_radius_px < 1 || plane_radius_px > 10) throw InputError("grow_plane_radius_px", "must be in [1, 10]");
 }
 
@@ -58,8 +59,10 @@ int GrowDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
     const float gx = state->slope_x.at<float>(p), gy = state->slope_y.at<float>(p);
     const cv::Point next[4] = {{p.x - 1, p.y}, {p.x + 1, p.y}, {p.x, p.y - 1}, {p.x, p.y + 1}};
     for (const cv::Point& q : next) {
-      if (!roi.contains(q) || std::isfinite(disparity.at<float>(q)) || tried.at<uint8_t>(q)) continue;
-      tried.at<uint8_t>(q) = 1;
+      // A pixel is tried again from later neighbours (up to max_tries): by
+      // then more of its neighbourhood is known, so the prediction is better.
+      if (!roi.contains(q) || std::isfinite(disparity.at<float>(q)) || tried.at<uint8_t>(q) >= o.max_tries) continue;
+      ++tried.at<uint8_t>(q);
       // Predicted from the plane through the valid neighbours (noise ~0.25 px
       // per pixel averages out), else from p and its slopes.
       double predicted = d + gx * (q.x - p.x) + gy * (q.y - p.y), qgx = gx, qgy = gy;

@@ -24,6 +24,7 @@ namespace stereorig {
 
 struct GrowOptions {
   bool enabled = true;            // default true
+  int max_tries = 2;              // attempts per pixel, from different accepted neighbours; default 2
   int plane_radius_px = 3;        // the prediction: plane through the valid pixels within this, px; default 3 (7x7)
   double max_deviation_px = 0.5;  // refined minus predicted disparity, px; default 0.5 (well below a ~8 px period)
   void Check() const;             // throws InputError naming the bad field

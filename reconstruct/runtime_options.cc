@@ -103,6 +103,7 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.grow.enabled = m.GetBool("grow", mo.grow.enabled);
     mo.grow.max_deviation_px = m.GetDouble("grow_max_deviation_px", mo.grow.max_deviation_px);
     mo.grow.plane_radius_px = m.GetInt("grow_plane_radius_px", mo.grow.plane_radius_px);
+    mo.grow.max_tries = m.GetInt("grow_max_tries", mo.grow.max_tries);
     mo.min_distinctness = m.GetDouble("min_distinctness", mo.min_distinctness);
     mo.grid_half_period_px = m.GetDouble("grid_half_period_px", mo.grid_half_period_px);
     m.Finish();
