@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <map>
 #include <vector>
 
@@ -267,9 +265,6 @@ int JoinAcrossPeriodJumps(const cv::Mat& left, const cv::Mat& right, const cv::R
     std::vector<float>& diffs = seams[key];
     std::nth_element(diffs.begin(), diffs.begin() + diffs.size() / 2, diffs.end());
     const double median = diffs[diffs.size() / 2];
-    if (getenv("LI_DEBUG"))
-      std::fprintf(stderr, "seam? %zu px between %zu and %zu px: jump %+.2f\n", length, components[key.first].size(),
-                   components[key.second].size(), median);
     // A smooth surface has no jump: one of about a period (not a depth
     // edge's arbitrary step, which the spread of the seam shows) means one
     // side has the wrong line. Both ways of joining them give one
@@ -299,10 +294,6 @@ int JoinAcrossPeriodJumps(const cv::Mat& left, const cv::Mat& right, const cv::R
       cost_move_a = na < nb ? 0 : 1;
       cost_move_b = 1 - cost_move_a;
     }
-    if (getenv("LI_DEBUG"))
-      std::fprintf(stderr, "seam %zu px between %.0f and %.0f px: jump %+.2f; dy a %+.3f -> %+.3f, b %+.3f -> %+.3f\n",
-                   length, na, nb, median, a0.mean_row_offset_px, a1.mean_row_offset_px, b0.mean_row_offset_px,
-                   b1.mean_row_offset_px);
     if (cost_move_a <= cost_move_b) {
       indexer.Move(components[a], a1.mean_shift_px);
       done[a] = true;
