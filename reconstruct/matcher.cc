@@ -329,14 +329,20 @@ MatchResult MatchCensusSgm(const cv::Mat& left, const cv::Mat& right, const cv::
   RemoveSpeckles(state.disparity_px, o);
   if (o.intensity_refinement && (o.line_index.enabled || o.grow.enabled)) {
     CorrectLineIndex(left, right, roi, o.line_index, accept, &state);
+    lap("line_index");
     GrowDisparity(left, right, roi, o.grow, accept, &state);
+    lap("grow");
     // Grown components are larger, so their vernier reads better; a
     // component moved now leaves a gap that growing closes.
     if (o.grow.enabled && CorrectLineIndex(left, right, roi, o.line_index, accept, &state) +
                                   JoinAcrossPeriodJumps(left, right, roi, o.line_index, accept, &state) >
-                              0)
+                              0) {
+      lap("line_index_2");
       GrowDisparity(left, right, roi, o.grow, accept, &state);
-    lap("line_index_grow");
+      lap("grow_2");
+    } else {
+      lap("line_index_2");
+    }
     RemoveSpeckles(state.disparity_px, o);
   }
   for (int y = 0; y < left.rows; ++y) {

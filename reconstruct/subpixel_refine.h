@@ -43,7 +43,8 @@ SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x,
                                double slope_y, const SubpixelOptions& options);
 
 // ZNCC of the window at disparity d (no fit; the right window warped by the
-// slopes as above, Lanczos-3 sampled). -1 if the window leaves either image.
+// slopes as above, linearly interpolated). -1 if the window leaves either
+// image.
 double WindowZncc(const cv::Mat& left, const cv::Mat& right, int x, int y, double d, double slope_x, double slope_y,
                   const SubpixelOptions& options);
 
