@@ -59,7 +59,8 @@ int RunScore(int argc, char** argv) {
       "reconstructs the active capture (and the passive one), aligns the merged cloud to the dense truth surface "
       "by one rigid motion (reported), and reports mean |error| and std per module and merged; the fill rate of "
       "each module over the object pixels that both its cameras see and a laser grid lights (from the truth's "
-      "depth, id and lit maps); and the active/passive valid-point ratio. Use the rig file from `stereorig "
+      "depth, id and lit maps); and the active/passive valid-point ratio (passive: the same options without the "
+      "lit-region crop and the grid-period distinctness test). Use the rig file from `stereorig "
       "calibrate`, as issue 5 asks; without --rig the dataset's truth rig is used (and said so).\n\n"
       "Example:\n  stereorig score --dataset demo/dataset --rig demo/rig.yaml --report score.json",
       "stereorig score"};
@@ -81,7 +82,9 @@ int RunScore(int argc, char** argv) {
   const Rig rig = ReadRigFile(rig_path);
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
   RuntimeOptions passive_options = options;
-  passive_options.crop_to_lit_region = false;  // no grid: the whole volume's ROI
+  // No grid: the whole volume's ROI, and no test of the grid's period.
+  passive_options.crop_to_lit_region = false;
+  passive_options.match.min_distinctness = 0;
   const Runtime runtime(rig, options), passive_runtime(rig, passive_options);
   nlohmann::json report = {{"dataset", dataset}, {"rig", rig_path}};
   {
