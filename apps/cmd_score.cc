@@ -11,6 +11,7 @@
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
+#include "apps/reconstruct_json.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
@@ -19,11 +20,6 @@
 
 namespace stereorig {
 namespace {
-
-nlohmann::json FiguresJson(const ErrorFigures& f) {
-  return {{"points", f.points}, {"mean_abs_mm", f.mean_abs_mm}, {"mean_mm", f.mean_mm},
-          {"std_mm", f.std_mm}, {"rms_mm", f.rms_mm},           {"p95_abs_mm", f.p95_abs_mm}};
-}
 
 nlohmann::json FillJson(const FillFigures& f) {
   nlohmann::json j = {
@@ -102,7 +98,7 @@ int RunScore(int argc, char** argv) {
     nlohmann::json sj = {
         {"scene", name},
         {"points", rec.cloud.size()},
-        {"merged", FiguresJson(s.accuracy.all)},
+        {"merged", ErrorFiguresJson(s.accuracy.all)},
         {"fill", FillJson(s.fill_all)},
         {"alignment_truth_from_cloud",
          {{"rotation_deg", s.accuracy.truth_from_cloud.AngleDeg()},
@@ -113,7 +109,7 @@ int RunScore(int argc, char** argv) {
                 100 * s.fill_all.fill(), s.fill_all.target_px, s.accuracy.all.mean_abs_mm, s.accuracy.all.std_mm);
     for (size_t m = 0; m < s.fill.size(); ++m) {
       const ErrorFigures& e = s.accuracy.per_module[m];
-      sj["modules"].push_back({{"module", m}, {"accuracy", FiguresJson(e)}, {"fill", FillJson(s.fill[m])}});
+      sj["modules"].push_back({{"module", m}, {"accuracy", ErrorFiguresJson(e)}, {"fill", FillJson(s.fill[m])}});
       std::printf("; m%zu fill %5.1f%% |e| %.4f std %.4f", m, 100 * s.fill[m].fill(), e.mean_abs_mm, e.std_mm);
     }
     if (!no_passive && fs::is_directory(scene_dir / "passive")) {

@@ -100,23 +100,32 @@ TEST(Render, DepthMapsMatchAnalyticIntersection) {
   }
 }
 
+// Camera 0 of the default rig looking at the plate scene (seed 5) with both
+// laser grids on, and the transforms the checks need.
+struct PlateWithGrids {
+  DefaultSetup s;
+  const Camera& cam = s.rig.sim.rig.camera(0);
+  const CameraRays rays{cam, 2};
+  const Pose world_from_cam = s.rig.world_from_camera[0];
+  const Scene scene = MakeScene("plate", s.spec.scenes, s.spec.render, 5);
+  const std::vector<LaserProjector> projectors =
+      MakeProjectors(s.spec, s.rig.world_from_projector, s.rig.projector_distance_mm);
+  const SceneRadiance rad = RenderScene(rays, world_from_cam, scene, projectors, s.spec.render);
+  const Pose obj_from_cam = scene.objects[0].object_from_world * world_from_cam;
+  const Pose proj_from_cam = s.rig.world_from_projector[0].Inverse() * world_from_cam;
+};
+
 // The laser lines fall where the projector's geometry says: along image rows,
 // the sub-pixel peaks of the laser image are unprojected exactly, met with
 // the plate's face, and turned into the projector's direction cosines, which
 // must sit on the grid sin(fan/2) * (2i/(N-1) - 1).
 TEST(Render, LaserLinesFallWhereTheProjectorGeometrySays) {
-  DefaultSetup s;
-  const int cam_index = 0;
-  const Camera& cam = s.rig.sim.rig.camera(cam_index);
-  const CameraRays rays(cam, 2);
-  const Pose& world_from_cam = s.rig.world_from_camera[cam_index];
-  const Scene scene = MakeScene("plate", s.spec.scenes, s.spec.render, 5);
-  const std::vector<LaserProjector> projectors =
-      MakeProjectors(s.spec, s.rig.world_from_projector, s.rig.projector_distance_mm);
-  const SceneRadiance rad = RenderScene(rays, world_from_cam, scene, projectors, s.spec.render);
-  const SceneObject& obj = scene.objects[0];
-  const Pose obj_from_cam = obj.object_from_world * world_from_cam;
-  const Pose proj_from_cam = s.rig.world_from_projector[0].Inverse() * world_from_cam;
+  const PlateWithGrids p;
+  const DefaultSetup& s = p.s;
+  const Camera& cam = p.cam;
+  const SceneRadiance& rad = p.rad;
+  const Pose& obj_from_cam = p.obj_from_cam;
+  const Pose& proj_from_cam = p.proj_from_cam;
   const ProjectorSpec& ps = s.spec.modules[0].projector;
   const double sin_half = std::sin(0.5 * ps.fan_angle_deg * M_PI / 180.0), sigma = ps.line_sigma_mrad * 1e-3;
   auto nearest = [&](double a) {
@@ -201,18 +210,12 @@ TEST(Render, LaserIsShadowed) {
 // (laser light above a quarter of a line's peak: 2 sigma off a line's
 // centre is e^-2 = 0.14 of it) falls outside the lit map.
 TEST(Render, LitMapMarksTheGridEnvelope) {
-  DefaultSetup s;
-  const int cam_index = 0;
-  const Camera& cam = s.rig.sim.rig.camera(cam_index);
-  const CameraRays rays(cam, 2);
-  const Pose& world_from_cam = s.rig.world_from_camera[cam_index];
-  const Scene scene = MakeScene("plate", s.spec.scenes, s.spec.render, 5);
-  const std::vector<LaserProjector> projectors =
-      MakeProjectors(s.spec, s.rig.world_from_projector, s.rig.projector_distance_mm);
-  const SceneRadiance rad = RenderScene(rays, world_from_cam, scene, projectors, s.spec.render);
-  const SceneObject& obj = scene.objects[0];
-  const Pose obj_from_cam = obj.object_from_world * world_from_cam;
-  const Pose proj_from_cam = s.rig.world_from_projector[0].Inverse() * world_from_cam;
+  const PlateWithGrids p;
+  const DefaultSetup& s = p.s;
+  const Camera& cam = p.cam;
+  const SceneRadiance& rad = p.rad;
+  const Pose& obj_from_cam = p.obj_from_cam;
+  const Pose& proj_from_cam = p.proj_from_cam;
   const ProjectorSpec& ps = s.spec.modules[0].projector;
   const double sin_half = std::sin(0.5 * ps.fan_angle_deg * M_PI / 180.0) + 2e-3 * ps.line_sigma_mrad;
   const Eigen::Vector3d half = 0.5 * s.spec.scenes.plate_size_mm;

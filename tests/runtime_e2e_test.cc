@@ -69,37 +69,36 @@ class RuntimeOnSimulatedScenes : public ::testing::Test {
 };
 std::string* RuntimeOnSimulatedScenes::dataset_ = nullptr;
 
-// Issue 5's figures, where this session meets them; the fill is asserted at
-// what it measures, NOT yet at the issue's 90 % (measured: cup 0.92 and 0.85
-// per module, sphere 0.83 and 0.82; the losses are listed by `stereorig
-// score`).
-TEST_F(RuntimeOnSimulatedScenes, CupMeetsTheAccuracyTargets) {
-  const Outcome o = Run("cup");
-  ASSERT_EQ(o.score.fill.size(), 2u);
+// Issue 5's per-module figures, where this session meets them, on both
+// modules. One module at 200 mm: mean |e| <= 0.1 mm, std <= 0.1 mm; measured
+// 0.05 / 0.07 mm: laser speckle (contrast 0.2, independent per camera)
+// decorrelates the views to a ZNCC of ~0.9, ~0.25 px of disparity noise =
+// 0.1 mm of depth. The fill is asserted at what it measures, NOT yet at the
+// issue's 90 % (`stereorig score` lists the losses). Nearly every point is on
+// a target pixel: points where the right camera does not see the surface
+// would be guesses.
+void ExpectModuleFigures(const SceneScore& s, double min_fill) {
+  ASSERT_EQ(s.fill.size(), 2u);
   for (size_t m = 0; m < 2; ++m) {
-    // One module at 200 mm: mean |e| <= 0.1 mm, std <= 0.1 mm (issue 5).
-    // Measured 0.05 / 0.07 mm: laser speckle (contrast 0.2, independent per
-    // camera) decorrelates the views to a ZNCC of ~0.9, ~0.25 px of
-    // disparity noise = 0.1 mm of depth.
-    EXPECT_LT(o.score.accuracy.per_module[m].mean_abs_mm, 0.1);
-    EXPECT_LT(o.score.accuracy.per_module[m].std_mm, 0.1);
-    EXPECT_GT(o.score.fill[m].fill(), 0.82);
-    // Nearly every point is on a target pixel: points where the right
-    // camera does not see the surface would be guesses.
-    EXPECT_LT(o.score.fill[m].other_px, 0.03 * o.score.fill[m].filled_px);
+    EXPECT_LT(s.accuracy.per_module[m].mean_abs_mm, 0.1) << "module " << m;
+    EXPECT_LT(s.accuracy.per_module[m].std_mm, 0.1) << "module " << m;
+    EXPECT_GT(s.fill[m].fill(), min_fill) << "module " << m;
+    EXPECT_LT(s.fill[m].other_px, 0.03 * s.fill[m].filled_px) << "module " << m;
   }
-  EXPECT_LT(o.score.accuracy.all.mean_abs_mm, 0.15);  // two modules merged
-  EXPECT_GT(o.score.fill_all.fill(), 0.85);
+  EXPECT_LT(s.accuracy.all.mean_abs_mm, 0.15);  // two modules merged
 }
 
+// Measured fill: 0.92 and 0.90 per module.
+TEST_F(RuntimeOnSimulatedScenes, CupMeetsTheAccuracyTargets) {
+  const Outcome o = Run("cup");
+  ExpectModuleFigures(o.score, 0.85);
+  EXPECT_GT(o.score.fill_all.fill(), 0.88);
+}
+
+// Measured fill: 0.84 on both modules.
 TEST_F(RuntimeOnSimulatedScenes, SphereAgreesWithTheAnalyticSphere) {
   const Outcome o = Run("sphere");
-  ASSERT_EQ(o.score.fill.size(), 2u);
-  for (size_t m = 0; m < 2; ++m) {
-    EXPECT_LT(o.score.accuracy.per_module[m].mean_abs_mm, 0.1);
-    EXPECT_LT(o.score.accuracy.per_module[m].std_mm, 0.1);
-    EXPECT_GT(o.score.fill[m].fill(), 0.78);
-  }
+  ExpectModuleFigures(o.score, 0.80);
   // The analytic sphere (object.yaml: centre, diameter), in the truth rig's
   // frame: the cloud needs no alignment here. Radial residuals of every
   // point; a wrong grid line index shows as a blob ~3.5 mm off.
