@@ -12,6 +12,7 @@ int RunMatch(int argc, char** argv);
 int RunVerify(int argc, char** argv);
 int RunCheck(int argc, char** argv);
 int RunBench(int argc, char** argv);
+int RunScore(int argc, char** argv);
 int RunRig(int argc, char** argv);
 int RunDemo(int argc, char** argv);
 
@@ -25,6 +26,7 @@ const std::vector<Command>& Commands() {
       {"verify", "reconstruction of a reference artifact -> VDI/VDE 2634-2 figures, pass/fail", &RunVerify},
       {"check", "nightly check: fresh target captures + rig file -> drift verdict, history", &RunCheck},
       {"bench", "throughput, side by side with an OpenCV StereoSGBM pipeline", &RunBench},
+      {"score", "the runtime on a simulator dataset against truth: accuracy, fill, active/passive", &RunScore},
       {"rig", "inspect a rig file: validate, summarise, export .cameramodel files", &RunRig},
       {"demo", "run every stage on the embedded default rig and print the figures", &RunDemo},
   };

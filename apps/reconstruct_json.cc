@@ -27,4 +27,9 @@ nlohmann::json ReconstructionJson(const Reconstruction& rec) {
   return j;
 }
 
+nlohmann::json ErrorFiguresJson(const ErrorFigures& f) {
+  return {{"points", f.points}, {"mean_abs_mm", f.mean_abs_mm}, {"mean_mm", f.mean_mm},
+          {"std_mm", f.std_mm}, {"rms_mm", f.rms_mm},           {"p95_abs_mm", f.p95_abs_mm}};
+}
+
 }  // namespace stereorig

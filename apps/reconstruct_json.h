@@ -4,11 +4,16 @@
 #include <nlohmann/json.hpp>
 
 #include "reconstruct/runtime.h"
+#include "reconstruct/score.h"
 
 namespace stereorig {
 
 // Per-step times (ms), point counts and fill rate per module, the merged
 // totals and the shape fit. Keys carry their units.
 nlohmann::json ReconstructionJson(const Reconstruction& rec);
+
+// Accuracy figures against truth (score.h): points, mean_abs_mm, mean_mm,
+// std_mm, rms_mm, p95_abs_mm.
+nlohmann::json ErrorFiguresJson(const ErrorFigures& f);
 
 }  // namespace stereorig

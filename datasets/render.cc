@@ -17,6 +17,11 @@ double LaserProjector::DistanceToLine(const Eigen::Vector3d& u, int family, int*
   return a - sin_half_fan * (k / half - 1.0);
 }
 
+bool LaserProjector::InEnvelope(const Eigen::Vector3d& u) const {
+  const double edge = sin_half_fan + 2 * sigma;
+  return u.z() > 0 && std::abs(u.x()) <= edge && std::abs(u.y()) <= edge;
+}
+
 double LaserProjector::Pattern(const Eigen::Vector3d& u) const {
   if (u.z() <= 0) return 0;
   const double reach = sin_half_fan + 4 * sigma;  // the lines end at the fan's edge (soft)
@@ -78,6 +83,24 @@ double LaserAt(const Scene& scene, const std::vector<LaserProjector>& projectors
   return sum;
 }
 
+// Bit k set if projector k's grid envelope covers p (outward normal n_vis,
+// turned towards the viewer), p faces it and nothing shadows it.
+uint8_t LitBy(const Scene& scene, const std::vector<LaserProjector>& projectors, const Eigen::Vector3d& p,
+              const Eigen::Vector3d& n_vis) {
+  uint8_t bits = 0;
+  for (size_t k = 0; k < projectors.size() && k < 8; ++k) {
+    const LaserProjector& l = projectors[k];
+    Eigen::Vector3d to = l.origin_world - p;
+    const double dist = to.norm();
+    to /= dist;
+    if (n_vis.dot(to) <= 0) continue;
+    if (!l.InEnvelope(l.projector_from_world.rotation() * (-to))) continue;
+    if (scene.Occluded(p, to, 1e-3, dist - 1e-3)) continue;
+    bits |= uint8_t(1u << k);
+  }
+  return bits;
+}
+
 }  // namespace
 
 SceneRadiance RenderScene(const CameraRays& rays, const Pose& world_from_cam, const Scene& scene,
@@ -88,6 +111,7 @@ SceneRadiance RenderScene(const CameraRays& rays, const Pose& world_from_cam, co
   out.laser = cv::Mat(H, W, CV_32F, cv::Scalar(0));
   out.depth = cv::Mat(H, W, CV_32F, cv::Scalar(0));
   out.id = cv::Mat(H, W, CV_8U, cv::Scalar(0));
+  out.lit = cv::Mat(H, W, CV_8U, cv::Scalar(0));
   const int n = render.samples_per_axis;
   const double inv_n2 = 1.0 / (n * n);
   const Eigen::Matrix3d& R = world_from_cam.rotation();
@@ -97,6 +121,7 @@ SceneRadiance RenderScene(const CameraRays& rays, const Pose& world_from_cam, co
     float* laser = out.laser.ptr<float>(r);
     float* depth = out.depth.ptr<float>(r);
     uint8_t* id = out.id.ptr<uint8_t>(r);
+    uint8_t* lit = out.lit.ptr<uint8_t>(r);
     for (int c = 0; c < W; ++c) {
       if (!rays.PixelValid(c, r)) {
         passive[c] = static_cast<float>(render.background_dn);
@@ -108,6 +133,9 @@ SceneRadiance RenderScene(const CameraRays& rays, const Pose& world_from_cam, co
         if (scene.Intersect(o, R * v, 0, 1e9, &hit)) {
           depth[c] = static_cast<float>(hit.t * v.z());
           id[c] = static_cast<uint8_t>(hit.object->id);
+          const Eigen::Vector3d d = R * v;
+          lit[c] = LitBy(scene, projectors, hit.p_world,
+                         hit.n_world.dot(d) > 0 ? Eigen::Vector3d(-hit.n_world) : hit.n_world);
         }
       }
       double sum_passive = 0, sum_laser = 0;

@@ -36,6 +36,11 @@ struct LaserProjector {
   // Relative line intensity (0..2, 2 at a crossing) along unit direction
   // u_projector (projector frame).
   double Pattern(const Eigen::Vector3d& u_projector) const;
+  // True if unit direction u_projector (projector frame) lies inside the
+  // grid's envelope: the square between the outermost lines of both
+  // families, widened by 2 sigma so the outermost lines themselves are in
+  // (|u_x|, |u_y| <= sin(fan/2) + 2 sigma, in front).
+  bool InEnvelope(const Eigen::Vector3d& u_projector) const;
   // Distance (direction-cosine units) from u to the nearest line of family
   // 0 (constant u_x) or 1 (constant u_y); the line index in *line.
   double DistanceToLine(const Eigen::Vector3d& u_projector, int family, int* line) const;
@@ -50,6 +55,12 @@ struct SceneRadiance {
   cv::Mat laser;    // CV_32F (H,W): laser light only, mean over the samples (DN)
   cv::Mat depth;    // CV_32F (H,W): z (camera frame, mm) where the pixel-centre ray meets a surface; 0 = none
   cv::Mat id;       // CV_8U (H,W): object id at the pixel centre; 0 = background
+  // CV_8U (H,W): which grids light the surface point at the pixel centre:
+  // bit k set if projector k (of the `projectors` list) has it inside its
+  // grid envelope (LaserProjector::InEnvelope), facing it, and not in its
+  // shadow; 0 = background or unlit. The denominator of the fill rate
+  // (reconstruct/fill_score.h): lines and the dark gaps between them alike.
+  cv::Mat lit;
 };
 
 // Ray-casts every pixel with n x n stratified samples (render.samples_per_axis).

@@ -100,24 +100,28 @@ TEST(Render, DepthMapsMatchAnalyticIntersection) {
   }
 }
 
+// Camera 0 of the default rig looking at the plate scene (seed 5) with both
+// laser grids on, and the transforms the checks need.
+struct PlateWithGrids {
+  DefaultSetup s;
+  const Camera& cam = s.rig.sim.rig.camera(0);
+  const CameraRays rays{cam, 2};
+  const Pose world_from_cam = s.rig.world_from_camera[0];
+  const Scene scene = MakeScene("plate", s.spec.scenes, s.spec.render, 5);
+  const std::vector<LaserProjector> projectors =
+      MakeProjectors(s.spec, s.rig.world_from_projector, s.rig.projector_distance_mm);
+  const SceneRadiance rad = RenderScene(rays, world_from_cam, scene, projectors, s.spec.render);
+  const Pose obj_from_cam = scene.objects[0].object_from_world * world_from_cam;
+  const Pose proj_from_cam = s.rig.world_from_projector[0].Inverse() * world_from_cam;
+};
+
 // The laser lines fall where the projector's geometry says: along image rows,
 // the sub-pixel peaks of the laser image are unprojected exactly, met with
 // the plate's face, and turned into the projector's direction cosines, which
 // must sit on the grid sin(fan/2) * (2i/(N-1) - 1).
 TEST(Render, LaserLinesFallWhereTheProjectorGeometrySays) {
-  DefaultSetup s;
-  const int cam_index = 0;
-  const Camera& cam = s.rig.sim.rig.camera(cam_index);
-  const CameraRays rays(cam, 2);
-  const Pose& world_from_cam = s.rig.world_from_camera[cam_index];
-  const Scene scene = MakeScene("plate", s.spec.scenes, s.spec.render, 5);
-  const std::vector<LaserProjector> projectors =
-      MakeProjectors(s.spec, s.rig.world_from_projector, s.rig.projector_distance_mm);
-  const SceneRadiance rad = RenderScene(rays, world_from_cam, scene, projectors, s.spec.render);
-  const SceneObject& obj = scene.objects[0];
-  const Pose obj_from_cam = obj.object_from_world * world_from_cam;
-  const Pose proj_from_cam = s.rig.world_from_projector[0].Inverse() * world_from_cam;
-  const ProjectorSpec& ps = s.spec.modules[0].projector;
+  const PlateWithGrids p;
+  const ProjectorSpec& ps = p.s.spec.modules[0].projector;
   const double sin_half = std::sin(0.5 * ps.fan_angle_deg * M_PI / 180.0), sigma = ps.line_sigma_mrad * 1e-3;
   auto nearest = [&](double a) {
     double best = 1e9;
@@ -130,24 +134,24 @@ TEST(Render, LaserLinesFallWhereTheProjectorGeometrySays) {
   double sum2 = 0, worst = 0;
   int peaks = 0;
   double max_l = 0;
-  cv::minMaxLoc(rad.laser, nullptr, &max_l);
-  for (int r = 2; r + 2 < rad.laser.rows; ++r) {
-    const float* L = rad.laser.ptr<float>(r);
-    for (int c = 2; c + 2 < rad.laser.cols; ++c) {
+  cv::minMaxLoc(p.rad.laser, nullptr, &max_l);
+  for (int r = 2; r + 2 < p.rad.laser.rows; ++r) {
+    const float* L = p.rad.laser.ptr<float>(r);
+    for (int c = 2; c + 2 < p.rad.laser.cols; ++c) {
       if (!(L[c] > L[c - 1] && L[c] >= L[c + 1] && L[c] > 0.3 * max_l)) continue;
       const double den = L[c - 1] - 2.0 * L[c] + L[c + 1];
       if (den >= 0) continue;
       const double q = c + 0.5 * (L[c - 1] - L[c + 1]) / den;
       Eigen::Vector3d v;
-      ASSERT_TRUE(cam.Unproject(Eigen::Vector2d(q, r), &v));
-      const Eigen::Vector3d o = obj_from_cam.translation_mm(), d = obj_from_cam.rotation() * v.normalized();
-      const double z = o.z() < 0 ? -0.5 * s.spec.scenes.plate_size_mm.z() : 0.5 * s.spec.scenes.plate_size_mm.z();
+      ASSERT_TRUE(p.cam.Unproject(Eigen::Vector2d(q, r), &v));
+      const Eigen::Vector3d o = p.obj_from_cam.translation_mm(), d = p.obj_from_cam.rotation() * v.normalized();
+      const double z = o.z() < 0 ? -0.5 * p.s.spec.scenes.plate_size_mm.z() : 0.5 * p.s.spec.scenes.plate_size_mm.z();
       const Eigen::Vector3d p_obj = o + (z - o.z()) / d.z() * d;
-      if (std::abs(p_obj.x()) > 0.5 * s.spec.scenes.plate_size_mm.x() - 1 ||
-          std::abs(p_obj.y()) > 0.5 * s.spec.scenes.plate_size_mm.y() - 1) {
+      if (std::abs(p_obj.x()) > 0.5 * p.s.spec.scenes.plate_size_mm.x() - 1 ||
+          std::abs(p_obj.y()) > 0.5 * p.s.spec.scenes.plate_size_mm.y() - 1) {
         continue;
       }
-      const Eigen::Vector3d u = (proj_from_cam * (obj_from_cam.Inverse() * p_obj)).normalized();
+      const Eigen::Vector3d u = (p.proj_from_cam * (p.obj_from_cam.Inverse() * p_obj)).normalized();
       // Peaks along a row belong to the near-vertical family (constant u_x);
       // skip those on or near a crossing line of the other family.
       if (std::abs(nearest(u.y())) < 3 * sigma || std::abs(u.y()) > sin_half) continue;
@@ -192,6 +196,54 @@ TEST(Render, LaserIsShadowed) {
   const Eigen::Vector3d p_front(0, 0, -0.5 * ss.sphere_diameter_mm);
   EXPECT_FALSE(front.Occluded(p_front, (l0.origin_world - p_front).normalized(), 1e-3,
                               (l0.origin_world - p_front).norm() - 1e-3));
+}
+
+// The grid-lit truth map: on the plate, a pixel is lit by projector 0 exactly
+// when its surface point (exact unprojection, closed-form plane, written
+// here) lies inside the square between projector 0's outermost lines (+2
+// line sigmas), as the spec's fan and the projector pose say. And no line
+// (laser light above a quarter of a line's peak: 2 sigma off a line's
+// centre is e^-2 = 0.14 of it) falls outside the lit map.
+TEST(Render, LitMapMarksTheGridEnvelope) {
+  const PlateWithGrids p;
+  const ProjectorSpec& ps = p.s.spec.modules[0].projector;
+  const double sin_half = std::sin(0.5 * ps.fan_angle_deg * M_PI / 180.0) + 2e-3 * ps.line_sigma_mrad;
+  const Eigen::Vector3d half = 0.5 * p.s.spec.scenes.plate_size_mm;
+  int checked = 0, lit = 0, wrong = 0, dark_light = 0;
+  for (int r = 0; r < p.cam.imager_height_px(); r += 3) {
+    for (int c = 0; c < p.cam.imager_width_px(); c += 3) {
+      if (p.rad.id.at<uint8_t>(r, c) == 0) {
+        dark_light += p.rad.lit.at<uint8_t>(r, c) != 0;
+        continue;
+      }
+      Eigen::Vector3d v;
+      ASSERT_TRUE(p.cam.Unproject(Eigen::Vector2d(c, r), &v));
+      const Eigen::Vector3d o = p.obj_from_cam.translation_mm(), d = p.obj_from_cam.rotation() * v;
+      const double z = o.z() < 0 ? -half.z() : half.z();  // the face towards the camera
+      const Eigen::Vector3d p_obj = o + (z - o.z()) / d.z() * d;
+      // Skip pixels within 0.5 mm of the plate's edge or of the envelope's
+      // border (the pixel centre's ray and this one differ by ~1e-5 mm).
+      if (std::abs(p_obj.x()) > half.x() - 0.5 || std::abs(p_obj.y()) > half.y() - 0.5) continue;
+      const Eigen::Vector3d u = (p.proj_from_cam * (p.obj_from_cam.Inverse() * p_obj)).normalized();
+      const double margin = std::max(std::abs(u.x()), std::abs(u.y())) - sin_half;
+      if (std::abs(margin) < 1e-4) continue;
+      const bool inside = margin < 0;
+      const bool marked = p.rad.lit.at<uint8_t>(r, c) & 1;
+      wrong += inside != marked;
+      lit += marked;
+      ++checked;
+      // Light only where the map says lit (by projector 0 or 1).
+      if (p.rad.lit.at<uint8_t>(r, c) == 0) {
+        EXPECT_LT(p.rad.laser.at<float>(r, c), 0.25 * ps.power_dn) << c << "," << r;
+      }
+    }
+  }
+  std::printf("lit map: %d plate pixels checked, %d lit, %d disagree\n", checked, lit, wrong);
+  EXPECT_GT(checked, 5000);
+  EXPECT_GT(lit, 1000);
+  EXPECT_LT(lit, checked);  // the plate is larger than the grid: both cases are tested
+  EXPECT_EQ(wrong, 0);
+  EXPECT_EQ(dark_light, 0);  // background is never lit
 }
 
 TEST(Render, SensorNoiseHasTheModelledSpread) {

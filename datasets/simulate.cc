@@ -320,6 +320,7 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
       WriteImage(tmp / "scenes" / scene.name / "active" / (name + ".png"), active);
       WriteImage(truth / ("depth_" + name + ".tiff"), rad.depth);
       WriteImage(truth / ("id_" + name + ".png"), rad.id);
+      WriteImage(truth / ("lit_" + name + ".png"), rad.lit);
       images += 2;
       progress.Done(scene.name + " " + name);
       return;

@@ -7,7 +7,7 @@
 //   DIR/truth/rig.yaml                      true rig, reference = module 0
 //   DIR/truth/calibration_poses.yaml
 //   DIR/truth/simulation.yaml               seed, knobs that are not in the spec (bumps)
-//   DIR/truth/scenes/<scene>/{object.yaml, surface.ply, depth_camK.tiff, id_camK.png}
+//   DIR/truth/scenes/<scene>/{object.yaml, surface.ply, depth_camK.tiff, id_camK.png, lit_camK.png}
 //
 // The folder appears atomically: everything is written to a sibling temporary
 // folder that is renamed into place at the end. The same spec and seed give

@@ -9,18 +9,30 @@
 
 #include "calib/core/input_error.h"
 #include "reconstruct/disparity_band.h"
+#include "reconstruct/line_index.h"
 #include "reconstruct/parallel_for.h"
+#include "reconstruct/region_grow.h"
 
 namespace stereorig {
 
 MatcherKind ParseMatcherKind(const std::string& name, const std::string& where) {
   if (name == "census_sgm") return MatcherKind::kCensusSgm;
   if (name == "opencv_sgbm_3way") return MatcherKind::kOpenCvSgbm3Way;
-  throw InputError(where, "unknown matcher '" + name + "' (census_sgm or opencv_sgbm_3way)");
+  if (name == "opencv_sgbm_3way_standalone") return MatcherKind::kOpenCvSgbm3WayStandalone;
+  throw InputError(where, "unknown matcher '" + name +
+                              "' (census_sgm, opencv_sgbm_3way or opencv_sgbm_3way_standalone)");
 }
 
 const char* MatcherKindName(MatcherKind kind) {
-  return kind == MatcherKind::kCensusSgm ? "census_sgm" : "opencv_sgbm_3way";
+  switch (kind) {
+    case MatcherKind::kCensusSgm:
+      return "census_sgm";
+    case MatcherKind::kOpenCvSgbm3Way:
+      return "opencv_sgbm_3way";
+    case MatcherKind::kOpenCvSgbm3WayStandalone:
+      return "opencv_sgbm_3way_standalone";
+  }
+  return "?";
 }
 
 void MatchOptions::Check() const {
@@ -37,7 +49,12 @@ void MatchOptions::Check() const {
   if (census_half_height_px < 1 || census_half_height_px > 3)
     throw InputError("census_half_height_px", "must be in [1, 3]");
   sgm.Check();
+  if (!(min_distinctness >= 0 && min_distinctness <= 2)) throw InputError("min_distinctness", "must be in [0, 2]");
+  if (!(grid_half_period_px >= 1 && grid_half_period_px <= 32))
+    throw InputError("grid_half_period_px", "must be in [1, 32]");
   subpixel.Check();
+  line_index.Check();
+  grow.Check();
   if (!(min_zncc >= -1 && min_zncc < 1)) throw InputError("min_zncc", "must be in [-1, 1)");
   if (!(max_plane_deviation_px >= 0)) throw InputError("max_plane_deviation_px", "must be >= 0 (0 = off)");
   if (!(min_texture_dn >= 0)) throw InputError("min_texture_dn", "must be >= 0");
@@ -181,8 +198,10 @@ void DisparitySlopes(const cv::Mat& disparity, cv::Mat* slope_x, cv::Mat* slope_
   const cv::Mat s_x = box(mx), s_y = box(my), s_xd = box(mx.mul(md) / cv::max(m, 1e-9f)),
                 s_yd = box(my.mul(md) / cv::max(m, 1e-9f)), s_xx = box(mx.mul(xs)), s_yy = box(my.mul(ys)),
                 s_xy = box(mx.mul(ys));
-  *slope_x = cv::Mat(disparity.size(), CV_32FC1, cv::Scalar(0));
-  *slope_y = cv::Mat(disparity.size(), CV_32FC1, cv::Scalar(0));
+  // slope_x, slope_y: views of the caller's maps (region size), written in place.
+  STEREORIG_CHECK(slope_x->size() == disparity.size() && slope_y->size() == disparity.size());
+  slope_x->setTo(0);
+  slope_y->setTo(0);
   *plane = cv::Mat(disparity.size(), CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
   for (int y = 0; y < disparity.rows; ++y)
     for (int x = 0; x < disparity.cols; ++x) {
@@ -282,55 +301,156 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
   const cv::Mat coarse_to_fine =
       sgbm ? SgbmRegion(left, right, roi, o) : MatchLevel(left, right, roi, dmin, num, o.pyramid_levels, o);
   lap(sgbm ? "sgbm" : "sgm");
-  result.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
-  result.confidence = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
-  const double dmax = o.min_disparity_px + o.num_disparities - 1;
-  cv::Mat slope_x, slope_y, plane;
-  DisparitySlopes(coarse_to_fine, &slope_x, &slope_y, &plane);
+  DisparityState state;
+  state.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
+  state.confidence = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
+  state.status = cv::Mat(left.size(), CV_8UC1, cv::Scalar(uint8_t(PixelStatus::kNotSearched)));
+  state.slope_x = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
+  state.slope_y = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
+  RefineAcceptance accept;
+  accept.subpixel = o.subpixel;
+  accept.min_zncc = o.min_zncc;
+  accept.min_texture_dn = o.min_texture_dn;
+  accept.min_disparity_px = o.min_disparity_px;
+  accept.max_disparity_px = o.min_disparity_px + o.num_disparities - 1;
+  accept.min_distinctness = o.min_distinctness;
+  accept.half_period_px = o.grid_half_period_px;
+  cv::Mat plane;
+  cv::Mat slope_x_roi = state.slope_x(roi), slope_y_roi = state.slope_y(roi);
+  DisparitySlopes(coarse_to_fine, &slope_x_roi, &slope_y_roi, &plane);
   ParallelForChunks(roi.height, o.num_threads, [&](int b, int e) {
     for (int yy = b; yy < e; ++yy) {
       const int y = roi.y + yy;
       const float* in = coarse_to_fine.ptr<float>(yy);
-      float* out = result.disparity_px.ptr<float>(y);
-      float* conf = result.confidence.ptr<float>(y);
+      const float* slope_x = state.slope_x.ptr<float>(y);
+      const float* slope_y = state.slope_y.ptr<float>(y);
+      float* out = state.disparity_px.ptr<float>(y);
+      float* conf = state.confidence.ptr<float>(y);
+      uint8_t* status = state.status.ptr<uint8_t>(y);
       for (int xx = 0; xx < roi.width; ++xx) {
-        if (std::isnan(in[xx])) continue;
         const int x = roi.x + xx;
+        auto reject = [&](PixelStatus why) { status[x] = uint8_t(why); };
+        if (std::isnan(in[xx])) {
+          reject(PixelStatus::kNoSgmMatch);
+          continue;
+        }
         double d = in[xx];
         float confidence = 1.0f;
         const float pl = plane.at<float>(yy, xx);
+        if (o.max_plane_deviation_px > 0 && std::isnan(pl)) {
+          reject(PixelStatus::kNoPlane);
+          continue;
+        }
         // The plane test below, applied early to the cost-fit disparity (the
         // refinement moves it by < max_shift_px): saves refining mismatches.
-        if (o.max_plane_deviation_px > 0 &&
-            (std::isnan(pl) || std::abs(d - pl) > o.max_plane_deviation_px + o.subpixel.max_shift_px))
+        if (o.max_plane_deviation_px > 0 && std::abs(d - pl) > o.max_plane_deviation_px + o.subpixel.max_shift_px) {
+          reject(PixelStatus::kOffPlaneCoarse);
           continue;
+        }
         if (o.intensity_refinement) {
-          const SubpixelResult s =
-              RefineDisparity(left, right, x, y, d, slope_x.at<float>(yy, xx), slope_y.at<float>(yy, xx), o.subpixel);
-          if (!s.ok || s.zncc < o.min_zncc || s.std_dn < o.min_texture_dn) continue;
+          const SubpixelResult s = RefineDisparity(left, right, x, y, d, slope_x[x], slope_y[x], o.subpixel);
+          const PixelStatus why = Accept(left, right, x, y, slope_x[x], slope_y[x], s, accept);
+          if (why != PixelStatus::kPoint) {
+            reject(why);
+            continue;
+          }
           d = s.disparity_px;
           confidence = float(std::clamp(s.zncc, 0.0, 1.0));
+        } else if (d < accept.min_disparity_px || d > accept.max_disparity_px) {  // range filter
+          reject(PixelStatus::kOutOfRange);
+          continue;
         }
-        if (d < o.min_disparity_px || d > dmax) continue;  // range filter
         // Consistency with the neighbourhood: the refined disparity must lie
         // within max_plane_deviation_px of the plane fitted to the 9x9
         // integer-level disparities around it (isolated mismatches and the
         // edges of mismatched patches fail this).
-        if (o.max_plane_deviation_px > 0 && (std::isnan(pl) || std::abs(d - pl) > o.max_plane_deviation_px)) continue;
+        if (o.max_plane_deviation_px > 0 && std::abs(d - pl) > o.max_plane_deviation_px) {
+          reject(PixelStatus::kOffPlane);
+          continue;
+        }
         out[x] = float(d);
         conf[x] = confidence;
+        status[x] = uint8_t(PixelStatus::kPoint);
       }
     }
   });
   lap("subpixel");
-  RemoveSpeckles(result.disparity_px, o);
-  for (int y = 0; y < left.rows; ++y) {
-    const float* d = result.disparity_px.ptr<float>(y);
-    float* c = result.confidence.ptr<float>(y);
-    for (int x = 0; x < left.cols; ++x)
-      if (!std::isfinite(d[x])) c[x] = 0;
+  // Seeds for the line-index test and growing: only the blobs the speckle
+  // filter keeps (a small mismatched blob would otherwise grow into a large
+  // wrong surface); the filter runs again on the grown map.
+  RemoveSpeckles(state.disparity_px, o);
+  if (o.intensity_refinement && (o.line_index.enabled || o.grow.enabled)) {
+    CorrectLineIndex(left, right, roi, o.line_index, accept, &state);
+    lap("line_index");
+    GrowDisparity(left, right, roi, o.grow, accept, &state);
+    lap("grow");
+    // Grown components are larger, so their vernier reads better; a
+    // component moved now leaves a gap that growing closes.
+    if (o.grow.enabled && CorrectLineIndex(left, right, roi, o.line_index, accept, &state) +
+                                  JoinAcrossPeriodJumps(left, right, roi, o.line_index, accept, &state) >
+                              0) {
+      lap("line_index_2");
+      GrowDisparity(left, right, roi, o.grow, accept, &state);
+      lap("grow_2");
+    } else {
+      lap("line_index_2");
+    }
+    RemoveSpeckles(state.disparity_px, o);
   }
+  for (int y = 0; y < left.rows; ++y) {
+    const float* d = state.disparity_px.ptr<float>(y);
+    float* c = state.confidence.ptr<float>(y);
+    uint8_t* status = state.status.ptr<uint8_t>(y);
+    for (int x = 0; x < left.cols; ++x)
+      if (!std::isfinite(d[x])) {
+        c[x] = 0;
+        if (status[x] == uint8_t(PixelStatus::kPoint)) status[x] = uint8_t(PixelStatus::kSpeckle);
+      }
+  }
+  result.disparity_px = state.disparity_px;
+  result.confidence = state.confidence;
+  result.status = state.status;
   lap("speckle");
+  return result;
+}
+
+MatchResult MatchOpenCvSgbm(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const MatchOptions& o) {
+  // SGBM needs the right image at the same column indices, so both images
+  // are cut to the ROI widened on the left by the largest disparity; those
+  // extra columns are the margin SGBM leaves invalid anyway.
+  const int num16 = (o.num_disparities + 15) / 16 * 16;
+  const int dmax = o.min_disparity_px + num16;
+  const int x0 = std::max(0, roi.x - std::max(0, dmax));
+  const int x1 = std::min(left.cols, roi.x + roi.width + std::max(0, -o.min_disparity_px));
+  const cv::Rect cut(x0, roi.y, x1 - x0, roi.height);
+  const int bs = o.sgbm_block_size;
+  cv::Ptr<cv::StereoSGBM> sgbm = cv::StereoSGBM::create(
+      o.min_disparity_px, num16, bs, 8 * bs * bs, 32 * bs * bs, o.sgm.lr_max_diff_px, 63, 10, o.speckle_window_px,
+      std::max(1, int(std::lround(o.speckle_range_px))), cv::StereoSGBM::MODE_SGBM_3WAY);
+  cv::Mat fixed;
+  const auto t0 = std::chrono::steady_clock::now();
+  sgbm->compute(left(cut), right(cut), fixed);
+  MatchResult result;
+  result.times_ms["sgbm"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  result.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
+  result.confidence = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
+  result.status = cv::Mat(left.size(), CV_8UC1, cv::Scalar(uint8_t(PixelStatus::kNotSearched)));
+  result.status(roi).setTo(uint8_t(PixelStatus::kNoSgmMatch));
+  const double dmax_valid = o.min_disparity_px + o.num_disparities - 1;
+  for (int y = 0; y < cut.height; ++y) {
+    const int16_t* f = fixed.ptr<int16_t>(y);
+    float* d = result.disparity_px.ptr<float>(roi.y + y);
+    float* c = result.confidence.ptr<float>(roi.y + y);
+    for (int x = std::max(roi.x, x0); x < roi.x + roi.width; ++x) {
+      const int16_t v = f[x - x0];
+      if (v < o.min_disparity_px * 16) continue;  // SGBM's invalid marker
+      const double disp = v / 16.0;
+      if (disp > dmax_valid) continue;
+      d[x] = float(disp);
+      c[x] = 1.0f;
+      result.status.at<uint8_t>(roi.y + y, x) = uint8_t(PixelStatus::kPoint);
+    }
+  }
   return result;
 }
 
@@ -342,6 +462,7 @@ MatchResult Match(const cv::Mat& left, const cv::Mat& right, const MatchOptions&
   if (left.size() != right.size()) throw InputError("match", "left and right images differ in size");
   const cv::Rect roi = ClampRoi(options.roi, left.size());
   if (roi.width <= 0 || roi.height <= 0) throw InputError("roi", "does not overlap the image");
+  if (options.matcher == MatcherKind::kOpenCvSgbm3WayStandalone) return MatchOpenCvSgbm(left, right, roi, options);
   return MatchRefineFilter(left, right, roi, options);
 }
 

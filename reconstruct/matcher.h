@@ -17,8 +17,12 @@
 //      disparity smaller than speckle_window_px), range.
 // MatcherKind::kOpenCvSgbm3Way runs OpenCV's StereoSGBM (MODE_SGBM_3WAY) on
 // the same region and the full range in place of steps 1-2, then the same
-// steps 3-4: the baseline every figure is compared against, differing from
-// ours in the correspondence step only.
+// steps 3-4: a baseline differing from ours in the integer matching only.
+// MatcherKind::kOpenCvSgbm3WayStandalone is StereoSGBM as OpenCV users run
+// it: its own 1/16 px sub-pixel fit, uniqueness, left-right check and
+// speckle filter, none of ours: the baseline whose whole correspondence
+// stage (filtering and sub-pixel included, as `stereorig match` defines it)
+// is OpenCV's. The bench reports both.
 #pragma once
 
 #include <map>
@@ -26,12 +30,16 @@
 #include <string>
 
 #include "reconstruct/census_sgm.h"
+#include "reconstruct/disparity_state.h"
+#include "reconstruct/line_index.h"
+#include "reconstruct/region_grow.h"
 #include "reconstruct/subpixel_refine.h"
 
 namespace stereorig {
 
-enum class MatcherKind { kCensusSgm, kOpenCvSgbm3Way };
-MatcherKind ParseMatcherKind(const std::string& name, const std::string& where);  // "census_sgm" | "opencv_sgbm_3way"
+enum class MatcherKind { kCensusSgm, kOpenCvSgbm3Way, kOpenCvSgbm3WayStandalone };
+// "census_sgm" | "opencv_sgbm_3way" | "opencv_sgbm_3way_standalone"
+MatcherKind ParseMatcherKind(const std::string& name, const std::string& where);
 const char* MatcherKindName(MatcherKind kind);
 
 struct MatchOptions {
@@ -57,13 +65,20 @@ struct MatchOptions {
   SubpixelOptions subpixel;          // its window and limits
   double min_zncc = 0.8;             // reject matches whose refined window correlates less; default 0.8
   double max_plane_deviation_px =
-      0.7;                      // reject d farther than this from the local 9x9 disparity plane (0 = off); default 0.7
-  double min_texture_dn = 1.5;  // reject windows with a grey-level std below this; default 1.5 DN
-  int speckle_window_px = 100;  // remove disparity blobs smaller than this, px (0 = off); default 100
-  double speckle_range_px = 1.0;  // neighbours within this disparity are one blob, px; default 1
-  int sgbm_block_size = 5;        // opencv_sgbm_3way: block size, px (odd); default 5
-  int num_threads = 2;            // threads for row-parallel steps; default 2
-  void Check() const;             // throws InputError naming the bad field
+      0.7;  // reject d farther than this from the local 9x9 disparity plane (0 = off); default 0.7
+  // census_sgm: the refined match must beat the ZNCC half a grid period
+  // either side by this (RefineAcceptance, disparity_state.h; 0 = off);
+  // default 0.4. Passive captures: set 0.
+  double min_distinctness = 0.4;
+  double grid_half_period_px = 4;  // half the laser grid's period along the rows, px; default 4 (~8 px period)
+  double min_texture_dn = 1.5;     // reject windows with a grey-level std below this; default 1.5 DN
+  LineIndexOptions line_index;     // census_sgm: the component-wide grid-period test (line_index.h)
+  GrowOptions grow;                // census_sgm: growing into the pixels SGM left empty (region_grow.h)
+  int speckle_window_px = 100;     // remove disparity blobs smaller than this, px (0 = off); default 100
+  double speckle_range_px = 1.0;   // neighbours within this disparity are one blob, px; default 1
+  int sgbm_block_size = 5;         // opencv_sgbm_3way: block size, px (odd); default 5
+  int num_threads = 2;             // threads for row-parallel steps; default 2
+  void Check() const;              // throws InputError naming the bad field
 };
 
 struct MatchResult {
@@ -73,6 +88,9 @@ struct MatchResult {
   // CV_32FC1, same size: confidence in [0, 1] (ZNCC of the refined window;
   // 1 without intensity_refinement), 0 where invalid.
   cv::Mat confidence;
+  // CV_8UC1, same size: PixelStatus of each pixel (census_sgm; SGBM:
+  // kPoint or kNoSgmMatch inside the ROI).
+  cv::Mat status;
   // Wall time of the sub-steps, ms: census_sgm: "band" (the half-resolution
   // range pass), "sgm" (census + SGM + left-right/uniqueness), "subpixel"
   // (slopes + Lucas-Kanade + filters), "speckle"; opencv_sgbm_3way: "sgbm"

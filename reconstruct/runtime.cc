@@ -141,7 +141,10 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
   } else {
     match.disparity_px = cv::Mat(size, CV_32FC1, cv::Scalar(std::numeric_limits<float>::infinity()));
     match.confidence = cv::Mat(size, CV_32FC1, cv::Scalar(0));
+    match.status = cv::Mat(size, CV_8UC1, cv::Scalar(uint8_t(PixelStatus::kNotSearched)));
   }
+  cv::Mat& status = report->status;
+  status = match.status;
   report->times_ms["match"] = MsSince(t);
 
   // Triangulate into an organised grid of reference-frame points (NaN = none).
@@ -157,10 +160,18 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
     const float* d = match.disparity_px.ptr<float>(y);
     const float* c = match.confidence.ptr<float>(y);
     cv::Vec3f* g = grid.ptr<cv::Vec3f>(y);
+    uint8_t* st = status.ptr<uint8_t>(y);
     for (int x = match_roi.x; x < match_roi.x + match_roi.width; ++x) {
-      if (!std::isfinite(d[x]) || c[x] < options_.min_confidence) continue;
+      if (!std::isfinite(d[x])) continue;
+      if (c[x] < options_.min_confidence) {
+        st[x] = uint8_t(PixelStatus::kLowConfidence);
+        continue;
+      }
       const Eigen::Vector3d p = r_ref * plan.geometry.Triangulate(x, y, d[x]) + t_ref;
-      if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;  // range: the volume
+      if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) {  // range: the volume
+        st[x] = uint8_t(PixelStatus::kOutsideVolume);
+        continue;
+      }
       g[x] = cv::Vec3f(float(p.x()), float(p.y()), float(p.z()));
     }
   }
@@ -184,7 +195,10 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
       for (int y = match_roi.y; y < match_roi.y + match_roi.height; ++y)
         for (int x = match_roi.x; x < match_roi.x + match_roi.width; ++x) {
           cv::Vec3f& p = grid.at<cv::Vec3f>(y, x);
-          if (!std::isnan(p[0]) && (p - m).dot(p - m) > limit2) p = cv::Vec3f(nan, nan, nan);
+          if (!std::isnan(p[0]) && (p - m).dot(p - m) > limit2) {
+            p = cv::Vec3f(nan, nan, nan);
+            status.at<uint8_t>(y, x) = uint8_t(PixelStatus::kObjectSize);
+          }
         }
     }
   }

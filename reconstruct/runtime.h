@@ -47,6 +47,11 @@ struct ModuleReport {
   int lit_pixels = 0;  // grid-lit pixels of the rectified left image in the volume's ROI
   int lit_filled = 0;  // of those, pixels with a kept point
   double fill_rate() const { return lit_pixels ? double(lit_filled) / lit_pixels : 0.0; }
+  // CV_8UC1, the module's rectified left image size: the PixelStatus
+  // (matcher.h) of each pixel: kPoint where a point was kept, else the test
+  // that dropped it (for scoring the fill against truth and finding where it
+  // is lost, reconstruct/fill_score.h).
+  cv::Mat status;
   std::map<std::string, double> times_ms;  // rectify, lit_region, match, triangulate, normals, mesh
 };
 

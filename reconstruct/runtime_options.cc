@@ -86,6 +86,23 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.speckle_range_px = m.GetDouble("speckle_range_px", mo.speckle_range_px);
     mo.sgbm_block_size = m.GetInt("sgbm_block_size", mo.sgbm_block_size);
     mo.num_threads = m.GetInt("num_threads", mo.num_threads);
+    mo.line_index.enabled = m.GetBool("line_index", mo.line_index.enabled);
+    mo.line_index.max_shift_px = m.GetInt("line_index_max_shift_px", mo.line_index.max_shift_px);
+    mo.line_index.min_component_px = m.GetInt("line_index_min_component_px", mo.line_index.min_component_px);
+    mo.line_index.samples = m.GetInt("line_index_samples", mo.line_index.samples);
+    mo.line_index.min_seam_px = m.GetInt("line_index_min_seam_px", mo.line_index.min_seam_px);
+    mo.line_index.max_seam_gap_px = m.GetInt("line_index_max_seam_gap_px", mo.line_index.max_seam_gap_px);
+    mo.line_index.window_half_height_px =
+        m.GetInt("line_index_window_half_height_px", mo.line_index.window_half_height_px);
+    mo.line_index.max_row_offset_px = m.GetDouble("line_index_max_row_offset_px", mo.line_index.max_row_offset_px);
+    mo.line_index.min_row_offset_step_px =
+        m.GetDouble("line_index_min_row_offset_step_px", mo.line_index.min_row_offset_step_px);
+    mo.grow.enabled = m.GetBool("grow", mo.grow.enabled);
+    mo.grow.max_deviation_px = m.GetDouble("grow_max_deviation_px", mo.grow.max_deviation_px);
+    mo.grow.plane_radius_px = m.GetInt("grow_plane_radius_px", mo.grow.plane_radius_px);
+    mo.grow.max_tries = m.GetInt("grow_max_tries", mo.grow.max_tries);
+    mo.min_distinctness = m.GetDouble("min_distinctness", mo.min_distinctness);
+    mo.grid_half_period_px = m.GetDouble("grid_half_period_px", mo.grid_half_period_px);
     m.Finish();
   }
   y.Finish();

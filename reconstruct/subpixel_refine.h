@@ -42,4 +42,26 @@ struct SubpixelResult {
 SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x, int y, double start_px, double slope_x,
                                double slope_y, const SubpixelOptions& options);
 
+// ZNCC of the window at disparity d (no fit; the right window warped by the
+// slopes as above, linearly interpolated). -1 if the window leaves either
+// image.
+double WindowZncc(const cv::Mat& left, const cv::Mat& right, int x, int y, double d, double slope_x, double slope_y,
+                  const SubpixelOptions& options);
+
+// The same fit with one more parameter: a vertical offset dy of the right
+// window (rows y + v + dy; rows interpolated by a cubic convolution). On a
+// correct match of a well rectified pair dy ~ 0. A match one laser-grid
+// period off along the row aligns the near-vertical lines but leaves the
+// near-horizontal ones (turned by the grid angle) offset vertically by about
+// period * tan(angle): the vernier line_index.h reads. Up to
+// options.max_iterations + 2 Gauss-Newton steps; |dy| <= 1 px.
+struct RowOffsetResult {
+  bool ok = false;
+  double disparity_px = 0;
+  double row_offset_px = 0;  // dy
+  double zncc = 0;
+};
+RowOffsetResult RefineDisparityAndRowOffset(const cv::Mat& left, const cv::Mat& right, int x, int y, double start_px,
+                                            double slope_x, double slope_y, const SubpixelOptions& options);
+
 }  // namespace stereorig

@@ -1,74 +1,133 @@
-// The runtime end to end on the default rig: a sphere rendered through every
-// camera (reconstruct/synthetic_scene.h, one ray per pixel, 2 DN noise),
-// reconstructed with the truth rig, scored against the analytic sphere.
+// The runtime end to end on the simulator's default rig and scenes (cup and
+// sphere, every sensor effect on: shot and read noise, laser speckle
+// contrast 0.2, PSF blur, 2x2 rays per pixel), reconstructed with the TRUE rig
+// (a calibration would take minutes; `stereorig score` measures the
+// calibrated case, docs/reconstruct.md). Judged as issue 5 judges:
+//   - accuracy against the simulator's dense truth surface after one rigid
+//     alignment (score.h), and for the sphere also against the analytic
+//     sphere of object.yaml, a computation that shares nothing with ours;
+//   - fill against the renderer's truth: object pixels both cameras of a
+//     module see and a grid lights (fill_score.h).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
 
-#include "datasets/default_rig.h"
+#include "calib/core/rig_file.h"
+#include "datasets/simulate.h"
 #include "reconstruct/runtime.h"
-#include "reconstruct/synthetic_scene.h"
+#include "reconstruct/scene_score.h"
 
 namespace stereorig {
 namespace {
 
-struct SphereScore {
-  int n = 0;
-  double mean_abs = 0, mean = 0, std = 0;
-};
+namespace fs = std::filesystem;
 
-SphereScore Score(const PointCloud& cloud, int module, const Eigen::Vector3d& c, double r) {
-  SphereScore s;
-  double sum = 0, sum2 = 0, sum_abs = 0;
-  for (size_t i = 0; i < cloud.size(); ++i) {
-    if (module >= 0 && cloud.module[i] != module) continue;
-    const double e = (cloud.xyz_mm[i].cast<double>() - c).norm() - r;
-    sum += e, sum2 += e * e, sum_abs += std::abs(e);
-    ++s.n;
+class RuntimeOnSimulatedScenes : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    SimSpec spec = DefaultSimSpec();
+    spec.scenes.names = {"cup", "sphere"};
+    SimulateOptions o;
+    o.out_dir = ::testing::TempDir() + "/runtime_e2e_dataset";
+    o.seed = 1;
+    o.calibration_captures = 0;
+    Simulate(spec, o);
+    dataset_ = new std::string(o.out_dir);
   }
-  if (s.n) {
-    s.mean = sum / s.n;
-    s.mean_abs = sum_abs / s.n;
-    s.std = std::sqrt(std::max(0.0, sum2 / s.n - s.mean * s.mean));
+  static void TearDownTestSuite() {
+    delete dataset_;
+    dataset_ = nullptr;
   }
-  return s;
+
+  struct Outcome {
+    Reconstruction rec;
+    SceneScore score;
+  };
+  static Outcome Run(const std::string& scene) {
+    const Rig rig = ReadRigFile(*dataset_ + "/truth/rig.yaml");
+    const Runtime runtime(rig, RuntimeOptions{});
+    Outcome out;
+    out.rec = runtime.Process(LoadCapture(*dataset_ + "/scenes/" + scene + "/active", rig), false);
+    out.score = ScoreScene(runtime, out.rec, ReadSceneTruth(*dataset_, scene));
+    for (size_t m = 0; m < out.score.fill.size(); ++m) {
+      const ErrorFigures& e = out.score.accuracy.per_module[m];
+      std::printf("%s module %zu: fill %.3f of %d target px; %d points, |e| %.4f mm, std %.4f mm\n", scene.c_str(), m,
+                  out.score.fill[m].fill(), out.score.fill[m].target_px, e.points, e.mean_abs_mm, e.std_mm);
+    }
+    std::printf("%s merged: |e| %.4f mm, std %.4f mm; aligned by %.4f deg, %.4f mm\n", scene.c_str(),
+                out.score.accuracy.all.mean_abs_mm, out.score.accuracy.all.std_mm,
+                out.score.accuracy.truth_from_cloud.AngleDeg(),
+                out.score.accuracy.truth_from_cloud.translation_mm().norm());
+    return out;
+  }
+  static std::string* dataset_;
+};
+std::string* RuntimeOnSimulatedScenes::dataset_ = nullptr;
+
+// Issue 5's per-module figures, where this session meets them, on both
+// modules. One module at 200 mm: mean |e| <= 0.1 mm, std <= 0.1 mm; measured
+// 0.05 / 0.07 mm: laser speckle (contrast 0.2, independent per camera)
+// decorrelates the views to a ZNCC of ~0.9, ~0.25 px of disparity noise =
+// 0.1 mm of depth. The fill is asserted at what it measures, NOT yet at the
+// issue's 90 % (`stereorig score` lists the losses). Nearly every point is on
+// a target pixel: points where the right camera does not see the surface
+// would be guesses.
+void ExpectModuleFigures(const SceneScore& s, double min_fill) {
+  ASSERT_EQ(s.fill.size(), 2u);
+  for (size_t m = 0; m < 2; ++m) {
+    EXPECT_LT(s.accuracy.per_module[m].mean_abs_mm, 0.1) << "module " << m;
+    EXPECT_LT(s.accuracy.per_module[m].std_mm, 0.1) << "module " << m;
+    EXPECT_GT(s.fill[m].fill(), min_fill) << "module " << m;
+    EXPECT_LT(s.fill[m].other_px, 0.03 * s.fill[m].filled_px) << "module " << m;
+  }
+  EXPECT_LT(s.accuracy.all.mean_abs_mm, 0.15);  // two modules merged
 }
 
-TEST(RuntimeE2e, SphereOnTheDefaultRigMeetsTheAccuracyTargets) {
-  const SimulatedRig sim = MakeDefaultRig();
-  SphereSceneSpec spec;
-  spec.centre_mm = sim.world_from_module0.Inverse() * Eigen::Vector3d::Zero();  // the world origin
-  spec.radius_mm = 25;
-  const std::vector<cv::Mat> images = RenderSphereCapture(sim.rig, spec);
-  const Runtime runtime(sim.rig, RuntimeOptions{});
-  for (const ModulePlan& p : runtime.plans())
-    std::printf("module %d: roi %dx%d+%d+%d, disparities [%d, %d)\n", p.module, p.roi.width, p.roi.height, p.roi.x,
-                p.roi.y, p.min_disparity_px, p.min_disparity_px + p.num_disparities);
-  const Reconstruction rec = runtime.Process(images, /*build_mesh=*/true);
-  for (const ModuleReport& m : rec.modules) {
-    const SphereScore s = Score(rec.cloud, m.module, spec.centre_mm, spec.radius_mm);
-    std::printf(
-        "module %d: %d points, fill %.3f of %d lit px, match roi %dx%d; |e| %.4f mm, mean %+.4f, std %.4f;"
-        " match %.1f ms\n",
-        m.module, m.points, m.fill_rate(), m.lit_pixels, m.match_roi.width, m.match_roi.height, s.mean_abs, s.mean,
-        s.std, m.times_ms.at("match"));
-    // Issue 5's one-module target is mean |e| <= 0.1 mm. The renderer's
-    // noise is 2 DN and its one-ray-per-pixel sampling aliases the ~1 px
-    // lines: measured ~0.07 px rms on good matches = 0.03 mm at 200 mm.
-    EXPECT_LT(s.mean_abs, 0.1);
-    // Issue 5: std <= 0.1 mm. Measured 0.07-0.09 mm: the spread is set by
-    // the ~0.2% of points that are still >1 px mismatches on the flanks.
-    EXPECT_LT(s.std, 0.1);
-    // NOT yet the issue's 90%: the flank facing away from the right camera
-    // (foreshortened ~30% in the right view) mostly fails (measured 0.63).
-    EXPECT_GT(m.fill_rate(), 0.6);
+// Measured fill: 0.92 and 0.90 per module.
+TEST_F(RuntimeOnSimulatedScenes, CupMeetsTheAccuracyTargets) {
+  const Outcome o = Run("cup");
+  ExpectModuleFigures(o.score, 0.85);
+  EXPECT_GT(o.score.fill_all.fill(), 0.88);
+}
+
+// Measured fill: 0.84 on both modules.
+TEST_F(RuntimeOnSimulatedScenes, SphereAgreesWithTheAnalyticSphere) {
+  const Outcome o = Run("sphere");
+  ExpectModuleFigures(o.score, 0.80);
+  // The analytic sphere (object.yaml: centre, diameter), in the truth rig's
+  // frame: the cloud needs no alignment here. Radial residuals of every
+  // point; a wrong grid line index shows as a blob ~3.5 mm off.
+  std::ifstream f(*dataset_ + "/truth/scenes/sphere/object.yaml");
+  std::stringstream text;
+  text << f.rdbuf();
+  std::smatch c, d;
+  const std::string s = text.str();
+  ASSERT_TRUE(std::regex_search(s, c, std::regex(R"(center_mm: \[([^,]+), ([^,]+), ([^\]]+)\])")));
+  ASSERT_TRUE(std::regex_search(s, d, std::regex(R"(diameter_mm: ([0-9.eE+-]+))")));
+  const Eigen::Vector3d centre(std::stod(c[1]), std::stod(c[2]), std::stod(c[3]));
+  const double radius = 0.5 * std::stod(d[1]);
+  int n = 0, far = 0;
+  double sum_abs = 0, worst = 0;
+  for (size_t i = 0; i < o.rec.cloud.size(); ++i) {
+    const double e = (o.rec.cloud.xyz_mm[i].cast<double>() - centre).norm() - radius;
+    sum_abs += std::abs(e);
+    far += std::abs(e) > 0.8;
+    worst = std::max(worst, std::abs(e));
+    ++n;
   }
-  const SphereScore all = Score(rec.cloud, -1, spec.centre_mm, spec.radius_mm);
-  std::printf("merged: %d points |e| %.4f mm std %.4f; point cloud %.1f ms; mesh %zu triangles\n", all.n, all.mean_abs,
-              all.std, rec.times_ms.at("total_point_cloud"), rec.mesh.triangles.size());
-  EXPECT_LT(all.mean_abs, 0.15);
-  EXPECT_GT(rec.mesh.triangles.size(), size_t(all.n));  // ~2 per point on a smooth grid
+  ASSERT_GT(n, 0);
+  std::printf("sphere: %d points, mean |radial residual| %.4f mm, %d beyond 0.8 mm, worst %.3f mm\n", n, sum_abs / n,
+              far, worst);
+  EXPECT_LT(sum_abs / n, 0.1);
+  // Session 1's demo failed P_F (range of radial residuals <= 1.5 mm) on a
+  // blob of ~375 points one grid period off; now none may be that far.
+  EXPECT_LT(far, n / 1000);
+  EXPECT_LT(worst, 1.5);
 }
 
 }  // namespace

@@ -1,0 +1,62 @@
+#include "reconstruct/disparity_state.h"
+
+#include <algorithm>
+
+namespace stereorig {
+
+const char* PixelStatusName(PixelStatus status) {
+  switch (status) {
+    case PixelStatus::kNotSearched:
+      return "not_searched";
+    case PixelStatus::kPoint:
+      return "point";
+    case PixelStatus::kNoSgmMatch:
+      return "no_sgm_match";
+    case PixelStatus::kNoPlane:
+      return "no_plane";
+    case PixelStatus::kOffPlaneCoarse:
+      return "off_plane_coarse";
+    case PixelStatus::kRefineFailed:
+      return "refine_failed";
+    case PixelStatus::kLowZncc:
+      return "low_zncc";
+    case PixelStatus::kLowTexture:
+      return "low_texture";
+    case PixelStatus::kOutOfRange:
+      return "out_of_range";
+    case PixelStatus::kOffPlane:
+      return "off_plane";
+    case PixelStatus::kSpeckle:
+      return "speckle";
+    case PixelStatus::kNotDistinct:
+      return "not_distinct";
+    case PixelStatus::kLowConfidence:
+      return "low_confidence";
+    case PixelStatus::kOutsideVolume:
+      return "outside_volume";
+    case PixelStatus::kObjectSize:
+      return "object_size";
+    case PixelStatus::kNumStatus:
+      break;
+  }
+  return "?";
+}
+
+PixelStatus Accept(const cv::Mat& left, const cv::Mat& right, int x, int y, double slope_x, double slope_y,
+                   const SubpixelResult& r, const RefineAcceptance& a) {
+  if (!r.ok) return PixelStatus::kRefineFailed;
+  if (r.zncc < a.min_zncc) return PixelStatus::kLowZncc;
+  if (r.std_dn < a.min_texture_dn) return PixelStatus::kLowTexture;
+  if (r.disparity_px < a.min_disparity_px || r.disparity_px > a.max_disparity_px) return PixelStatus::kOutOfRange;
+  if (a.min_distinctness > 0) {
+    // The grid's period in the right view shrinks or grows with the
+    // foreshortening: 1 - dd/dx of the left one's.
+    const double half = a.half_period_px * std::clamp(1.0 - slope_x, 0.3, 1.7);
+    const double off = std::max(WindowZncc(left, right, x, y, r.disparity_px - half, slope_x, slope_y, a.subpixel),
+                                WindowZncc(left, right, x, y, r.disparity_px + half, slope_x, slope_y, a.subpixel));
+    if (r.zncc - off < a.min_distinctness) return PixelStatus::kNotDistinct;
+  }
+  return PixelStatus::kPoint;
+}
+
+}  // namespace stereorig

@@ -1,0 +1,309 @@
+#include "reconstruct/line_index.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <vector>
+
+#include "calib/core/input_error.h"
+
+namespace stereorig {
+
+void LineIndexOptions::Check() const {
+  if (max_shift_px < 2 || max_shift_px > 64) throw InputError("line_index_max_shift_px", "must be in [2, 64]");
+  if (min_component_px < 1) throw InputError("line_index_min_component_px", "must be >= 1");
+  if (samples < 4 || samples > 10000) throw InputError("line_index_samples", "must be in [4, 10000]");
+  if (window_half_height_px < 0 || window_half_height_px > 30)
+    throw InputError("line_index_window_half_height_px", "must be in [0, 30]");
+  if (!(max_row_offset_px > 0 && max_row_offset_px < 1))
+    throw InputError("line_index_max_row_offset_px", "must be in (0, 1)");
+  if (min_seam_px < 1) throw InputError("line_index_min_seam_px", "must be >= 1");
+  if (max_seam_gap_px < 0 || max_seam_gap_px > 32) throw InputError("line_index_max_seam_gap_px", "must be in [0, 32]");
+  if (!(min_row_offset_step_px > 0 && min_row_offset_step_px < 1))
+    throw InputError("line_index_min_row_offset_step_px", "must be in (0, 1)");
+}
+
+cv::Mat LabelDisparityComponents(const cv::Mat& disparity_px, const cv::Rect& roi, double max_step_px,
+                                 std::vector<std::vector<int>>* components) {
+  const int cols = disparity_px.cols;
+  cv::Mat labels(disparity_px.size(), CV_32SC1, cv::Scalar(-1));
+  components->clear();
+  std::vector<int> stack;
+  for (int y = roi.y; y < roi.y + roi.height; ++y)
+    for (int x = roi.x; x < roi.x + roi.width; ++x) {
+      if (labels.at<int>(y, x) >= 0 || !std::isfinite(disparity_px.at<float>(y, x))) continue;
+      const int label = int(components->size());
+      components->emplace_back();
+      std::vector<int>& pixels = components->back();
+      labels.at<int>(y, x) = label;
+      stack.assign(1, y * cols + x);
+      while (!stack.empty()) {
+        const int i = stack.back();
+        stack.pop_back();
+        pixels.push_back(i);
+        const int py = i / cols, px = i % cols;
+        const float d = disparity_px.at<float>(py, px);
+        const int nx[4] = {px - 1, px + 1, px, px}, ny[4] = {py, py, py - 1, py + 1};
+        for (int k = 0; k < 4; ++k) {
+          if (!roi.contains(cv::Point(nx[k], ny[k]))) continue;
+          int& l = labels.at<int>(ny[k], nx[k]);
+          const float dn = disparity_px.at<float>(ny[k], nx[k]);
+          if (l >= 0 || !std::isfinite(dn) || std::abs(dn - d) > max_step_px) continue;
+          l = label;
+          stack.push_back(ny[k] * cols + nx[k]);
+        }
+      }
+    }
+  return labels;
+}
+
+namespace {
+
+struct Vernier {
+  double mean_row_offset_px = 0;  // over the sample's successful fits
+  double standard_error_px = 1e9;
+  double mean_shift_px = 0;  // mean of (fitted - starting disparity) + the shift tried
+  int fits = 0;
+};
+
+// The tests and the move, on one module's state.
+class LineIndexer {
+ public:
+  LineIndexer(const cv::Mat& left, const cv::Mat& right, const LineIndexOptions& o, const RefineAcceptance& accept,
+              DisparityState* state)
+      : left_(left), right_(right), o_(o), accept_(accept), state_(state), cols_(left.cols) {
+    tall_ = accept.subpixel;
+    tall_.half_height_px = o.window_half_height_px;
+  }
+
+  float D(int i) const { return state_->disparity_px.at<float>(i / cols_, i % cols_); }
+
+  // Up to o.samples valid pixels of `pixels`, spread evenly.
+  std::vector<int> Sample(const std::vector<int>& pixels) const {
+    std::vector<int> valid, sample;
+    for (int i : pixels)
+      if (std::isfinite(D(i))) valid.push_back(i);
+    const double stride = std::max(1.0, double(valid.size()) / o_.samples);
+    for (double k = 0.5 * stride; k < double(valid.size()); k += stride) sample.push_back(valid[size_t(k)]);
+    return sample;
+  }
+
+  // The row offset of the tall-window fit over `sample`, each started from
+  // its disparity + shift.
+  Vernier Read(const std::vector<int>& sample, double shift) const {
+    double sum = 0, sum2 = 0, sum_shift = 0;
+    int n = 0;
+    for (int i : sample) {
+      const RowOffsetResult r =
+          RefineDisparityAndRowOffset(left_, right_, i % cols_, i / cols_, D(i) + shift, SlopeX(i), SlopeY(i), tall_);
+      if (!r.ok) continue;
+      sum += r.row_offset_px, sum2 += r.row_offset_px * r.row_offset_px;
+      sum_shift += r.disparity_px - D(i);
+      ++n;
+    }
+    Vernier v;
+    v.fits = n;
+    if (n >= 4) {
+      v.mean_row_offset_px = sum / n;
+      v.mean_shift_px = sum_shift / n;
+      v.standard_error_px = std::sqrt(std::max(0.0, sum2 / n - v.mean_row_offset_px * v.mean_row_offset_px) / (n - 1));
+    }
+    return v;
+  }
+
+  // Mean ZNCC of the matcher's own refinement from disparity + shift.
+  double MeanZncc(const std::vector<int>& sample, double shift) const {
+    double sum = 0;
+    for (int i : sample) {
+      const SubpixelResult r =
+          RefineDisparity(left_, right_, i % cols_, i / cols_, D(i) + shift, SlopeX(i), SlopeY(i), accept_.subpixel);
+      sum += r.ok ? r.zncc : 0.0;
+    }
+    return sum / double(sample.size());
+  }
+
+  // Re-refines every pixel of `pixels` near disparity + shift: the period
+  // varies over a curved surface, so from starts 2 px either side (the
+  // other alignments are a period away), keeping the best correlation.
+  void Move(const std::vector<int>& pixels, double shift) {
+    for (int i : pixels) {
+      const int y = i / cols_, x = i % cols_;
+      float& d = state_->disparity_px.at<float>(y, x);
+      if (!std::isfinite(d)) continue;
+      SubpixelResult r;
+      for (int k = -2; k <= 2; ++k) {
+        const SubpixelResult rk =
+            RefineDisparity(left_, right_, x, y, d + shift + k, SlopeX(i), SlopeY(i), accept_.subpixel);
+        if (rk.ok && (!r.ok || rk.zncc > r.zncc)) r = rk;
+      }
+      const PixelStatus why = Accept(left_, right_, x, y, SlopeX(i), SlopeY(i), r, accept_);
+      state_->status.at<uint8_t>(y, x) = uint8_t(why);
+      if (why == PixelStatus::kPoint) {
+        d = float(r.disparity_px);
+        state_->confidence.at<float>(y, x) = float(std::clamp(r.zncc, 0.0, 1.0));
+      } else {
+        d = std::numeric_limits<float>::infinity();
+        state_->confidence.at<float>(y, x) = 0;
+      }
+    }
+  }
+
+  // One component's vernier test; returns true if it moved.
+  // offset_px: the row offset a correct match reads (0 on a well rectified pair).
+  bool TestComponent(const std::vector<int>& pixels, double offset_px) {
+    const std::vector<int> sample = Sample(pixels);
+    if (int(sample.size()) < 4) return false;
+    Vernier here = Read(sample, 0.0);
+    here.mean_row_offset_px -= offset_px;
+    if (here.fits < 4 ||
+        std::abs(here.mean_row_offset_px) <= std::max(o_.max_row_offset_px, 3 * here.standard_error_px))
+      return false;
+    // The other alignments: on each side, the shift whose refinement
+    // correlates best. Their row offsets step by about the same amount per
+    // period (the vernier): fit dy(k) = a + b k over k = -1, 0, +1 and move
+    // to the alignment nearest its zero crossing.
+    Vernier side[2];
+    for (int j = 0; j < 2; ++j) {
+      const int sign = j == 0 ? -1 : 1;
+      double best_z = -2, side_shift = 0;
+      for (int s = 2; s <= o_.max_shift_px; ++s) {
+        const double z = MeanZncc(sample, sign * s);
+        if (z > best_z) best_z = z, side_shift = sign * s;
+      }
+      side[j] = Read(sample, side_shift);
+      side[j].mean_row_offset_px -= offset_px;
+    }
+    double sw = 0, sk = 0, skk = 0, sd = 0, skd = 0;
+    const Vernier* points[3] = {&side[0], &here, &side[1]};
+    for (int k = -1; k <= 1; ++k) {
+      const Vernier& v = *points[k + 1];
+      if (v.fits < 4) continue;
+      const double w = 1.0 / (v.standard_error_px * v.standard_error_px + 1e-4);
+      sw += w, sk += w * k, skk += w * k * k, sd += w * v.mean_row_offset_px, skd += w * k * v.mean_row_offset_px;
+    }
+    const double det = sw * skk - sk * sk;
+    if (!(det > 0)) return false;
+    const double a = (skk * sd - sk * skd) / det, b = (sw * skd - sk * sd) / det;
+    if (std::abs(b) < o_.min_row_offset_step_px) return false;  // no vernier to read
+    const int k = int(std::lround(std::clamp(-a / b, -1.0, 1.0)));
+    if (k == 0 || points[k + 1]->fits < 4) return false;
+    Move(pixels, points[k + 1]->mean_shift_px);
+    return true;
+  }
+
+ private:
+  float SlopeX(int i) const { return state_->slope_x.at<float>(i / cols_, i % cols_); }
+  float SlopeY(int i) const { return state_->slope_y.at<float>(i / cols_, i % cols_); }
+
+  const cv::Mat& left_;
+  const cv::Mat& right_;
+  const LineIndexOptions& o_;
+  const RefineAcceptance& accept_;
+  DisparityState* state_;
+  const int cols_;
+  SubpixelOptions tall_;
+};
+
+}  // namespace
+
+int CorrectLineIndex(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const LineIndexOptions& o,
+                     const RefineAcceptance& accept, DisparityState* state) {
+  if (!o.enabled) return 0;
+  std::vector<std::vector<int>> components;
+  LabelDisparityComponents(state->disparity_px, roi, 1.0, &components);
+  LineIndexer indexer(left, right, o, accept, state);
+  int moved = 0;
+  for (const std::vector<int>& pixels : components) {
+    if (int(pixels.size()) < o.min_component_px) continue;
+    // Up to two moves: a component can be two periods off.
+    for (int round = 0; round < 2 && indexer.TestComponent(pixels, 0.0); ++round) ++moved;
+  }
+  return moved;
+}
+
+int JoinAcrossPeriodJumps(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const LineIndexOptions& o,
+                          const RefineAcceptance& accept, DisparityState* state) {
+  if (!o.enabled) return 0;
+  std::vector<std::vector<int>> components;
+  const cv::Mat labels = LabelDisparityComponents(state->disparity_px, roi, 1.0, &components);
+  // Disparity differences across every seam: from each pixel, the next
+  // valid pixel along its row and along its column, if it is within
+  // o.max_seam_gap_px and in another component, less the first one's
+  // disparity extrapolated along its local plane. Key = (a, b), a < b:
+  // d_b - d_a.
+  std::map<std::pair<int, int>, std::vector<float>> seams;
+  for (int y = roi.y; y < roi.y + roi.height; ++y)
+    for (int x = roi.x; x < roi.x + roi.width; ++x) {
+      const int a = labels.at<int>(y, x);
+      if (a < 0) continue;
+      for (int dir = 0; dir < 2; ++dir) {
+        for (int step = 1; step <= o.max_seam_gap_px + 1; ++step) {
+          const cv::Point q = dir == 0 ? cv::Point(x + step, y) : cv::Point(x, y + step);
+          if (!roi.contains(q)) break;
+          const int b = labels.at<int>(q);
+          if (b < 0) continue;
+          if (b == a) break;
+          const float slope = dir == 0 ? state->slope_x.at<float>(y, x) : state->slope_y.at<float>(y, x);
+          const float diff = state->disparity_px.at<float>(q) - (state->disparity_px.at<float>(y, x) + slope * step);
+          if (a < b)
+            seams[{a, b}].push_back(diff);
+          else
+            seams[{b, a}].push_back(-diff);
+          break;
+        }
+      }
+    }
+  // Longest seams first; each component moves at most once.
+  std::vector<std::pair<size_t, std::pair<int, int>>> order;
+  for (const auto& [key, diffs] : seams) order.push_back({diffs.size(), key});
+  std::sort(order.rbegin(), order.rend());
+  LineIndexer indexer(left, right, o, accept, state);
+  std::vector<bool> done(components.size(), false);
+  int moved = 0;
+  for (const auto& [length, key] : order) {
+    if (int(length) < o.min_seam_px) break;
+    std::vector<float>& diffs = seams[key];
+    std::nth_element(diffs.begin(), diffs.begin() + diffs.size() / 2, diffs.end());
+    const double median = diffs[diffs.size() / 2];
+    // A smooth surface has no jump: one of about a period (not a depth
+    // edge's arbitrary step, which the spread of the seam shows) means one
+    // side has the wrong line. Both ways of joining them give one
+    // alignment; keep the one whose size-weighted row offset (vernier) is
+    // nearer 0.
+    if (std::abs(median) < 3 || std::abs(median) > o.max_shift_px) continue;
+    int spread = 0;
+    for (float d : diffs) spread += std::abs(d - median) > 1.0f;
+    if (spread > int(diffs.size()) / 4) continue;
+    const auto [a, b] = key;
+    if (done[a] || done[b] || int(std::min(components[a].size(), components[b].size())) < o.min_component_px) continue;
+    const std::vector<int> sample_a = indexer.Sample(components[a]), sample_b = indexer.Sample(components[b]);
+    if (int(std::min(sample_a.size(), sample_b.size())) < 4) continue;
+    // a moves by +median to meet b, or b by -median to meet a.
+    const Vernier a0 = indexer.Read(sample_a, 0.0), a1 = indexer.Read(sample_a, median);
+    const Vernier b0 = indexer.Read(sample_b, 0.0), b1 = indexer.Read(sample_b, -median);
+    if (std::min({a0.fits, a1.fits, b0.fits, b1.fits}) < 4) continue;
+    const double na = double(components[a].size()), nb = double(components[b].size());
+    // Both sides end on one alignment either way: the right one reads a row
+    // offset of ~0. The vernier's reading has regional biases of ~0.1 px
+    // (surface curvature in the window), so when the two readings are
+    // within max_row_offset_px of each other the larger component, which
+    // SGM and growing made of more evidence, keeps its alignment.
+    double cost_move_a = std::abs((na * a1.mean_row_offset_px + nb * b0.mean_row_offset_px) / (na + nb));
+    double cost_move_b = std::abs((na * a0.mean_row_offset_px + nb * b1.mean_row_offset_px) / (na + nb));
+    if (std::abs(cost_move_a - cost_move_b) < o.max_row_offset_px) {
+      cost_move_a = na < nb ? 0 : 1;
+      cost_move_b = 1 - cost_move_a;
+    }
+    if (cost_move_a <= cost_move_b) {
+      indexer.Move(components[a], a1.mean_shift_px);
+      done[a] = true;
+    } else {
+      indexer.Move(components[b], b1.mean_shift_px);
+      done[b] = true;
+    }
+    ++moved;
+  }
+  return moved;
+}
+
+}  // namespace stereorig

@@ -1,0 +1,90 @@
+#include "reconstruct/region_grow.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <deque>
+
+#include "calib/core/input_error.h"
+
+namespace stereorig {
+
+void GrowOptions::Check() const {
+  if (!(max_deviation_px > 0 && max_deviation_px <= 4)) throw InputError("grow_max_deviation_px", "must be in (0, 4]");
+  if (max_tries < 1 || max_tries > 8) throw InputError("grow_max_tries", "must be in [1, 8]");
+  if (plane_radius_px < 1 || plane_radius_px > 10) throw InputError("grow_plane_radius_px", "must be in [1, 10]");
+}
+
+namespace {
+
+// Least-squares plane d = a + gx*(x - q.x) + gy*(y - q.y) through the valid
+// disparities of the (2r+1)^2 window around q. False if too few or
+// degenerate (then the caller predicts from one neighbour).
+bool LocalPlane(const cv::Mat& disparity, const cv::Rect& roi, cv::Point q, int r, double* a, double* gx, double* gy) {
+  double s1 = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0, sd = 0, sxd = 0, syd = 0;
+  for (int v = -r; v <= r; ++v)
+    for (int u = -r; u <= r; ++u) {
+      const cv::Point p(q.x + u, q.y + v);
+      if (!roi.contains(p)) continue;
+      const float d = disparity.at<float>(p);
+      if (!std::isfinite(d)) continue;
+      s1 += 1, sx += u, sy += v, sxx += u * u, syy += v * v, sxy += u * v;
+      sd += d, sxd += u * d, syd += v * d;
+    }
+  if (s1 < 6) return false;
+  Eigen::Matrix3d m;
+  m << s1, sx, sy, sx, sxx, sxy, sy, sxy, syy;
+  if (std::abs(m.determinant()) < 1e-6 * s1 * s1 * s1) return false;
+  const Eigen::Vector3d p = m.ldlt().solve(Eigen::Vector3d(sd, sxd, syd));
+  if (!p.allFinite()) return false;
+  *a = p[0], *gx = p[1], *gy = p[2];
+  return true;
+}
+
+}  // namespace
+
+int GrowDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const GrowOptions& o,
+                  const RefineAcceptance& accept, DisparityState* state) {
+  if (!o.enabled) return 0;
+  cv::Mat& disparity = state->disparity_px;
+  cv::Mat tried(left.size(), CV_8UC1, cv::Scalar(0));
+  std::deque<cv::Point> queue;
+  for (int y = roi.y; y < roi.y + roi.height; ++y)
+    for (int x = roi.x; x < roi.x + roi.width; ++x)
+      if (std::isfinite(disparity.at<float>(y, x))) queue.emplace_back(x, y);
+  int added = 0;
+  while (!queue.empty()) {
+    const cv::Point p = queue.front();
+    queue.pop_front();
+    const float d = disparity.at<float>(p);
+    const float gx = state->slope_x.at<float>(p), gy = state->slope_y.at<float>(p);
+    const cv::Point next[4] = {{p.x - 1, p.y}, {p.x + 1, p.y}, {p.x, p.y - 1}, {p.x, p.y + 1}};
+    for (const cv::Point& q : next) {
+      // A pixel is tried again from later neighbours (up to max_tries): by
+      // then more of its neighbourhood is known, so the prediction is better.
+      if (!roi.contains(q) || std::isfinite(disparity.at<float>(q)) || tried.at<uint8_t>(q) >= o.max_tries) continue;
+      ++tried.at<uint8_t>(q);
+      // Predicted from the plane through the valid neighbours (noise ~0.25 px
+      // per pixel averages out), else from p and its slopes.
+      double predicted = d + gx * (q.x - p.x) + gy * (q.y - p.y), qgx = gx, qgy = gy;
+      LocalPlane(disparity, roi, q, o.plane_radius_px, &predicted, &qgx, &qgy);
+      const SubpixelResult r = RefineDisparity(left, right, q.x, q.y, predicted, qgx, qgy, accept.subpixel);
+      PixelStatus why = Accept(left, right, q.x, q.y, qgx, qgy, r, accept);
+      if (why == PixelStatus::kPoint && std::abs(r.disparity_px - predicted) > o.max_deviation_px)
+        why = PixelStatus::kOffPlane;
+      if (why != PixelStatus::kPoint) {
+        state->status.at<uint8_t>(q) = uint8_t(why);  // the reason growing could not reach it
+        continue;
+      }
+      disparity.at<float>(q) = float(r.disparity_px);
+      state->confidence.at<float>(q) = float(std::clamp(r.zncc, 0.0, 1.0));
+      state->status.at<uint8_t>(q) = uint8_t(PixelStatus::kPoint);
+      state->slope_x.at<float>(q) = float(qgx);
+      state->slope_y.at<float>(q) = float(qgy);
+      queue.push_back(q);
+      ++added;
+    }
+  }
+  return added;
+}
+
+}  // namespace stereorig
