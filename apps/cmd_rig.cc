@@ -1,4 +1,5 @@
 // `stereorig rig`: validate a rig file, print a summary, export cameras.
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -7,6 +8,8 @@
 #include "calib/core/cameramodel_export.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
+#include "calib/rig_compare.h"
+#include "reconstruct/runtime.h"
 
 namespace stereorig {
 
@@ -32,19 +35,82 @@ void PrintRigSummary(const Rig& rig, FILE* out) {
   }
 }
 
+namespace {
+
+// Points filling a box centred `distance_mm` ahead of module 0 of `truth`
+// (its reference frame): a regular 11 x 11 x 7 grid over size_mm.
+std::vector<Eigen::Vector3d> VolumeGrid(const Rig& truth, double distance_mm, const Eigen::Vector3d& size_mm) {
+  const Eigen::Vector3d centre = PointAhead(truth, 0, distance_mm);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i <= 10; ++i)
+    for (int j = 0; j <= 10; ++j)
+      for (int k = 0; k <= 6; ++k)
+        points.push_back(centre + Eigen::Vector3d((i / 10.0 - 0.5) * size_mm.x(), (j / 10.0 - 0.5) * size_mm.y(),
+                                                  (k / 6.0 - 0.5) * size_mm.z()));
+  return points;
+}
+
+// The figures docs/calibration.md judges a calibration by, against a true
+// rig (a simulated dataset's truth/rig.yaml).
+void PrintAgainstTruth(const Rig& rig, const Rig& truth, double distance_mm, const Eigen::Vector3d& size_mm) {
+  if (truth.num_modules() != rig.num_modules() || truth.num_cameras() != rig.num_cameras())
+    throw InputError("--truth", "has " + std::to_string(truth.num_modules()) + " module(s) and " +
+                                    std::to_string(truth.num_cameras()) + " camera(s), the rig has " +
+                                    std::to_string(rig.num_modules()) + " and " + std::to_string(rig.num_cameras()));
+  const std::vector<Eigen::Vector3d> points = VolumeGrid(truth, distance_mm, size_mm);
+  std::printf("against the truth, over a %.0f x %.0f x %.0f mm volume %.0f mm ahead of module 0 (%zu points):\n",
+              size_mm.x(), size_mm.y(), size_mm.z(), distance_mm, points.size());
+  for (int k = 0; k < rig.num_modules(); ++k) {
+    std::vector<Eigen::Vector3d> p_cal, p_true;
+    TriangulateThroughModule(truth, rig, k, points, &p_cal, &p_true);
+    if (p_cal.size() < 3) {
+      std::printf("  module %d: sees fewer than 3 points of the volume\n", k);
+      continue;
+    }
+    std::printf("  module %d: 3D error after rigid alignment %.4f mm over %zu points; baseline %.4f mm (truth %.4f)\n",
+                k, RigidAlignedRms(p_true, p_cal), p_cal.size(), rig.module(k).right_from_left.DistanceMm(),
+                truth.module(k).right_from_left.DistanceMm());
+  }
+  for (int i = 0; i < rig.num_modules(); ++i)
+    for (int j = i + 1; j < rig.num_modules(); ++j) {
+      const double a = ModuleAgreementRms(truth, rig, rig.S(i, j), i, j, points);
+      if (std::isnan(a))
+        std::printf("  modules %d-%d: no point of the volume seen by both\n", i, j);
+      else
+        std::printf("  modules %d-%d: agreement through S %.4f mm RMS\n", i, j, a);
+    }
+}
+
+}  // namespace
+
 int RunRig(int argc, char** argv) {
   CLI::App app{
       "Validate a rig file (every key, rotation and the S invariants), print a summary, and optionally export "
       "each camera as an mrcal .cameramodel (extrinsics relative to module 0).\n\n"
-      "Example:\n  stereorig rig --rig out/rig.yaml --export-cameramodels out/models/",
+      "With --truth (a simulated dataset's truth/rig.yaml) it also judges the rig by what users measure with: "
+      "each module's 3D error (points of the volume projected through the true cameras, triangulated with this "
+      "rig's module, RMS after the best rigid alignment) and each module pair's agreement through S.\n\n"
+      "Examples:\n  stereorig rig --rig out/rig.yaml --export-cameramodels out/models/\n"
+      "  stereorig rig --rig out/rig.yaml --truth sim/truth/rig.yaml",
       "stereorig rig"};
-  std::string rig_path, export_dir;
+  std::string rig_path, export_dir, truth_path;
+  double distance_mm = 200.0;
+  std::vector<double> size_mm = {75, 75, 50};
   app.add_option("--rig", rig_path, "rig file (YAML, docs/formats.md)")->required();
   app.add_option("--export-cameramodels", export_dir, "folder to write camN.cameramodel files into");
+  app.add_option("--truth", truth_path, "true rig file to judge this one against (a simulated dataset's)");
+  app.add_option("--distance", distance_mm, "with --truth: the volume's centre ahead of module 0, mm")
+      ->capture_default_str();
+  app.add_option("--volume", size_mm, "with --truth: the volume's size x y z, mm")->expected(3)->capture_default_str();
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
+  if (!(distance_mm > 0)) throw InputError("--distance", "must be > 0 mm");
+  for (double v : size_mm)
+    if (!(v > 0)) throw InputError("--volume", "each size must be > 0 mm");
 
   const Rig rig = ReadRigFile(rig_path);
   PrintRigSummary(rig, stdout);
+  if (!truth_path.empty())
+    PrintAgainstTruth(rig, ReadRigFile(truth_path), distance_mm, Eigen::Vector3d(size_mm[0], size_mm[1], size_mm[2]));
   if (!export_dir.empty()) {
     if (!std::filesystem::is_directory(export_dir)) throw InputError(export_dir, "not a folder");
     for (int i = 0; i < rig.num_cameras(); ++i) {

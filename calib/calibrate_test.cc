@@ -233,35 +233,5 @@ TEST(CalibrateReport, NoRefinedSigmaForHeldParameters) {
   EXPECT_EQ(r.report.system.covariance_status, "ok");
 }
 
-// Judges a calibrated rig file against a simulated dataset's truth (not run
-// by default: it needs a dataset from `stereorig simulate` and a rig from
-// `stereorig calibrate` on it):
-//   STEREORIG_TRUTH_RIG=data/truth/rig.yaml STEREORIG_CALIBRATED_RIG=rig.yaml
-//     calib_e2e_test --gtest_also_run_disabled_tests --gtest_filter='*AgainstTruth*'
-TEST(CalibrateDataset, DISABLED_AgainstTruth) {
-  const char* truth_path = std::getenv("STEREORIG_TRUTH_RIG");
-  const char* cal_path = std::getenv("STEREORIG_CALIBRATED_RIG");
-  ASSERT_TRUE(truth_path && cal_path) << "set STEREORIG_TRUTH_RIG and STEREORIG_CALIBRATED_RIG";
-  const Rig truth = ReadRigFile(truth_path);
-  const Rig cal = ReadRigFile(cal_path);
-  // The default volume: the world origin, 200 mm in front of module 0's nominal frame.
-  const Pose ref_from_volume = testing::DefaultVolume(MakeDefaultRig().world_from_module0);
-  const auto points = VolumePoints(ref_from_volume, Eigen::Vector3d(75, 75, 50), 2000, 1);
-  for (int k = 0; k < truth.num_modules(); ++k) {
-    std::vector<Eigen::Vector3d> pc, pt;
-    testing::TriangulateThroughModule(truth, cal, k, points, &pc, &pt);
-    const double e = testing::RigidAlignedRms(pt, pc);
-    std::printf("module %d: 3D error after rigid alignment %.4f mm over %zu points; baseline %.4f mm (truth %.4f)\n", k,
-                e, pc.size(), cal.module(k).right_from_left.DistanceMm(), truth.module(k).right_from_left.DistanceMm());
-    EXPECT_LT(e, 0.05);
-  }
-  for (int i = 0; i < truth.num_modules(); ++i)
-    for (int j = i + 1; j < truth.num_modules(); ++j) {
-      const double a = testing::ModuleAgreementRms(truth, cal, cal.S(i, j), i, j, points);
-      std::printf("modules %d-%d: agreement through S %.4f mm\n", i, j, a);
-      EXPECT_LT(a, 0.05);
-    }
-}
-
 }  // namespace
 }  // namespace stereorig

@@ -59,6 +59,38 @@ TEST(Cli, GoodRigFileIsAccepted) {
   EXPECT_NE(r.out.find("2 module(s)"), std::string::npos);
 }
 
+// `rig --truth`: judged against itself every figure is 0; with module 1
+// moved 0.1 mm in module 0's frame (S changed, each module untouched), the
+// module 3D errors stay 0 and the agreement through S is exactly the 0.1 mm
+// shift (every point module 1 triangulates lands 0.1 mm off): an analytic
+// expectation, printed to 4 decimals.
+TEST(Cli, RigAgainstTruthGivesZeroForItselfAndTheShiftOfAMovedModule) {
+  const std::string truth_path = ::testing::TempDir() + "/truth_rig.yaml";
+  const std::string moved_path = ::testing::TempDir() + "/moved_rig.yaml";
+  const stereorig::SimulatedRig sim = stereorig::MakeDefaultRig();
+  std::ofstream(truth_path) << GoodRigText();
+  const stereorig::Rig& t = sim.rig;
+  const stereorig::Pose module0_from_module1(t.S(0, 1).rotation(),
+                                             t.S(0, 1).translation_mm() + Eigen::Vector3d(0.1, 0, 0));
+  const stereorig::Rig moved(t.cameras(), t.camera_names(), t.modules(), {stereorig::Pose(), module0_from_module1});
+  stereorig::WriteRigFile(moved, moved_path);
+
+  Result r = RunCli("rig --rig " + truth_path + " --truth " + truth_path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("module 0: 3D error after rigid alignment 0.0000 mm"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("module 1: 3D error after rigid alignment 0.0000 mm"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("agreement through S 0.0000 mm"), std::string::npos) << r.out;
+
+  r = RunCli("rig --rig " + moved_path + " --truth " + truth_path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("module 1: 3D error after rigid alignment 0.0000 mm"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("agreement through S 0.1000 mm"), std::string::npos) << r.out;
+
+  r = RunCli("rig --rig " + moved_path + " --truth " + truth_path + " --volume 75 75 0");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+}
+
 // Every malformed case of the rig-file contract: exit 2, one line on stderr
 // naming the file and the offending key.
 TEST(Cli, EveryMalformedRigFileExitsTwoNamingTheKey) {
