@@ -13,6 +13,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -25,6 +26,7 @@
 #include "datasets/default_rig.h"
 #include "reconstruct/metrology/ply_points.h"
 #include "reconstruct/runtime.h"
+#include "reconstruct/scene_score.h"
 #include "reconstruct/score.h"
 #include "reconstruct/synthetic_scene.h"
 
@@ -37,6 +39,9 @@ struct Scene {
   std::string name;
   std::vector<cv::Mat> images;
   std::vector<Eigen::Vector3d> truth;
+  // A dataset scene's truth maps (grid-lit, depth, ids): the truth fill, as
+  // `stereorig score` measures it. Absent for the built-in scene.
+  std::optional<SceneTruth> truth_maps;
 };
 
 double Median(std::vector<double> v) {
@@ -131,6 +136,11 @@ nlohmann::json PipelineJson(const Pipeline& p, const Rig& rig, const std::vector
       if (score.filled.points) acc["hole_fill"] = FiguresJson(score.filled);
       sj["accuracy"] = acc;
     }
+    if (s.truth_maps) {
+      const SceneScore score = ScoreScene(*p.runtime, rec, *s.truth_maps);
+      sj["truth_fill"] = score.fill_all.fill();
+      for (const FillFigures& f : score.fill) sj["truth_fill_per_module"].push_back(f.fill());
+    }
     j["scenes"].push_back(sj);
   }
   return j;
@@ -152,6 +162,7 @@ void PrintPipeline(const nlohmann::json& j) {
   for (const auto& s : j["scenes"]) {
     std::printf("  %-10s %7d points, fill %.1f%%", s["scene"].get<std::string>().c_str(), s["points"].get<int>(),
                 100 * s["fill_rate"].get<double>());
+    if (s.contains("truth_fill")) std::printf(" (truth fill %.1f%%)", 100 * s["truth_fill"].get<double>());
     if (s.contains("accuracy")) {
       const auto& a = s["accuracy"];
       std::printf(", merged |e| %.4f mm std %.4f", a["merged"]["mean_abs_mm"].get<double>(),
@@ -208,7 +219,7 @@ int RunBench(int argc, char** argv) {
     spec.centre_mm = sim.world_from_module0.Inverse() * Eigen::Vector3d::Zero();
     spec.radius_mm = 25;
     scenes.push_back(
-        {"sphere(builtin)", RenderSphereCapture(sim.rig, spec), SampleSphere(spec.centre_mm, spec.radius_mm, 0.2)});
+        {"sphere(builtin)", RenderSphereCapture(sim.rig, spec), SampleSphere(spec.centre_mm, spec.radius_mm, 0.2), {}});
   } else {
     namespace fs = std::filesystem;
     rig = ReadRigFile(rig_path.empty() ? (fs::path(dataset) / "truth" / "rig.yaml").string() : rig_path);
@@ -217,9 +228,11 @@ int RunBench(int argc, char** argv) {
     while (std::getline(ss, name, ',')) {
       const fs::path capture = fs::path(dataset) / "scenes" / name / "active";
       if (!fs::is_directory(capture)) continue;
-      Scene s{name, LoadCapture(capture.string(), rig), {}};
+      Scene s{name, LoadCapture(capture.string(), rig), {}, {}};
       const fs::path truth = fs::path(dataset) / "truth" / "scenes" / name / "surface.ply";
       if (fs::exists(truth)) s.truth = ReadPlyPoints(truth.string());
+      if (fs::exists(fs::path(dataset) / "truth" / "scenes" / name / "lit_cam0.png"))
+        s.truth_maps = ReadSceneTruth(dataset, name);
       scenes.push_back(std::move(s));
     }
     if (scenes.empty()) throw InputError(dataset, "none of the scenes " + scenes_arg + " has an active capture");
@@ -268,7 +281,8 @@ int RunBench(int argc, char** argv) {
   std::printf("speed ratio (ours / SGBM standalone pipeline): %.2fx wall, %.2fx CPU\n", ratio_standalone,
               cpu_ratio_standalone);
   std::printf(
-      "speed ratio (ours / SGBM in our pipeline): %.2fx wall, %.2fx CPU; peak memory while timed %.0f MB (%.0f MB of it "
+      "speed ratio (ours / SGBM in our pipeline): %.2fx wall, %.2fx CPU; peak memory while timed %.0f MB (%.0f MB of "
+      "it "
       "before any runtime work: libraries, captures, truth; whole process incl. scoring %.0f MB); machine load average "
       "%.1f (other processes "
       "slow both pipelines)\n",
