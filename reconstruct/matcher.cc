@@ -19,8 +19,8 @@ MatcherKind ParseMatcherKind(const std::string& name, const std::string& where) 
   if (name == "census_sgm") return MatcherKind::kCensusSgm;
   if (name == "opencv_sgbm_3way") return MatcherKind::kOpenCvSgbm3Way;
   if (name == "opencv_sgbm_3way_standalone") return MatcherKind::kOpenCvSgbm3WayStandalone;
-  throw InputError(where, "unknown matcher '" + name +
-                              "' (census_sgm, opencv_sgbm_3way or opencv_sgbm_3way_standalone)");
+  throw InputError(where,
+                   "unknown matcher '" + name + "' (census_sgm, opencv_sgbm_3way or opencv_sgbm_3way_standalone)");
 }
 
 const char* MatcherKindName(MatcherKind kind) {
@@ -254,9 +254,16 @@ bool OccupiedBand(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
 // OpenCV StereoSGBM (MODE_SGBM_3WAY) over `roi` and the full range, in place
 // of census SGM only: the filters and the sub-pixel step after it are the
 // same as ours, so the baseline differs in the correspondence step alone.
-// Its own speckle filter is off (ours runs after), its uniqueness and
-// left-right tolerance are ours. Returns CV_32FC1 of roi.size(), NaN = invalid.
-cv::Mat SgbmRegion(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const MatchOptions& o) {
+// Here its own speckle filter is off (ours runs after), its uniqueness and
+// left-right tolerance are ours; MatchOpenCvSgbm runs it with its own
+// filters. Returns CV_32FC1 of roi.size(), NaN = invalid.
+struct SgbmFilters {
+  int uniqueness_percent = 0;
+  int speckle_window_px = 0;  // 0 = SGBM's speckle filter off
+  int speckle_range_px = 0;
+};
+cv::Mat SgbmRegion(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const MatchOptions& o,
+                   const SgbmFilters& filters) {
   // SGBM needs the right image at the same column indices, so both images
   // are cut to the ROI widened on the left by the largest disparity; those
   // extra columns are the margin SGBM leaves invalid anyway.
@@ -266,9 +273,9 @@ cv::Mat SgbmRegion(const cv::Mat& left, const cv::Mat& right, const cv::Rect& ro
   const int x1 = std::min(left.cols, roi.x + roi.width + std::max(0, -o.min_disparity_px));
   const cv::Rect cut(x0, roi.y, x1 - x0, roi.height);
   const int bs = o.sgbm_block_size;
-  cv::Ptr<cv::StereoSGBM> sgbm =
-      cv::StereoSGBM::create(o.min_disparity_px, num16, bs, 8 * bs * bs, 32 * bs * bs, o.sgm.lr_max_diff_px, 63,
-                             o.sgm.uniqueness_percent, 0, 0, cv::StereoSGBM::MODE_SGBM_3WAY);
+  cv::Ptr<cv::StereoSGBM> sgbm = cv::StereoSGBM::create(
+      o.min_disparity_px, num16, bs, 8 * bs * bs, 32 * bs * bs, o.sgm.lr_max_diff_px, 63, filters.uniqueness_percent,
+      filters.speckle_window_px, filters.speckle_range_px, cv::StereoSGBM::MODE_SGBM_3WAY);
   cv::Mat fixed;
   sgbm->compute(left(cut), right(cut), fixed);
   cv::Mat out(roi.size(), CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
@@ -298,8 +305,8 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
   const bool sgbm = o.matcher == MatcherKind::kOpenCvSgbm3Way;
   if (!sgbm && o.narrow_range && o.pyramid_levels == 0) OccupiedBand(left, right, roi, o, &dmin, &num);
   if (!sgbm) lap("band");
-  const cv::Mat coarse_to_fine =
-      sgbm ? SgbmRegion(left, right, roi, o) : MatchLevel(left, right, roi, dmin, num, o.pyramid_levels, o);
+  const cv::Mat coarse_to_fine = sgbm ? SgbmRegion(left, right, roi, o, SgbmFilters{o.sgm.uniqueness_percent, 0, 0})
+                                      : MatchLevel(left, right, roi, dmin, num, o.pyramid_levels, o);
   lap(sgbm ? "sgbm" : "sgm");
   DisparityState state;
   state.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
@@ -415,40 +422,22 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
 }
 
 MatchResult MatchOpenCvSgbm(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const MatchOptions& o) {
-  // SGBM needs the right image at the same column indices, so both images
-  // are cut to the ROI widened on the left by the largest disparity; those
-  // extra columns are the margin SGBM leaves invalid anyway.
-  const int num16 = (o.num_disparities + 15) / 16 * 16;
-  const int dmax = o.min_disparity_px + num16;
-  const int x0 = std::max(0, roi.x - std::max(0, dmax));
-  const int x1 = std::min(left.cols, roi.x + roi.width + std::max(0, -o.min_disparity_px));
-  const cv::Rect cut(x0, roi.y, x1 - x0, roi.height);
-  const int bs = o.sgbm_block_size;
-  cv::Ptr<cv::StereoSGBM> sgbm = cv::StereoSGBM::create(
-      o.min_disparity_px, num16, bs, 8 * bs * bs, 32 * bs * bs, o.sgm.lr_max_diff_px, 63, 10, o.speckle_window_px,
-      std::max(1, int(std::lround(o.speckle_range_px))), cv::StereoSGBM::MODE_SGBM_3WAY);
-  cv::Mat fixed;
   const auto t0 = std::chrono::steady_clock::now();
-  sgbm->compute(left(cut), right(cut), fixed);
+  const cv::Mat d_roi = SgbmRegion(
+      left, right, roi, o, SgbmFilters{10, o.speckle_window_px, std::max(1, int(std::lround(o.speckle_range_px)))});
   MatchResult result;
   result.times_ms["sgbm"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   result.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
   result.confidence = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
   result.status = cv::Mat(left.size(), CV_8UC1, cv::Scalar(uint8_t(PixelStatus::kNotSearched)));
   result.status(roi).setTo(uint8_t(PixelStatus::kNoSgmMatch));
-  const double dmax_valid = o.min_disparity_px + o.num_disparities - 1;
-  for (int y = 0; y < cut.height; ++y) {
-    const int16_t* f = fixed.ptr<int16_t>(y);
-    float* d = result.disparity_px.ptr<float>(roi.y + y);
-    float* c = result.confidence.ptr<float>(roi.y + y);
-    for (int x = std::max(roi.x, x0); x < roi.x + roi.width; ++x) {
-      const int16_t v = f[x - x0];
-      if (v < o.min_disparity_px * 16) continue;  // SGBM's invalid marker
-      const double disp = v / 16.0;
-      if (disp > dmax_valid) continue;
-      d[x] = float(disp);
-      c[x] = 1.0f;
-      result.status.at<uint8_t>(roi.y + y, x) = uint8_t(PixelStatus::kPoint);
+  for (int y = 0; y < roi.height; ++y) {
+    const float* in = d_roi.ptr<float>(y);
+    for (int x = 0; x < roi.width; ++x) {
+      if (std::isnan(in[x])) continue;
+      result.disparity_px.at<float>(roi.y + y, roi.x + x) = in[x];
+      result.confidence.at<float>(roi.y + y, roi.x + x) = 1.0f;
+      result.status.at<uint8_t>(roi.y + y, roi.x + x) = uint8_t(PixelStatus::kPoint);
     }
   }
   return result;
