@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <unordered_map>
 
 namespace stereorig {
 namespace {
@@ -15,18 +16,39 @@ double Median(std::vector<double> v) {
   return v[k];
 }
 
-// Every k-th column so that at most `max_count` remain (deterministic).
-Eigen::Matrix3Xd StrideColumns(const Eigen::Matrix3Xd& m, int max_count, Eigen::VectorXd* values) {
-  const Eigen::Index step = std::max<Eigen::Index>(1, (m.cols() + max_count - 1) / max_count);
-  const Eigen::Index n = (m.cols() + step - 1) / step;
-  Eigen::Matrix3Xd out(3, n);
-  Eigen::VectorXd v(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    out.col(i) = m.col(i * step);
-    v(i) = (*values)(i * step);
+// The mean point and mean value of each occupied cube of a grid, the cube's
+// edge grown until at most ~max_count cubes remain: a subsample spread
+// evenly over the surface (a stride through the cloud's rows is not: it
+// thins the seen region's edges, which carry the extrapolation), with the
+// noise averaged down. Deterministic: cubes in order of first occupancy.
+Eigen::Matrix3Xd CellMeans(const Eigen::Matrix3Xd& x, const Eigen::VectorXd& y, int max_count, Eigen::VectorXd* means) {
+  const Eigen::Vector3d lo = x.rowwise().minCoeff(), extent = x.rowwise().maxCoeff() - lo;
+  // Start from a cell for which a surface of the box's size would give
+  // max_count cells, then grow by the excess.
+  double cell = std::max(1e-3, std::sqrt((extent.x() * extent.y() + extent.y() * extent.z() + extent.z() * extent.x()) /
+                                         std::max(1, max_count)));
+  std::unordered_map<int64_t, int> index;
+  std::vector<int> cell_of(x.cols());
+  for (int attempt = 0; attempt < 20; ++attempt, cell *= 1.15) {
+    index.clear();
+    const Eigen::Vector3i dims = (extent / cell).cast<int>() + Eigen::Vector3i::Ones();
+    for (Eigen::Index i = 0; i < x.cols(); ++i) {
+      const Eigen::Vector3i c = ((x.col(i) - lo) / cell).cast<int>().cwiseMin(dims - Eigen::Vector3i::Ones());
+      const int64_t key = c.x() + int64_t(dims.x()) * (c.y() + int64_t(dims.y()) * c.z());
+      cell_of[i] = index.emplace(key, int(index.size())).first->second;
+    }
+    if (int(index.size()) <= max_count) break;
   }
-  *values = std::move(v);
-  return out;
+  const Eigen::Index n = Eigen::Index(index.size());
+  Eigen::Matrix3Xd sum = Eigen::Matrix3Xd::Zero(3, n);
+  Eigen::VectorXd value = Eigen::VectorXd::Zero(n), count = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index i = 0; i < x.cols(); ++i) {
+    sum.col(cell_of[i]) += x.col(i);
+    value(cell_of[i]) += y(i);
+    count(cell_of[i]) += 1;
+  }
+  *means = value.cwiseQuotient(count);
+  return sum.array().rowwise() / count.transpose().array();
 }
 
 // The unit-variance kernel matrix C(i, j) = exp(-|xi - xj|^2 / (2 l^2)).
@@ -89,12 +111,10 @@ ResidualField ResidualField::Fit(const std::vector<Eigen::Vector3d>& points_mm, 
     all.col(i) = points_mm[keep[i]];
     y_all(i) = residuals_mm[keep[i]];
   }
-  Eigen::VectorXd y = y_all;
-  const Eigen::Matrix3Xd x = StrideColumns(all, o.max_points, &y);
-
+  Eigen::VectorXd y, y_ml;
+  const Eigen::Matrix3Xd x = CellMeans(all, y_all, o.max_points, &y);
   // Hyperparameters by marginal likelihood on a coarser subsample.
-  Eigen::VectorXd y_ml = y;
-  const Eigen::Matrix3Xd x_ml = StrideColumns(x, o.max_likelihood_points, &y_ml);
+  const Eigen::Matrix3Xd x_ml = CellMeans(all, y_all, o.max_likelihood_points, &y_ml);
   const std::vector<double> lengths =
       o.length_mm > 0 ? std::vector<double>{o.length_mm} : o.candidate_lengths_mm;
   double best = -std::numeric_limits<double>::infinity(), best_length = lengths.front(),
@@ -127,8 +147,8 @@ ResidualField ResidualField::Fit(const std::vector<Eigen::Vector3d>& points_mm, 
   f.signal_sd_mm_ = std::sqrt(best_signal_var);
   f.noise_sd_mm_ = std::sqrt(best_ratio * best_signal_var);
   std::snprintf(buf, sizeof buf,
-                "residual field: rms %.3f mm over %zu points, fitted on %d; length %.1f mm%s, signal sd %.3f mm, "
-                "noise sd %.3f mm",
+                "residual field: rms %.3f mm over %zu points, fitted on %d cell means; length %.1f mm%s, signal sd "
+                "%.3f mm, noise sd %.3f mm",
                 f.residual_rms_mm_, keep.size(), int(x.cols()), best_length, o.length_mm > 0 ? " (given)" : "",
                 f.signal_sd_mm_, f.noise_sd_mm_);
   f.description_ = buf;
