@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
-#include <chrono>
 
 #include <limits>
 
@@ -247,14 +246,11 @@ HoleFillResult FillHolesFromModel(const PointCloud& measured, const RuntimeOptio
     pts.push_back(measured.xyz_mm[i].cast<double>());
     if (measured.normal.size() == measured.size()) normals.push_back(measured.normal[i].cast<double>());
   }
-  auto T0 = std::chrono::steady_clock::now();
-  auto LAP = [&](const char* what) { auto t = std::chrono::steady_clock::now(); fprintf(stderr, "TIMING %s %.1f ms\n", what, std::chrono::duration<double, std::milli>(t - T0).count()); T0 = t; };
   ModelLattice lattice;
   if (!FitModel(pts, normals, options, &lattice, &result.message)) return result;
 
   // What the model misses, as a smooth field (residual_field.h): the fill
   // follows it (a tuber's bumps) and returns to the model far from data.
-  LAP("model fit");
   ResidualField field;
   if (options.fill_follow_residuals) {
     std::vector<Eigen::Vector3d> feet;
@@ -279,9 +275,7 @@ HoleFillResult FillHolesFromModel(const PointCloud& measured, const RuntimeOptio
   const int rows = lattice.rows, cols = lattice.cols;
   const size_t samples = size_t(rows + 1) * cols;
   const int threads = options.match.num_threads;
-  LAP("field fit");
   const std::vector<double> offset = FieldOnLattice(lattice, field, options.fill_spacing_mm, threads);
-  LAP("field on lattice");
   std::vector<Eigen::Vector3d> point(samples), normal(samples);
   std::vector<char> keep(samples, 0);
   {
@@ -294,7 +288,6 @@ HoleFillResult FillHolesFromModel(const PointCloud& measured, const RuntimeOptio
       }
     });
   }
-  LAP("lattice");
   std::vector<int> vertex(samples, -1);
   const int first_vertex = int(mesh->vertices_mm.size());
   int added = 0;
