@@ -313,7 +313,9 @@ HoleFillResult FillHolesFromModel(const PointCloud& measured, const RuntimeOptio
     }
   result.ok = true;
   result.added_points = added;
-  result.message = lattice.description + "; " + field.description();
+  result.message = lattice.description + "; " +
+                   (options.fill_follow_residuals ? field.description()
+                                                  : std::string("residual field not used (fill_follow_residuals: false)"));
   return result;
 }
 
