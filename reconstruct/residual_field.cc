@@ -21,7 +21,10 @@ double Median(std::vector<double> v) {
 // evenly over the surface (a stride through the cloud's rows is not: it
 // thins the seen region's edges, which carry the extrapolation), with the
 // noise averaged down. Deterministic: cubes in order of first occupancy.
-Eigen::Matrix3Xd CellMeans(const Eigen::Matrix3Xd& x, const Eigen::VectorXd& y, int max_count, Eigen::VectorXd* means) {
+// *weights: each cell's point count over the median count; a cell mean's
+// noise variance goes as 1 / weight.
+Eigen::Matrix3Xd CellMeans(const Eigen::Matrix3Xd& x, const Eigen::VectorXd& y, int max_count, Eigen::VectorXd* means,
+                           Eigen::VectorXd* weights) {
   const Eigen::Vector3d lo = x.rowwise().minCoeff(), extent = x.rowwise().maxCoeff() - lo;
   // Start from a cell for which a surface of the box's size would give
   // max_count cells, then grow by the excess.
@@ -29,7 +32,7 @@ Eigen::Matrix3Xd CellMeans(const Eigen::Matrix3Xd& x, const Eigen::VectorXd& y, 
                                          std::max(1, max_count)));
   std::unordered_map<int64_t, int> index;
   std::vector<int> cell_of(x.cols());
-  for (int attempt = 0; attempt < 20; ++attempt, cell *= 1.15) {
+  for (int attempt = 0; attempt < 20; ++attempt) {
     index.clear();
     const Eigen::Vector3i dims = (extent / cell).cast<int>() + Eigen::Vector3i::Ones();
     for (Eigen::Index i = 0; i < x.cols(); ++i) {
@@ -38,6 +41,8 @@ Eigen::Matrix3Xd CellMeans(const Eigen::Matrix3Xd& x, const Eigen::VectorXd& y, 
       cell_of[i] = index.emplace(key, int(index.size())).first->second;
     }
     if (int(index.size()) <= max_count) break;
+    // A surface's cell count goes as 1 / cell^2.
+    cell *= std::max(1.05, 1.02 * std::sqrt(double(index.size()) / max_count));
   }
   const Eigen::Index n = Eigen::Index(index.size());
   Eigen::Matrix3Xd sum = Eigen::Matrix3Xd::Zero(3, n);
@@ -48,6 +53,8 @@ Eigen::Matrix3Xd CellMeans(const Eigen::Matrix3Xd& x, const Eigen::VectorXd& y, 
     count(cell_of[i]) += 1;
   }
   *means = value.cwiseQuotient(count);
+  std::vector<double> counts(count.data(), count.data() + n);
+  *weights = count / Median(counts);
   return sum.array().rowwise() / count.transpose().array();
 }
 
@@ -63,11 +70,13 @@ Eigen::MatrixXd KernelMatrix(const Eigen::Matrix3Xd& x, double length_mm) {
   return k;
 }
 
-// Log marginal likelihood of y under N(0, s^2 (C + ratio I)) with s^2 at its
-// maximum, up to a constant; -inf if the matrix is not positive definite.
-double ProfiledLogLikelihood(const Eigen::MatrixXd& c, double ratio, const Eigen::VectorXd& y, double* signal_var) {
+// Log marginal likelihood of y under N(0, s^2 (C + ratio W^-1)), W the
+// cells' weights, with s^2 at its maximum, up to a constant; -inf if the
+// matrix is not positive definite.
+double ProfiledLogLikelihood(const Eigen::MatrixXd& c, double ratio, const Eigen::VectorXd& weights,
+                             const Eigen::VectorXd& y, double* signal_var) {
   Eigen::MatrixXd a = c;
-  a.diagonal().array() += ratio;
+  a.diagonal() += ratio * weights.cwiseInverse();
   const Eigen::LLT<Eigen::MatrixXd> llt(a);
   if (llt.info() != Eigen::Success) return -std::numeric_limits<double>::infinity();
   const double n = double(y.size());
@@ -111,10 +120,10 @@ ResidualField ResidualField::Fit(const std::vector<Eigen::Vector3d>& points_mm, 
     all.col(i) = points_mm[keep[i]];
     y_all(i) = residuals_mm[keep[i]];
   }
-  Eigen::VectorXd y, y_ml;
-  const Eigen::Matrix3Xd x = CellMeans(all, y_all, o.max_points, &y);
+  Eigen::VectorXd y, y_ml, w, w_ml;
+  const Eigen::Matrix3Xd x = CellMeans(all, y_all, o.max_points, &y, &w);
   // Hyperparameters by marginal likelihood on a coarser subsample.
-  const Eigen::Matrix3Xd x_ml = CellMeans(all, y_all, o.max_likelihood_points, &y_ml);
+  const Eigen::Matrix3Xd x_ml = CellMeans(all, y_all, o.max_likelihood_points, &y_ml, &w_ml);
   const std::vector<double> lengths =
       o.length_mm > 0 ? std::vector<double>{o.length_mm} : o.candidate_lengths_mm;
   double best = -std::numeric_limits<double>::infinity(), best_length = lengths.front(),
@@ -123,7 +132,7 @@ ResidualField ResidualField::Fit(const std::vector<Eigen::Vector3d>& points_mm, 
     const Eigen::MatrixXd c = KernelMatrix(x_ml, l);
     for (double ratio : o.candidate_noise_ratios) {
       double signal_var = 0;
-      const double ll = ProfiledLogLikelihood(c, ratio, y_ml, &signal_var);
+      const double ll = ProfiledLogLikelihood(c, ratio, w_ml, y_ml, &signal_var);
       if (ll > best) best = ll, best_length = l, best_ratio = ratio, best_signal_var = signal_var;
     }
   }
@@ -135,7 +144,7 @@ ResidualField ResidualField::Fit(const std::vector<Eigen::Vector3d>& points_mm, 
   // The field on the full subsample. The posterior mean c*' (C + ratio I)^-1 y
   // does not depend on s^2.
   Eigen::MatrixXd a = KernelMatrix(x, best_length);
-  a.diagonal().array() += best_ratio;
+  a.diagonal() += best_ratio * w.cwiseInverse();
   const Eigen::LLT<Eigen::MatrixXd> llt(a);
   if (llt.info() != Eigen::Success) {
     f.description_ = "residual field off: the kernel matrix is not positive definite";
