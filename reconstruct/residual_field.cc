@@ -141,7 +141,8 @@ ResidualField ResidualField::Fit(const std::vector<Eigen::Vector3d>& points_mm, 
     return f;
   }
 
-  // The field on the full subsample. The posterior mean c*' (C + ratio I)^-1 y
+  // The field on the full set of cell means. The posterior mean
+  // c*' (C + ratio W^-1)^-1 y
   // does not depend on s^2.
   Eigen::MatrixXd a = KernelMatrix(x, best_length);
   a.diagonal() += best_ratio * w.cwiseInverse();

@@ -75,7 +75,7 @@ class ResidualField {
 
  private:
   Eigen::Matrix3Xd points_mm_;  // (3, M) the fit's points
-  Eigen::VectorXd alpha_;       // (M) (C + ratio I)^-1 y
+  Eigen::VectorXd alpha_;       // (M) (C + ratio W^-1)^-1 y, W the cells' weights
   double length_mm_ = 0, signal_sd_mm_ = 0, noise_sd_mm_ = 0, residual_rms_mm_ = 0;
   std::string description_ = "residual field off";
 };
