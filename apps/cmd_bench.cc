@@ -74,11 +74,6 @@ double ResidentMemoryMb() {
   return resident * double(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
 }
 
-nlohmann::json FiguresJson(const ErrorFigures& f) {
-  return {{"points", f.points}, {"mean_abs_mm", f.mean_abs_mm}, {"mean_mm", f.mean_mm},
-          {"std_mm", f.std_mm}, {"rms_mm", f.rms_mm},           {"p95_abs_mm", f.p95_abs_mm}};
-}
-
 struct Pipeline {
   MatcherKind matcher;
   std::unique_ptr<Runtime> runtime;
@@ -126,14 +121,14 @@ nlohmann::json PipelineJson(const Pipeline& p, const Rig& rig, const std::vector
     if (!s.truth.empty()) {
       const CloudScore score = ScoreAgainstTruth(rec.cloud, s.truth, rig.num_modules());
       nlohmann::json acc = {
-          {"merged", FiguresJson(score.all)},
+          {"merged", ErrorFiguresJson(score.all)},
           {"alignment_truth_from_cloud",
            {{"rotation_deg", score.truth_from_cloud.AngleDeg()},
             {"translation_mm",
              {score.truth_from_cloud.translation_mm().x(), score.truth_from_cloud.translation_mm().y(),
               score.truth_from_cloud.translation_mm().z()}}}}};
-      for (size_t m = 0; m < score.per_module.size(); ++m) acc["module"].push_back(FiguresJson(score.per_module[m]));
-      if (score.filled.points) acc["hole_fill"] = FiguresJson(score.filled);
+      for (size_t m = 0; m < score.per_module.size(); ++m) acc["module"].push_back(ErrorFiguresJson(score.per_module[m]));
+      if (score.filled.points) acc["hole_fill"] = FilledJson(score);
       sj["accuracy"] = acc;
     }
     if (s.truth_maps) {

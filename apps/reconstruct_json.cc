@@ -1,5 +1,7 @@
 #include "apps/reconstruct_json.h"
 
+#include <cmath>
+
 namespace stereorig {
 
 nlohmann::json ReconstructionJson(const Reconstruction& rec) {
@@ -29,7 +31,18 @@ nlohmann::json ReconstructionJson(const Reconstruction& rec) {
 
 nlohmann::json ErrorFiguresJson(const ErrorFigures& f) {
   return {{"points", f.points}, {"mean_abs_mm", f.mean_abs_mm}, {"mean_mm", f.mean_mm},
-          {"std_mm", f.std_mm}, {"rms_mm", f.rms_mm},           {"p95_abs_mm", f.p95_abs_mm}};
+          {"std_mm", f.std_mm}, {"rms_mm", f.rms_mm},           {"p95_abs_mm", f.p95_abs_mm},
+          {"max_abs_mm", f.max_abs_mm}, {"within_0_5_mm", f.within_0_5_mm}};
+}
+
+nlohmann::json FilledJson(const CloudScore& score) {
+  nlohmann::json j = ErrorFiguresJson(score.filled);
+  for (const FillBand& b : score.filled_by_distance) {
+    nlohmann::json bj = ErrorFiguresJson(b.figures);
+    bj["from_measured_mm"] = {b.from_mm, std::isfinite(b.to_mm) ? nlohmann::json(b.to_mm) : nlohmann::json(nullptr)};
+    j["by_distance_to_measured"].push_back(bj);
+  }
+  return j;
 }
 
 }  // namespace stereorig

@@ -13,7 +13,12 @@ namespace stereorig {
 nlohmann::json ReconstructionJson(const Reconstruction& rec);
 
 // Accuracy figures against truth (score.h): points, mean_abs_mm, mean_mm,
-// std_mm, rms_mm, p95_abs_mm.
+// std_mm, rms_mm, p95_abs_mm, max_abs_mm, within_0_5_mm.
 nlohmann::json ErrorFiguresJson(const ErrorFigures& f);
+
+// The hole-filling points' figures (ErrorFiguresJson) and, under
+// by_distance_to_measured, the same per band of distance to the nearest
+// measured point (from_measured_mm: [from, to], null = no upper end).
+nlohmann::json FilledJson(const CloudScore& score);
 
 }  // namespace stereorig

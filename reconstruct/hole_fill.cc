@@ -5,10 +5,14 @@
 #include <cstdio>
 #include <functional>
 
-#include "reconstruct/kd_tree.h"
+#include <limits>
+
 #include "reconstruct/metrology/cylinder_fit.h"
 #include "reconstruct/metrology/ellipsoid_fit.h"
 #include "reconstruct/metrology/sphere_fit.h"
+#include "reconstruct/parallel_for.h"
+#include "reconstruct/proximity_grid.h"
+#include "reconstruct/residual_field.h"
 
 namespace stereorig {
 
@@ -20,8 +24,14 @@ namespace {
 struct ModelLattice {
   int rows = 0, cols = 0;
   std::function<Eigen::Vector3d(int i, int j, Eigen::Vector3d* normal)> sample;
+  // p's signed distance to the model along the model's normal (> 0
+  // outside), and *foot, where that normal meets the surface; NaN where p
+  // is off the modelled surface (beyond a cylinder's extent).
+  std::function<double(const Eigen::Vector3d& p, Eigen::Vector3d* foot)> residual;
   std::string description;  // the fitted model, one line
 };
+
+constexpr double kNotOnModel = std::numeric_limits<double>::quiet_NaN();
 
 // A fit is used only if the model explains at least this fraction of the
 // measured points: a model of the wrong kind or size can still gather a
@@ -71,6 +81,13 @@ bool FitModel(const std::vector<Eigen::Vector3d>& pts, const std::vector<Eigen::
         *n = Eigen::Vector3d(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
         return Eigen::Vector3d(c + r * *n);
       };
+      lattice->residual = [=](const Eigen::Vector3d& p, Eigen::Vector3d* foot) {
+        const Eigen::Vector3d v = p - c;
+        const double rho = v.norm();
+        if (!(rho > 0)) return kNotOnModel;
+        *foot = c + r / rho * v;
+        return rho - r;
+      };
       std::snprintf(buf, sizeof buf,
                     "sphere centre (%.3f, %.3f, %.3f) mm, radius %.3f mm, fit rms %.3f mm, %zu inliers", c.x(), c.y(),
                     c.z(), r, fit.rms_mm, fit.inliers.size());
@@ -100,6 +117,16 @@ bool FitModel(const std::vector<Eigen::Vector3d>& pts, const std::vector<Eigen::
         *n = std::cos(phi) * e1 + std::sin(phi) * e2;
         return Eigen::Vector3d(bottom + len * i / rows * d + r * *n);
       };
+      const Eigen::Vector3d axis_point = fit.axis_point_mm;
+      lattice->residual = [=](const Eigen::Vector3d& p, Eigen::Vector3d* foot) {
+        const Eigen::Vector3d v = p - axis_point;
+        const double along = v.dot(d);
+        const Eigen::Vector3d radial = v - along * d;
+        const double rho = radial.norm();
+        if (std::abs(along) > 0.5 * len || !(rho > 0)) return kNotOnModel;  // a cap: not modelled
+        *foot = axis_point + along * d + r / rho * radial;
+        return rho - r;
+      };
       std::snprintf(buf, sizeof buf,
                     "cylinder axis through (%.3f, %.3f, %.3f) mm along (%.4f, %.4f, %.4f), radius %.3f mm, length "
                     "%.1f mm, fit rms %.3f mm, %zu inliers",
@@ -123,6 +150,28 @@ bool FitModel(const std::vector<Eigen::Vector3d>& pts, const std::vector<Eigen::
       lattice->sample = [=](int i, int j, Eigen::Vector3d* n) {
         return fit.SurfacePoint(M_PI * i / rows, 2 * M_PI * j / cols, n);
       };
+      // Along the normal of the level set through p (x'A x = const), where
+      // it meets the ellipsoid: a quadratic in the step. The line leaves p
+      // at an angle of order |distance| x curvature to the surface's normal
+      // at the foot, so its length differs from the orthogonal distance by
+      // a second-order term (< 0.01 mm for 2 mm on a 17 mm radius of
+      // curvature).
+      const Eigen::Matrix3d r = fit.frame_from_ellipsoid;
+      const Eigen::Vector3d c = fit.center_mm, inv_a2 = a.cwiseProduct(a).cwiseInverse();
+      lattice->residual = [=](const Eigen::Vector3d& p, Eigen::Vector3d* foot) {
+        const Eigen::Vector3d u = r.transpose() * (p - c);
+        const Eigen::Vector3d g = u.cwiseProduct(inv_a2);
+        if (!(g.norm() > 0)) return kNotOnModel;
+        const Eigen::Vector3d v = g.normalized();  // outward
+        const double qa = v.cwiseProduct(v).dot(inv_a2), qb = 2 * v.dot(g), qc = u.dot(g) - 1;
+        const double disc = qb * qb - 4 * qa * qc;
+        if (disc < 0) return kNotOnModel;
+        // The root nearest to p (qb = 2|g| > 0; the other root is across
+        // the ellipsoid), in the form without cancellation near the surface.
+        const double t = -2 * qc / (qb + std::sqrt(disc));
+        *foot = c + r * (u + t * v);
+        return -t;
+      };
       std::snprintf(buf, sizeof buf,
                     "ellipsoid centre (%.3f, %.3f, %.3f) mm, semi-axes (%.3f, %.3f, %.3f) mm, fit rms %.3f mm, %zu "
                     "inliers",
@@ -135,6 +184,48 @@ bool FitModel(const std::vector<Eigen::Vector3d>& pts, const std::vector<Eigen::
   }
   lattice->description = buf;
   return true;
+}
+
+// The field at every lattice sample, (rows + 1) x cols, row-major. It is
+// evaluated on every step-th row and column (wrapping) and interpolated
+// bilinearly in between: with step x spacing <= l / 4 the interpolation
+// error, ~ (step x spacing)^2 / 8 x |field''| with |field''| ~ signal / l^2,
+// stays below 1% of the field's amplitude, and the Gaussian-process sums
+// (one per evaluation, over every fitted point) drop ~step^2-fold.
+std::vector<double> FieldOnLattice(const ModelLattice& lattice, const ResidualField& field, double spacing_mm,
+                                   int threads) {
+  const int rows = lattice.rows, cols = lattice.cols;
+  std::vector<double> out(size_t(rows + 1) * cols, 0.0);
+  if (!field.active()) return out;
+  const int step = std::max(1, int(field.length_mm() / (4 * spacing_mm)));
+  // Coarse rows 0, step, ..., rows; coarse columns 0, step, ... (then the
+  // wrap back to column 0, at index cols).
+  std::vector<int> rs, cs;
+  for (int i = 0; i < rows; i += step) rs.push_back(i);
+  rs.push_back(rows);
+  for (int j = 0; j < cols; j += step) cs.push_back(j);
+  const int ncs = int(cs.size());
+  std::vector<double> coarse(rs.size() * cs.size());
+  ParallelForChunks(int(coarse.size()), threads, [&](int begin, int end) {
+    for (int k = begin; k < end; ++k) {
+      Eigen::Vector3d n;
+      coarse[k] = field.Predict(lattice.sample(rs[k / ncs], cs[k % ncs], &n));
+    }
+  });
+  for (int i = 0; i <= rows; ++i) {
+    const int a = std::min(int(rs.size()) - 2, i / step);
+    const double ti = double(i - rs[a]) / (rs[a + 1] - rs[a]);
+    for (int j = 0; j < cols; ++j) {
+      const int b = j / step, b1 = (b + 1) % ncs;
+      const int j1 = b + 1 < ncs ? cs[b + 1] : cols;
+      const double tj = double(j - cs[b]) / (j1 - cs[b]);
+      const double* r0 = &coarse[size_t(a) * ncs];
+      const double* r1 = &coarse[size_t(a + 1) * ncs];
+      out[size_t(i) * cols + j] =
+          (1 - ti) * ((1 - tj) * r0[b] + tj * r0[b1]) + ti * ((1 - tj) * r1[b] + tj * r1[b1]);
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -158,31 +249,59 @@ HoleFillResult FillHolesFromModel(const PointCloud& measured, const RuntimeOptio
   ModelLattice lattice;
   if (!FitModel(pts, normals, options, &lattice, &result.message)) return result;
 
-  std::vector<Eigen::Vector3d> all;
-  all.reserve(measured.size());
-  for (const auto& p : measured.xyz_mm) all.push_back(p.cast<double>());
-  const KdTree3 tree(std::move(all));
+  // What the model misses, as a smooth field (residual_field.h): the fill
+  // follows it (a tuber's bumps) and returns to the model far from data.
+  ResidualField field;
+  if (options.fill_follow_residuals) {
+    std::vector<Eigen::Vector3d> feet;
+    std::vector<double> residuals;
+    feet.reserve(measured.size());
+    residuals.reserve(measured.size());
+    for (size_t i = 0; i < measured.size(); ++i) {
+      if (measured.module[i] == kFilledModule) continue;
+      Eigen::Vector3d foot;
+      const double r = lattice.residual(measured.xyz_mm[i].cast<double>(), &foot);
+      if (std::isnan(r)) continue;
+      feet.push_back(foot);
+      residuals.push_back(r);
+    }
+    ResidualFieldOptions fo;
+    fo.length_mm = options.fill_residual_length_mm;
+    field = ResidualField::Fit(feet, residuals, fo);
+  }
 
-  // Keep the samples with no measured point within 2 spacings: what no
-  // module saw.
+  // Each lattice sample, moved along the model normal by the field; kept
+  // where no measured point lies within 2 spacings: what no module saw.
   const int rows = lattice.rows, cols = lattice.cols;
-  std::vector<int> vertex(size_t(rows + 1) * cols, -1);
+  const size_t samples = size_t(rows + 1) * cols;
+  const int threads = options.match.num_threads;
+  const std::vector<double> offset = FieldOnLattice(lattice, field, options.fill_spacing_mm, threads);
+  std::vector<Eigen::Vector3d> point(samples), normal(samples);
+  std::vector<char> keep(samples, 0);
+  {
+    const ProximityGrid seen(measured.xyz_mm, 2 * options.fill_spacing_mm);
+    const double radius = 2 * options.fill_spacing_mm;
+    ParallelForChunks(int(samples), threads, [&](int begin, int end) {
+      for (int k = begin; k < end; ++k) {
+        point[k] = lattice.sample(k / cols, k % cols, &normal[k]) + offset[k] * normal[k];
+        keep[k] = !seen.AnyWithin(point[k], radius);
+      }
+    });
+  }
+  std::vector<int> vertex(samples, -1);
   const int first_vertex = int(mesh->vertices_mm.size());
   int added = 0;
-  for (int i = 0; i <= rows; ++i)
-    for (int j = 0; j < cols; ++j) {
-      Eigen::Vector3d n;
-      const Eigen::Vector3d p = lattice.sample(i, j, &n);
-      if (tree.NearestDistance(p) < 2 * options.fill_spacing_mm) continue;
-      vertex[size_t(i) * cols + j] = first_vertex + added;
-      cloud->xyz_mm.push_back(p.cast<float>());
-      cloud->normal.push_back(n.cast<float>());
-      cloud->intensity.push_back(0);
-      cloud->module.push_back(kFilledModule);
-      cloud->confidence.push_back(0.0f);
-      mesh->vertices_mm.push_back(p.cast<float>());
-      ++added;
-    }
+  for (size_t k = 0; k < samples; ++k) {
+    if (!keep[k]) continue;
+    vertex[k] = first_vertex + added;
+    cloud->xyz_mm.push_back(point[k].cast<float>());
+    cloud->normal.push_back(normal[k].cast<float>());
+    cloud->intensity.push_back(0);
+    cloud->module.push_back(kFilledModule);
+    cloud->confidence.push_back(0.0f);
+    mesh->vertices_mm.push_back(point[k].cast<float>());
+    ++added;
+  }
   for (int i = 0; i < rows; ++i)
     for (int j = 0; j < cols; ++j) {
       const int jn = (j + 1) % cols;
@@ -194,7 +313,9 @@ HoleFillResult FillHolesFromModel(const PointCloud& measured, const RuntimeOptio
     }
   result.ok = true;
   result.added_points = added;
-  result.message = lattice.description;
+  result.message = lattice.description + "; " +
+                   (options.fill_follow_residuals ? field.description()
+                                                  : std::string("residual field not used (fill_follow_residuals: false)"));
   return result;
 }
 

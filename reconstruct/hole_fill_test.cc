@@ -160,6 +160,76 @@ TEST(HoleFill, EllipsoidClosesTheUnseenRimOnTheTrueSurface) {
   EXPECT_EQ(InwardTriangles(fill.mesh, [&](const Eigen::Vector3d&) { return c; }), 0);
 }
 
+// Issue 5 on a real-ish object: a tuber-sized ellipsoid with low-frequency
+// radial bumps (|u| = 1 + h(u/|u|), u = p / semi-axes, |h| <= 0.05: up to
+// ~2 mm), like the simulator's tuber. The ellipsoid alone misses the bumps
+// by up to ~2 mm; following the measured residuals, the fill must follow
+// them where it continues the seen surface.
+TEST(HoleFill, BumpyEllipsoidFillFollowsTheBumps) {
+  const Eigen::Vector3d c(-4, 6, 205), axes(42, 30, 27);
+  const Eigen::Matrix3d rot = Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 0).normalized()).toRotationMatrix();
+  const Eigen::Vector3d g[3] = {Eigen::Vector3d(1, 0.3, 0).normalized(), Eigen::Vector3d(-0.2, 1, 0.5).normalized(),
+                                Eigen::Vector3d(0.4, -0.3, 1).normalized()};
+  const double f[3] = {2.3, 3.1, 2.7}, phase[3] = {0.3, 1.9, 4.0};
+  auto h = [&](const Eigen::Vector3d& w) {
+    double sum = 0;
+    for (int k = 0; k < 3; ++k) sum += std::sin(f[k] * g[k].dot(w) + phase[k]);
+    return 0.05 * sum / 3;
+  };
+  const auto ellipsoid = testing::EllipsoidSurface(c, rot, axes);
+  auto bumpy = [&](double a, double b, Eigen::Vector3d* n) {
+    const Eigen::Vector3d p = ellipsoid(a, b, n);  // n: the ellipsoid's normal (visibility, noise direction)
+    const Eigen::Vector3d w = axes.cwiseInverse().cwiseProduct(rot.transpose() * (p - c));
+    return Eigen::Vector3d(c + (1 + h(w)) * (p - c));
+  };
+  // Distance bound along the ray from the centre (>= the true distance).
+  auto truth_distance = [&](const Eigen::Vector3d& p) {
+    const Eigen::Vector3d u = axes.cwiseInverse().cwiseProduct(rot.transpose() * (p - c));
+    return (p - c).norm() * std::abs(1 - (1 + h(u.normalized())) / u.norm());
+  };
+  const PointCloud cloud = ToCloud(testing::SeenByTwoFacingCameras(bumpy, c, testing::NoiseSpec{}));
+  struct Figures {
+    double mean = 0, worst = 0, within_0_5 = 0;
+    int points = 0;
+  };
+  auto fill_figures = [&](bool follow) {
+    RuntimeOptions o;
+    o.shape_model = ShapeModel::kEllipsoid;
+    o.fill_follow_residuals = follow;
+    PointCloud out = cloud;
+    Mesh mesh;
+    const HoleFillResult r = FillHolesFromModel(cloud, o, &out, &mesh);
+    EXPECT_TRUE(r.ok) << r.message;
+    std::printf("%s: %d points added\n", r.message.c_str(), r.added_points);
+    Figures fig;
+    for (size_t i = cloud.size(); i < out.size(); ++i) {
+      const double d = truth_distance(out.xyz_mm[i].cast<double>());
+      fig.mean += d;
+      fig.worst = std::max(fig.worst, d);
+      fig.within_0_5 += d <= 0.5;
+      ++fig.points;
+    }
+    fig.mean /= std::max(1, fig.points);
+    fig.within_0_5 /= std::max(1, fig.points);
+    std::printf("  filled points against the bumpy truth: mean %.3f mm, worst %.3f mm, %.1f%% within 0.5 mm\n",
+                fig.mean, fig.worst, 100 * fig.within_0_5);
+    return fig;
+  };
+  const Figures model_only = fill_figures(false), following = fill_figures(true);
+  ASSERT_GT(following.points, 1000);
+  // The ellipsoid alone is off by the bumps (this is what the test is about).
+  EXPECT_GT(model_only.worst, 1.0);
+  // Following the residuals: the unseen rim is at most ~15 mm from the seen
+  // caps, about a length scale, so the field carries the bumps there. The
+  // 0.05 mm point noise is averaged away (cell means of ~20 points); what
+  // is left is the field's extrapolation, which decays to the model deep in
+  // a hole: the issue's 0.5 mm holds for nearly every point (measured:
+  // 0.028 mm mean, 0.21 mm worst, against 0.32 / 1.1 mm for the model).
+  EXPECT_GT(following.within_0_5, 0.99);
+  EXPECT_LT(following.mean, 0.25 * model_only.mean);
+  EXPECT_LT(following.worst, 0.6 * model_only.worst);
+}
+
 // A fit that fails is reported and nothing is added: too few points, an
 // object larger than object_size_mm, a model of the wrong kind.
 TEST(HoleFill, AFailedFitIsReportedAndNotUsed) {

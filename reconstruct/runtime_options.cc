@@ -36,6 +36,8 @@ void RuntimeOptions::Check() const {
   if (normal_step_px < 1 || normal_step_px > 10) throw InputError("normal_step_px", "must be in [1, 10]");
   if (!(mesh_max_edge_mm > 0)) throw InputError("mesh_max_edge_mm", "must be > 0");
   if (!(fill_spacing_mm > 0.05)) throw InputError("fill_spacing_mm", "must be > 0.05 mm");
+  if (!(fill_residual_length_mm == 0 || (fill_residual_length_mm >= 1 && fill_residual_length_mm <= 1000)))
+    throw InputError("fill_residual_length_mm", "must be 0 (chosen from the data) or in [1, 1000] mm");
   match.Check();
 }
 
@@ -60,6 +62,8 @@ RuntimeOptions FromYaml(YamlMap& y) {
   o.mesh_max_edge_mm = y.GetDouble("mesh_max_edge_mm", o.mesh_max_edge_mm);
   o.shape_model = ParseShapeModel(y.GetString("shape_model", "none"), y.Where("shape_model"));
   o.fill_spacing_mm = y.GetDouble("fill_spacing_mm", o.fill_spacing_mm);
+  o.fill_follow_residuals = y.GetBool("fill_follow_residuals", o.fill_follow_residuals);
+  o.fill_residual_length_mm = y.GetDouble("fill_residual_length_mm", o.fill_residual_length_mm);
   o.parallel_modules = y.GetBool("parallel_modules", o.parallel_modules);
   if (y.Has("match")) {
     YamlMap m = y.GetMap("match");

@@ -39,6 +39,16 @@ struct RuntimeOptions {
   double mesh_max_edge_mm = 1.5;  // organised mesh: no triangle edge longer than this (depth jumps); default 1.5
   ShapeModel shape_model = ShapeModel::kNone;  // hole filling model; default none
   double fill_spacing_mm = 1.0;                // hole filling: sample spacing on the model surface; default 1.0 mm
+  // Hole filling follows what the model misses: the measured points'
+  // residuals to the model, as a smooth field (residual_field.h), move each
+  // fill sample along the model's normal; far from the data the fill returns
+  // to the model. Off (the field is zero) where the model is exact to the
+  // noise (residual rms < 0.1 mm: a sphere, a cup). Default true.
+  bool fill_follow_residuals = true;
+  // The field's length scale, mm: about the size of the object's features
+  // the fill should follow. 0 (default) = chosen from the data by marginal
+  // likelihood over 6-30 mm.
+  double fill_residual_length_mm = 0;
   bool parallel_modules = true;                // process modules on separate threads; default true
 
   void Check() const;  // throws InputError naming the bad key

@@ -3,6 +3,8 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <memory>
 
 #include "reconstruct/kd_tree.h"
 
@@ -42,6 +44,8 @@ ErrorFigures Figures(std::vector<double> e) {
   const size_t k = std::min(e.size() - 1, size_t(0.95 * e.size()));
   std::nth_element(e.begin(), e.begin() + k, e.end());
   f.p95_abs_mm = e[k];
+  f.max_abs_mm = *std::max_element(e.begin(), e.end());
+  f.within_0_5_mm = double(std::count_if(e.begin(), e.end(), [](double v) { return v <= 0.5; })) / e.size();
   return f;
 }
 
@@ -102,6 +106,16 @@ CloudScore ScoreAgainstTruth(const PointCloud& cloud, const std::vector<Eigen::V
   score.truth_from_cloud = Pose(r, t);
   std::vector<double> all, filled;
   std::vector<std::vector<double>> per(num_modules);
+  // Filled points by distance to the nearest measured point (a rigid motion
+  // keeps distances: taken in the cloud's frame).
+  const double band_edges_mm[] = {0, 5, 15, std::numeric_limits<double>::infinity()};
+  std::vector<std::vector<double>> band(std::size(band_edges_mm) - 1);
+  std::unique_ptr<KdTree3> measured_tree;
+  if (measured.size() < cloud.size() && !measured.empty()) {
+    std::vector<Eigen::Vector3d> measured_points;
+    for (size_t i : measured) measured_points.push_back(cloud.xyz_mm[i].cast<double>());
+    measured_tree = std::make_unique<KdTree3>(std::move(measured_points));
+  }
   for (size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3d p = r * cloud.xyz_mm[i].cast<double>() + t;
     Eigen::Vector3d c, n;
@@ -112,6 +126,10 @@ CloudScore ScoreAgainstTruth(const PointCloud& cloud, const std::vector<Eigen::V
     const double e = sign * (p - c).dot(n);
     if (cloud.module[i] == kFilledModule) {
       filled.push_back(e);
+      const double d = measured_tree ? measured_tree->NearestDistance(cloud.xyz_mm[i].cast<double>())
+                                     : std::numeric_limits<double>::infinity();
+      for (size_t b = 0; b < band.size(); ++b)
+        if (d >= band_edges_mm[b] && d < band_edges_mm[b + 1]) band[b].push_back(e);
     } else {
       all.push_back(e);
       if (cloud.module[i] < num_modules) per[cloud.module[i]].push_back(e);
@@ -119,6 +137,8 @@ CloudScore ScoreAgainstTruth(const PointCloud& cloud, const std::vector<Eigen::V
   }
   score.all = Figures(std::move(all));
   score.filled = Figures(std::move(filled));
+  for (size_t b = 0; b < band.size(); ++b)
+    score.filled_by_distance.push_back({band_edges_mm[b], band_edges_mm[b + 1], Figures(std::move(band[b]))});
   for (int m = 0; m < num_modules; ++m) score.per_module[m] = Figures(std::move(per[m]));
   return score;
 }

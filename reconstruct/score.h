@@ -27,6 +27,15 @@ struct ErrorFigures {
   double std_mm = 0;
   double rms_mm = 0;
   double p95_abs_mm = 0;
+  double max_abs_mm = 0;
+  double within_0_5_mm = 0;  // fraction of points with |distance| <= 0.5 mm (issue 5's bound for the fill)
+};
+
+// The fill's figures for the filled points whose nearest measured point is
+// [from_mm, to_mm) away: how far the fill extrapolates from what was seen.
+struct FillBand {
+  double from_mm = 0, to_mm = 0;  // to_mm = infinity for the last band
+  ErrorFigures figures;
 };
 
 struct CloudScore {
@@ -34,6 +43,7 @@ struct CloudScore {
   ErrorFigures all;                      // measured points (filled ones excluded)
   std::vector<ErrorFigures> per_module;  // index = module
   ErrorFigures filled;                   // hole-filling points (module kFilledModule), if any
+  std::vector<FillBand> filled_by_distance;  // the same by distance to the nearest measured point: 0-5, 5-15, >= 15 mm
 };
 
 // `truth`: (N) samples in mm. `num_modules`: size of per_module.
