@@ -82,6 +82,7 @@ struct SgmWorkspace {
   std::vector<uint16_t> vert_a, vert_b;  // (w, stride + 2): top/bottom path, previous and current row
   std::vector<uint16_t> vert_min_a, vert_min_b;
   std::vector<uint16_t> horiz_a, horiz_b, horiz_c, horiz_d;  // (stride + 2): left->right, right->left
+  std::vector<uint16_t> shifted, shifted_rl;                 // (stride + 2): a predecessor in another window
   std::vector<uint16_t> right_best;                          // (16 + w + n)
   std::vector<uint64_t> right_reversed;                      // (stride + right width + stride + 16)
 };
@@ -104,13 +105,35 @@ uint16_t* PathBuffers(std::vector<uint16_t>& v, int count, int stride) {
   return p + 1;
 }
 
+// The path costs `prev` of a neighbour whose window starts `shift`
+// disparities below the current pixel's, read in the current pixel's
+// disparities: buf[i] = prev[i + shift] for i in [0, n), kBig where
+// i + shift falls outside the neighbour's n disparities (it never searched
+// them: "no match there"), and kBig at [-1] and [n, stride] as in any path
+// buffer. shift == 0 returns prev itself.
+const uint16_t* InWindowOf(const uint16_t* prev, int shift, int n, int stride, uint16_t* buf) {
+  if (shift == 0) return prev;
+  std::fill(buf - 1, buf + stride + 1, kBig);
+  const int i0 = std::max(0, -shift), i1 = std::min(n, n - shift);
+  if (i0 < i1) std::copy(prev + i0 + shift, prev + i1 + shift, buf + i0);
+  return buf;
+}
+
+// SGM with per-pixel search windows: pixel (x, y) of `region` searches the
+// n disparities [lo(y, x), lo(y, x) + n) (window_lo: CV_16SC1 of
+// region.size()). Every path step reads its predecessor through
+// InWindowOf, so the recursion compares equal disparities even where the
+// windows of neighbours differ; with a constant lo it is plain SGM.
 template <typename K>
-cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv::Rect& region, int min_disparity,
-                     int n, const SgmOptions& options) {
+cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv::Rect& region,
+                     const cv::Mat& window_lo, int n, const SgmOptions& options) {
   const int w = region.width, h = region.height;
   const int stride = K::Stride(n), path_stride = stride + 2;
   const int rw = right.width;
   const uint16_t p1 = uint16_t(options.p1), p2 = uint16_t(options.p2);
+  double lo_min = 0, lo_max = 0;
+  cv::minMaxLoc(window_lo, &lo_min, &lo_max);
+  auto lo_row = [&](int y) { return window_lo.ptr<int16_t>(y); };
   SgmWorkspace ws;
 
   // Cost volume (h, w, stride), uint8. Disparities whose right pixel falls
@@ -123,10 +146,11 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   for (int y = 0; y < h; ++y) {
     const uint64_t* cl = left.row(region.y + y);
     const uint64_t* cr = right.row(region.y + y);
+    const int16_t* lo = lo_row(y);
     std::reverse_copy(cr, cr + rw, reversed + stride);
     for (int x = 0; x < w; ++x) {
       uint8_t* c = cost + (size_t(y) * w + x) * stride;
-      const int xr0 = region.x + x - min_disparity;  // right x at d index 0
+      const int xr0 = region.x + x - lo[x];  // right x at d index 0
       // d indices whose right pixel xr0 - d lies in [0, rw).
       const int d_lo = std::clamp(xr0 - rw + 1, 0, n), d_hi = std::clamp(xr0 + 1, d_lo, n);
       if (d_lo == d_hi) {
@@ -150,35 +174,43 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   uint16_t* hb = PathBuffers(ws.horiz_b, 1, stride);
   uint16_t* hc = PathBuffers(ws.horiz_c, 1, stride);
   uint16_t* hd = PathBuffers(ws.horiz_d, 1, stride);
-  // Right-view best costs: right pixel xr_local = x - d + n - 1, stored at
-  // [16 + xr_local] (the SIMD kernel writes padding lanes below index 0).
-  const size_t right_best_size = 16 + size_t(w) + n;
-  uint16_t* right_best = Grow(ws.right_best, right_best_size) + 16;
+  uint16_t* shifted = PathBuffers(ws.shifted, 1, stride);
+  // Right-view best costs: the right pixel x - lo - d (local) is stored at
+  // [x - lo - d + lo_max + stride - 1] >= 0 (the SIMD kernel writes all
+  // `stride` lanes below its start).
+  const int rb_origin = int(lo_max) + stride - 1;
+  const size_t right_best_size = size_t(w) + size_t(lo_max - lo_min) + 2 * size_t(stride);
+  uint16_t* right_best = Grow(ws.right_best, right_best_size);
 
   cv::Mat disparity(h, w, CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
 
   auto winner_take_all = [&](int y, uint16_t* srow) {
-    std::fill(right_best - 16, right_best - 16 + right_best_size, uint16_t(0xFFFF));
+    const int16_t* lo = lo_row(y);
+    std::fill(right_best, right_best + right_best_size, uint16_t(0xFFFF));
     // Pixels 16 apart in turn: neighbours' runs overlap shifted by one lane,
     // and a load overlapping the previous store stalls store forwarding.
     for (int phase = 0; phase < 16; ++phase)
-      for (int x = phase; x < w; x += 16) K::RightBest(srow + size_t(x) * stride, n, stride, right_best + x + n - 1);
+      for (int x = phase; x < w; x += 16)
+        K::RightBest(srow + size_t(x) * stride, n, stride, right_best + x - lo[x] + rb_origin);
     float* out = disparity.ptr<float>(y);
     for (int x = 0; x < w; ++x) {
       uint16_t* s = srow + size_t(x) * stride;
       int best = 0;
       const uint16_t best_cost = K::Best(s, n, stride, &best);
-      if (best == 0 || best == n - 1) continue;  // at the range's edge: not a true minimum
+      if (best == 0 || best == n - 1) continue;  // at the window's edge: not a true minimum
       const uint16_t second = K::SecondBest(s, n, stride, best);
       if (int(second) * (100 - options.uniqueness_percent) < int(best_cost) * 100) continue;
       // Left-right check: the right pixel's own best disparity lies within
       // lr_max_diff_px of ours iff one of the left pixels x+k at disparity
-      // best+k (|k| <= tolerance, same right pixel) reaches its best cost.
-      const uint16_t right_min = right_best[x - best + n - 1];
+      // D+k (|k| <= tolerance, same right pixel) reaches its best cost.
+      const int disparity_px = lo[x] + best;
+      const uint16_t right_min = right_best[x - disparity_px + rb_origin];
       bool consistent = false;
       for (int k = -options.lr_max_diff_px; k <= options.lr_max_diff_px && !consistent; ++k) {
-        const int xk = x + k, dk = best + k;
-        if (xk >= 0 && xk < w && dk >= 0 && dk < n) consistent = srow[size_t(xk) * stride + dk] <= right_min;
+        const int xk = x + k;
+        if (xk < 0 || xk >= w) continue;
+        const int dk = disparity_px + k - lo[xk];
+        if (dk >= 0 && dk < n) consistent = srow[size_t(xk) * stride + dk] <= right_min;
       }
       if (!consistent) continue;
       const double c0 = s[best - 1], c1 = s[best], c2 = s[best + 1];
@@ -186,19 +218,23 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
       // three costs; the steeper side fixes the slope.
       const double slope = std::max(c0, c2) - c1;
       const double delta = slope > 0 ? 0.5 * (c0 - c2) / slope : 0.0;
-      out[x] = float(min_disparity + best + delta);
+      out[x] = float(disparity_px + delta);
     }
   };
 
-  // One row of the vertical path (top->bottom or bottom->top), then the two
-  // horizontal paths, all accumulated into srow.
-  auto vertical = [&](const uint8_t* crow, uint16_t* srow, bool first_row, SumMode mode) {
+  // One row of the vertical path (top->bottom or bottom->top; lo_prev: the
+  // windows of the row before along the path), then the two horizontal
+  // paths, all accumulated into srow.
+  auto vertical = [&](const uint8_t* crow, const int16_t* lo, const int16_t* lo_prev, uint16_t* srow,
+                      SumMode mode) {
     for (int x = 0; x < w; ++x) {
       uint16_t* cur = vert_cur + size_t(x) * path_stride;
       const uint8_t* c = crow + size_t(x) * stride;
-      vert_cur_min[x] = first_row ? K::First(c, cur, srow + size_t(x) * stride, mode, n, stride)
-                                  : K::Step(c, vert_prev + size_t(x) * path_stride, vert_prev_min[x], cur,
-                                            srow + size_t(x) * stride, mode, n, stride, p1, p2);
+      vert_cur_min[x] =
+          lo_prev == nullptr
+              ? K::First(c, cur, srow + size_t(x) * stride, mode, n, stride)
+              : K::Step(c, InWindowOf(vert_prev + size_t(x) * path_stride, lo[x] - lo_prev[x], n, stride, shifted),
+                        vert_prev_min[x], cur, srow + size_t(x) * stride, mode, n, stride, p1, p2);
     }
     std::swap(vert_prev, vert_cur);
     std::swap(vert_prev_min, vert_cur_min);
@@ -206,14 +242,18 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   // Left->right and right->left, interleaved: each step waits for the
   // previous pixel's minimum, so two independent chains keep the core busy.
   // (Sums are modulo 2^16 additions: their order does not change them.)
-  auto horizontal = [&](const uint8_t* crow, uint16_t* srow) {
+  uint16_t* shifted_rl = PathBuffers(ws.shifted_rl, 1, stride);
+  auto horizontal = [&](const uint8_t* crow, const int16_t* lo, uint16_t* srow) {
     const size_t last = size_t(w - 1) * stride;
     uint16_t m_lr = K::First(crow, ha, srow, SumMode::kAdd, n, stride);
     uint16_t m_rl = K::First(crow + last, hc, srow + last, SumMode::kAdd, n, stride);
     for (int i = 1; i < w; ++i) {
-      const size_t xl = size_t(i) * stride, xr = size_t(w - 1 - i) * stride;
-      m_lr = K::Step(crow + xl, ha, m_lr, hb, srow + xl, SumMode::kAdd, n, stride, p1, p2);
-      m_rl = K::Step(crow + xr, hc, m_rl, hd, srow + xr, SumMode::kAdd, n, stride, p1, p2);
+      const int il = i, ir = w - 1 - i;
+      const size_t xl = size_t(il) * stride, xr = size_t(ir) * stride;
+      m_lr = K::Step(crow + xl, InWindowOf(ha, lo[il] - lo[il - 1], n, stride, shifted), m_lr, hb, srow + xl,
+                     SumMode::kAdd, n, stride, p1, p2);
+      m_rl = K::Step(crow + xr, InWindowOf(hc, lo[ir] - lo[ir + 1], n, stride, shifted_rl), m_rl, hd, srow + xr,
+                     SumMode::kAdd, n, stride, p1, p2);
       std::swap(ha, hb);
       std::swap(hc, hd);
     }
@@ -223,8 +263,8 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   for (int y = 0; y < h; ++y) {
     uint16_t* srow = sum + (two_pass ? size_t(y) * w * stride : 0);
     const uint8_t* crow = cost + size_t(y) * w * stride;
-    vertical(crow, srow, y == 0, SumMode::kStore);
-    horizontal(crow, srow);
+    vertical(crow, lo_row(y), y == 0 ? nullptr : lo_row(y - 1), srow, SumMode::kStore);
+    horizontal(crow, lo_row(y), srow);
     if (!two_pass) winner_take_all(y, srow);
   }
   if (!two_pass) return disparity;
@@ -236,23 +276,46 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   for (int y = h - 1; y >= 0; --y) {
     const uint16_t* srow = sum + size_t(y) * w * stride;
     std::copy(srow, srow + size_t(w) * stride, total);
-    vertical(cost + size_t(y) * w * stride, total, y == h - 1, SumMode::kAdd);
+    vertical(cost + size_t(y) * w * stride, lo_row(y), y == h - 1 ? nullptr : lo_row(y + 1), total, SumMode::kAdd);
     winner_take_all(y, total);
   }
   return disparity;
+}
+
+cv::Mat SgmMatchWindowed(const CensusImage& left, const CensusImage& right, const cv::Rect& region,
+                         const cv::Mat& window_lo, int n, const SgmOptions& options) {
+  STEREORIG_CHECK(region.width > 0 && region.height > 0 && n > 0);
+  STEREORIG_CHECK(region.x >= 0 && region.y >= 0 && region.x + region.width <= left.width &&
+                  region.y + region.height <= left.height);
+  STEREORIG_CHECK(window_lo.type() == CV_16SC1 && window_lo.size() == region.size());
+#if defined(__AVX2__)
+  if (options.simd) return SgmMatchWith<sgm::Avx2Kernels>(left, right, region, window_lo, n, options);
+#endif
+  return SgmMatchWith<sgm::ScalarKernels>(left, right, region, window_lo, n, options);
 }
 
 }  // namespace
 
 cv::Mat SgmMatch(const CensusImage& left, const CensusImage& right, const cv::Rect& region, int min_disparity,
                  int num_disparities, const SgmOptions& options) {
-  STEREORIG_CHECK(region.width > 0 && region.height > 0 && num_disparities > 0);
-  STEREORIG_CHECK(region.x >= 0 && region.y >= 0 && region.x + region.width <= left.width &&
-                  region.y + region.height <= left.height);
-#if defined(__AVX2__)
-  if (options.simd) return SgmMatchWith<sgm::Avx2Kernels>(left, right, region, min_disparity, num_disparities, options);
-#endif
-  return SgmMatchWith<sgm::ScalarKernels>(left, right, region, min_disparity, num_disparities, options);
+  const cv::Mat window_lo(region.size(), CV_16SC1, cv::Scalar(min_disparity));
+  return SgmMatchWindowed(left, right, region, window_lo, num_disparities, options);
+}
+
+cv::Mat SgmMatchGuided(const CensusImage& left, const CensusImage& right, const cv::Rect& region,
+                       const cv::Mat& guide_px, int radius_px, int min_disparity, int num_disparities,
+                       const SgmOptions& options) {
+  STEREORIG_CHECK(guide_px.type() == CV_16SC1 && guide_px.size() == region.size() && radius_px >= 1);
+  const int n = 2 * radius_px + 1;
+  if (n >= num_disparities) return SgmMatch(left, right, region, min_disparity, num_disparities, options);
+  cv::Mat window_lo(region.size(), CV_16SC1);
+  for (int y = 0; y < region.height; ++y) {
+    const int16_t* g = guide_px.ptr<int16_t>(y);
+    int16_t* lo = window_lo.ptr<int16_t>(y);
+    for (int x = 0; x < region.width; ++x)
+      lo[x] = int16_t(std::clamp(g[x] - radius_px, min_disparity, min_disparity + num_disparities - n));
+  }
+  return SgmMatchWindowed(left, right, region, window_lo, n, options);
 }
 
 }  // namespace stereorig

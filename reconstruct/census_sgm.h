@@ -55,6 +55,21 @@ struct SgmOptions {
 cv::Mat SgmMatch(const CensusImage& left, const CensusImage& right, const cv::Rect& region, int min_disparity,
                  int num_disparities, const SgmOptions& options);
 
+// SGM as above, but each pixel searches only the 2*radius_px+1 disparities
+// [guide - radius_px, guide + radius_px] (moved inside [min_disparity,
+// min_disparity + num_disparities) where they would leave it); guide_px:
+// CV_16SC1 of region.size(), full-resolution px (GuideFromCoarse,
+// sgm_guide.h). Path costs step between neighbours whose windows differ by
+// comparing equal disparities; a disparity outside the neighbour's window
+// counts as the maximum cost. A minimum at the edge of a pixel's window is
+// rejected like one at the edge of the range. Where the truth lies inside
+// every window along the paths this gives SgmMatch's disparities at a cost
+// volume of 2*radius_px+1 instead of num_disparities per pixel. A window as
+// wide as the range runs SgmMatch.
+cv::Mat SgmMatchGuided(const CensusImage& left, const CensusImage& right, const cv::Rect& region,
+                       const cv::Mat& guide_px, int radius_px, int min_disparity, int num_disparities,
+                       const SgmOptions& options);
+
 // True if this build has the AVX2 kernels (SgmOptions::simd uses them).
 bool SgmSimdAvailable();
 

@@ -12,6 +12,7 @@
 #include "reconstruct/line_index.h"
 #include "reconstruct/parallel_for.h"
 #include "reconstruct/region_grow.h"
+#include "reconstruct/sgm_guide.h"
 
 namespace stereorig {
 
@@ -41,6 +42,7 @@ void MatchOptions::Check() const {
     throw InputError("min_disparity", "must be in [-1024, 2048]");
   if (roi.width < 0 || roi.height < 0) throw InputError("roi", "must have a non-negative size");
   if (pyramid_levels < 0 || pyramid_levels > 3) throw InputError("pyramid_levels", "must be in [0, 3]");
+  if (guided_radius_px < 0 || guided_radius_px > 64) throw InputError("guided_radius_px", "must be in [0, 64]");
   if (refine_radius_px < 1 || refine_radius_px > 8) throw InputError("refine_radius_px", "must be in [1, 8]");
   if (refine_half_window_px < 0 || refine_half_window_px > 5)
     throw InputError("refine_half_window_px", "must be in [0, 5]");
@@ -76,8 +78,10 @@ cv::Rect ClampRoi(const cv::Rect& roi, const cv::Size& size) {
 
 // Disparities of `region` at one pyramid level: CV_32FC1 of region.size(),
 // NaN = invalid. Recurses to the coarser level first when levels_left > 0.
+// guide_px (CV_16SC1 of region.size(), or empty): at the last level, search
+// only +-o.guided_radius_px around it (SgmMatchGuided).
 cv::Mat MatchLevel(const cv::Mat& left, const cv::Mat& right, const cv::Rect& region, int dmin, int num,
-                   int levels_left, const MatchOptions& o) {
+                   int levels_left, const MatchOptions& o, const cv::Mat& guide_px = cv::Mat()) {
   // Rows beyond the region too: the fine level's cost box reaches past it.
   // Only the columns the search reads: the region in the left image, the
   // region shifted by the disparity range in the right one.
@@ -89,6 +93,8 @@ cv::Mat MatchLevel(const cv::Mat& left, const cv::Mat& right, const cv::Rect& re
   const CensusImage cr = CensusTransform(
       right, region.y - margin, region.y + region.height + margin, o.num_threads, o.census_half_width_px,
       o.census_half_height_px, region.x - dmin - num - margin - reach, region.x + region.width - dmin + margin + reach);
+  if (levels_left == 0 && !guide_px.empty())
+    return SgmMatchGuided(cl, cr, region, guide_px, o.guided_radius_px, dmin, num, o.sgm);
   if (levels_left == 0) return SgmMatch(cl, cr, region, dmin, num, o.sgm);
 
   cv::Mat left_half, right_half;
@@ -223,15 +229,18 @@ void DisparitySlopes(const cv::Mat& disparity, cv::Mat* slope_x, cv::Mat* slope_
 
 // The band of disparities a half-resolution SGM finds in the ROI
 // (disparity_band.h), within the given range. Returns false (keep the full
-// range) if too few pixels matched.
+// range) if too few pixels matched. *guide_px: with o.guided_radius_px > 0
+// and a band found, the guide of the full-resolution search over the ROI
+// (GuideFromCoarse), else left empty.
 bool OccupiedBand(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const MatchOptions& o, int* dmin,
-                  int* num) {
+                  int* num, cv::Mat* guide_px) {
   cv::Mat lh, rh;
   cv::resize(left, lh, cv::Size(left.cols / 2, left.rows / 2), 0, 0, cv::INTER_AREA);
   cv::resize(right, rh, cv::Size(right.cols / 2, right.rows / 2), 0, 0, cv::INTER_AREA);
-  const cv::Rect half(roi.x / 2, roi.y / 2, std::max(1, roi.width / 2), std::max(1, roi.height / 2));
-  cv::Mat d = MatchLevel(lh, rh, half & cv::Rect(0, 0, lh.cols, lh.rows), int(std::floor(*dmin / 2.0)) - 1,
-                         (*num + 1) / 2 + 3, 0, o);
+  const cv::Rect half =
+      cv::Rect(roi.x / 2, roi.y / 2, std::max(1, roi.width / 2), std::max(1, roi.height / 2)) &
+      cv::Rect(0, 0, lh.cols, lh.rows);
+  cv::Mat d = MatchLevel(lh, rh, half, int(std::floor(*dmin / 2.0)) - 1, (*num + 1) / 2 + 3, 0, o);
   // The coarse level's mismatches are mostly small blobs: removing them
   // first leaves the band to the surfaces (disparity_band.h).
   MatchOptions blobs = o;
@@ -248,6 +257,7 @@ bool OccupiedBand(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
   if (new_max - new_min < 8) return false;
   *dmin = new_min;
   *num = new_max - new_min + 1;
+  if (o.guided_radius_px > 0) *guide_px = GuideFromCoarse(d, half, roi, (new_min + new_max) / 2);
   return true;
 }
 
@@ -303,10 +313,11 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
   };
   int dmin = o.min_disparity_px, num = o.num_disparities;
   const bool sgbm = o.matcher == MatcherKind::kOpenCvSgbm3Way;
-  if (!sgbm && o.narrow_range && o.pyramid_levels == 0) OccupiedBand(left, right, roi, o, &dmin, &num);
+  cv::Mat guide_px;
+  if (!sgbm && o.narrow_range && o.pyramid_levels == 0) OccupiedBand(left, right, roi, o, &dmin, &num, &guide_px);
   if (!sgbm) lap("band");
   const cv::Mat coarse_to_fine = sgbm ? SgbmRegion(left, right, roi, o, SgbmFilters{o.sgm.uniqueness_percent, 0, 0})
-                                      : MatchLevel(left, right, roi, dmin, num, o.pyramid_levels, o);
+                                      : MatchLevel(left, right, roi, dmin, num, o.pyramid_levels, o, guide_px);
   lap(sgbm ? "sgbm" : "sgm");
   DisparityState state;
   state.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));

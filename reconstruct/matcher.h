@@ -55,6 +55,14 @@ struct MatchOptions {
   // resolution. Cost: ~1/8 of a full search, saving most of a deep volume's range.
   bool narrow_range = true;  // default true
   int range_margin_px = 12;  // default 12 px: 6 let period-shifted matches in on the cup's flank (rms 0.07 -> 0.12 mm)
+  // census_sgm with narrow_range: the full-resolution SGM searches each pixel
+  // only within +-guided_radius_px of twice the band pass's half-resolution
+  // disparity there (sgm_guide.h, SgmMatchGuided), gaps filled from the
+  // neighbours: a cost volume of 2r+1 disparities instead of the whole band.
+  // 0 = search the whole band. Default 15 px (~2 grid periods either side
+  // of the coarse match: a coarse match one period off still has the truth
+  // in its window).
+  int guided_radius_px = 15;
   int refine_radius_px = 2;  // census_sgm: fine-level search +-radius around 2x coarse; default 2
   int refine_half_window_px = 1;     // census_sgm: fine-level cost box half size; default 1 (3x3)
   int census_half_width_px = 2;      // census_sgm: census window half width (<= 4); default 2 (5 px: tolerates

@@ -51,33 +51,38 @@ RectifiedGeometry ComputeRectification(const Camera& left, const Camera& right, 
   return g;
 }
 
-RectifyMaps BuildRectifyMaps(const RectifiedGeometry& g, const Camera& left, const Camera& right) {
+void BuildRectifyMap(const RectifiedGeometry& g, const Camera& cam, RectifiedView view, cv::Mat* map_x,
+                     cv::Mat* map_y) {
   const int w = g.size.width, h = g.size.height;
-  RectifyMaps maps;
-  const double cx_right = g.cx_left_px + g.disparity_offset_px;
-  auto build = [&](const Camera& cam, const Eigen::Matrix3d& cam_from_rect, double cx, cv::Mat* mx, cv::Mat* my) {
-    *mx = cv::Mat(h, w, CV_32FC1);
-    *my = cv::Mat(h, w, CV_32FC1);
-    Eigen::Matrix<double, Eigen::Dynamic, 3> rays(w, 3);
-    for (int v = 0; v < h; ++v) {
-      for (int u = 0; u < w; ++u) {
-        const Eigen::Vector3d ray_rect((u - cx) / g.focal_px, (v - g.cy_px) / g.focal_px, 1.0);
-        rays.row(u) = (cam_from_rect * ray_rect).transpose();
-      }
-      const Eigen::Matrix<double, Eigen::Dynamic, 2> q = cam.ProjectMany(rays);
-      float* px = mx->ptr<float>(v);
-      float* py = my->ptr<float>(v);
-      for (int u = 0; u < w; ++u) {
-        const bool ok = rays(u, 2) > 0 && std::isfinite(q(u, 0)) && std::isfinite(q(u, 1));
-        px[u] = ok ? float(q(u, 0)) : -1.f;
-        py[u] = ok ? float(q(u, 1)) : -1.f;
-      }
+  const bool left = view == RectifiedView::kLeft;
+  const Eigen::Matrix3d cam_from_rect = left ? g.rect_from_left.transpose() : g.right_from_rect;
+  const double cx = left ? g.cx_left_px : g.cx_left_px + g.disparity_offset_px;
+  *map_x = cv::Mat(h, w, CV_32FC1);
+  *map_y = cv::Mat(h, w, CV_32FC1);
+  Eigen::Matrix<double, Eigen::Dynamic, 3> rays(w, 3);
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const Eigen::Vector3d ray_rect((u - cx) / g.focal_px, (v - g.cy_px) / g.focal_px, 1.0);
+      rays.row(u) = (cam_from_rect * ray_rect).transpose();
     }
-  };
-  build(left, g.rect_from_left.transpose(), g.cx_left_px, &maps.left_x, &maps.left_y);
-  build(right, g.right_from_rect, cx_right, &maps.right_x, &maps.right_y);
-  cv::convertMaps(maps.left_x, maps.left_y, maps.left_fixed, maps.left_frac, CV_16SC2);
-  cv::convertMaps(maps.right_x, maps.right_y, maps.right_fixed, maps.right_frac, CV_16SC2);
+    const Eigen::Matrix<double, Eigen::Dynamic, 2> q = cam.ProjectMany(rays);
+    float* px = map_x->ptr<float>(v);
+    float* py = map_y->ptr<float>(v);
+    for (int u = 0; u < w; ++u) {
+      const bool ok = rays(u, 2) > 0 && std::isfinite(q(u, 0)) && std::isfinite(q(u, 1));
+      px[u] = ok ? float(q(u, 0)) : -1.f;
+      py[u] = ok ? float(q(u, 1)) : -1.f;
+    }
+  }
+}
+
+RectifyMaps BuildRectifyMaps(const RectifiedGeometry& g, const Camera& left, const Camera& right) {
+  RectifyMaps maps;
+  cv::Mat x, y;
+  BuildRectifyMap(g, left, RectifiedView::kLeft, &x, &y);
+  cv::convertMaps(x, y, maps.left_fixed, maps.left_frac, CV_16SC2);
+  BuildRectifyMap(g, right, RectifiedView::kRight, &x, &y);
+  cv::convertMaps(x, y, maps.right_fixed, maps.right_frac, CV_16SC2);
   return maps;
 }
 

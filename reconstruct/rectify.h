@@ -44,12 +44,19 @@ struct RectifiedGeometry {
 RectifiedGeometry ComputeRectification(const Camera& left, const Camera& right, const Pose& right_from_left,
                                        const Eigen::Vector3d& look_at_left_mm);
 
-// Remap tables (CV_32FC1 x and y, rectified size): rectified pixel ->
-// original pixel, for cv::remap. Pixels whose ray does not project (behind a
-// lens) get -1 (outside the image, so remap fills them with 0).
+// Remap table of one view (CV_32FC1 x and y, rectified size): rectified
+// pixel -> original pixel. Pixels whose ray does not project (behind a lens)
+// get -1 (outside the image, so remap fills them with 0).
+enum class RectifiedView { kLeft, kRight };
+void BuildRectifyMap(const RectifiedGeometry& g, const Camera& cam, RectifiedView view, cv::Mat* map_x,
+                     cv::Mat* map_y);
+
+// Both views' tables in cv::convertMaps fixed point (CV_16SC2 + CV_16UC1, the
+// fast cv::remap form, 1/32 px), the form the runtime keeps: 6 bytes a pixel
+// instead of the float tables' 8 (the float ones are rebuilt where exact
+// values are needed, e.g. scoring).
 struct RectifyMaps {
-  cv::Mat left_x, left_y, right_x, right_y;                // CV_32FC1
-  cv::Mat left_fixed, left_frac, right_fixed, right_frac;  // the same, cv::convertMaps fixed point (fast remap)
+  cv::Mat left_fixed, left_frac, right_fixed, right_frac;
 };
 RectifyMaps BuildRectifyMaps(const RectifiedGeometry& g, const Camera& left, const Camera& right);
 

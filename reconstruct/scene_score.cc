@@ -27,8 +27,12 @@ SceneScore ScoreScene(const Runtime& runtime, const Reconstruction& rec, const S
   const int nm = int(runtime.plans().size());
   s.accuracy = ScoreAgainstTruth(rec.cloud, truth.surface_mm, nm);
   for (int m = 0; m < nm && m < int(truth.fill_target.size()); ++m) {
-    const RectifyMaps& maps = runtime.plans()[m].maps;
-    const FillFigures f = ScoreFill(rec.modules[m].status, maps.left_x, maps.left_y, truth.fill_target[m]);
+    // The exact float table (the runtime keeps only the fixed-point one).
+    const ModulePlan& plan = runtime.plans()[m];
+    cv::Mat left_x, left_y;
+    BuildRectifyMap(plan.geometry, runtime.rig().camera(runtime.rig().module(plan.module).left_camera),
+                    RectifiedView::kLeft, &left_x, &left_y);
+    const FillFigures f = ScoreFill(rec.modules[m].status, left_x, left_y, truth.fill_target[m]);
     s.fill.push_back(f);
     s.fill_all.target_px += f.target_px;
     s.fill_all.filled_px += f.filled_px;
