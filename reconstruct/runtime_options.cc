@@ -97,6 +97,7 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.line_index.max_row_offset_px = m.GetDouble("line_index_max_row_offset_px", mo.line_index.max_row_offset_px);
     mo.line_index.min_row_offset_step_px =
         m.GetDouble("line_index_min_row_offset_step_px", mo.line_index.min_row_offset_step_px);
+    mo.line_index.drop_row_offset_px = m.GetDouble("line_index_drop_row_offset_px", mo.line_index.drop_row_offset_px);
     mo.grow.enabled = m.GetBool("grow", mo.grow.enabled);
     mo.grow.max_deviation_px = m.GetDouble("grow_max_deviation_px", mo.grow.max_deviation_px);
     mo.grow.plane_radius_px = m.GetInt("grow_plane_radius_px", mo.grow.plane_radius_px);
