@@ -84,6 +84,7 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.min_texture_dn = m.GetDouble("min_texture_dn", mo.min_texture_dn);
     mo.speckle_window_px = m.GetInt("speckle_window_px", mo.speckle_window_px);
     mo.speckle_range_px = m.GetDouble("speckle_range_px", mo.speckle_range_px);
+    mo.occlusion_margin_px = m.GetDouble("occlusion_margin_px", mo.occlusion_margin_px);
     mo.sgbm_block_size = m.GetInt("sgbm_block_size", mo.sgbm_block_size);
     mo.num_threads = m.GetInt("num_threads", mo.num_threads);
     mo.line_index.enabled = m.GetBool("line_index", mo.line_index.enabled);
