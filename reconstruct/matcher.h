@@ -78,8 +78,8 @@ struct MatchOptions {
   GrowOptions grow;                // census_sgm: growing into the pixels SGM left empty (region_grow.h)
   // census_sgm, opencv_sgbm_3way: drop the pixels the right camera cannot
   // see, last (right_occlusion.h): occluded by a nearer surface, or matched
-  // within this of a right column without data (`right_valid`). 0 = off;
-  // default 1 px.
+  // within this of a right column without data (`right_valid`). 0 = both
+  // off; default 1 px.
   double occlusion_margin_px = 1;
   // CV_8UC1 of the right image's size: 0 where the rectified right image
   // has no data (RightViewValidMask); empty = every column valid. The

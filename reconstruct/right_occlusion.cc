@@ -27,7 +27,7 @@ int DropRightInvisible(double margin_px, const cv::Mat& right_valid, const cv::R
   cv::Mat& disparity = state->disparity_px;
   STEREORIG_CHECK(right_valid.empty() || (right_valid.type() == CV_8UC1 && right_valid.size() == disparity.size()));
   const int cols = disparity.cols;
-  const double step_px = margin_px + 1;  // how much nearer an occluder must be (header)
+  constexpr double kStepPx = 1;  // how much nearer an occluder must be (header)
   std::vector<int> drop;
   int dropped = 0;
   for (int y = roi.y; y < roi.y + roi.height; ++y) {
@@ -44,11 +44,11 @@ int DropRightInvisible(double margin_px, const cv::Mat& right_valid, const cv::R
       // Outside the right view: no column there, or one without data.
       for (int c = int(std::floor(xr - margin_px)); c <= int(std::floor(xr + margin_px)) && !hidden; ++c)
         hidden = c < 0 || c >= cols || (valid && !valid[c]);
-      // Occluded: an occluder x' lands at x' - d' <= xr + margin, so
-      // x' <= x + (d' - d) + margin <= x + (row_max - d) + margin.
-      const int last = std::min(roi.x + roi.width - 1, int(std::floor(x + row_max - d[x] + margin_px)));
+      // Occluded: an occluder x' lands at x' - d' <= xr, so
+      // x' <= x + (d' - d) <= x + (row_max - d).
+      const int last = std::min(roi.x + roi.width - 1, int(std::floor(x + row_max - d[x])));
       for (int xo = x + 1; xo <= last && !hidden; ++xo)
-        hidden = std::isfinite(d[xo]) && d[xo] > d[x] + step_px && xo - d[xo] <= xr + margin_px;
+        hidden = std::isfinite(d[xo]) && d[xo] > d[x] + kStepPx && xo - d[xo] <= xr;
       if (hidden) drop.push_back(x);
     }
     // After the row's test: a dropped pixel still hides those behind it.
