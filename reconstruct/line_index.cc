@@ -22,8 +22,10 @@ void LineIndexOptions::Check() const {
   if (max_seam_gap_px < 0 || max_seam_gap_px > 32) throw InputError("line_index_max_seam_gap_px", "must be in [0, 32]");
   if (!(min_row_offset_step_px > 0 && min_row_offset_step_px < 1))
     throw InputError("line_index_min_row_offset_step_px", "must be in (0, 1)");
-  if (!(drop_row_offset_px == 0 || (drop_row_offset_px >= max_row_offset_px && drop_row_offset_px < 1)))
-    throw InputError("line_index_drop_row_offset_px", "must be 0 (off) or in [line_index_max_row_offset_px, 1)");
+  // Below max_row_offset_px it acts as max_row_offset_px (only components
+  // that read off are tested).
+  if (!(drop_row_offset_px >= 0 && drop_row_offset_px < 1))
+    throw InputError("line_index_drop_row_offset_px", "must be in [0, 1) (0 = off)");
 }
 
 cv::Mat LabelDisparityComponents(const cv::Mat& disparity_px, const cv::Rect& roi, double max_step_px,
