@@ -5,6 +5,9 @@
 // x' - D_near do).
 #include "reconstruct/right_occlusion.h"
 
+#include "calib/core/input_error.h"
+#include "reconstruct/runtime_options.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -97,6 +100,18 @@ TEST(RightOcclusion, ValidMaskFromRemapTables) {
   for (int x = 0; x < 10; ++x) mx.col(x).setTo(x - 3.0);  // rectified x -> sensor x - 3
   const cv::Mat v = RightViewValidMask(mx, my, cv::Size(5, 2));
   for (int x = 0; x < 10; ++x) EXPECT_EQ(v.at<uint8_t>(1, x), (x >= 3 && x <= 7) ? 255 : 0) << x;
+}
+
+// The runtime options file sets both new keys and rejects bad values.
+TEST(RightOcclusion, OptionsFileKeys) {
+  const RuntimeOptions o =
+      ParseRuntimeOptions("match:\n  occlusion_margin_px: 0\n  line_index_drop_row_offset_px: 0.2\n", "test");
+  EXPECT_EQ(o.match.occlusion_margin_px, 0.0);
+  EXPECT_EQ(o.match.line_index.drop_row_offset_px, 0.2);
+  EXPECT_EQ(RuntimeOptions{}.match.occlusion_margin_px, 1.0);
+  EXPECT_EQ(RuntimeOptions{}.match.line_index.drop_row_offset_px, 0.15);
+  EXPECT_THROW(ParseRuntimeOptions("match:\n  occlusion_margin_px: -1\n", "test"), InputError);
+  EXPECT_THROW(ParseRuntimeOptions("match:\n  line_index_drop_row_offset_px: 1.5\n", "test"), InputError);
 }
 
 }  // namespace
