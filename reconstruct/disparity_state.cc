@@ -36,6 +36,10 @@ const char* PixelStatusName(PixelStatus status) {
       return "outside_volume";
     case PixelStatus::kObjectSize:
       return "object_size";
+    case PixelStatus::kOccluded:
+      return "occluded";
+    case PixelStatus::kWrongLine:
+      return "wrong_line";
     case PixelStatus::kNumStatus:
       break;
   }

@@ -10,8 +10,8 @@
 namespace stereorig {
 
 // What became of each left pixel: a point, or the first test that rejected
-// it. The matcher sets the codes up to kSpeckle; the runtime adds the later
-// ones. For finding where fill is lost (`stereorig score` tabulates them).
+// it. The matcher sets the codes up to kNotDistinct and kOccluded,
+// kWrongLine; the runtime adds kLowConfidence, kOutsideVolume, kObjectSize. For finding where fill is lost (`stereorig score` tabulates them).
 enum class PixelStatus : uint8_t {
   kNotSearched = 0,  // outside the matched region
   kPoint,            // a valid disparity (and, in the runtime, a kept point)
@@ -28,6 +28,8 @@ enum class PixelStatus : uint8_t {
   kLowConfidence,    // runtime: confidence below min_confidence
   kOutsideVolume,    // runtime: triangulated outside the measurement volume
   kObjectSize,       // runtime: farther than object_size_mm from the module cloud's median
+  kOccluded,         // its match in the right view is hidden by a nearer surface, or outside it (right_occlusion.h)
+  kWrongLine,        // in a component on the wrong laser line that no whole-period move fixes (line_index.h)
   kNumStatus
 };
 const char* PixelStatusName(PixelStatus status);

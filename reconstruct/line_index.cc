@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <vector>
 
@@ -21,6 +22,10 @@ void LineIndexOptions::Check() const {
   if (max_seam_gap_px < 0 || max_seam_gap_px > 32) throw InputError("line_index_max_seam_gap_px", "must be in [0, 32]");
   if (!(min_row_offset_step_px > 0 && min_row_offset_step_px < 1))
     throw InputError("line_index_min_row_offset_step_px", "must be in (0, 1)");
+  // Below max_row_offset_px it acts as max_row_offset_px (only components
+  // that read off are tested).
+  if (!(drop_row_offset_px >= 0 && drop_row_offset_px < 1))
+    throw InputError("line_index_drop_row_offset_px", "must be in [0, 1) (0 = off)");
 }
 
 cv::Mat LabelDisparityComponents(const cv::Mat& disparity_px, const cv::Rect& roi, double max_step_px,
@@ -148,16 +153,39 @@ class LineIndexer {
     }
   }
 
-  // One component's vernier test; returns true if it moved.
+  // Drops every pixel of `pixels` (PixelStatus::kWrongLine).
+  void Drop(const std::vector<int>& pixels) {
+    for (int i : pixels) {
+      const int y = i / cols_, x = i % cols_;
+      float& d = state_->disparity_px.at<float>(y, x);
+      if (!std::isfinite(d)) continue;
+      d = std::numeric_limits<float>::infinity();
+      state_->confidence.at<float>(y, x) = 0;
+      state_->status.at<uint8_t>(y, x) = uint8_t(PixelStatus::kWrongLine);
+    }
+  }
+
+  enum class Outcome { kKept, kMoved, kDropped };
+
+  // One component's vernier test.
   // offset_px: the row offset a correct match reads (0 on a well rectified pair).
-  bool TestComponent(const std::vector<int>& pixels, double offset_px) {
+  Outcome TestComponent(const std::vector<int>& pixels, double offset_px) {
     const std::vector<int> sample = Sample(pixels);
-    if (int(sample.size()) < 4) return false;
+    if (int(sample.size()) < 4) return Outcome::kKept;
     Vernier here = Read(sample, 0.0);
     here.mean_row_offset_px -= offset_px;
     if (here.fits < 4 ||
         std::abs(here.mean_row_offset_px) <= std::max(o_.max_row_offset_px, 3 * here.standard_error_px))
-      return false;
+      return Outcome::kKept;
+    // Off, and the alignment the vernier points to cannot be read: the
+    // right line is out of reach (outside the right image, typically).
+    const bool droppable = o_.drop_row_offset_px > 0 && std::abs(here.mean_row_offset_px) >
+                                                            std::max(o_.drop_row_offset_px, 3 * here.standard_error_px);
+    auto unreadable = [&] {
+      if (!droppable) return Outcome::kKept;
+      Drop(pixels);
+      return Outcome::kDropped;
+    };
     // The other alignments: on each side, the shift whose refinement
     // correlates best. Their row offsets step by about the same amount per
     // period (the vernier): fit dy(k) = a + b k over k = -1, 0, +1 and move
@@ -182,13 +210,14 @@ class LineIndexer {
       sw += w, sk += w * k, skk += w * k * k, sd += w * v.mean_row_offset_px, skd += w * k * v.mean_row_offset_px;
     }
     const double det = sw * skk - sk * sk;
-    if (!(det > 0)) return false;
+    if (!(det > 0)) return unreadable();  // neither other alignment could be read
     const double a = (skk * sd - sk * skd) / det, b = (sw * skd - sk * sd) / det;
-    if (std::abs(b) < o_.min_row_offset_step_px) return false;  // no vernier to read
+    if (std::abs(b) < o_.min_row_offset_step_px) return Outcome::kKept;  // no vernier to read
     const int k = int(std::lround(std::clamp(-a / b, -1.0, 1.0)));
-    if (k == 0 || points[k + 1]->fits < 4) return false;
+    if (k == 0) return Outcome::kKept;
+    if (points[k + 1]->fits < 4) return unreadable();
     Move(pixels, points[k + 1]->mean_shift_px);
-    return true;
+    return Outcome::kMoved;
   }
 
  private:
@@ -216,7 +245,10 @@ int CorrectLineIndex(const cv::Mat& left, const cv::Mat& right, const cv::Rect& 
   for (const std::vector<int>& pixels : components) {
     if (int(pixels.size()) < o.min_component_px) continue;
     // Up to two moves: a component can be two periods off.
-    for (int round = 0; round < 2 && indexer.TestComponent(pixels, 0.0); ++round) ++moved;
+    for (int round = 0; round < 2; ++round) {
+      if (indexer.TestComponent(pixels, 0.0) != LineIndexer::Outcome::kMoved) break;
+      ++moved;
+    }
   }
   return moved;
 }

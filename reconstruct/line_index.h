@@ -18,6 +18,9 @@
 // for each, compare the mean ZNCC of the refined tall window at the current
 // disparity with that at shifts of 2..max_shift_px either way; move the
 // component to a shift that wins by min_gain, re-refining every pixel.
+// A component that reads off but whose better alignment cannot be read
+// (near the right image's edge, the true line can lie outside it) is
+// dropped (drop_row_offset_px).
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -34,13 +37,21 @@ struct LineIndexOptions {
   int window_half_height_px = 4;        // the test window's half height, px; default 4 (9 rows: > one period)
   double max_row_offset_px = 0.1;       // a component whose mean row offset is within this is kept; default 0.1 px
   double min_row_offset_step_px = 0.1;  // the row offset must change by this per period to be read; default 0.1 px
+  // A component that reads a row offset beyond this (and beyond 3 standard
+  // errors) but cannot be moved, because the alignment the vernier points to
+  // cannot be read (it lies outside the right image or no sample refines
+  // there), is on the wrong line with the right one out of reach: its pixels
+  // are dropped (PixelStatus::kWrongLine). 0 = off (kept, as before). Default
+  // 0.15 px: the true alignment reads |offset| < 0.1 px on the simulator's
+  // scenes (max_row_offset_px), one period off reads ~0.36 px (2.6 deg x 8 px).
+  double drop_row_offset_px = 0.15;
   int max_seam_gap_px = 8;  // JoinAcrossPeriodJumps: widest gap of invalid pixels a seam may span; default 8 px
   int min_seam_px = 30;     // JoinAcrossPeriodJumps: shortest seam between two components it acts on; default 30 px
   void Check() const;       // throws InputError naming the bad field
 };
 
 // Revises `state` (disparity, confidence, status) inside `roi`. Returns the
-// number of components moved. left, right: CV_8UC1 rectified.
+// number of components moved (dropped ones not counted). left, right: CV_8UC1 rectified.
 int CorrectLineIndex(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const LineIndexOptions& options,
                      const RefineAcceptance& accept, DisparityState* state);
 

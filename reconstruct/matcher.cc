@@ -12,6 +12,7 @@
 #include "reconstruct/line_index.h"
 #include "reconstruct/parallel_for.h"
 #include "reconstruct/region_grow.h"
+#include "reconstruct/right_occlusion.h"
 #include "reconstruct/sgm_guide.h"
 
 namespace stereorig {
@@ -62,6 +63,9 @@ void MatchOptions::Check() const {
   if (!(min_texture_dn >= 0)) throw InputError("min_texture_dn", "must be >= 0");
   if (speckle_window_px < 0) throw InputError("speckle_window_px", "must be >= 0 (0 = off)");
   if (!(speckle_range_px > 0)) throw InputError("speckle_range_px", "must be > 0");
+  if (!(occlusion_margin_px >= 0 && occlusion_margin_px <= 8))
+    throw InputError("occlusion_margin_px", "must be in [0, 8] (0 = off)");
+  if (!right_valid.empty() && right_valid.type() != CV_8UC1) throw InputError("right_valid", "must be CV_8UC1");
   if (sgbm_block_size < 1 || sgbm_block_size % 2 == 0 || sgbm_block_size > 11)
     throw InputError("sgbm_block_size", "must be odd, in [1, 11]");
   if (num_threads < 1 || num_threads > 64) throw InputError("num_threads", "must be in [1, 64]");
@@ -415,6 +419,7 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
     }
     RemoveSpeckles(state.disparity_px, o);
   }
+  DropRightInvisible(o.occlusion_margin_px, o.right_valid, roi, &state);
   for (int y = 0; y < left.rows; ++y) {
     const float* d = state.disparity_px.ptr<float>(y);
     float* c = state.confidence.ptr<float>(y);
@@ -460,6 +465,8 @@ MatchResult Match(const cv::Mat& left, const cv::Mat& right, const MatchOptions&
   options.Check();
   if (left.type() != CV_8UC1 || right.type() != CV_8UC1) throw InputError("match", "images must be 8-bit grey");
   if (left.size() != right.size()) throw InputError("match", "left and right images differ in size");
+  if (!options.right_valid.empty() && options.right_valid.size() != right.size())
+    throw InputError("right_valid", "differs in size from the right image");
   const cv::Rect roi = ClampRoi(options.roi, left.size());
   if (roi.width <= 0 || roi.height <= 0) throw InputError("roi", "does not overlap the image");
   if (options.matcher == MatcherKind::kOpenCvSgbm3WayStandalone) return MatchOpenCvSgbm(left, right, roi, options);

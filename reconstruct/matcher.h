@@ -14,7 +14,9 @@
 //      the cost fit's peak-locking bias;
 //   4. filters: ZNCC and texture thresholds, consistency with the local
 //      disparity plane, speckle removal (connected components of similar
-//      disparity smaller than speckle_window_px), range.
+//      disparity smaller than speckle_window_px), range; after the line
+//      index and growing, the pixels the right camera cannot see
+//      (right_occlusion.h).
 // MatcherKind::kOpenCvSgbm3Way runs OpenCV's StereoSGBM (MODE_SGBM_3WAY) on
 // the same region and the full range in place of steps 1-2, then the same
 // steps 3-4: a baseline differing from ours in the integer matching only.
@@ -82,6 +84,15 @@ struct MatchOptions {
   double min_texture_dn = 1.5;     // reject windows with a grey-level std below this; default 1.5 DN
   LineIndexOptions line_index;     // census_sgm: the component-wide grid-period test (line_index.h)
   GrowOptions grow;                // census_sgm: growing into the pixels SGM left empty (region_grow.h)
+  // census_sgm, opencv_sgbm_3way: drop the pixels the right camera cannot
+  // see, last (right_occlusion.h): occluded by a nearer surface, or matched
+  // within this of a right column without data (`right_valid`). 0 = both
+  // off; default 1 px.
+  double occlusion_margin_px = 1;
+  // CV_8UC1 of the right image's size: 0 where the rectified right image
+  // has no data (RightViewValidMask); empty = every column valid. The
+  // runtime sets it from its remap tables. Default empty.
+  cv::Mat right_valid;
   int speckle_window_px = 100;     // remove disparity blobs smaller than this, px (0 = off); default 100
   double speckle_range_px = 1.0;   // neighbours within this disparity are one blob, px; default 1
   int sgbm_block_size = 5;         // opencv_sgbm_3way: block size, px (odd); default 5

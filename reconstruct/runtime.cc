@@ -12,6 +12,7 @@
 
 #include "calib/core/input_error.h"
 #include "reconstruct/hole_fill.h"
+#include "reconstruct/right_occlusion.h"
 
 namespace stereorig {
 namespace {
@@ -68,6 +69,8 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
     plan.camera_centre_reference_mm = plan.reference_from_module.translation_mm();
     plan.geometry = ComputeRectification(left, right, mod.right_from_left, module_from_reference * volume_center_mm_);
     plan.maps = BuildRectifyMaps(plan.geometry, left, right);
+    plan.right_valid = RightViewValidMask(plan.maps.right_x, plan.maps.right_y,
+                                          cv::Size(right.imager_width_px(), right.imager_height_px()));
     // The volume's image: a box's central projection is bounded by its
     // corners' (all in front), and Z, so the disparity, is extreme at corners.
     double u0 = 1e9, u1 = -1e9, v0 = 1e9, v1 = -1e9, d0 = 1e9, d1 = -1e9;
@@ -136,6 +139,7 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
     mo.roi = match_roi;
     mo.min_disparity_px = plan.min_disparity_px;
     mo.num_disparities = plan.num_disparities;
+    mo.right_valid = plan.right_valid;
     match = Match(left, right, mo);
     for (const auto& [step, ms] : match.times_ms) report->times_ms["match." + step] = ms;
   } else {

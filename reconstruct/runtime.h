@@ -9,7 +9,7 @@
 // run on their own threads.
 //
 // Per module: rectify -> crop to the lit region -> match (matcher.h: census
-// SGM, filters, sub-pixel) -> triangulate to mm -> range filters (volume,
+// SGM, filters, sub-pixel, what the right camera cannot see) -> triangulate to mm -> range filters (volume,
 // object size) -> intensity, confidence -> normals from the depth grid ->
 // organised mesh. Then: concatenation through S into the reference frame,
 // the joined mesh, and hole filling from a fitted shape model.
@@ -32,6 +32,7 @@ struct ModulePlan {
   int module = 0;
   RectifiedGeometry geometry;
   RectifyMaps maps;
+  cv::Mat right_valid;       // CV_8UC1: rectified right px with sensor data (right_occlusion.h)
   cv::Rect roi;              // rectified left px covered by the measurement volume
   int min_disparity_px = 0;  // image disparity range of the volume (rectify.h), with 2 px margin
   int num_disparities = 0;

@@ -89,6 +89,7 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.min_texture_dn = m.GetDouble("min_texture_dn", mo.min_texture_dn);
     mo.speckle_window_px = m.GetInt("speckle_window_px", mo.speckle_window_px);
     mo.speckle_range_px = m.GetDouble("speckle_range_px", mo.speckle_range_px);
+    mo.occlusion_margin_px = m.GetDouble("occlusion_margin_px", mo.occlusion_margin_px);
     mo.sgbm_block_size = m.GetInt("sgbm_block_size", mo.sgbm_block_size);
     mo.num_threads = m.GetInt("num_threads", mo.num_threads);
     mo.line_index.enabled = m.GetBool("line_index", mo.line_index.enabled);
@@ -102,6 +103,7 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.line_index.max_row_offset_px = m.GetDouble("line_index_max_row_offset_px", mo.line_index.max_row_offset_px);
     mo.line_index.min_row_offset_step_px =
         m.GetDouble("line_index_min_row_offset_step_px", mo.line_index.min_row_offset_step_px);
+    mo.line_index.drop_row_offset_px = m.GetDouble("line_index_drop_row_offset_px", mo.line_index.drop_row_offset_px);
     mo.grow.enabled = m.GetBool("grow", mo.grow.enabled);
     mo.grow.max_deviation_px = m.GetDouble("grow_max_deviation_px", mo.grow.max_deviation_px);
     mo.grow.plane_radius_px = m.GetInt("grow_plane_radius_px", mo.grow.plane_radius_px);

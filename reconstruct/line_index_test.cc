@@ -1,0 +1,111 @@
+// The line-index test against ground truth: an analytically rendered plane
+// (synthetic_pair.h) whose disparity is known, with patches put one grid
+// period off by hand.
+#include "reconstruct/line_index.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "reconstruct/synthetic_pair.h"
+
+namespace stereorig {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// A fronto-parallel plane at 40 px of disparity, grid period 8 px turned
+// 2.6 deg (one period off reads a row offset of 8 tan 2.6 deg = 0.36 px).
+SyntheticPair Plane() {
+  SyntheticPairSpec spec;
+  spec.d0_px = 40, spec.du = 0, spec.dv = 0;
+  return RenderSyntheticPair(spec);
+}
+
+DisparityState EmptyState(const cv::Size& size) {
+  return DisparityState{cv::Mat(size, CV_32FC1, cv::Scalar(kInf)), cv::Mat(size, CV_32FC1, cv::Scalar(0)),
+                        cv::Mat(size, CV_8UC1, cv::Scalar(uint8_t(PixelStatus::kNoSgmMatch))),
+                        cv::Mat(size, CV_32FC1, cv::Scalar(0)), cv::Mat(size, CV_32FC1, cv::Scalar(0))};
+}
+
+// Puts columns [x0, x1) of rows [20, 220) at disparity `d`.
+void Patch(DisparityState* s, int x0, int x1, float d) {
+  for (int y = 20; y < 220; ++y)
+    for (int x = x0; x < x1; ++x) {
+      s->disparity_px.at<float>(y, x) = d;
+      s->confidence.at<float>(y, x) = 0.9f;
+      s->status.at<uint8_t>(y, x) = uint8_t(PixelStatus::kPoint);
+    }
+}
+
+RefineAcceptance Acceptance() {
+  RefineAcceptance a;
+  a.min_disparity_px = 0;
+  a.max_disparity_px = 80;
+  return a;
+}
+
+struct Outcome {
+  int right_line = 0, period_off = 0, wrong_line_status = 0, other = 0;
+};
+
+// Each pixel of columns [x0, x1) against the true disparity (40 px). The
+// refined disparity's noise at the injected 2 DN is ~0.02 px rms (matcher
+// tests), so 0.5 px tells the right line from one 8 px period off by a wide
+// margin; the 1 px band around -8 covers the refinement's max_shift_px.
+Outcome Classify(const DisparityState& s, const SyntheticPair& pair, int x0, int x1) {
+  Outcome o;
+  for (int y = 20; y < 220; ++y)
+    for (int x = x0; x < x1; ++x) {
+      const float d = s.disparity_px.at<float>(y, x);
+      const double e = d - pair.true_disparity_px.at<double>(y, x);
+      if (std::isfinite(d) && std::abs(e) < 0.5) {
+        ++o.right_line;
+      } else if (std::isfinite(d) && std::abs(e + 8) < 1.0) {
+        ++o.period_off;
+      } else if (s.status.at<uint8_t>(y, x) == uint8_t(PixelStatus::kWrongLine)) {
+        ++o.wrong_line_status;
+      } else {
+        ++o.other;
+      }
+    }
+  return o;
+}
+
+// Left pixels x < 44 have their true match (x - 40, window +-4 px) at least
+// partly outside the right image, so the true line cannot be read there;
+// one period off (d = 32), columns >= 39 land inside it (x - 32 - 4 - 3
+// Lanczos taps >= 0). A patch at [39, 44) is therefore on the wrong line with
+// the right one out of reach; a patch at [150, 160) one period off can be
+// moved back; a patch at [200, 210) on the right line must stay.
+TEST(LineIndex, DropsAWrongLinePatchWhoseRightLineIsOutsideTheRightImage) {
+  const SyntheticPair pair = Plane();
+  const cv::Rect roi(0, 0, pair.left.cols, pair.left.rows);
+  for (const double drop_px : {0.15, 0.0}) {
+    DisparityState s = EmptyState(pair.left.size());
+    Patch(&s, 39, 44, 32.f);
+    Patch(&s, 150, 160, 32.f);
+    Patch(&s, 200, 210, 40.f);
+    LineIndexOptions o;
+    o.drop_row_offset_px = drop_px;
+    CorrectLineIndex(pair.left, pair.right, roi, o, Acceptance(), &s);
+    const Outcome edge = Classify(s, pair, 39, 44), movable = Classify(s, pair, 150, 160),
+                  right = Classify(s, pair, 200, 210);
+    SCOPED_TRACE(drop_px);
+    // The movable and the correct patches: all on the right line, with or
+    // without the drop (refinement may refuse a few pixels: < 2 %).
+    EXPECT_GE(movable.right_line, 0.98 * 2000);
+    EXPECT_GE(right.right_line, 0.98 * 2000);
+    EXPECT_EQ(movable.wrong_line_status + right.wrong_line_status, 0);
+    if (drop_px > 0) {
+      EXPECT_EQ(edge.period_off, 0);
+      EXPECT_EQ(edge.wrong_line_status, 1000);
+    } else {
+      EXPECT_EQ(edge.period_off, 1000);  // off: kept one period off, as before the option
+    }
+  }
+}
+
+}  // namespace
+}  // namespace stereorig

@@ -1,0 +1,65 @@
+#include "reconstruct/right_occlusion.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "calib/core/input_error.h"
+
+namespace stereorig {
+
+cv::Mat RightViewValidMask(const cv::Mat& right_x, const cv::Mat& right_y, const cv::Size& sensor_size) {
+  STEREORIG_CHECK(right_x.type() == CV_32FC1 && right_y.type() == CV_32FC1 && right_x.size() == right_y.size());
+  cv::Mat valid(right_x.size(), CV_8UC1, cv::Scalar(0));
+  for (int y = 0; y < valid.rows; ++y) {
+    const float* mx = right_x.ptr<float>(y);
+    const float* my = right_y.ptr<float>(y);
+    uint8_t* v = valid.ptr<uint8_t>(y);
+    for (int x = 0; x < valid.cols; ++x)
+      v[x] = mx[x] >= 0 && my[x] >= 0 && mx[x] <= sensor_size.width - 1 && my[x] <= sensor_size.height - 1 ? 255 : 0;
+  }
+  return valid;
+}
+
+int DropRightInvisible(double margin_px, const cv::Mat& right_valid, const cv::Rect& roi, DisparityState* state) {
+  if (!(margin_px > 0)) return 0;
+  cv::Mat& disparity = state->disparity_px;
+  STEREORIG_CHECK(right_valid.empty() || (right_valid.type() == CV_8UC1 && right_valid.size() == disparity.size()));
+  const int cols = disparity.cols;
+  constexpr double kStepPx = 1;  // how much nearer an occluder must be (header)
+  std::vector<int> drop;
+  int dropped = 0;
+  for (int y = roi.y; y < roi.y + roi.height; ++y) {
+    float* d = disparity.ptr<float>(y);
+    const uint8_t* valid = right_valid.empty() ? nullptr : right_valid.ptr<uint8_t>(y);
+    float row_max = -std::numeric_limits<float>::infinity();
+    for (int x = roi.x; x < roi.x + roi.width; ++x)
+      if (std::isfinite(d[x])) row_max = std::max(row_max, d[x]);
+    drop.clear();
+    for (int x = roi.x; x < roi.x + roi.width; ++x) {
+      if (!std::isfinite(d[x])) continue;
+      const double xr = x - d[x];
+      bool hidden = false;
+      // Outside the right view: no column there, or one without data.
+      for (int c = int(std::floor(xr - margin_px)); c <= int(std::floor(xr + margin_px)) && !hidden; ++c)
+        hidden = c < 0 || c >= cols || (valid && !valid[c]);
+      // Occluded: an occluder x' lands at x' - d' <= xr, so
+      // x' <= x + (d' - d) <= x + (row_max - d).
+      const int last = std::min(roi.x + roi.width - 1, int(std::floor(x + row_max - d[x])));
+      for (int xo = x + 1; xo <= last && !hidden; ++xo)
+        hidden = std::isfinite(d[xo]) && d[xo] > d[x] + kStepPx && xo - d[xo] <= xr;
+      if (hidden) drop.push_back(x);
+    }
+    // After the row's test: a dropped pixel still hides those behind it.
+    for (int x : drop) {
+      d[x] = std::numeric_limits<float>::infinity();
+      state->confidence.at<float>(y, x) = 0;
+      state->status.at<uint8_t>(y, x) = uint8_t(PixelStatus::kOccluded);
+    }
+    dropped += int(drop.size());
+  }
+  return dropped;
+}
+
+}  // namespace stereorig
