@@ -69,8 +69,12 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
     plan.camera_centre_reference_mm = plan.reference_from_module.translation_mm();
     plan.geometry = ComputeRectification(left, right, mod.right_from_left, module_from_reference * volume_center_mm_);
     plan.maps = BuildRectifyMaps(plan.geometry, left, right);
-    plan.right_valid = RightViewValidMask(plan.maps.right_x, plan.maps.right_y,
-                                          cv::Size(right.imager_width_px(), right.imager_height_px()));
+    {  // the exact float table, only for the mask (the runtime keeps the fixed-point one)
+      cv::Mat right_x, right_y;
+      BuildRectifyMap(plan.geometry, right, RectifiedView::kRight, &right_x, &right_y);
+      plan.right_valid =
+          RightViewValidMask(right_x, right_y, cv::Size(right.imager_width_px(), right.imager_height_px()));
+    }
     // The volume's image: a box's central projection is bounded by its
     // corners' (all in front), and Z, so the disparity, is extreme at corners.
     double u0 = 1e9, u1 = -1e9, v0 = 1e9, v1 = -1e9, d0 = 1e9, d1 = -1e9;
