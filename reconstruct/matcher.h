@@ -63,6 +63,11 @@ struct MatchOptions {
   SgmOptions sgm;                    // census_sgm: penalties, paths, uniqueness, left-right check
   bool intensity_refinement = true;  // census_sgm: Lucas-Kanade sub-pixel step; default true
   SubpixelOptions subpixel;          // its window and limits
+  // census_sgm: do that fit densely, all pixels at once (dense_refine.h;
+  // the same fit, ~2x cheaper), pixels where the dense model does not hold
+  // falling back to the per-pixel fit; default true. false: per-pixel only.
+  // Ignored by the opencv_sgbm_3way matchers and without intensity_refinement.
+  bool subpixel_dense = true;
   double min_zncc = 0.8;             // reject matches whose refined window correlates less; default 0.8
   double max_plane_deviation_px =
       0.7;  // reject d farther than this from the local 9x9 disparity plane (0 = off); default 0.7
@@ -93,7 +98,8 @@ struct MatchResult {
   cv::Mat status;
   // Wall time of the sub-steps, ms: census_sgm: "band" (the half-resolution
   // range pass), "sgm" (census + SGM + left-right/uniqueness), "subpixel"
-  // (slopes + Lucas-Kanade + filters), "speckle"; opencv_sgbm_3way: "sgbm"
+  // (slopes + Lucas-Kanade + filters; "subpixel_dense" within it: the dense
+  // fit), "speckle"; opencv_sgbm_3way: "sgbm"
   // in place of "band" and "sgm".
   std::map<std::string, double> times_ms;
 };
