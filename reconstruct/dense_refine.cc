@@ -198,7 +198,8 @@ DenseRefineResult DenseRefine(const cv::Mat& left, const cv::Mat& right, const c
   }
   for (int yy = 0; yy < roi.height; ++yy)
     for (int xx = 0; xx < roi.width; ++xx)
-      if (std::isfinite(start_px.at<float>(yy, xx))) ++(result.ok.at<uint8_t>(yy, xx) ? result.num_dense : result.num_fallback);
+      if (std::isfinite(start_px.at<float>(yy, xx)))
+        ++(result.ok.at<uint8_t>(yy, xx) ? result.num_dense : result.num_fallback);
   return result;
 }
 

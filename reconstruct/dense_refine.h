@@ -43,13 +43,13 @@ namespace stereorig {
 constexpr double kMaxWarpDeviationPx = 0.04;
 
 struct DenseRefineResult {
-  cv::Rect roi;           // the region refined, in the left image
-  cv::Mat disparity_px;   // CV_32FC1, roi.size(): the refined disparity
-  cv::Mat zncc;           // CV_32FC1: as SubpixelResult::zncc
-  cv::Mat std_dn;         // CV_32FC1: as SubpixelResult::std_dn
-  cv::Mat ok;             // CV_8UC1: 1 = the dense fit stands; 0 = refine this pixel by RefineDisparity
-  int num_dense = 0;      // pixels with a start and ok = 1
-  int num_fallback = 0;   // pixels with a start and ok = 0
+  cv::Rect roi;          // the region refined, in the left image
+  cv::Mat disparity_px;  // CV_32FC1, roi.size(): the refined disparity
+  cv::Mat zncc;          // CV_32FC1: as SubpixelResult::zncc
+  cv::Mat std_dn;        // CV_32FC1: as SubpixelResult::std_dn
+  cv::Mat ok;            // CV_8UC1: 1 = the dense fit stands; 0 = refine this pixel by RefineDisparity
+  int num_dense = 0;     // pixels with a start and ok = 1
+  int num_fallback = 0;  // pixels with a start and ok = 0
 
   // The dense result at left pixel (x, y) as RefineDisparity's result
   // (ok = false: not dense, use the per-pixel path).

@@ -105,9 +105,9 @@ TEST(DenseRefine, RecoversTruthWithoutPeakLocking) {
       if (!d.ok) continue;
       const double truth = pair.true_disparity_px.at<double>(y, x);
       const double e = d.disparity_px - truth;
-      const SubpixelResult p = RefineDisparity(pair.left, pair.right, x, y, in.start.at<float>(yy, xx),
-                                               in.slope_x.at<float>(yy, xx), in.slope_y.at<float>(yy, xx),
-                                               SubpixelOptions{});
+      const SubpixelResult p =
+          RefineDisparity(pair.left, pair.right, x, y, in.start.at<float>(yy, xx), in.slope_x.at<float>(yy, xx),
+                          in.slope_y.at<float>(yy, xx), SubpixelOptions{});
       if (p.ok) per_pixel_sum2 += std::pow(p.disparity_px - truth, 2), ++per_pixel_n;
       const int bin = std::min(9, int((truth - std::floor(truth)) * 10));
       bin_sum[bin] += e, ++bin_n[bin];
@@ -152,8 +152,7 @@ TEST(DenseRefine, FallsBackWhereTheSlopesDoNotFitTheWindow) {
       const bool ok = dense.ok.at<uint8_t>(yy, xx);
       // Windows inside the ROI, matches inside the right image.
       const double truth = pair.true_disparity_px.at<double>(in.roi.y + yy, in.roi.x + xx);
-      if (yy < 1 || yy >= in.roi.height - 1 || xx < hw || xx >= in.roi.width - hw ||
-          in.roi.x + xx - truth < kMargin)
+      if (yy < 1 || yy >= in.roi.height - 1 || xx < hw || xx >= in.roi.width - hw || in.roi.x + xx - truth < kMargin)
         continue;
       if (xx < half - hw) left_dense += ok, ++left_n;
       if (xx >= half) right_dense += ok, ++right_n;

@@ -68,7 +68,7 @@ struct MatchOptions {
   // falling back to the per-pixel fit; default true. false: per-pixel only.
   // Ignored by the opencv_sgbm_3way matchers and without intensity_refinement.
   bool subpixel_dense = true;
-  double min_zncc = 0.8;             // reject matches whose refined window correlates less; default 0.8
+  double min_zncc = 0.8;  // reject matches whose refined window correlates less; default 0.8
   double max_plane_deviation_px =
       0.7;  // reject d farther than this from the local 9x9 disparity plane (0 = off); default 0.7
   // census_sgm: the refined match must beat the ZNCC half a grid period
