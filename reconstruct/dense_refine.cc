@@ -71,19 +71,27 @@ bool Solve3(const double m[3][3], const double rhs[3], double s[3]) {
   return std::isfinite(s[0]) && std::isfinite(s[1]) && std::isfinite(s[2]);
 }
 
-// The RMS of F(p) - F(c) - gx u - gy v over the window of centre (xx, yy)
-// (NaN if a field value is missing).
-float WarpDeviation(const cv::Mat& field, int xx, int yy, float gx, float gy, int hw, int hh) {
+// The RMS residual of the field over the window of centre (xx, yy) from
+// its least-squares plane there (NaN if a field value is missing): how far
+// the warp is from a planar one. The plane's slopes are the refined field's
+// own, not DisparitySlopes' (those, from the integer-level field, are off by
+// ~0.03-0.05 px/px on curved flanks; the per-pixel fit's model is off by as
+// much there).
+float WarpDeviation(const cv::Mat& field, int xx, int yy, int hw, int hh) {
   const float fc = field.at<float>(yy, xx);
-  float sum2 = 0;
+  float s = 0, su = 0, sv = 0, s2 = 0;
   for (int v = -hh; v <= hh; ++v) {
     const float* f = field.ptr<float>(yy + v) + xx;
     for (int u = -hw; u <= hw; ++u) {
-      const float dev = f[u] - fc - gx * float(u) - gy * float(v);
-      sum2 += dev * dev;
+      const float dev = f[u] - fc;
+      s += dev, su += dev * float(u), sv += dev * float(v), s2 += dev * dev;
     }
   }
-  return std::sqrt(sum2 / float((2 * hw + 1) * (2 * hh + 1)));
+  // Symmetric window: the plane's terms are orthogonal.
+  const float n = float((2 * hw + 1) * (2 * hh + 1));
+  const float uu = n * float(hw * (hw + 1)) / 3.0f, vv = n * float(hh * (hh + 1)) / 3.0f;
+  const float residual2 = s2 - s * s / n - su * su / uu - (vv > 0 ? sv * sv / vv : 0.0f);
+  return std::sqrt(std::max(0.0f, residual2) / n);
 }
 
 // The field for the next pass: the plane plus the mean, over twice the
@@ -98,7 +106,7 @@ float WarpDeviation(const cv::Mat& field, int xx, int yy, float gx, float gy, in
 // fit.
 void SmoothField(const cv::Mat& plane_px, int hw, int hh, cv::Mat* field) {
   cv::Mat correction = *field - plane_px;
-  correction.setTo(0, correction != correction);  // no plane: no correction (NaN != NaN)
+  cv::patchNaNs(correction, 0);  // no plane: no correction (a NaN would run along boxFilter's running sums)
   cv::Mat mean;
   cv::boxFilter(correction, mean, CV_32F, cv::Size(4 * hw + 1, 4 * hh + 1), cv::Point(-1, -1), true,
                 cv::BORDER_REPLICATE);
@@ -121,8 +129,9 @@ DenseRefineResult DenseRefine(const cv::Mat& left, const cv::Mat& right, const c
   cv::Mat field = plane_px.clone();
   cv::Mat gain(roi.size(), CV_32FC1, cv::Scalar(1)), offset(roi.size(), CV_32FC1, cv::Scalar(0));
   cv::Mat value(roi.size(), CV_32FC1), slope(roi.size(), CV_32FC1);
-  for (int it = 0; it < o.max_iterations; ++it) {
-    const bool last = it + 1 == o.max_iterations;
+  const int passes = o.max_iterations;
+  for (int it = 0; it < passes; ++it) {
+    const bool last = it + 1 == passes;
     if (it > 0) SmoothField(plane_px, hw, hh, &field);
     Warp(right, roi, field, num_threads, &value, &slope);
     ParallelForChunks(std::max(0, roi.height - 2 * hh), num_threads, [&](int b, int e) {
@@ -184,7 +193,7 @@ DenseRefineResult DenseRefine(const cv::Mat& left, const cv::Mat& right, const c
           const float gx = slope_x.at<float>(yy, xx), gy = slope_y.at<float>(yy, xx);
           const double reach = hw + std::abs(gx) * hw + std::abs(gy) * hh + o.max_shift_px + 4;
           if (x - start[xx] - reach < 0 || x - start[xx] + reach >= right.cols) continue;
-          if (!(WarpDeviation(field, xx, yy, gx, gy, hw, hh) <= kMaxWarpDeviationPx)) continue;
+          if (!(WarpDeviation(field, xx, yy, hw, hh) <= kMaxWarpDeviationPx)) continue;
           const double lmean = s[kL] / n, lstd = std::sqrt(std::max(0.0, s[kLL] / n - lmean * lmean));
           if (!(lstd > 0)) continue;
           const double rmean = s[kR] / n, rvar = s[kRR] / n - rmean * rmean, cov = s[kRL] / n - lmean * rmean;

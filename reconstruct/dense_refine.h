@@ -11,23 +11,24 @@
 // pixel. The gain and offset enter the sums algebraically, so 8 window sums
 // serve every pixel's system.
 //
-// That is the per-pixel fit exactly where F is, over the window, the
-// window's plane: F(c + (u, v)) = F(c) + gx u + gy v. The field starts as
-// the local disparity plane (DisparitySlopes' 9x9 fit: smooth, with those
-// slopes); after a pass it is that plane plus a local mean of the pixels'
-// corrections, so the last pass deviates from the per-pixel model by the
-// remaining noise of those means and by the slopes' error. A pixel's dense
-// result is kept only if
+// That is the per-pixel fit exactly where F is, over each window, the
+// window's plane. The field starts as the local disparity plane
+// (DisparitySlopes' 9x9 fit: smooth); after a pass it is that plane plus a
+// local mean of the pixels' corrections, so the last pass deviates from a
+// window's plane by the remaining noise of those means. The plane is the
+// field's own least-squares plane over the window: the refined field's
+// slopes, not DisparitySlopes' (those, from the integer-level field, are off
+// by ~0.03-0.05 px/px on curved flanks, where the per-pixel model is off by
+// as much; holding the dense fit to them sent ~80% of the cup's pixels back
+// to the per-pixel fit). A pixel's dense result is kept only if
 //   - every pixel of its window has a field value (inside the image, a plane);
-//   - the field deviates from its window's plane by at most
-//     kMaxWarpDeviationPx RMS over the window: the result differs from the
-//     per-pixel fit's by a weighted mean of the deviations (to first order),
-//     so by about that. A bound on the largest deviation instead would
-//     reject a fifth of a noise-free plane's pixels: the first pass's
-//     estimates scatter by the fit noise (~0.02 px at 2 DN), and 27 of them
-//     reach 2.5 sigma;
-//   - the last step was below converged_step_px, gain > 0, and the result
-//     is within max_shift_px of the start and inside RefineDisparity's reach.
+//   - the field's RMS residual from its window's plane is at most
+//     kMaxWarpDeviationPx: to first order the result then moves by a
+//     weighted mean of those residuals, so by about that;
+//   - the last step was below converged_step_px (so the last pass's
+//     linearisation point, shared by the window, was already close), gain
+//     > 0, and the result is within max_shift_px of the start and inside
+//     RefineDisparity's reach.
 // Every other pixel is left to RefineDisparity (ok = false below).
 #pragma once
 
@@ -37,9 +38,9 @@
 
 namespace stereorig {
 
-// The largest RMS deviation of the warp field from a window's plane for
+// The largest RMS residual of the warp field from a window's plane for
 // which the dense result stands in for the per-pixel one, px: about twice
-// the fit's noise on the laser grid, a tenth of a cost fit's error.
+// the fit's noise on the synthetic laser grid, a tenth of a cost fit's error.
 constexpr double kMaxWarpDeviationPx = 0.04;
 
 struct DenseRefineResult {
