@@ -149,7 +149,7 @@ void PrintPipeline(const nlohmann::json& j) {
   // Module 0's steps in pipeline order (map order is alphabetical): where the time goes.
   std::printf("  module 0 median ms:");
   for (const char* step : {"rectify", "lit_region", "match.band", "match.sgm", "match.sgbm", "match.subpixel",
-                           "match.speckle", "triangulate", "normals"}) {
+                           "match.subpixel_dense", "match.speckle", "triangulate", "normals"}) {
     const std::string key = std::string("module0.") + step;
     if (j["median_time_ms"].contains(key)) std::printf(" %s %.1f", step, j["median_time_ms"][key].get<double>());
   }

@@ -46,16 +46,26 @@ const char* PixelStatusName(PixelStatus status) {
   return "?";
 }
 
-PixelStatus Accept(const cv::Mat& left, const cv::Mat& right, int x, int y, double slope_x, double slope_y,
-                   const SubpixelResult& r, const RefineAcceptance& a) {
+PixelStatus AcceptFit(const SubpixelResult& r, const RefineAcceptance& a) {
   if (!r.ok) return PixelStatus::kRefineFailed;
   if (r.zncc < a.min_zncc) return PixelStatus::kLowZncc;
   if (r.std_dn < a.min_texture_dn) return PixelStatus::kLowTexture;
   if (r.disparity_px < a.min_disparity_px || r.disparity_px > a.max_disparity_px) return PixelStatus::kOutOfRange;
+  return PixelStatus::kPoint;
+}
+
+double DistinctnessShiftPx(double slope_x, const RefineAcceptance& a) {
+  // The grid's period in the right view shrinks or grows with the
+  // foreshortening: 1 - dd/dx of the left one's.
+  return a.half_period_px * std::clamp(1.0 - slope_x, 0.3, 1.7);
+}
+
+PixelStatus Accept(const cv::Mat& left, const cv::Mat& right, int x, int y, double slope_x, double slope_y,
+                   const SubpixelResult& r, const RefineAcceptance& a) {
+  const PixelStatus fit = AcceptFit(r, a);
+  if (fit != PixelStatus::kPoint) return fit;
   if (a.min_distinctness > 0) {
-    // The grid's period in the right view shrinks or grows with the
-    // foreshortening: 1 - dd/dx of the left one's.
-    const double half = a.half_period_px * std::clamp(1.0 - slope_x, 0.3, 1.7);
+    const double half = DistinctnessShiftPx(slope_x, a);
     const double off = std::max(WindowZncc(left, right, x, y, r.disparity_px - half, slope_x, slope_y, a.subpixel),
                                 WindowZncc(left, right, x, y, r.disparity_px + half, slope_x, slope_y, a.subpixel));
     if (r.zncc - off < a.min_distinctness) return PixelStatus::kNotDistinct;

@@ -59,8 +59,17 @@ struct RefineAcceptance {
   double half_period_px = 4;  // the shift of that test, px (the default rig's grid: ~8 px period)
 };
 
+// The tests on the fit alone (converged, ZNCC, texture, range): kPoint or
+// the test `r` fails. Shared by the per-pixel and dense fits (dense_refine.h).
+PixelStatus AcceptFit(const SubpixelResult& r, const RefineAcceptance& a);
+
+// The shift of the distinctness test at a pixel whose disparity slope along
+// the row is slope_x: half a grid period as the right view sees it, px.
+double DistinctnessShiftPx(double slope_x, const RefineAcceptance& a);
+
 // kPoint if the refinement `r` of left pixel (x, y) (slopes as refined) is a
-// match by `a`, else the test it fails.
+// match by `a`, else the test it fails: AcceptFit, then the distinctness
+// test (WindowZncc DistinctnessShiftPx either side).
 PixelStatus Accept(const cv::Mat& left, const cv::Mat& right, int x, int y, double slope_x, double slope_y,
                    const SubpixelResult& r, const RefineAcceptance& a);
 

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "calib/core/input_error.h"
+#include "reconstruct/dense_refine.h"
 #include "reconstruct/disparity_band.h"
 #include "reconstruct/line_index.h"
 #include "reconstruct/parallel_for.h"
@@ -340,6 +341,13 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
   cv::Mat plane;
   cv::Mat slope_x_roi = state.slope_x(roi), slope_y_roi = state.slope_y(roi);
   DisparitySlopes(coarse_to_fine, &slope_x_roi, &slope_y_roi, &plane);
+  DenseRefineResult dense;  // empty: every pixel takes the per-pixel fit
+  if (!sgbm && o.intensity_refinement && o.subpixel_dense) {
+    const auto t_dense = std::chrono::steady_clock::now();
+    dense = DenseRefine(left, right, roi, coarse_to_fine, plane, slope_x_roi, slope_y_roi, o.subpixel, o.num_threads);
+    result.times_ms["subpixel_dense"] =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_dense).count();
+  }
   ParallelForChunks(roi.height, o.num_threads, [&](int b, int e) {
     for (int yy = b; yy < e; ++yy) {
       const int y = roi.y + yy;
@@ -370,7 +378,8 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
           continue;
         }
         if (o.intensity_refinement) {
-          const SubpixelResult s = RefineDisparity(left, right, x, y, d, slope_x[x], slope_y[x], o.subpixel);
+          SubpixelResult s = dense.ok.empty() ? SubpixelResult{} : dense.At(x, y);
+          if (!s.ok) s = RefineDisparity(left, right, x, y, d, slope_x[x], slope_y[x], o.subpixel);
           const PixelStatus why = Accept(left, right, x, y, slope_x[x], slope_y[x], s, accept);
           if (why != PixelStatus::kPoint) {
             reject(why);

@@ -1,11 +1,11 @@
 #include "reconstruct/subpixel_refine.h"
 
 #include <Eigen/Dense>
-#include <array>
 #include <cmath>
 #include <cstdint>
 
 #include "calib/core/input_error.h"
+#include "reconstruct/lanczos_taps.h"
 
 namespace stereorig {
 
@@ -19,71 +19,6 @@ void SubpixelOptions::Check() const {
 }
 
 namespace {
-
-// Lanczos-3 kernel L(s) = sinc(s) sinc(s/3) and its derivative.
-void Lanczos3(double s, double* value, double* slope) {
-  if (std::abs(s) < 1e-8) {
-    *value = 1.0;
-    *slope = 0.0;
-    return;
-  }
-  if (std::abs(s) >= 3.0) {
-    *value = *slope = 0.0;
-    return;
-  }
-  const double a = M_PI * s, b = a / 3.0;
-  const double sa = std::sin(a), sb = std::sin(b), ca = std::cos(a), cb = std::cos(b);
-  const double num = 3.0 * sa * sb, den = a * a;
-  *value = num / den;
-  const double dnum = 3.0 * M_PI * (ca * sb + sa * cb / 3.0);
-  const double dden = 2.0 * M_PI * a;
-  *slope = (dnum * den - num * dden) / (den * den);
-}
-
-// Weights of the taps i0-2 .. i0+3 for a sample at i0 + t, t in [0,1), and of
-// its derivative along x, normalised to sum to 1 (a constant is exact),
-// tabulated at 1/kSteps px. The nearest entry is used: the position error is
-// at most 1/(2 kSteps) = 0.002 px, uniformly spread, far below the noise.
-constexpr int kSteps = 256;
-struct Taps {
-  float w[6], g[6];
-};
-const std::array<Taps, kSteps + 1>& TapTable() {
-  static const std::array<Taps, kSteps + 1> table = [] {
-    std::array<Taps, kSteps + 1> t{};
-    for (int i = 0; i <= kSteps; ++i) {
-      const double frac = double(i) / kSteps;
-      double w[6], g[6], sw = 0, sg = 0;
-      for (int k = 0; k < 6; ++k) {
-        Lanczos3(frac - (k - 2), &w[k], &g[k]);
-        sw += w[k];
-        sg += g[k];
-      }
-      for (int k = 0; k < 6; ++k) {
-        t[i].w[k] = float(w[k] / sw);
-        t[i].g[k] = float((g[k] * sw - w[k] * sg) / (sw * sw));
-      }
-    }
-    return t;
-  }();
-  return table;
-}
-
-// Samples R at the continuous column xr (row pointer `row`): value and slope.
-// xr >= 0 (the caller checks the reach), so truncation is floor.
-inline void Sample(const uint8_t* row, float xr, const std::array<Taps, kSteps + 1>& table, float* value,
-                   float* slope) {
-  const int i0 = int(xr);
-  const Taps& t = table[int((xr - float(i0)) * kSteps + 0.5f)];
-  const uint8_t* p = row + i0 - 2;
-  float v = 0, s = 0;
-  for (int k = 0; k < 6; ++k) {
-    v += t.w[k] * p[k];
-    s += t.g[k] * p[k];
-  }
-  *value = v;
-  *slope = s;
-}
 
 // Cubic convolution (Keys, a = -0.5) weights of rows i0-1 .. i0+2 for a
 // sample at i0 + t, t in [0, 1), and their derivatives along t.
@@ -124,7 +59,7 @@ SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x,
   // The sampled right columns must stay inside the image (6 taps).
   const double reach = hw + std::abs(slope_x) * hw + std::abs(slope_y) * hh + o.max_shift_px + 4;
   if (x - start_px - reach < 0 || x - start_px + reach >= right.cols) return result;
-  const auto& table = TapTable();
+  const LanczosTable& table = LanczosTapTable();
 
   // Gauss-Newton on (d, gain, offset); residual e = l - gain*r - offset with
   // r sampled at x+u - d - gx*u - gy*v, so de/dd = gain * r'.
@@ -139,7 +74,7 @@ SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x,
       const float row_start = float(x - d - slope_y * v), stride = float(1.0 - slope_x);
       for (int u = -hw; u <= hw; ++u) {
         float r, rg;
-        Sample(rrow, row_start + float(u) * stride, table, &r, &rg);
+        SampleLanczos(rrow, row_start + float(u) * stride, table, &r, &rg);
         const float l = lrow[u];
         const float j = fgain * rg;
         const float e = l - fgain * r - foffset;
@@ -219,7 +154,7 @@ RowOffsetResult RefineDisparityAndRowOffset(const cv::Mat& left, const cv::Mat& 
     }
   const double lmean = lsum / nwin, lstd = std::sqrt(std::max(0.0, lsum2 / nwin - lmean * lmean));
   if (!(lstd > 0)) return result;
-  const auto& table = TapTable();
+  const LanczosTable& table = LanczosTapTable();
   double d = start_px, dy = 0, gain = 1, offset = 0;
   double rs = 0, rs2 = 0, lr = 0;
   for (int it = 0; it < o.max_iterations + 2; ++it) {
@@ -236,7 +171,7 @@ RowOffsetResult RefineDisparityAndRowOffset(const cv::Mat& left, const cv::Mat& 
         double r = 0, rx = 0, ry = 0;
         for (int k = 0; k < 4; ++k) {
           float value, slope;
-          Sample(right.ptr<uint8_t>(y + v + i0 - 1 + k), row_start + float(u) * stride, table, &value, &slope);
+          SampleLanczos(right.ptr<uint8_t>(y + v + i0 - 1 + k), row_start + float(u) * stride, table, &value, &slope);
           r += w[k] * value, rx += w[k] * slope, ry += dw[k] * value;
         }
         const double l = lrow[u];
