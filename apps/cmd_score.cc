@@ -15,6 +15,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
+#include "reconstruct/fill_diagnosis.h"
 #include "reconstruct/runtime.h"
 #include "reconstruct/scene_score.h"
 
@@ -60,13 +61,17 @@ int RunScore(int argc, char** argv) {
       "calibrate`, as issue 5 asks; without --rig the dataset's truth rig is used (and said so).\n\n"
       "Example:\n  stereorig score --dataset demo/dataset --rig demo/rig.yaml --report score.json",
       "stereorig score"};
-  std::string dataset, rig_path, options_path, report_path, scenes_arg = "cup,sphere,ballbar,plate,tuber";
+  std::string dataset, rig_path, options_path, report_path, diagnose_dir, scenes_arg = "cup,sphere,ballbar,plate,tuber";
   bool no_passive = false;
   app.add_option("--dataset", dataset, "simulator dataset folder (scenes/, truth/)")->required();
   app.add_option("--rig", rig_path, "rig file to reconstruct with (default: DATASET/truth/rig.yaml)");
   app.add_option("--scenes", scenes_arg, "comma-separated scenes")->capture_default_str();
   app.add_option("--options", options_path, "runtime options YAML");
   app.add_option("--report", report_path, "write everything as JSON here");
+  app.add_option("--diagnose", diagnose_dir,
+                 "write where and why fill is lost here: per scene and module, PNGs of the pixel status, the lost "
+                 "target pixels (green: the truth disparity passes the tests, red: not) and |disparity - truth| "
+                 "(reconstruct/fill_diagnosis.h), and a table on stdout");
   app.add_flag("--no-passive", no_passive, "skip the passive captures (no active/passive ratio)");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 
@@ -93,7 +98,8 @@ int RunScore(int argc, char** argv) {
   for (std::string name; std::getline(ss, name, ',');) {
     const fs::path scene_dir = fs::path(dataset) / "scenes" / name;
     const SceneTruth truth = ReadSceneTruth(dataset, name);
-    const Reconstruction rec = runtime.Process(LoadCapture((scene_dir / "active").string(), rig), false);
+    const std::vector<cv::Mat> images = LoadCapture((scene_dir / "active").string(), rig);
+    const Reconstruction rec = runtime.Process(images, false);
     const SceneScore s = ScoreScene(runtime, rec, truth);
     nlohmann::json sj = {
         {"scene", name},
@@ -122,6 +128,18 @@ int RunScore(int argc, char** argv) {
     std::printf("; aligned by %.4f deg, %.4f mm\n", s.accuracy.truth_from_cloud.AngleDeg(),
                 s.accuracy.truth_from_cloud.translation_mm().norm());
     for (size_t m = 0; m < s.fill.size(); ++m) std::printf("  m%zu lost: %s\n", m, LossLine(s.fill[m]).c_str());
+    if (!diagnose_dir.empty()) {
+      fs::create_directories(diagnose_dir);
+      const Rig truth_rig = ReadRigFile((fs::path(dataset) / "truth" / "rig.yaml").string());
+      const std::vector<CameraTruthMaps> maps =
+          ReadCameraTruthMaps((fs::path(dataset) / "truth" / "scenes" / name).string(), truth_rig.num_cameras());
+      for (size_t m = 0; m < s.fill.size(); ++m) {
+        const FillDiagnosis d = DiagnoseFill(runtime, int(m), images, rec, truth.fill_target[m],
+                                             maps[truth_rig.module(int(m)).left_camera].depth_mm);
+        WriteFillDiagnosisImages(d, (fs::path(diagnose_dir) / (name + "_m" + std::to_string(m))).string());
+        std::printf("  m%zu diagnosis: %s", m, d.Summary().c_str());
+      }
+    }
     report["scenes"].push_back(sj);
   }
   if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
