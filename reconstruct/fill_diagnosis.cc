@@ -9,6 +9,7 @@
 
 #include "calib/core/input_error.h"
 #include "reconstruct/matcher.h"
+#include "reconstruct/oblique_refine.h"
 
 namespace stereorig {
 
@@ -79,6 +80,8 @@ FillDiagnosis DiagnoseFill(const Runtime& runtime, int module, const std::vector
   accept.max_disparity_px = mo.min_disparity_px + mo.num_disparities - 1;
   accept.min_distinctness = mo.min_distinctness;
   accept.half_period_px = mo.grid_half_period_px;
+  const ObliqueViews oblique(d.left, d.right, report.match_roi.y - 8, report.match_roi.y + report.match_roi.height + 8,
+                             ObliqueOptions{});
   d.truth_status = cv::Mat(plan.geometry.size, CV_8UC1, cv::Scalar(0));
   const cv::Mat& t = d.truth_disparity;
   double sum_abs = 0;
@@ -122,6 +125,12 @@ FillDiagnosis DiagnoseFill(const Runtime& runtime, int module, const std::vector
       const bool reachable = why == PixelStatus::kPoint;
       if (st < d.lost.size()) ++d.lost[st][reachable ? 0 : 1];
       if (!reachable) ++d.unreachable_by[size_t(why)];
+      if (!reachable && std::isfinite(td)) {
+        SubpixelResult r;
+        PixelStatus ow;
+        const bool tried = oblique.Refine(x, y, td, gx, gy, accept, &r, &ow);
+        if (tried && ow == PixelStatus::kPoint && std::abs(r.disparity_px - td) <= 0.5) ++d.unreachable_oblique_ok;
+      }
     }
   const int within = d.points_with_truth - d.points_off_1px;
   d.mean_abs_error_px = within > 0 ? sum_abs / within : 0.0;
@@ -131,7 +140,8 @@ FillDiagnosis DiagnoseFill(const Runtime& runtime, int module, const std::vector
 std::string FillDiagnosis::Summary() const {
   std::string s;
   char buf[160];
-  std::snprintf(buf, sizeof buf, "fill %.1f%% of %d target px; points off the truth by > 1 px: %d of %d (%.2f%%), "
+  std::snprintf(buf, sizeof buf,
+                "fill %.1f%% of %d target px; points off the truth by > 1 px: %d of %d (%.2f%%), "
                 "mean |d - truth| of the rest %.3f px\n",
                 100.0 * filled_px / std::max(1, target_px), target_px, points_off_1px, points_with_truth,
                 100.0 * points_off_1px / std::max(1, points_with_truth), mean_abs_error_px);
@@ -159,7 +169,9 @@ std::string FillDiagnosis::Summary() const {
                     100.0 * unreachable_by[k] / std::max(1, target_px));
       s += buf;
     }
-  return s + "\n";
+  std::snprintf(buf, sizeof buf, "\n  unreachable, but reached by the oblique refinement: %.2f%%\n",
+                100.0 * unreachable_oblique_ok / std::max(1, target_px));
+  return s + buf;
 }
 
 namespace {
@@ -211,12 +223,12 @@ void WriteFillDiagnosisImages(const FillDiagnosis& d, const std::string& prefix)
       const cv::Vec3b dim(g / 3, g / 3, g / 3);
       const bool target = d.target.at<uint8_t>(gy, gx);
       const uint8_t st = d.status.at<uint8_t>(gy, gx);
-      status.at<cv::Vec3b>(y, x) = target ? StatusColour(st)
-                                          : (st == uint8_t(PixelStatus::kPoint) ? cv::Vec3b(120, 200, 120) : dim);
+      status.at<cv::Vec3b>(y, x) =
+          target ? StatusColour(st) : (st == uint8_t(PixelStatus::kPoint) ? cv::Vec3b(120, 200, 120) : dim);
       cv::Vec3b l = target ? cv::Vec3b(g / 2, g / 2, g / 2) : dim;
       if (target && st != uint8_t(PixelStatus::kPoint))
         l = d.truth_status.at<uint8_t>(gy, gx) == uint8_t(PixelStatus::kPoint) ? cv::Vec3b(0, 255, 0)
-                                                                                 : cv::Vec3b(0, 0, 255);
+                                                                               : cv::Vec3b(0, 0, 255);
       lost.at<cv::Vec3b>(y, x) = l;
       // |d - truth|: black 0, white >= 0.5 px, red > 1 px (a wrong match).
       const float md = d.disparity_px.at<float>(gy, gx), td = d.truth_disparity.at<float>(gy, gx);

@@ -38,12 +38,12 @@ void RectifyModulePair(const Rig& rig, const ModulePlan& plan, const std::vector
                        cv::Mat* right);
 
 struct FillDiagnosis {
-  cv::Mat left, right;        // CV_8UC1 rectified pair
-  cv::Mat target;             // CV_8UC1: 255 = fill target (fill_score.h), rectified grid
-  cv::Mat truth_disparity;    // CV_32FC1, NaN = none
-  cv::Mat status;             // CV_8UC1 PixelStatus (ModuleReport::status)
-  cv::Mat disparity_px;       // CV_32FC1: the matcher's disparity (+inf = none); from a second Match() run
-  cv::Mat truth_status;       // CV_8UC1 PixelStatus of Accept() refined from the truth (lost targets only; else 0)
+  cv::Mat left, right;      // CV_8UC1 rectified pair
+  cv::Mat target;           // CV_8UC1: 255 = fill target (fill_score.h), rectified grid
+  cv::Mat truth_disparity;  // CV_32FC1, NaN = none
+  cv::Mat status;           // CV_8UC1 PixelStatus (ModuleReport::status)
+  cv::Mat disparity_px;     // CV_32FC1: the matcher's disparity (+inf = none); from a second Match() run
+  cv::Mat truth_status;     // CV_8UC1 PixelStatus of Accept() refined from the truth (lost targets only; else 0)
   cv::Rect match_roi;
   // Target pixels lost, by final status (rows) and by whether the truth is
   // reachable (the refinement from the truth passes Accept and stays within
@@ -56,6 +56,7 @@ struct FillDiagnosis {
   // surface more obliquely), binned at kForeshorteningEdges.
   static constexpr std::array<double, 7> kForeshorteningEdges = {0.3, 0.5, 0.7, 0.9, 1.1, 1.5, 2.0};
   std::array<int, 8> target_by_foreshortening{}, filled_by_foreshortening{};
+  int unreachable_oblique_ok = 0;  // unreachable ones the oblique refinement (oblique_refine.h) reaches from the truth
   int target_px = 0, filled_px = 0;
   int points_with_truth = 0, points_off_1px = 0;  // points with a truth disparity; of those, > 1 px off
   double mean_abs_error_px = 0;                   // of the points within 1 px
