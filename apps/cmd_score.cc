@@ -16,6 +16,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
+#include "reconstruct/fill_diagnosis.h"
 #include "reconstruct/runtime.h"
 #include "reconstruct/scene_score.h"
 
@@ -71,13 +72,17 @@ int RunScore(int argc, char** argv) {
       "calibrate`, as issue 5 asks; without --rig the dataset's truth rig is used (and said so).\n\n"
       "Example:\n  stereorig score --dataset demo/dataset --rig demo/rig.yaml --report score.json",
       "stereorig score"};
-  std::string dataset, rig_path, options_path, report_path, scenes_arg = "cup,sphere,ballbar,plate,tuber";
+  std::string dataset, rig_path, options_path, report_path, diagnose_dir, scenes_arg = "cup,sphere,ballbar,plate,tuber";
   bool no_passive = false;
   app.add_option("--dataset", dataset, "simulator dataset folder (scenes/, truth/)")->required();
   app.add_option("--rig", rig_path, "rig file to reconstruct with (default: DATASET/truth/rig.yaml)");
   app.add_option("--scenes", scenes_arg, "comma-separated scenes")->capture_default_str();
   app.add_option("--options", options_path, "runtime options YAML");
   app.add_option("--report", report_path, "write everything as JSON here");
+  app.add_option("--diagnose", diagnose_dir,
+                 "write where and why fill is lost here: per scene and module, PNGs of the pixel status, the lost "
+                 "target pixels (green: the truth disparity passes the tests, red: not) and |disparity - truth| "
+                 "(reconstruct/fill_diagnosis.h), and a table on stdout");
   app.add_flag("--no-passive", no_passive, "skip the passive captures (no active/passive ratio)");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 
@@ -106,7 +111,8 @@ int RunScore(int argc, char** argv) {
     const SceneTruth truth = ReadSceneTruth(dataset, name);
     // Hole filling runs with the mesh: only when the options ask for it.
     const bool fill = options.shape_model != ShapeModel::kNone;
-    const Reconstruction rec = runtime.Process(LoadCapture((scene_dir / "active").string(), rig), fill);
+    const std::vector<cv::Mat> images = LoadCapture((scene_dir / "active").string(), rig);
+    const Reconstruction rec = runtime.Process(images, fill);
     const SceneScore s = ScoreScene(runtime, rec, truth);
     nlohmann::json sj = {
         {"scene", name},
@@ -145,6 +151,18 @@ int RunScore(int argc, char** argv) {
         char band[48];
         std::snprintf(band, sizeof band, std::isfinite(b.to_mm) ? "%.0f-%.0f mm" : ">= %.0f mm", b.from_mm, b.to_mm);
         std::printf("    %-10s from measured: %s\n", band, FilledLine(b.figures).c_str());
+      }
+    }
+    if (!diagnose_dir.empty()) {
+      fs::create_directories(diagnose_dir);
+      const Rig truth_rig = ReadRigFile((fs::path(dataset) / "truth" / "rig.yaml").string());
+      const std::vector<CameraTruthMaps> maps =
+          ReadCameraTruthMaps((fs::path(dataset) / "truth" / "scenes" / name).string(), truth_rig.num_cameras());
+      for (size_t m = 0; m < s.fill.size(); ++m) {
+        const FillDiagnosis d = DiagnoseFill(runtime, int(m), images, rec, truth.fill_target[m],
+                                             maps[truth_rig.module(int(m)).left_camera].depth_mm);
+        WriteFillDiagnosisImages(d, (fs::path(diagnose_dir) / (name + "_m" + std::to_string(m))).string());
+        std::printf("  m%zu diagnosis: %s", m, d.Summary().c_str());
       }
     }
     report["scenes"].push_back(sj);

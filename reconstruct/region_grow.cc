@@ -1,10 +1,12 @@
 #include "reconstruct/region_grow.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <deque>
 
 #include "calib/core/input_error.h"
+#include "reconstruct/shifted_window.h"
 
 namespace stereorig {
 
@@ -12,6 +14,11 @@ void GrowOptions::Check() const {
   if (!(max_deviation_px > 0 && max_deviation_px <= 4)) throw InputError("grow_max_deviation_px", "must be in (0, 4]");
   if (max_tries < 1 || max_tries > 8) throw InputError("grow_max_tries", "must be in [1, 8]");
   if (plane_radius_px < 1 || plane_radius_px > 10) throw InputError("grow_plane_radius_px", "must be in [1, 10]");
+  oblique.Check();
+  if (!(shifted_min_foreshortening > 0 && shifted_min_foreshortening <= 1))
+    throw InputError("grow_shifted_min_foreshortening", "must be in (0, 1]");
+  if (!(shifted_min_zncc >= -1 && shifted_min_zncc < 1))
+    throw InputError("grow_shifted_min_zncc", "must be in [-1, 1)");
 }
 
 namespace {
@@ -47,6 +54,9 @@ int GrowDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
   if (!o.enabled) return 0;
   cv::Mat& disparity = state->disparity_px;
   cv::Mat tried(left.size(), CV_8UC1, cv::Scalar(0));
+  const ObliqueViews oblique(left, right, roi.y - 8, roi.y + roi.height + 8, o.oblique);
+  RefineAcceptance shifted_accept = accept;
+  shifted_accept.min_zncc = std::max(accept.min_zncc, o.shifted_min_zncc);
   std::deque<cv::Point> queue;
   for (int y = roi.y; y < roi.y + roi.height; ++y)
     for (int x = roi.x; x < roi.x + roi.width; ++x)
@@ -67,10 +77,29 @@ int GrowDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
       // per pixel averages out), else from p and its slopes.
       double predicted = d + gx * (q.x - p.x) + gy * (q.y - p.y), qgx = gx, qgy = gy;
       LocalPlane(disparity, roi, q, o.plane_radius_px, &predicted, &qgx, &qgy);
-      const SubpixelResult r = RefineDisparity(left, right, q.x, q.y, predicted, qgx, qgy, accept.subpixel);
+      SubpixelResult r = RefineDisparity(left, right, q.x, q.y, predicted, qgx, qgy, accept.subpixel);
       PixelStatus why = Accept(left, right, q.x, q.y, qgx, qgy, r, accept);
       if (why == PixelStatus::kPoint && std::abs(r.disparity_px - predicted) > o.max_deviation_px)
         why = PixelStatus::kOffPlane;
+      if (why != PixelStatus::kPoint && o.shifted_windows && 1 - qgx > o.shifted_min_foreshortening &&
+          1 - qgx < 1 / o.shifted_min_foreshortening) {
+        SubpixelResult shifted;
+        if (RefineShiftedWindow(left, right, q.x, q.y, p - q, predicted, qgx, qgy, shifted_accept, o.max_deviation_px,
+                                &shifted) == PixelStatus::kPoint) {
+          r = shifted;
+          why = PixelStatus::kPoint;
+        }
+      }
+      if (why != PixelStatus::kPoint) {
+        SubpixelResult oblique_result;
+        PixelStatus oblique_why;
+        if (oblique.Refine(q.x, q.y, predicted, qgx, qgy, accept, &oblique_result, &oblique_why) &&
+            oblique_why == PixelStatus::kPoint &&
+            std::abs(oblique_result.disparity_px - predicted) <= o.max_deviation_px) {
+          r = oblique_result;
+          why = PixelStatus::kPoint;
+        }
+      }
       if (why != PixelStatus::kPoint) {
         state->status.at<uint8_t>(q) = uint8_t(why);  // the reason growing could not reach it
         continue;

@@ -109,6 +109,15 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.grow.max_deviation_px = m.GetDouble("grow_max_deviation_px", mo.grow.max_deviation_px);
     mo.grow.plane_radius_px = m.GetInt("grow_plane_radius_px", mo.grow.plane_radius_px);
     mo.grow.max_tries = m.GetInt("grow_max_tries", mo.grow.max_tries);
+    mo.grow.shifted_windows = m.GetBool("grow_shifted_windows", mo.grow.shifted_windows);
+    mo.grow.shifted_min_foreshortening =
+        m.GetDouble("grow_shifted_min_foreshortening", mo.grow.shifted_min_foreshortening);
+    mo.grow.shifted_min_zncc = m.GetDouble("grow_shifted_min_zncc", mo.grow.shifted_min_zncc);
+    mo.grow.oblique.enabled = m.GetBool("grow_oblique", mo.grow.oblique.enabled);
+    mo.grow.oblique.min_foreshortening =
+        m.GetDouble("grow_oblique_min_foreshortening", mo.grow.oblique.min_foreshortening);
+    mo.grow.oblique.psf_sigma_px = m.GetDouble("grow_oblique_psf_sigma_px", mo.grow.oblique.psf_sigma_px);
+    mo.grow.oblique.max_half_width_px = m.GetInt("grow_oblique_max_half_width_px", mo.grow.oblique.max_half_width_px);
     mo.min_distinctness = m.GetDouble("min_distinctness", mo.min_distinctness);
     mo.grid_half_period_px = m.GetDouble("grid_half_period_px", mo.grid_half_period_px);
     m.Finish();

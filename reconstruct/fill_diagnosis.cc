@@ -1,0 +1,252 @@
+#include "reconstruct/fill_diagnosis.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "calib/core/input_error.h"
+#include "reconstruct/matcher.h"
+#include "reconstruct/oblique_refine.h"
+
+namespace stereorig {
+
+cv::Mat TruthDisparity(const ModulePlan& plan, const cv::Mat& left_depth_mm) {
+  const RectifiedGeometry& g = plan.geometry;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  cv::Mat out(g.size, CV_32FC1, cv::Scalar(nan));
+  const Eigen::Matrix3d left_from_rect = g.rect_from_left.transpose();
+  for (int v = 0; v < out.rows; ++v)
+    for (int u = 0; u < out.cols; ++u) {
+      const double ox = plan.maps.left_x.at<float>(v, u), oy = plan.maps.left_y.at<float>(v, u);
+      const int x0 = int(std::floor(ox)), y0 = int(std::floor(oy));
+      if (x0 < 0 || y0 < 0 || x0 + 1 >= left_depth_mm.cols || y0 + 1 >= left_depth_mm.rows) continue;
+      const float z00 = left_depth_mm.at<float>(y0, x0), z01 = left_depth_mm.at<float>(y0, x0 + 1),
+                  z10 = left_depth_mm.at<float>(y0 + 1, x0), z11 = left_depth_mm.at<float>(y0 + 1, x0 + 1);
+      if (!(z00 > 0 && z01 > 0 && z10 > 0 && z11 > 0)) continue;
+      // Within one surface, the depth of 2x2 neighbours differs by much less
+      // than this even on a limb at grazing view (~0.2 mm per px at 200 mm).
+      if (std::max({z00, z01, z10, z11}) - std::min({z00, z01, z10, z11}) > 2.0f) continue;
+      const double fx = ox - x0, fy = oy - y0;
+      const double z = (1 - fy) * ((1 - fx) * z00 + fx * z01) + fy * ((1 - fx) * z10 + fx * z11);
+      const Eigen::Vector3d ray_rect((u - g.cx_left_px) / g.focal_px, (v - g.cy_px) / g.focal_px, 1.0);
+      const double scale = z / (left_from_rect * ray_rect).z();  // p_rect = scale * ray_rect
+      out.at<float>(v, u) = float(g.focal_px * g.baseline_mm / scale - g.disparity_offset_px);
+    }
+  return out;
+}
+
+void RectifyModulePair(const Rig& rig, const ModulePlan& plan, const std::vector<cv::Mat>& images, cv::Mat* left,
+                       cv::Mat* right) {
+  const StereoModule& mod = rig.module(plan.module);
+  cv::remap(images[mod.left_camera], *left, plan.maps.left_fixed, plan.maps.left_frac, cv::INTER_LINEAR,
+            cv::BORDER_CONSTANT, 0);
+  cv::remap(images[mod.right_camera], *right, plan.maps.right_fixed, plan.maps.right_frac, cv::INTER_LINEAR,
+            cv::BORDER_CONSTANT, 0);
+}
+
+FillDiagnosis DiagnoseFill(const Runtime& runtime, int module, const std::vector<cv::Mat>& images,
+                           const Reconstruction& rec, const cv::Mat& target_original, const cv::Mat& left_depth_mm) {
+  const ModulePlan& plan = runtime.plans()[module];
+  const ModuleReport& report = rec.modules[module];
+  FillDiagnosis d;
+  RectifyModulePair(runtime.rig(), plan, images, &d.left, &d.right);
+  d.status = report.status;
+  d.match_roi = report.match_roi;
+  d.truth_disparity = TruthDisparity(plan, left_depth_mm);
+  d.target = cv::Mat(plan.geometry.size, CV_8UC1, cv::Scalar(0));
+  for (int y = 0; y < d.target.rows; ++y)
+    for (int x = 0; x < d.target.cols; ++x) {
+      const long c = std::lround(plan.maps.left_x.at<float>(y, x)), r = std::lround(plan.maps.left_y.at<float>(y, x));
+      if (c >= 0 && r >= 0 && c < target_original.cols && r < target_original.rows &&
+          target_original.at<uint8_t>(int(r), int(c)))
+        d.target.at<uint8_t>(y, x) = 255;
+    }
+  const MatchOptions& mo_base = runtime.options().match;
+  MatchOptions mo = mo_base;
+  mo.roi = report.match_roi;
+  mo.min_disparity_px = plan.min_disparity_px;
+  mo.num_disparities = plan.num_disparities;
+  d.disparity_px = report.match_roi.area() > 0
+                       ? Match(d.left, d.right, mo).disparity_px
+                       : cv::Mat(plan.geometry.size, CV_32FC1, cv::Scalar(std::numeric_limits<float>::infinity()));
+  RefineAcceptance accept;
+  accept.subpixel = mo.subpixel;
+  accept.min_zncc = mo.min_zncc;
+  accept.min_texture_dn = mo.min_texture_dn;
+  accept.min_disparity_px = mo.min_disparity_px;
+  accept.max_disparity_px = mo.min_disparity_px + mo.num_disparities - 1;
+  accept.min_distinctness = mo.min_distinctness;
+  accept.half_period_px = mo.grid_half_period_px;
+  const ObliqueViews oblique(d.left, d.right, report.match_roi.y - 8, report.match_roi.y + report.match_roi.height + 8,
+                             ObliqueOptions{});
+  d.truth_status = cv::Mat(plan.geometry.size, CV_8UC1, cv::Scalar(0));
+  const cv::Mat& t = d.truth_disparity;
+  double sum_abs = 0;
+  for (int y = 1; y + 1 < d.target.rows; ++y)
+    for (int x = 1; x + 1 < d.target.cols; ++x) {
+      const float td = t.at<float>(y, x);
+      const uint8_t st = d.status.at<uint8_t>(y, x);
+      if (st == uint8_t(PixelStatus::kPoint) && std::isfinite(td)) {
+        // The runtime's disparity is the second run's (Match is deterministic).
+        const float md = d.disparity_px.at<float>(y, x);
+        if (std::isfinite(md)) {
+          ++d.points_with_truth;
+          if (std::abs(md - td) > 1) {
+            ++d.points_off_1px;
+          } else {
+            sum_abs += std::abs(md - td);
+          }
+        }
+      }
+      if (!d.target.at<uint8_t>(y, x)) continue;
+      const float tl = t.at<float>(y, x - 1), tr = t.at<float>(y, x + 1), tu = t.at<float>(y - 1, x),
+                  tb = t.at<float>(y + 1, x);
+      const double gx = std::isfinite(tl) && std::isfinite(tr) ? 0.5 * (tr - tl) : 0.0;
+      const double gy = std::isfinite(tu) && std::isfinite(tb) ? 0.5 * (tb - tu) : 0.0;
+      const auto& edges = FillDiagnosis::kForeshorteningEdges;
+      const size_t bin = size_t(std::upper_bound(edges.begin(), edges.end(), 1.0 - gx) - edges.begin());
+      ++d.target_px;
+      ++d.target_by_foreshortening[bin];
+      if (st == uint8_t(PixelStatus::kPoint)) {
+        ++d.filled_px;
+        ++d.filled_by_foreshortening[bin];
+        continue;
+      }
+      PixelStatus why = PixelStatus::kNoPlane;  // no truth disparity: an edge
+      if (std::isfinite(td)) {
+        const SubpixelResult r = RefineDisparity(d.left, d.right, x, y, td, gx, gy, accept.subpixel);
+        why = Accept(d.left, d.right, x, y, gx, gy, r, accept);
+        if (why == PixelStatus::kPoint && std::abs(r.disparity_px - td) > 0.5) why = PixelStatus::kOffPlane;
+      }
+      d.truth_status.at<uint8_t>(y, x) = uint8_t(why);
+      const bool reachable = why == PixelStatus::kPoint;
+      if (st < d.lost.size()) ++d.lost[st][reachable ? 0 : 1];
+      if (!reachable) ++d.unreachable_by[size_t(why)];
+      if (!reachable && std::isfinite(td)) {
+        SubpixelResult r;
+        PixelStatus ow;
+        const bool tried = oblique.Refine(x, y, td, gx, gy, accept, &r, &ow);
+        if (tried && ow == PixelStatus::kPoint && std::abs(r.disparity_px - td) <= 0.5) ++d.unreachable_oblique_ok;
+      }
+    }
+  const int within = d.points_with_truth - d.points_off_1px;
+  d.mean_abs_error_px = within > 0 ? sum_abs / within : 0.0;
+  return d;
+}
+
+std::string FillDiagnosis::Summary() const {
+  std::string s;
+  char buf[160];
+  std::snprintf(buf, sizeof buf,
+                "fill %.1f%% of %d target px; points off the truth by > 1 px: %d of %d (%.2f%%), "
+                "mean |d - truth| of the rest %.3f px\n",
+                100.0 * filled_px / std::max(1, target_px), target_px, points_off_1px, points_with_truth,
+                100.0 * points_off_1px / std::max(1, points_with_truth), mean_abs_error_px);
+  s += buf;
+  s += "  lost (% of target): status: reachable from truth / not\n";
+  for (size_t k = 0; k < lost.size(); ++k) {
+    if (lost[k][0] + lost[k][1] == 0) continue;
+    std::snprintf(buf, sizeof buf, "    %-16s %5.2f%% / %5.2f%%\n", PixelStatusName(PixelStatus(k)),
+                  100.0 * lost[k][0] / std::max(1, target_px), 100.0 * lost[k][1] / std::max(1, target_px));
+    s += buf;
+  }
+  s += "  by foreshortening 1 - dd/dx: share of target, fill:";
+  for (size_t b = 0; b < target_by_foreshortening.size(); ++b) {
+    const std::string lo = b == 0 ? "" : std::to_string(kForeshorteningEdges[b - 1]).substr(0, 3);
+    const std::string hi = b == kForeshorteningEdges.size() ? "" : std::to_string(kForeshorteningEdges[b]).substr(0, 3);
+    std::snprintf(buf, sizeof buf, " [%s,%s) %.1f%% %.0f%%;", lo.c_str(), hi.c_str(),
+                  100.0 * target_by_foreshortening[b] / std::max(1, target_px),
+                  100.0 * filled_by_foreshortening[b] / std::max(1, target_by_foreshortening[b]));
+    s += buf;
+  }
+  s += "\n  unreachable, by the test failing at the truth:";
+  for (size_t k = 0; k < unreachable_by.size(); ++k)
+    if (unreachable_by[k]) {
+      std::snprintf(buf, sizeof buf, " %s %.2f%%", PixelStatusName(PixelStatus(k)),
+                    100.0 * unreachable_by[k] / std::max(1, target_px));
+      s += buf;
+    }
+  std::snprintf(buf, sizeof buf, "\n  unreachable, but reached by the oblique refinement: %.2f%%\n",
+                100.0 * unreachable_oblique_ok / std::max(1, target_px));
+  return s + buf;
+}
+
+namespace {
+
+cv::Vec3b StatusColour(uint8_t status) {  // BGR
+  switch (PixelStatus(status)) {
+    case PixelStatus::kPoint:
+      return {60, 160, 60};
+    case PixelStatus::kNoSgmMatch:
+      return {255, 80, 0};  // blue
+    case PixelStatus::kNotDistinct:
+      return {255, 0, 255};  // magenta
+    case PixelStatus::kLowZncc:
+      return {0, 0, 255};  // red
+    case PixelStatus::kOffPlane:
+    case PixelStatus::kOffPlaneCoarse:
+      return {0, 140, 255};  // orange
+    case PixelStatus::kNoPlane:
+      return {255, 255, 0};  // cyan
+    case PixelStatus::kRefineFailed:
+      return {0, 255, 255};  // yellow
+    case PixelStatus::kSpeckle:
+      return {40, 80, 140};  // brown
+    case PixelStatus::kLowTexture:
+      return {128, 0, 128};  // purple
+    default:
+      return {255, 255, 255};
+  }
+}
+
+void Write(const std::string& path, const cv::Mat& image) {
+  cv::Mat big;
+  cv::resize(image, big, image.size() * 2, 0, 0, cv::INTER_NEAREST);
+  if (!cv::imwrite(path, big)) throw InputError(path, "cannot write the image");
+}
+
+}  // namespace
+
+void WriteFillDiagnosisImages(const FillDiagnosis& d, const std::string& prefix) {
+  const cv::Rect r = d.match_roi;
+  if (r.area() == 0) return;
+  cv::Mat grey = d.left(r).clone();
+  Write(prefix + "_left.png", grey);
+  cv::Mat status(r.size(), CV_8UC3), lost(r.size(), CV_8UC3), error(r.size(), CV_8UC3);
+  for (int y = 0; y < r.height; ++y)
+    for (int x = 0; x < r.width; ++x) {
+      const int gx = x + r.x, gy = y + r.y;
+      const uint8_t g = grey.at<uint8_t>(y, x);
+      const cv::Vec3b dim(g / 3, g / 3, g / 3);
+      const bool target = d.target.at<uint8_t>(gy, gx);
+      const uint8_t st = d.status.at<uint8_t>(gy, gx);
+      status.at<cv::Vec3b>(y, x) =
+          target ? StatusColour(st) : (st == uint8_t(PixelStatus::kPoint) ? cv::Vec3b(120, 200, 120) : dim);
+      cv::Vec3b l = target ? cv::Vec3b(g / 2, g / 2, g / 2) : dim;
+      if (target && st != uint8_t(PixelStatus::kPoint))
+        l = d.truth_status.at<uint8_t>(gy, gx) == uint8_t(PixelStatus::kPoint) ? cv::Vec3b(0, 255, 0)
+                                                                               : cv::Vec3b(0, 0, 255);
+      lost.at<cv::Vec3b>(y, x) = l;
+      // |d - truth|: black 0, white >= 0.5 px, red > 1 px (a wrong match).
+      const float md = d.disparity_px.at<float>(gy, gx), td = d.truth_disparity.at<float>(gy, gx);
+      cv::Vec3b e = target ? cv::Vec3b(60, 30, 30) : cv::Vec3b(0, 0, 0);
+      if (std::isfinite(md) && std::isfinite(td) && st == uint8_t(PixelStatus::kPoint)) {
+        const float a = std::abs(md - td);
+        if (a > 1) {
+          e = cv::Vec3b(0, 0, 255);
+        } else {
+          const uint8_t v = uint8_t(std::min(255.f, a / 0.5f * 255.f));
+          e = cv::Vec3b(v, v, v);
+        }
+      }
+      error.at<cv::Vec3b>(y, x) = e;
+    }
+  Write(prefix + "_status.png", status);
+  Write(prefix + "_lost.png", lost);
+  Write(prefix + "_error.png", error);
+}
+
+}  // namespace stereorig

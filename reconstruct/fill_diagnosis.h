@@ -1,0 +1,77 @@
+// Where and why the fill is lost: a module's result laid beside the
+// simulator's truth on the rectified left grid.
+//
+// fill_score.h counts the target pixels (object, seen by both cameras, grid
+// lit) and the test that lost each. This goes one step further, for tuning:
+//   - the truth disparity of every rectified left pixel (the truth depth map
+//     sampled through the runtime's rectification, re-projected with the
+//     runtime's own rectified geometry, so it is what a perfect matcher would
+//     return on the calibrated rig);
+//   - for every lost target pixel, whether the matcher's own acceptance test
+//     (RefineAcceptance, disparity_state.h) passes when the Lucas-Kanade
+//     refinement starts from the truth with the truth's slopes: "reachable"
+//     pixels were lost by the search or the growing, the others by the image
+//     (or by a test that is too strict there);
+//   - for every point, its disparity error against the truth.
+// WriteFillDiagnosisImages() writes PNGs of these for viewing.
+#pragma once
+
+#include <array>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "reconstruct/disparity_state.h"
+#include "reconstruct/runtime.h"
+
+namespace stereorig {
+
+// CV_32FC1 on the module's rectified left grid: the image disparity (px,
+// rectify.h) of the surface the truth depth map puts behind each pixel, NaN
+// where there is none or the depth jumps within the 2x2 pixels sampled (an
+// edge). `left_depth_mm`: the truth depth map of the module's left camera
+// (fill_score.h, CameraTruthMaps::depth_mm).
+cv::Mat TruthDisparity(const ModulePlan& plan, const cv::Mat& left_depth_mm);
+
+// The module's rectified pair, as the runtime rectifies it.
+void RectifyModulePair(const Rig& rig, const ModulePlan& plan, const std::vector<cv::Mat>& images, cv::Mat* left,
+                       cv::Mat* right);
+
+struct FillDiagnosis {
+  cv::Mat left, right;      // CV_8UC1 rectified pair
+  cv::Mat target;           // CV_8UC1: 255 = fill target (fill_score.h), rectified grid
+  cv::Mat truth_disparity;  // CV_32FC1, NaN = none
+  cv::Mat status;           // CV_8UC1 PixelStatus (ModuleReport::status)
+  cv::Mat disparity_px;     // CV_32FC1: the matcher's disparity (+inf = none); from a second Match() run
+  cv::Mat truth_status;     // CV_8UC1 PixelStatus of Accept() refined from the truth (lost targets only; else 0)
+  cv::Rect match_roi;
+  // Target pixels lost, by final status (rows) and by whether the truth is
+  // reachable (the refinement from the truth passes Accept and stays within
+  // 0.5 px of it): lost[status][0] = reachable, [1] = not.
+  std::vector<std::array<int, 2>> lost = std::vector<std::array<int, 2>>(size_t(PixelStatus::kNumStatus));
+  // Of the unreachable ones: the status Accept gives from the truth.
+  std::vector<int> unreachable_by = std::vector<int>(size_t(PixelStatus::kNumStatus), 0);
+  // Target pixels and filled ones by the truth's foreshortening of the
+  // right view against the left, 1 - dd/dx (< 1: the right camera sees the
+  // surface more obliquely), binned at kForeshorteningEdges.
+  static constexpr std::array<double, 7> kForeshorteningEdges = {0.3, 0.5, 0.7, 0.9, 1.1, 1.5, 2.0};
+  std::array<int, 8> target_by_foreshortening{}, filled_by_foreshortening{};
+  int unreachable_oblique_ok = 0;  // unreachable ones the oblique refinement (oblique_refine.h) reaches from the truth
+  int target_px = 0, filled_px = 0;
+  int points_with_truth = 0, points_off_1px = 0;  // points with a truth disparity; of those, > 1 px off
+  double mean_abs_error_px = 0;                   // of the points within 1 px
+  std::string Summary() const;                    // a few lines of text
+};
+
+// `rec`/`runtime`: the reconstruction of `images`; `target_original`:
+// FillTargetMask() of the module; `left_depth_mm`: truth depth of its left
+// camera.
+FillDiagnosis DiagnoseFill(const Runtime& runtime, int module, const std::vector<cv::Mat>& images,
+                           const Reconstruction& rec, const cv::Mat& target_original, const cv::Mat& left_depth_mm);
+
+// Writes `prefix`_{left,status,lost,error}.png cropped to the match ROI:
+// status = colour per PixelStatus over the grey image (targets outlined);
+// lost = lost targets, green where reachable, red where not; error = |d - truth|.
+void WriteFillDiagnosisImages(const FillDiagnosis& d, const std::string& prefix);
+
+}  // namespace stereorig
