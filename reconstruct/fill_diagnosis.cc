@@ -13,14 +13,15 @@
 
 namespace stereorig {
 
-cv::Mat TruthDisparity(const ModulePlan& plan, const cv::Mat& left_depth_mm) {
+cv::Mat TruthDisparity(const ModulePlan& plan, const cv::Mat& left_x, const cv::Mat& left_y,
+                       const cv::Mat& left_depth_mm) {
   const RectifiedGeometry& g = plan.geometry;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   cv::Mat out(g.size, CV_32FC1, cv::Scalar(nan));
   const Eigen::Matrix3d left_from_rect = g.rect_from_left.transpose();
   for (int v = 0; v < out.rows; ++v)
     for (int u = 0; u < out.cols; ++u) {
-      const double ox = plan.maps.left_x.at<float>(v, u), oy = plan.maps.left_y.at<float>(v, u);
+      const double ox = left_x.at<float>(v, u), oy = left_y.at<float>(v, u);
       const int x0 = int(std::floor(ox)), y0 = int(std::floor(oy));
       if (x0 < 0 || y0 < 0 || x0 + 1 >= left_depth_mm.cols || y0 + 1 >= left_depth_mm.rows) continue;
       const float z00 = left_depth_mm.at<float>(y0, x0), z01 = left_depth_mm.at<float>(y0, x0 + 1),
@@ -55,11 +56,15 @@ FillDiagnosis DiagnoseFill(const Runtime& runtime, int module, const std::vector
   RectifyModulePair(runtime.rig(), plan, images, &d.left, &d.right);
   d.status = report.status;
   d.match_roi = report.match_roi;
-  d.truth_disparity = TruthDisparity(plan, left_depth_mm);
+  // The exact float table (the runtime keeps only the fixed-point one).
+  cv::Mat left_x, left_y;
+  BuildRectifyMap(plan.geometry, runtime.rig().camera(runtime.rig().module(module).left_camera), RectifiedView::kLeft,
+                  &left_x, &left_y);
+  d.truth_disparity = TruthDisparity(plan, left_x, left_y, left_depth_mm);
   d.target = cv::Mat(plan.geometry.size, CV_8UC1, cv::Scalar(0));
   for (int y = 0; y < d.target.rows; ++y)
     for (int x = 0; x < d.target.cols; ++x) {
-      const long c = std::lround(plan.maps.left_x.at<float>(y, x)), r = std::lround(plan.maps.left_y.at<float>(y, x));
+      const long c = std::lround(left_x.at<float>(y, x)), r = std::lround(left_y.at<float>(y, x));
       if (c >= 0 && r >= 0 && c < target_original.cols && r < target_original.rows &&
           target_original.at<uint8_t>(int(r), int(c)))
         d.target.at<uint8_t>(y, x) = 255;

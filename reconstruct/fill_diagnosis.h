@@ -30,8 +30,10 @@ namespace stereorig {
 // rectify.h) of the surface the truth depth map puts behind each pixel, NaN
 // where there is none or the depth jumps within the 2x2 pixels sampled (an
 // edge). `left_depth_mm`: the truth depth map of the module's left camera
-// (fill_score.h, CameraTruthMaps::depth_mm).
-cv::Mat TruthDisparity(const ModulePlan& plan, const cv::Mat& left_depth_mm);
+// (fill_score.h, CameraTruthMaps::depth_mm). left_x, left_y: the left
+// view's exact float remap table (rectify.h, BuildRectifyMap).
+cv::Mat TruthDisparity(const ModulePlan& plan, const cv::Mat& left_x, const cv::Mat& left_y,
+                       const cv::Mat& left_depth_mm);
 
 // The module's rectified pair, as the runtime rectifies it.
 void RectifyModulePair(const Rig& rig, const ModulePlan& plan, const std::vector<cv::Mat>& images, cv::Mat* left,
