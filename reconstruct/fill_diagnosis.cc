@@ -202,6 +202,10 @@ cv::Vec3b StatusColour(uint8_t status) {  // BGR
       return {40, 80, 140};  // brown
     case PixelStatus::kLowTexture:
       return {128, 0, 128};  // purple
+    case PixelStatus::kOccluded:
+      return {128, 128, 128};  // grey
+    case PixelStatus::kWrongLine:
+      return {180, 105, 255};  // pink
     default:
       return {255, 255, 255};
   }
