@@ -77,14 +77,7 @@ FillDiagnosis DiagnoseFill(const Runtime& runtime, int module, const std::vector
   d.disparity_px = report.match_roi.area() > 0
                        ? Match(d.left, d.right, mo).disparity_px
                        : cv::Mat(plan.geometry.size, CV_32FC1, cv::Scalar(std::numeric_limits<float>::infinity()));
-  RefineAcceptance accept;
-  accept.subpixel = mo.subpixel;
-  accept.min_zncc = mo.min_zncc;
-  accept.min_texture_dn = mo.min_texture_dn;
-  accept.min_disparity_px = mo.min_disparity_px;
-  accept.max_disparity_px = mo.min_disparity_px + mo.num_disparities - 1;
-  accept.min_distinctness = mo.min_distinctness;
-  accept.half_period_px = mo.grid_half_period_px;
+  const RefineAcceptance accept = AcceptanceFor(mo);
   const ObliqueViews oblique(d.left, d.right, report.match_roi.y - 8, report.match_roi.y + report.match_roi.height + 8,
                              ObliqueOptions{});
   d.truth_status = cv::Mat(plan.geometry.size, CV_8UC1, cv::Scalar(0));

@@ -330,14 +330,7 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
   state.status = cv::Mat(left.size(), CV_8UC1, cv::Scalar(uint8_t(PixelStatus::kNotSearched)));
   state.slope_x = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
   state.slope_y = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
-  RefineAcceptance accept;
-  accept.subpixel = o.subpixel;
-  accept.min_zncc = o.min_zncc;
-  accept.min_texture_dn = o.min_texture_dn;
-  accept.min_disparity_px = o.min_disparity_px;
-  accept.max_disparity_px = o.min_disparity_px + o.num_disparities - 1;
-  accept.min_distinctness = o.min_distinctness;
-  accept.half_period_px = o.grid_half_period_px;
+  const RefineAcceptance accept = AcceptanceFor(o);
   cv::Mat plane;
   cv::Mat slope_x_roi = state.slope_x(roi), slope_y_roi = state.slope_y(roi);
   DisparitySlopes(coarse_to_fine, &slope_x_roi, &slope_y_roi, &plane);
@@ -469,6 +462,18 @@ MatchResult MatchOpenCvSgbm(const cv::Mat& left, const cv::Mat& right, const cv:
 }
 
 }  // namespace
+
+RefineAcceptance AcceptanceFor(const MatchOptions& o) {
+  RefineAcceptance accept;
+  accept.subpixel = o.subpixel;
+  accept.min_zncc = o.min_zncc;
+  accept.min_texture_dn = o.min_texture_dn;
+  accept.min_disparity_px = o.min_disparity_px;
+  accept.max_disparity_px = o.min_disparity_px + o.num_disparities - 1;
+  accept.min_distinctness = o.min_distinctness;
+  accept.half_period_px = o.grid_half_period_px;
+  return accept;
+}
 
 MatchResult Match(const cv::Mat& left, const cv::Mat& right, const MatchOptions& options) {
   options.Check();

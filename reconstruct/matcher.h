@@ -127,6 +127,10 @@ struct MatchResult {
   std::map<std::string, double> times_ms;
 };
 
+// The sub-pixel step's acceptance tests (disparity_state.h) as the options
+// set them: the matcher's and anything that re-judges its matches.
+RefineAcceptance AcceptanceFor(const MatchOptions& options);
+
 // left, right: CV_8UC1, same size, rectified. Stateless and thread-safe.
 MatchResult Match(const cv::Mat& left, const cv::Mat& right, const MatchOptions& options);
 
