@@ -61,10 +61,14 @@ struct MatchOptions {
   // only within +-guided_radius_px of twice the band pass's half-resolution
   // disparity there (sgm_guide.h, SgmMatchGuided), gaps filled from the
   // neighbours: a cost volume of 2r+1 disparities instead of the whole band.
-  // 0 = search the whole band. Default 15 px (~2 grid periods either side
-  // of the coarse match: a coarse match one period off still has the truth
-  // in its window).
-  int guided_radius_px = 15;
+  // 0 = search the whole band. Default 0 (off): on the simulator's seed 7
+  // (truth rig) the guided search at 15 px let whole patches settle one grid
+  // period off (ball bar module 1 std 0.10 -> 0.46 mm, plate module 1 0.12 ->
+  // 0.20, sphere module 0 0.077 -> 0.099) and at 20 px the tuber's module 0
+  // (0.075 -> 0.119); seed 1 (calibrated rig) lost the plate's module 1 at 12
+  // and 15 px. The whole-band search had none of these. It saves ~20 ms of
+  // SGM per module; turn it on only with a test of its own scenes.
+  int guided_radius_px = 0;
   int refine_radius_px = 2;  // census_sgm: fine-level search +-radius around 2x coarse; default 2
   int refine_half_window_px = 1;     // census_sgm: fine-level cost box half size; default 1 (3x3)
   int census_half_width_px = 2;      // census_sgm: census window half width (<= 4); default 2 (5 px: tolerates
