@@ -91,6 +91,12 @@ int RunScore(int argc, char** argv) {
     rig_path = (fs::path(dataset) / "truth" / "rig.yaml").string();
     std::printf("score: no --rig: using the TRUTH rig %s (issue 5 judges with the calibrated one)\n", rig_path.c_str());
   }
+  if (!diagnose_dir.empty()) {  // before any work: an unusable folder is bad input, not a crash at the end
+    std::error_code ec;
+    fs::create_directories(diagnose_dir, ec);
+    if (ec || !fs::is_directory(diagnose_dir))
+      throw InputError(diagnose_dir, "--diagnose: cannot create this folder (" + ec.message() + ")");
+  }
   const Rig rig = ReadRigFile(rig_path);
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
   RuntimeOptions passive_options = options;
@@ -154,7 +160,6 @@ int RunScore(int argc, char** argv) {
       }
     }
     if (!diagnose_dir.empty()) {
-      fs::create_directories(diagnose_dir);
       const Rig truth_rig = ReadRigFile((fs::path(dataset) / "truth" / "rig.yaml").string());
       const std::vector<CameraTruthMaps> maps =
           ReadCameraTruthMaps((fs::path(dataset) / "truth" / "scenes" / name).string(), truth_rig.num_cameras());

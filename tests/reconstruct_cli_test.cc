@@ -59,6 +59,13 @@ TEST(MatchCli, WritesAPfmThatMatchesTheTruth) {
   EXPECT_TRUE(std::isinf(disp.at<float>(100, 0)));
 }
 
+// score: a dataset folder without a rig is bad input (exit 2), not a crash.
+// (An unusable --diagnose folder is also exit 2, checked by hand: a test
+// of it needs a whole dataset, since without one the rig fails first.)
+TEST(ScoreCli, MissingDatasetExitsTwo) {
+  EXPECT_EQ(RunCli("score --dataset " + ::testing::TempDir() + "/no_such_dataset"), 2);
+}
+
 TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
   const std::string dir = ::testing::TempDir() + "/match_cli_bad";
   std::filesystem::create_directories(dir);
