@@ -233,9 +233,10 @@ FitPassSums SubpixelWindow::FitPassAvx2(double d, float gain, float offset) cons
     sge = _mm256_fmadd_ps(g, e, sge), sre = _mm256_fmadd_ps(r, e, sre), se = _mm256_add_ps(se, e);
     slr = _mm256_fmadd_ps(l, r, slr);
   }
-  return FitPassSums{HorizontalSum(sgg), HorizontalSum(sgr), HorizontalSum(sg),
-                     HorizontalSum(srr), HorizontalSum(sr),  HorizontalSum(sge),
-                     HorizontalSum(sre), HorizontalSum(se),  HorizontalSum(slr)};
+  const __m256 lanes[8] = {sgg, sgr, sg, srr, sr, sge, sre, se};
+  alignas(32) float sums[8];
+  _mm256_store_ps(sums, TransposeSum8(lanes));
+  return FitPassSums{sums[0], sums[1], sums[2], sums[3], sums[4], sums[5], sums[6], sums[7], HorizontalSum(slr)};
 }
 
 double SubpixelWindow::ZnccAvx2(double d) const {
