@@ -44,6 +44,13 @@ FitPassSums SubpixelWindow::FitPass(double d, float gain, float offset) const {
   return FitPassPortable(d, gain, offset);
 }
 
+void SubpixelWindow::Sample(double d, int row_shift, float* r, float* g) const {
+#if defined(__AVX2__)
+  if (vector_) return SampleAvx2(d, row_shift, r, g);
+#endif
+  SamplePortable(d, row_shift, r, g);
+}
+
 double SubpixelWindow::Zncc(double d) const {
 #if defined(__AVX2__)
   if (vector_) return ZnccAvx2(d);
@@ -70,6 +77,17 @@ FitPassSums SubpixelWindow::FitPassPortable(double d, float gain, float offset) 
     }
   }
   return FitPassSums{sgg, sgr, sg, srr, sr, sge, sre, se, slr};
+}
+
+void SubpixelWindow::SamplePortable(double d, int row_shift, float* r, float* g) const {
+  const LanczosTable& table = LanczosTapTable();
+  int s = 0;
+  for (int v = -hh_; v <= hh_; ++v) {
+    const uint8_t* rrow = right_.ptr<uint8_t>(y_ + v + row_shift);
+    const float row_start = float(x_ - d - slope_y_ * v);
+    for (int u = -hw_; u <= hw_; ++u, ++s) SampleLanczos(rrow, row_start + float(u) * stride_, table, &r[s], &g[s]);
+  }
+  for (; s < padded_size(); ++s) r[s] = g[s] = 0;
 }
 
 double SubpixelWindow::ZnccPortable(double d) const {
@@ -196,32 +214,45 @@ void SubpixelWindow::SetUpLanes() {
   lsum_ = int64_t(HorizontalSum(ls)), lsum2_ = int64_t(HorizontalSum(ls2));
 }
 
-FitPassSums SubpixelWindow::FitPassAvx2(double d, float gain, float offset) const {
+namespace {
+
+// The Lanczos values r and slopes g of 8 samples at right columns
+// base + offset[k] of the rows at byte offsets row[k] + row_shift from
+// `right`.
+inline void SampleChunk(const uint8_t* right, __m256 base, const float* offset, const int32_t* row,
+                        int32_t row_shift, __m256* r, __m256* g) {
   const LanczosTable& table = LanczosTapTable();
-  const uint8_t* right = right_.data;
-  const __m256 base = _mm256_set1_ps(float(x_ - d)), steps = _mm256_set1_ps(float(kLanczosSteps));
-  const __m256 half = _mm256_set1_ps(0.5f), vgain = _mm256_set1_ps(gain), voffset = _mm256_set1_ps(offset);
+  const __m256 xr = _mm256_add_ps(base, _mm256_load_ps(offset));
+  const __m256i i0 = _mm256_cvttps_epi32(xr);
+  const __m256 frac = _mm256_sub_ps(xr, _mm256_cvtepi32_ps(i0));
+  alignas(32) int32_t col[8], entry[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(col),
+                     _mm256_add_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(row)),
+                                      _mm256_add_epi32(i0, _mm256_set1_epi32(row_shift))));
+  _mm256_store_si256(reinterpret_cast<__m256i*>(entry), _mm256_cvttps_epi32(_mm256_fmadd_ps(
+                                                            frac, _mm256_set1_ps(float(kLanczosSteps)), _mm256_set1_ps(0.5f))));
+  __m256 wp[8], gp[8];
+  for (int k = 0; k < 8; ++k) {
+    // Bytes i0-4 .. i0+3; the taps sit in lanes 2..7 (lanczos_taps.h).
+    const __m256 p = _mm256_cvtepi32_ps(
+        _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(right + col[k] - 4))));
+    const LanczosTaps& t = table[entry[k]];
+    wp[k] = _mm256_mul_ps(_mm256_load_ps(t.w), p);
+    gp[k] = _mm256_mul_ps(_mm256_load_ps(t.g), p);
+  }
+  *r = TransposeSum8(wp), *g = TransposeSum8(gp);
+}
+
+}  // namespace
+
+FitPassSums SubpixelWindow::FitPassAvx2(double d, float gain, float offset) const {
+  const __m256 base = _mm256_set1_ps(float(x_ - d));
+  const __m256 vgain = _mm256_set1_ps(gain), voffset = _mm256_set1_ps(offset);
   __m256 sgg = _mm256_setzero_ps(), sgr = sgg, sg = sgg, srr = sgg, sr = sgg, sge = sgg, sre = sgg, se = sgg,
          slr = sgg;
   for (int c = 0; c < n_; c += 8) {
-    // Positions, tap-table rows and first taps of 8 samples.
-    const __m256 xr = _mm256_add_ps(base, _mm256_load_ps(offset_ + c));
-    const __m256i i0 = _mm256_cvttps_epi32(xr);
-    const __m256 frac = _mm256_sub_ps(xr, _mm256_cvtepi32_ps(i0));
-    alignas(32) int32_t col[8], entry[8];
-    _mm256_store_si256(reinterpret_cast<__m256i*>(col),
-                       _mm256_add_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(row_ + c)), i0));
-    _mm256_store_si256(reinterpret_cast<__m256i*>(entry), _mm256_cvttps_epi32(_mm256_fmadd_ps(frac, steps, half)));
-    __m256 wp[8], gp[8];
-    for (int k = 0; k < 8; ++k) {
-      // Bytes i0-4 .. i0+3; the taps sit in lanes 2..7 (lanczos_taps.h).
-      const __m256 p = _mm256_cvtepi32_ps(
-          _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(right + col[k] - 4))));
-      const LanczosTaps& t = table[entry[k]];
-      wp[k] = _mm256_mul_ps(_mm256_load_ps(t.w), p);
-      gp[k] = _mm256_mul_ps(_mm256_load_ps(t.g), p);
-    }
-    __m256 r = TransposeSum8(wp), g = TransposeSum8(gp);
+    __m256 r, g;
+    SampleChunk(right_.data, base, offset_ + c, row_ + c, 0, &r, &g);
     const __m256 l = _mm256_load_ps(l_ + c);
     __m256 e = _mm256_sub_ps(_mm256_fnmadd_ps(vgain, r, l), voffset);
     if (c + 8 > n_) {  // padding lanes: no samples
@@ -237,6 +268,16 @@ FitPassSums SubpixelWindow::FitPassAvx2(double d, float gain, float offset) cons
   alignas(32) float sums[8];
   _mm256_store_ps(sums, TransposeSum8(lanes));
   return FitPassSums{sums[0], sums[1], sums[2], sums[3], sums[4], sums[5], sums[6], sums[7], HorizontalSum(slr)};
+}
+
+void SubpixelWindow::SampleAvx2(double d, int row_shift, float* r, float* g) const {
+  const __m256 base = _mm256_set1_ps(float(x_ - d));
+  const int32_t shift = int32_t(row_shift * int64_t(right_.step[0]));
+  for (int c = 0; c < n_; c += 8) {
+    __m256 rc, gc;
+    SampleChunk(right_.data, base, offset_ + c, row_ + c, shift, &rc, &gc);
+    _mm256_storeu_ps(r + c, rc), _mm256_storeu_ps(g + c, gc);
+  }
 }
 
 double SubpixelWindow::ZnccAvx2(double d) const {

@@ -39,8 +39,9 @@ enum class WindowKernel {
 
 class SubpixelWindow {
  public:
-  // The most samples the AVX2 path takes (larger windows: portable): 9x7.
-  static constexpr int kMaxVectorSamples = 64;
+  // The most samples the AVX2 path takes (larger windows: portable): up to
+  // 9x13, which holds the line-index vernier's 9x9 (line_index.h).
+  static constexpr int kMaxVectorSamples = 120;
 
   // Left pixel (x, y), the slopes dd/dx, dd/dy and the window size of o.
   // The window must lie inside the left image (the caller checks).
@@ -57,6 +58,13 @@ class SubpixelWindow {
   // i0-4 (the caller checks the reach; lanczos_taps.h).
   FitPassSums FitPass(double d, float gain, float offset) const;
 
+  // Each sample's right value r[s] and slope g[s] (Lanczos) at disparity d,
+  // from right rows shifted by row_shift (y + v + row_shift: those rows
+  // must be inside the image), s < size(); r, g hold padded_size() floats.
+  // The same reach as FitPass.
+  void Sample(double d, int row_shift, float* r, float* g) const;
+  int padded_size() const { return (n_ + 7) / 8 * 8; }
+
   // ZNCC of the window at disparity d, the right row linearly interpolated
   // (columns i0 .. i0+3 read: inside the row, the caller checks); -1 if
   // either window is flat.
@@ -64,12 +72,14 @@ class SubpixelWindow {
 
  private:
   FitPassSums FitPassPortable(double d, float gain, float offset) const;
+  void SamplePortable(double d, int row_shift, float* r, float* g) const;
   double ZnccPortable(double d) const;
-#if defined(__AVX2__)
+  // Defined in AVX2 builds only (and called only there): declared in all so
+  // the class is the same in every file.
   void SetUpLanes();  // the AVX2 path's arrays and the left sums
   FitPassSums FitPassAvx2(double d, float gain, float offset) const;
+  void SampleAvx2(double d, int row_shift, float* r, float* g) const;
   double ZnccAvx2(double d) const;
-#endif
 
   const cv::Mat& left_;
   const cv::Mat& right_;
