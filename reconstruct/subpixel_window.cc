@@ -10,8 +10,8 @@
 
 namespace stereorig {
 
-SubpixelWindow::SubpixelWindow(const cv::Mat& left, const cv::Mat& right, int x, int y, double slope_x,
-                               double slope_y, const SubpixelOptions& o, WindowKernel kernel)
+SubpixelWindow::SubpixelWindow(const cv::Mat& left, const cv::Mat& right, int x, int y, double slope_x, double slope_y,
+                               const SubpixelOptions& o, WindowKernel kernel)
     : left_(left),
       right_(right),
       x_(x),
@@ -141,8 +141,7 @@ struct WindowLanes {
 
 const WindowLanes& LanesFor(int hw, int hh, size_t left_step, size_t right_step) {
   thread_local WindowLanes lanes;
-  if (lanes.hw == hw && lanes.hh == hh && lanes.left_step == left_step && lanes.right_step == right_step)
-    return lanes;
+  if (lanes.hw == hw && lanes.hh == hh && lanes.left_step == left_step && lanes.right_step == right_step) return lanes;
   lanes.hw = hw, lanes.hh = hh, lanes.left_step = left_step, lanes.right_step = right_step;
   int s = 0;
   for (int v = -hh; v <= hh; ++v)
@@ -193,8 +192,8 @@ void SubpixelWindow::SetUpLanes() {
     const __m256i left_offset = _mm256_load_si256(reinterpret_cast<const __m256i*>(lanes.left_offset + c));
     __m256 l;
     if (gather) {
-      l = _mm256_cvtepi32_ps(_mm256_and_si256(
-          _mm256_i32gather_epi32(reinterpret_cast<const int*>(centre), left_offset, 1), low_byte));
+      l = _mm256_cvtepi32_ps(
+          _mm256_and_si256(_mm256_i32gather_epi32(reinterpret_cast<const int*>(centre), left_offset, 1), low_byte));
     } else {
       alignas(32) float values[8];
       for (int k = 0; k < 8; ++k) values[k] = centre[lanes.left_offset[c + k]];
@@ -206,9 +205,9 @@ void SubpixelWindow::SetUpLanes() {
     // u (1 - gx) - gy v: to float precision (~1e-6 px), as the positions.
     _mm256_store_ps(offset_ + c, _mm256_fmadd_ps(_mm256_load_ps(lanes.u + c), stride,
                                                  _mm256_mul_ps(_mm256_load_ps(lanes.v + c), minus_gy)));
-    _mm256_store_si256(reinterpret_cast<__m256i*>(row_ + c),
-                       _mm256_add_epi32(right_centre,
-                                        _mm256_load_si256(reinterpret_cast<const __m256i*>(lanes.right_row + c))));
+    _mm256_store_si256(
+        reinterpret_cast<__m256i*>(row_ + c),
+        _mm256_add_epi32(right_centre, _mm256_load_si256(reinterpret_cast<const __m256i*>(lanes.right_row + c))));
   }
   // Integers below 2^24 (64 samples of at most 255^2): exact in float.
   lsum_ = int64_t(HorizontalSum(ls)), lsum2_ = int64_t(HorizontalSum(ls2));
@@ -219,8 +218,8 @@ namespace {
 // The Lanczos values r and slopes g of 8 samples at right columns
 // base + offset[k] of the rows at byte offsets row[k] + row_shift from
 // `right`.
-inline void SampleChunk(const uint8_t* right, __m256 base, const float* offset, const int32_t* row,
-                        int32_t row_shift, __m256* r, __m256* g) {
+inline void SampleChunk(const uint8_t* right, __m256 base, const float* offset, const int32_t* row, int32_t row_shift,
+                        __m256* r, __m256* g) {
   const LanczosTable& table = LanczosTapTable();
   const __m256 xr = _mm256_add_ps(base, _mm256_load_ps(offset));
   const __m256i i0 = _mm256_cvttps_epi32(xr);
@@ -229,13 +228,14 @@ inline void SampleChunk(const uint8_t* right, __m256 base, const float* offset, 
   _mm256_store_si256(reinterpret_cast<__m256i*>(col),
                      _mm256_add_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(row)),
                                       _mm256_add_epi32(i0, _mm256_set1_epi32(row_shift))));
-  _mm256_store_si256(reinterpret_cast<__m256i*>(entry), _mm256_cvttps_epi32(_mm256_fmadd_ps(
-                                                            frac, _mm256_set1_ps(float(kLanczosSteps)), _mm256_set1_ps(0.5f))));
+  _mm256_store_si256(
+      reinterpret_cast<__m256i*>(entry),
+      _mm256_cvttps_epi32(_mm256_fmadd_ps(frac, _mm256_set1_ps(float(kLanczosSteps)), _mm256_set1_ps(0.5f))));
   __m256 wp[8], gp[8];
   for (int k = 0; k < 8; ++k) {
     // Bytes i0-4 .. i0+3; the taps sit in lanes 2..7 (lanczos_taps.h).
-    const __m256 p = _mm256_cvtepi32_ps(
-        _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(right + col[k] - 4))));
+    const __m256 p =
+        _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(right + col[k] - 4))));
     const LanczosTaps& t = table[entry[k]];
     wp[k] = _mm256_mul_ps(_mm256_load_ps(t.w), p);
     gp[k] = _mm256_mul_ps(_mm256_load_ps(t.g), p);
@@ -248,8 +248,7 @@ inline void SampleChunk(const uint8_t* right, __m256 base, const float* offset, 
 FitPassSums SubpixelWindow::FitPassAvx2(double d, float gain, float offset) const {
   const __m256 base = _mm256_set1_ps(float(x_ - d));
   const __m256 vgain = _mm256_set1_ps(gain), voffset = _mm256_set1_ps(offset);
-  __m256 sgg = _mm256_setzero_ps(), sgr = sgg, sg = sgg, srr = sgg, sr = sgg, sge = sgg, sre = sgg, se = sgg,
-         slr = sgg;
+  __m256 sgg = _mm256_setzero_ps(), sgr = sgg, sg = sgg, srr = sgg, sr = sgg, sge = sgg, sre = sgg, se = sgg, slr = sgg;
   for (int c = 0; c < n_; c += 8) {
     __m256 r, g;
     SampleChunk(right_.data, base, offset_ + c, row_ + c, 0, &r, &g);

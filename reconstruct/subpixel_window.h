@@ -84,12 +84,12 @@ class SubpixelWindow {
   const cv::Mat& left_;
   const cv::Mat& right_;
   int x_, y_, hw_, hh_, n_;
-  float stride_;      // 1 - slope_x: right px per left px along the row
-  double slope_y_;    // dd/dy
-  bool vector_;       // the AVX2 path
+  float stride_;    // 1 - slope_x: right px per left px along the row
+  double slope_y_;  // dd/dy
+  bool vector_;     // the AVX2 path
   int64_t lsum_ = 0, lsum2_ = 0;
-  // AVX2 path, flattened samples padded to a multiple of 8 (padding: copies
-  // of sample 0 with l = 0, masked out of the sums):
+  // AVX2 path, flattened samples padded to a multiple of 8 (padding: the
+  // centre pixel's position with l = 0, masked out of the sums):
   alignas(32) float l_[kMaxVectorSamples];       // left values
   alignas(32) float offset_[kMaxVectorSamples];  // right column minus (x - d): u (1 - gx) - gy v
   alignas(32) int32_t row_[kMaxVectorSamples];   // byte offset of the right row from right.data
@@ -108,7 +108,7 @@ class WindowZnccProbe {
 
  private:
   int x_, right_cols_;
-  double reach_px_;  // the right window's extent about x - d, with the taps' margin
+  double reach_px_;                       // the right window's extent about x - d, with the taps' margin
   std::optional<SubpixelWindow> window_;  // none if the left window leaves the image
 };
 

@@ -54,7 +54,8 @@ SubpixelResult RefineReference(const cv::Mat& left, const cv::Mat& right, int x,
   const int hw = o.half_width_px, hh = o.half_height_px, n = (2 * hw + 1) * (2 * hh + 1);
   double d = start, gain = 1, offset = 0, lsum = 0, lsum2 = 0, rs = 0, rs2 = 0, lr = 0;
   for (int v = -hh; v <= hh; ++v)
-    for (int u = -hw; u <= hw; ++u) lsum += left.at<uint8_t>(y + v, x + u), lsum2 += std::pow(left.at<uint8_t>(y + v, x + u), 2);
+    for (int u = -hw; u <= hw; ++u)
+      lsum += left.at<uint8_t>(y + v, x + u), lsum2 += std::pow(left.at<uint8_t>(y + v, x + u), 2);
   for (int it = 0; it < o.max_iterations; ++it) {
     Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
     Eigen::Vector3d jte = Eigen::Vector3d::Zero();
@@ -187,8 +188,7 @@ TEST(SubpixelWindow, FastSumsEqualPortableSums) {
       max_step = std::max(max_step, std::abs(step[0] - step[1]));
       max_dz = std::max(max_dz, std::abs(fast.Zncc(p.start) - plain.Zncc(p.start)));
     }
-    std::printf("%d rows: fast - portable: step max %.2e px, zncc max %.2e\n", 2 * half_height + 1, max_step,
-                max_dz);
+    std::printf("%d rows: fast - portable: step max %.2e px, zncc max %.2e\n", 2 * half_height + 1, max_step, max_dz);
     // Float summation order, and position rounding: the two paths round a
     // sample's position differently by ~1e-5 px, which picks the
     // neighbouring table entry for a sample within that of an entries'
@@ -215,8 +215,7 @@ TEST(SubpixelWindow, RefineDisparityRecoversNoiseFreeTruth) {
     ref_sum2 += std::pow(ref.disparity_px - p.truth, 2);
   }
   const double mean = sum / n, rms = std::sqrt(sum2 / n), ref_rms = std::sqrt(ref_sum2 / n);
-  std::printf("noise-free: %d fits, error mean %+.5f px, rms %.5f px (plain double fit %.5f)\n", n, mean, rms,
-              ref_rms);
+  std::printf("noise-free: %d fits, error mean %+.5f px, rms %.5f px (plain double fit %.5f)\n", n, mean, rms, ref_rms);
   EXPECT_GT(n, 1900);
   // The 0.29 DN rounding noise of both images is ~1/7 of the 2 DN for which
   // the fit's CRLB is ~0.015 px (dense_refine_test.cc): ~0.002 px; the rest
@@ -288,8 +287,10 @@ TEST(SubpixelWindow, RowOffsetFitEqualsPlainDoubleEvaluationAndReadsTheVernier) 
       max_ddy = std::max(max_ddy, std::abs(fast.row_offset_px - ref.row_offset_px));
       sum_dy += fast.row_offset_px, sum_e += fast.disparity_px - p.truth - period_off * spec.grid_period_px, ++n;
     }
-    std::printf("%g periods off: %d fits, fast - plain: d max %.5f px, dy max %.5f px; mean dy %+.4f px, d - shifted truth %+.4f px\n",
-                period_off, n, max_dd, max_ddy, sum_dy / n, sum_e / n);
+    std::printf(
+        "%g periods off: %d fits, fast - plain: d max %.5f px, dy max %.5f px; mean dy %+.4f px, d - shifted truth "
+        "%+.4f px\n",
+        period_off, n, max_dd, max_ddy, sum_dy / n, sum_e / n);
     EXPECT_GT(n, 200);
     // The table's 0.002 px (above); float samples add < 1e-4 px.
     EXPECT_LT(max_dd, 0.002);
