@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "reconstruct/subpixel_window.h"
+
 namespace stereorig {
 
 const char* PixelStatusName(PixelStatus status) {
@@ -66,9 +68,11 @@ PixelStatus Accept(const cv::Mat& left, const cv::Mat& right, int x, int y, doub
   if (fit != PixelStatus::kPoint) return fit;
   if (a.min_distinctness > 0) {
     const double half = DistinctnessShiftPx(slope_x, a);
-    const double off = std::max(WindowZncc(left, right, x, y, r.disparity_px - half, slope_x, slope_y, a.subpixel),
-                                WindowZncc(left, right, x, y, r.disparity_px + half, slope_x, slope_y, a.subpixel));
-    if (r.zncc - off < a.min_distinctness) return PixelStatus::kNotDistinct;
+    // One window for both shifts; the second is not needed once the first
+    // fails (the test is on the larger of the two).
+    const WindowZnccProbe probe(left, right, x, y, slope_x, slope_y, a.subpixel);
+    for (const double shift : {-half, half})
+      if (r.zncc - probe.At(r.disparity_px + shift) < a.min_distinctness) return PixelStatus::kNotDistinct;
   }
   return PixelStatus::kPoint;
 }

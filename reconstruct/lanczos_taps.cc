@@ -39,8 +39,8 @@ const LanczosTable& LanczosTapTable() {
         sg += g[k];
       }
       for (int k = 0; k < 6; ++k) {
-        t[i].w[k] = float(w[k] / sw);
-        t[i].g[k] = float((g[k] * sw - w[k] * sg) / (sw * sw));
+        t[i].w[kLanczosLane0 + k] = float(w[k] / sw);
+        t[i].g[kLanczosLane0 + k] = float((g[k] * sw - w[k] * sg) / (sw * sw));
       }
     }
     return t;

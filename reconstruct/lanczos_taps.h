@@ -15,9 +15,14 @@ namespace stereorig {
 // tabulated at 1/kLanczosSteps px. The nearest entry is used: the position
 // error is at most 1/(2 kLanczosSteps) = 0.002 px, uniformly spread, far
 // below the noise.
+//
+// Each entry holds the 6 weights in lanes 2..7 of 8 (lanes 0, 1 are 0), so
+// that 8 bytes loaded from column i0-4 line up with them: one 8-wide
+// multiply per sample in the AVX2 fit (subpixel_window.h).
 constexpr int kLanczosSteps = 256;
-struct LanczosTaps {
-  float w[6], g[6];
+constexpr int kLanczosLane0 = 2;  // the lane of tap i0-2
+struct alignas(32) LanczosTaps {
+  float w[8], g[8];
 };
 using LanczosTable = std::array<LanczosTaps, kLanczosSteps + 1>;
 const LanczosTable& LanczosTapTable();
@@ -33,8 +38,8 @@ inline void SampleLanczos(const uint8_t* row, float xr, const LanczosTable& tabl
   const uint8_t* p = row + i0 - 2;
   float v = 0, s = 0;
   for (int k = 0; k < 6; ++k) {
-    v += t.w[k] * p[k];
-    s += t.g[k] * p[k];
+    v += t.w[kLanczosLane0 + k] * p[k];
+    s += t.g[kLanczosLane0 + k] * p[k];
   }
   *value = v;
   *slope = s;

@@ -1,11 +1,11 @@
 #include "reconstruct/subpixel_refine.h"
 
-#include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
 #include "calib/core/input_error.h"
-#include "reconstruct/lanczos_taps.h"
+#include "reconstruct/subpixel_window.h"
 
 namespace stereorig {
 
@@ -20,21 +20,16 @@ void SubpixelOptions::Check() const {
 
 namespace {
 
-// Cubic convolution (Keys, a = -0.5) weights of rows i0-1 .. i0+2 for a
-// sample at i0 + t, t in [0, 1), and their derivatives along t.
-void CubicRows(double t, double w[4], double dw[4]) {
-  for (int k = 0; k < 4; ++k) {
-    const double s = t - (k - 1), a = std::abs(s), sign = s < 0 ? -1.0 : 1.0;
-    if (a <= 1) {
-      w[k] = (1.5 * a - 2.5) * a * a + 1;
-      dw[k] = sign * (4.5 * a - 5.0) * a;
-    } else if (a < 2) {
-      w[k] = ((-0.5 * a + 2.5) * a - 4) * a + 2;
-      dw[k] = sign * ((-1.5 * a + 5.0) * a - 4);
-    } else {
-      w[k] = dw[k] = 0;
-    }
-  }
+// x = A^-1 b for the symmetric 3x3 A = [a00 a01 a02; a01 a11 a12; a02 a12
+// a22], by cofactors (as Eigen's 3x3 inverse): not finite if A is singular.
+void SolveSymmetric3(double a00, double a01, double a02, double a11, double a12, double a22, const double b[3],
+                     double x[3]) {
+  const double c00 = a11 * a22 - a12 * a12, c01 = a02 * a12 - a01 * a22, c02 = a01 * a12 - a02 * a11;
+  const double c11 = a00 * a22 - a02 * a02, c12 = a01 * a02 - a00 * a12, c22 = a00 * a11 - a01 * a01;
+  const double inv_det = 1.0 / (a00 * c00 + a01 * c01 + a02 * c02);
+  x[0] = (c00 * b[0] + c01 * b[1] + c02 * b[2]) * inv_det;
+  x[1] = (c01 * b[0] + c11 * b[1] + c12 * b[2]) * inv_det;
+  x[2] = (c02 * b[0] + c12 * b[1] + c22 * b[2]) * inv_det;
 }
 
 }  // namespace
@@ -44,53 +39,33 @@ SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x,
   SubpixelResult result;
   const int hw = o.half_width_px, hh = o.half_height_px;
   if (y - hh < 0 || y + hh >= left.rows || x - hw < 0 || x + hw >= left.cols) return result;
-  const int nwin = (2 * hw + 1) * (2 * hh + 1);
-  double lsum = 0, lsum2 = 0;
-  for (int v = -hh; v <= hh; ++v) {
-    const uint8_t* lrow = left.ptr<uint8_t>(y + v);
-    for (int u = -hw; u <= hw; ++u) {
-      lsum += lrow[x + u];
-      lsum2 += double(lrow[x + u]) * lrow[x + u];
-    }
-  }
-  const double lmean = lsum / nwin;
-  result.std_dn = std::sqrt(std::max(0.0, lsum2 / nwin - lmean * lmean));
-  if (result.std_dn <= 0) return result;
   // The sampled right columns must stay inside the image (6 taps).
   const double reach = hw + std::abs(slope_x) * hw + std::abs(slope_y) * hh + o.max_shift_px + 4;
   if (x - start_px - reach < 0 || x - start_px + reach >= right.cols) return result;
-  const LanczosTable& table = LanczosTapTable();
+  // The AVX2 sums read 2 columns more to the left (subpixel_window.h); a
+  // column of margin more keeps float rounding of the positions inside.
+  const bool margin = x - start_px - reach >= 1;
+  const SubpixelWindow window(left, right, x, y, slope_x, slope_y, o,
+                              margin ? WindowKernel::kFastest : WindowKernel::kPortable);
+  const int nwin = window.size();
+  const double lmean = double(window.left_sum()) / nwin;
+  result.std_dn = std::sqrt(std::max(0.0, double(window.left_sum2()) / nwin - lmean * lmean));
+  if (result.std_dn <= 0) return result;
 
   // Gauss-Newton on (d, gain, offset); residual e = l - gain*r - offset with
-  // r sampled at x+u - d - gx*u - gy*v, so de/dd = gain * r'.
+  // r sampled at x+u - d - gx*u - gy*v, so de/dd = gain * r' and the
+  // Jacobian row is J = (gain r', -r, -1).
   double d = start_px, gain = 1.0, offset = 0.0;
-  double rs = 0, rs2 = 0, lr = 0;  // sums of the last pass, for the ZNCC
+  FitPassSums s;  // of the last pass, for the ZNCC
   for (int it = 0; it < o.max_iterations; ++it) {
-    float sjj = 0, sjr = 0, sj = 0, srr = 0, sr = 0, sje = 0, sre = 0, se = 0, slr = 0;
-    const float fgain = float(gain), foffset = float(offset);
-    for (int v = -hh; v <= hh; ++v) {
-      const uint8_t* lrow = left.ptr<uint8_t>(y + v) + x;
-      const uint8_t* rrow = right.ptr<uint8_t>(y + v);
-      const float row_start = float(x - d - slope_y * v), stride = float(1.0 - slope_x);
-      for (int u = -hw; u <= hw; ++u) {
-        float r, rg;
-        SampleLanczos(rrow, row_start + float(u) * stride, table, &r, &rg);
-        const float l = lrow[u];
-        const float j = fgain * rg;
-        const float e = l - fgain * r - foffset;
-        sjj += j * j, sjr += j * r, sj += j;
-        srr += r * r, sr += r;
-        sje += j * e, sre += r * e, se += e;
-        slr += l * r;
-      }
-    }
-    rs = sr, rs2 = srr, lr = slr;
-    Eigen::Matrix3d jtj;
-    jtj << sjj, -sjr, -sj,  //
-        -sjr, srr, sr,      //
-        -sj, sr, double(nwin);
-    const Eigen::Vector3d step = jtj.inverse() * (-Eigen::Vector3d(sje, -sre, -se));
-    if (!step.allFinite()) return result;
+    s = window.FitPass(d, float(gain), float(offset));
+    // The normal matrix J^T J and J^T e.
+    const double jtj_dd = gain * gain * s.gg, jtj_dgain = -gain * s.gr, jtj_doffset = -gain * s.g;
+    const double jtj_gain2 = s.rr, jtj_gain_offset = s.r, jtj_offset2 = nwin;
+    const double minus_jte[3] = {-gain * s.ge, s.re, s.e};
+    double step[3];
+    SolveSymmetric3(jtj_dd, jtj_dgain, jtj_doffset, jtj_gain2, jtj_gain_offset, jtj_offset2, minus_jte, step);
+    if (!(std::isfinite(step[0]) && std::isfinite(step[1]) && std::isfinite(step[2]))) return result;
     d += step[0];
     gain += step[1];
     offset += step[2];
@@ -100,9 +75,9 @@ SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x,
     if (std::abs(step[0]) < o.converged_step_px) break;
   }
   if (!(gain > 0)) return result;
-  const double rmean = rs / nwin;
-  const double rvar = rs2 / nwin - rmean * rmean;
-  const double cov = lr / nwin - lmean * rmean;
+  const double rmean = s.r / nwin;
+  const double rvar = s.rr / nwin - rmean * rmean;
+  const double cov = s.lr / nwin - lmean * rmean;
   result.zncc = rvar > 0 ? cov / (std::sqrt(rvar) * result.std_dn) : 0.0;
   result.disparity_px = d;
   result.ok = true;
@@ -111,91 +86,9 @@ SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x,
 
 double WindowZncc(const cv::Mat& left, const cv::Mat& right, int x, int y, double d, double slope_x, double slope_y,
                   const SubpixelOptions& o) {
-  const int hw = o.half_width_px, hh = o.half_height_px;
-  if (y - hh < 0 || y + hh >= left.rows || x - hw < 0 || x + hw >= left.cols) return -1;
-  const double reach = hw + std::abs(slope_x) * hw + std::abs(slope_y) * hh + 4;
-  if (x - d - reach < 0 || x - d + reach >= right.cols) return -1;
   // Linear interpolation: this is a coarse test (is the match distinct?),
   // at a third of the Lanczos cost.
-  float ls = 0, ls2 = 0, rs = 0, rs2 = 0, lr = 0;
-  for (int v = -hh; v <= hh; ++v) {
-    const uint8_t* lrow = left.ptr<uint8_t>(y + v) + x;
-    const uint8_t* rrow = right.ptr<uint8_t>(y + v);
-    const float row_start = float(x - d - slope_y * v), stride = float(1.0 - slope_x);
-    for (int u = -hw; u <= hw; ++u) {
-      const float xr = row_start + float(u) * stride;
-      const int i0 = int(xr);
-      const float t = xr - float(i0);
-      const float r = (1 - t) * rrow[i0] + t * rrow[i0 + 1];
-      const float l = lrow[u];
-      ls += l, ls2 += l * l, rs += r, rs2 += r * r, lr += l * r;
-    }
-  }
-  const int n = (2 * hw + 1) * (2 * hh + 1);
-  const double lv = double(ls2) / n - double(ls / n) * (ls / n), rv = double(rs2) / n - double(rs / n) * (rs / n);
-  if (!(lv > 0 && rv > 0)) return -1;
-  return (lr / n - (ls / n) * (rs / n)) / std::sqrt(lv * rv);
-}
-
-RowOffsetResult RefineDisparityAndRowOffset(const cv::Mat& left, const cv::Mat& right, int x, int y, double start_px,
-                                            double slope_x, double slope_y, const SubpixelOptions& o) {
-  RowOffsetResult result;
-  const int hw = o.half_width_px, hh = o.half_height_px;
-  // Rows y-hh-1+floor(dy) .. y+hh+2+floor(dy), |dy| <= 1.
-  if (y - hh - 2 < 0 || y + hh + 3 >= left.rows || x - hw < 0 || x + hw >= left.cols) return result;
-  const double reach = hw + std::abs(slope_x) * hw + std::abs(slope_y) * hh + o.max_shift_px + 4;
-  if (x - start_px - reach < 0 || x - start_px + reach >= right.cols) return result;
-  const int nwin = (2 * hw + 1) * (2 * hh + 1);
-  double lsum = 0, lsum2 = 0;
-  for (int v = -hh; v <= hh; ++v)
-    for (int u = -hw; u <= hw; ++u) {
-      const double l = left.at<uint8_t>(y + v, x + u);
-      lsum += l, lsum2 += l * l;
-    }
-  const double lmean = lsum / nwin, lstd = std::sqrt(std::max(0.0, lsum2 / nwin - lmean * lmean));
-  if (!(lstd > 0)) return result;
-  const LanczosTable& table = LanczosTapTable();
-  double d = start_px, dy = 0, gain = 1, offset = 0;
-  double rs = 0, rs2 = 0, lr = 0;
-  for (int it = 0; it < o.max_iterations + 2; ++it) {
-    const int i0 = int(std::floor(dy));
-    double w[4], dw[4];
-    CubicRows(dy - i0, w, dw);
-    Eigen::Matrix4d jtj = Eigen::Matrix4d::Zero();
-    Eigen::Vector4d jte = Eigen::Vector4d::Zero();
-    rs = rs2 = lr = 0;
-    for (int v = -hh; v <= hh; ++v) {
-      const uint8_t* lrow = left.ptr<uint8_t>(y + v) + x;
-      const float row_start = float(x - d - slope_y * v), stride = float(1.0 - slope_x);
-      for (int u = -hw; u <= hw; ++u) {
-        double r = 0, rx = 0, ry = 0;
-        for (int k = 0; k < 4; ++k) {
-          float value, slope;
-          SampleLanczos(right.ptr<uint8_t>(y + v + i0 - 1 + k), row_start + float(u) * stride, table, &value, &slope);
-          r += w[k] * value, rx += w[k] * slope, ry += dw[k] * value;
-        }
-        const double l = lrow[u];
-        const double e = l - gain * r - offset;
-        // de/d(d, dy, gain, offset)
-        const Eigen::Vector4d j(gain * rx, -gain * ry, -r, -1.0);
-        jtj += j * j.transpose();
-        jte += j * e;
-        rs += r, rs2 += r * r, lr += l * r;
-      }
-    }
-    const Eigen::Vector4d step = -jtj.ldlt().solve(jte);
-    if (!step.allFinite()) return result;
-    d += step[0], dy += step[1], gain += step[2], offset += step[3];
-    if (std::abs(d - start_px) > o.max_shift_px || std::abs(dy) > 1.0) return result;
-    if (std::abs(step[0]) < 0.01 && std::abs(step[1]) < 0.01) break;
-  }
-  if (!(gain > 0)) return result;
-  const double rmean = rs / nwin, rvar = rs2 / nwin - rmean * rmean;
-  result.zncc = rvar > 0 ? (lr / nwin - lmean * rmean) / (std::sqrt(rvar) * lstd) : 0.0;
-  result.disparity_px = d;
-  result.row_offset_px = dy;
-  result.ok = true;
-  return result;
+  return WindowZnccProbe(left, right, x, y, slope_x, slope_y, o).At(d);
 }
 
 }  // namespace stereorig

@@ -1,0 +1,307 @@
+#include "reconstruct/subpixel_window.h"
+
+#include <cmath>
+
+#include "reconstruct/lanczos_taps.h"
+
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
+namespace stereorig {
+
+SubpixelWindow::SubpixelWindow(const cv::Mat& left, const cv::Mat& right, int x, int y, double slope_x, double slope_y,
+                               const SubpixelOptions& o, WindowKernel kernel)
+    : left_(left),
+      right_(right),
+      x_(x),
+      y_(y),
+      hw_(o.half_width_px),
+      hh_(o.half_height_px),
+      n_((2 * hw_ + 1) * (2 * hh_ + 1)),
+      stride_(float(1.0 - slope_x)),
+      slope_y_(slope_y) {
+#if defined(__AVX2__)
+  vector_ = kernel == WindowKernel::kFastest && n_ <= kMaxVectorSamples;
+  if (vector_) {
+    SetUpLanes();
+    return;
+  }
+#else
+  (void)kernel;
+  vector_ = false;
+#endif
+  for (int v = -hh_; v <= hh_; ++v) {
+    const uint8_t* lrow = left.ptr<uint8_t>(y + v) + x;
+    for (int u = -hw_; u <= hw_; ++u) lsum_ += lrow[u], lsum2_ += lrow[u] * lrow[u];
+  }
+}
+
+FitPassSums SubpixelWindow::FitPass(double d, float gain, float offset) const {
+#if defined(__AVX2__)
+  if (vector_) return FitPassAvx2(d, gain, offset);
+#endif
+  return FitPassPortable(d, gain, offset);
+}
+
+void SubpixelWindow::Sample(double d, int row_shift, float* r, float* g) const {
+#if defined(__AVX2__)
+  if (vector_) return SampleAvx2(d, row_shift, r, g);
+#endif
+  SamplePortable(d, row_shift, r, g);
+}
+
+double SubpixelWindow::Zncc(double d) const {
+#if defined(__AVX2__)
+  if (vector_) return ZnccAvx2(d);
+#endif
+  return ZnccPortable(d);
+}
+
+FitPassSums SubpixelWindow::FitPassPortable(double d, float gain, float offset) const {
+  const LanczosTable& table = LanczosTapTable();
+  float sgg = 0, sgr = 0, sg = 0, srr = 0, sr = 0, sge = 0, sre = 0, se = 0, slr = 0;
+  for (int v = -hh_; v <= hh_; ++v) {
+    const uint8_t* lrow = left_.ptr<uint8_t>(y_ + v) + x_;
+    const uint8_t* rrow = right_.ptr<uint8_t>(y_ + v);
+    const float row_start = float(x_ - d - slope_y_ * v);
+    for (int u = -hw_; u <= hw_; ++u) {
+      float r, g;
+      SampleLanczos(rrow, row_start + float(u) * stride_, table, &r, &g);
+      const float l = lrow[u];
+      const float e = l - gain * r - offset;
+      sgg += g * g, sgr += g * r, sg += g;
+      srr += r * r, sr += r;
+      sge += g * e, sre += r * e, se += e;
+      slr += l * r;
+    }
+  }
+  return FitPassSums{sgg, sgr, sg, srr, sr, sge, sre, se, slr};
+}
+
+void SubpixelWindow::SamplePortable(double d, int row_shift, float* r, float* g) const {
+  const LanczosTable& table = LanczosTapTable();
+  int s = 0;
+  for (int v = -hh_; v <= hh_; ++v) {
+    const uint8_t* rrow = right_.ptr<uint8_t>(y_ + v + row_shift);
+    const float row_start = float(x_ - d - slope_y_ * v);
+    for (int u = -hw_; u <= hw_; ++u, ++s) SampleLanczos(rrow, row_start + float(u) * stride_, table, &r[s], &g[s]);
+  }
+  for (; s < padded_size(); ++s) r[s] = g[s] = 0;
+}
+
+double SubpixelWindow::ZnccPortable(double d) const {
+  float rs = 0, rs2 = 0, lr = 0;
+  for (int v = -hh_; v <= hh_; ++v) {
+    const uint8_t* lrow = left_.ptr<uint8_t>(y_ + v) + x_;
+    const uint8_t* rrow = right_.ptr<uint8_t>(y_ + v);
+    const float row_start = float(x_ - d - slope_y_ * v);
+    for (int u = -hw_; u <= hw_; ++u) {
+      const float xr = row_start + float(u) * stride_;
+      const int i0 = int(xr);
+      const float t = xr - float(i0);
+      const float r = (1 - t) * rrow[i0] + t * rrow[i0 + 1];
+      rs += r, rs2 += r * r, lr += lrow[u] * r;
+    }
+  }
+  const double n = n_, ls = double(lsum_) / n;
+  const double lv = double(lsum2_) / n - ls * ls, rv = double(rs2) / n - double(rs / n) * (rs / n);
+  if (!(lv > 0 && rv > 0)) return -1;
+  return (lr / n - ls * (rs / n)) / std::sqrt(lv * rv);
+}
+
+WindowZnccProbe::WindowZnccProbe(const cv::Mat& left, const cv::Mat& right, int x, int y, double slope_x,
+                                 double slope_y, const SubpixelOptions& o)
+    : x_(x),
+      right_cols_(right.cols),
+      reach_px_(o.half_width_px * (1 + std::abs(slope_x)) + std::abs(slope_y) * o.half_height_px + 4) {
+  const int hw = o.half_width_px, hh = o.half_height_px;
+  if (y - hh < 0 || y + hh >= left.rows || x - hw < 0 || x + hw >= left.cols) return;
+  window_.emplace(left, right, x, y, slope_x, slope_y, o);
+}
+
+double WindowZnccProbe::At(double d) const {
+  if (!window_ || x_ - d - reach_px_ < 0 || x_ - d + reach_px_ >= right_cols_) return -1;
+  return window_->Zncc(d);
+}
+
+#if defined(__AVX2__)
+namespace {
+
+// The window's shape flattened into lanes: each sample's u, v and byte
+// offsets from the centre pixel in the left and right images. The same
+// for every window of a run (options and image steps are fixed), so each
+// thread keeps the last one.
+struct WindowLanes {
+  int hw = -1, hh = -1;
+  size_t left_step = 0, right_step = 0;
+  alignas(32) float u[SubpixelWindow::kMaxVectorSamples], v[SubpixelWindow::kMaxVectorSamples];
+  alignas(32) int32_t left_offset[SubpixelWindow::kMaxVectorSamples], right_row[SubpixelWindow::kMaxVectorSamples];
+};
+
+const WindowLanes& LanesFor(int hw, int hh, size_t left_step, size_t right_step) {
+  thread_local WindowLanes lanes;
+  if (lanes.hw == hw && lanes.hh == hh && lanes.left_step == left_step && lanes.right_step == right_step) return lanes;
+  lanes.hw = hw, lanes.hh = hh, lanes.left_step = left_step, lanes.right_step = right_step;
+  int s = 0;
+  for (int v = -hh; v <= hh; ++v)
+    for (int u = -hw; u <= hw; ++u, ++s) {
+      lanes.u[s] = float(u), lanes.v[s] = float(v);
+      lanes.left_offset[s] = int32_t(v * int64_t(left_step) + u);
+      lanes.right_row[s] = int32_t(v * int64_t(right_step));
+    }
+  for (; s % 8 != 0; ++s) {  // padding: copies of the centre sample
+    lanes.u[s] = lanes.v[s] = 0;
+    lanes.left_offset[s] = lanes.right_row[s] = 0;
+  }
+  return lanes;
+}
+
+// Lane k of the result: the sum of the 8 lanes of a[k].
+inline __m256 TransposeSum8(const __m256 a[8]) {
+  const __m256 q0 = _mm256_hadd_ps(_mm256_hadd_ps(a[0], a[1]), _mm256_hadd_ps(a[2], a[3]));
+  const __m256 q1 = _mm256_hadd_ps(_mm256_hadd_ps(a[4], a[5]), _mm256_hadd_ps(a[6], a[7]));
+  return _mm256_add_ps(_mm256_permute2f128_ps(q0, q1, 0x20), _mm256_permute2f128_ps(q0, q1, 0x31));
+}
+
+// The sum of the 8 lanes, in double.
+inline double HorizontalSum(__m256 a) {
+  const __m128 s4 = _mm_add_ps(_mm256_castps256_ps128(a), _mm256_extractf128_ps(a, 1));
+  const __m128 s2 = _mm_add_ps(s4, _mm_movehl_ps(s4, s4));
+  return _mm_cvtss_f32(_mm_add_ss(s2, _mm_movehdup_ps(s2)));
+}
+
+// All ones in the first `valid` lanes (0..8), zero after.
+inline __m256 LeadingMask(int valid) {
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  return _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(valid), lane));
+}
+
+}  // namespace
+
+void SubpixelWindow::SetUpLanes() {
+  const WindowLanes& lanes = LanesFor(hw_, hh_, left_.step[0], right_.step[0]);
+  const uint8_t* centre = left_.ptr<uint8_t>(y_) + x_;
+  // A 4-byte gather reads up to 3 bytes past a sample: not past the last
+  // row's end.
+  const bool gather = y_ + hh_ < left_.rows - 1 || x_ + hw_ + 3 < left_.cols;
+  const __m256 stride = _mm256_set1_ps(stride_), minus_gy = _mm256_set1_ps(float(-slope_y_));
+  const __m256i right_centre = _mm256_set1_epi32(int32_t(y_ * right_.step[0])), low_byte = _mm256_set1_epi32(0xFF);
+  __m256 ls = _mm256_setzero_ps(), ls2 = ls;
+  for (int c = 0; c < n_; c += 8) {
+    const __m256i left_offset = _mm256_load_si256(reinterpret_cast<const __m256i*>(lanes.left_offset + c));
+    __m256 l;
+    if (gather) {
+      l = _mm256_cvtepi32_ps(
+          _mm256_and_si256(_mm256_i32gather_epi32(reinterpret_cast<const int*>(centre), left_offset, 1), low_byte));
+    } else {
+      alignas(32) float values[8];
+      for (int k = 0; k < 8; ++k) values[k] = centre[lanes.left_offset[c + k]];
+      l = _mm256_load_ps(values);
+    }
+    if (c + 8 > n_) l = _mm256_and_ps(l, LeadingMask(n_ - c));
+    _mm256_store_ps(l_ + c, l);
+    ls = _mm256_add_ps(ls, l), ls2 = _mm256_fmadd_ps(l, l, ls2);
+    // u (1 - gx) - gy v: to float precision (~1e-6 px), as the positions.
+    _mm256_store_ps(offset_ + c, _mm256_fmadd_ps(_mm256_load_ps(lanes.u + c), stride,
+                                                 _mm256_mul_ps(_mm256_load_ps(lanes.v + c), minus_gy)));
+    _mm256_store_si256(
+        reinterpret_cast<__m256i*>(row_ + c),
+        _mm256_add_epi32(right_centre, _mm256_load_si256(reinterpret_cast<const __m256i*>(lanes.right_row + c))));
+  }
+  // Integers below 2^24 (64 samples of at most 255^2): exact in float.
+  lsum_ = int64_t(HorizontalSum(ls)), lsum2_ = int64_t(HorizontalSum(ls2));
+}
+
+namespace {
+
+// The Lanczos values r and slopes g of 8 samples at right columns
+// base + offset[k] of the rows at byte offsets row[k] + row_shift from
+// `right`.
+inline void SampleChunk(const uint8_t* right, __m256 base, const float* offset, const int32_t* row, int32_t row_shift,
+                        __m256* r, __m256* g) {
+  const LanczosTable& table = LanczosTapTable();
+  const __m256 xr = _mm256_add_ps(base, _mm256_load_ps(offset));
+  const __m256i i0 = _mm256_cvttps_epi32(xr);
+  const __m256 frac = _mm256_sub_ps(xr, _mm256_cvtepi32_ps(i0));
+  alignas(32) int32_t col[8], entry[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(col),
+                     _mm256_add_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(row)),
+                                      _mm256_add_epi32(i0, _mm256_set1_epi32(row_shift))));
+  _mm256_store_si256(
+      reinterpret_cast<__m256i*>(entry),
+      _mm256_cvttps_epi32(_mm256_fmadd_ps(frac, _mm256_set1_ps(float(kLanczosSteps)), _mm256_set1_ps(0.5f))));
+  __m256 wp[8], gp[8];
+  for (int k = 0; k < 8; ++k) {
+    // Bytes i0-4 .. i0+3; the taps sit in lanes 2..7 (lanczos_taps.h).
+    const __m256 p =
+        _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(right + col[k] - 4))));
+    const LanczosTaps& t = table[entry[k]];
+    wp[k] = _mm256_mul_ps(_mm256_load_ps(t.w), p);
+    gp[k] = _mm256_mul_ps(_mm256_load_ps(t.g), p);
+  }
+  *r = TransposeSum8(wp), *g = TransposeSum8(gp);
+}
+
+}  // namespace
+
+FitPassSums SubpixelWindow::FitPassAvx2(double d, float gain, float offset) const {
+  const __m256 base = _mm256_set1_ps(float(x_ - d));
+  const __m256 vgain = _mm256_set1_ps(gain), voffset = _mm256_set1_ps(offset);
+  __m256 sgg = _mm256_setzero_ps(), sgr = sgg, sg = sgg, srr = sgg, sr = sgg, sge = sgg, sre = sgg, se = sgg, slr = sgg;
+  for (int c = 0; c < n_; c += 8) {
+    __m256 r, g;
+    SampleChunk(right_.data, base, offset_ + c, row_ + c, 0, &r, &g);
+    const __m256 l = _mm256_load_ps(l_ + c);
+    __m256 e = _mm256_sub_ps(_mm256_fnmadd_ps(vgain, r, l), voffset);
+    if (c + 8 > n_) {  // padding lanes: no samples
+      const __m256 mask = LeadingMask(n_ - c);
+      r = _mm256_and_ps(r, mask), g = _mm256_and_ps(g, mask), e = _mm256_and_ps(e, mask);
+    }
+    sgg = _mm256_fmadd_ps(g, g, sgg), sgr = _mm256_fmadd_ps(g, r, sgr), sg = _mm256_add_ps(sg, g);
+    srr = _mm256_fmadd_ps(r, r, srr), sr = _mm256_add_ps(sr, r);
+    sge = _mm256_fmadd_ps(g, e, sge), sre = _mm256_fmadd_ps(r, e, sre), se = _mm256_add_ps(se, e);
+    slr = _mm256_fmadd_ps(l, r, slr);
+  }
+  const __m256 lanes[8] = {sgg, sgr, sg, srr, sr, sge, sre, se};
+  alignas(32) float sums[8];
+  _mm256_store_ps(sums, TransposeSum8(lanes));
+  return FitPassSums{sums[0], sums[1], sums[2], sums[3], sums[4], sums[5], sums[6], sums[7], HorizontalSum(slr)};
+}
+
+void SubpixelWindow::SampleAvx2(double d, int row_shift, float* r, float* g) const {
+  const __m256 base = _mm256_set1_ps(float(x_ - d));
+  const int32_t shift = int32_t(row_shift * int64_t(right_.step[0]));
+  for (int c = 0; c < n_; c += 8) {
+    __m256 rc, gc;
+    SampleChunk(right_.data, base, offset_ + c, row_ + c, shift, &rc, &gc);
+    _mm256_storeu_ps(r + c, rc), _mm256_storeu_ps(g + c, gc);
+  }
+}
+
+double SubpixelWindow::ZnccAvx2(double d) const {
+  const __m256 base = _mm256_set1_ps(float(x_ - d));
+  const __m256i low_byte = _mm256_set1_epi32(0xFF);
+  __m256 rs = _mm256_setzero_ps(), rs2 = rs, lr = rs;
+  for (int c = 0; c < n_; c += 8) {
+    const __m256 xr = _mm256_add_ps(base, _mm256_load_ps(offset_ + c));
+    const __m256i i0 = _mm256_cvttps_epi32(xr);
+    const __m256 t = _mm256_sub_ps(xr, _mm256_cvtepi32_ps(i0));
+    // Bytes i0 .. i0+3 of each sample's row: i0 and i0+1 are the two taps.
+    const __m256i col = _mm256_add_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(row_ + c)), i0);
+    const __m256i q = _mm256_i32gather_epi32(reinterpret_cast<const int*>(right_.data), col, 1);
+    const __m256 p0 = _mm256_cvtepi32_ps(_mm256_and_si256(q, low_byte));
+    const __m256 p1 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(q, 8), low_byte));
+    __m256 r = _mm256_fmadd_ps(t, _mm256_sub_ps(p1, p0), p0);
+    if (c + 8 > n_) r = _mm256_and_ps(r, LeadingMask(n_ - c));
+    rs = _mm256_add_ps(rs, r), rs2 = _mm256_fmadd_ps(r, r, rs2);
+    lr = _mm256_fmadd_ps(_mm256_load_ps(l_ + c), r, lr);
+  }
+  const double n = n_, ls = double(lsum_) / n, mean_r = HorizontalSum(rs) / n;
+  const double lv = double(lsum2_) / n - ls * ls, rv = HorizontalSum(rs2) / n - mean_r * mean_r;
+  if (!(lv > 0 && rv > 0)) return -1;
+  return (HorizontalSum(lr) / n - ls * mean_r) / std::sqrt(lv * rv);
+}
+#endif  // __AVX2__
+
+}  // namespace stereorig
