@@ -30,33 +30,43 @@ void LineIndexOptions::Check() const {
 
 cv::Mat LabelDisparityComponents(const cv::Mat& disparity_px, const cv::Rect& roi, double max_step_px,
                                  std::vector<std::vector<int>>* components) {
+  STEREORIG_CHECK(disparity_px.type() == CV_32FC1 && disparity_px.isContinuous());
   const int cols = disparity_px.cols;
+  const int x0 = roi.x, x1 = roi.x + roi.width, y0 = roi.y, y1 = roi.y + roi.height;
   cv::Mat labels(disparity_px.size(), CV_32SC1, cv::Scalar(-1));
+  // Flat views: a pixel is its index y * cols + x in both maps.
+  const float* d_at = disparity_px.ptr<float>(0);
+  int* label_at = labels.ptr<int>(0);
   components->clear();
+  // Depth first from each unlabelled valid pixel in raster order, its
+  // neighbours pushed left, right, up, down: the order of each component's
+  // pixels, which LineIndexer::Sample picks from.
   std::vector<int> stack;
-  for (int y = roi.y; y < roi.y + roi.height; ++y)
-    for (int x = roi.x; x < roi.x + roi.width; ++x) {
-      if (labels.at<int>(y, x) >= 0 || !std::isfinite(disparity_px.at<float>(y, x))) continue;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      const int seed = y * cols + x;
+      if (label_at[seed] >= 0 || !std::isfinite(d_at[seed])) continue;
       const int label = int(components->size());
-      components->emplace_back();
-      std::vector<int>& pixels = components->back();
-      labels.at<int>(y, x) = label;
-      stack.assign(1, y * cols + x);
+      std::vector<int>& pixels = components->emplace_back();
+      label_at[seed] = label;
+      stack.assign(1, seed);
       while (!stack.empty()) {
         const int i = stack.back();
         stack.pop_back();
         pixels.push_back(i);
-        const int py = i / cols, px = i % cols;
-        const float d = disparity_px.at<float>(py, px);
-        const int nx[4] = {px - 1, px + 1, px, px}, ny[4] = {py, py, py - 1, py + 1};
-        for (int k = 0; k < 4; ++k) {
-          if (!roi.contains(cv::Point(nx[k], ny[k]))) continue;
-          int& l = labels.at<int>(ny[k], nx[k]);
-          const float dn = disparity_px.at<float>(ny[k], nx[k]);
-          if (l >= 0 || !std::isfinite(dn) || std::abs(dn - d) > max_step_px) continue;
-          l = label;
-          stack.push_back(ny[k] * cols + nx[k]);
-        }
+        const int py = i / cols, px = i - py * cols;
+        const float d = d_at[i];
+        auto visit = [&](bool inside, int j) {
+          if (!inside || label_at[j] >= 0) return;
+          const float dn = d_at[j];
+          if (!std::isfinite(dn) || std::abs(dn - d) > max_step_px) return;
+          label_at[j] = label;
+          stack.push_back(j);
+        };
+        visit(px - 1 >= x0, i - 1);
+        visit(px + 1 < x1, i + 1);
+        visit(py - 1 >= y0, i - cols);
+        visit(py + 1 < y1, i + cols);
       }
     }
   return labels;
