@@ -141,6 +141,7 @@ class LineIndexer {
   // varies over a curved surface, so from starts 2 px either side (the
   // other alignments are a period away), keeping the best correlation.
   void Move(const std::vector<int>& pixels, double shift) {
+    changed_ = true;
     for (int i : pixels) {
       const int y = i / cols_, x = i % cols_;
       float& d = state_->disparity_px.at<float>(y, x);
@@ -169,6 +170,7 @@ class LineIndexer {
       const int y = i / cols_, x = i % cols_;
       float& d = state_->disparity_px.at<float>(y, x);
       if (!std::isfinite(d)) continue;
+      changed_ = true;
       d = std::numeric_limits<float>::infinity();
       state_->confidence.at<float>(y, x) = 0;
       state_->status.at<uint8_t>(y, x) = uint8_t(PixelStatus::kWrongLine);
@@ -176,6 +178,9 @@ class LineIndexer {
   }
 
   enum class Outcome { kKept, kMoved, kDropped };
+
+  // Whether Move or Drop has changed the map.
+  bool changed() const { return changed_; }
 
   // One component's vernier test.
   // offset_px: the row offset a correct match reads (0 on a well rectified pair).
@@ -241,15 +246,18 @@ class LineIndexer {
   DisparityState* state_;
   const int cols_;
   SubpixelOptions tall_;
+  bool changed_ = false;
 };
 
 }  // namespace
 
 int CorrectLineIndex(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const LineIndexOptions& o,
-                     const RefineAcceptance& accept, DisparityState* state) {
+                     const RefineAcceptance& accept, DisparityState* state, DisparityComponents* labelled) {
   if (!o.enabled) return 0;
-  std::vector<std::vector<int>> components;
-  LabelDisparityComponents(state->disparity_px, roi, 1.0, &components);
+  DisparityComponents own;
+  if (!labelled) labelled = &own;
+  labelled->labels = LabelDisparityComponents(state->disparity_px, roi, 1.0, &labelled->pixels);
+  const std::vector<std::vector<int>>& components = labelled->pixels;
   LineIndexer indexer(left, right, o, accept, state);
   int moved = 0;
   for (const std::vector<int>& pixels : components) {
@@ -260,14 +268,21 @@ int CorrectLineIndex(const cv::Mat& left, const cv::Mat& right, const cv::Rect& 
       ++moved;
     }
   }
+  labelled->matches_disparity = !indexer.changed();
   return moved;
 }
 
 int JoinAcrossPeriodJumps(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const LineIndexOptions& o,
-                          const RefineAcceptance& accept, DisparityState* state) {
+                          const RefineAcceptance& accept, DisparityState* state, DisparityComponents* labelled) {
   if (!o.enabled) return 0;
-  std::vector<std::vector<int>> components;
-  const cv::Mat labels = LabelDisparityComponents(state->disparity_px, roi, 1.0, &components);
+  DisparityComponents own;
+  if (!labelled) labelled = &own;
+  if (!labelled->matches_disparity)
+    labelled->labels = LabelDisparityComponents(state->disparity_px, roi, 1.0, &labelled->pixels);
+  // Moves below change the map.
+  labelled->matches_disparity = false;
+  const cv::Mat& labels = labelled->labels;
+  const std::vector<std::vector<int>>& components = labelled->pixels;
   // Disparity differences across every seam: from each pixel, the next
   // valid pixel along its row and along its column, if it is within
   // o.max_seam_gap_px and in another component, less the first one's

@@ -414,9 +414,15 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
     lap("grow");
     // Grown components are larger, so their vernier reads better; a
     // component moved now leaves a gap that growing closes.
-    if (o.grow.enabled && CorrectLineIndex(left, right, roi, o.line_index, accept, &state) +
-                                  JoinAcrossPeriodJumps(left, right, roi, o.line_index, accept, &state) >
-                              0) {
+    // In this order (an operator's operands would be unsequenced): the
+    // components are labelled once if the vernier test changes nothing.
+    DisparityComponents components;
+    int moved = 0;
+    if (o.grow.enabled) {
+      moved += CorrectLineIndex(left, right, roi, o.line_index, accept, &state, &components);
+      moved += JoinAcrossPeriodJumps(left, right, roi, o.line_index, accept, &state, &components);
+    }
+    if (moved > 0) {
       lap("line_index_2");
       GrowDisparity(left, right, roi, o.grow, accept, &state, &*grow_memory);
       lap("grow_2");

@@ -30,16 +30,20 @@ namespace {
 bool LocalPlane(const cv::Mat& disparity, const cv::Rect& roi, cv::Point q, int r, double* a, double* gx, double* gy) {
   const int v0 = std::max(-r, roi.y - q.y), v1 = std::min(r, roi.y + roi.height - 1 - q.y);
   const int u0 = std::max(-r, roi.x - q.x), u1 = std::min(r, roi.x + roi.width - 1 - q.x);
-  double s1 = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0, sd = 0, sxd = 0, syd = 0;
+  // The pixel moments are sums of small integers: exact as ints, and the
+  // same as summed in doubles.
+  int n = 0, nx = 0, ny = 0, nxx = 0, nyy = 0, nxy = 0;
+  double sd = 0, sxd = 0, syd = 0;
   for (int v = v0; v <= v1; ++v) {
     const float* row = disparity.ptr<float>(q.y + v) + q.x;
     for (int u = u0; u <= u1; ++u) {
       const float d = row[u];
       if (!std::isfinite(d)) continue;
-      s1 += 1, sx += u, sy += v, sxx += u * u, syy += v * v, sxy += u * v;
+      ++n, nx += u, ny += v, nxx += u * u, nyy += v * v, nxy += u * v;
       sd += d, sxd += u * d, syd += v * d;
     }
   }
+  const double s1 = n, sx = nx, sy = ny, sxx = nxx, syy = nyy, sxy = nxy;
   if (s1 < 6) return false;
   Eigen::Matrix3d m;
   m << s1, sx, sy, sx, sxx, sxy, sy, sxy, syy;
