@@ -89,13 +89,17 @@ class LineIndexer {
       : left_(left), right_(right), o_(o), accept_(accept), state_(state), cols_(left.cols) {
     tall_ = accept.subpixel;
     tall_.half_height_px = o.window_half_height_px;
+    STEREORIG_CHECK(state->disparity_px.type() == CV_32FC1 && state->disparity_px.isContinuous() &&
+                    state->disparity_px.cols == cols_);
   }
 
-  float D(int i) const { return state_->disparity_px.at<float>(i / cols_, i % cols_); }
+  // The disparity of pixel i = y * cols + x (the map is continuous).
+  float D(int i) const { return state_->disparity_px.ptr<float>(0)[i]; }
 
   // Up to o.samples valid pixels of `pixels`, spread evenly.
   std::vector<int> Sample(const std::vector<int>& pixels) const {
     std::vector<int> valid, sample;
+    valid.reserve(pixels.size());
     for (int i : pixels)
       if (std::isfinite(D(i))) valid.push_back(i);
     const double stride = std::max(1.0, double(valid.size()) / o_.samples);

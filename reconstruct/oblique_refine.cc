@@ -25,13 +25,13 @@ constexpr double kLevels[] = {0.25, 0.35, 0.5, 0.7, 1.43, 2.0, 2.8, 4.0};
 // Tiles of the lazily blurred views: a refinement reads ~3 rows and 30-100
 // columns; a tile this size keeps OpenCV's per-call set-up small against
 // the filtering itself.
-constexpr int kTileRows = 8, kTileCols = 128;
+constexpr int kTileRows = 8, kTileCols = 64;
 
 }  // namespace
 
 ObliqueViews::ObliqueViews(const cv::Mat& left, const cv::Mat& right, int row_begin, int row_end,
                            const ObliqueOptions& options)
-    : left_(left), right_(right), options_(options) {
+    : left_(left), right_(right), identity_(cv::Mat::ones(1, 1, CV_32F)), options_(options) {
   if (!options.enabled) return;
   row_begin_ = std::max(0, row_begin), row_end_ = std::min(left.rows, row_end);
   if (row_end_ <= row_begin_) return;
@@ -65,7 +65,6 @@ void ObliqueViews::EnsureBlurred(Level& level, int y0, int y1, int x0, int x1) c
     (level.blur_left ? level.right : level.left) = level.blur_left ? right_ : left_;
     level.tile_done.assign(size_t((row_end_ - row_begin_ + kTileRows - 1) / kTileRows * tiles_per_row), false);
   }
-  const cv::Mat ky = (cv::Mat_<float>(1, 1) << 1.f);
   for (int ty = (y0 - row_begin_) / kTileRows; ty <= (y1 - 1 - row_begin_) / kTileRows; ++ty)
     for (int tx = x0 / kTileCols; tx <= (x1 - 1) / kTileCols; ++tx) {
       const size_t tile = size_t(ty * tiles_per_row + tx);
@@ -77,7 +76,7 @@ void ObliqueViews::EnsureBlurred(Level& level, int y0, int y1, int x0, int x1) c
       // from it (the image's own border only at its ends), so the tile is
       // what blurring whole rows gives.
       cv::Mat out = blurred(rect);
-      cv::sepFilter2D(sharp(rect), out, CV_8U, level.kernel, ky, cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
+      cv::sepFilter2D(sharp(rect), out, CV_8U, level.kernel, identity_, cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
     }
 }
 

@@ -75,6 +75,7 @@ class ObliqueViews {
   void EnsureBlurred(Level& level, int y0, int y1, int x0, int x1) const;
 
   cv::Mat left_, right_;
+  cv::Mat identity_;  // the filter across the rows: none (1x1 CV_32F, 1)
   int row_begin_ = 0, row_end_ = 0;
   ObliqueOptions options_;
   mutable std::vector<Level> levels_;
