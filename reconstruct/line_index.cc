@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 #include <vector>
 
 #include "calib/core/input_error.h"
@@ -40,34 +41,41 @@ cv::Mat LabelDisparityComponents(const cv::Mat& disparity_px, const cv::Rect& ro
   components->clear();
   // Depth first from each unlabelled valid pixel in raster order, its
   // neighbours pushed left, right, up, down: the order of each component's
-  // pixels, which LineIndexer::Sample picks from.
-  std::vector<int> stack;
+  // pixels, which LineIndexer::Sample picks from. Each pixel is pushed once
+  // and listed once, so both buffers hold at most the roi's pixels.
+  struct Pixel {
+    int x, y;
+  };
+  const size_t area = size_t(roi.area());
+  std::unique_ptr<Pixel[]> stack(new Pixel[area]);
+  std::unique_ptr<int[]> listed(new int[area]);
   for (int y = y0; y < y1; ++y)
     for (int x = x0; x < x1; ++x) {
       const int seed = y * cols + x;
       if (label_at[seed] >= 0 || !std::isfinite(d_at[seed])) continue;
       const int label = int(components->size());
-      std::vector<int>& pixels = components->emplace_back();
       label_at[seed] = label;
-      stack.assign(1, seed);
-      while (!stack.empty()) {
-        const int i = stack.back();
-        stack.pop_back();
-        pixels.push_back(i);
-        const int py = i / cols, px = i - py * cols;
+      size_t top = 0, n = 0;
+      stack[top++] = {x, y};
+      while (top > 0) {
+        const Pixel p = stack[--top];
+        const int i = p.y * cols + p.x;
+        listed[n++] = i;
         const float d = d_at[i];
-        auto visit = [&](bool inside, int j) {
-          if (!inside || label_at[j] >= 0) return;
+        // Joins neighbour (nx, ny), index j, if unlabelled, valid and near d.
+        auto visit = [&](int nx, int ny, int j) {
+          if (label_at[j] >= 0) return;
           const float dn = d_at[j];
           if (!std::isfinite(dn) || std::abs(dn - d) > max_step_px) return;
           label_at[j] = label;
-          stack.push_back(j);
+          stack[top++] = {nx, ny};
         };
-        visit(px - 1 >= x0, i - 1);
-        visit(px + 1 < x1, i + 1);
-        visit(py - 1 >= y0, i - cols);
-        visit(py + 1 < y1, i + cols);
+        if (p.x - 1 >= x0) visit(p.x - 1, p.y, i - 1);
+        if (p.x + 1 < x1) visit(p.x + 1, p.y, i + 1);
+        if (p.y - 1 >= y0) visit(p.x, p.y - 1, i - cols);
+        if (p.y + 1 < y1) visit(p.x, p.y + 1, i + cols);
       }
+      components->emplace_back(listed.get(), listed.get() + n);
     }
   return labels;
 }
