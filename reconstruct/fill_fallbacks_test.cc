@@ -3,6 +3,7 @@
 // refinement loses, and what it recovers lies on the true disparity.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <opencv2/imgproc.hpp>
@@ -136,6 +137,65 @@ TEST(ObliqueRefine, MatchesStronglyForeshortenedSurfacesOnTheTrueDisparity) {
     // ... and be more precise where it accepts: the views at one resolution
     // fit the window model, the plain refinement's sharper view does not.
     EXPECT_LT(r.oblique_rms, r.plain_rms);
+  }
+}
+
+// ObliqueViews blurs its views lazily, tile by tile, as pixels ask. That
+// cache must not change any result: each refinement, asked in a scattered
+// order over both kinds of level (left view blurred where 1 - dd/dx < 0.7,
+// right view where > 1.43), must equal the refinement on the views blurred
+// whole, as the fallback is defined (oblique_refine.h: the sharper view
+// low-passed along the rows by sigma_psf * sqrt(k^2 - 1)), and those must
+// lie on the true disparity (as SteepSlopeRecovery's rms: < 0.1 px).
+TEST(ObliqueRefine, LazyBlurringGivesTheResultsOfWholeViews) {
+  for (const double du : {0.6, -1.5}) {
+    SyntheticPairSpec spec;
+    spec.width = 480;
+    spec.du = du;
+    spec.dv = 0.0;
+    spec.d0_px = du > 0 ? 10.0 : 650.0;
+    spec.grid_sigma_px = 0.9;
+    SyntheticPair pair = RenderSyntheticPair(spec);
+    cv::GaussianBlur(pair.left, pair.left, cv::Size(5, 5), 0.6);
+    cv::GaussianBlur(pair.right, pair.right, cv::Size(5, 5), 0.6);
+    const ObliqueOptions options;
+    const double s = 1 - du;
+    // The levels nearest s = 0.4 and 2.5 (oblique_refine.cc): 0.35 and 2.8.
+    const double level = s < 1 ? 0.35 : 2.8, kl = s < 1 ? 1 / level : level;
+    const double level_sigma = options.psf_sigma_px * std::sqrt(kl * kl - 1);
+    const int radius = int(std::ceil(3 * level_sigma));
+    cv::Mat whole_left = pair.left.clone(), whole_right = pair.right.clone();
+    cv::Mat& sharp = s < 1 ? whole_left : whole_right;
+    cv::sepFilter2D(s < 1 ? pair.left : pair.right, sharp, CV_8U,
+                    cv::getGaussianKernel(2 * radius + 1, level_sigma, CV_32F), cv::Mat::ones(1, 1, CV_32F),
+                    cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
+    RefineAcceptance accept = Acceptance();
+    if (s < 1) accept.subpixel.half_width_px = std::clamp(int(std::lround(4 / s)), 4, options.max_half_width_px);
+    const ObliqueViews views(pair.left, pair.right, 0, pair.left.rows, options);
+    cv::RNG rng(7);
+    int n = 0, accepted = 0;
+    double sum2 = 0;
+    for (int i = 0; i < 3000; ++i) {
+      const int x = rng.uniform(0, pair.left.cols), y = rng.uniform(0, pair.left.rows);
+      const double truth = pair.true_disparity_px.at<double>(y, x), start = truth + 0.2;
+      SubpixelResult lazy;
+      PixelStatus lazy_why;
+      ASSERT_TRUE(views.Refine(x, y, start, du, 0.0, Acceptance(), &lazy, &lazy_why));
+      const SubpixelResult whole = RefineDisparity(whole_left, whole_right, x, y, start, du, 0.0, accept.subpixel);
+      const PixelStatus whole_why = Accept(whole_left, whole_right, x, y, du, 0.0, whole, accept);
+      ASSERT_EQ(lazy.ok, whole.ok) << x << "," << y;
+      ASSERT_EQ(lazy.disparity_px, whole.disparity_px) << x << "," << y;
+      ASSERT_EQ(lazy.zncc, whole.zncc) << x << "," << y;
+      ASSERT_EQ(lazy_why, whole_why) << x << "," << y;
+      ++n;
+      if (lazy_why == PixelStatus::kPoint) {
+        ++accepted;
+        sum2 += std::pow(lazy.disparity_px - truth, 2);
+      }
+    }
+    std::printf("dd/dx %.1f: %d of %d accepted, rms %.3f px\n", du, accepted, n, std::sqrt(sum2 / std::max(1, accepted)));
+    EXPECT_GT(accepted, n / 10);
+    EXPECT_LT(std::sqrt(sum2 / std::max(1, accepted)), 0.1);
   }
 }
 

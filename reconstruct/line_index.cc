@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 #include <vector>
 
 #include "calib/core/input_error.h"
@@ -30,34 +31,51 @@ void LineIndexOptions::Check() const {
 
 cv::Mat LabelDisparityComponents(const cv::Mat& disparity_px, const cv::Rect& roi, double max_step_px,
                                  std::vector<std::vector<int>>* components) {
+  STEREORIG_CHECK(disparity_px.type() == CV_32FC1 && disparity_px.isContinuous());
   const int cols = disparity_px.cols;
+  const int x0 = roi.x, x1 = roi.x + roi.width, y0 = roi.y, y1 = roi.y + roi.height;
   cv::Mat labels(disparity_px.size(), CV_32SC1, cv::Scalar(-1));
+  // Flat views: a pixel is its index y * cols + x in both maps.
+  const float* d_at = disparity_px.ptr<float>(0);
+  int* label_at = labels.ptr<int>(0);
   components->clear();
-  std::vector<int> stack;
-  for (int y = roi.y; y < roi.y + roi.height; ++y)
-    for (int x = roi.x; x < roi.x + roi.width; ++x) {
-      if (labels.at<int>(y, x) >= 0 || !std::isfinite(disparity_px.at<float>(y, x))) continue;
+  // Depth first from each unlabelled valid pixel in raster order, its
+  // neighbours pushed left, right, up, down: the order of each component's
+  // pixels, which LineIndexer::Sample picks from. Each pixel is pushed once
+  // and listed once, so both buffers hold at most the roi's pixels.
+  struct Pixel {
+    int x, y;
+  };
+  const size_t area = size_t(roi.area());
+  std::unique_ptr<Pixel[]> stack(new Pixel[area]);
+  std::unique_ptr<int[]> listed(new int[area]);
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      const int seed = y * cols + x;
+      if (label_at[seed] >= 0 || !std::isfinite(d_at[seed])) continue;
       const int label = int(components->size());
-      components->emplace_back();
-      std::vector<int>& pixels = components->back();
-      labels.at<int>(y, x) = label;
-      stack.assign(1, y * cols + x);
-      while (!stack.empty()) {
-        const int i = stack.back();
-        stack.pop_back();
-        pixels.push_back(i);
-        const int py = i / cols, px = i % cols;
-        const float d = disparity_px.at<float>(py, px);
-        const int nx[4] = {px - 1, px + 1, px, px}, ny[4] = {py, py, py - 1, py + 1};
-        for (int k = 0; k < 4; ++k) {
-          if (!roi.contains(cv::Point(nx[k], ny[k]))) continue;
-          int& l = labels.at<int>(ny[k], nx[k]);
-          const float dn = disparity_px.at<float>(ny[k], nx[k]);
-          if (l >= 0 || !std::isfinite(dn) || std::abs(dn - d) > max_step_px) continue;
-          l = label;
-          stack.push_back(ny[k] * cols + nx[k]);
-        }
+      label_at[seed] = label;
+      size_t top = 0, n = 0;
+      stack[top++] = {x, y};
+      while (top > 0) {
+        const Pixel p = stack[--top];
+        const int i = p.y * cols + p.x;
+        listed[n++] = i;
+        const float d = d_at[i];
+        // Joins neighbour (nx, ny), index j, if unlabelled, valid and near d.
+        auto visit = [&](int nx, int ny, int j) {
+          if (label_at[j] >= 0) return;
+          const float dn = d_at[j];
+          if (!std::isfinite(dn) || std::abs(dn - d) > max_step_px) return;
+          label_at[j] = label;
+          stack[top++] = {nx, ny};
+        };
+        if (p.x - 1 >= x0) visit(p.x - 1, p.y, i - 1);
+        if (p.x + 1 < x1) visit(p.x + 1, p.y, i + 1);
+        if (p.y - 1 >= y0) visit(p.x, p.y - 1, i - cols);
+        if (p.y + 1 < y1) visit(p.x, p.y + 1, i + cols);
       }
+      components->emplace_back(listed.get(), listed.get() + n);
     }
   return labels;
 }
@@ -79,13 +97,17 @@ class LineIndexer {
       : left_(left), right_(right), o_(o), accept_(accept), state_(state), cols_(left.cols) {
     tall_ = accept.subpixel;
     tall_.half_height_px = o.window_half_height_px;
+    STEREORIG_CHECK(state->disparity_px.type() == CV_32FC1 && state->disparity_px.isContinuous() &&
+                    state->disparity_px.cols == cols_);
   }
 
-  float D(int i) const { return state_->disparity_px.at<float>(i / cols_, i % cols_); }
+  // The disparity of pixel i = y * cols + x (the map is continuous).
+  float D(int i) const { return state_->disparity_px.ptr<float>(0)[i]; }
 
   // Up to o.samples valid pixels of `pixels`, spread evenly.
   std::vector<int> Sample(const std::vector<int>& pixels) const {
     std::vector<int> valid, sample;
+    valid.reserve(pixels.size());
     for (int i : pixels)
       if (std::isfinite(D(i))) valid.push_back(i);
     const double stride = std::max(1.0, double(valid.size()) / o_.samples);
@@ -131,6 +153,7 @@ class LineIndexer {
   // varies over a curved surface, so from starts 2 px either side (the
   // other alignments are a period away), keeping the best correlation.
   void Move(const std::vector<int>& pixels, double shift) {
+    changed_ = true;
     for (int i : pixels) {
       const int y = i / cols_, x = i % cols_;
       float& d = state_->disparity_px.at<float>(y, x);
@@ -159,6 +182,7 @@ class LineIndexer {
       const int y = i / cols_, x = i % cols_;
       float& d = state_->disparity_px.at<float>(y, x);
       if (!std::isfinite(d)) continue;
+      changed_ = true;
       d = std::numeric_limits<float>::infinity();
       state_->confidence.at<float>(y, x) = 0;
       state_->status.at<uint8_t>(y, x) = uint8_t(PixelStatus::kWrongLine);
@@ -166,6 +190,9 @@ class LineIndexer {
   }
 
   enum class Outcome { kKept, kMoved, kDropped };
+
+  // Whether Move or Drop has changed the map.
+  bool changed() const { return changed_; }
 
   // One component's vernier test.
   // offset_px: the row offset a correct match reads (0 on a well rectified pair).
@@ -231,15 +258,18 @@ class LineIndexer {
   DisparityState* state_;
   const int cols_;
   SubpixelOptions tall_;
+  bool changed_ = false;
 };
 
 }  // namespace
 
 int CorrectLineIndex(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const LineIndexOptions& o,
-                     const RefineAcceptance& accept, DisparityState* state) {
+                     const RefineAcceptance& accept, DisparityState* state, DisparityComponents* labelled) {
   if (!o.enabled) return 0;
-  std::vector<std::vector<int>> components;
-  LabelDisparityComponents(state->disparity_px, roi, 1.0, &components);
+  DisparityComponents own;
+  if (!labelled) labelled = &own;
+  labelled->labels = LabelDisparityComponents(state->disparity_px, roi, 1.0, &labelled->pixels);
+  const std::vector<std::vector<int>>& components = labelled->pixels;
   LineIndexer indexer(left, right, o, accept, state);
   int moved = 0;
   for (const std::vector<int>& pixels : components) {
@@ -250,14 +280,21 @@ int CorrectLineIndex(const cv::Mat& left, const cv::Mat& right, const cv::Rect& 
       ++moved;
     }
   }
+  labelled->matches_disparity = !indexer.changed();
   return moved;
 }
 
 int JoinAcrossPeriodJumps(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const LineIndexOptions& o,
-                          const RefineAcceptance& accept, DisparityState* state) {
+                          const RefineAcceptance& accept, DisparityState* state, DisparityComponents* labelled) {
   if (!o.enabled) return 0;
-  std::vector<std::vector<int>> components;
-  const cv::Mat labels = LabelDisparityComponents(state->disparity_px, roi, 1.0, &components);
+  DisparityComponents own;
+  if (!labelled) labelled = &own;
+  if (!labelled->matches_disparity)
+    labelled->labels = LabelDisparityComponents(state->disparity_px, roi, 1.0, &labelled->pixels);
+  // Moves below change the map.
+  labelled->matches_disparity = false;
+  const cv::Mat& labels = labelled->labels;
+  const std::vector<std::vector<int>>& components = labelled->pixels;
   // Disparity differences across every seam: from each pixel, the next
   // valid pixel along its row and along its column, if it is within
   // o.max_seam_gap_px and in another component, less the first one's

@@ -50,10 +50,22 @@ struct LineIndexOptions {
   void Check() const;       // throws InputError naming the bad field
 };
 
+// The connected components of the disparity map (LabelDisparityComponents
+// at 1 px), handed from CorrectLineIndex to JoinAcrossPeriodJumps: labelling
+// the whole map costs about as much as one component's vernier test, and
+// the second run of both finds nothing to move on most captures.
+struct DisparityComponents {
+  cv::Mat labels;                               // CV_32SC1 of the image's size, -1 = none
+  std::vector<std::vector<int>> pixels;         // per label, as y * cols + x
+  bool matches_disparity = false;               // labels the disparity map as it is now
+};
+
 // Revises `state` (disparity, confidence, status) inside `roi`. Returns the
 // number of components moved (dropped ones not counted). left, right: CV_8UC1 rectified.
+// components: if not null, receives the components it tested, marked as
+// matching the map if it left the map unchanged.
 int CorrectLineIndex(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const LineIndexOptions& options,
-                     const RefineAcceptance& accept, DisparityState* state);
+                     const RefineAcceptance& accept, DisparityState* state, DisparityComponents* components = nullptr);
 
 // Which line is which, by continuity: two components that meet along a seam
 // with a jump of about one grid period (a smooth surface has none, and a
@@ -61,8 +73,11 @@ int CorrectLineIndex(const cv::Mat& left, const cv::Mat& right, const cv::Rect& 
 // move leaves the size-weighted vernier reading over both nearer 0 is moved;
 // if that is a tie, the smaller one.
 // Run it after growing (the components then meet). Returns the number moved.
+// components: if not null and matching the map (from CorrectLineIndex, same
+// roi), used instead of labelling again; left marked as not matching.
 int JoinAcrossPeriodJumps(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi,
-                          const LineIndexOptions& options, const RefineAcceptance& accept, DisparityState* state);
+                          const LineIndexOptions& options, const RefineAcceptance& accept, DisparityState* state,
+                          DisparityComponents* components = nullptr);
 
 // Connected components of the valid disparities in `roi` (4-neighbours whose
 // disparities differ by <= max_step_px): CV_32SC1 label image (-1 = none),

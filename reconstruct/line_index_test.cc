@@ -107,5 +107,39 @@ TEST(LineIndex, DropsAWrongLinePatchWhoseRightLineIsOutsideTheRightImage) {
   }
 }
 
+// Two patches meeting along a seam with a one-period jump: the join moves
+// the one on the wrong line. The vernier test is made to keep both
+// (max_row_offset_px 0.9 > the 0.36 px one period off reads), so it leaves
+// the map unchanged and the join may take its components instead of
+// labelling again: the outcome must be the same either way.
+TEST(LineIndex, JoinMovesThePatchAcrossAPeriodJumpWithOrWithoutTheVernierTestsComponents) {
+  const SyntheticPair pair = Plane();
+  const cv::Rect roi(0, 0, pair.left.cols, pair.left.rows);
+  LineIndexOptions o;
+  o.max_row_offset_px = 0.9;
+  DisparityState shared = EmptyState(pair.left.size());
+  Patch(&shared, 100, 150, 40.f);
+  Patch(&shared, 150, 170, 32.f);
+  DisparityState separate{shared.disparity_px.clone(), shared.confidence.clone(), shared.status.clone(),
+                          shared.slope_x.clone(), shared.slope_y.clone()};
+  DisparityComponents components;
+  EXPECT_EQ(CorrectLineIndex(pair.left, pair.right, roi, o, Acceptance(), &shared, &components), 0);
+  EXPECT_TRUE(components.matches_disparity);
+  EXPECT_EQ(JoinAcrossPeriodJumps(pair.left, pair.right, roi, o, Acceptance(), &shared, &components), 1);
+  EXPECT_FALSE(components.matches_disparity);
+  CorrectLineIndex(pair.left, pair.right, roi, o, Acceptance(), &separate);
+  EXPECT_EQ(JoinAcrossPeriodJumps(pair.left, pair.right, roi, o, Acceptance(), &separate), 1);
+  // Against the truth (40 px): both patches on the right line (refinement
+  // may refuse a few pixels: < 2 %).
+  const Outcome a = Classify(shared, pair, 100, 150), b = Classify(shared, pair, 150, 170);
+  EXPECT_GE(a.right_line, 0.98 * 10000);
+  EXPECT_GE(b.right_line, 0.98 * 4000);
+  cv::Mat diff;
+  cv::compare(shared.disparity_px, separate.disparity_px, diff, cv::CMP_NE);
+  EXPECT_EQ(cv::countNonZero(diff), 0);
+  cv::compare(shared.status, separate.status, diff, cv::CMP_NE);
+  EXPECT_EQ(cv::countNonZero(diff), 0);
+}
+
 }  // namespace
 }  // namespace stereorig

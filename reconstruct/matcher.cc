@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -406,15 +407,24 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
   if (o.intensity_refinement && (o.line_index.enabled || o.grow.enabled)) {
     CorrectLineIndex(left, right, roi, o.line_index, accept, &state);
     lap("line_index");
-    GrowDisparity(left, right, roi, o.grow, accept, &state);
+    // Shared by both passes: the second does not repeat the first's failed tries.
+    std::optional<GrowMemory> grow_memory;
+    if (o.grow.enabled) grow_memory.emplace(left, right, roi, o.grow);
+    GrowDisparity(left, right, roi, o.grow, accept, &state, grow_memory ? &*grow_memory : nullptr);
     lap("grow");
     // Grown components are larger, so their vernier reads better; a
     // component moved now leaves a gap that growing closes.
-    if (o.grow.enabled && CorrectLineIndex(left, right, roi, o.line_index, accept, &state) +
-                                  JoinAcrossPeriodJumps(left, right, roi, o.line_index, accept, &state) >
-                              0) {
+    // In this order (an operator's operands would be unsequenced): the
+    // components are labelled once if the vernier test changes nothing.
+    DisparityComponents components;
+    int moved = 0;
+    if (o.grow.enabled) {
+      moved += CorrectLineIndex(left, right, roi, o.line_index, accept, &state, &components);
+      moved += JoinAcrossPeriodJumps(left, right, roi, o.line_index, accept, &state, &components);
+    }
+    if (moved > 0) {
       lap("line_index_2");
-      GrowDisparity(left, right, roi, o.grow, accept, &state);
+      GrowDisparity(left, right, roi, o.grow, accept, &state, &*grow_memory);
       lap("grow_2");
     } else {
       lap("line_index_2");

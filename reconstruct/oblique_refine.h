@@ -41,10 +41,18 @@ struct ObliqueOptions {
 };
 
 // The pair low-passed at a few foreshortening levels, for one capture.
+// A level's views are blurred on first use, tile by tile as pixels ask for
+// them (the filter runs along the rows and reads the whole image around a
+// tile, so a pixel's result does not depend on which tiles are blurred):
+// growing asks for a few levels at a few thousand scattered pixels, and
+// blurring everything up front cost more (~60 M instructions per module on
+// the demo cup) than the refinements that use it. Not thread-safe: Refine
+// fills that cache.
 class ObliqueViews {
  public:
-  // left, right: CV_8UC1 rectified. Only rows [row_begin, row_end) are
-  // filtered (the matched region plus the refinement window's reach).
+  // left, right: CV_8UC1 rectified, shared, not copied (they must stay
+  // unchanged while this is used). Only rows [row_begin, row_end) are filtered
+  // (the matched region plus the refinement window's reach).
   ObliqueViews(const cv::Mat& left, const cv::Mat& right, int row_begin, int row_end, const ObliqueOptions& options);
 
   // The refinement of left pixel (x, y) from start_px with slopes (gx, gy)
@@ -56,11 +64,21 @@ class ObliqueViews {
 
  private:
   struct Level {
-    double foreshortening;  // s this level is made for
-    cv::Mat left, right;    // one of them blurred
+    double foreshortening;        // s this level is made for
+    bool blur_left;               // which view is the sharper one, low-passed: the left where s < 1
+    cv::Mat kernel;               // the Gaussian along the rows, CV_32F column
+    cv::Mat left, right;          // the sharper view's copy is blurred tile by tile (empty until first used)
+    std::vector<bool> tile_done;  // per tile (kTileRows x kTileCols from (0, row_begin_), row-major): blurred yet
   };
+  // Blurs the tiles of `level`'s sharper view that meet rows [y0, y1) x
+  // columns [x0, x1) and are not yet.
+  void EnsureBlurred(Level& level, int y0, int y1, int x0, int x1) const;
+
+  cv::Mat left_, right_;
+  cv::Mat identity_;  // the filter across the rows: none (1x1 CV_32F, 1)
+  int row_begin_ = 0, row_end_ = 0;
   ObliqueOptions options_;
-  std::vector<Level> levels_;
+  mutable std::vector<Level> levels_;
 };
 
 }  // namespace stereorig

@@ -3,7 +3,8 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <deque>
+#include <optional>
+#include <vector>
 
 #include "calib/core/input_error.h"
 #include "reconstruct/shifted_window.h"
@@ -24,19 +25,25 @@ void GrowOptions::Check() const {
 namespace {
 
 // Least-squares plane d = a + gx*(x - q.x) + gy*(y - q.y) through the valid
-// disparities of the (2r+1)^2 window around q. False if too few or
-// degenerate (then the caller predicts from one neighbour).
+// disparities of the (2r+1)^2 window around q (clipped to roi). False if
+// too few or degenerate (then the caller predicts from one neighbour).
 bool LocalPlane(const cv::Mat& disparity, const cv::Rect& roi, cv::Point q, int r, double* a, double* gx, double* gy) {
-  double s1 = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0, sd = 0, sxd = 0, syd = 0;
-  for (int v = -r; v <= r; ++v)
-    for (int u = -r; u <= r; ++u) {
-      const cv::Point p(q.x + u, q.y + v);
-      if (!roi.contains(p)) continue;
-      const float d = disparity.at<float>(p);
+  const int v0 = std::max(-r, roi.y - q.y), v1 = std::min(r, roi.y + roi.height - 1 - q.y);
+  const int u0 = std::max(-r, roi.x - q.x), u1 = std::min(r, roi.x + roi.width - 1 - q.x);
+  // The pixel moments are sums of small integers: exact as ints, and the
+  // same as summed in doubles.
+  int n = 0, nx = 0, ny = 0, nxx = 0, nyy = 0, nxy = 0;
+  double sd = 0, sxd = 0, syd = 0;
+  for (int v = v0; v <= v1; ++v) {
+    const float* row = disparity.ptr<float>(q.y + v) + q.x;
+    for (int u = u0; u <= u1; ++u) {
+      const float d = row[u];
       if (!std::isfinite(d)) continue;
-      s1 += 1, sx += u, sy += v, sxx += u * u, syy += v * v, sxy += u * v;
+      ++n, nx += u, ny += v, nxx += u * u, nyy += v * v, nxy += u * v;
       sd += d, sxd += u * d, syd += v * d;
     }
+  }
+  const double s1 = n, sx = nx, sy = ny, sxx = nxx, syy = nyy, sxy = nxy;
   if (s1 < 6) return false;
   Eigen::Matrix3d m;
   m << s1, sx, sy, sx, sxx, sxy, sy, sxy, syy;
@@ -49,34 +56,64 @@ bool LocalPlane(const cv::Mat& disparity, const cv::Rect& roi, cv::Point q, int 
 
 }  // namespace
 
+GrowMemory::GrowMemory(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const GrowOptions& options)
+    : roi_(roi),
+      oblique_(left, right, roi.y - 8, roi.y + roi.height + 8, options.oblique),
+      failed_(size_t(roi.area())) {}
+
 int GrowDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const GrowOptions& o,
-                  const RefineAcceptance& accept, DisparityState* state) {
+                  const RefineAcceptance& accept, DisparityState* state, GrowMemory* memory) {
   if (!o.enabled) return 0;
+  std::optional<GrowMemory> own_memory;
+  if (!memory) memory = &own_memory.emplace(left, right, roi, o);
+  STEREORIG_CHECK(memory->roi_ == roi);
   cv::Mat& disparity = state->disparity_px;
-  cv::Mat tried(left.size(), CV_8UC1, cv::Scalar(0));
-  const ObliqueViews oblique(left, right, roi.y - 8, roi.y + roi.height + 8, o.oblique);
+  // Per pixel of roi, row-major.
+  auto index = [&](cv::Point q) { return size_t(q.y - roi.y) * size_t(roi.width) + size_t(q.x - roi.x); };
+  std::vector<uint8_t> tried(size_t(roi.area()), 0);
   RefineAcceptance shifted_accept = accept;
   shifted_accept.min_zncc = std::max(accept.min_zncc, o.shifted_min_zncc);
-  std::deque<cv::Point> queue;
-  for (int y = roi.y; y < roi.y + roi.height; ++y)
-    for (int x = roi.x; x < roi.x + roi.width; ++x)
-      if (std::isfinite(disparity.at<float>(y, x))) queue.emplace_back(x, y);
+  // Breadth first: a flat queue, popped from `head`, seeded with the valid
+  // pixels in raster order. Only those with an empty 4-neighbour in roi:
+  // the others have nothing to try (a valid pixel stays valid), so leaving
+  // them out changes nothing but the time (most of the map is interior).
+  std::vector<cv::Point> queue;
+  const int x_end = roi.x + roi.width, y_end = roi.y + roi.height;
+  for (int y = roi.y; y < y_end; ++y) {
+    const float* above = y > roi.y ? disparity.ptr<float>(y - 1) : nullptr;
+    const float* row = disparity.ptr<float>(y);
+    const float* below = y + 1 < y_end ? disparity.ptr<float>(y + 1) : nullptr;
+    for (int x = roi.x; x < x_end; ++x)
+      if (std::isfinite(row[x]) &&
+          ((x > roi.x && !std::isfinite(row[x - 1])) || (x + 1 < x_end && !std::isfinite(row[x + 1])) ||
+           (above && !std::isfinite(above[x])) || (below && !std::isfinite(below[x]))))
+        queue.emplace_back(x, y);
+  }
   int added = 0;
-  while (!queue.empty()) {
-    const cv::Point p = queue.front();
-    queue.pop_front();
+  for (size_t head = 0; head < queue.size(); ++head) {
+    const cv::Point p = queue[head];
     const float d = disparity.at<float>(p);
     const float gx = state->slope_x.at<float>(p), gy = state->slope_y.at<float>(p);
     const cv::Point next[4] = {{p.x - 1, p.y}, {p.x + 1, p.y}, {p.x, p.y - 1}, {p.x, p.y + 1}};
     for (const cv::Point& q : next) {
       // A pixel is tried again from later neighbours (up to max_tries): by
       // then more of its neighbourhood is known, so the prediction is better.
-      if (!roi.contains(q) || std::isfinite(disparity.at<float>(q)) || tried.at<uint8_t>(q) >= o.max_tries) continue;
-      ++tried.at<uint8_t>(q);
+      if (!roi.contains(q) || std::isfinite(disparity.at<float>(q))) continue;
+      uint8_t& tries = tried[index(q)];
+      if (tries >= o.max_tries) continue;
+      ++tries;
       // Predicted from the plane through the valid neighbours (noise ~0.25 px
       // per pixel averages out), else from p and its slopes.
       double predicted = d + gx * (q.x - p.x) + gy * (q.y - p.y), qgx = gx, qgy = gy;
       LocalPlane(disparity, roi, q, o.plane_radius_px, &predicted, &qgx, &qgy);
+      GrowMemory::FailedTry& last = memory->failed_[index(q)];
+      const cv::Point from = p - q;
+      // Tried exactly so before and failed (and nothing else has touched it
+      // since): it fails again, as before.
+      if (last.status != 0 && last.status == state->status.at<uint8_t>(q) && last.start_px == predicted &&
+          last.slope_x == qgx && last.slope_y == qgy &&
+          (!o.shifted_windows || (last.from_dx == from.x && last.from_dy == from.y)))
+        continue;
       SubpixelResult r = RefineDisparity(left, right, q.x, q.y, predicted, qgx, qgy, accept.subpixel);
       PixelStatus why = Accept(left, right, q.x, q.y, qgx, qgy, r, accept);
       if (why == PixelStatus::kPoint && std::abs(r.disparity_px - predicted) > o.max_deviation_px)
@@ -84,7 +121,7 @@ int GrowDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
       if (why != PixelStatus::kPoint && o.shifted_windows && 1 - qgx > o.shifted_min_foreshortening &&
           1 - qgx < 1 / o.shifted_min_foreshortening) {
         SubpixelResult shifted;
-        if (RefineShiftedWindow(left, right, q.x, q.y, p - q, predicted, qgx, qgy, shifted_accept, o.max_deviation_px,
+        if (RefineShiftedWindow(left, right, q.x, q.y, from, predicted, qgx, qgy, shifted_accept, o.max_deviation_px,
                                 &shifted) == PixelStatus::kPoint) {
           r = shifted;
           why = PixelStatus::kPoint;
@@ -93,7 +130,7 @@ int GrowDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
       if (why != PixelStatus::kPoint) {
         SubpixelResult oblique_result;
         PixelStatus oblique_why;
-        if (oblique.Refine(q.x, q.y, predicted, qgx, qgy, accept, &oblique_result, &oblique_why) &&
+        if (memory->oblique_.Refine(q.x, q.y, predicted, qgx, qgy, accept, &oblique_result, &oblique_why) &&
             oblique_why == PixelStatus::kPoint &&
             std::abs(oblique_result.disparity_px - predicted) <= o.max_deviation_px) {
           r = oblique_result;
@@ -102,8 +139,10 @@ int GrowDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
       }
       if (why != PixelStatus::kPoint) {
         state->status.at<uint8_t>(q) = uint8_t(why);  // the reason growing could not reach it
+        last = {predicted, qgx, qgy, int8_t(from.x), int8_t(from.y), uint8_t(why)};
         continue;
       }
+      last.status = 0;
       disparity.at<float>(q) = float(r.disparity_px);
       state->confidence.at<float>(q) = float(std::clamp(r.zncc, 0.0, 1.0));
       state->status.at<uint8_t>(q) = uint8_t(PixelStatus::kPoint);
