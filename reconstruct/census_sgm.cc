@@ -6,6 +6,7 @@
 
 #include "calib/core/input_error.h"
 #include "reconstruct/parallel_for.h"
+#include "reconstruct/scratch_buffer.h"
 #include "reconstruct/sgm_kernels.h"
 
 namespace stereorig {
@@ -69,15 +70,15 @@ namespace {
 using sgm::kBig;
 using sgm::SumMode;
 
-// The big buffers of one SgmMatch call, allocated once per call (the band
-// pass and the full-resolution pass are separate calls). Keeping them per
+// The buffers of one SgmMatch call, allocated once per call (the band pass
+// and the full-resolution pass are separate calls). The two big ones, the
+// cost volume and the forward sums, are ScratchArrays (not zeroed: every
+// element is written before it is read; huge pages). Keeping them per
 // thread across calls was tried: page faults stayed ~1.5 % of the runtime's
 // cycles either way (cv::Mat allocations dominate them), while the retained
 // volumes overlapped the sub-pixel step's buffers and raised the peak of
 // `reconstruct` on the plate from 230 to 293 MB.
 struct SgmWorkspace {
-  std::vector<uint8_t> cost;             // (h, w, stride)
-  std::vector<uint16_t> sum;             // (h or 1, w, stride)
   std::vector<uint16_t> total_row;       // (w, stride): backward pass
   std::vector<uint16_t> vert_a, vert_b;  // (w, stride + 2): top/bottom path, previous and current row
   std::vector<uint16_t> vert_min_a, vert_min_b;
@@ -140,7 +141,8 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   // off the image get the maximum cost, so they are never preferred. The
   // right row is reversed (with `stride` padding each side) so that each
   // pixel's run of disparities reads it forwards.
-  uint8_t* cost = Grow(ws.cost, size_t(h) * w * stride);
+  ScratchArray<uint8_t> cost_volume(size_t(h) * w * stride);
+  uint8_t* cost = cost_volume.data();
   uint64_t* reversed = Grow(ws.right_reversed, size_t(rw) + 2 * stride + 16);
   std::fill(reversed, reversed + size_t(rw) + 2 * stride + 16, 0);
   for (int y = 0; y < h; ++y) {
@@ -165,7 +167,8 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
 
   // Aggregated cost (h, w, stride) when a second pass is needed; otherwise one row.
   const bool two_pass = options.num_paths == 4;
-  uint16_t* sum = Grow(ws.sum, size_t(two_pass ? h : 1) * w * stride);
+  ScratchArray<uint16_t> sums(size_t(two_pass ? h : 1) * w * stride);
+  uint16_t* sum = sums.data();
   uint16_t* vert_prev = PathBuffers(ws.vert_a, w, stride);
   uint16_t* vert_cur = PathBuffers(ws.vert_b, w, stride);
   uint16_t* vert_prev_min = Grow(ws.vert_min_a, w);
