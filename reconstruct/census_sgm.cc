@@ -226,18 +226,19 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   };
 
   // One row of the vertical path (top->bottom or bottom->top; lo_prev: the
-  // windows of the row before along the path), then the two horizontal
-  // paths, all accumulated into srow.
-  auto vertical = [&](const uint8_t* crow, const int16_t* lo, const int16_t* lo_prev, uint16_t* srow,
-                      SumMode mode) {
+  // windows of the row before along the path), accumulated (SumMode) from
+  // sin into srow.
+  auto vertical = [&](const uint8_t* crow, const int16_t* lo, const int16_t* lo_prev, const uint16_t* sin,
+                      uint16_t* srow, SumMode mode) {
     for (int x = 0; x < w; ++x) {
       uint16_t* cur = vert_cur + size_t(x) * path_stride;
       const uint8_t* c = crow + size_t(x) * stride;
+      const size_t xs = size_t(x) * stride;
       vert_cur_min[x] =
           lo_prev == nullptr
-              ? K::First(c, cur, srow + size_t(x) * stride, mode, n, stride)
+              ? K::First(c, cur, sin + xs, srow + xs, mode, n, stride)
               : K::Step(c, InWindowOf(vert_prev + size_t(x) * path_stride, lo[x] - lo_prev[x], n, stride, shifted),
-                        vert_prev_min[x], cur, srow + size_t(x) * stride, mode, n, stride, p1, p2);
+                        vert_prev_min[x], cur, sin + xs, srow + xs, mode, n, stride, p1, p2);
     }
     std::swap(vert_prev, vert_cur);
     std::swap(vert_prev_min, vert_cur_min);
@@ -248,15 +249,15 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   uint16_t* shifted_rl = PathBuffers(ws.shifted_rl, 1, stride);
   auto horizontal = [&](const uint8_t* crow, const int16_t* lo, uint16_t* srow) {
     const size_t last = size_t(w - 1) * stride;
-    uint16_t m_lr = K::First(crow, ha, srow, SumMode::kAdd, n, stride);
-    uint16_t m_rl = K::First(crow + last, hc, srow + last, SumMode::kAdd, n, stride);
+    uint16_t m_lr = K::First(crow, ha, srow, srow, SumMode::kAdd, n, stride);
+    uint16_t m_rl = K::First(crow + last, hc, srow + last, srow + last, SumMode::kAdd, n, stride);
     for (int i = 1; i < w; ++i) {
       const int il = i, ir = w - 1 - i;
       const size_t xl = size_t(il) * stride, xr = size_t(ir) * stride;
       m_lr = K::Step(crow + xl, InWindowOf(ha, lo[il] - lo[il - 1], n, stride, shifted), m_lr, hb, srow + xl,
-                     SumMode::kAdd, n, stride, p1, p2);
+                     srow + xl, SumMode::kAdd, n, stride, p1, p2);
       m_rl = K::Step(crow + xr, InWindowOf(hc, lo[ir] - lo[ir + 1], n, stride, shifted_rl), m_rl, hd, srow + xr,
-                     SumMode::kAdd, n, stride, p1, p2);
+                     srow + xr, SumMode::kAdd, n, stride, p1, p2);
       std::swap(ha, hb);
       std::swap(hc, hd);
     }
@@ -266,20 +267,20 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   for (int y = 0; y < h; ++y) {
     uint16_t* srow = sum + (two_pass ? size_t(y) * w * stride : 0);
     const uint8_t* crow = cost + size_t(y) * w * stride;
-    vertical(crow, lo_row(y), y == 0 ? nullptr : lo_row(y - 1), srow, SumMode::kStore);
+    vertical(crow, lo_row(y), y == 0 ? nullptr : lo_row(y - 1), srow, srow, SumMode::kStore);
     horizontal(crow, lo_row(y), srow);
     if (!two_pass) winner_take_all(y, srow);
   }
   if (!two_pass) return disparity;
 
   // Backward pass: bottom -> top, then the winner per row. The row's total
-  // goes to a cache-resident copy, so the volume is only read, never
-  // written back (the pass is memory-bound).
+  // (forward sums + this path) goes to a cache-resident row, so the volume
+  // is only read, never written back (the pass is memory-bound).
   uint16_t* total = Grow(ws.total_row, size_t(w) * stride);
   for (int y = h - 1; y >= 0; --y) {
     const uint16_t* srow = sum + size_t(y) * w * stride;
-    std::copy(srow, srow + size_t(w) * stride, total);
-    vertical(cost + size_t(y) * w * stride, lo_row(y), y == h - 1 ? nullptr : lo_row(y + 1), total, SumMode::kAdd);
+    vertical(cost + size_t(y) * w * stride, lo_row(y), y == h - 1 ? nullptr : lo_row(y + 1), srow, total,
+             SumMode::kAdd);
     winner_take_all(y, total);
   }
   return disparity;
