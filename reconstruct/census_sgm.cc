@@ -112,12 +112,16 @@ uint16_t* PathBuffers(std::vector<uint16_t>& v, int count, int stride) {
 // i + shift falls outside the neighbour's n disparities (it never searched
 // them: "no match there"), and kBig at [-1] and [n, stride] as in any path
 // buffer. shift == 0 returns prev itself.
-const uint16_t* InWindowOf(const uint16_t* prev, int shift, int n, int stride, uint16_t* buf) {
-  if (shift == 0) return prev;
+// (The copy is out of line and the test inline: it runs once per pixel and
+// path, and only the guided search ever shifts.)
+[[gnu::noinline]] const uint16_t* ShiftedCopy(const uint16_t* prev, int shift, int n, int stride, uint16_t* buf) {
   std::fill(buf - 1, buf + stride + 1, kBig);
   const int i0 = std::max(0, -shift), i1 = std::min(n, n - shift);
   if (i0 < i1) std::copy(prev + i0 + shift, prev + i1 + shift, buf + i0);
   return buf;
+}
+inline const uint16_t* InWindowOf(const uint16_t* prev, int shift, int n, int stride, uint16_t* buf) {
+  return shift == 0 ? prev : ShiftedCopy(prev, shift, n, stride, buf);
 }
 
 // SGM with per-pixel search windows: pixel (x, y) of `region` searches the
