@@ -9,6 +9,10 @@
 #include "reconstruct/scratch_buffer.h"
 #include "reconstruct/sgm_kernels.h"
 
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
 namespace stereorig {
 
 void SgmOptions::Check() const {
@@ -19,6 +23,55 @@ void SgmOptions::Check() const {
     throw InputError("sgm.uniqueness_percent", "must be in [0, 50]");
   if (lr_max_diff_px < 0) throw InputError("sgm.lr_max_diff_px", "must be >= 0 (0 = exact)");
 }
+
+namespace {
+
+#if defined(__AVX2__)
+// Census of pixels [x, x + 32) of one row, 32 at a time: each neighbour's
+// comparison sets one bit in one of 8 byte planes (plane j holds bits
+// 8j..8j+7 of every pixel's signature), then the planes are transposed into
+// 32 signatures. rows[i]: the padded copy (4 replicated px each side) of
+// row dy = i - half_height. Bit positions are those of the scalar loop:
+// the first neighbour in raster order is the highest bit.
+void Census32(const uint8_t* const* rows, int half_width, int half_height, int x, uint64_t* dst) {
+  const int count = (2 * half_width + 1) * (2 * half_height + 1) - 1;
+  __m256i plane[8];
+  for (__m256i& p : plane) p = _mm256_setzero_si256();
+  const __m256i centre = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(rows[half_height] + 4 + x));
+  int k = 0;
+  for (int dy = -half_height; dy <= half_height; ++dy)
+    for (int dx = -half_width; dx <= half_width; ++dx) {
+      if (dx == 0 && dy == 0) continue;
+      const int bit = count - 1 - k++;
+      const __m256i nb = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(rows[dy + half_height] + 4 + x + dx));
+      // nb < centre (unsigned) <=> max(nb, centre) != nb.
+      const __m256i not_darker = _mm256_cmpeq_epi8(_mm256_max_epu8(nb, centre), nb);
+      plane[bit >> 3] = _mm256_or_si256(plane[bit >> 3],
+                                        _mm256_andnot_si256(not_darker, _mm256_set1_epi8(char(1 << (bit & 7)))));
+    }
+  // Byte transpose, within each 128-bit half (pixels 0-15 | 16-31).
+  __m256i u[8], v[8];
+  for (int j = 0; j < 4; ++j) {
+    u[2 * j] = _mm256_unpacklo_epi8(plane[2 * j], plane[2 * j + 1]);      // px 0-7 | 16-23
+    u[2 * j + 1] = _mm256_unpackhi_epi8(plane[2 * j], plane[2 * j + 1]);  // px 8-15 | 24-31
+  }
+  for (int j = 0; j < 2; ++j)
+    for (int half = 0; half < 2; ++half) {
+      const __m256i a = u[4 * j + half], b = u[4 * j + 2 + half];
+      v[4 * j + 2 * half] = _mm256_unpacklo_epi16(a, b);      // 4 px of planes 4j..4j+3
+      v[4 * j + 2 * half + 1] = _mm256_unpackhi_epi16(a, b);  // the next 4 px
+    }
+  // v[q] (q = 0..3): planes 0-3 of px 4q..4q+3 | 16+4q..; v[4 + q]: planes 4-7.
+  for (int q = 0; q < 4; ++q) {
+    const __m256i lo = _mm256_unpacklo_epi32(v[q], v[4 + q]);  // px 4q, 4q+1 | 16+4q, 17+4q
+    const __m256i hi = _mm256_unpackhi_epi32(v[q], v[4 + q]);  // px 4q+2, 4q+3 | 18+4q, 19+4q
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(dst + x + 4 * q), _mm256_permute2x128_si256(lo, hi, 0x20));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(dst + x + 16 + 4 * q), _mm256_permute2x128_si256(lo, hi, 0x31));
+  }
+}
+#endif
+
+}  // namespace
 
 CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int num_threads, int half_width,
                             int half_height, int col_begin, int col_end) {
@@ -33,24 +86,41 @@ CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int
   out.bits.assign(size_t(grey.cols) * (row_end - row_begin), 0);
   const int w = grey.cols, h = grey.rows;
   const int c0 = std::clamp(col_begin, 0, w), c1 = std::clamp(col_end, c0, w);
+  const int window_rows = 2 * half_height + 1;
   ParallelForChunks(row_end - row_begin, num_threads, [&](int b, int e) {
-    std::vector<uint8_t> padded(w + 8);
+    // The window's rows, each with a replicated border of 4 px either side
+    // (keeps the inner loops branch-free).
+    std::vector<uint8_t> padded(size_t(window_rows) * (w + 8));
+    const uint8_t* rows[7];
     for (int y = row_begin + b; y < row_begin + e; ++y) {
-      const uint8_t* centre = grey.ptr<uint8_t>(y);
+      for (int i = 0; i < window_rows; ++i) {
+        const uint8_t* src = grey.ptr<uint8_t>(std::clamp(y + i - half_height, 0, h - 1));
+        uint8_t* row = padded.data() + size_t(i) * (w + 8);
+        for (int j = 0; j < 4; ++j) {
+          row[j] = src[0];
+          row[w + 4 + j] = src[w - 1];
+        }
+        std::copy(src, src + w, row + 4);
+        rows[i] = row;
+      }
       uint64_t* dst = out.bits.data() + size_t(y - row_begin) * w;
-      for (int dy = -half_height; dy <= half_height; ++dy) {
-        const uint8_t* src = grey.ptr<uint8_t>(std::clamp(y + dy, 0, h - 1));
-        // Replicated border in a padded copy keeps the inner loop branch-free.
-        for (int i = 0; i < 4; ++i) {
-          padded[i] = src[0];
-          padded[w + 4 + i] = src[w - 1];
-        }
-        std::copy(src, src + w, padded.begin() + 4);
-        for (int dx = -half_width; dx <= half_width; ++dx) {
-          if (dx == 0 && dy == 0) continue;
-          const uint8_t* nb = padded.data() + 4 + dx;
-          for (int x = c0; x < c1; ++x) dst[x] = (dst[x] << 1) | uint64_t(nb[x] < centre[x]);
-        }
+      int x = c0;
+#if defined(__AVX2__)
+      for (; x + 32 <= c1; x += 32) Census32(rows, half_width, half_height, x, dst);
+      // The tail: one more block ending at c1 (it rewrites some pixels with
+      // the same signatures).
+      if (x < c1 && c1 - c0 >= 32) {
+        Census32(rows, half_width, half_height, c1 - 32, dst);
+        x = c1;
+      }
+#endif
+      const uint8_t* centre = rows[half_height] + 4;
+      for (; x < c1; ++x) {
+        uint64_t bits = 0;
+        for (int dy = -half_height; dy <= half_height; ++dy)
+          for (int dx = -half_width; dx <= half_width; ++dx)
+            if (dx != 0 || dy != 0) bits = (bits << 1) | uint64_t(rows[dy + half_height][4 + x + dx] < centre[x]);
+        dst[x] = bits;
       }
     }
   });
