@@ -32,14 +32,18 @@ namespace {
 // 8j..8j+7 of every pixel's signature), then the planes are transposed into
 // 32 signatures. rows[i]: the padded copy (4 replicated px each side) of
 // row dy = i - half_height. Bit positions are those of the scalar loop:
-// the first neighbour in raster order is the highest bit.
-void Census32(const uint8_t* const* rows, int half_width, int half_height, int x, uint64_t* dst) {
-  const int count = (2 * half_width + 1) * (2 * half_height + 1) - 1;
+// the first neighbour in raster order is the highest bit. The window is a
+// template argument so the loops unroll and the planes stay in registers.
+template <int half_width, int half_height>
+void Census32(const uint8_t* const* rows, int x, uint64_t* dst) {
+  constexpr int count = (2 * half_width + 1) * (2 * half_height + 1) - 1;
   __m256i plane[8];
   for (__m256i& p : plane) p = _mm256_setzero_si256();
   const __m256i centre = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(rows[half_height] + 4 + x));
   int k = 0;
+#pragma GCC unroll 8
   for (int dy = -half_height; dy <= half_height; ++dy)
+#pragma GCC unroll 16
     for (int dx = -half_width; dx <= half_width; ++dx) {
       if (dx == 0 && dy == 0) continue;
       const int bit = count - 1 - k++;
@@ -69,6 +73,39 @@ void Census32(const uint8_t* const* rows, int half_width, int half_height, int x
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(dst + x + 16 + 4 * q), _mm256_permute2x128_si256(lo, hi, 0x31));
   }
 }
+
+// Census32 for [x, end) in blocks of 32, the last one ending at `end` (it
+// rewrites some pixels with the same signatures); end - x >= 32.
+template <int half_width, int half_height>
+void CensusRow32(const uint8_t* const* rows, int x, int end, uint64_t* dst) {
+  for (; x + 32 <= end; x += 32) Census32<half_width, half_height>(rows, x, dst);
+  if (x < end) Census32<half_width, half_height>(rows, end - 32, dst);
+}
+
+using CensusRowFn = void (*)(const uint8_t* const*, int, int, uint64_t*);
+template <int half_width>
+CensusRowFn CensusRowFor(int half_height) {
+  switch (half_height) {
+    case 1:
+      return &CensusRow32<half_width, 1>;
+    case 2:
+      return &CensusRow32<half_width, 2>;
+    default:
+      return &CensusRow32<half_width, 3>;
+  }
+}
+CensusRowFn CensusRowFor(int half_width, int half_height) {
+  switch (half_width) {
+    case 1:
+      return CensusRowFor<1>(half_height);
+    case 2:
+      return CensusRowFor<2>(half_height);
+    case 3:
+      return CensusRowFor<3>(half_height);
+    default:
+      return CensusRowFor<4>(half_height);
+  }
+}
 #endif
 
 }  // namespace
@@ -87,6 +124,9 @@ CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int
   const int w = grey.cols, h = grey.rows;
   const int c0 = std::clamp(col_begin, 0, w), c1 = std::clamp(col_end, c0, w);
   const int window_rows = 2 * half_height + 1;
+#if defined(__AVX2__)
+  const CensusRowFn census_row = CensusRowFor(half_width, half_height);
+#endif
   ParallelForChunks(row_end - row_begin, num_threads, [&](int b, int e) {
     // The window's rows, each with a replicated border of 4 px either side
     // (keeps the inner loops branch-free).
@@ -106,11 +146,8 @@ CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int
       uint64_t* dst = out.bits.data() + size_t(y - row_begin) * w;
       int x = c0;
 #if defined(__AVX2__)
-      for (; x + 32 <= c1; x += 32) Census32(rows, half_width, half_height, x, dst);
-      // The tail: one more block ending at c1 (it rewrites some pixels with
-      // the same signatures).
-      if (x < c1 && c1 - c0 >= 32) {
-        Census32(rows, half_width, half_height, c1 - 32, dst);
+      if (c1 - c0 >= 32) {
+        census_row(rows, c0, c1, dst);
         x = c1;
       }
 #endif
