@@ -6,7 +6,12 @@
 
 #include "calib/core/input_error.h"
 #include "reconstruct/parallel_for.h"
+#include "reconstruct/scratch_buffer.h"
 #include "reconstruct/sgm_kernels.h"
+
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
 
 namespace stereorig {
 
@@ -18,6 +23,92 @@ void SgmOptions::Check() const {
     throw InputError("sgm.uniqueness_percent", "must be in [0, 50]");
   if (lr_max_diff_px < 0) throw InputError("sgm.lr_max_diff_px", "must be >= 0 (0 = exact)");
 }
+
+namespace {
+
+#if defined(__AVX2__)
+// Census of pixels [x, x + 32) of one row, 32 at a time: each neighbour's
+// comparison sets one bit in one of 8 byte planes (plane j holds bits
+// 8j..8j+7 of every pixel's signature), then the planes are transposed into
+// 32 signatures. rows[i]: the padded copy (4 replicated px each side) of
+// row dy = i - half_height. Bit positions are those of the scalar loop:
+// the first neighbour in raster order is the highest bit. The window is a
+// template argument so the loops unroll and the planes stay in registers.
+template <int half_width, int half_height>
+void Census32(const uint8_t* const* rows, int x, uint64_t* dst) {
+  constexpr int count = (2 * half_width + 1) * (2 * half_height + 1) - 1;
+  __m256i plane[8];
+  for (__m256i& p : plane) p = _mm256_setzero_si256();
+  const __m256i centre = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(rows[half_height] + 4 + x));
+  int k = 0;
+#pragma GCC unroll 8
+  for (int dy = -half_height; dy <= half_height; ++dy)
+#pragma GCC unroll 16
+    for (int dx = -half_width; dx <= half_width; ++dx) {
+      if (dx == 0 && dy == 0) continue;
+      const int bit = count - 1 - k++;
+      const __m256i nb = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(rows[dy + half_height] + 4 + x + dx));
+      // nb < centre (unsigned) <=> max(nb, centre) != nb.
+      const __m256i not_darker = _mm256_cmpeq_epi8(_mm256_max_epu8(nb, centre), nb);
+      plane[bit >> 3] = _mm256_or_si256(plane[bit >> 3],
+                                        _mm256_andnot_si256(not_darker, _mm256_set1_epi8(char(1 << (bit & 7)))));
+    }
+  // Byte transpose, within each 128-bit half (pixels 0-15 | 16-31).
+  __m256i u[8], v[8];
+  for (int j = 0; j < 4; ++j) {
+    u[2 * j] = _mm256_unpacklo_epi8(plane[2 * j], plane[2 * j + 1]);      // px 0-7 | 16-23
+    u[2 * j + 1] = _mm256_unpackhi_epi8(plane[2 * j], plane[2 * j + 1]);  // px 8-15 | 24-31
+  }
+  for (int j = 0; j < 2; ++j)
+    for (int half = 0; half < 2; ++half) {
+      const __m256i a = u[4 * j + half], b = u[4 * j + 2 + half];
+      v[4 * j + 2 * half] = _mm256_unpacklo_epi16(a, b);      // 4 px of planes 4j..4j+3
+      v[4 * j + 2 * half + 1] = _mm256_unpackhi_epi16(a, b);  // the next 4 px
+    }
+  // v[q] (q = 0..3): planes 0-3 of px 4q..4q+3 | 16+4q..; v[4 + q]: planes 4-7.
+  for (int q = 0; q < 4; ++q) {
+    const __m256i lo = _mm256_unpacklo_epi32(v[q], v[4 + q]);  // px 4q, 4q+1 | 16+4q, 17+4q
+    const __m256i hi = _mm256_unpackhi_epi32(v[q], v[4 + q]);  // px 4q+2, 4q+3 | 18+4q, 19+4q
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(dst + x + 4 * q), _mm256_permute2x128_si256(lo, hi, 0x20));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(dst + x + 16 + 4 * q), _mm256_permute2x128_si256(lo, hi, 0x31));
+  }
+}
+
+// Census32 for [x, end) in blocks of 32, the last one ending at `end` (it
+// rewrites some pixels with the same signatures); end - x >= 32.
+template <int half_width, int half_height>
+void CensusRow32(const uint8_t* const* rows, int x, int end, uint64_t* dst) {
+  for (; x + 32 <= end; x += 32) Census32<half_width, half_height>(rows, x, dst);
+  if (x < end) Census32<half_width, half_height>(rows, end - 32, dst);
+}
+
+using CensusRowFn = void (*)(const uint8_t* const*, int, int, uint64_t*);
+template <int half_width>
+CensusRowFn CensusRowFor(int half_height) {
+  switch (half_height) {
+    case 1:
+      return &CensusRow32<half_width, 1>;
+    case 2:
+      return &CensusRow32<half_width, 2>;
+    default:
+      return &CensusRow32<half_width, 3>;
+  }
+}
+CensusRowFn CensusRowFor(int half_width, int half_height) {
+  switch (half_width) {
+    case 1:
+      return CensusRowFor<1>(half_height);
+    case 2:
+      return CensusRowFor<2>(half_height);
+    case 3:
+      return CensusRowFor<3>(half_height);
+    default:
+      return CensusRowFor<4>(half_height);
+  }
+}
+#endif
+
+}  // namespace
 
 CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int num_threads, int half_width,
                             int half_height, int col_begin, int col_end) {
@@ -32,24 +123,41 @@ CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int
   out.bits.assign(size_t(grey.cols) * (row_end - row_begin), 0);
   const int w = grey.cols, h = grey.rows;
   const int c0 = std::clamp(col_begin, 0, w), c1 = std::clamp(col_end, c0, w);
+  const int window_rows = 2 * half_height + 1;
+#if defined(__AVX2__)
+  const CensusRowFn census_row = CensusRowFor(half_width, half_height);
+#endif
   ParallelForChunks(row_end - row_begin, num_threads, [&](int b, int e) {
-    std::vector<uint8_t> padded(w + 8);
+    // The window's rows, each with a replicated border of 4 px either side
+    // (keeps the inner loops branch-free).
+    std::vector<uint8_t> padded(size_t(window_rows) * (w + 8));
+    const uint8_t* rows[7];
     for (int y = row_begin + b; y < row_begin + e; ++y) {
-      const uint8_t* centre = grey.ptr<uint8_t>(y);
+      for (int i = 0; i < window_rows; ++i) {
+        const uint8_t* src = grey.ptr<uint8_t>(std::clamp(y + i - half_height, 0, h - 1));
+        uint8_t* row = padded.data() + size_t(i) * (w + 8);
+        for (int j = 0; j < 4; ++j) {
+          row[j] = src[0];
+          row[w + 4 + j] = src[w - 1];
+        }
+        std::copy(src, src + w, row + 4);
+        rows[i] = row;
+      }
       uint64_t* dst = out.bits.data() + size_t(y - row_begin) * w;
-      for (int dy = -half_height; dy <= half_height; ++dy) {
-        const uint8_t* src = grey.ptr<uint8_t>(std::clamp(y + dy, 0, h - 1));
-        // Replicated border in a padded copy keeps the inner loop branch-free.
-        for (int i = 0; i < 4; ++i) {
-          padded[i] = src[0];
-          padded[w + 4 + i] = src[w - 1];
-        }
-        std::copy(src, src + w, padded.begin() + 4);
-        for (int dx = -half_width; dx <= half_width; ++dx) {
-          if (dx == 0 && dy == 0) continue;
-          const uint8_t* nb = padded.data() + 4 + dx;
-          for (int x = c0; x < c1; ++x) dst[x] = (dst[x] << 1) | uint64_t(nb[x] < centre[x]);
-        }
+      int x = c0;
+#if defined(__AVX2__)
+      if (c1 - c0 >= 32) {
+        census_row(rows, c0, c1, dst);
+        x = c1;
+      }
+#endif
+      const uint8_t* centre = rows[half_height] + 4;
+      for (; x < c1; ++x) {
+        uint64_t bits = 0;
+        for (int dy = -half_height; dy <= half_height; ++dy)
+          for (int dx = -half_width; dx <= half_width; ++dx)
+            if (dx != 0 || dy != 0) bits = (bits << 1) | uint64_t(rows[dy + half_height][4 + x + dx] < centre[x]);
+        dst[x] = bits;
       }
     }
   });
@@ -69,15 +177,15 @@ namespace {
 using sgm::kBig;
 using sgm::SumMode;
 
-// The big buffers of one SgmMatch call, allocated once per call (the band
-// pass and the full-resolution pass are separate calls). Keeping them per
+// The buffers of one SgmMatch call, allocated once per call (the band pass
+// and the full-resolution pass are separate calls). The two big ones, the
+// cost volume and the forward sums, are ScratchArrays (not zeroed: every
+// element is written before it is read; huge pages). Keeping them per
 // thread across calls was tried: page faults stayed ~1.5 % of the runtime's
 // cycles either way (cv::Mat allocations dominate them), while the retained
 // volumes overlapped the sub-pixel step's buffers and raised the peak of
 // `reconstruct` on the plate from 230 to 293 MB.
 struct SgmWorkspace {
-  std::vector<uint8_t> cost;             // (h, w, stride)
-  std::vector<uint16_t> sum;             // (h or 1, w, stride)
   std::vector<uint16_t> total_row;       // (w, stride): backward pass
   std::vector<uint16_t> vert_a, vert_b;  // (w, stride + 2): top/bottom path, previous and current row
   std::vector<uint16_t> vert_min_a, vert_min_b;
@@ -111,12 +219,16 @@ uint16_t* PathBuffers(std::vector<uint16_t>& v, int count, int stride) {
 // i + shift falls outside the neighbour's n disparities (it never searched
 // them: "no match there"), and kBig at [-1] and [n, stride] as in any path
 // buffer. shift == 0 returns prev itself.
-const uint16_t* InWindowOf(const uint16_t* prev, int shift, int n, int stride, uint16_t* buf) {
-  if (shift == 0) return prev;
+// (The copy is out of line and the test inline: it runs once per pixel and
+// path, and only the guided search ever shifts.)
+[[gnu::noinline]] const uint16_t* ShiftedCopy(const uint16_t* prev, int shift, int n, int stride, uint16_t* buf) {
   std::fill(buf - 1, buf + stride + 1, kBig);
   const int i0 = std::max(0, -shift), i1 = std::min(n, n - shift);
   if (i0 < i1) std::copy(prev + i0 + shift, prev + i1 + shift, buf + i0);
   return buf;
+}
+inline const uint16_t* InWindowOf(const uint16_t* prev, int shift, int n, int stride, uint16_t* buf) {
+  return shift == 0 ? prev : ShiftedCopy(prev, shift, n, stride, buf);
 }
 
 // SGM with per-pixel search windows: pixel (x, y) of `region` searches the
@@ -140,7 +252,8 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   // off the image get the maximum cost, so they are never preferred. The
   // right row is reversed (with `stride` padding each side) so that each
   // pixel's run of disparities reads it forwards.
-  uint8_t* cost = Grow(ws.cost, size_t(h) * w * stride);
+  ScratchArray<uint8_t> cost_volume(size_t(h) * w * stride);
+  uint8_t* cost = cost_volume.data();
   uint64_t* reversed = Grow(ws.right_reversed, size_t(rw) + 2 * stride + 16);
   std::fill(reversed, reversed + size_t(rw) + 2 * stride + 16, 0);
   for (int y = 0; y < h; ++y) {
@@ -165,7 +278,8 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
 
   // Aggregated cost (h, w, stride) when a second pass is needed; otherwise one row.
   const bool two_pass = options.num_paths == 4;
-  uint16_t* sum = Grow(ws.sum, size_t(two_pass ? h : 1) * w * stride);
+  ScratchArray<uint16_t> sums(size_t(two_pass ? h : 1) * w * stride);
+  uint16_t* sum = sums.data();
   uint16_t* vert_prev = PathBuffers(ws.vert_a, w, stride);
   uint16_t* vert_cur = PathBuffers(ws.vert_b, w, stride);
   uint16_t* vert_prev_min = Grow(ws.vert_min_a, w);
@@ -223,18 +337,19 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   };
 
   // One row of the vertical path (top->bottom or bottom->top; lo_prev: the
-  // windows of the row before along the path), then the two horizontal
-  // paths, all accumulated into srow.
-  auto vertical = [&](const uint8_t* crow, const int16_t* lo, const int16_t* lo_prev, uint16_t* srow,
-                      SumMode mode) {
+  // windows of the row before along the path), accumulated (SumMode) from
+  // sin into srow.
+  auto vertical = [&](const uint8_t* crow, const int16_t* lo, const int16_t* lo_prev, const uint16_t* sin,
+                      uint16_t* srow, SumMode mode) {
     for (int x = 0; x < w; ++x) {
       uint16_t* cur = vert_cur + size_t(x) * path_stride;
       const uint8_t* c = crow + size_t(x) * stride;
+      const size_t xs = size_t(x) * stride;
       vert_cur_min[x] =
           lo_prev == nullptr
-              ? K::First(c, cur, srow + size_t(x) * stride, mode, n, stride)
+              ? K::First(c, cur, sin + xs, srow + xs, mode, n, stride)
               : K::Step(c, InWindowOf(vert_prev + size_t(x) * path_stride, lo[x] - lo_prev[x], n, stride, shifted),
-                        vert_prev_min[x], cur, srow + size_t(x) * stride, mode, n, stride, p1, p2);
+                        vert_prev_min[x], cur, sin + xs, srow + xs, mode, n, stride, p1, p2);
     }
     std::swap(vert_prev, vert_cur);
     std::swap(vert_prev_min, vert_cur_min);
@@ -245,15 +360,15 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   uint16_t* shifted_rl = PathBuffers(ws.shifted_rl, 1, stride);
   auto horizontal = [&](const uint8_t* crow, const int16_t* lo, uint16_t* srow) {
     const size_t last = size_t(w - 1) * stride;
-    uint16_t m_lr = K::First(crow, ha, srow, SumMode::kAdd, n, stride);
-    uint16_t m_rl = K::First(crow + last, hc, srow + last, SumMode::kAdd, n, stride);
+    uint16_t m_lr = K::First(crow, ha, srow, srow, SumMode::kAdd, n, stride);
+    uint16_t m_rl = K::First(crow + last, hc, srow + last, srow + last, SumMode::kAdd, n, stride);
     for (int i = 1; i < w; ++i) {
       const int il = i, ir = w - 1 - i;
       const size_t xl = size_t(il) * stride, xr = size_t(ir) * stride;
       m_lr = K::Step(crow + xl, InWindowOf(ha, lo[il] - lo[il - 1], n, stride, shifted), m_lr, hb, srow + xl,
-                     SumMode::kAdd, n, stride, p1, p2);
+                     srow + xl, SumMode::kAdd, n, stride, p1, p2);
       m_rl = K::Step(crow + xr, InWindowOf(hc, lo[ir] - lo[ir + 1], n, stride, shifted_rl), m_rl, hd, srow + xr,
-                     SumMode::kAdd, n, stride, p1, p2);
+                     srow + xr, SumMode::kAdd, n, stride, p1, p2);
       std::swap(ha, hb);
       std::swap(hc, hd);
     }
@@ -263,20 +378,20 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   for (int y = 0; y < h; ++y) {
     uint16_t* srow = sum + (two_pass ? size_t(y) * w * stride : 0);
     const uint8_t* crow = cost + size_t(y) * w * stride;
-    vertical(crow, lo_row(y), y == 0 ? nullptr : lo_row(y - 1), srow, SumMode::kStore);
+    vertical(crow, lo_row(y), y == 0 ? nullptr : lo_row(y - 1), srow, srow, SumMode::kStore);
     horizontal(crow, lo_row(y), srow);
     if (!two_pass) winner_take_all(y, srow);
   }
   if (!two_pass) return disparity;
 
   // Backward pass: bottom -> top, then the winner per row. The row's total
-  // goes to a cache-resident copy, so the volume is only read, never
-  // written back (the pass is memory-bound).
+  // (forward sums + this path) goes to a cache-resident row, so the volume
+  // is only read, never written back (the pass is memory-bound).
   uint16_t* total = Grow(ws.total_row, size_t(w) * stride);
   for (int y = h - 1; y >= 0; --y) {
     const uint16_t* srow = sum + size_t(y) * w * stride;
-    std::copy(srow, srow + size_t(w) * stride, total);
-    vertical(cost + size_t(y) * w * stride, lo_row(y), y == h - 1 ? nullptr : lo_row(y + 1), total, SumMode::kAdd);
+    vertical(cost + size_t(y) * w * stride, lo_row(y), y == h - 1 ? nullptr : lo_row(y + 1), srow, total,
+             SumMode::kAdd);
     winner_take_all(y, total);
   }
   return disparity;

@@ -2,9 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <utility>
 
 namespace stereorig {
 namespace {
@@ -30,6 +32,41 @@ cv::Mat RandomImage(std::mt19937& rng, int w, int h) {
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) img.at<uint8_t>(y, x) = uint8_t(grey(rng));
   return img;
+}
+
+// The signatures against their definition (census_sgm.h), computed here
+// pixel by pixel: bit (count - 1 - k) is set iff neighbour k in raster order
+// (centre skipped) is darker than the centre, borders replicate the edge.
+// Widths that are not multiples of 32 exercise both the 32-pixel AVX2
+// blocks and the per-pixel tail; grey levels 0..3 make ties (not darker)
+// frequent.
+TEST(CensusSgm, CensusTransformMatchesItsDefinition) {
+  std::mt19937 rng(11);
+  const int w = 101, h = 17;
+  for (const int levels : {256, 4}) {
+    cv::Mat img = RandomImage(rng, w, h);
+    if (levels < 256) img = img / (256 / levels);
+    for (const auto& [hw, hh] : {std::pair{1, 1}, std::pair{2, 3}, std::pair{4, 3}, std::pair{3, 2}})
+      for (const auto& [c0, c1] : {std::pair{0, w}, std::pair{5, 77}}) {
+        const int r0 = 2, r1 = 15;
+        const CensusImage c = CensusTransform(img, r0, r1, 2, hw, hh, c0, c1);
+        int wrong = 0;
+        for (int y = r0; y < r1; ++y)
+          for (int x = 0; x < w; ++x) {
+            uint64_t expected = 0;
+            if (x >= c0 && x < c1)
+              for (int dy = -hh; dy <= hh; ++dy)
+                for (int dx = -hw; dx <= hw; ++dx) {
+                  if (dx == 0 && dy == 0) continue;
+                  const uint8_t nb = img.at<uint8_t>(std::clamp(y + dy, 0, h - 1), std::clamp(x + dx, 0, w - 1));
+                  expected = (expected << 1) | uint64_t(nb < img.at<uint8_t>(y, x));
+                }
+            wrong += c.row(y)[x] != expected;
+          }
+        EXPECT_EQ(wrong, 0) << "levels " << levels << ", window " << 2 * hw + 1 << "x" << 2 * hh + 1 << ", columns ["
+                            << c0 << ", " << c1 << ")";
+      }
+  }
 }
 
 TEST(CensusSgm, SimdAndScalarPathsGiveIdenticalDisparities) {

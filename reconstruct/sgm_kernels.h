@@ -22,11 +22,13 @@ namespace stereorig::sgm {
 
 inline constexpr uint16_t kBig = 0x3FFF;  // "impossible" path cost; 4 x kBig still fits uint16
 
-// What a path step does with the sum of paths: start it, or add to it.
+// What a path step does with the sum of paths: start it (sum = v), or add
+// to the sum so far (sum = sum_in + v; sum_in may be sum itself, or the
+// forward pass's sums when the backward pass writes a row's total apart).
 enum class SumMode { kStore, kAdd };
 
-inline void Accumulate(uint16_t* sum, uint16_t v, SumMode mode) {
-  *sum = mode == SumMode::kStore ? v : uint16_t(*sum + v);
+inline void Accumulate(uint16_t* sum, const uint16_t* sum_in, uint16_t v, SumMode mode) {
+  *sum = mode == SumMode::kStore ? v : uint16_t(*sum_in + v);
 }
 
 struct ScalarKernels {
@@ -39,10 +41,10 @@ struct ScalarKernels {
 
   // One SGM recursion step along a path:
   //   cur[d] = c[d] + min(prev[d], prev[d-1]+p1, prev[d+1]+p1, prev_min+p2) - prev_min,
-  // accumulated into sum[d]. Returns min_d cur[d].
+  // accumulated into sum[d] (SumMode). Returns min_d cur[d].
   static uint16_t Step(const uint8_t* __restrict c, const uint16_t* __restrict prev, uint16_t prev_min,
-                       uint16_t* __restrict cur, uint16_t* __restrict sum, SumMode mode, int n, int /*stride*/,
-                       uint16_t p1, uint16_t p2) {
+                       uint16_t* __restrict cur, const uint16_t* sum_in, uint16_t* sum, SumMode mode, int n,
+                       int /*stride*/, uint16_t p1, uint16_t p2) {
     const uint16_t cap = uint16_t(prev_min + p2);
     uint16_t m = 0xFFFF;
     for (int d = 0; d < n; ++d) {
@@ -50,19 +52,19 @@ struct ScalarKernels {
       const uint16_t b = std::min(uint16_t(prev[d - 1] + p1), uint16_t(prev[d + 1] + p1));
       const uint16_t r = uint16_t(c[d] + std::min(a, b) - prev_min);
       cur[d] = r;
-      Accumulate(sum + d, r, mode);
+      Accumulate(sum + d, sum_in + d, r, mode);
       m = std::min(m, r);
     }
     return m;
   }
 
   // The first pixel of a path: cur = c.
-  static uint16_t First(const uint8_t* __restrict c, uint16_t* __restrict cur, uint16_t* __restrict sum, SumMode mode,
-                        int n, int /*stride*/) {
+  static uint16_t First(const uint8_t* __restrict c, uint16_t* __restrict cur, const uint16_t* sum_in, uint16_t* sum,
+                        SumMode mode, int n, int /*stride*/) {
     uint16_t m = 0xFFFF;
     for (int d = 0; d < n; ++d) {
       cur[d] = c[d];
-      Accumulate(sum + d, c[d], mode);
+      Accumulate(sum + d, sum_in + d, c[d], mode);
       m = std::min(m, cur[d]);
     }
     return m;
@@ -110,8 +112,8 @@ struct Avx2Kernels {
     return _mm256_and_si256(_mm256_cmpgt_epi16(lane, _mm256_set1_epi16(int16_t(k - 1))), _mm256_set1_epi16(kBig));
   }
 
-  static void Accumulate(uint16_t* sum, __m256i v, SumMode mode) {
-    Store(sum, mode == SumMode::kStore ? v : _mm256_add_epi16(Load(sum), v));
+  static void Accumulate(uint16_t* sum, const uint16_t* sum_in, __m256i v, SumMode mode) {
+    Store(sum, mode == SumMode::kStore ? v : _mm256_add_epi16(Load(sum_in), v));
   }
 
   // All `stride` lanes (lo, hi ignored: the caller overwrites lanes outside
@@ -152,34 +154,39 @@ struct Avx2Kernels {
   }
 
   static uint16_t Step(const uint8_t* __restrict c, const uint16_t* __restrict prev, uint16_t prev_min,
-                       uint16_t* __restrict cur, uint16_t* __restrict sum, SumMode mode, int n, int stride, uint16_t p1,
-                       uint16_t p2) {
+                       uint16_t* __restrict cur, const uint16_t* sum_in, uint16_t* sum, SumMode mode, int n,
+                       int stride, uint16_t p1, uint16_t p2) {
     const __m256i vp1 = _mm256_set1_epi16(int16_t(p1));
     const __m256i cap = _mm256_set1_epi16(int16_t(uint16_t(prev_min + p2)));
     const __m256i vprev_min = _mm256_set1_epi16(int16_t(prev_min));
     __m256i m = _mm256_set1_epi16(-1);
-    for (int d = 0; d < stride; d += 16) {
+    auto block = [&](int d) {
       const __m256i cost = _mm256_cvtepu8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(c + d)));
       const __m256i a = _mm256_min_epu16(Load(prev + d), cap);
       const __m256i b =
           _mm256_min_epu16(_mm256_add_epi16(Load(prev + d - 1), vp1), _mm256_add_epi16(Load(prev + d + 1), vp1));
-      __m256i r = _mm256_sub_epi16(_mm256_add_epi16(cost, _mm256_min_epu16(a, b)), vprev_min);
-      if (d + 16 > n) r = _mm256_max_epu16(r, PadMask(n - d));
+      return _mm256_sub_epi16(_mm256_add_epi16(cost, _mm256_min_epu16(a, b)), vprev_min);
+    };
+    auto finish = [&](int d, __m256i r) {
       Store(cur + d, r);
-      Accumulate(sum + d, r, mode);
+      Accumulate(sum + d, sum_in + d, r, mode);
       m = _mm256_min_epu16(m, r);
-    }
+    };
+    // Whole blocks, then the one holding padding lanes (if any).
+    const int whole = n / 16 * 16;
+    for (int d = 0; d < whole; d += 16) finish(d, block(d));
+    if (whole < stride) finish(whole, _mm256_max_epu16(block(whole), PadMask(n - whole)));
     return HorizontalMin(m);
   }
 
-  static uint16_t First(const uint8_t* __restrict c, uint16_t* __restrict cur, uint16_t* __restrict sum, SumMode mode,
-                        int n, int stride) {
+  static uint16_t First(const uint8_t* __restrict c, uint16_t* __restrict cur, const uint16_t* sum_in, uint16_t* sum,
+                        SumMode mode, int n, int stride) {
     __m256i m = _mm256_set1_epi16(-1);
     for (int d = 0; d < stride; d += 16) {
       __m256i r = _mm256_cvtepu8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(c + d)));
       if (d + 16 > n) r = _mm256_max_epu16(r, PadMask(n - d));
       Store(cur + d, r);
-      Accumulate(sum + d, r, mode);
+      Accumulate(sum + d, sum_in + d, r, mode);
       m = _mm256_min_epu16(m, r);
     }
     return HorizontalMin(m);
