@@ -163,7 +163,9 @@ cv::Mat MatchLevel(const cv::Mat& left, const cv::Mat& right, const cv::Rect& re
 
 // Removes connected blobs of similar disparity smaller than the window, on a
 // 1/16 px fixed-point copy (OpenCV's filterSpeckles does the labelling).
-void RemoveSpeckles(cv::Mat& disparity_px, const MatchOptions& o) {
+// disparity_px may be a view (the ROI of a full-image map): it is written in
+// place.
+void RemoveSpeckles(cv::Mat disparity_px, const MatchOptions& o) {
   if (o.speckle_window_px <= 0) return;
   constexpr int16_t kInvalid = std::numeric_limits<int16_t>::min();
   cv::Mat fixed(disparity_px.size(), CV_16SC1);
@@ -403,7 +405,7 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
   // Seeds for the line-index test and growing: only the blobs the speckle
   // filter keeps (a small mismatched blob would otherwise grow into a large
   // wrong surface); the filter runs again on the grown map.
-  RemoveSpeckles(state.disparity_px, o);
+  RemoveSpeckles(state.disparity_px(roi), o);  // outside the ROI nothing is valid
   if (o.intensity_refinement && (o.line_index.enabled || o.grow.enabled)) {
     CorrectLineIndex(left, right, roi, o.line_index, accept, &state);
     lap("line_index");
@@ -429,14 +431,14 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
     } else {
       lap("line_index_2");
     }
-    RemoveSpeckles(state.disparity_px, o);
+    RemoveSpeckles(state.disparity_px(roi), o);  // outside the ROI nothing is valid
   }
   DropRightInvisible(o.occlusion_margin_px, o.right_valid, roi, &state);
-  for (int y = 0; y < left.rows; ++y) {
+  for (int y = roi.y; y < roi.y + roi.height; ++y) {  // outside the ROI: no point, confidence 0 already
     const float* d = state.disparity_px.ptr<float>(y);
     float* c = state.confidence.ptr<float>(y);
     uint8_t* status = state.status.ptr<uint8_t>(y);
-    for (int x = 0; x < left.cols; ++x)
+    for (int x = roi.x; x < roi.x + roi.width; ++x)
       if (!std::isfinite(d[x])) {
         c[x] = 0;
         if (status[x] == uint8_t(PixelStatus::kPoint)) status[x] = uint8_t(PixelStatus::kSpeckle);
