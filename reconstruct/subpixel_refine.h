@@ -40,7 +40,7 @@ struct SubpixelResult {
   // bound when the misfit is white noise (the synthetic pairs: matches the
   // scatter, subpixel_sigma_test.cc). On the simulator's captures the misfit
   // is mostly laser speckle, correlated over ~2 px and so over fewer
-  // independent samples than n: the true scatter there is ~2.5-3.5x this
+  // independent samples than n: the true scatter there is ~2-4x this
   // (a relative confidence, not an absolute one). 0 when the dense fit
   // (dense_refine.h) produced the result.
   double disparity_sigma_px = 0;
