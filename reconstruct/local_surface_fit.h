@@ -30,10 +30,10 @@
 //     window (a straight silhouette through the centre) predicts 0.063,
 //     i.e. worse than no fit;
 //   - the quadric explains the window: the RMS misfit is at most
-//     max_misfit_ratio times the median misfit over all fitted windows (and
-//     never less than 0.05 px)
-//     (a depth edge, two components one grid period apart, or a surface
-//     curving faster than a quadric over the window misfit far more).
+//     max_misfit_ratio times the median misfit over all fitted windows, or
+//     0.05 px if that is more (a depth edge, two components one grid period
+//     apart, or a surface curving faster than a quadric over the window
+//     misfit far more).
 // Cost: the lateral detail finer than a quadric over the window (~4 x 2 mm
 // at 200 mm by default) is smoothed away; the fill is unchanged.
 #pragma once
