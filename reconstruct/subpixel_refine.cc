@@ -56,7 +56,7 @@ SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x,
   // r sampled at x+u - d - gx*u - gy*v, so de/dd = gain * r' and the
   // Jacobian row is J = (gain r', -r, -1).
   double d = start_px, gain = 1.0, offset = 0.0;
-  FitPassSums s;             // of the last pass, for the ZNCC
+  FitPassSums s;           // of the last pass, for the ZNCC
   double variance_dd = 0;  // (J^T J)^-1 [d, d] times the residual variance, of the last pass
   for (int it = 0; it < o.max_iterations; ++it) {
     s = window.FitPass(d, float(gain), float(offset));
@@ -75,8 +75,8 @@ SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x,
       // of a pixel's misfit, sensor noise and what the model does not
       // capture (speckle that differs between the views).
       const double a = float(gain), b = float(offset);
-      const double ee = double(window.left_sum2()) - 2 * a * s.lr - 2 * b * double(window.left_sum()) +
-                        a * a * s.rr + 2 * a * b * s.r + nwin * b * b;
+      const double ee = double(window.left_sum2()) - 2 * a * s.lr - 2 * b * double(window.left_sum()) + a * a * s.rr +
+                        2 * a * b * s.r + nwin * b * b;
       const double rss = std::max(0.0, ee - (minus_jte[0] * step[0] + minus_jte[1] * step[1] + minus_jte[2] * step[2]));
       const double unit[3] = {1, 0, 0};
       double column[3];
