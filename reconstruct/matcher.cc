@@ -60,6 +60,7 @@ void MatchOptions::Check() const {
   subpixel.Check();
   line_index.Check();
   grow.Check();
+  surface_fit.Check();
   if (!(min_zncc >= -1 && min_zncc < 1)) throw InputError("min_zncc", "must be in [-1, 1)");
   if (!(max_plane_deviation_px >= 0)) throw InputError("max_plane_deviation_px", "must be >= 0 (0 = off)");
   if (!(min_texture_dn >= 0)) throw InputError("min_texture_dn", "must be >= 0");
@@ -444,10 +445,14 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
         if (status[x] == uint8_t(PixelStatus::kPoint)) status[x] = uint8_t(PixelStatus::kSpeckle);
       }
   }
+  lap("speckle");
+  if (o.surface_fit.enabled) {
+    FitLocalSurface(roi, o.surface_fit, o.num_threads, &state.disparity_px);
+    lap("surface_fit");
+  }
   result.disparity_px = state.disparity_px;
   result.confidence = state.confidence;
   result.status = state.status;
-  lap("speckle");
   return result;
 }
 

@@ -91,6 +91,12 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.speckle_window_px = m.GetInt("speckle_window_px", mo.speckle_window_px);
     mo.speckle_range_px = m.GetDouble("speckle_range_px", mo.speckle_range_px);
     mo.occlusion_margin_px = m.GetDouble("occlusion_margin_px", mo.occlusion_margin_px);
+    mo.surface_fit.enabled = m.GetBool("surface_fit", mo.surface_fit.enabled);
+    mo.surface_fit.half_width_px = m.GetInt("surface_fit_half_width_px", mo.surface_fit.half_width_px);
+    mo.surface_fit.half_height_px = m.GetInt("surface_fit_half_height_px", mo.surface_fit.half_height_px);
+    mo.surface_fit.max_variance_growth =
+        m.GetDouble("surface_fit_max_variance_growth", mo.surface_fit.max_variance_growth);
+    mo.surface_fit.max_misfit_ratio = m.GetDouble("surface_fit_max_misfit_ratio", mo.surface_fit.max_misfit_ratio);
     mo.sgbm_block_size = m.GetInt("sgbm_block_size", mo.sgbm_block_size);
     mo.num_threads = m.GetInt("num_threads", mo.num_threads);
     mo.line_index.enabled = m.GetBool("line_index", mo.line_index.enabled);

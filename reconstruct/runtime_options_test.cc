@@ -1,4 +1,4 @@
-// Runtime options: the hole-filling keys are read, defaulted and checked
+// Runtime options: the hole-filling and surface-fit keys are read, defaulted and checked
 // (a bad value or an unknown key is an InputError naming it).
 #include "reconstruct/runtime_options.h"
 
@@ -10,6 +10,19 @@
 
 namespace stereorig {
 namespace {
+
+// Each (YAML text, key) must fail to parse with an InputError that names the key.
+template <size_t N>
+void ExpectEachRejectedNamingItsKey(const std::pair<const char*, const char*> (&bad)[N]) {
+  for (const auto& [text, key] : bad) {
+    try {
+      ParseRuntimeOptions(text, "bad.yaml");
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
+}
 
 TEST(RuntimeOptions, ReadsAndChecksTheFillKeys) {
   const RuntimeOptions d = ParseRuntimeOptions("shape_model: ellipsoid\n", "defaults.yaml");
@@ -23,14 +36,30 @@ TEST(RuntimeOptions, ReadsAndChecksTheFillKeys) {
                                                      {"fill_residual_length_mm: -3\n", "fill_residual_length_mm"},
                                                      {"fill_follow_residuals: maybe\n", "fill_follow_residuals"},
                                                      {"fill_follow_residual: true\n", "fill_follow_residual"}};
-  for (const auto& [text, key] : bad) {
-    try {
-      ParseRuntimeOptions(text, "bad.yaml");
-      ADD_FAILURE() << "accepted: " << text;
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
-    }
-  }
+  ExpectEachRejectedNamingItsKey(bad);
+}
+
+TEST(RuntimeOptions, ReadsAndChecksTheSurfaceFitKeys) {
+  const RuntimeOptions d = ParseRuntimeOptions("min_confidence: 0.5\n", "defaults.yaml");
+  EXPECT_TRUE(d.match.surface_fit.enabled);
+  EXPECT_EQ(d.match.surface_fit.half_width_px, 10);
+  EXPECT_EQ(d.match.surface_fit.half_height_px, 5);
+  const RuntimeOptions o = ParseRuntimeOptions(
+      "match:\n  surface_fit: false\n  surface_fit_half_width_px: 12\n  surface_fit_half_height_px: 6\n"
+      "  surface_fit_max_variance_growth: 2\n  surface_fit_max_misfit_ratio: 3\n",
+      "set.yaml");
+  EXPECT_FALSE(o.match.surface_fit.enabled);
+  EXPECT_EQ(o.match.surface_fit.half_width_px, 12);
+  EXPECT_EQ(o.match.surface_fit.half_height_px, 6);
+  EXPECT_EQ(o.match.surface_fit.max_variance_growth, 2.0);
+  EXPECT_EQ(o.match.surface_fit.max_misfit_ratio, 3.0);
+  const std::pair<const char*, const char*> bad[] = {
+      {"match:\n  surface_fit_half_width_px: 1\n", "surface_fit_half_width_px"},
+      {"match:\n  surface_fit_half_height_px: 0\n", "surface_fit_half_height_px"},
+      {"match:\n  surface_fit_max_variance_growth: 0.5\n", "surface_fit_max_variance_growth"},
+      {"match:\n  surface_fit_max_misfit_ratio: 0\n", "surface_fit_max_misfit_ratio"},
+      {"match:\n  surface_fits: true\n", "surface_fits"}};
+  ExpectEachRejectedNamingItsKey(bad);
 }
 
 }  // namespace

@@ -56,7 +56,8 @@ SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x,
   // r sampled at x+u - d - gx*u - gy*v, so de/dd = gain * r' and the
   // Jacobian row is J = (gain r', -r, -1).
   double d = start_px, gain = 1.0, offset = 0.0;
-  FitPassSums s;  // of the last pass, for the ZNCC
+  FitPassSums s;           // of the last pass, for the ZNCC
+  double variance_dd = 0;  // (J^T J)^-1 [d, d] times the residual variance, of the last pass
   for (int it = 0; it < o.max_iterations; ++it) {
     s = window.FitPass(d, float(gain), float(offset));
     // The normal matrix J^T J and J^T e.
@@ -66,6 +67,22 @@ SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x,
     double step[3];
     SolveSymmetric3(jtj_dd, jtj_dgain, jtj_doffset, jtj_gain2, jtj_gain_offset, jtj_offset2, minus_jte, step);
     if (!(std::isfinite(step[0]) && std::isfinite(step[1]) && std::isfinite(step[2]))) return result;
+    {
+      // The residual sum of squares e'e of the pass, expanded in the sums
+      // the pass has (e = l - gain r - offset, with the pass's float gain
+      // and offset), then after the step as the linearised model predicts
+      // it (e'e + step . J'e), over n - 3 degrees of freedom: the variance
+      // of a pixel's misfit, sensor noise and what the model does not
+      // capture (speckle that differs between the views).
+      const double a = float(gain), b = float(offset);
+      const double ee = double(window.left_sum2()) - 2 * a * s.lr - 2 * b * double(window.left_sum()) + a * a * s.rr +
+                        2 * a * b * s.r + nwin * b * b;
+      const double rss = std::max(0.0, ee - (minus_jte[0] * step[0] + minus_jte[1] * step[1] + minus_jte[2] * step[2]));
+      const double unit[3] = {1, 0, 0};
+      double column[3];
+      SolveSymmetric3(jtj_dd, jtj_dgain, jtj_doffset, jtj_gain2, jtj_gain_offset, jtj_offset2, unit, column);
+      variance_dd = column[0] * rss / (nwin - 3);
+    }
     d += step[0];
     gain += step[1];
     offset += step[2];
@@ -80,6 +97,7 @@ SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x,
   const double cov = s.lr / nwin - lmean * rmean;
   result.zncc = rvar > 0 ? cov / (std::sqrt(rvar) * result.std_dn) : 0.0;
   result.disparity_px = d;
+  result.disparity_sigma_px = std::sqrt(std::max(0.0, variance_dd));
   result.ok = true;
   return result;
 }

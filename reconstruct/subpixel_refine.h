@@ -34,6 +34,16 @@ struct SubpixelResult {
   double disparity_px = 0;
   double zncc = 0;    // normalised correlation of the fitted window, [-1, 1]
   double std_dn = 0;  // standard deviation of the left window, grey levels (texture)
+  // Predicted 1-sigma of disparity_px, px: the least-squares covariance of
+  // the last Gauss-Newton pass, (J^T J)^-1 [d, d] times the residual variance
+  // e^T e / (n - 3) (n window pixels, 3 parameters). It is the Cramer-Rao
+  // bound when the misfit is white noise (the synthetic pairs: matches the
+  // scatter, subpixel_sigma_test.cc). On the simulator's captures the misfit
+  // is mostly laser speckle, correlated over ~2 px and so over fewer
+  // independent samples than n: the true scatter there is ~2-4x this
+  // (a relative confidence, not an absolute one). 0 when the dense fit
+  // (dense_refine.h) produced the result.
+  double disparity_sigma_px = 0;
 };
 
 // left, right: CV_8UC1 rectified. (x, y): a left pixel; start_px: the

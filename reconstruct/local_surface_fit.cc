@@ -1,0 +1,197 @@
+#include "reconstruct/local_surface_fit.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+#include <vector>
+
+#include "calib/core/input_error.h"
+#include "reconstruct/parallel_for.h"
+
+namespace stereorig {
+
+void SurfaceFitOptions::Check() const {
+  if (half_width_px < 2 || half_width_px > 30) throw InputError("surface_fit_half_width_px", "must be in [2, 30]");
+  if (half_height_px < 1 || half_height_px > 30) throw InputError("surface_fit_half_height_px", "must be in [1, 30]");
+  if (!(max_variance_growth >= 1 && max_variance_growth <= 100))
+    throw InputError("surface_fit_max_variance_growth", "must be in [1, 100]");
+  if (!(max_misfit_ratio >= 1 && max_misfit_ratio <= 100))
+    throw InputError("surface_fit_max_misfit_ratio", "must be in [1, 100]");
+}
+
+namespace {
+
+constexpr int kTerms = 6;  // the quadric's terms u^i v^j, in the order of its coefficients:
+constexpr int kPowerU[kTerms] = {0, 1, 0, 2, 1, 0};
+constexpr int kPowerV[kTerms] = {0, 0, 1, 0, 1, 2};
+using Vector6 = std::array<double, kTerms>;
+using Matrix6 = std::array<Vector6, kTerms>;
+
+// The filter taps (x / half)^power, x = -half..half: offsets scaled to
+// [-1, 1] so the 6x6 system is well conditioned in float.
+cv::Mat PowerTaps(int half, int power, bool along_row) {
+  cv::Mat k = along_row ? cv::Mat(1, 2 * half + 1, CV_32F) : cv::Mat(2 * half + 1, 1, CV_32F);
+  for (int x = -half; x <= half; ++x) k.at<float>(x + half) = float(std::pow(double(x) / half, power));
+  return k;
+}
+
+// Window sums of image * (u/hw)^i * (v/hh)^j: a row pass (shared by every j)
+// then a column pass. Correlation (OpenCV does not flip kernels): out(x) =
+// sum_u k(u) in(x + u); outside the image counts as 0.
+cv::Mat RowMoment(const cv::Mat& image, int i, int hw) {
+  cv::Mat out;
+  cv::filter2D(image, out, CV_32F, PowerTaps(hw, i, true), cv::Point(-1, -1), 0, cv::BORDER_CONSTANT);
+  return out;
+}
+cv::Mat ColumnMoment(const cv::Mat& row_moment, int j, int hh) {
+  cv::Mat out;
+  cv::filter2D(row_moment, out, CV_32F, PowerTaps(hh, j, false), cv::Point(-1, -1), 0, cv::BORDER_CONSTANT);
+  return out;
+}
+
+// Cholesky factor of the symmetric positive definite a (lower triangle
+// read): false if not positive definite.
+bool Cholesky(const Matrix6& a, Matrix6* l) {
+  for (int j = 0; j < kTerms; ++j) {
+    double s = a[j][j];
+    for (int k = 0; k < j; ++k) s -= (*l)[j][k] * (*l)[j][k];
+    if (!(s > 0)) return false;
+    (*l)[j][j] = std::sqrt(s);
+    const double inv = 1.0 / (*l)[j][j];
+    for (int i = j + 1; i < kTerms; ++i) {
+      double t = a[i][j];
+      for (int k = 0; k < j; ++k) t -= (*l)[i][k] * (*l)[j][k];
+      (*l)[i][j] = t * inv;
+    }
+  }
+  return true;
+}
+
+// Solves l l^T x = b.
+Vector6 CholeskySolve(const Matrix6& l, Vector6 b) {
+  for (int i = 0; i < kTerms; ++i) {
+    for (int k = 0; k < i; ++k) b[i] -= l[i][k] * b[k];
+    b[i] /= l[i][i];
+  }
+  for (int i = kTerms - 1; i >= 0; --i) {
+    for (int k = i + 1; k < kTerms; ++k) b[i] -= l[k][i] * b[k];
+    b[i] /= l[i][i];
+  }
+  return b;
+}
+
+// The normal matrix of a window whose pixels are all valid (the same for
+// every such window): sums of the terms' products over the window.
+Matrix6 FullWindowMatrix(int hw, int hh) {
+  Matrix6 a{};
+  for (int v = -hh; v <= hh; ++v)
+    for (int u = -hw; u <= hw; ++u)
+      for (int p = 0; p < kTerms; ++p)
+        for (int q = 0; q < kTerms; ++q)
+          a[p][q] +=
+              std::pow(double(u) / hw, kPowerU[p] + kPowerU[q]) * std::pow(double(v) / hh, kPowerV[p] + kPowerV[q]);
+  return a;
+}
+
+}  // namespace
+
+int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_threads, cv::Mat* disparity_px) {
+  const cv::Rect roi = roi_in & cv::Rect(0, 0, disparity_px->cols, disparity_px->rows);
+  if (roi.area() == 0) return 0;
+  const int hw = o.half_width_px, hh = o.half_height_px;
+  cv::Mat d = (*disparity_px)(roi);
+  // The valid mask, and the disparities relative to their mean (float sums).
+  double sum = 0;
+  int count = 0;
+  for (int y = 0; y < roi.height; ++y)
+    for (int x = 0; x < roi.width; ++x)
+      if (std::isfinite(d.at<float>(y, x))) sum += d.at<float>(y, x), ++count;
+  if (count == 0) return 0;
+  const float mean = float(sum / count);
+  cv::Mat mask(roi.size(), CV_32F, cv::Scalar(0)), values(roi.size(), CV_32F, cv::Scalar(0));
+  for (int y = 0; y < roi.height; ++y)
+    for (int x = 0; x < roi.width; ++x) {
+      const float v = d.at<float>(y, x);
+      if (!std::isfinite(v)) continue;
+      mask.at<float>(y, x) = 1;
+      values.at<float>(y, x) = v - mean;
+    }
+  // Window sums: the mask's moments up to degree 4 (the normal matrix:
+  // moment[i][j] = sum of mask (u/hw)^i (v/hh)^j), the values' up to degree
+  // 2 (the right-hand side), and the values' squares (the misfit).
+  cv::Mat moment[5][5], value_moment[3][3];
+  for (int i = 0; i <= 4; ++i) {
+    const cv::Mat row = RowMoment(mask, i, hw);
+    for (int j = 0; i + j <= 4; ++j) moment[i][j] = ColumnMoment(row, j, hh);
+  }
+  for (int i = 0; i <= 2; ++i) {
+    const cv::Mat row = RowMoment(values, i, hw);
+    for (int j = 0; i + j <= 2; ++j) value_moment[i][j] = ColumnMoment(row, j, hh);
+  }
+  const cv::Mat squares = ColumnMoment(RowMoment(values.mul(values), 0, hw), 0, hh);
+
+  const Matrix6 full = FullWindowMatrix(hw, hh);
+  Matrix6 full_factor{};
+  Cholesky(full, &full_factor);
+  const int full_count = (2 * hw + 1) * (2 * hh + 1);
+  const double max_variance = o.max_variance_growth * CholeskySolve(full_factor, Vector6{1, 0, 0, 0, 0, 0})[0];
+  // Per pixel: the fitted value at its centre and the RMS misfit (NaN = no fit).
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  cv::Mat fitted(roi.size(), CV_32F, cv::Scalar(kNaN)), misfit(roi.size(), CV_32F, cv::Scalar(kNaN));
+  ParallelForChunks(roi.height, num_threads, [&](int b, int e) {
+    for (int y = b; y < e; ++y) {
+      const float* valid = mask.ptr<float>(y);
+      const float* m[5][5];
+      const float* r[3][3];
+      for (int i = 0; i <= 4; ++i)
+        for (int j = 0; i + j <= 4; ++j) m[i][j] = moment[i][j].ptr<float>(y);
+      for (int i = 0; i <= 2; ++i)
+        for (int j = 0; i + j <= 2; ++j) r[i][j] = value_moment[i][j].ptr<float>(y);
+      const float* sq = squares.ptr<float>(y);
+      for (int x = 0; x < roi.width; ++x) {
+        if (!(valid[x] > 0)) continue;
+        const double n = m[0][0][x];
+        if (n < 2 * kTerms) continue;
+        Vector6 rhs;
+        for (int p = 0; p < kTerms; ++p) rhs[p] = r[kPowerU[p]][kPowerV[p]][x];
+        Vector6 c;
+        if (n > full_count - 0.5) {  // every pixel valid: the full window's system
+          c = CholeskySolve(full_factor, rhs);
+        } else {
+          Matrix6 a, l{};
+          for (int p = 0; p < kTerms; ++p)
+            for (int q = 0; q <= p; ++q) a[p][q] = m[kPowerU[p] + kPowerU[q]][kPowerV[p] + kPowerV[q]][x];
+          if (!Cholesky(a, &l)) continue;
+          if (!(CholeskySolve(l, Vector6{1, 0, 0, 0, 0, 0})[0] <= max_variance)) continue;
+          c = CholeskySolve(l, rhs);
+        }
+        double fit_sum = 0;
+        for (int p = 0; p < kTerms; ++p) fit_sum += c[p] * rhs[p];
+        fitted.at<float>(y, x) = float(c[0]);
+        misfit.at<float>(y, x) = float(std::sqrt(std::max(0.0, sq[x] - fit_sum) / (n - kTerms)));
+      }
+    }
+  });
+  std::vector<float> misfits;
+  for (int y = 0; y < roi.height; ++y)
+    for (int x = 0; x < roi.width; ++x)
+      if (std::isfinite(misfit.at<float>(y, x))) misfits.push_back(misfit.at<float>(y, x));
+  if (misfits.empty()) return 0;
+  std::nth_element(misfits.begin(), misfits.begin() + misfits.size() / 2, misfits.end());
+  // Never below 0.05 px (a fifth of the simulator's speckle scatter): on a
+  // nearly noise-free surface the median misfit is rounding, and half the
+  // windows would fail a gate of twice that.
+  const double max_misfit = std::max(0.05, o.max_misfit_ratio * misfits[misfits.size() / 2]);
+  int replaced = 0;
+  for (int y = 0; y < roi.height; ++y)
+    for (int x = 0; x < roi.width; ++x)
+      if (misfit.at<float>(y, x) <= max_misfit) {
+        d.at<float>(y, x) = fitted.at<float>(y, x) + mean;
+        ++replaced;
+      }
+  return replaced;
+}
+
+}  // namespace stereorig

@@ -1,0 +1,64 @@
+// Averaging the refined disparities over a neighbourhood wider than their
+// error's correlation length, where a smooth surface explains them.
+//
+// Why: on the simulator's captures every refined disparity scatters by
+// ~0.25-0.28 px (0.11 mm at the plate's 196 mm), nearly Gaussian and the same
+// on every scene. It is laser speckle, independent in the two views: the
+// sensor noise alone would allow 0.02-0.04 px (the Lucas-Kanade window's
+// Cramer-Rao bound). A 9x3 window sees one or two lines over three rows, so
+// its estimate carries the speckle of those few samples; neighbouring
+// estimates share most of it (correlation 0.88 at 1 px, ~0 beyond 8 px along
+// the row and 5 px across). Only more area lowers it: a wider window, or
+// this fit of the estimates of many windows.
+//
+// What: each valid disparity is replaced by the value at its own pixel of a
+// quadric d(u, v) = c0 + c1 u + c2 v + c3 u^2 + c4 u v + c5 v^2, fitted by
+// least squares to the valid disparities of the (2 half_width + 1) x
+// (2 half_height + 1) window around it (normalised convolution: the window
+// sums of the 15 moments of the valid mask and the 6 of the disparities
+// come from separable filters, then one 6x6 solve per pixel). A quadric, not
+// a plane: a plane's value at the centre is biased by the surface's
+// curvature (on the demo sphere a 15x9 plane fit is worse than none).
+// The fit is kept only where it is trustworthy, else the pixel keeps its own
+// disparity:
+//   - the centre is well inside the valid pixels: its variance as the fit
+//     predicts it is at most max_variance_growth times that of a full
+//     window (a window cut by a silhouette extrapolates). The errors are
+//     correlated, so the real variance is ~26x the prediction for
+//     independent errors: a full 21x11 window predicts 0.015 of one
+//     pixel's variance and measures 0.40 (plate, 0.27 -> 0.17 px); half a
+//     window (a straight silhouette through the centre) predicts 0.063,
+//     i.e. worse than no fit;
+//   - the quadric explains the window: the RMS misfit is at most
+//     max_misfit_ratio times the median misfit over all fitted windows, or
+//     0.05 px if that is more (a depth edge, two components one grid period
+//     apart, or a surface curving faster than a quadric over the window
+//     misfit far more).
+// Cost: the lateral detail finer than a quadric over the window (~4 x 2 mm
+// at 200 mm by default) is smoothed away; the fill is unchanged.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+namespace stereorig {
+
+struct SurfaceFitOptions {
+  bool enabled = true;     // default true
+  int half_width_px = 10;  // window half width along the rows; default 10 (21 px: ~2.5 error correlation lengths)
+  int half_height_px = 5;  // window half height; default 5 (11 rows: ~2 correlation lengths)
+  // Largest predicted variance of the fitted centre, relative to a full
+  // window's, for the fit to replace the pixel; default 1.5. A 21x11
+  // window whose centre is 0 / 1 / 2 / 3 columns from a silhouette: 4.1 /
+  // 2.3 / 1.6 / 1.3; 0 / 1 rows from one: 3.2 / 1.5.
+  double max_variance_growth = 1.5;
+  // Largest RMS misfit of the quadric over its window, relative to the
+  // median over the module's windows; default 2.
+  double max_misfit_ratio = 2.0;
+  void Check() const;  // throws InputError naming the bad field
+};
+
+// disparity_px: CV_32FC1, +inf (or NaN) = none; only `roi` is read and
+// rewritten. Returns the number of pixels replaced by their fit.
+int FitLocalSurface(const cv::Rect& roi, const SurfaceFitOptions& options, int num_threads, cv::Mat* disparity_px);
+
+}  // namespace stereorig

@@ -1,0 +1,101 @@
+// The local quadric fit of the disparities (local_surface_fit.h) against
+// analytic disparity fields: a quadric surface is kept exactly, independent
+// noise falls by the factor least squares predicts, and a depth step and a
+// silhouette are left alone.
+#include "reconstruct/local_surface_fit.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <random>
+
+namespace stereorig {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// A curved surface's disparity field (px): a quadric in the pixel
+// coordinates, as a sphere's is near its centre.
+double Quadric(int x, int y) {
+  const double u = x - 100.0, v = y - 60.0;
+  return 40 + 0.05 * u - 0.02 * v + 4e-4 * u * u + 2e-4 * u * v + 6e-4 * v * v;
+}
+
+TEST(LocalSurfaceFit, KeepsAQuadricAndCutsIndependentNoiseAsPredicted) {
+  const double sigma_px = 0.3;  // about the speckle scatter of the simulator's disparities
+  cv::Mat d(120, 200, CV_32F), truth(120, 200, CV_32F);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0, sigma_px);
+  for (int y = 0; y < d.rows; ++y)
+    for (int x = 0; x < d.cols; ++x) {
+      truth.at<float>(y, x) = float(Quadric(x, y));
+      d.at<float>(y, x) = float(Quadric(x, y) + noise(rng));
+    }
+  cv::Mat clean = truth.clone();
+  const SurfaceFitOptions options;  // 21 x 11
+  // At least all but the outermost 2 rows and 4 columns (a window there
+  // extrapolates: up to 3.2x / 4.1x a full window's variance, above
+  // max_variance_growth).
+  EXPECT_GE(FitLocalSurface(cv::Rect(0, 0, d.cols, d.rows), options, 2, &clean), (d.rows - 4) * (d.cols - 8));
+  double worst = 0;
+  for (int y = 0; y < d.rows; ++y)
+    for (int x = 0; x < d.cols; ++x)
+      worst = std::max(worst, double(std::abs(clean.at<float>(y, x) - truth.at<float>(y, x))));
+  // The sums are float: ~1e-7 relative of values within +-10 px of their mean.
+  EXPECT_LT(worst, 2e-4) << "a quadric is reproduced exactly (no curvature bias)";
+
+  FitLocalSurface(cv::Rect(0, 0, d.cols, d.rows), options, 2, &d);
+  // Interior pixels (full windows): least squares predicts sigma *
+  // sqrt((A^T A)^-1 [0, 0]) = 0.3 * sqrt(0.0153) = 0.037 px for independent
+  // errors. The rms over N ~ 17000 pixels scatters by ~1/sqrt(2 N_eff)
+  // relative, N_eff ~ N / 231 (neighbouring fits share their data): 8%; 3
+  // of those.
+  double sum2 = 0;
+  int n = 0;
+  for (int y = 6; y < d.rows - 6; ++y)
+    for (int x = 11; x < d.cols - 11; ++x, ++n) sum2 += std::pow(d.at<float>(y, x) - truth.at<float>(y, x), 2);
+  const double rms = std::sqrt(sum2 / n), predicted = sigma_px * std::sqrt(0.0153);
+  EXPECT_NEAR(rms, predicted, 0.24 * predicted) << n << " pixels";
+  std::printf("noise %.2f px -> %.4f px rms after the fit (predicted %.4f)\n", sigma_px, rms, predicted);
+}
+
+TEST(LocalSurfaceFit, LeavesDepthStepsAndSilhouettesAlone) {
+  // Two planes 5 px of disparity apart (a depth edge) at x = 100, and no
+  // data right of x = 160 (a silhouette); independent noise of 0.3 px.
+  const double sigma_px = 0.3;
+  cv::Mat d(120, 200, CV_32F, cv::Scalar(kInf)), truth(120, 200, CV_32F, cv::Scalar(kInf));
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> noise(0, sigma_px);
+  for (int y = 0; y < d.rows; ++y)
+    for (int x = 0; x < 160; ++x) {
+      truth.at<float>(y, x) = float((x < 100 ? 45.0 : 40.0) + 0.01 * x);
+      d.at<float>(y, x) = float(truth.at<float>(y, x) + noise(rng));
+    }
+  const cv::Mat raw = d.clone();
+  FitLocalSurface(cv::Rect(0, 0, d.cols, d.rows), SurfaceFitOptions{}, 2, &d);
+  int unchanged_at_edge = 0, edge_pixels = 0, far_off = 0, unchanged_at_silhouette = 0, silhouette_pixels = 0;
+  for (int y = 6; y < d.rows - 6; ++y)
+    for (int x = 0; x < d.cols; ++x) {
+      const float v = d.at<float>(y, x);
+      if (x >= 160) {
+        EXPECT_FALSE(std::isfinite(v)) << "no point is made where there was none";
+        continue;
+      }
+      // A fit across the step would pull the pixels next to it by up to
+      // half the step (2.5 px); untouched pixels are off by the noise, 4.5
+      // sigma at most here (1.4 px over 19000 pixels has p ~ 0.1).
+      if (std::abs(v - truth.at<float>(y, x)) > 4.5 * sigma_px) ++far_off;
+      if (std::abs(x - 100) <= 2) ++edge_pixels, unchanged_at_edge += v == raw.at<float>(y, x);
+      if (x >= 158) ++silhouette_pixels, unchanged_at_silhouette += v == raw.at<float>(y, x);
+    }
+  EXPECT_EQ(far_off, 0);
+  EXPECT_EQ(unchanged_at_edge, edge_pixels) << "the quadric misfits a window across a step: the pixel keeps its value";
+  EXPECT_EQ(unchanged_at_silhouette, silhouette_pixels)
+      << "within 1 px of a silhouette the window extrapolates (2.3-4.1x a full window's variance): the pixel keeps "
+         "its value";
+}
+
+}  // namespace
+}  // namespace stereorig
