@@ -127,7 +127,8 @@ nlohmann::json PipelineJson(const Pipeline& p, const Rig& rig, const std::vector
             {"translation_mm",
              {score.truth_from_cloud.translation_mm().x(), score.truth_from_cloud.translation_mm().y(),
               score.truth_from_cloud.translation_mm().z()}}}}};
-      for (size_t m = 0; m < score.per_module.size(); ++m) acc["module"].push_back(ErrorFiguresJson(score.per_module[m]));
+      for (size_t m = 0; m < score.per_module.size(); ++m)
+        acc["module"].push_back(ErrorFiguresJson(score.per_module[m]));
       if (score.filled.points) acc["hole_fill"] = FilledJson(score);
       sj["accuracy"] = acc;
     }
@@ -150,10 +151,9 @@ void PrintPipeline(const nlohmann::json& j) {
   std::printf("  module 0 median ms:");
   // match.grow_2 runs only on captures where the second line-index pass
   // moved something: its median is over those captures.
-  for (const char* step :
-       {"rectify", "lit_region", "match.band", "match.sgm", "match.sgbm", "match.subpixel", "match.subpixel_dense",
-        "match.line_index", "match.grow", "match.line_index_2", "match.grow_2", "match.speckle", "triangulate",
-        "normals"}) {
+  for (const char* step : {"rectify", "lit_region", "match.band", "match.sgm", "match.sgbm", "match.subpixel",
+                           "match.subpixel_dense", "match.line_index", "match.grow", "match.line_index_2",
+                           "match.grow_2", "match.speckle", "match.surface_fit", "triangulate", "normals"}) {
     const std::string key = std::string("module0.") + step;
     if (j["median_time_ms"].contains(key)) std::printf(" %s %.1f", step, j["median_time_ms"][key].get<double>());
   }
