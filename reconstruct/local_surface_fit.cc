@@ -1,7 +1,7 @@
 #include "reconstruct/local_surface_fit.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <opencv2/imgproc.hpp>
@@ -26,8 +26,9 @@ namespace {
 constexpr int kTerms = 6;  // the quadric's terms u^i v^j, in the order of its coefficients:
 constexpr int kPowerU[kTerms] = {0, 1, 0, 2, 1, 0};
 constexpr int kPowerV[kTerms] = {0, 0, 1, 0, 1, 2};
-using Vector6 = std::array<double, kTerms>;
-using Matrix6 = std::array<Vector6, kTerms>;
+using Vector6 = Eigen::Matrix<double, kTerms, 1>;
+using Matrix6 = Eigen::Matrix<double, kTerms, kTerms>;
+using Cholesky6 = Eigen::LLT<Matrix6>;
 
 // The filter taps (x / half)^power, x = -half..half: offsets scaled to
 // [-1, 1] so the 6x6 system is well conditioned in float.
@@ -51,46 +52,15 @@ cv::Mat ColumnMoment(const cv::Mat& row_moment, int j, int hh) {
   return out;
 }
 
-// Cholesky factor of the symmetric positive definite a (lower triangle
-// read): false if not positive definite.
-bool Cholesky(const Matrix6& a, Matrix6* l) {
-  for (int j = 0; j < kTerms; ++j) {
-    double s = a[j][j];
-    for (int k = 0; k < j; ++k) s -= (*l)[j][k] * (*l)[j][k];
-    if (!(s > 0)) return false;
-    (*l)[j][j] = std::sqrt(s);
-    const double inv = 1.0 / (*l)[j][j];
-    for (int i = j + 1; i < kTerms; ++i) {
-      double t = a[i][j];
-      for (int k = 0; k < j; ++k) t -= (*l)[i][k] * (*l)[j][k];
-      (*l)[i][j] = t * inv;
-    }
-  }
-  return true;
-}
-
-// Solves l l^T x = b.
-Vector6 CholeskySolve(const Matrix6& l, Vector6 b) {
-  for (int i = 0; i < kTerms; ++i) {
-    for (int k = 0; k < i; ++k) b[i] -= l[i][k] * b[k];
-    b[i] /= l[i][i];
-  }
-  for (int i = kTerms - 1; i >= 0; --i) {
-    for (int k = i + 1; k < kTerms; ++k) b[i] -= l[k][i] * b[k];
-    b[i] /= l[i][i];
-  }
-  return b;
-}
-
 // The normal matrix of a window whose pixels are all valid (the same for
 // every such window): sums of the terms' products over the window.
 Matrix6 FullWindowMatrix(int hw, int hh) {
-  Matrix6 a{};
+  Matrix6 a = Matrix6::Zero();
   for (int v = -hh; v <= hh; ++v)
     for (int u = -hw; u <= hw; ++u)
       for (int p = 0; p < kTerms; ++p)
         for (int q = 0; q < kTerms; ++q)
-          a[p][q] +=
+          a(p, q) +=
               std::pow(double(u) / hw, kPowerU[p] + kPowerU[q]) * std::pow(double(v) / hh, kPowerV[p] + kPowerV[q]);
   return a;
 }
@@ -132,11 +102,9 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
   }
   const cv::Mat squares = ColumnMoment(RowMoment(values.mul(values), 0, hw), 0, hh);
 
-  const Matrix6 full = FullWindowMatrix(hw, hh);
-  Matrix6 full_factor{};
-  Cholesky(full, &full_factor);
+  const Cholesky6 full_factor(FullWindowMatrix(hw, hh));
   const int full_count = (2 * hw + 1) * (2 * hh + 1);
-  const double max_variance = o.max_variance_growth * CholeskySolve(full_factor, Vector6{1, 0, 0, 0, 0, 0})[0];
+  const double max_variance = o.max_variance_growth * full_factor.solve(Vector6::Unit(0))[0];
   // Per pixel: the fitted value at its centre and the RMS misfit (NaN = no fit).
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
   cv::Mat fitted(roi.size(), CV_32F, cv::Scalar(kNaN)), misfit(roi.size(), CV_32F, cv::Scalar(kNaN));
@@ -158,14 +126,15 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
         for (int p = 0; p < kTerms; ++p) rhs[p] = r[kPowerU[p]][kPowerV[p]][x];
         Vector6 c;
         if (n > full_count - 0.5) {  // every pixel valid: the full window's system
-          c = CholeskySolve(full_factor, rhs);
+          c = full_factor.solve(rhs);
         } else {
-          Matrix6 a, l{};
+          Matrix6 a;
           for (int p = 0; p < kTerms; ++p)
-            for (int q = 0; q <= p; ++q) a[p][q] = m[kPowerU[p] + kPowerU[q]][kPowerV[p] + kPowerV[q]][x];
-          if (!Cholesky(a, &l)) continue;
-          if (!(CholeskySolve(l, Vector6{1, 0, 0, 0, 0, 0})[0] <= max_variance)) continue;
-          c = CholeskySolve(l, rhs);
+            for (int q = 0; q <= p; ++q) a(p, q) = a(q, p) = m[kPowerU[p] + kPowerU[q]][kPowerV[p] + kPowerV[q]][x];
+          const Cholesky6 factor(a);
+          if (factor.info() != Eigen::Success) continue;
+          if (!(factor.solve(Vector6::Unit(0))[0] <= max_variance)) continue;
+          c = factor.solve(rhs);
         }
         double fit_sum = 0;
         for (int p = 0; p < kTerms; ++p) fit_sum += c[p] * rhs[p];
