@@ -1,7 +1,7 @@
 #include "reconstruct/local_surface_fit.h"
 
-#include <Eigen/Cholesky>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <opencv2/imgproc.hpp>
@@ -24,11 +24,68 @@ void SurfaceFitOptions::Check() const {
 namespace {
 
 constexpr int kTerms = 6;  // the quadric's terms u^i v^j, in the order of its coefficients:
-constexpr int kPowerU[kTerms] = {0, 1, 0, 2, 1, 0};
-constexpr int kPowerV[kTerms] = {0, 0, 1, 0, 1, 2};
-using Vector6 = Eigen::Matrix<double, kTerms, 1>;
-using Matrix6 = Eigen::Matrix<double, kTerms, kTerms>;
-using Cholesky6 = Eigen::LLT<Matrix6>;
+// the constant last. Then a Cholesky factor L of the normal matrix gives
+// all the fit needs from the forward substitution z = L^-1 rhs alone: the
+// fitted centre (the constant) z[5] / L[5][5], its predicted variance
+// 1 / L[5][5]^2 and the fitted sum of squares c . rhs = |z|^2 (no back
+// substitution, no second solve for the variance).
+constexpr int kPowerU[kTerms] = {2, 1, 0, 1, 0, 0};
+constexpr int kPowerV[kTerms] = {0, 1, 2, 0, 1, 0};
+constexpr int kConstant = kTerms - 1;
+using Matrix6 = std::array<std::array<double, kTerms>, kTerms>;
+
+// The Cholesky factor L of a symmetric 6x6 matrix (lower triangle), with
+// the reciprocals of its diagonal.
+struct Factor6 {
+  Matrix6 l{};
+  std::array<double, kTerms> inv_diag{};
+};
+
+// Factors the symmetric a (lower triangle read): false if it is not
+// positive definite. Written out at this fixed size (unrolled) rather than with Eigen::LLT, whose generic blocked code and L1 norm
+// cost ~860 instructions per 6x6 factorisation and ~350 per pair of solves;
+// on the demo cup two thirds of the fitted windows have holes and need
+// their own (docs/reconstruct.md, "The refinement steps' instruction count").
+inline bool Factor(const Matrix6& a, Factor6* f) {
+#pragma GCC unroll 6
+  for (int j = 0; j < kTerms; ++j) {
+    double s = a[j][j];
+#pragma GCC unroll 6
+    for (int k = 0; k < j; ++k) s -= f->l[j][k] * f->l[j][k];
+    if (!(s > 0)) return false;
+    f->inv_diag[j] = 1 / std::sqrt(s);
+#pragma GCC unroll 6
+    for (int i = j + 1; i < kTerms; ++i) {
+      double t = a[i][j];
+#pragma GCC unroll 6
+      for (int k = 0; k < j; ++k) t -= f->l[i][k] * f->l[j][k];
+      f->l[i][j] = t * f->inv_diag[j];
+    }
+  }
+  return true;
+}
+
+// The predicted variance of the fitted centre, relative to one pixel's
+// (the constant's diagonal entry of the inverse normal matrix).
+double CentreVariance(const Factor6& f) { return f.inv_diag[kConstant] * f.inv_diag[kConstant]; }
+
+// The fitted centre (the constant term) and the fitted sum of squares
+// c . rhs of the window whose normal matrix f factors.
+inline void SolveCentre(const Factor6& f, const std::array<double, kTerms>& rhs, double* centre,
+                        double* fitted_squares) {
+  std::array<double, kTerms> z;
+  double squares = 0;
+#pragma GCC unroll 6
+  for (int i = 0; i < kTerms; ++i) {
+    double t = rhs[i];
+#pragma GCC unroll 6
+    for (int k = 0; k < i; ++k) t -= f.l[i][k] * z[k];
+    z[i] = t * f.inv_diag[i];
+    squares += z[i] * z[i];
+  }
+  *centre = z[kConstant] * f.inv_diag[kConstant];
+  *fitted_squares = squares;
+}
 
 // The filter taps (x / half)^power, x = -half..half: offsets scaled to
 // [-1, 1] so the 6x6 system is well conditioned in float.
@@ -55,12 +112,12 @@ cv::Mat ColumnMoment(const cv::Mat& row_moment, int j, int hh) {
 // The normal matrix of a window whose pixels are all valid (the same for
 // every such window): sums of the terms' products over the window.
 Matrix6 FullWindowMatrix(int hw, int hh) {
-  Matrix6 a = Matrix6::Zero();
+  Matrix6 a{};
   for (int v = -hh; v <= hh; ++v)
     for (int u = -hw; u <= hw; ++u)
       for (int p = 0; p < kTerms; ++p)
         for (int q = 0; q < kTerms; ++q)
-          a(p, q) +=
+          a[p][q] +=
               std::pow(double(u) / hw, kPowerU[p] + kPowerU[q]) * std::pow(double(v) / hh, kPowerV[p] + kPowerV[q]);
   return a;
 }
@@ -102,9 +159,10 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
   }
   const cv::Mat squares = ColumnMoment(RowMoment(values.mul(values), 0, hw), 0, hh);
 
-  const Cholesky6 full_factor(FullWindowMatrix(hw, hh));
+  Factor6 full_factor;
+  STEREORIG_CHECK(Factor(FullWindowMatrix(hw, hh), &full_factor));
   const int full_count = (2 * hw + 1) * (2 * hh + 1);
-  const double max_variance = o.max_variance_growth * full_factor.solve(Vector6::Unit(0))[0];
+  const double max_variance = o.max_variance_growth * CentreVariance(full_factor);
   // Per pixel: the fitted value at its centre and the RMS misfit (NaN = no fit).
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
   cv::Mat fitted(roi.size(), CV_32F, cv::Scalar(kNaN)), misfit(roi.size(), CV_32F, cv::Scalar(kNaN));
@@ -122,23 +180,21 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
         if (!(valid[x] > 0)) continue;
         const double n = m[0][0][x];
         if (n < 2 * kTerms) continue;
-        Vector6 rhs;
+        std::array<double, kTerms> rhs;
         for (int p = 0; p < kTerms; ++p) rhs[p] = r[kPowerU[p]][kPowerV[p]][x];
-        Vector6 c;
+        double centre, fit_sum;
         if (n > full_count - 0.5) {  // every pixel valid: the full window's system
-          c = full_factor.solve(rhs);
+          SolveCentre(full_factor, rhs, &centre, &fit_sum);
         } else {
           Matrix6 a;
           for (int p = 0; p < kTerms; ++p)
-            for (int q = 0; q <= p; ++q) a(p, q) = a(q, p) = m[kPowerU[p] + kPowerU[q]][kPowerV[p] + kPowerV[q]][x];
-          const Cholesky6 factor(a);
-          if (factor.info() != Eigen::Success) continue;
-          if (!(factor.solve(Vector6::Unit(0))[0] <= max_variance)) continue;
-          c = factor.solve(rhs);
+            for (int q = 0; q <= p; ++q) a[p][q] = m[kPowerU[p] + kPowerU[q]][kPowerV[p] + kPowerV[q]][x];
+          Factor6 factor;
+          if (!Factor(a, &factor)) continue;
+          if (!(CentreVariance(factor) <= max_variance)) continue;
+          SolveCentre(factor, rhs, &centre, &fit_sum);
         }
-        double fit_sum = 0;
-        for (int p = 0; p < kTerms; ++p) fit_sum += c[p] * rhs[p];
-        fitted.at<float>(y, x) = float(c[0]);
+        fitted.at<float>(y, x) = float(centre);
         misfit.at<float>(y, x) = float(std::sqrt(std::max(0.0, sq[x] - fit_sum) / (n - kTerms)));
       }
     }

@@ -6,10 +6,13 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
+
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <random>
+#include <vector>
 
 namespace stereorig {
 namespace {
@@ -95,6 +98,69 @@ TEST(LocalSurfaceFit, LeavesDepthStepsAndSilhouettesAlone) {
   EXPECT_EQ(unchanged_at_silhouette, silhouette_pixels)
       << "within 1 px of a silhouette the window extrapolates (2.3-4.1x a full window's variance): the pixel keeps "
          "its value";
+}
+
+// Windows with holes (each has its own 6x6 system) against a plain least
+// squares fit written here: the quadric fitted to the window's valid pixels
+// by Eigen's QR, evaluated at the centre.
+TEST(LocalSurfaceFit, WindowsWithHolesEqualAPlainLeastSquaresFit) {
+  const double sigma_px = 0.3;
+  cv::Mat d(80, 120, CV_32F, cv::Scalar(kInf));
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0, sigma_px);
+  std::bernoulli_distribution hole(0.3);  // ~30 % of the pixels missing, as rejections scatter on a capture
+  for (int y = 0; y < d.rows; ++y)
+    for (int x = 0; x < d.cols; ++x)
+      if (!hole(rng)) d.at<float>(y, x) = float(Quadric(x, y) + noise(rng));
+  const cv::Mat raw = d.clone();
+  const SurfaceFitOptions o;
+  FitLocalSurface(cv::Rect(0, 0, d.cols, d.rows), o, 2, &d);
+  const int hw = o.half_width_px, hh = o.half_height_px;
+  // The plain fit's predicted variance of the centre for a full window, the
+  // reference of max_variance_growth.
+  auto design = [&](int x, int y, bool full, Eigen::MatrixXd* a, Eigen::VectorXd* b) {
+    std::vector<std::array<double, 7>> rows;
+    for (int v = -hh; v <= hh; ++v)
+      for (int u = -hw; u <= hw; ++u) {
+        const float value = raw.at<float>(y + v, x + u);
+        if (!full && !std::isfinite(value)) continue;
+        const double su = double(u) / hw, sv = double(v) / hh;
+        rows.push_back({1, su, sv, su * su, su * sv, sv * sv, full ? 0.0 : double(value)});
+      }
+    a->resize(Eigen::Index(rows.size()), 6), b->resize(Eigen::Index(rows.size()));
+    for (size_t i = 0; i < rows.size(); ++i) {
+      for (int k = 0; k < 6; ++k) (*a)(Eigen::Index(i), k) = rows[i][size_t(k)];
+      (*b)[Eigen::Index(i)] = rows[i][6];
+    }
+  };
+  Eigen::MatrixXd a;
+  Eigen::VectorXd b;
+  design(hw, hh, true, &a, &b);
+  const double full_variance = (a.transpose() * a).inverse()(0, 0);
+  int compared = 0;
+  double worst = 0;
+  for (int y = hh; y < d.rows - hh; ++y)
+    for (int x = hw; x < d.cols - hw; ++x) {
+      if (!std::isfinite(raw.at<float>(y, x))) continue;
+      design(x, y, false, &a, &b);
+      const double ratio = (a.transpose() * a).inverse()(0, 0) / full_variance;
+      // Away from the variance gate (the fit's float sums could fall either
+      // side of it); no window of this smooth field fails the misfit gate.
+      if (std::abs(ratio - o.max_variance_growth) < 0.05) continue;
+      const double plain = a.colPivHouseholderQr().solve(b)[0];
+      if (ratio > o.max_variance_growth) {
+        EXPECT_EQ(d.at<float>(y, x), raw.at<float>(y, x)) << "an extrapolating window leaves the pixel alone";
+        continue;
+      }
+      ++compared;
+      worst = std::max(worst, std::abs(d.at<float>(y, x) - plain));
+    }
+  std::printf("%d windows with holes: |fit - plain least squares| max %.2e px\n", compared, worst);
+  EXPECT_GT(compared, 2000);
+  // Float window sums of values within +-10 px of their mean (~1e-7
+  // relative) and the float result: well below 1e-4 px. A wrong moment or
+  // term would be off by the noise's scale, 0.01-0.3 px.
+  EXPECT_LT(worst, 1e-4);
 }
 
 }  // namespace
