@@ -1,6 +1,7 @@
 #include "reconstruct/disparity_state.h"
 
 #include <algorithm>
+#include <optional>
 
 #include "reconstruct/subpixel_window.h"
 
@@ -62,19 +63,40 @@ double DistinctnessShiftPx(double slope_x, const RefineAcceptance& a) {
   return a.half_period_px * std::clamp(1.0 - slope_x, 0.3, 1.7);
 }
 
+namespace {
+
+// The distinctness test of a fit that passed AcceptFit.
+PixelStatus AcceptDistinct(const WindowZnccProbe& probe, double slope_x, const SubpixelResult& r,
+                           const RefineAcceptance& a) {
+  const double half = DistinctnessShiftPx(slope_x, a);
+  // One window for both shifts; the second is not needed once the first
+  // fails (the test is on the larger of the two).
+  for (const double shift : {-half, half})
+    if (r.zncc - probe.At(r.disparity_px + shift) < a.min_distinctness) return PixelStatus::kNotDistinct;
+  return PixelStatus::kPoint;
+}
+
+}  // namespace
+
 PixelStatus Accept(const cv::Mat& left, const cv::Mat& right, int x, int y, double slope_x, double slope_y,
                    const SubpixelResult& r, const RefineAcceptance& a) {
   const PixelStatus fit = AcceptFit(r, a);
-  if (fit != PixelStatus::kPoint) return fit;
-  if (a.min_distinctness > 0) {
-    const double half = DistinctnessShiftPx(slope_x, a);
-    // One window for both shifts; the second is not needed once the first
-    // fails (the test is on the larger of the two).
-    const WindowZnccProbe probe(left, right, x, y, slope_x, slope_y, a.subpixel);
-    for (const double shift : {-half, half})
-      if (r.zncc - probe.At(r.disparity_px + shift) < a.min_distinctness) return PixelStatus::kNotDistinct;
-  }
-  return PixelStatus::kPoint;
+  if (fit != PixelStatus::kPoint || !(a.min_distinctness > 0)) return fit;
+  return AcceptDistinct(WindowZnccProbe(left, right, x, y, slope_x, slope_y, a.subpixel), slope_x, r, a);
+}
+
+PixelStatus RefineAndAccept(const cv::Mat& left, const cv::Mat& right, int x, int y, double start_px, double slope_x,
+                            double slope_y, const RefineAcceptance& a, SubpixelResult* result) {
+  std::optional<SubpixelWindow> window;
+  *result = RefineDisparity(left, right, x, y, start_px, slope_x, slope_y, a.subpixel, &window);
+  const PixelStatus fit = AcceptFit(*result, a);
+  if (fit != PixelStatus::kPoint || !(a.min_distinctness > 0)) return fit;
+  // The fit's window near the right image's left edge is the portable
+  // kind; the probe's is always the fastest (equal up to float rounding):
+  // set one up as Accept does, so the outcome is the same.
+  if (window->kernel() != WindowKernel::kFastest)
+    return AcceptDistinct(WindowZnccProbe(left, right, x, y, slope_x, slope_y, a.subpixel), slope_x, *result, a);
+  return AcceptDistinct(WindowZnccProbe(*window, slope_x, slope_y, a.subpixel), slope_x, *result, a);
 }
 
 }  // namespace stereorig

@@ -73,4 +73,12 @@ double DistinctnessShiftPx(double slope_x, const RefineAcceptance& a);
 PixelStatus Accept(const cv::Mat& left, const cv::Mat& right, int x, int y, double slope_x, double slope_y,
                    const SubpixelResult& r, const RefineAcceptance& a);
 
+// RefineDisparity(left, right, x, y, start_px, slope_x, slope_y,
+// a.subpixel) into *result, then Accept of it: the same outcome, with the
+// window's set-up (left values, sample offsets) done once for the fit and
+// the distinctness test (it was ~10 % of the sub-pixel step's instructions
+// when done twice).
+PixelStatus RefineAndAccept(const cv::Mat& left, const cv::Mat& right, int x, int y, double start_px, double slope_x,
+                            double slope_y, const RefineAcceptance& a, SubpixelResult* result);
+
 }  // namespace stereorig

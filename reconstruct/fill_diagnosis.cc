@@ -115,8 +115,8 @@ FillDiagnosis DiagnoseFill(const Runtime& runtime, int module, const std::vector
       }
       PixelStatus why = PixelStatus::kNoPlane;  // no truth disparity: an edge
       if (std::isfinite(td)) {
-        const SubpixelResult r = RefineDisparity(d.left, d.right, x, y, td, gx, gy, accept.subpixel);
-        why = Accept(d.left, d.right, x, y, gx, gy, r, accept);
+        SubpixelResult r;
+        why = RefineAndAccept(d.left, d.right, x, y, td, gx, gy, accept, &r);
         if (why == PixelStatus::kPoint && std::abs(r.disparity_px - td) > 0.5) why = PixelStatus::kOffPlane;
       }
       d.truth_status.at<uint8_t>(y, x) = uint8_t(why);

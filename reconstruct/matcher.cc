@@ -191,49 +191,65 @@ void RemoveSpeckles(cv::Mat disparity_px, const MatchOptions& o) {
 // ~0.005 px/px, so the sub-pixel window's model error is negligible.
 void DisparitySlopes(const cv::Mat& disparity, cv::Mat* slope_x, cv::Mat* slope_y, cv::Mat* plane) {
   const cv::Size k(9, 9);
-  cv::Mat m(disparity.size(), CV_32FC1), md(disparity.size(), CV_32FC1), xs(disparity.size(), CV_32FC1),
-      ys(disparity.size(), CV_32FC1);
-  for (int y = 0; y < disparity.rows; ++y)
+  // The valid mask's and the disparities' moments per pixel, in absolute
+  // coordinates (exact in float: integers below 2^24, and x d, y d rounded
+  // once), then their window sums.
+  cv::Mat m(disparity.size(), CV_32FC1), md(disparity.size(), CV_32FC1), mx(disparity.size(), CV_32FC1),
+      my(disparity.size(), CV_32FC1), mxd(disparity.size(), CV_32FC1), myd(disparity.size(), CV_32FC1),
+      mxx(disparity.size(), CV_32FC1), myy(disparity.size(), CV_32FC1), mxy(disparity.size(), CV_32FC1);
+  for (int y = 0; y < disparity.rows; ++y) {
+    const float* in = disparity.ptr<float>(y);
+    float *m_row = m.ptr<float>(y), *md_row = md.ptr<float>(y), *mx_row = mx.ptr<float>(y), *my_row = my.ptr<float>(y);
+    float *mxd_row = mxd.ptr<float>(y), *myd_row = myd.ptr<float>(y), *mxx_row = mxx.ptr<float>(y),
+          *myy_row = myy.ptr<float>(y), *mxy_row = mxy.ptr<float>(y);
+    const float fy = float(y);
     for (int x = 0; x < disparity.cols; ++x) {
-      const float d = disparity.at<float>(y, x);
+      const float d = in[x], fx = float(x);
       const bool valid = !std::isnan(d);
-      m.at<float>(y, x) = valid;
-      md.at<float>(y, x) = valid ? d : 0.f;
-      xs.at<float>(y, x) = float(x);
-      ys.at<float>(y, x) = float(y);
+      m_row[x] = valid;
+      md_row[x] = valid ? d : 0.f;
+      mx_row[x] = valid ? fx : 0.f;
+      my_row[x] = valid ? fy : 0.f;
+      mxd_row[x] = valid ? fx * d : 0.f;
+      myd_row[x] = valid ? fy * d : 0.f;
+      mxx_row[x] = valid ? fx * fx : 0.f;
+      myy_row[x] = valid ? fy * fy : 0.f;
+      mxy_row[x] = valid ? fx * fy : 0.f;
     }
+  }
   auto box = [&](const cv::Mat& a) {
     cv::Mat out;
     cv::boxFilter(a, out, CV_32F, k, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
     return out;
   };
-  // Coordinates relative to each window's centre keep the sums small.
-  const cv::Mat s_m = box(m), s_d = box(md);
-  cv::Mat mx = m.mul(xs), my = m.mul(ys);
-  const cv::Mat s_x = box(mx), s_y = box(my), s_xd = box(mx.mul(md) / cv::max(m, 1e-9f)),
-                s_yd = box(my.mul(md) / cv::max(m, 1e-9f)), s_xx = box(mx.mul(xs)), s_yy = box(my.mul(ys)),
-                s_xy = box(mx.mul(ys));
+  const cv::Mat s_m = box(m), s_d = box(md), s_x = box(mx), s_y = box(my), s_xd = box(mxd), s_yd = box(myd),
+                s_xx = box(mxx), s_yy = box(myy), s_xy = box(mxy);
   // slope_x, slope_y: views of the caller's maps (region size), written in place.
   STEREORIG_CHECK(slope_x->size() == disparity.size() && slope_y->size() == disparity.size());
   slope_x->setTo(0);
   slope_y->setTo(0);
   *plane = cv::Mat(disparity.size(), CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
-  for (int y = 0; y < disparity.rows; ++y)
+  for (int y = 0; y < disparity.rows; ++y) {
+    const float *n_row = s_m.ptr<float>(y), *x_row = s_x.ptr<float>(y), *y_row = s_y.ptr<float>(y),
+                *d_row = s_d.ptr<float>(y), *xx_row = s_xx.ptr<float>(y), *yy_row = s_yy.ptr<float>(y),
+                *xy_row = s_xy.ptr<float>(y), *xd_row = s_xd.ptr<float>(y), *yd_row = s_yd.ptr<float>(y);
+    float *gx_out = slope_x->ptr<float>(y), *gy_out = slope_y->ptr<float>(y), *plane_out = plane->ptr<float>(y);
     for (int x = 0; x < disparity.cols; ++x) {
-      const double n = s_m.at<float>(y, x);
+      const double n = n_row[x];
       if (n < 12) continue;
-      const double mxv = s_x.at<float>(y, x) / n, myv = s_y.at<float>(y, x) / n, md_ = s_d.at<float>(y, x) / n;
-      const double cxx = s_xx.at<float>(y, x) / n - mxv * mxv, cyy = s_yy.at<float>(y, x) / n - myv * myv;
-      const double cxy = s_xy.at<float>(y, x) / n - mxv * myv;
-      const double cxd = s_xd.at<float>(y, x) / n - mxv * md_, cyd = s_yd.at<float>(y, x) / n - myv * md_;
+      const double mxv = x_row[x] / n, myv = y_row[x] / n, md_ = d_row[x] / n;
+      const double cxx = xx_row[x] / n - mxv * mxv, cyy = yy_row[x] / n - myv * myv;
+      const double cxy = xy_row[x] / n - mxv * myv;
+      const double cxd = xd_row[x] / n - mxv * md_, cyd = yd_row[x] / n - myv * md_;
       const double det = cxx * cyy - cxy * cxy;
       if (!(det > 1e-6)) continue;
       const double gx = (cyy * cxd - cxy * cyd) / det, gy = (cxx * cyd - cxy * cxd) / det;
       if (std::abs(gx) > 1.5 || std::abs(gy) > 1.5) continue;  // a depth edge, not a surface
-      slope_x->at<float>(y, x) = float(gx);
-      slope_y->at<float>(y, x) = float(gy);
-      plane->at<float>(y, x) = float(md_ + gx * (x - mxv) + gy * (y - myv));
+      gx_out[x] = float(gx);
+      gy_out[x] = float(gy);
+      plane_out[x] = float(md_ + gx * (x - mxv) + gy * (y - myv));
     }
+  }
 }
 
 // The band of disparities a half-resolution SGM finds in the ROI
@@ -376,8 +392,8 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
         }
         if (o.intensity_refinement) {
           SubpixelResult s = dense.ok.empty() ? SubpixelResult{} : dense.At(x, y);
-          if (!s.ok) s = RefineDisparity(left, right, x, y, d, slope_x[x], slope_y[x], o.subpixel);
-          const PixelStatus why = Accept(left, right, x, y, slope_x[x], slope_y[x], s, accept);
+          const PixelStatus why = s.ok ? Accept(left, right, x, y, slope_x[x], slope_y[x], s, accept)
+                                       : RefineAndAccept(left, right, x, y, d, slope_x[x], slope_y[x], accept, &s);
           if (why != PixelStatus::kPoint) {
             reject(why);
             continue;

@@ -110,8 +110,7 @@ bool ObliqueViews::Refine(int x, int y, double start_px, double slope_x, double 
     const double centre = x - start_px;
     EnsureBlurred(*best, y - rows, y + rows + 1, int(std::floor(centre - reach)), int(std::ceil(centre + reach)) + 1);
   }
-  *result = RefineDisparity(best->left, best->right, x, y, start_px, slope_x, slope_y, a.subpixel);
-  *status = Accept(best->left, best->right, x, y, slope_x, slope_y, *result, a);
+  *status = RefineAndAccept(best->left, best->right, x, y, start_px, slope_x, slope_y, a, result);
   return true;
 }
 

@@ -114,8 +114,8 @@ int GrowDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
           last.slope_x == qgx && last.slope_y == qgy &&
           (!o.shifted_windows || (last.from_dx == from.x && last.from_dy == from.y)))
         continue;
-      SubpixelResult r = RefineDisparity(left, right, q.x, q.y, predicted, qgx, qgy, accept.subpixel);
-      PixelStatus why = Accept(left, right, q.x, q.y, qgx, qgy, r, accept);
+      SubpixelResult r;
+      PixelStatus why = RefineAndAccept(left, right, q.x, q.y, predicted, qgx, qgy, accept, &r);
       if (why == PixelStatus::kPoint && std::abs(r.disparity_px - predicted) > o.max_deviation_px)
         why = PixelStatus::kOffPlane;
       if (why != PixelStatus::kPoint && o.shifted_windows && 1 - qgx > o.shifted_min_foreshortening &&

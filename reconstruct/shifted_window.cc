@@ -10,9 +10,8 @@ PixelStatus RefineShiftedWindow(const cv::Mat& left, const cv::Mat& right, int x
   const cv::Point k(inward.x * accept.subpixel.half_width_px, inward.y * accept.subpixel.half_height_px);
   if (k.x == 0 && k.y == 0) return PixelStatus::kRefineFailed;
   const double along = slope_x * k.x + slope_y * k.y;  // d(x + k) - d(x) on the local plane
-  SubpixelResult r =
-      RefineDisparity(left, right, x + k.x, y + k.y, predicted_px + along, slope_x, slope_y, accept.subpixel);
-  PixelStatus why = Accept(left, right, x + k.x, y + k.y, slope_x, slope_y, r, accept);
+  SubpixelResult r;
+  PixelStatus why = RefineAndAccept(left, right, x + k.x, y + k.y, predicted_px + along, slope_x, slope_y, accept, &r);
   r.disparity_px -= along;
   if (why == PixelStatus::kPoint && std::abs(r.disparity_px - predicted_px) > max_deviation_px)
     why = PixelStatus::kOffPlane;

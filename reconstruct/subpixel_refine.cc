@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 
 #include "calib/core/input_error.h"
 #include "reconstruct/subpixel_window.h"
@@ -22,20 +23,29 @@ namespace {
 
 // x = A^-1 b for the symmetric 3x3 A = [a00 a01 a02; a01 a11 a12; a02 a12
 // a22], by cofactors (as Eigen's 3x3 inverse): not finite if A is singular.
+// *inverse00: (A^-1)[0][0], the same as the first entry of the solution for
+// b = (1, 0, 0) (no second solve for the variance of d).
 void SolveSymmetric3(double a00, double a01, double a02, double a11, double a12, double a22, const double b[3],
-                     double x[3]) {
+                     double x[3], double* inverse00) {
   const double c00 = a11 * a22 - a12 * a12, c01 = a02 * a12 - a01 * a22, c02 = a01 * a12 - a02 * a11;
   const double c11 = a00 * a22 - a02 * a02, c12 = a01 * a02 - a00 * a12, c22 = a00 * a11 - a01 * a01;
   const double inv_det = 1.0 / (a00 * c00 + a01 * c01 + a02 * c02);
   x[0] = (c00 * b[0] + c01 * b[1] + c02 * b[2]) * inv_det;
   x[1] = (c01 * b[0] + c11 * b[1] + c12 * b[2]) * inv_det;
   x[2] = (c02 * b[0] + c12 * b[1] + c22 * b[2]) * inv_det;
+  *inverse00 = c00 * inv_det;
 }
 
 }  // namespace
 
 SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x, int y, double start_px, double slope_x,
                                double slope_y, const SubpixelOptions& o) {
+  std::optional<SubpixelWindow> window;
+  return RefineDisparity(left, right, x, y, start_px, slope_x, slope_y, o, &window);
+}
+
+SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x, int y, double start_px, double slope_x,
+                               double slope_y, const SubpixelOptions& o, std::optional<SubpixelWindow>* window_out) {
   SubpixelResult result;
   const int hw = o.half_width_px, hh = o.half_height_px;
   if (y - hh < 0 || y + hh >= left.rows || x - hw < 0 || x + hw >= left.cols) return result;
@@ -45,8 +55,8 @@ SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x,
   // The AVX2 sums read 2 columns more to the left (subpixel_window.h); a
   // column of margin more keeps float rounding of the positions inside.
   const bool margin = x - start_px - reach >= 1;
-  const SubpixelWindow window(left, right, x, y, slope_x, slope_y, o,
-                              margin ? WindowKernel::kFastest : WindowKernel::kPortable);
+  const SubpixelWindow& window = window_out->emplace(left, right, x, y, slope_x, slope_y, o,
+                                                    margin ? WindowKernel::kFastest : WindowKernel::kPortable);
   const int nwin = window.size();
   const double lmean = double(window.left_sum()) / nwin;
   result.std_dn = std::sqrt(std::max(0.0, double(window.left_sum2()) / nwin - lmean * lmean));
@@ -64,8 +74,9 @@ SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x,
     const double jtj_dd = gain * gain * s.gg, jtj_dgain = -gain * s.gr, jtj_doffset = -gain * s.g;
     const double jtj_gain2 = s.rr, jtj_gain_offset = s.r, jtj_offset2 = nwin;
     const double minus_jte[3] = {-gain * s.ge, s.re, s.e};
-    double step[3];
-    SolveSymmetric3(jtj_dd, jtj_dgain, jtj_doffset, jtj_gain2, jtj_gain_offset, jtj_offset2, minus_jte, step);
+    double step[3], inverse_dd;
+    SolveSymmetric3(jtj_dd, jtj_dgain, jtj_doffset, jtj_gain2, jtj_gain_offset, jtj_offset2, minus_jte, step,
+                    &inverse_dd);
     if (!(std::isfinite(step[0]) && std::isfinite(step[1]) && std::isfinite(step[2]))) return result;
     {
       // The residual sum of squares e'e of the pass, expanded in the sums
@@ -78,10 +89,7 @@ SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x,
       const double ee = double(window.left_sum2()) - 2 * a * s.lr - 2 * b * double(window.left_sum()) + a * a * s.rr +
                         2 * a * b * s.r + nwin * b * b;
       const double rss = std::max(0.0, ee - (minus_jte[0] * step[0] + minus_jte[1] * step[1] + minus_jte[2] * step[2]));
-      const double unit[3] = {1, 0, 0};
-      double column[3];
-      SolveSymmetric3(jtj_dd, jtj_dgain, jtj_doffset, jtj_gain2, jtj_gain_offset, jtj_offset2, unit, column);
-      variance_dd = column[0] * rss / (nwin - 3);
+      variance_dd = inverse_dd * rss / (nwin - 3);
     }
     d += step[0];
     gain += step[1];

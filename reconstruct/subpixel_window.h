@@ -49,6 +49,7 @@ class SubpixelWindow {
                  const SubpixelOptions& o, WindowKernel kernel = WindowKernel::kFastest);
 
   int size() const { return n_; }  // samples, (2 hw + 1)(2 hh + 1)
+  WindowKernel kernel() const { return kernel_; }  // as constructed
   // Sums of the left values and their squares over the window (exact).
   int64_t left_sum() const { return lsum_; }
   int64_t left_sum2() const { return lsum2_; }
@@ -80,13 +81,15 @@ class SubpixelWindow {
   FitPassSums FitPassAvx2(double d, float gain, float offset) const;
   void SampleAvx2(double d, int row_shift, float* r, float* g) const;
   double ZnccAvx2(double d) const;
+  friend class WindowZnccProbe;
 
   const cv::Mat& left_;
   const cv::Mat& right_;
   int x_, y_, hw_, hh_, n_;
   float stride_;    // 1 - slope_x: right px per left px along the row
   double slope_y_;  // dd/dy
-  bool vector_;     // the AVX2 path
+  WindowKernel kernel_;
+  bool vector_;  // the AVX2 path
   int64_t lsum_ = 0, lsum2_ = 0;
   // AVX2 path, flattened samples padded to a multiple of 8 (padding: the
   // centre pixel's position with l = 0, masked out of the sums):
@@ -95,6 +98,13 @@ class SubpixelWindow {
   alignas(32) int32_t row_[kMaxVectorSamples];   // byte offset of the right row from right.data
 };
 
+// RefineDisparity (subpixel_refine.h), also handing back the window it
+// fitted (left empty where it returned before setting one up), so that the
+// distinctness test can reuse it (RefineAndAccept, disparity_state.h). The
+// same result as RefineDisparity.
+SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x, int y, double start_px, double slope_x,
+                               double slope_y, const SubpixelOptions& options, std::optional<SubpixelWindow>* window);
+
 // WindowZncc (subpixel_refine.h) of one window at several disparities,
 // the window set up once: the distinctness test (disparity_state.h) takes
 // two.
@@ -102,14 +112,21 @@ class WindowZnccProbe {
  public:
   WindowZnccProbe(const cv::Mat& left, const cv::Mat& right, int x, int y, double slope_x, double slope_y,
                   const SubpixelOptions& o);
+  // On a window already set up with WindowKernel::kFastest for these
+  // slopes and options (the fit's: RefineDisparity above), which must
+  // outlive the probe. The same values as the constructor above.
+  WindowZnccProbe(const SubpixelWindow& window, double slope_x, double slope_y, const SubpixelOptions& o);
+  WindowZnccProbe(const WindowZnccProbe&) = delete;
+  WindowZnccProbe& operator=(const WindowZnccProbe&) = delete;
   // = WindowZncc(left, right, x, y, d, slope_x, slope_y, o): -1 where the
   // window leaves either image.
   double At(double d) const;
 
  private:
   int x_, right_cols_;
-  double reach_px_;                       // the right window's extent about x - d, with the taps' margin
-  std::optional<SubpixelWindow> window_;  // none if the left window leaves the image
+  double reach_px_;                        // the right window's extent about x - d, with the taps' margin
+  std::optional<SubpixelWindow> own_;      // set up by the first constructor, if inside the left image
+  const SubpixelWindow* window_ = nullptr;  // own_ or the caller's; null if the left window leaves the image
 };
 
 }  // namespace stereorig

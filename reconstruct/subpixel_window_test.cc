@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <random>
 
+#include "reconstruct/disparity_state.h"
 #include "reconstruct/lanczos_taps.h"
 #include "reconstruct/subpixel_refine.h"
 #include "reconstruct/synthetic_pair.h"
@@ -165,6 +166,62 @@ TEST(SubpixelWindow, DistinctnessZnccEqualsPlainDoubleEvaluation) {
   // sample by < 1e-5 * 255 DN; float sums of 27 products ~1e-6 relative: the
   // ZNCC agrees to ~1e-5 (the test's threshold scale is 0.1).
   EXPECT_LT(max_dz, 1e-4);
+}
+
+// RefineAndAccept (disparity_state.h: one window for the fit and the
+// distinctness test) against the plain double fit and the plain ZNCC half
+// a period either side, the acceptance tests stated here.
+TEST(SubpixelWindow, RefineAndAcceptEqualsThePlainFitAndDistinctnessTest) {
+  SyntheticPairSpec spec;
+  const SyntheticPair pair = RenderSyntheticPair(spec);
+  RefineAcceptance a;  // min_zncc 0.8, texture 1.5 DN, distinctness 0.4 at half_period_px 4
+  a.min_disparity_px = 0, a.max_disparity_px = 200;
+  // Ignore pixels within this of a threshold: the fit's table moves d by
+  // < 0.002 px and the ZNCC by < 0.002 (RefineDisparityEqualsPlain...), so
+  // the two may fall either side of a threshold only that close to it.
+  constexpr double kMargin = 0.005;
+  int accepted = 0, rejected = 0;
+  for (const double off_px : {0.0, 2.5, 3.5}) {  // on the match, and a third / half a period off: some fail
+    for (Probe p : Probes(pair, spec, 700)) {
+      p.start += off_px;
+      SubpixelResult fast;
+      const PixelStatus why = RefineAndAccept(pair.left, pair.right, p.x, p.y, p.start, p.gx, p.gy, a, &fast);
+      const SubpixelResult ref = RefineReference(pair.left, pair.right, p.x, p.y, p.start, p.gx, p.gy, a.subpixel);
+      ASSERT_EQ(fast.ok, ref.ok) << p.x << "," << p.y;
+      PixelStatus plain = PixelStatus::kPoint;
+      double closest = 1;  // how near the plain evaluation is to a threshold
+      if (!ref.ok) {
+        plain = PixelStatus::kRefineFailed;
+      } else {
+        closest = std::abs(ref.zncc - a.min_zncc);
+        if (ref.zncc < a.min_zncc) {
+          plain = PixelStatus::kLowZncc;
+        } else {
+          const double half = a.half_period_px * (1 - p.gx);
+          for (const double shift : {-half, half}) {
+            const double margin = ref.zncc - ZnccReference(pair.left, pair.right, p.x, p.y, ref.disparity_px + shift,
+                                                           p.gx, p.gy, a.subpixel);
+            closest = std::min(closest, std::abs(margin - a.min_distinctness));
+            if (margin < a.min_distinctness) {
+              plain = PixelStatus::kNotDistinct;
+              break;
+            }
+          }
+        }
+      }
+      if (closest < kMargin) continue;
+      ASSERT_EQ(int(why), int(plain)) << p.x << "," << p.y << " start " << p.start;
+      if (why == PixelStatus::kPoint) {
+        EXPECT_NEAR(fast.disparity_px, ref.disparity_px, 0.002);
+        ++accepted;
+      } else {
+        ++rejected;
+      }
+    }
+  }
+  std::printf("RefineAndAccept = plain: %d accepted, %d rejected\n", accepted, rejected);
+  EXPECT_GT(accepted, 500);
+  EXPECT_GT(rejected, 100) << "the rejections are compared too";
 }
 
 TEST(SubpixelWindow, FastSumsEqualPortableSums) {
