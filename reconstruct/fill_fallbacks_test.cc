@@ -30,11 +30,7 @@ TEST(ShiftedWindow, RecoversThePixelsAtASilhouetteOnTheTrueDisparity) {
   SyntheticPair pair = RenderSyntheticPair(spec);
   constexpr int kEdge = 200;
   constexpr uint8_t kBackground = 12;
-  for (int y = 0; y < pair.left.rows; ++y) {
-    for (int x = kEdge; x < pair.left.cols; ++x) pair.left.at<uint8_t>(y, x) = kBackground;
-    const double edge_right = kEdge - pair.true_disparity_px.at<double>(y, kEdge);
-    for (int x = int(std::ceil(edge_right)); x < pair.right.cols; ++x) pair.right.at<uint8_t>(y, x) = kBackground;
-  }
+  EndPlaneAtColumn(kEdge, kBackground, &pair);
   const RefineAcceptance accept = Acceptance();
   int centred_ok = 0, shifted_ok = 0, n = 0;
   double worst = 0, sum2 = 0;
@@ -193,7 +189,8 @@ TEST(ObliqueRefine, LazyBlurringGivesTheResultsOfWholeViews) {
         sum2 += std::pow(lazy.disparity_px - truth, 2);
       }
     }
-    std::printf("dd/dx %.1f: %d of %d accepted, rms %.3f px\n", du, accepted, n, std::sqrt(sum2 / std::max(1, accepted)));
+    std::printf("dd/dx %.1f: %d of %d accepted, rms %.3f px\n", du, accepted, n,
+                std::sqrt(sum2 / std::max(1, accepted)));
     EXPECT_GT(accepted, n / 10);
     EXPECT_LT(std::sqrt(sum2 / std::max(1, accepted)), 0.1);
   }

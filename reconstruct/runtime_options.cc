@@ -119,6 +119,8 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.grow.shifted_min_foreshortening =
         m.GetDouble("grow_shifted_min_foreshortening", mo.grow.shifted_min_foreshortening);
     mo.grow.shifted_min_zncc = m.GetDouble("grow_shifted_min_zncc", mo.grow.shifted_min_zncc);
+    mo.grow.shifted_enclosed_min_zncc =
+        m.GetDouble("grow_shifted_enclosed_min_zncc", mo.grow.shifted_enclosed_min_zncc);
     mo.grow.oblique.enabled = m.GetBool("grow_oblique", mo.grow.oblique.enabled);
     mo.grow.oblique.min_foreshortening =
         m.GetDouble("grow_oblique_min_foreshortening", mo.grow.oblique.min_foreshortening);

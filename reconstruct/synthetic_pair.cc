@@ -106,4 +106,12 @@ SyntheticPair RenderSyntheticPair(const SyntheticPairSpec& s) {
   return out;
 }
 
+void EndPlaneAtColumn(int edge_x, uint8_t background_dn, SyntheticPair* pair) {
+  for (int y = 0; y < pair->left.rows; ++y) {
+    for (int x = edge_x; x < pair->left.cols; ++x) pair->left.at<uint8_t>(y, x) = background_dn;
+    const double edge_right = edge_x - pair->true_disparity_px.at<double>(y, edge_x);
+    for (int x = int(std::ceil(edge_right)); x < pair->right.cols; ++x) pair->right.at<uint8_t>(y, x) = background_dn;
+  }
+}
+
 }  // namespace stereorig

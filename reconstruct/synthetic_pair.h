@@ -42,4 +42,10 @@ struct SyntheticPair {
 
 SyntheticPair RenderSyntheticPair(const SyntheticPairSpec& spec);
 
+// The plane ends at column edge_x of the left image against a flat
+// background (an object's silhouette): the left pixels from edge_x on, and
+// the right pixels from that column's match on, are set to background_dn.
+// true_disparity_px is left as it is (the plane's).
+void EndPlaneAtColumn(int edge_x, uint8_t background_dn, SyntheticPair* pair);
+
 }  // namespace stereorig
