@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "calib/core/input_error.h"
 #include "reconstruct/parallel_for.h"
@@ -120,6 +121,7 @@ CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int
   row_begin = std::clamp(row_begin, 0, grey.rows);
   row_end = std::clamp(row_end, row_begin, grey.rows);
   out.row_begin = row_begin;
+  out.signature_bits = (2 * half_width + 1) * (2 * half_height + 1) - 1;
   out.bits.assign(size_t(grey.cols) * (row_end - row_begin), 0);
   const int w = grey.cols, h = grey.rows;
   const int c0 = std::clamp(col_begin, 0, w), c1 = std::clamp(col_end, c0, w);
@@ -193,6 +195,7 @@ struct SgmWorkspace {
   std::vector<uint16_t> shifted, shifted_rl;                 // (stride + 2): a predecessor in another window
   std::vector<uint16_t> right_best;                          // (16 + w + n)
   std::vector<uint64_t> right_reversed;                      // (stride + right width + stride + 16)
+  std::vector<uint8_t> nibble_planes;                        // (nibbles, right_reversed's size)
 };
 
 // Room for n elements (contents unspecified).
@@ -231,6 +234,57 @@ inline const uint16_t* InWindowOf(const uint16_t* prev, int shift, int n, int st
   return shift == 0 ? prev : ShiftedCopy(prev, shift, n, stride, buf);
 }
 
+// One row of the cost volume: pixel x of the region (left signatures cl,
+// window lo[x]) gets c[d] = Hamming(cl, right pixel region.x + x - lo[x] -
+// d), kCensusMaxCost where that pixel is off the right image. The right row
+// is given reversed (with `stride` padding each side) so that each pixel's
+// run of disparities reads it forwards: as signatures (kNibbles == 0) or as
+// kNibbles nibble planes of plane_stride bytes (sgm_kernels.h).
+struct CostRowArgs {
+  const uint64_t* cl;        // the left row's signatures
+  const int16_t* lo;         // (w) the windows' first disparities
+  const uint64_t* reversed;  // the right row reversed
+  const uint8_t* planes;     // its nibble planes, or null
+  size_t plane_stride;
+  int region_x, w, n, stride, rw;
+};
+template <typename K, int kNibbles>
+void CostRow(const CostRowArgs& a, uint8_t* cost_row) {
+  for (int x = 0; x < a.w; ++x) {
+    uint8_t* c = cost_row + size_t(x) * a.stride;
+    const int xr0 = a.region_x + x - a.lo[x];  // right x at d index 0
+    // d indices whose right pixel xr0 - d lies in [0, rw).
+    const int d_lo = std::clamp(xr0 - a.rw + 1, 0, a.n), d_hi = std::clamp(xr0 + 1, d_lo, a.n);
+    if (d_lo == d_hi) {
+      std::fill(c, c + a.stride, uint8_t(kCensusMaxCost));
+      continue;
+    }
+    const size_t r0 = size_t(a.stride + a.rw - 1 - xr0);  // the reversed row's index of d index 0
+    if constexpr (kNibbles > 0)
+      K::template CostFromNibbles<kNibbles>(a.cl[a.region_x + x], a.planes + r0, a.plane_stride, c, a.stride);
+    else
+      K::Cost(a.cl[a.region_x + x], a.reversed + r0, c, d_lo, d_hi, a.stride);
+    std::fill(c, c + d_lo, uint8_t(kCensusMaxCost));
+    std::fill(c + d_hi, c + a.n, uint8_t(kCensusMaxCost));
+  }
+}
+
+using CostRowFn = void (*)(const CostRowArgs&, uint8_t*);
+template <typename K, int... k>
+CostRowFn CostRowFor(int nibbles, std::integer_sequence<int, k...>) {
+  static constexpr CostRowFn fns[] = {&CostRow<K, k + 1>...};
+  return fns[std::clamp(nibbles, 1, 16) - 1];
+}
+// CostRow for signatures of `nibbles` nibbles: kernels with kNibbleCosts
+// read nibble planes (one instance per count, 1..16), others the signatures.
+template <typename K>
+CostRowFn CostRowFor(int nibbles) {
+  if constexpr (K::kNibbleCosts)
+    return CostRowFor<K>(nibbles, std::make_integer_sequence<int, 16>());
+  else
+    return &CostRow<K, 0>;
+}
+
 // SGM with per-pixel search windows: pixel (x, y) of `region` searches the
 // n disparities [lo(y, x), lo(y, x) + n) (window_lo: CV_16SC1 of
 // region.size()). Every path step reads its predecessor through
@@ -248,32 +302,24 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   auto lo_row = [&](int y) { return window_lo.ptr<int16_t>(y); };
   SgmWorkspace ws;
 
-  // Cost volume (h, w, stride), uint8. Disparities whose right pixel falls
-  // off the image get the maximum cost, so they are never preferred. The
-  // right row is reversed (with `stride` padding each side) so that each
-  // pixel's run of disparities reads it forwards.
+  // Cost volume (h, w, stride), uint8 (CostRow).
   ScratchArray<uint8_t> cost_volume(size_t(h) * w * stride);
   uint8_t* cost = cost_volume.data();
-  uint64_t* reversed = Grow(ws.right_reversed, size_t(rw) + 2 * stride + 16);
-  std::fill(reversed, reversed + size_t(rw) + 2 * stride + 16, 0);
+  const size_t reversed_size = size_t(rw) + 2 * stride + 16;
+  uint64_t* reversed = Grow(ws.right_reversed, reversed_size);
+  std::fill(reversed, reversed + reversed_size, 0);
+  // Kernels that read nibble planes get the reversed row split into them
+  // (+32 bytes: CostFromNibbles may read 16 beyond the last plane).
+  const int nibbles = (std::max(left.signature_bits, right.signature_bits) + 3) / 4;
+  uint8_t* planes = K::kNibbleCosts ? Grow(ws.nibble_planes, size_t(nibbles) * reversed_size + 32) : nullptr;
+  const CostRowFn cost_row = CostRowFor<K>(nibbles);
   for (int y = 0; y < h; ++y) {
-    const uint64_t* cl = left.row(region.y + y);
     const uint64_t* cr = right.row(region.y + y);
-    const int16_t* lo = lo_row(y);
     std::reverse_copy(cr, cr + rw, reversed + stride);
-    for (int x = 0; x < w; ++x) {
-      uint8_t* c = cost + (size_t(y) * w + x) * stride;
-      const int xr0 = region.x + x - lo[x];  // right x at d index 0
-      // d indices whose right pixel xr0 - d lies in [0, rw).
-      const int d_lo = std::clamp(xr0 - rw + 1, 0, n), d_hi = std::clamp(xr0 + 1, d_lo, n);
-      if (d_lo == d_hi) {
-        std::fill(c, c + stride, uint8_t(kCensusMaxCost));
-        continue;
-      }
-      K::Cost(cl[region.x + x], reversed + stride + rw - 1 - xr0, c, d_lo, d_hi, stride);
-      std::fill(c, c + d_lo, uint8_t(kCensusMaxCost));
-      std::fill(c + d_hi, c + n, uint8_t(kCensusMaxCost));
-    }
+    if constexpr (K::kNibbleCosts) K::NibblePlanes(reversed, int(reversed_size), nibbles, planes, reversed_size);
+    cost_row(
+        CostRowArgs{left.row(region.y + y), lo_row(y), reversed, planes, reversed_size, region.x, w, n, stride, rw},
+        cost + size_t(y) * w * stride);
   }
 
   // Aggregated cost (h, w, stride) when a second pass is needed; otherwise one row.

@@ -22,6 +22,7 @@ struct CensusImage {
   int width = 0;
   int height = 0;
   int row_begin = 0;           // first row held
+  int signature_bits = 64;     // bits a signature may use (the low ones); those above are 0. Default 64
   std::vector<uint64_t> bits;  // (rows held, width), row-major
   // Row y of the image; y must be one of the rows computed.
   const uint64_t* row(int y) const { return bits.data() + size_t(y - row_begin) * width; }

@@ -112,6 +112,39 @@ TEST(CensusSgm, SimdAndScalarPathsGiveIdenticalDisparities) {
   EXPECT_GT(valid_total, 20000);
 }
 
+// Signatures using all 64 bits and only the lowest 8 (a 3x3 census): the
+// AVX2 path's nibble-plane costs (16 and 2 planes) against the scalar
+// path's 64-bit popcounts, which need no planes.
+TEST(CensusSgm, NibblePlaneCostsEqualPopcountsForAnySignatureWidth) {
+  if (!SgmSimdAvailable()) GTEST_SKIP() << "this build has no AVX2 kernels (STEREORIG_NATIVE off or no AVX2)";
+  std::mt19937_64 rng(17);
+  const int w = 90, h = 24, shift = 5;
+  for (const int bits : {64, 8}) {
+    CensusImage left, right;
+    for (CensusImage* c : {&left, &right}) {
+      c->width = w;
+      c->height = h;
+      c->signature_bits = bits;
+      c->bits.resize(size_t(w) * h);
+    }
+    const uint64_t mask = bits == 64 ? ~uint64_t(0) : (uint64_t(1) << bits) - 1;
+    for (uint64_t& b : left.bits) b = rng() & mask;
+    // The right view: the left one moved by `shift` px, a few bits flipped.
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        right.bits[size_t(y) * w + x] =
+            (left.bits[size_t(y) * w + std::min(w - 1, x + shift)] ^ (rng() & rng())) & mask;
+    for (const int n : {16, 40}) {
+      SgmOptions o;
+      const cv::Mat simd = SgmMatch(left, right, cv::Rect(8, 0, 80, h), 0, n, o);
+      o.simd = false;
+      const cv::Mat scalar = SgmMatch(left, right, cv::Rect(8, 0, 80, h), 0, n, o);
+      const int valid = ExpectIdentical(simd, scalar, "bits " + std::to_string(bits) + " n " + std::to_string(n));
+      EXPECT_GT(valid, 80 * h / 2) << "bits " << bits;  // not vacuous: the shift is found
+    }
+  }
+}
+
 TEST(CensusSgm, FindsAKnownShiftOnRandomTexture) {
   // Independent of the implementation: the right view is the left one moved
   // by exactly 7 px, so every valid interior pixel must say 7 (+-0.5: the

@@ -68,7 +68,9 @@ struct MatchOptions {
   // 0.20, sphere module 0 0.077 -> 0.099) and at 20 px the tuber's module 0
   // (0.075 -> 0.119); seed 1 (calibrated rig) lost the plate's module 1 at 12
   // and 15 px. The whole-band search had none of these. It saves ~20 ms of
-  // SGM per module; turn it on only with a test of its own scenes.
+  // SGM per module; turn it on only with a test of its own scenes. Session 6,
+  // with the vernier and wrong-line drops: still (demo ball bar module 0 std
+  // 0.069 -> 0.152 mm, seed 7 ball bar module 1 0.080 -> 0.455).
   int guided_radius_px = 0;
   int refine_radius_px = 2;  // census_sgm: fine-level search +-radius around 2x coarse; default 2
   int refine_half_window_px = 1;     // census_sgm: fine-level cost box half size; default 1 (3x3)

@@ -1,7 +1,6 @@
 // The inner loops of census SGM (census_sgm.cc), twice: a portable scalar
-// version over exactly n disparities, and an AVX2 version (AVX-512
-// VPOPCNTDQ for the census costs where the CPU has it) over n rounded up to
-// a multiple of 16 lanes. Both give bit-identical disparities
+// version over exactly n disparities, and an AVX2 version over n rounded up
+// to a multiple of 16 lanes (census costs from nibble planes). Both give bit-identical disparities
 // (census_sgm_test.cc checks it on random data): the padding lanes of every
 // path cost are forced to kBig, so they never win a min and never feed a
 // real lane: they equal the kBig sentinel the scalar path reads at [n].
@@ -12,7 +11,9 @@
 #pragma once
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
+#include <utility>
 
 #if defined(__AVX2__)
 #include <immintrin.h>
@@ -32,6 +33,7 @@ inline void Accumulate(uint16_t* sum, const uint16_t* sum_in, uint16_t v, SumMod
 }
 
 struct ScalarKernels {
+  static constexpr bool kNibbleCosts = false;  // Cost reads the signatures themselves
   static int Stride(int n) { return n; }
 
   // c[d] = popcount(l ^ r[d]) for d in [lo, hi); the caller fills the rest.
@@ -95,8 +97,61 @@ struct ScalarKernels {
 };
 
 #if defined(__AVX2__)
+// kXorPopcount[v][i] = popcount(i ^ v) for a nibble v and i in [0, 16),
+// repeated in bytes 16..31 (both halves of a pshufb table).
+struct XorPopcountTables {
+  alignas(32) uint8_t bytes[16][32];
+  constexpr XorPopcountTables() : bytes() {
+    for (int v = 0; v < 16; ++v)
+      for (int i = 0; i < 32; ++i) bytes[v][i] = uint8_t(__builtin_popcount(unsigned((i & 15) ^ v)));
+  }
+};
+inline constexpr XorPopcountTables kXorPopcount{};
+
 struct Avx2Kernels {
+  // Census costs from nibble planes: a right row's signatures split into
+  // 4-bit planes (plane k: nibble k of every signature, one byte each), so
+  // one pshufb of the table popcount(i ^ left nibble k) by 32 bytes of plane
+  // k counts that nibble's differing bits for 32 disparities, and byte adds
+  // sum the planes: 2 instructions per nibble and 32 disparities (a 34-bit
+  // 5x7 census has 9 nibbles) instead of the 64-bit popcount's ~3 per
+  // disparity. Same counts as Cost, exactly.
+  static constexpr bool kNibbleCosts = true;
   static int Stride(int n) { return (n + 15) / 16 * 16; }
+
+  // planes[k * plane_stride + j] = nibble k of sig[j] for j in [0, count),
+  // k in [0, nibbles).
+  static void NibblePlanes(const uint64_t* __restrict sig, int count, int nibbles, uint8_t* __restrict planes,
+                           size_t plane_stride) {
+    for (int k = 0; k < nibbles; ++k) {
+      uint8_t* __restrict p = planes + k * plane_stride;
+      const int shift = 4 * k;
+      for (int j = 0; j < count; ++j) p[j] = uint8_t((sig[j] >> shift) & 15);
+    }
+  }
+
+  // c[d] = popcount(l ^ r[d]) for d in [0, stride), r[d]'s nibble k at
+  // planes[k * plane_stride + d]; l has at most 4 * kNibbles bits. Reads 32
+  // bytes at d = stride - 16 when stride is an odd multiple of 16 (and
+  // writes 16): planes must be readable 16 bytes beyond. Inlined into the
+  // caller's loop over a row (a call per pixel spilled the tables).
+  template <int kNibbles>
+  [[gnu::always_inline]] static inline void CostFromNibbles(uint64_t l, const uint8_t* planes, size_t plane_stride,
+                                                            uint8_t* c, int stride) {
+    __m256i table[kNibbles];
+    for (int k = 0; k < kNibbles; ++k)
+      table[k] = _mm256_load_si256(reinterpret_cast<const __m256i*>(kXorPopcount.bytes[(l >> (4 * k)) & 15]));
+    for (int d = 0; d < stride; d += 32) {
+      __m256i acc = _mm256_shuffle_epi8(table[0], _mm256_loadu_si256(reinterpret_cast<const __m256i*>(planes + d)));
+      for (int k = 1; k < kNibbles; ++k)
+        acc = _mm256_add_epi8(acc, _mm256_shuffle_epi8(table[k], _mm256_loadu_si256(reinterpret_cast<const __m256i*>(
+                                                                     planes + size_t(k) * plane_stride + d))));
+      if (d + 32 <= stride)
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(c + d), acc);
+      else
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(c + d), _mm256_castsi256_si128(acc));
+    }
+  }
 
   static __m256i Load(const uint16_t* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); }
   static void Store(uint16_t* p, __m256i v) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), v); }
@@ -114,43 +169,6 @@ struct Avx2Kernels {
 
   static void Accumulate(uint16_t* sum, const uint16_t* sum_in, __m256i v, SumMode mode) {
     Store(sum, mode == SumMode::kStore ? v : _mm256_add_epi16(Load(sum_in), v));
-  }
-
-  // All `stride` lanes (lo, hi ignored: the caller overwrites lanes outside
-  // them, and r must be readable over [0, stride)).
-  static void Cost(uint64_t l, const uint64_t* r, uint8_t* c, int /*lo*/, int /*hi*/, int stride) {
-#if defined(__AVX512VPOPCNTDQ__) && defined(__AVX512F__)
-    const __m512i vl = _mm512_set1_epi64(int64_t(l));
-    for (int d = 0; d < stride; d += 16) {
-      const __m512i a = _mm512_popcnt_epi64(_mm512_xor_si512(vl, _mm512_loadu_si512(r + d)));
-      const __m512i b = _mm512_popcnt_epi64(_mm512_xor_si512(vl, _mm512_loadu_si512(r + d + 8)));
-      _mm_storeu_si128(reinterpret_cast<__m128i*>(c + d),
-                       _mm_unpacklo_epi64(_mm512_maskz_cvtepi64_epi8(0xFF, a), _mm512_maskz_cvtepi64_epi8(0xFF, b)));
-    }
-#else
-    // Nibble-table popcount (pshufb), summed per 64-bit lane (psadbw).
-    const __m256i table = _mm256_setr_epi8(0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4,  //
-                                           0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4);
-    const __m256i nibble = _mm256_set1_epi8(0x0F);
-    const __m256i vl = _mm256_set1_epi64x(int64_t(l));
-    auto count4 = [&](const uint64_t* p) {
-      const __m256i x = _mm256_xor_si256(vl, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)));
-      const __m256i lo = _mm256_shuffle_epi8(table, _mm256_and_si256(x, nibble));
-      const __m256i hi = _mm256_shuffle_epi8(table, _mm256_and_si256(_mm256_srli_epi16(x, 4), nibble));
-      return _mm256_sad_epu8(_mm256_add_epi8(lo, hi), _mm256_setzero_si256());  // 4 counts, one per qword
-    };
-    // After the shifts, qword q holds the counts of d = q, 4+q, 8+q, 12+q in
-    // its bytes 0..3; gather the low dwords, then transpose the 4x4 bytes.
-    const __m256i low_dwords = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);
-    const __m128i transpose = _mm_setr_epi8(0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15);
-    for (int d = 0; d < stride; d += 16) {
-      const __m256i t = _mm256_or_si256(
-          _mm256_or_si256(count4(r + d), _mm256_slli_epi64(count4(r + d + 4), 8)),
-          _mm256_or_si256(_mm256_slli_epi64(count4(r + d + 8), 16), _mm256_slli_epi64(count4(r + d + 12), 24)));
-      const __m128i packed = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(t, low_dwords));
-      _mm_storeu_si128(reinterpret_cast<__m128i*>(c + d), _mm_shuffle_epi8(packed, transpose));
-    }
-#endif
   }
 
   static uint16_t Step(const uint8_t* __restrict c, const uint16_t* __restrict prev, uint16_t prev_min,
