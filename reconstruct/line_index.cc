@@ -19,6 +19,10 @@ void LineIndexOptions::Check() const {
     throw InputError("line_index_window_half_height_px", "must be in [0, 30]");
   if (!(max_row_offset_px > 0 && max_row_offset_px < 1))
     throw InputError("line_index_max_row_offset_px", "must be in (0, 1)");
+  if (footprint_gap_px < 0 || footprint_gap_px > 16)
+    throw InputError("line_index_footprint_gap_px", "must be in [0, 16]");
+  if (!(ambiguity_sigmas >= 0 && ambiguity_sigmas <= 5))
+    throw InputError("line_index_ambiguity_sigmas", "must be in [0, 5] (0 = off)");
   if (min_seam_px < 1) throw InputError("line_index_min_seam_px", "must be >= 1");
   if (max_seam_gap_px < 0 || max_seam_gap_px > 32) throw InputError("line_index_max_seam_gap_px", "must be in [0, 32]");
   if (!(min_row_offset_step_px > 0 && min_row_offset_step_px < 1))
@@ -104,28 +108,59 @@ class LineIndexer {
   // The disparity of pixel i = y * cols + x (the map is continuous).
   float D(int i) const { return state_->disparity_px.ptr<float>(0)[i]; }
 
-  // Up to o.samples valid pixels of `pixels`, spread evenly.
-  std::vector<int> Sample(const std::vector<int>& pixels) const {
-    std::vector<int> valid, sample;
-    valid.reserve(pixels.size());
+  // Where the vernier is read: a pixel and the disparity it starts from.
+  struct Start {
+    int i;    // y * cols + x
+    float d;  // the component's disparity there (a gap pixel: its neighbour's, carried along the row)
+    float slope_x, slope_y;
+  };
+
+  // Up to o.samples pixels of the component's footprint, spread evenly: its
+  // valid pixels and, with footprint_gap_px, the empty pixels up to that far
+  // along the row from them (started from the nearest valid one, carried
+  // along its slope). The valid pixels alone are a biased sample: they are
+  // the ones whose window passed the matcher's tests at the component's
+  // alignment, and at strong speckle those read the vernier nearer 0 on a
+  // wrong alignment than the footprint does (simulator's ball bar at speckle
+  // 0.4: a component two periods off read +0.11 px on its own pixels, +0.32
+  // on all pixels of its region).
+  std::vector<Start> Sample(const std::vector<int>& pixels) const {
+    std::vector<Start> all;
+    all.reserve(pixels.size() * size_t(1 + 2 * o_.footprint_gap_px));
     for (int i : pixels)
-      if (std::isfinite(D(i))) valid.push_back(i);
-    const double stride = std::max(1.0, double(valid.size()) / o_.samples);
-    for (double k = 0.5 * stride; k < double(valid.size()); k += stride) sample.push_back(valid[size_t(k)]);
+      if (std::isfinite(D(i))) all.push_back({i, D(i), SlopeX(i), SlopeY(i)});
+    const size_t valid = all.size();
+    for (size_t k = 0; k < valid; ++k) {
+      const Start s = all[k];
+      const int x = s.i % cols_;
+      for (const int dir : {-1, 1})
+        for (int u = 1; u <= o_.footprint_gap_px; ++u) {
+          const int xu = x + dir * u;
+          if (xu < 0 || xu >= cols_ || std::isfinite(D(s.i + dir * u))) break;
+          all.push_back({s.i + dir * u, s.d + float(dir * u) * s.slope_x, s.slope_x, s.slope_y});
+        }
+    }
+    // A gap pixel reached from both sides: once (the first listed).
+    std::stable_sort(all.begin(), all.end(), [](const Start& a, const Start& b) { return a.i < b.i; });
+    all.erase(std::unique(all.begin(), all.end(), [](const Start& a, const Start& b) { return a.i == b.i; }),
+              all.end());
+    std::vector<Start> sample;
+    const double stride = std::max(1.0, double(all.size()) / o_.samples);
+    for (double k = 0.5 * stride; k < double(all.size()); k += stride) sample.push_back(all[size_t(k)]);
     return sample;
   }
 
   // The row offset of the tall-window fit over `sample`, each started from
   // its disparity + shift.
-  Vernier Read(const std::vector<int>& sample, double shift) const {
+  Vernier Read(const std::vector<Start>& sample, double shift) const {
     double sum = 0, sum2 = 0, sum_shift = 0;
     int n = 0;
-    for (int i : sample) {
+    for (const Start& s : sample) {
       const RowOffsetResult r =
-          RefineDisparityAndRowOffset(left_, right_, i % cols_, i / cols_, D(i) + shift, SlopeX(i), SlopeY(i), tall_);
+          RefineDisparityAndRowOffset(left_, right_, s.i % cols_, s.i / cols_, s.d + shift, s.slope_x, s.slope_y, tall_);
       if (!r.ok) continue;
       sum += r.row_offset_px, sum2 += r.row_offset_px * r.row_offset_px;
-      sum_shift += r.disparity_px - D(i);
+      sum_shift += r.disparity_px - s.d;
       ++n;
     }
     Vernier v;
@@ -139,11 +174,11 @@ class LineIndexer {
   }
 
   // Mean ZNCC of the matcher's own refinement from disparity + shift.
-  double MeanZncc(const std::vector<int>& sample, double shift) const {
+  double MeanZncc(const std::vector<Start>& sample, double shift) const {
     double sum = 0;
-    for (int i : sample) {
-      const SubpixelResult r =
-          RefineDisparity(left_, right_, i % cols_, i / cols_, D(i) + shift, SlopeX(i), SlopeY(i), accept_.subpixel);
+    for (const Start& s : sample) {
+      const SubpixelResult r = RefineDisparity(left_, right_, s.i % cols_, s.i / cols_, s.d + shift, s.slope_x,
+                                               s.slope_y, accept_.subpixel);
       sum += r.ok ? r.zncc : 0.0;
     }
     return sum / double(sample.size());
@@ -197,12 +232,18 @@ class LineIndexer {
   // One component's vernier test.
   // offset_px: the row offset a correct match reads (0 on a well rectified pair).
   Outcome TestComponent(const std::vector<int>& pixels, double offset_px) {
-    const std::vector<int> sample = Sample(pixels);
+    const std::vector<Start> sample = Sample(pixels);
     if (int(sample.size()) < 4) return Outcome::kKept;
     Vernier here = Read(sample, 0.0);
     here.mean_row_offset_px -= offset_px;
-    if (here.fits < 4 ||
-        std::abs(here.mean_row_offset_px) <= std::max(o_.max_row_offset_px, 3 * here.standard_error_px))
+    if (here.fits < 4) return Outcome::kKept;
+    // Read as right without the other alignments: within max_row_offset_px
+    // and, with ambiguity_sigmas, by that many standard errors; without it,
+    // also anything within 3 standard errors (as before session 6: at
+    // speckle 0.4 a component one or two periods off read within that).
+    const double here_abs = std::abs(here.mean_row_offset_px);
+    if (o_.ambiguity_sigmas > 0 ? here_abs + o_.ambiguity_sigmas * here.standard_error_px <= o_.max_row_offset_px
+                                : here_abs <= std::max(o_.max_row_offset_px, 3 * here.standard_error_px))
       return Outcome::kKept;
     // Off, and the alignment the vernier points to cannot be read: the
     // right line is out of reach (outside the right image, typically).
@@ -239,8 +280,25 @@ class LineIndexer {
     const double det = sw * skk - sk * sk;
     if (!(det > 0)) return unreadable();  // neither other alignment could be read
     const double a = (skk * sd - sk * skd) / det, b = (sw * skd - sk * sd) / det;
-    if (std::abs(b) < o_.min_row_offset_step_px) return Outcome::kKept;  // no vernier to read
-    const int k = int(std::lround(std::clamp(-a / b, -1.0, 1.0)));
+    if (std::abs(b) < o_.min_row_offset_step_px) {  // no vernier to read
+      if (o_.ambiguity_sigmas <= 0) return Outcome::kKept;
+      // It read off (above) and the other alignments do not say which is
+      // right: unknown, so dropped.
+      Drop(pixels);
+      return Outcome::kDropped;
+    }
+    const double zero_crossing = std::clamp(-a / b, -1.0, 1.0);
+    const int k = int(std::lround(zero_crossing));
+    // The reading's uncertainty in alignments: the standard error of the
+    // intercept over the step. Nearer than ambiguity_sigmas of it to the
+    // midpoint between two alignments, neither is known: drop rather than
+    // keep or move a component that may be a period off.
+    if (o_.ambiguity_sigmas > 0 && std::abs(zero_crossing - k) + o_.ambiguity_sigmas * here.standard_error_px /
+                                                                      std::abs(b) >
+                                       0.5) {
+      Drop(pixels);
+      return Outcome::kDropped;
+    }
     if (k == 0) return Outcome::kKept;
     if (points[k + 1]->fits < 4) return unreadable();
     Move(pixels, points[k + 1]->mean_shift_px);
@@ -345,7 +403,7 @@ int JoinAcrossPeriodJumps(const cv::Mat& left, const cv::Mat& right, const cv::R
     if (spread > int(diffs.size()) / 4) continue;
     const auto [a, b] = key;
     if (done[a] || done[b] || int(std::min(components[a].size(), components[b].size())) < o.min_component_px) continue;
-    const std::vector<int> sample_a = indexer.Sample(components[a]), sample_b = indexer.Sample(components[b]);
+    const auto sample_a = indexer.Sample(components[a]), sample_b = indexer.Sample(components[b]);
     if (int(std::min(sample_a.size(), sample_b.size())) < 4) continue;
     // a moves by +median to meet b, or b by -median to meet a.
     const Vernier a0 = indexer.Read(sample_a, 0.0), a1 = indexer.Read(sample_a, median);

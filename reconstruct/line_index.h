@@ -45,6 +45,21 @@ struct LineIndexOptions {
   // 0.15 px: the true alignment reads |offset| < 0.1 px on the simulator's
   // scenes (max_row_offset_px), one period off reads ~0.36 px (2.6 deg x 8 px).
   double drop_row_offset_px = 0.15;
+  // The vernier is read over the component's footprint: its valid pixels
+  // and the empty ones up to this far along the row from them (0 = the valid
+  // pixels only, as before session 6). Default 8 px (one grid period: pixels
+  // between the lines too). See Sample() in line_index.cc.
+  int footprint_gap_px = 8;
+  // How sure the vernier must be, in standard errors of its reading. A
+  // component is kept without reading the other alignments only if its
+  // reading is within max_row_offset_px by this many standard errors; after
+  // reading them, the zero crossing of the fitted row offset must lie this
+  // many standard errors (of the crossing) inside half an alignment of the
+  // nearest one, else the component is dropped (PixelStatus::kWrongLine).
+  // 0 = off: kept within max(max_row_offset_px, 3 standard errors) and
+  // moved to the nearest alignment whatever the margin (before session 6).
+  // Default 1.
+  double ambiguity_sigmas = 1.0;
   int max_seam_gap_px = 8;  // JoinAcrossPeriodJumps: widest gap of invalid pixels a seam may span; default 8 px
   int min_seam_px = 30;     // JoinAcrossPeriodJumps: shortest seam between two components it acts on; default 30 px
   void Check() const;       // throws InputError naming the bad field

@@ -1,4 +1,4 @@
-// Runtime options: the hole-filling and surface-fit keys are read, defaulted and checked
+// Runtime options: the hole-filling, surface-fit and line-index ambiguity keys are read, defaulted and checked
 // (a bad value or an unknown key is an InputError naming it).
 #include "reconstruct/runtime_options.h"
 
@@ -59,6 +59,22 @@ TEST(RuntimeOptions, ReadsAndChecksTheSurfaceFitKeys) {
       {"match:\n  surface_fit_max_variance_growth: 0.5\n", "surface_fit_max_variance_growth"},
       {"match:\n  surface_fit_max_misfit_ratio: 0\n", "surface_fit_max_misfit_ratio"},
       {"match:\n  surface_fits: true\n", "surface_fits"}};
+  ExpectEachRejectedNamingItsKey(bad);
+}
+
+TEST(RuntimeOptions, ReadsAndChecksTheLineIndexAmbiguityKeys) {
+  const RuntimeOptions d = ParseRuntimeOptions("min_confidence: 0.5\n", "defaults.yaml");
+  EXPECT_EQ(d.match.line_index.footprint_gap_px, 8);
+  EXPECT_EQ(d.match.line_index.ambiguity_sigmas, 1.0);
+  const RuntimeOptions o = ParseRuntimeOptions(
+      "match:\n  line_index_footprint_gap_px: 0\n  line_index_ambiguity_sigmas: 2.5\n", "set.yaml");
+  EXPECT_EQ(o.match.line_index.footprint_gap_px, 0);
+  EXPECT_EQ(o.match.line_index.ambiguity_sigmas, 2.5);
+  const std::pair<const char*, const char*> bad[] = {
+      {"match:\n  line_index_footprint_gap_px: 17\n", "line_index_footprint_gap_px"},
+      {"match:\n  line_index_footprint_gap_px: -1\n", "line_index_footprint_gap_px"},
+      {"match:\n  line_index_ambiguity_sigmas: -0.5\n", "line_index_ambiguity_sigmas"},
+      {"match:\n  line_index_ambiguity_sigma: 1\n", "line_index_ambiguity_sigma"}};
   ExpectEachRejectedNamingItsKey(bad);
 }
 
