@@ -149,11 +149,11 @@ void PrintPipeline(const nlohmann::json& j) {
               j["median_time_ms"]["modules"].get<double>(), j["median_time_ms"]["module0.match"].get<double>());
   // Module 0's steps in pipeline order (map order is alphabetical): where the time goes.
   std::printf("  module 0 median ms:");
-  // match.grow_2 runs only on captures where the second line-index pass
-  // moved something: its median is over those captures.
+  // match.grow_2 and match.line_index_3 run only on captures where the
+  // second line-index pass moved something: their medians are over those captures.
   for (const char* step : {"rectify", "lit_region", "match.band", "match.sgm", "match.sgbm", "match.subpixel",
                            "match.subpixel_dense", "match.line_index", "match.grow", "match.line_index_2",
-                           "match.grow_2", "match.speckle", "match.surface_fit", "triangulate", "normals"}) {
+                           "match.grow_2", "match.line_index_3", "match.speckle", "match.surface_fit", "triangulate", "normals"}) {
     const std::string key = std::string("module0.") + step;
     if (j["median_time_ms"].contains(key)) std::printf(" %s %.1f", step, j["median_time_ms"][key].get<double>());
   }
