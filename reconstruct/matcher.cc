@@ -19,7 +19,6 @@
 
 namespace stereorig {
 
-
 MatcherKind ParseMatcherKind(const std::string& name, const std::string& where) {
   if (name == "census_sgm") return MatcherKind::kCensusSgm;
   if (name == "opencv_sgbm_3way") return MatcherKind::kOpenCvSgbm3Way;
