@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "calib/core/input_error.h"
+#include "reconstruct/footprint_sample.h"
 
 namespace stereorig {
 
@@ -45,7 +46,8 @@ cv::Mat LabelDisparityComponents(const cv::Mat& disparity_px, const cv::Rect& ro
   components->clear();
   // Depth first from each unlabelled valid pixel in raster order, its
   // neighbours pushed left, right, up, down: the order of each component's
-  // pixels, which LineIndexer::Sample picks from. Each pixel is pushed once
+  // pixels, which decides a footprint gap pixel's source when it is reached
+  // from both sides (footprint_sample.h). Each pixel is pushed once
   // and listed once, so both buffers hold at most the roi's pixels.
   struct Pixel {
     int x, y;
@@ -98,60 +100,30 @@ class LineIndexer {
  public:
   LineIndexer(const cv::Mat& left, const cv::Mat& right, const LineIndexOptions& o, const RefineAcceptance& accept,
               DisparityState* state)
-      : left_(left), right_(right), o_(o), accept_(accept), state_(state), cols_(left.cols) {
+      : left_(left),
+        right_(right),
+        o_(o),
+        accept_(accept),
+        state_(state),
+        cols_(left.cols),
+        sampler_(state->disparity_px, state->slope_x, state->slope_y, o.footprint_gap_px, o.samples) {
     tall_ = accept.subpixel;
     tall_.half_height_px = o.window_half_height_px;
     STEREORIG_CHECK(state->disparity_px.type() == CV_32FC1 && state->disparity_px.isContinuous() &&
                     state->disparity_px.cols == cols_);
   }
 
-  // The disparity of pixel i = y * cols + x (the map is continuous).
-  float D(int i) const { return state_->disparity_px.ptr<float>(0)[i]; }
+  using Start = FootprintStart;
 
-  // Where the vernier is read: a pixel and the disparity it starts from.
-  struct Start {
-    int i;    // y * cols + x
-    float d;  // the component's disparity there (a gap pixel: its neighbour's, carried along the row)
-    float slope_x, slope_y;
-  };
-
-  // Up to o.samples pixels of the component's footprint, spread evenly: its
-  // valid pixels and, with footprint_gap_px, the empty pixels up to that far
-  // along the row from them (started from the nearest valid one, carried
-  // along its slope). The valid pixels alone are a biased sample: they are
-  // the ones whose window passed the matcher's tests at the component's
-  // alignment, and at strong speckle those read the vernier nearer 0 on a
-  // wrong alignment than the footprint does (simulator's ball bar at speckle
-  // 0.4: a component two periods off read +0.11 px on its own pixels, +0.32
-  // on all pixels of its region).
-  std::vector<Start> Sample(const std::vector<int>& pixels) const {
-    std::vector<Start> all;
-    // No reserve for the worst case (every pixel with 2 * footprint_gap_px
-    // empty neighbours): 17x a large component's size, ~40 MB on the plate,
-    // which pushed the runtime's peak memory towards its 300 MB limit.
-    all.reserve(pixels.size());
-    for (int i : pixels)
-      if (std::isfinite(D(i))) all.push_back({i, D(i), SlopeX(i), SlopeY(i)});
-    const size_t valid = all.size();
-    for (size_t k = 0; k < valid; ++k) {
-      const Start s = all[k];
-      const int x = s.i % cols_;
-      for (const int dir : {-1, 1})
-        for (int u = 1; u <= o_.footprint_gap_px; ++u) {
-          const int xu = x + dir * u;
-          if (xu < 0 || xu >= cols_ || std::isfinite(D(s.i + dir * u))) break;
-          all.push_back({s.i + dir * u, s.d + float(dir * u) * s.slope_x, s.slope_x, s.slope_y});
-        }
-    }
-    // A gap pixel reached from both sides: once (the first listed).
-    std::stable_sort(all.begin(), all.end(), [](const Start& a, const Start& b) { return a.i < b.i; });
-    all.erase(std::unique(all.begin(), all.end(), [](const Start& a, const Start& b) { return a.i == b.i; }),
-              all.end());
-    std::vector<Start> sample;
-    const double stride = std::max(1.0, double(all.size()) / o_.samples);
-    for (double k = 0.5 * stride; k < double(all.size()); k += stride) sample.push_back(all[size_t(k)]);
-    return sample;
-  }
+  // Up to o.samples pixels of the component's footprint, spread evenly
+  // (footprint_sample.h): its valid pixels and, with footprint_gap_px, the
+  // empty pixels up to that far along the row from them. The valid pixels
+  // alone are a biased sample: they are the ones whose window passed the
+  // matcher's tests at the component's alignment, and at strong speckle
+  // those read the vernier nearer 0 on a wrong alignment than the footprint
+  // does (simulator's ball bar at speckle 0.4: a component two periods off
+  // read +0.11 px on its own pixels, +0.32 on all pixels of its region).
+  std::vector<Start> Sample(const std::vector<int>& pixels) { return sampler_.Sample(pixels); }
 
   // The row offset of the tall-window fit over `sample`, each started from
   // its disparity + shift.
@@ -319,6 +291,7 @@ class LineIndexer {
   DisparityState* state_;
   const int cols_;
   SubpixelOptions tall_;
+  FootprintSampler sampler_;
   bool changed_ = false;
 };
 
