@@ -1,7 +1,6 @@
 #include "reconstruct/disparity_state.h"
 
 #include <algorithm>
-#include <optional>
 
 #include "reconstruct/subpixel_window.h"
 
@@ -87,7 +86,7 @@ PixelStatus Accept(const cv::Mat& left, const cv::Mat& right, int x, int y, doub
 
 PixelStatus RefineAndAccept(const cv::Mat& left, const cv::Mat& right, int x, int y, double start_px, double slope_x,
                             double slope_y, const RefineAcceptance& a, SubpixelResult* result) {
-  std::optional<SubpixelWindow> window;
+  WindowSlot window;
   *result = RefineDisparity(left, right, x, y, start_px, slope_x, slope_y, a.subpixel, &window);
   const PixelStatus fit = AcceptFit(*result, a);
   if (fit != PixelStatus::kPoint || !(a.min_distinctness > 0)) return fit;

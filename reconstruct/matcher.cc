@@ -11,6 +11,7 @@
 #include "calib/core/input_error.h"
 #include "reconstruct/dense_refine.h"
 #include "reconstruct/disparity_band.h"
+#include "reconstruct/disparity_slopes.h"
 #include "reconstruct/line_index.h"
 #include "reconstruct/parallel_for.h"
 #include "reconstruct/region_grow.h"
@@ -182,73 +183,6 @@ void RemoveSpeckles(cv::Mat disparity_px, const MatchOptions& o) {
     const int16_t* f = fixed.ptr<int16_t>(y);
     for (int x = 0; x < disparity_px.cols; ++x)
       if (f[x] == kInvalid) d[x] = kInf;
-  }
-}
-
-// Local disparity slopes dd/dx, dd/dy: least-squares plane over the valid
-// pixels of a 9x9 window (box filters of masked moments). Averaging 81
-// samples of the ~0.1 px noisy integer-level field gives slopes good to
-// ~0.005 px/px, so the sub-pixel window's model error is negligible.
-void DisparitySlopes(const cv::Mat& disparity, cv::Mat* slope_x, cv::Mat* slope_y, cv::Mat* plane) {
-  const cv::Size k(9, 9);
-  // The valid mask's and the disparities' moments per pixel, in absolute
-  // coordinates (exact in float: integers below 2^24, and x d, y d rounded
-  // once), then their window sums.
-  cv::Mat m(disparity.size(), CV_32FC1), md(disparity.size(), CV_32FC1), mx(disparity.size(), CV_32FC1),
-      my(disparity.size(), CV_32FC1), mxd(disparity.size(), CV_32FC1), myd(disparity.size(), CV_32FC1),
-      mxx(disparity.size(), CV_32FC1), myy(disparity.size(), CV_32FC1), mxy(disparity.size(), CV_32FC1);
-  for (int y = 0; y < disparity.rows; ++y) {
-    const float* in = disparity.ptr<float>(y);
-    float *m_row = m.ptr<float>(y), *md_row = md.ptr<float>(y), *mx_row = mx.ptr<float>(y), *my_row = my.ptr<float>(y);
-    float *mxd_row = mxd.ptr<float>(y), *myd_row = myd.ptr<float>(y), *mxx_row = mxx.ptr<float>(y),
-          *myy_row = myy.ptr<float>(y), *mxy_row = mxy.ptr<float>(y);
-    const float fy = float(y);
-    for (int x = 0; x < disparity.cols; ++x) {
-      const float d = in[x], fx = float(x);
-      const bool valid = !std::isnan(d);
-      m_row[x] = valid;
-      md_row[x] = valid ? d : 0.f;
-      mx_row[x] = valid ? fx : 0.f;
-      my_row[x] = valid ? fy : 0.f;
-      mxd_row[x] = valid ? fx * d : 0.f;
-      myd_row[x] = valid ? fy * d : 0.f;
-      mxx_row[x] = valid ? fx * fx : 0.f;
-      myy_row[x] = valid ? fy * fy : 0.f;
-      mxy_row[x] = valid ? fx * fy : 0.f;
-    }
-  }
-  auto box = [&](const cv::Mat& a) {
-    cv::Mat out;
-    cv::boxFilter(a, out, CV_32F, k, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
-    return out;
-  };
-  const cv::Mat s_m = box(m), s_d = box(md), s_x = box(mx), s_y = box(my), s_xd = box(mxd), s_yd = box(myd),
-                s_xx = box(mxx), s_yy = box(myy), s_xy = box(mxy);
-  // slope_x, slope_y: views of the caller's maps (region size), written in place.
-  STEREORIG_CHECK(slope_x->size() == disparity.size() && slope_y->size() == disparity.size());
-  slope_x->setTo(0);
-  slope_y->setTo(0);
-  *plane = cv::Mat(disparity.size(), CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
-  for (int y = 0; y < disparity.rows; ++y) {
-    const float *n_row = s_m.ptr<float>(y), *x_row = s_x.ptr<float>(y), *y_row = s_y.ptr<float>(y),
-                *d_row = s_d.ptr<float>(y), *xx_row = s_xx.ptr<float>(y), *yy_row = s_yy.ptr<float>(y),
-                *xy_row = s_xy.ptr<float>(y), *xd_row = s_xd.ptr<float>(y), *yd_row = s_yd.ptr<float>(y);
-    float *gx_out = slope_x->ptr<float>(y), *gy_out = slope_y->ptr<float>(y), *plane_out = plane->ptr<float>(y);
-    for (int x = 0; x < disparity.cols; ++x) {
-      const double n = n_row[x];
-      if (n < 12) continue;
-      const double mxv = x_row[x] / n, myv = y_row[x] / n, md_ = d_row[x] / n;
-      const double cxx = xx_row[x] / n - mxv * mxv, cyy = yy_row[x] / n - myv * myv;
-      const double cxy = xy_row[x] / n - mxv * myv;
-      const double cxd = xd_row[x] / n - mxv * md_, cyd = yd_row[x] / n - myv * md_;
-      const double det = cxx * cyy - cxy * cxy;
-      if (!(det > 1e-6)) continue;
-      const double gx = (cyy * cxd - cxy * cyd) / det, gy = (cxx * cyd - cxy * cxd) / det;
-      if (std::abs(gx) > 1.5 || std::abs(gy) > 1.5) continue;  // a depth edge, not a surface
-      gx_out[x] = float(gx);
-      gy_out[x] = float(gy);
-      plane_out[x] = float(md_ + gx * (x - mxv) + gy * (y - myv));
-    }
   }
 }
 

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <optional>
 
 #include "calib/core/input_error.h"
 #include "reconstruct/subpixel_window.h"
@@ -40,12 +39,12 @@ void SolveSymmetric3(double a00, double a01, double a02, double a11, double a12,
 
 SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x, int y, double start_px, double slope_x,
                                double slope_y, const SubpixelOptions& o) {
-  std::optional<SubpixelWindow> window;
+  WindowSlot window;
   return RefineDisparity(left, right, x, y, start_px, slope_x, slope_y, o, &window);
 }
 
 SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x, int y, double start_px, double slope_x,
-                               double slope_y, const SubpixelOptions& o, std::optional<SubpixelWindow>* window_out) {
+                               double slope_y, const SubpixelOptions& o, WindowSlot* window_out) {
   SubpixelResult result;
   const int hw = o.half_width_px, hh = o.half_height_px;
   if (y - hh < 0 || y + hh >= left.rows || x - hw < 0 || x + hw >= left.cols) return result;

@@ -231,29 +231,41 @@ void SubpixelWindow::SetUpLanes() {
 
 namespace {
 
-// The Lanczos values r and slopes g of 8 samples at right columns
-// base + offset[k] of the rows at byte offsets row[k] + row_shift from
-// `right`.
+// The Lanczos values r and slopes g of the first `valid` (1..8) of 8
+// samples at right columns base + offset[k] of the rows at byte offsets
+// row[k] + row_shift from `right`; the other lanes' are 0.
 // `table`: LanczosTapTable(), looked up once per pass by the caller (a
 // function-local static's guard per chunk cost ~8 % of the pass).
+// The columns and table entries are handed to the scalar loads as unsigned
+// 32-bit (both are >= 0: the caller checks the reach), which the
+// extraction zero-extends for free, and an entry as its byte offset: no
+// sign extension or scaling per sample (~25 of a chunk's ~140
+// instructions).
 inline void SampleChunk(const uint8_t* right, const LanczosTable& table, __m256 base, const float* offset,
-                        const int32_t* row, int32_t row_shift, __m256* r, __m256* g) {
+                        const int32_t* row, int32_t row_shift, int valid, __m256* r, __m256* g) {
+  static_assert(sizeof(LanczosTaps) == 64);
   const __m256 xr = _mm256_add_ps(base, _mm256_load_ps(offset));
   const __m256i i0 = _mm256_cvttps_epi32(xr);
   const __m256 frac = _mm256_sub_ps(xr, _mm256_cvtepi32_ps(i0));
-  alignas(32) int32_t col[8], entry[8];
+  alignas(32) uint32_t col[8], entry_byte[8];
   _mm256_store_si256(reinterpret_cast<__m256i*>(col),
                      _mm256_add_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(row)),
                                       _mm256_add_epi32(i0, _mm256_set1_epi32(row_shift))));
   _mm256_store_si256(
-      reinterpret_cast<__m256i*>(entry),
-      _mm256_cvttps_epi32(_mm256_fmadd_ps(frac, _mm256_set1_ps(float(kLanczosSteps)), _mm256_set1_ps(0.5f))));
+      reinterpret_cast<__m256i*>(entry_byte),
+      _mm256_slli_epi32(
+          _mm256_cvttps_epi32(_mm256_fmadd_ps(frac, _mm256_set1_ps(float(kLanczosSteps)), _mm256_set1_ps(0.5f))), 6));
+  const uint8_t* table_bytes = reinterpret_cast<const uint8_t*>(table.data());
   __m256 wp[8], gp[8];
   for (int k = 0; k < 8; ++k) {
+    if (k >= valid) {  // padding: no sample (the last chunk only)
+      wp[k] = gp[k] = _mm256_setzero_ps();
+      continue;
+    }
     // Bytes i0-4 .. i0+3; the taps sit in lanes 2..7 (lanczos_taps.h).
     const __m256 p =
         _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(right + col[k] - 4))));
-    const LanczosTaps& t = table[entry[k]];
+    const LanczosTaps& t = *reinterpret_cast<const LanczosTaps*>(table_bytes + entry_byte[k]);
     wp[k] = _mm256_mul_ps(_mm256_load_ps(t.w), p);
     gp[k] = _mm256_mul_ps(_mm256_load_ps(t.g), p);
   }
@@ -267,19 +279,25 @@ FitPassSums SubpixelWindow::FitPassAvx2(double d, float gain, float offset) cons
   const __m256 vgain = _mm256_set1_ps(gain), voffset = _mm256_set1_ps(offset);
   const LanczosTable& table = LanczosTapTable();
   __m256 sgg = _mm256_setzero_ps(), sgr = sgg, sg = sgg, srr = sgg, sr = sgg, sge = sgg, sre = sgg, se = sgg, slr = sgg;
-  for (int c = 0; c < n_; c += 8) {
-    __m256 r, g;
-    SampleChunk(right_.data, table, base, offset_ + c, row_ + c, 0, &r, &g);
-    const __m256 l = _mm256_load_ps(l_ + c);
-    __m256 e = _mm256_sub_ps(_mm256_fnmadd_ps(vgain, r, l), voffset);
-    if (c + 8 > n_) {  // padding lanes: no samples
-      const __m256 mask = LeadingMask(n_ - c);
-      r = _mm256_and_ps(r, mask), g = _mm256_and_ps(g, mask), e = _mm256_and_ps(e, mask);
-    }
+  auto accumulate = [&](__m256 r, __m256 g, __m256 e, __m256 l) {
     sgg = _mm256_fmadd_ps(g, g, sgg), sgr = _mm256_fmadd_ps(g, r, sgr), sg = _mm256_add_ps(sg, g);
     srr = _mm256_fmadd_ps(r, r, srr), sr = _mm256_add_ps(sr, r);
     sge = _mm256_fmadd_ps(g, e, sge), sre = _mm256_fmadd_ps(r, e, sre), se = _mm256_add_ps(se, e);
     slr = _mm256_fmadd_ps(l, r, slr);
+  };
+  int c = 0;
+  for (; c + 8 <= n_; c += 8) {
+    __m256 r, g;
+    SampleChunk(right_.data, table, base, offset_ + c, row_ + c, 0, 8, &r, &g);
+    const __m256 l = _mm256_load_ps(l_ + c);
+    accumulate(r, g, _mm256_sub_ps(_mm256_fnmadd_ps(vgain, r, l), voffset), l);
+  }
+  if (c < n_) {  // the padded chunk: r, g are 0 in its padding lanes, e is masked there
+    __m256 r, g;
+    SampleChunk(right_.data, table, base, offset_ + c, row_ + c, 0, n_ - c, &r, &g);
+    const __m256 l = _mm256_load_ps(l_ + c);
+    const __m256 e = _mm256_and_ps(_mm256_sub_ps(_mm256_fnmadd_ps(vgain, r, l), voffset), LeadingMask(n_ - c));
+    accumulate(r, g, e, l);
   }
   const __m256 lanes[8] = {sgg, sgr, sg, srr, sr, sge, sre, se};
   alignas(32) float sums[8];
@@ -293,7 +311,7 @@ void SubpixelWindow::SampleAvx2(double d, int row_shift, float* r, float* g) con
   const LanczosTable& table = LanczosTapTable();
   for (int c = 0; c < n_; c += 8) {
     __m256 rc, gc;
-    SampleChunk(right_.data, table, base, offset_ + c, row_ + c, shift, &rc, &gc);
+    SampleChunk(right_.data, table, base, offset_ + c, row_ + c, shift, 8, &rc, &gc);
     _mm256_storeu_ps(r + c, rc), _mm256_storeu_ps(g + c, gc);
   }
 }
