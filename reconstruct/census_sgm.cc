@@ -292,6 +292,7 @@ struct PathShape {
   int n = 0;       // disparities per pixel (its window)
   int stride = 0;  // lanes per pixel in the cost volume and the sums (K::Stride(n))
   uint16_t p1 = 0, p2 = 0;
+  bool windows_vary = false;  // false: every pixel's window starts at the same disparity (SgmMatch)
 };
 
 // One row of the vertical path (top->bottom or bottom->top): path costs
@@ -307,6 +308,7 @@ template <typename K, int kBlocks, SumMode kMode, bool kSumMin>
                                    const uint16_t* prev_min, uint16_t* cur, uint16_t* cur_min, uint16_t* shifted,
                                    uint16_t* sum_min) {
   const int n = shape.n, stride = shape.stride;
+  const bool vary = shape.windows_vary;
   const size_t path_stride = size_t(stride) + 2;
   for (int x = 0; x < shape.w; ++x) {
     const size_t xs = size_t(x) * stride;
@@ -316,8 +318,8 @@ template <typename K, int kBlocks, SumMode kMode, bool kSumMin>
             ? K::template First<kMode, kSumMin, kBlocks>(crow + xs, cur + x * path_stride, sin + xs, srow + xs, n,
                                                          stride, smin)
             : K::template Step<kMode, kSumMin, kBlocks>(
-                  crow + xs, InWindowOf(prev + x * path_stride, lo[x] - lo_prev[x], n, stride, shifted), prev_min[x],
-                  cur + x * path_stride, sin + xs, srow + xs, n, stride, shape.p1, shape.p2, smin);
+                  crow + xs, InWindowOf(prev + x * path_stride, vary ? lo[x] - lo_prev[x] : 0, n, stride, shifted),
+                  prev_min[x], cur + x * path_stride, sin + xs, srow + xs, n, stride, shape.p1, shape.p2, smin);
   }
 }
 
@@ -331,6 +333,7 @@ template <typename K, int kBlocks>
                                      uint16_t* ha, uint16_t* hb, uint16_t* hc, uint16_t* hd, uint16_t* shifted,
                                      uint16_t* shifted_rl) {
   const int w = shape.w, n = shape.n, stride = shape.stride;
+  const bool vary = shape.windows_vary;
   const size_t last = size_t(w - 1) * stride;
   uint16_t m_lr = K::template First<SumMode::kAdd, false, kBlocks>(crow, ha, srow, srow, n, stride);
   uint16_t m_rl =
@@ -339,11 +342,11 @@ template <typename K, int kBlocks>
     const int il = i, ir = w - 1 - i;
     const size_t xl = size_t(il) * stride, xr = size_t(ir) * stride;
     m_lr = K::template Step<SumMode::kAdd, false, kBlocks>(
-        crow + xl, InWindowOf(ha, lo[il] - lo[il - 1], n, stride, shifted), m_lr, hb, srow + xl, srow + xl, n, stride,
-        shape.p1, shape.p2);
+        crow + xl, InWindowOf(ha, vary ? lo[il] - lo[il - 1] : 0, n, stride, shifted), m_lr, hb, srow + xl, srow + xl,
+        n, stride, shape.p1, shape.p2);
     m_rl = K::template Step<SumMode::kAdd, false, kBlocks>(
-        crow + xr, InWindowOf(hc, lo[ir] - lo[ir + 1], n, stride, shifted_rl), m_rl, hd, srow + xr, srow + xr, n,
-        stride, shape.p1, shape.p2);
+        crow + xr, InWindowOf(hc, vary ? lo[ir] - lo[ir + 1] : 0, n, stride, shifted_rl), m_rl, hd, srow + xr,
+        srow + xr, n, stride, shape.p1, shape.p2);
     std::swap(ha, hb);
     std::swap(hc, hd);
   }
@@ -361,6 +364,7 @@ template <typename K, int kBlocks>
                                  const uint16_t* row_min, uint16_t* right_best, size_t right_best_size, int rb_origin,
                                  const SgmOptions& options, float* out) {
   const int w = shape.w, n = shape.n, stride = shape.stride;
+  const int lr_max_diff_px = options.lr_max_diff_px, unique_percent = 100 - options.uniqueness_percent;
   std::fill(right_best, right_best + right_best_size, uint16_t(0xFFFF));
   // Pixels 16 apart in turn: neighbours' runs overlap shifted by one lane,
   // and a load overlapping the previous store stalls store forwarding.
@@ -373,20 +377,19 @@ template <typename K, int kBlocks>
     const int best = K::FindFirst(s, n, stride, best_cost);
     if (best == 0 || best == n - 1) continue;  // at the window's edge: not a true minimum
     const uint16_t second = K::SecondBest(s, n, stride, best);
-    if (int(second) * (100 - options.uniqueness_percent) < int(best_cost) * 100) continue;
+    if (int(second) * unique_percent < int(best_cost) * 100) continue;
     // Left-right check: the right pixel's own best disparity lies within
     // lr_max_diff_px of ours iff one of the left pixels x+k at disparity
     // D+k (|k| <= tolerance, same right pixel) reaches its best cost. k = 0
     // first, without a load: s[best] is best_cost (right_min <= it).
     const int disparity_px = lo[x] + best;
     const uint16_t right_min = right_best[x - disparity_px + rb_origin];
+    auto reaches = [&](int k) {
+      const int xk = x + k, dk = disparity_px + k - lo[std::clamp(xk, 0, w - 1)];
+      return xk >= 0 && xk < w && dk >= 0 && dk < n && srow[size_t(xk) * stride + dk] <= right_min;
+    };
     bool consistent = best_cost <= right_min;
-    for (int k = -options.lr_max_diff_px; k <= options.lr_max_diff_px && !consistent; ++k) {
-      const int xk = x + k;
-      if (k == 0 || xk < 0 || xk >= w) continue;
-      const int dk = disparity_px + k - lo[xk];
-      if (dk >= 0 && dk < n) consistent = srow[size_t(xk) * stride + dk] <= right_min;
-    }
+    for (int k = 1; k <= lr_max_diff_px && !consistent; ++k) consistent = reaches(-k) || reaches(k);
     if (!consistent) continue;
     const double c0 = s[best - 1], c1 = s[best], c2 = s[best + 1];
     // Equiangular fit: two lines of equal and opposite slope through the
@@ -439,10 +442,10 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
                      const cv::Mat& window_lo, int n, const SgmOptions& options) {
   const int w = region.width, h = region.height;
   const int stride = K::Stride(n);
-  const PathShape shape{w, n, stride, uint16_t(options.p1), uint16_t(options.p2)};
   const int rw = right.width;
   double lo_min = 0, lo_max = 0;
   cv::minMaxLoc(window_lo, &lo_min, &lo_max);
+  const PathShape shape{w, n, stride, uint16_t(options.p1), uint16_t(options.p2), lo_min != lo_max};
   auto lo_row = [&](int y) { return window_lo.ptr<int16_t>(y); };
   SgmWorkspace ws;
 
@@ -458,10 +461,18 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   const int nibbles = (std::max(left.signature_bits, right.signature_bits) + 3) / 4;
   uint8_t* planes = K::kNibbleCosts ? Grow(ws.nibble_planes, size_t(nibbles) * reversed_size + 32) : nullptr;
   const CostRowFn cost_row = CostRowFor<K>(nibbles);
+  // The reversed row's indices CostRow reads: pixel x starts at
+  // stride + rw - 1 - (region.x + x - lo[x]) and reads stride (+16) lanes;
+  // only these get planes (about half the row at full resolution).
+  const size_t planes_begin = size_t(std::clamp(stride + rw - region.x - w + int(lo_min), 0, int(reversed_size)));
+  const size_t planes_end =
+      size_t(std::clamp(2 * stride + rw + 15 - region.x + int(lo_max), int(planes_begin), int(reversed_size)));
   auto costs_of_row = [&](int y) {
     const uint64_t* cr = right.row(region.y + y);
     std::reverse_copy(cr, cr + rw, reversed + stride);
-    if constexpr (K::kNibbleCosts) K::NibblePlanes(reversed, int(reversed_size), nibbles, planes, reversed_size);
+    if constexpr (K::kNibbleCosts)
+      K::NibblePlanes(reversed + planes_begin, int(planes_end - planes_begin), nibbles, planes + planes_begin,
+                      reversed_size);
     cost_row(
         CostRowArgs{left.row(region.y + y), lo_row(y), reversed, planes, reversed_size, region.x, w, n, stride, rw},
         cost + size_t(y) * w * stride);
