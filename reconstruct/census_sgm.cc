@@ -250,7 +250,8 @@ struct CostRowArgs {
   int region_x, w, n, stride, rw;
 };
 template <typename K, int kNibbles>
-void CostRow(const CostRowArgs& a, uint8_t* cost_row) {
+void CostRow(const CostRowArgs& args, uint8_t* cost_row) {
+  const CostRowArgs a = args;  // a copy: the byte stores below might alias `args`, forcing reloads
   for (int x = 0; x < a.w; ++x) {
     uint8_t* c = cost_row + size_t(x) * a.stride;
     const int xr0 = a.region_x + x - a.lo[x];  // right x at d index 0
@@ -265,8 +266,8 @@ void CostRow(const CostRowArgs& a, uint8_t* cost_row) {
       K::template CostFromNibbles<kNibbles>(a.cl[a.region_x + x], a.planes + r0, a.plane_stride, c, a.stride);
     else
       K::Cost(a.cl[a.region_x + x], a.reversed + r0, c, d_lo, d_hi, a.stride);
-    std::fill(c, c + d_lo, uint8_t(kCensusMaxCost));
-    std::fill(c + d_hi, c + a.n, uint8_t(kCensusMaxCost));
+    if (d_lo > 0) std::fill(c, c + d_lo, uint8_t(kCensusMaxCost));
+    if (d_hi < a.n) std::fill(c + d_hi, c + a.n, uint8_t(kCensusMaxCost));
   }
 }
 
@@ -309,6 +310,7 @@ template <typename K, int kBlocks, SumMode kMode, bool kSumMin>
                                    uint16_t* sum_min) {
   const int n = shape.n, stride = shape.stride;
   const bool vary = shape.windows_vary;
+  const uint16_t p1 = shape.p1, p2 = shape.p2;  // locals: the row's stores might alias `shape`
   const size_t path_stride = size_t(stride) + 2;
   for (int x = 0; x < shape.w; ++x) {
     const size_t xs = size_t(x) * stride;
@@ -319,7 +321,7 @@ template <typename K, int kBlocks, SumMode kMode, bool kSumMin>
                                                          stride, smin)
             : K::template Step<kMode, kSumMin, kBlocks>(
                   crow + xs, InWindowOf(prev + x * path_stride, vary ? lo[x] - lo_prev[x] : 0, n, stride, shifted),
-                  prev_min[x], cur + x * path_stride, sin + xs, srow + xs, n, stride, shape.p1, shape.p2, smin);
+                  prev_min[x], cur + x * path_stride, sin + xs, srow + xs, n, stride, p1, p2, smin);
   }
 }
 
@@ -334,6 +336,7 @@ template <typename K, int kBlocks>
                                      uint16_t* shifted_rl) {
   const int w = shape.w, n = shape.n, stride = shape.stride;
   const bool vary = shape.windows_vary;
+  const uint16_t p1 = shape.p1, p2 = shape.p2;
   const size_t last = size_t(w - 1) * stride;
   uint16_t m_lr = K::template First<SumMode::kAdd, false, kBlocks>(crow, ha, srow, srow, n, stride);
   uint16_t m_rl =
@@ -343,10 +346,10 @@ template <typename K, int kBlocks>
     const size_t xl = size_t(il) * stride, xr = size_t(ir) * stride;
     m_lr = K::template Step<SumMode::kAdd, false, kBlocks>(
         crow + xl, InWindowOf(ha, vary ? lo[il] - lo[il - 1] : 0, n, stride, shifted), m_lr, hb, srow + xl, srow + xl,
-        n, stride, shape.p1, shape.p2);
+        n, stride, p1, p2);
     m_rl = K::template Step<SumMode::kAdd, false, kBlocks>(
         crow + xr, InWindowOf(hc, vary ? lo[ir] - lo[ir + 1] : 0, n, stride, shifted_rl), m_rl, hd, srow + xr,
-        srow + xr, n, stride, shape.p1, shape.p2);
+        srow + xr, n, stride, p1, p2);
     std::swap(ha, hb);
     std::swap(hc, hd);
   }
