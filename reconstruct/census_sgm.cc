@@ -194,6 +194,7 @@ struct SgmWorkspace {
   std::vector<uint16_t> horiz_a, horiz_b, horiz_c, horiz_d;  // (stride + 2): left->right, right->left
   std::vector<uint16_t> shifted, shifted_rl;                 // (stride + 2): a predecessor in another window
   std::vector<uint16_t> right_best;                          // (16 + w + n)
+  std::vector<uint16_t> row_min;                             // (w): each pixel's smallest total
   std::vector<uint64_t> right_reversed;                      // (stride + right width + stride + 16)
   std::vector<uint8_t> nibble_planes;                        // (nibbles, right_reversed's size)
 };
@@ -249,7 +250,8 @@ struct CostRowArgs {
   int region_x, w, n, stride, rw;
 };
 template <typename K, int kNibbles>
-void CostRow(const CostRowArgs& a, uint8_t* cost_row) {
+void CostRow(const CostRowArgs& args, uint8_t* cost_row) {
+  const CostRowArgs a = args;  // a copy: the byte stores below might alias `args`, forcing reloads
   for (int x = 0; x < a.w; ++x) {
     uint8_t* c = cost_row + size_t(x) * a.stride;
     const int xr0 = a.region_x + x - a.lo[x];  // right x at d index 0
@@ -264,8 +266,8 @@ void CostRow(const CostRowArgs& a, uint8_t* cost_row) {
       K::template CostFromNibbles<kNibbles>(a.cl[a.region_x + x], a.planes + r0, a.plane_stride, c, a.stride);
     else
       K::Cost(a.cl[a.region_x + x], a.reversed + r0, c, d_lo, d_hi, a.stride);
-    std::fill(c, c + d_lo, uint8_t(kCensusMaxCost));
-    std::fill(c + d_hi, c + a.n, uint8_t(kCensusMaxCost));
+    if (d_lo > 0) std::fill(c, c + d_lo, uint8_t(kCensusMaxCost));
+    if (d_hi < a.n) std::fill(c + d_hi, c + a.n, uint8_t(kCensusMaxCost));
   }
 }
 
@@ -285,6 +287,154 @@ CostRowFn CostRowFor(int nibbles) {
     return &CostRow<K, 0>;
 }
 
+// The sizes and penalties shared by one SGM call's row passes.
+struct PathShape {
+  int w = 0;       // pixels in a row of the region
+  int n = 0;       // disparities per pixel (its window)
+  int stride = 0;  // lanes per pixel in the cost volume and the sums (K::Stride(n))
+  uint16_t p1 = 0, p2 = 0;
+  bool windows_vary = false;  // false: every pixel's window starts at the same disparity (SgmMatch)
+};
+
+// One row of the vertical path (top->bottom or bottom->top): path costs
+// `cur` (w, stride + 2) and their minima cur_min from the row before along
+// the path (prev, prev_min; lo_prev its windows, null for the first row),
+// accumulated (kMode) from sin into srow; with kSumMin, sum_min[x] = the
+// smallest of srow's costs of pixel x. A function of its own (not inlined
+// into the caller's loop over rows): its loop keeps its pointers in
+// registers.
+template <typename K, int kBlocks, SumMode kMode, bool kSumMin>
+[[gnu::noinline]] void VerticalRow(const PathShape& shape, const uint8_t* crow, const int16_t* lo,
+                                   const int16_t* lo_prev, const uint16_t* sin, uint16_t* srow, const uint16_t* prev,
+                                   const uint16_t* prev_min, uint16_t* cur, uint16_t* cur_min, uint16_t* shifted,
+                                   uint16_t* sum_min) {
+  const int n = shape.n, stride = shape.stride;
+  const bool vary = shape.windows_vary;
+  const uint16_t p1 = shape.p1, p2 = shape.p2;  // locals: the row's stores might alias `shape`
+  const size_t path_stride = size_t(stride) + 2;
+  for (int x = 0; x < shape.w; ++x) {
+    const size_t xs = size_t(x) * stride;
+    uint16_t* smin = kSumMin ? sum_min + x : nullptr;
+    cur_min[x] =
+        lo_prev == nullptr
+            ? K::template First<kMode, kSumMin, kBlocks>(crow + xs, cur + x * path_stride, sin + xs, srow + xs, n,
+                                                         stride, smin)
+            : K::template Step<kMode, kSumMin, kBlocks>(
+                  crow + xs, InWindowOf(prev + x * path_stride, vary ? lo[x] - lo_prev[x] : 0, n, stride, shifted),
+                  prev_min[x], cur + x * path_stride, sin + xs, srow + xs, n, stride, p1, p2, smin);
+  }
+}
+
+// Left->right and right->left along one row, added into srow, interleaved:
+// each step waits for the previous pixel's minimum, so two independent
+// chains keep the core busy. (Sums are modulo 2^16 additions: their order
+// does not change them.) ha..hd, shifted, shifted_rl: path buffers of one
+// pixel (PathBuffers).
+template <typename K, int kBlocks>
+[[gnu::noinline]] void HorizontalRow(const PathShape& shape, const uint8_t* crow, const int16_t* lo, uint16_t* srow,
+                                     uint16_t* ha, uint16_t* hb, uint16_t* hc, uint16_t* hd, uint16_t* shifted,
+                                     uint16_t* shifted_rl) {
+  const int w = shape.w, n = shape.n, stride = shape.stride;
+  const bool vary = shape.windows_vary;
+  const uint16_t p1 = shape.p1, p2 = shape.p2;
+  const size_t last = size_t(w - 1) * stride;
+  uint16_t m_lr = K::template First<SumMode::kAdd, false, kBlocks>(crow, ha, srow, srow, n, stride);
+  uint16_t m_rl =
+      K::template First<SumMode::kAdd, false, kBlocks>(crow + last, hc, srow + last, srow + last, n, stride);
+  for (int i = 1; i < w; ++i) {
+    const int il = i, ir = w - 1 - i;
+    const size_t xl = size_t(il) * stride, xr = size_t(ir) * stride;
+    m_lr = K::template Step<SumMode::kAdd, false, kBlocks>(
+        crow + xl, InWindowOf(ha, vary ? lo[il] - lo[il - 1] : 0, n, stride, shifted), m_lr, hb, srow + xl, srow + xl,
+        n, stride, p1, p2);
+    m_rl = K::template Step<SumMode::kAdd, false, kBlocks>(
+        crow + xr, InWindowOf(hc, vary ? lo[ir] - lo[ir + 1] : 0, n, stride, shifted_rl), m_rl, hd, srow + xr,
+        srow + xr, n, stride, p1, p2);
+    std::swap(ha, hb);
+    std::swap(hc, hd);
+  }
+}
+
+// The winners of one row of summed costs srow (w, stride), windows lo:
+// out[x] = the disparity refined by an equiangular fit, left NaN where the
+// best cost is at the window's edge, fails the uniqueness test or the
+// left-right check. row_min: each pixel's smallest sum if the last path
+// found it (VerticalRow's sum_min), else null. right_best (right_best_size):
+// scratch for the right view's best costs, right pixel x - lo - d (local)
+// at [x - lo - d + rb_origin].
+template <typename K, int kBlocks>
+[[gnu::noinline]] void WinnerRow(const PathShape& shape, const uint16_t* srow, const int16_t* lo,
+                                 const uint16_t* row_min, uint16_t* right_best, size_t right_best_size, int rb_origin,
+                                 const SgmOptions& options, float* out) {
+  const int w = shape.w, n = shape.n, stride = shape.stride;
+  const int lr_max_diff_px = options.lr_max_diff_px, unique_percent = 100 - options.uniqueness_percent;
+  std::fill(right_best, right_best + right_best_size, uint16_t(0xFFFF));
+  // Pixels 16 apart in turn: neighbours' runs overlap shifted by one lane,
+  // and a load overlapping the previous store stalls store forwarding.
+  for (int phase = 0; phase < 16; ++phase)
+    for (int x = phase; x < w; x += 16)
+      K::template RightBest<kBlocks>(srow + size_t(x) * stride, n, stride, right_best + x - lo[x] + rb_origin);
+  for (int x = 0; x < w; ++x) {
+    const uint16_t* s = srow + size_t(x) * stride;
+    const uint16_t best_cost = row_min != nullptr ? row_min[x] : K::template Min<kBlocks>(s, stride);
+    const int best = K::FindFirst(s, n, stride, best_cost);
+    if (best == 0 || best == n - 1) continue;  // at the window's edge: not a true minimum
+    const uint16_t second = K::SecondBest(s, n, stride, best);
+    if (int(second) * unique_percent < int(best_cost) * 100) continue;
+    // Left-right check: the right pixel's own best disparity lies within
+    // lr_max_diff_px of ours iff one of the left pixels x+k at disparity
+    // D+k (|k| <= tolerance, same right pixel) reaches its best cost. k = 0
+    // first, without a load: s[best] is best_cost (right_min <= it).
+    const int disparity_px = lo[x] + best;
+    const uint16_t right_min = right_best[x - disparity_px + rb_origin];
+    auto reaches = [&](int k) {
+      const int xk = x + k, dk = disparity_px + k - lo[std::clamp(xk, 0, w - 1)];
+      return xk >= 0 && xk < w && dk >= 0 && dk < n && srow[size_t(xk) * stride + dk] <= right_min;
+    };
+    bool consistent = best_cost <= right_min;
+    for (int k = 1; k <= lr_max_diff_px && !consistent; ++k) consistent = reaches(-k) || reaches(k);
+    if (!consistent) continue;
+    const double c0 = s[best - 1], c1 = s[best], c2 = s[best + 1];
+    // Equiangular fit: two lines of equal and opposite slope through the
+    // three costs; the steeper side fixes the slope.
+    const double slope = std::max(c0, c2) - c1;
+    const double delta = slope > 0 ? 0.5 * (c0 - c2) / slope : 0.0;
+    out[x] = float(disparity_px + delta);
+  }
+}
+
+// The row passes of one SGM call, instances for its count of 16-lane blocks
+// (K::kBlockUnrolled) up to kMaxUnrolledBlocks (n <= 256), else the
+// run-time loops.
+inline constexpr int kMaxUnrolledBlocks = 16;
+template <typename K>
+struct RowPasses {
+  decltype(&VerticalRow<K, 0, SumMode::kStore, false>) forward_vertical;
+  decltype(&VerticalRow<K, 0, SumMode::kAdd, true>) backward_vertical;  // finds each pixel's smallest total
+  decltype(&HorizontalRow<K, 0>) horizontal;
+  decltype(&WinnerRow<K, 0>) winner;
+};
+template <typename K, int kBlocks>
+constexpr RowPasses<K> RowPassesOf() {
+  return {&VerticalRow<K, kBlocks, SumMode::kStore, false>, &VerticalRow<K, kBlocks, SumMode::kAdd, true>,
+          &HorizontalRow<K, kBlocks>, &WinnerRow<K, kBlocks>};
+}
+template <typename K, int... k>
+RowPasses<K> RowPassesFor(int blocks, std::integer_sequence<int, k...>) {
+  static constexpr RowPasses<K> table[] = {RowPassesOf<K, k>()...};
+  return table[blocks];
+}
+template <typename K>
+RowPasses<K> RowPassesFor(int stride) {
+  if constexpr (K::kBlockUnrolled) {
+    const int blocks = stride / 16;
+    return RowPassesFor<K>(blocks <= kMaxUnrolledBlocks ? blocks : 0,
+                           std::make_integer_sequence<int, kMaxUnrolledBlocks + 1>());
+  } else {
+    return RowPassesOf<K, 0>();
+  }
+}
+
 // SGM with per-pixel search windows: pixel (x, y) of `region` searches the
 // n disparities [lo(y, x), lo(y, x) + n) (window_lo: CV_16SC1 of
 // region.size()). Every path step reads its predecessor through
@@ -294,15 +444,16 @@ template <typename K>
 cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv::Rect& region,
                      const cv::Mat& window_lo, int n, const SgmOptions& options) {
   const int w = region.width, h = region.height;
-  const int stride = K::Stride(n), path_stride = stride + 2;
+  const int stride = K::Stride(n);
   const int rw = right.width;
-  const uint16_t p1 = uint16_t(options.p1), p2 = uint16_t(options.p2);
   double lo_min = 0, lo_max = 0;
   cv::minMaxLoc(window_lo, &lo_min, &lo_max);
+  const PathShape shape{w, n, stride, uint16_t(options.p1), uint16_t(options.p2), lo_min != lo_max};
   auto lo_row = [&](int y) { return window_lo.ptr<int16_t>(y); };
   SgmWorkspace ws;
 
-  // Cost volume (h, w, stride), uint8 (CostRow).
+  // Cost volume (h, w, stride), uint8 (CostRow), a row at a time as the
+  // forward pass reaches it (it reads the row while it is in cache).
   ScratchArray<uint8_t> cost_volume(size_t(h) * w * stride);
   uint8_t* cost = cost_volume.data();
   const size_t reversed_size = size_t(rw) + 2 * stride + 16;
@@ -313,14 +464,22 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   const int nibbles = (std::max(left.signature_bits, right.signature_bits) + 3) / 4;
   uint8_t* planes = K::kNibbleCosts ? Grow(ws.nibble_planes, size_t(nibbles) * reversed_size + 32) : nullptr;
   const CostRowFn cost_row = CostRowFor<K>(nibbles);
-  for (int y = 0; y < h; ++y) {
+  // The reversed row's indices CostRow reads: pixel x starts at
+  // stride + rw - 1 - (region.x + x - lo[x]) and reads stride (+16) lanes;
+  // only these get planes (about half the row at full resolution).
+  const size_t planes_begin = size_t(std::clamp(stride + rw - region.x - w + int(lo_min), 0, int(reversed_size)));
+  const size_t planes_end =
+      size_t(std::clamp(2 * stride + rw + 15 - region.x + int(lo_max), int(planes_begin), int(reversed_size)));
+  auto costs_of_row = [&](int y) {
     const uint64_t* cr = right.row(region.y + y);
     std::reverse_copy(cr, cr + rw, reversed + stride);
-    if constexpr (K::kNibbleCosts) K::NibblePlanes(reversed, int(reversed_size), nibbles, planes, reversed_size);
+    if constexpr (K::kNibbleCosts)
+      K::NibblePlanes(reversed + planes_begin, int(planes_end - planes_begin), nibbles, planes + planes_begin,
+                      reversed_size);
     cost_row(
         CostRowArgs{left.row(region.y + y), lo_row(y), reversed, planes, reversed_size, region.x, w, n, stride, rw},
         cost + size_t(y) * w * stride);
-  }
+  };
 
   // Aggregated cost (h, w, stride) when a second pass is needed; otherwise one row.
   const bool two_pass = options.num_paths == 4;
@@ -335,6 +494,8 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   uint16_t* hc = PathBuffers(ws.horiz_c, 1, stride);
   uint16_t* hd = PathBuffers(ws.horiz_d, 1, stride);
   uint16_t* shifted = PathBuffers(ws.shifted, 1, stride);
+  uint16_t* shifted_rl = PathBuffers(ws.shifted_rl, 1, stride);
+  uint16_t* row_min = Grow(ws.row_min, w);
   // Right-view best costs: the right pixel x - lo - d (local) is stored at
   // [x - lo - d + lo_max + stride - 1] >= 0 (the SIMD kernel writes all
   // `stride` lanes below its start).
@@ -344,101 +505,36 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
 
   cv::Mat disparity(h, w, CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
 
-  auto winner_take_all = [&](int y, uint16_t* srow) {
-    const int16_t* lo = lo_row(y);
-    std::fill(right_best, right_best + right_best_size, uint16_t(0xFFFF));
-    // Pixels 16 apart in turn: neighbours' runs overlap shifted by one lane,
-    // and a load overlapping the previous store stalls store forwarding.
-    for (int phase = 0; phase < 16; ++phase)
-      for (int x = phase; x < w; x += 16)
-        K::RightBest(srow + size_t(x) * stride, n, stride, right_best + x - lo[x] + rb_origin);
-    float* out = disparity.ptr<float>(y);
-    for (int x = 0; x < w; ++x) {
-      uint16_t* s = srow + size_t(x) * stride;
-      int best = 0;
-      const uint16_t best_cost = K::Best(s, n, stride, &best);
-      if (best == 0 || best == n - 1) continue;  // at the window's edge: not a true minimum
-      const uint16_t second = K::SecondBest(s, n, stride, best);
-      if (int(second) * (100 - options.uniqueness_percent) < int(best_cost) * 100) continue;
-      // Left-right check: the right pixel's own best disparity lies within
-      // lr_max_diff_px of ours iff one of the left pixels x+k at disparity
-      // D+k (|k| <= tolerance, same right pixel) reaches its best cost.
-      const int disparity_px = lo[x] + best;
-      const uint16_t right_min = right_best[x - disparity_px + rb_origin];
-      bool consistent = false;
-      for (int k = -options.lr_max_diff_px; k <= options.lr_max_diff_px && !consistent; ++k) {
-        const int xk = x + k;
-        if (xk < 0 || xk >= w) continue;
-        const int dk = disparity_px + k - lo[xk];
-        if (dk >= 0 && dk < n) consistent = srow[size_t(xk) * stride + dk] <= right_min;
-      }
-      if (!consistent) continue;
-      const double c0 = s[best - 1], c1 = s[best], c2 = s[best + 1];
-      // Equiangular fit: two lines of equal and opposite slope through the
-      // three costs; the steeper side fixes the slope.
-      const double slope = std::max(c0, c2) - c1;
-      const double delta = slope > 0 ? 0.5 * (c0 - c2) / slope : 0.0;
-      out[x] = float(disparity_px + delta);
-    }
-  };
-
-  // One row of the vertical path (top->bottom or bottom->top; lo_prev: the
-  // windows of the row before along the path), accumulated (SumMode) from
-  // sin into srow.
-  auto vertical = [&](const uint8_t* crow, const int16_t* lo, const int16_t* lo_prev, const uint16_t* sin,
-                      uint16_t* srow, SumMode mode) {
-    for (int x = 0; x < w; ++x) {
-      uint16_t* cur = vert_cur + size_t(x) * path_stride;
-      const uint8_t* c = crow + size_t(x) * stride;
-      const size_t xs = size_t(x) * stride;
-      vert_cur_min[x] =
-          lo_prev == nullptr
-              ? K::First(c, cur, sin + xs, srow + xs, mode, n, stride)
-              : K::Step(c, InWindowOf(vert_prev + size_t(x) * path_stride, lo[x] - lo_prev[x], n, stride, shifted),
-                        vert_prev_min[x], cur, sin + xs, srow + xs, mode, n, stride, p1, p2);
-    }
-    std::swap(vert_prev, vert_cur);
-    std::swap(vert_prev_min, vert_cur_min);
-  };
-  // Left->right and right->left, interleaved: each step waits for the
-  // previous pixel's minimum, so two independent chains keep the core busy.
-  // (Sums are modulo 2^16 additions: their order does not change them.)
-  uint16_t* shifted_rl = PathBuffers(ws.shifted_rl, 1, stride);
-  auto horizontal = [&](const uint8_t* crow, const int16_t* lo, uint16_t* srow) {
-    const size_t last = size_t(w - 1) * stride;
-    uint16_t m_lr = K::First(crow, ha, srow, srow, SumMode::kAdd, n, stride);
-    uint16_t m_rl = K::First(crow + last, hc, srow + last, srow + last, SumMode::kAdd, n, stride);
-    for (int i = 1; i < w; ++i) {
-      const int il = i, ir = w - 1 - i;
-      const size_t xl = size_t(il) * stride, xr = size_t(ir) * stride;
-      m_lr = K::Step(crow + xl, InWindowOf(ha, lo[il] - lo[il - 1], n, stride, shifted), m_lr, hb, srow + xl,
-                     srow + xl, SumMode::kAdd, n, stride, p1, p2);
-      m_rl = K::Step(crow + xr, InWindowOf(hc, lo[ir] - lo[ir + 1], n, stride, shifted_rl), m_rl, hd, srow + xr,
-                     srow + xr, SumMode::kAdd, n, stride, p1, p2);
-      std::swap(ha, hb);
-      std::swap(hc, hd);
-    }
-  };
-
   // Forward pass: top->bottom, left->right, right->left.
+  const RowPasses<K> rows = RowPassesFor<K>(stride);
   for (int y = 0; y < h; ++y) {
+    costs_of_row(y);
     uint16_t* srow = sum + (two_pass ? size_t(y) * w * stride : 0);
     const uint8_t* crow = cost + size_t(y) * w * stride;
-    vertical(crow, lo_row(y), y == 0 ? nullptr : lo_row(y - 1), srow, srow, SumMode::kStore);
-    horizontal(crow, lo_row(y), srow);
-    if (!two_pass) winner_take_all(y, srow);
+    rows.forward_vertical(shape, crow, lo_row(y), y == 0 ? nullptr : lo_row(y - 1), srow, srow, vert_prev,
+                          vert_prev_min, vert_cur, vert_cur_min, shifted, nullptr);
+    std::swap(vert_prev, vert_cur);
+    std::swap(vert_prev_min, vert_cur_min);
+    rows.horizontal(shape, crow, lo_row(y), srow, ha, hb, hc, hd, shifted, shifted_rl);
+    if (!two_pass)
+      rows.winner(shape, srow, lo_row(y), nullptr, right_best, right_best_size, rb_origin, options,
+                  disparity.ptr<float>(y));
   }
   if (!two_pass) return disparity;
 
   // Backward pass: bottom -> top, then the winner per row. The row's total
   // (forward sums + this path) goes to a cache-resident row, so the volume
-  // is only read, never written back (the pass is memory-bound).
+  // is only read, never written back (the pass is memory-bound); the path
+  // step also finds each pixel's smallest total (the winner's cost).
   uint16_t* total = Grow(ws.total_row, size_t(w) * stride);
   for (int y = h - 1; y >= 0; --y) {
     const uint16_t* srow = sum + size_t(y) * w * stride;
-    vertical(cost + size_t(y) * w * stride, lo_row(y), y == h - 1 ? nullptr : lo_row(y + 1), srow, total,
-             SumMode::kAdd);
-    winner_take_all(y, total);
+    rows.backward_vertical(shape, cost + size_t(y) * w * stride, lo_row(y), y == h - 1 ? nullptr : lo_row(y + 1), srow,
+                           total, vert_prev, vert_prev_min, vert_cur, vert_cur_min, shifted, row_min);
+    std::swap(vert_prev, vert_cur);
+    std::swap(vert_prev_min, vert_cur_min);
+    rows.winner(shape, total, lo_row(y), row_min, right_best, right_best_size, rb_origin, options,
+                disparity.ptr<float>(y));
   }
   return disparity;
 }

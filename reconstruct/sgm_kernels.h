@@ -28,12 +28,14 @@ inline constexpr uint16_t kBig = 0x3FFF;  // "impossible" path cost; 4 x kBig st
 // forward pass's sums when the backward pass writes a row's total apart).
 enum class SumMode { kStore, kAdd };
 
-inline void Accumulate(uint16_t* sum, const uint16_t* sum_in, uint16_t v, SumMode mode) {
-  *sum = mode == SumMode::kStore ? v : uint16_t(*sum_in + v);
+template <SumMode kMode>
+inline uint16_t Accumulate(uint16_t* sum, const uint16_t* sum_in, uint16_t v) {
+  return *sum = kMode == SumMode::kStore ? v : uint16_t(*sum_in + v);
 }
 
 struct ScalarKernels {
-  static constexpr bool kNibbleCosts = false;  // Cost reads the signatures themselves
+  static constexpr bool kNibbleCosts = false;    // Cost reads the signatures themselves
+  static constexpr bool kBlockUnrolled = false;  // one instance for any n (kBlocks is ignored)
   static int Stride(int n) { return n; }
 
   // c[d] = popcount(l ^ r[d]) for d in [lo, hi); the caller fills the rest.
@@ -43,55 +45,59 @@ struct ScalarKernels {
 
   // One SGM recursion step along a path:
   //   cur[d] = c[d] + min(prev[d], prev[d-1]+p1, prev[d+1]+p1, prev_min+p2) - prev_min,
-  // accumulated into sum[d] (SumMode). Returns min_d cur[d].
+  // accumulated into sum[d] (kMode). Returns min_d cur[d]; with kSumMin
+  // also *sum_min = min_d sum[d] (the winner's cost, when this path is the
+  // last).
+  template <SumMode kMode, bool kSumMin = false, int kBlocks = 0>
   static uint16_t Step(const uint8_t* __restrict c, const uint16_t* __restrict prev, uint16_t prev_min,
-                       uint16_t* __restrict cur, const uint16_t* sum_in, uint16_t* sum, SumMode mode, int n,
-                       int /*stride*/, uint16_t p1, uint16_t p2) {
+                       uint16_t* __restrict cur, const uint16_t* sum_in, uint16_t* sum, int n, int /*stride*/,
+                       uint16_t p1, uint16_t p2, uint16_t* sum_min = nullptr) {
     const uint16_t cap = uint16_t(prev_min + p2);
-    uint16_t m = 0xFFFF;
+    uint16_t m = 0xFFFF, sm = 0xFFFF;
     for (int d = 0; d < n; ++d) {
       const uint16_t a = std::min(prev[d], cap);
       const uint16_t b = std::min(uint16_t(prev[d - 1] + p1), uint16_t(prev[d + 1] + p1));
       const uint16_t r = uint16_t(c[d] + std::min(a, b) - prev_min);
       cur[d] = r;
-      Accumulate(sum + d, sum_in + d, r, mode);
+      sm = std::min(sm, Accumulate<kMode>(sum + d, sum_in + d, r));
       m = std::min(m, r);
     }
+    if constexpr (kSumMin) *sum_min = sm;
     return m;
   }
 
-  // The first pixel of a path: cur = c.
+  // The first pixel of a path: cur = c (sums and sum_min as Step).
+  template <SumMode kMode, bool kSumMin = false, int kBlocks = 0>
   static uint16_t First(const uint8_t* __restrict c, uint16_t* __restrict cur, const uint16_t* sum_in, uint16_t* sum,
-                        SumMode mode, int n, int /*stride*/) {
-    uint16_t m = 0xFFFF;
+                        int n, int /*stride*/, uint16_t* sum_min = nullptr) {
+    uint16_t m = 0xFFFF, sm = 0xFFFF;
     for (int d = 0; d < n; ++d) {
       cur[d] = c[d];
-      Accumulate(sum + d, sum_in + d, c[d], mode);
+      sm = std::min(sm, Accumulate<kMode>(sum + d, sum_in + d, c[d]));
       m = std::min(m, cur[d]);
     }
+    if constexpr (kSumMin) *sum_min = sm;
     return m;
   }
 
   // rb[-d] = min(rb[-d], s[d]) for d in [0, n).
+  template <int kBlocks = 0>
   static void RightBest(const uint16_t* __restrict s, int n, int /*stride*/, uint16_t* rb) {
     for (int d = 0; d < n; ++d) rb[-d] = std::min(rb[-d], s[d]);
   }
 
+  template <int kBlocks = 0>
   static uint16_t Min(const uint16_t* s, int n) {
     uint16_t m = 0xFFFF;
     for (int i = 0; i < n; ++i) m = std::min(m, s[i]);
     return m;
   }
 
-  // The smallest cost and its first index.
-  static uint16_t Best(const uint16_t* s, int n, int /*stride*/, int* index) {
-    const uint16_t m = Min(s, n);
-    *index = int(std::find(s, s + n, m) - s);
-    return m;
-  }
+  // The first index of the smallest cost m (m = Min(s, n)).
+  static int FindFirst(const uint16_t* s, int n, int /*stride*/, uint16_t m) { return int(std::find(s, s + n, m) - s); }
 
   // The smallest cost off best-1..best+1 (0xFFFF if there is none).
-  static uint16_t SecondBest(uint16_t* s, int n, int /*stride*/, int best) {
+  static uint16_t SecondBest(const uint16_t* s, int n, int /*stride*/, int best) {
     return std::min(Min(s, best - 1), Min(s + best + 2, n - best - 2));
   }
 };
@@ -117,6 +123,10 @@ struct Avx2Kernels {
   // 5x7 census has 9 nibbles) instead of the 64-bit popcount's ~3 per
   // disparity. Same counts as Cost, exactly.
   static constexpr bool kNibbleCosts = true;
+  // The block loops have instances for a fixed count of 16-lane blocks
+  // (kBlocks), unrolled whole: a path step over 6 blocks then carries no
+  // loop or remainder logic, which cost ~40% on top of its arithmetic.
+  static constexpr bool kBlockUnrolled = true;
   static int Stride(int n) { return (n + 15) / 16 * 16; }
 
   // planes[k * plane_stride + j] = nibble k of sig[j] for j in [0, count),
@@ -167,95 +177,131 @@ struct Avx2Kernels {
     return _mm256_and_si256(_mm256_cmpgt_epi16(lane, _mm256_set1_epi16(int16_t(k - 1))), _mm256_set1_epi16(kBig));
   }
 
-  static void Accumulate(uint16_t* sum, const uint16_t* sum_in, __m256i v, SumMode mode) {
-    Store(sum, mode == SumMode::kStore ? v : _mm256_add_epi16(Load(sum_in), v));
+  template <SumMode kMode>
+  static __m256i Accumulate(uint16_t* sum, const uint16_t* sum_in, __m256i v) {
+    const __m256i total = kMode == SumMode::kStore ? v : _mm256_add_epi16(Load(sum_in), v);
+    Store(sum, total);
+    return total;
   }
 
-  static uint16_t Step(const uint8_t* __restrict c, const uint16_t* __restrict prev, uint16_t prev_min,
-                       uint16_t* __restrict cur, const uint16_t* sum_in, uint16_t* sum, SumMode mode, int n,
-                       int stride, uint16_t p1, uint16_t p2) {
+  // f(d) for d = 0, 16, ... below stride (kBlocks > 0: stride is 16 *
+  // kBlocks, the loop unrolled whole; 0: known at run time only).
+  template <int kBlocks, typename F>
+  [[gnu::always_inline]] static inline void ForBlocks(int stride, F&& f) {
+    if constexpr (kBlocks > 0) {
+#pragma GCC unroll 16
+      for (int b = 0; b < kBlocks; ++b) f(16 * b);
+    } else {
+#pragma GCC unroll 4
+      for (int d = 0; d < stride; d += 16) f(d);
+    }
+  }
+
+  // The last block's padding lanes (kBig in lanes >= n - (stride - 16), none
+  // if n == stride); max() with it pins them.
+  static __m256i LastPadMask(int n, int stride) { return PadMask(n - (stride - 16)); }
+
+  // kBlocks: stride / 16 if the caller knows it at compile time, else 0.
+  // The padding lanes' sums are kBig times the paths so far, above any real
+  // sum: *sum_min is the real lanes' minimum, as in the scalar kernel.
+  template <SumMode kMode, bool kSumMin = false, int kBlocks = 0>
+  [[gnu::always_inline]] static inline uint16_t Step(const uint8_t* __restrict c, const uint16_t* __restrict prev,
+                                                     uint16_t prev_min, uint16_t* __restrict cur,
+                                                     const uint16_t* sum_in, uint16_t* sum, int n, int stride,
+                                                     uint16_t p1, uint16_t p2, uint16_t* sum_min = nullptr) {
+    if constexpr (kBlocks > 0) stride = 16 * kBlocks;
     const __m256i vp1 = _mm256_set1_epi16(int16_t(p1));
     const __m256i cap = _mm256_set1_epi16(int16_t(uint16_t(prev_min + p2)));
     const __m256i vprev_min = _mm256_set1_epi16(int16_t(prev_min));
-    __m256i m = _mm256_set1_epi16(-1);
-    auto block = [&](int d) {
+    const __m256i pad = LastPadMask(n, stride);
+    const int last = stride - 16;
+    __m256i m = _mm256_set1_epi16(-1), sm = m;
+    ForBlocks<kBlocks>(stride, [&](int d) {
       const __m256i cost = _mm256_cvtepu8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(c + d)));
       const __m256i a = _mm256_min_epu16(Load(prev + d), cap);
       const __m256i b =
           _mm256_min_epu16(_mm256_add_epi16(Load(prev + d - 1), vp1), _mm256_add_epi16(Load(prev + d + 1), vp1));
-      return _mm256_sub_epi16(_mm256_add_epi16(cost, _mm256_min_epu16(a, b)), vprev_min);
-    };
-    auto finish = [&](int d, __m256i r) {
+      __m256i r = _mm256_sub_epi16(_mm256_add_epi16(cost, _mm256_min_epu16(a, b)), vprev_min);
+      if (d == last) r = _mm256_max_epu16(r, pad);
       Store(cur + d, r);
-      Accumulate(sum + d, sum_in + d, r, mode);
+      const __m256i total = Accumulate<kMode>(sum + d, sum_in + d, r);
+      if constexpr (kSumMin) sm = _mm256_min_epu16(sm, total);
       m = _mm256_min_epu16(m, r);
-    };
-    // Whole blocks, then the one holding padding lanes (if any).
-    const int whole = n / 16 * 16;
-    for (int d = 0; d < whole; d += 16) finish(d, block(d));
-    if (whole < stride) finish(whole, _mm256_max_epu16(block(whole), PadMask(n - whole)));
+    });
+    if constexpr (kSumMin) *sum_min = HorizontalMin(sm);
     return HorizontalMin(m);
   }
 
-  static uint16_t First(const uint8_t* __restrict c, uint16_t* __restrict cur, const uint16_t* sum_in, uint16_t* sum,
-                        SumMode mode, int n, int stride) {
-    __m256i m = _mm256_set1_epi16(-1);
-    for (int d = 0; d < stride; d += 16) {
+  template <SumMode kMode, bool kSumMin = false, int kBlocks = 0>
+  [[gnu::always_inline]] static inline uint16_t First(const uint8_t* __restrict c, uint16_t* __restrict cur,
+                                                      const uint16_t* sum_in, uint16_t* sum, int n, int stride,
+                                                      uint16_t* sum_min = nullptr) {
+    if constexpr (kBlocks > 0) stride = 16 * kBlocks;
+    const __m256i pad = LastPadMask(n, stride);
+    const int last = stride - 16;
+    __m256i m = _mm256_set1_epi16(-1), sm = m;
+    ForBlocks<kBlocks>(stride, [&](int d) {
       __m256i r = _mm256_cvtepu8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(c + d)));
-      if (d + 16 > n) r = _mm256_max_epu16(r, PadMask(n - d));
+      if (d == last) r = _mm256_max_epu16(r, pad);
       Store(cur + d, r);
-      Accumulate(sum + d, sum_in + d, r, mode);
+      const __m256i total = Accumulate<kMode>(sum + d, sum_in + d, r);
+      if constexpr (kSumMin) sm = _mm256_min_epu16(sm, total);
       m = _mm256_min_epu16(m, r);
-    }
+    });
+    if constexpr (kSumMin) *sum_min = HorizontalMin(sm);
     return HorizontalMin(m);
   }
 
   // rb[-d] = min(rb[-d], s[d]) over all lanes (padding lanes hold >= 3 kBig,
   // above any real sum, so they change nothing a real lane reads); rb must
   // be writable down to rb[-(stride-1)].
+  template <int kBlocks = 0>
   static void RightBest(const uint16_t* __restrict s, int /*n*/, int stride, uint16_t* rb) {
     const __m256i reverse = _mm256_setr_epi8(14, 15, 12, 13, 10, 11, 8, 9, 6, 7, 4, 5, 2, 3, 0, 1,  //
                                              14, 15, 12, 13, 10, 11, 8, 9, 6, 7, 4, 5, 2, 3, 0, 1);
-    for (int d = 0; d < stride; d += 16) {
+    ForBlocks<kBlocks>(stride, [&](int d) {
       const __m256i v = _mm256_permute4x64_epi64(_mm256_shuffle_epi8(Load(s + d), reverse), 0x4E);
       uint16_t* dst = rb - d - 15;
       Store(dst, _mm256_min_epu16(Load(dst), v));
-    }
+    });
   }
 
+  template <int kBlocks = 0>
   static uint16_t Min(const uint16_t* s, int stride) {
     __m256i m = _mm256_set1_epi16(-1);
-    for (int d = 0; d < stride; d += 16) m = _mm256_min_epu16(m, Load(s + d));
+    ForBlocks<kBlocks>(stride, [&](int d) { m = _mm256_min_epu16(m, Load(s + d)); });
     return HorizontalMin(m);
   }
 
-  static uint16_t Best(const uint16_t* s, int /*n*/, int stride, int* index) {
-    const uint16_t m = Min(s, stride);
+  // The first index of the smallest cost m (m = Min(s, stride)).
+  static int FindFirst(const uint16_t* s, int /*n*/, int stride, uint16_t m) {
     const __m256i vm = _mm256_set1_epi16(int16_t(m));
     for (int d = 0; d < stride; d += 16) {
       const unsigned mask = unsigned(_mm256_movemask_epi8(_mm256_cmpeq_epi16(Load(s + d), vm)));
-      if (mask) {
-        *index = d + __builtin_ctz(mask) / 2;
-        return m;
-      }
+      if (mask) return d + __builtin_ctz(mask) / 2;
     }
-    *index = 0;  // unreachable: m is one of the lanes
-    return m;
+    return 0;  // unreachable: m is one of the lanes
   }
 
-  // Lanes best-1..best+1 are masked out in registers (a scalar write then a
-  // vector read of the same bytes would stall store forwarding). With no
-  // lane left (n == 3) the padding's >= 3 kBig stands in for 0xFFFF: both
-  // pass any uniqueness test (uniqueness_percent <= 50).
-  static uint16_t SecondBest(uint16_t* s, int /*n*/, int stride, int best) {
-    const __m256i lane = _mm256_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-    const __m256i lo = _mm256_set1_epi16(int16_t(best - 2)), hi = _mm256_set1_epi16(int16_t(best + 2));
+  // best in [1, n-2]. The one or two blocks holding best-1..best+1 are
+  // masked in registers (a scalar write then a vector read of the same
+  // bytes would stall store forwarding): kNear, read from best-1's place,
+  // has 0xFFFF in lanes best-1..best+1. The other blocks are plain minima.
+  // With no lane left (n == 3) the padding's >= 3 kBig stands in for
+  // 0xFFFF: both pass any uniqueness test (uniqueness_percent <= 50).
+  static uint16_t SecondBest(const uint16_t* s, int /*n*/, int stride, int best) {
+    static constexpr struct NearMask {
+      uint16_t lanes[48];
+      constexpr NearMask() : lanes() {
+        for (int i = 16; i < 19; ++i) lanes[i] = 0xFFFF;
+      }
+    } kNear{};
+    const int b0 = (best - 1) / 16 * 16, b1 = (best + 1) / 16 * 16;  // first lanes of those blocks
     __m256i m = _mm256_set1_epi16(-1);
-    for (int d = 0; d < stride; d += 16) {
-      const __m256i index = _mm256_add_epi16(lane, _mm256_set1_epi16(int16_t(d)));
-      const __m256i near = _mm256_and_si256(_mm256_cmpgt_epi16(index, lo), _mm256_cmpgt_epi16(hi, index));
-      m = _mm256_min_epu16(m, _mm256_or_si256(Load(s + d), near));
-    }
+    for (int d = 0; d < b0; d += 16) m = _mm256_min_epu16(m, Load(s + d));
+    for (int d = b1 + 16; d < stride; d += 16) m = _mm256_min_epu16(m, Load(s + d));
+    for (int d = b0; d <= b1; d += 16)  // kNear + 16 + d - (best - 1): lane l is near iff 0 <= d + l - best + 1 < 3
+      m = _mm256_min_epu16(m, _mm256_or_si256(Load(s + d), Load(kNear.lanes + 16 + d - best + 1)));
     return HorizontalMin(m);
   }
 };
