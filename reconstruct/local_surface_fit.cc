@@ -161,7 +161,7 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
   // filter reads only its own row, and the column filters' output rows kept
   // have their whole window inside the band's input rows, so every sum
   // comes from the same pixels by the same arithmetic as over the whole ROI.
-  constexpr int kBandRows = 64;
+  constexpr int kBandRows = 128;
   for (int y0 = 0; y0 < roi.height; y0 += kBandRows) {
     const int y1 = std::min(roi.height, y0 + kBandRows);
     const int in0 = std::max(0, y0 - hh), in1 = std::min(roi.height, y1 + hh);  // the band's input rows
