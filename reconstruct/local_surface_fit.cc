@@ -145,20 +145,6 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
       mask.at<float>(y, x) = 1;
       values.at<float>(y, x) = v - mean;
     }
-  // Window sums: the mask's moments up to degree 4 (the normal matrix:
-  // moment[i][j] = sum of mask (u/hw)^i (v/hh)^j), the values' up to degree
-  // 2 (the right-hand side), and the values' squares (the misfit).
-  cv::Mat moment[5][5], value_moment[3][3];
-  for (int i = 0; i <= 4; ++i) {
-    const cv::Mat row = RowMoment(mask, i, hw);
-    for (int j = 0; i + j <= 4; ++j) moment[i][j] = ColumnMoment(row, j, hh);
-  }
-  for (int i = 0; i <= 2; ++i) {
-    const cv::Mat row = RowMoment(values, i, hw);
-    for (int j = 0; i + j <= 2; ++j) value_moment[i][j] = ColumnMoment(row, j, hh);
-  }
-  const cv::Mat squares = ColumnMoment(RowMoment(values.mul(values), 0, hw), 0, hh);
-
   Factor6 full_factor;
   STEREORIG_CHECK(Factor(FullWindowMatrix(hw, hh), &full_factor));
   const int full_count = (2 * hw + 1) * (2 * hh + 1);
@@ -166,39 +152,64 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
   // Per pixel: the fitted value at its centre and the RMS misfit (NaN = no fit).
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
   cv::Mat fitted(roi.size(), CV_32F, cv::Scalar(kNaN)), misfit(roi.size(), CV_32F, cv::Scalar(kNaN));
-  ParallelForChunks(roi.height, num_threads, [&](int b, int e) {
-    for (int y = b; y < e; ++y) {
-      const float* valid = mask.ptr<float>(y);
-      const float* m[5][5];
-      const float* r[3][3];
-      for (int i = 0; i <= 4; ++i)
-        for (int j = 0; i + j <= 4; ++j) m[i][j] = moment[i][j].ptr<float>(y);
-      for (int i = 0; i <= 2; ++i)
-        for (int j = 0; i + j <= 2; ++j) r[i][j] = value_moment[i][j].ptr<float>(y);
-      const float* sq = squares.ptr<float>(y);
-      for (int x = 0; x < roi.width; ++x) {
-        if (!(valid[x] > 0)) continue;
-        const double n = m[0][0][x];
-        if (n < 2 * kTerms) continue;
-        std::array<double, kTerms> rhs;
-        for (int p = 0; p < kTerms; ++p) rhs[p] = r[kPowerU[p]][kPowerV[p]][x];
-        double centre, fit_sum;
-        if (n > full_count - 0.5) {  // every pixel valid: the full window's system
-          SolveCentre(full_factor, rhs, &centre, &fit_sum);
-        } else {
-          Matrix6 a;
-          for (int p = 0; p < kTerms; ++p)
-            for (int q = 0; q <= p; ++q) a[p][q] = m[kPowerU[p] + kPowerU[q]][kPowerV[p] + kPowerV[q]][x];
-          Factor6 factor;
-          if (!Factor(a, &factor)) continue;
-          if (!(CentreVariance(factor) <= max_variance)) continue;
-          SolveCentre(factor, rhs, &centre, &fit_sum);
-        }
-        fitted.at<float>(y, x) = float(centre);
-        misfit.at<float>(y, x) = float(std::sqrt(std::max(0.0, sq[x] - fit_sum) / (n - kTerms)));
-      }
+  // Window sums: the mask's moments up to degree 4 (the normal matrix:
+  // moment[i][j] = sum of mask (u/hw)^i (v/hh)^j), the values' up to degree
+  // 2 (the right-hand side), and the values' squares (the misfit). In bands
+  // of kBandRows output rows: the 22 moment images exist for one band and
+  // its hh-row margins at a time (over the whole ROI they were 30 MB per
+  // module on the demo plate, live while the other module matched). A row
+  // filter reads only its own row, and the column filters' output rows kept
+  // have their whole window inside the band's input rows, so every sum
+  // comes from the same pixels by the same arithmetic as over the whole ROI.
+  constexpr int kBandRows = 128;
+  for (int y0 = 0; y0 < roi.height; y0 += kBandRows) {
+    const int y1 = std::min(roi.height, y0 + kBandRows);
+    const int in0 = std::max(0, y0 - hh), in1 = std::min(roi.height, y1 + hh);  // the band's input rows
+    const cv::Mat band_mask = mask.rowRange(in0, in1), band_values = values.rowRange(in0, in1);
+    cv::Mat moment[5][5], value_moment[3][3];
+    for (int i = 0; i <= 4; ++i) {
+      const cv::Mat row = RowMoment(band_mask, i, hw);
+      for (int j = 0; i + j <= 4; ++j) moment[i][j] = ColumnMoment(row, j, hh);
     }
-  });
+    for (int i = 0; i <= 2; ++i) {
+      const cv::Mat row = RowMoment(band_values, i, hw);
+      for (int j = 0; i + j <= 2; ++j) value_moment[i][j] = ColumnMoment(row, j, hh);
+    }
+    const cv::Mat squares = ColumnMoment(RowMoment(band_values.mul(band_values), 0, hw), 0, hh);
+    ParallelForChunks(y1 - y0, num_threads, [&](int b, int e) {
+      for (int y = y0 + b; y < y0 + e; ++y) {
+        const float* valid = mask.ptr<float>(y);
+        const float* m[5][5];
+        const float* r[3][3];
+        for (int i = 0; i <= 4; ++i)
+          for (int j = 0; i + j <= 4; ++j) m[i][j] = moment[i][j].ptr<float>(y - in0);
+        for (int i = 0; i <= 2; ++i)
+          for (int j = 0; i + j <= 2; ++j) r[i][j] = value_moment[i][j].ptr<float>(y - in0);
+        const float* sq = squares.ptr<float>(y - in0);
+        for (int x = 0; x < roi.width; ++x) {
+          if (!(valid[x] > 0)) continue;
+          const double n = m[0][0][x];
+          if (n < 2 * kTerms) continue;
+          std::array<double, kTerms> rhs;
+          for (int p = 0; p < kTerms; ++p) rhs[p] = r[kPowerU[p]][kPowerV[p]][x];
+          double centre, fit_sum;
+          if (n > full_count - 0.5) {  // every pixel valid: the full window's system
+            SolveCentre(full_factor, rhs, &centre, &fit_sum);
+          } else {
+            Matrix6 a;
+            for (int p = 0; p < kTerms; ++p)
+              for (int q = 0; q <= p; ++q) a[p][q] = m[kPowerU[p] + kPowerU[q]][kPowerV[p] + kPowerV[q]][x];
+            Factor6 factor;
+            if (!Factor(a, &factor)) continue;
+            if (!(CentreVariance(factor) <= max_variance)) continue;
+            SolveCentre(factor, rhs, &centre, &fit_sum);
+          }
+          fitted.at<float>(y, x) = float(centre);
+          misfit.at<float>(y, x) = float(std::sqrt(std::max(0.0, sq[x] - fit_sum) / (n - kTerms)));
+        }
+      }
+    });
+  }
   std::vector<float> misfits;
   for (int y = 0; y < roi.height; ++y)
     for (int x = 0; x < roi.width; ++x)

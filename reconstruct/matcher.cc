@@ -174,8 +174,17 @@ void RemoveSpeckles(cv::Mat disparity_px, const MatchOptions& o) {
   for (int y = 0; y < disparity_px.rows; ++y) {
     const float* d = disparity_px.ptr<float>(y);
     int16_t* f = fixed.ptr<int16_t>(y);
-    for (int x = 0; x < disparity_px.cols; ++x)
-      f[x] = std::isfinite(d[x]) ? int16_t(std::clamp(std::lround(d[x] * 16.0), -32000L, 32000L)) : kInvalid;
+    for (int x = 0; x < disparity_px.cols; ++x) {
+      if (!std::isfinite(d[x])) {
+        f[x] = kInvalid;
+        continue;
+      }
+      // Rounded half away from zero as std::lround would (d * 16 has at most
+      // 24 significant bits, so adding 0.5 is exact), inline: std::lround is
+      // a libm call per pixel.
+      const double sixteenths = std::clamp(d[x] * 16.0, -32000.0, 32000.0);
+      f[x] = int16_t(int(sixteenths + std::copysign(0.5, sixteenths)));
+    }
   }
   cv::filterSpeckles(fixed, kInvalid, o.speckle_window_px, int(std::lround(o.speckle_range_px * 16)));
   for (int y = 0; y < disparity_px.rows; ++y) {

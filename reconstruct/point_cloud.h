@@ -19,12 +19,14 @@ struct PointCloud {
   std::vector<uint8_t> module;          // module index, or kFilledModule
   std::vector<float> confidence;        // [0, 1]
   size_t size() const { return xyz_mm.size(); }
+  void Reserve(size_t points);  // capacity for `points` in every field
   void Append(const PointCloud& other);
 };
 
 struct Mesh {
   std::vector<Eigen::Vector3f> vertices_mm;
   std::vector<Eigen::Vector3i> triangles;  // indices into vertices_mm, counter-clockwise seen from outside
+  void Reserve(size_t vertices, size_t triangles);
   void Append(const Mesh& other);
 };
 

@@ -28,14 +28,27 @@ int DropRightInvisible(double margin_px, const cv::Mat& right_valid, const cv::R
   STEREORIG_CHECK(right_valid.empty() || (right_valid.type() == CV_8UC1 && right_valid.size() == disparity.size()));
   const int cols = disparity.cols;
   constexpr double kStepPx = 1;  // how much nearer an occluder must be (header)
+  constexpr float kInf = std::numeric_limits<float>::infinity();
   std::vector<int> drop;
+  // first_landing[i]: the leftmost right column x' - d' that a valid pixel
+  // x' >= roi.x + i of the row lands at (+inf: none). A pixel can only be
+  // occluded if a pixel right of it lands at or left of its own landing, so
+  // where first_landing[i + 1] > xr the scan below is skipped: on a surface
+  // the right view does not fold, that is nearly every pixel, and the scan
+  // (up to row_max - d px) was the filter's cost. The same float landings
+  // as the scan's, so the result is the same.
+  std::vector<float> first_landing(roi.width + 1);
   int dropped = 0;
   for (int y = roi.y; y < roi.y + roi.height; ++y) {
     float* d = disparity.ptr<float>(y);
     const uint8_t* valid = right_valid.empty() ? nullptr : right_valid.ptr<uint8_t>(y);
-    float row_max = -std::numeric_limits<float>::infinity();
-    for (int x = roi.x; x < roi.x + roi.width; ++x)
-      if (std::isfinite(d[x])) row_max = std::max(row_max, d[x]);
+    float row_max = -kInf;
+    first_landing[roi.width] = kInf;
+    for (int x = roi.x + roi.width - 1; x >= roi.x; --x) {
+      const bool ok = std::isfinite(d[x]);
+      if (ok) row_max = std::max(row_max, d[x]);
+      first_landing[x - roi.x] = ok ? std::min(first_landing[x - roi.x + 1], x - d[x]) : first_landing[x - roi.x + 1];
+    }
     drop.clear();
     for (int x = roi.x; x < roi.x + roi.width; ++x) {
       if (!std::isfinite(d[x])) continue;
@@ -46,9 +59,11 @@ int DropRightInvisible(double margin_px, const cv::Mat& right_valid, const cv::R
         hidden = c < 0 || c >= cols || (valid && !valid[c]);
       // Occluded: an occluder x' lands at x' - d' <= xr, so
       // x' <= x + (d' - d) <= x + (row_max - d).
-      const int last = std::min(roi.x + roi.width - 1, int(std::floor(x + row_max - d[x])));
-      for (int xo = x + 1; xo <= last && !hidden; ++xo)
-        hidden = std::isfinite(d[xo]) && d[xo] > d[x] + kStepPx && xo - d[xo] <= xr;
+      if (!hidden && first_landing[x - roi.x + 1] <= xr) {
+        const int last = std::min(roi.x + roi.width - 1, int(std::floor(x + row_max - d[x])));
+        for (int xo = x + 1; xo <= last && !hidden; ++xo)
+          hidden = std::isfinite(d[xo]) && d[xo] > d[x] + kStepPx && xo - d[xo] <= xr;
+      }
       if (hidden) drop.push_back(x);
     }
     // After the row's test: a dropped pixel still hides those behind it.

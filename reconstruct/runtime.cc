@@ -12,6 +12,7 @@
 
 #include "calib/core/input_error.h"
 #include "reconstruct/hole_fill.h"
+#include "reconstruct/lit_mask.h"
 #include "reconstruct/right_occlusion.h"
 
 namespace stereorig {
@@ -26,18 +27,6 @@ std::vector<Eigen::Vector3d> VolumeCorners(const Eigen::Vector3d& centre, const 
     corners.push_back(centre + 0.5 * Eigen::Vector3d((i & 1 ? 1 : -1) * size.x(), (i & 2 ? 1 : -1) * size.y(),
                                                      (i & 4 ? 1 : -1) * size.z()));
   return corners;
-}
-
-// Grid-lit pixels: the local grey-level std over 9x9 exceeds the threshold.
-// The window is wider than the grid period, so the lit area is one solid
-// region, and uniform dark or ambient-lit areas are not.
-cv::Mat LitMask(const cv::Mat& grey, double contrast_dn) {
-  cv::Mat f, mean, mean2;
-  grey.convertTo(f, CV_32F);
-  cv::boxFilter(f, mean, CV_32F, cv::Size(9, 9));
-  cv::boxFilter(f.mul(f), mean2, CV_32F, cv::Size(9, 9));
-  cv::Mat var = mean2 - mean.mul(mean);
-  return var > float(contrast_dn * contrast_dn);
 }
 
 }  // namespace
@@ -155,21 +144,24 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
   status = match.status;
   report->times_ms["match"] = MsSince(t);
 
-  // Triangulate into an organised grid of reference-frame points (NaN = none).
+  // Triangulate into an organised grid of reference-frame points over the
+  // match ROI (NaN = none), and the list of its points: the steps below
+  // visit those only, row by row, as the cloud orders them.
   t = Clock::now();
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  cv::Mat grid(size, CV_32FC3, cv::Scalar(nan, nan, nan));
+  const cv::Rect& r = match_roi;
+  cv::Mat grid(r.size(), CV_32FC3, cv::Scalar(nan, nan, nan));  // grid(y - r.y, x - r.x)
+  std::vector<cv::Point> kept;                                    // image pixels of grid's points, row-major
   const Eigen::Vector3d lo = volume_center_mm_ - 0.5 * options_.volume_size_mm;
   const Eigen::Vector3d hi = volume_center_mm_ + 0.5 * options_.volume_size_mm;
-  std::vector<Eigen::Vector3d> kept;
   const Eigen::Matrix3d r_ref = plan.reference_from_module.rotation();
   const Eigen::Vector3d t_ref = plan.reference_from_module.translation_mm();
-  for (int y = match_roi.y; y < match_roi.y + match_roi.height; ++y) {
+  for (int y = r.y; y < r.y + r.height; ++y) {
     const float* d = match.disparity_px.ptr<float>(y);
     const float* c = match.confidence.ptr<float>(y);
-    cv::Vec3f* g = grid.ptr<cv::Vec3f>(y);
+    cv::Vec3f* g = grid.ptr<cv::Vec3f>(y - r.y) - r.x;
     uint8_t* st = status.ptr<uint8_t>(y);
-    for (int x = match_roi.x; x < match_roi.x + match_roi.width; ++x) {
+    for (int x = r.x; x < r.x + r.width; ++x) {
       if (!std::isfinite(d[x])) continue;
       if (c[x] < options_.min_confidence) {
         st[x] = uint8_t(PixelStatus::kLowConfidence);
@@ -181,83 +173,89 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
         continue;
       }
       g[x] = cv::Vec3f(float(p.x()), float(p.y()), float(p.z()));
+      kept.emplace_back(x, y);
     }
   }
+  auto grid_at = [&](const cv::Point& q) -> cv::Vec3f& { return grid.at<cv::Vec3f>(q.y - r.y, q.x - r.x); };
   // Object size: drop points farther than object_size_mm from the cloud's
   // per-axis median (background, gross mismatches).
-  {
+  if (!kept.empty()) {
     std::vector<float> xs, ys, zs;
-    for (int y = match_roi.y; y < match_roi.y + match_roi.height; ++y)
-      for (int x = match_roi.x; x < match_roi.x + match_roi.width; ++x) {
-        const cv::Vec3f& p = grid.at<cv::Vec3f>(y, x);
-        if (std::isnan(p[0])) continue;
-        xs.push_back(p[0]), ys.push_back(p[1]), zs.push_back(p[2]);
-      }
-    if (!xs.empty()) {
-      auto median = [](std::vector<float>& v) {
-        std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-        return v[v.size() / 2];
-      };
-      const cv::Vec3f m(median(xs), median(ys), median(zs));
-      const float limit2 = float(options_.object_size_mm * options_.object_size_mm);
-      for (int y = match_roi.y; y < match_roi.y + match_roi.height; ++y)
-        for (int x = match_roi.x; x < match_roi.x + match_roi.width; ++x) {
-          cv::Vec3f& p = grid.at<cv::Vec3f>(y, x);
-          if (!std::isnan(p[0]) && (p - m).dot(p - m) > limit2) {
-            p = cv::Vec3f(nan, nan, nan);
-            status.at<uint8_t>(y, x) = uint8_t(PixelStatus::kObjectSize);
-          }
-        }
+    xs.reserve(kept.size()), ys.reserve(kept.size()), zs.reserve(kept.size());
+    for (const cv::Point& q : kept) {
+      const cv::Vec3f& p = grid_at(q);
+      xs.push_back(p[0]), ys.push_back(p[1]), zs.push_back(p[2]);
     }
+    auto median = [](std::vector<float>& v) {
+      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+      return v[v.size() / 2];
+    };
+    const cv::Vec3f m(median(xs), median(ys), median(zs));
+    const float limit2 = float(options_.object_size_mm * options_.object_size_mm);
+    size_t n = 0;
+    for (const cv::Point& q : kept) {
+      cv::Vec3f& p = grid_at(q);
+      if ((p - m).dot(p - m) > limit2) {
+        p = cv::Vec3f(nan, nan, nan);
+        status.at<uint8_t>(q) = uint8_t(PixelStatus::kObjectSize);
+      } else {
+        kept[n++] = q;
+      }
+    }
+    kept.resize(n);
   }
   report->times_ms["triangulate"] = MsSince(t);
 
   // Normals from the depth grid (central differences +-step), oriented
   // towards the camera; the point's intensity and confidence; the index map
-  // for the mesh.
+  // for the mesh (over the match ROI, -1 = no point).
   t = Clock::now();
   const int s = options_.normal_step_px;
-  cv::Mat index(size, CV_32SC1, cv::Scalar(-1));
+  cv::Mat index(r.size(), CV_32SC1, cv::Scalar(-1));  // index(y - r.y, x - r.x)
   const Eigen::Vector3f eye = plan.camera_centre_reference_mm.cast<float>();
-  auto at = [&](int x, int y) -> const cv::Vec3f* {
-    if (x < 0 || y < 0 || x >= size.width || y >= size.height) return nullptr;
-    const cv::Vec3f& p = grid.at<cv::Vec3f>(y, x);
+  auto at = [&](int x, int y) -> const cv::Vec3f* {  // image pixel (x, y); outside the match ROI: no point
+    if (x < r.x || y < r.y || x >= r.x + r.width || y >= r.y + r.height) return nullptr;
+    const cv::Vec3f& p = grid.at<cv::Vec3f>(y - r.y, x - r.x);
     return std::isnan(p[0]) ? nullptr : &p;
   };
-  for (int y = match_roi.y; y < match_roi.y + match_roi.height; ++y) {
-    for (int x = match_roi.x; x < match_roi.x + match_roi.width; ++x) {
-      const cv::Vec3f* p = at(x, y);
-      if (!p) continue;
-      // Widest available symmetric or one-sided difference in each direction.
-      const cv::Vec3f *xa = at(x + s, y), *xb = at(x - s, y), *ya = at(x, y + s), *yb = at(x, y - s);
-      Eigen::Vector3f n(0, 0, 0);
-      if ((xa || xb) && (ya || yb)) {
-        const cv::Vec3f dx = (xa ? *xa : *p) - (xb ? *xb : *p);
-        const cv::Vec3f dy = (ya ? *ya : *p) - (yb ? *yb : *p);
-        n = Eigen::Vector3f(dx[0], dx[1], dx[2]).cross(Eigen::Vector3f(dy[0], dy[1], dy[2]));
-      }
-      const Eigen::Vector3f pe((*p)[0], (*p)[1], (*p)[2]);
-      if (n.norm() > 0) {
-        n.normalize();
-        if (n.dot(eye - pe) < 0) n = -n;
-      } else {
-        n = (eye - pe).normalized();  // isolated point: face the camera
-      }
-      index.at<int>(y, x) = int(cloud->size());
-      cloud->xyz_mm.push_back(pe);
-      cloud->normal.push_back(n);
-      cloud->intensity.push_back(left.at<uint8_t>(y, x));
-      cloud->module.push_back(uint8_t(plan.module));
-      cloud->confidence.push_back(match.confidence.at<float>(y, x));
+  cloud->Reserve(cloud->size() + kept.size());
+  for (const cv::Point& q : kept) {
+    const int x = q.x, y = q.y;
+    const cv::Vec3f* p = &grid_at(q);
+    // Widest available symmetric or one-sided difference in each direction.
+    const cv::Vec3f *xa = at(x + s, y), *xb = at(x - s, y), *ya = at(x, y + s), *yb = at(x, y - s);
+    Eigen::Vector3f n(0, 0, 0);
+    if ((xa || xb) && (ya || yb)) {
+      const cv::Vec3f dx = (xa ? *xa : *p) - (xb ? *xb : *p);
+      const cv::Vec3f dy = (ya ? *ya : *p) - (yb ? *yb : *p);
+      n = Eigen::Vector3f(dx[0], dx[1], dx[2]).cross(Eigen::Vector3f(dy[0], dy[1], dy[2]));
     }
+    const Eigen::Vector3f pe((*p)[0], (*p)[1], (*p)[2]);
+    if (n.norm() > 0) {
+      n.normalize();
+      if (n.dot(eye - pe) < 0) n = -n;
+    } else {
+      n = (eye - pe).normalized();  // isolated point: face the camera
+    }
+    index.at<int>(y - r.y, x - r.x) = int(cloud->size());
+    cloud->xyz_mm.push_back(pe);
+    cloud->normal.push_back(n);
+    cloud->intensity.push_back(left.at<uint8_t>(y, x));
+    cloud->module.push_back(uint8_t(plan.module));
+    cloud->confidence.push_back(match.confidence.at<float>(y, x));
   }
   report->points = int(cloud->size());
-  for (int y = 0; y < lit.rows; ++y)
+  for (int y = 0; y < lit.rows; ++y) {
+    const uint8_t* l = lit.ptr<uint8_t>(y);
+    const int yi = y + plan.roi.y - r.y;  // index's row
+    const int* in = yi >= 0 && yi < r.height ? index.ptr<int>(yi) : nullptr;
     for (int x = 0; x < lit.cols; ++x) {
-      if (!lit.at<uint8_t>(y, x)) continue;
+      if (!l[x]) continue;
       ++report->lit_pixels;
-      report->lit_filled += index.at<int>(y + plan.roi.y, x + plan.roi.x) >= 0;
+      const int xi = x + plan.roi.x - r.x;
+      report->lit_filled += in && xi >= 0 && xi < r.width && in[xi] >= 0;
     }
+  }
   report->times_ms["normals"] = MsSince(t);
 
   if (!build_mesh) return;
@@ -266,12 +264,13 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
   // order makes them counter-clockwise seen from the camera.
   t = Clock::now();
   mesh->vertices_mm = cloud->xyz_mm;
+  mesh->triangles.reserve(2 * kept.size());  // two per point inside a surface
   const float max_edge2 = float(options_.mesh_max_edge_mm * options_.mesh_max_edge_mm);
   auto short_edge = [&](int a, int b) { return (cloud->xyz_mm[a] - cloud->xyz_mm[b]).squaredNorm() <= max_edge2; };
-  for (int y = match_roi.y; y + 1 < match_roi.y + match_roi.height; ++y) {
+  for (int y = 0; y + 1 < r.height; ++y) {
     const int* r0 = index.ptr<int>(y);
     const int* r1 = index.ptr<int>(y + 1);
-    for (int x = match_roi.x; x + 1 < match_roi.x + match_roi.width; ++x) {
+    for (int x = 0; x + 1 < r.width; ++x) {
       const int a = r0[x], b = r0[x + 1], c = r1[x], d = r1[x + 1];
       if (a >= 0 && b >= 0 && c >= 0 && short_edge(a, b) && short_edge(a, c) && short_edge(b, c))
         mesh->triangles.emplace_back(a, c, b);
@@ -315,12 +314,18 @@ Reconstruction Runtime::Process(const std::vector<cv::Mat>& images, bool build_m
   }
   out.times_ms["modules"] = MsSince(t);
   t = Clock::now();
-  for (int m = 0; m < nm; ++m) out.cloud.Append(clouds[m]);
+  size_t total_points = 0;
+  for (const PointCloud& c : clouds) total_points += c.size();
+  out.cloud.Reserve(total_points);
+  for (int m = 0; m < nm; ++m) out.cloud.Append(clouds[m]), clouds[m] = PointCloud();
   out.times_ms["merge"] = MsSince(t);
   out.times_ms["total_point_cloud"] = MsSince(t_total);
   if (!build_mesh) return out;
   t = Clock::now();
-  for (int m = 0; m < nm; ++m) out.mesh.Append(meshes[m]);
+  size_t total_vertices = 0, total_triangles = 0;
+  for (const Mesh& mesh : meshes) total_vertices += mesh.vertices_mm.size(), total_triangles += mesh.triangles.size();
+  out.mesh.Reserve(total_vertices, total_triangles);
+  for (int m = 0; m < nm; ++m) out.mesh.Append(meshes[m]), meshes[m] = Mesh();
   out.times_ms["mesh_join"] = MsSince(t);
   t = Clock::now();
   if (options_.shape_model != ShapeModel::kNone) {
