@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "calib/core/input_error.h"
 #include "reconstruct/subpixel_window.h"
 
 namespace stereorig {
@@ -93,6 +94,7 @@ PixelStatus RefineAndAccept(const cv::Mat& left, const cv::Mat& right, int x, in
   // The fit's window near the right image's left edge is the portable
   // kind; the probe's is always the fastest (equal up to float rounding):
   // set one up as Accept does, so the outcome is the same.
+  STEREORIG_CHECK(window.has_value());  // AcceptFit passes only fits that set a window up
   if (window->kernel() != WindowKernel::kFastest)
     return AcceptDistinct(WindowZnccProbe(left, right, x, y, slope_x, slope_y, a.subpixel), slope_x, *result, a);
   return AcceptDistinct(WindowZnccProbe(*window, slope_x, slope_y, a.subpixel), slope_x, *result, a);

@@ -59,6 +59,7 @@ void FootprintSampler::VisitRow(int y, int x_begin, int x_end, Visit&& visit) co
 
 std::vector<FootprintStart> FootprintSampler::Sample(const std::vector<int>& pixels) {
   if (order_.empty()) order_.assign(disparity_px_.total(), 0);
+  STEREORIG_CHECK(order_.size() == disparity_px_.total() && disparity_px_.isContinuous());  // same map size
   const float* d = disparity_px_.ptr<float>(0);
   int x_min = INT_MAX, x_max = -1, y_min = INT_MAX, y_max = -1;
   for (size_t k = 0; k < pixels.size(); ++k) {

@@ -160,7 +160,9 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
   // module on the demo plate, live while the other module matched). A row
   // filter reads only its own row, and the column filters' output rows kept
   // have their whole window inside the band's input rows, so every sum
-  // comes from the same pixels by the same arithmetic as over the whole ROI.
+  // comes from the same pixels by the same arithmetic as over the whole ROI
+  // (filter2D stays direct, not DFT, below ~130 taps; Check() keeps the
+  // half widths <= 30, so kernels have <= 61 taps).
   constexpr int kBandRows = 128;
   for (int y0 = 0; y0 < roi.height; y0 += kBandRows) {
     const int y1 = std::min(roi.height, y0 + kBandRows);

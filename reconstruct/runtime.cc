@@ -159,7 +159,7 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
   for (int y = r.y; y < r.y + r.height; ++y) {
     const float* d = match.disparity_px.ptr<float>(y);
     const float* c = match.confidence.ptr<float>(y);
-    cv::Vec3f* g = grid.ptr<cv::Vec3f>(y - r.y) - r.x;
+    cv::Vec3f* g = grid.ptr<cv::Vec3f>(y - r.y);  // g[x - r.x]: no pointer before the row's start
     uint8_t* st = status.ptr<uint8_t>(y);
     for (int x = r.x; x < r.x + r.width; ++x) {
       if (!std::isfinite(d[x])) continue;
@@ -172,7 +172,7 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
         st[x] = uint8_t(PixelStatus::kOutsideVolume);
         continue;
       }
-      g[x] = cv::Vec3f(float(p.x()), float(p.y()), float(p.z()));
+      g[x - r.x] = cv::Vec3f(float(p.x()), float(p.y()), float(p.z()));
       kept.emplace_back(x, y);
     }
   }
