@@ -13,6 +13,15 @@
 
 namespace stereorig {
 
+double TruthSlopePx(float before_px, float centre_px, float after_px) {
+  if (!std::isfinite(centre_px)) return 0.0;
+  const bool has_before = std::isfinite(before_px), has_after = std::isfinite(after_px);
+  if (has_before && has_after) return 0.5 * (double(after_px) - before_px);
+  if (has_after) return double(after_px) - centre_px;
+  if (has_before) return double(centre_px) - before_px;
+  return 0.0;
+}
+
 cv::Mat TruthDisparity(const ModulePlan& plan, const cv::Mat& left_x, const cv::Mat& left_y,
                        const cv::Mat& left_depth_mm) {
   const RectifiedGeometry& g = plan.geometry;
@@ -102,8 +111,7 @@ FillDiagnosis DiagnoseFill(const Runtime& runtime, int module, const std::vector
       if (!d.target.at<uint8_t>(y, x)) continue;
       const float tl = t.at<float>(y, x - 1), tr = t.at<float>(y, x + 1), tu = t.at<float>(y - 1, x),
                   tb = t.at<float>(y + 1, x);
-      const double gx = std::isfinite(tl) && std::isfinite(tr) ? 0.5 * (tr - tl) : 0.0;
-      const double gy = std::isfinite(tu) && std::isfinite(tb) ? 0.5 * (tb - tu) : 0.0;
+      const double gx = TruthSlopePx(tl, td, tr), gy = TruthSlopePx(tu, td, tb);
       const auto& edges = FillDiagnosis::kForeshorteningEdges;
       const size_t bin = size_t(std::upper_bound(edges.begin(), edges.end(), 1.0 - gx) - edges.begin());
       ++d.target_px;

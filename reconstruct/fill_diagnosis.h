@@ -39,6 +39,12 @@ cv::Mat TruthDisparity(const ModulePlan& plan, const cv::Mat& left_x, const cv::
 void RectifyModulePair(const Rig& rig, const ModulePlan& plan, const std::vector<cv::Mat>& images, cv::Mat* left,
                        cv::Mat* right);
 
+// The truth disparity's slope along a row or column (px per px) at a pixel
+// holding `centre_px`, from its neighbours before and after (NaN = no truth):
+// the central difference where both exist, the one-sided one where only one
+// does (a silhouette or a depth edge), 0 where neither (or the centre) does.
+double TruthSlopePx(float before_px, float centre_px, float after_px);
+
 struct FillDiagnosis {
   cv::Mat left, right;      // CV_8UC1 rectified pair
   cv::Mat target;           // CV_8UC1: 255 = fill target (fill_score.h), rectified grid
