@@ -46,8 +46,9 @@ cv::Mat LabelDisparityComponents(const cv::Mat& disparity_px, const cv::Rect& ro
   // `stride`: kFree = a valid pixel not yet labelled, kBlocked = invalid or
   // the frame. A neighbour is then one test of its label, with no bounds or
   // validity test (the walk's cost is per pixel: ~40 instructions a pixel
-  // with those tests, 5 labellings per capture).
-  constexpr int kFree = -1, kBlocked = -2;
+  // with those tests, 5 labellings per capture). Once every valid pixel is
+  // labelled, the rows inside the frame are the output's.
+  constexpr int kFree = -2, kBlocked = -1;
   const int stride = roi.width + 2;
   std::vector<int> walk(size_t(stride) * size_t(roi.height + 2), kBlocked);
   const float* d_at = disparity_px.ptr<float>(0);  // a pixel is y * cols + x
@@ -67,10 +68,11 @@ cv::Mat LabelDisparityComponents(const cv::Mat& disparity_px, const cv::Rect& ro
   const size_t area = size_t(roi.area());
   std::unique_ptr<Pixel[]> stack(new Pixel[area]);
   std::unique_ptr<int[]> listed(new int[area]);
-  for (int y = y0; y < y1; ++y)
+  for (int y = y0; y < y1; ++y) {
+    const int row_w = (y - y0 + 1) * stride + 1 - x0;  // walk index of (x, y) = row_w + x
     for (int x = x0; x < x1; ++x) {
-      const int seed_w = (y - y0 + 1) * stride + (x - x0 + 1);
-      if (walk[size_t(seed_w)] != kFree) continue;
+      if (walk[size_t(row_w + x)] != kFree) continue;
+      const int seed_w = row_w + x;
       const int label = int(components->size());
       walk[size_t(seed_w)] = label;
       size_t top = 0, n = 0;
@@ -94,12 +96,18 @@ cv::Mat LabelDisparityComponents(const cv::Mat& disparity_px, const cv::Rect& ro
       }
       components->emplace_back(listed.get(), listed.get() + n);
     }
+  }
   // Labels as the image: -1 outside the roi and on invalid pixels.
-  cv::Mat labels(disparity_px.size(), CV_32SC1, cv::Scalar(-1));
-  for (int y = y0; y < y1; ++y) {
-    const int* w = walk.data() + size_t(y - y0 + 1) * size_t(stride) + 1;
-    int* out = labels.ptr<int>(y) + x0;
-    for (int x = 0; x < roi.width; ++x) out[x] = std::max(w[x], -1);
+  cv::Mat labels(disparity_px.size(), CV_32SC1);
+  for (int y = 0; y < disparity_px.rows; ++y) {
+    int* out = labels.ptr<int>(y);
+    if (y < y0 || y >= y1 || roi.width == 0) {
+      std::fill(out, out + cols, -1);
+      continue;
+    }
+    std::fill(out, out + x0, -1);
+    std::copy_n(walk.data() + size_t(y - y0 + 1) * size_t(stride) + 1, roi.width, out + x0);
+    std::fill(out + x1, out + cols, -1);
   }
   return labels;
 }
