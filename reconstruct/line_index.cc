@@ -37,52 +37,78 @@ void LineIndexOptions::Check() const {
 cv::Mat LabelDisparityComponents(const cv::Mat& disparity_px, const cv::Rect& roi, double max_step_px,
                                  std::vector<std::vector<int>>* components) {
   STEREORIG_CHECK(disparity_px.type() == CV_32FC1 && disparity_px.isContinuous());
+  STEREORIG_CHECK(roi.x >= 0 && roi.y >= 0 && roi.width >= 0 && roi.height >= 0 &&
+                  roi.x + roi.width <= disparity_px.cols && roi.y + roi.height <= disparity_px.rows);
   const int cols = disparity_px.cols;
   const int x0 = roi.x, x1 = roi.x + roi.width, y0 = roi.y, y1 = roi.y + roi.height;
-  cv::Mat labels(disparity_px.size(), CV_32SC1, cv::Scalar(-1));
-  // Flat views: a pixel is its index y * cols + x in both maps.
-  const float* d_at = disparity_px.ptr<float>(0);
-  int* label_at = labels.ptr<int>(0);
   components->clear();
+  // The walk's own labels over the roi with a one-pixel frame, row stride
+  // `stride`: kFree = a valid pixel not yet labelled, kBlocked = invalid or
+  // the frame. A neighbour is then one test of its label, with no bounds or
+  // validity test (the walk's cost is per pixel: ~40 instructions a pixel
+  // with those tests, 5 labellings per capture). Once every valid pixel is
+  // labelled, the rows inside the frame are the output's.
+  constexpr int kFree = -2, kBlocked = -1;
+  const int stride = roi.width + 2;
+  std::vector<int> walk(size_t(stride) * size_t(roi.height + 2), kBlocked);
+  const float* d_at = disparity_px.ptr<float>(0);  // a pixel is y * cols + x
+  for (int y = y0; y < y1; ++y) {
+    const float* d = d_at + size_t(y) * size_t(cols);
+    int* w = walk.data() + size_t(y - y0 + 1) * size_t(stride) + 1 - x0;
+    for (int x = x0; x < x1; ++x) w[x] = std::isfinite(d[x]) ? kFree : kBlocked;
+  }
   // Depth first from each unlabelled valid pixel in raster order, its
   // neighbours pushed left, right, up, down: the order of each component's
   // pixels, which decides a footprint gap pixel's source when it is reached
   // from both sides (footprint_sample.h). Each pixel is pushed once
   // and listed once, so both buffers hold at most the roi's pixels.
   struct Pixel {
-    int x, y;
+    int w, i;  // in `walk`, in the image
   };
   const size_t area = size_t(roi.area());
   std::unique_ptr<Pixel[]> stack(new Pixel[area]);
   std::unique_ptr<int[]> listed(new int[area]);
-  for (int y = y0; y < y1; ++y)
+  for (int y = y0; y < y1; ++y) {
+    const int row_w = (y - y0 + 1) * stride + 1 - x0;  // walk index of (x, y) = row_w + x
     for (int x = x0; x < x1; ++x) {
-      const int seed = y * cols + x;
-      if (label_at[seed] >= 0 || !std::isfinite(d_at[seed])) continue;
+      if (walk[size_t(row_w + x)] != kFree) continue;
+      const int seed_w = row_w + x;
       const int label = int(components->size());
-      label_at[seed] = label;
+      walk[size_t(seed_w)] = label;
       size_t top = 0, n = 0;
-      stack[top++] = {x, y};
+      stack[top++] = {seed_w, y * cols + x};
       while (top > 0) {
         const Pixel p = stack[--top];
-        const int i = p.y * cols + p.x;
-        listed[n++] = i;
-        const float d = d_at[i];
-        // Joins neighbour (nx, ny), index j, if unlabelled, valid and near d.
-        auto visit = [&](int nx, int ny, int j) {
-          if (label_at[j] >= 0) return;
-          const float dn = d_at[j];
-          if (!std::isfinite(dn) || std::abs(dn - d) > max_step_px) return;
-          label_at[j] = label;
-          stack[top++] = {nx, ny};
+        listed[n++] = p.i;
+        const float d = d_at[p.i];
+        // Joins the neighbour at walk offset dw, image offset di, if free
+        // and near d.
+        auto visit = [&](int dw, int di) {
+          int& l = walk[size_t(p.w + dw)];
+          if (l != kFree || std::abs(d_at[p.i + di] - d) > max_step_px) return;
+          l = label;
+          stack[top++] = {p.w + dw, p.i + di};
         };
-        if (p.x - 1 >= x0) visit(p.x - 1, p.y, i - 1);
-        if (p.x + 1 < x1) visit(p.x + 1, p.y, i + 1);
-        if (p.y - 1 >= y0) visit(p.x, p.y - 1, i - cols);
-        if (p.y + 1 < y1) visit(p.x, p.y + 1, i + cols);
+        visit(-1, -1);
+        visit(1, 1);
+        visit(-stride, -cols);
+        visit(stride, cols);
       }
       components->emplace_back(listed.get(), listed.get() + n);
     }
+  }
+  // Labels as the image: -1 outside the roi and on invalid pixels.
+  cv::Mat labels(disparity_px.size(), CV_32SC1);
+  for (int y = 0; y < disparity_px.rows; ++y) {
+    int* out = labels.ptr<int>(y);
+    if (y < y0 || y >= y1 || roi.width == 0) {
+      std::fill(out, out + cols, -1);
+      continue;
+    }
+    std::fill(out, out + x0, -1);
+    std::copy_n(walk.data() + size_t(y - y0 + 1) * size_t(stride) + 1, roi.width, out + x0);
+    std::fill(out + x1, out + cols, -1);
+  }
   return labels;
 }
 
@@ -297,6 +323,46 @@ class LineIndexer {
 
 }  // namespace
 
+std::map<std::pair<int, int>, std::vector<float>> SeamDifferences(const cv::Mat& labels, const cv::Mat& disparity_px,
+                                                                   const cv::Mat& slope_x, const cv::Mat& slope_y,
+                                                                   const cv::Rect& roi, int max_gap_px) {
+  STEREORIG_CHECK(labels.type() == CV_32SC1 && disparity_px.type() == CV_32FC1 && labels.size() == disparity_px.size());
+  STEREORIG_CHECK(slope_x.size() == disparity_px.size() && slope_y.size() == disparity_px.size());
+  std::map<std::pair<int, int>, std::vector<float>> seams;
+  // From pixel p (label a) to the next labelled pixel q (label b) along its
+  // row or column, `step` px on: d_q - (d_p + slope_p * step).
+  auto record = [&](int a, int b, float d_p, float d_q, float slope_p, int step) {
+    const float diff = d_q - (d_p + slope_p * step);
+    if (a < b)
+      seams[{a, b}].push_back(diff);
+    else
+      seams[{b, a}].push_back(-diff);
+  };
+  // One raster scan: the last labelled pixel along the current row, and
+  // along each column (its row, -1 = none yet). Each pixel's next labelled
+  // pixel is met once, so each pair is recorded once, whatever the gap.
+  std::vector<int> last_y(size_t(std::max(0, roi.width)), -1);
+  for (int y = roi.y; y < roi.y + roi.height; ++y) {
+    const int* label = labels.ptr<int>(y);
+    const float* d = disparity_px.ptr<float>(y);
+    int last_x = -1;
+    for (int x = roi.x; x < roi.x + roi.width; ++x) {
+      const int b = label[x];
+      if (b < 0) continue;
+      if (last_x >= 0 && x - last_x <= max_gap_px + 1 && label[last_x] != b)
+        record(label[last_x], b, d[last_x], d[x], slope_x.ptr<float>(y)[last_x], x - last_x);
+      last_x = x;
+      int& above = last_y[size_t(x - roi.x)];
+      if (above >= 0 && y - above <= max_gap_px + 1) {
+        const int a = labels.ptr<int>(above)[x];
+        if (a != b) record(a, b, disparity_px.ptr<float>(above)[x], d[x], slope_y.ptr<float>(above)[x], y - above);
+      }
+      above = y;
+    }
+  }
+  return seams;
+}
+
 int CorrectLineIndex(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const LineIndexOptions& o,
                      const RefineAcceptance& accept, DisparityState* state, DisparityComponents* labelled) {
   if (!o.enabled) return 0;
@@ -329,33 +395,8 @@ int JoinAcrossPeriodJumps(const cv::Mat& left, const cv::Mat& right, const cv::R
   labelled->matches_disparity = false;
   const cv::Mat& labels = labelled->labels;
   const std::vector<std::vector<int>>& components = labelled->pixels;
-  // Disparity differences across every seam: from each pixel, the next
-  // valid pixel along its row and along its column, if it is within
-  // o.max_seam_gap_px and in another component, less the first one's
-  // disparity extrapolated along its local plane. Key = (a, b), a < b:
-  // d_b - d_a.
-  std::map<std::pair<int, int>, std::vector<float>> seams;
-  for (int y = roi.y; y < roi.y + roi.height; ++y)
-    for (int x = roi.x; x < roi.x + roi.width; ++x) {
-      const int a = labels.at<int>(y, x);
-      if (a < 0) continue;
-      for (int dir = 0; dir < 2; ++dir) {
-        for (int step = 1; step <= o.max_seam_gap_px + 1; ++step) {
-          const cv::Point q = dir == 0 ? cv::Point(x + step, y) : cv::Point(x, y + step);
-          if (!roi.contains(q)) break;
-          const int b = labels.at<int>(q);
-          if (b < 0) continue;
-          if (b == a) break;
-          const float slope = dir == 0 ? state->slope_x.at<float>(y, x) : state->slope_y.at<float>(y, x);
-          const float diff = state->disparity_px.at<float>(q) - (state->disparity_px.at<float>(y, x) + slope * step);
-          if (a < b)
-            seams[{a, b}].push_back(diff);
-          else
-            seams[{b, a}].push_back(-diff);
-          break;
-        }
-      }
-    }
+  std::map<std::pair<int, int>, std::vector<float>> seams =
+      SeamDifferences(labels, state->disparity_px, state->slope_x, state->slope_y, roi, o.max_seam_gap_px);
   // Longest seams first; each component moves at most once.
   std::vector<std::pair<size_t, std::pair<int, int>>> order;
   for (const auto& [key, diffs] : seams) order.push_back({diffs.size(), key});

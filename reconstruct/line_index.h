@@ -23,7 +23,10 @@
 // dropped (drop_row_offset_px).
 #pragma once
 
+#include <map>
 #include <opencv2/core.hpp>
+#include <utility>
+#include <vector>
 
 #include "reconstruct/disparity_state.h"
 
@@ -99,5 +102,17 @@ int JoinAcrossPeriodJumps(const cv::Mat& left, const cv::Mat& right, const cv::R
 // and the pixels of each component (as y * cols + x).
 cv::Mat LabelDisparityComponents(const cv::Mat& disparity_px, const cv::Rect& roi, double max_step_px,
                                  std::vector<std::vector<int>>* components);
+
+// The disparity differences across the seams between components (labels
+// from LabelDisparityComponents, -1 = none) for JoinAcrossPeriodJumps: from
+// each labelled pixel p to the next labelled pixel q along its row and
+// along its column, if q is at most max_gap_px + 1 px on, inside `roi`, and
+// of another label, d_q - (d_p + slope_p * step) with p's slope along that
+// direction. Key (a, b), a < b: differences as d_b - d_a, in no particular
+// order (the join takes their median and spread). All maps CV_32FC1 except
+// labels (CV_32SC1), one size.
+std::map<std::pair<int, int>, std::vector<float>> SeamDifferences(const cv::Mat& labels, const cv::Mat& disparity_px,
+                                                                   const cv::Mat& slope_x, const cv::Mat& slope_y,
+                                                                   const cv::Rect& roi, int max_gap_px);
 
 }  // namespace stereorig

@@ -96,16 +96,21 @@ cv::Mat PowerTaps(int half, int power, bool along_row) {
 }
 
 // Window sums of image * (u/hw)^i * (v/hh)^j: a row pass (shared by every j)
-// then a column pass. Correlation (OpenCV does not flip kernels): out(x) =
-// sum_u k(u) in(x + u); outside the image counts as 0.
-cv::Mat RowMoment(const cv::Mat& image, int i, int hw) {
+// then a column pass, with the taps of PowerTaps. Correlation (OpenCV does
+// not flip kernels): out(x) = sum_u k(u) in(x + u); outside the image counts
+// as 0.
+cv::Mat RowMoment(const cv::Mat& image, const cv::Mat& taps) {
   cv::Mat out;
-  cv::filter2D(image, out, CV_32F, PowerTaps(hw, i, true), cv::Point(-1, -1), 0, cv::BORDER_CONSTANT);
+  cv::filter2D(image, out, CV_32F, taps, cv::Point(-1, -1), 0, cv::BORDER_CONSTANT);
   return out;
 }
-cv::Mat ColumnMoment(const cv::Mat& row_moment, int j, int hh) {
+// rows: the output rows wanted. Without BORDER_ISOLATED, filter2D reads the
+// rows of `row_moment` around them as they are (0 only beyond its ends), so
+// each output is the sum over the same pixels by the same arithmetic as when
+// every row is filtered.
+cv::Mat ColumnMoment(const cv::Mat& row_moment, const cv::Mat& taps, const cv::Range& rows) {
   cv::Mat out;
-  cv::filter2D(row_moment, out, CV_32F, PowerTaps(hh, j, false), cv::Point(-1, -1), 0, cv::BORDER_CONSTANT);
+  cv::filter2D(row_moment.rowRange(rows), out, CV_32F, taps, cv::Point(-1, -1), 0, cv::BORDER_CONSTANT);
   return out;
 }
 
@@ -132,19 +137,24 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
   // The valid mask, and the disparities relative to their mean (float sums).
   double sum = 0;
   int count = 0;
-  for (int y = 0; y < roi.height; ++y)
+  for (int y = 0; y < roi.height; ++y) {
+    const float* row = d.ptr<float>(y);
     for (int x = 0; x < roi.width; ++x)
-      if (std::isfinite(d.at<float>(y, x))) sum += d.at<float>(y, x), ++count;
+      if (std::isfinite(row[x])) sum += row[x], ++count;
+  }
   if (count == 0) return 0;
   const float mean = float(sum / count);
   cv::Mat mask(roi.size(), CV_32F, cv::Scalar(0)), values(roi.size(), CV_32F, cv::Scalar(0));
-  for (int y = 0; y < roi.height; ++y)
+  for (int y = 0; y < roi.height; ++y) {
+    const float* row = d.ptr<float>(y);
+    float* valid = mask.ptr<float>(y);
+    float* value = values.ptr<float>(y);
     for (int x = 0; x < roi.width; ++x) {
-      const float v = d.at<float>(y, x);
-      if (!std::isfinite(v)) continue;
-      mask.at<float>(y, x) = 1;
-      values.at<float>(y, x) = v - mean;
+      if (!std::isfinite(row[x])) continue;
+      valid[x] = 1;
+      value[x] = row[x] - mean;
     }
+  }
   Factor6 full_factor;
   STEREORIG_CHECK(Factor(FullWindowMatrix(hw, hh), &full_factor));
   const int full_count = (2 * hw + 1) * (2 * hh + 1);
@@ -155,39 +165,46 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
   // Window sums: the mask's moments up to degree 4 (the normal matrix:
   // moment[i][j] = sum of mask (u/hw)^i (v/hh)^j), the values' up to degree
   // 2 (the right-hand side), and the values' squares (the misfit). In bands
-  // of kBandRows output rows: the 22 moment images exist for one band and
-  // its hh-row margins at a time (over the whole ROI they were 30 MB per
-  // module on the demo plate, live while the other module matched). A row
-  // filter reads only its own row, and the column filters' output rows kept
-  // have their whole window inside the band's input rows, so every sum
+  // of kBandRows output rows: the 22 moment images exist for one band at a
+  // time (the row sums with its hh-row margins; over the whole ROI they were
+  // 30 MB per module on the demo plate, live while the other module
+  // matched). A row filter reads only its own row, and the column filters'
+  // output rows have their whole window inside the band's input rows
+  // (ColumnMoment), so every sum
   // comes from the same pixels by the same arithmetic as over the whole ROI
   // (filter2D stays direct, not DFT, below ~130 taps; Check() keeps the
   // half widths <= 30, so kernels have <= 61 taps).
   constexpr int kBandRows = 128;
+  cv::Mat row_taps[5], column_taps[5];
+  for (int i = 0; i <= 4; ++i) row_taps[i] = PowerTaps(hw, i, true), column_taps[i] = PowerTaps(hh, i, false);
   for (int y0 = 0; y0 < roi.height; y0 += kBandRows) {
     const int y1 = std::min(roi.height, y0 + kBandRows);
     const int in0 = std::max(0, y0 - hh), in1 = std::min(roi.height, y1 + hh);  // the band's input rows
     const cv::Mat band_mask = mask.rowRange(in0, in1), band_values = values.rowRange(in0, in1);
     cv::Mat moment[5][5], value_moment[3][3];
+    // Only the band's own rows of the column sums (not its margins).
+    const cv::Range out_rows(y0 - in0, y1 - in0);
     for (int i = 0; i <= 4; ++i) {
-      const cv::Mat row = RowMoment(band_mask, i, hw);
-      for (int j = 0; i + j <= 4; ++j) moment[i][j] = ColumnMoment(row, j, hh);
+      const cv::Mat row = RowMoment(band_mask, row_taps[i]);
+      for (int j = 0; i + j <= 4; ++j) moment[i][j] = ColumnMoment(row, column_taps[j], out_rows);
     }
     for (int i = 0; i <= 2; ++i) {
-      const cv::Mat row = RowMoment(band_values, i, hw);
-      for (int j = 0; i + j <= 2; ++j) value_moment[i][j] = ColumnMoment(row, j, hh);
+      const cv::Mat row = RowMoment(band_values, row_taps[i]);
+      for (int j = 0; i + j <= 2; ++j) value_moment[i][j] = ColumnMoment(row, column_taps[j], out_rows);
     }
-    const cv::Mat squares = ColumnMoment(RowMoment(band_values.mul(band_values), 0, hw), 0, hh);
+    const cv::Mat squares = ColumnMoment(RowMoment(band_values.mul(band_values), row_taps[0]), column_taps[0], out_rows);
     ParallelForChunks(y1 - y0, num_threads, [&](int b, int e) {
       for (int y = y0 + b; y < y0 + e; ++y) {
         const float* valid = mask.ptr<float>(y);
         const float* m[5][5];
         const float* r[3][3];
         for (int i = 0; i <= 4; ++i)
-          for (int j = 0; i + j <= 4; ++j) m[i][j] = moment[i][j].ptr<float>(y - in0);
+          for (int j = 0; i + j <= 4; ++j) m[i][j] = moment[i][j].ptr<float>(y - y0);
         for (int i = 0; i <= 2; ++i)
-          for (int j = 0; i + j <= 2; ++j) r[i][j] = value_moment[i][j].ptr<float>(y - in0);
-        const float* sq = squares.ptr<float>(y - in0);
+          for (int j = 0; i + j <= 2; ++j) r[i][j] = value_moment[i][j].ptr<float>(y - y0);
+        const float* sq = squares.ptr<float>(y - y0);
+        float* fitted_row = fitted.ptr<float>(y);
+        float* misfit_row = misfit.ptr<float>(y);
         for (int x = 0; x < roi.width; ++x) {
           if (!(valid[x] > 0)) continue;
           const double n = m[0][0][x];
@@ -206,16 +223,18 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
             if (!(CentreVariance(factor) <= max_variance)) continue;
             SolveCentre(factor, rhs, &centre, &fit_sum);
           }
-          fitted.at<float>(y, x) = float(centre);
-          misfit.at<float>(y, x) = float(std::sqrt(std::max(0.0, sq[x] - fit_sum) / (n - kTerms)));
+          fitted_row[x] = float(centre);
+          misfit_row[x] = float(std::sqrt(std::max(0.0, sq[x] - fit_sum) / (n - kTerms)));
         }
       }
     });
   }
   std::vector<float> misfits;
-  for (int y = 0; y < roi.height; ++y)
+  for (int y = 0; y < roi.height; ++y) {
+    const float* row = misfit.ptr<float>(y);
     for (int x = 0; x < roi.width; ++x)
-      if (std::isfinite(misfit.at<float>(y, x))) misfits.push_back(misfit.at<float>(y, x));
+      if (std::isfinite(row[x])) misfits.push_back(row[x]);
+  }
   if (misfits.empty()) return 0;
   std::nth_element(misfits.begin(), misfits.begin() + misfits.size() / 2, misfits.end());
   // Never below 0.05 px (a fifth of the simulator's speckle scatter): on a
@@ -223,12 +242,16 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
   // windows would fail a gate of twice that.
   const double max_misfit = std::max(0.05, o.max_misfit_ratio * misfits[misfits.size() / 2]);
   int replaced = 0;
-  for (int y = 0; y < roi.height; ++y)
+  for (int y = 0; y < roi.height; ++y) {
+    const float* misfit_row = misfit.ptr<float>(y);
+    const float* fitted_row = fitted.ptr<float>(y);
+    float* row = d.ptr<float>(y);
     for (int x = 0; x < roi.width; ++x)
-      if (misfit.at<float>(y, x) <= max_misfit) {
-        d.at<float>(y, x) = fitted.at<float>(y, x) + mean;
+      if (misfit_row[x] <= max_misfit) {
+        row[x] = fitted_row[x] + mean;
         ++replaced;
       }
+  }
   return replaced;
 }
 

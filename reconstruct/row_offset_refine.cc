@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "reconstruct/row_offset_sums.h"
 #include "reconstruct/subpixel_refine.h"
 #include "reconstruct/subpixel_window.h"
 
@@ -73,18 +74,9 @@ RowOffsetResult RefineDisparityAndRowOffset(const cv::Mat& left, const cv::Mat& 
     }
     // J = de/d(d, dy, gain, offset) = (gain rx, -gain ry, -r, -1): the
     // sums of r x, r y, r over the samples give J^T J and J^T e.
-    double sxx = 0, sxy = 0, sxr = 0, sx = 0, syy = 0, syr = 0, sy = 0, srr = 0, sr = 0;
-    double sxe = 0, sye = 0, sre = 0, se = 0, slr = 0;
-    for (int s = 0; s < nwin; ++s) {
-      double r = 0, rx = 0, ry = 0;
-      for (int k = 0; k < 4; ++k) r += w[k] * rk[k][s], rx += w[k] * gk[k][s], ry += dw[k] * rk[k][s];
-      const double e = l[s] - gain * r - offset;
-      sxx += rx * rx, sxy += rx * ry, sxr += rx * r, sx += rx;
-      syy += ry * ry, syr += ry * r, sy += ry;
-      srr += r * r, sr += r;
-      sxe += rx * e, sye += ry * e, sre += r * e, se += e;
-      slr += l[s] * r;
-    }
+    const RowOffsetSums t = RowOffsetPassSums(l, rk, gk, w, dw, gain, offset, nwin);
+    const double sxx = t.sxx, sxy = t.sxy, sxr = t.sxr, sx = t.sx, syy = t.syy, syr = t.syr, sy = t.sy;
+    const double srr = t.srr, sr = t.sr, sxe = t.sxe, sye = t.sye, sre = t.sre, se = t.se, slr = t.slr;
     rs = sr, rs2 = srr, lr = slr;
     const double a = gain;
     Eigen::Matrix4d jtj;
