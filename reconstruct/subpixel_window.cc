@@ -39,7 +39,9 @@ SubpixelWindow::SubpixelWindow(const cv::Mat& left, const cv::Mat& right, int x,
   }
 }
 
-FitPassSums SubpixelWindow::FitPass(double d, float gain, float offset) const {
+// The AVX2 pass inlined here: its caller (RefineDisparity) is in another
+// file, and a second call per pass cost ~8 instructions.
+[[gnu::flatten]] FitPassSums SubpixelWindow::FitPass(double d, float gain, float offset) const {
 #if defined(__AVX2__)
   if (vector_) return FitPassAvx2(d, gain, offset);
 #endif
@@ -58,6 +60,13 @@ double SubpixelWindow::Zncc(double d) const {
   if (vector_) return ZnccAvx2(d);
 #endif
   return ZnccPortable(d);
+}
+
+void SubpixelWindow::ZnccPair(double d0, double d1, double zncc[2]) const {
+#if defined(__AVX2__)
+  if (vector_) return ZnccPairAvx2(d0, d1, zncc);
+#endif
+  zncc[0] = ZnccPortable(d0), zncc[1] = ZnccPortable(d1);
 }
 
 FitPassSums SubpixelWindow::FitPassPortable(double d, float gain, float offset) const {
@@ -137,8 +146,13 @@ WindowZnccProbe::WindowZnccProbe(const SubpixelWindow& window, double slope_x, d
 }
 
 double WindowZnccProbe::At(double d) const {
-  if (!window_ || x_ - d - reach_px_ < 0 || x_ - d + reach_px_ >= right_cols_) return -1;
+  if (!Inside(d)) return -1;
   return window_->Zncc(d);
+}
+
+void WindowZnccProbe::AtPair(double d0, double d1, double zncc[2]) const {
+  if (Inside(d0) && Inside(d1)) return window_->ZnccPair(d0, d1, zncc);
+  zncc[0] = At(d0), zncc[1] = At(d1);
 }
 
 #if defined(__AVX2__)
@@ -149,6 +163,7 @@ namespace {
 // for every window of a run (options and image steps are fixed), so each
 // thread keeps the last one.
 struct WindowLanes {
+  const LanczosTable* table = nullptr;  // LanczosTapTable(): here so a window need not look it up (a call, a guard)
   int hw = -1, hh = -1;
   size_t left_step = 0, right_step = 0;
   alignas(32) float u[SubpixelWindow::kMaxVectorSamples], v[SubpixelWindow::kMaxVectorSamples];
@@ -159,6 +174,7 @@ const WindowLanes& LanesFor(int hw, int hh, size_t left_step, size_t right_step)
   thread_local WindowLanes lanes;
   if (lanes.hw == hw && lanes.hh == hh && lanes.left_step == left_step && lanes.right_step == right_step) return lanes;
   lanes.hw = hw, lanes.hh = hh, lanes.left_step = left_step, lanes.right_step = right_step;
+  lanes.table = &LanczosTapTable();
   int s = 0;
   for (int v = -hh; v <= hh; ++v)
     for (int u = -hw; u <= hw; ++u, ++s) {
@@ -197,6 +213,7 @@ inline __m256 LeadingMask(int valid) {
 
 void SubpixelWindow::SetUpLanes() {
   const WindowLanes& lanes = LanesFor(hw_, hh_, left_.step[0], right_.step[0]);
+  table_ = lanes.table;
   const uint8_t* centre = left_.ptr<uint8_t>(y_) + x_;
   // A 4-byte gather reads up to 3 bytes past a sample: not past the last
   // row's end.
@@ -234,8 +251,9 @@ namespace {
 // The Lanczos values r and slopes g of the first `valid` (1..8) of 8
 // samples at right columns base + offset[k] of the rows at byte offsets
 // row[k] + row_shift from `right`; the other lanes' are 0.
-// `table`: LanczosTapTable(), looked up once per pass by the caller (a
-// function-local static's guard per chunk cost ~8 % of the pass).
+// `table`: LanczosTapTable(), looked up once per thread (WindowLanes; a
+// function-local static's guard and call per chunk cost ~8 % of the pass,
+// once per pass still ~3 %).
 // The columns and table entries are handed to the scalar loads as unsigned
 // 32-bit (both are >= 0: the caller checks the reach), which the
 // extraction zero-extends for free, and an entry as its byte offset: no
@@ -277,7 +295,7 @@ inline void SampleChunk(const uint8_t* right, const LanczosTable& table, __m256 
 FitPassSums SubpixelWindow::FitPassAvx2(double d, float gain, float offset) const {
   const __m256 base = _mm256_set1_ps(float(x_ - d));
   const __m256 vgain = _mm256_set1_ps(gain), voffset = _mm256_set1_ps(offset);
-  const LanczosTable& table = LanczosTapTable();
+  const LanczosTable& table = *table_;
   __m256 sgg = _mm256_setzero_ps(), sgr = sgg, sg = sgg, srr = sgg, sr = sgg, sge = sgg, sre = sgg, se = sgg, slr = sgg;
   auto accumulate = [&](__m256 r, __m256 g, __m256 e, __m256 l) {
     sgg = _mm256_fmadd_ps(g, g, sgg), sgr = _mm256_fmadd_ps(g, r, sgr), sg = _mm256_add_ps(sg, g);
@@ -308,7 +326,7 @@ FitPassSums SubpixelWindow::FitPassAvx2(double d, float gain, float offset) cons
 void SubpixelWindow::SampleAvx2(double d, int row_shift, float* r, float* g) const {
   const __m256 base = _mm256_set1_ps(float(x_ - d));
   const int32_t shift = int32_t(row_shift * int64_t(right_.step[0]));
-  const LanczosTable& table = LanczosTapTable();
+  const LanczosTable& table = *table_;
   for (int c = 0; c < n_; c += 8) {
     __m256 rc, gc;
     SampleChunk(right_.data, table, base, offset_ + c, row_ + c, shift, 8, &rc, &gc);
@@ -316,28 +334,55 @@ void SubpixelWindow::SampleAvx2(double d, int row_shift, float* r, float* g) con
   }
 }
 
-double SubpixelWindow::ZnccAvx2(double d) const {
-  const __m256 base = _mm256_set1_ps(float(x_ - d));
+namespace {
+
+// The linearly interpolated right values r of chunk c (8 samples from c;
+// lanes past n are 0) at `base` = x - d, summed into rs, rs2 and lr (with
+// the left values l).
+inline void ZnccChunk(const uint8_t* right, __m256 base, const float* offset, const int32_t* row, const float* l,
+                      int valid, __m256* rs, __m256* rs2, __m256* lr) {
   const __m256i low_byte = _mm256_set1_epi32(0xFF);
-  __m256 rs = _mm256_setzero_ps(), rs2 = rs, lr = rs;
-  for (int c = 0; c < n_; c += 8) {
-    const __m256 xr = _mm256_add_ps(base, _mm256_load_ps(offset_ + c));
-    const __m256i i0 = _mm256_cvttps_epi32(xr);
-    const __m256 t = _mm256_sub_ps(xr, _mm256_cvtepi32_ps(i0));
-    // Bytes i0 .. i0+3 of each sample's row: i0 and i0+1 are the two taps.
-    const __m256i col = _mm256_add_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(row_ + c)), i0);
-    const __m256i q = _mm256_i32gather_epi32(reinterpret_cast<const int*>(right_.data), col, 1);
-    const __m256 p0 = _mm256_cvtepi32_ps(_mm256_and_si256(q, low_byte));
-    const __m256 p1 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(q, 8), low_byte));
-    __m256 r = _mm256_fmadd_ps(t, _mm256_sub_ps(p1, p0), p0);
-    if (c + 8 > n_) r = _mm256_and_ps(r, LeadingMask(n_ - c));
-    rs = _mm256_add_ps(rs, r), rs2 = _mm256_fmadd_ps(r, r, rs2);
-    lr = _mm256_fmadd_ps(_mm256_load_ps(l_ + c), r, lr);
-  }
-  const double n = n_, ls = double(lsum_) / n, mean_r = HorizontalSum(rs) / n;
-  const double lv = double(lsum2_) / n - ls * ls, rv = HorizontalSum(rs2) / n - mean_r * mean_r;
+  const __m256 xr = _mm256_add_ps(base, _mm256_load_ps(offset));
+  const __m256i i0 = _mm256_cvttps_epi32(xr);
+  const __m256 t = _mm256_sub_ps(xr, _mm256_cvtepi32_ps(i0));
+  // Bytes i0 .. i0+3 of each sample's row: i0 and i0+1 are the two taps.
+  const __m256i col = _mm256_add_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(row)), i0);
+  const __m256i q = _mm256_i32gather_epi32(reinterpret_cast<const int*>(right), col, 1);
+  const __m256 p0 = _mm256_cvtepi32_ps(_mm256_and_si256(q, low_byte));
+  const __m256 p1 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(q, 8), low_byte));
+  __m256 r = _mm256_fmadd_ps(t, _mm256_sub_ps(p1, p0), p0);
+  if (valid < 8) r = _mm256_and_ps(r, LeadingMask(valid));
+  *rs = _mm256_add_ps(*rs, r), *rs2 = _mm256_fmadd_ps(r, r, *rs2);
+  *lr = _mm256_fmadd_ps(_mm256_load_ps(l), r, *lr);
+}
+
+// The ZNCC from the window's sums: n samples, the left sums (exact) and
+// the right ones.
+inline double ZnccOfSums(int samples, int64_t lsum, int64_t lsum2, __m256 rs, __m256 rs2, __m256 lr) {
+  const double n = samples, ls = double(lsum) / n, mean_r = HorizontalSum(rs) / n;
+  const double lv = double(lsum2) / n - ls * ls, rv = HorizontalSum(rs2) / n - mean_r * mean_r;
   if (!(lv > 0 && rv > 0)) return -1;
   return (HorizontalSum(lr) / n - ls * mean_r) / std::sqrt(lv * rv);
+}
+
+}  // namespace
+
+double SubpixelWindow::ZnccAvx2(double d) const {
+  const __m256 base = _mm256_set1_ps(float(x_ - d));
+  __m256 rs = _mm256_setzero_ps(), rs2 = rs, lr = rs;
+  for (int c = 0; c < n_; c += 8) ZnccChunk(right_.data, base, offset_ + c, row_ + c, l_ + c, n_ - c, &rs, &rs2, &lr);
+  return ZnccOfSums(n_, lsum_, lsum2_, rs, rs2, lr);
+}
+
+void SubpixelWindow::ZnccPairAvx2(double d0, double d1, double zncc[2]) const {
+  const __m256 base0 = _mm256_set1_ps(float(x_ - d0)), base1 = _mm256_set1_ps(float(x_ - d1));
+  __m256 rs0 = _mm256_setzero_ps(), rs20 = rs0, lr0 = rs0, rs1 = rs0, rs21 = rs0, lr1 = rs0;
+  for (int c = 0; c < n_; c += 8) {
+    ZnccChunk(right_.data, base0, offset_ + c, row_ + c, l_ + c, n_ - c, &rs0, &rs20, &lr0);
+    ZnccChunk(right_.data, base1, offset_ + c, row_ + c, l_ + c, n_ - c, &rs1, &rs21, &lr1);
+  }
+  zncc[0] = ZnccOfSums(n_, lsum_, lsum2_, rs0, rs20, lr0);
+  zncc[1] = ZnccOfSums(n_, lsum_, lsum2_, rs1, rs21, lr1);
 }
 #endif  // __AVX2__
 
