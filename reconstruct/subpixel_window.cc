@@ -196,6 +196,14 @@ inline __m256 TransposeSum8(const __m256 a[8]) {
   return _mm256_add_ps(_mm256_permute2f128_ps(q0, q1, 0x20), _mm256_permute2f128_ps(q0, q1, 0x31));
 }
 
+// TransposeSum8 of a[0..3] and four zero vectors, without summing the
+// zeros: lane k < 4 the sum of the 8 lanes of a[k], in the same order (so
+// the same float), lanes 4..7 zero. For a last chunk of at most 4 samples.
+inline __m256 TransposeSum4(const __m256 a[4]) {
+  const __m256 q0 = _mm256_hadd_ps(_mm256_hadd_ps(a[0], a[1]), _mm256_hadd_ps(a[2], a[3]));
+  return _mm256_zextps128_ps256(_mm_add_ps(_mm256_castps256_ps128(q0), _mm256_extractf128_ps(q0, 1)));
+}
+
 // The sum of the 8 lanes, in double.
 inline double HorizontalSum(__m256 a) {
   const __m128 s4 = _mm_add_ps(_mm256_castps256_ps128(a), _mm256_extractf128_ps(a, 1));
@@ -221,7 +229,8 @@ void SubpixelWindow::SetUpLanes() {
   const __m256 stride = _mm256_set1_ps(stride_), minus_gy = _mm256_set1_ps(float(-slope_y_));
   const __m256i right_centre = _mm256_set1_epi32(int32_t(y_ * right_.step[0])), low_byte = _mm256_set1_epi32(0xFF);
   __m256 ls = _mm256_setzero_ps(), ls2 = ls;
-  for (int c = 0; c < n_; c += 8) {
+  const int n = n_;  // held: the stores below may alias n_ for the compiler, which then reloads it per chunk
+  for (int c = 0; c < n; c += 8) {
     const __m256i left_offset = _mm256_load_si256(reinterpret_cast<const __m256i*>(lanes.left_offset + c));
     __m256 l;
     if (gather) {
@@ -232,7 +241,7 @@ void SubpixelWindow::SetUpLanes() {
       for (int k = 0; k < 8; ++k) values[k] = centre[lanes.left_offset[c + k]];
       l = _mm256_load_ps(values);
     }
-    if (c + 8 > n_) l = _mm256_and_ps(l, LeadingMask(n_ - c));
+    if (c + 8 > n) l = _mm256_and_ps(l, LeadingMask(n - c));
     _mm256_store_ps(l_ + c, l);
     ls = _mm256_add_ps(ls, l), ls2 = _mm256_fmadd_ps(l, l, ls2);
     // u (1 - gx) - gy v: to float precision (~1e-6 px), as the positions.
@@ -259,8 +268,12 @@ namespace {
 // extraction zero-extends for free, and an entry as its byte offset: no
 // sign extension or scaling per sample (~25 of a chunk's ~140
 // instructions).
+// kLanes: 8, or 4 where valid <= 4 (a window's last chunk, e.g. 3 of the
+// 9x3 window's 27 samples): the sums of only 4 samples' products.
+template <int kLanes>
 inline void SampleChunk(const uint8_t* right, const LanczosTable& table, __m256 base, const float* offset,
                         const int32_t* row, int32_t row_shift, int valid, __m256* r, __m256* g) {
+  static_assert(kLanes == 8 || kLanes == 4);
   static_assert(sizeof(LanczosTaps) == 64);
   const __m256 xr = _mm256_add_ps(base, _mm256_load_ps(offset));
   const __m256i i0 = _mm256_cvttps_epi32(xr);
@@ -274,8 +287,8 @@ inline void SampleChunk(const uint8_t* right, const LanczosTable& table, __m256 
       _mm256_slli_epi32(
           _mm256_cvttps_epi32(_mm256_fmadd_ps(frac, _mm256_set1_ps(float(kLanczosSteps)), _mm256_set1_ps(0.5f))), 6));
   const uint8_t* table_bytes = reinterpret_cast<const uint8_t*>(table.data());
-  __m256 wp[8], gp[8];
-  for (int k = 0; k < 8; ++k) {
+  __m256 wp[kLanes], gp[kLanes];
+  for (int k = 0; k < kLanes; ++k) {
     if (k >= valid) {  // padding: no sample (the last chunk only)
       wp[k] = gp[k] = _mm256_setzero_ps();
       continue;
@@ -287,7 +300,11 @@ inline void SampleChunk(const uint8_t* right, const LanczosTable& table, __m256 
     wp[k] = _mm256_mul_ps(_mm256_load_ps(t.w), p);
     gp[k] = _mm256_mul_ps(_mm256_load_ps(t.g), p);
   }
-  *r = TransposeSum8(wp), *g = TransposeSum8(gp);
+  if constexpr (kLanes == 8) {
+    *r = TransposeSum8(wp), *g = TransposeSum8(gp);
+  } else {
+    *r = TransposeSum4(wp), *g = TransposeSum4(gp);
+  }
 }
 
 }  // namespace
@@ -306,13 +323,17 @@ FitPassSums SubpixelWindow::FitPassAvx2(double d, float gain, float offset) cons
   int c = 0;
   for (; c + 8 <= n_; c += 8) {
     __m256 r, g;
-    SampleChunk(right_.data, table, base, offset_ + c, row_ + c, 0, 8, &r, &g);
+    SampleChunk<8>(right_.data, table, base, offset_ + c, row_ + c, 0, 8, &r, &g);
     const __m256 l = _mm256_load_ps(l_ + c);
     accumulate(r, g, _mm256_sub_ps(_mm256_fnmadd_ps(vgain, r, l), voffset), l);
   }
   if (c < n_) {  // the padded chunk: r, g are 0 in its padding lanes, e is masked there
     __m256 r, g;
-    SampleChunk(right_.data, table, base, offset_ + c, row_ + c, 0, n_ - c, &r, &g);
+    if (n_ - c <= 4) {
+      SampleChunk<4>(right_.data, table, base, offset_ + c, row_ + c, 0, n_ - c, &r, &g);
+    } else {
+      SampleChunk<8>(right_.data, table, base, offset_ + c, row_ + c, 0, n_ - c, &r, &g);
+    }
     const __m256 l = _mm256_load_ps(l_ + c);
     const __m256 e = _mm256_and_ps(_mm256_sub_ps(_mm256_fnmadd_ps(vgain, r, l), voffset), LeadingMask(n_ - c));
     accumulate(r, g, e, l);
@@ -329,7 +350,7 @@ void SubpixelWindow::SampleAvx2(double d, int row_shift, float* r, float* g) con
   const LanczosTable& table = *table_;
   for (int c = 0; c < n_; c += 8) {
     __m256 rc, gc;
-    SampleChunk(right_.data, table, base, offset_ + c, row_ + c, shift, 8, &rc, &gc);
+    SampleChunk<8>(right_.data, table, base, offset_ + c, row_ + c, shift, 8, &rc, &gc);
     _mm256_storeu_ps(r + c, rc), _mm256_storeu_ps(g + c, gc);
   }
 }

@@ -264,7 +264,9 @@ TEST(SubpixelWindow, RefineAndAcceptEqualsThePlainFitAndDistinctnessTest) {
 TEST(SubpixelWindow, FastSumsEqualPortableSums) {
   SyntheticPairSpec spec;
   const SyntheticPair pair = RenderSyntheticPair(spec);
-  for (const int half_height : {1, 3}) {  // 27 samples (3 of 8 padded) and 63
+  // 9, 27, 45 and 63 samples: last chunks of 1, 3 (summed 4 wide), 5 and
+  // 7 (8 wide) samples.
+  for (const int half_height : {0, 1, 2, 3}) {
     SubpixelOptions o;
     o.half_height_px = half_height;
     double max_step = 0, max_dz = 0;
