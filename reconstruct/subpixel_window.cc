@@ -170,22 +170,28 @@ struct WindowLanes {
   alignas(32) int32_t left_offset[SubpixelWindow::kMaxVectorSamples], right_row[SubpixelWindow::kMaxVectorSamples];
 };
 
-const WindowLanes& LanesFor(int hw, int hh, size_t left_step, size_t right_step) {
-  thread_local WindowLanes lanes;
-  if (lanes.hw == hw && lanes.hh == hh && lanes.left_step == left_step && lanes.right_step == right_step) return lanes;
-  lanes.hw = hw, lanes.hh = hh, lanes.left_step = left_step, lanes.right_step = right_step;
-  lanes.table = &LanczosTapTable();
+// Fills *lanes for this shape. Out of line: inlined, its loops cost
+// SetUpLanes's every call registers and stack it otherwise does not need.
+[[gnu::noinline]] void BuildLanes(int hw, int hh, size_t left_step, size_t right_step, WindowLanes* lanes) {
+  lanes->hw = hw, lanes->hh = hh, lanes->left_step = left_step, lanes->right_step = right_step;
+  lanes->table = &LanczosTapTable();
   int s = 0;
   for (int v = -hh; v <= hh; ++v)
     for (int u = -hw; u <= hw; ++u, ++s) {
-      lanes.u[s] = float(u), lanes.v[s] = float(v);
-      lanes.left_offset[s] = int32_t(v * int64_t(left_step) + u);
-      lanes.right_row[s] = int32_t(v * int64_t(right_step));
+      lanes->u[s] = float(u), lanes->v[s] = float(v);
+      lanes->left_offset[s] = int32_t(v * int64_t(left_step) + u);
+      lanes->right_row[s] = int32_t(v * int64_t(right_step));
     }
   for (; s % 8 != 0; ++s) {  // padding: copies of the centre sample
-    lanes.u[s] = lanes.v[s] = 0;
-    lanes.left_offset[s] = lanes.right_row[s] = 0;
+    lanes->u[s] = lanes->v[s] = 0;
+    lanes->left_offset[s] = lanes->right_row[s] = 0;
   }
+}
+
+const WindowLanes& LanesFor(int hw, int hh, size_t left_step, size_t right_step) {
+  thread_local WindowLanes lanes;
+  if (lanes.hw != hw || lanes.hh != hh || lanes.left_step != left_step || lanes.right_step != right_step)
+    BuildLanes(hw, hh, left_step, right_step, &lanes);
   return lanes;
 }
 
