@@ -53,6 +53,19 @@ class SubpixelWindow {
                  const SubpixelOptions& o, WindowKernel kernel = WindowKernel::kFastest);
 
   int size() const { return n_; }  // samples, (2 hw + 1)(2 hh + 1)
+  // The AVX2 path's flattened samples, for a caller that inlines the pass
+  // (subpixel_window_avx2.h). Valid while the window lives, on is_vector()
+  // windows only.
+  struct VectorView {
+    const uint8_t* right;  // right.data
+    const LanczosTable* table;
+    int x, n;  // the window's centre column and its samples
+    const float* l;  // the padded arrays below
+    const float* offset;
+    const int32_t* row;
+  };
+  bool is_vector() const { return vector_; }
+  VectorView vector_view() const { return {right_.data, table_, x_, n_, l_, offset_, row_}; }
   WindowKernel kernel() const { return kernel_; }  // as constructed
   // Sums of the left values and their squares over the window (exact).
   int64_t left_sum() const { return lsum_; }
