@@ -58,7 +58,7 @@ SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x,
   // column of margin more keeps float rounding of the positions inside.
   const bool margin = x - start_px - reach >= 1;
   const SubpixelWindow& window = window_out->emplace(left, right, x, y, slope_x, slope_y, o,
-                                                    margin ? WindowKernel::kFastest : WindowKernel::kPortable);
+                                                     margin ? WindowKernel::kFastest : WindowKernel::kPortable);
   const int nwin = window.size();
   const double lmean = double(window.left_sum()) / nwin;
   result.std_dn = std::sqrt(std::max(0.0, double(window.left_sum2()) / nwin - lmean * lmean));

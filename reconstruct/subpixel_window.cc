@@ -41,8 +41,8 @@ SubpixelWindow::SubpixelWindow(const cv::Mat& left, const cv::Mat& right, int x,
   }
 }
 
-// The AVX2 pass inlined here: its caller (RefineDisparity) is in another
-// file, and a second call per pass cost ~8 instructions.
+// The AVX2 pass inlined here, for the callers that do not inline it
+// themselves (RefineDisparity does: subpixel_window_avx2.h).
 [[gnu::flatten]] FitPassSums SubpixelWindow::FitPass(double d, float gain, float offset) const {
 #if defined(__AVX2__)
   if (vector_) return FitPassAvx2(d, gain, offset);
@@ -141,8 +141,7 @@ WindowZnccProbe::WindowZnccProbe(const cv::Mat& left, const cv::Mat& right, int 
   window_ = &*own_;
 }
 
-WindowZnccProbe::WindowZnccProbe(const SubpixelWindow& window, double slope_x, double slope_y,
-                                 const SubpixelOptions& o)
+WindowZnccProbe::WindowZnccProbe(const SubpixelWindow& window, double slope_x, double slope_y, const SubpixelOptions& o)
     : x_(window.x_), right_cols_(window.right_.cols), reach_px_(ZnccReachPx(slope_x, slope_y, o)), window_(&window) {
   STEREORIG_CHECK(window.kernel() == WindowKernel::kFastest);
 }
@@ -234,7 +233,6 @@ void SubpixelWindow::SetUpLanes() {
   // Integers below 2^24 (64 samples of at most 255^2): exact in float.
   lsum_ = int64_t(HorizontalSum(ls)), lsum2_ = int64_t(HorizontalSum(ls2));
 }
-
 
 FitPassSums SubpixelWindow::FitPassAvx2(double d, float gain, float offset) const {
   return FitPassVector(vector_view(), d, gain, offset);

@@ -59,7 +59,7 @@ class SubpixelWindow {
   struct VectorView {
     const uint8_t* right;  // right.data
     const LanczosTable* table;
-    int x, n;  // the window's centre column and its samples
+    int x, n;        // the window's centre column and its samples
     const float* l;  // the padded arrays below
     const float* offset;
     const int32_t* row;
@@ -117,7 +117,7 @@ class SubpixelWindow {
   alignas(32) float l_[kMaxVectorSamples];       // left values
   alignas(32) float offset_[kMaxVectorSamples];  // right column minus (x - d): u (1 - gx) - gy v
   alignas(32) int32_t row_[kMaxVectorSamples];   // byte offset of the right row from right.data
-  const LanczosTable* table_;                    // LanczosTapTable(), held so a pass need not look it up
+  const LanczosTable* table_ = nullptr;          // LanczosTapTable(), held so a pass need not look it up
 };
 
 // Room for one SubpixelWindow, set up or not: std::optional's role, without
@@ -176,8 +176,8 @@ class WindowZnccProbe {
   int x_, right_cols_;
   bool Inside(double d) const { return window_ && x_ - d - reach_px_ >= 0 && x_ - d + reach_px_ < right_cols_; }
 
-  double reach_px_;                        // the right window's extent about x - d, with the taps' margin
-  WindowSlot own_;                         // set up by the first constructor, if inside the left image
+  double reach_px_;                         // the right window's extent about x - d, with the taps' margin
+  WindowSlot own_;                          // set up by the first constructor, if inside the left image
   const SubpixelWindow* window_ = nullptr;  // own_ or the caller's; null if the left window leaves the image
 };
 

@@ -102,7 +102,6 @@ inline void SampleChunk(const uint8_t* right, const LanczosTable& table, __m256 
   }
 }
 
-
 // SubpixelWindow::FitPass of a window on the AVX2 path (is_vector()).
 inline FitPassSums FitPassVector(const SubpixelWindow::VectorView& w, double d, float gain, float offset) {
   const __m256 base = _mm256_set1_ps(float(w.x - d));
