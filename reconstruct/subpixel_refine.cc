@@ -6,6 +6,9 @@
 
 #include "calib/core/input_error.h"
 #include "reconstruct/subpixel_window.h"
+#if defined(__AVX2__)
+#include "reconstruct/subpixel_window_avx2.h"  // the pass inlined into the Gauss-Newton loop
+#endif
 
 namespace stereorig {
 
@@ -55,7 +58,7 @@ SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x,
   // column of margin more keeps float rounding of the positions inside.
   const bool margin = x - start_px - reach >= 1;
   const SubpixelWindow& window = window_out->emplace(left, right, x, y, slope_x, slope_y, o,
-                                                    margin ? WindowKernel::kFastest : WindowKernel::kPortable);
+                                                     margin ? WindowKernel::kFastest : WindowKernel::kPortable);
   const int nwin = window.size();
   const double lmean = double(window.left_sum()) / nwin;
   result.std_dn = std::sqrt(std::max(0.0, double(window.left_sum2()) / nwin - lmean * lmean));
@@ -68,7 +71,12 @@ SubpixelResult RefineDisparity(const cv::Mat& left, const cv::Mat& right, int x,
   FitPassSums s;           // of the last pass, for the ZNCC
   double variance_dd = 0;  // (J^T J)^-1 [d, d] times the residual variance, of the last pass
   for (int it = 0; it < o.max_iterations; ++it) {
+#if defined(__AVX2__)
+    s = window.is_vector() ? FitPassVector(window.vector_view(), d, float(gain), float(offset))
+                           : window.FitPass(d, float(gain), float(offset));
+#else
     s = window.FitPass(d, float(gain), float(offset));
+#endif
     // The normal matrix J^T J and J^T e.
     const double jtj_dd = gain * gain * s.gg, jtj_dgain = -gain * s.gr, jtj_doffset = -gain * s.g;
     const double jtj_gain2 = s.rr, jtj_gain_offset = s.r, jtj_offset2 = nwin;

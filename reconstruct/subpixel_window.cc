@@ -8,6 +8,8 @@
 
 #if defined(__AVX2__)
 #include <immintrin.h>
+
+#include "reconstruct/subpixel_window_avx2.h"
 #endif
 
 namespace stereorig {
@@ -39,7 +41,9 @@ SubpixelWindow::SubpixelWindow(const cv::Mat& left, const cv::Mat& right, int x,
   }
 }
 
-FitPassSums SubpixelWindow::FitPass(double d, float gain, float offset) const {
+// The AVX2 pass inlined here, for the callers that do not inline it
+// themselves (RefineDisparity does: subpixel_window_avx2.h).
+[[gnu::flatten]] FitPassSums SubpixelWindow::FitPass(double d, float gain, float offset) const {
 #if defined(__AVX2__)
   if (vector_) return FitPassAvx2(d, gain, offset);
 #endif
@@ -58,6 +62,13 @@ double SubpixelWindow::Zncc(double d) const {
   if (vector_) return ZnccAvx2(d);
 #endif
   return ZnccPortable(d);
+}
+
+void SubpixelWindow::ZnccPair(double d0, double d1, double zncc[2]) const {
+#if defined(__AVX2__)
+  if (vector_) return ZnccPairAvx2(d0, d1, zncc);
+#endif
+  zncc[0] = ZnccPortable(d0), zncc[1] = ZnccPortable(d1);
 }
 
 FitPassSums SubpixelWindow::FitPassPortable(double d, float gain, float offset) const {
@@ -130,15 +141,19 @@ WindowZnccProbe::WindowZnccProbe(const cv::Mat& left, const cv::Mat& right, int 
   window_ = &*own_;
 }
 
-WindowZnccProbe::WindowZnccProbe(const SubpixelWindow& window, double slope_x, double slope_y,
-                                 const SubpixelOptions& o)
+WindowZnccProbe::WindowZnccProbe(const SubpixelWindow& window, double slope_x, double slope_y, const SubpixelOptions& o)
     : x_(window.x_), right_cols_(window.right_.cols), reach_px_(ZnccReachPx(slope_x, slope_y, o)), window_(&window) {
   STEREORIG_CHECK(window.kernel() == WindowKernel::kFastest);
 }
 
 double WindowZnccProbe::At(double d) const {
-  if (!window_ || x_ - d - reach_px_ < 0 || x_ - d + reach_px_ >= right_cols_) return -1;
+  if (!Inside(d)) return -1;
   return window_->Zncc(d);
+}
+
+void WindowZnccProbe::AtPair(double d0, double d1, double zncc[2]) const {
+  if (Inside(d0) && Inside(d1)) return window_->ZnccPair(d0, d1, zncc);
+  zncc[0] = At(d0), zncc[1] = At(d1);
 }
 
 #if defined(__AVX2__)
@@ -149,54 +164,43 @@ namespace {
 // for every window of a run (options and image steps are fixed), so each
 // thread keeps the last one.
 struct WindowLanes {
+  const LanczosTable* table = nullptr;  // LanczosTapTable(): here so a window need not look it up (a call, a guard)
   int hw = -1, hh = -1;
   size_t left_step = 0, right_step = 0;
   alignas(32) float u[SubpixelWindow::kMaxVectorSamples], v[SubpixelWindow::kMaxVectorSamples];
   alignas(32) int32_t left_offset[SubpixelWindow::kMaxVectorSamples], right_row[SubpixelWindow::kMaxVectorSamples];
 };
 
-const WindowLanes& LanesFor(int hw, int hh, size_t left_step, size_t right_step) {
-  thread_local WindowLanes lanes;
-  if (lanes.hw == hw && lanes.hh == hh && lanes.left_step == left_step && lanes.right_step == right_step) return lanes;
-  lanes.hw = hw, lanes.hh = hh, lanes.left_step = left_step, lanes.right_step = right_step;
+// Fills *lanes for this shape. Out of line: inlined, its loops cost
+// SetUpLanes's every call registers and stack it otherwise does not need.
+[[gnu::noinline]] void BuildLanes(int hw, int hh, size_t left_step, size_t right_step, WindowLanes* lanes) {
+  lanes->hw = hw, lanes->hh = hh, lanes->left_step = left_step, lanes->right_step = right_step;
+  lanes->table = &LanczosTapTable();
   int s = 0;
   for (int v = -hh; v <= hh; ++v)
     for (int u = -hw; u <= hw; ++u, ++s) {
-      lanes.u[s] = float(u), lanes.v[s] = float(v);
-      lanes.left_offset[s] = int32_t(v * int64_t(left_step) + u);
-      lanes.right_row[s] = int32_t(v * int64_t(right_step));
+      lanes->u[s] = float(u), lanes->v[s] = float(v);
+      lanes->left_offset[s] = int32_t(v * int64_t(left_step) + u);
+      lanes->right_row[s] = int32_t(v * int64_t(right_step));
     }
   for (; s % 8 != 0; ++s) {  // padding: copies of the centre sample
-    lanes.u[s] = lanes.v[s] = 0;
-    lanes.left_offset[s] = lanes.right_row[s] = 0;
+    lanes->u[s] = lanes->v[s] = 0;
+    lanes->left_offset[s] = lanes->right_row[s] = 0;
   }
+}
+
+const WindowLanes& LanesFor(int hw, int hh, size_t left_step, size_t right_step) {
+  thread_local WindowLanes lanes;
+  if (lanes.hw != hw || lanes.hh != hh || lanes.left_step != left_step || lanes.right_step != right_step)
+    BuildLanes(hw, hh, left_step, right_step, &lanes);
   return lanes;
-}
-
-// Lane k of the result: the sum of the 8 lanes of a[k].
-inline __m256 TransposeSum8(const __m256 a[8]) {
-  const __m256 q0 = _mm256_hadd_ps(_mm256_hadd_ps(a[0], a[1]), _mm256_hadd_ps(a[2], a[3]));
-  const __m256 q1 = _mm256_hadd_ps(_mm256_hadd_ps(a[4], a[5]), _mm256_hadd_ps(a[6], a[7]));
-  return _mm256_add_ps(_mm256_permute2f128_ps(q0, q1, 0x20), _mm256_permute2f128_ps(q0, q1, 0x31));
-}
-
-// The sum of the 8 lanes, in double.
-inline double HorizontalSum(__m256 a) {
-  const __m128 s4 = _mm_add_ps(_mm256_castps256_ps128(a), _mm256_extractf128_ps(a, 1));
-  const __m128 s2 = _mm_add_ps(s4, _mm_movehl_ps(s4, s4));
-  return _mm_cvtss_f32(_mm_add_ss(s2, _mm_movehdup_ps(s2)));
-}
-
-// All ones in the first `valid` lanes (0..8), zero after.
-inline __m256 LeadingMask(int valid) {
-  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  return _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(valid), lane));
 }
 
 }  // namespace
 
 void SubpixelWindow::SetUpLanes() {
   const WindowLanes& lanes = LanesFor(hw_, hh_, left_.step[0], right_.step[0]);
+  table_ = lanes.table;
   const uint8_t* centre = left_.ptr<uint8_t>(y_) + x_;
   // A 4-byte gather reads up to 3 bytes past a sample: not past the last
   // row's end.
@@ -204,7 +208,8 @@ void SubpixelWindow::SetUpLanes() {
   const __m256 stride = _mm256_set1_ps(stride_), minus_gy = _mm256_set1_ps(float(-slope_y_));
   const __m256i right_centre = _mm256_set1_epi32(int32_t(y_ * right_.step[0])), low_byte = _mm256_set1_epi32(0xFF);
   __m256 ls = _mm256_setzero_ps(), ls2 = ls;
-  for (int c = 0; c < n_; c += 8) {
+  const int n = n_;  // held: the stores below may alias n_ for the compiler, which then reloads it per chunk
+  for (int c = 0; c < n; c += 8) {
     const __m256i left_offset = _mm256_load_si256(reinterpret_cast<const __m256i*>(lanes.left_offset + c));
     __m256 l;
     if (gather) {
@@ -215,7 +220,7 @@ void SubpixelWindow::SetUpLanes() {
       for (int k = 0; k < 8; ++k) values[k] = centre[lanes.left_offset[c + k]];
       l = _mm256_load_ps(values);
     }
-    if (c + 8 > n_) l = _mm256_and_ps(l, LeadingMask(n_ - c));
+    if (c + 8 > n) l = _mm256_and_ps(l, LeadingMask(n - c));
     _mm256_store_ps(l_ + c, l);
     ls = _mm256_add_ps(ls, l), ls2 = _mm256_fmadd_ps(l, l, ls2);
     // u (1 - gx) - gy v: to float precision (~1e-6 px), as the positions.
@@ -229,115 +234,70 @@ void SubpixelWindow::SetUpLanes() {
   lsum_ = int64_t(HorizontalSum(ls)), lsum2_ = int64_t(HorizontalSum(ls2));
 }
 
-namespace {
-
-// The Lanczos values r and slopes g of the first `valid` (1..8) of 8
-// samples at right columns base + offset[k] of the rows at byte offsets
-// row[k] + row_shift from `right`; the other lanes' are 0.
-// `table`: LanczosTapTable(), looked up once per pass by the caller (a
-// function-local static's guard per chunk cost ~8 % of the pass).
-// The columns and table entries are handed to the scalar loads as unsigned
-// 32-bit (both are >= 0: the caller checks the reach), which the
-// extraction zero-extends for free, and an entry as its byte offset: no
-// sign extension or scaling per sample (~25 of a chunk's ~140
-// instructions).
-inline void SampleChunk(const uint8_t* right, const LanczosTable& table, __m256 base, const float* offset,
-                        const int32_t* row, int32_t row_shift, int valid, __m256* r, __m256* g) {
-  static_assert(sizeof(LanczosTaps) == 64);
-  const __m256 xr = _mm256_add_ps(base, _mm256_load_ps(offset));
-  const __m256i i0 = _mm256_cvttps_epi32(xr);
-  const __m256 frac = _mm256_sub_ps(xr, _mm256_cvtepi32_ps(i0));
-  alignas(32) uint32_t col[8], entry_byte[8];
-  _mm256_store_si256(reinterpret_cast<__m256i*>(col),
-                     _mm256_add_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(row)),
-                                      _mm256_add_epi32(i0, _mm256_set1_epi32(row_shift))));
-  _mm256_store_si256(
-      reinterpret_cast<__m256i*>(entry_byte),
-      _mm256_slli_epi32(
-          _mm256_cvttps_epi32(_mm256_fmadd_ps(frac, _mm256_set1_ps(float(kLanczosSteps)), _mm256_set1_ps(0.5f))), 6));
-  const uint8_t* table_bytes = reinterpret_cast<const uint8_t*>(table.data());
-  __m256 wp[8], gp[8];
-  for (int k = 0; k < 8; ++k) {
-    if (k >= valid) {  // padding: no sample (the last chunk only)
-      wp[k] = gp[k] = _mm256_setzero_ps();
-      continue;
-    }
-    // Bytes i0-4 .. i0+3; the taps sit in lanes 2..7 (lanczos_taps.h).
-    const __m256 p =
-        _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(right + col[k] - 4))));
-    const LanczosTaps& t = *reinterpret_cast<const LanczosTaps*>(table_bytes + entry_byte[k]);
-    wp[k] = _mm256_mul_ps(_mm256_load_ps(t.w), p);
-    gp[k] = _mm256_mul_ps(_mm256_load_ps(t.g), p);
-  }
-  *r = TransposeSum8(wp), *g = TransposeSum8(gp);
-}
-
-}  // namespace
-
 FitPassSums SubpixelWindow::FitPassAvx2(double d, float gain, float offset) const {
-  const __m256 base = _mm256_set1_ps(float(x_ - d));
-  const __m256 vgain = _mm256_set1_ps(gain), voffset = _mm256_set1_ps(offset);
-  const LanczosTable& table = LanczosTapTable();
-  __m256 sgg = _mm256_setzero_ps(), sgr = sgg, sg = sgg, srr = sgg, sr = sgg, sge = sgg, sre = sgg, se = sgg, slr = sgg;
-  auto accumulate = [&](__m256 r, __m256 g, __m256 e, __m256 l) {
-    sgg = _mm256_fmadd_ps(g, g, sgg), sgr = _mm256_fmadd_ps(g, r, sgr), sg = _mm256_add_ps(sg, g);
-    srr = _mm256_fmadd_ps(r, r, srr), sr = _mm256_add_ps(sr, r);
-    sge = _mm256_fmadd_ps(g, e, sge), sre = _mm256_fmadd_ps(r, e, sre), se = _mm256_add_ps(se, e);
-    slr = _mm256_fmadd_ps(l, r, slr);
-  };
-  int c = 0;
-  for (; c + 8 <= n_; c += 8) {
-    __m256 r, g;
-    SampleChunk(right_.data, table, base, offset_ + c, row_ + c, 0, 8, &r, &g);
-    const __m256 l = _mm256_load_ps(l_ + c);
-    accumulate(r, g, _mm256_sub_ps(_mm256_fnmadd_ps(vgain, r, l), voffset), l);
-  }
-  if (c < n_) {  // the padded chunk: r, g are 0 in its padding lanes, e is masked there
-    __m256 r, g;
-    SampleChunk(right_.data, table, base, offset_ + c, row_ + c, 0, n_ - c, &r, &g);
-    const __m256 l = _mm256_load_ps(l_ + c);
-    const __m256 e = _mm256_and_ps(_mm256_sub_ps(_mm256_fnmadd_ps(vgain, r, l), voffset), LeadingMask(n_ - c));
-    accumulate(r, g, e, l);
-  }
-  const __m256 lanes[8] = {sgg, sgr, sg, srr, sr, sge, sre, se};
-  alignas(32) float sums[8];
-  _mm256_store_ps(sums, TransposeSum8(lanes));
-  return FitPassSums{sums[0], sums[1], sums[2], sums[3], sums[4], sums[5], sums[6], sums[7], HorizontalSum(slr)};
+  return FitPassVector(vector_view(), d, gain, offset);
 }
 
 void SubpixelWindow::SampleAvx2(double d, int row_shift, float* r, float* g) const {
   const __m256 base = _mm256_set1_ps(float(x_ - d));
   const int32_t shift = int32_t(row_shift * int64_t(right_.step[0]));
-  const LanczosTable& table = LanczosTapTable();
+  const LanczosTable& table = *table_;
   for (int c = 0; c < n_; c += 8) {
     __m256 rc, gc;
-    SampleChunk(right_.data, table, base, offset_ + c, row_ + c, shift, 8, &rc, &gc);
+    SampleChunk<8>(right_.data, table, base, offset_ + c, row_ + c, shift, 8, &rc, &gc);
     _mm256_storeu_ps(r + c, rc), _mm256_storeu_ps(g + c, gc);
   }
 }
 
-double SubpixelWindow::ZnccAvx2(double d) const {
-  const __m256 base = _mm256_set1_ps(float(x_ - d));
+namespace {
+
+// The linearly interpolated right values r of chunk c (8 samples from c;
+// lanes past n are 0) at `base` = x - d, summed into rs, rs2 and lr (with
+// the left values l).
+inline void ZnccChunk(const uint8_t* right, __m256 base, const float* offset, const int32_t* row, const float* l,
+                      int valid, __m256* rs, __m256* rs2, __m256* lr) {
   const __m256i low_byte = _mm256_set1_epi32(0xFF);
-  __m256 rs = _mm256_setzero_ps(), rs2 = rs, lr = rs;
-  for (int c = 0; c < n_; c += 8) {
-    const __m256 xr = _mm256_add_ps(base, _mm256_load_ps(offset_ + c));
-    const __m256i i0 = _mm256_cvttps_epi32(xr);
-    const __m256 t = _mm256_sub_ps(xr, _mm256_cvtepi32_ps(i0));
-    // Bytes i0 .. i0+3 of each sample's row: i0 and i0+1 are the two taps.
-    const __m256i col = _mm256_add_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(row_ + c)), i0);
-    const __m256i q = _mm256_i32gather_epi32(reinterpret_cast<const int*>(right_.data), col, 1);
-    const __m256 p0 = _mm256_cvtepi32_ps(_mm256_and_si256(q, low_byte));
-    const __m256 p1 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(q, 8), low_byte));
-    __m256 r = _mm256_fmadd_ps(t, _mm256_sub_ps(p1, p0), p0);
-    if (c + 8 > n_) r = _mm256_and_ps(r, LeadingMask(n_ - c));
-    rs = _mm256_add_ps(rs, r), rs2 = _mm256_fmadd_ps(r, r, rs2);
-    lr = _mm256_fmadd_ps(_mm256_load_ps(l_ + c), r, lr);
-  }
-  const double n = n_, ls = double(lsum_) / n, mean_r = HorizontalSum(rs) / n;
-  const double lv = double(lsum2_) / n - ls * ls, rv = HorizontalSum(rs2) / n - mean_r * mean_r;
+  const __m256 xr = _mm256_add_ps(base, _mm256_load_ps(offset));
+  const __m256i i0 = _mm256_cvttps_epi32(xr);
+  const __m256 t = _mm256_sub_ps(xr, _mm256_cvtepi32_ps(i0));
+  // Bytes i0 .. i0+3 of each sample's row: i0 and i0+1 are the two taps.
+  const __m256i col = _mm256_add_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(row)), i0);
+  const __m256i q = _mm256_i32gather_epi32(reinterpret_cast<const int*>(right), col, 1);
+  const __m256 p0 = _mm256_cvtepi32_ps(_mm256_and_si256(q, low_byte));
+  const __m256 p1 = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(q, 8), low_byte));
+  __m256 r = _mm256_fmadd_ps(t, _mm256_sub_ps(p1, p0), p0);
+  if (valid < 8) r = _mm256_and_ps(r, LeadingMask(valid));
+  *rs = _mm256_add_ps(*rs, r), *rs2 = _mm256_fmadd_ps(r, r, *rs2);
+  *lr = _mm256_fmadd_ps(_mm256_load_ps(l), r, *lr);
+}
+
+// The ZNCC from the window's sums: n samples, the left sums (exact) and
+// the right ones.
+inline double ZnccOfSums(int samples, int64_t lsum, int64_t lsum2, __m256 rs, __m256 rs2, __m256 lr) {
+  const double n = samples, ls = double(lsum) / n, mean_r = HorizontalSum(rs) / n;
+  const double lv = double(lsum2) / n - ls * ls, rv = HorizontalSum(rs2) / n - mean_r * mean_r;
   if (!(lv > 0 && rv > 0)) return -1;
   return (HorizontalSum(lr) / n - ls * mean_r) / std::sqrt(lv * rv);
+}
+
+}  // namespace
+
+double SubpixelWindow::ZnccAvx2(double d) const {
+  const __m256 base = _mm256_set1_ps(float(x_ - d));
+  __m256 rs = _mm256_setzero_ps(), rs2 = rs, lr = rs;
+  for (int c = 0; c < n_; c += 8) ZnccChunk(right_.data, base, offset_ + c, row_ + c, l_ + c, n_ - c, &rs, &rs2, &lr);
+  return ZnccOfSums(n_, lsum_, lsum2_, rs, rs2, lr);
+}
+
+void SubpixelWindow::ZnccPairAvx2(double d0, double d1, double zncc[2]) const {
+  const __m256 base0 = _mm256_set1_ps(float(x_ - d0)), base1 = _mm256_set1_ps(float(x_ - d1));
+  __m256 rs0 = _mm256_setzero_ps(), rs20 = rs0, lr0 = rs0, rs1 = rs0, rs21 = rs0, lr1 = rs0;
+  for (int c = 0; c < n_; c += 8) {
+    ZnccChunk(right_.data, base0, offset_ + c, row_ + c, l_ + c, n_ - c, &rs0, &rs20, &lr0);
+    ZnccChunk(right_.data, base1, offset_ + c, row_ + c, l_ + c, n_ - c, &rs1, &rs21, &lr1);
+  }
+  zncc[0] = ZnccOfSums(n_, lsum_, lsum2_, rs0, rs20, lr0);
+  zncc[1] = ZnccOfSums(n_, lsum_, lsum2_, rs1, rs21, lr1);
 }
 #endif  // __AVX2__
 

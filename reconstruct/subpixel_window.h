@@ -21,6 +21,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "reconstruct/lanczos_taps.h"
 #include "reconstruct/subpixel_refine.h"
 
 namespace stereorig {
@@ -52,6 +53,19 @@ class SubpixelWindow {
                  const SubpixelOptions& o, WindowKernel kernel = WindowKernel::kFastest);
 
   int size() const { return n_; }  // samples, (2 hw + 1)(2 hh + 1)
+  // The AVX2 path's flattened samples, for a caller that inlines the pass
+  // (subpixel_window_avx2.h). Valid while the window lives, on is_vector()
+  // windows only.
+  struct VectorView {
+    const uint8_t* right;  // right.data
+    const LanczosTable* table;
+    int x, n;        // the window's centre column and its samples
+    const float* l;  // the padded arrays below
+    const float* offset;
+    const int32_t* row;
+  };
+  bool is_vector() const { return vector_; }
+  VectorView vector_view() const { return {right_.data, table_, x_, n_, l_, offset_, row_}; }
   WindowKernel kernel() const { return kernel_; }  // as constructed
   // Sums of the left values and their squares over the window (exact).
   int64_t left_sum() const { return lsum_; }
@@ -73,6 +87,9 @@ class SubpixelWindow {
   // (columns i0 .. i0+3 read: inside the row, the caller checks); -1 if
   // either window is flat.
   double Zncc(double d) const;
+  // Zncc(d0) and Zncc(d1) into zncc[0], zncc[1] (the same values), in one
+  // walk over the window: the distinctness test's two shifts.
+  void ZnccPair(double d0, double d1, double zncc[2]) const;
 
  private:
   FitPassSums FitPassPortable(double d, float gain, float offset) const;
@@ -84,6 +101,7 @@ class SubpixelWindow {
   FitPassSums FitPassAvx2(double d, float gain, float offset) const;
   void SampleAvx2(double d, int row_shift, float* r, float* g) const;
   double ZnccAvx2(double d) const;
+  void ZnccPairAvx2(double d0, double d1, double zncc[2]) const;
   friend class WindowZnccProbe;
 
   const cv::Mat& left_;
@@ -99,6 +117,7 @@ class SubpixelWindow {
   alignas(32) float l_[kMaxVectorSamples];       // left values
   alignas(32) float offset_[kMaxVectorSamples];  // right column minus (x - d): u (1 - gx) - gy v
   alignas(32) int32_t row_[kMaxVectorSamples];   // byte offset of the right row from right.data
+  const LanczosTable* table_ = nullptr;          // LanczosTapTable(), held so a pass need not look it up
 };
 
 // Room for one SubpixelWindow, set up or not: std::optional's role, without
@@ -149,11 +168,16 @@ class WindowZnccProbe {
   // = WindowZncc(left, right, x, y, d, slope_x, slope_y, o): -1 where the
   // window leaves either image.
   double At(double d) const;
+  // At(d0), At(d1) into zncc[0], zncc[1] (the same values), the window
+  // walked once where both are inside.
+  void AtPair(double d0, double d1, double zncc[2]) const;
 
  private:
   int x_, right_cols_;
-  double reach_px_;                        // the right window's extent about x - d, with the taps' margin
-  WindowSlot own_;                         // set up by the first constructor, if inside the left image
+  bool Inside(double d) const { return window_ && x_ - d - reach_px_ >= 0 && x_ - d + reach_px_ < right_cols_; }
+
+  double reach_px_;                         // the right window's extent about x - d, with the taps' margin
+  WindowSlot own_;                          // set up by the first constructor, if inside the left image
   const SubpixelWindow* window_ = nullptr;  // own_ or the caller's; null if the left window leaves the image
 };
 

@@ -168,6 +168,43 @@ TEST(SubpixelWindow, DistinctnessZnccEqualsPlainDoubleEvaluation) {
   EXPECT_LT(max_dz, 1e-4);
 }
 
+// The distinctness test's two shifts in one walk over the window
+// (ZnccPair, WindowZnccProbe::AtPair) against one shift at a time (Zncc,
+// At), which DistinctnessZnccEqualsPlainDoubleEvaluation checks against the
+// definition: the same arithmetic per shift, so the same doubles, on both
+// kernels, and -1 for a shift whose window leaves the right image.
+TEST(SubpixelWindow, ZnccPairEqualsTwoSingleZnccs) {
+  SyntheticPairSpec spec;
+  const SyntheticPair pair = RenderSyntheticPair(spec);
+  const SubpixelOptions o;
+  int compared = 0, outside = 0;
+  for (const Probe& p : Probes(pair, spec, 1000)) {
+    for (const WindowKernel kernel : {WindowKernel::kFastest, WindowKernel::kPortable}) {
+      const SubpixelWindow window(pair.left, pair.right, p.x, p.y, p.gx, p.gy, o, kernel);
+      double pair_zncc[2];
+      window.ZnccPair(p.start - 4, p.start + 3.7, pair_zncc);
+      ASSERT_EQ(pair_zncc[0], window.Zncc(p.start - 4)) << p.x << "," << p.y;
+      ASSERT_EQ(pair_zncc[1], window.Zncc(p.start + 3.7)) << p.x << "," << p.y;
+      ++compared;
+    }
+    // Shifts far enough to leave the right image on one side: At gives -1
+    // there, and AtPair the same.
+    const WindowZnccProbe probe(pair.left, pair.right, p.x, p.y, p.gx, p.gy, o);
+    for (const double far : {-double(pair.right.cols), double(pair.right.cols)}) {
+      double at_pair[2];
+      probe.AtPair(p.start, p.start + far, at_pair);
+      ASSERT_EQ(at_pair[0], probe.At(p.start));
+      ASSERT_EQ(at_pair[1], -1.0);
+      probe.AtPair(p.start + far, p.start - 2.5, at_pair);
+      ASSERT_EQ(at_pair[0], -1.0);
+      ASSERT_EQ(at_pair[1], probe.At(p.start - 2.5));
+      ++outside;
+    }
+  }
+  EXPECT_GT(compared, 1000);
+  EXPECT_GT(outside, 500);
+}
+
 // RefineAndAccept (disparity_state.h: one window for the fit and the
 // distinctness test) against the plain double fit and the plain ZNCC half
 // a period either side, the acceptance tests stated here.
@@ -227,7 +264,9 @@ TEST(SubpixelWindow, RefineAndAcceptEqualsThePlainFitAndDistinctnessTest) {
 TEST(SubpixelWindow, FastSumsEqualPortableSums) {
   SyntheticPairSpec spec;
   const SyntheticPair pair = RenderSyntheticPair(spec);
-  for (const int half_height : {1, 3}) {  // 27 samples (3 of 8 padded) and 63
+  // 9, 27, 45 and 63 samples: last chunks of 1, 3 (summed 4 wide), 5 and
+  // 7 (8 wide) samples.
+  for (const int half_height : {0, 1, 2, 3}) {
     SubpixelOptions o;
     o.half_height_px = half_height;
     double max_step = 0, max_dz = 0;
