@@ -101,8 +101,8 @@ Moments SumInOrder(const cv::Mat& disparity, const ValidityBits& valid, cv::Poin
 // columns at a time give the raster order's bits.
 constexpr float kExactMin = 1.0f / 256, kExactMax = 512;
 
-// Adds the window's moments to *m (zero), eight columns at a time; false
-// (m unspecified) if a valid disparity lies outside the exact range.
+// The window's moments, eight columns at a time; false (m unspecified) if a
+// valid disparity lies outside the exact range.
 bool SumExact(const cv::Mat& disparity, const ValidityBits& valid, cv::Point q, const Window& w, Moments* m) {
   const int width = w.u1 - w.u0 + 1;
   const __m256i lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
@@ -113,12 +113,15 @@ bool SumExact(const cv::Mat& disparity, const ValidityBits& valid, cv::Point q, 
   __m256i su = _mm256_setzero_si256(), suu = su, suv = su;
   __m256d sd = _mm256_setzero_pd(), sxd = sd, syd = sd;
   __m256 outside = zero;
+  int n = 0, ny = 0, nyy = 0;
+  const size_t step = disparity.step[0];
+  const uchar* first_row = disparity.ptr<uchar>(q.y + w.v0) + sizeof(float) * size_t(q.x + w.u0);
   for (int v = w.v0; v <= w.v1; ++v) {
     const uint64_t bits = valid.Span(q.x + w.u0, q.y + v, width);
     if (bits == 0) continue;
     const int count = std::popcount(bits);
-    m->n += count, m->ny += v * count, m->nyy += v * v * count;
-    const float* row = disparity.ptr<float>(q.y + v) + q.x + w.u0;
+    n += count, ny += v * count, nyy += v * v * count;
+    const float* row = reinterpret_cast<const float*>(first_row + step * size_t(v - w.v0));
     const __m256i vv = _mm256_set1_epi32(v);
     const __m256 fv = _mm256_set1_ps(float(v));
     for (int c = 0; c < width; c += 8) {
@@ -150,6 +153,7 @@ bool SumExact(const cv::Mat& disparity, const ValidityBits& valid, cv::Point q, 
   alignas(16) int32_t ints[4];
   _mm_store_si128(reinterpret_cast<__m128i*>(ints),
                   _mm_add_epi32(_mm256_castsi256_si128(hi), _mm256_extracti128_si256(hi, 1)));
+  m->n = n, m->ny = ny, m->nyy = nyy;
   m->nx = ints[0], m->nxx = ints[1], m->nxy = ints[2];
   const __m256d a = _mm256_hadd_pd(sd, sxd), b = _mm256_hadd_pd(syd, _mm256_setzero_pd());
   // a = [sd01, sxd01, sd23, sxd23], b = [syd01, 0, syd23, 0]

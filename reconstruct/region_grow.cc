@@ -51,7 +51,7 @@ bool Enclosed(const cv::Mat& disparity, const cv::Rect& roi, cv::Point q, cv::Po
 GrowMemory::GrowMemory(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const GrowOptions& options)
     : roi_(roi),
       oblique_(left, right, roi.y - 8, roi.y + roi.height + 8, options.oblique),
-      failed_(size_t(roi.area())) {}
+      latest_failed_(size_t(roi.area()), 0) {}
 
 int GrowDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const GrowOptions& o,
                   const RefineAcceptance& accept, DisparityState* state, GrowMemory* memory) {
@@ -91,15 +91,21 @@ int GrowDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
       LocalPlane plane{d + gx * (q.x - p.x) + gy * (q.y - p.y), gx, gy};
       FitLocalPlane(disparity, valid, roi, q, o.plane_radius_px, &plane);
       const double predicted = plane.disparity_px, qgx = plane.slope_x, qgy = plane.slope_y;
-      GrowMemory::FailedTry& last = memory->failed_[index(q)];
       const cv::Point from = p - q;
       const bool enclosed = o.shifted_windows && Enclosed(disparity, roi, q, from, accept.subpixel);
-      // Tried exactly so before and failed (and nothing else has touched it
-      // since): it fails again, as before.
-      if (last.status != 0 && last.status == state->status.at<uint8_t>(q) && last.start_px == predicted &&
-          last.slope_x == qgx && last.slope_y == qgy &&
-          (!o.shifted_windows || (last.from_dx == from.x && last.from_dy == from.y && last.enclosed == enclosed)))
+      // Tried exactly so before and failed: it fails again, as before.
+      int32_t& latest = memory->latest_failed_[index(q)];
+      const GrowMemory::FailedTry* repeat = nullptr;
+      for (int32_t i = latest; i != 0 && !repeat; i = memory->failed_[size_t(i - 1)].previous) {
+        const GrowMemory::FailedTry& f = memory->failed_[size_t(i - 1)];
+        if (f.start_px == predicted && f.slope_x == qgx && f.slope_y == qgy &&
+            (!o.shifted_windows || (f.from_dx == from.x && f.from_dy == from.y && f.enclosed == enclosed)))
+          repeat = &f;
+      }
+      if (repeat) {
+        state->status.at<uint8_t>(q) = repeat->status;
         continue;
+      }
       SubpixelResult r;
       PixelStatus why = RefineAndAccept(left, right, q.x, q.y, predicted, qgx, qgy, accept, &r);
       if (why == PixelStatus::kPoint && std::abs(r.disparity_px - predicted) > o.max_deviation_px)
@@ -126,10 +132,10 @@ int GrowDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
       }
       if (why != PixelStatus::kPoint) {
         state->status.at<uint8_t>(q) = uint8_t(why);  // the reason growing could not reach it
-        last = {predicted, qgx, qgy, int8_t(from.x), int8_t(from.y), uint8_t(why), enclosed};
+        memory->failed_.push_back({predicted, qgx, qgy, latest, int8_t(from.x), int8_t(from.y), uint8_t(why), enclosed});
+        latest = int32_t(memory->failed_.size());
         continue;
       }
-      last.status = 0;
       disparity.at<float>(q) = float(r.disparity_px);
       valid.Set(q.x, q.y, std::isfinite(disparity.at<float>(q)));
       state->confidence.at<float>(q) = float(std::clamp(r.zncc, 0.0, 1.0));

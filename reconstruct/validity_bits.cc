@@ -3,6 +3,10 @@
 #include <bit>
 #include <cmath>
 
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
 namespace stereorig {
 
 ValidityBits::ValidityBits(const cv::Mat& disparity, const cv::Rect& roi)
@@ -11,12 +15,18 @@ ValidityBits::ValidityBits(const cv::Mat& disparity, const cv::Rect& roi)
   for (int y = roi.y; y < roi.y + roi.height; ++y) {
     const float* row = disparity.ptr<float>(y) + roi.x;
     uint64_t* out = Row(y);
-    for (int x0 = 0; x0 < roi.width; x0 += 64) {
-      const int n = std::min(64, roi.width - x0);
-      uint64_t word = 0;
-      for (int i = 0; i < n; ++i) word |= uint64_t(std::isfinite(row[x0 + i])) << i;
-      out[x0 >> 6] = word;
+    int i = 0;
+#if defined(__AVX2__)
+    // Eight at a time: finite iff the exponent bits are not all set.
+    const __m256i exponent = _mm256_set1_epi32(0x7f800000);
+    for (; i + 8 <= roi.width; i += 8) {
+      const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(row + i));
+      const __m256i special = _mm256_cmpeq_epi32(_mm256_and_si256(v, exponent), exponent);
+      const uint64_t finite = uint64_t(~_mm256_movemask_ps(_mm256_castsi256_ps(special)) & 0xff);
+      out[i >> 6] |= finite << (i & 63);
     }
+#endif
+    for (; i < roi.width; ++i) out[i >> 6] |= uint64_t(std::isfinite(row[i])) << (i & 63);
   }
 }
 
