@@ -86,9 +86,11 @@ bool ObliqueViews::Refine(int x, int y, double start_px, double slope_x, double 
   if (levels_.empty() || !(s > 0) || (s > options_.min_foreshortening && s < 1 / options_.min_foreshortening))
     return false;
   Level* best = nullptr;
-  for (Level& level : levels_)
-    if (!best || std::abs(std::log(level.foreshortening / s)) < std::abs(std::log(best->foreshortening / s)))
-      best = &level;
+  double best_distance = 0;  // |log(foreshortening / s)| of best, each level's computed once
+  for (Level& level : levels_) {
+    const double distance = std::abs(std::log(level.foreshortening / s));
+    if (!best || distance < best_distance) best = &level, best_distance = distance;
+  }
   RefineAcceptance a = accept;
   if (s < 1)
     a.subpixel.half_width_px = std::clamp(int(std::lround(accept.subpixel.half_width_px / s)),

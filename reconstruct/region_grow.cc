@@ -1,13 +1,14 @@
 #include "reconstruct/region_grow.h"
 
-#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <optional>
 #include <vector>
 
 #include "calib/core/input_error.h"
+#include "reconstruct/local_plane.h"
 #include "reconstruct/shifted_window.h"
+#include "reconstruct/validity_bits.h"
 
 namespace stereorig {
 
@@ -25,36 +26,6 @@ void GrowOptions::Check() const {
 }
 
 namespace {
-
-// Least-squares plane d = a + gx*(x - q.x) + gy*(y - q.y) through the valid
-// disparities of the (2r+1)^2 window around q (clipped to roi). False if
-// too few or degenerate (then the caller predicts from one neighbour).
-bool LocalPlane(const cv::Mat& disparity, const cv::Rect& roi, cv::Point q, int r, double* a, double* gx, double* gy) {
-  const int v0 = std::max(-r, roi.y - q.y), v1 = std::min(r, roi.y + roi.height - 1 - q.y);
-  const int u0 = std::max(-r, roi.x - q.x), u1 = std::min(r, roi.x + roi.width - 1 - q.x);
-  // The pixel moments are sums of small integers: exact as ints, and the
-  // same as summed in doubles.
-  int n = 0, nx = 0, ny = 0, nxx = 0, nyy = 0, nxy = 0;
-  double sd = 0, sxd = 0, syd = 0;
-  for (int v = v0; v <= v1; ++v) {
-    const float* row = disparity.ptr<float>(q.y + v) + q.x;
-    for (int u = u0; u <= u1; ++u) {
-      const float d = row[u];
-      if (!std::isfinite(d)) continue;
-      ++n, nx += u, ny += v, nxx += u * u, nyy += v * v, nxy += u * v;
-      sd += d, sxd += u * d, syd += v * d;
-    }
-  }
-  const double s1 = n, sx = nx, sy = ny, sxx = nxx, syy = nyy, sxy = nxy;
-  if (s1 < 6) return false;
-  Eigen::Matrix3d m;
-  m << s1, sx, sy, sx, sxx, sxy, sy, sxy, syy;
-  if (std::abs(m.determinant()) < 1e-6 * s1 * s1 * s1) return false;
-  const Eigen::Vector3d p = m.ldlt().solve(Eigen::Vector3d(sd, sxd, syd));
-  if (!p.allFinite()) return false;
-  *a = p[0], *gx = p[1], *gy = p[2];
-  return true;
-}
 
 // Whether pixel q, grown from its neighbour q + from along the row, lies in
 // a hole of the matched surface rather than at its edge: some pixel on the
@@ -80,7 +51,7 @@ bool Enclosed(const cv::Mat& disparity, const cv::Rect& roi, cv::Point q, cv::Po
 GrowMemory::GrowMemory(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const GrowOptions& options)
     : roi_(roi),
       oblique_(left, right, roi.y - 8, roi.y + roi.height + 8, options.oblique),
-      failed_(size_t(roi.area())) {}
+      latest_failed_(size_t(roi.area()), 0) {}
 
 int GrowDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const GrowOptions& o,
                   const RefineAcceptance& accept, DisparityState* state, GrowMemory* memory) {
@@ -100,18 +71,8 @@ int GrowDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
   // pixels in raster order. Only those with an empty 4-neighbour in roi:
   // the others have nothing to try (a valid pixel stays valid), so leaving
   // them out changes nothing but the time (most of the map is interior).
-  std::vector<cv::Point> queue;
-  const int x_end = roi.x + roi.width, y_end = roi.y + roi.height;
-  for (int y = roi.y; y < y_end; ++y) {
-    const float* above = y > roi.y ? disparity.ptr<float>(y - 1) : nullptr;
-    const float* row = disparity.ptr<float>(y);
-    const float* below = y + 1 < y_end ? disparity.ptr<float>(y + 1) : nullptr;
-    for (int x = roi.x; x < x_end; ++x)
-      if (std::isfinite(row[x]) &&
-          ((x > roi.x && !std::isfinite(row[x - 1])) || (x + 1 < x_end && !std::isfinite(row[x + 1])) ||
-           (above && !std::isfinite(above[x])) || (below && !std::isfinite(below[x]))))
-        queue.emplace_back(x, y);
-  }
+  ValidityBits valid(disparity, roi);  // kept in step with `disparity` below
+  std::vector<cv::Point> queue = valid.EdgePixels();
   int added = 0;
   for (size_t head = 0; head < queue.size(); ++head) {
     const cv::Point p = queue[head];
@@ -127,17 +88,24 @@ int GrowDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
       ++tries;
       // Predicted from the plane through the valid neighbours (noise ~0.25 px
       // per pixel averages out), else from p and its slopes.
-      double predicted = d + gx * (q.x - p.x) + gy * (q.y - p.y), qgx = gx, qgy = gy;
-      LocalPlane(disparity, roi, q, o.plane_radius_px, &predicted, &qgx, &qgy);
-      GrowMemory::FailedTry& last = memory->failed_[index(q)];
+      LocalPlane plane{d + gx * (q.x - p.x) + gy * (q.y - p.y), gx, gy};
+      FitLocalPlane(disparity, valid, roi, q, o.plane_radius_px, &plane);
+      const double predicted = plane.disparity_px, qgx = plane.slope_x, qgy = plane.slope_y;
       const cv::Point from = p - q;
       const bool enclosed = o.shifted_windows && Enclosed(disparity, roi, q, from, accept.subpixel);
-      // Tried exactly so before and failed (and nothing else has touched it
-      // since): it fails again, as before.
-      if (last.status != 0 && last.status == state->status.at<uint8_t>(q) && last.start_px == predicted &&
-          last.slope_x == qgx && last.slope_y == qgy &&
-          (!o.shifted_windows || (last.from_dx == from.x && last.from_dy == from.y && last.enclosed == enclosed)))
+      // Tried exactly so before and failed: it fails again, as before.
+      int32_t& latest = memory->latest_failed_[index(q)];
+      const GrowMemory::FailedTry* repeat = nullptr;
+      for (int32_t i = latest; i != 0 && !repeat; i = memory->failed_[size_t(i - 1)].previous) {
+        const GrowMemory::FailedTry& f = memory->failed_[size_t(i - 1)];
+        if (f.start_px == predicted && f.slope_x == qgx && f.slope_y == qgy &&
+            (!o.shifted_windows || (f.from_dx == from.x && f.from_dy == from.y && f.enclosed == enclosed)))
+          repeat = &f;
+      }
+      if (repeat) {
+        state->status.at<uint8_t>(q) = repeat->status;
         continue;
+      }
       SubpixelResult r;
       PixelStatus why = RefineAndAccept(left, right, q.x, q.y, predicted, qgx, qgy, accept, &r);
       if (why == PixelStatus::kPoint && std::abs(r.disparity_px - predicted) > o.max_deviation_px)
@@ -164,11 +132,12 @@ int GrowDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
       }
       if (why != PixelStatus::kPoint) {
         state->status.at<uint8_t>(q) = uint8_t(why);  // the reason growing could not reach it
-        last = {predicted, qgx, qgy, int8_t(from.x), int8_t(from.y), uint8_t(why), enclosed};
+        memory->failed_.push_back({predicted, qgx, qgy, latest, int8_t(from.x), int8_t(from.y), uint8_t(why), enclosed});
+        latest = int32_t(memory->failed_.size());
         continue;
       }
-      last.status = 0;
       disparity.at<float>(q) = float(r.disparity_px);
+      valid.Set(q.x, q.y, std::isfinite(disparity.at<float>(q)));
       state->confidence.at<float>(q) = float(std::clamp(r.zncc, 0.0, 1.0));
       state->status.at<uint8_t>(q) = uint8_t(PixelStatus::kPoint);
       state->slope_x.at<float>(q) = float(qgx);
