@@ -17,6 +17,7 @@
 #include "reconstruct/region_grow.h"
 #include "reconstruct/right_occlusion.h"
 #include "reconstruct/sgm_guide.h"
+#include "reconstruct/speckle_filter.h"
 
 namespace stereorig {
 
@@ -164,7 +165,8 @@ cv::Mat MatchLevel(const cv::Mat& left, const cv::Mat& right, const cv::Rect& re
 }
 
 // Removes connected blobs of similar disparity smaller than the window, on a
-// 1/16 px fixed-point copy (OpenCV's filterSpeckles does the labelling).
+// 1/16 px fixed-point copy (labelled as OpenCV's filterSpeckles would,
+// speckle_filter.h).
 // disparity_px may be a view (the ROI of a full-image map): it is written in
 // place.
 void RemoveSpeckles(cv::Mat disparity_px, const MatchOptions& o) {
@@ -186,7 +188,7 @@ void RemoveSpeckles(cv::Mat disparity_px, const MatchOptions& o) {
       f[x] = int16_t(int(sixteenths + std::copysign(0.5, sixteenths)));
     }
   }
-  cv::filterSpeckles(fixed, kInvalid, o.speckle_window_px, int(std::lround(o.speckle_range_px * 16)));
+  FilterSpeckles16(fixed, kInvalid, o.speckle_window_px, int(std::lround(o.speckle_range_px * 16)));
   for (int y = 0; y < disparity_px.rows; ++y) {
     float* d = disparity_px.ptr<float>(y);
     const int16_t* f = fixed.ptr<int16_t>(y);

@@ -141,26 +141,29 @@ struct Avx2Kernels {
   }
 
   // c[d] = popcount(l ^ r[d]) for d in [0, stride), r[d]'s nibble k at
-  // planes[k * plane_stride + d]; l has at most 4 * kNibbles bits. Reads 32
-  // bytes at d = stride - 16 when stride is an odd multiple of 16 (and
-  // writes 16): planes must be readable 16 bytes beyond. Inlined into the
-  // caller's loop over a row (a call per pixel spilled the tables).
-  template <int kNibbles>
+  // planes[k * plane_stride + d]; l has at most 4 * kNibbles bits.
+  // kOddBlocks: stride is an odd multiple of 16; the last 16 lanes are then
+  // read as 32 bytes (and 16 written): planes must be readable 16 bytes
+  // beyond. Inlined into the caller's loop over a row (a call per pixel
+  // spilled the tables).
+  template <int kNibbles, bool kOddBlocks>
   [[gnu::always_inline]] static inline void CostFromNibbles(uint64_t l, const uint8_t* planes, size_t plane_stride,
                                                             uint8_t* c, int stride) {
     __m256i table[kNibbles];
     for (int k = 0; k < kNibbles; ++k)
       table[k] = _mm256_load_si256(reinterpret_cast<const __m256i*>(kXorPopcount.bytes[(l >> (4 * k)) & 15]));
-    for (int d = 0; d < stride; d += 32) {
+    auto costs32 = [&](int d) {
       __m256i acc = _mm256_shuffle_epi8(table[0], _mm256_loadu_si256(reinterpret_cast<const __m256i*>(planes + d)));
       for (int k = 1; k < kNibbles; ++k)
         acc = _mm256_add_epi8(acc, _mm256_shuffle_epi8(table[k], _mm256_loadu_si256(reinterpret_cast<const __m256i*>(
                                                                      planes + size_t(k) * plane_stride + d))));
-      if (d + 32 <= stride)
-        _mm256_storeu_si256(reinterpret_cast<__m256i*>(c + d), acc);
-      else
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(c + d), _mm256_castsi256_si128(acc));
-    }
+      return acc;
+    };
+    // The whole 32-lane chunks, then the odd 16 apart: no test per chunk.
+    const int whole = kOddBlocks ? stride - 16 : stride;
+    for (int d = 0; d < whole; d += 32) _mm256_storeu_si256(reinterpret_cast<__m256i*>(c + d), costs32(d));
+    if constexpr (kOddBlocks)
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(c + whole), _mm256_castsi256_si128(costs32(whole)));
   }
 
   static __m256i Load(const uint16_t* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); }
