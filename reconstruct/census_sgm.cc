@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <utility>
 
@@ -249,7 +250,7 @@ struct CostRowArgs {
   size_t plane_stride;
   int region_x, w, n, stride, rw;
 };
-template <typename K, int kNibbles>
+template <typename K, int kNibbles, bool kOddBlocks>
 void CostRow(const CostRowArgs& args, uint8_t* cost_row) {
   const CostRowArgs a = args;  // a copy: the byte stores below might alias `args`, forcing reloads
   for (int x = 0; x < a.w; ++x) {
@@ -258,33 +259,38 @@ void CostRow(const CostRowArgs& args, uint8_t* cost_row) {
     // d indices whose right pixel xr0 - d lies in [0, rw).
     const int d_lo = std::clamp(xr0 - a.rw + 1, 0, a.n), d_hi = std::clamp(xr0 + 1, d_lo, a.n);
     if (d_lo == d_hi) {
-      std::fill(c, c + a.stride, uint8_t(kCensusMaxCost));
+      std::memset(c, kCensusMaxCost, size_t(a.stride));
       continue;
     }
     const size_t r0 = size_t(a.stride + a.rw - 1 - xr0);  // the reversed row's index of d index 0
     if constexpr (kNibbles > 0)
-      K::template CostFromNibbles<kNibbles>(a.cl[a.region_x + x], a.planes + r0, a.plane_stride, c, a.stride);
+      K::template CostFromNibbles<kNibbles, kOddBlocks>(a.cl[a.region_x + x], a.planes + r0, a.plane_stride, c,
+                                                        a.stride);
     else
       K::Cost(a.cl[a.region_x + x], a.reversed + r0, c, d_lo, d_hi, a.stride);
-    if (d_lo > 0) std::fill(c, c + d_lo, uint8_t(kCensusMaxCost));
-    if (d_hi < a.n) std::fill(c + d_hi, c + a.n, uint8_t(kCensusMaxCost));
+    // memset, not std::fill: GCC left the fill a byte loop.
+    if (d_lo > 0) std::memset(c, kCensusMaxCost, size_t(d_lo));
+    if (d_hi < a.n) std::memset(c + d_hi, kCensusMaxCost, size_t(a.n - d_hi));
   }
 }
 
 using CostRowFn = void (*)(const CostRowArgs&, uint8_t*);
-template <typename K, int... k>
+template <typename K, bool kOddBlocks, int... k>
 CostRowFn CostRowFor(int nibbles, std::integer_sequence<int, k...>) {
-  static constexpr CostRowFn fns[] = {&CostRow<K, k + 1>...};
+  static constexpr CostRowFn fns[] = {&CostRow<K, k + 1, kOddBlocks>...};
   return fns[std::clamp(nibbles, 1, 16) - 1];
 }
-// CostRow for signatures of `nibbles` nibbles: kernels with kNibbleCosts
-// read nibble planes (one instance per count, 1..16), others the signatures.
+// CostRow for signatures of `nibbles` nibbles and `stride` lanes: kernels
+// with kNibbleCosts read nibble planes (one instance per count, 1..16, and
+// per parity of stride / 16), others the signatures.
 template <typename K>
-CostRowFn CostRowFor(int nibbles) {
-  if constexpr (K::kNibbleCosts)
-    return CostRowFor<K>(nibbles, std::make_integer_sequence<int, 16>());
-  else
-    return &CostRow<K, 0>;
+CostRowFn CostRowFor(int nibbles, int stride) {
+  if constexpr (K::kNibbleCosts) {
+    if (stride % 32 != 0) return CostRowFor<K, true>(nibbles, std::make_integer_sequence<int, 16>());
+    return CostRowFor<K, false>(nibbles, std::make_integer_sequence<int, 16>());
+  } else {
+    return &CostRow<K, 0, false>;
+  }
 }
 
 // The sizes and penalties shared by one SGM call's row passes.
@@ -463,7 +469,7 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   // (+32 bytes: CostFromNibbles may read 16 beyond the last plane).
   const int nibbles = (std::max(left.signature_bits, right.signature_bits) + 3) / 4;
   uint8_t* planes = K::kNibbleCosts ? Grow(ws.nibble_planes, size_t(nibbles) * reversed_size + 32) : nullptr;
-  const CostRowFn cost_row = CostRowFor<K>(nibbles);
+  const CostRowFn cost_row = CostRowFor<K>(nibbles, stride);
   // The reversed row's indices CostRow reads: pixel x starts at
   // stride + rw - 1 - (region.x + x - lo[x]) and reads stride (+16) lanes;
   // only these get planes (about half the row at full resolution).

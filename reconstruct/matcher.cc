@@ -17,6 +17,7 @@
 #include "reconstruct/region_grow.h"
 #include "reconstruct/right_occlusion.h"
 #include "reconstruct/sgm_guide.h"
+#include "reconstruct/speckle_filter.h"
 
 namespace stereorig {
 
@@ -164,35 +165,13 @@ cv::Mat MatchLevel(const cv::Mat& left, const cv::Mat& right, const cv::Rect& re
 }
 
 // Removes connected blobs of similar disparity smaller than the window, on a
-// 1/16 px fixed-point copy (OpenCV's filterSpeckles does the labelling).
+// 1/16 px fixed-point copy (labelled as OpenCV's filterSpeckles would,
+// speckle_filter.h).
 // disparity_px may be a view (the ROI of a full-image map): it is written in
 // place.
 void RemoveSpeckles(cv::Mat disparity_px, const MatchOptions& o) {
   if (o.speckle_window_px <= 0) return;
-  constexpr int16_t kInvalid = std::numeric_limits<int16_t>::min();
-  cv::Mat fixed(disparity_px.size(), CV_16SC1);
-  for (int y = 0; y < disparity_px.rows; ++y) {
-    const float* d = disparity_px.ptr<float>(y);
-    int16_t* f = fixed.ptr<int16_t>(y);
-    for (int x = 0; x < disparity_px.cols; ++x) {
-      if (!std::isfinite(d[x])) {
-        f[x] = kInvalid;
-        continue;
-      }
-      // Rounded half away from zero as std::lround would (d * 16 has at most
-      // 24 significant bits, so adding 0.5 is exact), inline: std::lround is
-      // a libm call per pixel.
-      const double sixteenths = std::clamp(d[x] * 16.0, -32000.0, 32000.0);
-      f[x] = int16_t(int(sixteenths + std::copysign(0.5, sixteenths)));
-    }
-  }
-  cv::filterSpeckles(fixed, kInvalid, o.speckle_window_px, int(std::lround(o.speckle_range_px * 16)));
-  for (int y = 0; y < disparity_px.rows; ++y) {
-    float* d = disparity_px.ptr<float>(y);
-    const int16_t* f = fixed.ptr<int16_t>(y);
-    for (int x = 0; x < disparity_px.cols; ++x)
-      if (f[x] == kInvalid) d[x] = kInf;
-  }
+  RemoveSpeckleBlobs(disparity_px, o.speckle_window_px, int(std::lround(o.speckle_range_px * 16)));
 }
 
 // The band of disparities a half-resolution SGM finds in the ROI

@@ -214,9 +214,11 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
   cv::Mat index(r.size(), CV_32SC1, cv::Scalar(-1));  // index(y - r.y, x - r.x)
   const Eigen::Vector3f eye = plan.camera_centre_reference_mm.cast<float>();
   auto at = [&](int x, int y) -> const cv::Vec3f* {  // image pixel (x, y); outside the match ROI: no point
-    if (x < r.x || y < r.y || x >= r.x + r.width || y >= r.y + r.height) return nullptr;
-    const cv::Vec3f& p = grid.at<cv::Vec3f>(y - r.y, x - r.x);
-    return std::isnan(p[0]) ? nullptr : &p;
+    // One unsigned comparison per axis tests both ends (x < r.x wraps round).
+    const unsigned gx = unsigned(x - r.x), gy = unsigned(y - r.y);
+    if (gx >= unsigned(r.width) || gy >= unsigned(r.height)) return nullptr;
+    const cv::Vec3f* p = grid.ptr<cv::Vec3f>(int(gy)) + gx;
+    return std::isnan((*p)[0]) ? nullptr : p;
   };
   cloud->Reserve(cloud->size() + kept.size());
   for (const cv::Point& q : kept) {
@@ -253,7 +255,7 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
       if (!l[x]) continue;
       ++report->lit_pixels;
       const int xi = x + plan.roi.x - r.x;
-      report->lit_filled += in && xi >= 0 && xi < r.width && in[xi] >= 0;
+      report->lit_filled += in && unsigned(xi) < unsigned(r.width) && in[xi] >= 0;
     }
   }
   report->times_ms["normals"] = MsSince(t);

@@ -130,37 +130,63 @@ struct Avx2Kernels {
   static int Stride(int n) { return (n + 15) / 16 * 16; }
 
   // planes[k * plane_stride + j] = nibble k of sig[j] for j in [0, count),
-  // k in [0, nibbles).
+  // k in [0, nibbles). 32 signatures at a time: each plane's nibbles are
+  // masked in their 64-bit lanes, narrowed to bytes by three rounds of packs
+  // (which interleave the 128-bit halves) and put back in order by one
+  // permute and one shuffle; the rest one by one.
   static void NibblePlanes(const uint64_t* __restrict sig, int count, int nibbles, uint8_t* __restrict planes,
                            size_t plane_stride) {
+    const __m256i low = _mm256_set1_epi64x(15);
+    // After the packs and the permute, each 128-bit half holds signatures
+    // 0,1,4,5,8,9,12,13, 2,3,6,7,10,11,14,15 (+16 in the upper half).
+    const __m256i order = _mm256_setr_epi8(0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15,  //
+                                           0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15);
+    int j = 0;
+    for (; j + 32 <= count; j += 32) {
+      __m256i v[8];
+      for (int i = 0; i < 8; ++i) v[i] = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(sig + j + 4 * i));
+      for (int k = 0; k < nibbles; ++k) {
+        const __m128i shift = _mm_cvtsi32_si128(4 * k);
+        __m256i t[8];
+        for (int i = 0; i < 8; ++i) t[i] = _mm256_and_si256(_mm256_srl_epi64(v[i], shift), low);
+        const __m256i a = _mm256_packus_epi32(_mm256_packus_epi32(t[0], t[1]), _mm256_packus_epi32(t[2], t[3]));
+        const __m256i b = _mm256_packus_epi32(_mm256_packus_epi32(t[4], t[5]), _mm256_packus_epi32(t[6], t[7]));
+        const __m256i bytes = _mm256_permute4x64_epi64(_mm256_packus_epi16(a, b), 0xD8);
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(planes + k * plane_stride + j),
+                            _mm256_shuffle_epi8(bytes, order));
+      }
+    }
     for (int k = 0; k < nibbles; ++k) {
       uint8_t* __restrict p = planes + k * plane_stride;
       const int shift = 4 * k;
-      for (int j = 0; j < count; ++j) p[j] = uint8_t((sig[j] >> shift) & 15);
+      for (int i = j; i < count; ++i) p[i] = uint8_t((sig[i] >> shift) & 15);
     }
   }
 
   // c[d] = popcount(l ^ r[d]) for d in [0, stride), r[d]'s nibble k at
-  // planes[k * plane_stride + d]; l has at most 4 * kNibbles bits. Reads 32
-  // bytes at d = stride - 16 when stride is an odd multiple of 16 (and
-  // writes 16): planes must be readable 16 bytes beyond. Inlined into the
-  // caller's loop over a row (a call per pixel spilled the tables).
-  template <int kNibbles>
+  // planes[k * plane_stride + d]; l has at most 4 * kNibbles bits.
+  // kOddBlocks: stride is an odd multiple of 16; the last 16 lanes are then
+  // read as 32 bytes (and 16 written): planes must be readable 16 bytes
+  // beyond. Inlined into the caller's loop over a row (a call per pixel
+  // spilled the tables).
+  template <int kNibbles, bool kOddBlocks>
   [[gnu::always_inline]] static inline void CostFromNibbles(uint64_t l, const uint8_t* planes, size_t plane_stride,
                                                             uint8_t* c, int stride) {
     __m256i table[kNibbles];
     for (int k = 0; k < kNibbles; ++k)
       table[k] = _mm256_load_si256(reinterpret_cast<const __m256i*>(kXorPopcount.bytes[(l >> (4 * k)) & 15]));
-    for (int d = 0; d < stride; d += 32) {
+    auto costs32 = [&](int d) {
       __m256i acc = _mm256_shuffle_epi8(table[0], _mm256_loadu_si256(reinterpret_cast<const __m256i*>(planes + d)));
       for (int k = 1; k < kNibbles; ++k)
         acc = _mm256_add_epi8(acc, _mm256_shuffle_epi8(table[k], _mm256_loadu_si256(reinterpret_cast<const __m256i*>(
                                                                      planes + size_t(k) * plane_stride + d))));
-      if (d + 32 <= stride)
-        _mm256_storeu_si256(reinterpret_cast<__m256i*>(c + d), acc);
-      else
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(c + d), _mm256_castsi256_si128(acc));
-    }
+      return acc;
+    };
+    // The whole 32-lane chunks, then the odd 16 apart: no test per chunk.
+    const int whole = kOddBlocks ? stride - 16 : stride;
+    for (int d = 0; d < whole; d += 32) _mm256_storeu_si256(reinterpret_cast<__m256i*>(c + d), costs32(d));
+    if constexpr (kOddBlocks)
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(c + whole), _mm256_castsi256_si128(costs32(whole)));
   }
 
   static __m256i Load(const uint16_t* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); }
