@@ -14,9 +14,9 @@
 namespace stereorig {
 
 double TruthSlopePx(float before_px, float centre_px, float after_px) {
-  if (!std::isfinite(centre_px)) return 0.0;
   const bool has_before = std::isfinite(before_px), has_after = std::isfinite(after_px);
   if (has_before && has_after) return 0.5 * (double(after_px) - before_px);
+  if (!std::isfinite(centre_px)) return 0.0;
   if (has_after) return double(after_px) - centre_px;
   if (has_before) return double(centre_px) - before_px;
   return 0.0;

@@ -41,8 +41,9 @@ void RectifyModulePair(const Rig& rig, const ModulePlan& plan, const std::vector
 
 // The truth disparity's slope along a row or column (px per px) at a pixel
 // holding `centre_px`, from its neighbours before and after (NaN = no truth):
-// the central difference where both exist, the one-sided one where only one
-// does (a silhouette or a depth edge), 0 where neither (or the centre) does.
+// the central difference where both exist (the centre need not), the
+// one-sided one where only one does and the centre has truth (a silhouette
+// or a depth edge), else 0.
 double TruthSlopePx(float before_px, float centre_px, float after_px);
 
 struct FillDiagnosis {

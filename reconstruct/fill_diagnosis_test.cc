@@ -27,8 +27,14 @@ TEST(FillDiagnosis, TruthSlopeAtASilhouetteIsOneSidedNotZero) {
 }
 
 TEST(FillDiagnosis, TruthSlopeWithoutTruthIsZero) {
-  EXPECT_EQ(TruthSlopePx(kNan, 9.0f, kNan), 0.0);  // an isolated truth pixel
-  EXPECT_EQ(TruthSlopePx(4.0f, kNan, 16.0f), 0.0);  // no truth at the pixel itself
+  EXPECT_EQ(TruthSlopePx(kNan, 9.0f, kNan), 0.0);   // an isolated truth pixel
+  EXPECT_EQ(TruthSlopePx(kNan, kNan, 16.0f), 0.0);  // one neighbour, none at the pixel: no difference
+}
+
+TEST(FillDiagnosis, TruthSlopeWithoutCentreTruthStillUsesBothNeighbours) {
+  // A pixel whose own 2x2 truth straddles a depth step (NaN) between two
+  // pixels that have truth: the central difference, as before session 8.
+  EXPECT_DOUBLE_EQ(TruthSlopePx(4.0f, kNan, 16.0f), 6.0);
 }
 
 }  // namespace

@@ -54,8 +54,8 @@ cv::Mat LabelDisparityComponents(const cv::Mat& disparity_px, const cv::Rect& ro
   const float* d_at = disparity_px.ptr<float>(0);  // a pixel is y * cols + x
   for (int y = y0; y < y1; ++y) {
     const float* d = d_at + size_t(y) * size_t(cols);
-    int* w = walk.data() + size_t(y - y0 + 1) * size_t(stride) + 1 - x0;
-    for (int x = x0; x < x1; ++x) w[x] = std::isfinite(d[x]) ? kFree : kBlocked;
+    int* w = walk.data() + size_t(y - y0 + 1) * size_t(stride) + 1;  // (x0, y)
+    for (int x = x0; x < x1; ++x) w[x - x0] = std::isfinite(d[x]) ? kFree : kBlocked;
   }
   // Depth first from each unlabelled valid pixel in raster order, its
   // neighbours pushed left, right, up, down: the order of each component's

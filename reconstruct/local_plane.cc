@@ -6,6 +6,8 @@
 #include <limits>
 #include <utility>
 
+#include "calib/core/input_error.h"
+
 #if defined(__AVX2__)
 #include <immintrin.h>
 #endif
@@ -168,6 +170,8 @@ bool SumExact(const cv::Mat& disparity, const ValidityBits& valid, cv::Point q, 
 
 bool FitLocalPlane(const cv::Mat& disparity, const ValidityBits& valid, const cv::Rect& roi, cv::Point q, int r,
                    LocalPlane* plane) {
+  // The exact-sum bound (local_plane.h) and Span's 64-bit words hold for r <= 10.
+  STEREORIG_CHECK(r >= 1 && r <= 10);
   const Window w{std::max(-r, roi.y - q.y), std::min(r, roi.y + roi.height - 1 - q.y), std::max(-r, roi.x - q.x),
                  std::min(r, roi.x + roi.width - 1 - q.x)};
   Moments m;

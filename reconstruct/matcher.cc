@@ -171,7 +171,8 @@ cv::Mat MatchLevel(const cv::Mat& left, const cv::Mat& right, const cv::Rect& re
 // place.
 void RemoveSpeckles(cv::Mat disparity_px, const MatchOptions& o) {
   if (o.speckle_window_px <= 0) return;
-  RemoveSpeckleBlobs(disparity_px, o.speckle_window_px, int(std::lround(o.speckle_range_px * 16)));
+  // 1/16 px units; 4096 px already joins any two 16-bit values (speckle_filter.cc).
+  RemoveSpeckleBlobs(disparity_px, o.speckle_window_px, int(std::lround(std::min(o.speckle_range_px, 4096.0) * 16)));
 }
 
 // The band of disparities a half-resolution SGM finds in the ROI

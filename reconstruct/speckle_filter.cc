@@ -79,6 +79,9 @@ void ToSixteenths(const float* d, int n, int16_t invalid, int16_t* f) {
 
 void FilterSpeckles16(cv::Mat disparity_16, int16_t invalid, int max_blob_px, int max_diff) {
   STEREORIG_CHECK(disparity_16.type() == CV_16SC1 && max_diff >= 0);
+  // 16-bit values differ by at most 65535: a larger reach joins the same
+  // neighbours, and the clamp keeps `a - b + max_diff` below int's range.
+  max_diff = std::min(max_diff, 65535);
   if (max_blob_px <= 0 || disparity_16.empty()) return;
   const int w = disparity_16.cols, h = disparity_16.rows;
   const std::unique_ptr<int32_t[]> label(new int32_t[size_t(w) * h]);  // every element written below

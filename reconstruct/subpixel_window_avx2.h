@@ -6,8 +6,10 @@
 //
 // Internal linkage, as lanczos_taps.h's SampleLanczos: each file compiles
 // its own copy, so no file can be handed another's copy built with other
-// flags. The arithmetic is the same in every copy (intrinsics: nothing for
-// the compiler to contract), so the sums are the same floats.
+// flags. The arithmetic is the same in every copy: no plain multiply here
+// feeds a plain add (each product goes to an hadd or is an explicit FMA),
+// so there is nothing GCC could contract differently in one copy; keep it
+// so when editing (GCC does fuse _mm256_mul_ps into _mm256_add_ps).
 #pragma once
 
 #if !defined(__AVX2__)
