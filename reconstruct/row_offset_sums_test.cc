@@ -32,7 +32,6 @@ TEST(RowOffsetSums, EqualThePlainLoopBitForBit) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> intensity(0, 255), slope(-40, 40);
   std::uniform_real_distribution<double> t01(0, 1), near1(0.5, 1.5), level(-20, 20);
-  int compared = 0;
   for (int trial = 0; trial < 300; ++trial) {
     const int n = 1 + trial % 120, npad = (n + 7) / 8 * 8;
     std::vector<float> buffer(9 * size_t(npad));
@@ -52,9 +51,7 @@ TEST(RowOffsetSums, EqualThePlainLoopBitForBit) {
     const double gain = near1(rng), offset = level(rng);
     const RowOffsetSums expected = PlainSums(l, rk, gk, w, dw, gain, offset, n);
     ASSERT_EQ(RowOffsetPassSums(l, rk, gk, w, dw, gain, offset, n), expected) << "n " << n;
-    ++compared;
   }
-  EXPECT_EQ(compared, 300);
 }
 
 }  // namespace
