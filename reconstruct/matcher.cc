@@ -171,8 +171,7 @@ cv::Mat MatchLevel(const cv::Mat& left, const cv::Mat& right, const cv::Rect& re
 // place.
 void RemoveSpeckles(cv::Mat disparity_px, const MatchOptions& o) {
   if (o.speckle_window_px <= 0) return;
-  // 1/16 px units; 4096 px already joins any two 16-bit values (speckle_filter.cc).
-  RemoveSpeckleBlobs(disparity_px, o.speckle_window_px, int(std::lround(std::min(o.speckle_range_px, 4096.0) * 16)));
+  RemoveSpeckleBlobs(disparity_px, o.speckle_window_px, o.speckle_range_px);
 }
 
 // The band of disparities a half-resolution SGM finds in the ROI

@@ -137,12 +137,10 @@ void FilterSpeckles16(cv::Mat disparity_16, int16_t invalid, int max_blob_px, in
   }
 }
 
-}  // namespace stereorig
-
-namespace stereorig {
-
-void RemoveSpeckleBlobs(cv::Mat disparity_px, int max_blob_px, int max_diff_16) {
-  STEREORIG_CHECK(disparity_px.type() == CV_32FC1);
+void RemoveSpeckleBlobs(cv::Mat disparity_px, int max_blob_px, double max_diff_px) {
+  STEREORIG_CHECK(disparity_px.type() == CV_32FC1 && max_diff_px >= 0);
+  // In sixteenths; 4096 px already joins any two 16-bit values.
+  const int max_diff_16 = int(std::lround(std::min(max_diff_px, 4096.0) * 16));
   constexpr int16_t kInvalid = std::numeric_limits<int16_t>::min();
   cv::Mat fixed(disparity_px.size(), CV_16SC1);
   for (int y = 0; y < disparity_px.rows; ++y)

@@ -23,8 +23,8 @@ void FilterSpeckles16(cv::Mat disparity_16, int16_t invalid, int max_blob_px, in
 // The same on a float map (CV_32FC1, may be a view, written in place), as
 // the matcher's speckle filter runs it: on a copy in 1/16 px (each finite
 // value clamped to +-2000 px and rounded half away from zero, as
-// std::lround), blobs whose neighbours differ by at most max_diff_16
-// sixteenths; removed and non-finite pixels become +inf.
-void RemoveSpeckleBlobs(cv::Mat disparity_px, int max_blob_px, int max_diff_16);
+// std::lround), blobs whose neighbours differ by at most max_diff_px
+// (rounded to sixteenths likewise); removed and non-finite pixels become +inf.
+void RemoveSpeckleBlobs(cv::Mat disparity_px, int max_blob_px, double max_diff_px);
 
 }  // namespace stereorig

@@ -109,7 +109,7 @@ TEST(RemoveSpeckleBlobs, MatchesRoundingThenOpenCvFilter) {
       cv::filterSpeckles(fixed, kInvalid, max_blob, 16);
       expected.setTo(std::numeric_limits<float>::infinity(), fixed == kInvalid);
       cv::Mat got = map.clone();
-      RemoveSpeckleBlobs(got, max_blob, 16);
+      RemoveSpeckleBlobs(got, max_blob, 1.0);  // 16 sixteenths
       ASSERT_EQ(cv::countNonZero(got != expected), 0) << size << " blob " << max_blob;  // NaN != NaN: none left
       kept += cv::countNonZero(got == map);  // finite values kept are untouched (NaN != NaN)
       removed += cv::countNonZero((got != map) & (map == map));
@@ -133,7 +133,7 @@ TEST(RemoveSpeckleBlobs, RoundsHalvesAwayFromZeroAndClamps) {
       cv::Mat row(1, 20, CV_32FC1, cv::Scalar(nan));
       row.at<float>(0, x) = a;
       row.at<float>(0, x + 1) = b;
-      RemoveSpeckleBlobs(row, 1, 16);
+      RemoveSpeckleBlobs(row, 1, 1.0);  // 16 sixteenths
       EXPECT_EQ(std::isfinite(row.at<float>(0, x)), joined) << a << " " << b << " at " << x;
       EXPECT_EQ(std::isfinite(row.at<float>(0, x + 1)), joined) << a << " " << b << " at " << x;
     }
