@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "calib/core/input_error.h"
-#include "reconstruct/kernel_correlation.h"
 #include "reconstruct/parallel_for.h"
 
 namespace stereorig {
@@ -43,9 +42,10 @@ struct Factor6 {
 };
 
 // Factors the symmetric a (lower triangle read): false if it is not
-// positive definite. Written out at this fixed size (unrolled) rather than with Eigen::LLT, whose generic blocked code
-// and L1 norm cost ~860 instructions per 6x6 factorisation and ~350 per pair of solves; on the demo cup two thirds of
-// the fitted windows have holes and need their own (docs/reconstruct.md, "The refinement steps' instruction count").
+// positive definite. Written out at this fixed size (unrolled) rather than with Eigen::LLT, whose generic blocked code and L1 norm
+// cost ~860 instructions per 6x6 factorisation and ~350 per pair of solves;
+// on the demo cup two thirds of the fitted windows have holes and need
+// their own (docs/reconstruct.md, "The refinement steps' instruction count").
 inline bool Factor(const Matrix6& a, Factor6* f) {
 #pragma GCC unroll 6
   for (int j = 0; j < kTerms; ++j) {
@@ -96,23 +96,21 @@ cv::Mat PowerTaps(int half, int power, bool along_row) {
 }
 
 // Window sums of image * (u/hw)^i * (v/hh)^j: a row pass (shared by every j)
-// then a column pass, with the taps of PowerTaps. Correlation: out(x) =
-// sum_u k(u) in(x + u); outside the image counts as 0. By the arithmetic of
-// cv::filter2D, which they replaced (kernel_correlation.h).
-cv::Mat RowMoment(const cv::Mat& image, const KernelTaps& taps) {
-  cv::Mat out(image.size(), CV_32F);
-  for (int y = 0; y < image.rows; ++y) CorrelateAlongRow(image.ptr<float>(y), image.cols, taps, out.ptr<float>(y));
+// then a column pass, with the taps of PowerTaps. Correlation (OpenCV does
+// not flip kernels): out(x) = sum_u k(u) in(x + u); outside the image counts
+// as 0.
+cv::Mat RowMoment(const cv::Mat& image, const cv::Mat& taps) {
+  cv::Mat out;
+  cv::filter2D(image, out, CV_32F, taps, cv::Point(-1, -1), 0, cv::BORDER_CONSTANT);
   return out;
 }
-// rows: the output rows wanted. Each reads the rows of `row_moment` around
-// it as they are (0 only beyond its ends), so each output is the sum over
-// the same pixels by the same arithmetic as when every row is filtered.
-cv::Mat ColumnMoment(const cv::Mat& row_moment, const KernelTaps& taps, const cv::Range& rows) {
-  cv::Mat out(rows.size(), row_moment.cols, CV_32F);
-  const long stride = long(row_moment.step1());
-  for (int y = rows.start; y < rows.end; ++y)
-    CorrelateDownColumns(row_moment.ptr<float>(0), stride, row_moment.rows, y, row_moment.cols, taps,
-                         out.ptr<float>(y - rows.start));
+// rows: the output rows wanted. Without BORDER_ISOLATED, filter2D reads the
+// rows of `row_moment` around them as they are (0 only beyond its ends), so
+// each output is the sum over the same pixels by the same arithmetic as when
+// every row is filtered.
+cv::Mat ColumnMoment(const cv::Mat& row_moment, const cv::Mat& taps, const cv::Range& rows) {
+  cv::Mat out;
+  cv::filter2D(row_moment.rowRange(rows), out, CV_32F, taps, cv::Point(-1, -1), 0, cv::BORDER_CONSTANT);
   return out;
 }
 
@@ -172,14 +170,13 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
   // 30 MB per module on the demo plate, live while the other module
   // matched). A row filter reads only its own row, and the column filters'
   // output rows have their whole window inside the band's input rows
-  // (ColumnMoment), so every sum comes from the same pixels by the same
-  // arithmetic as over the whole ROI.
+  // (ColumnMoment), so every sum
+  // comes from the same pixels by the same arithmetic as over the whole ROI
+  // (filter2D stays direct, not DFT, below ~130 taps; Check() keeps the
+  // half widths <= 30, so kernels have <= 61 taps).
   constexpr int kBandRows = 128;
-  KernelTaps row_taps[5], column_taps[5];
-  for (int i = 0; i <= 4; ++i) {
-    row_taps[i] = NonzeroTaps(PowerTaps(hw, i, true).ptr<float>(0), hw);
-    column_taps[i] = NonzeroTaps(PowerTaps(hh, i, false).ptr<float>(0), hh);
-  }
+  cv::Mat row_taps[5], column_taps[5];
+  for (int i = 0; i <= 4; ++i) row_taps[i] = PowerTaps(hw, i, true), column_taps[i] = PowerTaps(hh, i, false);
   for (int y0 = 0; y0 < roi.height; y0 += kBandRows) {
     const int y1 = std::min(roi.height, y0 + kBandRows);
     const int in0 = std::max(0, y0 - hh), in1 = std::min(roi.height, y1 + hh);  // the band's input rows
@@ -195,8 +192,7 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
       const cv::Mat row = RowMoment(band_values, row_taps[i]);
       for (int j = 0; i + j <= 2; ++j) value_moment[i][j] = ColumnMoment(row, column_taps[j], out_rows);
     }
-    const cv::Mat squares =
-        ColumnMoment(RowMoment(band_values.mul(band_values), row_taps[0]), column_taps[0], out_rows);
+    const cv::Mat squares = ColumnMoment(RowMoment(band_values.mul(band_values), row_taps[0]), column_taps[0], out_rows);
     ParallelForChunks(y1 - y0, num_threads, [&](int b, int e) {
       for (int y = y0 + b; y < y0 + e; ++y) {
         const float* valid = mask.ptr<float>(y);
