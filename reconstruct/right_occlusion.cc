@@ -38,10 +38,17 @@ int DropRightInvisible(double margin_px, const cv::Mat& right_valid, const cv::R
   // (up to row_max - d px) was the filter's cost. The same float landings
   // as the scan's, so the result is the same.
   std::vector<float> first_landing(roi.width + 1);
+  // invalid_before[c]: how many of the row's columns left of c have no data
+  // in the right view. The edge test below asks whether any column of a
+  // short range has none; one difference of this count answers it, where
+  // testing the columns one by one was a third of the filter's cost.
+  std::vector<int> invalid_before(size_t(cols) + 1, 0);
   int dropped = 0;
   for (int y = roi.y; y < roi.y + roi.height; ++y) {
     float* d = disparity.ptr<float>(y);
     const uint8_t* valid = right_valid.empty() ? nullptr : right_valid.ptr<uint8_t>(y);
+    if (valid)
+      for (int c = 0; c < cols; ++c) invalid_before[size_t(c) + 1] = invalid_before[size_t(c)] + (valid[c] == 0);
     float row_max = -kInf;
     first_landing[roi.width] = kInf;
     for (int x = roi.x + roi.width - 1; x >= roi.x; --x) {
@@ -53,10 +60,11 @@ int DropRightInvisible(double margin_px, const cv::Mat& right_valid, const cv::R
     for (int x = roi.x; x < roi.x + roi.width; ++x) {
       if (!std::isfinite(d[x])) continue;
       const double xr = x - d[x];
-      bool hidden = false;
-      // Outside the right view: no column there, or one without data.
-      for (int c = int(std::floor(xr - margin_px)); c <= int(std::floor(xr + margin_px)) && !hidden; ++c)
-        hidden = c < 0 || c >= cols || (valid && !valid[c]);
+      // Outside the right view: a column from c_first to c_last (c_first <=
+      // c_last, as margin_px > 0) outside the image, or one without data.
+      const int c_first = int(std::floor(xr - margin_px)), c_last = int(std::floor(xr + margin_px));
+      bool hidden = c_first < 0 || c_last >= cols ||
+                    (valid && invalid_before[size_t(c_last) + 1] > invalid_before[size_t(c_first)]);
       // Occluded: an occluder x' lands at x' - d' <= xr, so
       // x' <= x + (d' - d) <= x + (row_max - d).
       if (!hidden && first_landing[x - roi.x + 1] <= xr) {
