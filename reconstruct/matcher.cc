@@ -17,6 +17,7 @@
 #include "reconstruct/region_grow.h"
 #include "reconstruct/right_occlusion.h"
 #include "reconstruct/sgm_guide.h"
+#include "reconstruct/skipped_columns.h"
 #include "reconstruct/speckle_filter.h"
 
 namespace stereorig {
@@ -63,6 +64,8 @@ void MatchOptions::Check() const {
   line_index.Check();
   grow.Check();
   surface_fit.Check();
+  if (subpixel_column_step < 1 || subpixel_column_step > 4)
+    throw InputError("subpixel_column_step", "must be in [1, 4] (1 = every column)");
   if (!(min_zncc >= -1 && min_zncc < 1)) throw InputError("min_zncc", "must be in [-1, 1)");
   if (!(max_plane_deviation_px >= 0)) throw InputError("max_plane_deviation_px", "must be >= 0 (0 = off)");
   if (!(min_texture_dn >= 0)) throw InputError("min_texture_dn", "must be >= 0");
@@ -283,60 +286,93 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
     result.times_ms["subpixel_dense"] =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_dense).count();
   }
+  const int column_step = o.intensity_refinement ? o.subpixel_column_step : 1;
   ParallelForChunks(roi.height, o.num_threads, [&](int b, int e) {
     for (int yy = b; yy < e; ++yy) {
       const int y = roi.y + yy;
       const float* in = coarse_to_fine.ptr<float>(yy);
       const float* slope_x = state.slope_x.ptr<float>(y);
       const float* slope_y = state.slope_y.ptr<float>(y);
+      const float* plane_row = plane.ptr<float>(yy);
       float* out = state.disparity_px.ptr<float>(y);
       float* conf = state.confidence.ptr<float>(y);
       uint8_t* status = state.status.ptr<uint8_t>(y);
-      for (int xx = 0; xx < roi.width; ++xx) {
-        const int x = roi.x + xx;
-        auto reject = [&](PixelStatus why) { status[x] = uint8_t(why); };
-        if (std::isnan(in[xx])) {
-          reject(PixelStatus::kNoSgmMatch);
-          continue;
-        }
-        double d = in[xx];
-        float confidence = 1.0f;
-        const float pl = plane.at<float>(yy, xx);
-        if (o.max_plane_deviation_px > 0 && std::isnan(pl)) {
-          reject(PixelStatus::kNoPlane);
-          continue;
-        }
+      // The tests before the refinement: kPoint = refine the pixel.
+      auto before_refining = [&](int xx) {
+        if (std::isnan(in[xx])) return PixelStatus::kNoSgmMatch;
+        const float pl = plane_row[xx];
+        if (o.max_plane_deviation_px > 0 && std::isnan(pl)) return PixelStatus::kNoPlane;
         // The plane test below, applied early to the cost-fit disparity (the
         // refinement moves it by < max_shift_px): saves refining mismatches.
-        if (o.max_plane_deviation_px > 0 && std::abs(d - pl) > o.max_plane_deviation_px + o.subpixel.max_shift_px) {
-          reject(PixelStatus::kOffPlaneCoarse);
-          continue;
-        }
+        if (o.max_plane_deviation_px > 0 && std::abs(double(in[xx]) - pl) > o.max_plane_deviation_px + o.subpixel.max_shift_px)
+          return PixelStatus::kOffPlaneCoarse;
+        return PixelStatus::kPoint;
+      };
+      // Consistency with the neighbourhood: the refined disparity must lie
+      // within max_plane_deviation_px of the plane fitted to the 9x9
+      // integer-level disparities around it (isolated mismatches and the
+      // edges of mismatched patches fail this).
+      auto on_plane = [&](int xx, double d) {
+        return !(o.max_plane_deviation_px > 0 && std::abs(d - plane_row[xx]) > o.max_plane_deviation_px);
+      };
+      auto keep = [&](int x, double d, float confidence) {
+        out[x] = float(d);
+        conf[x] = confidence;
+        status[x] = uint8_t(PixelStatus::kPoint);
+      };
+      // The refinement and the tests after it; sets the pixel's state.
+      auto refine = [&](int xx) {
+        const int x = roi.x + xx;
+        double d = in[xx];
+        float confidence = 1.0f;
         if (o.intensity_refinement) {
           SubpixelResult s = dense.ok.empty() ? SubpixelResult{} : dense.At(x, y);
           const PixelStatus why = s.ok ? Accept(left, right, x, y, slope_x[x], slope_y[x], s, accept)
                                        : RefineAndAccept(left, right, x, y, d, slope_x[x], slope_y[x], accept, &s);
           if (why != PixelStatus::kPoint) {
-            reject(why);
-            continue;
+            status[x] = uint8_t(why);
+            return;
           }
           d = s.disparity_px;
           confidence = float(std::clamp(s.zncc, 0.0, 1.0));
         } else if (d < accept.min_disparity_px || d > accept.max_disparity_px) {  // range filter
-          reject(PixelStatus::kOutOfRange);
+          status[x] = uint8_t(PixelStatus::kOutOfRange);
+          return;
+        }
+        if (!on_plane(xx, d)) {
+          status[x] = uint8_t(PixelStatus::kOffPlane);
+          return;
+        }
+        keep(x, d, confidence);
+      };
+      // The refined columns first (all of them with column_step 1), then
+      // the skipped ones from those either side (skipped_columns.h).
+      for (int xx = 0; xx < roi.width; ++xx) {
+        if (!IsRefinedColumn(xx, column_step)) continue;
+        const PixelStatus why = before_refining(xx);
+        if (why == PixelStatus::kPoint)
+          refine(xx);
+        else
+          status[roi.x + xx] = uint8_t(why);
+      }
+      if (column_step == 1) continue;
+      for (int xx = 0; xx < roi.width; ++xx) {
+        if (IsRefinedColumn(xx, column_step)) continue;
+        const int x = roi.x + xx;
+        const PixelStatus why = before_refining(xx);
+        if (why != PixelStatus::kPoint) {
+          status[x] = uint8_t(why);
           continue;
         }
-        // Consistency with the neighbourhood: the refined disparity must lie
-        // within max_plane_deviation_px of the plane fitted to the 9x9
-        // integer-level disparities around it (isolated mismatches and the
-        // edges of mismatched patches fail this).
-        if (o.max_plane_deviation_px > 0 && std::abs(d - pl) > o.max_plane_deviation_px) {
-          reject(PixelStatus::kOffPlane);
-          continue;
-        }
-        out[x] = float(d);
-        conf[x] = confidence;
-        status[x] = uint8_t(PixelStatus::kPoint);
+        const int x_left = x - xx % column_step, x_right = x_left + column_step;
+        double d = 0;
+        float confidence = 0;
+        if (x_right < roi.x + roi.width &&
+            InterpolateSkippedColumn(out, conf, status, x_left, x, x_right, slope_x[x], &d, &confidence) &&
+            on_plane(xx, d))
+          keep(x, d, confidence);
+        else
+          refine(xx);
       }
     }
   });

@@ -80,6 +80,7 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.subpixel.half_width_px = m.GetInt("subpixel_half_width_px", mo.subpixel.half_width_px);
     mo.subpixel.half_height_px = m.GetInt("subpixel_half_height_px", mo.subpixel.half_height_px);
     mo.subpixel_dense = m.GetBool("subpixel_dense", mo.subpixel_dense);
+    mo.subpixel_column_step = m.GetInt("subpixel_column_step", mo.subpixel_column_step);
     mo.min_zncc = m.GetDouble("min_zncc", mo.min_zncc);
     mo.max_plane_deviation_px = m.GetDouble("max_plane_deviation_px", mo.max_plane_deviation_px);
     mo.narrow_range = m.GetBool("narrow_range", mo.narrow_range);

@@ -1,4 +1,4 @@
-// Runtime options: the hole-filling, surface-fit and line-index ambiguity keys are read, defaulted and checked
+// Runtime options: the hole-filling, surface-fit, line-index ambiguity and sub-pixel column-step keys are read, defaulted and checked
 // (a bad value or an unknown key is an InputError naming it).
 #include "reconstruct/runtime_options.h"
 
@@ -75,6 +75,17 @@ TEST(RuntimeOptions, ReadsAndChecksTheLineIndexAmbiguityKeys) {
       {"match:\n  line_index_footprint_gap_px: -1\n", "line_index_footprint_gap_px"},
       {"match:\n  line_index_ambiguity_sigmas: -0.5\n", "line_index_ambiguity_sigmas"},
       {"match:\n  line_index_ambiguity_sigma: 1\n", "line_index_ambiguity_sigma"}};
+  ExpectEachRejectedNamingItsKey(bad);
+}
+
+TEST(RuntimeOptions, ReadsAndChecksTheSubpixelColumnStep) {
+  EXPECT_EQ(ParseRuntimeOptions("min_confidence: 0.5\n", "defaults.yaml").match.subpixel_column_step, 1);
+  EXPECT_EQ(ParseRuntimeOptions("match:\n  subpixel_column_step: 3\n", "set.yaml").match.subpixel_column_step, 3);
+  const std::pair<const char*, const char*> bad[] = {
+      {"match:\n  subpixel_column_step: 0\n", "subpixel_column_step"},
+      {"match:\n  subpixel_column_step: 5\n", "subpixel_column_step"},
+      {"match:\n  subpixel_column_step: 1.5\n", "subpixel_column_step"},
+      {"match:\n  subpixel_column_steps: 2\n", "subpixel_column_steps"}};
   ExpectEachRejectedNamingItsKey(bad);
 }
 
