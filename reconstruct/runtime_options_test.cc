@@ -1,4 +1,4 @@
-// Runtime options: the hole-filling, surface-fit and line-index ambiguity keys are read, defaulted and checked
+// Runtime options: the hole-filling, surface-fit, line-index ambiguity and band-pass keys are read, defaulted and checked
 // (a bad value or an unknown key is an InputError naming it).
 #include "reconstruct/runtime_options.h"
 
@@ -75,6 +75,24 @@ TEST(RuntimeOptions, ReadsAndChecksTheLineIndexAmbiguityKeys) {
       {"match:\n  line_index_footprint_gap_px: -1\n", "line_index_footprint_gap_px"},
       {"match:\n  line_index_ambiguity_sigmas: -0.5\n", "line_index_ambiguity_sigmas"},
       {"match:\n  line_index_ambiguity_sigma: 1\n", "line_index_ambiguity_sigma"}};
+  ExpectEachRejectedNamingItsKey(bad);
+}
+
+TEST(RuntimeOptions, ReadsAndChecksTheBandPassKeys) {
+  const RuntimeOptions d = ParseRuntimeOptions("min_confidence: 0.5\n", "defaults.yaml");
+  EXPECT_EQ(d.match.band_sgm_paths, 4);
+  EXPECT_EQ(d.match.band_row_step, 1);
+  const RuntimeOptions o =
+      ParseRuntimeOptions("match:\n  band_sgm_paths: 3\n  band_row_step: 2\n  sgm_paths: 4\n", "set.yaml");
+  EXPECT_EQ(o.match.band_sgm_paths, 3);
+  EXPECT_EQ(o.match.band_row_step, 2);
+  EXPECT_EQ(o.match.sgm.num_paths, 4);  // the full-resolution search keeps its own
+  const std::pair<const char*, const char*> bad[] = {
+      {"match:\n  band_sgm_paths: 2\n", "band_sgm_paths"},
+      {"match:\n  band_row_step: 0\n", "band_row_step"},
+      {"match:\n  band_row_step: 3\n", "band_row_step"},
+      {"match:\n  band_row_step: 2\n  guided_radius_px: 15\n", "band_row_step"},
+      {"match:\n  band_row_steps: 2\n", "band_row_steps"}};
   ExpectEachRejectedNamingItsKey(bad);
 }
 
