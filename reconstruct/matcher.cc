@@ -49,6 +49,10 @@ void MatchOptions::Check() const {
   if (roi.width < 0 || roi.height < 0) throw InputError("roi", "must have a non-negative size");
   if (pyramid_levels < 0 || pyramid_levels > 3) throw InputError("pyramid_levels", "must be in [0, 3]");
   if (guided_radius_px < 0 || guided_radius_px > 64) throw InputError("guided_radius_px", "must be in [0, 64]");
+  if (band_sgm_paths != 3 && band_sgm_paths != 4) throw InputError("band_sgm_paths", "must be 3 or 4");
+  if (band_row_step < 1 || band_row_step > 2) throw InputError("band_row_step", "must be 1 or 2");
+  if (band_row_step > 1 && guided_radius_px > 0)
+    throw InputError("band_row_step", "must be 1 with guided_radius_px > 0 (the guide is half-resolution)");
   if (refine_radius_px < 1 || refine_radius_px > 8) throw InputError("refine_radius_px", "must be in [1, 8]");
   if (refine_half_window_px < 0 || refine_half_window_px > 5)
     throw InputError("refine_half_window_px", "must be in [0, 5]");
@@ -184,17 +188,21 @@ void RemoveSpeckles(cv::Mat disparity_px, const MatchOptions& o) {
 // (GuideFromCoarse), else left empty.
 bool OccupiedBand(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const MatchOptions& o, int* dmin,
                   int* num, cv::Mat* guide_px) {
+  const int ys = 2 * o.band_row_step;  // rows per band-pass row
   cv::Mat lh, rh;
-  cv::resize(left, lh, cv::Size(left.cols / 2, left.rows / 2), 0, 0, cv::INTER_AREA);
-  cv::resize(right, rh, cv::Size(right.cols / 2, right.rows / 2), 0, 0, cv::INTER_AREA);
+  cv::resize(left, lh, cv::Size(left.cols / 2, left.rows / ys), 0, 0, cv::INTER_AREA);
+  cv::resize(right, rh, cv::Size(right.cols / 2, right.rows / ys), 0, 0, cv::INTER_AREA);
   const cv::Rect half =
-      cv::Rect(roi.x / 2, roi.y / 2, std::max(1, roi.width / 2), std::max(1, roi.height / 2)) &
+      cv::Rect(roi.x / 2, roi.y / ys, std::max(1, roi.width / 2), std::max(1, roi.height / ys)) &
       cv::Rect(0, 0, lh.cols, lh.rows);
-  cv::Mat d = MatchLevel(lh, rh, half, int(std::floor(*dmin / 2.0)) - 1, (*num + 1) / 2 + 3, 0, o);
+  MatchOptions band_options = o;
+  band_options.sgm.num_paths = o.band_sgm_paths;
+  cv::Mat d = MatchLevel(lh, rh, half, int(std::floor(*dmin / 2.0)) - 1, (*num + 1) / 2 + 3, 0, band_options);
   // The coarse level's mismatches are mostly small blobs: removing them
-  // first leaves the band to the surfaces (disparity_band.h).
+  // first leaves the band to the surfaces (disparity_band.h). The window is
+  // an area: fewer rows, fewer pixels per blob.
   MatchOptions blobs = o;
-  blobs.speckle_window_px = kCoarseSpeckleWindowPx;
+  blobs.speckle_window_px = kCoarseSpeckleWindowPx / o.band_row_step;
   blobs.speckle_range_px = kCoarseSpeckleRangePx;
   RemoveSpeckles(d, blobs);
   std::vector<float> v;  // full-resolution px

@@ -58,6 +58,17 @@ struct MatchOptions {
   // resolution. Cost: ~1/8 of a full search, saving most of a deep volume's range.
   bool narrow_range = true;  // default true
   int range_margin_px = 12;  // default 12 px: 6 let period-shifted matches in on the cup's flank (rms 0.07 -> 0.12 mm)
+  // census_sgm with narrow_range: the band pass's SGM paths, 3 (left, right,
+  // top: one pass, no volume kept) or 4 (+bottom), independent of
+  // sgm.num_paths (the full-resolution search's). Default 4.
+  int band_sgm_paths = 4;
+  // census_sgm with narrow_range: the band pass runs on every
+  // band_row_step-th row of its half-resolution images (the rows averaged
+  // down, INTER_AREA; columns stay at half resolution, so a grid period is
+  // still ~4 px along the rows), its blob filter's window scaled by the
+  // same factor. 1 or 2; 2 needs guided_radius_px 0 (the guide is built on
+  // the half-resolution grid). Default 1.
+  int band_row_step = 1;
   // census_sgm with narrow_range: the full-resolution SGM searches each pixel
   // only within +-guided_radius_px of twice the band pass's half-resolution
   // disparity there (sgm_guide.h, SgmMatchGuided), gaps filled from the

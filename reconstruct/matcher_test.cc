@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <opencv2/imgproc.hpp>
+#include <utility>
 
 #include "reconstruct/synthetic_pair.h"
 
@@ -170,6 +171,26 @@ TEST(Matcher, CoarseToFineFindsTheRightLineToo) {
   Print("census_sgm levels=1", s);
   EXPECT_GT(s.fill(), 0.97);
   EXPECT_LT(s.max_abs, 0.5);
+}
+
+TEST(Matcher, CheaperBandPassesStillBracketTheTruth) {
+  // The occupied-band pass with 3 paths and on every other half-resolution
+  // row: the band it finds must still hold the whole plane (true d 40..56
+  // px) in a 96 px range, else pixels go unmatched or a grid period off
+  // (~8 px, far above the 0.5 px bound). Same bounds as the slanted-plane
+  // test above, whose pair this is.
+  const SyntheticPair pair = RenderSyntheticPair(SyntheticPairSpec{});
+  for (const auto& [paths, row_step] : {std::pair{3, 1}, std::pair{4, 2}, std::pair{3, 2}}) {
+    MatchOptions o = Options(MatcherKind::kCensusSgm);
+    o.min_disparity_px = 8;
+    o.num_disparities = 96;
+    o.band_sgm_paths = paths;
+    o.band_row_step = row_step;
+    const ErrorStats s = Score(Match(pair.left, pair.right, o), pair, kMargin);
+    Print("census_sgm cheap band", s);
+    EXPECT_GT(s.fill(), 0.97) << paths << " paths, row step " << row_step;
+    EXPECT_LT(s.max_abs, 0.5) << paths << " paths, row step " << row_step;
+  }
 }
 
 TEST(Matcher, RoiAndRangeAreHonoured) {

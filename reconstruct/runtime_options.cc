@@ -86,6 +86,8 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.narrow_range = m.GetBool("narrow_range", mo.narrow_range);
     mo.range_margin_px = m.GetInt("range_margin_px", mo.range_margin_px);
     mo.guided_radius_px = m.GetInt("guided_radius_px", mo.guided_radius_px);
+    mo.band_sgm_paths = m.GetInt("band_sgm_paths", mo.band_sgm_paths);
+    mo.band_row_step = m.GetInt("band_row_step", mo.band_row_step);
     mo.census_half_width_px = m.GetInt("census_half_width_px", mo.census_half_width_px);
     mo.census_half_height_px = m.GetInt("census_half_height_px", mo.census_half_height_px);
     mo.min_texture_dn = m.GetDouble("min_texture_dn", mo.min_texture_dn);

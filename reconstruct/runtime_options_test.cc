@@ -1,4 +1,5 @@
-// Runtime options: the hole-filling, surface-fit, line-index ambiguity and sub-pixel column-step keys are read, defaulted and checked
+// Runtime options: the hole-filling, surface-fit, line-index ambiguity, sub-pixel column-step and band-pass keys are read,
+// defaulted and checked
 // (a bad value or an unknown key is an InputError naming it).
 #include "reconstruct/runtime_options.h"
 
@@ -86,6 +87,24 @@ TEST(RuntimeOptions, ReadsAndChecksTheSubpixelColumnStep) {
       {"match:\n  subpixel_column_step: 5\n", "subpixel_column_step"},
       {"match:\n  subpixel_column_step: 1.5\n", "subpixel_column_step"},
       {"match:\n  subpixel_column_steps: 2\n", "subpixel_column_steps"}};
+  ExpectEachRejectedNamingItsKey(bad);
+}
+
+TEST(RuntimeOptions, ReadsAndChecksTheBandPassKeys) {
+  const RuntimeOptions d = ParseRuntimeOptions("min_confidence: 0.5\n", "defaults.yaml");
+  EXPECT_EQ(d.match.band_sgm_paths, 4);
+  EXPECT_EQ(d.match.band_row_step, 1);
+  const RuntimeOptions o =
+      ParseRuntimeOptions("match:\n  band_sgm_paths: 3\n  band_row_step: 2\n  sgm_paths: 4\n", "set.yaml");
+  EXPECT_EQ(o.match.band_sgm_paths, 3);
+  EXPECT_EQ(o.match.band_row_step, 2);
+  EXPECT_EQ(o.match.sgm.num_paths, 4);  // the full-resolution search keeps its own
+  const std::pair<const char*, const char*> bad[] = {
+      {"match:\n  band_sgm_paths: 2\n", "band_sgm_paths"},
+      {"match:\n  band_row_step: 0\n", "band_row_step"},
+      {"match:\n  band_row_step: 3\n", "band_row_step"},
+      {"match:\n  band_row_step: 2\n  guided_radius_px: 15\n", "band_row_step"},
+      {"match:\n  band_row_steps: 2\n", "band_row_steps"}};
   ExpectEachRejectedNamingItsKey(bad);
 }
 
