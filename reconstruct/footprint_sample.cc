@@ -57,7 +57,8 @@ void FootprintSampler::VisitRow(int y, int x_begin, int x_end, Visit&& visit) co
   }
 }
 
-std::vector<FootprintStart> FootprintSampler::Sample(const std::vector<int>& pixels) {
+std::vector<FootprintStart> FootprintSampler::Sample(const std::vector<int>& pixels, int area_per_sample_px) {
+  STEREORIG_CHECK(area_per_sample_px >= 0);
   if (order_.empty()) order_.assign(disparity_px_.total(), 0);
   STEREORIG_CHECK(order_.size() == disparity_px_.total() && disparity_px_.isContinuous());  // same map size
   const float* d = disparity_px_.ptr<float>(0);
@@ -81,7 +82,12 @@ std::vector<FootprintStart> FootprintSampler::Sample(const std::vector<int>& pix
       row_count_[size_t(y - y_min)] = n;
       total += size_t(n);
     }
-    const double stride = std::max(1.0, double(total) / samples_);
+    // With area_per_sample_px, one sample per that much footprint if that
+    // is more: the whole region is read, not just `samples_` of it.
+    const double samples = area_per_sample_px > 0
+                               ? std::max(double(samples_), std::floor(double(total) / area_per_sample_px))
+                               : double(samples_);
+    const double stride = std::max(1.0, double(total) / samples);
     double k = 0.5 * stride;  // the next rank to take, accumulated as in the plain listing
     size_t rank = 0;          // of the first footprint pixel of row y
     for (int y = y_min; y <= y_max && k < double(total); ++y) {

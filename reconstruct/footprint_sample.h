@@ -51,8 +51,11 @@ class FootprintSampler {
 
   // Up to `samples` pixels of the footprint of `pixels` (indices y * cols + x,
   // no duplicates; entries whose disparity is empty now are not part of it,
-  // but may be footprint gap pixels), in raster order.
-  std::vector<FootprintStart> Sample(const std::vector<int>& pixels);
+  // but may be footprint gap pixels), in raster order. With
+  // area_per_sample_px > 0, a footprint of N pixels gets
+  // max(samples, floor(N / area_per_sample_px)) of them instead
+  // (LineIndexOptions::area_per_sample_px), spread the same way.
+  std::vector<FootprintStart> Sample(const std::vector<int>& pixels, int area_per_sample_px = 0);
 
  private:
   // Calls visit(i, source) for the footprint pixels of row y within columns

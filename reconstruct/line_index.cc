@@ -20,10 +20,13 @@ void LineIndexOptions::Check() const {
     throw InputError("line_index_window_half_height_px", "must be in [0, 30]");
   if (!(max_row_offset_px > 0 && max_row_offset_px < 1))
     throw InputError("line_index_max_row_offset_px", "must be in (0, 1)");
+  if (area_per_sample_px < 0 || area_per_sample_px > 100000)
+    throw InputError("line_index_area_per_sample_px", "must be in [0, 100000] (0 = off)");
   if (footprint_gap_px < 0 || footprint_gap_px > 16)
     throw InputError("line_index_footprint_gap_px", "must be in [0, 16]");
   if (!(ambiguity_sigmas >= 0 && ambiguity_sigmas <= 5))
     throw InputError("line_index_ambiguity_sigmas", "must be in [0, 5] (0 = off)");
+  if (!(seam_spread_px > 0 && seam_spread_px <= 4)) throw InputError("line_index_seam_spread_px", "must be in (0, 4]");
   if (min_seam_px < 1) throw InputError("line_index_min_seam_px", "must be >= 1");
   if (max_seam_gap_px < 0 || max_seam_gap_px > 32) throw InputError("line_index_max_seam_gap_px", "must be in [0, 32]");
   if (!(min_row_offset_step_px > 0 && min_row_offset_step_px < 1))
@@ -233,7 +236,7 @@ class LineIndexer {
   // One component's vernier test.
   // offset_px: the row offset a correct match reads (0 on a well rectified pair).
   Outcome TestComponent(const std::vector<int>& pixels, double offset_px) {
-    const std::vector<Start> sample = Sample(pixels);
+    std::vector<Start> sample = Sample(pixels);
     if (int(sample.size()) < 4) return Outcome::kKept;
     Vernier here = Read(sample, 0.0);
     here.mean_row_offset_px -= offset_px;
@@ -242,10 +245,27 @@ class LineIndexer {
     // and, with ambiguity_sigmas, by that many standard errors; without it,
     // also anything within 3 standard errors (as before session 6: at
     // speckle 0.4 a component one or two periods off read within that).
-    const double here_abs = std::abs(here.mean_row_offset_px);
-    if (o_.ambiguity_sigmas > 0 ? here_abs + o_.ambiguity_sigmas * here.standard_error_px <= o_.max_row_offset_px
-                                : here_abs <= std::max(o_.max_row_offset_px, 3 * here.standard_error_px))
-      return Outcome::kKept;
+    auto read_as_right = [&] {
+      const double here_abs = std::abs(here.mean_row_offset_px);
+      return o_.ambiguity_sigmas > 0 ? here_abs + o_.ambiguity_sigmas * here.standard_error_px <= o_.max_row_offset_px
+                                     : here_abs <= std::max(o_.max_row_offset_px, 3 * here.standard_error_px);
+    };
+    if (read_as_right()) return Outcome::kKept;
+    // Not conclusive from `samples` pixels: with area_per_sample_px, read
+    // the whole footprint (one sample per that area) before moving or
+    // dropping it; the other alignments are then read over it too.
+    if (o_.area_per_sample_px > 0) {
+      std::vector<Start> whole = sampler_.Sample(pixels, o_.area_per_sample_px);
+      if (whole.size() > sample.size()) {
+        Vernier whole_here = Read(whole, 0.0);
+        whole_here.mean_row_offset_px -= offset_px;
+        if (whole_here.fits >= 4) {
+          sample = std::move(whole);
+          here = whole_here;
+          if (read_as_right()) return Outcome::kKept;
+        }
+      }
+    }
     // Off, and the alignment the vernier points to cannot be read: the
     // right line is out of reach (outside the right image, typically).
     const bool droppable = o_.drop_row_offset_px > 0 && std::abs(here.mean_row_offset_px) >
@@ -416,7 +436,7 @@ int JoinAcrossPeriodJumps(const cv::Mat& left, const cv::Mat& right, const cv::R
     // nearer 0.
     if (std::abs(median) < 3 || std::abs(median) > o.max_shift_px) continue;
     int spread = 0;
-    for (float d : diffs) spread += std::abs(d - median) > 1.0f;
+    for (float d : diffs) spread += std::abs(d - median) > o.seam_spread_px;
     if (spread > int(diffs.size()) / 4) continue;
     const auto [a, b] = key;
     if (done[a] || done[b] || int(std::min(components[a].size(), components[b].size())) < o.min_component_px) continue;

@@ -53,6 +53,23 @@ struct LineIndexOptions {
   // pixels only, as before session 6). Default 8 px (one grid period: pixels
   // between the lines too). See Sample() in line_index.cc.
   int footprint_gap_px = 8;
+  // A component whose reading from `samples` pixels is not conclusive
+  // (not read as right, above) is read again over its whole footprint, one
+  // sample per this many footprint pixels where that gives more, before it
+  // is moved or dropped (0 = off). 48 samples give a standard error that
+  // does not shrink as a component grows (~0.05 px at speckle 0.4: per-pixel
+  // sd ~0.37 px), so at strong speckle a large right component can read
+  // 0.3-0.5 of an alignment off and be dropped whole (simulator's sphere at
+  // speckle 0.4, module 1, an 18 400-pixel component: -0.133 +- 0.051 px
+  // from 62 samples, -0.067 +- 0.023 from 307). The tall window's area
+  // (9 x 9 = 81 px) keeps the samples' windows from overlapping, so their
+  // readings are about independent and the standard error from their
+  // scatter holds. Components read as right from `samples` are not re-read.
+  // The matcher uses it only in modules where growing's noise-derived ZNCC
+  // floor bites (GrowOptions::noise_zncc_factor, if on): at the default
+  // speckle a re-read only trades one noisy reading of a small component for
+  // another (demo ball bar, module 1: std 0.084 -> 0.088 mm). Default 81.
+  int area_per_sample_px = 81;
   // How sure the vernier must be, in standard errors of its reading. A
   // component is kept without reading the other alignments only if its
   // reading is within max_row_offset_px by this many standard errors; after
@@ -65,6 +82,16 @@ struct LineIndexOptions {
   double ambiguity_sigmas = 1.0;
   int max_seam_gap_px = 8;  // JoinAcrossPeriodJumps: widest gap of invalid pixels a seam may span; default 8 px
   int min_seam_px = 30;     // JoinAcrossPeriodJumps: shortest seam between two components it acts on; default 30 px
+  // JoinAcrossPeriodJumps: a seam is a period jump (not a depth edge, whose
+  // step varies along it) if at most a quarter of its differences lie
+  // farther than this from their median. Default 1 px. At speckle 0.4 the
+  // differences of a plain period jump scatter wider (simulator's plate,
+  // module 1: 10th-90th percentile -10.8 to -7.0 px around -9.2, half of
+  // them beyond 1 px): 2 px (a quarter period) still tells one period from
+  // none or two. Default 2 px (the demo, seed 7 and speckle 0 score as with
+  // 1 px; speckle 0.4 plate module 1: std 0.279 -> 0.143 mm, with the two
+  // options above).
+  double seam_spread_px = 2.0;
   void Check() const;       // throws InputError naming the bad field
 };
 

@@ -390,12 +390,22 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
   // wrong surface); the filter runs again on the grown map.
   RemoveSpeckles(state.disparity_px(roi), o);  // outside the ROI nothing is valid
   if (o.intensity_refinement && (o.line_index.enabled || o.grow.enabled)) {
-    CorrectLineIndex(left, right, roi, o.line_index, accept, &state);
+    // Growing's ZNCC floor, from the seeds' measured decorrelation (off by
+    // default: the matcher's min_zncc). With it on, the vernier's whole-
+    // footprint reading (line_index_area_per_sample_px) is used only where
+    // the floor bites: there the views decorrelate strongly (speckle) and 48
+    // samples leave large right components ambiguous; elsewhere they do not,
+    // and a re-read only trades one noisy reading for another.
+    RefineAcceptance grow_accept = accept;
+    grow_accept.min_zncc = GrowMinZncc(state.disparity_px, state.confidence, roi, o.grow, accept.min_zncc);
+    LineIndexOptions line_index = o.line_index;
+    if (o.grow.noise_zncc_factor > 0 && !(grow_accept.min_zncc < accept.min_zncc)) line_index.area_per_sample_px = 0;
+    CorrectLineIndex(left, right, roi, line_index, accept, &state);
     lap("line_index");
     // Shared by both passes: the second does not repeat the first's failed tries.
     std::optional<GrowMemory> grow_memory;
     if (o.grow.enabled) grow_memory.emplace(left, right, roi, o.grow);
-    GrowDisparity(left, right, roi, o.grow, accept, &state, grow_memory ? &*grow_memory : nullptr);
+    GrowDisparity(left, right, roi, o.grow, grow_accept, &state, grow_memory ? &*grow_memory : nullptr);
     lap("grow");
     // Grown components are larger, so their vernier reads better; a
     // component moved now leaves a gap that growing closes.
@@ -404,17 +414,17 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
     DisparityComponents components;
     int moved = 0;
     if (o.grow.enabled) {
-      moved += CorrectLineIndex(left, right, roi, o.line_index, accept, &state, &components);
-      moved += JoinAcrossPeriodJumps(left, right, roi, o.line_index, accept, &state, &components);
+      moved += CorrectLineIndex(left, right, roi, line_index, accept, &state, &components);
+      moved += JoinAcrossPeriodJumps(left, right, roi, line_index, accept, &state, &components);
     }
     if (moved > 0) {
       lap("line_index_2");
-      GrowDisparity(left, right, roi, o.grow, accept, &state, &*grow_memory);
+      GrowDisparity(left, right, roi, o.grow, grow_accept, &state, &*grow_memory);
       lap("grow_2");
       // What the second growing added from the moved components is tested
       // too: growing can carry a wrong alignment along (speckle 0.4).
       if (o.line_index.ambiguity_sigmas > 0) {
-        CorrectLineIndex(left, right, roi, o.line_index, accept, &state);
+        CorrectLineIndex(left, right, roi, line_index, accept, &state);
         lap("line_index_3");
       }
     } else {

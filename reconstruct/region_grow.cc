@@ -23,6 +23,28 @@ void GrowOptions::Check() const {
     throw InputError("grow_shifted_min_zncc", "must be in [-1, 1)");
   if (!(shifted_enclosed_min_zncc >= -1 && shifted_enclosed_min_zncc < 1))
     throw InputError("grow_shifted_enclosed_min_zncc", "must be in [-1, 1)");
+  if (!(noise_zncc_factor >= 0 && noise_zncc_factor <= 20))
+    throw InputError("grow_noise_zncc_factor", "must be in [0, 20] (0 = off)");
+  if (!(noise_min_zncc >= -1 && noise_min_zncc < 1)) throw InputError("grow_noise_min_zncc", "must be in [-1, 1)");
+}
+
+double GrowMinZncc(const cv::Mat& disparity_px, const cv::Mat& confidence, const cv::Rect& roi, const GrowOptions& o,
+                   double min_zncc) {
+  if (!(o.noise_zncc_factor > 0)) return min_zncc;
+  STEREORIG_CHECK(disparity_px.type() == CV_32FC1 && confidence.type() == CV_32FC1 &&
+                  disparity_px.size() == confidence.size());
+  std::vector<float> decorrelation;
+  for (int y = roi.y; y < roi.y + roi.height; ++y) {
+    const float* d = disparity_px.ptr<float>(y);
+    const float* c = confidence.ptr<float>(y);
+    for (int x = roi.x; x < roi.x + roi.width; ++x)
+      if (std::isfinite(d[x])) decorrelation.push_back(1.0f - c[x]);
+  }
+  if (decorrelation.empty()) return min_zncc;
+  const auto mid = decorrelation.begin() + std::ptrdiff_t(decorrelation.size() / 2);
+  std::nth_element(decorrelation.begin(), mid, decorrelation.end());
+  const double floor = 1.0 - o.noise_zncc_factor * double(*mid);
+  return std::min(min_zncc, std::max(o.noise_min_zncc, floor));
 }
 
 namespace {

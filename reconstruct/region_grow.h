@@ -52,12 +52,38 @@ struct GrowOptions {
   // Demo and seed 7: +0.4-0.9 fill points on every scene, per-module std
   // within +0.005 mm (docs/reconstruct.md, session 6).
   double shifted_enclosed_min_zncc = 0.8;
+  // Growing's ZNCC floor from the measured noise (GrowMinZncc; 0 = off:
+  // the matcher's min_zncc). A window's ZNCC at its true match is about
+  // S / (S + N), S the grid's variance in it and N the part of the two
+  // views that does not correlate (laser speckle, sensor noise), so 1 - ZNCC
+  // ~ N / (S + N) and the disparity's scatter grows as sqrt(1 - ZNCC). The
+  // module's typical decorrelation is the median 1 - ZNCC of the seeds (the
+  // matches growing starts from); a grown pixel, whose alignment its
+  // neighbours' plane already fixes (within max_deviation_px, far below a
+  // period), is accepted if its 1 - ZNCC is at most this times that, i.e. its
+  // scatter at most sqrt(this) times the typical one. The floor never rises
+  // above the matcher's min_zncc and never falls below noise_min_zncc.
+  // Demo (speckle 0.2): seeds' median ZNCC ~0.97, 1 - 4 x 0.03 > 0.8, so
+  // nothing changes (all 30 module rows of the demo, seed 7 and speckle 0
+  // score as before); speckle 0.4: median ~0.925, floor ~0.7, +3 to +32 fill
+  // points per module (docs/reconstruct.md, "Strong speckle (session 9)").
+  // Default 4.
+  double noise_zncc_factor = 4;
+  double noise_min_zncc = 0.6;  // the noise-derived floor's lowest value; default 0.6
   // Where it still fails on a strongly foreshortened surface, the views
   // matched in resolution (oblique_refine.h; on by default: +0.3-0.6 fill
   // points on every curved scene, accuracy unchanged).
   ObliqueOptions oblique;
   void Check() const;  // throws InputError naming the bad field
 };
+
+// The ZNCC growing accepts (GrowOptions::noise_zncc_factor): min_zncc if the
+// factor is 0 or no pixel of `roi` holds a disparity, else
+// clamp(1 - factor * median(1 - confidence), noise_min_zncc, min_zncc) over
+// the pixels of `roi` with a finite disparity (their confidence = the
+// refined window's ZNCC). disparity_px, confidence: CV_32FC1, same size.
+double GrowMinZncc(const cv::Mat& disparity_px, const cv::Mat& confidence, const cv::Rect& roi, const GrowOptions& o,
+                   double min_zncc);
 
 // What growing keeps between its passes over one capture (the matcher
 // grows, moves components to other lines, and grows again): the oblique

@@ -108,6 +108,7 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.line_index.samples = m.GetInt("line_index_samples", mo.line_index.samples);
     mo.line_index.min_seam_px = m.GetInt("line_index_min_seam_px", mo.line_index.min_seam_px);
     mo.line_index.max_seam_gap_px = m.GetInt("line_index_max_seam_gap_px", mo.line_index.max_seam_gap_px);
+    mo.line_index.seam_spread_px = m.GetDouble("line_index_seam_spread_px", mo.line_index.seam_spread_px);
     mo.line_index.window_half_height_px =
         m.GetInt("line_index_window_half_height_px", mo.line_index.window_half_height_px);
     mo.line_index.max_row_offset_px = m.GetDouble("line_index_max_row_offset_px", mo.line_index.max_row_offset_px);
@@ -115,6 +116,8 @@ RuntimeOptions FromYaml(YamlMap& y) {
         m.GetDouble("line_index_min_row_offset_step_px", mo.line_index.min_row_offset_step_px);
     mo.line_index.drop_row_offset_px = m.GetDouble("line_index_drop_row_offset_px", mo.line_index.drop_row_offset_px);
     mo.line_index.footprint_gap_px = m.GetInt("line_index_footprint_gap_px", mo.line_index.footprint_gap_px);
+    mo.line_index.area_per_sample_px =
+        m.GetInt("line_index_area_per_sample_px", mo.line_index.area_per_sample_px);
     mo.line_index.ambiguity_sigmas = m.GetDouble("line_index_ambiguity_sigmas", mo.line_index.ambiguity_sigmas);
     mo.grow.enabled = m.GetBool("grow", mo.grow.enabled);
     mo.grow.max_deviation_px = m.GetDouble("grow_max_deviation_px", mo.grow.max_deviation_px);
@@ -124,6 +127,8 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.grow.shifted_min_foreshortening =
         m.GetDouble("grow_shifted_min_foreshortening", mo.grow.shifted_min_foreshortening);
     mo.grow.shifted_min_zncc = m.GetDouble("grow_shifted_min_zncc", mo.grow.shifted_min_zncc);
+    mo.grow.noise_zncc_factor = m.GetDouble("grow_noise_zncc_factor", mo.grow.noise_zncc_factor);
+    mo.grow.noise_min_zncc = m.GetDouble("grow_noise_min_zncc", mo.grow.noise_min_zncc);
     mo.grow.shifted_enclosed_min_zncc =
         m.GetDouble("grow_shifted_enclosed_min_zncc", mo.grow.shifted_enclosed_min_zncc);
     mo.grow.oblique.enabled = m.GetBool("grow_oblique", mo.grow.oblique.enabled);

@@ -1,5 +1,5 @@
-// Runtime options: the hole-filling, surface-fit, line-index ambiguity, sub-pixel column-step and band-pass keys are read,
-// defaulted and checked
+// Runtime options: the hole-filling, surface-fit, line-index ambiguity, sub-pixel column-step, band-pass and strong-speckle
+// keys are read, defaulted and checked
 // (a bad value or an unknown key is an InputError naming it).
 #include "reconstruct/runtime_options.h"
 
@@ -105,6 +105,30 @@ TEST(RuntimeOptions, ReadsAndChecksTheBandPassKeys) {
       {"match:\n  band_row_step: 3\n", "band_row_step"},
       {"match:\n  band_row_step: 2\n  guided_radius_px: 15\n", "band_row_step"},
       {"match:\n  band_row_steps: 2\n", "band_row_steps"}};
+  ExpectEachRejectedNamingItsKey(bad);
+}
+
+TEST(RuntimeOptions, ReadsAndChecksTheStrongSpeckleKeys) {
+  const RuntimeOptions d = ParseRuntimeOptions("min_confidence: 0.5\n", "defaults.yaml");
+  EXPECT_EQ(d.match.grow.noise_zncc_factor, 4.0);
+  EXPECT_EQ(d.match.grow.noise_min_zncc, 0.6);
+  EXPECT_EQ(d.match.line_index.area_per_sample_px, 81);
+  EXPECT_EQ(d.match.line_index.seam_spread_px, 2.0);
+  const RuntimeOptions o = ParseRuntimeOptions(
+      "match:\n  grow_noise_zncc_factor: 0\n  grow_noise_min_zncc: 0.5\n  line_index_area_per_sample_px: 0\n"
+      "  line_index_seam_spread_px: 1\n",
+      "set.yaml");
+  EXPECT_EQ(o.match.grow.noise_zncc_factor, 0.0);
+  EXPECT_EQ(o.match.grow.noise_min_zncc, 0.5);
+  EXPECT_EQ(o.match.line_index.area_per_sample_px, 0);
+  EXPECT_EQ(o.match.line_index.seam_spread_px, 1.0);
+  const std::pair<const char*, const char*> bad[] = {
+      {"match:\n  grow_noise_zncc_factor: -1\n", "grow_noise_zncc_factor"},
+      {"match:\n  grow_noise_zncc_factor: 21\n", "grow_noise_zncc_factor"},
+      {"match:\n  grow_noise_min_zncc: 1\n", "grow_noise_min_zncc"},
+      {"match:\n  line_index_area_per_sample_px: -1\n", "line_index_area_per_sample_px"},
+      {"match:\n  line_index_seam_spread_px: 0\n", "line_index_seam_spread_px"},
+      {"match:\n  line_index_seam_spread_px: 5\n", "line_index_seam_spread_px"}};
   ExpectEachRejectedNamingItsKey(bad);
 }
 
