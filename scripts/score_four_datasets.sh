@@ -1,0 +1,23 @@
+#!/bin/bash
+# Scores one stereorig binary on the four datasets the speed and speckle work is judged on, for
+# scripts/score_gate.py. Each dataset: `stereorig score --no-passive`, JSON and text into OUTDIR.
+#   usage: scripts/score_four_datasets.sh STEREORIG OUTDIR [extra score args, e.g. --options o.yaml]
+# Datasets (override with the environment):
+#   DEMO=/tmp/demo      `stereorig demo --out $DEMO` (dataset + calibrated rig.yaml), default speckle 0.2, seed 1
+#   S7=/tmp/s7          `stereorig simulate --out $S7 --seed 7 --calibration-captures 0`, scored with its truth rig
+#   SP_OFF, SP_HIGH     speckle_contrast 0 / 0.4 (`simulate --write-default-spec s.yaml`, edit, `simulate --spec s.yaml
+#                       --out DIR --seed 1 --calibration-captures 0`), scored with $DEMO/rig.yaml
+set -euo pipefail
+if [ $# -lt 2 ]; then sed -n 2,10p "$0"; exit 2; fi
+B=$1; O=$2; shift 2
+DEMO=${DEMO:-/tmp/demo}; S7=${S7:-/tmp/s7}; SP_OFF=${SP_OFF:-/tmp/sp_off}; SP_HIGH=${SP_HIGH:-/tmp/sp_high}
+for d in "$DEMO/dataset" "$S7" "$SP_OFF" "$SP_HIGH"; do
+  [ -d "$d/scenes" ] || { echo "error: $d has no scenes/ (see the header of $0)" >&2; exit 2; }
+done
+mkdir -p "$O"
+run() { echo "scoring $2 ..." >&2; "$B" score --dataset "$2" "${@:3}" --no-passive --report "$O/$1.json" > "$O/$1.txt"; }
+run demo "$DEMO/dataset" --rig "$DEMO/rig.yaml" "$@"
+run s7 "$S7" "$@"
+run off "$SP_OFF" --rig "$DEMO/rig.yaml" "$@"
+run high "$SP_HIGH" --rig "$DEMO/rig.yaml" "$@"
+echo "scored into $O"

@@ -1,0 +1,33 @@
+#!/usr/bin/env python3
+"""usage: scripts/score_gate.py BASEDIR NEWDIR: per-module comparison of two scripts/score_four_datasets.sh outputs.
+The gate (session 9): per module, fill may drop at most 0.2 points and mean|e| / std may rise at most 0.002 mm;
+issue-5 targets (mean<=0.1, std<=0.1 per module) must not be newly broken. Prints every module and a verdict;
+exit 0 on pass, 1 on fail, 2 on bad arguments."""
+import json, sys, os
+if len(sys.argv) != 3:
+    print(__doc__, file=sys.stderr); sys.exit(2)
+base, new = sys.argv[1], sys.argv[2]
+fails = 0; rows = 0; worst = {'fill': 0, 'mean': 0, 'std': 0}
+for ds in ['demo', 's7', 'off', 'high']:
+    pb, pn = os.path.join(base, ds + '.json'), os.path.join(new, ds + '.json')
+    if not (os.path.exists(pb) and os.path.exists(pn)):
+        print(f'{ds}: missing'); fails += 1; continue
+    B = {s['scene']: s for s in json.load(open(pb))['scenes']}
+    N = {s['scene']: s for s in json.load(open(pn))['scenes']}
+    for sc in B:
+        if sc not in N: print(f'{ds} {sc}: missing in new'); fails += 1; continue
+        for mb, mn in zip(B[sc]['modules'], N[sc]['modules']):
+            fb, fn = 100 * mb['fill']['fill'], 100 * mn['fill']['fill']
+            eb, en = mb['accuracy']['mean_abs_mm'], mn['accuracy']['mean_abs_mm']
+            sb, sn = mb['accuracy']['std_mm'], mn['accuracy']['std_mm']
+            bad = []
+            if fn < fb - 0.2: bad.append('fill')
+            if en > eb + 0.002: bad.append('mean')
+            if sn > sb + 0.002: bad.append('std')
+            if ds != 'high' and ((en > 0.1 >= eb) or (sn > 0.1 >= sb)): bad.append('TARGET')
+            worst['fill'] = min(worst['fill'], fn - fb); worst['mean'] = max(worst['mean'], en - eb); worst['std'] = max(worst['std'], sn - sb)
+            rows += 1; fails += bool(bad)
+            print(f"{ds:5s} {sc:8s} m{mb['module']}: fill {fb:5.1f}->{fn:5.1f} ({fn-fb:+.2f})  |e| {eb:.4f}->{en:.4f} ({en-eb:+.4f})  std {sb:.4f}->{sn:.4f} ({sn-sb:+.4f}) {' '.join(bad)}")
+print(f"worst: fill {worst['fill']:+.2f} pts, mean {worst['mean']:+.4f} mm, std {worst['std']:+.4f} mm; {fails} of {rows} module rows fail the gate")
+print('GATE PASS' if fails == 0 else 'GATE FAIL')
+sys.exit(0 if fails == 0 else 1)
