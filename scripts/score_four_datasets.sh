@@ -8,7 +8,7 @@
 #   SP_OFF, SP_HIGH     speckle_contrast 0 / 0.4 (`simulate --write-default-spec s.yaml`, edit, `simulate --spec s.yaml
 #                       --out DIR --seed 1 --calibration-captures 0`), scored with $DEMO/rig.yaml
 set -euo pipefail
-if [ $# -lt 2 ]; then sed -n 2,10p "$0"; exit 2; fi
+if [ $# -lt 2 ]; then sed -n 2,9p "$0"; exit 2; fi
 B=$1; O=$2; shift 2
 DEMO=${DEMO:-/tmp/demo}; S7=${S7:-/tmp/s7}; SP_OFF=${SP_OFF:-/tmp/sp_off}; SP_HIGH=${SP_HIGH:-/tmp/sp_high}
 for d in "$DEMO/dataset" "$S7" "$SP_OFF" "$SP_HIGH"; do
