@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <iterator>
 
 #include "calib/core/input_error.h"
 
@@ -57,23 +58,43 @@ void FootprintSampler::VisitRow(int y, int x_begin, int x_end, Visit&& visit) co
   }
 }
 
-std::vector<FootprintStart> FootprintSampler::Sample(const std::vector<int>& pixels, int area_per_sample_px) {
-  STEREORIG_CHECK(area_per_sample_px >= 0);
+bool FootprintSampler::Mark(const std::vector<int>& pixels, int* x_begin, int* x_end, int* y_min, int* y_max) {
   if (order_.empty()) order_.assign(disparity_px_.total(), 0);
   STEREORIG_CHECK(order_.size() == disparity_px_.total() && disparity_px_.isContinuous());  // same map size
   const float* d = disparity_px_.ptr<float>(0);
-  int x_min = INT_MAX, x_max = -1, y_min = INT_MAX, y_max = -1;
+  int x_min = INT_MAX, x_max = -1;
+  *y_min = INT_MAX, *y_max = -1;
   for (size_t k = 0; k < pixels.size(); ++k) {
     const int i = pixels[k];
     if (!std::isfinite(d[i])) continue;
     order_[size_t(i)] = int(k) + 1;
     const int x = i % cols_, y = i / cols_;
     x_min = std::min(x_min, x), x_max = std::max(x_max, x);
-    y_min = std::min(y_min, y), y_max = std::max(y_max, y);
+    *y_min = std::min(*y_min, y), *y_max = std::max(*y_max, y);
   }
+  if (x_max < 0) return false;
+  *x_begin = std::max(0, x_min - gap_px_), *x_end = std::min(cols_ - 1, x_max + gap_px_);
+  return true;
+}
+
+void FootprintSampler::Unmark(const std::vector<int>& pixels) {
+  for (int i : pixels) order_[size_t(i)] = 0;
+}
+
+FootprintStart FootprintSampler::StartAt(int i, int source) const {
+  const float* d = disparity_px_.ptr<float>(0);
+  const int sy = source / cols_, sx = source % cols_;
+  const float slope_x = slope_x_.ptr<float>(sy)[sx], slope_y = slope_y_.ptr<float>(sy)[sx];
+  // A gap pixel's disparity: its source's, carried along the row.
+  const float start_px = i == source ? d[i] : d[source] + float(i - source) * slope_x;
+  return {i, start_px, slope_x, slope_y};
+}
+
+std::vector<FootprintStart> FootprintSampler::Sample(const std::vector<int>& pixels, int area_per_sample_px) {
+  STEREORIG_CHECK(area_per_sample_px >= 0);
   std::vector<FootprintStart> sample;
-  if (x_max >= 0) {
-    const int x_begin = std::max(0, x_min - gap_px_), x_end = std::min(cols_ - 1, x_max + gap_px_);
+  int x_begin, x_end, y_min, y_max;
+  if (Mark(pixels, &x_begin, &x_end, &y_min, &y_max)) {
     row_count_.assign(size_t(y_max - y_min + 1), 0);
     size_t total = 0;
     for (int y = y_min; y <= y_max; ++y) {
@@ -96,19 +117,63 @@ std::vector<FootprintStart> FootprintSampler::Sample(const std::vector<int>& pix
         size_t r = rank;
         VisitRow(y, x_begin, x_end, [&](int i, int source) {
           if (r++ != size_t(k) || !(k < double(total))) return;
-          const int sy = source / cols_, sx = source % cols_;
-          const float slope_x = slope_x_.ptr<float>(sy)[sx], slope_y = slope_y_.ptr<float>(sy)[sx];
-          // A gap pixel's disparity: its source's, carried along the row.
-          const float start_px = i == source ? d[i] : d[source] + float(i - source) * slope_x;
-          sample.push_back({i, start_px, slope_x, slope_y});
+          sample.push_back(StartAt(i, source));
           k += stride;
         });
       }
       rank += n;
     }
   }
-  for (int i : pixels) order_[size_t(i)] = 0;
+  Unmark(pixels);
   return sample;
+}
+
+std::vector<FootprintStart> FootprintSampler::SampleLattice(const std::vector<int>& pixels, int pitch_px) {
+  STEREORIG_CHECK(pitch_px >= 1);
+  std::vector<FootprintStart> sample;
+  int x_begin, x_end, y_min, y_max;
+  if (Mark(pixels, &x_begin, &x_end, &y_min, &y_max)) {
+    const int phase = pitch_px / 2;
+    // The first lattice row at or below y_min.
+    const int y_first = y_min + (phase - y_min % pitch_px + pitch_px) % pitch_px;
+    for (int y = y_first; y <= y_max; y += pitch_px) {
+      VisitRow(y, x_begin, x_end, [&](int i, int source) {
+        if ((i % cols_) % pitch_px == phase) sample.push_back(StartAt(i, source));
+      });
+    }
+  }
+  Unmark(pixels);
+  return sample;
+}
+
+std::vector<int> FootprintSampler::LatticeLadder() const {
+  std::vector<int> ladder = {1, 2, 3, 4, 6};
+  const int side = std::max(disparity_px_.cols, disparity_px_.rows);
+  for (int p = 9; p <= side; p *= 2) {
+    ladder.push_back(p);
+    if (p * 4 / 3 <= side) ladder.push_back(p * 4 / 3);
+  }
+  return ladder;
+}
+
+std::vector<FootprintStart> FootprintSampler::SampleLatticeAtLeast(const std::vector<int>& pixels, int min_samples,
+                                                                   int* pitch_px) {
+  STEREORIG_CHECK(min_samples >= 1);
+  const std::vector<int> ladder = LatticeLadder();
+  // The valid pixels alone, N, hold about N / p^2 lattice points: start at
+  // the coarsest pitch that could give min_samples and go finer while it
+  // does not (a thin component holds fewer).
+  size_t k = 0;
+  while (k + 1 < ladder.size() &&
+         double(pixels.size()) >= double(min_samples) * double(ladder[k + 1]) * double(ladder[k + 1]))
+    ++k;
+  for (;; --k) {
+    std::vector<FootprintStart> sample = SampleLattice(pixels, ladder[k]);
+    if (int(sample.size()) >= min_samples || k == 0) {
+      if (pitch_px) *pitch_px = ladder[k];
+      return sample;
+    }
+  }
 }
 
 }  // namespace stereorig

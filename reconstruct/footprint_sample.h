@@ -57,12 +57,44 @@ class FootprintSampler {
   // (LineIndexOptions::area_per_sample_px), spread the same way.
   std::vector<FootprintStart> Sample(const std::vector<int>& pixels, int area_per_sample_px = 0);
 
+  // The footprint pixels of `pixels` on the image's lattice of pitch
+  // pitch_px: x and y both = pitch_px / 2 (mod pitch_px), in raster order.
+  // The lattice is fixed in the image, not in the component, so two nearly
+  // equal components (one surface matched with slightly different options)
+  // are read at nearly the same pixels, and their readings differ only by
+  // the pixels that differ; the raster-rank Sample moves nearly every
+  // sample when a component gains or loses a few pixels. At pitch_px >= the
+  // vernier's 9 px window the samples' windows do not overlap.
+  std::vector<FootprintStart> SampleLattice(const std::vector<int>& pixels, int pitch_px);
+
+  // SampleLattice with at least min_samples pixels: at the coarsest pitch p
+  // of LatticeLadder() with N >= min_samples * p^2 (N = pixels.size(): its
+  // valid pixels hold about N / p^2 lattice points), or finer while that
+  // gives fewer, down to 1 px (every footprint pixel): a thin component can
+  // miss a coarse lattice entirely. A ladder, not sqrt(N / min_samples)
+  // rounded, so that a component's pitch changes only where its size
+  // crosses one of few thresholds. pitch_px: if not null, receives the
+  // pitch used.
+  std::vector<FootprintStart> SampleLatticeAtLeast(const std::vector<int>& pixels, int min_samples,
+                                                   int* pitch_px = nullptr);
+
+  // The lattice pitches, finest first: 1, 2, 3, 4, 6, then 9 and 12 px
+  // times powers of 2, up to the image's larger side.
+  std::vector<int> LatticeLadder() const;
+
  private:
   // Calls visit(i, source) for the footprint pixels of row y within columns
   // [x_begin, x_end], in order; source = i for a valid pixel, else the
   // valid pixel it starts from.
   template <typename Visit>
   void VisitRow(int y, int x_begin, int x_end, Visit&& visit) const;
+
+  // Marks the valid pixels of `pixels` in order_ and finds their bounding
+  // box widened by gap_px along the rows; false if none is valid.
+  bool Mark(const std::vector<int>& pixels, int* x_begin, int* x_end, int* y_min, int* y_max);
+  void Unmark(const std::vector<int>& pixels);
+  // The start of footprint pixel i reached from valid pixel `source`.
+  FootprintStart StartAt(int i, int source) const;
 
   const cv::Mat& disparity_px_;
   const cv::Mat& slope_x_;

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <cstdio>
 #include <random>
 
 #include "reconstruct/line_index.h"
@@ -71,32 +72,47 @@ TEST(FootprintSample, ListsValidAndGapPixelsWithTheirSourcesDisparity) {
   EXPECT_EQ(four.Sample(pixels), (std::vector<FootprintStart>{expected[1], expected[4], expected[6], expected[9]}));
 }
 
-// Random maps of blobs with holes, at the image's edges too; components
+// A random map of blobs with holes, at the image's edges too; components
 // labelled as CorrectLineIndex labels them, some of their pixels emptied
-// after labelling (as a move that refuses pixels leaves them). Every
-// component's sample must equal the plain listing's, bit for bit.
+// after labelling (as a move that refuses pixels leaves them).
+struct RandomMap {
+  cv::Size size;
+  cv::Mat d, gx, gy;
+  std::vector<std::vector<int>> components;
+};
+
+RandomMap MakeRandomMap(std::mt19937& rng, int trial) {
+  RandomMap m;
+  m.size = cv::Size(60 + trial % 7, 40 + trial % 5);
+  const cv::Size size = m.size;
+  m.d = cv::Mat(size, CV_32FC1, cv::Scalar(kInf)), m.gx = cv::Mat(size, CV_32FC1), m.gy = cv::Mat(size, CV_32FC1);
+  cv::randu(m.gx, -1, 1);
+  cv::randu(m.gy, -1, 1);
+  std::uniform_int_distribution<int> px(0, size.width - 1), py(0, size.height - 1), half(1, 9);
+  std::uniform_real_distribution<float> level(10, 60), unit(0, 1);
+  for (int blob = 0; blob < 12; ++blob) {
+    const int cx = px(rng), cy = py(rng), hw = half(rng), hh = half(rng);
+    const float base = level(rng);
+    for (int y = std::max(0, cy - hh); y < std::min(size.height, cy + hh); ++y)
+      for (int x = std::max(0, cx - hw); x < std::min(size.width, cx + hw); ++x)
+        if (unit(rng) < 0.75f) m.d.at<float>(y, x) = base + 0.1f * float(x - cx);  // holes: gap pixels inside
+  }
+  LabelDisparityComponents(m.d, cv::Rect(cv::Point(0, 0), size), 1.0, &m.components);
+  for (auto& pixels : m.components)
+    for (int i : pixels)
+      if (unit(rng) < 0.05f) m.d.at<float>(i / size.width, i % size.width) = kInf;
+  return m;
+}
+
+// Every component's sample on random maps must equal the plain listing's,
+// bit for bit.
 TEST(FootprintSample, EqualsThePlainSortedListingOnRandomMaps) {
   std::mt19937 rng(5);
   int compared = 0;
   for (int trial = 0; trial < 40; ++trial) {
-    const cv::Size size(60 + trial % 7, 40 + trial % 5);
-    cv::Mat d(size, CV_32FC1, cv::Scalar(kInf)), gx(size, CV_32FC1), gy(size, CV_32FC1);
-    cv::randu(gx, -1, 1);
-    cv::randu(gy, -1, 1);
-    std::uniform_int_distribution<int> px(0, size.width - 1), py(0, size.height - 1), half(1, 9);
-    std::uniform_real_distribution<float> level(10, 60), unit(0, 1);
-    for (int blob = 0; blob < 12; ++blob) {
-      const int cx = px(rng), cy = py(rng), hw = half(rng), hh = half(rng);
-      const float base = level(rng);
-      for (int y = std::max(0, cy - hh); y < std::min(size.height, cy + hh); ++y)
-        for (int x = std::max(0, cx - hw); x < std::min(size.width, cx + hw); ++x)
-          if (unit(rng) < 0.75f) d.at<float>(y, x) = base + 0.1f * float(x - cx);  // holes: gap pixels inside
-    }
-    std::vector<std::vector<int>> components;
-    LabelDisparityComponents(d, cv::Rect(cv::Point(0, 0), size), 1.0, &components);
-    for (auto& pixels : components)
-      for (int i : pixels)
-        if (unit(rng) < 0.05f) d.at<float>(i / size.width, i % size.width) = kInf;
+    const RandomMap m = MakeRandomMap(rng, trial);
+    const cv::Mat &d = m.d, &gx = m.gx, &gy = m.gy;
+    const auto& components = m.components;
     for (const int gap_px : {0, 3, 8})
       for (const int samples : {4, 48, 10000}) {
         FootprintSampler sampler(d, gx, gy, gap_px, samples);
@@ -108,6 +124,130 @@ TEST(FootprintSample, EqualsThePlainSortedListingOnRandomMaps) {
       }
   }
   EXPECT_GT(compared, 1000);  // not vacuous
+}
+
+// The lattice sample is the full footprint listing (PlainSample with every
+// pixel) filtered to x = y = pitch / 2 (mod pitch), on the same random maps.
+TEST(FootprintSample, LatticeSampleIsTheFootprintOnTheImagesLattice) {
+  std::mt19937 rng(7);
+  int compared = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const RandomMap m = MakeRandomMap(rng, trial);
+    const int cols = m.size.width;
+    FootprintSampler sampler(m.d, m.gx, m.gy, 3, 48);
+    for (const auto& pixels : m.components) {
+      const auto all = PlainSample(m.d, m.gx, m.gy, pixels, 3, 1 << 30);
+      for (const int pitch : {1, 2, 3, 9}) {
+        std::vector<FootprintStart> expected;
+        for (const FootprintStart& s : all)
+          if ((s.i % cols) % pitch == pitch / 2 && (s.i / cols) % pitch == pitch / 2) expected.push_back(s);
+        ASSERT_EQ(sampler.SampleLattice(pixels, pitch), expected) << "trial " << trial << " pitch " << pitch;
+        ++compared;
+      }
+    }
+  }
+  EXPECT_GT(compared, 200);  // not vacuous
+}
+
+// Why the lattice (LineIndexOptions::lattice_sampling): the same surface
+// matched twice, the second time without a 3-row strip along its top edge
+// (a slightly different SGM result), is read at a subset of the first
+// reading's pixels on the lattice, but at almost entirely other pixels by
+// raster rank (every rank after the strip shifts).
+TEST(FootprintSample, LatticeReadsANearlyEqualComponentAtTheSamePixels) {
+  const cv::Size size(320, 240);
+  cv::Mat d(size, CV_32FC1, cv::Scalar(kInf)), gx(size, CV_32FC1, cv::Scalar(0.05)), gy = gx.clone();
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> unit(0, 1);
+  for (int y = 40; y < 200; ++y)
+    for (int x = 60; x < 260; ++x)
+      if (unit(rng) < 0.9f) d.at<float>(y, x) = 40 + 0.05f * float(x - 60);
+  cv::Mat d_less = d.clone();
+  d_less(cv::Rect(60, 40, 200, 3)).setTo(kInf);
+  auto component = [&](const cv::Mat& map) {
+    std::vector<std::vector<int>> components;
+    LabelDisparityComponents(map, cv::Rect(cv::Point(0, 0), size), 1.0, &components);
+    size_t largest = 0;
+    for (size_t k = 0; k < components.size(); ++k)
+      if (components[k].size() > components[largest].size()) largest = k;
+    return components[largest];
+  };
+  const std::vector<int> full = component(d), less = component(d_less);
+  ASSERT_GT(full.size(), 25000u);
+  FootprintSampler on_full(d, gx, gy, 8, 48), on_less(d_less, gx, gy, 8, 48);
+  // The share of the second reading's pixels that the first also read.
+  auto shared = [](const std::vector<FootprintStart>& a, const std::vector<FootprintStart>& b) {
+    int n = 0;
+    for (const FootprintStart& s : b)
+      n += std::find_if(a.begin(), a.end(), [&](const FootprintStart& t) { return t.i == s.i; }) != a.end();
+    return double(n) / double(b.size());
+  };
+  int pitch_full = 0, pitch_less = 0;
+  const auto lattice_full = on_full.SampleLatticeAtLeast(full, 48, &pitch_full);
+  const auto lattice_less = on_less.SampleLatticeAtLeast(less, 48, &pitch_less);
+  EXPECT_EQ(pitch_full, pitch_less);
+  EXPECT_GE(lattice_full.size(), 48u);
+  EXPECT_DOUBLE_EQ(shared(lattice_full, lattice_less), 1.0);
+  // The strip holds at most one lattice row of the first reading's.
+  EXPECT_LE(lattice_full.size() - lattice_less.size(), size_t(200 / pitch_full + 1));
+  const double raster = shared(on_full.Sample(full), on_less.Sample(less));
+  std::printf("raster rank: %.0f %% of the second reading's pixels read the first time; lattice (pitch %d): 100 %%\n",
+              100 * raster, pitch_full);
+  EXPECT_LT(raster, 0.5);  // the raster-rank sample moved (measured: see the line above)
+}
+
+// A one-row component on an even row misses the 2 px lattice (odd rows)
+// and every coarser one: it is read at every footprint pixel, not left
+// unread (before, the line index kept a component with < 4 samples untested).
+TEST(FootprintSample, AThinComponentIsReadAtEveryPixel) {
+  const cv::Size size(80, 20);
+  cv::Mat d(size, CV_32FC1, cv::Scalar(kInf)), gx(size, CV_32FC1, cv::Scalar(0)), gy = gx.clone();
+  std::vector<int> pixels;
+  for (int x = 30; x < 50; ++x) d.at<float>(10, x) = 25, pixels.push_back(10 * size.width + x);
+  FootprintSampler sampler(d, gx, gy, 2, 48);
+  EXPECT_TRUE(sampler.SampleLattice(pixels, 2).empty());
+  int pitch = 0;
+  const auto sample = sampler.SampleLatticeAtLeast(pixels, 48, &pitch);
+  EXPECT_EQ(pitch, 1);
+  EXPECT_EQ(sample.size(), 20u + 2 * 2);  // the 20 valid pixels and 2 gap pixels either side
+}
+
+// The pitch the ladder picks: for a full rectangle (no footprint beyond
+// its valid pixels, which fill the lattice), the coarsest p with
+// N >= min_samples * p^2; for a thin one, finer until it gives enough.
+TEST(FootprintSample, LatticeAtLeastStartsFromTheSizeAndGoesFinerUntilItGivesEnough) {
+  const cv::Size size(400, 300);
+  cv::Mat d(size, CV_32FC1, cv::Scalar(kInf)), gx(size, CV_32FC1, cv::Scalar(0)), gy = gx.clone();
+  std::vector<int> block, strip;
+  for (int y = 20; y < 280; ++y)
+    for (int x = 20; x < 380; ++x) d.at<float>(y, x) = 30, block.push_back(y * size.width + x);
+  FootprintSampler sampler(d, gx, gy, 0, 48);
+  const std::vector<int> ladder = sampler.LatticeLadder();
+  ASSERT_EQ(std::vector<int>(ladder.begin(), ladder.begin() + 11),
+            std::vector<int>({1, 2, 3, 4, 6, 9, 12, 18, 24, 36, 48}));
+  for (const int min_samples : {4, 48, 500, 10000}) {
+    int pitch = 0;
+    const size_t n = sampler.SampleLatticeAtLeast(block, min_samples, &pitch).size();
+    int expected = 1;
+    for (int p : ladder)
+      if (double(block.size()) >= double(min_samples) * p * p) expected = p;
+    EXPECT_EQ(pitch, expected) << min_samples;
+    EXPECT_GE(n, size_t(min_samples));
+  }
+  // Rows 100..103 of the block (4 x 360 px): by size, pitch 4 (1440 >= 48 * 16: 90 points if it
+  // filled a square); on the image's lattice, rows = 2 mod 4 hold one row of 90, = 1 mod 2 two
+  // rows of 180: 90 >= 48 at pitch 4.
+  for (int y = 100; y < 104; ++y)
+    for (int x = 20; x < 380; ++x) strip.push_back(y * size.width + x);
+  int pitch = 0;
+  EXPECT_EQ(sampler.SampleLatticeAtLeast(strip, 48, &pitch).size(), 90u);
+  EXPECT_EQ(pitch, 4);
+  // Row 100 alone (360 px): by size pitch 4 (360 >= 20 * 16), but rows = 2 mod 4 miss it; one
+  // finer, 3: row 100 = 1 mod 3, 120 columns.
+  const std::vector<int> row(strip.begin(), strip.begin() + 360);
+  EXPECT_TRUE(sampler.SampleLattice(row, 4).empty());
+  EXPECT_EQ(sampler.SampleLatticeAtLeast(row, 20, &pitch).size(), 120u);
+  EXPECT_EQ(pitch, 3);
 }
 
 }  // namespace

@@ -20,8 +20,10 @@ void LineIndexOptions::Check() const {
     throw InputError("line_index_window_half_height_px", "must be in [0, 30]");
   if (!(max_row_offset_px > 0 && max_row_offset_px < 1))
     throw InputError("line_index_max_row_offset_px", "must be in (0, 1)");
-  if (area_per_sample_px < 0 || area_per_sample_px > 100000)
-    throw InputError("line_index_area_per_sample_px", "must be in [0, 100000] (0 = off)");
+  // Below the vernier window's 9 x 9 px the re-read's samples overlap: it
+  // costs more and reads little more.
+  if (area_per_sample_px != 0 && (area_per_sample_px < 81 || area_per_sample_px > 100000))
+    throw InputError("line_index_area_per_sample_px", "must be 0 (off) or in [81, 100000]");
   if (footprint_gap_px < 0 || footprint_gap_px > 16)
     throw InputError("line_index_footprint_gap_px", "must be in [0, 16]");
   if (!(ambiguity_sigmas >= 0 && ambiguity_sigmas <= 5))
@@ -152,7 +154,16 @@ class LineIndexer {
   // those read the vernier nearer 0 on a wrong alignment than the footprint
   // does (simulator's ball bar at speckle 0.4: a component two periods off
   // read +0.11 px on its own pixels, +0.32 on all pixels of its region).
-  std::vector<Start> Sample(const std::vector<int>& pixels) { return sampler_.Sample(pixels); }
+  std::vector<Start> Sample(const std::vector<int>& pixels) {
+    if (!o_.lattice_sampling) return sampler_.Sample(pixels);
+    return sampler_.SampleLatticeAtLeast(pixels, o_.samples);
+  }
+
+  // The whole footprint, one sample per area_per_sample_px.
+  std::vector<Start> SampleWhole(const std::vector<int>& pixels) {
+    if (!o_.lattice_sampling) return sampler_.Sample(pixels, o_.area_per_sample_px);
+    return sampler_.SampleLattice(pixels, std::max(1, int(std::lround(std::sqrt(double(o_.area_per_sample_px))))));
+  }
 
   // The row offset of the tall-window fit over `sample`, each started from
   // its disparity + shift.
@@ -255,7 +266,7 @@ class LineIndexer {
     // the whole footprint (one sample per that area) before moving or
     // dropping it; the other alignments are then read over it too.
     if (o_.area_per_sample_px > 0) {
-      std::vector<Start> whole = sampler_.Sample(pixels, o_.area_per_sample_px);
+      std::vector<Start> whole = SampleWhole(pixels);
       if (whole.size() > sample.size()) {
         Vernier whole_here = Read(whole, 0.0);
         whole_here.mean_row_offset_px -= offset_px;

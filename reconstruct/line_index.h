@@ -10,17 +10,20 @@
 // left-right check. Measured on the simulator's ball bar, module 1: 98 % of
 // its matches were one period off.
 //
-// The intensities do tell: after sub-pixel alignment, a window tall enough to
-// hold a near-horizontal line (9 rows) correlates ~0.9 at the true match and
-// ~0.75 one period off. One pixel's test is noisy (right ~85 % of the
-// time); the mean over a component's sampled pixels is not. So: label the
-// connected components of the disparity map (neighbours within 1 px), and
-// for each, compare the mean ZNCC of the refined tall window at the current
-// disparity with that at shifts of 2..max_shift_px either way; move the
-// component to a shift that wins by min_gain, re-refining every pixel.
-// A component that reads off but whose better alignment cannot be read
-// (near the right image's edge, the true line can lie outside it) is
-// dropped (drop_row_offset_px).
+// The intensities do tell, through a vernier: refine a window tall enough
+// to hold a near-horizontal line (9 rows) with a free row offset. At the
+// true match it reads ~0; one period off, the near-horizontal lines sit
+// p*sin(2.6 deg) ~ 0.36 px higher or lower, and the fit reads that. One
+// pixel's reading is noisy (sd ~0.1-0.4 px with speckle); the mean over a
+// component's sampled pixels is not. So: label the connected components of
+// the disparity map (neighbours within 1 px), read each one's mean row
+// offset at its alignment; if it is not conclusively ~0, read it at the
+// best-correlating shift 2..max_shift_px either way too, fit the offset's
+// step per period, and keep, move (re-refining every pixel) or, if the
+// zero crossing is ambiguous, drop the component (ambiguity_sigmas). A
+// component that reads off but whose better alignment cannot be read (near
+// the right image's edge, the true line can lie outside it) is dropped
+// (drop_row_offset_px). Where it is read: lattice_sampling.
 #pragma once
 
 #include <map>
@@ -36,7 +39,7 @@ struct LineIndexOptions {
   bool enabled = true;                  // default true
   int max_shift_px = 12;                // shifts tried: 2..max_shift_px either way, px; default 12 (> one ~8 px period)
   int min_component_px = 20;            // smaller components are left to the speckle filter; default 20 px
-  int samples = 48;                     // pixels per component refined at each shift; default 48
+  int samples = 48;                     // pixels per component (at least, with lattice_sampling) refined at each shift; default 48
   int window_half_height_px = 4;        // the test window's half height, px; default 4 (9 rows: > one period)
   double max_row_offset_px = 0.1;       // a component whose mean row offset is within this is kept; default 0.1 px
   double min_row_offset_step_px = 0.1;  // the row offset must change by this per period to be read; default 0.1 px
@@ -56,20 +59,34 @@ struct LineIndexOptions {
   // A component whose reading from `samples` pixels is not conclusive
   // (not read as right, above) is read again over its whole footprint, one
   // sample per this many footprint pixels where that gives more, before it
-  // is moved or dropped (0 = off). 48 samples give a standard error that
-  // does not shrink as a component grows (~0.05 px at speckle 0.4: per-pixel
-  // sd ~0.37 px), so at strong speckle a large right component can read
-  // 0.3-0.5 of an alignment off and be dropped whole (simulator's sphere at
-  // speckle 0.4, module 1, an 18 400-pixel component: -0.133 +- 0.051 px
-  // from 62 samples, -0.067 +- 0.023 from 307). The tall window's area
-  // (9 x 9 = 81 px) keeps the samples' windows from overlapping, so their
-  // readings are about independent and the standard error from their
-  // scatter holds. Components read as right from `samples` are not re-read.
-  // The matcher uses it only in modules where growing's noise-derived ZNCC
-  // floor bites (GrowOptions::noise_zncc_factor, if on): at the default
-  // speckle a re-read only trades one noisy reading of a small component for
-  // another (demo ball bar, module 1: std 0.084 -> 0.088 mm). Default 81.
+  // is moved or dropped (0 = off; else >= 81). `samples` give a standard
+  // error that does not shrink as a component grows (~0.05 px at speckle
+  // 0.4: per-pixel sd ~0.37 px), so at strong speckle a large right
+  // component can read 0.3-0.5 of an alignment off and be dropped whole
+  // (simulator's sphere at speckle 0.4, module 1, an 18 400-pixel
+  // component: -0.133 +- 0.051 px from 62 samples, -0.067 +- 0.023 from
+  // 307). With lattice_sampling the re-read is the image's lattice of pitch
+  // sqrt(area) = 9 px, the tall window's size: the samples' windows do not
+  // overlap, so the standard error from their scatter holds (the speckle's
+  // correlation length, ~8 x 5 px, is within a window). Without it, the
+  // re-read is spread by raster rank and its windows can overlap: its
+  // standard error is then an underestimate. Components read as right from
+  // `samples` are not re-read. The matcher uses it only in modules where
+  // growing's noise-derived ZNCC floor bites (GrowOptions::noise_zncc_factor,
+  // if on); with lattice sampling the demo scores the same either way.
+  // Default 81.
   int area_per_sample_px = 81;
+  // Where the vernier is read: on the image's lattice (FootprintSampler::
+  // SampleLatticeAtLeast, at least `samples` pixels; the re-read above at
+  // pitch sqrt(area_per_sample_px)) instead of by raster rank over the
+  // component's footprint. Raster rank moves nearly every sample when a
+  // component gains or loses a few pixels, so a component whose reading
+  // lies near a decision's threshold was kept, moved or dropped whole by
+  // chance: demo ball bar, module 1, fill 82.9 % at range_margin_px 12,
+  // 72.8 % at 11 and 27.4 % at 13 (an 18 700-pixel component dropped); on
+  // the lattice, 83.2-83.4 %. Default true; false = by raster rank, as
+  // before session 10.
+  bool lattice_sampling = true;
   // How sure the vernier must be, in standard errors of its reading. A
   // component is kept without reading the other alignments only if its
   // reading is within max_row_offset_px by this many standard errors; after
@@ -84,7 +101,7 @@ struct LineIndexOptions {
   int min_seam_px = 30;     // JoinAcrossPeriodJumps: shortest seam between two components it acts on; default 30 px
   // JoinAcrossPeriodJumps: a seam is a period jump (not a depth edge, whose
   // step varies along it) if at most a quarter of its differences lie
-  // farther than this from their median. Default 1 px. At speckle 0.4 the
+  // farther than this from their median (1 px before session 9). At speckle 0.4 the
   // differences of a plain period jump scatter wider (simulator's plate,
   // module 1: 10th-90th percentile -10.8 to -7.0 px around -9.2, half of
   // them beyond 1 px): 2 px (a quarter period) still tells one period from

@@ -106,6 +106,7 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.line_index.max_shift_px = m.GetInt("line_index_max_shift_px", mo.line_index.max_shift_px);
     mo.line_index.min_component_px = m.GetInt("line_index_min_component_px", mo.line_index.min_component_px);
     mo.line_index.samples = m.GetInt("line_index_samples", mo.line_index.samples);
+    mo.line_index.lattice_sampling = m.GetBool("line_index_lattice_sampling", mo.line_index.lattice_sampling);
     mo.line_index.min_seam_px = m.GetInt("line_index_min_seam_px", mo.line_index.min_seam_px);
     mo.line_index.max_seam_gap_px = m.GetInt("line_index_max_seam_gap_px", mo.line_index.max_seam_gap_px);
     mo.line_index.seam_spread_px = m.GetDouble("line_index_seam_spread_px", mo.line_index.seam_spread_px);

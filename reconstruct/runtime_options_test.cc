@@ -114,15 +114,19 @@ TEST(RuntimeOptions, ReadsAndChecksTheStrongSpeckleKeys) {
   EXPECT_EQ(d.match.grow.noise_min_zncc, 0.6);
   EXPECT_EQ(d.match.line_index.area_per_sample_px, 81);
   EXPECT_EQ(d.match.line_index.seam_spread_px, 2.0);
+  EXPECT_TRUE(d.match.line_index.lattice_sampling);
   const RuntimeOptions o = ParseRuntimeOptions(
       "match:\n  grow_noise_zncc_factor: 0\n  grow_noise_min_zncc: 0.5\n  line_index_area_per_sample_px: 0\n"
-      "  line_index_seam_spread_px: 1\n",
+      "  line_index_seam_spread_px: 1\n  line_index_lattice_sampling: false\n",
       "set.yaml");
   EXPECT_EQ(o.match.grow.noise_zncc_factor, 0.0);
   EXPECT_EQ(o.match.grow.noise_min_zncc, 0.5);
   EXPECT_EQ(o.match.line_index.area_per_sample_px, 0);
   EXPECT_EQ(o.match.line_index.seam_spread_px, 1.0);
+  EXPECT_FALSE(o.match.line_index.lattice_sampling);
   const std::pair<const char*, const char*> bad[] = {
+      {"match:\n  line_index_lattice_sampling: sometimes\n", "line_index_lattice_sampling"},
+      {"match:\n  line_index_area_per_sample_px: 80\n", "line_index_area_per_sample_px"},
       {"match:\n  grow_noise_zncc_factor: -1\n", "grow_noise_zncc_factor"},
       {"match:\n  grow_noise_zncc_factor: 21\n", "grow_noise_zncc_factor"},
       {"match:\n  grow_noise_min_zncc: 1\n", "grow_noise_min_zncc"},
