@@ -171,7 +171,12 @@ std::vector<FootprintStart> FootprintSampler::SampleLatticeAtLeast(const std::ve
     std::vector<FootprintStart> sample = SampleLattice(pixels, ladder[k]);
     if (int(sample.size()) >= min_samples || k == 0) {
       if (pitch_px) *pitch_px = ladder[k];
-      return sample;
+      if (ladder[k] > kDensePitchPx || int(sample.size()) <= 2 * min_samples) return sample;
+      // Windows this close overlap by 7/9 or more: thinned by rank.
+      std::vector<FootprintStart> thin;
+      const double every = double(sample.size()) / (2.0 * min_samples);
+      for (double r = 0.5 * every; r < double(sample.size()); r += every) thin.push_back(sample[size_t(r)]);
+      return thin;
     }
   }
 }

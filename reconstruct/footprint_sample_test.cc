@@ -250,5 +250,30 @@ TEST(FootprintSample, LatticeAtLeastStartsFromTheSizeAndGoesFinerUntilItGivesEno
   EXPECT_EQ(pitch, 3);
 }
 
+// A small dense component (20 x 20 px, 400 valid; pitch 2 holds 100
+// lattice points, pitch 3 7 x 6 = 42). By size (400 >= min_samples x p^2) 45
+// samples take pitch 2: 100 > 2 x 45, and at pitch 2 the 9-px windows
+// overlap by 7/9, so it is thinned to 90 of those 100, by rank. 60 take
+// pitch 2 too, 100 <= 120: all. 30 take pitch 3 (400 >= 270): not thinned.
+TEST(FootprintSample, ADenseLatticeIsThinnedToTwiceTheSamples) {
+  const cv::Size size(80, 60);
+  cv::Mat d(size, CV_32FC1, cv::Scalar(kInf)), gx(size, CV_32FC1, cv::Scalar(0)), gy = gx.clone();
+  std::vector<int> blob;
+  for (int y = 20; y < 40; ++y)
+    for (int x = 30; x < 50; ++x) d.at<float>(y, x) = 25, blob.push_back(y * size.width + x);
+  FootprintSampler sampler(d, gx, gy, 0, 48);
+  const auto at2 = sampler.SampleLattice(blob, 2);
+  ASSERT_EQ(at2.size(), 100u);
+  ASSERT_EQ(sampler.SampleLattice(blob, 3).size(), 42u);
+  int pitch = 0;
+  const auto thinned = sampler.SampleLatticeAtLeast(blob, 45, &pitch);
+  EXPECT_EQ(pitch, 2);
+  EXPECT_EQ(thinned.size(), 90u);
+  for (const FootprintStart& s : thinned) EXPECT_NE(std::find(at2.begin(), at2.end(), s), at2.end());
+  EXPECT_EQ(sampler.SampleLatticeAtLeast(blob, 60, &pitch), at2);
+  EXPECT_EQ(sampler.SampleLatticeAtLeast(blob, 30, &pitch).size(), 42u);
+  EXPECT_EQ(pitch, 3);
+}
+
 }  // namespace
 }  // namespace stereorig
