@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
-#include <iterator>
 
 #include "calib/core/input_error.h"
 
@@ -146,7 +145,7 @@ std::vector<FootprintStart> FootprintSampler::SampleLattice(const std::vector<in
   return sample;
 }
 
-std::vector<int> FootprintSampler::LatticeLadder() const {
+std::vector<int> FootprintSampler::LatticePitchesPx() const {
   std::vector<int> ladder = {1, 2, 3, 4, 6};
   const int side = std::max(disparity_px_.cols, disparity_px_.rows);
   for (int p = 9; p <= side; p *= 2) {
@@ -159,7 +158,7 @@ std::vector<int> FootprintSampler::LatticeLadder() const {
 std::vector<FootprintStart> FootprintSampler::SampleLatticeAtLeast(const std::vector<int>& pixels, int min_samples,
                                                                    int* pitch_px) {
   STEREORIG_CHECK(min_samples >= 1);
-  const std::vector<int> ladder = LatticeLadder();
+  const std::vector<int> ladder = LatticePitchesPx();
   // The valid pixels alone, N, hold about N / p^2 lattice points: start at
   // the coarsest pitch that could give min_samples and go finer while it
   // does not (a thin component holds fewer).
@@ -171,10 +170,10 @@ std::vector<FootprintStart> FootprintSampler::SampleLatticeAtLeast(const std::ve
     std::vector<FootprintStart> sample = SampleLattice(pixels, ladder[k]);
     if (int(sample.size()) >= min_samples || k == 0) {
       if (pitch_px) *pitch_px = ladder[k];
-      if (ladder[k] > kDensePitchPx || int(sample.size()) <= 2 * min_samples) return sample;
+      if (ladder[k] > kDensePitchPx || sample.size() <= 2 * size_t(min_samples)) return sample;
       // Windows this close overlap by 7/9 or more: thinned by rank.
       std::vector<FootprintStart> thin;
-      const double every = double(sample.size()) / (2.0 * min_samples);
+      const double every = double(sample.size()) / (2.0 * double(min_samples));
       for (double r = 0.5 * every; r < double(sample.size()); r += every) thin.push_back(sample[size_t(r)]);
       return thin;
     }

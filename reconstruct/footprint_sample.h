@@ -1,5 +1,7 @@
-// Where the line-index vernier (line_index.h) is read: pixels spread evenly
-// over a component's footprint.
+// Where the line-index vernier (line_index.h) is read: pixels of a
+// component's footprint, on a lattice fixed in the image (SampleLattice,
+// SampleLatticeAtLeast: the default since session 10) or spread evenly by
+// raster rank (Sample).
 //
 // The footprint is the component's valid pixels and the empty pixels up to
 // gap_px along the row from them (an empty pixel reached from a valid pixel
@@ -9,7 +11,7 @@
 // speckle those read the vernier nearer 0 on a wrong alignment than the
 // footprint does (docs/reconstruct.md, "Strong speckle").
 //
-// The sample: list the footprint in raster order (index y * cols + x), N
+// The raster-rank sample: list the footprint in raster order (index y * cols + x), N
 // pixels; stride = max(1, N / samples); take the pixels at ranks
 // floor(stride / 2 + j * stride) < N, the rank accumulated in a double as
 // k += stride. An empty pixel starts from the valid pixel it is reached
@@ -68,7 +70,7 @@ class FootprintSampler {
   std::vector<FootprintStart> SampleLattice(const std::vector<int>& pixels, int pitch_px);
 
   // SampleLattice with at least min_samples pixels: at the coarsest pitch p
-  // of LatticeLadder() with N >= min_samples * p^2 (N = pixels.size(): its
+  // of LatticePitchesPx() with N >= min_samples * p^2 (N = pixels.size(): its
   // valid pixels hold about N / p^2 lattice points), or finer while that
   // gives fewer, down to 1 px (every footprint pixel): a thin component can
   // miss a coarse lattice entirely. A ladder, not sqrt(N / min_samples)
@@ -77,14 +79,18 @@ class FootprintSampler {
   // of less than ~9 x min_samples px, or thin ones), at most
   // 2 x min_samples, every k-th of the lattice's in raster order: their
   // 9-px windows overlap by 7/9 or more, so more samples cost more and read
-  // little more (the line index's time, 5 demo scenes: ~+20 % without it).
-  // pitch_px: if not null, receives the pitch used.
+  // little more (with the probe in line_index.cc: the line index's time on
+  // the 5 demo scenes ~+30 % without them). That rank brings back some
+  // order dependence for these small components: a choice by a hash of the
+  // position was measured and read the demo ball bar's module 0 with std
+  // 0.072 mm instead of 0.068 (both draws of small pieces). pitch_px: if
+  // not null, receives the pitch used.
   std::vector<FootprintStart> SampleLatticeAtLeast(const std::vector<int>& pixels, int min_samples,
                                                    int* pitch_px = nullptr);
 
   // The lattice pitches, finest first: 1, 2, 3, 4, 6, then 9 and 12 px
   // times powers of 2, up to the image's larger side.
-  std::vector<int> LatticeLadder() const;
+  std::vector<int> LatticePitchesPx() const;
   static constexpr int kDensePitchPx = 2;
 
  private:

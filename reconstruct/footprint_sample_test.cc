@@ -9,8 +9,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <cstdio>
+#include <limits>
 #include <random>
 
 #include "reconstruct/line_index.h"
@@ -144,6 +144,13 @@ TEST(FootprintSample, LatticeSampleIsTheFootprintOnTheImagesLattice) {
         ASSERT_EQ(sampler.SampleLattice(pixels, pitch), expected) << "trial " << trial << " pitch " << pitch;
         ++compared;
       }
+      int pitch = 0;
+      const auto at_least = sampler.SampleLatticeAtLeast(pixels, 8, &pitch);
+      const auto on_lattice = sampler.SampleLattice(pixels, pitch);
+      EXPECT_TRUE(std::includes(on_lattice.begin(), on_lattice.end(), at_least.begin(), at_least.end(),
+                                [](const auto& a, const auto& b) { return a.i < b.i; }));
+      EXPECT_TRUE(std::adjacent_find(at_least.begin(), at_least.end(),
+                                     [](const auto& a, const auto& b) { return a.i >= b.i; }) == at_least.end());
     }
   }
   EXPECT_GT(compared, 200);  // not vacuous
@@ -196,20 +203,26 @@ TEST(FootprintSample, LatticeReadsANearlyEqualComponentAtTheSamePixels) {
   EXPECT_LT(raster, 0.5);  // the raster-rank sample moved (measured: see the line above)
 }
 
-// A one-row component on an even row misses the 2 px lattice (odd rows)
-// and every coarser one: it is read at every footprint pixel, not left
-// unread (before, the line index kept a component with < 4 samples untested).
+// A one-row component (200 px on row 12) misses the lattices of pitch 2
+// to 18 (row 12 is not p/2 mod p for any of them). By size it takes pitch 2
+// (200 >= 48 x 4), which gives none: it is read at pitch 1, every footprint
+// pixel (200 valid and 2 gap pixels either side), thinned by rank to
+// 2 x 48 = 96, not left unread (before, the line index kept a component
+// with < 4 samples untested).
 TEST(FootprintSample, AThinComponentIsReadAtEveryPixel) {
-  const cv::Size size(80, 20);
+  const cv::Size size(260, 20);
   cv::Mat d(size, CV_32FC1, cv::Scalar(kInf)), gx(size, CV_32FC1, cv::Scalar(0)), gy = gx.clone();
   std::vector<int> pixels;
-  for (int x = 30; x < 50; ++x) d.at<float>(10, x) = 25, pixels.push_back(10 * size.width + x);
+  for (int x = 30; x < 230; ++x) d.at<float>(12, x) = 25, pixels.push_back(12 * size.width + x);
   FootprintSampler sampler(d, gx, gy, 2, 48);
-  EXPECT_TRUE(sampler.SampleLattice(pixels, 2).empty());
+  for (const int p : {2, 3, 4, 6, 9, 12, 18}) EXPECT_TRUE(sampler.SampleLattice(pixels, p).empty()) << p;
+  EXPECT_EQ(sampler.SampleLattice(pixels, 1).size(), 204u);
   int pitch = 0;
   const auto sample = sampler.SampleLatticeAtLeast(pixels, 48, &pitch);
   EXPECT_EQ(pitch, 1);
-  EXPECT_EQ(sample.size(), 20u + 2 * 2);  // the 20 valid pixels and 2 gap pixels either side
+  EXPECT_EQ(sample.size(), 96u);
+  for (const FootprintStart& s : sample) EXPECT_TRUE(s.i / size.width == 12 && s.i % size.width >= 28 && s.i % size.width < 232);
+  EXPECT_TRUE(sampler.SampleLatticeAtLeast({}, 48, &pitch).empty());
 }
 
 // The pitch the ladder picks: for a full rectangle (no footprint beyond
@@ -222,7 +235,7 @@ TEST(FootprintSample, LatticeAtLeastStartsFromTheSizeAndGoesFinerUntilItGivesEno
   for (int y = 20; y < 280; ++y)
     for (int x = 20; x < 380; ++x) d.at<float>(y, x) = 30, block.push_back(y * size.width + x);
   FootprintSampler sampler(d, gx, gy, 0, 48);
-  const std::vector<int> ladder = sampler.LatticeLadder();
+  const std::vector<int> ladder = sampler.LatticePitchesPx();
   ASSERT_EQ(std::vector<int>(ladder.begin(), ladder.begin() + 11),
             std::vector<int>({1, 2, 3, 4, 6, 9, 12, 18, 24, 36, 48}));
   for (const int min_samples : {4, 48, 500, 10000}) {

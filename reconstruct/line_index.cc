@@ -146,14 +146,16 @@ class LineIndexer {
 
   using Start = FootprintStart;
 
-  // Up to o.samples pixels of the component's footprint, spread evenly
-  // (footprint_sample.h): its valid pixels and, with footprint_gap_px, the
-  // empty pixels up to that far along the row from them. The valid pixels
-  // alone are a biased sample: they are the ones whose window passed the
-  // matcher's tests at the component's alignment, and at strong speckle
-  // those read the vernier nearer 0 on a wrong alignment than the footprint
-  // does (simulator's ball bar at speckle 0.4: a component two periods off
-  // read +0.11 px on its own pixels, +0.32 on all pixels of its region).
+  // Pixels of the component's footprint (footprint_sample.h): its valid
+  // pixels and, with footprint_gap_px, the empty pixels up to that far
+  // along the row from them; at least o.samples of them on the image's
+  // lattice where the footprint holds as many (lattice_sampling), else
+  // o.samples spread by raster rank. The valid pixels alone are a biased
+  // sample: they are the ones whose window passed the matcher's tests at
+  // the component's alignment, and at strong speckle those read the vernier
+  // nearer 0 on a wrong alignment than the footprint does (simulator's ball
+  // bar at speckle 0.4: a component two periods off read +0.11 px on its
+  // own pixels, +0.32 on all pixels of its region).
   std::vector<Start> Sample(const std::vector<int>& pixels) {
     if (!o_.lattice_sampling) return sampler_.Sample(pixels);
     return sampler_.SampleLatticeAtLeast(pixels, o_.samples);
@@ -163,6 +165,16 @@ class LineIndexer {
   std::vector<Start> SampleWhole(const std::vector<int>& pixels) {
     if (!o_.lattice_sampling) return sampler_.Sample(pixels, o_.area_per_sample_px);
     return sampler_.SampleLattice(pixels, std::max(1, int(std::lround(std::sqrt(double(o_.area_per_sample_px))))));
+  }
+
+  // About `samples` of `sample`, every k-th (k = size / samples, at least
+  // 1: `samples` to 2 x `samples` of them).
+  std::vector<Start> Probe(const std::vector<Start>& sample) const {
+    const size_t every = std::max<size_t>(1, sample.size() / size_t(o_.samples));
+    if (every == 1) return sample;
+    std::vector<Start> probe;
+    for (size_t k = every / 2; k < sample.size(); k += every) probe.push_back(sample[k]);
+    return probe;
   }
 
   // The row offset of the tall-window fit over `sample`, each started from
@@ -248,6 +260,13 @@ class LineIndexer {
   // offset_px: the row offset a correct match reads (0 on a well rectified pair).
   Outcome TestComponent(const std::vector<int>& pixels, double offset_px) {
     std::vector<Start> sample = Sample(pixels);
+    // On the lattice, with area_per_sample_px, the whole footprint is read
+    // from the start (the matcher sets it only where growing's noise floor
+    // bites: strong speckle).
+    if (o_.lattice_sampling && o_.area_per_sample_px > 0) {
+      std::vector<Start> whole = SampleWhole(pixels);
+      if (whole.size() > sample.size()) sample = std::move(whole);
+    }
     if (int(sample.size()) < 4) return Outcome::kKept;
     Vernier here = Read(sample, 0.0);
     here.mean_row_offset_px -= offset_px;
@@ -261,11 +280,12 @@ class LineIndexer {
       return o_.ambiguity_sigmas > 0 ? here_abs + o_.ambiguity_sigmas * here.standard_error_px <= o_.max_row_offset_px
                                      : here_abs <= std::max(o_.max_row_offset_px, 3 * here.standard_error_px);
     };
-    if (read_as_right()) return Outcome::kKept;
-    // Not conclusive from `samples` pixels: with area_per_sample_px, read
-    // the whole footprint (one sample per that area) before moving or
-    // dropping it; the other alignments are then read over it too.
-    if (o_.area_per_sample_px > 0) {
+    if (o_.quick_keep && read_as_right()) return Outcome::kKept;
+    // Not conclusive from `samples` pixels (by raster rank): with
+    // area_per_sample_px, read the whole footprint (one sample per that
+    // area) before moving or dropping it; the other alignments are then read
+    // over it too. On the lattice it was read whole above.
+    if (o_.area_per_sample_px > 0 && !o_.lattice_sampling) {
       std::vector<Start> whole = SampleWhole(pixels);
       if (whole.size() > sample.size()) {
         Vernier whole_here = Read(whole, 0.0);
@@ -290,12 +310,11 @@ class LineIndexer {
     // correlates best. Their row offsets step by about the same amount per
     // period (the vernier): fit dy(k) = a + b k over k = -1, 0, +1 and move
     // to the alignment nearest its zero crossing.
-    // The shift is found from about `samples` of them (every k-th): it is
-    // the best of 2 x (max_shift_px - 1) mean correlations, which differ by
-    // far more than their noise; the row offset there is read from all.
-    std::vector<Start> probe;
-    const size_t every = std::max<size_t>(1, sample.size() / size_t(o_.samples));
-    for (size_t k = every / 2; k < sample.size(); k += every) probe.push_back(sample[k]);
+    // On the lattice, the shift is found from `samples` to 2 x `samples`
+    // of them (Probe): it is the best of 2 x (max_shift_px - 1) mean
+    // correlations, which differ by far more than their noise; the row
+    // offset there is read from all.
+    const std::vector<Start> probe = o_.lattice_sampling ? Probe(sample) : sample;
     Vernier side[2];
     for (int j = 0; j < 2; ++j) {
       const int sign = j == 0 ? -1 : 1;

@@ -39,7 +39,10 @@ struct LineIndexOptions {
   bool enabled = true;                  // default true
   int max_shift_px = 12;                // shifts tried: 2..max_shift_px either way, px; default 12 (> one ~8 px period)
   int min_component_px = 20;            // smaller components are left to the speckle filter; default 20 px
-  int samples = 48;                     // pixels per component (at least, with lattice_sampling) refined at each shift; default 48
+  // Pixels per component refined at each shift; default 48. With
+  // lattice_sampling at least this many where the footprint holds as many
+  // (48 to ~160 with the footprint's gap pixels), thinned to 2x at pitch <= 2.
+  int samples = 48;
   int window_half_height_px = 4;        // the test window's half height, px; default 4 (9 rows: > one period)
   double max_row_offset_px = 0.1;       // a component whose mean row offset is within this is kept; default 0.1 px
   double min_row_offset_step_px = 0.1;  // the row offset must change by this per period to be read; default 0.1 px
@@ -87,6 +90,14 @@ struct LineIndexOptions {
   // the lattice, 83.2-83.4 %. Default true; false = by raster rank, as
   // before session 10.
   bool lattice_sampling = true;
+  // A component whose own reading is right (ambiguity_sigmas, below) is kept
+  // without reading the other alignments. Not a YAML key: the matcher turns
+  // it off, with lattice_sampling, where growing's noise floor bites (strong
+  // speckle). There one period off reads only ~0.16-0.23 px against a
+  // standard error of ~0.04, so a wrong component can pass that test: the
+  // speckle-0.4 ball bar's module 1 kept one period off (std 1.3 mm) under 2
+  // of 6 option controls, 0 of 6 with the alignments always read.
+  bool quick_keep = true;
   // How sure the vernier must be, in standard errors of its reading. A
   // component is kept without reading the other alignments only if its
   // reading is within max_row_offset_px by this many standard errors; after

@@ -395,11 +395,15 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
     // footprint reading (line_index_area_per_sample_px) is used only where
     // the floor bites: there the views decorrelate strongly (speckle) and 48
     // samples leave large right components ambiguous; elsewhere they do not,
-    // and a re-read only trades one noisy reading for another.
+    // and a re-read only trades one noisy reading for another. There, too,
+    // no component is kept before its other alignments are read
+    // (LineIndexOptions::quick_keep).
     RefineAcceptance grow_accept = accept;
     grow_accept.min_zncc = GrowMinZncc(state.disparity_px, state.confidence, roi, o.grow, accept.min_zncc);
     LineIndexOptions line_index = o.line_index;
-    if (o.grow.noise_zncc_factor > 0 && !(grow_accept.min_zncc < accept.min_zncc)) line_index.area_per_sample_px = 0;
+    const bool floor_bites = o.grow.noise_zncc_factor > 0 && grow_accept.min_zncc < accept.min_zncc;
+    if (o.grow.noise_zncc_factor > 0 && !floor_bites) line_index.area_per_sample_px = 0;
+    if (floor_bites && line_index.lattice_sampling) line_index.quick_keep = false;
     CorrectLineIndex(left, right, roi, line_index, accept, &state);
     lap("line_index");
     // Shared by both passes: the second does not repeat the first's failed tries.
