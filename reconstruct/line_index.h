@@ -73,11 +73,12 @@ struct LineIndexOptions {
   // overlap, so the standard error from their scatter holds (the speckle's
   // correlation length, ~8 x 5 px, is within a window). Without it, the
   // re-read is spread by raster rank and its windows can overlap: its
-  // standard error is then an underestimate. Components read as right from
-  // `samples` are not re-read. The matcher uses it only in modules where
-  // growing's noise-derived ZNCC floor bites (GrowOptions::noise_zncc_factor,
-  // if on); with lattice sampling the demo scores the same either way.
-  // Default 81.
+  // standard error is then an underestimate. By raster rank, components
+  // read as right from `samples` are not re-read; on the lattice the whole
+  // footprint is read from the start wherever this is on. The matcher uses
+  // it only in modules where growing's noise-derived ZNCC floor bites
+  // (GrowOptions::noise_zncc_factor, if on); with lattice sampling the demo
+  // scores the same either way. Default 81.
   int area_per_sample_px = 81;
   // Where the vernier is read: on the image's lattice (FootprintSampler::
   // SampleLatticeAtLeast, at least `samples` pixels; the re-read above at
