@@ -145,6 +145,13 @@ std::vector<FootprintStart> FootprintSampler::SampleLattice(const std::vector<in
   return sample;
 }
 
+std::vector<FootprintStart> ThinByRank(const std::vector<FootprintStart>& sample, double every) {
+  STEREORIG_CHECK(every >= 1);
+  std::vector<FootprintStart> thin;
+  for (double r = 0.5 * every; r < double(sample.size()); r += every) thin.push_back(sample[size_t(r)]);
+  return thin;
+}
+
 std::vector<int> FootprintSampler::LatticePitchesPx() const {
   std::vector<int> ladder = {1, 2, 3, 4, 6};
   const int side = std::max(disparity_px_.cols, disparity_px_.rows);
@@ -172,10 +179,7 @@ std::vector<FootprintStart> FootprintSampler::SampleLatticeAtLeast(const std::ve
       if (pitch_px) *pitch_px = ladder[k];
       if (ladder[k] > kDensePitchPx || sample.size() <= 2 * size_t(min_samples)) return sample;
       // Windows this close overlap by 7/9 or more: thinned by rank.
-      std::vector<FootprintStart> thin;
-      const double every = double(sample.size()) / (2.0 * double(min_samples));
-      for (double r = 0.5 * every; r < double(sample.size()); r += every) thin.push_back(sample[size_t(r)]);
-      return thin;
+      return ThinByRank(sample, double(sample.size()) / (2.0 * double(min_samples)));
     }
   }
 }

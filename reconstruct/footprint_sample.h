@@ -40,6 +40,10 @@ struct FootprintStart {
   bool operator==(const FootprintStart&) const = default;
 };
 
+// Every `every`-th of `sample` (every >= 1) by rank: the elements at
+// floor(every / 2 + j * every), the position accumulated in a double.
+std::vector<FootprintStart> ThinByRank(const std::vector<FootprintStart>& sample, double every);
+
 // Samples footprints of components of one disparity map. Holds a per-pixel
 // scratch mark (4 bytes a pixel), so one sampler serves many components.
 class FootprintSampler {

@@ -171,10 +171,7 @@ class LineIndexer {
   // 1: `samples` to 2 x `samples` of them).
   std::vector<Start> Probe(const std::vector<Start>& sample) const {
     const size_t every = std::max<size_t>(1, sample.size() / size_t(o_.samples));
-    if (every == 1) return sample;
-    std::vector<Start> probe;
-    for (size_t k = every / 2; k < sample.size(); k += every) probe.push_back(sample[k]);
-    return probe;
+    return every == 1 ? sample : ThinByRank(sample, double(every));
   }
 
   // The row offset of the tall-window fit over `sample`, each started from
