@@ -58,6 +58,15 @@ double CpuSeconds() {
   return u.ru_utime.tv_sec + u.ru_stime.tv_sec + 1e-6 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
+// Minor page faults of the whole process so far: each is a page the kernel
+// zeroes and maps, on a VM often also backed by the host at that moment.
+// Far steadier than time on a shared machine.
+long MinorPageFaults() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_minflt;
+}
+
 double PeakMemoryMb() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
@@ -80,6 +89,7 @@ struct Pipeline {
   double build_ms = 0;
   double busy_s = 0;  // summed wall time of its Process() calls
   double cpu_s = 0;   // summed CPU time (all threads) of its Process() calls
+  long page_faults = 0;  // summed minor page faults of its Process() calls
   int objects = 0;
   std::map<std::string, std::vector<double>> steps;
 };
@@ -94,9 +104,11 @@ void BenchInterleaved(std::vector<Pipeline>& pipelines, const std::vector<Scene>
       for (Pipeline& p : pipelines) {
         const auto t0 = Clock::now();
         const double c0 = CpuSeconds();
+        const long f0 = MinorPageFaults();
         const Reconstruction rec = p.runtime->Process(s.images, false);
         p.busy_s += std::chrono::duration<double>(Clock::now() - t0).count();
         p.cpu_s += CpuSeconds() - c0;
+        p.page_faults += MinorPageFaults() - f0;
         ++p.objects;
         for (const auto& [k, v] : rec.times_ms) p.steps[k].push_back(v);
         for (const ModuleReport& m : rec.modules)
@@ -112,7 +124,8 @@ nlohmann::json PipelineJson(const Pipeline& p, const Rig& rig, const std::vector
                       {"objects", p.objects},
                       {"busy_s", p.busy_s},
                       {"objects_per_s", p.objects / p.busy_s},
-                      {"cpu_ms_per_object", 1e3 * p.cpu_s / p.objects}};
+                      {"cpu_ms_per_object", 1e3 * p.cpu_s / p.objects},
+                      {"page_faults_per_object", double(p.page_faults) / p.objects}};
   for (const auto& [k, v] : p.steps) j["median_time_ms"][k] = Median(v);
   for (const Scene& s : scenes) {
     const Reconstruction rec = p.runtime->Process(s.images, true);
@@ -143,10 +156,12 @@ nlohmann::json PipelineJson(const Pipeline& p, const Rig& rig, const std::vector
 }
 
 void PrintPipeline(const nlohmann::json& j) {
-  std::printf("%-17s %6.1f objects/s, %.0f CPU ms/object  (median: total %.1f ms, modules %.1f ms, match m0 %.1f ms)\n",
-              j["matcher"].get<std::string>().c_str(), j["objects_per_s"].get<double>(),
-              j["cpu_ms_per_object"].get<double>(), j["median_time_ms"]["total_point_cloud"].get<double>(),
-              j["median_time_ms"]["modules"].get<double>(), j["median_time_ms"]["module0.match"].get<double>());
+  std::printf(
+      "%-17s %6.1f objects/s, %.0f CPU ms/object, %.0f page faults/object  (median: total %.1f ms, modules %.1f ms, "
+      "match m0 %.1f ms)\n",
+      j["matcher"].get<std::string>().c_str(), j["objects_per_s"].get<double>(), j["cpu_ms_per_object"].get<double>(),
+      j["page_faults_per_object"].get<double>(), j["median_time_ms"]["total_point_cloud"].get<double>(),
+      j["median_time_ms"]["modules"].get<double>(), j["median_time_ms"]["module0.match"].get<double>());
   // Module 0's steps in pipeline order (map order is alphabetical): where the time goes.
   std::printf("  module 0 median ms:");
   // match.grow_2 and match.line_index_3 run only on captures where the
@@ -189,13 +204,13 @@ int RunBench(int argc, char** argv) {
       "ROI), everything after the correspondence step equal: 'opencv_sgbm_3way' replaces only our census SGM and "
       "its occupied-band pass (our filters, line index, growing and sub-pixel refinement follow); "
       "'opencv_sgbm_3way_standalone' replaces our whole correspondence stage (SGBM's own 1/16 px sub-pixel fit, "
-      "uniqueness, left-right check and speckle filter), as OpenCV users run it. Reports objects/s, per-step median "
-      "times (module 0's printed), peak memory (our runtime's own: the process's peak after running each capture "
-      "once with only the libraries and captures loaded, before the truth and the baselines; and the whole bench "
-      "process's), "
-      "the speed ratio, and both pipelines' accuracy (after one best rigid alignment to the truth surface) and "
-      "fill rate. Without --dataset it renders a built-in scene: a 50 mm sphere with the laser grids on the "
-      "embedded default rig.\n\n"
+      "uniqueness, left-right check and speckle filter), as OpenCV users run it. Reports objects/s, CPU ms and "
+      "minor page faults per object (a fault is a fresh page the kernel zeroes and maps: far steadier than time on "
+      "a shared machine), per-step median times (module 0's printed), peak memory (our runtime's own: the "
+      "process's peak after running each capture once with only the libraries and captures loaded, before the "
+      "truth and the baselines; and the whole bench process's), the speed ratio, and both pipelines' accuracy "
+      "(after one best rigid alignment to the truth surface) and fill rate. Without --dataset it renders a "
+      "built-in scene: a 50 mm sphere with the laser grids on the embedded default rig.\n\n"
       "Examples:\n  stereorig bench --runs 20\n"
       "  stereorig bench --dataset sim --scenes cup,sphere --rig calibrated.yaml --report bench.json",
       "stereorig bench"};
@@ -242,7 +257,7 @@ int RunBench(int argc, char** argv) {
     RuntimeOptions o = options;
     o.match.matcher = kind;
     const auto t0 = Clock::now();
-    pipelines.push_back(Pipeline{kind, std::make_unique<Runtime>(rig, o), 0, 0, 0, 0, {}});
+    pipelines.push_back(Pipeline{kind, std::make_unique<Runtime>(rig, o), 0, 0, 0, 0, 0, {}});
     pipelines.back().build_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   };
   // The runtime's own peak memory: so far the process holds the libraries,
