@@ -6,15 +6,15 @@
 // neighbourhood consistency test (max_plane_deviation_px, matcher.h).
 //
 // The plane's normal equations take the window sums of the valid mask's
-// moments (1, x, y, x^2, y^2, x y: integers, summed exactly) and of the
-// disparities' (d, x d, y d: summed in double). They are streamed down the
-// map, 9 rows held at a time, straight into the fit: no map-sized
-// intermediate (the nine box-filter images and their moment images this
-// replaced were ~60 % of the runtime's page faults). The sums equal
-// cv::boxFilter's to the bit wherever its double running sums are exact
-// (disparities >= 2^-6 px, maps below 4096 px: beyond, its float images of
-// x^2 were rounded and these sums stay exact), so the demo's clouds are
-// byte-identical.
+// moments (1, x, y, x^2, y^2, x y: integers) and of the disparities' (d, x d,
+// y d). The six integer ones are summed exactly in integer arithmetic, all
+// in one pass (WindowMaskMomentSums); the three others by cv::boxFilter. Its
+// double running sums of integers are exact too, so the six equal
+// cv::boxFilter's to the bit, and the planes those of nine box filters (the
+// demo's clouds are byte-identical), at less cost: the box filters were
+// ~60 % of this step's instructions, and the step runs on one thread before
+// the per-pixel fit. (To the bit for maps below 4096 px: beyond, the box
+// filters' float images of x^2 were rounded; these sums stay exact.)
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -32,21 +32,17 @@ constexpr int kSlopeWindowHalfPx = 4;  // the window: 9 x 9 px
 // not a surface). Coordinates are disparity's own (column, row).
 void DisparitySlopes(const cv::Mat& disparity, cv::Mat* slope_x, cv::Mat* slope_y, cv::Mat* plane);
 
-// The 9x9 window sums (zero outside the map) that DisparitySlopes fits, as
-// maps: each CV_32FC1 of disparity.size(), the sum rounded once to float.
-// x, y: disparity's column and row; d: the disparity (NaN: not in the sums).
-// For tests and diagnostics; DisparitySlopes streams them row by row.
-struct WindowMomentSums {
+// The 9x9 window sums (zero outside the map) of the valid mask's moments at
+// each pixel: each CV_32FC1 of disparity.size(), the exact integer sum
+// rounded once to float. x, y: disparity's column and row.
+struct MaskMomentSums {
   cv::Mat n;   // valid pixels
   cv::Mat x;   // sum of x
   cv::Mat y;   // sum of y
   cv::Mat xx;  // sum of x^2
   cv::Mat yy;  // sum of y^2
   cv::Mat xy;  // sum of x y
-  cv::Mat d;   // sum of d
-  cv::Mat xd;  // sum of float(x d)
-  cv::Mat yd;  // sum of float(y d)
 };
-WindowMomentSums WindowMomentSumMaps(const cv::Mat& disparity);
+MaskMomentSums WindowMaskMomentSums(const cv::Mat& disparity);
 
 }  // namespace stereorig

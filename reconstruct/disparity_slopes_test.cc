@@ -1,6 +1,6 @@
-// The local disparity plane (disparity_slopes.h): its streamed window sums
-// against cv::boxFilter of the masked moment images (the nine box filters
-// they replaced), and the planes against analytic ones.
+// The local disparity plane (disparity_slopes.h): its exact integer window
+// sums against cv::boxFilter of the masked moment images (the nine box
+// filters it replaced), and the planes against analytic ones.
 #include "reconstruct/disparity_slopes.h"
 
 #include <gtest/gtest.h>
@@ -27,15 +27,13 @@ cv::Mat PlaneWithHoles(cv::Size size, double hole_share, unsigned seed) {
   return d;
 }
 
-// The window sum of one masked moment m(x, y) f(x, y, d) by cv::boxFilter,
-// as the matcher took them before (float images, zero border).
-cv::Mat BoxSum(const cv::Mat& disparity, float (*f)(int x, int y, float d)) {
+// The window sum of one masked moment m(x, y) f(x, y) by cv::boxFilter, as
+// the matcher took them (float images, zero border).
+cv::Mat BoxSum(const cv::Mat& disparity, double (*f)(int x, int y)) {
   cv::Mat moment(disparity.size(), CV_32FC1);
   for (int y = 0; y < disparity.rows; ++y)
-    for (int x = 0; x < disparity.cols; ++x) {
-      const float d = disparity.at<float>(y, x);
-      moment.at<float>(y, x) = std::isnan(d) ? 0.f : f(x, y, d);
-    }
+    for (int x = 0; x < disparity.cols; ++x)
+      moment.at<float>(y, x) = std::isnan(disparity.at<float>(y, x)) ? 0.f : float(f(x, y));
   cv::Mat sum;
   const int k = 2 * kSlopeWindowHalfPx + 1;
   cv::boxFilter(moment, sum, CV_32F, cv::Size(k, k), cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
@@ -49,45 +47,27 @@ void ExpectBitEqual(const cv::Mat& a, const cv::Mat& b, const char* what) {
     for (int x = 0; x < a.cols; ++x) ASSERT_EQ(a.at<float>(y, x), b.at<float>(y, x)) << what << " at " << x << "," << y;
 }
 
-void ExpectEqualsBoxFilters(const cv::Mat& d) {
-  const WindowMomentSums s = WindowMomentSumMaps(d);
-  ExpectBitEqual(s.n, BoxSum(d, [](int, int, float) { return 1.f; }), "n");
-  ExpectBitEqual(s.x, BoxSum(d, [](int x, int, float) { return float(x); }), "x");
-  ExpectBitEqual(s.y, BoxSum(d, [](int, int y, float) { return float(y); }), "y");
-  ExpectBitEqual(s.xx, BoxSum(d, [](int x, int, float) { return float(double(x) * x); }), "xx");
-  ExpectBitEqual(s.yy, BoxSum(d, [](int, int y, float) { return float(double(y) * y); }), "yy");
-  ExpectBitEqual(s.xy, BoxSum(d, [](int x, int y, float) { return float(double(x) * y); }), "xy");
-  // The disparity moments as the matcher's images held them: x d and y d
-  // rounded to float before summing.
-  ExpectBitEqual(s.d, BoxSum(d, [](int, int, float v) { return v; }), "d");
-  ExpectBitEqual(s.xd, BoxSum(d, [](int x, int, float v) { return float(x) * v; }), "xd");
-  ExpectBitEqual(s.yd, BoxSum(d, [](int, int y, float v) { return float(y) * v; }), "yd");
-}
-
-TEST(DisparitySlopes, WindowSumsEqualBoxFilterToTheBit) {
+TEST(DisparitySlopes, IntegerWindowSumsEqualBoxFilterToTheBit) {
   // Larger than the window, and smaller than it in each direction (every
   // window then reaches past two borders). Coordinates here stay below
   // 2^12, so the box filter's float moment images (x^2 < 2^24) are exact.
-  for (const cv::Size size : {cv::Size(97, 61), cv::Size(5, 40), cv::Size(40, 3), cv::Size(1, 1)})
-    ExpectEqualsBoxFilters(PlaneWithHoles(size, 0.3, 7));
-  // Not a plane: disparities with full float mantissas, of either sign and
-  // magnitudes 0.1-300 px, as a verged pair's SGM map can hold. The box
-  // filter's double running sums are exact here (the terms' bits span < 53),
-  // and so are these: the two agree to the bit.
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<float> u(0, 1), mag(0.1f, 300.f);
-  cv::Mat noisy(83, 131, CV_32FC1);
-  for (int y = 0; y < noisy.rows; ++y)
-    for (int x = 0; x < noisy.cols; ++x)
-      noisy.at<float>(y, x) = u(rng) < 0.25f ? kNaN : (u(rng) < 0.2f ? -1.f : 1.f) * mag(rng);
-  ExpectEqualsBoxFilters(noisy);
+  for (const cv::Size size : {cv::Size(97, 61), cv::Size(5, 40), cv::Size(40, 3), cv::Size(1, 1)}) {
+    const cv::Mat d = PlaneWithHoles(size, 0.3, 7);
+    const MaskMomentSums s = WindowMaskMomentSums(d);
+    ExpectBitEqual(s.n, BoxSum(d, [](int, int) { return 1.0; }), "n");
+    ExpectBitEqual(s.x, BoxSum(d, [](int x, int) { return double(x); }), "x");
+    ExpectBitEqual(s.y, BoxSum(d, [](int, int y) { return double(y); }), "y");
+    ExpectBitEqual(s.xx, BoxSum(d, [](int x, int) { return double(x) * x; }), "xx");
+    ExpectBitEqual(s.yy, BoxSum(d, [](int, int y) { return double(y) * y; }), "yy");
+    ExpectBitEqual(s.xy, BoxSum(d, [](int x, int y) { return double(x) * y; }), "xy");
+  }
 }
 
 // Maps wider than 4096 px take 64-bit sums (81 x^2 no longer fits 32
 // bits): against the window sums added up plainly in double (exact: < 2^53).
 TEST(DisparitySlopes, WideMapWindowSumsAreExact) {
   const cv::Mat d = PlaneWithHoles(cv::Size(4300, 11), 0.3, 5);
-  const WindowMomentSums s = WindowMomentSumMaps(d);
+  const MaskMomentSums s = WindowMaskMomentSums(d);
   const int h = kSlopeWindowHalfPx;
   for (int y = 0; y < d.rows; ++y)
     for (int x = 0; x < d.cols; x += 7) {
