@@ -8,8 +8,8 @@
 // the runtime's CPU time. Kept: blocks below 8 MB come from the heap, and
 // up to 32 MB free at each heap's top stays mapped. Measured with
 // `stereorig bench` (docs/reconstruct.md, "Memory kept between captures"):
-// ~70 faults per object, +30-40 % objects/s, and the runtime's own peak
-// +30-40 MB (the free memory each thread's heap keeps), under 300 MB.
+// ~70 faults per object, +45 % objects/s, and the runtime's own peak
+// +20-35 MB (the free memory each thread's heap keeps): 251-269 MB.
 //
 // Process-wide (malloc's settings); the CLI applies it at start-up. A host
 // program embedding the runtime calls it itself, or tunes its allocator.
