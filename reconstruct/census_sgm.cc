@@ -181,14 +181,16 @@ using sgm::kBig;
 using sgm::SumMode;
 
 // The buffers of one SgmMatch call, allocated once per call (the band pass
-// and the full-resolution pass are separate calls). The two big ones, the
-// cost volume and the forward sums, are ScratchArrays (not zeroed: every
-// element is written before it is read; huge pages). Keeping them per
+// and the full-resolution pass are separate calls). The big one, the
+// forward sums (h x w x stride with 4 paths), is a ScratchArray (not
+// zeroed: every element is written before it is read; huge pages); the
+// costs are one row, computed again by the backward pass (session 11). Keeping them per
 // thread across calls was tried: page faults stayed ~1.5 % of the runtime's
 // cycles either way (cv::Mat allocations dominate them), while the retained
 // volumes overlapped the sub-pixel step's buffers and raised the peak of
 // `reconstruct` on the plate from 230 to 293 MB.
 struct SgmWorkspace {
+  std::vector<uint8_t> cost_row;         // (w, stride) + 64: one row's matching costs
   std::vector<uint16_t> total_row;       // (w, stride): backward pass
   std::vector<uint16_t> vert_a, vert_b;  // (w, stride + 2): top/bottom path, previous and current row
   std::vector<uint16_t> vert_min_a, vert_min_b;
@@ -458,10 +460,13 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   auto lo_row = [&](int y) { return window_lo.ptr<int16_t>(y); };
   SgmWorkspace ws;
 
-  // Cost volume (h, w, stride), uint8 (CostRow), a row at a time as the
-  // forward pass reaches it (it reads the row while it is in cache).
-  ScratchArray<uint8_t> cost_volume(size_t(h) * w * stride);
-  uint8_t* cost = cost_volume.data();
+  // The matching costs (w, stride), uint8 (CostRow), one row at a time:
+  // the forward pass takes each row as it reaches it, and the backward pass
+  // computes it again rather than keep the whole volume (h x w x stride
+  // bytes: 21-25 MB a module at full resolution on the demo, a third of the
+  // SGM's memory; the census costs are cheap to recompute, and the row stays
+  // in cache where the volume's row had to come from memory).
+  uint8_t* cost = Grow(ws.cost_row, size_t(w) * stride + 64);  // +64: slack past the row
   const size_t reversed_size = size_t(rw) + 2 * stride + 16;
   uint64_t* reversed = Grow(ws.right_reversed, reversed_size);
   std::fill(reversed, reversed + reversed_size, 0);
@@ -484,7 +489,7 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
                       reversed_size);
     cost_row(
         CostRowArgs{left.row(region.y + y), lo_row(y), reversed, planes, reversed_size, region.x, w, n, stride, rw},
-        cost + size_t(y) * w * stride);
+        cost);
   };
 
   // Aggregated cost (h, w, stride) when a second pass is needed; otherwise one row.
@@ -516,7 +521,7 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   for (int y = 0; y < h; ++y) {
     costs_of_row(y);
     uint16_t* srow = sum + (two_pass ? size_t(y) * w * stride : 0);
-    const uint8_t* crow = cost + size_t(y) * w * stride;
+    const uint8_t* crow = cost;
     rows.forward_vertical(shape, crow, lo_row(y), y == 0 ? nullptr : lo_row(y - 1), srow, srow, vert_prev,
                           vert_prev_min, vert_cur, vert_cur_min, shifted, nullptr);
     std::swap(vert_prev, vert_cur);
@@ -535,7 +540,8 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   uint16_t* total = Grow(ws.total_row, size_t(w) * stride);
   for (int y = h - 1; y >= 0; --y) {
     const uint16_t* srow = sum + size_t(y) * w * stride;
-    rows.backward_vertical(shape, cost + size_t(y) * w * stride, lo_row(y), y == h - 1 ? nullptr : lo_row(y + 1), srow,
+    costs_of_row(y);
+    rows.backward_vertical(shape, cost, lo_row(y), y == h - 1 ? nullptr : lo_row(y + 1), srow,
                            total, vert_prev, vert_prev_min, vert_cur, vert_cur_min, shifted, row_min);
     std::swap(vert_prev, vert_cur);
     std::swap(vert_prev_min, vert_cur_min);

@@ -9,7 +9,7 @@
 // up to 32 MB free at each heap's top stays mapped. Measured with
 // `stereorig bench` (docs/reconstruct.md, "Memory kept between captures"):
 // ~70 faults per object, +45 % objects/s, and the runtime's own peak
-// +20-35 MB (the free memory each thread's heap keeps): 251-269 MB.
+// +20-35 MB (the free memory each thread's heap keeps).
 //
 // Process-wide (malloc's settings); the CLI applies it at start-up. A host
 // program embedding the runtime calls it itself, or tunes its allocator.
