@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <utility>
@@ -184,11 +185,11 @@ using sgm::SumMode;
 // and the full-resolution pass are separate calls). The big one, the
 // forward sums (h x w x stride with 4 paths), is a ScratchArray (not
 // zeroed: every element is written before it is read; huge pages); the
-// costs are one row, computed again by the backward pass (session 11). Keeping them per
-// thread across calls was tried: page faults stayed ~1.5 % of the runtime's
-// cycles either way (cv::Mat allocations dominate them), while the retained
-// volumes overlapped the sub-pixel step's buffers and raised the peak of
-// `reconstruct` on the plate from 230 to 293 MB.
+// costs are one row, computed again by the backward pass (session 11).
+// Keeping the volumes per thread across calls was tried (session 7, with
+// the cost volume): page faults stayed ~1.5 % of the runtime's cycles either
+// way, while the retained volumes overlapped the sub-pixel step's buffers
+// and raised the peak of `reconstruct` on the plate from 230 to 293 MB.
 struct SgmWorkspace {
   std::vector<uint8_t> cost_row;         // (w, stride) + 64: one row's matching costs
   std::vector<uint16_t> total_row;       // (w, stride): backward pass
@@ -207,6 +208,11 @@ template <typename T>
 T* Grow(std::vector<T>& v, size_t n) {
   if (v.size() < n) v.resize(n);
   return v.data();
+}
+
+// p rounded up to a 64-byte boundary (the caller allocated 63 bytes more).
+uint8_t* Align64(uint8_t* p) {
+  return reinterpret_cast<uint8_t*>((reinterpret_cast<uintptr_t>(p) + 63) & ~uintptr_t(63));
 }
 
 // Path buffers for `count` pixels of `stride` lanes with kBig sentinels at
@@ -238,7 +244,7 @@ inline const uint16_t* InWindowOf(const uint16_t* prev, int shift, int n, int st
   return shift == 0 ? prev : ShiftedCopy(prev, shift, n, stride, buf);
 }
 
-// One row of the cost volume: pixel x of the region (left signatures cl,
+// One row of matching costs: pixel x of the region (left signatures cl,
 // window lo[x]) gets c[d] = Hamming(cl, right pixel region.x + x - lo[x] -
 // d), kCensusMaxCost where that pixel is off the right image. The right row
 // is given reversed (with `stride` padding each side) so that each pixel's
@@ -299,7 +305,7 @@ CostRowFn CostRowFor(int nibbles, int stride) {
 struct PathShape {
   int w = 0;       // pixels in a row of the region
   int n = 0;       // disparities per pixel (its window)
-  int stride = 0;  // lanes per pixel in the cost volume and the sums (K::Stride(n))
+  int stride = 0;  // lanes per pixel in the cost row and the sums (K::Stride(n))
   uint16_t p1 = 0, p2 = 0;
   bool windows_vary = false;  // false: every pixel's window starts at the same disparity (SgmMatch)
 };
@@ -466,7 +472,9 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   // bytes: 21-25 MB a module at full resolution on the demo, a third of the
   // SGM's memory; the census costs are cheap to recompute, and the row stays
   // in cache where the volume's row had to come from memory).
-  uint8_t* cost = Grow(ws.cost_row, size_t(w) * stride + 64);  // +64: slack past the row
+  // On a 64-byte boundary, as the volume's rows were (its 32-byte stores
+  // then never straddle a cache line; no kernel reads past w * stride).
+  uint8_t* cost = Align64(Grow(ws.cost_row, size_t(w) * stride + 63));
   const size_t reversed_size = size_t(rw) + 2 * stride + 16;
   uint64_t* reversed = Grow(ws.right_reversed, reversed_size);
   std::fill(reversed, reversed + reversed_size, 0);
@@ -534,15 +542,15 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   if (!two_pass) return disparity;
 
   // Backward pass: bottom -> top, then the winner per row. The row's total
-  // (forward sums + this path) goes to a cache-resident row, so the volume
-  // is only read, never written back (the pass is memory-bound); the path
+  // (forward sums + this path) goes to a cache-resident row, so the forward
+  // sums are only read, never written back (the pass is memory-bound); the path
   // step also finds each pixel's smallest total (the winner's cost).
   uint16_t* total = Grow(ws.total_row, size_t(w) * stride);
   for (int y = h - 1; y >= 0; --y) {
     const uint16_t* srow = sum + size_t(y) * w * stride;
     costs_of_row(y);
-    rows.backward_vertical(shape, cost, lo_row(y), y == h - 1 ? nullptr : lo_row(y + 1), srow,
-                           total, vert_prev, vert_prev_min, vert_cur, vert_cur_min, shifted, row_min);
+    rows.backward_vertical(shape, cost, lo_row(y), y == h - 1 ? nullptr : lo_row(y + 1), srow, total, vert_prev,
+                           vert_prev_min, vert_cur, vert_cur_min, shifted, row_min);
     std::swap(vert_prev, vert_cur);
     std::swap(vert_prev_min, vert_cur_min);
     rows.winner(shape, total, lo_row(y), row_min, right_best, right_best_size, rb_origin, options,

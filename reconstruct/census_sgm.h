@@ -64,9 +64,9 @@ cv::Mat SgmMatch(const CensusImage& left, const CensusImage& right, const cv::Re
 // comparing equal disparities; a disparity outside the neighbour's window
 // counts as the maximum cost. A minimum at the edge of a pixel's window is
 // rejected like one at the edge of the range. Where the truth lies inside
-// every window along the paths this gives SgmMatch's disparities at a cost
-// volume of 2*radius_px+1 instead of num_disparities per pixel. A window as
-// wide as the range runs SgmMatch.
+// every window along the paths this gives SgmMatch's disparities with
+// 2*radius_px+1 disparities per pixel instead of num_disparities. A window
+// as wide as the range runs SgmMatch.
 cv::Mat SgmMatchGuided(const CensusImage& left, const CensusImage& right, const cv::Rect& region,
                        const cv::Mat& guide_px, int radius_px, int min_disparity, int num_disparities,
                        const SgmOptions& options);
