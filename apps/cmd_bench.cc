@@ -50,21 +50,19 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// CPU time of the whole process (every thread), s. Only one pipeline runs at
-// a time, so its difference across a call is that call's CPU time.
-double CpuSeconds() {
+// The whole process's (every thread's) CPU time, s, and minor page faults
+// so far (each a page the kernel zeroes and maps; on a VM often backed by
+// the host at that moment: far steadier than time on a shared machine).
+// Only one pipeline runs at a time, so differences across a call are that
+// call's.
+struct Usage {
+  double cpu_s = 0;
+  long minor_faults = 0;
+};
+Usage UsageNow() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
-  return u.ru_utime.tv_sec + u.ru_stime.tv_sec + 1e-6 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
-
-// Minor page faults of the whole process so far: each is a page the kernel
-// zeroes and maps, on a VM often also backed by the host at that moment.
-// Far steadier than time on a shared machine.
-long MinorPageFaults() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return u.ru_minflt;
+  return {u.ru_utime.tv_sec + u.ru_stime.tv_sec + 1e-6 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec), u.ru_minflt};
 }
 
 double PeakMemoryMb() {
@@ -103,12 +101,12 @@ void BenchInterleaved(std::vector<Pipeline>& pipelines, const std::vector<Scene>
     for (const Scene& s : scenes)
       for (Pipeline& p : pipelines) {
         const auto t0 = Clock::now();
-        const double c0 = CpuSeconds();
-        const long f0 = MinorPageFaults();
+        const Usage u0 = UsageNow();
         const Reconstruction rec = p.runtime->Process(s.images, false);
         p.busy_s += std::chrono::duration<double>(Clock::now() - t0).count();
-        p.cpu_s += CpuSeconds() - c0;
-        p.page_faults += MinorPageFaults() - f0;
+        const Usage u1 = UsageNow();
+        p.cpu_s += u1.cpu_s - u0.cpu_s;
+        p.page_faults += u1.minor_faults - u0.minor_faults;
         ++p.objects;
         for (const auto& [k, v] : rec.times_ms) p.steps[k].push_back(v);
         for (const ModuleReport& m : rec.modules)

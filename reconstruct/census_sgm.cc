@@ -191,7 +191,7 @@ using sgm::SumMode;
 // way, while the retained volumes overlapped the sub-pixel step's buffers
 // and raised the peak of `reconstruct` on the plate from 230 to 293 MB.
 struct SgmWorkspace {
-  std::vector<uint8_t> cost_row;         // (w, stride) + 64: one row's matching costs
+  std::vector<uint8_t> cost_row;         // (w, stride) + 63 to align: one row's matching costs
   std::vector<uint16_t> total_row;       // (w, stride): backward pass
   std::vector<uint16_t> vert_a, vert_b;  // (w, stride + 2): top/bottom path, previous and current row
   std::vector<uint16_t> vert_min_a, vert_min_b;
@@ -529,12 +529,11 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   for (int y = 0; y < h; ++y) {
     costs_of_row(y);
     uint16_t* srow = sum + (two_pass ? size_t(y) * w * stride : 0);
-    const uint8_t* crow = cost;
-    rows.forward_vertical(shape, crow, lo_row(y), y == 0 ? nullptr : lo_row(y - 1), srow, srow, vert_prev,
+    rows.forward_vertical(shape, cost, lo_row(y), y == 0 ? nullptr : lo_row(y - 1), srow, srow, vert_prev,
                           vert_prev_min, vert_cur, vert_cur_min, shifted, nullptr);
     std::swap(vert_prev, vert_cur);
     std::swap(vert_prev_min, vert_cur_min);
-    rows.horizontal(shape, crow, lo_row(y), srow, ha, hb, hc, hd, shifted, shifted_rl);
+    rows.horizontal(shape, cost, lo_row(y), srow, ha, hb, hc, hd, shifted, shifted_rl);
     if (!two_pass)
       rows.winner(shape, srow, lo_row(y), nullptr, right_best, right_best_size, rb_origin, options,
                   disparity.ptr<float>(y));

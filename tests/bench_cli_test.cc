@@ -39,9 +39,9 @@ TEST(BenchCli, ReportsBothPipelinesAccuracyAndAHeapKeptBetweenCaptures) {
   const nlohmann::json& merged = j["ours"]["scenes"][0]["accuracy"]["merged"];
   EXPECT_GT(merged["points"].get<int>(), 10000);
   EXPECT_LT(merged["mean_abs_mm"].get<double>(), 0.1);
+#if !defined(__SANITIZE_ADDRESS__)  // ASan's allocator and shadow memory change both figures
   // The memory bound (measured 124 MB on this scene).
   EXPECT_LE(j["runtime_peak_memory_mb"].get<double>(), 300);
-#if !defined(__SANITIZE_ADDRESS__)
   // With the heap kept: 36 faults per object measured; with glibc's
   // defaults 6 000-7 900 (each capture's ~25 MB of maps faulted in again,
   // 4 KB at a time). A tenth of that is the line between the two.
