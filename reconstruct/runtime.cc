@@ -341,7 +341,7 @@ Reconstruction Runtime::Process(const std::vector<cv::Mat>& images, bool build_m
   return out;
 }
 
-std::vector<cv::Mat> LoadCapture(const std::string& dir, const Rig& rig) {
+void CheckCaptureFiles(const std::string& dir, const Rig& rig) {
   namespace fs = std::filesystem;
   if (!fs::is_directory(dir)) throw InputError(dir, "capture folder not found");
   const std::regex cam_re("cam([0-9]+)\\.png");
@@ -352,10 +352,17 @@ std::vector<cv::Mat> LoadCapture(const std::string& dir, const Rig& rig) {
       throw InputError(entry.path().string(), "the rig has only " + std::to_string(rig.num_cameras()) +
                                                   " cameras: this capture does not match the rig");
   }
+  for (int k = 0; k < rig.num_cameras(); ++k) {
+    const fs::path path = fs::path(dir) / ("cam" + std::to_string(k) + ".png");
+    if (!fs::exists(path)) throw InputError(path.string(), "missing camera image (camera " + std::to_string(k) + ")");
+  }
+}
+
+std::vector<cv::Mat> LoadCapture(const std::string& dir, const Rig& rig) {
+  CheckCaptureFiles(dir, rig);
   std::vector<cv::Mat> images;
   for (int k = 0; k < rig.num_cameras(); ++k) {
-    const std::string path = (fs::path(dir) / ("cam" + std::to_string(k) + ".png")).string();
-    if (!fs::exists(path)) throw InputError(path, "missing camera image (camera " + std::to_string(k) + ")");
+    const std::string path = (std::filesystem::path(dir) / ("cam" + std::to_string(k) + ".png")).string();
     cv::Mat img = cv::imread(path, cv::IMREAD_UNCHANGED);
     if (img.empty()) throw InputError(path, "cannot read the image");
     if (img.type() != CV_8UC1) throw InputError(path, "must be an 8-bit single-channel (grey) PNG");

@@ -93,10 +93,16 @@ class Runtime {
   std::vector<ModulePlan> plans_;
 };
 
+// The checks of LoadCapture that need no decoding: DIR is a folder holding
+// camK.png for every camera K of the rig and none beyond them (a capture made
+// with another rig). Throws InputError naming the folder or file. Cheap, so a
+// batch checks all its captures before it writes anything.
+void CheckCaptureFiles(const std::string& dir, const Rig& rig);
+
 // Loads a capture folder: DIR/camK.png for every camera K of the rig, 8-bit
 // grey, the rig's imager size. Throws InputError naming the file on a
 // missing camera, a wrong size or type, or a camK.png beyond the rig's
-// cameras (a capture made with another rig).
+// cameras (CheckCaptureFiles).
 std::vector<cv::Mat> LoadCapture(const std::string& dir, const Rig& rig);
 
 // The point `distance_mm` in front of module `m`'s baseline midpoint along

@@ -94,6 +94,10 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
 }  // namespace
 }  // namespace stereorig
 
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+
 #include "calib/core/rig_file.h"
 #include "datasets/default_rig.h"
 #include "reconstruct/metrology/ply_points.h"
@@ -182,6 +186,58 @@ TEST_F(ReconstructCli, BadOptionsOrMeshNameExitTwo) {
   WriteFileAtomically(dir_ + "/bad.yaml", "object_size_mm: 80\nvolume_sise_mm: [1, 2, 3]\n");
   EXPECT_EQ(RunCli(Args(dir_ + "/capture", "--options " + dir_ + "/bad.yaml")), 2);
   EXPECT_EQ(RunCli(Args(dir_ + "/capture", "--mesh " + dir_ + "/out.obj")), 2);
+  ExpectNoOutput();
+}
+
+// Many captures, one runtime (apps/reconstruct_batch.h): each cloud is the
+// one a single-capture run writes, byte for byte (the runtime keeps no state
+// between captures); a capture with a broken image gets no output while the
+// others do, and the run exits 2.
+TEST_F(ReconstructCli, ABatchWritesEachCapturesOwnCloudAndSkipsABrokenOne) {
+  ASSERT_EQ(RunCli(Args(dir_ + "/capture")), 0);
+  const std::string batch = dir_ + "/batch";
+  std::filesystem::remove_all(batch);
+  std::filesystem::create_directories(batch);
+  for (const char* name : {"0001", "0002", "0003"}) std::filesystem::copy(dir_ + "/capture", batch + "/" + name);
+  WriteFileAtomically(batch + "/0002/cam1.png", "not a png");  // found only when decoded
+  const std::string out = dir_ + "/batch_out";
+  std::filesystem::remove_all(out);
+  EXPECT_EQ(RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + batch + "/0001 " + batch + "/0002 " +
+                   batch + "/0003 --out-dir " + out + " --mesh-format stl --report " + out + "/batch.json"),
+            2);
+  auto bytes = [](const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  };
+  const std::string single = bytes(dir_ + "/out.ply");
+  ASSERT_GT(single.size(), 1000000u);
+  for (const char* name : {"0001", "0003"}) {
+    EXPECT_EQ(bytes(out + "/" + name + ".ply"), single) << name;
+    EXPECT_TRUE(std::filesystem::exists(out + "/" + name + ".json")) << name;
+    EXPECT_TRUE(std::filesystem::exists(out + "/" + name + ".mesh.stl")) << name;
+  }
+  for (const char* ext : {".ply", ".json", ".mesh.stl"}) EXPECT_FALSE(std::filesystem::exists(out + "/0002" + ext));
+  const nlohmann::json summary = nlohmann::json::parse(bytes(out + "/batch.json"));
+  EXPECT_EQ(summary["reconstructed"], 2);
+  EXPECT_EQ(summary["failed"], 1);
+  EXPECT_EQ(summary["captures"][1]["ok"], false);
+  EXPECT_NE(summary["captures"][1]["error"].get<std::string>().find("0002/cam1.png"), std::string::npos);
+}
+
+// What needs no decoding is checked for every capture first: a missing
+// camera in the last folder, a folder given twice, or --out with several
+// captures write nothing at all.
+TEST_F(ReconstructCli, ABatchWithAMissingCameraOrARepeatedFolderWritesNothing) {
+  const std::string missing = BrokenCapture("batch_missing");
+  std::filesystem::remove(missing + "/cam3.png");
+  const std::string out = dir_ + "/batch_nothing";
+  std::filesystem::remove_all(out);
+  const std::string head = "reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture ";
+  EXPECT_EQ(RunCli(head + missing + " --out-dir " + out), 2);
+  EXPECT_EQ(RunCli(head + dir_ + "/capture/ --out-dir " + out), 2);
+  EXPECT_EQ(RunCli(head + missing + " --out " + dir_ + "/out.ply"), 2);
+  EXPECT_EQ(RunCli(head + "--out-dir " + out + " --mesh-format obj"), 2);
+  EXPECT_FALSE(std::filesystem::exists(out));
   ExpectNoOutput();
 }
 

@@ -1,0 +1,157 @@
+#include "apps/reconstruct_batch.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <future>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "apps/command.h"
+#include "apps/reconstruct_json.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/input_error.h"
+#include "reconstruct/ply_io.h"
+#include "reconstruct/runtime.h"
+
+namespace stereorig {
+
+namespace fs = std::filesystem;
+
+std::vector<std::string> BatchOutputNames(const std::vector<std::string>& capture_dirs) {
+  std::vector<std::vector<std::string>> parts;
+  std::map<fs::path, std::string> seen;  // normal absolute path -> as given
+  for (const std::string& dir : capture_dirs) {
+    fs::path p = fs::absolute(fs::path(dir)).lexically_normal();
+    if (!p.has_filename()) p = p.parent_path();  // "caps/0001/" names 0001
+    if (const auto it = seen.find(p); it != seen.end())
+      throw InputError("--capture", dir + " is given twice (as " + it->second + ")");
+    seen.emplace(p, dir);
+    std::vector<std::string> components;
+    for (const fs::path& c : p.relative_path()) components.push_back(c.string());
+    if (components.empty()) throw InputError(dir, "a capture folder cannot be the file system's root");
+    parts.push_back(std::move(components));
+  }
+  size_t shared = 0;  // components every path has in common, at least the last one of each kept
+  if (!parts.empty()) {
+    size_t shortest = parts[0].size();
+    for (const auto& p : parts) shortest = std::min(shortest, p.size());
+    while (shared + 1 < shortest &&
+           std::all_of(parts.begin(), parts.end(), [&](const auto& p) { return p[shared] == parts[0][shared]; }))
+      ++shared;
+  }
+  std::vector<std::string> names;
+  std::map<std::string, size_t> by_name;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    std::string name;
+    for (size_t k = shared; k < parts[i].size(); ++k) name += (name.empty() ? "" : "_") + parts[i][k];
+    if (const auto it = by_name.find(name); it != by_name.end())
+      throw InputError("--capture", capture_dirs[it->second] + " and " + capture_dirs[i] +
+                                        " would both write outputs named '" + name + "': rename one folder");
+    by_name.emplace(name, i);
+    names.push_back(name);
+  }
+  return names;
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double MsSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+}  // namespace
+
+int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchRequest& request) {
+  const std::vector<std::string>& dirs = request.capture_dirs;
+  if (dirs.empty()) throw InputError("--capture", "no capture folder given");
+  if (!request.mesh_format.empty() && request.mesh_format != "ply" && request.mesh_format != "stl")
+    throw InputError("--mesh-format", "must be ply or stl, not '" + request.mesh_format + "'");
+  // Everything that needs no decoding is checked before anything is written.
+  const std::vector<std::string> names = BatchOutputNames(dirs);
+  for (const std::string& dir : dirs) CheckCaptureFiles(dir, rig);
+  std::error_code ec;
+  fs::create_directories(request.out_dir, ec);
+  if (ec || !fs::is_directory(request.out_dir))
+    throw InputError(request.out_dir, "cannot create the output folder" + (ec ? ": " + ec.message() : ""));
+
+  const auto t_build = Clock::now();
+  const Runtime runtime(rig, options);
+  const double build_ms = MsSince(t_build);
+  std::printf("runtime built in %.0f ms (%d modules); %zu captures -> %s\n", build_ms, rig.num_modules(), dirs.size(),
+              request.out_dir.c_str());
+  std::fflush(stdout);
+
+  const bool mesh = !request.mesh_format.empty();
+  nlohmann::json summary;
+  summary["runtime_build_ms"] = build_ms;
+  summary["captures"] = nlohmann::json::array();
+  int failed = 0;
+  const auto t_all = Clock::now();
+  auto load = [&rig](const std::string& dir) { return LoadCapture(dir, rig); };
+  std::future<std::vector<cv::Mat>> next = std::async(std::launch::async, load, dirs[0]);
+  for (size_t i = 0; i < dirs.size(); ++i) {
+    const auto t = Clock::now();
+    nlohmann::json entry;
+    entry["capture"] = dirs[i];
+    entry["name"] = names[i];
+    std::vector<cv::Mat> images;
+    try {
+      images = next.get();
+    } catch (const InputError& e) {
+      // Bad images in this capture: no output for it; the rest go on.
+      ++failed;
+      std::fprintf(stderr, "stereorig reconstruct: [%zu/%zu] %s\n", i + 1, dirs.size(), e.what());
+      entry["ok"] = false;
+      entry["error"] = e.what();
+      summary["captures"].push_back(entry);
+      if (i + 1 < dirs.size()) next = std::async(std::launch::async, load, dirs[i + 1]);
+      continue;
+    }
+    if (i + 1 < dirs.size()) next = std::async(std::launch::async, load, dirs[i + 1]);
+    const Reconstruction rec = runtime.Process(images, mesh);
+    const fs::path stem = fs::path(request.out_dir) / names[i];
+    const std::string cloud_path = stem.string() + ".ply";
+    WriteCloudPly(rec.cloud, cloud_path);
+    entry["cloud"] = cloud_path;
+    if (mesh) {
+      const std::string mesh_path = stem.string() + ".mesh." + request.mesh_format;
+      WriteMesh(rec.mesh, mesh_path);
+      entry["mesh"] = mesh_path;
+    }
+    const std::string report_path = stem.string() + ".json";
+    WriteFileAtomically(report_path, ReconstructionJson(rec).dump(2) + "\n");
+    entry["report"] = report_path;
+    entry["ok"] = true;
+    entry["points"] = rec.cloud.size();
+    entry["point_cloud_ms"] = rec.times_ms.at("total_point_cloud");
+    entry["wall_ms"] = MsSince(t);  // waiting for the images, reconstructing, writing
+    std::string fills;
+    for (const ModuleReport& m : rec.modules) {
+      char buf[48];
+      std::snprintf(buf, sizeof buf, "%sm%d %.1f%%", fills.empty() ? "" : ", ", m.module, 100 * m.fill_rate());
+      fills += buf;
+    }
+    std::printf("[%zu/%zu] %s: %zu points (fill %s), %.0f ms -> %s\n", i + 1, dirs.size(), dirs[i].c_str(),
+                rec.cloud.size(), fills.c_str(), entry["wall_ms"].get<double>(), cloud_path.c_str());
+    std::fflush(stdout);
+    summary["captures"].push_back(entry);
+  }
+  const double all_ms = MsSince(t_all);
+  const int done = int(dirs.size()) - failed;
+  summary["reconstructed"] = done;
+  summary["failed"] = failed;
+  summary["wall_ms"] = all_ms;
+  summary["objects_per_s"] = done > 0 ? 1000.0 * done / all_ms : 0.0;
+  std::printf("%d of %zu captures in %.2f s: %.1f objects/s (reading, reconstructing and writing)\n", done,
+              dirs.size(), all_ms / 1000, summary["objects_per_s"].get<double>());
+  if (!request.summary_path.empty()) WriteFileAtomically(request.summary_path, summary.dump(2) + "\n");
+  if (failed > 0) {
+    std::fprintf(stderr, "stereorig reconstruct: %d of %zu captures were bad input and have no output\n", failed,
+                 dirs.size());
+    return kExitBadInput;
+  }
+  return kExitOk;
+}
+
+}  // namespace stereorig
