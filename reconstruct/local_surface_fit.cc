@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
@@ -12,9 +13,19 @@
 
 namespace stereorig {
 
+namespace {
+// The windows' largest half size: filter2D stays direct (not DFT) below ~130
+// taps, and the moments' sums in float stay exact enough.
+constexpr int kMaxHalfSizePx = 30;
+}  // namespace
+
 void SurfaceFitOptions::Check() const {
-  if (half_width_px < 2 || half_width_px > 30) throw InputError("surface_fit_half_width_px", "must be in [2, 30]");
-  if (half_height_px < 1 || half_height_px > 30) throw InputError("surface_fit_half_height_px", "must be in [1, 30]");
+  if (half_width_px < 2 || half_width_px > kMaxHalfSizePx)
+    throw InputError("surface_fit_half_width_px", "must be in [2, 30]");
+  if (half_height_px < 1 || half_height_px > kMaxHalfSizePx)
+    throw InputError("surface_fit_half_height_px", "must be in [1, 30]");
+  if (!(reference_misfit_px >= 0 && reference_misfit_px <= 10))
+    throw InputError("surface_fit_reference_misfit_px", "must be in [0, 10] px (0 = the window never grows)");
   if (!(max_variance_growth >= 1 && max_variance_growth <= 100))
     throw InputError("surface_fit_max_variance_growth", "must be in [1, 100]");
   if (!(max_misfit_ratio >= 1 && max_misfit_ratio <= 100))
@@ -127,41 +138,26 @@ Matrix6 FullWindowMatrix(int hw, int hh) {
   return a;
 }
 
-}  // namespace
+// The fitted value at each pixel's centre and its window's RMS misfit (NaN
+// = no fit), px; a pixel takes its fit where misfit <= max_misfit_px.
+struct FitMaps {
+  cv::Mat fitted, misfit;
+  double median_misfit_px = 0;
+  double max_misfit_px = 0;  // 0: nothing was fitted
+};
 
-int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_threads, cv::Mat* disparity_px) {
-  const cv::Rect roi = roi_in & cv::Rect(0, 0, disparity_px->cols, disparity_px->rows);
-  if (roi.area() == 0) return 0;
-  const int hw = o.half_width_px, hh = o.half_height_px;
-  cv::Mat d = (*disparity_px)(roi);
-  // The valid mask, and the disparities relative to their mean (float sums).
-  double sum = 0;
-  int count = 0;
-  for (int y = 0; y < roi.height; ++y) {
-    const float* row = d.ptr<float>(y);
-    for (int x = 0; x < roi.width; ++x)
-      if (std::isfinite(row[x])) sum += row[x], ++count;
-  }
-  if (count == 0) return 0;
-  const float mean = float(sum / count);
-  cv::Mat mask(roi.size(), CV_32F, cv::Scalar(0)), values(roi.size(), CV_32F, cv::Scalar(0));
-  for (int y = 0; y < roi.height; ++y) {
-    const float* row = d.ptr<float>(y);
-    float* valid = mask.ptr<float>(y);
-    float* value = values.ptr<float>(y);
-    for (int x = 0; x < roi.width; ++x) {
-      if (!std::isfinite(row[x])) continue;
-      valid[x] = 1;
-      value[x] = row[x] - mean;
-    }
-  }
+// One pass of the fit with a (2 hw + 1) x (2 hh + 1) window over the ROI's
+// valid mask and values (relative to their mean).
+FitMaps FitQuadrics(const cv::Mat& mask, const cv::Mat& values, int hw, int hh, const SurfaceFitOptions& o,
+                    int num_threads) {
+  const cv::Size size = mask.size();
   Factor6 full_factor;
   STEREORIG_CHECK(Factor(FullWindowMatrix(hw, hh), &full_factor));
   const int full_count = (2 * hw + 1) * (2 * hh + 1);
   const double max_variance = o.max_variance_growth * CentreVariance(full_factor);
   // Per pixel: the fitted value at its centre and the RMS misfit (NaN = no fit).
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-  cv::Mat fitted(roi.size(), CV_32F, cv::Scalar(kNaN)), misfit(roi.size(), CV_32F, cv::Scalar(kNaN));
+  cv::Mat fitted(size, CV_32F, cv::Scalar(kNaN)), misfit(size, CV_32F, cv::Scalar(kNaN));
   // Window sums: the mask's moments up to degree 4 (the normal matrix:
   // moment[i][j] = sum of mask (u/hw)^i (v/hh)^j), the values' up to degree
   // 2 (the right-hand side), and the values' squares (the misfit). In bands
@@ -177,9 +173,9 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
   constexpr int kBandRows = 128;
   cv::Mat row_taps[5], column_taps[5];
   for (int i = 0; i <= 4; ++i) row_taps[i] = PowerTaps(hw, i, true), column_taps[i] = PowerTaps(hh, i, false);
-  for (int y0 = 0; y0 < roi.height; y0 += kBandRows) {
-    const int y1 = std::min(roi.height, y0 + kBandRows);
-    const int in0 = std::max(0, y0 - hh), in1 = std::min(roi.height, y1 + hh);  // the band's input rows
+  for (int y0 = 0; y0 < size.height; y0 += kBandRows) {
+    const int y1 = std::min(size.height, y0 + kBandRows);
+    const int in0 = std::max(0, y0 - hh), in1 = std::min(size.height, y1 + hh);  // the band's input rows
     const cv::Mat band_mask = mask.rowRange(in0, in1), band_values = values.rowRange(in0, in1);
     cv::Mat moment[5][5], value_moment[3][3];
     // Only the band's own rows of the column sums (not its margins).
@@ -205,7 +201,7 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
         const float* sq = squares.ptr<float>(y - y0);
         float* fitted_row = fitted.ptr<float>(y);
         float* misfit_row = misfit.ptr<float>(y);
-        for (int x = 0; x < roi.width; ++x) {
+        for (int x = 0; x < size.width; ++x) {
           if (!(valid[x] > 0)) continue;
           const double n = m[0][0][x];
           if (n < 2 * kTerms) continue;
@@ -229,28 +225,80 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
       }
     });
   }
+  FitMaps out{fitted, misfit, 0.0};
   std::vector<float> misfits;
-  for (int y = 0; y < roi.height; ++y) {
+  for (int y = 0; y < size.height; ++y) {
     const float* row = misfit.ptr<float>(y);
-    for (int x = 0; x < roi.width; ++x)
+    for (int x = 0; x < size.width; ++x)
       if (std::isfinite(row[x])) misfits.push_back(row[x]);
   }
-  if (misfits.empty()) return 0;
+  if (misfits.empty()) return out;
   std::nth_element(misfits.begin(), misfits.begin() + misfits.size() / 2, misfits.end());
   // Never below 0.05 px (a fifth of the simulator's speckle scatter): on a
   // nearly noise-free surface the median misfit is rounding, and half the
   // windows would fail a gate of twice that.
-  const double max_misfit = std::max(0.05, o.max_misfit_ratio * misfits[misfits.size() / 2]);
+  out.median_misfit_px = misfits[misfits.size() / 2];
+  out.max_misfit_px = std::max(0.05, o.max_misfit_ratio * out.median_misfit_px);
+  return out;
+}
+
+}  // namespace
+
+int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_threads, cv::Mat* disparity_px) {
+  const cv::Rect roi = roi_in & cv::Rect(0, 0, disparity_px->cols, disparity_px->rows);
+  if (roi.area() == 0) return 0;
+  cv::Mat d = (*disparity_px)(roi);
+  // The valid mask, and the disparities relative to their mean (float sums).
+  double sum = 0;
+  int count = 0;
+  for (int y = 0; y < roi.height; ++y) {
+    const float* row = d.ptr<float>(y);
+    for (int x = 0; x < roi.width; ++x)
+      if (std::isfinite(row[x])) sum += row[x], ++count;
+  }
+  if (count == 0) return 0;
+  const float mean = float(sum / count);
+  cv::Mat mask(roi.size(), CV_32F, cv::Scalar(0)), values(roi.size(), CV_32F, cv::Scalar(0));
+  for (int y = 0; y < roi.height; ++y) {
+    const float* row = d.ptr<float>(y);
+    float* valid = mask.ptr<float>(y);
+    float* value = values.ptr<float>(y);
+    for (int x = 0; x < roi.width; ++x) {
+      if (!std::isfinite(row[x])) continue;
+      valid[x] = 1;
+      value[x] = row[x] - mean;
+    }
+  }
+  const FitMaps own = FitQuadrics(mask, values, o.half_width_px, o.half_height_px, o, num_threads);
+  if (!(own.max_misfit_px > 0)) return 0;  // nothing fitted
+  // Stronger noise than the window was sized for: a second pass whose
+  // window's sides grow with the measured misfit (its area with the
+  // variance), so the fitted centre's scatter stays near the default's.
+  // Where the wide fit is not trusted (nearer a silhouette, or a depth edge
+  // or seam within its larger window), the pixel takes its own window's fit.
+  std::optional<FitMaps> wide;
+  if (o.reference_misfit_px > 0 && own.median_misfit_px > o.reference_misfit_px) {
+    const double grow = own.median_misfit_px / o.reference_misfit_px;
+    const int hw = std::min(kMaxHalfSizePx, int(std::lround(o.half_width_px * grow)));
+    const int hh = std::min(kMaxHalfSizePx, int(std::lround(o.half_height_px * grow)));
+    if (hw != o.half_width_px || hh != o.half_height_px) wide = FitQuadrics(mask, values, hw, hh, o, num_threads);
+  }
   int replaced = 0;
   for (int y = 0; y < roi.height; ++y) {
-    const float* misfit_row = misfit.ptr<float>(y);
-    const float* fitted_row = fitted.ptr<float>(y);
+    const float* own_misfit = own.misfit.ptr<float>(y);
+    const float* own_fitted = own.fitted.ptr<float>(y);
+    const float* wide_misfit = wide ? wide->misfit.ptr<float>(y) : nullptr;
+    const float* wide_fitted = wide ? wide->fitted.ptr<float>(y) : nullptr;
     float* row = d.ptr<float>(y);
-    for (int x = 0; x < roi.width; ++x)
-      if (misfit_row[x] <= max_misfit) {
-        row[x] = fitted_row[x] + mean;
+    for (int x = 0; x < roi.width; ++x) {
+      if (wide && wide_misfit[x] <= wide->max_misfit_px) {
+        row[x] = wide_fitted[x] + mean;
+        ++replaced;
+      } else if (own_misfit[x] <= own.max_misfit_px) {
+        row[x] = own_fitted[x] + mean;
         ++replaced;
       }
+    }
   }
   return replaced;
 }

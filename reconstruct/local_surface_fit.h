@@ -34,6 +34,11 @@
 //     0.05 px if that is more (a depth edge, two components one grid period
 //     apart, or a surface curving faster than a quadric over the window
 //     misfit far more).
+// Stronger noise: where the module's median misfit exceeds
+// reference_misfit_px (the scatter the window is sized for), a second pass
+// fits a window whose sides are larger by their ratio, so its area grows
+// with the variance; each pixel takes that fit where the same two tests
+// trust it, else its own window's.
 // Cost: the lateral detail finer than a quadric over the window (~4 x 2 mm
 // at 200 mm by default) is smoothed away; the fill is unchanged.
 #pragma once
@@ -54,6 +59,13 @@ struct SurfaceFitOptions {
   // Largest RMS misfit of the quadric over its window, relative to the
   // median over the module's windows; default 2.
   double max_misfit_ratio = 2.0;
+  // The median misfit (px) the window above is sized for; default 0.2 (the
+  // simulator's default speckle: 0.17-0.20 px on every scene and module).
+  // Where a module's median misfit is larger (stronger speckle: 0.26-0.30
+  // px at twice the default), a second pass fits a window whose sides are
+  // larger by their ratio (its area by the variance's), and each pixel takes
+  // that fit where it is trusted, else its own window's. 0 = never.
+  double reference_misfit_px = 0.2;
   void Check() const;  // throws InputError naming the bad field
 };
 

@@ -37,7 +37,8 @@ TEST(LocalSurfaceFit, KeepsAQuadricAndCutsIndependentNoiseAsPredicted) {
       d.at<float>(y, x) = float(Quadric(x, y) + noise(rng));
     }
   cv::Mat clean = truth.clone();
-  const SurfaceFitOptions options;  // 21 x 11
+  SurfaceFitOptions options;  // 21 x 11
+  options.reference_misfit_px = 0;  // that window alone (the noise is above the reference: it would grow)
   // At least all but the outermost 2 rows and 4 columns (a window there
   // extrapolates: up to 3.2x / 4.1x a full window's variance, above
   // max_variance_growth).
@@ -116,7 +117,8 @@ TEST(LocalSurfaceFit, WindowsWithHolesEqualAPlainLeastSquaresFit) {
     for (int x = 0; x < d.cols; ++x)
       if (!hole(rng)) d.at<float>(y, x) = float(Quadric(x, y) + noise(rng));
   const cv::Mat raw = d.clone();
-  const SurfaceFitOptions o;
+  SurfaceFitOptions o;
+  o.reference_misfit_px = 0;  // one window size, the one compared below
   FitLocalSurface(cv::Rect(0, 0, d.cols, d.rows), o, 2, &d);
   const int hw = o.half_width_px, hh = o.half_height_px;
   // The plain fit's predicted variance of the centre for a full window, the
@@ -168,6 +170,80 @@ TEST(LocalSurfaceFit, WindowsWithHolesEqualAPlainLeastSquaresFit) {
   // relative) and the float result: well below 1e-4 px. A wrong moment or
   // term would be off by the noise's scale, 0.01-0.3 px.
   EXPECT_LT(worst, 1e-4);
+}
+
+// The fitted centre's variance for independent errors of unit variance and
+// a full (2 hw + 1) x (2 hh + 1) window: (A^T A)^-1 [0, 0] of the quadric's
+// design matrix (constant term first), by Eigen.
+double CentreVarianceFactor(int hw, int hh) {
+  Eigen::MatrixXd a((2 * hw + 1) * (2 * hh + 1), 6);
+  int i = 0;
+  for (int v = -hh; v <= hh; ++v)
+    for (int u = -hw; u <= hw; ++u, ++i) {
+      const double su = double(u) / hw, sv = double(v) / hh;
+      a.row(i) << 1, su, sv, su * su, su * sv, sv * sv;
+    }
+  return (a.transpose() * a).inverse()(0, 0);
+}
+
+// The rms of the fitted field against the truth over pixels whose
+// (2 hw + 1) x (2 hh + 1) window is inside the image.
+double InteriorRms(const cv::Mat& d, const cv::Mat& truth, int hw, int hh) {
+  double sum2 = 0;
+  int n = 0;
+  for (int y = hh; y < d.rows - hh; ++y)
+    for (int x = hw; x < d.cols - hw; ++x, ++n) sum2 += std::pow(d.at<float>(y, x) - truth.at<float>(y, x), 2);
+  return std::sqrt(sum2 / n);
+}
+
+// Noise twice the reference misfit: the window's sides double (41 x 21, 3.7x
+// the area), and the fitted field's scatter is what least squares predicts
+// for that window, ~half the default window's. Noise below the reference:
+// the result is exactly the one window's.
+TEST(LocalSurfaceFit, GrowsItsWindowWithTheMeasuredNoise) {
+  cv::Mat truth(240, 400, CV_32F);
+  for (int y = 0; y < truth.rows; ++y)
+    for (int x = 0; x < truth.cols; ++x) {  // the quadric above, stretched 2x (a flatter surface)
+      const double u = x / 2.0 - 100.0, v = y / 2.0 - 60.0;
+      truth.at<float>(y, x) = float(40 + 0.05 * u - 0.02 * v + 4e-4 * u * u + 2e-4 * u * v + 6e-4 * v * v);
+    }
+  auto noisy = [&](double sigma_px, uint64_t seed) {
+    cv::Mat d = truth.clone();
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> noise(0, sigma_px);
+    for (int y = 0; y < d.rows; ++y)
+      for (int x = 0; x < d.cols; ++x) d.at<float>(y, x) += float(noise(rng));
+    return d;
+  };
+  const cv::Rect all(0, 0, truth.cols, truth.rows);
+  SurfaceFitOptions fixed;
+  fixed.reference_misfit_px = 0;
+  SurfaceFitOptions adaptive;
+  adaptive.reference_misfit_px = 0.2;
+
+  const double sigma_px = 0.4;  // independent errors: the median misfit is ~sigma, twice the reference
+  const cv::Mat raw = noisy(sigma_px, 3);
+  cv::Mat one = raw.clone(), grown = raw.clone();
+  FitLocalSurface(all, fixed, 2, &one);
+  FitLocalSurface(all, adaptive, 2, &grown);
+  // Both measured where the wide window is full. The rms over N ~ 79 000
+  // pixels scatters by ~1/sqrt(2 N_eff) relative, N_eff ~ N / window area
+  // (neighbouring fits share their data): 4 % for 21 x 11, 7.4 % for
+  // 41 x 21; 3 of the latter.
+  const double rms_one = InteriorRms(one, truth, 20, 10), rms_grown = InteriorRms(grown, truth, 20, 10);
+  const double predicted_one = sigma_px * std::sqrt(CentreVarianceFactor(10, 5));
+  const double predicted_grown = sigma_px * std::sqrt(CentreVarianceFactor(20, 10));
+  EXPECT_NEAR(rms_one, predicted_one, 0.24 * predicted_one);
+  EXPECT_NEAR(rms_grown, predicted_grown, 0.24 * predicted_grown);
+  EXPECT_LT(rms_grown, 0.7 * rms_one);  // predicted 0.51
+  std::printf("noise %.2f px: 21x11 %.4f px rms (predicted %.4f), grown %.4f (41x21 predicted %.4f)\n", sigma_px,
+              rms_one, predicted_one, rms_grown, predicted_grown);
+
+  const cv::Mat quiet = noisy(0.1, 4);  // half the reference
+  cv::Mat quiet_one = quiet.clone(), quiet_adaptive = quiet.clone();
+  FitLocalSurface(all, fixed, 2, &quiet_one);
+  FitLocalSurface(all, adaptive, 2, &quiet_adaptive);
+  EXPECT_EQ(cv::norm(quiet_one, quiet_adaptive, cv::NORM_INF), 0.0);
 }
 
 }  // namespace

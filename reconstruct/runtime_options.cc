@@ -100,6 +100,8 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.surface_fit.max_variance_growth =
         m.GetDouble("surface_fit_max_variance_growth", mo.surface_fit.max_variance_growth);
     mo.surface_fit.max_misfit_ratio = m.GetDouble("surface_fit_max_misfit_ratio", mo.surface_fit.max_misfit_ratio);
+    mo.surface_fit.reference_misfit_px =
+        m.GetDouble("surface_fit_reference_misfit_px", mo.surface_fit.reference_misfit_px);
     mo.sgbm_block_size = m.GetInt("sgbm_block_size", mo.sgbm_block_size);
     mo.num_threads = m.GetInt("num_threads", mo.num_threads);
     mo.line_index.enabled = m.GetBool("line_index", mo.line_index.enabled);

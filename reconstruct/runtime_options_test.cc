@@ -45,20 +45,24 @@ TEST(RuntimeOptions, ReadsAndChecksTheSurfaceFitKeys) {
   EXPECT_TRUE(d.match.surface_fit.enabled);
   EXPECT_EQ(d.match.surface_fit.half_width_px, 10);
   EXPECT_EQ(d.match.surface_fit.half_height_px, 5);
+  EXPECT_EQ(d.match.surface_fit.reference_misfit_px, 0.2);
   const RuntimeOptions o = ParseRuntimeOptions(
       "match:\n  surface_fit: false\n  surface_fit_half_width_px: 12\n  surface_fit_half_height_px: 6\n"
-      "  surface_fit_max_variance_growth: 2\n  surface_fit_max_misfit_ratio: 3\n",
+      "  surface_fit_max_variance_growth: 2\n  surface_fit_max_misfit_ratio: 3\n"
+      "  surface_fit_reference_misfit_px: 0\n",
       "set.yaml");
   EXPECT_FALSE(o.match.surface_fit.enabled);
   EXPECT_EQ(o.match.surface_fit.half_width_px, 12);
   EXPECT_EQ(o.match.surface_fit.half_height_px, 6);
   EXPECT_EQ(o.match.surface_fit.max_variance_growth, 2.0);
   EXPECT_EQ(o.match.surface_fit.max_misfit_ratio, 3.0);
+  EXPECT_EQ(o.match.surface_fit.reference_misfit_px, 0.0);
   const std::pair<const char*, const char*> bad[] = {
       {"match:\n  surface_fit_half_width_px: 1\n", "surface_fit_half_width_px"},
       {"match:\n  surface_fit_half_height_px: 0\n", "surface_fit_half_height_px"},
       {"match:\n  surface_fit_max_variance_growth: 0.5\n", "surface_fit_max_variance_growth"},
       {"match:\n  surface_fit_max_misfit_ratio: 0\n", "surface_fit_max_misfit_ratio"},
+      {"match:\n  surface_fit_reference_misfit_px: -0.1\n", "surface_fit_reference_misfit_px"},
       {"match:\n  surface_fits: true\n", "surface_fits"}};
   ExpectEachRejectedNamingItsKey(bad);
 }
