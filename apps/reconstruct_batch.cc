@@ -62,22 +62,81 @@ double MsSince(Clock::time_point t0) { return std::chrono::duration<double, std:
 
 }  // namespace
 
+namespace {
+
+// Every file the batch writes, by capture: cloud, report, mesh ("" if none).
+struct CaptureOutputs {
+  std::string cloud, report, mesh;
+};
+
+// The output paths of every capture, and the summary's, checked before
+// anything is written: no two the same file (folders "x" and "x.mesh" with
+// --mesh-format ply; a --report naming a capture's own report), and the
+// summary's folder exists or is the output folder.
+std::vector<CaptureOutputs> PlanOutputs(const std::vector<std::string>& names, const BatchRequest& request) {
+  std::vector<CaptureOutputs> outputs;
+  std::map<fs::path, std::string> claimed;  // normal absolute path -> what writes it
+  auto claim = [&](const std::string& path, const std::string& what) {
+    const fs::path key = fs::absolute(fs::path(path)).lexically_normal();
+    if (const auto it = claimed.find(key); it != claimed.end())
+      throw InputError(path, "would be written twice (" + it->second + " and " + what + "): rename a folder or "
+                                 "choose another --report");
+    claimed.emplace(key, what);
+  };
+  for (const std::string& name : names) {
+    const std::string stem = (fs::path(request.out_dir) / name).string();
+    CaptureOutputs o{stem + ".ply", stem + ".json", ""};
+    claim(o.cloud, name + "'s cloud");
+    claim(o.report, name + "'s report");
+    if (!request.mesh_format.empty()) {
+      o.mesh = stem + ".mesh." + request.mesh_format;
+      claim(o.mesh, name + "'s mesh");
+    }
+    outputs.push_back(o);
+  }
+  if (!request.summary_path.empty()) {
+    claim(request.summary_path, "the summary (--report)");
+    const fs::path folder = fs::absolute(fs::path(request.summary_path)).parent_path().lexically_normal();
+    const fs::path out = fs::absolute(fs::path(request.out_dir)).lexically_normal();
+    if (folder != out && !fs::is_directory(folder))
+      throw InputError(request.summary_path, "its folder does not exist");
+  }
+  return outputs;
+}
+
+// LoadCapture, any failure as bad input naming the folder (a folder removed
+// or made unreadable after the first check throws filesystem_error).
+std::vector<cv::Mat> LoadCaptureOrInputError(const std::string& dir, const Rig& rig) {
+  try {
+    return LoadCapture(dir, rig);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(dir, std::string("cannot read the capture: ") + e.what());
+  }
+}
+
+}  // namespace
+
 int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchRequest& request) {
   const std::vector<std::string>& dirs = request.capture_dirs;
   if (dirs.empty()) throw InputError("--capture", "no capture folder given");
   if (!request.mesh_format.empty() && request.mesh_format != "ply" && request.mesh_format != "stl")
     throw InputError("--mesh-format", "must be ply or stl, not '" + request.mesh_format + "'");
-  // Everything that needs no decoding is checked before anything is written.
+  // Everything that needs no decoding is checked before anything is written,
+  // the runtime too (its options can still be bad input for this rig).
   const std::vector<std::string> names = BatchOutputNames(dirs);
+  const std::vector<CaptureOutputs> outputs = PlanOutputs(names, request);
   for (const std::string& dir : dirs) CheckCaptureFiles(dir, rig);
+  auto load = [&rig](const std::string& dir) { return LoadCaptureOrInputError(dir, rig); };
+  std::future<std::vector<cv::Mat>> next = std::async(std::launch::async, load, dirs[0]);  // while the runtime builds
+  const auto t_build = Clock::now();
+  const Runtime runtime(rig, options);
+  const double build_ms = MsSince(t_build);
   std::error_code ec;
   fs::create_directories(request.out_dir, ec);
   if (ec || !fs::is_directory(request.out_dir))
     throw InputError(request.out_dir, "cannot create the output folder" + (ec ? ": " + ec.message() : ""));
-
-  const auto t_build = Clock::now();
-  const Runtime runtime(rig, options);
-  const double build_ms = MsSince(t_build);
   std::printf("runtime built in %.0f ms (%d modules); %zu captures -> %s\n", build_ms, rig.num_modules(), dirs.size(),
               request.out_dir.c_str());
   std::fflush(stdout);
@@ -88,8 +147,6 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
   summary["captures"] = nlohmann::json::array();
   int failed = 0;
   const auto t_all = Clock::now();
-  auto load = [&rig](const std::string& dir) { return LoadCapture(dir, rig); };
-  std::future<std::vector<cv::Mat>> next = std::async(std::launch::async, load, dirs[0]);
   for (size_t i = 0; i < dirs.size(); ++i) {
     const auto t = Clock::now();
     nlohmann::json entry;
@@ -99,9 +156,12 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
     try {
       images = next.get();
     } catch (const InputError& e) {
-      // Bad images in this capture: no output for it; the rest go on.
+      // Bad images in this capture: no output for it (not a stale one from
+      // an earlier run either); the rest go on.
       ++failed;
       std::fprintf(stderr, "stereorig reconstruct: [%zu/%zu] %s\n", i + 1, dirs.size(), e.what());
+      for (const std::string& path : {outputs[i].cloud, outputs[i].report, outputs[i].mesh})
+        if (!path.empty()) fs::remove(path, ec);
       entry["ok"] = false;
       entry["error"] = e.what();
       summary["captures"].push_back(entry);
@@ -110,18 +170,15 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
     }
     if (i + 1 < dirs.size()) next = std::async(std::launch::async, load, dirs[i + 1]);
     const Reconstruction rec = runtime.Process(images, mesh);
-    const fs::path stem = fs::path(request.out_dir) / names[i];
-    const std::string cloud_path = stem.string() + ".ply";
+    const std::string& cloud_path = outputs[i].cloud;
     WriteCloudPly(rec.cloud, cloud_path);
     entry["cloud"] = cloud_path;
     if (mesh) {
-      const std::string mesh_path = stem.string() + ".mesh." + request.mesh_format;
-      WriteMesh(rec.mesh, mesh_path);
-      entry["mesh"] = mesh_path;
+      WriteMesh(rec.mesh, outputs[i].mesh);
+      entry["mesh"] = outputs[i].mesh;
     }
-    const std::string report_path = stem.string() + ".json";
-    WriteFileAtomically(report_path, ReconstructionJson(rec).dump(2) + "\n");
-    entry["report"] = report_path;
+    WriteFileAtomically(outputs[i].report, ReconstructionJson(rec).dump(2) + "\n");
+    entry["report"] = outputs[i].report;
     entry["ok"] = true;
     entry["points"] = rec.cloud.size();
     entry["point_cloud_ms"] = rec.times_ms.at("total_point_cloud");

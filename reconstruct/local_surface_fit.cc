@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <string>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
@@ -21,9 +22,9 @@ constexpr int kMaxHalfSizePx = 30;
 
 void SurfaceFitOptions::Check() const {
   if (half_width_px < 2 || half_width_px > kMaxHalfSizePx)
-    throw InputError("surface_fit_half_width_px", "must be in [2, 30]");
+    throw InputError("surface_fit_half_width_px", "must be in [2, " + std::to_string(kMaxHalfSizePx) + "]");
   if (half_height_px < 1 || half_height_px > kMaxHalfSizePx)
-    throw InputError("surface_fit_half_height_px", "must be in [1, 30]");
+    throw InputError("surface_fit_half_height_px", "must be in [1, " + std::to_string(kMaxHalfSizePx) + "]");
   if (!(reference_misfit_px >= 0 && reference_misfit_px <= 10))
     throw InputError("surface_fit_reference_misfit_px", "must be in [0, 10] px (0 = the window never grows)");
   if (!(max_variance_growth >= 1 && max_variance_growth <= 100))
@@ -273,14 +274,17 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
   if (!(own.max_misfit_px > 0)) return 0;  // nothing fitted
   // Stronger noise than the window was sized for: a second pass whose
   // window's sides grow with the measured misfit (its area with the
-  // variance), so the fitted centre's scatter stays near the default's.
-  // Where the wide fit is not trusted (nearer a silhouette, or a depth edge
-  // or seam within its larger window), the pixel takes its own window's fit.
+  // variance; both sides by one ratio, capped so the longer stays within
+  // kMaxHalfSizePx), so the fitted centre's scatter stays near the default's.
+  // A pixel takes the wide fit only where its own window's fit is trusted
+  // too (a seam or a wrong patch smaller than the wide window stays out of
+  // it) and the wide one is (nearer a silhouette, or with a depth edge in
+  // the larger window, it keeps its own window's fit).
   std::optional<FitMaps> wide;
   if (o.reference_misfit_px > 0 && own.median_misfit_px > o.reference_misfit_px) {
-    const double grow = own.median_misfit_px / o.reference_misfit_px;
-    const int hw = std::min(kMaxHalfSizePx, int(std::lround(o.half_width_px * grow)));
-    const int hh = std::min(kMaxHalfSizePx, int(std::lround(o.half_height_px * grow)));
+    const double grow = std::min({own.median_misfit_px / o.reference_misfit_px, double(kMaxHalfSizePx) / o.half_width_px,
+                                  double(kMaxHalfSizePx) / o.half_height_px});
+    const int hw = int(std::lround(o.half_width_px * grow)), hh = int(std::lround(o.half_height_px * grow));
     if (hw != o.half_width_px || hh != o.half_height_px) wide = FitQuadrics(mask, values, hw, hh, o, num_threads);
   }
   int replaced = 0;
@@ -291,13 +295,9 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
     const float* wide_fitted = wide ? wide->fitted.ptr<float>(y) : nullptr;
     float* row = d.ptr<float>(y);
     for (int x = 0; x < roi.width; ++x) {
-      if (wide && wide_misfit[x] <= wide->max_misfit_px) {
-        row[x] = wide_fitted[x] + mean;
-        ++replaced;
-      } else if (own_misfit[x] <= own.max_misfit_px) {
-        row[x] = own_fitted[x] + mean;
-        ++replaced;
-      }
+      if (!(own_misfit[x] <= own.max_misfit_px)) continue;  // NaN: no fit
+      row[x] = (wide && wide_misfit[x] <= wide->max_misfit_px ? wide_fitted[x] : own_fitted[x]) + mean;
+      ++replaced;
     }
   }
   return replaced;

@@ -38,9 +38,11 @@
 // reference_misfit_px (the scatter the window is sized for), a second pass
 // fits a window whose sides are larger by their ratio, so its area grows
 // with the variance; each pixel takes that fit where the same two tests
-// trust it, else its own window's.
+// trust it and its own window's fit is trusted, else its own window's.
 // Cost: the lateral detail finer than a quadric over the window (~4 x 2 mm
-// at 200 mm by default) is smoothed away; the fill is unchanged.
+// at 200 mm by default, ~6 x 3 mm where the window grows at twice the
+// default speckle) is smoothed away; the fill is unchanged. The second pass
+// holds two more ROI-sized float images while it runs.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -63,8 +65,9 @@ struct SurfaceFitOptions {
   // simulator's default speckle: 0.17-0.20 px on every scene and module).
   // Where a module's median misfit is larger (stronger speckle: 0.26-0.30
   // px at twice the default), a second pass fits a window whose sides are
-  // larger by their ratio (its area by the variance's), and each pixel takes
-  // that fit where it is trusted, else its own window's. 0 = never.
+  // larger by their ratio (its area by the variance's), and each pixel whose
+  // own window's fit is trusted takes that fit where it is trusted too, else
+  // its own window's. 0 = never.
   double reference_misfit_px = 0.2;
   void Check() const;  // throws InputError naming the bad field
 };

@@ -246,5 +246,36 @@ TEST(LocalSurfaceFit, GrowsItsWindowWithTheMeasuredNoise) {
   EXPECT_EQ(cv::norm(quiet_one, quiet_adaptive, cv::NORM_INF), 0.0);
 }
 
+// A patch a few pixels across and 3 px off (a wrong alignment the line
+// index left, a seam) misfits its own window, so it keeps its disparities;
+// the grown window would dilute it (its misfit there is under the gate),
+// so the wide fit is taken only where the own window's is trusted too.
+TEST(LocalSurfaceFit, APatchItsOwnWindowRejectsStaysOutOfTheGrownFit) {
+  cv::Mat d(240, 400, CV_32F);
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> noise(0, 0.4);  // twice the reference: the window grows
+  for (int y = 0; y < d.rows; ++y)
+    for (int x = 0; x < d.cols; ++x) d.at<float>(y, x) = float(40 + 0.01 * x + noise(rng));
+  std::vector<cv::Rect> patches;
+  for (int k = 0; k < 5; ++k) patches.emplace_back(60 + 60 * k, 100, 6, 4);
+  for (const cv::Rect& p : patches) d(p) += 3.0;
+  const cv::Mat raw = d.clone();
+  SurfaceFitOptions adaptive;
+  adaptive.reference_misfit_px = 0.2;
+  FitLocalSurface(cv::Rect(0, 0, d.cols, d.rows), adaptive, 2, &d);
+  int kept = 0, total = 0;
+  for (const cv::Rect& p : patches)
+    for (int y = p.y; y < p.y + p.height; ++y)
+      for (int x = p.x; x < p.x + p.width; ++x, ++total) kept += d.at<float>(y, x) == raw.at<float>(y, x);
+  EXPECT_EQ(kept, total) << "patch pixels smoothed into the surface around them";
+  // Far from the patches the wide fit is taken: scatter well under the
+  // 21 x 11 window's (0.4 * sqrt(0.0153) = 0.049 px).
+  double sum2 = 0;
+  int n = 0;
+  for (int y = 150; y < 230; ++y)
+    for (int x = 20; x < 380; ++x, ++n) sum2 += std::pow(d.at<float>(y, x) - (40 + 0.01 * x), 2);
+  EXPECT_LT(std::sqrt(sum2 / n), 0.7 * 0.049);
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -348,7 +348,8 @@ void CheckCaptureFiles(const std::string& dir, const Rig& rig) {
   for (const auto& entry : fs::directory_iterator(dir)) {
     std::smatch m;
     const std::string name = entry.path().filename().string();
-    if (std::regex_match(name, m, cam_re) && std::stoi(m[1]) >= rig.num_cameras())
+    // More than 6 digits is beyond any rig (and beyond std::stoi's range).
+    if (std::regex_match(name, m, cam_re) && (m[1].length() > 6 || std::stoi(m[1]) >= rig.num_cameras()))
       throw InputError(entry.path().string(), "the rig has only " + std::to_string(rig.num_cameras()) +
                                                   " cameras: this capture does not match the rig");
   }

@@ -63,6 +63,7 @@ TEST(RuntimeOptions, ReadsAndChecksTheSurfaceFitKeys) {
       {"match:\n  surface_fit_max_variance_growth: 0.5\n", "surface_fit_max_variance_growth"},
       {"match:\n  surface_fit_max_misfit_ratio: 0\n", "surface_fit_max_misfit_ratio"},
       {"match:\n  surface_fit_reference_misfit_px: -0.1\n", "surface_fit_reference_misfit_px"},
+      {"match:\n  surface_fit_reference_misfit_px: 11\n", "surface_fit_reference_misfit_px"},
       {"match:\n  surface_fits: true\n", "surface_fits"}};
   ExpectEachRejectedNamingItsKey(bad);
 }

@@ -237,6 +237,17 @@ TEST_F(ReconstructCli, ABatchWithAMissingCameraOrARepeatedFolderWritesNothing) {
   EXPECT_EQ(RunCli(head + dir_ + "/capture/ --out-dir " + out), 2);
   EXPECT_EQ(RunCli(head + missing + " --out " + dir_ + "/out.ply"), 2);
   EXPECT_EQ(RunCli(head + "--out-dir " + out + " --mesh-format obj"), 2);
+  // Folders "x" and "x.mesh": x's mesh would be x.mesh's cloud.
+  const std::string clash = dir_ + "/batch_clash";
+  std::filesystem::remove_all(clash);
+  std::filesystem::create_directories(clash);
+  std::filesystem::copy(dir_ + "/capture", clash + "/x");
+  std::filesystem::copy(dir_ + "/capture", clash + "/x.mesh");
+  EXPECT_EQ(RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + clash + "/x " + clash + "/x.mesh --out-dir " +
+                   out + " --mesh-format ply"),
+            2);
+  // The summary's folder does not exist: found before the first cloud.
+  EXPECT_EQ(RunCli(head + "--out-dir " + out + " --report " + dir_ + "/no_such_folder/batch.json"), 2);
   EXPECT_FALSE(std::filesystem::exists(out));
   ExpectNoOutput();
 }
