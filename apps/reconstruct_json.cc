@@ -16,6 +16,10 @@ nlohmann::json ReconstructionJson(const Reconstruction& rec) {
                          {"match_roi_px", {m.match_roi.x, m.match_roi.y, m.match_roi.width, m.match_roi.height}},
                          {"disparity_range_px", {m.min_disparity_px, m.min_disparity_px + m.num_disparities}}};
     for (const auto& [step, ms] : m.times_ms) mj["time_ms"][step] = ms;
+    if (m.surface_fit)
+      mj["surface_fit"] = {{"window_px", {2 * m.surface_fit->half_width_px + 1, 2 * m.surface_fit->half_height_px + 1}},
+                           {"median_misfit_px", m.surface_fit->median_misfit_px},
+                           {"pixels_fitted", m.surface_fit->replaced}};
     j["modules"].push_back(mj);
     lit += m.lit_pixels;
     filled += m.lit_filled;

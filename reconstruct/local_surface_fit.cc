@@ -245,7 +245,11 @@ FitMaps FitQuadrics(const cv::Mat& mask, const cv::Mat& values, int hw, int hh, 
 
 }  // namespace
 
-int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_threads, cv::Mat* disparity_px) {
+int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_threads, cv::Mat* disparity_px,
+                    SurfaceFitSummary* summary) {
+  SurfaceFitSummary own_summary;
+  if (!summary) summary = &own_summary;
+  *summary = SurfaceFitSummary{0, 0, o.half_width_px, o.half_height_px};
   const cv::Rect roi = roi_in & cv::Rect(0, 0, disparity_px->cols, disparity_px->rows);
   if (roi.area() == 0) return 0;
   cv::Mat d = (*disparity_px)(roi);
@@ -272,6 +276,7 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
   }
   const FitMaps own = FitQuadrics(mask, values, o.half_width_px, o.half_height_px, o, num_threads);
   if (!(own.max_misfit_px > 0)) return 0;  // nothing fitted
+  summary->median_misfit_px = own.median_misfit_px;
   // Stronger noise than the window was sized for: a second pass whose
   // window's sides grow with the measured misfit (its area with the
   // variance; both sides by one ratio, capped so the longer stays within
@@ -285,7 +290,10 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
     const double grow = std::min({own.median_misfit_px / o.reference_misfit_px, double(kMaxHalfSizePx) / o.half_width_px,
                                   double(kMaxHalfSizePx) / o.half_height_px});
     const int hw = int(std::lround(o.half_width_px * grow)), hh = int(std::lround(o.half_height_px * grow));
-    if (hw != o.half_width_px || hh != o.half_height_px) wide = FitQuadrics(mask, values, hw, hh, o, num_threads);
+    if (hw != o.half_width_px || hh != o.half_height_px) {
+      wide = FitQuadrics(mask, values, hw, hh, o, num_threads);
+      summary->half_width_px = hw, summary->half_height_px = hh;
+    }
   }
   int replaced = 0;
   for (int y = 0; y < roi.height; ++y) {
@@ -300,6 +308,7 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
       ++replaced;
     }
   }
+  summary->replaced = replaced;
   return replaced;
 }
 

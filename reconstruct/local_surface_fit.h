@@ -72,8 +72,18 @@ struct SurfaceFitOptions {
   void Check() const;  // throws InputError naming the bad field
 };
 
+// What a fit did, for the reconstruction report.
+struct SurfaceFitSummary {
+  int replaced = 0;            // pixels that took a fit
+  double median_misfit_px = 0;  // of the options' window; 0 if nothing was fitted
+  // The widest window any pixel took: the options' own, or the grown one.
+  int half_width_px = 0, half_height_px = 0;
+};
+
 // disparity_px: CV_32FC1, +inf (or NaN) = none; only `roi` is read and
-// rewritten. Returns the number of pixels replaced by their fit.
-int FitLocalSurface(const cv::Rect& roi, const SurfaceFitOptions& options, int num_threads, cv::Mat* disparity_px);
+// rewritten. Returns the number of pixels replaced by their fit; *summary
+// (optional) gets that and the window and misfit behind it.
+int FitLocalSurface(const cv::Rect& roi, const SurfaceFitOptions& options, int num_threads, cv::Mat* disparity_px,
+                    SurfaceFitSummary* summary = nullptr);
 
 }  // namespace stereorig

@@ -225,7 +225,13 @@ TEST(LocalSurfaceFit, GrowsItsWindowWithTheMeasuredNoise) {
   const cv::Mat raw = noisy(sigma_px, 3);
   cv::Mat one = raw.clone(), grown = raw.clone();
   FitLocalSurface(all, fixed, 2, &one);
-  FitLocalSurface(all, adaptive, 2, &grown);
+  SurfaceFitSummary summary;
+  FitLocalSurface(all, adaptive, 2, &grown, &summary);
+  // The median of a chi distribution with ~225 degrees of freedom, over ~90 000
+  // windows: sigma within ~0.5 %; the window's sides double.
+  EXPECT_NEAR(summary.median_misfit_px, sigma_px, 0.02 * sigma_px);
+  EXPECT_EQ(summary.half_width_px, 20);
+  EXPECT_EQ(summary.half_height_px, 10);
   // Both measured where the wide window is full. The rms over N ~ 79 000
   // pixels scatters by ~1/sqrt(2 N_eff) relative, N_eff ~ N / window area
   // (neighbouring fits share their data): 4 % for 21 x 11, 7.4 % for
@@ -242,7 +248,9 @@ TEST(LocalSurfaceFit, GrowsItsWindowWithTheMeasuredNoise) {
   const cv::Mat quiet = noisy(0.1, 4);  // half the reference
   cv::Mat quiet_one = quiet.clone(), quiet_adaptive = quiet.clone();
   FitLocalSurface(all, fixed, 2, &quiet_one);
-  FitLocalSurface(all, adaptive, 2, &quiet_adaptive);
+  FitLocalSurface(all, adaptive, 2, &quiet_adaptive, &summary);
+  EXPECT_EQ(summary.half_width_px, 10);
+  EXPECT_EQ(summary.half_height_px, 5);
   EXPECT_EQ(cv::norm(quiet_one, quiet_adaptive, cv::NORM_INF), 0.0);
 }
 

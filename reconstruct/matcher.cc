@@ -449,7 +449,8 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
   }
   lap("speckle");
   if (o.surface_fit.enabled) {
-    FitLocalSurface(roi, o.surface_fit, o.num_threads, &state.disparity_px);
+    result.surface_fit.emplace();
+    FitLocalSurface(roi, o.surface_fit, o.num_threads, &state.disparity_px, &*result.surface_fit);
     lap("surface_fit");
   }
   result.disparity_px = state.disparity_px;

@@ -28,6 +28,7 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <opencv2/core.hpp>
 #include <string>
 
@@ -158,6 +159,8 @@ struct MatchResult {
   // fit), "speckle"; opencv_sgbm_3way: "sgbm"
   // in place of "band" and "sgm".
   std::map<std::string, double> times_ms;
+  // The local surface fit's window and misfit, if it ran (MatchOptions::surface_fit).
+  std::optional<SurfaceFitSummary> surface_fit;
 };
 
 // The sub-pixel step's acceptance tests (disparity_state.h) as the options

@@ -135,6 +135,7 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
     mo.right_valid = plan.right_valid;
     match = Match(left, right, mo);
     for (const auto& [step, ms] : match.times_ms) report->times_ms["match." + step] = ms;
+    report->surface_fit = match.surface_fit;
   } else {
     match.disparity_px = cv::Mat(size, CV_32FC1, cv::Scalar(std::numeric_limits<float>::infinity()));
     match.confidence = cv::Mat(size, CV_32FC1, cv::Scalar(0));

@@ -17,6 +17,7 @@
 
 #include <map>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,7 @@ struct ModuleReport {
   // is lost, reconstruct/fill_score.h).
   cv::Mat status;
   std::map<std::string, double> times_ms;  // rectify, lit_region, match, triangulate, normals, mesh
+  std::optional<SurfaceFitSummary> surface_fit;  // the matcher's (matcher.h), if the fit ran
 };
 
 struct Reconstruction {

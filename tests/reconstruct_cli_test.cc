@@ -217,6 +217,11 @@ TEST_F(ReconstructCli, ABatchWritesEachCapturesOwnCloudAndSkipsABrokenOne) {
     EXPECT_TRUE(std::filesystem::exists(out + "/" + name + ".mesh.stl")) << name;
   }
   for (const char* ext : {".ply", ".json", ".mesh.stl"}) EXPECT_FALSE(std::filesystem::exists(out + "/0002" + ext));
+  // Each capture's report is the single run's, the surface fit's window included.
+  const nlohmann::json report = nlohmann::json::parse(bytes(out + "/0001.json"));
+  ASSERT_EQ(report["modules"].size(), 2u);
+  EXPECT_EQ(report["modules"][0]["surface_fit"]["window_px"].size(), 2u);
+  EXPECT_GT(report["modules"][0]["surface_fit"]["pixels_fitted"].get<int>(), 10000);
   const nlohmann::json summary = nlohmann::json::parse(bytes(out + "/batch.json"));
   EXPECT_EQ(summary["reconstructed"], 2);
   EXPECT_EQ(summary["failed"], 1);
