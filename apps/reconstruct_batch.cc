@@ -60,9 +60,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double MsSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
-}  // namespace
-
-namespace {
 
 // Every file the batch writes, by capture: cloud, report, mesh ("" if none).
 struct CaptureOutputs {
@@ -153,22 +150,25 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
     entry["capture"] = dirs[i];
     entry["name"] = names[i];
     std::vector<cv::Mat> images;
+    std::string error;
     try {
       images = next.get();
     } catch (const InputError& e) {
+      error = e.what();
+    }
+    if (i + 1 < dirs.size()) next = std::async(std::launch::async, load, dirs[i + 1]);
+    if (!error.empty()) {
       // Bad images in this capture: no output for it (not a stale one from
       // an earlier run either); the rest go on.
       ++failed;
-      std::fprintf(stderr, "stereorig reconstruct: [%zu/%zu] %s\n", i + 1, dirs.size(), e.what());
+      std::fprintf(stderr, "stereorig reconstruct: [%zu/%zu] %s\n", i + 1, dirs.size(), error.c_str());
       for (const std::string& path : {outputs[i].cloud, outputs[i].report, outputs[i].mesh})
         if (!path.empty()) fs::remove(path, ec);
       entry["ok"] = false;
-      entry["error"] = e.what();
+      entry["error"] = error;
       summary["captures"].push_back(entry);
-      if (i + 1 < dirs.size()) next = std::async(std::launch::async, load, dirs[i + 1]);
       continue;
     }
-    if (i + 1 < dirs.size()) next = std::async(std::launch::async, load, dirs[i + 1]);
     const Reconstruction rec = runtime.Process(images, mesh);
     const std::string& cloud_path = outputs[i].cloud;
     WriteCloudPly(rec.cloud, cloud_path);
@@ -182,7 +182,8 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
     entry["ok"] = true;
     entry["points"] = rec.cloud.size();
     entry["point_cloud_ms"] = rec.times_ms.at("total_point_cloud");
-    entry["wall_ms"] = MsSince(t);  // waiting for the images, reconstructing, writing
+    const double wall_ms = MsSince(t);  // waiting for the images, reconstructing, writing
+    entry["wall_ms"] = wall_ms;
     std::string fills;
     for (const ModuleReport& m : rec.modules) {
       char buf[48];
@@ -190,7 +191,7 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
       fills += buf;
     }
     std::printf("[%zu/%zu] %s: %zu points (fill %s), %.0f ms -> %s\n", i + 1, dirs.size(), dirs[i].c_str(),
-                rec.cloud.size(), fills.c_str(), entry["wall_ms"].get<double>(), cloud_path.c_str());
+                rec.cloud.size(), fills.c_str(), wall_ms, cloud_path.c_str());
     std::fflush(stdout);
     summary["captures"].push_back(entry);
   }
