@@ -287,7 +287,8 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
   // the larger window, it keeps its own window's fit).
   std::optional<FitMaps> wide;
   if (o.reference_misfit_px > 0 && own.median_misfit_px > o.reference_misfit_px) {
-    const double grow = std::min({own.median_misfit_px / o.reference_misfit_px, double(kMaxHalfSizePx) / o.half_width_px,
+    const double ratio = own.median_misfit_px / o.reference_misfit_px;
+    const double grow = std::min({ratio * ratio, double(kMaxHalfSizePx) / o.half_width_px,
                                   double(kMaxHalfSizePx) / o.half_height_px});
     const int hw = int(std::lround(o.half_width_px * grow)), hh = int(std::lround(o.half_height_px * grow));
     if (hw != o.half_width_px || hh != o.half_height_px) {

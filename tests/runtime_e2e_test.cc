@@ -130,5 +130,42 @@ TEST_F(RuntimeOnSimulatedScenes, SphereAgreesWithTheAnalyticSphere) {
   EXPECT_LT(worst, 1.5);
 }
 
+// Twice the default speckle (contrast 0.4) on the flatness plate, the scene
+// where it hurt most: issue 5 asks the figures at speckle off, default and
+// high. The local surface fit measures the stronger noise (median misfit
+// ~0.28 px against its 0.2 px reference), fits a wider window and reaches
+// the edges of the valid region (local_surface_fit.h, session 13). On this
+// realization (truth rig, seed 1, the plate alone; the simulator and the
+// runtime are deterministic): mean |e| 0.073 / 0.069 mm, std 0.105 / 0.091
+// mm; session 12's fit 0.100 / 0.092 and 0.145 / 0.128. (The scored
+// speckle-0.4 dataset, another realization, gives std 0.092 / 0.085 with
+// the calibrated rig: the figure moves by ~10 % between realizations, so
+// issue 5's 0.1 mm is met on one and missed by 5 % on this one.) Asserted:
+// the issue's mean |e| target, and std below 0.115 mm, which session 12's
+// fit fails on both modules.
+TEST(RuntimeAtStrongSpeckle, PlateMeetsTheMeanTargetAndStaysNearTheStdOne) {
+  SimSpec spec = DefaultSimSpec();
+  spec.scenes.names = {"plate"};
+  spec.render.speckle_contrast = 0.4;
+  SimulateOptions o;
+  o.out_dir = ::testing::TempDir() + "/runtime_e2e_speckle04";
+  o.seed = 1;
+  o.calibration_captures = 0;
+  Simulate(spec, o);
+  const Rig rig = ReadRigFile(o.out_dir + "/truth/rig.yaml");
+  const Runtime runtime(rig, RuntimeOptions{});
+  const Reconstruction rec = runtime.Process(LoadCapture(o.out_dir + "/scenes/plate/active", rig), false);
+  const SceneScore s = ScoreScene(runtime, rec, ReadSceneTruth(o.out_dir, "plate"));
+  ASSERT_EQ(s.fill.size(), 2u);
+  for (size_t m = 0; m < 2; ++m) {
+    const ErrorFigures& e = s.accuracy.per_module[m];
+    std::printf("speckle 0.4 plate module %zu: fill %.3f, %d points, |e| %.4f mm, std %.4f mm\n", m, s.fill[m].fill(),
+                e.points, e.mean_abs_mm, e.std_mm);
+    EXPECT_LT(e.mean_abs_mm, 0.1) << "module " << m;
+    EXPECT_LT(e.std_mm, 0.115) << "module " << m;
+  }
+  EXPECT_LT(s.accuracy.all.mean_abs_mm, 0.15);  // two modules merged
+}
+
 }  // namespace
 }  // namespace stereorig
