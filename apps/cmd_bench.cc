@@ -24,6 +24,7 @@
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
 #include "datasets/default_rig.h"
+#include "reconstruct/elapsed_ms.h"
 #include "reconstruct/metrology/ply_points.h"
 #include "reconstruct/runtime.h"
 #include "reconstruct/scene_score.h"
@@ -256,7 +257,7 @@ int RunBench(int argc, char** argv) {
     o.match.matcher = kind;
     const auto t0 = Clock::now();
     pipelines.push_back(Pipeline{kind, std::make_unique<Runtime>(rig, o), 0, 0, 0, 0, 0, {}});
-    pipelines.back().build_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    pipelines.back().build_ms = MsSince(t0);
   };
   // The runtime's own peak memory: so far the process holds the libraries,
   // the rig and the captures only; our runtime is built and runs every

@@ -7,6 +7,7 @@
 #include "apps/cli_util.h"
 #include "apps/command.h"
 #include "calib/core/input_error.h"
+#include "reconstruct/elapsed_ms.h"
 #include "reconstruct/matcher.h"
 #include "reconstruct/pfm.h"
 
@@ -55,7 +56,7 @@ int RunMatch(int argc, char** argv) {
 
   const auto t0 = std::chrono::steady_clock::now();
   const MatchResult result = Match(left, right, options);
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  const double ms = MsSince(t0);
   WritePfm(result.disparity_px, out_path);
   int valid = 0;
   for (int y = 0; y < result.disparity_px.rows; ++y)

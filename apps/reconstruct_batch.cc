@@ -12,6 +12,7 @@
 #include "apps/reconstruct_json.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
+#include "reconstruct/elapsed_ms.h"
 #include "reconstruct/ply_io.h"
 #include "reconstruct/runtime.h"
 
@@ -58,7 +59,6 @@ std::vector<std::string> BatchOutputNames(const std::vector<std::string>& captur
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double MsSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 
 // Every file the batch writes, by capture: cloud, report, mesh ("" if none).

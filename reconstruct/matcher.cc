@@ -12,6 +12,7 @@
 #include "reconstruct/dense_refine.h"
 #include "reconstruct/disparity_band.h"
 #include "reconstruct/disparity_slopes.h"
+#include "reconstruct/elapsed_ms.h"
 #include "reconstruct/line_index.h"
 #include "reconstruct/parallel_for.h"
 #include "reconstruct/region_grow.h"
@@ -291,8 +292,7 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
   if (!sgbm && o.intensity_refinement && o.subpixel_dense) {
     const auto t_dense = std::chrono::steady_clock::now();
     dense = DenseRefine(left, right, roi, coarse_to_fine, plane, slope_x_roi, slope_y_roi, o.subpixel, o.num_threads);
-    result.times_ms["subpixel_dense"] =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_dense).count();
+    result.times_ms["subpixel_dense"] = MsSince(t_dense);
   }
   const int column_step = o.intensity_refinement ? o.subpixel_column_step : 1;
   ParallelForChunks(roi.height, o.num_threads, [&](int b, int e) {
@@ -464,7 +464,7 @@ MatchResult MatchOpenCvSgbm(const cv::Mat& left, const cv::Mat& right, const cv:
   const cv::Mat d_roi = SgbmRegion(
       left, right, roi, o, SgbmFilters{10, o.speckle_window_px, std::max(1, int(std::lround(o.speckle_range_px)))});
   MatchResult result;
-  result.times_ms["sgbm"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  result.times_ms["sgbm"] = MsSince(t0);
   result.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
   result.confidence = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
   result.status = cv::Mat(left.size(), CV_8UC1, cv::Scalar(uint8_t(PixelStatus::kNotSearched)));

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "calib/core/input_error.h"
+#include "reconstruct/elapsed_ms.h"
 #include "reconstruct/hole_fill.h"
 #include "reconstruct/lit_mask.h"
 #include "reconstruct/right_occlusion.h"
@@ -19,7 +20,6 @@ namespace stereorig {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double MsSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 std::vector<Eigen::Vector3d> VolumeCorners(const Eigen::Vector3d& centre, const Eigen::Vector3d& size) {
   std::vector<Eigen::Vector3d> corners;
