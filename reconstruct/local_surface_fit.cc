@@ -278,9 +278,10 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
   if (!(own.max_misfit_px > 0)) return 0;  // nothing fitted
   summary->median_misfit_px = own.median_misfit_px;
   // Stronger noise than the window was sized for: a second pass whose
-  // window's sides grow with the measured misfit (its area with the
-  // variance; both sides by one ratio, capped so the longer stays within
-  // kMaxHalfSizePx), so the fitted centre's scatter stays near the default's.
+  // window's sides grow with the square of the measured misfit's ratio to
+  // the reference (both sides by one factor, capped so the longer stays
+  // within kMaxHalfSizePx; the ratio alone, area with the variance, left the
+  // speckle-0.4 scatter 1.2-1.5x the default's: local_surface_fit.h).
   // A pixel takes the wide fit only where its own window's fit is trusted
   // too (a seam or a wrong patch smaller than the wide window stays out of
   // it) and the wide one is (nearer a silhouette, or with a depth edge in
