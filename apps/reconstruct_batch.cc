@@ -60,7 +60,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-
 // Every file the batch writes, by capture: cloud, report, mesh ("" if none).
 struct CaptureOutputs {
   std::string cloud, report, mesh;

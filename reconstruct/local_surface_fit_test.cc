@@ -106,8 +106,8 @@ TEST(LocalSurfaceFit, LeavesDepthStepsAloneAndFitsUpToSilhouettes) {
   // max_variance_growth, so the pixel takes the fit, whose scatter is
   // 0.3 * sqrt(4.1 * 0.0153) = 0.075 px at most: a quarter of the raw
   // 0.3 px. Over 216 pixels in ~10 independent windows along the edge the
-  // rms scatters by ~1/sqrt(2 * 10) = 22 % relative; 0.5x the raw rms is
-  // > 7 of those above the prediction.
+  // rms scatters by ~1/sqrt(2 * 10) = 22 % relative; 0.5x the raw rms (0.15
+  // px) is 2x the worst pixel's prediction, > 4 of those above it.
   EXPECT_EQ(changed_at_silhouette, silhouette_pixels) << "a half window's fit is better than the pixel's own value";
   EXPECT_LT(std::sqrt(silhouette_fit2 / silhouette_pixels), 0.5 * std::sqrt(silhouette_raw2 / silhouette_pixels));
 }
