@@ -9,7 +9,6 @@
 
 #include "calib/core/input_error.h"
 #include "reconstruct/parallel_for.h"
-#include "reconstruct/scratch_buffer.h"
 #include "reconstruct/sgm_kernels.h"
 
 #if defined(__AVX2__)
@@ -182,17 +181,20 @@ using sgm::kBig;
 using sgm::SumMode;
 
 // The buffers of one SgmMatch call, allocated once per call (the band pass
-// and the full-resolution pass are separate calls). The big one, the
-// forward sums (h x w x stride with 4 paths), is a ScratchArray (not
-// zeroed: every element is written before it is read; huge pages); the
-// costs are one row, computed again by the backward pass (session 11).
-// Keeping the volumes per thread across calls was tried (session 7, with
-// the cost volume): page faults stayed ~1.5 % of the runtime's cycles either
-// way, while the retained volumes overlapped the sub-pixel step's buffers
-// and raised the peak of `reconstruct` on the plate from 230 to 293 MB.
+// and the full-resolution pass are separate calls). All are a few rows: the
+// costs are one row (computed again where needed, session 11), and the
+// 4-path forward sums one block of rows, run again from the top->bottom
+// path's saved state (session 15; they were the whole region, h x w x
+// stride uint16 on fresh huge pages, ~40-50 MB a module).
 struct SgmWorkspace {
   std::vector<uint8_t> cost_row;         // (w, stride) + 63 to align: one row's matching costs
   std::vector<uint16_t> total_row;       // (w, stride): backward pass
+  std::vector<uint16_t> block_sums;      // (block rows, w, stride): a block's forward sums
+  std::vector<uint8_t> block_costs;      // (block rows, w * stride rounded up to 64) + 63 to align: its costs
+  std::vector<uint16_t> saved_paths;     // (blocks, w, stride + 2): the top->bottom path at each block's start
+  std::vector<uint16_t> saved_mins;      // (blocks, w)
+  std::vector<uint16_t> back_a, back_b;  // (w, stride + 2): bottom->top path, previous and current row
+  std::vector<uint16_t> back_min_a, back_min_b;
   std::vector<uint16_t> vert_a, vert_b;  // (w, stride + 2): top/bottom path, previous and current row
   std::vector<uint16_t> vert_min_a, vert_min_b;
   std::vector<uint16_t> horiz_a, horiz_b, horiz_c, horiz_d;  // (stride + 2): left->right, right->left
@@ -489,7 +491,7 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   const size_t planes_begin = size_t(std::clamp(stride + rw - region.x - w + int(lo_min), 0, int(reversed_size)));
   const size_t planes_end =
       size_t(std::clamp(2 * stride + rw + 15 - region.x + int(lo_max), int(planes_begin), int(reversed_size)));
-  auto costs_of_row = [&](int y) {
+  auto costs_of_row = [&](int y, uint8_t* dst) {
     const uint64_t* cr = right.row(region.y + y);
     std::reverse_copy(cr, cr + rw, reversed + stride);
     if constexpr (K::kNibbleCosts)
@@ -497,13 +499,12 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
                       reversed_size);
     cost_row(
         CostRowArgs{left.row(region.y + y), lo_row(y), reversed, planes, reversed_size, region.x, w, n, stride, rw},
-        cost);
+        dst);
   };
 
-  // Aggregated cost (h, w, stride) when a second pass is needed; otherwise one row.
+  // One row of sums when a single pass suffices (num_paths 2/3); the
+  // 4-path SGM's forward sums are held a block of rows at a time (below).
   const bool two_pass = options.num_paths == 4;
-  ScratchArray<uint16_t> sums(size_t(two_pass ? h : 1) * w * stride);
-  uint16_t* sum = sums.data();
   uint16_t* vert_prev = PathBuffers(ws.vert_a, w, stride);
   uint16_t* vert_cur = PathBuffers(ws.vert_b, w, stride);
   uint16_t* vert_prev_min = Grow(ws.vert_min_a, w);
@@ -523,37 +524,90 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   uint16_t* right_best = Grow(ws.right_best, right_best_size);
 
   cv::Mat disparity(h, w, CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
-
-  // Forward pass: top->bottom, left->right, right->left.
   const RowPasses<K> rows = RowPassesFor<K>(stride);
-  for (int y = 0; y < h; ++y) {
-    costs_of_row(y);
-    uint16_t* srow = sum + (two_pass ? size_t(y) * w * stride : 0);
-    rows.forward_vertical(shape, cost, lo_row(y), y == 0 ? nullptr : lo_row(y - 1), srow, srow, vert_prev,
+  const size_t row_elems = size_t(w) * stride;        // one row of costs or sums
+  const size_t path_elems = size_t(w) * (stride + 2);  // one row of a path, with its sentinels
+
+  // The forward paths of row y (top->bottom continued from the state in
+  // vert_prev, then left->right and right->left) summed into srow; costs
+  // into crow.
+  auto forward_row = [&](int y, uint8_t* crow, uint16_t* srow) {
+    costs_of_row(y, crow);
+    rows.forward_vertical(shape, crow, lo_row(y), y == 0 ? nullptr : lo_row(y - 1), srow, srow, vert_prev,
                           vert_prev_min, vert_cur, vert_cur_min, shifted, nullptr);
     std::swap(vert_prev, vert_cur);
     std::swap(vert_prev_min, vert_cur_min);
-    rows.horizontal(shape, cost, lo_row(y), srow, ha, hb, hc, hd, shifted, shifted_rl);
-    if (!two_pass)
+    rows.horizontal(shape, crow, lo_row(y), srow, ha, hb, hc, hd, shifted, shifted_rl);
+  };
+  if (!two_pass) {
+    uint16_t* srow = Grow(ws.block_sums, row_elems);
+    for (int y = 0; y < h; ++y) {
+      forward_row(y, cost, srow);
       rows.winner(shape, srow, lo_row(y), nullptr, right_best, right_best_size, rb_origin, options,
                   disparity.ptr<float>(y));
+    }
+    return disparity;
   }
-  if (!two_pass) return disparity;
+
+  // 4 paths: the bottom->top path needs every row's forward sums, which
+  // are not kept for the whole region (h x w x stride uint16: ~40-50 MB a
+  // module at full resolution, fresh pages the kernel zeroes on every
+  // call). The top->bottom path runs once alone, saving its state at the
+  // start of each block of ~sqrt(h) rows; the backward pass then takes
+  // the blocks bottom to top, runs the forward paths again over the block
+  // from its saved state (keeping the block's costs and sums, a few MB in
+  // cache) and goes up through it. Same arithmetic in the same order, so
+  // the same sums; one more top->bottom path per row is the price.
+  const int block_rows = std::max(1, int(std::lround(std::sqrt(double(h)))));
+  const int num_blocks = (h + block_rows - 1) / block_rows;
+  uint16_t* saved = Grow(ws.saved_paths, size_t(num_blocks) * path_elems);
+  uint16_t* saved_min = Grow(ws.saved_mins, size_t(num_blocks) * w);
+  {
+    uint16_t* srow = Grow(ws.block_sums, row_elems);  // the vertical path alone; not read
+    for (int y = 0; y < h; ++y) {
+      if (y % block_rows == 0 && y > 0) {
+        const int b = y / block_rows;
+        std::copy(vert_prev - 1, vert_prev - 1 + path_elems, saved + b * path_elems);
+        std::copy(vert_prev_min, vert_prev_min + w, saved_min + size_t(b) * w);
+      }
+      costs_of_row(y, cost);
+      rows.forward_vertical(shape, cost, lo_row(y), y == 0 ? nullptr : lo_row(y - 1), srow, srow, vert_prev,
+                            vert_prev_min, vert_cur, vert_cur_min, shifted, nullptr);
+      std::swap(vert_prev, vert_cur);
+      std::swap(vert_prev_min, vert_cur_min);
+    }
+  }
 
   // Backward pass: bottom -> top, then the winner per row. The row's total
-  // (forward sums + this path) goes to a cache-resident row, so the forward
-  // sums are only read, never written back (the pass is memory-bound); the path
-  // step also finds each pixel's smallest total (the winner's cost).
-  uint16_t* total = Grow(ws.total_row, size_t(w) * stride);
-  for (int y = h - 1; y >= 0; --y) {
-    const uint16_t* srow = sum + size_t(y) * w * stride;
-    costs_of_row(y);
-    rows.backward_vertical(shape, cost, lo_row(y), y == h - 1 ? nullptr : lo_row(y + 1), srow, total, vert_prev,
-                           vert_prev_min, vert_cur, vert_cur_min, shifted, row_min);
-    std::swap(vert_prev, vert_cur);
-    std::swap(vert_prev_min, vert_cur_min);
-    rows.winner(shape, total, lo_row(y), row_min, right_best, right_best_size, rb_origin, options,
-                disparity.ptr<float>(y));
+  // (forward sums + this path) goes to a row of its own, so the block's
+  // sums are only read; the path step also finds each pixel's smallest
+  // total (the winner's cost).
+  uint16_t* sums = Grow(ws.block_sums, size_t(block_rows) * row_elems);
+  // Each row of costs on a 64-byte boundary, as the single row is.
+  const size_t cost_pitch = (row_elems + 63) / 64 * 64;
+  uint8_t* costs = Align64(Grow(ws.block_costs, size_t(block_rows) * cost_pitch + 63));
+  uint16_t* total = Grow(ws.total_row, row_elems);
+  uint16_t* back_prev = PathBuffers(ws.back_a, w, stride);
+  uint16_t* back_cur = PathBuffers(ws.back_b, w, stride);
+  uint16_t* back_prev_min = Grow(ws.back_min_a, w);
+  uint16_t* back_cur_min = Grow(ws.back_min_b, w);
+  for (int b = num_blocks - 1; b >= 0; --b) {
+    const int y0 = b * block_rows, y1 = std::min(h, y0 + block_rows);
+    if (b > 0) {
+      std::copy(saved + b * path_elems, saved + (b + 1) * path_elems, vert_prev - 1);
+      std::copy(saved_min + size_t(b) * w, saved_min + size_t(b + 1) * w, vert_prev_min);
+    }
+    for (int y = y0; y < y1; ++y) forward_row(y, costs + (y - y0) * cost_pitch, sums + (y - y0) * row_elems);
+    for (int y = y1 - 1; y >= y0; --y) {
+      const uint8_t* crow = costs + (y - y0) * cost_pitch;
+      rows.backward_vertical(shape, crow, lo_row(y), y == h - 1 ? nullptr : lo_row(y + 1),
+                             sums + (y - y0) * row_elems, total, back_prev, back_prev_min, back_cur, back_cur_min,
+                             shifted, row_min);
+      std::swap(back_prev, back_cur);
+      std::swap(back_prev_min, back_cur_min);
+      rows.winner(shape, total, lo_row(y), row_min, right_best, right_best_size, rb_origin, options,
+                  disparity.ptr<float>(y));
+    }
   }
   return disparity;
 }

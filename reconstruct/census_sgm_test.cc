@@ -233,7 +233,9 @@ cv::Mat ReferenceSgm(const CensusImage& left, const CensusImage& right, const cv
 // disparities (one to 17 blocks of 16 lanes: the unrolled instances and the
 // run-time loop), padded and whole last blocks, 3 and 4 paths, a negative
 // minimum, a region at the right border (part of the range off the right
-// image), a textured view shifted by 7 px (most pixels pass every test) and
+// image), region heights of 20, 24, 7 and 1 rows (the 4-path forward sums
+// are held in blocks of ~sqrt(h) rows: whole blocks, a short last block, a
+// single row), a textured view shifted by 7 px (most pixels pass every test) and
 // pure noise (uniqueness and left-right rejections).
 TEST(CensusSgm, MatchesAPlainReferenceImplementation) {
   std::mt19937 rng(23);
@@ -247,7 +249,8 @@ TEST(CensusSgm, MatchesAPlainReferenceImplementation) {
     const CensusImage cr = CensusTransform(*right, 0, h, 1, 2, 3);
     for (const int n : {3, 16, 21, 40, 96, 140, 270})
       for (const int min_d : {-3, 2})
-        for (const cv::Rect& region : {cv::Rect(10, 2, 80, 20), cv::Rect(w - 25, 0, 25, h)})
+        for (const cv::Rect& region :
+             {cv::Rect(10, 2, 80, 20), cv::Rect(w - 25, 0, 25, h), cv::Rect(5, 9, 60, 7), cv::Rect(5, 11, 60, 1)})
           for (const int paths : {3, 4}) {
             SgmOptions o;
             o.num_paths = paths;
@@ -262,7 +265,7 @@ TEST(CensusSgm, MatchesAPlainReferenceImplementation) {
             }
           }
   }
-  EXPECT_EQ(cases, 2 * 7 * 2 * 2 * 2 * 2);
+  EXPECT_EQ(cases, 2 * 7 * 2 * 4 * 2 * 2);
   // Not vacuous: the shifted view matches most pixels whose range holds 7.
   EXPECT_GT(valid_total, 10000);
 }
