@@ -525,7 +525,7 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
 
   cv::Mat disparity(h, w, CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
   const RowPasses<K> rows = RowPassesFor<K>(stride);
-  const size_t row_elems = size_t(w) * stride;        // one row of costs or sums
+  const size_t row_elems = size_t(w) * stride;         // one row of costs or sums
   const size_t path_elems = size_t(w) * (stride + 2);  // one row of a path, with its sentinels
 
   // The forward paths of row y (top->bottom continued from the state in
@@ -600,9 +600,8 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
     for (int y = y0; y < y1; ++y) forward_row(y, costs + (y - y0) * cost_pitch, sums + (y - y0) * row_elems);
     for (int y = y1 - 1; y >= y0; --y) {
       const uint8_t* crow = costs + (y - y0) * cost_pitch;
-      rows.backward_vertical(shape, crow, lo_row(y), y == h - 1 ? nullptr : lo_row(y + 1),
-                             sums + (y - y0) * row_elems, total, back_prev, back_prev_min, back_cur, back_cur_min,
-                             shifted, row_min);
+      rows.backward_vertical(shape, crow, lo_row(y), y == h - 1 ? nullptr : lo_row(y + 1), sums + (y - y0) * row_elems,
+                             total, back_prev, back_prev_min, back_cur, back_cur_min, shifted, row_min);
       std::swap(back_prev, back_cur);
       std::swap(back_prev_min, back_cur_min);
       rows.winner(shape, total, lo_row(y), row_min, right_best, right_best_size, rb_origin, options,
