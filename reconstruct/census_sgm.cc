@@ -24,6 +24,7 @@ void SgmOptions::Check() const {
   if (uniqueness_percent < 0 || uniqueness_percent > 50)
     throw InputError("sgm.uniqueness_percent", "must be in [0, 50]");
   if (lr_max_diff_px < 0) throw InputError("sgm.lr_max_diff_px", "must be >= 0 (0 = exact)");
+  if (block_rows < 0) throw InputError("sgm.block_rows", "must be >= 0 (0 = about sqrt(rows))");
 }
 
 namespace {
@@ -189,13 +190,13 @@ using sgm::SumMode;
 struct SgmWorkspace {
   std::vector<uint8_t> cost_row;         // (w, stride) + 63 to align: one row's matching costs
   std::vector<uint16_t> total_row;       // (w, stride): backward pass
-  std::vector<uint16_t> block_sums;      // (block rows, w, stride): a block's forward sums
+  std::vector<uint16_t> block_sums;      // (block rows, w * stride rounded up to 32) + 31 to align: a block's forward sums
   std::vector<uint8_t> block_costs;      // (block rows, w * stride rounded up to 64) + 63 to align: its costs
   std::vector<uint16_t> saved_paths;     // (blocks, w, stride + 2): the top->bottom path at each block's start
   std::vector<uint16_t> saved_mins;      // (blocks, w)
   std::vector<uint16_t> back_a, back_b;  // (w, stride + 2): bottom->top path, previous and current row
   std::vector<uint16_t> back_min_a, back_min_b;
-  std::vector<uint16_t> vert_a, vert_b;  // (w, stride + 2): top/bottom path, previous and current row
+  std::vector<uint16_t> vert_a, vert_b;  // (w, stride + 2): top->bottom path, previous and current row
   std::vector<uint16_t> vert_min_a, vert_min_b;
   std::vector<uint16_t> horiz_a, horiz_b, horiz_c, horiz_d;  // (stride + 2): left->right, right->left
   std::vector<uint16_t> shifted, shifted_rl;                 // (stride + 2): a predecessor in another window
@@ -213,8 +214,9 @@ T* Grow(std::vector<T>& v, size_t n) {
 }
 
 // p rounded up to a 64-byte boundary (the caller allocated 63 bytes more).
-uint8_t* Align64(uint8_t* p) {
-  return reinterpret_cast<uint8_t*>((reinterpret_cast<uintptr_t>(p) + 63) & ~uintptr_t(63));
+template <typename T>
+T* Align64(T* p) {
+  return reinterpret_cast<T*>((reinterpret_cast<uintptr_t>(p) + 63) & ~uintptr_t(63));
 }
 
 // Path buffers for `count` pixels of `stride` lanes with kBig sentinels at
@@ -468,14 +470,13 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   auto lo_row = [&](int y) { return window_lo.ptr<int16_t>(y); };
   SgmWorkspace ws;
 
-  // The matching costs (w, stride), uint8 (CostRow), one row at a time:
-  // the forward pass takes each row as it reaches it, and the backward pass
-  // computes it again rather than keep the whole volume (h x w x stride
-  // bytes: 21-25 MB a module at full resolution on the demo, a third of the
-  // SGM's memory; the census costs are cheap to recompute, and the row stays
-  // in cache where the volume's row had to come from memory).
-  // On a 64-byte boundary, as the volume's rows were (its 32-byte stores
-  // then never straddle a cache line; no kernel reads past w * stride).
+  // The matching costs (w, stride), uint8 (CostRow), a row at a time,
+  // never a volume (h x w x stride bytes: 21-25 MB a module at full
+  // resolution on the demo; the census costs are cheap to recompute): one
+  // row for the 3-path pass and the 4-path top->bottom pass, a block's rows
+  // for the 4-path backward pass (below).
+  // On a 64-byte boundary (32-byte stores then never straddle a cache line;
+  // no kernel reads past w * stride).
   uint8_t* cost = Align64(Grow(ws.cost_row, size_t(w) * stride + 63));
   const size_t reversed_size = size_t(rw) + 2 * stride + 16;
   uint64_t* reversed = Grow(ws.right_reversed, reversed_size);
@@ -502,7 +503,7 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
         dst);
   };
 
-  // One row of sums when a single pass suffices (num_paths 2/3); the
+  // One row of sums when a single pass suffices (num_paths 3); the
   // 4-path SGM's forward sums are held a block of rows at a time (below).
   const bool two_pass = options.num_paths == 4;
   uint16_t* vert_prev = PathBuffers(ws.vert_a, w, stride);
@@ -540,7 +541,7 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
     rows.horizontal(shape, crow, lo_row(y), srow, ha, hb, hc, hd, shifted, shifted_rl);
   };
   if (!two_pass) {
-    uint16_t* srow = Grow(ws.block_sums, row_elems);
+    uint16_t* srow = Align64(Grow(ws.block_sums, row_elems + 31));
     for (int y = 0; y < h; ++y) {
       forward_row(y, cost, srow);
       rows.winner(shape, srow, lo_row(y), nullptr, right_best, right_best_size, rb_origin, options,
@@ -558,12 +559,13 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   // from its saved state (keeping the block's costs and sums, a few MB in
   // cache) and goes up through it. Same arithmetic in the same order, so
   // the same sums; one more top->bottom path per row is the price.
-  const int block_rows = std::max(1, int(std::lround(std::sqrt(double(h)))));
+  const int block_rows =
+      std::min(h, options.block_rows > 0 ? options.block_rows : std::max(1, int(std::lround(std::sqrt(double(h))))));
   const int num_blocks = (h + block_rows - 1) / block_rows;
   uint16_t* saved = Grow(ws.saved_paths, size_t(num_blocks) * path_elems);
   uint16_t* saved_min = Grow(ws.saved_mins, size_t(num_blocks) * w);
   {
-    uint16_t* srow = Grow(ws.block_sums, row_elems);  // the vertical path alone; not read
+    uint16_t* srow = Align64(Grow(ws.block_sums, row_elems + 31));  // the vertical path alone; not read
     for (int y = 0; y < h; ++y) {
       if (y % block_rows == 0 && y > 0) {
         const int b = y / block_rows;
@@ -582,7 +584,9 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   // (forward sums + this path) goes to a row of its own, so the block's
   // sums are only read; the path step also finds each pixel's smallest
   // total (the winner's cost).
-  uint16_t* sums = Grow(ws.block_sums, size_t(block_rows) * row_elems);
+  // Each row of sums on a 64-byte boundary too (32 uint16).
+  const size_t sum_pitch = (row_elems + 31) / 32 * 32;
+  uint16_t* sums = Align64(Grow(ws.block_sums, size_t(block_rows) * sum_pitch + 31));
   // Each row of costs on a 64-byte boundary, as the single row is.
   const size_t cost_pitch = (row_elems + 63) / 64 * 64;
   uint8_t* costs = Align64(Grow(ws.block_costs, size_t(block_rows) * cost_pitch + 63));
@@ -597,10 +601,10 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
       std::copy(saved + b * path_elems, saved + (b + 1) * path_elems, vert_prev - 1);
       std::copy(saved_min + size_t(b) * w, saved_min + size_t(b + 1) * w, vert_prev_min);
     }
-    for (int y = y0; y < y1; ++y) forward_row(y, costs + (y - y0) * cost_pitch, sums + (y - y0) * row_elems);
+    for (int y = y0; y < y1; ++y) forward_row(y, costs + (y - y0) * cost_pitch, sums + (y - y0) * sum_pitch);
     for (int y = y1 - 1; y >= y0; --y) {
       const uint8_t* crow = costs + (y - y0) * cost_pitch;
-      rows.backward_vertical(shape, crow, lo_row(y), y == h - 1 ? nullptr : lo_row(y + 1), sums + (y - y0) * row_elems,
+      rows.backward_vertical(shape, crow, lo_row(y), y == h - 1 ? nullptr : lo_row(y + 1), sums + (y - y0) * sum_pitch,
                              total, back_prev, back_prev_min, back_cur, back_cur_min, shifted, row_min);
       std::swap(back_prev, back_cur);
       std::swap(back_prev_min, back_cur_min);

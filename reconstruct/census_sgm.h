@@ -45,7 +45,11 @@ struct SgmOptions {
   int uniqueness_percent = 5;  // best cost must beat every cost off the best+-1 by this %; default 5
   int lr_max_diff_px = 1;      // left-right consistency tolerance, whole px; default 1
   bool simd = true;            // AVX2 kernels if the build has them (else scalar); false = scalar; default true
-  void Check() const;          // throws InputError naming the bad field
+  // 4 paths: rows per block of the forward sums the bottom->top pass reads
+  // (census_sgm.cc); 0 = about sqrt(rows), the least memory. The result
+  // does not depend on it, only memory and time do. Default 0.
+  int block_rows = 0;
+  void Check() const;  // throws InputError naming the bad field
 };
 
 // SGM over `region` (left image px) for integer disparities

@@ -258,8 +258,9 @@ TEST(CensusSgm, MatchesAPlainReferenceImplementation) {
             for (const bool simd : {true, false}) {
               o.simd = simd;
               const std::string what = "n " + std::to_string(n) + " min " + std::to_string(min_d) + " paths " +
-                                       std::to_string(paths) + " x " + std::to_string(region.x) + " simd " +
-                                       std::to_string(simd);
+                                       std::to_string(paths) + " region " + std::to_string(region.x) + "," +
+                                       std::to_string(region.y) + " " + std::to_string(region.width) + "x" +
+                                       std::to_string(region.height) + " simd " + std::to_string(simd);
               valid_total += ExpectIdentical(SgmMatch(cl, cr, region, min_d, n, o), reference, what);
               ++cases;
             }
