@@ -192,8 +192,8 @@ struct SgmWorkspace {
   std::vector<uint16_t> total_row;       // (w, stride): backward pass
   std::vector<uint16_t> block_sums;      // (block rows, w * stride rounded up to 32) + 31 to align: a block's forward sums
   std::vector<uint8_t> block_costs;      // (block rows, w * stride rounded up to 64) + 63 to align: its costs
-  std::vector<uint16_t> saved_paths;     // (blocks, w, stride + 2): the top->bottom path at each block's start
-  std::vector<uint16_t> saved_mins;      // (blocks, w)
+  std::vector<uint16_t> saved_paths;     // (blocks - 1, w, stride + 2): the top->bottom path at blocks 1, 2, ...
+  std::vector<uint16_t> saved_mins;      // (blocks - 1, w)
   std::vector<uint16_t> back_a, back_b;  // (w, stride + 2): bottom->top path, previous and current row
   std::vector<uint16_t> back_min_a, back_min_b;
   std::vector<uint16_t> vert_a, vert_b;  // (w, stride + 2): top->bottom path, previous and current row
@@ -428,14 +428,15 @@ inline constexpr int kMaxUnrolledBlocks = 16;
 template <typename K>
 struct RowPasses {
   decltype(&VerticalRow<K, 0, SumMode::kStore, false>) forward_vertical;
+  decltype(&VerticalRow<K, 0, SumMode::kNone, false>) vertical_alone;   // the path's state only, no sums
   decltype(&VerticalRow<K, 0, SumMode::kAdd, true>) backward_vertical;  // finds each pixel's smallest total
   decltype(&HorizontalRow<K, 0>) horizontal;
   decltype(&WinnerRow<K, 0>) winner;
 };
 template <typename K, int kBlocks>
 constexpr RowPasses<K> RowPassesOf() {
-  return {&VerticalRow<K, kBlocks, SumMode::kStore, false>, &VerticalRow<K, kBlocks, SumMode::kAdd, true>,
-          &HorizontalRow<K, kBlocks>, &WinnerRow<K, kBlocks>};
+  return {&VerticalRow<K, kBlocks, SumMode::kStore, false>, &VerticalRow<K, kBlocks, SumMode::kNone, false>,
+          &VerticalRow<K, kBlocks, SumMode::kAdd, true>, &HorizontalRow<K, kBlocks>, &WinnerRow<K, kBlocks>};
 }
 template <typename K, int... k>
 RowPasses<K> RowPassesFor(int blocks, std::integer_sequence<int, k...>) {
@@ -529,15 +530,20 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   const size_t row_elems = size_t(w) * stride;         // one row of costs or sums
   const size_t path_elems = size_t(w) * (stride + 2);  // one row of a path, with its sentinels
 
-  // The forward paths of row y (top->bottom continued from the state in
-  // vert_prev, then left->right and right->left) summed into srow; costs
-  // into crow.
-  auto forward_row = [&](int y, uint8_t* crow, uint16_t* srow) {
-    costs_of_row(y, crow);
-    rows.forward_vertical(shape, crow, lo_row(y), y == 0 ? nullptr : lo_row(y - 1), srow, srow, vert_prev,
-                          vert_prev_min, vert_cur, vert_cur_min, shifted, nullptr);
+  // The top->bottom path's step to row y (costs crow), continued from the
+  // state in vert_prev: into srow by `vertical` (forward_vertical stores
+  // it, vertical_alone leaves srow alone).
+  auto top_down = [&](decltype(rows.forward_vertical) vertical, int y, const uint8_t* crow, uint16_t* srow) {
+    vertical(shape, crow, lo_row(y), y == 0 ? nullptr : lo_row(y - 1), srow, srow, vert_prev, vert_prev_min, vert_cur,
+             vert_cur_min, shifted, nullptr);
     std::swap(vert_prev, vert_cur);
     std::swap(vert_prev_min, vert_cur_min);
+  };
+  // The forward paths of row y (top->bottom, then left->right and
+  // right->left) summed into srow; costs into crow.
+  auto forward_row = [&](int y, uint8_t* crow, uint16_t* srow) {
+    costs_of_row(y, crow);
+    top_down(rows.forward_vertical, y, crow, srow);
     rows.horizontal(shape, crow, lo_row(y), srow, ha, hb, hc, hd, shifted, shifted_rl);
   };
   if (!two_pass) {
@@ -562,22 +568,18 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   const int block_rows =
       std::min(h, options.block_rows > 0 ? options.block_rows : std::max(1, int(std::lround(std::sqrt(double(h))))));
   const int num_blocks = (h + block_rows - 1) / block_rows;
-  uint16_t* saved = Grow(ws.saved_paths, size_t(num_blocks) * path_elems);
-  uint16_t* saved_min = Grow(ws.saved_mins, size_t(num_blocks) * w);
-  {
-    uint16_t* srow = Align64(Grow(ws.block_sums, row_elems + 31));  // the vertical path alone; not read
-    for (int y = 0; y < h; ++y) {
-      if (y % block_rows == 0 && y > 0) {
-        const int b = y / block_rows;
-        std::copy(vert_prev - 1, vert_prev - 1 + path_elems, saved + b * path_elems);
-        std::copy(vert_prev_min, vert_prev_min + w, saved_min + size_t(b) * w);
-      }
-      costs_of_row(y, cost);
-      rows.forward_vertical(shape, cost, lo_row(y), y == 0 ? nullptr : lo_row(y - 1), srow, srow, vert_prev,
-                            vert_prev_min, vert_cur, vert_cur_min, shifted, nullptr);
-      std::swap(vert_prev, vert_cur);
-      std::swap(vert_prev_min, vert_cur_min);
+  // The state at the start of blocks 1, 2, ... (block 0 starts the path).
+  uint16_t* saved = Grow(ws.saved_paths, size_t(num_blocks - 1) * path_elems);
+  uint16_t* saved_min = Grow(ws.saved_mins, size_t(num_blocks - 1) * w);
+  uint16_t* total = Grow(ws.total_row, row_elems);  // also the (untouched) sum row of vertical_alone
+  for (int y = 0; y < h; ++y) {
+    if (y % block_rows == 0 && y > 0) {
+      const size_t slot = size_t(y / block_rows - 1);
+      std::copy(vert_prev - 1, vert_prev - 1 + path_elems, saved + slot * path_elems);
+      std::copy(vert_prev_min, vert_prev_min + w, saved_min + slot * w);
     }
+    costs_of_row(y, cost);
+    top_down(rows.vertical_alone, y, cost, total);
   }
 
   // Backward pass: bottom -> top, then the winner per row. The row's total
@@ -590,7 +592,6 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   // Each row of costs on a 64-byte boundary, as the single row is.
   const size_t cost_pitch = (row_elems + 63) / 64 * 64;
   uint8_t* costs = Align64(Grow(ws.block_costs, size_t(block_rows) * cost_pitch + 63));
-  uint16_t* total = Grow(ws.total_row, row_elems);
   uint16_t* back_prev = PathBuffers(ws.back_a, w, stride);
   uint16_t* back_cur = PathBuffers(ws.back_b, w, stride);
   uint16_t* back_prev_min = Grow(ws.back_min_a, w);
@@ -598,8 +599,9 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   for (int b = num_blocks - 1; b >= 0; --b) {
     const int y0 = b * block_rows, y1 = std::min(h, y0 + block_rows);
     if (b > 0) {
-      std::copy(saved + b * path_elems, saved + (b + 1) * path_elems, vert_prev - 1);
-      std::copy(saved_min + size_t(b) * w, saved_min + size_t(b + 1) * w, vert_prev_min);
+      const size_t slot = size_t(b - 1);
+      std::copy(saved + slot * path_elems, saved + (slot + 1) * path_elems, vert_prev - 1);
+      std::copy(saved_min + slot * w, saved_min + (slot + 1) * w, vert_prev_min);
     }
     for (int y = y0; y < y1; ++y) forward_row(y, costs + (y - y0) * cost_pitch, sums + (y - y0) * sum_pitch);
     for (int y = y1 - 1; y >= y0; --y) {

@@ -23,13 +23,15 @@ namespace stereorig::sgm {
 
 inline constexpr uint16_t kBig = 0x3FFF;  // "impossible" path cost; 4 x kBig still fits uint16
 
-// What a path step does with the sum of paths: start it (sum = v), or add
-// to the sum so far (sum = sum_in + v; sum_in may be sum itself, or the
-// forward pass's sums when the backward pass writes a row's total apart).
-enum class SumMode { kStore, kAdd };
+// What a path step does with the sum of paths: start it (sum = v), add to
+// the sum so far (sum = sum_in + v; sum_in may be sum itself, or the
+// forward pass's sums when the backward pass writes a row's total apart),
+// or nothing (kNone: the path alone, for its state; sum is not touched).
+enum class SumMode { kStore, kAdd, kNone };
 
 template <SumMode kMode>
 inline uint16_t Accumulate(uint16_t* sum, const uint16_t* sum_in, uint16_t v) {
+  if constexpr (kMode == SumMode::kNone) return v;
   return *sum = kMode == SumMode::kStore ? v : uint16_t(*sum_in + v);
 }
 
@@ -205,6 +207,7 @@ struct Avx2Kernels {
 
   template <SumMode kMode>
   static __m256i Accumulate(uint16_t* sum, const uint16_t* sum_in, __m256i v) {
+    if constexpr (kMode == SumMode::kNone) return v;
     const __m256i total = kMode == SumMode::kStore ? v : _mm256_add_epi16(Load(sum_in), v);
     Store(sum, total);
     return total;
