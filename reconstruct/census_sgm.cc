@@ -53,8 +53,8 @@ void Census32(const uint8_t* const* rows, int x, uint64_t* dst) {
       const __m256i nb = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(rows[dy + half_height] + 4 + x + dx));
       // nb < centre (unsigned) <=> max(nb, centre) != nb.
       const __m256i not_darker = _mm256_cmpeq_epi8(_mm256_max_epu8(nb, centre), nb);
-      plane[bit >> 3] = _mm256_or_si256(plane[bit >> 3],
-                                        _mm256_andnot_si256(not_darker, _mm256_set1_epi8(char(1 << (bit & 7)))));
+      plane[bit >> 3] =
+          _mm256_or_si256(plane[bit >> 3], _mm256_andnot_si256(not_darker, _mm256_set1_epi8(char(1 << (bit & 7)))));
     }
   // Byte transpose, within each 128-bit half (pixels 0-15 | 16-31).
   __m256i u[8], v[8];
@@ -188,12 +188,12 @@ using sgm::SumMode;
 // path's saved state (session 15; they were the whole region, h x w x
 // stride uint16 on fresh huge pages, ~40-50 MB a module).
 struct SgmWorkspace {
-  std::vector<uint8_t> cost_row;         // (w, stride) + 63 to align: one row's matching costs
-  std::vector<uint16_t> total_row;       // (w, stride): backward pass
-  std::vector<uint16_t> block_sums;      // (block rows, w * stride rounded up to 32) + 31 to align: a block's forward sums
-  std::vector<uint8_t> block_costs;      // (block rows, w * stride rounded up to 64) + 63 to align: its costs
-  std::vector<uint16_t> saved_paths;     // (blocks - 1, w, stride + 2): the top->bottom path at blocks 1, 2, ...
-  std::vector<uint16_t> saved_mins;      // (blocks - 1, w)
+  std::vector<uint8_t> cost_row;      // (w, stride) + 63 to align: one row's matching costs
+  std::vector<uint16_t> total_row;    // (w, stride): backward pass
+  std::vector<uint16_t> block_sums;   // (block rows, w * stride rounded up to 32) + 31 to align: a block's forward sums
+  std::vector<uint8_t> block_costs;   // (block rows, w * stride rounded up to 64) + 63 to align: its costs
+  std::vector<uint16_t> saved_paths;  // (blocks - 1, w, stride + 2): the top->bottom path at blocks 1, 2, ...
+  std::vector<uint16_t> saved_mins;   // (blocks - 1, w)
   std::vector<uint16_t> back_a, back_b;  // (w, stride + 2): bottom->top path, previous and current row
   std::vector<uint16_t> back_min_a, back_min_b;
   std::vector<uint16_t> vert_a, vert_b;  // (w, stride + 2): top->bottom path, previous and current row

@@ -33,7 +33,7 @@ TEST(GuideFromCoarse, UpsamplesAndInterpolatesGapsOfAPlane) {
   for (int x = 0; x < 12; ++x)  // at the row's start (removed blobs are inf): the nearest value
     coarse.at<float>(8, x) = std::numeric_limits<float>::infinity();
   for (int x = 0; x < coarse.cols; ++x) coarse.at<float>(15, x) = kNan;  // a whole row
-  const cv::Rect region(22, 14, 60, 40);  // full-res px, inside 2 * coarse_region
+  const cv::Rect region(22, 14, 60, 40);                                 // full-res px, inside 2 * coarse_region
   const cv::Mat guide = GuideFromCoarse(coarse, coarse_region, region, -999);
   ASSERT_EQ(guide.type(), CV_16SC1);
   ASSERT_EQ(guide.size(), region.size());
@@ -94,8 +94,8 @@ TEST(SgmMatchGuided, EqualsTheWholeRangeSearchWhereTheTruthIsInsideTheWindow) {
   const GuidedCase c = MakeCase();
   SgmOptions o;
   const cv::Mat full = SgmMatch(c.left, c.right, c.region, kMinDisparity, kNumDisparities, o);
-  const cv::Mat guided = SgmMatchGuided(c.left, c.right, c.region, JitteredGuide(c, 8, 3), kRadius, kMinDisparity,
-                                        kNumDisparities, o);
+  const cv::Mat guided =
+      SgmMatchGuided(c.left, c.right, c.region, JitteredGuide(c, 8, 3), kRadius, kMinDisparity, kNumDisparities, o);
   int full_valid = 0, both = 0, same = 0, guided_wrong = 0;
   for (int y = 0; y < full.rows; ++y)
     for (int x = 0; x < full.cols; ++x) {
@@ -126,8 +126,7 @@ TEST(SgmMatchGuided, SimdAndScalarAgreeUnderShiftingWindows) {
     o.num_paths = paths;
     const cv::Mat simd = SgmMatchGuided(c.left, c.right, c.region, guide, kRadius, kMinDisparity, kNumDisparities, o);
     o.simd = false;
-    const cv::Mat scalar =
-        SgmMatchGuided(c.left, c.right, c.region, guide, kRadius, kMinDisparity, kNumDisparities, o);
+    const cv::Mat scalar = SgmMatchGuided(c.left, c.right, c.region, guide, kRadius, kMinDisparity, kNumDisparities, o);
     int differ = 0;
     for (int y = 0; y < simd.rows; ++y)
       for (int x = 0; x < simd.cols; ++x) {
