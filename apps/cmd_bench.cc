@@ -86,8 +86,8 @@ struct Pipeline {
   MatcherKind matcher;
   std::unique_ptr<Runtime> runtime;
   double build_ms = 0;
-  double busy_s = 0;  // summed wall time of its Process() calls
-  double cpu_s = 0;   // summed CPU time (all threads) of its Process() calls
+  double busy_s = 0;     // summed wall time of its Process() calls
+  double cpu_s = 0;      // summed CPU time (all threads) of its Process() calls
   long page_faults = 0;  // summed minor page faults of its Process() calls
   int objects = 0;
   std::map<std::string, std::vector<double>> steps;
@@ -165,9 +165,10 @@ void PrintPipeline(const nlohmann::json& j) {
   std::printf("  module 0 median ms:");
   // match.grow_2 and match.line_index_3 run only on captures where the
   // second line-index pass moved something: their medians are over those captures.
-  for (const char* step : {"rectify", "lit_region", "match.band", "match.sgm", "match.sgbm", "match.subpixel",
-                           "match.subpixel_dense", "match.line_index", "match.grow", "match.line_index_2",
-                           "match.grow_2", "match.line_index_3", "match.speckle", "match.surface_fit", "triangulate", "normals"}) {
+  for (const char* step :
+       {"rectify", "lit_region", "match.band", "match.sgm", "match.sgbm", "match.subpixel", "match.subpixel_dense",
+        "match.line_index", "match.grow", "match.line_index_2", "match.grow_2", "match.line_index_3", "match.speckle",
+        "match.surface_fit", "triangulate", "normals"}) {
     const std::string key = std::string("module0.") + step;
     if (j["median_time_ms"].contains(key)) std::printf(" %s %.1f", step, j["median_time_ms"][key].get<double>());
   }

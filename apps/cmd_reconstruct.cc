@@ -54,8 +54,8 @@ int RunReconstruct(int argc, char** argv) {
   if (out_dir.empty() && out_path.empty())
     throw InputError("--out", "give --out (one capture) or --out-dir (many captures)");
   if (out_dir.empty() && capture_dirs.size() > 1)
-    throw InputError("--capture", std::to_string(capture_dirs.size()) +
-                                        " captures given: write them with --out-dir DIR, not --out");
+    throw InputError("--capture",
+                     std::to_string(capture_dirs.size()) + " captures given: write them with --out-dir DIR, not --out");
   if (!out_dir.empty()) {
     const Rig rig = ReadRigFile(rig_path);
     const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);

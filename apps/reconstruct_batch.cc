@@ -75,7 +75,8 @@ std::vector<CaptureOutputs> PlanOutputs(const std::vector<std::string>& names, c
   auto claim = [&](const std::string& path, const std::string& what) {
     const fs::path key = fs::absolute(fs::path(path)).lexically_normal();
     if (const auto it = claimed.find(key); it != claimed.end())
-      throw InputError(path, "would be written twice (" + it->second + " and " + what + "): rename a folder or "
+      throw InputError(path, "would be written twice (" + it->second + " and " + what +
+                                 "): rename a folder or "
                                  "choose another --report");
     claimed.emplace(key, what);
   };
@@ -94,8 +95,7 @@ std::vector<CaptureOutputs> PlanOutputs(const std::vector<std::string>& names, c
     claim(request.summary_path, "the summary (--report)");
     const fs::path folder = fs::absolute(fs::path(request.summary_path)).parent_path().lexically_normal();
     const fs::path out = fs::absolute(fs::path(request.out_dir)).lexically_normal();
-    if (folder != out && !fs::is_directory(folder))
-      throw InputError(request.summary_path, "its folder does not exist");
+    if (folder != out && !fs::is_directory(folder)) throw InputError(request.summary_path, "its folder does not exist");
   }
   return outputs;
 }
@@ -200,8 +200,8 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
   summary["failed"] = failed;
   summary["wall_ms"] = all_ms;
   summary["objects_per_s"] = done > 0 ? 1000.0 * done / all_ms : 0.0;
-  std::printf("%d of %zu captures in %.2f s: %.1f objects/s (reading, reconstructing and writing)\n", done,
-              dirs.size(), all_ms / 1000, summary["objects_per_s"].get<double>());
+  std::printf("%d of %zu captures in %.2f s: %.1f objects/s (reading, reconstructing and writing)\n", done, dirs.size(),
+              all_ms / 1000, summary["objects_per_s"].get<double>());
   if (!request.summary_path.empty()) WriteFileAtomically(request.summary_path, summary.dump(2) + "\n");
   if (failed > 0) {
     std::fprintf(stderr, "stereorig reconstruct: %d of %zu captures were bad input and have no output\n", failed,

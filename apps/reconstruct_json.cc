@@ -34,8 +34,9 @@ nlohmann::json ReconstructionJson(const Reconstruction& rec) {
 }
 
 nlohmann::json ErrorFiguresJson(const ErrorFigures& f) {
-  return {{"points", f.points}, {"mean_abs_mm", f.mean_abs_mm}, {"mean_mm", f.mean_mm},
-          {"std_mm", f.std_mm}, {"rms_mm", f.rms_mm},           {"p95_abs_mm", f.p95_abs_mm},
+  return {{"points", f.points},         {"mean_abs_mm", f.mean_abs_mm},
+          {"mean_mm", f.mean_mm},       {"std_mm", f.std_mm},
+          {"rms_mm", f.rms_mm},         {"p95_abs_mm", f.p95_abs_mm},
           {"max_abs_mm", f.max_abs_mm}, {"within_0_5_mm", f.within_0_5_mm}};
 }
 

@@ -221,7 +221,8 @@ TEST(FootprintSample, AThinComponentIsReadAtEveryPixel) {
   const auto sample = sampler.SampleLatticeAtLeast(pixels, 48, &pitch);
   EXPECT_EQ(pitch, 1);
   EXPECT_EQ(sample.size(), 96u);
-  for (const FootprintStart& s : sample) EXPECT_TRUE(s.i / size.width == 12 && s.i % size.width >= 28 && s.i % size.width < 232);
+  for (const FootprintStart& s : sample)
+    EXPECT_TRUE(s.i / size.width == 12 && s.i % size.width >= 28 && s.i % size.width < 232);
   EXPECT_TRUE(sampler.SampleLatticeAtLeast({}, 48, &pitch).empty());
 }
 

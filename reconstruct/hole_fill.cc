@@ -221,8 +221,7 @@ std::vector<double> FieldOnLattice(const ModelLattice& lattice, const ResidualFi
       const double tj = double(j - cs[b]) / (j1 - cs[b]);
       const double* r0 = &coarse[size_t(a) * ncs];
       const double* r1 = &coarse[size_t(a + 1) * ncs];
-      out[size_t(i) * cols + j] =
-          (1 - ti) * ((1 - tj) * r0[b] + tj * r0[b1]) + ti * ((1 - tj) * r1[b] + tj * r1[b1]);
+      out[size_t(i) * cols + j] = (1 - ti) * ((1 - tj) * r0[b] + tj * r0[b1]) + ti * ((1 - tj) * r1[b] + tj * r1[b1]);
     }
   }
   return out;
@@ -313,9 +312,10 @@ HoleFillResult FillHolesFromModel(const PointCloud& measured, const RuntimeOptio
     }
   result.ok = true;
   result.added_points = added;
-  result.message = lattice.description + "; " +
-                   (options.fill_follow_residuals ? field.description()
-                                                  : std::string("residual field not used (fill_follow_residuals: false)"));
+  result.message =
+      lattice.description + "; " +
+      (options.fill_follow_residuals ? field.description()
+                                     : std::string("residual field not used (fill_follow_residuals: false)"));
   return result;
 }
 

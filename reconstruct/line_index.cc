@@ -180,8 +180,8 @@ class LineIndexer {
     double sum = 0, sum2 = 0, sum_shift = 0;
     int n = 0;
     for (const Start& s : sample) {
-      const RowOffsetResult r =
-          RefineDisparityAndRowOffset(left_, right_, s.i % cols_, s.i / cols_, s.d + shift, s.slope_x, s.slope_y, tall_);
+      const RowOffsetResult r = RefineDisparityAndRowOffset(left_, right_, s.i % cols_, s.i / cols_, s.d + shift,
+                                                            s.slope_x, s.slope_y, tall_);
       if (!r.ok) continue;
       sum += r.row_offset_px, sum2 += r.row_offset_px * r.row_offset_px;
       sum_shift += r.disparity_px - s.d;
@@ -201,8 +201,8 @@ class LineIndexer {
   double MeanZncc(const std::vector<Start>& sample, double shift) const {
     double sum = 0;
     for (const Start& s : sample) {
-      const SubpixelResult r = RefineDisparity(left_, right_, s.i % cols_, s.i / cols_, s.d + shift, s.slope_x,
-                                               s.slope_y, accept_.subpixel);
+      const SubpixelResult r =
+          RefineDisparity(left_, right_, s.i % cols_, s.i / cols_, s.d + shift, s.slope_x, s.slope_y, accept_.subpixel);
       sum += r.ok ? r.zncc : 0.0;
     }
     return sum / double(sample.size());
@@ -347,9 +347,8 @@ class LineIndexer {
     // intercept over the step. Nearer than ambiguity_sigmas of it to the
     // midpoint between two alignments, neither is known: drop rather than
     // keep or move a component that may be a period off.
-    if (o_.ambiguity_sigmas > 0 && std::abs(zero_crossing - k) + o_.ambiguity_sigmas * here.standard_error_px /
-                                                                      std::abs(b) >
-                                       0.5) {
+    if (o_.ambiguity_sigmas > 0 &&
+        std::abs(zero_crossing - k) + o_.ambiguity_sigmas * here.standard_error_px / std::abs(b) > 0.5) {
       Drop(pixels);
       return Outcome::kDropped;
     }
@@ -377,8 +376,8 @@ class LineIndexer {
 }  // namespace
 
 std::map<std::pair<int, int>, std::vector<float>> SeamDifferences(const cv::Mat& labels, const cv::Mat& disparity_px,
-                                                                   const cv::Mat& slope_x, const cv::Mat& slope_y,
-                                                                   const cv::Rect& roi, int max_gap_px) {
+                                                                  const cv::Mat& slope_x, const cv::Mat& slope_y,
+                                                                  const cv::Rect& roi, int max_gap_px) {
   STEREORIG_CHECK(labels.type() == CV_32SC1 && disparity_px.type() == CV_32FC1 && labels.size() == disparity_px.size());
   STEREORIG_CHECK(slope_x.size() == disparity_px.size() && slope_y.size() == disparity_px.size());
   std::map<std::pair<int, int>, std::vector<float>> seams;

@@ -36,9 +36,9 @@
 namespace stereorig {
 
 struct LineIndexOptions {
-  bool enabled = true;                  // default true
-  int max_shift_px = 12;                // shifts tried: 2..max_shift_px either way, px; default 12 (> one ~8 px period)
-  int min_component_px = 20;            // smaller components are left to the speckle filter; default 20 px
+  bool enabled = true;        // default true
+  int max_shift_px = 12;      // shifts tried: 2..max_shift_px either way, px; default 12 (> one ~8 px period)
+  int min_component_px = 20;  // smaller components are left to the speckle filter; default 20 px
   // Pixels per component refined at each shift; default 48. With
   // lattice_sampling at least this many where the footprint holds as many
   // (48 to ~160 with the footprint's gap pixels), thinned to 2x at pitch <= 2.
@@ -121,7 +121,7 @@ struct LineIndexOptions {
   // 1 px; speckle 0.4 plate module 1: std 0.279 -> 0.143 mm, with the two
   // options above).
   double seam_spread_px = 2.0;
-  void Check() const;       // throws InputError naming the bad field
+  void Check() const;  // throws InputError naming the bad field
 };
 
 // The connected components of the disparity map (LabelDisparityComponents
@@ -129,9 +129,9 @@ struct LineIndexOptions {
 // the whole map costs about as much as one component's vernier test, and
 // the second run of both finds nothing to move on most captures.
 struct DisparityComponents {
-  cv::Mat labels;                               // CV_32SC1 of the image's size, -1 = none
-  std::vector<std::vector<int>> pixels;         // per label, as y * cols + x
-  bool matches_disparity = false;               // labels the disparity map as it is now
+  cv::Mat labels;                        // CV_32SC1 of the image's size, -1 = none
+  std::vector<std::vector<int>> pixels;  // per label, as y * cols + x
+  bool matches_disparity = false;        // labels the disparity map as it is now
 };
 
 // Revises `state` (disparity, confidence, status) inside `roi`. Returns the
@@ -168,7 +168,7 @@ cv::Mat LabelDisparityComponents(const cv::Mat& disparity_px, const cv::Rect& ro
 // order (the join takes their median and spread). All maps CV_32FC1 except
 // labels (CV_32SC1), one size.
 std::map<std::pair<int, int>, std::vector<float>> SeamDifferences(const cv::Mat& labels, const cv::Mat& disparity_px,
-                                                                   const cv::Mat& slope_x, const cv::Mat& slope_y,
-                                                                   const cv::Rect& roi, int max_gap_px);
+                                                                  const cv::Mat& slope_x, const cv::Mat& slope_y,
+                                                                  const cv::Rect& roi, int max_gap_px);
 
 }  // namespace stereorig

@@ -38,7 +38,8 @@ cv::Mat PlainLabels(const cv::Mat& d, const cv::Rect& roi, double max_step_px, s
         const cv::Point p = stack.back();
         stack.pop_back();
         listed.push_back(p.y * d.cols + p.x);
-        for (const cv::Point q : {p + cv::Point(-1, 0), p + cv::Point(1, 0), p + cv::Point(0, -1), p + cv::Point(0, 1)}) {
+        for (const cv::Point q :
+             {p + cv::Point(-1, 0), p + cv::Point(1, 0), p + cv::Point(0, -1), p + cv::Point(0, 1)}) {
           if (!roi.contains(q) || labels.at<int>(q) >= 0) continue;
           const float dn = d.at<float>(q);
           if (!std::isfinite(dn) || std::abs(dn - d.at<float>(p)) > max_step_px) continue;
@@ -53,9 +54,8 @@ cv::Mat PlainLabels(const cv::Mat& d, const cv::Rect& roi, double max_step_px, s
 
 // The seam collection before session 8: from every labelled pixel, the next
 // labelled pixel along its row and its column within max_gap_px + 1.
-std::map<std::pair<int, int>, std::vector<float>> PlainSeams(const cv::Mat& labels, const cv::Mat& d,
-                                                             const cv::Mat& gx, const cv::Mat& gy,
-                                                             const cv::Rect& roi, int max_gap_px) {
+std::map<std::pair<int, int>, std::vector<float>> PlainSeams(const cv::Mat& labels, const cv::Mat& d, const cv::Mat& gx,
+                                                             const cv::Mat& gy, const cv::Rect& roi, int max_gap_px) {
   std::map<std::pair<int, int>, std::vector<float>> seams;
   for (int y = roi.y; y < roi.y + roi.height; ++y)
     for (int x = roi.x; x < roi.x + roi.width; ++x) {

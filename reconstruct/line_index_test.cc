@@ -238,9 +238,9 @@ TEST(LineIndex, JoinReadsANoisySeamAsAPeriodJumpWithinAQuarterPeriod) {
 // samples (15 on the lattice: pitch 48) is not conclusive (standard error
 // ~0.1 px against the 0.1 px keep threshold and 0.18 px step) and is
 // dropped; reading one sample per 81 px (the 9 px lattice, ~290 of its
-// footprint: standard error ~4x smaller) it must be kept whole, over five noise seeds, and a large patch one period off must
-// still never be kept one period off (measured: moved, ~1200 of its 16 000
-// pixels pass the refinement's tests at 45 DN, none a period off).
+// footprint: standard error ~4x smaller) it must be kept whole, over five noise seeds, and a large patch one period off
+// must still never be kept one period off (measured: moved, ~1200 of its 16 000 pixels pass the refinement's tests at
+// 45 DN, none a period off).
 TEST(LineIndex, ReadingTheWholeFootprintKeepsALargeRightComponent) {
   int lost_small = 0, lost_whole = 0, kept_off_whole = 0;
   for (int seed = 1; seed <= 5; ++seed) {
@@ -317,9 +317,10 @@ TEST(LineIndex, LatticeSamplingKeepsTheDecisionWhenAComponentLosesAFewPixels) {
       }
     }
   }
-  std::printf("outcome flips in %d perturbed runs (2 patches each): lattice %d, raster rank %d; off patch kept off: "
-              "lattice %d, raster rank %d (of %d runs)\n",
-              runs, flips[0], flips[1], kept_off[0], kept_off[1], runs + 4);
+  std::printf(
+      "outcome flips in %d perturbed runs (2 patches each): lattice %d, raster rank %d; off patch kept off: "
+      "lattice %d, raster rank %d (of %d runs)\n",
+      runs, flips[0], flips[1], kept_off[0], kept_off[1], runs + 4);
   EXPECT_EQ(kept_off[0], 0);
   // Measured: lattice 0, raster rank 8. The lattice's perturbed samples are
   // its unperturbed ones less ~2 %: only a reading within that of its

@@ -62,8 +62,9 @@ cv::Mat LitMask(const cv::Mat& grey, double contrast_dn) {
     const __m256d vscale = _mm256_set1_pd(scale);
     const __m256 vthreshold = _mm256_set1_ps(threshold);
     auto means = [&](const std::vector<uint32_t>& p, int x0) {
-      const __m256i sums = _mm256_sub_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p.data() + x0 + kWindow)),
-                                            _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p.data() + x0)));
+      const __m256i sums =
+          _mm256_sub_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p.data() + x0 + kWindow)),
+                           _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p.data() + x0)));
       const __m128 lo = _mm256_cvtpd_ps(_mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_castsi256_si128(sums)), vscale));
       const __m128 hi = _mm256_cvtpd_ps(_mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_extracti128_si256(sums, 1)), vscale));
       return _mm256_set_m128(hi, lo);

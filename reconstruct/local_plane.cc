@@ -137,12 +137,12 @@ bool SumExact(const cv::Mat& disparity, const ValidityBits& valid, cv::Point q, 
       suu = _mm256_add_epi32(suu, _mm256_mullo_epi32(u, u));
       suv = _mm256_add_epi32(suv, _mm256_mullo_epi32(u, vv));
       const __m256 a = _mm256_andnot_ps(sign, d);
-      outside = _mm256_or_ps(outside, _mm256_or_ps(_mm256_and_ps(_mm256_cmp_ps(a, low, _CMP_LT_OQ),
-                                                                 _mm256_cmp_ps(a, zero, _CMP_NEQ_OQ)),
-                                                   _mm256_cmp_ps(a, high, _CMP_GE_OQ)));
+      outside = _mm256_or_ps(
+          outside, _mm256_or_ps(_mm256_and_ps(_mm256_cmp_ps(a, low, _CMP_LT_OQ), _mm256_cmp_ps(a, zero, _CMP_NEQ_OQ)),
+                                _mm256_cmp_ps(a, high, _CMP_GE_OQ)));
       const __m256 ud = _mm256_mul_ps(_mm256_cvtepi32_ps(u), d), vd = _mm256_mul_ps(fv, d);
-      sd = _mm256_add_pd(sd, _mm256_add_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(d)),
-                                           _mm256_cvtps_pd(_mm256_extractf128_ps(d, 1))));
+      sd = _mm256_add_pd(
+          sd, _mm256_add_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(d)), _mm256_cvtps_pd(_mm256_extractf128_ps(d, 1))));
       sxd = _mm256_add_pd(sxd, _mm256_add_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(ud)),
                                              _mm256_cvtps_pd(_mm256_extractf128_ps(ud, 1))));
       syd = _mm256_add_pd(syd, _mm256_add_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(vd)),

@@ -104,8 +104,8 @@ TEST(LocalPlane, EqualsTheEigenFitBitForBitOnRandomWindows) {
     for (int y = 0; y < disparity.rows; ++y)
       for (int x = 0; x < disparity.cols; ++x)
         disparity.at<float>(y, x) = rng.uniform(0.0, 1.0) < density ? RandomDisparity(rng, regime)
-                                    : rng.uniform(0, 2)                ? kInf
-                                                                       : kNaN;
+                                    : rng.uniform(0, 2)             ? kInf
+                                                                    : kNaN;
     // Rois ending at the image's last column and row too (the fit's
     // reads there must stay inside).
     const int x0 = rng.uniform(0, 70), y0 = rng.uniform(0, 30);
@@ -123,8 +123,8 @@ TEST(LocalPlane, EqualsTheEigenFitBitForBitOnRandomWindows) {
       if (!got) continue;
       ++fitted;
       ASSERT_TRUE(SameBits(plane.disparity_px, a) && SameBits(plane.slope_x, gx) && SameBits(plane.slope_y, gy))
-          << "trial " << trial << " q " << q << " r " << r << ": " << plane.disparity_px << " " << plane.slope_x
-          << " " << plane.slope_y << " vs " << a << " " << gx << " " << gy;
+          << "trial " << trial << " q " << q << " r " << r << ": " << plane.disparity_px << " " << plane.slope_x << " "
+          << plane.slope_y << " vs " << a << " " << gx << " " << gy;
     }
   }
   EXPECT_GT(fitted, compared / 2);  // most windows fit: the comparison is not vacuous

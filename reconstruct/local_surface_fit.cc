@@ -4,9 +4,9 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <opencv2/imgproc.hpp>
 #include <optional>
 #include <string>
-#include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "calib/core/input_error.h"
@@ -54,10 +54,9 @@ struct Factor6 {
 };
 
 // Factors the symmetric a (lower triangle read): false if it is not
-// positive definite. Written out at this fixed size (unrolled) rather than with Eigen::LLT, whose generic blocked code and L1 norm
-// cost ~860 instructions per 6x6 factorisation and ~350 per pair of solves;
-// on the demo cup two thirds of the fitted windows have holes and need
-// their own (docs/reconstruct.md, "The refinement steps' instruction count").
+// positive definite. Written out at this fixed size (unrolled) rather than with Eigen::LLT, whose generic blocked code
+// and L1 norm cost ~860 instructions per 6x6 factorisation and ~350 per pair of solves; on the demo cup two thirds of
+// the fitted windows have holes and need their own (docs/reconstruct.md, "The refinement steps' instruction count").
 inline bool Factor(const Matrix6& a, Factor6* f) {
 #pragma GCC unroll 6
   for (int j = 0; j < kTerms; ++j) {
@@ -189,7 +188,8 @@ FitMaps FitQuadrics(const cv::Mat& mask, const cv::Mat& values, int hw, int hh, 
       const cv::Mat row = RowMoment(band_values, row_taps[i]);
       for (int j = 0; i + j <= 2; ++j) value_moment[i][j] = ColumnMoment(row, column_taps[j], out_rows);
     }
-    const cv::Mat squares = ColumnMoment(RowMoment(band_values.mul(band_values), row_taps[0]), column_taps[0], out_rows);
+    const cv::Mat squares =
+        ColumnMoment(RowMoment(band_values.mul(band_values), row_taps[0]), column_taps[0], out_rows);
     ParallelForChunks(y1 - y0, num_threads, [&](int b, int e) {
       for (int y = y0 + b; y < y0 + e; ++y) {
         const float* valid = mask.ptr<float>(y);
@@ -289,8 +289,8 @@ int FitLocalSurface(const cv::Rect& roi_in, const SurfaceFitOptions& o, int num_
   std::optional<FitMaps> wide;
   if (o.reference_misfit_px > 0 && own.median_misfit_px > o.reference_misfit_px) {
     const double ratio = own.median_misfit_px / o.reference_misfit_px;
-    const double grow = std::min({ratio * ratio, double(kMaxHalfSizePx) / o.half_width_px,
-                                  double(kMaxHalfSizePx) / o.half_height_px});
+    const double grow =
+        std::min({ratio * ratio, double(kMaxHalfSizePx) / o.half_width_px, double(kMaxHalfSizePx) / o.half_height_px});
     const int hw = int(std::lround(o.half_width_px * grow)), hh = int(std::lround(o.half_height_px * grow));
     if (hw != o.half_width_px || hh != o.half_height_px) {
       wide = FitQuadrics(mask, values, hw, hh, o, num_threads);

@@ -88,7 +88,7 @@ struct SurfaceFitOptions {
 
 // What a fit did, for the reconstruction report.
 struct SurfaceFitSummary {
-  int replaced = 0;            // pixels that took a fit
+  int replaced = 0;             // pixels that took a fit
   double median_misfit_px = 0;  // of the options' window; 0 if nothing was fitted
   // The options' window, or the grown one when the second pass ran.
   int half_width_px = 0, half_height_px = 0;

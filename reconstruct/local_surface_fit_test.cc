@@ -37,7 +37,7 @@ TEST(LocalSurfaceFit, KeepsAQuadricAndCutsIndependentNoiseAsPredicted) {
       d.at<float>(y, x) = float(Quadric(x, y) + noise(rng));
     }
   cv::Mat clean = truth.clone();
-  SurfaceFitOptions options;  // 21 x 11
+  SurfaceFitOptions options;        // 21 x 11
   options.reference_misfit_px = 0;  // that window alone (the noise is above the reference: it would grow)
   // At least every pixel whose window only one image edge cuts (at most
   // half a window: up to 3.2x / 4.1x a full window's variance, within

@@ -4,9 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <optional>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 
 #include "calib/core/input_error.h"
 #include "reconstruct/dense_refine.h"
@@ -193,9 +193,8 @@ bool OccupiedBand(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
   cv::Mat lh, rh;
   cv::resize(left, lh, cv::Size(left.cols / 2, left.rows / ys), 0, 0, cv::INTER_AREA);
   cv::resize(right, rh, cv::Size(right.cols / 2, right.rows / ys), 0, 0, cv::INTER_AREA);
-  const cv::Rect half =
-      cv::Rect(roi.x / 2, roi.y / ys, std::max(1, roi.width / 2), std::max(1, roi.height / ys)) &
-      cv::Rect(0, 0, lh.cols, lh.rows);
+  const cv::Rect half = cv::Rect(roi.x / 2, roi.y / ys, std::max(1, roi.width / 2), std::max(1, roi.height / ys)) &
+                        cv::Rect(0, 0, lh.cols, lh.rows);
   MatchOptions band_options = o;
   band_options.sgm.num_paths = o.band_sgm_paths;
   cv::Mat d = MatchLevel(lh, rh, half, int(std::floor(*dmin / 2.0)) - 1, (*num + 1) / 2 + 3, 0, band_options);
@@ -312,7 +311,8 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
         if (o.max_plane_deviation_px > 0 && std::isnan(pl)) return PixelStatus::kNoPlane;
         // The plane test below, applied early to the cost-fit disparity (the
         // refinement moves it by < max_shift_px): saves refining mismatches.
-        if (o.max_plane_deviation_px > 0 && std::abs(double(in[xx]) - pl) > o.max_plane_deviation_px + o.subpixel.max_shift_px)
+        if (o.max_plane_deviation_px > 0 &&
+            std::abs(double(in[xx]) - pl) > o.max_plane_deviation_px + o.subpixel.max_shift_px)
           return PixelStatus::kOffPlaneCoarse;
         return PixelStatus::kPoint;
       };

@@ -28,8 +28,8 @@
 #pragma once
 
 #include <map>
-#include <optional>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 
 #include "reconstruct/census_sgm.h"
@@ -84,7 +84,7 @@ struct MatchOptions {
   // with the vernier and wrong-line drops: still (demo ball bar module 0 std
   // 0.069 -> 0.152 mm, seed 7 ball bar module 1 0.080 -> 0.455).
   int guided_radius_px = 0;
-  int refine_radius_px = 2;  // census_sgm: fine-level search +-radius around 2x coarse; default 2
+  int refine_radius_px = 2;          // census_sgm: fine-level search +-radius around 2x coarse; default 2
   int refine_half_window_px = 1;     // census_sgm: fine-level cost box half size; default 1 (3x3)
   int census_half_width_px = 2;      // census_sgm: census window half width (<= 4); default 2 (5 px: tolerates
                                      // foreshortening, cup fill 47% -> 73% vs 9 px)
@@ -136,11 +136,11 @@ struct MatchOptions {
   // has no data (RightViewValidMask); empty = every column valid. The
   // runtime sets it from its remap tables. Default empty.
   cv::Mat right_valid;
-  int speckle_window_px = 100;     // remove disparity blobs smaller than this, px (0 = off); default 100
-  double speckle_range_px = 1.0;   // neighbours within this disparity are one blob, px; default 1
-  int sgbm_block_size = 5;         // opencv_sgbm_3way: block size, px (odd); default 5
-  int num_threads = 2;             // threads for row-parallel steps; default 2
-  void Check() const;              // throws InputError naming the bad field
+  int speckle_window_px = 100;    // remove disparity blobs smaller than this, px (0 = off); default 100
+  double speckle_range_px = 1.0;  // neighbours within this disparity are one blob, px; default 1
+  int sgbm_block_size = 5;        // opencv_sgbm_3way: block size, px (odd); default 5
+  int num_threads = 2;            // threads for row-parallel steps; default 2
+  void Check() const;             // throws InputError naming the bad field
 };
 
 struct MatchResult {

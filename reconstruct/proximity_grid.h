@@ -33,8 +33,8 @@ class ProximityGrid {
   double cell_mm_ = 1;
   Eigen::Vector3d origin_mm_ = Eigen::Vector3d::Zero();  // the bounding box's minimum corner
   int nx_ = 0, ny_ = 0, nz_ = 0;
-  std::vector<int> cell_start_;            // (nx*ny*nz + 1): cell c's points are [start[c], start[c+1])
-  std::vector<Eigen::Vector3f> points_;    // sorted by cell
+  std::vector<int> cell_start_;          // (nx*ny*nz + 1): cell c's points are [start[c], start[c+1])
+  std::vector<Eigen::Vector3f> points_;  // sorted by cell
 };
 
 }  // namespace stereorig

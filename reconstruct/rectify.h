@@ -48,8 +48,7 @@ RectifiedGeometry ComputeRectification(const Camera& left, const Camera& right, 
 // pixel -> original pixel. Pixels whose ray does not project (behind a lens)
 // get -1 (outside the image, so remap fills them with 0).
 enum class RectifiedView { kLeft, kRight };
-void BuildRectifyMap(const RectifiedGeometry& g, const Camera& cam, RectifiedView view, cv::Mat* map_x,
-                     cv::Mat* map_y);
+void BuildRectifyMap(const RectifiedGeometry& g, const Camera& cam, RectifiedView view, cv::Mat* map_x, cv::Mat* map_y);
 
 // Both views' tables in cv::convertMaps fixed point (CV_16SC2 + CV_16UC1, the
 // fast cv::remap form, 1/32 px), the form the runtime keeps: 6 bytes a pixel

@@ -154,7 +154,8 @@ int GrowDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
       }
       if (why != PixelStatus::kPoint) {
         state->status.at<uint8_t>(q) = uint8_t(why);  // the reason growing could not reach it
-        memory->failed_.push_back({predicted, qgx, qgy, latest, int8_t(from.x), int8_t(from.y), uint8_t(why), enclosed});
+        memory->failed_.push_back(
+            {predicted, qgx, qgy, latest, int8_t(from.x), int8_t(from.y), uint8_t(why), enclosed});
         latest = int32_t(memory->failed_.size());
         continue;
       }

@@ -6,12 +6,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <limits>
 #include <vector>
-#include <algorithm>
 
 #include "reconstruct/synthetic_pair.h"
 
@@ -270,8 +270,8 @@ TEST(RegionGrow, NoiseDerivedZnccFloorFillsMoreOfANoisyPlaneOnTheTruth) {
       }
       for (double w : taps) sum2 += (w / sum) * (w / sum);
       const double clean_var = sd[0] * sd[0], noise_var = spec.noise_sigma_dn * spec.noise_sigma_dn;
-      analytic_decorrelation.push_back(1 - clean_var / std::sqrt((clean_var + noise_var) *
-                                                                 (clean_var + sum2 * noise_var)));
+      analytic_decorrelation.push_back(1 -
+                                       clean_var / std::sqrt((clean_var + noise_var) * (clean_var + sum2 * noise_var)));
       if (Accept(pair.left, pair.right, x, y, spec.du, spec.dv, r, accept) != PixelStatus::kPoint) continue;
       seeds.disparity_px.at<float>(y, x) = float(r.disparity_px);
       seeds.confidence.at<float>(y, x) = float(r.zncc);
@@ -293,8 +293,8 @@ TEST(RegionGrow, NoiseDerivedZnccFloorFillsMoreOfANoisyPlaneOnTheTruth) {
   off.noise_zncc_factor = 0;
   EXPECT_EQ(GrowMinZncc(seeds.disparity_px, seeds.confidence, roi, off, accept.min_zncc), accept.min_zncc);
   auto grow = [&](double min_zncc, int* filled, double* rms, double* worst) {
-    DisparityState s{seeds.disparity_px.clone(), seeds.confidence.clone(), seeds.status.clone(),
-                     seeds.slope_x.clone(), seeds.slope_y.clone()};
+    DisparityState s{seeds.disparity_px.clone(), seeds.confidence.clone(), seeds.status.clone(), seeds.slope_x.clone(),
+                     seeds.slope_y.clone()};
     RefineAcceptance a = accept;
     a.min_zncc = min_zncc;
     GrowDisparity(pair.left, pair.right, roi, GrowOptions{}, a, &s);
@@ -315,8 +315,10 @@ TEST(RegionGrow, NoiseDerivedZnccFloorFillsMoreOfANoisyPlaneOnTheTruth) {
   double rms_off = 0, rms_on = 0, worst_off = 0, worst_on = 0;
   grow(accept.min_zncc, &filled_off, &rms_off, &worst_off);
   grow(floor, &filled_on, &rms_on, &worst_on);
-  std::printf("floor %.3f from the seeds, %.3f from all (analytic %.3f); filled %d -> %d of %d, rms %.3f -> %.3f px, worst %.2f -> %.2f px\n", floor,
-              measured_floor, analytic_floor, filled_off, filled_on, roi.area(), rms_off, rms_on, worst_off, worst_on);
+  std::printf(
+      "floor %.3f from the seeds, %.3f from all (analytic %.3f); filled %d -> %d of %d, rms %.3f -> %.3f px, worst "
+      "%.2f -> %.2f px\n",
+      floor, measured_floor, analytic_floor, filled_off, filled_on, roi.area(), rms_off, rms_on, worst_off, worst_on);
   // The decorrelation measured from the fits' ZNCC against the analytic one
   // (median over ~1500 lattice pixels; a single 27-sample ZNCC scatters by
   // ~0.05, the median far less): the fit maximises the ZNCC over the

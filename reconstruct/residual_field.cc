@@ -124,8 +124,7 @@ ResidualField ResidualField::Fit(const std::vector<Eigen::Vector3d>& points_mm, 
   const Eigen::Matrix3Xd x = CellMeans(all, y_all, o.max_points, &y, &w);
   // Hyperparameters by marginal likelihood on a coarser subsample.
   const Eigen::Matrix3Xd x_ml = CellMeans(all, y_all, o.max_likelihood_points, &y_ml, &w_ml);
-  const std::vector<double> lengths =
-      o.length_mm > 0 ? std::vector<double>{o.length_mm} : o.candidate_lengths_mm;
+  const std::vector<double> lengths = o.length_mm > 0 ? std::vector<double>{o.length_mm} : o.candidate_lengths_mm;
   double best = -std::numeric_limits<double>::infinity(), best_length = lengths.front(),
          best_ratio = o.candidate_noise_ratios.back(), best_signal_var = 0;
   for (double l : lengths) {

@@ -44,12 +44,12 @@ namespace stereorig {
 
 struct ResidualFieldOptions {
   double length_mm = 0;  // kernel length scale; 0 (default) = chosen by marginal likelihood
-  std::vector<double> candidate_lengths_mm = {6, 8.5, 12, 17, 24, 30};  // default: 6-30 mm, x1.4 steps
+  std::vector<double> candidate_lengths_mm = {6, 8.5, 12, 17, 24, 30};         // default: 6-30 mm, x1.4 steps
   std::vector<double> candidate_noise_ratios = {0.003, 0.01, 0.03, 0.1, 0.3};  // n^2 / s^2
-  int max_points = 1000;             // cell means the field is fitted on (at most); default 1000
-  int max_likelihood_points = 400;   // cell means the hyperparameters are chosen on; default 400
-  double min_rms_mm = 0.1;           // residual rms below which the field is off; default 0.1 mm
-  double outlier_mads = 5;           // residual cut, in robust sigmas about the median; default 5
+  int max_points = 1000;            // cell means the field is fitted on (at most); default 1000
+  int max_likelihood_points = 400;  // cell means the hyperparameters are chosen on; default 400
+  double min_rms_mm = 0.1;          // residual rms below which the field is off; default 0.1 mm
+  double outlier_mads = 5;          // residual cut, in robust sigmas about the median; default 5
 };
 
 class ResidualField {

@@ -152,7 +152,7 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const cv::Rect& r = match_roi;
   cv::Mat grid(r.size(), CV_32FC3, cv::Scalar(nan, nan, nan));  // grid(y - r.y, x - r.x)
-  std::vector<cv::Point> kept;                                    // image pixels of grid's points, row-major
+  std::vector<cv::Point> kept;                                  // image pixels of grid's points, row-major
   const Eigen::Vector3d lo = volume_center_mm_ - 0.5 * options_.volume_size_mm;
   const Eigen::Vector3d hi = volume_center_mm_ + 0.5 * options_.volume_size_mm;
   const Eigen::Matrix3d r_ref = plan.reference_from_module.rotation();

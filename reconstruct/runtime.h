@@ -54,7 +54,7 @@ struct ModuleReport {
   // that dropped it (for scoring the fill against truth and finding where it
   // is lost, reconstruct/fill_score.h).
   cv::Mat status;
-  std::map<std::string, double> times_ms;  // rectify, lit_region, match, triangulate, normals, mesh
+  std::map<std::string, double> times_ms;        // rectify, lit_region, match, triangulate, normals, mesh
   std::optional<SurfaceFitSummary> surface_fit;  // the matcher's (matcher.h), if the fit ran
 };
 

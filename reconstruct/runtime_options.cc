@@ -119,8 +119,7 @@ RuntimeOptions FromYaml(YamlMap& y) {
         m.GetDouble("line_index_min_row_offset_step_px", mo.line_index.min_row_offset_step_px);
     mo.line_index.drop_row_offset_px = m.GetDouble("line_index_drop_row_offset_px", mo.line_index.drop_row_offset_px);
     mo.line_index.footprint_gap_px = m.GetInt("line_index_footprint_gap_px", mo.line_index.footprint_gap_px);
-    mo.line_index.area_per_sample_px =
-        m.GetInt("line_index_area_per_sample_px", mo.line_index.area_per_sample_px);
+    mo.line_index.area_per_sample_px = m.GetInt("line_index_area_per_sample_px", mo.line_index.area_per_sample_px);
     mo.line_index.ambiguity_sigmas = m.GetDouble("line_index_ambiguity_sigmas", mo.line_index.ambiguity_sigmas);
     mo.grow.enabled = m.GetBool("grow", mo.grow.enabled);
     mo.grow.max_deviation_px = m.GetDouble("grow_max_deviation_px", mo.grow.max_deviation_px);

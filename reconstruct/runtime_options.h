@@ -49,7 +49,7 @@ struct RuntimeOptions {
   // the fill should follow. 0 (default) = chosen from the data by marginal
   // likelihood over 6-30 mm.
   double fill_residual_length_mm = 0;
-  bool parallel_modules = true;                // process modules on separate threads; default true
+  bool parallel_modules = true;  // process modules on separate threads; default true
 
   void Check() const;  // throws InputError naming the bad key
 };

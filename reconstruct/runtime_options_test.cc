@@ -1,6 +1,5 @@
-// Runtime options: the hole-filling, surface-fit, line-index ambiguity, sub-pixel column-step, band-pass and strong-speckle
-// keys are read, defaulted and checked
-// (a bad value or an unknown key is an InputError naming it).
+// Runtime options: the hole-filling, surface-fit, line-index ambiguity, sub-pixel column-step, band-pass and
+// strong-speckle keys are read, defaulted and checked (a bad value or an unknown key is an InputError naming it).
 #include "reconstruct/runtime_options.h"
 
 #include <gtest/gtest.h>
@@ -72,8 +71,8 @@ TEST(RuntimeOptions, ReadsAndChecksTheLineIndexAmbiguityKeys) {
   const RuntimeOptions d = ParseRuntimeOptions("min_confidence: 0.5\n", "defaults.yaml");
   EXPECT_EQ(d.match.line_index.footprint_gap_px, 8);
   EXPECT_EQ(d.match.line_index.ambiguity_sigmas, 1.0);
-  const RuntimeOptions o = ParseRuntimeOptions(
-      "match:\n  line_index_footprint_gap_px: 0\n  line_index_ambiguity_sigmas: 2.5\n", "set.yaml");
+  const RuntimeOptions o =
+      ParseRuntimeOptions("match:\n  line_index_footprint_gap_px: 0\n  line_index_ambiguity_sigmas: 2.5\n", "set.yaml");
   EXPECT_EQ(o.match.line_index.footprint_gap_px, 0);
   EXPECT_EQ(o.match.line_index.ambiguity_sigmas, 2.5);
   const std::pair<const char*, const char*> bad[] = {
@@ -87,11 +86,10 @@ TEST(RuntimeOptions, ReadsAndChecksTheLineIndexAmbiguityKeys) {
 TEST(RuntimeOptions, ReadsAndChecksTheSubpixelColumnStep) {
   EXPECT_EQ(ParseRuntimeOptions("min_confidence: 0.5\n", "defaults.yaml").match.subpixel_column_step, 1);
   EXPECT_EQ(ParseRuntimeOptions("match:\n  subpixel_column_step: 3\n", "set.yaml").match.subpixel_column_step, 3);
-  const std::pair<const char*, const char*> bad[] = {
-      {"match:\n  subpixel_column_step: 0\n", "subpixel_column_step"},
-      {"match:\n  subpixel_column_step: 5\n", "subpixel_column_step"},
-      {"match:\n  subpixel_column_step: 1.5\n", "subpixel_column_step"},
-      {"match:\n  subpixel_column_steps: 2\n", "subpixel_column_steps"}};
+  const std::pair<const char*, const char*> bad[] = {{"match:\n  subpixel_column_step: 0\n", "subpixel_column_step"},
+                                                     {"match:\n  subpixel_column_step: 5\n", "subpixel_column_step"},
+                                                     {"match:\n  subpixel_column_step: 1.5\n", "subpixel_column_step"},
+                                                     {"match:\n  subpixel_column_steps: 2\n", "subpixel_column_steps"}};
   ExpectEachRejectedNamingItsKey(bad);
 }
 

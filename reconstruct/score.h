@@ -39,10 +39,10 @@ struct FillBand {
 };
 
 struct CloudScore {
-  Pose truth_from_cloud;                 // the best rigid alignment
-  ErrorFigures all;                      // measured points (filled ones excluded)
-  std::vector<ErrorFigures> per_module;  // index = module
-  ErrorFigures filled;                   // hole-filling points (module kFilledModule), if any
+  Pose truth_from_cloud;                     // the best rigid alignment
+  ErrorFigures all;                          // measured points (filled ones excluded)
+  std::vector<ErrorFigures> per_module;      // index = module
+  ErrorFigures filled;                       // hole-filling points (module kFilledModule), if any
   std::vector<FillBand> filled_by_distance;  // the same by distance to the nearest measured point: 0-5, 5-15, >= 15 mm
 };
 

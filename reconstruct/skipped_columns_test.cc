@@ -29,7 +29,7 @@ TEST(SkippedColumns, InterpolatesOnlyBetweenAcceptedNeighboursOnTheSlope) {
   float conf = 0;
   ASSERT_TRUE(InterpolateSkippedColumn(d, c, s, 10, 11, 13, 0.1, &out, &conf));
   EXPECT_NEAR(out, 40.0 + 0.5 / 3, 1e-5);  // a third of the way
-  EXPECT_FLOAT_EQ(conf, 0.9f);              // the lower of the two
+  EXPECT_FLOAT_EQ(conf, 0.9f);             // the lower of the two
   ASSERT_TRUE(InterpolateSkippedColumn(d, c, s, 10, 12, 13, 0.1, &out, &conf));
   EXPECT_NEAR(out, 40.0 + 2 * 0.5 / 3, 1e-5);
   // A step beyond the slope (a depth edge, a grid period): no value.

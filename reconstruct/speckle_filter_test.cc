@@ -5,10 +5,10 @@
 
 #include <gtest/gtest.h>
 
-#include <opencv2/calib3d.hpp>
 #include <cmath>
 #include <iterator>
 #include <limits>
+#include <opencv2/calib3d.hpp>
 #include <random>
 #include <tuple>
 
@@ -86,9 +86,17 @@ TEST(RemoveSpeckleBlobs, MatchesRoundingThenOpenCvFilter) {
   std::mt19937 rng(3);
   std::uniform_int_distribution<int> percent(0, 99);
   std::uniform_real_distribution<float> level(-30, 30), jitter(-0.08f, 0.08f);
-  const float specials[] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
-                            -std::numeric_limits<float>::infinity(), -0.0f, 0.0f, 2500.0f, -2500.0f,
-                            1.0f / 32, -1.0f / 32, 3.0f / 32, -5.0f / 32};
+  const float specials[] = {std::numeric_limits<float>::quiet_NaN(),
+                            std::numeric_limits<float>::infinity(),
+                            -std::numeric_limits<float>::infinity(),
+                            -0.0f,
+                            0.0f,
+                            2500.0f,
+                            -2500.0f,
+                            1.0f / 32,
+                            -1.0f / 32,
+                            3.0f / 32,
+                            -5.0f / 32};
   int kept = 0, removed = 0;
   for (const cv::Size size : {cv::Size(101, 37), cv::Size(7, 5), cv::Size(16, 9)})
     for (const int max_blob : {3, 20}) {
@@ -109,7 +117,7 @@ TEST(RemoveSpeckleBlobs, MatchesRoundingThenOpenCvFilter) {
       cv::filterSpeckles(fixed, kInvalid, max_blob, 16);
       expected.setTo(std::numeric_limits<float>::infinity(), fixed == kInvalid);
       cv::Mat got = map.clone();
-      RemoveSpeckleBlobs(got, max_blob, 1.0);  // 16 sixteenths
+      RemoveSpeckleBlobs(got, max_blob, 1.0);                                           // 16 sixteenths
       ASSERT_EQ(cv::countNonZero(got != expected), 0) << size << " blob " << max_blob;  // NaN != NaN: none left
       kept += cv::countNonZero(got == map);  // finite values kept are untouched (NaN != NaN)
       removed += cv::countNonZero((got != map) & (map == map));
@@ -126,9 +134,9 @@ TEST(RemoveSpeckleBlobs, MatchesRoundingThenOpenCvFilter) {
 // scalar tail.
 TEST(RemoveSpeckleBlobs, RoundsHalvesAwayFromZeroAndClamps) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  for (const auto& [a, b, joined] : {std::tuple{0.0f, 16.5f / 16, false}, std::tuple{0.0f, -16.5f / 16, false},
-                                     std::tuple{0.0f, 15.5f / 16, true}, std::tuple{0.0f, -15.5f / 16, true},
-                                     std::tuple{2001.0f, 2500.0f, true}, std::tuple{-2500.0f, -2001.0f, true}})
+  for (const auto& [a, b, joined] :
+       {std::tuple{0.0f, 16.5f / 16, false}, std::tuple{0.0f, -16.5f / 16, false}, std::tuple{0.0f, 15.5f / 16, true},
+        std::tuple{0.0f, -15.5f / 16, true}, std::tuple{2001.0f, 2500.0f, true}, std::tuple{-2500.0f, -2001.0f, true}})
     for (const int x : {0, 9, 17}) {
       cv::Mat row(1, 20, CV_32FC1, cv::Scalar(nan));
       row.at<float>(0, x) = a;

@@ -5,10 +5,10 @@
 // test time, by tests/reference/mrcal_project.py.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <cstdio>
 #include <fstream>
 #include <random>
-#include <unistd.h>
 #include <sstream>
 
 #include "calib/core/camera.h"

@@ -202,8 +202,8 @@ TEST_F(ReconstructCli, ABatchWritesEachCapturesOwnCloudAndSkipsABrokenOne) {
   WriteFileAtomically(batch + "/0002/cam1.png", "not a png");  // found only when decoded
   const std::string out = dir_ + "/batch_out";
   std::filesystem::remove_all(out);
-  EXPECT_EQ(RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + batch + "/0001 " + batch + "/0002 " +
-                   batch + "/0003 --out-dir " + out + " --mesh-format stl --report " + out + "/batch.json"),
+  EXPECT_EQ(RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + batch + "/0001 " + batch + "/0002 " + batch +
+                   "/0003 --out-dir " + out + " --mesh-format stl --report " + out + "/batch.json"),
             2);
   auto bytes = [](const std::string& path) {
     std::ifstream f(path, std::ios::binary);

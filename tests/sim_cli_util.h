@@ -28,5 +28,4 @@ std::string Slurp(const std::string& p) {
   return s.str();
 }
 
-
 }  // namespace sim_cli
