@@ -14,7 +14,9 @@ nlohmann::json ReconstructionJson(const Reconstruction& rec) {
                          {"lit_pixels_filled", m.lit_filled},
                          {"fill_rate", m.fill_rate()},
                          {"match_roi_px", {m.match_roi.x, m.match_roi.y, m.match_roi.width, m.match_roi.height}},
-                         {"disparity_range_px", {m.min_disparity_px, m.min_disparity_px + m.num_disparities}}};
+                         {"disparity_range_px", {m.min_disparity_px, m.min_disparity_px + m.num_disparities}},
+                         {"searched_disparity_px",
+                          {m.searched_min_disparity_px, m.searched_min_disparity_px + m.searched_num_disparities}}};
     for (const auto& [step, ms] : m.times_ms) mj["time_ms"][step] = ms;
     if (m.surface_fit)
       mj["surface_fit"] = {{"window_px", {2 * m.surface_fit->half_width_px + 1, 2 * m.surface_fit->half_height_px + 1}},

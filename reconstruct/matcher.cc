@@ -274,6 +274,8 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
   cv::Mat guide_px;
   if (!sgbm && o.narrow_range && o.pyramid_levels == 0) OccupiedBand(left, right, roi, o, &dmin, &num, &guide_px);
   if (!sgbm) lap("band");
+  result.searched_min_disparity_px = dmin;
+  result.searched_num_disparities = num;
   const cv::Mat coarse_to_fine = sgbm ? SgbmRegion(left, right, roi, o, SgbmFilters{o.sgm.uniqueness_percent, 0, 0})
                                       : MatchLevel(left, right, roi, dmin, num, o.pyramid_levels, o, guide_px);
   lap(sgbm ? "sgbm" : "sgm");
@@ -465,6 +467,8 @@ MatchResult MatchOpenCvSgbm(const cv::Mat& left, const cv::Mat& right, const cv:
       left, right, roi, o, SgbmFilters{10, o.speckle_window_px, std::max(1, int(std::lround(o.speckle_range_px)))});
   MatchResult result;
   result.times_ms["sgbm"] = MsSince(t0);
+  result.searched_min_disparity_px = o.min_disparity_px;
+  result.searched_num_disparities = o.num_disparities;
   result.disparity_px = cv::Mat(left.size(), CV_32FC1, cv::Scalar(kInf));
   result.confidence = cv::Mat(left.size(), CV_32FC1, cv::Scalar(0));
   result.status = cv::Mat(left.size(), CV_8UC1, cv::Scalar(uint8_t(PixelStatus::kNotSearched)));

@@ -159,6 +159,12 @@ struct MatchResult {
   // fit), "speckle"; opencv_sgbm_3way: "sgbm"
   // in place of "band" and "sgm".
   std::map<std::string, double> times_ms;
+  // The disparities searched at full resolution, [min, min + num) px:
+  // census_sgm with narrow_range, the occupied band the half-resolution pass
+  // found (or the whole range if it found none); otherwise the whole
+  // options.min_disparity_px / num_disparities range.
+  int searched_min_disparity_px = 0;
+  int searched_num_disparities = 0;
   // The local surface fit's window and misfit, if it ran (MatchOptions::surface_fit).
   std::optional<SurfaceFitSummary> surface_fit;
 };

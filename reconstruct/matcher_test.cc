@@ -193,6 +193,40 @@ TEST(Matcher, CheaperBandPassesStillBracketTheTruth) {
   }
 }
 
+TEST(Matcher, ReportsTheDisparitiesItSearched) {
+  // The slanted plane's true disparities: 40 + 0.04 x + 0.015 y over
+  // 320 x 240, 40 to 56.3 px. The occupied band the half-resolution pass
+  // finds must hold them and lie inside the 96 px given; without the
+  // band pass, and with OpenCV SGBM, the whole given range is searched.
+  const SyntheticPair pair = RenderSyntheticPair(SyntheticPairSpec{});
+  double truth_lo = 1e9, truth_hi = -1e9;
+  cv::minMaxLoc(pair.true_disparity_px, &truth_lo, &truth_hi);
+  ASSERT_GT(truth_hi - truth_lo, 16);  // the slanted plane, not a flat one
+  MatchOptions o = Options(MatcherKind::kCensusSgm);
+  o.min_disparity_px = 8;
+  o.num_disparities = 96;
+  const MatchResult banded = Match(pair.left, pair.right, o);
+  std::printf("band [%d, %d) for truth [%.2f, %.2f]\n", banded.searched_min_disparity_px,
+              banded.searched_min_disparity_px + banded.searched_num_disparities, truth_lo, truth_hi);
+  EXPECT_LE(banded.searched_min_disparity_px, truth_lo);
+  EXPECT_GE(banded.searched_min_disparity_px + banded.searched_num_disparities - 1, truth_hi);
+  EXPECT_GE(banded.searched_min_disparity_px, o.min_disparity_px);
+  // Measured [8, 72): narrower than the range, though not by much on this
+  // synthetic grid (the coarse pass also matches it whole periods off).
+  EXPECT_LT(banded.searched_num_disparities, o.num_disparities);
+  o.narrow_range = false;
+  const MatchResult whole = Match(pair.left, pair.right, o);
+  EXPECT_EQ(whole.searched_min_disparity_px, 8);
+  EXPECT_EQ(whole.searched_num_disparities, 96);
+  for (const MatcherKind kind : {MatcherKind::kOpenCvSgbm3Way, MatcherKind::kOpenCvSgbm3WayStandalone}) {
+    o.matcher = kind;
+    o.narrow_range = true;
+    const MatchResult sgbm = Match(pair.left, pair.right, o);
+    EXPECT_EQ(sgbm.searched_min_disparity_px, 8);
+    EXPECT_EQ(sgbm.searched_num_disparities, 96);
+  }
+}
+
 TEST(Matcher, RoiAndRangeAreHonoured) {
   const SyntheticPair pair = RenderSyntheticPair(SyntheticPairSpec{});
   MatchOptions o = Options(MatcherKind::kCensusSgm);

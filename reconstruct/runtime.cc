@@ -136,6 +136,8 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
     match = Match(left, right, mo);
     for (const auto& [step, ms] : match.times_ms) report->times_ms["match." + step] = ms;
     report->surface_fit = match.surface_fit;
+    report->searched_min_disparity_px = match.searched_min_disparity_px;
+    report->searched_num_disparities = match.searched_num_disparities;
   } else {
     match.disparity_px = cv::Mat(size, CV_32FC1, cv::Scalar(std::numeric_limits<float>::infinity()));
     match.confidence = cv::Mat(size, CV_32FC1, cv::Scalar(0));

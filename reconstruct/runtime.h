@@ -43,8 +43,11 @@ struct ModulePlan {
 
 struct ModuleReport {
   int module = 0;
-  cv::Rect match_roi;  // after cropping to the lit region
-  int min_disparity_px = 0, num_disparities = 0;
+  cv::Rect match_roi;                             // after cropping to the lit region
+  int min_disparity_px = 0, num_disparities = 0;  // the volume's range, [min, min + num) px
+  // What the matcher searched at full resolution (MatchResult): the occupied
+  // band within that range; 0 / 0 when nothing was matched (no lit region).
+  int searched_min_disparity_px = 0, searched_num_disparities = 0;
   int points = 0;      // points kept
   int lit_pixels = 0;  // grid-lit pixels of the rectified left image in the volume's ROI
   int lit_filled = 0;  // of those, pixels with a kept point

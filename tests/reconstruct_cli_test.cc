@@ -154,7 +154,19 @@ TEST_F(ReconstructCli, WritesACloudAnyPlyReaderReadsOnTheSphere) {
   int near = 0;
   for (const auto& p : pts) near += std::abs((p - centre_).norm() - 25.0) < 0.3;
   EXPECT_GT(near, 0.99 * pts.size());
-  EXPECT_TRUE(std::filesystem::exists(dir_ + "/out.json"));
+  // The report names what each module searched: the occupied band, inside
+  // the volume's range and narrower (the sphere fills a fraction of it).
+  std::ifstream report_file(dir_ + "/out.json");
+  const nlohmann::json report = nlohmann::json::parse(report_file);
+  ASSERT_EQ(report["modules"].size(), 2u);
+  for (const nlohmann::json& m : report["modules"]) {
+    const int range_lo = m["disparity_range_px"][0], range_hi = m["disparity_range_px"][1];
+    const int band_lo = m["searched_disparity_px"][0], band_hi = m["searched_disparity_px"][1];
+    EXPECT_LE(range_lo, band_lo) << m.dump();
+    EXPECT_LT(band_lo, band_hi) << m.dump();
+    EXPECT_LE(band_hi, range_hi) << m.dump();
+    EXPECT_LT(band_hi - band_lo, (range_hi - range_lo) / 2) << m.dump();
+  }
   // Binary STL: 80-byte header, count, 50 bytes per triangle.
   const auto stl_size = std::filesystem::file_size(dir_ + "/out.stl");
   EXPECT_GT(stl_size, 84u + 50u * 10000);
