@@ -17,6 +17,9 @@ nlohmann::json ReconstructionJson(const Reconstruction& rec) {
                          {"disparity_range_px", {m.min_disparity_px, m.min_disparity_px + m.num_disparities}},
                          {"searched_disparity_px",
                           {m.searched_min_disparity_px, m.searched_min_disparity_px + m.searched_num_disparities}}};
+    mj["lit_pixels_by_status"] = nlohmann::json::object();
+    for (size_t k = 0; k < m.lit_by_status.size(); ++k)
+      if (m.lit_by_status[k] > 0) mj["lit_pixels_by_status"][PixelStatusName(PixelStatus(k))] = m.lit_by_status[k];
     for (const auto& [step, ms] : m.times_ms) mj["time_ms"][step] = ms;
     if (m.surface_fit)
       mj["surface_fit"] = {{"window_px", {2 * m.surface_fit->half_width_px + 1, 2 * m.surface_fit->half_height_px + 1}},

@@ -257,6 +257,7 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
     for (int x = 0; x < lit.cols; ++x) {
       if (!l[x]) continue;
       ++report->lit_pixels;
+      ++report->lit_by_status[status.at<uint8_t>(y + plan.roi.y, x + plan.roi.x)];
       const int xi = x + plan.roi.x - r.x;
       report->lit_filled += in && unsigned(xi) < unsigned(r.width) && in[xi] >= 0;
     }

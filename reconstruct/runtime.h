@@ -15,6 +15,7 @@
 // the joined mesh, and hole filling from a fitted shape model.
 #pragma once
 
+#include <array>
 #include <map>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -51,6 +52,10 @@ struct ModuleReport {
   int points = 0;      // points kept
   int lit_pixels = 0;  // grid-lit pixels of the rectified left image in the volume's ROI
   int lit_filled = 0;  // of those, pixels with a kept point
+  // The lit pixels by their final PixelStatus (disparity_state.h): kPoint
+  // counts lit_filled, the others name the test that refused the rest. The
+  // runtime's own account of where fill goes, with no truth needed.
+  std::array<int, size_t(PixelStatus::kNumStatus)> lit_by_status{};
   double fill_rate() const { return lit_pixels ? double(lit_filled) / lit_pixels : 0.0; }
   // CV_8UC1, the module's rectified left image size: the PixelStatus
   // (matcher.h) of each pixel: kPoint where a point was kept, else the test

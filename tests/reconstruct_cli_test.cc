@@ -166,6 +166,14 @@ TEST_F(ReconstructCli, WritesACloudAnyPlyReaderReadsOnTheSphere) {
     EXPECT_LT(band_lo, band_hi) << m.dump();
     EXPECT_LE(band_hi, range_hi) << m.dump();
     EXPECT_LT(band_hi - band_lo, (range_hi - range_lo) / 2) << m.dump();
+    // Every lit pixel has one final status: they add up to lit_pixels, the
+    // kept ones to lit_pixels_filled, and on this clean sphere most are kept.
+    int lit_sum = 0;
+    for (const auto& [status, count] : m["lit_pixels_by_status"].items()) lit_sum += count.get<int>();
+    EXPECT_EQ(lit_sum, m["lit_pixels"].get<int>()) << m.dump();
+    ASSERT_TRUE(m["lit_pixels_by_status"].contains("point")) << m.dump();
+    EXPECT_EQ(m["lit_pixels_by_status"]["point"].get<int>(), m["lit_pixels_filled"].get<int>()) << m.dump();
+    EXPECT_GT(m["lit_pixels_by_status"]["point"].get<int>(), m["lit_pixels"].get<int>() / 2) << m.dump();
   }
   // Binary STL: 80-byte header, count, 50 bytes per triangle.
   const auto stl_size = std::filesystem::file_size(dir_ + "/out.stl");
