@@ -4,6 +4,7 @@
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
+#include "apps/module_summary.h"
 #include "apps/reconstruct_batch.h"
 #include "apps/reconstruct_json.h"
 #include "calib/core/atomic_file.h"
@@ -75,9 +76,7 @@ int RunReconstruct(int argc, char** argv) {
   if (!mesh_path.empty()) WriteMesh(rec.mesh, mesh_path);
   const nlohmann::json report = ReconstructionJson(rec);
   if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
-  for (const ModuleReport& m : rec.modules)
-    std::printf("module %d: %d points, fill %.1f%% of %d grid-lit px, match %.1f ms\n", m.module, m.points,
-                100 * m.fill_rate(), m.lit_pixels, m.times_ms.at("match"));
+  for (const ModuleReport& m : rec.modules) std::printf("%s\n", ModuleSummary(m).c_str());
   std::printf("%zu points (%d from the shape model) in %.1f ms; wrote %s", rec.cloud.size(), rec.filled_points,
               rec.times_ms.at("total_point_cloud"), out_path.c_str());
   if (!mesh_path.empty()) std::printf(", %s (%zu triangles)", mesh_path.c_str(), rec.mesh.triangles.size());

@@ -102,6 +102,7 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
 #include "datasets/default_rig.h"
 #include "reconstruct/metrology/ply_points.h"
 #include "reconstruct/synthetic_scene.h"
+#include "tests/cli_runner.h"
 
 namespace stereorig {
 namespace {
@@ -179,6 +180,19 @@ TEST_F(ReconstructCli, WritesACloudAnyPlyReaderReadsOnTheSphere) {
   const auto stl_size = std::filesystem::file_size(dir_ + "/out.stl");
   EXPECT_GT(stl_size, 84u + 50u * 10000);
   EXPECT_EQ((stl_size - 84) % 50, 0u);
+}
+
+TEST_F(ReconstructCli, PrintsPerModuleTheBandSearchedAndWhereFillWent) {
+  const testing::Result r = testing::RunCli(Args(dir_ + "/capture"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const std::string module : {"module 0: ", "module 1: "}) {
+    const size_t at = r.out.find(module);
+    ASSERT_NE(at, std::string::npos) << r.out;
+    const size_t next = r.out.find('\n', r.out.find('\n', at) + 1);  // the module's two lines
+    const std::string lines = r.out.substr(at, next - at);
+    EXPECT_NE(lines.find("\n  searched d ["), std::string::npos) << lines;
+    EXPECT_NE(lines.find("lit px without a point: "), std::string::npos) << lines;
+  }
 }
 
 TEST_F(ReconstructCli, MissingCameraExitsTwoAndWritesNothing) {
