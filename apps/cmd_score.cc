@@ -12,6 +12,7 @@
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
+#include "apps/module_summary.h"
 #include "apps/reconstruct_json.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
@@ -30,23 +31,6 @@ nlohmann::json FillJson(const FillFigures& f) {
     if (f.target_status[k] && k != size_t(PixelStatus::kPoint))
       j["target_px_lost_by"][PixelStatusName(PixelStatus(k))] = f.target_status[k];
   return j;
-}
-
-// "no_sgm_match 4.1%, low_zncc 2.0%, ...": the target pixels each test lost,
-// largest first.
-std::string LossLine(const FillFigures& f) {
-  std::vector<std::pair<int, size_t>> losses;
-  for (size_t k = 0; k < f.target_status.size(); ++k)
-    if (f.target_status[k] && k != size_t(PixelStatus::kPoint)) losses.push_back({f.target_status[k], k});
-  std::sort(losses.rbegin(), losses.rend());
-  std::string line;
-  char buf[64];
-  for (const auto& [n, k] : losses) {
-    std::snprintf(buf, sizeof buf, "%s%s %.1f%%", line.empty() ? "" : ", ", PixelStatusName(PixelStatus(k)),
-                  100.0 * n / std::max(1, f.target_px));
-    line += buf;
-  }
-  return line;
 }
 
 // "12695 points, |e| mean 0.52 p95 1.40 max 2.31 mm, 61.0% within 0.5 mm".
@@ -146,7 +130,8 @@ int RunScore(int argc, char** argv) {
     }
     std::printf("; aligned by %.4f deg, %.4f mm\n", s.accuracy.truth_from_cloud.AngleDeg(),
                 s.accuracy.truth_from_cloud.translation_mm().norm());
-    for (size_t m = 0; m < s.fill.size(); ++m) std::printf("  m%zu lost: %s\n", m, LossLine(s.fill[m]).c_str());
+    for (size_t m = 0; m < s.fill.size(); ++m)
+      std::printf("  m%zu lost: %s\n", m, LossLine(s.fill[m].target_status, s.fill[m].target_px).c_str());
     if (fill) {
       sj["shape_fit"] = rec.shape_fit;
       sj["hole_fill_ms"] = rec.times_ms.at("hole_fill");

@@ -7,30 +7,34 @@
 
 namespace stereorig {
 
+std::string LossLine(std::span<const int> counts_by_status, int total_px, int max_reasons) {
+  std::vector<std::pair<int, size_t>> losses;  // (count, status)
+  for (size_t k = 0; k < counts_by_status.size(); ++k)
+    if (counts_by_status[k] && k != size_t(PixelStatus::kPoint)) losses.push_back({counts_by_status[k], k});
+  std::sort(losses.rbegin(), losses.rend());
+  const size_t shown = max_reasons > 0 ? std::min(losses.size(), size_t(max_reasons)) : losses.size();
+  std::string line;
+  char buf[64];
+  for (size_t i = 0; i < shown; ++i) {
+    std::snprintf(buf, sizeof buf, "%s%s %.1f%%", i ? ", " : "", PixelStatusName(PixelStatus(losses[i].second)),
+                  100.0 * losses[i].first / std::max(1, total_px));
+    line += buf;
+  }
+  if (shown < losses.size()) line += ", ...";
+  return line;
+}
+
 std::string ModuleSummary(const ModuleReport& m, int max_reasons) {
   const auto match = m.times_ms.find("match");
   char buf[256];
-  std::snprintf(buf, sizeof buf, "module %d: %d points, fill %.1f%% of %d grid-lit px, match %.1f ms", m.module,
-                m.points, 100 * m.fill_rate(), m.lit_pixels, match == m.times_ms.end() ? 0.0 : match->second);
-  std::string s = buf;
   std::snprintf(buf, sizeof buf,
-                "\n  searched d [%d, %d) of [%d, %d) px; lit px without a point:", m.searched_min_disparity_px,
-                m.searched_min_disparity_px + m.searched_num_disparities, m.min_disparity_px,
-                m.min_disparity_px + m.num_disparities);
-  s += buf;
-  std::vector<std::pair<int, int>> lost;  // (count, status)
-  for (size_t k = 0; k < m.lit_by_status.size(); ++k)
-    if (PixelStatus(k) != PixelStatus::kPoint && m.lit_by_status[k] > 0) lost.emplace_back(m.lit_by_status[k], int(k));
-  std::sort(lost.begin(), lost.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-  if (lost.empty()) return s + " none";
-  const int shown = std::min(int(lost.size()), std::max(1, max_reasons));
-  for (int i = 0; i < shown; ++i) {
-    std::snprintf(buf, sizeof buf, "%s %s %.1f%%", i ? "," : "", PixelStatusName(PixelStatus(lost[i].second)),
-                  100.0 * lost[i].first / std::max(1, m.lit_pixels));
-    s += buf;
-  }
-  if (shown < int(lost.size())) s += ", ...";
-  return s;
+                "module %d: %d points, fill %.1f%% of %d grid-lit px, match %.1f ms\n"
+                "  searched d [%d, %d) of [%d, %d) px; lit px without a point: ",
+                m.module, m.points, 100 * m.fill_rate(), m.lit_pixels, match == m.times_ms.end() ? 0.0 : match->second,
+                m.searched_min_disparity_px, m.searched_min_disparity_px + m.searched_num_disparities,
+                m.min_disparity_px, m.min_disparity_px + m.num_disparities);
+  const std::string losses = LossLine(m.lit_by_status, m.lit_pixels, std::max(1, max_reasons));
+  return buf + (losses.empty() ? "none" : losses);
 }
 
 }  // namespace stereorig

@@ -1,20 +1,27 @@
-// The console lines `stereorig reconstruct` prints per module: points, fill,
-// match time, then what was searched and where the lit pixels without a
-// point went (the report's searched_disparity_px and lit_pixels_by_status,
-// read by a person at the line).
+// Console lines about where fill goes, read by a person: the losses by
+// PixelStatus (`stereorig score` over the truth target, `stereorig
+// reconstruct` over the grid-lit pixels) and `reconstruct`'s per-module
+// summary (the report's searched_disparity_px and lit_pixels_by_status).
 #pragma once
 
+#include <span>
 #include <string>
 
 #include "reconstruct/runtime.h"
 
 namespace stereorig {
 
+// "no_sgm_match 4.1%, low_zncc 2.0%, ...": the pixels each status other than
+// kPoint holds (counts indexed by the PixelStatus value), largest first, as
+// shares of total_px. With max_reasons > 0 only that many, then ", ..." if
+// there were more; "" when no pixel was lost.
+std::string LossLine(std::span<const int> counts_by_status, int total_px, int max_reasons = 0);
+
 // Two lines, no trailing newline, e.g.
 //   module 1: 0 points, fill 0.0% of 36293 grid-lit px, match 82.7 ms
 //     searched d [-21, 43) of [-100, 173) px; lit px without a point: no_sgm_match 29.8%, off_plane_coarse 18.7%, ...
-// The reasons are the `max_reasons` largest, largest first, as shares of the
-// lit pixels; "none" when every lit pixel has a point.
+// The reasons are LossLine's `max_reasons` largest over the lit pixels;
+// "none" when every lit pixel has a point.
 std::string ModuleSummary(const ModuleReport& m, int max_reasons = 3);
 
 }  // namespace stereorig

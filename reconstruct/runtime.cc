@@ -254,10 +254,11 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
     const uint8_t* l = lit.ptr<uint8_t>(y);
     const int yi = y + plan.roi.y - r.y;  // index's row
     const int* in = yi >= 0 && yi < r.height ? index.ptr<int>(yi) : nullptr;
+    const uint8_t* st = status.ptr<uint8_t>(y + plan.roi.y) + plan.roi.x;  // the lit mask's pixel x is st[x]
     for (int x = 0; x < lit.cols; ++x) {
       if (!l[x]) continue;
       ++report->lit_pixels;
-      ++report->lit_by_status[status.at<uint8_t>(y + plan.roi.y, x + plan.roi.x)];
+      ++report->lit_by_status[st[x]];
       const int xi = x + plan.roi.x - r.x;
       report->lit_filled += in && unsigned(xi) < unsigned(r.width) && in[xi] >= 0;
     }
