@@ -9,7 +9,7 @@
 // valid pixels alone are a biased sample: they are the ones whose window
 // passed the matcher's tests at the component's alignment, and at strong
 // speckle those read the vernier nearer 0 on a wrong alignment than the
-// footprint does (docs/reconstruct.md, "Strong speckle").
+// footprint does (docs/reconstruct-log.md, "Strong speckle").
 //
 // The raster-rank sample: list the footprint in raster order (index y * cols + x), N
 // pixels; stride = max(1, N / samples); take the pixels at ranks

@@ -7,7 +7,7 @@
 // and on this VM each costs ~15 us (the host maps the page too), ~1/4 of
 // the runtime's CPU time. Kept: blocks below 8 MB come from the heap, and
 // up to 32 MB free at each heap's top stays mapped. Measured with
-// `stereorig bench` (docs/reconstruct.md, "Memory kept between captures"):
+// `stereorig bench` (docs/reconstruct-log.md, "Memory kept between captures"):
 // ~70 faults per object, +45 % objects/s, and the runtime's own peak
 // +20-35 MB (the free memory each thread's heap keeps).
 //

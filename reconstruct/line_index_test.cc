@@ -333,7 +333,7 @@ TEST(LineIndex, LatticeSamplingKeepsTheDecisionWhenAComponentLosesAFewPixels) {
 // bites): no component is kept on its own reading before the other
 // alignments are read. Its benefit is measured on the simulator's scenes
 // (speckle 0.4 ball bar, module 1: kept one period off under 2 of 6 option
-// controls with it, 0 of 6 without; docs/reconstruct.md); this checks its
+// controls with it, 0 of 6 without; docs/reconstruct-log.md); this checks its
 // cost against the truth (40 px) on the noisy shallow-grid plane: a large
 // right-line patch read through the full test is still kept (>= 90 %), and
 // a patch one period off is still never kept one period off, over 5 seeds.

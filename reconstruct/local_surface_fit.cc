@@ -56,7 +56,8 @@ struct Factor6 {
 // Factors the symmetric a (lower triangle read): false if it is not
 // positive definite. Written out at this fixed size (unrolled) rather than with Eigen::LLT, whose generic blocked code
 // and L1 norm cost ~860 instructions per 6x6 factorisation and ~350 per pair of solves; on the demo cup two thirds of
-// the fitted windows have holes and need their own (docs/reconstruct.md, "The refinement steps' instruction count").
+// the fitted windows have holes and need their own (docs/reconstruct-log.md, "The refinement steps'
+// instruction count").
 inline bool Factor(const Matrix6& a, Factor6* f) {
 #pragma GCC unroll 6
   for (int j = 0; j < kTerms; ++j) {

@@ -34,7 +34,7 @@
 //     correlated over a few pixels. Raising the gate from 1.5 to 10 lowered
 //     the std of every module of the four scored datasets (demo, seed 7,
 //     speckle 0 and 0.4): default speckle by 0.0003-0.0043 mm, speckle 0.4
-//     by 0.009-0.024 mm; fill unchanged (docs/reconstruct.md, "Fitted up to
+//     by 0.009-0.024 mm; fill unchanged (docs/reconstruct-log.md, "Fitted up to
 //     the edges, and a wider window at strong speckle (session 13)");
 //   - the quadric explains the window: the RMS misfit is at most
 //     max_misfit_ratio times the median misfit over all fitted windows, or

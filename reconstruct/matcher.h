@@ -109,7 +109,7 @@ struct MatchOptions {
   // and the line index are unchanged. 1 = every pixel; in [1, 4]; default 1:
   // step 2 saves 10.5 % of the cup's module instructions at unchanged
   // precision, but the line index's component decisions flip on 8 of the
-  // 40 scored modules (docs/reconstruct.md, session 9).
+  // 40 scored modules (docs/reconstruct-log.md, session 9).
   int subpixel_column_step = 1;
   double min_zncc = 0.8;  // reject matches whose refined window correlates less; default 0.8
   double max_plane_deviation_px =

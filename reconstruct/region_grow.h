@@ -38,7 +38,7 @@ struct GrowOptions {
   // ball bar 79.5 -> 82 %) for at most +0.006 mm of per-module std. At 0.9
   // it filled more (ball bar 85 %) but admitted wrong windows at
   // silhouettes: std over 0.1 mm on the ball bar and plate
-  // (docs/reconstruct.md).
+  // (docs/reconstruct-log.md).
   bool shifted_windows = true;
   double shifted_min_foreshortening = 0.5;  // default 0.5
   double shifted_min_zncc = 0.95;           // the shifted window's ZNCC must reach this too; default 0.95
@@ -50,7 +50,7 @@ struct GrowOptions {
   // the surface around it; the wrong windows that 0.95 keeps out lie at
   // silhouettes and the lit region's end, where the far side is background.
   // Demo and seed 7: +0.4-0.9 fill points on every scene, per-module std
-  // within +0.005 mm (docs/reconstruct.md, session 6).
+  // within +0.005 mm (docs/reconstruct-log.md, session 6).
   double shifted_enclosed_min_zncc = 0.8;
   // Growing's ZNCC floor from the measured noise (GrowMinZncc; 0 = off:
   // the matcher's min_zncc). A window's ZNCC at its true match is about
@@ -66,7 +66,7 @@ struct GrowOptions {
   // Demo (speckle 0.2): seeds' median ZNCC ~0.97, 1 - 4 x 0.03 > 0.8, so
   // nothing changes (all 30 module rows of the demo, seed 7 and speckle 0
   // score as before); speckle 0.4: median ~0.925, floor ~0.7, +3 to +32 fill
-  // points per module (docs/reconstruct.md, "Strong speckle (session 9)").
+  // points per module (docs/reconstruct-log.md, "Strong speckle (session 9)").
   // Default 4.
   double noise_zncc_factor = 4;
   double noise_min_zncc = 0.6;  // the noise-derived floor's lowest value; default 0.6
