@@ -2,6 +2,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 
 #include "apps/cli_util.h"
@@ -16,8 +17,9 @@ namespace stereorig {
 namespace {
 
 cv::Mat ReadGrey(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) throw InputError(path, "no such file");
   cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (image.empty()) throw InputError(path, "cannot read the image (missing or not an image)");
+  if (image.empty()) throw InputError(path, "cannot read the image (not an image, or a damaged one)");
   if (image.type() != CV_8UC1) throw InputError(path, "must be an 8-bit single-channel (grey) image");
   return image;
 }

@@ -59,6 +59,27 @@ TEST(Cli, GoodRigFileIsAccepted) {
   EXPECT_NE(r.out.find("2 module(s)"), std::string::npos);
 }
 
+// An image `match` cannot read is named in one line: a missing file without
+// OpenCV's own warning above it (imread of a missing file warns on stderr;
+// reconstruct and score check that their files exist first, and now match
+// does too), a file that is not an image as such.
+TEST(Cli, UnreadableImagesAreNamedInOneLine) {
+  const std::string dir = ::testing::TempDir() + "/cli_unreadable";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/junk.png") << "not a png";
+  for (const char* name : {"missing.png", "junk.png"}) {
+    const std::string path = dir + "/" + name;
+    const Result r = RunCli("match --left " + path + " --right " + path +
+                            " --min-disparity 0 --num-disparities 16 --out " + dir + "/d.pfm");
+    EXPECT_EQ(r.code, 2) << name;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(path), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("WARN"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/d.pfm"));
+  }
+}
+
 // `rig --truth`: judged against itself every figure is 0; with module 1
 // moved 0.1 mm in module 0's frame (S changed, each module untouched), the
 // module 3D errors stay 0 and the agreement through S is exactly the 0.1 mm
