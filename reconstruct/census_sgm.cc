@@ -168,6 +168,11 @@ CensusImage CensusTransform(const cv::Mat& grey, int row_begin, int row_end, int
   return out;
 }
 
+bool SgmPathCostsFitBytes(const SgmOptions& options, int signature_bits, int num_disparities) {
+  const int max_cost = std::max(kCensusMaxCost, signature_bits);
+  return num_disparities > 3 && max_cost + 2 * options.p2 <= 254;
+}
+
 bool SgmSimdAvailable() {
 #if defined(__AVX2__)
   return true;
@@ -187,23 +192,24 @@ using sgm::SumMode;
 // 4-path forward sums one block of rows, run again from the top->bottom
 // path's saved state (session 15; they were the whole region, h x w x
 // stride uint16 on fresh huge pages, ~40-50 MB a module).
+template <typename P>  // the path costs' type (K::Path)
 struct SgmWorkspace {
-  std::vector<uint8_t> cost_row;      // (w, stride) + 63 to align: one row's matching costs
-  std::vector<uint16_t> total_row;    // (w, stride): backward pass
-  std::vector<uint16_t> block_sums;   // (block rows, w * stride rounded up to 32) + 31 to align: a block's forward sums
-  std::vector<uint8_t> block_costs;   // (block rows, w * stride rounded up to 64) + 63 to align: its costs
-  std::vector<uint16_t> saved_paths;  // (blocks - 1, w, stride + 2): the top->bottom path at blocks 1, 2, ...
-  std::vector<uint16_t> saved_mins;   // (blocks - 1, w)
-  std::vector<uint16_t> back_a, back_b;  // (w, stride + 2): bottom->top path, previous and current row
+  std::vector<uint8_t> cost_row;     // (w, stride) + 63 to align: one row's matching costs
+  std::vector<uint16_t> total_row;   // (w, stride): backward pass
+  std::vector<uint16_t> block_sums;  // (block rows, w * stride rounded up to 32) + 31 to align: a block's forward sums
+  std::vector<uint8_t> block_costs;  // (block rows, w * stride rounded up to 64) + 63 to align: its costs
+  std::vector<P> saved_paths;        // (blocks - 1, w, stride + 2): the top->bottom path at blocks 1, 2, ...
+  std::vector<uint16_t> saved_mins;  // (blocks - 1, w)
+  std::vector<P> back_a, back_b;     // (w, stride + 2): bottom->top path, previous and current row
   std::vector<uint16_t> back_min_a, back_min_b;
-  std::vector<uint16_t> vert_a, vert_b;  // (w, stride + 2): top->bottom path, previous and current row
+  std::vector<P> vert_a, vert_b;  // (w, stride + 2): top->bottom path, previous and current row
   std::vector<uint16_t> vert_min_a, vert_min_b;
-  std::vector<uint16_t> horiz_a, horiz_b, horiz_c, horiz_d;  // (stride + 2): left->right, right->left
-  std::vector<uint16_t> shifted, shifted_rl;                 // (stride + 2): a predecessor in another window
-  std::vector<uint16_t> right_best;                          // (16 + w + n)
-  std::vector<uint16_t> row_min;                             // (w): each pixel's smallest total
-  std::vector<uint64_t> right_reversed;                      // (stride + right width + stride + 16)
-  std::vector<uint8_t> nibble_planes;                        // (nibbles, right_reversed's size)
+  std::vector<P> horiz_a, horiz_b, horiz_c, horiz_d;  // (stride + 2): left->right, right->left
+  std::vector<P> shifted, shifted_rl;                 // (stride + 2): a predecessor in another window
+  std::vector<uint16_t> right_best;                   // (16 + w + n)
+  std::vector<uint16_t> row_min;                      // (w): each pixel's smallest total
+  std::vector<uint64_t> right_reversed;               // (stride + right width + stride + 16)
+  std::vector<uint8_t> nibble_planes;                 // (nibbles, right_reversed's size)
 };
 
 // Room for n elements (contents unspecified).
@@ -219,33 +225,38 @@ T* Align64(T* p) {
   return reinterpret_cast<T*>((reinterpret_cast<uintptr_t>(p) + 63) & ~uintptr_t(63));
 }
 
-// Path buffers for `count` pixels of `stride` lanes with kBig sentinels at
-// [-1] and [stride]; returns element 0 of pixel 0 (pixel i at i*(stride+2)).
-uint16_t* PathBuffers(std::vector<uint16_t>& v, int count, int stride) {
-  uint16_t* p = Grow(v, size_t(count) * (stride + 2));
+// Path buffers for `count` pixels of `stride` lanes with `big` sentinels
+// (K::kPathBig) at [-1] and [stride]; returns element 0 of pixel 0 (pixel i
+// at i*(stride+2)).
+template <typename P>
+P* PathBuffers(std::vector<P>& v, int count, int stride, P big) {
+  P* p = Grow(v, size_t(count) * (stride + 2));
   for (int i = 0; i < count; ++i) {
-    p[size_t(i) * (stride + 2)] = kBig;
-    p[size_t(i) * (stride + 2) + stride + 1] = kBig;
+    p[size_t(i) * (stride + 2)] = big;
+    p[size_t(i) * (stride + 2) + stride + 1] = big;
   }
   return p + 1;
 }
 
 // The path costs `prev` of a neighbour whose window starts `shift`
 // disparities below the current pixel's, read in the current pixel's
-// disparities: buf[i] = prev[i + shift] for i in [0, n), kBig where
-// i + shift falls outside the neighbour's n disparities (it never searched
-// them: "no match there"), and kBig at [-1] and [n, stride] as in any path
-// buffer. shift == 0 returns prev itself.
+// disparities: buf[i] = prev[i + shift] for i in [0, n), `big` (the kernel
+// set's kPathBig) where i + shift falls outside the neighbour's n
+// disparities (it never searched them: "no match there"), and `big` at [-1]
+// and [n, stride] as in any path buffer. shift == 0 returns prev itself.
 // (The copy is out of line and the test inline: it runs once per pixel and
 // path, and only the guided search ever shifts.)
-[[gnu::noinline]] const uint16_t* ShiftedCopy(const uint16_t* prev, int shift, int n, int stride, uint16_t* buf) {
-  std::fill(buf - 1, buf + stride + 1, kBig);
+template <typename P, P kBigP>
+[[gnu::noinline]] const P* ShiftedCopy(const P* prev, int shift, int n, int stride, P* buf) {
+  std::fill(buf - 1, buf + stride + 1, kBigP);
   const int i0 = std::max(0, -shift), i1 = std::min(n, n - shift);
   if (i0 < i1) std::copy(prev + i0 + shift, prev + i1 + shift, buf + i0);
   return buf;
 }
-inline const uint16_t* InWindowOf(const uint16_t* prev, int shift, int n, int stride, uint16_t* buf) {
-  return shift == 0 ? prev : ShiftedCopy(prev, shift, n, stride, buf);
+template <typename K>
+inline const typename K::Path* InWindowOf(const typename K::Path* prev, int shift, int n, int stride,
+                                          typename K::Path* buf) {
+  return shift == 0 ? prev : ShiftedCopy<typename K::Path, K::kPathBig>(prev, shift, n, stride, buf);
 }
 
 // One row of matching costs: pixel x of the region (left signatures cl,
@@ -323,9 +334,9 @@ struct PathShape {
 // registers.
 template <typename K, int kBlocks, SumMode kMode, bool kSumMin>
 [[gnu::noinline]] void VerticalRow(const PathShape& shape, const uint8_t* crow, const int16_t* lo,
-                                   const int16_t* lo_prev, const uint16_t* sin, uint16_t* srow, const uint16_t* prev,
-                                   const uint16_t* prev_min, uint16_t* cur, uint16_t* cur_min, uint16_t* shifted,
-                                   uint16_t* sum_min) {
+                                   const int16_t* lo_prev, const uint16_t* sin, uint16_t* srow,
+                                   const typename K::Path* prev, const uint16_t* prev_min, typename K::Path* cur,
+                                   uint16_t* cur_min, typename K::Path* shifted, uint16_t* sum_min) {
   const int n = shape.n, stride = shape.stride;
   const bool vary = shape.windows_vary;
   const uint16_t p1 = shape.p1, p2 = shape.p2;  // locals: the row's stores might alias `shape`
@@ -338,7 +349,7 @@ template <typename K, int kBlocks, SumMode kMode, bool kSumMin>
             ? K::template First<kMode, kSumMin, kBlocks>(crow + xs, cur + x * path_stride, sin + xs, srow + xs, n,
                                                          stride, smin)
             : K::template Step<kMode, kSumMin, kBlocks>(
-                  crow + xs, InWindowOf(prev + x * path_stride, vary ? lo[x] - lo_prev[x] : 0, n, stride, shifted),
+                  crow + xs, InWindowOf<K>(prev + x * path_stride, vary ? lo[x] - lo_prev[x] : 0, n, stride, shifted),
                   prev_min[x], cur + x * path_stride, sin + xs, srow + xs, n, stride, p1, p2, smin);
   }
 }
@@ -350,8 +361,8 @@ template <typename K, int kBlocks, SumMode kMode, bool kSumMin>
 // pixel (PathBuffers).
 template <typename K, int kBlocks>
 [[gnu::noinline]] void HorizontalRow(const PathShape& shape, const uint8_t* crow, const int16_t* lo, uint16_t* srow,
-                                     uint16_t* ha, uint16_t* hb, uint16_t* hc, uint16_t* hd, uint16_t* shifted,
-                                     uint16_t* shifted_rl) {
+                                     typename K::Path* ha, typename K::Path* hb, typename K::Path* hc,
+                                     typename K::Path* hd, typename K::Path* shifted, typename K::Path* shifted_rl) {
   const int w = shape.w, n = shape.n, stride = shape.stride;
   const bool vary = shape.windows_vary;
   const uint16_t p1 = shape.p1, p2 = shape.p2;
@@ -363,10 +374,10 @@ template <typename K, int kBlocks>
     const int il = i, ir = w - 1 - i;
     const size_t xl = size_t(il) * stride, xr = size_t(ir) * stride;
     m_lr = K::template Step<SumMode::kAdd, false, kBlocks>(
-        crow + xl, InWindowOf(ha, vary ? lo[il] - lo[il - 1] : 0, n, stride, shifted), m_lr, hb, srow + xl, srow + xl,
-        n, stride, p1, p2);
+        crow + xl, InWindowOf<K>(ha, vary ? lo[il] - lo[il - 1] : 0, n, stride, shifted), m_lr, hb, srow + xl,
+        srow + xl, n, stride, p1, p2);
     m_rl = K::template Step<SumMode::kAdd, false, kBlocks>(
-        crow + xr, InWindowOf(hc, vary ? lo[ir] - lo[ir + 1] : 0, n, stride, shifted_rl), m_rl, hd, srow + xr,
+        crow + xr, InWindowOf<K>(hc, vary ? lo[ir] - lo[ir + 1] : 0, n, stride, shifted_rl), m_rl, hd, srow + xr,
         srow + xr, n, stride, p1, p2);
     std::swap(ha, hb);
     std::swap(hc, hd);
@@ -469,7 +480,9 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   cv::minMaxLoc(window_lo, &lo_min, &lo_max);
   const PathShape shape{w, n, stride, uint16_t(options.p1), uint16_t(options.p2), lo_min != lo_max};
   auto lo_row = [&](int y) { return window_lo.ptr<int16_t>(y); };
-  SgmWorkspace ws;
+  using P = typename K::Path;
+  constexpr P kPathBig = K::kPathBig;
+  SgmWorkspace<P> ws;
 
   // The matching costs (w, stride), uint8 (CostRow), a row at a time,
   // never a volume (h x w x stride bytes: 21-25 MB a module at full
@@ -507,16 +520,16 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   // One row of sums when a single pass suffices (num_paths 3); the
   // 4-path SGM's forward sums are held a block of rows at a time (below).
   const bool two_pass = options.num_paths == 4;
-  uint16_t* vert_prev = PathBuffers(ws.vert_a, w, stride);
-  uint16_t* vert_cur = PathBuffers(ws.vert_b, w, stride);
+  P* vert_prev = PathBuffers(ws.vert_a, w, stride, kPathBig);
+  P* vert_cur = PathBuffers(ws.vert_b, w, stride, kPathBig);
   uint16_t* vert_prev_min = Grow(ws.vert_min_a, w);
   uint16_t* vert_cur_min = Grow(ws.vert_min_b, w);
-  uint16_t* ha = PathBuffers(ws.horiz_a, 1, stride);
-  uint16_t* hb = PathBuffers(ws.horiz_b, 1, stride);
-  uint16_t* hc = PathBuffers(ws.horiz_c, 1, stride);
-  uint16_t* hd = PathBuffers(ws.horiz_d, 1, stride);
-  uint16_t* shifted = PathBuffers(ws.shifted, 1, stride);
-  uint16_t* shifted_rl = PathBuffers(ws.shifted_rl, 1, stride);
+  P* ha = PathBuffers(ws.horiz_a, 1, stride, kPathBig);
+  P* hb = PathBuffers(ws.horiz_b, 1, stride, kPathBig);
+  P* hc = PathBuffers(ws.horiz_c, 1, stride, kPathBig);
+  P* hd = PathBuffers(ws.horiz_d, 1, stride, kPathBig);
+  P* shifted = PathBuffers(ws.shifted, 1, stride, kPathBig);
+  P* shifted_rl = PathBuffers(ws.shifted_rl, 1, stride, kPathBig);
   uint16_t* row_min = Grow(ws.row_min, w);
   // Right-view best costs: the right pixel x - lo - d (local) is stored at
   // [x - lo - d + lo_max + stride - 1] >= 0 (the SIMD kernel writes all
@@ -569,7 +582,7 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
       std::min(h, options.block_rows > 0 ? options.block_rows : std::max(1, int(std::lround(std::sqrt(double(h))))));
   const int num_blocks = (h + block_rows - 1) / block_rows;
   // The state at the start of blocks 1, 2, ... (block 0 starts the path).
-  uint16_t* saved = Grow(ws.saved_paths, size_t(num_blocks - 1) * path_elems);
+  P* saved = Grow(ws.saved_paths, size_t(num_blocks - 1) * path_elems);
   uint16_t* saved_min = Grow(ws.saved_mins, size_t(num_blocks - 1) * w);
   uint16_t* total = Grow(ws.total_row, row_elems);  // also the (untouched) sum row of vertical_alone
   for (int y = 0; y < h; ++y) {
@@ -592,8 +605,8 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   // Each row of costs on a 64-byte boundary, as the single row is.
   const size_t cost_pitch = (row_elems + 63) / 64 * 64;
   uint8_t* costs = Align64(Grow(ws.block_costs, size_t(block_rows) * cost_pitch + 63));
-  uint16_t* back_prev = PathBuffers(ws.back_a, w, stride);
-  uint16_t* back_cur = PathBuffers(ws.back_b, w, stride);
+  P* back_prev = PathBuffers(ws.back_a, w, stride, kPathBig);
+  P* back_cur = PathBuffers(ws.back_b, w, stride, kPathBig);
   uint16_t* back_prev_min = Grow(ws.back_min_a, w);
   uint16_t* back_cur_min = Grow(ws.back_min_b, w);
   for (int b = num_blocks - 1; b >= 0; --b) {
@@ -624,7 +637,11 @@ cv::Mat SgmMatchWindowed(const CensusImage& left, const CensusImage& right, cons
                   region.y + region.height <= left.height);
   STEREORIG_CHECK(window_lo.type() == CV_16SC1 && window_lo.size() == region.size());
 #if defined(__AVX2__)
-  if (options.simd) return SgmMatchWith<sgm::Avx2Kernels>(left, right, region, window_lo, n, options);
+  if (options.simd) {
+    if (SgmPathCostsFitBytes(options, std::max(left.signature_bits, right.signature_bits), n))
+      return SgmMatchWith<sgm::Avx2ByteKernels>(left, right, region, window_lo, n, options);
+    return SgmMatchWith<sgm::Avx2Kernels>(left, right, region, window_lo, n, options);
+  }
 #endif
   return SgmMatchWith<sgm::ScalarKernels>(left, right, region, window_lo, n, options);
 }

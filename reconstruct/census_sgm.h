@@ -1,6 +1,7 @@
 // Census transform and semi-global matching (SGM) on a rectified 8-bit pair,
 // our own implementation: costs are uint8 Hamming distances of census
-// signatures (up to 9x7 window, 62 bits), path costs are uint16, one
+// signatures (up to 9x7 window, 62 bits), path costs are uint16 (bytes in
+// the AVX2 kernels where that is exact: SgmPathCostsFitBytes), one
 // contiguous run of disparities per pixel. The inner loops (sgm_kernels.h)
 // run in AVX2 where the build has it, else portably; both give the same
 // disparities.
@@ -77,5 +78,18 @@ cv::Mat SgmMatchGuided(const CensusImage& left, const CensusImage& right, const 
 
 // True if this build has the AVX2 kernels (SgmOptions::simd uses them).
 bool SgmSimdAvailable();
+
+// True if the AVX2 kernels keep the path costs in bytes (32 disparities per
+// instruction; sgm_kernels.h, Avx2ByteKernels) for these options, signature
+// width and disparities per pixel, which they do only where that gives the
+// 16-bit path costs exactly. A path's smallest cost is at most the largest
+// matching cost (its best disparity adds only its own cost), so every path
+// cost, and every value a step compares, lies in [0, max cost + p2] (max
+// cost: kCensusMaxCost or the signatures' width); the bytes are taken while
+// max cost + 2 p2 <= 254, a margin of p2 over what exactness needs, and the
+// uniqueness test needs a lane off the best +-1 (more than 3 disparities).
+// The default p2 of 80: 62 + 160 = 222, so bytes; p2 above 95 (96 with
+// 62-bit signatures): 16 bits. Either way the same disparities.
+bool SgmPathCostsFitBytes(const SgmOptions& options, int signature_bits, int num_disparities);
 
 }  // namespace stereorig

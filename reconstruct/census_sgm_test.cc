@@ -271,6 +271,58 @@ TEST(CensusSgm, MatchesAPlainReferenceImplementation) {
   EXPECT_GT(valid_total, 10000);
 }
 
+// The AVX2 kernels' byte path costs at the edge of where they are exact
+// (SgmPathCostsFitBytes): 64-bit random signatures (costs up to 64, the
+// largest any signature gives) with p2 = 95 (64 + 2 x 95 = 254: bytes) and
+// 96 (16 bits), a small and a large p1, against the plain reference and the
+// scalar kernels. Noise on both sides drives the path costs up to their
+// ceiling, max cost + p2; a view shifted by 5 px with a few bits flipped
+// keeps the valid path busy.
+TEST(CensusSgm, BytePathCostsAreExactUpToTheirLimit) {
+  if (!SgmSimdAvailable()) GTEST_SKIP() << "this build has no AVX2 kernels (STEREORIG_NATIVE off or no AVX2)";
+  std::mt19937_64 rng(29);
+  const int w = 90, h = 16, shift = 5;
+  CensusImage left, shifted, noise;
+  for (CensusImage* c : {&left, &shifted, &noise}) {
+    c->width = w;
+    c->height = h;
+    c->signature_bits = 64;
+    c->bits.resize(size_t(w) * h);
+  }
+  for (uint64_t& b : left.bits) b = rng();
+  for (uint64_t& b : noise.bits) b = rng();
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      shifted.bits[size_t(y) * w + x] = left.bits[size_t(y) * w + std::min(w - 1, x + shift)] ^ (rng() & rng());
+  int cases = 0, valid_total = 0;
+  for (const int p2 : {95, 96})
+    for (const int p1 : {8, 94})
+      for (const int n : {4, 17, 48, 130}) {
+        SgmOptions o;
+        o.p1 = p1;
+        o.p2 = p2;
+        EXPECT_EQ(SgmPathCostsFitBytes(o, 64, n), p2 == 95) << "p2 " << p2 << " n " << n;
+        for (const CensusImage* right : {&shifted, &noise})
+          for (const int paths : {3, 4}) {
+            o.num_paths = paths;
+            const cv::Rect region(6, 0, 84, h);
+            const std::string what = "p2 " + std::to_string(p2) + " p1 " + std::to_string(p1) + " n " +
+                                     std::to_string(n) + " paths " + std::to_string(paths);
+            o.simd = true;
+            const cv::Mat simd = SgmMatch(left, *right, region, 0, n, o);
+            valid_total += ExpectIdentical(simd, ReferenceSgm(left, *right, region, 0, n, o), what + " reference");
+            o.simd = false;
+            ExpectIdentical(simd, SgmMatch(left, *right, region, 0, n, o), what + " scalar");
+            ++cases;
+          }
+      }
+  EXPECT_EQ(cases, 2 * 2 * 4 * 2 * 2);
+  EXPECT_GT(valid_total, 5000);  // not vacuous: the shifted view is matched
+  SgmOptions o;
+  EXPECT_FALSE(SgmPathCostsFitBytes(o, 62, 3));  // n = 3: 16 bits (the uniqueness test's empty case)
+  EXPECT_TRUE(SgmPathCostsFitBytes(o, 34, 4));   // the default 5x7 census and p2: bytes
+}
+
 TEST(CensusSgm, FindsAKnownShiftOnRandomTexture) {
   // Independent of the implementation: the right view is the left one moved
   // by exactly 7 px, so every valid interior pixel must say 7 (+-0.5: the

@@ -36,6 +36,8 @@ inline uint16_t Accumulate(uint16_t* sum, const uint16_t* sum_in, uint16_t v) {
 }
 
 struct ScalarKernels {
+  using Path = uint16_t;                         // path costs (sums are uint16 in every kernel set)
+  static constexpr Path kPathBig = kBig;         // path buffers' sentinels and padding lanes
   static constexpr bool kNibbleCosts = false;    // Cost reads the signatures themselves
   static constexpr bool kBlockUnrolled = false;  // one instance for any n (kBlocks is ignored)
   static int Stride(int n) { return n; }
@@ -125,6 +127,8 @@ struct Avx2Kernels {
   // 5x7 census has 9 nibbles) instead of the 64-bit popcount's ~3 per
   // disparity. Same counts as Cost, exactly.
   static constexpr bool kNibbleCosts = true;
+  using Path = uint16_t;
+  static constexpr Path kPathBig = kBig;
   // The block loops have instances for a fixed count of 16-lane blocks
   // (kBlocks), unrolled whole: a path step over 6 blocks then carries no
   // loop or remainder logic, which cost ~40% on top of its arithmetic.
@@ -332,6 +336,141 @@ struct Avx2Kernels {
     for (int d = b0; d <= b1; d += 16)  // kNear + 16 + d - (best - 1): lane l is near iff 0 <= d + l - best + 1 < 3
       m = _mm256_min_epu16(m, _mm256_or_si256(Load(s + d), Load(kNear.lanes + 16 + d - best + 1)));
     return HorizontalMin(m);
+  }
+};
+
+// The path costs as bytes, 32 disparities per instruction instead of 16,
+// where that gives the same path costs (SgmPathCostsFitBytes, census_sgm.h):
+// every path cost is c + min(...) - prev_min with the min in [prev_min,
+// prev_min + p2], so it lies in [0, max cost + p2], and prev_min itself is at
+// most max cost (at the best disparity the min is prev_min), so the capped
+// term prev_min + p2 is too. Below 255 that, unsigned saturating byte adds
+// change no min a real lane takes (a saturated 255 loses to the capped term
+// as the true value would), and the rest is exact: min - prev_min is in
+// [0, p2] and adding the cost stays below 255. The sums stay
+// uint16, in the same layout as Avx2Kernels' (costs, sums and the winner
+// search are theirs); only the path buffers are bytes, with 255 as their
+// sentinels and padding lanes (summed over 3-4 paths, 765-1020: above any
+// real sum, <= 4 x (64 + 95), as the 16-bit kernels' multiples of kBig are).
+// A stride that is an odd multiple of 16 ends in one 16-lane chunk.
+struct Avx2ByteKernels : Avx2Kernels {
+  using Path = uint8_t;
+  static constexpr Path kPathBig = 0xFF;
+
+  // 0xFF in byte lanes >= k (k in [1, 32]), 0 below.
+  static __m256i BytePadMask(int k) {
+    const __m256i lane = _mm256_setr_epi8(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21,
+                                          22, 23, 24, 25, 26, 27, 28, 29, 30, 31);
+    return _mm256_cmpgt_epi8(lane, _mm256_set1_epi8(char(k - 1)));
+  }
+
+  // The smallest byte of m and tail.
+  static uint16_t ByteMin(__m256i m, __m128i tail) {
+    __m128i x = _mm_min_epu8(_mm_min_epu8(_mm256_castsi256_si128(m), _mm256_extracti128_si256(m, 1)), tail);
+    x = _mm_and_si128(_mm_min_epu8(x, _mm_srli_epi16(x, 8)), _mm_set1_epi16(0xFF));
+    return uint16_t(_mm_cvtsi128_si32(_mm_minpos_epu16(x)));
+  }
+
+  // The 32 byte path costs r of lanes d..d+31 (or the low 16 of it, kHalf)
+  // into the sums (kMode), their minimum into *sm (kSumMin).
+  template <SumMode kMode, bool kSumMin, bool kHalf>
+  [[gnu::always_inline]] static inline void AccumulateBytes(__m256i r, const uint16_t* sum_in, uint16_t* sum, int d,
+                                                            __m256i* sm) {
+    static_assert(!(kMode == SumMode::kNone && kSumMin), "the sums' minimum needs the sums");
+    if constexpr (kMode != SumMode::kNone) {
+      const __m256i lo = _mm256_cvtepu8_epi16(_mm256_castsi256_si128(r));
+      const __m256i t0 = kMode == SumMode::kStore ? lo : _mm256_add_epi16(Load(sum_in + d), lo);
+      Store(sum + d, t0);
+      if constexpr (kSumMin) *sm = _mm256_min_epu16(*sm, t0);
+      if constexpr (!kHalf) {
+        const __m256i hi = _mm256_cvtepu8_epi16(_mm256_extracti128_si256(r, 1));
+        const __m256i t1 = kMode == SumMode::kStore ? hi : _mm256_add_epi16(Load(sum_in + d + 16), hi);
+        Store(sum + d + 16, t1);
+        if constexpr (kSumMin) *sm = _mm256_min_epu16(*sm, t1);
+      }
+    }
+  }
+
+  // f(d, last) for the whole 32-lane chunks d = 0, 32, ... below stride
+  // (kBlocks > 0: stride is 16 * kBlocks, unrolled whole); `last`: the
+  // chunk holds lane n - 1 (no 16-lane chunk follows).
+  template <int kBlocks, typename F>
+  [[gnu::always_inline]] static inline void ForChunks(int stride, F&& f) {
+    if constexpr (kBlocks > 0) {
+#pragma GCC unroll 8
+      for (int b = 0; b < kBlocks / 2; ++b) f(32 * b, kBlocks % 2 == 0 && b == kBlocks / 2 - 1);
+    } else {
+      const int whole = stride / 32 * 32;
+#pragma GCC unroll 2
+      for (int d = 0; d < whole; d += 32) f(d, stride % 32 == 0 && d == whole - 32);
+    }
+  }
+
+  template <SumMode kMode, bool kSumMin = false, int kBlocks = 0>
+  [[gnu::always_inline]] static inline uint16_t Step(const uint8_t* __restrict c, const uint8_t* __restrict prev,
+                                                     uint16_t prev_min, uint8_t* __restrict cur, const uint16_t* sum_in,
+                                                     uint16_t* sum, int n, int stride, uint16_t p1, uint16_t p2,
+                                                     uint16_t* sum_min = nullptr) {
+    if constexpr (kBlocks > 0) stride = 16 * kBlocks;
+    const __m256i vp1 = _mm256_set1_epi8(char(p1));
+    const __m256i cap = _mm256_set1_epi8(char(prev_min + p2));
+    const __m256i vprev_min = _mm256_set1_epi8(char(prev_min));
+    __m256i m = _mm256_set1_epi8(-1), sm = m;
+    ForChunks<kBlocks>(stride, [&](int d, bool last) {
+      const __m256i a = _mm256_min_epu8(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(prev + d)), cap);
+      const __m256i b =
+          _mm256_min_epu8(_mm256_adds_epu8(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(prev + d - 1)), vp1),
+                          _mm256_adds_epu8(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(prev + d + 1)), vp1));
+      __m256i r = _mm256_add_epi8(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + d)),
+                                  _mm256_sub_epi8(_mm256_min_epu8(a, b), vprev_min));
+      if (last) r = _mm256_max_epu8(r, BytePadMask(n - (stride - 32)));
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(cur + d), r);
+      m = _mm256_min_epu8(m, r);
+      AccumulateBytes<kMode, kSumMin, false>(r, sum_in, sum, d, &sm);
+    });
+    __m128i tail = _mm_set1_epi8(-1);
+    if (stride % 32 == 16) {  // the last 16 lanes, in 128-bit registers
+      const int d = stride - 16;
+      const __m128i a =
+          _mm_min_epu8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(prev + d)), _mm256_castsi256_si128(cap));
+      const __m128i b = _mm_min_epu8(
+          _mm_adds_epu8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(prev + d - 1)), _mm256_castsi256_si128(vp1)),
+          _mm_adds_epu8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(prev + d + 1)), _mm256_castsi256_si128(vp1)));
+      __m128i r = _mm_add_epi8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(c + d)),
+                               _mm_sub_epi8(_mm_min_epu8(a, b), _mm256_castsi256_si128(vprev_min)));
+      r = _mm_max_epu8(r, _mm256_castsi256_si128(BytePadMask(n - d)));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(cur + d), r);
+      tail = r;
+      AccumulateBytes<kMode, kSumMin, true>(_mm256_castsi128_si256(r), sum_in, sum, d, &sm);
+    }
+    if constexpr (kSumMin) *sum_min = HorizontalMin(sm);
+    return ByteMin(m, tail);
+  }
+
+  template <SumMode kMode, bool kSumMin = false, int kBlocks = 0>
+  [[gnu::always_inline]] static inline uint16_t First(const uint8_t* __restrict c, uint8_t* __restrict cur,
+                                                      const uint16_t* sum_in, uint16_t* sum, int n, int stride,
+                                                      uint16_t* sum_min = nullptr) {
+    if constexpr (kBlocks > 0) stride = 16 * kBlocks;
+    __m256i m = _mm256_set1_epi8(-1), sm = m;
+    ForChunks<kBlocks>(stride, [&](int d, bool last) {
+      __m256i r = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + d));
+      if (last) r = _mm256_max_epu8(r, BytePadMask(n - (stride - 32)));
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(cur + d), r);
+      m = _mm256_min_epu8(m, r);
+      AccumulateBytes<kMode, kSumMin, false>(r, sum_in, sum, d, &sm);
+    });
+    __m128i tail = _mm_set1_epi8(-1);
+    if (stride % 32 == 16) {
+      const int d = stride - 16;
+      const __m128i r = _mm_max_epu8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(c + d)),
+                                     _mm256_castsi256_si128(BytePadMask(n - d)));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(cur + d), r);
+      tail = r;
+      AccumulateBytes<kMode, kSumMin, true>(_mm256_castsi128_si256(r), sum_in, sum, d, &sm);
+    }
+    if constexpr (kSumMin) *sum_min = HorizontalMin(sm);
+    return ByteMin(m, tail);
   }
 };
 #endif  // __AVX2__
