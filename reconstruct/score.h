@@ -8,7 +8,7 @@
 // alone would add up to half the sample spacing to every error.
 // The alignment is point-to-plane ICP from the identity (the calibrated
 // reference frame differs from the truth by a small rigid motion), pairs
-// farther than 1 mm rejected.
+// whose nearest truth sample is farther than 2 mm left out.
 #pragma once
 
 #include <Eigen/Core>
