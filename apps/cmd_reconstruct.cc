@@ -5,6 +5,7 @@
 #include "apps/cli_util.h"
 #include "apps/command.h"
 #include "apps/module_summary.h"
+#include "apps/output_paths.h"
 #include "apps/reconstruct_batch.h"
 #include "apps/reconstruct_json.h"
 #include "calib/core/atomic_file.h"
@@ -64,8 +65,14 @@ int RunReconstruct(int argc, char** argv) {
   }
   const std::string& capture_dir = capture_dirs.front();
 
-  // Every input is checked before anything is written.
-  if (!mesh_path.empty()) CheckMeshPath(mesh_path);
+  // Every input, and where each output goes, is checked before any work.
+  OutputPaths outputs;
+  outputs.Claim(out_path, "the cloud (--out)");
+  if (!mesh_path.empty()) {
+    CheckMeshPath(mesh_path);
+    outputs.Claim(mesh_path, "the mesh (--mesh)");
+  }
+  if (!report_path.empty()) outputs.Claim(report_path, "the report (--report)");
   const Rig rig = ReadRigFile(rig_path);
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
   const std::vector<cv::Mat> images = LoadCapture(capture_dir, rig);

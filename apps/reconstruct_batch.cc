@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/command.h"
+#include "apps/output_paths.h"
 #include "apps/reconstruct_json.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
@@ -71,15 +72,9 @@ struct CaptureOutputs {
 // summary's folder exists or is the output folder.
 std::vector<CaptureOutputs> PlanOutputs(const std::vector<std::string>& names, const BatchRequest& request) {
   std::vector<CaptureOutputs> outputs;
-  std::map<fs::path, std::string> claimed;  // normal absolute path -> what writes it
-  auto claim = [&](const std::string& path, const std::string& what) {
-    const fs::path key = fs::absolute(fs::path(path)).lexically_normal();
-    if (const auto it = claimed.find(key); it != claimed.end())
-      throw InputError(path, "would be written twice (" + it->second + " and " + what +
-                                 "): rename a folder or "
-                                 "choose another --report");
-    claimed.emplace(key, what);
-  };
+  OutputPaths paths;
+  // The output folder is created later, once everything is checked.
+  auto claim = [&](const std::string& path, const std::string& what) { paths.Claim(path, what, false); };
   for (const std::string& name : names) {
     const std::string stem = (fs::path(request.out_dir) / name).string();
     CaptureOutputs o{stem + ".ply", stem + ".json", ""};

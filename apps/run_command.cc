@@ -1,6 +1,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 
 #include "apps/command.h"
 #include "calib/core/input_error.h"
@@ -16,6 +17,12 @@ int RunCommand(const Command& command, int argc, char** argv) {
     std::fprintf(stderr, "stereorig %s: %s\n", command.name, e.what());
     return kExitBadInput;
   } catch (const InputError& e) {
+    std::fprintf(stderr, "stereorig %s: %s\n", command.name, e.what());
+    return kExitBadInput;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // A path the user gave that cannot be listed, read or written (a folder
+    // without permission, a file where a folder should be): its message
+    // names the path.
     std::fprintf(stderr, "stereorig %s: %s\n", command.name, e.what());
     return kExitBadInput;
   }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <limits>
 #include <opencv2/imgcodecs.hpp>
@@ -85,6 +87,22 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
       throw InputError("runtime options", "the measurement volume is not in " + mod.name + "'s view");
     plan.min_disparity_px = int(std::floor(d0)) - 2;
     plan.num_disparities = int(std::ceil(d1)) - int(std::floor(d0)) + 5;
+    {  // What the matcher will be asked for, checked now rather than mid-capture on a module's thread.
+      MatchOptions mo = options_.match;
+      mo.min_disparity_px = plan.min_disparity_px;
+      mo.num_disparities = plan.num_disparities;
+      try {
+        mo.Check();
+      } catch (const InputError& e) {
+        char range[96];
+        std::snprintf(range, sizeof range, "disparities %d to %d px", plan.min_disparity_px,
+                      plan.min_disparity_px + plan.num_disparities - 1);
+        throw InputError("runtime options", "the measurement volume needs " + std::string(range) + " in " + mod.name +
+                                                ", which the matcher cannot search (" + e.what() +
+                                                "): make the volume shallower (volume_size_mm's depth) or move it "
+                                                "farther from the cameras (working_distance_mm, volume_center_mm)");
+      }
+    }
     plans_.push_back(std::move(plan));
   }
 }
@@ -310,12 +328,23 @@ Reconstruction Runtime::Process(const std::vector<cv::Mat>& images, bool build_m
   out.modules.resize(nm);
   auto t = Clock::now();
   if (options_.parallel_modules && nm > 1) {
+    // An exception must not leave a module's thread (std::terminate) nor
+    // unwind past threads not yet joined: each module's is kept, every
+    // thread joined, then the first one rethrown.
+    std::vector<std::exception_ptr> errors(nm);
+    auto run = [&](int m) {
+      try {
+        ProcessModule(plans_[m], images, build_mesh, &clouds[m], &meshes[m], &out.modules[m]);
+      } catch (...) {
+        errors[m] = std::current_exception();
+      }
+    };
     std::vector<std::thread> threads;
-    for (int m = 1; m < nm; ++m)
-      threads.emplace_back(
-          [&, m] { ProcessModule(plans_[m], images, build_mesh, &clouds[m], &meshes[m], &out.modules[m]); });
-    ProcessModule(plans_[0], images, build_mesh, &clouds[0], &meshes[0], &out.modules[0]);
+    for (int m = 1; m < nm; ++m) threads.emplace_back(run, m);
+    run(0);
     for (auto& th : threads) th.join();
+    for (const std::exception_ptr& e : errors)
+      if (e) std::rethrow_exception(e);
   } else {
     for (int m = 0; m < nm; ++m) ProcessModule(plans_[m], images, build_mesh, &clouds[m], &meshes[m], &out.modules[m]);
   }
@@ -369,7 +398,12 @@ std::vector<cv::Mat> LoadCapture(const std::string& dir, const Rig& rig) {
   std::vector<cv::Mat> images;
   for (int k = 0; k < rig.num_cameras(); ++k) {
     const std::string path = (std::filesystem::path(dir) / ("cam" + std::to_string(k) + ".png")).string();
-    cv::Mat img = cv::imread(path, cv::IMREAD_UNCHANGED);
+    cv::Mat img;
+    try {
+      img = cv::imread(path, cv::IMREAD_UNCHANGED);
+    } catch (const cv::Exception& e) {  // e.g. a header whose size the decoder refuses
+      throw InputError(path, "cannot read the image (" + e.msg + ")");
+    }
     if (img.empty()) throw InputError(path, "cannot read the image");
     if (img.type() != CV_8UC1) throw InputError(path, "must be an 8-bit single-channel (grey) PNG");
     const Camera& cam = rig.camera(k);

@@ -223,6 +223,45 @@ TEST_F(ReconstructCli, BadOptionsOrMeshNameExitTwo) {
   ExpectNoOutput();
 }
 
+// Where each output goes is checked before any work (apps/output_paths.h):
+// a mesh in a missing folder, or two outputs naming one file, exit 2 with
+// one line naming the path, and nothing is written. (Before, the whole
+// capture was reconstructed, the cloud written, then the mesh failed, or
+// the mesh silently replaced the cloud.)
+TEST_F(ReconstructCli, OutputPathsAreCheckedBeforeAnyWork) {
+  const std::string base =
+      "reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture --out " + dir_ + "/out.ply ";
+  const std::pair<std::string, std::string> cases[] = {
+      {"--mesh " + dir_ + "/no_such_folder/m.stl", "its folder does not exist"},
+      {"--mesh " + dir_ + "/out.ply", "would be written twice"},
+      {"--report " + dir_ + "/./out.ply", "would be written twice"},
+      {"--report " + dir_, "is a folder"}};
+  for (const auto& [extra, says] : cases) {
+    const testing::Result r = testing::RunCli(base + extra);
+    EXPECT_EQ(r.code, 2) << extra;
+    EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    ExpectNoOutput();
+  }
+}
+
+// A measurement volume deeper than the matcher can search (150 x 150 x 300
+// mm at 200 mm: disparities -203 to 1535 px on this rig, past its 1024)
+// is refused when the runtime is built, naming the volume. It used to reach
+// the matcher's own check on a module's thread mid-capture, which with the
+// modules in parallel ended the process by std::terminate (exit 134).
+TEST_F(ReconstructCli, AVolumeTooDeepForTheMatcherExitsTwo) {
+  for (const char* parallel : {"true", "false"}) {
+    WriteFileAtomically(dir_ + "/deep.yaml",
+                        std::string("volume_size_mm: [150, 150, 300]\nparallel_modules: ") + parallel + "\n");
+    const testing::Result r = testing::RunCli(Args(dir_ + "/capture", "--options " + dir_ + "/deep.yaml"));
+    EXPECT_EQ(r.code, 2) << "parallel_modules " << parallel << ": " << r.err;
+    EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("the measurement volume needs disparities"), std::string::npos) << r.err;
+    ExpectNoOutput();
+  }
+}
+
 // Many captures, one runtime (apps/reconstruct_batch.h): each cloud is the
 // one a single-capture run writes, byte for byte (the runtime keeps no state
 // between captures); a capture with a broken image gets no output while the

@@ -1,0 +1,26 @@
+// The files one command will write, checked before it does any work: no file
+// named twice (its cloud and its mesh at one path would leave only the last
+// written), and each one's folder there to write in. A failure is bad input
+// (InputError) naming the path, so nothing is computed only to fail at the
+// end with some outputs written and others not.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <string>
+
+namespace stereorig {
+
+class OutputPaths {
+ public:
+  // Records `path`, written as `what` (for the message). Throws InputError if
+  // another output already claimed the same file, or, with
+  // check_folder, if its folder does not exist (off for files in a folder
+  // the command creates itself).
+  void Claim(const std::string& path, const std::string& what, bool check_folder = true);
+
+ private:
+  std::map<std::filesystem::path, std::string> claimed_;  // normal absolute path -> what writes it
+};
+
+}  // namespace stereorig
