@@ -19,6 +19,7 @@
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
+#include "apps/output_paths.h"
 #include "apps/reconstruct_json.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
@@ -225,6 +226,7 @@ int RunBench(int argc, char** argv) {
   app.add_option("--report", report_path, "write everything as JSON here");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
   if (runs < 1) throw InputError("--runs", "must be >= 1");
+  if (!report_path.empty()) OutputPaths().Claim(report_path, "the report (--report)");  // before minutes of runs
 
   Rig rig;
   std::vector<Scene> scenes;

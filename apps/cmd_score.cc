@@ -13,6 +13,7 @@
 #include "apps/cli_util.h"
 #include "apps/command.h"
 #include "apps/module_summary.h"
+#include "apps/output_paths.h"
 #include "apps/reconstruct_json.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
@@ -71,6 +72,7 @@ int RunScore(int argc, char** argv) {
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 
   namespace fs = std::filesystem;
+  if (!report_path.empty()) OutputPaths().Claim(report_path, "the report (--report)");  // before minutes of scoring
   if (rig_path.empty()) {
     rig_path = (fs::path(dataset) / "truth" / "rig.yaml").string();
     std::printf("score: no --rig: using the TRUTH rig %s (issue 5 judges with the calibrated one)\n", rig_path.c_str());

@@ -49,5 +49,16 @@ TEST(BenchCli, ReportsBothPipelinesAccuracyAndAHeapKeptBetweenCaptures) {
 #endif
 }
 
+// A --report that cannot be written is refused before the runs (which take
+// minutes on a dataset), not after them: nothing measured is printed.
+TEST(BenchCli, AReportInAMissingFolderExitsTwoBeforeAnyRun) {
+  const std::string report = ::testing::TempDir() + "/no_such_folder_" + std::to_string(getpid()) + "/b.json";
+  const testing::Result r = RunCli("bench --runs 1 --report " + report);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(report), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find("objects/s"), std::string::npos) << r.out;
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -10,6 +10,7 @@
 
 #include "calib/core/atomic_file.h"
 #include "reconstruct/synthetic_pair.h"
+#include "tests/cli_runner.h"
 
 namespace stereorig {
 namespace {
@@ -64,6 +65,13 @@ TEST(MatchCli, WritesAPfmThatMatchesTheTruth) {
 // of it needs a whole dataset, since without one the rig fails first.)
 TEST(ScoreCli, MissingDatasetExitsTwo) {
   EXPECT_EQ(RunCli("score --dataset " + ::testing::TempDir() + "/no_such_dataset"), 2);
+  // A --report that cannot be written is named before anything else is read
+  // (not after minutes of scoring).
+  const std::string report = ::testing::TempDir() + "/no_such_folder/s.json";
+  const testing::Result r =
+      testing::RunCli("score --dataset " + ::testing::TempDir() + "/no_such_dataset --report " + report);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(report + ": its folder does not exist"), std::string::npos) << r.err;
 }
 
 TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
