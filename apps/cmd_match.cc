@@ -8,6 +8,7 @@
 #include "apps/cli_util.h"
 #include "apps/command.h"
 #include "calib/core/input_error.h"
+#include "calib/core/png_file.h"
 #include "reconstruct/elapsed_ms.h"
 #include "reconstruct/matcher.h"
 #include "reconstruct/pfm.h"
@@ -18,6 +19,7 @@ namespace {
 
 cv::Mat ReadGrey(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw InputError(path, "no such file");
+  CheckPngIsWhole(path);
   cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
   if (image.empty()) throw InputError(path, "cannot read the image (not an image, or a damaged one)");
   if (image.type() != CV_8UC1) throw InputError(path, "must be an 8-bit single-channel (grey) image");

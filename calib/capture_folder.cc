@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "calib/core/input_error.h"
+#include "calib/core/png_file.h"
 #include "calib/layout_file.h"
 #include "targets/target_file.h"
 
@@ -39,6 +40,7 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
       const fs::path image = captures[n] / ("cam" + std::to_string(c) + ".png");
       if (!fs::exists(image))
         throw InputError(image.string(), "missing (each capture needs camK.png for every camera)");
+      CheckPngIsWhole(image.string());
       const cv::Mat grey = cv::imread(image.string(), cv::IMREAD_GRAYSCALE);
       if (grey.empty()) throw InputError(image.string(), "cannot be read as an image");
       CameraImager& spec = out.cameras[c];

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "calib/core/input_error.h"
+#include "calib/core/png_file.h"
 #include "reconstruct/elapsed_ms.h"
 #include "reconstruct/hole_fill.h"
 #include "reconstruct/lit_mask.h"
@@ -398,6 +399,7 @@ std::vector<cv::Mat> LoadCapture(const std::string& dir, const Rig& rig) {
   std::vector<cv::Mat> images;
   for (int k = 0; k < rig.num_cameras(); ++k) {
     const std::string path = (std::filesystem::path(dir) / ("cam" + std::to_string(k) + ".png")).string();
+    CheckPngIsWhole(path);
     cv::Mat img;
     try {
       img = cv::imread(path, cv::IMREAD_UNCHANGED);

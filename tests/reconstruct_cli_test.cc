@@ -217,6 +217,19 @@ TEST_F(ReconstructCli, WrongImageSizeExitsTwoAndWritesNothing) {
   ExpectNoOutput();
 }
 
+// A capture image cut short (a camera still writing it) is named in one
+// line; libpng used to print its own "libpng error: Read Error" line first.
+TEST_F(ReconstructCli, AnImageCutShortIsNamedInOneLine) {
+  const std::string d = BrokenCapture("cut_short");
+  const auto size = std::filesystem::file_size(d + "/cam1.png");
+  std::filesystem::resize_file(d + "/cam1.png", size / 2);
+  const testing::Result r = testing::RunCli(Args(d));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(d + "/cam1.png: a PNG cut short"), std::string::npos) << r.err;
+  ExpectNoOutput();
+}
+
 TEST_F(ReconstructCli, CaptureFromALargerRigExitsTwo) {
   const std::string d = BrokenCapture("extra_camera");
   std::filesystem::copy(d + "/cam0.png", d + "/cam4.png");
