@@ -72,7 +72,6 @@ int RunScore(int argc, char** argv) {
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 
   namespace fs = std::filesystem;
-  if (!report_path.empty()) OutputPaths().Claim(report_path, "the report (--report)");  // before minutes of scoring
   if (rig_path.empty()) {
     rig_path = (fs::path(dataset) / "truth" / "rig.yaml").string();
     std::printf("score: no --rig: using the TRUTH rig %s (issue 5 judges with the calibrated one)\n", rig_path.c_str());
@@ -83,6 +82,8 @@ int RunScore(int argc, char** argv) {
     if (ec || !fs::is_directory(diagnose_dir))
       throw InputError(diagnose_dir, "--diagnose: cannot create this folder (" + ec.message() + ")");
   }
+  // After --diagnose's folder exists: the report may go in it.
+  if (!report_path.empty()) OutputPaths().Claim(report_path, "the report (--report)");  // before minutes of scoring
   const Rig rig = ReadRigFile(rig_path);
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
   RuntimeOptions passive_options = options;

@@ -8,7 +8,8 @@ void OutputPaths::Claim(const std::string& path, const std::string& what, bool c
   namespace fs = std::filesystem;
   const fs::path key = fs::absolute(fs::path(path)).lexically_normal();
   if (const auto it = claimed_.find(key); it != claimed_.end())
-    throw InputError(path, "would be written twice (" + it->second + " and " + what + ")");
+    throw InputError(
+        path, "would be written twice (" + it->second + " and " + what + ")" + (remedy_.empty() ? "" : ": " + remedy_));
   if (check_folder && !fs::is_directory(key.parent_path())) throw InputError(path, "its folder does not exist");
   if (fs::is_directory(key)) throw InputError(path, "is a folder, not a file to write");
   claimed_.emplace(key, what);

@@ -8,11 +8,14 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <utility>
 
 namespace stereorig {
 
 class OutputPaths {
  public:
+  // `remedy`: appended to the message when a file is claimed twice.
+  explicit OutputPaths(std::string remedy = "") : remedy_(std::move(remedy)) {}
   // Records `path`, written as `what` (for the message). Throws InputError if
   // another output already claimed the same file, or, with
   // check_folder, if its folder does not exist (off for files in a folder
@@ -20,6 +23,7 @@ class OutputPaths {
   void Claim(const std::string& path, const std::string& what, bool check_folder = true);
 
  private:
+  std::string remedy_;
   std::map<std::filesystem::path, std::string> claimed_;  // normal absolute path -> what writes it
 };
 

@@ -72,7 +72,7 @@ struct CaptureOutputs {
 // summary's folder exists or is the output folder.
 std::vector<CaptureOutputs> PlanOutputs(const std::vector<std::string>& names, const BatchRequest& request) {
   std::vector<CaptureOutputs> outputs;
-  OutputPaths paths;
+  OutputPaths paths("rename a folder or choose another --report");
   // The output folder is created later, once everything is checked.
   auto claim = [&](const std::string& path, const std::string& what) { paths.Claim(path, what, false); };
   for (const std::string& name : names) {

@@ -82,12 +82,13 @@ bool SgmSimdAvailable();
 // True if the AVX2 kernels keep the path costs in bytes (32 disparities per
 // instruction; sgm_kernels.h, Avx2ByteKernels) for these options, signature
 // width and disparities per pixel, which they do only where that gives the
-// 16-bit path costs exactly. A path's smallest cost is at most the largest
-// matching cost (its best disparity adds only its own cost), so every path
-// cost, and every value a step compares, lies in [0, max cost + p2] (max
-// cost: kCensusMaxCost or the signatures' width); the bytes are taken while
-// max cost + 2 p2 <= 254, a margin of p2 over what exactness needs, and the
-// uniqueness test needs a lane off the best +-1 (more than 3 disparities).
+// 16-bit path costs exactly. Every path cost lies in [0, max cost + p2] (max
+// cost: kCensusMaxCost or the signatures' width), so a path's smallest cost
+// does too, and the capped term a step compares, smallest + p2, is at most
+// max cost + 2 p2 (with constant windows the smallest is at most max cost,
+// but a guided search's predecessor may have its best outside the pixel's
+// window); the bytes are taken while that is <= 254, and the uniqueness
+// test needs a lane off the best +-1 (more than 3 disparities).
 // The default p2 of 80: 62 + 160 = 222, so bytes; p2 above 95 (96 with
 // 62-bit signatures): 16 bits. Either way the same disparities.
 bool SgmPathCostsFitBytes(const SgmOptions& options, int signature_bits, int num_disparities);

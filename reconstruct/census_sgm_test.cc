@@ -318,6 +318,29 @@ TEST(CensusSgm, BytePathCostsAreExactUpToTheirLimit) {
       }
   EXPECT_EQ(cases, 2 * 2 * 4 * 2 * 2);
   EXPECT_GT(valid_total, 5000);  // not vacuous: the shifted view is matched
+  // The guided search, where a pixel's window can miss its predecessor's
+  // best disparity (its smallest path cost then exceeds the largest matching
+  // cost, up to max cost + p2): windows on the true shift for 70 % of the
+  // pixels, anywhere in [0, 130) for the rest (mostly disjoint from their
+  // neighbours'), against the scalar kernels.
+  cv::Mat guide(h, 84, CV_16SC1);
+  std::uniform_int_distribution<int> anywhere(0, 129);
+  std::bernoulli_distribution on_truth(0.7);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < guide.cols; ++x) guide.at<int16_t>(y, x) = int16_t(on_truth(rng) ? shift : anywhere(rng));
+  int guided_valid = 0;
+  for (const int p2 : {95, 96})
+    for (const int paths : {3, 4}) {
+      SgmOptions o;
+      o.p2 = p2;
+      o.num_paths = paths;
+      o.simd = true;
+      const cv::Mat simd = SgmMatchGuided(left, shifted, cv::Rect(6, 0, 84, h), guide, 8, 0, 130, o);
+      o.simd = false;
+      guided_valid += ExpectIdentical(simd, SgmMatchGuided(left, shifted, cv::Rect(6, 0, 84, h), guide, 8, 0, 130, o),
+                                      "guided p2 " + std::to_string(p2) + " paths " + std::to_string(paths));
+    }
+  EXPECT_GT(guided_valid, 1000);  // not vacuous
   SgmOptions o;
   EXPECT_FALSE(SgmPathCostsFitBytes(o, 62, 3));  // n = 3: 16 bits (the uniqueness test's empty case)
   EXPECT_TRUE(SgmPathCostsFitBytes(o, 34, 4));   // the default 5x7 census and p2: bytes

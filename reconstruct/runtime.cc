@@ -341,7 +341,12 @@ Reconstruction Runtime::Process(const std::vector<cv::Mat>& images, bool build_m
       }
     };
     std::vector<std::thread> threads;
-    for (int m = 1; m < nm; ++m) threads.emplace_back(run, m);
+    try {
+      for (int m = 1; m < nm; ++m) threads.emplace_back(run, m);
+    } catch (...) {  // no thread to be had: those started are joined before the error goes on
+      for (auto& th : threads) th.join();
+      throw;
+    }
     run(0);
     for (auto& th : threads) th.join();
     for (const std::exception_ptr& e : errors)

@@ -342,12 +342,14 @@ struct Avx2Kernels {
 // The path costs as bytes, 32 disparities per instruction instead of 16,
 // where that gives the same path costs (SgmPathCostsFitBytes, census_sgm.h):
 // every path cost is c + min(...) - prev_min with the min in [prev_min,
-// prev_min + p2], so it lies in [0, max cost + p2], and prev_min itself is at
-// most max cost (at the best disparity the min is prev_min), so the capped
-// term prev_min + p2 is too. Below 255 that, unsigned saturating byte adds
-// change no min a real lane takes (a saturated 255 loses to the capped term
-// as the true value would), and the rest is exact: min - prev_min is in
-// [0, p2] and adding the cost stays below 255. The sums stay
+// prev_min + p2], so it lies in [0, max cost + p2], prev_min (a path cost)
+// too, and the capped term prev_min + p2 is at most max cost + 2 p2 (a
+// guided search's shifted predecessor can have its smallest cost outside
+// the window, so its prev_min is not bounded by max cost). Below 255 that,
+// unsigned saturating byte adds change no min a real lane takes (a
+// saturated 255 loses to the capped term as the true value would), and the
+// rest is exact: min - prev_min is in [0, p2] and adding the cost stays
+// below 255. The sums stay
 // uint16, in the same layout as Avx2Kernels' (costs, sums and the winner
 // search are theirs); only the path buffers are bytes, with 255 as their
 // sentinels and padding lanes (summed over 3-4 paths, 765-1020: above any

@@ -1,5 +1,6 @@
 #include "calib/core/png_file.h"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <fstream>
@@ -16,15 +17,17 @@ bool CheckPngIsWhole(const std::string& path) {
   if (!f) throw InputError(path, "cannot be opened");
   std::array<uint8_t, 8> head{};
   if (!f.read(reinterpret_cast<char*>(head.data()), head.size()) || head != kSignature) return false;
+  // IEND closes the image; libpng ignores bytes after it, so it is looked
+  // for in the file's last 4 KiB rather than only at its very end.
   f.seekg(0, std::ios::end);
   const std::streamoff size = f.tellg();
-  std::array<uint8_t, 12> tail{};
-  if (size >= std::streamoff(head.size() + tail.size())) {
-    f.seekg(size - std::streamoff(tail.size()));
-    f.read(reinterpret_cast<char*>(tail.data()), tail.size());
-  }
-  if (!f || tail != kEnd)
-    throw InputError(path, "a PNG cut short (it does not end with its IEND chunk: still being written?)");
+  const std::streamoff span = std::min<std::streamoff>(size - std::streamoff(head.size()), 4096);
+  std::string tail(size_t(std::max<std::streamoff>(span, 0)), '\0');
+  f.seekg(size - span);
+  f.read(tail.data(), std::streamsize(tail.size()));
+  const std::string end(reinterpret_cast<const char*>(kEnd.data()), kEnd.size());
+  if (!f || tail.find(end) == std::string::npos)
+    throw InputError(path, "a PNG cut short (no IEND chunk at its end: still being written?)");
   return true;
 }
 

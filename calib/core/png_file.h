@@ -9,9 +9,9 @@
 namespace stereorig {
 
 // False if `path` does not start with the PNG signature (not a PNG: left to
-// the decoder). True if it does and ends with the IEND chunk. Throws
-// InputError naming the file if it is a PNG that does not end so (cut short,
-// or trailing bytes after the image).
+// the decoder). True if it does and its IEND chunk closes it (within its
+// last 4 KiB: libpng ignores bytes after it). Throws InputError naming the
+// file if it is a PNG without one there (cut short).
 bool CheckPngIsWhole(const std::string& path);
 
 }  // namespace stereorig
