@@ -72,6 +72,15 @@ TEST(ScoreCli, MissingDatasetExitsTwo) {
       testing::RunCli("score --dataset " + ::testing::TempDir() + "/no_such_dataset --report " + report);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find(report + ": its folder does not exist"), std::string::npos) << r.err;
+  // A report inside the --diagnose folder, which score creates: accepted (the
+  // run then stops at the missing dataset, not at the report).
+  const std::string diagnose = ::testing::TempDir() + "/score_cli_diagnose";
+  std::filesystem::remove_all(diagnose);
+  const testing::Result d = testing::RunCli("score --dataset " + ::testing::TempDir() + "/no_such_dataset --diagnose " +
+                                            diagnose + " --report " + diagnose + "/s.json");
+  EXPECT_EQ(d.code, 2);
+  EXPECT_EQ(d.err.find("s.json"), std::string::npos) << d.err;
+  EXPECT_NE(d.err.find("no_such_dataset"), std::string::npos) << d.err;
 }
 
 TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
