@@ -73,8 +73,8 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
     for (const Eigen::Vector3d& c : corners_ref) {
       const Eigen::Vector3d p_rect = plan.geometry.rect_from_left * (module_from_reference * c);
       if (!(p_rect.z() > 1.0))
-        throw InputError("runtime options", "the measurement volume reaches behind " + mod.name +
-                                                "'s cameras: check volume_center_mm / volume_size_mm");
+        throw InputError(options_.Where(), "the measurement volume reaches behind " + mod.name +
+                                               "'s cameras: check volume_center_mm / volume_size_mm");
       const Eigen::Vector3d q = plan.geometry.PixelAndDisparity(p_rect);
       u0 = std::min(u0, q.x()), u1 = std::max(u1, q.x());
       v0 = std::min(v0, q.y()), v1 = std::max(v1, q.y());
@@ -85,7 +85,7 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
                         cv::Point(int(std::ceil(u1)) + 1, int(std::ceil(v1)) + 1)) &
                image;
     if (plan.roi.area() == 0)
-      throw InputError("runtime options", "the measurement volume is not in " + mod.name + "'s view");
+      throw InputError(options_.Where(), "the measurement volume is not in " + mod.name + "'s view");
     plan.min_disparity_px = int(std::floor(d0)) - 2;
     plan.num_disparities = int(std::ceil(d1)) - int(std::floor(d0)) + 5;
     {  // What the matcher will be asked for, checked now rather than mid-capture on a module's thread.
@@ -98,10 +98,10 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
         char range[96];
         std::snprintf(range, sizeof range, "disparities %d to %d px", plan.min_disparity_px,
                       plan.min_disparity_px + plan.num_disparities - 1);
-        throw InputError("runtime options", "the measurement volume needs " + std::string(range) + " in " + mod.name +
-                                                ", which the matcher cannot search (" + e.what() +
-                                                "): make the volume shallower (volume_size_mm's depth) or move it "
-                                                "farther from the cameras (working_distance_mm, volume_center_mm)");
+        throw InputError(options_.Where(), "the measurement volume needs " + std::string(range) + " in " + mod.name +
+                                               ", which the matcher cannot search (" + e.what() +
+                                               "): make the volume shallower (volume_size_mm's depth) or move it "
+                                               "farther from the cameras (working_distance_mm, volume_center_mm)");
       }
     }
     plans_.push_back(std::move(plan));

@@ -155,12 +155,16 @@ RuntimeOptions FromYaml(YamlMap& y) {
 
 RuntimeOptions ReadRuntimeOptions(const std::string& path) {
   YamlMap y = YamlMap::LoadFile(path);
-  return FromYaml(y);
+  RuntimeOptions o = FromYaml(y);
+  o.source = path;
+  return o;
 }
 
 RuntimeOptions ParseRuntimeOptions(const std::string& text, const std::string& where) {
   YamlMap y = YamlMap::LoadString(text, where);
-  return FromYaml(y);
+  RuntimeOptions o = FromYaml(y);
+  o.source = where;
+  return o;
 }
 
 }  // namespace stereorig

@@ -51,6 +51,13 @@ struct RuntimeOptions {
   double fill_residual_length_mm = 0;
   bool parallel_modules = true;  // process modules on separate threads; default true
 
+  // Where these options came from (the YAML file's path; empty for the
+  // built-in defaults), for messages about them that only the Runtime can
+  // give (a volume this rig cannot see or search). Not a YAML key.
+  std::string source;
+  // "runtime options", or "<source> (runtime options)": the `where` of such messages.
+  std::string Where() const { return source.empty() ? "runtime options" : source + " (runtime options)"; }
+
   void Check() const;  // throws InputError naming the bad key
 };
 

@@ -287,7 +287,9 @@ TEST_F(ReconstructCli, AVolumeTooDeepForTheMatcherExitsTwo) {
     const testing::Result r = testing::RunCli(Args(dir_ + "/capture", "--options " + dir_ + "/deep.yaml"));
     EXPECT_EQ(r.code, 2) << "parallel_modules " << parallel << ": " << r.err;
     EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
-    EXPECT_NE(r.err.find("the measurement volume needs disparities"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(dir_ + "/deep.yaml (runtime options): the measurement volume needs disparities"),
+              std::string::npos)
+        << r.err;
     ExpectNoOutput();
   }
 }
