@@ -390,7 +390,8 @@ template <typename K, int kBlocks>
 // left-right check. row_min: each pixel's smallest sum if the last path
 // found it (VerticalRow's sum_min), else null. right_best (right_best_size):
 // scratch for the right view's best costs, right pixel x - lo - d (local)
-// at [x - lo - d + rb_origin].
+// at [rb_origin - (x - lo - d)]: by decreasing right pixel, so pixel x's
+// disparities 0, 1, ... are a forward run from [rb_origin - (x - lo)].
 template <typename K, int kBlocks>
 [[gnu::noinline]] void WinnerRow(const PathShape& shape, const uint16_t* srow, const int16_t* lo,
                                  const uint16_t* row_min, uint16_t* right_best, size_t right_best_size, int rb_origin,
@@ -402,7 +403,7 @@ template <typename K, int kBlocks>
   // and a load overlapping the previous store stalls store forwarding.
   for (int phase = 0; phase < 16; ++phase)
     for (int x = phase; x < w; x += 16)
-      K::template RightBest<kBlocks>(srow + size_t(x) * stride, n, stride, right_best + x - lo[x] + rb_origin);
+      K::template RightBest<kBlocks>(srow + size_t(x) * stride, n, stride, right_best + rb_origin - (x - lo[x]));
   for (int x = 0; x < w; ++x) {
     const uint16_t* s = srow + size_t(x) * stride;
     const uint16_t best_cost = row_min != nullptr ? row_min[x] : K::template Min<kBlocks>(s, stride);
@@ -415,7 +416,7 @@ template <typename K, int kBlocks>
     // D+k (|k| <= tolerance, same right pixel) reaches its best cost. k = 0
     // first, without a load: s[best] is best_cost (right_min <= it).
     const int disparity_px = lo[x] + best;
-    const uint16_t right_min = right_best[x - disparity_px + rb_origin];
+    const uint16_t right_min = right_best[rb_origin - (x - disparity_px)];
     auto reaches = [&](int k) {
       const int xk = x + k, dk = disparity_px + k - lo[std::clamp(xk, 0, w - 1)];
       return xk >= 0 && xk < w && dk >= 0 && dk < n && srow[size_t(xk) * stride + dk] <= right_min;
@@ -532,9 +533,10 @@ cv::Mat SgmMatchWith(const CensusImage& left, const CensusImage& right, const cv
   P* shifted_rl = PathBuffers(ws.shifted_rl, 1, stride, kPathBig);
   uint16_t* row_min = Grow(ws.row_min, w);
   // Right-view best costs: the right pixel x - lo - d (local) is stored at
-  // [x - lo - d + lo_max + stride - 1] >= 0 (the SIMD kernel writes all
-  // `stride` lanes below its start).
-  const int rb_origin = int(lo_max) + stride - 1;
+  // [rb_origin - (x - lo - d)], from 0 (x = w - 1, lo = lo_min, d = 0) up to
+  // w - 1 + lo_max - lo_min + stride - 1 (the SIMD kernel writes all `stride`
+  // lanes of a run).
+  const int rb_origin = w - 1 - int(lo_min);
   const size_t right_best_size = size_t(w) + size_t(lo_max - lo_min) + 2 * size_t(stride);
   uint16_t* right_best = Grow(ws.right_best, right_best_size);
 

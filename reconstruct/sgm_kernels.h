@@ -84,10 +84,10 @@ struct ScalarKernels {
     return m;
   }
 
-  // rb[-d] = min(rb[-d], s[d]) for d in [0, n).
+  // rb[d] = min(rb[d], s[d]) for d in [0, n).
   template <int kBlocks = 0>
   static void RightBest(const uint16_t* __restrict s, int n, int /*stride*/, uint16_t* rb) {
-    for (int d = 0; d < n; ++d) rb[-d] = std::min(rb[-d], s[d]);
+    for (int d = 0; d < n; ++d) rb[d] = std::min(rb[d], s[d]);
   }
 
   template <int kBlocks = 0>
@@ -285,18 +285,14 @@ struct Avx2Kernels {
     return HorizontalMin(m);
   }
 
-  // rb[-d] = min(rb[-d], s[d]) over all lanes (padding lanes hold >= 3 kBig,
-  // above any real sum, so they change nothing a real lane reads); rb must
-  // be writable down to rb[-(stride-1)].
+  // rb[d] = min(rb[d], s[d]) over all lanes (padding lanes hold more than
+  // any real sum, so they change nothing a real lane reads); rb must be
+  // writable up to rb[stride - 1]. (The right view's best costs are stored
+  // by decreasing right pixel, so a pixel's run of disparities is a forward
+  // run there: no lane reversal, session 17.)
   template <int kBlocks = 0>
   static void RightBest(const uint16_t* __restrict s, int /*n*/, int stride, uint16_t* rb) {
-    const __m256i reverse = _mm256_setr_epi8(14, 15, 12, 13, 10, 11, 8, 9, 6, 7, 4, 5, 2, 3, 0, 1,  //
-                                             14, 15, 12, 13, 10, 11, 8, 9, 6, 7, 4, 5, 2, 3, 0, 1);
-    ForBlocks<kBlocks>(stride, [&](int d) {
-      const __m256i v = _mm256_permute4x64_epi64(_mm256_shuffle_epi8(Load(s + d), reverse), 0x4E);
-      uint16_t* dst = rb - d - 15;
-      Store(dst, _mm256_min_epu16(Load(dst), v));
-    });
+    ForBlocks<kBlocks>(stride, [&](int d) { Store(rb + d, _mm256_min_epu16(Load(rb + d), Load(s + d))); });
   }
 
   template <int kBlocks = 0>
