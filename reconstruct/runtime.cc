@@ -4,19 +4,17 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <exception>
 #include <filesystem>
 #include <limits>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <regex>
-#include <thread>
 
 #include "calib/core/input_error.h"
-#include "calib/core/png_file.h"
 #include "reconstruct/elapsed_ms.h"
+#include "reconstruct/grey_image.h"
 #include "reconstruct/hole_fill.h"
 #include "reconstruct/lit_mask.h"
+#include "reconstruct/parallel_for.h"
 #include "reconstruct/right_occlusion.h"
 
 namespace stereorig {
@@ -328,32 +326,12 @@ Reconstruction Runtime::Process(const std::vector<cv::Mat>& images, bool build_m
   std::vector<Mesh> meshes(nm);
   out.modules.resize(nm);
   auto t = Clock::now();
-  if (options_.parallel_modules && nm > 1) {
-    // An exception must not leave a module's thread (std::terminate) nor
-    // unwind past threads not yet joined: each module's is kept, every
-    // thread joined, then the first one rethrown.
-    std::vector<std::exception_ptr> errors(nm);
-    auto run = [&](int m) {
-      try {
-        ProcessModule(plans_[m], images, build_mesh, &clouds[m], &meshes[m], &out.modules[m]);
-      } catch (...) {
-        errors[m] = std::current_exception();
-      }
-    };
-    std::vector<std::thread> threads;
-    try {
-      for (int m = 1; m < nm; ++m) threads.emplace_back(run, m);
-    } catch (...) {  // no thread to be had: those started are joined before the error goes on
-      for (auto& th : threads) th.join();
-      throw;
-    }
-    run(0);
-    for (auto& th : threads) th.join();
-    for (const std::exception_ptr& e : errors)
-      if (e) std::rethrow_exception(e);
-  } else {
-    for (int m = 0; m < nm; ++m) ProcessModule(plans_[m], images, build_mesh, &clouds[m], &meshes[m], &out.modules[m]);
-  }
+  // One module per thread (module 0 on this one), or all here in turn;
+  // ParallelForChunks joins every thread before rethrowing what one threw.
+  ParallelForChunks(nm, options_.parallel_modules ? nm : 1, [&](int begin, int end) {
+    for (int m = begin; m < end; ++m)
+      ProcessModule(plans_[m], images, build_mesh, &clouds[m], &meshes[m], &out.modules[m]);
+  });
   out.times_ms["modules"] = MsSince(t);
   t = Clock::now();
   size_t total_points = 0;
@@ -404,15 +382,7 @@ std::vector<cv::Mat> LoadCapture(const std::string& dir, const Rig& rig) {
   std::vector<cv::Mat> images;
   for (int k = 0; k < rig.num_cameras(); ++k) {
     const std::string path = (std::filesystem::path(dir) / ("cam" + std::to_string(k) + ".png")).string();
-    CheckPngIsWhole(path);
-    cv::Mat img;
-    try {
-      img = cv::imread(path, cv::IMREAD_UNCHANGED);
-    } catch (const cv::Exception& e) {  // e.g. a header whose size the decoder refuses
-      throw InputError(path, "cannot read the image (" + e.msg + ")");
-    }
-    if (img.empty()) throw InputError(path, "cannot read the image");
-    if (img.type() != CV_8UC1) throw InputError(path, "must be an 8-bit single-channel (grey) PNG");
+    cv::Mat img = ReadGreyImage(path);
     const Camera& cam = rig.camera(k);
     if (img.cols != cam.imager_width_px() || img.rows != cam.imager_height_px())
       throw InputError(path, "is " + std::to_string(img.cols) + "x" + std::to_string(img.rows) + ", the rig says " +
