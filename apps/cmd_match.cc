@@ -2,31 +2,16 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <opencv2/imgcodecs.hpp>
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
 #include "calib/core/input_error.h"
-#include "calib/core/png_file.h"
 #include "reconstruct/elapsed_ms.h"
+#include "reconstruct/grey_image.h"
 #include "reconstruct/matcher.h"
 #include "reconstruct/pfm.h"
 
 namespace stereorig {
-
-namespace {
-
-cv::Mat ReadGrey(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) throw InputError(path, "no such file");
-  CheckPngIsWhole(path);
-  cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (image.empty()) throw InputError(path, "cannot read the image (not an image, or a damaged one)");
-  if (image.type() != CV_8UC1) throw InputError(path, "must be an 8-bit single-channel (grey) image");
-  return image;
-}
-
-}  // namespace
 
 int RunMatch(int argc, char** argv) {
   CLI::App app{
@@ -55,7 +40,7 @@ int RunMatch(int argc, char** argv) {
   options.matcher = ParseMatcherKind(matcher, "--matcher");
   if (!roi.empty()) options.roi = cv::Rect(roi[0], roi[1], roi[2], roi[3]);
   options.Check();
-  const cv::Mat left = ReadGrey(left_path), right = ReadGrey(right_path);
+  const cv::Mat left = ReadGreyImage(left_path), right = ReadGreyImage(right_path);
   if (left.size() != right.size()) throw InputError(right_path, "size differs from the left image");
 
   const auto t0 = std::chrono::steady_clock::now();

@@ -1,0 +1,17 @@
+// Reading one 8-bit grey image the user gave (a capture's camK.png, a
+// rectified pair for `match`): every way it can be unreadable is bad input
+// (InputError) in one line naming the file, never OpenCV's or libpng's own
+// lines on stderr.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+
+namespace stereorig {
+
+// The image at `path`, CV_8UC1. Throws InputError if the file is missing, is
+// a PNG cut short (calib/core/png_file.h), cannot be decoded, or is not
+// 8-bit single-channel.
+cv::Mat ReadGreyImage(const std::string& path);
+
+}  // namespace stereorig
