@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
+#include <string>
 
 #include "calib/core/rig.h"
 
@@ -41,8 +42,16 @@ struct RectifiedGeometry {
 // volume's centre): it fixes the principal points and the disparity offset.
 // The focal length is the smaller mean focal length of the two cameras, so
 // no view is magnified beyond its native sampling.
+// Throws InputError on a degenerate module (zero baseline, baseline along
+// the optical axes: where `names.rig`) or a look-at point behind it (where
+// `names.options`); the messages name the module as `names.module`.
+struct RectificationNames {
+  std::string rig = "rig";                  // the rig file
+  std::string options = "runtime options";  // where the measurement volume was set
+  std::string module = "a module";          // e.g. "module 'm1'"
+};
 RectifiedGeometry ComputeRectification(const Camera& left, const Camera& right, const Pose& right_from_left,
-                                       const Eigen::Vector3d& look_at_left_mm);
+                                       const Eigen::Vector3d& look_at_left_mm, const RectificationNames& names = {});
 
 // Remap table of one view (CV_32FC1 x and y, rectified size): rectified
 // pixel -> original pixel. Pixels whose ray does not project (behind a lens)

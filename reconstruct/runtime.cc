@@ -51,13 +51,14 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
     const Camera& left = rig_.camera(mod.left_camera);
     const Camera& right = rig_.camera(mod.right_camera);
     if (right.imager_width_px() != left.imager_width_px() || right.imager_height_px() != left.imager_height_px())
-      throw InputError("rig", mod.name + ": its two cameras' imagers differ in size (not supported)");
+      throw InputError(rig_.Where(), mod.name + ": its two cameras' imagers differ in size (not supported)");
     ModulePlan plan;
     plan.module = m;
     plan.reference_from_module = rig_.S(0, m);
     const Pose module_from_reference = rig_.S(m, 0);
     plan.camera_centre_reference_mm = plan.reference_from_module.translation_mm();
-    plan.geometry = ComputeRectification(left, right, mod.right_from_left, module_from_reference * volume_center_mm_);
+    plan.geometry = ComputeRectification(left, right, mod.right_from_left, module_from_reference * volume_center_mm_,
+                                         RectificationNames{rig_.Where(), options_.Where(), mod.name});
     plan.maps = BuildRectifyMaps(plan.geometry, left, right);
     {  // the exact float table, only for the mask (the runtime keeps the fixed-point one)
       cv::Mat right_x, right_y;

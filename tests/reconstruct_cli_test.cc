@@ -294,6 +294,35 @@ TEST_F(ReconstructCli, AVolumeTooDeepForTheMatcherExitsTwo) {
   }
 }
 
+// A rig file whose module cannot be rectified, and a measurement volume
+// behind a module: one line naming the file that is wrong and the module, no
+// output.
+TEST_F(ReconstructCli, ADegenerateModuleOrAVolumeBehindItNamesTheFileAndModule) {
+  const SimulatedRig sim = MakeDefaultRig();
+  std::vector<StereoModule> modules = sim.rig.modules();
+  modules[1].right_from_left = Pose(modules[1].right_from_left.rotation(), Eigen::Vector3d::Zero());
+  const Rig flat(sim.rig.cameras(), sim.rig.camera_names(), modules, sim.rig.S(), "test");
+  WriteRigFile(flat, dir_ + "/flat.yaml");
+  testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/flat.yaml --capture " + dir_ +
+                                      "/capture --out " + dir_ + "/out.ply --report " + dir_ + "/out.json");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(dir_ + "/flat.yaml: " + modules[1].name + ": its cameras share one centre"), std::string::npos)
+      << r.err;
+  ExpectNoOutput();
+
+  // The reference frame is module 0's left camera: z < 0 is behind it.
+  WriteFileAtomically(dir_ + "/behind.yaml", "volume_center_mm: [0, 0, -300]\n");
+  r = testing::RunCli(Args(dir_ + "/capture", "--options " + dir_ + "/behind.yaml"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(dir_ + "/behind.yaml (runtime options): the measurement volume's centre is behind " +
+                       sim.rig.module(0).name),
+            std::string::npos)
+      << r.err;
+  ExpectNoOutput();
+}
+
 // Many captures, one runtime (apps/reconstruct_batch.h): each cloud is the
 // one a single-capture run writes, byte for byte (the runtime keeps no state
 // between captures); a capture with a broken image gets no output while the

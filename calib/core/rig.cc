@@ -37,7 +37,8 @@ Rig::Rig(std::vector<Camera> cameras, std::vector<std::string> camera_names, std
     : cameras_(std::move(cameras)),
       camera_names_(std::move(camera_names)),
       modules_(std::move(modules)),
-      S_(std::move(S)) {
+      S_(std::move(S)),
+      source_(where) {
   CheckTopology(where);
   if (static_cast<int>(S_.size()) != num_modules()) {
     throw InputError(where, "S has " + std::to_string(S_.size()) + " rows but the rig has " +

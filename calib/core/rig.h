@@ -51,7 +51,8 @@ class Rig {
   Rig(std::vector<Camera> cameras, std::vector<std::string> camera_names, std::vector<StereoModule> modules,
       const std::vector<Pose>& module0_from_module);
   // Takes a full S as given; throws InputError(`where`, ...) if it breaks an
-  // invariant, or if modules name cameras that do not exist.
+  // invariant, or if modules name cameras that do not exist. `where` (the
+  // rig file's path) is kept as source().
   Rig(std::vector<Camera> cameras, std::vector<std::string> camera_names, std::vector<StereoModule> modules,
       std::vector<std::vector<Pose>> S, const std::string& where);
 
@@ -70,6 +71,12 @@ class Rig {
   // cam_from_module0 = cam_from_module_i * module_i_from_module0.
   Pose CamFromReference(int camera_index) const;
 
+  // Where the rig was read from (the `where` it was built with; empty for a
+  // rig built in memory), and the `where` of later messages about it: the
+  // source, or "rig" when there is none.
+  const std::string& source() const { return source_; }
+  std::string Where() const { return source_.empty() ? "rig" : source_; }
+
   Provenance& provenance() { return provenance_; }
   const Provenance& provenance() const { return provenance_; }
 
@@ -85,6 +92,7 @@ class Rig {
   std::vector<StereoModule> modules_;
   std::vector<std::vector<Pose>> S_;
   Provenance provenance_;
+  std::string source_;
 };
 
 }  // namespace stereorig
