@@ -128,6 +128,9 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
   fs::create_directories(request.out_dir, ec);
   if (ec || !fs::is_directory(request.out_dir))
     throw InputError(request.out_dir, "cannot create the output folder" + (ec ? ": " + ec.message() : ""));
+  // A summary from an earlier run would describe that run until this one
+  // ends: it goes now and is written anew at the end.
+  if (!request.summary_path.empty()) fs::remove(request.summary_path, ec);
   std::printf("runtime built in %.0f ms (%d modules); %zu captures -> %s\n", build_ms, rig.num_modules(), dirs.size(),
               request.out_dir.c_str());
   std::fflush(stdout);
@@ -151,27 +154,34 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
       error = e.what();
     }
     if (i + 1 < dirs.size()) next = std::async(std::launch::async, load, dirs[i + 1]);
-    if (!error.empty()) {
-      // Bad images in this capture: no output for it (not a stale one from
-      // an earlier run either); the rest go on.
+    // A capture that fails (bad images, or outputs that cannot be written)
+    // has no output: not a partial one, nor a stale one from an earlier run.
+    // The rest go on.
+    auto fail = [&](const std::string& why) {
       ++failed;
-      std::fprintf(stderr, "stereorig reconstruct: [%zu/%zu] %s\n", i + 1, dirs.size(), error.c_str());
+      std::fprintf(stderr, "stereorig reconstruct: [%zu/%zu] %s\n", i + 1, dirs.size(), why.c_str());
       for (const std::string& path : {outputs[i].cloud, outputs[i].report, outputs[i].mesh})
         if (!path.empty()) fs::remove(path, ec);
       entry["ok"] = false;
-      entry["error"] = error;
+      entry["error"] = why;
       summary["captures"].push_back(entry);
+    };
+    if (!error.empty()) {
+      fail(error);
       continue;
     }
     const Reconstruction rec = runtime.Process(images, mesh);
     const std::string& cloud_path = outputs[i].cloud;
-    WriteCloudPly(rec.cloud, cloud_path);
-    entry["cloud"] = cloud_path;
-    if (mesh) {
-      WriteMesh(rec.mesh, outputs[i].mesh);
-      entry["mesh"] = outputs[i].mesh;
+    try {
+      WriteCloudPly(rec.cloud, cloud_path);
+      if (mesh) WriteMesh(rec.mesh, outputs[i].mesh);
+      WriteFileAtomically(outputs[i].report, ReconstructionJson(rec).dump(2) + "\n");
+    } catch (const InputError& e) {  // the writers' failures (atomic_file.h)
+      fail(e.what());
+      continue;
     }
-    WriteFileAtomically(outputs[i].report, ReconstructionJson(rec).dump(2) + "\n");
+    entry["cloud"] = cloud_path;
+    if (mesh) entry["mesh"] = outputs[i].mesh;
     entry["report"] = outputs[i].report;
     entry["ok"] = true;
     entry["points"] = rec.cloud.size();
@@ -199,8 +209,8 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
               all_ms / 1000, summary["objects_per_s"].get<double>());
   if (!request.summary_path.empty()) WriteFileAtomically(request.summary_path, summary.dump(2) + "\n");
   if (failed > 0) {
-    std::fprintf(stderr, "stereorig reconstruct: %d of %zu captures were bad input and have no output\n", failed,
-                 dirs.size());
+    std::fprintf(stderr, "stereorig reconstruct: %d of %zu captures failed (bad input, or outputs that could not be "
+                 "written) and have no output\n", failed, dirs.size());
     return kExitBadInput;
   }
   return kExitOk;

@@ -363,6 +363,43 @@ TEST_F(ReconstructCli, ABatchWritesEachCapturesOwnCloudAndSkipsABrokenOne) {
   EXPECT_NE(summary["captures"][1]["error"].get<std::string>().find("0002/cam1.png"), std::string::npos);
 }
 
+// A capture whose outputs cannot be written has none, not a partial nor a
+// stale one, and the batch goes on. The trigger: a 240-character folder
+// name, so "<name>.ply" (244) is a valid file name but the atomic writer's
+// temporary ".tmp-<pid>-<n>-<name>.ply" passes NAME_MAX (255): open fails
+// with ENAMETOOLONG, as a full disk would fail a write (root ignores
+// permissions, so these tests cannot use them).
+TEST_F(ReconstructCli, ABatchCaptureWhoseOutputsCannotBeWrittenHasNone) {
+  const std::string batch = dir_ + "/batch_write", out = dir_ + "/batch_write_out";
+  std::filesystem::remove_all(batch);
+  std::filesystem::remove_all(out);
+  std::filesystem::create_directories(batch);
+  std::filesystem::create_directories(out);
+  const std::string long_name(240, 'w');
+  for (const std::string& name : {std::string("0001"), long_name})
+    std::filesystem::copy(dir_ + "/capture", batch + "/" + name);
+  std::ofstream(out + "/" + long_name + ".json") << "a report from an earlier run\n";  // (not atomic: see above)
+  ASSERT_TRUE(std::filesystem::exists(out + "/" + long_name + ".json"));
+  const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + batch + "/0001 " +
+                                            batch + "/" + long_name + " --out-dir " + out + " --report " + out +
+                                            "/batch.json");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("[2/2] " + out + "/" + long_name + ".ply: cannot write: File name too long"), std::string::npos)
+      << r.err;
+  EXPECT_TRUE(std::filesystem::exists(out + "/0001.ply"));
+  EXPECT_TRUE(std::filesystem::exists(out + "/0001.json"));
+  for (const char* ext : {".ply", ".json"}) EXPECT_FALSE(std::filesystem::exists(out + "/" + long_name + ext)) << ext;
+  std::ifstream f(out + "/batch.json");
+  const nlohmann::json summary = nlohmann::json::parse(f);
+  EXPECT_EQ(summary["reconstructed"], 1);
+  EXPECT_EQ(summary["failed"], 1);
+  EXPECT_EQ(summary["captures"][0]["ok"], true);
+  EXPECT_EQ(summary["captures"][1]["ok"], false);
+  EXPECT_NE(summary["captures"][1]["error"].get<std::string>().find("cannot write"), std::string::npos);
+  for (const auto& entry : std::filesystem::directory_iterator(out))  // no temporary left behind
+    EXPECT_NE(entry.path().filename().string().rfind(".tmp-", 0), 0u) << entry.path();
+}
+
 // What needs no decoding is checked for every capture first: a missing
 // camera in the last folder, a folder given twice, or --out with several
 // captures write nothing at all.
