@@ -43,6 +43,8 @@ const char* PixelStatusName(PixelStatus status) {
       return "occluded";
     case PixelStatus::kWrongLine:
       return "wrong_line";
+    case PixelStatus::kLeftViewEdge:
+      return "left_view_edge";
     case PixelStatus::kNumStatus:
       break;
   }

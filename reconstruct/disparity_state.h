@@ -11,7 +11,7 @@ namespace stereorig {
 
 // What became of each left pixel: a point, or the first test that rejected
 // it. The matcher sets the codes up to kNotDistinct and kOccluded,
-// kWrongLine; the runtime adds kLowConfidence, kOutsideVolume, kObjectSize. For finding where fill is lost (`stereorig
+// kWrongLine, kLeftViewEdge; the runtime adds kLowConfidence, kOutsideVolume, kObjectSize. For finding where fill is lost (`stereorig
 // score` tabulates them).
 enum class PixelStatus : uint8_t {
   kNotSearched = 0,  // outside the matched region
@@ -31,6 +31,7 @@ enum class PixelStatus : uint8_t {
   kObjectSize,       // runtime: farther than object_size_mm from the module cloud's median
   kOccluded,         // its match in the right view is hidden by a nearer surface, or outside it (right_occlusion.h)
   kWrongLine,        // in a component on the wrong laser line that no whole-period move fixes (line_index.h)
+  kLeftViewEdge,     // its refinement window reaches past the left view's data (left_view_edge.h)
   kNumStatus
 };
 const char* PixelStatusName(PixelStatus status);

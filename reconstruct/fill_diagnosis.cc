@@ -207,6 +207,8 @@ cv::Vec3b StatusColour(uint8_t status) {  // BGR
       return {128, 128, 128};  // grey
     case PixelStatus::kWrongLine:
       return {180, 105, 255};  // pink
+    case PixelStatus::kLeftViewEdge:
+      return {64, 64, 64};  // dark grey
     default:
       return {255, 255, 255};
   }

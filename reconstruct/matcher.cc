@@ -13,6 +13,7 @@
 #include "reconstruct/disparity_band.h"
 #include "reconstruct/disparity_slopes.h"
 #include "reconstruct/elapsed_ms.h"
+#include "reconstruct/left_view_edge.h"
 #include "reconstruct/line_index.h"
 #include "reconstruct/parallel_for.h"
 #include "reconstruct/region_grow.h"
@@ -79,6 +80,7 @@ void MatchOptions::Check() const {
   if (!(occlusion_margin_px >= 0 && occlusion_margin_px <= 8))
     throw InputError("occlusion_margin_px", "must be in [0, 8] (0 = off)");
   if (!right_valid.empty() && right_valid.type() != CV_8UC1) throw InputError("right_valid", "must be CV_8UC1");
+  if (!left_valid.empty() && left_valid.type() != CV_8UC1) throw InputError("left_valid", "must be CV_8UC1");
   if (sgbm_block_size < 1 || sgbm_block_size % 2 == 0 || sgbm_block_size > 11)
     throw InputError("sgbm_block_size", "must be odd, in [1, 11]");
   if (num_threads < 1 || num_threads > 64) throw InputError("num_threads", "must be in [1, 64]");
@@ -439,6 +441,7 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
     RemoveSpeckles(state.disparity_px(roi), o);  // outside the ROI nothing is valid
   }
   DropRightInvisible(o.occlusion_margin_px, o.right_valid, roi, &state);
+  DropLeftViewEdge(o.left_valid, o.subpixel.half_width_px, o.subpixel.half_height_px, roi, &state);
   for (int y = roi.y; y < roi.y + roi.height; ++y) {  // outside the ROI: no point, confidence 0 already
     const float* d = state.disparity_px.ptr<float>(y);
     float* c = state.confidence.ptr<float>(y);
@@ -505,6 +508,8 @@ MatchResult Match(const cv::Mat& left, const cv::Mat& right, const MatchOptions&
   if (left.size() != right.size()) throw InputError("match", "left and right images differ in size");
   if (!options.right_valid.empty() && options.right_valid.size() != right.size())
     throw InputError("right_valid", "differs in size from the right image");
+  if (!options.left_valid.empty() && options.left_valid.size() != left.size())
+    throw InputError("left_valid", "differs in size from the left image");
   const cv::Rect roi = ClampRoi(options.roi, left.size());
   if (roi.width <= 0 || roi.height <= 0) throw InputError("roi", "does not overlap the image");
   if (options.matcher == MatcherKind::kOpenCvSgbm3WayStandalone) return MatchOpenCvSgbm(left, right, roi, options);

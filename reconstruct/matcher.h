@@ -133,9 +133,16 @@ struct MatchOptions {
   // finer than the window (~4 x 2 mm at 200 mm) is smoothed. Default on.
   SurfaceFitOptions surface_fit;
   // CV_8UC1 of the right image's size: 0 where the rectified right image
-  // has no data (RightViewValidMask); empty = every column valid. The
+  // has no data (ViewValidMask); empty = every column valid. The
   // runtime sets it from its remap tables. Default empty.
   cv::Mat right_valid;
+  // census_sgm, opencv_sgbm_3way: CV_8UC1 of the left image's size, 0 where
+  // the rectified left image has no data (ViewValidMask of the left remap
+  // tables). Last but the surface fit, a point whose sub-pixel window
+  // (subpixel.half_width_px x half_height_px about it) reaches such a pixel
+  // is dropped (left_view_edge.h). Empty = no test. The runtime sets it.
+  // Default empty.
+  cv::Mat left_valid;
   int speckle_window_px = 100;    // remove disparity blobs smaller than this, px (0 = off); default 100
   double speckle_range_px = 1.0;  // neighbours within this disparity are one blob, px; default 1
   int sgbm_block_size = 5;        // opencv_sgbm_3way: block size, px (odd); default 5

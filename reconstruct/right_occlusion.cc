@@ -9,12 +9,12 @@
 
 namespace stereorig {
 
-cv::Mat RightViewValidMask(const cv::Mat& right_x, const cv::Mat& right_y, const cv::Size& sensor_size) {
-  STEREORIG_CHECK(right_x.type() == CV_32FC1 && right_y.type() == CV_32FC1 && right_x.size() == right_y.size());
-  cv::Mat valid(right_x.size(), CV_8UC1, cv::Scalar(0));
+cv::Mat ViewValidMask(const cv::Mat& map_x, const cv::Mat& map_y, const cv::Size& sensor_size) {
+  STEREORIG_CHECK(map_x.type() == CV_32FC1 && map_y.type() == CV_32FC1 && map_x.size() == map_y.size());
+  cv::Mat valid(map_x.size(), CV_8UC1, cv::Scalar(0));
   for (int y = 0; y < valid.rows; ++y) {
-    const float* mx = right_x.ptr<float>(y);
-    const float* my = right_y.ptr<float>(y);
+    const float* mx = map_x.ptr<float>(y);
+    const float* my = map_y.ptr<float>(y);
     uint8_t* v = valid.ptr<uint8_t>(y);
     for (int x = 0; x < valid.cols; ++x)
       v[x] = mx[x] >= 0 && my[x] >= 0 && mx[x] <= sensor_size.width - 1 && my[x] <= sensor_size.height - 1 ? 255 : 0;

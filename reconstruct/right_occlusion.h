@@ -29,10 +29,11 @@
 
 namespace stereorig {
 
-// CV_8UC1, right_x's size: 255 where the rectified right pixel samples the
-// sensor (right_x in [0, width - 1], right_y in [0, height - 1]), else 0.
-// right_x, right_y: CV_32FC1 rectification maps (rectified -> original px).
-cv::Mat RightViewValidMask(const cv::Mat& right_x, const cv::Mat& right_y, const cv::Size& sensor_size);
+// CV_8UC1, map_x's size: 255 where the rectified pixel samples the sensor
+// (map_x in [0, width - 1], map_y in [0, height - 1]), else 0. map_x, map_y:
+// CV_32FC1 rectification maps (rectified -> original px) of either view: the
+// right view's for the test below, the left view's for left_view_edge.h.
+cv::Mat ViewValidMask(const cv::Mat& map_x, const cv::Mat& map_y, const cv::Size& sensor_size);
 
 // Sets the disparity of every pixel of `roi` that the right camera cannot
 // see (see above) to +inf, its confidence to 0 and its status to

@@ -6,6 +6,7 @@
 #include "reconstruct/right_occlusion.h"
 
 #include "calib/core/input_error.h"
+#include "reconstruct/disparity_state_testing.h"
 #include "reconstruct/runtime_options.h"
 
 #include <gtest/gtest.h>
@@ -17,12 +18,7 @@
 namespace stereorig {
 namespace {
 
-DisparityState StateOf(const cv::Mat& disparity) {
-  return DisparityState{disparity.clone(), cv::Mat(disparity.size(), CV_32FC1, cv::Scalar(0.9)),
-                        cv::Mat(disparity.size(), CV_8UC1, cv::Scalar(uint8_t(PixelStatus::kPoint))),
-                        cv::Mat(disparity.size(), CV_32FC1, cv::Scalar(0)),
-                        cv::Mat(disparity.size(), CV_32FC1, cv::Scalar(0))};
-}
+using testing::StateOf;
 
 bool Dropped(const DisparityState& s, int y, int x) {
   return !std::isfinite(s.disparity_px.at<float>(y, x)) &&
@@ -155,7 +151,7 @@ TEST(RightOcclusion, DropsExactlyWhatThePlainRuleDrops) {
 TEST(RightOcclusion, ValidMaskFromRemapTables) {
   cv::Mat mx(2, 10, CV_32FC1), my(2, 10, CV_32FC1, cv::Scalar(0.5));
   for (int x = 0; x < 10; ++x) mx.col(x).setTo(x - 3.0);  // rectified x -> sensor x - 3
-  const cv::Mat v = RightViewValidMask(mx, my, cv::Size(5, 2));
+  const cv::Mat v = ViewValidMask(mx, my, cv::Size(5, 2));
   for (int x = 0; x < 10; ++x) EXPECT_EQ(v.at<uint8_t>(1, x), (x >= 3 && x <= 7) ? 255 : 0) << x;
 }
 

@@ -60,11 +60,12 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
     plan.geometry = ComputeRectification(left, right, mod.right_from_left, module_from_reference * volume_center_mm_,
                                          RectificationNames{rig_.Where(), options_.Where(), mod.name});
     plan.maps = BuildRectifyMaps(plan.geometry, left, right);
-    {  // the exact float table, only for the mask (the runtime keeps the fixed-point one)
-      cv::Mat right_x, right_y;
-      BuildRectifyMap(plan.geometry, right, RectifiedView::kRight, &right_x, &right_y);
-      plan.right_valid =
-          RightViewValidMask(right_x, right_y, cv::Size(right.imager_width_px(), right.imager_height_px()));
+    {  // the exact float tables, only for the masks (the runtime keeps the fixed-point ones)
+      cv::Mat map_x, map_y;
+      BuildRectifyMap(plan.geometry, right, RectifiedView::kRight, &map_x, &map_y);
+      plan.right_valid = ViewValidMask(map_x, map_y, cv::Size(right.imager_width_px(), right.imager_height_px()));
+      BuildRectifyMap(plan.geometry, left, RectifiedView::kLeft, &map_x, &map_y);
+      plan.left_valid = ViewValidMask(map_x, map_y, cv::Size(left.imager_width_px(), left.imager_height_px()));
     }
     // The volume's image: a box's central projection is bounded by its
     // corners' (all in front), and Z, so the disparity, is extreme at corners.
@@ -151,6 +152,7 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
     mo.min_disparity_px = plan.min_disparity_px;
     mo.num_disparities = plan.num_disparities;
     mo.right_valid = plan.right_valid;
+    mo.left_valid = plan.left_valid;
     match = Match(left, right, mo);
     for (const auto& [step, ms] : match.times_ms) report->times_ms["match." + step] = ms;
     report->surface_fit = match.surface_fit;

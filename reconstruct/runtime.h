@@ -35,6 +35,7 @@ struct ModulePlan {
   RectifiedGeometry geometry;
   RectifyMaps maps;
   cv::Mat right_valid;       // CV_8UC1: rectified right px with sensor data (right_occlusion.h)
+  cv::Mat left_valid;        // CV_8UC1: rectified left px with sensor data (left_view_edge.h)
   cv::Rect roi;              // rectified left px covered by the measurement volume
   int min_disparity_px = 0;  // image disparity range of the volume (rectify.h), with 2 px margin
   int num_disparities = 0;
