@@ -11,8 +11,16 @@ point-to-plane ICP from the identity, then takes each measured point's
 distance to the plane through its 8 nearest truth samples, signed by the
 cloud's normal (the definition in reconstruct/score.h; none of its code).
 Compares per module and merged: the point count exactly, mean |e| and std
-within TOLERANCE_MM (default 0.002). Prints one line per figure; exit 0 if all
+within TOLERANCE_MM (default 0.001). Prints one line per figure; exit 0 if all
 agree, 1 if not, 2 on bad arguments.
+
+Why 0.001 mm: the two alignments differ by design only where the surface
+hardly fixes the motion (score.cc damps those directions, this script leaves
+them out), and there the distances change by well under a micrometre
+(score_test.cc measured 0.6 um on an ellipsoidal cap); the scorer also aligns
+on a 20 000-point subsample. Measured on the demo's five scenes: 0.03 um at
+most. The score gate (scripts/score_gate.py) acts on 0.002 mm, so the scorer
+must be right to better than that.
 
 Shares nothing with the C++ scorer but the definition: PLY parsing, the k-d
 tree (scipy.spatial.cKDTree against reconstruct/kd_tree.h), the plane fits
@@ -82,15 +90,20 @@ def rotation(w):
 
 
 def align(tree, truth, points, iterations=40):
-    """truth_from_cloud (R, t) by point-to-plane ICP from the identity, and whether it converged."""
+    """truth_from_cloud (R, t) by point-to-plane ICP from the identity, and whether it converged.
+
+    As score.h defines it: pairs whose nearest truth sample is farther than
+    MAX_PAIR_MM are left out, and so are those whose distance exceeds
+    max(0.05 mm, 3 x the median |distance|) (mismatches)."""
     r, t = np.eye(3), np.zeros(3)
     previous_rms = np.inf
     for _ in range(iterations):
         p = points @ r.T + t
         c, n, nearest = local_planes(tree, truth, p)
-        keep = nearest <= MAX_PAIR_MM
-        p, c, n = p[keep], c[keep], n[keep]
         residual = np.einsum('ni,ni->n', p - c, n)
+        keep = nearest <= MAX_PAIR_MM
+        keep &= np.abs(residual) <= max(0.05, 3 * np.median(np.abs(residual[keep])))
+        p, n, residual = p[keep], n[keep], residual[keep]
         rms = np.sqrt(np.mean(residual**2))
         # Converged when the fit no longer improves (1e-6 mm: three orders
         # below the figures' tolerance). Not on the step: along directions
@@ -102,7 +115,11 @@ def align(tree, truth, points, iterations=40):
         previous_rms = rms
         pivot = p.mean(axis=0)  # rotations about the points' centroid: rotation and translation decoupled
         jacobian = np.hstack([np.cross(p - pivot, n), n])  # d residual / d (rotation vector, translation)
-        step = np.linalg.lstsq(jacobian, -residual, rcond=None)[0]  # undamped
+        # Truncated least squares: a direction the surface fixes 100 times
+        # more weakly than its best-fixed one (a plate sliding in its plane,
+        # a cylinder turning about its axis) is not moved. Undamped there,
+        # the plate slid until the mismatch cut hid its overhang.
+        step = np.linalg.lstsq(jacobian, -residual, rcond=1e-2)[0]
         dr = rotation(step[:3])
         r, t = dr @ r, dr @ (t - pivot) + pivot + step[3:]
     return r, t, False
@@ -135,7 +152,7 @@ def main():
         return 2
     report = json.load(open(sys.argv[1]))
     dataset, cloud_dir = sys.argv[2], sys.argv[3]
-    tolerance = float(sys.argv[4]) if len(sys.argv) == 5 else 0.002
+    tolerance = float(sys.argv[4]) if len(sys.argv) == 5 else 0.001
     bad = 0
     for scene in report['scenes']:
         name = scene['scene']
