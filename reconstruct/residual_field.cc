@@ -2,6 +2,8 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
+#include <array>
+#include <map>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -87,6 +89,39 @@ double ProfiledLogLikelihood(const Eigen::MatrixXd& c, double ratio, const Eigen
 
 }  // namespace
 
+namespace internal {
+
+double BlockCrossValidationError(const Eigen::MatrixXd& c, double ratio, const Eigen::VectorXd& weights,
+                                 const Eigen::VectorXd& y, const Eigen::Matrix3Xd& x, double block_mm) {
+  Eigen::MatrixXd a = c;
+  a.diagonal() += ratio * weights.cwiseInverse();
+  const Eigen::LLT<Eigen::MatrixXd> llt(a);
+  if (llt.info() != Eigen::Success) return std::numeric_limits<double>::infinity();
+  const Eigen::MatrixXd inverse = llt.solve(Eigen::MatrixXd::Identity(a.rows(), a.cols()));
+  const Eigen::VectorXd alpha = inverse * y;
+  std::map<std::array<int, 3>, std::vector<Eigen::Index>> blocks;  // ordered: the same sum every run
+  for (Eigen::Index i = 0; i < x.cols(); ++i) {
+    const Eigen::Vector3i b = (x.col(i) / block_mm).array().floor().cast<int>();
+    blocks[{b.x(), b.y(), b.z()}].push_back(i);
+  }
+  double error = 0;
+  for (const auto& [key, idx] : blocks) {
+    const Eigen::Index m = Eigen::Index(idx.size());
+    Eigen::MatrixXd inverse_bb(m, m);
+    Eigen::VectorXd alpha_b(m), weights_b(m);
+    for (Eigen::Index r = 0; r < m; ++r) {
+      alpha_b(r) = alpha(idx[r]);
+      weights_b(r) = weights(idx[r]);
+      for (Eigen::Index q = 0; q < m; ++q) inverse_bb(r, q) = inverse(idx[r], idx[q]);
+    }
+    const Eigen::VectorXd held_out = inverse_bb.ldlt().solve(alpha_b);
+    error += (held_out.array().square() * weights_b.array()).sum();
+  }
+  return error;
+}
+
+}  // namespace internal
+
 ResidualField ResidualField::Fit(const std::vector<Eigen::Vector3d>& points_mm, const std::vector<double>& residuals_mm,
                                  const ResidualFieldOptions& o) {
   ResidualField f;
@@ -125,15 +160,28 @@ ResidualField ResidualField::Fit(const std::vector<Eigen::Vector3d>& points_mm, 
   // Hyperparameters by marginal likelihood on a coarser subsample.
   const Eigen::Matrix3Xd x_ml = CellMeans(all, y_all, o.max_likelihood_points, &y_ml, &w_ml);
   const std::vector<double> lengths = o.length_mm > 0 ? std::vector<double>{o.length_mm} : o.candidate_lengths_mm;
+  const bool by_cross_validation = o.cv_block_mm > 0 && lengths.size() > 1;
   double best = -std::numeric_limits<double>::infinity(), best_length = lengths.front(),
          best_ratio = o.candidate_noise_ratios.back(), best_signal_var = 0;
+  double best_held_out = std::numeric_limits<double>::infinity();
   for (double l : lengths) {
     const Eigen::MatrixXd c = KernelMatrix(x_ml, l);
+    // The noise ratio for this length, by marginal likelihood.
+    double l_best = -std::numeric_limits<double>::infinity(), l_ratio = 0, l_signal_var = 0;
     for (double ratio : o.candidate_noise_ratios) {
       double signal_var = 0;
       const double ll = ProfiledLogLikelihood(c, ratio, w_ml, y_ml, &signal_var);
-      if (ll > best) best = ll, best_length = l, best_ratio = ratio, best_signal_var = signal_var;
+      if (ll > l_best) l_best = ll, l_ratio = ratio, l_signal_var = signal_var;
     }
+    if (!std::isfinite(l_best)) continue;
+    if (by_cross_validation) {
+      const double held_out = internal::BlockCrossValidationError(c, l_ratio, w_ml, y_ml, x_ml, o.cv_block_mm);
+      if (!(held_out < best_held_out)) continue;
+      best_held_out = held_out;
+    } else if (!(l_best > best)) {
+      continue;
+    }
+    best = l_best, best_length = l, best_ratio = l_ratio, best_signal_var = l_signal_var;
   }
   if (!std::isfinite(best)) {
     f.description_ = "residual field off: no kernel matrix was positive definite";
@@ -158,7 +206,10 @@ ResidualField ResidualField::Fit(const std::vector<Eigen::Vector3d>& points_mm, 
   std::snprintf(buf, sizeof buf,
                 "residual field: rms %.3f mm over %zu points, fitted on %d cell means; length %.1f mm%s, signal sd "
                 "%.3f mm, noise sd %.3f mm",
-                f.residual_rms_mm_, keep.size(), int(x.cols()), best_length, o.length_mm > 0 ? " (given)" : "",
+                f.residual_rms_mm_, keep.size(), int(x.cols()), best_length,
+                o.length_mm > 0         ? " (given)"
+                : by_cross_validation ? " (by held-out blocks)"
+                                      : " (by likelihood)",
                 f.signal_sd_mm_, f.noise_sd_mm_);
   f.description_ = buf;
   return f;

@@ -46,8 +46,9 @@ struct RuntimeOptions {
   // noise (residual rms < 0.1 mm: a sphere, a cup). Default true.
   bool fill_follow_residuals = true;
   // The field's length scale, mm: about the size of the object's features
-  // the fill should follow. 0 (default) = chosen from the data by marginal
-  // likelihood over 6-30 mm.
+  // the fill should follow. 0 (default) = chosen from the data, of 6-30 mm:
+  // the one that best predicts the residuals left out a block at a time
+  // (residual_field.h).
   double fill_residual_length_mm = 0;
   bool parallel_modules = true;  // process modules on separate threads; default true
 
