@@ -13,10 +13,16 @@
 // module's std 0.084 mm instead of 0.071 (docs/reconstruct-log.md, session
 // 18). The right view's edge is the other test in right_occlusion.h.
 //
-// The rule: a point is kept only if its whole refinement window, the
-// (2 half_width + 1) x (2 half_height + 1) pixels about it, has left data.
-// No margin beyond the window: the gain (std) is all there at the window's
-// own size, and each more column costs fill along the edge.
+// The rule: a point is kept only if its refinement window, the
+// (2 half_width + 1) x (2 half_height + 1) pixels about it (the sub-pixel
+// step's window), has left data. No margin beyond the window: the gain
+// (std) is all there at the window's own size, and each more column costs
+// fill along the edge. Not covered: the wider windows growing may refine a
+// pixel with instead (oblique_refine.h, up to 25 columns; shifted_window.h,
+// to one side), which can still reach the zero fill from up to ~12 columns
+// away; on the demo plate no cluster of errors was left there. Run before
+// the right view's occlusion test (right_occlusion.h), so that these
+// points do not hide correct ones as occluders.
 #pragma once
 
 #include <opencv2/core.hpp>

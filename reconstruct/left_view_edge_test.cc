@@ -109,6 +109,7 @@ TEST(LeftViewEdge, TheMatcherKeepsNoPointWhoseWindowHoldsTheZeroFill) {
               without.points, without.beyond_half_px, without.max_abs_px, with.points, with.beyond_half_px,
               with.max_abs_px);
   EXPECT_GT(without.beyond_half_px, 0);  // the control
+  EXPECT_GT(without.window_in_no_data, 0);
   EXPECT_EQ(with.window_in_no_data, 0);
   EXPECT_EQ(with.beyond_half_px, 0);
   EXPECT_LT(with.max_abs_px, 0.5);

@@ -48,7 +48,7 @@ struct RectifiedGeometry {
 struct RectificationNames {
   std::string rig = "rig";                  // the rig file
   std::string options = "runtime options";  // where the measurement volume was set
-  std::string module = "a module";          // e.g. "module 'm1'"
+  std::string module = "a module";          // the module's name, e.g. "module0"
 };
 RectifiedGeometry ComputeRectification(const Camera& left, const Camera& right, const Pose& right_from_left,
                                        const Eigen::Vector3d& look_at_left_mm, const RectificationNames& names = {});

@@ -87,6 +87,17 @@ double ProfiledLogLikelihood(const Eigen::MatrixXd& c, double ratio, const Eigen
   return -0.5 * n * std::log(*signal_var) - 0.5 * log_det;
 }
 
+// The points' indices by cube of block_mm (a grid anchored at the origin),
+// cubes in a fixed order: the same sums every run.
+std::map<std::array<int, 3>, std::vector<Eigen::Index>> Blocks(const Eigen::Matrix3Xd& x, double block_mm) {
+  std::map<std::array<int, 3>, std::vector<Eigen::Index>> blocks;
+  for (Eigen::Index i = 0; i < x.cols(); ++i) {
+    const Eigen::Vector3i b = (x.col(i) / block_mm).array().floor().cast<int>();
+    blocks[{b.x(), b.y(), b.z()}].push_back(i);
+  }
+  return blocks;
+}
+
 }  // namespace
 
 namespace internal {
@@ -99,13 +110,8 @@ double BlockCrossValidationError(const Eigen::MatrixXd& c, double ratio, const E
   if (llt.info() != Eigen::Success) return std::numeric_limits<double>::infinity();
   const Eigen::MatrixXd inverse = llt.solve(Eigen::MatrixXd::Identity(a.rows(), a.cols()));
   const Eigen::VectorXd alpha = inverse * y;
-  std::map<std::array<int, 3>, std::vector<Eigen::Index>> blocks;  // ordered: the same sum every run
-  for (Eigen::Index i = 0; i < x.cols(); ++i) {
-    const Eigen::Vector3i b = (x.col(i) / block_mm).array().floor().cast<int>();
-    blocks[{b.x(), b.y(), b.z()}].push_back(i);
-  }
   double error = 0;
-  for (const auto& [key, idx] : blocks) {
+  for (const auto& [key, idx] : Blocks(x, block_mm)) {
     const Eigen::Index m = Eigen::Index(idx.size());
     Eigen::MatrixXd inverse_bb(m, m);
     Eigen::VectorXd alpha_b(m), weights_b(m);
@@ -157,10 +163,14 @@ ResidualField ResidualField::Fit(const std::vector<Eigen::Vector3d>& points_mm, 
   }
   Eigen::VectorXd y, y_ml, w, w_ml;
   const Eigen::Matrix3Xd x = CellMeans(all, y_all, o.max_points, &y, &w);
-  // Hyperparameters by marginal likelihood on a coarser subsample.
+  // Hyperparameters on a coarser subsample: the noise ratio by marginal
+  // likelihood, the length by held-out blocks (or likelihood too; header).
   const Eigen::Matrix3Xd x_ml = CellMeans(all, y_all, o.max_likelihood_points, &y_ml, &w_ml);
   const std::vector<double> lengths = o.length_mm > 0 ? std::vector<double>{o.length_mm} : o.candidate_lengths_mm;
-  const bool by_cross_validation = o.cv_block_mm > 0 && lengths.size() > 1;
+  // With the data in one block, leaving it out says nothing of the length:
+  // the likelihood decides.
+  const bool by_cross_validation =
+      o.cv_block_mm > 0 && lengths.size() > 1 && Blocks(x_ml, o.cv_block_mm).size() >= 2;
   double best = -std::numeric_limits<double>::infinity(), best_length = lengths.front(),
          best_ratio = o.candidate_noise_ratios.back(), best_signal_var = 0;
   double best_held_out = std::numeric_limits<double>::infinity();

@@ -65,7 +65,8 @@ struct ResidualFieldOptions {
   double outlier_mads = 5;          // residual cut, in robust sigmas about the median; default 5
   // The held-out blocks' edge for choosing the length, mm; default 15 (the
   // fill's bands reach 5-15 mm from the data). 0 = choose the length by the
-  // marginal likelihood too (before session 18).
+  // marginal likelihood too (before session 18), as also happens when all
+  // the data lie in one block.
   double cv_block_mm = 15;
 };
 

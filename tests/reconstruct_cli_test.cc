@@ -364,31 +364,36 @@ TEST_F(ReconstructCli, ABatchWritesEachCapturesOwnCloudAndSkipsABrokenOne) {
 }
 
 // A capture whose outputs cannot be written has none, not a partial nor a
-// stale one, and the batch goes on. The trigger: a 240-character folder
-// name, so "<name>.ply" (244) is a valid file name but the atomic writer's
-// temporary ".tmp-<pid>-<n>-<name>.ply" passes NAME_MAX (255): open fails
-// with ENAMETOOLONG, as a full disk would fail a write (root ignores
-// permissions, so these tests cannot use them).
+// stale one, and the batch goes on. The trigger: a 236-character folder
+// name. Its outputs' names are valid (the longest, "<name>.mesh.stl", 245
+// characters), and so is the atomic writer's temporary for the cloud,
+// ".tmp-<pid>-<n>-<name>.ply" (248-252 with a 3-7 digit pid), but not the
+// mesh's (253-257 + 5 > 255 = NAME_MAX): the cloud is written, then the
+// mesh fails with ENAMETOOLONG, as a full disk would fail a write (root
+// ignores permissions, so these tests cannot use them). The written cloud
+// must go too.
 TEST_F(ReconstructCli, ABatchCaptureWhoseOutputsCannotBeWrittenHasNone) {
   const std::string batch = dir_ + "/batch_write", out = dir_ + "/batch_write_out";
   std::filesystem::remove_all(batch);
   std::filesystem::remove_all(out);
   std::filesystem::create_directories(batch);
   std::filesystem::create_directories(out);
-  const std::string long_name(240, 'w');
+  const std::string long_name(236, 'w');
   for (const std::string& name : {std::string("0001"), long_name})
     std::filesystem::copy(dir_ + "/capture", batch + "/" + name);
   std::ofstream(out + "/" + long_name + ".json") << "a report from an earlier run\n";  // (not atomic: see above)
   ASSERT_TRUE(std::filesystem::exists(out + "/" + long_name + ".json"));
   const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + batch + "/0001 " +
-                                            batch + "/" + long_name + " --out-dir " + out + " --report " + out +
-                                            "/batch.json");
+                                            batch + "/" + long_name + " --out-dir " + out +
+                                            " --mesh-format stl --report " + out + "/batch.json");
   EXPECT_EQ(r.code, 2) << r.err;
-  EXPECT_NE(r.err.find("[2/2] " + out + "/" + long_name + ".ply: cannot write: File name too long"), std::string::npos)
+  EXPECT_NE(r.err.find("[2/2] " + out + "/" + long_name + ".mesh.stl: cannot write: File name too long"),
+            std::string::npos)
       << r.err;
-  EXPECT_TRUE(std::filesystem::exists(out + "/0001.ply"));
-  EXPECT_TRUE(std::filesystem::exists(out + "/0001.json"));
-  for (const char* ext : {".ply", ".json"}) EXPECT_FALSE(std::filesystem::exists(out + "/" + long_name + ext)) << ext;
+  for (const char* ext : {".ply", ".json", ".mesh.stl"}) {
+    EXPECT_TRUE(std::filesystem::exists(out + "/0001" + ext)) << ext;
+    EXPECT_FALSE(std::filesystem::exists(out + "/" + long_name + ext)) << ext;
+  }
   std::ifstream f(out + "/batch.json");
   const nlohmann::json summary = nlohmann::json::parse(f);
   EXPECT_EQ(summary["reconstructed"], 1);

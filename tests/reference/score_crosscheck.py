@@ -153,6 +153,9 @@ def main():
     report = json.load(open(sys.argv[1]))
     dataset, cloud_dir = sys.argv[2], sys.argv[3]
     tolerance = float(sys.argv[4]) if len(sys.argv) == 5 else 0.001
+    if not report.get('scenes') or not all(scene.get('modules') for scene in report['scenes']):
+        print(f'{sys.argv[1]}: no scene or no module to compare', file=sys.stderr)
+        return 2
     bad = 0
     for scene in report['scenes']:
         name = scene['scene']
