@@ -123,7 +123,8 @@ struct MatchOptions {
   LineIndexOptions line_index;     // census_sgm: the component-wide grid-period test (line_index.h)
   GrowOptions grow;                // census_sgm: growing into the pixels SGM left empty (region_grow.h)
   // census_sgm, opencv_sgbm_3way: drop the pixels the right camera cannot
-  // see, last (right_occlusion.h): occluded by a nearer surface, or matched
+  // see, last but the surface fit, after the left view's edge test
+  // (right_occlusion.h): occluded by a nearer surface, or matched
   // within this of a right column without data (`right_valid`). 0 = both
   // off; default 1 px.
   double occlusion_margin_px = 1;
