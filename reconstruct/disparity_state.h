@@ -11,8 +11,8 @@ namespace stereorig {
 
 // What became of each left pixel: a point, or the first test that rejected
 // it. The matcher sets the codes up to kNotDistinct and kOccluded,
-// kWrongLine, kLeftViewEdge; the runtime adds kLowConfidence, kOutsideVolume, kObjectSize. For finding where fill is lost (`stereorig
-// score` tabulates them).
+// kWrongLine, kLeftViewEdge; the runtime adds kLowConfidence, kOutsideVolume, kObjectSize. For finding where fill is
+// lost (`stereorig score` tabulates them).
 enum class PixelStatus : uint8_t {
   kNotSearched = 0,  // outside the matched region
   kPoint,            // a valid disparity (and, in the runtime, a kept point)

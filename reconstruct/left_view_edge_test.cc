@@ -57,9 +57,9 @@ TEST(LeftViewEdge, DropsExactlyThePointsWhoseWindowReachesNoData) {
 }
 
 struct EdgeErrors {
-  int points = 0;           // valid pixels within 12 columns of the edge
-  int beyond_half_px = 0;   // of those, |d - truth| > 0.5 px
-  double max_abs_px = 0;    // over the whole image
+  int points = 0;             // valid pixels within 12 columns of the edge
+  int beyond_half_px = 0;     // of those, |d - truth| > 0.5 px
+  double max_abs_px = 0;      // over the whole image
   int window_in_no_data = 0;  // valid pixels whose 9 x 3 window reaches a column >= the edge
 };
 

@@ -26,7 +26,8 @@ RectifiedGeometry ComputeRectification(const Camera& left, const Camera& right, 
   const Eigen::Matrix3d& r = right_from_left.rotation();
   const Eigen::Vector3d right_centre_left = -r.transpose() * right_from_left.translation_mm();
   g.baseline_mm = right_centre_left.norm();
-  if (!(g.baseline_mm > 0)) throw InputError(names.rig, names.module + ": its cameras share one centre (zero baseline)");
+  if (!(g.baseline_mm > 0))
+    throw InputError(names.rig, names.module + ": its cameras share one centre (zero baseline)");
   const Eigen::Vector3d e1 = right_centre_left / g.baseline_mm;
   const Eigen::Vector3d mean_axis = (Eigen::Vector3d::UnitZ() + r.transpose() * Eigen::Vector3d::UnitZ()).normalized();
   Eigen::Vector3d e2 = mean_axis.cross(e1);
@@ -40,8 +41,9 @@ RectifiedGeometry ComputeRectification(const Camera& left, const Camera& right, 
   g.focal_px = std::min(0.5 * (left.fx() + left.fy()), 0.5 * (right.fx() + right.fy()));
   g.size = cv::Size(left.imager_width_px(), left.imager_height_px());
   const Eigen::Vector3d c = g.rect_from_left * look_at_left_mm;
-  if (!(c.z() > 0)) throw InputError(names.options, "the measurement volume's centre is behind " + names.module +
-                                                 ": check volume_center_mm / working_distance_mm");
+  if (!(c.z() > 0))
+    throw InputError(names.options, "the measurement volume's centre is behind " + names.module +
+                                        ": check volume_center_mm / working_distance_mm");
   // Centre pixel of the image ((W-1)/2 in mrcal's pixel-centre convention).
   g.cx_left_px = 0.5 * (g.size.width - 1) - g.focal_px * c.x() / c.z();
   g.cy_px = 0.5 * (g.size.height - 1) - g.focal_px * c.y() / c.z();

@@ -3,10 +3,10 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <array>
-#include <map>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <unordered_map>
 
 namespace stereorig {
@@ -169,8 +169,7 @@ ResidualField ResidualField::Fit(const std::vector<Eigen::Vector3d>& points_mm, 
   const std::vector<double> lengths = o.length_mm > 0 ? std::vector<double>{o.length_mm} : o.candidate_lengths_mm;
   // With the data in one block, leaving it out says nothing of the length:
   // the likelihood decides.
-  const bool by_cross_validation =
-      o.cv_block_mm > 0 && lengths.size() > 1 && Blocks(x_ml, o.cv_block_mm).size() >= 2;
+  const bool by_cross_validation = o.cv_block_mm > 0 && lengths.size() > 1 && Blocks(x_ml, o.cv_block_mm).size() >= 2;
   double best = -std::numeric_limits<double>::infinity(), best_length = lengths.front(),
          best_ratio = o.candidate_noise_ratios.back(), best_signal_var = 0;
   double best_held_out = std::numeric_limits<double>::infinity();
@@ -217,7 +216,7 @@ ResidualField ResidualField::Fit(const std::vector<Eigen::Vector3d>& points_mm, 
                 "residual field: rms %.3f mm over %zu points, fitted on %d cell means; length %.1f mm%s, signal sd "
                 "%.3f mm, noise sd %.3f mm",
                 f.residual_rms_mm_, keep.size(), int(x.cols()), best_length,
-                o.length_mm > 0         ? " (given)"
+                o.length_mm > 0       ? " (given)"
                 : by_cross_validation ? " (by held-out blocks)"
                                       : " (by likelihood)",
                 f.signal_sd_mm_, f.noise_sd_mm_);

@@ -303,8 +303,8 @@ TEST_F(ReconstructCli, ADegenerateModuleOrAVolumeBehindItNamesTheFileAndModule) 
   modules[1].right_from_left = Pose(modules[1].right_from_left.rotation(), Eigen::Vector3d::Zero());
   const Rig flat(sim.rig.cameras(), sim.rig.camera_names(), modules, sim.rig.S(), "test");
   WriteRigFile(flat, dir_ + "/flat.yaml");
-  testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/flat.yaml --capture " + dir_ +
-                                      "/capture --out " + dir_ + "/out.ply --report " + dir_ + "/out.json");
+  testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/flat.yaml --capture " + dir_ + "/capture --out " +
+                                      dir_ + "/out.ply --report " + dir_ + "/out.json");
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find(dir_ + "/flat.yaml: " + modules[1].name + ": its cameras share one centre"), std::string::npos)
@@ -383,9 +383,9 @@ TEST_F(ReconstructCli, ABatchCaptureWhoseOutputsCannotBeWrittenHasNone) {
     std::filesystem::copy(dir_ + "/capture", batch + "/" + name);
   std::ofstream(out + "/" + long_name + ".json") << "a report from an earlier run\n";  // (not atomic: see above)
   ASSERT_TRUE(std::filesystem::exists(out + "/" + long_name + ".json"));
-  const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + batch + "/0001 " +
-                                            batch + "/" + long_name + " --out-dir " + out +
-                                            " --mesh-format stl --report " + out + "/batch.json");
+  const testing::Result r =
+      testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + batch + "/0001 " + batch + "/" +
+                      long_name + " --out-dir " + out + " --mesh-format stl --report " + out + "/batch.json");
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("[2/2] " + out + "/" + long_name + ".mesh.stl: cannot write: File name too long"),
             std::string::npos)
