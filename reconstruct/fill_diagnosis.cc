@@ -6,6 +6,7 @@
 #include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <tuple>
 
 #include "calib/core/input_error.h"
 #include "reconstruct/matcher.h"
@@ -20,6 +21,62 @@ double TruthSlopePx(float before_px, float centre_px, float after_px) {
   if (has_after) return double(after_px) - centre_px;
   if (has_before) return double(centre_px) - before_px;
   return 0.0;
+}
+
+SilhouetteErrorProfile ProfileSilhouetteError(const cv::Mat& disparity_px, const cv::Mat& truth_disparity,
+                                              const cv::Mat& status) {
+  STEREORIG_CHECK(disparity_px.type() == CV_32FC1 && truth_disparity.type() == CV_32FC1 && status.type() == CV_8UC1);
+  STEREORIG_CHECK(disparity_px.size() == status.size() && truth_disparity.size() == status.size());
+  constexpr int kMax = SilhouetteErrorProfile::kMaxDistancePx;
+  SilhouetteErrorProfile p;
+  double interior_sum = 0;
+  // Distance to the first pixel without truth at x + k (step +1) or x - k
+  // (step -1), k <= kMax; 0 if there is none that near.
+  auto silhouette_distance = [&](const float* truth, int x, int step) {
+    for (int k = 1; k <= kMax; ++k) {
+      const int xs = x + step * k;
+      if (xs < 0 || xs >= truth_disparity.cols) return 0;
+      if (!std::isfinite(truth[xs])) return k;
+    }
+    return 0;
+  };
+  for (int y = 0; y < status.rows; ++y) {
+    const float* truth = truth_disparity.ptr<float>(y);
+    const float* disparity = disparity_px.ptr<float>(y);
+    const uint8_t* st = status.ptr<uint8_t>(y);
+    for (int x = 0; x < status.cols; ++x) {
+      if (st[x] != uint8_t(PixelStatus::kPoint) || !std::isfinite(disparity[x]) || !std::isfinite(truth[x])) continue;
+      const double e = double(disparity[x]) - truth[x];
+      const int right = silhouette_distance(truth, x, +1), left = silhouette_distance(truth, x, -1);
+      if (right > 0) ++p.right_count[right], p.right_mean_px[right] += e;
+      if (left > 0) ++p.left_count[left], p.left_mean_px[left] += e;
+      if (right == 0 && left == 0) ++p.interior_count, interior_sum += e;
+    }
+  }
+  for (int k = 1; k <= kMax; ++k) {
+    if (p.right_count[k] > 0) p.right_mean_px[k] /= p.right_count[k];
+    if (p.left_count[k] > 0) p.left_mean_px[k] /= p.left_count[k];
+  }
+  if (p.interior_count > 0) p.interior_mean_px = interior_sum / p.interior_count;
+  return p;
+}
+
+std::string SilhouetteErrorProfile::Summary() const {
+  std::string s = "mean d - truth by distance to the silhouette along the row, px (points: mean):";
+  char buf[64];
+  for (const auto& [side, count, mean] :
+       {std::tuple{"right", &right_count, &right_mean_px}, std::tuple{"left", &left_count, &left_mean_px}}) {
+    s += std::string(" ") + side;
+    bool any = false;
+    for (int k = 1; k <= kMaxDistancePx; ++k) {
+      if ((*count)[k] == 0) continue;
+      std::snprintf(buf, sizeof buf, " %d: %d: %+.2f", k, (*count)[k], (*mean)[k]);
+      s += buf, any = true;
+    }
+    s += any ? ";" : " none;";
+  }
+  std::snprintf(buf, sizeof buf, " farther: %d: %+.3f\n", interior_count, interior_mean_px);
+  return s + buf;
 }
 
 cv::Mat TruthDisparity(const ModulePlan& plan, const cv::Mat& left_x, const cv::Mat& left_y,
@@ -140,6 +197,7 @@ FillDiagnosis DiagnoseFill(const Runtime& runtime, int module, const std::vector
     }
   const int within = d.points_with_truth - d.points_off_1px;
   d.mean_abs_error_px = within > 0 ? sum_abs / within : 0.0;
+  d.silhouette = ProfileSilhouetteError(d.disparity_px, d.truth_disparity, d.status);
   return d;
 }
 
@@ -177,7 +235,7 @@ std::string FillDiagnosis::Summary() const {
     }
   std::snprintf(buf, sizeof buf, "\n  unreachable, but reached by the oblique refinement: %.2f%%\n",
                 100.0 * unreachable_oblique_ok / std::max(1, target_px));
-  return s + buf;
+  return s + buf + "  " + silhouette.Summary();
 }
 
 namespace {

@@ -46,6 +46,32 @@ void RectifyModulePair(const Rig& rig, const ModulePlan& plan, const std::vector
 // or a depth edge), else 0.
 double TruthSlopePx(float before_px, float centre_px, float after_px);
 
+// The points' signed disparity error d - truth by their distance along the
+// row to the object's silhouette: the nearest pixel of the row without
+// truth (NaN), to the right and to the left; the image's own border is not
+// a silhouette. A window-based match near a silhouette measures the
+// surface a little inside it, where the image blur and the truncated pixel
+// footprint put the intensity; on a limb seen at a grazing angle that is
+// a different disparity (docs/reconstruct-log.md, "Points at a
+// silhouette (session 19)").
+struct SilhouetteErrorProfile {
+  static constexpr int kMaxDistancePx = 6;  // nearer ones are binned by distance; the rest are "interior"
+  // Index k = 1..kMaxDistancePx: the points k px from the silhouette on
+  // that side (silhouette at x + k on the right, x - k on the left; a point
+  // near both counts in both). Index 0 is unused.
+  std::array<int, kMaxDistancePx + 1> right_count{}, left_count{};
+  std::array<double, kMaxDistancePx + 1> right_mean_px{}, left_mean_px{};
+  int interior_count = 0;  // farther than kMaxDistancePx from both
+  double interior_mean_px = 0;
+  std::string Summary() const;  // one line
+};
+
+// Over the pixels of `status` (CV_8UC1 PixelStatus) that are points, with
+// a finite disparity in `disparity_px` and a truth in `truth_disparity`
+// (both CV_32FC1, the status's size).
+SilhouetteErrorProfile ProfileSilhouetteError(const cv::Mat& disparity_px, const cv::Mat& truth_disparity,
+                                              const cv::Mat& status);
+
 struct FillDiagnosis {
   cv::Mat left, right;      // CV_8UC1 rectified pair
   cv::Mat target;           // CV_8UC1: 255 = fill target (fill_score.h), rectified grid
@@ -69,6 +95,7 @@ struct FillDiagnosis {
   int target_px = 0, filled_px = 0;
   int points_with_truth = 0, points_off_1px = 0;  // points with a truth disparity; of those, > 1 px off
   double mean_abs_error_px = 0;                   // of the points within 1 px
+  SilhouetteErrorProfile silhouette;              // the points' error near the silhouette
   std::string Summary() const;                    // a few lines of text
 };
 
