@@ -5,6 +5,7 @@
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
+#include "apps/output_paths.h"
 #include "calib/core/input_error.h"
 #include "reconstruct/elapsed_ms.h"
 #include "reconstruct/grey_image.h"
@@ -30,7 +31,10 @@ int RunMatch(int argc, char** argv) {
   app.add_option("--num-disparities", options.num_disparities, "number of disparities searched, px")->required();
   app.add_option("--out", out_path, "output disparity map (.pfm)")->required();
   app.add_option("--roi", roi, "left-image region to match: x y width height (default: whole image)")->expected(4);
-  app.add_option("--matcher", matcher, "census_sgm (ours) or opencv_sgbm_3way (baseline)")->capture_default_str();
+  app.add_option("--matcher", matcher,
+                 "census_sgm (ours), opencv_sgbm_3way (OpenCV's SGBM, then our filters and sub-pixel fit: the "
+                 "bench's baseline) or opencv_sgbm_3way_standalone (SGBM with its own sub-pixel fit only)")
+      ->capture_default_str();
   app.add_option("--pyramid-levels", options.pyramid_levels,
                  "census_sgm: halvings before the full-range SGM (0 = full-resolution SGM)")
       ->capture_default_str();
@@ -40,6 +44,7 @@ int RunMatch(int argc, char** argv) {
   options.matcher = ParseMatcherKind(matcher, "--matcher");
   if (!roi.empty()) options.roi = cv::Rect(roi[0], roi[1], roi[2], roi[3]);
   options.Check();
+  OutputPaths().Claim(out_path, "the disparity map");  // its folder checked before the matching runs
   const cv::Mat left = ReadGreyImage(left_path), right = ReadGreyImage(right_path);
   if (left.size() != right.size()) throw InputError(right_path, "size differs from the left image");
 

@@ -18,12 +18,11 @@
 namespace stereorig {
 
 void SgmOptions::Check() const {
-  if (p1 < 1 || p1 > 200) throw InputError("sgm.p1", "must be in [1, 200] census bits");
-  if (p2 <= p1 || p2 > 1000) throw InputError("sgm.p2", "must be in (p1, 1000] census bits");
-  if (num_paths != 3 && num_paths != 4) throw InputError("sgm.num_paths", "must be 3 or 4");
-  if (uniqueness_percent < 0 || uniqueness_percent > 50)
-    throw InputError("sgm.uniqueness_percent", "must be in [0, 50]");
-  if (lr_max_diff_px < 0) throw InputError("sgm.lr_max_diff_px", "must be >= 0 (0 = exact)");
+  if (p1 < 1 || p1 > 200) throw InputError("sgm_p1", "must be in [1, 200] census bits");
+  if (p2 <= p1 || p2 > 1000) throw InputError("sgm_p2", "must be in (sgm_p1, 1000] census bits");
+  if (num_paths != 3 && num_paths != 4) throw InputError("sgm_paths", "must be 3 or 4");
+  if (uniqueness_percent < 0 || uniqueness_percent > 50) throw InputError("uniqueness_percent", "must be in [0, 50]");
+  if (lr_max_diff_px < 0) throw InputError("lr_max_diff_px", "must be >= 0 (0 = exact)");
   if (block_rows < 0) throw InputError("sgm.block_rows", "must be >= 0 (0 = about sqrt(rows))");
 }
 

@@ -51,6 +51,7 @@ void MatchOptions::Check() const {
   if (roi.width < 0 || roi.height < 0) throw InputError("roi", "must have a non-negative size");
   if (pyramid_levels < 0 || pyramid_levels > 3) throw InputError("pyramid_levels", "must be in [0, 3]");
   if (guided_radius_px < 0 || guided_radius_px > 64) throw InputError("guided_radius_px", "must be in [0, 64]");
+  if (range_margin_px < 0 || range_margin_px > 256) throw InputError("range_margin_px", "must be in [0, 256] px");
   if (band_sgm_paths != 3 && band_sgm_paths != 4) throw InputError("band_sgm_paths", "must be 3 or 4");
   if (band_row_step < 1 || band_row_step > 2) throw InputError("band_row_step", "must be 1 or 2");
   if (band_row_step > 1 && guided_radius_px > 0)

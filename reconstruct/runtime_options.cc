@@ -38,7 +38,11 @@ void RuntimeOptions::Check() const {
   if (!(fill_spacing_mm > 0.05)) throw InputError("fill_spacing_mm", "must be > 0.05 mm");
   if (!(fill_residual_length_mm == 0 || (fill_residual_length_mm >= 1 && fill_residual_length_mm <= 1000)))
     throw InputError("fill_residual_length_mm", "must be 0 (chosen from the data) or in [1, 1000] mm");
-  match.Check();
+  try {
+    match.Check();
+  } catch (const InputError& e) {  // named as the options file names it: match.<key>
+    throw InputError("", std::string("match.") + e.what());
+  }
 }
 
 namespace {

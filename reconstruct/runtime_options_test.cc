@@ -1,5 +1,6 @@
 // Runtime options: the hole-filling, surface-fit, line-index ambiguity, sub-pixel column-step, band-pass and
-// strong-speckle keys are read, defaulted and checked (a bad value or an unknown key is an InputError naming it).
+// strong-speckle keys are read, defaulted and checked (a bad value or an unknown key is an InputError naming it,
+// as the options file spells it).
 #include "reconstruct/runtime_options.h"
 
 #include <gtest/gtest.h>
@@ -109,6 +110,26 @@ TEST(RuntimeOptions, ReadsAndChecksTheBandPassKeys) {
       {"match:\n  band_row_step: 2\n  guided_radius_px: 15\n", "band_row_step"},
       {"match:\n  band_row_steps: 2\n", "band_row_steps"}};
   ExpectEachRejectedNamingItsKey(bad);
+}
+
+// A bad value under match: is named match.<key>, the key the file holds,
+// also where the check sits in a nested options struct (the SGM's and the
+// sub-pixel fit's once said sgm.p2, subpixel.half_width_px: keys no
+// options file has).
+TEST(RuntimeOptions, AMatchValueOutOfRangeIsNamedAsTheFileNamesIt) {
+  const std::pair<const char*, const char*> bad[] = {
+      {"match:\n  sgm_p1: 0\n", "match.sgm_p1:"},
+      {"match:\n  sgm_p1: 10\n  sgm_p2: 5\n", "match.sgm_p2:"},
+      {"match:\n  sgm_paths: 8\n", "match.sgm_paths:"},
+      {"match:\n  uniqueness_percent: 60\n", "match.uniqueness_percent:"},
+      {"match:\n  lr_max_diff_px: -1\n", "match.lr_max_diff_px:"},
+      {"match:\n  subpixel_half_width_px: 0\n", "match.subpixel_half_width_px:"},
+      {"match:\n  subpixel_half_height_px: 31\n", "match.subpixel_half_height_px:"},
+      {"match:\n  min_zncc: 1.0\n", "match.min_zncc:"},
+      {"match:\n  range_margin_px: -50\n", "match.range_margin_px:"},
+      {"match:\n  range_margin_px: 257\n", "match.range_margin_px:"}};
+  ExpectEachRejectedNamingItsKey(bad);
+  EXPECT_EQ(ParseRuntimeOptions("match:\n  range_margin_px: 0\n", "ok.yaml").match.range_margin_px, 0);
 }
 
 TEST(RuntimeOptions, ReadsAndChecksTheStrongSpeckleKeys) {

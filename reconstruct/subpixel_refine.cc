@@ -13,8 +13,8 @@
 namespace stereorig {
 
 void SubpixelOptions::Check() const {
-  if (half_width_px < 1 || half_width_px > 30) throw InputError("subpixel.half_width_px", "must be in [1, 30]");
-  if (half_height_px < 0 || half_height_px > 30) throw InputError("subpixel.half_height_px", "must be in [0, 30]");
+  if (half_width_px < 1 || half_width_px > 30) throw InputError("subpixel_half_width_px", "must be in [1, 30]");
+  if (half_height_px < 0 || half_height_px > 30) throw InputError("subpixel_half_height_px", "must be in [0, 30]");
   if (max_iterations < 1 || max_iterations > 50) throw InputError("subpixel.max_iterations", "must be in [1, 50]");
   if (!(converged_step_px > 0 && converged_step_px < 0.5))
     throw InputError("subpixel.converged_step_px", "must be in (0, 0.5) px");

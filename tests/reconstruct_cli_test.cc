@@ -106,6 +106,14 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
                    out),
             2);
   EXPECT_FALSE(std::filesystem::exists(out));
+  // An output folder that is not there is refused before the matching runs
+  // (the writer's own error came only after it).
+  const testing::Result no_folder =
+      testing::RunCli("match --left " + dir + "/small.png --right " + dir +
+                      "/small.png --min-disparity 0 --num-disparities 16 --out " + dir + "/no_such_folder/disp.pfm");
+  EXPECT_EQ(no_folder.code, 2);
+  EXPECT_NE(no_folder.err.find("no_such_folder/disp.pfm: its folder does not exist"), std::string::npos)
+      << no_folder.err;
 }
 
 }  // namespace
