@@ -43,7 +43,8 @@ RectifiedGeometry ComputeRectification(const Camera& left, const Camera& right, 
   const Eigen::Vector3d c = g.rect_from_left * look_at_left_mm;
   if (!(c.z() > 0))
     throw InputError(names.options, "the measurement volume's centre is behind " + names.module +
-                                        ": check volume_center_mm / working_distance_mm");
+                                        ": check volume_center_mm / working_distance_mm" +
+                                        (names.also_check.empty() ? "" : ", or " + names.also_check));
   // Centre pixel of the image ((W-1)/2 in mrcal's pixel-centre convention).
   g.cx_left_px = 0.5 * (g.size.width - 1) - g.focal_px * c.x() / c.z();
   g.cy_px = 0.5 * (g.size.height - 1) - g.focal_px * c.y() / c.z();

@@ -49,6 +49,10 @@ struct RectificationNames {
   std::string rig = "rig";                  // the rig file
   std::string options = "runtime options";  // where the measurement volume was set
   std::string module = "a module";          // the module's name, e.g. "module0"
+  // What else to check when the volume is behind the module, appended as
+  // "or ...": for a module other than the reference one, its pose in the
+  // rig file (the volume is set in the reference frame). Empty: nothing.
+  std::string also_check;
 };
 RectifiedGeometry ComputeRectification(const Camera& left, const Camera& right, const Pose& right_from_left,
                                        const Eigen::Vector3d& look_at_left_mm, const RectificationNames& names = {});

@@ -57,8 +57,12 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
     plan.reference_from_module = rig_.S(0, m);
     const Pose module_from_reference = rig_.S(m, 0);
     plan.camera_centre_reference_mm = plan.reference_from_module.translation_mm();
+    // The volume is set in module 0's frame: for another module, a wrong
+    // pose in the rig file can put it behind too.
+    const std::string pose_check =
+        m == 0 ? "" : mod.name + "'s pose in " + rig_.Where() + " (the volume is set in module 0's frame)";
     plan.geometry = ComputeRectification(left, right, mod.right_from_left, module_from_reference * volume_center_mm_,
-                                         RectificationNames{rig_.Where(), options_.Where(), mod.name});
+                                         RectificationNames{rig_.Where(), options_.Where(), mod.name, pose_check});
     plan.maps = BuildRectifyMaps(plan.geometry, left, right);
     {  // the exact float tables, only for the masks (the runtime keeps the fixed-point ones)
       cv::Mat map_x, map_y;
@@ -74,7 +78,8 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
       const Eigen::Vector3d p_rect = plan.geometry.rect_from_left * (module_from_reference * c);
       if (!(p_rect.z() > 1.0))
         throw InputError(options_.Where(), "the measurement volume reaches behind " + mod.name +
-                                               "'s cameras: check volume_center_mm / volume_size_mm");
+                                               "'s cameras: check volume_center_mm / volume_size_mm" +
+                                               (pose_check.empty() ? "" : ", or " + pose_check));
       const Eigen::Vector3d q = plan.geometry.PixelAndDisparity(p_rect);
       u0 = std::min(u0, q.x()), u1 = std::max(u1, q.x());
       v0 = std::min(v0, q.y()), v1 = std::max(v1, q.y());

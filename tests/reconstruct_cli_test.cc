@@ -325,7 +325,25 @@ TEST_F(ReconstructCli, ADegenerateModuleOrAVolumeBehindItNamesTheFileAndModule) 
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find(dir_ + "/behind.yaml (runtime options): the measurement volume's centre is behind " +
-                       sim.rig.module(0).name),
+                       sim.rig.module(0).name + ": check volume_center_mm / working_distance_mm\n"),
+            std::string::npos)
+      << r.err;  // module 0's pose is the reference frame itself: nothing more to check
+  ExpectNoOutput();
+
+  // Module 1 turned about its own vertical axis to face away, in a rig file
+  // that is otherwise right: the default volume is behind it, and its pose
+  // is as likely the cause as the options.
+  const Eigen::Matrix3d half_turn_y = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const Rig turned(sim.rig.cameras(), sim.rig.camera_names(), sim.rig.modules(),
+                   {Pose(), sim.rig.S(0, 1) * Pose(half_turn_y, Eigen::Vector3d::Zero())});
+  WriteRigFile(turned, dir_ + "/turned.yaml");
+  r = testing::RunCli("reconstruct --rig " + dir_ + "/turned.yaml --capture " + dir_ + "/capture --out " + dir_ +
+                      "/out.ply --report " + dir_ + "/out.json");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("the measurement volume's centre is behind " + sim.rig.module(1).name +
+                       ": check volume_center_mm / working_distance_mm, or " + sim.rig.module(1).name + "'s pose in " +
+                       dir_ + "/turned.yaml"),
             std::string::npos)
       << r.err;
   ExpectNoOutput();
