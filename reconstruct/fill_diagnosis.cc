@@ -24,33 +24,37 @@ double TruthSlopePx(float before_px, float centre_px, float after_px) {
 }
 
 SilhouetteErrorProfile ProfileSilhouetteError(const cv::Mat& disparity_px, const cv::Mat& truth_disparity,
-                                              const cv::Mat& status) {
+                                              const cv::Mat& status, const cv::Mat& left_valid) {
   STEREORIG_CHECK(disparity_px.type() == CV_32FC1 && truth_disparity.type() == CV_32FC1 && status.type() == CV_8UC1);
   STEREORIG_CHECK(disparity_px.size() == status.size() && truth_disparity.size() == status.size());
+  STEREORIG_CHECK(left_valid.empty() || (left_valid.type() == CV_8UC1 && left_valid.size() == status.size()));
   constexpr int kMax = SilhouetteErrorProfile::kMaxDistancePx;
   SilhouetteErrorProfile p;
   double interior_sum = 0;
-  // Distance to the first pixel without truth at x + k (step +1) or x - k
-  // (step -1), k <= kMax; 0 if there is none that near.
-  auto silhouette_distance = [&](const float* truth, int x, int step) {
-    for (int k = 1; k <= kMax; ++k) {
-      const int xs = x + step * k;
-      if (xs < 0 || xs >= truth_disparity.cols) return 0;
-      if (!std::isfinite(truth[xs])) return k;
-    }
-    return 0;
-  };
   for (int y = 0; y < status.rows; ++y) {
     const float* truth = truth_disparity.ptr<float>(y);
     const float* disparity = disparity_px.ptr<float>(y);
     const uint8_t* st = status.ptr<uint8_t>(y);
+    const uint8_t* valid = left_valid.empty() ? nullptr : left_valid.ptr<uint8_t>(y);
+    // Distance to the first pixel without truth at x + k (step +1) or x - k
+    // (step -1), k <= kMax; 0 if there is none that near, or the first is
+    // past the image's border or the left view's data (not a silhouette).
+    auto silhouette_distance = [&](int x, int step) {
+      for (int k = 1; k <= kMax; ++k) {
+        const int xs = x + step * k;
+        if (xs < 0 || xs >= truth_disparity.cols) return 0;
+        if (!std::isfinite(truth[xs])) return valid && !valid[xs] ? 0 : k;
+      }
+      return 0;
+    };
     for (int x = 0; x < status.cols; ++x) {
       if (st[x] != uint8_t(PixelStatus::kPoint) || !std::isfinite(disparity[x]) || !std::isfinite(truth[x])) continue;
       const double e = double(disparity[x]) - truth[x];
-      const int right = silhouette_distance(truth, x, +1), left = silhouette_distance(truth, x, -1);
-      if (right > 0) ++p.right_count[right], p.right_mean_px[right] += e;
-      if (left > 0) ++p.left_count[left], p.left_mean_px[left] += e;
-      if (right == 0 && left == 0) ++p.interior_count, interior_sum += e;
+      const bool off = std::abs(e) > 1;
+      const int right = silhouette_distance(x, +1), left = silhouette_distance(x, -1);
+      if (right > 0) ++p.right_count[right], p.right_off_1px[right] += off, p.right_mean_px[right] += e;
+      if (left > 0) ++p.left_count[left], p.left_off_1px[left] += off, p.left_mean_px[left] += e;
+      if (right == 0 && left == 0) ++p.interior_count, p.interior_off_1px += off, interior_sum += e;
     }
   }
   for (int k = 1; k <= kMax; ++k) {
@@ -62,20 +66,20 @@ SilhouetteErrorProfile ProfileSilhouetteError(const cv::Mat& disparity_px, const
 }
 
 std::string SilhouetteErrorProfile::Summary() const {
-  std::string s = "mean d - truth by distance to the silhouette along the row, px (points: mean):";
+  std::string s = "mean d - truth by distance to the silhouette along the row, px (k: points (> 1 px off): mean):";
   char buf[64];
-  for (const auto& [side, count, mean] :
-       {std::tuple{"right", &right_count, &right_mean_px}, std::tuple{"left", &left_count, &left_mean_px}}) {
+  for (const auto& [side, count, off, mean] : {std::tuple{"right", &right_count, &right_off_1px, &right_mean_px},
+                                               std::tuple{"left", &left_count, &left_off_1px, &left_mean_px}}) {
     s += std::string(" ") + side;
     bool any = false;
     for (int k = 1; k <= kMaxDistancePx; ++k) {
       if ((*count)[k] == 0) continue;
-      std::snprintf(buf, sizeof buf, " %d: %d: %+.2f", k, (*count)[k], (*mean)[k]);
+      std::snprintf(buf, sizeof buf, " %d: %d (%d): %+.2f", k, (*count)[k], (*off)[k], (*mean)[k]);
       s += buf, any = true;
     }
     s += any ? ";" : " none;";
   }
-  std::snprintf(buf, sizeof buf, " farther: %d: %+.3f\n", interior_count, interior_mean_px);
+  std::snprintf(buf, sizeof buf, " farther: %d (%d): %+.3f\n", interior_count, interior_off_1px, interior_mean_px);
   return s + buf;
 }
 
@@ -197,7 +201,7 @@ FillDiagnosis DiagnoseFill(const Runtime& runtime, int module, const std::vector
     }
   const int within = d.points_with_truth - d.points_off_1px;
   d.mean_abs_error_px = within > 0 ? sum_abs / within : 0.0;
-  d.silhouette = ProfileSilhouetteError(d.disparity_px, d.truth_disparity, d.status);
+  d.silhouette = ProfileSilhouetteError(d.disparity_px, d.truth_disparity, d.status, plan.left_valid);
   return d;
 }
 

@@ -48,29 +48,36 @@ double TruthSlopePx(float before_px, float centre_px, float after_px);
 
 // The points' signed disparity error d - truth by their distance along the
 // row to the object's silhouette: the nearest pixel of the row without
-// truth (NaN), to the right and to the left; the image's own border is not
-// a silhouette. A window-based match near a silhouette measures the
-// surface a little inside it, where the image blur and the truncated pixel
-// footprint put the intensity; on a limb seen at a grazing angle that is
-// a different disparity (docs/reconstruct-log.md, "Points at a
-// silhouette (session 19)").
+// truth (NaN), to the right and to the left. Neither the image's own border
+// nor, given `left_valid`, the edge of the left view's data (rectified
+// pixels whose source is off the sensor: NaN there too) is a silhouette.
+// A window-based match near a silhouette measures the surface a little
+// inside it, where the image blur and the truncated pixel footprint put the
+// intensity; on a limb seen at a grazing angle that is a different
+// disparity (docs/reconstruct-log.md, "Points at a silhouette (session
+// 19)"). The count of points > 1 px off in each bin tells a shift of the
+// whole bin from a few gross mismatches pulling its mean.
 struct SilhouetteErrorProfile {
   static constexpr int kMaxDistancePx = 6;  // nearer ones are binned by distance; the rest are "interior"
   // Index k = 1..kMaxDistancePx: the points k px from the silhouette on
   // that side (silhouette at x + k on the right, x - k on the left; a point
   // near both counts in both). Index 0 is unused.
   std::array<int, kMaxDistancePx + 1> right_count{}, left_count{};
+  std::array<int, kMaxDistancePx + 1> right_off_1px{}, left_off_1px{};  // of those, |d - truth| > 1 px
   std::array<double, kMaxDistancePx + 1> right_mean_px{}, left_mean_px{};
   int interior_count = 0;  // farther than kMaxDistancePx from both
+  int interior_off_1px = 0;
   double interior_mean_px = 0;
   std::string Summary() const;  // one line
 };
 
 // Over the pixels of `status` (CV_8UC1 PixelStatus) that are points, with
 // a finite disparity in `disparity_px` and a truth in `truth_disparity`
-// (both CV_32FC1, the status's size).
+// (both CV_32FC1, the status's size). left_valid: CV_8UC1 of that size
+// (ModulePlan::left_valid), 0 where the left view has no data; empty: all
+// have.
 SilhouetteErrorProfile ProfileSilhouetteError(const cv::Mat& disparity_px, const cv::Mat& truth_disparity,
-                                              const cv::Mat& status);
+                                              const cv::Mat& status, const cv::Mat& left_valid = cv::Mat());
 
 struct FillDiagnosis {
   cv::Mat left, right;      // CV_8UC1 rectified pair

@@ -80,8 +80,10 @@ TEST(FillDiagnosis, SilhouetteProfileBinsPointsByTheirDistanceToTheObjectsEdge) 
   // (8 px in 3 rows).
   EXPECT_EQ(p.interior_count, 24);
   EXPECT_DOUBLE_EQ(p.interior_mean_px, 0.25);
-  EXPECT_NE(p.Summary().find("right 1: 2: +1.00 2: 2: +0.50"), std::string::npos) << p.Summary();
-  EXPECT_NE(p.Summary().find("left 1: 3: -1.00 2: 3: +0.25"), std::string::npos) << p.Summary();
+  // Points > 1 px off: none (the +1 is not more than 1).
+  EXPECT_EQ(p.right_off_1px[1], 0);
+  EXPECT_NE(p.Summary().find("right 1: 2 (0): +1.00 2: 2 (0): +0.50"), std::string::npos) << p.Summary();
+  EXPECT_NE(p.Summary().find("left 1: 3 (0): -1.00 2: 3 (0): +0.25"), std::string::npos) << p.Summary();
 }
 
 TEST(FillDiagnosis, SilhouetteProfileDoesNotTakeTheImagesBorderForAnEdge) {
@@ -97,6 +99,17 @@ TEST(FillDiagnosis, SilhouetteProfileDoesNotTakeTheImagesBorderForAnEdge) {
   const SilhouetteErrorProfile p = ProfileSilhouetteError(m.disparity, m.truth, m.status);
   for (int k = 1; k <= SilhouetteErrorProfile::kMaxDistancePx; ++k) EXPECT_EQ(p.right_count[k], 0) << k;
   EXPECT_NE(p.Summary().find("right none;"), std::string::npos) << p.Summary();
+  // The same at the left border: the object from x = 0 has no silhouette on
+  // its left.
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 10; ++x) {
+      m.truth.at<float>(y, x) = 50;
+      m.disparity.at<float>(y, x) = 50.25f;
+      m.status.at<uint8_t>(y, x) = uint8_t(PixelStatus::kPoint);
+    }
+  const SilhouetteErrorProfile whole = ProfileSilhouetteError(m.disparity, m.truth, m.status);
+  EXPECT_EQ(whole.interior_count, 120);  // every point of the 40 x 3 map
+  EXPECT_NE(whole.Summary().find("right none; left none;"), std::string::npos) << whole.Summary();
   EXPECT_EQ(p.left_count[1], 3);
   // x = 16 .. 39 (24 px in 3 rows), x = 28 and 29 among them with their
   // +0.5 and +1.
@@ -115,7 +128,26 @@ TEST(FillDiagnosis, SilhouetteProfileCountsAThinObjectOnBothSides) {
   EXPECT_EQ(p.right_count[3], 1);            // x = 10, error 0
   EXPECT_EQ(p.left_count[1], 1);             // x = 10
   EXPECT_DOUBLE_EQ(p.left_mean_px[3], 2.0);  // x = 12
+  // x = 11 is 2 px from both, error +1.
+  EXPECT_EQ(p.right_count[2], 1);
+  EXPECT_EQ(p.left_count[2], 1);
+  EXPECT_DOUBLE_EQ(p.right_mean_px[2], 1.0);
+  EXPECT_DOUBLE_EQ(p.left_mean_px[2], 1.0);
+  EXPECT_EQ(p.right_off_1px[1], 1);  // x = 12: +2
+  EXPECT_EQ(p.left_off_1px[3], 1);
   EXPECT_EQ(p.interior_count, 0);
+}
+
+// Where the truth ends because the left view's data does (the rectified
+// pixel's source is off the sensor), that is no silhouette either.
+TEST(FillDiagnosis, SilhouetteProfileDoesNotTakeTheLeftViewsEdgeForAnEdge) {
+  SilhouetteMaps m;
+  cv::Mat left_valid(3, 40, CV_8UC1, cv::Scalar(255));
+  left_valid.colRange(30, 40).setTo(0);  // no view right of the object
+  const SilhouetteErrorProfile p = ProfileSilhouetteError(m.disparity, m.truth, m.status, left_valid);
+  for (int k = 1; k <= SilhouetteErrorProfile::kMaxDistancePx; ++k) EXPECT_EQ(p.right_count[k], 0) << k;
+  EXPECT_EQ(p.left_count[1], 3);        // the left silhouette still is one
+  EXPECT_EQ(p.interior_count, 3 * 14);  // x = 16 .. 29
 }
 
 }  // namespace

@@ -107,13 +107,16 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
             2);
   EXPECT_FALSE(std::filesystem::exists(out));
   // An output folder that is not there is refused before the matching runs
-  // (the writer's own error came only after it).
-  const testing::Result no_folder =
-      testing::RunCli("match --left " + dir + "/small.png --right " + dir +
-                      "/small.png --min-disparity 0 --num-disparities 16 --out " + dir + "/no_such_folder/disp.pfm");
-  EXPECT_EQ(no_folder.code, 2);
-  EXPECT_NE(no_folder.err.find("no_such_folder/disp.pfm: its folder does not exist"), std::string::npos)
-      << no_folder.err;
+  // (the writer's own error came only after it), before the images are
+  // even read: with a left image missing too, the folder is what is named.
+  for (const std::string left : {"small.png", "missing.png"}) {
+    const testing::Result no_folder =
+        testing::RunCli("match --left " + dir + "/" + left + " --right " + dir +
+                        "/small.png --min-disparity 0 --num-disparities 16 --out " + dir + "/no_such_folder/disp.pfm");
+    EXPECT_EQ(no_folder.code, 2);
+    EXPECT_NE(no_folder.err.find("no_such_folder/disp.pfm: its folder does not exist"), std::string::npos)
+        << no_folder.err;
+  }
 }
 
 }  // namespace
@@ -343,7 +346,7 @@ TEST_F(ReconstructCli, ADegenerateModuleOrAVolumeBehindItNamesTheFileAndModule) 
   EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("the measurement volume's centre is behind " + sim.rig.module(1).name +
                        ": check volume_center_mm / working_distance_mm, or " + sim.rig.module(1).name + "'s pose in " +
-                       dir_ + "/turned.yaml"),
+                       dir_ + "/turned.yaml (the volume is set in module 0's frame)\n"),
             std::string::npos)
       << r.err;
   ExpectNoOutput();
