@@ -48,13 +48,15 @@ struct SilhouetteMaps {
   cv::Mat truth{3, 40, CV_32FC1, cv::Scalar(kNan)};
   cv::Mat status{3, 40, CV_8UC1, cv::Scalar(uint8_t(PixelStatus::kNotSearched))};
   SilhouetteMaps() {
-    for (int y = 0; y < 3; ++y)
-      for (int x = 10; x <= 29; ++x) {
-        const float e = x == 29 ? 1.0f : x == 28 ? 0.5f : x == 10 ? -1.0f : 0.25f;
-        truth.at<float>(y, x) = 50;
-        disparity.at<float>(y, x) = 50 + e;
-        status.at<uint8_t>(y, x) = uint8_t(PixelStatus::kPoint);
-      }
+    for (int x = 10; x <= 29; ++x) SetColumn(x, x == 29 ? 1.0f : x == 28 ? 0.5f : x == 10 ? -1.0f : 0.25f);
+  }
+  // Column x on the object (truth 50 px) in every row, a point off by e.
+  void SetColumn(int x, float e) {
+    for (int y = 0; y < 3; ++y) {
+      truth.at<float>(y, x) = 50;
+      disparity.at<float>(y, x) = 50 + e;
+      status.at<uint8_t>(y, x) = uint8_t(PixelStatus::kPoint);
+    }
   }
 };
 
@@ -90,23 +92,13 @@ TEST(FillDiagnosis, SilhouetteProfileDoesNotTakeTheImagesBorderForAnEdge) {
   SilhouetteMaps m;
   // The object now runs to the image's right border (x = 39): no point has
   // a silhouette on its right any more.
-  for (int y = 0; y < 3; ++y)
-    for (int x = 30; x < 40; ++x) {
-      m.truth.at<float>(y, x) = 50;
-      m.disparity.at<float>(y, x) = 50.25f;
-      m.status.at<uint8_t>(y, x) = uint8_t(PixelStatus::kPoint);
-    }
+  for (int x = 30; x < 40; ++x) m.SetColumn(x, 0.25f);
   const SilhouetteErrorProfile p = ProfileSilhouetteError(m.disparity, m.truth, m.status);
   for (int k = 1; k <= SilhouetteErrorProfile::kMaxDistancePx; ++k) EXPECT_EQ(p.right_count[k], 0) << k;
   EXPECT_NE(p.Summary().find("right none;"), std::string::npos) << p.Summary();
   // The same at the left border: the object from x = 0 has no silhouette on
   // its left.
-  for (int y = 0; y < 3; ++y)
-    for (int x = 0; x < 10; ++x) {
-      m.truth.at<float>(y, x) = 50;
-      m.disparity.at<float>(y, x) = 50.25f;
-      m.status.at<uint8_t>(y, x) = uint8_t(PixelStatus::kPoint);
-    }
+  for (int x = 0; x < 10; ++x) m.SetColumn(x, 0.25f);
   const SilhouetteErrorProfile whole = ProfileSilhouetteError(m.disparity, m.truth, m.status);
   EXPECT_EQ(whole.interior_count, 120);  // every point of the 40 x 3 map
   EXPECT_NE(whole.Summary().find("right none; left none;"), std::string::npos) << whole.Summary();
