@@ -2,6 +2,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <utility>
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
@@ -43,7 +45,18 @@ int RunMatch(int argc, char** argv) {
 
   options.matcher = ParseMatcherKind(matcher, "--matcher");
   if (!roi.empty()) options.roi = cv::Rect(roi[0], roi[1], roi[2], roi[3]);
-  options.Check();
+  try {
+    options.Check();
+  } catch (const InputError& e) {  // named by the flag that set it, not by the options field
+    const std::string what = e.what();
+    for (const auto& [field, flag] : {std::pair{"num_disparities", "--num-disparities"},
+                                      {"min_disparity", "--min-disparity"},
+                                      {"roi", "--roi"},
+                                      {"pyramid_levels", "--pyramid-levels"},
+                                      {"num_threads", "--threads"}})
+      if (what.rfind(std::string(field) + ": ", 0) == 0) throw InputError(flag, what.substr(std::strlen(field) + 2));
+    throw;
+  }
   OutputPaths().Claim(out_path, "the disparity map");  // its folder checked before the matching runs
   const cv::Mat left = ReadGreyImage(left_path), right = ReadGreyImage(right_path);
   if (left.size() != right.size()) throw InputError(right_path, "size differs from the left image");

@@ -106,6 +106,15 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
                    out),
             2);
   EXPECT_FALSE(std::filesystem::exists(out));
+  // A bad value is named by the flag the user typed.
+  for (const auto& [flag, value] : {std::pair{"--num-disparities", "1"}, {"--threads", "0"}}) {
+    const std::string args = std::string(flag) == "--threads" ? std::string(" --num-disparities 16 --threads ") + value
+                                                              : std::string(" --num-disparities ") + value;
+    const testing::Result bad = testing::RunCli("match --left " + dir + "/small.png --right " + dir +
+                                                "/small.png --min-disparity 0" + args + " --out " + out);
+    EXPECT_EQ(bad.code, 2);
+    EXPECT_NE(bad.err.find(std::string(flag) + ": must be in"), std::string::npos) << bad.err;
+  }
   // An output folder that is not there is refused before the matching runs
   // (the writer's own error came only after it), before the images are
   // even read: with a left image missing too, the folder is what is named.
