@@ -2,7 +2,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <utility>
 
 #include "apps/cli_util.h"
@@ -48,13 +47,12 @@ int RunMatch(int argc, char** argv) {
   try {
     options.Check();
   } catch (const InputError& e) {  // named by the flag that set it, not by the options field
-    const std::string what = e.what();
     for (const auto& [field, flag] : {std::pair{"num_disparities", "--num-disparities"},
                                       {"min_disparity", "--min-disparity"},
                                       {"roi", "--roi"},
                                       {"pyramid_levels", "--pyramid-levels"},
                                       {"num_threads", "--threads"}})
-      if (what.rfind(std::string(field) + ": ", 0) == 0) throw InputError(flag, what.substr(std::strlen(field) + 2));
+      if (e.where() == field) throw InputError(flag, e.problem());
     throw;
   }
   OutputPaths().Claim(out_path, "the disparity map");  // its folder checked before the matching runs

@@ -41,7 +41,7 @@ void RuntimeOptions::Check() const {
   try {
     match.Check();
   } catch (const InputError& e) {  // named as the options file names it: match.<key>
-    throw InputError("", std::string("match.") + e.what());
+    throw InputError("match." + e.where(), e.problem());
   }
 }
 

@@ -16,7 +16,14 @@ class InputError : public std::runtime_error {
  public:
   // `where` names the file (and key, if any); `what` says the problem.
   InputError(const std::string& where, const std::string& problem)
-      : std::runtime_error(where.empty() ? problem : where + ": " + problem) {}
+      : std::runtime_error(where.empty() ? problem : where + ": " + problem), where_(where), problem_(problem) {}
+  // The two parts, for a caller that knows the key by another name (an
+  // options section's prefix, a command-line flag) and throws it again.
+  const std::string& where() const { return where_; }
+  const std::string& problem() const { return problem_; }
+
+ private:
+  std::string where_, problem_;
 };
 
 }  // namespace stereorig
