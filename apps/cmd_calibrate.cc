@@ -8,6 +8,7 @@
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
+#include "apps/output_paths.h"
 #include "calib/calibrate.h"
 #include "calib/capture_folder.h"
 
@@ -53,6 +54,13 @@ int RunCalibrate(int argc, char** argv) {
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
   options.system.refine_intrinsics = !fixed_intrinsics;
   options.Check();
+  // Checked before the calibration runs (minutes): a rig file and a report
+  // at one path, or in a folder that is not there, would fail only at the end.
+  OutputPaths outputs;
+  outputs.Protect(target_path, "the target file (--target)");
+  outputs.Protect(layout_path, "the layout file (--layout)");
+  outputs.Claim(out_path, "the rig file (--out)");
+  outputs.Claim(report_path, "the report (--report)");
 
   const FolderCalibration folder = CalibrateCaptureFolder(captures, target_path, layout_path, options);
   const CalibrationResult& result = folder.result;

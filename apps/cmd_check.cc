@@ -7,6 +7,7 @@
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
+#include "apps/output_paths.h"
 #include "calib/capture_folder.h"
 #include "calib/check/history.h"
 #include "calib/check/nightly_check.h"
@@ -85,6 +86,14 @@ int RunCheck(int argc, char** argv) {
     throw InputError("", "--rig, --captures and --target are required (see --help)");
   }
   options.Check();
+  // The report and the history checked before the target is detected: a
+  // report over the rig file, or into a folder that is not there, would
+  // fail (or destroy the rig file) only after the work.
+  OutputPaths outputs;
+  outputs.Protect(rig_path, "the rig file (--rig)");
+  outputs.Protect(target_path, "the target file (--target)");
+  if (!report_path.empty()) outputs.Claim(report_path, "the report (--report)");
+  outputs.Claim(history_db, "the history database (--history-db, updated in place)");
 
   const Rig rig = ReadRigFile(rig_path);
   const Target target = ReadTargetFile(target_path);

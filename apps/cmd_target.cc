@@ -4,6 +4,7 @@
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
+#include "apps/output_paths.h"
 #include "calib/core/input_error.h"
 #include "targets/board_svg.h"
 #include "targets/target_file.h"
@@ -29,6 +30,10 @@ int RunTarget(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--write-target", write_target, "also write the target file used here (YAML)");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
+  OutputPaths outputs;
+  outputs.Protect(target_path, "the target file (--target)");
+  outputs.Claim(out_path, "the SVG (--out)");
+  if (!write_target.empty()) outputs.Claim(write_target, "the target file (--write-target)");
 
   const Target target = target_path.empty() ? DefaultTarget() : ReadTargetFile(target_path);
   BoardSvgOptions options;

@@ -6,6 +6,7 @@
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
+#include "apps/output_paths.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "reconstruct/metrology/artifact.h"
@@ -44,6 +45,10 @@ int RunVerify(int argc, char** argv) {
   app.add_option("--min-points", options.min_points, "fewest points that must lie on the artifact")
       ->capture_default_str();
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
+  OutputPaths outputs;  // the report's path checked before the clouds are read and judged
+  outputs.Protect(artifact_path, "the artifact file (--artifact)");
+  for (const std::string& cloud : clouds) outputs.Protect(cloud, "a cloud (--cloud)");
+  if (!report_path.empty()) outputs.Claim(report_path, "the report (--report)");
 
   const Artifact artifact = ReadArtifactFile(artifact_path);
   std::vector<ArtifactEvaluation> positions;

@@ -1,6 +1,7 @@
 // The files one command will write, checked before it does any work: no file
 // named twice (its cloud and its mesh at one path would leave only the last
-// written), and each one's folder there to write in. A failure is bad input
+// written), none of them one of the command's inputs (a report written over
+// the rig file it was checking), and each one's folder there to write in. A failure is bad input
 // (InputError) naming the path, so nothing is computed only to fail at the
 // end with some outputs written and others not.
 #pragma once
@@ -21,10 +22,15 @@ class OutputPaths {
   // check_folder, if its folder does not exist (off for files in a folder
   // the command creates itself).
   void Claim(const std::string& path, const std::string& what, bool check_folder = true);
+  // Records an input the command reads, `what` naming it ("the rig file
+  // (--rig)"): a Claim of the same file throws InputError. Call before the
+  // Claims. An empty path is ignored (an optional input not given).
+  void Protect(const std::string& path, const std::string& what);
 
  private:
   std::string remedy_;
   std::map<std::filesystem::path, std::string> claimed_;  // normal absolute path -> what writes it
+  std::map<std::filesystem::path, std::string> inputs_;   // normal absolute path -> the input it is
 };
 
 }  // namespace stereorig

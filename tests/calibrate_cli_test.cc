@@ -142,5 +142,33 @@ TEST(CalibrateCli, RefusesAFaceSeenByTheWrongModule) {
   EXPECT_FALSE(fs::exists(set.dir + "/rig.yaml"));
 }
 
+// The rig file and the report are checked before the captures are read: one
+// path for both left the report in place of the rig file with exit 0, and a
+// report into a missing folder failed after the whole calibration with the
+// rig file already written. Each is refused at once (no capture needed: the
+// folder given does not even exist), and nothing is written.
+TEST(CalibrateCli, OutputsThatCollideOrHaveNoFolderAreRefusedBeforeAnyWork) {
+  const std::string dir = ::testing::TempDir() + "/calib_cli_paths";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir + "/layout.yaml") << "modules:\n  - {name: module0, left: 0, right: 1}\n";
+  const std::string inputs =
+      "calibrate --captures " + dir + "/no_captures --target " + dir + "/target.yaml --layout " + dir + "/layout.yaml";
+  testing::Result r = testing::RunCli(inputs + " --out " + dir + "/rig.yaml --report " + dir + "/rig.yaml");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("rig.yaml: would be written twice (the rig file (--out) and the report (--report))"),
+            std::string::npos)
+      << r.err;
+  r = testing::RunCli(inputs + " --out " + dir + "/rig.yaml --report " + dir + "/missing/report.json");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("report.json: its folder does not exist"), std::string::npos) << r.err;
+  r = testing::RunCli(inputs + " --out " + dir + "/layout.yaml --report " + dir + "/report.json");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("layout.yaml: is the layout file (--layout)"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
+  EXPECT_FALSE(fs::exists(dir + "/report.json"));
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -172,6 +172,25 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     EXPECT_NE(LastLine(r.err).find(not_db), std::string::npos) << r.err;
     EXPECT_EQ(Bytes(not_db), "not a database\n");
   }
+  {  // A report named as the rig file (it would replace the rig file with
+     // JSON), or into a folder that is not there (it failed after the
+     // detection): refused before any work, the rig file and history intact.
+    const std::string rig_bytes = Bytes(dir + "/rig.yaml");
+    auto check_report = [&](const std::string& report_path) {
+      return RunCli("check --rig " + dir + "/rig.yaml --captures " + dir + "/ds --target " + dir +
+                    "/ds/target.yaml --history-db " + db + " --report " + report_path);
+    };
+    r = check_report(dir + "/rig.yaml");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(LastLine(r.err).find("rig.yaml: is the rig file (--rig)"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("detecting"), std::string::npos) << r.err;  // before the detection's progress
+    EXPECT_EQ(Bytes(dir + "/rig.yaml"), rig_bytes);
+    r = check_report(dir + "/missing/check.json");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(LastLine(r.err).find("check.json: its folder does not exist"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("detecting"), std::string::npos) << r.err;
+    EXPECT_EQ(Bytes(db), db_bytes);
+  }
   fs::remove_all(dir);
 }
 

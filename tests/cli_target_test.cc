@@ -54,4 +54,28 @@ TEST(CliTarget, BadTargetFileExitsTwoAndWritesNothing) {
   EXPECT_EQ(RunStereorig("target").code, 2);  // --out is required
 }
 
+// Its outputs are checked before anything is drawn: one path for both, or
+// the target file it reads as the SVG, would leave the SVG replaced by YAML
+// (or the target file by the SVG) with exit 0.
+TEST(CliTarget, OutputsThatCollideOrOverwriteTheTargetFileAreRefused) {
+  const std::string dir = ::testing::TempDir() + "/cli_target_paths";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  Result r = RunStereorig("target --out " + dir + "/board.svg --write-target " + dir + "/board.svg");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("board.svg: would be written twice"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/board.svg"));
+
+  ASSERT_EQ(RunStereorig("target --out " + dir + "/first.svg --write-target " + dir + "/board.yaml").code, 0);
+  const std::string yaml = Slurp(dir + "/board.yaml");
+  r = RunStereorig("target --target " + dir + "/board.yaml --out " + dir + "/board.yaml");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("board.yaml: is the target file (--target)"), std::string::npos) << r.err;
+  EXPECT_EQ(Slurp(dir + "/board.yaml"), yaml);
+
+  r = RunStereorig("target --out " + dir + "/missing/board.svg");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("its folder does not exist"), std::string::npos) << r.err;
+}
+
 }  // namespace

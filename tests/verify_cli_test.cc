@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 
 #include "tests/cli_runner.h"
@@ -90,6 +91,28 @@ TEST(VerifyCli, BadInputExitsTwoAndWritesNoReport) {
   EXPECT_EQ(Lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("tiny.ply"), std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(report));
+}
+
+// The report's path is checked before the clouds are judged: a missing
+// folder printed the whole verdict and then exited 2, and a report named as
+// one of the clouds would have replaced the cloud with JSON.
+TEST(VerifyCli, AReportWithoutAFolderOrOverACloudIsRefusedBeforeTheVerdict) {
+  const std::string good = WriteSphere("good_paths.ply", 19.05);
+  const std::string before = [&] {
+    std::ifstream f(good, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  }();
+  auto r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + good + " --report " +
+                  ::testing::TempDir() + "/no_such_folder/verify.json");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.out, "");  // no verdict printed
+  EXPECT_NE(r.err.find("verify.json: its folder does not exist"), std::string::npos) << r.err;
+  r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + good + " --report " + good);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.out, "");
+  EXPECT_NE(r.err.find("is a cloud (--cloud)"), std::string::npos) << r.err;
+  std::ifstream f(good, std::ios::binary);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(f), {}), before);
 }
 
 // The rest of issue 6's bad input: every artifact type with a field
