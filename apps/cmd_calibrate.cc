@@ -11,6 +11,7 @@
 #include "apps/output_paths.h"
 #include "calib/calibrate.h"
 #include "calib/capture_folder.h"
+#include "calib/core/input_error.h"
 
 namespace stereorig {
 
@@ -61,6 +62,10 @@ int RunCalibrate(int argc, char** argv) {
   outputs.Protect(layout_path, "the layout file (--layout)");
   outputs.Claim(out_path, "the rig file (--out)");
   outputs.Claim(report_path, "the report (--report)");
+  if (!cameramodels_dir.empty() && std::filesystem::exists(cameramodels_dir) &&
+      !std::filesystem::is_directory(cameramodels_dir))
+    throw InputError(cameramodels_dir,
+                     "is a file, not a folder to write camK.cameramodel into (--export-cameramodels)");
 
   const FolderCalibration folder = CalibrateCaptureFolder(captures, target_path, layout_path, options);
   const CalibrationResult& result = folder.result;

@@ -165,9 +165,14 @@ TEST(CalibrateCli, OutputsThatCollideOrHaveNoFolderAreRefusedBeforeAnyWork) {
   r = testing::RunCli(inputs + " --out " + dir + "/layout.yaml --report " + dir + "/report.json");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("layout.yaml: is the layout file (--layout)"), std::string::npos) << r.err;
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  std::ofstream(dir + "/models") << "a file, not a folder\n";
+  r = testing::RunCli(inputs + " --out " + dir + "/rig.yaml --report " + dir + "/report.json --export-cameramodels " +
+                      dir + "/models");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("models: is a file, not a folder"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
   EXPECT_FALSE(fs::exists(dir + "/report.json"));
-  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
 }
 
 }  // namespace
