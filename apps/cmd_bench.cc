@@ -226,7 +226,12 @@ int RunBench(int argc, char** argv) {
   app.add_option("--report", report_path, "write everything as JSON here");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
   if (runs < 1) throw InputError("--runs", "must be >= 1");
-  if (!report_path.empty()) OutputPaths().Claim(report_path, "the report (--report)");  // before minutes of runs
+  if (!report_path.empty()) {  // before minutes of runs
+    OutputPaths outputs;
+    outputs.Protect(rig_path, "the rig file (--rig)");
+    outputs.Protect(options_path, "the options file (--options)");
+    outputs.Claim(report_path, "the report (--report)");
+  }
 
   Rig rig;
   std::vector<Scene> scenes;

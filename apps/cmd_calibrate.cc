@@ -62,10 +62,7 @@ int RunCalibrate(int argc, char** argv) {
   outputs.Protect(layout_path, "the layout file (--layout)");
   outputs.Claim(out_path, "the rig file (--out)");
   outputs.Claim(report_path, "the report (--report)");
-  if (!cameramodels_dir.empty() && std::filesystem::exists(cameramodels_dir) &&
-      !std::filesystem::is_directory(cameramodels_dir))
-    throw InputError(cameramodels_dir,
-                     "is a file, not a folder to write camK.cameramodel into (--export-cameramodels)");
+  if (!cameramodels_dir.empty()) outputs.ClaimFolder(cameramodels_dir, "the camera models (--export-cameramodels)");
 
   const FolderCalibration folder = CalibrateCaptureFolder(captures, target_path, layout_path, options);
   const CalibrationResult& result = folder.result;

@@ -77,6 +77,7 @@ int RunCheck(int argc, char** argv) {
   app.add_flag("--history", history_only, "print the trend of every figure from the history, and stop");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 
+  const bool history_given = !history_db.empty();
   if (history_db.empty()) {
     if (rig_path.empty()) throw InputError("", "give --rig or --history-db");
     history_db = DefaultHistoryPath(rig_path);
@@ -93,7 +94,8 @@ int RunCheck(int argc, char** argv) {
   outputs.Protect(rig_path, "the rig file (--rig)");
   outputs.Protect(target_path, "the target file (--target)");
   if (!report_path.empty()) outputs.Claim(report_path, "the report (--report)");
-  outputs.Claim(history_db, "the history database (--history-db, updated in place)");
+  outputs.Claim(history_db, history_given ? "the history database (--history-db, updated in place)"
+                                          : "the history database (by default beside the rig file, updated in place)");
 
   const Rig rig = ReadRigFile(rig_path);
   const Target target = ReadTargetFile(target_path);

@@ -55,7 +55,10 @@ int RunMatch(int argc, char** argv) {
       if (e.where() == field) throw InputError(flag, e.problem());
     throw;
   }
-  OutputPaths().Claim(out_path, "the disparity map");  // its folder checked before the matching runs
+  OutputPaths outputs;  // its folder checked before the matching runs, and that it is neither image
+  outputs.Protect(left_path, "the left image (--left)");
+  outputs.Protect(right_path, "the right image (--right)");
+  outputs.Claim(out_path, "the disparity map (--out)");
   const cv::Mat left = ReadGreyImage(left_path), right = ReadGreyImage(right_path);
   if (left.size() != right.size()) throw InputError(right_path, "size differs from the left image");
 

@@ -61,6 +61,12 @@ int RunReconstruct(int argc, char** argv) {
     throw InputError("--capture",
                      std::to_string(capture_dirs.size()) + " captures given: write them with --out-dir DIR, not --out");
   if (!out_dir.empty()) {
+    if (!report_path.empty()) {  // the batch checks its own outputs (reconstruct_batch.h); not over an input
+      OutputPaths inputs;
+      inputs.Protect(rig_path, "the rig file (--rig)");
+      inputs.Protect(options_path, "the options file (--options)");
+      inputs.Claim(report_path, "the batch report (--report)", false);
+    }
     const Rig rig = ReadRigFile(rig_path);
     const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
     return ReconstructBatch(rig, options, BatchRequest{capture_dirs, out_dir, mesh_format, report_path});
@@ -69,6 +75,8 @@ int RunReconstruct(int argc, char** argv) {
 
   // Every input, and where each output goes, is checked before any work.
   OutputPaths outputs;
+  outputs.Protect(rig_path, "the rig file (--rig)");
+  outputs.Protect(options_path, "the options file (--options)");
   outputs.Claim(out_path, "the cloud (--out)");
   if (!mesh_path.empty()) {
     CheckMeshPath(mesh_path);

@@ -83,7 +83,12 @@ int RunScore(int argc, char** argv) {
       throw InputError(diagnose_dir, "--diagnose: cannot create this folder (" + ec.message() + ")");
   }
   // After --diagnose's folder exists: the report may go in it.
-  if (!report_path.empty()) OutputPaths().Claim(report_path, "the report (--report)");  // before minutes of scoring
+  if (!report_path.empty()) {  // before minutes of scoring
+    OutputPaths outputs;
+    outputs.Protect(rig_path, "the rig file (--rig)");
+    outputs.Protect(options_path, "the options file (--options)");
+    outputs.Claim(report_path, "the report (--report)");
+  }
   const Rig rig = ReadRigFile(rig_path);
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
   RuntimeOptions passive_options = options;

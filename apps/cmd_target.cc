@@ -30,10 +30,13 @@ int RunTarget(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--write-target", write_target, "also write the target file used here (YAML)");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
+  // --write-target may name the --target file itself (it writes back what
+  // it read, defaults filled in), so it is claimed before that is
+  // protected; the SVG may not.
   OutputPaths outputs;
+  if (!write_target.empty()) outputs.Claim(write_target, "the target file (--write-target)");
   outputs.Protect(target_path, "the target file (--target)");
   outputs.Claim(out_path, "the SVG (--out)");
-  if (!write_target.empty()) outputs.Claim(write_target, "the target file (--write-target)");
 
   const Target target = target_path.empty() ? DefaultTarget() : ReadTargetFile(target_path);
   BoardSvgOptions options;

@@ -6,8 +6,10 @@ namespace stereorig {
 
 namespace {
 
+// The file a path names: symbolic links followed as far as the path exists
+// (an output through a link to an input is that input), the rest normalised.
 std::filesystem::path Key(const std::string& path) {
-  return std::filesystem::absolute(std::filesystem::path(path)).lexically_normal();
+  return std::filesystem::weakly_canonical(std::filesystem::absolute(std::filesystem::path(path)));
 }
 
 }  // namespace
@@ -26,6 +28,27 @@ void OutputPaths::Claim(const std::string& path, const std::string& what, bool c
         path, "would be written twice (" + it->second + " and " + what + ")" + (remedy_.empty() ? "" : ": " + remedy_));
   if (check_folder && !fs::is_directory(key.parent_path())) throw InputError(path, "its folder does not exist");
   if (fs::is_directory(key)) throw InputError(path, "is a folder, not a file to write");
+  claimed_.emplace(key, what);
+}
+
+void OutputPaths::ClaimFolder(const std::string& path, const std::string& what) {
+  namespace fs = std::filesystem;
+  const fs::path key = Key(path);
+  if (const auto it = inputs_.find(key); it != inputs_.end())
+    throw InputError(path, "is " + it->second + ", not a folder for " + what);
+  if (const auto it = claimed_.find(key); it != claimed_.end())
+    throw InputError(path, "is claimed by " + it->second + " as a file, not a folder for " + what);
+  // The nearest part of the path that exists must be a folder: the command
+  // creates the rest.
+  for (fs::path p = key; !p.empty(); p = p.parent_path()) {
+    if (fs::exists(p)) {
+      if (!fs::is_directory(p))
+        throw InputError(
+            path, (p == key ? std::string("is a file") : p.string() + " is a file") + ", not a folder for " + what);
+      break;
+    }
+    if (p == p.root_path()) break;
+  }
   claimed_.emplace(key, what);
 }
 

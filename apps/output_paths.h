@@ -1,7 +1,8 @@
 // The files one command will write, checked before it does any work: no file
 // named twice (its cloud and its mesh at one path would leave only the last
-// written), none of them one of the command's inputs (a report written over
-// the rig file it was checking), and each one's folder there to write in. A failure is bad input
+// written), none of them one of the inputs the command protects (a report
+// written over the rig file it was checking), and each one's folder there to
+// write in. Paths are compared after following symbolic links. A failure is bad input
 // (InputError) naming the path, so nothing is computed only to fail at the
 // end with some outputs written and others not.
 #pragma once
@@ -26,6 +27,10 @@ class OutputPaths {
   // (--rig)"): a Claim of the same file throws InputError. Call before the
   // Claims. An empty path is ignored (an optional input not given).
   void Protect(const std::string& path, const std::string& what);
+  // Records a folder the command creates if needed and writes files into
+  // (`what` names it). Throws InputError if it is an input or a claimed
+  // file, or if it, or the nearest part of its path that exists, is a file.
+  void ClaimFolder(const std::string& path, const std::string& what);
 
  private:
   std::string remedy_;

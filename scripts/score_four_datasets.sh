@@ -15,6 +15,13 @@ if [ $# -lt 2 ]; then sed -n 2,12p "$0"; exit 2; fi
 B=$1; O=$2; shift 2
 DEMO=${DEMO:-/tmp/demo}; S7=${S7:-/tmp/s7}; SP_OFF=${SP_OFF:-/tmp/sp_off}; SP_HIGH=${SP_HIGH:-/tmp/sp_high}
 EXTRA=${EXTRA:-}
+for e in $EXTRA; do  # name=DIR, a plain name, not one of the four (its files would replace theirs)
+  n=${e%%=*}
+  if [[ $e != *=* || ! $n =~ ^[A-Za-z0-9_]+$ || $n =~ ^(demo|s7|off|high)$ ]]; then
+    echo "error: EXTRA entry '$e': give name=DIR, the name letters, digits or _ and not demo, s7, off or high" >&2
+    exit 2
+  fi
+done
 for d in "$DEMO/dataset" "$S7" "$SP_OFF" "$SP_HIGH" $(for e in $EXTRA; do echo "${e#*=}"; done); do
   [ -d "$d/scenes" ] || { echo "error: $d has no scenes/ (see the header of $0)" >&2; exit 2; }
 done

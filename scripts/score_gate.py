@@ -11,9 +11,13 @@ base, new = sys.argv[1], sys.argv[2]
 fails = 0; rows = 0; worst = {'fill': 0, 'mean': 0, 'std': 0}
 # The datasets: every <name>.json in BASEDIR (score_four_datasets.sh writes demo, s7, off and high; more
 # realizations may sit beside them, names starting 'high' for speckle 0.4).
-datasets = sorted(f[:-5] for f in os.listdir(base) if f.endswith('.json'))
+for d in (base, new):
+    if not os.path.isdir(d):
+        print(f'{d}: not a folder', file=sys.stderr); sys.exit(2)
+# Both folders' datasets: one on a side only is reported missing (a row that fails).
+datasets = sorted({f[:-5] for d in (base, new) for f in os.listdir(d) if f.endswith('.json')})
 if not datasets:
-    print(f'{base}: no <dataset>.json', file=sys.stderr); sys.exit(2)
+    print(f'{base}, {new}: no <dataset>.json', file=sys.stderr); sys.exit(2)
 sums = {'fill': 0.0, 'mean': 0.0, 'std': 0.0}
 for ds in datasets:
     pb, pn = os.path.join(base, ds + '.json'), os.path.join(new, ds + '.json')

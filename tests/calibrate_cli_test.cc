@@ -166,13 +166,23 @@ TEST(CalibrateCli, OutputsThatCollideOrHaveNoFolderAreRefusedBeforeAnyWork) {
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("layout.yaml: is the layout file (--layout)"), std::string::npos) << r.err;
   EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  // The camera models' folder (created if needed): not a file, not under
+  // a file, not the rig file's or the report's path (create_directories
+  // failed there only after both were written).
   std::ofstream(dir + "/models") << "a file, not a folder\n";
-  r = testing::RunCli(inputs + " --out " + dir + "/rig.yaml --report " + dir + "/report.json --export-cameramodels " +
-                      dir + "/models");
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("models: is a file, not a folder"), std::string::npos) << r.err;
-  EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
-  EXPECT_FALSE(fs::exists(dir + "/report.json"));
+  const std::pair<std::string, std::string> folders[] = {
+      {dir + "/models", "models: is a file, not a folder"},
+      {dir + "/models/sub", "/models is a file, not a folder"},
+      {dir + "/rig.yaml", "rig.yaml: is claimed by the rig file (--out) as a file"}};
+  for (const auto& [folder, says] : folders) {
+    r = testing::RunCli(inputs + " --out " + dir + "/rig.yaml --report " + dir + "/report.json --export-cameramodels " +
+                        folder);
+    EXPECT_EQ(r.code, 2) << folder;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+  }
+  // (Each message names an output, which only the checks before the
+  // calibration can: the captures and target given do not exist, so the
+  // calibration would have failed naming those.)
 }
 
 }  // namespace

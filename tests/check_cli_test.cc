@@ -190,6 +190,11 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     EXPECT_NE(LastLine(r.err).find("check.json: its folder does not exist"), std::string::npos) << r.err;
     EXPECT_EQ(r.err.find("detecting"), std::string::npos) << r.err;
     EXPECT_EQ(Bytes(db), db_bytes);
+    // Without --history-db the history's default path is what is named.
+    r = RunCli("check --rig " + dir + "/rig.yaml --captures " + dir + "/ds --target " + dir +
+               "/ds/target.yaml --report " + dir + "/check-history.sqlite");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(LastLine(r.err).find("(by default beside the rig file"), std::string::npos) << r.err;
   }
   fs::remove_all(dir);
 }

@@ -73,6 +73,18 @@ TEST(CliTarget, OutputsThatCollideOrOverwriteTheTargetFileAreRefused) {
   EXPECT_NE(r.err.find("board.yaml: is the target file (--target)"), std::string::npos) << r.err;
   EXPECT_EQ(Slurp(dir + "/board.yaml"), yaml);
 
+  // --write-target may write back the target file it read.
+  r = RunStereorig("target --target " + dir + "/board.yaml --out " + dir + "/second.svg --write-target " + dir +
+                   "/board.yaml");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(Slurp(dir + "/board.yaml"), yaml);
+  // Through a symbolic link the SVG would still land on the target file.
+  std::filesystem::create_symlink(dir + "/board.yaml", dir + "/link.yaml");
+  r = RunStereorig("target --target " + dir + "/board.yaml --out " + dir + "/link.yaml");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("link.yaml: is the target file (--target)"), std::string::npos) << r.err;
+  EXPECT_EQ(Slurp(dir + "/board.yaml"), yaml);
+
   r = RunStereorig("target --out " + dir + "/missing/board.svg");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("its folder does not exist"), std::string::npos) << r.err;

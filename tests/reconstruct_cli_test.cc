@@ -126,6 +126,14 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
     EXPECT_NE(no_folder.err.find("no_such_folder/disp.pfm: its folder does not exist"), std::string::npos)
         << no_folder.err;
   }
+  // The map written over an input image (it used to replace it with PFM data).
+  const auto png_size = std::filesystem::file_size(dir + "/small.png");
+  const testing::Result over_left =
+      testing::RunCli("match --left " + dir + "/small.png --right " + dir +
+                      "/big.png --min-disparity 0 --num-disparities 16 --out " + dir + "/small.png");
+  EXPECT_EQ(over_left.code, 2);
+  EXPECT_NE(over_left.err.find("small.png: is the left image (--left)"), std::string::npos) << over_left.err;
+  EXPECT_EQ(std::filesystem::file_size(dir + "/small.png"), png_size);
 }
 
 }  // namespace
@@ -293,6 +301,31 @@ TEST_F(ReconstructCli, OutputPathsAreCheckedBeforeAnyWork) {
     EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
     ExpectNoOutput();
   }
+  // No output over an input: the rig file named as the report (directly, or
+  // through a symbolic link to it), or the options file as the cloud, would
+  // be replaced by JSON or PLY. Both inputs stay byte-identical.
+  auto bytes = [](const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  };
+  WriteFileAtomically(dir_ + "/o.yaml", "object_size_mm: 80\n");
+  std::filesystem::remove(dir_ + "/rig_link.yaml");
+  std::filesystem::create_symlink(dir_ + "/rig.yaml", dir_ + "/rig_link.yaml");
+  const std::string rig_bytes = bytes(dir_ + "/rig.yaml");
+  const std::pair<std::string, std::string> over_inputs[] = {
+      {base + "--report " + dir_ + "/rig.yaml", "rig.yaml: is the rig file (--rig)"},
+      {base + "--report " + dir_ + "/rig_link.yaml", "rig_link.yaml: is the rig file (--rig)"},
+      {"reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture --options " + dir_ + "/o.yaml --out " +
+           dir_ + "/o.yaml",
+       "o.yaml: is the options file (--options)"}};
+  for (const auto& [args, says] : over_inputs) {
+    const testing::Result r = testing::RunCli(args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+  }
+  EXPECT_EQ(bytes(dir_ + "/rig.yaml"), rig_bytes);
+  EXPECT_EQ(bytes(dir_ + "/o.yaml"), "object_size_mm: 80\n");
+  ExpectNoOutput();
 }
 
 // A measurement volume deeper than the matcher can search (150 x 150 x 300
