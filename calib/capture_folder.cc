@@ -41,8 +41,19 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
       if (!fs::exists(image))
         throw InputError(image.string(), "missing (each capture needs camK.png for every camera)");
       CheckPngIsWhole(image.string());
-      const cv::Mat grey = cv::imread(image.string(), cv::IMREAD_GRAYSCALE);
+      // Read as stored, and held to what the runtime reads
+      // (reconstruct/grey_image.h): imread's own conversion to grey would
+      // take a 16-bit image's high byte (a 12-bit camera's image in the low
+      // bits turns nearly black, and then no board is found) and let a
+      // colour capture through that `reconstruct` refuses.
+      const cv::Mat grey = cv::imread(image.string(), cv::IMREAD_UNCHANGED);
       if (grey.empty()) throw InputError(image.string(), "cannot be read as an image");
+      if (grey.type() != CV_8UC1)
+        throw InputError(image.string(),
+                         "must be an 8-bit single-channel (grey) image, as `stereorig reconstruct` "
+                         "reads too (this one has " +
+                             std::to_string(grey.channels()) + " channel(s) of " +
+                             std::to_string(8 * int(grey.elemSize1())) + " bits)");
       CameraImager& spec = out.cameras[c];
       if (spec.width_px == 0) {
         spec.width_px = grey.cols;

@@ -129,6 +129,14 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     cv::imwrite(d + "/005/cam2.png", cv::Mat(480, 640, CV_8UC1, cv::Scalar(40)));
     expect_refused(check(d, dir + "/rig.yaml"), "005/cam2.png", "wrong-size image");
   }
+  {  // A 16-bit image (a 12-bit camera's, in the low bits): imread's grey
+     // conversion took its high byte, a nearly black image.
+    const std::string d = copy("sixteen_bit");
+    cv::Mat wide;
+    cv::imread(d + "/002/cam0.png", cv::IMREAD_GRAYSCALE).convertTo(wide, CV_16U, 16.0);
+    cv::imwrite(d + "/002/cam0.png", wide);
+    expect_refused(check(d, dir + "/rig.yaml"), "002/cam0.png: must be an 8-bit single-channel", "16-bit image");
+  }
   {  // Captures from another rig whose camera 3 is another camera (half the pixels).
     const std::string d = copy("other_camera");
     for (const auto& capture : fs::directory_iterator(d)) {
