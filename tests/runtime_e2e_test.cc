@@ -167,5 +167,43 @@ TEST(RuntimeAtStrongSpeckle, PlateMeetsTheMeanTargetAndStaysNearTheStdOne) {
   EXPECT_LT(s.accuracy.all.mean_abs_mm, 0.15);  // two modules merged
 }
 
+// The default speckle on a realization no option was tuned on (seed 6,
+// the ball bar and the plate alone, truth rig; the scene list is part of
+// the realization). Session 20 found the four datasets every session
+// scored hiding failures that fresh realizations show (reconstruct-log.md,
+// "The speed options scored on fresh realizations"); this one guards issue
+// 5's targets, per module and merged, as the issue states them. Measured:
+// ball bar 0.053 / 0.059 mm mean |e|, std 0.069 / 0.094 mm (module 1's
+// nearest the target: ~30 points a few pixels off at the lower ball's left
+// silhouette), plate std 0.069 / 0.073; fill 0.806 / 0.796 and 0.967 /
+// 0.975, asserted less ~3 points (the simulator and the runtime are
+// deterministic: the margin is for a deliberate change of the pipeline,
+// which should then say why).
+TEST(RuntimeOnAFreshRealization, BallBarAndPlateMeetTheAccuracyTargets) {
+  SimSpec spec = DefaultSimSpec();
+  spec.scenes.names = {"ballbar", "plate"};
+  SimulateOptions o;
+  o.out_dir = ::testing::TempDir() + "/runtime_e2e_seed6";
+  o.seed = 6;
+  o.calibration_captures = 0;
+  Simulate(spec, o);
+  const Rig rig = ReadRigFile(o.out_dir + "/truth/rig.yaml");
+  const Runtime runtime(rig, RuntimeOptions{});
+  for (const auto& [scene, min_fill] : {std::pair{"ballbar", 0.77}, {"plate", 0.94}}) {
+    const Reconstruction rec = runtime.Process(LoadCapture(o.out_dir + "/scenes/" + scene + "/active", rig), false);
+    const SceneScore s = ScoreScene(runtime, rec, ReadSceneTruth(o.out_dir, scene));
+    ASSERT_EQ(s.fill.size(), 2u);
+    for (size_t m = 0; m < 2; ++m) {
+      const ErrorFigures& e = s.accuracy.per_module[m];
+      std::printf("seed 6 %s module %zu: fill %.3f, %d points, |e| %.4f mm, std %.4f mm\n", scene, m, s.fill[m].fill(),
+                  e.points, e.mean_abs_mm, e.std_mm);
+      EXPECT_LT(e.mean_abs_mm, 0.1) << scene << " module " << m;
+      EXPECT_LT(e.std_mm, 0.1) << scene << " module " << m;
+      EXPECT_GT(s.fill[m].fill(), min_fill) << scene << " module " << m;
+    }
+    EXPECT_LT(s.accuracy.all.mean_abs_mm, 0.15) << scene;  // two modules merged
+  }
+}
+
 }  // namespace
 }  // namespace stereorig
