@@ -19,10 +19,12 @@ datasets = sorted({f[:-5] for d in (base, new) for f in os.listdir(d) if f.endsw
 if not datasets:
     print(f'{base}, {new}: no <dataset>.json', file=sys.stderr); sys.exit(2)
 sums = {'fill': 0.0, 'mean': 0.0, 'std': 0.0}
+missing = 0  # datasets on one side only
 for ds in datasets:
     pb, pn = os.path.join(base, ds + '.json'), os.path.join(new, ds + '.json')
     if not (os.path.exists(pb) and os.path.exists(pn)):
-        print(f'{ds}: missing'); fails += 1; continue
+        side = 'BASEDIR' if not os.path.exists(pb) else 'NEWDIR'
+        print(f'{ds}: missing in {side}'); fails += 1; missing += 1; continue
     B = {s['scene']: s for s in json.load(open(pb))['scenes']}
     N = {s['scene']: s for s in json.load(open(pn))['scenes']}
     for sc in set(N) - set(B): print(f'{ds} {sc}: only in new'); fails += 1
@@ -43,7 +45,8 @@ for ds in datasets:
             sums['fill'] += fn - fb; sums['mean'] += en - eb; sums['std'] += sn - sb
             rows += 1; fails += bool(bad)
             print(f"{ds:5s} {sc:8s} m{mb['module']}: fill {fb:5.1f}->{fn:5.1f} ({fn-fb:+.2f})  |e| {eb:.4f}->{en:.4f} ({en-eb:+.4f})  std {sb:.4f}->{sn:.4f} ({sn-sb:+.4f}) {' '.join(bad)}")
-print(f"worst: fill {worst['fill']:+.2f} pts, mean {worst['mean']:+.4f} mm, std {worst['std']:+.4f} mm; {fails} of {rows} module rows fail the gate")
+print(f"worst: fill {worst['fill']:+.2f} pts, mean {worst['mean']:+.4f} mm, std {worst['std']:+.4f} mm; "
+      f"{fails - missing} of {rows} module rows fail the gate" + (f"; {missing} dataset(s) missing on one side" if missing else ""))
 if rows:
     print(f"average over the rows: fill {sums['fill']/rows:+.2f} pts, mean {sums['mean']/rows:+.4f} mm, std {sums['std']/rows:+.4f} mm")
 print('GATE PASS' if fails == 0 else 'GATE FAIL')
