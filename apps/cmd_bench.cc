@@ -226,12 +226,7 @@ int RunBench(int argc, char** argv) {
   app.add_option("--report", report_path, "write everything as JSON here");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
   if (runs < 1) throw InputError("--runs", "must be >= 1");
-  if (!report_path.empty()) {  // before minutes of runs
-    OutputPaths outputs;
-    outputs.Protect(rig_path, "the rig file (--rig)");
-    outputs.Protect(options_path, "the options file (--options)");
-    outputs.Claim(report_path, "the report (--report)");
-  }
+  if (!report_path.empty()) ClaimRuntimeReport(report_path, rig_path, options_path);  // before minutes of runs
 
   Rig rig;
   std::vector<Scene> scenes;

@@ -61,12 +61,9 @@ int RunReconstruct(int argc, char** argv) {
     throw InputError("--capture",
                      std::to_string(capture_dirs.size()) + " captures given: write them with --out-dir DIR, not --out");
   if (!out_dir.empty()) {
-    if (!report_path.empty()) {  // the batch checks its own outputs (reconstruct_batch.h); not over an input
-      OutputPaths inputs;
-      inputs.Protect(rig_path, "the rig file (--rig)");
-      inputs.Protect(options_path, "the options file (--options)");
-      inputs.Claim(report_path, "the batch report (--report)", false);
-    }
+    // The batch checks its own outputs (reconstruct_batch.h); here only that
+    // its summary is not over an input (its folder may be the one it creates).
+    if (!report_path.empty()) ClaimRuntimeReport(report_path, rig_path, options_path, false);
     const Rig rig = ReadRigFile(rig_path);
     const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
     return ReconstructBatch(rig, options, BatchRequest{capture_dirs, out_dir, mesh_format, report_path});

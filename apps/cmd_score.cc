@@ -83,12 +83,7 @@ int RunScore(int argc, char** argv) {
       throw InputError(diagnose_dir, "--diagnose: cannot create this folder (" + ec.message() + ")");
   }
   // After --diagnose's folder exists: the report may go in it.
-  if (!report_path.empty()) {  // before minutes of scoring
-    OutputPaths outputs;
-    outputs.Protect(rig_path, "the rig file (--rig)");
-    outputs.Protect(options_path, "the options file (--options)");
-    outputs.Claim(report_path, "the report (--report)");
-  }
+  if (!report_path.empty()) ClaimRuntimeReport(report_path, rig_path, options_path);  // before minutes of scoring
   const Rig rig = ReadRigFile(rig_path);
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
   RuntimeOptions passive_options = options;

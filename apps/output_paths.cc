@@ -31,6 +31,14 @@ void OutputPaths::Claim(const std::string& path, const std::string& what, bool c
   claimed_.emplace(key, what);
 }
 
+void ClaimRuntimeReport(const std::string& report_path, const std::string& rig_path, const std::string& options_path,
+                        bool check_folder) {
+  OutputPaths outputs;
+  outputs.Protect(rig_path, "the rig file (--rig)");
+  outputs.Protect(options_path, "the options file (--options)");
+  outputs.Claim(report_path, "the report (--report)", check_folder);
+}
+
 void OutputPaths::ClaimFolder(const std::string& path, const std::string& what) {
   namespace fs = std::filesystem;
   const fs::path key = Key(path);

@@ -38,4 +38,10 @@ class OutputPaths {
   std::map<std::filesystem::path, std::string> inputs_;   // normal absolute path -> the input it is
 };
 
+// The --report of a command that reads a rig file and runtime options
+// (bench, score, a reconstruct batch): claimed, not over either input
+// (an empty path: not given). check_folder as OutputPaths::Claim.
+void ClaimRuntimeReport(const std::string& report_path, const std::string& rig_path, const std::string& options_path,
+                        bool check_folder = true);
+
 }  // namespace stereorig
