@@ -29,10 +29,11 @@ namespace {
 namespace fs = std::filesystem;
 
 // Simulates `scenes` (active and passive captures, no calibration captures)
-// into TempDir()/name at `seed` and speckle contrast `speckle`; returns the
-// folder. The scene list is part of the realization.
-std::string SimulateScenes(const std::vector<std::string>& scenes, int seed, double speckle, const std::string& name) {
-  SimSpec spec = DefaultSimSpec();
+// of the rig in `spec` (default: the default rig) into TempDir()/name at
+// `seed` and speckle contrast `speckle`; returns the folder. The scene list
+// is part of the realization.
+std::string SimulateScenes(const std::vector<std::string>& scenes, int seed, double speckle, const std::string& name,
+                           SimSpec spec = DefaultSimSpec()) {
   spec.scenes.names = scenes;
   spec.render.speckle_contrast = speckle;
   SimulateOptions o;
@@ -41,6 +42,24 @@ std::string SimulateScenes(const std::vector<std::string>& scenes, int seed, dou
   o.calibration_captures = 0;
   Simulate(spec, o);
   return o.out_dir;
+}
+
+// Reconstructs `scene`'s active capture of `dataset` with its truth rig and
+// default options, scores it (as RuntimeOnSimulatedScenes::Run) and prints
+// each module's figures after `label`.
+SceneScore ReconstructAndScore(const std::string& dataset, const std::string& scene, const std::string& label) {
+  const Rig rig = ReadRigFile(dataset + "/truth/rig.yaml");
+  const Runtime runtime(rig, RuntimeOptions{});
+  const Reconstruction rec = runtime.Process(LoadCapture(dataset + "/scenes/" + scene + "/active", rig), false);
+  const SceneScore s = ScoreScene(runtime, rec, ReadSceneTruth(dataset, scene));
+  for (size_t m = 0; m < s.fill.size(); ++m) {
+    const ErrorFigures& e = s.accuracy.per_module[m];
+    std::printf("%s module %zu: fill %.3f, %d points, |e| %.4f mm, std %.4f mm\n", label.c_str(), m, s.fill[m].fill(),
+                e.points, e.mean_abs_mm, e.std_mm);
+  }
+  std::printf("%s merged: |e| %.4f mm; aligned by %.4f deg, %.4f mm\n", label.c_str(), s.accuracy.all.mean_abs_mm,
+              s.accuracy.truth_from_cloud.AngleDeg(), s.accuracy.truth_from_cloud.translation_mm().norm());
+  return s;
 }
 
 class RuntimeOnSimulatedScenes : public ::testing::Test {
@@ -156,15 +175,10 @@ TEST_F(RuntimeOnSimulatedScenes, SphereAgreesWithTheAnalyticSphere) {
 // fit fails on both modules.
 TEST(RuntimeAtStrongSpeckle, PlateMeetsTheMeanTargetAndStaysNearTheStdOne) {
   const std::string dataset = SimulateScenes({"plate"}, 1, 0.4, "runtime_e2e_speckle04");
-  const Rig rig = ReadRigFile(dataset + "/truth/rig.yaml");
-  const Runtime runtime(rig, RuntimeOptions{});
-  const Reconstruction rec = runtime.Process(LoadCapture(dataset + "/scenes/plate/active", rig), false);
-  const SceneScore s = ScoreScene(runtime, rec, ReadSceneTruth(dataset, "plate"));
+  const SceneScore s = ReconstructAndScore(dataset, "plate", "speckle 0.4 plate");
   ASSERT_EQ(s.fill.size(), 2u);
   for (size_t m = 0; m < 2; ++m) {
     const ErrorFigures& e = s.accuracy.per_module[m];
-    std::printf("speckle 0.4 plate module %zu: fill %.3f, %d points, |e| %.4f mm, std %.4f mm\n", m, s.fill[m].fill(),
-                e.points, e.mean_abs_mm, e.std_mm);
     EXPECT_LT(e.mean_abs_mm, 0.1) << "module " << m;
     EXPECT_LT(e.std_mm, 0.115) << "module " << m;
   }
@@ -186,22 +200,50 @@ TEST(RuntimeAtStrongSpeckle, PlateMeetsTheMeanTargetAndStaysNearTheStdOne) {
 TEST(RuntimeOnAFreshRealization, BallBarAndPlateMeetTheAccuracyTargets) {
   const std::string dataset =
       SimulateScenes({"ballbar", "plate"}, 6, DefaultSimSpec().render.speckle_contrast, "runtime_e2e_seed6");
-  const Rig rig = ReadRigFile(dataset + "/truth/rig.yaml");
-  const Runtime runtime(rig, RuntimeOptions{});
   for (const auto& [scene, min_fill] : {std::pair{"ballbar", 0.77}, {"plate", 0.94}}) {
-    const Reconstruction rec = runtime.Process(LoadCapture(dataset + "/scenes/" + scene + "/active", rig), false);
-    const SceneScore s = ScoreScene(runtime, rec, ReadSceneTruth(dataset, scene));
+    const SceneScore s = ReconstructAndScore(dataset, scene, std::string("seed 6 ") + scene);
     ASSERT_EQ(s.fill.size(), 2u);
     for (size_t m = 0; m < 2; ++m) {
       const ErrorFigures& e = s.accuracy.per_module[m];
-      std::printf("seed 6 %s module %zu: fill %.3f, %d points, |e| %.4f mm, std %.4f mm\n", scene, m, s.fill[m].fill(),
-                  e.points, e.mean_abs_mm, e.std_mm);
       EXPECT_LT(e.mean_abs_mm, 0.1) << scene << " module " << m;
       EXPECT_LT(e.std_mm, 0.1) << scene << " module " << m;
       EXPECT_GT(s.fill[m].fill(), min_fill) << scene << " module " << m;
     }
     EXPECT_LT(s.accuracy.all.mean_abs_mm, 0.15) << scene;  // two modules merged
   }
+}
+
+// A rig of three modules, 120 degrees apart around the object (the default
+// rig's module 0, and its module 1's cameras and projector moved to +-120
+// degrees), every module's grid lighting the object for all: the runtime is
+// built for M modules, and the merge through S is only exercised beyond the
+// facing pair here. Scored as above (truth rig, seed 11, the cup): each
+// module must meet issue 5's per-module targets after ONE rigid alignment of
+// the merged cloud, so a module put into the reference frame by the wrong S
+// (or none) shows as millimetres of error on that module. Measured: mean |e|
+// 0.033 / 0.034 / 0.031 mm, std 0.043 / 0.044 / 0.039 mm, fill 0.922 / 0.895
+// / 0.901 (`stereorig score` on the same realization); fill asserted ~3
+// points under that, as above.
+TEST(RuntimeOnAThreeModuleRig, EveryModuleMeetsTheAccuracyTargetsInOneFrame) {
+  SimSpec spec = DefaultSimSpec();
+  ASSERT_EQ(spec.modules.size(), 2u);
+  spec.modules.push_back(spec.modules[1]);
+  for (int m = 1; m < 3; ++m) {
+    const double a = 2 * M_PI * m / 3;
+    spec.modules[m].name = "module" + std::to_string(m);
+    spec.modules[m].center_mm = Eigen::Vector3d(200 * std::sin(a), 0, -200 * std::cos(a));
+  }
+  const std::string dataset =
+      SimulateScenes({"cup"}, 11, DefaultSimSpec().render.speckle_contrast, "runtime_e2e_ring3", spec);
+  const SceneScore s = ReconstructAndScore(dataset, "cup", "three modules, cup");
+  ASSERT_EQ(s.fill.size(), 3u);  // the truth rig has three modules, each scored
+  for (size_t m = 0; m < 3; ++m) {
+    const ErrorFigures& e = s.accuracy.per_module[m];
+    EXPECT_LT(e.mean_abs_mm, 0.1) << "module " << m;
+    EXPECT_LT(e.std_mm, 0.1) << "module " << m;
+    EXPECT_GT(s.fill[m].fill(), 0.86) << "module " << m;
+  }
+  EXPECT_LT(s.accuracy.all.mean_abs_mm, 0.15);  // three modules merged
 }
 
 }  // namespace
