@@ -60,6 +60,7 @@ int RunCalibrate(int argc, char** argv) {
   OutputPaths outputs;
   outputs.Protect(target_path, "the target file (--target)");
   outputs.Protect(layout_path, "the layout file (--layout)");
+  for (const std::string& image : CaptureFolderImages(captures)) outputs.Protect(image, "a capture image (--captures)");
   outputs.Claim(out_path, "the rig file (--out)");
   outputs.Claim(report_path, "the report (--report)");
   if (!cameramodels_dir.empty()) outputs.ClaimFolder(cameramodels_dir, "the camera models (--export-cameramodels)");

@@ -93,6 +93,7 @@ int RunCheck(int argc, char** argv) {
   OutputPaths outputs;
   outputs.Protect(rig_path, "the rig file (--rig)");
   outputs.Protect(target_path, "the target file (--target)");
+  for (const std::string& image : CaptureFolderImages(captures)) outputs.Protect(image, "a capture image (--captures)");
   if (!report_path.empty()) outputs.Claim(report_path, "the report (--report)");
   outputs.Claim(history_db, history_given ? "the history database (--history-db, updated in place)"
                                           : "the history database (by default beside the rig file, updated in place)");

@@ -71,16 +71,20 @@ int RunReconstruct(int argc, char** argv) {
   const std::string& capture_dir = capture_dirs.front();
 
   // Every input, and where each output goes, is checked before any work.
+  // The rig file is read first: it says which capture images will be read,
+  // and none of them may be an output (--out DIR/cam0.png).
+  const Rig rig = ReadRigFile(rig_path);
   OutputPaths outputs;
   outputs.Protect(rig_path, "the rig file (--rig)");
   outputs.Protect(options_path, "the options file (--options)");
+  for (const std::string& image : CaptureImagePaths(capture_dir, rig))
+    outputs.Protect(image, "a capture image (--capture)");
   outputs.Claim(out_path, "the cloud (--out)");
   if (!mesh_path.empty()) {
     CheckMeshPath(mesh_path);
     outputs.Claim(mesh_path, "the mesh (--mesh)");
   }
   if (!report_path.empty()) outputs.Claim(report_path, "the report (--report)");
-  const Rig rig = ReadRigFile(rig_path);
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
   const std::vector<cv::Mat> images = LoadCapture(capture_dir, rig);
   const Runtime runtime(rig, options);

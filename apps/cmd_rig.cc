@@ -5,6 +5,7 @@
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
+#include "apps/output_paths.h"
 #include "calib/core/cameramodel_export.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
@@ -97,7 +98,8 @@ int RunRig(int argc, char** argv) {
   double distance_mm = 200.0;
   std::vector<double> size_mm = {75, 75, 50};
   app.add_option("--rig", rig_path, "rig file (YAML, docs/formats.md)")->required();
-  app.add_option("--export-cameramodels", export_dir, "folder to write camN.cameramodel files into");
+  app.add_option("--export-cameramodels", export_dir,
+                 "folder to write camN.cameramodel files into (created if needed)");
   app.add_option("--truth", truth_path, "true rig file to judge this one against (a simulated dataset's)");
   app.add_option("--distance", distance_mm, "with --truth: the volume's centre ahead of module 0, mm")
       ->capture_default_str();
@@ -107,17 +109,32 @@ int RunRig(int argc, char** argv) {
   for (double v : size_mm)
     if (!(v > 0)) throw InputError("--volume", "each size must be > 0 mm");
 
+  // The models' folder (created if needed) is checked before the rig file
+  // is read: not a file, not under one, not the rig or truth file.
+  OutputPaths outputs;
+  outputs.Protect(rig_path, "the rig file (--rig)");
+  outputs.Protect(truth_path, "the true rig file (--truth)");
+  if (!export_dir.empty()) outputs.ClaimFolder(export_dir, "the camera models (--export-cameramodels)");
+
   const Rig rig = ReadRigFile(rig_path);
+  // Each model's file, named after its camera, is not an input either (the
+  // folder is created below, so its existence is not asked).
+  std::vector<std::string> model_paths;
+  for (int i = 0; !export_dir.empty() && i < rig.num_cameras(); ++i) {
+    model_paths.push_back((std::filesystem::path(export_dir) / (rig.camera_names()[i] + ".cameramodel")).string());
+    outputs.Claim(model_paths.back(), "camera " + std::to_string(i) + "'s model (--export-cameramodels)", false);
+  }
   PrintRigSummary(rig, stdout);
   if (!truth_path.empty())
     PrintAgainstTruth(rig, ReadRigFile(truth_path), distance_mm, Eigen::Vector3d(size_mm[0], size_mm[1], size_mm[2]));
   if (!export_dir.empty()) {
-    if (!std::filesystem::is_directory(export_dir)) throw InputError(export_dir, "not a folder");
-    for (int i = 0; i < rig.num_cameras(); ++i) {
-      const std::string path = (std::filesystem::path(export_dir) / (rig.camera_names()[i] + ".cameramodel")).string();
-      WriteCameramodel(rig.camera(i), rig.CamFromReference(i), path);
-      std::printf("wrote %s\n", path.c_str());
-    }
+    std::error_code ec;
+    std::filesystem::create_directories(export_dir, ec);
+    if (ec) throw InputError(export_dir, "cannot create the folder: " + ec.message());
+  }
+  for (int i = 0; i < int(model_paths.size()); ++i) {
+    WriteCameramodel(rig.camera(i), rig.CamFromReference(i), model_paths[i]);
+    std::printf("wrote %s\n", model_paths[i].c_str());
   }
   return kExitOk;
 }

@@ -3,6 +3,7 @@
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
+#include "apps/output_paths.h"
 #include "calib/core/atomic_file.h"
 #include "datasets/sim_spec.h"
 #include "datasets/simulate.h"
@@ -40,6 +41,12 @@ int RunSimulate(int argc, char** argv) {
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 
   if (!write_spec.empty()) {
+    // Checked like every other command's outputs (apps/output_paths.h): its
+    // folder exists, it is not a folder, and it is not the --spec file given
+    // alongside (which the default would replace).
+    OutputPaths outputs;
+    outputs.Protect(spec_path, "the spec file (--spec)");
+    outputs.Claim(write_spec, "the default spec (--write-default-spec)");
     WriteFileAtomically(write_spec, SimSpecToYaml(DefaultSimSpec()));
     std::printf("wrote the default spec to %s\n", write_spec.c_str());
     return kExitOk;

@@ -68,11 +68,15 @@ struct CaptureOutputs {
 
 // The output paths of every capture, and the summary's, checked before
 // anything is written: no two the same file (folders "x" and "x.mesh" with
-// --mesh-format ply; a --report naming a capture's own report), and the
+// --mesh-format ply; a --report naming a capture's own report), none one of
+// the capture images read (a --report named caps/0001/cam0.png), and the
 // summary's folder exists or is the output folder.
-std::vector<CaptureOutputs> PlanOutputs(const std::vector<std::string>& names, const BatchRequest& request) {
+std::vector<CaptureOutputs> PlanOutputs(const std::vector<std::string>& names, const BatchRequest& request,
+                                        const Rig& rig) {
   std::vector<CaptureOutputs> outputs;
   OutputPaths paths("rename a folder or choose another --report");
+  for (const std::string& dir : request.capture_dirs)
+    for (const std::string& image : CaptureImagePaths(dir, rig)) paths.Protect(image, "a capture image (--capture)");
   // The output folder is created later, once everything is checked.
   auto claim = [&](const std::string& path, const std::string& what) { paths.Claim(path, what, false); };
   for (const std::string& name : names) {
@@ -117,7 +121,7 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
   // Everything that needs no decoding is checked before anything is written,
   // the runtime too (its options can still be bad input for this rig).
   const std::vector<std::string> names = BatchOutputNames(dirs);
-  const std::vector<CaptureOutputs> outputs = PlanOutputs(names, request);
+  const std::vector<CaptureOutputs> outputs = PlanOutputs(names, request, rig);
   for (const std::string& dir : dirs) CheckCaptureFiles(dir, rig);
   auto load = [&rig](const std::string& dir) { return LoadCaptureOrInputError(dir, rig); };
   std::future<std::vector<cv::Mat>> next = std::async(std::launch::async, load, dirs[0]);  // while the runtime builds

@@ -15,15 +15,43 @@ namespace stereorig {
 
 namespace fs = std::filesystem;
 
-DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& target, int num_cameras,
-                                     const DetectOptions& options, bool progress) {
-  fs::path dir(dir_in);
-  if (!fs::is_directory(dir)) throw InputError(dir_in, "no such captures folder");
-  if (fs::is_directory(dir / "calibration")) dir /= "calibration";
+namespace {
+
+// Where a captures folder's captures are: `dir`, or its calibration/
+// sub-folder if it has one (a dataset written by `stereorig simulate`).
+fs::path CapturesRoot(const fs::path& dir) { return fs::is_directory(dir / "calibration") ? dir / "calibration" : dir; }
+
+// The capture sub-folders of `root` (a folder), sorted by name.
+std::vector<fs::path> CaptureSubfolders(const fs::path& root) {
   std::vector<fs::path> captures;
-  for (const auto& e : fs::directory_iterator(dir))
+  for (const auto& e : fs::directory_iterator(root))
     if (e.is_directory()) captures.push_back(e.path());
   std::sort(captures.begin(), captures.end());
+  return captures;
+}
+
+}  // namespace
+
+std::vector<std::string> CaptureFolderImages(const std::string& dir) {
+  std::vector<std::string> images;
+  if (!fs::is_directory(dir)) return images;
+  for (const fs::path& capture : CaptureSubfolders(CapturesRoot(dir))) {
+    for (const auto& e : fs::directory_iterator(capture)) {
+      const std::string name = e.path().filename().string();
+      if (name.size() > 7 && name.compare(0, 3, "cam") == 0 && e.path().extension() == ".png" &&
+          std::all_of(name.begin() + 3, name.end() - 4, ::isdigit))
+        images.push_back(e.path().string());
+    }
+  }
+  std::sort(images.begin(), images.end());
+  return images;
+}
+
+DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& target, int num_cameras,
+                                     const DetectOptions& options, bool progress) {
+  if (!fs::is_directory(dir_in)) throw InputError(dir_in, "no such captures folder");
+  const fs::path dir = CapturesRoot(dir_in);
+  const std::vector<fs::path> captures = CaptureSubfolders(dir);
   if (captures.empty()) throw InputError(dir.string(), "holds no capture folders (expected NNN/camK.png)");
 
   DetectedCaptures out;

@@ -34,6 +34,13 @@ struct DetectedCaptures {
   int num_captures = 0;
 };
 
+// The images a captures folder holds: every file named camK.png (any K) in
+// each capture sub-folder, as DetectCaptureFolder finds them (a dataset's
+// calibration/ sub-folder for a dataset). For a command to protect from its
+// outputs (apps/output_paths.h) before any work; empty if `dir` is not a
+// folder (the detector names it then).
+std::vector<std::string> CaptureFolderImages(const std::string& dir);
+
 // Detects the target in every image. Throws InputError (naming the file) on
 // a missing folder or image, an unreadable image, or images of one camera
 // with different sizes. `progress`: one line per capture on stderr.

@@ -367,6 +367,13 @@ Reconstruction Runtime::Process(const std::vector<cv::Mat>& images, bool build_m
   return out;
 }
 
+std::vector<std::string> CaptureImagePaths(const std::string& dir, const Rig& rig) {
+  std::vector<std::string> paths;
+  for (int k = 0; k < rig.num_cameras(); ++k)
+    paths.push_back((std::filesystem::path(dir) / ("cam" + std::to_string(k) + ".png")).string());
+  return paths;
+}
+
 void CheckCaptureFiles(const std::string& dir, const Rig& rig) {
   namespace fs = std::filesystem;
   if (!fs::is_directory(dir)) throw InputError(dir, "capture folder not found");
@@ -379,17 +386,17 @@ void CheckCaptureFiles(const std::string& dir, const Rig& rig) {
       throw InputError(entry.path().string(), "the rig has only " + std::to_string(rig.num_cameras()) +
                                                   " cameras: this capture does not match the rig");
   }
-  for (int k = 0; k < rig.num_cameras(); ++k) {
-    const fs::path path = fs::path(dir) / ("cam" + std::to_string(k) + ".png");
-    if (!fs::exists(path)) throw InputError(path.string(), "missing camera image (camera " + std::to_string(k) + ")");
-  }
+  const std::vector<std::string> paths = CaptureImagePaths(dir, rig);
+  for (size_t k = 0; k < paths.size(); ++k)
+    if (!fs::exists(paths[k])) throw InputError(paths[k], "missing camera image (camera " + std::to_string(k) + ")");
 }
 
 std::vector<cv::Mat> LoadCapture(const std::string& dir, const Rig& rig) {
   CheckCaptureFiles(dir, rig);
+  const std::vector<std::string> paths = CaptureImagePaths(dir, rig);
   std::vector<cv::Mat> images;
   for (int k = 0; k < rig.num_cameras(); ++k) {
-    const std::string path = (std::filesystem::path(dir) / ("cam" + std::to_string(k) + ".png")).string();
+    const std::string& path = paths[k];
     cv::Mat img = ReadGreyImage(path);
     const Camera& cam = rig.camera(k);
     if (img.cols != cam.imager_width_px() || img.rows != cam.imager_height_px())

@@ -104,6 +104,11 @@ class Runtime {
   std::vector<ModulePlan> plans_;
 };
 
+// The files LoadCapture reads from capture folder DIR: DIR/camK.png for
+// every camera K of the rig, in camera order (a command protects them from
+// its outputs, apps/output_paths.h).
+std::vector<std::string> CaptureImagePaths(const std::string& dir, const Rig& rig);
+
 // The checks of LoadCapture that need no decoding: DIR is a folder holding
 // camK.png for every camera K of the rig and none beyond them (a capture made
 // with another rig). Throws InputError naming the folder or file. Cheap, so a

@@ -9,6 +9,7 @@
 #include <unistd.h>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 
@@ -183,6 +184,47 @@ TEST(CalibrateCli, OutputsThatCollideOrHaveNoFolderAreRefusedBeforeAnyWork) {
   // (Each message names an output, which only the checks before the
   // calibration can: the captures and target given do not exist, so the
   // calibration would have failed naming those.)
+}
+
+// The capture images are inputs too (calib/capture_folder.h,
+// CaptureFolderImages): --out, --report or --export-cameramodels named like
+// one of them, in a captures folder or a dataset's calibration/, would
+// replace it. Refused before any work, one line naming the path, the images
+// byte-identical and nothing written. (The target file given does not
+// exist: only the check before the calibration can name the output.)
+TEST(CalibrateCli, AnOutputOverACaptureImageIsRefused) {
+  const std::string dir = ::testing::TempDir() + "/calib_cli_images";
+  fs::remove_all(dir);
+  fs::create_directories(dir + "/caps/000");
+  fs::create_directories(dir + "/ds/calibration/001");
+  std::ofstream(dir + "/layout.yaml") << "modules:\n  - {name: module0, left: 0, right: 1}\n";
+  const std::vector<std::string> images = {dir + "/caps/000/cam0.png", dir + "/caps/000/cam1.png",
+                                           dir + "/ds/calibration/001/cam1.png"};
+  for (const std::string& image : images) std::ofstream(image) << "an image\n";
+  auto calibrate = [&](const std::string& captures, const std::string& outputs) {
+    return testing::RunCli("calibrate --captures " + dir + "/" + captures + " --target " + dir +
+                           "/target.yaml --layout " + dir + "/layout.yaml " + outputs);
+  };
+  const std::string rig = " --out " + dir + "/rig.yaml", report = " --report " + dir + "/report.json";
+  const struct {
+    std::string captures, outputs, says;
+  } cases[] = {
+      {"caps", " --out " + images[0] + report, images[0] + ": is a capture image (--captures)"},
+      {"caps", rig + " --report " + images[1], images[1] + ": is a capture image (--captures)"},
+      {"ds", rig + " --report " + images[2], images[2] + ": is a capture image (--captures)"},
+      {"caps", rig + report + " --export-cameramodels " + images[0], images[0] + ": is a capture image (--captures)"}};
+  for (const auto& c : cases) {
+    const testing::Result r = calibrate(c.captures, c.outputs);
+    EXPECT_EQ(r.code, 2) << c.outputs;
+    EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << r.err;
+  }
+  for (const std::string& image : images) {
+    std::ifstream f(image);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(f), {}), "an image\n") << image;
+  }
+  EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
+  EXPECT_FALSE(fs::exists(dir + "/report.json"));
 }
 
 }  // namespace

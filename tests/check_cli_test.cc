@@ -207,5 +207,27 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
   fs::remove_all(dir);
 }
 
+// The capture images are inputs too: a --report or --history-db named like
+// one of them would replace it. Refused before any work (no rig file nor
+// target is read: neither exists), one line naming the path, the image
+// byte-identical.
+TEST(CheckCli, AnOutputOverACaptureImageIsRefused) {
+  const std::string dir = ::testing::TempDir() + "/check_cli_images";
+  fs::remove_all(dir);
+  fs::create_directories(dir + "/tonight/000");
+  const std::string image = dir + "/tonight/000/cam2.png";
+  std::ofstream(image) << "an image\n";
+  const std::string head =
+      "check --rig " + dir + "/rig.yaml --captures " + dir + "/tonight --target " + dir + "/target.yaml ";
+  for (const std::string& outputs : {"--report " + image, "--history-db " + image}) {
+    const Result r = RunCli(head + outputs);
+    EXPECT_EQ(r.code, 2) << outputs;
+    EXPECT_EQ(Occurrences(r.err, "stereorig check: "), 1) << r.err;
+    EXPECT_NE(LastLine(r.err).find(image + ": is a capture image (--captures)"), std::string::npos) << r.err;
+  }
+  EXPECT_EQ(Bytes(image), "an image\n");
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace stereorig

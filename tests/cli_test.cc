@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include "calib/core/rig_file.h"
@@ -195,6 +196,44 @@ TEST(Cli, RigExportWritesCameramodelsThatRoundTrip) {
   const Result r = RunCli("rig --rig " + path + " --export-cameramodels " + dir);
   EXPECT_EQ(r.code, 0) << r.err;
   for (int i = 0; i < 4; ++i) EXPECT_TRUE(std::filesystem::exists(dir + "/cam" + std::to_string(i) + ".cameramodel"));
+}
+
+// `rig --export-cameramodels` checks its folder (created if needed) before
+// it reads the rig file (apps/output_paths.h): the rig file's path, or a
+// path under it, is refused, as is a folder in which a model would replace
+// the rig or truth file (a rig file named cam0.cameramodel). Exit 2, one
+// line naming the path, nothing printed, the input byte-identical.
+TEST(Cli, RigExportRefusesAFolderOverItsInputsBeforeAnyWork) {
+  namespace fs = std::filesystem;
+  const std::string dir = ::testing::TempDir() + "/cli_export_inputs";
+  fs::remove_all(dir);
+  fs::create_directories(dir + "/models");
+  const std::string rig = dir + "/rig.yaml", truth = dir + "/truth.yaml", named = dir + "/models/cam0.cameramodel";
+  for (const std::string& path : {rig, truth, named}) std::ofstream(path) << GoodRigText();
+  const std::string text = GoodRigText();
+  auto bytes = [](const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  };
+  const std::pair<std::string, std::string> cases[] = {
+      {"--rig " + rig + " --export-cameramodels " + rig, rig + ": is the rig file (--rig), not a folder"},
+      {"--rig " + rig + " --export-cameramodels " + rig + "/models", "/rig.yaml is a file, not a folder"},
+      {"--rig " + rig + " --truth " + truth + " --export-cameramodels " + truth,
+       truth + ": is the true rig file (--truth), not a folder"},
+      {"--rig " + named + " --export-cameramodels " + dir + "/models", named + ": is the rig file (--rig)"}};
+  for (const auto& [args, says] : cases) {
+    const Result r = RunCli("rig " + args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "") << args;  // refused before the rig was read and summarised
+  }
+  for (const std::string& path : {rig, truth, named}) EXPECT_EQ(bytes(path), text) << path;
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir + "/models"), fs::directory_iterator()), 1);
+  // A folder that is not there yet is created, as calibrate's is.
+  const Result r = RunCli("rig --rig " + rig + " --export-cameramodels " + dir + "/new/models");
+  EXPECT_EQ(r.code, 0) << r.err;
+  for (int i = 0; i < 4; ++i) EXPECT_TRUE(fs::exists(dir + "/new/models/cam" + std::to_string(i) + ".cameramodel"));
 }
 
 }  // namespace

@@ -328,6 +328,40 @@ TEST_F(ReconstructCli, OutputPathsAreCheckedBeforeAnyWork) {
   ExpectNoOutput();
 }
 
+// The capture's own images are inputs too: an output named like one of them
+// (--out DIR/cam0.png, --report DIR/cam1.png, through a symbolic link, or a
+// batch's --report in one of its captures) would replace it. Refused before
+// any work, one line naming the path; every image byte-identical, nothing
+// written. (The single run used to reconstruct and write the cloud over
+// cam0.png; the batch deleted the summary's path first.)
+TEST_F(ReconstructCli, AnOutputOverACaptureImageIsRefused) {
+  const std::string d = BrokenCapture("own_images");
+  auto bytes = [](const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  };
+  std::vector<std::string> images;
+  for (int k = 0; k < 4; ++k) images.push_back(bytes(d + "/cam" + std::to_string(k) + ".png"));
+  std::filesystem::remove(dir_ + "/image_link.png");
+  std::filesystem::create_symlink(d + "/cam3.png", dir_ + "/image_link.png");
+  const std::string head = "reconstruct --rig " + dir_ + "/rig.yaml --capture " + d;
+  const std::pair<std::string, std::string> cases[] = {
+      {head + " --out " + d + "/cam0.png", d + "/cam0.png: is a capture image (--capture)"},
+      {head + " --out " + dir_ + "/out.ply --report " + d + "/./cam1.png", d + "/./cam1.png: is a capture image"},
+      {head + " --out " + dir_ + "/image_link.png", "image_link.png: is a capture image"},
+      {head + " " + dir_ + "/capture --out-dir " + dir_ + "/own_images_out --report " + d + "/cam2.png",
+       d + "/cam2.png: is a capture image"}};
+  for (const auto& [args, says] : cases) {
+    const testing::Result r = testing::RunCli(args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+  }
+  for (int k = 0; k < 4; ++k) EXPECT_EQ(bytes(d + "/cam" + std::to_string(k) + ".png"), images[k]) << k;
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/own_images_out"));
+  ExpectNoOutput();
+}
+
 // A measurement volume deeper than the matcher can search (150 x 150 x 300
 // mm at 200 mm: disparities -203 to 1535 px on this rig, past its 1024)
 // is refused when the runtime is built, naming the volume. It used to reach

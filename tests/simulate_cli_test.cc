@@ -40,4 +40,35 @@ TEST(SimulateCli, DefaultSpecFileRoundTripsAndBadKeysExitTwo) {
   EXPECT_NE(r.err.find("captures"), std::string::npos) << r.err;
 }
 
+// --write-default-spec is checked like every command's output
+// (apps/output_paths.h): over the --spec file given with it (an edited spec
+// replaced by the default), directly or through a symbolic link, at a
+// folder, or in a folder that is not there: exit 2, one line naming the
+// path, the spec byte-identical and nothing written.
+TEST(SimulateCli, WriteDefaultSpecRefusesTheSpecItWasGivenAndAFolder) {
+  const std::string dir = ::testing::TempDir() + "/sim_write_spec";
+  fs::remove_all(dir);
+  fs::create_directories(dir + "/a_folder");
+  const std::string spec = dir + "/edited.yaml";
+  ASSERT_EQ(RunCli("simulate --write-default-spec " + spec).code, 0);
+  std::string edited = Slurp(spec);
+  edited.replace(edited.find("captures: 50"), 12, "captures: 12");
+  std::ofstream(spec) << edited;
+  fs::create_symlink(spec, dir + "/link.yaml");
+  const std::pair<std::string, std::string> cases[] = {
+      {"--spec " + spec + " --write-default-spec " + spec, spec + ": is the spec file (--spec)"},
+      {"--spec " + spec + " --write-default-spec " + dir + "/link.yaml", dir + "/link.yaml: is the spec file (--spec)"},
+      {"--write-default-spec " + dir + "/a_folder", dir + "/a_folder: is a folder"},
+      {"--write-default-spec " + dir + "/missing/s.yaml", dir + "/missing/s.yaml: its folder does not exist"}};
+  for (const auto& [args, says] : cases) {
+    const Result r = RunCli("simulate " + args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+  }
+  EXPECT_EQ(Slurp(spec), edited);
+  EXPECT_TRUE(fs::is_empty(dir + "/a_folder"));
+  EXPECT_FALSE(fs::exists(dir + "/missing"));
+}
+
 }  // namespace
