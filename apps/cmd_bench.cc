@@ -226,7 +226,14 @@ int RunBench(int argc, char** argv) {
   app.add_option("--report", report_path, "write everything as JSON here");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
   if (runs < 1) throw InputError("--runs", "must be >= 1");
-  if (!report_path.empty()) ClaimRuntimeReport(report_path, rig_path, options_path);  // before minutes of runs
+  // Before minutes of runs; with a dataset and no --rig, its truth rig is
+  // the input to protect.
+  namespace fs = std::filesystem;
+  const std::string rig_read =
+      rig_path.empty() && !dataset.empty() ? (fs::path(dataset) / "truth" / "rig.yaml").string() : rig_path;
+  if (!report_path.empty())
+    ClaimRuntimeReport(report_path, rig_read, options_path, true,
+                       rig_path.empty() ? "the dataset's truth rig file (read without --rig)" : "the rig file (--rig)");
 
   Rig rig;
   std::vector<Scene> scenes;
@@ -239,8 +246,7 @@ int RunBench(int argc, char** argv) {
     scenes.push_back(
         {"sphere(builtin)", RenderSphereCapture(sim.rig, spec), SampleSphere(spec.centre_mm, spec.radius_mm, 0.2), {}});
   } else {
-    namespace fs = std::filesystem;
-    rig = ReadRigFile(rig_path.empty() ? (fs::path(dataset) / "truth" / "rig.yaml").string() : rig_path);
+    rig = ReadRigFile(rig_read);
     std::stringstream ss(scenes_arg);
     std::string name;
     while (std::getline(ss, name, ',')) {

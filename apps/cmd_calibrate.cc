@@ -12,6 +12,7 @@
 #include "calib/calibrate.h"
 #include "calib/capture_folder.h"
 #include "calib/core/input_error.h"
+#include "calib/layout_file.h"
 
 namespace stereorig {
 
@@ -63,7 +64,17 @@ int RunCalibrate(int argc, char** argv) {
   for (const std::string& image : CaptureFolderImages(captures)) outputs.Protect(image, "a capture image (--captures)");
   outputs.Claim(out_path, "the rig file (--out)");
   outputs.Claim(report_path, "the report (--report)");
-  if (!cameramodels_dir.empty()) outputs.ClaimFolder(cameramodels_dir, "the camera models (--export-cameramodels)");
+  if (!cameramodels_dir.empty()) {
+    outputs.ClaimFolder(cameramodels_dir, "the camera models (--export-cameramodels)");
+    // Each model file too (camK.cameramodel for every camera of the layout):
+    // a rig file named DIR/cam0.cameramodel would be replaced by a model.
+    int num_cameras = 0;
+    for (const ModuleLayout& m : ReadLayoutFile(layout_path))
+      num_cameras = std::max({num_cameras, m.left_camera + 1, m.right_camera + 1});
+    for (int k = 0; k < num_cameras; ++k)
+      outputs.Claim((std::filesystem::path(cameramodels_dir) / ("cam" + std::to_string(k) + ".cameramodel")).string(),
+                    "camera " + std::to_string(k) + "'s model (--export-cameramodels)", false);
+  }
 
   const FolderCalibration folder = CalibrateCaptureFolder(captures, target_path, layout_path, options);
   const CalibrationResult& result = folder.result;

@@ -72,7 +72,8 @@ int RunScore(int argc, char** argv) {
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 
   namespace fs = std::filesystem;
-  if (rig_path.empty()) {
+  const bool rig_given = !rig_path.empty();
+  if (!rig_given) {
     rig_path = (fs::path(dataset) / "truth" / "rig.yaml").string();
     std::printf("score: no --rig: using the TRUTH rig %s (issue 5 judges with the calibrated one)\n", rig_path.c_str());
   }
@@ -83,7 +84,9 @@ int RunScore(int argc, char** argv) {
       throw InputError(diagnose_dir, "--diagnose: cannot create this folder (" + ec.message() + ")");
   }
   // After --diagnose's folder exists: the report may go in it.
-  if (!report_path.empty()) ClaimRuntimeReport(report_path, rig_path, options_path);  // before minutes of scoring
+  if (!report_path.empty())  // before minutes of scoring
+    ClaimRuntimeReport(report_path, rig_path, options_path, true,
+                       rig_given ? "the rig file (--rig)" : "the dataset's truth rig file (read without --rig)");
   const Rig rig = ReadRigFile(rig_path);
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
   RuntimeOptions passive_options = options;

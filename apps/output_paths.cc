@@ -32,9 +32,9 @@ void OutputPaths::Claim(const std::string& path, const std::string& what, bool c
 }
 
 void ClaimRuntimeReport(const std::string& report_path, const std::string& rig_path, const std::string& options_path,
-                        bool check_folder) {
+                        bool check_folder, const std::string& rig_what) {
   OutputPaths outputs;
-  outputs.Protect(rig_path, "the rig file (--rig)");
+  outputs.Protect(rig_path, rig_what);
   outputs.Protect(options_path, "the options file (--options)");
   outputs.Claim(report_path, "the report (--report)", check_folder);
 }

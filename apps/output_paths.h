@@ -41,7 +41,9 @@ class OutputPaths {
 // The --report of a command that reads a rig file and runtime options
 // (bench, score, a reconstruct batch): claimed, not over either input
 // (an empty path: not given). check_folder as OutputPaths::Claim.
+// rig_what names the rig file in the message (a dataset's truth rig when no
+// --rig was given).
 void ClaimRuntimeReport(const std::string& report_path, const std::string& rig_path, const std::string& options_path,
-                        bool check_folder = true);
+                        bool check_folder = true, const std::string& rig_what = "the rig file (--rig)");
 
 }  // namespace stereorig

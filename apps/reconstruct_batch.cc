@@ -77,6 +77,7 @@ std::vector<CaptureOutputs> PlanOutputs(const std::vector<std::string>& names, c
   OutputPaths paths("rename a folder or choose another --report");
   for (const std::string& dir : request.capture_dirs)
     for (const std::string& image : CaptureImagePaths(dir, rig)) paths.Protect(image, "a capture image (--capture)");
+  paths.ClaimFolder(request.out_dir, "the output folder (--out-dir)");  // not a file, nor under one
   // The output folder is created later, once everything is checked.
   auto claim = [&](const std::string& path, const std::string& what) { paths.Claim(path, what, false); };
   for (const std::string& name : names) {

@@ -60,5 +60,23 @@ TEST(BenchCli, AReportInAMissingFolderExitsTwoBeforeAnyRun) {
   EXPECT_EQ(r.out.find("objects/s"), std::string::npos) << r.out;
 }
 
+// With --dataset and no --rig, the bench reads the dataset's truth rig: a
+// --report at that path would replace it. Refused before any run (the
+// dataset holds nothing else: only the check can name the report), the rig
+// file left as it was.
+TEST(BenchCli, AReportOverTheDatasetsTruthRigIsRefused) {
+  const std::string dataset = ::testing::TempDir() + "/bench_truth_rig_" + std::to_string(getpid());
+  std::filesystem::create_directories(dataset + "/truth");
+  const std::string rig = dataset + "/truth/rig.yaml";
+  { std::ofstream(rig) << "the truth rig\n"; }
+  const testing::Result r = RunCli("bench --runs 1 --dataset " + dataset + " --report " + rig);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(rig + ": is the dataset's truth rig file (read without --rig)"), std::string::npos) << r.err;
+  std::ifstream f(rig);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(f), {}), "the truth rig\n");
+  std::filesystem::remove_all(dataset);
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -181,6 +181,15 @@ TEST(CalibrateCli, OutputsThatCollideOrHaveNoFolderAreRefusedBeforeAnyWork) {
     EXPECT_EQ(r.code, 2) << folder;
     EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
   }
+  // Each model file too: a rig file named models/cam1.cameramodel would be
+  // replaced by camera 1's model after the calibration.
+  fs::create_directories(dir + "/m2");
+  r = testing::RunCli(inputs + " --out " + dir + "/m2/cam1.cameramodel --report " + dir +
+                      "/report.json --export-cameramodels " + dir + "/m2");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("cam1.cameramodel: would be written twice (the rig file (--out) and camera 1's model"),
+            std::string::npos)
+      << r.err;
   // (Each message names an output, which only the checks before the
   // calibration can: the captures and target given do not exist, so the
   // calibration would have failed naming those.)

@@ -534,6 +534,21 @@ TEST_F(ReconstructCli, ABatchWithAMissingCameraOrARepeatedFolderWritesNothing) {
             2);
   // The summary's folder does not exist: found before the first cloud.
   EXPECT_EQ(RunCli(head + "--out-dir " + out + " --report " + dir_ + "/no_such_folder/batch.json"), 2);
+  // An --out-dir that is a file, or under one: refused with the paths
+  // (apps/output_paths.h ClaimFolder), not when the runtime is built and the
+  // folder cannot be made; the file is left as it was.
+  const std::string file = dir_ + "/batch_a_file";
+  { std::ofstream(file) << "not a folder\n"; }
+  for (const std::string& bad : {file, file + "/sub"}) {
+    const testing::Result r = testing::RunCli(head + "--out-dir " + bad);
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(bad + ": "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("is a file, not a folder for the output folder (--out-dir)"), std::string::npos) << r.err;
+    EXPECT_EQ(r.out.find("reconstruct"), std::string::npos) << r.out;  // no capture begun
+  }
+  std::ifstream f(file);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(f), {}), "not a folder\n");
   EXPECT_FALSE(std::filesystem::exists(out));
   ExpectNoOutput();
 }
