@@ -35,6 +35,19 @@ TargetGeometry TargetGeometryFromTarget(const Target& t) {
   return g;
 }
 
+std::vector<int> CapturesWithDifferentFaces(const CalibrationInput& in, int left_camera, int right_camera) {
+  std::map<int, Face> left_face;  // capture -> face the left camera saw
+  for (const BoardObservation& o : in.observations)
+    if (o.camera == left_camera && !o.corner_ids.empty()) left_face[o.capture] = o.face;
+  std::set<int> out;
+  for (const BoardObservation& o : in.observations) {
+    if (o.camera != right_camera || o.corner_ids.empty()) continue;
+    auto it = left_face.find(o.capture);
+    if (it != left_face.end() && it->second != o.face) out.insert(o.capture);
+  }
+  return {out.begin(), out.end()};
+}
+
 void CalibrationOptions::Check() const {
   intrinsics.Check();
   stereo.Check();
@@ -66,7 +79,6 @@ void ValidateInput(const CalibrationInput& in) {
     }
   }
   std::set<std::pair<int, int>> seen;
-  std::map<std::pair<int, int>, Face> module_face;  // (capture, module)
   std::vector<int> views(nc, 0);
   for (const BoardObservation& o : in.observations) {
     const std::string w = src + ": capture " + std::to_string(o.capture) + ", camera " + std::to_string(o.camera);
@@ -100,10 +112,6 @@ void ValidateInput(const CalibrationInput& in) {
       throw InputError(w, std::string("face seen by the wrong module: module ") + std::to_string(k) + " (" + m.name +
                               ") sees only the " + FaceName(*m.face) + " face, but this view is of the " +
                               FaceName(o.face) + " face");
-    }
-    auto [it, fresh] = module_face.insert({{o.capture, k}, o.face});
-    if (!fresh && it->second != o.face) {
-      throw InputError(w, "the two cameras of module " + std::to_string(k) + " saw different faces in one capture");
     }
     if (!o.corner_ids.empty()) ++views[o.camera];
   }
@@ -265,6 +273,9 @@ std::string CalibrationReport::ToJson() const {
   for (const StereoReport& s : stereo) {
     j.BeginObject().Int("module", s.module).String("name", s.module_name);
     j.Int("shared_views", s.num_shared_views).Int("frames", s.num_frames).Number("rms_px", s.rms_px);
+    j.BeginArray("different_face_captures");
+    for (int c : s.different_face_captures) j.Int(c);
+    j.EndArray();
     j.Int("outliers", s.num_outliers).Number("baseline_mm", s.baseline_mm).Number("rotation_deg", s.rotation_deg);
     j.Numbers("right_from_left_rotation_vector_deg",
               {s.right_from_left_rotation_vector_deg.x(), s.right_from_left_rotation_vector_deg.y(),
@@ -411,6 +422,20 @@ std::string SummaryText(const CalibrationReport& rep) {
                s.module_name.c_str(), s.baseline_mm, s.baseline_sigma_mm, s.rotation_deg, s.rotation_sigma_deg,
                s.rms_px, s.num_outliers, s.rectified_row_rms_px, s.rectified_row_max_px, s.num_corner_pairs,
                s.num_shared_views);
+    if (!s.different_face_captures.empty()) {
+      std::string list;
+      for (size_t i = 0; i < s.different_face_captures.size(); ++i) {
+        if (i == 20) {
+          list += ", ...";  // the report lists them all
+          break;
+        }
+        list += (i ? ", " : "") + std::to_string(s.different_face_captures[i]);
+      }
+      AppendLine(&out,
+                 "    %zu capture(s) set aside in stages 2 and 3: its two cameras saw different faces (the board's "
+                 "plane between them, or a face misread): %s",
+                 s.different_face_captures.size(), list.c_str());
+    }
   }
   if (rep.num_modules > 1) {
     const SystemReport& s = rep.system;

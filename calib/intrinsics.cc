@@ -230,31 +230,8 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
                                     ", need at least " + std::to_string(options.min_views));
   }
 
-  MrcalProblem p;
-  STEREORIG_CHECK(p.SetLensmodel(options.lensmodel));
-  p.corners_x = target.corners_x;
-  p.corners_y = target.corners_y;
-  p.spacing_mm = target.square_size_mm;
-  p.num_intrinsics_cameras = 1;
-  p.imagersizes = {spec.width_px, spec.height_px};
-  p.intrinsics.assign(p.num_params(), 0.0);
-  p.intrinsics[0] = p.intrinsics[1] = f_seed;
-  p.intrinsics[2] = 0.5 * (spec.width_px - 1);
-  p.intrinsics[3] = 0.5 * (spec.height_px - 1);
-
-  IntrinsicsResult result{Camera("LENSMODEL_PINHOLE", {1, 1, 0, 0}, 1, 1), {}, {}, {}, {}, {}};
-  const int n = target.num_corners();
-  p.pool.resize(views.size() * n);
   double max_tilt = 0;
-  for (size_t k = 0; k < views.size(); ++k) {
-    const Pose& seed = seeds[k];
-    max_tilt = std::max(max_tilt, TiltDeg(seed));
-    p.frames_toref.push_back(MrcalProblem::ToMrcal(seed));
-    p.observations.push_back({.icam = {.intrinsics = 0, .extrinsics = -1}, .iframe = static_cast<int>(k)});
-    FillPoolBlock(*views[k], target, &p.pool[k * n]);
-    result.captures.push_back(views[k]->capture);
-    result.faces.push_back(views[k]->face);
-  }
+  for (const Pose& seed : seeds) max_tilt = std::max(max_tilt, TiltDeg(seed));
   if (max_tilt < options.min_tilt_deg) {
     char buf[160];
     std::snprintf(buf, sizeof buf,
@@ -262,24 +239,87 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
                   views.size(), max_tilt, options.min_tilt_deg);
     throw InputError(cam_where, buf);
   }
-  const int missing = p.CountNonPositiveWeights();
 
-  // Step 1: the board poses alone. Step 2: with the lens core. Step 3: all,
-  // distortions regularised, outliers rejected (then unregularised, see
-  // SolveFinal).
-  p.selections = {.do_optimize_intrinsics_core = false,
-                  .do_optimize_intrinsics_distortions = false,
-                  .do_optimize_extrinsics = true,
-                  .do_optimize_frames = true,
-                  .do_optimize_calobject_warp = false,
-                  .do_apply_regularization = false,
-                  .do_apply_outlier_rejection = false};
-  p.Optimize(options.verbose);
-  p.selections.do_optimize_intrinsics_core = true;
-  p.Optimize(options.verbose);
-  p.selections.do_optimize_intrinsics_distortions = true;
-  const int non_positive = SolveFinal(&p, options.verbose);
+  const int n = target.num_corners();
+  MrcalProblem p;
+  int missing = 0, non_positive = 0;
+  // Solves for `views` from `seeds` (board poses; the lens from `intrinsics`
+  // when given, else the pinhole seed).
+  auto solve = [&](const std::vector<double>& intrinsics) {
+    p = MrcalProblem();
+    STEREORIG_CHECK(p.SetLensmodel(options.lensmodel));
+    p.corners_x = target.corners_x;
+    p.corners_y = target.corners_y;
+    p.spacing_mm = target.square_size_mm;
+    p.num_intrinsics_cameras = 1;
+    p.imagersizes = {spec.width_px, spec.height_px};
+    if (intrinsics.empty()) {
+      p.intrinsics.assign(p.num_params(), 0.0);
+      p.intrinsics[0] = p.intrinsics[1] = f_seed;
+      p.intrinsics[2] = 0.5 * (spec.width_px - 1);
+      p.intrinsics[3] = 0.5 * (spec.height_px - 1);
+    } else {
+      p.intrinsics = intrinsics;
+    }
+    p.pool.resize(views.size() * n);
+    for (size_t k = 0; k < views.size(); ++k) {
+      p.frames_toref.push_back(MrcalProblem::ToMrcal(seeds[k]));
+      p.observations.push_back({.icam = {.intrinsics = 0, .extrinsics = -1}, .iframe = static_cast<int>(k)});
+      FillPoolBlock(*views[k], target, &p.pool[k * n]);
+    }
+    missing = p.CountNonPositiveWeights();
+    // Step 1: the board poses alone. Step 2: with the lens core. Step 3: all,
+    // distortions regularised, outliers rejected (then unregularised, see
+    // SolveFinal).
+    p.selections = {.do_optimize_intrinsics_core = false,
+                    .do_optimize_intrinsics_distortions = false,
+                    .do_optimize_extrinsics = true,
+                    .do_optimize_frames = true,
+                    .do_optimize_calobject_warp = false,
+                    .do_apply_regularization = false,
+                    .do_apply_outlier_rejection = false};
+    p.Optimize(options.verbose);
+    p.selections.do_optimize_intrinsics_core = true;
+    p.Optimize(options.verbose);
+    p.selections.do_optimize_intrinsics_distortions = true;
+    non_positive = SolveFinal(&p, options.verbose);
+  };
+  solve({});
+  // A view whose inlier corners no longer determine its board pose (mrcal's
+  // outlier rejection left fewer than min_corners_per_view, or one row or
+  // column: seen on grazing views of a ring's edge-on board) leaves that pose
+  // undetermined in the final unregularised solve: J'J is singular and the
+  // uncertainty NaN. Such views are dropped and the rest solved again from
+  // where they were (their own outliers found afresh), until none is left.
+  for (;;) {
+    std::vector<const BoardObservation*> kept;
+    std::vector<Pose> kept_seeds;
+    for (size_t k = 0; k < views.size(); ++k) {
+      std::vector<int> inliers;
+      for (int i = 0; i < n; ++i)
+        if (p.pool[k * n + i].z > 0) inliers.push_back(i);
+      if (static_cast<int>(inliers.size()) >= options.min_corners_per_view &&
+          CornersSpanAPlane(inliers, target.corners_x)) {
+        kept.push_back(views[k]);
+        kept_seeds.push_back(MrcalProblem::FromMrcal(p.frames_toref[k]));
+      }
+    }
+    if (kept.size() == views.size()) break;
+    dropped += static_cast<int>(views.size() - kept.size());
+    if (static_cast<int>(kept.size()) < options.min_views) {
+      throw InputError(cam_where, "too few views left after outlier rejection: " + std::to_string(kept.size()) +
+                                      ", need at least " + std::to_string(options.min_views));
+    }
+    views = std::move(kept);
+    seeds = std::move(kept_seeds);
+    solve(std::vector<double>(p.intrinsics));
+  }
 
+  IntrinsicsResult result{Camera("LENSMODEL_PINHOLE", {1, 1, 0, 0}, 1, 1), {}, {}, {}, {}, {}};
+  for (const BoardObservation* v : views) {
+    result.captures.push_back(v->capture);
+    result.faces.push_back(v->face);
+  }
   result.camera = Camera(options.lensmodel, p.intrinsics, spec.width_px, spec.height_px, cam_where);
   for (const mrcal_pose_t& f : p.frames_toref) result.cam_from_face.push_back(MrcalProblem::FromMrcal(f));
 

@@ -77,4 +77,11 @@ struct CalibrationInput {
   std::string source = "observations";  // for provenance and error messages
 };
 
+// The captures in which a module's two cameras (global indices) saw different faces of the
+// target (views with corners only), sorted. Physically possible: the board
+// nearly edge-on to the module, its plane passing between the two cameras.
+// Stage 1 uses such views as they are; stages 2 and 3 set the module's views
+// of these captures aside (a face misread by the detector looks the same).
+std::vector<int> CapturesWithDifferentFaces(const CalibrationInput& input, int left_camera, int right_camera);
+
 }  // namespace stereorig

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 
 #include "calib/core/input_error.h"
 #include "calib/projection_uncertainty.h"
@@ -59,21 +60,31 @@ StereoResult CalibrateStereo(int module, const ModuleLayout& layout, const Intri
   const std::string where = input.source + ": module " + std::to_string(module) + " (" + layout.name + ")";
   const TargetGeometry& target = input.target;
   // Stage-1 views by capture.
+  // Captures whose two views show different faces are set aside, both views:
+  // one board pose per capture (mrcal's frame) cannot hold two faces without
+  // back_from_front, which the joint solve does not model; and a face misread
+  // by the detector looks the same. Stage 1 has used the views as they are.
+  const std::vector<int> different_faces = CapturesWithDifferentFaces(input, layout.left_camera, layout.right_camera);
+  const std::set<int> set_aside(different_faces.begin(), different_faces.end());
   std::map<int, int> left_view, right_view;
-  for (size_t k = 0; k < left.captures.size(); ++k) left_view[left.captures[k]] = static_cast<int>(k);
-  for (size_t k = 0; k < right.captures.size(); ++k) right_view[right.captures[k]] = static_cast<int>(k);
+  for (size_t k = 0; k < left.captures.size(); ++k)
+    if (!set_aside.count(left.captures[k])) left_view[left.captures[k]] = static_cast<int>(k);
+  for (size_t k = 0; k < right.captures.size(); ++k)
+    if (!set_aside.count(right.captures[k])) right_view[right.captures[k]] = static_cast<int>(k);
   std::vector<Pose> rl;
   for (const auto& [capture, kl] : left_view) {
     auto it = right_view.find(capture);
     if (it == right_view.end()) continue;
-    if (left.faces[kl] != right.faces[it->second]) {
-      throw InputError(where, "capture " + std::to_string(capture) + ": its two cameras saw different faces");
-    }
+    STEREORIG_CHECK(left.faces[kl] == right.faces[it->second]);
     rl.push_back(right.cam_from_face[it->second] * left.cam_from_face[kl].Inverse());
   }
   if (static_cast<int>(rl.size()) < options.min_shared_views) {
+    std::string aside;
+    if (!set_aside.empty()) {
+      aside = " (" + std::to_string(set_aside.size()) + " more set aside: their two cameras saw different faces)";
+    }
     throw InputError(where, "too few views shared by both cameras: " + std::to_string(rl.size()) + ", need " +
-                                std::to_string(options.min_shared_views));
+                                std::to_string(options.min_shared_views) + aside);
   }
   const Pose right_from_left_seed = AveragePoses(rl);
 
@@ -144,6 +155,7 @@ StereoResult CalibrateStereo(int module, const ModuleLayout& layout, const Intri
   r.module = module;
   r.module_name = layout.name;
   r.num_shared_views = static_cast<int>(rl.size());
+  r.different_face_captures = different_faces;
   r.num_frames = p.num_frames();
   const std::vector<double> x = p.Residuals();
   r.rms_px = BoardResidualRms(p, x);

@@ -25,9 +25,12 @@ struct StereoOptions {
 struct StereoReport {
   int module = -1;
   std::string module_name;
-  int num_shared_views = 0;  // captures both cameras saw
-  int num_frames = 0;        // captures either camera saw
-  double rms_px = 0.0;       // joint solve, RMS of residual coordinates
+  int num_shared_views = 0;  // captures both cameras saw (the same face), used for right_from_left
+  // Captures in which the two cameras saw different faces (the board's plane
+  // between them, or a face misread): set aside here and in stage 3.
+  std::vector<int> different_face_captures;
+  int num_frames = 0;   // captures either camera saw
+  double rms_px = 0.0;  // joint solve, RMS of residual coordinates
   int num_outliers = 0;
   double baseline_mm = 0.0;   // |t| of right_from_left
   double rotation_deg = 0.0;  // angle of right_from_left

@@ -215,6 +215,15 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   }
   rep.num_captures = static_cast<int>(boards.size());
 
+  // A module's views of a capture in which its two cameras saw different
+  // faces are set aside, as in stage 2: the board pose (one per capture) and
+  // back_from_front could hold them, but a face misread by the detector looks
+  // the same, and the module posed no board there to check them against.
+  std::set<std::pair<int, int>> set_aside;  // (capture, module)
+  for (int k = 0; k < M; ++k)
+    for (int c : CapturesWithDifferentFaces(input, modules[k].left_camera, modules[k].right_camera))
+      set_aside.insert({c, k});
+
   std::vector<ceres::ResidualBlockId> corner_blocks;
   bool any_back = false;
   for (const BoardObservation& o : input.observations) {
@@ -222,6 +231,7 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
     auto mo = module_of.find(o.camera);
     if (b == boards.end() || mo == module_of.end()) continue;
     const auto [k, is_right] = mo->second;
+    if (set_aside.count({o.capture, k})) continue;
     const bool back = o.face == Face::kBack;
     any_back |= back;
     for (size_t i = 0; i < o.corner_ids.size(); ++i) {
