@@ -12,6 +12,7 @@
 #include "calib/check/history.h"
 #include "calib/check/nightly_check.h"
 #include "calib/core/atomic_file.h"
+#include "calib/core/capture_image_name.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
 #include "targets/target_file.h"
@@ -31,13 +32,12 @@ void RejectCamerasBeyondTheRig(const std::string& captures, int num_cameras) {
   if (!fs::is_directory(captures)) return;  // the detector names a missing folder
   for (auto it = fs::recursive_directory_iterator(captures); it != fs::recursive_directory_iterator(); ++it) {
     if (it.depth() >= 2) it.disable_recursion_pending();
-    const std::string name = it->path().filename().string();
-    if (name.size() < 8 || name.compare(0, 3, "cam") != 0 || it->path().extension() != ".png") continue;
-    const std::string digits = name.substr(3, name.size() - 7);
-    if (digits.empty() || !std::all_of(digits.begin(), digits.end(), ::isdigit)) continue;
-    if (std::stoi(digits) >= num_cameras) {
-      throw InputError(it->path().string(), "camera " + digits + ", but the rig has " + std::to_string(num_cameras) +
-                                                " cameras: captures from another rig?");
+    const std::optional<int> camera = CameraIndexOfImageName(it->path().filename().string());
+    if (camera && *camera >= num_cameras) {
+      throw InputError(it->path().string(),
+                       (*camera == kCameraIndexBeyondAnyRig ? std::string("a camera index beyond any rig")
+                                                            : "camera " + std::to_string(*camera)) +
+                           ", but the rig has " + std::to_string(num_cameras) + " cameras: captures from another rig?");
     }
   }
 }

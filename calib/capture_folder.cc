@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "calib/core/capture_image_name.h"
 #include "calib/core/input_error.h"
 #include "calib/core/png_file.h"
 #include "calib/layout_file.h"
@@ -37,10 +38,7 @@ std::vector<std::string> CaptureFolderImages(const std::string& dir) {
   if (!fs::is_directory(dir)) return images;
   for (const fs::path& capture : CaptureSubfolders(CapturesRoot(dir))) {
     for (const auto& e : fs::directory_iterator(capture)) {
-      const std::string name = e.path().filename().string();
-      if (name.size() > 7 && name.compare(0, 3, "cam") == 0 && e.path().extension() == ".png" &&
-          std::all_of(name.begin() + 3, name.end() - 4, ::isdigit))
-        images.push_back(e.path().string());
+      if (CameraIndexOfImageName(e.path().filename().string())) images.push_back(e.path().string());
     }
   }
   std::sort(images.begin(), images.end());
@@ -65,7 +63,7 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
     const int capture = numeric ? std::stoi(name) : static_cast<int>(n);
     std::string line = "detect " + name + ":";
     for (int c = 0; c < num_cameras; ++c) {
-      const fs::path image = captures[n] / ("cam" + std::to_string(c) + ".png");
+      const fs::path image = captures[n] / CameraImageName(c);
       if (!fs::exists(image))
         throw InputError(image.string(), "missing (each capture needs camK.png for every camera)");
       CheckPngIsWhole(image.string());

@@ -7,8 +7,8 @@
 #include <filesystem>
 #include <limits>
 #include <opencv2/imgproc.hpp>
-#include <regex>
 
+#include "calib/core/capture_image_name.h"
 #include "calib/core/input_error.h"
 #include "reconstruct/elapsed_ms.h"
 #include "reconstruct/grey_image.h"
@@ -370,19 +370,16 @@ Reconstruction Runtime::Process(const std::vector<cv::Mat>& images, bool build_m
 std::vector<std::string> CaptureImagePaths(const std::string& dir, const Rig& rig) {
   std::vector<std::string> paths;
   for (int k = 0; k < rig.num_cameras(); ++k)
-    paths.push_back((std::filesystem::path(dir) / ("cam" + std::to_string(k) + ".png")).string());
+    paths.push_back((std::filesystem::path(dir) / CameraImageName(k)).string());
   return paths;
 }
 
 void CheckCaptureFiles(const std::string& dir, const Rig& rig) {
   namespace fs = std::filesystem;
   if (!fs::is_directory(dir)) throw InputError(dir, "capture folder not found");
-  const std::regex cam_re("cam([0-9]+)\\.png");
   for (const auto& entry : fs::directory_iterator(dir)) {
-    std::smatch m;
-    const std::string name = entry.path().filename().string();
-    // More than 6 digits is beyond any rig (and beyond std::stoi's range).
-    if (std::regex_match(name, m, cam_re) && (m[1].length() > 6 || std::stoi(m[1]) >= rig.num_cameras()))
+    const std::optional<int> camera = CameraIndexOfImageName(entry.path().filename().string());
+    if (camera && *camera >= rig.num_cameras())
       throw InputError(entry.path().string(), "the rig has only " + std::to_string(rig.num_cameras()) +
                                                   " cameras: this capture does not match the rig");
   }

@@ -155,6 +155,14 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     }
     expect_refused(check(d, dir + "/rig.yaml"), "but the rig has 4 cameras", "captures of a larger rig");
   }
+  {  // A camera index no int holds (std::stoi threw out_of_range here, past
+     // RunCommand: the process aborted).
+    const std::string d = copy("huge_index");
+    for (const auto& capture : fs::directory_iterator(d))
+      fs::copy_file(capture.path() / "cam0.png", capture.path() / "cam12345678901.png");
+    expect_refused(check(d, dir + "/rig.yaml"), "a camera index beyond any rig, but the rig has 4 cameras",
+                   "a camera index beyond any rig");
+  }
   {  // The right images with the rig file of another rig: every camera's
      // focal length 20% longer and its centre 40 px away.
     std::vector<Camera> cameras;
