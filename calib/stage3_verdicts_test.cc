@@ -23,7 +23,7 @@ constexpr double kNoisePx = 0.2;
 // the board's rows 4..6 (their poses cannot take it up: mrcal flags those
 // corners). Before stage 3 honoured the verdicts (measured when written), its
 // reprojection RMS was 0.66 px, camera 0's refined intrinsics up to 9.3 and
-// S up to 8.4 noise sigmas off the truth (the bounds below are 4); after,
+// S up to 8.7 noise sigmas off the truth (the bounds below are 4); after,
 // 0.196 px and 1.6 / 1.6 sigmas.
 TEST(CalibrateSystemVerdicts, CornersEarlierStagesRejectedStayOut) {
   auto s = testing::MakeDefaultScene(71, 25, kNoisePx);
