@@ -137,6 +137,54 @@ void Progress(bool on, const std::string& msg) {
   if (on) std::cerr << "calibrate: " << msg << std::endl;
 }
 
+// What stages 1 and 2 rejected, for stage 3 to leave out (SystemExclusions):
+//  - the views stage 1 dropped (too few corners, collinear, no PnP seed, or
+//    left without a determined board pose by the outlier rejection);
+//  - the corners mrcal's outlier rejection flagged in stage 1, the camera's
+//    own solve: one that does not fit its camera's intrinsics, with a board
+//    pose of its own per view, has no business steering the joint solve;
+//  - and those it flagged in stage 2, the module's joint solve: there the
+//    board pose is shared by the two cameras, as in stage 3 (which shares it
+//    among every module), so a corner inconsistent with its partner camera
+//    is the same inconsistency stage 3 would meet. Stage 2 re-marks every
+//    corner from weight 1, so the two sets differ and are united.
+// A flagged corner is one the view saw whose pool weight is <= 0 after the
+// solve (an unseen corner is -1 from the start, and not in the view).
+SystemExclusions EarlierStageVerdicts(const CalibrationInput& in, const std::vector<IntrinsicsResult>& stage1,
+                                      const std::vector<StereoResult>& stage2) {
+  SystemExclusions ex;
+  const int n = in.target.num_corners();
+  std::map<std::pair<int, int>, const BoardObservation*> obs;  // (capture, camera)
+  for (const BoardObservation& o : in.observations)
+    if (!o.corner_ids.empty()) obs[{o.capture, o.camera}] = &o;
+  // Corners `o` saw whose weight in the pool block `block` is <= 0.
+  auto mark = [&](const BoardObservation& o, const mrcal_point3_t* block) {
+    for (int id : o.corner_ids)
+      if (block[id].z <= 0) ex.corners.insert({o.capture, o.camera, id});
+  };
+  for (size_t c = 0; c < stage1.size(); ++c) {
+    const IntrinsicsResult& s1 = stage1[c];
+    const int camera = s1.report.camera;
+    std::set<int> used(s1.captures.begin(), s1.captures.end());
+    for (const auto& [key, o] : obs)
+      if (key.second == camera && !used.count(key.first)) ex.views.insert(key);
+    for (size_t k = 0; k < s1.captures.size(); ++k) {
+      auto it = obs.find({s1.captures[k], camera});
+      if (it != obs.end()) mark(*it->second, &s1.problem.pool[k * n]);
+    }
+  }
+  for (size_t m = 0; m < stage2.size(); ++m) {
+    const StereoResult& s2 = stage2[m];
+    const int cams[2] = {in.modules[m].left_camera, in.modules[m].right_camera};
+    for (int o = 0; o < s2.problem.num_observations(); ++o) {
+      const mrcal_observation_board_t& ob = s2.problem.observations[o];
+      auto it = obs.find({s2.captures[ob.iframe], cams[ob.icam.intrinsics]});
+      if (it != obs.end()) mark(*it->second, &s2.problem.pool[o * n]);
+    }
+  }
+  return ex;
+}
+
 }  // namespace
 
 CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions& options) {
@@ -179,7 +227,8 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
     Progress(options.progress, "stage 3: Horn + bundle adjustment over " + std::to_string(M) + " modules");
     double s2 = 0;
     for (const StereoReport& s : rep.stereo) s2 += s.rms_px * s.rms_px;
-    result.stage3 = CalibrateSystem(in, modules, std::sqrt(s2 / rep.stereo.size()), options.system);
+    result.stage3 = CalibrateSystem(in, modules, std::sqrt(s2 / rep.stereo.size()), options.system,
+                                    EarlierStageVerdicts(in, result.stage1, result.stage2));
     modules = result.stage3.modules;
     module0_from_module = result.stage3.module0_from_module;
     rep.system = result.stage3.report;
@@ -302,6 +351,8 @@ std::string CalibrationReport::ToJson() const {
   if (num_modules > 1) {
     const SystemReport& s = system;
     j.BeginObject("stage3_system").Int("captures", s.num_captures).Int("corner_residuals", s.num_residual_corners);
+    j.Int("skipped_views", s.num_skipped_views).Int("skipped_view_corners", s.num_skipped_view_corners);
+    j.Int("skipped_outlier_corners", s.num_skipped_outlier_corners);
     j.BeginArray("spanning_tree");
     for (const auto& [a, b] : s.spanning_tree) {
       j.BeginObject().Int("parent", a).Int("child", b).Number("horn_rms_mm", s.horn_rms_mm.at({a, b})).EndObject();
@@ -441,6 +492,12 @@ std::string SummaryText(const CalibrationReport& rep) {
     const SystemReport& s = rep.system;
     AppendLine(&out, "stage 3: the S matrix (%d captures, %d corner residuals)", s.num_captures,
                s.num_residual_corners);
+    if (s.num_skipped_views > 0 || s.num_skipped_outlier_corners > 0) {
+      AppendLine(&out,
+                 "  left out as stages 1-2 judged: %d view(s) stage 1 dropped (%d corners), %d outlier corner(s) of "
+                 "stage 1 or 2",
+                 s.num_skipped_views, s.num_skipped_view_corners, s.num_skipped_outlier_corners);
+    }
     AppendLine(&out, "  reprojection rms: Horn only %.3f px, refined %.3f px", s.horn_reprojection_rms_px,
                s.refined_reprojection_rms_px);
     for (size_t k = 1; k < s.module0_from_module.size(); ++k) {

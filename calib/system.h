@@ -19,7 +19,9 @@
 #pragma once
 
 #include <map>
+#include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "calib/core/camera.h"
@@ -49,6 +51,19 @@ struct ModuleCameras {
   int left_camera = -1, right_camera = -1;  // global indices
   Camera left, right;
   Pose right_from_left;
+};
+
+// The earlier stages' verdicts that stage 3 honours: the views stage 1
+// dropped (their inliers no longer determined a board pose, or too few
+// corners) and the corners mrcal's outlier rejection flagged in stage 1 (the
+// camera's own solve) or stage 2 (the module's joint solve). They stay out of
+// the triangulated board poses and of the adjustment: its Huber loss only
+// bounds an outlier's pull, it does not remove it.
+struct SystemExclusions {
+  std::set<std::pair<int, int>> views;          // (capture, camera)
+  std::set<std::tuple<int, int, int>> corners;  // (capture, camera, corner id)
+  bool ExcludesView(int capture, int camera) const { return views.count({capture, camera}) > 0; }
+  bool ExcludesCorner(int capture, int camera, int id) const { return corners.count({capture, camera, id}) > 0; }
 };
 
 struct STransformSigma {
@@ -83,6 +98,11 @@ struct SystemReport {
   double horn_reprojection_rms_px = 0.0;               // S and stereo held at Horn/stage 2, board poses solved
   double refined_reprojection_rms_px = 0.0;            // after the full adjustment
   int num_residual_corners = 0;
+  // Left out as the earlier stages judged (SystemExclusions), counted among
+  // the views and corners the adjustment would otherwise have used:
+  int num_skipped_views = 0;                             // views stage 1 dropped
+  int num_skipped_view_corners = 0;                      // their corners
+  int num_skipped_outlier_corners = 0;                   // single corners stage 1 or 2 flagged as outliers
   std::vector<Pose> module0_from_module_horn;            // (M,)
   std::vector<Pose> module0_from_module;                 // (M,) refined
   std::vector<STransformSigma> sigma;                    // for modules 1..M-1
@@ -105,9 +125,11 @@ struct SystemResult {
 // `modules`: stage-2 results per module. `corner_sigma_px`: the corner noise
 // (stage 2's residual RMS), which weighs back_from_front's prior against the
 // reprojection residuals. Throws InputError if a module shares no capture
-// with the others (the S matrix would be undetermined).
+// with the others (the S matrix would be undetermined). `excluded`: views and
+// corners the earlier stages rejected, left out here too.
 SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<ModuleCameras>& modules,
-                             double corner_sigma_px, const SystemOptions& options);
+                             double corner_sigma_px, const SystemOptions& options,
+                             const SystemExclusions& excluded = {});
 
 // Board poses: for each capture, module_from_front of one module, from its
 // triangulated corners (Horn). Also the triangulated points themselves.
@@ -117,9 +139,11 @@ struct ModuleCaptureView {
   std::vector<int> corner_ids;            // (N,)
   std::vector<Eigen::Vector3d> p_module;  // (N,) triangulated, module frame, mm
 };
-// views[k][capture]: module k's posed captures.
+// views[k][capture]: module k's posed captures, from the corners `excluded`
+// leaves in.
 std::vector<std::map<int, ModuleCaptureView>> PoseBoardsByTriangulation(const CalibrationInput& input,
                                                                         const std::vector<ModuleCameras>& modules,
-                                                                        int min_corners);
+                                                                        int min_corners,
+                                                                        const SystemExclusions& excluded = {});
 
 }  // namespace stereorig
