@@ -271,13 +271,7 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
     // Step 1: the board poses alone. Step 2: with the lens core. Step 3: all,
     // distortions regularised, outliers rejected (then unregularised, see
     // SolveFinal).
-    p.selections = {.do_optimize_intrinsics_core = false,
-                    .do_optimize_intrinsics_distortions = false,
-                    .do_optimize_extrinsics = true,
-                    .do_optimize_frames = true,
-                    .do_optimize_calobject_warp = false,
-                    .do_apply_regularization = false,
-                    .do_apply_outlier_rejection = false};
+    p.SelectPosesOnly();
     p.Optimize(options.verbose);
     p.selections.do_optimize_intrinsics_core = true;
     p.Optimize(options.verbose);

@@ -53,6 +53,16 @@ int MrcalProblem::CountNonPositiveWeights() const {
   return n;
 }
 
+void MrcalProblem::SelectPosesOnly() {
+  selections = {.do_optimize_intrinsics_core = false,
+                .do_optimize_intrinsics_distortions = false,
+                .do_optimize_extrinsics = true,
+                .do_optimize_frames = true,
+                .do_optimize_calobject_warp = false,
+                .do_apply_regularization = false,
+                .do_apply_outlier_rejection = false};
+}
+
 mrcal_pose_t MrcalProblem::ToMrcal(const Pose& a_from_b) {
   const Eigen::Vector3d r = a_from_b.RotationVector();
   const Eigen::Vector3d& t = a_from_b.translation_mm();

@@ -40,6 +40,10 @@ struct MrcalProblem {
   int num_measurements() const;
   int num_measurements_boards() const;
 
+  // The staged solve's first step, as mrcal's own tool begins: the board
+  // poses and camera extrinsics alone, lens held, no regularisation, no
+  // outlier rejection. Sets `selections` to that.
+  void SelectPosesOnly();
   // Runs mrcal_optimize with the current selections. Updates the state and
   // marks new outliers in the pool (weight < 0).
   mrcal_stats_t Optimize(bool verbose = false);

@@ -131,13 +131,7 @@ StereoResult CalibrateStereo(int module, const ModuleLayout& layout, const Intri
     }
   }
   const int missing = p.CountNonPositiveWeights();
-  p.selections = {.do_optimize_intrinsics_core = false,
-                  .do_optimize_intrinsics_distortions = false,
-                  .do_optimize_extrinsics = true,
-                  .do_optimize_frames = true,
-                  .do_optimize_calobject_warp = false,
-                  .do_apply_regularization = false,
-                  .do_apply_outlier_rejection = false};
+  p.SelectPosesOnly();
   p.Optimize(options.verbose);
   p.selections.do_optimize_intrinsics_core = true;
   p.selections.do_optimize_intrinsics_distortions = true;

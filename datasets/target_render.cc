@@ -28,6 +28,11 @@ Eigen::Vector3d PhysicalBoard::TrueCorner(Face face, int id) const {
   return Eigen::Vector3d(c.x(), c.y(), face == Face::kFront ? -w : w);
 }
 
+Eigen::Vector3d PhysicalBoard::TrueCornerInFront(Face face, int id) const {
+  const Eigen::Vector3d x = TrueCorner(face, id);
+  return face == Face::kFront ? x : true_back_from_front.Inverse() * x;
+}
+
 PhysicalBoard MakePhysicalBoard(const Target& target, const CalibrationSpec& spec) {
   PhysicalBoard b;
   b.target = &target;

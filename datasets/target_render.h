@@ -34,6 +34,10 @@ struct PhysicalBoard {
   double Bow(double x_mm, double y_mm) const;
   // A corner's true 3D position in its face frame, mm.
   Eigen::Vector3d TrueCorner(Face face, int id) const;
+  // The same in the front face's frame (a back corner through the true
+  // back_from_front): the board as one rigid body, the frame a capture's
+  // board pose is given in.
+  Eigen::Vector3d TrueCornerInFront(Face face, int id) const;
 };
 
 PhysicalBoard MakePhysicalBoard(const Target& target, const CalibrationSpec& spec);

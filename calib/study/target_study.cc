@@ -108,14 +108,9 @@ RunFigures RunOne(const Board& b, int captures, unsigned seed, const StudyOption
   SyntheticOptions o;
   o.seed = seed;
   o.noise_px = so.noise_px;
-  const Pose front_from_true_back = board.true_back_from_front.Inverse();
   const SyntheticData data = ObserveBoards(
       truth, TargetGeometryFromTarget(target), ref_from_front,
-      [&](Face face, int id) {
-        const Eigen::Vector3d x = board.TrueCorner(face, id);
-        return face == Face::kFront ? x : front_from_true_back * x;
-      },
-      o);
+      [&](Face face, int id) { return board.TrueCornerInFront(face, id); }, o);
   size_t corners = 0;
   for (const BoardObservation& v : data.input.observations) corners += v.corner_ids.size();
   f.corners_per_view = static_cast<double>(corners) / std::max<size_t>(1, data.input.observations.size());
