@@ -233,7 +233,8 @@ int RunBench(int argc, char** argv) {
       rig_path.empty() && !dataset.empty() ? (fs::path(dataset) / "truth" / "rig.yaml").string() : rig_path;
   if (!report_path.empty())
     ClaimRuntimeReport(report_path, rig_read, options_path, true,
-                       rig_path.empty() ? "the dataset's truth rig file (read without --rig)" : "the rig file (--rig)");
+                       rig_path.empty() ? "the dataset's truth rig file (read without --rig)" : "the rig file (--rig)",
+                       DatasetInputs(dataset));
 
   Rig rig;
   std::vector<Scene> scenes;

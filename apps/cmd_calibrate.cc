@@ -80,7 +80,9 @@ int RunCalibrate(int argc, char** argv) {
   const CalibrationResult& result = folder.result;
   WriteCalibrationOutputs(result, out_path, report_path);
   if (!cameramodels_dir.empty()) {
-    std::filesystem::create_directories(cameramodels_dir);
+    std::error_code ec;
+    std::filesystem::create_directories(cameramodels_dir, ec);
+    if (ec) throw InputError(cameramodels_dir, "cannot create the folder: " + ec.message());
     ExportCameramodels(result.rig, cameramodels_dir);
   }
   std::printf("%s", SummaryText(result.report).c_str());

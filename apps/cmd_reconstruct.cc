@@ -66,7 +66,8 @@ int RunReconstruct(int argc, char** argv) {
     if (!report_path.empty()) ClaimRuntimeReport(report_path, rig_path, options_path, false);
     const Rig rig = ReadRigFile(rig_path);
     const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
-    return ReconstructBatch(rig, options, BatchRequest{capture_dirs, out_dir, mesh_format, report_path});
+    return ReconstructBatch(rig, options,
+                            BatchRequest{capture_dirs, out_dir, mesh_format, report_path, rig_path, options_path});
   }
   const std::string& capture_dir = capture_dirs.front();
 

@@ -121,6 +121,12 @@ int RunRig(int argc, char** argv) {
   // folder is created below, so its existence is not asked).
   std::vector<std::string> model_paths;
   for (int i = 0; !export_dir.empty() && i < rig.num_cameras(); ++i) {
+    // A camera name is the model's file name: a plain one, or the model
+    // would land outside the folder (or in one that is not there).
+    const std::string& name = rig.camera_names()[i];
+    if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos)
+      throw InputError(rig_path, "camera " + std::to_string(i) + "'s name \"" + name +
+                                     "\" is not a plain file name: cannot export its model");
     model_paths.push_back((std::filesystem::path(export_dir) / (rig.camera_names()[i] + ".cameramodel")).string());
     outputs.Claim(model_paths.back(), "camera " + std::to_string(i) + "'s model (--export-cameramodels)", false);
   }

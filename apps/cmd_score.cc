@@ -83,11 +83,26 @@ int RunScore(int argc, char** argv) {
     if (ec || !fs::is_directory(diagnose_dir))
       throw InputError(diagnose_dir, "--diagnose: cannot create this folder (" + ec.message() + ")");
   }
-  // After --diagnose's folder exists: the report may go in it.
-  if (!report_path.empty())  // before minutes of scoring
-    ClaimRuntimeReport(report_path, rig_path, options_path, true,
-                       rig_given ? "the rig file (--rig)" : "the dataset's truth rig file (read without --rig)");
+  // After --diagnose's folder exists (the report may go in it), before
+  // anything is read: the report, not over the rig, the options or any file
+  // of the dataset the scorer reads; once the rig says how many modules, the
+  // diagnosis images too.
+  const std::string rig_what = rig_given ? "the rig file (--rig)" : "the dataset's truth rig file (read without --rig)";
+  const auto dataset_inputs = DatasetInputs(dataset);
+  ClaimRuntimeReport(report_path, rig_path, options_path, true, rig_what, dataset_inputs);
   const Rig rig = ReadRigFile(rig_path);
+  std::vector<std::pair<std::string, std::string>> diagnosis_images;
+  if (!diagnose_dir.empty()) {
+    std::stringstream list(scenes_arg);
+    for (std::string name; std::getline(list, name, ',');)
+      for (int m = 0; m < rig.num_modules(); ++m)
+        for (const char* kind : {"left", "status", "lost", "error"})
+          diagnosis_images.push_back(
+              {(fs::path(diagnose_dir) / (name + "_m" + std::to_string(m) + "_" + kind + ".png")).string(),
+               "a diagnosis image (--diagnose)"});
+  }
+  if (!diagnosis_images.empty())
+    ClaimRuntimeReport(report_path, rig_path, options_path, true, rig_what, dataset_inputs, diagnosis_images);
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
   RuntimeOptions passive_options = options;
   // No grid: the whole volume's ROI, and no test of the grid's period.

@@ -1,5 +1,6 @@
 #include "apps/output_paths.h"
 
+#include "calib/core/capture_image_name.h"
 #include "calib/core/input_error.h"
 
 namespace stereorig {
@@ -32,11 +33,36 @@ void OutputPaths::Claim(const std::string& path, const std::string& what, bool c
 }
 
 void ClaimRuntimeReport(const std::string& report_path, const std::string& rig_path, const std::string& options_path,
-                        bool check_folder, const std::string& rig_what) {
+                        bool check_folder, const std::string& rig_what,
+                        const std::vector<std::pair<std::string, std::string>>& more_inputs,
+                        const std::vector<std::pair<std::string, std::string>>& more_outputs) {
   OutputPaths outputs;
   outputs.Protect(rig_path, rig_what);
   outputs.Protect(options_path, "the options file (--options)");
-  outputs.Claim(report_path, "the report (--report)", check_folder);
+  for (const auto& [path, what] : more_inputs) outputs.Protect(path, what);
+  if (!report_path.empty()) outputs.Claim(report_path, "the report (--report)", check_folder);
+  for (const auto& [path, what] : more_outputs) outputs.Claim(path, what, false);
+}
+
+std::vector<std::pair<std::string, std::string>> DatasetInputs(const std::string& dataset) {
+  namespace fs = std::filesystem;
+  std::vector<std::pair<std::string, std::string>> inputs;
+  if (dataset.empty() || !fs::is_directory(dataset)) return inputs;
+  const fs::path root(dataset);
+  inputs.push_back({(root / "truth" / "rig.yaml").string(), "the dataset's truth rig file"});
+  inputs.push_back({(root / "spec.yaml").string(), "the dataset's spec"});
+  if (fs::is_directory(root / "scenes")) {
+    for (const auto& scene : fs::directory_iterator(root / "scenes")) {
+      for (const char* mode : {"active", "passive"}) {
+        const fs::path capture = scene.path() / mode;
+        if (!fs::is_directory(capture)) continue;
+        for (const auto& e : fs::directory_iterator(capture))
+          if (CameraIndexOfImageName(e.path().filename().string()))
+            inputs.push_back({e.path().string(), "a capture image of the dataset"});
+      }
+    }
+  }
+  return inputs;
 }
 
 void OutputPaths::ClaimFolder(const std::string& path, const std::string& what) {

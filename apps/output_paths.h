@@ -11,6 +11,7 @@
 #include <map>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace stereorig {
 
@@ -43,7 +44,19 @@ class OutputPaths {
 // (an empty path: not given). check_folder as OutputPaths::Claim.
 // rig_what names the rig file in the message (a dataset's truth rig when no
 // --rig was given).
+// more_inputs: further (path, what) inputs to protect (DatasetInputs).
+// more_outputs: further files the command writes, claimed without the folder
+// test (score's --diagnose images).
 void ClaimRuntimeReport(const std::string& report_path, const std::string& rig_path, const std::string& options_path,
-                        bool check_folder = true, const std::string& rig_what = "the rig file (--rig)");
+                        bool check_folder = true, const std::string& rig_what = "the rig file (--rig)",
+                        const std::vector<std::pair<std::string, std::string>>& more_inputs = {},
+                        const std::vector<std::pair<std::string, std::string>>& more_outputs = {});
+
+// The files `stereorig score` and `bench` read from a simulated dataset
+// (docs/formats.md "Datasets"), as (path, what) for OutputPaths::Protect:
+// truth/rig.yaml (the scorer reads it even when --rig is given), spec.yaml,
+// and every camK.png of scenes/<scene>/{active,passive}/. Empty if `dataset`
+// is empty or not a folder.
+std::vector<std::pair<std::string, std::string>> DatasetInputs(const std::string& dataset);
 
 }  // namespace stereorig

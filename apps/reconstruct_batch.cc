@@ -75,6 +75,8 @@ std::vector<CaptureOutputs> PlanOutputs(const std::vector<std::string>& names, c
                                         const Rig& rig) {
   std::vector<CaptureOutputs> outputs;
   OutputPaths paths("rename a folder or choose another --report");
+  paths.Protect(request.rig_path, "the rig file (--rig)");
+  paths.Protect(request.options_path, "the options file (--options)");
   for (const std::string& dir : request.capture_dirs)
     for (const std::string& image : CaptureImagePaths(dir, rig)) paths.Protect(image, "a capture image (--capture)");
   paths.ClaimFolder(request.out_dir, "the output folder (--out-dir)");  // not a file, nor under one

@@ -25,6 +25,8 @@ struct BatchRequest {
   std::string out_dir;       // created if missing
   std::string mesh_format;   // "" (no mesh), "ply" or "stl"
   std::string summary_path;  // "" or the batch's JSON summary
+  std::string rig_path;      // the rig file and options file read ("" if none): no output may be either
+  std::string options_path;
 };
 
 // Checks every capture folder's files (CheckCaptureFiles) and the names

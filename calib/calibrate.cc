@@ -483,9 +483,9 @@ std::string SummaryText(const CalibrationReport& rep) {
         list += (i ? ", " : "") + std::to_string(s.different_face_captures[i]);
       }
       AppendLine(&out,
-                 "    %zu capture(s) set aside in stages 2 and 3: its two cameras saw different faces (the board's "
-                 "plane between them, or a face misread): %s",
-                 s.different_face_captures.size(), list.c_str());
+                 "    %zu capture(s) set aside in stage 2%s: the module's two cameras saw different faces (the "
+                 "board's plane between them, or a face misread): %s",
+                 s.different_face_captures.size(), rep.num_modules > 1 ? " and 3" : "", list.c_str());
     }
   }
   if (rep.num_modules > 1) {

@@ -101,7 +101,7 @@ TEST(CalibrateDifferentFaces, AModuleWhoseCamerasSawDifferentFacesIsCalibratedAn
   EXPECT_EQ(json["stage2_stereo"][0]["different_face_captures"], nlohmann::json::array({edge_on}));
   // Module 1 faces module 0: the same plane passes between its cameras too.
   EXPECT_EQ(json["stage2_stereo"][1]["different_face_captures"], nlohmann::json(CapturesWithDifferentFaces(in, 2, 3)));
-  EXPECT_NE(SummaryText(res.report).find("1 capture(s) set aside in stages 2 and 3"), std::string::npos);
+  EXPECT_NE(SummaryText(res.report).find("1 capture(s) set aside in stage 2 and 3"), std::string::npos);
   ExpectAccurate(s, res);
 }
 

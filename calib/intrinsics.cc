@@ -230,15 +230,22 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
                                     ", need at least " + std::to_string(options.min_views));
   }
 
+  // Checked again whenever views are dropped below: the tilted ones may be
+  // the ones that go.
   double max_tilt = 0;
-  for (const Pose& seed : seeds) max_tilt = std::max(max_tilt, TiltDeg(seed));
-  if (max_tilt < options.min_tilt_deg) {
-    char buf[160];
-    std::snprintf(buf, sizeof buf,
-                  "degenerate views: all %zu are fronto-parallel (largest board tilt %.1f deg < %.1f); tilt the board",
-                  views.size(), max_tilt, options.min_tilt_deg);
-    throw InputError(cam_where, buf);
-  }
+  auto refuse_fronto_parallel = [&] {
+    max_tilt = 0;
+    for (const Pose& seed : seeds) max_tilt = std::max(max_tilt, TiltDeg(seed));
+    if (max_tilt < options.min_tilt_deg) {
+      char buf[160];
+      std::snprintf(
+          buf, sizeof buf,
+          "degenerate views: all %zu are fronto-parallel (largest board tilt %.1f deg < %.1f); tilt the board",
+          views.size(), max_tilt, options.min_tilt_deg);
+      throw InputError(cam_where, buf);
+    }
+  };
+  refuse_fronto_parallel();
 
   const int n = target.num_corners();
   MrcalProblem p;
@@ -306,6 +313,7 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
     }
     views = std::move(kept);
     seeds = std::move(kept_seeds);
+    refuse_fronto_parallel();
     solve(std::vector<double>(p.intrinsics));
   }
 

@@ -226,7 +226,7 @@ TEST(Cli, RigExportRefusesAFolderOverItsInputsBeforeAnyWork) {
     EXPECT_EQ(r.code, 2) << args;
     EXPECT_EQ(Lines(r.err), 1) << r.err;
     EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
-    EXPECT_EQ(r.out, "") << args;  // refused before the rig was read and summarised
+    EXPECT_EQ(r.out, "") << args;  // refused before the rig was summarised
   }
   for (const std::string& path : {rig, truth, named}) EXPECT_EQ(bytes(path), text) << path;
   EXPECT_EQ(std::distance(fs::directory_iterator(dir + "/models"), fs::directory_iterator()), 1);
@@ -234,6 +234,18 @@ TEST(Cli, RigExportRefusesAFolderOverItsInputsBeforeAnyWork) {
   const Result r = RunCli("rig --rig " + rig + " --export-cameramodels " + dir + "/new/models");
   EXPECT_EQ(r.code, 0) << r.err;
   for (int i = 0; i < 4; ++i) EXPECT_TRUE(fs::exists(dir + "/new/models/cam" + std::to_string(i) + ".cameramodel"));
+  // A camera name is its model's file name: one that is not a plain name
+  // ("../cam1": outside the folder) is refused before any model is written.
+  std::string escaping = text;
+  const size_t at = escaping.find("name: \"cam1\"");
+  ASSERT_NE(at, std::string::npos);
+  escaping.replace(at, 12, "name: \"../cam1\"");
+  std::ofstream(dir + "/escaping.yaml") << escaping;
+  const Result e = RunCli("rig --rig " + dir + "/escaping.yaml --export-cameramodels " + dir + "/esc/models");
+  EXPECT_EQ(e.code, 2) << e.err;
+  EXPECT_NE(e.err.find("camera 1's name \"../cam1\" is not a plain file name"), std::string::npos) << e.err;
+  EXPECT_FALSE(fs::exists(dir + "/esc/models/cam0.cameramodel"));
+  EXPECT_FALSE(fs::exists(dir + "/esc/cam1.cameramodel"));
 }
 
 }  // namespace

@@ -362,6 +362,47 @@ TEST_F(ReconstructCli, AnOutputOverACaptureImageIsRefused) {
   ExpectNoOutput();
 }
 
+// score reads the dataset's truth rig (the scorer's frame and fill) even
+// with --rig, and the dataset's capture images; its --diagnose images are
+// outputs too. Each collision is refused before any scoring, in one line,
+// the inputs byte-identical. A batch's per-capture outputs may not be the
+// rig or options file either.
+TEST_F(ReconstructCli, ScoreAndBatchOutputsOverTheirInputsAreRefused) {
+  auto bytes = [](const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  };
+  const std::string d = dir_ + "/score_dataset";
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d + "/truth");
+  std::filesystem::create_directories(d + "/scenes/cup/active");
+  std::filesystem::copy_file(dir_ + "/rig.yaml", d + "/truth/rig.yaml");
+  std::filesystem::copy_file(dir_ + "/capture/cam0.png", d + "/scenes/cup/active/cam0.png");
+  const std::string rig = bytes(d + "/truth/rig.yaml"), image = bytes(d + "/scenes/cup/active/cam0.png");
+  const std::string score = "score --dataset " + d + " --scenes cup --no-passive";
+  const std::pair<std::string, std::string> cases[] = {
+      {score + " --rig " + dir_ + "/rig.yaml --report " + d + "/truth/rig.yaml",
+       d + "/truth/rig.yaml: is the dataset's truth rig file"},
+      {score + " --report " + d + "/scenes/cup/active/cam0.png", "cam0.png: is a capture image of the dataset"},
+      {score + " --diagnose " + dir_ + "/diag --report " + dir_ + "/diag/cup_m1_status.png",
+       "cup_m1_status.png: would be written twice (the report (--report) and a diagnosis image (--diagnose))"},
+      {"reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture --out-dir " + dir_ +
+           "/batch_opts --options " + dir_ + "/batch_opts/capture.json",
+       "capture.json: is the options file (--options)"}};
+  std::filesystem::create_directories(dir_ + "/batch_opts");
+  { std::ofstream(dir_ + "/batch_opts/capture.json") << "match: {}\n"; }
+  for (const auto& [args, says] : cases) {
+    const testing::Result r = testing::RunCli(args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+  }
+  EXPECT_EQ(bytes(d + "/truth/rig.yaml"), rig);
+  EXPECT_EQ(bytes(d + "/scenes/cup/active/cam0.png"), image);
+  EXPECT_EQ(bytes(dir_ + "/batch_opts/capture.json"), "match: {}\n");
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/batch_opts/capture.ply"));
+}
+
 // A measurement volume deeper than the matcher can search (150 x 150 x 300
 // mm at 200 mm: disparities -203 to 1535 px on this rig, past its 1024)
 // is refused when the runtime is built, naming the volume. It used to reach

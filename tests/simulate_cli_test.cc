@@ -52,7 +52,9 @@ TEST(SimulateCli, WriteDefaultSpecRefusesTheSpecItWasGivenAndAFolder) {
   const std::string spec = dir + "/edited.yaml";
   ASSERT_EQ(RunCli("simulate --write-default-spec " + spec).code, 0);
   std::string edited = Slurp(spec);
-  edited.replace(edited.find("captures: 50"), 12, "captures: 12");
+  const size_t at = edited.find("captures: 50");
+  ASSERT_NE(at, std::string::npos) << "the default spec changed: edit another key";
+  edited.replace(at, 12, "captures: 12");
   std::ofstream(spec) << edited;
   fs::create_symlink(spec, dir + "/link.yaml");
   const std::pair<std::string, std::string> cases[] = {

@@ -13,6 +13,7 @@ std::optional<int> CameraIndexOfImageName(const std::string& file_name) {
   const std::string digits = file_name.substr(prefix.size(), file_name.size() - prefix.size() - suffix.size());
   if (!std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c) != 0; }))
     return std::nullopt;
+  if (digits.size() > 1 && digits[0] == '0') return std::nullopt;  // cam07.png: not a name any reader opens
   if (digits.size() > 6) return kCameraIndexBeyondAnyRig;
   return std::stoi(digits);
 }
