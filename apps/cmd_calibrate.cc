@@ -68,10 +68,7 @@ int RunCalibrate(int argc, char** argv) {
     outputs.ClaimFolder(cameramodels_dir, "the camera models (--export-cameramodels)");
     // Each model file too (camK.cameramodel for every camera of the layout):
     // a rig file named DIR/cam0.cameramodel would be replaced by a model.
-    int num_cameras = 0;
-    for (const ModuleLayout& m : ReadLayoutFile(layout_path))
-      num_cameras = std::max({num_cameras, m.left_camera + 1, m.right_camera + 1});
-    for (int k = 0; k < num_cameras; ++k)
+    for (int k = 0, n = LayoutCameraCount(ReadLayoutFile(layout_path)); k < n; ++k)
       outputs.Claim((std::filesystem::path(cameramodels_dir) / ("cam" + std::to_string(k) + ".cameramodel")).string(),
                     "camera " + std::to_string(k) + "'s model (--export-cameramodels)", false);
   }

@@ -127,7 +127,7 @@ int RunRig(int argc, char** argv) {
     if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos)
       throw InputError(rig_path, "camera " + std::to_string(i) + "'s name \"" + name +
                                      "\" is not a plain file name: cannot export its model");
-    model_paths.push_back((std::filesystem::path(export_dir) / (rig.camera_names()[i] + ".cameramodel")).string());
+    model_paths.push_back((std::filesystem::path(export_dir) / (name + ".cameramodel")).string());
     outputs.Claim(model_paths.back(), "camera " + std::to_string(i) + "'s model (--export-cameramodels)", false);
   }
   PrintRigSummary(rig, stdout);

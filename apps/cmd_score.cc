@@ -96,10 +96,8 @@ int RunScore(int argc, char** argv) {
     std::stringstream list(scenes_arg);
     for (std::string name; std::getline(list, name, ',');)
       for (int m = 0; m < rig.num_modules(); ++m)
-        for (const char* kind : {"left", "status", "lost", "error"})
-          diagnosis_images.push_back(
-              {(fs::path(diagnose_dir) / (name + "_m" + std::to_string(m) + "_" + kind + ".png")).string(),
-               "a diagnosis image (--diagnose)"});
+        for (const std::string& path : FillDiagnosisImagePaths(FillDiagnosisPrefix(diagnose_dir, name, m)))
+          diagnosis_images.push_back({path, "a diagnosis image (--diagnose)"});
   }
   if (!diagnosis_images.empty())
     ClaimRuntimeReport(report_path, rig_path, options_path, true, rig_what, dataset_inputs, diagnosis_images);
@@ -172,7 +170,7 @@ int RunScore(int argc, char** argv) {
       for (size_t m = 0; m < s.fill.size(); ++m) {
         const FillDiagnosis d = DiagnoseFill(runtime, int(m), images, rec, truth.fill_target[m],
                                              maps[truth_rig.module(int(m)).left_camera].depth_mm);
-        WriteFillDiagnosisImages(d, (fs::path(diagnose_dir) / (name + "_m" + std::to_string(m))).string());
+        WriteFillDiagnosisImages(d, FillDiagnosisPrefix(diagnose_dir, name, int(m)));
         std::printf("  m%zu diagnosis: %s", m, d.Summary().c_str());
       }
     }

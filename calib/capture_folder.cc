@@ -139,10 +139,7 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
   input.target = TargetGeometryFromTarget(target);
   input.modules = ReadLayoutFile(layout_path);
   input.source = captures_dir;
-  int num_cameras = 0;
-  for (const ModuleLayout& m : input.modules) {
-    num_cameras = std::max({num_cameras, m.left_camera + 1, m.right_camera + 1});
-  }
+  const int num_cameras = LayoutCameraCount(input.modules);
   DetectedCaptures detected = DetectCaptureFolder(captures_dir, target, num_cameras, DetectOptions(), options.progress);
   input.cameras = detected.cameras;
   input.observations = std::move(detected.observations);

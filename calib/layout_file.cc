@@ -1,5 +1,7 @@
 #include "calib/layout_file.h"
 
+#include <algorithm>
+
 #include "calib/core/input_error.h"
 #include "calib/core/yaml_reader.h"
 
@@ -38,6 +40,12 @@ std::vector<ModuleLayout> Parse(YamlMap root) {
 }  // namespace
 
 std::vector<ModuleLayout> ReadLayoutFile(const std::string& path) { return Parse(YamlMap::LoadFile(path)); }
+
+int LayoutCameraCount(const std::vector<ModuleLayout>& modules) {
+  int n = 0;
+  for (const ModuleLayout& m : modules) n = std::max({n, m.left_camera + 1, m.right_camera + 1});
+  return n;
+}
 
 std::vector<ModuleLayout> ParseLayoutYaml(const std::string& text, const std::string& where) {
   return Parse(YamlMap::LoadString(text, where));

@@ -19,4 +19,8 @@ namespace stereorig {
 std::vector<ModuleLayout> ReadLayoutFile(const std::string& path);
 std::vector<ModuleLayout> ParseLayoutYaml(const std::string& text, const std::string& where);
 
+// The number of cameras a layout names: one more than its highest camera
+// index (cameras 0 .. N-1, each camK.png of a capture).
+int LayoutCameraCount(const std::vector<ModuleLayout>& modules);
+
 }  // namespace stereorig

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -284,11 +285,20 @@ void Write(const std::string& path, const cv::Mat& image) {
 
 }  // namespace
 
+std::vector<std::string> FillDiagnosisImagePaths(const std::string& prefix) {
+  return {prefix + "_left.png", prefix + "_status.png", prefix + "_lost.png", prefix + "_error.png"};
+}
+
+std::string FillDiagnosisPrefix(const std::string& dir, const std::string& scene, int module) {
+  return (std::filesystem::path(dir) / (scene + "_m" + std::to_string(module))).string();
+}
+
 void WriteFillDiagnosisImages(const FillDiagnosis& d, const std::string& prefix) {
+  const std::vector<std::string> paths = FillDiagnosisImagePaths(prefix);
   const cv::Rect r = d.match_roi;
   if (r.area() == 0) return;
   cv::Mat grey = d.left(r).clone();
-  Write(prefix + "_left.png", grey);
+  Write(paths[0], grey);
   cv::Mat status(r.size(), CV_8UC3), lost(r.size(), CV_8UC3), error(r.size(), CV_8UC3);
   for (int y = 0; y < r.height; ++y)
     for (int x = 0; x < r.width; ++x) {
@@ -318,9 +328,9 @@ void WriteFillDiagnosisImages(const FillDiagnosis& d, const std::string& prefix)
       }
       error.at<cv::Vec3b>(y, x) = e;
     }
-  Write(prefix + "_status.png", status);
-  Write(prefix + "_lost.png", lost);
-  Write(prefix + "_error.png", error);
+  Write(paths[1], status);
+  Write(paths[2], lost);
+  Write(paths[3], error);
 }
 
 }  // namespace stereorig

@@ -117,4 +117,12 @@ FillDiagnosis DiagnoseFill(const Runtime& runtime, int module, const std::vector
 // lost = lost targets, green where reachable, red where not; error = |d - truth|.
 void WriteFillDiagnosisImages(const FillDiagnosis& d, const std::string& prefix);
 
+// The files WriteFillDiagnosisImages writes for `prefix` (a command claims
+// them before any work): prefix_left.png, _status.png, _lost.png, _error.png.
+std::vector<std::string> FillDiagnosisImagePaths(const std::string& prefix);
+
+// The prefix `stereorig score --diagnose` gives module `module` of `scene`:
+// DIR/<scene>_m<module>.
+std::string FillDiagnosisPrefix(const std::string& dir, const std::string& scene, int module);
+
 }  // namespace stereorig
