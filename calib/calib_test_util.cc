@@ -28,6 +28,25 @@ Eigen::Vector2d MeanFramesProjectionError(const Camera& truth, const std::vector
 
 namespace stereorig::testing {
 
+std::vector<int> CapturesWhoseBoardPlaneSeparates(const Rig& truth, const std::vector<Pose>& ref_from_front,
+                                                  const CalibrationInput& in, int camera_a, int camera_b) {
+  std::map<int, int> seen;  // capture -> how many of the two cameras saw the board
+  for (const BoardObservation& o : in.observations)
+    if ((o.camera == camera_a || o.camera == camera_b) && !o.corner_ids.empty()) ++seen[o.capture];
+  const Eigen::Vector3d centre_a = truth.CamFromReference(camera_a).Inverse().translation_mm();
+  const Eigen::Vector3d centre_b = truth.CamFromReference(camera_b).Inverse().translation_mm();
+  std::vector<int> out;
+  for (const auto& [capture, n] : seen) {
+    if (n < 2) continue;
+    const Pose& board = ref_from_front.at(capture);
+    const Eigen::Vector3d normal = board.rotation().col(2);
+    const double side_a = normal.dot(centre_a - board.translation_mm());
+    const double side_b = normal.dot(centre_b - board.translation_mm());
+    if (side_a * side_b < 0) out.push_back(capture);
+  }
+  return out;
+}
+
 DefaultScene MakeDefaultScene(unsigned seed, int captures, double noise_px) {
   return MakeScene(MakeDefaultRig(), seed, captures, noise_px);
 }

@@ -36,6 +36,15 @@ Eigen::Vector2d MeanFramesProjectionError(const Camera& truth, const std::vector
 
 namespace stereorig::testing {
 
+// The captures in which two cameras both observed the board (a view with
+// corners in `in`) and the TRUE board's plane (front face at
+// ref_from_front[capture], reference frame) passes between their centres:
+// those in which they saw different faces, judged from the truth's geometry
+// alone, not from the faces the observations carry (nor from calib's
+// bookkeeping, which the tests check against it). Sorted.
+std::vector<int> CapturesWhoseBoardPlaneSeparates(const Rig& truth, const std::vector<Pose>& ref_from_front,
+                                                  const CalibrationInput& in, int camera_a, int camera_b);
+
 // The default rig with `captures` synthetic captures of the default test
 // target at `noise_px`. The engine is told a back_from_front that differs
 // from the true one by a draw from its stated 1 sigma, as a measured one would.
