@@ -147,7 +147,9 @@ void Progress(bool on, const std::string& msg) {
 //    board pose is shared by the two cameras, as in stage 3 (which shares it
 //    among every module), so a corner inconsistent with its partner camera
 //    is the same inconsistency stage 3 would meet. Stage 2 re-marks every
-//    corner from weight 1, so the two sets differ and are united.
+//    corner from weight 1, so the two sets differ and are united;
+//  - the captures stage 2 set aside for a module (its two cameras saw
+//    different faces): its list, so that stages 2 and 3 cannot disagree.
 // A flagged corner is one the view saw whose pool weight is <= 0 after the
 // solve (an unseen corner is -1 from the start, and not in the view).
 SystemExclusions EarlierStageVerdicts(const CalibrationInput& in, const std::vector<IntrinsicsResult>& stage1,
@@ -175,6 +177,7 @@ SystemExclusions EarlierStageVerdicts(const CalibrationInput& in, const std::vec
   }
   for (size_t m = 0; m < stage2.size(); ++m) {
     const StereoResult& s2 = stage2[m];
+    for (int c : s2.report.different_face_captures) ex.module_captures.insert({c, static_cast<int>(m)});
     const int cams[2] = {in.modules[m].left_camera, in.modules[m].right_camera};
     for (int o = 0; o < s2.problem.num_observations(); ++o) {
       const mrcal_observation_board_t& ob = s2.problem.observations[o];

@@ -130,5 +130,37 @@ TEST(CalibrateDifferentFaces, AFaceMisreadInOneCameraDoesNotPoisonTheSolve) {
   ExpectAccurate(s, res);
 }
 
+// A view stage 1 dropped (here cut to 5 corners, under the 8 a view needs)
+// still says which face its camera saw: its partner's view of the capture,
+// misread, is set aside with it, in stage 2 and stage 3. Counting only the
+// views stage 1 kept would let the misread face into stage 3, checked by
+// nothing (the module poses no board there).
+TEST(CalibrateDifferentFaces, AViewStageOneDroppedStillSetsItsCaptureAside) {
+  testing::DefaultScene s = testing::MakeDefaultScene(6, kCaptures, kNoisePx);
+  CalibrationInput& in = s.data.input;
+  int misread = -1;
+  for (BoardObservation& o : in.observations) {
+    if (o.camera == 3 && Find(in, o.capture, 2) && Find(in, o.capture, 0) && Find(in, o.capture, 1)) {
+      o.face = o.face == Face::kFront ? Face::kBack : Face::kFront;
+      misread = o.capture;
+      break;
+    }
+  }
+  ASSERT_GE(misread, 0);
+  for (BoardObservation& o : in.observations) {
+    if (o.capture == misread && o.camera == 2) {
+      o.corner_ids.resize(5);
+      o.q_px.resize(5);
+    }
+  }
+  const CalibrationResult res = Calibrate(in, CalibrationOptions());
+  const std::vector<int>& used = res.stage1[2].captures;
+  ASSERT_EQ(std::find(used.begin(), used.end(), misread), used.end()) << "stage 1 must drop camera 2's view";
+  EXPECT_EQ(res.report.stereo[1].different_face_captures, std::vector<int>{misread});
+  const std::vector<int>& frames = res.stage2[1].captures;
+  EXPECT_EQ(std::find(frames.begin(), frames.end(), misread), frames.end());
+  ExpectAccurate(s, res);
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -11,6 +11,7 @@
 
 #include "calib/calib_test_util.h"
 #include "calib/calibrate.h"
+#include "calib/system.h"
 
 namespace stereorig {
 namespace {
@@ -103,6 +104,44 @@ TEST(CalibrateSystemVerdicts, CornersEarlierStagesRejectedStayOut) {
     EXPECT_LT(std::abs(dt(i)), 4.0 * sys.sigma[0].translation_mm(i) * to_noise) << "S translation " << i;
   }
   std::printf("largest |error| / noise sigma: intrinsics %.2f, S %.2f\n", max_z, max_s);
+}
+
+// A capture stage 2 set aside for a module (its cameras saw different faces)
+// stays out of stage 3 as stage 2's list says (SystemExclusions::
+// module_captures), not as stage 3 would judge it again: here an ordinary
+// capture, which stage 3's own look at the faces would keep, is named set
+// aside for module 1, and both of module 1's views of it leave the
+// adjustment and its Horn poses. Stage 3 alone, on the true cameras.
+TEST(CalibrateSystemVerdicts, ACaptureStageTwoSetAsideStaysOut) {
+  const auto s = testing::MakeDefaultScene(72, 12, kNoisePx);
+  const CalibrationInput& in = s.data.input;
+  std::vector<ModuleCameras> modules;
+  for (int k = 0; k < 2; ++k) {
+    const StereoModule& m = s.truth.rig.module(k);
+    modules.push_back({m.left_camera, m.right_camera, s.truth.rig.camera(m.left_camera),
+                       s.truth.rig.camera(m.right_camera), m.right_from_left});
+  }
+  SystemOptions options;
+  options.compute_covariance = false;
+  const SystemReport all = CalibrateSystem(in, modules, kNoisePx, options).report;
+  // A capture both modules posed: module 1's corners in it.
+  const auto views = PoseBoardsByTriangulation(in, modules, options.min_triangulated_corners);
+  int capture = -1;
+  for (const auto& [c, v] : views[1])
+    if (views[0].count(c)) capture = c;
+  ASSERT_GE(capture, 0);
+  int module1_corners = 0;
+  for (const BoardObservation& o : in.observations)
+    if (o.capture == capture && (o.camera == 2 || o.camera == 3))
+      module1_corners += static_cast<int>(o.corner_ids.size());
+  ASSERT_GT(module1_corners, 0);
+
+  SystemExclusions set_aside;
+  set_aside.module_captures.insert({capture, 1});
+  const SystemReport without = CalibrateSystem(in, modules, kNoisePx, options, set_aside).report;
+  EXPECT_EQ(without.num_residual_corners, all.num_residual_corners - module1_corners);
+  EXPECT_EQ(without.shared_captures.at({0, 1}), all.shared_captures.at({0, 1}) - 1);
+  EXPECT_EQ(without.num_captures, all.num_captures);  // module 0 still poses it
 }
 
 }  // namespace

@@ -64,6 +64,8 @@ StereoResult CalibrateStereo(int module, const ModuleLayout& layout, const Intri
   // one board pose per capture (mrcal's frame) cannot hold two faces without
   // back_from_front, which the joint solve does not model; and a face misread
   // by the detector looks the same. Stage 1 has used the views as they are.
+  // Judged over every view, those stage 1 dropped too (CapturesWithDifferentFaces
+  // says why); stage 3 takes this list from the report, it does not judge again.
   const std::vector<int> different_faces = CapturesWithDifferentFaces(input, layout.left_camera, layout.right_camera);
   const std::set<int> set_aside(different_faces.begin(), different_faces.end());
   std::map<int, int> left_view, right_view;

@@ -80,7 +80,9 @@ std::vector<std::map<int, ModuleCaptureView>> PoseBoardsByTriangulation(const Ca
       auto il = index.find({c, m.left_camera});
       auto ir = index.find({c, m.right_camera});
       if (il == index.end() || ir == index.end()) continue;
-      if (excluded.ExcludesView(c, m.left_camera) || excluded.ExcludesView(c, m.right_camera)) continue;
+      if (excluded.ExcludesView(c, m.left_camera) || excluded.ExcludesView(c, m.right_camera) ||
+          excluded.ExcludesModuleCapture(c, static_cast<int>(k)))
+        continue;
       const BoardObservation& l = *il->second;
       const BoardObservation& r = *ir->second;
       if (l.face != r.face) continue;
@@ -219,14 +221,10 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   rep.num_captures = static_cast<int>(boards.size());
 
   // A module's views of a capture in which its two cameras saw different
-  // faces are set aside, as in stage 2: the board pose (one per capture) and
-  // back_from_front could hold them, but a face misread by the detector looks
-  // the same, and the module posed no board there to check them against.
-  std::set<std::pair<int, int>> set_aside;  // (capture, module)
-  for (int k = 0; k < M; ++k)
-    for (int c : CapturesWithDifferentFaces(input, modules[k].left_camera, modules[k].right_camera))
-      set_aside.insert({c, k});
-
+  // faces stay set aside, as stage 2 decided (excluded.module_captures): the
+  // board pose (one per capture) and back_from_front could hold them, but a
+  // face misread by the detector looks the same, and the module posed no
+  // board there to check them against.
   std::vector<ceres::ResidualBlockId> corner_blocks;
   bool any_back = false;
   for (const BoardObservation& o : input.observations) {
@@ -234,7 +232,7 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
     auto mo = module_of.find(o.camera);
     if (b == boards.end() || mo == module_of.end()) continue;
     const auto [k, is_right] = mo->second;
-    if (set_aside.count({o.capture, k})) continue;
+    if (excluded.ExcludesModuleCapture(o.capture, k)) continue;
     // The earlier stages' verdicts (SystemExclusions). The Huber loss bounds
     // each corner's pull but does not remove it: a grazing view's corners,
     // outliers in their camera's own solve, pulled a ring's intrinsics 1.6 px

@@ -55,15 +55,20 @@ struct ModuleCameras {
 
 // The earlier stages' verdicts that stage 3 honours: the views stage 1
 // dropped (their inliers no longer determined a board pose, or too few
-// corners) and the corners mrcal's outlier rejection flagged in stage 1 (the
-// camera's own solve) or stage 2 (the module's joint solve). They stay out of
-// the triangulated board poses and of the adjustment: its Huber loss only
-// bounds an outlier's pull, it does not remove it.
+// corners), the corners mrcal's outlier rejection flagged in stage 1 (the
+// camera's own solve) or stage 2 (the module's joint solve), and the captures
+// stage 2 set aside for a module because its two cameras saw different faces
+// (StereoReport::different_face_captures: stage 2's list, not recomputed
+// here). They stay out of the triangulated board poses and of the
+// adjustment: its Huber loss only bounds an outlier's pull, it does not
+// remove it.
 struct SystemExclusions {
-  std::set<std::pair<int, int>> views;          // (capture, camera)
-  std::set<std::tuple<int, int, int>> corners;  // (capture, camera, corner id)
+  std::set<std::pair<int, int>> views;            // (capture, camera)
+  std::set<std::tuple<int, int, int>> corners;    // (capture, camera, corner id)
+  std::set<std::pair<int, int>> module_captures;  // (capture, module): both of the module's views
   bool ExcludesView(int capture, int camera) const { return views.count({capture, camera}) > 0; }
   bool ExcludesCorner(int capture, int camera, int id) const { return corners.count({capture, camera, id}) > 0; }
+  bool ExcludesModuleCapture(int capture, int module) const { return module_captures.count({capture, module}) > 0; }
 };
 
 struct STransformSigma {
@@ -125,8 +130,10 @@ struct SystemResult {
 // `modules`: stage-2 results per module. `corner_sigma_px`: the corner noise
 // (stage 2's residual RMS), which weighs back_from_front's prior against the
 // reprojection residuals. Throws InputError if a module shares no capture
-// with the others (the S matrix would be undetermined). `excluded`: views and
-// corners the earlier stages rejected, left out here too.
+// with the others (the S matrix would be undetermined). `excluded`: views,
+// corners and module-captures the earlier stages rejected or set aside, left
+// out here too (Calibrate passes them; a capture whose two views of a module
+// show different faces gives that module no board pose in any case).
 SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<ModuleCameras>& modules,
                              double corner_sigma_px, const SystemOptions& options,
                              const SystemExclusions& excluded = {});
