@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <vector>
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
@@ -41,6 +43,47 @@ std::string FilledLine(const ErrorFigures& f) {
                 f.mean_abs_mm, f.p95_abs_mm, f.max_abs_mm, 100 * f.within_0_5_mm);
   return buf;
 }
+
+// The folders of --diagnose that do not exist yet: checked before anything
+// is read (the nearest existing part of the path a folder), created only
+// once every input has been checked and read (Create), and removed again,
+// while still empty, if the command fails after that (a scene that is not in
+// the dataset): bad input leaves no new folder behind.
+class DiagnoseFolder {
+ public:
+  explicit DiagnoseFolder(const std::string& dir) : dir_(dir) {
+    namespace fs = std::filesystem;
+    if (dir.empty()) return;
+    OutputPaths().ClaimFolder(dir, "the diagnosis images (--diagnose)");
+    for (fs::path p = fs::weakly_canonical(fs::absolute(dir)); !p.empty() && !fs::exists(p); p = p.parent_path())
+      missing_.insert(missing_.begin(), p);  // outermost first
+  }
+  // Whether `folder` is one that Create will make (the report may go in it).
+  bool WillCreate(const std::filesystem::path& folder) const {
+    const auto key = std::filesystem::weakly_canonical(std::filesystem::absolute(folder));
+    return std::find(missing_.begin(), missing_.end(), key) != missing_.end();
+  }
+  void Create() {
+    if (dir_.empty()) return;
+    std::error_code ec;
+    std::filesystem::create_directories(dir_, ec);
+    if (ec || !std::filesystem::is_directory(dir_))
+      throw InputError(dir_, "--diagnose: cannot create this folder (" + ec.message() + ")");
+    created_ = true;
+  }
+  ~DiagnoseFolder() {
+    if (!created_ || std::uncaught_exceptions() <= exceptions_) return;  // not failing
+    std::error_code ec;  // a folder not empty stays, and so do its parents
+    auto p = missing_.rbegin();
+    while (p != missing_.rend() && std::filesystem::remove(*p, ec)) ++p;
+  }
+
+ private:
+  std::string dir_;
+  std::vector<std::filesystem::path> missing_;  // outermost first
+  bool created_ = false;
+  int exceptions_ = std::uncaught_exceptions();
+};
 
 }  // namespace
 
@@ -77,19 +120,17 @@ int RunScore(int argc, char** argv) {
     rig_path = (fs::path(dataset) / "truth" / "rig.yaml").string();
     std::printf("score: no --rig: using the TRUTH rig %s (issue 5 judges with the calibrated one)\n", rig_path.c_str());
   }
-  if (!diagnose_dir.empty()) {  // before any work: an unusable folder is bad input, not a crash at the end
-    std::error_code ec;
-    fs::create_directories(diagnose_dir, ec);
-    if (ec || !fs::is_directory(diagnose_dir))
-      throw InputError(diagnose_dir, "--diagnose: cannot create this folder (" + ec.message() + ")");
-  }
-  // After --diagnose's folder exists (the report may go in it), before
-  // anything is read: the report, not over the rig, the options or any file
-  // of the dataset the scorer reads; once the rig says how many modules, the
+  // Before any work: an unusable --diagnose folder is bad input, not a crash
+  // at the end; but it is created only after every input check below.
+  DiagnoseFolder diagnose(diagnose_dir);
+  // Before anything is read: the report, not over the rig, the options or
+  // any file of the dataset the scorer reads (its folder may be one
+  // --diagnose will create); once the rig says how many modules, the
   // diagnosis images too.
   const std::string rig_what = rig_given ? "the rig file (--rig)" : "the dataset's truth rig file (read without --rig)";
   const auto dataset_inputs = DatasetInputs(dataset);
-  ClaimRuntimeReport(report_path, rig_path, options_path, true, rig_what, dataset_inputs);
+  const bool check_report_folder = report_path.empty() || !diagnose.WillCreate(fs::absolute(report_path).parent_path());
+  ClaimRuntimeReport(report_path, rig_path, options_path, check_report_folder, rig_what, dataset_inputs);
   const Rig rig = ReadRigFile(rig_path);
   std::vector<std::pair<std::string, std::string>> diagnosis_images;
   if (!diagnose_dir.empty()) {
@@ -100,13 +141,15 @@ int RunScore(int argc, char** argv) {
           diagnosis_images.push_back({path, "a diagnosis image (--diagnose)"});
   }
   if (!diagnosis_images.empty())
-    ClaimRuntimeReport(report_path, rig_path, options_path, true, rig_what, dataset_inputs, diagnosis_images);
+    ClaimRuntimeReport(report_path, rig_path, options_path, check_report_folder, rig_what, dataset_inputs,
+                       diagnosis_images);
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
   RuntimeOptions passive_options = options;
   // No grid: the whole volume's ROI, and no test of the grid's period.
   passive_options.crop_to_lit_region = false;
   passive_options.match.min_distinctness = 0;
   const Runtime runtime(rig, options), passive_runtime(rig, passive_options);
+  diagnose.Create();
   nlohmann::json report = {{"dataset", dataset}, {"rig", rig_path}};
   {
     std::ifstream spec(fs::path(dataset) / "spec.yaml");

@@ -61,8 +61,8 @@ TEST(MatchCli, WritesAPfmThatMatchesTheTruth) {
 }
 
 // score: a dataset folder without a rig is bad input (exit 2), not a crash.
-// (An unusable --diagnose folder is also exit 2, checked by hand: a test
-// of it needs a whole dataset, since without one the rig fails first.)
+// (An unusable --diagnose folder, and bad input beside a usable one:
+// ReconstructCli.ScoreBadInputLeavesNoDiagnoseFolder.)
 TEST(ScoreCli, MissingDatasetExitsTwo) {
   EXPECT_EQ(RunCli("score --dataset " + ::testing::TempDir() + "/no_such_dataset"), 2);
   // A --report that cannot be written is named before anything else is read
@@ -81,6 +81,7 @@ TEST(ScoreCli, MissingDatasetExitsTwo) {
   EXPECT_EQ(d.code, 2);
   EXPECT_EQ(d.err.find("s.json"), std::string::npos) << d.err;
   EXPECT_NE(d.err.find("no_such_dataset"), std::string::npos) << d.err;
+  EXPECT_FALSE(std::filesystem::exists(diagnose)) << "bad input left the --diagnose folder behind";
 }
 
 TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
@@ -172,6 +173,17 @@ class ReconstructCli : public ::testing::Test {
     const std::string d = dir_ + "/" + name;
     std::filesystem::remove_all(d);
     std::filesystem::copy(dir_ + "/capture", d);
+    return d;
+  }
+  // A dataset folder as far as score reads it before scoring: the truth rig
+  // and one scene capture image (the rig file's).
+  std::string ScoreDataset(const std::string& name) {
+    const std::string d = dir_ + "/" + name;
+    std::filesystem::remove_all(d);
+    std::filesystem::create_directories(d + "/truth");
+    std::filesystem::create_directories(d + "/scenes/cup/active");
+    std::filesystem::copy_file(dir_ + "/rig.yaml", d + "/truth/rig.yaml");
+    std::filesystem::copy_file(dir_ + "/capture/cam0.png", d + "/scenes/cup/active/cam0.png");
     return d;
   }
   std::string Args(const std::string& capture, const std::string& extra = "") {
@@ -372,12 +384,7 @@ TEST_F(ReconstructCli, ScoreAndBatchOutputsOverTheirInputsAreRefused) {
     std::ifstream f(path, std::ios::binary);
     return std::string(std::istreambuf_iterator<char>(f), {});
   };
-  const std::string d = dir_ + "/score_dataset";
-  std::filesystem::remove_all(d);
-  std::filesystem::create_directories(d + "/truth");
-  std::filesystem::create_directories(d + "/scenes/cup/active");
-  std::filesystem::copy_file(dir_ + "/rig.yaml", d + "/truth/rig.yaml");
-  std::filesystem::copy_file(dir_ + "/capture/cam0.png", d + "/scenes/cup/active/cam0.png");
+  const std::string d = ScoreDataset("score_dataset");
   const std::string rig = bytes(d + "/truth/rig.yaml"), image = bytes(d + "/scenes/cup/active/cam0.png");
   const std::string score = "score --dataset " + d + " --scenes cup --no-passive";
   const std::pair<std::string, std::string> cases[] = {
@@ -401,6 +408,33 @@ TEST_F(ReconstructCli, ScoreAndBatchOutputsOverTheirInputsAreRefused) {
   EXPECT_EQ(bytes(d + "/scenes/cup/active/cam0.png"), image);
   EXPECT_EQ(bytes(dir_ + "/batch_opts/capture.json"), "match: {}\n");
   EXPECT_FALSE(std::filesystem::exists(dir_ + "/batch_opts/capture.ply"));
+}
+
+// score creates its --diagnose folder, but only once the input is known
+// good: a refused --report, a --diagnose under a file, a scene the dataset
+// lacks each exit 2 in one line and leave no folder behind (score used to
+// create the folder first, and left it empty on every such refusal).
+TEST_F(ReconstructCli, ScoreBadInputLeavesNoDiagnoseFolder) {
+  const std::string d = ScoreDataset("score_dataset_diag");
+  const std::string diag = dir_ + "/diag_new";
+  const std::string score = "score --dataset " + d + " --no-passive --diagnose " + diag + "/deeper";
+  const std::pair<std::string, std::string> cases[] = {
+      {score + " --scenes cup --report " + dir_ + "/no_such_folder/s.json",
+       "no_such_folder/s.json: its folder does not exist"},
+      {score + " --scenes cup --rig " + dir_ + "/rig.yaml --report " + dir_ + "/rig.yaml",
+       "rig.yaml: is the rig file (--rig)"},
+      {score + " --scenes cup --report " + diag + "/deeper/cup_m0_left.png", "cup_m0_left.png: would be written twice"},
+      {score + " --scenes no_such_scene", "no_such_scene"},
+      {"score --dataset " + d + " --scenes cup --diagnose " + dir_ + "/rig.yaml/diag", "rig.yaml is a file"}};
+  for (const auto& [args, says] : cases) {
+    std::filesystem::remove_all(diag);
+    const testing::Result r = testing::RunCli(args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(diag)) << args;
+  }
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir_ + "/rig.yaml"));
 }
 
 // A measurement volume deeper than the matcher can search (150 x 150 x 300
