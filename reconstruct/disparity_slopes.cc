@@ -65,6 +65,10 @@ MaskMomentSums MomentSums(const cv::Mat& disparity) {
 
 }  // namespace
 
+bool IsSurfaceSlope(double slope_x, double slope_y) {
+  return slope_x <= kMaxSurfaceSlope && std::abs(slope_y) <= kMaxSurfaceSlope;
+}
+
 MaskMomentSums WindowMaskMomentSums(const cv::Mat& disparity) {
   STEREORIG_CHECK(disparity.type() == CV_32FC1);
   // 81 * 4095^2 < 2^31: int32 (the demo's maps are ~430 x 540 px).
@@ -117,7 +121,7 @@ void DisparitySlopes(const cv::Mat& disparity, cv::Mat* slope_x, cv::Mat* slope_
       const double det = cxx * cyy - cxy * cxy;
       if (!(det > 1e-6)) continue;
       const double gx = (cyy * cxd - cxy * cyd) / det, gy = (cxx * cyd - cxy * cxd) / det;
-      if (std::abs(gx) > 1.5 || std::abs(gy) > 1.5) continue;  // a depth edge, not a surface
+      if (!IsSurfaceSlope(gx, gy)) continue;
       gx_out[x] = float(gx);
       gy_out[x] = float(gy);
       plane_out[x] = float(md_ + gx * (x - mxv) + gy * (y - myv));

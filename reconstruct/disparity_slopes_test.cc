@@ -135,5 +135,33 @@ TEST(DisparitySlopes, NoPlaneOnSparseWindowsOrDepthEdges) {
   EXPECT_NEAR(gx.at<float>(15, 5), 0, 1e-5);
 }
 
+// The bound on dd/dx is one-sided (IsSurfaceSlope): a plane the left camera
+// sees at a grazing angle slopes down the row without limit (the ring's
+// oblique plate: -1.6 px/px), while a slope above 1 means the right camera
+// sees the plane's back. Exact planes, so the fitted slopes are the
+// analytic ones within RecoversAnAnalyticPlaneThroughHoles's float
+// rounding.
+TEST(DisparitySlopes, APlaneTheLeftCameraGrazesHasOneAndTheRightCamerasBackHasNone) {
+  for (const double gx : {-1.6, -4.0, 1.6}) {
+    cv::Mat d(40, 60, CV_32FC1);
+    for (int y = 0; y < d.rows; ++y)
+      for (int x = 0; x < d.cols; ++x) d.at<float>(y, x) = float(150 + gx * x + 0.02 * y);
+    cv::Mat slope_x(d.size(), CV_32FC1), slope_y(d.size(), CV_32FC1), plane;
+    DisparitySlopes(d, &slope_x, &slope_y, &plane);
+    const int planes = cv::countNonZero(plane == plane);
+    if (gx > 1) {
+      EXPECT_EQ(planes, 0) << gx;
+      continue;
+    }
+    EXPECT_EQ(planes, int(d.total())) << gx;
+    EXPECT_NEAR(slope_x.at<float>(20, 30), gx, 3e-3) << gx;
+    EXPECT_NEAR(plane.at<float>(20, 30), d.at<float>(20, 30), 1.2e-2) << gx;
+  }
+  EXPECT_TRUE(IsSurfaceSlope(-100, 0));
+  EXPECT_TRUE(IsSurfaceSlope(kMaxSurfaceSlope, -kMaxSurfaceSlope));
+  EXPECT_FALSE(IsSurfaceSlope(1.6, 0));
+  EXPECT_FALSE(IsSurfaceSlope(0, -1.6));
+}
+
 }  // namespace
 }  // namespace stereorig

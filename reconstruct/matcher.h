@@ -146,9 +146,19 @@ struct MatchOptions {
   cv::Mat left_valid;
   int speckle_window_px = 100;    // remove disparity blobs smaller than this, px (0 = off); default 100
   double speckle_range_px = 1.0;  // neighbours within this disparity are one blob, px; default 1
-  int sgbm_block_size = 5;        // opencv_sgbm_3way: block size, px (odd); default 5
-  int num_threads = 2;            // threads for row-parallel steps; default 2
-  void Check() const;             // throws InputError naming the bad field
+  // census_sgm, opencv_sgbm_3way: where both of two neighbours' local
+  // planes step more than speckle_range_px per px the same way, take their
+  // difference from that step (RemoveSpeckleBlobsAlongSlopes,
+  // speckle_filter.h): a surface the left camera grazes, dd/dx < -1 (a
+  // plate 60 degrees to a module), is then one blob instead of one-pixel
+  // strips the filter removes. Default false: on the default rig's scenes
+  // it changes a few limbs' points, and the score gate's fresh realizations
+  // read +0.010 mm std on one cup's module and -0.77 fill points on one
+  // ball bar's (docs/reconstruct-log.md, "The oblique plate (session 22)").
+  bool speckle_along_slopes = false;
+  int sgbm_block_size = 5;  // opencv_sgbm_3way: block size, px (odd); default 5
+  int num_threads = 2;      // threads for row-parallel steps; default 2
+  void Check() const;       // throws InputError naming the bad field
 };
 
 struct MatchResult {

@@ -97,6 +97,7 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.min_texture_dn = m.GetDouble("min_texture_dn", mo.min_texture_dn);
     mo.speckle_window_px = m.GetInt("speckle_window_px", mo.speckle_window_px);
     mo.speckle_range_px = m.GetDouble("speckle_range_px", mo.speckle_range_px);
+    mo.speckle_along_slopes = m.GetBool("speckle_along_slopes", mo.speckle_along_slopes);
     mo.occlusion_margin_px = m.GetDouble("occlusion_margin_px", mo.occlusion_margin_px);
     mo.surface_fit.enabled = m.GetBool("surface_fit", mo.surface_fit.enabled);
     mo.surface_fit.half_width_px = m.GetInt("surface_fit_half_width_px", mo.surface_fit.half_width_px);

@@ -77,8 +77,13 @@ void ToSixteenths(const float* d, int n, int16_t invalid, int16_t* f) {
 
 }  // namespace
 
-void FilterSpeckles16(cv::Mat disparity_16, int16_t invalid, int max_blob_px, int max_diff) {
+void FilterSpeckles16(cv::Mat disparity_16, int16_t invalid, int max_blob_px, int max_diff, const cv::Mat& step_left_16,
+                      const cv::Mat& step_up_16) {
   STEREORIG_CHECK(disparity_16.type() == CV_16SC1 && max_diff >= 0);
+  const bool steps = !step_left_16.empty();
+  STEREORIG_CHECK(step_left_16.empty() == step_up_16.empty());
+  STEREORIG_CHECK(!steps || (step_left_16.type() == CV_16SC1 && step_up_16.type() == CV_16SC1 &&
+                             step_left_16.size() == disparity_16.size() && step_up_16.size() == disparity_16.size()));
   // 16-bit values differ by at most 65535: a larger reach joins the same
   // neighbours, and the clamp keeps `a - b + max_diff` below int's range.
   max_diff = std::min(max_diff, 65535);
@@ -86,7 +91,8 @@ void FilterSpeckles16(cv::Mat disparity_16, int16_t invalid, int max_blob_px, in
   const int w = disparity_16.cols, h = disparity_16.rows;
   const std::unique_ptr<int32_t[]> label(new int32_t[size_t(w) * h]);  // every element written below
   Labels sets;
-  // |a - b| <= max_diff as one unsigned comparison.
+  // |a - b| <= max_diff as one unsigned comparison (a, b: 16-bit values
+  // and steps, so a - b + max_diff stays within int).
   const unsigned reach = 2u * unsigned(max_diff);
   auto near = [&](int a, int b) { return unsigned(a - b + max_diff) <= reach; };
   // Pass 1: each valid pixel joins its left and upper neighbours' blobs
@@ -95,6 +101,8 @@ void FilterSpeckles16(cv::Mat disparity_16, int16_t invalid, int max_blob_px, in
   auto label_row = [&](int y, auto has_up) {
     const int16_t* d = disparity_16.ptr<int16_t>(y);
     const int16_t* up = has_up ? disparity_16.ptr<int16_t>(y - 1) : nullptr;
+    const int16_t* step_left = steps ? step_left_16.ptr<int16_t>(y) : nullptr;
+    const int16_t* step_up = steps ? step_up_16.ptr<int16_t>(y) : nullptr;
     int32_t* l = label.get() + size_t(y) * w;
     const int32_t* lu = l - (has_up ? w : 0);
     int32_t left = 0;
@@ -105,10 +113,10 @@ void FilterSpeckles16(cv::Mat disparity_16, int16_t invalid, int max_blob_px, in
         l[x] = left = 0;
         continue;
       }
-      int32_t mine = left != 0 && near(v, left_v) ? left : 0;
+      int32_t mine = left != 0 && near(v - (steps ? step_left[x] : 0), left_v) ? left : 0;
       if constexpr (decltype(has_up)::value) {
         const int32_t u = lu[x];
-        if (u != 0 && near(v, up[x])) mine = mine == 0 || mine == u ? u : sets.Join(mine, u);
+        if (u != 0 && near(v - (steps ? step_up[x] : 0), up[x])) mine = mine == 0 || mine == u ? u : sets.Join(mine, u);
       }
       if (mine == 0) mine = sets.New();
       l[x] = left = mine;
@@ -137,7 +145,11 @@ void FilterSpeckles16(cv::Mat disparity_16, int16_t invalid, int max_blob_px, in
   }
 }
 
-void RemoveSpeckleBlobs(cv::Mat disparity_px, int max_blob_px, double max_diff_px) {
+namespace {
+
+// RemoveSpeckleBlobs, with FilterSpeckles16's steps (empty: none).
+void RemoveBlobs(cv::Mat disparity_px, int max_blob_px, double max_diff_px, const cv::Mat& step_left_16,
+                 const cv::Mat& step_up_16) {
   STEREORIG_CHECK(disparity_px.type() == CV_32FC1 && max_diff_px >= 0);
   // In sixteenths; 4096 px already joins any two 16-bit values.
   const int max_diff_16 = int(std::lround(std::min(max_diff_px, 4096.0) * 16));
@@ -145,13 +157,49 @@ void RemoveSpeckleBlobs(cv::Mat disparity_px, int max_blob_px, double max_diff_p
   cv::Mat fixed(disparity_px.size(), CV_16SC1);
   for (int y = 0; y < disparity_px.rows; ++y)
     ToSixteenths(disparity_px.ptr<float>(y), disparity_px.cols, kInvalid, fixed.ptr<int16_t>(y));
-  FilterSpeckles16(fixed, kInvalid, max_blob_px, max_diff_16);
+  FilterSpeckles16(fixed, kInvalid, max_blob_px, max_diff_16, step_left_16, step_up_16);
   for (int y = 0; y < disparity_px.rows; ++y) {
     float* d = disparity_px.ptr<float>(y);
     const int16_t* f = fixed.ptr<int16_t>(y);
     for (int x = 0; x < disparity_px.cols; ++x)
       if (f[x] == kInvalid) d[x] = std::numeric_limits<float>::infinity();
   }
+}
+
+}  // namespace
+
+void RemoveSpeckleBlobs(cv::Mat disparity_px, int max_blob_px, double max_diff_px) {
+  RemoveBlobs(disparity_px, max_blob_px, max_diff_px, cv::Mat(), cv::Mat());
+}
+
+void RemoveSpeckleBlobsAlongSlopes(cv::Mat disparity_px, const cv::Mat& slope_x, const cv::Mat& slope_y,
+                                   int max_blob_px, double max_diff_px) {
+  STEREORIG_CHECK(slope_x.type() == CV_32FC1 && slope_y.type() == CV_32FC1 && slope_x.size() == disparity_px.size() &&
+                  slope_y.size() == disparity_px.size());
+  if (max_blob_px <= 0 || disparity_px.empty()) return;
+  // The step from the left (upper) neighbour a to b, in sixteenths: their
+  // mean slope where each one's slope steps beyond the reach, the same way
+  // (|slope| <= 2000 px/px keeps it within 16 bits); else 0.
+  const double reach_16 = double(std::lround(std::min(max_diff_px, 4096.0) * 16));
+  auto sixteenths = [&](float a, float b) {
+    const double a_16 = 16.0 * double(a), b_16 = 16.0 * double(b);
+    const bool steep = (a_16 > reach_16 && b_16 > reach_16) || (a_16 < -reach_16 && b_16 < -reach_16);
+    if (!steep || !std::isfinite(a_16 + b_16)) return int16_t(0);
+    return int16_t(std::lround(std::clamp(0.5 * (a_16 + b_16), -32000.0, 32000.0)));
+  };
+  cv::Mat step_left(disparity_px.size(), CV_16SC1, cv::Scalar(0)),
+      step_up(disparity_px.size(), CV_16SC1, cv::Scalar(0));
+  for (int y = 0; y < disparity_px.rows; ++y) {
+    const float* gx = slope_x.ptr<float>(y);
+    const float* gy = slope_y.ptr<float>(y);
+    const float* gy_up = y > 0 ? slope_y.ptr<float>(y - 1) : nullptr;
+    int16_t* left = step_left.ptr<int16_t>(y);
+    int16_t* up = step_up.ptr<int16_t>(y);
+    for (int x = 1; x < disparity_px.cols; ++x) left[x] = sixteenths(gx[x - 1], gx[x]);
+    if (gy_up)
+      for (int x = 0; x < disparity_px.cols; ++x) up[x] = sixteenths(gy_up[x], gy[x]);
+  }
+  RemoveBlobs(disparity_px, max_blob_px, max_diff_px, step_left, step_up);
 }
 
 }  // namespace stereorig

@@ -147,5 +147,55 @@ TEST(RemoveSpeckleBlobs, RoundsHalvesAwayFromZeroAndClamps) {
     }
 }
 
+// A surface steeper than the reach: dd/dx = -1.6 px/px (the ring's oblique
+// plate), 40 x 30 px with 0.1 px of noise. The plain test (reach 1 px) never
+// joins two row neighbours there, so every column is a blob of 30 px and a
+// window of 100 removes it all; along the slopes it is one blob, and a
+// 5 x 5 patch on it a grid period (8 px) off, with the same slopes, is
+// still its own blob and goes.
+TEST(RemoveSpeckleBlobsAlongSlopes, KeepsASurfaceSteeperThanTheReach) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> noise(-0.1f, 0.1f);
+  cv::Mat map(30, 40, CV_32FC1), slope_x(map.size(), CV_32FC1, cv::Scalar(-1.6)),
+      slope_y(map.size(), CV_32FC1, cv::Scalar(0.02));
+  for (int y = 0; y < map.rows; ++y)
+    for (int x = 0; x < map.cols; ++x) map.at<float>(y, x) = 100 - 1.6f * x + 0.02f * y + noise(rng);
+  map(cv::Rect(20, 10, 5, 5)) += 8;
+  cv::Mat plain = map.clone(), along = map.clone();
+  RemoveSpeckleBlobs(plain, 100, 1.0);
+  RemoveSpeckleBlobsAlongSlopes(along, slope_x, slope_y, 100, 1.0);
+  EXPECT_EQ(cv::countNonZero(plain == map), 0) << "the plain test cuts the surface into strips";
+  const cv::Mat kept = along == map;
+  EXPECT_EQ(cv::countNonZero(kept), int(map.total()) - 25);
+  EXPECT_EQ(cv::countNonZero(kept(cv::Rect(20, 10, 5, 5))), 0) << "the patch a period off";
+}
+
+// Where every predicted step is within the reach (|slopes| < 0.5 px/px,
+// their sum's step < 1 px), the filter is RemoveSpeckleBlobs, bit for bit,
+// on random blob maps.
+TEST(RemoveSpeckleBlobsAlongSlopes, IsThePlainFilterWhereTheSlopesAreWithinTheReach) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> level(-30, 30), jitter(-0.6f, 0.6f), slope(-0.49f, 0.49f);
+  std::uniform_int_distribution<int> percent(0, 99);
+  int removed = 0;
+  for (const cv::Size size : {cv::Size(101, 37), cv::Size(16, 9)}) {
+    cv::Mat map(size, CV_32FC1), slope_x(size, CV_32FC1), slope_y(size, CV_32FC1);
+    for (int y = 0; y < size.height; ++y)
+      for (int x = 0; x < size.width; ++x) {
+        const int p = percent(rng);
+        map.at<float>(y, x) = p < 10 ? std::numeric_limits<float>::infinity()
+                                     : level(rng) * float((x / 5 + y / 4) % 3 != 0) + jitter(rng);
+        slope_x.at<float>(y, x) = slope(rng);
+        slope_y.at<float>(y, x) = slope(rng);
+      }
+    cv::Mat plain = map.clone(), along = map.clone();
+    RemoveSpeckleBlobs(plain, 20, 1.0);
+    RemoveSpeckleBlobsAlongSlopes(along, slope_x, slope_y, 20, 1.0);
+    ASSERT_EQ(cv::countNonZero(plain != along), 0) << size;
+    removed += cv::countNonZero(plain != map);
+  }
+  EXPECT_GT(removed, 100);
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -47,9 +47,10 @@ std::string SimulateScenes(const std::vector<std::string>& scenes, int seed, dou
 // Reconstructs `scene`'s active capture of `dataset` with its truth rig and
 // default options, scores it (as RuntimeOnSimulatedScenes::Run) and prints
 // each module's figures after `label`.
-SceneScore ReconstructAndScore(const std::string& dataset, const std::string& scene, const std::string& label) {
+SceneScore ReconstructAndScore(const std::string& dataset, const std::string& scene, const std::string& label,
+                               const RuntimeOptions& options = RuntimeOptions{}) {
   const Rig rig = ReadRigFile(dataset + "/truth/rig.yaml");
-  const Runtime runtime(rig, RuntimeOptions{});
+  const Runtime runtime(rig, options);
   const Reconstruction rec = runtime.Process(LoadCapture(dataset + "/scenes/" + scene + "/active", rig), false);
   const SceneScore s = ScoreScene(runtime, rec, ReadSceneTruth(dataset, scene));
   for (size_t m = 0; m < s.fill.size(); ++m) {
@@ -224,17 +225,23 @@ TEST(RuntimeOnAFreshRealization, BallBarAndPlateMeetTheAccuracyTargets) {
 // 0.033 / 0.034 / 0.031 mm, std 0.043 / 0.044 / 0.039 mm, fill 0.922 / 0.895
 // / 0.901 (`stereorig score` on the same realization); fill asserted ~3
 // points under that, as above.
-TEST(RuntimeOnAThreeModuleRig, EveryModuleMeetsTheAccuracyTargetsInOneFrame) {
+// The default spec with a third module: module 1's cameras and projector
+// copied, modules 1 and 2 at +-120 degrees around the object.
+SimSpec ThreeModuleRingSpec() {
   SimSpec spec = DefaultSimSpec();
-  ASSERT_EQ(spec.modules.size(), 2u);
+  EXPECT_EQ(spec.modules.size(), 2u);
   spec.modules.push_back(spec.modules[1]);
   for (int m = 1; m < 3; ++m) {
     const double a = 2 * M_PI * m / 3;
     spec.modules[m].name = "module" + std::to_string(m);
     spec.modules[m].center_mm = Eigen::Vector3d(200 * std::sin(a), 0, -200 * std::cos(a));
   }
+  return spec;
+}
+
+TEST(RuntimeOnAThreeModuleRig, EveryModuleMeetsTheAccuracyTargetsInOneFrame) {
   const std::string dataset =
-      SimulateScenes({"cup"}, 11, DefaultSimSpec().render.speckle_contrast, "runtime_e2e_ring3", spec);
+      SimulateScenes({"cup"}, 11, DefaultSimSpec().render.speckle_contrast, "runtime_e2e_ring3", ThreeModuleRingSpec());
   const SceneScore s = ReconstructAndScore(dataset, "cup", "three modules, cup");
   ASSERT_EQ(s.fill.size(), 3u);  // the truth rig has three modules, each scored
   for (size_t m = 0; m < 3; ++m) {
@@ -244,6 +251,32 @@ TEST(RuntimeOnAThreeModuleRig, EveryModuleMeetsTheAccuracyTargetsInOneFrame) {
     EXPECT_GT(s.fill[m].fill(), 0.86) << "module " << m;
   }
   EXPECT_LT(s.accuracy.all.mean_abs_mm, 0.15);  // three modules merged
+}
+
+// The plate on the ring faces modules 1 and 2 at ~60 degrees (its yaw is
+// random within +-10 degrees); in this realization (seed 4, the plate
+// alone) module 1's left camera grazes it: dd/dx ~ -1.6 px/px, the right
+// view 2.6x as wide as the left. With default options module 1 keeps no
+// point (the speckle filter's 1 px reach cuts that slope into one-pixel
+// strips, each removed); with match.speckle_along_slopes it is one
+// surface. Measured with it (~7 s): fill 0.620, mean |e| 0.027 mm, std
+// 0.126 mm. Issue 5's std target (0.1 mm) is not met and not asserted: the
+// CLI's realization of this spec and seed (`stereorig simulate`, `score
+// --diagnose`: fill 0.647, std 0.216 mm) has 1.45 % of its points > 1 px
+// off (a band along the plate's right edge 0.4-0.7 px low, scattered
+// mismatches), the rest 0.16 px from the truth on average. Asserted: the
+// mean |e| target (0.1 mm: the default speckle's ~0.25 px of disparity
+// noise is ~0.1 mm at 200 mm, ExpectModuleFigures), and the fill ~5 points
+// under what it measures, as above.
+TEST(RuntimeOnAThreeModuleRig, APlateTheLeftCameraGrazesIsMeasuredAlongItsSlope) {
+  const std::string dataset = SimulateScenes({"plate"}, 4, DefaultSimSpec().render.speckle_contrast,
+                                             "runtime_e2e_ring3_plate", ThreeModuleRingSpec());
+  RuntimeOptions options;
+  options.match.speckle_along_slopes = true;
+  const SceneScore s = ReconstructAndScore(dataset, "plate", "three modules, plate", options);
+  ASSERT_EQ(s.fill.size(), 3u);
+  EXPECT_GT(s.fill[1].fill(), 0.57);
+  EXPECT_LT(s.accuracy.per_module[1].mean_abs_mm, 0.1);
 }
 
 }  // namespace
