@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -44,47 +43,6 @@ std::string FilledLine(const ErrorFigures& f) {
   return buf;
 }
 
-// The folders of --diagnose that do not exist yet: checked before anything
-// is read (the nearest existing part of the path a folder), created only
-// once every input has been checked and read (Create), and removed again,
-// while still empty, if the command fails after that (a scene that is not in
-// the dataset): bad input leaves no new folder behind.
-class DiagnoseFolder {
- public:
-  explicit DiagnoseFolder(const std::string& dir) : dir_(dir) {
-    namespace fs = std::filesystem;
-    if (dir.empty()) return;
-    OutputPaths().ClaimFolder(dir, "the diagnosis images (--diagnose)");
-    for (fs::path p = fs::weakly_canonical(fs::absolute(dir)); !p.empty() && !fs::exists(p); p = p.parent_path())
-      missing_.insert(missing_.begin(), p);  // outermost first
-  }
-  // Whether `folder` is one that Create will make (the report may go in it).
-  bool WillCreate(const std::filesystem::path& folder) const {
-    const auto key = std::filesystem::weakly_canonical(std::filesystem::absolute(folder));
-    return std::find(missing_.begin(), missing_.end(), key) != missing_.end();
-  }
-  void Create() {
-    if (dir_.empty()) return;
-    std::error_code ec;
-    std::filesystem::create_directories(dir_, ec);
-    if (ec || !std::filesystem::is_directory(dir_))
-      throw InputError(dir_, "--diagnose: cannot create this folder (" + ec.message() + ")");
-    created_ = true;
-  }
-  ~DiagnoseFolder() {
-    if (!created_ || std::uncaught_exceptions() <= exceptions_) return;  // not failing
-    std::error_code ec;  // a folder not empty stays, and so do its parents
-    auto p = missing_.rbegin();
-    while (p != missing_.rend() && std::filesystem::remove(*p, ec)) ++p;
-  }
-
- private:
-  std::string dir_;
-  std::vector<std::filesystem::path> missing_;  // outermost first
-  bool created_ = false;
-  int exceptions_ = std::uncaught_exceptions();
-};
-
 }  // namespace
 
 int RunScore(int argc, char** argv) {
@@ -122,7 +80,10 @@ int RunScore(int argc, char** argv) {
   }
   // Before any work: an unusable --diagnose folder is bad input, not a crash
   // at the end; but it is created only after every input check below.
-  DiagnoseFolder diagnose(diagnose_dir);
+  // (apps/output_paths.h FolderToCreate: removed again, while empty, if the
+  // run fails after it is made.)
+  FolderToCreate diagnose;
+  if (!diagnose_dir.empty()) diagnose = OutputPaths().ClaimFolder(diagnose_dir, "the diagnosis images (--diagnose)");
   // Before anything is read: the report, not over the rig, the options or
   // any file of the dataset the scorer reads (its folder may be one
   // --diagnose will create); once the rig says how many modules, the
