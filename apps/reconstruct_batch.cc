@@ -216,6 +216,10 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
               all_ms / 1000, summary["objects_per_s"].get<double>());
   if (!request.summary_path.empty()) WriteFileAtomically(request.summary_path, summary.dump(2) + "\n");
   if (failed > 0) {
+    // Every capture failed and nothing was written in it (no summary
+    // there): a new output folder goes again, as bad input found earlier
+    // leaves none.
+    out_folder.RemoveIfEmpty();
     std::fprintf(stderr,
                  "stereorig reconstruct: %d of %zu captures failed (bad input, or outputs that could not be "
                  "written) and have no output\n",

@@ -543,6 +543,35 @@ TEST_F(ReconstructCli, ABatchWritesEachCapturesOwnCloudAndSkipsABrokenOne) {
   EXPECT_NE(summary["captures"][1]["error"].get<std::string>().find("0002/cam1.png"), std::string::npos);
 }
 
+// A batch whose every capture is broken in a way found only when decoded
+// (a PNG cut short, one that is not a PNG) exits 2 and leaves no new
+// --out-dir behind, nor the missing folders above it (FolderToCreate,
+// apps/output_paths.h); the batch used to leave them, empty. A folder that
+// was there before stays, and so does one holding another capture's output
+// (ABatchWritesEachCapturesOwnCloudAndSkipsABrokenOne).
+TEST_F(ReconstructCli, ABatchWhoseEveryCaptureFailsLeavesNoNewFolder) {
+  const std::string cut = BrokenCapture("batch_all_cut"), junk = BrokenCapture("batch_all_junk");
+  {
+    std::ifstream in(dir_ + "/capture/cam2.png", std::ios::binary);
+    std::string bytes(std::istreambuf_iterator<char>(in), {});
+    WriteFileAtomically(cut + "/cam2.png", bytes.substr(0, bytes.size() / 2));
+  }
+  WriteFileAtomically(junk + "/cam1.png", "not a png");
+  const std::string head = "reconstruct --rig " + dir_ + "/rig.yaml --capture " + cut + " " + junk + " --out-dir ";
+  const std::string fresh = dir_ + "/batch_all_new";
+  std::filesystem::remove_all(fresh);
+  const testing::Result r = testing::RunCli(head + fresh + "/deeper");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("batch_all_cut/cam2.png"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("batch_all_junk/cam1.png"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(fresh)) << "bad input left the --out-dir folder behind";
+  const std::string existing = dir_ + "/batch_all_existing";
+  std::filesystem::remove_all(existing);
+  std::filesystem::create_directories(existing);
+  EXPECT_EQ(RunCli(head + existing), 2);
+  EXPECT_TRUE(std::filesystem::is_directory(existing)) << "a folder that was there before was removed";
+}
+
 // A capture whose outputs cannot be written has none, not a partial nor a
 // stale one, and the batch goes on. The trigger: a 236-character folder
 // name. Its outputs' names are valid (the longest, "<name>.mesh.stl", 245
