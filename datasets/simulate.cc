@@ -231,7 +231,10 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
       MakeProjectors(spec, sr.world_from_projector, sr.projector_distance_mm);
 
   // --- the output folder: a sibling temporary, renamed at the end
-  const fs::path out = fs::absolute(fs::path(options.out_dir)).lexically_normal();
+  fs::path out = fs::absolute(fs::path(options.out_dir)).lexically_normal();
+  // "ds/" (or ".") normalises to a path ending in a separator, whose parent
+  // is the folder itself: renaming it into place would then fail.
+  if (!out.has_filename()) out = out.parent_path();
   const fs::path parent = out.parent_path();
   std::error_code ec;
   fs::create_directories(parent, ec);
