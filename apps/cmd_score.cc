@@ -93,10 +93,14 @@ int RunScore(int argc, char** argv) {
   const bool check_report_folder = report_path.empty() || !diagnose.WillCreate(fs::absolute(report_path).parent_path());
   ClaimRuntimeReport(report_path, rig_path, options_path, check_report_folder, rig_what, dataset_inputs);
   const Rig rig = ReadRigFile(rig_path);
+  std::vector<std::string> scenes;
+  {
+    std::stringstream list(scenes_arg);
+    for (std::string name; std::getline(list, name, ',');) scenes.push_back(name);
+  }
   std::vector<std::pair<std::string, std::string>> diagnosis_images;
   if (!diagnose_dir.empty()) {
-    std::stringstream list(scenes_arg);
-    for (std::string name; std::getline(list, name, ',');)
+    for (const std::string& name : scenes)
       for (int m = 0; m < rig.num_modules(); ++m)
         for (const std::string& path : FillDiagnosisImagePaths(FillDiagnosisPrefix(diagnose_dir, name, m)))
           diagnosis_images.push_back({path, "a diagnosis image (--diagnose)"});
@@ -104,6 +108,17 @@ int RunScore(int argc, char** argv) {
   if (!diagnosis_images.empty())
     ClaimRuntimeReport(report_path, rig_path, options_path, check_report_folder, rig_what, dataset_inputs,
                        diagnosis_images);
+  // Every scene named is in the dataset, with its capture's files and its
+  // truth, before any is scored: a scene misnamed after others in --scenes
+  // used to be found only once they were scored, their diagnosis images
+  // left in a new --diagnose folder.
+  for (const std::string& name : scenes) {
+    const fs::path scene_dir = fs::path(dataset) / "scenes" / name;
+    if (!fs::is_directory(scene_dir)) throw InputError(scene_dir.string(), "no such scene in the dataset (--scenes)");
+    CheckCaptureFiles((scene_dir / "active").string(), rig);
+    const fs::path surface = fs::path(dataset) / "truth" / "scenes" / name / "surface.ply";
+    if (!fs::is_regular_file(surface)) throw InputError(surface.string(), "no such file (the scene's truth)");
+  }
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
   RuntimeOptions passive_options = options;
   // No grid: the whole volume's ROI, and no test of the grid's period.
@@ -118,8 +133,7 @@ int RunScore(int argc, char** argv) {
     text << spec.rdbuf();
     report["spec_yaml"] = text.str();
   }
-  std::stringstream ss(scenes_arg);
-  for (std::string name; std::getline(ss, name, ',');) {
+  for (const std::string& name : scenes) {
     const fs::path scene_dir = fs::path(dataset) / "scenes" / name;
     const SceneTruth truth = ReadSceneTruth(dataset, name);
     // Hole filling runs with the mesh: only when the options ask for it.
