@@ -246,6 +246,25 @@ TEST(Cli, RigExportRefusesAFolderOverItsInputsBeforeAnyWork) {
   EXPECT_NE(e.err.find("camera 1's name \"../cam1\" is not a plain file name"), std::string::npos) << e.err;
   EXPECT_FALSE(fs::exists(dir + "/esc/models/cam0.cameramodel"));
   EXPECT_FALSE(fs::exists(dir + "/esc/cam1.cameramodel"));
+  EXPECT_FALSE(fs::exists(dir + "/esc"));
+}
+
+// A models' folder that cannot be made (a name longer than the file
+// system's 255 characters) exits 2 in one line naming it, and the folder
+// above it that was made on the way is removed again (FolderToCreate,
+// apps/output_paths.h); it used to stay, empty.
+TEST(Cli, RigExportToAFolderThatCannotBeMadeLeavesNoFolder) {
+  namespace fs = std::filesystem;
+  const std::string dir = ::testing::TempDir() + "/cli_export_long";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir + "/rig.yaml") << GoodRigText();
+  const std::string folder = dir + "/new/" + std::string(300, 'x');
+  const Result r = RunCli("rig --rig " + dir + "/rig.yaml --export-cameramodels " + folder);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(folder + ": cannot create this folder"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/new")) << "the folder made on the way was left behind";
 }
 
 }  // namespace

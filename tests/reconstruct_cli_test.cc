@@ -437,6 +437,9 @@ TEST_F(ReconstructCli, ScoreBadInputLeavesNoDiagnoseFolder) {
       {score + " --scenes cup --report " + diag + "/deeper/cup_m0_left.png", "cup_m0_left.png: would be written twice"},
       {score + " --scenes no_such_scene", "scenes/no_such_scene: no such scene in the dataset"},
       {score + " --scenes broken", "broken/surface.ply"},
+      // Checked, but too long a name for the file system: made in part.
+      {"score --dataset " + d + " --no-passive --scenes broken --diagnose " + diag + "/" + std::string(300, 'x'),
+       "cannot create this folder for the diagnosis images (--diagnose)"},
       {"score --dataset " + d + " --scenes cup --diagnose " + dir_ + "/rig.yaml/diag", "rig.yaml is a file"}};
   for (const auto& [args, says] : cases) {
     std::filesystem::remove_all(diag);
@@ -607,6 +610,23 @@ TEST_F(ReconstructCli, ABatchWhoseEveryCaptureFailsLeavesNoNewFolder) {
   std::filesystem::create_directories(existing);
   EXPECT_EQ(RunCli(head + existing), 2);
   EXPECT_TRUE(std::filesystem::is_directory(existing)) << "a folder that was there before was removed";
+}
+
+// An --out-dir that cannot be made (a name longer than the file system's
+// 255 characters) exits 2 in one line naming it, once the runtime is
+// built, and the folder made above it on the way is removed again; it used
+// to stay, empty.
+TEST_F(ReconstructCli, ABatchOutDirThatCannotBeMadeLeavesNoFolder) {
+  const std::string fresh = dir_ + "/batch_long";
+  std::filesystem::remove_all(fresh);
+  const std::string out = fresh + "/" + std::string(300, 'x');
+  const testing::Result r =
+      testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture --out-dir " + out);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(out + ": cannot create this folder for the output folder (--out-dir)"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(fresh)) << "the folder made on the way was left behind";
 }
 
 // A capture whose outputs cannot be written has none, not a partial nor a
