@@ -1,8 +1,5 @@
 #include "apps/output_paths.h"
 
-#include <algorithm>
-#include <utility>
-
 #include "calib/core/capture_image_name.h"
 #include "calib/core/input_error.h"
 
@@ -87,57 +84,7 @@ FolderToCreate OutputPaths::ClaimFolder(const std::string& path, const std::stri
     if (p == p.root_path()) break;
   }
   claimed_.emplace(key, what);
-  std::vector<fs::path> missing;
-  for (fs::path p = key; !p.empty() && !fs::exists(p); p = p.parent_path()) {
-    missing.insert(missing.begin(), p);  // outermost first
-    if (p == p.root_path()) break;
-  }
-  return FolderToCreate(path, what, std::move(missing));
-}
-
-FolderToCreate::FolderToCreate(FolderToCreate&& other) noexcept
-    : path_(std::move(other.path_)),
-      what_(std::move(other.what_)),
-      missing_(std::move(other.missing_)),
-      created_(std::exchange(other.created_, false)),
-      exceptions_(other.exceptions_) {}
-
-FolderToCreate& FolderToCreate::operator=(FolderToCreate&& other) noexcept {
-  if (this != &other) {
-    path_ = std::move(other.path_);
-    what_ = std::move(other.what_);
-    missing_ = std::move(other.missing_);
-    created_ = std::exchange(other.created_, false);
-    exceptions_ = other.exceptions_;
-  }
-  return *this;
-}
-
-FolderToCreate::~FolderToCreate() {
-  if (std::uncaught_exceptions() > exceptions_) RemoveIfEmpty();  // failing
-}
-
-bool FolderToCreate::WillCreate(const std::filesystem::path& folder) const {
-  return std::find(missing_.begin(), missing_.end(), Key(folder.string())) != missing_.end();
-}
-
-void FolderToCreate::Create() {
-  if (path_.empty()) return;
-  created_ = true;  // before: a failure part way leaves folders to remove
-  std::error_code ec;
-  std::filesystem::create_directories(path_, ec);
-  if (ec || !std::filesystem::is_directory(path_))
-    throw InputError(path_, "cannot create this folder for " + what_ + (ec ? ": " + ec.message() : ""));
-}
-
-void FolderToCreate::RemoveIfEmpty() {
-  if (!created_) return;
-  created_ = false;
-  std::error_code ec;
-  for (auto p = missing_.rbegin(); p != missing_.rend(); ++p) {  // innermost first
-    if (!std::filesystem::exists(*p, ec)) continue;              // not made (Create failed part way)
-    if (!std::filesystem::remove(*p, ec)) break;                 // not empty: it and the folders above it stay
-  }
+  return FolderToCreate(path, what);
 }
 
 }  // namespace stereorig

@@ -1,4 +1,4 @@
-#include "apps/output_paths.h"
+#include "calib/core/folder_to_create.h"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +12,7 @@ namespace fs = std::filesystem;
 
 // A fresh scratch folder for one test.
 std::string Scratch(const std::string& name) {
-  const std::string dir = ::testing::TempDir() + "/output_paths_" + name;
+  const std::string dir = ::testing::TempDir() + "/folder_to_create_" + name;
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -24,7 +24,7 @@ std::string Scratch(const std::string& name) {
 TEST(FolderToCreate, AFailureRemovesWhatItCreatedAndNothingElse) {
   const std::string dir = Scratch("fail");
   try {
-    FolderToCreate folder = OutputPaths().ClaimFolder(dir + "/a/b/c", "the test folder");
+    FolderToCreate folder(dir + "/a/b/c", "the test folder");
     EXPECT_TRUE(folder.WillCreate(dir + "/a"));
     EXPECT_TRUE(folder.WillCreate(dir + "/a/b/c"));
     EXPECT_FALSE(folder.WillCreate(dir));
@@ -43,7 +43,7 @@ TEST(FolderToCreate, AFailureRemovesWhatItCreatedAndNothingElse) {
 TEST(FolderToCreate, WhatHoldsAFileOrExistedBeforeStays) {
   const std::string dir = Scratch("stays");
   {
-    FolderToCreate folder = OutputPaths().ClaimFolder(dir + "/a/b", "the test folder");
+    FolderToCreate folder(dir + "/a/b", "the test folder");
     folder.Create();
     std::ofstream(dir + "/a/b/written.txt") << "written before the failure\n";
     folder.RemoveIfEmpty();
@@ -51,25 +51,26 @@ TEST(FolderToCreate, WhatHoldsAFileOrExistedBeforeStays) {
   EXPECT_TRUE(fs::exists(dir + "/a/b/written.txt"));
   fs::create_directories(dir + "/existing");
   {
-    FolderToCreate folder = OutputPaths().ClaimFolder(dir + "/existing", "the test folder");
+    FolderToCreate folder(dir + "/existing", "the test folder");
     EXPECT_FALSE(folder.WillCreate(dir + "/existing"));
     folder.Create();
     folder.RemoveIfEmpty();
   }
   EXPECT_TRUE(fs::is_directory(dir + "/existing"));
   {
-    FolderToCreate folder = OutputPaths().ClaimFolder(dir + "/ok", "the test folder");
+    FolderToCreate folder(dir + "/ok", "the test folder");
     folder.Create();
   }
   EXPECT_TRUE(fs::is_directory(dir + "/ok"));
 }
 
-// Moved (as ClaimFolder's result is), only the last owner removes.
+// Moved (as OutputPaths::ClaimFolder's result is), only the last owner
+// removes.
 TEST(FolderToCreate, AMovedFromObjectRemovesNothing) {
   const std::string dir = Scratch("moved");
   FolderToCreate kept;
   {
-    FolderToCreate folder = OutputPaths().ClaimFolder(dir + "/a", "the test folder");
+    FolderToCreate folder(dir + "/a", "the test folder");
     folder.Create();
     kept = std::move(folder);
     folder.RemoveIfEmpty();  // moved from: nothing to remove
