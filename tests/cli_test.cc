@@ -187,6 +187,29 @@ TEST(Cli, EverySubcommandsHelpTeachesWithAnExample) {
   }
 }
 
+// demo's --out is made before any step: under a file it is refused naming
+// the file, and one that cannot be made (a name longer than the file
+// system's 255 characters) leaves none of the folders made on the way (it
+// used to leave them, empty). Exit 2, one line, no step run.
+TEST(Cli, DemoOutThatCannotBeMadeLeavesNoFolder) {
+  namespace fs = std::filesystem;
+  const std::string dir = ::testing::TempDir() + "/cli_demo_out";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir + "/a_file") << "not a folder\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {dir + "/a_file/demo", "/a_file is a file, not a folder for everything the demo writes (--out)"},
+      {dir + "/new/" + std::string(300, 'x'), "File name too long"}};
+  for (const auto& [out, says] : cases) {
+    const Result r = RunCli("demo --out " + out);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_EQ(r.out.find("$ stereorig"), std::string::npos) << "a step ran: " << r.out;
+  }
+  EXPECT_FALSE(fs::exists(dir + "/new")) << "the folder made on the way was left behind";
+}
+
 TEST(Cli, RigExportWritesCameramodelsThatRoundTrip) {
   const std::string dir = ::testing::TempDir() + "/cli_export";
   std::filesystem::remove_all(dir);

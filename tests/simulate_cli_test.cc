@@ -58,6 +58,26 @@ TEST(SimulateCli, AnOutFolderWithATrailingSlashIsWritten) {
   }
 }
 
+// An --out that cannot be made (a name longer than the file system's 255
+// characters: the folder itself, or the temporary beside it, ".<name>.tmp-
+// <pid>") exits 2 in one line naming it, and the folders made above it on the
+// way are removed again (FolderToCreate, calib/core/folder_to_create.h); they
+// used to stay, empty.
+TEST(SimulateCli, AnOutThatCannotBeMadeLeavesNoFolder) {
+  const std::string dir = ::testing::TempDir() + "/sim_long";
+  fs::remove_all(dir);
+  const std::pair<std::string, std::string> cases[] = {{dir + "/new/" + std::string(300, 'x') + "/ds", "xxx"},
+                                                       {dir + "/new/" + std::string(250, 'y'), "/.yyy"}};
+  for (const auto& [out, says] : cases) {
+    const Result r = RunCli("simulate --out " + out + " --calibration-captures 1 --no-scenes");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("File name too long"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir + "/new")) << "the folder made on the way was left behind: " << out.substr(0, 80);
+  }
+}
+
 // --write-default-spec is checked like every command's output
 // (apps/output_paths.h): over the --spec file given with it (an edited spec
 // replaced by the default), directly or through a symbolic link, at a
