@@ -80,8 +80,8 @@ int RunScore(int argc, char** argv) {
   }
   // Before any work: an unusable --diagnose folder is bad input, not a crash
   // at the end; but it is created only after every input check below.
-  // (apps/output_paths.h FolderToCreate: removed again, while empty, if the
-  // run fails after it is made.)
+  // (FolderToCreate, calib/core/folder_to_create.h: removed again, while
+  // empty, if the run fails after it is made.)
   FolderToCreate diagnose;
   if (!diagnose_dir.empty()) diagnose = OutputPaths().ClaimFolder(diagnose_dir, "the diagnosis images (--diagnose)");
   // Before anything is read: the report, not over the rig, the options or

@@ -275,7 +275,7 @@ TEST(Cli, RigExportRefusesAFolderOverItsInputsBeforeAnyWork) {
 // A models' folder that cannot be made (a name longer than the file
 // system's 255 characters) exits 2 in one line naming it, and the folder
 // above it that was made on the way is removed again (FolderToCreate,
-// apps/output_paths.h); it used to stay, empty.
+// calib/core/folder_to_create.h); it used to stay, empty.
 TEST(Cli, RigExportToAFolderThatCannotBeMadeLeavesNoFolder) {
   namespace fs = std::filesystem;
   const std::string dir = ::testing::TempDir() + "/cli_export_long";

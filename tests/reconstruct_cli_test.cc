@@ -586,7 +586,7 @@ TEST_F(ReconstructCli, ABatchWritesEachCapturesOwnCloudAndSkipsABrokenOne) {
 // A batch whose every capture is broken in a way found only when decoded
 // (a PNG cut short, one that is not a PNG) exits 2 and leaves no new
 // --out-dir behind, nor the missing folders above it (FolderToCreate,
-// apps/output_paths.h); the batch used to leave them, empty. A folder that
+// calib/core/folder_to_create.h); the batch used to leave them, empty. A folder that
 // was there before stays, and so does one holding another capture's output
 // (ABatchWritesEachCapturesOwnCloudAndSkipsABrokenOne).
 TEST_F(ReconstructCli, ABatchWhoseEveryCaptureFailsLeavesNoNewFolder) {
