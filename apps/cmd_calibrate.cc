@@ -11,7 +11,6 @@
 #include "apps/output_paths.h"
 #include "calib/calibrate.h"
 #include "calib/capture_folder.h"
-#include "calib/core/input_error.h"
 #include "calib/layout_file.h"
 
 namespace stereorig {
@@ -64,8 +63,9 @@ int RunCalibrate(int argc, char** argv) {
   for (const std::string& image : CaptureFolderImages(captures)) outputs.Protect(image, "a capture image (--captures)");
   outputs.Claim(out_path, "the rig file (--out)");
   outputs.Claim(report_path, "the report (--report)");
+  FolderToCreate models_folder;  // made once the calibration has succeeded
   if (!cameramodels_dir.empty()) {
-    outputs.ClaimFolder(cameramodels_dir, "the camera models (--export-cameramodels)");
+    models_folder = outputs.ClaimFolder(cameramodels_dir, "the camera models (--export-cameramodels)");
     // Each model file too (camK.cameramodel for every camera of the layout):
     // a rig file named DIR/cam0.cameramodel would be replaced by a model.
     for (int k = 0, n = LayoutCameraCount(ReadLayoutFile(layout_path)); k < n; ++k)
@@ -75,13 +75,11 @@ int RunCalibrate(int argc, char** argv) {
 
   const FolderCalibration folder = CalibrateCaptureFolder(captures, target_path, layout_path, options);
   const CalibrationResult& result = folder.result;
+  // The models' folder first: one that cannot be made leaves no rig file
+  // or report behind either.
+  models_folder.Create();
   WriteCalibrationOutputs(result, out_path, report_path);
-  if (!cameramodels_dir.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(cameramodels_dir, ec);
-    if (ec) throw InputError(cameramodels_dir, "cannot create the folder: " + ec.message());
-    ExportCameramodels(result.rig, cameramodels_dir);
-  }
+  if (!cameramodels_dir.empty()) ExportCameramodels(result.rig, cameramodels_dir);
   std::printf("%s", SummaryText(result.report).c_str());
   std::printf("wrote %s and %s\n", out_path.c_str(), report_path.c_str());
   return 0;

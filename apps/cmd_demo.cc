@@ -8,6 +8,7 @@
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
+#include "apps/output_paths.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 
@@ -57,9 +58,10 @@ int RunDemo(int argc, char** argv) {
   app.add_option("--seed", seed, "simulator seed")->capture_default_str();
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 
-  std::error_code ec;
-  std::filesystem::create_directories(out, ec);
-  if (ec) throw InputError(out, "cannot create folder: " + ec.message());
+  // Made at once (nothing after this is bad input), and, if it cannot be
+  // made, none of it left (apps/output_paths.h).
+  FolderToCreate out_folder = OutputPaths().ClaimFolder(out, "everything the demo writes (--out)");
+  out_folder.Create();
   const std::string ds = Join(out, "dataset"), rig = Join(out, "rig.yaml");
   const std::string s = std::to_string(seed);
   int failures = 0;
@@ -127,6 +129,7 @@ int RunDemo(int argc, char** argv) {
   std::printf("\n== 5. the nightly check: 8 fresh target captures of the unmoved rig, then after a bump\n");
   const std::string night = Join(out, "night_ok"), bumped = Join(out, "night_bumped");
   const std::string history = Join(out, "check-history.sqlite");
+  std::error_code ec;
   std::filesystem::remove(history, ec);
   expect(Step({"simulate", "--out", night, "--seed", std::to_string(seed + 100), "--calibration-captures", "8",
                "--no-scenes"}),

@@ -114,7 +114,8 @@ int RunRig(int argc, char** argv) {
   OutputPaths outputs;
   outputs.Protect(rig_path, "the rig file (--rig)");
   outputs.Protect(truth_path, "the true rig file (--truth)");
-  if (!export_dir.empty()) outputs.ClaimFolder(export_dir, "the camera models (--export-cameramodels)");
+  FolderToCreate models_folder;  // made once the rig and truth are read
+  if (!export_dir.empty()) models_folder = outputs.ClaimFolder(export_dir, "the camera models (--export-cameramodels)");
 
   const Rig rig = ReadRigFile(rig_path);
   // Each model's file, named after its camera, is not an input either (the
@@ -133,11 +134,7 @@ int RunRig(int argc, char** argv) {
   PrintRigSummary(rig, stdout);
   if (!truth_path.empty())
     PrintAgainstTruth(rig, ReadRigFile(truth_path), distance_mm, Eigen::Vector3d(size_mm[0], size_mm[1], size_mm[2]));
-  if (!export_dir.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(export_dir, ec);
-    if (ec) throw InputError(export_dir, "cannot create the folder: " + ec.message());
-  }
+  models_folder.Create();
   for (int i = 0; i < int(model_paths.size()); ++i) {
     WriteCameramodel(rig.camera(i), rig.CamFromReference(i), model_paths[i]);
     std::printf("wrote %s\n", model_paths[i].c_str());

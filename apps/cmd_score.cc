@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -44,47 +43,6 @@ std::string FilledLine(const ErrorFigures& f) {
   return buf;
 }
 
-// The folders of --diagnose that do not exist yet: checked before anything
-// is read (the nearest existing part of the path a folder), created only
-// once every input has been checked and read (Create), and removed again,
-// while still empty, if the command fails after that (a scene that is not in
-// the dataset): bad input leaves no new folder behind.
-class DiagnoseFolder {
- public:
-  explicit DiagnoseFolder(const std::string& dir) : dir_(dir) {
-    namespace fs = std::filesystem;
-    if (dir.empty()) return;
-    OutputPaths().ClaimFolder(dir, "the diagnosis images (--diagnose)");
-    for (fs::path p = fs::weakly_canonical(fs::absolute(dir)); !p.empty() && !fs::exists(p); p = p.parent_path())
-      missing_.insert(missing_.begin(), p);  // outermost first
-  }
-  // Whether `folder` is one that Create will make (the report may go in it).
-  bool WillCreate(const std::filesystem::path& folder) const {
-    const auto key = std::filesystem::weakly_canonical(std::filesystem::absolute(folder));
-    return std::find(missing_.begin(), missing_.end(), key) != missing_.end();
-  }
-  void Create() {
-    if (dir_.empty()) return;
-    std::error_code ec;
-    std::filesystem::create_directories(dir_, ec);
-    if (ec || !std::filesystem::is_directory(dir_))
-      throw InputError(dir_, "--diagnose: cannot create this folder (" + ec.message() + ")");
-    created_ = true;
-  }
-  ~DiagnoseFolder() {
-    if (!created_ || std::uncaught_exceptions() <= exceptions_) return;  // not failing
-    std::error_code ec;  // a folder not empty stays, and so do its parents
-    auto p = missing_.rbegin();
-    while (p != missing_.rend() && std::filesystem::remove(*p, ec)) ++p;
-  }
-
- private:
-  std::string dir_;
-  std::vector<std::filesystem::path> missing_;  // outermost first
-  bool created_ = false;
-  int exceptions_ = std::uncaught_exceptions();
-};
-
 }  // namespace
 
 int RunScore(int argc, char** argv) {
@@ -122,7 +80,10 @@ int RunScore(int argc, char** argv) {
   }
   // Before any work: an unusable --diagnose folder is bad input, not a crash
   // at the end; but it is created only after every input check below.
-  DiagnoseFolder diagnose(diagnose_dir);
+  // (FolderToCreate, calib/core/folder_to_create.h: removed again, while
+  // empty, if the run fails after it is made.)
+  FolderToCreate diagnose;
+  if (!diagnose_dir.empty()) diagnose = OutputPaths().ClaimFolder(diagnose_dir, "the diagnosis images (--diagnose)");
   // Before anything is read: the report, not over the rig, the options or
   // any file of the dataset the scorer reads (its folder may be one
   // --diagnose will create); once the rig says how many modules, the
@@ -132,10 +93,14 @@ int RunScore(int argc, char** argv) {
   const bool check_report_folder = report_path.empty() || !diagnose.WillCreate(fs::absolute(report_path).parent_path());
   ClaimRuntimeReport(report_path, rig_path, options_path, check_report_folder, rig_what, dataset_inputs);
   const Rig rig = ReadRigFile(rig_path);
+  std::vector<std::string> scenes;
+  {
+    std::stringstream list(scenes_arg);
+    for (std::string name; std::getline(list, name, ',');) scenes.push_back(name);
+  }
   std::vector<std::pair<std::string, std::string>> diagnosis_images;
   if (!diagnose_dir.empty()) {
-    std::stringstream list(scenes_arg);
-    for (std::string name; std::getline(list, name, ',');)
+    for (const std::string& name : scenes)
       for (int m = 0; m < rig.num_modules(); ++m)
         for (const std::string& path : FillDiagnosisImagePaths(FillDiagnosisPrefix(diagnose_dir, name, m)))
           diagnosis_images.push_back({path, "a diagnosis image (--diagnose)"});
@@ -143,6 +108,17 @@ int RunScore(int argc, char** argv) {
   if (!diagnosis_images.empty())
     ClaimRuntimeReport(report_path, rig_path, options_path, check_report_folder, rig_what, dataset_inputs,
                        diagnosis_images);
+  // Every scene named is in the dataset, with its capture's files and its
+  // truth, before any is scored: a scene misnamed after others in --scenes
+  // used to be found only once they were scored, their diagnosis images
+  // left in a new --diagnose folder.
+  for (const std::string& name : scenes) {
+    const fs::path scene_dir = fs::path(dataset) / "scenes" / name;
+    if (!fs::is_directory(scene_dir)) throw InputError(scene_dir.string(), "no such scene in the dataset (--scenes)");
+    CheckCaptureFiles((scene_dir / "active").string(), rig);
+    const fs::path surface = fs::path(dataset) / "truth" / "scenes" / name / "surface.ply";
+    if (!fs::is_regular_file(surface)) throw InputError(surface.string(), "no such file (the scene's truth)");
+  }
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
   RuntimeOptions passive_options = options;
   // No grid: the whole volume's ROI, and no test of the grid's period.
@@ -157,8 +133,7 @@ int RunScore(int argc, char** argv) {
     text << spec.rdbuf();
     report["spec_yaml"] = text.str();
   }
-  std::stringstream ss(scenes_arg);
-  for (std::string name; std::getline(ss, name, ',');) {
+  for (const std::string& name : scenes) {
     const fs::path scene_dir = fs::path(dataset) / "scenes" / name;
     const SceneTruth truth = ReadSceneTruth(dataset, name);
     // Hole filling runs with the mesh: only when the options ask for it.

@@ -65,7 +65,7 @@ std::vector<std::pair<std::string, std::string>> DatasetInputs(const std::string
   return inputs;
 }
 
-void OutputPaths::ClaimFolder(const std::string& path, const std::string& what) {
+FolderToCreate OutputPaths::ClaimFolder(const std::string& path, const std::string& what) {
   namespace fs = std::filesystem;
   const fs::path key = Key(path);
   if (const auto it = inputs_.find(key); it != inputs_.end())
@@ -84,6 +84,7 @@ void OutputPaths::ClaimFolder(const std::string& path, const std::string& what) 
     if (p == p.root_path()) break;
   }
   claimed_.emplace(key, what);
+  return FolderToCreate(path, what);
 }
 
 }  // namespace stereorig

@@ -13,6 +13,8 @@
 #include <utility>
 #include <vector>
 
+#include "calib/core/folder_to_create.h"
+
 namespace stereorig {
 
 class OutputPaths {
@@ -31,7 +33,9 @@ class OutputPaths {
   // Records a folder the command creates if needed and writes files into
   // (`what` names it). Throws InputError if it is an input or a claimed
   // file, or if it, or the nearest part of its path that exists, is a file.
-  void ClaimFolder(const std::string& path, const std::string& what);
+  // The command creates it through the object returned, once every input
+  // is checked (FolderToCreate::Create).
+  [[nodiscard]] FolderToCreate ClaimFolder(const std::string& path, const std::string& what);
 
  private:
   std::string remedy_;

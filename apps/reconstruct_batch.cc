@@ -71,15 +71,16 @@ struct CaptureOutputs {
 // --mesh-format ply; a --report naming a capture's own report), none one of
 // the capture images read (a --report named caps/0001/cam0.png), and the
 // summary's folder exists or is the output folder.
+// `out_folder`: set to the output folder, to be created (FolderToCreate).
 std::vector<CaptureOutputs> PlanOutputs(const std::vector<std::string>& names, const BatchRequest& request,
-                                        const Rig& rig) {
+                                        const Rig& rig, FolderToCreate* out_folder) {
   std::vector<CaptureOutputs> outputs;
   OutputPaths paths("rename a folder or choose another --report");
   paths.Protect(request.rig_path, "the rig file (--rig)");
   paths.Protect(request.options_path, "the options file (--options)");
   for (const std::string& dir : request.capture_dirs)
     for (const std::string& image : CaptureImagePaths(dir, rig)) paths.Protect(image, "a capture image (--capture)");
-  paths.ClaimFolder(request.out_dir, "the output folder (--out-dir)");  // not a file, nor under one
+  *out_folder = paths.ClaimFolder(request.out_dir, "the output folder (--out-dir)");  // not a file, nor under one
   // The output folder is created later, once everything is checked.
   auto claim = [&](const std::string& path, const std::string& what) { paths.Claim(path, what, false); };
   for (const std::string& name : names) {
@@ -124,17 +125,16 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
   // Everything that needs no decoding is checked before anything is written,
   // the runtime too (its options can still be bad input for this rig).
   const std::vector<std::string> names = BatchOutputNames(dirs);
-  const std::vector<CaptureOutputs> outputs = PlanOutputs(names, request, rig);
+  FolderToCreate out_folder;
+  const std::vector<CaptureOutputs> outputs = PlanOutputs(names, request, rig, &out_folder);
   for (const std::string& dir : dirs) CheckCaptureFiles(dir, rig);
   auto load = [&rig](const std::string& dir) { return LoadCaptureOrInputError(dir, rig); };
   std::future<std::vector<cv::Mat>> next = std::async(std::launch::async, load, dirs[0]);  // while the runtime builds
   const auto t_build = Clock::now();
   const Runtime runtime(rig, options);
   const double build_ms = MsSince(t_build);
+  out_folder.Create();
   std::error_code ec;
-  fs::create_directories(request.out_dir, ec);
-  if (ec || !fs::is_directory(request.out_dir))
-    throw InputError(request.out_dir, "cannot create the output folder" + (ec ? ": " + ec.message() : ""));
   // A summary from an earlier run would describe that run until this one
   // ends: it goes now and is written anew at the end.
   if (!request.summary_path.empty()) fs::remove(request.summary_path, ec);
@@ -216,6 +216,10 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
               all_ms / 1000, summary["objects_per_s"].get<double>());
   if (!request.summary_path.empty()) WriteFileAtomically(request.summary_path, summary.dump(2) + "\n");
   if (failed > 0) {
+    // Every capture failed and nothing was written in it (no summary
+    // there): a new output folder goes again, as bad input found earlier
+    // leaves none.
+    out_folder.RemoveIfEmpty();
     std::fprintf(stderr,
                  "stereorig reconstruct: %d of %zu captures failed (bad input, or outputs that could not be "
                  "written) and have no output\n",

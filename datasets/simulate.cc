@@ -15,6 +15,7 @@
 #include <sstream>
 #include <thread>
 
+#include "calib/core/folder_to_create.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
 #include "datasets/calibration_poses.h"
@@ -231,11 +232,16 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
       MakeProjectors(spec, sr.world_from_projector, sr.projector_distance_mm);
 
   // --- the output folder: a sibling temporary, renamed at the end
-  const fs::path out = fs::absolute(fs::path(options.out_dir)).lexically_normal();
+  fs::path out = fs::absolute(fs::path(options.out_dir)).lexically_normal();
+  // "ds/" (or ".") normalises to a path ending in a separator, whose parent
+  // is the folder itself: renaming it into place would then fail.
+  if (!out.has_filename()) out = out.parent_path();
   const fs::path parent = out.parent_path();
+  // Made now, and removed again while empty if the run fails after this (a
+  // folder that cannot be made, part way too): no new empty folder left.
+  FolderToCreate parent_folder(parent.string(), "the dataset's folder (--out)");
+  parent_folder.Create();
   std::error_code ec;
-  fs::create_directories(parent, ec);
-  if (ec) throw InputError(parent.string(), "cannot create folder: " + ec.message());
   if (fs::exists(out)) {
     if (!fs::is_directory(out)) throw InputError(out.string(), "exists and is not a folder");
     if (!fs::is_empty(out) && !fs::exists(out / "spec.yaml")) {

@@ -104,8 +104,10 @@ TEST(CalibrateCli, RenderedCapturesToRigFileAndReport) {
   const std::string args = "calibrate --captures " + set.dir + "/captures --target " + set.dir +
                            "/target.yaml --layout " + set.dir + "/layout.yaml --out " + set.dir +
                            "/rig.yaml --report " + set.dir + "/report.json --lensmodel LENSMODEL_OPENCV5";
-  const testing::Result r = testing::RunCli(args);
+  fs::remove_all(set.dir + "/new");
+  const testing::Result r = testing::RunCli(args + " --export-cameramodels " + set.dir + "/new/models");
   ASSERT_EQ(r.code, 0) << r.err;
+  for (int k = 0; k < 4; ++k) EXPECT_TRUE(fs::exists(set.dir + "/new/models/cam" + std::to_string(k) + ".cameramodel"));
   std::printf("%s", r.out.c_str());
   EXPECT_NE(r.err.find("detect 000"), std::string::npos);  // progress
   const Rig rig = ReadRigFile(set.dir + "/rig.yaml");
@@ -117,6 +119,26 @@ TEST(CalibrateCli, RenderedCapturesToRigFileAndReport) {
   // Rendered corners carry a few hundredths of a pixel of detection error (no
   // lens distortion here), far below the 0.2 px of the corner-level tests.
   EXPECT_LT(agreement, 0.05);
+}
+
+// A models' folder that passes the checks but cannot be made (a name
+// longer than the file system's 255 characters) is found only after the
+// calibration: exit 2 naming it, and nothing left, neither the folder made
+// above it on the way nor the rig file and report (both used to be written
+// before the folder was made, and the folder above it stayed, empty).
+TEST(CalibrateCli, AModelsFolderThatCannotBeMadeLeavesNothing) {
+  const RenderedSet& set = Rendered();
+  const std::string folder = set.dir + "/long/" + std::string(300, 'x');
+  fs::remove_all(set.dir + "/long");
+  const testing::Result r =
+      testing::RunCli("calibrate --captures " + set.dir + "/captures --target " + set.dir + "/target.yaml --layout " +
+                      set.dir + "/layout.yaml --out " + set.dir + "/long_rig.yaml --report " + set.dir +
+                      "/long_report.json --lensmodel LENSMODEL_OPENCV5 --export-cameramodels " + folder);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find(folder + ": cannot create this folder for the camera models"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(set.dir + "/long")) << "the folder made on the way was left behind";
+  EXPECT_FALSE(fs::exists(set.dir + "/long_rig.yaml"));
+  EXPECT_FALSE(fs::exists(set.dir + "/long_report.json"));
 }
 
 TEST(CalibrateCli, RefusesImagesOfTheWrongSize) {

@@ -146,6 +146,8 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
 
 #include "calib/core/rig_file.h"
 #include "datasets/default_rig.h"
+#include "datasets/sim_spec.h"
+#include "datasets/simulate.h"
 #include "reconstruct/metrology/ply_points.h"
 #include "reconstruct/synthetic_scene.h"
 #include "tests/cli_runner.h"
@@ -418,13 +420,26 @@ TEST_F(ReconstructCli, ScoreBadInputLeavesNoDiagnoseFolder) {
   const std::string d = ScoreDataset("score_dataset_diag");
   const std::string diag = dir_ + "/diag_new";
   const std::string score = "score --dataset " + d + " --no-passive --diagnose " + diag + "/deeper";
+  // A scene that passes the checks made before the folder is created (its
+  // camera images there, a truth surface file) but fails once read: the
+  // folder, made by then, goes again.
+  std::filesystem::create_directories(d + "/scenes/broken/active");
+  for (int k = 0; k < 4; ++k)
+    std::filesystem::copy_file(dir_ + "/capture/cam" + std::to_string(k) + ".png",
+                               d + "/scenes/broken/active/cam" + std::to_string(k) + ".png");
+  std::filesystem::create_directories(d + "/truth/scenes/broken");
+  WriteFileAtomically(d + "/truth/scenes/broken/surface.ply", "not a ply\n");
   const std::pair<std::string, std::string> cases[] = {
       {score + " --scenes cup --report " + dir_ + "/no_such_folder/s.json",
        "no_such_folder/s.json: its folder does not exist"},
       {score + " --scenes cup --rig " + dir_ + "/rig.yaml --report " + dir_ + "/rig.yaml",
        "rig.yaml: is the rig file (--rig)"},
       {score + " --scenes cup --report " + diag + "/deeper/cup_m0_left.png", "cup_m0_left.png: would be written twice"},
-      {score + " --scenes no_such_scene", "no_such_scene"},
+      {score + " --scenes no_such_scene", "scenes/no_such_scene: no such scene in the dataset"},
+      {score + " --scenes broken", "broken/surface.ply"},
+      // Checked, but too long a name for the file system: made in part.
+      {"score --dataset " + d + " --no-passive --scenes broken --diagnose " + diag + "/" + std::string(300, 'x'),
+       "cannot create this folder for the diagnosis images (--diagnose)"},
       {"score --dataset " + d + " --scenes cup --diagnose " + dir_ + "/rig.yaml/diag", "rig.yaml is a file"}};
   for (const auto& [args, says] : cases) {
     std::filesystem::remove_all(diag);
@@ -435,6 +450,31 @@ TEST_F(ReconstructCli, ScoreBadInputLeavesNoDiagnoseFolder) {
     EXPECT_FALSE(std::filesystem::exists(diag)) << args;
   }
   EXPECT_TRUE(std::filesystem::is_regular_file(dir_ + "/rig.yaml"));
+}
+
+// score checks every scene of --scenes before it scores any: a misnamed
+// one after a good one exits 2 in one line and leaves no --diagnose folder.
+// It used to be found only once the good scene was scored, whose diagnosis
+// images stayed in the new folder.
+TEST_F(ReconstructCli, ScoreChecksEverySceneBeforeScoringAny) {
+  const std::string d = dir_ + "/score_sim";
+  std::filesystem::remove_all(d);
+  SimSpec spec = DefaultSimSpec();
+  spec.scenes.names = {"sphere"};
+  SimulateOptions sim;
+  sim.out_dir = d;
+  sim.calibration_captures = 0;
+  sim.threads = 2;
+  Simulate(spec, sim);
+  const std::string diag = dir_ + "/score_sim_diag";
+  std::filesystem::remove_all(diag);
+  const testing::Result r =
+      testing::RunCli("score --dataset " + d + " --scenes sphere,spher --no-passive --diagnose " + diag + "/deeper");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("scenes/spher: no such scene in the dataset (--scenes)"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find("points"), std::string::npos) << "a scene was scored: " << r.out;
+  EXPECT_FALSE(std::filesystem::exists(diag)) << "bad input left the --diagnose folder behind";
 }
 
 // A measurement volume deeper than the matcher can search (150 x 150 x 300
@@ -541,6 +581,52 @@ TEST_F(ReconstructCli, ABatchWritesEachCapturesOwnCloudAndSkipsABrokenOne) {
   EXPECT_EQ(summary["failed"], 1);
   EXPECT_EQ(summary["captures"][1]["ok"], false);
   EXPECT_NE(summary["captures"][1]["error"].get<std::string>().find("0002/cam1.png"), std::string::npos);
+}
+
+// A batch whose every capture is broken in a way found only when decoded
+// (a PNG cut short, one that is not a PNG) exits 2 and leaves no new
+// --out-dir behind, nor the missing folders above it (FolderToCreate,
+// calib/core/folder_to_create.h); the batch used to leave them, empty. A folder that
+// was there before stays, and so does one holding another capture's output
+// (ABatchWritesEachCapturesOwnCloudAndSkipsABrokenOne).
+TEST_F(ReconstructCli, ABatchWhoseEveryCaptureFailsLeavesNoNewFolder) {
+  const std::string cut = BrokenCapture("batch_all_cut"), junk = BrokenCapture("batch_all_junk");
+  {
+    std::ifstream in(dir_ + "/capture/cam2.png", std::ios::binary);
+    std::string bytes(std::istreambuf_iterator<char>(in), {});
+    WriteFileAtomically(cut + "/cam2.png", bytes.substr(0, bytes.size() / 2));
+  }
+  WriteFileAtomically(junk + "/cam1.png", "not a png");
+  const std::string head = "reconstruct --rig " + dir_ + "/rig.yaml --capture " + cut + " " + junk + " --out-dir ";
+  const std::string fresh = dir_ + "/batch_all_new";
+  std::filesystem::remove_all(fresh);
+  const testing::Result r = testing::RunCli(head + fresh + "/deeper");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("batch_all_cut/cam2.png"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("batch_all_junk/cam1.png"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(fresh)) << "bad input left the --out-dir folder behind";
+  const std::string existing = dir_ + "/batch_all_existing";
+  std::filesystem::remove_all(existing);
+  std::filesystem::create_directories(existing);
+  EXPECT_EQ(RunCli(head + existing), 2);
+  EXPECT_TRUE(std::filesystem::is_directory(existing)) << "a folder that was there before was removed";
+}
+
+// An --out-dir that cannot be made (a name longer than the file system's
+// 255 characters) exits 2 in one line naming it, once the runtime is
+// built, and the folder made above it on the way is removed again; it used
+// to stay, empty.
+TEST_F(ReconstructCli, ABatchOutDirThatCannotBeMadeLeavesNoFolder) {
+  const std::string fresh = dir_ + "/batch_long";
+  std::filesystem::remove_all(fresh);
+  const std::string out = fresh + "/" + std::string(300, 'x');
+  const testing::Result r =
+      testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture --out-dir " + out);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(out + ": cannot create this folder for the output folder (--out-dir)"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(fresh)) << "the folder made on the way was left behind";
 }
 
 // A capture whose outputs cannot be written has none, not a partial nor a

@@ -40,6 +40,44 @@ TEST(SimulateCli, DefaultSpecFileRoundTripsAndBadKeysExitTwo) {
   EXPECT_NE(r.err.find("captures"), std::string::npos) << r.err;
 }
 
+// An --out with a trailing slash (as a shell's completion writes it) names
+// the same folder as without one. simulate used to render the whole dataset
+// and then fail to rename it into place ("cannot replace: Invalid
+// argument", exit 2), leaving the new folder behind, empty. Written again
+// over itself, the dataset is replaced whole, nothing left beside it.
+TEST(SimulateCli, AnOutFolderWithATrailingSlashIsWritten) {
+  const std::string dir = ::testing::TempDir() + "/sim_trailing_slash";
+  fs::remove_all(dir);
+  for (int run = 0; run < 2; ++run) {
+    const Result r = RunCli("simulate --out " + dir + "/new/ds/ --calibration-captures 1 --no-scenes");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(dir + "/new/ds/calibration/000/cam3.png")) << run;
+    int entries = 0;
+    for (const auto& e : fs::directory_iterator(dir + "/new")) entries += e.path().filename() == "ds" ? 1 : 100;
+    EXPECT_EQ(entries, 1) << "something beside the dataset, run " << run;
+  }
+}
+
+// An --out that cannot be made (a name longer than the file system's 255
+// characters: the folder itself, or the temporary beside it, ".<name>.tmp-
+// <pid>") exits 2 in one line naming it, and the folders made above it on the
+// way are removed again (FolderToCreate, calib/core/folder_to_create.h); they
+// used to stay, empty.
+TEST(SimulateCli, AnOutThatCannotBeMadeLeavesNoFolder) {
+  const std::string dir = ::testing::TempDir() + "/sim_long";
+  fs::remove_all(dir);
+  const std::pair<std::string, std::string> cases[] = {{dir + "/new/" + std::string(300, 'x') + "/ds", "xxx"},
+                                                       {dir + "/new/" + std::string(250, 'y'), "/.yyy"}};
+  for (const auto& [out, says] : cases) {
+    const Result r = RunCli("simulate --out " + out + " --calibration-captures 1 --no-scenes");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("File name too long"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir + "/new")) << "the folder made on the way was left behind: " << out.substr(0, 80);
+  }
+}
+
 // --write-default-spec is checked like every command's output
 // (apps/output_paths.h): over the --spec file given with it (an edited spec
 // replaced by the default), directly or through a symbolic link, at a

@@ -1,0 +1,48 @@
+// The folder a command creates: made late, undone on failure.
+#pragma once
+
+#include <exception>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace stereorig {
+
+// A folder a command creates, and the folders above it that did not exist
+// when this object was made (a command's output folder is made so by
+// OutputPaths::ClaimFolder, apps/output_paths.h, after its checks): created
+// only once every input has been checked (Create), and removed again,
+// innermost first and only while empty, if the command fails after that (an
+// exception leaving the scope of this object, or RemoveIfEmpty), Create
+// failing part way included. So bad input found after the claim leaves no
+// new folder behind, while a folder that existed before, or one holding
+// what the command wrote before a later failure, stays.
+class FolderToCreate {
+ public:
+  FolderToCreate() = default;  // no folder: an optional one not asked for
+  // `what` names the folder's use in messages ("the camera models
+  // (--export-cameramodels)").
+  FolderToCreate(const std::string& path, const std::string& what);
+  FolderToCreate(FolderToCreate&& other) noexcept;
+  FolderToCreate& operator=(FolderToCreate&& other) noexcept;
+  FolderToCreate(const FolderToCreate&) = delete;
+  FolderToCreate& operator=(const FolderToCreate&) = delete;
+  ~FolderToCreate();
+  // Whether `folder` is the claimed folder or one above it that Create will
+  // make (a file claimed in it needs no folder test).
+  bool WillCreate(const std::filesystem::path& folder) const;
+  // Creates the folder (and the missing ones above it). Throws InputError
+  // naming it if it cannot be made. Nothing happens for no folder.
+  void Create();
+  // For a command that fails by its exit code, not an exception (a batch
+  // whose every capture failed): the folders Create made, while empty.
+  void RemoveIfEmpty();
+
+ private:
+  std::string path_, what_;                     // as given; what it holds (for the message)
+  std::vector<std::filesystem::path> missing_;  // normal absolute paths not there when claimed, outermost first
+  bool created_ = false;
+  int exceptions_ = std::uncaught_exceptions();  // at construction: more in the destructor means failing
+};
+
+}  // namespace stereorig
