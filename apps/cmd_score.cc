@@ -90,6 +90,8 @@ int RunScore(int argc, char** argv) {
   // diagnosis images too.
   const std::string rig_what = rig_given ? "the rig file (--rig)" : "the dataset's truth rig file (read without --rig)";
   const auto dataset_inputs = DatasetInputs(dataset);
+  if (!report_path.empty() && diagnose.WillCreate(fs::absolute(report_path)))
+    throw InputError(report_path, "is a folder --diagnose creates, not a file for the report (--report)");
   const bool check_report_folder = report_path.empty() || !diagnose.WillCreate(fs::absolute(report_path).parent_path());
   ClaimRuntimeReport(report_path, rig_path, options_path, check_report_folder, rig_what, dataset_inputs);
   const Rig rig = ReadRigFile(rig_path);

@@ -27,6 +27,8 @@ void OutputPaths::Claim(const std::string& path, const std::string& what, bool c
   if (const auto it = claimed_.find(key); it != claimed_.end())
     throw InputError(
         path, "would be written twice (" + it->second + " and " + what + ")" + (remedy_.empty() ? "" : ": " + remedy_));
+  if (const auto it = folders_.find(key); it != folders_.end())
+    throw InputError(path, "is a folder this command creates for " + it->second + ", not a file to write");
   if (check_folder && !fs::is_directory(key.parent_path())) throw InputError(path, "its folder does not exist");
   if (fs::is_directory(key)) throw InputError(path, "is a folder, not a file to write");
   claimed_.emplace(key, what);
@@ -73,7 +75,9 @@ FolderToCreate OutputPaths::ClaimFolder(const std::string& path, const std::stri
   if (const auto it = claimed_.find(key); it != claimed_.end())
     throw InputError(path, "is claimed by " + it->second + " as a file, not a folder for " + what);
   // The nearest part of the path that exists must be a folder: the command
-  // creates the rest.
+  // creates the rest, none of which may be a file another output claimed
+  // (--report a with --export-cameramodels a/b).
+  std::vector<fs::path> missing;
   for (fs::path p = key; !p.empty(); p = p.parent_path()) {
     if (fs::exists(p)) {
       if (!fs::is_directory(p))
@@ -81,8 +85,12 @@ FolderToCreate OutputPaths::ClaimFolder(const std::string& path, const std::stri
             path, (p == key ? std::string("is a file") : p.string() + " is a file") + ", not a folder for " + what);
       break;
     }
+    if (const auto it = claimed_.find(p); it != claimed_.end())
+      throw InputError(path, p.string() + " is claimed by " + it->second + " as a file, not a folder for " + what);
+    missing.push_back(p);
     if (p == p.root_path()) break;
   }
+  for (const fs::path& p : missing) folders_.emplace(p, what);
   claimed_.emplace(key, what);
   return FolderToCreate(path, what);
 }

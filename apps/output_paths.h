@@ -22,7 +22,8 @@ class OutputPaths {
   // `remedy`: appended to the message when a file is claimed twice.
   explicit OutputPaths(std::string remedy = "") : remedy_(std::move(remedy)) {}
   // Records `path`, written as `what` (for the message). Throws InputError if
-  // another output already claimed the same file, or, with
+  // another output already claimed the same file, if it is a folder a
+  // ClaimFolder before will create, or, with
   // check_folder, if its folder does not exist (off for files in a folder
   // the command creates itself).
   void Claim(const std::string& path, const std::string& what, bool check_folder = true);
@@ -32,7 +33,8 @@ class OutputPaths {
   void Protect(const std::string& path, const std::string& what);
   // Records a folder the command creates if needed and writes files into
   // (`what` names it). Throws InputError if it is an input or a claimed
-  // file, or if it, or the nearest part of its path that exists, is a file.
+  // file, if a missing folder above it is a claimed file, or if it, or the
+  // nearest part of its path that exists, is a file.
   // The command creates it through the object returned, once every input
   // is checked (FolderToCreate::Create).
   [[nodiscard]] FolderToCreate ClaimFolder(const std::string& path, const std::string& what);
@@ -41,6 +43,7 @@ class OutputPaths {
   std::string remedy_;
   std::map<std::filesystem::path, std::string> claimed_;  // normal absolute path -> what writes it
   std::map<std::filesystem::path, std::string> inputs_;   // normal absolute path -> the input it is
+  std::map<std::filesystem::path, std::string> folders_;  // folders ClaimFolder will create -> what they hold
 };
 
 // The --report of a command that reads a rig file and runtime options

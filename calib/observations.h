@@ -85,11 +85,11 @@ struct CalibrationInput {
 // stage 3 honours stage 2's list (SystemExclusions). Over every view,
 // including those stage 1 drops: a dropped view (too few corners, no board
 // pose determined) still says which face its camera saw, so a misread face
-// in its partner's view is still caught. Counting only the views stage 1
-// kept let such a misread view into stage 3, where the module poses no board
-// to check it: a module's 3D error 0.082 mm and the modules' agreement 0.059
-// mm, over the 0.05 mm bounds (CalibrateDifferentFaces.
-// AViewStageOneDroppedStillSetsItsCaptureAside, measured when written).
+// in its partner's view is still caught. A rule counting only the views
+// stage 1 kept would let such a misread view into stage 3, where the module
+// poses no board to check it: measured with that rule, a module's 3D error
+// 0.082 mm and the modules' agreement 0.059 mm, over the 0.05 mm bounds
+// (CalibrateDifferentFaces.AViewStageOneDroppedStillSetsItsCaptureAside).
 std::vector<int> CapturesWithDifferentFaces(const CalibrationInput& input, int left_camera, int right_camera);
 
 }  // namespace stereorig

@@ -123,7 +123,7 @@ TEST(CalibrateSystemVerdicts, ACaptureStageTwoSetAsideStaysOut) {
   }
   SystemOptions options;
   options.compute_covariance = false;
-  const SystemReport all = CalibrateSystem(in, modules, kNoisePx, options).report;
+  const SystemReport all = CalibrateSystem(in, modules, kNoisePx, options, SystemExclusions{}).report;
   // A capture both modules posed: module 1's corners in it.
   const auto views = PoseBoardsByTriangulation(in, modules, options.min_triangulated_corners);
   int capture = -1;

@@ -132,11 +132,13 @@ struct SystemResult {
 // reprojection residuals. Throws InputError if a module shares no capture
 // with the others (the S matrix would be undetermined). `excluded`: views,
 // corners and module-captures the earlier stages rejected or set aside, left
-// out here too (Calibrate passes them; a capture whose two views of a module
-// show different faces gives that module no board pose in any case).
+// out here too (Calibrate passes them). No default: a caller passing none
+// gets every view in the adjustment, those of a capture whose two views of
+// a module show different faces included (such a capture gives that module
+// no board pose of its own, but its corners still enter wherever another
+// module posed the board).
 SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<ModuleCameras>& modules,
-                             double corner_sigma_px, const SystemOptions& options,
-                             const SystemExclusions& excluded = {});
+                             double corner_sigma_px, const SystemOptions& options, const SystemExclusions& excluded);
 
 // Board poses: for each capture, module_from_front of one module, from its
 // triangulated corners (Horn). Also the triangulated points themselves.

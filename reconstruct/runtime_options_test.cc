@@ -94,6 +94,15 @@ TEST(RuntimeOptions, ReadsAndChecksTheSubpixelColumnStep) {
   ExpectEachRejectedNamingItsKey(bad);
 }
 
+TEST(RuntimeOptions, ReadsAndChecksTheSpeckleAlongSlopesKey) {
+  EXPECT_FALSE(ParseRuntimeOptions("min_confidence: 0.5\n", "defaults.yaml").match.speckle_along_slopes);
+  EXPECT_TRUE(ParseRuntimeOptions("match:\n  speckle_along_slopes: true\n", "set.yaml").match.speckle_along_slopes);
+  const std::pair<const char*, const char*> bad[] = {
+      {"match:\n  speckle_along_slopes: maybe\n", "speckle_along_slopes"},
+      {"match:\n  speckle_along_slope: true\n", "speckle_along_slope"}};
+  ExpectEachRejectedNamingItsKey(bad);
+}
+
 TEST(RuntimeOptions, ReadsAndChecksTheBandPassKeys) {
   const RuntimeOptions d = ParseRuntimeOptions("min_confidence: 0.5\n", "defaults.yaml");
   EXPECT_EQ(d.match.band_sgm_paths, 4);

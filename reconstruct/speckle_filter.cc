@@ -147,12 +147,16 @@ void FilterSpeckles16(cv::Mat disparity_16, int16_t invalid, int max_blob_px, in
 
 namespace {
 
+// The reach in sixteenths of a pixel; 4096 px already joins any two 16-bit
+// values. One rule for the filter and for the steps it is given, so that
+// where no step passes the reach the filter is the plain one.
+int ReachSixteenths(double max_diff_px) { return int(std::lround(std::min(max_diff_px, 4096.0) * 16)); }
+
 // RemoveSpeckleBlobs, with FilterSpeckles16's steps (empty: none).
 void RemoveBlobs(cv::Mat disparity_px, int max_blob_px, double max_diff_px, const cv::Mat& step_left_16,
                  const cv::Mat& step_up_16) {
   STEREORIG_CHECK(disparity_px.type() == CV_32FC1 && max_diff_px >= 0);
-  // In sixteenths; 4096 px already joins any two 16-bit values.
-  const int max_diff_16 = int(std::lround(std::min(max_diff_px, 4096.0) * 16));
+  const int max_diff_16 = ReachSixteenths(max_diff_px);
   constexpr int16_t kInvalid = std::numeric_limits<int16_t>::min();
   cv::Mat fixed(disparity_px.size(), CV_16SC1);
   for (int y = 0; y < disparity_px.rows; ++y)
@@ -180,7 +184,7 @@ void RemoveSpeckleBlobsAlongSlopes(cv::Mat disparity_px, const cv::Mat& slope_x,
   // The step from the left (upper) neighbour a to b, in sixteenths: their
   // mean slope where each one's slope steps beyond the reach, the same way
   // (|slope| <= 2000 px/px keeps it within 16 bits); else 0.
-  const double reach_16 = double(std::lround(std::min(max_diff_px, 4096.0) * 16));
+  const double reach_16 = ReachSixteenths(max_diff_px);
   auto sixteenths = [&](float a, float b) {
     const double a_16 = 16.0 * double(a), b_16 = 16.0 * double(b);
     const bool steep = (a_16 > reach_16 && b_16 > reach_16) || (a_16 < -reach_16 && b_16 < -reach_16);

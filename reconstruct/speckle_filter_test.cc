@@ -170,6 +170,27 @@ TEST(RemoveSpeckleBlobsAlongSlopes, KeepsASurfaceSteeperThanTheReach) {
   EXPECT_EQ(cv::countNonZero(kept(cv::Rect(20, 10, 5, 5))), 0) << "the patch a period off";
 }
 
+// The same surface turned a quarter: dd/dy = -1.6 px/px down the columns
+// (the steps between a pixel and the one above it), dd/dx = 0.02. The plain
+// test joins each row and no two rows: 30 px blobs, all removed; along the
+// slopes one blob, and the patch a period off goes.
+TEST(RemoveSpeckleBlobsAlongSlopes, KeepsASurfaceSteeperThanTheReachDownTheColumns) {
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<float> noise(-0.1f, 0.1f);
+  cv::Mat map(40, 30, CV_32FC1), slope_x(map.size(), CV_32FC1, cv::Scalar(0.02)),
+      slope_y(map.size(), CV_32FC1, cv::Scalar(-1.6));
+  for (int y = 0; y < map.rows; ++y)
+    for (int x = 0; x < map.cols; ++x) map.at<float>(y, x) = 100 + 0.02f * x - 1.6f * y + noise(rng);
+  map(cv::Rect(10, 20, 5, 5)) += 8;
+  cv::Mat plain = map.clone(), along = map.clone();
+  RemoveSpeckleBlobs(plain, 100, 1.0);
+  RemoveSpeckleBlobsAlongSlopes(along, slope_x, slope_y, 100, 1.0);
+  EXPECT_EQ(cv::countNonZero(plain == map), 0) << "the plain test cuts the surface into rows";
+  const cv::Mat kept = along == map;
+  EXPECT_EQ(cv::countNonZero(kept), int(map.total()) - 25);
+  EXPECT_EQ(cv::countNonZero(kept(cv::Rect(10, 20, 5, 5))), 0) << "the patch a period off";
+}
+
 // Where every predicted step is within the reach (|slopes| < 0.5 px/px,
 // their sum's step < 1 px), the filter is RemoveSpeckleBlobs, bit for bit,
 // on random blob maps.

@@ -139,6 +139,20 @@ TEST(CalibrateCli, AModelsFolderThatCannotBeMadeLeavesNothing) {
   EXPECT_FALSE(fs::exists(set.dir + "/long")) << "the folder made on the way was left behind";
   EXPECT_FALSE(fs::exists(set.dir + "/long_rig.yaml"));
   EXPECT_FALSE(fs::exists(set.dir + "/long_report.json"));
+  // A report at a folder the export would create (--report A with
+  // --export-cameramodels A/models): refused before the calibration, not
+  // found when the models' folder cannot be made after it.
+  const std::string report = set.dir + "/a_report_not_a_folder";
+  fs::remove_all(report);
+  const testing::Result clash =
+      testing::RunCli("calibrate --captures " + set.dir + "/captures --target " + set.dir + "/target.yaml --layout " +
+                      set.dir + "/layout.yaml --out " + set.dir + "/clash_rig.yaml --report " + report +
+                      " --export-cameramodels " + report + "/models");
+  EXPECT_EQ(clash.code, 2) << clash.err;
+  EXPECT_NE(clash.err.find("is claimed by the report (--report) as a file"), std::string::npos) << clash.err;
+  EXPECT_EQ(clash.err.find("detect 000"), std::string::npos) << "refused before any work";
+  EXPECT_FALSE(fs::exists(report));
+  EXPECT_FALSE(fs::exists(set.dir + "/clash_rig.yaml"));
 }
 
 TEST(CalibrateCli, RefusesImagesOfTheWrongSize) {

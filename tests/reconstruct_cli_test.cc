@@ -435,6 +435,9 @@ TEST_F(ReconstructCli, ScoreBadInputLeavesNoDiagnoseFolder) {
       {score + " --scenes cup --rig " + dir_ + "/rig.yaml --report " + dir_ + "/rig.yaml",
        "rig.yaml: is the rig file (--rig)"},
       {score + " --scenes cup --report " + diag + "/deeper/cup_m0_left.png", "cup_m0_left.png: would be written twice"},
+      // The report at the folder --diagnose creates, or at one above it.
+      {score + " --scenes cup --report " + diag + "/deeper", "is a folder --diagnose creates"},
+      {score + " --scenes cup --report " + diag, "is a folder --diagnose creates"},
       {score + " --scenes no_such_scene", "scenes/no_such_scene: no such scene in the dataset"},
       {score + " --scenes broken", "broken/surface.ply"},
       // Checked, but too long a name for the file system: made in part.

@@ -18,6 +18,7 @@
 #include <sstream>
 #include <vector>
 
+#include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
 #include "datasets/simulate.h"
 #include "reconstruct/runtime.h"
@@ -229,7 +230,7 @@ TEST(RuntimeOnAFreshRealization, BallBarAndPlateMeetTheAccuracyTargets) {
 // copied, modules 1 and 2 at +-120 degrees around the object.
 SimSpec ThreeModuleRingSpec() {
   SimSpec spec = DefaultSimSpec();
-  EXPECT_EQ(spec.modules.size(), 2u);
+  STEREORIG_CHECK(spec.modules.size() == 2);  // module 1 is copied below
   spec.modules.push_back(spec.modules[1]);
   for (int m = 1; m < 3; ++m) {
     const double a = 2 * M_PI * m / 3;
@@ -267,7 +268,10 @@ TEST(RuntimeOnAThreeModuleRig, EveryModuleMeetsTheAccuracyTargetsInOneFrame) {
 // mismatches), the rest 0.16 px from the truth on average. Asserted: the
 // mean |e| target (0.1 mm: the default speckle's ~0.25 px of disparity
 // noise is ~0.1 mm at 200 mm, ExpectModuleFigures), and the fill ~5 points
-// under what it measures, as above.
+// under what it measures, as above; module 1's std only as a guard against
+// a growing tail of mismatches, at twice what it measures (0.25 mm: not a
+// target). Modules 0 and 2, which the option changes too (measured std
+// 0.074 and 0.088 mm), are held to issue 5's per-module targets.
 TEST(RuntimeOnAThreeModuleRig, APlateTheLeftCameraGrazesIsMeasuredAlongItsSlope) {
   const std::string dataset = SimulateScenes({"plate"}, 4, DefaultSimSpec().render.speckle_contrast,
                                              "runtime_e2e_ring3_plate", ThreeModuleRingSpec());
@@ -277,6 +281,11 @@ TEST(RuntimeOnAThreeModuleRig, APlateTheLeftCameraGrazesIsMeasuredAlongItsSlope)
   ASSERT_EQ(s.fill.size(), 3u);
   EXPECT_GT(s.fill[1].fill(), 0.57);
   EXPECT_LT(s.accuracy.per_module[1].mean_abs_mm, 0.1);
+  EXPECT_LT(s.accuracy.per_module[1].std_mm, 0.25);
+  for (const size_t m : {size_t(0), size_t(2)}) {
+    EXPECT_LT(s.accuracy.per_module[m].mean_abs_mm, 0.1) << "module " << m;
+    EXPECT_LT(s.accuracy.per_module[m].std_mm, 0.1) << "module " << m;
+  }
 }
 
 }  // namespace
