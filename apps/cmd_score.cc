@@ -157,7 +157,10 @@ int RunScore(int argc, char** argv) {
                 100 * s.fill_all.fill(), s.fill_all.target_px, s.accuracy.all.mean_abs_mm, s.accuracy.all.std_mm);
     for (size_t m = 0; m < s.fill.size(); ++m) {
       const ErrorFigures& e = s.accuracy.per_module[m];
-      sj["modules"].push_back({{"module", m}, {"accuracy", ErrorFiguresJson(e)}, {"fill", FillJson(s.fill[m])}});
+      sj["modules"].push_back({{"module", m},
+                               {"accuracy", ErrorFiguresJson(e)},
+                               {"fill", FillJson(s.fill[m])},
+                               {"points_seen_through", rec.modules[m].seen_through}});
       std::printf("; m%zu fill %5.1f%% |e| %.4f std %.4f", m, 100 * s.fill[m].fill(), e.mean_abs_mm, e.std_mm);
     }
     if (!no_passive && fs::is_directory(scene_dir / "passive")) {
@@ -169,8 +172,11 @@ int RunScore(int argc, char** argv) {
     }
     std::printf("; aligned by %.4f deg, %.4f mm\n", s.accuracy.truth_from_cloud.AngleDeg(),
                 s.accuracy.truth_from_cloud.translation_mm().norm());
-    for (size_t m = 0; m < s.fill.size(); ++m)
+    for (size_t m = 0; m < s.fill.size(); ++m) {
       std::printf("  m%zu lost: %s\n", m, LossLine(s.fill[m].target_status, s.fill[m].target_px).c_str());
+      if (rec.modules[m].seen_through > 0)
+        std::printf("  m%zu free-space test: %d points removed (seen through)\n", m, rec.modules[m].seen_through);
+    }
     if (fill) {
       sj["shape_fit"] = rec.shape_fit;
       sj["hole_fill_ms"] = rec.times_ms.at("hole_fill");

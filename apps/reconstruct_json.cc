@@ -10,6 +10,7 @@ nlohmann::json ReconstructionJson(const Reconstruction& rec) {
   for (const ModuleReport& m : rec.modules) {
     nlohmann::json mj = {{"module", m.module},
                          {"points", m.points},
+                         {"points_seen_through", m.seen_through},
                          {"lit_pixels", m.lit_pixels},
                          {"lit_pixels_filled", m.lit_filled},
                          {"fill_rate", m.fill_rate()},

@@ -45,6 +45,8 @@ const char* PixelStatusName(PixelStatus status) {
       return "wrong_line";
     case PixelStatus::kLeftViewEdge:
       return "left_view_edge";
+    case PixelStatus::kSeenThrough:
+      return "seen_through";
     case PixelStatus::kNumStatus:
       break;
   }

@@ -11,8 +11,8 @@ namespace stereorig {
 
 // What became of each left pixel: a point, or the first test that rejected
 // it. The matcher sets the codes up to kNotDistinct and kOccluded,
-// kWrongLine, kLeftViewEdge; the runtime adds kLowConfidence, kOutsideVolume, kObjectSize. For finding where fill is
-// lost (`stereorig score` tabulates them).
+// kWrongLine, kLeftViewEdge; the runtime adds kLowConfidence, kOutsideVolume, kObjectSize, kSeenThrough. For finding
+// where fill is lost (`stereorig score` tabulates them).
 enum class PixelStatus : uint8_t {
   kNotSearched = 0,  // outside the matched region
   kPoint,            // a valid disparity (and, in the runtime, a kept point)
@@ -32,6 +32,7 @@ enum class PixelStatus : uint8_t {
   kOccluded,         // its match in the right view is hidden by a nearer surface, or outside it (right_occlusion.h)
   kWrongLine,        // in a component on the wrong laser line that no whole-period move fixes (line_index.h)
   kLeftViewEdge,     // its refinement window reaches past the left view's data (left_view_edge.h)
+  kSeenThrough,      // runtime: other modules' surfaces facing this camera lie in front of it (free_space.h)
   kNumStatus
 };
 const char* PixelStatusName(PixelStatus status);

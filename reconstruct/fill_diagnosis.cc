@@ -272,6 +272,8 @@ cv::Vec3b StatusColour(uint8_t status) {  // BGR
       return {180, 105, 255};  // pink
     case PixelStatus::kLeftViewEdge:
       return {64, 64, 64};  // dark grey
+    case PixelStatus::kSeenThrough:
+      return {0, 0, 128};  // dark red
     default:
       return {255, 255, 255};
   }

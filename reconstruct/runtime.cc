@@ -11,6 +11,7 @@
 #include "calib/core/capture_image_name.h"
 #include "calib/core/input_error.h"
 #include "reconstruct/elapsed_ms.h"
+#include "reconstruct/free_space.h"
 #include "reconstruct/grey_image.h"
 #include "reconstruct/hole_fill.h"
 #include "reconstruct/lit_mask.h"
@@ -28,6 +29,54 @@ std::vector<Eigen::Vector3d> VolumeCorners(const Eigen::Vector3d& centre, const 
     corners.push_back(centre + 0.5 * Eigen::Vector3d((i & 1 ? 1 : -1) * size.x(), (i & 2 ? 1 : -1) * size.y(),
                                                      (i & 4 ? 1 : -1) * size.z()));
   return corners;
+}
+
+// Removes module m's refuted points from its cloud and mesh, marks their
+// pixels kSeenThrough and recounts the module's report. A point's pixel is
+// its reprojection through the module's rectification (the points were
+// triangulated from pixel centres, so it rounds back to them).
+void RemoveRefuted(const ModulePlan& plan, const std::vector<uint8_t>& refuted, PointCloud* cloud, Mesh* mesh,
+                   ModuleReport* report) {
+  const Pose module_from_reference = plan.reference_from_module.Inverse();
+  const Eigen::Matrix3d r = plan.geometry.rect_from_left * module_from_reference.rotation();
+  const Eigen::Vector3d t = plan.geometry.rect_from_left * module_from_reference.translation_mm();
+  std::vector<int> new_index(cloud->size(), -1);
+  PointCloud kept;
+  kept.Reserve(cloud->size());
+  for (size_t i = 0; i < cloud->size(); ++i) {
+    if (!refuted[i]) {
+      new_index[i] = int(kept.size());
+      kept.xyz_mm.push_back(cloud->xyz_mm[i]);
+      kept.normal.push_back(cloud->normal[i]);
+      kept.intensity.push_back(cloud->intensity[i]);
+      kept.module.push_back(cloud->module[i]);
+      kept.confidence.push_back(cloud->confidence[i]);
+      continue;
+    }
+    ++report->seen_through;
+    const Eigen::Vector3d q = plan.geometry.PixelAndDisparity(r * cloud->xyz_mm[i].cast<double>() + t);
+    const cv::Point px(int(std::lround(q.x())), int(std::lround(q.y())));
+    STEREORIG_CHECK(px.inside(cv::Rect(cv::Point(0, 0), report->status.size())));
+    uint8_t& st = report->status.at<uint8_t>(px);
+    STEREORIG_CHECK(st == uint8_t(PixelStatus::kPoint));
+    st = uint8_t(PixelStatus::kSeenThrough);
+    const cv::Point lit_px = px - plan.roi.tl();
+    if (lit_px.inside(cv::Rect(cv::Point(0, 0), report->lit.size())) && report->lit.at<uint8_t>(lit_px)) {
+      --report->lit_filled;
+      --report->lit_by_status[size_t(PixelStatus::kPoint)];
+      ++report->lit_by_status[size_t(PixelStatus::kSeenThrough)];
+    }
+  }
+  report->points = int(kept.size());
+  *cloud = std::move(kept);
+  if (mesh->vertices_mm.empty()) return;
+  Mesh out;
+  out.vertices_mm = cloud->xyz_mm;
+  for (const Eigen::Vector3i& tri : mesh->triangles) {
+    const Eigen::Vector3i m(new_index[tri[0]], new_index[tri[1]], new_index[tri[2]]);
+    if (m.minCoeff() >= 0) out.triangles.push_back(m);
+  }
+  *mesh = std::move(out);
 }
 
 }  // namespace
@@ -145,6 +194,7 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
                                : cv::Rect();
   }
   report->match_roi = match_roi;
+  report->lit = lit;
   report->min_disparity_px = plan.min_disparity_px;
   report->num_disparities = plan.num_disparities;
   report->times_ms["lit_region"] = MsSince(t);
@@ -341,6 +391,18 @@ Reconstruction Runtime::Process(const std::vector<cv::Mat>& images, bool build_m
       ProcessModule(plans_[m], images, build_mesh, &clouds[m], &meshes[m], &out.modules[m]);
   });
   out.times_ms["modules"] = MsSince(t);
+  if (options_.free_space_test && nm > 1) {
+    t = Clock::now();
+    std::vector<FreeSpaceView> views(nm);
+    for (int m = 0; m < nm; ++m)
+      views[m] = FreeSpaceView{plans_[m].geometry, plans_[m].reference_from_module.Inverse(),
+                               plans_[m].camera_centre_reference_mm};
+    const std::vector<std::vector<uint8_t>> refuted = FreeSpaceRefuted(views, clouds, options_.free_space);
+    for (int m = 0; m < nm; ++m)
+      if (std::find(refuted[m].begin(), refuted[m].end(), 1) != refuted[m].end())
+        RemoveRefuted(plans_[m], refuted[m], &clouds[m], &meshes[m], &out.modules[m]);
+    out.times_ms["free_space"] = MsSince(t);
+  }
   t = Clock::now();
   size_t total_points = 0;
   for (const PointCloud& c : clouds) total_points += c.size();

@@ -50,9 +50,10 @@ struct ModuleReport {
   // What the matcher searched at full resolution (MatchResult): the occupied
   // band within that range; 0 / 0 when nothing was matched (no lit region).
   int searched_min_disparity_px = 0, searched_num_disparities = 0;
-  int points = 0;      // points kept
-  int lit_pixels = 0;  // grid-lit pixels of the rectified left image in the volume's ROI
-  int lit_filled = 0;  // of those, pixels with a kept point
+  int points = 0;        // points kept
+  int seen_through = 0;  // of the module's points, those the free-space test removed (free_space.h)
+  int lit_pixels = 0;    // grid-lit pixels of the rectified left image in the volume's ROI
+  int lit_filled = 0;    // of those, pixels with a kept point
   // The lit pixels by their final PixelStatus (disparity_state.h): kPoint
   // counts lit_filled, the others name the test that refused the rest. The
   // runtime's own account of where fill goes, with no truth needed.
@@ -63,6 +64,9 @@ struct ModuleReport {
   // that dropped it (for scoring the fill against truth and finding where it
   // is lost, reconstruct/fill_score.h).
   cv::Mat status;
+  // CV_8UC1 over the volume's ROI (ModulePlan::roi): the grid-lit pixels
+  // lit_pixels counts (for recounting after the free-space test).
+  cv::Mat lit;
   std::map<std::string, double> times_ms;        // rectify, lit_region, match, triangulate, normals, mesh
   std::optional<SurfaceFitSummary> surface_fit;  // the matcher's (matcher.h), if the fit ran
 };
@@ -71,7 +75,7 @@ struct Reconstruction {
   PointCloud cloud;  // all modules, then filled points; reference frame
   Mesh mesh;         // empty unless requested
   std::vector<ModuleReport> modules;
-  std::map<std::string, double> times_ms;  // modules (wall), merge, mesh_join, hole_fill, total_point_cloud
+  std::map<std::string, double> times_ms;  // modules (wall), free_space, merge, mesh_join, hole_fill, total_point_cloud
   int filled_points = 0;                   // points added by hole filling
   std::string shape_fit;                   // one line: the fitted model, or why there is none
 };

@@ -1,5 +1,7 @@
 #include "reconstruct/runtime_options.h"
 
+#include <string>
+
 #include "calib/core/input_error.h"
 #include "calib/core/yaml_reader.h"
 
@@ -38,6 +40,18 @@ void RuntimeOptions::Check() const {
   if (!(fill_spacing_mm > 0.05)) throw InputError("fill_spacing_mm", "must be > 0.05 mm");
   if (!(fill_residual_length_mm == 0 || (fill_residual_length_mm >= 1 && fill_residual_length_mm <= 1000)))
     throw InputError("fill_residual_length_mm", "must be 0 (chosen from the data) or in [1, 1000] mm");
+  if (!(free_space.margin_px > 0 && free_space.margin_px <= 100))
+    throw InputError("free_space_margin_px", "must be in (0, 100] px");
+  if (free_space.window_radius_px < 0 || free_space.window_radius_px > 5)
+    throw InputError("free_space_window_radius_px", "must be in [0, 5] px");
+  {
+    const int window = (2 * free_space.window_radius_px + 1) * (2 * free_space.window_radius_px + 1);
+    if (free_space.min_support < 1 || free_space.min_support > window)
+      throw InputError("free_space_min_support",
+                       "must be in [1, " + std::to_string(window) + "] (the pixels of the window)");
+  }
+  if (!(free_space.min_facing_cos >= 0 && free_space.min_facing_cos < 1))
+    throw InputError("free_space_min_facing_cos", "must be in [0, 1)");
   try {
     match.Check();
   } catch (const InputError& e) {  // named as the options file names it: match.<key>
@@ -69,6 +83,11 @@ RuntimeOptions FromYaml(YamlMap& y) {
   o.fill_follow_residuals = y.GetBool("fill_follow_residuals", o.fill_follow_residuals);
   o.fill_residual_length_mm = y.GetDouble("fill_residual_length_mm", o.fill_residual_length_mm);
   o.parallel_modules = y.GetBool("parallel_modules", o.parallel_modules);
+  o.free_space_test = y.GetBool("free_space_test", o.free_space_test);
+  o.free_space.margin_px = y.GetDouble("free_space_margin_px", o.free_space.margin_px);
+  o.free_space.window_radius_px = y.GetInt("free_space_window_radius_px", o.free_space.window_radius_px);
+  o.free_space.min_support = y.GetInt("free_space_min_support", o.free_space.min_support);
+  o.free_space.min_facing_cos = y.GetDouble("free_space_min_facing_cos", o.free_space.min_facing_cos);
   if (y.Has("match")) {
     YamlMap m = y.GetMap("match");
     MatchOptions& mo = o.match;

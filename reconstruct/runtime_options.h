@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "reconstruct/free_space.h"
 #include "reconstruct/matcher.h"
 
 namespace stereorig {
@@ -51,6 +52,11 @@ struct RuntimeOptions {
   // (residual_field.h).
   double fill_residual_length_mm = 0;
   bool parallel_modules = true;  // process modules on separate threads; default true
+  // The free-space test across modules (free_space.h): a module's point is
+  // removed (status kSeenThrough) where the other modules' surfaces facing
+  // its left camera lie in front of it along its ray. Only with 2+ modules.
+  bool free_space_test = true;  // default true
+  FreeSpaceOptions free_space;  // its thresholds (free_space.h)
 
   // Where these options came from (the YAML file's path; empty for the
   // built-in defaults), for messages about them that only the Runtime can

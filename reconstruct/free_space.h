@@ -1,0 +1,66 @@
+// The free-space (visibility) test across modules: a module's point is refuted
+// when the other modules measured a surface facing that module's left camera
+// in front of it, along the camera's own ray. The camera could not have seen
+// the point through that surface, so one of the two is wrong; the facing
+// surface, measured by another module from another direction, is kept.
+//
+// Why: where a module's right camera grazes a surface (1 - dd/dx < 0.3), the
+// matcher can keep a whole patch matched tens of px off, a smooth surface
+// behind the real one inside the measurement volume; nothing in that
+// module's own data tells it from a surface ("The oblique plate (session
+// 22)" (reconstruct-log.md)). Another module that measures the real surface
+// puts its points in front of that patch along the first module's rays.
+//
+// Per module j: a depth buffer over module j's rectified left image holds,
+// at each pixel, the largest disparity (in module j's image-disparity units,
+// rectify.h: the nearest) of the other modules' points that project there
+// and face camera j (unit normal . unit direction to camera j >
+// min_facing_cos). A point P of module j at pixel (u, v) with disparity d_P
+// is refuted when at least `min_support` of the buffer's pixels (x, y)
+// within `window_radius_px` of (u, v) hold a disparity > d_P(x, y) +
+// margin_px, where d_P(x, y) is P's own surface (the plane through P normal
+// to its normal) at that pixel: on a surface camera j sees obliquely the
+// disparity steps by up to B / Z tan(75 deg) ~ 1.7 px per px, and a correct
+// neighbour two px away would otherwise read nearer by more than the margin.
+//
+// Comparing disparities is comparing depths scaled by the module's own
+// noise: Z = f B / (d + offset), so a margin of m px is m sigma_Z / sigma_d
+// with sigma_Z = Z^2 sigma_d / (f B) the depth sigma of a point whose
+// disparity scatters by sigma_d (docs/reconstruct.md, the option's row).
+// The rule never removes a point behind the facing surface (a facing
+// module's correct points, seen from its partner, lie behind the partner's
+// surface), nor where no other module's point projects.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "calib/core/pose.h"
+#include "reconstruct/point_cloud.h"
+#include "reconstruct/rectify.h"
+
+namespace stereorig {
+
+struct FreeSpaceOptions {
+  double margin_px = 4.0;        // in front by more than this (the tested module's disparity); default 4 px
+  int window_radius_px = 2;      // buffer pixels searched around the point's pixel; default 2 (5x5)
+  int min_support = 3;           // buffer pixels in front needed; default 3
+  double min_facing_cos = 0.26;  // another module's point faces the camera if n.v exceeds this (~75 deg); default 0.26
+};
+
+// One module's rectified left camera, as the runtime's plan holds it.
+struct FreeSpaceView {
+  RectifiedGeometry geometry;                                            // module j's rectification (rectify.h)
+  Pose module_from_reference;                                            // S[j][0]
+  Eigen::Vector3d camera_centre_reference_mm = Eigen::Vector3d::Zero();  // its left camera centre
+};
+
+// clouds[j]: module j's points (reference frame, mm) with unit normals; the
+// cloud's `module` field is ignored (clouds[j] is module j's). Returns, per
+// module, one flag per point: 1 = refuted. views.size() == clouds.size().
+std::vector<std::vector<uint8_t>> FreeSpaceRefuted(const std::vector<FreeSpaceView>& views,
+                                                   const std::vector<PointCloud>& clouds,
+                                                   const FreeSpaceOptions& options);
+
+}  // namespace stereorig

@@ -1,0 +1,175 @@
+#include "reconstruct/free_space.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+namespace stereorig {
+namespace {
+
+// A rectified left camera at `centre_mm` (reference frame) looking at
+// `look_at_mm`, y down: f 1000 px, 752 x 582 px, baseline 90 mm, no offset.
+FreeSpaceView CameraAt(const Eigen::Vector3d& centre_mm, const Eigen::Vector3d& look_at_mm) {
+  const Eigen::Vector3d z = (look_at_mm - centre_mm).normalized();
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitY().cross(z).normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  Eigen::Matrix3d reference_from_module;
+  reference_from_module << x, y, z;
+  FreeSpaceView v;
+  v.geometry.focal_px = 1000;
+  v.geometry.cx_left_px = 376;
+  v.geometry.cy_px = 291;
+  v.geometry.baseline_mm = 90;
+  v.geometry.size = cv::Size(752, 582);
+  v.module_from_reference = Pose(reference_from_module, centre_mm).Inverse();
+  v.camera_centre_reference_mm = centre_mm;
+  return v;
+}
+
+// Points of the rectangle z = z_mm, x in [x0, x1), y in [-20, 20) mm, every
+// 0.15 mm (~0.75 px at 200 mm: at least one point per pixel), normal n.
+void AddPlanePatch(double z_mm, double x0, double x1, const Eigen::Vector3f& n, PointCloud* c) {
+  for (double y = -20; y < 20; y += 0.15)
+    for (double x = x0; x < x1; x += 0.15) {
+      c->xyz_mm.emplace_back(float(x), float(y), float(z_mm));
+      c->normal.push_back(n);
+      c->intensity.push_back(0);
+      c->module.push_back(0);
+      c->confidence.push_back(1);
+    }
+}
+
+// The default rig's pair: module 0 at the origin, module 1 across the
+// target at 400 mm, both looking at (0, 0, 200) mm.
+std::vector<FreeSpaceView> FacingPair() {
+  const Eigen::Vector3d target(0, 0, 200);
+  return {CameraAt(Eigen::Vector3d::Zero(), target), CameraAt(Eigen::Vector3d(0, 0, 400), target)};
+}
+
+// A ring's pair: module 0 at the origin, module 1 60 deg round the y axis,
+// 200 mm from (0, 0, 200) mm, both looking at it.
+std::vector<FreeSpaceView> SixtyDegreePair() {
+  const Eigen::Vector3d target(0, 0, 200);
+  const double a = 60 * M_PI / 180;
+  return {CameraAt(Eigen::Vector3d::Zero(), target),
+          CameraAt(target + 200 * Eigen::Vector3d(std::sin(a), 0, -std::cos(a)), target)};
+}
+
+size_t Count(const std::vector<uint8_t>& flags, size_t begin, size_t end) {
+  size_t n = 0;
+  for (size_t i = begin; i < end; ++i) n += flags[i];
+  return n;
+}
+
+// Module 0 looks along +z; module 1 from 60 deg round the y axis, both at
+// the plane z = 200 mm. Module 0 measures the left half of the plane right
+// and, over the right half, a wrong surface 50 mm behind it (the ring's
+// grazed module: ~225 px of disparity off at this range); module 1 measures
+// the whole plane. From camera 0, module 1's points lie in front of the
+// wrong surface: it goes, and nothing else does.
+TEST(FreeSpaceRefuted, RemovesAWrongSurfaceBehindAnotherModulesFacingSurface) {
+  const std::vector<FreeSpaceView> views = SixtyDegreePair();
+  const Eigen::Vector3f towards_cameras(0, 0, -1);  // faces both cameras (camera 1 at 60 deg: n.v = 0.5)
+  std::vector<PointCloud> clouds(2);
+  AddPlanePatch(200, -20, 0, towards_cameras, &clouds[0]);
+  const size_t true_points = clouds[0].size();
+  AddPlanePatch(250, 0, 25, towards_cameras, &clouds[0]);  // the wrong surface (x up to 25: the ray's spread)
+  AddPlanePatch(200, -20, 20, towards_cameras, &clouds[1]);
+
+  const std::vector<std::vector<uint8_t>> refuted = FreeSpaceRefuted(views, clouds, FreeSpaceOptions());
+  ASSERT_EQ(refuted.size(), 2u);
+  EXPECT_EQ(Count(refuted[0], 0, true_points), 0u) << "module 0's true surface kept";
+  EXPECT_EQ(Count(refuted[1], 0, clouds[1].size()), 0u) << "module 1's surface kept";
+  // The wrong surface's points whose rays (from camera 0) cross module 1's
+  // patch: x < 20 * 250 / 200 = 25 mm, all of them but its edge's pixels.
+  const size_t wrong = clouds[0].size() - true_points;
+  size_t behind_patch = 0, removed_behind_patch = 0;
+  for (size_t i = true_points; i < clouds[0].size(); ++i) {
+    const Eigen::Vector3f& p = clouds[0].xyz_mm[i];
+    if (p.x() * 200 / 250 < 19.5 && std::abs(p.y() * 200 / 250) < 19.5) {
+      ++behind_patch;
+      removed_behind_patch += refuted[0][i];
+    }
+  }
+  EXPECT_GT(behind_patch, wrong / 2);
+  EXPECT_EQ(removed_behind_patch, behind_patch) << "the wrong surface behind module 1's is removed";
+}
+
+// The default rig's pair: two modules facing each other across a 2 mm
+// plate, each measuring its own face. From either camera the other
+// module's points lie behind its own surface (and face away): nothing is
+// removed. Also with the facing test off (min_facing_cos 0 still needs
+// n.v > 0) and a 1 px margin.
+TEST(FreeSpaceRefuted, RemovesNothingFromAFacingPairsPlate) {
+  const std::vector<FreeSpaceView> views = FacingPair();
+  std::vector<PointCloud> clouds(2);
+  AddPlanePatch(199, -20, 20, Eigen::Vector3f(0, 0, -1), &clouds[0]);
+  AddPlanePatch(201, -20, 20, Eigen::Vector3f(0, 0, 1), &clouds[1]);
+  for (const FreeSpaceOptions& o : {FreeSpaceOptions(), FreeSpaceOptions{1.0, 1, 1, 0.0}}) {
+    const std::vector<std::vector<uint8_t>> refuted = FreeSpaceRefuted(views, clouds, o);
+    EXPECT_EQ(Count(refuted[0], 0, clouds[0].size()), 0u);
+    EXPECT_EQ(Count(refuted[1], 0, clouds[1].size()), 0u);
+  }
+}
+
+// A point behind another module's surface that faces AWAY from the camera
+// (its back face, which the camera cannot see anyway) is not refuted: only
+// surfaces facing the camera block its view. Module 1, across the plate,
+// measured the plate's far face; module 0 a point 5 mm behind it.
+TEST(FreeSpaceRefuted, ABackFacingSurfaceRefutesNothing) {
+  const std::vector<FreeSpaceView> views = FacingPair();
+  std::vector<PointCloud> clouds(2);
+  AddPlanePatch(205, -5, 5, Eigen::Vector3f(0, 0, -1), &clouds[0]);
+  AddPlanePatch(200, -20, 20, Eigen::Vector3f(0, 0, 1), &clouds[1]);
+  const std::vector<std::vector<uint8_t>> refuted = FreeSpaceRefuted(views, clouds, FreeSpaceOptions());
+  EXPECT_EQ(Count(refuted[0], 0, clouds[0].size()), 0u);
+}
+
+// Only what lies in FRONT refutes: module 0 measures a small plate at
+// 200 mm, module 1 (60 deg round) a background plate at 230 mm that faces
+// camera 0 too and spans its view behind the small plate. Every module-1
+// point near module 0's rays lies 30 mm (~70 px) behind: nothing of module
+// 0 goes.
+TEST(FreeSpaceRefuted, ASurfaceBehindFromTheCamerasViewRefutesNothing) {
+  const std::vector<FreeSpaceView> views = SixtyDegreePair();
+  std::vector<PointCloud> clouds(2);
+  AddPlanePatch(200, -5, 5, Eigen::Vector3f(0, 0, -1), &clouds[0]);
+  AddPlanePatch(230, -20, 20, Eigen::Vector3f(0, 0, -1), &clouds[1]);
+  const std::vector<std::vector<uint8_t>> refuted = FreeSpaceRefuted(views, clouds, FreeSpaceOptions());
+  EXPECT_EQ(Count(refuted[0], 0, clouds[0].size()), 0u);
+}
+
+// A steep surface both modules measure: the plane through (0, 0, 200) mm
+// turned 70 deg from camera 0's axis (towards module 1, which sees it
+// nearly face on). In camera 0's image its disparity steps by ~1.2 px/px,
+// so another module's correct points two px away read ~2.5 px nearer than
+// the point: the test compares them with the point's own plane (its
+// normal), and nothing is removed, also at a 2 px margin (where, compared
+// with the point's own disparity, the window's far columns would refute it).
+TEST(FreeSpaceRefuted, KeepsASteepSurfaceBothModulesMeasure) {
+  const Eigen::Vector3d target(0, 0, 200);
+  const double tilt = 70 * M_PI / 180;
+  const std::vector<FreeSpaceView> views = SixtyDegreePair();
+  const Eigen::Vector3f n(float(std::sin(tilt)), 0, float(-std::cos(tilt)));     // faces both cameras
+  const Eigen::Vector3f along(float(std::cos(tilt)), 0, float(std::sin(tilt)));  // in the plane, across y
+  std::vector<PointCloud> clouds(2);
+  for (PointCloud& c : clouds)
+    for (double y = -20; y < 20; y += 0.15)
+      for (double s = -20; s < 20; s += 0.15) {
+        c.xyz_mm.push_back(target.cast<float>() + float(s) * along + Eigen::Vector3f(0, float(y), 0));
+        c.normal.push_back(n);
+        c.intensity.push_back(0);
+        c.module.push_back(0);
+        c.confidence.push_back(1);
+      }
+  for (const double margin_px : {4.0, 2.0}) {
+    FreeSpaceOptions o;
+    o.margin_px = margin_px;
+    const std::vector<std::vector<uint8_t>> refuted = FreeSpaceRefuted(views, clouds, o);
+    EXPECT_EQ(Count(refuted[0], 0, clouds[0].size()), 0u) << margin_px << " px";
+    EXPECT_EQ(Count(refuted[1], 0, clouds[1].size()), 0u) << margin_px << " px";
+  }
+}
+
+}  // namespace
+}  // namespace stereorig
