@@ -3,91 +3,198 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <opencv2/core.hpp>
 
 #include "calib/core/input_error.h"
 
 namespace stereorig {
 
+namespace {
+
+// Module j's rectified left frame: a point's pixel and disparity there.
+class ModuleProjection {
+ public:
+  explicit ModuleProjection(const FreeSpaceView& view)
+      : g_(view.geometry),
+        r_(g_.rect_from_left * view.module_from_reference.rotation()),
+        t_(g_.rect_from_left * view.module_from_reference.translation_mm()) {}
+
+  const RectifiedGeometry& geometry() const { return g_; }
+  Eigen::Vector3d Rectified(const Eigen::Vector3f& p_reference_mm) const {
+    return r_ * p_reference_mm.cast<double>() + t_;
+  }
+  Eigen::Vector3d RectifiedDirection(const Eigen::Vector3f& n_reference) const {
+    return r_ * n_reference.cast<double>();
+  }
+  // (u, v) the nearest pixel, *q the pixel and disparity; false if P is
+  // behind the camera or outside the image.
+  bool Project(const Eigen::Vector3d& p_rect, int* u, int* v, Eigen::Vector3d* q) const {
+    if (!(p_rect.z() > 1e-6)) return false;
+    *q = g_.PixelAndDisparity(p_rect);
+    *u = int(std::lround(q->x())), *v = int(std::lround(q->y()));
+    return *u >= 0 && *v >= 0 && *u < g_.size.width && *v < g_.size.height;
+  }
+
+ private:
+  const RectifiedGeometry& g_;
+  Eigen::Matrix3d r_;
+  Eigen::Vector3d t_;
+};
+
+// The depth buffer of module j: at each pixel of its rectified left image,
+// the largest disparity of the other modules' points that face camera j,
+// among those `usable` (empty: all); -inf where none. Empty if none.
+cv::Mat FacingDepthBuffer(int j, const FreeSpaceView& view, const ModuleProjection& proj,
+                          const std::vector<PointCloud>& clouds, const std::vector<std::vector<uint8_t>>& usable,
+                          const FreeSpaceOptions& options) {
+  const float none = -std::numeric_limits<float>::infinity();
+  const Eigen::Vector3f eye = view.camera_centre_reference_mm.cast<float>();
+  cv::Mat buffer;  // CV_32FC1
+  for (int k = 0; k < int(clouds.size()); ++k) {
+    if (k == j) continue;
+    const PointCloud& c = clouds[k];
+    for (size_t i = 0; i < c.size(); ++i) {
+      if (!usable.empty() && !usable[k][i]) continue;
+      const Eigen::Vector3f to_eye = eye - c.xyz_mm[i];
+      const float dist = to_eye.norm();
+      if (!(c.normal[i].dot(to_eye) > float(options.min_facing_cos) * dist)) continue;
+      int u, v;
+      Eigen::Vector3d q;
+      if (!proj.Project(proj.Rectified(c.xyz_mm[i]), &u, &v, &q)) continue;
+      if (buffer.empty()) buffer = cv::Mat(proj.geometry().size, CV_32FC1, cv::Scalar(none));
+      float& b = buffer.at<float>(v, u);
+      b = std::max(b, float(q.z()));
+    }
+  }
+  return buffer;
+}
+
+// Whether module j's point i is refuted by `buffer` (FacingDepthBuffer).
+bool SeenThrough(const ModuleProjection& proj, const PointCloud& c, size_t i, const cv::Mat& buffer,
+                 const FreeSpaceOptions& options) {
+  const RectifiedGeometry& g = proj.geometry();
+  const Eigen::Vector3d p_rect = proj.Rectified(c.xyz_mm[i]);
+  int u, v;
+  Eigen::Vector3d q;
+  if (!proj.Project(p_rect, &u, &v, &q)) return false;
+  // P's own surface, its normal's plane n.X = h (rectified frame), in
+  // j's image: d = B (n_x (u - cx) + n_y (v - cy) + n_z f) / h, so the
+  // disparity steps by B n_x / h and B n_y / h per px. A correct point
+  // of another module on the same surface, one or two px away, differs
+  // by that step, not by the margin. Clamped to the steepest facing
+  // slope, px/px at depth Z: B / Z * tan(acos(min_facing_cos)).
+  const double cos_max = std::max(options.min_facing_cos, 0.05);
+  const double tan_max = std::sqrt(1 - cos_max * cos_max) / cos_max;
+  const Eigen::Vector3d n_rect = proj.RectifiedDirection(c.normal[i]);
+  const double h = n_rect.dot(p_rect);
+  const double max_slope = g.baseline_mm / p_rect.z() * tan_max;
+  double sx = 0, sy = 0;
+  if (std::abs(h) > 1e-9) {
+    sx = std::clamp(g.baseline_mm * n_rect.x() / h, -max_slope, max_slope);
+    sy = std::clamp(g.baseline_mm * n_rect.y() / h, -max_slope, max_slope);
+  }
+  const int rad = options.window_radius_px;
+  int support = 0;
+  for (int y = std::max(0, v - rad); y <= std::min(g.size.height - 1, v + rad); ++y) {
+    const float* b = buffer.ptr<float>(y);
+    for (int x = std::max(0, u - rad); x <= std::min(g.size.width - 1, u + rad); ++x) {
+      const double front = q.z() + sx * (x - q.x()) + sy * (y - q.y()) + options.margin_px;
+      support += b[x] > front;
+    }
+  }
+  return support >= options.min_support;
+}
+
+// Module j's surfaces: a label per point, points joined through the same
+// or 4-neighbouring pixels of j's rectified left image when they lie within
+// max_edge_mm of each other (union-find over the points).
+std::vector<int> SurfaceLabels(const ModuleProjection& proj, const PointCloud& c, double max_edge_mm) {
+  std::vector<int> parent(c.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  const float max_edge2 = float(max_edge_mm * max_edge_mm);
+  auto join = [&](int a, int b) {
+    if ((c.xyz_mm[a] - c.xyz_mm[b]).squaredNorm() > max_edge2) return;
+    a = find(a), b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  };
+  cv::Mat first(proj.geometry().size, CV_32SC1, cv::Scalar(-1));  // the first point at each pixel
+  for (size_t i = 0; i < c.size(); ++i) {
+    int u, v;
+    Eigen::Vector3d q;
+    if (!proj.Project(proj.Rectified(c.xyz_mm[i]), &u, &v, &q)) continue;
+    int& f = first.at<int>(v, u);
+    if (f < 0) {
+      f = int(i);
+    } else {
+      join(f, int(i));
+    }
+  }
+  for (int y = 0; y < first.rows; ++y) {
+    const int* row = first.ptr<int>(y);
+    const int* below = y + 1 < first.rows ? first.ptr<int>(y + 1) : nullptr;
+    for (int x = 0; x < first.cols; ++x) {
+      if (row[x] < 0) continue;
+      if (x + 1 < first.cols && row[x + 1] >= 0) join(row[x], row[x + 1]);
+      if (below && below[x] >= 0) join(row[x], below[x]);
+    }
+  }
+  std::vector<int> label(c.size());
+  for (size_t i = 0; i < c.size(); ++i) label[i] = find(int(i));
+  return label;
+}
+
+}  // namespace
+
 std::vector<std::vector<uint8_t>> FreeSpaceRefuted(const std::vector<FreeSpaceView>& views,
                                                    const std::vector<PointCloud>& clouds,
                                                    const FreeSpaceOptions& options) {
   STEREORIG_CHECK(views.size() == clouds.size());
   const int nm = int(views.size());
-  std::vector<std::vector<uint8_t>> refuted(nm);
-  for (int j = 0; j < nm; ++j) refuted[j].assign(clouds[j].size(), 0);
-  const float none = -std::numeric_limits<float>::infinity();
+  std::vector<ModuleProjection> projections;
+  projections.reserve(nm);
+  for (const FreeSpaceView& view : views) projections.emplace_back(view);
+  // The test with the buffers of the `usable` points (empty: all), on
+  // every point not already `refuted`.
+  auto test = [&](const std::vector<std::vector<uint8_t>>& usable, std::vector<std::vector<uint8_t>>* refuted) {
+    for (int j = 0; j < nm; ++j) {
+      if (clouds[j].size() == 0) continue;
+      const cv::Mat buffer = FacingDepthBuffer(j, views[j], projections[j], clouds, usable, options);
+      if (buffer.empty()) continue;
+      for (size_t i = 0; i < clouds[j].size(); ++i)
+        if (!(*refuted)[j][i]) (*refuted)[j][i] = SeenThrough(projections[j], clouds[j], i, buffer, options);
+    }
+  };
+  std::vector<std::vector<uint8_t>> first(nm);
+  for (int j = 0; j < nm; ++j) first[j].assign(clouds[j].size(), 0);
+  test({}, &first);
+
+  // The surfaces at least surface_fraction refuted go whole.
+  std::vector<std::vector<uint8_t>> wrong(nm), usable(nm);
+  bool any_wrong = false;
   for (int j = 0; j < nm; ++j) {
-    if (clouds[j].size() == 0) continue;
-    const FreeSpaceView& view = views[j];
-    const RectifiedGeometry& g = view.geometry;
-    // rect_from_reference: the rectified left frame of module j.
-    const Eigen::Matrix3d r = g.rect_from_left * view.module_from_reference.rotation();
-    const Eigen::Vector3d t = g.rect_from_left * view.module_from_reference.translation_mm();
-    const Eigen::Vector3f eye = view.camera_centre_reference_mm.cast<float>();
-    auto project = [&](const Eigen::Vector3f& p, int* u, int* v, float* d) {
-      const Eigen::Vector3d p_rect = r * p.cast<double>() + t;
-      if (!(p_rect.z() > 1e-6)) return false;
-      const Eigen::Vector3d q = g.PixelAndDisparity(p_rect);
-      *u = int(std::lround(q.x())), *v = int(std::lround(q.y()));
-      *d = float(q.z());
-      return *u >= 0 && *v >= 0 && *u < g.size.width && *v < g.size.height;
-    };
-    // The depth buffer of the other modules' points that face camera j.
-    cv::Mat buffer;  // CV_32FC1, rectified left size: the largest disparity, -inf = none
-    for (int k = 0; k < nm; ++k) {
-      if (k == j) continue;
-      const PointCloud& c = clouds[k];
-      for (size_t i = 0; i < c.size(); ++i) {
-        const Eigen::Vector3f to_eye = eye - c.xyz_mm[i];
-        const float dist = to_eye.norm();
-        if (!(c.normal[i].dot(to_eye) > float(options.min_facing_cos) * dist)) continue;
-        int u, v;
-        float d;
-        if (!project(c.xyz_mm[i], &u, &v, &d)) continue;
-        if (buffer.empty()) buffer = cv::Mat(g.size, CV_32FC1, cv::Scalar(none));
-        float& b = buffer.at<float>(v, u);
-        if (d > b) b = d;
+    wrong[j].assign(clouds[j].size(), 0);
+    if (std::find(first[j].begin(), first[j].end(), 1) != first[j].end()) {
+      const std::vector<int> label = SurfaceLabels(projections[j], clouds[j], options.surface_max_edge_mm);
+      std::vector<int> size(clouds[j].size(), 0), refuted(clouds[j].size(), 0);
+      for (size_t i = 0; i < label.size(); ++i) ++size[label[i]], refuted[label[i]] += first[j][i];
+      for (size_t i = 0; i < label.size(); ++i) {
+        wrong[j][i] = refuted[label[i]] >= options.surface_fraction * size[label[i]];
+        any_wrong = any_wrong || wrong[j][i];
       }
     }
-    if (buffer.empty()) continue;
-    const int rad = options.window_radius_px;
-    // The steepest slope a facing surface has in j's image, px/px at depth
-    // Z: B / Z * tan(acos(min_facing_cos)).
-    const double cos_max = std::max(options.min_facing_cos, 0.05);
-    const double tan_max = std::sqrt(1 - cos_max * cos_max) / cos_max;
-    const PointCloud& c = clouds[j];
-    for (size_t i = 0; i < c.size(); ++i) {
-      const Eigen::Vector3d p_rect = r * c.xyz_mm[i].cast<double>() + t;
-      if (!(p_rect.z() > 1e-6)) continue;
-      const Eigen::Vector3d q = g.PixelAndDisparity(p_rect);
-      const int u = int(std::lround(q.x())), v = int(std::lround(q.y()));
-      if (u < 0 || v < 0 || u >= g.size.width || v >= g.size.height) continue;
-      // P's own surface, its normal's plane n.X = h (rectified frame), in
-      // j's image: d = B (n_x (u - cx) + n_y (v - cy) + n_z f) / h, so the
-      // disparity steps by B n_x / h and B n_y / h per px. A correct point
-      // of another module on the same surface, one or two px away, differs
-      // by that step, not by the margin. Clamped to the steepest facing slope.
-      const Eigen::Vector3d n_rect = r * c.normal[i].cast<double>();
-      const double h = n_rect.dot(p_rect);
-      const double max_slope = g.baseline_mm / p_rect.z() * tan_max;
-      double sx = 0, sy = 0;
-      if (std::abs(h) > 1e-9) {
-        sx = std::clamp(g.baseline_mm * n_rect.x() / h, -max_slope, max_slope);
-        sy = std::clamp(g.baseline_mm * n_rect.y() / h, -max_slope, max_slope);
-      }
-      int support = 0;
-      for (int y = std::max(0, v - rad); y <= std::min(g.size.height - 1, v + rad); ++y) {
-        const float* b = buffer.ptr<float>(y);
-        for (int x = std::max(0, u - rad); x <= std::min(g.size.width - 1, u + rad); ++x) {
-          const double front = q.z() + sx * (x - q.x()) + sy * (y - q.y()) + options.margin_px;
-          support += b[x] > front;
-        }
-      }
-      refuted[j][i] = support >= options.min_support;
-    }
+    usable[j].resize(clouds[j].size());
+    for (size_t i = 0; i < clouds[j].size(); ++i) usable[j][i] = !wrong[j][i];
   }
-  return refuted;
+  if (!any_wrong) return first;
+  // Again without the wrong surfaces as occluders: what they alone refuted
+  // stays. What is refuted then, or lies on a wrong surface, goes.
+  test(usable, &wrong);
+  return wrong;
 }
 
 }  // namespace stereorig

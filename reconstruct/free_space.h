@@ -30,6 +30,19 @@
 // The rule never removes a point behind the facing surface (a facing
 // module's correct points, seen from its partner, lie behind the partner's
 // surface), nor where no other module's point projects.
+//
+// Whole surfaces. A wrong patch is refuted only where another module's
+// cover lies in front of it; its points beyond that cover survive, and
+// where they lie in front of a third view's correct surface they refute
+// THAT (the ring's plate at seed 5: module 2's surviving wrong points took
+// 1 302 correct points of module 1, "The free-space test across modules,
+// whole surfaces (session 23)", reconstruct-log.md). So the points are
+// first grouped into surfaces, per module: points joined through
+// neighbouring pixels of its rectified left image whose points lie within
+// surface_max_edge_mm of each other (the mesh's own rule for a depth jump).
+// A surface at least surface_fraction of whose points the test refutes is
+// wrong as a whole: all of it goes, and the test is made again with the
+// depth buffers of what is left, so that a wrong surface refutes nothing.
 #pragma once
 
 #include <Eigen/Core>
@@ -43,10 +56,14 @@
 namespace stereorig {
 
 struct FreeSpaceOptions {
-  double margin_px = 4.0;        // in front by more than this (the tested module's disparity); default 4 px
-  int window_radius_px = 2;      // buffer pixels searched around the point's pixel; default 2 (5x5)
-  int min_support = 3;           // buffer pixels in front needed; default 3
-  double min_facing_cos = 0.26;  // another module's point faces the camera if n.v exceeds this (~75 deg); default 0.26
+  double margin_px = 4.0;         // in front by more than this (the tested module's disparity); default 4 px
+  int window_radius_px = 2;       // buffer pixels searched around the point's pixel; default 2 (5x5)
+  int min_support = 3;            // buffer pixels in front needed; default 3
+  double min_facing_cos = 0.26;   // another module's point faces the camera if n.v exceeds this (~75 deg); default 0.26
+  double surface_fraction = 0.8;  // a surface this share of which is refuted goes whole; (0, 1], default 0.8
+  // Neighbouring pixels' points within this distance are one surface. Not
+  // a key of its own: the runtime sets it to mesh_max_edge_mm. Default 1.5.
+  double surface_max_edge_mm = 1.5;
 };
 
 // One module's rectified left camera, as the runtime's plan holds it.

@@ -61,6 +61,23 @@ size_t Count(const std::vector<uint8_t>& flags, size_t begin, size_t end) {
   return n;
 }
 
+// SixtyDegreePair's scene below: module 0 measures the plane z = 200 mm for
+// x < 0 and a wrong surface at z = 250 mm for x in [0, wrong_end_mm);
+// module 1 the plane for x in [-20, 20) mm. All face both cameras.
+struct WrongSurfaceScene {
+  std::vector<PointCloud> clouds = std::vector<PointCloud>(2);
+  size_t true_points = 0;  // module 0's first points: the true plane; the wrong surface's after
+};
+WrongSurfaceScene WrongSurfaceBehindThePlane(double wrong_end_mm) {
+  const Eigen::Vector3f towards_cameras(0, 0, -1);  // faces both cameras (camera 1 at 60 deg: n.v = 0.5)
+  WrongSurfaceScene s;
+  AddPlanePatch(200, -20, 0, towards_cameras, &s.clouds[0]);
+  s.true_points = s.clouds[0].size();
+  AddPlanePatch(250, 0, wrong_end_mm, towards_cameras, &s.clouds[0]);
+  AddPlanePatch(200, -20, 20, towards_cameras, &s.clouds[1]);
+  return s;
+}
+
 // Module 0 looks along +z; module 1 from 60 deg round the y axis, both at
 // the plane z = 200 mm. Module 0 measures the left half of the plane right
 // and, over the right half, a wrong surface 50 mm behind it (the ring's
@@ -69,12 +86,7 @@ size_t Count(const std::vector<uint8_t>& flags, size_t begin, size_t end) {
 // wrong surface: it goes, and nothing else does.
 TEST(FreeSpaceRefuted, RemovesAWrongSurfaceBehindAnotherModulesFacingSurface) {
   const std::vector<FreeSpaceView> views = SixtyDegreePair();
-  const Eigen::Vector3f towards_cameras(0, 0, -1);  // faces both cameras (camera 1 at 60 deg: n.v = 0.5)
-  std::vector<PointCloud> clouds(2);
-  AddPlanePatch(200, -20, 0, towards_cameras, &clouds[0]);
-  const size_t true_points = clouds[0].size();
-  AddPlanePatch(250, 0, 25, towards_cameras, &clouds[0]);  // the wrong surface (x up to 25: the ray's spread)
-  AddPlanePatch(200, -20, 20, towards_cameras, &clouds[1]);
+  const auto [clouds, true_points] = WrongSurfaceBehindThePlane(25);  // x up to 25: the ray's spread
 
   const std::vector<std::vector<uint8_t>> refuted = FreeSpaceRefuted(views, clouds, FreeSpaceOptions());
   ASSERT_EQ(refuted.size(), 2u);
@@ -95,6 +107,57 @@ TEST(FreeSpaceRefuted, RemovesAWrongSurfaceBehindAnotherModulesFacingSurface) {
   EXPECT_EQ(removed_behind_patch, behind_patch) << "the wrong surface behind module 1's is removed";
 }
 
+// A wrong surface most of which another module's surface hides goes whole:
+// as above, but the wrong surface reaches x = 27 mm, past the rays (x <
+// 25 mm) that cross module 1's patch, so ~7 % of it has nothing in front
+// and is refuted by nothing. It lies on one surface (neighbouring pixels'
+// points 0.2 mm apart), > surface_fraction (0.8) of which is refuted: all
+// of it goes.
+TEST(FreeSpaceRefuted, ASurfaceMostOfWhichIsSeenThroughGoesWhole) {
+  const std::vector<FreeSpaceView> views = SixtyDegreePair();
+  const auto [clouds, true_points] = WrongSurfaceBehindThePlane(27);
+  const std::vector<std::vector<uint8_t>> refuted = FreeSpaceRefuted(views, clouds, FreeSpaceOptions());
+  EXPECT_EQ(Count(refuted[0], 0, true_points), 0u) << "module 0's true surface kept";
+  EXPECT_EQ(Count(refuted[0], true_points, clouds[0].size()), clouds[0].size() - true_points)
+      << "the whole wrong surface removed, also where nothing lies in front of it";
+  EXPECT_EQ(Count(refuted[1], 0, clouds[1].size()), 0u) << "module 1's surface kept";
+}
+
+// A wrong surface refutes nothing once it is found wrong. Module 0 as
+// above (the true plane's left half, and the wrong surface at 250 mm
+// behind module 1's patch); module 1 also measures a background plane at
+// z = 300 mm, x in [-100, -20) mm, which it sees past the plate, and whose
+// rays from camera 1 at x in ~[-58, -22) mm cross the wrong surface
+// (camera 1 at (173, 0, 100) mm: the ray to (-40, 0, 300) crosses z = 250
+// at x = 13 mm). Seen from camera 1 the wrong surface lies in front of that
+// part of the background and faces it (n.v ~0.68): the first pass refutes
+// ~45 % of the background, and all of the wrong surface. The wrong surface
+// is then removed whole, and without it the background stands. (Had the
+// wrong surface hidden more than surface_fraction of the background, both
+// would have gone: the rule reads which surface is mostly seen through.)
+TEST(FreeSpaceRefuted, AWrongSurfaceRefutesNothing) {
+  const std::vector<FreeSpaceView> views = SixtyDegreePair();
+  const Eigen::Vector3f towards_cameras(0, 0, -1);
+  auto [clouds, true_points] = WrongSurfaceBehindThePlane(25);
+  const size_t plate_points = clouds[1].size();
+  AddPlanePatch(300, -100, -20, towards_cameras, &clouds[1]);
+  const std::vector<std::vector<uint8_t>> refuted = FreeSpaceRefuted(views, clouds, FreeSpaceOptions());
+  EXPECT_EQ(Count(refuted[0], 0, true_points), 0u) << "module 0's true surface kept";
+  EXPECT_EQ(Count(refuted[0], true_points, clouds[0].size()), clouds[0].size() - true_points)
+      << "the wrong surface removed";
+  EXPECT_EQ(Count(refuted[1], 0, plate_points), 0u) << "module 1's plate kept";
+  EXPECT_EQ(Count(refuted[1], plate_points, clouds[1].size()), 0u) << "module 1's background kept";
+  // The first pass alone (a wrong surface is a surface all of which is
+  // refuted, and it is not: nothing is removed whole) refutes the
+  // background behind the wrong surface: what the second pass undoes.
+  FreeSpaceOptions whole_only;
+  whole_only.surface_fraction = 1;
+  std::vector<PointCloud> partial = clouds;
+  AddPlanePatch(250, 25, 27, towards_cameras, &partial[0]);  // a strip nothing hides: the surface is not all refuted
+  const std::vector<std::vector<uint8_t>> first = FreeSpaceRefuted(views, partial, whole_only);
+  EXPECT_GT(Count(first[1], plate_points, partial[1].size()), 1000u);
+}
+
 // The default rig's pair: two modules facing each other across a 2 mm
 // plate, each measuring its own face. From either camera the other
 // module's points lie behind its own surface (and face away): nothing is
@@ -105,7 +168,7 @@ TEST(FreeSpaceRefuted, RemovesNothingFromAFacingPairsPlate) {
   std::vector<PointCloud> clouds(2);
   AddPlanePatch(199, -20, 20, Eigen::Vector3f(0, 0, -1), &clouds[0]);
   AddPlanePatch(201, -20, 20, Eigen::Vector3f(0, 0, 1), &clouds[1]);
-  for (const FreeSpaceOptions& o : {FreeSpaceOptions(), FreeSpaceOptions{1.0, 1, 1, 0.0}}) {
+  for (const FreeSpaceOptions& o : {FreeSpaceOptions(), FreeSpaceOptions{1.0, 1, 1, 0.0, 0.8, 1.5}}) {
     const std::vector<std::vector<uint8_t>> refuted = FreeSpaceRefuted(views, clouds, o);
     EXPECT_EQ(Count(refuted[0], 0, clouds[0].size()), 0u);
     EXPECT_EQ(Count(refuted[1], 0, clouds[1].size()), 0u);

@@ -397,7 +397,9 @@ Reconstruction Runtime::Process(const std::vector<cv::Mat>& images, bool build_m
     for (int m = 0; m < nm; ++m)
       views[m] = FreeSpaceView{plans_[m].geometry, plans_[m].reference_from_module.Inverse(),
                                plans_[m].camera_centre_reference_mm};
-    const std::vector<std::vector<uint8_t>> refuted = FreeSpaceRefuted(views, clouds, options_.free_space);
+    FreeSpaceOptions free_space = options_.free_space;
+    free_space.surface_max_edge_mm = options_.mesh_max_edge_mm;  // a surface: what the mesh joins
+    const std::vector<std::vector<uint8_t>> refuted = FreeSpaceRefuted(views, clouds, free_space);
     for (int m = 0; m < nm; ++m)
       if (std::find(refuted[m].begin(), refuted[m].end(), 1) != refuted[m].end())
         RemoveRefuted(plans_[m], refuted[m], &clouds[m], &meshes[m], &out.modules[m]);

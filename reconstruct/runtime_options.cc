@@ -52,6 +52,8 @@ void RuntimeOptions::Check() const {
   }
   if (!(free_space.min_facing_cos >= 0 && free_space.min_facing_cos < 1))
     throw InputError("free_space_min_facing_cos", "must be in [0, 1)");
+  if (!(free_space.surface_fraction > 0 && free_space.surface_fraction <= 1))
+    throw InputError("free_space_surface_fraction", "must be in (0, 1]");
   try {
     match.Check();
   } catch (const InputError& e) {  // named as the options file names it: match.<key>
@@ -88,6 +90,7 @@ RuntimeOptions FromYaml(YamlMap& y) {
   o.free_space.window_radius_px = y.GetInt("free_space_window_radius_px", o.free_space.window_radius_px);
   o.free_space.min_support = y.GetInt("free_space_min_support", o.free_space.min_support);
   o.free_space.min_facing_cos = y.GetDouble("free_space_min_facing_cos", o.free_space.min_facing_cos);
+  o.free_space.surface_fraction = y.GetDouble("free_space_surface_fraction", o.free_space.surface_fraction);
   if (y.Has("match")) {
     YamlMap m = y.GetMap("match");
     MatchOptions& mo = o.match;

@@ -110,15 +110,17 @@ TEST(RuntimeOptions, ReadsAndChecksTheFreeSpaceKeys) {
   EXPECT_EQ(d.free_space.window_radius_px, 2);
   EXPECT_EQ(d.free_space.min_support, 3);
   EXPECT_EQ(d.free_space.min_facing_cos, 0.26);
+  EXPECT_EQ(d.free_space.surface_fraction, 0.8);
   const RuntimeOptions o = ParseRuntimeOptions(
       "free_space_test: false\nfree_space_margin_px: 6\nfree_space_window_radius_px: 1\nfree_space_min_support: 5\n"
-      "free_space_min_facing_cos: 0.5\n",
+      "free_space_min_facing_cos: 0.5\nfree_space_surface_fraction: 1\n",
       "set.yaml");
   EXPECT_FALSE(o.free_space_test);
   EXPECT_EQ(o.free_space.margin_px, 6.0);
   EXPECT_EQ(o.free_space.window_radius_px, 1);
   EXPECT_EQ(o.free_space.min_support, 5);
   EXPECT_EQ(o.free_space.min_facing_cos, 0.5);
+  EXPECT_EQ(o.free_space.surface_fraction, 1.0);
   const std::pair<const char*, const char*> bad[] = {
       {"free_space_test: maybe\n", "free_space_test"},
       {"free_space_tests: true\n", "free_space_tests"},
@@ -129,7 +131,9 @@ TEST(RuntimeOptions, ReadsAndChecksTheFreeSpaceKeys) {
       {"free_space_min_support: 0\n", "free_space_min_support"},
       {"free_space_min_support: 26\n", "free_space_min_support"},  // the default 5x5 window has 25 pixels
       {"free_space_min_facing_cos: 1\n", "free_space_min_facing_cos"},
-      {"free_space_min_facing_cos: -0.1\n", "free_space_min_facing_cos"}};
+      {"free_space_min_facing_cos: -0.1\n", "free_space_min_facing_cos"},
+      {"free_space_surface_fraction: 0\n", "free_space_surface_fraction"},
+      {"free_space_surface_fraction: 1.01\n", "free_space_surface_fraction"}};
   ExpectEachRejectedNamingItsKey(bad);
 }
 

@@ -294,11 +294,13 @@ TEST(RuntimeOnAThreeModuleRig, APlateTheLeftCameraGrazesIsMeasuredAlongItsSlope)
 // its own data refutes ("The oblique plate (session 22)" in
 // reconstruct-log.md). Module 1 measures the plate from the other side of
 // module 2's view, and its points lie in front of that patch along module
-// 2's left camera's rays: the free-space test (free_space.h) removes it.
-// Asserted against the same capture without the test: module 2's points
-// more than 0.5 mm off (~1.1 px of disparity at 200 mm; the module's
-// correct points scatter by ~0.1 mm, so 0.5 mm is 5 sigma) fall to at most
-// a tenth, and modules 0 and 1 lose at most 0.1 % of their points (their
+// 2's left camera's rays: the free-space test (free_space.h) removes it,
+// and, as ~97 % of the patch is seen through, the patch goes whole (its
+// ~3 % beyond module 1's cover too: session 22's test alone left 29 of
+// 2 564). Asserted against the same capture without the test: module 2's
+// points more than 0.5 mm off (~1.1 px of disparity at 200 mm; the
+// module's correct points scatter by ~0.1 mm, so 0.5 mm is 5 sigma) fall
+// to at most 1 %, and modules 0 and 1 lose at most 0.1 % of their points (their
 // surfaces are the plate itself; what the test may take from them is a
 // point whose 5x5 neighbourhood holds another module's nearer points, at
 // the plate's edges).
@@ -315,7 +317,7 @@ TEST(RuntimeOnAThreeModuleRig, TheFreeSpaceTestRemovesAPatchTheRightCameraGrazes
   const long off_without = off(without.accuracy.per_module[2]), off_with = off(with.accuracy.per_module[2]);
   std::printf("module 2: %ld points > 0.5 mm off without the test, %ld with it\n", off_without, off_with);
   EXPECT_GT(off_without, 500) << "the realization no longer has the grazed patch";
-  EXPECT_LE(off_with, off_without / 10);
+  EXPECT_LE(off_with, off_without / 100);
   for (const size_t m : {size_t(0), size_t(1)}) {
     EXPECT_GE(with.accuracy.per_module[m].points, 0.999 * without.accuracy.per_module[m].points) << "module " << m;
     EXPECT_LT(with.accuracy.per_module[m].std_mm, 0.15) << "module " << m;
