@@ -44,13 +44,18 @@ class ModuleProjection {
 
 // The depth buffer of module j: at each pixel of its rectified left image,
 // the largest disparity of the other modules' points that face camera j,
-// among those `usable` (empty: all); -inf where none. Empty if none.
-cv::Mat FacingDepthBuffer(int j, const FreeSpaceView& view, const ModuleProjection& proj,
-                          const std::vector<PointCloud>& clouds, const std::vector<std::vector<uint8_t>>& usable,
-                          const FreeSpaceOptions& options) {
+// among those `usable` (empty: all); -inf where none. `owner`: that
+// point's (module, index). Both empty if no point projects.
+struct DepthBuffer {
+  cv::Mat disparity;  // CV_32FC1
+  cv::Mat owner;      // CV_32SC2
+};
+DepthBuffer FacingDepthBuffer(int j, const FreeSpaceView& view, const ModuleProjection& proj,
+                              const std::vector<PointCloud>& clouds, const std::vector<std::vector<uint8_t>>& usable,
+                              const FreeSpaceOptions& options) {
   const float none = -std::numeric_limits<float>::infinity();
   const Eigen::Vector3f eye = view.camera_centre_reference_mm.cast<float>();
-  cv::Mat buffer;  // CV_32FC1
+  DepthBuffer buffer;
   for (int k = 0; k < int(clouds.size()); ++k) {
     if (k == j) continue;
     const PointCloud& c = clouds[k];
@@ -62,45 +67,70 @@ cv::Mat FacingDepthBuffer(int j, const FreeSpaceView& view, const ModuleProjecti
       int u, v;
       Eigen::Vector3d q;
       if (!proj.Project(proj.Rectified(c.xyz_mm[i]), &u, &v, &q)) continue;
-      if (buffer.empty()) buffer = cv::Mat(proj.geometry().size, CV_32FC1, cv::Scalar(none));
-      float& b = buffer.at<float>(v, u);
-      b = std::max(b, float(q.z()));
+      if (buffer.disparity.empty()) {
+        buffer.disparity = cv::Mat(proj.geometry().size, CV_32FC1, cv::Scalar(none));
+        buffer.owner = cv::Mat(proj.geometry().size, CV_32SC2, cv::Scalar(-1, -1));
+      }
+      float& b = buffer.disparity.at<float>(v, u);
+      if (float(q.z()) > b) {
+        b = float(q.z());
+        buffer.owner.at<cv::Vec2i>(v, u) = cv::Vec2i(k, int(i));
+      }
     }
   }
   return buffer;
 }
 
-// Whether module j's point i is refuted by `buffer` (FacingDepthBuffer).
-bool SeenThrough(const ModuleProjection& proj, const PointCloud& c, size_t i, const cv::Mat& buffer,
-                 const FreeSpaceOptions& options) {
+// The disparity slopes (px/px) in j's image of the plane through p_rect
+// with normal n_rect (rectified frame): n.X = h gives d = B (n_x (u - cx) +
+// n_y (v - cy) + n_z f) / h, so d steps by B n_x / h and B n_y / h per px.
+// Clamped to the steepest facing slope at that depth, B / Z tan(acos(
+// min_facing_cos)).
+Eigen::Vector2d PlaneSlopes(const RectifiedGeometry& g, const Eigen::Vector3d& p_rect, const Eigen::Vector3d& n_rect,
+                            const FreeSpaceOptions& options) {
+  const double cos_max = std::max(options.min_facing_cos, 0.05);
+  const double tan_max = std::sqrt(1 - cos_max * cos_max) / cos_max;
+  const double max_slope = g.baseline_mm / p_rect.z() * tan_max;
+  const double h = n_rect.dot(p_rect);
+  if (!(std::abs(h) > 1e-9)) return Eigen::Vector2d::Zero();
+  return Eigen::Vector2d(std::clamp(g.baseline_mm * n_rect.x() / h, -max_slope, max_slope),
+                         std::clamp(g.baseline_mm * n_rect.y() / h, -max_slope, max_slope));
+}
+
+// Whether module j's rectified pair correlates at buffer pixel (x, y), at
+// its point's disparity, the window warped by that point's own plane.
+bool SeenByTheModule(const FreeSpaceView& view, const ModuleProjection& proj, const std::vector<PointCloud>& clouds,
+                     const DepthBuffer& buffer, int x, int y, const FreeSpaceOptions& options) {
+  const cv::Vec2i owner = buffer.owner.at<cv::Vec2i>(y, x);
+  const PointCloud& c = clouds[owner[0]];
+  const Eigen::Vector3d q_rect = proj.Rectified(c.xyz_mm[owner[1]]);
+  const Eigen::Vector2d slopes =
+      PlaneSlopes(proj.geometry(), q_rect, proj.RectifiedDirection(c.normal[owner[1]]), options);
+  return WindowZncc(view.left_rectified, view.right_rectified, x, y, buffer.disparity.at<float>(y, x), slopes.x(),
+                    slopes.y(), options.window) >= options.min_zncc;
+}
+
+// Whether module j's point i is refuted by `buffer`; with photo_check,
+// only by buffer pixels module j's own pair correlates (SeenByTheModule).
+bool SeenThrough(const FreeSpaceView& view, const ModuleProjection& proj, const std::vector<PointCloud>& clouds, int j,
+                 size_t i, const DepthBuffer& buffer, bool photo_check, const FreeSpaceOptions& options) {
   const RectifiedGeometry& g = proj.geometry();
+  const PointCloud& c = clouds[j];
   const Eigen::Vector3d p_rect = proj.Rectified(c.xyz_mm[i]);
   int u, v;
   Eigen::Vector3d q;
   if (!proj.Project(p_rect, &u, &v, &q)) return false;
-  // P's own surface, its normal's plane n.X = h (rectified frame), in
-  // j's image: d = B (n_x (u - cx) + n_y (v - cy) + n_z f) / h, so the
-  // disparity steps by B n_x / h and B n_y / h per px. A correct point
-  // of another module on the same surface, one or two px away, differs
-  // by that step, not by the margin. Clamped to the steepest facing
-  // slope, px/px at depth Z: B / Z * tan(acos(min_facing_cos)).
-  const double cos_max = std::max(options.min_facing_cos, 0.05);
-  const double tan_max = std::sqrt(1 - cos_max * cos_max) / cos_max;
-  const Eigen::Vector3d n_rect = proj.RectifiedDirection(c.normal[i]);
-  const double h = n_rect.dot(p_rect);
-  const double max_slope = g.baseline_mm / p_rect.z() * tan_max;
-  double sx = 0, sy = 0;
-  if (std::abs(h) > 1e-9) {
-    sx = std::clamp(g.baseline_mm * n_rect.x() / h, -max_slope, max_slope);
-    sy = std::clamp(g.baseline_mm * n_rect.y() / h, -max_slope, max_slope);
-  }
+  // P's own surface, its normal's plane: a correct point of another module
+  // on the same surface, one or two px away, differs by the plane's step,
+  // not by the margin.
+  const Eigen::Vector2d slopes = PlaneSlopes(g, p_rect, proj.RectifiedDirection(c.normal[i]), options);
   const int rad = options.window_radius_px;
   int support = 0;
   for (int y = std::max(0, v - rad); y <= std::min(g.size.height - 1, v + rad); ++y) {
-    const float* b = buffer.ptr<float>(y);
+    const float* b = buffer.disparity.ptr<float>(y);
     for (int x = std::max(0, u - rad); x <= std::min(g.size.width - 1, u + rad); ++x) {
-      const double front = q.z() + sx * (x - q.x()) + sy * (y - q.y()) + options.margin_px;
-      support += b[x] > front;
+      const double front = q.z() + slopes.x() * (x - q.x()) + slopes.y() * (y - q.y()) + options.margin_px;
+      if (b[x] > front && (!photo_check || SeenByTheModule(view, proj, clouds, buffer, x, y, options))) ++support;
     }
   }
   return support >= options.min_support;
@@ -159,41 +189,46 @@ std::vector<std::vector<uint8_t>> FreeSpaceRefuted(const std::vector<FreeSpaceVi
   projections.reserve(nm);
   for (const FreeSpaceView& view : views) projections.emplace_back(view);
   // The test with the buffers of the `usable` points (empty: all), on
-  // every point not already `refuted`.
-  auto test = [&](const std::vector<std::vector<uint8_t>>& usable, std::vector<std::vector<uint8_t>>* refuted) {
+  // every point not already `refuted`; the photo check where asked and
+  // module j has its images.
+  auto test = [&](const std::vector<std::vector<uint8_t>>& usable, bool photo_check,
+                  std::vector<std::vector<uint8_t>>* refuted) {
     for (int j = 0; j < nm; ++j) {
       if (clouds[j].size() == 0) continue;
-      const cv::Mat buffer = FacingDepthBuffer(j, views[j], projections[j], clouds, usable, options);
-      if (buffer.empty()) continue;
+      const DepthBuffer buffer = FacingDepthBuffer(j, views[j], projections[j], clouds, usable, options);
+      if (buffer.disparity.empty()) continue;
+      const bool check = photo_check && !views[j].left_rectified.empty();
       for (size_t i = 0; i < clouds[j].size(); ++i)
-        if (!(*refuted)[j][i]) (*refuted)[j][i] = SeenThrough(projections[j], clouds[j], i, buffer, options);
+        if (!(*refuted)[j][i])
+          (*refuted)[j][i] = SeenThrough(views[j], projections[j], clouds, j, i, buffer, check, options);
     }
   };
   std::vector<std::vector<uint8_t>> first(nm);
   for (int j = 0; j < nm; ++j) first[j].assign(clouds[j].size(), 0);
-  test({}, &first);
+  test({}, false, &first);
+  bool any_refuted = false;
+  for (int j = 0; j < nm; ++j)
+    any_refuted = any_refuted || std::find(first[j].begin(), first[j].end(), 1) != first[j].end();
+  if (!any_refuted) return first;
 
   // The surfaces at least surface_fraction refuted go whole.
   std::vector<std::vector<uint8_t>> wrong(nm), usable(nm);
-  bool any_wrong = false;
   for (int j = 0; j < nm; ++j) {
     wrong[j].assign(clouds[j].size(), 0);
     if (std::find(first[j].begin(), first[j].end(), 1) != first[j].end()) {
       const std::vector<int> label = SurfaceLabels(projections[j], clouds[j], options.surface_max_edge_mm);
       std::vector<int> size(clouds[j].size(), 0), refuted(clouds[j].size(), 0);
       for (size_t i = 0; i < label.size(); ++i) ++size[label[i]], refuted[label[i]] += first[j][i];
-      for (size_t i = 0; i < label.size(); ++i) {
+      for (size_t i = 0; i < label.size(); ++i)
         wrong[j][i] = refuted[label[i]] >= options.surface_fraction * size[label[i]];
-        any_wrong = any_wrong || wrong[j][i];
-      }
     }
     usable[j].resize(clouds[j].size());
     for (size_t i = 0; i < clouds[j].size(); ++i) usable[j][i] = !wrong[j][i];
   }
-  if (!any_wrong) return first;
-  // Again without the wrong surfaces as occluders: what they alone refuted
-  // stays. What is refuted then, or lies on a wrong surface, goes.
-  test(usable, &wrong);
+  // Again without the wrong surfaces as occluders (what they alone refuted
+  // stays), and with the photo check. What is refuted then, or lies on a
+  // wrong surface, goes.
+  test(usable, true, &wrong);
   return wrong;
 }
 

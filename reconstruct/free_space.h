@@ -43,15 +43,33 @@
 // A surface at least surface_fraction of whose points the test refutes is
 // wrong as a whole: all of it goes, and the test is made again with the
 // depth buffers of what is left, so that a wrong surface refutes nothing.
+//
+// The refuter in the refuted module's own images. A point of a correct
+// surface can still be refuted by another module's points a little off
+// their surface: seen from a camera that views the surface obliquely, a
+// ~1 mm offset along the normal is several times the margin along the ray
+// (the ring's plate at seed 5: module 2's points 0.97-1.13 mm off took
+// module 1's points, which module 1's left camera sees ~75 deg off its
+// normal). Had the refuter's surface really been there, module j's own
+// cameras would have seen it: so in the second pass a nearer buffer pixel
+// counts only if module j's rectified pair correlates there at the
+// refuter's disparity (the sub-pixel window's ZNCC, warped by the
+// refuter's own plane in j's image, >= min_zncc: what j's matcher would
+// have accepted). Not in the first pass: a module whose RIGHT camera
+// grazes the surface (the grazed patch's case) cannot correlate that
+// surface at all, and its wrong patch must still be found; a surface
+// mostly hidden goes whole on geometry alone.
 #pragma once
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <vector>
 
 #include "calib/core/pose.h"
 #include "reconstruct/point_cloud.h"
 #include "reconstruct/rectify.h"
+#include "reconstruct/subpixel_refine.h"
 
 namespace stereorig {
 
@@ -64,6 +82,11 @@ struct FreeSpaceOptions {
   // Neighbouring pixels' points within this distance are one surface. Not
   // a key of its own: the runtime sets it to mesh_max_edge_mm. Default 1.5.
   double surface_max_edge_mm = 1.5;
+  // The second pass's photo check (FreeSpaceView's images): the window and
+  // the least ZNCC. Not keys of their own: the runtime sets them to the
+  // matcher's (match.subpixel_half_width_px / _height_px, match.min_zncc).
+  SubpixelOptions window;
+  double min_zncc = 0.8;
 };
 
 // One module's rectified left camera, as the runtime's plan holds it.
@@ -71,6 +94,9 @@ struct FreeSpaceView {
   RectifiedGeometry geometry;                                            // module j's rectification (rectify.h)
   Pose module_from_reference;                                            // S[j][0]
   Eigen::Vector3d camera_centre_reference_mm = Eigen::Vector3d::Zero();  // its left camera centre
+  // Its rectified pair (CV_8UC1, geometry.size) for the second pass's photo
+  // check; empty: no check (every nearer buffer pixel counts).
+  cv::Mat left_rectified, right_rectified;
 };
 
 // clouds[j]: module j's points (reference frame, mm) with unit normals; the

@@ -163,7 +163,8 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
 }
 
 void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& images, bool build_mesh,
-                            PointCloud* cloud, Mesh* mesh, ModuleReport* report) const {
+                            PointCloud* cloud, Mesh* mesh, ModuleReport* report,
+                            std::pair<cv::Mat, cv::Mat>* rectified) const {
   const StereoModule& mod = rig_.module(plan.module);
   report->module = plan.module;
   auto t = Clock::now();
@@ -181,6 +182,7 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
     cv::remap(images[mod.right_camera], r, plan.maps.right_fixed(band), plan.maps.right_frac(band), cv::INTER_LINEAR,
               cv::BORDER_CONSTANT, 0);
   }
+  if (rectified) *rectified = {left, right};  // shared, not copied
   report->times_ms["rectify"] = MsSince(t);
 
   t = Clock::now();
@@ -383,26 +385,33 @@ Reconstruction Runtime::Process(const std::vector<cv::Mat>& images, bool build_m
   std::vector<PointCloud> clouds(nm);
   std::vector<Mesh> meshes(nm);
   out.modules.resize(nm);
+  // Each module's rectified pair, kept for the free-space test's photo check.
+  const bool free_space = options_.free_space_test && nm > 1;
+  std::vector<std::pair<cv::Mat, cv::Mat>> rectified(free_space ? nm : 0);
   auto t = Clock::now();
   // One module per thread (module 0 on this one), or all here in turn;
   // ParallelForChunks joins every thread before rethrowing what one threw.
   ParallelForChunks(nm, options_.parallel_modules ? nm : 1, [&](int begin, int end) {
     for (int m = begin; m < end; ++m)
-      ProcessModule(plans_[m], images, build_mesh, &clouds[m], &meshes[m], &out.modules[m]);
+      ProcessModule(plans_[m], images, build_mesh, &clouds[m], &meshes[m], &out.modules[m],
+                    free_space ? &rectified[m] : nullptr);
   });
   out.times_ms["modules"] = MsSince(t);
-  if (options_.free_space_test && nm > 1) {
+  if (free_space) {
     t = Clock::now();
     std::vector<FreeSpaceView> views(nm);
     for (int m = 0; m < nm; ++m)
       views[m] = FreeSpaceView{plans_[m].geometry, plans_[m].reference_from_module.Inverse(),
-                               plans_[m].camera_centre_reference_mm};
-    FreeSpaceOptions free_space = options_.free_space;
-    free_space.surface_max_edge_mm = options_.mesh_max_edge_mm;  // a surface: what the mesh joins
-    const std::vector<std::vector<uint8_t>> refuted = FreeSpaceRefuted(views, clouds, free_space);
+                               plans_[m].camera_centre_reference_mm, rectified[m].first, rectified[m].second};
+    FreeSpaceOptions o = options_.free_space;
+    o.surface_max_edge_mm = options_.mesh_max_edge_mm;  // a surface: what the mesh joins
+    o.window = options_.match.subpixel;                 // the photo check: what the matcher would accept
+    o.min_zncc = options_.match.min_zncc;
+    const std::vector<std::vector<uint8_t>> refuted = FreeSpaceRefuted(views, clouds, o);
     for (int m = 0; m < nm; ++m)
       if (std::find(refuted[m].begin(), refuted[m].end(), 1) != refuted[m].end())
         RemoveRefuted(plans_[m], refuted[m], &clouds[m], &meshes[m], &out.modules[m]);
+    rectified.clear();
     out.times_ms["free_space"] = MsSince(t);
   }
   t = Clock::now();

@@ -97,9 +97,10 @@ class Runtime {
   Reconstruction Process(const std::vector<cv::Mat>& images, bool build_mesh) const;
 
   // The per-module work of Process(), exposed for tests: the module's cloud
-  // (reference frame) and its organised mesh (if build_mesh).
+  // (reference frame) and its organised mesh (if build_mesh); and, if
+  // `rectified` is given, the rectified pair it matched (left, right).
   void ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& images, bool build_mesh, PointCloud* cloud,
-                     Mesh* mesh, ModuleReport* report) const;
+                     Mesh* mesh, ModuleReport* report, std::pair<cv::Mat, cv::Mat>* rectified = nullptr) const;
 
  private:
   Rig rig_;
