@@ -95,11 +95,7 @@ int RunScore(int argc, char** argv) {
   const bool check_report_folder = report_path.empty() || !diagnose.WillCreate(fs::absolute(report_path).parent_path());
   ClaimRuntimeReport(report_path, rig_path, options_path, check_report_folder, rig_what, dataset_inputs);
   const Rig rig = ReadRigFile(rig_path);
-  std::vector<std::string> scenes;
-  {
-    std::stringstream list(scenes_arg);
-    for (std::string name; std::getline(list, name, ',');) scenes.push_back(name);
-  }
+  const std::vector<std::string> scenes = SplitSceneList(scenes_arg);
   std::vector<std::pair<std::string, std::string>> diagnosis_images;
   if (!diagnose_dir.empty()) {
     for (const std::string& name : scenes)
@@ -114,9 +110,9 @@ int RunScore(int argc, char** argv) {
   // truth, before any is scored: a scene misnamed after others in --scenes
   // used to be found only once they were scored, their diagnosis images
   // left in a new --diagnose folder.
+  CheckScenesInDataset(dataset, scenes);
   for (const std::string& name : scenes) {
     const fs::path scene_dir = fs::path(dataset) / "scenes" / name;
-    if (!fs::is_directory(scene_dir)) throw InputError(scene_dir.string(), "no such scene in the dataset (--scenes)");
     CheckCaptureFiles((scene_dir / "active").string(), rig);
     const fs::path surface = fs::path(dataset) / "truth" / "scenes" / name / "surface.ply";
     if (!fs::is_regular_file(surface)) throw InputError(surface.string(), "no such file (the scene's truth)");
