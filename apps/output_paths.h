@@ -23,7 +23,9 @@ class OutputPaths {
   explicit OutputPaths(std::string remedy = "") : remedy_(std::move(remedy)) {}
   // Records `path`, written as `what` (for the message). Throws InputError if
   // another output already claimed the same file, if it is a folder a
-  // ClaimFolder before will create, or, with
+  // ClaimFolder before will create, if a name in it that does not exist yet
+  // (the file's, or a folder's the command creates) is longer than the file
+  // system allows (NAME_MAX), or, with
   // check_folder, if its folder does not exist (off for files in a folder
   // the command creates itself).
   void Claim(const std::string& path, const std::string& what, bool check_folder = true);
@@ -33,8 +35,12 @@ class OutputPaths {
   void Protect(const std::string& path, const std::string& what);
   // Records a folder the command creates if needed and writes files into
   // (`what` names it). Throws InputError if it is an input or a claimed
-  // file, if a missing folder above it is a claimed file, or if it, or the
-  // nearest part of its path that exists, is a file.
+  // file, if a missing folder above it is a claimed file, if it, or the
+  // nearest part of its path that exists, is a file, or if the folders
+  // missing cannot be made there: a name longer than the file system allows
+  // (pathconf NAME_MAX of that nearest existing folder, 255 on ext4), or a
+  // nearest existing folder this process may not write in and search
+  // (access W_OK|X_OK; the folder itself if it exists).
   // The command creates it through the object returned, once every input
   // is checked (FolderToCreate::Create).
   [[nodiscard]] FolderToCreate ClaimFolder(const std::string& path, const std::string& what);
