@@ -234,9 +234,12 @@ int RunBench(int argc, char** argv) {
   const std::string rig_read =
       rig_path.empty() && !dataset.empty() ? (fs::path(dataset) / "truth" / "rig.yaml").string() : rig_path;
   if (!report_path.empty())
-    ClaimRuntimeReport(report_path, rig_read, options_path, true,
-                       rig_path.empty() ? "the dataset's truth rig file (read without --rig)" : "the rig file (--rig)",
-                       DatasetInputs(dataset));
+    ClaimRuntimeReport(
+        {.path = report_path,
+         .rig_path = rig_read,
+         .rig_what = rig_path.empty() ? "the dataset's truth rig file (read without --rig)" : "the rig file (--rig)",
+         .options_path = options_path,
+         .more_inputs = DatasetInputs(dataset)});
   // Scenes the user named must all be there (a misspelt one used to be
   // skipped, and fewer scenes benched without a word); the default list
   // takes those the dataset holds.

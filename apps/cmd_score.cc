@@ -87,25 +87,24 @@ int RunScore(int argc, char** argv) {
   // Before anything is read: the report, not over the rig, the options or
   // any file of the dataset the scorer reads (its folder may be one
   // --diagnose will create); once the rig says how many modules, the
-  // diagnosis images too.
-  const std::string rig_what = rig_given ? "the rig file (--rig)" : "the dataset's truth rig file (read without --rig)";
-  const auto dataset_inputs = DatasetInputs(dataset);
+  // diagnosis images too, against the same claims.
   if (!report_path.empty() && diagnose.WillCreate(fs::absolute(report_path)))
     throw InputError(report_path, "is a folder --diagnose creates, not a file for the report (--report)");
-  const bool check_report_folder = report_path.empty() || !diagnose.WillCreate(fs::absolute(report_path).parent_path());
-  ClaimRuntimeReport(report_path, rig_path, options_path, check_report_folder, rig_what, dataset_inputs);
+  OutputPaths outputs = ClaimRuntimeReport(
+      {.path = report_path,
+       .rig_path = rig_path,
+       .rig_what = rig_given ? "the rig file (--rig)" : "the dataset's truth rig file (read without --rig)",
+       .options_path = options_path,
+       .check_folder = report_path.empty() || !diagnose.WillCreate(fs::absolute(report_path).parent_path()),
+       .more_inputs = DatasetInputs(dataset)});
   const Rig rig = ReadRigFile(rig_path);
   const std::vector<std::string> scenes = SplitSceneList(scenes_arg);
-  std::vector<std::pair<std::string, std::string>> diagnosis_images;
   if (!diagnose_dir.empty()) {
     for (const std::string& name : scenes)
       for (int m = 0; m < rig.num_modules(); ++m)
         for (const std::string& path : FillDiagnosisImagePaths(FillDiagnosisPrefix(diagnose_dir, name, m)))
-          diagnosis_images.push_back({path, "a diagnosis image (--diagnose)"});
+          outputs.Claim(path, "a diagnosis image (--diagnose)", false);
   }
-  if (!diagnosis_images.empty())
-    ClaimRuntimeReport(report_path, rig_path, options_path, check_report_folder, rig_what, dataset_inputs,
-                       diagnosis_images);
   // Every scene named is in the dataset, with its capture's files and its
   // truth, before any is scored: a scene misnamed after others in --scenes
   // used to be found only once they were scored, their diagnosis images

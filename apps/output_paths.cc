@@ -71,16 +71,13 @@ void OutputPaths::Claim(const std::string& path, const std::string& what, bool c
   claimed_.emplace(key, what);
 }
 
-void ClaimRuntimeReport(const std::string& report_path, const std::string& rig_path, const std::string& options_path,
-                        bool check_folder, const std::string& rig_what,
-                        const std::vector<std::pair<std::string, std::string>>& more_inputs,
-                        const std::vector<std::pair<std::string, std::string>>& more_outputs) {
+OutputPaths ClaimRuntimeReport(const RuntimeReportClaim& report) {
   OutputPaths outputs;
-  outputs.Protect(rig_path, rig_what);
-  outputs.Protect(options_path, "the options file (--options)");
-  for (const auto& [path, what] : more_inputs) outputs.Protect(path, what);
-  if (!report_path.empty()) outputs.Claim(report_path, "the report (--report)", check_folder);
-  for (const auto& [path, what] : more_outputs) outputs.Claim(path, what, false);
+  outputs.Protect(report.rig_path, report.rig_what);
+  outputs.Protect(report.options_path, "the options file (--options)");
+  for (const auto& [path, what] : report.more_inputs) outputs.Protect(path, what);
+  if (!report.path.empty()) outputs.Claim(report.path, "the report (--report)", report.check_folder);
+  return outputs;
 }
 
 std::vector<std::pair<std::string, std::string>> DatasetInputs(const std::string& dataset) {
