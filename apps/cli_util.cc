@@ -1,8 +1,11 @@
 #include "apps/cli_util.h"
 
 #include <cstdio>
+#include <filesystem>
+#include <sstream>
 
 #include "apps/command.h"
+#include "calib/core/input_error.h"
 
 namespace stereorig {
 
@@ -17,6 +20,28 @@ std::optional<int> ParseArgs(CLI::App& app, int argc, char** argv) {
     return kExitBadInput;
   }
   return std::nullopt;
+}
+
+std::vector<std::string> SplitSceneList(const std::string& list) {
+  std::vector<std::string> scenes;
+  std::stringstream in(list);
+  for (std::string name; std::getline(in, name, ',');) scenes.push_back(name);
+  return scenes;
+}
+
+void CheckScenesInDataset(const std::string& dataset, const std::vector<std::string>& scenes) {
+  namespace fs = std::filesystem;
+  const fs::path scenes_dir = fs::path(dataset) / "scenes";
+  std::vector<std::string> missing;
+  for (const std::string& name : scenes)
+    if (!fs::is_directory(scenes_dir / name / "active")) missing.push_back(name);
+  if (missing.size() == 1)
+    throw InputError((scenes_dir / missing[0]).string(), "no such scene in the dataset (--scenes)");
+  if (!missing.empty()) {
+    std::string names;
+    for (const std::string& name : missing) names += (names.empty() ? "" : ", ") + name;
+    throw InputError(scenes_dir.string(), "no such scenes in the dataset (--scenes): " + names);
+  }
 }
 
 int NotBuiltYet(const char* name, const char* what, int argc, char** argv) {

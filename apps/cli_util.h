@@ -1,10 +1,12 @@
 // Shared pieces of the subcommands: argument parsing with the project's exit
-// codes, and the "not built yet" answer of subcommands still to come.
+// codes, the scenes of a simulator dataset a command is asked for, and the
+// "not built yet" answer of subcommands still to come.
 #pragma once
 
 #include <CLI/CLI.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace stereorig {
 
@@ -12,6 +14,17 @@ namespace stereorig {
 // (0 after printing --help to stdout; 2 after one line on stderr for a usage
 // error), or std::nullopt when it should run.
 std::optional<int> ParseArgs(CLI::App& app, int argc, char** argv);
+
+// The scene names of a --scenes argument, "cup,sphere" -> {cup, sphere}.
+std::vector<std::string> SplitSceneList(const std::string& list);
+
+// Throws InputError unless every scene of `scenes` is in the simulator
+// dataset `dataset`, i.e. DATASET/scenes/<name>/active is a folder
+// (docs/formats.md "Datasets"). For the scenes a user named (`score`, and
+// `bench` with --scenes given): a misspelt one is refused before any work,
+// not skipped or found after the others were run. One missing scene is
+// named by its folder; several by the dataset's scenes/ folder and a list.
+void CheckScenesInDataset(const std::string& dataset, const std::vector<std::string>& scenes);
 
 // For subcommands a later issue fills in: prints what it will do and exits 2.
 int NotBuiltYet(const char* name, const char* what, int argc, char** argv);

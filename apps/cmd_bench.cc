@@ -14,7 +14,6 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
-#include <sstream>
 #include <thread>
 
 #include "apps/cli_util.h"
@@ -218,7 +217,10 @@ int RunBench(int argc, char** argv) {
   std::string dataset, rig_path, options_path, report_path, scenes_arg = "cup,sphere,ballbar,plate,tuber";
   int runs = 20;
   app.add_option("--dataset", dataset, "simulator dataset folder (scenes/<scene>/active, truth/)");
-  app.add_option("--scenes", scenes_arg, "with --dataset: comma-separated scenes (missing ones are skipped)")
+  app.add_option("--scenes", scenes_arg,
+                 "with --dataset: comma-separated scenes; each one named must be in the dataset "
+                 "(scenes/<name>/active), or the bench exits 2 before any run; by default, those of the five the "
+                 "dataset holds")
       ->capture_default_str();
   app.add_option("--rig", rig_path, "rig file to reconstruct with (default: the dataset's truth/rig.yaml)");
   app.add_option("--options", options_path, "runtime options YAML");
@@ -232,9 +234,17 @@ int RunBench(int argc, char** argv) {
   const std::string rig_read =
       rig_path.empty() && !dataset.empty() ? (fs::path(dataset) / "truth" / "rig.yaml").string() : rig_path;
   if (!report_path.empty())
-    ClaimRuntimeReport(report_path, rig_read, options_path, true,
-                       rig_path.empty() ? "the dataset's truth rig file (read without --rig)" : "the rig file (--rig)",
-                       DatasetInputs(dataset));
+    ClaimRuntimeReport(
+        {.path = report_path,
+         .rig_path = rig_read,
+         .rig_what = rig_path.empty() ? "the dataset's truth rig file (read without --rig)" : "the rig file (--rig)",
+         .options_path = options_path,
+         .more_inputs = DatasetInputs(dataset)});
+  // Scenes the user named must all be there (a misspelt one used to be
+  // skipped, and fewer scenes benched without a word); the default list
+  // takes those the dataset holds.
+  const std::vector<std::string> scene_names = SplitSceneList(scenes_arg);
+  if (!dataset.empty() && app.count("--scenes") > 0) CheckScenesInDataset(dataset, scene_names);
 
   Rig rig;
   std::vector<Scene> scenes;
@@ -248,11 +258,9 @@ int RunBench(int argc, char** argv) {
         {"sphere(builtin)", RenderSphereCapture(sim.rig, spec), SampleSphere(spec.centre_mm, spec.radius_mm, 0.2), {}});
   } else {
     rig = ReadRigFile(rig_read);
-    std::stringstream ss(scenes_arg);
-    std::string name;
-    while (std::getline(ss, name, ',')) {
+    for (const std::string& name : scene_names) {
       const fs::path capture = fs::path(dataset) / "scenes" / name / "active";
-      if (!fs::is_directory(capture)) continue;
+      if (!fs::is_directory(capture)) continue;  // a default scene this dataset lacks (named ones: checked above)
       scenes.push_back(Scene{name, LoadCapture(capture.string(), rig), {}, {}});
     }
     if (scenes.empty()) throw InputError(dataset, "none of the scenes " + scenes_arg + " has an active capture");

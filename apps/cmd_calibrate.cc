@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <vector>
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
@@ -64,16 +65,20 @@ int RunCalibrate(int argc, char** argv) {
   outputs.Claim(out_path, "the rig file (--out)");
   outputs.Claim(report_path, "the report (--report)");
   FolderToCreate models_folder;  // made once the calibration has succeeded
-  if (!cameramodels_dir.empty()) {
+  if (!cameramodels_dir.empty())
     models_folder = outputs.ClaimFolder(cameramodels_dir, "the camera models (--export-cameramodels)");
+  // Read once, here: the calibration's modules, and the cameras whose models
+  // --export-cameramodels writes.
+  const std::vector<ModuleLayout> layout = ReadLayoutFile(layout_path);
+  if (!cameramodels_dir.empty()) {
     // Each model file too (camK.cameramodel for every camera of the layout):
     // a rig file named DIR/cam0.cameramodel would be replaced by a model.
-    for (int k = 0, n = LayoutCameraCount(ReadLayoutFile(layout_path)); k < n; ++k)
+    for (int k = 0, n = LayoutCameraCount(layout); k < n; ++k)
       outputs.Claim((std::filesystem::path(cameramodels_dir) / ("cam" + std::to_string(k) + ".cameramodel")).string(),
                     "camera " + std::to_string(k) + "'s model (--export-cameramodels)", false);
   }
 
-  const FolderCalibration folder = CalibrateCaptureFolder(captures, target_path, layout_path, options);
+  const FolderCalibration folder = CalibrateCaptureFolder(captures, target_path, layout, options);
   const CalibrationResult& result = folder.result;
   // The models' folder first: one that cannot be made leaves no rig file
   // or report behind either.

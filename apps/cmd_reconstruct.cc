@@ -63,7 +63,9 @@ int RunReconstruct(int argc, char** argv) {
   if (!out_dir.empty()) {
     // The batch checks its own outputs (reconstruct_batch.h); here only that
     // its summary is not over an input (its folder may be the one it creates).
-    if (!report_path.empty()) ClaimRuntimeReport(report_path, rig_path, options_path, false);
+    if (!report_path.empty())
+      ClaimRuntimeReport(
+          {.path = report_path, .rig_path = rig_path, .options_path = options_path, .check_folder = false});
     const Rig rig = ReadRigFile(rig_path);
     const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
     return ReconstructBatch(rig, options,

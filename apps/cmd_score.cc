@@ -87,36 +87,31 @@ int RunScore(int argc, char** argv) {
   // Before anything is read: the report, not over the rig, the options or
   // any file of the dataset the scorer reads (its folder may be one
   // --diagnose will create); once the rig says how many modules, the
-  // diagnosis images too.
-  const std::string rig_what = rig_given ? "the rig file (--rig)" : "the dataset's truth rig file (read without --rig)";
-  const auto dataset_inputs = DatasetInputs(dataset);
+  // diagnosis images too, against the same claims.
   if (!report_path.empty() && diagnose.WillCreate(fs::absolute(report_path)))
     throw InputError(report_path, "is a folder --diagnose creates, not a file for the report (--report)");
-  const bool check_report_folder = report_path.empty() || !diagnose.WillCreate(fs::absolute(report_path).parent_path());
-  ClaimRuntimeReport(report_path, rig_path, options_path, check_report_folder, rig_what, dataset_inputs);
+  OutputPaths outputs = ClaimRuntimeReport(
+      {.path = report_path,
+       .rig_path = rig_path,
+       .rig_what = rig_given ? "the rig file (--rig)" : "the dataset's truth rig file (read without --rig)",
+       .options_path = options_path,
+       .check_folder = report_path.empty() || !diagnose.WillCreate(fs::absolute(report_path).parent_path()),
+       .more_inputs = DatasetInputs(dataset)});
   const Rig rig = ReadRigFile(rig_path);
-  std::vector<std::string> scenes;
-  {
-    std::stringstream list(scenes_arg);
-    for (std::string name; std::getline(list, name, ',');) scenes.push_back(name);
-  }
-  std::vector<std::pair<std::string, std::string>> diagnosis_images;
+  const std::vector<std::string> scenes = SplitSceneList(scenes_arg);
   if (!diagnose_dir.empty()) {
     for (const std::string& name : scenes)
       for (int m = 0; m < rig.num_modules(); ++m)
         for (const std::string& path : FillDiagnosisImagePaths(FillDiagnosisPrefix(diagnose_dir, name, m)))
-          diagnosis_images.push_back({path, "a diagnosis image (--diagnose)"});
+          outputs.Claim(path, "a diagnosis image (--diagnose)", false);
   }
-  if (!diagnosis_images.empty())
-    ClaimRuntimeReport(report_path, rig_path, options_path, check_report_folder, rig_what, dataset_inputs,
-                       diagnosis_images);
   // Every scene named is in the dataset, with its capture's files and its
   // truth, before any is scored: a scene misnamed after others in --scenes
   // used to be found only once they were scored, their diagnosis images
   // left in a new --diagnose folder.
+  CheckScenesInDataset(dataset, scenes);
   for (const std::string& name : scenes) {
     const fs::path scene_dir = fs::path(dataset) / "scenes" / name;
-    if (!fs::is_directory(scene_dir)) throw InputError(scene_dir.string(), "no such scene in the dataset (--scenes)");
     CheckCaptureFiles((scene_dir / "active").string(), rig);
     const fs::path surface = fs::path(dataset) / "truth" / "scenes" / name / "surface.ply";
     if (!fs::is_regular_file(surface)) throw InputError(surface.string(), "no such file (the scene's truth)");

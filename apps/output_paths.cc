@@ -1,5 +1,10 @@
 #include "apps/output_paths.h"
 
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
 #include "calib/core/capture_image_name.h"
 #include "calib/core/input_error.h"
 
@@ -7,10 +12,41 @@ namespace stereorig {
 
 namespace {
 
+namespace fs = std::filesystem;
+
 // The file a path names: symbolic links followed as far as the path exists
 // (an output through a link to an input is that input), the rest normalised.
-std::filesystem::path Key(const std::string& path) {
-  return std::filesystem::weakly_canonical(std::filesystem::absolute(std::filesystem::path(path)));
+fs::path Key(const std::string& path) { return NormalPath(path); }
+
+// The deepest part of `key` (a Key) that exists, or empty if none does;
+// `missing` gets the parts below it, innermost first. A part that cannot be
+// looked up (a name too long for the file system) is missing.
+fs::path DeepestExisting(const fs::path& key, std::vector<fs::path>* missing) {
+  for (fs::path p = key; !p.empty(); p = p.parent_path()) {
+    std::error_code ec;
+    if (fs::exists(p, ec)) return p;
+    missing->push_back(p);
+    if (p == p.root_path()) break;
+  }
+  return {};
+}
+
+// Throws InputError(path, "cannot <doing>: ...") if the name of a part of
+// `missing` (the parts of a path to create below `existing`) is longer than
+// the file system there allows (pathconf NAME_MAX: 255 on ext4), which
+// creating it would find only after the command's work.
+void CheckNamesFit(const std::string& path, const std::string& doing, const fs::path& existing,
+                   const std::vector<fs::path>& missing) {
+  if (existing.empty()) return;
+  const long name_max = pathconf(existing.c_str(), _PC_NAME_MAX);
+  if (name_max <= 0) return;  // no limit, or none known
+  for (const fs::path& p : missing) {
+    const std::string name = p.filename().string();
+    if (static_cast<long>(name.size()) <= name_max) continue;
+    throw InputError(path, "cannot " + doing + ": " + std::strerror(ENAMETOOLONG) + " (" + name.substr(0, 16) +
+                               "...: " + std::to_string(name.size()) + " characters, more than the " +
+                               std::to_string(name_max) + " the file system allows in " + existing.string() + ")");
+  }
 }
 
 }  // namespace
@@ -20,7 +56,6 @@ void OutputPaths::Protect(const std::string& path, const std::string& what) {
 }
 
 void OutputPaths::Claim(const std::string& path, const std::string& what, bool check_folder) {
-  namespace fs = std::filesystem;
   const fs::path key = Key(path);
   if (const auto it = inputs_.find(key); it != inputs_.end())
     throw InputError(path, "is " + it->second + ": writing " + what + " there would overwrite an input");
@@ -29,25 +64,23 @@ void OutputPaths::Claim(const std::string& path, const std::string& what, bool c
         path, "would be written twice (" + it->second + " and " + what + ")" + (remedy_.empty() ? "" : ": " + remedy_));
   if (const auto it = folders_.find(key); it != folders_.end())
     throw InputError(path, "is a folder this command creates for " + it->second + ", not a file to write");
+  std::vector<fs::path> missing;
+  CheckNamesFit(path, "write " + what, DeepestExisting(key, &missing), missing);
   if (check_folder && !fs::is_directory(key.parent_path())) throw InputError(path, "its folder does not exist");
   if (fs::is_directory(key)) throw InputError(path, "is a folder, not a file to write");
   claimed_.emplace(key, what);
 }
 
-void ClaimRuntimeReport(const std::string& report_path, const std::string& rig_path, const std::string& options_path,
-                        bool check_folder, const std::string& rig_what,
-                        const std::vector<std::pair<std::string, std::string>>& more_inputs,
-                        const std::vector<std::pair<std::string, std::string>>& more_outputs) {
+OutputPaths ClaimRuntimeReport(const RuntimeReportClaim& report) {
   OutputPaths outputs;
-  outputs.Protect(rig_path, rig_what);
-  outputs.Protect(options_path, "the options file (--options)");
-  for (const auto& [path, what] : more_inputs) outputs.Protect(path, what);
-  if (!report_path.empty()) outputs.Claim(report_path, "the report (--report)", check_folder);
-  for (const auto& [path, what] : more_outputs) outputs.Claim(path, what, false);
+  outputs.Protect(report.rig_path, report.rig_what);
+  outputs.Protect(report.options_path, "the options file (--options)");
+  for (const auto& [path, what] : report.more_inputs) outputs.Protect(path, what);
+  if (!report.path.empty()) outputs.Claim(report.path, "the report (--report)", report.check_folder);
+  return outputs;
 }
 
 std::vector<std::pair<std::string, std::string>> DatasetInputs(const std::string& dataset) {
-  namespace fs = std::filesystem;
   std::vector<std::pair<std::string, std::string>> inputs;
   if (dataset.empty() || !fs::is_directory(dataset)) return inputs;
   const fs::path root(dataset);
@@ -68,7 +101,6 @@ std::vector<std::pair<std::string, std::string>> DatasetInputs(const std::string
 }
 
 FolderToCreate OutputPaths::ClaimFolder(const std::string& path, const std::string& what) {
-  namespace fs = std::filesystem;
   const fs::path key = Key(path);
   if (const auto it = inputs_.find(key); it != inputs_.end())
     throw InputError(path, "is " + it->second + ", not a folder for " + what);
@@ -78,17 +110,21 @@ FolderToCreate OutputPaths::ClaimFolder(const std::string& path, const std::stri
   // creates the rest, none of which may be a file another output claimed
   // (--report a with --export-cameramodels a/b).
   std::vector<fs::path> missing;
-  for (fs::path p = key; !p.empty(); p = p.parent_path()) {
-    if (fs::exists(p)) {
-      if (!fs::is_directory(p))
-        throw InputError(
-            path, (p == key ? std::string("is a file") : p.string() + " is a file") + ", not a folder for " + what);
-      break;
-    }
+  const fs::path existing = DeepestExisting(key, &missing);
+  if (!existing.empty() && !fs::is_directory(existing))
+    throw InputError(path, (existing == key ? std::string("is a file") : existing.string() + " is a file") +
+                               ", not a folder for " + what);
+  for (const fs::path& p : missing)
     if (const auto it = claimed_.find(p); it != claimed_.end())
       throw InputError(path, p.string() + " is claimed by " + it->second + " as a file, not a folder for " + what);
-    missing.push_back(p);
-    if (p == p.root_path()) break;
+  // And the rest can be made, and written in: found now, not when the
+  // folder is created after the command's work.
+  CheckNamesFit(path, "create this folder for " + what, existing, missing);
+  if (!existing.empty() && access(existing.c_str(), W_OK | X_OK) != 0) {
+    const std::string why = std::strerror(errno);
+    throw InputError(path, missing.empty()
+                               ? "cannot write " + what + " in this folder: " + why
+                               : "cannot create this folder for " + what + ": " + existing.string() + ": " + why);
   }
   for (const fs::path& p : missing) folders_.emplace(p, what);
   claimed_.emplace(key, what);

@@ -23,7 +23,9 @@ class OutputPaths {
   explicit OutputPaths(std::string remedy = "") : remedy_(std::move(remedy)) {}
   // Records `path`, written as `what` (for the message). Throws InputError if
   // another output already claimed the same file, if it is a folder a
-  // ClaimFolder before will create, or, with
+  // ClaimFolder before will create, if a name in it that does not exist yet
+  // (the file's, or a folder's the command creates) is longer than the file
+  // system allows (NAME_MAX), or, with
   // check_folder, if its folder does not exist (off for files in a folder
   // the command creates itself).
   void Claim(const std::string& path, const std::string& what, bool check_folder = true);
@@ -33,8 +35,12 @@ class OutputPaths {
   void Protect(const std::string& path, const std::string& what);
   // Records a folder the command creates if needed and writes files into
   // (`what` names it). Throws InputError if it is an input or a claimed
-  // file, if a missing folder above it is a claimed file, or if it, or the
-  // nearest part of its path that exists, is a file.
+  // file, if a missing folder above it is a claimed file, if it, or the
+  // nearest part of its path that exists, is a file, or if the folders
+  // missing cannot be made there: a name longer than the file system allows
+  // (pathconf NAME_MAX of that nearest existing folder, 255 on ext4), or a
+  // nearest existing folder this process may not write in and search
+  // (access W_OK|X_OK; the folder itself if it exists).
   // The command creates it through the object returned, once every input
   // is checked (FolderToCreate::Create).
   [[nodiscard]] FolderToCreate ClaimFolder(const std::string& path, const std::string& what);
@@ -47,17 +53,23 @@ class OutputPaths {
 };
 
 // The --report of a command that reads a rig file and runtime options
-// (bench, score, a reconstruct batch): claimed, not over either input
-// (an empty path: not given). check_folder as OutputPaths::Claim.
-// rig_what names the rig file in the message (a dataset's truth rig when no
-// --rig was given).
-// more_inputs: further (path, what) inputs to protect (DatasetInputs).
-// more_outputs: further files the command writes, claimed without the folder
-// test (score's --diagnose images).
-void ClaimRuntimeReport(const std::string& report_path, const std::string& rig_path, const std::string& options_path,
-                        bool check_folder = true, const std::string& rig_what = "the rig file (--rig)",
-                        const std::vector<std::pair<std::string, std::string>>& more_inputs = {},
-                        const std::vector<std::pair<std::string, std::string>>& more_outputs = {});
+// (bench, score, a reconstruct batch), and the inputs it may not replace.
+// An empty path: not given. Call sites name the fields they set:
+//   ClaimRuntimeReport({.path = report, .rig_path = rig, .options_path = options});
+// (Every field has an initializer: GCC's -Wmissing-field-initializers then
+// lets a designated initializer leave it out.)
+struct RuntimeReportClaim {
+  std::string path{};                             // --report
+  std::string rig_path{};                         // the rig file the command reads
+  std::string rig_what = "the rig file (--rig)";  // names it in the message (a dataset's truth rig without --rig)
+  std::string options_path{};                     // --options
+  bool check_folder = true;                       // as OutputPaths::Claim: off if the command creates the folder
+  std::vector<std::pair<std::string, std::string>> more_inputs{};  // further (path, what) to protect (DatasetInputs)
+};
+// Protects the inputs and claims the report. Returns the OutputPaths that
+// holds them, for the command's further outputs (score's --diagnose images,
+// known once the rig is read): each is then checked against the report too.
+OutputPaths ClaimRuntimeReport(const RuntimeReportClaim& report);
 
 // The files `stereorig score` and `bench` read from a simulated dataset
 // (docs/formats.md "Datasets"), as (path, what) for OutputPaths::Protect:

@@ -132,12 +132,12 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
 }
 
 FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const std::string& target_path,
-                                         const std::string& layout_path, const CalibrationOptions& options) {
+                                         const std::vector<ModuleLayout>& modules, const CalibrationOptions& options) {
   options.Check();
   const Target target = ReadTargetFile(target_path);
   CalibrationInput input;
   input.target = TargetGeometryFromTarget(target);
-  input.modules = ReadLayoutFile(layout_path);
+  input.modules = modules;
   input.source = captures_dir;
   const int num_cameras = LayoutCameraCount(input.modules);
   DetectedCaptures detected = DetectCaptureFolder(captures_dir, target, num_cameras, DetectOptions(), options.progress);

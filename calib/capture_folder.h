@@ -47,14 +47,16 @@ std::vector<std::string> CaptureFolderImages(const std::string& dir);
 DetectedCaptures DetectCaptureFolder(const std::string& dir, const Target& target, int num_cameras,
                                      const DetectOptions& options, bool progress);
 
-// The whole of `stereorig calibrate`: reads the target and layout files,
-// detects the target in every capture and runs the three stages.
+// The whole of `stereorig calibrate`: reads the target file, detects the
+// target in every capture and runs the three stages on the modules of
+// `modules` (the layout file, ReadLayoutFile in calib/layout_file.h, read
+// by the caller, which needs its cameras before: the files it will write).
 struct FolderCalibration {
   CalibrationResult result;
   int num_captures = 0;
   int num_views = 0;  // images with an accepted detection
 };
 FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const std::string& target_path,
-                                         const std::string& layout_path, const CalibrationOptions& options);
+                                         const std::vector<ModuleLayout>& modules, const CalibrationOptions& options);
 
 }  // namespace stereorig

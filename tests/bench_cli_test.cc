@@ -10,6 +10,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 
 #include "tests/cli_runner.h"
 
@@ -75,6 +76,42 @@ TEST(BenchCli, AReportOverTheDatasetsTruthRigIsRefused) {
   EXPECT_NE(r.err.find(rig + ": is the dataset's truth rig file (read without --rig)"), std::string::npos) << r.err;
   std::ifstream f(rig);
   EXPECT_EQ(std::string(std::istreambuf_iterator<char>(f), {}), "the truth rig\n");
+  std::filesystem::remove_all(dataset);
+}
+
+// Scenes named with --scenes must all be in the dataset: a misspelt one
+// exits 2 before any work (it used to be skipped, and fewer scenes benched
+// without a word), naming the dataset's scene folder and every missing
+// scene. With the default list, scenes the dataset lacks are still skipped.
+// The dataset holds only an (empty) cup capture and a truth rig that is not
+// one: a run that gets past the scene check stops at the rig, before any
+// image is read.
+TEST(BenchCli, AMissingSceneNamedInScenesExitsTwoBeforeAnyRun) {
+  const std::string dataset = ::testing::TempDir() + "/bench_scenes_" + std::to_string(getpid());
+  std::filesystem::remove_all(dataset);
+  std::filesystem::create_directories(dataset + "/scenes/cup/active");
+  std::filesystem::create_directories(dataset + "/scenes/sphere/passive");  // no active capture: not a scene to bench
+  std::filesystem::create_directories(dataset + "/truth");
+  { std::ofstream(dataset + "/truth/rig.yaml") << "not a rig\n"; }
+  const std::string bench = "bench --runs 1 --dataset " + dataset;
+  const std::pair<std::string, std::string> refused[] = {
+      {" --scenes cup,spher", dataset + "/scenes/spher: no such scene in the dataset (--scenes)"},
+      {" --scenes sphere", dataset + "/scenes/sphere: no such scene in the dataset (--scenes)"},
+      {" --scenes spher,cup,ballbal", dataset + "/scenes: no such scenes in the dataset (--scenes): spher, ballbal"}};
+  for (const auto& [scenes, says] : refused) {
+    const testing::Result r = RunCli(bench + scenes);
+    EXPECT_EQ(r.code, 2) << scenes;
+    EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_EQ(r.out.find("objects/s"), std::string::npos) << r.out;
+  }
+  // Every named scene there, or the default list: on to the rig file.
+  for (const std::string scenes : {" --scenes cup", ""}) {
+    const testing::Result r = RunCli(bench + scenes);
+    EXPECT_EQ(r.code, 2) << scenes;
+    EXPECT_NE(r.err.find(dataset + "/truth/rig.yaml"), std::string::npos) << scenes << ": " << r.err;
+    EXPECT_EQ(r.err.find("no such scene"), std::string::npos) << scenes << ": " << r.err;
+  }
   std::filesystem::remove_all(dataset);
 }
 

@@ -121,11 +121,12 @@ TEST(CalibrateCli, RenderedCapturesToRigFileAndReport) {
   EXPECT_LT(agreement, 0.05);
 }
 
-// A models' folder that passes the checks but cannot be made (a name
-// longer than the file system's 255 characters) is found only after the
-// calibration: exit 2 naming it, and nothing left, neither the folder made
-// above it on the way nor the rig file and report (both used to be written
-// before the folder was made, and the folder above it stayed, empty).
+// A models' folder that cannot be made (a name longer than the file
+// system's 255 characters): exit 2 naming it, and nothing left, neither a
+// folder above it nor the rig file and report (both used to be written
+// before the folder was made, and the folder above it stayed, empty). It is
+// refused when claimed, before the calibration (it used to be found only
+// when the folder was made after it).
 TEST(CalibrateCli, AModelsFolderThatCannotBeMadeLeavesNothing) {
   const RenderedSet& set = Rendered();
   const std::string folder = set.dir + "/long/" + std::string(300, 'x');
@@ -136,6 +137,7 @@ TEST(CalibrateCli, AModelsFolderThatCannotBeMadeLeavesNothing) {
                       "/long_report.json --lensmodel LENSMODEL_OPENCV5 --export-cameramodels " + folder);
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find(folder + ": cannot create this folder for the camera models"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("accepted views"), std::string::npos) << "the calibration ran: " << r.err;
   EXPECT_FALSE(fs::exists(set.dir + "/long")) << "the folder made on the way was left behind";
   EXPECT_FALSE(fs::exists(set.dir + "/long_rig.yaml"));
   EXPECT_FALSE(fs::exists(set.dir + "/long_report.json"));

@@ -189,8 +189,8 @@ TEST(Cli, EverySubcommandsHelpTeachesWithAnExample) {
 
 // demo's --out is made before any step: under a file it is refused naming
 // the file, and one that cannot be made (a name longer than the file
-// system's 255 characters) leaves none of the folders made on the way (it
-// used to leave them, empty). Exit 2, one line, no step run.
+// system's 255 characters) leaves no folder above it (it used to leave
+// those made on the way, empty). Exit 2, one line, no step run.
 TEST(Cli, DemoOutThatCannotBeMadeLeavesNoFolder) {
   namespace fs = std::filesystem;
   const std::string dir = ::testing::TempDir() + "/cli_demo_out";
@@ -273,9 +273,9 @@ TEST(Cli, RigExportRefusesAFolderOverItsInputsBeforeAnyWork) {
 }
 
 // A models' folder that cannot be made (a name longer than the file
-// system's 255 characters) exits 2 in one line naming it, and the folder
-// above it that was made on the way is removed again (FolderToCreate,
-// calib/core/folder_to_create.h); it used to stay, empty.
+// system's 255 characters) exits 2 in one line naming it, and leaves no
+// folder above it (refused when claimed, OutputPaths::ClaimFolder; a folder
+// made on the way used to stay, empty).
 TEST(Cli, RigExportToAFolderThatCannotBeMadeLeavesNoFolder) {
   namespace fs = std::filesystem;
   const std::string dir = ::testing::TempDir() + "/cli_export_long";

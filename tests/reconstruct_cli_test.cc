@@ -440,7 +440,7 @@ TEST_F(ReconstructCli, ScoreBadInputLeavesNoDiagnoseFolder) {
       {score + " --scenes cup --report " + diag, "is a folder --diagnose creates"},
       {score + " --scenes no_such_scene", "scenes/no_such_scene: no such scene in the dataset"},
       {score + " --scenes broken", "broken/surface.ply"},
-      // Checked, but too long a name for the file system: made in part.
+      // Too long a name for the file system: refused when claimed.
       {"score --dataset " + d + " --no-passive --scenes broken --diagnose " + diag + "/" + std::string(300, 'x'),
        "cannot create this folder for the diagnosis images (--diagnose)"},
       {"score --dataset " + d + " --scenes cup --diagnose " + dir_ + "/rig.yaml/diag", "rig.yaml is a file"}};
@@ -616,9 +616,10 @@ TEST_F(ReconstructCli, ABatchWhoseEveryCaptureFailsLeavesNoNewFolder) {
 }
 
 // An --out-dir that cannot be made (a name longer than the file system's
-// 255 characters) exits 2 in one line naming it, once the runtime is
-// built, and the folder made above it on the way is removed again; it used
-// to stay, empty.
+// 255 characters) exits 2 in one line naming it, and leaves no folder above
+// it: refused when claimed (OutputPaths::ClaimFolder), before the runtime
+// is built; it used to be found once it was built, and the folder made
+// above it on the way stayed, empty.
 TEST_F(ReconstructCli, ABatchOutDirThatCannotBeMadeLeavesNoFolder) {
   const std::string fresh = dir_ + "/batch_long";
   std::filesystem::remove_all(fresh);

@@ -9,16 +9,21 @@ namespace stereorig {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-// Symbolic links followed as far as the path exists, the rest normalised
-// (as apps/output_paths.cc compares paths).
-fs::path Normal(const fs::path& path) { return fs::weakly_canonical(fs::absolute(path)); }
-
-}  // namespace
+fs::path NormalPath(const fs::path& path) {
+  const fs::path absolute = fs::absolute(path);
+  std::error_code ec;
+  fs::path normal = fs::weakly_canonical(absolute, ec);
+  if (!ec) return normal;
+  // weakly_canonical stops at a part it cannot look up (ENAMETOOLONG):
+  // resolve what is above it, and keep the rest as written.
+  const fs::path parent = absolute.parent_path();
+  if (parent == absolute) throw fs::filesystem_error("cannot resolve the path", absolute, ec);
+  return (NormalPath(parent) / absolute.filename()).lexically_normal();
+}
 
 FolderToCreate::FolderToCreate(const std::string& path, const std::string& what) : path_(path), what_(what) {
-  for (fs::path p = Normal(path); !p.empty() && !fs::exists(p); p = p.parent_path()) {
+  std::error_code ec;  // a part that cannot be looked up is not there
+  for (fs::path p = NormalPath(path); !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
     missing_.insert(missing_.begin(), p);  // outermost first
     if (p == p.root_path()) break;
   }
@@ -47,7 +52,7 @@ FolderToCreate::~FolderToCreate() {
 }
 
 bool FolderToCreate::WillCreate(const fs::path& folder) const {
-  return std::find(missing_.begin(), missing_.end(), Normal(folder)) != missing_.end();
+  return std::find(missing_.begin(), missing_.end(), NormalPath(folder)) != missing_.end();
 }
 
 void FolderToCreate::Create() {

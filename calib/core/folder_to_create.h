@@ -8,6 +8,13 @@
 
 namespace stereorig {
 
+// The file or folder a path names, as the output checks compare paths
+// (apps/output_paths.h, FolderToCreate): absolute, symbolic links followed
+// as far as the path exists, the rest normalised. A part the file system
+// cannot look up (a name longer than it allows) counts as not there, so
+// such a path is a path to refuse by name, not a std::filesystem error.
+std::filesystem::path NormalPath(const std::filesystem::path& path);
+
 // A folder a command creates, and the folders above it that did not exist
 // when this object was made (a command's output folder is made so by
 // OutputPaths::ClaimFolder, apps/output_paths.h, after its checks): created
