@@ -97,21 +97,41 @@ Eigen::Vector2d PlaneSlopes(const RectifiedGeometry& g, const Eigen::Vector3d& p
                          std::clamp(g.baseline_mm * n_rect.y() / h, -max_slope, max_slope));
 }
 
-// Whether module j's rectified pair correlates at buffer pixel (x, y), at
-// its point's disparity, the window warped by that point's own plane.
-bool SeenByTheModule(const FreeSpaceView& view, const ModuleProjection& proj, const std::vector<PointCloud>& clouds,
-                     const DepthBuffer& buffer, int x, int y, const FreeSpaceOptions& options) {
+// Below this foreshortening of the right view, s = 1 - dd/dx, the right
+// camera grazes the surface: a window of 9 left columns covers under 3 right
+// ones, and a correct match does not correlate (the fill diagnosis's
+// lowest bin, fill_diagnosis.h; the matcher's distinctness clamp).
+constexpr double kRightViewGrazing = 0.3;
+
+// Whether the nearer point at buffer pixel (x, y) counts against module j's
+// point, by j's own rectified pair: it does where the pair correlates there
+// (the best ZNCC of the window, warped by that point's own plane, at its
+// plane's disparity at the pixel's centre and 0.5 px either side, >=
+// min_zncc), and where the pair cannot tell: j's right camera grazes that
+// plane, or no window can be taken (off the image, or a flat or blank
+// window: rows outside the module's rectified band are 0).
+bool CountsByTheModulesPair(const FreeSpaceView& view, const ModuleProjection& proj,
+                            const std::vector<PointCloud>& clouds, const DepthBuffer& buffer, int x, int y,
+                            const FreeSpaceOptions& options) {
   const cv::Vec2i owner = buffer.owner.at<cv::Vec2i>(y, x);
   const PointCloud& c = clouds[owner[0]];
   const Eigen::Vector3d q_rect = proj.Rectified(c.xyz_mm[owner[1]]);
   const Eigen::Vector2d slopes =
       PlaneSlopes(proj.geometry(), q_rect, proj.RectifiedDirection(c.normal[owner[1]]), options);
-  return WindowZncc(view.left_rectified, view.right_rectified, x, y, buffer.disparity.at<float>(y, x), slopes.x(),
-                    slopes.y(), options.window) >= options.min_zncc;
+  if (1 - slopes.x() < kRightViewGrazing) return true;
+  // The point lies somewhere in its pixel: its plane's disparity at the
+  // pixel's centre.
+  const Eigen::Vector3d q = proj.geometry().PixelAndDisparity(q_rect);
+  const double d = q.z() + slopes.x() * (x - q.x()) + slopes.y() * (y - q.y());
+  double best = -1;
+  for (const double step : {-0.5, 0.0, 0.5})
+    best = std::max(best, WindowZncc(view.left_rectified, view.right_rectified, x, y, d + step, slopes.x(), slopes.y(),
+                                     options.window));
+  return best <= -1 || best >= options.min_zncc;
 }
 
 // Whether module j's point i is refuted by `buffer`; with photo_check,
-// only by buffer pixels module j's own pair correlates (SeenByTheModule).
+// only by the buffer pixels CountsByTheModulesPair counts.
 bool SeenThrough(const FreeSpaceView& view, const ModuleProjection& proj, const std::vector<PointCloud>& clouds, int j,
                  size_t i, const DepthBuffer& buffer, bool photo_check, const FreeSpaceOptions& options) {
   const RectifiedGeometry& g = proj.geometry();
@@ -130,7 +150,8 @@ bool SeenThrough(const FreeSpaceView& view, const ModuleProjection& proj, const 
     const float* b = buffer.disparity.ptr<float>(y);
     for (int x = std::max(0, u - rad); x <= std::min(g.size.width - 1, u + rad); ++x) {
       const double front = q.z() + slopes.x() * (x - q.x()) + slopes.y() * (y - q.y()) + options.margin_px;
-      if (b[x] > front && (!photo_check || SeenByTheModule(view, proj, clouds, buffer, x, y, options))) ++support;
+      if (b[x] > front && (!photo_check || CountsByTheModulesPair(view, proj, clouds, buffer, x, y, options)))
+        ++support;
     }
   }
   return support >= options.min_support;
@@ -188,24 +209,32 @@ std::vector<std::vector<uint8_t>> FreeSpaceRefuted(const std::vector<FreeSpaceVi
   std::vector<ModuleProjection> projections;
   projections.reserve(nm);
   for (const FreeSpaceView& view : views) projections.emplace_back(view);
-  // The test with the buffers of the `usable` points (empty: all), on
-  // every point not already `refuted`; the photo check where asked and
-  // module j has its images.
-  auto test = [&](const std::vector<std::vector<uint8_t>>& usable, bool photo_check,
-                  std::vector<std::vector<uint8_t>>* refuted) {
+  for (int j = 0; j < nm; ++j) {
+    const FreeSpaceView& v = views[j];
+    if (v.left_rectified.empty() && v.right_rectified.empty()) continue;
+    STEREORIG_CHECK(v.left_rectified.type() == CV_8UC1 && v.right_rectified.type() == CV_8UC1 &&
+                    v.left_rectified.size() == v.geometry.size && v.right_rectified.size() == v.geometry.size);
+  }
+  // The test with the buffers of the `usable` points (empty: all), on the
+  // points `to_test` flags (empty: all); with photo_check, where module j
+  // has its images.
+  auto test = [&](const std::vector<std::vector<uint8_t>>& usable, const std::vector<std::vector<uint8_t>>& to_test,
+                  bool photo_check) {
+    std::vector<std::vector<uint8_t>> refuted(nm);
     for (int j = 0; j < nm; ++j) {
+      refuted[j].assign(clouds[j].size(), 0);
       if (clouds[j].size() == 0) continue;
+      if (!to_test.empty() && std::find(to_test[j].begin(), to_test[j].end(), 1) == to_test[j].end()) continue;
       const DepthBuffer buffer = FacingDepthBuffer(j, views[j], projections[j], clouds, usable, options);
       if (buffer.disparity.empty()) continue;
       const bool check = photo_check && !views[j].left_rectified.empty();
       for (size_t i = 0; i < clouds[j].size(); ++i)
-        if (!(*refuted)[j][i])
-          (*refuted)[j][i] = SeenThrough(views[j], projections[j], clouds, j, i, buffer, check, options);
+        if (to_test.empty() || to_test[j][i])
+          refuted[j][i] = SeenThrough(views[j], projections[j], clouds, j, i, buffer, check, options);
     }
+    return refuted;
   };
-  std::vector<std::vector<uint8_t>> first(nm);
-  for (int j = 0; j < nm; ++j) first[j].assign(clouds[j].size(), 0);
-  test({}, false, &first);
+  const std::vector<std::vector<uint8_t>> first = test({}, {}, false);
   bool any_refuted = false;
   for (int j = 0; j < nm; ++j)
     any_refuted = any_refuted || std::find(first[j].begin(), first[j].end(), 1) != first[j].end();
@@ -225,10 +254,18 @@ std::vector<std::vector<uint8_t>> FreeSpaceRefuted(const std::vector<FreeSpaceVi
     usable[j].resize(clouds[j].size());
     for (size_t i = 0; i < clouds[j].size(); ++i) usable[j][i] = !wrong[j][i];
   }
-  // Again without the wrong surfaces as occluders (what they alone refuted
-  // stays), and with the photo check. What is refuted then, or lies on a
-  // wrong surface, goes.
-  test(usable, true, &wrong);
+  // Again, without the wrong surfaces as occluders (what they alone refuted
+  // stays), on what the first pass refuted off them (with fewer occluders
+  // nothing else can be). What is refuted then, or lies on a wrong surface,
+  // goes.
+  std::vector<std::vector<uint8_t>> again(nm);
+  for (int j = 0; j < nm; ++j) {
+    again[j].resize(clouds[j].size());
+    for (size_t i = 0; i < clouds[j].size(); ++i) again[j][i] = first[j][i] && !wrong[j][i];
+  }
+  const std::vector<std::vector<uint8_t>> second = test(usable, again, true);
+  for (int j = 0; j < nm; ++j)
+    for (size_t i = 0; i < clouds[j].size(); ++i) wrong[j][i] = wrong[j][i] || second[j][i];
   return wrong;
 }
 

@@ -29,36 +29,43 @@
 // disparity scatters by sigma_d (docs/reconstruct.md, the option's row).
 // The rule never removes a point behind the facing surface (a facing
 // module's correct points, seen from its partner, lie behind the partner's
-// surface), nor where no other module's point projects.
+// surface); a point no other module's point hides goes only with its whole
+// surface (below).
 //
 // Whole surfaces. A wrong patch is refuted only where another module's
-// cover lies in front of it; its points beyond that cover survive, and
-// where they lie in front of a third view's correct surface they refute
-// THAT (the ring's plate at seed 5: module 2's surviving wrong points took
-// 1 302 correct points of module 1, "The free-space test across modules,
-// whole surfaces (session 23)", reconstruct-log.md). So the points are
-// first grouped into surfaces, per module: points joined through
-// neighbouring pixels of its rectified left image whose points lie within
-// surface_max_edge_mm of each other (the mesh's own rule for a depth jump).
-// A surface at least surface_fraction of whose points the test refutes is
-// wrong as a whole: all of it goes, and the test is made again with the
-// depth buffers of what is left, so that a wrong surface refutes nothing.
+// cover lies in front of it; its points beyond that cover survive (the
+// ring's plate at seed 11: 84 of module 2's 2 587 wrong points, "The
+// free-space test across modules, whole surfaces (session 23)",
+// reconstruct-log.md). So the points are first grouped into surfaces, per
+// module: points joined through neighbouring pixels of its rectified left
+// image whose points lie within surface_max_edge_mm of each other (the
+// mesh's own rule for a depth jump). A surface at least surface_fraction of
+// whose points the first pass refutes is wrong as a whole: all of it goes,
+// and the points the first pass refuted elsewhere are tested again with
+// depth buffers without the wrong surfaces, which so refute nothing more.
+// The shares are read once: two surfaces each hidden mostly by the other
+// both go.
 //
-// The refuter in the refuted module's own images. A point of a correct
-// surface can still be refuted by another module's points a little off
-// their surface: seen from a camera that views the surface obliquely, a
-// ~1 mm offset along the normal is several times the margin along the ray
-// (the ring's plate at seed 5: module 2's points 0.97-1.13 mm off took
-// module 1's points, which module 1's left camera sees ~75 deg off its
-// normal). Had the refuter's surface really been there, module j's own
-// cameras would have seen it: so in the second pass a nearer buffer pixel
-// counts only if module j's rectified pair correlates there at the
-// refuter's disparity (the sub-pixel window's ZNCC, warped by the
-// refuter's own plane in j's image, >= min_zncc: what j's matcher would
-// have accepted). Not in the first pass: a module whose RIGHT camera
-// grazes the surface (the grazed patch's case) cannot correlate that
-// surface at all, and its wrong patch must still be found; a surface
-// mostly hidden goes whole on geometry alone.
+// The hiding point in the refuted module's own images (the second pass). A
+// point of a correct surface can still be refuted by another module's
+// points a little off their surface: seen from a camera that views the
+// surface obliquely, a ~1 mm offset along the normal is several times the
+// margin along the ray (the ring's plate at seed 5: module 2's points
+// 0.97-1.13 mm off took 1 303 of module 1's points, which module 1's left
+// camera sees ~75 deg off the plate's normal). Had the hiding surface
+// really been there, module j's own cameras would have seen it: in the
+// second pass a nearer buffer pixel counts only where module j's rectified
+// pair correlates there (the best ZNCC of the sub-pixel window, linear
+// taps, warped by the hiding point's own plane in j's image, at that
+// plane's disparity at the pixel's centre and 0.5 px either side, >=
+// min_zncc: a correlation j's matcher would have started from; no fit, no
+// distinctness test), or where the pair cannot tell: j's right camera grazes
+// that plane (1 - dd/dx < 0.3), or no window can be read (off the image,
+// flat or blank). Not in the first pass: a module whose view of the surface
+// is poor (seed 5's module 2, 1 - dd/dx in [0.3, 0.5)) correlates little of
+// it even where it is there, and its wrong patch must still be found: with
+// the check there, seed 5's module 2 kept wrong surfaces (std 0.29 -> 0.82
+// mm).
 #pragma once
 
 #include <Eigen/Core>
@@ -79,12 +86,14 @@ struct FreeSpaceOptions {
   int min_support = 3;            // buffer pixels in front needed; default 3
   double min_facing_cos = 0.26;   // another module's point faces the camera if n.v exceeds this (~75 deg); default 0.26
   double surface_fraction = 0.8;  // a surface this share of which is refuted goes whole; (0, 1], default 0.8
-  // Neighbouring pixels' points within this distance are one surface. Not
-  // a key of its own: the runtime sets it to mesh_max_edge_mm. Default 1.5.
+  // Not keys of their own: Runtime::Process sets these from the runtime's
+  // options, over whatever RuntimeOptions::free_space holds.
+  // Neighbouring pixels' points within this distance are one surface: the
+  // mesh's mesh_max_edge_mm. Default 1.5.
   double surface_max_edge_mm = 1.5;
   // The second pass's photo check (FreeSpaceView's images): the window and
-  // the least ZNCC. Not keys of their own: the runtime sets them to the
-  // matcher's (match.subpixel_half_width_px / _height_px, match.min_zncc).
+  // the least ZNCC, the matcher's (match.subpixel_half_width_px /
+  // _height_px, match.min_zncc).
   SubpixelOptions window;
   double min_zncc = 0.8;
 };
