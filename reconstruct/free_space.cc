@@ -234,7 +234,7 @@ std::vector<std::vector<uint8_t>> FreeSpaceRefuted(const std::vector<FreeSpaceVi
     }
     return refuted;
   };
-  const std::vector<std::vector<uint8_t>> first = test({}, {}, false);
+  std::vector<std::vector<uint8_t>> first = test({}, {}, false);
   bool any_refuted = false;
   for (int j = 0; j < nm; ++j)
     any_refuted = any_refuted || std::find(first[j].begin(), first[j].end(), 1) != first[j].end();
