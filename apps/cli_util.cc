@@ -1,5 +1,6 @@
 #include "apps/cli_util.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -25,7 +26,14 @@ std::optional<int> ParseArgs(CLI::App& app, int argc, char** argv) {
 std::vector<std::string> SplitSceneList(const std::string& list) {
   std::vector<std::string> scenes;
   std::stringstream in(list);
-  for (std::string name; std::getline(in, name, ',');) scenes.push_back(name);
+  for (std::string name; std::getline(in, name, ',');) {
+    if (name.empty()) throw InputError("--scenes " + list, "an empty scene name (two commas, or one at an end)");
+    if (std::find(scenes.begin(), scenes.end(), name) != scenes.end())
+      throw InputError("--scenes " + list, "names '" + name + "' twice");
+    scenes.push_back(name);
+  }
+  if (scenes.empty() || list.back() == ',')
+    throw InputError("--scenes " + list, "an empty scene name (two commas, or one at an end)");
   return scenes;
 }
 

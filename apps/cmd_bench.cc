@@ -216,12 +216,14 @@ int RunBench(int argc, char** argv) {
       "stereorig bench"};
   std::string dataset, rig_path, options_path, report_path, scenes_arg = "cup,sphere,ballbar,plate,tuber";
   int runs = 20;
-  app.add_option("--dataset", dataset, "simulator dataset folder (scenes/<scene>/active, truth/)");
+  CLI::Option* dataset_option =
+      app.add_option("--dataset", dataset, "simulator dataset folder (scenes/<scene>/active, truth/)");
   app.add_option("--scenes", scenes_arg,
                  "with --dataset: comma-separated scenes; each one named must be in the dataset "
                  "(scenes/<name>/active), or the bench exits 2 before any run; by default, those of the five the "
                  "dataset holds")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->needs(dataset_option);
   app.add_option("--rig", rig_path, "rig file to reconstruct with (default: the dataset's truth/rig.yaml)");
   app.add_option("--options", options_path, "runtime options YAML");
   app.add_option("--runs", runs, "passes over the scenes per pipeline")->capture_default_str();

@@ -97,7 +97,10 @@ TEST(BenchCli, AMissingSceneNamedInScenesExitsTwoBeforeAnyRun) {
   const std::pair<std::string, std::string> refused[] = {
       {" --scenes cup,spher", dataset + "/scenes/spher: no such scene in the dataset (--scenes)"},
       {" --scenes sphere", dataset + "/scenes/sphere: no such scene in the dataset (--scenes)"},
-      {" --scenes spher,cup,ballbal", dataset + "/scenes: no such scenes in the dataset (--scenes): spher, ballbal"}};
+      {" --scenes spher,cup,ballbal", dataset + "/scenes: no such scenes in the dataset (--scenes): spher, ballbal"},
+      {" --scenes cup,,sphere", "--scenes cup,,sphere: an empty scene name"},
+      {" --scenes cup,", "--scenes cup,: an empty scene name"},
+      {" --scenes cup,cup", "--scenes cup,cup: names 'cup' twice"}};
   for (const auto& [scenes, says] : refused) {
     const testing::Result r = RunCli(bench + scenes);
     EXPECT_EQ(r.code, 2) << scenes;
@@ -113,6 +116,15 @@ TEST(BenchCli, AMissingSceneNamedInScenesExitsTwoBeforeAnyRun) {
     EXPECT_EQ(r.err.find("no such scene"), std::string::npos) << scenes << ": " << r.err;
   }
   std::filesystem::remove_all(dataset);
+}
+
+// --scenes picks scenes of a --dataset; without one (the built-in sphere)
+// it would be ignored: refused instead.
+TEST(BenchCli, ScenesWithoutADatasetIsRefused) {
+  const testing::Result r = RunCli("bench --runs 1 --scenes cup");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--scenes requires --dataset"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find("objects/s"), std::string::npos) << r.out;
 }
 
 }  // namespace
