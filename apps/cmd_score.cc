@@ -155,7 +155,8 @@ int RunScore(int argc, char** argv) {
       sj["modules"].push_back({{"module", m},
                                {"accuracy", ErrorFiguresJson(e)},
                                {"fill", FillJson(s.fill[m])},
-                               {"points_seen_through", rec.modules[m].seen_through}});
+                               {"points_seen_through", rec.modules[m].seen_through},
+                               {"points_on_seen_through_surfaces", rec.modules[m].seen_through_surface}});
       std::printf("; m%zu fill %5.1f%% |e| %.4f std %.4f", m, 100 * s.fill[m].fill(), e.mean_abs_mm, e.std_mm);
     }
     if (!no_passive && fs::is_directory(scene_dir / "passive")) {
@@ -170,7 +171,8 @@ int RunScore(int argc, char** argv) {
     for (size_t m = 0; m < s.fill.size(); ++m) {
       std::printf("  m%zu lost: %s\n", m, LossLine(s.fill[m].target_status, s.fill[m].target_px).c_str());
       if (rec.modules[m].seen_through > 0)
-        std::printf("  m%zu free-space test: %d points removed (seen through)\n", m, rec.modules[m].seen_through);
+        std::printf("  m%zu free-space test: %d points removed (seen through; %d of them with their surface)\n", m,
+                    rec.modules[m].seen_through, rec.modules[m].seen_through_surface);
     }
     if (fill) {
       sj["shape_fit"] = rec.shape_fit;

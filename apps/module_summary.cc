@@ -34,9 +34,11 @@ std::string ModuleSummary(const ModuleReport& m, int max_reasons) {
                 m.searched_min_disparity_px, m.searched_min_disparity_px + m.searched_num_disparities,
                 m.min_disparity_px, m.min_disparity_px + m.num_disparities);
   const std::string losses = LossLine(m.lit_by_status, m.lit_pixels, std::max(1, max_reasons));
-  const std::string seen =
-      m.seen_through > 0 ? "\n  " + std::to_string(m.seen_through) + " points removed, seen through (free_space_test)"
-                         : "";
+  const std::string seen = m.seen_through > 0
+                               ? "\n  " + std::to_string(m.seen_through) +
+                                     " points removed, seen through (free_space_test; " +
+                                     std::to_string(m.seen_through_surface) + " of them with their surface)"
+                               : "";
   return buf + (losses.empty() ? "none" : losses) + seen;
 }
 

@@ -11,6 +11,7 @@ nlohmann::json ReconstructionJson(const Reconstruction& rec) {
     nlohmann::json mj = {{"module", m.module},
                          {"points", m.points},
                          {"points_seen_through", m.seen_through},
+                         {"points_on_seen_through_surfaces", m.seen_through_surface},
                          {"lit_pixels", m.lit_pixels},
                          {"lit_pixels_filled", m.lit_filled},
                          {"fill_rate", m.fill_rate()},

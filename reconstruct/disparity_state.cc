@@ -47,6 +47,8 @@ const char* PixelStatusName(PixelStatus status) {
       return "left_view_edge";
     case PixelStatus::kSeenThrough:
       return "seen_through";
+    case PixelStatus::kSeenThroughSurface:
+      return "seen_through_surface";
     case PixelStatus::kNumStatus:
       break;
   }

@@ -11,28 +11,29 @@ namespace stereorig {
 
 // What became of each left pixel: a point, or the first test that rejected
 // it. The matcher sets the codes up to kNotDistinct and kOccluded,
-// kWrongLine, kLeftViewEdge; the runtime adds kLowConfidence, kOutsideVolume, kObjectSize, kSeenThrough. For finding
-// where fill is lost (`stereorig score` tabulates them).
+// kWrongLine, kLeftViewEdge; the runtime adds kLowConfidence, kOutsideVolume, kObjectSize, kSeenThrough,
+// kSeenThroughSurface. For finding where fill is lost (`stereorig score` tabulates them).
 enum class PixelStatus : uint8_t {
-  kNotSearched = 0,  // outside the matched region
-  kPoint,            // a valid disparity (and, in the runtime, a kept point)
-  kNoSgmMatch,       // SGM: left-right check, uniqueness, or the best cost at the range's edge
-  kNoPlane,          // too few valid neighbours for the local plane, or a depth edge
-  kOffPlaneCoarse,   // the cost-fit disparity is off the local plane (before refinement)
-  kRefineFailed,     // sub-pixel refinement diverged, moved too far, or left the image
-  kLowZncc,          // refined window correlates below min_zncc
-  kLowTexture,       // window std below min_texture_dn
-  kOutOfRange,       // refined disparity outside the searched range
-  kOffPlane,         // refined disparity off the local plane
-  kSpeckle,          // in a blob smaller than speckle_window_px
-  kNotDistinct,      // correlates about as well half a grid period off (RefineAcceptance)
-  kLowConfidence,    // runtime: confidence below min_confidence
-  kOutsideVolume,    // runtime: triangulated outside the measurement volume
-  kObjectSize,       // runtime: farther than object_size_mm from the module cloud's median
-  kOccluded,         // its match in the right view is hidden by a nearer surface, or outside it (right_occlusion.h)
-  kWrongLine,        // in a component on the wrong laser line that no whole-period move fixes (line_index.h)
-  kLeftViewEdge,     // its refinement window reaches past the left view's data (left_view_edge.h)
-  kSeenThrough,      // runtime: other modules' surfaces facing this camera lie in front of it (free_space.h)
+  kNotSearched = 0,     // outside the matched region
+  kPoint,               // a valid disparity (and, in the runtime, a kept point)
+  kNoSgmMatch,          // SGM: left-right check, uniqueness, or the best cost at the range's edge
+  kNoPlane,             // too few valid neighbours for the local plane, or a depth edge
+  kOffPlaneCoarse,      // the cost-fit disparity is off the local plane (before refinement)
+  kRefineFailed,        // sub-pixel refinement diverged, moved too far, or left the image
+  kLowZncc,             // refined window correlates below min_zncc
+  kLowTexture,          // window std below min_texture_dn
+  kOutOfRange,          // refined disparity outside the searched range
+  kOffPlane,            // refined disparity off the local plane
+  kSpeckle,             // in a blob smaller than speckle_window_px
+  kNotDistinct,         // correlates about as well half a grid period off (RefineAcceptance)
+  kLowConfidence,       // runtime: confidence below min_confidence
+  kOutsideVolume,       // runtime: triangulated outside the measurement volume
+  kObjectSize,          // runtime: farther than object_size_mm from the module cloud's median
+  kOccluded,            // its match in the right view is hidden by a nearer surface, or outside it (right_occlusion.h)
+  kWrongLine,           // in a component on the wrong laser line that no whole-period move fixes (line_index.h)
+  kLeftViewEdge,        // its refinement window reaches past the left view's data (left_view_edge.h)
+  kSeenThrough,         // runtime: other modules' surfaces facing this camera lie in front of it (free_space.h)
+  kSeenThroughSurface,  // runtime: on a surface the free-space test found mostly seen through, removed whole
   kNumStatus
 };
 const char* PixelStatusName(PixelStatus status);

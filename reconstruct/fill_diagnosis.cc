@@ -274,6 +274,8 @@ cv::Vec3b StatusColour(uint8_t status) {  // BGR
       return {64, 64, 64};  // dark grey
     case PixelStatus::kSeenThrough:
       return {0, 0, 128};  // dark red
+    case PixelStatus::kSeenThroughSurface:
+      return {128, 0, 128};  // dark magenta
     default:
       return {255, 255, 255};
   }

@@ -264,9 +264,17 @@ std::vector<std::vector<uint8_t>> FreeSpaceRefuted(const std::vector<FreeSpaceVi
     for (size_t i = 0; i < clouds[j].size(); ++i) again[j][i] = first[j][i] && !wrong[j][i];
   }
   const std::vector<std::vector<uint8_t>> second = test(usable, again, true);
-  for (int j = 0; j < nm; ++j)
-    for (size_t i = 0; i < clouds[j].size(); ++i) wrong[j][i] = wrong[j][i] || second[j][i];
-  return wrong;
+  std::vector<std::vector<uint8_t>> verdict(nm);
+  for (int j = 0; j < nm; ++j) {
+    verdict[j].assign(clouds[j].size(), uint8_t(FreeSpaceVerdict::kKept));
+    for (size_t i = 0; i < clouds[j].size(); ++i) {
+      if (wrong[j][i])
+        verdict[j][i] = uint8_t(first[j][i] ? FreeSpaceVerdict::kSeenThrough : FreeSpaceVerdict::kOnSeenThroughSurface);
+      else if (second[j][i])
+        verdict[j][i] = uint8_t(FreeSpaceVerdict::kSeenThrough);
+    }
+  }
+  return verdict;
 }
 
 }  // namespace stereorig

@@ -108,9 +108,17 @@ struct FreeSpaceView {
   cv::Mat left_rectified, right_rectified;
 };
 
+// What the test says of a point.
+enum class FreeSpaceVerdict : uint8_t {
+  kKept = 0,
+  kSeenThrough = 1,           // other modules' facing points hide it from its camera
+  kOnSeenThroughSurface = 2,  // nothing hides it, but it lies on a surface mostly seen through: removed whole
+};
+
 // clouds[j]: module j's points (reference frame, mm) with unit normals; the
 // cloud's `module` field is ignored (clouds[j] is module j's). Returns, per
-// module, one flag per point: 1 = refuted. views.size() == clouds.size().
+// module, one FreeSpaceVerdict per point (as uint8_t: 0 = kept).
+// views.size() == clouds.size().
 std::vector<std::vector<uint8_t>> FreeSpaceRefuted(const std::vector<FreeSpaceView>& views,
                                                    const std::vector<PointCloud>& clouds,
                                                    const FreeSpaceOptions& options);

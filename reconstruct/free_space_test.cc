@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 
 namespace stereorig {
 namespace {
@@ -56,9 +57,12 @@ std::vector<FreeSpaceView> SixtyDegreePair() {
           CameraAt(target + 200 * Eigen::Vector3d(std::sin(a), 0, -std::cos(a)), target)};
 }
 
-size_t Count(const std::vector<uint8_t>& flags, size_t begin, size_t end) {
+// How many of [begin, end) the test removes (any verdict but kKept), or,
+// with `only`, how many have that verdict.
+size_t Count(const std::vector<uint8_t>& verdicts, size_t begin, size_t end,
+             std::optional<FreeSpaceVerdict> only = std::nullopt) {
   size_t n = 0;
-  for (size_t i = begin; i < end; ++i) n += flags[i];
+  for (size_t i = begin; i < end; ++i) n += only ? verdicts[i] == uint8_t(*only) : verdicts[i] != 0;
   return n;
 }
 
@@ -121,6 +125,10 @@ TEST(FreeSpaceRefuted, ASurfaceMostOfWhichIsSeenThroughGoesWhole) {
   EXPECT_EQ(Count(refuted[0], 0, true_points), 0u) << "module 0's true surface kept";
   EXPECT_EQ(Count(refuted[0], true_points, clouds[0].size()), clouds[0].size() - true_points)
       << "the whole wrong surface removed, also where nothing lies in front of it";
+  // Where nothing hides it (x > 25 mm: ~7 %), said so.
+  const size_t on_surface = Count(refuted[0], true_points, clouds[0].size(), FreeSpaceVerdict::kOnSeenThroughSurface);
+  EXPECT_GT(on_surface, (clouds[0].size() - true_points) * 5 / 100);
+  EXPECT_LT(on_surface, (clouds[0].size() - true_points) * 15 / 100);
   EXPECT_EQ(Count(refuted[1], 0, clouds[1].size()), 0u) << "module 1's surface kept";
 }
 

@@ -31,8 +31,9 @@ std::vector<Eigen::Vector3d> VolumeCorners(const Eigen::Vector3d& centre, const 
   return corners;
 }
 
-// Removes module m's refuted points from its cloud and mesh, marks their
-// pixels kSeenThrough and recounts the module's report. A point's pixel is
+// Removes module m's refuted points (FreeSpaceVerdict) from its cloud and
+// mesh, marks their pixels kSeenThrough or kSeenThroughSurface and recounts
+// the module's report. A point's pixel is
 // its reprojection through the module's rectification (the points were
 // triangulated from pixel centres, so it rounds back to them).
 void RemoveRefuted(const ModulePlan& plan, const std::vector<uint8_t>& refuted, PointCloud* cloud, Mesh* mesh,
@@ -53,18 +54,20 @@ void RemoveRefuted(const ModulePlan& plan, const std::vector<uint8_t>& refuted, 
       kept.confidence.push_back(cloud->confidence[i]);
       continue;
     }
+    const bool surface = refuted[i] == uint8_t(FreeSpaceVerdict::kOnSeenThroughSurface);
     ++report->seen_through;
+    report->seen_through_surface += surface;
     const Eigen::Vector3d q = plan.geometry.PixelAndDisparity(r * cloud->xyz_mm[i].cast<double>() + t);
     const cv::Point px(int(std::lround(q.x())), int(std::lround(q.y())));
     STEREORIG_CHECK(px.inside(cv::Rect(cv::Point(0, 0), report->status.size())));
     uint8_t& st = report->status.at<uint8_t>(px);
     STEREORIG_CHECK(st == uint8_t(PixelStatus::kPoint));
-    st = uint8_t(PixelStatus::kSeenThrough);
+    st = uint8_t(surface ? PixelStatus::kSeenThroughSurface : PixelStatus::kSeenThrough);
     const cv::Point lit_px = px - plan.roi.tl();
     if (lit_px.inside(cv::Rect(cv::Point(0, 0), report->lit.size())) && report->lit.at<uint8_t>(lit_px)) {
       --report->lit_filled;
       --report->lit_by_status[size_t(PixelStatus::kPoint)];
-      ++report->lit_by_status[size_t(PixelStatus::kSeenThrough)];
+      ++report->lit_by_status[size_t(st)];
     }
   }
   report->points = int(kept.size());
@@ -409,7 +412,7 @@ Reconstruction Runtime::Process(const std::vector<cv::Mat>& images, bool build_m
     o.min_zncc = options_.match.min_zncc;
     const std::vector<std::vector<uint8_t>> refuted = FreeSpaceRefuted(views, clouds, o);
     for (int m = 0; m < nm; ++m)
-      if (std::find(refuted[m].begin(), refuted[m].end(), 1) != refuted[m].end())
+      if (std::any_of(refuted[m].begin(), refuted[m].end(), [](uint8_t v) { return v != 0; }))
         RemoveRefuted(plans_[m], refuted[m], &clouds[m], &meshes[m], &out.modules[m]);
     rectified.clear();
     out.times_ms["free_space"] = MsSince(t);

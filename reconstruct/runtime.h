@@ -50,10 +50,11 @@ struct ModuleReport {
   // What the matcher searched at full resolution (MatchResult): the occupied
   // band within that range; 0 / 0 when nothing was matched (no lit region).
   int searched_min_disparity_px = 0, searched_num_disparities = 0;
-  int points = 0;        // points kept
-  int seen_through = 0;  // of the module's points, those the free-space test removed (free_space.h)
-  int lit_pixels = 0;    // grid-lit pixels of the rectified left image in the volume's ROI
-  int lit_filled = 0;    // of those, pixels with a kept point
+  int points = 0;                // points kept
+  int seen_through = 0;          // of the module's points, those the free-space test removed (free_space.h)
+  int seen_through_surface = 0;  // of those, the ones nothing hid: removed with their surface, mostly seen through
+  int lit_pixels = 0;            // grid-lit pixels of the rectified left image in the volume's ROI
+  int lit_filled = 0;            // of those, pixels with a kept point
   // The lit pixels by their final PixelStatus (disparity_state.h): kPoint
   // counts lit_filled, the others name the test that refused the rest. The
   // runtime's own account of where fill goes, with no truth needed.
