@@ -14,23 +14,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The file a path names: symbolic links followed as far as the path exists
-// (an output through a link to an input is that input), the rest normalised.
-fs::path Key(const std::string& path) { return NormalPath(path); }
-
-// The deepest part of `key` (a Key) that exists, or empty if none does;
-// `missing` gets the parts below it, innermost first. A part that cannot be
-// looked up (a name too long for the file system) is missing.
-fs::path DeepestExisting(const fs::path& key, std::vector<fs::path>* missing) {
-  for (fs::path p = key; !p.empty(); p = p.parent_path()) {
-    std::error_code ec;
-    if (fs::exists(p, ec)) return p;
-    missing->push_back(p);
-    if (p == p.root_path()) break;
-  }
-  return {};
-}
-
 // Throws InputError(path, "cannot <doing>: ...") if the name of a part of
 // `missing` (the parts of a path to create below `existing`) is longer than
 // the file system there allows (pathconf NAME_MAX: 255 on ext4), which
@@ -52,11 +35,11 @@ void CheckNamesFit(const std::string& path, const std::string& doing, const fs::
 }  // namespace
 
 void OutputPaths::Protect(const std::string& path, const std::string& what) {
-  if (!path.empty()) inputs_.emplace(Key(path), what);
+  if (!path.empty()) inputs_.emplace(NormalPath(path), what);  // an output through a link to an input is that input
 }
 
 void OutputPaths::Claim(const std::string& path, const std::string& what, bool check_folder) {
-  const fs::path key = Key(path);
+  const fs::path key = NormalPath(path);
   if (const auto it = inputs_.find(key); it != inputs_.end())
     throw InputError(path, "is " + it->second + ": writing " + what + " there would overwrite an input");
   if (const auto it = claimed_.find(key); it != claimed_.end())
@@ -65,7 +48,7 @@ void OutputPaths::Claim(const std::string& path, const std::string& what, bool c
   if (const auto it = folders_.find(key); it != folders_.end())
     throw InputError(path, "is a folder this command creates for " + it->second + ", not a file to write");
   std::vector<fs::path> missing;
-  CheckNamesFit(path, "write " + what, DeepestExisting(key, &missing), missing);
+  CheckNamesFit(path, "write " + what, DeepestExistingPart(key, &missing), missing);
   if (check_folder && !fs::is_directory(key.parent_path())) throw InputError(path, "its folder does not exist");
   if (fs::is_directory(key)) throw InputError(path, "is a folder, not a file to write");
   claimed_.emplace(key, what);
@@ -101,7 +84,7 @@ std::vector<std::pair<std::string, std::string>> DatasetInputs(const std::string
 }
 
 FolderToCreate OutputPaths::ClaimFolder(const std::string& path, const std::string& what) {
-  const fs::path key = Key(path);
+  const fs::path key = NormalPath(path);
   if (const auto it = inputs_.find(key); it != inputs_.end())
     throw InputError(path, "is " + it->second + ", not a folder for " + what);
   if (const auto it = claimed_.find(key); it != claimed_.end())
@@ -110,7 +93,7 @@ FolderToCreate OutputPaths::ClaimFolder(const std::string& path, const std::stri
   // creates the rest, none of which may be a file another output claimed
   // (--report a with --export-cameramodels a/b).
   std::vector<fs::path> missing;
-  const fs::path existing = DeepestExisting(key, &missing);
+  const fs::path existing = DeepestExistingPart(key, &missing);
   if (!existing.empty() && !fs::is_directory(existing))
     throw InputError(path, (existing == key ? std::string("is a file") : existing.string() + " is a file") +
                                ", not a folder for " + what);

@@ -21,12 +21,19 @@ fs::path NormalPath(const fs::path& path) {
   return (NormalPath(parent) / absolute.filename()).lexically_normal();
 }
 
-FolderToCreate::FolderToCreate(const std::string& path, const std::string& what) : path_(path), what_(what) {
-  std::error_code ec;  // a part that cannot be looked up is not there
-  for (fs::path p = NormalPath(path); !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
-    missing_.insert(missing_.begin(), p);  // outermost first
+fs::path DeepestExistingPart(const fs::path& normal, std::vector<fs::path>* missing) {
+  for (fs::path p = normal; !p.empty(); p = p.parent_path()) {
+    std::error_code ec;
+    if (fs::exists(p, ec)) return p;
+    missing->push_back(p);
     if (p == p.root_path()) break;
   }
+  return {};
+}
+
+FolderToCreate::FolderToCreate(const std::string& path, const std::string& what) : path_(path), what_(what) {
+  DeepestExistingPart(NormalPath(path), &missing_);
+  std::reverse(missing_.begin(), missing_.end());  // outermost first
 }
 
 FolderToCreate::FolderToCreate(FolderToCreate&& other) noexcept

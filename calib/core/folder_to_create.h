@@ -15,6 +15,12 @@ namespace stereorig {
 // such a path is a path to refuse by name, not a std::filesystem error.
 std::filesystem::path NormalPath(const std::filesystem::path& path);
 
+// The deepest part of `normal` (a NormalPath) that exists, or empty if none
+// does; `missing` gets the parts below it, innermost first. A part that
+// cannot be looked up (a name too long for the file system) is missing.
+std::filesystem::path DeepestExistingPart(const std::filesystem::path& normal,
+                                          std::vector<std::filesystem::path>* missing);
+
 // A folder a command creates, and the folders above it that did not exist
 // when this object was made (a command's output folder is made so by
 // OutputPaths::ClaimFolder, apps/output_paths.h, after its checks): created
