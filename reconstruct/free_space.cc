@@ -44,15 +44,17 @@ class ModuleProjection {
 
 // The depth buffer of module j: at each pixel of its rectified left image,
 // the largest disparity of the other modules' points that face camera j,
-// among those `usable` (empty: all); -inf where none. `owner`: that
-// point's (module, index). Both empty if no point projects.
+// among those `usable` (empty: all); -inf where none. With `owners`,
+// `owner` holds that point's (module, index) (the photo check's; the first
+// pass, which runs on every capture, has no use for it). Empty if no point
+// projects.
 struct DepthBuffer {
   cv::Mat disparity;  // CV_32FC1
   cv::Mat owner;      // CV_32SC2
 };
 DepthBuffer FacingDepthBuffer(int j, const FreeSpaceView& view, const ModuleProjection& proj,
                               const std::vector<PointCloud>& clouds, const std::vector<std::vector<uint8_t>>& usable,
-                              const FreeSpaceOptions& options) {
+                              const FreeSpaceOptions& options, bool owners) {
   const float none = -std::numeric_limits<float>::infinity();
   const Eigen::Vector3f eye = view.camera_centre_reference_mm.cast<float>();
   DepthBuffer buffer;
@@ -69,12 +71,12 @@ DepthBuffer FacingDepthBuffer(int j, const FreeSpaceView& view, const ModuleProj
       if (!proj.Project(proj.Rectified(c.xyz_mm[i]), &u, &v, &q)) continue;
       if (buffer.disparity.empty()) {
         buffer.disparity = cv::Mat(proj.geometry().size, CV_32FC1, cv::Scalar(none));
-        buffer.owner = cv::Mat(proj.geometry().size, CV_32SC2, cv::Scalar(-1, -1));
+        if (owners) buffer.owner = cv::Mat(proj.geometry().size, CV_32SC2, cv::Scalar(-1, -1));
       }
       float& b = buffer.disparity.at<float>(v, u);
       if (float(q.z()) > b) {
         b = float(q.z());
-        buffer.owner.at<cv::Vec2i>(v, u) = cv::Vec2i(k, int(i));
+        if (owners) buffer.owner.at<cv::Vec2i>(v, u) = cv::Vec2i(k, int(i));
       }
     }
   }
@@ -225,9 +227,9 @@ std::vector<std::vector<uint8_t>> FreeSpaceRefuted(const std::vector<FreeSpaceVi
       refuted[j].assign(clouds[j].size(), 0);
       if (clouds[j].size() == 0) continue;
       if (!to_test.empty() && std::find(to_test[j].begin(), to_test[j].end(), 1) == to_test[j].end()) continue;
-      const DepthBuffer buffer = FacingDepthBuffer(j, views[j], projections[j], clouds, usable, options);
-      if (buffer.disparity.empty()) continue;
       const bool check = photo_check && !views[j].left_rectified.empty();
+      const DepthBuffer buffer = FacingDepthBuffer(j, views[j], projections[j], clouds, usable, options, check);
+      if (buffer.disparity.empty()) continue;
       for (size_t i = 0; i < clouds[j].size(); ++i)
         if (to_test.empty() || to_test[j][i])
           refuted[j][i] = SeenThrough(views[j], projections[j], clouds, j, i, buffer, check, options);
