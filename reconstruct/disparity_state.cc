@@ -49,6 +49,8 @@ const char* PixelStatusName(PixelStatus status) {
       return "seen_through";
     case PixelStatus::kSeenThroughSurface:
       return "seen_through_surface";
+    case PixelStatus::kRightViewEdge:
+      return "right_view_edge";
     case PixelStatus::kNumStatus:
       break;
   }

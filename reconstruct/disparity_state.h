@@ -11,8 +11,8 @@ namespace stereorig {
 
 // What became of each left pixel: a point, or the first test that rejected
 // it. The matcher sets the codes up to kNotDistinct and kOccluded,
-// kWrongLine, kLeftViewEdge; the runtime adds kLowConfidence, kOutsideVolume, kObjectSize, kSeenThrough,
-// kSeenThroughSurface. For finding where fill is lost (`stereorig score` tabulates them).
+// kWrongLine, kLeftViewEdge, kRightViewEdge; the runtime adds kLowConfidence, kOutsideVolume, kObjectSize,
+// kSeenThrough, kSeenThroughSurface. For finding where fill is lost (`stereorig score` tabulates them).
 enum class PixelStatus : uint8_t {
   kNotSearched = 0,     // outside the matched region
   kPoint,               // a valid disparity (and, in the runtime, a kept point)
@@ -34,6 +34,7 @@ enum class PixelStatus : uint8_t {
   kLeftViewEdge,        // its refinement window reaches past the left view's data (left_view_edge.h)
   kSeenThrough,         // runtime: other modules' surfaces facing this camera lie in front of it (free_space.h)
   kSeenThroughSurface,  // runtime: on a surface the free-space test found mostly seen through, removed whole
+  kRightViewEdge,       // in a surface at the right view's edge whose line cannot be checked (right_view_edge.h)
   kNumStatus
 };
 const char* PixelStatusName(PixelStatus status);

@@ -276,6 +276,8 @@ cv::Vec3b StatusColour(uint8_t status) {  // BGR
       return {0, 0, 128};  // dark red
     case PixelStatus::kSeenThroughSurface:
       return {128, 0, 128};  // dark magenta
+    case PixelStatus::kRightViewEdge:
+      return {128, 128, 0};  // teal
     default:
       return {255, 255, 255};
   }

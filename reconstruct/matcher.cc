@@ -18,6 +18,7 @@
 #include "reconstruct/parallel_for.h"
 #include "reconstruct/region_grow.h"
 #include "reconstruct/right_occlusion.h"
+#include "reconstruct/right_view_edge.h"
 #include "reconstruct/sgm_guide.h"
 #include "reconstruct/skipped_columns.h"
 #include "reconstruct/speckle_filter.h"
@@ -456,6 +457,8 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
   // and as occluders they would hide correct points next to them.
   DropLeftViewEdge(o.left_valid, o.subpixel.half_width_px, o.subpixel.half_height_px, roi, &state);
   DropRightInvisible(o.occlusion_margin_px, o.right_valid, roi, &state);
+  // After it: the points it drops at the edge are no surface to continue.
+  if (o.right_view_edge_test) DropUnverifiableAtRightViewEdge(o.right_valid, accept, 1.0, roi, &state);
   for (int y = roi.y; y < roi.y + roi.height; ++y) {  // outside the ROI: no point, confidence 0 already
     const float* d = state.disparity_px.ptr<float>(y);
     float* c = state.confidence.ptr<float>(y);

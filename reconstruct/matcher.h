@@ -128,6 +128,12 @@ struct MatchOptions {
   // within this of a right column without data (`right_valid`). 0 = both
   // off; default 1 px.
   double occlusion_margin_px = 1;
+  // census_sgm, opencv_sgbm_3way: right after that, drop the surfaces near
+  // the right view's edge whose alternatives a grid period over fall off
+  // the view, so that no test can tell whether they lie a period off, and
+  // which continue nowhere outside that zone (right_view_edge.h, status
+  // right_view_edge). Default on.
+  bool right_view_edge_test = true;
   // census_sgm, opencv_sgbm_3way: last, each disparity replaced by a quadric
   // fitted to its neighbourhood where one explains it (local_surface_fit.h):
   // the speckle scatter of the disparities (~0.27 px) falls by ~35%, detail

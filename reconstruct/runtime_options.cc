@@ -121,6 +121,7 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.speckle_range_px = m.GetDouble("speckle_range_px", mo.speckle_range_px);
     mo.speckle_along_slopes = m.GetBool("speckle_along_slopes", mo.speckle_along_slopes);
     mo.occlusion_margin_px = m.GetDouble("occlusion_margin_px", mo.occlusion_margin_px);
+    mo.right_view_edge_test = m.GetBool("right_view_edge_test", mo.right_view_edge_test);
     mo.surface_fit.enabled = m.GetBool("surface_fit", mo.surface_fit.enabled);
     mo.surface_fit.half_width_px = m.GetInt("surface_fit_half_width_px", mo.surface_fit.half_width_px);
     mo.surface_fit.half_height_px = m.GetInt("surface_fit_half_height_px", mo.surface_fit.half_height_px);
