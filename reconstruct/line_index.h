@@ -117,10 +117,13 @@ struct LineIndexOptions {
   // differences of a plain period jump scatter wider (simulator's plate,
   // module 1: 10th-90th percentile -10.8 to -7.0 px around -9.2, half of
   // them beyond 1 px): 2 px (a quarter period) still tells one period from
-  // none or two. Default 2 px (the demo, seed 7 and speckle 0 score as with
-  // 1 px; speckle 0.4 plate module 1: std 0.279 -> 0.143 mm, with the two
-  // options above).
-  double seam_spread_px = 2.0;
+  // none or two (the demo, seed 7 and speckle 0 score as with 1 px; speckle
+  // 0.4 plate module 1: std 0.279 -> 0.143 mm, with the two options above).
+  // Default 3 px since session 24: on a steep limb the differences also carry
+  // the slopes extrapolated over the gap (seed 5's default-speckle ball bar,
+  // module 1: a patch a period off, 34 % of its seam beyond 2 px; std 0.400
+  // -> 0.076 mm at 3 px, no other row of the gate worse).
+  double seam_spread_px = 3.0;
   void Check() const;  // throws InputError naming the bad field
 };
 

@@ -180,7 +180,7 @@ TEST(RuntimeOptions, ReadsAndChecksTheStrongSpeckleKeys) {
   EXPECT_EQ(d.match.grow.noise_zncc_factor, 4.0);
   EXPECT_EQ(d.match.grow.noise_min_zncc, 0.6);
   EXPECT_EQ(d.match.line_index.area_per_sample_px, 81);
-  EXPECT_EQ(d.match.line_index.seam_spread_px, 2.0);
+  EXPECT_EQ(d.match.line_index.seam_spread_px, 3.0);
   EXPECT_TRUE(d.match.line_index.lattice_sampling);
   const RuntimeOptions o = ParseRuntimeOptions(
       "match:\n  grow_noise_zncc_factor: 0\n  grow_noise_min_zncc: 0.5\n  line_index_area_per_sample_px: 0\n"
