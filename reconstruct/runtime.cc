@@ -25,6 +25,7 @@ using Clock = std::chrono::steady_clock;
 
 std::vector<Eigen::Vector3d> VolumeCorners(const Eigen::Vector3d& centre, const Eigen::Vector3d& size) {
   std::vector<Eigen::Vector3d> corners;
+  corners.reserve(8);
   for (int i = 0; i < 8; ++i)
     corners.push_back(centre + 0.5 * Eigen::Vector3d((i & 1 ? 1 : -1) * size.x(), (i & 2 ? 1 : -1) * size.y(),
                                                      (i & 4 ? 1 : -1) * size.z()));
@@ -445,6 +446,7 @@ Reconstruction Runtime::Process(const std::vector<cv::Mat>& images, bool build_m
 
 std::vector<std::string> CaptureImagePaths(const std::string& dir, const Rig& rig) {
   std::vector<std::string> paths;
+  paths.reserve(size_t(rig.num_cameras()));
   for (int k = 0; k < rig.num_cameras(); ++k)
     paths.push_back((std::filesystem::path(dir) / CameraImageName(k)).string());
   return paths;
