@@ -456,9 +456,10 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
   // The left view's edge first: its points are off by up to a few pixels,
   // and as occluders they would hide correct points next to them.
   DropLeftViewEdge(o.left_valid, o.subpixel.half_width_px, o.subpixel.half_height_px, roi, &state);
-  DropRightInvisible(o.occlusion_margin_px, o.right_valid, roi, &state);
+  const ViewGaps right_gaps(o.right_valid);
+  DropRightInvisible(o.occlusion_margin_px, right_gaps, roi, &state);
   // After it: the points it drops at the edge are no surface to continue.
-  if (o.right_view_edge_test) DropUnverifiableAtRightViewEdge(o.right_valid, accept, 1.0, roi, &state);
+  if (o.right_view_edge_test) DropUnverifiableAtRightViewEdge(right_gaps, accept, 1.0, roi, &state);
   for (int y = roi.y; y < roi.y + roi.height; ++y) {  // outside the ROI: no point, confidence 0 already
     const float* d = state.disparity_px.ptr<float>(y);
     float* c = state.confidence.ptr<float>(y);

@@ -22,10 +22,27 @@ cv::Mat ViewValidMask(const cv::Mat& map_x, const cv::Mat& map_y, const cv::Size
   return valid;
 }
 
+ViewGaps::ViewGaps(const cv::Mat& valid) {
+  if (valid.empty()) return;
+  STEREORIG_CHECK(valid.type() == CV_8UC1);
+  invalid_before_ = cv::Mat(valid.rows, valid.cols + 1, CV_32SC1);
+  for (int y = 0; y < valid.rows; ++y) {
+    const uint8_t* v = valid.ptr<uint8_t>(y);
+    int* count = invalid_before_.ptr<int>(y);
+    count[0] = 0;
+    for (int c = 0; c < valid.cols; ++c) count[c + 1] = count[c] + (v[c] == 0);
+  }
+}
+
 int DropRightInvisible(double margin_px, const cv::Mat& right_valid, const cv::Rect& roi, DisparityState* state) {
   if (!(margin_px > 0)) return 0;
+  return DropRightInvisible(margin_px, ViewGaps(right_valid), roi, state);
+}
+
+int DropRightInvisible(double margin_px, const ViewGaps& right_gaps, const cv::Rect& roi, DisparityState* state) {
+  if (!(margin_px > 0)) return 0;
   cv::Mat& disparity = state->disparity_px;
-  STEREORIG_CHECK(right_valid.empty() || (right_valid.type() == CV_8UC1 && right_valid.size() == disparity.size()));
+  STEREORIG_CHECK(right_gaps.empty() || right_gaps.size() == disparity.size());
   const int cols = disparity.cols;
   constexpr double kStepPx = 1;  // how much nearer an occluder must be (header)
   constexpr float kInf = std::numeric_limits<float>::infinity();
@@ -38,17 +55,12 @@ int DropRightInvisible(double margin_px, const cv::Mat& right_valid, const cv::R
   // (up to row_max - d px) was the filter's cost. The same float landings
   // as the scan's, so the result is the same.
   std::vector<float> first_landing(roi.width + 1);
-  // invalid_before[c]: how many of the row's columns left of c have no data
-  // in the right view. The edge test below asks whether any column of a
-  // short range has none; one difference of this count answers it, where
+  // The edge test below asks whether any column of a short range has no
+  // data; one difference of ViewGaps' per-row counts answers it, where
   // testing the columns one by one was a third of the filter's cost.
-  std::vector<int> invalid_before(size_t(cols) + 1, 0);
   int dropped = 0;
   for (int y = roi.y; y < roi.y + roi.height; ++y) {
     float* d = disparity.ptr<float>(y);
-    const uint8_t* valid = right_valid.empty() ? nullptr : right_valid.ptr<uint8_t>(y);
-    if (valid)
-      for (int c = 0; c < cols; ++c) invalid_before[size_t(c) + 1] = invalid_before[size_t(c)] + (valid[c] == 0);
     float row_max = -kInf;
     first_landing[roi.width] = kInf;
     for (int x = roi.x + roi.width - 1; x >= roi.x; --x) {
@@ -63,8 +75,7 @@ int DropRightInvisible(double margin_px, const cv::Mat& right_valid, const cv::R
       // Outside the right view: a column from c_first to c_last (c_first <=
       // c_last, as margin_px > 0) outside the image, or one without data.
       const int c_first = int(std::floor(xr - margin_px)), c_last = int(std::floor(xr + margin_px));
-      bool hidden = c_first < 0 || c_last >= cols ||
-                    (valid && invalid_before[size_t(c_last) + 1] > invalid_before[size_t(c_first)]);
+      bool hidden = c_first < 0 || c_last >= cols || right_gaps.AnyIn(y, c_first, c_last);
       // Occluded: an occluder x' lands at x' - d' <= xr, so
       // x' <= x + (d' - d) <= x + (row_max - d).
       if (!hidden && first_landing[x - roi.x + 1] <= xr) {

@@ -35,6 +35,29 @@ namespace stereorig {
 // right view's for the test below, the left view's for left_view_edge.h.
 cv::Mat ViewValidMask(const cv::Mat& map_x, const cv::Mat& map_y, const cv::Size& sensor_size);
 
+// The right view's columns without data, row by row, for the tests that
+// ask whether a range of right columns holds one (this one's edge test,
+// right_view_edge.h): built once per capture, each question is then one
+// difference of per-row counts.
+class ViewGaps {
+ public:
+  // valid: CV_8UC1 (ViewValidMask), or empty: every column of the image has
+  // data (only the image's own edges bound the view).
+  explicit ViewGaps(const cv::Mat& valid);
+  // Whether columns first..last of row y (0 <= first <= last < the mask's
+  // width) hold one without data. Always false without a mask.
+  bool AnyIn(int y, int first, int last) const {
+    if (invalid_before_.empty()) return false;
+    const int* row = invalid_before_.ptr<int>(y);
+    return row[last + 1] > row[first];
+  }
+  bool empty() const { return invalid_before_.empty(); }
+  cv::Size size() const { return {invalid_before_.cols - 1, invalid_before_.rows}; }
+
+ private:
+  cv::Mat invalid_before_;  // CV_32SC1, rows x (cols + 1): a row's columns without data left of column c
+};
+
 // Sets the disparity of every pixel of `roi` that the right camera cannot
 // see (see above) to +inf, its confidence to 0 and its status to
 // PixelStatus::kOccluded. margin_px: the right-view edge's margin, > 0
@@ -42,5 +65,8 @@ cv::Mat ViewValidMask(const cv::Mat& map_x, const cv::Mat& map_y, const cv::Size
 // right_valid: CV_8UC1 the disparity map's size, or empty (every column of
 // the image is valid). Returns the number of pixels dropped.
 int DropRightInvisible(double margin_px, const cv::Mat& right_valid, const cv::Rect& roi, DisparityState* state);
+// The same with the right view's gaps already counted (ViewGaps of that
+// mask; empty: none).
+int DropRightInvisible(double margin_px, const ViewGaps& right_gaps, const cv::Rect& roi, DisparityState* state);
 
 }  // namespace stereorig

@@ -10,22 +10,23 @@ namespace stereorig {
 
 int DropUnverifiableAtRightViewEdge(const cv::Mat& right_valid, const RefineAcceptance& accept, double max_step_px,
                                     const cv::Rect& roi, DisparityState* state) {
+  return DropUnverifiableAtRightViewEdge(ViewGaps(right_valid), accept, max_step_px, roi, state);
+}
+
+int DropUnverifiableAtRightViewEdge(const ViewGaps& right_gaps, const RefineAcceptance& accept, double max_step_px,
+                                    const cv::Rect& roi, DisparityState* state) {
   cv::Mat& disparity = state->disparity_px;
-  STEREORIG_CHECK(right_valid.empty() || (right_valid.type() == CV_8UC1 && right_valid.size() == disparity.size()));
+  STEREORIG_CHECK(right_gaps.empty() || right_gaps.size() == disparity.size());
   STEREORIG_CHECK(max_step_px > 0 && (roi & cv::Rect(0, 0, disparity.cols, disparity.rows)) == roi);
   const int cols = disparity.cols;
   const double half_width_px = accept.subpixel.half_width_px;
   // The zone, over the ROI: 1 = a valid pixel whose alternatives a period
   // either side reach a right column without data.
   cv::Mat zone(roi.size(), CV_8UC1, cv::Scalar(0));
-  std::vector<int> invalid_before(size_t(cols) + 1, 0);  // the row's right columns without data left of c
   int in_zone = 0;
   for (int y = roi.y; y < roi.y + roi.height; ++y) {
     const float* d = disparity.ptr<float>(y);
     const float* slope_x = state->slope_x.ptr<float>(y);
-    const uint8_t* valid = right_valid.empty() ? nullptr : right_valid.ptr<uint8_t>(y);
-    if (valid)
-      for (int c = 0; c < cols; ++c) invalid_before[size_t(c) + 1] = invalid_before[size_t(c)] + (valid[c] == 0);
     uint8_t* z = zone.ptr<uint8_t>(y - roi.y);
     for (int x = roi.x; x < roi.x + roi.width; ++x) {
       if (!std::isfinite(d[x])) continue;
@@ -33,8 +34,7 @@ int DropUnverifiableAtRightViewEdge(const cv::Mat& right_valid, const RefineAcce
       const double reach = 2 * DistinctnessShiftPx(slope, accept) + half_width_px;
       const double xr = x - d[x];
       const int c_first = int(std::floor(xr - reach)), c_last = int(std::ceil(xr + reach));
-      const bool unverifiable = c_first < 0 || c_last >= cols ||
-                                (valid && invalid_before[size_t(c_last) + 1] > invalid_before[size_t(c_first)]);
+      const bool unverifiable = c_first < 0 || c_last >= cols || right_gaps.AnyIn(y, c_first, c_last);
       if (unverifiable) {
         z[x - roi.x] = 1;
         ++in_zone;

@@ -32,6 +32,7 @@
 #include <opencv2/core.hpp>
 
 #include "reconstruct/disparity_state.h"
+#include "reconstruct/right_occlusion.h"
 
 namespace stereorig {
 
@@ -44,6 +45,10 @@ namespace stereorig {
 // window's half width (accept.subpixel.half_width_px). max_step_px > 0.
 // Returns the pixels dropped.
 int DropUnverifiableAtRightViewEdge(const cv::Mat& right_valid, const RefineAcceptance& accept, double max_step_px,
+                                    const cv::Rect& roi, DisparityState* state);
+// The same with the right view's gaps already counted (right_occlusion.h;
+// the matcher counts them once for this test and the occlusion test).
+int DropUnverifiableAtRightViewEdge(const ViewGaps& right_gaps, const RefineAcceptance& accept, double max_step_px,
                                     const cv::Rect& roi, DisparityState* state);
 
 }  // namespace stereorig
