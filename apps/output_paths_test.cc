@@ -7,30 +7,16 @@
 #include <string>
 
 #include "calib/core/input_error.h"
+#include "calib/core/input_error_testing.h"
 
 namespace stereorig {
 namespace {
 
 namespace fs = std::filesystem;
 
-// A fresh scratch folder for one test.
-std::string Scratch(const std::string& name) {
-  const std::string dir = ::testing::TempDir() + "/output_paths_" + name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+using testing::InputErrorMessage;
 
-// The InputError message `claim` throws, or "" if it throws none.
-template <typename Claim>
-std::string Refusal(Claim claim) {
-  try {
-    claim();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string Scratch(const std::string& name) { return testing::ScratchFolder("output_paths_" + name); }
 
 // A folder whose name is longer than the file system allows (255 on ext4)
 // is refused by the claim itself, naming the path and the problem, before
@@ -44,7 +30,7 @@ TEST(OutputPaths, AFolderNameTooLongForTheFileSystemIsRefusedWhenClaimed) {
   ASSERT_GT(name_max, 0) << "a file system without a name limit: nothing to test";
   const std::string too_long(name_max + 1, 'x');
   for (const std::string& folder : {dir + "/" + too_long, dir + "/new/" + too_long + "/deeper"}) {
-    const std::string says = Refusal([&] { (void)OutputPaths().ClaimFolder(folder, "the test folder"); });
+    const std::string says = InputErrorMessage([&] { (void)OutputPaths().ClaimFolder(folder, "the test folder"); });
     EXPECT_EQ(says.rfind(folder + ": cannot create this folder for the test folder: File name too long", 0), 0u)
         << says;
     EXPECT_NE(says.find(std::to_string(name_max + 1) + " characters"), std::string::npos) << says;
@@ -64,13 +50,14 @@ TEST(OutputPaths, AFileNameTooLongForTheFileSystemIsRefusedWhenClaimed) {
   ASSERT_GT(name_max, 0) << "a file system without a name limit: nothing to test";
   const std::string too_long = std::string(name_max - 4, 'x') + ".json";
   const std::string file = dir + "/" + too_long;
-  std::string says = Refusal([&] { OutputPaths().Claim(file, "the report (--report)"); });
+  std::string says = InputErrorMessage([&] { OutputPaths().Claim(file, "the report (--report)"); });
   EXPECT_EQ(says.rfind(file + ": cannot write the report (--report): File name too long", 0), 0u) << says;
   OutputPaths outputs;
   (void)outputs.ClaimFolder(dir + "/out", "the output folder");
-  says = Refusal([&] { outputs.Claim(dir + "/out/" + too_long, "a capture's report", false); });
+  says = InputErrorMessage([&] { outputs.Claim(dir + "/out/" + too_long, "a capture's report", false); });
   EXPECT_NE(says.find("cannot write a capture's report: File name too long"), std::string::npos) << says;
-  EXPECT_EQ(Refusal([&] { outputs.Claim(dir + "/out/" + too_long.substr(1), "a capture's report", false); }), "");
+  EXPECT_EQ(InputErrorMessage([&] { outputs.Claim(dir + "/out/" + too_long.substr(1), "a capture's report", false); }),
+            "");
 }
 
 }  // namespace

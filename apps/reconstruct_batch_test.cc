@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "calib/core/input_error.h"
+#include "calib/core/input_error_testing.h"
 
 namespace stereorig {
 namespace {
@@ -32,12 +33,7 @@ TEST(BatchOutputNames, RelativePathsAreTakenFromTheWorkingFolder) {
 
 // The InputError's message, or "" if none was thrown.
 std::string ErrorOf(const std::vector<std::string>& dirs) {
-  try {
-    BatchOutputNames(dirs);
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
+  return testing::InputErrorMessage([&] { BatchOutputNames(dirs); });
 }
 
 TEST(BatchOutputNames, AFolderGivenTwiceOrCollidingNamesAreBadInput) {

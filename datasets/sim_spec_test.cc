@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "calib/core/input_error.h"
+#include "calib/core/input_error_testing.h"
 #include "datasets/default_rig.h"
 #include "datasets/sim_test_util.h"
 
@@ -10,12 +11,7 @@ namespace stereorig {
 namespace {
 
 std::string ErrorOf(const std::string& text) {
-  try {
-    ParseSimSpecYaml(text, "spec.yaml");
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
+  return testing::InputErrorMessage([&] { ParseSimSpecYaml(text, "spec.yaml"); });
 }
 
 std::string Replace(std::string text, const std::string& from, const std::string& to) {

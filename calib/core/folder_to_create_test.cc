@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "calib/core/input_error_testing.h"
+
 #include <fstream>
 #include <stdexcept>
 
@@ -10,13 +12,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A fresh scratch folder for one test.
-std::string Scratch(const std::string& name) {
-  const std::string dir = ::testing::TempDir() + "/folder_to_create_" + name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+std::string Scratch(const std::string& name) { return testing::ScratchFolder("folder_to_create_" + name); }
 
 // Create() makes the folder and the missing ones above it; an exception
 // leaving the object's scope removes them all again while empty, but never

@@ -3,32 +3,26 @@
 #include <gtest/gtest.h>
 
 #include "calib/core/input_error.h"
+#include "calib/core/input_error_testing.h"
 
 namespace stereorig {
 namespace {
 
-std::string MessageOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using testing::InputErrorMessage;
 
 TEST(YamlMap, NamesFileAndKeyInEveryError) {
   YamlMap m = YamlMap::LoadString("a: 1\nb: [1, 2]\nc: {d: .nan}\ne: text\n", "f.yaml");
   EXPECT_EQ(m.GetDouble("a"), 1.0);
-  EXPECT_EQ(MessageOf([&] { m.GetDoubles("b", 3); }), "f.yaml: b: expected 3 numbers, got 2");
-  EXPECT_EQ(MessageOf([&] { m.GetMap("c").GetDouble("d"); }), "f.yaml: c.d: NaN or Inf is not allowed");
-  EXPECT_EQ(MessageOf([&] { m.GetDouble("e"); }), "f.yaml: e: expected a number, got 'text'");
-  EXPECT_EQ(MessageOf([&] { m.GetDouble("zz"); }), "f.yaml: zz: missing key");
+  EXPECT_EQ(InputErrorMessage([&] { m.GetDoubles("b", 3); }), "f.yaml: b: expected 3 numbers, got 2");
+  EXPECT_EQ(InputErrorMessage([&] { m.GetMap("c").GetDouble("d"); }), "f.yaml: c.d: NaN or Inf is not allowed");
+  EXPECT_EQ(InputErrorMessage([&] { m.GetDouble("e"); }), "f.yaml: e: expected a number, got 'text'");
+  EXPECT_EQ(InputErrorMessage([&] { m.GetDouble("zz"); }), "f.yaml: zz: missing key");
 }
 
 TEST(YamlMap, FinishRejectsKeysNobodyRead) {
   YamlMap m = YamlMap::LoadString("known: 1\ntypo_key: 2\n", "f.yaml");
   m.GetInt("known");
-  EXPECT_EQ(MessageOf([&] { m.Finish(); }), "f.yaml: typo_key: unknown key");
+  EXPECT_EQ(InputErrorMessage([&] { m.Finish(); }), "f.yaml: typo_key: unknown key");
   m.GetInt("typo_key");
   EXPECT_NO_THROW(m.Finish());
 }
