@@ -91,7 +91,7 @@ int RunDemo(int argc, char** argv) {
   const std::string passive_options = Join(out, "passive_options.yaml");
   WriteFileAtomically(passive_options,
                       "# Runtime options for a capture without the laser grids (docs/reconstruct.md).\n"
-                      "crop_to_lit_region: false\nmatch:\n  min_distinctness: 0\n");
+                      "crop_to_lit_region: false\nmatch:\n  min_distinctness: 0\n  grid_line_test: false\n");
   for (const char* mode : {"active", "passive"}) {
     const std::string name = std::string("cup_") + mode;
     std::vector<std::string> args = {"reconstruct",

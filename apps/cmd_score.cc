@@ -118,9 +118,10 @@ int RunScore(int argc, char** argv) {
   }
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
   RuntimeOptions passive_options = options;
-  // No grid: the whole volume's ROI, and no test of the grid's period.
+  // No grid: the whole volume's ROI, no test of the grid's period, none of its lines.
   passive_options.crop_to_lit_region = false;
   passive_options.match.min_distinctness = 0;
+  passive_options.match.grid_line.enabled = false;
   const Runtime runtime(rig, options), passive_runtime(rig, passive_options);
   diagnose.Create();
   nlohmann::json report = {{"dataset", dataset}, {"rig", rig_path}};

@@ -51,6 +51,8 @@ const char* PixelStatusName(PixelStatus status) {
       return "seen_through_surface";
     case PixelStatus::kRightViewEdge:
       return "right_view_edge";
+    case PixelStatus::kNoGridLine:
+      return "no_grid_line";
     case PixelStatus::kNumStatus:
       break;
   }

@@ -11,7 +11,7 @@ namespace stereorig {
 
 // What became of each left pixel: a point, or the first test that rejected
 // it. The matcher sets the codes up to kNotDistinct and kOccluded,
-// kWrongLine, kLeftViewEdge, kRightViewEdge; the runtime adds kLowConfidence, kOutsideVolume, kObjectSize,
+// kWrongLine, kLeftViewEdge, kRightViewEdge, kNoGridLine; the runtime adds kLowConfidence, kOutsideVolume, kObjectSize,
 // kSeenThrough, kSeenThroughSurface. For finding where fill is lost (`stereorig score` tabulates them).
 enum class PixelStatus : uint8_t {
   kNotSearched = 0,     // outside the matched region
@@ -35,6 +35,7 @@ enum class PixelStatus : uint8_t {
   kSeenThrough,         // runtime: other modules' surfaces facing this camera lie in front of it (free_space.h)
   kSeenThroughSurface,  // runtime: on a surface the free-space test found mostly seen through, removed whole
   kRightViewEdge,       // in a surface at the right view's edge whose line cannot be checked (right_view_edge.h)
+  kNoGridLine,          // no laser line near it: its match rests on shading or an outline (grid_line_support.h)
   kNumStatus
 };
 const char* PixelStatusName(PixelStatus status);

@@ -278,6 +278,8 @@ cv::Vec3b StatusColour(uint8_t status) {  // BGR
       return {128, 0, 128};  // dark magenta
     case PixelStatus::kRightViewEdge:
       return {128, 128, 0};  // teal
+    case PixelStatus::kNoGridLine:
+      return {0, 128, 128};  // olive
     default:
       return {255, 255, 255};
   }

@@ -13,6 +13,7 @@
 #include "reconstruct/disparity_band.h"
 #include "reconstruct/disparity_slopes.h"
 #include "reconstruct/elapsed_ms.h"
+#include "reconstruct/grid_line_support.h"
 #include "reconstruct/left_view_edge.h"
 #include "reconstruct/line_index.h"
 #include "reconstruct/parallel_for.h"
@@ -71,6 +72,7 @@ void MatchOptions::Check() const {
   subpixel.Check();
   line_index.Check();
   grow.Check();
+  grid_line.Check();
   surface_fit.Check();
   if (subpixel_column_step < 1 || subpixel_column_step > 4)
     throw InputError("subpixel_column_step", "must be in [1, 4] (1 = every column)");
@@ -460,6 +462,7 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
   DropRightInvisible(o.occlusion_margin_px, right_gaps, roi, &state);
   // After it: the points it drops at the edge are no surface to continue.
   if (o.right_view_edge_test) DropUnverifiableAtRightViewEdge(right_gaps, accept, 1.0, roi, &state);
+  DropWithoutGridLine(left, o.grid_line, int(std::ceil(o.grid_half_period_px)), roi, &state);
   for (int y = roi.y; y < roi.y + roi.height; ++y) {  // outside the ROI: no point, confidence 0 already
     const float* d = state.disparity_px.ptr<float>(y);
     float* c = state.confidence.ptr<float>(y);

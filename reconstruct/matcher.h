@@ -34,6 +34,7 @@
 
 #include "reconstruct/census_sgm.h"
 #include "reconstruct/disparity_state.h"
+#include "reconstruct/grid_line_support.h"
 #include "reconstruct/line_index.h"
 #include "reconstruct/local_surface_fit.h"
 #include "reconstruct/region_grow.h"
@@ -134,6 +135,12 @@ struct MatchOptions {
   // which continue nowhere outside that zone (right_view_edge.h, status
   // right_view_edge). Default on.
   bool right_view_edge_test = true;
+  // census_sgm, opencv_sgbm_3way: then drop the points no laser line
+  // supports: fewer than grid_line.min_ridge_px ridges of the grid in the
+  // window around them (grid_line_support.h, status no_grid_line): matches
+  // on ambient shading and on the object's outline beside the grid's
+  // envelope. Off for passive captures (no grid). Default on.
+  GridLineOptions grid_line;
   // census_sgm, opencv_sgbm_3way: last, each disparity replaced by a quadric
   // fitted to its neighbourhood where one explains it (local_surface_fit.h):
   // the speckle scatter of the disparities (~0.27 px) falls by ~35%, detail

@@ -122,6 +122,10 @@ RuntimeOptions FromYaml(YamlMap& y) {
     mo.speckle_along_slopes = m.GetBool("speckle_along_slopes", mo.speckle_along_slopes);
     mo.occlusion_margin_px = m.GetDouble("occlusion_margin_px", mo.occlusion_margin_px);
     mo.right_view_edge_test = m.GetBool("right_view_edge_test", mo.right_view_edge_test);
+    mo.grid_line.enabled = m.GetBool("grid_line_test", mo.grid_line.enabled);
+    mo.grid_line.min_prominence_dn = m.GetDouble("grid_line_min_prominence_dn", mo.grid_line.min_prominence_dn);
+    mo.grid_line.radius_px = m.GetInt("grid_line_radius_px", mo.grid_line.radius_px);
+    mo.grid_line.min_ridge_px = m.GetInt("grid_line_min_ridge_px", mo.grid_line.min_ridge_px);
     mo.surface_fit.enabled = m.GetBool("surface_fit", mo.surface_fit.enabled);
     mo.surface_fit.half_width_px = m.GetInt("surface_fit_half_width_px", mo.surface_fit.half_width_px);
     mo.surface_fit.half_height_px = m.GetInt("surface_fit_half_height_px", mo.surface_fit.half_height_px);

@@ -1,0 +1,151 @@
+// The grid-line support test: ridges on constructed profiles and the drop
+// on a constructed image (exact), and the matcher on an analytically
+// rendered grid-lit plane, which the test must leave whole.
+#include "reconstruct/grid_line_support.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "calib/core/input_error.h"
+#include "reconstruct/disparity_state_testing.h"
+#include "reconstruct/matcher.h"
+#include "reconstruct/runtime_options.h"
+#include "reconstruct/synthetic_pair.h"
+
+namespace stereorig {
+namespace {
+
+using testing::StateOf;
+
+// One row profile, repeated on every row (so no column is a ridge):
+// background 20 DN;
+//   x = 2: a line too near the image's edge to be tested (reach 4): none;
+//   x = 10: a laser line, 60 DN over troughs of 20: a ridge;
+//   x = 30: an outline's step 20 -> 120 with a 5 DN overshoot at x = 31:
+//     on one side only, and the overshoot stands 5 < 8 DN above the
+//     plateau: none;
+//   x = 45: a bump 6 DN high: none;
+//   x = 52: a bump exactly 8 DN high (the threshold, inclusive): a ridge.
+cv::Mat Profiles(int rows) {
+  cv::Mat grey(rows, 60, CV_8UC1, cv::Scalar(20));
+  for (int y = 0; y < rows; ++y) {
+    uint8_t* g = grey.ptr<uint8_t>(y);
+    g[1] = 40, g[2] = 70, g[3] = 40;
+    g[9] = 40, g[10] = 80, g[11] = 40;
+    for (int x = 30; x < 40; ++x) g[x] = 120;
+    g[29] = 60, g[31] = 125;
+    g[45] = 26;
+    g[52] = 28;
+  }
+  return grey;
+}
+
+TEST(GridLine, RidgesAreLinePeaksNotStepsOrShallowBumps) {
+  const cv::Mat grey = Profiles(20);
+  const cv::Mat ridges = GridRidges(grey, 4, 8.0);
+  ASSERT_EQ(ridges.size(), grey.size());
+  for (int y = 0; y < grey.rows; ++y)
+    for (int x = 0; x < grey.cols; ++x)
+      EXPECT_EQ(ridges.at<uint8_t>(y, x), (x == 10 || x == 52) ? 1 : 0) << x << " " << y;
+  // The same along the columns.
+  cv::Mat grey_t, ridges_t;
+  cv::transpose(grey, grey_t);
+  cv::transpose(GridRidges(grey_t, 4, 8.0), ridges_t);
+  EXPECT_EQ(cv::norm(ridges_t != ridges, cv::NORM_L1), 0.0);
+  // A higher threshold loses the 8 DN bump, keeps the line.
+  const cv::Mat strict = GridRidges(grey, 4, 9.0);
+  EXPECT_EQ(cv::countNonZero(strict.col(52)), 0);
+  EXPECT_EQ(cv::countNonZero(strict.col(10)), grey.rows);
+}
+
+// Lines (ridges along the rows) at x = 4 and x = 20, 28, ..., 92 on a
+// 30 DN background; from x = 100 an ambient-lit plateau (120 DN) that ends
+// at x = 150 in an outline against a 16 DN background. A point everywhere
+// at d = 10; the ROI starts at x = 10, so the line at x = 4 lies outside it
+// but within reach of its windows. Radius 6, 3 ridge pixels: a point is kept
+// exactly when a line lies within 6 columns (the window then holds >= 7 of
+// its pixels), so x = 10 (the line at 4) and 14..98 are kept, 11..13 and
+// >= 99 (the plateau, the outline, the background) dropped. Outside the
+// ROI nothing changes; a pixel without a point keeps its status.
+TEST(GridLine, DropsExactlyThePointsNoLineSupports) {
+  cv::Mat grey(60, 200, CV_8UC1, cv::Scalar(30));
+  std::set<int> lines = {4};
+  for (int x = 20; x <= 92; x += 8) lines.insert(x);
+  for (int x : lines) grey.col(x).setTo(90), grey.col(x - 1).setTo(60), grey.col(x + 1).setTo(60);
+  grey(cv::Rect(100, 0, 50, 60)).setTo(120);
+  grey(cv::Rect(150, 0, 50, 60)).setTo(16);
+  DisparityState s = StateOf(cv::Mat(60, 200, CV_32FC1, cv::Scalar(10.0f)));
+  s.disparity_px.at<float>(30, 120) = std::numeric_limits<float>::infinity();
+  s.status.at<uint8_t>(30, 120) = uint8_t(PixelStatus::kLowZncc);
+  const cv::Rect roi(10, 5, 180, 50);
+  GridLineOptions o;
+  ASSERT_EQ(o.radius_px, 6);
+  ASSERT_EQ(o.min_ridge_px, 3);
+  int expected = 0;
+  auto kept = [&](int x) {
+    for (int c : lines)
+      if (std::abs(x - c) <= 6) return true;
+    return false;
+  };
+  for (int y = roi.y; y < roi.br().y; ++y)
+    for (int x = roi.x; x < roi.br().x; ++x) expected += !kept(x) && !(x == 120 && y == 30);
+  EXPECT_EQ(DropWithoutGridLine(grey, o, 4, roi, &s), expected);
+  for (int y = 0; y < 60; ++y)
+    for (int x = 0; x < 200; ++x) {
+      const bool dropped = roi.contains(cv::Point(x, y)) && !kept(x) && !(x == 120 && y == 30);
+      ASSERT_EQ(std::isfinite(s.disparity_px.at<float>(y, x)), !dropped && !(x == 120 && y == 30)) << x << " " << y;
+      const PixelStatus want = (x == 120 && y == 30) ? PixelStatus::kLowZncc
+                               : dropped             ? PixelStatus::kNoGridLine
+                                                     : PixelStatus::kPoint;
+      EXPECT_EQ(s.status.at<uint8_t>(y, x), uint8_t(want)) << x << " " << y;
+      EXPECT_EQ(s.confidence.at<float>(y, x), dropped ? 0.0f : 0.9f);
+    }
+  // Off: nothing is touched.
+  DisparityState untouched = StateOf(cv::Mat(60, 200, CV_32FC1, cv::Scalar(10.0f)));
+  o.enabled = false;
+  EXPECT_EQ(DropWithoutGridLine(grey, o, 4, roi, &untouched), 0);
+  EXPECT_EQ(cv::countNonZero(untouched.status != uint8_t(PixelStatus::kPoint)), 0);
+}
+
+// The matcher tests' slanted plane under the grid (d = 40 + 0.04 x +
+// 0.015 y, grid period 8 px, lines 150 DN, noise 2 DN): every pixel of it
+// lies within half a period of a line, so the test must drop no point and
+// change none (the same map to the float with the test off).
+TEST(GridLine, TheMatcherKeepsAGridLitPlaneWhole) {
+  const SyntheticPair pair = RenderSyntheticPair(SyntheticPairSpec{});
+  MatchOptions o;
+  o.min_disparity_px = 24;
+  o.num_disparities = 64;
+  o.grid_line.enabled = false;
+  const MatchResult without_test = Match(pair.left, pair.right, o);
+  o.grid_line.enabled = true;
+  const MatchResult with_test = Match(pair.left, pair.right, o);
+  EXPECT_GT(cv::countNonZero(with_test.status == uint8_t(PixelStatus::kPoint)), 50000);
+  EXPECT_EQ(cv::countNonZero(with_test.status == uint8_t(PixelStatus::kNoGridLine)), 0);
+  EXPECT_EQ(cv::norm(with_test.status != without_test.status, cv::NORM_L1), 0.0);
+  const cv::Mat a = with_test.disparity_px, b = without_test.disparity_px;
+  EXPECT_EQ(cv::countNonZero((a != b) & (a == a)), 0);  // NaN-free maps: +inf marks no point
+}
+
+TEST(GridLine, TheOptionsAreReadAndChecked) {
+  const RuntimeOptions defaults;
+  EXPECT_TRUE(defaults.match.grid_line.enabled);
+  const RuntimeOptions o = ParseRuntimeOptions(
+      "match:\n  grid_line_test: false\n  grid_line_min_prominence_dn: 12\n  grid_line_radius_px: 8\n"
+      "  grid_line_min_ridge_px: 5\n",
+      "test");
+  EXPECT_FALSE(o.match.grid_line.enabled);
+  EXPECT_EQ(o.match.grid_line.min_prominence_dn, 12);
+  EXPECT_EQ(o.match.grid_line.radius_px, 8);
+  EXPECT_EQ(o.match.grid_line.min_ridge_px, 5);
+  EXPECT_THROW(ParseRuntimeOptions("match:\n  grid_line_radius_px: 0\n", "test"), InputError);
+  EXPECT_THROW(ParseRuntimeOptions("match:\n  grid_line_min_prominence_dn: 0\n", "test"), InputError);
+  // (2 * 2 + 1)^2 = 25 pixels in a radius-2 window: 26 cannot be met.
+  EXPECT_THROW(ParseRuntimeOptions("match:\n  grid_line_radius_px: 2\n  grid_line_min_ridge_px: 26\n", "test"),
+               InputError);
+}
+
+}  // namespace
+}  // namespace stereorig
