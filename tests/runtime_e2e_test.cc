@@ -10,6 +10,7 @@
 //     module see and a grid lights (fill_score.h).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -237,6 +238,35 @@ TEST(RuntimeOnAFreshRealization, ThePlateBesideTheRightViewsEdgeKeepsNoStripAPer
   ASSERT_EQ(off.fill.size(), 2u);
   ASSERT_EQ(on.fill.size(), 2u);
   EXPECT_GT(off.accuracy.per_module[0].std_mm, 0.1);
+  for (size_t m = 0; m < 2; ++m) {
+    EXPECT_LT(on.accuracy.per_module[m].mean_abs_mm, 0.1) << "module " << m;
+    EXPECT_LT(on.accuracy.per_module[m].std_mm, 0.1) << "module " << m;
+    EXPECT_GT(on.fill[m].fill(), off.fill[m].fill() - 0.002) << "module " << m;
+  }
+}
+
+// The grid-line test (grid_line_support.h) on a realization where it
+// matters: the default ball bar alone at seed 16, truth rig. Above the grid's
+// envelope the balls are lit by ambient light only; growing carried the
+// limbs' disparity into that band along their outlines, points 1-1.5 mm off.
+// Measured (`stereorig score`, the same realization, match.grid_line_test
+// false / true): module 0 std 0.105 -> 0.087 mm, module 1 0.119 -> 0.088 mm;
+// fill 80.3 / 82.2 % both ways (the points dropped lie outside the grid-lit
+// target). Over the ball bar alone at seeds 1-30, modules above 0.1 mm std
+// went from 14 to 6 of 60 and no module's fill moved
+// (docs/reconstruct-log.md, session 25). Asserted: without the test a module
+// misses issue 5's std target (the control); with it both meet the targets
+// and keep their fill to 0.2 points.
+TEST(RuntimeOnAFreshRealization, TheBallBarKeepsNoPointOnItsOutlineBesideTheGrid) {
+  const std::string dataset =
+      SimulateScenes({"ballbar"}, 16, DefaultSimSpec().render.speckle_contrast, "runtime_e2e_ballbar16");
+  RuntimeOptions without_test;
+  without_test.match.grid_line.enabled = false;
+  const SceneScore off = ReconstructAndScore(dataset, "ballbar", "seed 16 ball bar, without the test", without_test);
+  const SceneScore on = ReconstructAndScore(dataset, "ballbar", "seed 16 ball bar");
+  ASSERT_EQ(off.fill.size(), 2u);
+  ASSERT_EQ(on.fill.size(), 2u);
+  EXPECT_GT(std::max(off.accuracy.per_module[0].std_mm, off.accuracy.per_module[1].std_mm), 0.1);
   for (size_t m = 0; m < 2; ++m) {
     EXPECT_LT(on.accuracy.per_module[m].mean_abs_mm, 0.1) << "module " << m;
     EXPECT_LT(on.accuracy.per_module[m].std_mm, 0.1) << "module " << m;
