@@ -32,7 +32,7 @@ namespace stereorig {
 struct GridLineOptions {
   bool enabled = true;           // default true; off for passive captures (no grid)
   double min_prominence_dn = 8;  // a ridge's height above the lowest grey within reach on each side; default 8 DN
-  int radius_px = 6;             // the window's half size; default 6 px
+  int radius_px = 5;             // the window's half size; default 5 px (half the default grid's period + 1)
   int min_ridge_px = 3;          // ridge pixels the window must hold; default 3
   void Check() const;            // throws InputError naming the bad key
 };

@@ -60,18 +60,18 @@ TEST(GridLine, RidgesAreLinePeaksNotStepsOrShallowBumps) {
   EXPECT_EQ(cv::countNonZero(strict.col(10)), grey.rows);
 }
 
-// Lines (ridges along the rows) at x = 4 and x = 20, 28, ..., 92 on a
+// Lines (ridges along the rows) at x = 6 and x = 20, 28, ..., 92 on a
 // 30 DN background; from x = 100 an ambient-lit plateau (120 DN) that ends
 // at x = 150 in an outline against a 16 DN background. A point everywhere
-// at d = 10; the ROI starts at x = 10, so the line at x = 4 lies outside it
-// but within reach of its windows. Radius 6, 3 ridge pixels: a point is kept
-// exactly when a line lies within 6 columns (the window then holds >= 7 of
-// its pixels), so x = 10 (the line at 4) and 14..98 are kept, 11..13 and
-// >= 99 (the plateau, the outline, the background) dropped. Outside the
+// at d = 10; the ROI starts at x = 10, so the line at x = 6 lies outside it
+// but within reach of its windows. Radius 5, 3 ridge pixels: a point is kept
+// exactly when a line lies within 5 columns (the window then holds >= 6 of
+// its pixels), so x = 10, 11 (the line at 6) and 15..97 are kept, 12..14 and
+// >= 98 (the plateau, the outline, the background) dropped. Outside the
 // ROI nothing changes; a pixel without a point keeps its status.
 TEST(GridLine, DropsExactlyThePointsNoLineSupports) {
   cv::Mat grey(60, 200, CV_8UC1, cv::Scalar(30));
-  std::set<int> lines = {4};
+  std::set<int> lines = {6};
   for (int x = 20; x <= 92; x += 8) lines.insert(x);
   for (int x : lines) grey.col(x).setTo(90), grey.col(x - 1).setTo(60), grey.col(x + 1).setTo(60);
   grey(cv::Rect(100, 0, 50, 60)).setTo(120);
@@ -81,12 +81,12 @@ TEST(GridLine, DropsExactlyThePointsNoLineSupports) {
   s.status.at<uint8_t>(30, 120) = uint8_t(PixelStatus::kLowZncc);
   const cv::Rect roi(10, 5, 180, 50);
   GridLineOptions o;
-  ASSERT_EQ(o.radius_px, 6);
+  ASSERT_EQ(o.radius_px, 5);
   ASSERT_EQ(o.min_ridge_px, 3);
   int expected = 0;
   auto kept = [&](int x) {
     for (int c : lines)
-      if (std::abs(x - c) <= 6) return true;
+      if (std::abs(x - c) <= 5) return true;
     return false;
   };
   for (int y = roi.y; y < roi.br().y; ++y)
