@@ -50,6 +50,11 @@ void OutputPaths::Claim(const std::string& path, const std::string& what, bool c
   std::vector<fs::path> missing;
   CheckNamesFit(path, "write " + what, DeepestExistingPart(key, &missing), missing);
   if (check_folder && !fs::is_directory(key.parent_path())) throw InputError(path, "its folder does not exist");
+  // Found now, not when the file is written after the command's work.
+  if (check_folder && access(key.parent_path().c_str(), W_OK | X_OK) != 0) {
+    const std::string why = std::strerror(errno);
+    throw InputError(path, "cannot write " + what + " in its folder " + key.parent_path().string() + ": " + why);
+  }
   if (fs::is_directory(key)) throw InputError(path, "is a folder, not a file to write");
   claimed_.emplace(key, what);
 }

@@ -26,8 +26,9 @@ class OutputPaths {
   // ClaimFolder before will create, if a name in it that does not exist yet
   // (the file's, or a folder's the command creates) is longer than the file
   // system allows (NAME_MAX), or, with
-  // check_folder, if its folder does not exist (off for files in a folder
-  // the command creates itself).
+  // check_folder, if its folder does not exist or this process may not
+  // write in it (access W_OK|X_OK; off for files in a folder the command
+  // creates itself, which ClaimFolder checks).
   void Claim(const std::string& path, const std::string& what, bool check_folder = true);
   // Records an input the command reads, `what` naming it ("the rig file
   // (--rig)"): a Claim of the same file throws InputError. Call before the

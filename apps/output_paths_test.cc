@@ -3,7 +3,12 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <sys/wait.h>
+
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
+#include <functional>
 #include <string>
 
 #include "calib/core/input_error.h"
@@ -21,9 +26,7 @@ std::string Scratch(const std::string& name) { return testing::ScratchFolder("ou
 // A folder whose name is longer than the file system allows (255 on ext4)
 // is refused by the claim itself, naming the path and the problem, before
 // the command does any work: it used to be found only by Create, after it.
-// Nothing is made. (The other claim-time test, a nearest existing folder
-// this process may not write in, cannot be tested here: the tests run as
-// root in CI, for whom access() grants everything.)
+// Nothing is made. (A folder this process may not write in: below.)
 TEST(OutputPaths, AFolderNameTooLongForTheFileSystemIsRefusedWhenClaimed) {
   const std::string dir = Scratch("long_folder");
   const long name_max = pathconf(dir.c_str(), _PC_NAME_MAX);
@@ -58,6 +61,68 @@ TEST(OutputPaths, AFileNameTooLongForTheFileSystemIsRefusedWhenClaimed) {
   EXPECT_NE(says.find("cannot write a capture's report: File name too long"), std::string::npos) << says;
   EXPECT_EQ(InputErrorMessage([&] { outputs.Claim(dir + "/out/" + too_long.substr(1), "a capture's report", false); }),
             "");
+}
+
+// The message of the InputError `claim` throws in a process that is not
+// root, "" if it throws none. Root (as in CI) may write in any folder
+// (access() grants it everything), so then the claim runs in a forked child
+// that first becomes the unprivileged user 65534 (nobody) and sends the
+// message back through a pipe.
+std::string ClaimAsUnprivileged(const std::function<void()>& claim) {
+  if (geteuid() != 0) return InputErrorMessage(claim);
+  int fds[2];
+  if (pipe(fds) != 0) return "pipe failed";
+  const pid_t pid = fork();
+  if (pid < 0) return "fork failed";
+  if (pid == 0) {
+    close(fds[0]);
+    std::string message;
+    if (setgid(65534) != 0 || setuid(65534) != 0) {
+      message = "could not become user 65534";
+    } else {
+      try {
+        message = InputErrorMessage(claim);
+      } catch (...) {
+        message = "another exception";
+      }
+    }
+    const ssize_t written = write(fds[1], message.data(), message.size());
+    _exit(written == static_cast<ssize_t>(message.size()) ? 0 : 1);
+  }
+  close(fds[1]);
+  std::string message;
+  char buffer[512];
+  for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;) message.append(buffer, size_t(n));
+  close(fds[0]);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  return message;
+}
+
+// A file claimed in a folder this process may not write in, or a folder to
+// create there, is refused when claimed, naming the path and the reason,
+// not after the command's work when the file is written. The same claims
+// in a folder anyone may write in pass (the control).
+TEST(OutputPaths, AFolderThisProcessMayNotWriteInIsRefusedWhenClaimed) {
+  const std::string dir = Scratch("not_writable");
+  const std::string locked = dir + "/locked", open = dir + "/open";
+  fs::create_directories(locked);
+  fs::create_directories(open);
+  fs::permissions(locked, fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
+                              fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec);
+  fs::permissions(open, fs::perms::all);
+  const std::string locked_normal = fs::path(locked).lexically_normal().string();  // as messages name it
+  std::string says = ClaimAsUnprivileged([&] { OutputPaths().Claim(locked + "/cloud.ply", "the cloud (--out)"); });
+  EXPECT_EQ(says, locked + "/cloud.ply: cannot write the cloud (--out) in its folder " + locked_normal + ": " +
+                      std::strerror(EACCES));
+  says = ClaimAsUnprivileged([&] { (void)OutputPaths().ClaimFolder(locked + "/new", "the output folder"); });
+  EXPECT_EQ(says.rfind(locked + "/new: cannot create this folder for the output folder: " + locked_normal + ": ", 0),
+            0u)
+      << says;
+  EXPECT_EQ(ClaimAsUnprivileged([&] { OutputPaths().Claim(open + "/cloud.ply", "the cloud (--out)"); }), "");
+  EXPECT_EQ(ClaimAsUnprivileged([&] { (void)OutputPaths().ClaimFolder(open + "/new", "the output folder"); }), "");
+  EXPECT_FALSE(fs::exists(open + "/new"));  // a claim makes nothing
 }
 
 }  // namespace
