@@ -50,10 +50,14 @@ void OutputPaths::Claim(const std::string& path, const std::string& what, bool c
   std::vector<fs::path> missing;
   CheckNamesFit(path, "write " + what, DeepestExistingPart(key, &missing), missing);
   if (check_folder && !fs::is_directory(key.parent_path())) throw InputError(path, "its folder does not exist");
-  // Found now, not when the file is written after the command's work.
-  if (check_folder && access(key.parent_path().c_str(), W_OK | X_OK) != 0) {
+  // Found now, not when the file is written after the command's work. The
+  // folder the path names, not its link's target's: the file is written
+  // there (a temporary file renamed over the path, calib/core/atomic_file.h).
+  const fs::path folder = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
+  if (check_folder && access(folder.c_str(), W_OK | X_OK) != 0) {
     const std::string why = std::strerror(errno);
-    throw InputError(path, "cannot write " + what + " in its folder " + key.parent_path().string() + ": " + why);
+    throw InputError(path,
+                     "cannot write " + what + " in its folder " + folder.lexically_normal().string() + ": " + why);
   }
   if (fs::is_directory(key)) throw InputError(path, "is a folder, not a file to write");
   claimed_.emplace(key, what);

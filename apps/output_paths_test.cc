@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <grp.h>
 #include <sys/wait.h>
 
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <string>
 
@@ -63,11 +65,15 @@ TEST(OutputPaths, AFileNameTooLongForTheFileSystemIsRefusedWhenClaimed) {
             "");
 }
 
+// Returned by ClaimAsUnprivileged when root cannot become another user
+// (a user namespace without uid 65534): nothing can be tested.
+constexpr char kNoUnprivilegedUser[] = "could not become user 65534";
+
 // The message of the InputError `claim` throws in a process that is not
 // root, "" if it throws none. Root (as in CI) may write in any folder
 // (access() grants it everything), so then the claim runs in a forked child
-// that first becomes the unprivileged user 65534 (nobody) and sends the
-// message back through a pipe.
+// that first becomes the unprivileged user 65534 (nobody, no supplementary
+// groups) and sends the message back through a pipe.
 std::string ClaimAsUnprivileged(const std::function<void()>& claim) {
   if (geteuid() != 0) return InputErrorMessage(claim);
   int fds[2];
@@ -77,8 +83,8 @@ std::string ClaimAsUnprivileged(const std::function<void()>& claim) {
   if (pid == 0) {
     close(fds[0]);
     std::string message;
-    if (setgid(65534) != 0 || setuid(65534) != 0) {
-      message = "could not become user 65534";
+    if (setgroups(0, nullptr) != 0 || setgid(65534) != 0 || setuid(65534) != 0) {
+      message = kNoUnprivilegedUser;
     } else {
       try {
         message = InputErrorMessage(claim);
@@ -92,10 +98,20 @@ std::string ClaimAsUnprivileged(const std::function<void()>& claim) {
   close(fds[1]);
   std::string message;
   char buffer[512];
-  for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;) message.append(buffer, size_t(n));
+  for (;;) {
+    const ssize_t n = read(fds[0], buffer, sizeof buffer);
+    if (n > 0) {
+      message.append(buffer, size_t(n));
+    } else if (n == 0 || errno != EINTR) {
+      break;
+    }
+  }
   close(fds[0]);
   int status = 0;
-  waitpid(pid, &status, 0);
+  pid_t waited;
+  do waited = waitpid(pid, &status, 0);
+  while (waited < 0 && errno == EINTR);
+  EXPECT_EQ(waited, pid);
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
   return message;
 }
@@ -105,15 +121,32 @@ std::string ClaimAsUnprivileged(const std::function<void()>& claim) {
 // not after the command's work when the file is written. The same claims
 // in a folder anyone may write in pass (the control).
 TEST(OutputPaths, AFolderThisProcessMayNotWriteInIsRefusedWhenClaimed) {
-  const std::string dir = Scratch("not_writable");
+  // In /tmp, not the build tree: user 65534 must be able to reach the
+  // folders, and a checkout may lie below a folder only root may enter
+  // (/root, mode 0700).
+  char templ[] = "/tmp/stereorig_output_paths_XXXXXX";
+  ASSERT_NE(mkdtemp(templ), nullptr) << std::strerror(errno);
+  const std::string dir = templ;
+  fs::permissions(dir, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec | fs::perms::others_read |
+                           fs::perms::others_exec);
+  struct Cleanup {
+    std::string dir;
+    ~Cleanup() {
+      std::error_code ignored;
+      fs::permissions(dir + "/locked", fs::perms::owner_all, ignored);
+      fs::remove_all(dir, ignored);
+    }
+  } cleanup{dir};
   const std::string locked = dir + "/locked", open = dir + "/open";
   fs::create_directories(locked);
   fs::create_directories(open);
+  std::ofstream(locked + "/target.ply") << "an earlier cloud\n";  // a link's target, below
   fs::permissions(locked, fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
                               fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec);
   fs::permissions(open, fs::perms::all);
   const std::string locked_normal = fs::path(locked).lexically_normal().string();  // as messages name it
   std::string says = ClaimAsUnprivileged([&] { OutputPaths().Claim(locked + "/cloud.ply", "the cloud (--out)"); });
+  if (says == kNoUnprivilegedUser) GTEST_SKIP() << "root cannot become user 65534 here: nothing to test";
   EXPECT_EQ(says, locked + "/cloud.ply: cannot write the cloud (--out) in its folder " + locked_normal + ": " +
                       std::strerror(EACCES));
   says = ClaimAsUnprivileged([&] { (void)OutputPaths().ClaimFolder(locked + "/new", "the output folder"); });
@@ -123,6 +156,10 @@ TEST(OutputPaths, AFolderThisProcessMayNotWriteInIsRefusedWhenClaimed) {
   EXPECT_EQ(ClaimAsUnprivileged([&] { OutputPaths().Claim(open + "/cloud.ply", "the cloud (--out)"); }), "");
   EXPECT_EQ(ClaimAsUnprivileged([&] { (void)OutputPaths().ClaimFolder(open + "/new", "the output folder"); }), "");
   EXPECT_FALSE(fs::exists(open + "/new"));  // a claim makes nothing
+  // A path through a link to a file is written in the link's folder (a
+  // temporary file renamed over the link): that folder is the one checked.
+  fs::create_symlink(locked + "/target.ply", open + "/link.ply");
+  EXPECT_EQ(ClaimAsUnprivileged([&] { OutputPaths().Claim(open + "/link.ply", "the cloud (--out)"); }), "");
 }
 
 }  // namespace
