@@ -94,9 +94,9 @@ int DropWithoutGridLine(const cv::Mat& left, const GridLineOptions& o, int reach
     float* d = state->disparity_px.ptr<float>(y);
     float* conf = state->confidence.ptr<float>(y);
     uint8_t* status = state->status.ptr<uint8_t>(y);
-    const uint16_t* n = count.ptr<uint16_t>(y - read_area.y) - read_area.x;
+    const uint16_t* n = count.ptr<uint16_t>(y - read_area.y);  // column x at n[x - read_area.x]
     for (int x = roi.x; x < roi.x + roi.width; ++x) {
-      if (!std::isfinite(d[x]) || n[x] >= o.min_ridge_px) continue;
+      if (!std::isfinite(d[x]) || n[x - read_area.x] >= o.min_ridge_px) continue;
       d[x] = std::numeric_limits<float>::infinity();
       conf[x] = 0;
       status[x] = uint8_t(PixelStatus::kNoGridLine);

@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include "calib/core/input_error.h"
@@ -127,6 +129,88 @@ TEST(GridLine, TheMatcherKeepsAGridLitPlaneWhole) {
   EXPECT_EQ(cv::norm(with_test.status != without_test.status, cv::NORM_L1), 0.0);
   const cv::Mat a = with_test.disparity_px, b = without_test.disparity_px;
   EXPECT_EQ(cv::countNonZero((a != b) & (a == a)), 0);  // NaN-free maps: +inf marks no point
+}
+
+// The rule written out pixel by pixel, as the header states it: along a row
+// (a column), a pixel at least k from the image's edge that is >= the pixel
+// before it and > the one after it and stands >= ceil(c) above the lowest of
+// the k before it and of the k after it.
+cv::Mat ReferenceRidges(const cv::Mat& grey, int k, double c) {
+  cv::Mat out(grey.size(), CV_8UC1, cv::Scalar(0));
+  const int height = int(std::ceil(c));
+  for (int y = 0; y < grey.rows; ++y)
+    for (int x = 0; x < grey.cols; ++x) {
+      const int v = grey.at<uint8_t>(y, x);
+      for (const bool along_x : {true, false}) {
+        const int n = along_x ? grey.cols : grey.rows, i = along_x ? x : y;
+        if (i < k || i >= n - k) continue;
+        auto at = [&](int j) { return int(along_x ? grey.at<uint8_t>(y, j) : grey.at<uint8_t>(j, x)); };
+        int low_before = 255, low_after = 255;
+        for (int s = 1; s <= k; ++s)
+          low_before = std::min(low_before, at(i - s)), low_after = std::min(low_after, at(i + s));
+        if (v >= at(i - 1) && v > at(i + 1) && v - low_before >= height && v - low_after >= height)
+          out.at<uint8_t>(y, x) = 1;
+      }
+    }
+  return out;
+}
+
+// Random images of every size from 1 px, grey levels drawn from a few values
+// (ties and flat tops) or the whole range, views into a larger image, reach
+// 1-6, heights 0.5-60 DN: the ridges equal the reference's, and the drop
+// equals the reference's count of ridges (read around the ROI as the header
+// says) in each point's window. Exact.
+TEST(GridLine, RidgesAndTheDropEqualAPixelByPixelReference) {
+  cv::RNG rng(25);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int rows = rng.uniform(1, 41), cols = rng.uniform(1, 41);
+    cv::Mat big(rows + 6, cols + 6, CV_8UC1);
+    if (trial % 2 == 0) {
+      rng.fill(big, cv::RNG::UNIFORM, 0, 256);
+    } else {  // few levels: ties everywhere
+      for (int y = 0; y < big.rows; ++y)
+        for (int x = 0; x < big.cols; ++x) big.at<uint8_t>(y, x) = uint8_t(20 * rng.uniform(0, 4));
+    }
+    const cv::Mat grey = big(cv::Rect(3, 3, cols, rows));  // a view
+    const int k = rng.uniform(1, 7);
+    const double c = rng.uniform(0.5, 60.0);
+    const cv::Mat ridges = GridRidges(grey, k, c), reference = ReferenceRidges(grey, k, c);
+    ASSERT_EQ(cv::norm(ridges != reference, cv::NORM_L1), 0.0) << "trial " << trial << " k " << k << " c " << c;
+
+    GridLineOptions o;
+    o.min_prominence_dn = c;
+    o.radius_px = rng.uniform(1, 8);
+    o.min_ridge_px = rng.uniform(1, 6);
+    const cv::Rect roi(rng.uniform(0, cols), rng.uniform(0, rows), 0, 0);
+    const cv::Rect box = cv::Rect(roi.x, roi.y, rng.uniform(1, cols - roi.x + 1), rng.uniform(1, rows - roi.y + 1));
+    cv::Mat disparity(rows, cols, CV_32FC1, cv::Scalar(10.0f));
+    for (int i = 0; i < rows * cols / 5; ++i)
+      disparity.at<float>(rng.uniform(0, rows), rng.uniform(0, cols)) = std::numeric_limits<float>::infinity();
+    DisparityState s = StateOf(disparity);
+    const int dropped = DropWithoutGridLine(grey, o, k, box, &s);
+    // The reference: ridges of the area the windows and their ridge tests
+    // reach, counted in each window.
+    const int r = o.radius_px;
+    const cv::Rect image(0, 0, cols, rows);
+    const cv::Rect windows = cv::Rect(box.x - r, box.y - r, box.width + 2 * r, box.height + 2 * r) & image;
+    const cv::Rect read = cv::Rect(windows.x - k, windows.y - k, windows.width + 2 * k, windows.height + 2 * k) & image;
+    const cv::Mat read_ridges = ReferenceRidges(grey(read), k, c);
+    int expected = 0;
+    for (int y = 0; y < rows; ++y)
+      for (int x = 0; x < cols; ++x) {
+        int count = 0;
+        for (int v = y - r; v <= y + r; ++v)
+          for (int u = x - r; u <= x + r; ++u)
+            if (read.contains(cv::Point(u, v))) count += read_ridges.at<uint8_t>(v - read.y, u - read.x);
+        const bool valid = std::isfinite(disparity.at<float>(y, x));
+        const bool drop = valid && box.contains(cv::Point(x, y)) && count < o.min_ridge_px;
+        expected += drop;
+        ASSERT_EQ(std::isfinite(s.disparity_px.at<float>(y, x)), valid && !drop)
+            << "trial " << trial << " " << x << " " << y;
+        ASSERT_EQ(s.status.at<uint8_t>(y, x), uint8_t(drop ? PixelStatus::kNoGridLine : PixelStatus::kPoint));
+      }
+    ASSERT_EQ(dropped, expected) << "trial " << trial;
+  }
 }
 
 TEST(GridLine, TheOptionsAreReadAndChecked) {
