@@ -53,7 +53,8 @@ void OutputPaths::Claim(const std::string& path, const std::string& what, bool c
   // Found now, not when the file is written after the command's work. The
   // folder the path names, not its link's target's: the file is written
   // there (a temporary file renamed over the path, calib/core/atomic_file.h).
-  const fs::path folder = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
+  const fs::path given_folder = fs::path(path).parent_path();
+  const fs::path folder = given_folder.empty() ? fs::path(".") : given_folder;
   if (check_folder && access(folder.c_str(), W_OK | X_OK) != 0) {
     const std::string why = std::strerror(errno);
     throw InputError(path,

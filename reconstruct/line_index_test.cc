@@ -216,6 +216,29 @@ int JoinPerturbedPeriodJump(const SyntheticPair& pair, double spread_px, const s
   return moved;
 }
 
+// The perturbed period jump at two spreads: refused at `refused_px` (no
+// move, no patch pixel on the right line), joined at `joined_px` (one move,
+// at least min_right_line of the patch's 4 000 pixels on the right line and
+// fewer than max_period_off a period off).
+void ExpectRefusedThenJoined(const SyntheticPair& pair, double refused_px, double joined_px,
+                             const std::function<float(int, int)>& perturb, int min_right_line, int max_period_off) {
+  for (const double spread_px : {refused_px, joined_px}) {
+    Outcome patch;
+    const int moved = JoinPerturbedPeriodJump(pair, spread_px, perturb, &patch);
+    std::printf("seam spread %.0f px: %d moved; patch: %d on the right line, %d a period off\n", spread_px, moved,
+                patch.right_line, patch.period_off);
+    SCOPED_TRACE(spread_px);
+    if (spread_px == refused_px) {
+      EXPECT_EQ(moved, 0);
+      EXPECT_EQ(patch.right_line, 0);
+    } else {
+      EXPECT_EQ(moved, 1);
+      EXPECT_GE(patch.right_line, min_right_line);
+      EXPECT_LT(patch.period_off, max_period_off);
+    }
+  }
+}
+
 // The seam join at strong speckle (LineIndexOptions::seam_spread_px): the
 // disparities on both sides of a seam scatter (speckle 0.4: the simulator's
 // plate read its seam differences from -10.8 to -7.0 px around -9.2, 10th to
@@ -225,25 +248,12 @@ int JoinPerturbedPeriodJump(const SyntheticPair& pair, double spread_px, const s
 // quarter), 8 % beyond 2 px (a quarter period: it joins). Against the truth
 // (40 px): with 2 px the period-off patch is moved onto the right line.
 TEST(LineIndex, JoinReadsANoisySeamAsAPeriodJumpWithinAQuarterPeriod) {
-  const SyntheticPair pair = Plane();
   cv::RNG rng(5);
-  for (const double spread_px : {1.0, 2.0}) {
-    Outcome patch;
-    const int moved = JoinPerturbedPeriodJump(
-        pair, spread_px, [&rng](int, int) { return float(rng.gaussian(0.8)); }, &patch);
-    SCOPED_TRACE(spread_px);
-    if (spread_px == 1.0) {
-      EXPECT_EQ(moved, 0);
-      EXPECT_EQ(patch.right_line, 0);
-    } else {
-      EXPECT_EQ(moved, 1);
-      // Moved and re-refined, from the noisy disparities (+-0.8 px) plus
-      // the period: most of the patch on the right line (measured 90 %; the
-      // rest refused or, 3 %, back a period off).
-      EXPECT_GE(patch.right_line, 0.85 * 4000);
-      EXPECT_LT(patch.period_off, 0.05 * 4000);
-    }
-  }
+  // Joined: moved and re-refined, from the noisy disparities (+-0.8 px)
+  // plus the period: most of the patch on the right line (measured 90 %;
+  // the rest refused or, 3 %, back a period off).
+  ExpectRefusedThenJoined(
+      Plane(), 1.0, 2.0, [&rng](int, int) { return float(rng.gaussian(0.8)); }, int(0.85 * 4000), int(0.05 * 4000));
 }
 
 // A seam scattered wider, as on a steep limb, where the differences carry
@@ -255,26 +265,12 @@ TEST(LineIndex, JoinReadsANoisySeamAsAPeriodJumpWithinAQuarterPeriod) {
 // differences lie beyond 2 px of the median (refused) and none beyond 3 px,
 // the default (joined). Against the truth (40 px).
 TEST(LineIndex, JoinReadsASeamScatteredAsOnASteepLimbAsAPeriodJump) {
-  const SyntheticPair pair = Plane();
   EXPECT_EQ(LineIndexOptions{}.seam_spread_px, 3.0);
   auto wander = [](int x, int y) { return x < 150 ? 0.f : float(2.5 * std::sin(2 * M_PI * y / 50.0)); };
-  for (const double spread_px : {2.0, 3.0}) {
-    Outcome patch;
-    const int moved = JoinPerturbedPeriodJump(pair, spread_px, wander, &patch);
-    std::printf("seam spread %.0f px: %d moved; patch: %d on the right line, %d a period off\n", spread_px, moved,
-                patch.right_line, patch.period_off);
-    SCOPED_TRACE(spread_px);
-    if (spread_px == 2.0) {
-      EXPECT_EQ(moved, 0);
-      EXPECT_EQ(patch.right_line, 0);
-    } else {
-      EXPECT_EQ(moved, 1);
-      // Moved and re-refined from up to 2.5 px off the truth (Move tries
-      // starts 2 px either side): nearly all on the right line.
-      EXPECT_GE(patch.right_line, 0.95 * 4000);
-      EXPECT_EQ(patch.period_off, 0);
-    }
-  }
+  // Joined: moved and re-refined from up to 2.5 px off the truth (Move
+  // tries starts 2 px either side): nearly all on the right line, none a
+  // period off.
+  ExpectRefusedThenJoined(Plane(), 2.0, 3.0, wander, int(0.95 * 4000), 1);
 }
 
 // A depth edge is no period jump: its step varies along it. Here the patch
