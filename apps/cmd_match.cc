@@ -11,6 +11,7 @@
 #include "reconstruct/elapsed_ms.h"
 #include "reconstruct/grey_image.h"
 #include "reconstruct/matcher.h"
+#include "reconstruct/parallel_for.h"
 #include "reconstruct/pfm.h"
 
 namespace stereorig {
@@ -39,7 +40,8 @@ int RunMatch(int argc, char** argv) {
   app.add_option("--pyramid-levels", options.pyramid_levels,
                  "census_sgm: halvings before the full-range SGM (0 = full-resolution SGM)")
       ->capture_default_str();
-  app.add_option("--threads", options.num_threads, "threads")->capture_default_str();
+  app.add_option("--threads", options.num_threads, "threads the matching may use at once (1 = this one only)")
+      ->capture_default_str();
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 
   options.matcher = ParseMatcherKind(matcher, "--matcher");
@@ -63,7 +65,7 @@ int RunMatch(int argc, char** argv) {
   if (left.size() != right.size()) throw InputError(right_path, "size differs from the left image");
 
   const auto t0 = std::chrono::steady_clock::now();
-  const MatchResult result = Match(left, right, options);
+  const MatchResult result = WorkerPool(options.num_threads).Run([&] { return Match(left, right, options); });
   const double ms = MsSince(t0);
   WritePfm(result.disparity_px, out_path);
   int valid = 0;

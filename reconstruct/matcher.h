@@ -170,7 +170,7 @@ struct MatchOptions {
   // ball bar's (docs/reconstruct-log.md, "The oblique plate (session 22)").
   bool speckle_along_slopes = false;
   int sgbm_block_size = 5;  // opencv_sgbm_3way: block size, px (odd); default 5
-  int num_threads = 2;      // threads for row-parallel steps; default 2
+  int num_threads = 2;      // threads a row-parallel step may use (1 = the calling one only); default 2
   void Check() const;       // throws InputError naming the bad field
 };
 

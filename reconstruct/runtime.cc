@@ -96,6 +96,9 @@ Eigen::Vector3d PointAhead(const Rig& rig, int m, double distance_mm) {
 
 Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), options_(options) {
   options_.Check();
+  // As many threads as the loops below can use at once: each module's row
+  // loops, times the modules if they run in parallel.
+  pool_ = WorkerPool(options_.match.num_threads * (options_.parallel_modules ? rig_.num_modules() : 1));
   volume_center_mm_ =
       options_.volume_center_mm ? *options_.volume_center_mm : PointAhead(rig_, 0, options_.working_distance_mm);
   const std::vector<Eigen::Vector3d> corners_ref = VolumeCorners(volume_center_mm_, options_.volume_size_mm);
@@ -370,6 +373,10 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
 }
 
 Reconstruction Runtime::Process(const std::vector<cv::Mat>& images, bool build_mesh) const {
+  return pool_.Run([&] { return ProcessOnThisThread(images, build_mesh); });
+}
+
+Reconstruction Runtime::ProcessOnThisThread(const std::vector<cv::Mat>& images, bool build_mesh) const {
   if (int(images.size()) != rig_.num_cameras())
     throw InputError("capture", "has " + std::to_string(images.size()) + " images, the rig has " +
                                     std::to_string(rig_.num_cameras()) + " cameras");
@@ -393,8 +400,8 @@ Reconstruction Runtime::Process(const std::vector<cv::Mat>& images, bool build_m
   const bool free_space = options_.free_space_test && nm > 1;
   std::vector<std::pair<cv::Mat, cv::Mat>> rectified(free_space ? nm : 0);
   auto t = Clock::now();
-  // One module per thread (module 0 on this one), or all here in turn;
-  // ParallelForChunks joins every thread before rethrowing what one threw.
+  // The modules in parallel on the pool, or all here in turn; an exception
+  // in one reaches the caller once the others have stopped.
   ParallelForChunks(nm, options_.parallel_modules ? nm : 1, [&](int begin, int end) {
     for (int m = begin; m < end; ++m)
       ProcessModule(plans_[m], images, build_mesh, &clouds[m], &meshes[m], &out.modules[m],

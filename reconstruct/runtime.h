@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "calib/core/rig.h"
+#include "reconstruct/parallel_for.h"
 #include "reconstruct/point_cloud.h"
 #include "reconstruct/rectify.h"
 #include "reconstruct/runtime_options.h"
@@ -95,6 +96,8 @@ class Runtime {
   // size the rig says. `build_mesh` adds the organised meshes, the joined
   // mesh and the model fill (timed separately). Throws InputError on images
   // of the wrong number, type or size.
+  // Runs on the runtime's worker pool: at most match.num_threads threads
+  // per module, times the modules if parallel_modules (parallel_for.h).
   Reconstruction Process(const std::vector<cv::Mat>& images, bool build_mesh) const;
 
   // The per-module work of Process(), exposed for tests: the module's cloud
@@ -104,10 +107,13 @@ class Runtime {
                      Mesh* mesh, ModuleReport* report, std::pair<cv::Mat, cv::Mat>* rectified = nullptr) const;
 
  private:
+  Reconstruction ProcessOnThisThread(const std::vector<cv::Mat>& images, bool build_mesh) const;
+
   Rig rig_;
   RuntimeOptions options_;
   Eigen::Vector3d volume_center_mm_;
   std::vector<ModulePlan> plans_;
+  WorkerPool pool_;
 };
 
 // The files LoadCapture reads from capture folder DIR: DIR/camK.png for

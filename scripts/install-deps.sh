@@ -7,7 +7,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libceres-dev libsuitesparse-dev
   libmrcal-dev mrcal python3 python3-mrcal python3-numpy python3-scipy
-  libopencv-dev python3-opencv
+  libopencv-dev python3-opencv libtbb-dev
   libapriltag-dev
   libyaml-cpp-dev libcli11-dev libsqlite3-dev libnanoflann-dev nlohmann-json3-dev
   googletest libgtest-dev
