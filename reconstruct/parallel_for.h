@@ -12,6 +12,7 @@
 #pragma once
 
 #include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/info.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/task_arena.h>
 
@@ -47,7 +48,10 @@ void ParallelForChunks(int n, int num_threads, Fn&& fn) {
 class WorkerPool {
  public:
   WorkerPool() : WorkerPool(1) {}
-  explicit WorkerPool(int threads) : arena_(std::make_shared<tbb::task_arena>(std::max(1, threads))) {}
+  // Capped at the hardware threads here: oneTBB warns on stderr when asked
+  // for more workers than it has.
+  explicit WorkerPool(int threads)
+      : arena_(std::make_shared<tbb::task_arena>(std::clamp(threads, 1, tbb::info::default_concurrency()))) {}
   int max_threads() const { return arena_->max_concurrency(); }
   template <typename Fn>
   auto Run(Fn&& fn) const {

@@ -95,6 +95,20 @@ TEST(WorkerPool, OneThreadRunsEveryChunkOnTheCallingThread) {
   EXPECT_EQ(ids, std::set<std::thread::id>{caller});
 }
 
+// Asked for more threads than the machine has, the pool takes what it has,
+// without oneTBB's warning on stderr ("The number of workers is currently
+// limited to ...") in every command's output.
+TEST(WorkerPool, MoreThreadsThanTheMachineHasGiveTheMachinesQuietly) {
+  const int hardware = int(std::thread::hardware_concurrency());
+  testing::internal::CaptureStderr();
+  const WorkerPool pool(4 * hardware + 4);
+  const size_t used = pool.Run([&] { return ThreadsUsed([&](auto fn) { ParallelForChunks(400, 64, fn); }).size(); });
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+  EXPECT_EQ(pool.max_threads(), hardware);
+  EXPECT_LE(used, size_t(hardware));
+  EXPECT_EQ(WorkerPool(1).max_threads(), 1);
+}
+
 TEST(WorkerPool, RunReturnsTheResultAndPassesExceptionsOn) {
   const WorkerPool pool(2);
   EXPECT_EQ(pool.Run([] { return 42; }), 42);
