@@ -105,4 +105,11 @@ DefaultScene MakeScene(const SimulatedRig& rig, unsigned seed, int captures, dou
   return s;
 }
 
+std::vector<const BoardObservation*> ViewsOf(const CalibrationInput& in, int cam) {
+  std::vector<const BoardObservation*> v;
+  for (const auto& o : in.observations)
+    if (o.camera == cam) v.push_back(&o);
+  return v;
+}
+
 }  // namespace stereorig::testing

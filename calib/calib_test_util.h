@@ -45,6 +45,9 @@ namespace stereorig::testing {
 std::vector<int> CapturesWhoseBoardPlaneSeparates(const Rig& truth, const std::vector<Pose>& ref_from_front,
                                                   const CalibrationInput& in, int camera_a, int camera_b);
 
+// The observations camera `cam` made, in capture order (pointers into `in`).
+std::vector<const BoardObservation*> ViewsOf(const CalibrationInput& in, int cam);
+
 // The default rig with `captures` synthetic captures of the default test
 // target at `noise_px`. The engine is told a back_from_front that differs
 // from the true one by a draw from its stated 1 sigma, as a measured one would.

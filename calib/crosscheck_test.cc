@@ -17,13 +17,6 @@
 namespace stereorig {
 namespace {
 
-std::vector<const BoardObservation*> ViewsOf(const CalibrationInput& in, int cam) {
-  std::vector<const BoardObservation*> v;
-  for (const auto& o : in.observations)
-    if (o.camera == cam) v.push_back(&o);
-  return v;
-}
-
 TEST(Crosscheck, Stage1AgainstOpencvAndMrcalCalibrateCameras) {
   // Boards kept near camera 0's optical axis, 200 mm away (+-10 mm), so that
   // most views are whole.
@@ -42,7 +35,7 @@ TEST(Crosscheck, Stage1AgainstOpencvAndMrcalCalibrateCameras) {
   // those); on this set's partial views its seeding falls into a local
   // minimum (4.4 px RMS, measured). So all three run on the whole-board views.
   std::vector<const BoardObservation*> views;
-  for (const BoardObservation* v : ViewsOf(in, cam))
+  for (const BoardObservation* v : testing::ViewsOf(in, cam))
     if (static_cast<int>(v->corner_ids.size()) == in.target.num_corners()) views.push_back(v);
   std::printf("%zu whole-board views\n", views.size());
   ASSERT_GE(views.size(), 10u);

@@ -15,13 +15,6 @@
 namespace stereorig {
 namespace {
 
-std::vector<const BoardObservation*> ViewsOf(const CalibrationInput& in, int cam) {
-  std::vector<const BoardObservation*> v;
-  for (const auto& o : in.observations)
-    if (o.camera == cam) v.push_back(&o);
-  return v;
-}
-
 // True cam_from_face of each view the solve used.
 std::vector<Pose> TrueCamFromFace(const testing::DefaultScene& s, int cam, const IntrinsicsResult& r) {
   std::vector<Pose> out;
@@ -38,7 +31,7 @@ TEST(Intrinsics, Opencv8RecoversTheTruthWithinItsUncertainty) {
     const auto s = testing::MakeDefaultScene(seed, 20, noise);
     for (int cam : {0, 3}) {
       const auto r = CalibrateIntrinsics(cam, s.data.input.cameras[cam], s.data.input.target,
-                                         ViewsOf(s.data.input, cam), IntrinsicsOptions(), "test");
+                                         testing::ViewsOf(s.data.input, cam), IntrinsicsOptions(), "test");
       // Residual RMS per coordinate: the noise, less the fitted dof; 10%.
       EXPECT_NEAR(r.report.rms_px, noise, 0.1 * noise) << seed << " cam " << cam;
       EXPECT_EQ(r.report.num_outliers, 0);
@@ -61,8 +54,8 @@ TEST(Intrinsics, LensModelsAreSelectable) {
        {"LENSMODEL_OPENCV5", "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=8_Ny=6_fov_x_deg=45"}) {
     IntrinsicsOptions opt;
     opt.lensmodel = model;
-    const auto r =
-        CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, ViewsOf(s.data.input, 0), opt, "test");
+    const auto r = CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target,
+                                       testing::ViewsOf(s.data.input, 0), opt, "test");
     EXPECT_EQ(r.camera.lensmodel_name(), model);
     // Both models can represent this mild OPENCV8 lens within noise here.
     EXPECT_NEAR(r.report.rms_px, 0.2, 0.03) << model;
@@ -78,7 +71,7 @@ TEST(Intrinsics, RejectsAnOutlierCorner) {
       break;
     }
   }
-  const auto r = CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, ViewsOf(s.data.input, 0),
+  const auto r = CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, testing::ViewsOf(s.data.input, 0),
                                      IntrinsicsOptions(), "test");
   EXPECT_GE(r.report.num_outliers, 1);
   EXPECT_NEAR(r.report.rms_px, 0.2, 0.02);
@@ -102,7 +95,7 @@ TEST(Intrinsics, DropsAViewThatOutlierRejectionLeavesUndetermined) {
     break;
   }
   ASSERT_GE(capture, 0);
-  const auto r = CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, ViewsOf(s.data.input, 0),
+  const auto r = CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, testing::ViewsOf(s.data.input, 0),
                                      IntrinsicsOptions(), "test");
   EXPECT_EQ(std::find(r.captures.begin(), r.captures.end(), capture), r.captures.end());
   EXPECT_EQ(r.report.num_views_dropped, 1);
@@ -122,8 +115,8 @@ TEST(Intrinsics, RefusesFrontoParallelViews) {
   o.max_roll_deg = 20.0;
   s.data = MakeSyntheticCaptures(s.truth.rig, s.data.input.target, s.true_back_from_front, s.ref_from_volume, o);
   try {
-    CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, ViewsOf(s.data.input, 0), IntrinsicsOptions(),
-                        "test");
+    CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, testing::ViewsOf(s.data.input, 0),
+                        IntrinsicsOptions(), "test");
     FAIL() << "fronto-parallel views accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("fronto-parallel"), std::string::npos) << e.what();
@@ -132,7 +125,7 @@ TEST(Intrinsics, RefusesFrontoParallelViews) {
 
 TEST(Intrinsics, RefusesTooFewViews) {
   const auto s = testing::MakeDefaultScene(51, 3, 0.2);
-  EXPECT_THROW(CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, ViewsOf(s.data.input, 0),
+  EXPECT_THROW(CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, testing::ViewsOf(s.data.input, 0),
                                    IntrinsicsOptions(), "test"),
                InputError);
 }

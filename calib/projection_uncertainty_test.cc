@@ -75,18 +75,11 @@ void ExpectMatchesPython(const MrcalProblem& p, const std::vector<std::pair<int,
   }
 }
 
-std::vector<const BoardObservation*> ViewsOf(const CalibrationInput& in, int cam) {
-  std::vector<const BoardObservation*> v;
-  for (const auto& o : in.observations)
-    if (o.camera == cam) v.push_back(&o);
-  return v;
-}
-
 TEST(ProjectionUncertainty, Stage1MatchesPythonMrcal) {
   const auto scene = testing::MakeDefaultScene(3, 14, 0.2);
   IntrinsicsOptions opt;
   const auto r = CalibrateIntrinsics(0, scene.data.input.cameras[0], scene.data.input.target,
-                                     ViewsOf(scene.data.input, 0), opt, "test");
+                                     testing::ViewsOf(scene.data.input, 0), opt, "test");
   std::vector<std::pair<int, Eigen::Vector3d>> q = {
       {0, {0, 0, 200}}, {0, {-60, -45, 210}}, {0, {70, 50, 190}}, {0, {10, -30, 400}}};
   ExpectMatchesPython(r.problem, q, "stage1");
@@ -96,9 +89,10 @@ TEST(ProjectionUncertainty, Stage2WithExtrinsicsMatchesPythonMrcal) {
   const auto scene = testing::MakeDefaultScene(4, 12, 0.2);
   const CalibrationInput& in = scene.data.input;
   IntrinsicsOptions opt;
-  const auto l = CalibrateIntrinsics(0, in.cameras[0], in.target, ViewsOf(in, 0), opt, "test");
-  const auto r = CalibrateIntrinsics(1, in.cameras[1], in.target, ViewsOf(in, 1), opt, "test");
-  const auto s = CalibrateStereo(0, in.modules[0], l, r, ViewsOf(in, 0), ViewsOf(in, 1), in, StereoOptions(), opt);
+  const auto l = CalibrateIntrinsics(0, in.cameras[0], in.target, testing::ViewsOf(in, 0), opt, "test");
+  const auto r = CalibrateIntrinsics(1, in.cameras[1], in.target, testing::ViewsOf(in, 1), opt, "test");
+  const auto s = CalibrateStereo(0, in.modules[0], l, r, testing::ViewsOf(in, 0), testing::ViewsOf(in, 1), in,
+                                 StereoOptions(), opt);
   std::vector<std::pair<int, Eigen::Vector3d>> q = {{0, {0, 0, 200}}, {1, {0, 0, 200}}, {1, {-50, 40, 220}}};
   ExpectMatchesPython(s.problem, q, "stage2");
 }
@@ -108,7 +102,7 @@ TEST(ProjectionUncertainty, SplinedModelMatchesPythonMrcal) {
   IntrinsicsOptions opt;
   opt.lensmodel = "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=8_Ny=6_fov_x_deg=45";
   const auto r = CalibrateIntrinsics(0, scene.data.input.cameras[0], scene.data.input.target,
-                                     ViewsOf(scene.data.input, 0), opt, "test");
+                                     testing::ViewsOf(scene.data.input, 0), opt, "test");
   std::vector<std::pair<int, Eigen::Vector3d>> q = {{0, {0, 0, 200}}, {0, {-40, 30, 200}}};
   ExpectMatchesPython(r.problem, q, "splined");
 }
