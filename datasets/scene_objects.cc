@@ -404,9 +404,16 @@ double SceneObject::Albedo(const Eigen::Vector3d& p) const {
   return albedo * (1.0 + texture_contrast * 0.25 * t);
 }
 
-bool Scene::Intersect(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_min, double t_max,
-                      SceneHit* hit) const {
-  bool found = false;
+namespace {
+
+// Tests the ray o + t d, t in [t_min, t_max), against every shape of the
+// objects whose bounding sphere it crosses, each in its object's frame.
+// on_hit(object, t, n_object) is called for each shape hit before the
+// current t_max and returns the t_max to go on with; at or below t_min the
+// walk stops.
+template <class OnHit>
+void WalkShapeHits(const std::vector<SceneObject>& objects, const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                   double t_min, double t_max, OnHit&& on_hit) {
   for (const SceneObject& obj : objects) {
     double b0, b1;
     if (!SphereSpan(o, d, obj.bound_center_world, obj.bound_radius_mm, &b0, &b1)) continue;
@@ -417,32 +424,36 @@ bool Scene::Intersect(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double
       double t;
       Eigen::Vector3d n;
       if (shape->Intersect(oo, dd, t_min, t_max, &t, &n)) {
-        t_max = t;
-        found = true;
-        hit->t = t;
-        hit->n_world = obj.world_from_object.rotation() * n;
-        hit->object = &obj;
+        t_max = on_hit(obj, t, n);
+        if (t_max <= t_min) return;
       }
     }
   }
+}
+
+}  // namespace
+
+bool Scene::Intersect(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_min, double t_max,
+                      SceneHit* hit) const {
+  bool found = false;
+  WalkShapeHits(objects, o, d, t_min, t_max, [&](const SceneObject& obj, double t, const Eigen::Vector3d& n) {
+    found = true;  // the nearest so far: search on only before it
+    hit->t = t;
+    hit->n_world = obj.world_from_object.rotation() * n;
+    hit->object = &obj;
+    return t;
+  });
   if (found) hit->p_world = o + hit->t * d;
   return found;
 }
 
 bool Scene::Occluded(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_min, double t_max) const {
-  for (const SceneObject& obj : objects) {
-    double b0, b1;
-    if (!SphereSpan(o, d, obj.bound_center_world, obj.bound_radius_mm, &b0, &b1)) continue;
-    if (b1 <= t_min || b0 >= t_max) continue;
-    const Eigen::Vector3d oo = obj.object_from_world * o;
-    const Eigen::Vector3d dd = obj.object_from_world.rotation() * d;
-    for (const auto& shape : obj.shapes) {
-      double t;
-      Eigen::Vector3d n;
-      if (shape->Intersect(oo, dd, t_min, t_max, &t, &n)) return true;
-    }
-  }
-  return false;
+  bool hit = false;
+  WalkShapeHits(objects, o, d, t_min, t_max, [&](const SceneObject&, double, const Eigen::Vector3d&) {
+    hit = true;  // any hit will do: stop
+    return t_min;
+  });
+  return hit;
 }
 
 namespace {
