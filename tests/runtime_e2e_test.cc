@@ -17,6 +17,7 @@
 #include <fstream>
 #include <regex>
 #include <sstream>
+#include <thread>
 #include <vector>
 
 #include "calib/core/input_error.h"
@@ -160,6 +161,41 @@ TEST_F(RuntimeOnSimulatedScenes, SphereAgreesWithTheAnalyticSphere) {
   // blob of ~375 points one grid period off; now none may be that far.
   EXPECT_LT(far, n / 1000);
   EXPECT_LT(worst, 1.5);
+}
+
+// A capture's cloud does not depend on the threads that made it: the
+// runtime's loops run on a work-stealing pool (parallel_for.h), whose chunks
+// start wherever threads come free, and Process() may be called from several
+// threads at once. The sphere's cloud, bit for bit: with the default pool (2
+// modules x 2 threads), every step on the calling thread (modules in turn,
+// one thread each), 8 threads per module, and two Process() calls at once on
+// one runtime.
+TEST_F(RuntimeOnSimulatedScenes, TheCloudIsTheSameWhateverTheThreads) {
+  const Rig rig = ReadRigFile(*dataset_ + "/truth/rig.yaml");
+  const std::vector<cv::Mat> capture = LoadCapture(*dataset_ + "/scenes/sphere/active", rig);
+  auto same = [](const PointCloud& a, const PointCloud& b) {
+    return a.xyz_mm == b.xyz_mm && a.normal == b.normal && a.intensity == b.intensity && a.module == b.module &&
+           a.confidence == b.confidence;
+  };
+  const Runtime pooled(rig, RuntimeOptions{});
+  const PointCloud reference = pooled.Process(capture, false).cloud;
+  ASSERT_GT(reference.size(), 10000u);
+
+  RuntimeOptions one_thread;
+  one_thread.parallel_modules = false;
+  one_thread.match.num_threads = 1;
+  EXPECT_TRUE(same(Runtime(rig, one_thread).Process(capture, false).cloud, reference)) << "one thread";
+
+  RuntimeOptions eight_threads;
+  eight_threads.match.num_threads = 8;
+  EXPECT_TRUE(same(Runtime(rig, eight_threads).Process(capture, false).cloud, reference)) << "8 threads per module";
+
+  PointCloud first, second;
+  std::thread other([&] { first = pooled.Process(capture, false).cloud; });
+  second = pooled.Process(capture, false).cloud;
+  other.join();
+  EXPECT_TRUE(same(first, reference)) << "two calls at once: the other thread's";
+  EXPECT_TRUE(same(second, reference)) << "two calls at once: this thread's";
 }
 
 // Twice the default speckle (contrast 0.4) on the flatness plate, the scene
