@@ -10,6 +10,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include "tests/cli_runner.h"
@@ -34,7 +35,14 @@ TEST(BenchCli, ReportsBothPipelinesAccuracyAndAHeapKeptBetweenCaptures) {
     EXPECT_EQ(j[p]["objects"].get<int>(), 2) << p;  // 1 scene x 2 runs
     EXPECT_GT(j[p]["objects_per_s"].get<double>(), 0) << p;
     EXPECT_GT(j[p]["cpu_ms_per_object"].get<double>(), 0) << p;
+    // CPU over wall time: the same seconds as the two figures above, and
+    // no more cores than the machine has (rusage's clock ticks aside).
+    const double cores = j[p]["cores_busy"].get<double>();
+    EXPECT_NEAR(cores, j[p]["cpu_ms_per_object"].get<double>() * j[p]["objects_per_s"].get<double>() / 1000, 1e-9) << p;
+    EXPECT_GT(cores, 0) << p;
+    EXPECT_LT(cores, std::thread::hardware_concurrency() + 0.5) << p;
   }
+  EXPECT_NE(r.out.find("cores busy"), std::string::npos) << r.out;
   // Against the simulator's truth surface (independent of the runtime):
   // measured 0.010 mm mean |e|; the single-module goal is 0.1 mm.
   const nlohmann::json& merged = j["ours"]["scenes"][0]["accuracy"]["merged"];
