@@ -51,7 +51,7 @@ struct RuntimeOptions {
   // the one that best predicts the residuals left out a block at a time
   // (residual_field.h).
   double fill_residual_length_mm = 0;
-  bool parallel_modules = true;  // process modules on separate threads; default true
+  bool parallel_modules = true;  // the modules in parallel on the runtime's worker pool (parallel_for.h); default true
   // The free-space test across modules (free_space.h): a module's point is
   // removed (status kSeenThrough) where the other modules' surfaces facing
   // its left camera lie in front of it along its ray. Only with 2+ modules.
