@@ -373,10 +373,10 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
 }
 
 Reconstruction Runtime::Process(const std::vector<cv::Mat>& images, bool build_mesh) const {
-  return pool_.Run([&] { return ProcessOnThisThread(images, build_mesh); });
+  return pool_.Run([&] { return ProcessInPool(images, build_mesh); });
 }
 
-Reconstruction Runtime::ProcessOnThisThread(const std::vector<cv::Mat>& images, bool build_mesh) const {
+Reconstruction Runtime::ProcessInPool(const std::vector<cv::Mat>& images, bool build_mesh) const {
   if (int(images.size()) != rig_.num_cameras())
     throw InputError("capture", "has " + std::to_string(images.size()) + " images, the rig has " +
                                     std::to_string(rig_.num_cameras()) + " cameras");

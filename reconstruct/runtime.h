@@ -107,7 +107,8 @@ class Runtime {
                      Mesh* mesh, ModuleReport* report, std::pair<cv::Mat, cv::Mat>* rectified = nullptr) const;
 
  private:
-  Reconstruction ProcessOnThisThread(const std::vector<cv::Mat>& images, bool build_mesh) const;
+  // Process()'s work, run inside pool_ (its loops take pool_'s threads).
+  Reconstruction ProcessInPool(const std::vector<cv::Mat>& images, bool build_mesh) const;
 
   Rig rig_;
   RuntimeOptions options_;
