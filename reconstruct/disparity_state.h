@@ -3,6 +3,7 @@
 // accepts a refined disparity.
 #pragma once
 
+#include <limits>
 #include <opencv2/core.hpp>
 
 #include "reconstruct/subpixel_refine.h"
@@ -48,6 +49,15 @@ struct DisparityState {
   cv::Mat slope_x;       // CV_32F: dd/dx of the local disparity plane, px/px (0 where unknown)
   cv::Mat slope_y;       // CV_32F: dd/dy
 };
+
+// Withdraws the point at left pixel (x, y), for the reason `why`: no
+// disparity (+inf), confidence 0, status `why`. The one way the tests
+// after the match drop a point, so the three maps always agree.
+inline void DropPoint(int x, int y, PixelStatus why, DisparityState* state) {
+  state->disparity_px.at<float>(y, x) = std::numeric_limits<float>::infinity();
+  state->confidence.at<float>(y, x) = 0;
+  state->status.at<uint8_t>(y, x) = uint8_t(why);
+}
 
 // When a Lucas-Kanade refinement (subpixel_refine.h) counts as a match.
 struct RefineAcceptance {

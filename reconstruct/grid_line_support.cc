@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <opencv2/imgproc.hpp>
 
 #include "calib/core/input_error.h"
@@ -91,15 +90,11 @@ int DropWithoutGridLine(const cv::Mat& left, const GridLineOptions& o, int reach
   cv::boxFilter(ridges, count, CV_16U, cv::Size(2 * r + 1, 2 * r + 1), cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
   int dropped = 0;
   for (int y = roi.y; y < roi.y + roi.height; ++y) {
-    float* d = state->disparity_px.ptr<float>(y);
-    float* conf = state->confidence.ptr<float>(y);
-    uint8_t* status = state->status.ptr<uint8_t>(y);
+    const float* d = state->disparity_px.ptr<float>(y);
     const uint16_t* n = count.ptr<uint16_t>(y - read_area.y);  // column x at n[x - read_area.x]
     for (int x = roi.x; x < roi.x + roi.width; ++x) {
       if (!std::isfinite(d[x]) || n[x - read_area.x] >= o.min_ridge_px) continue;
-      d[x] = std::numeric_limits<float>::infinity();
-      conf[x] = 0;
-      status[x] = uint8_t(PixelStatus::kNoGridLine);
+      DropPoint(x, y, PixelStatus::kNoGridLine, state);
       ++dropped;
     }
   }

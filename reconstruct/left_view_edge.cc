@@ -1,7 +1,6 @@
 #include "reconstruct/left_view_edge.h"
 
 #include <cmath>
-#include <limits>
 #include <opencv2/imgproc.hpp>
 
 #include "calib/core/input_error.h"
@@ -11,7 +10,7 @@ namespace stereorig {
 int DropLeftViewEdge(const cv::Mat& left_valid, int half_width_px, int half_height_px, const cv::Rect& roi,
                      DisparityState* state) {
   if (left_valid.empty()) return 0;
-  cv::Mat& disparity = state->disparity_px;
+  const cv::Mat& disparity = state->disparity_px;
   STEREORIG_CHECK(left_valid.type() == CV_8UC1 && left_valid.size() == disparity.size());
   STEREORIG_CHECK(half_width_px >= 0 && half_height_px >= 0);
   // A pixel's window is all data where the mask eroded by the window is
@@ -23,14 +22,10 @@ int DropLeftViewEdge(const cv::Mat& left_valid, int half_width_px, int half_heig
   int dropped = 0;
   for (int y = roi.y; y < roi.y + roi.height; ++y) {
     const uint8_t* in = inside.ptr<uint8_t>(y);
-    float* d = disparity.ptr<float>(y);
-    float* c = state->confidence.ptr<float>(y);
-    uint8_t* s = state->status.ptr<uint8_t>(y);
+    const float* d = disparity.ptr<float>(y);
     for (int x = roi.x; x < roi.x + roi.width; ++x) {
       if (in[x] || !std::isfinite(d[x])) continue;
-      d[x] = std::numeric_limits<float>::infinity();
-      c[x] = 0;
-      s[x] = uint8_t(PixelStatus::kLeftViewEdge);
+      DropPoint(x, y, PixelStatus::kLeftViewEdge, state);
       ++dropped;
     }
   }

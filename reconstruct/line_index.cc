@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <map>
 #include <memory>
 #include <vector>
@@ -224,14 +223,13 @@ class LineIndexer {
         if (rk.ok && (!r.ok || rk.zncc > r.zncc)) r = rk;
       }
       const PixelStatus why = Accept(left_, right_, x, y, SlopeX(i), SlopeY(i), r, accept_);
-      state_->status.at<uint8_t>(y, x) = uint8_t(why);
-      if (why == PixelStatus::kPoint) {
-        d = float(r.disparity_px);
-        state_->confidence.at<float>(y, x) = float(std::clamp(r.zncc, 0.0, 1.0));
-      } else {
-        d = std::numeric_limits<float>::infinity();
-        state_->confidence.at<float>(y, x) = 0;
+      if (why != PixelStatus::kPoint) {
+        DropPoint(x, y, why, state_);
+        continue;
       }
+      d = float(r.disparity_px);
+      state_->confidence.at<float>(y, x) = float(std::clamp(r.zncc, 0.0, 1.0));
+      state_->status.at<uint8_t>(y, x) = uint8_t(PixelStatus::kPoint);
     }
   }
 
@@ -239,12 +237,9 @@ class LineIndexer {
   void Drop(const std::vector<int>& pixels) {
     for (int i : pixels) {
       const int y = i / cols_, x = i % cols_;
-      float& d = state_->disparity_px.at<float>(y, x);
-      if (!std::isfinite(d)) continue;
+      if (!std::isfinite(state_->disparity_px.at<float>(y, x))) continue;
       changed_ = true;
-      d = std::numeric_limits<float>::infinity();
-      state_->confidence.at<float>(y, x) = 0;
-      state_->status.at<uint8_t>(y, x) = uint8_t(PixelStatus::kWrongLine);
+      DropPoint(x, y, PixelStatus::kWrongLine, state_);
     }
   }
 

@@ -41,7 +41,7 @@ int DropRightInvisible(double margin_px, const cv::Mat& right_valid, const cv::R
 
 int DropRightInvisible(double margin_px, const ViewGaps& right_gaps, const cv::Rect& roi, DisparityState* state) {
   if (!(margin_px > 0)) return 0;
-  cv::Mat& disparity = state->disparity_px;
+  const cv::Mat& disparity = state->disparity_px;
   STEREORIG_CHECK(right_gaps.empty() || right_gaps.size() == disparity.size());
   const int cols = disparity.cols;
   constexpr double kStepPx = 1;  // how much nearer an occluder must be (header)
@@ -60,7 +60,7 @@ int DropRightInvisible(double margin_px, const ViewGaps& right_gaps, const cv::R
   // testing the columns one by one was a third of the filter's cost.
   int dropped = 0;
   for (int y = roi.y; y < roi.y + roi.height; ++y) {
-    float* d = disparity.ptr<float>(y);
+    const float* d = disparity.ptr<float>(y);
     float row_max = -kInf;
     first_landing[roi.width] = kInf;
     for (int x = roi.x + roi.width - 1; x >= roi.x; --x) {
@@ -86,11 +86,7 @@ int DropRightInvisible(double margin_px, const ViewGaps& right_gaps, const cv::R
       if (hidden) drop.push_back(x);
     }
     // After the row's test: a dropped pixel still hides those behind it.
-    for (int x : drop) {
-      d[x] = std::numeric_limits<float>::infinity();
-      state->confidence.at<float>(y, x) = 0;
-      state->status.at<uint8_t>(y, x) = uint8_t(PixelStatus::kOccluded);
-    }
+    for (int x : drop) DropPoint(x, y, PixelStatus::kOccluded, state);
     dropped += int(drop.size());
   }
   return dropped;

@@ -1,7 +1,6 @@
 #include "reconstruct/right_view_edge.h"
 
 #include <cmath>
-#include <limits>
 #include <vector>
 
 #include "calib/core/input_error.h"
@@ -15,7 +14,7 @@ int DropUnverifiableAtRightViewEdge(const cv::Mat& right_valid, const RefineAcce
 
 int DropUnverifiableAtRightViewEdge(const ViewGaps& right_gaps, const RefineAcceptance& accept, double max_step_px,
                                     const cv::Rect& roi, DisparityState* state) {
-  cv::Mat& disparity = state->disparity_px;
+  const cv::Mat& disparity = state->disparity_px;
   STEREORIG_CHECK(right_gaps.empty() || right_gaps.size() == disparity.size());
   STEREORIG_CHECK(max_step_px > 0 && (roi & cv::Rect(0, 0, disparity.cols, disparity.rows)) == roi);
   const int cols = disparity.cols;
@@ -74,11 +73,7 @@ int DropUnverifiableAtRightViewEdge(const ViewGaps& right_gaps, const RefineAcce
         }
       }
       if (leaves_zone) continue;
-      for (const cv::Point& p : component) {
-        disparity.at<float>(p.y + roi.y, p.x + roi.x) = std::numeric_limits<float>::infinity();
-        state->confidence.at<float>(p.y + roi.y, p.x + roi.x) = 0;
-        state->status.at<uint8_t>(p.y + roi.y, p.x + roi.x) = uint8_t(PixelStatus::kRightViewEdge);
-      }
+      for (const cv::Point& p : component) DropPoint(p.x + roi.x, p.y + roi.y, PixelStatus::kRightViewEdge, state);
       dropped += int(component.size());
     }
   return dropped;
