@@ -51,13 +51,13 @@ CameraSpec ParseCamera(YamlMap m) {
 
 ProjectorSpec ParseProjector(YamlMap m) {
   ProjectorSpec p;
-  p.enabled = m.GetBool("enabled", p.enabled);
+  m.Read("enabled", &p.enabled);
   p.offset_mm = GetVec3(m, "offset_mm", p.offset_mm);
-  p.lines = m.GetInt("lines", p.lines);
-  p.fan_angle_deg = m.GetDouble("fan_angle_deg", p.fan_angle_deg);
-  p.rotation_deg = m.GetDouble("rotation_deg", p.rotation_deg);
-  p.line_sigma_mrad = m.GetDouble("line_sigma_mrad", p.line_sigma_mrad);
-  p.power_dn = m.GetDouble("power_dn", p.power_dn);
+  m.Read("lines", &p.lines);
+  m.Read("fan_angle_deg", &p.fan_angle_deg);
+  m.Read("rotation_deg", &p.rotation_deg);
+  m.Read("line_sigma_mrad", &p.line_sigma_mrad);
+  m.Read("power_dn", &p.power_dn);
   m.Finish();
   Require(p.lines >= 2, m.Where(), "lines", "must be at least 2");
   Require(p.fan_angle_deg > 0 && p.fan_angle_deg < 170, m.Where(), "fan_angle_deg", "must be in (0, 170)");
@@ -72,8 +72,8 @@ ModuleSpec ParseModule(YamlMap m) {
   s.center_mm = GetVec3(m, "center_mm", s.center_mm);
   s.look_at_mm = GetVec3(m, "look_at_mm", s.look_at_mm);
   s.up = GetVec3(m, "up", s.up);
-  s.baseline_mm = m.GetDouble("baseline_mm", s.baseline_mm);
-  s.verging_deg = m.GetDouble("verging_deg", s.verging_deg);
+  m.Read("baseline_mm", &s.baseline_mm);
+  m.Read("verging_deg", &s.verging_deg);
   s.left = ParseCamera(m.GetMap("left_camera"));
   s.right = ParseCamera(m.GetMap("right_camera"));
   if (m.Has("projector")) {
@@ -189,38 +189,38 @@ SimSpec ParseSimSpecYaml(const std::string& text, const std::string& where) {
   if (root.Has("render")) {
     YamlMap r = root.GetMap("render");
     RenderSpec& d = s.render;
-    d.samples_per_axis = r.GetInt("samples_per_axis", d.samples_per_axis);
-    d.edge_samples_per_axis = r.GetInt("edge_samples_per_axis", d.edge_samples_per_axis);
-    d.ambient_dn = r.GetDouble("ambient_dn", d.ambient_dn);
-    d.ambient_directional = r.GetDouble("ambient_directional", d.ambient_directional);
-    d.background_dn = r.GetDouble("background_dn", d.background_dn);
-    d.stray_light_dn = r.GetDouble("stray_light_dn", d.stray_light_dn);
-    d.psf_sigma_px = r.GetDouble("psf_sigma_px", d.psf_sigma_px);
-    d.noise = r.GetBool("noise", d.noise);
-    d.full_well_e = r.GetDouble("full_well_e", d.full_well_e);
-    d.read_noise_e = r.GetDouble("read_noise_e", d.read_noise_e);
-    d.speckle_contrast = r.GetDouble("speckle_contrast", d.speckle_contrast);
-    d.speckle_grain_px = r.GetDouble("speckle_grain_px", d.speckle_grain_px);
-    d.texture_contrast = r.GetDouble("texture_contrast", d.texture_contrast);
-    d.texture_wavelength_mm = r.GetDouble("texture_wavelength_mm", d.texture_wavelength_mm);
+    r.Read("samples_per_axis", &d.samples_per_axis);
+    r.Read("edge_samples_per_axis", &d.edge_samples_per_axis);
+    r.Read("ambient_dn", &d.ambient_dn);
+    r.Read("ambient_directional", &d.ambient_directional);
+    r.Read("background_dn", &d.background_dn);
+    r.Read("stray_light_dn", &d.stray_light_dn);
+    r.Read("psf_sigma_px", &d.psf_sigma_px);
+    r.Read("noise", &d.noise);
+    r.Read("full_well_e", &d.full_well_e);
+    r.Read("read_noise_e", &d.read_noise_e);
+    r.Read("speckle_contrast", &d.speckle_contrast);
+    r.Read("speckle_grain_px", &d.speckle_grain_px);
+    r.Read("texture_contrast", &d.texture_contrast);
+    r.Read("texture_wavelength_mm", &d.texture_wavelength_mm);
     r.Finish();
     d.Check(r.Where());
   }
   if (root.Has("calibration")) {
     YamlMap c = root.GetMap("calibration");
     CalibrationSpec& d = s.calibration;
-    d.captures = c.GetInt("captures", d.captures);
+    c.Read("captures", &d.captures);
     d.target = c.GetString("target", d.target);
-    d.tilt_max_deg = c.GetDouble("tilt_max_deg", d.tilt_max_deg);
-    d.roll_max_deg = c.GetDouble("roll_max_deg", d.roll_max_deg);
+    c.Read("tilt_max_deg", &d.tilt_max_deg);
+    c.Read("roll_max_deg", &d.roll_max_deg);
     d.volume_mm = GetVec3(c, "volume_mm", d.volume_mm);
-    d.scale_error_ppm = c.GetDouble("scale_error_ppm", d.scale_error_ppm);
-    d.back_misalignment_deg = c.GetDouble("back_misalignment_deg", d.back_misalignment_deg);
-    d.back_misalignment_mm = c.GetDouble("back_misalignment_mm", d.back_misalignment_mm);
-    d.nonflatness_mm = c.GetDouble("nonflatness_mm", d.nonflatness_mm);
-    d.white_albedo = c.GetDouble("white_albedo", d.white_albedo);
-    d.black_albedo = c.GetDouble("black_albedo", d.black_albedo);
-    d.min_corners_per_camera = c.GetInt("min_corners_per_camera", d.min_corners_per_camera);
+    c.Read("scale_error_ppm", &d.scale_error_ppm);
+    c.Read("back_misalignment_deg", &d.back_misalignment_deg);
+    c.Read("back_misalignment_mm", &d.back_misalignment_mm);
+    c.Read("nonflatness_mm", &d.nonflatness_mm);
+    c.Read("white_albedo", &d.white_albedo);
+    c.Read("black_albedo", &d.black_albedo);
+    c.Read("min_corners_per_camera", &d.min_corners_per_camera);
     c.Finish();
     d.Check(c.Where());
   }
@@ -236,19 +236,19 @@ SimSpec ParseSimSpecYaml(const std::string& text, const std::string& where) {
         d.names.push_back(e.as<std::string>());
       }
     }
-    d.wobble_shift_mm = c.GetDouble("wobble_shift_mm", d.wobble_shift_mm);
-    d.wobble_tilt_deg = c.GetDouble("wobble_tilt_deg", d.wobble_tilt_deg);
-    d.cup_diameter_mm = c.GetDouble("cup_diameter_mm", d.cup_diameter_mm);
-    d.cup_height_mm = c.GetDouble("cup_height_mm", d.cup_height_mm);
-    d.cup_albedo = c.GetDouble("cup_albedo", d.cup_albedo);
-    d.sphere_diameter_mm = c.GetDouble("sphere_diameter_mm", d.sphere_diameter_mm);
-    d.ballbar_sphere_diameter_mm = c.GetDouble("ballbar_sphere_diameter_mm", d.ballbar_sphere_diameter_mm);
-    d.ballbar_distance_mm = c.GetDouble("ballbar_distance_mm", d.ballbar_distance_mm);
+    c.Read("wobble_shift_mm", &d.wobble_shift_mm);
+    c.Read("wobble_tilt_deg", &d.wobble_tilt_deg);
+    c.Read("cup_diameter_mm", &d.cup_diameter_mm);
+    c.Read("cup_height_mm", &d.cup_height_mm);
+    c.Read("cup_albedo", &d.cup_albedo);
+    c.Read("sphere_diameter_mm", &d.sphere_diameter_mm);
+    c.Read("ballbar_sphere_diameter_mm", &d.ballbar_sphere_diameter_mm);
+    c.Read("ballbar_distance_mm", &d.ballbar_distance_mm);
     d.plate_size_mm = GetVec3(c, "plate_size_mm", d.plate_size_mm);
     d.tuber_semi_axes_mm = GetVec3(c, "tuber_semi_axes_mm", d.tuber_semi_axes_mm);
-    d.tuber_bump = c.GetDouble("tuber_bump", d.tuber_bump);
-    d.artifact_albedo = c.GetDouble("artifact_albedo", d.artifact_albedo);
-    d.tuber_albedo = c.GetDouble("tuber_albedo", d.tuber_albedo);
+    c.Read("tuber_bump", &d.tuber_bump);
+    c.Read("artifact_albedo", &d.artifact_albedo);
+    c.Read("tuber_albedo", &d.tuber_albedo);
     c.Finish();
     d.Check(c.Where());
   }

@@ -29,6 +29,12 @@ class YamlMap {
   int GetInt(const std::string& key);
   int GetInt(const std::string& key, int default_value);
   bool GetBool(const std::string& key, bool default_value);
+  // An optional key read into *value, which holds its default and keeps it
+  // when the key is absent: the field is named once, so a key cannot be read
+  // into one field with another's default. Bad values throw as the getters.
+  void Read(const std::string& key, double* value) { *value = GetDouble(key, *value); }
+  void Read(const std::string& key, int* value) { *value = GetInt(key, *value); }
+  void Read(const std::string& key, bool* value) { *value = GetBool(key, *value); }
   std::string GetString(const std::string& key);
   std::string GetString(const std::string& key, const std::string& default_value);
   // A flat sequence of finite numbers; `expected_size` < 0 accepts any length.

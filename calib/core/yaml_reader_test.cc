@@ -34,6 +34,32 @@ TEST(YamlMap, DefaultsCountAsRead) {
   EXPECT_NO_THROW(m.Finish());
 }
 
+TEST(YamlMap, ReadKeepsTheDefaultOfAnAbsentKeyAndNamesABadOne) {
+  YamlMap m = YamlMap::LoadString("n: 7\nx: 2.5\nflag: false\nbad_int: 1.5\nbad_bool: maybe\n", "f.yaml");
+  int n = 1, absent_int = 4;
+  double x = 0.5, absent_double = 9.25;
+  bool flag = true, absent_bool = true;
+  m.Read("n", &n);
+  m.Read("x", &x);
+  m.Read("flag", &flag);
+  m.Read("no_int", &absent_int);
+  m.Read("no_double", &absent_double);
+  m.Read("no_bool", &absent_bool);
+  EXPECT_EQ(n, 7);
+  EXPECT_EQ(x, 2.5);
+  EXPECT_FALSE(flag);
+  EXPECT_EQ(absent_int, 4);
+  EXPECT_EQ(absent_double, 9.25);
+  EXPECT_TRUE(absent_bool);
+  int bad_int = 3;
+  bool bad_bool = true;
+  EXPECT_EQ(InputErrorMessage([&] { m.Read("bad_int", &bad_int); }), "f.yaml: bad_int: expected an integer");
+  EXPECT_EQ(InputErrorMessage([&] { m.Read("bad_bool", &bad_bool); }), "f.yaml: bad_bool: expected true or false");
+  EXPECT_EQ(bad_int, 3);  // a value that does not parse leaves the field as it was
+  EXPECT_TRUE(bad_bool);
+  EXPECT_NO_THROW(m.Finish());  // every key was read, the absent ones too
+}
+
 TEST(YamlMap, SyntaxErrorsAreInputErrors) {
   EXPECT_THROW(YamlMap::LoadString("a: [1, 2\n", "f.yaml"), InputError);
   EXPECT_THROW(YamlMap::LoadString("- just a list\n", "f.yaml"), InputError);
