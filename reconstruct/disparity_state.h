@@ -51,8 +51,9 @@ struct DisparityState {
 };
 
 // Withdraws the point at left pixel (x, y), for the reason `why`: no
-// disparity (+inf), confidence 0, status `why`. The one way the tests
-// after the match drop a point, so the three maps always agree.
+// disparity (+inf), confidence 0, status `why`. How the tests after the
+// match (and the line index's re-refinement) drop a point, so the three
+// maps always agree.
 inline void DropPoint(int x, int y, PixelStatus why, DisparityState* state) {
   state->disparity_px.at<float>(y, x) = std::numeric_limits<float>::infinity();
   state->confidence.at<float>(y, x) = 0;

@@ -57,7 +57,7 @@ TEST(YamlMap, ReadKeepsTheDefaultOfAnAbsentKeyAndNamesABadOne) {
   EXPECT_EQ(InputErrorMessage([&] { m.Read("bad_bool", &bad_bool); }), "f.yaml: bad_bool: expected true or false");
   EXPECT_EQ(bad_int, 3);  // a value that does not parse leaves the field as it was
   EXPECT_TRUE(bad_bool);
-  EXPECT_NO_THROW(m.Finish());  // every key was read, the absent ones too
+  EXPECT_NO_THROW(m.Finish());  // the file's keys were all read, the two bad ones included
 }
 
 TEST(YamlMap, SyntaxErrorsAreInputErrors) {
