@@ -8,6 +8,7 @@
 
 #include "calib/core/input_error.h"
 #include "reconstruct/footprint_sample.h"
+#include "reconstruct/parallel_for.h"
 
 namespace stereorig {
 
@@ -176,14 +177,21 @@ class LineIndexer {
   // The row offset of the tall-window fit over `sample`, each started from
   // its disparity + shift.
   Vernier Read(const std::vector<Start>& sample, double shift) const {
+    std::vector<RowOffsetResult> fits(sample.size());
+    ParallelForChunks(int(sample.size()), o_.num_threads, [&](int begin, int end) {
+      for (int k = begin; k < end; ++k) {
+        const Start& s = sample[size_t(k)];
+        fits[size_t(k)] = RefineDisparityAndRowOffset(left_, right_, s.i % cols_, s.i / cols_, s.d + shift, s.slope_x,
+                                                      s.slope_y, tall_);
+      }
+    });
     double sum = 0, sum2 = 0, sum_shift = 0;
     int n = 0;
-    for (const Start& s : sample) {
-      const RowOffsetResult r = RefineDisparityAndRowOffset(left_, right_, s.i % cols_, s.i / cols_, s.d + shift,
-                                                            s.slope_x, s.slope_y, tall_);
+    for (size_t k = 0; k < sample.size(); ++k) {  // in the samples' order
+      const RowOffsetResult& r = fits[k];
       if (!r.ok) continue;
       sum += r.row_offset_px, sum2 += r.row_offset_px * r.row_offset_px;
-      sum_shift += r.disparity_px - s.d;
+      sum_shift += r.disparity_px - sample[k].d;
       ++n;
     }
     Vernier v;
@@ -198,12 +206,17 @@ class LineIndexer {
 
   // Mean ZNCC of the matcher's own refinement from disparity + shift.
   double MeanZncc(const std::vector<Start>& sample, double shift) const {
+    std::vector<double> zncc(sample.size());
+    ParallelForChunks(int(sample.size()), o_.num_threads, [&](int begin, int end) {
+      for (int k = begin; k < end; ++k) {
+        const Start& s = sample[size_t(k)];
+        const SubpixelResult r = RefineDisparity(left_, right_, s.i % cols_, s.i / cols_, s.d + shift, s.slope_x,
+                                                 s.slope_y, accept_.subpixel);
+        zncc[size_t(k)] = r.ok ? r.zncc : 0.0;
+      }
+    });
     double sum = 0;
-    for (const Start& s : sample) {
-      const SubpixelResult r =
-          RefineDisparity(left_, right_, s.i % cols_, s.i / cols_, s.d + shift, s.slope_x, s.slope_y, accept_.subpixel);
-      sum += r.ok ? r.zncc : 0.0;
-    }
+    for (double z : zncc) sum += z;  // in the samples' order
     return sum / double(sample.size());
   }
 
@@ -212,25 +225,31 @@ class LineIndexer {
   // other alignments are a period away), keeping the best correlation.
   void Move(const std::vector<int>& pixels, double shift) {
     changed_ = true;
-    for (int i : pixels) {
-      const int y = i / cols_, x = i % cols_;
-      float& d = state_->disparity_px.at<float>(y, x);
-      if (!std::isfinite(d)) continue;
-      SubpixelResult r;
-      for (int k = -2; k <= 2; ++k) {
-        const SubpixelResult rk =
-            RefineDisparity(left_, right_, x, y, d + shift + k, SlopeX(i), SlopeY(i), accept_.subpixel);
-        if (rk.ok && (!r.ok || rk.zncc > r.zncc)) r = rk;
-      }
-      const PixelStatus why = Accept(left_, right_, x, y, SlopeX(i), SlopeY(i), r, accept_);
-      if (why != PixelStatus::kPoint) {
-        DropPoint(x, y, why, state_);
-        continue;
-      }
-      d = float(r.disparity_px);
-      state_->confidence.at<float>(y, x) = float(std::clamp(r.zncc, 0.0, 1.0));
-      state_->status.at<uint8_t>(y, x) = uint8_t(PixelStatus::kPoint);
+    // Each pixel reads and writes only its own state.
+    ParallelForChunks(int(pixels.size()), o_.num_threads, [&](int begin, int end) {
+      for (int k = begin; k < end; ++k) MovePixel(pixels[size_t(k)], shift);
+    });
+  }
+
+  // Move() for pixel i.
+  void MovePixel(int i, double shift) {
+    const int y = i / cols_, x = i % cols_;
+    float& d = state_->disparity_px.at<float>(y, x);
+    if (!std::isfinite(d)) return;
+    SubpixelResult r;
+    for (int k = -2; k <= 2; ++k) {
+      const SubpixelResult rk =
+          RefineDisparity(left_, right_, x, y, d + shift + k, SlopeX(i), SlopeY(i), accept_.subpixel);
+      if (rk.ok && (!r.ok || rk.zncc > r.zncc)) r = rk;
     }
+    const PixelStatus why = Accept(left_, right_, x, y, SlopeX(i), SlopeY(i), r, accept_);
+    if (why != PixelStatus::kPoint) {
+      DropPoint(x, y, why, state_);
+      return;
+    }
+    d = float(r.disparity_px);
+    state_->confidence.at<float>(y, x) = float(std::clamp(r.zncc, 0.0, 1.0));
+    state_->status.at<uint8_t>(y, x) = uint8_t(PixelStatus::kPoint);
   }
 
   // Drops every pixel of `pixels` (PixelStatus::kWrongLine).

@@ -99,6 +99,10 @@ struct LineIndexOptions {
   // speckle-0.4 ball bar's module 1 kept one period off (std 1.3 mm) under 2
   // of 6 option controls, 0 of 6 with the alignments always read.
   bool quick_keep = true;
+  // Threads for a component's fits (its samples at one shift, its pixels
+  // when moved), summed in the samples' order: the same result on any
+  // number. Not a YAML key: the matcher's num_threads.
+  int num_threads = 1;
   // How sure the vernier must be, in standard errors of its reading. A
   // component is kept without reading the other alignments only if its
   // reading is within max_row_offset_px by this many standard errors; after

@@ -420,6 +420,7 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
     RefineAcceptance grow_accept = accept;
     grow_accept.min_zncc = GrowMinZncc(state.disparity_px, state.confidence, roi, o.grow, accept.min_zncc);
     LineIndexOptions line_index = o.line_index;
+    line_index.num_threads = o.num_threads;
     const bool floor_bites = o.grow.noise_zncc_factor > 0 && grow_accept.min_zncc < accept.min_zncc;
     if (o.grow.noise_zncc_factor > 0 && !floor_bites) line_index.area_per_sample_px = 0;
     if (floor_bites && line_index.lattice_sampling) line_index.quick_keep = false;

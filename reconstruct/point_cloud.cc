@@ -10,6 +10,14 @@ void PointCloud::Reserve(size_t points) {
   confidence.reserve(points);
 }
 
+void PointCloud::Resize(size_t points) {
+  xyz_mm.resize(points);
+  normal.resize(points);
+  intensity.resize(points);
+  module.resize(points);
+  confidence.resize(points);
+}
+
 void PointCloud::Append(const PointCloud& o) {
   xyz_mm.insert(xyz_mm.end(), o.xyz_mm.begin(), o.xyz_mm.end());
   normal.insert(normal.end(), o.normal.begin(), o.normal.end());

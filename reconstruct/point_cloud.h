@@ -20,6 +20,7 @@ struct PointCloud {
   std::vector<float> confidence;        // [0, 1]
   size_t size() const { return xyz_mm.size(); }
   void Reserve(size_t points);  // capacity for `points` in every field
+  void Resize(size_t points);   // `points` in every field; new ones uninitialised (Eigen) or zero
   void Append(const PointCloud& other);
 };
 

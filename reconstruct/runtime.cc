@@ -243,25 +243,40 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
   const Eigen::Vector3d hi = volume_center_mm_ + 0.5 * options_.volume_size_mm;
   const Eigen::Matrix3d r_ref = plan.reference_from_module.rotation();
   const Eigen::Vector3d t_ref = plan.reference_from_module.translation_mm();
-  for (int y = r.y; y < r.y + r.height; ++y) {
-    const float* d = match.disparity_px.ptr<float>(y);
-    const float* c = match.confidence.ptr<float>(y);
-    cv::Vec3f* g = grid.ptr<cv::Vec3f>(y - r.y);  // g[x - r.x]: no pointer before the row's start
-    uint8_t* st = status.ptr<uint8_t>(y);
-    for (int x = r.x; x < r.x + r.width; ++x) {
-      if (!std::isfinite(d[x])) continue;
-      if (c[x] < options_.min_confidence) {
-        st[x] = uint8_t(PixelStatus::kLowConfidence);
-        continue;
+  // Rows in parallel (each row's kept columns apart), then listed in row
+  // order: the same list as one pass down the rows. The steps from here to
+  // the cloud run last in the module, often while the other module is done
+  // and its core free.
+  std::vector<std::vector<int>> kept_x(size_t(r.height));
+  ParallelForChunks(r.height, options_.match.num_threads, [&](int begin, int end) {
+    for (int y = r.y + begin; y < r.y + end; ++y) {
+      const float* d = match.disparity_px.ptr<float>(y);
+      const float* c = match.confidence.ptr<float>(y);
+      cv::Vec3f* g = grid.ptr<cv::Vec3f>(y - r.y);  // g[x - r.x]: no pointer before the row's start
+      uint8_t* st = status.ptr<uint8_t>(y);
+      std::vector<int>& row_kept = kept_x[size_t(y - r.y)];
+      for (int x = r.x; x < r.x + r.width; ++x) {
+        if (!std::isfinite(d[x])) continue;
+        if (c[x] < options_.min_confidence) {
+          st[x] = uint8_t(PixelStatus::kLowConfidence);
+          continue;
+        }
+        const Eigen::Vector3d p = r_ref * plan.geometry.Triangulate(x, y, d[x]) + t_ref;
+        if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) {  // range: the volume
+          st[x] = uint8_t(PixelStatus::kOutsideVolume);
+          continue;
+        }
+        g[x - r.x] = cv::Vec3f(float(p.x()), float(p.y()), float(p.z()));
+        row_kept.push_back(x);
       }
-      const Eigen::Vector3d p = r_ref * plan.geometry.Triangulate(x, y, d[x]) + t_ref;
-      if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) {  // range: the volume
-        st[x] = uint8_t(PixelStatus::kOutsideVolume);
-        continue;
-      }
-      g[x - r.x] = cv::Vec3f(float(p.x()), float(p.y()), float(p.z()));
-      kept.emplace_back(x, y);
     }
+  });
+  {
+    size_t n = 0;
+    for (const std::vector<int>& row : kept_x) n += row.size();
+    kept.reserve(n);
+    for (int yy = 0; yy < r.height; ++yy)
+      for (int x : kept_x[size_t(yy)]) kept.emplace_back(x, r.y + yy);
   }
   auto grid_at = [&](const cv::Point& q) -> cv::Vec3f& { return grid.at<cv::Vec3f>(q.y - r.y, q.x - r.x); };
   // Object size: drop points farther than object_size_mm from the cloud's
@@ -307,32 +322,38 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
     const cv::Vec3f* p = grid.ptr<cv::Vec3f>(int(gy)) + gx;
     return std::isnan((*p)[0]) ? nullptr : p;
   };
-  cloud->Reserve(cloud->size() + kept.size());
-  for (const cv::Point& q : kept) {
-    const int x = q.x, y = q.y;
-    const cv::Vec3f* p = &grid_at(q);
-    // Widest available symmetric or one-sided difference in each direction.
-    const cv::Vec3f *xa = at(x + s, y), *xb = at(x - s, y), *ya = at(x, y + s), *yb = at(x, y - s);
-    Eigen::Vector3f n(0, 0, 0);
-    if ((xa || xb) && (ya || yb)) {
-      const cv::Vec3f dx = (xa ? *xa : *p) - (xb ? *xb : *p);
-      const cv::Vec3f dy = (ya ? *ya : *p) - (yb ? *yb : *p);
-      n = Eigen::Vector3f(dx[0], dx[1], dx[2]).cross(Eigen::Vector3f(dy[0], dy[1], dy[2]));
+  // Point k of `kept` is the cloud's point base + k, written by whichever
+  // thread has it: the same cloud as one pass in order.
+  const size_t base = cloud->size();
+  cloud->Resize(base + kept.size());
+  ParallelForChunks(int(kept.size()), options_.match.num_threads, [&](int begin, int end) {
+    for (int k = begin; k < end; ++k) {
+      const int x = kept[size_t(k)].x, y = kept[size_t(k)].y;
+      const cv::Vec3f* p = &grid_at(kept[size_t(k)]);
+      // Widest available symmetric or one-sided difference in each direction.
+      const cv::Vec3f *xa = at(x + s, y), *xb = at(x - s, y), *ya = at(x, y + s), *yb = at(x, y - s);
+      Eigen::Vector3f n(0, 0, 0);
+      if ((xa || xb) && (ya || yb)) {
+        const cv::Vec3f dx = (xa ? *xa : *p) - (xb ? *xb : *p);
+        const cv::Vec3f dy = (ya ? *ya : *p) - (yb ? *yb : *p);
+        n = Eigen::Vector3f(dx[0], dx[1], dx[2]).cross(Eigen::Vector3f(dy[0], dy[1], dy[2]));
+      }
+      const Eigen::Vector3f pe((*p)[0], (*p)[1], (*p)[2]);
+      if (n.norm() > 0) {
+        n.normalize();
+        if (n.dot(eye - pe) < 0) n = -n;
+      } else {
+        n = (eye - pe).normalized();  // isolated point: face the camera
+      }
+      const size_t i = base + size_t(k);
+      index.at<int>(y - r.y, x - r.x) = int(i);
+      cloud->xyz_mm[i] = pe;
+      cloud->normal[i] = n;
+      cloud->intensity[i] = left.at<uint8_t>(y, x);
+      cloud->module[i] = uint8_t(plan.module);
+      cloud->confidence[i] = match.confidence.at<float>(y, x);
     }
-    const Eigen::Vector3f pe((*p)[0], (*p)[1], (*p)[2]);
-    if (n.norm() > 0) {
-      n.normalize();
-      if (n.dot(eye - pe) < 0) n = -n;
-    } else {
-      n = (eye - pe).normalized();  // isolated point: face the camera
-    }
-    index.at<int>(y - r.y, x - r.x) = int(cloud->size());
-    cloud->xyz_mm.push_back(pe);
-    cloud->normal.push_back(n);
-    cloud->intensity.push_back(left.at<uint8_t>(y, x));
-    cloud->module.push_back(uint8_t(plan.module));
-    cloud->confidence.push_back(match.confidence.at<float>(y, x));
-  }
+  });
   report->points = int(cloud->size());
   for (int y = 0; y < lit.rows; ++y) {
     const uint8_t* l = lit.ptr<uint8_t>(y);
