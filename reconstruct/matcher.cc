@@ -460,7 +460,7 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
   // and as occluders they would hide correct points next to them.
   DropLeftViewEdge(o.left_valid, o.subpixel.half_width_px, o.subpixel.half_height_px, roi, &state);
   const ViewGaps right_gaps(o.right_valid);
-  DropRightInvisible(o.occlusion_margin_px, right_gaps, roi, &state);
+  DropRightInvisible(o.occlusion_margin_px, right_gaps, roi, &state, o.num_threads);
   // After it: the points it drops at the edge are no surface to continue.
   if (o.right_view_edge_test) DropUnverifiableAtRightViewEdge(right_gaps, accept, 1.0, roi, &state);
   DropWithoutGridLine(left, o.grid_line, int(std::ceil(o.grid_half_period_px)), roi, &state);

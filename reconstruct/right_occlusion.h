@@ -63,10 +63,14 @@ class ViewGaps {
 // PixelStatus::kOccluded. margin_px: the right-view edge's margin, > 0
 // (0 = both tests off, nothing is touched).
 // right_valid: CV_8UC1 the disparity map's size, or empty (every column of
-// the image is valid). Returns the number of pixels dropped.
-int DropRightInvisible(double margin_px, const cv::Mat& right_valid, const cv::Rect& roi, DisparityState* state);
+// the image is valid). Returns the number of pixels dropped. The rows are
+// independent: they run on up to num_threads threads (ParallelForChunks),
+// with the same result on any number.
+int DropRightInvisible(double margin_px, const cv::Mat& right_valid, const cv::Rect& roi, DisparityState* state,
+                       int num_threads = 1);
 // The same with the right view's gaps already counted (ViewGaps of that
 // mask; empty: none).
-int DropRightInvisible(double margin_px, const ViewGaps& right_gaps, const cv::Rect& roi, DisparityState* state);
+int DropRightInvisible(double margin_px, const ViewGaps& right_gaps, const cv::Rect& roi, DisparityState* state,
+                       int num_threads = 1);
 
 }  // namespace stereorig

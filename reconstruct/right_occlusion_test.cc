@@ -122,28 +122,31 @@ TEST(RightOcclusion, DropsExactlyWhatThePlainRuleDrops) {
     for (int y = 0; y < d.rows; ++y)
       for (int x = 0; x < d.cols; ++x)
         if (unit(rng) < 0.03f) valid.at<uint8_t>(y, x) = 0;
-    DisparityState s = StateOf(d);
-    const int dropped = DropRightInvisible(margin, valid, roi, &s);
-    int expected = 0, occluded = 0;
-    for (int y = roi.y; y < roi.y + roi.height; ++y)
-      for (int x = roi.x; x < roi.x + roi.width; ++x) {
-        const float dx = d.at<float>(y, x);
-        if (!std::isfinite(dx)) continue;
-        const double xr = x - dx;
-        bool outside = false;
-        for (int c = int(std::floor(xr - margin)); c <= int(std::floor(xr + margin)); ++c)
-          outside = outside || c < 0 || c >= d.cols || !valid.at<uint8_t>(y, c);
-        bool behind = false;
-        for (int xo = x + 1; xo < roi.x + roi.width; ++xo) {
-          const float o = d.at<float>(y, xo);
-          behind = behind || (std::isfinite(o) && o > dx + 1 && xo - o <= xr);
+    for (const int threads : {1, 4}) {  // the rows on one thread, or cut into chunks among several
+      SCOPED_TRACE(threads);
+      DisparityState s = StateOf(d);
+      const int dropped = DropRightInvisible(margin, valid, roi, &s, threads);
+      int expected = 0, occluded = 0;
+      for (int y = roi.y; y < roi.y + roi.height; ++y)
+        for (int x = roi.x; x < roi.x + roi.width; ++x) {
+          const float dx = d.at<float>(y, x);
+          if (!std::isfinite(dx)) continue;
+          const double xr = x - dx;
+          bool outside = false;
+          for (int c = int(std::floor(xr - margin)); c <= int(std::floor(xr + margin)); ++c)
+            outside = outside || c < 0 || c >= d.cols || !valid.at<uint8_t>(y, c);
+          bool behind = false;
+          for (int xo = x + 1; xo < roi.x + roi.width; ++xo) {
+            const float o = d.at<float>(y, xo);
+            behind = behind || (std::isfinite(o) && o > dx + 1 && xo - o <= xr);
+          }
+          expected += outside || behind;
+          occluded += behind && !outside;
+          EXPECT_EQ(Dropped(s, y, x), outside || behind) << y << " " << x;
         }
-        expected += outside || behind;
-        occluded += behind && !outside;
-        EXPECT_EQ(Dropped(s, y, x), outside || behind) << y << " " << x;
-      }
-    EXPECT_EQ(dropped, expected);
-    EXPECT_GT(occluded, 100);  // the rows do exercise the occlusion scan
+      EXPECT_EQ(dropped, expected);
+      EXPECT_GT(occluded, 100);  // the rows do exercise the occlusion scan
+    }
   }
 }
 
