@@ -181,16 +181,25 @@ FitMaps FitQuadrics(const cv::Mat& mask, const cv::Mat& values, int hw, int hh, 
     cv::Mat moment[5][5], value_moment[3][3];
     // Only the band's own rows of the column sums (not its margins).
     const cv::Range out_rows(y0 - in0, y1 - in0);
-    for (int i = 0; i <= 4; ++i) {
-      const cv::Mat row = RowMoment(band_mask, row_taps[i]);
-      for (int j = 0; i + j <= 4; ++j) moment[i][j] = ColumnMoment(row, column_taps[j], out_rows);
-    }
-    for (int i = 0; i <= 2; ++i) {
-      const cv::Mat row = RowMoment(band_values, row_taps[i]);
-      for (int j = 0; i + j <= 2; ++j) value_moment[i][j] = ColumnMoment(row, column_taps[j], out_rows);
-    }
-    const cv::Mat squares =
-        ColumnMoment(RowMoment(band_values.mul(band_values), row_taps[0]), column_taps[0], out_rows);
+    cv::Mat squares;
+    // Nine independent chains (a row filter, then its column filters), each
+    // into its own images: on the pool (OpenCV's filter2D runs on one
+    // thread), the same sums on any number of threads.
+    ParallelForChunks(9, num_threads, [&](int begin, int end) {
+      for (int chain = begin; chain < end; ++chain) {
+        if (chain < 5) {  // the mask's moments, u^i
+          const int i = chain;
+          const cv::Mat row = RowMoment(band_mask, row_taps[i]);
+          for (int j = 0; i + j <= 4; ++j) moment[i][j] = ColumnMoment(row, column_taps[j], out_rows);
+        } else if (chain < 8) {  // the values', u^i
+          const int i = chain - 5;
+          const cv::Mat row = RowMoment(band_values, row_taps[i]);
+          for (int j = 0; i + j <= 2; ++j) value_moment[i][j] = ColumnMoment(row, column_taps[j], out_rows);
+        } else {  // the values' squares
+          squares = ColumnMoment(RowMoment(band_values.mul(band_values), row_taps[0]), column_taps[0], out_rows);
+        }
+      }
+    });
     ParallelForChunks(y1 - y0, num_threads, [&](int b, int e) {
       for (int y = y0 + b; y < y0 + e; ++y) {
         const float* valid = mask.ptr<float>(y);
