@@ -60,6 +60,7 @@ int RunMatch(int argc, char** argv) {
   OutputPaths outputs;  // its folder checked before the matching runs, and that it is neither image
   outputs.Protect(left_path, "the left image (--left)");
   outputs.Protect(right_path, "the right image (--right)");
+  CheckPfmPath(out_path);
   outputs.Claim(out_path, "the disparity map (--out)");
   const cv::Mat left = ReadGreyImage(left_path), right = ReadGreyImage(right_path);
   if (left.size() != right.size()) throw InputError(right_path, "size differs from the left image");

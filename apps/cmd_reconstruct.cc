@@ -83,6 +83,7 @@ int RunReconstruct(int argc, char** argv) {
   outputs.Protect(options_path, "the options file (--options)");
   for (const std::string& image : CaptureImagePaths(capture_dir, rig))
     outputs.Protect(image, "a capture image (--capture)");
+  CheckCloudPath(out_path);
   outputs.Claim(out_path, "the cloud (--out)");
   if (!mesh_path.empty()) {
     CheckMeshPath(mesh_path);

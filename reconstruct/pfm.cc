@@ -84,7 +84,14 @@ cv::Mat DecodePfm(const std::string& bytes, const std::string& where) {
   return image;
 }
 
-void WritePfm(const cv::Mat& image_f32, const std::string& path) { WriteFileAtomically(path, EncodePfm(image_f32)); }
+void WritePfm(const cv::Mat& image_f32, const std::string& path) {
+  CheckPfmPath(path);
+  WriteFileAtomically(path, EncodePfm(image_f32));
+}
+
+void CheckPfmPath(const std::string& path) {
+  if (!path.ends_with(".pfm")) throw InputError(path, "disparity output must end in .pfm (it is written as PFM)");
+}
 
 cv::Mat ReadPfm(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

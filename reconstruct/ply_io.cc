@@ -22,10 +22,6 @@ void Put(std::string& out, T v) {
   out.append(b, sizeof(T));
 }
 
-bool EndsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 }  // namespace
 
 std::string EncodeCloudPly(const PointCloud& c) {
@@ -48,18 +44,23 @@ std::string EncodeCloudPly(const PointCloud& c) {
 }
 
 void WriteCloudPly(const PointCloud& cloud, const std::string& path) {
+  CheckCloudPath(path);
   WriteFileAtomically(path, EncodeCloudPly(cloud));
 }
 
+void CheckCloudPath(const std::string& path) {
+  if (!path.ends_with(".ply")) throw InputError(path, "cloud output must end in .ply (it is written as binary PLY)");
+}
+
 void CheckMeshPath(const std::string& path) {
-  if (!EndsWith(path, ".ply") && !EndsWith(path, ".stl"))
+  if (!path.ends_with(".ply") && !path.ends_with(".stl"))
     throw InputError(path, "mesh output must end in .ply or .stl");
 }
 
 void WriteMesh(const Mesh& m, const std::string& path) {
   CheckMeshPath(path);
   std::string out;
-  if (EndsWith(path, ".stl")) {
+  if (path.ends_with(".stl")) {
     out.assign(80, ' ');
     out.replace(0, 40, "stereorig mesh, reference frame, mm     ");
     Put(out, uint32_t(m.triangles.size()));

@@ -14,7 +14,12 @@
 namespace stereorig {
 
 std::string EncodeCloudPly(const PointCloud& cloud);
+// Binary PLY; InputError unless `path` ends in .ply (CheckCloudPath).
 void WriteCloudPly(const PointCloud& cloud, const std::string& path);
+// Throws InputError unless `path` ends in .ply: a cloud is always PLY, and
+// "cloud.xyz" or "cloud.pcd" would otherwise get PLY bytes a reader of that
+// format cannot parse. Commands call it before any work.
+void CheckCloudPath(const std::string& path);
 // `path` ending in .stl -> binary STL, .ply -> binary PLY; else InputError.
 void WriteMesh(const Mesh& mesh, const std::string& path);
 // Throws InputError unless `path` ends in .ply or .stl.

@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "calib/core/rig_file.h"
@@ -79,6 +81,29 @@ TEST(Cli, UnreadableImagesAreNamedInOneLine) {
     EXPECT_EQ(r.err.find("WARN"), std::string::npos) << r.err;
     EXPECT_FALSE(std::filesystem::exists(dir + "/d.pfm"));
   }
+}
+
+// The disparity map is always PFM: `--out d.png` would hold PFM bytes an
+// image viewer cannot open. (Before, it was written there and match exited
+// 0.) Refused before the matching, in one line naming the path.
+TEST(Cli, MatchRefusesADisparityMapNotNamedPfm) {
+  const std::string dir = ::testing::TempDir() + "/cli_match_out";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const cv::Mat grey(32, 64, CV_8UC1, cv::Scalar(100));
+  ASSERT_TRUE(cv::imwrite(dir + "/l.png", grey));
+  for (const char* name : {"/d.png", "/d.tiff"}) {
+    const Result r = RunCli("match --left " + dir + "/l.png --right " + dir +
+                            "/l.png --min-disparity 0 --num-disparities 16 --out " + dir + name);
+    EXPECT_EQ(r.code, 2) << name;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(dir + name + ": disparity output must end in .pfm"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir + name)) << name;
+  }
+  const Result ok = RunCli("match --left " + dir + "/l.png --right " + dir +
+                           "/l.png --min-disparity 0 --num-disparities 16 --out " + dir + "/d.pfm");
+  EXPECT_EQ(ok.code, 0) << ok.err;
+  EXPECT_TRUE(std::filesystem::exists(dir + "/d.pfm"));
 }
 
 // `rig --truth`: judged against itself every figure is 0; with module 1

@@ -295,6 +295,20 @@ TEST_F(ReconstructCli, BadOptionsOrMeshNameExitTwo) {
   ExpectNoOutput();
 }
 
+// The cloud is always binary PLY: a cloud named for another format would
+// hold bytes its reader cannot parse. (Before, `--out cloud.xyz` wrote PLY
+// there and exited 0.) Refused before any work, in one line naming it.
+TEST_F(ReconstructCli, ACloudNotNamedPlyExitsTwo) {
+  for (const char* name : {"/out.xyz", "/out.pcd", "/out.ply.tmp"}) {
+    const testing::Result r =
+        testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture --out " + dir_ + name);
+    EXPECT_EQ(r.code, 2) << name;
+    EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(dir_ + name + ": cloud output must end in .ply"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir_ + name)) << name;
+  }
+}
+
 // Where each output goes is checked before any work (apps/output_paths.h):
 // a mesh in a missing folder, or two outputs naming one file, exit 2 with
 // one line naming the path, and nothing is written. (Before, the whole
