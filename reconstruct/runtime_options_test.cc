@@ -25,6 +25,17 @@ void ExpectEachRejectedNamingItsKey(const std::pair<const char*, const char*> (&
   }
 }
 
+// Every key commented out: the built-in defaults, as with no file.
+TEST(RuntimeOptions, AFileOfCommentsOnlyGivesTheDefaults) {
+  const RuntimeOptions d;
+  const RuntimeOptions o = ParseRuntimeOptions("# object_size_mm: 80\n# match:\n#   num_threads: 1\n", "c.yaml");
+  EXPECT_EQ(o.object_size_mm, d.object_size_mm);
+  EXPECT_EQ(o.volume_size_mm, d.volume_size_mm);
+  EXPECT_EQ(o.match.num_threads, d.match.num_threads);
+  EXPECT_EQ(o.match.min_zncc, d.match.min_zncc);
+  EXPECT_EQ(o.shape_model, d.shape_model);
+}
+
 TEST(RuntimeOptions, ReadsAndChecksTheFillKeys) {
   const RuntimeOptions d = ParseRuntimeOptions("shape_model: ellipsoid\n", "defaults.yaml");
   EXPECT_TRUE(d.fill_follow_residuals);

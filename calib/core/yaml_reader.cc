@@ -15,6 +15,7 @@ YamlMap YamlMap::LoadFile(const std::string& path) {
   } catch (const YAML::Exception& e) {
     throw InputError(path, "not valid YAML: " + e.msg + " (line " + std::to_string(e.mark.line + 1) + ")");
   }
+  if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);  // empty, or comments only: no keys
   if (!root.IsMap()) throw InputError(path, "expected a YAML mapping at the top level");
   return YamlMap(root, path, "");
 }
@@ -26,6 +27,7 @@ YamlMap YamlMap::LoadString(const std::string& text, const std::string& where) {
   } catch (const YAML::Exception& e) {
     throw InputError(where, "not valid YAML: " + e.msg);
   }
+  if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
   if (!root.IsMap()) throw InputError(where, "expected a YAML mapping at the top level");
   return YamlMap(root, where, "");
 }

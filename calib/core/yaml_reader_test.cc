@@ -60,6 +60,19 @@ TEST(YamlMap, ReadKeepsTheDefaultOfAnAbsentKeyAndNamesABadOne) {
   EXPECT_NO_THROW(m.Finish());  // the file's keys were all read, the two bad ones included
 }
 
+// An options file with every key commented out means "the defaults" (it
+// was refused as "expected a YAML mapping at the top level"); a file that
+// needs keys then names the first one missing.
+TEST(YamlMap, AnEmptyOrCommentOnlyDocumentHasNoKeys) {
+  for (const char* text : {"", "# a: 1\n# b: 2\n", "---\n"}) {
+    YamlMap m = YamlMap::LoadString(text, "f.yaml");
+    EXPECT_FALSE(m.Has("a")) << text;
+    EXPECT_EQ(m.GetInt("a", 7), 7) << text;
+    EXPECT_EQ(InputErrorMessage([&] { m.GetInt("b"); }), "f.yaml: b: missing key") << text;
+    EXPECT_NO_THROW(m.Finish()) << text;
+  }
+}
+
 TEST(YamlMap, SyntaxErrorsAreInputErrors) {
   EXPECT_THROW(YamlMap::LoadString("a: [1, 2\n", "f.yaml"), InputError);
   EXPECT_THROW(YamlMap::LoadString("- just a list\n", "f.yaml"), InputError);
