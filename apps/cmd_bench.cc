@@ -96,9 +96,12 @@ struct Pipeline {
 // Both pipelines run interleaved (ours, baseline, ours, ...), capture by
 // capture, so a change in the machine's load hits both alike; objects/s is
 // objects over the summed wall time of each pipeline's own Process() calls.
+// Progress on stderr after each run over the scenes (a dataset's default
+// 5 scenes x 3 runs take ~1 min), outside the timed calls.
 void BenchInterleaved(std::vector<Pipeline>& pipelines, const std::vector<Scene>& scenes, int runs) {
+  STEREORIG_CHECK(pipelines.size() >= 2);  // ours, then the SGBM pipeline
   for (Pipeline& p : pipelines) p.runtime->Process(scenes[0].images, false);  // warm-up
-  for (int r = 0; r < runs; ++r)
+  for (int r = 0; r < runs; ++r) {
     for (const Scene& s : scenes)
       for (Pipeline& p : pipelines) {
         const auto t0 = Clock::now();
@@ -113,6 +116,10 @@ void BenchInterleaved(std::vector<Pipeline>& pipelines, const std::vector<Scene>
         for (const ModuleReport& m : rec.modules)
           for (const auto& [k, v] : m.times_ms) p.steps["module" + std::to_string(m.module) + "." + k].push_back(v);
       }
+    std::fprintf(stderr, "bench: [%d/%d] run %d timed; so far ours %.1f objects/s, the SGBM pipeline %.1f\n", r + 1,
+                 runs, r + 1, pipelines[0].objects / pipelines[0].busy_s, pipelines[1].objects / pipelines[1].busy_s);
+  }
+  std::fprintf(stderr, "bench: meshing, hole filling and scoring each pipeline's clouds (untimed)...\n");
 }
 
 // One pipeline's JSON section: speed, step medians; then, untimed by the

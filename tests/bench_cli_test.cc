@@ -26,6 +26,9 @@ TEST(BenchCli, ReportsBothPipelinesAccuracyAndAHeapKeptBetweenCaptures) {
   const testing::Result r = RunCli("bench --runs 2 --report " + report);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("page faults/object"), std::string::npos) << r.out;
+  // Progress on stderr after each run (a dataset's runs take ~1 min).
+  EXPECT_NE(r.err.find("bench: [1/2] run 1 timed; so far ours "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("bench: [2/2] run 2 timed"), std::string::npos) << r.err;
   std::ifstream f(report);
   ASSERT_TRUE(f.good()) << report;
   const nlohmann::json j = nlohmann::json::parse(f);
