@@ -99,7 +99,8 @@ struct Pipeline {
 // Progress on stderr after each run over the scenes (a dataset's default
 // 5 scenes x 3 runs take ~1 min), outside the timed calls.
 void BenchInterleaved(std::vector<Pipeline>& pipelines, const std::vector<Scene>& scenes, int runs) {
-  STEREORIG_CHECK(pipelines.size() >= 2);  // ours, then the SGBM pipeline
+  // pipelines[0]: ours, [1]: the SGBM pipeline (the progress line names both).
+  STEREORIG_CHECK(pipelines.size() >= 2);
   for (Pipeline& p : pipelines) p.runtime->Process(scenes[0].images, false);  // warm-up
   for (int r = 0; r < runs; ++r) {
     for (const Scene& s : scenes)
