@@ -96,8 +96,8 @@ struct Pipeline {
 // Both pipelines run interleaved (ours, baseline, ours, ...), capture by
 // capture, so a change in the machine's load hits both alike; objects/s is
 // objects over the summed wall time of each pipeline's own Process() calls.
-// Progress on stderr after each run over the scenes (a dataset's default
-// 5 scenes x 3 runs take ~1 min), outside the timed calls.
+// Progress on stderr after each run over the scenes (the five default
+// scenes take ~20 s a run), outside the timed calls.
 void BenchInterleaved(std::vector<Pipeline>& pipelines, const std::vector<Scene>& scenes, int runs) {
   // pipelines[0]: ours, [1]: the SGBM pipeline (the progress line names both).
   STEREORIG_CHECK(pipelines.size() >= 2);

@@ -60,8 +60,8 @@ int RunMatch(int argc, char** argv) {
   OutputPaths outputs;  // its folder checked before the matching runs, and that it is neither image
   outputs.Protect(left_path, "the left image (--left)");
   outputs.Protect(right_path, "the right image (--right)");
-  CheckPfmPath(out_path);
   outputs.Claim(out_path, "the disparity map (--out)");
+  CheckPfmPath(out_path);  // after the claim: "is the left image" says more than "not .pfm" would
   const cv::Mat left = ReadGreyImage(left_path), right = ReadGreyImage(right_path);
   if (left.size() != right.size()) throw InputError(right_path, "size differs from the left image");
 

@@ -83,8 +83,8 @@ int RunReconstruct(int argc, char** argv) {
   outputs.Protect(options_path, "the options file (--options)");
   for (const std::string& image : CaptureImagePaths(capture_dir, rig))
     outputs.Protect(image, "a capture image (--capture)");
-  CheckCloudPath(out_path);
   outputs.Claim(out_path, "the cloud (--out)");
+  CheckCloudPath(out_path);  // after the claim: "is an input" says more than "not .ply" would
   if (!mesh_path.empty()) {
     CheckMeshPath(mesh_path);
     outputs.Claim(mesh_path, "the mesh (--mesh)");

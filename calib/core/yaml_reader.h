@@ -18,9 +18,10 @@ namespace stereorig {
 class YamlMap {
  public:
   // Parses `path`; throws InputError on a missing file or a syntax error.
-  // An empty document (an empty file, or comments only: an options file
-  // with every key commented out) is a mapping with no keys: every optional
-  // key takes its default, and a required one is reported missing.
+  // An empty document (an empty file, comments only, as an options file
+  // with every key commented out, or a bare `null` / `~`) is a mapping
+  // with no keys: every optional key takes its default, and a required one
+  // is reported missing.
   static YamlMap LoadFile(const std::string& path);
   static YamlMap LoadString(const std::string& text, const std::string& where);
   // `node` must be a mapping; `where` is "file: key.path" for messages.
