@@ -188,12 +188,12 @@ void RemoveSpeckles(cv::Mat disparity_px, const MatchOptions& o) {
   RemoveSpeckleBlobs(disparity_px, o.speckle_window_px, o.speckle_range_px);
 }
 
-// The same on the matcher's map within `roi`; with speckle_along_slopes,
-// neighbours compared along the local planes' slopes
-// (RemoveSpeckleBlobsAlongSlopes): a surface sloping more than
-// speckle_range_px per px is one blob, not strips.
-void RemoveSpeckles(DisparityState* state, const cv::Rect& roi, const MatchOptions& o) {
-  if (!o.speckle_along_slopes) return RemoveSpeckles(state->disparity_px(roi), o);
+// The same on the matcher's map within `roi`; along_slopes: neighbours
+// compared along the local planes' slopes (RemoveSpeckleBlobsAlongSlopes):
+// a surface sloping more than speckle_range_px per px is one blob, not
+// strips.
+void RemoveSpeckles(DisparityState* state, const cv::Rect& roi, const MatchOptions& o, bool along_slopes) {
+  if (!along_slopes) return RemoveSpeckles(state->disparity_px(roi), o);
   if (o.speckle_window_px <= 0) return;
   RemoveSpeckleBlobsAlongSlopes(state->disparity_px(roi), state->slope_x(roi), state->slope_y(roi), o.speckle_window_px,
                                 o.speckle_range_px);
@@ -407,7 +407,7 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
   // Seeds for the line-index test and growing: only the blobs the speckle
   // filter keeps (a small mismatched blob would otherwise grow into a large
   // wrong surface); the filter runs again on the grown map.
-  RemoveSpeckles(&state, roi, o);  // outside the ROI nothing is valid
+  RemoveSpeckles(&state, roi, o, o.speckle_along_slopes);  // outside the ROI nothing is valid
   if (o.intensity_refinement && (o.line_index.enabled || o.grow.enabled)) {
     // Growing's ZNCC floor, from the seeds' measured decorrelation (off by
     // default: the matcher's min_zncc). With it on, the vernier's whole-
@@ -454,7 +454,8 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
     } else {
       lap("line_index_2");
     }
-    RemoveSpeckles(&state, roi, o);  // outside the ROI nothing is valid
+    // The last pass: grown steep flanks are strips under the plain rule.
+    RemoveSpeckles(&state, roi, o, o.speckle_along_slopes || o.final_speckle_along_slopes);
   }
   // The left view's edge first: its points are off by up to a few pixels,
   // and as occluders they would hide correct points next to them.

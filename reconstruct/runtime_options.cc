@@ -120,6 +120,7 @@ RuntimeOptions FromYaml(YamlMap& y) {
     m.Read("speckle_window_px", &mo.speckle_window_px);
     m.Read("speckle_range_px", &mo.speckle_range_px);
     m.Read("speckle_along_slopes", &mo.speckle_along_slopes);
+    m.Read("final_speckle_along_slopes", &mo.final_speckle_along_slopes);
     m.Read("occlusion_margin_px", &mo.occlusion_margin_px);
     m.Read("right_view_edge_test", &mo.right_view_edge_test);
     m.Read("grid_line_test", &mo.grid_line.enabled);

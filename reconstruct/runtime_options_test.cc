@@ -105,12 +105,17 @@ TEST(RuntimeOptions, ReadsAndChecksTheSubpixelColumnStep) {
   ExpectEachRejectedNamingItsKey(bad);
 }
 
-TEST(RuntimeOptions, ReadsAndChecksTheSpeckleAlongSlopesKey) {
-  EXPECT_FALSE(ParseRuntimeOptions("min_confidence: 0.5\n", "defaults.yaml").match.speckle_along_slopes);
+TEST(RuntimeOptions, ReadsAndChecksTheSpeckleAlongSlopesKeys) {
+  const RuntimeOptions d = ParseRuntimeOptions("min_confidence: 0.5\n", "defaults.yaml");
+  EXPECT_FALSE(d.match.speckle_along_slopes);
+  EXPECT_TRUE(d.match.final_speckle_along_slopes);
   EXPECT_TRUE(ParseRuntimeOptions("match:\n  speckle_along_slopes: true\n", "set.yaml").match.speckle_along_slopes);
+  EXPECT_FALSE(ParseRuntimeOptions("match:\n  final_speckle_along_slopes: false\n", "set.yaml")
+                   .match.final_speckle_along_slopes);
   const std::pair<const char*, const char*> bad[] = {
       {"match:\n  speckle_along_slopes: maybe\n", "speckle_along_slopes"},
-      {"match:\n  speckle_along_slope: true\n", "speckle_along_slope"}};
+      {"match:\n  speckle_along_slope: true\n", "speckle_along_slope"},
+      {"match:\n  final_speckle_along_slopes: 2\n", "final_speckle_along_slopes"}};
   ExpectEachRejectedNamingItsKey(bad);
 }
 
