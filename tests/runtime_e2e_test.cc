@@ -271,7 +271,8 @@ TEST(RuntimeOnAFreshRealization, BallBarAndPlateMeetTheAccuracyTargets) {
 // matters: the default plate alone at seed 35, truth rig. Module 0's right
 // sensor ends beside the plate, and without the test strips of points a grid
 // period off stay beside its edge. Measured (`stereorig score`, the same
-// realization, match.right_view_edge_test false / true): module 0 std 0.153
+// realization, match.right_view_edge_test false / true; before session 28's
+// last speckle pass along the slopes): module 0 std 0.153
 // -> 0.077 mm, mean |e| 0.064 -> 0.059 mm; module 1 0.071 mm both ways; fill
 // 96.8 / 97.3 % both ways. (Seed 10 read 0.179 -> 0.073 mm before the seam
 // join's spread went to 3 px, which now moves its strips as well.) Asserted:
@@ -297,7 +298,8 @@ TEST(RuntimeOnAFreshRealization, ThePlateBesideTheRightViewsEdgeKeepsNoStripAPer
 // matters: the default ball bar alone at seed 16, truth rig. Above the grid's
 // envelope the balls are lit by ambient light only; growing carried the
 // limbs' disparity into that band along their outlines, points 1-1.5 mm off.
-// Measured (`stereorig score`, the same realization, match.grid_line_test
+// Measured (before session 28's last speckle pass along the slopes;
+// `stereorig score`, the same realization, match.grid_line_test
 // false / true): module 0 std 0.105 -> 0.083 mm, module 1 0.119 -> 0.083 mm;
 // fill 80.3 / 82.2 % both ways (the points dropped lie outside the grid-lit
 // target). Over the ball bar alone at seeds 1-30, modules above 0.1 mm std
@@ -329,19 +331,19 @@ TEST(RuntimeOnAFreshRealization, TheBallBarKeepsNoPointOnItsOutlineBesideTheGrid
 // 91.3 %, mean |e| and std unchanged to 0.0001 mm; on the score gate's 90
 // module rows +0.21 fill points on average, none lower, std within
 // +0.0004 mm (docs/reconstruct-log.md, session 28). Asserted: each module
-// gains fill (at least 0.1 point, measured 0.3) at the gate's accuracy
-// bound (+0.002 mm), and with it both modules reach issue 5's 90 %, which
-// module 0 misses without it (the control).
+// gains fill (at least 0.1 point, measured 0.3) within the gate's accuracy
+// bound (+0.002 mm) and issue 5's targets. Not asserted: the 90 % module 0
+// now reaches, by 0.2 points (too close for a later change's noise).
 TEST(RuntimeOnAFreshRealization, TheTubersSteepFlankSurvivesTheLastSpecklePass) {
   RuntimeOptions plain;
   plain.match.final_speckle_along_slopes = false;
   const auto [off, on] = ScoreControlAndDefault("tuber", 3, plain, "plain last pass");
   ASSERT_EQ(off.fill.size(), 2u);
   ASSERT_EQ(on.fill.size(), 2u);
-  EXPECT_LT(off.fill[0].fill(), 0.90);
   for (size_t m = 0; m < 2; ++m) {
     EXPECT_GT(on.fill[m].fill(), off.fill[m].fill() + 0.001) << "module " << m;
-    EXPECT_GE(on.fill[m].fill(), 0.90) << "module " << m;
+    EXPECT_LT(on.accuracy.per_module[m].mean_abs_mm, 0.1) << "module " << m;
+    EXPECT_LT(on.accuracy.per_module[m].std_mm, 0.1) << "module " << m;
     EXPECT_LT(on.accuracy.per_module[m].mean_abs_mm, off.accuracy.per_module[m].mean_abs_mm + 0.002) << "module " << m;
     EXPECT_LT(on.accuracy.per_module[m].std_mm, off.accuracy.per_module[m].std_mm + 0.002) << "module " << m;
   }
@@ -391,7 +393,9 @@ TEST(RuntimeOnAThreeModuleRig, EveryModuleMeetsTheAccuracyTargetsInOneFrame) {
 // alone) module 1's left camera grazes it: dd/dx ~ -1.6 px/px, the right
 // view 2.6x as wide as the left. With default options module 1 keeps no
 // point (the speckle filter's 1 px reach cuts that slope into one-pixel
-// strips, each removed); with match.speckle_along_slopes it is one
+// strips, each removed; following the slopes in the last pass alone, the
+// default since session 28, does not save them: session 22 measured 0 %
+// with only that pass); with match.speckle_along_slopes it is one
 // surface. Measured with it (~7 s): fill 0.620, mean |e| 0.027 mm, std
 // 0.126 mm. Issue 5's std target (0.1 mm) is not met and not asserted: the
 // CLI's realization of this spec and seed (`stereorig simulate`, `score
