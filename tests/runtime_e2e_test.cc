@@ -81,6 +81,18 @@ ControlAndDefault ScoreControlAndDefault(const std::string& scene, int seed, con
           ReconstructAndScore(dataset, scene, label)};
 }
 
+// Both modules of the default run meet issue 5's per-module targets (mean
+// |e| and std < 0.1 mm) and keep at least min_fill_gain more fill than the
+// control (negative: lose at most that much). Both runs have two modules
+// (the caller asserts it).
+void ExpectTargetsAndFillAgainstControl(const ControlAndDefault& r, double min_fill_gain) {
+  for (size_t m = 0; m < 2; ++m) {
+    EXPECT_LT(r.on.accuracy.per_module[m].mean_abs_mm, 0.1) << "module " << m;
+    EXPECT_LT(r.on.accuracy.per_module[m].std_mm, 0.1) << "module " << m;
+    EXPECT_GT(r.on.fill[m].fill(), r.off.fill[m].fill() + min_fill_gain) << "module " << m;
+  }
+}
+
 class RuntimeOnSimulatedScenes : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -283,15 +295,11 @@ TEST(RuntimeOnAFreshRealization, BallBarAndPlateMeetTheAccuracyTargets) {
 TEST(RuntimeOnAFreshRealization, ThePlateBesideTheRightViewsEdgeKeepsNoStripAPeriodOff) {
   RuntimeOptions without_test;
   without_test.match.right_view_edge_test = false;
-  const auto [off, on] = ScoreControlAndDefault("plate", 35, without_test, "without the test");
-  ASSERT_EQ(off.fill.size(), 2u);
-  ASSERT_EQ(on.fill.size(), 2u);
-  EXPECT_GT(off.accuracy.per_module[0].std_mm, 0.1);
-  for (size_t m = 0; m < 2; ++m) {
-    EXPECT_LT(on.accuracy.per_module[m].mean_abs_mm, 0.1) << "module " << m;
-    EXPECT_LT(on.accuracy.per_module[m].std_mm, 0.1) << "module " << m;
-    EXPECT_GT(on.fill[m].fill(), off.fill[m].fill() - 0.002) << "module " << m;
-  }
+  const ControlAndDefault r = ScoreControlAndDefault("plate", 35, without_test, "without the test");
+  ASSERT_EQ(r.off.fill.size(), 2u);
+  ASSERT_EQ(r.on.fill.size(), 2u);
+  EXPECT_GT(r.off.accuracy.per_module[0].std_mm, 0.1);
+  ExpectTargetsAndFillAgainstControl(r, -0.002);
 }
 
 // The grid-line test (grid_line_support.h) on a realization where it
@@ -310,15 +318,11 @@ TEST(RuntimeOnAFreshRealization, ThePlateBesideTheRightViewsEdgeKeepsNoStripAPer
 TEST(RuntimeOnAFreshRealization, TheBallBarKeepsNoPointOnItsOutlineBesideTheGrid) {
   RuntimeOptions without_test;
   without_test.match.grid_line.enabled = false;
-  const auto [off, on] = ScoreControlAndDefault("ballbar", 16, without_test, "without the test");
-  ASSERT_EQ(off.fill.size(), 2u);
-  ASSERT_EQ(on.fill.size(), 2u);
-  EXPECT_GT(std::max(off.accuracy.per_module[0].std_mm, off.accuracy.per_module[1].std_mm), 0.1);
-  for (size_t m = 0; m < 2; ++m) {
-    EXPECT_LT(on.accuracy.per_module[m].mean_abs_mm, 0.1) << "module " << m;
-    EXPECT_LT(on.accuracy.per_module[m].std_mm, 0.1) << "module " << m;
-    EXPECT_GT(on.fill[m].fill(), off.fill[m].fill() - 0.002) << "module " << m;
-  }
+  const ControlAndDefault r = ScoreControlAndDefault("ballbar", 16, without_test, "without the test");
+  ASSERT_EQ(r.off.fill.size(), 2u);
+  ASSERT_EQ(r.on.fill.size(), 2u);
+  EXPECT_GT(std::max(r.off.accuracy.per_module[0].std_mm, r.off.accuracy.per_module[1].std_mm), 0.1);
+  ExpectTargetsAndFillAgainstControl(r, -0.002);
 }
 
 // The last speckle pass along the slopes (match.final_speckle_along_slopes)
@@ -337,15 +341,14 @@ TEST(RuntimeOnAFreshRealization, TheBallBarKeepsNoPointOnItsOutlineBesideTheGrid
 TEST(RuntimeOnAFreshRealization, TheTubersSteepFlankSurvivesTheLastSpecklePass) {
   RuntimeOptions plain;
   plain.match.final_speckle_along_slopes = false;
-  const auto [off, on] = ScoreControlAndDefault("tuber", 3, plain, "plain last pass");
-  ASSERT_EQ(off.fill.size(), 2u);
-  ASSERT_EQ(on.fill.size(), 2u);
-  for (size_t m = 0; m < 2; ++m) {
-    EXPECT_GT(on.fill[m].fill(), off.fill[m].fill() + 0.001) << "module " << m;
-    EXPECT_LT(on.accuracy.per_module[m].mean_abs_mm, 0.1) << "module " << m;
-    EXPECT_LT(on.accuracy.per_module[m].std_mm, 0.1) << "module " << m;
-    EXPECT_LT(on.accuracy.per_module[m].mean_abs_mm, off.accuracy.per_module[m].mean_abs_mm + 0.002) << "module " << m;
-    EXPECT_LT(on.accuracy.per_module[m].std_mm, off.accuracy.per_module[m].std_mm + 0.002) << "module " << m;
+  const ControlAndDefault r = ScoreControlAndDefault("tuber", 3, plain, "plain last pass");
+  ASSERT_EQ(r.off.fill.size(), 2u);
+  ASSERT_EQ(r.on.fill.size(), 2u);
+  ExpectTargetsAndFillAgainstControl(r, 0.001);
+  for (size_t m = 0; m < 2; ++m) {  // within the score gate's accuracy bound
+    const ErrorFigures &on = r.on.accuracy.per_module[m], &off = r.off.accuracy.per_module[m];
+    EXPECT_LT(on.mean_abs_mm, off.mean_abs_mm + 0.002) << "module " << m;
+    EXPECT_LT(on.std_mm, off.std_mm + 0.002) << "module " << m;
   }
 }
 
