@@ -15,9 +15,7 @@ YamlMap YamlMap::LoadFile(const std::string& path) {
   } catch (const YAML::Exception& e) {
     throw InputError(path, "not valid YAML: " + e.msg + " (line " + std::to_string(e.mark.line + 1) + ")");
   }
-  if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);  // empty, or comments only: no keys
-  if (!root.IsMap()) throw InputError(path, "expected a YAML mapping at the top level");
-  return YamlMap(root, path, "");
+  return FromDocument(root, path);
 }
 
 YamlMap YamlMap::LoadString(const std::string& text, const std::string& where) {
@@ -27,7 +25,11 @@ YamlMap YamlMap::LoadString(const std::string& text, const std::string& where) {
   } catch (const YAML::Exception& e) {
     throw InputError(where, "not valid YAML: " + e.msg);
   }
-  if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
+  return FromDocument(root, where);
+}
+
+YamlMap YamlMap::FromDocument(YAML::Node root, const std::string& where) {
+  if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);  // empty, or comments only: no keys
   if (!root.IsMap()) throw InputError(where, "expected a YAML mapping at the top level");
   return YamlMap(root, where, "");
 }

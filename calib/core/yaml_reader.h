@@ -65,6 +65,9 @@ class YamlMap {
   static Eigen::Matrix4d ToMatrix4(const YAML::Node& n, const std::string& where);
 
  private:
+  // The parsed document of LoadFile / LoadString as a mapping (a null
+  // document: one with no keys); `where` names it in errors.
+  static YamlMap FromDocument(YAML::Node root, const std::string& where);
   YAML::Node Require(const std::string& key);
 
   YAML::Node node_;
