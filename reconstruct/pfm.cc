@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "calib/core/atomic_file.h"
+#include "calib/core/file_suffix.h"
 #include "calib/core/input_error.h"
 
 namespace stereorig {
@@ -90,7 +91,8 @@ void WritePfm(const cv::Mat& image_f32, const std::string& path) {
 }
 
 void CheckPfmPath(const std::string& path) {
-  if (!path.ends_with(".pfm")) throw InputError(path, "disparity output must end in .pfm (it is written as PFM)");
+  if (!EndsWithIgnoringCase(path, ".pfm"))
+    throw InputError(path, "disparity output must end in .pfm (it is written as PFM)");
 }
 
 cv::Mat ReadPfm(const std::string& path) {

@@ -19,7 +19,8 @@ std::string EncodePfm(const cv::Mat& image_f32);
 cv::Mat DecodePfm(const std::string& bytes, const std::string& where);
 
 // File forms. Writing is atomic; reading throws InputError naming the file.
-// WritePfm throws InputError unless `path` ends in .pfm (CheckPfmPath).
+// WritePfm throws InputError unless `path` ends in .pfm, in any case
+// (CheckPfmPath).
 void WritePfm(const cv::Mat& image_f32, const std::string& path);
 // Throws InputError unless `path` ends in .pfm: "disp.png" or "disp.tiff"
 // would otherwise hold PFM bytes an image viewer cannot open. Commands call

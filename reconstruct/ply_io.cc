@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "calib/core/atomic_file.h"
+#include "calib/core/file_suffix.h"
 #include "calib/core/input_error.h"
 
 namespace stereorig {
@@ -49,18 +50,19 @@ void WriteCloudPly(const PointCloud& cloud, const std::string& path) {
 }
 
 void CheckCloudPath(const std::string& path) {
-  if (!path.ends_with(".ply")) throw InputError(path, "cloud output must end in .ply (it is written as binary PLY)");
+  if (!EndsWithIgnoringCase(path, ".ply"))
+    throw InputError(path, "cloud output must end in .ply (it is written as binary PLY)");
 }
 
 void CheckMeshPath(const std::string& path) {
-  if (!path.ends_with(".ply") && !path.ends_with(".stl"))
+  if (!EndsWithIgnoringCase(path, ".ply") && !EndsWithIgnoringCase(path, ".stl"))
     throw InputError(path, "mesh output must end in .ply or .stl");
 }
 
 void WriteMesh(const Mesh& m, const std::string& path) {
   CheckMeshPath(path);
   std::string out;
-  if (path.ends_with(".stl")) {
+  if (EndsWithIgnoringCase(path, ".stl")) {
     out.assign(80, ' ');
     out.replace(0, 40, "stereorig mesh, reference frame, mm     ");
     Put(out, uint32_t(m.triangles.size()));

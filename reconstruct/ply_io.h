@@ -15,6 +15,7 @@ namespace stereorig {
 
 std::string EncodeCloudPly(const PointCloud& cloud);
 // Binary PLY; InputError unless `path` ends in .ply (CheckCloudPath).
+// Suffixes here are read without case (.PLY, .Stl: file_suffix.h).
 void WriteCloudPly(const PointCloud& cloud, const std::string& path);
 // Throws InputError unless `path` ends in .ply: a cloud is always PLY, and
 // "cloud.xyz" or "cloud.pcd" would otherwise get PLY bytes a reader of that

@@ -104,6 +104,13 @@ TEST(Cli, MatchRefusesADisparityMapNotNamedPfm) {
                            "/l.png --min-disparity 0 --num-disparities 16 --out " + dir + "/d.pfm");
   EXPECT_EQ(ok.code, 0) << ok.err;
   EXPECT_TRUE(std::filesystem::exists(dir + "/d.pfm"));
+  // The suffix in any case ("D.PFM", as users type it) is PFM too.
+  const Result upper = RunCli("match --left " + dir + "/l.png --right " + dir +
+                              "/l.png --min-disparity 0 --num-disparities 16 --out " + dir + "/D.PFM");
+  EXPECT_EQ(upper.code, 0) << upper.err;
+  const cv::Mat by_opencv = cv::imread(dir + "/D.PFM", cv::IMREAD_UNCHANGED);  // OpenCV's own PFM reader
+  EXPECT_EQ(by_opencv.type(), CV_32FC1);
+  EXPECT_EQ(by_opencv.size(), grey.size());
 }
 
 // `rig --truth`: judged against itself every figure is 0; with module 1

@@ -140,6 +140,7 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
 }  // namespace
 }  // namespace stereorig
 
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
@@ -307,6 +308,29 @@ TEST_F(ReconstructCli, ACloudNotNamedPlyExitsTwo) {
     EXPECT_NE(r.err.find(dir_ + name + ": cloud output must end in .ply"), std::string::npos) << r.err;
     EXPECT_FALSE(std::filesystem::exists(dir_ + name)) << name;
   }
+}
+
+// The suffix picks the format whatever its case, as users type it:
+// "out.PLY" is binary PLY, "out.STL" binary STL. (Before, both were refused
+// as not .ply / .stl.)
+TEST_F(ReconstructCli, UpperCaseSuffixesNameTheSameFormats) {
+  const std::string cloud = dir_ + "/upper.PLY", mesh = dir_ + "/upper.STL";
+  for (const std::string& f : {cloud, mesh}) std::filesystem::remove(f);
+  const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ +
+                                            "/capture --out " + cloud + " --mesh " + mesh);
+  ASSERT_EQ(r.code, 0) << r.err;
+  // The metrology library's PLY reader, independent of our writer.
+  EXPECT_GT(ReadPlyPoints(cloud).size(), 40000u);
+  // Binary STL, not PLY: 80-byte header, count, 50 bytes per triangle.
+  std::ifstream in(mesh, std::ios::binary);
+  std::string head(84, '\0');
+  ASSERT_TRUE(in.read(head.data(), 84));
+  EXPECT_NE(head.substr(0, 3), "ply");
+  uint32_t triangles = 0;
+  std::memcpy(&triangles, head.data() + 80, 4);
+  EXPECT_GT(triangles, 10000u);
+  EXPECT_EQ(std::filesystem::file_size(mesh), 84u + 50u * triangles);
+  for (const std::string& f : {cloud, mesh}) std::filesystem::remove(f);
 }
 
 // Where each output goes is checked before any work (apps/output_paths.h):
