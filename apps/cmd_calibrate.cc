@@ -83,8 +83,7 @@ int RunCalibrate(int argc, char** argv) {
   // The models' folder first: one that cannot be made leaves no rig file
   // or report behind either.
   models_folder.Create();
-  WriteCalibrationOutputs(result, out_path, report_path);
-  if (!cameramodels_dir.empty()) ExportCameramodels(result.rig, cameramodels_dir);
+  WriteCalibrationOutputs(result, out_path, report_path, cameramodels_dir);
   std::printf("%s", SummaryText(result.report).c_str());
   std::printf("wrote %s and %s\n", out_path.c_str(), report_path.c_str());
   return 0;

@@ -95,10 +95,13 @@ int RunReconstruct(int argc, char** argv) {
   const Runtime runtime(rig, options);
   const Reconstruction rec = runtime.Process(images, !mesh_path.empty());
 
-  WriteCloudPly(rec.cloud, out_path);
-  if (!mesh_path.empty()) WriteMesh(rec.mesh, mesh_path);
-  const nlohmann::json report = ReconstructionJson(rec);
-  if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
+  // All or none: a report that cannot be written (a full disk) leaves an
+  // earlier run's cloud and mesh as they were, not a new cloud beside them.
+  AtomicOutputSet written;
+  written.Add(out_path, EncodeCloudPly(rec.cloud));
+  if (!mesh_path.empty()) written.Add(mesh_path, EncodeMesh(rec.mesh, mesh_path));
+  if (!report_path.empty()) written.Add(report_path, ReconstructionJson(rec).dump(2) + "\n");
+  written.Commit();
   for (const ModuleReport& m : rec.modules) std::printf("%s\n", ModuleSummary(m).c_str());
   std::printf("%zu points (%d from the shape model) in %.1f ms; wrote %s", rec.cloud.size(), rec.filled_points,
               rec.times_ms.at("total_point_cloud"), out_path.c_str());

@@ -6,6 +6,7 @@
 #include "apps/cli_util.h"
 #include "apps/command.h"
 #include "apps/output_paths.h"
+#include "calib/core/atomic_file.h"
 #include "calib/core/cameramodel_export.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
@@ -135,10 +136,11 @@ int RunRig(int argc, char** argv) {
   if (!truth_path.empty())
     PrintAgainstTruth(rig, ReadRigFile(truth_path), distance_mm, Eigen::Vector3d(size_mm[0], size_mm[1], size_mm[2]));
   models_folder.Create();
-  for (int i = 0; i < int(model_paths.size()); ++i) {
-    WriteCameramodel(rig.camera(i), rig.CamFromReference(i), model_paths[i]);
-    std::printf("wrote %s\n", model_paths[i].c_str());
-  }
+  AtomicOutputSet written;  // every model or none
+  for (int i = 0; i < int(model_paths.size()); ++i)
+    written.Add(model_paths[i], CameramodelText(rig.camera(i), rig.CamFromReference(i)));
+  written.Commit();
+  for (const std::string& path : model_paths) std::printf("wrote %s\n", path.c_str());
   return kExitOk;
 }
 

@@ -5,6 +5,7 @@
 #include "apps/cli_util.h"
 #include "apps/command.h"
 #include "apps/output_paths.h"
+#include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "targets/board_svg.h"
 #include "targets/target_file.h"
@@ -42,13 +43,13 @@ int RunTarget(int argc, char** argv) {
   BoardSvgOptions options;
   options.faces = faces == "front" ? SvgFaces::kFront : faces == "back" ? SvgFaces::kBack : SvgFaces::kBoth;
   const BoardSvg svg = MakeBoardSvg(target, options);
-  WriteBoardSvg(svg, out_path);
+  AtomicOutputSet written;  // both or neither
+  written.Add(out_path, svg.text);
+  if (!write_target.empty()) written.Add(write_target, TargetToYaml(target));
+  written.Commit();
   std::printf("wrote %s: page %.1f x %.1f mm; print at 100 %% and check that the bar measures %.1f mm\n",
               out_path.c_str(), svg.width_mm, svg.height_mm, options.scale_bar_mm);
-  if (!write_target.empty()) {
-    WriteTargetFile(target, write_target);
-    std::printf("wrote %s\n", write_target.c_str());
-  }
+  if (!write_target.empty()) std::printf("wrote %s\n", write_target.c_str());
   return kExitOk;
 }
 

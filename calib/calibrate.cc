@@ -416,12 +416,25 @@ std::string CalibrationReport::ToJson() const {
   return j.str() + "\n";
 }
 
-std::vector<std::string> ExportCameramodels(const Rig& rig, const std::string& dir) {
+namespace {
+
+// Each camera's model as DIR/<camera name>.cameramodel, added to *outputs;
+// returns their paths.
+std::vector<std::string> AddCameramodels(const Rig& rig, const std::string& dir, AtomicOutputSet* outputs) {
   std::vector<std::string> paths;
   for (int c = 0; c < rig.num_cameras(); ++c) {
     paths.push_back(dir + "/" + rig.camera_names()[c] + ".cameramodel");
-    WriteCameramodel(rig.camera(c), rig.CamFromReference(c), paths.back());
+    outputs->Add(paths.back(), CameramodelText(rig.camera(c), rig.CamFromReference(c)));
   }
+  return paths;
+}
+
+}  // namespace
+
+std::vector<std::string> ExportCameramodels(const Rig& rig, const std::string& dir) {
+  AtomicOutputSet outputs;
+  std::vector<std::string> paths = AddCameramodels(rig, dir, &outputs);
+  outputs.Commit();
   return paths;
 }
 
@@ -532,9 +545,12 @@ std::string SummaryText(const CalibrationReport& rep) {
 }
 
 void WriteCalibrationOutputs(const CalibrationResult& result, const std::string& rig_path,
-                             const std::string& report_path) {
-  WriteRigFile(result.rig, rig_path);
-  WriteFileAtomically(report_path, result.report.ToJson());
+                             const std::string& report_path, const std::string& cameramodels_dir) {
+  AtomicOutputSet outputs;
+  outputs.Add(rig_path, RigToYaml(result.rig));
+  outputs.Add(report_path, result.report.ToJson());
+  if (!cameramodels_dir.empty()) AddCameramodels(result.rig, cameramodels_dir, &outputs);
+  outputs.Commit();
 }
 
 }  // namespace stereorig

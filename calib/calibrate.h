@@ -53,15 +53,17 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
 void ValidateInput(const CalibrationInput& input);
 
 // Writes every camera of `rig` as DIR/<camera name>.cameramodel (mrcal's
-// format, %.17g), with extrinsics = cam_from_module0. Each file is written
-// atomically. Returns the paths written.
+// format, %.17g), with extrinsics = cam_from_module0, all or none
+// (AtomicOutputSet). Returns the paths written.
 std::vector<std::string> ExportCameramodels(const Rig& rig, const std::string& dir);
 
 // A readable summary of every stage (a few lines per camera and module).
 std::string SummaryText(const CalibrationReport& report);
 
-// Writes the rig file and the JSON report, each atomically.
+// Writes the rig file, the JSON report and, if cameramodels_dir is given,
+// ExportCameramodels' files there, all or none (AtomicOutputSet): a model
+// that cannot be written leaves an earlier run's rig file as it was.
 void WriteCalibrationOutputs(const CalibrationResult& result, const std::string& rig_path,
-                             const std::string& report_path);
+                             const std::string& report_path, const std::string& cameramodels_dir = "");
 
 }  // namespace stereorig

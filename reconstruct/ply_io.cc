@@ -59,7 +59,7 @@ void CheckMeshPath(const std::string& path) {
     throw InputError(path, "mesh output must end in .ply or .stl");
 }
 
-void WriteMesh(const Mesh& m, const std::string& path) {
+std::string EncodeMesh(const Mesh& m, const std::string& path) {
   CheckMeshPath(path);
   std::string out;
   if (EndsWithIgnoringCase(path, ".stl")) {
@@ -88,7 +88,9 @@ void WriteMesh(const Mesh& m, const std::string& path) {
       for (int k = 0; k < 3; ++k) Put(out, int32_t(t[k]));
     }
   }
-  WriteFileAtomically(path, out);
+  return out;
 }
+
+void WriteMesh(const Mesh& m, const std::string& path) { WriteFileAtomically(path, EncodeMesh(m, path)); }
 
 }  // namespace stereorig

@@ -23,6 +23,8 @@ void WriteCloudPly(const PointCloud& cloud, const std::string& path);
 void CheckCloudPath(const std::string& path);
 // `path` ending in .stl -> binary STL, .ply -> binary PLY; else InputError.
 void WriteMesh(const Mesh& mesh, const std::string& path);
+// The bytes WriteMesh writes to `path` (its suffix picks the format).
+std::string EncodeMesh(const Mesh& mesh, const std::string& path);
 // Throws InputError unless `path` ends in .ply or .stl.
 void CheckMeshPath(const std::string& path);
 

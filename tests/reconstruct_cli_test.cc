@@ -333,6 +333,30 @@ TEST_F(ReconstructCli, UpperCaseSuffixesNameTheSameFormats) {
   for (const std::string& f : {cloud, mesh}) std::filesystem::remove(f);
 }
 
+// The cloud, mesh and report of one capture are written all or none: a
+// report that cannot be written (here its temporary file's name is too long
+// for the file system, as a full disk would fail it later) leaves an earlier
+// run's cloud as it was, no mesh and no temporary file. (Before, the new
+// cloud and mesh were in place and the run exited 2.)
+TEST_F(ReconstructCli, AReportThatCannotBeWrittenLeavesTheEarlierCloud) {
+  const std::string dir = dir_ + "/all_or_none";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/out.ply") << "earlier run";
+  const std::string long_report = dir + "/" + std::string(250, 'r') + ".json";  // legal; its temporary file's is not
+  const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ +
+                                            "/capture --out " + dir + "/out.ply --mesh " + dir + "/out.stl --report " +
+                                            long_report);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("cannot write: File name too long"), std::string::npos) << r.err;
+  std::ifstream cloud(dir + "/out.ply");
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(cloud), {}), "earlier run");
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) names.push_back(entry.path().filename());
+  EXPECT_EQ(names, std::vector<std::string>{"out.ply"});  // no mesh, report or temporary file
+}
+
 // Where each output goes is checked before any work (apps/output_paths.h):
 // a mesh in a missing folder, or two outputs naming one file, exit 2 with
 // one line naming the path, and nothing is written. (Before, the whole

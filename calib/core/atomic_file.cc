@@ -43,15 +43,35 @@ void AtomicOutput::Commit() {
   committed_ = true;
 }
 
-void WriteFileAtomically(const std::string& path, const std::string& bytes) {
-  AtomicOutput out(path);
+namespace {
+
+// `bytes` into out's temporary file, synced; InputError naming `path`.
+void WriteTemporary(const AtomicOutput& out, const std::string& path, const std::string& bytes) {
   FILE* f = std::fopen(out.temp_path().c_str(), "wb");
   if (!f) throw InputError(path, std::string("cannot write: ") + std::strerror(errno));
   const bool ok =
       std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size() && std::fflush(f) == 0 && fsync(fileno(f)) == 0;
   const bool closed = std::fclose(f) == 0;
   if (!ok || !closed) throw InputError(path, "write failed (disk full?)");
+}
+
+}  // namespace
+
+void WriteFileAtomically(const std::string& path, const std::string& bytes) {
+  AtomicOutput out(path);
+  WriteTemporary(out, path, bytes);
   out.Commit();
+}
+
+void AtomicOutputSet::Add(const std::string& path, const std::string& bytes) {
+  auto out = std::make_unique<AtomicOutput>(path);
+  WriteTemporary(*out, path, bytes);  // on failure `out` removes its temporary file
+  staged_.push_back(std::move(out));
+}
+
+void AtomicOutputSet::Commit() {
+  for (const std::unique_ptr<AtomicOutput>& out : staged_) out->Commit();
+  staged_.clear();
 }
 
 }  // namespace stereorig

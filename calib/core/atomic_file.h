@@ -3,7 +3,9 @@
 // file, never a half-written one.
 #pragma once
 
+#include <memory>
 #include <string>
+#include <vector>
 
 namespace stereorig {
 
@@ -30,6 +32,21 @@ class AtomicOutput {
   std::string path_;
   std::string temp_path_;
   bool committed_ = false;
+};
+
+// The outputs of one run, all or none: Add writes each to its temporary
+// file (failing as WriteFileAtomically does); Commit renames them all, once
+// every one is written. Destroyed before Commit (a later output failed), it
+// removes the temporary files: a run that fails while writing its second or
+// third output (a full disk) leaves every file at its output paths as it
+// was, not the first output new and the rest old.
+class AtomicOutputSet {
+ public:
+  void Add(const std::string& path, const std::string& bytes);
+  void Commit();  // in the order added; throws InputError on a failed rename
+
+ private:
+  std::vector<std::unique_ptr<AtomicOutput>> staged_;
 };
 
 }  // namespace stereorig

@@ -1,0 +1,74 @@
+#include "calib/core/atomic_file.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "calib/core/input_error_testing.h"
+
+namespace stereorig {
+namespace {
+
+std::string Contents(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// The names in `dir`, temporary files (".tmp-...") included.
+std::vector<std::string> Names(const std::string& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) names.push_back(entry.path().filename());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+TEST(AtomicOutputSet, CommitWritesEveryOutput) {
+  const std::string dir = testing::ScratchFolder("atomic_set_commit");
+  AtomicOutputSet outputs;
+  outputs.Add(dir + "/a.ply", "cloud");
+  outputs.Add(dir + "/b.json", "report");
+  EXPECT_TRUE(Contents(dir + "/a.ply").empty()) << "nothing at the output paths before Commit";
+  outputs.Commit();
+  EXPECT_EQ(Contents(dir + "/a.ply"), "cloud");
+  EXPECT_EQ(Contents(dir + "/b.json"), "report");
+  EXPECT_EQ(Names(dir), (std::vector<std::string>{"a.ply", "b.json"}));  // no temporary file left
+}
+
+// A later output that cannot be written (here its temporary file's name is
+// too long for the file system, as a full disk would fail it later) leaves
+// the earlier run's files as they were and no temporary file: not the first
+// output new and the others old.
+TEST(AtomicOutputSet, AFailingOutputLeavesEveryEarlierFileAsItWas) {
+  const std::string dir = testing::ScratchFolder("atomic_set_fail");
+  WriteFileAtomically(dir + "/a.ply", "old cloud");
+  const std::string long_name =
+      dir + "/" + std::string(250, 'r') + ".json";  // legal; its ".tmp-<pid>-<n>-" form is not
+  {
+    AtomicOutputSet outputs;
+    outputs.Add(dir + "/a.ply", "new cloud");
+    EXPECT_NE(testing::InputErrorMessage([&] { outputs.Add(long_name, "report"); }).find("cannot write"),
+              std::string::npos);
+  }  // not committed
+  EXPECT_EQ(Contents(dir + "/a.ply"), "old cloud");
+  EXPECT_EQ(Names(dir), std::vector<std::string>{"a.ply"});
+}
+
+TEST(WriteFileAtomically, ReplacesTheFileAndLeavesNoTemporaryFile) {
+  const std::string dir = testing::ScratchFolder("atomic_write");
+  WriteFileAtomically(dir + "/r.json", "first");
+  WriteFileAtomically(dir + "/r.json", "second");
+  EXPECT_EQ(Contents(dir + "/r.json"), "second");
+  EXPECT_EQ(Names(dir), std::vector<std::string>{"r.json"});
+  EXPECT_NE(testing::InputErrorMessage([&] {
+              WriteFileAtomically(dir + "/no_such_folder/r.json", "x");
+            }).find("does not exist"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace stereorig
