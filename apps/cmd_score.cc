@@ -52,10 +52,11 @@ int RunScore(int argc, char** argv) {
       "by one rigid motion (reported), and reports mean |error| and std per module and merged; the fill rate of "
       "each module over the object pixels that both its cameras see and a laser grid lights (from the truth's "
       "depth, id and lit maps); and the active/passive valid-point ratio (passive: the same options without the "
-      "lit-region crop and the grid-period distinctness test). With a shape_model in --options, the hole-filling "
-      "points too: their distance to the truth surface (mean, p95, max, share within 0.5 mm), overall and by their "
-      "distance to the nearest measured point (0-5, 5-15, >= 15 mm). Use the rig file from `stereorig "
-      "calibrate`, as issue 5 asks; without --rig the dataset's truth rig is used (and said so).\n\n"
+      "lit-region crop, the grid-period distinctness test and the grid-line test). With a shape_model in --options, "
+      "the hole-filling points too: their distance to the truth surface (mean, p95, max, share within 0.5 mm), "
+      "overall and by their distance to the nearest measured point (0-5, 5-15, >= 15 mm). Judge with the rig file "
+      "from `stereorig calibrate`, as the line will run: without --rig the dataset's truth rig is used (and said "
+      "so), which leaves out the calibration's own error.\n\n"
       "Example:\n  stereorig score --dataset demo/dataset --rig demo/rig.yaml --report score.json",
       "stereorig score"};
   std::string dataset, rig_path, options_path, report_path, diagnose_dir, scenes_arg = "cup,sphere,ballbar,plate,tuber";
@@ -76,7 +77,8 @@ int RunScore(int argc, char** argv) {
   const bool rig_given = !rig_path.empty();
   if (!rig_given) {
     rig_path = (fs::path(dataset) / "truth" / "rig.yaml").string();
-    std::printf("score: no --rig: using the TRUTH rig %s (issue 5 judges with the calibrated one)\n", rig_path.c_str());
+    std::printf("score: no --rig: using the TRUTH rig %s (the line runs with the calibrated one: give --rig)\n",
+                rig_path.c_str());
   }
   // Before any work: an unusable --diagnose folder is bad input, not a crash
   // at the end; but it is created only after every input check below.

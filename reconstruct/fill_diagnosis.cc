@@ -243,10 +243,8 @@ std::string FillDiagnosis::Summary() const {
   return s + buf + "  " + silhouette.Summary();
 }
 
-namespace {
-
-cv::Vec3b StatusColour(uint8_t status) {  // BGR
-  switch (PixelStatus(status)) {
+cv::Vec3b DiagnosisColour(PixelStatus status) {
+  switch (status) {
     case PixelStatus::kPoint:
       return {60, 160, 60};
     case PixelStatus::kNoSgmMatch:
@@ -275,7 +273,7 @@ cv::Vec3b StatusColour(uint8_t status) {  // BGR
     case PixelStatus::kSeenThrough:
       return {0, 0, 128};  // dark red
     case PixelStatus::kSeenThroughSurface:
-      return {128, 0, 128};  // dark magenta
+      return {139, 61, 72};  // dark slate blue
     case PixelStatus::kRightViewEdge:
       return {128, 128, 0};  // teal
     case PixelStatus::kNoGridLine:
@@ -284,6 +282,8 @@ cv::Vec3b StatusColour(uint8_t status) {  // BGR
       return {255, 255, 255};
   }
 }
+
+namespace {
 
 void Write(const std::string& path, const cv::Mat& image) {
   cv::Mat big;
@@ -316,7 +316,7 @@ void WriteFillDiagnosisImages(const FillDiagnosis& d, const std::string& prefix)
       const bool target = d.target.at<uint8_t>(gy, gx);
       const uint8_t st = d.status.at<uint8_t>(gy, gx);
       status.at<cv::Vec3b>(y, x) =
-          target ? StatusColour(st) : (st == uint8_t(PixelStatus::kPoint) ? cv::Vec3b(120, 200, 120) : dim);
+          target ? DiagnosisColour(PixelStatus(st)) : (st == uint8_t(PixelStatus::kPoint) ? cv::Vec3b(120, 200, 120) : dim);
       cv::Vec3b l = target ? cv::Vec3b(g / 2, g / 2, g / 2) : dim;
       if (target && st != uint8_t(PixelStatus::kPoint))
         l = d.truth_status.at<uint8_t>(gy, gx) == uint8_t(PixelStatus::kPoint) ? cv::Vec3b(0, 255, 0)

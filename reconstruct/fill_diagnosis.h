@@ -117,6 +117,12 @@ FillDiagnosis DiagnoseFill(const Runtime& runtime, int module, const std::vector
 // lost = lost targets, green where reachable, red where not; error = |d - truth|.
 void WriteFillDiagnosisImages(const FillDiagnosis& d, const std::string& prefix);
 
+// The BGR colour of `status` in the status image (docs/reconstruct.md,
+// `--diagnose`): each loss its own, except off_plane_coarse drawn with
+// off_plane; white for the statuses no target pixel should hold
+// (not_searched, out_of_range, low_confidence, outside_volume, object_size).
+cv::Vec3b DiagnosisColour(PixelStatus status);
+
 // The files WriteFillDiagnosisImages writes for `prefix` (a command claims
 // them before any work): prefix_left.png, _status.png, _lost.png, _error.png.
 std::vector<std::string> FillDiagnosisImagePaths(const std::string& prefix);

@@ -6,8 +6,11 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <string>
 
 namespace stereorig {
 namespace {
@@ -140,6 +143,27 @@ TEST(FillDiagnosis, SilhouetteProfileDoesNotTakeTheLeftViewsEdgeForAnEdge) {
   for (int k = 1; k <= SilhouetteErrorProfile::kMaxDistancePx; ++k) EXPECT_EQ(p.right_count[k], 0) << k;
   EXPECT_EQ(p.left_count[1], 3);        // the left silhouette still is one
   EXPECT_EQ(p.interior_count, 3 * 14);  // x = 16 .. 29
+}
+
+// Every status a target pixel can end in has its own colour in the status
+// image, so the image tells them apart (low_texture and
+// seen_through_surface were both purple before), except off_plane_coarse,
+// drawn with off_plane on purpose; none is the white of the statuses no
+// target holds.
+TEST(FillDiagnosis, EachLossHasItsOwnColour) {
+  std::map<std::array<uint8_t, 3>, std::string> seen;
+  for (int k = 0; k < int(PixelStatus::kNumStatus); ++k) {
+    const PixelStatus status = PixelStatus(k);
+    if (status == PixelStatus::kOffPlaneCoarse) continue;
+    const cv::Vec3b c = DiagnosisColour(status);
+    const std::array<uint8_t, 3> bgr{c[0], c[1], c[2]};
+    if (bgr == std::array<uint8_t, 3>{255, 255, 255}) continue;  // not a target's status
+    const auto [it, inserted] = seen.emplace(bgr, PixelStatusName(status));
+    EXPECT_TRUE(inserted) << PixelStatusName(status) << " has " << it->second << "'s colour";
+  }
+  EXPECT_EQ(DiagnosisColour(PixelStatus::kOffPlaneCoarse), DiagnosisColour(PixelStatus::kOffPlane));
+  // The statuses the guide lists with a colour of their own: 16, point included.
+  EXPECT_EQ(seen.size(), 16u);
 }
 
 }  // namespace

@@ -35,7 +35,7 @@ struct RuntimeOptions {
   double lit_contrast_dn = 12.0;   // a pixel is "lit" if its 9x9 grey-level std exceeds this; default 12 DN
   MatchOptions match;              // matcher; its range and ROI are derived per module (ignored here)
   // Per-point confidence below which a point is dropped, [0, 1].
-  double min_confidence = 0.5;    // default 0.5 (= match.min_zncc)
+  double min_confidence = 0.5;    // default 0.5 (below match.min_zncc's 0.8, which usually bites first)
   int normal_step_px = 2;         // normals from neighbours +-this many px in the depth grid; default 2
   double mesh_max_edge_mm = 1.5;  // organised mesh: no triangle edge longer than this (depth jumps); default 1.5
   ShapeModel shape_model = ShapeModel::kNone;  // hole filling model; default none
