@@ -78,6 +78,13 @@ std::vector<std::pair<std::string, std::string>> DatasetInputs(const std::string
   if (dataset.empty() || !fs::is_directory(dataset)) return inputs;
   const fs::path root(dataset);
   inputs.push_back({(root / "truth" / "rig.yaml").string(), "the dataset's truth rig file"});
+  // The rest of the truth: surfaces, depth, id and lit maps, object poses.
+  std::error_code ec;
+  if (fs::is_directory(root / "truth"))
+    for (auto it = fs::recursive_directory_iterator(root / "truth", ec);
+         !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
+      if (it->is_regular_file(ec) && it->path().filename() != "rig.yaml")
+        inputs.push_back({it->path().string(), "a truth file of the dataset"});
   inputs.push_back({(root / "spec.yaml").string(), "the dataset's spec"});
   if (fs::is_directory(root / "scenes")) {
     for (const auto& scene : fs::directory_iterator(root / "scenes")) {

@@ -74,9 +74,10 @@ OutputPaths ClaimRuntimeReport(const RuntimeReportClaim& report);
 
 // The files `stereorig score` and `bench` read from a simulated dataset
 // (docs/formats.md "Datasets"), as (path, what) for OutputPaths::Protect:
-// truth/rig.yaml (the scorer reads it even when --rig is given), spec.yaml,
-// and every camK.png of scenes/<scene>/{active,passive}/. Empty if `dataset`
-// is empty or not a folder.
+// truth/rig.yaml (the scorer reads it even when --rig is given), every
+// other file under truth/ (surfaces, depth, id and lit maps, object poses),
+// spec.yaml, and every camK.png of scenes/<scene>/{active,passive}/. Empty
+// if `dataset` is empty or not a folder.
 std::vector<std::pair<std::string, std::string>> DatasetInputs(const std::string& dataset);
 
 }  // namespace stereorig

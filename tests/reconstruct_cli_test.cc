@@ -439,7 +439,8 @@ TEST_F(ReconstructCli, AnOutputOverACaptureImageIsRefused) {
 }
 
 // score reads the dataset's truth rig (the scorer's frame and fill) even
-// with --rig, and the dataset's capture images; its --diagnose images are
+// with --rig, the rest of its truth (surfaces, maps: replaced by a report
+// before) and the dataset's capture images; its --diagnose images are
 // outputs too. Each collision is refused before any scoring, in one line,
 // the inputs byte-identical. A batch's per-capture outputs may not be the
 // rig or options file either.
@@ -449,12 +450,15 @@ TEST_F(ReconstructCli, ScoreAndBatchOutputsOverTheirInputsAreRefused) {
     return std::string(std::istreambuf_iterator<char>(f), {});
   };
   const std::string d = ScoreDataset("score_dataset");
+  std::filesystem::create_directories(d + "/truth/scenes/cup");
+  { std::ofstream(d + "/truth/scenes/cup/surface.ply") << "the truth surface\n"; }
   const std::string rig = bytes(d + "/truth/rig.yaml"), image = bytes(d + "/scenes/cup/active/cam0.png");
   const std::string score = "score --dataset " + d + " --scenes cup --no-passive";
   const std::pair<std::string, std::string> cases[] = {
       {score + " --rig " + dir_ + "/rig.yaml --report " + d + "/truth/rig.yaml",
        d + "/truth/rig.yaml: is the dataset's truth rig file"},
       {score + " --report " + d + "/scenes/cup/active/cam0.png", "cam0.png: is a capture image of the dataset"},
+      {score + " --report " + d + "/truth/scenes/cup/surface.ply", "surface.ply: is a truth file of the dataset"},
       {score + " --diagnose " + dir_ + "/diag --report " + dir_ + "/diag/cup_m1_status.png",
        "cup_m1_status.png: would be written twice (the report (--report) and a diagnosis image (--diagnose))"},
       {"reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture --out-dir " + dir_ +
@@ -470,6 +474,7 @@ TEST_F(ReconstructCli, ScoreAndBatchOutputsOverTheirInputsAreRefused) {
   }
   EXPECT_EQ(bytes(d + "/truth/rig.yaml"), rig);
   EXPECT_EQ(bytes(d + "/scenes/cup/active/cam0.png"), image);
+  EXPECT_EQ(bytes(d + "/truth/scenes/cup/surface.ply"), "the truth surface\n");
   EXPECT_EQ(bytes(dir_ + "/batch_opts/capture.json"), "match: {}\n");
   EXPECT_FALSE(std::filesystem::exists(dir_ + "/batch_opts/capture.ply"));
 }
