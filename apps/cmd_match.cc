@@ -32,7 +32,8 @@ int RunMatch(int argc, char** argv) {
   app.add_option("--min-disparity", options.min_disparity_px, "smallest disparity searched, px")->required();
   app.add_option("--num-disparities", options.num_disparities, "number of disparities searched, px")->required();
   app.add_option("--out", out_path, "output disparity map (.pfm)")->required();
-  app.add_option("--roi", roi, "left-image region to match: x y width height (default: whole image)")->expected(4);
+  app.add_option("--roi", roi, "left-image region to match: x y width height, inside the image (default: whole image)")
+      ->expected(4);
   app.add_option("--matcher", matcher,
                  "census_sgm (ours), opencv_sgbm_3way (OpenCV's SGBM, then our filters and sub-pixel fit: the "
                  "bench's baseline) or opencv_sgbm_3way_standalone (SGBM with its own sub-pixel fit only)")
@@ -64,16 +65,26 @@ int RunMatch(int argc, char** argv) {
   CheckPfmPath(out_path);  // after the claim: "is the left image" says more than "not .pfm" would
   const cv::Mat left = ReadGreyImage(left_path), right = ReadGreyImage(right_path);
   if (left.size() != right.size()) throw InputError(right_path, "size differs from the left image");
+  // A region partly or wholly outside the image, or empty, is a mistake to
+  // name, not one to clip or widen to the whole image without a word.
+  const cv::Rect image(0, 0, left.cols, left.rows);
+  if (!roi.empty() && (roi[2] <= 0 || roi[3] <= 0 || (options.roi & image) != options.roi))
+    throw InputError("--roi", std::to_string(roi[0]) + " " + std::to_string(roi[1]) + " " + std::to_string(roi[2]) +
+                                  " " + std::to_string(roi[3]) + " must have a positive size and lie inside the " +
+                                  std::to_string(left.cols) + "x" + std::to_string(left.rows) + " image");
+  const cv::Rect matched = roi.empty() ? image : options.roi;
 
   const auto t0 = std::chrono::steady_clock::now();
   const MatchResult result = WorkerPool(options.num_threads).Run([&] { return Match(left, right, options); });
   const double ms = MsSince(t0);
   WritePfm(result.disparity_px, out_path);
-  int valid = 0;
-  for (int y = 0; y < result.disparity_px.rows; ++y)
-    for (int x = 0; x < result.disparity_px.cols; ++x) valid += std::isfinite(result.disparity_px.at<float>(y, x));
-  std::printf("%s: %d valid disparities of %d px (%.1f%%) in %.1f ms; wrote %s\n", MatcherKindName(options.matcher),
-              valid, left.cols * left.rows, 100.0 * valid / (left.cols * left.rows), ms, out_path.c_str());
+  int valid = 0;  // in the matched region: outside it nothing is
+  for (int y = matched.y; y < matched.y + matched.height; ++y)
+    for (int x = matched.x; x < matched.x + matched.width; ++x)
+      valid += std::isfinite(result.disparity_px.at<float>(y, x));
+  std::printf("%s: %d valid disparities of %d px%s (%.1f%%) in %.1f ms; wrote %s\n", MatcherKindName(options.matcher),
+              valid, matched.area(), roi.empty() ? "" : " in --roi", 100.0 * valid / matched.area(), ms,
+              out_path.c_str());
   return kExitOk;
 }
 

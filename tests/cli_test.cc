@@ -83,6 +83,35 @@ TEST(Cli, UnreadableImagesAreNamedInOneLine) {
   }
 }
 
+// --roi must lie inside the image and have a positive size: a region partly
+// outside was clipped, and an empty one (or one wholly outside) matched the
+// whole image, each with exit 0. Now exit 2, one line naming --roi, before
+// any matching; a region inside is matched, and the summary counts over it.
+TEST(Cli, MatchRefusesARegionNotInsideTheImage) {
+  const std::string dir = ::testing::TempDir() + "/cli_match_roi";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const cv::Mat grey(32, 64, CV_8UC1, cv::Scalar(100));
+  ASSERT_TRUE(cv::imwrite(dir + "/l.png", grey));
+  const std::string base =
+      "match --left " + dir + "/l.png --right " + dir + "/l.png --min-disparity 0 --num-disparities 16 --out " + dir;
+  for (const char* roi : {"40 10 30 10", "0 0 100000 100000", "-1 0 64 32", "10 10 0 5", "0 0 0 0", "70 40 5 5"}) {
+    const Result r = RunCli(base + "/d.pfm --roi " + roi);
+    EXPECT_EQ(r.code, 2) << roi;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("--roi: " + std::string(roi) + " must have a positive size and lie inside the 64x32 image"),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/d.pfm")) << roi;
+  }
+  const Result ok = RunCli(base + "/d.pfm --roi 0 0 64 32");
+  EXPECT_EQ(ok.code, 0) << ok.err;
+  EXPECT_NE(ok.out.find(" of 2048 px in --roi ("), std::string::npos) << ok.out;
+  const Result part = RunCli(base + "/p.pfm --roi 8 4 20 10");
+  EXPECT_EQ(part.code, 0) << part.err;
+  EXPECT_NE(part.out.find(" of 200 px in --roi ("), std::string::npos) << part.out;
+}
+
 // The disparity map is always PFM: `--out d.png` would hold PFM bytes an
 // image viewer cannot open. (Before, it was written there and match exited
 // 0.) Refused before the matching, in one line naming the path.
