@@ -83,16 +83,22 @@ TEST(Cli, UnreadableImagesAreNamedInOneLine) {
   }
 }
 
+// A fresh scratch folder holding l.png, a flat 64x32 grey image: a pair
+// (left = right) for match's argument checks.
+std::string MatchScratch(const std::string& name) {
+  const std::string dir = ::testing::TempDir() + "/" + name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  EXPECT_TRUE(cv::imwrite(dir + "/l.png", cv::Mat(32, 64, CV_8UC1, cv::Scalar(100))));
+  return dir;
+}
+
 // --roi must lie inside the image and have a positive size: a region partly
 // outside was clipped, and an empty one (or one wholly outside) matched the
 // whole image, each with exit 0. Now exit 2, one line naming --roi, before
 // any matching; a region inside is matched, and the summary counts over it.
 TEST(Cli, MatchRefusesARegionNotInsideTheImage) {
-  const std::string dir = ::testing::TempDir() + "/cli_match_roi";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  const cv::Mat grey(32, 64, CV_8UC1, cv::Scalar(100));
-  ASSERT_TRUE(cv::imwrite(dir + "/l.png", grey));
+  const std::string dir = MatchScratch("cli_match_roi");
   const std::string base =
       "match --left " + dir + "/l.png --right " + dir + "/l.png --min-disparity 0 --num-disparities 16 --out " + dir;
   for (const char* roi : {"40 10 30 10", "0 0 100000 100000", "-1 0 64 32", "10 10 0 5", "0 0 0 0", "70 40 5 5"}) {
@@ -116,11 +122,8 @@ TEST(Cli, MatchRefusesARegionNotInsideTheImage) {
 // image viewer cannot open. (Before, it was written there and match exited
 // 0.) Refused before the matching, in one line naming the path.
 TEST(Cli, MatchRefusesADisparityMapNotNamedPfm) {
-  const std::string dir = ::testing::TempDir() + "/cli_match_out";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  const cv::Mat grey(32, 64, CV_8UC1, cv::Scalar(100));
-  ASSERT_TRUE(cv::imwrite(dir + "/l.png", grey));
+  const std::string dir = MatchScratch("cli_match_out");
+  const cv::Size grey(64, 32);  // MatchScratch's image
   for (const char* name : {"/d.png", "/d.tiff"}) {
     const Result r = RunCli("match --left " + dir + "/l.png --right " + dir +
                             "/l.png --min-disparity 0 --num-disparities 16 --out " + dir + name);
@@ -139,7 +142,7 @@ TEST(Cli, MatchRefusesADisparityMapNotNamedPfm) {
   EXPECT_EQ(upper.code, 0) << upper.err;
   const cv::Mat by_opencv = cv::imread(dir + "/D.PFM", cv::IMREAD_UNCHANGED);  // OpenCV's own PFM reader
   EXPECT_EQ(by_opencv.type(), CV_32FC1);
-  EXPECT_EQ(by_opencv.size(), grey.size());
+  EXPECT_EQ(by_opencv.size(), grey);
 }
 
 // `rig --truth`: judged against itself every figure is 0; with module 1
