@@ -37,6 +37,16 @@ std::vector<std::string> SplitSceneList(const std::string& list) {
   return scenes;
 }
 
+void CheckDatasetFolder(const std::string& dataset) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(dataset, ec)) throw InputError(dataset, "no such dataset folder (--dataset)");
+  if (!fs::is_directory(dataset, ec))
+    throw InputError(dataset, "is a file, not a dataset folder (--dataset: the folder stereorig simulate writes)");
+  if (!fs::is_directory(fs::path(dataset) / "truth", ec))
+    throw InputError(dataset, "is not a simulator dataset: it has no truth/ folder (--dataset)");
+}
+
 void CheckScenesInDataset(const std::string& dataset, const std::vector<std::string>& scenes) {
   namespace fs = std::filesystem;
   const fs::path scenes_dir = fs::path(dataset) / "scenes";

@@ -1,22 +1,27 @@
 #include "reconstruct/grey_image.h"
 
-#include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 
+#include "calib/core/file_suffix.h"
 #include "calib/core/input_error.h"
+#include "calib/core/input_file.h"
 #include "calib/core/png_file.h"
 
 namespace stereorig {
 
 cv::Mat ReadGreyImage(const std::string& path) {
   // Missing: imread would print OpenCV's own warning first.
-  if (!std::filesystem::is_regular_file(path)) throw InputError(path, "no such file");
-  CheckPngIsWhole(path);
+  RequireInputFile(path);
+  // Named .png but holding another format: its decoder would print its own
+  // complaint (libjpeg's "Premature end of JPEG file") before ours.
+  if (!CheckPngIsWhole(path) && EndsWithIgnoringCase(path, ".png"))
+    throw InputError(path, "is not a PNG file, though named .png");
   cv::Mat image;
   try {
     image = cv::imread(path, cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& e) {  // e.g. a header whose size the decoder refuses
-    throw InputError(path, "cannot read the image (" + e.msg + ")");
+    // e.err alone: e.msg adds OpenCV's version, source file and a newline.
+    throw InputError(path, "cannot read the image (" + e.err + ")");
   }
   if (image.empty()) throw InputError(path, "cannot read the image (not an image, or a damaged one)");
   if (image.type() != CV_8UC1) throw InputError(path, "must be an 8-bit single-channel (grey) image");

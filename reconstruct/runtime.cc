@@ -482,6 +482,7 @@ std::vector<std::string> CaptureImagePaths(const std::string& dir, const Rig& ri
 
 void CheckCaptureFiles(const std::string& dir, const Rig& rig) {
   namespace fs = std::filesystem;
+  if (fs::exists(dir) && !fs::is_directory(dir)) throw InputError(dir, "is a file, not a capture folder");
   if (!fs::is_directory(dir)) throw InputError(dir, "capture folder not found");
   for (const auto& entry : fs::directory_iterator(dir)) {
     const std::optional<int> camera = CameraIndexOfImageName(entry.path().filename().string());
@@ -491,7 +492,10 @@ void CheckCaptureFiles(const std::string& dir, const Rig& rig) {
   }
   const std::vector<std::string> paths = CaptureImagePaths(dir, rig);
   for (size_t k = 0; k < paths.size(); ++k)
-    if (!fs::exists(paths[k])) throw InputError(paths[k], "missing camera image (camera " + std::to_string(k) + ")");
+    if (!fs::exists(paths[k]))
+      throw InputError(paths[k], "missing camera image (camera " + std::to_string(k) + ")");
+    else if (fs::is_directory(paths[k]))
+      throw InputError(paths[k], "is a folder, not camera " + std::to_string(k) + "'s image");
 }
 
 std::vector<cv::Mat> LoadCapture(const std::string& dir, const Rig& rig) {

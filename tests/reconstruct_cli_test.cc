@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
 #include "calib/core/atomic_file.h"
@@ -64,7 +65,20 @@ TEST(MatchCli, WritesAPfmThatMatchesTheTruth) {
 // (An unusable --diagnose folder, and bad input beside a usable one:
 // ReconstructCli.ScoreBadInputLeavesNoDiagnoseFolder.)
 TEST(ScoreCli, MissingDatasetExitsTwo) {
-  EXPECT_EQ(RunCli("score --dataset " + ::testing::TempDir() + "/no_such_dataset"), 2);
+  // Named as what it is: before, every case read "DATASET/truth/rig.yaml: no such file".
+  const std::string file = ::testing::TempDir() + "/score_cli_not_a_dataset.yaml";
+  { std::ofstream(file) << "a: 1\n"; }
+  const std::pair<std::string, std::string> datasets[] = {
+      {::testing::TempDir() + "/no_such_dataset", "no such dataset folder (--dataset)"},
+      {file, "is a file, not a dataset folder"},
+      {::testing::TempDir(), "is not a simulator dataset: it has no truth/ folder"}};
+  for (const auto& [dataset, says] : datasets)
+    for (const char* command : {"score --dataset ", "bench --runs 1 --dataset "}) {
+      const testing::Result r = testing::RunCli(command + dataset);
+      EXPECT_EQ(r.code, 2) << command << dataset;
+      EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+      EXPECT_NE(r.err.find(dataset + ": " + says), std::string::npos) << r.err;
+    }
   // A --report that cannot be written is named before anything else is read
   // (not after minutes of scoring).
   const std::string report = ::testing::TempDir() + "/no_such_folder/s.json";
@@ -155,6 +169,14 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
 
 namespace stereorig {
 namespace {
+
+// `stereorig args` exits 2 with one line on stderr that says `says`.
+void ExpectRefusedInOneLine(const std::string& args, const std::string& says) {
+  const testing::Result r = testing::RunCli(args);
+  EXPECT_EQ(r.code, 2) << args;
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+}
 
 class ReconstructCli : public ::testing::Test {
  protected:
@@ -282,6 +304,57 @@ TEST_F(ReconstructCli, AnImageCutShortIsNamedInOneLine) {
   ExpectNoOutput();
 }
 
+// PNG's chunk CRC (ISO 3309, as zlib's crc32), for a header made by hand.
+uint32_t PngCrc(const std::string& bytes) {
+  uint32_t c = 0xFFFFFFFFu;
+  for (const unsigned char b : bytes) {
+    c ^= b;
+    for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
+  }
+  return c ^ 0xFFFFFFFFu;
+}
+
+// Inputs of the wrong kind, each named in one line as what it is, before any
+// work and with no output. Before: JPEG bytes named cam1.png printed
+// libjpeg's "Premature end of JPEG file" first; a header of 60000 x 60000 px
+// printed OpenCV's two-line assertion; a folder for a file read "no such
+// file"; a file for --capture "capture folder not found".
+TEST_F(ReconstructCli, InputsOfTheWrongKindAreNamedInOneLine) {
+  const std::string jpeg = BrokenCapture("jpeg_named_png");
+  std::vector<uchar> bytes;
+  ASSERT_TRUE(cv::imencode(".jpg", cv::Mat(582, 752, CV_8UC1, cv::Scalar(90)), bytes));
+  {
+    std::ofstream(jpeg + "/cam1.png", std::ios::binary)
+        .write(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  }
+  const std::string huge = BrokenCapture("huge_header");
+  {  // a whole PNG (signature, IHDR, an empty IDAT, IEND, with their CRCs) claiming 60000 x 60000 px
+    auto be32 = [](uint32_t v) { return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)}; };
+    const std::string ihdr = "IHDR" + be32(60000) + be32(60000) + std::string{8, 0, 0, 0, 0};
+    const std::string png = std::string("\x89PNG\r\n\x1a\n", 8) + be32(13) + ihdr + be32(PngCrc(ihdr)) + be32(0) +
+                            "IDAT" + be32(PngCrc("IDAT")) + be32(0) + "IEND" + be32(PngCrc("IEND"));
+    std::ofstream(huge + "/cam1.png", std::ios::binary) << png;
+  }
+  const std::string folder = BrokenCapture("folder_for_image");
+  std::filesystem::remove(folder + "/cam1.png");
+  std::filesystem::create_directory(folder + "/cam1.png");
+  const std::string base = "reconstruct --out " + dir_ + "/out.ply ";
+  const std::pair<std::string, std::string> cases[] = {
+      {base + "--rig " + dir_ + "/rig.yaml --capture " + jpeg,
+       jpeg + "/cam1.png: is not a PNG file, though named .png"},
+      {base + "--rig " + dir_ + "/rig.yaml --capture " + huge,
+       huge + "/cam1.png: cannot read the image (pixels <= CV_IO_MAX_IMAGE_PIXELS)"},
+      {base + "--rig " + dir_ + "/rig.yaml --capture " + folder,
+       folder + "/cam1.png: is a folder, not camera 1's image"},
+      {base + "--rig " + dir_ + "/capture --capture " + dir_ + "/capture", dir_ + "/capture: is a folder, not a file"},
+      {base + "--rig " + dir_ + "/rig.yaml --capture " + dir_ + "/rig.yaml",
+       dir_ + "/rig.yaml: is a file, not a capture folder"}};
+  for (const auto& [args, says] : cases) {
+    ExpectRefusedInOneLine(args, says);
+    ExpectNoOutput();
+  }
+}
+
 TEST_F(ReconstructCli, CaptureFromALargerRigExitsTwo) {
   const std::string d = BrokenCapture("extra_camera");
   std::filesystem::copy(d + "/cam0.png", d + "/cam4.png");
@@ -344,9 +417,9 @@ TEST_F(ReconstructCli, AReportThatCannotBeWrittenLeavesTheEarlierCloud) {
   std::filesystem::create_directories(dir);
   std::ofstream(dir + "/out.ply") << "earlier run";
   const std::string long_report = dir + "/" + std::string(250, 'r') + ".json";  // legal; its temporary file's is not
-  const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ +
-                                            "/capture --out " + dir + "/out.ply --mesh " + dir + "/out.stl --report " +
-                                            long_report);
+  const testing::Result r =
+      testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture --out " + dir +
+                      "/out.ply --mesh " + dir + "/out.stl --report " + long_report);
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("cannot write: File name too long"), std::string::npos) << r.err;
@@ -427,12 +500,7 @@ TEST_F(ReconstructCli, AnOutputOverACaptureImageIsRefused) {
       {head + " --out " + dir_ + "/image_link.png", "image_link.png: is a capture image"},
       {head + " " + dir_ + "/capture --out-dir " + dir_ + "/own_images_out --report " + d + "/cam2.png",
        d + "/cam2.png: is a capture image"}};
-  for (const auto& [args, says] : cases) {
-    const testing::Result r = testing::RunCli(args);
-    EXPECT_EQ(r.code, 2) << args;
-    EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
-    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
-  }
+  for (const auto& [args, says] : cases) ExpectRefusedInOneLine(args, says);
   for (int k = 0; k < 4; ++k) EXPECT_EQ(bytes(d + "/cam" + std::to_string(k) + ".png"), images[k]) << k;
   EXPECT_FALSE(std::filesystem::exists(dir_ + "/own_images_out"));
   ExpectNoOutput();
@@ -466,12 +534,7 @@ TEST_F(ReconstructCli, ScoreAndBatchOutputsOverTheirInputsAreRefused) {
        "capture.json: is the options file (--options)"}};
   std::filesystem::create_directories(dir_ + "/batch_opts");
   { std::ofstream(dir_ + "/batch_opts/capture.json") << "match: {}\n"; }
-  for (const auto& [args, says] : cases) {
-    const testing::Result r = testing::RunCli(args);
-    EXPECT_EQ(r.code, 2) << args;
-    EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
-    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
-  }
+  for (const auto& [args, says] : cases) ExpectRefusedInOneLine(args, says);
   EXPECT_EQ(bytes(d + "/truth/rig.yaml"), rig);
   EXPECT_EQ(bytes(d + "/scenes/cup/active/cam0.png"), image);
   EXPECT_EQ(bytes(d + "/truth/scenes/cup/surface.ply"), "the truth surface\n");

@@ -2,13 +2,15 @@
 
 #include <cmath>
 #include <filesystem>
+#include <set>
 
 #include "input_error.h"
+#include "input_file.h"
 
 namespace stereorig {
 
 YamlMap YamlMap::LoadFile(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) throw InputError(path, "no such file");
+  RequireInputFile(path);
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);
@@ -37,6 +39,14 @@ YamlMap YamlMap::FromDocument(YAML::Node root, const std::string& where) {
 YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string key_path)
     : node_(node), file_(std::move(file)), key_path_(std::move(key_path)) {
   if (!node_.IsMap()) throw InputError(Where(), "expected a mapping");
+  // yaml-cpp keeps a repeated key's first value and drops the rest without
+  // a word: "units: mm" then "units: m" would read as mm.
+  std::set<std::string> keys;
+  for (const auto& kv : node_) {
+    if (!kv.first.IsScalar()) throw InputError(Where(), "a key must be a plain name");
+    if (!keys.insert(kv.first.Scalar()).second)
+      throw InputError(Where(kv.first.Scalar()), "given twice in one mapping: keep one");
+  }
 }
 
 std::string YamlMap::Where(const std::string& key) const {

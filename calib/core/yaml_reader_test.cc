@@ -73,6 +73,18 @@ TEST(YamlMap, AnEmptyOrCommentOnlyDocumentHasNoKeys) {
   }
 }
 
+// yaml-cpp keeps a repeated key's first value silently ("units: mm" then
+// "units: m" read as mm); a strict reader names the key, at any depth.
+TEST(YamlMap, AKeyGivenTwiceIsRefused) {
+  EXPECT_EQ(InputErrorMessage([] { YamlMap::LoadString("units: mm\nunits: m\n", "f.yaml"); }),
+            "f.yaml: units: given twice in one mapping: keep one");
+  YamlMap m = YamlMap::LoadString("match: {p1: 8, p1: 9}\nother: {p1: 1}\n", "f.yaml");
+  EXPECT_EQ(InputErrorMessage([&] { m.GetMap("match"); }), "f.yaml: match.p1: given twice in one mapping: keep one");
+  EXPECT_EQ(m.GetMap("other").GetInt("p1"), 1);  // one per mapping is fine
+  EXPECT_EQ(InputErrorMessage([] { YamlMap::LoadString("? [a, b]\n: 1\n", "f.yaml"); }),
+            "f.yaml: a key must be a plain name");
+}
+
 TEST(YamlMap, SyntaxErrorsAreInputErrors) {
   EXPECT_THROW(YamlMap::LoadString("a: [1, 2\n", "f.yaml"), InputError);
   EXPECT_THROW(YamlMap::LoadString("- just a list\n", "f.yaml"), InputError);
