@@ -1,6 +1,7 @@
 // `stereorig check`: the nightly recalibration check. Fresh target captures
 // + the stored rig file -> ok / recalibrate, what moved, and history.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -82,10 +83,19 @@ int RunCheck(int argc, char** argv) {
     if (rig_path.empty()) throw InputError("", "give --rig or --history-db");
     history_db = DefaultHistoryPath(rig_path);
   }
-  if (history_only) return PrintHistory(history_db);
+  if (history_only) {
+    // It reads the history alone: options for a check would be ignored.
+    for (const char* flag : {"--captures", "--target", "--report", "--k-sigma"})
+      if (app.count(flag) > 0) throw InputError(flag, "does not apply with --history (it prints the trend and stops)");
+    return PrintHistory(history_db);
+  }
   if (rig_path.empty() || captures.empty() || target_path.empty()) {
     throw InputError("", "--rig, --captures and --target are required (see --help)");
   }
+  // A coverage factor, as in GUM: 2-3 usual; a huge or infinite one would
+  // pass any drift and write those thresholds into the history.
+  if (!(std::isfinite(options.k_sigma) && options.k_sigma > 0 && options.k_sigma <= 10))
+    throw InputError("--k-sigma", "must be in (0, 10] (each threshold is k times the figure's sigma)");
   options.Check();
   // The report and the history checked before the target is detected: a
   // report over the rig file, or into a folder that is not there, would

@@ -5,6 +5,7 @@
 #include "apps/command.h"
 #include "apps/output_paths.h"
 #include "calib/core/atomic_file.h"
+#include "calib/core/input_error.h"
 #include "datasets/sim_spec.h"
 #include "datasets/simulate.h"
 
@@ -28,8 +29,12 @@ int RunSimulate(int argc, char** argv) {
   SimulateOptions o;
   bool no_scenes = false;
   app.add_option("--spec", spec_path, "rig spec YAML (default: the embedded default rig)")->check(CLI::ExistingFile);
-  app.add_option("--out", o.out_dir, "dataset folder to write (replaced atomically if it already holds a dataset)");
-  app.add_option("--seed", o.seed, "random seed: poses, scenes, noise")->capture_default_str();
+  app.add_option("--out", o.out_dir,
+                 "dataset folder to write; if it already holds a dataset, the whole folder is replaced atomically, "
+                 "anything else in it included");
+  app.add_option("--seed", o.seed, "random seed: poses, scenes, noise (>= 0)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--threads", o.threads, "worker threads (0 = all cores)")->capture_default_str();
   app.add_option("--calibration-captures", o.calibration_captures, "override the spec's number of target captures");
   app.add_flag("--no-scenes", no_scenes, "render the calibration captures only");
@@ -39,8 +44,22 @@ int RunSimulate(int argc, char** argv) {
   app.add_option("--bump-rotation-deg", o.bump.rotation_deg, "bump: rotation angle, about a seeded random axis");
   app.add_option("--bump-translation-mm", o.bump.translation_mm, "bump: shift, along a seeded random direction");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
+  // A bump needs what to move and by how much: either alone used to render
+  // an undisturbed rig without a word.
+  const bool bump_what = app.count("--bump-camera") + app.count("--bump-module") > 0;
+  const bool bump_amount = app.count("--bump-rotation-deg") + app.count("--bump-translation-mm") > 0;
+  if (bump_amount && !bump_what)
+    throw InputError(app.count("--bump-rotation-deg") ? "--bump-rotation-deg" : "--bump-translation-mm",
+                     "needs --bump-camera or --bump-module (what to move)");
+  if (bump_what && !bump_amount)
+    throw InputError(app.count("--bump-camera") ? "--bump-camera" : "--bump-module",
+                     "needs --bump-rotation-deg or --bump-translation-mm (by how much)");
 
   if (!write_spec.empty()) {
+    for (const char* flag : {"--out", "--seed", "--threads", "--calibration-captures", "--no-scenes", "--bump-camera",
+                             "--bump-module", "--bump-rotation-deg", "--bump-translation-mm"})
+      if (app.count(flag) > 0)
+        throw InputError(flag, "does not apply with --write-default-spec (it writes the spec and stops)");
     // Checked like every other command's outputs (apps/output_paths.h): its
     // folder exists, it is not a folder, and it is not the --spec file given
     // alongside (which the default would replace).

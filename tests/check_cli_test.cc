@@ -117,6 +117,17 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     EXPECT_EQ(Bytes(db), db_bytes) << what << ": the history changed";
   };
 
+  {  // A coverage factor that is not finite, or so large it would pass any
+     // drift (inf was accepted, a verdict "ok" with infinite thresholds
+     // written into the history), and a check's options with --history,
+     // which reads the history alone (they were ignored).
+    for (const char* k : {"inf", "1e9", "0"})
+      expect_refused(RunCli("check --rig " + dir + "/rig.yaml --captures " + dir + "/ds --target " + dir +
+                            "/ds/target.yaml --history-db " + db + " --report " + report + " --k-sigma " + k),
+                     "--k-sigma: must be in (0, 10]", k);
+    expect_refused(RunCli("check --history --history-db " + db + " --report " + report),
+                   "--report: does not apply with --history", "--history with --report");
+  }
   {  // A corrupt (truncated, unreadable) image.
     const std::string d = copy("corrupt");
     const std::string bad = d + "/003/cam1.png";

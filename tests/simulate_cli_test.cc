@@ -78,6 +78,29 @@ TEST(SimulateCli, AnOutThatCannotBeMadeLeavesNoFolder) {
   }
 }
 
+// Options that would be ignored, or read wrongly, are refused before any
+// work, in one line naming the flag: a bump without what to move or by how
+// much rendered an undisturbed rig; --write-default-spec ignored --out; a
+// negative seed wrapped round to 2^64 - 1.
+TEST(SimulateCli, OptionsThatWouldBeIgnoredAreRefused) {
+  const std::string dir = ::testing::TempDir() + "/sim_ignored_options";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string out = " --out " + dir + "/ds";
+  const std::pair<std::string, std::string> cases[] = {
+      {out + " --bump-rotation-deg 0.1", "--bump-rotation-deg: needs --bump-camera or --bump-module"},
+      {out + " --bump-camera 1", "--bump-camera: needs --bump-rotation-deg or --bump-translation-mm"},
+      {" --write-default-spec " + dir + "/s.yaml" + out, "--out: does not apply with --write-default-spec"},
+      {out + " --seed -1", "--seed"}};
+  for (const auto& [args, says] : cases) {
+    const Result r = RunCli("simulate" + args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+  }
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
 // --write-default-spec is checked like every command's output
 // (apps/output_paths.h): over the --spec file given with it (an edited spec
 // replaced by the default), directly or through a symbolic link, at a

@@ -12,7 +12,8 @@
 namespace stereorig {
 
 void CheckOptions::Check() const {
-  if (!(k_sigma > 0)) throw InputError("check options", "k_sigma must be positive");
+  if (!(k_sigma > 0 && std::isfinite(k_sigma)))
+    throw InputError("check options", "k_sigma must be positive and finite");
   if (min_captures < 1) throw InputError("check options", "min_captures must be >= 1");
   if (min_corners_per_view < 4) throw InputError("check options", "min_corners_per_view must be >= 4");
 }
