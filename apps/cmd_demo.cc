@@ -85,13 +85,14 @@ int RunDemo(int argc, char** argv) {
 
   std::printf("\n== 3. reconstruct the cup, active (laser grids on) and passive, with the calibrated rig\n");
   // The default options are the grid's: the passive capture (no grid) is
-  // matched over the whole volume and without the grid-period test, as the
-  // options guide says (docs/reconstruct.md), from a file the user can
-  // reuse.
+  // matched over the whole volume and without the grid's own tests, as the
+  // options guide says (docs/reconstruct.md) and score's passive run does
+  // (PassiveOptions, runtime_options.h), from a file the user can reuse.
   const std::string passive_options = Join(out, "passive_options.yaml");
   WriteFileAtomically(passive_options,
                       "# Runtime options for a capture without the laser grids (docs/reconstruct.md).\n"
-                      "crop_to_lit_region: false\nmatch:\n  min_distinctness: 0\n  grid_line_test: false\n");
+                      "crop_to_lit_region: false\nmatch:\n  min_distinctness: 0\n  grid_line_test: false\n"
+                      "  line_index: false\n");
   for (const char* mode : {"active", "passive"}) {
     const std::string name = std::string("cup_") + mode;
     std::vector<std::string> args = {"reconstruct",

@@ -24,7 +24,7 @@ int RunReconstruct(int argc, char** argv) {
       "The capture folder holds camK.png (8-bit grey) for every camera K of the rig. Runtime options (YAML) "
       "give the measurement volume and object size; docs/reconstruct.md lists every key. The defaults are for "
       "captures under the laser grids; a capture without them (passive) needs crop_to_lit_region: false and "
-      "match: {min_distinctness: 0, grid_line_test: false} (`stereorig demo` writes such a file, "
+      "match: {min_distinctness: 0, grid_line_test: false, line_index: false} (`stereorig demo` writes such a file, "
       "passive_options.yaml).\n"
       "In the line, give many captures and --out-dir: one process (starting one costs ~0.25 s: loading the "
       "libraries, reading the rig, building the rectification maps) reconstructs them all, the next capture "

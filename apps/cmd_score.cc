@@ -52,7 +52,8 @@ int RunScore(int argc, char** argv) {
       "by one rigid motion (reported), and reports mean |error| and std per module and merged; the fill rate of "
       "each module over the object pixels that both its cameras see and a laser grid lights (from the truth's "
       "depth, id and lit maps); and the active/passive valid-point ratio (passive: the same options without the "
-      "lit-region crop, the grid-period distinctness test and the grid-line test). With a shape_model in --options, "
+      "lit-region crop, the grid-period distinctness test, the grid-line test and the line index). With a shape_model "
+      "in --options, "
       "the hole-filling points too: their distance to the truth surface (mean, p95, max, share within 0.5 mm), "
       "overall and by their distance to the nearest measured point (0-5, 5-15, >= 15 mm). Judge with the rig file "
       "from `stereorig calibrate`, as the line will run: without --rig the dataset's truth rig is used (and said "
@@ -120,12 +121,7 @@ int RunScore(int argc, char** argv) {
     if (!fs::is_regular_file(surface)) throw InputError(surface.string(), "no such file (the scene's truth)");
   }
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
-  RuntimeOptions passive_options = options;
-  // No grid: the whole volume's ROI, no test of the grid's period, none of its lines.
-  passive_options.crop_to_lit_region = false;
-  passive_options.match.min_distinctness = 0;
-  passive_options.match.grid_line.enabled = false;
-  const Runtime runtime(rig, options), passive_runtime(rig, passive_options);
+  const Runtime runtime(rig, options), passive_runtime(rig, PassiveOptions(options));
   diagnose.Create();
   nlohmann::json report = {{"dataset", dataset}, {"rig", rig_path}};
   {
@@ -166,9 +162,16 @@ int RunScore(int argc, char** argv) {
     if (!no_passive && fs::is_directory(scene_dir / "passive")) {
       const Reconstruction passive = passive_runtime.Process(LoadCapture((scene_dir / "passive").string(), rig), false);
       sj["passive_points"] = passive.cloud.size();
-      const double ratio = passive.cloud.size() == 0 ? 0.0 : double(rec.cloud.size()) / passive.cloud.size();
-      sj["active_over_passive"] = ratio;
-      std::printf("; passive %zu points (active/passive %.1fx)", passive.cloud.size(), ratio);
+      if (passive.cloud.size() > 0) {
+        const double ratio = double(rec.cloud.size()) / passive.cloud.size();
+        sj["active_over_passive"] = ratio;
+        std::printf("; passive %zu points (active/passive %.1fx)", passive.cloud.size(), ratio);
+      } else {  // no ratio to give: null, not 0 (which would read as "passive did better")
+        sj["active_over_passive"] = nullptr;
+        std::printf("; passive 0 points (no active/passive ratio)");
+      }
+    } else if (!no_passive) {
+      std::printf("; no passive capture (%s)", (scene_dir / "passive").c_str());
     }
     std::printf("; aligned by %.4f deg, %.4f mm\n", s.accuracy.truth_from_cloud.AngleDeg(),
                 s.accuracy.truth_from_cloud.translation_mm().norm());

@@ -179,6 +179,14 @@ RuntimeOptions FromYaml(YamlMap& y) {
 
 }  // namespace
 
+RuntimeOptions PassiveOptions(RuntimeOptions active) {
+  active.crop_to_lit_region = false;
+  active.match.min_distinctness = 0;
+  active.match.grid_line.enabled = false;
+  active.match.line_index.enabled = false;
+  return active;
+}
+
 RuntimeOptions ReadRuntimeOptions(const std::string& path) {
   YamlMap y = YamlMap::LoadFile(path);
   RuntimeOptions o = FromYaml(y);

@@ -70,6 +70,14 @@ struct RuntimeOptions {
 
 // Reads a runtime options YAML file (keys: docs/reconstruct.md).
 RuntimeOptions ReadRuntimeOptions(const std::string& path);
+
+// `active` for a capture without the laser grids (passive), so that the two
+// run the same pipeline: the grid's own steps off, the rest as given. No
+// crop to the lit region (the whole volume's ROI); no distinctness test half
+// a grid period off; no grid-line test; no line index (which laser line is
+// which: without lines its vernier reads noise, and on the demo cup it
+// dropped a third of module 0's pixels as wrong_line, every point).
+RuntimeOptions PassiveOptions(RuntimeOptions active);
 RuntimeOptions ParseRuntimeOptions(const std::string& text, const std::string& where);
 
 }  // namespace stereorig

@@ -26,6 +26,23 @@ void ExpectEachRejectedNamingItsKey(const std::pair<const char*, const char*> (&
 }
 
 // Every key commented out: the built-in defaults, as with no file.
+// A passive capture runs the same pipeline without the grid's own steps:
+// exactly those four are off, everything else as given.
+TEST(RuntimeOptions, PassiveOptionsTurnOffTheGridsStepsOnly) {
+  RuntimeOptions active;
+  active.object_size_mm = 60;
+  active.match.min_zncc = 0.7;
+  const RuntimeOptions passive = PassiveOptions(active);
+  EXPECT_FALSE(passive.crop_to_lit_region);
+  EXPECT_EQ(passive.match.min_distinctness, 0);
+  EXPECT_FALSE(passive.match.grid_line.enabled);
+  EXPECT_FALSE(passive.match.line_index.enabled);
+  EXPECT_EQ(passive.object_size_mm, 60);
+  EXPECT_EQ(passive.match.min_zncc, 0.7);
+  EXPECT_EQ(passive.match.grow.enabled, active.match.grow.enabled);
+  EXPECT_EQ(passive.match.speckle_window_px, active.match.speckle_window_px);
+}
+
 TEST(RuntimeOptions, AFileOfCommentsOnlyGivesTheDefaults) {
   const RuntimeOptions d;
   const RuntimeOptions o = ParseRuntimeOptions("# object_size_mm: 80\n# match:\n#   num_threads: 1\n", "c.yaml");
