@@ -232,8 +232,7 @@ int RunBench(int argc, char** argv) {
   app.add_option("--scenes", scenes_arg,
                  "with --dataset: comma-separated scenes; each one named must be in the dataset "
                  "(scenes/<name>/active), or the bench exits 2 before any run; by default, those of the five the "
-                 "dataset holds")
-      ->capture_default_str()
+                 "dataset holds (cup,sphere,ballbar,plate,tuber)")
       ->needs(dataset_option);
   app.add_option("--rig", rig_path, "rig file to reconstruct with (default: the dataset's truth/rig.yaml)");
   app.add_option("--options", options_path, "runtime options YAML");

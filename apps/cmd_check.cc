@@ -74,7 +74,9 @@ int RunCheck(int argc, char** argv) {
   app.add_option("--target", target_path, "the target file (YAML) of the board in the captures");
   app.add_option("--history-db", history_db, "SQLite history (default: check-history.sqlite beside the rig file)");
   app.add_option("--report", report_path, "write the figures as JSON here");
-  app.add_option("--k-sigma", options.k_sigma, "coverage factor of every threshold")->capture_default_str();
+  app.add_option("--k-sigma", options.k_sigma,
+                 "coverage factor of every threshold, in (0, 10]: each is k times its figure's sigma")
+      ->capture_default_str();
   app.add_flag("--history", history_only, "print the trend of every figure from the history, and stop");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 

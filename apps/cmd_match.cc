@@ -29,8 +29,10 @@ int RunMatch(int argc, char** argv) {
   std::vector<int> roi;
   app.add_option("--left", left_path, "rectified left image (8-bit grey)")->required();
   app.add_option("--right", right_path, "rectified right image (8-bit grey, same size)")->required();
-  app.add_option("--min-disparity", options.min_disparity_px, "smallest disparity searched, px")->required();
-  app.add_option("--num-disparities", options.num_disparities, "number of disparities searched, px")->required();
+  app.add_option("--min-disparity", options.min_disparity_px, "smallest disparity searched, px, in [-1024, 2048]")
+      ->required();
+  app.add_option("--num-disparities", options.num_disparities, "number of disparities searched, in [2, 1024]")
+      ->required();
   app.add_option("--out", out_path, "output disparity map (.pfm)")->required();
   app.add_option("--roi", roi, "left-image region to match: x y width height, inside the image (default: whole image)")
       ->expected(4);
@@ -41,7 +43,8 @@ int RunMatch(int argc, char** argv) {
   app.add_option("--pyramid-levels", options.pyramid_levels,
                  "census_sgm: halvings before the full-range SGM (0 = full-resolution SGM)")
       ->capture_default_str();
-  app.add_option("--threads", options.num_threads, "threads the matching may use at once (1 = this one only)")
+  app.add_option("--threads", options.num_threads,
+                 "threads the matching may use at once, in [1, 64] (1 = this one only)")
       ->capture_default_str();
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 

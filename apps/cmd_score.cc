@@ -64,7 +64,10 @@ int RunScore(int argc, char** argv) {
   bool no_passive = false;
   app.add_option("--dataset", dataset, "simulator dataset folder (scenes/, truth/)")->required();
   app.add_option("--rig", rig_path, "rig file to reconstruct with (default: DATASET/truth/rig.yaml)");
-  app.add_option("--scenes", scenes_arg, "comma-separated scenes")->capture_default_str();
+  app.add_option("--scenes", scenes_arg,
+                 "comma-separated scenes, each of which must be in the dataset (scenes/<name>/active), or score "
+                 "exits 2 before any scoring")
+      ->capture_default_str();
   app.add_option("--options", options_path, "runtime options YAML");
   app.add_option("--report", report_path, "write everything as JSON here");
   app.add_option("--diagnose", diagnose_dir,

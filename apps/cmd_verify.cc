@@ -42,7 +42,7 @@ int RunVerify(int argc, char** argv) {
   app.add_option("--artifact", artifact_path, "artifact file (YAML; docs/verify-and-check.md)")->required();
   app.add_option("--cloud", clouds, "point cloud (PLY, mm) of one position; repeat for several")->required();
   app.add_option("--report", report_path, "write the figures as JSON here");
-  app.add_option("--min-points", options.min_points, "fewest points that must lie on the artifact")
+  app.add_option("--min-points", options.min_points, "fewest points that must lie on the artifact (>= 10)")
       ->capture_default_str();
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
   OutputPaths outputs;  // the report's path checked before the clouds are read and judged
