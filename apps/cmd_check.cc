@@ -111,11 +111,13 @@ int RunCheck(int argc, char** argv) {
                                           : "the history database (by default beside the rig file, updated in place)");
 
   const Rig rig = ReadRigFile(rig_path);
+  RequireCalibrationResiduals(rig, rig_path);  // named by the rig file, before minutes of detection
   const Target target = ReadTargetFile(target_path);
   RejectCamerasBeyondTheRig(captures, rig.num_cameras());
   // A history that is not ours is refused before any work, so a failed run
   // leaves neither a report nor a half-recorded night.
   if (std::filesystem::exists(history_db)) ReadHistoryRuns(history_db);
+  if (!std::filesystem::is_directory(captures)) throw InputError(captures, "no such captures folder");
   std::fprintf(stderr, "check: detecting the target in %s\n", captures.c_str());
   const DetectedCaptures detected = DetectCaptureFolder(captures, target, rig.num_cameras(), DetectOptions(), true);
   for (int c = 0; c < rig.num_cameras(); ++c) {

@@ -20,6 +20,7 @@ namespace stereorig {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::Lines;
 using testing::Result;
 using testing::RunCli;
 
@@ -117,6 +118,19 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     EXPECT_EQ(Bytes(db), db_bytes) << what << ": the history changed";
   };
 
+  {  // A rig file without a calibration's residuals (the simulator's truth
+     // rig), or a captures folder that is not there: named before the
+     // target's detection starts (its progress line), in one line. Before,
+     // the first was named by the captures folder, after the detection.
+    const std::string truth = dir + "/ds/truth/rig.yaml";
+    Result no_residuals = RunCli("check --rig " + truth + " --captures " + dir + "/ds --target " + dir +
+                                 "/ds/target.yaml --history-db " + db + " --report " + report);
+    expect_refused(no_residuals, truth + ": the rig file has no provenance.residuals.cam0_rms_px", "truth rig");
+    EXPECT_EQ(Lines(no_residuals.err), 1) << no_residuals.err;
+    Result no_captures = check(dir + "/no_such_captures", dir + "/rig.yaml");
+    expect_refused(no_captures, dir + "/no_such_captures: no such captures folder", "no captures folder");
+    EXPECT_EQ(Lines(no_captures.err), 1) << no_captures.err;
+  }
   {  // A coverage factor that is not finite, or so large it would pass any
      // drift (inf was accepted, a verdict "ok" with infinite thresholds
      // written into the history), and a check's options with --history,

@@ -122,10 +122,7 @@ Consistency CameraConsistency(const Inputs& in, int c, const std::set<int>& trus
 
 }  // namespace
 
-CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vector<BoardObservation>& views,
-                            const CheckOptions& options, const std::string& where) {
-  options.Check();
-  Inputs in{rig, target, options, {}, {}, {}, {}};
+void RequireCalibrationResiduals(const Rig& rig, const std::string& where) {
   for (int c = 0; c < rig.num_cameras(); ++c) {
     const std::string key = "cam" + std::to_string(c) + "_rms_px";
     auto it = rig.provenance().residuals.find(key);
@@ -134,7 +131,16 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
                                   "; the check sets its thresholds from a calibration's residuals "
                                   "(use a rig written by stereorig calibrate)");
     }
-    in.sigma_px.push_back(it->second);
+  }
+}
+
+CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vector<BoardObservation>& views,
+                            const CheckOptions& options, const std::string& where) {
+  options.Check();
+  RequireCalibrationResiduals(rig, where);
+  Inputs in{rig, target, options, {}, {}, {}, {}};
+  for (int c = 0; c < rig.num_cameras(); ++c) {
+    in.sigma_px.push_back(rig.provenance().residuals.at("cam" + std::to_string(c) + "_rms_px"));
     in.u_px.push_back(Lookup(rig.provenance().uncertainties, "cam" + std::to_string(c) + "_projection_center_px", 0));
   }
   for (const BoardObservation& v : views) {

@@ -52,8 +52,14 @@ struct CheckResult {
   std::string Explanation() const;  // one line naming what moved
 };
 
+// Throws InputError(`where`, ...) unless the rig file holds the
+// calibration residuals the thresholds need (provenance.residuals.camK_rms_px,
+// > 0, for every camera): a rig stereorig calibrate did not write. Commands
+// call it with the rig file's path before the target is detected.
+void RequireCalibrationResiduals(const Rig& rig, const std::string& where);
+
 // Throws InputError(`where`, ...) when the rig file lacks the calibration
-// residuals the thresholds need, when there are too few captures, when a view
+// residuals the thresholds need (RequireCalibrationResiduals), when there are too few captures, when a view
 // names a camera the rig does not have, or when the captures do not fit the
 // rig at all (another rig's captures).
 CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vector<BoardObservation>& views,
