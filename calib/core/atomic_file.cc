@@ -23,7 +23,8 @@ std::string MakeTempPath(const std::string& path) {
 
 }  // namespace
 
-AtomicOutput::AtomicOutput(const std::string& path) : path_(path), temp_path_(MakeTempPath(path)) {
+AtomicOutput::AtomicOutput(const std::string& path)
+    : path_(path), temp_path_(MakeTempPath(path)), pending_(temp_path_) {
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();
   if (!parent.empty() && !std::filesystem::is_directory(parent)) {
     throw InputError(path, "output folder '" + parent.string() + "' does not exist");
@@ -32,6 +33,7 @@ AtomicOutput::AtomicOutput(const std::string& path) : path_(path), temp_path_(Ma
 
 AtomicOutput::~AtomicOutput() {
   if (!committed_) std::remove(temp_path_.c_str());
+  pending_.Release();
 }
 
 void AtomicOutput::Commit() {
@@ -40,6 +42,7 @@ void AtomicOutput::Commit() {
     std::remove(temp_path_.c_str());
     throw InputError(path_, "cannot write: " + err);
   }
+  pending_.Release();
   committed_ = true;
 }
 

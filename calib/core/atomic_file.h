@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "calib/core/pending_temporary.h"
+
 namespace stereorig {
 
 // Writes `bytes` to `path` atomically. Throws InputError naming `path` if the
@@ -31,6 +33,7 @@ class AtomicOutput {
  private:
   std::string path_;
   std::string temp_path_;
+  PendingTemporary pending_;  // removed by a termination signal while it exists
   bool committed_ = false;
 };
 
