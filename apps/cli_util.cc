@@ -37,13 +37,15 @@ std::vector<std::string> SplitSceneList(const std::string& list) {
   return scenes;
 }
 
-void CheckDatasetFolder(const std::string& dataset) {
+void CheckDatasetFolder(const std::string& dataset, bool need_truth) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  if (!fs::exists(dataset, ec)) throw InputError(dataset, "no such dataset folder (--dataset)");
-  if (!fs::is_directory(dataset, ec))
+  const fs::file_status status = fs::status(dataset, ec);
+  if (status.type() == fs::file_type::not_found) throw InputError(dataset, "no such dataset folder (--dataset)");
+  if (ec) throw InputError(dataset, "cannot read it: " + ec.message());
+  if (!fs::is_directory(status))
     throw InputError(dataset, "is a file, not a dataset folder (--dataset: the folder stereorig simulate writes)");
-  if (!fs::is_directory(fs::path(dataset) / "truth", ec))
+  if (need_truth && !fs::is_directory(fs::path(dataset) / "truth", ec))
     throw InputError(dataset, "is not a simulator dataset: it has no truth/ folder (--dataset)");
 }
 

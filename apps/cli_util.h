@@ -28,10 +28,11 @@ std::vector<std::string> SplitSceneList(const std::string& list);
 // named by its folder; several by the dataset's scenes/ folder and a list.
 void CheckScenesInDataset(const std::string& dataset, const std::vector<std::string>& scenes);
 
-// Throws InputError naming `dataset` unless it is a folder with truth/ in
-// it: a file or a wrong folder given to --dataset is named as such, not as
-// a missing DATASET/truth/rig.yaml.
-void CheckDatasetFolder(const std::string& dataset);
+// Throws InputError naming `dataset` unless it is a folder, and (with
+// need_truth: no --rig given, so its truth/rig.yaml is the rig) one with
+// truth/ in it: a file or a wrong folder given to --dataset is named as
+// such, not as a missing DATASET/truth/rig.yaml.
+void CheckDatasetFolder(const std::string& dataset, bool need_truth);
 
 // For subcommands a later issue fills in: prints what it will do and exits 2.
 int NotBuiltYet(const char* name, const char* what, int argc, char** argv);

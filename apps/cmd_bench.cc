@@ -256,7 +256,7 @@ int RunBench(int argc, char** argv) {
   // skipped, and fewer scenes benched without a word); the default list
   // takes those the dataset holds.
   const std::vector<std::string> scene_names = SplitSceneList(scenes_arg);
-  if (!dataset.empty()) CheckDatasetFolder(dataset);
+  if (!dataset.empty()) CheckDatasetFolder(dataset, rig_path.empty());  // its own captures with --rig: no truth
   if (!dataset.empty() && app.count("--scenes") > 0) CheckScenesInDataset(dataset, scene_names);
 
   Rig rig;

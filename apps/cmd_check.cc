@@ -117,6 +117,8 @@ int RunCheck(int argc, char** argv) {
   // A history that is not ours is refused before any work, so a failed run
   // leaves neither a report nor a half-recorded night.
   if (std::filesystem::exists(history_db)) ReadHistoryRuns(history_db);
+  if (std::filesystem::exists(captures) && !std::filesystem::is_directory(captures))
+    throw InputError(captures, "is a file, not a captures folder");
   if (!std::filesystem::is_directory(captures)) throw InputError(captures, "no such captures folder");
   std::fprintf(stderr, "check: detecting the target in %s\n", captures.c_str());
   const DetectedCaptures detected = DetectCaptureFolder(captures, target, rig.num_cameras(), DetectOptions(), true);

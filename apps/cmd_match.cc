@@ -50,6 +50,14 @@ int RunMatch(int argc, char** argv) {
 
   options.matcher = ParseMatcherKind(matcher, "--matcher");
   if (!roi.empty()) options.roi = cv::Rect(roi[0], roi[1], roi[2], roi[3]);
+  // An empty or negative size first, in the words of the full check below
+  // (MatchOptions::Check would say "non-negative", as if 0 were fine).
+  auto roi_refusal = [&](const std::string& image) {
+    return InputError("--roi", std::to_string(roi[0]) + " " + std::to_string(roi[1]) + " " + std::to_string(roi[2]) +
+                                   " " + std::to_string(roi[3]) + " must have a positive size and lie inside the " +
+                                   image);
+  };
+  if (!roi.empty() && (roi[2] <= 0 || roi[3] <= 0)) throw roi_refusal("image");
   try {
     options.Check();
   } catch (const InputError& e) {  // named by the flag that set it, not by the options field
@@ -71,10 +79,8 @@ int RunMatch(int argc, char** argv) {
   // A region partly or wholly outside the image, or empty, is a mistake to
   // name, not one to clip or widen to the whole image without a word.
   const cv::Rect image(0, 0, left.cols, left.rows);
-  if (!roi.empty() && (roi[2] <= 0 || roi[3] <= 0 || (options.roi & image) != options.roi))
-    throw InputError("--roi", std::to_string(roi[0]) + " " + std::to_string(roi[1]) + " " + std::to_string(roi[2]) +
-                                  " " + std::to_string(roi[3]) + " must have a positive size and lie inside the " +
-                                  std::to_string(left.cols) + "x" + std::to_string(left.rows) + " image");
+  if (!roi.empty() && (options.roi & image) != options.roi)
+    throw roi_refusal(std::to_string(left.cols) + "x" + std::to_string(left.rows) + " image");
   const cv::Rect matched = roi.empty() ? image : options.roi;
 
   const auto t0 = std::chrono::steady_clock::now();

@@ -1,4 +1,5 @@
 // `stereorig reconstruct`: rig file + capture -> point cloud, mesh, report.
+#include <cctype>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -56,6 +57,8 @@ int RunReconstruct(int argc, char** argv) {
   mesh->excludes(dir);
   format->needs(dir);
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
+  // In any case, as --mesh's suffix (STL, Ply): the files are named in lower case.
+  for (char& c : mesh_format) c = char(std::tolower(static_cast<unsigned char>(c)));
   if (out_dir.empty() && out_path.empty())
     throw InputError("--out", "give --out (one capture) or --out-dir (many captures)");
   if (out_dir.empty() && capture_dirs.size() > 1)

@@ -103,7 +103,7 @@ int RunScore(int argc, char** argv) {
        .options_path = options_path,
        .check_folder = report_path.empty() || !diagnose.WillCreate(fs::absolute(report_path).parent_path()),
        .more_inputs = DatasetInputs(dataset)});
-  CheckDatasetFolder(dataset);  // named as what it is, not as a missing truth/rig.yaml
+  CheckDatasetFolder(dataset, true);  // named as what it is, not as a missing truth/rig.yaml
   const Rig rig = ReadRigFile(rig_path);
   const std::vector<std::string> scenes = SplitSceneList(scenes_arg);
   if (!diagnose_dir.empty()) {

@@ -32,8 +32,12 @@ int RunSimulate(int argc, char** argv) {
   app.add_option("--out", o.out_dir,
                  "dataset folder to write; if it already holds a dataset, the whole folder is replaced atomically, "
                  "anything else in it included");
+  // Checked on the text: a negative seed would wrap round to 2^64 - 1
+  // (CLI11's NonNegativeNumber prints DBL_MAX's 309 digits as its bound).
   app.add_option("--seed", o.seed, "random seed: poses, scenes, noise (>= 0)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(CLI::Validator(
+          [](const std::string& text) { return text.starts_with('-') ? std::string("must be >= 0") : std::string(); },
+          "", "NonNegative"))
       ->capture_default_str();
   app.add_option("--threads", o.threads, "worker threads (0 = all cores)")->capture_default_str();
   app.add_option("--calibration-captures", o.calibration_captures, "override the spec's number of target captures");
@@ -44,6 +48,11 @@ int RunSimulate(int argc, char** argv) {
   app.add_option("--bump-rotation-deg", o.bump.rotation_deg, "bump: rotation angle, about a seeded random axis");
   app.add_option("--bump-translation-mm", o.bump.translation_mm, "bump: shift, along a seeded random direction");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
+  if (!write_spec.empty())
+    for (const char* flag : {"--out", "--seed", "--threads", "--calibration-captures", "--no-scenes", "--bump-camera",
+                             "--bump-module", "--bump-rotation-deg", "--bump-translation-mm"})
+      if (app.count(flag) > 0)
+        throw InputError(flag, "does not apply with --write-default-spec (it writes the spec and stops)");
   // A bump needs what to move and by how much: either alone used to render
   // an undisturbed rig without a word.
   const bool bump_what = app.count("--bump-camera") + app.count("--bump-module") > 0;
@@ -56,10 +65,6 @@ int RunSimulate(int argc, char** argv) {
                      "needs --bump-rotation-deg or --bump-translation-mm (by how much)");
 
   if (!write_spec.empty()) {
-    for (const char* flag : {"--out", "--seed", "--threads", "--calibration-captures", "--no-scenes", "--bump-camera",
-                             "--bump-module", "--bump-rotation-deg", "--bump-translation-mm"})
-      if (app.count(flag) > 0)
-        throw InputError(flag, "does not apply with --write-default-spec (it writes the spec and stops)");
     // Checked like every other command's outputs (apps/output_paths.h): its
     // folder exists, it is not a folder, and it is not the --spec file given
     // alongside (which the default would replace).

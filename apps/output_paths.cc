@@ -83,7 +83,7 @@ std::vector<std::pair<std::string, std::string>> DatasetInputs(const std::string
   if (fs::is_directory(root / "truth"))
     for (auto it = fs::recursive_directory_iterator(root / "truth", ec);
          !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
-      if (it->is_regular_file(ec) && it->path().filename() != "rig.yaml")
+      if (it->is_regular_file(ec) && it->path() != root / "truth" / "rig.yaml")
         inputs.push_back({it->path().string(), "a truth file of the dataset"});
   inputs.push_back({(root / "spec.yaml").string(), "the dataset's spec"});
   if (fs::is_directory(root / "scenes")) {

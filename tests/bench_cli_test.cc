@@ -126,6 +126,17 @@ TEST(BenchCli, AMissingSceneNamedInScenesExitsTwoBeforeAnyRun) {
     EXPECT_NE(r.err.find(dataset + "/truth/rig.yaml"), std::string::npos) << scenes << ": " << r.err;
     EXPECT_EQ(r.err.find("no such scene"), std::string::npos) << scenes << ": " << r.err;
   }
+  // A line's own captures, laid out as scenes/<name>/active, with its
+  // calibrated rig: no truth/ is needed (only without --rig, whose default
+  // is truth/rig.yaml). On to that rig file here too.
+  std::filesystem::remove_all(dataset + "/truth");
+  { std::ofstream(dataset + "/own_rig.yaml") << "not a rig\n"; }
+  const testing::Result own = RunCli(bench + " --scenes cup --rig " + dataset + "/own_rig.yaml");
+  EXPECT_EQ(own.code, 2);
+  EXPECT_NE(own.err.find(dataset + "/own_rig.yaml"), std::string::npos) << own.err;
+  const testing::Result no_truth = RunCli(bench + " --scenes cup");
+  EXPECT_NE(no_truth.err.find(dataset + ": is not a simulator dataset: it has no truth/ folder"), std::string::npos)
+      << no_truth.err;
   std::filesystem::remove_all(dataset);
 }
 

@@ -101,12 +101,18 @@ TEST(Cli, MatchRefusesARegionNotInsideTheImage) {
   const std::string dir = MatchScratch("cli_match_roi");
   const std::string base =
       "match --left " + dir + "/l.png --right " + dir + "/l.png --min-disparity 0 --num-disparities 16 --out " + dir;
-  for (const char* roi : {"40 10 30 10", "0 0 100000 100000", "-1 0 64 32", "10 10 0 5", "0 0 0 0", "70 40 5 5"}) {
+  // An empty or negative size is refused before the images are read (no
+  // size to name yet), one outside the image after.
+  const std::pair<std::string, std::string> cases[] = {
+      {"40 10 30 10", "the 64x32 image"}, {"0 0 100000 100000", "the 64x32 image"},
+      {"-1 0 64 32", "the 64x32 image"},  {"70 40 5 5", "the 64x32 image"},
+      {"10 10 0 5", "the image"},         {"0 0 0 0", "the image"},
+      {"10 10 -5 5", "the image"}};
+  for (const auto& [roi, image] : cases) {
     const Result r = RunCli(base + "/d.pfm --roi " + roi);
     EXPECT_EQ(r.code, 2) << roi;
     EXPECT_EQ(Lines(r.err), 1) << r.err;
-    EXPECT_NE(r.err.find("--roi: " + std::string(roi) + " must have a positive size and lie inside the 64x32 image"),
-              std::string::npos)
+    EXPECT_NE(r.err.find("--roi: " + roi + " must have a positive size and lie inside " + image), std::string::npos)
         << r.err;
     EXPECT_FALSE(std::filesystem::exists(dir + "/d.pfm")) << roi;
   }

@@ -690,7 +690,7 @@ TEST_F(ReconstructCli, ABatchWritesEachCapturesOwnCloudAndSkipsABrokenOne) {
   const std::string out = dir_ + "/batch_out";
   std::filesystem::remove_all(out);
   EXPECT_EQ(RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + batch + "/0001 " + batch + "/0002 " + batch +
-                   "/0003 --out-dir " + out + " --mesh-format stl --report " + out + "/batch.json"),
+                   "/0003 --out-dir " + out + " --mesh-format STL --report " + out + "/batch.json"),  // any case
             2);
   auto bytes = [](const std::string& path) {
     std::ifstream f(path, std::ios::binary);

@@ -91,7 +91,8 @@ TEST(SimulateCli, OptionsThatWouldBeIgnoredAreRefused) {
       {out + " --bump-rotation-deg 0.1", "--bump-rotation-deg: needs --bump-camera or --bump-module"},
       {out + " --bump-camera 1", "--bump-camera: needs --bump-rotation-deg or --bump-translation-mm"},
       {" --write-default-spec " + dir + "/s.yaml" + out, "--out: does not apply with --write-default-spec"},
-      {out + " --seed -1", "--seed"}};
+      {" --write-default-spec " + dir + "/s.yaml --bump-camera 1", "--bump-camera: does not apply with"},
+      {out + " --seed -1", "--seed: must be >= 0"}};
   for (const auto& [args, says] : cases) {
     const Result r = RunCli("simulate" + args);
     EXPECT_EQ(r.code, 2) << args;

@@ -1,5 +1,6 @@
 #include "atomic_file.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -73,7 +74,43 @@ void AtomicOutputSet::Add(const std::string& path, const std::string& bytes) {
 }
 
 void AtomicOutputSet::Commit() {
-  for (const std::unique_ptr<AtomicOutput>& out : staged_) out->Commit();
+  // What is at each output path now, kept under a second name until every
+  // rename is done.
+  struct Earlier {
+    bool existed = false;
+    std::string kept;  // the hard link's path; empty if none was made
+    std::unique_ptr<PendingTemporary> pending;
+  };
+  std::vector<Earlier> earlier(staged_.size());
+  for (size_t i = 0; i < staged_.size(); ++i) {
+    const std::string& path = staged_[i]->path();
+    struct stat st {};
+    if (lstat(path.c_str(), &st) != 0) continue;
+    earlier[i].existed = true;
+    const std::string kept = MakeTempPath(path);
+    if (link(path.c_str(), kept.c_str()) != 0) continue;
+    earlier[i].kept = kept;
+    earlier[i].pending = std::make_unique<PendingTemporary>(kept);
+  }
+  auto drop_kept = [&] {
+    for (const Earlier& e : earlier)
+      if (!e.kept.empty()) std::remove(e.kept.c_str());  // gone already where it was put back
+  };
+  size_t done = 0;
+  try {
+    for (; done < staged_.size(); ++done) staged_[done]->Commit();
+  } catch (...) {
+    for (size_t j = 0; j < done; ++j) {
+      const std::string& path = staged_[j]->path();
+      if (!earlier[j].kept.empty())
+        std::rename(earlier[j].kept.c_str(), path.c_str());
+      else if (!earlier[j].existed)
+        std::remove(path.c_str());
+    }
+    drop_kept();
+    throw;
+  }
+  drop_kept();
   staged_.clear();
 }
 

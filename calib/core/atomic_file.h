@@ -28,7 +28,8 @@ class AtomicOutput {
   // Same folder and extension as the final path, so format-by-extension
   // writers still work.
   const std::string& temp_path() const { return temp_path_; }
-  void Commit();  // renames; throws InputError on failure
+  const std::string& path() const { return path_; }  // the final path
+  void Commit();                                     // renames; throws InputError on failure
 
  private:
   std::string path_;
@@ -42,11 +43,15 @@ class AtomicOutput {
 // every one is written. Destroyed before Commit (a later output failed), it
 // removes the temporary files: a run that fails while writing its second or
 // third output (a full disk) leaves every file at its output paths as it
-// was, not the first output new and the rest old.
+// was, not the first output new and the rest old. A rename that fails
+// within Commit (an immutable or busy file) puts back what the renames
+// before it replaced (kept under a second name, a hard link, until all are
+// done) and removes what they added; where the file system makes no hard
+// link, that one earlier file cannot be put back.
 class AtomicOutputSet {
  public:
   void Add(const std::string& path, const std::string& bytes);
-  void Commit();  // in the order added; throws InputError on a failed rename
+  void Commit();  // in the order added; throws InputError on a failed rename, the earlier files put back
 
  private:
   std::vector<std::unique_ptr<AtomicOutput>> staged_;

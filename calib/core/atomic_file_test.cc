@@ -58,6 +58,25 @@ TEST(AtomicOutputSet, AFailingOutputLeavesEveryEarlierFileAsItWas) {
   EXPECT_EQ(Names(dir), std::vector<std::string>{"a.ply"});
 }
 
+// A rename that fails within Commit (here onto a folder that holds a file;
+// in use: an immutable or busy file) puts back what the renames before it
+// replaced and removes what they added: the earlier run's files as they were,
+// and nothing else left (no temporary file, no kept copy).
+TEST(AtomicOutputSet, ARenameThatFailsPutsTheEarlierFilesBack) {
+  const std::string dir = testing::ScratchFolder("atomic_set_rename_fails");
+  WriteFileAtomically(dir + "/a.ply", "old cloud");
+  std::filesystem::create_directory(dir + "/busy");
+  WriteFileAtomically(dir + "/busy/inside", "x");
+  AtomicOutputSet outputs;
+  outputs.Add(dir + "/a.ply", "new cloud");
+  outputs.Add(dir + "/b.json", "new report");
+  outputs.Add(dir + "/busy", "cannot replace a folder");
+  EXPECT_NE(testing::InputErrorMessage([&] { outputs.Commit(); }).find(dir + "/busy: cannot write"), std::string::npos);
+  EXPECT_EQ(Contents(dir + "/a.ply"), "old cloud");
+  EXPECT_EQ(Names(dir), (std::vector<std::string>{"a.ply", "busy"}));
+  EXPECT_EQ(Names(dir + "/busy"), std::vector<std::string>{"inside"});
+}
+
 TEST(WriteFileAtomically, ReplacesTheFileAndLeavesNoTemporaryFile) {
   const std::string dir = testing::ScratchFolder("atomic_write");
   WriteFileAtomically(dir + "/r.json", "first");

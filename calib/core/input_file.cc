@@ -7,10 +7,13 @@
 namespace stereorig {
 
 void RequireInputFile(const std::string& path) {
+  namespace fs = std::filesystem;
   std::error_code ec;
-  if (std::filesystem::is_regular_file(path, ec)) return;
-  if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a folder, not a file");
-  throw InputError(path, "no such file");
+  const fs::file_status status = fs::status(path, ec);
+  if (status.type() == fs::file_type::not_found) throw InputError(path, "no such file");
+  if (ec) throw InputError(path, "cannot read it: " + ec.message());  // e.g. a folder on the way not searchable
+  if (fs::is_directory(status)) throw InputError(path, "is a folder, not a file");
+  if (!fs::is_regular_file(status)) throw InputError(path, "is not a regular file");
 }
 
 }  // namespace stereorig

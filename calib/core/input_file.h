@@ -7,7 +7,8 @@
 namespace stereorig {
 
 // Throws InputError naming `path` unless it is a regular file (or a link to
-// one): "no such file", or "is a folder, not a file".
+// one): "no such file", "is a folder, not a file", or why it cannot be
+// looked at (a folder on the way the process may not search).
 void RequireInputFile(const std::string& path);
 
 }  // namespace stereorig
