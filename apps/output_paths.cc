@@ -81,7 +81,8 @@ std::vector<std::pair<std::string, std::string>> DatasetInputs(const std::string
   // The rest of the truth: surfaces, depth, id and lit maps, object poses.
   std::error_code ec;
   if (fs::is_directory(root / "truth"))
-    for (auto it = fs::recursive_directory_iterator(root / "truth", ec);
+    for (auto it =
+             fs::recursive_directory_iterator(root / "truth", fs::directory_options::follow_directory_symlink, ec);
          !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
       if (it->is_regular_file(ec) && it->path() != root / "truth" / "rig.yaml")
         inputs.push_back({it->path().string(), "a truth file of the dataset"});

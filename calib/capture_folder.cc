@@ -8,6 +8,7 @@
 
 #include "calib/core/capture_image_name.h"
 #include "calib/core/input_error.h"
+#include "calib/core/input_file.h"
 #include "calib/core/png_file.h"
 #include "calib/layout_file.h"
 #include "targets/target_file.h"
@@ -66,13 +67,20 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
       const fs::path image = captures[n] / CameraImageName(c);
       if (!fs::exists(image))
         throw InputError(image.string(), "missing (each capture needs camK.png for every camera)");
-      CheckPngIsWhole(image.string());
+      RequireInputFile(image.string());  // a folder named cam0.png
+      // Not a PNG though so named (a JPEG): its decoder would complain first.
+      if (!CheckPngIsWhole(image.string())) throw InputError(image.string(), "is not a PNG file, though named .png");
       // Read as stored, and held to what the runtime reads
       // (reconstruct/grey_image.h): imread's own conversion to grey would
       // take a 16-bit image's high byte (a 12-bit camera's image in the low
       // bits turns nearly black, and then no board is found) and let a
       // colour capture through that `reconstruct` refuses.
-      const cv::Mat grey = cv::imread(image.string(), cv::IMREAD_UNCHANGED);
+      cv::Mat grey;
+      try {
+        grey = cv::imread(image.string(), cv::IMREAD_UNCHANGED);
+      } catch (const cv::Exception& e) {  // a header whose size the decoder refuses: its short text, one line
+        throw InputError(image.string(), "cannot read the image (" + e.err + ")");
+      }
       if (grey.empty()) throw InputError(image.string(), "cannot be read as an image");
       if (grey.type() != CV_8UC1)
         throw InputError(image.string(),

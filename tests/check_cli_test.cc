@@ -142,6 +142,12 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     expect_refused(RunCli("check --history --history-db " + db + " --report " + report),
                    "--report: does not apply with --history", "--history with --report");
   }
+  {  // Bytes of another format (a JPEG's start) named cam1.png: named so, in
+     // one line (before, the decoder's own complaint could come first).
+    const std::string d = copy("jpeg_named_png");
+    std::ofstream(d + "/003/cam1.png", std::ios::binary | std::ios::trunc) << "\xff\xd8\xff\xe0 a JPEG's start";
+    expect_refused(check(d, dir + "/rig.yaml"), "003/cam1.png: is not a PNG file, though named .png", "JPEG bytes");
+  }
   {  // A corrupt (truncated, unreadable) image.
     const std::string d = copy("corrupt");
     const std::string bad = d + "/003/cam1.png";
