@@ -1,7 +1,6 @@
 // `stereorig check`: the nightly recalibration check. Fresh target captures
 // + the stored rig file -> ok / recalibrate, what moved, and history.
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -94,11 +93,12 @@ int RunCheck(int argc, char** argv) {
   if (rig_path.empty() || captures.empty() || target_path.empty()) {
     throw InputError("", "--rig, --captures and --target are required (see --help)");
   }
-  // A coverage factor, as in GUM: 2-3 usual; a huge or infinite one would
-  // pass any drift and write those thresholds into the history.
-  if (!(std::isfinite(options.k_sigma) && options.k_sigma > 0 && options.k_sigma <= 10))
-    throw InputError("--k-sigma", "must be in (0, 10] (each threshold is k times the figure's sigma)");
-  options.Check();
+  try {
+    options.Check();
+  } catch (const InputError& e) {  // named by the flag that set it
+    if (e.where() == "k_sigma") throw InputError("--k-sigma", e.problem());
+    throw;
+  }
   // The report and the history checked before the target is detected: a
   // report over the rig file, or into a folder that is not there, would
   // fail (or destroy the rig file) only after the work.
@@ -117,9 +117,7 @@ int RunCheck(int argc, char** argv) {
   // A history that is not ours is refused before any work, so a failed run
   // leaves neither a report nor a half-recorded night.
   if (std::filesystem::exists(history_db)) ReadHistoryRuns(history_db);
-  if (std::filesystem::exists(captures) && !std::filesystem::is_directory(captures))
-    throw InputError(captures, "is a file, not a captures folder");
-  if (!std::filesystem::is_directory(captures)) throw InputError(captures, "no such captures folder");
+  RequireCapturesFolder(captures);  // before the progress line
   std::fprintf(stderr, "check: detecting the target in %s\n", captures.c_str());
   const DetectedCaptures detected = DetectCaptureFolder(captures, target, rig.num_cameras(), DetectOptions(), true);
   for (int c = 0; c < rig.num_cameras(); ++c) {

@@ -46,9 +46,14 @@ std::vector<std::string> CaptureFolderImages(const std::string& dir) {
   return images;
 }
 
+void RequireCapturesFolder(const std::string& dir) {
+  if (fs::is_directory(dir)) return;
+  throw InputError(dir, fs::exists(dir) ? "is a file, not a captures folder" : "no such captures folder");
+}
+
 DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& target, int num_cameras,
                                      const DetectOptions& options, bool progress) {
-  if (!fs::is_directory(dir_in)) throw InputError(dir_in, "no such captures folder");
+  RequireCapturesFolder(dir_in);
   const fs::path dir = CapturesRoot(dir_in);
   const std::vector<fs::path> captures = CaptureSubfolders(dir);
   if (captures.empty()) throw InputError(dir.string(), "holds no capture folders (expected NNN/camK.png)");

@@ -41,6 +41,11 @@ struct DetectedCaptures {
 // folder (the detector names it then).
 std::vector<std::string> CaptureFolderImages(const std::string& dir);
 
+// Throws InputError naming `dir` unless it is a folder: "no such captures
+// folder", or "is a file, not a captures folder". DetectCaptureFolder calls
+// it first; a command calls it before announcing the detection.
+void RequireCapturesFolder(const std::string& dir);
+
 // Detects the target in every image. Throws InputError (naming the file) on
 // a missing folder or image, an unreadable image, or images of one camera
 // with different sizes. `progress`: one line per capture on stderr.

@@ -5,7 +5,6 @@
 #include <sstream>
 #include <vector>
 
-#include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 
 namespace stereorig {
@@ -145,7 +144,5 @@ BoardSvg MakeBoardSvg(const Target& target, const BoardSvgOptions& options) {
   out.text = o.str();
   return out;
 }
-
-void WriteBoardSvg(const BoardSvg& svg, const std::string& path) { WriteFileAtomically(path, svg.text); }
 
 }  // namespace stereorig

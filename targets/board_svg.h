@@ -33,6 +33,5 @@ struct BoardSvg {
 
 // Throws InputError if `options` asks for the back face of a plain board.
 BoardSvg MakeBoardSvg(const Target& target, const BoardSvgOptions& options = {});
-void WriteBoardSvg(const BoardSvg& svg, const std::string& path);  // atomic
 
 }  // namespace stereorig

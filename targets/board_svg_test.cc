@@ -12,6 +12,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "targets/detect.h"
 
@@ -36,7 +37,7 @@ TEST(BoardSvg, SquaresScaleBarAndPageAreInTrueMillimetres) {
   const Target target = DefaultTarget();
   const std::string path = (std::filesystem::temp_directory_path() / "stereorig_board_svg_test.svg").string();
   const BoardSvg svg = MakeBoardSvg(target);
-  WriteBoardSvg(svg, path);
+  WriteFileAtomically(path, svg.text);
   const std::string text = ReadAll(path);
   ASSERT_EQ(text, svg.text);
 
@@ -137,7 +138,7 @@ TEST(BoardSvg, RasterisedPrintIsDetectedWhereTheTargetSaysItsCornersAre) {
     options.faces = kinds[k];
     svgs.push_back(MakeBoardSvg(target, options));
     const std::string stem = dir + "/stereorig_raster_test_" + std::to_string(k);
-    WriteBoardSvg(svgs.back(), stem + ".svg");
+    WriteFileAtomically(stem + ".svg", svgs.back().text);
     cmd += " " + stem + ".svg " + stem + ".png";
   }
   ASSERT_EQ(std::system(cmd.c_str()), 0);

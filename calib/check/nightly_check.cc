@@ -12,8 +12,10 @@
 namespace stereorig {
 
 void CheckOptions::Check() const {
-  if (!(k_sigma > 0 && std::isfinite(k_sigma)))
-    throw InputError("check options", "k_sigma must be positive and finite");
+  // A coverage factor, as in GUM (2-3 usual): a huge or infinite one would
+  // pass any drift and write such thresholds into the history.
+  if (!(k_sigma > 0 && k_sigma <= 10))
+    throw InputError("k_sigma", "must be in (0, 10] (each threshold is k times the figure's sigma)");
   if (min_captures < 1) throw InputError("check options", "min_captures must be >= 1");
   if (min_corners_per_view < 4) throw InputError("check options", "min_corners_per_view must be >= 4");
 }

@@ -29,7 +29,7 @@ struct CheckOptions {
   // Coverage factor of every threshold: a figure fails when it exceeds its
   // H0 expectation by this many standard errors. 3.5 gives a per-figure false
   // alarm rate near 2e-4 for Gaussian noise.
-  double k_sigma = 3.5;
+  double k_sigma = 3.5;          // in (0, 10]
   int min_captures = 5;          // fewer: bad input
   int min_corners_per_view = 6;  // views with fewer are ignored
   void Check() const;
