@@ -6,6 +6,7 @@
 
 #include "atomic_file.h"
 #include "input_error.h"
+#include "lens_plausibility.h"
 #include "yaml_reader.h"
 
 namespace stereorig {
@@ -84,6 +85,7 @@ Rig ParseRig(YamlMap root) {
     std::vector<double> intrinsics = c.GetDoubles("intrinsics");
     const std::vector<int> size = c.GetInts("imagersize", 2);
     cameras.emplace_back(model, std::move(intrinsics), size[0], size[1], c.Where());
+    CheckLensIsPlausible(cameras.back(), c.Where());
     c.Finish();
   }
 

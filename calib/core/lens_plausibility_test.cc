@@ -1,0 +1,110 @@
+#include "calib/core/lens_plausibility.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+#include "calib/core/input_error.h"
+#include "calib/core/rig_file.h"
+
+namespace stereorig {
+namespace {
+
+// The default rig's left camera, as `stereorig calibrate` wrote it for the
+// demo: fx, fy, cx, cy, k1, k2, p1, p2, k3.
+std::vector<double> DemoIntrinsics() {
+  return {1025.0168, 1025.4201, 379.4664, 293.1394, -0.1106, 0.0970, 1.84e-4, -9.17e-5, -0.0471};
+}
+
+Camera Opencv5(const std::vector<double>& intrinsics) { return Camera("LENSMODEL_OPENCV5", intrinsics, 752, 582); }
+
+std::string ErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(LensPlausibility, RealLensesPass) {
+  EXPECT_NO_THROW(CheckLensIsPlausible(Opencv5(DemoIntrinsics()), "demo"));
+  // Strong barrel distortion that stays one-to-one over the imager: the
+  // corner is r = 0.46 (normalised) from the centre, where
+  // d(r (1 + k1 r^2)) / dr = 1 + 3 k1 r^2 = 0.81 > 0.
+  std::vector<double> barrel = DemoIntrinsics();
+  barrel[4] = -0.3, barrel[5] = barrel[8] = 0;
+  EXPECT_NO_THROW(CheckLensIsPlausible(Opencv5(barrel), "barrel"));
+  // A pinhole of 2 px focal length: a field of view near 180 deg, real for
+  // no lens on this imager but not refused by these checks (they refuse
+  // what cannot be a lens, not what is unusual).
+  EXPECT_NO_THROW(CheckLensIsPlausible(Camera("LENSMODEL_PINHOLE", {300, 300, 375.5, 290.5}, 752, 582), "wide"));
+}
+
+TEST(LensPlausibility, APrincipalPointOffTheImagerIsRefused) {
+  std::vector<double> k = DemoIntrinsics();
+  k[2] = 900;  // cx beyond the 752 px width
+  const std::string e = ErrorOf([&] { CheckLensIsPlausible(Opencv5(k), "rig.yaml: cameras[0]"); });
+  EXPECT_NE(e.find("rig.yaml: cameras[0]: the principal point (cx, cy) = (900, 293.1) px lies off the 752 x 582"),
+            std::string::npos)
+      << e;
+}
+
+TEST(LensPlausibility, PixelsFarFromSquareAreRefused) {
+  std::vector<double> k = DemoIntrinsics();
+  k[0] = 2 * k[1];  // fx doubled
+  EXPECT_NE(ErrorOf([&] { CheckLensIsPlausible(Opencv5(k), "c"); }).find("fx / fy = 2051 / 1025 = 2"),
+            std::string::npos);
+  k[0] = 1.45 * k[1];  // inside the limit
+  EXPECT_NO_THROW(CheckLensIsPlausible(Opencv5(k), "c"));
+}
+
+TEST(LensPlausibility, AFieldOfViewOfNothingIsRefused) {
+  std::vector<double> k = DemoIntrinsics();
+  k[0] = k[1] = 1e7;  // the edge pixels' centres, 751 px apart, span 751 / 1e7 rad = 0.004303 deg
+  const std::string e = ErrorOf([&] { CheckLensIsPlausible(Opencv5(k), "c"); });
+  EXPECT_NE(e.find("a field of view of 0.004303 deg across"), std::string::npos) << e;
+  k[0] = k[1] = 4e5;  // 751 / 4e5 rad = 0.108 deg: a long telephoto, kept
+  EXPECT_NO_THROW(CheckLensIsPlausible(Opencv5(k), "c"));
+}
+
+// k1 = -50: r (1 + k1 r^2) peaks at r = 1 / sqrt(-3 k1) = 0.0816 (normalised;
+// k2, k3 zeroed), i.e. 0.0544 * fx = 56 px from the principal point (the
+// analytic bound, not this code's), far inside the imager: beyond it no ray
+// projects, so the walk outwards must stop there.
+TEST(LensPlausibility, ADistortionThatFoldsBackIsRefused) {
+  std::vector<double> k = DemoIntrinsics();
+  k[4] = -50, k[5] = k[8] = 0;
+  const double r_peak = 1 / std::sqrt(-3 * k[4]);
+  const double fold_px = k[0] * r_peak * (1 + k[4] * r_peak * r_peak);
+  ASSERT_NEAR(fold_px, 55.8, 0.1);
+  const std::string e = ErrorOf([&] { CheckLensIsPlausible(Opencv5(k), "c"); });
+  EXPECT_NE(e.find("check the distortion coefficients"), std::string::npos) << e;
+  // The first pixel refused lies beyond the fold, and within one sample
+  // step (the longest line: the corner, ~475 px, / 64) of it.
+  const size_t from = e.find(" px from the principal point");
+  ASSERT_NE(from, std::string::npos) << e;
+  const size_t start = e.rfind(", ", from) + 2;
+  const double refused_px = std::stod(e.substr(start, from - start));
+  EXPECT_GT(refused_px, fold_px) << e;
+  EXPECT_LT(refused_px, fold_px + 475.0 / kSamplesPerLine) << e;
+}
+
+// The rig file reader applies the checks, naming the file and the camera.
+TEST(LensPlausibility, TheRigFileReaderRefusesAnImplausibleCamera) {
+  Rig rig({Opencv5(DemoIntrinsics()), Opencv5(DemoIntrinsics())}, {"cam0", "cam1"},
+          {{"module0", 0, 1, Pose::FromRotationVector({0, -0.1047, 0}, {-90, 0, 5})}}, {Pose::Identity()});
+  const std::string good = RigToYaml(rig);
+  EXPECT_NO_THROW(ParseRigYaml(good, "rig.yaml"));
+  std::string bad = good;
+  const size_t fx = bad.find("intrinsics: [") + 13;  // cameras[0]'s fx, to the comma
+  bad.replace(fx, bad.find(',', fx) - fx, "1e12");
+  const std::string e = ErrorOf([&] { ParseRigYaml(bad, "rig.yaml"); });
+  EXPECT_EQ(e.rfind("rig.yaml", 0), 0u) << e;
+  EXPECT_NE(e.find("cameras[0]"), std::string::npos) << e;
+  EXPECT_NE(e.find("pixels that far from square"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace stereorig
