@@ -43,7 +43,15 @@ YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string key_path)
   // a word: "units: mm" then "units: m" would read as mm.
   std::set<std::string> keys;
   for (const auto& kv : node_) {
-    if (!kv.first.IsScalar()) throw InputError(Where(), "a key must be a plain name");
+    if (!kv.first.IsScalar()) {
+      // `null:` and `~:` read as YAML's null, not as a name, and a flow list
+      // or mapping can be a key too; say which line, and how to mean a name.
+      const std::string what = kv.first.IsNull()       ? "null (write \"null\" for a key of that name)"
+                               : kv.first.IsSequence() ? "a list"
+                                                       : "a mapping";
+      throw InputError(
+          Where(), "line " + std::to_string(kv.first.Mark().line + 1) + ": a key must be a plain name, not " + what);
+    }
     if (!keys.insert(kv.first.Scalar()).second)
       throw InputError(Where(kv.first.Scalar()), "given twice in one mapping: keep one");
   }

@@ -82,7 +82,16 @@ TEST(YamlMap, AKeyGivenTwiceIsRefused) {
   EXPECT_EQ(InputErrorMessage([&] { m.GetMap("match"); }), "f.yaml: match.p1: given twice in one mapping: keep one");
   EXPECT_EQ(m.GetMap("other").GetInt("p1"), 1);  // one per mapping is fine
   EXPECT_EQ(InputErrorMessage([] { YamlMap::LoadString("? [a, b]\n: 1\n", "f.yaml"); }),
-            "f.yaml: a key must be a plain name");
+            "f.yaml: line 1: a key must be a plain name, not a list");
+  // Unquoted, null and ~ are YAML's null: the message said only "plain
+  // name" of a key that looks like one.
+  EXPECT_EQ(InputErrorMessage([] { YamlMap::LoadString("a: 1\nnull: 3\n", "f.yaml"); }),
+            "f.yaml: line 2: a key must be a plain name, not null (write \"null\" for a key of that name)");
+  EXPECT_EQ(InputErrorMessage([] { YamlMap::LoadString("match: {~: 3}\n", "f.yaml").GetMap("match"); }),
+            "f.yaml: match: line 1: a key must be a plain name, not null (write \"null\" for a key of that name)");
+  EXPECT_EQ(InputErrorMessage([] { YamlMap::LoadString("{a: 1}: 2\n", "f.yaml"); }),
+            "f.yaml: line 1: a key must be a plain name, not a mapping");
+  EXPECT_EQ(YamlMap::LoadString("\"null\": 3\n", "f.yaml").GetInt("null"), 3);  // quoted: a name
 }
 
 TEST(YamlMap, SyntaxErrorsAreInputErrors) {
