@@ -8,6 +8,7 @@
 
 #include "calib/core/camera.h"
 #include "calib/core/input_error.h"
+#include "calib/core/lens_plausibility.h"
 #include "calib/core/rig_file.h"
 #include "calib/core/yaml_reader.h"
 
@@ -44,8 +45,9 @@ CameraSpec ParseCamera(YamlMap m) {
   c.width_px = size[0];
   c.height_px = size[1];
   m.Finish();
-  // Validates the model name and the number of intrinsics, naming the key.
-  Camera(c.lensmodel, c.intrinsics, c.width_px, c.height_px, m.Where());
+  // Validates the model name and the number of intrinsics, then that it
+  // could be a real lens (as a rig file's cameras are), naming the key.
+  CheckLensIsPlausible(Camera(c.lensmodel, c.intrinsics, c.width_px, c.height_px, m.Where()), m.Where());
   return c;
 }
 

@@ -67,6 +67,11 @@ TEST(SimSpec, BadSpecsNameTheKey) {
   EXPECT_NE(ErrorOf(Replace(good, "intrinsics: [1024.98", "intrinsics: [1, 1024.98")).find("left_camera"),
             std::string::npos);
   EXPECT_NE(ErrorOf(Replace(good, "format: stereorig-sim-spec", "format: other")).find("format"), std::string::npos);
+  // A camera no lens could be (fx 100x fy: calib/core/lens_plausibility.h),
+  // refused as a rig file's would be, naming the camera.
+  const std::string e = ErrorOf(Replace(good, "intrinsics: [1024.98", "intrinsics: [102498"));
+  EXPECT_NE(e.find("left_camera"), std::string::npos) << e;
+  EXPECT_NE(e.find("pixels that far from square"), std::string::npos) << e;
 }
 
 TEST(SimSpec, RingsOfOneTwoThreeModulesBuild) {
