@@ -35,17 +35,18 @@ void CheckLineFromPrincipalPoint(const Camera& camera, const Eigen::Vector2d& en
   double previous_rad = OffAxisRad(v);
   for (int k = 1; k <= kSamplesPerLine; ++k) {
     const Eigen::Vector2d q = principal + (end - principal) * (double(k) / kSamplesPerLine);
-    const std::string there = "pixel " + Pixel(q) + ", " + Number((q - principal).norm()) +
-                              " px from the principal point (check the distortion coefficients)";
-    if (!camera.Unproject(q, &v)) throw InputError(where, "the lens model gives no ray for " + there);
+    const std::string there =
+        "pixel " + Pixel(q) + ", " + Number((q - principal).norm()) + " px from the principal point";
+    const std::string advice = "; check the distortion coefficients";
+    if (!camera.Unproject(q, &v)) throw InputError(where, "the lens model gives no ray for " + there + advice);
     if ((camera.Project(v) - q).norm() > kRoundTripTolerancePx) {
-      throw InputError(
-          where, "the lens model does not map the imager one-to-one: " + there + " does not project back onto itself");
+      throw InputError(where, "the lens model does not map the imager one-to-one: " + there +
+                                  " does not project back onto itself" + advice);
     }
     const double rad = OffAxisRad(v);
     if (!(rad > previous_rad)) {
-      throw InputError(where,
-                       "the lens model folds back: moving out to " + there + " the ray turns towards the optical axis");
+      throw InputError(where, "the lens model folds back: moving out to " + there +
+                                  " the ray turns towards the optical axis" + advice);
     }
     previous_rad = rad;
   }
@@ -80,9 +81,10 @@ void CheckLensIsPlausible(const Camera& camera, const std::string& where) {
                                   {principal.x(), bottom}};
   for (const Eigen::Vector2d& end : ends) CheckLineFromPrincipalPoint(camera, end, where);
 
+  // Both ends were unprojected above, unless one is the principal point,
+  // whose ray was.
   Eigen::Vector3d left_ray, right_ray;
-  camera.Unproject(ends[4], &left_ray);  // both unprojected above
-  camera.Unproject(ends[5], &right_ray);
+  STEREORIG_CHECK(camera.Unproject(ends[4], &left_ray) && camera.Unproject(ends[5], &right_ray));
   const double fov_deg = std::acos(std::clamp(left_ray.dot(right_ray), -1.0, 1.0)) * 180 / M_PI;
   if (!(fov_deg >= kMinFieldOfViewDeg)) {
     throw InputError(where, "fx = " + Number(camera.fx()) + " px gives the " + imager + " a field of view of " +
