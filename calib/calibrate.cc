@@ -12,6 +12,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/cameramodel_export.h"
 #include "calib/core/input_error.h"
+#include "calib/core/lens_plausibility.h"
 #include "calib/core/rig_file.h"
 #include "calib/json_writer.h"
 
@@ -546,6 +547,18 @@ std::string SummaryText(const CalibrationReport& rep) {
 
 void WriteCalibrationOutputs(const CalibrationResult& result, const std::string& rig_path,
                              const std::string& report_path, const std::string& cameramodels_dir) {
+  // A rig file its readers would refuse (ReadRigFile checks every lens) is
+  // not written: a solve that diverged says so now, not at the next
+  // reconstruct.
+  for (int k = 0; k < result.rig.num_cameras(); ++k) {
+    try {
+      CheckLensIsPlausible(result.rig.camera(k), "");
+    } catch (const InputError& e) {
+      throw InputError(rig_path, "not written: the calibration gave camera " + std::to_string(k) +
+                                     " a lens no camera has (" + e.problem() +
+                                     "); its captures do not constrain it (more views, reaching the imager's corners)");
+    }
+  }
   AtomicOutputSet outputs;
   outputs.Add(rig_path, RigToYaml(result.rig));
   outputs.Add(report_path, result.report.ToJson());

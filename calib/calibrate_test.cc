@@ -11,9 +11,11 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 
 #include "calib/calib_test_util.h"
 #include "calib/core/input_error.h"
+#include "calib/core/input_error_testing.h"
 #include "calib/core/mrcal_c.h"
 #include "calib/core/rig_file.h"
 #include "datasets/calibration_poses.h"
@@ -274,6 +276,41 @@ TEST(CalibrateReport, JsonHoldsEveryStage) {
     // cameras: sqrt(2) * 0.2 px, less the fit; within 25%.
     EXPECT_NEAR(st.rectified_row_rms_px, std::sqrt(2.0) * kNoisePx, 0.25 * std::sqrt(2.0) * kNoisePx);
   }
+}
+
+// A calibration whose camera no lens could be (here its k1 set to -50 by
+// hand, as a diverged solve might leave it: the distortion folds back ~60 px
+// from the centre) writes nothing: ReadRigFile would refuse that rig file,
+// and every reconstruct after it. The earlier run's rig file stays.
+TEST(CalibrateReport, ALensNoCameraHasIsNotWritten) {
+  std::vector<Camera> cameras;
+  for (int k = 0; k < 2; ++k)
+    cameras.emplace_back("LENSMODEL_OPENCV5", std::vector<double>{1025, 1025, 375.5, 290.5, -0.1, 0.09, 0, 0, 0}, 752,
+                         582);
+  CalibrationResult r{
+      Rig(cameras, {"cam0", "cam1"}, {{"module0", 0, 1, Pose::FromRotationVector({0, -0.1047, 0}, {-90, 0, 5})}},
+          {Pose::Identity()}),
+      {},
+      {},
+      {},
+      {}};
+  const std::string dir = ::testing::TempDir() + "/calibrate_implausible";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  WriteCalibrationOutputs(r, dir + "/rig.yaml", dir + "/report.json");  // plausible: written
+  const std::string earlier = RigToYaml(ReadRigFile(dir + "/rig.yaml"));
+
+  std::vector<double> folded = cameras[1].intrinsics();
+  folded[4] = -50;
+  cameras[1] = Camera("LENSMODEL_OPENCV5", folded, 752, 582);
+  r.rig = Rig(cameras, {"cam0", "cam1"}, {r.rig.module(0)}, {Pose::Identity()});
+  std::filesystem::remove(dir + "/report.json");
+  const std::string e =
+      testing::InputErrorMessage([&] { WriteCalibrationOutputs(r, dir + "/rig.yaml", dir + "/report.json"); });
+  EXPECT_EQ(e.rfind(dir + "/rig.yaml: not written: the calibration gave camera 1 a lens no camera has (", 0), 0u) << e;
+  EXPECT_NE(e.find("check the distortion coefficients"), std::string::npos) << e;
+  EXPECT_EQ(RigToYaml(ReadRigFile(dir + "/rig.yaml")), earlier);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/report.json"));
 }
 
 }  // namespace
