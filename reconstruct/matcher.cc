@@ -257,13 +257,20 @@ cv::Mat SgbmRegion(const cv::Mat& left, const cv::Mat& right, const cv::Rect& ro
   const int x0 = std::max(0, roi.x - std::max(0, dmax));
   const int x1 = std::min(left.cols, roi.x + roi.width + std::max(0, -o.min_disparity_px));
   const cv::Rect cut(x0, roi.y, x1 - x0, roi.height);
+  cv::Mat out(roi.size(), CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  // Where no column of the cut has its whole range inside the image, OpenCV
+  // 4.6's SGBM returns before it allocates its buffers, and their
+  // destructor then fails an assertion: a cv::Exception thrown from a
+  // destructor, which ends the process (a rig whose range is wider than its
+  // images: exit 134 where it should have found nothing). No pixel can be
+  // matched then, so none is.
+  if (cut.width <= std::max(dmax, 0) - std::min(o.min_disparity_px, 0)) return out;
   const int bs = o.sgbm_block_size;
   cv::Ptr<cv::StereoSGBM> sgbm = cv::StereoSGBM::create(
       o.min_disparity_px, num16, bs, 8 * bs * bs, 32 * bs * bs, o.sgm.lr_max_diff_px, 63, filters.uniqueness_percent,
       filters.speckle_window_px, filters.speckle_range_px, cv::StereoSGBM::MODE_SGBM_3WAY);
   cv::Mat fixed;
   sgbm->compute(left(cut), right(cut), fixed);
-  cv::Mat out(roi.size(), CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
   const double dmax_valid = o.min_disparity_px + o.num_disparities - 1;
   for (int y = 0; y < cut.height; ++y) {
     const int16_t* f = fixed.ptr<int16_t>(y);

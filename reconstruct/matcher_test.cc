@@ -227,6 +227,26 @@ TEST(Matcher, ReportsTheDisparitiesItSearched) {
   }
 }
 
+// A range wider than the images (a rig whose working distance the options
+// miss by far): OpenCV's SGBM, left to itself, ends the process there
+// (OpenCV 4.6 asserts in a destructor when no column has its whole range in
+// the image). Both SGBM pipelines find nothing instead, and say so.
+TEST(Matcher, SgbmWithARangeWiderThanTheImageFindsNothing) {
+  const SyntheticPair pair = RenderSyntheticPair(SyntheticPairSpec{});
+  for (const MatcherKind kind : {MatcherKind::kOpenCvSgbm3Way, MatcherKind::kOpenCvSgbm3WayStandalone}) {
+    MatchOptions o = Options(kind);
+    o.min_disparity_px = 0;
+    o.num_disparities = pair.left.cols + 16;  // every column's range reaches past the right image's left edge
+    const MatchResult m = Match(pair.left, pair.right, o);
+    int finite = 0;
+    for (int y = 0; y < m.disparity_px.rows; ++y)
+      for (int x = 0; x < m.disparity_px.cols; ++x) finite += std::isfinite(m.disparity_px.at<float>(y, x));
+    EXPECT_EQ(finite, 0) << MatcherKindName(kind);
+    EXPECT_EQ(cv::countNonZero(m.status == uint8_t(PixelStatus::kNoSgmMatch)), pair.left.rows * pair.left.cols)
+        << MatcherKindName(kind);
+  }
+}
+
 TEST(Matcher, RoiAndRangeAreHonoured) {
   const SyntheticPair pair = RenderSyntheticPair(SyntheticPairSpec{});
   MatchOptions o = Options(MatcherKind::kCensusSgm);
