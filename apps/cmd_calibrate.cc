@@ -49,8 +49,10 @@ int RunCalibrate(int argc, char** argv) {
   app.add_option("--focal", options.intrinsics.seed_focal_px, "rough focal length for the PnP seed, px (0: estimate)")
       ->capture_default_str();
   app.add_option("--uncertainty-range", options.intrinsics.uncertainty_range_mm,
-                 "range of the points whose projection uncertainty is reported, mm")
-      ->capture_default_str();
+                 "range of the points whose projection uncertainty is reported (and the nightly check's thresholds "
+                 "come from), mm; 0: each camera's median distance to the board in its views, where the rig measures")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--huber", options.system.huber_px, "stage 3 robust loss scale, px")->capture_default_str();
   app.add_flag("--fixed-intrinsics", fixed_intrinsics, "hold the intrinsics at stage 2's values in stage 3");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;

@@ -22,7 +22,8 @@ void IntrinsicsOptions::Check() const {
   if (min_corners_per_view < 4) throw InputError("options.min_corners_per_view", "must be >= 4");
   if (min_views < 2) throw InputError("options.min_views", "must be >= 2");
   if (min_tilt_deg < 0 || min_tilt_deg > 80) throw InputError("options.min_tilt_deg", "must be in [0, 80]");
-  if (uncertainty_range_mm <= 0) throw InputError("options.uncertainty_range_mm", "must be > 0");
+  if (!(uncertainty_range_mm >= 0))
+    throw InputError("options.uncertainty_range_mm", "must be > 0 (or 0: the board's median distance)");
   if (coverage_cells_x < 1 || coverage_cells_y < 1) throw InputError("options.coverage_cells", "must be >= 1");
   if (worst_views_reported < 0) throw InputError("options.worst_views_reported", "must be >= 0");
 }
@@ -167,7 +168,8 @@ void FillCoverageAndUncertainty(const MrcalProblem& p, int icam, const Intrinsic
       static_cast<double>(std::count_if(r->coverage.begin(), r->coverage.end(), [](int c) { return c > 0; })) /
       r->coverage.size();
 
-  r->uncertainty_range_mm = options.uncertainty_range_mm;
+  r->uncertainty_range_mm =
+      options.uncertainty_range_mm > 0 ? options.uncertainty_range_mm : p.MedianBoardDistanceMm(icam);
   const int np = p.num_params();
   r->intrinsics.assign(p.intrinsics.begin() + icam * np, p.intrinsics.begin() + (icam + 1) * np);
   ProjectionUncertaintyEvaluator eval(p);
@@ -181,7 +183,7 @@ void FillCoverageAndUncertainty(const MrcalProblem& p, int icam, const Intrinsic
                                                                    {"bottom-left", {0, height - 1.0}},
                                                                    {"bottom-right", {width - 1.0, height - 1.0}}};
   for (const auto& [name, q] : at) {
-    const ProjectionUncertainty u = eval.AtPixel(icam, q, options.uncertainty_range_mm);
+    const ProjectionUncertainty u = eval.AtPixel(icam, q, r->uncertainty_range_mm);
     r->uncertainty.push_back({name, q, u.rms_stdev_px, u.worst_direction_stdev_px});
   }
 }

@@ -39,13 +39,40 @@ TEST(Intrinsics, Opencv8RecoversTheTruthWithinItsUncertainty) {
       // Projection at the image centre against the truth: within 4 sigma of
       // the predicted uncertainty (2D: |e|^2 / sigma^2 ~ chi2(2) / 2 scaled).
       const auto truth = TrueCamFromFace(s, cam, r);
-      const Eigen::Vector2d e = testing::MeanFramesProjectionError(
-          s.truth.rig.camera(cam), truth, r.camera, r.cam_from_face, r.report.uncertainty[0].q_px, 200.0);
+      const Eigen::Vector2d e =
+          testing::MeanFramesProjectionError(s.truth.rig.camera(cam), truth, r.camera, r.cam_from_face,
+                                             r.report.uncertainty[0].q_px, r.report.uncertainty_range_mm);
       EXPECT_LT(e.norm(), 4.0 * std::sqrt(2.0) * r.report.uncertainty[0].rms_stdev_px) << seed << " cam " << cam;
       EXPECT_LT(r.report.uncertainty[0].rms_stdev_px, 0.2);  // the centre is well covered
       EXPECT_GT(r.report.coverage_fraction, 0.2);
     }
   }
+}
+
+// The projection uncertainty is reported at the board's median distance
+// from the camera (the default, uncertainty_range_mm 0): the true poses'
+// median, within what 0.2 px of corner noise moves a solved pose's depth
+// (~0.1 mm at ~200 mm; 0.5 mm allowed). A given range is used as given.
+TEST(Intrinsics, UncertaintyIsReportedWhereTheBoardWas) {
+  const auto s = testing::MakeDefaultScene(13, 20, 0.2);
+  for (int cam : {0, 3}) {
+    const auto r = CalibrateIntrinsics(cam, s.data.input.cameras[cam], s.data.input.target,
+                                       testing::ViewsOf(s.data.input, cam), IntrinsicsOptions(), "test");
+    const TargetGeometry& g = s.data.input.target;
+    const Eigen::Vector3d centre(0.5 * (g.corners_x - 1) * g.square_size_mm, 0.5 * (g.corners_y - 1) * g.square_size_mm,
+                                 0);
+    std::vector<double> true_mm;
+    for (const Pose& cam_from_face : TrueCamFromFace(s, cam, r)) true_mm.push_back((cam_from_face * centre).norm());
+    std::nth_element(true_mm.begin(), true_mm.begin() + true_mm.size() / 2, true_mm.end());
+    const double median_mm = true_mm[true_mm.size() / 2];
+    EXPECT_NEAR(r.report.uncertainty_range_mm, median_mm, 0.5) << "cam " << cam;
+    EXPECT_GT(median_mm, 150);  // the default scene holds the board ~200 mm away: not a degenerate 0
+  }
+  IntrinsicsOptions at_300;
+  at_300.uncertainty_range_mm = 300;
+  const auto r300 = CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target,
+                                        testing::ViewsOf(s.data.input, 0), at_300, "test");
+  EXPECT_EQ(r300.report.uncertainty_range_mm, 300);
 }
 
 TEST(Intrinsics, LensModelsAreSelectable) {

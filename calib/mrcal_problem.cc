@@ -1,5 +1,7 @@
 #include "calib/mrcal_problem.h"
 
+#include <algorithm>
+
 #include "calib/core/input_error.h"
 
 namespace stereorig {
@@ -74,6 +76,21 @@ mrcal_pose_t MrcalProblem::ToMrcal(const Pose& a_from_b) {
 
 Pose MrcalProblem::FromMrcal(const mrcal_pose_t& rt) {
   return Pose::FromRotationVector(Eigen::Vector3d(rt.r.x, rt.r.y, rt.r.z), Eigen::Vector3d(rt.t.x, rt.t.y, rt.t.z));
+}
+
+double MrcalProblem::MedianBoardDistanceMm(int icam_intrinsics) const {
+  const Eigen::Vector3d centre_in_frame(0.5 * (corners_x - 1) * spacing_mm, 0.5 * (corners_y - 1) * spacing_mm, 0);
+  std::vector<double> distances_mm;
+  for (const mrcal_observation_board_t& o : observations) {
+    if (o.icam.intrinsics != icam_intrinsics) continue;
+    Eigen::Vector3d p = FromMrcal(frames_toref[o.iframe]) * centre_in_frame;  // reference frame
+    if (o.icam.extrinsics >= 0) p = FromMrcal(extrinsics_fromref[o.icam.extrinsics]) * p;
+    distances_mm.push_back(p.norm());
+  }
+  if (distances_mm.empty()) return 0;
+  const auto middle = distances_mm.begin() + distances_mm.size() / 2;
+  std::nth_element(distances_mm.begin(), middle, distances_mm.end());
+  return *middle;
 }
 
 }  // namespace stereorig

@@ -53,6 +53,12 @@ struct MrcalProblem {
   // Number of pool entries with weight <= 0 (missing + outliers).
   int CountNonPositiveWeights() const;
 
+  // The median distance, mm, from intrinsics camera `icam_intrinsics` to
+  // the centre of the board's corner grid over that camera's observations,
+  // at the current poses: where the board was held, which is where the rig
+  // is meant to measure. 0 if the camera observes nothing.
+  double MedianBoardDistanceMm(int icam_intrinsics) const;
+
   // Pose helpers. mrcal_pose_t is (r: rotation vector, t: mm).
   static mrcal_pose_t ToMrcal(const Pose& a_from_b);
   static Pose FromMrcal(const mrcal_pose_t& rt_a_b);
