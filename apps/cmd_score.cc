@@ -37,6 +37,7 @@ nlohmann::json FillJson(const FillFigures& f) {
 
 // "12695 points, |e| mean 0.52 p95 1.40 max 2.31 mm, 61.0% within 0.5 mm".
 std::string FilledLine(const ErrorFigures& f) {
+  if (f.points <= 0) return "no point";
   char buf[160];
   std::snprintf(buf, sizeof buf, "%6d points, |e| mean %.3f p95 %.3f max %.3f mm, %5.1f%% within 0.5 mm", f.points,
                 f.mean_abs_mm, f.p95_abs_mm, f.max_abs_mm, 100 * f.within_0_5_mm);
@@ -136,6 +137,10 @@ int RunScore(int argc, char** argv) {
   for (const std::string& name : scenes) {
     const fs::path scene_dir = fs::path(dataset) / "scenes" / name;
     const SceneTruth truth = ReadSceneTruth(dataset, name);
+    // The truth frame is the truth rig's module 0, the volume the rig
+    // file's: close enough (a calibrated rig differs by a fraction of a
+    // mm) to tell a volume that misses the scene.
+    const double truth_in_volume = ShareInsideBox(truth.surface_mm, runtime.volume_center_mm(), options.volume_size_mm);
     // Hole filling runs with the mesh: only when the options ask for it.
     const bool fill = options.shape_model != ShapeModel::kNone;
     const std::vector<cv::Mat> images = LoadCapture((scene_dir / "active").string(), rig);
@@ -144,6 +149,7 @@ int RunScore(int argc, char** argv) {
     nlohmann::json sj = {
         {"scene", name},
         {"points", rec.cloud.size()},
+        {"truth_in_volume", truth_in_volume},
         {"merged", ErrorFiguresJson(s.accuracy.all)},
         {"fill", FillJson(s.fill_all)},
         {"alignment_truth_from_cloud",
@@ -151,8 +157,9 @@ int RunScore(int argc, char** argv) {
           {"translation_mm",
            {s.accuracy.truth_from_cloud.translation_mm().x(), s.accuracy.truth_from_cloud.translation_mm().y(),
             s.accuracy.truth_from_cloud.translation_mm().z()}}}}};
-    std::printf("%-8s %7zu points, fill %5.1f%% of %6d px; merged |e| %.4f std %.4f mm", name.c_str(), rec.cloud.size(),
-                100 * s.fill_all.fill(), s.fill_all.target_px, s.accuracy.all.mean_abs_mm, s.accuracy.all.std_mm);
+    std::printf("%-8s %7zu points, fill %5.1f%% of %6d px; merged %s%s", name.c_str(), rec.cloud.size(),
+                100 * s.fill_all.fill(), s.fill_all.target_px, ErrorText(s.accuracy.all).c_str(),
+                s.accuracy.all.points > 0 ? " mm" : "");
     for (size_t m = 0; m < s.fill.size(); ++m) {
       const ErrorFigures& e = s.accuracy.per_module[m];
       sj["modules"].push_back({{"module", m},
@@ -160,7 +167,7 @@ int RunScore(int argc, char** argv) {
                                {"fill", FillJson(s.fill[m])},
                                {"points_seen_through", rec.modules[m].seen_through},
                                {"points_on_seen_through_surfaces", rec.modules[m].seen_through_surface}});
-      std::printf("; m%zu fill %5.1f%% |e| %.4f std %.4f", m, 100 * s.fill[m].fill(), e.mean_abs_mm, e.std_mm);
+      std::printf("; m%zu fill %5.1f%% %s", m, 100 * s.fill[m].fill(), ErrorText(e).c_str());
     }
     if (!no_passive && fs::is_directory(scene_dir / "passive")) {
       const Reconstruction passive = passive_runtime.Process(LoadCapture((scene_dir / "passive").string(), rig), false);
@@ -178,6 +185,14 @@ int RunScore(int argc, char** argv) {
     }
     std::printf("; aligned by %.4f deg, %.4f mm\n", s.accuracy.truth_from_cloud.AngleDeg(),
                 s.accuracy.truth_from_cloud.translation_mm().norm());
+    if (truth_in_volume < 0.5 && !truth.surface_mm.empty()) {
+      Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+      for (const Eigen::Vector3d& p : truth.surface_mm) centroid += p / double(truth.surface_mm.size());
+      std::printf(
+          "  the measurement volume holds %.0f%% of this scene's truth surface: its centre is %.0f mm from "
+          "module 0, the scene's %.0f mm; set working_distance_mm (or volume_center_mm) in --options\n",
+          100 * truth_in_volume, runtime.volume_center_mm().norm(), centroid.norm());
+    }
     for (size_t m = 0; m < s.fill.size(); ++m) {
       std::printf("  m%zu lost: %s\n", m, LossLine(s.fill[m].target_status, s.fill[m].target_px).c_str());
       if (rec.modules[m].seen_through > 0)

@@ -39,7 +39,15 @@ std::string ModuleSummary(const ModuleReport& m, int max_reasons) {
                                      " points removed, seen through (free_space_test; " +
                                      std::to_string(m.seen_through_surface) + " of them with their surface)"
                                : "";
-  return buf + (losses.empty() ? "none" : losses) + seen;
+  // No point at all where the grid lights pixels: most often the object is
+  // not in the measurement volume (a rig used at another distance than the
+  // defaults' 200 mm finds nothing, and exit 0 alone would not say why).
+  const std::string nothing =
+      m.points == 0 && m.lit_pixels > 0
+          ? "\n  no point: if the object is not in the measurement volume, set working_distance_mm (or "
+            "volume_center_mm, volume_size_mm) to where it is (docs/reconstruct.md, \"When the fill rate is low\")"
+          : "";
+  return buf + (losses.empty() ? "none" : losses) + seen + nothing;
 }
 
 }  // namespace stereorig

@@ -41,5 +41,23 @@ TEST(ModuleSummary, SaysNoneWhenEveryLitPixelHasAPoint) {
   EXPECT_EQ(s.substr(s.find('\n') + 1), "  searched d [35, 120) of [-100, 174) px; lit px without a point: none");
 }
 
+// A module whose lit pixels all went without a point (the walkthrough's
+// 300 mm rig under the default 200 mm volume: no_sgm_match 85.6 %) says
+// where to look; one with a point, or with nothing lit, does not.
+TEST(ModuleSummary, NoPointAtAllNamesTheMeasurementVolume) {
+  ModuleReport m = Report();
+  m.points = m.lit_filled = 0;
+  m.lit_by_status[size_t(PixelStatus::kNoSgmMatch)] = 1000;
+  const std::string s = ModuleSummary(m);
+  EXPECT_NE(s.find("\n  no point: if the object is not in the measurement volume, set working_distance_mm"),
+            std::string::npos)
+      << s;
+  m.points = 1;
+  EXPECT_EQ(ModuleSummary(m).find("no point:"), std::string::npos);
+  m.points = 0;
+  m.lit_pixels = 0;
+  EXPECT_EQ(ModuleSummary(m).find("no point:"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -1,6 +1,7 @@
 #include "apps/reconstruct_json.h"
 
 #include <cmath>
+#include <cstdio>
 
 namespace stereorig {
 
@@ -41,10 +42,22 @@ nlohmann::json ReconstructionJson(const Reconstruction& rec) {
 }
 
 nlohmann::json ErrorFiguresJson(const ErrorFigures& f) {
-  return {{"points", f.points},         {"mean_abs_mm", f.mean_abs_mm},
-          {"mean_mm", f.mean_mm},       {"std_mm", f.std_mm},
-          {"rms_mm", f.rms_mm},         {"p95_abs_mm", f.p95_abs_mm},
-          {"max_abs_mm", f.max_abs_mm}, {"within_0_5_mm", f.within_0_5_mm}};
+  const auto figure = [&](double x) { return f.points > 0 ? nlohmann::json(x) : nlohmann::json(nullptr); };
+  return {{"points", f.points},
+          {"mean_abs_mm", figure(f.mean_abs_mm)},
+          {"mean_mm", figure(f.mean_mm)},
+          {"std_mm", figure(f.std_mm)},
+          {"rms_mm", figure(f.rms_mm)},
+          {"p95_abs_mm", figure(f.p95_abs_mm)},
+          {"max_abs_mm", figure(f.max_abs_mm)},
+          {"within_0_5_mm", figure(f.within_0_5_mm)}};
+}
+
+std::string ErrorText(const ErrorFigures& f) {
+  if (f.points <= 0) return "no point";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "|e| %.4f std %.4f", f.mean_abs_mm, f.std_mm);
+  return buf;
 }
 
 nlohmann::json FilledJson(const CloudScore& score) {

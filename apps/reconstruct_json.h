@@ -2,6 +2,7 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "reconstruct/runtime.h"
 #include "reconstruct/score.h"
@@ -14,7 +15,11 @@ nlohmann::json ReconstructionJson(const Reconstruction& rec);
 
 // Accuracy figures against truth (score.h): points, mean_abs_mm, mean_mm,
 // std_mm, rms_mm, p95_abs_mm, max_abs_mm, within_0_5_mm.
+// With no point the figures are null, not 0 (which reads as a perfect score).
 nlohmann::json ErrorFiguresJson(const ErrorFigures& f);
+
+// "|e| 0.0345 std 0.0443" (mm), or "no point" when there is none to score.
+std::string ErrorText(const ErrorFigures& f);
 
 // The hole-filling points' figures (ErrorFiguresJson) and, under
 // by_distance_to_measured, the same per band of distance to the nearest

@@ -91,6 +91,9 @@ class Runtime {
   const Rig& rig() const { return rig_; }
   const RuntimeOptions& options() const { return options_; }
   const std::vector<ModulePlan>& plans() const { return plans_; }
+  // The measurement volume's centre in the reference frame (module 0), mm:
+  // volume_center_mm, or working_distance_mm ahead of module 0.
+  const Eigen::Vector3d& volume_center_mm() const { return volume_center_mm_; }
 
   // images[k]: camera k's 8-bit grey image (global camera index), each the
   // size the rig says. `build_mesh` adds the organised meshes, the joined

@@ -155,4 +155,14 @@ CloudScore ScoreAgainstTruth(const PointCloud& cloud, const std::vector<Eigen::V
   return score;
 }
 
+double ShareInsideBox(const std::vector<Eigen::Vector3d>& points_mm, const Eigen::Vector3d& centre_mm,
+                      const Eigen::Vector3d& size_mm) {
+  if (points_mm.empty()) return 0;
+  const Eigen::Vector3d lo = centre_mm - 0.5 * size_mm, hi = centre_mm + 0.5 * size_mm;
+  const auto inside = std::count_if(points_mm.begin(), points_mm.end(), [&](const Eigen::Vector3d& p) {
+    return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all();
+  });
+  return double(inside) / double(points_mm.size());
+}
+
 }  // namespace stereorig

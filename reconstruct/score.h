@@ -49,4 +49,11 @@ struct CloudScore {
 // `truth`: (N) samples in mm. `num_modules`: size of per_module.
 CloudScore ScoreAgainstTruth(const PointCloud& cloud, const std::vector<Eigen::Vector3d>& truth, int num_modules);
 
+// The share, in [0, 1], of `points_mm` inside the axis-aligned box of size
+// `size_mm` centred on `centre_mm` (faces included); 0 for no point. Score
+// uses it on a scene's truth surface and the measurement volume: a volume
+// that misses the object scores an empty cloud, which must not pass silently.
+double ShareInsideBox(const std::vector<Eigen::Vector3d>& points_mm, const Eigen::Vector3d& centre_mm,
+                      const Eigen::Vector3d& size_mm);
+
 }  // namespace stereorig

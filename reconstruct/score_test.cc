@@ -381,5 +381,19 @@ TEST(ScoreAgainstTruth, FilledPointsAreScoredApart) {
   }
 }
 
+// Points on a 10 x 10 x 10 lattice of 1 mm pitch, 0..9 on each axis, and
+// boxes whose share is counted by hand: faces count as inside.
+TEST(ShareInsideBox, CountsThePointsOnAndInTheBox) {
+  std::vector<Eigen::Vector3d> points;
+  for (int x = 0; x < 10; ++x)
+    for (int y = 0; y < 10; ++y)
+      for (int z = 0; z < 10; ++z) points.emplace_back(x, y, z);
+  EXPECT_DOUBLE_EQ(ShareInsideBox(points, {4.5, 4.5, 4.5}, {9, 9, 9}), 1.0);    // faces at 0 and 9: all 1000
+  EXPECT_DOUBLE_EQ(ShareInsideBox(points, {4.5, 4.5, 2}, {9, 9, 4}), 0.5);      // z 0..4: 500
+  EXPECT_DOUBLE_EQ(ShareInsideBox(points, {0, 0, 0}, {2, 2, 2}), 0.008);        // x, y, z in 0..1: 8
+  EXPECT_DOUBLE_EQ(ShareInsideBox(points, {4.5, 4.5, 300}, {9, 9, 100}), 0.0);  // a volume 300 mm away
+  EXPECT_DOUBLE_EQ(ShareInsideBox({}, {0, 0, 0}, {1, 1, 1}), 0.0);
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -181,6 +181,19 @@ TEST(Cli, RigAgainstTruthGivesZeroForItselfAndTheShiftOfAMovedModule) {
   r = RunCli("rig --rig " + moved_path + " --truth " + truth_path + " --volume 75 75 0");
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(Lines(r.err), 1) << r.err;
+
+  // At its working distance (the default 200 mm) every point of the volume
+  // is seen by both cameras of each module; 100 mm ahead, module 0's two
+  // views overlap on a sliver of it (36 of 847 points, measured), and the
+  // judgement says it is taken mostly outside where the rig measures.
+  r = RunCli("rig --rig " + truth_path + " --truth " + truth_path);
+  EXPECT_EQ(r.out.find("see only"), std::string::npos) << r.out;
+  r = RunCli("rig --rig " + truth_path + " --truth " + truth_path + " --distance 100");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("(module 0's two cameras see only 36 of the 847 points: is --distance, 100 mm, where this rig "
+                       "measures?)"),
+            std::string::npos)
+      << r.out;
 }
 
 // Every malformed case of the rig-file contract: exit 2, one line on stderr
