@@ -59,15 +59,15 @@ TEST(SimulateCli, AnOutFolderWithATrailingSlashIsWritten) {
 }
 
 // An --out that cannot be made (a name longer than the file system's 255
-// characters: the folder itself, or the temporary beside it, ".<name>.tmp-
-// <pid>") exits 2 in one line naming it, and the folders made above it on the
-// way are removed again (FolderToCreate, calib/core/folder_to_create.h); they
-// used to stay, empty.
+// bytes: a folder above it, or the folder itself) exits 2 in one line naming
+// it, before any rendering, and the folders made above it on the way are
+// removed again (FolderToCreate, calib/core/folder_to_create.h); they used to
+// stay, empty.
 TEST(SimulateCli, AnOutThatCannotBeMadeLeavesNoFolder) {
   const std::string dir = ::testing::TempDir() + "/sim_long";
   fs::remove_all(dir);
   const std::pair<std::string, std::string> cases[] = {{dir + "/new/" + std::string(300, 'x') + "/ds", "xxx"},
-                                                       {dir + "/new/" + std::string(250, 'y'), "/.yyy"}};
+                                                       {dir + "/new/" + std::string(256, 'z'), "/zzz"}};
   for (const auto& [out, says] : cases) {
     const Result r = RunCli("simulate --out " + out + " --calibration-captures 1 --no-scenes");
     EXPECT_EQ(r.code, 2) << r.err;

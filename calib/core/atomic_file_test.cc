@@ -39,20 +39,21 @@ TEST(AtomicOutputSet, CommitWritesEveryOutput) {
   EXPECT_EQ(Names(dir), (std::vector<std::string>{"a.ply", "b.json"}));  // no temporary file left
 }
 
-// A later output that cannot be written (here its temporary file's name is
-// too long for the file system, as a full disk would fail it later) leaves
-// the earlier run's files as they were and no temporary file: not the first
-// output new and the others old.
+// A later output that cannot be written leaves the earlier run's files as
+// they were and no temporary file: not the first output new and the others
+// old. The later output's folder is one where no file can be created, not
+// even by root (as a full disk fails a write, after the earlier output's
+// temporary file is written): /proc.
 TEST(AtomicOutputSet, AFailingOutputLeavesEveryEarlierFileAsItWas) {
   const std::string dir = testing::ScratchFolder("atomic_set_fail");
   WriteFileAtomically(dir + "/a.ply", "old cloud");
-  const std::string long_name =
-      dir + "/" + std::string(250, 'r') + ".json";  // legal; its ".tmp-<pid>-<n>-" form is not
+  const std::string unwritable = "/proc/stereorig-atomic-set-test.json";
   {
     AtomicOutputSet outputs;
     outputs.Add(dir + "/a.ply", "new cloud");
-    EXPECT_NE(testing::InputErrorMessage([&] { outputs.Add(long_name, "report"); }).find("cannot write"),
-              std::string::npos);
+    EXPECT_NE(
+        testing::InputErrorMessage([&] { outputs.Add(unwritable, "report"); }).find(unwritable + ": cannot write"),
+        std::string::npos);
   }  // not committed
   EXPECT_EQ(Contents(dir + "/a.ply"), "old cloud");
   EXPECT_EQ(Names(dir), std::vector<std::string>{"a.ply"});
