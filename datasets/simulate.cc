@@ -18,6 +18,7 @@
 #include "calib/core/folder_to_create.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
+#include "calib/core/temporary_name.h"
 #include "datasets/calibration_poses.h"
 #include "datasets/camera_rays.h"
 #include "datasets/render.h"
@@ -248,7 +249,8 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
       throw InputError(out.string(), "exists and is not a stereorig dataset (no spec.yaml); refusing to replace it");
     }
   }
-  const fs::path tmp = parent / ("." + out.filename().string() + ".tmp-" + std::to_string(getpid()));
+  const std::string pid = std::to_string(getpid());
+  const fs::path tmp = parent / TemporaryName(".", out.filename().string(), ".tmp-" + pid);
   fs::remove_all(tmp, ec);
   struct Cleanup {
     fs::path path;
@@ -427,7 +429,7 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
 
   // --- into place
   if (fs::exists(out)) {
-    const fs::path old = parent / ("." + out.filename().string() + ".old-" + std::to_string(getpid()));
+    const fs::path old = parent / TemporaryName(".", out.filename().string(), ".old-" + pid);
     fs::rename(out, old, ec);
     if (ec) throw InputError(out.string(), "cannot replace: " + ec.message());
     fs::rename(tmp, out, ec);

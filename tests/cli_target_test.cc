@@ -79,6 +79,25 @@ TEST(CliTarget, ATargetFileThatCannotBeWrittenLeavesTheEarlierSvg) {
   EXPECT_EQ(files, 1);  // board.svg alone: no temporary file
 }
 
+// A target file's name of up to the file system's 255 bytes is written,
+// and nothing else is left beside it. (Before, one of 250 failed: its
+// temporary file's name, ".tmp-<pid>-<n>-<name>", passed 255.)
+TEST(CliTarget, ATargetFileNameOf255BytesIsWritten) {
+  const std::string dir = ::testing::TempDir() + "/cli_target_long_name";
+  for (const size_t name_bytes : {250u, 255u}) {
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    const std::string name = std::string(name_bytes - 5, 't') + ".yaml";
+    const Result r = RunStereorig("target --out " + dir + "/board.svg --write-target " + dir + "/" + name);
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(Slurp(dir + "/" + name).find("stereorig-target"), std::string::npos) << name_bytes;
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) names.push_back(entry.path().filename());
+    std::sort(names.begin(), names.end());
+    EXPECT_EQ(names, (std::vector<std::string>{"board.svg", name}));
+  }
+}
+
 // Its outputs are checked before anything is drawn: one path for both, or
 // the target file it reads as the SVG, would leave the SVG replaced by YAML
 // (or the target file by the SVG) with exit 0.

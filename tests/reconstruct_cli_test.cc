@@ -438,6 +438,26 @@ TEST_F(ReconstructCli, AReportThatCannotBeWrittenLeavesTheEarlierCloud) {
   EXPECT_EQ(names, std::vector<std::string>{"out.ply"});  // no mesh or temporary file
 }
 
+// A report whose name takes the file system's whole 255 bytes is written
+// beside the cloud, nothing else left. (Before, any name over about 235
+// bytes failed: its temporary file's name, ".tmp-<pid>-<n>-<name>", passed
+// 255.)
+TEST_F(ReconstructCli, AReportNameOf255BytesIsWritten) {
+  const std::string dir = dir_ + "/long_report_name";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string name = std::string(250, 'r') + ".json";
+  const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ +
+                                            "/capture --out " + dir + "/out.ply --report " + dir + "/" + name);
+  EXPECT_EQ(r.code, 0) << r.err;
+  std::ifstream report(dir + "/" + name);
+  EXPECT_GT(nlohmann::json::parse(report, nullptr, false).value("points", 0), 40000) << "not the report";
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) names.push_back(entry.path().filename());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"out.ply", name}));
+}
+
 // Where each output goes is checked before any work (apps/output_paths.h):
 // a mesh in a missing folder, or two outputs naming one file, exit 2 with
 // one line naming the path, and nothing is written. (Before, the whole

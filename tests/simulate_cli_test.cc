@@ -78,6 +78,29 @@ TEST(SimulateCli, AnOutThatCannotBeMadeLeavesNoFolder) {
   }
 }
 
+// An --out whose name takes up to the file system's 255 bytes is written,
+// and written again over itself, nothing left beside it. (Before, one of 250
+// bytes failed: the temporary folder's name, ".<name>.tmp-<pid>", passed
+// 255, as did ".<name>.old-<pid>", the earlier dataset's while it is
+// replaced.)
+TEST(SimulateCli, AnOutNameOf255BytesIsWritten) {
+  const std::string dir = ::testing::TempDir() + "/sim_long_name";
+  fs::remove_all(dir);
+  const std::pair<std::string, std::string> cases[] = {
+      {std::string(250, 'y'), "--calibration-captures 1"},  // a whole capture in it
+      {std::string(255, 'y'), "--calibration-captures 0"},
+      {std::string(255, 'y'), "--calibration-captures 0"}};  // replacing the one before
+  for (const auto& [name, captures] : cases) {
+    const Result r = RunCli("simulate --out " + dir + "/" + name + " --no-scenes " + captures);
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(dir + "/" + name + "/spec.yaml")) << name.size();
+  }
+  EXPECT_TRUE(fs::exists(dir + "/" + std::string(250, 'y') + "/calibration/000/cam3.png"));
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(dir)) ++entries, (void)e;
+  EXPECT_EQ(entries, 2) << "something beside the two datasets";
+}
+
 // Options that would be ignored, or read wrongly, are refused before any
 // work, in one line naming the flag: a bump without what to move or by how
 // much rendered an undisturbed rig; --write-default-spec ignored --out; a

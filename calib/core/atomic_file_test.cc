@@ -90,5 +90,41 @@ TEST(WriteFileAtomically, ReplacesTheFileAndLeavesNoTemporaryFile) {
             std::string::npos);
 }
 
+// Any name the file system takes is written, up to its 255 bytes. (Before,
+// the temporary file's name, ".tmp-<pid>-<n>-" before the output's, passed
+// 255 for a name of about 235 bytes, and the write failed with "File name
+// too long".) The temporary file keeps the extension: writers that pick the
+// format by it (cv::imwrite) still work.
+TEST(WriteFileAtomically, ANameOfUpTo255BytesIsWritten) {
+  const std::string dir = testing::ScratchFolder("atomic_long_name");
+  for (const size_t name_bytes : {236u, 250u, 255u}) {
+    const std::string name = std::string(name_bytes - 5, 'r') + ".json";
+    WriteFileAtomically(dir + "/" + name, "report " + std::to_string(name_bytes));
+    EXPECT_EQ(Contents(dir + "/" + name), "report " + std::to_string(name_bytes));
+    AtomicOutputSet outputs;
+    outputs.Add(dir + "/" + name, "again");
+    outputs.Add(dir + "/a.ply", "cloud");
+    outputs.Commit();
+    EXPECT_EQ(Contents(dir + "/" + name), "again");
+    EXPECT_EQ(Names(dir), (std::vector<std::string>{"a.ply", name}));  // no temporary file, no kept copy
+    std::filesystem::remove(dir + "/" + name);
+  }
+  const AtomicOutput image(dir + "/" + std::string(251, 'i') + ".png");
+  EXPECT_EQ(std::filesystem::path(image.temp_path()).extension(), ".png");
+  EXPECT_LE(std::filesystem::path(image.temp_path()).filename().string().size(), 255u);
+}
+
+// A name longer than the file system takes is still refused by it, in the
+// same words, and leaves nothing.
+TEST(WriteFileAtomically, ANameLongerThan255BytesIsRefused) {
+  const std::string dir = testing::ScratchFolder("atomic_too_long_name");
+  const std::string path = dir + "/" + std::string(251, 'r') + ".json";
+  EXPECT_NE(testing::InputErrorMessage([&] {
+              WriteFileAtomically(path, "x");
+            }).find(path + ": cannot write: File name too long"),
+            std::string::npos);
+  EXPECT_TRUE(Names(dir).empty());
+}
+
 }  // namespace
 }  // namespace stereorig
