@@ -17,6 +17,7 @@
 
 #include "calib/core/folder_to_create.h"
 #include "calib/core/input_error.h"
+#include "calib/core/pending_temporary.h"
 #include "calib/core/rig_file.h"
 #include "calib/core/temporary_name.h"
 #include "datasets/calibration_poses.h"
@@ -252,8 +253,10 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
   const std::string pid = std::to_string(getpid());
   const fs::path tmp = parent / TemporaryName(".", out.filename().string(), ".tmp-" + pid);
   fs::remove_all(tmp, ec);
+  // Removed if the run fails, by an exception or a termination signal.
   struct Cleanup {
     fs::path path;
+    PendingTemporary pending{path.string(), TemporaryKind::kFolder};
     bool keep = false;
     ~Cleanup() {
       std::error_code e;
@@ -438,6 +441,7 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
       fs::rename(old, out, e2);
       throw InputError(out.string(), "cannot rename the finished dataset into place: " + ec.message());
     }
+    const PendingTemporary pending_old(old.string(), TemporaryKind::kFolder);  // a signal finishes the removal
     fs::remove_all(old, ec);
   } else {
     fs::rename(tmp, out, ec);
