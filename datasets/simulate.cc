@@ -17,7 +17,9 @@
 
 #include "calib/core/folder_to_create.h"
 #include "calib/core/input_error.h"
+#include "calib/core/pending_temporary.h"
 #include "calib/core/rig_file.h"
+#include "calib/core/temporary_name.h"
 #include "datasets/calibration_poses.h"
 #include "datasets/camera_rays.h"
 #include "datasets/render.h"
@@ -248,10 +250,13 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
       throw InputError(out.string(), "exists and is not a stereorig dataset (no spec.yaml); refusing to replace it");
     }
   }
-  const fs::path tmp = parent / ("." + out.filename().string() + ".tmp-" + std::to_string(getpid()));
+  const std::string pid = std::to_string(getpid());
+  const fs::path tmp = parent / TemporaryName(".", out.filename().string(), ".tmp-" + pid);
   fs::remove_all(tmp, ec);
+  // Removed if the run fails, by an exception or a termination signal.
   struct Cleanup {
     fs::path path;
+    PendingTemporary pending{path.string(), TemporaryKind::kFolder};
     bool keep = false;
     ~Cleanup() {
       std::error_code e;
@@ -427,7 +432,7 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
 
   // --- into place
   if (fs::exists(out)) {
-    const fs::path old = parent / ("." + out.filename().string() + ".old-" + std::to_string(getpid()));
+    const fs::path old = parent / TemporaryName(".", out.filename().string(), ".old-" + pid);
     fs::rename(out, old, ec);
     if (ec) throw InputError(out.string(), "cannot replace: " + ec.message());
     fs::rename(tmp, out, ec);
@@ -436,6 +441,7 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
       fs::rename(old, out, e2);
       throw InputError(out.string(), "cannot rename the finished dataset into place: " + ec.message());
     }
+    const PendingTemporary pending_old(old.string(), TemporaryKind::kFolder);  // a signal finishes the removal
     fs::remove_all(old, ec);
   } else {
     fs::rename(tmp, out, ec);

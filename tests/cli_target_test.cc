@@ -3,9 +3,12 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "tests/cli_runner.h"
 
@@ -54,24 +57,45 @@ TEST(CliTarget, BadTargetFileExitsTwoAndWritesNothing) {
   EXPECT_EQ(RunStereorig("target").code, 2);  // --out is required
 }
 
-// Both outputs or neither: a target file that cannot be written (here its
-// temporary file's name is too long for the file system, as a full disk
-// would fail it later) leaves an earlier run's SVG as it was and no
-// temporary file. (Before, the new SVG was in place and the run exited 2.)
+// Both outputs or neither: a target file that cannot be written (in a
+// folder where no file can be created, UnwritablePath, as a full disk would
+// fail it after the SVG's temporary file is written) leaves an earlier run's
+// SVG as it was and no temporary file. (Before, the new SVG was in place and
+// the run exited 2.)
 TEST(CliTarget, ATargetFileThatCannotBeWrittenLeavesTheEarlierSvg) {
+  if (!stereorig::testing::WritesFailLateInUnwritablePaths()) GTEST_SKIP() << "needs root: see UnwritablePath";
   const std::string dir = ::testing::TempDir() + "/cli_target_all_or_none";
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   std::ofstream(dir + "/board.svg") << "earlier run";
-  const std::string long_name = dir + "/" + std::string(250, 't') + ".yaml";  // legal; its temporary file's is not
-  const Result r = RunStereorig("target --out " + dir + "/board.svg --write-target " + long_name);
+  const std::string unwritable = stereorig::testing::UnwritablePath("cli-target.yaml");
+  const Result r = RunStereorig("target --out " + dir + "/board.svg --write-target " + unwritable);
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  EXPECT_NE(r.err.find("cannot write: File name too long"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(unwritable + ": cannot write: No such file or directory"), std::string::npos) << r.err;
   EXPECT_EQ(Slurp(dir + "/board.svg"), "earlier run");
   int files = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) ++files, (void)entry;
-  EXPECT_EQ(files, 1);  // board.svg alone: no temporary file, no target file
+  EXPECT_EQ(files, 1);  // board.svg alone: no temporary file
+}
+
+// A target file's name of up to the file system's 255 bytes is written,
+// and nothing else is left beside it. (Before, one of 250 failed: its
+// temporary file's name, ".tmp-<pid>-<n>-<name>", passed 255.)
+TEST(CliTarget, ATargetFileNameOf255BytesIsWritten) {
+  const std::string dir = ::testing::TempDir() + "/cli_target_long_name";
+  for (const size_t name_bytes : {250u, 255u}) {
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    const std::string name = std::string(name_bytes - 5, 't') + ".yaml";
+    const Result r = RunStereorig("target --out " + dir + "/board.svg --write-target " + dir + "/" + name);
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(Slurp(dir + "/" + name).find("stereorig-target"), std::string::npos) << name_bytes;
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) names.push_back(entry.path().filename());
+    std::sort(names.begin(), names.end());
+    EXPECT_EQ(names, (std::vector<std::string>{"board.svg", name}));
+  }
 }
 
 // Its outputs are checked before anything is drawn: one path for both, or

@@ -154,6 +154,12 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
 }  // namespace
 }  // namespace stereorig
 
+#include <fcntl.h>
+#include <linux/fs.h>
+#include <sys/ioctl.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -407,27 +413,49 @@ TEST_F(ReconstructCli, UpperCaseSuffixesNameTheSameFormats) {
 }
 
 // The cloud, mesh and report of one capture are written all or none: a
-// report that cannot be written (here its temporary file's name is too long
-// for the file system, as a full disk would fail it later) leaves an earlier
-// run's cloud as it was, no mesh and no temporary file. (Before, the new
-// cloud and mesh were in place and the run exited 2.)
+// report that cannot be written (in a folder where no file can be created,
+// testing::UnwritablePath, as a full disk would fail it after the cloud's and
+// mesh's temporary files are written) leaves an earlier run's cloud as it
+// was, no mesh and no temporary file. (Before, the new cloud and mesh were in
+// place and the run exited 2.)
 TEST_F(ReconstructCli, AReportThatCannotBeWrittenLeavesTheEarlierCloud) {
+  if (!testing::WritesFailLateInUnwritablePaths()) GTEST_SKIP() << "needs root: see UnwritablePath";
   const std::string dir = dir_ + "/all_or_none";
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   std::ofstream(dir + "/out.ply") << "earlier run";
-  const std::string long_report = dir + "/" + std::string(250, 'r') + ".json";  // legal; its temporary file's is not
+  const std::string unwritable = testing::UnwritablePath("reconstruct-report.json");
   const testing::Result r =
       testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture --out " + dir +
-                      "/out.ply --mesh " + dir + "/out.stl --report " + long_report);
+                      "/out.ply --mesh " + dir + "/out.stl --report " + unwritable);
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
-  EXPECT_NE(r.err.find("cannot write: File name too long"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(unwritable + ": cannot write: No such file or directory"), std::string::npos) << r.err;
   std::ifstream cloud(dir + "/out.ply");
   EXPECT_EQ(std::string(std::istreambuf_iterator<char>(cloud), {}), "earlier run");
   std::vector<std::string> names;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) names.push_back(entry.path().filename());
-  EXPECT_EQ(names, std::vector<std::string>{"out.ply"});  // no mesh, report or temporary file
+  EXPECT_EQ(names, std::vector<std::string>{"out.ply"});  // no mesh or temporary file
+}
+
+// A report whose name takes the file system's whole 255 bytes is written
+// beside the cloud, nothing else left. (Before, any name over about 235
+// bytes failed: its temporary file's name, ".tmp-<pid>-<n>-<name>", passed
+// 255.)
+TEST_F(ReconstructCli, AReportNameOf255BytesIsWritten) {
+  const std::string dir = dir_ + "/long_report_name";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string name = std::string(250, 'r') + ".json";
+  const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ +
+                                            "/capture --out " + dir + "/out.ply --report " + dir + "/" + name);
+  EXPECT_EQ(r.code, 0) << r.err;
+  std::ifstream report(dir + "/" + name);
+  EXPECT_GT(nlohmann::json::parse(report, nullptr, false).value("points", 0), 40000) << "not the report";
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) names.push_back(entry.path().filename());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"out.ply", name}));
 }
 
 // Where each output goes is checked before any work (apps/output_paths.h):
@@ -763,37 +791,55 @@ TEST_F(ReconstructCli, ABatchOutDirThatCannotBeMadeLeavesNoFolder) {
   EXPECT_FALSE(std::filesystem::exists(fresh)) << "the folder made on the way was left behind";
 }
 
+// Sets or clears a file's immutable attribute (chattr +i, -i); false where
+// the file system or the process's capabilities (CAP_LINUX_IMMUTABLE) do not
+// allow it.
+bool SetImmutable(const std::string& path, bool immutable) {
+  const int fd = open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return false;
+  int flags = 0;
+  bool done = ioctl(fd, FS_IOC_GETFLAGS, &flags) == 0;
+  flags = immutable ? flags | FS_IMMUTABLE_FL : flags & ~FS_IMMUTABLE_FL;
+  done = done && ioctl(fd, FS_IOC_SETFLAGS, &flags) == 0;
+  close(fd);
+  return done;
+}
+
 // A capture whose outputs cannot be written has none, not a partial nor a
-// stale one, and the batch goes on. The trigger: a 236-character folder
-// name. Its outputs' names are valid (the longest, "<name>.mesh.stl", 245
-// characters), and so is the atomic writer's temporary for the cloud,
-// ".tmp-<pid>-<n>-<name>.ply" (248-252 with a 3-7 digit pid), but not the
-// mesh's (253-257 + 5 > 255 = NAME_MAX): the cloud is written, then the
-// mesh fails with ENAMETOOLONG, as a full disk would fail a write (root
-// ignores permissions, so these tests cannot use them). The written cloud
-// must go too.
+// stale one, and the batch goes on. The trigger: an earlier run's mesh of
+// the second capture that is immutable (chattr +i), so its cloud is written,
+// then renaming the new mesh over the old fails with EPERM, late, as a full
+// disk would fail a write (root ignores permissions, and the claim refuses a
+// folder at an output path, so these tests cannot use them; a name whose
+// temporary file's name was too long for the file system served before,
+// until temporary names were made to fit). The written cloud must go too;
+// the immutable mesh stays as it was.
 TEST_F(ReconstructCli, ABatchCaptureWhoseOutputsCannotBeWrittenHasNone) {
   const std::string batch = dir_ + "/batch_write", out = dir_ + "/batch_write_out";
+  const std::string old_mesh = out + "/0002.mesh.stl";
+  SetImmutable(old_mesh, false);  // left by a run that crashed
   std::filesystem::remove_all(batch);
   std::filesystem::remove_all(out);
   std::filesystem::create_directories(batch);
   std::filesystem::create_directories(out);
-  const std::string long_name(236, 'w');
-  for (const std::string& name : {std::string("0001"), long_name})
-    std::filesystem::copy(dir_ + "/capture", batch + "/" + name);
-  std::ofstream(out + "/" + long_name + ".json") << "a report from an earlier run\n";  // (not atomic: see above)
-  ASSERT_TRUE(std::filesystem::exists(out + "/" + long_name + ".json"));
+  for (const char* name : {"0001", "0002"}) std::filesystem::copy(dir_ + "/capture", batch + "/" + name);
+  std::ofstream(out + "/0002.json") << "a report from an earlier run\n";
+  std::ofstream(old_mesh) << "a mesh from an earlier run\n";
+  if (!SetImmutable(old_mesh, true)) GTEST_SKIP() << "cannot make a file immutable here (CAP_LINUX_IMMUTABLE?)";
+  struct Mutable {
+    std::string path;
+    ~Mutable() { SetImmutable(path, false); }  // whatever the test found: the next run can remove it
+  } undo{old_mesh};
   const testing::Result r =
-      testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + batch + "/0001 " + batch + "/" +
-                      long_name + " --out-dir " + out + " --mesh-format stl --report " + out + "/batch.json");
+      testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + batch + "/0001 " + batch +
+                      "/0002 --out-dir " + out + " --mesh-format stl --report " + out + "/batch.json");
   EXPECT_EQ(r.code, 2) << r.err;
-  EXPECT_NE(r.err.find("[2/2] " + out + "/" + long_name + ".mesh.stl: cannot write: File name too long"),
-            std::string::npos)
-      << r.err;
-  for (const char* ext : {".ply", ".json", ".mesh.stl"}) {
+  EXPECT_NE(r.err.find("[2/2] " + old_mesh + ": cannot write: Operation not permitted"), std::string::npos) << r.err;
+  for (const char* ext : {".ply", ".json", ".mesh.stl"})
     EXPECT_TRUE(std::filesystem::exists(out + "/0001" + ext)) << ext;
-    EXPECT_FALSE(std::filesystem::exists(out + "/" + long_name + ext)) << ext;
-  }
+  for (const char* ext : {".ply", ".json"}) EXPECT_FALSE(std::filesystem::exists(out + "/0002" + ext)) << ext;
+  std::ifstream mesh(old_mesh);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(mesh), {}), "a mesh from an earlier run\n");
   std::ifstream f(out + "/batch.json");
   const nlohmann::json summary = nlohmann::json::parse(f);
   EXPECT_EQ(summary["reconstructed"], 1);

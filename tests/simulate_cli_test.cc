@@ -3,7 +3,17 @@
 // whole default dataset is in simulate_e2e_test.cc.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <chrono>
+#include <functional>
+#include <string>
+#include <thread>
+#include <vector>
 
 #include "tests/sim_cli_util.h"
 
@@ -59,15 +69,15 @@ TEST(SimulateCli, AnOutFolderWithATrailingSlashIsWritten) {
 }
 
 // An --out that cannot be made (a name longer than the file system's 255
-// characters: the folder itself, or the temporary beside it, ".<name>.tmp-
-// <pid>") exits 2 in one line naming it, and the folders made above it on the
-// way are removed again (FolderToCreate, calib/core/folder_to_create.h); they
-// used to stay, empty.
+// bytes: a folder above it, or the folder itself) exits 2 in one line naming
+// it, before any rendering, and the folders made above it on the way are
+// removed again (FolderToCreate, calib/core/folder_to_create.h); they used to
+// stay, empty.
 TEST(SimulateCli, AnOutThatCannotBeMadeLeavesNoFolder) {
   const std::string dir = ::testing::TempDir() + "/sim_long";
   fs::remove_all(dir);
   const std::pair<std::string, std::string> cases[] = {{dir + "/new/" + std::string(300, 'x') + "/ds", "xxx"},
-                                                       {dir + "/new/" + std::string(250, 'y'), "/.yyy"}};
+                                                       {dir + "/new/" + std::string(256, 'z'), "/zzz"}};
   for (const auto& [out, says] : cases) {
     const Result r = RunCli("simulate --out " + out + " --calibration-captures 1 --no-scenes");
     EXPECT_EQ(r.code, 2) << r.err;
@@ -76,6 +86,84 @@ TEST(SimulateCli, AnOutThatCannotBeMadeLeavesNoFolder) {
     EXPECT_NE(r.err.find("File name too long"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir + "/new")) << "the folder made on the way was left behind: " << out.substr(0, 80);
   }
+}
+
+// An --out whose name takes up to the file system's 255 bytes is written,
+// and written again over itself, nothing left beside it. (Before, one of 250
+// bytes failed: the temporary folder's name, ".<name>.tmp-<pid>", passed
+// 255, as did ".<name>.old-<pid>", the earlier dataset's while it is
+// replaced.)
+TEST(SimulateCli, AnOutNameOf255BytesIsWritten) {
+  const std::string dir = ::testing::TempDir() + "/sim_long_name";
+  fs::remove_all(dir);
+  const std::pair<std::string, std::string> cases[] = {
+      {std::string(250, 'y'), "--calibration-captures 1"},  // a whole capture in it
+      {std::string(255, 'y'), "--calibration-captures 0"},
+      {std::string(255, 'y'), "--calibration-captures 0"}};  // replacing the one before
+  for (const auto& [name, captures] : cases) {
+    const Result r = RunCli("simulate --out " + dir + "/" + name + " --no-scenes " + captures);
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(dir + "/" + name + "/spec.yaml")) << name.size();
+  }
+  EXPECT_TRUE(fs::exists(dir + "/" + std::string(250, 'y') + "/calibration/000/cam3.png"));
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(dir)) ++entries, (void)e;
+  EXPECT_EQ(entries, 2) << "something beside the two datasets";
+}
+
+// `stereorig simulate` stopped by SIGTERM mid-render dies of the signal and
+// leaves neither its temporary folder (it used to leave .<name>.tmp-<pid>/
+// with every image rendered so far: calib/core/pending_temporary.h) nor the
+// dataset. 200 captures would take a minute: the signal comes once the first
+// image is there, found by polling (the ray tables come first, a few seconds
+// on a loaded machine).
+TEST(SimulateCli, ATerminationSignalMidRenderLeavesNoTemporaryFolder) {
+  const std::string dir = ::testing::TempDir() + "/sim_signal";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string out = dir + "/ds";
+  const char* argv[] = {"stereorig", "simulate",    "--out",     out.c_str(), "--calibration-captures",
+                        "200",       "--no-scenes", "--threads", "2",         nullptr};
+  posix_spawn_file_actions_t quiet;
+  posix_spawn_file_actions_init(&quiet);
+  posix_spawn_file_actions_addopen(&quiet, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&quiet, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+  pid_t pid = 0;
+  const int spawned =
+      posix_spawn(&pid, stereorig::testing::kBin.c_str(), &quiet, nullptr, const_cast<char**>(argv), environ);
+  posix_spawn_file_actions_destroy(&quiet);
+  ASSERT_EQ(spawned, 0);
+  // The wait status once it ends, or -1 if it still runs when `until` comes
+  // true or `seconds` have passed.
+  auto status_within = [pid](int seconds, const std::function<bool()>& until) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
+    int status = 0;
+    while (std::chrono::steady_clock::now() < deadline) {
+      if (waitpid(pid, &status, WNOHANG) == pid) return status;
+      if (until && until()) return -1;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return -1;
+  };
+  const fs::path first_image = dir + "/.ds.tmp-" + std::to_string(pid) + "/calibration/000/cam0.png";
+  const int early = status_within(60, [&] {
+    std::error_code ec;
+    return fs::exists(first_image, ec);
+  });
+  ASSERT_EQ(early, -1) << "simulate ended before its first image was seen";
+  ASSERT_TRUE(fs::exists(first_image)) << "no image within a minute";
+  kill(pid, SIGTERM);
+  int status = status_within(20, nullptr);
+  if (status == -1) {
+    kill(pid, SIGKILL);
+    waitpid(pid, &status, 0);
+    FAIL() << "simulate did not end within 20 s of SIGTERM";
+  }
+  ASSERT_TRUE(WIFSIGNALED(status)) << "exit status " << WEXITSTATUS(status);
+  EXPECT_EQ(WTERMSIG(status), SIGTERM);
+  std::vector<std::string> left;
+  for (const auto& entry : fs::directory_iterator(dir)) left.push_back(entry.path().filename());
+  EXPECT_TRUE(left.empty()) << "left: " << (left.empty() ? "" : left[0]);
 }
 
 // Options that would be ignored, or read wrongly, are refused before any

@@ -10,16 +10,19 @@
 #include <filesystem>
 
 #include "input_error.h"
+#include "temporary_name.h"
 
 namespace stereorig {
 
 namespace {
 
+// ".tmp-<pid>-<n>-<name>" beside `path`: unique by the pid and counter,
+// hidden, and of any length the file system takes (the name shortened).
 std::string MakeTempPath(const std::string& path) {
   static std::atomic<int> counter{0};
   const std::filesystem::path p(path);
-  const std::string stem = ".tmp-" + std::to_string(getpid()) + "-" + std::to_string(counter++) + "-";
-  return (p.parent_path() / (stem + p.filename().string())).string();
+  const std::string tag = ".tmp-" + std::to_string(getpid()) + "-" + std::to_string(counter++) + "-";
+  return (p.parent_path() / TemporaryName(tag, p.filename().string())).string();
 }
 
 }  // namespace

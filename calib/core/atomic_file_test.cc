@@ -39,20 +39,21 @@ TEST(AtomicOutputSet, CommitWritesEveryOutput) {
   EXPECT_EQ(Names(dir), (std::vector<std::string>{"a.ply", "b.json"}));  // no temporary file left
 }
 
-// A later output that cannot be written (here its temporary file's name is
-// too long for the file system, as a full disk would fail it later) leaves
-// the earlier run's files as they were and no temporary file: not the first
-// output new and the others old.
+// A later output that cannot be written leaves the earlier run's files as
+// they were and no temporary file: not the first output new and the others
+// old. The later output's folder is one where no file can be created, not
+// even by root (as a full disk fails a write, after the earlier output's
+// temporary file is written): /proc.
 TEST(AtomicOutputSet, AFailingOutputLeavesEveryEarlierFileAsItWas) {
   const std::string dir = testing::ScratchFolder("atomic_set_fail");
   WriteFileAtomically(dir + "/a.ply", "old cloud");
-  const std::string long_name =
-      dir + "/" + std::string(250, 'r') + ".json";  // legal; its ".tmp-<pid>-<n>-" form is not
+  const std::string unwritable = "/proc/stereorig-atomic-set-test.json";
   {
     AtomicOutputSet outputs;
     outputs.Add(dir + "/a.ply", "new cloud");
-    EXPECT_NE(testing::InputErrorMessage([&] { outputs.Add(long_name, "report"); }).find("cannot write"),
-              std::string::npos);
+    EXPECT_NE(
+        testing::InputErrorMessage([&] { outputs.Add(unwritable, "report"); }).find(unwritable + ": cannot write"),
+        std::string::npos);
   }  // not committed
   EXPECT_EQ(Contents(dir + "/a.ply"), "old cloud");
   EXPECT_EQ(Names(dir), std::vector<std::string>{"a.ply"});
@@ -87,6 +88,42 @@ TEST(WriteFileAtomically, ReplacesTheFileAndLeavesNoTemporaryFile) {
               WriteFileAtomically(dir + "/no_such_folder/r.json", "x");
             }).find("does not exist"),
             std::string::npos);
+}
+
+// Any name the file system takes is written, up to its 255 bytes. (Before,
+// the temporary file's name, ".tmp-<pid>-<n>-" before the output's, passed
+// 255 for a name of about 235 bytes, and the write failed with "File name
+// too long".) The temporary file keeps the extension: writers that pick the
+// format by it (cv::imwrite) still work.
+TEST(WriteFileAtomically, ANameOfUpTo255BytesIsWritten) {
+  const std::string dir = testing::ScratchFolder("atomic_long_name");
+  for (const size_t name_bytes : {236u, 250u, 255u}) {
+    const std::string name = std::string(name_bytes - 5, 'r') + ".json";
+    WriteFileAtomically(dir + "/" + name, "report " + std::to_string(name_bytes));
+    EXPECT_EQ(Contents(dir + "/" + name), "report " + std::to_string(name_bytes));
+    AtomicOutputSet outputs;
+    outputs.Add(dir + "/" + name, "again");
+    outputs.Add(dir + "/a.ply", "cloud");
+    outputs.Commit();
+    EXPECT_EQ(Contents(dir + "/" + name), "again");
+    EXPECT_EQ(Names(dir), (std::vector<std::string>{"a.ply", name}));  // no temporary file, no kept copy
+    std::filesystem::remove(dir + "/" + name);
+  }
+  const AtomicOutput image(dir + "/" + std::string(251, 'i') + ".png");
+  EXPECT_EQ(std::filesystem::path(image.temp_path()).extension(), ".png");
+  EXPECT_LE(std::filesystem::path(image.temp_path()).filename().string().size(), 255u);
+}
+
+// A name longer than the file system takes is still refused by it, in the
+// same words, and leaves nothing.
+TEST(WriteFileAtomically, ANameLongerThan255BytesIsRefused) {
+  const std::string dir = testing::ScratchFolder("atomic_too_long_name");
+  const std::string path = dir + "/" + std::string(251, 'r') + ".json";
+  EXPECT_NE(testing::InputErrorMessage([&] {
+              WriteFileAtomically(path, "x");
+            }).find(path + ": cannot write: File name too long"),
+            std::string::npos);
+  EXPECT_TRUE(Names(dir).empty());
 }
 
 }  // namespace

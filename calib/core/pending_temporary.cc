@@ -8,16 +8,20 @@
 #include <atomic>
 #include <mutex>
 
+#include "calib/core/signal_safe_removal.h"
+
 namespace stereorig {
 
 namespace {
 
-// A slot's path is written before it is marked ready, and the handler reads
-// only ready slots: a signal between the two sees a free slot. Lock-free
-// atomics and unlink(2) are what a signal handler may use.
+// A slot's path and kind are written before it is marked ready, and the
+// handler reads only ready slots: a signal between the two sees a free slot.
+// Lock-free atomics, unlink(2) and RemoveTreeSignalSafe are what a signal
+// handler may use.
 enum SlotState : int { kFree = 0, kFilling = 1, kReady = 2 };
 struct Slot {
   std::atomic<int> state{kFree};
+  TemporaryKind kind = TemporaryKind::kFile;
   char path[PATH_MAX];
 };
 static_assert(std::atomic<int>::is_always_lock_free);
@@ -26,8 +30,13 @@ Slot g_slots[PendingTemporary::kMaxPending];
 constexpr int kSignals[] = {SIGTERM, SIGINT, SIGHUP};
 
 extern "C" void RemovePendingAndDie(int signal) {
-  for (Slot& slot : g_slots)
-    if (slot.state.load() == kReady) unlink(slot.path);
+  for (Slot& slot : g_slots) {
+    if (slot.state.load() != kReady) continue;
+    if (slot.kind == TemporaryKind::kFolder)
+      RemoveTreeSignalSafe(slot.path);
+    else
+      unlink(slot.path);
+  }
   std::signal(signal, SIG_DFL);
   raise(signal);
 }
@@ -48,13 +57,14 @@ void InstallHandlers() {
 
 }  // namespace
 
-PendingTemporary::PendingTemporary(const std::string& path) {
+PendingTemporary::PendingTemporary(const std::string& path, TemporaryKind kind) {
   if (path.size() >= PATH_MAX) return;
   InstallHandlers();
   for (int i = 0; i < kMaxPending; ++i) {
     int expected = kFree;
     if (!g_slots[i].state.compare_exchange_strong(expected, kFilling)) continue;
     std::memcpy(g_slots[i].path, path.c_str(), path.size() + 1);
+    g_slots[i].kind = kind;
     g_slots[i].state.store(kReady);
     slot_ = i;
     return;

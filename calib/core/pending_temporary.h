@@ -1,30 +1,35 @@
-// Temporary output files that a termination signal removes. A line's
-// process stopped mid-write (SIGTERM from its supervisor, Ctrl-C) would
-// otherwise leave hidden .tmp-* files beside its outputs (atomic_file.h):
-// harmless to the outputs, but they pile up. While a PendingTemporary
-// lives, SIGTERM, SIGINT or SIGHUP unlinks its file, then the process dies
-// of the signal as it would have.
+// Temporary outputs that a termination signal removes. A line's process
+// stopped mid-write (SIGTERM from its supervisor, Ctrl-C) would otherwise
+// leave hidden .tmp-* files beside its outputs (atomic_file.h), or a
+// simulated dataset's temporary folder of hundreds of images
+// (datasets/simulate.cc): harmless to the outputs, but they pile up. While
+// a PendingTemporary lives, SIGTERM, SIGINT or SIGHUP removes its file, or
+// its folder and all in it (signal_safe_removal.h: links not followed, at
+// most kMaxRemovalDepth levels), then the process dies of the signal as it
+// would have.
 //
 // The handlers are installed on first use, for each of those signals whose
 // handler is still the default (a program's own handler is left alone).
-// Best effort: at most kMaxPending files at once, paths under PATH_MAX.
+// Best effort: at most kMaxPending at once, paths under PATH_MAX.
 #pragma once
 
 #include <string>
 
 namespace stereorig {
 
+enum class TemporaryKind { kFile, kFolder };
+
 class PendingTemporary {
  public:
   static constexpr int kMaxPending = 128;
 
-  explicit PendingTemporary(const std::string& path);
+  explicit PendingTemporary(const std::string& path, TemporaryKind kind = TemporaryKind::kFile);
   ~PendingTemporary() { Release(); }
   PendingTemporary(const PendingTemporary&) = delete;
   PendingTemporary& operator=(const PendingTemporary&) = delete;
 
-  // The file is gone (renamed into place or removed): a signal no longer
-  // touches it.
+  // The file or folder is gone (renamed into place or removed): a signal
+  // no longer touches it.
   void Release();
 
  private:

@@ -9,6 +9,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "calib/core/atomic_file.h"
@@ -60,6 +61,38 @@ TEST(PendingTemporary, AProgramsOwnHandlerIsKept) {
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 7);
   EXPECT_EQ(FileCount(dir), 1);
+}
+
+// A folder's tree goes too (simulate's temporary dataset): its files and
+// folders, and a link in it, but not the folder outside the tree that the
+// link points to. The child fills the folder once it is registered, as
+// simulate does, then the signal comes.
+TEST(PendingTemporary, ATerminationSignalRemovesAPendingFolderButNotWhatItsLinksPointTo) {
+  for (const int signal : {SIGTERM, SIGINT, SIGHUP}) {
+    const std::string dir = testing::ScratchFolder("pending_folder_" + std::to_string(signal));
+    const std::string tree = dir + "/.ds.tmp-1";
+    std::filesystem::create_directory(dir + "/outside");
+    std::ofstream(dir + "/outside/keep.txt") << "keep";
+    const pid_t child = fork();
+    if (child == 0) {
+      PendingTemporary pending(tree, TemporaryKind::kFolder);
+      std::error_code ec;
+      std::filesystem::create_directories(tree + "/calibration/000", ec);
+      std::filesystem::create_directories(tree + "/truth/scenes/cup", ec);
+      for (const char* file : {"/spec.yaml", "/calibration/000/cam0.png", "/truth/scenes/cup/surface.ply"})
+        std::ofstream(tree + file) << "x";
+      std::filesystem::create_directory_symlink(dir + "/outside", tree + "/truth/outside", ec);
+      if (ec) _exit(3);
+      raise(signal);
+      _exit(4);  // not reached: the signal ends the child
+    }
+    int status = 0;
+    waitpid(child, &status, 0);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "child exit status " << WEXITSTATUS(status);
+    EXPECT_EQ(WTERMSIG(status), signal);
+    EXPECT_EQ(FileCount(dir), 1) << "the temporary folder was left";
+    EXPECT_TRUE(std::filesystem::exists(dir + "/outside/keep.txt")) << "the link was followed";
+  }
 }
 
 }  // namespace
