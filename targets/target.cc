@@ -55,6 +55,17 @@ Target::Target(Layout layout, const std::string& where) : layout_(std::move(layo
         }
         tag_bits_[f].push_back(RenderTagBits(l.tag_family, t.id));
       }
+      // Two tags of one face printed over each other are read as neither
+      // (a small grid in the default's design spaces its four tags closer
+      // than their size). Touching edges are allowed.
+      const std::vector<TagPlacement>& tags = l.faces[f].tags;
+      for (size_t a = 0; a < tags.size(); ++a)
+        for (size_t b = a + 1; b < tags.size(); ++b)
+          if (std::abs(tags[a].center_x_mm - tags[b].center_x_mm) < l.tag_size_mm &&
+              std::abs(tags[a].center_y_mm - tags[b].center_y_mm) < l.tag_size_mm) {
+            throw InputError(where, "tags " + std::to_string(tags[a].id) + " and " + std::to_string(tags[b].id) +
+                                        " overlap: their centres must be at least tag_size_mm apart along x or y");
+          }
     }
   }
 }

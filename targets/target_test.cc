@@ -66,6 +66,18 @@ TEST(Target, RejectsBadLayouts) {
   l = DefaultTarget().layout();
   l.square_size_mm = -1;
   EXPECT_THROW(Target(l, "t"), InputError);
+  // Two tags of a face printed over each other (11 mm tags 5 mm apart, both
+  // in the top margin), and, the other way, two just touching: 11 mm apart.
+  l = DefaultTarget().layout();
+  l.faces[0].tags[1].center_x_mm = l.faces[0].tags[0].center_x_mm + 5;
+  try {
+    Target(l, "t");
+    ADD_FAILURE() << "overlapping tags accepted";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "t: tags 0 and 1 overlap: their centres must be at least tag_size_mm apart along x or y");
+  }
+  l.faces[0].tags[1].center_x_mm = l.faces[0].tags[0].center_x_mm + l.tag_size_mm;
+  EXPECT_NO_THROW(Target(l, "t"));
 }
 
 TEST(TargetFile, RoundTripsExactlyAndRejectsUnknownKeys) {
