@@ -1,6 +1,7 @@
 // `stereorig target`: the printable target (SVG, true scale), and optionally
 // its target file to start from.
 #include <cstdio>
+#include <vector>
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
@@ -8,9 +9,27 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "targets/board_svg.h"
+#include "targets/target.h"
 #include "targets/target_file.h"
 
 namespace stereorig {
+
+namespace {
+
+// The default target's design at another size, checked as a target file's
+// layout is (tags clear of the squares and of each other); a problem is
+// named by the flags that chose it.
+Target ResizedDefaultTarget(int corners_x, int corners_y, double square_mm, double thickness_mm) {
+  try {
+    Target::Layout layout = DoubleSidedTarget(corners_x, corners_y, square_mm).layout();
+    layout.back_from_front = IdealBackFromFront(corners_x, square_mm, thickness_mm);
+    return Target(layout, "");
+  } catch (const InputError& e) {
+    throw InputError("--corners, --square-mm", e.problem());
+  }
+}
+
+}  // namespace
 
 int RunTarget(int argc, char** argv) {
   CLI::App app{
@@ -18,13 +37,34 @@ int RunTarget(int argc, char** argv) {
       "back right), each face's name and tag IDs, markers at corner 0's row and column, and a 100 mm scale bar. "
       "Print at 100 % (actual size, no fit-to-page), then measure the bar and the squares (docs/targets.md).\n\n"
       "Without --target, the embedded default target (11x9 inner corners of 9 mm, tag36h11, front IDs 0-7, back "
-      "IDs 100-107). --write-target saves the target file used, to edit and measure against.\n\n"
+      "IDs 100-107, a 5 mm plate), or its design at another size (--corners, --square-mm, --thickness-mm): the same "
+      "tags and margins, the back face in register with the front. --write-target saves the target file used, to "
+      "edit and measure against: its back_from_front and flatness are the design's until you measure the board.\n\n"
       "Examples:\n"
       "  stereorig target --out board.svg --write-target board.yaml\n"
+      "  stereorig target --corners 13 10 --square-mm 12 --thickness-mm 6 --out b12.svg --write-target b12.yaml\n"
       "  stereorig target --target my_board.yaml --face back --out back.svg",
       "stereorig target"};
   std::string target_path, out_path, write_target, faces = "both";
-  app.add_option("--target", target_path, "target file (YAML, docs/targets.md); default: the embedded default");
+  std::vector<int> corners;
+  double square_mm = 0, thickness_mm = 0;
+  CLI::Option* target_option =
+      app.add_option("--target", target_path, "target file (YAML, docs/targets.md); default: the embedded default");
+  CLI::Option* corners_option =
+      app.add_option("--corners", corners, "the default's design with X x Y inner corners (default 11 9)")
+          ->expected(2)
+          ->check(CLI::Range(2, 200))
+          ->excludes(target_option);
+  CLI::Option* square_option =
+      app.add_option("--square-mm", square_mm, "the default's design with squares of this edge, mm (default 9)")
+          ->check(CLI::Range(1.0, 500.0))
+          ->excludes(target_option);
+  CLI::Option* thickness_option =
+      app.add_option(
+             "--thickness-mm", thickness_mm,
+             "the default's design on a plate this thick, mm (default 5): the back face's depth behind the front")
+          ->check(CLI::Range(0.1, 100.0))
+          ->excludes(target_option);
   app.add_option("--out", out_path, "SVG to write (atomically)")->required();
   app.add_option("--face", faces, "which faces to draw: both, front or back")
       ->check(CLI::IsMember({"both", "front", "back"}))
@@ -39,7 +79,13 @@ int RunTarget(int argc, char** argv) {
   outputs.Protect(target_path, "the target file (--target)");
   outputs.Claim(out_path, "the SVG (--out)");
 
-  const Target target = target_path.empty() ? DefaultTarget() : ReadTargetFile(target_path);
+  const bool resized = corners_option->count() || square_option->count() || thickness_option->count();
+  const Target target = !target_path.empty() ? ReadTargetFile(target_path)
+                        : resized
+                            ? ResizedDefaultTarget(corners.empty() ? 11 : corners[0], corners.empty() ? 9 : corners[1],
+                                                   square_option->count() ? square_mm : 9.0,
+                                                   thickness_option->count() ? thickness_mm : 5.0)
+                            : DefaultTarget();
   BoardSvgOptions options;
   options.faces = faces == "front" ? SvgFaces::kFront : faces == "back" ? SvgFaces::kBack : SvgFaces::kBoth;
   const BoardSvg svg = MakeBoardSvg(target, options);

@@ -44,6 +44,39 @@ TEST(CliTarget, WritesTheDefaultBoardAndItsTargetFile) {
   EXPECT_NE(back_svg.find("id=\"back\""), std::string::npos);
 }
 
+// The default's design at another size (a user's own board): the corner
+// grid, the tags in the margins (4 a margin, spread over the grid's width
+// plus a square each side: centres at -s + (cx + 1) s (k + 1/2) / 4, and
+// -s - margin / 2 above) and the back in register through the plate
+// (back_from_front = diag(-1, 1, -1), ((cx - 1) s, 0, thickness)), worked
+// out by hand from docs/targets.md's frames; the file reads back. Boards too
+// small for the tags, and a size given with --target, are refused.
+TEST(CliTarget, TheDefaultsDesignAtAnotherSize) {
+  const std::string dir = ::testing::TempDir() + "/cli_target_resized";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const Result r = RunStereorig("target --corners 8 6 --square-mm 20 --thickness-mm 6 --out " + dir +
+                                "/b.svg --write-target " + dir + "/b.yaml");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string yaml = Slurp(dir + "/b.yaml");
+  for (const char* line : {"corners_x: 8 ", "corners_y: 6 ", "square_size_mm: 20\n", "{id: 0, center_mm: [2.5, -27.5]}",
+                           "{id: 3, center_mm: [137.5, -27.5]}", "{id: 107, center_mm: [137.5, 127.5]}",
+                           "back_from_front: [[-1, 0, 0, 140], [0, 1, 0, -0], [0, 0, -1, 6], [0, 0, 0, 1]]"})
+    EXPECT_NE(yaml.find(line), std::string::npos) << line << "\n" << yaml;
+  const Result back = RunStereorig("target --target " + dir + "/b.yaml --out " + dir + "/again.svg");
+  EXPECT_EQ(back.code, 0) << back.err;
+  EXPECT_EQ(Slurp(dir + "/again.svg"), Slurp(dir + "/b.svg"));
+
+  const Result tiny = RunStereorig("target --corners 4 3 --square-mm 3 --out " + dir + "/tiny.svg");
+  EXPECT_EQ(tiny.code, 2);
+  EXPECT_EQ(std::count(tiny.err.begin(), tiny.err.end(), '\n'), 1) << tiny.err;
+  EXPECT_NE(tiny.err.find("--corners, --square-mm: "), std::string::npos) << tiny.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/tiny.svg"));
+  const Result both = RunStereorig("target --target " + dir + "/b.yaml --square-mm 12 --out " + dir + "/x.svg");
+  EXPECT_EQ(both.code, 2);
+  EXPECT_NE(both.err.find("--target excludes --square-mm"), std::string::npos) << both.err;
+}
+
 TEST(CliTarget, BadTargetFileExitsTwoAndWritesNothing) {
   const std::string dir = ::testing::TempDir() + "/cli_target_bad";
   std::filesystem::create_directories(dir);
