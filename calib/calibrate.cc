@@ -204,6 +204,7 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
   CalibrationReport& rep = result.report;
   rep.source = in.source;
   rep.num_modules = M;
+  rep.capture_names = in.capture_names;
 
   // Stage 1.
   for (int c = 0; c < nc; ++c) {
@@ -283,7 +284,8 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
 
 namespace {
 
-void WriteIntrinsics(JsonWriter& j, const IntrinsicsReport& r) {
+// names: capture index -> folder name (CalibrationReport::capture_names).
+void WriteIntrinsics(JsonWriter& j, const IntrinsicsReport& r, const std::map<int, std::string>& names) {
   j.BeginObject();
   j.Int("camera", r.camera).String("name", r.camera_name).String("lensmodel", r.lensmodel);
   j.Int("views", r.num_views).Int("views_dropped", r.num_views_dropped).Int("corners", r.num_corners);
@@ -291,7 +293,9 @@ void WriteIntrinsics(JsonWriter& j, const IntrinsicsReport& r) {
   j.Number("max_tilt_deg", r.max_tilt_deg);
   j.BeginArray("worst_views");
   for (const ViewResidual& v : r.worst_views) {
-    j.BeginObject().Int("capture", v.capture).Number("rms_px", v.rms_px).Int("corners", v.num_corners).EndObject();
+    j.BeginObject().Int("capture", v.capture);
+    if (auto it = names.find(v.capture); it != names.end()) j.String("capture_name", it->second);
+    j.Number("rms_px", v.rms_px).Int("corners", v.num_corners).EndObject();
   }
   j.EndArray();
   j.BeginObject("coverage").Int("cells_x", r.coverage_cells_x).Int("cells_y", r.coverage_cells_y);
@@ -316,11 +320,16 @@ void WritePose(JsonWriter& j, const std::string& key, const Pose& p) {
 
 }  // namespace
 
+std::string CalibrationReport::CaptureName(int capture) const {
+  const auto it = capture_names.find(capture);
+  return it != capture_names.end() ? it->second : std::to_string(capture);
+}
+
 std::string CalibrationReport::ToJson() const {
   JsonWriter j;
   j.BeginObject().String("source", source).Int("modules", num_modules);
   j.BeginArray("stage1_intrinsics");
-  for (const IntrinsicsReport& r : intrinsics) WriteIntrinsics(j, r);
+  for (const IntrinsicsReport& r : intrinsics) WriteIntrinsics(j, r, capture_names);
   j.EndArray();
   j.BeginArray("stage2_stereo");
   for (const StereoReport& s : stereo) {
@@ -329,6 +338,11 @@ std::string CalibrationReport::ToJson() const {
     j.BeginArray("different_face_captures");
     for (int c : s.different_face_captures) j.Int(c);
     j.EndArray();
+    if (!capture_names.empty()) {  // the same captures by folder name, in the same order
+      j.BeginArray("different_face_capture_names");
+      for (int c : s.different_face_captures) j.String("", CaptureName(c));
+      j.EndArray();
+    }
     j.Int("outliers", s.num_outliers).Number("baseline_mm", s.baseline_mm).Number("rotation_deg", s.rotation_deg);
     j.Numbers("right_from_left_rotation_vector_deg",
               {s.right_from_left_rotation_vector_deg.x(), s.right_from_left_rotation_vector_deg.y(),
@@ -346,8 +360,8 @@ std::string CalibrationReport::ToJson() const {
     j.Number("rectified_row_rms_px", s.rectified_row_rms_px).Number("rectified_row_max_px", s.rectified_row_max_px);
     j.Int("corner_pairs", s.num_corner_pairs);
     j.BeginArray("cameras_joint_solve");
-    WriteIntrinsics(j, s.left);
-    WriteIntrinsics(j, s.right);
+    WriteIntrinsics(j, s.left, capture_names);
+    WriteIntrinsics(j, s.right, capture_names);
     j.EndArray();
     j.EndObject();
   }
@@ -479,7 +493,8 @@ std::string SummaryText(const CalibrationReport& rep) {
                  e[0], v[1], e[1], v[2], e[2], v[3], e[3]);
     }
     if (!r.worst_views.empty()) {
-      AppendLine(&out, "    worst view: capture %d, rms %.3f px", r.worst_views[0].capture, r.worst_views[0].rms_px);
+      AppendLine(&out, "    worst view: capture %s, rms %.3f px", rep.CaptureName(r.worst_views[0].capture).c_str(),
+                 r.worst_views[0].rms_px);
     }
   }
   AppendLine(&out, "stage 2: stereo extrinsics per module");
@@ -497,7 +512,7 @@ std::string SummaryText(const CalibrationReport& rep) {
           list += ", ...";  // the report lists them all
           break;
         }
-        list += (i ? ", " : "") + std::to_string(s.different_face_captures[i]);
+        list += (i ? ", " : "") + rep.CaptureName(s.different_face_captures[i]);
       }
       AppendLine(&out,
                  "    %zu capture(s) set aside in stage 2%s: the module's two cameras saw different faces (the "

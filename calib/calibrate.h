@@ -10,6 +10,7 @@
 // refused with an InputError that names the problem.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,10 @@ struct CalibrationReport {
   std::vector<StereoReport> stereo;          // stage 2, per module
   SystemReport system;                       // stage 3 (empty for a 1-module rig)
   int num_modules = 0;
+  std::map<int, std::string> capture_names;  // CalibrationInput::capture_names
+  // The capture's folder name where known, else its index in decimal: how
+  // the summary names a capture (the JSON keeps the index and adds the name).
+  std::string CaptureName(int capture) const;
   std::string ToJson() const;
 };
 

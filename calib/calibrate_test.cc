@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 
 #include "calib/calib_test_util.h"
 #include "calib/core/input_error.h"
@@ -230,6 +231,41 @@ TEST(CalibrateReport, ExportsCameramodelsThatMrcalReads) {
     EXPECT_NEAR(m->rt_cam_ref[3], cam_from_ref.translation_mm().x(), 1e-9);
     mrcal_free_cameramodel(&m);
   }
+}
+
+// A capture whose folder name is known (calib/capture_folder.h) is named by
+// it in the summary, as the detection lines name it; the JSON keeps the
+// index and adds the name beside it. Without a name (observations from
+// elsewhere) the index stands, as before.
+TEST(CalibrateReport, NamesCapturesByTheirFoldersWhereKnown) {
+  CalibrationReport rep;
+  rep.num_modules = 1;
+  IntrinsicsReport camera;
+  camera.camera_name = "cam0";
+  camera.worst_views = {{3, 0.25, 40}, {5, 0.2, 40}};
+  rep.intrinsics = {camera};
+  StereoReport module;
+  module.module_name = "module0";
+  module.different_face_captures = {3, 5};
+  rep.stereo = {module};
+
+  EXPECT_NE(SummaryText(rep).find("worst view: capture 3, rms 0.250 px"), std::string::npos) << SummaryText(rep);
+  EXPECT_EQ(nlohmann::json::parse(rep.ToJson())["stage1_intrinsics"][0]["worst_views"][0].count("capture_name"), 0u);
+
+  rep.capture_names = {{3, "pose_d"}};  // 5 unnamed: its index
+  const std::string text = SummaryText(rep);
+  EXPECT_NE(text.find("worst view: capture pose_d, rms 0.250 px"), std::string::npos) << text;
+  EXPECT_NE(text.find("saw different faces (the board's plane between them, or a face misread): pose_d, 5"),
+            std::string::npos)
+      << text;
+  const nlohmann::json j = nlohmann::json::parse(rep.ToJson());
+  const nlohmann::json& worst = j["stage1_intrinsics"][0]["worst_views"];
+  EXPECT_EQ(worst[0]["capture"], 3);
+  EXPECT_EQ(worst[0]["capture_name"], "pose_d");
+  EXPECT_EQ(worst[1]["capture"], 5);
+  EXPECT_EQ(worst[1].count("capture_name"), 0u);
+  EXPECT_EQ(j["stage2_stereo"][0]["different_face_captures"], nlohmann::json({3, 5}));
+  EXPECT_EQ(j["stage2_stereo"][0]["different_face_capture_names"], nlohmann::json({"pose_d", "5"}));
 }
 
 TEST(CalibrateReport, JsonHoldsEveryStage) {

@@ -67,6 +67,7 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
     const std::string name = captures[n].filename().string();
     const bool numeric = !name.empty() && std::all_of(name.begin(), name.end(), ::isdigit);
     const int capture = numeric ? std::stoi(name) : static_cast<int>(n);
+    out.capture_names[capture] = name;
     std::string line = "detect " + name + ":";
     for (int c = 0; c < num_cameras; ++c) {
       const fs::path image = captures[n] / CameraImageName(c);
@@ -156,6 +157,7 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
   DetectedCaptures detected = DetectCaptureFolder(captures_dir, target, num_cameras, DetectOptions(), options.progress);
   input.cameras = detected.cameras;
   input.observations = std::move(detected.observations);
+  input.capture_names = std::move(detected.capture_names);
   FolderCalibration out;
   out.num_captures = detected.num_captures;
   out.num_views = static_cast<int>(input.observations.size());

@@ -7,6 +7,7 @@
 // works too: its calibration/ sub-folder is used.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,7 @@ struct DetectedCaptures {
   std::vector<BoardObservation> observations;
   std::vector<ImageDetectionLog> log;  // one entry per image
   int num_captures = 0;
+  std::map<int, std::string> capture_names;  // capture index -> its sub-folder's name (CalibrationInput's)
 };
 
 // The images a captures folder holds: every file named camK.png (any K) in

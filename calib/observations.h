@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -75,6 +76,10 @@ struct CalibrationInput {
   std::vector<ModuleLayout> modules;  // module 0 is the reference
   std::vector<BoardObservation> observations;
   std::string source = "observations";  // for provenance and error messages
+  // Capture index -> the name of its folder (calib/capture_folder.h), for
+  // the report to name a capture as the detection lines do; empty for
+  // observations from elsewhere (the synthetic rigs).
+  std::map<int, std::string> capture_names;
 };
 
 // The captures in which a module's two cameras (global indices) saw different faces of the

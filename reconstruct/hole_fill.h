@@ -18,9 +18,12 @@
 // outward-facing triangles. Filled points carry module = kFilledModule and
 // confidence 0.
 //
-// A fit is not used (ok = false, message says why, nothing added) if it
-// fails, if the model is larger than object_size_mm, or if it explains less
-// than half of the measured points.
+// The fit runs on every k-th point of `measured` (k = size / 20000, at
+// least 1). A fit is not used (ok = false, message says why, nothing added)
+// if it fails, if the model is larger than object_size_mm (its diameter,
+// length or longest axis), or if fewer than half of the points fitted (the
+// subsample) are its inliers. The "N inliers" of the message counts points
+// of that subsample.
 #pragma once
 
 #include <string>

@@ -25,9 +25,21 @@ struct RuntimeOptions {
   std::optional<Eigen::Vector3d> volume_center_mm;  // default: see working_distance_mm
   double working_distance_mm = 200.0;  // only used to place the default volume centre; default 200 (the seed's)
   Eigen::Vector3d volume_size_mm = Eigen::Vector3d(150, 150, 100);  // default 150 x 150 x 100 (the seed's)
-  // Largest dimension of the objects measured, mm. Points farther than this
-  // from the robust centre of a module's cloud are rejected as background or
-  // gross mismatches, and the shape model's size is checked against it.
+  // Largest dimension of the objects measured (the largest distance between
+  // two of their points), mm. Used against two different lengths:
+  //  - points (runtime.cc): in each module, a point (inside the volume, with
+  //    confidence >= min_confidence) whose 3D distance from the per-axis
+  //    median of that module's points exceeds this is dropped
+  //    (PixelStatus::kObjectSize: background, gross mismatches). A radius of
+  //    object_size_mm around a point on or near the object: it does not
+  //    check the object's size, and an object up to ~2x this across can
+  //    keep every point;
+  //  - the shape model (hole_fill.cc): refused if its full extent exceeds
+  //    this: a sphere's or cylinder's diameter, a cylinder's length, an
+  //    ellipsoid's longest axis (RANSAC already skips cylinder radii and
+  //    ellipsoid semi-axes above it).
+  // So an object larger than this can keep its points and yet have its
+  // fitted model refused.
   double object_size_mm = 100.0;  // default 100
   // Crop each capture's ROI to the bounding box of the laser-lit area (active
   // mode): the grid lights ~81x81 mm at 200 mm, a quarter of the image.

@@ -7,9 +7,11 @@
 #include <gtest/gtest.h>
 
 #include <unistd.h>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 
@@ -119,6 +121,54 @@ TEST(CalibrateCli, RenderedCapturesToRigFileAndReport) {
   // Rendered corners carry a few hundredths of a pixel of detection error (no
   // lens distortion here), far below the 0.2 px of the corner-level tests.
   EXPECT_LT(agreement, 0.05);
+}
+
+// Captures in folders with names of their own (pose_a, pose_b, ...): the
+// summary names each camera's worst view by its folder, as the detection
+// lines do ("detect pose_d: ..."); it used to print the capture's 0-based
+// position among the folders ("worst view: capture 3"), which the user had
+// to count out. The report keeps the index and adds the name beside it.
+TEST(CalibrateCli, SummaryNamesTheWorstViewsByTheirFolders) {
+  const RenderedSet& set = Rendered();
+  const std::string named = set.dir + "/named";
+  fs::remove_all(named);
+  std::vector<fs::path> numbered;
+  for (const auto& e : fs::directory_iterator(set.dir + "/captures")) numbered.push_back(e.path());
+  std::sort(numbered.begin(), numbered.end());
+  ASSERT_EQ(numbered.size(), 8u);
+  std::vector<std::string> names;  // by position: the capture index a non-numeric folder gets
+  for (size_t k = 0; k < numbered.size(); ++k) {
+    names.push_back(std::string("pose_") + char('a' + k));
+    fs::create_directories(named + "/" + names.back());
+    for (const auto& image : fs::directory_iterator(numbered[k]))
+      fs::copy_file(image.path(), named + "/" + names.back() + "/" + image.path().filename().string());
+  }
+  const std::string report = set.dir + "/named_report.json";
+  const testing::Result r = testing::RunCli("calibrate --captures " + named + " --target " + set.dir +
+                                            "/target.yaml --layout " + set.dir + "/layout.yaml --out " + set.dir +
+                                            "/named_rig.yaml --report " + report + " --lensmodel LENSMODEL_OPENCV5");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("detect pose_d:"), std::string::npos) << r.err;
+  const std::string said = "worst view: capture ";
+  int lines = 0;
+  for (size_t at = r.out.find(said); at != std::string::npos; at = r.out.find(said, at + 1)) {
+    ++lines;
+    EXPECT_EQ(r.out.compare(at + said.size(), 5, "pose_"), 0) << r.out.substr(at, 50);
+  }
+  EXPECT_EQ(lines, 4) << r.out;  // one per camera
+  std::ifstream f(report);
+  const nlohmann::json j = nlohmann::json::parse(f);
+  int views = 0;
+  for (const auto& camera : j.at("stage1_intrinsics"))
+    for (const auto& v : camera.at("worst_views")) {
+      ++views;
+      const int capture = v.at("capture").get<int>();
+      ASSERT_GE(capture, 0);
+      ASSERT_LT(capture, 8);
+      ASSERT_TRUE(v.contains("capture_name")) << v.dump();
+      EXPECT_EQ(v.at("capture_name").get<std::string>(), names[size_t(capture)]);
+    }
+  EXPECT_GT(views, 0);
 }
 
 // A models' folder that cannot be made (a name longer than the file
