@@ -89,8 +89,8 @@ bool FitModel(const std::vector<Eigen::Vector3d>& pts, const std::vector<Eigen::
         return rho - r;
       };
       std::snprintf(buf, sizeof buf,
-                    "sphere centre (%.3f, %.3f, %.3f) mm, radius %.3f mm, fit rms %.3f mm, %zu inliers", c.x(), c.y(),
-                    c.z(), r, fit.rms_mm, fit.inliers.size());
+                    "sphere centre (%.3f, %.3f, %.3f) mm, radius %.3f mm, fit rms %.3f mm, %zu of %zu fitted points inliers", c.x(), c.y(),
+                    c.z(), r, fit.rms_mm, fit.inliers.size(), pts.size());
       break;
     }
     case ShapeModel::kCylinder: {
@@ -129,9 +129,9 @@ bool FitModel(const std::vector<Eigen::Vector3d>& pts, const std::vector<Eigen::
       };
       std::snprintf(buf, sizeof buf,
                     "cylinder axis through (%.3f, %.3f, %.3f) mm along (%.4f, %.4f, %.4f), radius %.3f mm, length "
-                    "%.1f mm, fit rms %.3f mm, %zu inliers",
+                    "%.1f mm, fit rms %.3f mm, %zu of %zu fitted points inliers",
                     fit.axis_point_mm.x(), fit.axis_point_mm.y(), fit.axis_point_mm.z(), d.x(), d.y(), d.z(), r, len,
-                    fit.rms_mm, fit.inliers.size());
+                    fit.rms_mm, fit.inliers.size(), pts.size());
       break;
     }
     case ShapeModel::kEllipsoid: {
@@ -174,9 +174,9 @@ bool FitModel(const std::vector<Eigen::Vector3d>& pts, const std::vector<Eigen::
       };
       std::snprintf(buf, sizeof buf,
                     "ellipsoid centre (%.3f, %.3f, %.3f) mm, semi-axes (%.3f, %.3f, %.3f) mm, fit rms %.3f mm, %zu "
-                    "inliers",
+                    "of %zu fitted points inliers",
                     fit.center_mm.x(), fit.center_mm.y(), fit.center_mm.z(), a.x(), a.y(), a.z(), fit.rms_mm,
-                    fit.inliers.size());
+                    fit.inliers.size(), pts.size());
       break;
     }
     case ShapeModel::kNone:
