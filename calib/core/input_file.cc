@@ -6,13 +6,14 @@
 
 namespace stereorig {
 
-void RequireInputFile(const std::string& path) {
+void RequireInputFile(const std::string& path, bool pipe_too) {
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
   if (status.type() == fs::file_type::not_found) throw InputError(path, "no such file");
   if (ec) throw InputError(path, "cannot read it: " + ec.message());  // e.g. a folder on the way not searchable
   if (fs::is_directory(status)) throw InputError(path, "is a folder, not a file");
+  if (pipe_too && fs::is_fifo(status)) return;
   if (!fs::is_regular_file(status)) throw InputError(path, "is not a regular file");
 }
 

@@ -9,6 +9,9 @@ namespace stereorig {
 // Throws InputError naming `path` unless it is a regular file (or a link to
 // one): "no such file", "is a folder, not a file", or why it cannot be
 // looked at (a folder on the way the process may not search).
-void RequireInputFile(const std::string& path);
+// With `pipe_too`, a pipe is taken as well (a text input read once from
+// start to end, e.g. a YAML file given as `--options <(...)` or
+// /dev/stdin); images, which are read by seeking, are not.
+void RequireInputFile(const std::string& path, bool pipe_too = false);
 
 }  // namespace stereorig

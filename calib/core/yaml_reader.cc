@@ -10,7 +10,7 @@
 namespace stereorig {
 
 YamlMap YamlMap::LoadFile(const std::string& path) {
-  RequireInputFile(path);
+  RequireInputFile(path, /*pipe_too=*/true);  // read once, start to end
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);

@@ -1,6 +1,12 @@
 #include "calib/core/yaml_reader.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <thread>
 
 #include "calib/core/input_error.h"
 #include "calib/core/input_error_testing.h"
@@ -92,6 +98,29 @@ TEST(YamlMap, AKeyGivenTwiceIsRefused) {
   EXPECT_EQ(InputErrorMessage([] { YamlMap::LoadString("{a: 1}: 2\n", "f.yaml"); }),
             "f.yaml: line 1: a key must be a plain name, not a mapping");
   EXPECT_EQ(YamlMap::LoadString("\"null\": 3\n", "f.yaml").GetInt("null"), 3);  // quoted: a name
+}
+
+// A pipe reads as a file (`--options <(printf ...)`, /dev/stdin): the
+// shell's process substitution was refused as "not a regular file". A
+// device is still refused.
+TEST(YamlMap, APipeIsReadLikeAFile) {
+  const std::string fifo = ::testing::TempDir() + "/yaml_pipe";
+  std::filesystem::remove(fifo);
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  std::thread writer([&] { std::ofstream(fifo) << "match: {p1: 7}\n"; });  // blocks until the reader opens it
+  std::optional<YamlMap> m;
+  std::string refused;
+  try {
+    m = YamlMap::LoadFile(fifo);
+  } catch (const InputError& e) {
+    refused = e.what();
+    std::ifstream release(fifo);  // the writer waits for a reader: let it finish
+  }
+  writer.join();
+  ASSERT_TRUE(m) << refused;
+  EXPECT_EQ(m->GetMap("match").GetInt("p1"), 7);
+  std::filesystem::remove(fifo);
+  EXPECT_EQ(InputErrorMessage([] { YamlMap::LoadFile("/dev/null"); }), "/dev/null: is not a regular file");
 }
 
 TEST(YamlMap, SyntaxErrorsAreInputErrors) {
