@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include <Eigen/Geometry>  // cross()
+
 #include "calib/core/input_error.h"
 
 namespace stereorig {
@@ -22,17 +24,23 @@ std::string Pixel(const Eigen::Vector2d& q) {
   return buf;
 }
 
-// Angle of a unit ray off the camera's optical axis (+z), rad.
-double OffAxisRad(const Eigen::Vector3d& v) { return std::atan2(v.head<2>().norm(), v.z()); }
+// Angle between two unit rays, rad (atan2 of the cross and dot products:
+// exact near 0, where acos is not).
+double AngleRad(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
 
 // Walks from the principal point to `end` and throws where the lens stops
 // mapping pixels to rays one-to-one.
 void CheckLineFromPrincipalPoint(const Camera& camera, const Eigen::Vector2d& end, const std::string& where) {
   const Eigen::Vector2d principal(camera.cx(), camera.cy());
   if ((end - principal).norm() < 1) return;  // the principal point is (nearly) this end
-  Eigen::Vector3d v;
-  if (!camera.Unproject(principal, &v)) throw InputError(where, "the principal point has no ray (lens model)");
-  double previous_rad = OffAxisRad(v);
+  // Angles are taken from the principal point's own ray, not from +z: in a
+  // splined model the spline can move the axis off (cx, cy) (mrcal's own
+  // splined test model: 23 px), and the angle off +z then first falls
+  // along a line from (cx, cy).
+  Eigen::Vector3d principal_ray, v;
+  if (!camera.Unproject(principal, &principal_ray))
+    throw InputError(where, "the principal point has no ray (lens model)");
+  double previous_rad = 0;
   for (int k = 1; k <= kSamplesPerLine; ++k) {
     const Eigen::Vector2d q = principal + (end - principal) * (double(k) / kSamplesPerLine);
     const std::string there =
@@ -43,10 +51,10 @@ void CheckLineFromPrincipalPoint(const Camera& camera, const Eigen::Vector2d& en
       throw InputError(where, "the lens model does not map the imager one-to-one: " + there +
                                   " does not project back onto itself" + advice);
     }
-    const double rad = OffAxisRad(v);
+    const double rad = AngleRad(v, principal_ray);
     if (!(rad > previous_rad)) {
       throw InputError(where, "the lens model folds back: moving out to " + there +
-                                  " the ray turns towards the optical axis" + advice);
+                                  " the ray turns back towards the principal point's" + advice);
     }
     previous_rad = rad;
   }

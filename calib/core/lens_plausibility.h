@@ -17,9 +17,10 @@
 // - the lens maps the imager one-to-one: along straight lines from the
 //   principal point to the imager's corners and edge midpoints (8 lines,
 //   kSamplesPerLine pixels each), every pixel unprojects to a ray that
-//   projects back within kRoundTripTolerancePx, and the ray's angle off the
-//   optical axis grows strictly with the pixel's distance from the
-//   principal point. A distortion that folds back fails one or the other.
+//   projects back within kRoundTripTolerancePx, and the ray's angle to the
+//   principal point's own ray grows strictly with the pixel's distance from
+//   the principal point. A distortion that folds back fails one or the
+//   other.
 #pragma once
 
 #include <string>

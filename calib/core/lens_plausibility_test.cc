@@ -36,10 +36,26 @@ TEST(LensPlausibility, RealLensesPass) {
   std::vector<double> barrel = DemoIntrinsics();
   barrel[4] = -0.3, barrel[5] = barrel[8] = 0;
   EXPECT_NO_THROW(CheckLensIsPlausible(Opencv5(barrel), "barrel"));
-  // A pinhole of 2 px focal length: a field of view near 180 deg, real for
-  // no lens on this imager but not refused by these checks (they refuse
-  // what cannot be a lens, not what is unusual).
+  // A pinhole of 300 px focal length on this imager: 103 deg across, wide
+  // for a pinhole but a lens (these checks refuse what cannot be one).
   EXPECT_NO_THROW(CheckLensIsPlausible(Camera("LENSMODEL_PINHOLE", {300, 300, 375.5, 290.5}, 752, 582), "wide"));
+}
+
+// A splined stereographic lens whose spline shifts every point by the same
+// 0.0224 (normalised), i.e. 23 px at fx 1025: its optical axis projects
+// 23 px right of (cx, cy), as in mrcal's own splined test model. Walking
+// left from (cx, cy), the rays' angle off +z first falls (towards the axis),
+// which the first version of the check took for a fold; from the principal
+// point's own ray it grows. A real lens: accepted.
+TEST(LensPlausibility, ASplinedLensWhoseAxisIsOffThePrincipalPointPasses) {
+  const int nx = 16, ny = 12;
+  std::vector<double> intrinsics = {1025, 1025, 375.5, 290.5};
+  for (int k = 0; k < nx * ny; ++k) intrinsics.insert(intrinsics.end(), {23.0 / 1025, 0.0});
+  const Camera splined("LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=16_Ny=12_fov_x_deg=50", intrinsics, 752, 582);
+  Eigen::Vector3d axis_px = Eigen::Vector3d::Zero();
+  axis_px.head<2>() = splined.Project(Eigen::Vector3d::UnitZ());
+  ASSERT_NEAR(axis_px.x() - 375.5, 23, 0.01);  // the premise: the axis 23 px off (cx, cy)
+  EXPECT_NO_THROW(CheckLensIsPlausible(splined, "splined"));
 }
 
 TEST(LensPlausibility, APrincipalPointOffTheImagerIsRefused) {
