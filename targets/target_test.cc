@@ -67,16 +67,21 @@ TEST(Target, RejectsBadLayouts) {
   l.square_size_mm = -1;
   EXPECT_THROW(Target(l, "t"), InputError);
   // Two tags of a face printed over each other (11 mm tags 5 mm apart, both
-  // in the top margin), and, the other way, two just touching: 11 mm apart.
-  l = DefaultTarget().layout();
-  l.faces[0].tags[1].center_x_mm = l.faces[0].tags[0].center_x_mm + 5;
-  try {
-    Target(l, "t");
-    ADD_FAILURE() << "overlapping tags accepted";
-  } catch (const InputError& e) {
-    EXPECT_STREQ(e.what(), "t: tags 0 and 1 overlap: their centres must be at least tag_size_mm apart along x or y");
+  // in the top margin), or touching (11 mm apart: detection then misses
+  // them), and, accepted, an eighth of a tag between their borders.
+  for (const double apart_mm : {5.0, 11.0, 12.37}) {
+    l = DefaultTarget().layout();
+    l.faces[0].tags[1].center_x_mm = l.faces[0].tags[0].center_x_mm + apart_mm;
+    try {
+      Target(l, "t");
+      ADD_FAILURE() << "tags " << apart_mm << " mm apart accepted";
+    } catch (const InputError& e) {
+      EXPECT_STREQ(e.what(),
+                   "t: tags 0 and 1 are too close: their centres must be at least tag_size_mm + 1/8 of it (12.4 mm) "
+                   "apart along x or y, for the white between them");
+    }
   }
-  l.faces[0].tags[1].center_x_mm = l.faces[0].tags[0].center_x_mm + l.tag_size_mm;
+  l.faces[0].tags[1].center_x_mm = l.faces[0].tags[0].center_x_mm + 11 * 9.0 / 8;
   EXPECT_NO_THROW(Target(l, "t"));
 }
 
