@@ -85,8 +85,11 @@ int RunCalibrate(int argc, char** argv) {
   // The models' folder first: one that cannot be made leaves no rig file
   // or report behind either.
   models_folder.Create();
-  WriteCalibrationOutputs(result, out_path, report_path, cameramodels_dir);
+  // The summary first: a calibration whose rig file is refused (a lens no
+  // camera has) still shows what it found.
   std::printf("%s", SummaryText(result.report).c_str());
+  std::fflush(stdout);
+  WriteCalibrationOutputs(result, out_path, report_path, cameramodels_dir);
   std::printf("wrote %s and %s\n", out_path.c_str(), report_path.c_str());
   return 0;
 }

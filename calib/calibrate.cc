@@ -564,14 +564,17 @@ void WriteCalibrationOutputs(const CalibrationResult& result, const std::string&
                              const std::string& report_path, const std::string& cameramodels_dir) {
   // A rig file its readers would refuse (ReadRigFile checks every lens) is
   // not written: a solve that diverged says so now, not at the next
-  // reconstruct.
+  // reconstruct. The report is, to find out why.
   for (int k = 0; k < result.rig.num_cameras(); ++k) {
     try {
       CheckLensIsPlausible(result.rig.camera(k), "");
     } catch (const InputError& e) {
+      WriteFileAtomically(report_path, result.report.ToJson());
       throw InputError(rig_path, "not written: the calibration gave camera " + std::to_string(k) +
                                      " a lens no camera has (" + e.problem() +
-                                     "); its captures do not constrain it (more views, reaching the imager's corners)");
+                                     "); its captures do not constrain it (more views, reaching the imager's "
+                                     "corners); the report is in " +
+                                     report_path);
     }
   }
   AtomicOutputSet outputs;

@@ -67,7 +67,9 @@ std::string SummaryText(const CalibrationReport& report);
 
 // Writes the rig file, the JSON report and, if cameramodels_dir is given,
 // ExportCameramodels' files there, all or none (AtomicOutputSet): a model
-// that cannot be written leaves an earlier run's rig file as it was.
+// that cannot be written leaves an earlier run's rig file as it was. A
+// camera no lens could be (lens_plausibility.h) writes the report alone and
+// throws InputError naming the rig file: its readers would refuse it.
 void WriteCalibrationOutputs(const CalibrationResult& result, const std::string& rig_path,
                              const std::string& report_path, const std::string& cameramodels_dir = "");
 
