@@ -82,6 +82,12 @@ int RunCheck(int argc, char** argv) {
   const bool history_given = !history_db.empty();
   if (history_db.empty()) {
     if (rig_path.empty()) throw InputError("", "give --rig or --history-db");
+    // The history lives beside the rig file: a rig given as a pipe
+    // (`--rig <(...)`) has no folder to keep it in (/dev/fd/), which would
+    // fail only after the whole check.
+    std::error_code ec;
+    if (std::filesystem::is_fifo(rig_path, ec))
+      throw InputError("--rig", rig_path + " is a pipe, with no folder for the history beside it: give --history-db");
     history_db = DefaultHistoryPath(rig_path);
   }
   if (history_only) {

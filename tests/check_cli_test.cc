@@ -6,6 +6,7 @@
 // camera model), and a history path that is not a database.
 #include <gtest/gtest.h>
 #include <sqlite3.h>
+#include <sys/stat.h>
 
 #include <filesystem>
 #include <fstream>
@@ -118,6 +119,24 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     EXPECT_EQ(Bytes(db), db_bytes) << what << ": the history changed";
   };
 
+  {  // A rig file given as a pipe (`--rig <(cat rig.yaml)`) without
+     // --history-db: the history's default place, beside the rig file, is
+     // /dev/fd/; it failed only after the whole check ("verdict: ok", then
+     // exit 2). Refused before anything is read.
+    const std::string fifo = dir + "/rig.fifo";
+    ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+    const Result piped = RunCli("check --rig " + fifo + " --captures " + dir + "/ds --target " + dir +
+                                "/ds/target.yaml --report " + report);
+    EXPECT_EQ(piped.code, 2) << piped.err;
+    EXPECT_EQ(Lines(piped.err), 1) << piped.err;
+    EXPECT_NE(piped.err.find("--rig: " + fifo +
+                             " is a pipe, with no folder for the history beside it: give "
+                             "--history-db"),
+              std::string::npos)
+        << piped.err;
+    EXPECT_FALSE(fs::exists(report));
+    fs::remove(fifo);
+  }
   {  // A rig file without a calibration's residuals (the simulator's truth
      // rig), or a captures folder that is not there: named before the
      // target's detection starts (its progress line), in one line. Before,
