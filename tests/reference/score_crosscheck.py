@@ -166,6 +166,13 @@ def main():
         rows += [(f"m{m['module']}", m['accuracy'], per_module.get(m['module'], figures([])))
                  for m in scene['modules']]
         for label, theirs, ours in rows:
+            if theirs['points'] == 0 or ours['points'] == 0:
+                # No point: score's figures are null (JSON), nothing to compare but the count.
+                ok = theirs['points'] == ours['points']
+                bad += not ok
+                print(f"{name:8s} {label:6s} points {theirs['points']} / {ours['points']}"
+                      f"{'' if ok else '  DIFFERS'}")
+                continue
             ok = (theirs['points'] == ours['points'] and
                   abs(theirs['mean_abs_mm'] - ours['mean_abs_mm']) <= tolerance and
                   abs(theirs['std_mm'] - ours['std_mm']) <= tolerance)
