@@ -1,5 +1,8 @@
 #include "datasets/simulate.h"
 
+#include <fcntl.h>  // AT_FDCWD
+#include <stdio.h>  // renameat2, RENAME_EXCHANGE (glibc, _GNU_SOURCE)
+
 #include <unistd.h>
 
 #include <Eigen/Geometry>
@@ -431,7 +434,15 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
   }
 
   // --- into place
-  if (fs::exists(out)) {
+  // An earlier dataset is swapped with the new one in one step where the
+  // file system can (renameat2's RENAME_EXCHANGE): `out` is then a whole
+  // dataset at every instant, and the temporary folder, which a termination
+  // signal removes, holds the new one before the swap and the old one after
+  // it. (With two renames, a signal between them removed the new dataset
+  // and left the old one hidden: nothing at `out`.)
+  if (fs::exists(out) && renameat2(AT_FDCWD, tmp.c_str(), AT_FDCWD, out.c_str(), RENAME_EXCHANGE) == 0) {
+    fs::remove_all(tmp, ec);     // the earlier dataset; `cleanup` still covers it
+  } else if (fs::exists(out)) {  // no exchange here (e.g. an older kernel): two renames
     const fs::path old = parent / TemporaryName(".", out.filename().string(), ".old-" + pid);
     fs::rename(out, old, ec);
     if (ec) throw InputError(out.string(), "cannot replace: " + ec.message());

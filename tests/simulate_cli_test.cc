@@ -59,9 +59,14 @@ TEST(SimulateCli, AnOutFolderWithATrailingSlashIsWritten) {
   const std::string dir = ::testing::TempDir() + "/sim_trailing_slash";
   fs::remove_all(dir);
   for (int run = 0; run < 2; ++run) {
-    const Result r = RunCli("simulate --out " + dir + "/new/ds/ --calibration-captures 1 --no-scenes");
+    // Two captures, then one: the second dataset replaces the first whole
+    // (swapped in one step where the file system can: simulate.cc), so its
+    // capture 001 is gone.
+    const Result r =
+        RunCli("simulate --out " + dir + "/new/ds/ --calibration-captures " + (run ? "1" : "2") + " --no-scenes");
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(fs::exists(dir + "/new/ds/calibration/000/cam3.png")) << run;
+    EXPECT_EQ(fs::exists(dir + "/new/ds/calibration/001"), run == 0) << run;
     int entries = 0;
     for (const auto& e : fs::directory_iterator(dir + "/new")) entries += e.path().filename() == "ds" ? 1 : 100;
     EXPECT_EQ(entries, 1) << "something beside the dataset, run " << run;

@@ -46,7 +46,9 @@ bool RemoveAt(int folder_fd, const char* name, int depth) {
   if (errno != EISDIR && errno != EPERM) return false;  // Linux says EISDIR for a folder, POSIX EPERM
   if (depth > kMaxRemovalDepth) return false;
   const int fd = openat(folder_fd, name, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
-  if (fd < 0) return false;  // not a folder after all (EPERM: an immutable file), or replaced by a link
+  // Gone meanwhile (another remover got there first): removed. Else not a
+  // folder after all (EPERM: an immutable file), or replaced by a link.
+  if (fd < 0) return errno == ENOENT;
   // Listed again only if all it listed went, yet the folder is not empty:
   // something new came (what cannot be removed is not tried again, level
   // after level).
