@@ -11,8 +11,9 @@
 // the camera and what is wrong:
 // - the principal point (cx, cy) lies on the imager (mrcal's pixel
 //   convention: [-0.5, width - 0.5] x [-0.5, height - 0.5]);
-// - the pixels are near square: fx / fy in [2/3, 3/2] (machine-vision
-//   sensors are square to ~1 %; a factor of 1.5 is a typo, not a sensor);
+// - the pixels are not far from square: fx / fy in [1/3, 3] (machine-vision
+//   sensors are square to ~1 %, and binning one axis by 2, or one field of
+//   an interlaced frame, gives 2; a factor above 3 is a typo, not a sensor);
 // - the imager's width spans at least kMinFieldOfViewDeg of view;
 // - the lens maps the imager one-to-one: along straight lines from the
 //   principal point to the imager's corners and edge midpoints (8 lines,
@@ -30,7 +31,7 @@
 namespace stereorig {
 
 inline constexpr double kMinFieldOfViewDeg = 0.1;
-inline constexpr double kMaxPixelAspect = 1.5;  // fx / fy and fy / fx at most this
+inline constexpr double kMaxPixelAspect = 3;  // fx / fy and fy / fx at most this
 inline constexpr int kSamplesPerLine = 64;
 inline constexpr double kRoundTripTolerancePx = 1e-3;
 
