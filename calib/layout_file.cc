@@ -1,6 +1,8 @@
 #include "calib/layout_file.h"
 
 #include <algorithm>
+#include <map>
+#include <string>
 
 #include "calib/core/input_error.h"
 #include "calib/core/yaml_reader.h"
@@ -11,6 +13,7 @@ namespace {
 
 std::vector<ModuleLayout> Parse(YamlMap root) {
   std::vector<ModuleLayout> out;
+  std::map<int, std::string> module_of_camera;  // camera index -> the module naming it
   for (YamlMap m : root.GetMaps("modules")) {
     ModuleLayout l;
     l.name = m.GetString("name");
@@ -29,10 +32,25 @@ std::vector<ModuleLayout> Parse(YamlMap root) {
     if (l.left_camera < 0 || l.right_camera < 0 || l.left_camera == l.right_camera) {
       throw InputError(m.Where(), "left and right must be two different camera indices >= 0");
     }
+    // Refused here, when the file is read, rather than after every image of
+    // the captures has been detected (calibrate's input checks).
+    for (const int c : {l.left_camera, l.right_camera}) {
+      const auto [it, added] = module_of_camera.emplace(c, l.name);
+      if (!added)
+        throw InputError(m.Where(), "camera " + std::to_string(c) + " is already in module " + it->second +
+                                        ": each camera belongs to exactly one module");
+    }
     m.Finish();
     out.push_back(l);
   }
   if (out.empty()) throw InputError(root.Where("modules"), "no modules");
+  // Cameras are numbered 0..N-1 (camK.png in each capture): one left out of
+  // every module is a gap.
+  for (int c = 0, n = module_of_camera.rbegin()->first + 1; c < n; ++c)
+    if (!module_of_camera.count(c))
+      throw InputError(root.Where("modules"), "camera " + std::to_string(c) + " is in no module, though camera " +
+                                                  std::to_string(n - 1) +
+                                                  " is: cameras are numbered 0.. without gaps, each in one module");
   root.Finish();
   return out;
 }

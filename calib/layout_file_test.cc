@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "calib/core/input_error.h"
+#include "calib/core/input_error_testing.h"
 
 namespace stereorig {
 namespace {
@@ -25,6 +26,22 @@ TEST(LayoutFile, RejectsBadInput) {
   EXPECT_THROW(ParseLayoutYaml("modules:\n  - {name: m, left: 1, right: 1}\n", "t"), InputError);
   EXPECT_THROW(ParseLayoutYaml("modules: []\n", "t"), InputError);
   EXPECT_THROW(ParseLayoutYaml("modules:\n  - {name: m, left: 0, right: 1}\nextra: 1\n", "t"), InputError);
+}
+
+// A camera in two modules, or a camera number left out, is named when the
+// file is read (calibrate used to find it only after detecting every image).
+TEST(LayoutFile, EachCameraIsInExactlyOneModule) {
+  EXPECT_EQ(testing::InputErrorMessage([] {
+              ParseLayoutYaml("modules:\n  - {name: a, left: 0, right: 1}\n  - {name: b, left: 1, right: 2}\n", "t");
+            }),
+            "t: modules[1]: camera 1 is already in module a: each camera belongs to exactly one module");
+  EXPECT_EQ(testing::InputErrorMessage([] {
+              ParseLayoutYaml("modules:\n  - {name: a, left: 0, right: 1}\n  - {name: b, left: 3, right: 4}\n", "t");
+            }),
+            "t: modules: camera 2 is in no module, though camera 4 is: cameras are numbered 0.. without gaps, each in "
+            "one module");
+  EXPECT_NO_THROW(
+      ParseLayoutYaml("modules:\n  - {name: a, left: 2, right: 3}\n  - {name: b, left: 1, right: 0}\n", "t"));
 }
 
 }  // namespace
