@@ -12,6 +12,7 @@
 
 #include "calib/calib_test_util.h"
 #include "calib/core/input_error.h"
+#include "calib/stereo.h"
 
 namespace stereorig {
 namespace {
@@ -76,6 +77,41 @@ TEST(Intrinsics, UncertaintyIsReportedWhereTheBoardWas) {
   const auto r300 = CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target,
                                         testing::ViewsOf(s.data.input, 0), at_300, "test");
   EXPECT_EQ(r300.report.uncertainty_range_mm, 300);
+}
+
+// Stage 2 too (the report the rig file's uncertainties come from): each
+// camera's range is its own median board distance, against the truth, as in
+// stage 1. The right camera sits at its extrinsics from the left one; on
+// this nearly symmetric rig its median happens to equal the left camera's
+// (202.69 mm both), so this pins the values, not the frame they are taken
+// in (the second reading checked that by hand: 215.34 against 215.33 mm).
+TEST(Intrinsics, Stage2ReportsEachCamerasUncertaintyWhereTheBoardWasFromIt) {
+  const auto s = testing::MakeDefaultScene(14, 12, 0.2);
+  const CalibrationInput& in = s.data.input;
+  const IntrinsicsOptions opt;
+  const auto l = CalibrateIntrinsics(0, in.cameras[0], in.target, testing::ViewsOf(in, 0), opt, "test");
+  const auto r = CalibrateIntrinsics(1, in.cameras[1], in.target, testing::ViewsOf(in, 1), opt, "test");
+  const StereoResult st = CalibrateStereo(0, in.modules[0], l, r, testing::ViewsOf(in, 0), testing::ViewsOf(in, 1), in,
+                                          StereoOptions(), opt);
+  const Eigen::Vector3d centre(0.5 * (in.target.corners_x - 1) * in.target.square_size_mm,
+                               0.5 * (in.target.corners_y - 1) * in.target.square_size_mm, 0);
+  for (const int cam : {0, 1}) {
+    std::vector<double> true_mm;
+    for (const mrcal_observation_board_t& o : st.problem.observations) {
+      if (o.icam.intrinsics != cam) continue;
+      const Pose face_from_front = st.faces[o.iframe] == Face::kFront ? Pose::Identity() : s.true_back_from_front;
+      const Pose cam_from_face =
+          s.truth.rig.CamFromReference(cam) * s.data.ref_from_front[st.captures[o.iframe]] * face_from_front.Inverse();
+      true_mm.push_back((cam_from_face * centre).norm());
+    }
+    ASSERT_FALSE(true_mm.empty());
+    std::nth_element(true_mm.begin(), true_mm.begin() + true_mm.size() / 2, true_mm.end());
+    const double median_mm = true_mm[true_mm.size() / 2];
+    const IntrinsicsReport& report = cam == 0 ? st.report.left : st.report.right;
+    std::printf("stage 2, cam %d: uncertainty at %.2f mm, the true poses' median %.2f mm\n", cam,
+                report.uncertainty_range_mm, median_mm);
+    EXPECT_NEAR(report.uncertainty_range_mm, median_mm, 0.5) << "cam " << cam;
+  }
 }
 
 TEST(Intrinsics, LensModelsAreSelectable) {
