@@ -189,15 +189,8 @@ void PrintPipeline(const nlohmann::json& j) {
     if (s.contains("truth_fill")) std::printf(" (truth fill %.1f%%)", 100 * s["truth_fill"].get<double>());
     if (s.contains("accuracy")) {
       const auto& a = s["accuracy"];
-      // ErrorFiguresJson's figures are null where there was no point.
-      const auto error_text = [](const nlohmann::json& f) {
-        if (f["points"].get<int>() <= 0) return std::string("no point");
-        char buf[64];
-        std::snprintf(buf, sizeof buf, "|e| %.4f std %.4f", f["mean_abs_mm"].get<double>(), f["std_mm"].get<double>());
-        return std::string(buf);
-      };
-      std::printf(", merged %s%s", error_text(a["merged"]).c_str(), a["merged"]["points"].get<int>() > 0 ? " mm" : "");
-      for (size_t m = 0; m < a["module"].size(); ++m) std::printf(", m%zu %s", m, error_text(a["module"][m]).c_str());
+      std::printf(", merged %s", ErrorText(a["merged"], " mm").c_str());
+      for (size_t m = 0; m < a["module"].size(); ++m) std::printf(", m%zu %s", m, ErrorText(a["module"][m]).c_str());
       std::printf("; aligned by %.4f deg, %.4f mm", a["alignment_truth_from_cloud"]["rotation_deg"].get<double>(),
                   std::hypot(a["alignment_truth_from_cloud"]["translation_mm"][0].get<double>(),
                              a["alignment_truth_from_cloud"]["translation_mm"][1].get<double>(),

@@ -157,9 +157,8 @@ int RunScore(int argc, char** argv) {
           {"translation_mm",
            {s.accuracy.truth_from_cloud.translation_mm().x(), s.accuracy.truth_from_cloud.translation_mm().y(),
             s.accuracy.truth_from_cloud.translation_mm().z()}}}}};
-    std::printf("%-8s %7zu points, fill %5.1f%% of %6d px; merged %s%s", name.c_str(), rec.cloud.size(),
-                100 * s.fill_all.fill(), s.fill_all.target_px, ErrorText(s.accuracy.all).c_str(),
-                s.accuracy.all.points > 0 ? " mm" : "");
+    std::printf("%-8s %7zu points, fill %5.1f%% of %6d px; merged %s", name.c_str(), rec.cloud.size(),
+                100 * s.fill_all.fill(), s.fill_all.target_px, ErrorText(s.accuracy.all, " mm").c_str());
     for (size_t m = 0; m < s.fill.size(); ++m) {
       const ErrorFigures& e = s.accuracy.per_module[m];
       sj["modules"].push_back({{"module", m},

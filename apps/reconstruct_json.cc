@@ -53,11 +53,18 @@ nlohmann::json ErrorFiguresJson(const ErrorFigures& f) {
           {"within_0_5_mm", figure(f.within_0_5_mm)}};
 }
 
-std::string ErrorText(const ErrorFigures& f) {
+std::string ErrorText(const ErrorFigures& f, const char* unit) {
   if (f.points <= 0) return "no point";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "|e| %.4f std %.4f", f.mean_abs_mm, f.std_mm);
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "|e| %.4f std %.4f%s", f.mean_abs_mm, f.std_mm, unit);
   return buf;
+}
+
+std::string ErrorText(const nlohmann::json& figures, const char* unit) {
+  ErrorFigures f;
+  f.points = figures["points"].get<int>();
+  if (f.points > 0) f.mean_abs_mm = figures["mean_abs_mm"].get<double>(), f.std_mm = figures["std_mm"].get<double>();
+  return ErrorText(f, unit);
 }
 
 nlohmann::json FilledJson(const CloudScore& score) {

@@ -18,8 +18,10 @@ nlohmann::json ReconstructionJson(const Reconstruction& rec);
 // With no point the figures are null, not 0 (which reads as a perfect score).
 nlohmann::json ErrorFiguresJson(const ErrorFigures& f);
 
-// "|e| 0.0345 std 0.0443" (mm), or "no point" when there is none to score.
-std::string ErrorText(const ErrorFigures& f);
+// "|e| 0.0345 std 0.0443" (mm) then `unit`, or "no point" when there is
+// none to score; of the figures, or of ErrorFiguresJson's object of them.
+std::string ErrorText(const ErrorFigures& f, const char* unit = "");
+std::string ErrorText(const nlohmann::json& figures, const char* unit = "");
 
 // The hole-filling points' figures (ErrorFiguresJson) and, under
 // by_distance_to_measured, the same per band of distance to the nearest

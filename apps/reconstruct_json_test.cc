@@ -22,6 +22,9 @@ TEST(ReconstructJson, FiguresOfNoPointAreNullNotZero) {
   some.std_mm = 0.0443;
   EXPECT_DOUBLE_EQ(ErrorFiguresJson(some)["mean_abs_mm"].get<double>(), 0.0345);
   EXPECT_EQ(ErrorText(some), "|e| 0.0345 std 0.0443");
+  // The same read back from the JSON (bench prints from its report).
+  EXPECT_EQ(ErrorText(ErrorFiguresJson(some), " mm"), "|e| 0.0345 std 0.0443 mm");
+  EXPECT_EQ(ErrorText(ErrorFiguresJson(none), " mm"), "no point");
 }
 
 }  // namespace
