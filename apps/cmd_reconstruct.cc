@@ -82,10 +82,7 @@ int RunReconstruct(int argc, char** argv) {
   // and none of them may be an output (--out DIR/cam0.png).
   const Rig rig = ReadRigFile(rig_path);
   OutputPaths outputs;
-  outputs.Protect(rig_path, "the rig file (--rig)");
-  outputs.Protect(options_path, "the options file (--options)");
-  for (const std::string& image : CaptureImagePaths(capture_dir, rig))
-    outputs.Protect(image, "a capture image (--capture)");
+  ProtectCaptureInputs(rig_path, options_path, capture_dir, rig, &outputs);
   outputs.Claim(out_path, "the cloud (--out)");
   CheckCloudPath(out_path);  // after the claim: "is an input" says more than "not .ply" would
   if (!mesh_path.empty()) {

@@ -14,6 +14,7 @@ int RunCheck(int argc, char** argv);
 int RunBench(int argc, char** argv);
 int RunScore(int argc, char** argv);
 int RunRig(int argc, char** argv);
+int RunTune(int argc, char** argv);
 int RunDemo(int argc, char** argv);
 
 const std::vector<Command>& Commands() {
@@ -27,6 +28,7 @@ const std::vector<Command>& Commands() {
       {"check", "nightly check: fresh target captures + rig file -> drift verdict, history", &RunCheck},
       {"bench", "throughput, side by side with an OpenCV StereoSGBM pipeline", &RunBench},
       {"score", "the runtime on a simulator dataset against truth: accuracy, fill, active/passive", &RunScore},
+      {"tune", "measure the laser grid's period in a capture -> the runtime options tied to it", &RunTune},
       {"rig", "inspect a rig file: validate, summarise, export .cameramodel files", &RunRig},
       {"demo", "run every stage on the embedded default rig and print the figures", &RunDemo},
   };

@@ -7,6 +7,7 @@
 
 #include "calib/core/capture_image_name.h"
 #include "calib/core/input_error.h"
+#include "reconstruct/runtime.h"
 
 namespace stereorig {
 
@@ -130,6 +131,14 @@ FolderToCreate OutputPaths::ClaimFolder(const std::string& path, const std::stri
   for (const fs::path& p : missing) folders_.emplace(p, what);
   claimed_.emplace(key, what);
   return FolderToCreate(path, what);
+}
+
+void ProtectCaptureInputs(const std::string& rig_path, const std::string& options_path, const std::string& capture_dir,
+                          const Rig& rig, OutputPaths* outputs) {
+  outputs->Protect(rig_path, "the rig file (--rig)");
+  outputs->Protect(options_path, "the options file (--options)");
+  for (const std::string& image : CaptureImagePaths(capture_dir, rig))
+    outputs->Protect(image, "a capture image (--capture)");
 }
 
 }  // namespace stereorig

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "calib/core/folder_to_create.h"
+#include "calib/core/rig.h"
 
 namespace stereorig {
 
@@ -71,6 +72,12 @@ struct RuntimeReportClaim {
 // holds them, for the command's further outputs (score's --diagnose images,
 // known once the rig is read): each is then checked against the report too.
 OutputPaths ClaimRuntimeReport(const RuntimeReportClaim& report);
+
+// The inputs of a command that reconstructs one capture (reconstruct,
+// tune): its rig file, its options file (if given) and the capture's
+// camK.png images (runtime.h CaptureImagePaths: the rig says which).
+void ProtectCaptureInputs(const std::string& rig_path, const std::string& options_path, const std::string& capture_dir,
+                          const Rig& rig, OutputPaths* outputs);
 
 // The files `stereorig score` and `bench` read from a simulated dataset
 // (docs/formats.md "Datasets"), as (path, what) for OutputPaths::Protect:

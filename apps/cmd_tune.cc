@@ -1,0 +1,150 @@
+// `stereorig tune`: the laser grid's period measured in a capture, and the
+// runtime options tied to it set from it.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "apps/cli_util.h"
+#include "apps/command.h"
+#include "apps/output_paths.h"
+#include "apps/tuned_options.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/input_error.h"
+#include "calib/core/rig_file.h"
+#include "reconstruct/grid_period.h"
+#include "reconstruct/grid_period_options.h"
+#include "reconstruct/runtime.h"
+
+namespace stereorig {
+namespace {
+
+std::string Number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
+// A module's period varying by more than this share over its image (half
+// the blocks' interquartile range) says the surface was not a plane facing
+// it: the period then mixes foreshortenings, and is not the grid's own.
+constexpr double kMaxRelativeSpread = 0.05;
+// Modules whose periods differ by more than this share: one set of options
+// serves them all, so it takes their median, and says so.
+constexpr double kMaxRelativeModuleDifference = 0.05;
+
+// The rectified left image of each module and its grid-lit pixels (the
+// runtime's own: one pass of ProcessModule, whose lit mask covers the
+// volume's ROI), measured.
+std::optional<GridPeriodMeasurement> MeasureModule(const Runtime& runtime, const ModulePlan& plan,
+                                                   const std::vector<cv::Mat>& images) {
+  PointCloud cloud;
+  ModuleReport report;
+  std::pair<cv::Mat, cv::Mat> rectified;
+  runtime.ProcessModule(plan, images, false, &cloud, nullptr, &report, &rectified);
+  cv::Mat lit = cv::Mat::zeros(rectified.first.size(), CV_8UC1);
+  report.lit.copyTo(lit(plan.roi));
+  return MeasureGridPeriodPx(rectified.first, lit);
+}
+
+}  // namespace
+
+int RunTune(int argc, char** argv) {
+  CLI::App app{
+      "Measures the laser grid's period P in a capture (the distance between neighbouring near-vertical lines "
+      "along the rows of each module's rectified left image) and sets the runtime options tied to it: "
+      "match.grid_half_period_px (P / 2), match.line_index_max_shift_px (1.5 P), "
+      "match.line_index_window_half_height_px (at least (P - 1) / 2), match.line_index_footprint_gap_px (P) and "
+      "match.grid_line_radius_px (P / 2 rounded up, + 1), P taken to the nearest pixel. The defaults are these rules "
+      "at the "
+      "default grid's 8 px, so on a rig like the default nothing changes. Use it when commissioning a rig with "
+      "another projector, lens or working distance (docs/reconstruct.md, 'Another projector').\n"
+      "Capture a flat matte plate facing the modules, lasers on, filling the measurement volume's middle: on a "
+      "curved or turned surface the period is stretched by the foreshortening, and the spread printed per "
+      "module says so. The other keys of --options are kept; --out writes them with the new ones (YAML comments "
+      "of --options are not carried over).\n\n"
+      "Example:\n  stereorig tune --rig rig.yaml --capture plate --options line.yaml --out line_tuned.yaml\n"
+      "  stereorig reconstruct --rig rig.yaml --capture part1 --options line_tuned.yaml --out part1.ply",
+      "stereorig tune"};
+  std::string rig_path, capture_dir, options_path, out_path;
+  app.add_option("--rig", rig_path, "rig file (from stereorig calibrate)")->required();
+  app.add_option("--capture", capture_dir, "capture folder (camK.png per camera) of a flat plate, lasers on")
+      ->required();
+  app.add_option("--options", options_path, "runtime options YAML to start from (default: the built-in defaults)");
+  app.add_option("--out", out_path, "write the tuned runtime options here (.yaml); without it, only print them");
+  if (auto rc = ParseArgs(app, argc, argv)) return *rc;
+
+  const Rig rig = ReadRigFile(rig_path);
+  OutputPaths outputs;
+  ProtectCaptureInputs(rig_path, options_path, capture_dir, rig, &outputs);
+  if (!out_path.empty()) {
+    outputs.Claim(out_path, "the tuned options (--out)");
+    CheckOptionsPath(out_path);
+  }
+  RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
+  const std::vector<cv::Mat> images = LoadCapture(capture_dir, rig);
+  const Runtime runtime(rig, options);
+
+  std::vector<double> periods;
+  std::string measured;  // "module 0 7.96 px (spread 0.04 px), module 1 ...", for the file's header
+  for (const ModulePlan& plan : runtime.plans()) {
+    const auto m = MeasureModule(runtime, plan, images);
+    if (!m) {
+      std::printf("module %d: no grid period found in its lit region (too few lit rows, or no lines)\n", plan.module);
+      continue;
+    }
+    std::printf("module %d: grid period %.2f px along the rows, spread %.2f px over %d blocks of %d rows\n",
+                plan.module, m->period_px, m->spread_px, m->blocks, GridPeriodOptions{}.block_rows);
+    if (m->spread_px > kMaxRelativeSpread * m->period_px)
+      std::printf(
+          "  warning: module %d's period varies by more than %.0f %% over its image: a curved or turned "
+          "surface; measure on a flat plate facing the module\n",
+          plan.module, 100 * kMaxRelativeSpread);
+    periods.push_back(m->period_px);
+    char text[96];
+    std::snprintf(text, sizeof text, "module %d %.2f px (spread %.2f px)", plan.module, m->period_px, m->spread_px);
+    measured += (measured.empty() ? "" : ", ") + std::string(text);
+  }
+  if (periods.empty())
+    throw InputError(capture_dir,
+                     "no module's left image shows the laser grid's period: are the lasers on, and the plate inside "
+                     "the measurement volume? (a passive capture has no grid)");
+  std::vector<double> sorted = periods;
+  std::sort(sorted.begin(), sorted.end());
+  const double period_px = 0.5 * (sorted[(sorted.size() - 1) / 2] + sorted[sorted.size() / 2]);
+  if (sorted.back() - sorted.front() > kMaxRelativeModuleDifference * period_px)
+    std::printf(
+        "warning: the modules' periods differ by more than %.0f %% (%.2f to %.2f px): one set of options "
+        "serves them all, so it takes their median\n",
+        100 * kMaxRelativeModuleDifference, sorted.front(), sorted.back());
+
+  const std::vector<GridPeriodKey> keys = SetGridPeriodKeys(period_px, &options.match);
+  std::printf("P = %.2f px, taken as %ld px:\n", period_px, std::lround(period_px));
+  for (const GridPeriodKey& k : keys)
+    std::printf("  match.%-34s %g%s\n", k.key.c_str(), k.value,
+                k.value == k.before ? "  (unchanged)" : ("  (was " + Number(k.before) + ")").c_str());
+  const bool all_default =
+      std::all_of(keys.begin(), keys.end(), [](const GridPeriodKey& k) { return k.value == k.before; });
+  if (all_default)
+    std::printf("the keys already fit this grid\n");
+  else
+    std::printf(
+        "check the accuracy with the new keys: stereorig verify on the sphere and the ball bar, several "
+        "positions (docs/reconstruct.md, \"Another projector\")\n");
+  if (out_path.empty()) {
+    std::printf("no --out: nothing written\n");
+    return kExitOk;
+  }
+  const std::string header = "Runtime options from `stereorig tune --capture " + capture_dir + "` with the rig " +
+                             rig_path + ".\nThe laser grid's period along the rectified rows: " + measured +
+                             ".\nThe match keys tied to it were set from P = " + Number(period_px) +
+                             " px (docs/reconstruct.md, \"Another projector\").";
+  const std::string text = TunedOptionsYaml(options_path, keys, header);
+  ParseRuntimeOptions(text, out_path).Check();  // what a later --options will read: the same keys, valid
+  WriteFileAtomically(out_path, text);
+  std::printf("wrote %s\n", out_path.c_str());
+  return kExitOk;
+}
+
+}  // namespace stereorig

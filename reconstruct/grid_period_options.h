@@ -1,0 +1,47 @@
+// The runtime options tied to the laser grid's period P along the rows
+// (grid_period.h measures it), set from P by the rules of
+// docs/reconstruct.md "Another projector: a different grid period". The
+// defaults are these rules at the default grid's P = 8 px, so a measured P
+// that rounds to 8 px leaves every key at its default.
+//
+// P is taken to the nearest whole pixel: the keys are whole pixels (or,
+// grid_half_period_px, half pixels), and the defaults were tuned at 8 px
+// for a measured 7.96 px, so no finer step has been shown to matter.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "reconstruct/matcher.h"
+
+namespace stereorig {
+
+// The periods the rules below can serve, px: 1.5 P must fit
+// line_index_max_shift_px's limit of 64, and the shortest period whose
+// neighbouring alignment (at shift P) the line index can try (shifts
+// from 2 up).
+inline constexpr double kMinGridPeriodPx = 3;
+inline constexpr double kMaxGridPeriodPx = 42;
+
+struct GridPeriodKey {
+  std::string key;  // as the options file names it: match.<key>
+  double value = 0;
+  double before = 0;  // the options' value before the change
+};
+
+// Sets the keys tied to the period in *o and returns them, each with its
+// value before. Throws InputError("period") if period_px is outside
+// [kMinGridPeriodPx, kMaxGridPeriodPx].
+//  - grid_half_period_px = P / 2 (the distinctness shift, the grid-line
+//    test's ridge reach, the right view's edge zone);
+//  - line_index_max_shift_px = 1.5 P (the next alignment, stretched by a
+//    surface turned away, stays within the shifts tried);
+//  - line_index_window_half_height_px = at least (P - 1) / 2, never below
+//    the default (the vernier's window holds a near-horizontal line);
+//  - line_index_footprint_gap_px = P, at most 16 (its limit: one period of
+//    empty pixels between the lines belongs to the footprint);
+//  - grid_line_radius_px = P / 2 + 1 (inside the grid's envelope every
+//    pixel is within half a period of a line).
+std::vector<GridPeriodKey> SetGridPeriodKeys(double period_px, MatchOptions* o);
+
+}  // namespace stereorig

@@ -1,0 +1,163 @@
+// The grid period measured from rectified left images whose true period is
+// known analytically (synthetic_pair.h renders two families of Gaussian
+// lines turned by grid_angle_deg, a period p apart across the lines: along
+// a row the near-vertical family is p / cos(angle) apart), and the keys
+// set from it.
+//
+// Tolerance of the period: 0.1 % of it. The peaks' positions come from
+// three-point fits, exact for Gaussian peaks; the differenced lines'
+// correlation is not quite Gaussian, which leaves up to 0.064 % (5.5 px at
+// 10 degrees, 0.0036 px; 31 px at 2.6 degrees, 0.0057 px) on the
+// noise-free images of these periods and angles, and the 2 DN sensor
+// noise and 15 % albedo texture the tests add move it by < 0.0006 px (the
+// same images rendered without them). The keys need P to the nearest
+// pixel.
+#include "reconstruct/grid_period.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "calib/core/input_error.h"
+#include "reconstruct/grid_period_options.h"
+#include "reconstruct/lit_mask.h"
+#include "reconstruct/synthetic_pair.h"
+
+namespace stereorig {
+namespace {
+
+constexpr double kRelativeTolerance = 0.001;
+
+double AlongRowPeriodPx(const SyntheticPairSpec& s) {
+  return s.grid_period_px / std::cos(s.grid_angle_deg * M_PI / 180);
+}
+
+SyntheticPairSpec Grid(double period_px, double angle_deg) {
+  SyntheticPairSpec s;
+  s.width = 400, s.height = 160;
+  s.grid_period_px = period_px;
+  s.grid_angle_deg = angle_deg;  // the renderer divides by sin(angle): not 0
+  return s;
+}
+
+cv::Mat AllLit(const cv::Mat& image) { return cv::Mat(image.size(), CV_8UC1, cv::Scalar(255)); }
+
+TEST(GridPeriod, MeasuresTheAnalyticPeriodAlongTheRows) {
+  for (double angle : {2.6, 10.0})
+    for (double period : {5.5, 8.0, 9.3, 12.15, 20.0, 31.0}) {
+      const SyntheticPairSpec spec = Grid(period, angle);
+      const SyntheticPair pair = RenderSyntheticPair(spec);
+      const auto m = MeasureGridPeriodPx(pair.left, AllLit(pair.left));
+      ASSERT_TRUE(m) << period << " px at " << angle << " deg";
+      EXPECT_NEAR(m->period_px, AlongRowPeriodPx(spec), kRelativeTolerance * AlongRowPeriodPx(spec))
+          << period << " px at " << angle << " deg";
+      EXPECT_LT(m->spread_px, kRelativeTolerance * AlongRowPeriodPx(spec))
+          << "a flat surface: every block reads the same period";
+      EXPECT_EQ(m->blocks, 10);  // 160 rows in blocks of 16
+      EXPECT_EQ(m->rows, 160);
+    }
+}
+
+// The lit mask of the runtime (9 x 9 windows) leaves the centres of a long
+// period's cells unlit: the runs join across them, and every row counts.
+TEST(GridPeriod, JoinsTheUnlitCentresOfALongPeriodsCells) {
+  const SyntheticPairSpec spec = Grid(31.0, 2.6);
+  SyntheticPairSpec dark = spec;
+  dark.ambient_dn = 0;  // lines on black: nothing but the lines is lit
+  const SyntheticPair lines = RenderSyntheticPair(dark);
+  const cv::Mat lit = LitMask(lines.left, 12);
+  ASSERT_LT(cv::countNonZero(lit), lit.total() * 0.9) << "the cells' centres are not lit";
+  const auto m = MeasureGridPeriodPx(lines.left, lit);
+  ASSERT_TRUE(m);
+  EXPECT_NEAR(m->period_px, AlongRowPeriodPx(spec), kRelativeTolerance * AlongRowPeriodPx(spec));
+  EXPECT_EQ(m->rows, 160);
+}
+
+// Only the lit part of the image counts: rows outside it are not used, and
+// a part too small for min_blocks gives no measurement.
+TEST(GridPeriod, ReadsOnlyTheLitRegion) {
+  const SyntheticPairSpec spec = Grid(9.3, 2.6);
+  const SyntheticPair pair = RenderSyntheticPair(spec);
+  cv::Mat lit = cv::Mat::zeros(pair.left.size(), CV_8UC1);
+  lit(cv::Rect(100, 40, 200, 64)).setTo(255);  // rows 40..103: blocks 2..6
+  const auto m = MeasureGridPeriodPx(pair.left, lit);
+  ASSERT_TRUE(m);
+  EXPECT_NEAR(m->period_px, AlongRowPeriodPx(spec), kRelativeTolerance * AlongRowPeriodPx(spec));
+  EXPECT_EQ(m->rows, 64);
+  EXPECT_EQ(m->blocks, 5);
+  cv::Mat small = cv::Mat::zeros(pair.left.size(), CV_8UC1);
+  small(cv::Rect(100, 0, 200, 32)).setTo(255);  // two blocks
+  EXPECT_FALSE(MeasureGridPeriodPx(pair.left, small));
+  cv::Mat narrow = cv::Mat::zeros(pair.left.size(), CV_8UC1);
+  narrow(cv::Rect(100, 0, 40, 160)).setTo(255);  // runs shorter than min_run_px
+  const auto none = MeasureGridPeriodPx(pair.left, narrow);
+  EXPECT_FALSE(none);
+}
+
+// Without the lasers (ambient light on a weakly textured surface) there is
+// no period to read.
+TEST(GridPeriod, FindsNoneWithoutTheGrid) {
+  SyntheticPairSpec spec = Grid(8.0, 2.6);
+  spec.laser_on = false;
+  const SyntheticPair pair = RenderSyntheticPair(spec);
+  EXPECT_FALSE(MeasureGridPeriodPx(pair.left, AllLit(pair.left)));
+}
+
+// A surface whose period differs between its halves (turned differently
+// towards the camera): the median is one of the two, and the spread says
+// the surface was not one plane facing the camera.
+TEST(GridPeriod, SpreadShowsTwoPeriods) {
+  const SyntheticPair a = RenderSyntheticPair(Grid(8.0, 2.6)), b = RenderSyntheticPair(Grid(10.0, 2.6));
+  cv::Mat left = a.left.clone();
+  b.left(cv::Rect(0, 64, 400, 96)).copyTo(left(cv::Rect(0, 64, 400, 96)));  // 4 blocks of 8 px, 6 of 10 px
+  const auto m = MeasureGridPeriodPx(left, AllLit(left));
+  ASSERT_TRUE(m);
+  const double ten = 10.0 / std::cos(2.6 * M_PI / 180);
+  EXPECT_NEAR(m->period_px, ten, kRelativeTolerance * ten);
+  EXPECT_GT(m->spread_px, 0.5);  // quartiles on both sides: (10.01 - 8.01) / 2 ~ 1
+}
+
+TEST(GridPeriodKeys, TheDefaultGridsPeriodGivesTheDefaults) {
+  // 7.96 px: the simulator's default grid measured on its plate
+  // (docs/reconstruct.md); anything that rounds to 8 px.
+  for (double period : {7.6, 7.96, 8.0, 8.4}) {
+    MatchOptions o;
+    const std::vector<GridPeriodKey> keys = SetGridPeriodKeys(period, &o);
+    ASSERT_EQ(keys.size(), 5u);
+    // `before` is the defaults' value (o started as them); the fields are
+    // set to `value` (ALongerPeriodScalesTheKeysByTheDocumentedRules).
+    for (const GridPeriodKey& k : keys) EXPECT_EQ(k.value, k.before) << k.key << " at " << period << " px";
+  }
+}
+
+TEST(GridPeriodKeys, ALongerPeriodScalesTheKeysByTheDocumentedRules) {
+  MatchOptions o;
+  const std::vector<GridPeriodKey> keys = SetGridPeriodKeys(12.15, &o);  // 12 px
+  EXPECT_EQ(o.grid_half_period_px, 6.0);                                 // P / 2
+  EXPECT_EQ(o.line_index.max_shift_px, 18);                              // 1.5 P
+  EXPECT_EQ(o.line_index.window_half_height_px, 6);                      // ceil((P - 1) / 2)
+  EXPECT_EQ(o.line_index.footprint_gap_px, 12);                          // P
+  EXPECT_EQ(o.grid_line.radius_px, 7);                                   // ceil(P / 2) + 1
+  EXPECT_EQ(keys[1].key, "line_index_max_shift_px");
+  EXPECT_EQ(keys[1].before, 12);
+  EXPECT_NO_THROW(o.Check());
+  MatchOptions longest;
+  SetGridPeriodKeys(kMaxGridPeriodPx, &longest);
+  EXPECT_EQ(longest.line_index.footprint_gap_px, 16);  // its limit
+  EXPECT_NO_THROW(longest.Check()) << "every key within its range at the longest period served";
+  MatchOptions shortest;
+  SetGridPeriodKeys(kMinGridPeriodPx, &shortest);
+  EXPECT_NO_THROW(shortest.Check());
+  EXPECT_EQ(shortest.line_index.window_half_height_px, 4) << "never below the default";
+}
+
+TEST(GridPeriodKeys, RefusesAPeriodTheKeysCannotServe) {
+  MatchOptions o;
+  EXPECT_THROW(SetGridPeriodKeys(2.9, &o), InputError);
+  EXPECT_THROW(SetGridPeriodKeys(42.6, &o), InputError);
+  EXPECT_THROW(SetGridPeriodKeys(std::nan(""), &o), InputError);
+  EXPECT_EQ(o.grid_half_period_px, MatchOptions{}.grid_half_period_px) << "left as it was";
+}
+
+}  // namespace
+}  // namespace stereorig

@@ -1,0 +1,160 @@
+// `stereorig tune` end to end on the simulator's plate: the grid period it
+// measures against the gratings the simulator projects, and the options
+// file it writes.
+//
+// Truth: the simulator's DOE puts a family's lines at direction cosines
+// sin(fan/2) (2i/(N-1) - 1) (datasets/sim_spec.h), so they are
+// 2 sin(fan/2) / (N - 1) apart, and the image's period is that spacing
+// times the same local Jacobian (the plate's pose, the projector's and the
+// camera's geometry) for any N. Two renders of one scene and seed that
+// differ only in N therefore have periods in the ratio (N2 - 1) / (N1 - 1):
+// 50 / 33 for the default 51 lines and 34. The two medians sample the same
+// stretch of plate, so the ratio holds to the measurement's own noise: the
+// blocks' spread is ~0.05 px at 8 px and ~0.08 at 12.7 over ~28 blocks,
+// a standard error of ~0.15 % each, ~0.2 % on the ratio; 0.6 % is three of
+// those.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+#include "datasets/simulate.h"
+#include "reconstruct/runtime_options.h"
+#include "tests/cli_runner.h"
+
+namespace stereorig {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kRatioTolerance = 0.006;
+
+class TuneCli : public ::testing::Test {
+ protected:
+  // The plate alone at seed 1, with the default grating (51 lines) and a
+  // coarser one (34): folders fine/ and coarse/.
+  static void SetUpTestSuite() {
+    dir_ = ::testing::TempDir() + "/tune_cli";
+    fs::remove_all(dir_);
+    for (const auto& [name, lines] : {std::pair{"fine", 51}, std::pair{"coarse", 34}}) {
+      SimSpec spec = DefaultSimSpec();
+      spec.scenes.names = {"plate"};
+      for (ModuleSpec& m : spec.modules) m.projector.lines = lines;
+      SimulateOptions o;
+      o.out_dir = dir_ + "/" + name;
+      o.seed = 1;
+      o.calibration_captures = 0;
+      Simulate(spec, o);
+    }
+  }
+  static std::string Tune(const std::string& dataset, const std::string& extra = "") {
+    return "tune --rig " + dir_ + "/" + dataset + "/truth/rig.yaml --capture " + dir_ + "/" + dataset +
+           "/scenes/plate/active " + extra;
+  }
+  // The periods `tune` printed, per module, and P.
+  static std::vector<double> Periods(const std::string& out) {
+    std::vector<double> periods;
+    const std::regex line(R"(module (\d+): grid period ([0-9.]+) px)");
+    for (auto it = std::sregex_iterator(out.begin(), out.end(), line); it != std::sregex_iterator(); ++it)
+      periods.push_back(std::stod((*it)[2]));
+    return periods;
+  }
+  static double P(const std::string& out) {
+    std::smatch m;
+    EXPECT_TRUE(std::regex_search(out, m, std::regex(R"(P = ([0-9.]+) px)"))) << out;
+    return m.empty() ? 0 : std::stod(m[1]);
+  }
+  static std::string dir_;
+};
+std::string TuneCli::dir_;
+
+TEST_F(TuneCli, ThePeriodsRatioIsTheGratingsRatio) {
+  const testing::Result fine = testing::RunCli(Tune("fine")), coarse = testing::RunCli(Tune("coarse"));
+  ASSERT_EQ(fine.code, 0) << fine.err;
+  ASSERT_EQ(coarse.code, 0) << coarse.err;
+  const std::vector<double> f = Periods(fine.out), c = Periods(coarse.out);
+  ASSERT_EQ(f.size(), 2u) << fine.out;
+  ASSERT_EQ(c.size(), 2u) << coarse.out;
+  for (size_t m = 0; m < 2; ++m) {
+    std::printf("module %zu: %.2f px with 51 lines, %.2f px with 34: ratio %.4f (50/33 = %.4f)\n", m, f[m], c[m],
+                c[m] / f[m], 50.0 / 33);
+    EXPECT_NEAR(c[m] / f[m], 50.0 / 33, kRatioTolerance * 50.0 / 33) << "module " << m;
+  }
+}
+
+// The default grating is what the defaults were tuned for: every key stays,
+// and the file written reads back as the defaults.
+TEST_F(TuneCli, TheDefaultGridLeavesEveryKeyAsItWas) {
+  const std::string out = dir_ + "/fine.yaml";
+  const testing::Result r = testing::RunCli(Tune("fine", "--out " + out));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(std::lround(P(r.out)), 8);
+  int unchanged = 0;
+  for (size_t at = r.out.find("(unchanged)"); at != std::string::npos; at = r.out.find("(unchanged)", at + 1))
+    ++unchanged;
+  EXPECT_EQ(unchanged, 5) << r.out;
+  const MatchOptions read = ReadRuntimeOptions(out).match, defaults;
+  EXPECT_EQ(read.grid_half_period_px, defaults.grid_half_period_px);
+  EXPECT_EQ(read.line_index.max_shift_px, defaults.line_index.max_shift_px);
+  EXPECT_EQ(read.line_index.window_half_height_px, defaults.line_index.window_half_height_px);
+  EXPECT_EQ(read.line_index.footprint_gap_px, defaults.line_index.footprint_gap_px);
+  EXPECT_EQ(read.grid_line.radius_px, defaults.grid_line.radius_px);
+}
+
+// A coarser grating: the keys follow docs/reconstruct.md's rules from P to
+// the nearest pixel, the other keys of --options stay, and `reconstruct`
+// takes the file.
+TEST_F(TuneCli, ACoarserGridSetsTheKeysByTheRulesAndKeepsTheOthers) {
+  const std::string base = dir_ + "/base.yaml", out = dir_ + "/coarse.yaml";
+  std::ofstream(base) << "# the line's own settings\nobject_size_mm: 80\nmatch:\n  min_zncc: 0.85\n";
+  const testing::Result r = testing::RunCli(Tune("coarse", "--options " + base + " --out " + out));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const long p = std::lround(P(r.out));
+  EXPECT_GE(p, 12);  // 8.4 px x 50 / 33 on this plate
+  EXPECT_LE(p, 13);
+  const RuntimeOptions read = ReadRuntimeOptions(out);
+  EXPECT_EQ(read.object_size_mm, 80);
+  EXPECT_EQ(read.match.min_zncc, 0.85);
+  EXPECT_EQ(read.match.grid_half_period_px, p / 2.0);
+  EXPECT_EQ(read.match.line_index.max_shift_px, std::lround(1.5 * p));
+  EXPECT_EQ(read.match.line_index.window_half_height_px, std::ceil((p - 1) / 2.0));
+  EXPECT_EQ(read.match.line_index.footprint_gap_px, p);
+  EXPECT_EQ(read.match.grid_line.radius_px, std::ceil(p / 2.0) + 1);
+  std::ifstream in(out);
+  std::string first;
+  std::getline(in, first);
+  EXPECT_EQ(first.rfind("# Runtime options from `stereorig tune", 0), 0u) << first;
+  const testing::Result rec =
+      testing::RunCli("reconstruct --rig " + dir_ + "/coarse/truth/rig.yaml --capture " + dir_ +
+                      "/coarse/scenes/plate/active --options " + out + " --out " + dir_ + "/coarse.ply");
+  EXPECT_EQ(rec.code, 0) << rec.err;
+}
+
+TEST_F(TuneCli, APassiveCaptureHasNoPeriodExitsTwoAndWritesNothing) {
+  const std::string out = dir_ + "/passive.yaml";
+  const testing::Result r = testing::RunCli("tune --rig " + dir_ + "/fine/truth/rig.yaml --capture " + dir_ +
+                                            "/fine/scenes/plate/passive --out " + out);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("no module's left image shows the laser grid's period"), std::string::npos) << r.err;
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(TuneCli, OutputsOverInputsOrNotYamlAreRefused) {
+  const std::string base = dir_ + "/keep.yaml";
+  std::ofstream(base) << "object_size_mm: 80\n";
+  const testing::Result over = testing::RunCli(Tune("fine", "--options " + base + " --out " + base));
+  EXPECT_EQ(over.code, 2);
+  EXPECT_NE(over.err.find("the options file (--options)"), std::string::npos) << over.err;
+  std::ifstream in(base);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "object_size_mm: 80\n") << "left as it was";
+  const testing::Result ply = testing::RunCli(Tune("fine", "--out " + dir_ + "/tuned.ply"));
+  EXPECT_EQ(ply.code, 2);
+  EXPECT_NE(ply.err.find(".yaml or .yml"), std::string::npos) << ply.err;
+  EXPECT_FALSE(fs::exists(dir_ + "/tuned.ply"));
+}
+
+}  // namespace
+}  // namespace stereorig
