@@ -63,9 +63,10 @@ struct Imager {
 std::vector<double> WalkFractions(double entry, double length_px) {
   if ((1 - entry) * length_px < 1) entry = 1;  // the line ends where it reaches the imager
   const int on_imager = entry < 1 ? kSamplesPerLine : 0;
-  const int stretch = entry == 0   ? 0
-                      : entry == 1 ? kSamplesPerLine
-                                   : std::min<int>(kSamplesPerLine, std::ceil(kSamplesPerLine * entry / (1 - entry)));
+  const int stretch =
+      entry == 0   ? 0
+      : entry == 1 ? kSamplesPerLine
+                   : std::min(kSamplesPerLine, static_cast<int>(std::ceil(kSamplesPerLine * entry / (1 - entry))));
   std::vector<double> t;
   for (int k = 1; k <= stretch; ++k) t.push_back(entry * k / stretch);
   for (int k = 1; k <= on_imager; ++k) t.push_back(entry + (1 - entry) * k / on_imager);
