@@ -74,6 +74,16 @@ TEST(SimSpec, BadSpecsNameTheKey) {
   EXPECT_NE(e.find("pixels that far from square"), std::string::npos) << e;
 }
 
+// The first camera read out in its top 100 rows, a window its principal
+// point (cy = 293 px) lies below: a real sensor mode, which the spec's lens
+// check (as a rig file's) admits.
+TEST(SimSpec, AWindowedCameraIsAccepted) {
+  const std::string good = SimSpecToYaml(DefaultSimSpec());
+  const std::string windowed = Replace(good, "imager_size: [752, 582]", "imager_size: [752, 100]");
+  EXPECT_EQ(ErrorOf(windowed), "");
+  EXPECT_EQ(ParseSimSpecYaml(windowed, "spec.yaml").modules[0].left.height_px, 100);
+}
+
 TEST(SimSpec, RingsOfOneTwoThreeModulesBuild) {
   for (int m = 1; m <= 3; ++m) {
     const SpecRig r = BuildSpecRig(SmallRingSpec(m, 4, 1));

@@ -58,13 +58,14 @@ TEST(LensPlausibility, ASplinedLensWhoseAxisIsOffThePrincipalPointPasses) {
   EXPECT_NO_THROW(CheckLensIsPlausible(splined, "splined"));
 }
 
-TEST(LensPlausibility, APrincipalPointOffTheImagerIsRefused) {
+// cx = 900 on the 752 px wide imager was refused until windowed sensors
+// were admitted: it is the demo lens read out in the left 752 columns of a
+// sensor 1800 px wide. Refusals of a principal point that no window
+// explains: lens_plausibility_window_test.cc.
+TEST(LensPlausibility, APrincipalPointOffTheImagerPasses) {
   std::vector<double> k = DemoIntrinsics();
-  k[2] = 900;  // cx beyond the 752 px width
-  const std::string e = ErrorOf([&] { CheckLensIsPlausible(Opencv5(k), "rig.yaml: cameras[0]"); });
-  EXPECT_NE(e.find("rig.yaml: cameras[0]: the principal point (cx, cy) = (900, 293.1) px lies off the 752 x 582"),
-            std::string::npos)
-      << e;
+  k[2] = 900;
+  EXPECT_NO_THROW(CheckLensIsPlausible(Opencv5(k), "rig.yaml: cameras[0]"));
 }
 
 TEST(LensPlausibility, PixelsFarFromSquareAreRefused) {

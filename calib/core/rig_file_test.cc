@@ -56,6 +56,25 @@ TEST(RigFile, WriteReadWriteIsBitIdentical) {
   }
 }
 
+// Cameras read out in windows of a 1920 x 1200 sensor (f = 1365 px, the
+// principal point at its centre): a 640 x 480 corner and a 1920 x 200
+// strip at the bottom, whose principal points (window coordinates) lie off
+// them. The reader's lens check admits them (calib/core/lens_plausibility.h).
+TEST(RigFile, WindowedCamerasAreRead) {
+  const std::vector<double> distortion = {-0.11, 0.09, 2e-4, -1e-4, -0.02, 0, 0, 0};
+  std::vector<double> corner = {1365, 1365, 959.5 - 1280, 599.5 - 720}, strip = {1365, 1365, 959.5, 599.5 - 1000};
+  corner.insert(corner.end(), distortion.begin(), distortion.end());
+  strip.insert(strip.end(), distortion.begin(), distortion.end());
+  const Rig rig({Camera("LENSMODEL_OPENCV8", corner, 640, 480), Camera("LENSMODEL_OPENCV8", strip, 1920, 200)},
+                {"corner", "strip"}, {{"module0", 0, 1, Pose::FromRotationVector({0, -0.1047, 0}, {-90, 0, 5})}},
+                {Pose::Identity()});
+  const std::string path = ::testing::TempDir() + "/rig_windowed.yaml";
+  WriteRigFile(rig, path);
+  const Rig back = ReadRigFile(path);
+  EXPECT_EQ(back.camera(0).intrinsics(), corner);
+  EXPECT_EQ(back.camera(1).intrinsics(), strip);
+}
+
 TEST(RigFile, IsPlainYamlWithoutCustomTags) {
   const std::string text = RigToYaml(MakeRandomRig(1));
   EXPECT_EQ(text.find("!!"), std::string::npos);
