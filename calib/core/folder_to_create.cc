@@ -1,6 +1,10 @@
 #include "calib/core/folder_to_create.h"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <utility>
 
 #include "calib/core/input_error.h"
@@ -29,6 +33,20 @@ fs::path DeepestExistingPart(const fs::path& normal, std::vector<fs::path>* miss
     if (p == p.root_path()) break;
   }
   return {};
+}
+
+void CheckNamesFit(const std::string& path, const std::string& doing, const fs::path& existing,
+                   const std::vector<fs::path>& missing) {
+  if (existing.empty()) return;
+  const long name_max = pathconf(existing.c_str(), _PC_NAME_MAX);
+  if (name_max <= 0) return;  // no limit, or none known
+  for (const fs::path& p : missing) {
+    const std::string name = p.filename().string();
+    if (static_cast<long>(name.size()) <= name_max) continue;
+    throw InputError(path, "cannot " + doing + ": " + std::strerror(ENAMETOOLONG) + " (" + name.substr(0, 16) +
+                               "...: " + std::to_string(name.size()) + " characters, more than the " +
+                               std::to_string(name_max) + " the file system allows in " + existing.string() + ")");
+  }
 }
 
 FolderToCreate::FolderToCreate(const std::string& path, const std::string& what) : path_(path), what_(what) {

@@ -21,6 +21,15 @@ std::filesystem::path NormalPath(const std::filesystem::path& path);
 std::filesystem::path DeepestExistingPart(const std::filesystem::path& normal,
                                           std::vector<std::filesystem::path>* missing);
 
+// Throws InputError(path, "cannot <doing>: File name too long (...)") if the
+// name of a part of `missing` (the parts of `path` to create below
+// `existing`, as DeepestExistingPart gives them) is longer than the file
+// system there allows (pathconf NAME_MAX: 255 on ext4): found before a
+// command's work, not by creating it after, nor as a std::filesystem error
+// from looking it up. Nothing is checked if `existing` is empty.
+void CheckNamesFit(const std::string& path, const std::string& doing, const std::filesystem::path& existing,
+                   const std::vector<std::filesystem::path>& missing);
+
 // A folder a command creates, and the folders above it that did not exist
 // when this object was made (a command's output folder is made so by
 // OutputPaths::ClaimFolder, apps/output_paths.h, after its checks): created
