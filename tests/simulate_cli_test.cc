@@ -128,14 +128,15 @@ TEST(SimulateCli, AnOutNameOf255BytesIsWritten) {
 // `stereorig simulate` stopped by SIGTERM mid-render dies of the signal and
 // leaves neither its temporary folder (it used to leave .<name>.tmp-<pid>/
 // with every image rendered so far: calib/core/pending_temporary.h) nor the
-// dataset. 200 captures would take a minute: the signal comes once the first
+// dataset, nor the folders it made above them (new/sub: they used to stay,
+// empty; calib/core/folder_to_create.h). 200 captures would take a minute: the signal comes once the first
 // image is there, found by polling (the ray tables come first, a few seconds
 // on a loaded machine).
 TEST(SimulateCli, ATerminationSignalMidRenderLeavesNoTemporaryFolder) {
   const std::string dir = ::testing::TempDir() + "/sim_signal";
   fs::remove_all(dir);
   fs::create_directories(dir);
-  const std::string out = dir + "/ds";
+  const std::string out = dir + "/new/sub/ds";
   const char* argv[] = {"stereorig", "simulate",    "--out",     out.c_str(), "--calibration-captures",
                         "200",       "--no-scenes", "--threads", "2",         nullptr};
   posix_spawn_file_actions_t quiet;
@@ -159,7 +160,7 @@ TEST(SimulateCli, ATerminationSignalMidRenderLeavesNoTemporaryFolder) {
     }
     return -1;
   };
-  const fs::path first_image = dir + "/.ds.tmp-" + std::to_string(pid) + "/calibration/000/cam0.png";
+  const fs::path first_image = dir + "/new/sub/.ds.tmp-" + std::to_string(pid) + "/calibration/000/cam0.png";
   const int early = status_within(60, [&] {
     std::error_code ec;
     return fs::exists(first_image, ec);

@@ -58,6 +58,8 @@ FolderToCreate::FolderToCreate(FolderToCreate&& other) noexcept
     : path_(std::move(other.path_)),
       what_(std::move(other.what_)),
       missing_(std::move(other.missing_)),
+      made_(std::move(other.made_)),
+      on_signal_(std::move(other.on_signal_)),
       created_(std::exchange(other.created_, false)),
       exceptions_(other.exceptions_) {}
 
@@ -66,6 +68,8 @@ FolderToCreate& FolderToCreate::operator=(FolderToCreate&& other) noexcept {
     path_ = std::move(other.path_);
     what_ = std::move(other.what_);
     missing_ = std::move(other.missing_);
+    made_ = std::move(other.made_);
+    on_signal_ = std::move(other.on_signal_);
     created_ = std::exchange(other.created_, false);
     exceptions_ = other.exceptions_;
   }
@@ -83,8 +87,19 @@ bool FolderToCreate::WillCreate(const fs::path& folder) const {
 void FolderToCreate::Create() {
   if (path_.empty()) return;
   created_ = true;  // before: a failure part way leaves folders to remove
+  // One by one, outermost first, to know which this process made: only
+  // those are removed, on failure or on a signal.
   std::error_code ec;
-  fs::create_directories(path_, ec);
+  for (const fs::path& p : missing_) {
+    if (!fs::create_directory(p, ec)) {
+      if (ec) break;
+      continue;  // made meanwhile by another process: not ours to remove
+    }
+    made_.push_back(p);
+    on_signal_.push_back(std::make_unique<PendingTemporary>(p.string(), TemporaryKind::kEmptyFolder));
+  }
+  // A part gone since the claim (it then existed): made again, not ours.
+  if (!ec) fs::create_directories(path_, ec);
   if (ec || !fs::is_directory(path_))
     throw InputError(path_, "cannot create this folder for " + what_ + (ec ? ": " + ec.message() : ""));
 }
@@ -92,10 +107,11 @@ void FolderToCreate::Create() {
 void FolderToCreate::RemoveIfEmpty() {
   if (!created_) return;
   created_ = false;
+  on_signal_.clear();
   std::error_code ec;
-  for (auto p = missing_.rbegin(); p != missing_.rend(); ++p) {  // innermost first
-    if (!fs::exists(*p, ec)) continue;                           // not made (Create failed part way)
-    if (!fs::remove(*p, ec)) break;                              // not empty: it and the folders above it stay
+  for (auto p = made_.rbegin(); p != made_.rend(); ++p) {  // innermost first
+    if (!fs::exists(*p, ec)) continue;                     // removed by someone else
+    if (!fs::remove(*p, ec)) break;                        // not empty: it and the folders above it stay
   }
 }
 

@@ -3,8 +3,11 @@
 
 #include <exception>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
+
+#include "calib/core/pending_temporary.h"
 
 namespace stereorig {
 
@@ -36,9 +39,12 @@ void CheckNamesFit(const std::string& path, const std::string& doing, const std:
 // only once every input has been checked (Create), and removed again,
 // innermost first and only while empty, if the command fails after that (an
 // exception leaving the scope of this object, or RemoveIfEmpty), Create
-// failing part way included. So bad input found after the claim leaves no
-// new folder behind, while a folder that existed before, or one holding
-// what the command wrote before a later failure, stays.
+// failing part way included, or if a termination signal ends the process
+// while this object lives (pending_temporary.h: after the temporary files
+// and folders in them). So bad input found after the claim, or Ctrl-C,
+// leaves no new folder behind, while a folder that existed before (another
+// process's made meanwhile included), or one holding what the command wrote
+// before a later failure, stays.
 class FolderToCreate {
  public:
   FolderToCreate() = default;  // no folder: an optional one not asked for
@@ -63,6 +69,8 @@ class FolderToCreate {
  private:
   std::string path_, what_;                     // as given; what it holds (for the message)
   std::vector<std::filesystem::path> missing_;  // normal absolute paths not there when claimed, outermost first
+  std::vector<std::filesystem::path> made_;     // those Create made itself, outermost first
+  std::vector<std::unique_ptr<PendingTemporary>> on_signal_;  // made_, for a termination signal to remove
   bool created_ = false;
   int exceptions_ = std::uncaught_exceptions();  // at construction: more in the destructor means failing
 };
