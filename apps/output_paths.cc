@@ -11,29 +11,7 @@
 
 namespace stereorig {
 
-namespace {
-
 namespace fs = std::filesystem;
-
-// Throws InputError(path, "cannot <doing>: ...") if the name of a part of
-// `missing` (the parts of a path to create below `existing`) is longer than
-// the file system there allows (pathconf NAME_MAX: 255 on ext4), which
-// creating it would find only after the command's work.
-void CheckNamesFit(const std::string& path, const std::string& doing, const fs::path& existing,
-                   const std::vector<fs::path>& missing) {
-  if (existing.empty()) return;
-  const long name_max = pathconf(existing.c_str(), _PC_NAME_MAX);
-  if (name_max <= 0) return;  // no limit, or none known
-  for (const fs::path& p : missing) {
-    const std::string name = p.filename().string();
-    if (static_cast<long>(name.size()) <= name_max) continue;
-    throw InputError(path, "cannot " + doing + ": " + std::strerror(ENAMETOOLONG) + " (" + name.substr(0, 16) +
-                               "...: " + std::to_string(name.size()) + " characters, more than the " +
-                               std::to_string(name_max) + " the file system allows in " + existing.string() + ")");
-  }
-}
-
-}  // namespace
 
 void OutputPaths::Protect(const std::string& path, const std::string& what) {
   if (!path.empty()) inputs_.emplace(NormalPath(path), what);  // an output through a link to an input is that input

@@ -242,6 +242,13 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
   // is the folder itself: renaming it into place would then fail.
   if (!out.has_filename()) out = out.parent_path();
   const fs::path parent = out.parent_path();
+  // Every name to create fits the file system, the dataset's own included,
+  // as every command's output folders are checked (apps/output_paths.h): a
+  // name too long used to surface as a raw std::filesystem error, or as a
+  // rename failing after all the rendering.
+  std::vector<fs::path> missing;
+  CheckNamesFit(out.string(), "create this folder for the dataset (--out)",
+                DeepestExistingPart(NormalPath(out), &missing), missing);
   // Made now, and removed again while empty if the run fails after this (a
   // folder that cannot be made, part way too): no new empty folder left.
   FolderToCreate parent_folder(parent.string(), "the dataset's folder (--out)");

@@ -10,7 +10,7 @@
 namespace stereorig {
 
 // The image at `path`, CV_8UC1. Throws InputError if the file is missing, is
-// a PNG cut short (calib/core/png_file.h), cannot be decoded, or is not
+// a PNG cut short or damaged (calib/core/png_file.h), cannot be decoded, or is not
 // 8-bit single-channel.
 cv::Mat ReadGreyImage(const std::string& path);
 

@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "tests/cli_runner.h"
+#include "tests/sim_scene.h"
 
 namespace stereorig {
 namespace {
@@ -137,6 +138,26 @@ TEST(BenchCli, AMissingSceneNamedInScenesExitsTwoBeforeAnyRun) {
   const testing::Result no_truth = RunCli(bench + " --scenes cup");
   EXPECT_NE(no_truth.err.find(dataset + ": is not a simulator dataset: it has no truth/ folder"), std::string::npos)
       << no_truth.err;
+  std::filesystem::remove_all(dataset);
+}
+
+// A measurement volume that misses a scene: the bench says so (as score
+// does), naming the scene. The sphere's centre is ~33 mm to the side of
+// module 0 and ~205 mm ahead of it; a 150 mm wide volume centred 200 mm to
+// the side holds none of it (and still projects into the images: the
+// runtime builds). One scene, one run, empty clouds: a few seconds. (The
+// default volume, which holds the sphere, would add ~10 s of scoring.)
+TEST(BenchCli, SaysWhenTheMeasurementVolumeMissesAScenesTruth) {
+  const std::string dataset = testing::SimulateOneScene("sphere", 1, "bench_volume");
+  const std::string options = dataset + "/volume_beside.yaml";
+  { std::ofstream(options) << "volume_center_mm: [200, 0, 200]\n"; }
+  const testing::Result missed =
+      RunCli("bench --runs 1 --dataset " + dataset + " --scenes sphere --options " + options);
+  ASSERT_EQ(missed.code, 0) << missed.err;
+  EXPECT_NE(missed.out.find("bench: the measurement volume holds 0% of sphere's truth surface: both pipelines will "
+                            "find little or nothing; set working_distance_mm (or volume_center_mm) in --options\n"),
+            std::string::npos)
+      << missed.out;
   std::filesystem::remove_all(dataset);
 }
 

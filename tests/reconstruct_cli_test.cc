@@ -165,6 +165,7 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
 #include <iterator>
 #include <nlohmann/json.hpp>
 
+#include "calib/core/png_file.h"
 #include "calib/core/rig_file.h"
 #include "datasets/default_rig.h"
 #include "datasets/sim_spec.h"
@@ -299,25 +300,35 @@ TEST_F(ReconstructCli, WrongImageSizeExitsTwoAndWritesNothing) {
 
 // A capture image cut short (a camera still writing it) is named in one
 // line; libpng used to print its own "libpng error: Read Error" line first.
-TEST_F(ReconstructCli, AnImageCutShortIsNamedInOneLine) {
+// So is one with a byte flipped in its image data (a disk's or a copy's
+// damage): libpng printed "libpng error: bad adaptive filter value" above
+// our "cannot read the image (not an image, or a damaged one)".
+TEST_F(ReconstructCli, AnImageCutShortOrDamagedIsNamedInOneLine) {
   const std::string d = BrokenCapture("cut_short");
   const auto size = std::filesystem::file_size(d + "/cam1.png");
   std::filesystem::resize_file(d + "/cam1.png", size / 2);
-  const testing::Result r = testing::RunCli(Args(d));
+  testing::Result r = testing::RunCli(Args(d));
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find(d + "/cam1.png: a PNG cut short"), std::string::npos) << r.err;
   ExpectNoOutput();
-}
 
-// PNG's chunk CRC (ISO 3309, as zlib's crc32), for a header made by hand.
-uint32_t PngCrc(const std::string& bytes) {
-  uint32_t c = 0xFFFFFFFFu;
-  for (const unsigned char b : bytes) {
-    c ^= b;
-    for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
-  }
-  return c ^ 0xFFFFFFFFu;
+  const std::string damaged = BrokenCapture("damaged");
+  std::fstream f(damaged + "/cam2.png", std::ios::in | std::ios::out | std::ios::binary);
+  const std::string bytes{std::istreambuf_iterator<char>(f), {}};
+  const size_t idat = bytes.find("IDAT");  // its type; its data follows
+  ASSERT_NE(idat, std::string::npos);
+  f.seekp(std::streamoff(idat + 100));
+  f.put(char(bytes[idat + 100] ^ 0x10));
+  f.close();
+  r = testing::RunCli(Args(damaged));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(damaged + "/cam2.png: a damaged PNG (its IDAT chunk at byte " + std::to_string(idat - 4) +
+                       " fails its CRC check)"),
+            std::string::npos)
+      << r.err;
+  ExpectNoOutput();
 }
 
 // Inputs of the wrong kind, each named in one line as what it is, before any

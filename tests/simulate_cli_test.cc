@@ -75,22 +75,31 @@ TEST(SimulateCli, AnOutFolderWithATrailingSlashIsWritten) {
 
 // An --out that cannot be made (a name longer than the file system's 255
 // bytes: a folder above it, or the folder itself) exits 2 in one line naming
-// it, before any rendering, and the folders made above it on the way are
-// removed again (FolderToCreate, calib/core/folder_to_create.h); they used to
-// stay, empty.
+// it and the name, before any rendering, and the folders made above it on
+// the way are removed again (FolderToCreate, calib/core/folder_to_create.h);
+// they used to stay, empty. The dataset's own name too long, in a folder
+// there or one to make, used to be std::filesystem's "filesystem error:
+// status: File name too long [path]".
 TEST(SimulateCli, AnOutThatCannotBeMadeLeavesNoFolder) {
-  const std::string dir = ::testing::TempDir() + "/sim_long";
+  const std::string dir = fs::path(::testing::TempDir() + "/sim_long").lexically_normal();  // as messages name it
   fs::remove_all(dir);
-  const std::pair<std::string, std::string> cases[] = {{dir + "/new/" + std::string(300, 'x') + "/ds", "xxx"},
-                                                       {dir + "/new/" + std::string(256, 'z'), "/zzz"}};
-  for (const auto& [out, says] : cases) {
+  fs::create_directories(dir);
+  const std::string x300(300, 'x'), z256(256, 'z');
+  const struct {
+    std::string out, name;
+  } cases[] = {{dir + "/new/" + x300 + "/ds", x300}, {dir + "/new/" + z256, z256}, {dir + "/" + z256, z256}};
+  for (const auto& [out, name] : cases) {
     const Result r = RunCli("simulate --out " + out + " --calibration-captures 1 --no-scenes");
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_EQ(Lines(r.err), 1) << r.err;
-    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find("File name too long"), std::string::npos) << r.err;
-    EXPECT_FALSE(fs::exists(dir + "/new")) << "the folder made on the way was left behind: " << out.substr(0, 80);
+    EXPECT_NE(r.err.find(out + ": cannot create this folder for the dataset (--out): File name too long (" +
+                         name.substr(0, 16) + "...: " + std::to_string(name.size()) +
+                         " characters, more than the 255 the file system allows in " + dir + ")\n"),
+              std::string::npos)
+        << r.err;
+    EXPECT_TRUE(fs::is_empty(dir)) << "the folder made on the way was left behind: " << out.substr(0, 80);
   }
+  fs::remove_all(dir);
 }
 
 // An --out whose name takes up to the file system's 255 bytes is written,
@@ -119,14 +128,15 @@ TEST(SimulateCli, AnOutNameOf255BytesIsWritten) {
 // `stereorig simulate` stopped by SIGTERM mid-render dies of the signal and
 // leaves neither its temporary folder (it used to leave .<name>.tmp-<pid>/
 // with every image rendered so far: calib/core/pending_temporary.h) nor the
-// dataset. 200 captures would take a minute: the signal comes once the first
+// dataset, nor the folders it made above them (new/sub: they used to stay,
+// empty; calib/core/folder_to_create.h). 200 captures would take a minute: the signal comes once the first
 // image is there, found by polling (the ray tables come first, a few seconds
 // on a loaded machine).
 TEST(SimulateCli, ATerminationSignalMidRenderLeavesNoTemporaryFolder) {
   const std::string dir = ::testing::TempDir() + "/sim_signal";
   fs::remove_all(dir);
   fs::create_directories(dir);
-  const std::string out = dir + "/ds";
+  const std::string out = dir + "/new/sub/ds";
   const char* argv[] = {"stereorig", "simulate",    "--out",     out.c_str(), "--calibration-captures",
                         "200",       "--no-scenes", "--threads", "2",         nullptr};
   posix_spawn_file_actions_t quiet;
@@ -150,7 +160,7 @@ TEST(SimulateCli, ATerminationSignalMidRenderLeavesNoTemporaryFolder) {
     }
     return -1;
   };
-  const fs::path first_image = dir + "/.ds.tmp-" + std::to_string(pid) + "/calibration/000/cam0.png";
+  const fs::path first_image = dir + "/new/sub/.ds.tmp-" + std::to_string(pid) + "/calibration/000/cam0.png";
   const int early = status_within(60, [&] {
     std::error_code ec;
     return fs::exists(first_image, ec);

@@ -1,6 +1,10 @@
 #include "calib/core/folder_to_create.h"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <utility>
 
 #include "calib/core/input_error.h"
@@ -31,6 +35,20 @@ fs::path DeepestExistingPart(const fs::path& normal, std::vector<fs::path>* miss
   return {};
 }
 
+void CheckNamesFit(const std::string& path, const std::string& doing, const fs::path& existing,
+                   const std::vector<fs::path>& missing) {
+  if (existing.empty()) return;
+  const long name_max = pathconf(existing.c_str(), _PC_NAME_MAX);
+  if (name_max <= 0) return;  // no limit, or none known
+  for (const fs::path& p : missing) {
+    const std::string name = p.filename().string();
+    if (static_cast<long>(name.size()) <= name_max) continue;
+    throw InputError(path, "cannot " + doing + ": " + std::strerror(ENAMETOOLONG) + " (" + name.substr(0, 16) +
+                               "...: " + std::to_string(name.size()) + " characters, more than the " +
+                               std::to_string(name_max) + " the file system allows in " + existing.string() + ")");
+  }
+}
+
 FolderToCreate::FolderToCreate(const std::string& path, const std::string& what) : path_(path), what_(what) {
   DeepestExistingPart(NormalPath(path), &missing_);
   std::reverse(missing_.begin(), missing_.end());  // outermost first
@@ -40,6 +58,8 @@ FolderToCreate::FolderToCreate(FolderToCreate&& other) noexcept
     : path_(std::move(other.path_)),
       what_(std::move(other.what_)),
       missing_(std::move(other.missing_)),
+      made_(std::move(other.made_)),
+      on_signal_(std::move(other.on_signal_)),
       created_(std::exchange(other.created_, false)),
       exceptions_(other.exceptions_) {}
 
@@ -48,6 +68,8 @@ FolderToCreate& FolderToCreate::operator=(FolderToCreate&& other) noexcept {
     path_ = std::move(other.path_);
     what_ = std::move(other.what_);
     missing_ = std::move(other.missing_);
+    made_ = std::move(other.made_);
+    on_signal_ = std::move(other.on_signal_);
     created_ = std::exchange(other.created_, false);
     exceptions_ = other.exceptions_;
   }
@@ -65,8 +87,19 @@ bool FolderToCreate::WillCreate(const fs::path& folder) const {
 void FolderToCreate::Create() {
   if (path_.empty()) return;
   created_ = true;  // before: a failure part way leaves folders to remove
+  // One by one, outermost first, to know which this process made: only
+  // those are removed, on failure or on a signal.
   std::error_code ec;
-  fs::create_directories(path_, ec);
+  for (const fs::path& p : missing_) {
+    if (!fs::create_directory(p, ec)) {
+      if (ec) break;
+      continue;  // made meanwhile by another process: not ours to remove
+    }
+    made_.push_back(p);
+    on_signal_.push_back(std::make_unique<PendingTemporary>(p.string(), TemporaryKind::kEmptyFolder));
+  }
+  // A part gone since the claim (it then existed): made again, not ours.
+  if (!ec) fs::create_directories(path_, ec);
   if (ec || !fs::is_directory(path_))
     throw InputError(path_, "cannot create this folder for " + what_ + (ec ? ": " + ec.message() : ""));
 }
@@ -74,10 +107,11 @@ void FolderToCreate::Create() {
 void FolderToCreate::RemoveIfEmpty() {
   if (!created_) return;
   created_ = false;
+  on_signal_.clear();
   std::error_code ec;
-  for (auto p = missing_.rbegin(); p != missing_.rend(); ++p) {  // innermost first
-    if (!fs::exists(*p, ec)) continue;                           // not made (Create failed part way)
-    if (!fs::remove(*p, ec)) break;                              // not empty: it and the folders above it stay
+  for (auto p = made_.rbegin(); p != made_.rend(); ++p) {  // innermost first
+    if (!fs::exists(*p, ec)) continue;                     // removed by someone else
+    if (!fs::remove(*p, ec)) break;                        // not empty: it and the folders above it stay
   }
 }
 

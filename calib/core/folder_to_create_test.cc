@@ -2,10 +2,13 @@
 
 #include <gtest/gtest.h>
 
-#include "calib/core/input_error_testing.h"
-
+#include <csignal>
 #include <fstream>
 #include <stdexcept>
+
+#include "calib/core/atomic_file.h"
+#include "calib/core/input_error_testing.h"
+#include "calib/core/signal_testing.h"
 
 namespace stereorig {
 namespace {
@@ -74,6 +77,38 @@ TEST(FolderToCreate, AMovedFromObjectRemovesNothing) {
   EXPECT_TRUE(fs::is_directory(dir + "/a"));
   kept.RemoveIfEmpty();
   EXPECT_FALSE(fs::exists(dir + "/a"));
+}
+
+// A termination signal while the object lives (Ctrl-C mid-run) removes the
+// folders it made, as a failure does, once the pending temporary files in
+// them are gone (pending_temporary.h); they used to stay, empty. Only while
+// empty (x/y holds a file: it and x stay), and only those it made: `dir`,
+// and `dir`/p, made by another process (here the child itself) between the
+// claim and Create, stay, though empty.
+TEST(FolderToCreate, ATerminationSignalRemovesWhatItCreatedWhileEmpty) {
+  for (const int signal : {SIGTERM, SIGINT, SIGHUP}) {
+    const std::string dir = Scratch("signal_" + std::to_string(signal));
+    const int status = testing::StatusOfAChild([&] {
+      FolderToCreate outputs(dir + "/a/b/c", "the test folder");
+      FolderToCreate kept(dir + "/x/y", "the test folder");
+      FolderToCreate theirs(dir + "/p/q", "the test folder");
+      fs::create_directory(dir + "/p");  // another process's, after the claim
+      outputs.Create();
+      kept.Create();
+      theirs.Create();
+      std::ofstream(dir + "/x/y/written.txt") << "written before the signal\n";
+      AtomicOutput out(dir + "/a/b/c/cloud.ply");  // a pending temporary file in the folder
+      std::ofstream(out.temp_path()) << "half a cloud";
+      if (!fs::exists(out.temp_path()) || !fs::is_directory(dir + "/p/q")) _exit(3);
+      raise(signal);
+    });
+    ASSERT_TRUE(testing::DiedOf(status, signal));
+    EXPECT_FALSE(fs::exists(dir + "/a")) << "the folders it made were left";
+    EXPECT_TRUE(fs::exists(dir + "/x/y/written.txt"));
+    EXPECT_FALSE(fs::exists(dir + "/p/q"));
+    EXPECT_TRUE(fs::is_directory(dir + "/p")) << "another's folder was removed";
+    EXPECT_TRUE(fs::is_directory(dir));
+  }
 }
 
 // No folder asked for: Create and RemoveIfEmpty do nothing.

@@ -16,8 +16,8 @@ namespace {
 
 // A slot's path and kind are written before it is marked ready, and the
 // handler reads only ready slots: a signal between the two sees a free slot.
-// Lock-free atomics, unlink(2) and RemoveTreeSignalSafe are what a signal
-// handler may use.
+// Lock-free atomics, unlink(2), rmdir(2) and RemoveTreeSignalSafe are what a
+// signal handler may use.
 enum SlotState : int { kFree = 0, kFilling = 1, kReady = 2 };
 struct Slot {
   std::atomic<int> state{kFree};
@@ -34,8 +34,17 @@ extern "C" void RemovePendingAndDie(int signal) {
     if (slot.state.load() != kReady) continue;
     if (slot.kind == TemporaryKind::kFolder)
       RemoveTreeSignalSafe(slot.path);
-    else
+    else if (slot.kind == TemporaryKind::kFile)
       unlink(slot.path);
+  }
+  // Then the empty folders, now that what was in them is gone. A folder is
+  // emptied by removing the ones in it, whatever slots they hold: passes
+  // until one removes nothing (rmdir fails on a folder not empty, or gone).
+  for (bool removed = true; removed;) {
+    removed = false;
+    for (Slot& slot : g_slots)
+      if (slot.state.load() == kReady && slot.kind == TemporaryKind::kEmptyFolder && rmdir(slot.path) == 0)
+        removed = true;
   }
   std::signal(signal, SIG_DFL);
   raise(signal);

@@ -8,6 +8,10 @@
 // most kMaxRemovalDepth levels), then the process dies of the signal as it
 // would have.
 //
+// A folder the process made (kEmptyFolder: FolderToCreate's, folder_to_create.h)
+// is removed only while empty (rmdir), after the files and trees, innermost
+// first whatever order they were registered in.
+//
 // The handlers are installed on first use, for each of those signals whose
 // handler is still the default (a program's own handler is left alone).
 // Best effort: at most kMaxPending at once, paths under PATH_MAX.
@@ -17,7 +21,11 @@
 
 namespace stereorig {
 
-enum class TemporaryKind { kFile, kFolder };
+enum class TemporaryKind {
+  kFile,         // unlinked
+  kFolder,       // removed with all in it
+  kEmptyFolder,  // removed only if empty (once the others are gone)
+};
 
 class PendingTemporary {
  public:

@@ -14,6 +14,7 @@
 
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error_testing.h"
+#include "calib/core/signal_testing.h"
 
 namespace stereorig {
 namespace {
@@ -27,26 +28,20 @@ int FileCount(const std::string& dir) {
 // In a child: an atomic output whose temporary file is written, then
 // `signal` raised before the rename. The child's wait status.
 int StatusOfAChildSignalledMidWrite(const std::string& dir, int signal, void (*own_handler)(int)) {
-  const pid_t child = fork();
-  if (child == 0) {
+  return testing::StatusOfAChild([&] {
     if (own_handler) std::signal(signal, own_handler);
     AtomicOutput out(dir + "/cloud.ply");
     FILE* f = std::fopen(out.temp_path().c_str(), "wb");
     if (!f || std::fputs("half a cloud", f) < 0 || std::fclose(f) != 0) _exit(3);
     raise(signal);
-    _exit(4);  // not reached: the signal ends the child
-  }
-  int status = 0;
-  waitpid(child, &status, 0);
-  return status;
+  });
 }
 
 TEST(PendingTemporary, ATerminationSignalMidWriteRemovesTheTemporaryFile) {
   for (const int signal : {SIGTERM, SIGINT, SIGHUP}) {
     const std::string dir = testing::ScratchFolder("pending_temporary_" + std::to_string(signal));
     const int status = StatusOfAChildSignalledMidWrite(dir, signal, nullptr);
-    ASSERT_TRUE(WIFSIGNALED(status)) << "child exit status " << WEXITSTATUS(status);
-    EXPECT_EQ(WTERMSIG(status), signal);  // it still dies of the signal
+    ASSERT_TRUE(testing::DiedOf(status, signal));  // it still dies of the signal
     EXPECT_EQ(FileCount(dir), 0) << "the temporary file was left";
   }
 }
@@ -73,8 +68,7 @@ TEST(PendingTemporary, ATerminationSignalRemovesAPendingFolderButNotWhatItsLinks
     const std::string tree = dir + "/.ds.tmp-1";
     std::filesystem::create_directory(dir + "/outside");
     std::ofstream(dir + "/outside/keep.txt") << "keep";
-    const pid_t child = fork();
-    if (child == 0) {
+    const int status = testing::StatusOfAChild([&] {
       PendingTemporary pending(tree, TemporaryKind::kFolder);
       std::error_code ec;
       std::filesystem::create_directories(tree + "/calibration/000", ec);
@@ -84,12 +78,8 @@ TEST(PendingTemporary, ATerminationSignalRemovesAPendingFolderButNotWhatItsLinks
       std::filesystem::create_directory_symlink(dir + "/outside", tree + "/truth/outside", ec);
       if (ec) _exit(3);
       raise(signal);
-      _exit(4);  // not reached: the signal ends the child
-    }
-    int status = 0;
-    waitpid(child, &status, 0);
-    ASSERT_TRUE(WIFSIGNALED(status)) << "child exit status " << WEXITSTATUS(status);
-    EXPECT_EQ(WTERMSIG(status), signal);
+    });
+    ASSERT_TRUE(testing::DiedOf(status, signal));
     EXPECT_EQ(FileCount(dir), 1) << "the temporary folder was left";
     EXPECT_TRUE(std::filesystem::exists(dir + "/outside/keep.txt")) << "the link was followed";
   }
