@@ -101,9 +101,27 @@ int RunTune(int argc, char** argv) {
           "  warning: module %d's period varies by more than %.0f %% over its image: a curved or turned "
           "surface; measure on a flat plate facing the module\n",
           plan.module, 100 * kMaxRelativeSpread);
+    if (std::isnan(m->shift_per_row_px)) {
+      std::printf(
+          "  its turn against the rows was not read: check the line index's vernier by hand "
+          "(docs/reconstruct.md, \"Another projector\")\n");
+    } else {
+      const double offset_px = RowOffsetPerPeriodPx(*m);
+      std::printf(
+          "  the grid is turned %.2f deg against the rows: the line index's vernier reads %.2f px per period "
+          "(its thresholds need %.2f-%.2f)\n",
+          GridTurnDeg(*m), offset_px, kMinRowOffsetPerPeriodPx, kMaxRowOffsetPerPeriodPx);
+      if (offset_px < kMinRowOffsetPerPeriodPx || offset_px > kMaxRowOffsetPerPeriodPx)
+        std::printf(
+            "  warning: module %d's line index cannot tell a line from its neighbour reliably at this turn: "
+            "turn the projector about its axis so that P tan(turn) lies in %.2f-%.2f px, or set "
+            "match.line_index_* by hand (docs/reconstruct.md, \"Another projector\")\n",
+            plan.module, kMinRowOffsetPerPeriodPx, kMaxRowOffsetPerPeriodPx);
+    }
     periods.push_back(m->period_px);
-    char text[96];
-    std::snprintf(text, sizeof text, "module %d %.2f px (spread %.2f px)", plan.module, m->period_px, m->spread_px);
+    char text[128];
+    std::snprintf(text, sizeof text, "module %d %.2f px (spread %.2f px, turned %.2f deg)", plan.module, m->period_px,
+                  m->spread_px, GridTurnDeg(*m));
     measured += (measured.empty() ? "" : ", ") + std::string(text);
   }
   if (periods.empty())

@@ -23,6 +23,19 @@ namespace stereorig {
 inline constexpr double kMinGridPeriodPx = 3;
 inline constexpr double kMaxGridPeriodPx = 42;
 
+// The row offset per period the line index's vernier reads between a
+// component on its line and one a period off (RowOffsetPerPeriodPx,
+// grid_period.h), as the default thresholds need it (line_index.h): above
+// the 0.15 px at which a component is dropped as a period off, by the
+// ~0.05 px standard error of a component's reading at strong speckle (a
+// period-off component read one standard error low is still dropped);
+// below the 1 px row offset the sub-pixel fit allows (subpixel_refine.h),
+// by twice that. The default rig reads 0.26-0.46 px on the simulator's
+// plates (its modules' rolls turn the grid 1.8-3.2 deg in the rectified
+// images). Not a key: the projector's turn about its axis sets it.
+inline constexpr double kMinRowOffsetPerPeriodPx = 0.2;
+inline constexpr double kMaxRowOffsetPerPeriodPx = 0.9;
+
 struct GridPeriodKey {
   std::string key;  // as the options file names it: match.<key>
   double value = 0;
