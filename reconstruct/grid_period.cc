@@ -167,10 +167,10 @@ std::vector<std::vector<std::pair<int, int>>> LitRuns(const cv::Mat& lit, const 
 // within half a period less a pixel (the peak one period over is the next
 // line). Its three-point position is biased by a share of a pixel that
 // depends on where the peak falls between two lags, so it is read at r = 4,
-// 8, .., 32 (the peaks fall at different fractions; an r whose peak would
-// pass the reach, by the shift r = 4 reads, is left out) and the shift
-// fitted through the origin, sum(r x_r) / sum(r^2). NaN where a peak is
-// missing.
+// 8, .., 32 (the peaks fall at different fractions; the separations stop
+// where the shift fitted so far would put the peak past the reach) and the
+// shift fitted through the origin, sum(r x_r) / sum(r^2). NaN where the
+// first peak is missing.
 double BlockShiftPerRowPx(const cv::Mat& left, const std::vector<std::vector<std::pair<int, int>>>& runs, int y0,
                           int y1, double period_px, const GridPeriodOptions& o) {
   const int reach = std::max(1, int(period_px / 2));
@@ -207,7 +207,7 @@ double RowOffsetPerPeriodPx(const GridPeriodMeasurement& m) { return m.period_px
 std::optional<GridPeriodMeasurement> MeasureGridPeriodPx(const cv::Mat& left, const cv::Mat& lit,
                                                          const GridPeriodOptions& o) {
   STEREORIG_CHECK(left.type() == CV_8UC1 && lit.type() == CV_8UC1 && lit.size() == left.size());
-  STEREORIG_CHECK(o.block_rows >= 1 && o.min_run_px >= 8 && o.max_period_px >= 3);
+  STEREORIG_CHECK(o.block_rows >= 1 && o.min_run_px >= 8 && o.max_period_px >= 3 && o.min_blocks >= 1);
   const int lags = std::min(kMaxLagPx, std::max(o.max_period_px + 2, left.cols / 2));
   const std::vector<std::vector<std::pair<int, int>>> runs = LitRuns(lit, o);
   GridPeriodMeasurement out;

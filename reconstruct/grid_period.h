@@ -45,8 +45,9 @@ struct GridPeriodMeasurement {
   // How far the near-vertical lines move along the row from one row to the
   // next, px (the tangent of the grid's turn against the rows, its sign the
   // direction): the median of the blocks' readings, each from the cross-
-  // correlation of rows block_rows / 2 apart. NaN where fewer than
-  // min_blocks blocks read it.
+  // correlations of rows 4, 8, .., 32 apart, their peaks fitted through the
+  // origin (grid_period.cc). NaN where fewer than min_blocks blocks read
+  // it.
   double shift_per_row_px = std::numeric_limits<double>::quiet_NaN();
 };
 

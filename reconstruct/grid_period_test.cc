@@ -42,12 +42,16 @@ SyntheticPairSpec Grid(double period_px, double angle_deg) {
 cv::Mat AllLit(const cv::Mat& image) { return cv::Mat(image.size(), CV_8UC1, cv::Scalar(255)); }
 
 // The period, and the grid's turn against the rows against the angle the
-// renderer turns its lines by (both read from the same images). Turn: Tolerance 0.1 deg: the three-point peak positions
-// are biased by where each peak falls between two lags; read at eight row separations and fitted, what is left on these
-// images is <= 0.08 deg (1 deg at 5.5 px, where all eight peaks fall within 0.6 px of lag 0), and the row offset per
-// period the vernier's thresholds need (0.2-0.9 px) is then known to ~4 % at the default 2.6 deg. A short period turned
-// steeply (5.5 px at 10 deg: the lines move 2.8 px in 16 rows, past half a period) is read from few separations and is
-// not tested.
+// renderer turns its lines by (both read from the same images). Turn
+// tolerance 0.1 deg: the three-point peak positions are biased by where
+// each peak falls between two lags; read at eight row separations and
+// fitted, what is left on these images is <= 0.08 deg (1 deg at 5.5 px,
+// where all eight peaks fall within 0.6 px of lag 0), and the row offset
+// per period the vernier's thresholds need (0.2-0.9 px) is then known to
+// ~4 % at the default 2.6 deg. A short period turned steeply (5.5 px at 10
+// deg: the lines move 1.4 px in 8 rows) is read from the 4-row separation
+// alone (8 rows would put its peak past half a period less a pixel) and
+// its turn is not tested.
 TEST(GridPeriod, MeasuresTheAnalyticPeriodAndTurn) {
   for (double angle : {1.0, 2.6, 5.0, 10.0})
     for (double period : {5.5, 8.0, 12.15, 31.0}) {
@@ -128,7 +132,7 @@ TEST(GridPeriod, SpreadShowsTwoPeriods) {
 }
 
 TEST(GridPeriodKeys, TheDefaultGridsPeriodGivesTheDefaults) {
-  // 7.96 px: the simulator's default grid measured on its plate
+  // The simulator's default grid reads 8.07-8.46 px on its scenes
   // (docs/reconstruct.md); anything that rounds to 8 px.
   for (double period : {7.6, 7.96, 8.0, 8.4}) {
     MatchOptions o;
