@@ -55,7 +55,9 @@ int RunTune(int argc, char** argv) {
       "Measures the laser grid's period P in a capture (the distance between neighbouring near-vertical lines "
       "along the rows of each module's rectified left image) and sets the runtime options tied to it: "
       "match.grid_half_period_px (P / 2), match.line_index_max_shift_px (1.5 P), "
-      "match.line_index_window_half_height_px (at least (P - 1) / 2), match.line_index_footprint_gap_px (P) and "
+      "match.line_index_window_half_height_px (at least (P - 1) / 2), match.line_index_footprint_gap_px (P, at most "
+      "16) "
+      "and "
       "match.grid_line_radius_px (P / 2 rounded up, + 1), P taken to the nearest pixel. The defaults are these rules "
       "at the "
       "default grid's 8 px, so on a rig like the default nothing changes. Use it when commissioning a rig with "
@@ -82,12 +84,14 @@ int RunTune(int argc, char** argv) {
     outputs.Claim(out_path, "the tuned options (--out)");
     CheckOptionsPath(out_path);
   }
-  RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
+  // Read once: --options may be a pipe, and --out keeps its keys.
+  const std::string options_text = options_path.empty() ? "" : ReadOptionsText(options_path);
+  RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ParseRuntimeOptions(options_text, options_path);
   const std::vector<cv::Mat> images = LoadCapture(capture_dir, rig);
   const Runtime runtime(rig, options);
 
   std::vector<double> periods;
-  std::string measured;  // "module 0 7.96 px (spread 0.04 px), module 1 ...", for the file's header
+  std::string measured;  // "module 0 8.07 px (spread 0.04 px, turned 2.53 deg), ...": the file's header
   for (const ModulePlan& plan : runtime.plans()) {
     const auto m = MeasureModule(runtime, plan, images);
     if (!m) {
@@ -101,15 +105,39 @@ int RunTune(int argc, char** argv) {
           "  warning: module %d's period varies by more than %.0f %% over its image: a curved or turned "
           "surface; measure on a flat plate facing the module\n",
           plan.module, 100 * kMaxRelativeSpread);
+    if (std::isnan(m->shift_per_row_px)) {
+      std::printf(
+          "  its turn against the rows was not read: check the line index's vernier by hand "
+          "(docs/reconstruct.md, \"Another projector\")\n");
+    } else {
+      const double offset_px = RowOffsetPerPeriodPx(*m);
+      std::printf(
+          "  the grid is turned %.2f deg against the rows: the line index's vernier reads %.2f px per period "
+          "(its thresholds need %.2f-%.2f)\n",
+          GridTurnDeg(*m), offset_px, kMinRowOffsetPerPeriodPx, kMaxRowOffsetPerPeriodPx);
+      if (offset_px < kMinRowOffsetPerPeriodPx || offset_px > kMaxRowOffsetPerPeriodPx)
+        std::printf(
+            "  warning: module %d's line index cannot tell a line from its neighbour reliably at this turn: "
+            "turn the projector about its axis so that P tan(turn) lies in %.2f-%.2f px, or set "
+            "match.line_index_* by hand (docs/reconstruct.md, \"Another projector\")\n",
+            plan.module, kMinRowOffsetPerPeriodPx, kMaxRowOffsetPerPeriodPx);
+    }
     periods.push_back(m->period_px);
-    char text[96];
-    std::snprintf(text, sizeof text, "module %d %.2f px (spread %.2f px)", plan.module, m->period_px, m->spread_px);
+    char text[128];
+    if (std::isnan(m->shift_per_row_px))
+      std::snprintf(text, sizeof text, "module %d %.2f px (spread %.2f px, turn not read)", plan.module, m->period_px,
+                    m->spread_px);
+    else
+      std::snprintf(text, sizeof text, "module %d %.2f px (spread %.2f px, turned %.2f deg)", plan.module, m->period_px,
+                    m->spread_px, GridTurnDeg(*m));
     measured += (measured.empty() ? "" : ", ") + std::string(text);
   }
   if (periods.empty())
     throw InputError(capture_dir,
-                     "no module's left image shows the laser grid's period: are the lasers on, and the plate inside "
-                     "the measurement volume? (a passive capture has no grid)");
+                     "no module's left image shows a laser grid's period (" + Number(kMinGridPeriodPx) + "-" +
+                         Number(kMaxGridPeriodPx) +
+                         " px along the rows): are the lasers on, and the plate inside the measurement volume? (a "
+                         "passive capture has no grid)");
   std::vector<double> sorted = periods;
   std::sort(sorted.begin(), sorted.end());
   const double period_px = 0.5 * (sorted[(sorted.size() - 1) / 2] + sorted[sorted.size() / 2]);
@@ -119,7 +147,17 @@ int RunTune(int argc, char** argv) {
         "serves them all, so it takes their median\n",
         100 * kMaxRelativeModuleDifference, sorted.front(), sorted.back());
 
+  if (!(period_px >= kMinGridPeriodPx && period_px <= kMaxGridPeriodPx))
+    throw InputError(capture_dir, "the grid's period, " + Number(period_px) +
+                                      " px (the modules' median), is outside the " + Number(kMinGridPeriodPx) + "-" +
+                                      Number(kMaxGridPeriodPx) + " px the runtime's keys can serve");
   const std::vector<GridPeriodKey> keys = SetGridPeriodKeys(period_px, &options.match);
+  try {  // a key of --options may not fit the new ones (grid_line_min_ridge_px and a smaller radius)
+    options.Check();
+  } catch (const InputError& e) {
+    throw InputError(options_path.empty() ? capture_dir : options_path,
+                     "with the keys tune sets, " + std::string(e.what()));
+  }
   std::printf("P = %.2f px, taken as %ld px:\n", period_px, std::lround(period_px));
   for (const GridPeriodKey& k : keys)
     std::printf("  match.%-34s %g%s\n", k.key.c_str(), k.value,
@@ -140,7 +178,7 @@ int RunTune(int argc, char** argv) {
                              rig_path + ".\nThe laser grid's period along the rectified rows: " + measured +
                              ".\nThe match keys tied to it were set from P = " + Number(period_px) +
                              " px (docs/reconstruct.md, \"Another projector\").";
-  const std::string text = TunedOptionsYaml(options_path, keys, header);
+  const std::string text = TunedOptionsYaml(options_text, keys, header);
   ParseRuntimeOptions(text, out_path).Check();  // what a later --options will read: the same keys, valid
   WriteFileAtomically(out_path, text);
   std::printf("wrote %s\n", out_path.c_str());

@@ -3,17 +3,21 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <fstream>
 #include <sstream>
 
 #include "calib/core/file_suffix.h"
 #include "calib/core/input_error.h"
+#include "calib/core/input_file.h"
 
 namespace stereorig {
 
-std::string TunedOptionsYaml(const std::string& base_path, const std::vector<GridPeriodKey>& keys,
+std::string TunedOptionsYaml(const std::string& base_text, const std::vector<GridPeriodKey>& keys,
                              const std::string& header) {
-  YAML::Node root = base_path.empty() ? YAML::Node(YAML::NodeType::Map) : YAML::LoadFile(base_path);
-  if (!root.IsMap()) root = YAML::Node(YAML::NodeType::Map);  // an empty file: every key at its default
+  // Parsed and checked before (ParseRuntimeOptions): valid YAML, a mapping
+  // or an empty document (every key at its default).
+  YAML::Node root = YAML::Load(base_text);
+  if (!root.IsMap()) root = YAML::Node(YAML::NodeType::Map);
   if (!root["match"].IsMap()) root["match"] = YAML::Node(YAML::NodeType::Map);
   YAML::Node match = root["match"];
   for (const GridPeriodKey& k : keys) {
@@ -34,6 +38,15 @@ std::string TunedOptionsYaml(const std::string& base_path, const std::vector<Gri
 void CheckOptionsPath(const std::string& path) {
   if (!EndsWithIgnoringCase(path, ".yaml") && !EndsWithIgnoringCase(path, ".yml"))
     throw InputError(path, "an options file must end in .yaml or .yml");
+}
+
+std::string ReadOptionsText(const std::string& path) {
+  RequireInputFile(path, /*pipe_too=*/true);
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw InputError(path, "cannot be read");
+  return text.str();
 }
 
 }  // namespace stereorig

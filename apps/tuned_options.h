@@ -11,12 +11,16 @@
 
 namespace stereorig {
 
-// base_path: the --options file (already read and checked), or empty. Its
-// keys and their order are kept, its comments are not (yaml-cpp does not
-// keep them). Each line of `header` becomes a "# " comment line. Whole
-// values are written as integers.
-std::string TunedOptionsYaml(const std::string& base_path, const std::vector<GridPeriodKey>& keys,
+// base_text: the --options file's text (already parsed and checked: it is
+// read once, so a pipe works), or empty. Its keys and their order are kept,
+// its comments are not (yaml-cpp does not keep them). Each line of `header`
+// becomes a "# " comment line. Whole values are written as integers.
+std::string TunedOptionsYaml(const std::string& base_text, const std::vector<GridPeriodKey>& keys,
                              const std::string& header);
+
+// The whole text of the --options file at `path` (a pipe too), read once.
+// Throws InputError naming it if it is missing, a folder, or unreadable.
+std::string ReadOptionsText(const std::string& path);
 
 // Throws InputError(path) unless it ends in .yaml or .yml (any case): an
 // options file, not a cloud or image typed in the wrong place.

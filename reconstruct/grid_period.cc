@@ -20,24 +20,48 @@ struct LagSums {
   explicit LagSums(int lags) : s(lags + 1, 0.0), n(lags + 1, 0.0) {}
 };
 
-// Adds the run [x0, x1) of `row` to the sums, as its central differences
-// g(x) = (row(x + 1) - row(x - 1)) / 2: the lines' edges, with what varies
-// slowly along the row (shading, albedo, and the near-horizontal family,
-// whose lines cross a row at a few degrees as bumps tens of px wide)
-// suppressed; their broad correlation would tilt the peaks at the period.
-// Lags up to half the run's length (beyond, a peak rests on too few pairs).
-void AddRun(const uint8_t* row, int x0, int x1, std::vector<double>* g, LagSums* sums) {
-  const int length = x1 - x0 - 2;  // the differences of the run's inner pixels
+// The run [x0, x1) of `row` as its central differences
+// g(x) = (row(x + 1) - row(x - 1)) / 2 over its inner pixels x0 + 1 ..
+// x1 - 2, mean removed: the lines' edges, with what varies slowly along the
+// row (shading, albedo, and the near-horizontal family, whose lines cross a
+// row at a few degrees as bumps tens of px wide) suppressed; their broad
+// correlation would tilt the peaks at the period.
+void Differences(const uint8_t* row, int x0, int x1, std::vector<double>* g) {
+  const int length = x1 - x0 - 2;
   g->resize(length);
   double mean = 0;
   for (int i = 0; i < length; ++i) mean += (*g)[i] = 0.5 * (double(row[x0 + i + 2]) - row[x0 + i]);
   mean /= length;
   for (double& v : *g) v -= mean;
+}
+
+// Adds the run [x0, x1) of `row` to the autocorrelation sums, as its
+// differences, at lags up to half its length (beyond, a peak rests on too
+// few pairs).
+void AddRun(const uint8_t* row, int x0, int x1, std::vector<double>* g, LagSums* sums) {
+  Differences(row, x0, x1, g);
+  const int length = int(g->size());
   const int lags = std::min<int>(length / 2, int(sums->s.size()) - 1);
   for (int k = 0; k <= lags; ++k) {
     double s = 0;
     for (int i = 0; i + k < length; ++i) s += (*g)[i] * (*g)[i + k];
     sums->s[k] += s, sums->n[k] += length - k;
+  }
+}
+
+// Adds the cross-correlation of rows `a` and `b` (rows apart) over the
+// columns [x0, x1) lit in both, at shifts -reach..reach of b against a,
+// to c (index shift + reach): where the near-vertical lines of row a are
+// found again in row b.
+void AddRowPair(const uint8_t* a, const uint8_t* b, int x0, int x1, int reach, std::vector<double>* ga,
+                std::vector<double>* gb, std::vector<double>* c) {
+  Differences(a, x0, x1, ga);
+  Differences(b, x0, x1, gb);
+  const int length = int(ga->size());
+  for (int s = -reach; s <= reach; ++s) {
+    double sum = 0;
+    for (int i = std::max(0, -s); i < length && i + s < length; ++i) sum += (*ga)[i] * (*gb)[i + s];
+    (*c)[s + reach] += sum;
   }
 }
 
@@ -110,47 +134,106 @@ double Quantile(const std::vector<double>& sorted, double q) {
   return sorted[i] + (at - i) * (sorted[i + 1] - sorted[i]);
 }
 
+// The lit runs of each row: lit pixels joined across gaps up to
+// max_period_px (the dark centres of a long period's cells), those at
+// least min_run_px long, as [begin, end) columns.
+std::vector<std::vector<std::pair<int, int>>> LitRuns(const cv::Mat& lit, const GridPeriodOptions& o) {
+  std::vector<std::vector<std::pair<int, int>>> runs(lit.rows);
+  for (int y = 0; y < lit.rows; ++y) {
+    const uint8_t* on = lit.ptr<uint8_t>(y);
+    for (int x = 0; x < lit.cols;) {
+      if (!on[x]) {
+        ++x;
+        continue;
+      }
+      int end = x + 1, gap = 0;
+      for (int xx = x + 1; xx < lit.cols && gap <= o.max_period_px; ++xx) {
+        if (on[xx])
+          end = xx + 1, gap = 0;
+        else
+          ++gap;
+      }
+      if (end - x >= o.min_run_px) runs[y].push_back({x, end});
+      x = end;
+    }
+  }
+  return runs;
+}
+
+// How far the near-vertical lines move along the row per row, px, in the
+// block of rows [y0, y1) whose period is period_px. The cross-correlation
+// of each row with the row r below (within the image), over the columns lit
+// in both, summed over the block, peaks at r times that shift, looked for
+// within half a period less a pixel (the peak one period over is the next
+// line). Its three-point position is biased by a share of a pixel that
+// depends on where the peak falls between two lags, so it is read at r = 4,
+// 8, .., 32 (the peaks fall at different fractions; the separations stop
+// where the shift fitted so far would put the peak past the reach) and the
+// shift fitted through the origin, sum(r x_r) / sum(r^2). NaN where the
+// first peak is missing.
+double BlockShiftPerRowPx(const cv::Mat& left, const std::vector<std::vector<std::pair<int, int>>>& runs, int y0,
+                          int y1, double period_px, const GridPeriodOptions& o) {
+  const int reach = std::max(1, int(period_px / 2));
+  std::vector<double> c, ga, gb;
+  double sum_rx = 0, sum_rr = 0;
+  for (int rows_apart = 4; rows_apart <= 32; rows_apart += 4) {
+    if (sum_rr > 0 && rows_apart * std::abs(sum_rx / sum_rr) > reach - 1) break;
+    c.assign(2 * reach + 1, 0.0);
+    bool any = false;
+    for (int y = y0; y < y1 && y + rows_apart < left.rows; ++y)
+      for (const auto& [a0, a1] : runs[y])
+        for (const auto& [b0, b1] : runs[y + rows_apart]) {
+          const int x0 = std::max(a0, b0), x1 = std::min(a1, b1);
+          if (x1 - x0 < o.min_run_px) continue;
+          AddRowPair(left.ptr<uint8_t>(y), left.ptr<uint8_t>(y + rows_apart), x0, x1, reach, &ga, &gb, &c);
+          any = true;
+        }
+    if (!any) break;
+    int best = 1;
+    for (int k = 1; k + 1 < int(c.size()); ++k)
+      if (c[k] > c[best]) best = k;
+    if (!(c[best] > 0) || !IsPeak(c, best)) break;
+    sum_rx += rows_apart * (PeakPosition(c, best) - reach), sum_rr += double(rows_apart) * rows_apart;
+  }
+  return sum_rr > 0 ? sum_rx / sum_rr : std::nan("");
+}
+
 }  // namespace
+
+double GridTurnDeg(const GridPeriodMeasurement& m) { return std::atan(std::abs(m.shift_per_row_px)) * 180 / M_PI; }
+
+double RowOffsetPerPeriodPx(const GridPeriodMeasurement& m) { return m.period_px * std::abs(m.shift_per_row_px); }
 
 std::optional<GridPeriodMeasurement> MeasureGridPeriodPx(const cv::Mat& left, const cv::Mat& lit,
                                                          const GridPeriodOptions& o) {
   STEREORIG_CHECK(left.type() == CV_8UC1 && lit.type() == CV_8UC1 && lit.size() == left.size());
-  STEREORIG_CHECK(o.block_rows >= 1 && o.min_run_px >= 8 && o.max_period_px >= 3);
+  STEREORIG_CHECK(o.block_rows >= 1 && o.min_run_px >= 8 && o.max_period_px >= 3 && o.min_blocks >= 1);
   const int lags = std::min(kMaxLagPx, std::max(o.max_period_px + 2, left.cols / 2));
+  const std::vector<std::vector<std::pair<int, int>>> runs = LitRuns(lit, o);
   GridPeriodMeasurement out;
-  std::vector<double> periods, g;
+  std::vector<double> periods, shifts, g;
   for (int y0 = 0; y0 < left.rows; y0 += o.block_rows) {
+    const int y1 = std::min(left.rows, y0 + o.block_rows);
     LagSums sums(lags);
-    for (int y = y0; y < std::min(left.rows, y0 + o.block_rows); ++y) {
-      const uint8_t* row = left.ptr<uint8_t>(y);
-      const uint8_t* on = lit.ptr<uint8_t>(y);
-      bool row_used = false;
-      for (int x = 0; x < left.cols;) {
-        if (!on[x]) {
-          ++x;
-          continue;
-        }
-        // A run: lit pixels joined across gaps up to max_period_px.
-        int end = x + 1, gap = 0;
-        for (int xx = x + 1; xx < left.cols && gap <= o.max_period_px; ++xx) {
-          if (on[xx])
-            end = xx + 1, gap = 0;
-          else
-            ++gap;
-        }
-        if (end - x >= o.min_run_px) AddRun(row, x, end, &g, &sums), row_used = true;
-        x = end;
-      }
-      out.rows += row_used;
+    for (int y = y0; y < y1; ++y) {
+      for (const auto& [x0, x1] : runs[y]) AddRun(left.ptr<uint8_t>(y), x0, x1, &g, &sums);
+      out.rows += !runs[y].empty();
     }
     const double period = BlockPeriodPx(Normalised(sums), o);
-    if (!std::isnan(period)) periods.push_back(period);
+    if (std::isnan(period)) continue;
+    periods.push_back(period);
+    const double shift = BlockShiftPerRowPx(left, runs, y0, y1, period, o);
+    if (!std::isnan(shift)) shifts.push_back(shift);
   }
   if (int(periods.size()) < o.min_blocks) return std::nullopt;
   std::sort(periods.begin(), periods.end());
   out.blocks = int(periods.size());
   out.period_px = Quantile(periods, 0.5);
   out.spread_px = 0.5 * (Quantile(periods, 0.75) - Quantile(periods, 0.25));
+  if (int(shifts.size()) >= o.min_blocks) {
+    std::sort(shifts.begin(), shifts.end());
+    out.shift_per_row_px = Quantile(shifts, 0.5);
+  }
   return out;
 }
 

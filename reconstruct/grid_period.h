@@ -22,6 +22,7 @@
 // facing enough to measure on.
 #pragma once
 
+#include <limits>
 #include <opencv2/core.hpp>
 #include <optional>
 
@@ -41,7 +42,22 @@ struct GridPeriodMeasurement {
   double spread_px = 0;  // half the interquartile range of the blocks' periods, px
   int blocks = 0;        // blocks that gave a period
   int rows = 0;          // rows with at least one lit run of min_run_px
+  // How far the near-vertical lines move along the row from one row to the
+  // next, px (the tangent of the grid's turn against the rows, its sign the
+  // direction): the median of the blocks' readings, each from the cross-
+  // correlations of rows 4, 8, .., 32 apart, their peaks fitted through the
+  // origin (grid_period.cc). NaN where fewer than min_blocks blocks read
+  // it.
+  double shift_per_row_px = std::numeric_limits<double>::quiet_NaN();
 };
+
+// The grid's turn against the rows, degrees (>= 0): atan |shift_per_row_px|.
+double GridTurnDeg(const GridPeriodMeasurement& m);
+// The row offset between neighbouring lines one period apart along a row,
+// P |tan(turn)|, px: what the line index's vernier reads
+// (line_index.h; it must stay well above its 0.15 px drop threshold and
+// below the 1 px the sub-pixel fit's row offset allows).
+double RowOffsetPerPeriodPx(const GridPeriodMeasurement& m);
 
 // left: CV_8UC1, the rectified left image (or a view of it). lit: CV_8UC1
 // of left's size, non-zero where the grid lights the pixel (lit_mask.h);

@@ -8,10 +8,9 @@
 // three-point fits, exact for Gaussian peaks; the differenced lines'
 // correlation is not quite Gaussian, which leaves up to 0.064 % (5.5 px at
 // 10 degrees, 0.0036 px; 31 px at 2.6 degrees, 0.0057 px) on the
-// noise-free images of these periods and angles, and the 2 DN sensor
-// noise and 15 % albedo texture the tests add move it by < 0.0006 px (the
-// same images rendered without them). The keys need P to the nearest
-// pixel.
+// noise-free images of these periods at 2.6 and 10 degrees (1 and 5 stay
+// within the tolerance too), and the 2 DN sensor noise and 15 % albedo texture the tests add move it by < 0.0006 px
+// (the same images rendered without them). The keys need P to the nearest pixel.
 #include "reconstruct/grid_period.h"
 
 #include <gtest/gtest.h>
@@ -42,19 +41,34 @@ SyntheticPairSpec Grid(double period_px, double angle_deg) {
 
 cv::Mat AllLit(const cv::Mat& image) { return cv::Mat(image.size(), CV_8UC1, cv::Scalar(255)); }
 
-TEST(GridPeriod, MeasuresTheAnalyticPeriodAlongTheRows) {
-  for (double angle : {2.6, 10.0})
-    for (double period : {5.5, 8.0, 9.3, 12.15, 20.0, 31.0}) {
+// The period, and the grid's turn against the rows against the angle the
+// renderer turns its lines by (both read from the same images). Turn
+// tolerance 0.1 deg: the three-point peak positions are biased by where
+// each peak falls between two lags; read at eight row separations and
+// fitted, what is left on these images is <= 0.08 deg (1 deg at 5.5 px,
+// where all eight peaks fall within 0.6 px of lag 0), and the row offset
+// per period the vernier's thresholds need (0.2-0.9 px) is then known to
+// ~4 % at the default 2.6 deg. A short period turned steeply (5.5 px at 10
+// deg: the lines move 1.4 px in 8 rows) is read from the 4-row separation
+// alone (8 rows would put its peak past half a period less a pixel) and
+// its turn is not tested.
+TEST(GridPeriod, MeasuresTheAnalyticPeriodAndTurn) {
+  for (double angle : {1.0, 2.6, 5.0, 10.0})
+    for (double period : {5.5, 8.0, 12.15, 31.0}) {
       const SyntheticPairSpec spec = Grid(period, angle);
       const SyntheticPair pair = RenderSyntheticPair(spec);
       const auto m = MeasureGridPeriodPx(pair.left, AllLit(pair.left));
       ASSERT_TRUE(m) << period << " px at " << angle << " deg";
-      EXPECT_NEAR(m->period_px, AlongRowPeriodPx(spec), kRelativeTolerance * AlongRowPeriodPx(spec))
-          << period << " px at " << angle << " deg";
-      EXPECT_LT(m->spread_px, kRelativeTolerance * AlongRowPeriodPx(spec))
-          << "a flat surface: every block reads the same period";
+      const double p = AlongRowPeriodPx(spec);
+      EXPECT_NEAR(m->period_px, p, kRelativeTolerance * p) << period << " px at " << angle << " deg";
+      EXPECT_LT(m->spread_px, kRelativeTolerance * p) << "a flat surface: every block reads the same period";
       EXPECT_EQ(m->blocks, 10);  // 160 rows in blocks of 16
       EXPECT_EQ(m->rows, 160);
+      if (angle == 10.0 && period == 5.5) continue;
+      EXPECT_NEAR(GridTurnDeg(*m), angle, 0.1) << period << " px at " << angle << " deg";
+      const double tan_angle = std::tan(angle * M_PI / 180);
+      EXPECT_NEAR(RowOffsetPerPeriodPx(*m), p * tan_angle, p * (std::tan((angle + 0.1) * M_PI / 180) - tan_angle))
+          << period << " px at " << angle << " deg";
     }
 }
 
@@ -118,7 +132,7 @@ TEST(GridPeriod, SpreadShowsTwoPeriods) {
 }
 
 TEST(GridPeriodKeys, TheDefaultGridsPeriodGivesTheDefaults) {
-  // 7.96 px: the simulator's default grid measured on its plate
+  // The simulator's default grid reads 8.07-8.46 px on its scenes
   // (docs/reconstruct.md); anything that rounds to 8 px.
   for (double period : {7.6, 7.96, 8.0, 8.4}) {
     MatchOptions o;

@@ -54,7 +54,8 @@ bool CheckPngIsWhole(const std::string& path) {
     if (at == std::streamoff(kSignature.size()) && chunk != "IHDR")
       throw InputError(path, "a damaged PNG (" + named + " should be IHDR)");
     if (std::streamoff(length) > size - at - 12)
-      throw InputError(path, "a PNG cut short (" + named + " runs past the end of the file: still being written?)");
+      throw InputError(
+          path, "a PNG cut short or damaged (" + named + " is longer than the rest of the file: still being written?)");
     chunk.resize(4 + size_t(length));
     char crc_bytes[4];
     if (!f.read(chunk.data() + 4, std::streamsize(length)) || !f.read(crc_bytes, 4))

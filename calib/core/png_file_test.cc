@@ -57,8 +57,10 @@ TEST(PngFile, AWholePngPassesAndOneCutShortIsNamed) {
   ExpectRefused(Write("cut.png", kWhole.substr(0, kWhole.size() - 7)), no_iend);
   ExpectRefused(Write("head_only.png", kSignature), no_iend);
   ExpectRefused(Write("cut_between_chunks.png", kWhole.substr(0, kWhole.size() - 12)), no_iend);
-  ExpectRefused(Write("cut_in_data.png", kWhole.substr(0, 500)),
-                "a PNG cut short (its IDAT chunk at byte 33 runs past the end of the file: still being written?)");
+  ExpectRefused(
+      Write("cut_in_data.png", kWhole.substr(0, 500)),
+      "a PNG cut short or damaged (its IDAT chunk at byte 33 is longer than the rest of the file: still being "
+      "written?)");
 }
 
 // A byte flipped anywhere fails a chunk's CRC: refused before libpng prints

@@ -13,12 +13,16 @@
 namespace stereorig::testing {
 
 // Runs `body` in a forked child, which ends it by raising a signal while
-// what it made lives (or _exit(3) if it could not make it). Returns the
+// what it made lives (or _exit(3) if it could not make it, or threw). Returns the
 // child's wait status: exit 4 if `body` returns.
 inline int StatusOfAChild(const std::function<void()>& body) {
   const pid_t child = fork();
   if (child == 0) {
-    body();
+    try {  // a throw must not unwind into gtest: the child would run the rest of the suite
+      body();
+    } catch (...) {
+      _exit(3);
+    }
     _exit(4);
   }
   int status = 0;
