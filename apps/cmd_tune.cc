@@ -117,9 +117,10 @@ int RunTune(int argc, char** argv) {
           GridTurnDeg(*m), offset_px, kMinRowOffsetPerPeriodPx, kMaxRowOffsetPerPeriodPx);
       if (offset_px < kMinRowOffsetPerPeriodPx || offset_px > kMaxRowOffsetPerPeriodPx)
         std::printf(
-            "  warning: module %d's line index cannot tell a line from its neighbour reliably at this turn: "
-            "turn the projector about its axis so that P tan(turn) lies in %.2f-%.2f px, or set "
-            "match.line_index_* by hand (docs/reconstruct.md, \"Another projector\")\n",
+            "  warning: at this turn module %d's line index cannot tell a line from its neighbour reliably (at "
+            "strong speckle a component a line off may be kept, or the right one dropped): turn the projector "
+            "about its axis so that P tan(turn) lies in %.2f-%.2f px (docs/reconstruct.md, \"Another "
+            "projector\")\n",
             plan.module, kMinRowOffsetPerPeriodPx, kMaxRowOffsetPerPeriodPx);
     }
     periods.push_back(m->period_px);
