@@ -12,6 +12,7 @@
 #include "apps/tuned_options.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
+#include "calib/core/number_text.h"
 #include "calib/core/rig_file.h"
 #include "reconstruct/grid_period.h"
 #include "reconstruct/grid_period_options.h"
@@ -19,12 +20,6 @@
 
 namespace stereorig {
 namespace {
-
-std::string Number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", v);
-  return text;
-}
 
 // A module's period varying by more than this share over its image (half
 // the blocks' interquartile range) says the surface was not a plane facing
@@ -135,8 +130,8 @@ int RunTune(int argc, char** argv) {
   }
   if (periods.empty())
     throw InputError(capture_dir,
-                     "no module's left image shows a laser grid's period (" + Number(kMinGridPeriodPx) + "-" +
-                         Number(kMaxGridPeriodPx) +
+                     "no module's left image shows a laser grid's period (" + NumberText(kMinGridPeriodPx) + "-" +
+                         NumberText(kMaxGridPeriodPx) +
                          " px along the rows): are the lasers on, and the plate inside the measurement volume? (a "
                          "passive capture has no grid)");
   std::vector<double> sorted = periods;
@@ -149,9 +144,9 @@ int RunTune(int argc, char** argv) {
         100 * kMaxRelativeModuleDifference, sorted.front(), sorted.back());
 
   if (!(period_px >= kMinGridPeriodPx && period_px <= kMaxGridPeriodPx))
-    throw InputError(capture_dir, "the grid's period, " + Number(period_px) +
-                                      " px (the modules' median), is outside the " + Number(kMinGridPeriodPx) + "-" +
-                                      Number(kMaxGridPeriodPx) + " px the runtime's keys can serve");
+    throw InputError(capture_dir, "the grid's period, " + NumberText(period_px) +
+                                      " px (the modules' median), is outside the " + NumberText(kMinGridPeriodPx) +
+                                      "-" + NumberText(kMaxGridPeriodPx) + " px the runtime's keys can serve");
   const std::vector<GridPeriodKey> keys = SetGridPeriodKeys(period_px, &options.match);
   try {  // a key of --options may not fit the new ones (grid_line_min_ridge_px and a smaller radius)
     options.Check();
@@ -162,7 +157,7 @@ int RunTune(int argc, char** argv) {
   std::printf("P = %.2f px, taken as %ld px:\n", period_px, std::lround(period_px));
   for (const GridPeriodKey& k : keys)
     std::printf("  match.%-34s %g%s\n", k.key.c_str(), k.value,
-                k.value == k.before ? "  (unchanged)" : ("  (was " + Number(k.before) + ")").c_str());
+                k.value == k.before ? "  (unchanged)" : ("  (was " + NumberText(k.before) + ")").c_str());
   const bool all_default =
       std::all_of(keys.begin(), keys.end(), [](const GridPeriodKey& k) { return k.value == k.before; });
   if (all_default)
@@ -177,7 +172,7 @@ int RunTune(int argc, char** argv) {
   }
   const std::string header = "Runtime options from `stereorig tune --capture " + capture_dir + "` with the rig " +
                              rig_path + ".\nThe laser grid's period along the rectified rows: " + measured +
-                             ".\nThe match keys tied to it were set from P = " + Number(period_px) +
+                             ".\nThe match keys tied to it were set from P = " + NumberText(period_px) +
                              " px (docs/reconstruct.md, \"Another projector\").";
   const std::string text = TunedOptionsYaml(options_text, keys, header);
   ParseRuntimeOptions(text, out_path).Check();  // what a later --options will read: the same keys, valid

@@ -8,16 +8,13 @@
 #include <Eigen/Geometry>  // cross()
 
 #include "calib/core/input_error.h"
+#include "calib/core/number_text.h"
 
 namespace stereorig {
 
 namespace {
 
-std::string Number(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4g", x);
-  return buf;
-}
+std::string Number(double x) { return NumberText(x, 4); }
 
 std::string Pixel(const Eigen::Vector2d& q) {
   char buf[64];

@@ -7,6 +7,7 @@
 #include "atomic_file.h"
 #include "input_error.h"
 #include "lens_plausibility.h"
+#include "number_text.h"
 #include "yaml_reader.h"
 
 namespace stereorig {
@@ -119,11 +120,7 @@ Rig ParseRig(YamlMap root) {
 
 }  // namespace
 
-std::string FormatDouble(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", x);
-  return buf;
-}
+std::string FormatDouble(double x) { return NumberText(x, 17); }
 
 std::string NowUtcIso8601() {
   const std::time_t t = std::time(nullptr);
