@@ -16,6 +16,7 @@
 #include "calib/core/rig_file.h"
 #include "reconstruct/grid_period.h"
 #include "reconstruct/grid_period_options.h"
+#include "reconstruct/lit_mask.h"
 #include "reconstruct/runtime.h"
 
 namespace stereorig {
@@ -29,18 +30,15 @@ constexpr double kMaxRelativeSpread = 0.05;
 // serves them all, so it takes their median, and says so.
 constexpr double kMaxRelativeModuleDifference = 0.05;
 
-// The rectified left image of each module and its grid-lit pixels (the
-// runtime's own: one pass of ProcessModule, whose lit mask covers the
-// volume's ROI), measured.
+// The rectified left image of each module and its grid-lit pixels within
+// the volume's ROI, as the runtime finds them (its rectification and lit
+// mask), measured.
 std::optional<GridPeriodMeasurement> MeasureModule(const Runtime& runtime, const ModulePlan& plan,
                                                    const std::vector<cv::Mat>& images) {
-  PointCloud cloud;
-  ModuleReport report;
-  std::pair<cv::Mat, cv::Mat> rectified;
-  runtime.ProcessModule(plan, images, false, &cloud, nullptr, &report, &rectified);
-  cv::Mat lit = cv::Mat::zeros(rectified.first.size(), CV_8UC1);
-  report.lit.copyTo(lit(plan.roi));
-  return MeasureGridPeriodPx(rectified.first, lit);
+  const cv::Mat left = runtime.Rectify(plan, images).first;
+  cv::Mat lit = cv::Mat::zeros(left.size(), CV_8UC1);
+  LitMask(left(plan.roi), runtime.options().lit_contrast_dn).copyTo(lit(plan.roi));
+  return MeasureGridPeriodPx(left, lit);
 }
 
 }  // namespace

@@ -169,29 +169,33 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
   }
 }
 
+std::pair<cv::Mat, cv::Mat> Runtime::Rectify(const ModulePlan& plan, const std::vector<cv::Mat>& images) const {
+  const StereoModule& mod = rig_.module(plan.module);
+  // The rows of the ROI (plus the matcher's window margins), full width:
+  // the right view needs columns left of the ROI.
+  const cv::Size size = plan.geometry.size;
+  const cv::Rect band(0, std::max(0, plan.roi.y - kWindowMarginPx), size.width,
+                      std::min(size.height, plan.roi.y + plan.roi.height + kWindowMarginPx) -
+                          std::max(0, plan.roi.y - kWindowMarginPx));
+  cv::Mat left = cv::Mat::zeros(size, CV_8UC1), right = cv::Mat::zeros(size, CV_8UC1);
+  cv::Mat l = left(band), r = right(band);
+  cv::remap(images[mod.left_camera], l, plan.maps.left_fixed(band), plan.maps.left_frac(band), cv::INTER_LINEAR,
+            cv::BORDER_CONSTANT, 0);
+  cv::remap(images[mod.right_camera], r, plan.maps.right_fixed(band), plan.maps.right_frac(band), cv::INTER_LINEAR,
+            cv::BORDER_CONSTANT, 0);
+  return {left, right};
+}
+
 void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& images, bool build_mesh,
                             PointCloud* cloud, Mesh* mesh, ModuleReport* report,
                             std::pair<cv::Mat, cv::Mat>* rectified) const {
-  const StereoModule& mod = rig_.module(plan.module);
   report->module = plan.module;
   auto t = Clock::now();
-  // Rectify the rows of the ROI (plus the matcher's window margins), full
-  // width: the right view needs columns left of the ROI.
-  const cv::Size size = plan.geometry.size;
-  const int margin = 8;
-  const cv::Rect band(0, std::max(0, plan.roi.y - margin), size.width,
-                      std::min(size.height, plan.roi.y + plan.roi.height + margin) - std::max(0, plan.roi.y - margin));
-  cv::Mat left = cv::Mat::zeros(size, CV_8UC1), right = cv::Mat::zeros(size, CV_8UC1);
-  {
-    cv::Mat l = left(band), r = right(band);
-    cv::remap(images[mod.left_camera], l, plan.maps.left_fixed(band), plan.maps.left_frac(band), cv::INTER_LINEAR,
-              cv::BORDER_CONSTANT, 0);
-    cv::remap(images[mod.right_camera], r, plan.maps.right_fixed(band), plan.maps.right_frac(band), cv::INTER_LINEAR,
-              cv::BORDER_CONSTANT, 0);
-  }
+  const auto [left, right] = Rectify(plan, images);
   if (rectified) *rectified = {left, right};  // shared, not copied
   report->times_ms["rectify"] = MsSince(t);
-
+  const cv::Size size = plan.geometry.size;
+  const int margin = kWindowMarginPx;
   t = Clock::now();
   const cv::Mat lit = LitMask(left(plan.roi), options_.lit_contrast_dn);
   cv::Rect match_roi = plan.roi;

@@ -30,6 +30,10 @@
 
 namespace stereorig {
 
+// The rows rectified above and below a module's ROI, and the margin added
+// around the lit region it crops to: the matcher's windows reach this far.
+inline constexpr int kWindowMarginPx = 8;
+
 // What the runtime precomputes for one module.
 struct ModulePlan {
   int module = 0;
@@ -102,6 +106,12 @@ class Runtime {
   // Runs on the runtime's worker pool: at most match.num_threads threads
   // per module, times the modules if parallel_modules (parallel_for.h).
   Reconstruction Process(const std::vector<cv::Mat>& images, bool build_mesh) const;
+
+  // A module's rectified pair (left, right; CV_8UC1, the rectified size):
+  // the rows of its ROI and kWindowMarginPx above and below, full width,
+  // the rest 0. ProcessModule's first step; `stereorig tune` measures the
+  // grid in the left one.
+  std::pair<cv::Mat, cv::Mat> Rectify(const ModulePlan& plan, const std::vector<cv::Mat>& images) const;
 
   // The per-module work of Process(), exposed for tests: the module's cloud
   // (reference frame) and its organised mesh (if build_mesh); and, if
