@@ -12,6 +12,7 @@
 #include "apps/tuned_options.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
+#include "calib/core/input_file.h"
 #include "calib/core/number_text.h"
 #include "calib/core/rig_file.h"
 #include "reconstruct/grid_period.h"
@@ -78,7 +79,7 @@ int RunTune(int argc, char** argv) {
     CheckOptionsPath(out_path);
   }
   // Read once: --options may be a pipe, and --out keeps its keys.
-  const std::string options_text = options_path.empty() ? "" : ReadOptionsText(options_path);
+  const std::string options_text = options_path.empty() ? "" : ReadInputText(options_path);
   RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ParseRuntimeOptions(options_text, options_path);
   const std::vector<cv::Mat> images = LoadCapture(capture_dir, rig);
   const Runtime runtime(rig, options);

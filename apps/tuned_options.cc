@@ -3,12 +3,10 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
-#include <fstream>
 #include <sstream>
 
 #include "calib/core/file_suffix.h"
 #include "calib/core/input_error.h"
-#include "calib/core/input_file.h"
 
 namespace stereorig {
 
@@ -38,15 +36,6 @@ std::string TunedOptionsYaml(const std::string& base_text, const std::vector<Gri
 void CheckOptionsPath(const std::string& path) {
   if (!EndsWithIgnoringCase(path, ".yaml") && !EndsWithIgnoringCase(path, ".yml"))
     throw InputError(path, "an options file must end in .yaml or .yml");
-}
-
-std::string ReadOptionsText(const std::string& path) {
-  RequireInputFile(path, /*pipe_too=*/true);
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw InputError(path, "cannot be read");
-  return text.str();
 }
 
 }  // namespace stereorig

@@ -18,10 +18,6 @@ namespace stereorig {
 std::string TunedOptionsYaml(const std::string& base_text, const std::vector<GridPeriodKey>& keys,
                              const std::string& header);
 
-// The whole text of the --options file at `path` (a pipe too), read once.
-// Throws InputError naming it if it is missing, a folder, or unreadable.
-std::string ReadOptionsText(const std::string& path);
-
 // Throws InputError(path) unless it ends in .yaml or .yml (any case): an
 // options file, not a cloud or image typed in the wrong place.
 void CheckOptionsPath(const std::string& path);

@@ -2,12 +2,12 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
-#include <fstream>
 #include <set>
 #include <sstream>
 
 #include "calib/core/camera.h"
 #include "calib/core/input_error.h"
+#include "calib/core/input_file.h"
 #include "calib/core/lens_plausibility.h"
 #include "calib/core/rig_file.h"
 #include "calib/core/yaml_reader.h"
@@ -259,13 +259,7 @@ SimSpec ParseSimSpecYaml(const std::string& text, const std::string& where) {
   return s;
 }
 
-SimSpec ReadSimSpecFile(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) throw InputError(path, "cannot open the spec file");
-  std::ostringstream text;
-  text << f.rdbuf();
-  return ParseSimSpecYaml(text.str(), path);
-}
+SimSpec ReadSimSpecFile(const std::string& path) { return ParseSimSpecYaml(ReadInputText(path), path); }
 
 std::string SimSpecToYaml(const SimSpec& s) {
   std::ostringstream o;

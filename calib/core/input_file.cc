@@ -1,6 +1,8 @@
 #include "calib/core/input_file.h"
 
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "calib/core/input_error.h"
 
@@ -15,6 +17,15 @@ void RequireInputFile(const std::string& path, bool pipe_too) {
   if (fs::is_directory(status)) throw InputError(path, "is a folder, not a file");
   if (pipe_too && fs::is_fifo(status)) return;
   if (!fs::is_regular_file(status)) throw InputError(path, "is not a regular file");
+}
+
+std::string ReadInputText(const std::string& path) {
+  RequireInputFile(path, /*pipe_too=*/true);
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in || in.bad()) throw InputError(path, "cannot be read");
+  return text.str();
 }
 
 }  // namespace stereorig

@@ -14,4 +14,9 @@ namespace stereorig {
 // /dev/stdin); images, which are read by seeking, are not.
 void RequireInputFile(const std::string& path, bool pipe_too = false);
 
+// The whole text of a file (or pipe) read once from start to end, after
+// RequireInputFile(path, /*pipe_too=*/true). Throws InputError naming it if
+// it cannot be read.
+std::string ReadInputText(const std::string& path);
+
 }  // namespace stereorig
