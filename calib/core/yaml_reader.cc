@@ -9,13 +9,25 @@
 
 namespace stereorig {
 
+namespace {
+
+// yaml-cpp's parse error, named by `where` and the line it points to (a
+// file read whole or a string: the same line numbers).
+InputError SyntaxError(const std::string& where, const YAML::Exception& e) {
+  std::string line;
+  if (!e.mark.is_null()) line = " (line " + std::to_string(e.mark.line + 1) + ")";
+  return InputError(where, "not valid YAML: " + e.msg + line);
+}
+
+}  // namespace
+
 YamlMap YamlMap::LoadFile(const std::string& path) {
   RequireInputFile(path, /*pipe_too=*/true);  // read once, start to end
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);
   } catch (const YAML::Exception& e) {
-    throw InputError(path, "not valid YAML: " + e.msg + " (line " + std::to_string(e.mark.line + 1) + ")");
+    throw SyntaxError(path, e);
   }
   return FromDocument(root, path);
 }
@@ -25,7 +37,7 @@ YamlMap YamlMap::LoadString(const std::string& text, const std::string& where) {
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw InputError(where, "not valid YAML: " + e.msg);
+    throw SyntaxError(where, e);
   }
   return FromDocument(root, where);
 }
