@@ -47,15 +47,14 @@ std::optional<GridPeriodMeasurement> MeasureModule(const Runtime& runtime, const
 int RunTune(int argc, char** argv) {
   CLI::App app{
       "Measures the laser grid's period P in a capture (the distance between neighbouring near-vertical lines "
-      "along the rows of each module's rectified left image) and sets the runtime options tied to it: "
-      "match.grid_half_period_px (P / 2), match.line_index_max_shift_px (1.5 P), "
-      "match.line_index_window_half_height_px (at least (P - 1) / 2), match.line_index_footprint_gap_px (P, at most "
-      "16) "
-      "and "
-      "match.grid_line_radius_px (P / 2 rounded up, + 1), P taken to the nearest pixel. The defaults are these rules "
-      "at the "
+      "along the rows of each module's rectified left image) and sets the runtime options tied to it, P taken to "
+      "the nearest pixel: match.grid_half_period_px (P / 2, at most 4: the distinctness test's shift; longer, its "
+      "probes pass mismatches at rims), match.line_index_max_shift_px (1.5 P), "
+      "match.line_index_window_half_height_px (at least (P - 1) / 2), match.line_index_footprint_gap_px (P, at "
+      "most 16) and match.grid_line_radius_px (P / 2 rounded up, + 1). The defaults are these rules at the "
       "default grid's 8 px, so on a rig like the default nothing changes. Use it when commissioning a rig with "
-      "another projector, lens or working distance (docs/reconstruct.md, 'Another projector').\n"
+      "another projector, lens or working distance (docs/reconstruct.md, 'Another projector'). A P within 0.1 px "
+      "of a half pixel is warned of: another capture may round it the other way.\n"
       "Capture a flat matte plate facing the modules, lasers on, filling the measurement volume's middle: on a "
       "curved or turned surface the period is stretched by the foreshortening, and the spread printed per "
       "module says so. The other keys of --options are kept; --out writes them with the new ones (YAML comments "
@@ -154,6 +153,11 @@ int RunTune(int argc, char** argv) {
                      "with the keys tune sets, " + std::string(e.what()));
   }
   std::printf("P = %.2f px, taken as %ld px:\n", period_px, std::lround(period_px));
+  if (const int other_px = OtherRoundedPeriodPx(period_px))
+    std::printf(
+        "  warning: P lies within %.1f px of the half pixel, so another capture of this rig may read it as %d px "
+        "and set other keys: measure the plate in a second position, and keep the set that verifies better\n",
+        kRoundingMarginPx, other_px);
   for (const GridPeriodKey& k : keys)
     std::printf("  match.%-34s %g%s\n", k.key.c_str(), k.value,
                 k.value == k.before ? "  (unchanged)" : ("  (was " + NumberText(k.before) + ")").c_str());

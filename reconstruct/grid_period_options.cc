@@ -23,7 +23,7 @@ std::vector<GridPeriodKey> SetGridPeriodKeys(double period_px, MatchOptions* o) 
     keys.push_back({key, value, double(*field)});
     *field = static_cast<std::remove_reference_t<decltype(*field)>>(value);
   };
-  set("grid_half_period_px", &o->grid_half_period_px, 0.5 * p);
+  set("grid_half_period_px", &o->grid_half_period_px, std::min(0.5 * p, kMaxGridHalfPeriodPx));
   set("line_index_max_shift_px", &o->line_index.max_shift_px, std::lround(1.5 * p));
   // ceil((p - 1) / 2) = floor(p / 2) for a whole p.
   set("line_index_window_half_height_px", &o->line_index.window_half_height_px,
@@ -31,6 +31,13 @@ std::vector<GridPeriodKey> SetGridPeriodKeys(double period_px, MatchOptions* o) 
   set("line_index_footprint_gap_px", &o->line_index.footprint_gap_px, std::min(16, p));
   set("grid_line_radius_px", &o->grid_line.radius_px, (p + 1) / 2 + 1);  // ceil(p / 2) + 1
   return keys;
+}
+
+int OtherRoundedPeriodPx(double period_px) {
+  const double below = std::floor(period_px);
+  if (std::abs(period_px - (below + 0.5)) >= kRoundingMarginPx) return 0;
+  const long nearest = std::lround(period_px);
+  return int(nearest == long(below) ? below + 1 : below);
 }
 
 }  // namespace stereorig

@@ -37,6 +37,22 @@ inline constexpr double kMaxGridPeriodPx = 42;
 inline constexpr double kMinRowOffsetPerPeriodPx = 0.2;
 inline constexpr double kMaxRowOffsetPerPeriodPx = 0.9;
 
+// grid_half_period_px is P / 2 up to this, px, and this above it. It is the
+// distinctness test's shift (disparity_state.h): a match must correlate
+// better than its window moved this far either side. Past the lines' own
+// width (~2.6 px at half height on the default rig) a longer shift does not
+// decorrelate a true match any better; it only takes the probes further
+// off, and at a rim onto the background, so that a mismatch there passes.
+// Measured (docs/reconstruct-log.md, session 32) on a 34-line grating, P =
+// 12.7-13.0 px, six datasets (lines of sigma 1 and 2 mrad, three seeds
+// each), tune's keys with P / 2 = 6.5 px against the same with 4 px: the
+// ball bar's std rose on 11 of the 12 modules (0.11-0.21 mm, against
+// 0.08-0.13 mm), for more fill on the cup (+1-5 points); with 4 px it stayed
+// within 0.02 mm of the defaults' on 11 of the 12 (the 12th took a patch a
+// line off, the line index's). So coarser grids keep the default grid's
+// half period.
+inline constexpr double kMaxGridHalfPeriodPx = 4;
+
 struct GridPeriodKey {
   std::string key;  // as the options file names it: match.<key>
   double value = 0;
@@ -46,8 +62,9 @@ struct GridPeriodKey {
 // Sets the keys tied to the period in *o and returns them, each with its
 // value before. Throws InputError("period") if period_px is outside
 // [kMinGridPeriodPx, kMaxGridPeriodPx].
-//  - grid_half_period_px = P / 2 (the distinctness shift, the grid-line
-//    test's ridge reach, the right view's edge zone);
+//  - grid_half_period_px = P / 2, at most kMaxGridHalfPeriodPx (the
+//    distinctness shift, the grid-line test's ridge reach, the right
+//    view's edge zone);
 //  - line_index_max_shift_px = 1.5 P (the next alignment, stretched by a
 //    surface turned away, stays within the shifts tried);
 //  - line_index_window_half_height_px = at least (P - 1) / 2, never below
@@ -57,5 +74,18 @@ struct GridPeriodKey {
 //  - grid_line_radius_px = ceil(P / 2) + 1 (inside the grid's envelope
 //    every pixel is within half a period of a line).
 std::vector<GridPeriodKey> SetGridPeriodKeys(double period_px, MatchOptions* o);
+
+// How near a measured period may lie to a half pixel, px, before another
+// capture of the same rig may round it the other way: the period read on
+// one rig varies by a few per cent with the surface's depth and turn (the
+// default grid: 8.07 px on the plate, 8.46 on the tuber; a 34-line grating
+// 12.46 on the cup, 12.74 on the plate), ~0.1 px between plate positions.
+inline constexpr double kRoundingMarginPx = 0.1;
+
+// The whole-pixel period on the other side of the half pixel period_px
+// lies within kRoundingMarginPx of (e.g. 12 for 12.55, 13 for 12.45), or 0
+// if it lies further from one: the keys SetGridPeriodKeys sets may then
+// differ between two captures of one rig.
+int OtherRoundedPeriodPx(double period_px);
 
 }  // namespace stereorig

@@ -16,6 +16,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "calib/core/input_error.h"
 #include "reconstruct/grid_period_options.h"
@@ -147,7 +149,7 @@ TEST(GridPeriodKeys, TheDefaultGridsPeriodGivesTheDefaults) {
 TEST(GridPeriodKeys, ALongerPeriodScalesTheKeysByTheDocumentedRules) {
   MatchOptions o;
   const std::vector<GridPeriodKey> keys = SetGridPeriodKeys(12.15, &o);  // 12 px
-  EXPECT_EQ(o.grid_half_period_px, 6.0);                                 // P / 2
+  EXPECT_EQ(o.grid_half_period_px, kMaxGridHalfPeriodPx);                // P / 2, at most 4 px
   EXPECT_EQ(o.line_index.max_shift_px, 18);                              // 1.5 P
   EXPECT_EQ(o.line_index.window_half_height_px, 6);                      // ceil((P - 1) / 2)
   EXPECT_EQ(o.line_index.footprint_gap_px, 12);                          // P
@@ -163,6 +165,28 @@ TEST(GridPeriodKeys, ALongerPeriodScalesTheKeysByTheDocumentedRules) {
   SetGridPeriodKeys(kMinGridPeriodPx, &shortest);
   EXPECT_NO_THROW(shortest.Check());
   EXPECT_EQ(shortest.line_index.window_half_height_px, 4) << "never below the default";
+  EXPECT_EQ(shortest.grid_half_period_px, 1.5) << "P / 2 below the cap";
+}
+
+// The distinctness shift is P / 2 up to the default grid's 4 px and 4 px
+// above: never longer than the defaults' (grid_period_options.h).
+TEST(GridPeriodKeys, TheHalfPeriodKeyStopsAtTheDefaultGrids) {
+  EXPECT_EQ(kMaxGridHalfPeriodPx, MatchOptions{}.grid_half_period_px);
+  for (const auto& [period_px, half_px] : std::vector<std::pair<double, double>>{
+           {5.8, 3.0}, {7.0, 3.5}, {8.2, 4.0}, {9.0, 4.0}, {12.7, 4.0}, {30.0, 4.0}}) {
+    MatchOptions o;
+    SetGridPeriodKeys(period_px, &o);
+    EXPECT_EQ(o.grid_half_period_px, half_px) << period_px << " px";
+  }
+}
+
+TEST(GridPeriodKeys, APeriodNearAHalfPixelNamesTheOtherRounding) {
+  EXPECT_EQ(OtherRoundedPeriodPx(12.46), 13);  // rounds to 12
+  EXPECT_EQ(OtherRoundedPeriodPx(12.55), 12);  // rounds to 13
+  EXPECT_EQ(OtherRoundedPeriodPx(12.74), 0);
+  EXPECT_EQ(OtherRoundedPeriodPx(12.39), 0);
+  EXPECT_EQ(OtherRoundedPeriodPx(8.07), 0);
+  EXPECT_EQ(OtherRoundedPeriodPx(7.5), 7) << "lround takes 7.5 to 8";
 }
 
 TEST(GridPeriodKeys, RefusesAPeriodTheKeysCannotServe) {

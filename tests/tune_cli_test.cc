@@ -19,6 +19,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 
 #include <cmath>
@@ -28,6 +29,7 @@
 #include <thread>
 
 #include "datasets/simulate.h"
+#include "reconstruct/grid_period_options.h"
 #include "reconstruct/runtime_options.h"
 #include "tests/cli_runner.h"
 
@@ -40,8 +42,10 @@ constexpr double kRatioTolerance = 0.01;
 
 class TuneCli : public ::testing::Test {
  protected:
-  // The plate alone at seed 1, with the default grating (51 lines) and a
-  // coarser one (34): folders fine/ and coarse/.
+  // The plate alone at seed 1, with the default grating (51 lines) and
+  // coarser ones (34; 41, whose period, 8.4 px x 50 / 40 = 10.5, lies on a
+  // half pixel), and the default turned: folders fine/, coarse/, half/,
+  // turned/ and square/.
   static void SetUpTestSuite() {
     dir_ = ::testing::TempDir() + "/tune_cli";
     fs::remove_all(dir_);
@@ -51,7 +55,7 @@ class TuneCli : public ::testing::Test {
       double turn_deg;  // about the projector's axis
     };
     for (const Grating& g : {Grating{"fine", 51, 2.6}, Grating{"coarse", 34, 2.6}, Grating{"turned", 51, 4.6},
-                             Grating{"square", 51, 0.6}}) {
+                             Grating{"square", 51, 0.6}, Grating{"half", 41, 2.6}}) {
       SimSpec spec = DefaultSimSpec();
       spec.scenes.names = {"plate"};
       for (ModuleSpec& m : spec.modules) m.projector.lines = g.lines, m.projector.rotation_deg = g.turn_deg;
@@ -170,7 +174,7 @@ TEST_F(TuneCli, ACoarserGridSetsTheKeysByTheRulesAndKeepsTheOthers) {
   const RuntimeOptions read = ReadRuntimeOptions(out);
   EXPECT_EQ(read.object_size_mm, 80);
   EXPECT_EQ(read.match.min_zncc, 0.85);
-  EXPECT_EQ(read.match.grid_half_period_px, p / 2.0);
+  EXPECT_EQ(read.match.grid_half_period_px, std::min(p / 2.0, kMaxGridHalfPeriodPx));
   EXPECT_EQ(read.match.line_index.max_shift_px, std::lround(1.5 * p));
   EXPECT_EQ(read.match.line_index.window_half_height_px, std::ceil((p - 1) / 2.0));
   EXPECT_EQ(read.match.line_index.footprint_gap_px, p);
@@ -204,7 +208,30 @@ TEST_F(TuneCli, OptionsFromAPipeKeepTheirKeys) {
   ASSERT_EQ(r.code, 0) << r.err;
   const RuntimeOptions read = ReadRuntimeOptions(out);
   EXPECT_EQ(read.object_size_mm, 80);
-  EXPECT_NE(read.match.grid_half_period_px, MatchOptions{}.grid_half_period_px) << "the tuned keys are there too";
+  EXPECT_NE(read.match.line_index.max_shift_px, MatchOptions{}.line_index.max_shift_px)
+      << "the tuned keys are there too";
+}
+
+// A period on a half pixel may round the other way on the next capture:
+// tune says so, and names the other whole period. The 51-line plate reads
+// 8.41 and 8.45 px (modules 0 and 1), so 41 lines 10.51-10.56 px (x 50 / 40;
+// the measured ratios are within 0.1 %, ThePeriodsRatioIsTheGratingsRatio).
+// The check allows 0.08 px about 10.5: a period it passes is still inside
+// the warning's 0.1 px margin by 0.02.
+TEST_F(TuneCli, APeriodOnAHalfPixelIsWarnedOf) {
+  const testing::Result half = testing::RunCli(Tune("half"));
+  ASSERT_EQ(half.code, 0) << half.err;
+  const double p = P(half.out);
+  EXPECT_NEAR(p, 10.5, 0.1 - 0.02) << half.out;
+  const std::string other = std::to_string(std::lround(p) == 10 ? 11 : 10);
+  EXPECT_NE(half.out.find("warning: P lies within 0.1 px of the half pixel, so another capture of this rig may "
+                          "read it as " +
+                          other + " px"),
+            std::string::npos)
+      << half.out;
+  const testing::Result coarse = testing::RunCli(Tune("coarse"));  // 12.74 / 12.80 px
+  ASSERT_EQ(coarse.code, 0) << coarse.err;
+  EXPECT_EQ(coarse.out.find("half pixel"), std::string::npos) << coarse.out;
 }
 
 TEST_F(TuneCli, APassiveCaptureHasNoPeriodExitsTwoAndWritesNothing) {
