@@ -169,6 +169,34 @@ TEST(BenchCli, BenchAndScoreWarnOnStderrWhenTheMeasurementVolumeMissesAScenesTru
   std::filesystem::remove_all(dataset);
 }
 
+// A damaged truth map is bad input named in one line, by bench and score
+// alike: they read the simulator's truth maps through the checked reader
+// (reconstruct/image_file.h) as every image input. A lit map cut short used
+// to reach imread, which let libpng print "libpng error: Read Error" before
+// the error; a folder where a depth map belongs read as "cannot read it".
+TEST(BenchCli, BenchAndScoreNameADamagedTruthMapInOneLine) {
+  namespace fs = std::filesystem;
+  const std::string dataset = testing::SimulateOneScene("sphere", 1, "bench_truth_map");
+  const std::string truth = dataset + "/truth/scenes/sphere/";
+  auto expect_named = [&](const std::string& says) {
+    for (const std::string command : {"bench --runs 1", "score --no-passive"}) {
+      const testing::Result r = RunCli(command + " --dataset " + dataset + " --scenes sphere");
+      EXPECT_EQ(r.code, 2) << command << ": " << r.err;
+      EXPECT_EQ(testing::Lines(r.err), 1) << command << ": " << r.err;
+      EXPECT_NE(r.err.find(says), std::string::npos) << command << ": " << r.err;
+    }
+  };
+  const std::string lit = truth + "lit_cam1.png", whole = dataset + "/lit_cam1_whole.png";
+  fs::copy_file(lit, whole);
+  fs::resize_file(lit, fs::file_size(lit) / 2);
+  expect_named(lit + ": a PNG cut short or damaged (its IDAT chunk at byte 33 is longer than the rest of the file");
+  fs::rename(whole, lit);
+  fs::remove(truth + "depth_cam2.tiff");
+  fs::create_directory(truth + "depth_cam2.tiff");
+  expect_named(truth + "depth_cam2.tiff: is a folder, not a file");
+  fs::remove_all(dataset);
+}
+
 // --scenes picks scenes of a --dataset; without one (the built-in sphere)
 // it would be ignored: refused instead.
 TEST(BenchCli, ScenesWithoutADatasetIsRefused) {
