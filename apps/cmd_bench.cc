@@ -20,6 +20,7 @@
 #include "apps/command.h"
 #include "apps/output_paths.h"
 #include "apps/reconstruct_json.h"
+#include "apps/volume_warning.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
@@ -308,13 +309,9 @@ int RunBench(int argc, char** argv) {
       if (fs::exists(truth)) s.truth = ReadPlyPoints(truth.string());
       if (fs::exists(fs::path(dataset) / "truth" / "scenes" / s.name / "lit_cam0.png"))
         s.truth_maps = ReadSceneTruth(dataset, s.name);
-      // As score says it: a volume that misses the scene benches empty clouds.
-      const double inside = ShareInsideBox(s.truth, pipelines[0].runtime->volume_center_mm(), options.volume_size_mm);
-      if (!s.truth.empty() && inside < 0.5)
-        std::printf(
-            "bench: the measurement volume holds %.0f%% of %s's truth surface: both pipelines will find "
-            "little or nothing; set working_distance_mm (or volume_center_mm) in --options\n",
-            100 * inside, s.name.c_str());
+      // A volume that misses the scene benches empty clouds: said as score says it.
+      WarnIfVolumeMissesTruth("bench", s.name, s.truth, pipelines[0].runtime->volume_center_mm(),
+                              options.volume_size_mm);
     }
   }
   const double loaded_mb = ResidentMemoryMb();  // + truth surfaces and maps, before the baselines' runtimes

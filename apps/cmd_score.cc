@@ -16,6 +16,7 @@
 #include "apps/module_summary.h"
 #include "apps/output_paths.h"
 #include "apps/reconstruct_json.h"
+#include "apps/volume_warning.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
@@ -140,7 +141,8 @@ int RunScore(int argc, char** argv) {
     // The truth frame is the truth rig's module 0, the volume the rig
     // file's: close enough (a calibrated rig differs by a fraction of a
     // mm) to tell a volume that misses the scene.
-    const double truth_in_volume = ShareInsideBox(truth.surface_mm, runtime.volume_center_mm(), options.volume_size_mm);
+    const double truth_in_volume =
+        WarnIfVolumeMissesTruth("score", name, truth.surface_mm, runtime.volume_center_mm(), options.volume_size_mm);
     // Hole filling runs with the mesh: only when the options ask for it.
     const bool fill = options.shape_model != ShapeModel::kNone;
     const std::vector<cv::Mat> images = LoadCapture((scene_dir / "active").string(), rig);
@@ -184,14 +186,6 @@ int RunScore(int argc, char** argv) {
     }
     std::printf("; aligned by %.4f deg, %.4f mm\n", s.accuracy.truth_from_cloud.AngleDeg(),
                 s.accuracy.truth_from_cloud.translation_mm().norm());
-    if (truth_in_volume < 0.5 && !truth.surface_mm.empty()) {
-      Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-      for (const Eigen::Vector3d& p : truth.surface_mm) centroid += p / double(truth.surface_mm.size());
-      std::printf(
-          "  the measurement volume holds %.0f%% of this scene's truth surface: its centre is %.0f mm from "
-          "module 0, the scene's %.0f mm; set working_distance_mm (or volume_center_mm) in --options\n",
-          100 * truth_in_volume, runtime.volume_center_mm().norm(), centroid.norm());
-    }
     for (size_t m = 0; m < s.fill.size(); ++m) {
       std::printf("  m%zu lost: %s\n", m, LossLine(s.fill[m].target_status, s.fill[m].target_px).c_str());
       if (rec.modules[m].seen_through > 0)

@@ -237,7 +237,10 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
       MakeProjectors(spec, sr.world_from_projector, sr.projector_distance_mm);
 
   // --- the output folder: a sibling temporary, renamed at the end
-  fs::path out = fs::absolute(fs::path(options.out_dir)).lexically_normal();
+  // The work is done on `out`, absolute and normalised; messages name the
+  // folder as the user typed it (they used to name `out`).
+  const std::string& typed = options.out_dir;
+  fs::path out = fs::absolute(fs::path(typed)).lexically_normal();
   // "ds/" (or ".") normalises to a path ending in a separator, whose parent
   // is the folder itself: renaming it into place would then fail.
   if (!out.has_filename()) out = out.parent_path();
@@ -247,17 +250,21 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
   // name too long used to surface as a raw std::filesystem error, or as a
   // rename failing after all the rendering.
   std::vector<fs::path> missing;
-  CheckNamesFit(out.string(), "create this folder for the dataset (--out)",
-                DeepestExistingPart(NormalPath(out), &missing), missing);
+  CheckNamesFit(typed, "create this folder for the dataset (--out)", DeepestExistingPart(NormalPath(out), &missing),
+                missing);
   // Made now, and removed again while empty if the run fails after this (a
   // folder that cannot be made, part way too): no new empty folder left.
-  FolderToCreate parent_folder(parent.string(), "the dataset's folder (--out)");
-  parent_folder.Create();
+  FolderToCreate parent_folder(parent.string(), "the dataset (--out)");
+  try {
+    parent_folder.Create();
+  } catch (const InputError& e) {  // named by the folder above it: named as typed
+    throw InputError(typed, e.problem());
+  }
   std::error_code ec;
   if (fs::exists(out)) {
-    if (!fs::is_directory(out)) throw InputError(out.string(), "exists and is not a folder");
+    if (!fs::is_directory(out)) throw InputError(typed, "exists and is not a folder");
     if (!fs::is_empty(out) && !fs::exists(out / "spec.yaml")) {
-      throw InputError(out.string(), "exists and is not a stereorig dataset (no spec.yaml); refusing to replace it");
+      throw InputError(typed, "exists and is not a stereorig dataset (no spec.yaml); refusing to replace it");
     }
   }
   const std::string pid = std::to_string(getpid());
@@ -274,7 +281,8 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
     }
   } cleanup{tmp};
   fs::create_directories(tmp / "truth", ec);
-  if (ec) throw InputError(tmp.string(), "cannot create folder: " + ec.message());
+  if (ec)
+    throw InputError(typed, "cannot create its temporary folder " + tmp.filename().string() + ": " + ec.message());
 
   // --- ray tables
   const auto t_rays = std::chrono::steady_clock::now();
@@ -452,18 +460,18 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
   } else if (fs::exists(out)) {  // no exchange here (e.g. an older kernel): two renames
     const fs::path old = parent / TemporaryName(".", out.filename().string(), ".old-" + pid);
     fs::rename(out, old, ec);
-    if (ec) throw InputError(out.string(), "cannot replace: " + ec.message());
+    if (ec) throw InputError(typed, "cannot replace: " + ec.message());
     fs::rename(tmp, out, ec);
     if (ec) {
       std::error_code e2;
       fs::rename(old, out, e2);
-      throw InputError(out.string(), "cannot rename the finished dataset into place: " + ec.message());
+      throw InputError(typed, "cannot rename the finished dataset into place: " + ec.message());
     }
     const PendingTemporary pending_old(old.string(), TemporaryKind::kFolder);  // a signal finishes the removal
     fs::remove_all(old, ec);
   } else {
     fs::rename(tmp, out, ec);
-    if (ec) throw InputError(out.string(), "cannot rename the finished dataset into place: " + ec.message());
+    if (ec) throw InputError(typed, "cannot rename the finished dataset into place: " + ec.message());
   }
   cleanup.keep = true;
 

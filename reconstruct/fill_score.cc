@@ -2,19 +2,23 @@
 
 #include <cmath>
 #include <filesystem>
-#include <opencv2/imgcodecs.hpp>
 
 #include "calib/core/input_error.h"
+#include "reconstruct/image_file.h"
 
 namespace stereorig {
 
 std::vector<CameraTruthMaps> ReadCameraTruthMaps(const std::string& dir, int num_cameras) {
   namespace fs = std::filesystem;
+  // Through the checked reader, as every image input: a truth map missing,
+  // cut short or damaged is named in one line, before libpng could print its
+  // own (it used to read as an empty Mat, after "libpng error: Read Error").
   auto read = [&](const std::string& name, int type) {
     const std::string path = (fs::path(dir) / name).string();
-    if (!fs::exists(path)) throw InputError(path, "missing truth map");
-    cv::Mat m = cv::imread(path, cv::IMREAD_UNCHANGED);
-    if (m.empty() || m.type() != type) throw InputError(path, "cannot read it, or it has the wrong pixel type");
+    cv::Mat m = ReadImageFile(path);
+    if (m.type() != type)
+      throw InputError(path, "a truth map of the wrong pixel type (" + cv::typeToString(m.type()) + ", not " +
+                                 cv::typeToString(type) + ")");
     return m;
   };
   std::vector<CameraTruthMaps> maps;

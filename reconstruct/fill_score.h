@@ -33,7 +33,8 @@ struct CameraTruthMaps {
 };
 
 // Reads `dir`/{depth_camK.tiff, id_camK.png, lit_camK.png} for K < num_cameras.
-// Throws InputError naming a missing or malformed file.
+// Throws InputError naming a file that is missing, cut short, damaged or of
+// the wrong pixel type (read through reconstruct/image_file.h).
 std::vector<CameraTruthMaps> ReadCameraTruthMaps(const std::string& dir, int num_cameras);
 
 // CV_8UC1, the left camera's imager size: 255 on the pixels that count for

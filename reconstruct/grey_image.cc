@@ -1,29 +1,12 @@
 #include "reconstruct/grey_image.h"
 
-#include <opencv2/imgcodecs.hpp>
-
-#include "calib/core/file_suffix.h"
 #include "calib/core/input_error.h"
-#include "calib/core/input_file.h"
-#include "calib/core/png_file.h"
+#include "reconstruct/image_file.h"
 
 namespace stereorig {
 
 cv::Mat ReadGreyImage(const std::string& path) {
-  // Missing: imread would print OpenCV's own warning first.
-  RequireInputFile(path);
-  // Named .png but holding another format: its decoder would print its own
-  // complaint (libjpeg's "Premature end of JPEG file") before ours.
-  if (!CheckPngIsWhole(path) && EndsWithIgnoringCase(path, ".png"))
-    throw InputError(path, "is not a PNG file, though named .png");
-  cv::Mat image;
-  try {
-    image = cv::imread(path, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {  // e.g. a header whose size the decoder refuses
-    // e.err alone: e.msg adds OpenCV's version, source file and a newline.
-    throw InputError(path, "cannot read the image (" + e.err + ")");
-  }
-  if (image.empty()) throw InputError(path, "cannot read the image (not an image, or a damaged one)");
+  cv::Mat image = ReadImageFile(path);
   if (image.type() != CV_8UC1) throw InputError(path, "must be an 8-bit single-channel (grey) image");
   return image;
 }

@@ -9,9 +9,9 @@
 
 namespace stereorig {
 
-// The image at `path`, CV_8UC1. Throws InputError if the file is missing, is
-// a PNG cut short or damaged (calib/core/png_file.h), cannot be decoded, or is not
-// 8-bit single-channel.
+// The image at `path`, CV_8UC1. Throws InputError if ReadImageFile
+// (reconstruct/image_file.h) does (the file missing, a PNG cut short or
+// damaged, one that cannot be decoded), or if it is not 8-bit single-channel.
 cv::Mat ReadGreyImage(const std::string& path);
 
 }  // namespace stereorig

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <string>
 #include <thread>
 #include <utility>
@@ -141,24 +142,59 @@ TEST(BenchCli, AMissingSceneNamedInScenesExitsTwoBeforeAnyRun) {
   std::filesystem::remove_all(dataset);
 }
 
-// A measurement volume that misses a scene: the bench says so (as score
-// does), naming the scene. The sphere's centre is ~33 mm to the side of
-// module 0 and ~205 mm ahead of it; a 150 mm wide volume centred 200 mm to
-// the side holds none of it (and still projects into the images: the
-// runtime builds). One scene, one run, empty clouds: a few seconds. (The
-// default volume, which holds the sphere, would add ~10 s of scoring.)
-TEST(BenchCli, SaysWhenTheMeasurementVolumeMissesAScenesTruth) {
+// A measurement volume that misses a scene: bench and score say so in the
+// same line, naming the scene and both distances, on stderr (a warning:
+// stdout carries the results; bench used to print it on stdout, score on
+// stdout within the scene's figures). The sphere's centre is ~33 mm to the
+// side of module 0 and ~205 mm ahead of it; a 150 mm wide volume centred
+// 200 mm to the side (283 mm from module 0) holds none of it (and still
+// projects into the images: the runtime builds). One scene, one run, empty
+// clouds: a few seconds. (The default volume, which holds the sphere, would
+// add ~10 s of scoring.)
+TEST(BenchCli, BenchAndScoreWarnOnStderrWhenTheMeasurementVolumeMissesAScenesTruth) {
   const std::string dataset = testing::SimulateOneScene("sphere", 1, "bench_volume");
   const std::string options = dataset + "/volume_beside.yaml";
   { std::ofstream(options) << "volume_center_mm: [200, 0, 200]\n"; }
-  const testing::Result missed =
-      RunCli("bench --runs 1 --dataset " + dataset + " --scenes sphere --options " + options);
-  ASSERT_EQ(missed.code, 0) << missed.err;
-  EXPECT_NE(missed.out.find("bench: the measurement volume holds 0% of sphere's truth surface: both pipelines will "
-                            "find little or nothing; set working_distance_mm (or volume_center_mm) in --options\n"),
-            std::string::npos)
-      << missed.out;
+  for (const std::string command : {"bench --runs 1", "score --no-passive"}) {
+    const testing::Result missed = RunCli(command + " --dataset " + dataset + " --scenes sphere --options " + options);
+    ASSERT_EQ(missed.code, 0) << command << ": " << missed.err;
+    // The scene's distance is the simulator's (about 206 mm): any number.
+    const std::regex warning(command.substr(0, command.find(' ')) +
+                             ": the measurement volume holds 0% of sphere's truth surface: its centre is 283 mm from "
+                             "module 0, the scene's [0-9]+ mm; set working_distance_mm \\(or volume_center_mm\\) in "
+                             "--options\n");
+    EXPECT_TRUE(std::regex_search(missed.err, warning)) << command << ": " << missed.err;
+    EXPECT_EQ(missed.out.find("measurement volume"), std::string::npos) << command << ": " << missed.out;
+  }
   std::filesystem::remove_all(dataset);
+}
+
+// A damaged truth map is bad input named in one line, by bench and score
+// alike: they read the simulator's truth maps through the checked reader
+// (reconstruct/image_file.h) as every image input. A lit map cut short used
+// to reach imread, which let libpng print "libpng error: Read Error" before
+// the error; a folder where a depth map belongs read as "cannot read it".
+TEST(BenchCli, BenchAndScoreNameADamagedTruthMapInOneLine) {
+  namespace fs = std::filesystem;
+  const std::string dataset = testing::SimulateOneScene("sphere", 1, "bench_truth_map");
+  const std::string truth = dataset + "/truth/scenes/sphere/";
+  auto expect_named = [&](const std::string& says) {
+    for (const std::string command : {"bench --runs 1", "score --no-passive"}) {
+      const testing::Result r = RunCli(command + " --dataset " + dataset + " --scenes sphere");
+      EXPECT_EQ(r.code, 2) << command << ": " << r.err;
+      EXPECT_EQ(testing::Lines(r.err), 1) << command << ": " << r.err;
+      EXPECT_NE(r.err.find(says), std::string::npos) << command << ": " << r.err;
+    }
+  };
+  const std::string lit = truth + "lit_cam1.png", whole = dataset + "/lit_cam1_whole.png";
+  fs::copy_file(lit, whole);
+  fs::resize_file(lit, fs::file_size(lit) / 2);
+  expect_named(lit + ": a PNG cut short or damaged (its IDAT chunk at byte 33 is longer than the rest of the file");
+  fs::rename(whole, lit);
+  fs::remove(truth + "depth_cam2.tiff");
+  fs::create_directory(truth + "depth_cam2.tiff");
+  expect_named(truth + "depth_cam2.tiff: is a folder, not a file");
+  fs::remove_all(dataset);
 }
 
 // --scenes picks scenes of a --dataset; without one (the built-in sphere)

@@ -331,11 +331,42 @@ TEST_F(ReconstructCli, AnImageCutShortOrDamagedIsNamedInOneLine) {
   ExpectNoOutput();
 }
 
+// Image data damaged under valid CRCs (the chunk's CRC redone after the
+// damage, as a faulty tool rewriting the file would) is named in one line
+// too: libpng used to print "libpng error: IDAT: invalid block type" (or
+// "... invalid distance too far back") above our "cannot read the image".
+TEST_F(ReconstructCli, ImageDataDamagedUnderValidCrcsIsNamedInOneLine) {
+  const std::string d = BrokenCapture("deflate_damaged");
+  std::fstream f(d + "/cam3.png", std::ios::in | std::ios::out | std::ios::binary);
+  std::string bytes{std::istreambuf_iterator<char>(f), {}};
+  const size_t idat = bytes.find("IDAT");  // the first IDAT's type; its data follows
+  ASSERT_NE(idat, std::string::npos);
+  const auto* length_bytes = reinterpret_cast<const unsigned char*>(bytes.data() + idat - 4);
+  const size_t length = size_t(length_bytes[0]) << 24 | length_bytes[1] << 16 | length_bytes[2] << 8 | length_bytes[3];
+  bytes[idat + 4 + 2] |= 0x06;  // after zlib's 2-byte header, the first block's type: 11, reserved
+  const uint32_t crc = PngCrc(std::string_view(bytes).substr(idat, 4 + length));
+  for (int i = 0; i < 4; ++i) bytes[idat + 4 + length + i] = char(crc >> (24 - 8 * i));
+  f.seekp(0);
+  f.write(bytes.data(), std::streamsize(bytes.size()));
+  f.close();
+  const testing::Result r = testing::RunCli(Args(d));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_EQ(r.err.find("libpng"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(d + "/cam3.png: a damaged PNG (its image data does not inflate: invalid block type)\n"),
+            std::string::npos)
+      << r.err;
+  ExpectNoOutput();
+}
+
 // Inputs of the wrong kind, each named in one line as what it is, before any
 // work and with no output. Before: JPEG bytes named cam1.png printed
 // libjpeg's "Premature end of JPEG file" first; a header of 60000 x 60000 px
 // printed OpenCV's two-line assertion; a folder for a file read "no such
-// file"; a file for --capture "capture folder not found".
+// file"; a file for --capture "capture folder not found". (The header of
+// 60000 x 60000 px over an empty IDAT is now named by its image data, which
+// is checked first; OpenCV's refusal of an image too large is provoked on
+// a whole capture by lowering its limit, OPENCV_IO_MAX_IMAGE_PIXELS.)
 TEST_F(ReconstructCli, InputsOfTheWrongKindAreNamedInOneLine) {
   const std::string jpeg = BrokenCapture("jpeg_named_png");
   std::vector<uchar> bytes;
@@ -360,7 +391,7 @@ TEST_F(ReconstructCli, InputsOfTheWrongKindAreNamedInOneLine) {
       {base + "--rig " + dir_ + "/rig.yaml --capture " + jpeg,
        jpeg + "/cam1.png: is not a PNG file, though named .png"},
       {base + "--rig " + dir_ + "/rig.yaml --capture " + huge,
-       huge + "/cam1.png: cannot read the image (pixels <= CV_IO_MAX_IMAGE_PIXELS)"},
+       huge + "/cam1.png: a damaged PNG (its image data is cut short: its deflate stream does not end)"},
       {base + "--rig " + dir_ + "/rig.yaml --capture " + folder,
        folder + "/cam1.png: is a folder, not camera 1's image"},
       {base + "--rig " + dir_ + "/capture --capture " + dir_ + "/capture", dir_ + "/capture: is a folder, not a file"},
@@ -370,6 +401,11 @@ TEST_F(ReconstructCli, InputsOfTheWrongKindAreNamedInOneLine) {
     ExpectRefusedInOneLine(args, says);
     ExpectNoOutput();
   }
+  setenv("OPENCV_IO_MAX_IMAGE_PIXELS", "100000", 1);  // a capture has 752 x 582 px
+  ExpectRefusedInOneLine(Args(dir_ + "/capture"),
+                         dir_ + "/capture/cam0.png: cannot read the image (pixels <= CV_IO_MAX_IMAGE_PIXELS)");
+  unsetenv("OPENCV_IO_MAX_IMAGE_PIXELS");
+  ExpectNoOutput();
 }
 
 TEST_F(ReconstructCli, CaptureFromALargerRigExitsTwo) {

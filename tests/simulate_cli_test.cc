@@ -181,6 +181,42 @@ TEST(SimulateCli, ATerminationSignalMidRenderLeavesNoTemporaryFolder) {
   EXPECT_TRUE(left.empty()) << "left: " << (left.empty() ? "" : left[0]);
 }
 
+// simulate's errors about --out name it as the user typed it, relative and
+// unnormalised; they used to name it absolute and normalised (./junk/ as
+// /home/.../junk), a path the user never wrote. The work is still done on
+// the normalised path. Each is refused before any rendering, in one line,
+// nothing left behind.
+TEST(SimulateCli, OutErrorsNameTheFolderAsTyped) {
+  const std::string dir = ::testing::TempDir() + "/sim_typed";
+  fs::remove_all(dir);
+  fs::create_directories(dir + "/junk");
+  std::ofstream(dir + "/junk/notes.txt") << "not a dataset\n";
+  std::ofstream(dir + "/afile") << "a file\n";
+  struct InFolder {  // the working folder for the relative --out, restored however the test ends
+    fs::path before = fs::current_path();
+    explicit InFolder(const std::string& folder) { fs::current_path(folder); }
+    ~InFolder() { fs::current_path(before); }
+  } in_dir(dir);
+  const std::string z256(256, 'z');
+  const std::string not_a_dataset = ": exists and is not a stereorig dataset (no spec.yaml); refusing to replace it\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {"junk", "junk" + not_a_dataset},
+      {"./junk/", "./junk/" + not_a_dataset},
+      {"afile", "afile: exists and is not a folder\n"},
+      {"afile/ds", "afile/ds: cannot create this folder for the dataset (--out): Not a directory\n"},
+      {"new/" + z256, "new/" + z256 + ": cannot create this folder for the dataset (--out): File name too long ("}};
+  for (const auto& [out, says] : cases) {
+    const Result r = RunCli("simulate --out " + out + " --calibration-captures 0 --no-scenes");
+    EXPECT_EQ(r.code, 2) << out;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_EQ(r.err.rfind("stereorig simulate: " + says, 0), 0u) << r.err;  // the line starts so
+  }
+  std::vector<std::string> left;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) left.push_back(fs::relative(e.path(), dir).string());
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"afile", "junk", "junk/notes.txt"}));
+}
+
 // Options that would be ignored, or read wrongly, are refused before any
 // work, in one line naming the flag: a bump without what to move or by how
 // much rendered an undisturbed rig; --write-default-spec ignored --out; a

@@ -3,8 +3,10 @@
 #include <zlib.h>
 
 #include <fstream>
+#include <optional>
 
 #include "calib/core/input_error.h"
+#include "calib/core/png_image_data.h"
 
 namespace stereorig {
 namespace {
@@ -40,6 +42,7 @@ bool CheckPngIsWhole(const std::string& path) {
   // Each chunk: length (4 bytes, big-endian, < 2^31), type (4 letters), its
   // data, and the CRC of type and data. The buffer holds type and data.
   std::string chunk;
+  std::optional<PngImageData> image_data;
   for (std::streamoff at = std::streamoff(kSignature.size());;) {
     char length_bytes[4];
     if (size - at < 12 || !f.read(length_bytes, 4))
@@ -62,6 +65,15 @@ bool CheckPngIsWhole(const std::string& path) {
       throw InputError(path, "cannot be read");
     if (PngCrc(chunk) != BigEndian32(crc_bytes))
       throw InputError(path, "a damaged PNG (" + named + " fails its CRC check)");
+    // Then the image data, inflated as it streams past (png_image_data.h).
+    const std::string_view data = std::string_view(chunk).substr(4);
+    if (!image_data) {
+      image_data.emplace(path, data);  // IHDR, the first chunk
+    } else if (chunk.compare(0, 4, "IDAT") == 0) {
+      image_data->Add(data, uint64_t(at));
+    } else if (image_data->started() || chunk.compare(0, 4, "IEND") == 0) {
+      image_data->Finish();
+    }
     if (chunk.compare(0, 4, "IEND") == 0) return true;
     at += 12 + std::streamoff(length);
   }

@@ -1,6 +1,7 @@
 #include "calib/core/png_file.h"
 
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include <fstream>
 #include <string>
@@ -19,11 +20,39 @@ std::string Chunk(const std::string& type, const std::string& data) {
   return BigEndian32(uint32_t(data.size())) + type + data + BigEndian32(PngCrc(type + data));
 }
 
-// Signature, IHDR (13 bytes: the checks do not read it), an IDAT of 1000
-// bytes (standing for the image) and IEND: 1 057 bytes, the IDAT's data at
-// bytes 41-1040, its CRC at 1041-1044, IEND at 1045.
-const std::string kWhole =
-    kSignature + Chunk("IHDR", std::string(13, '\1')) + Chunk("IDAT", std::string(1000, 'x')) + Chunk("IEND", "");
+// An IHDR's 13 bytes: width, height, bit depth, colour type (0 grey),
+// compression, filter and interlace method.
+std::string Ihdr(uint32_t width_px, uint32_t height_px, int bit_depth = 8, int colour_type = 0, int interlace = 0) {
+  return BigEndian32(width_px) + BigEndian32(height_px) + std::string{char(bit_depth), char(colour_type), 0, 0} +
+         char(interlace);
+}
+
+// `raw` as a zlib stream at compression `level` (0: stored, byte for byte).
+std::string Deflate(const std::string& raw, int level) {
+  uLongf size = compressBound(uLong(raw.size()));
+  std::string out(size, '\0');
+  EXPECT_EQ(compress2(reinterpret_cast<Bytef*>(out.data()), &size, reinterpret_cast<const Bytef*>(raw.data()),
+                      uLong(raw.size()), level),
+            Z_OK);
+  out.resize(size);
+  return out;
+}
+
+// A 42 x 23 px 8-bit grey image's rows: each a filter byte (0, none) and 42
+// pixels, 23 x 43 = 989 bytes.
+std::string Rows(int num_bytes = 989) {
+  std::string rows(size_t(num_bytes), '\0');
+  for (size_t i = 0; i < rows.size(); ++i)
+    if (i % 43) rows[i] = char(i * 7);
+  return rows;
+}
+
+// Signature, IHDR (42 x 23 px, 8-bit grey), an IDAT of 1000 bytes (the rows
+// stored: zlib's 2-byte header, a 5-byte stored-block header, the 989 bytes,
+// the Adler-32) and IEND: 1 057 bytes, the IDAT's data at bytes 41-1040, its
+// CRC at 1041-1044, IEND at 1045.
+const std::string kImageData = Deflate(Rows(), 0);
+const std::string kWhole = kSignature + Chunk("IHDR", Ihdr(42, 23)) + Chunk("IDAT", kImageData) + Chunk("IEND", "");
 
 std::string Write(const std::string& name, const std::string& bytes) {
   const std::string path = ::testing::TempDir() + "/png_file_test_" + name;
@@ -50,6 +79,8 @@ TEST(PngFile, CrcIsPngs) {
 }
 
 TEST(PngFile, AWholePngPassesAndOneCutShortIsNamed) {
+  ASSERT_EQ(kImageData.size(), 1000u);
+  ASSERT_EQ(kWhole.size(), 1057u);
   EXPECT_TRUE(CheckPngIsWhole(Write("whole.png", kWhole)));
   // Bytes after IEND are ignored by libpng, so the file is whole.
   EXPECT_TRUE(CheckPngIsWhole(Write("trailing.png", kWhole + std::string(5000, 'x'))));
@@ -84,6 +115,78 @@ TEST(PngFile, ADamagedPngIsNamedWithTheChunk) {
                 "a damaged PNG (its chunk at byte 33 has no valid type or length)");
   ExpectRefused(Write("no_ihdr.png", kSignature + Chunk("IDAT", "x") + Chunk("IEND", "")),
                 "a damaged PNG (its IDAT chunk at byte 8 should be IHDR)");
+}
+
+// Image data damaged under valid CRCs (the CRCs redone after the damage, as
+// a faulty tool rewriting a file would): refused before libpng prints its
+// own line ("libpng error: IDAT: invalid block type", "... incorrect data
+// check", "Not enough image data", "Extra compressed data").
+TEST(PngFile, ImageDataThatDoesNotInflateToTheImageIsNamed) {
+  const std::string head = kSignature + Chunk("IHDR", Ihdr(42, 23)), iend = Chunk("IEND", "");
+  auto with_data = [&](const std::string& name, const std::string& data) {
+    return Write(name, head + Chunk("IDAT", data) + iend);
+  };
+  std::string block_type = kImageData;
+  block_type[2] |= 0x06;  // the first block's BTYPE 11: reserved
+  ExpectRefused(with_data("block_type.png", block_type),
+                "a damaged PNG (its image data does not inflate: invalid block type)");
+  std::string pixel = kImageData;
+  pixel[500] ^= 0x01;  // a stored byte: inflates, but fails the Adler-32
+  ExpectRefused(with_data("pixel.png", pixel), "a damaged PNG (its image data does not inflate: incorrect data check)");
+  const std::string cut = "a damaged PNG (its image data is cut short: its deflate stream does not end)";
+  ExpectRefused(with_data("cut.png", kImageData.substr(0, 500)), cut);
+  ExpectRefused(with_data("cut_before_checksum.png", kImageData.substr(0, 998)), cut);
+  ExpectRefused(with_data("empty.png", ""), cut);
+  ExpectRefused(with_data("short.png", Deflate(Rows(988), 9)),
+                "a damaged PNG (its image data inflates to 988 bytes; its IHDR's 42 x 23 px image needs 989)");
+  ExpectRefused(with_data("long.png", Deflate(Rows(990), 9)),
+                "a damaged PNG (its image data inflates to 990 bytes; its IHDR's 42 x 23 px image needs 989)");
+  const std::string past_end = "a damaged PNG (its image data goes on after the end of its deflate stream)";
+  ExpectRefused(with_data("past_end.png", kImageData + "x"), past_end);
+  ExpectRefused(Write("past_end_in_next.png", head + Chunk("IDAT", kImageData) + Chunk("IDAT", "x") + iend), past_end);
+  ExpectRefused(Write("no_idat.png", head + iend), "a damaged PNG (it has no IDAT chunk: no image data)");
+  ExpectRefused(
+      Write("idat_after_text.png", head + Chunk("IDAT", kImageData) + Chunk("tEXt", "abc") + Chunk("IDAT", "") + iend),
+      "a damaged PNG (its IDAT chunk at byte " + std::to_string(head.size() + 12 + 1000 + 15) +
+          " comes after other chunks that followed the image data: IDAT chunks must be consecutive)");
+  // Nor may a chunk come between the IDATs while the stream runs.
+  ExpectRefused(Write("text_between.png", head + Chunk("IDAT", kImageData.substr(0, 500)) + Chunk("tEXt", "abc") +
+                                              Chunk("IDAT", kImageData.substr(500)) + iend),
+                cut);
+}
+
+// The stream may be split anywhere across consecutive IDATs, empty ones
+// included, with other chunks before them and after; compressed or stored.
+TEST(PngFile, ImageDataSplitAcrossIdatChunksPasses) {
+  const std::string head = kSignature + Chunk("IHDR", Ihdr(42, 23)) + Chunk("tEXt", "abc");
+  const std::string compressed = Deflate(Rows(), 9);
+  ASSERT_LT(compressed.size(), kImageData.size());
+  for (const std::string& data : {kImageData, compressed}) {
+    const size_t cuts[] = {0, 1, 2, data.size() / 2, data.size()};
+    std::string chunks;
+    for (int i = 0; i < 4; ++i) chunks += Chunk("IDAT", data.substr(cuts[i], cuts[i + 1] - cuts[i]));
+    EXPECT_TRUE(CheckPngIsWhole(Write("split.png", head + Chunk("IDAT", "") + chunks + Chunk("IDAT", "") +
+                                                       Chunk("tEXt", "def") + Chunk("IEND", ""))));
+  }
+}
+
+// An IHDR libpng refuses ("Invalid color type", "Image width is zero") is
+// named as such: the image data's size cannot be known.
+TEST(PngFile, AnIhdrPngDoesNotDefineIsNamed) {
+  auto with_ihdr = [&](const std::string& name, const std::string& ihdr) {
+    return Write(name, kSignature + Chunk("IHDR", ihdr) + Chunk("IDAT", kImageData) + Chunk("IEND", ""));
+  };
+  ExpectRefused(with_ihdr("colour_5.png", Ihdr(42, 23, 8, 5)),
+                "a damaged PNG (its IHDR gives colour type 5 at bit depth 8, which PNG does not define)");
+  ExpectRefused(with_ihdr("rgb_4bit.png", Ihdr(42, 23, 4, 2)),
+                "a damaged PNG (its IHDR gives colour type 2 at bit depth 4, which PNG does not define)");
+  ExpectRefused(with_ihdr("width_0.png", Ihdr(0, 23)), "a damaged PNG (its IHDR gives an image of 0 x 23 px)");
+  ExpectRefused(with_ihdr("height_2^31.png", Ihdr(42, 0x80000000u)),
+                "a damaged PNG (its IHDR gives an image of 42 x 2147483648 px)");
+  ExpectRefused(with_ihdr("interlace_2.png", Ihdr(42, 23, 8, 0, 2)),
+                "a damaged PNG (its IHDR gives compression, filter or interlace method 0, 0, 2, which PNG does not "
+                "define)");
+  ExpectRefused(with_ihdr("ihdr_14.png", Ihdr(42, 23) + "x"), "a damaged PNG (its IHDR chunk holds 14 bytes, not 13)");
 }
 
 TEST(PngFile, OtherFilesAreLeftToTheDecoder) {

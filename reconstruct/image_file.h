@@ -1,0 +1,19 @@
+// Reading one image file the user gave, as stored (any depth and channel
+// count): every way it can be unreadable is bad input (InputError) in one line
+// naming the file, never OpenCV's or libpng's own lines on stderr. The one
+// reader of reconstruct's image inputs: the grey captures
+// (reconstruct/grey_image.h) and the simulator's truth maps
+// (reconstruct/fill_score.h).
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+
+namespace stereorig {
+
+// The image at `path` (cv::IMREAD_UNCHANGED). Throws InputError if the file
+// is missing or not a file, is a PNG cut short or damaged
+// (calib/core/png_file.h), is named .png but is not one, or cannot be decoded.
+cv::Mat ReadImageFile(const std::string& path);
+
+}  // namespace stereorig
