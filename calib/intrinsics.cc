@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "calib/core/input_error.h"
+#include "calib/pinhole_seed.h"
 #include "calib/projection_uncertainty.h"
 
 namespace stereorig {
@@ -38,11 +39,10 @@ void FillPoolBlock(const BoardObservation& obs, const TargetGeometry& target, mr
 
 namespace {
 
-// The seed pose of one view from PnP through a distortion-free pinhole with
-// focal `f_px` and the centre at the middle of the imager; nullopt if PnP
-// fails (a nearly collinear view: seen in the target study, 13x11 board).
-std::optional<Pose> SeedPose(const BoardObservation& obs, const TargetGeometry& target, double f_px, int width,
-                             int height) {
+// The seed pose of one view from PnP through the distortion-free pinhole
+// `seed`; nullopt if PnP fails (a nearly collinear view: seen in the target
+// study, 13x11 board).
+std::optional<Pose> SeedPose(const BoardObservation& obs, const TargetGeometry& target, const PinholeSeed& seed) {
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
   for (size_t k = 0; k < obs.corner_ids.size(); ++k) {
@@ -50,33 +50,14 @@ std::optional<Pose> SeedPose(const BoardObservation& obs, const TargetGeometry& 
     object.emplace_back(p.x(), p.y(), p.z());
     image.emplace_back(obs.q_px[k].x(), obs.q_px[k].y());
   }
-  const cv::Matx33d K(f_px, 0, 0.5 * (width - 1), 0, f_px, 0.5 * (height - 1), 0, 0, 1);
+  const double f = seed.focal_px;
+  const cv::Matx33d K(f, 0, seed.principal_point_px.x(), 0, f, seed.principal_point_px.y(), 0, 0, 1);
   cv::Mat rvec, tvec;
   const bool ok = cv::solvePnP(object, image, K, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_IPPE);
   if (!ok || rvec.total() != 3 || tvec.total() != 3) return std::nullopt;
   Pose pose = Pose::FromRotationVector(Eigen::Vector3d(rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2)),
                                        Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2)));
   return pose;
-}
-
-double EstimateFocal(const std::vector<const BoardObservation*>& views, const TargetGeometry& target, int width,
-                     int height) {
-  std::vector<std::vector<cv::Point3f>> objects;
-  std::vector<std::vector<cv::Point2f>> images;
-  for (const BoardObservation* v : views) {
-    std::vector<cv::Point3f> o;
-    std::vector<cv::Point2f> q;
-    for (size_t k = 0; k < v->corner_ids.size(); ++k) {
-      const Eigen::Vector3d p = target.CornerInFace(v->corner_ids[k]);
-      o.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), 0.f);
-      q.emplace_back(static_cast<float>(v->q_px[k].x()), static_cast<float>(v->q_px[k].y()));
-    }
-    objects.push_back(o);
-    images.push_back(q);
-  }
-  const cv::Mat K = cv::initCameraMatrix2D(objects, images, cv::Size(width, height));
-  const double f = 0.5 * (K.at<double>(0, 0) + K.at<double>(1, 1));
-  return std::isfinite(f) && f > 0 ? f : width;  // a 53 deg lens if the estimate fails
 }
 
 // Angle between the board normal and the camera's optical axis, degrees.
@@ -211,13 +192,12 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
                                     std::to_string(options.min_views));
   }
 
-  const double f_seed =
-      options.seed_focal_px > 0 ? options.seed_focal_px : EstimateFocal(views, target, spec.width_px, spec.height_px);
+  const PinholeSeed pinhole = EstimatePinholeSeed(views, target, spec.width_px, spec.height_px, options.seed_focal_px);
   std::vector<Pose> seeds;
   {
     std::vector<const BoardObservation*> posed;
     for (const BoardObservation* v : views) {
-      const std::optional<Pose> seed = SeedPose(*v, target, f_seed, spec.width_px, spec.height_px);
+      const std::optional<Pose> seed = SeedPose(*v, target, pinhole);
       if (!seed) {
         ++dropped;
         continue;
@@ -264,9 +244,9 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
     p.imagersizes = {spec.width_px, spec.height_px};
     if (intrinsics.empty()) {
       p.intrinsics.assign(p.num_params(), 0.0);
-      p.intrinsics[0] = p.intrinsics[1] = f_seed;
-      p.intrinsics[2] = 0.5 * (spec.width_px - 1);
-      p.intrinsics[3] = 0.5 * (spec.height_px - 1);
+      p.intrinsics[0] = p.intrinsics[1] = pinhole.focal_px;
+      p.intrinsics[2] = pinhole.principal_point_px.x();
+      p.intrinsics[3] = pinhole.principal_point_px.y();
     } else {
       p.intrinsics = intrinsics;
     }
