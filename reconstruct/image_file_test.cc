@@ -1,8 +1,9 @@
 // ReadImageFile against libpng (through OpenCV) on PNGs built here byte by
 // byte, interlaced or not, of several sizes, bit depths and colour types:
-// where libpng decodes the image data, the checked reader passes it; where
-// it is one byte short (libpng: "Not enough image data"), the reader names
-// the file in one line and libpng prints nothing. An independent check of
+// where libpng decodes the image data, the checked reader passes it (one
+// byte too many, or bytes after the stream: with libpng's warning line);
+// where it is one byte short (libpng: "Not enough image data"), the reader
+// names the file in one line and libpng prints nothing. An independent check of
 // the image data's size (calib/core/png_image_data.h), Adam7's passes above
 // all.
 #include "reconstruct/image_file.h"
@@ -13,6 +14,7 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "calib/core/input_error.h"
@@ -29,9 +31,10 @@ std::string Chunk(const std::string& type, const std::string& data) {
 }
 
 // A PNG whose image data is `num_bytes` of rows, every filter byte 0 (none)
-// and the pixels a ramp, deflated by zlib.
+// and the pixels a ramp, deflated by zlib, then `trailing` (bytes after the
+// deflate stream's end, in the same IDAT).
 std::string Png(uint32_t width_px, uint32_t height_px, int bit_depth, int colour_type, bool interlaced,
-                uint64_t num_bytes) {
+                uint64_t num_bytes, const std::string& trailing = "") {
   std::string raw(num_bytes, '\0');
   for (size_t i = 0; i < raw.size(); ++i) raw[i] = char(i % 251);
   // Filter bytes 0: the rows' first bytes, pass by pass. Simplest to set
@@ -55,6 +58,7 @@ std::string Png(uint32_t width_px, uint32_t height_px, int bit_depth, int colour
                       uLong(raw.size()), 9),
             Z_OK);
   idat.resize(size);
+  idat += trailing;
   const std::string ihdr = BigEndian32(width_px) + BigEndian32(height_px) +
                            std::string{char(bit_depth), char(colour_type), 0, 0, char(interlaced)};
   return std::string("\x89PNG\r\n\x1a\n", 8) + Chunk("IHDR", ihdr) + Chunk("IDAT", idat) + Chunk("IEND", "");
@@ -110,6 +114,32 @@ TEST(ReadImageFile, PassesWhatLibpngDecodesAndNamesImageDataOneByteShort) {
               << what;
         }
         EXPECT_EQ(::testing::internal::GetCapturedStderr(), "") << what;
+
+        // One byte too many, and bytes after the stream's end: libpng reads
+        // the image whole with a warning, and so do we, the warning its.
+        const std::pair<std::string, std::string> extras[] = {
+            {Png(s.width, s.height, f.bit_depth, f.colour_type, interlaced, n + 1),
+             "libpng warning: IDAT: Too much image data\n"},
+            {Png(s.width, s.height, f.bit_depth, f.colour_type, interlaced, n, "junk"),
+             "libpng warning: IDAT: Extra compressed data\n"}};
+        for (const auto& [png, warning] : extras) {
+          ::testing::internal::CaptureStderr();
+          const cv::Mat by_libpng_too = Decode(png);
+          EXPECT_EQ(::testing::internal::GetCapturedStderr(), warning) << what;
+          EXPECT_EQ(by_libpng_too.size(), s) << what;
+          ::testing::internal::CaptureStderr();
+          try {
+            const cv::Mat read = ReadImageFile(Write(png));
+            EXPECT_EQ(read.size(), s) << what;
+            EXPECT_EQ(read.type(), f.cv_type) << what;
+            if (read.size() == s && read.type() == f.cv_type) {  // the n bytes' image: the extra is ignored
+              EXPECT_EQ(cv::norm(read, by_libpng, cv::NORM_INF), 0) << what;
+            }
+          } catch (const InputError& e) {
+            ADD_FAILURE() << what << ": " << e.what();
+          }
+          EXPECT_EQ(::testing::internal::GetCapturedStderr(), warning) << what;
+        }
         ++cases;
       }
   EXPECT_EQ(cases, 60);

@@ -364,9 +364,10 @@ TEST_F(ReconstructCli, ImageDataDamagedUnderValidCrcsIsNamedInOneLine) {
 // libjpeg's "Premature end of JPEG file" first; a header of 60000 x 60000 px
 // printed OpenCV's two-line assertion; a folder for a file read "no such
 // file"; a file for --capture "capture folder not found". (The header of
-// 60000 x 60000 px over an empty IDAT is now named by its image data, which
-// is checked first; OpenCV's refusal of an image too large is provoked on
-// a whole capture by lowering its limit, OPENCV_IO_MAX_IMAGE_PIXELS.)
+// 60000 x 60000 px is past OpenCV's 2^30 px, so its image data is not
+// inflated before the decoder refuses the header: calib/core/
+// png_image_data.h. OpenCV's refusal is also provoked on a whole capture by
+// lowering its limit, OPENCV_IO_MAX_IMAGE_PIXELS.)
 TEST_F(ReconstructCli, InputsOfTheWrongKindAreNamedInOneLine) {
   const std::string jpeg = BrokenCapture("jpeg_named_png");
   std::vector<uchar> bytes;
@@ -391,7 +392,7 @@ TEST_F(ReconstructCli, InputsOfTheWrongKindAreNamedInOneLine) {
       {base + "--rig " + dir_ + "/rig.yaml --capture " + jpeg,
        jpeg + "/cam1.png: is not a PNG file, though named .png"},
       {base + "--rig " + dir_ + "/rig.yaml --capture " + huge,
-       huge + "/cam1.png: a damaged PNG (its image data is cut short: its deflate stream does not end)"},
+       huge + "/cam1.png: cannot read the image (pixels <= CV_IO_MAX_IMAGE_PIXELS)"},
       {base + "--rig " + dir_ + "/rig.yaml --capture " + folder,
        folder + "/cam1.png: is a folder, not camera 1's image"},
       {base + "--rig " + dir_ + "/capture --capture " + dir_ + "/capture", dir_ + "/capture: is a folder, not a file"},

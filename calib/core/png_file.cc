@@ -71,8 +71,10 @@ bool CheckPngIsWhole(const std::string& path) {
       image_data.emplace(path, data);  // IHDR, the first chunk
     } else if (chunk.compare(0, 4, "IDAT") == 0) {
       image_data->Add(data, uint64_t(at));
-    } else if (image_data->started() || chunk.compare(0, 4, "IEND") == 0) {
+    } else if (chunk.compare(0, 4, "IEND") == 0) {
       image_data->Finish();
+    } else {
+      image_data->Interrupt(std::string_view(chunk).substr(0, 4), uint64_t(at));
     }
     if (chunk.compare(0, 4, "IEND") == 0) return true;
     at += 12 + std::streamoff(length);

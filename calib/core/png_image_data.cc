@@ -2,6 +2,7 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <new>
 
 #include "calib/core/input_error.h"
@@ -14,10 +15,21 @@ uint32_t BigEndian32(const char* p) {
   return uint32_t(b[0]) << 24 | uint32_t(b[1]) << 16 | uint32_t(b[2]) << 8 | uint32_t(b[3]);
 }
 
+// a + b and a * b, saturated at UINT64_MAX (PngImageDataBytes).
+uint64_t SaturatedAdd(uint64_t a, uint64_t b) {
+  uint64_t sum;
+  return __builtin_add_overflow(a, b, &sum) ? UINT64_MAX : sum;
+}
+uint64_t SaturatedMultiply(uint64_t a, uint64_t b) {
+  uint64_t product;
+  return __builtin_mul_overflow(a, b, &product) ? UINT64_MAX : product;
+}
+
 uint64_t RowsBytes(uint64_t width_px, uint64_t height_px, int bit_depth, int channels) {
   if (width_px == 0 || height_px == 0) return 0;  // an empty pass: no row, no filter byte
+  // Below 2^31 px x 64 bits a pixel: below 2^37, no overflow.
   const uint64_t row_bytes = (width_px * uint64_t(bit_depth) * uint64_t(channels) + 7) / 8;
-  return height_px * (1 + row_bytes);
+  return SaturatedMultiply(height_px, 1 + row_bytes);
 }
 
 // The channels of a colour type at a bit depth PNG allows for it (PNG
@@ -53,7 +65,7 @@ uint64_t PngImageDataBytes(uint32_t width_px, uint32_t height_px, int bit_depth,
   for (int p = 0; p < 7; ++p) {
     const uint64_t w = width_px > uint32_t(kX0[p]) ? (uint64_t(width_px) - kX0[p] + kDx[p] - 1) / kDx[p] : 0;
     const uint64_t h = height_px > uint32_t(kY0[p]) ? (uint64_t(height_px) - kY0[p] + kDy[p] - 1) / kDy[p] : 0;
-    bytes += RowsBytes(w, h, bit_depth, channels);
+    bytes = SaturatedAdd(bytes, RowsBytes(w, h, bit_depth, channels));
   }
   return bytes;
 }
@@ -65,9 +77,12 @@ PngImageData::PngImageData(const std::string& path, std::string_view ihdr) : pat
   const int bit_depth = static_cast<unsigned char>(ihdr[8]), colour_type = static_cast<unsigned char>(ihdr[9]);
   const int compression = static_cast<unsigned char>(ihdr[10]), filter = static_cast<unsigned char>(ihdr[11]);
   const int interlace = static_cast<unsigned char>(ihdr[12]);
-  constexpr uint32_t kMaxSide = 0x7FFFFFFFu;
-  if (width_px_ == 0 || height_px_ == 0 || width_px_ > kMaxSide || height_px_ > kMaxSide)
-    Fail("its IHDR gives an image of " + std::to_string(width_px_) + " x " + std::to_string(height_px_) + " px");
+  const std::string size = std::to_string(width_px_) + " x " + std::to_string(height_px_) + " px";
+  if (width_px_ == 0 || height_px_ == 0 || width_px_ > 0x7FFFFFFFu || height_px_ > 0x7FFFFFFFu)
+    Fail("its IHDR gives an image of " + size);
+  if (width_px_ > kMaxSidePx || height_px_ > kMaxSidePx)
+    throw InputError(path_, "a PNG too large to read (its IHDR gives an image of " + size + "; libpng reads up to " +
+                                std::to_string(kMaxSidePx) + " px a side)");
   const int channels = Channels(colour_type, bit_depth);
   if (channels == 0)
     Fail("its IHDR gives colour type " + std::to_string(colour_type) + " at bit depth " + std::to_string(bit_depth) +
@@ -76,6 +91,7 @@ PngImageData::PngImageData(const std::string& path, std::string_view ihdr) : pat
     Fail("its IHDR gives compression, filter or interlace method " + std::to_string(compression) + ", " +
          std::to_string(filter) + ", " + std::to_string(interlace) + ", which PNG does not define");
   expected_bytes_ = PngImageDataBytes(width_px_, height_px_, bit_depth, channels, interlace == 1);
+  if (uint64_t(width_px_) * height_px_ > kMaxPixels) return;  // the decoder refuses it from the header
   stream_ = std::make_unique<z_stream>();
   if (inflateInit(stream_.get()) != Z_OK) throw std::bad_alloc();
   // 32 KB, zlib's window; 1 MB measured no faster on the demo's captures.
@@ -91,24 +107,30 @@ void PngImageData::Fail(const std::string& problem) const {
 }
 
 void PngImageData::Add(std::string_view idat_data, uint64_t at) {
-  if (finished_)
+  if (!interrupted_by_.empty()) {
+    if (!ended_)
+      Fail(interrupted_by_ + " comes between IDAT chunks, inside the image data's deflate stream: IDAT chunks " +
+           "must be consecutive");
     Fail("its IDAT chunk at byte " + std::to_string(at) +
          " comes after other chunks that followed the image data: IDAT chunks must be consecutive");
+  }
   started_ = true;
-  if (idat_data.empty()) return;
-  if (ended_) Fail("its image data goes on after the end of its deflate stream");
+  // Bytes after the stream's end or past the image's: libpng ignores them.
+  if (!stream_ || ended_ || idat_data.empty()) return;
   // zlib's avail_in is 32 bits, a chunk's length below 2^31: one go.
   stream_->next_in = reinterpret_cast<Bytef*>(const_cast<char*>(idat_data.data()));
   stream_->avail_in = uInt(idat_data.size());
   while (stream_->avail_in > 0) {
+    // Up to one byte past the image: that byte shows the stream gives more.
+    const uint64_t wanted = expected_bytes_ + 1 - inflated_bytes_;
+    const uInt room = uInt(std::min<uint64_t>(scratch_.size(), wanted));
     stream_->next_out = scratch_.data();
-    stream_->avail_out = uInt(scratch_.size());
+    stream_->avail_out = room;
     const int rc = inflate(stream_.get(), Z_NO_FLUSH);
-    inflated_bytes_ += scratch_.size() - stream_->avail_out;
-    if (rc == Z_STREAM_END) {
+    inflated_bytes_ += room - stream_->avail_out;
+    if (rc == Z_STREAM_END || inflated_bytes_ > expected_bytes_) {
       ended_ = true;
-      if (stream_->avail_in > 0) Fail("its image data goes on after the end of its deflate stream");
-      break;
+      return;
     }
     if (rc == Z_MEM_ERROR) throw std::bad_alloc();
     if (rc == Z_NEED_DICT) Fail("its image data does not inflate: its deflate stream asks for a preset dictionary");
@@ -117,12 +139,18 @@ void PngImageData::Add(std::string_view idat_data, uint64_t at) {
   }
 }
 
+void PngImageData::Interrupt(std::string_view chunk_type, uint64_t at) {
+  if (started_ && interrupted_by_.empty())
+    interrupted_by_ = "its " + std::string(chunk_type) + " chunk at byte " + std::to_string(at);
+}
+
 void PngImageData::Finish() {
   if (finished_) return;
   finished_ = true;
   if (!started_) Fail("it has no IDAT chunk: no image data");
+  if (!stream_) return;  // over kMaxPixels: the decoder's
   if (!ended_) Fail("its image data is cut short: its deflate stream does not end");
-  if (inflated_bytes_ != expected_bytes_)
+  if (inflated_bytes_ < expected_bytes_)
     Fail("its image data inflates to " + std::to_string(inflated_bytes_) + " bytes; its IHDR's " +
          std::to_string(width_px_) + " x " + std::to_string(height_px_) + " px image needs " +
          std::to_string(expected_bytes_));

@@ -12,8 +12,22 @@ TEST(PngImageDataBytes, ARowIsAFilterByteAndItsPackedPixels) {
   EXPECT_EQ(PngImageDataBytes(9, 5, 1, 1, false), 5u * 3u);          // 9 bits: 2 bytes
   EXPECT_EQ(PngImageDataBytes(3, 2, 16, 4, false), 2u * 25u);        // RGBA, 16-bit: 8 bytes a pixel
   EXPECT_EQ(PngImageDataBytes(5, 1, 4, 1, false), 1u * 4u);          // 20 bits: 3 bytes
-  // No overflow at PNG's largest sides (2^31 - 1 px).
-  EXPECT_EQ(PngImageDataBytes(0x7FFFFFFF, 0x7FFFFFFF, 16, 4, false), 0x7FFFFFFFull * (1 + 8ull * 0x7FFFFFFF));
+}
+
+// At PNG's largest sides (2^31 - 1 px), against values worked out by hand.
+// 8-bit grey: 2^31 - 1 rows of 1 + (2^31 - 1) = 2^31 bytes: 2^62 - 2^31.
+// libpng's largest (10^6 px a side), 16-bit RGBA: 10^6 rows of 1 + 8 x 10^6
+// bytes. 16-bit RGBA, 2^31 - 1 rows: 2^30 px wide, rows of 2^33 + 1 bytes,
+// make 2^64 - 2^33 + 2^31 - 1, which fits; one pixel wider, rows of
+// 2^33 + 9 bytes, 2^64 + 5 x 2^31 - 9, which does not: saturated, as at
+// 2^31 - 1 px wide (about 2^65), interlaced or not.
+TEST(PngImageDataBytes, TheLargestHeadersCountExactlyOrSaturate) {
+  EXPECT_EQ(PngImageDataBytes(0x7FFFFFFF, 0x7FFFFFFF, 8, 1, false), 4611686016279904256ull);
+  EXPECT_EQ(PngImageDataBytes(1000000, 1000000, 16, 4, false), 8000001000000ull);
+  EXPECT_EQ(PngImageDataBytes(1u << 30, 0x7FFFFFFF, 16, 4, false), 18446744067267100671ull);
+  EXPECT_EQ(PngImageDataBytes((1u << 30) + 1, 0x7FFFFFFF, 16, 4, false), UINT64_MAX);
+  EXPECT_EQ(PngImageDataBytes(0x7FFFFFFF, 0x7FFFFFFF, 16, 4, false), UINT64_MAX);
+  EXPECT_EQ(PngImageDataBytes(0x7FFFFFFF, 0x7FFFFFFF, 16, 4, true), UINT64_MAX);
 }
 
 // Adam7's seven passes, each its own sub-image of rows; a pass without a
