@@ -45,6 +45,12 @@ struct PinholeSeed {
   Eigen::Vector2d principal_point_px = Eigen::Vector2d::Zero();  // (cx, cy), image coordinates; may be off the image
 };
 
+// The candidates, the centred seed (the image's centre with OpenCV's focal
+// length, or the given one) first; none repeats another.
+std::vector<PinholeSeed> PinholeSeedCandidates(const std::vector<const BoardObservation*>& views,
+                                               const TargetGeometry& target, int width_px, int height_px,
+                                               double given_focal_px);
+
 // `views`: one camera's observations, each with corners spanning the board's
 // plane. `given_focal_px` > 0 is every candidate's focal length (the user's
 // rough value); the principal point is still chosen.
