@@ -90,9 +90,13 @@ TEST(IntrinsicsWindow, PrincipalPointOffTheWindowsCentreIsFound) {
     const IntrinsicsResult r = CalibrateIntrinsics(0, data.input.cameras[0], target, testing::ViewsOf(data.input, 0),
                                                    IntrinsicsOptions(), "test");
     // Converged to the noise: the residual RMS per coordinate, less the
-    // fitted dof (6 a board pose, 9 the lens); 10 %.
+    // fitted dof (6 a board pose, 9 the lens). Its relative spread: ~1.4 %
+    // expected from ~2400 residual coordinates (1 / sqrt(2 N)); measured over
+    // 20 seeds (21-40) on the windows that converged, sd 1.8 %, extremes
+    // -4.5 % and +6.3 %. 7.5 %: 4 sd, above the extremes.
     const double dof_share = (6.0 * r.report.num_views + 9) / (2.0 * r.report.num_corners);
-    EXPECT_NEAR(r.report.rms_px, noise_px * std::sqrt(1 - dof_share), 0.1 * noise_px);
+    const double expected_rms_px = noise_px * std::sqrt(1 - dof_share);
+    EXPECT_NEAR(r.report.rms_px, expected_rms_px, 0.075 * expected_rms_px);
     EXPECT_EQ(r.report.num_outliers, 0);
     // fx, fy, cx, cy within 4 sigma of the truth (OPENCV5 holds the true
     // lens: its rational terms are 0).

@@ -25,11 +25,12 @@
 //   above within 60 px, but has no real solution (f^2 < 0) for the 320 x
 //   240 one: under 20 deg of a distorted lens's field, 43 deg off its axis;
 // - the principal point at the centre, with OpenCV's focal length (the seed
-//   before windows were considered), and with focal lengths from half the
-//   image's width to 16 times it, a factor sqrt(2) apart: mrcal converges
-//   from the centre when the focal length is roughly right (measured for
-//   the 1025 px lens: from 905 px on the 320 x 240 corner window, from
-//   1415 px on the 640 x 480 one).
+//   before windows were considered: kept unless another candidate's RMS is
+//   under 0.2 x its own, see pinhole_seed.cc for the figures), and with
+//   focal lengths from half the image's width to 16 times it, a factor
+//   sqrt(2) apart (for a 640 px window: 320, 453, 640, 905, 1280, 1810 px,
+//   ...). Their purpose: from a centred principal point, mrcal converges
+//   when the focal length is roughly right.
 // Measured on the windows of calib/intrinsics_window_test.cc.
 #pragma once
 
@@ -44,6 +45,12 @@ struct PinholeSeed {
   double focal_px = 0;
   Eigen::Vector2d principal_point_px = Eigen::Vector2d::Zero();  // (cx, cy), image coordinates; may be off the image
 };
+
+// The candidates, the centred seed (the image's centre with OpenCV's focal
+// length, or the given one) first; none repeats another.
+std::vector<PinholeSeed> PinholeSeedCandidates(const std::vector<const BoardObservation*>& views,
+                                               const TargetGeometry& target, int width_px, int height_px,
+                                               double given_focal_px);
 
 // `views`: one camera's observations, each with corners spanning the board's
 // plane. `given_focal_px` > 0 is every candidate's focal length (the user's
