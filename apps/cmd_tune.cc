@@ -15,6 +15,7 @@
 #include "calib/core/input_file.h"
 #include "calib/core/number_text.h"
 #include "calib/core/rig_file.h"
+#include "reconstruct/grid_line_width.h"
 #include "reconstruct/grid_period.h"
 #include "reconstruct/grid_period_options.h"
 #include "reconstruct/lit_mask.h"
@@ -94,10 +95,10 @@ int RunTune(int argc, char** argv) {
     std::printf("module %d: grid period %.2f px along the rows, spread %.2f px over %d blocks of %d rows\n",
                 plan.module, m->period_px, m->spread_px, m->blocks, GridPeriodOptions{}.block_rows);
     if (m->spread_px > kMaxRelativeSpread * m->period_px)
-      std::printf(
-          "  warning: module %d's period varies by more than %.0f %% over its image: a curved or turned "
-          "surface; measure on a flat plate facing the module\n",
-          plan.module, 100 * kMaxRelativeSpread);
+      std::fprintf(stderr,
+                   "tune: warning: module %d's period varies by more than %.0f %% over its image: a curved or turned "
+                   "surface; measure on a flat plate facing the module\n",
+                   plan.module, 100 * kMaxRelativeSpread);
     if (std::isnan(m->shift_per_row_px)) {
       std::printf(
           "  its turn against the rows was not read: check the line index's vernier by hand "
@@ -109,21 +110,41 @@ int RunTune(int argc, char** argv) {
           "(its thresholds need %.2f-%.2f)\n",
           GridTurnDeg(*m), offset_px, kMinRowOffsetPerPeriodPx, kMaxRowOffsetPerPeriodPx);
       if (offset_px < kMinRowOffsetPerPeriodPx || offset_px > kMaxRowOffsetPerPeriodPx)
-        std::printf(
-            "  warning: at this turn module %d's line index cannot tell a line from its neighbour reliably (at "
+        std::fprintf(
+            stderr,
+            "tune: warning: at this turn module %d's line index cannot tell a line from its neighbour reliably (at "
             "strong speckle a component a line off may be kept, or the right one dropped): turn the projector "
             "about its axis so that P tan(turn) lies in %.2f-%.2f px (docs/reconstruct.md, \"Another "
             "projector\")\n",
             plan.module, kMinRowOffsetPerPeriodPx, kMaxRowOffsetPerPeriodPx);
     }
+    if (std::isnan(m->line_sigma_over_period)) {
+      std::printf(
+          "  its lines' width was not read (a period under %.0f px, saturated lines, or lines so wide that "
+          "their profile is a sinusoid)\n",
+          kMinLineWidthPeriodPx);
+    } else {
+      std::printf(
+          "  its lines are %.2f px wide (sigma along the rows): %.3f of the period (the runtime is tuned "
+          "for up to %.2f)\n",
+          m->line_sigma_over_period * m->period_px, m->line_sigma_over_period, kMaxLineSigmaOverPeriod);
+      if (m->line_sigma_over_period > kMaxLineSigmaOverPeriod)
+        std::fprintf(stderr,
+                     "tune: warning: module %d's lines are wide for their period (sigma %.3f of it): the grid fades "
+                     "towards a sinusoid, which looks the same a period off, and the matcher loses fill or keeps "
+                     "patches a line off. Focus the projector's lines, or use a longer period "
+                     "(docs/reconstruct.md, \"Another projector\")\n",
+                     plan.module, m->line_sigma_over_period);
+    }
     periods.push_back(m->period_px);
-    char text[128];
-    if (std::isnan(m->shift_per_row_px))
-      std::snprintf(text, sizeof text, "module %d %.2f px (spread %.2f px, turn not read)", plan.module, m->period_px,
-                    m->spread_px);
-    else
-      std::snprintf(text, sizeof text, "module %d %.2f px (spread %.2f px, turned %.2f deg)", plan.module, m->period_px,
-                    m->spread_px, GridTurnDeg(*m));
+    char text[192];
+    const std::string turn =
+        std::isnan(m->shift_per_row_px) ? "turn not read" : "turned " + NumberText(GridTurnDeg(*m), 3) + " deg";
+    const std::string width = std::isnan(m->line_sigma_over_period)
+                                  ? "line width not read"
+                                  : "lines sigma " + NumberText(m->line_sigma_over_period, 3) + " P";
+    std::snprintf(text, sizeof text, "module %d %.2f px (spread %.2f px, %s, %s)", plan.module, m->period_px,
+                  m->spread_px, turn.c_str(), width.c_str());
     measured += (measured.empty() ? "" : ", ") + std::string(text);
   }
   if (periods.empty())
@@ -136,8 +157,9 @@ int RunTune(int argc, char** argv) {
   std::sort(sorted.begin(), sorted.end());
   const double period_px = 0.5 * (sorted[(sorted.size() - 1) / 2] + sorted[sorted.size() / 2]);
   if (sorted.back() - sorted.front() > kMaxRelativeModuleDifference * period_px)
-    std::printf(
-        "warning: the modules' periods differ by more than %.0f %% (%.2f to %.2f px): one set of options "
+    std::fprintf(
+        stderr,
+        "tune: warning: the modules' periods differ by more than %.0f %% (%.2f to %.2f px): one set of options "
         "serves them all, so it takes their median\n",
         100 * kMaxRelativeModuleDifference, sorted.front(), sorted.back());
 
@@ -154,8 +176,9 @@ int RunTune(int argc, char** argv) {
   }
   std::printf("P = %.2f px, taken as %ld px:\n", period_px, std::lround(period_px));
   if (const int other_px = OtherRoundedPeriodPx(period_px))
-    std::printf(
-        "  warning: P lies within %.1f px of the half pixel, so another capture of this rig may read it as %d px "
+    std::fprintf(
+        stderr,
+        "tune: warning: P lies within %.1f px of the half pixel, so another capture of this rig may read it as %d px "
         "and set other keys: measure the plate in a second position, and keep the set that verifies better\n",
         kRoundingMarginPx, other_px);
   for (const GridPeriodKey& k : keys)

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "calib/core/input_error.h"
+#include "reconstruct/grid_line_width.h"
 
 namespace stereorig {
 namespace {
@@ -212,6 +213,7 @@ std::optional<GridPeriodMeasurement> MeasureGridPeriodPx(const cv::Mat& left, co
   const std::vector<std::vector<std::pair<int, int>>> runs = LitRuns(lit, o);
   GridPeriodMeasurement out;
   std::vector<double> periods, shifts, g;
+  GridHarmonicPowers harmonics;
   for (int y0 = 0; y0 < left.rows; y0 += o.block_rows) {
     const int y1 = std::min(left.rows, y0 + o.block_rows);
     LagSums sums(lags);
@@ -222,6 +224,9 @@ std::optional<GridPeriodMeasurement> MeasureGridPeriodPx(const cv::Mat& left, co
     const double period = BlockPeriodPx(Normalised(sums), o);
     if (std::isnan(period)) continue;
     periods.push_back(period);
+    if (period >= kMinLineWidthPeriodPx)
+      for (int y = y0; y < y1; ++y)
+        for (const auto& [x0, x1] : runs[y]) AddRunHarmonics(left.ptr<uint8_t>(y), x0, x1, period, &harmonics);
     const double shift = BlockShiftPerRowPx(left, runs, y0, y1, period, o);
     if (!std::isnan(shift)) shifts.push_back(shift);
   }
@@ -230,6 +235,8 @@ std::optional<GridPeriodMeasurement> MeasureGridPeriodPx(const cv::Mat& left, co
   out.blocks = int(periods.size());
   out.period_px = Quantile(periods, 0.5);
   out.spread_px = 0.5 * (Quantile(periods, 0.75) - Quantile(periods, 0.25));
+  if (out.period_px >= kMinLineWidthPeriodPx)
+    out.line_sigma_over_period = LineSigmaOverPeriod(harmonics, out.period_px);
   if (int(shifts.size()) >= o.min_blocks) {
     std::sort(shifts.begin(), shifts.end());
     out.shift_per_row_px = Quantile(shifts, 0.5);

@@ -49,6 +49,11 @@ struct GridPeriodMeasurement {
   // origin (grid_period.cc). NaN where fewer than min_blocks blocks read
   // it.
   double shift_per_row_px = std::numeric_limits<double>::quiet_NaN();
+  // The lines' width for their period, sigma / P along the rows
+  // (grid_line_width.h), from the harmonics of the blocks' runs at each
+  // block's own period. NaN below kMinLineWidthPeriodPx or where the
+  // second harmonic does not stand above the noise.
+  double line_sigma_over_period = std::numeric_limits<double>::quiet_NaN();
 };
 
 // The grid's turn against the rows, degrees (>= 0): atan |shift_per_row_px|.

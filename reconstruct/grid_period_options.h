@@ -53,6 +53,17 @@ inline constexpr double kMaxRowOffsetPerPeriodPx = 0.9;
 // half period.
 inline constexpr double kMaxGridHalfPeriodPx = 4;
 
+// The widest lines, sigma / P along the rows (grid_line_width.h), the
+// runtime's defaults are known to work with. The simulator's default grid
+// reads 0.168 on its plate (both modules; 0.171-0.173 on the cup), a
+// 34-line grating 0.108 (the per-module std over 0.1 mm on 2 of 18
+// scene-modules, three seeds). Lines twice as wide (line_sigma_mrad 2) read
+// 0.177-0.181 on the 34-line grating (std over 0.1 mm on 7 of 18, up to
+// 0.185 mm), and 0.227 on the default 51-line grating, where modules lost
+// most of their points (sphere module 1 0 % fill, ball bar 2.4 %) or kept
+// a patch a line off (0.52 mm std) (docs/reconstruct-log.md, session 32).
+inline constexpr double kMaxLineSigmaOverPeriod = 0.18;
+
 struct GridPeriodKey {
   std::string key;  // as the options file names it: match.<key>
   double value = 0;

@@ -115,14 +115,17 @@ struct MatchOptions {
   double min_zncc = 0.8;  // reject matches whose refined window correlates less; default 0.8
   double max_plane_deviation_px =
       0.7;  // reject d farther than this from the local 9x9 disparity plane (0 = off); default 0.7
-  // census_sgm: the refined match must beat the ZNCC half a grid period
+  // census_sgm: the refined match must beat the ZNCC grid_half_period_px
   // either side by this (RefineAcceptance, disparity_state.h; 0 = off);
   // default 0.4. Passive captures: set 0.
   double min_distinctness = 0.4;
-  double grid_half_period_px = 4;  // half the laser grid's period along the rows, px; default 4 (~8 px period)
-  double min_texture_dn = 1.5;     // reject windows with a grey-level std below this; default 1.5 DN
-  LineIndexOptions line_index;     // census_sgm: the component-wide grid-period test (line_index.h)
-  GrowOptions grow;                // census_sgm: growing into the pixels SGM left empty (region_grow.h)
+  // The distinctness test's shift (and the grid-line test's and the right
+  // view edge's reach), px: half the laser grid's period along the rows,
+  // at most 4 (grid_period_options.h); default 4 (the default ~8 px period).
+  double grid_half_period_px = 4;
+  double min_texture_dn = 1.5;  // reject windows with a grey-level std below this; default 1.5 DN
+  LineIndexOptions line_index;  // census_sgm: the component-wide grid-period test (line_index.h)
+  GrowOptions grow;             // census_sgm: growing into the pixels SGM left empty (region_grow.h)
   // census_sgm, opencv_sgbm_3way: drop the pixels the right camera cannot
   // see, last but the surface fit, after the left view's edge test
   // (right_occlusion.h): occluded by a nearer surface, or matched
