@@ -39,27 +39,6 @@ void FillPoolBlock(const BoardObservation& obs, const TargetGeometry& target, mr
 
 namespace {
 
-// The seed pose of one view from PnP through the distortion-free pinhole
-// `seed`; nullopt if PnP fails (a nearly collinear view: seen in the target
-// study, 13x11 board).
-std::optional<Pose> SeedPose(const BoardObservation& obs, const TargetGeometry& target, const PinholeSeed& seed) {
-  std::vector<cv::Point3d> object;
-  std::vector<cv::Point2d> image;
-  for (size_t k = 0; k < obs.corner_ids.size(); ++k) {
-    const Eigen::Vector3d p = target.CornerInFace(obs.corner_ids[k]);
-    object.emplace_back(p.x(), p.y(), p.z());
-    image.emplace_back(obs.q_px[k].x(), obs.q_px[k].y());
-  }
-  const double f = seed.focal_px;
-  const cv::Matx33d K(f, 0, seed.principal_point_px.x(), 0, f, seed.principal_point_px.y(), 0, 0, 1);
-  cv::Mat rvec, tvec;
-  const bool ok = cv::solvePnP(object, image, K, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_IPPE);
-  if (!ok || rvec.total() != 3 || tvec.total() != 3) return std::nullopt;
-  Pose pose = Pose::FromRotationVector(Eigen::Vector3d(rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2)),
-                                       Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2)));
-  return pose;
-}
-
 // Angle between the board normal and the camera's optical axis, degrees.
 double TiltDeg(const Pose& cam_from_face) {
   const Eigen::Vector3d n = cam_from_face.rotation().col(2);
@@ -197,7 +176,7 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
   {
     std::vector<const BoardObservation*> posed;
     for (const BoardObservation* v : views) {
-      const std::optional<Pose> seed = SeedPose(*v, target, pinhole);
+      const std::optional<Pose> seed = PinholeBoardPose(CornersOfView(*v, target), pinhole);
       if (!seed) {
         ++dropped;
         continue;

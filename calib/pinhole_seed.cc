@@ -83,35 +83,45 @@ std::optional<PinholeSeed> ClosedForm(const std::vector<const BoardObservation*>
   return PinholeSeed{scale_px * std::sqrt(f2), centre_px + scale_px * c};
 }
 
-// One view's corners: on the board (mm, the face's frame) and in the image
-// (px).
-struct ViewCorners {
-  std::vector<cv::Point3d> board;
-  std::vector<cv::Point2d> image;
-};
-
 // The sum of the squared distances, px^2, of the view's corners from their
-// reprojection through `seed` after the view's board pose is solved alone
-// (PnP, IPPE); nullopt if PnP fails: OpenCV returns false for a row of
-// corners and one beside it, and true with a NaN pose for corners on one
-// line (measured, 11 x 9 board).
+// reprojection through `seed` after the view's board pose is solved alone;
+// nullopt if PnP fails (PinholeBoardPose).
 std::optional<double> ViewSumSquares(const ViewCorners& v, const PinholeSeed& seed) {
-  const cv::Matx33d K(seed.focal_px, 0, seed.principal_point_px.x(), 0, seed.focal_px, seed.principal_point_px.y(), 0,
-                      0, 1);
-  cv::Mat rvec, tvec;
-  if (!cv::solvePnP(v.board, v.image, K, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_IPPE)) return std::nullopt;
-  std::vector<cv::Point2d> projected;
-  cv::projectPoints(v.board, rvec, tvec, K, cv::noArray(), projected);
+  const std::optional<Pose> cam_from_face = PinholeBoardPose(v, seed);
+  if (!cam_from_face) return std::nullopt;
   double sum_sq = 0;
-  for (size_t k = 0; k < v.image.size(); ++k) {
-    const cv::Point2d d = projected[k] - v.image[k];
-    sum_sq += d.dot(d);
+  for (size_t k = 0; k < v.image_px.size(); ++k) {
+    const cv::Point3d& b = v.board_mm[k];
+    const Eigen::Vector3d p = *cam_from_face * Eigen::Vector3d(b.x, b.y, b.z);
+    const Eigen::Vector2d projected = seed.focal_px * p.head<2>() / p.z() + seed.principal_point_px;
+    sum_sq += (projected - Eigen::Vector2d(v.image_px[k].x, v.image_px[k].y)).squaredNorm();
   }
   if (!std::isfinite(sum_sq)) return std::nullopt;
   return sum_sq;
 }
 
 }  // namespace
+
+ViewCorners CornersOfView(const BoardObservation& view, const TargetGeometry& target) {
+  ViewCorners corners;
+  for (size_t k = 0; k < view.corner_ids.size(); ++k) {
+    const Eigen::Vector3d p = target.CornerInFace(view.corner_ids[k]);
+    corners.board_mm.emplace_back(p.x(), p.y(), p.z());
+    corners.image_px.emplace_back(view.q_px[k].x(), view.q_px[k].y());
+  }
+  return corners;
+}
+
+std::optional<Pose> PinholeBoardPose(const ViewCorners& corners, const PinholeSeed& seed) {
+  const cv::Matx33d K(seed.focal_px, 0, seed.principal_point_px.x(), 0, seed.focal_px, seed.principal_point_px.y(), 0,
+                      0, 1);
+  cv::Vec3d rvec, tvec;
+  if (!cv::solvePnP(corners.board_mm, corners.image_px, K, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_IPPE))
+    return std::nullopt;
+  const Eigen::Vector3d r(rvec[0], rvec[1], rvec[2]), t(tvec[0], tvec[1], tvec[2]);
+  if (!r.allFinite() || !t.allFinite()) return std::nullopt;
+  return Pose::FromRotationVector(r, t);
+}
 
 std::vector<PinholeSeed> PinholeSeedCandidates(const std::vector<const BoardObservation*>& views,
                                                const TargetGeometry& target, int width_px, int height_px,
@@ -145,14 +155,8 @@ PinholeSeed EstimatePinholeSeed(const std::vector<const BoardObservation*>& all_
   std::vector<double> rms_px;
   for (;;) {
     candidates = PinholeSeedCandidates(views, target, width_px, height_px, given_focal_px);
-    std::vector<ViewCorners> corners(views.size());
-    for (size_t v = 0; v < views.size(); ++v) {
-      for (size_t k = 0; k < views[v]->corner_ids.size(); ++k) {
-        const Eigen::Vector3d p = target.CornerInFace(views[v]->corner_ids[k]);
-        corners[v].board.emplace_back(p.x(), p.y(), p.z());
-        corners[v].image.emplace_back(views[v]->q_px[k].x(), views[v]->q_px[k].y());
-      }
-    }
+    std::vector<ViewCorners> corners;
+    for (const BoardObservation* view : views) corners.push_back(CornersOfView(*view, target));
     std::vector<std::vector<std::optional<double>>> sum_sq(candidates.size());  // (candidate, view), px^2
     std::vector<bool> usable(views.size(), true);
     for (size_t c = 0; c < candidates.size(); ++c) {
@@ -166,7 +170,7 @@ PinholeSeed EstimatePinholeSeed(const std::vector<const BoardObservation*>& all_
     for (size_t v = 0; v < views.size(); ++v) {
       if (!usable[v]) continue;
       usable_views.push_back(views[v]);
-      num_corners += corners[v].image.size();
+      num_corners += corners[v].image_px.size();
     }
     if (num_corners == 0) return candidates.front();  // the centred seed, as before windows were considered
     if (usable_views.size() < views.size()) {

@@ -35,8 +35,11 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
 
+#include "calib/core/pose.h"
 #include "calib/observations.h"
 
 namespace stereorig {
@@ -45,6 +48,20 @@ struct PinholeSeed {
   double focal_px = 0;
   Eigen::Vector2d principal_point_px = Eigen::Vector2d::Zero();  // (cx, cy), image coordinates; may be off the image
 };
+
+// One view's corners: on the board (mm, the face's frame) and in the image
+// (px), as OpenCV's PnP takes them.
+struct ViewCorners {
+  std::vector<cv::Point3d> board_mm;
+  std::vector<cv::Point2d> image_px;
+};
+ViewCorners CornersOfView(const BoardObservation& view, const TargetGeometry& target);
+
+// The board's pose in the camera, cam_from_face, from PnP (IPPE) through the
+// distortion-free pinhole `seed`; nullopt if PnP fails: OpenCV returns false
+// for a row of corners and one beside it, and true with a NaN pose for
+// corners on one line (measured, 11 x 9 board).
+std::optional<Pose> PinholeBoardPose(const ViewCorners& corners, const PinholeSeed& seed);
 
 // The candidates, the centred seed (the image's centre with OpenCV's focal
 // length, or the given one) first; none repeats another.
