@@ -28,7 +28,8 @@ int RunCalibrate(int argc, char** argv) {
       "module1, left: 2, right: 3, face: back}\n('face' is optional; if given, a detection of the other face by "
       "that module is refused).\n\n"
       "Refuses with exit 2: too few views, all views fronto-parallel, a camera that never sees the board, images "
-      "of the wrong size, a face seen by the wrong module.\n\n"
+      "of the wrong size, a face seen by the wrong module; and, after the solve (the summary and the report written, "
+      "the rig file not), a stage that did not converge (rms over --max-rms-px) or a lens no camera has.\n\n"
       "Example:\n  stereorig calibrate --captures data/calibration --target target.yaml --layout layout.yaml "
       "--out rig.yaml --report report.json",
       "stereorig calibrate"};
@@ -53,6 +54,11 @@ int RunCalibrate(int argc, char** argv) {
                  "come from), mm; 0: each camera's median distance to the board in its views, where the rig measures")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--max-rms-px", options.max_rms_px,
+                 "refuse to write the rig file when a stage's reprojection rms is over this, px: that stage did not "
+                 "converge (a converged camera shows its corners' noise, a few tenths of a px at most)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--huber", options.system.huber_px, "stage 3 robust loss scale, px")->capture_default_str();
   app.add_flag("--fixed-intrinsics", fixed_intrinsics, "hold the intrinsics at stage 2's values in stage 3");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
@@ -89,7 +95,7 @@ int RunCalibrate(int argc, char** argv) {
   // camera has) still shows what it found.
   std::printf("%s", SummaryText(result.report).c_str());
   std::fflush(stdout);
-  WriteCalibrationOutputs(result, out_path, report_path, cameramodels_dir);
+  WriteCalibrationOutputs(result, options.max_rms_px, out_path, report_path, cameramodels_dir);
   std::printf("wrote %s and %s\n", out_path.c_str(), report_path.c_str());
   return 0;
 }

@@ -9,6 +9,7 @@
 #include <map>
 #include <set>
 
+#include "calib/convergence.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/cameramodel_export.h"
 #include "calib/core/input_error.h"
@@ -50,6 +51,7 @@ std::vector<int> CapturesWithDifferentFaces(const CalibrationInput& in, int left
 }
 
 void CalibrationOptions::Check() const {
+  if (!(max_rms_px > 0)) throw InputError("options.max_rms_px", "must be > 0 px");
   intrinsics.Check();
   stereo.Check();
   system.Check();
@@ -560,8 +562,15 @@ std::string SummaryText(const CalibrationReport& rep) {
   return out;
 }
 
-void WriteCalibrationOutputs(const CalibrationResult& result, const std::string& rig_path,
+void WriteCalibrationOutputs(const CalibrationResult& result, double max_rms_px, const std::string& rig_path,
                              const std::string& report_path, const std::string& cameramodels_dir) {
+  // A solve that did not converge is named first: its lenses may well be
+  // implausible too, but its RMS says which stage failed.
+  const std::string not_converged = NotConvergedProblem(result.report, max_rms_px);
+  if (!not_converged.empty()) {
+    WriteFileAtomically(report_path, result.report.ToJson());
+    throw InputError(rig_path, "not written: " + not_converged + "; the report is in " + report_path);
+  }
   // A rig file its readers would refuse (ReadRigFile checks every lens) is
   // not written: a solve that diverged says so now, not at the next
   // reconstruct. The report is, to find out why.

@@ -275,7 +275,7 @@ TEST(CalibrateReport, JsonHoldsEveryStage) {
   std::printf("%s", SummaryText(r.report).c_str());
   // The rig file and report round-trip: the rig file reads back with its S.
   const std::string dir = ::testing::TempDir();
-  WriteCalibrationOutputs(r, dir + "/rig.yaml", dir + "/report.json");
+  WriteCalibrationOutputs(r, 1.0, dir + "/rig.yaml", dir + "/report.json");
   const Rig back = ReadRigFile(dir + "/rig.yaml");
   EXPECT_LT((back.S(0, 1).Inverse() * r.rig.S(0, 1)).DistanceMm(), 1e-9);
   EXPECT_EQ(back.provenance().residuals.count("cam0_rms_px"), 1u);
@@ -334,7 +334,7 @@ TEST(CalibrateReport, ALensNoCameraHasIsNotWritten) {
   const std::string dir = ::testing::TempDir() + "/calibrate_implausible";
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
-  WriteCalibrationOutputs(r, dir + "/rig.yaml", dir + "/report.json");  // plausible: written
+  WriteCalibrationOutputs(r, 1.0, dir + "/rig.yaml", dir + "/report.json");  // plausible: written
   const std::string earlier = RigToYaml(ReadRigFile(dir + "/rig.yaml"));
 
   std::vector<double> folded = cameras[1].intrinsics();
@@ -343,7 +343,7 @@ TEST(CalibrateReport, ALensNoCameraHasIsNotWritten) {
   r.rig = Rig(cameras, {"cam0", "cam1"}, {r.rig.module(0)}, {Pose::Identity()});
   std::filesystem::remove(dir + "/report.json");
   const std::string e =
-      testing::InputErrorMessage([&] { WriteCalibrationOutputs(r, dir + "/rig.yaml", dir + "/report.json"); });
+      testing::InputErrorMessage([&] { WriteCalibrationOutputs(r, 1.0, dir + "/rig.yaml", dir + "/report.json"); });
   EXPECT_EQ(e.rfind(dir + "/rig.yaml: not written: the calibration gave camera 1 a lens no camera has (", 0), 0u) << e;
   EXPECT_NE(e.find("check the distortion coefficients"), std::string::npos) << e;
   EXPECT_NE(e.find("the report is in " + dir + "/report.json"), std::string::npos) << e;

@@ -12,10 +12,13 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
 #include "calib/calib_test_util.h"
+#include "calib/convergence.h"
+#include "calib/core/input_error.h"
 #include "calib/intrinsics.h"
 
 namespace stereorig {
@@ -106,6 +109,60 @@ TEST(IntrinsicsWindow, PrincipalPointOffTheWindowsCentreIsFound) {
           << "intrinsic " << i << " (fx fy cx cy)";
     }
   }
+}
+
+// Where stage 1 does not converge, the calibration says so and writes no rig
+// file (calib/convergence.h). Behind a 320 x 240 window at the corner of a
+// 1920 x 1200 sensor (above) some seeds' captures leave the solve far from
+// the lens, every figure of it plausible: on seeds 21-60, 7 of 40 were
+// refused before the solve (fronto-parallel views, a negative focal length
+// from the seed), 8 ended at rms 1.6-62 px with fx 0-1514 px for the true
+// 1025, and 25 converged to rms 0.156-0.190 px (0.2 px of noise) with fx
+// within 1.4 % of the truth. Judged against the truth here: a camera more
+// than 10 % off in fx or 50 px off in (cx, cy) (the converged ones' worst:
+// 1.4 %, 17 px; the others' best 48 %) must be named, every other one must
+// pass. The seeds: those of 21-40 that reach the solve (the refused ones
+// cost seconds each), all four that did not converge among them, and six
+// that did.
+TEST(IntrinsicsWindow, AStageOneThatDidNotConvergeIsNamed) {
+  const SensorWindow w{"320x240 at (0, 0) of 1920x1200", 1920, 1200, 0, 0, 320, 240};
+  const Camera truth = WindowedCamera(w);
+  const WindowScene scene = MakeWindowScene(truth);
+  const TargetGeometry target = DefaultTestTarget();
+  int num_converged = 0, num_not_converged = 0;
+  for (const int seed : {21, 23, 24, 25, 27, 32, 33, 35, 36, 37}) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    SyntheticOptions o;
+    o.seed = seed;
+    o.num_captures = 30;
+    o.noise_px = 0.2;
+    const SyntheticData data =
+        MakeSyntheticCaptures(scene.rig, target, target.back_from_front, scene.ref_from_volume, o);
+    CalibrationReport report;
+    try {
+      report.intrinsics.push_back(CalibrateIntrinsics(0, data.input.cameras[0], target, testing::ViewsOf(data.input, 0),
+                                                      IntrinsicsOptions(), "test")
+                                      .report);
+    } catch (const InputError& e) {
+      ADD_FAILURE() << "refused before the solve: " << e.what();
+      continue;
+    }
+    const std::vector<double>& v = report.intrinsics[0].intrinsics;
+    const std::vector<double>& t = truth.intrinsics();
+    const bool near_truth = std::abs(v[0] - t[0]) < 0.10 * t[0] && std::hypot(v[2] - t[2], v[3] - t[3]) < 50;
+    (near_truth ? num_converged : num_not_converged) += 1;
+    const std::string problem = NotConvergedProblem(report, CalibrationOptions().max_rms_px);
+    if (near_truth) {
+      EXPECT_EQ(problem, "") << "fx " << v[0] << ", rms " << report.intrinsics[0].rms_px;
+    } else {
+      EXPECT_EQ(problem.rfind("stage 1 did not converge: camera 0 (cam0) at rms ", 0), 0u)
+          << problem << " (fx " << v[0] << ")";
+    }
+  }
+  // Both kinds among these seeds (25, 32, 35, 36 did not converge), so
+  // neither branch above passes for want of a case.
+  EXPECT_GE(num_converged, 5);
+  EXPECT_GE(num_not_converged, 3);
 }
 
 }  // namespace
