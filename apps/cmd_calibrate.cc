@@ -54,9 +54,10 @@ int RunCalibrate(int argc, char** argv) {
                  "come from), mm; 0: each camera's median distance to the board in its views, where the rig measures")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--max-rms-px", options.max_rms_px,
-                 "refuse to write the rig file when a stage's reprojection rms is over this, px: that stage did not "
-                 "converge (a converged camera shows its corners' noise, a few tenths of a px at most)")
+  app.add_option("--max-rms-px", options.intrinsics.max_rms_px,
+                 "a stage whose reprojection rms is over this did not converge, px: stage 1 then solves again from its "
+                 "other seeds, and no rig file is written while a stage stays over it (a converged camera shows its "
+                 "corners' noise, a few tenths of a px at most)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   app.add_option("--huber", options.system.huber_px, "stage 3 robust loss scale, px")->capture_default_str();
@@ -95,7 +96,7 @@ int RunCalibrate(int argc, char** argv) {
   // camera has) still shows what it found.
   std::printf("%s", SummaryText(result.report).c_str());
   std::fflush(stdout);
-  WriteCalibrationOutputs(result, options.max_rms_px, out_path, report_path, cameramodels_dir);
+  WriteCalibrationOutputs(result, options.intrinsics.max_rms_px, out_path, report_path, cameramodels_dir);
   std::printf("wrote %s and %s\n", out_path.c_str(), report_path.c_str());
   return 0;
 }

@@ -51,7 +51,6 @@ std::vector<int> CapturesWithDifferentFaces(const CalibrationInput& in, int left
 }
 
 void CalibrationOptions::Check() const {
-  if (!(max_rms_px > 0)) throw InputError("options.max_rms_px", "must be > 0 px");
   intrinsics.Check();
   stereo.Check();
   system.Check();
@@ -213,7 +212,8 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
     Progress(options.progress, "stage 1: intrinsics of camera " + std::to_string(c) + " (" +
                                    std::to_string(by_camera[c].size()) + " views)");
     result.stage1.push_back(
-        CalibrateIntrinsics(c, in.cameras[c], in.target, by_camera[c], options.intrinsics, in.source));
+        CalibrateIntrinsics(c, in.cameras[c], in.target, by_camera[c], options.intrinsics, in.source,
+                            [&](const std::string& message) { Progress(options.progress, message); }));
     rep.intrinsics.push_back(result.stage1.back().report);
   }
   // Stage 2.
@@ -293,6 +293,7 @@ void WriteIntrinsics(JsonWriter& j, const IntrinsicsReport& r, const std::map<in
   j.Int("views", r.num_views).Int("views_dropped", r.num_views_dropped).Int("corners", r.num_corners);
   j.Int("outliers", r.num_outliers).Number("rms_px", r.rms_px).Number("observed_sigma_px", r.observed_sigma_px);
   j.Number("max_tilt_deg", r.max_tilt_deg);
+  j.Int("seeds_tried", r.seeds_tried);
   j.BeginArray("worst_views");
   for (const ViewResidual& v : r.worst_views) {
     j.BeginObject().Int("capture", v.capture);
@@ -493,6 +494,10 @@ std::string SummaryText(const CalibrationReport& rep) {
       const auto& e = r.intrinsics_sigma;
       AppendLine(&out, "    fx %.2f +- %.2f, fy %.2f +- %.2f, cx %.2f +- %.2f, cy %.2f +- %.2f px (1 sigma)", v[0],
                  e[0], v[1], e[1], v[2], e[2], v[3], e[3]);
+    }
+    if (r.seeds_tried > 1) {
+      AppendLine(&out, "    solved from each of %d pinhole seeds, the lowest rms kept: the first did not converge",
+                 r.seeds_tried);
     }
     if (!r.worst_views.empty()) {
       AppendLine(&out, "    worst view: capture %s, rms %.3f px", rep.CaptureName(r.worst_views[0].capture).c_str(),

@@ -27,13 +27,6 @@ struct CalibrationOptions {
   StereoOptions stereo;
   SystemOptions system;
   bool progress = false;  // one line per step on stderr; default false
-  // A stage whose reprojection RMS is over this did not converge, and its
-  // rig file is not written (convergence.h). Default 1 px: at 200 mm and the
-  // default rig's 1025 px focal length ~0.2 mm across the ray, twice the
-  // runtime's whole error budget, and 5x the synthetic noise the tests
-  // inject; a camera that converged shows its corners' noise (0.02 px on
-  // the rendered default dataset).
-  double max_rms_px = 1.0;
   void Check() const;
 };
 
@@ -76,7 +69,7 @@ std::string SummaryText(const CalibrationReport& report);
 // ExportCameramodels' files there, all or none (AtomicOutputSet): a model
 // that cannot be written leaves an earlier run's rig file as it was. A
 // camera no lens could be (lens_plausibility.h), or a stage over
-// `max_rms_px` (convergence.h), writes the report alone and throws
+// `max_rms_px` (IntrinsicsOptions::max_rms_px, convergence.h), writes the report alone and throws
 // InputError naming the rig file: its readers would refuse the first, and
 // the second would measure nothing to its figures.
 void WriteCalibrationOutputs(const CalibrationResult& result, double max_rms_px, const std::string& rig_path,

@@ -8,6 +8,7 @@
 // uncertainty (a port of mrcal's, see projection_uncertainty.h).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,14 @@ struct IntrinsicsOptions {
   int min_corners_per_view = 8;  // views with fewer corners are not used; default 8
   int min_views = 5;             // fewer usable views is an input error; default 5
   double min_tilt_deg = 10.0;    // if no view tilts the board more than this, the set is degenerate; default 10 deg
+  // A solve whose RMS is over this did not converge: stage 1 tries the next
+  // seed candidate (calib/pinhole_seed.h), and calibrate writes no rig file
+  // while any stage is over it (calib/convergence.h). Default 1 px: at 200 mm
+  // and the default rig's 1025 px focal length ~0.2 mm across the ray, twice
+  // the runtime's whole error budget, and 5x the synthetic noise the tests
+  // inject; a camera that converged shows its corners' noise (0.02 px on the
+  // rendered default dataset).
+  double max_rms_px = 1.0;
   // Range of the points whose projection uncertainty is reported, mm. 0
   // (default): the median distance of the board from the camera in its
   // views, where the rig measures (a fixed 200 mm reported a rig working at
@@ -66,6 +75,9 @@ struct IntrinsicsReport {
   double rms_px = 0.0;             // RMS of the inlier residual coordinates (x and y pooled), px
   double observed_sigma_px = 0.0;  // std of the residuals (the noise the uncertainty assumes)
   double max_tilt_deg = 0.0;       // largest board tilt among the views
+  // Seed candidates solved from (calib/pinhole_seed.h): 1 where the first
+  // converged; all of them where none did.
+  int seeds_tried = 0;
   std::vector<ViewResidual> worst_views;
   int coverage_cells_x = 0, coverage_cells_y = 0;
   std::vector<int> coverage;                  // (cells_y, cells_x) row-major: inlier corners per cell
@@ -87,9 +99,13 @@ struct IntrinsicsResult {
 
 // `views`: this camera's observations (all of the same camera). Throws
 // InputError (`where` names the input) on too few views or a degenerate set.
+// Solved from the first of RankedPinholeSeeds (calib/pinhole_seed.h); where
+// that solve's RMS is over options.max_rms_px, from every candidate, the
+// lowest RMS kept (`progress`, if given, is told so: that takes seconds).
 IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const TargetGeometry& target,
                                      const std::vector<const BoardObservation*>& views,
-                                     const IntrinsicsOptions& options, const std::string& where);
+                                     const IntrinsicsOptions& options, const std::string& where,
+                                     const std::function<void(const std::string&)>& progress = {});
 
 // Shared helpers for the mrcal problems of stages 1 and 2.
 // False for the lens models whose every parameter the boards determine

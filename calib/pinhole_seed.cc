@@ -3,6 +3,7 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <opencv2/calib3d.hpp>
 #include <optional>
 
@@ -141,8 +142,9 @@ std::vector<PinholeSeed> PinholeSeedCandidates(const std::vector<const BoardObse
   return candidates;
 }
 
-PinholeSeed EstimatePinholeSeed(const std::vector<const BoardObservation*>& all_views, const TargetGeometry& target,
-                                int width_px, int height_px, double given_focal_px) {
+std::vector<PinholeSeed> RankedPinholeSeeds(const std::vector<const BoardObservation*>& all_views,
+                                            const TargetGeometry& target, int width_px, int height_px,
+                                            double given_focal_px) {
   // A view whose PnP fails (for one candidate or all) is left out of every
   // candidate's score alike, rather than making scores infinite; and out of
   // the candidates themselves (a nearly collinear view's homography moved
@@ -172,7 +174,7 @@ PinholeSeed EstimatePinholeSeed(const std::vector<const BoardObservation*>& all_
       usable_views.push_back(views[v]);
       num_corners += corners[v].image_px.size();
     }
-    if (num_corners == 0) return candidates.front();  // the centred seed, as before windows were considered
+    if (num_corners == 0) return candidates;  // the centred seed first, as before windows were considered
     if (usable_views.size() < views.size()) {
       views = std::move(usable_views);
       continue;
@@ -184,7 +186,6 @@ PinholeSeed EstimatePinholeSeed(const std::vector<const BoardObservation*>& all_
     }
     break;
   }
-  const PinholeSeed& centred = candidates.front();
   size_t best = 0;
   for (size_t c = 1; c < candidates.size(); ++c)
     if (rms_px[c] < rms_px[best]) best = c;
@@ -203,7 +204,23 @@ PinholeSeed EstimatePinholeSeed(const std::vector<const BoardObservation*>& all_
   // neither). 0.2 is 2x below the least ordinary ratio and 2.4x above the
   // one that needs the switch.
   constexpr double kRequiredRmsRatio = 0.2;
-  return rms_px[best] < kRequiredRmsRatio * rms_px[0] ? candidates[best] : centred;
+  const size_t chosen = rms_px[best] < kRequiredRmsRatio * rms_px[0] ? best : 0;
+  // Then the others, best first: where the solve from the chosen one does
+  // not converge, stage 1 tries them in turn (intrinsics.h).
+  std::vector<size_t> order(candidates.size());
+  std::iota(order.begin(), order.end(), size_t(0));
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    if ((a == chosen) != (b == chosen)) return a == chosen;
+    return rms_px[a] < rms_px[b];
+  });
+  std::vector<PinholeSeed> ranked;
+  for (const size_t c : order) ranked.push_back(candidates[c]);
+  return ranked;
+}
+
+PinholeSeed EstimatePinholeSeed(const std::vector<const BoardObservation*>& views, const TargetGeometry& target,
+                                int width_px, int height_px, double given_focal_px) {
+  return RankedPinholeSeeds(views, target, width_px, height_px, given_focal_px).front();
 }
 
 }  // namespace stereorig
