@@ -120,7 +120,7 @@ TEST(PngReader, ADamagedPngIsNamedWithTheChunk) {
   std::string iend = kWhole;
   iend[kWhole.size() - 1] ^= 0x01;
   ExpectRefused(iend, "a damaged PNG (its IEND chunk at byte 1045 fails its CRC check)");
-  std::string text = Chunk("tEXt", "Software\0x");
+  std::string text = Chunk("tEXt", std::string("Software\0x", 10));  // keyword, NUL, text
   text[12] ^= 0x01;
   ExpectRefused(kHead + text + Chunk("IDAT", kImageData) + kIend,
                 "a damaged PNG (its tEXt chunk at byte 33 fails its CRC check)");
