@@ -4,12 +4,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include <optional>
 
 #include "calib/core/capture_image_name.h"
 #include "calib/core/input_error.h"
 #include "calib/core/input_file.h"
-#include "calib/core/png_file.h"
+#include "calib/core/png_reader.h"
 #include "calib/layout_file.h"
 #include "targets/target_file.h"
 
@@ -75,25 +75,22 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
         throw InputError(image.string(), "missing (each capture needs camK.png for every camera)");
       RequireInputFile(image.string());  // a folder named cam0.png
       // Not a PNG though so named (a JPEG): its decoder would complain first.
-      if (!CheckPngIsWhole(image.string())) throw InputError(image.string(), "is not a PNG file, though named .png");
-      // Read as stored, and held to what the runtime reads
-      // (reconstruct/grey_image.h): imread's own conversion to grey would
-      // take a 16-bit image's high byte (a 12-bit camera's image in the low
-      // bits turns nearly black, and then no board is found) and let a
-      // colour capture through that `reconstruct` refuses.
-      cv::Mat grey;
-      try {
-        grey = cv::imread(image.string(), cv::IMREAD_UNCHANGED);
-      } catch (const cv::Exception& e) {  // a header whose size the decoder refuses: its short text, one line
-        throw InputError(image.string(), "cannot read the image (" + e.err + ")");
-      }
-      if (grey.empty()) throw InputError(image.string(), "cannot be read as an image");
-      if (grey.type() != CV_8UC1)
+      std::optional<PngReader> png = PngReader::Open(image.string());
+      if (!png) throw InputError(image.string(), "is not a PNG file, though named .png");
+      // Held to what the runtime reads (reconstruct/grey_image.h), from the
+      // header, before decoding: imread's own conversion to grey would take
+      // a 16-bit image's high byte (a 12-bit camera's image in the low bits
+      // turns nearly black, and then no board is found) and let a colour
+      // capture through that `reconstruct` refuses. The channels and bits
+      // are imread's (IMREAD_UNCHANGED), as png_reader.h gives them.
+      if (png->channels() != 1 || png->bit_depth() != 8)
         throw InputError(image.string(),
                          "must be an 8-bit single-channel (grey) image, as `stereorig reconstruct` "
                          "reads too (this one has " +
-                             std::to_string(grey.channels()) + " channel(s) of " +
-                             std::to_string(8 * int(grey.elemSize1())) + " bits)");
+                             std::to_string(png->channels()) + " channel(s) of " + std::to_string(png->bit_depth()) +
+                             " bits)");
+      cv::Mat grey(int(png->height_px()), int(png->width_px()), CV_8UC1);
+      png->Read(grey.data, grey.step);
       CameraImager& spec = out.cameras[c];
       if (spec.width_px == 0) {
         spec.width_px = grey.cols;

@@ -11,9 +11,10 @@
 
 namespace stereorig {
 
-// The image at `path` (cv::IMREAD_UNCHANGED). Throws InputError if the file
-// is missing or not a file, is a PNG cut short or damaged
-// (calib/core/png_file.h), is named .png but is not one, or cannot be decoded.
+// The image at `path`, as cv::imread(path, IMREAD_UNCHANGED) gives it; a PNG
+// decoded once, by calib/core/png_reader.h. Throws InputError if the file is
+// missing or not a file, is a PNG cut short, damaged or too large
+// (png_reader.h), is named .png but is not one, or cannot be decoded.
 cv::Mat ReadImageFile(const std::string& path);
 
 }  // namespace stereorig
