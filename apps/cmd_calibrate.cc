@@ -96,7 +96,7 @@ int RunCalibrate(int argc, char** argv) {
   // camera has) still shows what it found.
   std::printf("%s", SummaryText(result.report).c_str());
   std::fflush(stdout);
-  WriteCalibrationOutputs(result, options.intrinsics.max_rms_px, out_path, report_path, cameramodels_dir);
+  WriteCalibrationOutputs(result, out_path, report_path, cameramodels_dir);
   std::printf("wrote %s and %s\n", out_path.c_str(), report_path.c_str());
   return 0;
 }

@@ -206,6 +206,7 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
   rep.source = in.source;
   rep.num_modules = M;
   rep.capture_names = in.capture_names;
+  rep.max_rms_px = options.intrinsics.max_rms_px;
 
   // Stage 1.
   for (int c = 0; c < nc; ++c) {
@@ -216,6 +217,11 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
                             [&](const std::string& message) { Progress(options.progress, message); }));
     rep.intrinsics.push_back(result.stage1.back().report);
   }
+  // A camera that did not converge ends the calibration here: stages 2 and 3
+  // would start from its wrong lens, and could refuse the captures for it
+  // ("too few views shared") before the convergence check named the cause.
+  rep.not_converged = NotConvergedProblem(rep, rep.max_rms_px);
+  if (!rep.not_converged.empty()) return result;
   // Stage 2.
   std::vector<ModuleCameras> modules;
   for (int k = 0; k < M; ++k) {
@@ -244,6 +250,8 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
     result.stage3.module0_from_module_horn = module0_from_module;
     result.stage3.modules = modules;
   }
+
+  rep.not_converged = NotConvergedProblem(rep, rep.max_rms_px);
 
   // The rig.
   std::vector<Camera> cameras(nc, Camera("LENSMODEL_PINHOLE", {1, 1, 0, 0}, 1, 1));
@@ -331,6 +339,8 @@ std::string CalibrationReport::CaptureName(int capture) const {
 std::string CalibrationReport::ToJson() const {
   JsonWriter j;
   j.BeginObject().String("source", source).Int("modules", num_modules);
+  // The verdict calibrate acted on: a report beside no new rig file says why.
+  j.BeginObject("convergence").Number("max_rms_px", max_rms_px).String("not_converged", not_converged).EndObject();
   j.BeginArray("stage1_intrinsics");
   for (const IntrinsicsReport& r : intrinsics) WriteIntrinsics(j, r, capture_names);
   j.EndArray();
@@ -369,7 +379,7 @@ std::string CalibrationReport::ToJson() const {
     j.EndObject();
   }
   j.EndArray();
-  if (num_modules > 1) {
+  if (num_modules > 1 && !stereo.empty()) {  // stage 3 ran (not after a stage 1 that did not converge)
     const SystemReport& s = system;
     j.BeginObject("stage3_system").Int("captures", s.num_captures).Int("corner_residuals", s.num_residual_corners);
     j.Int("skipped_views", s.num_skipped_views).Int("skipped_view_corners", s.num_skipped_view_corners);
@@ -390,6 +400,7 @@ std::string CalibrationReport::ToJson() const {
     j.EndArray().EndObject();
     j.BeginObject("refined")
         .Number("reprojection_rms_px", s.refined_reprojection_rms_px)
+        .Number("median_corner_residual_px", s.refined_median_corner_residual_px)
         .BeginArray("module0_from_module");
     for (const Pose& p : s.module0_from_module) {
       j.BeginObject();
@@ -504,6 +515,10 @@ std::string SummaryText(const CalibrationReport& rep) {
                  r.worst_views[0].rms_px);
     }
   }
+  if (rep.stereo.empty() && !rep.not_converged.empty()) {
+    AppendLine(&out, "stages 2 and 3 not run: stage 1 did not converge (rms over %g px)", rep.max_rms_px);
+    return out;
+  }
   AppendLine(&out, "stage 2: stereo extrinsics per module");
   for (const StereoReport& s : rep.stereo) {
     AppendLine(&out,
@@ -567,14 +582,13 @@ std::string SummaryText(const CalibrationReport& rep) {
   return out;
 }
 
-void WriteCalibrationOutputs(const CalibrationResult& result, double max_rms_px, const std::string& rig_path,
+void WriteCalibrationOutputs(const CalibrationResult& result, const std::string& rig_path,
                              const std::string& report_path, const std::string& cameramodels_dir) {
   // A solve that did not converge is named first: its lenses may well be
   // implausible too, but its RMS says which stage failed.
-  const std::string not_converged = NotConvergedProblem(result.report, max_rms_px);
-  if (!not_converged.empty()) {
+  if (!result.report.not_converged.empty()) {
     WriteFileAtomically(report_path, result.report.ToJson());
-    throw InputError(rig_path, "not written: " + not_converged + "; the report is in " + report_path);
+    throw InputError(rig_path, "not written: " + result.report.not_converged + "; the report is in " + report_path);
   }
   // A rig file its readers would refuse (ReadRigFile checks every lens) is
   // not written: a solve that diverged says so now, not at the next

@@ -37,6 +37,11 @@ struct CalibrationReport {
   SystemReport system;                       // stage 3 (empty for a 1-module rig)
   int num_modules = 0;
   std::map<int, std::string> capture_names;  // CalibrationInput::capture_names
+  // The limit every stage was held to (IntrinsicsOptions::max_rms_px) and,
+  // if one stayed over it, NotConvergedProblem's line (calib/convergence.h;
+  // "" if all converged). Stage 1 over it: stages 2 and 3 are not run.
+  double max_rms_px = 0.0;
+  std::string not_converged;
   // The capture's folder name where known, else its index in decimal: how
   // the summary names a capture (the JSON keeps the index and adds the name).
   std::string CaptureName(int capture) const;
@@ -68,11 +73,11 @@ std::string SummaryText(const CalibrationReport& report);
 // Writes the rig file, the JSON report and, if cameramodels_dir is given,
 // ExportCameramodels' files there, all or none (AtomicOutputSet): a model
 // that cannot be written leaves an earlier run's rig file as it was. A
-// camera no lens could be (lens_plausibility.h), or a stage over
-// `max_rms_px` (IntrinsicsOptions::max_rms_px, convergence.h), writes the report alone and throws
-// InputError naming the rig file: its readers would refuse the first, and
-// the second would measure nothing to its figures.
-void WriteCalibrationOutputs(const CalibrationResult& result, double max_rms_px, const std::string& rig_path,
+// camera no lens could be (lens_plausibility.h), or a stage that did not
+// converge (report.not_converged, convergence.h), writes the report alone
+// and throws InputError naming the rig file: its readers would refuse the
+// first, and the second would measure nothing to its figures.
+void WriteCalibrationOutputs(const CalibrationResult& result, const std::string& rig_path,
                              const std::string& report_path, const std::string& cameramodels_dir = "");
 
 }  // namespace stereorig

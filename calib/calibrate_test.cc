@@ -143,6 +143,13 @@ TEST(CalibrateE2E, ThreeModuleRingWithDifferentFaces) {
     EXPECT_EQ(r.report.stereo[k].different_face_captures, different[k]) << "module " << k;
   }
   EXPECT_NEAR(r.report.system.refined_reprojection_rms_px, kNoisePx, 0.1 * kNoisePx);
+  // The median corner distance the convergence check reads: a Rayleigh
+  // distribution's median, sqrt(2 ln 2) = 1.177 times the noise per
+  // coordinate, within the same 10 % (its own spread over thousands of
+  // corners is ~1 %).
+  EXPECT_NEAR(r.report.system.refined_median_corner_residual_px, std::sqrt(2 * std::log(2.0)) * kNoisePx,
+              0.1 * std::sqrt(2 * std::log(2.0)) * kNoisePx);
+  EXPECT_EQ(r.report.not_converged, "");
   ASSERT_EQ(r.report.system.sigma.size(), 2u);
   for (const STransformSigma& s : r.report.system.sigma) {
     const int k = s.module;
@@ -275,7 +282,7 @@ TEST(CalibrateReport, JsonHoldsEveryStage) {
   std::printf("%s", SummaryText(r.report).c_str());
   // The rig file and report round-trip: the rig file reads back with its S.
   const std::string dir = ::testing::TempDir();
-  WriteCalibrationOutputs(r, 1.0, dir + "/rig.yaml", dir + "/report.json");
+  WriteCalibrationOutputs(r, dir + "/rig.yaml", dir + "/report.json");
   const Rig back = ReadRigFile(dir + "/rig.yaml");
   EXPECT_LT((back.S(0, 1).Inverse() * r.rig.S(0, 1)).DistanceMm(), 1e-9);
   EXPECT_EQ(back.provenance().residuals.count("cam0_rms_px"), 1u);
@@ -334,7 +341,7 @@ TEST(CalibrateReport, ALensNoCameraHasIsNotWritten) {
   const std::string dir = ::testing::TempDir() + "/calibrate_implausible";
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
-  WriteCalibrationOutputs(r, 1.0, dir + "/rig.yaml", dir + "/report.json");  // plausible: written
+  WriteCalibrationOutputs(r, dir + "/rig.yaml", dir + "/report.json");  // plausible: written
   const std::string earlier = RigToYaml(ReadRigFile(dir + "/rig.yaml"));
 
   std::vector<double> folded = cameras[1].intrinsics();
@@ -343,7 +350,7 @@ TEST(CalibrateReport, ALensNoCameraHasIsNotWritten) {
   r.rig = Rig(cameras, {"cam0", "cam1"}, {r.rig.module(0)}, {Pose::Identity()});
   std::filesystem::remove(dir + "/report.json");
   const std::string e =
-      testing::InputErrorMessage([&] { WriteCalibrationOutputs(r, 1.0, dir + "/rig.yaml", dir + "/report.json"); });
+      testing::InputErrorMessage([&] { WriteCalibrationOutputs(r, dir + "/rig.yaml", dir + "/report.json"); });
   EXPECT_EQ(e.rfind(dir + "/rig.yaml: not written: the calibration gave camera 1 a lens no camera has (", 0), 0u) << e;
   EXPECT_NE(e.find("check the distortion coefficients"), std::string::npos) << e;
   EXPECT_NE(e.find("the report is in " + dir + "/report.json"), std::string::npos) << e;

@@ -112,21 +112,24 @@ TEST(IntrinsicsWindow, PrincipalPointOffTheWindowsCentreIsFound) {
 }
 
 // Where the solve from the first pinhole seed does not converge, stage 1
-// solves from every candidate (calib/pinhole_seed.h) and keeps the lowest
-// RMS; where none converges, calibrate names the camera and writes no rig
-// file (calib/convergence.h). Behind a 320 x 240 window at the corner of a
+// solves from every candidate (calib/pinhole_seed.h) and keeps the best;
+// where none converges, calibrate names the camera and writes no rig file
+// (calib/convergence.h). Behind a 320 x 240 window at the corner of a
 // 1920 x 1200 sensor (above), seeds 21-60 of these synthetic captures: from
 // the first seed alone 7 of 40 were refused (fronto-parallel views, a
 // negative focal length) and 8 ended at rms 1.6-62 px with fx 0-1514 px
 // for the true 1025, every figure plausible; 25 converged to rms
 // 0.156-0.190 px (0.2 px of noise), fx within 1.4 % of the truth. From
 // every candidate 10 of the 15 converged too (0.15-0.17 px, fx within
-// 1.7 %); 3 stay at 5.5-34 px and 2 refused. Judged against the truth: a
-// camera more than 10 % off in fx or 50 px off in (cx, cy) (the converged
+// 1.7 %); 3 stay at 5.5-34 px and 2 are refused. Judged against the truth:
+// a camera more than 10 % off in fx or 50 px off in (cx, cy) (the converged
 // ones' worst: 1.7 %, 18 px; the others' best 74 %) must be named, every
-// other one must pass. The seeds: two that converge from the first seed,
-// one (55) only from another, one (49) from none; the cheapest of each kind
-// (a failed first seed costs ~15-20 s here: 12 more solves).
+// other one must pass. The seeds, the cheapest of each kind (a failed first
+// seed costs ~15-20 s here: 12 more solves): two that converge from the
+// first seed; 55, refused from the first seed (fronto-parallel) and
+// converging from another; 49, over the limit from the first (8.1 px) and
+// from every other. (Refused from every seed, the first's refusal given:
+// Intrinsics' fronto-parallel test, intrinsics_test.cc.)
 TEST(IntrinsicsWindow, EverySeedIsTriedBeforeACameraIsNamedAsNotConverged) {
   const SensorWindow w{"320x240 at (0, 0) of 1920x1200", 1920, 1200, 0, 0, 320, 240};
   const Camera truth = WindowedCamera(w);
@@ -147,7 +150,7 @@ TEST(IntrinsicsWindow, EverySeedIsTriedBeforeACameraIsNamedAsNotConverged) {
                                                       IntrinsicsOptions(), "test")
                                       .report);
     } catch (const InputError& e) {
-      ADD_FAILURE() << "refused before the solve: " << e.what();
+      ADD_FAILURE() << "refused: " << e.what();
       continue;
     }
     const IntrinsicsReport& r = report.intrinsics[0];

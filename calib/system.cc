@@ -337,6 +337,20 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   set_free(true, options.refine_stereo, bff_free, options.refine_intrinsics);
   ceres::Solve(sopt, &problem, &summary);
   rep.refined_reprojection_rms_px = corner_rms();
+  {
+    ceres::Problem::EvaluateOptions eo;
+    eo.residual_blocks = corner_blocks;
+    eo.apply_loss_function = false;
+    std::vector<double> r;
+    problem.Evaluate(eo, nullptr, &r, nullptr, nullptr);
+    std::vector<double> distances_px;  // each corner block's residual is its (du, dv)
+    for (size_t i = 0; i + 1 < r.size(); i += 2) distances_px.push_back(std::hypot(r[i], r[i + 1]));
+    if (!distances_px.empty()) {
+      auto mid = distances_px.begin() + distances_px.size() / 2;
+      std::nth_element(distances_px.begin(), mid, distances_px.end());
+      rep.refined_median_corner_residual_px = *mid;
+    }
+  }
   rep.solver_summary = summary.BriefReport();
 
   for (int k = 0; k < M; ++k) result.module0_from_module.push_back(k == 0 ? Pose::Identity() : s_blocks[k].ToPose());

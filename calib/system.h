@@ -102,6 +102,10 @@ struct SystemReport {
   std::map<std::pair<int, int>, double> horn_rms_mm;   // Horn fit RMS of each tree edge
   double horn_reprojection_rms_px = 0.0;               // S and stereo held at Horn/stage 2, board poses solved
   double refined_reprojection_rms_px = 0.0;            // after the full adjustment
+  // The median of the corners' residual distances after it, px: what the
+  // convergence check reads (calib/convergence.h), as the RMS counts in full
+  // the few corners the Huber loss leaves out by design.
+  double refined_median_corner_residual_px = 0.0;
   int num_residual_corners = 0;
   // Left out as the earlier stages judged (SystemExclusions), counted among
   // the views and corners the adjustment would otherwise have used:

@@ -211,9 +211,11 @@ TEST(CalibrateCli, AModelsFolderThatCannotBeMadeLeavesNothing) {
 // convergence.h): the summary is printed and the report written, to find
 // out why; the rig file and the camera models are not, and an earlier run's
 // rig file stays. Provoked here with a limit under the rendered corners'
-// noise (stage 1 at a few hundredths of a px): every camera is named. A
-// real stage 1 that did not converge: IntrinsicsWindow.
-// AStageOneThatDidNotConvergeIsNamed (calib_test).
+// noise (stage 1 at a few hundredths of a px; each camera then solved from
+// every seed candidate, all converging to it): every camera is named, and
+// the report says why it stands alone. A real stage 1 that did not
+// converge: IntrinsicsWindow.EverySeedIsTriedBeforeACameraIsNamedAsNotConverged
+// (calib_e2e_test).
 TEST(CalibrateCli, AStageOverTheRmsLimitWritesNoRigFile) {
   const RenderedSet& set = Rendered();
   const std::string dir = set.dir + "/rms_limit";
@@ -235,7 +237,15 @@ TEST(CalibrateCli, AStageOverTheRmsLimitWritesNoRigFile) {
   EXPECT_NE(r.out.find("stage 1: intrinsics per camera"), std::string::npos) << "the summary first: " << r.out;
   std::ifstream earlier(rig);
   EXPECT_EQ(std::string(std::istreambuf_iterator<char>(earlier), {}), "an earlier run's rig file\n");
-  EXPECT_TRUE(fs::exists(report));
+  EXPECT_NE(r.out.find("stages 2 and 3 not run: stage 1 did not converge"), std::string::npos) << r.out;
+  std::ifstream report_file(report);
+  const nlohmann::json j = nlohmann::json::parse(report_file);
+  EXPECT_EQ(j.at("convergence").at("max_rms_px").get<double>(), 0.001);
+  EXPECT_EQ(j.at("convergence").at("not_converged").get<std::string>().rfind("stage 1 did not converge: camera 0", 0),
+            0u)
+      << j.at("convergence").dump();
+  EXPECT_EQ(j.at("stage1_intrinsics").size(), 4u);
+  EXPECT_EQ(j.at("stage2_stereo").size(), 0u);  // not run
   EXPECT_FALSE(fs::exists(dir + "/models")) << "camera models of a calibration that did not converge";
   // A limit that is not a positive number: refused before any work.
   const testing::Result zero = testing::RunCli(args + " --max-rms-px 0");
