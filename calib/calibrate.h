@@ -56,7 +56,9 @@ struct CalibrationResult {
   SystemResult stage3;
 };
 
-// Validates `input` (throws InputError) and runs the three stages.
+// Validates `input` (throws InputError) and runs the three stages. Where a
+// camera's stage 1 did not converge (report.not_converged), it stops there:
+// the result holds stage 1 and the report only, no rig (an empty Rig).
 CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOptions& options);
 
 // The input checks alone (throws InputError on the first problem).

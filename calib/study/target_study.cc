@@ -124,6 +124,10 @@ RunFigures RunOne(const Board& b, int captures, unsigned seed, const StudyOption
     f.error = e.what();
     return f;
   }
+  if (!r.report.not_converged.empty()) {  // no rig: calibrate would write none (calib/convergence.h)
+    f.error = r.report.not_converged;
+    return f;
+  }
   const auto points = VolumePoints(ref_from_world, Eigen::Vector3d(75, 75, 50), 500, seed + 1000);
   for (int k = 0; k < truth.num_modules(); ++k) {
     f.baseline_error_mm.push_back(
