@@ -310,12 +310,16 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
         intr ? problem.SetParameterBlockVariable(v.data()) : problem.SetParameterBlockConstant(v.data());
       }
   };
-  auto corner_rms = [&]() {
+  // The corners' residuals, each block's (du, dv), px, without the loss.
+  auto corner_residuals = [&]() {
     ceres::Problem::EvaluateOptions eo;
     eo.residual_blocks = corner_blocks;
     eo.apply_loss_function = false;
     std::vector<double> r;
     problem.Evaluate(eo, nullptr, &r, nullptr, nullptr);
+    return r;
+  };
+  auto rms = [](const std::vector<double>& r) {
     double s2 = 0;
     for (double x : r) s2 += x * x;
     return r.empty() ? 0.0 : std::sqrt(s2 / r.size());
@@ -332,24 +336,18 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   // Horn-only: S and the stereo pairs held, the board poses solved.
   set_free(false, false, false, false);
   ceres::Solve(sopt, &problem, &summary);
-  rep.horn_reprojection_rms_px = corner_rms();
+  rep.horn_reprojection_rms_px = rms(corner_residuals());
   // The full adjustment.
   set_free(true, options.refine_stereo, bff_free, options.refine_intrinsics);
   ceres::Solve(sopt, &problem, &summary);
-  rep.refined_reprojection_rms_px = corner_rms();
-  {
-    ceres::Problem::EvaluateOptions eo;
-    eo.residual_blocks = corner_blocks;
-    eo.apply_loss_function = false;
-    std::vector<double> r;
-    problem.Evaluate(eo, nullptr, &r, nullptr, nullptr);
-    std::vector<double> distances_px;  // each corner block's residual is its (du, dv)
-    for (size_t i = 0; i + 1 < r.size(); i += 2) distances_px.push_back(std::hypot(r[i], r[i + 1]));
-    if (!distances_px.empty()) {
-      auto mid = distances_px.begin() + distances_px.size() / 2;
-      std::nth_element(distances_px.begin(), mid, distances_px.end());
-      rep.refined_median_corner_residual_px = *mid;
-    }
+  const std::vector<double> refined = corner_residuals();
+  rep.refined_reprojection_rms_px = rms(refined);
+  std::vector<double> distances_px;
+  for (size_t i = 0; i + 1 < refined.size(); i += 2) distances_px.push_back(std::hypot(refined[i], refined[i + 1]));
+  if (!distances_px.empty()) {
+    auto mid = distances_px.begin() + distances_px.size() / 2;
+    std::nth_element(distances_px.begin(), mid, distances_px.end());
+    rep.refined_median_corner_residual_px = *mid;
   }
   rep.solver_summary = summary.BriefReport();
 
