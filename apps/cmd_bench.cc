@@ -20,6 +20,7 @@
 #include "apps/command.h"
 #include "apps/output_paths.h"
 #include "apps/reconstruct_json.h"
+#include "apps/truth_rig_warning.h"
 #include "apps/volume_warning.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
@@ -358,6 +359,7 @@ int RunBench(int argc, char** argv) {
       "%.0f MB\n",
       runtime_peak_mb, bench_peak_mb, loaded_mb, PeakMemoryMb());
   if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
+  if (rig_path.empty()) WarnOfTruthRig("bench", dataset.empty() ? "the simulator's default rig" : rig_read);
   return kExitOk;
 }
 

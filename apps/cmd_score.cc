@@ -16,6 +16,7 @@
 #include "apps/module_summary.h"
 #include "apps/output_paths.h"
 #include "apps/reconstruct_json.h"
+#include "apps/truth_rig_warning.h"
 #include "apps/volume_warning.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
@@ -81,11 +82,7 @@ int RunScore(int argc, char** argv) {
 
   namespace fs = std::filesystem;
   const bool rig_given = !rig_path.empty();
-  if (!rig_given) {
-    rig_path = (fs::path(dataset) / "truth" / "rig.yaml").string();
-    std::printf("score: no --rig: using the TRUTH rig %s (the line runs with the calibrated one: give --rig)\n",
-                rig_path.c_str());
-  }
+  if (!rig_given) rig_path = (fs::path(dataset) / "truth" / "rig.yaml").string();
   // Before any work: an unusable --diagnose folder is bad input, not a crash
   // at the end; but it is created only after every input check below.
   // (FolderToCreate, calib/core/folder_to_create.h: removed again, while
@@ -219,6 +216,7 @@ int RunScore(int argc, char** argv) {
     std::fflush(stdout);  // each scene's lines as it is done (~3 s a scene), also into a pipe or a log file
   }
   if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
+  if (!rig_given) WarnOfTruthRig("score", rig_path);
   return kExitOk;
 }
 

@@ -142,8 +142,9 @@ TEST(BenchCli, AMissingSceneNamedInScenesExitsTwoBeforeAnyRun) {
   std::filesystem::remove_all(dataset);
 }
 
-// A measurement volume that misses a scene: bench and score say so in the
-// same line, naming the scene and both distances, on stderr (a warning:
+// A measurement volume that misses a scene, and a run without --rig (the
+// truth rig read): bench and score warn of each in one line on stderr. The
+// volume's line names the scene and both distances, on stderr (a warning:
 // stdout carries the results; bench used to print it on stdout, score on
 // stdout within the scene's figures). The sphere's centre is ~33 mm to the
 // side of module 0 and ~205 mm ahead of it; a 150 mm wide volume centred
@@ -151,7 +152,7 @@ TEST(BenchCli, AMissingSceneNamedInScenesExitsTwoBeforeAnyRun) {
 // projects into the images: the runtime builds). One scene, one run, empty
 // clouds: a few seconds. (The default volume, which holds the sphere, would
 // add ~10 s of scoring.)
-TEST(BenchCli, BenchAndScoreWarnOnStderrWhenTheMeasurementVolumeMissesAScenesTruth) {
+TEST(BenchCli, BenchAndScoreWarnOnStderrOfAVolumeThatMissesAScenesTruthAndOfTheTruthRig) {
   const std::string dataset = testing::SimulateOneScene("sphere", 1, "bench_volume");
   const std::string options = dataset + "/volume_beside.yaml";
   { std::ofstream(options) << "volume_center_mm: [200, 0, 200]\n"; }
@@ -165,6 +166,18 @@ TEST(BenchCli, BenchAndScoreWarnOnStderrWhenTheMeasurementVolumeMissesAScenesTru
                              "--options\n");
     EXPECT_TRUE(std::regex_search(missed.err, warning)) << command << ": " << missed.err;
     EXPECT_EQ(missed.out.find("measurement volume"), std::string::npos) << command << ": " << missed.out;
+    // Without --rig the dataset's truth rig is read: said on stderr too
+    // (score used to print it on stdout, bench not at all); with the same
+    // file given as --rig, nothing.
+    const std::string truth_rig = dataset + "/truth/rig.yaml";
+    const std::string says = command.substr(0, command.find(' ')) + ": warning: no --rig: the figures above are " +
+                             "the TRUTH rig's (" + truth_rig + ")";
+    EXPECT_NE(missed.err.find(says), std::string::npos) << command << ": " << missed.err;
+    EXPECT_EQ(missed.out.find("TRUTH"), std::string::npos) << command << ": " << missed.out;
+    const testing::Result given =
+        RunCli(command + " --dataset " + dataset + " --scenes sphere --options " + options + " --rig " + truth_rig);
+    ASSERT_EQ(given.code, 0) << command << ": " << given.err;
+    EXPECT_EQ(given.err.find("no --rig"), std::string::npos) << command << ": " << given.err;
   }
   std::filesystem::remove_all(dataset);
 }
