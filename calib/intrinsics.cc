@@ -39,13 +39,12 @@ void FillPoolBlock(const BoardObservation& obs, const TargetGeometry& target, mr
   }
 }
 
-namespace {
-
-// Angle between the board normal and the camera's optical axis, degrees.
 double TiltDeg(const Pose& cam_from_face) {
   const Eigen::Vector3d n = cam_from_face.rotation().col(2);
   return std::acos(std::min(1.0, std::abs(n.z()))) * 180.0 / M_PI;
 }
+
+namespace {
 
 // Of two solves of one camera from different seeds, the one that fits its
 // corners better: the lower RMS; one that is not a number never wins. Each
@@ -354,7 +353,8 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
       // A later seed's board poses are held to the tilt test once solved as
       // well: a seed far from the lens can tilt the PnP poses of views that
       // are fronto-parallel in truth past the test the first seed failed,
-      // and fronto-parallel views fit any focal length.
+      // and fronto-parallel views fit any focal length (intrinsics_test.cc:
+      // RefusesFrontoParallelViewsThatAFarSeedPosesTilted).
       if (c > 0) {
         double solved_tilt_deg = 0;
         for (const Pose& pose : r.cam_from_face) solved_tilt_deg = std::max(solved_tilt_deg, TiltDeg(pose));

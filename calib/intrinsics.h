@@ -123,6 +123,10 @@ bool LensmodelNeedsRegularization(const std::string& lensmodel);
 // more without it (the outliers found stay out). Returns the number of pool
 // entries with weight <= 0 afterwards (missing corners + outliers).
 int SolveFinal(MrcalProblem* problem, bool verbose);
+// The board's tilt in a view: the angle between the board's normal and the
+// camera's optical axis, degrees (0: fronto-parallel). Stage 1 refuses views
+// of which none tilts more than IntrinsicsOptions::min_tilt_deg.
+double TiltDeg(const Pose& cam_from_face);
 // True if the corners span at least two rows and two columns of the board
 // (not all collinear), so that a board pose follows from them.
 bool CornersSpanAPlane(const std::vector<int>& corner_ids, int corners_x);
