@@ -27,8 +27,8 @@ int RunMatch(int argc, char** argv) {
   std::string left_path, right_path, out_path, matcher = "census_sgm";
   MatchOptions options;
   std::vector<int> roi;
-  app.add_option("--left", left_path, "rectified left image (8-bit grey)")->required();
-  app.add_option("--right", right_path, "rectified right image (8-bit grey, same size)")->required();
+  app.add_option("--left", left_path, "rectified left image (8-bit grey PNG)")->required();
+  app.add_option("--right", right_path, "rectified right image (8-bit grey PNG, same size)")->required();
   app.add_option("--min-disparity", options.min_disparity_px, "smallest disparity searched, px, in [-1024, 2048]")
       ->required();
   app.add_option("--num-disparities", options.num_disparities, "number of disparities searched, in [2, 1024]")

@@ -14,13 +14,14 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <thread>
 
+#include "calib/core/float_tiff.h"
 #include "calib/core/folder_to_create.h"
 #include "calib/core/input_error.h"
 #include "calib/core/pending_temporary.h"
+#include "calib/core/png_writer.h"
 #include "calib/core/rig_file.h"
 #include "calib/core/temporary_name.h"
 #include "datasets/calibration_poses.h"
@@ -73,10 +74,16 @@ void WriteText(const fs::path& path, const std::string& text) {
   if (!f) throw InputError(path.string(), "cannot write");
 }
 
+// An 8-bit grey PNG (captures, id and lit maps; deflate level 1: fast, as
+// the dataset's writer always was) or the float32 TIFF of a depth map.
 void WriteImage(const fs::path& path, const cv::Mat& image) {
-  std::vector<int> params;
-  if (path.extension() == ".png") params = {cv::IMWRITE_PNG_COMPRESSION, 1};
-  if (!cv::imwrite(path.string(), image, params)) throw InputError(path.string(), "cannot write image");
+  if (path.extension() == ".tiff") {
+    STEREORIG_CHECK(image.type() == CV_32FC1);
+    WriteFloatTiff(path.string(), image.cols, image.rows, image.ptr<float>(), image.step);
+    return;
+  }
+  STEREORIG_CHECK(path.extension() == ".png" && image.type() == CV_8UC1);
+  WriteText(path, EncodePng({uint32_t(image.cols), uint32_t(image.rows), 1, 8, image.data, image.step}, 1));
 }
 
 void WritePly(const fs::path& path, const std::vector<Eigen::Vector3d>& points) {

@@ -5,11 +5,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <tuple>
 
+#include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
+#include "calib/core/png_writer.h"
 #include "reconstruct/matcher.h"
 #include "reconstruct/oblique_refine.h"
 
@@ -288,7 +289,9 @@ namespace {
 void Write(const std::string& path, const cv::Mat& image) {
   cv::Mat big;
   cv::resize(image, big, image.size() * 2, 0, 0, cv::INTER_NEAREST);
-  if (!cv::imwrite(path, big)) throw InputError(path, "cannot write the image");
+  STEREORIG_CHECK(big.depth() == CV_8U);
+  WriteFileAtomically(path, EncodePng({uint32_t(big.cols), uint32_t(big.rows), big.channels(), 8, big.data, big.step},
+                                      1));  // deflate level 1, cv::imwrite's default
 }
 
 }  // namespace
@@ -315,8 +318,8 @@ void WriteFillDiagnosisImages(const FillDiagnosis& d, const std::string& prefix)
       const cv::Vec3b dim(g / 3, g / 3, g / 3);
       const bool target = d.target.at<uint8_t>(gy, gx);
       const uint8_t st = d.status.at<uint8_t>(gy, gx);
-      status.at<cv::Vec3b>(y, x) =
-          target ? DiagnosisColour(PixelStatus(st)) : (st == uint8_t(PixelStatus::kPoint) ? cv::Vec3b(120, 200, 120) : dim);
+      status.at<cv::Vec3b>(y, x) = target ? DiagnosisColour(PixelStatus(st))
+                                          : (st == uint8_t(PixelStatus::kPoint) ? cv::Vec3b(120, 200, 120) : dim);
       cv::Vec3b l = target ? cv::Vec3b(g / 2, g / 2, g / 2) : dim;
       if (target && st != uint8_t(PixelStatus::kPoint))
         l = d.truth_status.at<uint8_t>(gy, gx) == uint8_t(PixelStatus::kPoint) ? cv::Vec3b(0, 255, 0)

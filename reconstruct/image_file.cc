@@ -1,17 +1,29 @@
 #include "reconstruct/image_file.h"
 
-#include <opencv2/imgcodecs.hpp>
+#include <fstream>
 #include <optional>
 
 #include "calib/core/file_suffix.h"
+#include "calib/core/float_tiff.h"
 #include "calib/core/input_error.h"
 #include "calib/core/input_file.h"
 #include "calib/core/png_reader.h"
 
 namespace stereorig {
 
+namespace {
+
+std::string FirstBytes(const std::string& path, size_t count) {
+  std::ifstream f(path, std::ios::binary);
+  std::string bytes(count, '\0');
+  f.read(bytes.data(), std::streamsize(count));
+  bytes.resize(size_t(f.gcount()));
+  return bytes;
+}
+
+}  // namespace
+
 cv::Mat ReadImageFile(const std::string& path) {
-  // Missing: imread would print OpenCV's own warning first.
   RequireInputFile(path);
   // A PNG (every capture, the truth maps' id and lit maps) is decoded once,
   // by libpng, into the Mat imread would give.
@@ -21,19 +33,17 @@ cv::Mat ReadImageFile(const std::string& path) {
     png->Read(image.data, image.step);
     return image;
   }
-  // Named .png but holding another format: its decoder would print its own
-  // complaint (libjpeg's "Premature end of JPEG file") before ours.
   if (EndsWithIgnoringCase(path, ".png")) throw InputError(path, "is not a PNG file, though named .png");
-  // Any other format imread reads (the truth maps' depth, TIFF).
-  cv::Mat image;
-  try {
-    image = cv::imread(path, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {  // e.g. a header whose size the decoder refuses
-    // e.err alone: e.msg adds OpenCV's version, source file and a newline.
-    throw InputError(path, "cannot read the image (" + e.err + ")");
+  // The truth maps' depth: float32 TIFF, by libtiff.
+  if (StartsAsTiff(FirstBytes(path, 4))) {
+    FloatImage depth = ReadFloatTiff(path);
+    cv::Mat image(int(depth.height_px), int(depth.width_px), CV_32FC1);
+    std::copy(depth.values.begin(), depth.values.end(), image.ptr<float>());
+    return image;
   }
-  if (image.empty()) throw InputError(path, "cannot read the image (not an image, or a damaged one)");
-  return image;
+  throw InputError(path,
+                   "is neither a PNG nor a TIFF file (images are read as PNG; float32 TIFF for the simulator's depth "
+                   "maps)");
 }
 
 }  // namespace stereorig

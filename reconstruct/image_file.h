@@ -11,10 +11,13 @@
 
 namespace stereorig {
 
-// The image at `path`, as cv::imread(path, IMREAD_UNCHANGED) gives it; a PNG
-// decoded once, by calib/core/png_reader.h. Throws InputError if the file is
-// missing or not a file, is a PNG cut short, damaged or too large
-// (png_reader.h), is named .png but is not one, or cannot be decoded.
+// The image at `path`, as cv::imread(path, IMREAD_UNCHANGED) gives it: a PNG
+// decoded once, by calib/core/png_reader.h, or a float32 single-channel TIFF
+// (CV_32FC1), by calib/core/float_tiff.h. No other format: the binary does
+// not link OpenCV's imgcodecs (png_writer.h says why). Throws InputError if
+// the file is missing or not a file, is a PNG cut short, damaged or too
+// large (png_reader.h), is named .png but is not one, is a TIFF of another
+// kind or damaged, or is neither.
 cv::Mat ReadImageFile(const std::string& path);
 
 }  // namespace stereorig

@@ -9,7 +9,7 @@ packages=(
   libmrcal-dev mrcal python3 python3-mrcal python3-numpy python3-scipy
   libopencv-dev python3-opencv libtbb-dev
   libapriltag-dev
-  libyaml-cpp-dev libcli11-dev libsqlite3-dev libnanoflann-dev nlohmann-json3-dev zlib1g-dev libpng-dev
+  libyaml-cpp-dev libcli11-dev libsqlite3-dev libnanoflann-dev nlohmann-json3-dev zlib1g-dev libpng-dev libtiff-dev
   googletest libgtest-dev
 )
 
