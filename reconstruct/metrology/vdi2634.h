@@ -19,7 +19,7 @@
 // the figures are computed; the report says how many. A shape that does not
 // cover the certified artifact plausibly (a plane much smaller or larger than
 // the plate) is refused. The fit never uses the reconstruction's own shape
-// prior.
+// prior: the caller leaves out hole filling's points (ply_points.h).
 #pragma once
 
 #include <Eigen/Core>
