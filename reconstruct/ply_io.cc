@@ -8,6 +8,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/file_suffix.h"
 #include "calib/core/input_error.h"
+#include "reconstruct/metrology/ply_points.h"
 
 namespace stereorig {
 namespace {
@@ -15,6 +16,8 @@ namespace {
 // The project targets little-endian hosts (x86-64, arm64); PLY and STL here
 // are little-endian, so values are copied as they are in memory.
 static_assert(std::endian::native == std::endian::little, "little-endian host expected");
+// `stereorig verify` leaves the filled points out by this module.
+static_assert(kPlyFilledModule == kFilledModule, "verify must know hole filling's module");
 
 template <typename T>
 void Put(std::string& out, T v) {

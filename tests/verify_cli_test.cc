@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <random>
 
 #include "tests/cli_runner.h"
 
@@ -157,6 +158,60 @@ TEST(VerifyCli, MissingFieldsOfEveryTypeAndTooFewPointsOnTheArtifactExitTwo) {
   EXPECT_EQ(Lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("sparse_sphere.ply"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(report));
+}
+
+// Hole filling's points (module 255, added by the runtime from a fitted shape
+// model) are not measurements: verify skips them and says how many. Truth:
+// the certified sphere's two caps (74 deg each, what two facing modules
+// see) measured with radial noise sigma = 0.02 mm (modules 0 and 1), and the
+// unseen belt between them filled from a model 1 mm too large in radius
+// (module 255). On the measured points alone, P_S is 0 within 6 sigma of
+// the diameter's noise, 2 sigma / sqrt(N) = 0.0003 mm at N ~ 16 000 (0.005 mm
+// allowed, as the exact-sample tests), and P_F is the noise's range, under
+// 10 sigma = 0.2 mm. Fitted too, the filled belt would read P_F ~ 1 mm and a
+// larger P_S.
+TEST(VerifyCli, HoleFillingsPointsAreSkippedAndCounted) {
+  const double r = 19.05, sigma_mm = 0.02;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0, sigma_mm);
+  struct Vertex {
+    double x, y, z;
+    int module;
+  };
+  std::vector<Vertex> vertices;
+  int filled = 0;
+  for (double t = 0; t < M_PI; t += 0.02)
+    for (double p = 0; p < 2 * M_PI; p += 0.05) {
+      const bool seen = t < 1.3 || t > M_PI - 1.3;
+      const double radius = seen ? r + noise(rng) : r + 1.0;
+      vertices.push_back({10 + radius * std::sin(t) * std::cos(p), -5 + radius * std::sin(t) * std::sin(p),
+                          radius * std::cos(t), seen ? (t < 1.3 ? 0 : 1) : 255});
+      filled += !seen;
+    }
+  const std::string cloud = ::testing::TempDir() + "/filled_" + std::to_string(getpid()) + ".ply";
+  {
+    std::ofstream f(cloud);
+    f << "ply\nformat ascii 1.0\nelement vertex " << vertices.size()
+      << "\nproperty double x\nproperty double y\nproperty double z\nproperty uchar module\nend_header\n";
+    f.precision(17);
+    for (const Vertex& v : vertices) f << v.x << " " << v.y << " " << v.z << " " << v.module << "\n";
+  }
+  const std::string report = ::testing::TempDir() + "/verify_filled_" + std::to_string(getpid()) + ".json";
+  const auto r_cli =
+      RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + cloud + " --report " + report);
+  EXPECT_EQ(r_cli.code, 0) << r_cli.out << r_cli.err;
+  EXPECT_NE(r_cli.out.find("filled"), std::string::npos) << r_cli.out;
+  std::ifstream f(report);
+  ASSERT_TRUE(f.good()) << r_cli.out << r_cli.err;
+  const auto j = nlohmann::json::parse(f)["positions"][0];
+  EXPECT_EQ(j.value("points_filled_skipped", -1), filled);
+  EXPECT_EQ(j["points_total"].get<int>(), static_cast<int>(vertices.size()));
+  EXPECT_EQ(j["points_on_artifact"].get<int>(), static_cast<int>(vertices.size()) - filled);
+  ASSERT_EQ(j["figures"].size(), 2u);
+  EXPECT_EQ(j["figures"][0]["name"], "P_F");
+  EXPECT_LT(j["figures"][0]["value_mm"].get<double>(), 10 * sigma_mm);
+  EXPECT_EQ(j["figures"][1]["name"], "P_S");
+  EXPECT_LT(std::abs(j["figures"][1]["value_mm"].get<double>()), 0.005);
 }
 
 }  // namespace

@@ -50,7 +50,7 @@ double ReadBinary(std::istream& in, const std::string& t, bool swap, const std::
 
 }  // namespace
 
-std::vector<Eigen::Vector3d> ReadPlyPoints(const std::string& path) {
+PlyVertices ReadPlyVertices(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "cannot open");
   std::string line;
@@ -108,17 +108,19 @@ std::vector<Eigen::Vector3d> ReadPlyPoints(const std::string& path) {
     }
   }
   if (!seen_vertex || num_vertices < 0) throw InputError(path, "PLY has no vertex element");
-  int ix = -1, iy = -1, iz = -1;
+  int ix = -1, iy = -1, iz = -1, imodule = -1;
   for (int i = 0; i < static_cast<int>(props.size()); ++i) {
     if (!props[i].count_type.empty()) continue;
     if (props[i].name == "x") ix = i;
     if (props[i].name == "y") iy = i;
     if (props[i].name == "z") iz = i;
+    if (props[i].name == "module") imodule = i;
   }
   if (ix < 0 || iy < 0 || iz < 0) throw InputError(path, "PLY vertices have no x, y, z");
   const bool swap = (enc == Encoding::kBig) == (std::endian::native == std::endian::little);
-  std::vector<Eigen::Vector3d> points;
-  points.reserve(static_cast<size_t>(num_vertices));
+  PlyVertices out;
+  out.points.reserve(static_cast<size_t>(num_vertices));
+  if (imodule >= 0) out.module.reserve(static_cast<size_t>(num_vertices));
   std::vector<double> v(props.size());
   for (long long k = 0; k < num_vertices; ++k) {
     if (enc == Encoding::kAscii) {
@@ -146,9 +148,29 @@ std::vector<Eigen::Vector3d> ReadPlyPoints(const std::string& path) {
     }
     const Eigen::Vector3d p(v[ix], v[iy], v[iz]);
     if (!p.allFinite()) throw InputError(path, "vertex " + std::to_string(k) + " is not finite");
-    points.push_back(p);
+    out.points.push_back(p);
+    if (imodule >= 0) out.module.push_back(static_cast<int>(v[imodule]));
   }
-  return points;
+  return out;
+}
+
+std::vector<Eigen::Vector3d> ReadPlyPoints(const std::string& path) { return ReadPlyVertices(path).points; }
+
+MeasuredPoints ReadMeasuredPlyPoints(const std::string& path) {
+  PlyVertices all = ReadPlyVertices(path);
+  MeasuredPoints measured;
+  if (all.module.empty()) {
+    measured.points = std::move(all.points);
+    return measured;
+  }
+  for (size_t k = 0; k < all.points.size(); ++k) {
+    if (all.module[k] == kPlyFilledModule) {
+      ++measured.filled_skipped;
+    } else {
+      measured.points.push_back(all.points[k]);
+    }
+  }
+  return measured;
 }
 
 }  // namespace stereorig

@@ -10,8 +10,28 @@
 
 namespace stereorig {
 
+// The `module` of the points stereorig's hole filling adds from a fitted
+// shape model (reconstruct/point_cloud.h's kFilledModule, docs/reconstruct.md's
+// PLY properties): no module measured them.
+inline constexpr int kPlyFilledModule = 255;
+
+struct PlyVertices {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<int> module;  // each vertex's `module` property; empty when the file has none
+};
+
 // Throws InputError naming the file on a missing file, a malformed header, no
 // x/y/z, a truncated body or non-finite coordinates.
-std::vector<Eigen::Vector3d> ReadPlyPoints(const std::string& path);
+PlyVertices ReadPlyVertices(const std::string& path);
+std::vector<Eigen::Vector3d> ReadPlyPoints(const std::string& path);  // ReadPlyVertices(path).points
+
+// The measured points of a cloud: the vertices whose module is not
+// kPlyFilledModule (all of them when the file has no `module`), and how many
+// filled ones were left out.
+struct MeasuredPoints {
+  std::vector<Eigen::Vector3d> points;
+  int filled_skipped = 0;
+};
+MeasuredPoints ReadMeasuredPlyPoints(const std::string& path);
 
 }  // namespace stereorig

@@ -36,6 +36,23 @@ TEST(PlyPoints, ReadsAsciiAndBinaryWithExtraProperties) {
   EXPECT_EQ(p[1], Eigen::Vector3d(0.1, 1.0 / 3.0, -7.25));
 }
 
+TEST(PlyPoints, MeasuredPointsLeaveHoleFillingsOut) {
+  const std::string path = ::testing::TempDir() + "/filled.ply";
+  std::ofstream(path) << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                         "property float z\nproperty uchar module\nend_header\n1 2 3 0\n4 5 6 255\n7 8 9 1\n";
+  const PlyVertices all = ReadPlyVertices(path);
+  EXPECT_EQ(all.module, (std::vector<int>{0, kPlyFilledModule, 1}));
+  const MeasuredPoints measured = ReadMeasuredPlyPoints(path);
+  EXPECT_EQ(measured.filled_skipped, 1);
+  ASSERT_EQ(measured.points.size(), 2u);
+  EXPECT_EQ(measured.points[1], Eigen::Vector3d(7, 8, 9));
+  // Without a module property every vertex is measured.
+  std::ofstream(path) << "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                         "property float z\nend_header\n1 2 3\n";
+  EXPECT_EQ(ReadMeasuredPlyPoints(path).points.size(), 1u);
+  EXPECT_EQ(ReadMeasuredPlyPoints(path).filled_skipped, 0);
+}
+
 TEST(PlyPoints, RejectsBrokenFiles) {
   const std::string dir = ::testing::TempDir();
   std::ofstream(dir + "/c.ply") << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"

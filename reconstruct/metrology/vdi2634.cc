@@ -3,8 +3,11 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <map>
 #include <numeric>
+#include <tuple>
 
 #include "calib/core/input_error.h"
 #include "reconstruct/metrology/plane_fit.h"
@@ -21,6 +24,10 @@ void VerifyOptions::Check() const {
     throw InputError("verify options", "ballbar_shaft_cone_deg must be in [0, 90)");
   }
   if (plate_edge_margin_mm < 0) throw InputError("verify options", "plate_edge_margin_mm must not be negative");
+  if (!(capture_band_mm > 0)) throw InputError("verify options", "capture_band_mm must be positive");
+  if (plate_min_coverage < 0 || plate_min_coverage > 1) {
+    throw InputError("verify options", "plate_min_coverage must be in [0, 1]");
+  }
 }
 
 bool ArtifactEvaluation::pass() const {
@@ -69,29 +76,160 @@ double Range(const std::vector<double>& r) {
 // no longer changes (2-4 rounds in practice).
 constexpr int kMaxSegmentationRounds = 20;
 
-// One sphere of known nominal radius: segment, fit, exclude, refit.
-SphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, double nominal_radius, double band,
-                            const VerifyOptions& o, int* excluded) {
+std::string Mm(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f", v);
+  return buf;
+}
+
+// RANSAC's band, which only locates the shape.
+double LocateBandMm(const VerifyOptions& o, double mpe_mm) { return o.locate_band_mm > 0 ? o.locate_band_mm : mpe_mm; }
+
+// The band whose points are the artifact's: never so narrow that an error
+// beyond the MPE is cut off before the figures see it.
+double CaptureBandMm(const VerifyOptions& o, double mpe_mm) { return std::max(o.capture_band_mm, 2 * mpe_mm); }
+
+std::vector<int> WithinSphereShell(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& center_mm,
+                                   double radius_mm, double band_mm) {
+  std::vector<int> in;
+  for (int i = 0; i < static_cast<int>(pts.size()); ++i)
+    if (std::abs((pts[i] - center_mm).norm() - radius_mm) < band_mm) in.push_back(i);
+  return in;
+}
+
+// One sphere of known nominal radius: locate (RANSAC, narrow band), capture
+// (every point within the capture band, iterated with the fit), exclude,
+// refit.
+SphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, double nominal_radius, double locate_band_mm,
+                            double capture_band_mm, const VerifyOptions& o, int* excluded) {
   SphereFitOptions so;
-  so.inlier_threshold_mm = band;
+  so.inlier_threshold_mm = locate_band_mm;
   so.expected_radius_mm = nominal_radius;
-  so.radius_tolerance_mm = std::max(band, 0.1 * nominal_radius);
+  so.radius_tolerance_mm = std::max(locate_band_mm, 0.1 * nominal_radius);
   so.ransac_iterations = 1000;
   so.seed = o.seed;
   SphereFit fit = FitSphereRobust(pts, so);
   if (!fit.ok) return fit;
-  // The artifact's points are those within the band of the fitted sphere:
-  // iterate to that fixed point, so the set does not depend on RANSAC's path.
+  // The artifact's points are those within the capture band of the fitted
+  // sphere: iterate to that fixed point, so the set does not depend on
+  // RANSAC's path.
   for (int it = 0; it < kMaxSegmentationRounds; ++it) {
-    std::vector<int> in;
-    for (int i = 0; i < static_cast<int>(pts.size()); ++i)
-      if (std::abs((pts[i] - fit.center_mm).norm() - fit.radius_mm) < band) in.push_back(i);
+    const std::vector<int> in = WithinSphereShell(pts, fit.center_mm, fit.radius_mm, capture_band_mm);
     if (in == fit.inliers) break;
     fit = RefineSphere(pts, in, fit.center_mm, fit.radius_mm, 50);
     if (!fit.ok) return fit;
   }
+  // Still the certified size, within RANSAC's own tolerance: on a cloud of
+  // something else the capture can drift to another sphere.
+  if (std::abs(fit.radius_mm - nominal_radius) > so.radius_tolerance_mm) {
+    fit.ok = false;
+    fit.message = "the points within " + Mm(capture_band_mm) + " mm of the sphere RANSAC found fit one " +
+                  Mm(2 * fit.radius_mm) + " mm in diameter, not " + Mm(2 * nominal_radius) + " mm";
+    return fit;
+  }
   const std::vector<int> kept = ExcludeWorst(fit.inliers, fit.residuals_mm, o.excluded_fraction_max, excluded);
   return RefineSphere(pts, kept, fit.center_mm, fit.radius_mm, 50);
+}
+
+// A plane's points' outline: the smallest-area rectangle in the plane that
+// holds them (u along its longer side). Their principal axes would not do: a
+// square plate's are arbitrary, and its diagonals would be taken for sides.
+struct InPlaneExtent {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero(), u = Eigen::Vector3d::UnitX(), v = Eigen::Vector3d::UnitY();
+  double u0_mm = 0, u1_mm = 0, v0_mm = 0, v1_mm = 0;
+  double length_mm() const { return u1_mm - u0_mm; }
+  double width_mm() const { return v1_mm - v0_mm; }
+  // Inside the outline eroded by `margin_mm` on every side.
+  bool InsideEroded(const Eigen::Vector3d& p, double margin_mm) const {
+    const Eigen::Vector3d d = p - mean;
+    return d.dot(u) > u0_mm + margin_mm && d.dot(u) < u1_mm - margin_mm && d.dot(v) > v0_mm + margin_mm &&
+           d.dot(v) < v1_mm - margin_mm;
+  }
+};
+
+double Cross2(const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
+}
+
+// Andrew's monotone chain: the convex hull, counter-clockwise.
+std::vector<Eigen::Vector2d> ConvexHull(std::vector<Eigen::Vector2d> q) {
+  std::sort(q.begin(), q.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  if (q.size() < 3) return q;
+  std::vector<Eigen::Vector2d> hull(2 * q.size());
+  size_t k = 0;
+  for (size_t i = 0; i < q.size(); ++i) {  // lower hull
+    while (k >= 2 && Cross2(hull[k - 2], hull[k - 1], q[i]) <= 0) --k;
+    hull[k++] = q[i];
+  }
+  for (size_t i = q.size() - 1, lower = k + 1; i-- > 0;) {  // upper hull
+    while (k >= lower && Cross2(hull[k - 2], hull[k - 1], q[i]) <= 0) --k;
+    hull[k++] = q[i];
+  }
+  hull.resize(k - 1);
+  return hull;
+}
+
+// The smallest-area enclosing rectangle has a side along an edge of the
+// convex hull (Freeman and Shapira): try each.
+InPlaneExtent ExtentOf(const std::vector<Eigen::Vector3d>& pts, const std::vector<int>& idx,
+                       const Eigen::Vector3d& normal) {
+  InPlaneExtent e;
+  for (int i : idx) e.mean += pts[i];
+  e.mean /= static_cast<double>(std::max<size_t>(1, idx.size()));
+  const Eigen::Vector3d a = normal.unitOrthogonal(), b = normal.cross(a);
+  std::vector<Eigen::Vector2d> q;
+  q.reserve(idx.size());
+  for (int i : idx) q.emplace_back((pts[i] - e.mean).dot(a), (pts[i] - e.mean).dot(b));
+  const std::vector<Eigen::Vector2d> hull = ConvexHull(std::move(q));
+  double best_area_mm2 = std::numeric_limits<double>::infinity();
+  for (size_t k = 0; k < hull.size(); ++k) {
+    const Eigen::Vector2d side = hull[(k + 1) % hull.size()] - hull[k];
+    if (side.norm() == 0) continue;
+    const Eigen::Vector2d s = side.normalized(), t(-s.y(), s.x());
+    double s0 = 1e300, s1 = -1e300, t0 = 1e300, t1 = -1e300;
+    for (const Eigen::Vector2d& h : hull) {
+      s0 = std::min(s0, h.dot(s)), s1 = std::max(s1, h.dot(s));
+      t0 = std::min(t0, h.dot(t)), t1 = std::max(t1, h.dot(t));
+    }
+    if ((s1 - s0) * (t1 - t0) >= best_area_mm2) continue;
+    best_area_mm2 = (s1 - s0) * (t1 - t0);
+    const bool s_longer = s1 - s0 >= t1 - t0;
+    const Eigen::Vector3d s3 = s.x() * a + s.y() * b, t3 = t.x() * a + t.y() * b;
+    e.u = s_longer ? s3 : t3;
+    e.v = s_longer ? t3 : s3;
+    std::tie(e.u0_mm, e.u1_mm, e.v0_mm, e.v1_mm) =
+        s_longer ? std::make_tuple(s0, s1, t0, t1) : std::make_tuple(t0, t1, s0, s1);
+  }
+  return e;
+}
+
+std::vector<int> WithinPlaneBand(const std::vector<Eigen::Vector3d>& pts, const PlaneFit& plane, double band_mm) {
+  std::vector<int> in;
+  for (int i = 0; i < static_cast<int>(pts.size()); ++i)
+    if (std::abs(plane.normal.dot(pts[i]) - plane.offset_mm) < band_mm) in.push_back(i);
+  return in;
+}
+
+// The plane found must be the plate: it spans at least `min_coverage` of the
+// certified length and width, and no more than the certified size plus twice
+// the capture band (what the plate's sides can add). A sphere's cap or a
+// table is refused, naming what was found.
+void RequirePlateCoverage(const InPlaneExtent& e, const Artifact& a, const VerifyOptions& o, double capture_band_mm,
+                          const std::string& where) {
+  const double longer = std::max(a.plate_length_mm, a.plate_width_mm);
+  const double shorter = std::min(a.plate_length_mm, a.plate_width_mm);
+  const std::string found = "the plane found spans " + Mm(e.length_mm()) + " x " + Mm(e.width_mm()) +
+                            " mm, the plate is " + Mm(longer) + " x " + Mm(shorter) + " mm";
+  if (e.length_mm() < o.plate_min_coverage * longer || e.width_mm() < o.plate_min_coverage * shorter) {
+    throw InputError(where, found + ": not the plate, or too little of it seen (at least " +
+                                std::to_string(static_cast<int>(std::lround(100 * o.plate_min_coverage))) +
+                                "% of its length and width must be)");
+  }
+  if (e.length_mm() > longer + 2 * capture_band_mm || e.width_mm() > shorter + 2 * capture_band_mm) {
+    throw InputError(where, found + ": another surface than the plate lies in its plane (crop the cloud to the plate)");
+  }
 }
 
 }  // namespace
@@ -114,9 +252,11 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
   };
   switch (a.type) {
     case ArtifactType::kSphere: {
-      const double band = o.segmentation_band_mm > 0 ? o.segmentation_band_mm : a.mpe.probing_form_mm;
+      const double mpe = std::max(a.mpe.probing_form_mm, a.mpe.probing_size_mm);
+      e.capture_band_mm = CaptureBandMm(o, mpe);
       int excluded = 0;
-      const SphereFit fit = FitArtifactSphere(pts, 0.5 * a.sphere_diameter_mm, band, o, &excluded);
+      const SphereFit fit = FitArtifactSphere(pts, 0.5 * a.sphere_diameter_mm, LocateBandMm(o, a.mpe.probing_form_mm),
+                                              e.capture_band_mm, o, &excluded);
       if (!fit.ok) throw InputError(where, "no sphere of the certified size found in the cloud: " + fit.message);
       require_points(static_cast<int>(fit.inliers.size()) + excluded, "sphere");
       e.points_on_artifact = static_cast<int>(fit.inliers.size()) + excluded;
@@ -129,14 +269,16 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       break;
     }
     case ArtifactType::kBallBar: {
-      const double band = o.segmentation_band_mm > 0 ? o.segmentation_band_mm : a.mpe.sphere_spacing_mm;
+      const double band = CaptureBandMm(o, a.mpe.sphere_spacing_mm);
+      e.capture_band_mm = band;
       const double r = 0.5 * a.sphere_diameter_mm;
       std::vector<double> all_residuals;
       std::vector<Eigen::Vector3d> remaining = pts;
       int excluded_total = 0, on_artifact = 0;
       for (int ball = 0; ball < 2; ++ball) {
         int excluded = 0;
-        const SphereFit fit = FitArtifactSphere(remaining, r, band, o, &excluded);
+        const SphereFit fit =
+            FitArtifactSphere(remaining, r, LocateBandMm(o, a.mpe.sphere_spacing_mm), band, o, &excluded);
         if (!fit.ok) {
           throw InputError(where, "ball " + std::to_string(ball + 1) + " of the ball bar not found: " + fit.message);
         }
@@ -153,7 +295,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
         remaining.swap(rest);
       }
       // Second pass: with both centres known, each ball's points are those
-      // within the band of its sphere and outside the shaft's cone about the
+      // within the capture band of its sphere and outside the shaft's cone about the
       // bar axis; the sets and fits are iterated to their fixed point, then
       // the worst points are excluded and each ball is refitted.
       {
@@ -209,36 +351,26 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       break;
     }
     case ArtifactType::kPlate: {
-      const double band = o.segmentation_band_mm > 0 ? o.segmentation_band_mm : a.mpe.flatness_mm;
+      e.capture_band_mm = CaptureBandMm(o, a.mpe.flatness_mm);
       PlaneFitOptions po;
-      po.inlier_threshold_mm = band;
+      po.inlier_threshold_mm = LocateBandMm(o, a.mpe.flatness_mm);
       po.seed = o.seed;
       PlaneFit fit = FitPlaneRobust(pts, po);
       if (!fit.ok) throw InputError(where, "no plane found in the cloud: " + fit.message);
-      // The face only: erode the segmented points' in-plane extent (along
-      // their principal axes) by the edge margin.
-      {
-        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-        for (int i : fit.inliers) mean += pts[i];
-        mean /= static_cast<double>(fit.inliers.size());
-        Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-        for (int i : fit.inliers) scatter += (pts[i] - mean) * (pts[i] - mean).transpose();
-        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(scatter);
-        const Eigen::Vector3d u = es.eigenvectors().col(2), v = es.eigenvectors().col(1);
-        double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
-        for (int i : fit.inliers) {
-          const Eigen::Vector3d d = pts[i] - mean;
-          u0 = std::min(u0, d.dot(u));
-          u1 = std::max(u1, d.dot(u));
-          v0 = std::min(v0, d.dot(v));
-          v1 = std::max(v1, d.dot(v));
-        }
-        const double m = o.plate_edge_margin_mm;
-        std::vector<int> face;
-        for (int i : fit.inliers) {
-          const Eigen::Vector3d d = pts[i] - mean;
-          if (d.dot(u) > u0 + m && d.dot(u) < u1 - m && d.dot(v) > v0 + m && d.dot(v) < v1 - m) face.push_back(i);
-        }
+      // The face: the points within the capture band of the plane, inside
+      // their in-plane extent (along their principal axes) eroded by the edge
+      // margin; the set and the least-squares plane iterated to their fixed
+      // point.
+      std::vector<int> face;
+      for (int round = 0; round < kMaxSegmentationRounds; ++round) {
+        const std::vector<int> captured = WithinPlaneBand(pts, fit, e.capture_band_mm);
+        const InPlaneExtent extent = ExtentOf(pts, captured, fit.normal);
+        RequirePlateCoverage(extent, a, o, e.capture_band_mm, where);
+        std::vector<int> next;
+        for (int i : captured)
+          if (extent.InsideEroded(pts[i], o.plate_edge_margin_mm)) next.push_back(i);
+        if (round > 0 && next == face) break;
+        face.swap(next);
         fit = FitPlaneLeastSquares(pts, face);
         if (!fit.ok) throw InputError(where, "the plate's face is too small after the edge margin: " + fit.message);
       }

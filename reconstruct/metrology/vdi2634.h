@@ -7,12 +7,19 @@
 //   - flatness F: the range of residuals to the least-squares plane.
 // Each is judged against the artifact's maximum permissible error (MPE).
 //
-// Fitting is robust: RANSAC segments the artifact's points (points farther
-// than the MPE from every consensus shape are not on the artifact), then a
-// least-squares fit on all of them. As the standard allows, up to 0.3% of the
+// Which points are the artifact's is decided in two steps. RANSAC *locates*
+// the shape with a narrow band (the MPE): a consensus of points measured
+// within the MPE. Then every point within the much wider *capture band* of the
+// located shape (5 mm by default, never less than twice the MPE) is the
+// artifact's, and all of them enter the least-squares fit and the figures: the
+// runtime's known gross error, a patch one laser-grid period off, is ~3.5 mm
+// deep (docs/reconstruct.md), and a band that left it out would hide exactly
+// the error the figures must show. As the standard allows, up to 0.3% of the
 // artifact's points - those with the largest residuals - are excluded before
-// the figures are computed; the report says how many. The fit never uses the
-// reconstruction's own shape prior.
+// the figures are computed; the report says how many. A shape that does not
+// cover the certified artifact plausibly (a plane much smaller or larger than
+// the plate) is refused. The fit never uses the reconstruction's own shape
+// prior: the caller leaves out hole filling's points (ply_points.h).
 #pragma once
 
 #include <Eigen/Core>
@@ -25,9 +32,16 @@ namespace stereorig {
 
 struct VerifyOptions {
   double excluded_fraction_max = 0.003;  // the standard's 0.3%
-  // RANSAC inlier band, mm; <= 0 means "the MPE of the figure" (a point
-  // farther than the MPE from the artifact cannot be part of a passing one).
-  double segmentation_band_mm = 0;
+  // RANSAC's inlier band, mm, which only locates the shape; <= 0 means "the
+  // MPE of the figure" (a consensus of points measured within the MPE).
+  double locate_band_mm = 0;
+  // The artifact's points: those within this distance of the located shape,
+  // mm, iterated with the least-squares fit to a fixed point. Used as
+  // max(capture_band_mm, 2 * MPE): narrower, an error beyond the MPE would be
+  // cut off before the figures see it. 5 mm holds a patch one grid period off
+  // (~3.5 mm) with room for the fit's shift, and stays clear of the far face
+  // of the simulator's 8 mm plate.
+  double capture_band_mm = 5.0;
   int min_points = 200;  // fewer points on the artifact: bad input
   // Ball bar: each ball's points within this angle of the bar axis (towards
   // the other ball) belong to the shaft's neighbourhood and are not used.
@@ -35,6 +49,10 @@ struct VerifyOptions {
   // Plate: the face is evaluated inside its outline eroded by this border,
   // so the edges and sides (chamfers, the plate's thickness) are not.
   double plate_edge_margin_mm = 5.0;
+  // Plate: the plane found must span at least this fraction of the certified
+  // length and of the width (and at most the certified size plus twice the
+  // capture band), or it is not the plate.
+  double plate_min_coverage = 0.5;
   unsigned seed = 1;
   void Check() const;
 };
@@ -48,9 +66,11 @@ struct Figure {
 
 struct ArtifactEvaluation {
   ArtifactType type = ArtifactType::kSphere;
-  int points_total = 0;        // in the cloud
-  int points_on_artifact = 0;  // after segmentation
-  int points_excluded = 0;     // the standard's <= 0.3%
+  int points_total = 0;        // given (the measured points of the cloud)
+  int points_on_artifact = 0;  // within the capture band (and, plate, the eroded outline; ball bar, off the shaft)
+  int points_excluded = 0;     // the standard's <= 0.3% of points_on_artifact
+  double capture_band_mm = 0;  // the band used (VerifyOptions::capture_band_mm, at least 2 * MPE)
+  int points_used() const { return points_on_artifact - points_excluded; }
   std::vector<Figure> figures;
   // Residuals to the fitted shape(s) after exclusion, as the seed reports them.
   double residual_mean_abs_mm = 0;
@@ -64,7 +84,8 @@ struct ArtifactEvaluation {
 };
 
 // Throws InputError(`where`, ...) when the cloud has too few points on the
-// artifact, or the artifact cannot be found in it.
+// artifact, the artifact cannot be found in it, or what is found does not
+// cover the certified artifact plausibly.
 ArtifactEvaluation EvaluateArtifact(const Artifact& artifact, const std::vector<Eigen::Vector3d>& points_mm,
                                     const VerifyOptions& options, const std::string& where);
 
