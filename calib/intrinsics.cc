@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <optional>
@@ -57,6 +58,58 @@ namespace {
 bool FitsBetter(const IntrinsicsReport& a, const IntrinsicsReport& b) {
   if (std::isnan(b.rms_px)) return !std::isnan(a.rms_px);
   return a.rms_px < b.rms_px;
+}
+
+// How many of the focal length's sigmas the solved-pose tilt test allows
+// for. The sigma is the solve's covariance scaled by the observed residual
+// noise (ProjectionUncertaintyEvaluator), so the bound follows from the
+// noise in the corners; one-sided at 3 sigma, a set whose solved tilt is
+// right is wrongly lowered below it with probability 0.13 % where the
+// linearised covariance holds.
+constexpr double kTiltTestSigmas = 3.0;
+
+// The largest board tilt among a solve's poses, deg, were its focal length
+// kTiltTestSigmas of its own sigma lower (0 if fx is within that of 0).
+//
+// Near fronto-parallel, the corners fix each board's perspective (its
+// relative depth across the board, tan(tilt) x extent / depth) and its scale
+// in the image (fx / depth), not the tilt and fx apart: a solve can trade a
+// larger fx (the board farther) for a proportionally larger tan(tilt) at
+// almost the same cost, a valley along which the noise decides where it
+// ends. A solved tilt is therefore no evidence of tilted views unless fx is
+// determined; its tangent moves with fx. Measured (intrinsics_test.cc:
+// RefusesFlatViewsWhoseSolvedPosesTiltWithTheirFocalLength): flat views,
+// true tilt 3.0 deg, fx 1025 px, solved to fx 4617 +- 824 px with poses
+// tilted 13.44 deg: tan(13.44) / tan(3.0) = 4.50 = 4617 / 1025; 6.3 deg
+// here. Seeded at 1025 px (tilt test off) the solve slid to the same 4617
+// px, at 1024.98 px to a negative fx. Well-posed default scenes (6-20
+// captures, tilts 39-44 deg, 0.2 px of noise) have a relative sigma of fx of
+// 0.06-0.25 % (84 solves), which moves this bound by under a tenth of a
+// degree (0.07 deg at most over the statistical suite's 80 solves).
+double SolvedTiltLowerBoundDeg(const IntrinsicsResult& r) {
+  double max_tilt_deg = 0;
+  for (const Pose& pose : r.cam_from_face) max_tilt_deg = std::max(max_tilt_deg, TiltDeg(pose));
+  const IntrinsicsReport& report = r.report;
+  // No covariance (its factorisation failed): the solved tilt as it is.
+  if (report.intrinsics_sigma.empty()) return max_tilt_deg;
+  const double fx_low_fraction =
+      std::max(0.0, 1.0 - kTiltTestSigmas * report.intrinsics_sigma[0] / report.intrinsics[0]);
+  return std::atan(std::tan(max_tilt_deg * M_PI / 180.0) * fx_low_fraction) * 180.0 / M_PI;
+}
+
+// Throws the fronto-parallel InputError if `r`'s solved poses fail the tilt
+// test at the focal length's lower bound (SolvedTiltLowerBoundDeg).
+void RefuseSolvedFlatViews(const IntrinsicsResult& r, double min_tilt_deg, const std::string& cam_where) {
+  const double lower_deg = SolvedTiltLowerBoundDeg(r);
+  if (lower_deg >= min_tilt_deg) return;
+  char buf[240];
+  std::snprintf(buf, sizeof buf,
+                "degenerate views: all %zu are fronto-parallel (solved at fx %.4g +- %.3g px, whose largest board "
+                "tilt is %.1f deg at fx %.0f sigma lower, < %.1f); tilt the board",
+                r.cam_from_face.size(), r.report.intrinsics[0],
+                r.report.intrinsics_sigma.empty() ? 0.0 : r.report.intrinsics_sigma[0], lower_deg, kTiltTestSigmas,
+                min_tilt_deg);
+  throw InputError(cam_where, buf);
 }
 
 }  // namespace
@@ -350,16 +403,15 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
   for (size_t c = 0; c < candidates.size(); ++c) {
     try {
       IntrinsicsResult r = solve_from(candidates[c], views, dropped);
-      // A later seed's board poses are held to the tilt test once solved as
+      // Every seed's board poses are held to the tilt test once solved as
       // well: a seed far from the lens can tilt the PnP poses of views that
-      // are fronto-parallel in truth past the test the first seed failed,
-      // and fronto-parallel views fit any focal length (intrinsics_test.cc:
-      // RefusesFrontoParallelViewsThatAFarSeedPosesTilted).
-      if (c > 0) {
-        double solved_tilt_deg = 0;
-        for (const Pose& pose : r.cam_from_face) solved_tilt_deg = std::max(solved_tilt_deg, TiltDeg(pose));
-        if (solved_tilt_deg < options.min_tilt_deg) continue;
-      }
+      // are fronto-parallel in truth past the test the first seed failed, and
+      // fronto-parallel views fit any focal length (intrinsics_test.cc:
+      // RefusesFrontoParallelViewsThatAFarSeedPosesTilted). The solved tilt
+      // is taken at the focal length's lower bound, since it grows with the
+      // solved focal length (SolvedTiltLowerBoundDeg). A refusal here is
+      // caught below like the seed's own.
+      RefuseSolvedFlatViews(r, options.min_tilt_deg, cam_where);
       if (c == 0 && r.report.rms_px <= retry_above_rms_px) {
         r.report.seeds_tried = 1;
         return r;

@@ -125,7 +125,9 @@ bool LensmodelNeedsRegularization(const std::string& lensmodel);
 int SolveFinal(MrcalProblem* problem, bool verbose);
 // The board's tilt in a view: the angle between the board's normal and the
 // camera's optical axis, degrees (0: fronto-parallel). Stage 1 refuses views
-// of which none tilts more than IntrinsicsOptions::min_tilt_deg.
+// of which none tilts more than IntrinsicsOptions::min_tilt_deg: as posed
+// from the pinhole seed, and as solved with the focal length 3 sigma lower
+// (intrinsics.cc: SolvedTiltLowerBoundDeg).
 double TiltDeg(const Pose& cam_from_face);
 // True if the corners span at least two rows and two columns of the board
 // (not all collinear), so that a board pose follows from them.
