@@ -64,6 +64,26 @@ void CheckScenesInDataset(const std::string& dataset, const std::vector<std::str
   }
 }
 
+std::vector<std::string> ScenesToRun(const std::string& dataset, const std::vector<std::string>& scenes, bool named) {
+  if (named) {
+    CheckScenesInDataset(dataset, scenes);
+    return scenes;
+  }
+  namespace fs = std::filesystem;
+  const fs::path scenes_dir = fs::path(dataset) / "scenes";
+  std::vector<std::string> held;
+  std::string defaults;
+  for (const std::string& name : scenes) {
+    if (fs::is_directory(scenes_dir / name / "active")) held.push_back(name);
+    defaults += (defaults.empty() ? "" : ", ") + name;
+  }
+  if (held.empty())
+    throw InputError(scenes_dir.string(),
+                     "holds none of the default scenes (" + defaults +
+                         ", each a folder <name>/active): name the dataset's scenes with --scenes");
+  return held;
+}
+
 int NotBuiltYet(const char* name, const char* what, int argc, char** argv) {
   CLI::App app{std::string(what) + "\n\nNOT BUILT YET: this subcommand is reserved; a later release fills it in.",
                std::string("stereorig ") + name};

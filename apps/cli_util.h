@@ -28,6 +28,13 @@ std::vector<std::string> SplitSceneList(const std::string& list);
 // named by its folder; several by the dataset's scenes/ folder and a list.
 void CheckScenesInDataset(const std::string& dataset, const std::vector<std::string>& scenes);
 
+// The scenes of `dataset` a command (`score`, `bench`) runs, in the order of
+// `scenes`. With `named` (the user gave --scenes): all of them, each one
+// required (CheckScenesInDataset). Otherwise `scenes` is the default list:
+// those of it the dataset holds (DATASET/scenes/<name>/active a folder), the
+// others skipped; throws InputError naming the dataset when it holds none.
+std::vector<std::string> ScenesToRun(const std::string& dataset, const std::vector<std::string>& scenes, bool named);
+
 // Throws InputError naming `dataset` unless it is a folder, and (with
 // need_truth: no --rig given, so its truth/rig.yaml is the rig) one with
 // truth/ in it: a file or a wrong folder given to --dataset is named as

@@ -253,9 +253,11 @@ int RunBench(int argc, char** argv) {
   // Scenes the user named must all be there (a misspelt one used to be
   // skipped, and fewer scenes benched without a word); the default list
   // takes those the dataset holds.
-  const std::vector<std::string> scene_names = SplitSceneList(scenes_arg);
-  if (!dataset.empty()) CheckDatasetFolder(dataset, rig_path.empty());  // its own captures with --rig: no truth
-  if (!dataset.empty() && app.count("--scenes") > 0) CheckScenesInDataset(dataset, scene_names);
+  std::vector<std::string> scene_names = SplitSceneList(scenes_arg);
+  if (!dataset.empty()) {
+    CheckDatasetFolder(dataset, rig_path.empty());  // its own captures with --rig: no truth
+    scene_names = ScenesToRun(dataset, scene_names, app.count("--scenes") > 0);
+  }
 
   Rig rig;
   std::vector<Scene> scenes;
@@ -271,10 +273,8 @@ int RunBench(int argc, char** argv) {
     rig = ReadRigFile(rig_read);
     for (const std::string& name : scene_names) {
       const fs::path capture = fs::path(dataset) / "scenes" / name / "active";
-      if (!fs::is_directory(capture)) continue;  // a default scene this dataset lacks (named ones: checked above)
       scenes.push_back(Scene{name, LoadCapture(capture.string(), rig), {}, {}});
     }
-    if (scenes.empty()) throw InputError(dataset, "none of the scenes " + scenes_arg + " has an active capture");
   }
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
   std::printf("bench: %zu scene(s), %d run(s) each, %d modules, %u hardware threads\n", scenes.size(), runs,

@@ -24,6 +24,39 @@ std::string LossLine(std::span<const int> counts_by_status, int total_px, int ma
   return line;
 }
 
+namespace {
+
+constexpr const char* kSetTheVolume =
+    "set working_distance_mm (or volume_center_mm, volume_size_mm) to where it is (docs/reconstruct.md, \"When the "
+    "fill rate is low\")";
+
+// The line a module with no point gets, "" for one with a point. With lit
+// pixels and none kept, most often the object is not in the measurement
+// volume (a rig used at another distance than the defaults' 200 mm finds
+// nothing, and exit 0 alone would not say why). With none lit where the
+// volume projects (lit_pixels counts only its ROI), the left image is lit
+// elsewhere (the volume is beside the object) or nowhere (a dark or flat
+// image): camera_lit_pixels tells which (-1: not counted).
+std::string NoPointHint(const ModuleReport& m) {
+  if (m.points > 0) return "";
+  if (m.lit_pixels > 0)
+    return std::string("\n  no point: if the object is not in the measurement volume, ") + kSetTheVolume;
+  if (m.camera_lit_pixels > 0)
+    return "\n  no point: " + std::to_string(m.camera_lit_pixels) +
+           " px of the left camera's image are grid-lit, none where the measurement volume projects: the volume is "
+           "beside the object; " +
+           kSetTheVolume;
+  if (m.camera_lit_pixels == 0)
+    return "\n  no point: no pixel of the left camera's image is grid-lit (9x9 std above lit_contrast_dn): a dark or "
+           "flat image (the grid off or out of view, too short an exposure); check the capture";
+  return std::string(
+             "\n  no point: no grid-lit pixel where the measurement volume projects: if the object is not in "
+             "the volume, ") +
+         kSetTheVolume;
+}
+
+}  // namespace
+
 std::string ModuleSummary(const ModuleReport& m, int max_reasons) {
   const auto match = m.times_ms.find("match");
   char buf[256];
@@ -39,15 +72,7 @@ std::string ModuleSummary(const ModuleReport& m, int max_reasons) {
                                      " points removed, seen through (free_space_test; " +
                                      std::to_string(m.seen_through_surface) + " of them with their surface)"
                                : "";
-  // No point at all where the grid lights pixels: most often the object is
-  // not in the measurement volume (a rig used at another distance than the
-  // defaults' 200 mm finds nothing, and exit 0 alone would not say why).
-  const std::string nothing =
-      m.points == 0 && m.lit_pixels > 0
-          ? "\n  no point: if the object is not in the measurement volume, set working_distance_mm (or "
-            "volume_center_mm, volume_size_mm) to where it is (docs/reconstruct.md, \"When the fill rate is low\")"
-          : "";
-  return buf + (losses.empty() ? "none" : losses) + seen + nothing;
+  return buf + (losses.empty() ? "none" : losses) + seen + NoPointHint(m);
 }
 
 }  // namespace stereorig

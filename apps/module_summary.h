@@ -21,8 +21,12 @@ std::string LossLine(std::span<const int> counts_by_status, int total_px, int ma
 //   module 1: 0 points, fill 0.0% of 36293 grid-lit px, match 82.7 ms
 //     searched d [-21, 43) of [-100, 173) px; lit px without a point: no_sgm_match 29.8%, off_plane_coarse 18.7%, ...
 // The reasons are LossLine's `max_reasons` largest over the lit pixels;
-// "none" when every lit pixel has a point. A module with lit pixels and no
-// point gets a third line: where to set the measurement volume.
+// "none" when every lit pixel has a point. A module with no point gets one
+// more line, after the free-space test's: where to set the measurement
+// volume; with no lit pixel in the volume's ROI, whether the left image is
+// lit elsewhere (the volume is beside the object: the same advice) or
+// nowhere (a dark or flat image: check the capture), from
+// ModuleReport::camera_lit_pixels.
 std::string ModuleSummary(const ModuleReport& m, int max_reasons = 3);
 
 }  // namespace stereorig

@@ -43,7 +43,7 @@ TEST(ModuleSummary, SaysNoneWhenEveryLitPixelHasAPoint) {
 
 // A module whose lit pixels all went without a point (the walkthrough's
 // 300 mm rig under the default 200 mm volume: no_sgm_match 85.6 %) says
-// where to look; one with a point, or with nothing lit, does not.
+// where to look; one with a point does not.
 TEST(ModuleSummary, NoPointAtAllNamesTheMeasurementVolume) {
   ModuleReport m = Report();
   m.points = m.lit_filled = 0;
@@ -54,9 +54,32 @@ TEST(ModuleSummary, NoPointAtAllNamesTheMeasurementVolume) {
       << s;
   m.points = 1;
   EXPECT_EQ(ModuleSummary(m).find("no point:"), std::string::npos);
-  m.points = 0;
-  m.lit_pixels = 0;
-  EXPECT_EQ(ModuleSummary(m).find("no point:"), std::string::npos);
+}
+
+// No lit pixel where the volume projects: the hint used to need lit pixels,
+// so a volume beside the object gave an empty module and no word. Now the
+// left camera's whole image tells a volume beside the object (lit
+// elsewhere: where to set the volume) from a dark or flat capture.
+TEST(ModuleSummary, NoLitPixelInTheVolumeSaysWhetherTheImageIsLitElsewhere) {
+  ModuleReport m = Report();
+  m.points = m.lit_filled = m.lit_pixels = 0;
+  m.camera_lit_pixels = 164311;
+  EXPECT_NE(ModuleSummary(m).find("\n  no point: 164311 px of the left camera's image are grid-lit, none where the "
+                                  "measurement volume projects: the volume is beside the object; set "
+                                  "working_distance_mm (or volume_center_mm, volume_size_mm) to where it is"),
+            std::string::npos)
+      << ModuleSummary(m);
+  m.camera_lit_pixels = 0;
+  EXPECT_NE(ModuleSummary(m).find("\n  no point: no pixel of the left camera's image is grid-lit (9x9 std above "
+                                  "lit_contrast_dn): a dark or flat image"),
+            std::string::npos)
+      << ModuleSummary(m);
+  EXPECT_EQ(ModuleSummary(m).find("working_distance_mm"), std::string::npos) << ModuleSummary(m);
+  m.camera_lit_pixels = -1;  // not counted: both causes stay open
+  EXPECT_NE(ModuleSummary(m).find("\n  no point: no grid-lit pixel where the measurement volume projects: if the "
+                                  "object is not in the volume, set working_distance_mm"),
+            std::string::npos)
+      << ModuleSummary(m);
 }
 
 }  // namespace

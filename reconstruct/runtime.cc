@@ -372,6 +372,9 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
       report->lit_filled += in && unsigned(xi) < unsigned(r.width) && in[xi] >= 0;
     }
   }
+  if (report->lit_pixels == 0)  // an empty module's why (module_summary.h); a few ms, only then
+    report->camera_lit_pixels =
+        cv::countNonZero(LitMask(images[rig_.module(plan.module).left_camera], options_.lit_contrast_dn));
   report->times_ms["normals"] = MsSince(t);
 
   if (!build_mesh) return;

@@ -60,6 +60,10 @@ struct ModuleReport {
   int seen_through_surface = 0;  // of those, the ones nothing hid: removed with their surface, mostly seen through
   int lit_pixels = 0;            // grid-lit pixels of the rectified left image in the volume's ROI
   int lit_filled = 0;            // of those, pixels with a kept point
+  // Only when lit_pixels is 0 (else -1): the grid-lit pixels of the left
+  // camera's whole image, unrectified. Tells a volume beside what the grid
+  // lights (> 0) from a capture it lights nowhere (0: dark, no grid).
+  int camera_lit_pixels = -1;
   // The lit pixels by their final PixelStatus (disparity_state.h): kPoint
   // counts lit_filled, the others name the test that refused the rest. The
   // runtime's own account of where fill goes, with no truth needed.

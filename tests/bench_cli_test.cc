@@ -182,6 +182,46 @@ TEST(BenchCli, BenchAndScoreWarnOnStderrOfAVolumeThatMissesAScenesTruthAndOfTheT
   std::filesystem::remove_all(dataset);
 }
 
+// Without --scenes, score and bench take those of the five default scenes
+// the dataset holds: score used to require all five, and refused a dataset
+// of one scene with "no such scenes in the dataset (--scenes): cup, ballbar,
+// plate, tuber" though no --scenes was given. A dataset holding none of them
+// is refused in one line that says so. The volume beside the scene keeps
+// the run to empty clouds: a few seconds.
+TEST(BenchCli, BenchAndScoreWithoutScenesTakeTheDefaultScenesTheDatasetHolds) {
+  namespace fs = std::filesystem;
+  const std::string dataset = testing::SimulateOneScene("sphere", 1, "bench_default_scenes");
+  const std::string options = dataset + "/volume_beside.yaml";
+  { std::ofstream(options) << "volume_center_mm: [200, 0, 200]\n"; }
+  const std::string commands[] = {"score --no-passive", "bench --runs 1"};
+  for (const std::string& command : commands) {
+    const testing::Result r = RunCli(command + " --dataset " + dataset + " --options " + options);
+    EXPECT_EQ(r.code, 0) << command << ": " << r.err;
+    EXPECT_EQ(r.err.find("no such scene"), std::string::npos) << command << ": " << r.err;
+    EXPECT_NE(r.out.find("sphere"), std::string::npos) << command << ": " << r.out;
+    EXPECT_EQ(r.out.find("cup"), std::string::npos) << command << ": " << r.out;
+  }
+  // Named scenes are still all required.
+  for (const std::string& command : commands) {
+    const testing::Result r = RunCli(command + " --dataset " + dataset + " --scenes sphere,cup");
+    EXPECT_EQ(r.code, 2) << command;
+    EXPECT_EQ(testing::Lines(r.err), 1) << command << ": " << r.err;
+    EXPECT_NE(r.err.find(dataset + "/scenes/cup: no such scene in the dataset (--scenes)"), std::string::npos)
+        << command << ": " << r.err;
+  }
+  fs::rename(dataset + "/scenes/sphere", dataset + "/scenes/ball");
+  for (const std::string& command : commands) {
+    const testing::Result r = RunCli(command + " --dataset " + dataset);
+    EXPECT_EQ(r.code, 2) << command;
+    EXPECT_EQ(testing::Lines(r.err), 1) << command << ": " << r.err;
+    EXPECT_NE(r.err.find(dataset + "/scenes: holds none of the default scenes (cup, sphere, ballbar, plate, tuber, "
+                                   "each a folder <name>/active): name the dataset's scenes with --scenes"),
+              std::string::npos)
+        << command << ": " << r.err;
+  }
+  fs::remove_all(dataset);
+}
+
 // A damaged truth map is bad input named in one line, by bench and score
 // alike: they read the simulator's truth maps through the checked reader
 // (reconstruct/image_file.h) as every image input. A lit map cut short used

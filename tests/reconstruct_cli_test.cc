@@ -164,6 +164,7 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <regex>
 
 #include "calib/core/png_testing.h"
 #include "calib/core/rig_file.h"
@@ -281,6 +282,38 @@ TEST_F(ReconstructCli, PrintsPerModuleTheBandSearchedAndWhereFillWent) {
     const std::string lines = r.out.substr(at, next - at);
     EXPECT_NE(lines.find("\n  searched d ["), std::string::npos) << lines;
     EXPECT_NE(lines.find("lit px without a point: "), std::string::npos) << lines;
+  }
+}
+
+// A module that ends with no point says why, also with no grid-lit pixel
+// where the measurement volume projects: the hint used to need lit pixels
+// there, so a volume beside the object (its ROI, cropped to nothing lit,
+// holds 0 lit px) gave "0 points ... of 0 grid-lit px", exit 0 and no word.
+// The left camera's whole image tells that case (lit elsewhere: set the
+// volume) from a dark capture (lit nowhere: check the capture).
+TEST_F(ReconstructCli, AModuleWithNoLitPixelInTheVolumeSaysWhy) {
+  WriteFileAtomically(dir_ + "/beside.yaml", "volume_center_mm: [200, 0, 200]\n");
+  const std::string dark = BrokenCapture("dark");
+  for (int k = 0; k < 4; ++k) {  // the capture's images, flat at 10 grey levels
+    const std::string image = dark + "/cam" + std::to_string(k) + ".png";
+    ASSERT_TRUE(cv::imwrite(image, cv::Mat(cv::imread(image).size(), CV_8UC1, cv::Scalar(10))));
+  }
+  const std::pair<std::string, std::regex> cases[] = {
+      {Args(dir_ + "/capture", "--options " + dir_ + "/beside.yaml"),
+       std::regex("\n  no point: [1-9][0-9]* px of the left camera's image are grid-lit, none where the measurement "
+                  "volume projects: the volume is beside the object; set working_distance_mm \\(or "
+                  "volume_center_mm, volume_size_mm\\) to where it is")},
+      {Args(dark), std::regex("\n  no point: no pixel of the left camera's image is grid-lit \\(9x9 std above "
+                              "lit_contrast_dn\\): a dark or flat image")}};
+  for (const auto& [args, says] : cases) {
+    const testing::Result r = testing::RunCli(args);
+    ASSERT_EQ(r.code, 0) << args << ": " << r.err;
+    for (const std::string module : {"module 0: 0 points", "module 1: 0 points"}) {
+      const size_t at = r.out.find(module), next = r.out.find("\nmodule", at + 1);
+      ASSERT_NE(at, std::string::npos) << r.out;
+      const std::string summary = r.out.substr(at, next == std::string::npos ? std::string::npos : next - at);
+      EXPECT_TRUE(std::regex_search(summary, says)) << args << ":\n" << summary;
+    }
   }
 }
 
