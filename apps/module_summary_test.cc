@@ -82,5 +82,33 @@ TEST(ModuleSummary, NoLitPixelInTheVolumeSaysWhetherTheImageIsLitElsewhere) {
       << ModuleSummary(m);
 }
 
+// Matches within a band-pass bin (4 px) of an end of the volume's range
+// are warned of, naming the end; farther in, or with no point, not.
+TEST(ModuleSummary, MatchesReachingAnEndOfTheRangeAreWarnedOf) {
+  ModuleReport m = Report();  // range [-100, 174)
+  m.occupied_min_disparity_px = 35;
+  m.occupied_max_disparity_px = 119;
+  EXPECT_EQ(m.RangeEndReached(), 0);
+  EXPECT_EQ(ModuleSummary(m).find("warning:"), std::string::npos);
+  m.occupied_max_disparity_px = 169;  // 4 px from 173, the range's last disparity
+  EXPECT_EQ(m.RangeEndReached(), +1);
+  EXPECT_NE(ModuleSummary(m).find("\n  warning: its matches reach the near end of the measurement volume's disparity "
+                                  "range (d up to 169 of [-100, 174) px)"),
+            std::string::npos)
+      << ModuleSummary(m);
+  m.occupied_max_disparity_px = 168;
+  EXPECT_EQ(m.RangeEndReached(), 0);
+  m.occupied_min_disparity_px = -98;
+  EXPECT_EQ(m.RangeEndReached(), -1);
+  EXPECT_NE(ModuleSummary(m).find("reach the far end of the measurement volume's disparity range (d down to -98 of"),
+            std::string::npos)
+      << ModuleSummary(m);
+  m.points = 0;
+  EXPECT_EQ(ModuleSummary(m).find("warning:"), std::string::npos);
+  m.points = 600;
+  m.occupied_max_disparity_px = m.occupied_min_disparity_px - 1;  // no band found
+  EXPECT_EQ(m.RangeEndReached(), 0);
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -203,9 +203,9 @@ void RemoveSpeckles(DisparityState* state, const cv::Rect& roi, const MatchOptio
 // (disparity_band.h), within the given range. Returns false (keep the full
 // range) if too few pixels matched. *guide_px: with o.guided_radius_px > 0
 // and a band found, the guide of the full-resolution search over the ROI
-// (GuideFromCoarse), else left empty.
+// (GuideFromCoarse), else left empty. Sets `result`'s occupied band.
 bool OccupiedBand(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const MatchOptions& o, int* dmin,
-                  int* num, cv::Mat* guide_px) {
+                  int* num, cv::Mat* guide_px, MatchResult* result) {
   const int ys = 2 * o.band_row_step;  // rows per band-pass row
   cv::Mat lh, rh;
   cv::resize(left, lh, cv::Size(left.cols / 2, left.rows / ys), 0, 0, cv::INTER_AREA);
@@ -228,6 +228,8 @@ bool OccupiedBand(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
       if (std::isfinite(d.at<float>(y, x))) v.push_back(2 * d.at<float>(y, x));
   const std::optional<DisparityBand> band = OccupiedDisparityBand(v, o.range_margin_px);
   if (!band) return false;
+  result->occupied_min_disparity_px = band->min_px + o.range_margin_px;
+  result->occupied_max_disparity_px = band->max_px - o.range_margin_px;
   const int new_min = std::max(*dmin, band->min_px), new_max = std::min(*dmin + *num - 1, band->max_px);
   if (new_max - new_min < 8) return false;
   *dmin = new_min;
@@ -296,7 +298,8 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
   int dmin = o.min_disparity_px, num = o.num_disparities;
   const bool sgbm = o.matcher == MatcherKind::kOpenCvSgbm3Way;
   cv::Mat guide_px;
-  if (!sgbm && o.narrow_range && o.pyramid_levels == 0) OccupiedBand(left, right, roi, o, &dmin, &num, &guide_px);
+  if (!sgbm && o.narrow_range && o.pyramid_levels == 0)
+    OccupiedBand(left, right, roi, o, &dmin, &num, &guide_px, &result);
   if (!sgbm) lap("band");
   result.searched_min_disparity_px = dmin;
   result.searched_num_disparities = num;

@@ -10,6 +10,7 @@
 
 #include "calib/core/capture_image_name.h"
 #include "calib/core/input_error.h"
+#include "reconstruct/disparity_band.h"
 #include "reconstruct/elapsed_ms.h"
 #include "reconstruct/free_space.h"
 #include "reconstruct/grey_image.h"
@@ -226,6 +227,8 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
     report->surface_fit = match.surface_fit;
     report->searched_min_disparity_px = match.searched_min_disparity_px;
     report->searched_num_disparities = match.searched_num_disparities;
+    report->occupied_min_disparity_px = match.occupied_min_disparity_px;
+    report->occupied_max_disparity_px = match.occupied_max_disparity_px;
   } else {
     match.disparity_px = cv::Mat(size, CV_32FC1, cv::Scalar(std::numeric_limits<float>::infinity()));
     match.confidence = cv::Mat(size, CV_32FC1, cv::Scalar(0));
@@ -519,6 +522,13 @@ std::vector<cv::Mat> LoadCapture(const std::string& dir, const Rig& rig) {
     images.push_back(std::move(img));
   }
   return images;
+}
+
+int ModuleReport::RangeEndReached() const {
+  if (occupied_max_disparity_px < occupied_min_disparity_px || num_disparities <= 0) return 0;
+  if (min_disparity_px + num_disparities - 1 - occupied_max_disparity_px <= kBandBinPx) return +1;
+  if (occupied_min_disparity_px - min_disparity_px <= kBandBinPx) return -1;
+  return 0;
 }
 
 }  // namespace stereorig

@@ -317,6 +317,31 @@ TEST_F(ReconstructCli, AModuleWithNoLitPixelInTheVolumeSaysWhy) {
   }
 }
 
+// A volume that holds only the sphere's front cap (20 mm deep, from 25 to 5
+// mm in front of its centre): the surface goes on past the volume's far
+// end, and the matches reach it, which the summary and the report say
+// (ModuleReport::RangeEndReached); under the default volume, which holds
+// the whole sphere, neither module says so.
+TEST_F(ReconstructCli, MatchesReachingAnEndOfTheVolumesRangeAreWarnedOf) {
+  const Eigen::Vector3d cap_centre_mm = centre_ - 15.0 * centre_.normalized();
+  WriteFileAtomically(dir_ + "/cap.yaml", "volume_center_mm: [" + std::to_string(cap_centre_mm.x()) + ", " +
+                                              std::to_string(cap_centre_mm.y()) + ", " +
+                                              std::to_string(cap_centre_mm.z()) +
+                                              "]\nvolume_size_mm: [150, 150, 20]\n");
+  const std::string warning = "warning: its matches reach the far end of the measurement volume's disparity range";
+  const testing::Result whole = testing::RunCli(Args(dir_ + "/capture"));
+  ASSERT_EQ(whole.code, 0) << whole.err;
+  EXPECT_EQ(whole.out.find("warning: its matches reach"), std::string::npos) << whole.out;
+  const testing::Result cap = testing::RunCli(Args(dir_ + "/capture", "--options " + dir_ + "/cap.yaml"));
+  ASSERT_EQ(cap.code, 0) << cap.err;
+  EXPECT_NE(cap.out.find(warning), std::string::npos) << cap.out;
+  std::ifstream f(dir_ + "/out.json");
+  const nlohmann::json report = nlohmann::json::parse(f);
+  int far_with_points = 0;
+  for (const auto& m : report["modules"]) far_with_points += m["range_end_reached"] == "far" && m["points"] > 0;
+  EXPECT_GE(far_with_points, 1) << report["modules"].dump();
+}
+
 TEST_F(ReconstructCli, MissingCameraExitsTwoAndWritesNothing) {
   const std::string d = BrokenCapture("missing");
   std::filesystem::remove(d + "/cam2.png");
