@@ -56,17 +56,15 @@ std::string NoPointHint(const ModuleReport& m) {
 }
 
 // A module whose matches reach an end of the volume's disparity range
-// (ModuleReport::RangeEndReached): its points may be a copy of the grid
+// (ModuleReport::RangeEndsReached): its points may be a copy of the grid
 // whole periods off, where nothing is. "" otherwise, or with no point.
 std::string RangeEndWarning(const ModuleReport& m) {
-  const int end = m.points > 0 ? m.RangeEndReached() : 0;
-  if (end == 0) return "";
-  const bool near = end > 0;
-  return "\n  warning: its matches reach the " + std::string(near ? "near" : "far") +
-         " end of the measurement volume's disparity range (d " +
-         (near ? "up to " + std::to_string(m.occupied_max_disparity_px)
-               : "down to " + std::to_string(m.occupied_min_disparity_px)) +
-         " of [" + std::to_string(m.min_disparity_px) + ", " + std::to_string(m.min_disparity_px + m.num_disparities) +
+  const ModuleReport::RangeEnds ends = m.RangeEndsReached();
+  if (m.points == 0 || !(ends.near || ends.far)) return "";
+  const std::string which = ends.near && ends.far ? "both ends" : ends.near ? "the near end" : "the far end";
+  return "\n  warning: its matches reach " + which + " of the measurement volume's disparity range (the band pass's " +
+         "d [" + std::to_string(m.occupied_min_disparity_px) + ", " + std::to_string(m.occupied_end_disparity_px) +
+         ") of [" + std::to_string(m.min_disparity_px) + ", " + std::to_string(m.min_disparity_px + m.num_disparities) +
          ") px): the object may go on past the volume, or the laser grid was matched whole periods off (it repeats "
          "along the rows), its points where nothing is; if the object is not well inside the volume, " +
          kSetTheVolume;

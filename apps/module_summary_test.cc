@@ -82,32 +82,42 @@ TEST(ModuleSummary, NoLitPixelInTheVolumeSaysWhetherTheImageIsLitElsewhere) {
       << ModuleSummary(m);
 }
 
-// Matches within a band-pass bin (4 px) of an end of the volume's range
-// are warned of, naming the end; farther in, or with no point, not.
+// The band pass's kept bins within one bin (4 px) of an end of the
+// volume's range are warned of, naming the end; farther in, with no point,
+// or with no band, not.
 TEST(ModuleSummary, MatchesReachingAnEndOfTheRangeAreWarnedOf) {
   ModuleReport m = Report();  // range [-100, 174)
+  auto ends = [&] {
+    const ModuleReport::RangeEnds e = m.RangeEndsReached();
+    return std::string(e.far ? "far" : "") + (e.near ? "near" : "");
+  };
   m.occupied_min_disparity_px = 35;
-  m.occupied_max_disparity_px = 119;
-  EXPECT_EQ(m.RangeEndReached(), 0);
+  m.occupied_end_disparity_px = 120;
+  EXPECT_EQ(ends(), "");
   EXPECT_EQ(ModuleSummary(m).find("warning:"), std::string::npos);
-  m.occupied_max_disparity_px = 169;  // 4 px from 173, the range's last disparity
-  EXPECT_EQ(m.RangeEndReached(), +1);
+  m.occupied_end_disparity_px = 170;  // 4 px from the range's end, 174
+  EXPECT_EQ(ends(), "near");
   EXPECT_NE(ModuleSummary(m).find("\n  warning: its matches reach the near end of the measurement volume's disparity "
-                                  "range (d up to 169 of [-100, 174) px)"),
+                                  "range (the band pass's d [35, 170) of [-100, 174) px)"),
             std::string::npos)
       << ModuleSummary(m);
-  m.occupied_max_disparity_px = 168;
-  EXPECT_EQ(m.RangeEndReached(), 0);
-  m.occupied_min_disparity_px = -98;
-  EXPECT_EQ(m.RangeEndReached(), -1);
-  EXPECT_NE(ModuleSummary(m).find("reach the far end of the measurement volume's disparity range (d down to -98 of"),
-            std::string::npos)
+  m.occupied_end_disparity_px = 169;
+  EXPECT_EQ(ends(), "");
+  m.occupied_min_disparity_px = -96;  // 4 px from -100
+  EXPECT_EQ(ends(), "far");
+  EXPECT_NE(ModuleSummary(m).find("reach the far end of the measurement volume's disparity range"), std::string::npos)
       << ModuleSummary(m);
+  m.occupied_min_disparity_px = -95;
+  EXPECT_EQ(ends(), "");
+  m.occupied_min_disparity_px = -100;
+  m.occupied_end_disparity_px = 174;
+  EXPECT_EQ(ends(), "farnear");
+  EXPECT_NE(ModuleSummary(m).find("reach both ends of"), std::string::npos) << ModuleSummary(m);
   m.points = 0;
   EXPECT_EQ(ModuleSummary(m).find("warning:"), std::string::npos);
   m.points = 600;
-  m.occupied_max_disparity_px = m.occupied_min_disparity_px - 1;  // no band found
-  EXPECT_EQ(m.RangeEndReached(), 0);
+  m.occupied_end_disparity_px = m.occupied_min_disparity_px;  // no band found
+  EXPECT_EQ(ends(), "");
 }
 
 }  // namespace

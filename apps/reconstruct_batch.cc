@@ -203,6 +203,20 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
     }
     std::printf("[%zu/%zu] %s: %zu points (fill %s), %.0f ms -> %s\n", i + 1, dirs.size(), dirs[i].c_str(),
                 rec.cloud.size(), fills.c_str(), wall_ms, cloud_path.c_str());
+    // The one-capture summary's warning (module_summary.h), in a line per
+    // module: a batch is what a line runs.
+    for (const ModuleReport& m : rec.modules) {
+      const ModuleReport::RangeEnds ends = m.RangeEndsReached();
+      if (m.points > 0 && (ends.near || ends.far))
+        std::printf(
+            "  warning: module %d's matches reach %s of the measurement volume's disparity range (%s: "
+            "range_end_reached): its points may lie where nothing is; check the volume\n",
+            m.module,
+            ends.near && ends.far ? "both ends"
+            : ends.near           ? "the near end"
+                                  : "the far end",
+            outputs[i].report.c_str());
+    }
     std::fflush(stdout);
     summary["captures"].push_back(entry);
   }

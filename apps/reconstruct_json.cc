@@ -20,9 +20,10 @@ nlohmann::json ReconstructionJson(const Reconstruction& rec) {
                          {"disparity_range_px", {m.min_disparity_px, m.min_disparity_px + m.num_disparities}},
                          {"searched_disparity_px",
                           {m.searched_min_disparity_px, m.searched_min_disparity_px + m.searched_num_disparities}}};
-    if (m.occupied_max_disparity_px >= m.occupied_min_disparity_px)
-      mj["occupied_disparity_px"] = {m.occupied_min_disparity_px, m.occupied_max_disparity_px + 1};
-    mj["range_end_reached"] = m.RangeEndReached() > 0 ? "near" : m.RangeEndReached() < 0 ? "far" : "none";
+    if (m.occupied_end_disparity_px > m.occupied_min_disparity_px)
+      mj["occupied_disparity_px"] = {m.occupied_min_disparity_px, m.occupied_end_disparity_px};
+    const ModuleReport::RangeEnds ends = m.RangeEndsReached();
+    mj["range_end_reached"] = ends.near && ends.far ? "both" : ends.near ? "near" : ends.far ? "far" : "none";
     mj["lit_pixels_by_status"] = nlohmann::json::object();
     for (size_t k = 0; k < m.lit_by_status.size(); ++k)
       if (m.lit_by_status[k] > 0) mj["lit_pixels_by_status"][PixelStatusName(PixelStatus(k))] = m.lit_by_status[k];

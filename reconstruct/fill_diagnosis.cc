@@ -290,8 +290,9 @@ void Write(const std::string& path, const cv::Mat& image) {
   cv::Mat big;
   cv::resize(image, big, image.size() * 2, 0, 0, cv::INTER_NEAREST);
   STEREORIG_CHECK(big.depth() == CV_8U);
-  WriteFileAtomically(path, EncodePng({uint32_t(big.cols), uint32_t(big.rows), big.channels(), 8, big.data, big.step},
-                                      1));  // deflate level 1, cv::imwrite's default
+  WriteFileAtomically(
+      path, EncodePng({uint32_t(big.cols), uint32_t(big.rows), big.channels(), 8, big.data, big.step},
+                      1));  // deflate level 1, imwrite's default level (same pixels; imwrite's filter choice differed)
 }
 
 }  // namespace

@@ -229,7 +229,7 @@ bool OccupiedBand(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi
   const std::optional<DisparityBand> band = OccupiedDisparityBand(v, o.range_margin_px);
   if (!band) return false;
   result->occupied_min_disparity_px = band->min_px + o.range_margin_px;
-  result->occupied_max_disparity_px = band->max_px - o.range_margin_px;
+  result->occupied_end_disparity_px = band->max_px - o.range_margin_px;
   const int new_min = std::max(*dmin, band->min_px), new_max = std::min(*dmin + *num - 1, band->max_px);
   if (new_max - new_min < 8) return false;
   *dmin = new_min;

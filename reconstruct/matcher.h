@@ -210,13 +210,15 @@ struct MatchResult {
   // options.min_disparity_px / num_disparities range.
   int searched_min_disparity_px = 0;
   int searched_num_disparities = 0;
-  // The band the half-resolution pass found before range_margin_px was added
-  // (its kept clusters' extent, full-resolution px, inclusive); max < min
-  // where it found none (and for the other matchers). Matches reaching an end
-  // of the volume's range say the surface may go on past it, or a copy of
-  // the grid whole periods off was matched (MatchesReachTheRangesEnd).
+  // The band the half-resolution pass found before range_margin_px was added:
+  // [min, end) px, the edges of its kept 4 px bins (disparity_band.h), so
+  // its matches lie within one bin of each edge; end <= min where it found
+  // none (narrow_range off, pyramid_levels >= 1, the OpenCV matchers).
+  // Matches reaching an end of the volume's range say the surface may go on
+  // past it, or a copy of the grid whole periods off was matched
+  // (ModuleReport::RangeEndsReached).
   int occupied_min_disparity_px = 0;
-  int occupied_max_disparity_px = -1;
+  int occupied_end_disparity_px = 0;
   // The local surface fit's window and misfit, if it ran (MatchOptions::surface_fit).
   std::optional<SurfaceFitSummary> surface_fit;
 };

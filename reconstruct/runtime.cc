@@ -228,7 +228,7 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
     report->searched_min_disparity_px = match.searched_min_disparity_px;
     report->searched_num_disparities = match.searched_num_disparities;
     report->occupied_min_disparity_px = match.occupied_min_disparity_px;
-    report->occupied_max_disparity_px = match.occupied_max_disparity_px;
+    report->occupied_end_disparity_px = match.occupied_end_disparity_px;
   } else {
     match.disparity_px = cv::Mat(size, CV_32FC1, cv::Scalar(std::numeric_limits<float>::infinity()));
     match.confidence = cv::Mat(size, CV_32FC1, cv::Scalar(0));
@@ -524,11 +524,10 @@ std::vector<cv::Mat> LoadCapture(const std::string& dir, const Rig& rig) {
   return images;
 }
 
-int ModuleReport::RangeEndReached() const {
-  if (occupied_max_disparity_px < occupied_min_disparity_px || num_disparities <= 0) return 0;
-  if (min_disparity_px + num_disparities - 1 - occupied_max_disparity_px <= kBandBinPx) return +1;
-  if (occupied_min_disparity_px - min_disparity_px <= kBandBinPx) return -1;
-  return 0;
+ModuleReport::RangeEnds ModuleReport::RangeEndsReached() const {
+  if (occupied_end_disparity_px <= occupied_min_disparity_px || num_disparities <= 0) return {};
+  return {.near = min_disparity_px + num_disparities - occupied_end_disparity_px <= kBandBinPx,
+          .far = occupied_min_disparity_px - min_disparity_px <= kBandBinPx};
 }
 
 }  // namespace stereorig

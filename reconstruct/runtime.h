@@ -55,24 +55,27 @@ struct ModuleReport {
   // What the matcher searched at full resolution (MatchResult): the occupied
   // band within that range; 0 / 0 when nothing was matched (no lit region).
   int searched_min_disparity_px = 0, searched_num_disparities = 0;
-  // The band pass's matches before its margin (MatchResult), inclusive;
-  // max < min where it found none.
-  int occupied_min_disparity_px = 0, occupied_max_disparity_px = -1;
-  // Which end of the volume's range those matches reach, within one of the
-  // band pass's bins (kBandBinPx): +1 the near end (the largest
-  // disparities), -1 the far end, 0 neither (or no band). Reached, the
-  // surface may go on past the volume, or the grid was matched a whole
-  // number of periods off, a copy of itself inside the range (the grid's
-  // turn makes it repeat every ~22 periods along a row), its points where
-  // nothing is. Measured on the demo's five scenes (calibrated rig): 4-px
-  // bins, the defaults' modules keep 49-152 px from either end; with the
-  // volume moved in front of the objects (`volume_center_mm: [0, 0, 130]`,
-  // 40 mm deep) or to 120 mm (`working_distance_mm: 120`), every scene with
-  // points has a module within -5 to 3 px of an end, though not every module
-  // with wrong points does (the front plate's module 0: 25 px). Against the
-  // truth (`score --diagnose`): the front cup's module 0 all 185 px off, the
-  // 120 mm cup's module 1 95 % more than 2 mm off.
-  int RangeEndReached() const;
+  // The band pass's kept bins before its margin (MatchResult): [min, end)
+  // px; end <= min where it found none.
+  int occupied_min_disparity_px = 0, occupied_end_disparity_px = 0;
+  // Which ends of the volume's range those bins reach, within one bin
+  // (kBandBinPx: matches within two bins, 8 px, of the end); near = the
+  // largest disparities. Reached, the surface may go on past the volume, or
+  // the grid was matched a whole number of periods off, a copy of itself
+  // inside the range (the grid's turn makes it repeat every ~22 periods
+  // along a row), its points where nothing is. Measured on the demo's five
+  // scenes (calibrated rig): under the default volume every module's bins
+  // keep 49-153 px from either end; with the volume moved in front of the
+  // objects (`volume_center_mm: [0, 0, 130]`, 40 mm deep) or to 120 mm
+  // (`working_distance_mm: 120`), every scene with points has a module
+  // reaching an end, though not every module with wrong points does (the
+  // front plate's module 0: 25 px). Against the truth (`score --diagnose`):
+  // the front cup's module 0 all 185 px off, the 120 mm cup's module 1 95 %
+  // more than 2 mm off. Neither end without a band.
+  struct RangeEnds {
+    bool near = false, far = false;
+  };
+  RangeEnds RangeEndsReached() const;
   int points = 0;                // points kept
   int seen_through = 0;          // of the module's points, those the free-space test removed (free_space.h)
   int seen_through_surface = 0;  // of those, the ones nothing hid: removed with their surface, mostly seen through

@@ -340,6 +340,14 @@ TEST_F(ReconstructCli, MatchesReachingAnEndOfTheVolumesRangeAreWarnedOf) {
   int far_with_points = 0;
   for (const auto& m : report["modules"]) far_with_points += m["range_end_reached"] == "far" && m["points"] > 0;
   EXPECT_GE(far_with_points, 1) << report["modules"].dump();
+  // In a batch (what a line runs), one line per such module.
+  const testing::Result batch =
+      testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture --out-dir " + dir_ +
+                      "/batch_cap --options " + dir_ + "/cap.yaml");
+  ASSERT_EQ(batch.code, 0) << batch.err;
+  EXPECT_TRUE(std::regex_search(batch.out, std::regex("\n  warning: module [01]'s matches reach the far end of the "
+                                                      "measurement volume's disparity range")))
+      << batch.out;
 }
 
 TEST_F(ReconstructCli, MissingCameraExitsTwoAndWritesNothing) {

@@ -4,7 +4,9 @@
 
 #include <cstdarg>
 #include <cstdio>
+#include <cstring>
 #include <memory>
+#include <vector>
 
 #include "calib/core/input_error.h"
 
@@ -23,7 +25,10 @@ int KeepError(TIFF*, void* user_data, const char* module, const char* format, va
   if (messages.error.empty()) {
     char text[512];
     std::vsnprintf(text, sizeof text, format, args);
-    messages.error = (module != nullptr && *module != '\0' ? std::string(module) + ": " : std::string()) + text;
+    try {  // bad_alloc must not unwind through libtiff's C frames (the message is then lost, not the failure)
+      messages.error = (module != nullptr && *module != '\0' ? std::string(module) + ": " : std::string()) + text;
+    } catch (...) {
+    }
   }
   return 1;  // handled: libtiff's global handler (stderr) is not called
 }
@@ -71,7 +76,11 @@ FloatImage ReadFloatTiff(const std::string& path) {
   TIFFGetFieldDefaulted(tiff.get(), TIFFTAG_PLANARCONFIG, &planar);
   if (bits != 32 || format != SAMPLEFORMAT_IEEEFP || channels != 1)
     throw InputError(path, "a TIFF of " + std::to_string(channels) + " channel(s) of " + std::to_string(bits) +
-                               "-bit " + (format == SAMPLEFORMAT_IEEEFP ? "float" : "integer") +
+                               "-bit " +
+                               (format == SAMPLEFORMAT_IEEEFP ? "float"
+                                : format == SAMPLEFORMAT_INT  ? "signed integer"
+                                : format == SAMPLEFORMAT_UINT ? "integer"
+                                                              : "other") +
                                " samples; only float32 single-channel TIFFs are read (depth maps)");
   if (TIFFIsTiled(tiff.get())) throw InputError(path, "a tiled TIFF; only TIFFs in strips are read");
   if (width_px == 0 || height_px == 0 || uint64_t(width_px) * height_px > kMaxFloatTiffPixels)
@@ -105,11 +114,12 @@ void WriteFloatTiff(const std::string& path, uint32_t width_px, uint32_t height_
   TIFFSetField(tiff.get(), TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
   TIFFSetField(tiff.get(), TIFFTAG_COMPRESSION, COMPRESSION_NONE);
   TIFFSetField(tiff.get(), TIFFTAG_ROWSPERSTRIP, TIFFDefaultStripSize(tiff.get(), 0));
+  // libtiff may change the row it is given (byte-swapped for another byte
+  // order, a predictor's differences): each row goes through a copy.
+  std::vector<float> row(width_px);
   for (uint32_t y = 0; y < height_px; ++y) {
-    // libtiff's scanline buffer is not const, though it only reads it when
-    // uncompressed and copies it otherwise.
-    auto* row = const_cast<char*>(reinterpret_cast<const char*>(pixels) + y * row_stride_bytes);
-    if (TIFFWriteScanline(tiff.get(), row, y, 0) != 1)
+    std::memcpy(row.data(), reinterpret_cast<const char*>(pixels) + y * row_stride_bytes, width_px * sizeof(float));
+    if (TIFFWriteScanline(tiff.get(), row.data(), y, 0) != 1)
       throw InputError(path, "cannot write the TIFF file" + Said(messages));
   }
   TIFF* file = tiff.release();

@@ -31,7 +31,9 @@ inline constexpr uint64_t kMaxFloatTiffPixels = uint64_t(1) << 28;  // as PngRea
 FloatImage ReadFloatTiff(const std::string& path);
 
 // Writes `pixels` (height_px rows of width_px floats, row y at pixels +
-// y * row_stride_bytes) to `path` as a float32 TIFF. Throws InputError
+// y * row_stride_bytes) to `path` as a float32 TIFF, in place (libtiff
+// writes the file as it goes): callers pass a temporary path (the
+// simulator writes into its temporary dataset folder). Throws InputError
 // naming the file if it cannot be written.
 void WriteFloatTiff(const std::string& path, uint32_t width_px, uint32_t height_px, const float* pixels,
                     size_t row_stride_bytes);

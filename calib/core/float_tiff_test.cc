@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <tiffio.h>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -62,13 +63,56 @@ TEST(FloatTiff, WrittenFilesReadInImreadAndBack) {
 }
 
 // Datasets simulated before this reader wrote their depth maps with
-// cv::imwrite (uncompressed); OpenCV's other compressions read too.
+// cv::imwrite (uncompressed strips of 2 rows: OpenCV 4.6 writes float TIFFs
+// uncompressed whatever its compression parameter).
 TEST(FloatTiff, ReadsWhatImwriteWrote) {
   const cv::Mat depth = DepthLike(47, 52);
-  for (const int compression : {1, 5, 8, 32946}) {  // none, LZW, Adobe deflate, deflate
-    const std::string path = TempPath("float_tiff_imwrite.tiff");
-    ASSERT_TRUE(cv::imwrite(path, depth, {cv::IMWRITE_TIFF_COMPRESSION, compression})) << compression;
-    EXPECT_TRUE(SameBits(AsMat(ReadFloatTiff(path)), depth)) << compression;
+  const std::string path = TempPath("float_tiff_imwrite.tiff");
+  ASSERT_TRUE(cv::imwrite(path, depth));
+  EXPECT_TRUE(SameBits(AsMat(ReadFloatTiff(path)), depth));
+}
+
+// `depth` written by libtiff itself with `compression`, the floating-point
+// predictor or none, `mode` "w" (the machine's byte order) or "wb"
+// (big-endian), `rows_per_strip` rows a strip: layouts other writers make.
+void WriteWithLibtiff(const std::string& path, const cv::Mat& depth, uint16_t compression, uint16_t predictor,
+                      const char* mode, uint32_t rows_per_strip) {
+  TIFF* tiff = TIFFOpen(path.c_str(), mode);
+  ASSERT_NE(tiff, nullptr);
+  TIFFSetField(tiff, TIFFTAG_IMAGEWIDTH, uint32_t(depth.cols));
+  TIFFSetField(tiff, TIFFTAG_IMAGELENGTH, uint32_t(depth.rows));
+  TIFFSetField(tiff, TIFFTAG_BITSPERSAMPLE, 32);
+  TIFFSetField(tiff, TIFFTAG_SAMPLEFORMAT, SAMPLEFORMAT_IEEEFP);
+  TIFFSetField(tiff, TIFFTAG_SAMPLESPERPIXEL, 1);
+  TIFFSetField(tiff, TIFFTAG_PHOTOMETRIC, PHOTOMETRIC_MINISBLACK);
+  TIFFSetField(tiff, TIFFTAG_COMPRESSION, compression);
+  if (predictor != PREDICTOR_NONE) TIFFSetField(tiff, TIFFTAG_PREDICTOR, predictor);
+  TIFFSetField(tiff, TIFFTAG_ROWSPERSTRIP, rows_per_strip);
+  for (int y = 0; y < depth.rows; ++y) {  // from a copy: libtiff byte-swaps and predicts in place
+    cv::Mat row = depth.row(y).clone();
+    ASSERT_EQ(TIFFWriteScanline(tiff, row.data, uint32_t(y), 0), 1);
+  }
+  TIFFClose(tiff);
+}
+
+TEST(FloatTiff, ReadsOtherWritersLayouts) {
+  const cv::Mat depth = DepthLike(47, 52);
+  const std::string path = TempPath("float_tiff_libtiff.tiff");
+  struct Layout {
+    uint16_t compression, predictor;
+    const char* mode;
+    uint32_t rows_per_strip;
+  };
+  for (const Layout& l :
+       {Layout{COMPRESSION_LZW, PREDICTOR_FLOATINGPOINT, "w", 8},
+        Layout{COMPRESSION_ADOBE_DEFLATE, PREDICTOR_NONE, "w", 47},
+        Layout{COMPRESSION_ADOBE_DEFLATE, PREDICTOR_FLOATINGPOINT, "w", 5},
+        // (Big-endian with the floating-point predictor: libtiff 4.5.0 writes
+        // samples that it, and so imread, read back as other values.)
+        Layout{COMPRESSION_LZW, PREDICTOR_NONE, "wb", 5}, Layout{COMPRESSION_NONE, PREDICTOR_NONE, "wb", 1}}) {
+    SCOPED_TRACE(std::to_string(l.compression) + " " + std::to_string(l.predictor) + " " + l.mode);
+    WriteWithLibtiff(path, depth, l.compression, l.predictor, l.mode, l.rows_per_strip);
+    EXPECT_TRUE(SameBits(AsMat(ReadFloatTiff(path)), depth));
   }
 }
 
@@ -110,6 +154,22 @@ TEST(FloatTiff, AnotherKindOrADamagedFileIsNamedInOneLine) {
     EXPECT_EQ(what.find(cut + ": "), 0u) << what;
     EXPECT_EQ(what.find('\n'), std::string::npos) << what;
   }
+  // Damage inside a compressed strip (the directory whole): the row that
+  // cannot be decoded is named. The first strip's bytes overwritten.
+  const std::string lzw = TempPath("float_tiff_lzw.tiff");
+  WriteWithLibtiff(lzw, depth, COMPRESSION_LZW, PREDICTOR_FLOATINGPOINT, "w", 4);
+  {
+    TIFF* tiff = TIFFOpen(lzw.c_str(), "r");
+    ASSERT_NE(tiff, nullptr);
+    const uint64_t strip_at = TIFFGetStrileOffset(tiff, 0), strip_bytes = TIFFGetStrileByteCount(tiff, 0);
+    TIFFClose(tiff);
+    std::fstream f(lzw, std::ios::binary | std::ios::in | std::ios::out);
+    f.seekp(std::streamoff(strip_at));
+    f << std::string(size_t(strip_bytes), '\xff');
+  }
+  const std::string damaged = RefusalOf(lzw);
+  EXPECT_EQ(damaged.find(lzw + ": a TIFF cut short or damaged (row 0 of 40 cannot be read) (libtiff: "), 0u) << damaged;
+  EXPECT_EQ(damaged.find('\n'), std::string::npos) << damaged;
   const std::string text = TempPath("float_tiff_text.tiff");
   std::ofstream(text) << "not a TIFF\n";
   EXPECT_EQ(RefusalOf(text).find(text + ": cannot be read as a TIFF file (libtiff: "), 0u);

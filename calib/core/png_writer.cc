@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "calib/core/png_reader.h"
+
 namespace stereorig {
 
 namespace {
@@ -28,10 +30,12 @@ void WriteToBytes(png_structp png, png_bytep data, size_t length) {
   PngEncoding& e = EncodingOf(png);
   try {
     e.bytes.append(reinterpret_cast<const char*>(data), length);
-  } catch (const std::bad_alloc&) {  // must not unwind through libpng's C frames
+  } catch (...) {  // must not unwind through libpng's C frames
     e.out_of_memory = true;
-    png_error(png, "out of memory");
   }
+  // Outside the handler: a longjmp out of a catch block would leave the
+  // exception unfinished.
+  if (e.out_of_memory) png_error(png, "out of memory");
 }
 
 void FlushNothing(png_structp) {}
@@ -70,9 +74,10 @@ std::string EncodePng(const PngImage& image, int compression_level) {
     throw std::invalid_argument("EncodePng: channels must be 1, 3 or 4");
   if (image.bit_depth != 8 && image.bit_depth != 16)
     throw std::invalid_argument("EncodePng: bit depth must be 8 or 16");
-  if (image.width_px == 0 || image.height_px == 0 || image.width_px > PNG_UINT_31_MAX ||
-      image.height_px > PNG_UINT_31_MAX)
-    throw std::invalid_argument("EncodePng: a side must be in [1, 2^31 - 1] px");
+  // libpng's limit on a side when writing too (its user limits' default).
+  if (image.width_px == 0 || image.height_px == 0 || image.width_px > PngReader::kMaxSidePx ||
+      image.height_px > PngReader::kMaxSidePx)
+    throw std::invalid_argument("EncodePng: a side must be in [1, 1000000] px");
   if (compression_level < 0 || compression_level > 9)
     throw std::invalid_argument("EncodePng: compression level must be in [0, 9]");
   if (image.row_stride_bytes < size_t(image.width_px) * size_t(image.channels) * size_t(image.bit_depth / 8))

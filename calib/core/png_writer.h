@@ -29,8 +29,8 @@ struct PngImage {
 // The PNG file of `image`, deflated at `compression_level` (0 none, 1
 // fastest, as the simulator writes its captures, ... 9 smallest). Throws
 // std::invalid_argument for a layout PNG cannot hold as given (channels,
-// bit depth, a side 0 or over 2^31 - 1 px) or a compression level outside
-// [0, 9].
+// bit depth, a side 0 or over libpng's 10^6 px: PngReader::kMaxSidePx) or a
+// compression level outside [0, 9].
 std::string EncodePng(const PngImage& image, int compression_level);
 
 }  // namespace stereorig

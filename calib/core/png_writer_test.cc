@@ -92,6 +92,10 @@ TEST(EncodePng, ALayoutPngCannotHoldIsRefused) {
   PngImage empty = view;
   empty.height_px = 0;
   EXPECT_THROW(EncodePng(empty, 1), std::invalid_argument);
+  PngImage too_wide = view;  // libpng's limit, refused before a pixel is read
+  too_wide.width_px = PngReader::kMaxSidePx + 1;
+  too_wide.row_stride_bytes = too_wide.width_px;
+  EXPECT_THROW(EncodePng(too_wide, 1), std::invalid_argument);
   PngImage short_rows = view;
   short_rows.row_stride_bytes = 4;
   EXPECT_THROW(EncodePng(short_rows, 1), std::invalid_argument);
