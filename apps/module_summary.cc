@@ -59,9 +59,8 @@ std::string NoPointHint(const ModuleReport& m) {
 // (ModuleReport::RangeEndsReached): its points may be a copy of the grid
 // whole periods off, where nothing is. "" otherwise, or with no point.
 std::string RangeEndWarning(const ModuleReport& m) {
-  const ModuleReport::RangeEnds ends = m.RangeEndsReached();
-  if (m.points == 0 || !(ends.near || ends.far)) return "";
-  const std::string which = ends.near && ends.far ? "both ends" : ends.near ? "the near end" : "the far end";
+  const std::string which = RangeEndsWarnedOf(m);
+  if (which.empty()) return "";
   return "\n  warning: its matches reach " + which + " of the measurement volume's disparity range (the band pass's " +
          "d [" + std::to_string(m.occupied_min_disparity_px) + ", " + std::to_string(m.occupied_end_disparity_px) +
          ") of [" + std::to_string(m.min_disparity_px) + ", " + std::to_string(m.min_disparity_px + m.num_disparities) +
@@ -71,6 +70,12 @@ std::string RangeEndWarning(const ModuleReport& m) {
 }
 
 }  // namespace
+
+std::string RangeEndsWarnedOf(const ModuleReport& m) {
+  const ModuleReport::RangeEnds ends = m.RangeEndsReached();
+  if (m.points == 0 || !(ends.near || ends.far)) return "";
+  return ends.near && ends.far ? "both ends" : ends.near ? "the near end" : "the far end";
+}
 
 std::string ModuleSummary(const ModuleReport& m, int max_reasons) {
   const auto match = m.times_ms.find("match");

@@ -29,4 +29,10 @@ std::string LossLine(std::span<const int> counts_by_status, int total_px, int ma
 // ModuleReport::camera_lit_pixels.
 std::string ModuleSummary(const ModuleReport& m, int max_reasons = 3);
 
+// The ends of the volume's disparity range a module with points is warned
+// of (ModuleReport::RangeEndsReached): "both ends", "the near end", "the far
+// end", or "" (none reached, or no point). ModuleSummary's warning line and
+// a batch's per-module line both name them so.
+std::string RangeEndsWarnedOf(const ModuleReport& m);
+
 }  // namespace stereorig

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/command.h"
+#include "apps/module_summary.h"
 #include "apps/output_paths.h"
 #include "apps/reconstruct_json.h"
 #include "calib/core/atomic_file.h"
@@ -206,16 +207,12 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
     // The one-capture summary's warning (module_summary.h), in a line per
     // module: a batch is what a line runs.
     for (const ModuleReport& m : rec.modules) {
-      const ModuleReport::RangeEnds ends = m.RangeEndsReached();
-      if (m.points > 0 && (ends.near || ends.far))
+      const std::string which = RangeEndsWarnedOf(m);
+      if (!which.empty())
         std::printf(
             "  warning: module %d's matches reach %s of the measurement volume's disparity range (%s: "
             "range_end_reached): its points may lie where nothing is; check the volume\n",
-            m.module,
-            ends.near && ends.far ? "both ends"
-            : ends.near           ? "the near end"
-                                  : "the far end",
-            outputs[i].report.c_str());
+            m.module, which.c_str(), outputs[i].report.c_str());
     }
     std::fflush(stdout);
     summary["captures"].push_back(entry);
