@@ -1,6 +1,8 @@
 // `stereorig reconstruct`: rig file + capture -> point cloud, mesh, report.
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "apps/cli_util.h"
@@ -9,6 +11,7 @@
 #include "apps/output_paths.h"
 #include "apps/reconstruct_batch.h"
 #include "apps/reconstruct_json.h"
+#include "apps/reconstruct_stream.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
@@ -34,17 +37,27 @@ int RunReconstruct(int argc, char** argv) {
       "('caps/0001' -> 0001, 'scenes/cup/active' and 'scenes/sphere/active' -> cup_active, sphere_active). "
       "Missing or extra camK.png files, or clashing output names, stop the batch before anything is written; a "
       "capture whose images cannot be decoded or have the wrong size is reported and gets no output, the others "
-      "go on, and the exit code is 2.\n\n"
+      "go on, and the exit code is 2.\n"
+      "Driven by the line's acquisition software, one capture at a time: --capture - reads the capture folders "
+      "from standard input, one path per line (a pipe, or a FIFO written once a folder is complete), and "
+      "reconstructs each as its line arrives, with one runtime built at the start; each capture writes "
+      "<name>.ply and <name>.json, <name> its folder's last name, and prints its line on stdout at once. A bad "
+      "capture (a missing camera, a name or folder already used in the run, bad images) is named on stderr, gets "
+      "no output, and the stream goes on; the end of the input ends the run (exit 2 if any capture failed).\n\n"
       "Examples:\n  stereorig reconstruct --rig rig.yaml --capture data/scenes/cup/active --out cup.ply "
       "--mesh cup.stl --report cup.json\n"
       "  stereorig reconstruct --rig rig.yaml --capture line/0001 line/0002 line/0003 --out-dir clouds "
-      "--report clouds/batch.json",
+      "--report clouds/batch.json\n"
+      "  acquire | stereorig reconstruct --rig rig.yaml --capture - --out-dir clouds   (acquire prints each "
+      "complete capture folder's path)",
       "stereorig reconstruct"};
   std::vector<std::string> capture_dirs;
   std::string rig_path, out_path, out_dir, mesh_path, mesh_format, report_path, options_path;
   app.add_option("--rig", rig_path, "rig file (from stereorig calibrate)")->required();
-  app.add_option("--capture", capture_dirs,
-                 "capture folder(s) with camK.png per camera; several (or repeated) need --out-dir")
+  app.add_option(
+         "--capture", capture_dirs,
+         "capture folder(s) with camK.png per camera; several (or repeated) need --out-dir; '-' reads them from "
+         "standard input, one per line, as they come")
       ->required();
   auto* out = app.add_option("--out", out_path, "one capture: the point cloud (binary PLY)");
   auto* dir = app.add_option("--out-dir", out_dir, "many captures: write <name>.ply, <name>.json here");
@@ -59,6 +72,11 @@ int RunReconstruct(int argc, char** argv) {
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
   // In any case, as --mesh's suffix (STL, Ply): the files are named in lower case.
   for (char& c : mesh_format) c = char(std::tolower(static_cast<unsigned char>(c)));
+  const bool stream = std::find(capture_dirs.begin(), capture_dirs.end(), "-") != capture_dirs.end();
+  if (stream && capture_dirs.size() > 1)
+    throw InputError("--capture", "'-' (the capture folders read from standard input) must be the only --capture");
+  if (stream && out_dir.empty())
+    throw InputError("--capture", "'-' (the capture folders read from standard input) needs --out-dir DIR");
   if (out_dir.empty() && out_path.empty())
     throw InputError("--out", "give --out (one capture) or --out-dir (many captures)");
   if (out_dir.empty() && capture_dirs.size() > 1)
@@ -72,6 +90,9 @@ int RunReconstruct(int argc, char** argv) {
           {.path = report_path, .rig_path = rig_path, .options_path = options_path, .check_folder = false});
     const Rig rig = ReadRigFile(rig_path);
     const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
+    if (stream)
+      return ReconstructStream(rig, options, StreamRequest{out_dir, mesh_format, report_path, rig_path, options_path},
+                               std::cin);
     return ReconstructBatch(rig, options,
                             BatchRequest{capture_dirs, out_dir, mesh_format, report_path, rig_path, options_path});
   }

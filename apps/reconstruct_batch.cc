@@ -9,13 +9,10 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/command.h"
-#include "apps/module_summary.h"
 #include "apps/output_paths.h"
-#include "apps/reconstruct_json.h"
-#include "calib/core/atomic_file.h"
+#include "apps/reconstruct_capture.h"
 #include "calib/core/input_error.h"
 #include "reconstruct/elapsed_ms.h"
-#include "reconstruct/ply_io.h"
 #include "reconstruct/runtime.h"
 
 namespace stereorig {
@@ -62,11 +59,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Every file the batch writes, by capture: cloud, report, mesh ("" if none).
-struct CaptureOutputs {
-  std::string cloud, report, mesh;
-};
-
 // The output paths of every capture, and the summary's, checked before
 // anything is written: no two the same file (folders "x" and "x.mesh" with
 // --mesh-format ply; a --report naming a capture's own report), none one of
@@ -85,14 +77,10 @@ std::vector<CaptureOutputs> PlanOutputs(const std::vector<std::string>& names, c
   // The output folder is created later, once everything is checked.
   auto claim = [&](const std::string& path, const std::string& what) { paths.Claim(path, what, false); };
   for (const std::string& name : names) {
-    const std::string stem = (fs::path(request.out_dir) / name).string();
-    CaptureOutputs o{stem + ".ply", stem + ".json", ""};
+    const CaptureOutputs o = CaptureOutputsNamed(request.out_dir, name, request.mesh_format);
     claim(o.cloud, name + "'s cloud");
     claim(o.report, name + "'s report");
-    if (!request.mesh_format.empty()) {
-      o.mesh = stem + ".mesh." + request.mesh_format;
-      claim(o.mesh, name + "'s mesh");
-    }
+    if (!o.mesh.empty()) claim(o.mesh, name + "'s mesh");
     outputs.push_back(o);
   }
   if (!request.summary_path.empty()) {
@@ -102,18 +90,6 @@ std::vector<CaptureOutputs> PlanOutputs(const std::vector<std::string>& names, c
     if (folder != out && !fs::is_directory(folder)) throw InputError(request.summary_path, "its folder does not exist");
   }
   return outputs;
-}
-
-// LoadCapture, any failure as bad input naming the folder (a folder removed
-// or made unreadable after the first check throws filesystem_error).
-std::vector<cv::Mat> LoadCaptureOrInputError(const std::string& dir, const Rig& rig) {
-  try {
-    return LoadCapture(dir, rig);
-  } catch (const InputError&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw InputError(dir, std::string("cannot read the capture: ") + e.what());
-  }
 }
 
 }  // namespace
@@ -143,7 +119,6 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
               request.out_dir.c_str());
   std::fflush(stdout);
 
-  const bool mesh = !request.mesh_format.empty();
   nlohmann::json summary;
   summary["runtime_build_ms"] = build_ms;
   summary["captures"] = nlohmann::json::array();
@@ -151,9 +126,8 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
   const auto t_all = Clock::now();
   for (size_t i = 0; i < dirs.size(); ++i) {
     const auto t = Clock::now();
-    nlohmann::json entry;
-    entry["capture"] = dirs[i];
-    entry["name"] = names[i];
+    char progress[48];
+    std::snprintf(progress, sizeof progress, "[%zu/%zu]", i + 1, dirs.size());
     std::vector<cv::Mat> images;
     std::string error;
     try {
@@ -162,82 +136,24 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
       error = e.what();
     }
     if (i + 1 < dirs.size()) next = std::async(std::launch::async, load, dirs[i + 1]);
+    if (error.empty()) {
+      try {
+        summary["captures"].push_back(ReconstructCapture(runtime, images, dirs[i], names[i], outputs[i], progress, t));
+        continue;
+      } catch (const InputError& e) {  // the writers' failures (atomic_file.h)
+        error = e.what();
+      }
+    }
     // A capture that fails (bad images, or outputs that cannot be written)
-    // has no output: not a partial one, nor a stale one from an earlier run.
-    // The rest go on.
-    auto fail = [&](const std::string& why) {
-      ++failed;
-      std::fprintf(stderr, "stereorig reconstruct: [%zu/%zu] %s\n", i + 1, dirs.size(), why.c_str());
-      for (const std::string& path : {outputs[i].cloud, outputs[i].report, outputs[i].mesh})
-        if (!path.empty()) fs::remove(path, ec);
-      entry["ok"] = false;
-      entry["error"] = why;
-      summary["captures"].push_back(entry);
-    };
-    if (!error.empty()) {
-      fail(error);
-      continue;
-    }
-    const Reconstruction rec = runtime.Process(images, mesh);
-    const std::string& cloud_path = outputs[i].cloud;
-    try {
-      WriteCloudPly(rec.cloud, cloud_path);
-      if (mesh) WriteMesh(rec.mesh, outputs[i].mesh);
-      WriteFileAtomically(outputs[i].report, ReconstructionJson(rec).dump(2) + "\n");
-    } catch (const InputError& e) {  // the writers' failures (atomic_file.h)
-      fail(e.what());
-      continue;
-    }
-    entry["cloud"] = cloud_path;
-    if (mesh) entry["mesh"] = outputs[i].mesh;
-    entry["report"] = outputs[i].report;
-    entry["ok"] = true;
-    entry["points"] = rec.cloud.size();
-    entry["point_cloud_ms"] = rec.times_ms.at("total_point_cloud");
-    const double wall_ms = MsSince(t);  // waiting for the images, reconstructing, writing
-    entry["wall_ms"] = wall_ms;
-    std::string fills;
-    for (const ModuleReport& m : rec.modules) {
-      char buf[48];
-      std::snprintf(buf, sizeof buf, "%sm%d %.1f%%", fills.empty() ? "" : ", ", m.module, 100 * m.fill_rate());
-      fills += buf;
-    }
-    std::printf("[%zu/%zu] %s: %zu points (fill %s), %.0f ms -> %s\n", i + 1, dirs.size(), dirs[i].c_str(),
-                rec.cloud.size(), fills.c_str(), wall_ms, cloud_path.c_str());
-    // The one-capture summary's warning (module_summary.h), in a line per
-    // module: a batch is what a line runs.
-    for (const ModuleReport& m : rec.modules) {
-      const std::string which = RangeEndsWarnedOf(m);
-      if (!which.empty())
-        std::printf(
-            "  warning: module %d's matches reach %s of the measurement volume's disparity range (%s: "
-            "range_end_reached): its points may lie where nothing is; check the volume\n",
-            m.module, which.c_str(), outputs[i].report.c_str());
-    }
-    std::fflush(stdout);
-    summary["captures"].push_back(entry);
+    // has no output; the rest go on.
+    ++failed;
+    summary["captures"].push_back(FailedCapture(dirs[i], names[i], outputs[i], progress, error));
   }
-  const double all_ms = MsSince(t_all);
-  const int done = int(dirs.size()) - failed;
-  summary["reconstructed"] = done;
-  summary["failed"] = failed;
-  summary["wall_ms"] = all_ms;
-  summary["objects_per_s"] = done > 0 ? 1000.0 * done / all_ms : 0.0;
-  std::printf("%d of %zu captures in %.2f s: %.1f objects/s (reading, reconstructing and writing)\n", done, dirs.size(),
-              all_ms / 1000, summary["objects_per_s"].get<double>());
-  if (!request.summary_path.empty()) WriteFileAtomically(request.summary_path, summary.dump(2) + "\n");
-  if (failed > 0) {
-    // Every capture failed and nothing was written in it (no summary
-    // there): a new output folder goes again, as bad input found earlier
-    // leaves none.
-    out_folder.RemoveIfEmpty();
-    std::fprintf(stderr,
-                 "stereorig reconstruct: %d of %zu captures failed (bad input, or outputs that could not be "
-                 "written) and have no output\n",
-                 failed, dirs.size());
-    return kExitBadInput;
-  }
-  return kExitOk;
+  const int code = FinishRun(&summary, int(dirs.size()), failed, MsSince(t_all), request.summary_path);
+  // Every capture failed and nothing was written in it (no summary there):
+  // a new output folder goes again, as bad input found earlier leaves none.
+  if (failed > 0) out_folder.RemoveIfEmpty();
+  return code;
 }
 
 }  // namespace stereorig

@@ -1,0 +1,107 @@
+#include "apps/reconstruct_capture.h"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "apps/command.h"
+#include "apps/module_summary.h"
+#include "apps/reconstruct_json.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/input_error.h"
+#include "reconstruct/elapsed_ms.h"
+#include "reconstruct/ply_io.h"
+
+namespace stereorig {
+
+namespace fs = std::filesystem;
+
+CaptureOutputs CaptureOutputsNamed(const std::string& out_dir, const std::string& name,
+                                   const std::string& mesh_format) {
+  const std::string stem = (fs::path(out_dir) / name).string();
+  return {stem + ".ply", stem + ".json", mesh_format.empty() ? "" : stem + ".mesh." + mesh_format};
+}
+
+std::vector<cv::Mat> LoadCaptureOrInputError(const std::string& dir, const Rig& rig) {
+  try {
+    return LoadCapture(dir, rig);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(dir, std::string("cannot read the capture: ") + e.what());
+  }
+}
+
+nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::Mat>& images, const std::string& dir,
+                                  const std::string& name, const CaptureOutputs& outputs, const std::string& progress,
+                                  std::chrono::steady_clock::time_point started) {
+  const bool mesh = !outputs.mesh.empty();
+  const Reconstruction rec = runtime.Process(images, mesh);
+  WriteCloudPly(rec.cloud, outputs.cloud);
+  if (mesh) WriteMesh(rec.mesh, outputs.mesh);
+  WriteFileAtomically(outputs.report, ReconstructionJson(rec).dump(2) + "\n");
+  nlohmann::json entry;
+  entry["capture"] = dir;
+  entry["name"] = name;
+  entry["cloud"] = outputs.cloud;
+  if (mesh) entry["mesh"] = outputs.mesh;
+  entry["report"] = outputs.report;
+  entry["ok"] = true;
+  entry["points"] = rec.cloud.size();
+  entry["point_cloud_ms"] = rec.times_ms.at("total_point_cloud");
+  const double wall_ms = MsSince(started);
+  entry["wall_ms"] = wall_ms;
+  std::string fills;
+  for (const ModuleReport& m : rec.modules) {
+    char buf[48];
+    std::snprintf(buf, sizeof buf, "%sm%d %.1f%%", fills.empty() ? "" : ", ", m.module, 100 * m.fill_rate());
+    fills += buf;
+  }
+  std::printf("%s %s: %zu points (fill %s), %.0f ms -> %s\n", progress.c_str(), dir.c_str(), rec.cloud.size(),
+              fills.c_str(), wall_ms, outputs.cloud.c_str());
+  // The one-capture summary's warning (module_summary.h), in a line per
+  // module: a batch or a stream is what a line runs.
+  for (const ModuleReport& m : rec.modules) {
+    const std::string which = RangeEndsWarnedOf(m);
+    if (!which.empty())
+      std::printf(
+          "  warning: module %d's matches reach %s of the measurement volume's disparity range (%s: "
+          "range_end_reached): its points may lie where nothing is; check the volume\n",
+          m.module, which.c_str(), outputs.report.c_str());
+  }
+  std::fflush(stdout);
+  return entry;
+}
+
+nlohmann::json FailedCapture(const std::string& dir, const std::string& name, const CaptureOutputs& outputs,
+                             const std::string& progress, const std::string& why) {
+  std::fprintf(stderr, "stereorig reconstruct: %s %s\n", progress.c_str(), why.c_str());
+  std::error_code ec;
+  for (const std::string& path : {outputs.cloud, outputs.report, outputs.mesh})
+    if (!path.empty()) fs::remove(path, ec);
+  nlohmann::json entry;
+  entry["capture"] = dir;
+  entry["name"] = name;
+  entry["ok"] = false;
+  entry["error"] = why;
+  return entry;
+}
+
+int FinishRun(nlohmann::json* summary, int total, int failed, double wall_ms, const std::string& summary_path) {
+  const int done = total - failed;
+  (*summary)["reconstructed"] = done;
+  (*summary)["failed"] = failed;
+  (*summary)["wall_ms"] = wall_ms;
+  (*summary)["objects_per_s"] = done > 0 ? 1000.0 * done / wall_ms : 0.0;
+  std::printf("%d of %d captures in %.2f s: %.1f objects/s (reading, reconstructing and writing)\n", done, total,
+              wall_ms / 1000, (*summary)["objects_per_s"].get<double>());
+  std::fflush(stdout);
+  if (!summary_path.empty()) WriteFileAtomically(summary_path, summary->dump(2) + "\n");
+  if (failed == 0) return kExitOk;
+  std::fprintf(stderr,
+               "stereorig reconstruct: %d of %d captures failed (bad input, or outputs that could not be "
+               "written) and have no output\n",
+               failed, total);
+  return kExitBadInput;
+}
+
+}  // namespace stereorig

@@ -1,0 +1,61 @@
+// One capture of a many-capture run of `stereorig reconstruct` (a batch,
+// reconstruct_batch.h, or a stream, reconstruct_stream.h): reconstructed by
+// the run's runtime, its outputs written, its line printed. Shared so that a
+// batch and a stream write, say and record the same for a capture.
+#pragma once
+
+#include <chrono>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "calib/core/rig.h"
+#include "reconstruct/runtime.h"
+
+namespace stereorig {
+
+// Every file one capture writes: its cloud, its report, its mesh ("" if none).
+struct CaptureOutputs {
+  std::string cloud, report, mesh;
+};
+
+// The outputs of the capture named `name` in `out_dir`: <name>.ply,
+// <name>.json and, unless mesh_format is "", <name>.mesh.<mesh_format>.
+CaptureOutputs CaptureOutputsNamed(const std::string& out_dir, const std::string& name, const std::string& mesh_format);
+
+// LoadCapture (runtime.h), any failure as bad input naming the folder: a
+// folder removed or made unreadable after its files were checked throws a
+// std::filesystem error, here an InputError.
+std::vector<cv::Mat> LoadCaptureOrInputError(const std::string& dir, const Rig& rig);
+
+// Reconstructs the capture from folder `dir` (its decoded `images`) and
+// writes its outputs, each atomically (the mesh only if outputs.mesh is
+// set). Prints to stdout, flushed, "<progress> <dir>: N points (fill m0 x%,
+// m1 y%), T ms -> <cloud>" (T: the wall time since `started`, when the
+// capture's turn began: waiting for its images, reconstructing, writing),
+// then a warning line per module whose matches reach an end of the volume's
+// disparity range (module_summary.h RangeEndsWarnedOf). Returns the capture's
+// entry of the run's summary (capture, name, ok, cloud, mesh, report, points,
+// point_cloud_ms, wall_ms). Throws InputError if an output cannot be written
+// (the writers', atomic_file.h); the caller then calls FailedCapture.
+nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::Mat>& images, const std::string& dir,
+                                  const std::string& name, const CaptureOutputs& outputs, const std::string& progress,
+                                  std::chrono::steady_clock::time_point started);
+
+// A capture that failed (bad images, outputs that could not be written, a
+// name already used): it has no output, not a partial one nor a stale one
+// from an earlier run (every file of `outputs` that exists is removed), and
+// "stereorig reconstruct: <progress> <why>" goes to stderr. Returns its entry
+// of the summary (capture, name, ok false, error).
+nlohmann::json FailedCapture(const std::string& dir, const std::string& name, const CaptureOutputs& outputs,
+                             const std::string& progress, const std::string& why);
+
+// The run's end: "<done> of <total> captures in S s: R objects/s (...)" on
+// stdout, the summary's totals (reconstructed, failed, wall_ms,
+// objects_per_s) set and the summary written atomically to summary_path
+// (unless ""); with failures, the stderr line that counts them. Returns the
+// exit code: kExitOk, or kExitBadInput when any capture failed.
+int FinishRun(nlohmann::json* summary, int total, int failed, double wall_ms, const std::string& summary_path);
+
+}  // namespace stereorig

@@ -1,0 +1,224 @@
+// `stereorig reconstruct --capture - --out-dir OUT` (apps/reconstruct_stream.h)
+// end to end, as a line's acquisition software drives it: capture folders
+// written to the process's standard input one at a time, each one's line
+// read back from its standard output before the next folder is sent.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "calib/core/atomic_file.h"
+#include "calib/core/rig_file.h"
+#include "datasets/default_rig.h"
+#include "reconstruct/synthetic_scene.h"
+#include "tests/cli_runner.h"
+
+namespace stereorig {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Bytes(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+// The binary with pipes to its standard input and output (stderr to a file).
+class Child {
+ public:
+  Child(const std::vector<std::string>& args, const std::string& err_path) {
+    int in[2], out[2];
+    if (pipe(in) != 0 || pipe(out) != 0) return;
+    pid_ = fork();
+    if (pid_ == 0) {
+      dup2(in[0], 0);
+      dup2(out[1], 1);
+      const int err = open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      dup2(err, 2);
+      for (int fd : {in[0], in[1], out[0], out[1], err}) close(fd);
+      std::vector<char*> argv;
+      for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+      argv.push_back(nullptr);
+      execv(argv[0], argv.data());
+      _exit(127);
+    }
+    close(in[0]);
+    close(out[1]);
+    to_child_ = in[1];
+    from_child_ = out[0];
+  }
+  ~Child() {
+    if (to_child_ >= 0) close(to_child_);
+    if (from_child_ >= 0) close(from_child_);
+    if (pid_ > 0 && !waited_) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+  bool started() const { return pid_ > 0 && to_child_ >= 0; }
+  void Send(const std::string& line) {
+    const std::string s = line + "\n";
+    ASSERT_EQ(write(to_child_, s.data(), s.size()), ssize_t(s.size()));
+  }
+  void CloseInput() {
+    close(to_child_);
+    to_child_ = -1;
+  }
+  // Reads stdout until it holds `n` lines or `timeout_s` pass; returns all
+  // read so far.
+  const std::string& ReadLines(int n, double timeout_s) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (testing::Lines(out_) < n) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now());
+      if (left.count() <= 0) break;
+      pollfd p{from_child_, POLLIN, 0};
+      if (poll(&p, 1, int(left.count())) <= 0) break;
+      char buf[4096];
+      const ssize_t got = read(from_child_, buf, sizeof buf);
+      if (got <= 0) break;
+      out_.append(buf, size_t(got));
+    }
+    return out_;
+  }
+  int Wait() {
+    int status = 0;
+    waitpid(pid_, &status, 0);
+    waited_ = true;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+ private:
+  pid_t pid_ = -1;
+  int to_child_ = -1, from_child_ = -1;
+  bool waited_ = false;
+  std::string out_;
+};
+
+class ReconstructStreamCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = ::testing::TempDir() + "/reconstruct_stream_cli";
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ + "/line/0001");
+    const SimulatedRig sim = MakeDefaultRig();
+    WriteRigFile(sim.rig, dir_ + "/rig.yaml");
+    SphereSceneSpec spec;
+    spec.centre_mm = sim.world_from_module0.Inverse() * Eigen::Vector3d::Zero();
+    const std::vector<cv::Mat> images = RenderSphereCapture(sim.rig, spec);
+    for (size_t k = 0; k < images.size(); ++k)
+      cv::imwrite(dir_ + "/line/0001/cam" + std::to_string(k) + ".png", images[k]);
+    fs::copy(dir_ + "/line/0001", dir_ + "/line/0002");
+    fs::copy(dir_ + "/line/0001", dir_ + "/line/0003");
+    WriteFileAtomically(dir_ + "/line/0003/cam1.png", "not a png");  // found only when decoded
+    fs::create_directories(dir_ + "/other");
+    fs::copy(dir_ + "/line/0001", dir_ + "/other/0001");  // a name used already
+    // The single-capture run every streamed cloud must equal, byte for byte.
+    const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ +
+                                              "/line/0001 --out " + dir_ + "/single.ply");
+    ASSERT_EQ(r.code, 0) << r.err;
+  }
+  static std::string dir_;
+};
+std::string ReconstructStreamCli::dir_;
+
+// Each capture's line comes back before the next folder is sent (the
+// runtime is driven one object at a time, as a line does); the cloud is the
+// single run's, byte for byte; a broken capture, a folder sent again and a
+// folder whose name was used already are each named on stderr and get no
+// output, and the stream goes on; the end of the input ends the run, exit 2
+// (captures failed), with the summary.
+TEST_F(ReconstructStreamCli, ReconstructsEachFolderAsItsLineArrives) {
+  const std::string out = dir_ + "/out", err = dir_ + "/stream_err.txt";
+  fs::remove_all(out);
+  Child child({testing::kBin, "reconstruct", "--rig", dir_ + "/rig.yaml", "--capture", "-", "--out-dir", out,
+               "--report", out + "/summary.json"},
+              err);
+  ASSERT_TRUE(child.started());
+  // Generous: the runtime's build and one capture take < 1 s on 2 cores.
+  // Only a process that waits for the end of its input fails this.
+  const double timeout_s = 120;
+  ASSERT_NE(child.ReadLines(1, timeout_s).find("reading capture folders from standard input"), std::string::npos)
+      << child.ReadLines(1, 0);
+  child.Send(dir_ + "/line/0001");
+  const std::string& first = child.ReadLines(2, timeout_s);
+  ASSERT_EQ(testing::Lines(first), 2) << "no line for the first capture while the input is open: " << first;
+  EXPECT_NE(first.find("[1] " + dir_ + "/line/0001: "), std::string::npos) << first;
+  EXPECT_EQ(Bytes(out + "/0001.ply"), Bytes(dir_ + "/single.ply"));
+  child.Send(dir_ + "/line/0003");   // bad images
+  child.Send("");                    // skipped
+  child.Send(dir_ + "/line/0001/");  // the same folder again
+  child.Send(dir_ + "/other/0001");  // another folder of the same name
+  child.Send(dir_ + "/line/0002\r");
+  const std::string& second = child.ReadLines(3, timeout_s);
+  EXPECT_NE(second.find("[5] " + dir_ + "/line/0002: "), std::string::npos) << second;
+  child.CloseInput();
+  EXPECT_EQ(child.Wait(), 2);
+  const std::string all = child.ReadLines(4, timeout_s);
+  EXPECT_NE(all.find("2 of 5 captures"), std::string::npos) << all;
+  EXPECT_EQ(Bytes(out + "/0002.ply"), Bytes(dir_ + "/single.ply"));
+  EXPECT_FALSE(fs::exists(out + "/0003.ply"));
+  EXPECT_FALSE(fs::exists(out + "/0003.json"));
+  const std::string e = Bytes(err);
+  EXPECT_NE(e.find("[2] " + dir_ + "/line/0003/cam1.png: is not a PNG"), std::string::npos) << e;
+  EXPECT_NE(e.find("[3] " + dir_ + "/line/0001/: was given already (capture 1)"), std::string::npos) << e;
+  EXPECT_NE(e.find("[4] " + dir_ + "/other/0001: would write outputs named '0001'"), std::string::npos) << e;
+  EXPECT_NE(e.find("3 of 5 captures failed"), std::string::npos) << e;
+  const nlohmann::json summary = nlohmann::json::parse(Bytes(out + "/summary.json"));
+  EXPECT_EQ(summary["reconstructed"], 2);
+  EXPECT_EQ(summary["failed"], 3);
+  ASSERT_EQ(summary["captures"].size(), 5u);
+  EXPECT_EQ(summary["captures"][0]["ok"], true);
+  EXPECT_EQ(summary["captures"][1]["ok"], false);
+  EXPECT_EQ(summary["captures"][4]["name"], "0002");
+  // The refused names did not remove what the first capture wrote.
+  EXPECT_EQ(Bytes(out + "/0001.ply"), Bytes(dir_ + "/single.ply"));
+  EXPECT_TRUE(fs::exists(out + "/0001.json"));
+}
+
+// Bad use is refused before any work, in one line: '-' beside other
+// folders, '-' without --out-dir; an input holding no folder exits 2 and
+// leaves no new output folder.
+TEST_F(ReconstructStreamCli, BadUseExitsTwoInOneLine) {
+  const std::string rig = " --rig " + dir_ + "/rig.yaml";
+  const testing::Result mixed =
+      testing::RunCli("reconstruct" + rig + " --capture - " + dir_ + "/line/0001 --out-dir " + dir_ + "/o1");
+  EXPECT_EQ(mixed.code, 2);
+  EXPECT_EQ(testing::Lines(mixed.err), 1) << mixed.err;
+  EXPECT_NE(mixed.err.find("must be the only --capture"), std::string::npos) << mixed.err;
+  const testing::Result no_dir = testing::RunCli("reconstruct" + rig + " --capture - --out " + dir_ + "/o.ply");
+  EXPECT_EQ(no_dir.code, 2);
+  EXPECT_NE(no_dir.err.find("needs --out-dir"), std::string::npos) << no_dir.err;
+  const std::string fresh = dir_ + "/empty_run/out";
+  fs::remove_all(dir_ + "/empty_run");
+  const testing::Result empty =
+      testing::RunCli("reconstruct" + rig + " --capture - --out-dir " + fresh + " < /dev/null");
+  EXPECT_EQ(empty.code, 2);
+  EXPECT_NE(empty.err.find("standard input held no capture folder"), std::string::npos) << empty.err;
+  EXPECT_FALSE(fs::exists(dir_ + "/empty_run")) << "an input with no folder left the output folder behind";
+  // A capture whose report would be the run's summary is refused when its
+  // line comes (a batch refuses it before any work), and writes nothing.
+  const std::string list = dir_ + "/list.txt", clash = dir_ + "/clash";
+  WriteFileAtomically(list, dir_ + "/line/0001\n");
+  fs::remove_all(clash);
+  const testing::Result r = testing::RunCli("reconstruct" + rig + " --capture - --out-dir " + clash + " --report " +
+                                            clash + "/0001.json < " + list);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(
+      r.err.find("[1] " + clash + "/0001.json: would be written twice (the summary (--report) and 0001's report)"),
+      std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(clash + "/0001.ply"));
+  EXPECT_EQ(nlohmann::json::parse(Bytes(clash + "/0001.json"))["failed"], 1);
+}
+
+}  // namespace
+}  // namespace stereorig
