@@ -3,7 +3,6 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <map>
 #include <nlohmann/json.hpp>
 
 #include "apps/output_paths.h"
@@ -17,20 +16,10 @@ namespace stereorig {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-// The folder as a batch compares them (reconstruct_batch.h BatchOutputNames):
-// absolute and normal, links not followed ("caps/0001/" is "caps/0001").
-fs::path FolderKey(const std::string& dir) {
-  fs::path p = fs::absolute(fs::path(dir)).lexically_normal();
-  if (!p.has_filename()) p = p.parent_path();
-  return p;
-}
-
-}  // namespace
-
 std::string StreamOutputName(const std::string& dir) {
-  const std::string name = FolderKey(dir).filename().string();
+  fs::path p = fs::absolute(fs::path(dir)).lexically_normal();
+  if (!p.has_filename()) p = p.parent_path();  // "caps/0001/" names 0001
+  const std::string name = p.filename().string();
   if (name.empty()) throw InputError(dir, "a capture folder cannot be the file system's root");
   return name;
 }
@@ -39,26 +28,33 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// What the stream has written so far, to refuse a capture that would replace
-// it: by output name and by folder (FolderKey), the capture each came from.
-struct Written {
-  std::map<std::string, std::pair<int, std::string>> by_name;  // name -> (line, folder as given)
-  std::map<fs::path, int> by_folder;                           // folder -> line
-};
+// At most this many failed captures are listed in the summary (the count is
+// always whole): a stream may run for days, and its memory must not grow
+// with it. Reconstructed captures are not listed; each has its own report.
+constexpr int kMaxFailuresListed = 1000;
 
 // The checks of one capture that need no decoding, in the order a user
 // would fix them. Throws InputError naming the problem. `paths`: the run's
 // protected inputs and claimed summary; the capture's own images are
-// protected and its outputs claimed in a copy.
+// protected and its outputs claimed in a copy. `run_started`: an output
+// last written since then is this run's (a folder sent twice, or two
+// folders of one name) and is not replaced. Asking the file system, not a
+// list of the names written, keeps the memory of a stream that runs for
+// days constant (the kernel's file times lag its clock by a tick, ~4 ms: the
+// runtime's build lies between the start and the first write).
 void CheckStreamCapture(const std::string& dir, const std::string& name, const CaptureOutputs& outputs, const Rig& rig,
-                        const Written& written, OutputPaths paths) {
-  if (const auto it = written.by_folder.find(FolderKey(dir)); it != written.by_folder.end())
-    throw InputError(dir, "was given already (capture " + std::to_string(it->second) +
-                              "): its outputs are written; a capture is reconstructed once per run");
-  if (const auto it = written.by_name.find(name); it != written.by_name.end())
-    throw InputError(dir, "would write outputs named '" + name + "', as " + it->second.second + " (capture " +
-                              std::to_string(it->second.first) +
-                              ") did: a stream names each capture by its folder's last name; rename the folder");
+                        fs::file_time_type run_started, OutputPaths paths) {
+  for (const std::string& path : {outputs.cloud, outputs.report, outputs.mesh}) {
+    std::error_code ec;
+    if (path.empty() || !fs::exists(path, ec)) continue;
+    const fs::file_time_type written = fs::last_write_time(path, ec);
+    if (!ec && written >= run_started)
+      throw InputError(dir, "would replace " + path +
+                                ", which this run wrote: a stream names each capture by its folder's last name ('" +
+                                name +
+                                "'), so a folder sent twice, or two folders of one name, would overwrite a "
+                                "measurement; rename the folder");
+  }
   for (const std::string& image : CaptureImagePaths(dir, rig)) paths.Protect(image, "a capture image");
   paths.Claim(outputs.cloud, name + "'s cloud");
   paths.Claim(outputs.report, name + "'s report");
@@ -80,6 +76,7 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
     const fs::path out = fs::absolute(fs::path(request.out_dir)).lexically_normal();
     if (folder != out && !fs::is_directory(folder)) throw InputError(request.summary_path, "its folder does not exist");
   }
+  const fs::file_time_type run_started = fs::file_time_type::clock::now();
   const auto t_build = Clock::now();
   const Runtime runtime(rig, options);  // bad options for this rig: refused before anything is written
   const double build_ms = MsSince(t_build);
@@ -95,8 +92,7 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
 
   nlohmann::json summary;
   summary["runtime_build_ms"] = build_ms;
-  summary["captures"] = nlohmann::json::array();
-  Written written;
+  summary["failed_captures"] = nlohmann::json::array();  // the first kMaxFailuresListed
   int total = 0, failed = 0;
   const auto t_all = Clock::now();
   std::string line;
@@ -115,19 +111,17 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
       const CaptureOutputs planned = CaptureOutputsNamed(request.out_dir, name, request.mesh_format);
       // Refused here, nothing of the name is removed: it may be an earlier
       // capture's output or an input.
-      CheckStreamCapture(dir, name, planned, rig, written, paths);
+      CheckStreamCapture(dir, name, planned, rig, run_started, paths);
       outputs = planned;
       CheckCaptureFiles(dir, rig);
       const std::vector<cv::Mat> images = LoadCaptureOrInputError(dir, rig);
-      summary["captures"].push_back(ReconstructCapture(runtime, images, dir, name, outputs, progress, t));
-      written.by_name[name] = {total, dir};
-      written.by_folder[FolderKey(dir)] = total;
+      ReconstructCapture(runtime, images, dir, name, outputs, progress, t);
       continue;
     } catch (const InputError& e) {  // the capture's files, images or outputs
       error = e.what();
     }
-    ++failed;
-    summary["captures"].push_back(FailedCapture(dir, name, outputs, progress, error));
+    const nlohmann::json entry = FailedCapture(dir, name, outputs, progress, error);
+    if (++failed <= kMaxFailuresListed) summary["failed_captures"].push_back(entry);
   }
   if (total == 0) {
     out_folder.RemoveIfEmpty();

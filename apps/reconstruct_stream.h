@@ -37,7 +37,11 @@ struct StreamRequest {
 // Builds the runtime, then reads `in` to its end: each line (a trailing '\r'
 // dropped; blank lines skipped) names a capture folder, reconstructed and
 // written as out_dir/<name>.ply, <name>.json and <name>.mesh.<format>, each
-// atomically, with one line on stdout, flushed (reconstruct_capture.h).
+// atomically, with one line on stdout, flushed (reconstruct_capture.h). An
+// output this run wrote already is never replaced: that capture is refused.
+// The memory does not grow with the captures: the summary (written when the
+// input ends) holds the totals and the first 1000 failed captures, not the
+// reconstructed ones, which have their own reports.
 // Returns the exit code: 0, or 2 when any capture failed. Throws InputError
 // for bad input found before the first line is read (the options, the
 // output folder, the summary's path: nothing written then) and when the
