@@ -66,6 +66,11 @@ int RunReconstruct(int argc, char** argv) {
   app.add_option("--report", report_path,
                  "one capture: its per-step times, point counts and fill rates as JSON; many: the batch's summary");
   app.add_option("--options", options_path, "runtime options YAML (default: the built-in defaults)");
+  std::string warm_up_dir;
+  app.add_option("--warm-up", warm_up_dir,
+                 "with --capture -: reconstruct this capture once before reading the first folder, writing "
+                 "nothing, so that the line's first object does not pay the first capture's start-up costs (a "
+                 "capture of a typical object)");
   out->excludes(dir);
   mesh->excludes(dir);
   format->needs(dir);
@@ -75,6 +80,10 @@ int RunReconstruct(int argc, char** argv) {
   const bool stream = std::find(capture_dirs.begin(), capture_dirs.end(), "-") != capture_dirs.end();
   if (stream && capture_dirs.size() > 1)
     throw InputError("--capture", "'-' (the capture folders read from standard input) must be the only --capture");
+  if (!warm_up_dir.empty() && !stream)
+    throw InputError("--warm-up",
+                     "is for a stream of captures (--capture -): a batch or one capture has no first "
+                     "object to wait for it");
   if (stream && out_dir.empty())
     throw InputError("--capture", "'-' (the capture folders read from standard input) needs --out-dir DIR");
   if (out_dir.empty() && out_path.empty())
@@ -91,7 +100,8 @@ int RunReconstruct(int argc, char** argv) {
     const Rig rig = ReadRigFile(rig_path);
     const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
     if (stream)
-      return ReconstructStream(rig, options, StreamRequest{out_dir, mesh_format, report_path, rig_path, options_path},
+      return ReconstructStream(rig, options,
+                               StreamRequest{out_dir, mesh_format, report_path, rig_path, options_path, warm_up_dir},
                                std::cin);
     return ReconstructBatch(rig, options,
                             BatchRequest{capture_dirs, out_dir, mesh_format, report_path, rig_path, options_path});

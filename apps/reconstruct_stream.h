@@ -32,6 +32,11 @@ struct StreamRequest {
   std::string summary_path;  // "" or the run's JSON summary, written at the end of the input
   std::string rig_path;      // the rig file and options file read ("" if none): no output may be either
   std::string options_path;
+  // "" or a capture reconstructed once before the first line is read, its
+  // outputs not written: the first capture after a start costs more than a
+  // warm one (the heap's pages faulted in, ~15 us each on this VM, the
+  // worker threads started), which a line's first object would pay.
+  std::string warm_up_dir;
 };
 
 // Builds the runtime, then reads `in` to its end: each line (a trailing '\r'

@@ -140,13 +140,16 @@ TEST_F(ReconstructStreamCli, ReconstructsEachFolderAsItsLineArrives) {
   const std::string out = dir_ + "/out", err = dir_ + "/stream_err.txt";
   fs::remove_all(out);
   Child child({testing::kBin, "reconstruct", "--rig", dir_ + "/rig.yaml", "--capture", "-", "--out-dir", out,
-               "--report", out + "/summary.json"},
+               "--report", out + "/summary.json", "--warm-up", dir_ + "/line/0002"},
               err);
   ASSERT_TRUE(child.started());
   // Generous: the runtime's build and one capture take < 1 s on 2 cores.
   // Only a process that waits for the end of its input fails this.
   const double timeout_s = 120;
-  ASSERT_NE(child.ReadLines(1, timeout_s).find("reading capture folders from standard input"), std::string::npos)
+  // The warm-up capture is reconstructed first and writes nothing (0002 is
+  // sent and written below), nor changes what comes after (byte-identical
+  // clouds: Process is stateless).
+  ASSERT_NE(child.ReadLines(1, timeout_s).find("warmed up on " + dir_ + "/line/0002 in "), std::string::npos)
       << child.ReadLines(1, 0);
   child.Send(dir_ + "/line/0001");
   const std::string& first = child.ReadLines(2, timeout_s);
@@ -197,8 +200,9 @@ TEST_F(ReconstructStreamCli, ReconstructsEachFolderAsItsLineArrives) {
 }
 
 // Bad use is refused before any work, in one line: '-' beside other
-// folders, '-' without --out-dir; an input holding no folder exits 2 and
-// leaves no new output folder.
+// folders, '-' without --out-dir, --warm-up without '-', a warm-up capture
+// whose images are bad; an input holding no folder exits 2 and leaves no new
+// output folder.
 TEST_F(ReconstructStreamCli, BadUseExitsTwoInOneLine) {
   const std::string rig = " --rig " + dir_ + "/rig.yaml";
   const testing::Result mixed =
@@ -209,6 +213,18 @@ TEST_F(ReconstructStreamCli, BadUseExitsTwoInOneLine) {
   const testing::Result no_dir = testing::RunCli("reconstruct" + rig + " --capture - --out " + dir_ + "/o.ply");
   EXPECT_EQ(no_dir.code, 2);
   EXPECT_NE(no_dir.err.find("needs --out-dir"), std::string::npos) << no_dir.err;
+  const testing::Result warm_batch =
+      testing::RunCli("reconstruct" + rig + " --capture " + dir_ + "/line/0001 --out-dir " + dir_ + "/o2 --warm-up " +
+                      dir_ + "/line/0002");
+  EXPECT_EQ(warm_batch.code, 2);
+  EXPECT_NE(warm_batch.err.find("--warm-up: is for a stream of captures"), std::string::npos) << warm_batch.err;
+  EXPECT_FALSE(fs::exists(dir_ + "/o2"));
+  const testing::Result bad_warm = testing::RunCli("reconstruct" + rig + " --capture - --out-dir " + dir_ +
+                                                   "/o3 --warm-up " + dir_ + "/line/0003 < /dev/null");
+  EXPECT_EQ(bad_warm.code, 2);
+  EXPECT_EQ(testing::Lines(bad_warm.err), 1) << bad_warm.err;
+  EXPECT_NE(bad_warm.err.find(dir_ + "/line/0003/cam1.png"), std::string::npos) << bad_warm.err;
+  EXPECT_FALSE(fs::exists(dir_ + "/o3")) << "a bad warm-up capture left the output folder behind";
   const std::string fresh = dir_ + "/empty_run/out";
   fs::remove_all(dir_ + "/empty_run");
   const testing::Result empty =
