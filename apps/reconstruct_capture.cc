@@ -86,14 +86,15 @@ nlohmann::json FailedCapture(const std::string& dir, const std::string& name, co
   return entry;
 }
 
-int FinishRun(nlohmann::json* summary, int total, int failed, double wall_ms, const std::string& summary_path) {
+int FinishRun(nlohmann::json* summary, int total, int failed, double wall_ms, const std::string& timed,
+              const std::string& summary_path) {
   const int done = total - failed;
   (*summary)["reconstructed"] = done;
   (*summary)["failed"] = failed;
   (*summary)["wall_ms"] = wall_ms;
   (*summary)["objects_per_s"] = done > 0 ? 1000.0 * done / wall_ms : 0.0;
-  std::printf("%d of %d captures in %.2f s: %.1f objects/s (reading, reconstructing and writing)\n", done, total,
-              wall_ms / 1000, (*summary)["objects_per_s"].get<double>());
+  std::printf("%d of %d captures in %.2f s: %.1f objects/s (%s)\n", done, total, wall_ms / 1000,
+              (*summary)["objects_per_s"].get<double>(), timed.c_str());
   std::fflush(stdout);
   if (!summary_path.empty()) WriteFileAtomically(summary_path, summary->dump(2) + "\n");
   if (failed == 0) return kExitOk;

@@ -51,11 +51,13 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
 nlohmann::json FailedCapture(const std::string& dir, const std::string& name, const CaptureOutputs& outputs,
                              const std::string& progress, const std::string& why);
 
-// The run's end: "<done> of <total> captures in S s: R objects/s (...)" on
-// stdout, the summary's totals (reconstructed, failed, wall_ms,
-// objects_per_s) set and the summary written atomically to summary_path
-// (unless ""); with failures, the stderr line that counts them. Returns the
-// exit code: kExitOk, or kExitBadInput when any capture failed.
-int FinishRun(nlohmann::json* summary, int total, int failed, double wall_ms, const std::string& summary_path);
+// The run's end: "<done> of <total> captures in S s: R objects/s (<timed>)"
+// on stdout (`timed`: what the wall time holds), the summary's totals
+// (reconstructed, failed, wall_ms, objects_per_s) set and the summary
+// written atomically to summary_path (unless ""); with failures, the stderr
+// line that counts them. Returns the exit code: kExitOk, or kExitBadInput
+// when any capture failed.
+int FinishRun(nlohmann::json* summary, int total, int failed, double wall_ms, const std::string& timed,
+              const std::string& summary_path);
 
 }  // namespace stereorig

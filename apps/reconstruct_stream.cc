@@ -139,7 +139,9 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
     out_folder.RemoveIfEmpty();
     throw InputError("--capture -", "standard input held no capture folder (one folder's path per line)");
   }
-  const int code = FinishRun(&summary, total, failed, MsSince(t_all), request.summary_path);
+  const int code = FinishRun(&summary, total, failed, MsSince(t_all),
+                             "the stream's wall time: waiting for the input, reading, reconstructing and writing",
+                             request.summary_path);
   if (failed > 0) out_folder.RemoveIfEmpty();  // as a batch: nothing written, no new folder
   return code;
 }
