@@ -39,11 +39,12 @@ int RunReconstruct(int argc, char** argv) {
       "capture whose images cannot be decoded or have the wrong size is reported and gets no output, the others "
       "go on, and the exit code is 2.\n"
       "Driven by the line's acquisition software, one capture at a time: --capture - reads the capture folders "
-      "from standard input, one path per line (a pipe, or a FIFO written once a folder is complete), and "
-      "reconstructs each as its line arrives, with one runtime built at the start; each capture writes "
-      "<name>.ply and <name>.json, <name> its folder's last name, and prints its line on stdout at once. A bad "
-      "capture (a missing camera, a name or folder already used in the run, bad images) is named on stderr, gets "
-      "no output, and the stream goes on; the end of the input ends the run (exit 2 if any capture failed).\n\n"
+      "from standard input, one path per line, sent once the folder is complete (a pipe, or a FIFO: see "
+      "docs/reconstruct.md, 'Captures as they come'), and reconstructs each as its line arrives, with one runtime "
+      "built at the start; each capture writes <name>.ply and <name>.json, <name> its folder's last name, and "
+      "prints one line '[k] DIR: ...' on stdout at once. An output that exists is never replaced. A bad capture (a "
+      "missing camera, bad images, an output name that exists already) is named on stderr and on its line, gets no "
+      "output, and the stream goes on; the end of the input ends the run (exit 2 if any capture failed).\n\n"
       "Examples:\n  stereorig reconstruct --rig rig.yaml --capture data/scenes/cup/active --out cup.ply "
       "--mesh cup.stl --report cup.json\n"
       "  stereorig reconstruct --rig rig.yaml --capture line/0001 line/0002 line/0003 --out-dir clouds "
@@ -64,9 +65,14 @@ int RunReconstruct(int argc, char** argv) {
   auto* mesh = app.add_option("--mesh", mesh_path, "one capture: also write the joined mesh (.ply or .stl)");
   auto* format = app.add_option("--mesh-format", mesh_format, "many captures: also write <name>.mesh.<ply|stl>");
   app.add_option("--report", report_path,
-                 "one capture: its per-step times, point counts and fill rates as JSON; many: the batch's summary");
+                 "one capture: its per-step times, point counts and fill rates as JSON; many: the batch's summary; "
+                 "--capture -: the stream's totals and failed captures, written when the input ends");
   app.add_option("--options", options_path, "runtime options YAML (default: the built-in defaults)");
-  std::string warm_up_dir;
+  std::string warm_up_dir, capture_root;
+  app.add_option("--capture-root", capture_root,
+                 "with --capture -: name each capture by its folder's path below this folder, joined with '_' "
+                 "(root line: line/2026-12-06/0001 -> 2026-12-06_0001) instead of its last name; folders not below "
+                 "it are refused");
   app.add_option("--warm-up", warm_up_dir,
                  "with --capture -: reconstruct this capture once before reading the first folder, writing "
                  "nothing, so that the line's first object does not pay the first capture's start-up costs (a "
@@ -80,6 +86,12 @@ int RunReconstruct(int argc, char** argv) {
   const bool stream = std::find(capture_dirs.begin(), capture_dirs.end(), "-") != capture_dirs.end();
   if (stream && capture_dirs.size() > 1)
     throw InputError("--capture", "'-' (the capture folders read from standard input) must be the only --capture");
+  if (app.count("--warm-up") > 0 && warm_up_dir.empty())
+    throw InputError("--warm-up", "names no capture folder (an empty path)");
+  if (app.count("--capture-root") > 0 && !stream)
+    throw InputError("--capture-root",
+                     "is for a stream of captures (--capture -): a batch names its captures after "
+                     "the folders they all share");
   if (!warm_up_dir.empty() && !stream)
     throw InputError("--warm-up",
                      "is for a stream of captures (--capture -): a batch or one capture has no first "
@@ -100,9 +112,10 @@ int RunReconstruct(int argc, char** argv) {
     const Rig rig = ReadRigFile(rig_path);
     const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
     if (stream)
-      return ReconstructStream(rig, options,
-                               StreamRequest{out_dir, mesh_format, report_path, rig_path, options_path, warm_up_dir},
-                               std::cin);
+      return ReconstructStream(
+          rig, options,
+          StreamRequest{out_dir, mesh_format, report_path, rig_path, options_path, warm_up_dir, capture_root},
+          std::cin);
     return ReconstructBatch(rig, options,
                             BatchRequest{capture_dirs, out_dir, mesh_format, report_path, rig_path, options_path});
   }

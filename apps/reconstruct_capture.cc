@@ -36,9 +36,14 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
                                   std::chrono::steady_clock::time_point started) {
   const bool mesh = !outputs.mesh.empty();
   const Reconstruction rec = runtime.Process(images, mesh);
-  WriteCloudPly(rec.cloud, outputs.cloud);
-  if (mesh) WriteMesh(rec.mesh, outputs.mesh);
-  WriteFileAtomically(outputs.report, ReconstructionJson(rec).dump(2) + "\n");
+  // All or none: written beside their paths, then renamed in together, so a
+  // failure (a full disk) or a signal while they are written leaves none of
+  // them new beside an earlier run's others.
+  AtomicOutputSet written;
+  written.Add(outputs.cloud, EncodeCloudPly(rec.cloud));
+  if (mesh) written.Add(outputs.mesh, EncodeMesh(rec.mesh, outputs.mesh));
+  written.Add(outputs.report, ReconstructionJson(rec).dump(2) + "\n");
+  written.Commit();
   nlohmann::json entry;
   entry["capture"] = dir;
   entry["name"] = name;

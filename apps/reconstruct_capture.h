@@ -30,8 +30,8 @@ CaptureOutputs CaptureOutputsNamed(const std::string& out_dir, const std::string
 std::vector<cv::Mat> LoadCaptureOrInputError(const std::string& dir, const Rig& rig);
 
 // Reconstructs the capture from folder `dir` (its decoded `images`) and
-// writes its outputs, each atomically (the mesh only if outputs.mesh is
-// set). Prints to stdout, flushed, "<progress> <dir>: N points (fill m0 x%,
+// writes its outputs, all or none (atomic_file.h AtomicOutputSet; the mesh
+// only if outputs.mesh is set). Prints to stdout, flushed, "<progress> <dir>: N points (fill m0 x%,
 // m1 y%), T ms -> <cloud>" (T: the wall time since `started`, when the
 // capture's turn began: waiting for its images, reconstructing, writing),
 // then a warning line per module whose matches reach an end of the volume's

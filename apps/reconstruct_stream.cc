@@ -16,11 +16,33 @@ namespace stereorig {
 
 namespace fs = std::filesystem;
 
-std::string StreamOutputName(const std::string& dir) {
+namespace {
+
+// Absolute and normal, without a trailing separator ("caps/0001/" is
+// "caps/0001"); links not followed, as a batch compares its folders.
+fs::path FolderPath(const std::string& dir) {
   fs::path p = fs::absolute(fs::path(dir)).lexically_normal();
-  if (!p.has_filename()) p = p.parent_path();  // "caps/0001/" names 0001
-  const std::string name = p.filename().string();
-  if (name.empty()) throw InputError(dir, "a capture folder cannot be the file system's root");
+  if (!p.has_filename()) p = p.parent_path();
+  return p;
+}
+
+}  // namespace
+
+std::string StreamOutputName(const std::string& dir, const std::string& root) {
+  const fs::path p = FolderPath(dir);
+  if (root.empty()) {
+    const std::string name = p.filename().string();
+    if (name.empty()) throw InputError(dir, "a capture folder cannot be the file system's root");
+    return name;
+  }
+  const fs::path below = p.lexically_relative(FolderPath(root));
+  if (below.empty() || below == "." || *below.begin() == "..")
+    throw InputError(dir, "is not a folder below --capture-root " + root + ", which names the captures");
+  std::string name;
+  for (const fs::path& c : below) {
+    if (!name.empty()) name.push_back('_');
+    name.append(c.string());
+  }
   return name;
 }
 
@@ -36,24 +58,23 @@ constexpr int kMaxFailuresListed = 1000;
 // The checks of one capture that need no decoding, in the order a user
 // would fix them. Throws InputError naming the problem. `paths`: the run's
 // protected inputs and claimed summary; the capture's own images are
-// protected and its outputs claimed in a copy. `run_started`: an output
-// last written since then is this run's (a folder sent twice, or two
-// folders of one name) and is not replaced. Asking the file system, not a
-// list of the names written, keeps the memory of a stream that runs for
-// days constant (the kernel's file times lag its clock by a tick, ~4 ms: the
-// runtime's build lies between the start and the first write).
+// protected and its outputs claimed in a copy. An output that exists is
+// never replaced: a line's measurements are its record, and a folder sent
+// twice, two folders of one name (day-numbered folders under dated ones) or
+// a run over an earlier run's output folder would otherwise overwrite them
+// unseen. Asking the file system keeps the memory constant over a stream
+// that runs for days.
 void CheckStreamCapture(const std::string& dir, const std::string& name, const CaptureOutputs& outputs, const Rig& rig,
-                        fs::file_time_type run_started, OutputPaths paths) {
+                        OutputPaths paths) {
   for (const std::string& path : {outputs.cloud, outputs.report, outputs.mesh}) {
     std::error_code ec;
-    if (path.empty() || !fs::exists(path, ec)) continue;
-    const fs::file_time_type written = fs::last_write_time(path, ec);
-    if (!ec && written >= run_started)
-      throw InputError(dir, "would replace " + path +
-                                ", which this run wrote: a stream names each capture by its folder's last name ('" +
+    if (!path.empty() && fs::symlink_status(path, ec).type() != fs::file_type::not_found)
+      throw InputError(dir, "its output " + path +
+                                " exists already: a stream never replaces a measurement (this run's or an earlier "
+                                "one's); name each capture's folder uniquely (it is named '" +
                                 name +
-                                "'), so a folder sent twice, or two folders of one name, would overwrite a "
-                                "measurement; rename the folder");
+                                "'; --capture-root names captures by their path below it), or write to "
+                                "another --out-dir");
   }
   for (const std::string& image : CaptureImagePaths(dir, rig)) paths.Protect(image, "a capture image");
   paths.Claim(outputs.cloud, name + "'s cloud");
@@ -76,7 +97,8 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
     const fs::path out = fs::absolute(fs::path(request.out_dir)).lexically_normal();
     if (folder != out && !fs::is_directory(folder)) throw InputError(request.summary_path, "its folder does not exist");
   }
-  const fs::file_time_type run_started = fs::file_time_type::clock::now();
+  if (!request.capture_root.empty() && !fs::is_directory(request.capture_root))
+    throw InputError(request.capture_root, "is not a folder (--capture-root: the captures' folders lie below it)");
   const auto t_build = Clock::now();
   const Runtime runtime(rig, options);  // bad options for this rig: refused before anything is written
   const double build_ms = MsSince(t_build);
@@ -91,10 +113,6 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
     warm_up_ms = MsSince(t_warm);
   }
   out_folder.Create();
-  std::error_code ec;
-  // A summary from an earlier run would describe that run until this one
-  // ends: it goes now and is written anew at the end.
-  if (!request.summary_path.empty()) fs::remove(request.summary_path, ec);
   std::printf("runtime built in %.0f ms (%d modules)", build_ms, rig.num_modules());
   if (!request.warm_up_dir.empty())
     std::printf(", warmed up on %s in %.0f ms (not written)", request.warm_up_dir.c_str(), warm_up_ms);
@@ -112,6 +130,13 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
     if (!line.empty() && line.back() == '\r') line.pop_back();  // written on Windows
     if (line.find_first_not_of(" \t") == std::string::npos) continue;
     const auto t = Clock::now();
+    if (total == 0 && !request.summary_path.empty()) {
+      // A summary from an earlier run would describe that run until this
+      // one ends: it goes with the first capture and is written anew at the
+      // end (an input with no capture leaves it).
+      std::error_code ec;
+      fs::remove(request.summary_path, ec);
+    }
     const std::string& dir = line;
     char progress[24];
     std::snprintf(progress, sizeof progress, "[%d]", ++total);
@@ -119,20 +144,28 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
     CaptureOutputs outputs;  // set once they are this capture's to write (or to remove)
     std::string error;
     try {
-      name = StreamOutputName(dir);
+      if (dir.find('\0') != std::string::npos)
+        throw InputError("line " + std::to_string(total), "holds a NUL byte: not a folder's path");
+      name = StreamOutputName(dir, request.capture_root);
       const CaptureOutputs planned = CaptureOutputsNamed(request.out_dir, name, request.mesh_format);
-      // Refused here, nothing of the name is removed: it may be an earlier
-      // capture's output or an input.
-      CheckStreamCapture(dir, name, planned, rig, run_started, paths);
-      outputs = planned;
+      CheckStreamCapture(dir, name, planned, rig, paths);
       CheckCaptureFiles(dir, rig);
+      // None of them exists (checked above): a failure from here on removes
+      // only what this capture may have written.
+      outputs = planned;
       const std::vector<cv::Mat> images = LoadCaptureOrInputError(dir, rig);
       ReconstructCapture(runtime, images, dir, name, outputs, progress, t);
       continue;
     } catch (const InputError& e) {  // the capture's files, images or outputs
       error = e.what();
+    } catch (const fs::filesystem_error& e) {  // a path the file system cannot look up (a link loop, too long)
+      error = dir + ": " + e.code().message();
     }
     const nlohmann::json entry = FailedCapture(dir, name, outputs, progress, error);
+    // On stdout too: a caller reading each capture's line there gets one for
+    // every capture.
+    std::printf("%s %s: no output (%s)\n", progress, dir.c_str(), error.c_str());
+    std::fflush(stdout);
     if (++failed <= kMaxFailuresListed) summary["failed_captures"].push_back(entry);
   }
   if (total == 0) {

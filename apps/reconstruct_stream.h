@@ -21,10 +21,15 @@
 
 namespace stereorig {
 
-// A capture's output name in a stream: its folder's last name
-// ("line/2026-12-06/0001", "line/2026-12-06/0001/" -> "0001"; "." -> the
-// current folder's name). Throws InputError(dir) for the file system's root.
-std::string StreamOutputName(const std::string& dir);
+// A capture's output name in a stream. Without `root` (""), its folder's
+// last name ("line/2026-12-06/0001", "line/2026-12-06/0001/" -> "0001"; "."
+// -> the current folder's name). With it, the folder's path below `root`,
+// joined with '_' (root "line": "line/2026-12-06/0001" ->
+// "2026-12-06_0001"), as a batch names its folders after the part all share:
+// folders numbered afresh each day keep their names apart. Paths compared
+// absolute and normal, links not followed. Throws InputError(dir) for the
+// file system's root, or a folder that is not below `root`.
+std::string StreamOutputName(const std::string& dir, const std::string& root = "");
 
 struct StreamRequest {
   std::string out_dir;       // created if missing
@@ -37,6 +42,7 @@ struct StreamRequest {
   // warm one (the heap's pages faulted in, ~15 us each on this VM, the
   // worker threads started), which a line's first object would pay.
   std::string warm_up_dir;
+  std::string capture_root;  // "" or the folder the captures' output names are taken below (StreamOutputName)
 };
 
 // Builds the runtime, then reads `in` to its end: each line (a trailing '\r'

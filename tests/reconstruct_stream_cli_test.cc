@@ -15,6 +15,9 @@
 #include <iterator>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "calib/core/atomic_file.h"
 #include "calib/core/rig_file.h"
@@ -27,6 +30,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
+int RunCliCode(const std::string& args) { return testing::RunCli(args).code; }
+
 std::string Bytes(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(f), {});
@@ -36,6 +41,8 @@ std::string Bytes(const std::string& path) {
 class Child {
  public:
   Child(const std::vector<std::string>& args, const std::string& err_path) {
+    // A child that ended early makes a write fail (EPIPE), not kill the test.
+    signal(SIGPIPE, SIG_IGN);
     int in[2], out[2];
     if (pipe(in) != 0 || pipe(out) != 0) return;
     pid_ = fork();
@@ -65,8 +72,8 @@ class Child {
     }
   }
   bool started() const { return pid_ > 0 && to_child_ >= 0; }
-  void Send(const std::string& line) {
-    const std::string s = line + "\n";
+  void Send(const std::string& line, bool newline = true) {
+    const std::string s = newline ? line + "\n" : line;
     ASSERT_EQ(write(to_child_, s.data(), s.size()), ssize_t(s.size()));
   }
   void CloseInput() {
@@ -130,17 +137,20 @@ class ReconstructStreamCli : public ::testing::Test {
 };
 std::string ReconstructStreamCli::dir_;
 
-// Each capture's line comes back before the next folder is sent (the
-// runtime is driven one object at a time, as a line does); the cloud is the
-// single run's, byte for byte; a broken capture, a folder sent again and a
-// folder whose name was used already are each named on stderr and get no
-// output (what the run wrote stays), and the stream goes on; the end of the
-// input ends the run, exit 2 (captures failed), with the summary.
+// Each capture's line comes back on stdout before the next folder is sent
+// (the runtime is driven one object at a time, as a line does), a failed
+// capture's too; the cloud is the single run's, byte for byte; a broken
+// capture, a link loop, a folder sent again and another folder of the same
+// name are each named on stderr and get no output (an existing output is
+// never replaced, what the run wrote stays), and the stream goes on; the end
+// of the input (no trailing newline) ends the run, exit 2 (captures
+// failed), with the summary.
 TEST_F(ReconstructStreamCli, ReconstructsEachFolderAsItsLineArrives) {
   const std::string out = dir_ + "/out", err = dir_ + "/stream_err.txt";
   fs::remove_all(out);
+  fs::create_symlink("loop", dir_ + "/loop");  // a path the file system cannot resolve (ELOOP)
   Child child({testing::kBin, "reconstruct", "--rig", dir_ + "/rig.yaml", "--capture", "-", "--out-dir", out,
-               "--report", out + "/summary.json", "--warm-up", dir_ + "/line/0002"},
+               "--mesh-format", "stl", "--report", out + "/summary.json", "--warm-up", dir_ + "/line/0002"},
               err);
   ASSERT_TRUE(child.started());
   // Generous: the runtime's build and one capture take < 1 s on 2 cores.
@@ -151,58 +161,92 @@ TEST_F(ReconstructStreamCli, ReconstructsEachFolderAsItsLineArrives) {
   // clouds: Process is stateless).
   ASSERT_NE(child.ReadLines(1, timeout_s).find("warmed up on " + dir_ + "/line/0002 in "), std::string::npos)
       << child.ReadLines(1, 0);
-  child.Send(dir_ + "/line/0001");
-  const std::string& first = child.ReadLines(2, timeout_s);
-  ASSERT_EQ(testing::Lines(first), 2) << "no line for the first capture while the input is open: " << first;
-  EXPECT_NE(first.find("[1] " + dir_ + "/line/0001: "), std::string::npos) << first;
+  // One folder at a time, each one's line read before the next is sent.
+  const std::vector<std::pair<std::string, std::string>> sent = {
+      {dir_ + "/line/0001", "[1] " + dir_ + "/line/0001: "},
+      {dir_ + "/line/0003", "[2] " + dir_ + "/line/0003: no output (" + dir_ + "/line/0003/cam1.png: is not a PNG"},
+      {dir_ + "/loop", "[3] " + dir_ + "/loop: no output (" + dir_ + "/loop: Too many levels of symbolic links)"},
+      {dir_ + "/line/0001/", "[4] " + dir_ + "/line/0001/: no output (" + dir_ + "/line/0001/: its output " + out +
+                                 "/0001.ply exists already"},
+      {dir_ + "/other/0001", "[5] " + dir_ + "/other/0001: no output (" + dir_ + "/other/0001: its output " + out +
+                                 "/0001.ply exists already"},
+  };
+  for (size_t k = 0; k < sent.size(); ++k) {
+    child.Send(sent[k].first);
+    if (k == 1) child.Send("");  // skipped, not counted
+    const std::string& so_far = child.ReadLines(int(k) + 2, timeout_s);
+    ASSERT_EQ(testing::Lines(so_far), int(k) + 2) << "no line for " << sent[k].first << " while the input is open:\n"
+                                                  << so_far;
+    EXPECT_NE(so_far.find(sent[k].second), std::string::npos) << so_far;
+  }
   EXPECT_EQ(Bytes(out + "/0001.ply"), Bytes(dir_ + "/single.ply"));
-  child.Send(dir_ + "/line/0003");   // bad images
-  child.Send("");                    // skipped
-  child.Send(dir_ + "/line/0001/");  // the same folder again
-  child.Send(dir_ + "/other/0001");  // another folder of the same name
-  child.Send(dir_ + "/line/0002\r");
-  const std::string& second = child.ReadLines(3, timeout_s);
-  EXPECT_NE(second.find("[5] " + dir_ + "/line/0002: "), std::string::npos) << second;
+  child.Send(dir_ + "/line/0002\r", false);  // written on Windows, and the input's last line without a newline
   child.CloseInput();
   EXPECT_EQ(child.Wait(), 2);
-  const std::string all = child.ReadLines(4, timeout_s);
-  EXPECT_NE(all.find("2 of 5 captures"), std::string::npos) << all;
+  const std::string all = child.ReadLines(8, timeout_s);
+  EXPECT_NE(all.find("[6] " + dir_ + "/line/0002: "), std::string::npos) << all;
+  EXPECT_NE(all.find("2 of 6 captures"), std::string::npos) << all;
   EXPECT_EQ(Bytes(out + "/0002.ply"), Bytes(dir_ + "/single.ply"));
-  EXPECT_FALSE(fs::exists(out + "/0003.ply"));
-  EXPECT_FALSE(fs::exists(out + "/0003.json"));
+  for (const char* name : {"0001", "0002"}) {
+    EXPECT_TRUE(fs::exists(out + "/" + name + ".json")) << name;
+    EXPECT_TRUE(fs::exists(out + "/" + name + ".mesh.stl")) << name;
+  }
+  for (const char* ext : {".ply", ".json", ".mesh.stl"}) EXPECT_FALSE(fs::exists(out + "/0003" + ext)) << ext;
   const std::string e = Bytes(err);
   EXPECT_NE(e.find("[2] " + dir_ + "/line/0003/cam1.png: is not a PNG"), std::string::npos) << e;
-  EXPECT_NE(e.find("[3] " + dir_ + "/line/0001/: would replace " + out + "/0001.ply, which this run wrote"),
-            std::string::npos)
-      << e;
-  EXPECT_NE(e.find("[4] " + dir_ + "/other/0001: would replace " + out + "/0001.ply, which this run wrote"),
-            std::string::npos)
-      << e;
-  EXPECT_NE(e.find("3 of 5 captures failed"), std::string::npos) << e;
+  EXPECT_NE(e.find("4 of 6 captures failed"), std::string::npos) << e;
   const nlohmann::json summary = nlohmann::json::parse(Bytes(out + "/summary.json"));
   EXPECT_EQ(summary["reconstructed"], 2);
-  EXPECT_EQ(summary["failed"], 3);
-  ASSERT_EQ(summary["failed_captures"].size(), 3u);
+  EXPECT_EQ(summary["failed"], 4);
+  ASSERT_EQ(summary["failed_captures"].size(), 4u);
   EXPECT_EQ(summary["failed_captures"][0]["name"], "0003");
-  EXPECT_EQ(summary["failed_captures"][2]["capture"], dir_ + "/other/0001");
+  EXPECT_EQ(summary["failed_captures"][3]["capture"], dir_ + "/other/0001");
   // The refused names did not remove what the first capture wrote.
   EXPECT_EQ(Bytes(out + "/0001.ply"), Bytes(dir_ + "/single.ply"));
-  EXPECT_TRUE(fs::exists(out + "/0001.json"));
-  // A later run replaces an earlier run's outputs, as a batch does: only this
-  // run's own are kept from being replaced.
+  // Nor does a later run over the same folder replace it: an earlier run's
+  // measurement stays, and that capture is refused.
   WriteFileAtomically(out + "/0001.ply", "an earlier run's cloud");
   const std::string list = dir_ + "/again.txt";
   WriteFileAtomically(list, dir_ + "/line/0001\n");
   const testing::Result again =
       testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture - --out-dir " + out + " < " + list);
-  EXPECT_EQ(again.code, 0) << again.err;
-  EXPECT_EQ(Bytes(out + "/0001.ply"), Bytes(dir_ + "/single.ply"));
+  EXPECT_EQ(again.code, 2) << again.err;
+  EXPECT_NE(again.out.find("[1] " + dir_ + "/line/0001: no output"), std::string::npos) << again.out;
+  EXPECT_EQ(Bytes(out + "/0001.ply"), "an earlier run's cloud");
+}
+
+// --capture-root names each capture by its path below the root, so folders
+// numbered afresh each day keep apart; a folder not below it is refused.
+TEST_F(ReconstructStreamCli, ACaptureRootNamesCapturesByTheirPathBelowIt) {
+  const std::string root = dir_ + "/days", out = dir_ + "/days_out";
+  fs::remove_all(root);
+  fs::remove_all(out);
+  fs::create_directories(root + "/2026-12-06");
+  fs::create_directories(root + "/2026-12-07");
+  fs::copy(dir_ + "/line/0001", root + "/2026-12-06/0001");
+  fs::copy(dir_ + "/line/0001", root + "/2026-12-07/0001");
+  const std::string list = dir_ + "/days.txt";
+  WriteFileAtomically(list, root + "/2026-12-06/0001\n" + root + "/2026-12-07/0001\n" + dir_ + "/line/0002\n");
+  const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture - --out-dir " + out +
+                                            " --capture-root " + root + " < " + list);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(Bytes(out + "/2026-12-06_0001.ply"), Bytes(dir_ + "/single.ply"));
+  EXPECT_EQ(Bytes(out + "/2026-12-07_0001.ply"), Bytes(dir_ + "/single.ply"));
+  EXPECT_NE(r.err.find("[3] " + dir_ + "/line/0002: is not a folder below --capture-root " + root), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(out + "/0002.ply"));
+  const testing::Result missing = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture - --out-dir " +
+                                                  out + " --capture-root " + dir_ + "/no_such_root < " + list);
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_EQ(testing::Lines(missing.err), 1) << missing.err;
+  EXPECT_NE(missing.err.find("no_such_root: is not a folder"), std::string::npos) << missing.err;
 }
 
 // Bad use is refused before any work, in one line: '-' beside other
-// folders, '-' without --out-dir, --warm-up without '-', a warm-up capture
-// whose images are bad; an input holding no folder exits 2 and leaves no new
-// output folder.
+// folders, '-' without --out-dir, --warm-up or --capture-root without '-',
+// an empty --warm-up, a warm-up capture whose images are bad; an input
+// holding no folder exits 2 and leaves no new output folder and an earlier
+// summary as it was.
 TEST_F(ReconstructStreamCli, BadUseExitsTwoInOneLine) {
   const std::string rig = " --rig " + dir_ + "/rig.yaml";
   const testing::Result mixed =
@@ -232,6 +276,19 @@ TEST_F(ReconstructStreamCli, BadUseExitsTwoInOneLine) {
   EXPECT_EQ(empty.code, 2);
   EXPECT_NE(empty.err.find("standard input held no capture folder"), std::string::npos) << empty.err;
   EXPECT_FALSE(fs::exists(dir_ + "/empty_run")) << "an input with no folder left the output folder behind";
+  const std::string earlier = dir_ + "/earlier_summary.json";
+  WriteFileAtomically(earlier, "an earlier run's summary");
+  EXPECT_EQ(
+      RunCliCode("reconstruct" + rig + " --capture - --out-dir " + fresh + " --report " + earlier + " < /dev/null"), 2);
+  EXPECT_EQ(Bytes(earlier), "an earlier run's summary") << "an input with no capture removed the earlier summary";
+  const testing::Result empty_warm =
+      testing::RunCli("reconstruct" + rig + " --capture - --out-dir " + dir_ + "/o4 --warm-up '' < /dev/null");
+  EXPECT_EQ(empty_warm.code, 2);
+  EXPECT_NE(empty_warm.err.find("--warm-up: names no capture folder"), std::string::npos) << empty_warm.err;
+  const testing::Result root_batch = testing::RunCli("reconstruct" + rig + " --capture " + dir_ +
+                                                     "/line/0001 --out-dir " + dir_ + "/o5 --capture-root " + dir_);
+  EXPECT_EQ(root_batch.code, 2);
+  EXPECT_NE(root_batch.err.find("--capture-root: is for a stream"), std::string::npos) << root_batch.err;
   // A capture whose report would be the run's summary is refused when its
   // line comes (a batch refuses it before any work), and writes nothing.
   const std::string list = dir_ + "/list.txt", clash = dir_ + "/clash";
