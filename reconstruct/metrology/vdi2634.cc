@@ -12,6 +12,7 @@
 #include "calib/core/input_error.h"
 #include "reconstruct/metrology/plane_fit.h"
 #include "reconstruct/metrology/sphere_fit.h"
+#include "reconstruct/metrology/sphere_uncertainty.h"
 
 namespace stereorig {
 
@@ -28,6 +29,9 @@ void VerifyOptions::Check() const {
   if (plate_min_coverage < 0 || plate_min_coverage > 1) {
     throw InputError("verify options", "plate_min_coverage must be in [0, 1]");
   }
+  if (!(max_uncertainty_fraction_of_mpe > 0)) {
+    throw InputError("verify options", "max_uncertainty_fraction_of_mpe must be positive");
+  }
 }
 
 bool ArtifactEvaluation::pass() const {
@@ -37,7 +41,31 @@ bool ArtifactEvaluation::pass() const {
 namespace {
 
 Figure MakeFigure(const std::string& name, double value, double mpe) {
-  return {name, value, mpe, std::abs(value) <= mpe};
+  return {name, value, mpe, std::abs(value) <= mpe, std::nullopt};
+}
+
+// A figure the fit leaves undetermined is refused rather than judged: its
+// value would be the fit's noise (VerifyOptions::max_uncertainty_fraction_of_mpe).
+void RequireDetermined(const Figure& f, const std::string& coverage, const VerifyOptions& o, const std::string& where) {
+  const double u_mm = f.standard_uncertainty_mm.value();
+  if (u_mm <= o.max_uncertainty_fraction_of_mpe * f.mpe_mm) return;
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "%s is not determined: %s, which fits it to +-%.3f mm (1 sigma), more than %.0f%% of "
+                "its MPE (%.3f mm); measure more of the artifact",
+                f.name.c_str(), coverage.c_str(), u_mm, 100 * o.max_uncertainty_fraction_of_mpe, f.mpe_mm);
+  throw InputError(where, buf);
+}
+
+std::string CapsText(const std::vector<double>& cap_half_angles_deg) {
+  std::string text =
+      cap_half_angles_deg.size() == 1 ? "the sphere's points cover a cap of " : "the balls' points cover caps of ";
+  for (size_t k = 0; k < cap_half_angles_deg.size(); ++k) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%s%.0f", k ? " and " : "", cap_half_angles_deg[k]);
+    text += buf;
+  }
+  return text + " deg half-angle";
 }
 
 // Drops the largest-|residual| points, at most `fraction` of them, and
@@ -263,8 +291,13 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       e.points_excluded = excluded;
       e.sphere_centers_mm = {fit.center_mm};
       e.sphere_diameters_mm = {2 * fit.radius_mm};
+      const SphereFitUncertainty u = SphereUncertainty(pts, fit);
+      e.sphere_cap_half_angles_deg = {u.cap_half_angle_deg};
+      e.sphere_diameter_std_mm = {u.diameter_std_mm};
       e.figures = {MakeFigure("P_F", Range(fit.residuals_mm), a.mpe.probing_form_mm),
                    MakeFigure("P_S", 2 * fit.radius_mm - a.sphere_diameter_mm, a.mpe.probing_size_mm)};
+      e.figures[1].standard_uncertainty_mm = u.diameter_std_mm;
+      RequireDetermined(e.figures[1], CapsText(e.sphere_cap_half_angles_deg), o, where);
       ResidualStats(fit.residuals_mm, &e);
       break;
     }
@@ -273,6 +306,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       e.capture_band_mm = band;
       const double r = 0.5 * a.sphere_diameter_mm;
       std::vector<double> all_residuals;
+      Eigen::Matrix3d centers_covariance_mm2 = Eigen::Matrix3d::Zero();  // sum of the two balls'
       std::vector<Eigen::Vector3d> remaining = pts;
       int excluded_total = 0, on_artifact = 0;
       for (int ball = 0; ball < 2; ++ball) {
@@ -329,6 +363,8 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
         all_residuals.clear();
         excluded_total = 0;
         on_artifact = 0;
+        e.sphere_cap_half_angles_deg.clear();
+        e.sphere_diameter_std_mm.clear();
         for (int ball = 0; ball < 2; ++ball) {
           std::vector<double> res;
           for (int i : idx[ball]) res.push_back((pts[i] - centers[ball]).norm() - radii[ball]);
@@ -338,6 +374,10 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
           if (!fit.ok) throw InputError(where, "ball " + std::to_string(ball + 1) + " refit failed: " + fit.message);
           e.sphere_centers_mm[ball] = fit.center_mm;
           e.sphere_diameters_mm[ball] = 2 * fit.radius_mm;
+          const SphereFitUncertainty u = SphereUncertainty(pts, fit);
+          e.sphere_cap_half_angles_deg.push_back(u.cap_half_angle_deg);
+          e.sphere_diameter_std_mm.push_back(u.diameter_std_mm);
+          centers_covariance_mm2 += u.center_covariance_mm2;
           all_residuals.insert(all_residuals.end(), fit.residuals_mm.begin(), fit.residuals_mm.end());
           excluded_total += excluded;
           on_artifact += static_cast<int>(idx[ball].size());
@@ -345,8 +385,13 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       }
       e.points_on_artifact = on_artifact;
       e.points_excluded = excluded_total;
-      const double distance = (e.sphere_centers_mm[0] - e.sphere_centers_mm[1]).norm();
-      e.figures = {MakeFigure("SD", distance - a.center_distance_mm, a.mpe.sphere_spacing_mm)};
+      const Eigen::Vector3d bar_mm = e.sphere_centers_mm[0] - e.sphere_centers_mm[1];
+      e.figures = {MakeFigure("SD", bar_mm.norm() - a.center_distance_mm, a.mpe.sphere_spacing_mm)};
+      // The two centres' errors are independent (disjoint points); the
+      // distance moves with their difference along the bar.
+      const Eigen::Vector3d along = bar_mm.normalized();
+      e.figures[0].standard_uncertainty_mm = std::sqrt(along.dot(centers_covariance_mm2 * along));
+      RequireDetermined(e.figures[0], CapsText(e.sphere_cap_half_angles_deg), o, where);
       ResidualStats(all_residuals, &e);
       break;
     }
