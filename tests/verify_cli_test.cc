@@ -263,6 +263,7 @@ TEST(VerifyCli, ACapTooSmallToFitTheDiameterIsRefusedAndAGoodOneReportsItsUncert
   // Two 74-degree caps facing each other: no mean direction, or nearly none.
   EXPECT_GT(j["spheres"][0]["cap_half_angle_deg"].get<double>(), 150);
   EXPECT_NEAR(j["spheres"][0]["diameter_mm"].get<double>(), 2 * r, 0.005);
+  EXPECT_NEAR(j["spheres"][0]["form_mm"].get<double>(), j["figures"][0]["value_mm"].get<double>(), 1e-12);  // P_F
 }
 
 }  // namespace

@@ -294,6 +294,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       const SphereFitUncertainty u = SphereUncertainty(pts, fit);
       e.sphere_cap_half_angles_deg = {u.cap_half_angle_deg};
       e.sphere_diameter_std_mm = {u.diameter_std_mm};
+      e.sphere_form_mm = {Range(fit.residuals_mm)};
       e.figures = {MakeFigure("P_F", Range(fit.residuals_mm), a.mpe.probing_form_mm),
                    MakeFigure("P_S", 2 * fit.radius_mm - a.sphere_diameter_mm, a.mpe.probing_size_mm)};
       e.figures[1].standard_uncertainty_mm = u.diameter_std_mm;
@@ -365,6 +366,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
         on_artifact = 0;
         e.sphere_cap_half_angles_deg.clear();
         e.sphere_diameter_std_mm.clear();
+        e.sphere_form_mm.clear();
         for (int ball = 0; ball < 2; ++ball) {
           std::vector<double> res;
           for (int i : idx[ball]) res.push_back((pts[i] - centers[ball]).norm() - radii[ball]);
@@ -377,6 +379,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
           const SphereFitUncertainty u = SphereUncertainty(pts, fit);
           e.sphere_cap_half_angles_deg.push_back(u.cap_half_angle_deg);
           e.sphere_diameter_std_mm.push_back(u.diameter_std_mm);
+          e.sphere_form_mm.push_back(Range(fit.residuals_mm));
           centers_covariance_mm2 += u.center_covariance_mm2;
           all_residuals.insert(all_residuals.end(), fit.residuals_mm.begin(), fit.residuals_mm.end());
           excluded_total += excluded;

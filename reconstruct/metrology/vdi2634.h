@@ -96,6 +96,10 @@ struct ArtifactEvaluation {
   // fit its diameter (sphere_uncertainty.h).
   std::vector<double> sphere_cap_half_angles_deg;
   std::vector<double> sphere_diameter_std_mm;
+  // Per sphere: the range of its residuals (what P_F is for the sphere).
+  // Reported, not judged, for the ball bar, whose figure is SD: a patch one
+  // grid period off on one ball shows here, where SD may not show it.
+  std::vector<double> sphere_form_mm;
   Eigen::Vector3d plane_normal = Eigen::Vector3d::Zero();
   double plane_offset_mm = 0;
   bool pass() const;

@@ -314,6 +314,16 @@ int DisplaceSymmetricPatch(std::vector<Eigen::Vector3d>* s, const Eigen::Vector3
   return moved;
 }
 
+// A ball as both modules see it: 70-degree caps about -z and +z, sampled
+// every 0.4 mm, with radial noise.
+std::vector<Eigen::Vector3d> BallSeenFromBothSides(const Eigen::Vector3d& c, double r_mm, double noise_mm,
+                                                   std::mt19937* rng) {
+  auto ball = SphereCap(c, r_mm, {0, 0, -1}, 70, 0.4, noise_mm, rng);
+  const auto back = SphereCap(c, r_mm, {0, 0, 1}, 70, 0.4, noise_mm, rng);
+  ball.insert(ball.end(), back.begin(), back.end());
+  return ball;
+}
+
 TEST(Vdi2634, APatchAGridPeriodOffShowsInTheSphereFiguresAsTheTruthPredicts) {
   // Truth: the certified sphere (r = 19.05 mm), both modules' caps (70 deg
   // about -z and +z) at 0.5 mm, radial noise sigma = 0.05 mm, and a patch
@@ -383,6 +393,106 @@ TEST(Vdi2634, APatchAGridPeriodOffShowsInTheFlatnessAsTheTruthPredicts) {
   EXPECT_LE(FigureOf(e, "F"), h + 10 * sigma_mm);
   EXPECT_LT(std::min((e.plane_normal - normal).norm(), (e.plane_normal + normal).norm()), 1e-4);
   EXPECT_FALSE(e.pass());
+}
+
+// A ball bar whose ball 1 has a patch one grid period off. Truth: balls of
+// the certified 25.4 mm at (-50, 0, 0) and (50, 0, 0), each seen by both
+// modules (70-degree caps about -z and +z at 0.4 mm), radial noise
+// sigma = 0.05 mm, no shaft in the cloud (so the shaft cone is off and every
+// point of each ball is the artifact's). Ball 1's patch: the points within
+// 25 deg of an axis in the y-z plane and of its opposite move radially by h.
+// Point-symmetric, it leaves ball 1's least-squares centre at the truth, so
+// SD stays 0 within the centres' noise (sigma / sqrt(N) ~ 0.001 mm; 0.01 mm
+// allowed, as for the sphere, for the sampling's small asymmetry), and moves
+// only ball 1's radius, to the mean distance: its diameter reads
+// 25.4 + 2 f h within 0.01 mm (f the patch's share of ball 1's points used,
+// the 0.3% excluded being the patch's), and its form (the range of its
+// residuals) reads within [|h|, |h| + 10 sigma], while ball 2's is the noise's
+// (< 10 sigma). Every patch point stays on the artifact.
+TEST(Vdi2634, APatchAGridPeriodOffOnOneBallShowsInTheBallBarAsTheTruthPredicts) {
+  const double sigma_mm = 0.05, r_mm = 12.7;
+  VerifyOptions no_shaft;
+  no_shaft.ballbar_shaft_cone_deg = 0;
+  for (const double h : {3.5, -3.5}) {
+    std::mt19937 rng(21);
+    const Eigen::Vector3d c1(-50, 0, 0), c2(50, 0, 0), axis(0, std::sin(40 * kPi / 180), std::cos(40 * kPi / 180));
+    auto b1 = BallSeenFromBothSides(c1, r_mm, sigma_mm, &rng);
+    auto b2 = BallSeenFromBothSides(c2, r_mm, sigma_mm, &rng);
+    const int moved = DisplaceSymmetricPatch(&b1, c1, axis, 25, h);
+    const int n1 = static_cast<int>(b1.size()), n2 = static_cast<int>(b2.size());
+    const int k1 = static_cast<int>(std::floor(0.003 * n1)), k2 = static_cast<int>(std::floor(0.003 * n2));
+    const double f = static_cast<double>(moved - k1) / (n1 - k1);
+    std::vector<Eigen::Vector3d> bar = b1;
+    bar.insert(bar.end(), b2.begin(), b2.end());
+    SCOPED_TRACE(::testing::Message() << moved << " of " << n1 << " points of ball 1 moved " << h << " mm");
+    const ArtifactEvaluation e = EvaluateArtifact(BallBarArtifact(), bar, no_shaft, "test");
+    EXPECT_EQ(e.points_on_artifact, n1 + n2);  // the patch is not dropped
+    EXPECT_EQ(e.points_excluded, k1 + k2);
+    // Which fitted sphere is ball 1 is RANSAC's choice.
+    ASSERT_EQ(e.sphere_centers_mm.size(), 2u);
+    const int i1 = (e.sphere_centers_mm[0] - c1).norm() < (e.sphere_centers_mm[1] - c1).norm() ? 0 : 1;
+    EXPECT_LT((e.sphere_centers_mm[i1] - c1).norm(), 0.01);
+    EXPECT_LT((e.sphere_centers_mm[1 - i1] - c2).norm(), 0.01);
+    EXPECT_NEAR(FigureOf(e, "SD"), 0.0, 0.01);
+    EXPECT_NEAR(e.sphere_diameters_mm[i1], 2 * r_mm + 2 * f * h, 0.01);
+    EXPECT_NEAR(e.sphere_diameters_mm[1 - i1], 2 * r_mm, 0.01);
+    ASSERT_EQ(e.sphere_form_mm.size(), 2u);
+    EXPECT_GE(e.sphere_form_mm[i1], std::abs(h));
+    EXPECT_LE(e.sphere_form_mm[i1], std::abs(h) + 10 * sigma_mm);
+    EXPECT_LT(e.sphere_form_mm[1 - i1], 10 * sigma_mm);
+  }
+}
+
+// The realistic patch is one-sided (one module's view) and displaced along
+// that module's line of sight (the camera at -z): it pulls ball 1's centre,
+// and SD must move as the least-squares fit of the measured points says.
+// Judge: the independent Kasa + Spath fit of each ball's points (the test
+// knows which are whose), with the standard's 0.3% dropped, within
+// 0.005 mm. The patch must stay in (every point on the artifact: moved
+// along z by |h| = 3.5 mm, no point's radius changes by more than |h|, inside
+// the 5 mm band) and show in SD well beyond the noise (> 0.1 mm for ~9% of
+// ball 1 moved 3.5 mm; the centres' noise is ~0.001 mm) and in ball 1's
+// form (>= 0.7 |h|: the flank's points move less radially than |h|).
+TEST(Vdi2634, AOneSidedPatchOnOneBallMovesSdAsAnIndependentFitSays) {
+  const double sigma_mm = 0.05, r_mm = 12.7;
+  VerifyOptions no_shaft;
+  no_shaft.ballbar_shaft_cone_deg = 0;
+  for (const double h : {3.5, -3.5}) {  // deeper, shallower
+    std::mt19937 rng(22);
+    const Eigen::Vector3d c1(-50, 0, 0), c2(50, 0, 0);
+    auto b1 = BallSeenFromBothSides(c1, r_mm, sigma_mm, &rng);
+    auto b2 = BallSeenFromBothSides(c2, r_mm, sigma_mm, &rng);
+    // The front module's view only: within 25 deg of a direction 30 deg off
+    // -z, towards -x (the far side from ball 2).
+    const Eigen::Vector3d towards(-std::sin(30 * kPi / 180), 0, -std::cos(30 * kPi / 180));
+    int moved = 0;
+    for (auto& p : b1) {
+      if ((p - c1).normalized().dot(towards) < std::cos(25 * kPi / 180)) continue;
+      p.z() += h;
+      ++moved;
+    }
+    std::vector<Eigen::Vector3d> bar = b1;
+    bar.insert(bar.end(), b2.begin(), b2.end());
+    const ArtifactEvaluation e = EvaluateArtifact(BallBarArtifact(), bar, no_shaft, "test");
+    SCOPED_TRACE(::testing::Message() << moved << " of " << b1.size() << " points of ball 1 moved " << h << " mm");
+    EXPECT_EQ(e.points_on_artifact, static_cast<int>(bar.size()));
+    auto reference_center = [](const std::vector<Eigen::Vector3d>& ball) {
+      Eigen::Vector3d c;
+      double r;
+      ReferenceSphere(ball, &c, &r);
+      std::vector<double> res;
+      for (const auto& p : ball) res.push_back((p - c).norm() - r);
+      ReferenceSphere(DropWorst(ball, res), &c, &r);
+      return c;
+    };
+    const double reference_sd = (reference_center(b1) - reference_center(b2)).norm() - 100.0;
+    EXPECT_NEAR(FigureOf(e, "SD"), reference_sd, 0.005);
+    EXPECT_GT(std::abs(FigureOf(e, "SD")), 0.1);
+    ASSERT_EQ(e.sphere_form_mm.size(), 2u);
+    const int i1 = (e.sphere_centers_mm[0] - c1).norm() < (e.sphere_centers_mm[1] - c1).norm() ? 0 : 1;
+    EXPECT_GE(e.sphere_form_mm[i1], 0.7 * std::abs(h));
+    EXPECT_LT(e.sphere_form_mm[1 - i1], 10 * sigma_mm);
+  }
 }
 
 // --- (5) The artifact found must be the artifact. ---
