@@ -68,15 +68,17 @@ int RunVerify(int argc, char** argv) {
       "5 mm: a patch one laser-grid period off, ~3.5 mm, stays in) is the artifact's and enters the least-squares "
       "fit and the figures; up to 0.3% of those (the largest residuals) may be excluded, as the standard allows. "
       "What is found must be the artifact: a sphere whose captured points fit a diameter more than 10% off the "
-      "certified one, or a plane that spans less than half of the plate's length or width or more than the plate, "
-      "is refused (exit 2). Points added by hole filling (PLY module 255) are not measured and are skipped: the fit "
+      "certified one, or a plane whose dense part (a few stray points do not count) spans less than half of the "
+      "plate's length or width or more than the plate, is refused (exit 2). Points added by hole filling (PLY module "
+      "255) are not measured and are skipped: the fit "
       "never uses the reconstruction's own shape prior. A position whose points leave P_S (sphere) or SD (ball bar) "
       "undetermined is refused (exit 2): the figure's standard uncertainty from the fit must be at most 10% of its "
       "MPE (a sphere's cap of ~18 deg half-angle at the demo's density fits its diameter to ~0.15 mm). The table "
       "gives, per position, each figure's standard uncertainty (u_mm), the points in the cloud, the filled ones "
       "skipped, those on the artifact, those excluded and those used, and per sphere its diameter, the diameter's "
       "standard uncertainty, the half-angle of the cap its points cover and its form (the range of its residuals; "
-      "on a ball bar reported, not judged: a patch one grid period off on one ball shows there).\n\n"
+      "on a ball bar reported, not judged: a patch one grid period off on one ball shows there); per plate the "
+      "outline of its face's dense part.\n\n"
       "Exit codes: 0 every figure passes; 1 a figure exceeds its MPE; 2 bad input.\n\n"
       "Example:\n  stereorig verify --artifact datasets/artifacts/sphere_38mm.yaml --cloud sphere_pos1.ply "
       "--cloud sphere_pos2.ply --report verify.json",
@@ -136,6 +138,12 @@ int RunVerify(int argc, char** argv) {
     }
     PrintSpheres(i + 1, e);
     if (!e.sphere_centers_mm.empty()) pj["spheres"] = SpheresJson(e);
+    if (e.type == ArtifactType::kPlate) {
+      std::printf("%-8zu plate face: outline %.1f x %.1f mm (its dense part; %d captured points outside it)\n", i + 1,
+                  e.plate_outline_length_mm, e.plate_outline_width_mm, e.plate_points_off_outline);
+      pj["plate_outline_mm"] = {e.plate_outline_length_mm, e.plate_outline_width_mm};
+      pj["plate_points_off_outline"] = e.plate_points_off_outline;
+    }
     report["positions"].push_back(pj);
   }
   std::printf(

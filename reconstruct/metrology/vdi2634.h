@@ -100,6 +100,10 @@ struct ArtifactEvaluation {
   // Reported, not judged, for the ball bar, whose figure is SD: a patch one
   // grid period off on one ball shows here, where SD may not show it.
   std::vector<double> sphere_form_mm;
+  // Plate: the outline of the face's dense part (plate_outline.h), before the
+  // edge margin, and the captured points left outside it (strays, sparse edges).
+  double plate_outline_length_mm = 0, plate_outline_width_mm = 0;
+  int plate_points_off_outline = 0;
   Eigen::Vector3d plane_normal = Eigen::Vector3d::Zero();
   double plane_offset_mm = 0;
   bool pass() const;

@@ -589,6 +589,54 @@ TEST(Vdi2634, ABallBarWhoseCentresAreUndeterminedIsRefused) {
   }
 }
 
+// --- (7) Stray points in the plate's plane. ---
+
+TEST(Vdi2634, AStrayPointInThePlatesPlaneMovesNeitherItsOutlineNorItsFigure) {
+  // Truth: the 130 mm plate at 0.5 mm, noise 0.05 mm, and one stray point in
+  // its plane 8 mm or 20 mm beyond a side (a speck of the table, a
+  // mismatched pixel: inside the 5 mm capture band). The face evaluated is
+  // the plate's eroded by 5 mm, whatever the stray: the same points on the
+  // artifact and the same F as without it. Before, the outline held every
+  // point: the 8 mm stray moved that side's margin 8 mm out (more points,
+  // the plate's edge in the figures), the 20 mm one made the plate "another
+  // surface" (138 -> 150 mm, over 130 + 2 x 5) and refused it.
+  std::mt19937 rng(31);
+  const Eigen::Vector3d c(0, 0, 5), normal = Eigen::Vector3d(0.1, -0.2, 1).normalized();
+  const auto plate = PlatePoints(c, normal, 130, 0.5, 0.05, &rng);
+  const ArtifactEvaluation clean = EvaluateArtifact(PlateArtifact(), plate, VerifyOptions(), "plate.ply");
+  const Eigen::Vector3d x = normal.unitOrthogonal();  // PlatePoints' first side
+  for (const double beyond_mm : {8.0, 20.0}) {
+    auto with_stray = plate;
+    with_stray.push_back(c + (65 + beyond_mm) * x);
+    SCOPED_TRACE(::testing::Message() << "a stray " << beyond_mm << " mm beyond a side");
+    const ArtifactEvaluation e = EvaluateArtifact(PlateArtifact(), with_stray, VerifyOptions(), "plate.ply");
+    EXPECT_EQ(e.points_on_artifact, clean.points_on_artifact);
+    EXPECT_EQ(FigureOf(e, "F"), FigureOf(clean, "F"));
+  }
+}
+
+TEST(Vdi2634, StrayPointsDoNotMakeTooLittleOfThePlateEnough) {
+  // Truth: 60 x 60 mm of the 130 mm plate seen (46%: under the half that
+  // must be), and two stray points in its plane at (40, 40) and (-40, -40) mm
+  // from its centre, 10 mm beyond the seen square along each side. Before,
+  // the outline held them: it spanned 80 mm (62%) and the plate passed as
+  // seen; it is refused, naming the 60 mm actually seen.
+  std::mt19937 rng(32);
+  const Eigen::Vector3d c(0, 0, 5), normal(0, 0, 1);
+  auto seen = PlatePoints(c, normal, 60, 0.5, 0.05, &rng);
+  const Eigen::Vector3d x = normal.unitOrthogonal(), y = normal.cross(x);
+  seen.push_back(c + 40 * x + 40 * y);
+  seen.push_back(c - 40 * x - 40 * y);
+  try {
+    EvaluateArtifact(PlateArtifact(), seen, VerifyOptions(), "part.ply");
+    ADD_FAILURE() << "46% of the plate taken for enough";
+  } catch (const InputError& error) {
+    const std::string what = error.what();
+    EXPECT_NE(what.find("too little of it seen"), std::string::npos) << what;
+    EXPECT_NE(what.find("spans 60.0 x 60.0 mm"), std::string::npos) << what;
+  }
+}
+
 TEST(Vdi2634, TooFewPointsIsBadInput) {
   std::mt19937 rng(6);
   auto s = SphereCap({0, 0, 0}, 19.05, {0, 0, -1}, 10, 1.0, 0, &rng);
