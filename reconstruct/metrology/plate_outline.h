@@ -23,8 +23,9 @@
 
 namespace stereorig {
 
-// A rectangle in a plane: u along its longer side, v = normal x u-ish, both
-// unit and in the plane; the sides at u0..u1 and v0..v1 about `mean`.
+// A rectangle in a plane: u along its longer side and v across it, both
+// unit and in the plane; its sides at u0..u1 along u and v0..v1 along v,
+// measured from `mean` (the dense points' mean).
 struct PlaneOutline {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero(), u = Eigen::Vector3d::UnitX(), v = Eigen::Vector3d::UnitY();
   double u0_mm = 0, u1_mm = 0, v0_mm = 0, v1_mm = 0;
