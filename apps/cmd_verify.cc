@@ -18,7 +18,42 @@ namespace stereorig {
 namespace {
 
 nlohmann::json FigureJson(const Figure& f) {
-  return {{"name", f.name}, {"value_mm", f.value_mm}, {"mpe_mm", f.mpe_mm}, {"pass", f.pass}};
+  nlohmann::json j = {{"name", f.name}, {"value_mm", f.value_mm}, {"mpe_mm", f.mpe_mm}, {"pass", f.pass}};
+  if (f.standard_uncertainty_mm) j["standard_uncertainty_mm"] = *f.standard_uncertainty_mm;
+  return j;
+}
+
+// Each fitted sphere (1 for a sphere, 2 for a ball bar): its size, how much
+// of it the points cover, how well they fit its diameter, and its form (on
+// a ball bar, where a patch one grid period off on one ball shows).
+nlohmann::json SpheresJson(const ArtifactEvaluation& e) {
+  nlohmann::json spheres = nlohmann::json::array();
+  for (size_t k = 0; k < e.sphere_centers_mm.size(); ++k) {
+    const Eigen::Vector3d& c = e.sphere_centers_mm[k];
+    spheres.push_back({{"center_mm", {c.x(), c.y(), c.z()}},
+                       {"diameter_mm", e.sphere_diameters_mm[k]},
+                       {"diameter_std_mm", e.sphere_diameter_std_mm[k]},
+                       {"cap_half_angle_deg", e.sphere_cap_half_angles_deg[k]},
+                       {"form_mm", e.sphere_form_mm[k]}});
+  }
+  return spheres;
+}
+
+void PrintSpheres(size_t position, const ArtifactEvaluation& e) {
+  for (size_t k = 0; k < e.sphere_centers_mm.size(); ++k) {
+    std::printf(
+        "%-8zu sphere %zu: diameter %.4f mm, standard uncertainty %.4f mm, cap half-angle %.0f deg, form (residual "
+        "range) %.4f mm%s\n",
+        position, k + 1, e.sphere_diameters_mm[k], e.sphere_diameter_std_mm[k], e.sphere_cap_half_angles_deg[k],
+        e.sphere_form_mm[k], e.type == ArtifactType::kBallBar ? " (not judged: the ball bar's figure is SD)" : "");
+  }
+}
+
+std::string UncertaintyText(const Figure& f) {
+  if (!f.standard_uncertainty_mm) return "-";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4f", *f.standard_uncertainty_mm);
+  return buf;
 }
 
 }  // namespace
@@ -33,10 +68,17 @@ int RunVerify(int argc, char** argv) {
       "5 mm: a patch one laser-grid period off, ~3.5 mm, stays in) is the artifact's and enters the least-squares "
       "fit and the figures; up to 0.3% of those (the largest residuals) may be excluded, as the standard allows. "
       "What is found must be the artifact: a sphere whose captured points fit a diameter more than 10% off the "
-      "certified one, or a plane that spans less than half of the plate's length or width or more than the plate, "
-      "is refused (exit 2). Points added by hole filling (PLY module 255) are not measured and are skipped: the fit "
-      "never uses the reconstruction's own shape prior. The table gives, per position, the points in the cloud, "
-      "the filled ones skipped, those on the artifact, those excluded and those used.\n\n"
+      "certified one, or a plane whose dense part (a few stray points do not count) spans less than half of the "
+      "plate's length or width or more than the plate, is refused (exit 2). Points added by hole filling (PLY module "
+      "255) are not measured and are skipped: the fit never uses the reconstruction's own shape prior. A position "
+      "whose points leave P_S (sphere) or SD (ball bar) "
+      "undetermined is refused (exit 2): the figure's standard uncertainty from the fit must be at most 10% of its "
+      "MPE (a sphere's cap of ~18 deg half-angle at the demo's density fits its diameter to ~0.15 mm). The table "
+      "gives, per position, each figure's standard uncertainty (u_mm), the points in the cloud, the filled ones "
+      "skipped, those on the artifact, those excluded and those used, and per sphere its diameter, the diameter's "
+      "standard uncertainty, the half-angle of the cap its points cover and its form (the range of its residuals; "
+      "on a ball bar reported, not judged: a patch one grid period off on one ball shows there); per plate the "
+      "outline of its face's dense part.\n\n"
       "Exit codes: 0 every figure passes; 1 a figure exceeds its MPE; 2 bad input.\n\n"
       "Example:\n  stereorig verify --artifact datasets/artifacts/sphere_38mm.yaml --cloud sphere_pos1.ply "
       "--cloud sphere_pos2.ply --report verify.json",
@@ -73,8 +115,8 @@ int RunVerify(int argc, char** argv) {
 
   std::printf("artifact: %s (%s); capture band %.1f mm\n", artifact.name.c_str(), ArtifactTypeName(artifact.type),
               positions.front().capture_band_mm);
-  std::printf("%-8s %-6s %10s %7s %4s %8s %7s %8s %8s %8s %10s\n", "position", "figure", "value_mm", "mpe_mm", "pass",
-              "cloud", "filled", "artifact", "excluded", "used", "mean|e|_mm");
+  std::printf("%-8s %-6s %10s %8s %7s %4s %8s %7s %8s %8s %8s %10s\n", "position", "figure", "value_mm", "u_mm",
+              "mpe_mm", "pass", "cloud", "filled", "artifact", "excluded", "used", "mean|e|_mm");
   nlohmann::json report = {{"artifact", artifact.name}, {"type", ArtifactTypeName(artifact.type)}};
   for (size_t i = 0; i < positions.size(); ++i) {
     const ArtifactEvaluation& e = positions[i];
@@ -89,16 +131,25 @@ int RunVerify(int argc, char** argv) {
                          {"residual_std_mm", e.residual_std_mm},
                          {"pass", e.pass()}};
     for (const Figure& f : e.figures) {
-      std::printf("%-8zu %-6s %10.4f %7.3f %4s %8d %7d %8d %8d %8d %10.4f\n", i + 1, f.name.c_str(), f.value_mm,
-                  f.mpe_mm, f.pass ? "yes" : "NO", e.points_total + filled_skipped[i], filled_skipped[i],
-                  e.points_on_artifact, e.points_excluded, e.points_used(), e.residual_mean_abs_mm);
+      std::printf("%-8zu %-6s %10.4f %8s %7.3f %4s %8d %7d %8d %8d %8d %10.4f\n", i + 1, f.name.c_str(), f.value_mm,
+                  UncertaintyText(f).c_str(), f.mpe_mm, f.pass ? "yes" : "NO", e.points_total + filled_skipped[i],
+                  filled_skipped[i], e.points_on_artifact, e.points_excluded, e.points_used(), e.residual_mean_abs_mm);
       pj["figures"].push_back(FigureJson(f));
+    }
+    PrintSpheres(i + 1, e);
+    if (!e.sphere_centers_mm.empty()) pj["spheres"] = SpheresJson(e);
+    if (e.type == ArtifactType::kPlate) {
+      std::printf("%-8zu plate face: outline %.1f x %.1f mm (its dense part; %d captured points outside it)\n", i + 1,
+                  e.plate_outline_length_mm, e.plate_outline_width_mm, e.plate_points_off_outline);
+      pj["plate_outline_mm"] = {e.plate_outline_length_mm, e.plate_outline_width_mm};
+      pj["plate_points_off_outline"] = e.plate_points_off_outline;
     }
     report["positions"].push_back(pj);
   }
   std::printf(
-      "points: cloud = all vertices; filled = added by hole filling (module 255), skipped; artifact = within the "
-      "capture band; excluded = the largest residuals (<= 0.3%%); used = in the figures\n");
+      "u_mm = the figure's standard uncertainty (k = 1) from the fit's covariance; points: cloud = all vertices; "
+      "filled = added by hole filling (module 255), skipped; artifact = within the capture band; excluded = the "
+      "largest residuals (<= 0.3%%); used = in the figures\n");
   std::printf("summary over %zu position(s):", positions.size());
   for (const Figure& f : summary.worst) {
     std::printf("  %s %.4f mm (MPE %.3f) %s", f.name.c_str(), f.value_mm, f.mpe_mm, f.pass ? "pass" : "FAIL");

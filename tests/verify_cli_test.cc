@@ -214,4 +214,56 @@ TEST(VerifyCli, HoleFillingsPointsAreSkippedAndCounted) {
   EXPECT_LT(std::abs(j["figures"][1]["value_mm"].get<double>()), 0.005);
 }
 
+// A sphere's cap too small to fit its diameter is refused (exit 2, one line
+// naming the cloud, no report); a sphere seen well reports each figure's
+// standard uncertainty and each sphere's cap and diameter uncertainty.
+// Truth: the certified sphere, a 15-degree cap of 2000 points with the
+// runtime's noise (0.05 mm, radial): its diameter's standard uncertainty is
+// ~0.22 mm (reconstruct/metrology/sphere_uncertainty_test.cc), over the
+// rule's 10% of the 1.5 mm MPE. Before the rule verify judged it (exit 0).
+TEST(VerifyCli, ACapTooSmallToFitTheDiameterIsRefusedAndAGoodOneReportsItsUncertainty) {
+  const double r = 19.05, sigma_mm = 0.05, cap_rad = 15 * M_PI / 180;
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> noise(0, sigma_mm);
+  const std::string cap = ::testing::TempDir() + "/cap15_" + std::to_string(getpid()) + ".ply";
+  {
+    std::ofstream f(cap);
+    f << "ply\nformat ascii 1.0\nelement vertex 2000\nproperty double x\nproperty double y\nproperty double z\n"
+         "end_header\n";
+    f.precision(17);
+    for (int i = 0; i < 2000; ++i) {  // uniform in area: cos t uniform
+      const double t = std::acos(1 - u(rng) * (1 - std::cos(cap_rad))), p = 2 * M_PI * u(rng);
+      const double radius = r + noise(rng);
+      f << radius * std::sin(t) * std::cos(p) << " " << radius * std::sin(t) * std::sin(p) << " "
+        << 150 - radius * std::cos(t) << "\n";
+    }
+  }
+  const std::string report = ::testing::TempDir() + "/verify_cap_" + std::to_string(getpid()) + ".json";
+  std::filesystem::remove(report);
+  auto r_cli = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + cap + " --report " + report);
+  EXPECT_EQ(r_cli.code, 2) << r_cli.out << r_cli.err;
+  EXPECT_EQ(Lines(r_cli.err), 1) << r_cli.err;
+  EXPECT_NE(r_cli.err.find(cap + ": P_S is not determined"), std::string::npos) << r_cli.err;
+  EXPECT_EQ(r_cli.out, "");  // nothing judged
+  EXPECT_FALSE(std::filesystem::exists(report));
+
+  r_cli = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + WriteSphere("good_u.ply", r) +
+                 " --report " + report);
+  EXPECT_EQ(r_cli.code, 0) << r_cli.out << r_cli.err;
+  EXPECT_NE(r_cli.out.find("cap half-angle"), std::string::npos) << r_cli.out;
+  std::ifstream f(report);
+  ASSERT_TRUE(f.good());
+  const auto j = nlohmann::json::parse(f)["positions"][0];
+  EXPECT_FALSE(j["figures"][0].contains("standard_uncertainty_mm"));  // P_F: a range, no fit uncertainty
+  // Exact samples: the residuals, and so the uncertainty, are rounding.
+  EXPECT_LT(j["figures"][1]["standard_uncertainty_mm"].get<double>(), 1e-6);
+  ASSERT_EQ(j["spheres"].size(), 1u);
+  EXPECT_LT(j["spheres"][0]["diameter_std_mm"].get<double>(), 1e-6);
+  // Two 74-degree caps facing each other: no mean direction, or nearly none.
+  EXPECT_GT(j["spheres"][0]["cap_half_angle_deg"].get<double>(), 150);
+  EXPECT_NEAR(j["spheres"][0]["diameter_mm"].get<double>(), 2 * r, 0.005);
+  EXPECT_NEAR(j["spheres"][0]["form_mm"].get<double>(), j["figures"][0]["value_mm"].get<double>(), 1e-12);  // P_F
+}
+
 }  // namespace

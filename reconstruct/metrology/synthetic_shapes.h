@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -70,6 +71,38 @@ inline std::function<Eigen::Vector3d(double, double, Eigen::Vector3d*)> Cylinder
     *n = std::cos(phi) * e1 + std::sin(phi) * e2;
     return Eigen::Vector3d(centre + (b - 0.5) * len * d + r * *n);
   };
+}
+
+// A sphere's cap: the points within `half_angle_deg` of `axis` seen from
+// `centre`, uniform in area (cos of the polar angle uniform).
+inline std::function<Eigen::Vector3d(double, double, Eigen::Vector3d*)> SphereCapSurface(const Eigen::Vector3d& centre,
+                                                                                         const Eigen::Vector3d& axis,
+                                                                                         double r,
+                                                                                         double half_angle_deg) {
+  const Eigen::Vector3d z = axis.normalized(), x = z.unitOrthogonal(), y = z.cross(x);
+  const double cos_max = std::cos(half_angle_deg * M_PI / 180);
+  return [=](double a, double b, Eigen::Vector3d* n) {
+    const double c = 1 - a * (1 - cos_max), s = std::sqrt(std::max(0.0, 1 - c * c)), phi = 2 * M_PI * b;
+    *n = c * z + s * (std::cos(phi) * x + std::sin(phi) * y);
+    return Eigen::Vector3d(centre + r * *n);
+  };
+}
+
+// `count` samples of a surface, each moved along its normal by Gaussian noise
+// of `noise_mm` (1 sigma): every point seen, no outliers.
+inline std::vector<Eigen::Vector3d> NoisySurfaceSamples(
+    const std::function<Eigen::Vector3d(double, double, Eigen::Vector3d*)>& surface, int count, double noise_mm,
+    std::mt19937* rng) {
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> noise(0, noise_mm);
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(count);
+  for (int i = 0; i < count; ++i) {
+    Eigen::Vector3d n;
+    const Eigen::Vector3d p = surface(u(*rng), u(*rng), &n);
+    points.push_back(p + noise(*rng) * n);
+  }
+  return points;
 }
 
 // An ellipsoid: centre, frame_from_ellipsoid rotation, semi-axes.

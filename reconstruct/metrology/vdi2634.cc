@@ -11,7 +11,9 @@
 
 #include "calib/core/input_error.h"
 #include "reconstruct/metrology/plane_fit.h"
+#include "reconstruct/metrology/plate_outline.h"
 #include "reconstruct/metrology/sphere_fit.h"
+#include "reconstruct/metrology/sphere_uncertainty.h"
 
 namespace stereorig {
 
@@ -28,6 +30,9 @@ void VerifyOptions::Check() const {
   if (plate_min_coverage < 0 || plate_min_coverage > 1) {
     throw InputError("verify options", "plate_min_coverage must be in [0, 1]");
   }
+  if (!(max_uncertainty_fraction_of_mpe > 0)) {
+    throw InputError("verify options", "max_uncertainty_fraction_of_mpe must be positive");
+  }
 }
 
 bool ArtifactEvaluation::pass() const {
@@ -37,7 +42,31 @@ bool ArtifactEvaluation::pass() const {
 namespace {
 
 Figure MakeFigure(const std::string& name, double value, double mpe) {
-  return {name, value, mpe, std::abs(value) <= mpe};
+  return {name, value, mpe, std::abs(value) <= mpe, std::nullopt};
+}
+
+// A figure the fit leaves undetermined is refused rather than judged: its
+// value would be the fit's noise (VerifyOptions::max_uncertainty_fraction_of_mpe).
+void RequireDetermined(const Figure& f, const std::string& coverage, const VerifyOptions& o, const std::string& where) {
+  const double u_mm = f.standard_uncertainty_mm.value();
+  if (u_mm <= o.max_uncertainty_fraction_of_mpe * f.mpe_mm) return;
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "%s is not determined: %s, which fits it to +-%.3f mm (1 sigma), more than %.0f%% of "
+                "its MPE (%.3f mm); measure more of the artifact",
+                f.name.c_str(), coverage.c_str(), u_mm, 100 * o.max_uncertainty_fraction_of_mpe, f.mpe_mm);
+  throw InputError(where, buf);
+}
+
+std::string CapsText(const std::vector<double>& cap_half_angles_deg) {
+  std::string text =
+      cap_half_angles_deg.size() == 1 ? "the sphere's points cover a cap of " : "the balls' points cover caps of ";
+  for (size_t k = 0; k < cap_half_angles_deg.size(); ++k) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%s%.0f", k ? " and " : "", cap_half_angles_deg[k]);
+    text += buf;
+  }
+  return text + " deg half-angle";
 }
 
 // Drops the largest-|residual| points, at most `fraction` of them, and
@@ -131,80 +160,6 @@ SphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, double nomi
   return RefineSphere(pts, kept, fit.center_mm, fit.radius_mm, 50);
 }
 
-// A plane's points' outline: the smallest-area rectangle in the plane that
-// holds them (u along its longer side). Their principal axes would not do: a
-// square plate's are arbitrary, and its diagonals would be taken for sides.
-struct InPlaneExtent {
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero(), u = Eigen::Vector3d::UnitX(), v = Eigen::Vector3d::UnitY();
-  double u0_mm = 0, u1_mm = 0, v0_mm = 0, v1_mm = 0;
-  double length_mm() const { return u1_mm - u0_mm; }
-  double width_mm() const { return v1_mm - v0_mm; }
-  // Inside the outline eroded by `margin_mm` on every side.
-  bool InsideEroded(const Eigen::Vector3d& p, double margin_mm) const {
-    const Eigen::Vector3d d = p - mean;
-    return d.dot(u) > u0_mm + margin_mm && d.dot(u) < u1_mm - margin_mm && d.dot(v) > v0_mm + margin_mm &&
-           d.dot(v) < v1_mm - margin_mm;
-  }
-};
-
-double Cross2(const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
-}
-
-// Andrew's monotone chain: the convex hull, counter-clockwise.
-std::vector<Eigen::Vector2d> ConvexHull(std::vector<Eigen::Vector2d> q) {
-  std::sort(q.begin(), q.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
-  });
-  if (q.size() < 3) return q;
-  std::vector<Eigen::Vector2d> hull(2 * q.size());
-  size_t k = 0;
-  for (size_t i = 0; i < q.size(); ++i) {  // lower hull
-    while (k >= 2 && Cross2(hull[k - 2], hull[k - 1], q[i]) <= 0) --k;
-    hull[k++] = q[i];
-  }
-  for (size_t i = q.size() - 1, lower = k + 1; i-- > 0;) {  // upper hull
-    while (k >= lower && Cross2(hull[k - 2], hull[k - 1], q[i]) <= 0) --k;
-    hull[k++] = q[i];
-  }
-  hull.resize(k - 1);
-  return hull;
-}
-
-// The smallest-area enclosing rectangle has a side along an edge of the
-// convex hull (Freeman and Shapira): try each.
-InPlaneExtent ExtentOf(const std::vector<Eigen::Vector3d>& pts, const std::vector<int>& idx,
-                       const Eigen::Vector3d& normal) {
-  InPlaneExtent e;
-  for (int i : idx) e.mean += pts[i];
-  e.mean /= static_cast<double>(std::max<size_t>(1, idx.size()));
-  const Eigen::Vector3d a = normal.unitOrthogonal(), b = normal.cross(a);
-  std::vector<Eigen::Vector2d> q;
-  q.reserve(idx.size());
-  for (int i : idx) q.emplace_back((pts[i] - e.mean).dot(a), (pts[i] - e.mean).dot(b));
-  const std::vector<Eigen::Vector2d> hull = ConvexHull(std::move(q));
-  double best_area_mm2 = std::numeric_limits<double>::infinity();
-  for (size_t k = 0; k < hull.size(); ++k) {
-    const Eigen::Vector2d side = hull[(k + 1) % hull.size()] - hull[k];
-    if (side.norm() == 0) continue;
-    const Eigen::Vector2d s = side.normalized(), t(-s.y(), s.x());
-    double s0 = 1e300, s1 = -1e300, t0 = 1e300, t1 = -1e300;
-    for (const Eigen::Vector2d& h : hull) {
-      s0 = std::min(s0, h.dot(s)), s1 = std::max(s1, h.dot(s));
-      t0 = std::min(t0, h.dot(t)), t1 = std::max(t1, h.dot(t));
-    }
-    if ((s1 - s0) * (t1 - t0) >= best_area_mm2) continue;
-    best_area_mm2 = (s1 - s0) * (t1 - t0);
-    const bool s_longer = s1 - s0 >= t1 - t0;
-    const Eigen::Vector3d s3 = s.x() * a + s.y() * b, t3 = t.x() * a + t.y() * b;
-    e.u = s_longer ? s3 : t3;
-    e.v = s_longer ? t3 : s3;
-    std::tie(e.u0_mm, e.u1_mm, e.v0_mm, e.v1_mm) =
-        s_longer ? std::make_tuple(s0, s1, t0, t1) : std::make_tuple(t0, t1, s0, s1);
-  }
-  return e;
-}
-
 std::vector<int> WithinPlaneBand(const std::vector<Eigen::Vector3d>& pts, const PlaneFit& plane, double band_mm) {
   std::vector<int> in;
   for (int i = 0; i < static_cast<int>(pts.size()); ++i)
@@ -216,7 +171,7 @@ std::vector<int> WithinPlaneBand(const std::vector<Eigen::Vector3d>& pts, const 
 // certified length and width, and no more than the certified size plus twice
 // the capture band (what the plate's sides can add). A sphere's cap or a
 // table is refused, naming what was found.
-void RequirePlateCoverage(const InPlaneExtent& e, const Artifact& a, const VerifyOptions& o, double capture_band_mm,
+void RequirePlateCoverage(const PlaneOutline& e, const Artifact& a, const VerifyOptions& o, double capture_band_mm,
                           const std::string& where) {
   const double longer = std::max(a.plate_length_mm, a.plate_width_mm);
   const double shorter = std::min(a.plate_length_mm, a.plate_width_mm);
@@ -263,8 +218,14 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       e.points_excluded = excluded;
       e.sphere_centers_mm = {fit.center_mm};
       e.sphere_diameters_mm = {2 * fit.radius_mm};
+      const SphereFitUncertainty u = SphereUncertainty(pts, fit);
+      e.sphere_cap_half_angles_deg = {u.cap_half_angle_deg};
+      e.sphere_diameter_std_mm = {u.diameter_std_mm};
+      e.sphere_form_mm = {Range(fit.residuals_mm)};
       e.figures = {MakeFigure("P_F", Range(fit.residuals_mm), a.mpe.probing_form_mm),
                    MakeFigure("P_S", 2 * fit.radius_mm - a.sphere_diameter_mm, a.mpe.probing_size_mm)};
+      e.figures[1].standard_uncertainty_mm = u.diameter_std_mm;
+      RequireDetermined(e.figures[1], CapsText(e.sphere_cap_half_angles_deg), o, where);
       ResidualStats(fit.residuals_mm, &e);
       break;
     }
@@ -273,6 +234,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       e.capture_band_mm = band;
       const double r = 0.5 * a.sphere_diameter_mm;
       std::vector<double> all_residuals;
+      Eigen::Matrix3d centers_covariance_mm2 = Eigen::Matrix3d::Zero();  // sum of the two balls'
       std::vector<Eigen::Vector3d> remaining = pts;
       int excluded_total = 0, on_artifact = 0;
       for (int ball = 0; ball < 2; ++ball) {
@@ -329,6 +291,9 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
         all_residuals.clear();
         excluded_total = 0;
         on_artifact = 0;
+        e.sphere_cap_half_angles_deg.clear();
+        e.sphere_diameter_std_mm.clear();
+        e.sphere_form_mm.clear();
         for (int ball = 0; ball < 2; ++ball) {
           std::vector<double> res;
           for (int i : idx[ball]) res.push_back((pts[i] - centers[ball]).norm() - radii[ball]);
@@ -338,6 +303,11 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
           if (!fit.ok) throw InputError(where, "ball " + std::to_string(ball + 1) + " refit failed: " + fit.message);
           e.sphere_centers_mm[ball] = fit.center_mm;
           e.sphere_diameters_mm[ball] = 2 * fit.radius_mm;
+          const SphereFitUncertainty u = SphereUncertainty(pts, fit);
+          e.sphere_cap_half_angles_deg.push_back(u.cap_half_angle_deg);
+          e.sphere_diameter_std_mm.push_back(u.diameter_std_mm);
+          e.sphere_form_mm.push_back(Range(fit.residuals_mm));
+          centers_covariance_mm2 += u.center_covariance_mm2;
           all_residuals.insert(all_residuals.end(), fit.residuals_mm.begin(), fit.residuals_mm.end());
           excluded_total += excluded;
           on_artifact += static_cast<int>(idx[ball].size());
@@ -345,8 +315,13 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       }
       e.points_on_artifact = on_artifact;
       e.points_excluded = excluded_total;
-      const double distance = (e.sphere_centers_mm[0] - e.sphere_centers_mm[1]).norm();
-      e.figures = {MakeFigure("SD", distance - a.center_distance_mm, a.mpe.sphere_spacing_mm)};
+      const Eigen::Vector3d bar_mm = e.sphere_centers_mm[0] - e.sphere_centers_mm[1];
+      e.figures = {MakeFigure("SD", bar_mm.norm() - a.center_distance_mm, a.mpe.sphere_spacing_mm)};
+      // The two centres' errors are independent (disjoint points); the
+      // distance moves with their difference along the bar.
+      const Eigen::Vector3d along = bar_mm.normalized();
+      e.figures[0].standard_uncertainty_mm = std::sqrt(along.dot(centers_covariance_mm2 * along));
+      RequireDetermined(e.figures[0], CapsText(e.sphere_cap_half_angles_deg), o, where);
       ResidualStats(all_residuals, &e);
       break;
     }
@@ -358,14 +333,17 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       PlaneFit fit = FitPlaneRobust(pts, po);
       if (!fit.ok) throw InputError(where, "no plane found in the cloud: " + fit.message);
       // The face: the points within the capture band of the plane, inside
-      // their in-plane extent (along their principal axes) eroded by the edge
-      // margin; the set and the least-squares plane iterated to their fixed
-      // point.
+      // the outline of their dense part (plate_outline.h: a few stray points
+      // do not widen it) eroded by the edge margin; the set and the
+      // least-squares plane iterated to their fixed point.
       std::vector<int> face;
       for (int round = 0; round < kMaxSegmentationRounds; ++round) {
         const std::vector<int> captured = WithinPlaneBand(pts, fit, e.capture_band_mm);
-        const InPlaneExtent extent = ExtentOf(pts, captured, fit.normal);
+        const PlaneOutline extent = OutlineOfDensePart(pts, captured, fit.normal);
         RequirePlateCoverage(extent, a, o, e.capture_band_mm, where);
+        e.plate_outline_length_mm = extent.length_mm();
+        e.plate_outline_width_mm = extent.width_mm();
+        e.plate_points_off_outline = extent.points_outside;
         std::vector<int> next;
         for (int i : captured)
           if (extent.InsideEroded(pts[i], o.plate_edge_margin_mm)) next.push_back(i);

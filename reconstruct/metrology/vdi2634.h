@@ -23,6 +23,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,16 @@ struct VerifyOptions {
   // length and of the width (and at most the certified size plus twice the
   // capture band), or it is not the plate.
   double plate_min_coverage = 0.5;
+  // P_S (sphere) and SD (ball bar) must be determined by the fit to a
+  // standard uncertainty (k = 1, the fit's covariance: sphere_uncertainty.h)
+  // of at most this fraction of their MPE, or the position is refused: a
+  // small cap's fitted diameter is noise, not the system's size error. 0.1
+  // keeps the expanded uncertainty (k = 2) within a fifth of the MPE, so the
+  // verdict is the figure's, not the fit's. Measured basis: 2000 points of a
+  // 38.1 mm sphere with the runtime's 0.05 mm noise fit its diameter to
+  // 0.005 mm over a hemisphere, 0.12 mm over a 20-degree cap and 0.5 mm over
+  // a 10-degree cap (sphere_uncertainty_test.cc; docs/verify-and-check.md).
+  double max_uncertainty_fraction_of_mpe = 0.1;
   unsigned seed = 1;
   void Check() const;
 };
@@ -62,6 +73,9 @@ struct Figure {
   double value_mm = 0;
   double mpe_mm = 0;
   bool pass = false;  // |value| <= mpe
+  // value_mm's standard uncertainty (k = 1) from the fit's covariance, for
+  // the figures that have one (P_S, SD); P_F and F are ranges of residuals.
+  std::optional<double> standard_uncertainty_mm;
 };
 
 struct ArtifactEvaluation {
@@ -78,14 +92,27 @@ struct ArtifactEvaluation {
   // The fitted geometry.
   std::vector<Eigen::Vector3d> sphere_centers_mm;  // 1 (sphere) or 2 (ball bar)
   std::vector<double> sphere_diameters_mm;
+  // Per sphere, parallel: how much of it the points cover and how well they
+  // fit its diameter (sphere_uncertainty.h).
+  std::vector<double> sphere_cap_half_angles_deg;
+  std::vector<double> sphere_diameter_std_mm;
+  // Per sphere: the range of its residuals (what P_F is for the sphere).
+  // Reported, not judged, for the ball bar, whose figure is SD: a patch one
+  // grid period off on one ball shows here, where SD may not show it.
+  std::vector<double> sphere_form_mm;
+  // Plate: the outline of the face's dense part (plate_outline.h), before the
+  // edge margin, and the captured points left outside it (strays, sparse edges).
+  double plate_outline_length_mm = 0, plate_outline_width_mm = 0;
+  int plate_points_off_outline = 0;
   Eigen::Vector3d plane_normal = Eigen::Vector3d::Zero();
   double plane_offset_mm = 0;
   bool pass() const;
 };
 
 // Throws InputError(`where`, ...) when the cloud has too few points on the
-// artifact, the artifact cannot be found in it, or what is found does not
-// cover the certified artifact plausibly.
+// artifact, the artifact cannot be found in it, what is found does not
+// cover the certified artifact plausibly, or the points leave P_S or SD
+// undetermined (max_uncertainty_fraction_of_mpe).
 ArtifactEvaluation EvaluateArtifact(const Artifact& artifact, const std::vector<Eigen::Vector3d>& points_mm,
                                     const VerifyOptions& options, const std::string& where);
 
