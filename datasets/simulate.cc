@@ -193,7 +193,7 @@ void SimulateOptions::Check() const {
   // Written so that NaN fails too. 10 % is a focal length no focus ring
   // turns by unnoticed; 50 px is 7 % of the default sensor's width.
   if (!(std::abs(bump.lens.focal_percent) <= 10)) throw InputError("--bump-focal-percent", "must be within +-10");
-  if (!(bump.lens.principal_point_px.cwiseAbs().maxCoeff() <= 50))
+  if (!(std::abs(bump.lens.principal_point_px.x()) <= 50 && std::abs(bump.lens.principal_point_px.y()) <= 50))
     throw InputError("--bump-principal-point-px", "each of DX and DY must be within +-50 px");
 }
 

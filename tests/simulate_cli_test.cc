@@ -262,6 +262,7 @@ TEST(SimulateCli, LensDriftIsValidatedAndRecordedInTheTruth) {
       {out + " --bump-camera 1 --bump-focal-percent nan", "--bump-focal-percent"},
       {out + " --bump-camera 1 --bump-principal-point-px 60 0", "--bump-principal-point-px: each of DX and DY"},
       {out + " --bump-camera 1 --bump-principal-point-px 0 -51", "--bump-principal-point-px: each of DX and DY"},
+      {out + " --bump-camera 1 --bump-principal-point-px nan 0", "--bump-principal-point-px: each of DX and DY"},
       {out + " --bump-camera 1 --bump-principal-point-px 1", "--bump-principal-point-px"},
       {out + " --bump-camera 9 --bump-focal-percent 0.1 --calibration-captures 0 --no-scenes",
        "--bump-camera: no camera 9"},

@@ -5,7 +5,9 @@
 //
 // Judged as issue 6 asks: over 20 seeds, no false alarm unbumped; a bump of
 // 0.05 deg of one camera's rotation, or 0.1 mm of one module's translation,
-// flagged in >= 19 of 20 seeds, with the right camera or module named.
+// flagged in >= 19 of 20 seeds, with the right camera or module named. And
+// one camera's lens drifted (focal length, principal point): flagged, the
+// camera named, and never said to have merely moved.
 #include "calib/check/nightly_check.h"
 
 #include <gtest/gtest.h>
