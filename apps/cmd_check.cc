@@ -167,6 +167,7 @@ int RunCheck(int argc, char** argv) {
                                         {"principal_point_px", {c.principal_point_px.x(), c.principal_point_px.y()}}});
   }
   report["closure_modules"] = result.closure_modules;
+  report["split_modules"] = result.split_modules;
 
   if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
   AppendToHistory(history_db, {0, report["date_utc"], rig_path, captures, "", ""}, result);

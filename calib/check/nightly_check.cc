@@ -32,9 +32,15 @@ std::string CheckResult::Explanation() const {
                                [c](const CameraChange& x) { return x.camera == c; });
     s << (change != camera_changes.end() ? change->Describe() : "camera " + std::to_string(c) + " moved") << "; ";
   }
+  auto holds = [](const std::vector<int>& v, int m) { return std::find(v.begin(), v.end(), m) != v.end(); };
   for (int m : moved_modules) {
-    const bool closure = std::find(closure_modules.begin(), closure_modules.end(), m) != closure_modules.end();
-    s << "module " << m << (closure ? " moved or a lens changed; " : " moved; ");
+    s << "module " << m;
+    if (holds(closure_modules, m))
+      s << " moved or a lens changed; ";
+    else if (holds(split_modules, m))
+      s << "'s cameras disagree: one moved or its lens changed; ";
+    else
+      s << " moved; ";
   }
   if (moved_cameras.empty() && moved_modules.empty()) s << "figures exceed their thresholds; ";
   std::string out = s.str();
@@ -366,8 +372,10 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
       others.erase(named);
       const Consistency con = CameraConsistency(in, named, others);
       result.camera_changes.push_back(ExplainCameraChange(rig, target, named, con.views, con.threshold_px));
-    } else
+    } else {
       result.moved_modules.push_back(m);
+      result.split_modules.push_back(m);
+    }
   }
 
   // --- Module pairs: closure through the target. ---

@@ -52,12 +52,16 @@ struct CheckResult {
   // check cannot tell (calib/check/camera_change.h). A camera without one is
   // explained as moved.
   std::vector<CameraChange> camera_changes;
-  std::vector<int> moved_modules;  // both cameras moved, or a pair closure failed
+  std::vector<int> moved_modules;  // its cameras disagree with no camera to blame, or a pair closure failed
   // Of moved_modules, those named by failing closures alone (each module
   // agrees with itself): a closure shows that two modules' board poses
   // disagree, which a module's motion and a small change of one of their
   // lenses (a focal length scales a module's pose) both do. Explained so.
   std::vector<int> closure_modules;
+  // Of moved_modules, those whose own two cameras disagree while neither
+  // disagrees with the other modules (or there are none): something in the
+  // module changed, a camera's pose or lens, not the module as a whole.
+  std::vector<int> split_modules;
   bool ok() const;
   std::string Verdict() const { return ok() ? "ok" : "recalibrate"; }
   std::string Explanation() const;  // one line naming what moved

@@ -260,6 +260,33 @@ TEST(NightlyCheck, FlagsAndNamesACameraWhosePrincipalPointMoved) {
   EXPECT_EQ(Said(r, CameraChangeKind::kMoved), 0);
 }
 
+// The verdict says no more than the figures tell: a closure cannot tell a
+// module's motion from a lens drift, a module whose own cameras disagree did
+// not move as a whole, and a camera's change reads as its fits found it.
+TEST(NightlyCheck, ExplanationSaysNoMoreThanTheFiguresTell) {
+  CheckResult r;
+  r.figures = {{"pair_0_1_closure_mm", 0.1, 0.01, false, 8}};
+  r.moved_modules = {1};
+  r.closure_modules = {1};
+  EXPECT_EQ(r.Explanation(), "module 1 moved or a lens changed");
+  r.closure_modules.clear();
+  r.split_modules = {1};
+  EXPECT_EQ(r.Explanation(), "module 1's cameras disagree: one moved or its lens changed");
+  r.moved_modules.clear();
+  CameraChange lens;
+  lens.camera = 2;
+  lens.kind = CameraChangeKind::kLens;
+  lens.focal_percent = 0.1;
+  lens.principal_point_px = {-0.001, 0.25};
+  r.moved_cameras = {2};
+  r.camera_changes = {lens};
+  EXPECT_EQ(r.Explanation(), "camera 2's lens changed: focal length +0.100 %, principal point +0.00, +0.25 px");
+  r.camera_changes[0].kind = CameraChangeKind::kMovedOrLens;
+  EXPECT_EQ(r.Explanation(), "camera 2 moved or its lens changed");
+  r.camera_changes[0].kind = CameraChangeKind::kMoved;
+  EXPECT_EQ(r.Explanation(), "camera 2 moved");
+}
+
 TEST(NightlyCheck, BadInputIsRefused) {
   const SimulatedRig truth = MakeDefaultRig();
   const Target target = DefaultTarget();
