@@ -1,5 +1,6 @@
 // `stereorig simulate`: render a rig spec into a dataset with ground truth.
 #include <cstdio>
+#include <vector>
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
@@ -23,7 +24,9 @@ int RunSimulate(int argc, char** argv) {
       "  stereorig simulate --write-default-spec my_rig.yaml     # edit it, then:\n"
       "  stereorig simulate --spec my_rig.yaml --out data/my_rig\n"
       "  stereorig simulate --out data/bumped --bump-camera 1 --bump-rotation-deg 0.05 \\\n"
-      "      --calibration-captures 8 --no-scenes                # the morning after a bump",
+      "      --calibration-captures 8 --no-scenes                # the morning after a bump\n"
+      "  stereorig simulate --out data/refocused --bump-camera 2 --bump-focal-percent 0.1 \\\n"
+      "      --calibration-captures 8 --no-scenes                # camera 2's focus ring turned",
       "stereorig simulate"};
   std::string spec_path, write_spec;
   SimulateOptions o;
@@ -47,22 +50,38 @@ int RunSimulate(int argc, char** argv) {
   app.add_option("--bump-module", o.bump.module, "move this module (cameras and projector) as a whole");
   app.add_option("--bump-rotation-deg", o.bump.rotation_deg, "bump: rotation angle, about a seeded random axis");
   app.add_option("--bump-translation-mm", o.bump.translation_mm, "bump: shift, along a seeded random direction");
+  app.add_option("--bump-focal-percent", o.bump.lens.focal_percent,
+                 "bump the camera's lens: fx and fy scaled by 1 + P/100 (a focus ring turned, thermal drift); "
+                 "within +-10");
+  std::vector<double> principal_point_px;
+  app.add_option("--bump-principal-point-px", principal_point_px,
+                 "bump the camera's lens: its principal point moved by DX DY px; each within +-50")
+      ->expected(2);
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
+  if (principal_point_px.size() == 2) o.bump.lens.principal_point_px = {principal_point_px[0], principal_point_px[1]};
   if (!write_spec.empty())
-    for (const char* flag : {"--out", "--seed", "--threads", "--calibration-captures", "--no-scenes", "--bump-camera",
-                             "--bump-module", "--bump-rotation-deg", "--bump-translation-mm"})
+    for (const char* flag :
+         {"--out", "--seed", "--threads", "--calibration-captures", "--no-scenes", "--bump-camera", "--bump-module",
+          "--bump-rotation-deg", "--bump-translation-mm", "--bump-focal-percent", "--bump-principal-point-px"})
       if (app.count(flag) > 0)
         throw InputError(flag, "does not apply with --write-default-spec (it writes the spec and stops)");
   // A bump needs what to move and by how much: either alone used to render
-  // an undisturbed rig without a word.
+  // an undisturbed rig without a word. A lens drift needs its camera.
   const bool bump_what = app.count("--bump-camera") + app.count("--bump-module") > 0;
-  const bool bump_amount = app.count("--bump-rotation-deg") + app.count("--bump-translation-mm") > 0;
-  if (bump_amount && !bump_what)
+  const bool bump_motion = app.count("--bump-rotation-deg") + app.count("--bump-translation-mm") > 0;
+  const bool bump_lens = app.count("--bump-focal-percent") + app.count("--bump-principal-point-px") > 0;
+  if (bump_lens && app.count("--bump-camera") == 0)
+    throw InputError(app.count("--bump-focal-percent") ? "--bump-focal-percent" : "--bump-principal-point-px",
+                     "needs --bump-camera (a lens drifts in one camera, not in a whole module)");
+  if (bump_motion && !bump_what)
     throw InputError(app.count("--bump-rotation-deg") ? "--bump-rotation-deg" : "--bump-translation-mm",
                      "needs --bump-camera or --bump-module (what to move)");
-  if (bump_what && !bump_amount)
+  if (bump_what && !bump_motion && !bump_lens)
     throw InputError(app.count("--bump-camera") ? "--bump-camera" : "--bump-module",
-                     "needs --bump-rotation-deg or --bump-translation-mm (by how much)");
+                     app.count("--bump-camera")
+                         ? "needs --bump-rotation-deg, --bump-translation-mm, --bump-focal-percent or "
+                           "--bump-principal-point-px (by how much)"
+                         : "needs --bump-rotation-deg or --bump-translation-mm (by how much)");
 
   if (!write_spec.empty()) {
     // Checked like every other command's outputs (apps/output_paths.h): its

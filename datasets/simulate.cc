@@ -121,8 +121,9 @@ void ParallelFor(int n, int threads, const std::function<void(int)>& f) {
   if (error) std::rethrow_exception(error);
 }
 
-// The true rig from each camera's world pose (module frame = left camera).
-Rig RigFromWorldPoses(const Rig& like, const std::vector<Pose>& world_from_camera) {
+// The true rig from its cameras and each one's world pose (module frame =
+// left camera).
+Rig RigFromWorldPoses(const Rig& like, const std::vector<Camera>& cameras, const std::vector<Pose>& world_from_camera) {
   std::vector<StereoModule> modules = like.modules();
   std::vector<Pose> module0_from_module;
   const Pose& world_from_module0 = world_from_camera[like.module(0).left_camera];
@@ -130,7 +131,7 @@ Rig RigFromWorldPoses(const Rig& like, const std::vector<Pose>& world_from_camer
     m.right_from_left = world_from_camera[m.right_camera].Inverse() * world_from_camera[m.left_camera];
     module0_from_module.push_back(world_from_module0.Inverse() * world_from_camera[m.left_camera]);
   }
-  Rig rig(like.cameras(), like.camera_names(), modules, module0_from_module);
+  Rig rig(cameras, like.camera_names(), modules, module0_from_module);
   rig.provenance() = like.provenance();
   return rig;
 }
@@ -184,6 +185,16 @@ void SimulateOptions::Check() const {
   if (bump.camera >= 0 && bump.module >= 0) throw InputError("--bump-camera", "bump a camera or a module, not both");
   if (std::abs(bump.rotation_deg) > 10) throw InputError("--bump-rotation-deg", "must be within +-10");
   if (std::abs(bump.translation_mm) > 10) throw InputError("--bump-translation-mm", "must be within +-10");
+  // A lens belongs to one camera; a whole module's lenses do not drift as one.
+  if (bump.lens.Any() && bump.camera < 0) {
+    throw InputError(bump.lens.focal_percent != 0 ? "--bump-focal-percent" : "--bump-principal-point-px",
+                     "needs --bump-camera (a lens drifts in one camera, not in a whole module)");
+  }
+  // Written so that NaN fails too. 10 % is a focal length no focus ring
+  // turns by unnoticed; 50 px is 7 % of the default sensor's width.
+  if (!(std::abs(bump.lens.focal_percent) <= 10)) throw InputError("--bump-focal-percent", "must be within +-10");
+  if (!(std::abs(bump.lens.principal_point_px.x()) <= 50 && std::abs(bump.lens.principal_point_px.y()) <= 50))
+    throw InputError("--bump-principal-point-px", "each of DX and DY must be within +-50 px");
 }
 
 SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options) {
@@ -210,9 +221,13 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
     const Eigen::Vector3d axis = RandomAxis(&rng), dir = RandomAxis(&rng);
     const Pose delta(Eigen::AngleAxisd(b.rotation_deg * M_PI / 180.0, axis).toRotationMatrix(),
                      b.translation_mm * dir);  // in the moved camera's / module's own frame
+    std::vector<Camera> cameras = sr.sim.rig.cameras();
     if (b.camera >= 0) {
       if (b.camera >= num_cameras) throw InputError("--bump-camera", "no camera " + std::to_string(b.camera));
       sr.world_from_camera[b.camera] = sr.world_from_camera[b.camera] * delta;
+      // The drifted lens renders the images and is what truth/rig.yaml
+      // records: the truth is the rig as it now is.
+      cameras[b.camera] = WithLensDrift(cameras[b.camera], b.lens);
     } else {
       if (b.module >= sr.sim.rig.num_modules())
         throw InputError("--bump-module", "no module " + std::to_string(b.module));
@@ -223,14 +238,16 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
       sr.world_from_camera[m.right_camera] = moved * sr.world_from_camera[m.right_camera];
       sr.world_from_projector[b.module] = moved * sr.world_from_projector[b.module];
     }
-    sr.sim.rig = RigFromWorldPoses(sr.sim.rig, sr.world_from_camera);
+    sr.sim.rig = RigFromWorldPoses(sr.sim.rig, cameras, sr.world_from_camera);
     sr.sim.world_from_module0 = sr.world_from_camera[sr.sim.rig.module(0).left_camera];
     std::ostringstream o;
     o << "bump:\n"
       << "  camera: " << b.camera << "\n  module: " << b.module << "\n"
       << "  rotation_deg: " << FormatDouble(b.rotation_deg) << "\n  rotation_axis: " << Vec3Yaml(axis) << "\n"
       << "  translation_mm: " << FormatDouble(b.translation_mm) << "\n  translation_direction: " << Vec3Yaml(dir)
-      << "\n  frame: \"the moved camera's (or the module's left camera's) own frame, before the move\"\n";
+      << "\n  frame: \"the moved camera's (or the module's left camera's) own frame, before the move\"\n"
+      << "  focal_percent: " << FormatDouble(b.lens.focal_percent) << "\n  principal_point_px: ["
+      << FormatDouble(b.lens.principal_point_px.x()) << ", " << FormatDouble(b.lens.principal_point_px.y()) << "]\n";
     bump_yaml = o.str();
   }
   const Rig& rig = sr.sim.rig;

@@ -18,17 +18,20 @@
 #include <functional>
 #include <string>
 
+#include "datasets/lens_drift.h"
 #include "datasets/sim_spec.h"
 
 namespace stereorig {
 
-// "The morning after a bump": the true rig moved before rendering.
+// "The morning after a bump": the true rig moved, or one camera's lens
+// drifted, before rendering.
 struct RigBump {
   int camera = -1;              // global camera index to disturb, -1 = none
   int module = -1;              // module index to move as a whole (its cameras and projector), -1 = none
   double rotation_deg = 0.0;    // angle of the disturbance, about an axis drawn from the seed
   double translation_mm = 0.0;  // length of the shift, along a direction drawn from the seed
-  bool Any() const { return (camera >= 0 || module >= 0) && (rotation_deg != 0 || translation_mm != 0); }
+  LensDrift lens;               // the bumped camera's intrinsics drift (with `camera` only: a lens is one camera's)
+  bool Any() const { return (camera >= 0 || module >= 0) && (rotation_deg != 0 || translation_mm != 0 || lens.Any()); }
 };
 
 struct SimulateOptions {

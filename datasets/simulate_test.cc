@@ -98,26 +98,55 @@ TEST(Simulate, RefusesToReplaceAFolderThatIsNotADatasetAndLeavesNoTemporaries) {
   }
 }
 
-// The morning after a bump: the truth moves by exactly what was asked.
-TEST(Simulate, BumpsMoveTheTruthByTheRequestedAmount) {
+// truth/rig.yaml of a small two-module rig (no scenes, seed 3), bumped.
+Rig BumpedTruth(const std::string& name, const RigBump& bump) {
   SimSpec spec = SmallRingSpec(2, 4, 1);
   spec.scenes.names.clear();
-  const Rig before = ReadRigFile(RunSim(spec, "bump0", 3, 2) + "/truth/rig.yaml");
+  return ReadRigFile(RunSim(spec, name, 3, 2, bump) + "/truth/rig.yaml");
+}
+
+// The morning after a bump: the truth moves by exactly what was asked.
+TEST(Simulate, BumpsMoveTheTruthByTheRequestedAmount) {
+  const Rig before = BumpedTruth("bump0", {});
   RigBump cam;
   cam.camera = 1;
   cam.rotation_deg = 0.05;
-  const Rig after_cam = ReadRigFile(RunSim(spec, "bump1", 3, 2, cam) + "/truth/rig.yaml");
+  const Rig after_cam = BumpedTruth("bump1", cam);
   const Pose d = before.module(0).right_from_left * after_cam.module(0).right_from_left.Inverse();
   EXPECT_NEAR(d.AngleDeg(), 0.05, 1e-9);
   EXPECT_LT((before.S(0, 1).Inverse() * after_cam.S(0, 1)).AngleDeg(), 1e-12);  // other modules untouched
   RigBump mod;
   mod.module = 1;
   mod.translation_mm = 0.1;
-  const Rig after_mod = ReadRigFile(RunSim(spec, "bump2", 3, 2, mod) + "/truth/rig.yaml");
+  const Rig after_mod = BumpedTruth("bump2", mod);
   const Pose m = before.S(0, 1).Inverse() * after_mod.S(0, 1);
   EXPECT_NEAR(m.DistanceMm(), 0.1, 1e-9);
   EXPECT_LT(m.AngleDeg(), 1e-9);
   EXPECT_LT((before.module(1).right_from_left.Inverse() * after_mod.module(1).right_from_left).DistanceMm(), 1e-9);
+}
+
+// A drifted lens: truth/rig.yaml holds exactly the drifted intrinsics of that
+// camera, every other intrinsic and every pose as they were.
+TEST(Simulate, ALensDriftChangesOnlyThatCamerasIntrinsics) {
+  const Rig before = BumpedTruth("lens0", {});
+  RigBump lens;
+  lens.camera = 2;
+  lens.lens.focal_percent = 0.1;
+  lens.lens.principal_point_px = {0.5, -1.25};
+  const Rig after = BumpedTruth("lens1", lens);
+  for (int c = 0; c < before.num_cameras(); ++c) {
+    std::vector<double> expected = before.camera(c).intrinsics();
+    if (c == 2) {
+      expected[0] *= 1.001;
+      expected[1] *= 1.001;
+      expected[2] += 0.5;
+      expected[3] -= 1.25;
+    }
+    for (size_t i = 0; i < expected.size(); ++i)
+      EXPECT_NEAR(after.camera(c).intrinsics()[i], expected[i], 1e-9) << "camera " << c << " intrinsic " << i;
+    EXPECT_LT((before.CamFromReference(c).Inverse() * after.CamFromReference(c)).DistanceMm(), 1e-9);
+    EXPECT_LT((before.CamFromReference(c).Inverse() * after.CamFromReference(c)).AngleDeg(), 1e-9);
+  }
 }
 
 }  // namespace

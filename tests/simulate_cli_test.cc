@@ -228,7 +228,10 @@ TEST(SimulateCli, OptionsThatWouldBeIgnoredAreRefused) {
   const std::string out = " --out " + dir + "/ds";
   const std::pair<std::string, std::string> cases[] = {
       {out + " --bump-rotation-deg 0.1", "--bump-rotation-deg: needs --bump-camera or --bump-module"},
-      {out + " --bump-camera 1", "--bump-camera: needs --bump-rotation-deg or --bump-translation-mm"},
+      {out + " --bump-camera 1",
+       "--bump-camera: needs --bump-rotation-deg, --bump-translation-mm, --bump-focal-percent or "
+       "--bump-principal-point-px"},
+      {out + " --bump-module 1", "--bump-module: needs --bump-rotation-deg or --bump-translation-mm"},
       {" --write-default-spec " + dir + "/s.yaml" + out, "--out: does not apply with --write-default-spec"},
       {" --write-default-spec " + dir + "/s.yaml --bump-camera 1", "--bump-camera: does not apply with"},
       {out + " --seed -1", "--seed: must be >= 0"}};
@@ -239,6 +242,47 @@ TEST(SimulateCli, OptionsThatWouldBeIgnoredAreRefused) {
     EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
   }
   EXPECT_TRUE(fs::is_empty(dir));
+}
+
+// A lens drift (--bump-focal-percent, --bump-principal-point-px) belongs to
+// one camera and has a plausible size: anything else exits 2 before any
+// work, one line naming the flag. A good one renders, and truth/rig.yaml and
+// truth/simulation.yaml record the drifted lens.
+TEST(SimulateCli, LensDriftIsValidatedAndRecordedInTheTruth) {
+  const std::string dir = ::testing::TempDir() + "/sim_lens_drift";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string out = " --out " + dir + "/ds";
+  const std::pair<std::string, std::string> cases[] = {
+      {out + " --bump-focal-percent 0.1", "--bump-focal-percent: needs --bump-camera"},
+      {out + " --bump-principal-point-px 1 0", "--bump-principal-point-px: needs --bump-camera"},
+      {out + " --bump-module 1 --bump-focal-percent 0.1", "--bump-focal-percent: needs --bump-camera"},
+      {out + " --bump-camera 1 --bump-focal-percent 12", "--bump-focal-percent: must be within +-10"},
+      {out + " --bump-camera 1 --bump-focal-percent -12", "--bump-focal-percent: must be within +-10"},
+      {out + " --bump-camera 1 --bump-focal-percent nan", "--bump-focal-percent"},
+      {out + " --bump-camera 1 --bump-principal-point-px 60 0", "--bump-principal-point-px: each of DX and DY"},
+      {out + " --bump-camera 1 --bump-principal-point-px 0 -51", "--bump-principal-point-px: each of DX and DY"},
+      {out + " --bump-camera 1 --bump-principal-point-px nan 0", "--bump-principal-point-px: each of DX and DY"},
+      {out + " --bump-camera 1 --bump-principal-point-px 1", "--bump-principal-point-px"},
+      {out + " --bump-camera 9 --bump-focal-percent 0.1 --calibration-captures 0 --no-scenes",
+       "--bump-camera: no camera 9"},
+      {" --write-default-spec " + dir + "/s.yaml --bump-focal-percent 1", "--bump-focal-percent: does not apply with"}};
+  for (const auto& [args, says] : cases) {
+    const Result r = RunCli("simulate" + args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
+  }
+  EXPECT_TRUE(fs::is_empty(dir));
+
+  const Result r = RunCli("simulate" + out +
+                          " --bump-camera 1 --bump-focal-percent 0.5 --bump-principal-point-px 1.5 -2"
+                          " --calibration-captures 1 --no-scenes");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string info = Slurp(dir + "/ds/truth/simulation.yaml");
+  EXPECT_NE(info.find("focal_percent: 0.5\n"), std::string::npos) << info;
+  EXPECT_NE(info.find("principal_point_px: [1.5, -2]\n"), std::string::npos) << info;
+  // truth/rig.yaml's drifted intrinsics: Simulate.ALensDriftChangesOnlyThatCamerasIntrinsics.
 }
 
 // --write-default-spec is checked like every command's output

@@ -12,13 +12,15 @@
 //   - per module pair, the closure through the double-sided target: the board
 //     pose from module i alone against the one from module j alone, mean over
 //     captures, in mm (at the board centre) and degrees.
-// Cameras are named by elimination: the worst camera over its threshold is
-// set aside and the rest re-evaluated without it, until all that remain agree.
+// A module whose cameras disagree names the camera that also disagrees with
+// the other modules, and says whether a new pose or a new lens (focal length,
+// principal point) explains its corners, or that the check cannot tell.
 #pragma once
 
 #include <string>
 #include <vector>
 
+#include "calib/check/camera_change.h"
 #include "calib/core/rig.h"
 #include "calib/observations.h"
 #include "targets/target.h"
@@ -46,7 +48,20 @@ struct CheckFigure {
 struct CheckResult {
   std::vector<CheckFigure> figures;
   std::vector<int> moved_cameras;  // named by elimination, global indices
-  std::vector<int> moved_modules;  // both cameras moved, or a pair closure failed
+  // For each of moved_cameras: whether it moved, its lens changed, or the
+  // check cannot tell (calib/check/camera_change.h). A camera without one is
+  // explained as moved.
+  std::vector<CameraChange> camera_changes;
+  std::vector<int> moved_modules;  // its cameras disagree with no camera to blame, or a pair closure failed
+  // Of moved_modules, those named by failing closures alone (each module
+  // agrees with itself): a closure shows that two modules' board poses
+  // disagree, which a module's motion and a small change of one of their
+  // lenses (a focal length scales a module's pose) both do. Explained so.
+  std::vector<int> closure_modules;
+  // Of moved_modules, those whose own two cameras disagree while neither
+  // disagrees with the other modules (or there are none): something in the
+  // module changed, a camera's pose or lens, not the module as a whole.
+  std::vector<int> split_modules;
   bool ok() const;
   std::string Verdict() const { return ok() ? "ok" : "recalibrate"; }
   std::string Explanation() const;  // one line naming what moved

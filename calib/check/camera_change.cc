@@ -1,0 +1,123 @@
+#include "calib/check/camera_change.h"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <cstdio>
+
+#include "calib/check/board_pose.h"
+
+namespace stereorig {
+
+std::string CameraChange::Describe() const {
+  const std::string name = "camera " + std::to_string(camera);
+  switch (kind) {
+    case CameraChangeKind::kMoved:
+      return name + " moved";
+    case CameraChangeKind::kLens: {
+      // Printed as rounded: no "-0.00".
+      auto shown = [](double x, double step) { return std::abs(x) < step / 2 ? 0.0 : x; };
+      char text[160];
+      std::snprintf(text, sizeof text, "'s lens changed: focal length %+.3f %%, principal point %+.2f, %+.2f px",
+                    shown(focal_percent, 0.001), shown(principal_point_px.x(), 0.01),
+                    shown(principal_point_px.y(), 0.01));
+      return name + text;
+    }
+    case CameraChangeKind::kMovedOrLens:
+      break;
+  }
+  return name + " moved or its lens changed";
+}
+
+namespace {
+
+// A corner of the camera: its point in the reference frame (through the pose
+// the other cameras imply) and where the camera saw it.
+struct Corner {
+  Eigen::Vector3d p_ref;
+  Eigen::Vector2d q;
+};
+
+// Residual of one corner with the camera's pose refitted:
+// Project(Pose(rt) * cam_from_ref * p_ref) - q, numerically differentiated
+// (mrcal's projection is not templated).
+struct MovedResidual {
+  const Camera* camera;
+  Pose cam_from_ref;
+  Corner corner;
+  bool operator()(const double* rt, double* residual) const {
+    const Pose new_from_old = Pose::FromRotationVector({rt[0], rt[1], rt[2]}, {rt[3], rt[4], rt[5]});
+    const Eigen::Vector3d p_cam = new_from_old * (cam_from_ref * corner.p_ref);
+    if (p_cam.z() <= 0) return false;
+    const Eigen::Vector2d e = camera->Project(p_cam) - corner.q;
+    residual[0] = e.x();
+    residual[1] = e.y();
+    return true;
+  }
+  static ceres::CostFunction* Create(const Camera* camera, const Pose& cam_from_ref, const Corner& corner) {
+    return new ceres::NumericDiffCostFunction<MovedResidual, ceres::CENTRAL, 2, 6>(
+        new MovedResidual{camera, cam_from_ref, corner});
+  }
+};
+
+double RmsPerAxis(double sum_of_squares, size_t corners) { return std::sqrt(sum_of_squares / (2.0 * corners)); }
+
+double MovedFitRms(const Camera& camera, const Pose& cam_from_ref, const std::vector<Corner>& corners) {
+  double rt[6] = {0, 0, 0, 0, 0, 0};
+  ceres::Problem problem;
+  for (const Corner& c : corners)
+    problem.AddResidualBlock(MovedResidual::Create(&camera, cam_from_ref, c), nullptr, rt);
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_QR;
+  options.max_num_iterations = 20;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  return RmsPerAxis(2.0 * summary.final_cost, corners.size());
+}
+
+}  // namespace
+
+CameraChange ExplainCameraChange(const Rig& rig, const Target& target, int camera, const std::vector<PosedView>& views,
+                                 double threshold_px) {
+  const Camera& cam = rig.camera(camera);
+  const Pose cam_from_ref = rig.CamFromReference(camera);
+  std::vector<Corner> corners;
+  for (const PosedView& pv : views)
+    for (size_t k = 0; k < pv.view->corner_ids.size(); ++k)
+      corners.push_back(
+          {pv.ref_from_front * CornerInFront(target, pv.view->face, pv.view->corner_ids[k]), pv.view->q_px[k]});
+  CameraChange change;
+  change.camera = camera;
+  change.threshold_px = threshold_px;
+  if (corners.size() < 6) return change;
+
+  // The lens fit is linear: every mrcal model stereorig uses maps its
+  // normalised (distorted) coordinates u to q = f u + c, so the lens with
+  // its focal length scaled by (1 + s) and its centre moved by d sees
+  // q' = c + d + (1 + s)(q - c). Least squares on (s, dx, dy).
+  const Eigen::Vector2d c(cam.cx(), cam.cy());
+  Eigen::MatrixXd a(2 * corners.size(), 3);
+  Eigen::VectorXd b(2 * corners.size());
+  for (size_t i = 0; i < corners.size(); ++i) {
+    const Eigen::Vector3d p_cam = cam_from_ref * corners[i].p_ref;
+    const Eigen::Vector2d q = cam.Project(p_cam);
+    // q' - q_observed = (q - q_observed) + s (q - c) + d
+    a.row(2 * i) << q.x() - c.x(), 1, 0;
+    a.row(2 * i + 1) << q.y() - c.y(), 0, 1;
+    b.segment<2>(2 * i) = corners[i].q - q;
+  }
+  const Eigen::Vector3d x = a.colPivHouseholderQr().solve(b);
+  change.focal_percent = 100.0 * x[0];
+  change.principal_point_px = x.tail<2>();
+  change.lens_rms_px = RmsPerAxis((a * x - b).squaredNorm(), corners.size());
+  change.moved_rms_px = MovedFitRms(cam, cam_from_ref, corners);
+
+  const bool moved_fits = change.moved_rms_px <= threshold_px, lens_fits = change.lens_rms_px <= threshold_px;
+  change.kind = moved_fits && !lens_fits   ? CameraChangeKind::kMoved
+                : lens_fits && !moved_fits ? CameraChangeKind::kLens
+                                           : CameraChangeKind::kMovedOrLens;
+  return change;
+}
+
+}  // namespace stereorig

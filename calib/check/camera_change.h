@@ -1,0 +1,57 @@
+// What changed in a camera that no longer agrees with the others: did it
+// move, or did its lens drift (a focus ring turned or thermal drift scaling
+// the focal length, a knock moving the principal point)?
+//
+// Both are fitted to the camera's corners, with the board poses the other
+// cameras imply held fixed:
+//   - moved: its pose cam_from_ref refitted (6 parameters), lens as stored;
+//   - lens:  its focal length (fx and fy by one factor) and principal point
+//            refitted (3 parameters), pose as stored.
+// A change is what explains the corners: a fit whose residual RMS passes the
+// camera's consistency threshold (the same k-sigma bound, from the stored
+// calibration, that flagged it). Where both fit, the check cannot tell them
+// apart and says so: a principal-point shift of d px looks, to first order,
+// like a turn of d / f rad about the image's other axis, and a focal change
+// like a shift along the optical axis when the board stays at one depth.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "calib/core/rig.h"
+#include "calib/observations.h"
+#include "targets/target.h"
+
+namespace stereorig {
+
+enum class CameraChangeKind {
+  kMoved,        // only a new pose explains its corners
+  kLens,         // only a new focal length and principal point explain them
+  kMovedOrLens,  // either does (or neither alone): the check cannot tell
+};
+
+struct CameraChange {
+  int camera = -1;
+  CameraChangeKind kind = CameraChangeKind::kMovedOrLens;
+  double moved_rms_px = 0;  // per axis, with the pose refitted
+  double lens_rms_px = 0;   // per axis, with the lens refitted
+  double threshold_px = 0;  // what either must pass to explain the corners
+  // The lens fit's estimate: fx and fy scaled by 1 + focal_percent / 100,
+  // (cx, cy) moved by principal_point_px.
+  double focal_percent = 0;
+  Eigen::Vector2d principal_point_px = Eigen::Vector2d::Zero();
+  std::string Describe() const;  // "camera 2 moved", "camera 2's lens changed (...)", ...
+};
+
+// One view of camera `camera` with the board pose the other cameras imply.
+struct PosedView {
+  const BoardObservation* view;
+  Pose ref_from_front;
+};
+
+// `views` are the camera's views, each with the pose from the others;
+// `threshold_px` its consistency threshold (per-axis RMS).
+CameraChange ExplainCameraChange(const Rig& rig, const Target& target, int camera, const std::vector<PosedView>& views,
+                                 double threshold_px);
+
+}  // namespace stereorig

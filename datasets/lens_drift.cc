@@ -1,0 +1,16 @@
+#include "datasets/lens_drift.h"
+
+namespace stereorig {
+
+Camera WithLensDrift(const Camera& camera, const LensDrift& drift) {
+  std::vector<double> intrinsics = camera.intrinsics();
+  const double scale = 1.0 + drift.focal_percent / 100.0;
+  intrinsics[0] *= scale;
+  intrinsics[1] *= scale;
+  intrinsics[2] += drift.principal_point_px.x();
+  intrinsics[3] += drift.principal_point_px.y();
+  return Camera(camera.lensmodel_name(), intrinsics, camera.imager_width_px(), camera.imager_height_px(),
+                "drifted lens");
+}
+
+}  // namespace stereorig
