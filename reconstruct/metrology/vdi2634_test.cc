@@ -615,6 +615,33 @@ TEST(Vdi2634, AStrayPointInThePlatesPlaneMovesNeitherItsOutlineNorItsFigure) {
   }
 }
 
+TEST(Vdi2634, AGapAcrossThePlateKeepsBothSidesInTheFigures) {
+  // Truth: the 130 mm plate at 0.5 mm, noise 0.05 mm, its strip beyond
+  // u = 34 mm raised 3 mm out of the plane (a warp: F reads ~3 mm less what
+  // the fitted plane's tilt takes up, well over the 1.5 mm MPE), and the same
+  // plate with no point at u 30..34 mm (a shadow or a seam across the face).
+  // Both sides of the gap are the plate's: the figures must see the warp
+  // either way (F the same within the noise's reach, 10 x 0.05 mm). Before,
+  // the dense cells' largest group alone was the face: the strip beyond the
+  // gap left the figures and the warped plate passed.
+  std::mt19937 rng(33);
+  const Eigen::Vector3d c(0, 0, 5), normal(0, 0, 1);
+  const Eigen::Vector3d x = normal.unitOrthogonal();
+  std::vector<Eigen::Vector3d> warped, gapped;
+  for (const Eigen::Vector3d& p : PlatePoints(c, normal, 130, 0.5, 0.05, &rng)) {
+    const double u_mm = (p - c).dot(x);
+    const Eigen::Vector3d q = u_mm > 34 ? Eigen::Vector3d(p + 3.0 * normal) : p;
+    warped.push_back(q);
+    if (u_mm < 30 || u_mm > 34) gapped.push_back(q);
+  }
+  const ArtifactEvaluation whole = EvaluateArtifact(PlateArtifact(), warped, VerifyOptions(), "plate.ply");
+  const ArtifactEvaluation split = EvaluateArtifact(PlateArtifact(), gapped, VerifyOptions(), "plate.ply");
+  ASSERT_GT(FigureOf(whole, "F"), 1.5);
+  EXPECT_FALSE(whole.pass());
+  EXPECT_NEAR(FigureOf(split, "F"), FigureOf(whole, "F"), 0.5);
+  EXPECT_FALSE(split.pass()) << "the warped strip beyond the gap left the figures";
+}
+
 TEST(Vdi2634, StrayPointsDoNotMakeTooLittleOfThePlateEnough) {
   // Truth: 60 x 60 mm of the 130 mm plate seen (46%: under the half that
   // must be), and two stray points in its plane at (40, 40) and (-40, -40) mm
