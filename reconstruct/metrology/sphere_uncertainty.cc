@@ -48,10 +48,22 @@ SphereFitUncertainty SphereUncertainty(const std::vector<Eigen::Vector3d>& point
     ss_mm2 += fit.residuals_mm[k] * fit.residuals_mm[k];
   }
   const double sigma2_mm2 = ss_mm2 / static_cast<double>(fit.inliers.size() - 4);
-  const Eigen::Matrix4d covariance = sigma2_mm2 * jtj.ldlt().solve(Eigen::Matrix4d::Identity());
-  // A cap too small to pin the radius at all reads as infinitely uncertain.
-  u.diameter_std_mm = std::isfinite(covariance(3, 3)) ? 2 * std::sqrt(std::max(0.0, covariance(3, 3)))
-                                                      : std::numeric_limits<double>::infinity();
+  // A cap too small to pin the parameters (J'J near singular: Eigen's LDLT
+  // would solve it as a pseudo-inverse and read an undetermined radius as
+  // exact) reads as infinitely uncertain, and so does a variance that is not
+  // positive and finite.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eigen(jtj);
+  const Eigen::Vector4d values = eigen.eigenvalues();  // increasing
+  constexpr double kInfinite = std::numeric_limits<double>::infinity();
+  if (!(values(0) > 1e-12 * values(3))) {
+    u.diameter_std_mm = kInfinite;
+    u.center_covariance_mm2 = Eigen::Vector3d::Constant(kInfinite).asDiagonal();
+    return u;
+  }
+  const Eigen::Matrix4d covariance =
+      sigma2_mm2 * eigen.eigenvectors() * values.cwiseInverse().asDiagonal() * eigen.eigenvectors().transpose();
+  u.diameter_std_mm =
+      covariance(3, 3) > 0 && std::isfinite(covariance(3, 3)) ? 2 * std::sqrt(covariance(3, 3)) : kInfinite;
   u.center_covariance_mm2 = covariance.topLeftCorner<3, 3>();
   return u;
 }

@@ -17,8 +17,11 @@ namespace stereorig {
 struct SphereFitUncertainty {
   // The half-angle of the cone about the points' mean direction (from the
   // fitted centre) that holds 99% of them, degrees: 90 for a hemisphere, near
-  // 180 for a sphere seen from both sides. The 99% keeps a few strays from
-  // setting it.
+  // 180 for a sphere seen from both sides, and also for two small opposite
+  // caps (it is the extent about one axis, not the share of the sphere
+  // covered: the uncertainties below are what says how well the points pin
+  // the sphere). The 99% keeps a few strays from setting it (above ~100
+  // points; with fewer, it is the largest angle).
   double cap_half_angle_deg = 0;
   // Standard uncertainties (k = 1) from the Gauss-Newton fit's covariance,
   // sigma^2 (J^T J)^-1, with sigma^2 = sum e^2 / (n - 4) from the residuals

@@ -45,17 +45,33 @@ Figure MakeFigure(const std::string& name, double value, double mpe) {
   return {name, value, mpe, std::abs(value) <= mpe, std::nullopt};
 }
 
-// A figure the fit leaves undetermined is refused rather than judged: its
-// value would be the fit's noise (VerifyOptions::max_uncertainty_fraction_of_mpe).
-void RequireDetermined(const Figure& f, const std::string& coverage, const VerifyOptions& o, const std::string& where) {
-  const double u_mm = f.standard_uncertainty_mm.value();
-  if (u_mm <= o.max_uncertainty_fraction_of_mpe * f.mpe_mm) return;
-  char buf[256];
-  std::snprintf(buf, sizeof buf,
-                "%s is not determined: %s, which fits it to +-%.3f mm (1 sigma), more than %.0f%% of "
-                "its MPE (%.3f mm); measure more of the artifact",
-                f.name.c_str(), coverage.c_str(), u_mm, 100 * o.max_uncertainty_fraction_of_mpe, f.mpe_mm);
-  throw InputError(where, buf);
+// A position whose verdict would rest on a figure the fit leaves
+// undetermined (its standard uncertainty over
+// VerifyOptions::max_uncertainty_fraction_of_mpe of its MPE: its value would
+// be the fit's noise) is refused: a PASS cannot be claimed from it. Not when
+// the position fails beyond doubt without it: another figure fails (P_F has
+// no fit uncertainty), or this one by more than twice its uncertainty
+// (|value| - 2u > MPE); such a position is judged, FAIL. A non-finite or
+// non-positive uncertainty counts as undetermined.
+void RequireDeterminedIfPassing(const ArtifactEvaluation& e, const std::string& coverage, const VerifyOptions& o,
+                                const std::string& where) {
+  for (const Figure& f : e.figures) {
+    if (f.pass) continue;
+    const double u_mm = f.standard_uncertainty_mm.value_or(0.0);
+    if (std::isfinite(u_mm) && std::abs(f.value_mm) - 2 * u_mm > f.mpe_mm) return;  // fails beyond doubt
+  }
+  for (const Figure& f : e.figures) {
+    if (!f.standard_uncertainty_mm) continue;
+    const double u_mm = *f.standard_uncertainty_mm;
+    if (u_mm > 0 && u_mm <= o.max_uncertainty_fraction_of_mpe * f.mpe_mm) continue;
+    char buf[320];
+    std::snprintf(buf, sizeof buf,
+                  "%s is not determined: %s and scatter by %.3f mm (residual std), which fits it to +-%.3f mm (1 "
+                  "sigma), more than %.0f%% of its MPE (%.3f mm); measure more of the artifact, or with less noise",
+                  f.name.c_str(), coverage.c_str(), e.residual_std_mm, u_mm, 100 * o.max_uncertainty_fraction_of_mpe,
+                  f.mpe_mm);
+    throw InputError(where, buf);
+  }
 }
 
 std::string CapsText(const std::vector<double>& cap_half_angles_deg) {
@@ -225,8 +241,8 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       e.figures = {MakeFigure("P_F", Range(fit.residuals_mm), a.mpe.probing_form_mm),
                    MakeFigure("P_S", 2 * fit.radius_mm - a.sphere_diameter_mm, a.mpe.probing_size_mm)};
       e.figures[1].standard_uncertainty_mm = u.diameter_std_mm;
-      RequireDetermined(e.figures[1], CapsText(e.sphere_cap_half_angles_deg), o, where);
       ResidualStats(fit.residuals_mm, &e);
+      RequireDeterminedIfPassing(e, CapsText(e.sphere_cap_half_angles_deg), o, where);
       break;
     }
     case ArtifactType::kBallBar: {
@@ -320,9 +336,12 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       // The two centres' errors are independent (disjoint points); the
       // distance moves with their difference along the bar.
       const Eigen::Vector3d along = bar_mm.normalized();
-      e.figures[0].standard_uncertainty_mm = std::sqrt(along.dot(centers_covariance_mm2 * along));
-      RequireDetermined(e.figures[0], CapsText(e.sphere_cap_half_angles_deg), o, where);
+      const double variance_mm2 = along.dot(centers_covariance_mm2 * along);
+      e.figures[0].standard_uncertainty_mm = variance_mm2 > 0 && std::isfinite(variance_mm2)
+                                                 ? std::sqrt(variance_mm2)
+                                                 : std::numeric_limits<double>::infinity();
       ResidualStats(all_residuals, &e);
+      RequireDeterminedIfPassing(e, CapsText(e.sphere_cap_half_angles_deg), o, where);
       break;
     }
     case ArtifactType::kPlate: {

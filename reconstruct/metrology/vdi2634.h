@@ -56,8 +56,10 @@ struct VerifyOptions {
   double plate_min_coverage = 0.5;
   // P_S (sphere) and SD (ball bar) must be determined by the fit to a
   // standard uncertainty (k = 1, the fit's covariance: sphere_uncertainty.h)
-  // of at most this fraction of their MPE, or the position is refused: a
-  // small cap's fitted diameter is noise, not the system's size error. 0.1
+  // of at most this fraction of their MPE, or a position that would pass is
+  // refused (one that fails beyond doubt is judged: another figure fails, or
+  // this one by more than 2u): a small cap's fitted diameter is noise, not
+  // the system's size error. 0.1
   // keeps the expanded uncertainty (k = 2) within a fifth of the MPE, so the
   // verdict is the figure's, not the fit's. Measured basis: 2000 points of a
   // 38.1 mm sphere with the runtime's 0.05 mm noise fit its diameter to
@@ -112,7 +114,8 @@ struct ArtifactEvaluation {
 // Throws InputError(`where`, ...) when the cloud has too few points on the
 // artifact, the artifact cannot be found in it, what is found does not
 // cover the certified artifact plausibly, or the points leave P_S or SD
-// undetermined (max_uncertainty_fraction_of_mpe).
+// undetermined (max_uncertainty_fraction_of_mpe) where the position would
+// otherwise pass.
 ArtifactEvaluation EvaluateArtifact(const Artifact& artifact, const std::vector<Eigen::Vector3d>& points_mm,
                                     const VerifyOptions& options, const std::string& where);
 

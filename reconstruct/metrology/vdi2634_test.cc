@@ -552,6 +552,29 @@ TEST(Vdi2634, ASmallCapsDiameterIsRefusedAndALargerCapsIsJudged) {
   EXPECT_LT(std::abs(FigureOf(e, "P_S")), 5 * 0.054);
 }
 
+TEST(Vdi2634, AnUndeterminedSizeDoesNotHideADeterminedFailure) {
+  // The refusal is for a PASS the fit cannot carry, not for a position that
+  // fails beyond doubt (second reading: both were exit 2, "bad input").
+  // (1) A 40-degree cap of 2000 points with 0.3 mm noise: u(P_S) ~0.17 mm,
+  // over 10% of the MPE, but its form P_F (the residuals' range, ~6 sigma =
+  // 1.8 mm) exceeds the 1.5 mm MPE whatever the size: judged, FAIL. (2) A
+  // 15-degree cap 3 mm too large in diameter, the runtime's 0.05 mm noise:
+  // u(P_S) ~0.22 mm, and |P_S| - 2u ~2.5 mm > 1.5 mm: judged, FAIL.
+  const Eigen::Vector3d c(1, 2, 150), view(0.1, 0, -1);
+  std::mt19937 rng(12);
+  const auto noisy = testing::NoisySurfaceSamples(testing::SphereCapSurface(c, view, 19.05, 40), 2000, 0.3, &rng);
+  const ArtifactEvaluation e1 = EvaluateArtifact(SphereArtifact(), noisy, VerifyOptions(), "noisy40.ply");
+  ASSERT_GT(e1.figures[1].standard_uncertainty_mm.value(), 0.15);
+  EXPECT_GT(FigureOf(e1, "P_F"), 1.5);
+  EXPECT_FALSE(e1.pass());
+  const auto big = testing::NoisySurfaceSamples(testing::SphereCapSurface(c, view, 19.05 + 1.5, 15), 2000, 0.05, &rng);
+  const ArtifactEvaluation e2 = EvaluateArtifact(SphereArtifact(), big, VerifyOptions(), "big15.ply");
+  const double u_mm = e2.figures[1].standard_uncertainty_mm.value();
+  ASSERT_GT(u_mm, 0.15);
+  EXPECT_GT(std::abs(FigureOf(e2, "P_S")) - 2 * u_mm, 1.5);
+  EXPECT_FALSE(e2.pass());
+}
+
 TEST(Vdi2634, ABallBarWhoseCentresAreUndeterminedIsRefused) {
   // Each ball a cap of 600 points, noise 0.05 mm, seen from 31 deg off the
   // bar's perpendicular, away from the other ball (clear of the shaft cone),
