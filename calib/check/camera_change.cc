@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "calib/check/board_pose.h"
 
@@ -73,6 +74,8 @@ double MovedFitRms(const Camera& camera, const Pose& cam_from_ref, const std::ve
   options.max_num_iterations = 20;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
+  // A solve that failed explains nothing (its final cost is not a cost).
+  if (!summary.IsSolutionUsable()) return std::numeric_limits<double>::infinity();
   return RmsPerAxis(2.0 * summary.final_cost, corners.size());
 }
 
@@ -90,7 +93,10 @@ CameraChange ExplainCameraChange(const Rig& rig, const Target& target, int camer
   CameraChange change;
   change.camera = camera;
   change.threshold_px = threshold_px;
-  if (corners.size() < 6) return change;
+  if (corners.size() < 6) {  // too few to fit either: no fit, not a perfect one (null in the report)
+    change.moved_rms_px = change.lens_rms_px = std::numeric_limits<double>::quiet_NaN();
+    return change;
+  }
 
   // The lens fit is linear: every mrcal model stereorig uses maps its
   // normalised (distorted) coordinates u to q = f u + c, so the lens with
