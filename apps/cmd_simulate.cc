@@ -82,6 +82,9 @@ int RunSimulate(int argc, char** argv) {
                          ? "needs --bump-rotation-deg, --bump-translation-mm, --bump-focal-percent or "
                            "--bump-principal-point-px (by how much)"
                          : "needs --bump-rotation-deg or --bump-translation-mm (by how much)");
+  if (bump_what && !o.bump.Any())  // every amount given is 0 (NaN and bounds: the options' checks)
+    throw InputError(app.count("--bump-camera") ? "--bump-camera" : "--bump-module",
+                     "every amount given is 0: the rig would render undisturbed; give a nonzero amount");
 
   if (!write_spec.empty()) {
     // Checked like every other command's outputs (apps/output_paths.h): its

@@ -264,6 +264,9 @@ TEST(SimulateCli, LensDriftIsValidatedAndRecordedInTheTruth) {
       {out + " --bump-camera 1 --bump-principal-point-px 0 -51", "--bump-principal-point-px: each of DX and DY"},
       {out + " --bump-camera 1 --bump-principal-point-px nan 0", "--bump-principal-point-px: each of DX and DY"},
       {out + " --bump-camera 1 --bump-principal-point-px 1", "--bump-principal-point-px"},
+      {out + " --bump-camera 1 --bump-focal-percent 0", "--bump-camera: every amount given is 0"},
+      {out + " --bump-camera 1 --bump-principal-point-px 0 0", "--bump-camera: every amount given is 0"},
+      {out + " --bump-module 1 --bump-rotation-deg 0", "--bump-module: every amount given is 0"},
       {out + " --bump-camera 9 --bump-focal-percent 0.1 --calibration-captures 0 --no-scenes",
        "--bump-camera: no camera 9"},
       {" --write-default-spec " + dir + "/s.yaml --bump-focal-percent 1", "--bump-focal-percent: does not apply with"}};
