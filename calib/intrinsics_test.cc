@@ -68,6 +68,20 @@ testing::DefaultScene FlatBoardScene(unsigned seed, double noise_px, double late
   return s;
 }
 
+// Camera `cam`'s views of scene `s`, and stage 1's ranked pinhole seeds
+// for them.
+struct ViewsAndSeeds {
+  std::vector<const BoardObservation*> views;
+  std::vector<PinholeSeed> pinhole_seeds;
+};
+ViewsAndSeeds ViewsAndSeedsOf(const testing::DefaultScene& s, int cam, const IntrinsicsOptions& options) {
+  ViewsAndSeeds v{testing::ViewsOf(s.data.input, cam), {}};
+  const CameraImager& spec = s.data.input.cameras[cam];
+  v.pinhole_seeds =
+      RankedPinholeSeeds(v.views, s.data.input.target, spec.width_px, spec.height_px, options.seed_focal_px);
+  return v;
+}
+
 // Asserts that `views` of camera `cam` are flat in truth (every board tilted
 // under half of min_tilt_deg) and that the first of `pinhole_seeds` poses
 // them under min_tilt_deg: stage 1 refuses it before solving.
@@ -280,9 +294,7 @@ TEST(Intrinsics, RefusesFrontoParallelViewsThatAFarSeedPosesTilted) {
     const testing::DefaultScene s = FlatBoardScene(seed, noise_px, volume.lateral_mm, volume.depth_mm);
     const TargetGeometry& target = s.data.input.target;
     const CameraImager& spec = s.data.input.cameras[cam];
-    const std::vector<const BoardObservation*> views = testing::ViewsOf(s.data.input, cam);
-    const std::vector<PinholeSeed> pinhole_seeds =
-        RankedPinholeSeeds(views, target, spec.width_px, spec.height_px, options.seed_focal_px);
+    const auto [views, pinhole_seeds] = ViewsAndSeedsOf(s, cam, options);
     ASSERT_NO_FATAL_FAILURE(AssertFlatAndTheFirstSeedRefused(s, cam, views, pinhole_seeds, options));
     double later_seed_deg = 0;
     for (size_t c = 1; c < pinhole_seeds.size(); ++c)
@@ -323,9 +335,7 @@ TEST(Intrinsics, RefusesFlatViewsWhoseSolvedPosesTiltWithTheirFocalLength) {
   const testing::DefaultScene s = FlatBoardScene(43, noise_px, 40.0, 60.0);
   const TargetGeometry& target = s.data.input.target;
   const CameraImager& spec = s.data.input.cameras[cam];
-  const std::vector<const BoardObservation*> views = testing::ViewsOf(s.data.input, cam);
-  const std::vector<PinholeSeed> pinhole_seeds =
-      RankedPinholeSeeds(views, target, spec.width_px, spec.height_px, options.seed_focal_px);
+  const auto [views, pinhole_seeds] = ViewsAndSeedsOf(s, cam, options);
   ASSERT_NO_FATAL_FAILURE(AssertFlatAndTheFirstSeedRefused(s, cam, views, pinhole_seeds, options));
 
   const double true_fx_px = s.truth.rig.camera(cam).intrinsics()[0];
