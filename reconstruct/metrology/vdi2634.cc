@@ -238,7 +238,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       e.sphere_cap_half_angles_deg = {u.cap_half_angle_deg};
       e.sphere_diameter_std_mm = {u.diameter_std_mm};
       e.sphere_form_mm = {Range(fit.residuals_mm)};
-      e.figures = {MakeFigure("P_F", Range(fit.residuals_mm), a.mpe.probing_form_mm),
+      e.figures = {MakeFigure("P_F", e.sphere_form_mm[0], a.mpe.probing_form_mm),
                    MakeFigure("P_S", 2 * fit.radius_mm - a.sphere_diameter_mm, a.mpe.probing_size_mm)};
       e.figures[1].standard_uncertainty_mm = u.diameter_std_mm;
       ResidualStats(fit.residuals_mm, &e);
