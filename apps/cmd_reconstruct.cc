@@ -1,8 +1,9 @@
 // `stereorig reconstruct`: rig file + capture -> point cloud, mesh, report.
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
-#include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "apps/cli_util.h"
@@ -44,7 +45,8 @@ int RunReconstruct(int argc, char** argv) {
       "built at the start; each capture writes <name>.ply and <name>.json, <name> its folder's last name, and "
       "prints one line '[k] DIR: ...' on stdout at once. An output that exists is never replaced. A bad capture (a "
       "missing camera, bad images, an output name that exists already) is named on stderr and on its line, gets no "
-      "output, and the stream goes on; the end of the input ends the run (exit 2 if any capture failed).\n\n"
+      "output, and the stream goes on; the end of the input ends the run (exit 2 if any capture failed), and so "
+      "does SIGTERM or Ctrl-C, once the capture in progress is written (its summary says so).\n\n"
       "Examples:\n  stereorig reconstruct --rig rig.yaml --capture data/scenes/cup/active --out cup.ply "
       "--mesh cup.stl --report cup.json\n"
       "  stereorig reconstruct --rig rig.yaml --capture line/0001 line/0002 line/0003 --out-dir clouds "
@@ -115,7 +117,7 @@ int RunReconstruct(int argc, char** argv) {
       return ReconstructStream(
           rig, options,
           StreamRequest{out_dir, mesh_format, report_path, rig_path, options_path, warm_up_dir, capture_root},
-          std::cin);
+          STDIN_FILENO);
     return ReconstructBatch(rig, options,
                             BatchRequest{capture_dirs, out_dir, mesh_format, report_path, rig_path, options_path});
   }

@@ -5,8 +5,10 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "apps/command.h"
 #include "apps/output_paths.h"
 #include "apps/reconstruct_capture.h"
+#include "apps/stream_input.h"
 #include "calib/core/folder_to_create.h"
 #include "calib/core/input_error.h"
 #include "reconstruct/elapsed_ms.h"
@@ -84,7 +86,7 @@ void CheckStreamCapture(const std::string& dir, const std::string& name, const C
 
 }  // namespace
 
-int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const StreamRequest& request, std::istream& in) {
+int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const StreamRequest& request, int input_fd) {
   if (!request.mesh_format.empty() && request.mesh_format != "ply" && request.mesh_format != "stl")
     throw InputError("--mesh-format", "must be ply or stl, not '" + request.mesh_format + "'");
   OutputPaths paths("choose another --report");
@@ -99,6 +101,9 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
   }
   if (!request.capture_root.empty() && !fs::is_directory(request.capture_root))
     throw InputError(request.capture_root, "is not a folder (--capture-root: the captures' folders lie below it)");
+  // Before the runtime: its pool's threads, started with it, inherit the
+  // blocked stop signals (stream_input.h).
+  StreamInput input(input_fd);
   const auto t_build = Clock::now();
   const Runtime runtime(rig, options);  // bad options for this rig: refused before anything is written
   const double build_ms = MsSince(t_build);
@@ -126,7 +131,7 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
   int total = 0, failed = 0;
   const auto t_all = Clock::now();
   std::string line;
-  while (std::getline(in, line)) {
+  while (input.Next(&line)) {
     if (!line.empty() && line.back() == '\r') line.pop_back();  // written on Windows
     if (line.find_first_not_of(" \t") == std::string::npos) continue;
     const auto t = Clock::now();
@@ -168,8 +173,23 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
     std::fflush(stdout);
     if (++failed <= kMaxFailuresListed) summary["failed_captures"].push_back(entry);
   }
+  if (!input.error().empty()) {  // the input ends here: what was read is done, the summary written
+    std::fprintf(stderr, "stereorig reconstruct: standard input could not be read further: %s\n",
+                 input.error().c_str());
+    summary["input_error"] = input.error();
+  }
+  const int stop = input.stop_signal();
+  if (stop != 0) {
+    std::printf(
+        "stopped by %s after %d capture%s; no further line read (a capture in progress when it came was finished "
+        "and written)\n",
+        SignalName(stop).c_str(), total, total == 1 ? "" : "s");
+    std::fflush(stdout);
+    summary["stopped_by"] = SignalName(stop);
+  }
   if (total == 0) {
     out_folder.RemoveIfEmpty();
+    if (stop != 0) return kExitOk;  // stopped before the line's first object: nothing to sum up
     throw InputError("--capture -", "standard input held no capture folder (one folder's path per line)");
   }
   const int code = FinishRun(&summary, total, failed, MsSince(t_all),

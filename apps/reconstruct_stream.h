@@ -13,7 +13,6 @@
 // written) is named on stderr and gets no output, while the stream goes on.
 #pragma once
 
-#include <istream>
 #include <string>
 
 #include "calib/core/rig.h"
@@ -45,7 +44,11 @@ struct StreamRequest {
   std::string capture_root;  // "" or the folder the captures' output names are taken below (StreamOutputName)
 };
 
-// Builds the runtime, then reads `in` to its end: each line (a trailing '\r'
+// Builds the runtime, then reads `input_fd` (standard input) to its end, or
+// until SIGTERM or SIGINT stops it (stream_input.h: the capture in progress
+// is finished and written, no further line read, the summary written with
+// `stopped_by`; a stop before the first capture returns 0 and writes no
+// summary). Each line (a trailing '\r'
 // dropped; blank lines skipped) names a capture folder, reconstructed and
 // written as out_dir/<name>.ply, <name>.json and <name>.mesh.<format>, each
 // atomically, with one line on stdout, flushed (reconstruct_capture.h). An
@@ -57,6 +60,6 @@ struct StreamRequest {
 // for bad input found before the first line is read (the options, the
 // output folder, the summary's path: nothing written then) and when the
 // input holds no capture folder at all.
-int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const StreamRequest& request, std::istream& in);
+int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const StreamRequest& request, int input_fd);
 
 }  // namespace stereorig

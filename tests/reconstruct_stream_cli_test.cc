@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -96,6 +97,7 @@ class Child {
     }
     return out_;
   }
+  void Signal(int signal) { kill(pid_, signal); }
   int Wait() {
     int status = 0;
     waitpid(pid_, &status, 0);
@@ -213,6 +215,67 @@ TEST_F(ReconstructStreamCli, ReconstructsEachFolderAsItsLineArrives) {
   EXPECT_EQ(again.code, 2) << again.err;
   EXPECT_NE(again.out.find("[1] " + dir_ + "/line/0001: no output"), std::string::npos) << again.out;
   EXPECT_EQ(Bytes(out + "/0001.ply"), "an earlier run's cloud");
+}
+
+// A stop signal (systemd's stop sends SIGTERM, a terminal's Ctrl-C SIGINT)
+// ends the stream as the end of its input does: the capture in progress is
+// finished and written, no further line is read, the summary is written
+// (`stopped_by`), exit 0. Before, the signal's default action killed the
+// process and the summary was never written.
+TEST_F(ReconstructStreamCli, AStopSignalEndsTheStreamAsTheEndOfItsInputDoes) {
+  const double timeout_s = 120;  // a liveness bound, as above: the input stays open, only the signal ends the run
+  auto start = [&](const std::string& out) {
+    fs::remove_all(out);
+    return std::make_unique<Child>(
+        std::vector<std::string>{testing::kBin, "reconstruct", "--rig", dir_ + "/rig.yaml", "--capture", "-",
+                                 "--out-dir", out, "--report", out + "/summary.json"},
+        out + "_err.txt");
+  };
+  {  // Between captures: the stream waits for its next line.
+    const std::string out = dir_ + "/stop_idle";
+    const auto child = start(out);
+    ASSERT_TRUE(child->started());
+    child->Send(dir_ + "/line/0001");
+    ASSERT_EQ(testing::Lines(child->ReadLines(2, timeout_s)), 2) << child->ReadLines(2, 0);
+    child->Signal(SIGTERM);
+    EXPECT_EQ(child->Wait(), 0) << Bytes(out + "_err.txt");
+    const std::string all = child->ReadLines(4, timeout_s);
+    EXPECT_NE(all.find("stopped by SIGTERM after 1 capture;"), std::string::npos) << all;
+    EXPECT_EQ(Bytes(out + "/0001.ply"), Bytes(dir_ + "/single.ply"));
+    const nlohmann::json summary = nlohmann::json::parse(Bytes(out + "/summary.json"));
+    EXPECT_EQ(summary["reconstructed"], 1);
+    EXPECT_EQ(summary["stopped_by"], "SIGTERM");
+  }
+  {  // Right after a line is sent, most often while its capture is
+     // reconstructed. Whether the process had read the line when the signal
+     // came is the scheduler's choice; either way the capture is whole or
+     // absent, its line and the summary say which, and no temporary file is
+     // left.
+    const std::string out = dir_ + "/stop_busy";
+    const auto child = start(out);
+    ASSERT_TRUE(child->started());
+    ASSERT_EQ(testing::Lines(child->ReadLines(1, timeout_s)), 1);  // the runtime is built
+    child->Send(dir_ + "/line/0001");
+    usleep(20000);
+    child->Signal(SIGINT);
+    EXPECT_EQ(child->Wait(), 0) << Bytes(out + "_err.txt");
+    const std::string all = child->ReadLines(4, timeout_s);
+    EXPECT_NE(all.find("stopped by SIGINT after "), std::string::npos) << all;
+    const bool reconstructed = fs::exists(out + "/0001.ply");
+    EXPECT_EQ(all.find("[1] " + dir_ + "/line/0001: ") != std::string::npos, reconstructed) << all;
+    if (reconstructed) {
+      EXPECT_EQ(Bytes(out + "/0001.ply"), Bytes(dir_ + "/single.ply"));
+      const nlohmann::json summary = nlohmann::json::parse(Bytes(out + "/summary.json"));
+      EXPECT_EQ(summary["reconstructed"], 1);
+      EXPECT_EQ(summary["stopped_by"], "SIGINT");
+      for (const auto& entry : fs::directory_iterator(out)) {
+        const std::string name = entry.path().filename().string();
+        EXPECT_TRUE(name == "0001.ply" || name == "0001.json" || name == "summary.json") << name;
+      }
+    } else {
+      EXPECT_FALSE(fs::exists(out)) << "a stream stopped before its first capture left its new output folder";
+    }
+  }
 }
 
 // --capture-root names each capture by its path below the root, so folders

@@ -1,0 +1,58 @@
+// The lines of a stream's input (apps/reconstruct_stream.h), read so that a
+// stop signal ends the stream cleanly. A line process is stopped by its
+// supervisor: systemd's `stop` sends SIGTERM, a terminal's Ctrl-C SIGINT.
+// Killed by the signal's default action, the stream would write no summary
+// (its totals and failed captures); with a StreamInput it finishes the
+// capture it is on, reads no further line and ends as at the end of its
+// input, summary written.
+//
+// How no signal is lost: while a StreamInput exists, SIGTERM and SIGINT are
+// blocked in the thread that made it and in every thread started after it
+// (threads inherit the mask: the runtime's pool, built afterwards), and they
+// are let in only inside Next()'s wait for input (ppoll, which unblocks them
+// and waits in one step). A signal sent while a capture is reconstructed or
+// written stays pending until that capture is done and the next wait
+// begins; one sent during the wait ends it at once. A thread started before
+// the StreamInput (none in stereorig) could still take the signal: Next()
+// then sees the stop when it is next called.
+//
+// A process that must go at once, mid-capture, is killed (SIGKILL): its
+// outputs are written atomically, so none is ever half-written.
+#pragma once
+
+#include <csignal>
+#include <string>
+
+namespace stereorig {
+
+class StreamInput {
+ public:
+  // Reads `fd` (a pipe, a FIFO, a file); does not own it. One at a time.
+  explicit StreamInput(int fd);
+  ~StreamInput();  // the signal mask and handlers as they were
+  StreamInput(const StreamInput&) = delete;
+  StreamInput& operator=(const StreamInput&) = delete;
+
+  // The next line, without its '\n' (the input's last line may lack one).
+  // False at the end of the input, when a stop signal came (stop_signal()),
+  // or when the input cannot be read (error()); a line that was only partly
+  // read when the signal came is dropped, as it may be incomplete.
+  bool Next(std::string* line);
+
+  int stop_signal() const;                             // SIGTERM, SIGINT, or 0
+  const std::string& error() const { return error_; }  // "" or why the input could not be read
+
+ private:
+  int fd_;
+  std::string buffer_;  // read but not yet returned
+  size_t begin_ = 0;    // where buffer_'s next line starts
+  bool at_end_ = false;
+  std::string error_;
+  sigset_t old_mask_;
+  struct sigaction old_term_, old_int_;
+};
+
+// "SIGTERM", "SIGINT", or "signal N".
+std::string SignalName(int signal);
+
+}  // namespace stereorig
