@@ -11,13 +11,14 @@
 // (threads inherit the mask: the runtime's pool, built afterwards), and they
 // are let in only inside Next()'s wait for input (ppoll, which unblocks them
 // and waits in one step). A signal sent while a capture is reconstructed or
-// written stays pending until that capture is done and the next wait
-// begins; one sent during the wait ends it at once. A thread started before
-// the StreamInput (none in stereorig) could still take the signal: Next()
-// then sees the stop when it is next called.
-//
-// A process that must go at once, mid-capture, is killed (SIGKILL): its
-// outputs are written atomically, so none is ever half-written.
+// written stays pending until that capture is done; Next() then takes it
+// (sigtimedwait) before it begins another line, whether or not input is
+// waiting (lines queued in a pipe, a file given as the input). One sent
+// during the wait ends it at once. Should a thread started before the
+// StreamInput take one (none does in stereorig), its handler wakes the wait
+// through a pipe. A process started with one of them ignored (`nohup`, a
+// shell's background job's SIGINT) keeps it ignored. A stop signal that
+// comes after the input has ended changes nothing: the stream is ending.
 #pragma once
 
 #include <csignal>
@@ -29,7 +30,9 @@ class StreamInput {
  public:
   // Reads `fd` (a pipe, a FIFO, a file); does not own it. One at a time.
   explicit StreamInput(int fd);
-  ~StreamInput();  // the signal mask and handlers as they were
+  // The thread's signal mask as it was; the handlers stay (a signal after
+  // the stream, as the process returns its exit code, changes nothing).
+  ~StreamInput();
   StreamInput(const StreamInput&) = delete;
   StreamInput& operator=(const StreamInput&) = delete;
 
@@ -43,13 +46,16 @@ class StreamInput {
   const std::string& error() const { return error_; }  // "" or why the input could not be read
 
  private:
+  void TakePendingStop();  // a handled signal pending (blocked) becomes the stop
+
   int fd_;
   std::string buffer_;  // read but not yet returned
   size_t begin_ = 0;    // where buffer_'s next line starts
   bool at_end_ = false;
   std::string error_;
-  sigset_t old_mask_;
-  struct sigaction old_term_, old_int_;
+  int wake_[2] = {-1, -1};  // the handler's self-pipe: read end, write end
+  sigset_t handled_;        // the stop signals handled (not ignored at the start)
+  sigset_t old_mask_;       // the thread's mask before
 };
 
 // "SIGTERM", "SIGINT", or "signal N".

@@ -48,6 +48,13 @@ class Child {
     if (pipe(in) != 0 || pipe(out) != 0) return;
     pid_ = fork();
     if (pid_ == 0) {
+      // The signals as a supervisor starts a service: default actions,
+      // none blocked (a test run as a shell's background job inherits SIGINT
+      // ignored, and SIGPIPE is ignored above).
+      for (int s : {SIGINT, SIGTERM, SIGPIPE}) signal(s, SIG_DFL);
+      sigset_t none;
+      sigemptyset(&none);
+      sigprocmask(SIG_SETMASK, &none, nullptr);
       dup2(in[0], 0);
       dup2(out[1], 1);
       const int err = open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
@@ -98,9 +105,20 @@ class Child {
     return out_;
   }
   void Signal(int signal) { kill(pid_, signal); }
-  int Wait() {
+  // The exit code; -1 if it died of a signal, -2 if it had not ended
+  // after `timeout_s` (then it is killed).
+  int Wait(double timeout_s = 120) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
     int status = 0;
-    waitpid(pid_, &status, 0);
+    while (waitpid(pid_, &status, WNOHANG) == 0) {
+      if (std::chrono::steady_clock::now() > end) {
+        kill(pid_, SIGKILL);
+        waitpid(pid_, nullptr, 0);
+        waited_ = true;
+        return -2;
+      }
+      usleep(10000);
+    }
     waited_ = true;
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   }
@@ -245,6 +263,25 @@ TEST_F(ReconstructStreamCli, AStopSignalEndsTheStreamAsTheEndOfItsInputDoes) {
     const nlohmann::json summary = nlohmann::json::parse(Bytes(out + "/summary.json"));
     EXPECT_EQ(summary["reconstructed"], 1);
     EXPECT_EQ(summary["stopped_by"], "SIGTERM");
+  }
+  {  // With lines queued: a stop that comes during a capture is taken
+     // before the next line, though input is waiting (three lines sent at
+     // once, the signal right after: at most the first is reconstructed,
+     // however the scheduler orders the read and the signal).
+    const std::string out = dir_ + "/stop_queued";
+    const auto child = start(out);
+    ASSERT_TRUE(child->started());
+    ASSERT_EQ(testing::Lines(child->ReadLines(1, timeout_s)), 1);  // the runtime is built
+    fs::remove_all(dir_ + "/queued");
+    fs::create_directories(dir_ + "/queued");
+    for (const char* name : {"a", "b", "c"}) fs::copy(dir_ + "/line/0001", dir_ + "/queued/" + name);
+    child->Send(dir_ + "/queued/a\n" + dir_ + "/queued/b\n" + dir_ + "/queued/c");
+    child->Signal(SIGTERM);
+    EXPECT_EQ(child->Wait(), 0) << Bytes(out + "_err.txt");
+    const std::string all = child->ReadLines(4, timeout_s);
+    EXPECT_FALSE(fs::exists(out + "/b.ply")) << all;
+    EXPECT_FALSE(fs::exists(out + "/c.ply")) << all;
+    EXPECT_NE(all.find("stopped by SIGTERM after "), std::string::npos) << all;
   }
   {  // Right after a line is sent, most often while its capture is
      // reconstructed. Whether the process had read the line when the signal
