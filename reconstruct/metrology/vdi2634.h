@@ -113,7 +113,9 @@ struct ArtifactEvaluation {
 
 // Throws InputError(`where`, ...) when the cloud has too few points on the
 // artifact, the artifact cannot be found in it, what is found does not
-// cover the certified artifact plausibly, or the points leave P_S or SD
+// cover the certified artifact plausibly (a sphere or ball whose free-radius
+// fit leaves the certified size or does not converge: the message names the
+// ball, both diameters and the cap its points cover), or the points leave P_S or SD
 // undetermined (max_uncertainty_fraction_of_mpe) where the position would
 // otherwise pass.
 ArtifactEvaluation EvaluateArtifact(const Artifact& artifact, const std::vector<Eigen::Vector3d>& points_mm,
