@@ -20,7 +20,22 @@ namespace {
 nlohmann::json FigureJson(const Figure& f) {
   nlohmann::json j = {{"name", f.name}, {"value_mm", f.value_mm}, {"mpe_mm", f.mpe_mm}, {"pass", f.pass}};
   if (f.standard_uncertainty_mm) j["standard_uncertainty_mm"] = *f.standard_uncertainty_mm;
+  if (f.fit_standard_uncertainty_mm) j["fit_standard_uncertainty_mm"] = *f.fit_standard_uncertainty_mm;
+  if (f.certificate_standard_uncertainty_mm) {
+    j["certificate_standard_uncertainty_mm"] = *f.certificate_standard_uncertainty_mm;
+  }
   return j;
+}
+
+// A figure's u and its parts: the fit's and the certificate's (U / k),
+// combined in quadrature.
+void PrintUncertainty(size_t position, const Figure& f, double coverage_factor) {
+  if (!f.standard_uncertainty_mm) return;
+  const double certificate_mm = f.certificate_standard_uncertainty_mm.value_or(0.0);
+  char fit[64] = "no fit part: a range of residuals";
+  if (f.fit_standard_uncertainty_mm) std::snprintf(fit, sizeof fit, "fit %.4f mm", *f.fit_standard_uncertainty_mm);
+  std::printf("%-8zu %s: u %.4f mm = %s (+) certificate %.4f mm (U %.4f mm / k %g)\n", position, f.name.c_str(),
+              *f.standard_uncertainty_mm, fit, certificate_mm, certificate_mm * coverage_factor, coverage_factor);
 }
 
 // Each fitted sphere (1 for a sphere, 2 for a ball bar): its size, how much
@@ -72,11 +87,14 @@ int RunVerify(int argc, char** argv) {
       "plate's length or width or more than the plate, is refused (exit 2). Points added by hole filling (PLY module "
       "255) are not measured and are skipped: the fit never uses the reconstruction's own shape prior. A position "
       "whose points leave P_S (sphere) or SD (ball bar) "
-      "undetermined cannot pass: it is refused (exit 2) when the figure's standard uncertainty from the fit is over "
+      "undetermined cannot pass: it is refused (exit 2) when the figure's standard uncertainty is over "
       "10% of its MPE (a sphere's cap of ~18 deg half-angle at the demo's density fits its diameter to ~0.15 mm), "
       "unless the position fails beyond doubt anyway (another figure fails, or this one by more than twice its "
-      "uncertainty: then FAIL, exit 1). The table "
-      "gives, per position, each figure's standard uncertainty (u_mm), the points in the cloud, the filled ones "
+      "uncertainty: then FAIL, exit 1). The artifact file's uncertainties are its certificate's expanded ones, U at "
+      "k = 2 (or its uncertainty_coverage_factor): U / k enters P_S (diameter), SD (centre distance) and F (flatness) "
+      "in quadrature with the fit's, and the rules above read the combined u. The table "
+      "gives, per position, each figure's standard uncertainty (u_mm; both parts on a line of their own), the points "
+      "in the cloud, the filled ones "
       "skipped, those on the artifact, those excluded and those used, and per sphere its diameter, the diameter's "
       "standard uncertainty, the half-angle of the cap its points cover and its form (the range of its residuals; "
       "on a ball bar reported, not judged: a patch one grid period off on one ball shows there); per plate the "
@@ -119,7 +137,9 @@ int RunVerify(int argc, char** argv) {
               positions.front().capture_band_mm);
   std::printf("%-8s %-6s %10s %8s %7s %4s %8s %7s %8s %8s %8s %10s\n", "position", "figure", "value_mm", "u_mm",
               "mpe_mm", "pass", "cloud", "filled", "artifact", "excluded", "used", "mean|e|_mm");
-  nlohmann::json report = {{"artifact", artifact.name}, {"type", ArtifactTypeName(artifact.type)}};
+  nlohmann::json report = {{"artifact", artifact.name},
+                           {"type", ArtifactTypeName(artifact.type)},
+                           {"uncertainty_coverage_factor", artifact.uncertainty_coverage_factor}};
   for (size_t i = 0; i < positions.size(); ++i) {
     const ArtifactEvaluation& e = positions[i];
     nlohmann::json pj = {{"cloud", clouds[i]},
@@ -138,6 +158,7 @@ int RunVerify(int argc, char** argv) {
                   filled_skipped[i], e.points_on_artifact, e.points_excluded, e.points_used(), e.residual_mean_abs_mm);
       pj["figures"].push_back(FigureJson(f));
     }
+    for (const Figure& f : e.figures) PrintUncertainty(i + 1, f, artifact.uncertainty_coverage_factor);
     PrintSpheres(i + 1, e);
     if (!e.sphere_centers_mm.empty()) pj["spheres"] = SpheresJson(e);
     if (e.type == ArtifactType::kPlate) {
@@ -149,7 +170,8 @@ int RunVerify(int argc, char** argv) {
     report["positions"].push_back(pj);
   }
   std::printf(
-      "u_mm = the figure's standard uncertainty (k = 1) from the fit's covariance; points: cloud = all vertices; "
+      "u_mm = the figure's standard uncertainty (k = 1): the fit's (its covariance) and the certificate's (U / k) "
+      "in quadrature; points: cloud = all vertices; "
       "filled = added by hole filling (module 255), skipped; artifact = within the capture band; excluded = the "
       "largest residuals (<= 0.3%%); used = in the figures\n");
   std::printf("summary over %zu position(s):", positions.size());

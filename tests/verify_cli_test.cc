@@ -254,10 +254,21 @@ TEST(VerifyCli, ACapTooSmallToFitTheDiameterIsRefusedAndAGoodOneReportsItsUncert
   EXPECT_NE(r_cli.out.find("cap half-angle"), std::string::npos) << r_cli.out;
   std::ifstream f(report);
   ASSERT_TRUE(f.good());
-  const auto j = nlohmann::json::parse(f)["positions"][0];
-  EXPECT_FALSE(j["figures"][0].contains("standard_uncertainty_mm"));  // P_F: a range, no fit uncertainty
-  // Exact samples: the residuals, and so the uncertainty, are rounding.
-  EXPECT_LT(j["figures"][1]["standard_uncertainty_mm"].get<double>(), 1e-6);
+  const auto written = nlohmann::json::parse(f);
+  EXPECT_EQ(written["uncertainty_coverage_factor"].get<double>(), 2.0);
+  const auto j = written["positions"][0];
+  EXPECT_FALSE(j["figures"][0].contains("standard_uncertainty_mm"));  // P_F: a range, no uncertainty
+  // Exact samples: the residuals, and so the fit's uncertainty, are rounding;
+  // the certificate's diameter_uncertainty_mm 0.002 (U, k = 2) adds 0.001 mm
+  // in quadrature (before, it was read and ignored: u was the fit's alone).
+  const auto& p_s = j["figures"][1];
+  const double fit_mm = p_s["fit_standard_uncertainty_mm"].get<double>();
+  EXPECT_LT(fit_mm, 1e-6);
+  EXPECT_EQ(p_s["certificate_standard_uncertainty_mm"].get<double>(), 0.001);
+  EXPECT_EQ(p_s["standard_uncertainty_mm"].get<double>(), std::hypot(fit_mm, 0.001));
+  EXPECT_NE(r_cli.out.find("P_S: u 0.0010 mm = fit 0.0000 mm (+) certificate 0.0010 mm (U 0.0020 mm / k 2)"),
+            std::string::npos)
+      << r_cli.out;
   ASSERT_EQ(j["spheres"].size(), 1u);
   EXPECT_LT(j["spheres"][0]["diameter_std_mm"].get<double>(), 1e-6);
   // Two 74-degree caps facing each other: no mean direction, or nearly none.

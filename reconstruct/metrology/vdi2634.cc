@@ -42,19 +42,83 @@ bool ArtifactEvaluation::pass() const {
 namespace {
 
 Figure MakeFigure(const std::string& name, double value, double mpe) {
-  return {name, value, mpe, std::abs(value) <= mpe, std::nullopt};
+  Figure f;
+  f.name = name;
+  f.value_mm = value;
+  f.mpe_mm = mpe;
+  f.pass = std::abs(value) <= mpe;
+  return f;
 }
 
-// A position whose verdict would rest on a figure the fit leaves
-// undetermined (its standard uncertainty over
+// The figure's standard uncertainty from its parts, either of which may be
+// absent: their quadrature sum (an infinite fit part stays infinite).
+void SetUncertainty(Figure* f, std::optional<double> fit_mm, std::optional<double> certificate_mm) {
+  f->fit_standard_uncertainty_mm = fit_mm;
+  f->certificate_standard_uncertainty_mm = certificate_mm;
+  if (fit_mm || certificate_mm)
+    f->standard_uncertainty_mm = std::hypot(fit_mm.value_or(0.0), certificate_mm.value_or(0.0));
+}
+
+// What the certificate certifies for a figure.
+const char* CertifiedQuantity(const std::string& figure) {
+  if (figure == "P_S") return "diameter";
+  if (figure == "SD") return "centre distance";
+  return "flatness";
+}
+
+// Why figure f is not determined: what the fit reads (the points' coverage
+// and scatter), what the certificate allows, and what would help.
+std::string UndeterminedText(const Figure& f, const ArtifactEvaluation& e, const std::string& coverage,
+                             double coverage_factor, double limit_mm, const VerifyOptions& o) {
+  const double fit_mm = f.fit_standard_uncertainty_mm.value_or(0.0);
+  const double certificate_mm = f.certificate_standard_uncertainty_mm.value_or(0.0);
+  char buf[320];
+  std::string text = f.name + " is not determined: ";
+  if (f.fit_standard_uncertainty_mm) {
+    std::snprintf(buf, sizeof buf, "%s and scatter by %.3f mm (residual std), which fits it to +-%.3f mm (1 sigma)",
+                  coverage.c_str(), e.residual_std_mm, fit_mm);
+    text += buf;
+  }
+  if (certificate_mm > 0) {
+    std::snprintf(buf, sizeof buf, "%sthe certificate gives the %s to +-%.3f mm (1 sigma: U %.3f mm at k = %g)",
+                  f.fit_standard_uncertainty_mm ? ", and " : "", CertifiedQuantity(f.name), certificate_mm,
+                  certificate_mm * coverage_factor, coverage_factor);
+    text += buf;
+    if (f.fit_standard_uncertainty_mm) {
+      std::snprintf(buf, sizeof buf, ": +-%.3f mm combined", *f.standard_uncertainty_mm);
+      text += buf;
+    }
+  }
+  std::snprintf(buf, sizeof buf, ", more than %.0f%% of its MPE (%.3f mm); ", 100 * o.max_uncertainty_fraction_of_mpe,
+                f.mpe_mm);
+  text += buf;
+  if (certificate_mm >= limit_mm) {
+    std::snprintf(
+        buf, sizeof buf,
+        "the certificate's part alone is over it: verify needs an artifact calibrated to U < %.3f mm (k = %g)",
+        limit_mm * coverage_factor, coverage_factor);
+  } else if (certificate_mm > 0 && std::isfinite(fit_mm) && fit_mm > 0 && fit_mm <= limit_mm) {
+    std::snprintf(buf, sizeof buf,
+                  "measure more of the artifact, or with less noise: with this certificate the fit must reach "
+                  "+-%.3f mm",
+                  std::sqrt(limit_mm * limit_mm - certificate_mm * certificate_mm));
+  } else {
+    std::snprintf(buf, sizeof buf, "measure more of the artifact, or with less noise");
+  }
+  return text + buf;
+}
+
+// A position whose verdict would rest on a figure the fit or the certificate
+// leaves undetermined (its standard uncertainty, both parts combined, over
 // VerifyOptions::max_uncertainty_fraction_of_mpe of its MPE: its value would
-// be the fit's noise) is refused: a PASS cannot be claimed from it. Not when
-// the position fails beyond doubt without it: another figure fails (P_F has
-// no fit uncertainty), or this one by more than twice its uncertainty
-// (|value| - 2u > MPE); such a position is judged, FAIL. A non-finite or
-// non-positive uncertainty counts as undetermined.
-void RequireDeterminedIfPassing(const ArtifactEvaluation& e, const std::string& coverage, const VerifyOptions& o,
-                                const std::string& where) {
+// be the fit's noise, or its reference not known well enough) is refused: a
+// PASS cannot be claimed from it. Not when the position fails beyond doubt
+// without it: another figure fails (P_F has no uncertainty), or this one by
+// more than twice its combined uncertainty (|value| - 2u > MPE); such a
+// position is judged, FAIL. A non-finite or non-positive fit part counts as
+// undetermined (a certificate's 0 is an exact reference).
+void RequireDeterminedIfPassing(const ArtifactEvaluation& e, const std::string& coverage, double coverage_factor,
+                                const VerifyOptions& o, const std::string& where) {
   for (const Figure& f : e.figures) {
     if (f.pass) continue;
     const double u_mm = f.standard_uncertainty_mm.value_or(0.0);
@@ -62,15 +126,10 @@ void RequireDeterminedIfPassing(const ArtifactEvaluation& e, const std::string& 
   }
   for (const Figure& f : e.figures) {
     if (!f.standard_uncertainty_mm) continue;
-    const double u_mm = *f.standard_uncertainty_mm;
-    if (u_mm > 0 && u_mm <= o.max_uncertainty_fraction_of_mpe * f.mpe_mm) continue;
-    char buf[320];
-    std::snprintf(buf, sizeof buf,
-                  "%s is not determined: %s and scatter by %.3f mm (residual std), which fits it to +-%.3f mm (1 "
-                  "sigma), more than %.0f%% of its MPE (%.3f mm); measure more of the artifact, or with less noise",
-                  f.name.c_str(), coverage.c_str(), e.residual_std_mm, u_mm, 100 * o.max_uncertainty_fraction_of_mpe,
-                  f.mpe_mm);
-    throw InputError(where, buf);
+    const double limit_mm = o.max_uncertainty_fraction_of_mpe * f.mpe_mm;
+    const bool fit_determined = !f.fit_standard_uncertainty_mm || *f.fit_standard_uncertainty_mm > 0;
+    if (fit_determined && *f.standard_uncertainty_mm <= limit_mm) continue;
+    throw InputError(where, UndeterminedText(f, e, coverage, coverage_factor, limit_mm, o));
   }
 }
 
@@ -373,9 +432,9 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       e.sphere_form_mm = {Range(fit.residuals_mm)};
       e.figures = {MakeFigure("P_F", e.sphere_form_mm[0], a.mpe.probing_form_mm),
                    MakeFigure("P_S", 2 * fit.radius_mm - a.sphere_diameter_mm, a.mpe.probing_size_mm)};
-      e.figures[1].standard_uncertainty_mm = u.diameter_std_mm;
+      SetUncertainty(&e.figures[1], u.diameter_std_mm, a.StandardUncertaintyMm(a.sphere_diameter_uncertainty_mm));
       ResidualStats(fit.residuals_mm, &e);
-      RequireDeterminedIfPassing(e, CapsText(e.sphere_cap_half_angles_deg), o, where);
+      RequireDeterminedIfPassing(e, CapsText(e.sphere_cap_half_angles_deg), a.uncertainty_coverage_factor, o, where);
       break;
     }
     case ArtifactType::kBallBar: {
@@ -484,11 +543,12 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       // distance moves with their difference along the bar.
       const Eigen::Vector3d along = bar_mm.normalized();
       const double variance_mm2 = along.dot(centers_covariance_mm2 * along);
-      e.figures[0].standard_uncertainty_mm = variance_mm2 > 0 && std::isfinite(variance_mm2)
-                                                 ? std::sqrt(variance_mm2)
-                                                 : std::numeric_limits<double>::infinity();
+      SetUncertainty(&e.figures[0],
+                     variance_mm2 > 0 && std::isfinite(variance_mm2) ? std::sqrt(variance_mm2)
+                                                                     : std::numeric_limits<double>::infinity(),
+                     a.StandardUncertaintyMm(a.center_distance_uncertainty_mm));
       ResidualStats(all_residuals, &e);
-      RequireDeterminedIfPassing(e, CapsText(e.sphere_cap_half_angles_deg), o, where);
+      RequireDeterminedIfPassing(e, CapsText(e.sphere_cap_half_angles_deg), a.uncertainty_coverage_factor, o, where);
       break;
     }
     case ArtifactType::kPlate: {
@@ -527,7 +587,11 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       e.plane_normal = fit.normal;
       e.plane_offset_mm = fit.offset_mm;
       e.figures = {MakeFigure("F", Range(fit.residuals_mm), a.mpe.flatness_mm)};
+      // F is a range of residuals: no fit covariance; the certificate's
+      // uncertainty of the plate's flatness is its uncertainty.
+      SetUncertainty(&e.figures[0], std::nullopt, a.StandardUncertaintyMm(a.flatness_uncertainty_mm));
       ResidualStats(fit.residuals_mm, &e);
+      RequireDeterminedIfPassing(e, "", a.uncertainty_coverage_factor, o, where);
       break;
     }
   }

@@ -710,6 +710,142 @@ TEST(Vdi2634, ASmallCapBallThatLeavesTheCertifiedSizeIsNamedNotLost) {
   }
 }
 
+// The certificate's uncertainty U (expanded, k = 2 unless the file says
+// otherwise) enters each figure's standard uncertainty as U / k, in
+// quadrature with the fit's: an analytic check on one cloud evaluated against
+// certificates that differ only in U and k. Truth: the 30-degree cap of the
+// test above (2000 points, 0.05 mm noise: the fit's u(D) ~0.054 mm, judged
+// with an exact reference). The points and the fit do not change with the
+// certificate, so the value and the fit's part are bit-identical, the
+// certificate's part is U / k exactly and the combined u is their hypot to
+// the last bit. The 10%-of-MPE rule (0.15 mm) then reads the combined u:
+// U 0.2 mm at k = 2 (0.1 mm) is judged, the same U at k = 1 (0.2 mm) is
+// refused for the certificate alone, and U 0.29 mm at k = 2 (0.145 mm, under
+// 0.15 mm alone) is refused because the two parts together are over it.
+TEST(Vdi2634, TheCertificatesUncertaintyAddsToTheFitsInQuadrature) {
+  const Eigen::Vector3d c(1, 2, 150), view(0.1, 0, -1);
+  std::mt19937 rng(11);
+  testing::NoisySurfaceSamples(testing::SphereCapSurface(c, view, 19.05, 15), 2000, 0.05, &rng);  // as above
+  const auto cap = testing::NoisySurfaceSamples(testing::SphereCapSurface(c, view, 19.05, 30), 2000, 0.05, &rng);
+  auto with_certificate = [](double expanded_mm, double k) {
+    Artifact a = SphereArtifact();
+    a.sphere_diameter_uncertainty_mm = expanded_mm;
+    a.uncertainty_coverage_factor = k;
+    return a;
+  };
+  const ArtifactEvaluation exact = EvaluateArtifact(with_certificate(0, 2), cap, VerifyOptions(), "cap30.ply");
+  const Figure& p0 = exact.figures[1];
+  ASSERT_EQ(p0.name, "P_S");
+  ASSERT_TRUE(p0.fit_standard_uncertainty_mm.has_value());
+  const double fit_mm = *p0.fit_standard_uncertainty_mm;
+  EXPECT_EQ(fit_mm, exact.sphere_diameter_std_mm[0]);
+  EXPECT_EQ(p0.certificate_standard_uncertainty_mm, 0.0);
+  EXPECT_EQ(p0.standard_uncertainty_mm, fit_mm);
+  EXPECT_FALSE(exact.figures[0].standard_uncertainty_mm.has_value());  // P_F: no uncertainty
+
+  const ArtifactEvaluation e = EvaluateArtifact(with_certificate(0.2, 2), cap, VerifyOptions(), "cap30.ply");
+  const Figure& p = e.figures[1];
+  EXPECT_EQ(p.value_mm, p0.value_mm);
+  EXPECT_EQ(p.fit_standard_uncertainty_mm, fit_mm);
+  EXPECT_EQ(p.certificate_standard_uncertainty_mm, 0.2 / 2);
+  EXPECT_EQ(p.standard_uncertainty_mm, std::hypot(fit_mm, 0.1));
+  EXPECT_GT(*p.standard_uncertainty_mm, 0.1);
+
+  try {
+    EvaluateArtifact(with_certificate(0.2, 1), cap, VerifyOptions(), "cap30.ply");
+    ADD_FAILURE() << "a certificate of +-0.2 mm (k = 1) carried a verdict on a 1.5 mm MPE";
+  } catch (const InputError& error) {
+    const std::string what = error.what();
+    EXPECT_EQ(what.rfind("cap30.ply: P_S is not determined", 0), 0u) << what;
+    EXPECT_NE(what.find("the certificate gives the diameter to +-0.200 mm (1 sigma: U 0.200 mm at k = 1)"),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("verify needs an artifact calibrated to U < 0.150 mm (k = 1)"), std::string::npos) << what;
+  }
+  ASSERT_GT(std::hypot(fit_mm, 0.145), 0.15);
+  try {
+    EvaluateArtifact(with_certificate(0.29, 2), cap, VerifyOptions(), "cap30.ply");
+    ADD_FAILURE() << "fit and certificate, each under 10% of the MPE, over it together, judged";
+  } catch (const InputError& error) {
+    const std::string what = error.what();
+    char combined[64];
+    std::snprintf(combined, sizeof combined, ": +-%.3f mm combined", std::hypot(fit_mm, 0.145));
+    EXPECT_NE(what.find(combined), std::string::npos) << combined << " in " << what;
+    EXPECT_NE(what.find("with this certificate the fit must reach +-0.038 mm"), std::string::npos) << what;
+  }
+}
+
+// The ball bar's SD takes the certified centre distance's U / k, the plate's
+// F the certified flatness's (F, a range of residuals, has no fit part).
+// Exact samples (the first test's), so the fit's part is rounding.
+TEST(Vdi2634, TheCentreDistanceAndFlatnessCertificatesEnterSdAndF) {
+  std::mt19937 rng(1);
+  auto bb = SphereCap({-50, 0, 0}, 12.7, {0, 0, -1}, 80, 0.2, 0, &rng);
+  const auto bb2 = SphereCap({50, 0, 0}, 12.7, {0, 0, -1}, 80, 0.2, 0, &rng);
+  bb.insert(bb.end(), bb2.begin(), bb2.end());
+  Artifact bar = BallBarArtifact();
+  bar.center_distance_uncertainty_mm = 0.003;
+  bar.sphere_diameter_uncertainty_mm = 0.5;  // a ball's diameter is not what SD is taken against
+  const Figure sd = EvaluateArtifact(bar, bb, VerifyOptions(), "bar.ply").figures[0];
+  ASSERT_TRUE(sd.fit_standard_uncertainty_mm.has_value());
+  EXPECT_LT(*sd.fit_standard_uncertainty_mm, 1e-6);
+  EXPECT_EQ(sd.certificate_standard_uncertainty_mm, 0.003 / 2);
+  EXPECT_EQ(sd.standard_uncertainty_mm, std::hypot(*sd.fit_standard_uncertainty_mm, 0.0015));
+
+  const auto plate = PlatePoints({0, 0, 5}, {0.1, -0.2, 1}, 130, 1.0, 0.05, &rng);
+  Artifact a = PlateArtifact();
+  a.flatness_uncertainty_mm = 0.002;
+  const Figure f = EvaluateArtifact(a, plate, VerifyOptions(), "plate.ply").figures[0];
+  EXPECT_FALSE(f.fit_standard_uncertainty_mm.has_value());
+  EXPECT_EQ(f.certificate_standard_uncertainty_mm, 0.001);
+  EXPECT_EQ(f.standard_uncertainty_mm, 0.001);
+  EXPECT_TRUE(f.pass);              // F of 0.05 mm noise: ~8 sigma, 0.4 mm
+  a.flatness_uncertainty_mm = 0.4;  // 0.2 mm (k = 1): over 10% of the 1.5 mm MPE
+  try {
+    EvaluateArtifact(a, plate, VerifyOptions(), "plate.ply");
+    ADD_FAILURE() << "a plate certified to +-0.4 mm (k = 2) carried a verdict on a 1.5 mm MPE";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "plate.ply: F is not determined: the certificate gives the flatness to +-0.200 mm (1 sigma: U 0.400 mm "
+              "at k = 2), more than 10% of its MPE (1.500 mm); the certificate's part alone is over it: verify needs "
+              "an artifact "
+              "calibrated to U < 0.300 mm (k = 2)");
+  }
+}
+
+// "Fails beyond doubt" (|value| - 2u > MPE) reads the combined u too. Truth:
+// exact samples of a sphere 1.6 mm and 2.0 mm too large in diameter (the
+// fit's part is rounding, so u is the certificate's U / k). With an exact
+// reference P_S 1.6 mm fails; with U 0.4 mm (u 0.2 mm, over 10% of the MPE)
+// 1.6 - 0.4 = 1.2 mm is within the MPE: the certificate could explain the
+// excess, so the position is refused, not failed; 2.0 - 0.4 = 1.6 mm is not:
+// FAIL.
+TEST(Vdi2634, ACertificateThatCouldExplainAFailureIsNotIgnored) {
+  auto sphere = [](double diameter_mm) {
+    std::mt19937 rng(1);
+    auto s = SphereCap({3, -2, 1}, diameter_mm / 2, {0, 0, -1}, 80, 0.5, 0, &rng);
+    const auto s2 = SphereCap({3, -2, 1}, diameter_mm / 2, {0, 0, 1}, 80, 0.5, 0, &rng);
+    s.insert(s.end(), s2.begin(), s2.end());
+    return s;
+  };
+  Artifact a = SphereArtifact();
+  const auto big = sphere(38.1 + 1.6);
+  const ArtifactEvaluation exact = EvaluateArtifact(a, big, VerifyOptions(), "big.ply");
+  EXPECT_NEAR(FigureOf(exact, "P_S"), 1.6, 0.005);
+  EXPECT_FALSE(exact.pass());
+  a.sphere_diameter_uncertainty_mm = 0.4;
+  try {
+    EvaluateArtifact(a, big, VerifyOptions(), "big.ply");
+    ADD_FAILURE() << "P_S 1.6 mm +- 0.2 mm failed beyond doubt against a 1.5 mm MPE";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()).rfind("big.ply: P_S is not determined", 0), 0u) << error.what();
+  }
+  const ArtifactEvaluation bigger = EvaluateArtifact(a, sphere(38.1 + 2.0), VerifyOptions(), "bigger.ply");
+  EXPECT_NEAR(FigureOf(bigger, "P_S"), 2.0, 0.005);
+  EXPECT_NEAR(bigger.figures[1].standard_uncertainty_mm.value(), 0.2, 1e-6);
+  EXPECT_FALSE(bigger.pass());
+}
+
 // --- (7) Stray points in the plate's plane. ---
 
 TEST(Vdi2634, AStrayPointInThePlatesPlaneMovesNeitherItsOutlineNorItsFigure) {
@@ -793,10 +929,28 @@ TEST(Vdi2634, TooFewPointsIsBadInput) {
 }
 
 TEST(ArtifactFile, RoundTripsAndRejectsMissingFields) {
-  const Artifact a = BallBarArtifact();
+  Artifact a = BallBarArtifact();
+  a.center_distance_uncertainty_mm = 0.003;
+  a.uncertainty_coverage_factor = 2.1;
   const Artifact back = ParseArtifactYaml(ArtifactToYaml(a), "a.yaml");
   EXPECT_EQ(back.center_distance_mm, 100.0);
   EXPECT_EQ(back.type, ArtifactType::kBallBar);
+  EXPECT_EQ(back.center_distance_uncertainty_mm, 0.003);
+  EXPECT_EQ(back.uncertainty_coverage_factor, 2.1);
+  // A file without the coverage factor (every file before it) reads k = 2.
+  const std::string sphere =
+      "format: stereorig-artifact\nversion: 1\nunits: mm\ntype: sphere\ndiameter_mm: 38.1\n"
+      "diameter_uncertainty_mm: 0.002\n";
+  EXPECT_EQ(ParseArtifactYaml(sphere, "a.yaml").uncertainty_coverage_factor, 2.0);
+  EXPECT_EQ(ParseArtifactYaml(sphere, "a.yaml").StandardUncertaintyMm(0.002), 0.001);
+  EXPECT_EQ(ParseArtifactYaml(sphere + "uncertainty_coverage_factor: 1\n", "a.yaml").uncertainty_coverage_factor, 1.0);
+  try {
+    ParseArtifactYaml(sphere + "uncertainty_coverage_factor: 0.95\n", "a.yaml");
+    ADD_FAILURE() << "a confidence level read as a coverage factor";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("uncertainty_coverage_factor: must be in [1, 10]"), std::string::npos)
+        << error.what();
+  }
   EXPECT_THROW(ParseArtifactYaml("format: stereorig-artifact\nversion: 1\nunits: mm\ntype: sphere\n", "a.yaml"),
                InputError);
   EXPECT_THROW(ParseArtifactYaml("format: stereorig-artifact\nversion: 1\nunits: mm\ntype: cube\n", "a.yaml"),
