@@ -1,6 +1,7 @@
 // `stereorig verify`: VDI/VDE 2634-2 acceptance figures from reconstructions
 // of a reference artifact, judged against the MPE. Exit 0 all pass, 1 any
-// fails, 2 bad input.
+// fails, 2 bad input or a position not judged (printed and reported all the
+// same).
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -17,8 +18,11 @@ namespace stereorig {
 
 namespace {
 
-nlohmann::json FigureJson(const Figure& f) {
-  nlohmann::json j = {{"name", f.name}, {"value_mm", f.value_mm}, {"mpe_mm", f.mpe_mm}, {"pass", f.pass}};
+// judged: false for a position not judged, whose figures are reported with
+// "pass": null.
+nlohmann::json FigureJson(const Figure& f, bool judged) {
+  nlohmann::json j = {{"name", f.name}, {"value_mm", f.value_mm}, {"mpe_mm", f.mpe_mm}, {"pass", nullptr}};
+  if (judged) j["pass"] = f.pass;
   if (f.standard_uncertainty_mm) j["standard_uncertainty_mm"] = *f.standard_uncertainty_mm;
   if (f.fit_standard_uncertainty_mm) j["fit_standard_uncertainty_mm"] = *f.fit_standard_uncertainty_mm;
   if (f.certificate_standard_uncertainty_mm) {
@@ -87,10 +91,14 @@ int RunVerify(int argc, char** argv) {
       "plate's length or width or more than the plate, is refused (exit 2). Points added by hole filling (PLY module "
       "255) are not measured and are skipped: the fit never uses the reconstruction's own shape prior. A position "
       "whose points leave P_S (sphere) or SD (ball bar) "
-      "undetermined cannot pass: it is refused (exit 2) when the figure's standard uncertainty is over "
+      "undetermined cannot pass: it is not judged (exit 2) when the figure's standard uncertainty is over "
       "10% of its MPE (a sphere's cap of ~18 deg half-angle at the demo's density fits its diameter to ~0.15 mm), "
       "unless the position fails beyond doubt anyway (another figure fails, or this one by more than twice its "
-      "uncertainty: then FAIL, exit 1). The artifact file's uncertainties are its certificate's expanded ones, U at "
+      "uncertainty: then FAIL, exit 1). A position not judged is still printed and reported in full, its pass "
+      "column '-' and a NOT JUDGED line saying why (JSON: judged false, pass null, not_judged_reason); the summary "
+      "takes the judged positions' worst, the verdict is NOT JUDGED, the report (if asked for) is written whole, "
+      "and the run exits 2 with the reason on stderr. Bad input in any cloud stops the run before anything is "
+      "printed or written. The artifact file's uncertainties are its certificate's expanded ones, U at "
       "k = 2 (or its uncertainty_coverage_factor): U / k enters P_S (diameter), SD (centre distance) and F (flatness) "
       "in quadrature with the fit's, and the rules above read the combined u. The table "
       "gives, per position, each figure's standard uncertainty (u_mm; both parts on a line of their own), the points "
@@ -99,7 +107,7 @@ int RunVerify(int argc, char** argv) {
       "standard uncertainty, the half-angle of the cap its points cover and its form (the range of its residuals; "
       "on a ball bar reported, not judged: a patch one grid period off on one ball shows there); per plate the "
       "outline of its face's dense part.\n\n"
-      "Exit codes: 0 every figure passes; 1 a figure exceeds its MPE; 2 bad input.\n\n"
+      "Exit codes: 0 every figure passes; 1 a figure exceeds its MPE; 2 bad input, or a position not judged.\n\n"
       "Example:\n  stereorig verify --artifact datasets/artifacts/sphere_38mm.yaml --cloud sphere_pos1.ply "
       "--cloud sphere_pos2.ply --report verify.json",
       "stereorig verify"};
@@ -131,7 +139,11 @@ int RunVerify(int argc, char** argv) {
     filled_skipped.push_back(measured.filled_skipped);
     positions.push_back(EvaluateArtifact(artifact, measured.points, options, cloud));
   }
+  // A position left not judged (a figure the points or the certificate leave
+  // undetermined) is still printed and reported in full, marked so; the run
+  // then exits 2, as bad input does, after the complete report is written.
   const VerifySummary summary = Summarise(positions);
+  const bool all_judged = summary.not_judged_positions.empty();
 
   std::printf("artifact: %s (%s); capture band %.1f mm\n", artifact.name.c_str(), ArtifactTypeName(artifact.type),
               positions.front().capture_band_mm);
@@ -151,12 +163,22 @@ int RunVerify(int argc, char** argv) {
                          {"capture_band_mm", e.capture_band_mm},
                          {"residual_mean_abs_mm", e.residual_mean_abs_mm},
                          {"residual_std_mm", e.residual_std_mm},
-                         {"pass", e.pass()}};
+                         {"judged", e.judged()},
+                         {"pass", nullptr}};
+    if (e.judged()) {
+      pj["pass"] = e.pass();
+    } else {
+      pj["not_judged_reason"] = e.not_judged_reason;
+    }
     for (const Figure& f : e.figures) {
       std::printf("%-8zu %-6s %10.4f %8s %7.3f %4s %8d %7d %8d %8d %8d %10.4f\n", i + 1, f.name.c_str(), f.value_mm,
-                  UncertaintyText(f).c_str(), f.mpe_mm, f.pass ? "yes" : "NO", e.points_total + filled_skipped[i],
-                  filled_skipped[i], e.points_on_artifact, e.points_excluded, e.points_used(), e.residual_mean_abs_mm);
-      pj["figures"].push_back(FigureJson(f));
+                  UncertaintyText(f).c_str(), f.mpe_mm,
+                  !e.judged() ? "-"
+                  : f.pass    ? "yes"
+                              : "NO",
+                  e.points_total + filled_skipped[i], filled_skipped[i], e.points_on_artifact, e.points_excluded,
+                  e.points_used(), e.residual_mean_abs_mm);
+      pj["figures"].push_back(FigureJson(f, e.judged()));
     }
     for (const Figure& f : e.figures) PrintUncertainty(i + 1, f, artifact.uncertainty_coverage_factor);
     PrintSpheres(i + 1, e);
@@ -167,21 +189,50 @@ int RunVerify(int argc, char** argv) {
       pj["plate_outline_mm"] = {e.plate_outline_length_mm, e.plate_outline_width_mm};
       pj["plate_points_off_outline"] = e.plate_points_off_outline;
     }
+    if (!e.judged()) std::printf("%-8zu NOT JUDGED: %s\n", i + 1, e.not_judged_reason.c_str());
     report["positions"].push_back(pj);
   }
   std::printf(
       "u_mm = the figure's standard uncertainty (k = 1): the fit's (its covariance) and the certificate's (U / k) "
       "in quadrature; points: cloud = all vertices; "
       "filled = added by hole filling (module 255), skipped; artifact = within the capture band; excluded = the "
-      "largest residuals (<= 0.3%%); used = in the figures\n");
-  std::printf("summary over %zu position(s):", positions.size());
+      "largest residuals (<= 0.3%%); used = in the figures; pass - = not judged (the line NOT JUDGED says why)\n");
+  const size_t judged = positions.size() - summary.not_judged_positions.size();
+  if (all_judged) {
+    std::printf("summary over %zu position(s):", positions.size());
+  } else if (judged == 0) {
+    std::printf("summary: no position judged");
+  } else {
+    std::printf("summary over the %zu judged of %zu position(s):", judged, positions.size());
+  }
+  report["summary"]["worst"] = nlohmann::json::array();
   for (const Figure& f : summary.worst) {
     std::printf("  %s %.4f mm (MPE %.3f) %s", f.name.c_str(), f.value_mm, f.mpe_mm, f.pass ? "pass" : "FAIL");
-    report["summary"]["worst"].push_back(FigureJson(f));
+    report["summary"]["worst"].push_back(FigureJson(f, true));
   }
-  std::printf("\nverdict: %s\n", summary.pass ? "PASS" : "FAIL");
+  const char* verdict = !all_judged ? "NOT JUDGED" : summary.pass ? "PASS" : "FAIL";
+  std::printf("\nverdict: %s", verdict);
+  report["summary"]["verdict"] = verdict;
   report["summary"]["pass"] = summary.pass;
+  report["summary"]["positions_not_judged"] = nlohmann::json::array();
+  for (int k : summary.not_judged_positions) {
+    report["summary"]["positions_not_judged"].push_back(k + 1);  // numbered as in the table
+    std::printf("%s%d", k == summary.not_judged_positions.front() ? " (position " : ", ", k + 1);
+  }
+  std::printf("%s\n", all_judged ? "" : ": a figure left undetermined; exit 2)");
   if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
+  if (!all_judged) {
+    // One line on stderr, as for bad input: the first position's reason.
+    const int first = summary.not_judged_positions.front();
+    std::string problem = positions[first].not_judged_reason;
+    if (summary.not_judged_positions.size() > 1) {
+      char more[96];
+      std::snprintf(more, sizeof more, " (and %zu more position(s) not judged: the table says why)",
+                    summary.not_judged_positions.size() - 1);
+      problem += more;
+    }
+    throw InputError(clouds[first], problem);
+  }
   return summary.pass ? kExitOk : kExitCheckFailed;
 }
 

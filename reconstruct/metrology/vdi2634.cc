@@ -36,7 +36,7 @@ void VerifyOptions::Check() const {
 }
 
 bool ArtifactEvaluation::pass() const {
-  return std::all_of(figures.begin(), figures.end(), [](const Figure& f) { return f.pass; });
+  return judged() && std::all_of(figures.begin(), figures.end(), [](const Figure& f) { return f.pass; });
 }
 
 namespace {
@@ -108,29 +108,31 @@ std::string UndeterminedText(const Figure& f, const ArtifactEvaluation& e, const
   return text + buf;
 }
 
-// A position whose verdict would rest on a figure the fit or the certificate
-// leaves undetermined (its standard uncertainty, both parts combined, over
-// VerifyOptions::max_uncertainty_fraction_of_mpe of its MPE: its value would
-// be the fit's noise, or its reference not known well enough) is refused: a
-// PASS cannot be claimed from it. Not when the position fails beyond doubt
-// without it: another figure fails (P_F has no uncertainty), or this one by
-// more than twice its combined uncertainty (|value| - 2u > MPE); such a
-// position is judged, FAIL. A non-finite or non-positive fit part counts as
-// undetermined (a certificate's 0 is an exact reference).
-void RequireDeterminedIfPassing(const ArtifactEvaluation& e, const std::string& coverage, double coverage_factor,
-                                const VerifyOptions& o, const std::string& where) {
+// Why a position whose verdict would rest on a figure the fit or the
+// certificate leaves undetermined (its standard uncertainty, both parts
+// combined, over VerifyOptions::max_uncertainty_fraction_of_mpe of its MPE:
+// its value would be the fit's noise, or its reference not known well enough)
+// is not judged: a PASS cannot be claimed from it. Empty when the position
+// fails beyond doubt without it: another figure fails (P_F has no
+// uncertainty), or this one by more than twice its combined uncertainty
+// (|value| - 2u > MPE); such a position is judged, FAIL. A non-finite or
+// non-positive fit part counts as undetermined (a certificate's 0 is an exact
+// reference).
+std::string NotJudgedReason(const ArtifactEvaluation& e, const std::string& coverage, double coverage_factor,
+                            const VerifyOptions& o) {
   for (const Figure& f : e.figures) {
     if (f.pass) continue;
     const double u_mm = f.standard_uncertainty_mm.value_or(0.0);
-    if (std::isfinite(u_mm) && std::abs(f.value_mm) - 2 * u_mm > f.mpe_mm) return;  // fails beyond doubt
+    if (std::isfinite(u_mm) && std::abs(f.value_mm) - 2 * u_mm > f.mpe_mm) return "";  // fails beyond doubt
   }
   for (const Figure& f : e.figures) {
     if (!f.standard_uncertainty_mm) continue;
     const double limit_mm = o.max_uncertainty_fraction_of_mpe * f.mpe_mm;
     const bool fit_determined = !f.fit_standard_uncertainty_mm || *f.fit_standard_uncertainty_mm > 0;
     if (fit_determined && *f.standard_uncertainty_mm <= limit_mm) continue;
-    throw InputError(where, UndeterminedText(f, e, coverage, coverage_factor, limit_mm, o));
+    return UndeterminedText(f, e, coverage, coverage_factor, limit_mm, o);
   }
+  return "";
 }
 
 std::string CapsText(const std::vector<double>& cap_half_angles_deg) {
@@ -434,7 +436,8 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
                    MakeFigure("P_S", 2 * fit.radius_mm - a.sphere_diameter_mm, a.mpe.probing_size_mm)};
       SetUncertainty(&e.figures[1], u.diameter_std_mm, a.StandardUncertaintyMm(a.sphere_diameter_uncertainty_mm));
       ResidualStats(fit.residuals_mm, &e);
-      RequireDeterminedIfPassing(e, CapsText(e.sphere_cap_half_angles_deg), a.uncertainty_coverage_factor, o, where);
+      e.not_judged_reason =
+          NotJudgedReason(e, CapsText(e.sphere_cap_half_angles_deg), a.uncertainty_coverage_factor, o);
       break;
     }
     case ArtifactType::kBallBar: {
@@ -548,7 +551,8 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
                                                                      : std::numeric_limits<double>::infinity(),
                      a.StandardUncertaintyMm(a.center_distance_uncertainty_mm));
       ResidualStats(all_residuals, &e);
-      RequireDeterminedIfPassing(e, CapsText(e.sphere_cap_half_angles_deg), a.uncertainty_coverage_factor, o, where);
+      e.not_judged_reason =
+          NotJudgedReason(e, CapsText(e.sphere_cap_half_angles_deg), a.uncertainty_coverage_factor, o);
       break;
     }
     case ArtifactType::kPlate: {
@@ -591,7 +595,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       // uncertainty of the plate's flatness is its uncertainty.
       SetUncertainty(&e.figures[0], std::nullopt, a.StandardUncertaintyMm(a.flatness_uncertainty_mm));
       ResidualStats(fit.residuals_mm, &e);
-      RequireDeterminedIfPassing(e, "", a.uncertainty_coverage_factor, o, where);
+      e.not_judged_reason = NotJudgedReason(e, "", a.uncertainty_coverage_factor, o);
       break;
     }
   }
@@ -601,13 +605,18 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
 VerifySummary Summarise(const std::vector<ArtifactEvaluation>& positions) {
   VerifySummary s;
   std::map<std::string, Figure> worst;
-  for (const auto& p : positions) {
+  for (size_t i = 0; i < positions.size(); ++i) {
+    const ArtifactEvaluation& p = positions[i];
+    if (!p.judged()) {
+      s.not_judged_positions.push_back(static_cast<int>(i));
+      continue;
+    }
     for (const Figure& f : p.figures) {
       auto it = worst.find(f.name);
       if (it == worst.end() || std::abs(f.value_mm) > std::abs(it->second.value_mm)) worst[f.name] = f;
     }
   }
-  s.pass = !positions.empty();
+  s.pass = !positions.empty() && s.not_judged_positions.empty();
   for (const auto& [name, f] : worst) {
     s.worst.push_back(f);
     s.pass = s.pass && f.pass;

@@ -120,23 +120,33 @@ struct ArtifactEvaluation {
   int plate_points_off_outline = 0;
   Eigen::Vector3d plane_normal = Eigen::Vector3d::Zero();
   double plane_offset_mm = 0;
-  bool pass() const;
+  // Empty when the position is judged. Otherwise why it is not: a figure the
+  // points or the certificate leave undetermined where the position would
+  // otherwise pass (VerifyOptions::max_uncertainty_fraction_of_mpe; the text
+  // names the figure, its uncertainty and what would help). Its figures are
+  // all filled in, to be reported, not judged.
+  std::string not_judged_reason;
+  bool judged() const { return not_judged_reason.empty(); }
+  bool pass() const;  // judged, and every figure within its MPE
 };
 
 // Throws InputError(`where`, ...) when the cloud has too few points on the
 // artifact, the artifact cannot be found in it, what is found does not
 // cover the certified artifact plausibly (a sphere or ball whose free-radius
 // fit leaves the certified size or does not converge: the message names the
-// ball, both diameters and the cap its points cover), or the points or the
-// certificate leave P_S, SD or F undetermined (max_uncertainty_fraction_of_mpe)
-// where the position would otherwise pass.
+// ball, both diameters and the cap its points cover). Points or a
+// certificate that leave P_S, SD or F undetermined where the position would
+// otherwise pass are no error: the evaluation comes back with every figure
+// and not_judged_reason set.
 ArtifactEvaluation EvaluateArtifact(const Artifact& artifact, const std::vector<Eigen::Vector3d>& points_mm,
                                     const VerifyOptions& options, const std::string& where);
 
-// Several positions of the same artifact: per figure, the worst |value|.
+// Several positions of the same artifact: per figure, the worst |value| of
+// the judged positions. No PASS is claimed while a position is not judged.
 struct VerifySummary {
-  std::vector<Figure> worst;  // one per figure name, the position with the largest |value|
-  bool pass = false;
+  std::vector<Figure> worst;              // one per figure name, the judged position with the largest |value|
+  std::vector<int> not_judged_positions;  // indices into the positions given
+  bool pass = false;                      // every position judged, and every figure within its MPE
 };
 VerifySummary Summarise(const std::vector<ArtifactEvaluation>& positions);
 
