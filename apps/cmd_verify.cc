@@ -1,7 +1,8 @@
 // `stereorig verify`: VDI/VDE 2634-2 acceptance figures from reconstructions
 // of a reference artifact, judged against the MPE. Exit 0 all pass, 1 any
-// fails, 2 bad input or a position not judged (printed and reported all the
-// same).
+// judged position fails, 2 bad input or (with no failure) a position not
+// judged (printed all the same; no report written).
+#include <algorithm>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -95,9 +96,10 @@ int RunVerify(int argc, char** argv) {
       "10% of its MPE (a sphere's cap of ~18 deg half-angle at the demo's density fits its diameter to ~0.15 mm), "
       "unless the position fails beyond doubt anyway (another figure fails, or this one by more than twice its "
       "uncertainty: then FAIL, exit 1). A position not judged is still printed and reported in full, its pass "
-      "column '-' and a NOT JUDGED line saying why (JSON: judged false, pass null, not_judged_reason); the summary "
-      "takes the judged positions' worst, the verdict is NOT JUDGED, the report (if asked for) is written whole, "
-      "and the run exits 2 with the reason on stderr. Bad input in any cloud stops the run before anything is "
+      "column '-' and a NOT JUDGED line saying why; the summary takes the judged positions' worst. If a judged "
+      "position fails, the verdict is FAIL (exit 1) and the report lists the positions not judged (judged false, "
+      "pass null, not_judged_reason); otherwise the verdict is NOT JUDGED and the run exits 2 with the reason on "
+      "stderr, writing no report, as for bad input. Bad input in any cloud stops the run before anything is "
       "printed or written. The artifact file's uncertainties are its certificate's expanded ones, U at "
       "k = 2 (or its uncertainty_coverage_factor): U / k enters P_S (diameter), SD (centre distance) and F (flatness) "
       "in quadrature with the fit's, and the rules above read the combined u. The table "
@@ -107,7 +109,8 @@ int RunVerify(int argc, char** argv) {
       "standard uncertainty, the half-angle of the cap its points cover and its form (the range of its residuals; "
       "on a ball bar reported, not judged: a patch one grid period off on one ball shows there); per plate the "
       "outline of its face's dense part.\n\n"
-      "Exit codes: 0 every figure passes; 1 a figure exceeds its MPE; 2 bad input, or a position not judged.\n\n"
+      "Exit codes: 0 every figure passes; 1 a figure of a judged position exceeds its MPE; 2 bad input, or a "
+      "position not judged (and none failed).\n\n"
       "Example:\n  stereorig verify --artifact datasets/artifacts/sphere_38mm.yaml --cloud sphere_pos1.ply "
       "--cloud sphere_pos2.ply --report verify.json",
       "stereorig verify"};
@@ -140,10 +143,15 @@ int RunVerify(int argc, char** argv) {
     positions.push_back(EvaluateArtifact(artifact, measured.points, options, cloud));
   }
   // A position left not judged (a figure the points or the certificate leave
-  // undetermined) is still printed and reported in full, marked so; the run
-  // then exits 2, as bad input does, after the complete report is written.
+  // undetermined) is still printed in full, marked so. A judged position that
+  // fails fails the acceptance test whatever the others say: FAIL, exit 1,
+  // the report written. Otherwise the run is not judged: exit 2 with the
+  // reason on stderr and, as for bad input, no report written (an earlier
+  // one at that path stays as it was: docs/formats.md).
   const VerifySummary summary = Summarise(positions);
   const bool all_judged = summary.not_judged_positions.empty();
+  const bool judged_failure = std::any_of(positions.begin(), positions.end(),
+                                          [](const ArtifactEvaluation& e) { return e.judged() && !e.pass(); });
 
   std::printf("artifact: %s (%s); capture band %.1f mm\n", artifact.name.c_str(), ArtifactTypeName(artifact.type),
               positions.front().capture_band_mm);
@@ -210,7 +218,7 @@ int RunVerify(int argc, char** argv) {
     std::printf("  %s %.4f mm (MPE %.3f) %s", f.name.c_str(), f.value_mm, f.mpe_mm, f.pass ? "pass" : "FAIL");
     report["summary"]["worst"].push_back(FigureJson(f, true));
   }
-  const char* verdict = !all_judged ? "NOT JUDGED" : summary.pass ? "PASS" : "FAIL";
+  const char* verdict = judged_failure ? "FAIL" : !all_judged ? "NOT JUDGED" : "PASS";
   std::printf("\nverdict: %s", verdict);
   report["summary"]["verdict"] = verdict;
   report["summary"]["pass"] = summary.pass;
@@ -219,9 +227,11 @@ int RunVerify(int argc, char** argv) {
     report["summary"]["positions_not_judged"].push_back(k + 1);  // numbered as in the table
     std::printf("%s%d", k == summary.not_judged_positions.front() ? " (position " : ", ", k + 1);
   }
-  std::printf("%s\n", all_judged ? "" : ": a figure left undetermined; exit 2)");
-  if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
-  if (!all_judged) {
+  std::printf("%s\n", all_judged       ? ""
+                      : judged_failure ? " not judged: a figure left undetermined)"
+                                       : ": a figure left undetermined; exit 2, no report written)");
+  if (!report_path.empty() && (all_judged || judged_failure)) WriteFileAtomically(report_path, report.dump(2) + "\n");
+  if (!all_judged && !judged_failure) {
     // One line on stderr, as for bad input: the first position's reason.
     const int first = summary.not_judged_positions.front();
     std::string problem = positions[first].not_judged_reason;

@@ -114,8 +114,12 @@ std::string ArtifactToYaml(const Artifact& a) {
         << "flatness_uncertainty_mm: " << FormatDouble(a.flatness_uncertainty_mm) << "\n";
       break;
   }
-  o << "uncertainty_coverage_factor: " << FormatDouble(a.uncertainty_coverage_factor)
-    << "   # k of the expanded uncertainties above (U = k u)\n";
+  // Only where it is not the default k = 2: a file without the key reads the
+  // same here and in builds that predate it (which refuse an unknown key).
+  if (a.uncertainty_coverage_factor != 2.0) {
+    o << "uncertainty_coverage_factor: " << FormatDouble(a.uncertainty_coverage_factor)
+      << "   # k of the expanded uncertainties above (U = k u)\n";
+  }
   o << "mpe_mm: {P_F: " << FormatDouble(a.mpe.probing_form_mm) << ", P_S: " << FormatDouble(a.mpe.probing_size_mm)
     << ", SD: " << FormatDouble(a.mpe.sphere_spacing_mm) << ", F: " << FormatDouble(a.mpe.flatness_mm) << "}\n";
   return o.str();

@@ -787,6 +787,7 @@ TEST(Vdi2634, TheCertificatesUncertaintyAddsToTheFitsInQuadrature) {
   EXPECT_EQ(p.certificate_standard_uncertainty_mm, 0.2 / 2);
   EXPECT_EQ(p.standard_uncertainty_mm, std::hypot(fit_mm, 0.1));
   EXPECT_GT(*p.standard_uncertainty_mm, 0.1);
+  EXPECT_TRUE(e.judged()) << e.not_judged_reason;  // hypot(0.054, 0.1) = 0.114 mm: under the 0.15 mm limit
 
   {
     const std::string what =
@@ -827,6 +828,8 @@ TEST(Vdi2634, TheCentreDistanceAndFlatnessCertificatesEnterSdAndF) {
 
   const auto plate = PlatePoints({0, 0, 5}, {0.1, -0.2, 1}, 130, 1.0, 0.05, &rng);
   Artifact a = PlateArtifact();
+  a.flatness_uncertainty_mm = 0;  // an exact reference: F has no uncertainty to report, not 0
+  EXPECT_FALSE(EvaluateArtifact(a, plate, VerifyOptions(), "plate.ply").figures[0].standard_uncertainty_mm);
   a.flatness_uncertainty_mm = 0.002;
   const Figure f = EvaluateArtifact(a, plate, VerifyOptions(), "plate.ply").figures[0];
   EXPECT_FALSE(f.fit_standard_uncertainty_mm.has_value());
@@ -834,10 +837,11 @@ TEST(Vdi2634, TheCentreDistanceAndFlatnessCertificatesEnterSdAndF) {
   EXPECT_EQ(f.standard_uncertainty_mm, 0.001);
   EXPECT_TRUE(f.pass);              // F of 0.05 mm noise: ~8 sigma, 0.4 mm
   a.flatness_uncertainty_mm = 0.4;  // 0.2 mm (k = 1): over 10% of the 1.5 mm MPE
-  EXPECT_EQ(NotJudgedReason(EvaluateArtifact(a, plate, VerifyOptions(), "plate.ply")),
-            "F is not determined: the certificate gives the flatness to +-0.200 mm (1 sigma: U 0.400 mm at k = 2), "
-            "more than 10% of its MPE (1.500 mm); the certificate's part alone is over it: verify needs an artifact "
-            "calibrated to U < 0.300 mm (k = 2)");
+  EXPECT_EQ(
+      NotJudgedReason(EvaluateArtifact(a, plate, VerifyOptions(), "plate.ply")),
+      "F is not determined: the certificate gives the flatness to +-0.200 mm (1 sigma: U 0.400 mm at k = 2), "
+      "more than 10% of its MPE (1.500 mm); the certificate's part alone is at or over it: verify needs an artifact "
+      "calibrated to U < 0.300 mm (k = 2)");
 }
 
 // "Fails beyond doubt" (|value| - 2u > MPE) reads the combined u too. Truth:
