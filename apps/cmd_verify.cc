@@ -1,6 +1,8 @@
 // `stereorig verify`: VDI/VDE 2634-2 acceptance figures from reconstructions
 // of a reference artifact, judged against the MPE. Exit 0 all pass, 1 any
-// fails, 2 bad input.
+// judged position fails, 2 bad input or (with no failure) a position not
+// judged (printed all the same; no report written).
+#include <algorithm>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -17,10 +19,28 @@ namespace stereorig {
 
 namespace {
 
-nlohmann::json FigureJson(const Figure& f) {
-  nlohmann::json j = {{"name", f.name}, {"value_mm", f.value_mm}, {"mpe_mm", f.mpe_mm}, {"pass", f.pass}};
+// judged: false for a position not judged, whose figures are reported with
+// "pass": null.
+nlohmann::json FigureJson(const Figure& f, bool judged) {
+  nlohmann::json j = {{"name", f.name}, {"value_mm", f.value_mm}, {"mpe_mm", f.mpe_mm}, {"pass", nullptr}};
+  if (judged) j["pass"] = f.pass;
   if (f.standard_uncertainty_mm) j["standard_uncertainty_mm"] = *f.standard_uncertainty_mm;
+  if (f.fit_standard_uncertainty_mm) j["fit_standard_uncertainty_mm"] = *f.fit_standard_uncertainty_mm;
+  if (f.certificate_standard_uncertainty_mm) {
+    j["certificate_standard_uncertainty_mm"] = *f.certificate_standard_uncertainty_mm;
+  }
   return j;
+}
+
+// A figure's u and its parts: the fit's and the certificate's (U / k),
+// combined in quadrature.
+void PrintUncertainty(size_t position, const Figure& f, double coverage_factor) {
+  if (!f.standard_uncertainty_mm) return;
+  const double certificate_mm = f.certificate_standard_uncertainty_mm.value_or(0.0);
+  char fit[64] = "no fit part: a range of residuals";
+  if (f.fit_standard_uncertainty_mm) std::snprintf(fit, sizeof fit, "fit %.4f mm", *f.fit_standard_uncertainty_mm);
+  std::printf("%-8zu %s: u %.4f mm = %s (+) certificate %.4f mm (U %.4f mm / k %g)\n", position, f.name.c_str(),
+              *f.standard_uncertainty_mm, fit, certificate_mm, certificate_mm * coverage_factor, coverage_factor);
 }
 
 // Each fitted sphere (1 for a sphere, 2 for a ball bar): its size, how much
@@ -72,16 +92,25 @@ int RunVerify(int argc, char** argv) {
       "plate's length or width or more than the plate, is refused (exit 2). Points added by hole filling (PLY module "
       "255) are not measured and are skipped: the fit never uses the reconstruction's own shape prior. A position "
       "whose points leave P_S (sphere) or SD (ball bar) "
-      "undetermined cannot pass: it is refused (exit 2) when the figure's standard uncertainty from the fit is over "
+      "undetermined cannot pass: it is not judged (exit 2) when the figure's standard uncertainty is over "
       "10% of its MPE (a sphere's cap of ~18 deg half-angle at the demo's density fits its diameter to ~0.15 mm), "
       "unless the position fails beyond doubt anyway (another figure fails, or this one by more than twice its "
-      "uncertainty: then FAIL, exit 1). The table "
-      "gives, per position, each figure's standard uncertainty (u_mm), the points in the cloud, the filled ones "
+      "uncertainty: then FAIL, exit 1). A position not judged is still printed and reported in full, its pass "
+      "column '-' and a NOT JUDGED line saying why; the summary takes the judged positions' worst. If a judged "
+      "position fails, the verdict is FAIL (exit 1) and the report lists the positions not judged (judged false, "
+      "pass null, not_judged_reason); otherwise the verdict is NOT JUDGED and the run exits 2 with the reason on "
+      "stderr, writing no report, as for bad input. Bad input in any cloud stops the run before anything is "
+      "printed or written. The artifact file's uncertainties are its certificate's expanded ones, U at "
+      "k = 2 (or its uncertainty_coverage_factor): U / k enters P_S (diameter), SD (centre distance) and F (flatness) "
+      "in quadrature with the fit's, and the rules above read the combined u. The table "
+      "gives, per position, each figure's standard uncertainty (u_mm; both parts on a line of their own), the points "
+      "in the cloud, the filled ones "
       "skipped, those on the artifact, those excluded and those used, and per sphere its diameter, the diameter's "
       "standard uncertainty, the half-angle of the cap its points cover and its form (the range of its residuals; "
       "on a ball bar reported, not judged: a patch one grid period off on one ball shows there); per plate the "
       "outline of its face's dense part.\n\n"
-      "Exit codes: 0 every figure passes; 1 a figure exceeds its MPE; 2 bad input.\n\n"
+      "Exit codes: 0 every figure passes; 1 a figure of a judged position exceeds its MPE; 2 bad input, or a "
+      "position not judged (and none failed).\n\n"
       "Example:\n  stereorig verify --artifact datasets/artifacts/sphere_38mm.yaml --cloud sphere_pos1.ply "
       "--cloud sphere_pos2.ply --report verify.json",
       "stereorig verify"};
@@ -113,13 +142,24 @@ int RunVerify(int argc, char** argv) {
     filled_skipped.push_back(measured.filled_skipped);
     positions.push_back(EvaluateArtifact(artifact, measured.points, options, cloud));
   }
+  // A position left not judged (a figure the points or the certificate leave
+  // undetermined) is still printed in full, marked so. A judged position that
+  // fails fails the acceptance test whatever the others say: FAIL, exit 1,
+  // the report written. Otherwise the run is not judged: exit 2 with the
+  // reason on stderr and, as for bad input, no report written (an earlier
+  // one at that path stays as it was: docs/formats.md).
   const VerifySummary summary = Summarise(positions);
+  const bool all_judged = summary.not_judged_positions.empty();
+  const bool judged_failure = std::any_of(positions.begin(), positions.end(),
+                                          [](const ArtifactEvaluation& e) { return e.judged() && !e.pass(); });
 
   std::printf("artifact: %s (%s); capture band %.1f mm\n", artifact.name.c_str(), ArtifactTypeName(artifact.type),
               positions.front().capture_band_mm);
   std::printf("%-8s %-6s %10s %8s %7s %4s %8s %7s %8s %8s %8s %10s\n", "position", "figure", "value_mm", "u_mm",
               "mpe_mm", "pass", "cloud", "filled", "artifact", "excluded", "used", "mean|e|_mm");
-  nlohmann::json report = {{"artifact", artifact.name}, {"type", ArtifactTypeName(artifact.type)}};
+  nlohmann::json report = {{"artifact", artifact.name},
+                           {"type", ArtifactTypeName(artifact.type)},
+                           {"uncertainty_coverage_factor", artifact.uncertainty_coverage_factor}};
   for (size_t i = 0; i < positions.size(); ++i) {
     const ArtifactEvaluation& e = positions[i];
     nlohmann::json pj = {{"cloud", clouds[i]},
@@ -131,13 +171,24 @@ int RunVerify(int argc, char** argv) {
                          {"capture_band_mm", e.capture_band_mm},
                          {"residual_mean_abs_mm", e.residual_mean_abs_mm},
                          {"residual_std_mm", e.residual_std_mm},
-                         {"pass", e.pass()}};
+                         {"judged", e.judged()},
+                         {"pass", nullptr}};
+    if (e.judged()) {
+      pj["pass"] = e.pass();
+    } else {
+      pj["not_judged_reason"] = e.not_judged_reason;
+    }
     for (const Figure& f : e.figures) {
       std::printf("%-8zu %-6s %10.4f %8s %7.3f %4s %8d %7d %8d %8d %8d %10.4f\n", i + 1, f.name.c_str(), f.value_mm,
-                  UncertaintyText(f).c_str(), f.mpe_mm, f.pass ? "yes" : "NO", e.points_total + filled_skipped[i],
-                  filled_skipped[i], e.points_on_artifact, e.points_excluded, e.points_used(), e.residual_mean_abs_mm);
-      pj["figures"].push_back(FigureJson(f));
+                  UncertaintyText(f).c_str(), f.mpe_mm,
+                  !e.judged() ? "-"
+                  : f.pass    ? "yes"
+                              : "NO",
+                  e.points_total + filled_skipped[i], filled_skipped[i], e.points_on_artifact, e.points_excluded,
+                  e.points_used(), e.residual_mean_abs_mm);
+      pj["figures"].push_back(FigureJson(f, e.judged()));
     }
+    for (const Figure& f : e.figures) PrintUncertainty(i + 1, f, artifact.uncertainty_coverage_factor);
     PrintSpheres(i + 1, e);
     if (!e.sphere_centers_mm.empty()) pj["spheres"] = SpheresJson(e);
     if (e.type == ArtifactType::kPlate) {
@@ -146,20 +197,52 @@ int RunVerify(int argc, char** argv) {
       pj["plate_outline_mm"] = {e.plate_outline_length_mm, e.plate_outline_width_mm};
       pj["plate_points_off_outline"] = e.plate_points_off_outline;
     }
+    if (!e.judged()) std::printf("%-8zu NOT JUDGED: %s\n", i + 1, e.not_judged_reason.c_str());
     report["positions"].push_back(pj);
   }
   std::printf(
-      "u_mm = the figure's standard uncertainty (k = 1) from the fit's covariance; points: cloud = all vertices; "
+      "u_mm = the figure's standard uncertainty (k = 1): the fit's (its covariance) and the certificate's (U / k) "
+      "in quadrature; points: cloud = all vertices; "
       "filled = added by hole filling (module 255), skipped; artifact = within the capture band; excluded = the "
-      "largest residuals (<= 0.3%%); used = in the figures\n");
-  std::printf("summary over %zu position(s):", positions.size());
+      "largest residuals (<= 0.3%%); used = in the figures; pass - = not judged (the line NOT JUDGED says why)\n");
+  const size_t judged = positions.size() - summary.not_judged_positions.size();
+  if (all_judged) {
+    std::printf("summary over %zu position(s):", positions.size());
+  } else if (judged == 0) {
+    std::printf("summary: no position judged");
+  } else {
+    std::printf("summary over the %zu judged of %zu position(s):", judged, positions.size());
+  }
+  report["summary"]["worst"] = nlohmann::json::array();
   for (const Figure& f : summary.worst) {
     std::printf("  %s %.4f mm (MPE %.3f) %s", f.name.c_str(), f.value_mm, f.mpe_mm, f.pass ? "pass" : "FAIL");
-    report["summary"]["worst"].push_back(FigureJson(f));
+    report["summary"]["worst"].push_back(FigureJson(f, true));
   }
-  std::printf("\nverdict: %s\n", summary.pass ? "PASS" : "FAIL");
+  const char* verdict = judged_failure ? "FAIL" : !all_judged ? "NOT JUDGED" : "PASS";
+  std::printf("\nverdict: %s", verdict);
+  report["summary"]["verdict"] = verdict;
   report["summary"]["pass"] = summary.pass;
-  if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
+  report["summary"]["positions_not_judged"] = nlohmann::json::array();
+  for (int k : summary.not_judged_positions) {
+    report["summary"]["positions_not_judged"].push_back(k + 1);  // numbered as in the table
+    std::printf("%s%d", k == summary.not_judged_positions.front() ? " (position " : ", ", k + 1);
+  }
+  std::printf("%s\n", all_judged       ? ""
+                      : judged_failure ? " not judged: a figure left undetermined)"
+                                       : ": a figure left undetermined; exit 2, no report written)");
+  if (!report_path.empty() && (all_judged || judged_failure)) WriteFileAtomically(report_path, report.dump(2) + "\n");
+  if (!all_judged && !judged_failure) {
+    // One line on stderr, as for bad input: the first position's reason.
+    const int first = summary.not_judged_positions.front();
+    std::string problem = positions[first].not_judged_reason;
+    if (summary.not_judged_positions.size() > 1) {
+      char more[96];
+      std::snprintf(more, sizeof more, " (and %zu more position(s) not judged: the table says why)",
+                    summary.not_judged_positions.size() - 1);
+      problem += more;
+    }
+    throw InputError(clouds[first], problem);
+  }
   return summary.pass ? kExitOk : kExitCheckFailed;
 }
 

@@ -63,6 +63,11 @@ Artifact Parse(YamlMap m) {
   } else {
     throw InputError(m.Where("type"), "expected sphere, ballbar or plate, got '" + type + "'");
   }
+  a.uncertainty_coverage_factor = m.GetDouble("uncertainty_coverage_factor", a.uncertainty_coverage_factor);
+  if (!(a.uncertainty_coverage_factor >= 1 && a.uncertainty_coverage_factor <= 10)) {
+    throw InputError(m.Where("uncertainty_coverage_factor"),
+                     "must be in [1, 10]: the certificate's k (U = k u, usually 2), not a confidence level");
+  }
   if (m.Has("mpe_mm")) {
     YamlMap e = m.GetMap("mpe_mm");
     a.mpe.probing_form_mm = e.GetDouble("P_F", a.mpe.probing_form_mm);
@@ -108,6 +113,12 @@ std::string ArtifactToYaml(const Artifact& a) {
         << "width_mm: " << FormatDouble(a.plate_width_mm) << "\n"
         << "flatness_uncertainty_mm: " << FormatDouble(a.flatness_uncertainty_mm) << "\n";
       break;
+  }
+  // Only where it is not the default k = 2: a file without the key reads the
+  // same here and in builds that predate it (which refuse an unknown key).
+  if (a.uncertainty_coverage_factor != 2.0) {
+    o << "uncertainty_coverage_factor: " << FormatDouble(a.uncertainty_coverage_factor)
+      << "   # k of the expanded uncertainties above (U = k u)\n";
   }
   o << "mpe_mm: {P_F: " << FormatDouble(a.mpe.probing_form_mm) << ", P_S: " << FormatDouble(a.mpe.probing_size_mm)
     << ", SD: " << FormatDouble(a.mpe.sphere_spacing_mm) << ", F: " << FormatDouble(a.mpe.flatness_mm) << "}\n";

@@ -18,17 +18,29 @@ struct MaximumPermissibleErrors {
   double flatness_mm = 1.5;        // F
 };
 
+// The certificate's uncertainties (*_uncertainty_mm) are expanded
+// uncertainties U, as calibration certificates state them (ISO/IEC 17025,
+// GUM): U = k u with the coverage factor k the certificate gives, usually 2
+// (~95%). verify combines their standard uncertainties U / k with the fit's
+// (vdi2634.h). An absent uncertainty reads 0: the reference taken as exact.
 struct Artifact {
   std::string name;  // e.g. a serial number
   ArtifactType type = ArtifactType::kSphere;
   double sphere_diameter_mm = 0;              // sphere, and each ball of a ball bar
-  double sphere_diameter_uncertainty_mm = 0;  // certified, k = 2
+  double sphere_diameter_uncertainty_mm = 0;  // U of the certified diameter
   double center_distance_mm = 0;              // ball bar
-  double center_distance_uncertainty_mm = 0;
-  double plate_length_mm = 0;  // plate
+  double center_distance_uncertainty_mm = 0;  // U of the certified centre distance
+  double plate_length_mm = 0;                 // plate
   double plate_width_mm = 0;
-  double flatness_uncertainty_mm = 0;  // certified flatness of the plate, k = 2
+  double flatness_uncertainty_mm = 0;  // U of the plate's certified flatness
+  // k of every U above (`uncertainty_coverage_factor`, optional; default 2,
+  // in [1, 10]: a confidence level such as 0.95 is not a coverage factor).
+  double uncertainty_coverage_factor = 2;
   MaximumPermissibleErrors mpe;
+  // The certificate's standard uncertainty (k = 1) of a certified value.
+  double StandardUncertaintyMm(double expanded_uncertainty_mm) const {
+    return expanded_uncertainty_mm / uncertainty_coverage_factor;
+  }
 };
 
 // Throws InputError naming the file and key (missing fields for the type,

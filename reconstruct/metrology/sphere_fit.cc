@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "calib/core/input_error.h"
@@ -13,6 +14,9 @@ void SphereFitOptions::Check() const {
   if (!(inlier_threshold_mm > 0)) throw InputError("sphere fit", "inlier_threshold_mm must be positive");
   if (expected_radius_mm < 0 || radius_tolerance_mm < 0) throw InputError("sphere fit", "radius must not be negative");
   if (max_iterations < 1) throw InputError("sphere fit", "max_iterations must be >= 1");
+  if (!refine_radius && !(expected_radius_mm > 0)) {
+    throw InputError("sphere fit", "a held radius (refine_radius false) needs expected_radius_mm");
+  }
 }
 
 namespace {
@@ -37,8 +41,16 @@ bool SphereThrough4(const Eigen::Vector3d* p, Eigen::Vector3d* c, double* r) {
 
 }  // namespace
 
-SphereFit RefineSphere(const std::vector<Eigen::Vector3d>& points, const std::vector<int>& indices,
-                       const Eigen::Vector3d& initial_center_mm, double initial_radius_mm, int max_iterations) {
+namespace {
+
+// A last Gauss-Newton step under this is a fixed point (the loop's own stop,
+// 1e-12 relative, can sit just above rounding on a large cloud).
+constexpr double kConvergedStepMm = 1e-6;
+
+// Gauss-Newton on the geometric distance, with the radius free or held.
+SphereFit Refine(const std::vector<Eigen::Vector3d>& points, const std::vector<int>& indices,
+                 const Eigen::Vector3d& initial_center_mm, double initial_radius_mm, int max_iterations,
+                 bool free_radius) {
   SphereFit fit;
   fit.inliers = indices;
   if (indices.size() < 4) {
@@ -46,8 +58,10 @@ SphereFit RefineSphere(const std::vector<Eigen::Vector3d>& points, const std::ve
     return fit;
   }
   // Parameters (cx, cy, cz, r); residual e_i = |p_i - c| - r;
-  // de/dc = -(p - c)/|p - c|, de/dr = -1.
+  // de/dc = -(p - c)/|p - c|, de/dr = -1. With the radius held, its row and
+  // column are left out (r's step is 0).
   Eigen::Vector4d x(initial_center_mm.x(), initial_center_mm.y(), initial_center_mm.z(), initial_radius_mm);
+  double last_step_mm = std::numeric_limits<double>::infinity();
   for (int it = 0; it < max_iterations; ++it) {
     Eigen::Matrix4d jtj = Eigen::Matrix4d::Zero();
     Eigen::Vector4d jte = Eigen::Vector4d::Zero();
@@ -60,13 +74,19 @@ SphereFit RefineSphere(const std::vector<Eigen::Vector3d>& points, const std::ve
       jtj += j * j.transpose();
       jte += j * (n - x[3]);
     }
-    const Eigen::Vector4d step = jtj.ldlt().solve(-jte);
+    Eigen::Vector4d step = Eigen::Vector4d::Zero();
+    if (free_radius) {
+      step = jtj.ldlt().solve(-jte);
+    } else {
+      step.head<3>() = jtj.topLeftCorner<3, 3>().ldlt().solve(-jte.head<3>());
+    }
     if (!step.allFinite()) {
       fit.message = "degenerate geometry (points do not constrain a sphere)";
       return fit;
     }
     x += step;
-    if (step.norm() < 1e-12 * (1.0 + x.norm())) break;
+    last_step_mm = step.norm();
+    if (last_step_mm < 1e-12 * (1.0 + x.norm())) break;
   }
   fit.center_mm = x.head<3>();
   fit.radius_mm = x[3];
@@ -77,9 +97,22 @@ SphereFit RefineSphere(const std::vector<Eigen::Vector3d>& points, const std::ve
     ss += e * e;
   }
   fit.rms_mm = std::sqrt(ss / indices.size());
+  fit.converged = last_step_mm < kConvergedStepMm;
   fit.ok = std::isfinite(fit.radius_mm) && fit.radius_mm > 0;
   if (!fit.ok) fit.message = "did not converge to a sphere";
   return fit;
+}
+
+}  // namespace
+
+SphereFit RefineSphere(const std::vector<Eigen::Vector3d>& points, const std::vector<int>& indices,
+                       const Eigen::Vector3d& initial_center_mm, double initial_radius_mm, int max_iterations) {
+  return Refine(points, indices, initial_center_mm, initial_radius_mm, max_iterations, true);
+}
+
+SphereFit RefineSphereCenter(const std::vector<Eigen::Vector3d>& points, const std::vector<int>& indices,
+                             const Eigen::Vector3d& initial_center_mm, double radius_mm, int max_iterations) {
+  return Refine(points, indices, initial_center_mm, radius_mm, max_iterations, false);
 }
 
 SphereFit FitSphereRobust(const std::vector<Eigen::Vector3d>& points, const SphereFitOptions& o) {
@@ -126,12 +159,31 @@ SphereFit FitSphereRobust(const std::vector<Eigen::Vector3d>& points, const Sphe
   std::vector<int> inliers;
   for (int i = 0; i < n; ++i)
     if (std::abs((points[i] - best_c).norm() - best_r) < o.inlier_threshold_mm) inliers.push_back(i);
-  SphereFit fit = RefineSphere(points, inliers, best_c, best_r, o.max_iterations);
+  auto refine = [&](const Eigen::Vector3d& c, double r) {
+    return o.refine_radius ? RefineSphere(points, inliers, c, r, o.max_iterations)
+                           : RefineSphereCenter(points, inliers, c, o.expected_radius_mm, o.max_iterations);
+  };
+  SphereFit fit = refine(best_c, best_r);
   if (!fit.ok) return fit;
+  if (!o.refine_radius) {
+    // A cap of a sphere of known size fits two such spheres, one either side
+    // of it (the cap seen from outside, and from inside). When the cap's
+    // sagitta is within the inlier band both hold every point, and RANSAC's
+    // hypothesis may be either; keep the one that fits better (its RMS on the
+    // same points). The mirror's centre lies 2 r along the cap's mean
+    // direction.
+    Eigen::Vector3d mean_direction = Eigen::Vector3d::Zero();
+    for (int i : inliers) mean_direction += (points[i] - fit.center_mm).normalized();
+    if (mean_direction.norm() > 1e-9 * inliers.size()) {
+      const Eigen::Vector3d mirror_c = fit.center_mm + 2 * o.expected_radius_mm * mean_direction.normalized();
+      const SphereFit mirror = refine(mirror_c, o.expected_radius_mm);
+      if (mirror.ok && mirror.rms_mm < fit.rms_mm) fit = mirror;
+    }
+  }
   inliers.clear();
   for (int i = 0; i < n; ++i)
     if (std::abs((points[i] - fit.center_mm).norm() - fit.radius_mm) < o.inlier_threshold_mm) inliers.push_back(i);
-  return RefineSphere(points, inliers, fit.center_mm, fit.radius_mm, o.max_iterations);
+  return refine(fit.center_mm, fit.radius_mm);
 }
 
 }  // namespace stereorig

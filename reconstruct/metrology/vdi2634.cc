@@ -36,42 +36,104 @@ void VerifyOptions::Check() const {
 }
 
 bool ArtifactEvaluation::pass() const {
-  return std::all_of(figures.begin(), figures.end(), [](const Figure& f) { return f.pass; });
+  return judged() && std::all_of(figures.begin(), figures.end(), [](const Figure& f) { return f.pass; });
 }
 
 namespace {
 
 Figure MakeFigure(const std::string& name, double value, double mpe) {
-  return {name, value, mpe, std::abs(value) <= mpe, std::nullopt};
+  Figure f;
+  f.name = name;
+  f.value_mm = value;
+  f.mpe_mm = mpe;
+  f.pass = std::abs(value) <= mpe;
+  return f;
 }
 
-// A position whose verdict would rest on a figure the fit leaves
-// undetermined (its standard uncertainty over
-// VerifyOptions::max_uncertainty_fraction_of_mpe of its MPE: its value would
-// be the fit's noise) is refused: a PASS cannot be claimed from it. Not when
-// the position fails beyond doubt without it: another figure fails (P_F has
-// no fit uncertainty), or this one by more than twice its uncertainty
+// The figure's standard uncertainty from its parts, either of which may be
+// absent: their quadrature sum (an infinite fit part stays infinite).
+void SetUncertainty(Figure* f, std::optional<double> fit_mm, std::optional<double> certificate_mm) {
+  f->fit_standard_uncertainty_mm = fit_mm;
+  f->certificate_standard_uncertainty_mm = certificate_mm;
+  if (fit_mm || certificate_mm)
+    f->standard_uncertainty_mm = std::hypot(fit_mm.value_or(0.0), certificate_mm.value_or(0.0));
+}
+
+// What the certificate certifies for a figure.
+const char* CertifiedQuantity(const std::string& figure) {
+  if (figure == "P_S") return "diameter";
+  if (figure == "SD") return "centre distance";
+  return "flatness";
+}
+
+// Why figure f is not determined: what the fit reads (the points' coverage
+// and scatter), what the certificate allows, and what would help.
+std::string UndeterminedText(const Figure& f, const ArtifactEvaluation& e, const std::string& coverage,
+                             double coverage_factor, double limit_mm, const VerifyOptions& o) {
+  const double fit_mm = f.fit_standard_uncertainty_mm.value_or(0.0);
+  const double certificate_mm = f.certificate_standard_uncertainty_mm.value_or(0.0);
+  char buf[320];
+  std::string text = f.name + " is not determined: ";
+  if (f.fit_standard_uncertainty_mm) {
+    std::snprintf(buf, sizeof buf, "%s and scatter by %.3f mm (residual std), which fits it to +-%.3f mm (1 sigma)",
+                  coverage.c_str(), e.residual_std_mm, fit_mm);
+    text += buf;
+  }
+  if (certificate_mm > 0) {
+    std::snprintf(buf, sizeof buf, "%sthe certificate gives the %s to +-%.3f mm (1 sigma: U %.3f mm at k = %g)",
+                  f.fit_standard_uncertainty_mm ? ", and " : "", CertifiedQuantity(f.name), certificate_mm,
+                  certificate_mm * coverage_factor, coverage_factor);
+    text += buf;
+    if (f.fit_standard_uncertainty_mm) {
+      std::snprintf(buf, sizeof buf, ": +-%.3f mm combined", *f.standard_uncertainty_mm);
+      text += buf;
+    }
+  }
+  std::snprintf(buf, sizeof buf, ", more than %.0f%% of its MPE (%.3f mm); ", 100 * o.max_uncertainty_fraction_of_mpe,
+                f.mpe_mm);
+  text += buf;
+  // At the limit exactly, any fit part puts u over it: U must stay under.
+  if (certificate_mm >= limit_mm) {
+    std::snprintf(
+        buf, sizeof buf,
+        "the certificate's part alone is at or over it: verify needs an artifact calibrated to U < %.3f mm (k = %g)",
+        limit_mm * coverage_factor, coverage_factor);
+  } else if (certificate_mm > 0 && std::isfinite(fit_mm) && fit_mm > 0 && fit_mm <= limit_mm) {
+    std::snprintf(buf, sizeof buf,
+                  "measure more of the artifact, or with less noise: with this certificate the fit must reach "
+                  "+-%.3f mm",
+                  std::sqrt(limit_mm * limit_mm - certificate_mm * certificate_mm));
+  } else {
+    std::snprintf(buf, sizeof buf, "measure more of the artifact, or with less noise");
+  }
+  return text + buf;
+}
+
+// Why a position whose verdict would rest on a figure the fit or the
+// certificate leaves undetermined (its standard uncertainty, both parts
+// combined, over VerifyOptions::max_uncertainty_fraction_of_mpe of its MPE:
+// its value would be the fit's noise, or its reference not known well enough)
+// is not judged: a PASS cannot be claimed from it. Empty when the position
+// fails beyond doubt without it: another figure fails (P_F has no
+// uncertainty), or this one by more than twice its combined uncertainty
 // (|value| - 2u > MPE); such a position is judged, FAIL. A non-finite or
-// non-positive uncertainty counts as undetermined.
-void RequireDeterminedIfPassing(const ArtifactEvaluation& e, const std::string& coverage, const VerifyOptions& o,
-                                const std::string& where) {
+// non-positive fit part counts as undetermined (a certificate's 0 is an exact
+// reference).
+std::string NotJudgedReason(const ArtifactEvaluation& e, const std::string& coverage, double coverage_factor,
+                            const VerifyOptions& o) {
   for (const Figure& f : e.figures) {
     if (f.pass) continue;
     const double u_mm = f.standard_uncertainty_mm.value_or(0.0);
-    if (std::isfinite(u_mm) && std::abs(f.value_mm) - 2 * u_mm > f.mpe_mm) return;  // fails beyond doubt
+    if (std::isfinite(u_mm) && std::abs(f.value_mm) - 2 * u_mm > f.mpe_mm) return "";  // fails beyond doubt
   }
   for (const Figure& f : e.figures) {
     if (!f.standard_uncertainty_mm) continue;
-    const double u_mm = *f.standard_uncertainty_mm;
-    if (u_mm > 0 && u_mm <= o.max_uncertainty_fraction_of_mpe * f.mpe_mm) continue;
-    char buf[320];
-    std::snprintf(buf, sizeof buf,
-                  "%s is not determined: %s and scatter by %.3f mm (residual std), which fits it to +-%.3f mm (1 "
-                  "sigma), more than %.0f%% of its MPE (%.3f mm); measure more of the artifact, or with less noise",
-                  f.name.c_str(), coverage.c_str(), e.residual_std_mm, u_mm, 100 * o.max_uncertainty_fraction_of_mpe,
-                  f.mpe_mm);
-    throw InputError(where, buf);
+    const double limit_mm = o.max_uncertainty_fraction_of_mpe * f.mpe_mm;
+    const bool fit_determined = !f.fit_standard_uncertainty_mm || *f.fit_standard_uncertainty_mm > 0;
+    if (fit_determined && *f.standard_uncertainty_mm <= limit_mm) continue;
+    return UndeterminedText(f, e, coverage, coverage_factor, limit_mm, o);
   }
+  return "";
 }
 
 std::string CapsText(const std::vector<double>& cap_half_angles_deg) {
@@ -121,6 +183,10 @@ double Range(const std::vector<double>& r) {
 // no longer changes (2-4 rounds in practice).
 constexpr int kMaxSegmentationRounds = 20;
 
+// Gauss-Newton iterations of a sphere fit (it converges in 3-6 from a start
+// near the solution: sphere_fit.h).
+constexpr int kRefineIterations = 50;
+
 std::string Mm(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.1f", v);
@@ -142,38 +208,163 @@ std::vector<int> WithinSphereShell(const std::vector<Eigen::Vector3d>& pts, cons
   return in;
 }
 
-// One sphere of known nominal radius: locate (RANSAC, narrow band), capture
-// (every point within the capture band, iterated with the fit), exclude,
-// refit.
-SphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, double nominal_radius, double locate_band_mm,
-                            double capture_band_mm, const VerifyOptions& o, int* excluded) {
+// A sphere evaluated where it is: its residuals over `indices` (no fit).
+SphereFit SphereAt(const std::vector<Eigen::Vector3d>& pts, const std::vector<int>& indices,
+                   const Eigen::Vector3d& center_mm, double radius_mm) {
+  SphereFit at;
+  at.ok = true;
+  at.center_mm = center_mm;
+  at.radius_mm = radius_mm;
+  at.inliers = indices;
+  for (int i : indices) at.residuals_mm.push_back((pts[i] - center_mm).norm() - radius_mm);
+  return at;
+}
+
+// One sphere of the certified size, located and fitted: `located` false when
+// RANSAC found none (fit.message says why); otherwise fit.ok false when the
+// free-radius fit of the located sphere's points left the certified size or
+// did not converge (fit.message says what it saw).
+struct ArtifactSphereFit {
+  bool located = false;
+  Eigen::Vector3d located_center_mm = Eigen::Vector3d::Zero();  // of the sphere of the certified size
+  SphereFit fit;
+  int excluded = 0;
+};
+
+// How far a free fit's radius may leave the certified one: RANSAC's own
+// tolerance for a sphere of the certified size.
+double RadiusToleranceMm(double locate_band_mm, double nominal_radius_mm) {
+  return std::max(locate_band_mm, 0.1 * nominal_radius_mm);
+}
+
+bool LeftCertifiedSize(const SphereFit& fit, double nominal_radius_mm, double tolerance_mm) {
+  return !fit.ok || !fit.converged || !(std::abs(fit.radius_mm - nominal_radius_mm) <= tolerance_mm);
+}
+
+double SumOfSquares(const std::vector<double>& r) {
+  double ss = 0;
+  for (double x : r) ss += x * x;
+  return ss;
+}
+
+// Why a located sphere's free-radius fit is not the artifact's: the cap its
+// points cover, the diameter they fit against the certified one, and how well
+// a cap like this fits a diameter at all, so the reader can tell a cap too
+// small to fit from another object. That last is the fit's covariance taken at
+// the located sphere of the certified size (a runaway fit's own is
+// meaningless), with the noise of the better-fitting of the two spheres.
+std::string LeftCertifiedSizeText(const std::vector<Eigen::Vector3d>& pts, const std::vector<int>& captured,
+                                  const Eigen::Vector3d& located_center_mm, const SphereFit& free_fit,
+                                  double nominal_radius_mm, double tolerance_mm, double capture_band_mm) {
+  SphereFitUncertainty u{180.0, std::numeric_limits<double>::infinity(), {}};
+  if (captured.size() > 4) {
+    SphereFit at = SphereAt(pts, captured, located_center_mm, nominal_radius_mm);
+    if (free_fit.ok && free_fit.residuals_mm.size() == captured.size() &&
+        SumOfSquares(free_fit.residuals_mm) < SumOfSquares(at.residuals_mm)) {
+      at.residuals_mm = free_fit.residuals_mm;
+    }
+    u = SphereUncertainty(pts, at);
+  }
+  char buf[512];
+  std::snprintf(
+      buf, sizeof buf,
+      "its %zu points within %.1f mm of the sphere of the certified size cover a cap of %.0f deg half-angle and ",
+      captured.size(), capture_band_mm, u.cap_half_angle_deg);
+  std::string text = buf;
+  if (!free_fit.ok) {
+    text += "a free-radius fit of them failed (" + free_fit.message + ")";
+  } else if (!free_fit.converged) {
+    std::snprintf(buf, sizeof buf,
+                  "a free-radius fit of them did not converge in %d iterations (last at %.1f mm in diameter; the "
+                  "certified is %.1f mm)",
+                  kRefineIterations, 2 * free_fit.radius_mm, 2 * nominal_radius_mm);
+    text += buf;
+  } else {
+    std::snprintf(
+        buf, sizeof buf,
+        "fit, with a free radius, a sphere %.1f mm in diameter, not the certified %.1f mm (+-%.1f mm allowed)",
+        2 * free_fit.radius_mm, 2 * nominal_radius_mm, 2 * tolerance_mm);
+    text += buf;
+  }
+  // A cap that cannot pin the diameter within the tolerance (3 sigma) is too
+  // small; one that can, and fits another size, is another object.
+  if (!(3 * u.diameter_std_mm <= 2 * tolerance_mm)) {
+    std::snprintf(buf, sizeof buf, "; a cap this small fits a diameter only to +-%.2f mm (1 sigma): measure more of it",
+                  u.diameter_std_mm);
+  } else {
+    std::snprintf(buf, sizeof buf,
+                  "; a cap like this fits a diameter to +-%.3f mm (1 sigma): not the artifact, or not of its certified "
+                  "size",
+                  u.diameter_std_mm);
+  }
+  return text + buf;
+}
+
+// "ball 2 of the ball bar (centre near (50.0, 0.0, 150.0) mm)": which one
+// is RANSAC's order, so the centre says where it is.
+std::string BallText(int ball, const Eigen::Vector3d& center_mm) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "ball %d of the ball bar (centre near (%.1f, %.1f, %.1f) mm)", ball + 1, center_mm.x(),
+                center_mm.y(), center_mm.z());
+  return buf;
+}
+
+// One sphere of known nominal radius: locate (RANSAC with the certified size,
+// its centre refined with the radius held, on whichever side of the points
+// fits better: sphere_fit.h; a free radius refined straight from a 4-point
+// hypothesis on the wrong side of a small cap must pass through a plane to
+// reach the right side, and ran away to spheres kilometres wide), capture
+// (every point within the capture band, iterated with the free-radius fit to
+// a fixed point), exclude, refit. The radius is free in every fit after
+// locating: P_S and SD are measured, not assumed; a free fit that leaves the
+// certified size (RANSAC's own tolerance) or does not converge is reported
+// as such.
+ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, double nominal_radius,
+                                    double locate_band_mm, double capture_band_mm, const VerifyOptions& o) {
   SphereFitOptions so;
   so.inlier_threshold_mm = locate_band_mm;
   so.expected_radius_mm = nominal_radius;
-  so.radius_tolerance_mm = std::max(locate_band_mm, 0.1 * nominal_radius);
+  so.radius_tolerance_mm = RadiusToleranceMm(locate_band_mm, nominal_radius);
   so.ransac_iterations = 1000;
   so.seed = o.seed;
-  SphereFit fit = FitSphereRobust(pts, so);
-  if (!fit.ok) return fit;
+  so.refine_radius = false;
+  ArtifactSphereFit out;
+  const SphereFit located = FitSphereRobust(pts, so);
+  if (!located.ok) {
+    out.fit = located;
+    return out;
+  }
+  out.located = true;
+  out.located_center_mm = located.center_mm;
   // The artifact's points are those within the capture band of the fitted
   // sphere: iterate to that fixed point, so the set does not depend on
-  // RANSAC's path.
+  // RANSAC's path. The located sphere has the certified radius, so the set is
+  // refitted with a free radius at least once (the exclusion ranks the free
+  // fit's residuals). Each free fit must stay the certified size, within
+  // RANSAC's own tolerance: on a cloud of something else, or on a cap too
+  // small to fit a diameter, it leaves it.
+  SphereFit fit = located;
+  std::vector<int> in = WithinSphereShell(pts, located.center_mm, located.radius_mm, capture_band_mm);
   for (int it = 0; it < kMaxSegmentationRounds; ++it) {
-    const std::vector<int> in = WithinSphereShell(pts, fit.center_mm, fit.radius_mm, capture_band_mm);
-    if (in == fit.inliers) break;
-    fit = RefineSphere(pts, in, fit.center_mm, fit.radius_mm, 50);
-    if (!fit.ok) return fit;
+    fit = RefineSphere(pts, in, fit.center_mm, fit.radius_mm, kRefineIterations);
+    if (LeftCertifiedSize(fit, nominal_radius, so.radius_tolerance_mm)) {
+      out.fit.ok = false;
+      out.fit.message = LeftCertifiedSizeText(pts, in, located.center_mm, fit, nominal_radius, so.radius_tolerance_mm,
+                                              capture_band_mm);
+      return out;
+    }
+    std::vector<int> next = WithinSphereShell(pts, fit.center_mm, fit.radius_mm, capture_band_mm);
+    if (next == in) break;
+    in.swap(next);
   }
-  // Still the certified size, within RANSAC's own tolerance: on a cloud of
-  // something else the capture can drift to another sphere.
-  if (std::abs(fit.radius_mm - nominal_radius) > so.radius_tolerance_mm) {
-    fit.ok = false;
-    fit.message = "the points within " + Mm(capture_band_mm) + " mm of the sphere RANSAC found fit one " +
-                  Mm(2 * fit.radius_mm) + " mm in diameter, not " + Mm(2 * nominal_radius) + " mm";
-    return fit;
+  const std::vector<int> kept = ExcludeWorst(fit.inliers, fit.residuals_mm, o.excluded_fraction_max, &out.excluded);
+  out.fit = RefineSphere(pts, kept, fit.center_mm, fit.radius_mm, kRefineIterations);
+  if (LeftCertifiedSize(out.fit, nominal_radius, so.radius_tolerance_mm)) {
+    out.fit.message = LeftCertifiedSizeText(pts, kept, located.center_mm, out.fit, nominal_radius,
+                                            so.radius_tolerance_mm, capture_band_mm);
+    out.fit.ok = false;
   }
-  const std::vector<int> kept = ExcludeWorst(fit.inliers, fit.residuals_mm, o.excluded_fraction_max, excluded);
-  return RefineSphere(pts, kept, fit.center_mm, fit.radius_mm, 50);
+  return out;
 }
 
 std::vector<int> WithinPlaneBand(const std::vector<Eigen::Vector3d>& pts, const PlaneFit& plane, double band_mm) {
@@ -225,10 +416,14 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
     case ArtifactType::kSphere: {
       const double mpe = std::max(a.mpe.probing_form_mm, a.mpe.probing_size_mm);
       e.capture_band_mm = CaptureBandMm(o, mpe);
-      int excluded = 0;
-      const SphereFit fit = FitArtifactSphere(pts, 0.5 * a.sphere_diameter_mm, LocateBandMm(o, a.mpe.probing_form_mm),
-                                              e.capture_band_mm, o, &excluded);
-      if (!fit.ok) throw InputError(where, "no sphere of the certified size found in the cloud: " + fit.message);
+      const ArtifactSphereFit found = FitArtifactSphere(pts, 0.5 * a.sphere_diameter_mm,
+                                                        LocateBandMm(o, a.mpe.probing_form_mm), e.capture_band_mm, o);
+      if (!found.located) {
+        throw InputError(where, "no sphere of the certified size found in the cloud: " + found.fit.message);
+      }
+      if (!found.fit.ok) throw InputError(where, "the sphere: " + found.fit.message);
+      const SphereFit& fit = found.fit;
+      const int excluded = found.excluded;
       require_points(static_cast<int>(fit.inliers.size()) + excluded, "sphere");
       e.points_on_artifact = static_cast<int>(fit.inliers.size()) + excluded;
       e.points_excluded = excluded;
@@ -240,9 +435,10 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       e.sphere_form_mm = {Range(fit.residuals_mm)};
       e.figures = {MakeFigure("P_F", e.sphere_form_mm[0], a.mpe.probing_form_mm),
                    MakeFigure("P_S", 2 * fit.radius_mm - a.sphere_diameter_mm, a.mpe.probing_size_mm)};
-      e.figures[1].standard_uncertainty_mm = u.diameter_std_mm;
+      SetUncertainty(&e.figures[1], u.diameter_std_mm, a.StandardUncertaintyMm(a.sphere_diameter_uncertainty_mm));
       ResidualStats(fit.residuals_mm, &e);
-      RequireDeterminedIfPassing(e, CapsText(e.sphere_cap_half_angles_deg), o, where);
+      e.not_judged_reason =
+          NotJudgedReason(e, CapsText(e.sphere_cap_half_angles_deg), a.uncertainty_coverage_factor, o);
       break;
     }
     case ArtifactType::kBallBar: {
@@ -253,13 +449,27 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       Eigen::Matrix3d centers_covariance_mm2 = Eigen::Matrix3d::Zero();  // sum of the two balls'
       std::vector<Eigen::Vector3d> remaining = pts;
       int excluded_total = 0, on_artifact = 0;
+      // The balls as located (certified size), for a second-pass fit that
+      // leaves it: what cap it saw and how well such a cap fits a diameter.
+      std::vector<Eigen::Vector3d> located_centers_mm;
+      const double tolerance_mm = RadiusToleranceMm(LocateBandMm(o, a.mpe.sphere_spacing_mm), r);
+      auto require_certified_size = [&](int ball, const std::vector<int>& indices, const SphereFit& fit) {
+        if (!LeftCertifiedSize(fit, r, tolerance_mm)) return;
+        throw InputError(where,
+                         BallText(ball, located_centers_mm[ball]) + ": " +
+                             LeftCertifiedSizeText(pts, indices, located_centers_mm[ball], fit, r, tolerance_mm, band));
+      };
       for (int ball = 0; ball < 2; ++ball) {
-        int excluded = 0;
-        const SphereFit fit =
-            FitArtifactSphere(remaining, r, LocateBandMm(o, a.mpe.sphere_spacing_mm), band, o, &excluded);
-        if (!fit.ok) {
-          throw InputError(where, "ball " + std::to_string(ball + 1) + " of the ball bar not found: " + fit.message);
+        const ArtifactSphereFit found =
+            FitArtifactSphere(remaining, r, LocateBandMm(o, a.mpe.sphere_spacing_mm), band, o);
+        if (!found.located) {
+          throw InputError(where,
+                           "ball " + std::to_string(ball + 1) + " of the ball bar not found: " + found.fit.message);
         }
+        if (!found.fit.ok) throw InputError(where, BallText(ball, found.located_center_mm) + ": " + found.fit.message);
+        const SphereFit& fit = found.fit;
+        const int excluded = found.excluded;
+        located_centers_mm.push_back(found.located_center_mm);
         require_points(static_cast<int>(fit.inliers.size()) + excluded, "ball bar's spheres");
         excluded_total += excluded;
         on_artifact += static_cast<int>(fit.inliers.size()) + excluded;
@@ -298,8 +508,8 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
           if (!changed) break;
           for (int ball = 0; ball < 2; ++ball) {
             idx[ball].swap(next[ball]);
-            const SphereFit fit = RefineSphere(pts, idx[ball], centers[ball], radii[ball], 50);
-            if (!fit.ok) throw InputError(where, "ball " + std::to_string(ball + 1) + " refit failed: " + fit.message);
+            const SphereFit fit = RefineSphere(pts, idx[ball], centers[ball], radii[ball], kRefineIterations);
+            require_certified_size(ball, idx[ball], fit);
             centers[ball] = fit.center_mm;
             radii[ball] = fit.radius_mm;
           }
@@ -315,8 +525,8 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
           for (int i : idx[ball]) res.push_back((pts[i] - centers[ball]).norm() - radii[ball]);
           int excluded = 0;
           const std::vector<int> kept = ExcludeWorst(idx[ball], res, o.excluded_fraction_max, &excluded);
-          const SphereFit fit = RefineSphere(pts, kept, centers[ball], radii[ball], 50);
-          if (!fit.ok) throw InputError(where, "ball " + std::to_string(ball + 1) + " refit failed: " + fit.message);
+          const SphereFit fit = RefineSphere(pts, kept, centers[ball], radii[ball], kRefineIterations);
+          require_certified_size(ball, kept, fit);
           e.sphere_centers_mm[ball] = fit.center_mm;
           e.sphere_diameters_mm[ball] = 2 * fit.radius_mm;
           const SphereFitUncertainty u = SphereUncertainty(pts, fit);
@@ -337,11 +547,13 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       // distance moves with their difference along the bar.
       const Eigen::Vector3d along = bar_mm.normalized();
       const double variance_mm2 = along.dot(centers_covariance_mm2 * along);
-      e.figures[0].standard_uncertainty_mm = variance_mm2 > 0 && std::isfinite(variance_mm2)
-                                                 ? std::sqrt(variance_mm2)
-                                                 : std::numeric_limits<double>::infinity();
+      SetUncertainty(&e.figures[0],
+                     variance_mm2 > 0 && std::isfinite(variance_mm2) ? std::sqrt(variance_mm2)
+                                                                     : std::numeric_limits<double>::infinity(),
+                     a.StandardUncertaintyMm(a.center_distance_uncertainty_mm));
       ResidualStats(all_residuals, &e);
-      RequireDeterminedIfPassing(e, CapsText(e.sphere_cap_half_angles_deg), o, where);
+      e.not_judged_reason =
+          NotJudgedReason(e, CapsText(e.sphere_cap_half_angles_deg), a.uncertainty_coverage_factor, o);
       break;
     }
     case ArtifactType::kPlate: {
@@ -380,7 +592,14 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       e.plane_normal = fit.normal;
       e.plane_offset_mm = fit.offset_mm;
       e.figures = {MakeFigure("F", Range(fit.residuals_mm), a.mpe.flatness_mm)};
+      // F is a range of residuals: no fit covariance; the certificate's
+      // uncertainty of the plate's flatness is its uncertainty, and without
+      // one F has none to report (not 0: a range varies from sample to
+      // sample, ~0.01 mm over 20 000-point simulated plates).
+      if (a.flatness_uncertainty_mm > 0)
+        SetUncertainty(&e.figures[0], std::nullopt, a.StandardUncertaintyMm(a.flatness_uncertainty_mm));
       ResidualStats(fit.residuals_mm, &e);
+      e.not_judged_reason = NotJudgedReason(e, "", a.uncertainty_coverage_factor, o);
       break;
     }
   }
@@ -390,13 +609,18 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
 VerifySummary Summarise(const std::vector<ArtifactEvaluation>& positions) {
   VerifySummary s;
   std::map<std::string, Figure> worst;
-  for (const auto& p : positions) {
+  for (size_t i = 0; i < positions.size(); ++i) {
+    const ArtifactEvaluation& p = positions[i];
+    if (!p.judged()) {
+      s.not_judged_positions.push_back(static_cast<int>(i));
+      continue;
+    }
     for (const Figure& f : p.figures) {
       auto it = worst.find(f.name);
       if (it == worst.end() || std::abs(f.value_mm) > std::abs(it->second.value_mm)) worst[f.name] = f;
     }
   }
-  s.pass = !positions.empty();
+  s.pass = !positions.empty() && s.not_judged_positions.empty();
   for (const auto& [name, f] : worst) {
     s.worst.push_back(f);
     s.pass = s.pass && f.pass;

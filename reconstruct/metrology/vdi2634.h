@@ -54,14 +54,16 @@ struct VerifyOptions {
   // length and of the width (and at most the certified size plus twice the
   // capture band), or it is not the plate.
   double plate_min_coverage = 0.5;
-  // P_S (sphere) and SD (ball bar) must be determined by the fit to a
-  // standard uncertainty (k = 1, the fit's covariance: sphere_uncertainty.h)
-  // of at most this fraction of their MPE, or a position that would pass is
-  // refused (one that fails beyond doubt is judged: another figure fails, or
-  // this one by more than 2u): a small cap's fitted diameter is noise, not
-  // the system's size error. 0.1
-  // keeps the expanded uncertainty (k = 2) within a fifth of the MPE, so the
-  // verdict is the figure's, not the fit's. Measured basis: 2000 points of a
+  // P_S (sphere), SD (ball bar) and F (plate) must be determined to a
+  // standard uncertainty (k = 1; the fit's covariance, sphere_uncertainty.h,
+  // and the certificate's, combined: Figure) of at most this fraction of
+  // their MPE, or a position that would pass is refused (one that fails
+  // beyond doubt is judged: another figure fails, or this one by more than
+  // 2u): a small cap's fitted diameter is noise, not the system's size error,
+  // and a figure taken against a reference known to no better than the
+  // tolerance says nothing of the system. 0.1 keeps the expanded uncertainty
+  // (k = 2) within a fifth of the MPE, so the verdict is the figure's, not
+  // the fit's or the certificate's. Measured basis: 2000 points of a
   // 38.1 mm sphere with the runtime's 0.05 mm noise fit its diameter to
   // 0.005 mm over a hemisphere, 0.12 mm over a 20-degree cap and 0.5 mm over
   // a 10-degree cap (sphere_uncertainty_test.cc; docs/verify-and-check.md).
@@ -75,9 +77,19 @@ struct Figure {
   double value_mm = 0;
   double mpe_mm = 0;
   bool pass = false;  // |value| <= mpe
-  // value_mm's standard uncertainty (k = 1) from the fit's covariance, for
-  // the figures that have one (P_S, SD); P_F and F are ranges of residuals.
+  // value_mm's standard uncertainty (k = 1): its two parts below combined in
+  // quadrature, u = sqrt(u_fit^2 + u_certificate^2) (independent sources:
+  // the measurement's noise, the reference's calibration; VDI/VDE 2634-2 and
+  // ISO 10360 count the artifact's calibration uncertainty in the test's).
+  // P_S and SD have both; F the certificate's alone (a range of residuals has
+  // no fit covariance); P_F none (the sphere's form is measured against its
+  // own fit, whatever its certified size). Absent where neither part is.
   std::optional<double> standard_uncertainty_mm;
+  // From the fit's covariance (sphere_uncertainty.h): P_S, SD.
+  std::optional<double> fit_standard_uncertainty_mm;
+  // The certificate's U / k of the certified value the figure is taken
+  // against: the diameter (P_S), the centre distance (SD), the flatness (F).
+  std::optional<double> certificate_standard_uncertainty_mm;
 };
 
 struct ArtifactEvaluation {
@@ -108,21 +120,33 @@ struct ArtifactEvaluation {
   int plate_points_off_outline = 0;
   Eigen::Vector3d plane_normal = Eigen::Vector3d::Zero();
   double plane_offset_mm = 0;
-  bool pass() const;
+  // Empty when the position is judged. Otherwise why it is not: a figure the
+  // points or the certificate leave undetermined where the position would
+  // otherwise pass (VerifyOptions::max_uncertainty_fraction_of_mpe; the text
+  // names the figure, its uncertainty and what would help). Its figures are
+  // all filled in, to be reported, not judged.
+  std::string not_judged_reason;
+  bool judged() const { return not_judged_reason.empty(); }
+  bool pass() const;  // judged, and every figure within its MPE
 };
 
 // Throws InputError(`where`, ...) when the cloud has too few points on the
 // artifact, the artifact cannot be found in it, what is found does not
-// cover the certified artifact plausibly, or the points leave P_S or SD
-// undetermined (max_uncertainty_fraction_of_mpe) where the position would
-// otherwise pass.
+// cover the certified artifact plausibly (a sphere or ball whose free-radius
+// fit leaves the certified size or does not converge: the message names the
+// ball, both diameters and the cap its points cover). Points or a
+// certificate that leave P_S, SD or F undetermined where the position would
+// otherwise pass are no error: the evaluation comes back with every figure
+// and not_judged_reason set.
 ArtifactEvaluation EvaluateArtifact(const Artifact& artifact, const std::vector<Eigen::Vector3d>& points_mm,
                                     const VerifyOptions& options, const std::string& where);
 
-// Several positions of the same artifact: per figure, the worst |value|.
+// Several positions of the same artifact: per figure, the worst |value| of
+// the judged positions. No PASS is claimed while a position is not judged.
 struct VerifySummary {
-  std::vector<Figure> worst;  // one per figure name, the position with the largest |value|
-  bool pass = false;
+  std::vector<Figure> worst;              // one per figure name, the judged position with the largest |value|
+  std::vector<int> not_judged_positions;  // indices into the positions given
+  bool pass = false;                      // every position judged, and every figure within its MPE
 };
 VerifySummary Summarise(const std::vector<ArtifactEvaluation>& positions);
 
