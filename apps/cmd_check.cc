@@ -57,8 +57,9 @@ int RunCheck(int argc, char** argv) {
       "is held fixed; only the board poses are re-estimated. It reports each camera's consistency with the others, "
       "each module's stereo consistency and rectified-row error, and each module pair's closure through the "
       "target, each next to a threshold derived from the stored calibration's own residuals and uncertainties. "
-      "It names the camera or module that changed, says whether a named camera moved, its lens changed (focal "
-      "length, principal point) or it cannot tell, and appends the run to an SQLite history.\n\n"
+      "It names the camera or module that changed, says whether a new pose or a new lens (focal length, principal "
+      "point) explains a named camera's corners, either (it cannot tell) or neither alone, and appends the run to "
+      "an SQLite history.\n\n"
       "Exit codes: 0 ok; 1 recalibrate; 2 bad input.\n\n"
       "Examples:\n"
       "  stereorig check --rig rig.yaml --captures tonight/ --target target.yaml --report tonight/check.json\n"
@@ -154,12 +155,13 @@ int RunCheck(int argc, char** argv) {
   report["explanation"] = result.Explanation();
   report["moved_cameras"] = result.moved_cameras;
   report["moved_modules"] = result.moved_modules;
-  // Each named camera: moved, lens changed, or either (the check cannot
-  // tell), with both fits' residuals and the lens fit's estimate.
-  static const char* const kKindNames[] = {"moved", "lens", "moved_or_lens"};
+  // Each named camera: what explains its corners (a new pose, a new lens,
+  // either, neither, or too few corners to fit), with both fits' residuals
+  // (null when not fitted) and the lens fit's estimate.
   for (const CameraChange& c : result.camera_changes) {
     report["camera_changes"].push_back({{"camera", c.camera},
-                                        {"kind", kKindNames[static_cast<int>(c.kind)]},
+                                        {"kind", CameraChangeKindName(c.kind)},
+                                        {"corners", c.corners},
                                         {"moved_fit_rms_px", c.moved_rms_px},
                                         {"lens_fit_rms_px", c.lens_rms_px},
                                         {"threshold_px", c.threshold_px},

@@ -14,7 +14,8 @@
 //     captures, in mm (at the board centre) and degrees.
 // A module whose cameras disagree names the camera that also disagrees with
 // the other modules, and says whether a new pose or a new lens (focal length,
-// principal point) explains its corners, or that the check cannot tell.
+// principal point) explains its corners, either does (the check cannot
+// tell), or neither alone does.
 #pragma once
 
 #include <string>
@@ -48,9 +49,10 @@ struct CheckFigure {
 struct CheckResult {
   std::vector<CheckFigure> figures;
   std::vector<int> moved_cameras;  // named by elimination, global indices
-  // For each of moved_cameras: whether it moved, its lens changed, or the
-  // check cannot tell (calib/check/camera_change.h). A camera without one is
-  // explained as moved.
+  // For each of moved_cameras: what explains its corners, a new pose, a new
+  // lens, either (the check cannot tell), neither alone, or too few corners
+  // to tell (calib/check/camera_change.h). A camera without one is explained
+  // as moved.
   std::vector<CameraChange> camera_changes;
   std::vector<int> moved_modules;  // its cameras disagree with no camera to blame, or a pair closure failed
   // Of moved_modules, those named by failing closures alone (each module
