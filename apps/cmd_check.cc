@@ -153,11 +153,16 @@ int RunCheck(int argc, char** argv) {
   std::printf("verdict: %s (%s)\n", result.Verdict().c_str(), result.Explanation().c_str());
   report["verdict"] = result.Verdict();
   report["explanation"] = result.Explanation();
-  report["moved_cameras"] = result.moved_cameras;
+  // Every camera named, then of those the ones the check says moved (kind
+  // "moved"; camera_changes says what explains each). Until flagged_cameras
+  // came, moved_cameras listed every camera named, a changed lens too.
+  report["flagged_cameras"] = result.FlaggedCameras();
+  report["moved_cameras"] = result.MovedCameras();
   report["moved_modules"] = result.moved_modules;
   // Each named camera: what explains its corners (a new pose, a new lens,
   // either, neither, or too few corners to fit), with both fits' residuals
   // (null when not fitted) and the lens fit's estimate.
+  report["camera_changes"] = nlohmann::json::array();  // present, if empty, as the lists above
   for (const CameraChange& c : result.camera_changes) {
     report["camera_changes"].push_back({{"camera", c.camera},
                                         {"kind", CameraChangeKindName(c.kind)},

@@ -24,14 +24,23 @@ bool CheckResult::ok() const {
   return std::all_of(figures.begin(), figures.end(), [](const CheckFigure& f) { return f.pass; });
 }
 
+std::vector<int> CheckResult::FlaggedCameras() const {
+  std::vector<int> cameras;
+  for (const CameraChange& c : camera_changes) cameras.push_back(c.camera);
+  return cameras;
+}
+
+std::vector<int> CheckResult::MovedCameras() const {
+  std::vector<int> cameras;
+  for (const CameraChange& c : camera_changes)
+    if (c.kind == CameraChangeKind::kMoved) cameras.push_back(c.camera);
+  return cameras;
+}
+
 std::string CheckResult::Explanation() const {
   if (ok()) return "every figure within its threshold";
   std::ostringstream s;
-  for (int c : moved_cameras) {
-    auto change = std::find_if(camera_changes.begin(), camera_changes.end(),
-                               [c](const CameraChange& x) { return x.camera == c; });
-    s << (change != camera_changes.end() ? change->Describe() : "camera " + std::to_string(c) + " moved") << "; ";
-  }
+  for (const CameraChange& c : camera_changes) s << c.Describe() << "; ";
   auto holds = [](const std::vector<int>& v, int m) { return std::find(v.begin(), v.end(), m) != v.end(); };
   for (int m : moved_modules) {
     s << "module " << m;
@@ -42,7 +51,7 @@ std::string CheckResult::Explanation() const {
     else
       s << " moved; ";
   }
-  if (moved_cameras.empty() && moved_modules.empty()) s << "figures exceed their thresholds; ";
+  if (camera_changes.empty() && moved_modules.empty()) s << "figures exceed their thresholds; ";
   std::string out = s.str();
   return out.substr(0, out.size() - 2);
 }
@@ -365,7 +374,6 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
       }
     }
     if (named >= 0 && best_ratio > 1.0) {
-      result.moved_cameras.push_back(named);
       // Moved, or a drifted lens? Its corners against the poses every other
       // camera implies, judged by its own consistency threshold.
       std::set<int> others = all;

@@ -48,11 +48,11 @@ struct CheckFigure {
 
 struct CheckResult {
   std::vector<CheckFigure> figures;
-  std::vector<int> moved_cameras;  // named by elimination, global indices
-  // For each of moved_cameras: what explains its corners, a new pose, a new
-  // lens, either (the check cannot tell), neither alone, or too few corners
-  // to tell (calib/check/camera_change.h). A camera without one is explained
-  // as moved.
+  // One per camera named by elimination (its module's cameras disagree and
+  // it also disagrees with the other modules), in the order named: what
+  // explains its corners, a new pose, a new lens, either (the check cannot
+  // tell), neither alone, or too few corners to tell
+  // (calib/check/camera_change.h).
   std::vector<CameraChange> camera_changes;
   std::vector<int> moved_modules;  // its cameras disagree with no camera to blame, or a pair closure failed
   // Of moved_modules, those named by failing closures alone (each module
@@ -66,7 +66,12 @@ struct CheckResult {
   std::vector<int> split_modules;
   bool ok() const;
   std::string Verdict() const { return ok() ? "ok" : "recalibrate"; }
-  std::string Explanation() const;  // one line naming what moved
+  std::string Explanation() const;  // one line: what changed, in no more words than the figures support
+  // Every camera named (camera_changes' cameras), and of those the ones only
+  // a new pose explains (kind kMoved): the report's flagged_cameras and
+  // moved_cameras.
+  std::vector<int> FlaggedCameras() const;
+  std::vector<int> MovedCameras() const;
 };
 
 // Throws InputError(`where`, ...) unless the rig file holds the

@@ -138,7 +138,7 @@ BumpReading ReadBumps(const std::function<Bump(unsigned)>& bump_for, double nois
     const std::vector<int> cameras = bump.camera >= 0 ? std::vector<int>{bump.camera} : std::vector<int>{};
     const std::vector<int> modules = bump.module >= 0 ? std::vector<int>{bump.module} : std::vector<int>{};
     for (const CameraChange& c : r.camera_changes) ++reading.said[static_cast<int>(c.kind)];
-    if (r.moved_cameras == cameras && r.moved_modules == modules) {
+    if (r.FlaggedCameras() == cameras && r.moved_modules == modules) {
       ++reading.named;
     } else {
       std::string figures;
@@ -204,7 +204,7 @@ LensDriftReading ReadLensDrifts(const LensDrift& drift, double noise_px, unsigne
     const std::vector<BoardObservation> views = Observe(truth, target, bump, seed, noise_px);
     const CheckResult r = RunNightlyCheck(stored, target, views, CheckOptions(), "test");
     reading.flagged += !r.ok();
-    if (r.moved_cameras != std::vector<int>{bump.camera} || !r.moved_modules.empty()) {
+    if (r.FlaggedCameras() != std::vector<int>{bump.camera} || !r.moved_modules.empty()) {
       std::printf("seed %u lens of camera %d: %s\n", seed, bump.camera, r.Explanation().c_str());
       continue;
     }
@@ -289,9 +289,10 @@ TEST(NightlyCheck, ExplanationSaysNoMoreThanTheFiguresTell) {
   lens.kind = CameraChangeKind::kLens;
   lens.focal_percent = 0.1;
   lens.principal_point_px = {-0.001, 0.25};
-  r.moved_cameras = {2};
   r.camera_changes = {lens};
   EXPECT_EQ(r.Explanation(), "camera 2's lens changed: focal length +0.100 %, principal point +0.00, +0.25 px");
+  EXPECT_EQ(r.FlaggedCameras(), std::vector<int>{2});
+  EXPECT_TRUE(r.MovedCameras().empty());  // a changed lens is not a moved camera
   r.camera_changes[0].kind = CameraChangeKind::kMovedOrLens;
   EXPECT_EQ(r.Explanation(), "camera 2 moved or its lens changed (either explains its corners)");
   r.camera_changes[0].kind = CameraChangeKind::kUnexplained;
@@ -306,6 +307,7 @@ TEST(NightlyCheck, ExplanationSaysNoMoreThanTheFiguresTell) {
   EXPECT_EQ(r.Explanation(), "camera 2 changed: too few corners (4) to fit a new pose or a new lens");
   r.camera_changes[0].kind = CameraChangeKind::kMoved;
   EXPECT_EQ(r.Explanation(), "camera 2 moved");
+  EXPECT_EQ(r.MovedCameras(), std::vector<int>{2});
 }
 
 TEST(NightlyCheck, BadInputIsRefused) {
