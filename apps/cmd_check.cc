@@ -158,7 +158,12 @@ int RunCheck(int argc, char** argv) {
   // came, moved_cameras listed every camera named, a changed lens too.
   report["flagged_cameras"] = result.FlaggedCameras();
   report["moved_cameras"] = result.MovedCameras();
-  report["moved_modules"] = result.moved_modules;
+  // Every module named; none is said to have moved as a whole, since no
+  // figure tells a module's motion from a lens change (closure_modules and
+  // split_modules say why each is named). Until flagged_modules came,
+  // moved_modules listed every module named.
+  report["flagged_modules"] = result.FlaggedModules();
+  report["moved_modules"] = nlohmann::json::array();
   // Each named camera: what explains its corners (a new pose, a new lens,
   // either, neither, or too few corners to fit), with both fits' residuals
   // (null when not fitted) and the lens fit's estimate.
@@ -174,6 +179,7 @@ int RunCheck(int argc, char** argv) {
                                         {"principal_point_px", {c.principal_point_px.x(), c.principal_point_px.y()}}});
   }
   report["closure_modules"] = result.closure_modules;
+  report["closure_which_unknown"] = result.closure_which_unknown;
   report["split_modules"] = result.split_modules;
 
   if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");

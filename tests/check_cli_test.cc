@@ -268,16 +268,21 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
 
 // The report's lists say what the check found (docs/verify-and-check.md,
 // "The report"): flagged_cameras every camera named, moved_cameras only
-// those a new pose alone explains (camera_changes' kind "moved"). Before,
-// moved_cameras named a camera whose focal length had drifted.
+// those a new pose alone explains (camera_changes' kind "moved");
+// flagged_modules every module named, moved_modules none (no figure tells a
+// module's motion from a lens change), and a two-module rig's closure names
+// both modules and says it cannot tell which one changed. Before,
+// moved_cameras named a camera whose focal length had drifted, and a shift
+// of module 0 read "module 1 moved or a lens changed".
 //
 // The stored rig: the simulator's truth with 0.03 px residuals, what a
 // calibrated rig's rendered corners read (stage 1: 0.022 px, a night:
 // 0.03 px). Measured: camera 2's focal length +0.5 % leaves 0.120 px with a
 // new pose and 0.023 px with a new lens, camera 2 turned 0.05 deg 0.023 and
 // 0.079 px, against a threshold of 0.034 px: each kind by a factor of 2.3 or
-// more.
-TEST(CheckCli, TheReportListsEveryNamedCameraAndAsMovedOnlyThoseThatMoved) {
+// more; module 0 shifted 0.1 mm reads a closure of 0.101 mm against
+// 0.0097 mm.
+TEST(CheckCli, TheReportListsEveryNamedCameraAndModuleAndAsMovedOnlyThoseThatMoved) {
   const std::string dir = ::testing::TempDir() + "/check_cli_kinds_" + std::to_string(getpid());
   fs::remove_all(dir);
   fs::create_directories(dir);
@@ -309,6 +314,15 @@ TEST(CheckCli, TheReportListsEveryNamedCameraAndAsMovedOnlyThoseThatMoved) {
   EXPECT_EQ(turned["moved_cameras"], nlohmann::json::array({2})) << turned.dump(2);
   ASSERT_EQ(turned["camera_changes"].size(), 1u) << turned.dump(2);
   EXPECT_EQ(turned["camera_changes"][0]["kind"], "moved");
+  EXPECT_EQ(turned["flagged_modules"], nlohmann::json::array());
+  const nlohmann::json shifted = night("shifted", "--bump-module 0 --bump-translation-mm 0.1");
+  ASSERT_TRUE(shifted.is_object());
+  EXPECT_EQ(shifted["explanation"], "module 0 and module 1 disagree: one moved or a lens changed");
+  EXPECT_EQ(shifted["flagged_modules"], nlohmann::json::array({0, 1})) << shifted.dump(2);
+  EXPECT_EQ(shifted["moved_modules"], nlohmann::json::array()) << shifted.dump(2);
+  EXPECT_EQ(shifted["closure_modules"], nlohmann::json::array({0, 1})) << shifted.dump(2);
+  EXPECT_EQ(shifted["closure_which_unknown"], true) << shifted.dump(2);
+  EXPECT_EQ(shifted["flagged_cameras"], nlohmann::json::array()) << shifted.dump(2);
   fs::remove_all(dir);
 }
 

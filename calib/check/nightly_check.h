@@ -54,15 +54,18 @@ struct CheckResult {
   // tell), neither alone, or too few corners to tell
   // (calib/check/camera_change.h).
   std::vector<CameraChange> camera_changes;
-  std::vector<int> moved_modules;  // its cameras disagree with no camera to blame, or a pair closure failed
-  // Of moved_modules, those named by failing closures alone (each module
-  // agrees with itself): a closure shows that two modules' board poses
-  // disagree, which a module's motion and a small change of one of their
-  // lenses (a focal length scales a module's pose) both do. Explained so.
+  // Modules named by failing closures alone (each module agrees with
+  // itself): a closure shows that two modules' board poses disagree, which a
+  // module's motion and a small change of one of their lenses (a focal
+  // length scales a module's pose) both do. With three or more modules, the
+  // module in the most failing pairs; with two, both, and
+  // closure_which_unknown is set: nothing outside the pair tells which one
+  // changed (module 0 only defines the reference frame).
   std::vector<int> closure_modules;
-  // Of moved_modules, those whose own two cameras disagree while neither
-  // disagrees with the other modules (or there are none): something in the
-  // module changed, a camera's pose or lens, not the module as a whole.
+  bool closure_which_unknown = false;
+  // Modules whose own two cameras disagree while neither disagrees with the
+  // other modules (or there are none): something in the module changed, a
+  // camera's pose or lens, not the module as a whole.
   std::vector<int> split_modules;
   bool ok() const;
   std::string Verdict() const { return ok() ? "ok" : "recalibrate"; }
@@ -72,6 +75,10 @@ struct CheckResult {
   // moved_cameras.
   std::vector<int> FlaggedCameras() const;
   std::vector<int> MovedCameras() const;
+  // Every module named (split_modules and closure_modules, sorted): the
+  // report's flagged_modules. No figure tells a module's motion from a lens
+  // change, so none is said to have moved as a whole.
+  std::vector<int> FlaggedModules() const;
 };
 
 // Throws InputError(`where`, ...) unless the rig file holds the
