@@ -56,7 +56,7 @@ std::string CameraChange::Describe() const {
         out += residual(moved_rms_px, "pose");
         out += ", ";
       } else {
-        out += "the pose fit's solve failed; residual ";
+        out += "the pose fit's solve failed, residual ";  // no "; ": it separates the explanation's items
       }
       out += residual(lens_rms_px, "lens");  // the lens fit is linear: always one
       char against[48];

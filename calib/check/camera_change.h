@@ -58,7 +58,7 @@ struct CameraChange {
   // "camera 2 moved", "camera 2's lens changed: ...", "camera 2 moved or its
   // lens changed (either explains its corners)", "camera 2 changed: neither
   // a new pose nor a new lens alone explains its corners (...)", "camera 2
-  // changed: too few corners (4) to fit a new pose or a new lens".
+  // changed: too few corners (N) to fit a new pose or a new lens".
   std::string Describe() const;
 };
 

@@ -30,13 +30,6 @@ std::vector<int> CheckResult::FlaggedCameras() const {
   return cameras;
 }
 
-std::vector<int> CheckResult::MovedCameras() const {
-  std::vector<int> cameras;
-  for (const CameraChange& c : camera_changes)
-    if (c.kind == CameraChangeKind::kMoved) cameras.push_back(c.camera);
-  return cameras;
-}
-
 std::vector<int> CheckResult::FlaggedModules() const {
   std::set<int> modules(split_modules.begin(), split_modules.end());
   modules.insert(closure_modules.begin(), closure_modules.end());
@@ -269,6 +262,20 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
     throw InputError(where,
                      "the captures do not fit this rig at all (every camera is off by > 2 px): "
                      "captures of another rig, or the wrong rig file?");
+  }
+  // A camera with no figure is not checked: the check would call the rig
+  // ok with it moved (8 captures only camera 0 saw, it turned 1 degree:
+  // "ok, every figure within its threshold" with no figure at all, a second
+  // reading found). Bad input: the captures must show the board to each
+  // camera with another camera in the same capture.
+  std::string unchecked;
+  for (int c = 0; c < rig.num_cameras(); ++c)
+    if (!camera_figures.count(c)) unchecked += (unchecked.empty() ? "" : ", ") + std::to_string(c);
+  if (!unchecked.empty()) {
+    throw InputError(where, "camera(s) " + unchecked +
+                                " saw the board in no capture where another camera saw it too, so the check cannot "
+                                "tell whether they moved: take captures that show the board to every camera with "
+                                "another one");
   }
   for (auto& [c, f] : camera_figures) result.figures.push_back(f);
 

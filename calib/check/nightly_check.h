@@ -70,11 +70,10 @@ struct CheckResult {
   bool ok() const;
   std::string Verdict() const { return ok() ? "ok" : "recalibrate"; }
   std::string Explanation() const;  // one line: what changed, in no more words than the figures support
-  // Every camera named (camera_changes' cameras), and of those the ones only
-  // a new pose explains (kind kMoved): the report's flagged_cameras and
-  // moved_cameras.
+  // Every camera named (camera_changes' cameras): the report's
+  // flagged_cameras (and moved_cameras, its old name; each change's kind
+  // says what explains it).
   std::vector<int> FlaggedCameras() const;
-  std::vector<int> MovedCameras() const;
   // Every module named (split_modules and closure_modules, sorted): the
   // report's flagged_modules. No figure tells a module's motion from a lens
   // change, so none is said to have moved as a whole.
