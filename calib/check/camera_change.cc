@@ -11,24 +11,64 @@
 
 namespace stereorig {
 
-std::string CameraChange::Describe() const {
-  const std::string name = "camera " + std::to_string(camera);
+const char* CameraChangeKindName(CameraChangeKind kind) {
   switch (kind) {
     case CameraChangeKind::kMoved:
-      return name + " moved";
+      return "moved";
+    case CameraChangeKind::kLens:
+      return "lens";
+    case CameraChangeKind::kMovedOrLens:
+      return "moved_or_lens";
+    case CameraChangeKind::kUnexplained:
+      return "unexplained";
+    case CameraChangeKind::kNotFitted:
+      break;
+  }
+  return "not_fitted";
+}
+
+std::string CameraChange::Describe() const {
+  // Printed as rounded: no "-0.00".
+  auto shown = [](double x, double step) { return std::abs(x) < step / 2 ? 0.0 : x; };
+  // "0.079 px with a new pose"; a pose fit whose solve failed has none.
+  auto residual = [](double rms_px, const char* with) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.3f px with a new %s", rms_px, with);
+    return std::string(text);
+  };
+  std::string out = "camera " + std::to_string(camera);
+  switch (kind) {
+    case CameraChangeKind::kMoved:
+      return out + " moved";
     case CameraChangeKind::kLens: {
-      // Printed as rounded: no "-0.00".
-      auto shown = [](double x, double step) { return std::abs(x) < step / 2 ? 0.0 : x; };
       char text[160];
       std::snprintf(text, sizeof text, "'s lens changed: focal length %+.3f %%, principal point %+.2f, %+.2f px",
                     shown(focal_percent, 0.001), shown(principal_point_px.x(), 0.01),
                     shown(principal_point_px.y(), 0.01));
-      return name + text;
+      return out + text;
     }
     case CameraChangeKind::kMovedOrLens:
+      return out + " moved or its lens changed (either explains its corners)";
+    case CameraChangeKind::kUnexplained: {
+      out += " changed: neither a new pose nor a new lens alone explains its corners (";
+      if (std::isfinite(moved_rms_px)) {
+        out += "residual ";
+        out += residual(moved_rms_px, "pose");
+        out += ", ";
+      } else {
+        out += "the pose fit's solve failed, residual ";  // no "; ": it separates the explanation's items
+      }
+      out += residual(lens_rms_px, "lens");  // the lens fit is linear: always one
+      char against[48];
+      std::snprintf(against, sizeof against, ", against %.3f px)", threshold_px);
+      return out + against;
+    }
+    case CameraChangeKind::kNotFitted:
       break;
   }
-  return name + " moved or its lens changed";
+  char text[96];
+  std::snprintf(text, sizeof text, " changed: too few corners (%d) to fit a new pose or a new lens", corners);
+  return out + text;
 }
 
 namespace {
@@ -93,7 +133,9 @@ CameraChange ExplainCameraChange(const Rig& rig, const Target& target, int camer
   CameraChange change;
   change.camera = camera;
   change.threshold_px = threshold_px;
-  if (corners.size() < 6) {  // too few to fit either: no fit, not a perfect one (null in the report)
+  change.corners = static_cast<int>(corners.size());
+  if (change.corners < kMinCornersToFit) {  // no fit, not a perfect one (null in the report)
+    change.kind = CameraChangeKind::kNotFitted;
     change.moved_rms_px = change.lens_rms_px = std::numeric_limits<double>::quiet_NaN();
     return change;
   }
@@ -120,9 +162,10 @@ CameraChange ExplainCameraChange(const Rig& rig, const Target& target, int camer
   change.moved_rms_px = MovedFitRms(cam, cam_from_ref, corners);
 
   const bool moved_fits = change.moved_rms_px <= threshold_px, lens_fits = change.lens_rms_px <= threshold_px;
-  change.kind = moved_fits && !lens_fits   ? CameraChangeKind::kMoved
-                : lens_fits && !moved_fits ? CameraChangeKind::kLens
-                                           : CameraChangeKind::kMovedOrLens;
+  change.kind = moved_fits && lens_fits ? CameraChangeKind::kMovedOrLens
+                : moved_fits            ? CameraChangeKind::kMoved
+                : lens_fits             ? CameraChangeKind::kLens
+                                        : CameraChangeKind::kUnexplained;
   return change;
 }
 

@@ -13,9 +13,13 @@
 // apart and says so: a principal-point shift of d px looks, to first order,
 // like a turn of d / f rad about the image's other axis, and a focal change
 // like a shift along the optical axis when the board stays at one depth.
+// Where neither fits, it says that, and no more: the camera moved and its
+// lens changed, or something neither fit frees changed (its distortion, its
+// sensor), or the threshold was passed by chance.
 #pragma once
 
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 #include "calib/core/rig.h"
@@ -27,20 +31,35 @@ namespace stereorig {
 enum class CameraChangeKind {
   kMoved,        // only a new pose explains its corners
   kLens,         // only a new focal length and principal point explain them
-  kMovedOrLens,  // either does (or neither alone): the check cannot tell
+  kMovedOrLens,  // either explains them: the check cannot tell which
+  kUnexplained,  // neither alone explains them (above: what may have changed)
+  kNotFitted,    // too few corners to fit either (fewer than kMinCornersToFit)
 };
+
+// The kind's name in the JSON report: "moved", "lens", "moved_or_lens",
+// "unexplained", "not_fitted".
+const char* CameraChangeKindName(CameraChangeKind kind);
+
+// Fewer corners than this fit neither change: the pose fit has 6 unknowns.
+constexpr int kMinCornersToFit = 6;
 
 struct CameraChange {
   int camera = -1;
-  CameraChangeKind kind = CameraChangeKind::kMovedOrLens;
-  double moved_rms_px = 0;  // per axis, with the pose refitted
-  double lens_rms_px = 0;   // per axis, with the lens refitted
+  CameraChangeKind kind = CameraChangeKind::kNotFitted;
+  int corners = 0;  // behind both fits
+  // Per axis; NaN when not fitted; +inf when the pose fit's solve failed.
+  double moved_rms_px = 0;  // with the pose refitted
+  double lens_rms_px = 0;   // with the lens refitted
   double threshold_px = 0;  // what either must pass to explain the corners
   // The lens fit's estimate: fx and fy scaled by 1 + focal_percent / 100,
   // (cx, cy) moved by principal_point_px.
   double focal_percent = 0;
   Eigen::Vector2d principal_point_px = Eigen::Vector2d::Zero();
-  std::string Describe() const;  // "camera 2 moved", "camera 2's lens changed (...)", ...
+  // "camera 2 moved", "camera 2's lens changed: ...", "camera 2 moved or its
+  // lens changed (either explains its corners)", "camera 2 changed: neither
+  // a new pose nor a new lens alone explains its corners (...)", "camera 2
+  // changed: too few corners (N) to fit a new pose or a new lens".
+  std::string Describe() const;
 };
 
 // One view of camera `camera` with the board pose the other cameras imply.

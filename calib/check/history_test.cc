@@ -13,7 +13,12 @@ namespace {
 CheckResult Result(double value, bool pass) {
   CheckResult r;
   r.figures = {{"cam0_consistency_rms_px", value, 0.25, pass, 700}, {"pair_0_1_closure_mm", value / 10, 0.02, true, 8}};
-  if (!pass) r.moved_cameras = {0};
+  if (!pass) {
+    CameraChange moved;
+    moved.camera = 0;
+    moved.kind = CameraChangeKind::kMoved;
+    r.camera_changes = {moved};
+  }
   return r;
 }
 

@@ -24,25 +24,32 @@ bool CheckResult::ok() const {
   return std::all_of(figures.begin(), figures.end(), [](const CheckFigure& f) { return f.pass; });
 }
 
+std::vector<int> CheckResult::FlaggedCameras() const {
+  std::vector<int> cameras;
+  for (const CameraChange& c : camera_changes) cameras.push_back(c.camera);
+  return cameras;
+}
+
+std::vector<int> CheckResult::FlaggedModules() const {
+  std::set<int> modules(split_modules.begin(), split_modules.end());
+  modules.insert(closure_modules.begin(), closure_modules.end());
+  return {modules.begin(), modules.end()};
+}
+
 std::string CheckResult::Explanation() const {
   if (ok()) return "every figure within its threshold";
   std::ostringstream s;
-  for (int c : moved_cameras) {
-    auto change = std::find_if(camera_changes.begin(), camera_changes.end(),
-                               [c](const CameraChange& x) { return x.camera == c; });
-    s << (change != camera_changes.end() ? change->Describe() : "camera " + std::to_string(c) + " moved") << "; ";
+  for (const CameraChange& c : camera_changes) s << c.Describe() << "; ";
+  for (int m : split_modules) s << "module " << m << "'s cameras disagree: one moved or its lens changed; ";
+  if (closure_which_unknown && closure_modules.size() == 2) {
+    // Two modules: their closure says they disagree, not which one changed.
+    s << "module " << closure_modules[0] << " and module " << closure_modules[1]
+      << " disagree: one moved or a lens changed; ";
+  } else {
+    for (int m : closure_modules) s << "module " << m << " moved or a lens changed; ";
   }
-  auto holds = [](const std::vector<int>& v, int m) { return std::find(v.begin(), v.end(), m) != v.end(); };
-  for (int m : moved_modules) {
-    s << "module " << m;
-    if (holds(closure_modules, m))
-      s << " moved or a lens changed; ";
-    else if (holds(split_modules, m))
-      s << "'s cameras disagree: one moved or its lens changed; ";
-    else
-      s << " moved; ";
-  }
-  if (moved_cameras.empty() && moved_modules.empty()) s << "figures exceed their thresholds; ";
+  if (camera_changes.empty() && split_modules.empty() && closure_modules.empty())
+    s << "figures exceed their thresholds; ";
   std::string out = s.str();
   return out.substr(0, out.size() - 2);
 }
@@ -256,6 +263,20 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
                      "the captures do not fit this rig at all (every camera is off by > 2 px): "
                      "captures of another rig, or the wrong rig file?");
   }
+  // A camera with no figure is not checked: the check would call the rig
+  // ok with it moved (8 captures only camera 0 saw, it turned 1 degree:
+  // "ok, every figure within its threshold" with no figure at all, a second
+  // reading found). Bad input: the captures must show the board to each
+  // camera with another camera in the same capture.
+  std::string unchecked;
+  for (int c = 0; c < rig.num_cameras(); ++c)
+    if (!camera_figures.count(c)) unchecked += (unchecked.empty() ? "" : ", ") + std::to_string(c);
+  if (!unchecked.empty()) {
+    throw InputError(where, "camera(s) " + unchecked +
+                                " saw the board in no capture where another camera saw it too, so the check cannot "
+                                "tell whether they moved: take captures that show the board to every camera with "
+                                "another one");
+  }
   for (auto& [c, f] : camera_figures) result.figures.push_back(f);
 
   // --- Modules: stereo consistency (each camera through its partner's pose). ---
@@ -365,7 +386,6 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
       }
     }
     if (named >= 0 && best_ratio > 1.0) {
-      result.moved_cameras.push_back(named);
       // Moved, or a drifted lens? Its corners against the poses every other
       // camera implies, judged by its own consistency threshold.
       std::set<int> others = all;
@@ -373,7 +393,6 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
       const Consistency con = CameraConsistency(in, named, others);
       result.camera_changes.push_back(ExplainCameraChange(rig, target, named, con.views, con.threshold_px));
     } else {
-      result.moved_modules.push_back(m);
       result.split_modules.push_back(m);
     }
   }
@@ -442,24 +461,21 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
       }
     }
   }
-  // Whole modules that moved: their pairs fail while each module is
-  // consistent in itself. A pair's closure only shows relative motion: with
-  // two modules, which one moved cannot be told, and since module 0 defines
-  // the reference frame the other one is named. With three or more, the
-  // module in the most failing pairs is named. Either way the verdict says
-  // "moved or a lens changed": a focal drift of one camera too small for any
-  // camera figure still scales its module's board pose, and fails the
-  // closure alone (a 0.01 % one does, end to end: docs/verify-and-check.md).
+  // Whole modules that moved, or a lens changed: their pairs fail while each
+  // module is consistent in itself. A pair's closure only shows relative
+  // motion: with two modules, which one changed cannot be told (module 0
+  // defines the reference frame, nothing more), so both are named and said
+  // to disagree. With three or more, the module in the most failing pairs is
+  // named. Either way the verdict says "moved or a lens changed": a focal
+  // drift of one camera too small for any camera figure still scales its
+  // module's board pose, and fails the closure alone (a 0.01 % one does, end
+  // to end: docs/verify-and-check.md). failed_pairs_of counts no pair with a
+  // module whose cameras disagree, so no split module is named again here.
   int most = 0;
   for (const auto& [m, count] : failed_pairs_of) most = std::max(most, count);
-  for (const auto& [m, count] : failed_pairs_of) {
-    const bool name = rig.num_modules() == 2 ? m != 0 : (count == most && count >= 2);
-    if (name && std::find(result.moved_modules.begin(), result.moved_modules.end(), m) == result.moved_modules.end()) {
-      result.moved_modules.push_back(m);
-      result.closure_modules.push_back(m);
-    }
-  }
-  std::sort(result.moved_modules.begin(), result.moved_modules.end());
+  for (const auto& [m, count] : failed_pairs_of)
+    if (rig.num_modules() == 2 || (count == most && count >= 2)) result.closure_modules.push_back(m);
+  result.closure_which_unknown = rig.num_modules() == 2 && !result.closure_modules.empty();
   return result;
 }
 

@@ -14,7 +14,8 @@
 //     captures, in mm (at the board centre) and degrees.
 // A module whose cameras disagree names the camera that also disagrees with
 // the other modules, and says whether a new pose or a new lens (focal length,
-// principal point) explains its corners, or that the check cannot tell.
+// principal point) explains its corners, either does (the check cannot
+// tell), or neither alone does.
 #pragma once
 
 #include <string>
@@ -47,24 +48,36 @@ struct CheckFigure {
 
 struct CheckResult {
   std::vector<CheckFigure> figures;
-  std::vector<int> moved_cameras;  // named by elimination, global indices
-  // For each of moved_cameras: whether it moved, its lens changed, or the
-  // check cannot tell (calib/check/camera_change.h). A camera without one is
-  // explained as moved.
+  // One per camera named by elimination (its module's cameras disagree and
+  // it also disagrees with the other modules), in the order named: what
+  // explains its corners, a new pose, a new lens, either (the check cannot
+  // tell), neither alone, or too few corners to tell
+  // (calib/check/camera_change.h).
   std::vector<CameraChange> camera_changes;
-  std::vector<int> moved_modules;  // its cameras disagree with no camera to blame, or a pair closure failed
-  // Of moved_modules, those named by failing closures alone (each module
-  // agrees with itself): a closure shows that two modules' board poses
-  // disagree, which a module's motion and a small change of one of their
-  // lenses (a focal length scales a module's pose) both do. Explained so.
+  // Modules named by failing closures alone (each module agrees with
+  // itself): a closure shows that two modules' board poses disagree, which a
+  // module's motion and a small change of one of their lenses (a focal
+  // length scales a module's pose) both do. With three or more modules, the
+  // module in the most failing pairs; with two, both, and
+  // closure_which_unknown is set: nothing outside the pair tells which one
+  // changed (module 0 only defines the reference frame).
   std::vector<int> closure_modules;
-  // Of moved_modules, those whose own two cameras disagree while neither
-  // disagrees with the other modules (or there are none): something in the
-  // module changed, a camera's pose or lens, not the module as a whole.
+  bool closure_which_unknown = false;
+  // Modules whose own two cameras disagree while neither disagrees with the
+  // other modules (or there are none): something in the module changed, a
+  // camera's pose or lens, not the module as a whole.
   std::vector<int> split_modules;
   bool ok() const;
   std::string Verdict() const { return ok() ? "ok" : "recalibrate"; }
-  std::string Explanation() const;  // one line naming what moved
+  std::string Explanation() const;  // one line: what changed, in no more words than the figures support
+  // Every camera named (camera_changes' cameras): the report's
+  // flagged_cameras (and moved_cameras, its old name; each change's kind
+  // says what explains it).
+  std::vector<int> FlaggedCameras() const;
+  // Every module named (split_modules and closure_modules, sorted): the
+  // report's flagged_modules. No figure tells a module's motion from a lens
+  // change, so none is said to have moved as a whole.
+  std::vector<int> FlaggedModules() const;
 };
 
 // Throws InputError(`where`, ...) unless the rig file holds the

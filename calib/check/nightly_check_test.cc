@@ -12,7 +12,10 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <functional>
+#include <limits>
+#include <map>
 #include <random>
 
 #include "calib/core/input_error.h"
@@ -24,6 +27,10 @@ namespace {
 
 constexpr double kNoisePx = 0.2;
 constexpr int kCaptures = 8;
+
+// How many named cameras the check said each CameraChangeKind of.
+using KindCounts = std::array<int, static_cast<int>(CameraChangeKind::kNotFitted) + 1>;
+int Said(const KindCounts& said, CameraChangeKind kind) { return said[static_cast<int>(kind)]; }
 
 struct Bump {
   int camera = -1;            // rotate this camera ...
@@ -112,12 +119,14 @@ TEST(NightlyCheck, NoFalseAlarmOnTheUnbumpedRigOverTwentySeeds) {
 }
 
 // Over seeds 1..20, in how many the check flags the rig bumped by
-// bump_for(seed), and in how many it names exactly what the bump moved (its
-// camera, or its module, and nothing else); a seed it misnames is printed
-// with every figure.
+// bump_for(seed), and in how many it names exactly what the figures can tell
+// of the bump (its camera; for a module, both modules of the default rig,
+// whose one closure cannot tell which of the two changed; nothing else); a
+// seed it misnames is printed with every figure.
 struct BumpReading {
   int flagged = 0, named = 0;
-  int called_lens = 0;  // named cameras said to have only a changed lens
+  KindCounts said = {};                          // named cameras by kind
+  std::map<std::string, int> explanations = {};  // seeds by the verdict's words
 };
 BumpReading ReadBumps(const std::function<Bump(unsigned)>& bump_for, double noise_px = kNoisePx) {
   const SimulatedRig truth = MakeDefaultRig();
@@ -130,9 +139,10 @@ BumpReading ReadBumps(const std::function<Bump(unsigned)>& bump_for, double nois
         RunNightlyCheck(stored, target, Observe(truth, target, bump, seed, noise_px), CheckOptions(), "test");
     reading.flagged += !r.ok();
     const std::vector<int> cameras = bump.camera >= 0 ? std::vector<int>{bump.camera} : std::vector<int>{};
-    const std::vector<int> modules = bump.module >= 0 ? std::vector<int>{bump.module} : std::vector<int>{};
-    for (const CameraChange& c : r.camera_changes) reading.called_lens += c.kind == CameraChangeKind::kLens;
-    if (r.moved_cameras == cameras && r.moved_modules == modules) {
+    const std::vector<int> modules = bump.module >= 0 ? std::vector<int>{0, 1} : std::vector<int>{};
+    for (const CameraChange& c : r.camera_changes) ++reading.said[static_cast<int>(c.kind)];
+    ++reading.explanations[r.Explanation()];
+    if (r.FlaggedCameras() == cameras && r.FlaggedModules() == modules) {
       ++reading.named;
     } else {
       std::string figures;
@@ -154,18 +164,29 @@ TEST(NightlyCheck, FlagsAndNamesACameraRotatedByFiveHundredthsOfADegree) {
   });
   EXPECT_GE(r.flagged, 19);
   EXPECT_GE(r.named, 19);
-  EXPECT_EQ(r.called_lens, 0);  // its new pose fits: never blamed on the lens alone
+  // Its new pose fits: never blamed on the lens alone, nor said to be
+  // explained by neither.
+  EXPECT_EQ(Said(r.said, CameraChangeKind::kLens), 0);
+  EXPECT_EQ(Said(r.said, CameraChangeKind::kUnexplained), 0);
 }
 
-TEST(NightlyCheck, FlagsAndNamesAModuleShiftedByATenthOfAMillimetre) {
-  const BumpReading r = ReadBumps([](unsigned) {
-    Bump bump;
-    bump.module = 1;
-    bump.translation_mm = 0.1;
-    return bump;
-  });
-  EXPECT_GE(r.flagged, 19);
-  EXPECT_GE(r.named, 19);
+// Either module of the two shifted 0.1 mm: flagged, and both modules named
+// as disagreeing, since their closure cannot tell which one changed (module 0
+// only defines the reference frame) nor a motion from a lens drift. A shift
+// of module 0 read "module 1 moved or a lens changed": the module that did
+// not change.
+TEST(NightlyCheck, FlagsAModuleShiftedByATenthOfAMillimetreAndSaysWhichPairDisagrees) {
+  for (int module : {0, 1}) {
+    BumpReading r = ReadBumps([module](unsigned) {
+      Bump bump;
+      bump.module = module;
+      bump.translation_mm = 0.1;
+      return bump;
+    });
+    EXPECT_GE(r.flagged, 19) << "module " << module;
+    EXPECT_GE(r.named, 19) << "module " << module;
+    EXPECT_GE(r.explanations["module 0 and module 1 disagree: one moved or a lens changed"], 19) << "module " << module;
+  }
 }
 
 // A lens drift of camera seed % 4 over seeds 1..`seeds`: how often it is
@@ -180,7 +201,7 @@ TEST(NightlyCheck, FlagsAndNamesAModuleShiftedByATenthOfAMillimetre) {
 // some 200 px from the centre that is 0.005 %.
 struct LensDriftReading {
   int flagged = 0, named = 0;
-  int said[3] = {0, 0, 0};          // by CameraChangeKind, over the named seeds
+  KindCounts said = {};             // over the named seeds
   double worst_focal_error_sd = 0;  // max |estimate - truth| / its standard error
 };
 LensDriftReading ReadLensDrifts(const LensDrift& drift, double noise_px, unsigned seeds) {
@@ -195,7 +216,7 @@ LensDriftReading ReadLensDrifts(const LensDrift& drift, double noise_px, unsigne
     const std::vector<BoardObservation> views = Observe(truth, target, bump, seed, noise_px);
     const CheckResult r = RunNightlyCheck(stored, target, views, CheckOptions(), "test");
     reading.flagged += !r.ok();
-    if (r.moved_cameras != std::vector<int>{bump.camera} || !r.moved_modules.empty()) {
+    if (r.FlaggedCameras() != std::vector<int>{bump.camera} || !r.FlaggedModules().empty()) {
       std::printf("seed %u lens of camera %d: %s\n", seed, bump.camera, r.Explanation().c_str());
       continue;
     }
@@ -211,10 +232,10 @@ LensDriftReading ReadLensDrifts(const LensDrift& drift, double noise_px, unsigne
     reading.worst_focal_error_sd =
         std::max(reading.worst_focal_error_sd, std::abs(change.focal_percent - drift.focal_percent) / sd_percent);
   }
+  std::printf("said: moved %d, lens %d, moved or lens %d, unexplained %d, not fitted %d\n", reading.said[0],
+              reading.said[1], reading.said[2], reading.said[3], reading.said[4]);
   return reading;
 }
-
-int Said(const LensDriftReading& r, CameraChangeKind kind) { return r.said[static_cast<int>(kind)]; }
 
 // 0.1 % of focal length (fx, fy), at 0.2 px corner noise: flagged and the
 // camera named, never as merely "moved". End to end, 0.1 % moves a module's
@@ -230,7 +251,8 @@ TEST(NightlyCheck, FlagsAndNamesACameraWhoseFocalLengthDriftedATenthOfAPercent) 
   const LensDriftReading r = ReadLensDrifts(drift, kNoisePx, 20);
   EXPECT_GE(r.flagged, 19);
   EXPECT_GE(r.named, 19);
-  EXPECT_EQ(Said(r, CameraChangeKind::kMoved), 0);
+  EXPECT_EQ(Said(r.said, CameraChangeKind::kMoved), 0);
+  EXPECT_EQ(Said(r.said, CameraChangeKind::kUnexplained), 0);  // the lens fit frees just what drifted
   EXPECT_LE(r.worst_focal_error_sd, 4.0);
 }
 
@@ -244,7 +266,7 @@ TEST(NightlyCheck, TellsALensDriftFromAMotionWhenTheCornersAreSharp) {
   const LensDriftReading r = ReadLensDrifts(drift, 0.03, 10);
   EXPECT_EQ(r.flagged, 10);
   EXPECT_EQ(r.named, 10);
-  EXPECT_EQ(Said(r, CameraChangeKind::kLens), 10);
+  EXPECT_EQ(Said(r.said, CameraChangeKind::kLens), 10);
   EXPECT_LE(r.worst_focal_error_sd, 4.0);
 }
 
@@ -257,7 +279,8 @@ TEST(NightlyCheck, FlagsAndNamesACameraWhosePrincipalPointMoved) {
   const LensDriftReading r = ReadLensDrifts(drift, kNoisePx, 20);
   EXPECT_GE(r.flagged, 19);
   EXPECT_GE(r.named, 19);
-  EXPECT_EQ(Said(r, CameraChangeKind::kMoved), 0);
+  EXPECT_EQ(Said(r.said, CameraChangeKind::kMoved), 0);
+  EXPECT_EQ(Said(r.said, CameraChangeKind::kUnexplained), 0);
 }
 
 // The verdict says no more than the figures tell: a closure cannot tell a
@@ -266,23 +289,38 @@ TEST(NightlyCheck, FlagsAndNamesACameraWhosePrincipalPointMoved) {
 TEST(NightlyCheck, ExplanationSaysNoMoreThanTheFiguresTell) {
   CheckResult r;
   r.figures = {{"pair_0_1_closure_mm", 0.1, 0.01, false, 8}};
-  r.moved_modules = {1};
-  r.closure_modules = {1};
-  EXPECT_EQ(r.Explanation(), "module 1 moved or a lens changed");
+  r.closure_modules = {0, 1};  // two modules
+  r.closure_which_unknown = true;
+  EXPECT_EQ(r.Explanation(), "module 0 and module 1 disagree: one moved or a lens changed");
+  EXPECT_EQ(r.FlaggedModules(), (std::vector<int>{0, 1}));
+  r.closure_modules = {2};  // three or more: the module in the most failing pairs
+  r.closure_which_unknown = false;
+  EXPECT_EQ(r.Explanation(), "module 2 moved or a lens changed");
   r.closure_modules.clear();
   r.split_modules = {1};
   EXPECT_EQ(r.Explanation(), "module 1's cameras disagree: one moved or its lens changed");
-  r.moved_modules.clear();
+  EXPECT_EQ(r.FlaggedModules(), std::vector<int>{1});
+  r.split_modules.clear();
   CameraChange lens;
   lens.camera = 2;
   lens.kind = CameraChangeKind::kLens;
   lens.focal_percent = 0.1;
   lens.principal_point_px = {-0.001, 0.25};
-  r.moved_cameras = {2};
   r.camera_changes = {lens};
   EXPECT_EQ(r.Explanation(), "camera 2's lens changed: focal length +0.100 %, principal point +0.00, +0.25 px");
+  EXPECT_EQ(r.FlaggedCameras(), std::vector<int>{2});
   r.camera_changes[0].kind = CameraChangeKind::kMovedOrLens;
-  EXPECT_EQ(r.Explanation(), "camera 2 moved or its lens changed");
+  EXPECT_EQ(r.Explanation(), "camera 2 moved or its lens changed (either explains its corners)");
+  r.camera_changes[0].kind = CameraChangeKind::kUnexplained;
+  r.camera_changes[0].moved_rms_px = std::numeric_limits<double>::infinity();  // its solve failed
+  r.camera_changes[0].lens_rms_px = 0.0812;
+  r.camera_changes[0].threshold_px = 0.0405;
+  EXPECT_EQ(r.Explanation(),
+            "camera 2 changed: neither a new pose nor a new lens alone explains its corners (the pose fit's solve "
+            "failed, residual 0.081 px with a new lens, against 0.041 px)");
+  r.camera_changes[0].kind = CameraChangeKind::kNotFitted;
+  r.camera_changes[0].corners = 4;
+  EXPECT_EQ(r.Explanation(), "camera 2 changed: too few corners (4) to fit a new pose or a new lens");
   r.camera_changes[0].kind = CameraChangeKind::kMoved;
   EXPECT_EQ(r.Explanation(), "camera 2 moved");
 }
@@ -307,6 +345,37 @@ TEST(NightlyCheck, BadInputIsRefused) {
   for (auto& v : foreign)
     for (auto& q : v.q_px) q.x() += 40;  // and another lens centre
   EXPECT_THROW(RunNightlyCheck(StoredRig(truth), target, foreign, CheckOptions(), "captures"), InputError);
+  // Captures that show the board to one camera alone check nothing: camera 0
+  // turned by a whole degree read "ok" with no figure at all (a second
+  // reading found it). So does a rig of which one camera saw nothing.
+  std::vector<BoardObservation> alone = Observe(
+      truth, target,
+      [] {
+        Bump b;
+        b.camera = 0;
+        b.rotation_deg = 1.0;
+        return b;
+      }(),
+      3);
+  std::erase_if(alone, [](const BoardObservation& v) { return v.camera != 0; });
+  ASSERT_GE(alone.size(), 3u);  // the check's minimum of captures
+  std::vector<BoardObservation> without_3 = views;
+  try {
+    RunNightlyCheck(StoredRig(truth), target, alone, CheckOptions(), "captures");
+    ADD_FAILURE() << "captures only camera 0 saw were judged";
+  } catch (const InputError& e) {
+    EXPECT_NE(
+        std::string(e.what()).find("camera(s) 0, 1, 2, 3 saw the board in no capture where another camera saw it too"),
+        std::string::npos)
+        << e.what();
+  }
+  std::erase_if(without_3, [](const BoardObservation& v) { return v.camera == 3; });
+  try {
+    RunNightlyCheck(StoredRig(truth), target, without_3, CheckOptions(), "captures");
+    ADD_FAILURE() << "captures camera 3 never saw were judged";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("camera(s) 3 saw"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
