@@ -36,15 +36,30 @@ std::vector<int> CheckResult::FlaggedModules() const {
   return {modules.begin(), modules.end()};
 }
 
+ClosureNaming NameClosureModules(const std::map<int, int>& failed_pairs_of) {
+  int most = 0;
+  for (const auto& [m, count] : failed_pairs_of) most = std::max(most, count);
+  ClosureNaming named;
+  for (const auto& [m, count] : failed_pairs_of)
+    if (count == most && count > 0) named.modules.push_back(m);
+  named.which_unknown = most == 1 || named.modules.size() > 1;
+  return named;
+}
+
 std::string CheckResult::Explanation() const {
   if (ok()) return "every figure within its threshold";
   std::ostringstream s;
   for (const CameraChange& c : camera_changes) s << c.Describe() << "; ";
   for (int m : split_modules) s << "module " << m << "'s cameras disagree: one moved or its lens changed; ";
   if (closure_which_unknown && closure_modules.size() == 2) {
-    // Two modules: their closure says they disagree, not which one changed.
+    // One failing pair: its closure says they disagree, not which one changed.
     s << "module " << closure_modules[0] << " and module " << closure_modules[1]
       << " disagree: one moved or a lens changed; ";
+  } else if (closure_which_unknown) {
+    s << "modules ";
+    for (size_t k = 0; k < closure_modules.size(); ++k)
+      s << (k == 0 ? "" : k + 1 == closure_modules.size() ? " and " : ", ") << closure_modules[k];
+    s << " disagree: one or more moved or a lens changed; ";
   } else {
     for (int m : closure_modules) s << "module " << m << " moved or a lens changed; ";
   }
@@ -463,19 +478,18 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   }
   // Whole modules that moved, or a lens changed: their pairs fail while each
   // module is consistent in itself. A pair's closure only shows relative
-  // motion: with two modules, which one changed cannot be told (module 0
-  // defines the reference frame, nothing more), so both are named and said
-  // to disagree. With three or more, the module in the most failing pairs is
-  // named. Either way the verdict says "moved or a lens changed": a focal
-  // drift of one camera too small for any camera figure still scales its
-  // module's board pose, and fails the closure alone (a 0.01 % one does, end
-  // to end: docs/verify-and-check.md). failed_pairs_of counts no pair with a
-  // module whose cameras disagree, so no split module is named again here.
-  int most = 0;
-  for (const auto& [m, count] : failed_pairs_of) most = std::max(most, count);
-  for (const auto& [m, count] : failed_pairs_of)
-    if (rig.num_modules() == 2 || (count == most && count >= 2)) result.closure_modules.push_back(m);
-  result.closure_which_unknown = rig.num_modules() == 2 && !result.closure_modules.empty();
+  // motion, so a module is named alone only when it is in more failing pairs
+  // than any other (NameClosureModules); a single failing pair (always so
+  // with two modules: module 0 defines the reference frame, nothing more) or
+  // a tie names the modules and says they disagree. Either way the verdict
+  // says "moved or a lens changed": a focal drift of one camera too small for
+  // any camera figure still scales its module's board pose, and fails the
+  // closure alone (a 0.01 % one does, end to end: docs/verify-and-check.md).
+  // failed_pairs_of counts no pair with a module whose cameras disagree, so
+  // no split module is named again here.
+  const ClosureNaming named = NameClosureModules(failed_pairs_of);
+  result.closure_modules = named.modules;
+  result.closure_which_unknown = named.which_unknown;
   return result;
 }
 

@@ -18,6 +18,7 @@
 // tell), or neither alone does.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -57,10 +58,9 @@ struct CheckResult {
   // Modules named by failing closures alone (each module agrees with
   // itself): a closure shows that two modules' board poses disagree, which a
   // module's motion and a small change of one of their lenses (a focal
-  // length scales a module's pose) both do. With three or more modules, the
-  // module in the most failing pairs; with two, both, and
-  // closure_which_unknown is set: nothing outside the pair tells which one
-  // changed (module 0 only defines the reference frame).
+  // length scales a module's pose) both do. NameClosureModules (below) says
+  // which: one module, or several of which the check cannot tell which
+  // changed (closure_which_unknown).
   std::vector<int> closure_modules;
   bool closure_which_unknown = false;
   // Modules whose own two cameras disagree while neither disagrees with the
@@ -79,6 +79,19 @@ struct CheckResult {
   // change, so none is said to have moved as a whole.
   std::vector<int> FlaggedModules() const;
 };
+
+// The modules failing closures name, from each module's count of failing
+// pairs (module -> count, modules in no failing pair absent): the module in
+// the most pairs, alone, when it is in at least two (it disagrees with
+// modules that agree among themselves); otherwise every module tied at the
+// top, and which_unknown: a single failing pair (always so with two modules:
+// module 0 only defines the reference frame), or a tie (a ring whose every
+// pair fails) tells that they disagree, not which one changed.
+struct ClosureNaming {
+  std::vector<int> modules;  // ascending
+  bool which_unknown = false;
+};
+ClosureNaming NameClosureModules(const std::map<int, int>& failed_pairs_of);
 
 // Throws InputError(`where`, ...) unless the rig file holds the
 // calibration residuals the thresholds need (provenance.residuals.camK_rms_px,

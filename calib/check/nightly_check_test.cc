@@ -325,6 +325,32 @@ TEST(NightlyCheck, ExplanationSaysNoMoreThanTheFiguresTell) {
   EXPECT_EQ(r.Explanation(), "camera 2 moved");
 }
 
+// Which modules failing closures name, from each module's count of failing
+// pairs: one module alone only when it is in more failing pairs than any
+// other; a single failing pair or a tie names the modules and says they
+// disagree. Before, a rig of three or more modules named every module tied
+// at the top as "moved or a lens changed" (a ring whose three pairs all
+// fail: each of the three), and nothing when a single pair failed.
+TEST(NightlyCheck, ClosuresNameOneModuleOnlyWhenItIsInTheMostFailingPairs) {
+  auto named = [](const std::map<int, int>& counts) {
+    const ClosureNaming n = NameClosureModules(counts);
+    CheckResult r;
+    r.figures = {{"pair_closure_mm", 1, 0.1, false, 8}};
+    r.closure_modules = n.modules;
+    r.closure_which_unknown = n.which_unknown;
+    return r.Explanation();
+  };
+  EXPECT_EQ(named({{0, 1}, {1, 1}}), "module 0 and module 1 disagree: one moved or a lens changed");  // two modules
+  EXPECT_EQ(named({{0, 1}, {1, 2}, {2, 1}}), "module 1 moved or a lens changed");  // a ring, module 1 moved
+  EXPECT_EQ(named({{0, 2}, {1, 2}, {2, 2}}), "modules 0, 1 and 2 disagree: one or more moved or a lens changed");
+  EXPECT_EQ(named({{1, 1}, {2, 1}}), "module 1 and module 2 disagree: one moved or a lens changed");  // one pair of 3
+  // Four modules, 2 and 3 moved together: all four pairs across fail, a tie.
+  EXPECT_EQ(named({{0, 2}, {1, 2}, {2, 2}, {3, 2}}),
+            "modules 0, 1, 2 and 3 disagree: one or more moved or a lens changed");
+  EXPECT_TRUE(NameClosureModules({}).modules.empty());
+  EXPECT_FALSE(NameClosureModules({}).which_unknown);
+}
+
 TEST(NightlyCheck, BadInputIsRefused) {
   const SimulatedRig truth = MakeDefaultRig();
   const Target target = DefaultTarget();
