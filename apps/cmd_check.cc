@@ -159,10 +159,8 @@ int RunCheck(int argc, char** argv) {
   // drift, on a module shift, and on a turned camera whose lens fit passes
   // too, a second reading found). What explains each: camera_changes' kind,
   // closure_modules and split_modules.
-  report["flagged_cameras"] = result.FlaggedCameras();
-  report["moved_cameras"] = result.FlaggedCameras();
-  report["flagged_modules"] = result.FlaggedModules();
-  report["moved_modules"] = result.FlaggedModules();
+  report["flagged_cameras"] = report["moved_cameras"] = result.FlaggedCameras();
+  report["flagged_modules"] = report["moved_modules"] = result.FlaggedModules();
   // Each named camera: what explains its corners (a new pose, a new lens,
   // either, neither, or too few corners to fit), with both fits' residuals
   // (null when not fitted) and the lens fit's estimate.

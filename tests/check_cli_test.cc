@@ -75,6 +75,17 @@ DbState ReadDb(const std::string& path) {
   return s;
 }
 
+// The simulator's truth rig as a calibration would have stored it: every
+// camera's residual RMS set to `rms_px` (the check's thresholds derive
+// from it). Returns it.
+Rig WriteStoredRig(const std::string& truth_path, double rms_px, const std::string& out_path) {
+  Rig rig = ReadRigFile(truth_path);
+  for (int c = 0; c < rig.num_cameras(); ++c)
+    rig.provenance().residuals["cam" + std::to_string(c) + "_rms_px"] = rms_px;
+  WriteRigFile(rig, out_path);
+  return rig;
+}
+
 TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
   const std::string dir = ::testing::TempDir() + "/check_cli_" + std::to_string(getpid());
   fs::remove_all(dir);
@@ -84,9 +95,7 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
   ASSERT_EQ(r.code, 0) << r.err;
   // The stored rig: the true rig with the residuals a calibration would have
   // written (the check derives its thresholds from them).
-  Rig rig = ReadRigFile(dir + "/ds/truth/rig.yaml");
-  for (int c = 0; c < rig.num_cameras(); ++c) rig.provenance().residuals["cam" + std::to_string(c) + "_rms_px"] = 0.2;
-  WriteRigFile(rig, dir + "/rig.yaml");
+  const Rig rig = WriteStoredRig(dir + "/ds/truth/rig.yaml", 0.2, dir + "/rig.yaml");
   const std::string db = dir + "/history.sqlite", report = dir + "/check.json";
   auto check = [&](const std::string& captures, const std::string& rig_path) {
     return RunCli("check --rig " + rig_path + " --captures " + captures + " --target " + dir +
@@ -287,9 +296,7 @@ TEST(CheckCli, TheReportListsEveryNamedCameraAndModuleAndWhatExplainsEach) {
   fs::create_directories(dir);
   Result r = RunCli("simulate --out " + dir + "/unmoved --seed 21 --calibration-captures 1 --no-scenes");
   ASSERT_EQ(r.code, 0) << r.err;
-  Rig rig = ReadRigFile(dir + "/unmoved/truth/rig.yaml");
-  for (int c = 0; c < rig.num_cameras(); ++c) rig.provenance().residuals["cam" + std::to_string(c) + "_rms_px"] = 0.03;
-  WriteRigFile(rig, dir + "/rig.yaml");
+  WriteStoredRig(dir + "/unmoved/truth/rig.yaml", 0.03, dir + "/rig.yaml");
   // A night of 8 captures after `bump`, checked: its report.
   auto night = [&](const std::string& name, const std::string& bump) {
     const std::string captures = dir + "/" + name, report = dir + "/" + name + ".json";
