@@ -1,5 +1,6 @@
 // `stereorig verify`: VDI/VDE 2634-2 acceptance figures from reconstructions
-// of a reference artifact, judged against the MPE. Exit 0 all pass, 1 any
+// of a reference artifact, judged against the MPE under an ISO 14253-1
+// decision rule (--decision-rule, default simple acceptance). Exit 0 all pass, 1 any
 // judged position fails, 2 bad input or (with no failure) a position not
 // judged (printed all the same; no report written).
 #include <algorithm>
@@ -29,7 +30,39 @@ nlohmann::json FigureJson(const Figure& f, bool judged) {
   if (f.certificate_standard_uncertainty_mm) {
     j["certificate_standard_uncertainty_mm"] = *f.certificate_standard_uncertainty_mm;
   }
+  // ISO 14253-1's zone of the figure with U = 2u (decision_rule.h); a figure
+  // without u has neither.
+  if (const auto zone = f.zone()) {
+    j["expanded_uncertainty_mm"] = f.ExpandedUncertaintyMm();
+    j["zone"] = ConformanceZoneName(*zone);
+  }
   return j;
+}
+
+// The zone's name and its condition, for the uncertainty line.
+std::string ZoneText(ConformanceZone zone) {
+  switch (zone) {
+    case ConformanceZone::kConformance:
+      return "conformance zone (|value| + 2u <= MPE)";
+    case ConformanceZone::kUncertaintyRange:
+      return "uncertainty range (within 2u of the MPE)";
+    case ConformanceZone::kNonconformance:
+      return "nonconformance zone (|value| - 2u > MPE)";
+  }
+  return "?";
+}
+
+// What each rule passes, for the table's heading.
+const char* DecisionRuleText(DecisionRule rule) {
+  switch (rule) {
+    case DecisionRule::kSimpleAcceptance:
+      return "simple acceptance: a figure passes if |value| <= MPE";
+    case DecisionRule::kGuardedAcceptance:
+      return "guarded acceptance: a figure passes only if |value| + 2u <= MPE (proven within it)";
+    case DecisionRule::kGuardedRejection:
+      return "guarded rejection: a figure fails only if |value| - 2u > MPE (proven beyond it)";
+  }
+  return "?";
 }
 
 // A figure's u and its parts: the fit's and the certificate's (U / k),
@@ -37,10 +70,11 @@ nlohmann::json FigureJson(const Figure& f, bool judged) {
 void PrintUncertainty(size_t position, const Figure& f, double coverage_factor) {
   if (!f.standard_uncertainty_mm) return;
   const double certificate_mm = f.certificate_standard_uncertainty_mm.value_or(0.0);
-  char fit[64] = "no fit part: a range of residuals";
+  char fit[64] = "no fit part: a range of residuals";  // P_F, F
   if (f.fit_standard_uncertainty_mm) std::snprintf(fit, sizeof fit, "fit %.4f mm", *f.fit_standard_uncertainty_mm);
-  std::printf("%-8zu %s: u %.4f mm = %s (+) certificate %.4f mm (U %.4f mm / k %g)\n", position, f.name.c_str(),
-              *f.standard_uncertainty_mm, fit, certificate_mm, certificate_mm * coverage_factor, coverage_factor);
+  std::printf("%-8zu %s: u %.4f mm = %s (+) certificate %.4f mm (U %.4f mm / k %g); 2u %.4f mm: %s\n", position,
+              f.name.c_str(), *f.standard_uncertainty_mm, fit, certificate_mm, certificate_mm * coverage_factor,
+              coverage_factor, f.ExpandedUncertaintyMm(), ZoneText(*f.zone()).c_str());
 }
 
 // Each fitted sphere (1 for a sphere, 2 for a ball bar): its size, how much
@@ -102,14 +136,24 @@ int RunVerify(int argc, char** argv) {
       "stderr, writing no report, as for bad input. Bad input in any cloud stops the run before anything is "
       "printed or written. The artifact file's uncertainties are its certificate's expanded ones, U at "
       "k = 2 (or its uncertainty_coverage_factor): U / k enters P_S (diameter), SD (centre distance) and F (flatness) "
-      "in quadrature with the fit's, and the rules above read the combined u. The table "
+      "in quadrature with the fit's, and the rules above read the combined u. A sphere's form_uncertainty_mm "
+      "(its certified form) is P_F's, as a plate's flatness_uncertainty_mm is F's.\n\n"
+      "--decision-rule says how a figure and its expanded uncertainty 2u are judged against the MPE (ISO 14253-1; "
+      "the rules as ILAC-G8 names them): simple (default: pass if |value| <= MPE, what the standard's tables "
+      "compare), guarded-acceptance (pass only if |value| + 2u <= MPE: conformance proven; for whoever must prove "
+      "the rig conforms, e.g. a supplier at delivery) or guarded-rejection (fail only if |value| - 2u > MPE: "
+      "nonconformance proven; for whoever must prove it does not). Each figure's zone (conformance, uncertainty "
+      "range, nonconformance) is printed and reported whatever the rule; a figure without u (P_F or F against an "
+      "exact certificate) has none and every rule judges it as simple does. The refusal of a figure over 10% of its "
+      "MPE holds under every rule. The table "
       "gives, per position, each figure's standard uncertainty (u_mm; both parts on a line of their own), the points "
       "in the cloud, the filled ones "
       "skipped, those on the artifact, those excluded and those used, and per sphere its diameter, the diameter's "
       "standard uncertainty, the half-angle of the cap its points cover and its form (the range of its residuals; "
       "on a ball bar reported, not judged: a patch one grid period off on one ball shows there); per plate the "
       "outline of its face's dense part.\n\n"
-      "Exit codes: 0 every figure passes; 1 a figure of a judged position exceeds its MPE; 2 bad input, or a "
+      "Exit codes: 0 every figure passes; 1 a figure of a judged position fails (under the decision rule); 2 bad "
+      "input, or a "
       "position not judged (and none failed).\n\n"
       "Example:\n  stereorig verify --artifact datasets/artifacts/sphere_38mm.yaml --cloud sphere_pos1.ply "
       "--cloud sphere_pos2.ply --report verify.json",
@@ -128,7 +172,16 @@ int RunVerify(int argc, char** argv) {
                  "projector whose grid-period-off error is deeper than ~3.5 mm")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  std::string rule_name = DecisionRuleName(options.decision_rule);
+  app.add_option("--decision-rule", rule_name,
+                 "simple (|value| <= MPE), guarded-acceptance (|value| + 2u <= MPE) or guarded-rejection (fail only "
+                 "if |value| - 2u > MPE): ISO 14253-1, see above")
+      ->capture_default_str()
+      ->check(CLI::IsMember({DecisionRuleName(DecisionRule::kSimpleAcceptance),
+                             DecisionRuleName(DecisionRule::kGuardedAcceptance),
+                             DecisionRuleName(DecisionRule::kGuardedRejection)}));
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
+  options.decision_rule = *ParseDecisionRule(rule_name);
   OutputPaths outputs;  // the report's path checked before the clouds are read and judged
   outputs.Protect(artifact_path, "the artifact file (--artifact)");
   for (const std::string& cloud : clouds) outputs.Protect(cloud, "a cloud (--cloud)");
@@ -148,18 +201,21 @@ int RunVerify(int argc, char** argv) {
   // the report written. Otherwise the run is not judged: exit 2 with the
   // reason on stderr and, as for bad input, no report written (an earlier
   // one at that path stays as it was: docs/formats.md).
-  const VerifySummary summary = Summarise(positions);
+  const VerifySummary summary = Summarise(positions, options.decision_rule);
   const bool all_judged = summary.not_judged_positions.empty();
   const bool judged_failure = std::any_of(positions.begin(), positions.end(),
                                           [](const ArtifactEvaluation& e) { return e.judged() && !e.pass(); });
 
   std::printf("artifact: %s (%s); capture band %.1f mm\n", artifact.name.c_str(), ArtifactTypeName(artifact.type),
               positions.front().capture_band_mm);
+  std::printf("decision rule: %s\n", DecisionRuleText(options.decision_rule));
   std::printf("%-8s %-6s %10s %8s %7s %4s %8s %7s %8s %8s %8s %10s\n", "position", "figure", "value_mm", "u_mm",
               "mpe_mm", "pass", "cloud", "filled", "artifact", "excluded", "used", "mean|e|_mm");
   nlohmann::json report = {{"artifact", artifact.name},
                            {"type", ArtifactTypeName(artifact.type)},
-                           {"uncertainty_coverage_factor", artifact.uncertainty_coverage_factor}};
+                           {"uncertainty_coverage_factor", artifact.uncertainty_coverage_factor},
+                           {"decision_rule", DecisionRuleName(options.decision_rule)},
+                           {"decision_coverage_factor", kDecisionCoverageFactor}};
   for (size_t i = 0; i < positions.size(); ++i) {
     const ArtifactEvaluation& e = positions[i];
     nlohmann::json pj = {{"cloud", clouds[i]},
@@ -204,7 +260,8 @@ int RunVerify(int argc, char** argv) {
       "u_mm = the figure's standard uncertainty (k = 1): the fit's (its covariance) and the certificate's (U / k) "
       "in quadrature; points: cloud = all vertices; "
       "filled = added by hole filling (module 255), skipped; artifact = within the capture band; excluded = the "
-      "largest residuals (<= 0.3%%); used = in the figures; pass - = not judged (the line NOT JUDGED says why)\n");
+      "largest residuals (<= 0.3%%); used = in the figures; pass: under the decision rule, - = not judged (the line "
+      "NOT JUDGED says why)\n");
   const size_t judged = positions.size() - summary.not_judged_positions.size();
   if (all_judged) {
     std::printf("summary over %zu position(s):", positions.size());
@@ -215,7 +272,12 @@ int RunVerify(int argc, char** argv) {
   }
   report["summary"]["worst"] = nlohmann::json::array();
   for (const Figure& f : summary.worst) {
-    std::printf("  %s %.4f mm (MPE %.3f) %s", f.name.c_str(), f.value_mm, f.mpe_mm, f.pass ? "pass" : "FAIL");
+    if (options.decision_rule != DecisionRule::kSimpleAcceptance && f.standard_uncertainty_mm) {
+      std::printf("  %s %.4f mm (2u %.4f, MPE %.3f) %s", f.name.c_str(), f.value_mm, f.ExpandedUncertaintyMm(),
+                  f.mpe_mm, f.pass ? "pass" : "FAIL");
+    } else {
+      std::printf("  %s %.4f mm (MPE %.3f) %s", f.name.c_str(), f.value_mm, f.mpe_mm, f.pass ? "pass" : "FAIL");
+    }
     report["summary"]["worst"].push_back(FigureJson(f, true));
   }
   const char* verdict = judged_failure ? "FAIL" : !all_judged ? "NOT JUDGED" : "PASS";

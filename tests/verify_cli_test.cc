@@ -378,4 +378,52 @@ TEST(VerifyCli, APositionNotJudgedAmongJudgedOnesIsShownAndAJudgedFailureStillFa
   EXPECT_FALSE(std::filesystem::exists(report));
 }
 
+// --decision-rule (ISO 14253-1). Truth: the exact sphere 1.4 mm and 1.6 mm
+// too large in diameter, certified to U 0.28 mm at k = 2 (u 0.14 mm, within
+// the refusal's 0.15 mm; the fit's part is rounding), so 2u = 0.28 mm and
+// both lie in the uncertainty range [1.22, 1.78] mm. Simple acceptance
+// passes 1.4 and fails 1.6; guarded acceptance fails both; guarded rejection
+// passes both. The zone is reported whatever the rule; a rule not among the
+// three is bad usage: exit 2, one line, no report.
+TEST(VerifyCli, TheDecisionRuleJudgesTheUncertaintyRangeAndTheReportSaysWhichRuleAndZone) {
+  const std::string artifact = WriteArtifact(
+      "format: stereorig-artifact\nversion: 1\nunits: mm\nname: test sphere\ntype: sphere\n"
+      "diameter_mm: 38.1\ndiameter_uncertainty_mm: 0.28\n");
+  const std::string within = WriteSphere("rule_14.ply", 19.05 + 0.7), beyond = WriteSphere("rule_16.ply", 19.05 + 0.8);
+  const std::string report = ::testing::TempDir() + "/verify_rule_" + std::to_string(getpid()) + ".json";
+  struct Case {
+    const char* rule;
+    int within_exit, beyond_exit;
+  };
+  for (const Case& c : {Case{"simple", 0, 1}, Case{"guarded-acceptance", 1, 1}, Case{"guarded-rejection", 0, 0}}) {
+    for (const auto& [cloud, expected_exit] : {std::pair{within, c.within_exit}, std::pair{beyond, c.beyond_exit}}) {
+      std::filesystem::remove(report);
+      const auto r = RunCli("verify --artifact " + artifact + " --cloud " + cloud + " --decision-rule " + c.rule +
+                            " --report " + report);
+      EXPECT_EQ(r.code, expected_exit) << c.rule << " " << cloud << "\n" << r.out << r.err;
+      EXPECT_NE(r.out.find(std::string("verdict: ") + (expected_exit == 0 ? "PASS" : "FAIL")), std::string::npos)
+          << r.out;
+      EXPECT_NE(r.out.find("2u 0.2800 mm: uncertainty range"), std::string::npos) << r.out;
+      std::ifstream f(report);
+      ASSERT_TRUE(f.good()) << c.rule;
+      const auto j = nlohmann::json::parse(f);
+      EXPECT_EQ(j["decision_rule"], c.rule);
+      EXPECT_EQ(j["decision_coverage_factor"].get<double>(), 2.0);
+      const auto& p_s = j["positions"][0]["figures"][1];
+      EXPECT_EQ(p_s["name"], "P_S");
+      EXPECT_EQ(p_s["zone"], "uncertainty_range");
+      EXPECT_NEAR(p_s["expanded_uncertainty_mm"].get<double>(), 0.28, 1e-6);
+      EXPECT_EQ(p_s["pass"].get<bool>(), expected_exit == 0);
+      EXPECT_FALSE(j["positions"][0]["figures"][0].contains("zone"));  // P_F: no u, no zone
+    }
+  }
+  std::filesystem::remove(report);
+  const auto r =
+      RunCli("verify --artifact " + artifact + " --cloud " + within + " --decision-rule guarded --report " + report);
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("--decision-rule"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(report));
+}
+
 }  // namespace

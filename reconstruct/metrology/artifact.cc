@@ -46,6 +46,7 @@ Artifact Parse(YamlMap m) {
     a.type = ArtifactType::kSphere;
     a.sphere_diameter_mm = Positive(m, "diameter_mm");
     a.sphere_diameter_uncertainty_mm = NonNegative(m, "diameter_uncertainty_mm");
+    a.sphere_form_uncertainty_mm = NonNegative(m, "form_uncertainty_mm");
   } else if (type == "ballbar") {
     a.type = ArtifactType::kBallBar;
     a.sphere_diameter_mm = Positive(m, "sphere_diameter_mm");
@@ -101,6 +102,12 @@ std::string ArtifactToYaml(const Artifact& a) {
     case ArtifactType::kSphere:
       o << "diameter_mm: " << FormatDouble(a.sphere_diameter_mm) << "\n"
         << "diameter_uncertainty_mm: " << FormatDouble(a.sphere_diameter_uncertainty_mm) << "\n";
+      // Only where given: a file without it reads the same in builds that
+      // predate the key (which refuse an unknown key).
+      if (a.sphere_form_uncertainty_mm > 0) {
+        o << "form_uncertainty_mm: " << FormatDouble(a.sphere_form_uncertainty_mm)
+          << "   # U of the certified form (P_F)\n";
+      }
       break;
     case ArtifactType::kBallBar:
       o << "sphere_diameter_mm: " << FormatDouble(a.sphere_diameter_mm) << "\n"

@@ -28,6 +28,7 @@ struct Artifact {
   ArtifactType type = ArtifactType::kSphere;
   double sphere_diameter_mm = 0;              // sphere, and each ball of a ball bar
   double sphere_diameter_uncertainty_mm = 0;  // U of the certified diameter
+  double sphere_form_uncertainty_mm = 0;      // sphere: U of its certified form (P_F's reference)
   double center_distance_mm = 0;              // ball bar
   double center_distance_uncertainty_mm = 0;  // U of the certified centre distance
   double plate_length_mm = 0;                 // plate

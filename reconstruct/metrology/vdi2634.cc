@@ -46,8 +46,7 @@ Figure MakeFigure(const std::string& name, double value, double mpe) {
   f.name = name;
   f.value_mm = value;
   f.mpe_mm = mpe;
-  f.pass = std::abs(value) <= mpe;
-  return f;
+  return f;  // pass: JudgeFigures, once its uncertainty is known
 }
 
 // The figure's standard uncertainty from its parts, either of which may be
@@ -63,6 +62,7 @@ void SetUncertainty(Figure* f, std::optional<double> fit_mm, std::optional<doubl
 const char* CertifiedQuantity(const std::string& figure) {
   if (figure == "P_S") return "diameter";
   if (figure == "SD") return "centre distance";
+  if (figure == "P_F") return "sphere's form";
   return "flatness";
 }
 
@@ -109,31 +109,41 @@ std::string UndeterminedText(const Figure& f, const ArtifactEvaluation& e, const
   return text + buf;
 }
 
+// Whether figure f is determined enough to judge: no uncertainty at all (a
+// range of residuals against an exact reference), or a combined u within
+// VerifyOptions::max_uncertainty_fraction_of_mpe of its MPE. A non-finite or
+// non-positive fit part counts as undetermined (a certificate's 0 is an
+// exact reference).
+bool Determined(const Figure& f, const VerifyOptions& o) {
+  if (!f.standard_uncertainty_mm) return true;
+  const bool fit_determined = !f.fit_standard_uncertainty_mm || *f.fit_standard_uncertainty_mm > 0;
+  return fit_determined && *f.standard_uncertainty_mm <= o.max_uncertainty_fraction_of_mpe * f.mpe_mm;
+}
+
 // Why a position whose verdict would rest on a figure the fit or the
-// certificate leaves undetermined (its standard uncertainty, both parts
-// combined, over VerifyOptions::max_uncertainty_fraction_of_mpe of its MPE:
-// its value would be the fit's noise, or its reference not known well enough)
-// is not judged: a PASS cannot be claimed from it. Empty when the position
-// fails beyond doubt without it: another figure fails (P_F has no
-// uncertainty), or this one by more than twice its combined uncertainty
-// (|value| - 2u > MPE); such a position is judged, FAIL. A non-finite or
-// non-positive fit part counts as undetermined (a certificate's 0 is an exact
-// reference).
+// certificate leaves undetermined (Determined: its value would be the fit's
+// noise, or its reference not known well enough) is not judged: a PASS
+// cannot be claimed from it. Empty when the position fails without it: a
+// figure that fails the decision rule is determined itself (P_F without a
+// form certificate always is), or fails beyond doubt (|value| - 2u > MPE:
+// ISO 14253-1's nonconformance zone, however large u); such a position is
+// judged, FAIL.
 std::string NotJudgedReason(const ArtifactEvaluation& e, const std::string& coverage, double coverage_factor,
                             const VerifyOptions& o) {
   for (const Figure& f : e.figures) {
     if (f.pass) continue;
-    const double u_mm = f.standard_uncertainty_mm.value_or(0.0);
-    if (std::isfinite(u_mm) && std::abs(f.value_mm) - 2 * u_mm > f.mpe_mm) return "";  // fails beyond doubt
+    if (Determined(f, o) || f.zone() == ConformanceZone::kNonconformance) return "";
   }
   for (const Figure& f : e.figures) {
-    if (!f.standard_uncertainty_mm) continue;
-    const double limit_mm = o.max_uncertainty_fraction_of_mpe * f.mpe_mm;
-    const bool fit_determined = !f.fit_standard_uncertainty_mm || *f.fit_standard_uncertainty_mm > 0;
-    if (fit_determined && *f.standard_uncertainty_mm <= limit_mm) continue;
-    return UndeterminedText(f, e, coverage, coverage_factor, limit_mm, o);
+    if (Determined(f, o)) continue;
+    return UndeterminedText(f, e, coverage, coverage_factor, o.max_uncertainty_fraction_of_mpe * f.mpe_mm, o);
   }
   return "";
+}
+
+// Each figure's pass under the rule, from its value and its U (set above).
+void JudgeFigures(DecisionRule rule, std::vector<Figure>* figures) {
+  for (Figure& f : *figures) f.pass = Passes(rule, f.value_mm, f.ExpandedUncertaintyMm(), f.mpe_mm);
 }
 
 std::string CapsText(const std::vector<double>& cap_half_angles_deg) {
@@ -435,8 +445,13 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       e.sphere_form_mm = {Range(fit.residuals_mm)};
       e.figures = {MakeFigure("P_F", e.sphere_form_mm[0], a.mpe.probing_form_mm),
                    MakeFigure("P_S", 2 * fit.radius_mm - a.sphere_diameter_mm, a.mpe.probing_size_mm)};
+      // P_F: the sphere's own form is in the measured range; its certificate
+      // (if any) is P_F's uncertainty, as the flatness certificate is F's.
+      if (a.sphere_form_uncertainty_mm > 0)
+        SetUncertainty(&e.figures[0], std::nullopt, a.StandardUncertaintyMm(a.sphere_form_uncertainty_mm));
       SetUncertainty(&e.figures[1], u.diameter_std_mm, a.StandardUncertaintyMm(a.sphere_diameter_uncertainty_mm));
       ResidualStats(fit.residuals_mm, &e);
+      JudgeFigures(o.decision_rule, &e.figures);
       e.not_judged_reason =
           NotJudgedReason(e, CapsText(e.sphere_cap_half_angles_deg), a.uncertainty_coverage_factor, o);
       break;
@@ -552,6 +567,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
                                                                      : std::numeric_limits<double>::infinity(),
                      a.StandardUncertaintyMm(a.center_distance_uncertainty_mm));
       ResidualStats(all_residuals, &e);
+      JudgeFigures(o.decision_rule, &e.figures);
       e.not_judged_reason =
           NotJudgedReason(e, CapsText(e.sphere_cap_half_angles_deg), a.uncertainty_coverage_factor, o);
       break;
@@ -599,6 +615,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       if (a.flatness_uncertainty_mm > 0)
         SetUncertainty(&e.figures[0], std::nullopt, a.StandardUncertaintyMm(a.flatness_uncertainty_mm));
       ResidualStats(fit.residuals_mm, &e);
+      JudgeFigures(o.decision_rule, &e.figures);
       e.not_judged_reason = NotJudgedReason(e, "", a.uncertainty_coverage_factor, o);
       break;
     }
@@ -606,25 +623,27 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
   return e;
 }
 
-VerifySummary Summarise(const std::vector<ArtifactEvaluation>& positions) {
+VerifySummary Summarise(const std::vector<ArtifactEvaluation>& positions, DecisionRule rule) {
   VerifySummary s;
+  s.pass = !positions.empty();
   std::map<std::string, Figure> worst;
+  auto judged_magnitude = [rule](const Figure& f) {
+    return JudgedMagnitudeMm(rule, f.value_mm, f.ExpandedUncertaintyMm());
+  };
   for (size_t i = 0; i < positions.size(); ++i) {
     const ArtifactEvaluation& p = positions[i];
     if (!p.judged()) {
       s.not_judged_positions.push_back(static_cast<int>(i));
+      s.pass = false;
       continue;
     }
     for (const Figure& f : p.figures) {
+      s.pass = s.pass && f.pass;
       auto it = worst.find(f.name);
-      if (it == worst.end() || std::abs(f.value_mm) > std::abs(it->second.value_mm)) worst[f.name] = f;
+      if (it == worst.end() || judged_magnitude(f) > judged_magnitude(it->second)) worst[f.name] = f;
     }
   }
-  s.pass = !positions.empty() && s.not_judged_positions.empty();
-  for (const auto& [name, f] : worst) {
-    s.worst.push_back(f);
-    s.pass = s.pass && f.pass;
-  }
+  for (const auto& [name, f] : worst) s.worst.push_back(f);
   return s;
 }
 

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "reconstruct/metrology/artifact.h"
+#include "reconstruct/metrology/decision_rule.h"
 
 namespace stereorig {
 
@@ -68,6 +69,14 @@ struct VerifyOptions {
   // 0.005 mm over a hemisphere, 0.12 mm over a 20-degree cap and 0.5 mm over
   // a 10-degree cap (sphere_uncertainty_test.cc; docs/verify-and-check.md).
   double max_uncertainty_fraction_of_mpe = 0.1;
+  // How a figure and its expanded uncertainty U = 2u are judged against the
+  // MPE (decision_rule.h, ISO 14253-1): simple acceptance (|value| <= MPE,
+  // the default), guarded acceptance (|value| + U <= MPE) or guarded
+  // rejection (fail only if |value| - U > MPE). A figure without u (P_F
+  // without the certificate's form_uncertainty_mm, F without its
+  // flatness_uncertainty_mm) is judged with U = 0 by every rule. The
+  // refusal above holds under every rule: its u is a floor, not the error.
+  DecisionRule decision_rule = DecisionRule::kSimpleAcceptance;
   unsigned seed = 1;
   void Check() const;
 };
@@ -76,20 +85,33 @@ struct Figure {
   std::string name;  // "P_F", "P_S", "SD", "F"
   double value_mm = 0;
   double mpe_mm = 0;
-  bool pass = false;  // |value| <= mpe
+  bool pass = false;  // within the MPE under VerifyOptions::decision_rule (simple: |value| <= mpe)
   // value_mm's standard uncertainty (k = 1): its two parts below combined in
   // quadrature, u = sqrt(u_fit^2 + u_certificate^2) (independent sources:
   // the measurement's noise, the reference's calibration; VDI/VDE 2634-2 and
   // ISO 10360 count the artifact's calibration uncertainty in the test's).
-  // P_S and SD have both; F the certificate's alone (a range of residuals has
-  // no fit covariance); P_F none (the sphere's form is measured against its
-  // own fit, whatever its certified size). Absent where neither part is.
+  // P_S and SD have both; F and P_F the certificate's alone (a range of
+  // residuals has no fit covariance; P_F's is the sphere's certified form,
+  // form_uncertainty_mm, not its size: the form is measured against the
+  // sphere's own fit). Absent where neither part is (an exact certificate
+  // leaves a range without one, not with 0).
   std::optional<double> standard_uncertainty_mm;
   // From the fit's covariance (sphere_uncertainty.h): P_S, SD.
   std::optional<double> fit_standard_uncertainty_mm;
   // The certificate's U / k of the certified value the figure is taken
-  // against: the diameter (P_S), the centre distance (SD), the flatness (F).
+  // against: the diameter (P_S), the centre distance (SD), the flatness (F);
+  // for P_F the sphere's certified form.
   std::optional<double> certificate_standard_uncertainty_mm;
+  // U = kDecisionCoverageFactor * u, what the guarded rules read; 0 without u.
+  double ExpandedUncertaintyMm() const {
+    return standard_uncertainty_mm ? kDecisionCoverageFactor * *standard_uncertainty_mm : 0.0;
+  }
+  // ISO 14253-1's zone of value_mm against mpe_mm with that U; none
+  // without u (a figure whose uncertainty is unknown is in no proven zone).
+  std::optional<ConformanceZone> zone() const {
+    if (!standard_uncertainty_mm) return std::nullopt;
+    return ZoneOf(value_mm, ExpandedUncertaintyMm(), mpe_mm);
+  }
 };
 
 struct ArtifactEvaluation {
@@ -141,13 +163,16 @@ struct ArtifactEvaluation {
 ArtifactEvaluation EvaluateArtifact(const Artifact& artifact, const std::vector<Eigen::Vector3d>& points_mm,
                                     const VerifyOptions& options, const std::string& where);
 
-// Several positions of the same artifact: per figure, the worst |value| of
-// the judged positions. No PASS is claimed while a position is not judged.
+// Several positions of the same artifact: per figure, the judged position
+// nearest to failing under the decision rule (the largest
+// JudgedMagnitudeMm: under simple acceptance the largest |value|). No PASS is
+// claimed while a position is not judged.
 struct VerifySummary {
-  std::vector<Figure> worst;              // one per figure name, the judged position with the largest |value|
+  std::vector<Figure> worst;              // one per figure name
   std::vector<int> not_judged_positions;  // indices into the positions given
-  bool pass = false;                      // every position judged, and every figure within its MPE
+  bool pass = false;                      // every position judged, and every figure of each within its MPE
 };
-VerifySummary Summarise(const std::vector<ArtifactEvaluation>& positions);
+VerifySummary Summarise(const std::vector<ArtifactEvaluation>& positions,
+                        DecisionRule rule = DecisionRule::kSimpleAcceptance);
 
 }  // namespace stereorig

@@ -876,6 +876,131 @@ TEST(Vdi2634, ACertificateThatCouldExplainAFailureIsNotIgnored) {
   EXPECT_FALSE(bigger.pass());
 }
 
+// --- Decision rules (ISO 14253-1; decision_rule.h). ---
+//
+// Truth: exact samples of a sphere whose diameter is off by a known amount
+// (the fit's part of u is rounding, ~1e-7 mm), certified to U 0.28 mm at
+// k = 2: u = 0.14 mm, within the 0.15 mm the refusal allows, so U = 2u =
+// 0.28 mm and the conformance zone ends at 1.22 mm, the nonconformance zone
+// starts beyond 1.78 mm. P_S 1.0 is in the first, 1.4 and 1.6 in the
+// uncertainty range, 2.0 in the second.
+std::vector<Eigen::Vector3d> ExactSphere(double diameter_mm) {
+  std::mt19937 rng(1);
+  auto s = SphereCap({3, -2, 1}, diameter_mm / 2, {0, 0, -1}, 80, 0.5, 0, &rng);
+  const auto s2 = SphereCap({3, -2, 1}, diameter_mm / 2, {0, 0, 1}, 80, 0.5, 0, &rng);
+  s.insert(s.end(), s2.begin(), s2.end());
+  return s;
+}
+
+TEST(Vdi2634, EachDecisionRuleJudgesTheUncertaintyRangeItsOwnWay) {
+  Artifact a = SphereArtifact();
+  a.sphere_diameter_uncertainty_mm = 0.28;
+  struct Case {
+    double size_error_mm;
+    ConformanceZone zone;
+    bool simple, guarded_acceptance, guarded_rejection;
+  };
+  for (const Case& c : {Case{1.0, ConformanceZone::kConformance, true, true, true},
+                        Case{1.4, ConformanceZone::kUncertaintyRange, true, false, true},
+                        Case{1.6, ConformanceZone::kUncertaintyRange, false, false, true},
+                        Case{2.0, ConformanceZone::kNonconformance, false, false, false}}) {
+    const auto points = ExactSphere(38.1 + c.size_error_mm);
+    for (auto [rule, pass] : {std::pair{DecisionRule::kSimpleAcceptance, c.simple},
+                              std::pair{DecisionRule::kGuardedAcceptance, c.guarded_acceptance},
+                              std::pair{DecisionRule::kGuardedRejection, c.guarded_rejection}}) {
+      VerifyOptions o;
+      o.decision_rule = rule;
+      const ArtifactEvaluation e = EvaluateArtifact(a, points, o, "sphere.ply");
+      const Figure& p_s = e.figures[1];
+      ASSERT_EQ(p_s.name, "P_S");
+      EXPECT_NEAR(p_s.value_mm, c.size_error_mm, 0.005);
+      EXPECT_NEAR(p_s.standard_uncertainty_mm.value(), 0.14, 1e-6);
+      EXPECT_NEAR(p_s.ExpandedUncertaintyMm(), 0.28, 2e-6);
+      EXPECT_EQ(p_s.zone(), c.zone) << c.size_error_mm;
+      // P_F of exact samples is rounding: no certificate, no u, no zone.
+      EXPECT_FALSE(e.figures[0].zone().has_value());
+      EXPECT_TRUE(e.figures[0].pass);
+      // u is within the refusal's limit, so every verdict is a judgement.
+      EXPECT_TRUE(e.judged()) << DecisionRuleName(rule) << " " << c.size_error_mm << ": " << e.not_judged_reason;
+      EXPECT_EQ(p_s.pass, pass) << DecisionRuleName(rule) << " " << c.size_error_mm;
+      EXPECT_EQ(e.pass(), pass) << DecisionRuleName(rule) << " " << c.size_error_mm;
+    }
+  }
+}
+
+// A figure the refusal leaves undetermined stays so under the guarded
+// rules: guarded acceptance does not turn its uncertainty range into a
+// FAIL, guarded rejection not into a PASS. Truth: the exact sphere 1.0 mm
+// too large, certified to U 0.4 mm (k = 2): u 0.2 mm, over 0.15 mm.
+TEST(Vdi2634, TheRefusalOfAnUndeterminedFigureHoldsUnderEveryRule) {
+  Artifact a = SphereArtifact();
+  a.sphere_diameter_uncertainty_mm = 0.4;
+  const auto points = ExactSphere(38.1 + 1.0);
+  for (DecisionRule rule :
+       {DecisionRule::kSimpleAcceptance, DecisionRule::kGuardedAcceptance, DecisionRule::kGuardedRejection}) {
+    VerifyOptions o;
+    o.decision_rule = rule;
+    const ArtifactEvaluation e = EvaluateArtifact(a, points, o, "sphere.ply");
+    EXPECT_EQ(NotJudgedReason(e).rfind("P_S is not determined", 0), 0u) << DecisionRuleName(rule);
+  }
+}
+
+// The sphere's form certificate is P_F's uncertainty, as the flatness
+// certificate is F's: its U / k, the certificate's part alone. Truth: exact
+// samples (P_F is rounding). U 0.02 mm at k = 2: u 0.01 mm, judged; U 0.4 mm:
+// u 0.2 mm, over 10% of the 1.5 mm MPE: not judged, the message naming the
+// sphere's form.
+TEST(Vdi2634, TheSpheresFormCertificateIsTheUncertaintyOfPF) {
+  Artifact a = SphereArtifact();
+  a.sphere_form_uncertainty_mm = 0.02;
+  const auto points = ExactSphere(38.1);
+  const ArtifactEvaluation e = EvaluateArtifact(a, points, VerifyOptions(), "sphere.ply");
+  const Figure& p_f = e.figures[0];
+  ASSERT_EQ(p_f.name, "P_F");
+  EXPECT_FALSE(p_f.fit_standard_uncertainty_mm.has_value());
+  EXPECT_EQ(p_f.certificate_standard_uncertainty_mm, 0.01);
+  EXPECT_EQ(p_f.standard_uncertainty_mm, 0.01);
+  EXPECT_EQ(p_f.zone(), ConformanceZone::kConformance);
+  EXPECT_TRUE(e.pass()) << e.not_judged_reason;
+  EXPECT_FALSE(e.figures[1].certificate_standard_uncertainty_mm.value() > 0);  // the diameter's is not the form's
+  a.sphere_form_uncertainty_mm = 0.4;
+  EXPECT_EQ(NotJudgedReason(EvaluateArtifact(a, points, VerifyOptions(), "sphere.ply")),
+            "P_F is not determined: the certificate gives the sphere's form to +-0.200 mm (1 sigma: U 0.400 mm at k "
+            "= 2), more than 10% of its MPE (1.500 mm); the certificate's part alone is at or over it: verify needs "
+            "an artifact calibrated to U < 0.300 mm (k = 2)");
+}
+
+// The summary's worst figure is the one nearest to failing under the rule,
+// and the summary passes only if every judged figure does: under guarded
+// acceptance a smaller error with a larger U can be the one that fails.
+// Figures built by hand (Summarise reads nothing else): position 1 P_S 1.30
+// mm with u 0.01 (|v| + U = 1.32), position 2 P_S 1.25 mm with u 0.14 (1.53).
+TEST(Vdi2634, TheSummarysWorstIsTheFigureNearestToFailingUnderTheRule) {
+  auto position = [](double value_mm, double u_mm, DecisionRule rule) {
+    ArtifactEvaluation e;
+    Figure f;
+    f.name = "P_S";
+    f.value_mm = value_mm;
+    f.mpe_mm = 1.5;
+    f.standard_uncertainty_mm = u_mm;
+    f.pass = Passes(rule, f.value_mm, f.ExpandedUncertaintyMm(), f.mpe_mm);
+    e.figures = {f};
+    return e;
+  };
+  for (DecisionRule rule : {DecisionRule::kSimpleAcceptance, DecisionRule::kGuardedAcceptance}) {
+    const VerifySummary s = Summarise({position(1.30, 0.01, rule), position(1.25, 0.14, rule)}, rule);
+    ASSERT_EQ(s.worst.size(), 1u);
+    const bool guarded = rule == DecisionRule::kGuardedAcceptance;
+    EXPECT_EQ(s.worst[0].value_mm, guarded ? 1.25 : 1.30) << DecisionRuleName(rule);
+    EXPECT_EQ(s.worst[0].pass, !guarded) << DecisionRuleName(rule);
+    EXPECT_EQ(s.pass, !guarded) << DecisionRuleName(rule);
+  }
+  // A failing position is never hidden behind a worse-looking passing one:
+  // under guarded acceptance position 2 fails, listed first or last.
+  const DecisionRule rule = DecisionRule::kGuardedAcceptance;
+  EXPECT_FALSE(Summarise({position(1.25, 0.14, rule), position(1.30, 0.01, rule)}, rule).pass);
+}
+
 // --- (7) Stray points in the plate's plane. ---
 
 TEST(Vdi2634, AStrayPointInThePlatesPlaneMovesNeitherItsOutlineNorItsFigure) {
@@ -969,6 +1094,11 @@ TEST(ArtifactFile, RoundTripsAndRejectsMissingFields) {
   EXPECT_EQ(back.type, ArtifactType::kBallBar);
   EXPECT_EQ(back.center_distance_uncertainty_mm, 0.003);
   EXPECT_EQ(back.uncertainty_coverage_factor, 2.1);
+  // The sphere's form certificate: written only where given, read back.
+  Artifact sphere_a = SphereArtifact();
+  EXPECT_EQ(ArtifactToYaml(sphere_a).find("form_uncertainty_mm"), std::string::npos);
+  sphere_a.sphere_form_uncertainty_mm = 0.0005;
+  EXPECT_EQ(ParseArtifactYaml(ArtifactToYaml(sphere_a), "a.yaml").sphere_form_uncertainty_mm, 0.0005);
   // A file without the coverage factor (every file before it) reads k = 2.
   const std::string sphere =
       "format: stereorig-artifact\nversion: 1\nunits: mm\ntype: sphere\ndiameter_mm: 38.1\n"
