@@ -23,7 +23,9 @@ namespace {
 // judged: false for a position not judged, whose figures are reported with
 // "pass": null.
 nlohmann::json FigureJson(const Figure& f, bool judged) {
-  nlohmann::json j = {{"name", f.name}, {"value_mm", f.value_mm}, {"mpe_mm", f.mpe_mm}, {"pass", nullptr}};
+  judged = judged && f.judged;  // a figure left undetermined: its pass is not claimed
+  nlohmann::json j = {
+      {"name", f.name}, {"value_mm", f.value_mm}, {"mpe_mm", f.mpe_mm}, {"judged", judged}, {"pass", nullptr}};
   if (judged) j["pass"] = f.pass;
   if (f.standard_uncertainty_mm) j["standard_uncertainty_mm"] = *f.standard_uncertainty_mm;
   if (f.fit_standard_uncertainty_mm) j["fit_standard_uncertainty_mm"] = *f.fit_standard_uncertainty_mm;
@@ -31,8 +33,8 @@ nlohmann::json FigureJson(const Figure& f, bool judged) {
     j["certificate_standard_uncertainty_mm"] = *f.certificate_standard_uncertainty_mm;
   }
   // ISO 14253-1's zone of the figure with U = 2u (decision_rule.h); a figure
-  // without u has neither.
-  if (const auto zone = f.zone()) {
+  // without u has neither, nor one whose u is a floor (not judged).
+  if (const auto zone = f.zone(); zone && f.judged) {
     j["expanded_uncertainty_mm"] = f.ExpandedUncertaintyMm();
     j["zone"] = ConformanceZoneName(*zone);
   }
@@ -58,9 +60,10 @@ const char* DecisionRuleText(DecisionRule rule) {
     case DecisionRule::kSimpleAcceptance:
       return "simple acceptance: a figure passes if |value| <= MPE";
     case DecisionRule::kGuardedAcceptance:
-      return "guarded acceptance: a figure passes only if |value| + 2u <= MPE (proven within it)";
+      return "guarded acceptance: a figure passes only if |value| + 2u <= MPE (within it by its expanded "
+             "uncertainty)";
     case DecisionRule::kGuardedRejection:
-      return "guarded rejection: a figure fails only if |value| - 2u > MPE (proven beyond it)";
+      return "guarded rejection: a figure fails only if |value| - 2u > MPE (beyond it by its expanded uncertainty)";
   }
   return "?";
 }
@@ -72,9 +75,10 @@ void PrintUncertainty(size_t position, const Figure& f, double coverage_factor) 
   const double certificate_mm = f.certificate_standard_uncertainty_mm.value_or(0.0);
   char fit[64] = "no fit part: a range of residuals";  // P_F, F
   if (f.fit_standard_uncertainty_mm) std::snprintf(fit, sizeof fit, "fit %.4f mm", *f.fit_standard_uncertainty_mm);
+  const std::string zone = f.judged ? ZoneText(*f.zone()) : "no zone: u over the limit is a floor, not the error";
   std::printf("%-8zu %s: u %.4f mm = %s (+) certificate %.4f mm (U %.4f mm / k %g); 2u %.4f mm: %s\n", position,
               f.name.c_str(), *f.standard_uncertainty_mm, fit, certificate_mm, certificate_mm * coverage_factor,
-              coverage_factor, f.ExpandedUncertaintyMm(), ZoneText(*f.zone()).c_str());
+              coverage_factor, f.ExpandedUncertaintyMm(), zone.c_str());
 }
 
 // Each fitted sphere (1 for a sphere, 2 for a ball bar): its size, how much
@@ -137,15 +141,17 @@ int RunVerify(int argc, char** argv) {
       "printed or written. The artifact file's uncertainties are its certificate's expanded ones, U at "
       "k = 2 (or its uncertainty_coverage_factor): U / k enters P_S (diameter), SD (centre distance) and F (flatness) "
       "in quadrature with the fit's, and the rules above read the combined u. A sphere's form_uncertainty_mm "
-      "(its certified form) is P_F's, as a plate's flatness_uncertainty_mm is F's.\n\n"
-      "--decision-rule says how a figure and its expanded uncertainty 2u are judged against the MPE (ISO 14253-1; "
-      "the rules as ILAC-G8 names them): simple (default: pass if |value| <= MPE, what the standard's tables "
-      "compare), guarded-acceptance (pass only if |value| + 2u <= MPE: conformance proven; for whoever must prove "
-      "the rig conforms, e.g. a supplier at delivery) or guarded-rejection (fail only if |value| - 2u > MPE: "
-      "nonconformance proven; for whoever must prove it does not). Each figure's zone (conformance, uncertainty "
-      "range, nonconformance) is printed and reported whatever the rule; a figure without u (P_F or F against an "
-      "exact certificate) has none and every rule judges it as simple does. The refusal of a figure over 10% of its "
-      "MPE holds under every rule. The table "
+      "(the U of its certified form) is P_F's, as a plate's flatness_uncertainty_mm is F's.\n\n"
+      "--decision-rule says how a figure and its expanded uncertainty 2u are judged against the MPE (ISO 14253-1: "
+      "the uncertainty counts against whoever must prove a claim; the rules as ILAC-G8 names them): simple "
+      "(default, as earlier builds: pass if |value| <= MPE, u not used), guarded-acceptance (pass only if |value| + "
+      "2u <= MPE; for whoever must show the rig conforms, e.g. a supplier at delivery) or guarded-rejection (fail "
+      "only if |value| - 2u > MPE; for whoever must show it does not). Each figure's zone (conformance, "
+      "uncertainty range, nonconformance) is printed and reported whatever the rule; u is the fit's covariance and "
+      "the certificate's, a floor rather than the whole error. A figure without u (P_F or F against an exact "
+      "certificate) has no zone, and every rule judges it with 2u = 0. A figure whose u is over 10% of its MPE is "
+      "judged only where its failure would stand with any larger u (simple: |value| - 2u > MPE; guarded-acceptance: "
+      "any failure; guarded-rejection: never); otherwise it is shown with '-' in the pass column. The table "
       "gives, per position, each figure's standard uncertainty (u_mm; both parts on a line of their own), the points "
       "in the cloud, the filled ones "
       "skipped, those on the artifact, those excluded and those used, and per sphere its diameter, the diameter's "
@@ -201,7 +207,7 @@ int RunVerify(int argc, char** argv) {
   // the report written. Otherwise the run is not judged: exit 2 with the
   // reason on stderr and, as for bad input, no report written (an earlier
   // one at that path stays as it was: docs/formats.md).
-  const VerifySummary summary = Summarise(positions, options.decision_rule);
+  const VerifySummary summary = Summarise(positions);
   const bool all_judged = summary.not_judged_positions.empty();
   const bool judged_failure = std::any_of(positions.begin(), positions.end(),
                                           [](const ArtifactEvaluation& e) { return e.judged() && !e.pass(); });
@@ -237,14 +243,20 @@ int RunVerify(int argc, char** argv) {
     for (const Figure& f : e.figures) {
       std::printf("%-8zu %-6s %10.4f %8s %7.3f %4s %8d %7d %8d %8d %8d %10.4f\n", i + 1, f.name.c_str(), f.value_mm,
                   UncertaintyText(f).c_str(), f.mpe_mm,
-                  !e.judged() ? "-"
-                  : f.pass    ? "yes"
-                              : "NO",
+                  !e.judged() || !f.judged ? "-"
+                  : f.pass                 ? "yes"
+                                           : "NO",
                   e.points_total + filled_skipped[i], filled_skipped[i], e.points_on_artifact, e.points_excluded,
                   e.points_used(), e.residual_mean_abs_mm);
       pj["figures"].push_back(FigureJson(f, e.judged()));
     }
-    for (const Figure& f : e.figures) PrintUncertainty(i + 1, f, artifact.uncertainty_coverage_factor);
+    for (const Figure& f : e.figures) {
+      PrintUncertainty(i + 1, f, artifact.uncertainty_coverage_factor);
+      if (!f.standard_uncertainty_mm && options.decision_rule != DecisionRule::kSimpleAcceptance) {
+        std::printf("%-8zu %s: no u (%s): judged with 2u = 0, as simple acceptance does\n", i + 1, f.name.c_str(),
+                    f.name == "P_F" ? "the artifact file gives no form_uncertainty_mm" : "an exact certificate");
+      }
+    }
     PrintSpheres(i + 1, e);
     if (!e.sphere_centers_mm.empty()) pj["spheres"] = SpheresJson(e);
     if (e.type == ArtifactType::kPlate) {
@@ -282,6 +294,13 @@ int RunVerify(int argc, char** argv) {
   }
   const char* verdict = judged_failure ? "FAIL" : !all_judged ? "NOT JUDGED" : "PASS";
   std::printf("\nverdict: %s", verdict);
+  // What a PASS says under a guarded rule, with the stated u (a floor: the
+  // fit's covariance and the certificate, docs/verify-and-check.md).
+  if (all_judged && !judged_failure && options.decision_rule == DecisionRule::kGuardedAcceptance) {
+    std::printf(" (guarded acceptance: every figure within its MPE by 2u)");
+  } else if (all_judged && !judged_failure && options.decision_rule == DecisionRule::kGuardedRejection) {
+    std::printf(" (guarded rejection: no figure beyond its MPE by 2u; a figure may still exceed it)");
+  }
   report["summary"]["verdict"] = verdict;
   report["summary"]["pass"] = summary.pass;
   report["summary"]["positions_not_judged"] = nlohmann::json::array();

@@ -404,6 +404,20 @@ TEST(VerifyCli, TheDecisionRuleJudgesTheUncertaintyRangeAndTheReportSaysWhichRul
       EXPECT_NE(r.out.find(std::string("verdict: ") + (expected_exit == 0 ? "PASS" : "FAIL")), std::string::npos)
           << r.out;
       EXPECT_NE(r.out.find("2u 0.2800 mm: uncertainty range"), std::string::npos) << r.out;
+      // P_F has no u here (no form_uncertainty_mm): the guarded rules say
+      // they judged it with 2u = 0; simple acceptance never reads u.
+      const bool simple = std::string(c.rule) == "simple";
+      EXPECT_EQ(r.out.find("P_F: no u (the artifact file gives no form_uncertainty_mm): judged with 2u = 0") ==
+                    std::string::npos,
+                simple)
+          << r.out;
+      if (expected_exit == 0 && !simple) {
+        EXPECT_NE(
+            r.out.find(std::string("verdict: PASS (") +
+                       (std::string(c.rule) == "guarded-acceptance" ? "guarded acceptance" : "guarded rejection")),
+            std::string::npos)
+            << r.out;
+      }
       std::ifstream f(report);
       ASSERT_TRUE(f.good()) << c.rule;
       const auto j = nlohmann::json::parse(f);
@@ -413,6 +427,7 @@ TEST(VerifyCli, TheDecisionRuleJudgesTheUncertaintyRangeAndTheReportSaysWhichRul
       EXPECT_EQ(p_s["name"], "P_S");
       EXPECT_EQ(p_s["zone"], "uncertainty_range");
       EXPECT_NEAR(p_s["expanded_uncertainty_mm"].get<double>(), 0.28, 1e-6);
+      EXPECT_TRUE(p_s["judged"].get<bool>());
       EXPECT_EQ(p_s["pass"].get<bool>(), expected_exit == 0);
       EXPECT_FALSE(j["positions"][0]["figures"][0].contains("zone"));  // P_F: no u, no zone
     }

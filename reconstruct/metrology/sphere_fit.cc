@@ -180,9 +180,15 @@ SphereFit FitSphereRobust(const std::vector<Eigen::Vector3d>& points, const Sphe
       if (mirror.ok && mirror.rms_mm < fit.rms_mm) fit = mirror;
     }
   }
-  inliers.clear();
+  std::vector<int> refined;
   for (int i = 0; i < n; ++i)
-    if (std::abs((points[i] - fit.center_mm).norm() - fit.radius_mm) < o.inlier_threshold_mm) inliers.push_back(i);
+    if (std::abs((points[i] - fit.center_mm).norm() - fit.radius_mm) < o.inlier_threshold_mm) refined.push_back(i);
+  // With the radius held, points on a sphere whose radius differs from the
+  // expected one by more than the inlier band (but within
+  // radius_tolerance_mm, where RANSAC counted them) all lie outside the band
+  // of the refined sphere: keep RANSAC's consensus then, rather than fail on
+  // an empty set (a cloud measured 10% too large was "fewer than 4 points").
+  if (refined.size() >= 4 || o.refine_radius) inliers.swap(refined);
   return refine(fit.center_mm, fit.radius_mm);
 }
 

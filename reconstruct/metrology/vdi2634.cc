@@ -120,30 +120,51 @@ bool Determined(const Figure& f, const VerifyOptions& o) {
   return fit_determined && *f.standard_uncertainty_mm <= o.max_uncertainty_fraction_of_mpe * f.mpe_mm;
 }
 
+// Whether an undetermined figure's FAIL stands all the same. Its u is a
+// floor (the fit counts its points as independent), so only a failure that a
+// larger u would not undo: under simple acceptance a value beyond the MPE by
+// more than 2u (the nonconformance zone: beyond it by more than its noise,
+// and simple acceptance reads the value alone); under guarded acceptance any
+// failure (a larger U only widens the guard band); under guarded rejection
+// none (a larger U could pull the value out of the nonconformance zone).
+bool FailureStands(DecisionRule rule, const Figure& f) {
+  if (f.pass) return false;
+  switch (rule) {
+    case DecisionRule::kSimpleAcceptance:
+      return f.zone() == ConformanceZone::kNonconformance;
+    case DecisionRule::kGuardedAcceptance:
+      return true;
+    case DecisionRule::kGuardedRejection:
+      break;
+  }
+  return false;
+}
+
+// Each figure's pass under the rule, from its value and its U (set above),
+// and whether that verdict stands (Figure::judged): the figure is
+// determined, or its failure stands without it.
+void JudgeFigures(DecisionRule rule, const VerifyOptions& o, std::vector<Figure>* figures) {
+  for (Figure& f : *figures) {
+    f.pass = Passes(rule, f.value_mm, f.ExpandedUncertaintyMm(), f.mpe_mm);
+    f.judged = Determined(f, o) || FailureStands(rule, f);
+  }
+}
+
 // Why a position whose verdict would rest on a figure the fit or the
-// certificate leaves undetermined (Determined: its value would be the fit's
-// noise, or its reference not known well enough) is not judged: a PASS
-// cannot be claimed from it. Empty when the position fails without it: a
-// figure that fails the decision rule is determined itself (P_F without a
-// form certificate always is), or fails beyond doubt (|value| - 2u > MPE:
-// ISO 14253-1's nonconformance zone, however large u); such a position is
-// judged, FAIL.
+// certificate leaves undetermined (Figure::judged false: its value would be
+// the fit's noise, or its reference not known well enough) is not judged:
+// neither a PASS nor a FAIL can be claimed from it. Empty when every figure
+// is judged, or one that is judged fails: the position is judged, FAIL,
+// whatever the others leave undetermined.
 std::string NotJudgedReason(const ArtifactEvaluation& e, const std::string& coverage, double coverage_factor,
                             const VerifyOptions& o) {
+  for (const Figure& f : e.figures)
+    if (f.judged && !f.pass) return "";
   for (const Figure& f : e.figures) {
-    if (f.pass) continue;
-    if (Determined(f, o) || f.zone() == ConformanceZone::kNonconformance) return "";
-  }
-  for (const Figure& f : e.figures) {
-    if (Determined(f, o)) continue;
+    if (f.judged) continue;
     return UndeterminedText(f, e, coverage, coverage_factor, o.max_uncertainty_fraction_of_mpe * f.mpe_mm, o);
   }
   return "";
-}
-
-// Each figure's pass under the rule, from its value and its U (set above).
-void JudgeFigures(DecisionRule rule, std::vector<Figure>* figures) {
-  for (Figure& f : *figures) f.pass = Passes(rule, f.value_mm, f.ExpandedUncertaintyMm(), f.mpe_mm);
 }
 
 std::string CapsText(const std::vector<double>& cap_half_angles_deg) {
@@ -303,11 +324,48 @@ std::string LeftCertifiedSizeText(const std::vector<Eigen::Vector3d>& pts, const
                   u.diameter_std_mm);
   } else {
     std::snprintf(buf, sizeof buf,
-                  "; a cap like this fits a diameter to +-%.3f mm (1 sigma): not the artifact, or not of its certified "
+                  "; a cap like this fits a diameter to +-%.4f mm (1 sigma): not the artifact, or not of its certified "
                   "size",
                   u.diameter_std_mm);
+    text += buf;
+    // A fitted size is a fact about the cloud: it may be the rig's scale.
+    if (free_fit.ok && free_fit.converged) {
+      std::snprintf(buf, sizeof buf,
+                    ", or measured at a scale %+.0f%% off (a rig calibrated with a wrong target square size reads "
+                    "every length so)",
+                    100 * (free_fit.radius_mm / nominal_radius_mm - 1));
+      text += buf;
+    }
+    return text;
   }
   return text + buf;
+}
+
+// When no sphere of the certified size is found: whether the cloud holds a
+// sphere of another size (RANSAC with the radius free, within half to twice
+// the certified one, at least min_points points within the band), and the
+// scale that would make it the artifact's; empty if it holds none.
+std::string OtherSizeText(const std::vector<Eigen::Vector3d>& pts, double nominal_radius_mm, double locate_band_mm,
+                          const VerifyOptions& o) {
+  SphereFitOptions so;
+  so.inlier_threshold_mm = locate_band_mm;
+  so.expected_radius_mm = 1.25 * nominal_radius_mm;  // hypotheses in [0.5, 2] x the certified radius
+  so.radius_tolerance_mm = 0.75 * nominal_radius_mm;
+  so.ransac_iterations = 1000;
+  so.seed = o.seed;
+  const SphereFit other = FitSphereRobust(pts, so);
+  if (!other.ok || !other.converged || static_cast<int>(other.inliers.size()) < o.min_points ||
+      !(other.radius_mm >= 0.5 * nominal_radius_mm && other.radius_mm <= 2 * nominal_radius_mm)) {
+    return "";
+  }
+  char buf[384];
+  std::snprintf(buf, sizeof buf,
+                "; it holds one %.1f mm in diameter (%zu points within %.1f mm of it), not the certified %.1f mm: not "
+                "the artifact, not of its certified size, or measured at a scale %+.0f%% off (a rig calibrated with a "
+                "wrong target square size reads every length so)",
+                2 * other.radius_mm, other.inliers.size(), locate_band_mm, 2 * nominal_radius_mm,
+                100 * (other.radius_mm / nominal_radius_mm - 1));
+  return buf;
 }
 
 // "ball 2 of the ball bar (centre near (50.0, 0.0, 150.0) mm)": which one
@@ -342,6 +400,7 @@ ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, dou
   const SphereFit located = FitSphereRobust(pts, so);
   if (!located.ok) {
     out.fit = located;
+    out.fit.message += OtherSizeText(pts, nominal_radius, locate_band_mm, o);
     return out;
   }
   out.located = true;
@@ -410,6 +469,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
                                     const std::string& where) {
   o.Check();
   ArtifactEvaluation e;
+  e.decision_rule = o.decision_rule;
   e.type = a.type;
   e.points_total = static_cast<int>(pts.size());
   if (e.points_total < o.min_points) {
@@ -451,7 +511,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
         SetUncertainty(&e.figures[0], std::nullopt, a.StandardUncertaintyMm(a.sphere_form_uncertainty_mm));
       SetUncertainty(&e.figures[1], u.diameter_std_mm, a.StandardUncertaintyMm(a.sphere_diameter_uncertainty_mm));
       ResidualStats(fit.residuals_mm, &e);
-      JudgeFigures(o.decision_rule, &e.figures);
+      JudgeFigures(o.decision_rule, o, &e.figures);
       e.not_judged_reason =
           NotJudgedReason(e, CapsText(e.sphere_cap_half_angles_deg), a.uncertainty_coverage_factor, o);
       break;
@@ -567,7 +627,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
                                                                      : std::numeric_limits<double>::infinity(),
                      a.StandardUncertaintyMm(a.center_distance_uncertainty_mm));
       ResidualStats(all_residuals, &e);
-      JudgeFigures(o.decision_rule, &e.figures);
+      JudgeFigures(o.decision_rule, o, &e.figures);
       e.not_judged_reason =
           NotJudgedReason(e, CapsText(e.sphere_cap_half_angles_deg), a.uncertainty_coverage_factor, o);
       break;
@@ -615,7 +675,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       if (a.flatness_uncertainty_mm > 0)
         SetUncertainty(&e.figures[0], std::nullopt, a.StandardUncertaintyMm(a.flatness_uncertainty_mm));
       ResidualStats(fit.residuals_mm, &e);
-      JudgeFigures(o.decision_rule, &e.figures);
+      JudgeFigures(o.decision_rule, o, &e.figures);
       e.not_judged_reason = NotJudgedReason(e, "", a.uncertainty_coverage_factor, o);
       break;
     }
@@ -623,13 +683,10 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
   return e;
 }
 
-VerifySummary Summarise(const std::vector<ArtifactEvaluation>& positions, DecisionRule rule) {
+VerifySummary Summarise(const std::vector<ArtifactEvaluation>& positions) {
   VerifySummary s;
   s.pass = !positions.empty();
   std::map<std::string, Figure> worst;
-  auto judged_magnitude = [rule](const Figure& f) {
-    return JudgedMagnitudeMm(rule, f.value_mm, f.ExpandedUncertaintyMm());
-  };
   for (size_t i = 0; i < positions.size(); ++i) {
     const ArtifactEvaluation& p = positions[i];
     if (!p.judged()) {
@@ -637,8 +694,14 @@ VerifySummary Summarise(const std::vector<ArtifactEvaluation>& positions, Decisi
       s.pass = false;
       continue;
     }
+    auto judged_magnitude = [&p](const Figure& f) {
+      return JudgedMagnitudeMm(p.decision_rule, f.value_mm, f.ExpandedUncertaintyMm());
+    };
     for (const Figure& f : p.figures) {
       s.pass = s.pass && f.pass;
+      // A figure left undetermined in a position that fails by another is
+      // not a measurement of the system: not the worst.
+      if (!f.judged) continue;
       auto it = worst.find(f.name);
       if (it == worst.end() || judged_magnitude(f) > judged_magnitude(it->second)) worst[f.name] = f;
     }

@@ -74,8 +74,11 @@ struct VerifyOptions {
   // the default), guarded acceptance (|value| + U <= MPE) or guarded
   // rejection (fail only if |value| - U > MPE). A figure without u (P_F
   // without the certificate's form_uncertainty_mm, F without its
-  // flatness_uncertainty_mm) is judged with U = 0 by every rule. The
-  // refusal above holds under every rule: its u is a floor, not the error.
+  // flatness_uncertainty_mm) is judged with U = 0 by every rule. A figure
+  // the refusal above leaves undetermined has a u that is a floor, not its
+  // error: it is judged only where its failure stands however large u is
+  // (simple acceptance: |value| - 2u > MPE; guarded acceptance: any failure;
+  // guarded rejection: never), and its pass never.
   DecisionRule decision_rule = DecisionRule::kSimpleAcceptance;
   unsigned seed = 1;
   void Check() const;
@@ -86,6 +89,11 @@ struct Figure {
   double value_mm = 0;
   double mpe_mm = 0;
   bool pass = false;  // within the MPE under VerifyOptions::decision_rule (simple: |value| <= mpe)
+  // Whether `pass` stands: the figure is determined (its u within
+  // VerifyOptions::max_uncertainty_fraction_of_mpe of its MPE, or it has no
+  // u), or it fails in a way a larger u would not undo (vdi2634.cc,
+  // FailureStands). A figure not judged is reported, its pass not claimed.
+  bool judged = true;
   // value_mm's standard uncertainty (k = 1): its two parts below combined in
   // quadrature, u = sqrt(u_fit^2 + u_certificate^2) (independent sources:
   // the measurement's noise, the reference's calibration; VDI/VDE 2634-2 and
@@ -122,6 +130,7 @@ struct ArtifactEvaluation {
   double capture_band_mm = 0;  // the band used (VerifyOptions::capture_band_mm, at least 2 * MPE)
   int points_used() const { return points_on_artifact - points_excluded; }
   std::vector<Figure> figures;
+  DecisionRule decision_rule = DecisionRule::kSimpleAcceptance;  // VerifyOptions::decision_rule, as judged
   // Residuals to the fitted shape(s) after exclusion, as the seed reports them.
   double residual_mean_abs_mm = 0;
   double residual_std_mm = 0;
@@ -164,15 +173,14 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& artifact, const std::vector<
                                     const VerifyOptions& options, const std::string& where);
 
 // Several positions of the same artifact: per figure, the judged position
-// nearest to failing under the decision rule (the largest
-// JudgedMagnitudeMm: under simple acceptance the largest |value|). No PASS is
-// claimed while a position is not judged.
+// nearest to failing under the decision rule they were evaluated with (the
+// largest JudgedMagnitudeMm: under simple acceptance the largest |value|),
+// of the figures judged. No PASS is claimed while a position is not judged.
 struct VerifySummary {
   std::vector<Figure> worst;              // one per figure name
   std::vector<int> not_judged_positions;  // indices into the positions given
   bool pass = false;                      // every position judged, and every figure of each within its MPE
 };
-VerifySummary Summarise(const std::vector<ArtifactEvaluation>& positions,
-                        DecisionRule rule = DecisionRule::kSimpleAcceptance);
+VerifySummary Summarise(const std::vector<ArtifactEvaluation>& positions);
 
 }  // namespace stereorig

@@ -928,20 +928,69 @@ TEST(Vdi2634, EachDecisionRuleJudgesTheUncertaintyRangeItsOwnWay) {
   }
 }
 
-// A figure the refusal leaves undetermined stays so under the guarded
-// rules: guarded acceptance does not turn its uncertainty range into a
-// FAIL, guarded rejection not into a PASS. Truth: the exact sphere 1.0 mm
-// too large, certified to U 0.4 mm (k = 2): u 0.2 mm, over 0.15 mm.
-TEST(Vdi2634, TheRefusalOfAnUndeterminedFigureHoldsUnderEveryRule) {
+// A figure the refusal leaves undetermined (u over 10% of the MPE) has a u
+// that is a floor, not its error: its verdict stands only where a larger u
+// would not undo it. Truth: the exact sphere 1.0, 1.4 and 2.0 mm too large,
+// certified to U 0.4 mm (k = 2): u 0.2 mm (over 0.15 mm), 2u 0.4 mm, so the
+// zones are conformance, uncertainty range and nonconformance. No PASS is
+// claimed from it under any rule; a FAIL stands under simple acceptance only
+// beyond 2u (2.0), under guarded acceptance always (a larger U only widens
+// the guard band), under guarded rejection never (a larger U could undo it).
+TEST(Vdi2634, AnUndeterminedFigureIsJudgedOnlyWhereALargerUncertaintyWouldNotUndoItsVerdict) {
   Artifact a = SphereArtifact();
   a.sphere_diameter_uncertainty_mm = 0.4;
-  const auto points = ExactSphere(38.1 + 1.0);
-  for (DecisionRule rule :
-       {DecisionRule::kSimpleAcceptance, DecisionRule::kGuardedAcceptance, DecisionRule::kGuardedRejection}) {
+  struct Case {
+    double size_error_mm;
+    bool judged_simple, judged_guarded_acceptance, judged_guarded_rejection;
+  };
+  for (const Case& c : {Case{1.0, false, false, false}, Case{1.4, false, true, false}, Case{2.0, true, true, false}}) {
+    const auto points = ExactSphere(38.1 + c.size_error_mm);
+    for (auto [rule, judged] : {std::pair{DecisionRule::kSimpleAcceptance, c.judged_simple},
+                                std::pair{DecisionRule::kGuardedAcceptance, c.judged_guarded_acceptance},
+                                std::pair{DecisionRule::kGuardedRejection, c.judged_guarded_rejection}}) {
+      VerifyOptions o;
+      o.decision_rule = rule;
+      const ArtifactEvaluation e = EvaluateArtifact(a, points, o, "sphere.ply");
+      const std::string what = std::string(DecisionRuleName(rule)) + " " + std::to_string(c.size_error_mm);
+      ASSERT_NEAR(e.figures[1].standard_uncertainty_mm.value(), 0.2, 1e-6) << what;
+      EXPECT_EQ(e.figures[1].judged, judged) << what;
+      EXPECT_EQ(e.judged(), judged) << what << ": " << e.not_judged_reason;
+      if (judged) {
+        EXPECT_FALSE(e.pass()) << what;  // only failures stand
+      } else {
+        EXPECT_EQ(NotJudgedReason(e).rfind("P_S is not determined", 0), 0u) << what;
+      }
+    }
+  }
+}
+
+// In a position judged FAIL by one figure, another left undetermined is
+// reported but not judged: its pass is not claimed, and it is not the
+// summary's worst. Truth as AnUndeterminedSizeDoesNotHideADeterminedFailure
+// (1): a 40-degree cap with 0.3 mm noise, P_F ~1.8 mm over its MPE, u(P_S)
+// ~0.17 mm over 10% of it.
+TEST(Vdi2634, AFigureLeftUndeterminedInAFailingPositionIsNotJudgedNorTheWorst) {
+  const Eigen::Vector3d c(1, 2, 150), view(0.1, 0, -1);
+  std::mt19937 rng(12);
+  const auto noisy = testing::NoisySurfaceSamples(testing::SphereCapSurface(c, view, 19.05, 40), 2000, 0.3, &rng);
+  for (DecisionRule rule : {DecisionRule::kSimpleAcceptance, DecisionRule::kGuardedRejection}) {
     VerifyOptions o;
     o.decision_rule = rule;
-    const ArtifactEvaluation e = EvaluateArtifact(a, points, o, "sphere.ply");
-    EXPECT_EQ(NotJudgedReason(e).rfind("P_S is not determined", 0), 0u) << DecisionRuleName(rule);
+    const ArtifactEvaluation e = EvaluateArtifact(SphereArtifact(), noisy, o, "noisy40.ply");
+    ASSERT_TRUE(e.judged()) << e.not_judged_reason;
+    EXPECT_FALSE(e.pass());
+    EXPECT_TRUE(e.figures[0].judged);  // P_F: no u, determined
+    EXPECT_FALSE(e.figures[0].pass);
+    ASSERT_GT(e.figures[1].standard_uncertainty_mm.value(), 0.15);
+    ASSERT_LT(std::abs(e.figures[1].value_mm) + 2 * *e.figures[1].standard_uncertainty_mm, 1.5);  // would pass
+    EXPECT_FALSE(e.figures[1].judged) << DecisionRuleName(rule);
+    auto exact_points = SphereCap({0, 0, 0}, 19.05, {0, 0, -1}, 80, 0.3, 0, &rng);
+    const ArtifactEvaluation exact = EvaluateArtifact(SphereArtifact(), exact_points, o, "exact.ply");
+    const VerifySummary sum = Summarise({exact, e});
+    EXPECT_FALSE(sum.pass);
+    for (const Figure& f : sum.worst) {
+      EXPECT_EQ(f.value_mm, f.name == "P_F" ? FigureOf(e, "P_F") : FigureOf(exact, "P_S")) << f.name;
+    }
   }
 }
 
@@ -970,14 +1019,18 @@ TEST(Vdi2634, TheSpheresFormCertificateIsTheUncertaintyOfPF) {
             "an artifact calibrated to U < 0.300 mm (k = 2)");
 }
 
-// The summary's worst figure is the one nearest to failing under the rule,
-// and the summary passes only if every judged figure does: under guarded
-// acceptance a smaller error with a larger U can be the one that fails.
-// Figures built by hand (Summarise reads nothing else): position 1 P_S 1.30
-// mm with u 0.01 (|v| + U = 1.32), position 2 P_S 1.25 mm with u 0.14 (1.53).
+// The summary's worst figure is the one nearest to failing under the rule
+// the positions were evaluated with, and the summary passes only if every
+// judged figure does: under guarded acceptance a smaller error with a larger
+// U can be the one that fails; under guarded rejection a larger error with a
+// larger U the one that does not. Figures built by hand (Summarise reads
+// nothing else): P_S 1.30 mm with u 0.01 (|v| + 2u = 1.32, |v| - 2u = 1.28)
+// and P_S 1.25 mm with u 0.14 (1.53, 0.97); and 1.60 mm with u 0.01 (1.58)
+// against 1.70 mm with u 0.14 (1.42).
 TEST(Vdi2634, TheSummarysWorstIsTheFigureNearestToFailingUnderTheRule) {
   auto position = [](double value_mm, double u_mm, DecisionRule rule) {
     ArtifactEvaluation e;
+    e.decision_rule = rule;
     Figure f;
     f.name = "P_S";
     f.value_mm = value_mm;
@@ -988,7 +1041,7 @@ TEST(Vdi2634, TheSummarysWorstIsTheFigureNearestToFailingUnderTheRule) {
     return e;
   };
   for (DecisionRule rule : {DecisionRule::kSimpleAcceptance, DecisionRule::kGuardedAcceptance}) {
-    const VerifySummary s = Summarise({position(1.30, 0.01, rule), position(1.25, 0.14, rule)}, rule);
+    const VerifySummary s = Summarise({position(1.30, 0.01, rule), position(1.25, 0.14, rule)});
     ASSERT_EQ(s.worst.size(), 1u);
     const bool guarded = rule == DecisionRule::kGuardedAcceptance;
     EXPECT_EQ(s.worst[0].value_mm, guarded ? 1.25 : 1.30) << DecisionRuleName(rule);
@@ -998,7 +1051,20 @@ TEST(Vdi2634, TheSummarysWorstIsTheFigureNearestToFailingUnderTheRule) {
   // A failing position is never hidden behind a worse-looking passing one:
   // under guarded acceptance position 2 fails, listed first or last.
   const DecisionRule rule = DecisionRule::kGuardedAcceptance;
-  EXPECT_FALSE(Summarise({position(1.25, 0.14, rule), position(1.30, 0.01, rule)}, rule).pass);
+  EXPECT_FALSE(Summarise({position(1.25, 0.14, rule), position(1.30, 0.01, rule)}).pass);
+  // Guarded rejection: 1.60 mm (u 0.01) fails, 1.70 mm (u 0.14) does not;
+  // the worst is the failing one, whatever the order.
+  const DecisionRule rejection = DecisionRule::kGuardedRejection;
+  for (bool swapped : {false, true}) {
+    std::vector<ArtifactEvaluation> p = {position(1.60, 0.01, rejection), position(1.70, 0.14, rejection)};
+    if (swapped) std::swap(p[0], p[1]);
+    const VerifySummary s = Summarise(p);
+    ASSERT_EQ(s.worst.size(), 1u);
+    EXPECT_EQ(s.worst[0].value_mm, 1.60);
+    EXPECT_FALSE(s.worst[0].pass);
+    EXPECT_FALSE(s.pass);
+  }
+  EXPECT_TRUE(Summarise({position(1.70, 0.14, rejection)}).pass);
 }
 
 // --- (7) Stray points in the plate's plane. ---
