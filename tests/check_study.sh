@@ -7,9 +7,13 @@
 # ring turned, thermal drift). Each kind of night comes from one simulator
 # run of 8*N captures, split into nights by capture index.
 #
-# Usage: tests/check_study.sh BIN WORKDIR [NIGHTS=20] [KIND...]
-#   KIND: unmoved | camera | module | focal:P (camera 2's fx, fy scaled by
-#   1 + P/100) | principal:DX,DY (camera 1's principal point moved, px).
+# Usage: [STUDY_SPEC=spec.yaml] tests/check_study.sh BIN WORKDIR [NIGHTS=20] [KIND...]
+#   KIND: unmoved | camera | module | module:M (module M shifted, on a rig of
+#   three or more modules, where the closures can name it: "module M moved
+#   or a lens changed") | focal:P (camera 2's fx, fy scaled by 1 + P/100) |
+#   principal:DX,DY (camera 1's principal point moved, px).
+#   STUDY_SPEC: a simulator spec (docs/simulator.md) for the rig, calibrated
+#   and disturbed alike; default the embedded two-module rig.
 #   Default: unmoved camera module focal:0.015 principal:0.05,0 (the
 #   smallest lens drifts flagged and named on 20 of 20 nights).
 # Prints one line per kind: flagged/named counts, and how many nights said a
@@ -28,11 +32,13 @@ set -euo pipefail
 bin=$1; work=$2; nights=${3:-20}
 shift $(( $# < 3 ? $# : 3 ))
 kinds=("$@")
+spec=()
+[ -z "${STUDY_SPEC:-}" ] || spec=(--spec "$(realpath "$STUDY_SPEC")")
 [ ${#kinds[@]} -gt 0 ] || kinds=(unmoved camera module focal:0.015 principal:0.05,0)
 mkdir -p "$work"
 cd "$work"
 if [ ! -f rig.yaml ]; then
-  "$bin" simulate --out cal --seed 7 --no-scenes >/dev/null 2>&1
+  "$bin" simulate --out cal --seed 7 --no-scenes "${spec[@]}" >/dev/null 2>&1
   "$bin" calibrate --captures cal --target cal/target.yaml --layout cal/layout.yaml --out rig.yaml \
     --report cal.json >/dev/null 2>&1
 fi
@@ -42,7 +48,8 @@ ok=1
 run_kind() {  # name, named explanation (ERE; "" = the check must say ok), specific explanation (ERE), simulate flags...
   local name=$1 expect=$2 exact=$3; shift 3
   rm -rf "$name"
-  "$bin" simulate --out "$name" --seed 1000 --calibration-captures "$total" --no-scenes "$@" >/dev/null 2>&1
+  "$bin" simulate --out "$name" --seed 1000 --calibration-captures "$total" --no-scenes "${spec[@]}" "$@" \
+    >/dev/null 2>&1
   local flagged=0 named=0 specific=0 unexplained=0
   for ((n = 0; n < nights; n++)); do
     local night="$name.night$n"
@@ -78,6 +85,9 @@ for kind in "${kinds[@]}"; do
     module)  # the two modules' closure tells neither which one changed nor a motion from a lens drift: never exact
       run_kind module "module 0 and module 1 disagree: one moved or a lens changed" "" \
         --bump-module 1 --bump-translation-mm 0.1 ;;
+    module:*)  # three or more modules: the shifted one is in every failing pair, and named alone
+      m=${kind#module:}
+      run_kind "module_$m" "module $m moved or a lens changed" "" --bump-module "$m" --bump-translation-mm 0.1 ;;
     focal:*)
       p=${kind#focal:}
       run_kind "focal_$p" "camera 2('s lens changed: [^;]*| moved or its lens changed $either)" "camera 2's lens changed: [^;]*" \

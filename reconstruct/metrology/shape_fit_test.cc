@@ -1,11 +1,13 @@
 // The cylinder and ellipsoid fits against the analytic truth: noisy partial
 // clouds (what two facing modules see: two opposite caps or strips), with 5%
-// gross outliers, must give back the true parameters.
+// gross outliers, must give back the true parameters. And the sphere's
+// locating fit on a sphere of another size than expected.
 #include <gtest/gtest.h>
 
 #include "reconstruct/metrology/cylinder_fit.h"
 #include "reconstruct/metrology/ellipsoid_fit.h"
 #include "reconstruct/metrology/least_squares.h"
+#include "reconstruct/metrology/sphere_fit.h"
 #include "reconstruct/metrology/synthetic_shapes.h"
 
 namespace stereorig {
@@ -88,6 +90,38 @@ TEST(EllipsoidFit, FailsPlainlyOnTooFewPointsOrAPlane) {
   for (int i = 0; i < 2000; ++i) plane.push_back(Eigen::Vector3d(i % 40, i / 40, 200));
   const EllipsoidFit fit = FitEllipsoidRobust(plane, EllipsoidFitOptions{});
   EXPECT_FALSE(fit.ok && fit.inliers.size() > 0.5 * plane.size()) << fit.message;
+}
+
+// Locating a sphere of known size (radius held) on points of a sphere 1.8 mm
+// larger in radius: within RANSAC's radius tolerance (1.9 mm), beyond the
+// 1.5 mm inlier band. The radius-held refinement leaves every point 1.8 mm
+// off, so none was within the band and the fit failed ("fewer than 4
+// points"); RANSAC's consensus is kept instead. Truth: exact samples of the
+// whole sphere about (3, -2, 1): the held-radius centre is the true centre
+// (the points are symmetric about it), and every point is RANSAC's.
+TEST(SphereFit, LocatingASphereOfAnotherSizeWithinTheToleranceKeepsRansacsConsensus) {
+  const Eigen::Vector3d c(3, -2, 1);
+  const double r = 19.05 + 1.8;
+  std::vector<Eigen::Vector3d> pts;
+  for (int i = 0; i <= 40; ++i) {
+    const double t = M_PI * i / 40;
+    const int k = std::max(1, static_cast<int>(80 * std::sin(t)));
+    for (int j = 0; j < k; ++j) {
+      const double p = 2 * M_PI * j / k;
+      pts.push_back(c + r * Eigen::Vector3d(std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)));
+    }
+  }
+  SphereFitOptions o;
+  o.inlier_threshold_mm = 1.5;
+  o.expected_radius_mm = 19.05;
+  o.radius_tolerance_mm = 1.905;
+  o.ransac_iterations = 1000;
+  o.refine_radius = false;
+  const SphereFit fit = FitSphereRobust(pts, o);
+  ASSERT_TRUE(fit.ok) << fit.message;
+  EXPECT_EQ(fit.radius_mm, 19.05);
+  EXPECT_LT((fit.center_mm - c).norm(), 0.01);
+  EXPECT_GT(fit.inliers.size(), pts.size() / 2);
 }
 
 }  // namespace

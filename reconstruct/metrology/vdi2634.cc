@@ -121,12 +121,12 @@ bool Determined(const Figure& f, const VerifyOptions& o) {
 }
 
 // Whether an undetermined figure's FAIL stands all the same. Its u is a
-// floor (the fit counts its points as independent), so only a failure that a
-// larger u would not undo: under simple acceptance a value beyond the MPE by
-// more than 2u (the nonconformance zone: beyond it by more than its noise,
-// and simple acceptance reads the value alone); under guarded acceptance any
-// failure (a larger U only widens the guard band); under guarded rejection
-// none (a larger U could pull the value out of the nonconformance zone).
+// floor (the fit counts its points as independent). Simple acceptance reads
+// the value alone, so its failure stands where the value itself is beyond
+// doubt: beyond the MPE by more than its stated 2u (the nonconformance zone:
+// more than its noise). Under guarded acceptance any failure stands (a
+// larger u only widens the guard band); under guarded rejection none (a
+// larger u could pull the value out of the nonconformance zone).
 bool FailureStands(DecisionRule rule, const Figure& f) {
   if (f.pass) return false;
   switch (rule) {
@@ -278,6 +278,26 @@ double SumOfSquares(const std::vector<double>& r) {
   return ss;
 }
 
+// ", or measured at a scale +20% off (...)": a sphere's fitted size is a fact
+// about the cloud, and a rig calibrated with a wrong target square size reads
+// every length scaled. Said only where that is plausible: within 50% of the
+// certified size, and on a ball bar only if the other ball (its fitted
+// radius over the certified, when known) is off the same way, by at least
+// half as much.
+std::string ScaleText(double scale, std::optional<double> other_ball_scale) {
+  const double off = scale - 1;
+  if (!(std::abs(off) <= 0.5)) return "";
+  if (other_ball_scale &&
+      !((*other_ball_scale - 1) * off > 0 && std::abs(*other_ball_scale - 1) >= 0.5 * std::abs(off)))
+    return "";
+  char buf[160];
+  std::snprintf(buf, sizeof buf,
+                ", or measured at a scale %+.0f%% off (a rig calibrated with a wrong target square size reads every "
+                "length so)",
+                100 * off);
+  return buf;
+}
+
 // Why a located sphere's free-radius fit is not the artifact's: the cap its
 // points cover, the diameter they fit against the certified one, and how well
 // a cap like this fits a diameter at all, so the reader can tell a cap too
@@ -286,7 +306,8 @@ double SumOfSquares(const std::vector<double>& r) {
 // meaningless), with the noise of the better-fitting of the two spheres.
 std::string LeftCertifiedSizeText(const std::vector<Eigen::Vector3d>& pts, const std::vector<int>& captured,
                                   const Eigen::Vector3d& located_center_mm, const SphereFit& free_fit,
-                                  double nominal_radius_mm, double tolerance_mm, double capture_band_mm) {
+                                  double nominal_radius_mm, double tolerance_mm, double capture_band_mm,
+                                  std::optional<double> other_ball_scale) {
   SphereFitUncertainty u{180.0, std::numeric_limits<double>::infinity(), {}};
   if (captured.size() > 4) {
     SphereFit at = SphereAt(pts, captured, located_center_mm, nominal_radius_mm);
@@ -328,14 +349,7 @@ std::string LeftCertifiedSizeText(const std::vector<Eigen::Vector3d>& pts, const
                   "size",
                   u.diameter_std_mm);
     text += buf;
-    // A fitted size is a fact about the cloud: it may be the rig's scale.
-    if (free_fit.ok && free_fit.converged) {
-      std::snprintf(buf, sizeof buf,
-                    ", or measured at a scale %+.0f%% off (a rig calibrated with a wrong target square size reads "
-                    "every length so)",
-                    100 * (free_fit.radius_mm / nominal_radius_mm - 1));
-      text += buf;
-    }
+    if (free_fit.ok && free_fit.converged) text += ScaleText(free_fit.radius_mm / nominal_radius_mm, other_ball_scale);
     return text;
   }
   return text + buf;
@@ -346,7 +360,7 @@ std::string LeftCertifiedSizeText(const std::vector<Eigen::Vector3d>& pts, const
 // the certified one, at least min_points points within the band), and the
 // scale that would make it the artifact's; empty if it holds none.
 std::string OtherSizeText(const std::vector<Eigen::Vector3d>& pts, double nominal_radius_mm, double locate_band_mm,
-                          const VerifyOptions& o) {
+                          std::optional<double> other_ball_scale, const VerifyOptions& o) {
   SphereFitOptions so;
   so.inlier_threshold_mm = locate_band_mm;
   so.expected_radius_mm = 1.25 * nominal_radius_mm;  // hypotheses in [0.5, 2] x the certified radius
@@ -358,14 +372,12 @@ std::string OtherSizeText(const std::vector<Eigen::Vector3d>& pts, double nomina
       !(other.radius_mm >= 0.5 * nominal_radius_mm && other.radius_mm <= 2 * nominal_radius_mm)) {
     return "";
   }
-  char buf[384];
+  char buf[256];
   std::snprintf(buf, sizeof buf,
                 "; it holds one %.1f mm in diameter (%zu points within %.1f mm of it), not the certified %.1f mm: not "
-                "the artifact, not of its certified size, or measured at a scale %+.0f%% off (a rig calibrated with a "
-                "wrong target square size reads every length so)",
-                2 * other.radius_mm, other.inliers.size(), locate_band_mm, 2 * nominal_radius_mm,
-                100 * (other.radius_mm / nominal_radius_mm - 1));
-  return buf;
+                "the artifact, or not of its certified size",
+                2 * other.radius_mm, other.inliers.size(), locate_band_mm, 2 * nominal_radius_mm);
+  return buf + ScaleText(other.radius_mm / nominal_radius_mm, other_ball_scale);
 }
 
 // "ball 2 of the ball bar (centre near (50.0, 0.0, 150.0) mm)": which one
@@ -387,8 +399,11 @@ std::string BallText(int ball, const Eigen::Vector3d& center_mm) {
 // locating: P_S and SD are measured, not assumed; a free fit that leaves the
 // certified size (RANSAC's own tolerance) or does not converge is reported
 // as such.
+// other_ball_scale: on a ball bar's second ball, the first's fitted radius
+// over the certified one (ScaleText).
 ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, double nominal_radius,
-                                    double locate_band_mm, double capture_band_mm, const VerifyOptions& o) {
+                                    double locate_band_mm, double capture_band_mm, const VerifyOptions& o,
+                                    std::optional<double> other_ball_scale = std::nullopt) {
   SphereFitOptions so;
   so.inlier_threshold_mm = locate_band_mm;
   so.expected_radius_mm = nominal_radius;
@@ -400,7 +415,7 @@ ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, dou
   const SphereFit located = FitSphereRobust(pts, so);
   if (!located.ok) {
     out.fit = located;
-    out.fit.message += OtherSizeText(pts, nominal_radius, locate_band_mm, o);
+    out.fit.message += OtherSizeText(pts, nominal_radius, locate_band_mm, other_ball_scale, o);
     return out;
   }
   out.located = true;
@@ -419,7 +434,7 @@ ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, dou
     if (LeftCertifiedSize(fit, nominal_radius, so.radius_tolerance_mm)) {
       out.fit.ok = false;
       out.fit.message = LeftCertifiedSizeText(pts, in, located.center_mm, fit, nominal_radius, so.radius_tolerance_mm,
-                                              capture_band_mm);
+                                              capture_band_mm, other_ball_scale);
       return out;
     }
     std::vector<int> next = WithinSphereShell(pts, fit.center_mm, fit.radius_mm, capture_band_mm);
@@ -430,7 +445,7 @@ ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, dou
   out.fit = RefineSphere(pts, kept, fit.center_mm, fit.radius_mm, kRefineIterations);
   if (LeftCertifiedSize(out.fit, nominal_radius, so.radius_tolerance_mm)) {
     out.fit.message = LeftCertifiedSizeText(pts, kept, located.center_mm, out.fit, nominal_radius,
-                                            so.radius_tolerance_mm, capture_band_mm);
+                                            so.radius_tolerance_mm, capture_band_mm, other_ball_scale);
     out.fit.ok = false;
   }
   return out;
@@ -528,15 +543,17 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       // leaves it: what cap it saw and how well such a cap fits a diameter.
       std::vector<Eigen::Vector3d> located_centers_mm;
       const double tolerance_mm = RadiusToleranceMm(LocateBandMm(o, a.mpe.sphere_spacing_mm), r);
-      auto require_certified_size = [&](int ball, const std::vector<int>& indices, const SphereFit& fit) {
+      auto require_certified_size = [&](int ball, const std::vector<int>& indices, const SphereFit& fit,
+                                        double other_ball_radius_mm) {
         if (!LeftCertifiedSize(fit, r, tolerance_mm)) return;
-        throw InputError(where,
-                         BallText(ball, located_centers_mm[ball]) + ": " +
-                             LeftCertifiedSizeText(pts, indices, located_centers_mm[ball], fit, r, tolerance_mm, band));
+        throw InputError(where, BallText(ball, located_centers_mm[ball]) + ": " +
+                                    LeftCertifiedSizeText(pts, indices, located_centers_mm[ball], fit, r, tolerance_mm,
+                                                          band, other_ball_radius_mm / r));
       };
       for (int ball = 0; ball < 2; ++ball) {
         const ArtifactSphereFit found =
-            FitArtifactSphere(remaining, r, LocateBandMm(o, a.mpe.sphere_spacing_mm), band, o);
+            FitArtifactSphere(remaining, r, LocateBandMm(o, a.mpe.sphere_spacing_mm), band, o,
+                              ball == 0 ? std::nullopt : std::optional<double>(0.5 * e.sphere_diameters_mm[0] / r));
         if (!found.located) {
           throw InputError(where,
                            "ball " + std::to_string(ball + 1) + " of the ball bar not found: " + found.fit.message);
@@ -584,7 +601,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
           for (int ball = 0; ball < 2; ++ball) {
             idx[ball].swap(next[ball]);
             const SphereFit fit = RefineSphere(pts, idx[ball], centers[ball], radii[ball], kRefineIterations);
-            require_certified_size(ball, idx[ball], fit);
+            require_certified_size(ball, idx[ball], fit, radii[1 - ball]);
             centers[ball] = fit.center_mm;
             radii[ball] = fit.radius_mm;
           }
@@ -601,7 +618,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
           int excluded = 0;
           const std::vector<int> kept = ExcludeWorst(idx[ball], res, o.excluded_fraction_max, &excluded);
           const SphereFit fit = RefineSphere(pts, kept, centers[ball], radii[ball], kRefineIterations);
-          require_certified_size(ball, kept, fit);
+          require_certified_size(ball, kept, fit, radii[1 - ball]);
           e.sphere_centers_mm[ball] = fit.center_mm;
           e.sphere_diameters_mm[ball] = 2 * fit.radius_mm;
           const SphereFitUncertainty u = SphereUncertainty(pts, fit);

@@ -91,8 +91,10 @@ struct Figure {
   bool pass = false;  // within the MPE under VerifyOptions::decision_rule (simple: |value| <= mpe)
   // Whether `pass` stands: the figure is determined (its u within
   // VerifyOptions::max_uncertainty_fraction_of_mpe of its MPE, or it has no
-  // u), or it fails in a way a larger u would not undo (vdi2634.cc,
-  // FailureStands). A figure not judged is reported, its pass not claimed.
+  // u), or its failure stands without it (vdi2634.cc, FailureStands: under
+  // simple acceptance beyond the MPE by more than its stated 2u, under
+  // guarded acceptance any failure, under guarded rejection none). A figure
+  // not judged is reported, its pass not claimed.
   bool judged = true;
   // value_mm's standard uncertainty (k = 1): its two parts below combined in
   // quadrature, u = sqrt(u_fit^2 + u_certificate^2) (independent sources:

@@ -988,6 +988,7 @@ TEST(Vdi2634, AFigureLeftUndeterminedInAFailingPositionIsNotJudgedNorTheWorst) {
     const ArtifactEvaluation exact = EvaluateArtifact(SphereArtifact(), exact_points, o, "exact.ply");
     const VerifySummary sum = Summarise({exact, e});
     EXPECT_FALSE(sum.pass);
+    ASSERT_EQ(sum.worst.size(), 2u);
     for (const Figure& f : sum.worst) {
       EXPECT_EQ(f.value_mm, f.name == "P_F" ? FigureOf(e, "P_F") : FigureOf(exact, "P_S")) << f.name;
     }
@@ -1065,6 +1066,49 @@ TEST(Vdi2634, TheSummarysWorstIsTheFigureNearestToFailingUnderTheRule) {
     EXPECT_FALSE(s.pass);
   }
   EXPECT_TRUE(Summarise({position(1.70, 0.14, rejection)}).pass);
+}
+
+// A rig that measures every length a few per cent too large (a calibration
+// target file with a wrong square size does that) must fail the acceptance
+// test, not be refused as bad input. Truth: exact samples of the sphere
+// scaled by 1.098, P_S = 0.098 * 38.1 = 3.734 mm. Its radius is within
+// RANSAC's tolerance (10% of it) but 1.87 mm off the certified one, beyond
+// the 1.5 mm band, so with the radius held no point lay within the band of
+// the located sphere: it was refused as "no sphere of the certified size
+// found in the cloud: fewer than 4 points". Scaled by 1.2 and 1.4, no
+// sphere of the certified size is found, and the message names the sphere
+// a free-radius search finds (45.7 and 53.3 mm) and the scale it would
+// take. A ball bar whose ball 1 has the certified size and ball 2 is 1.3x
+// too large is not blamed on the rig's scale: one ball would show it too.
+TEST(Vdi2634, ACloudAFewPercentTooLargeFailsAndOneFarOffNamesTheScale) {
+  const ArtifactEvaluation e = EvaluateArtifact(SphereArtifact(), ExactSphere(38.1 * 1.098), VerifyOptions(), "s.ply");
+  EXPECT_TRUE(e.judged()) << e.not_judged_reason;
+  EXPECT_FALSE(e.pass());
+  EXPECT_NEAR(FigureOf(e, "P_S"), 0.098 * 38.1, 0.005);
+  for (auto [scale, text] : {std::pair{1.2, "it holds one 45.7 mm in diameter"}, std::pair{1.4, "one 53.3 mm"}}) {
+    try {
+      EvaluateArtifact(SphereArtifact(), ExactSphere(38.1 * scale), VerifyOptions(), "s.ply");
+      ADD_FAILURE() << "a sphere " << scale << "x too large was judged";
+    } catch (const InputError& error) {
+      const std::string what = error.what();
+      EXPECT_NE(what.find(text), std::string::npos) << what;
+      char expected[64];
+      std::snprintf(expected, sizeof expected, "or measured at a scale %+.0f%% off", 100 * (scale - 1));
+      EXPECT_NE(what.find(expected), std::string::npos) << what;
+    }
+  }
+  std::mt19937 rng(1);
+  auto bar = BallSeenFromBothSides({-50, 0, 0}, 12.7, 0, &rng);
+  const auto big_ball = BallSeenFromBothSides({50, 0, 0}, 12.7 * 1.3, 0, &rng);
+  bar.insert(bar.end(), big_ball.begin(), big_ball.end());
+  try {
+    EvaluateArtifact(BallBarArtifact(), bar, VerifyOptions(), "bar.ply");
+    ADD_FAILURE() << "a ball bar with a ball 1.3x too large was judged";
+  } catch (const InputError& error) {
+    const std::string what = error.what();
+    EXPECT_NE(what.find("not the artifact, or not of its certified size"), std::string::npos) << what;
+    EXPECT_EQ(what.find("scale"), std::string::npos) << what;
+  }
 }
 
 // --- (7) Stray points in the plate's plane. ---
