@@ -150,6 +150,19 @@ int RunCheck(int argc, char** argv) {
     report["figures"].push_back(
         {{"name", f.name}, {"value", f.value}, {"threshold", f.threshold}, {"pass", f.pass}, {"samples", f.samples}});
   }
+  // Views set aside whole: their corners fit no board pose, not even their
+  // own (a detection slip where the board is seen nearly edge-on).
+  report["views_set_aside"] = nlohmann::json::array();
+  for (const SetAsideView& v : result.views_set_aside) {
+    const auto name = detected.capture_names.find(v.capture);
+    const std::string capture = name != detected.capture_names.end() ? name->second : std::to_string(v.capture);
+    std::printf(
+        "set aside: capture %s cam%d: its corners fit even their own board pose only to %.3f px (bound %.3f px): "
+        "a detection slip, not a change\n",
+        capture.c_str(), v.camera, v.own_fit_rms_px, v.bound_px);
+    report["views_set_aside"].push_back(
+        {{"capture", capture}, {"camera", v.camera}, {"own_fit_rms_px", v.own_fit_rms_px}, {"bound_px", v.bound_px}});
+  }
   std::printf("verdict: %s (%s)\n", result.Verdict().c_str(), result.Explanation().c_str());
   report["verdict"] = result.Verdict();
   report["explanation"] = result.Explanation();

@@ -97,5 +97,29 @@ TEST(SimSpec, RingsOfOneTwoThreeModulesBuild) {
   }
 }
 
+// The shipped three-module ring (datasets/specs/ring3.yaml, the check's
+// three-module study) is the default rig with module 1 copied twice to
+// 120 and 240 degrees about the vertical, 200 mm from the centre: the
+// same cameras and projector, and everything else the default's.
+TEST(SimSpec, TheShippedRingIsTheDefaultRigWithModuleOneCopiedTo120And240Degrees) {
+  const SimSpec ring = ReadSimSpecFile(std::string(STEREORIG_SOURCE_DIR) + "/datasets/specs/ring3.yaml");
+  const SimSpec def = DefaultSimSpec();
+  ASSERT_EQ(ring.modules.size(), 3u);
+  EXPECT_EQ(ring.modules[0].center_mm, def.modules[0].center_mm);
+  for (int m = 1; m < 3; ++m) {
+    const double a = 2 * M_PI * m / 3;
+    EXPECT_LT((ring.modules[m].center_mm - Eigen::Vector3d(200 * std::sin(a), 0, -200 * std::cos(a))).norm(), 1e-5)
+        << m;
+    EXPECT_EQ(ring.modules[m].name, "module" + std::to_string(m));
+  }
+  EXPECT_EQ(ring.calibration.min_corners_per_camera, 0);
+  // Apart from the ring's own keys, the file is the default spec.
+  SimSpec as_default = ring;
+  as_default.modules.resize(2);
+  as_default.modules[1].center_mm = def.modules[1].center_mm;
+  as_default.calibration.min_corners_per_camera = def.calibration.min_corners_per_camera;
+  EXPECT_EQ(SimSpecToYaml(as_default), SimSpecToYaml(def));
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -193,6 +193,57 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
                                 " captures show the target; the check needs " + std::to_string(options.min_captures));
   }
 
+  CheckResult result;
+  // Views whose corners do not fit even their own board pose are set aside
+  // whole, before anything else uses them: a detection slip, corners taken
+  // for the wrong squares where the board is seen nearly edge-on (a ring of
+  // modules sees it so; measured on a three-module ring: 0.44-0.81 px per
+  // axis at 78-87 deg incidence, 13-33 corners, against 0.014-0.038 px for
+  // every other view of the same night). Such a view fits no pose, and
+  // through the all-camera pose it spoiled every other view of its capture
+  // (0.2-1.0 px), which the check read as cameras moved: 8 of 10 unmoved
+  // nights flagged. A moved camera's view, and one whose lens drifted, still
+  // fit their own pose (it absorbs the motion), so nothing the check must
+  // see is set aside. The bound: kOwnFitBound times the larger of the
+  // camera's calibration RMS and the median of its views' tonight (noisier
+  // images than the calibration's raise it for all views alike).
+  {
+    constexpr double kOwnFitBound = 3.0;
+    std::map<const BoardObservation*, double> own_rms;
+    std::vector<std::vector<double>> by_camera(rig.num_cameras());
+    for (auto& [capture, vs] : in.by_capture) {
+      const BoardPoseEstimate all = EstimateBoardPose(rig, target, vs);
+      for (const BoardObservation* v : vs) {
+        const BoardPoseEstimate own = EstimateBoardPose(rig, target, {v}, all.ok ? &all.ref_from_front : nullptr);
+        if (!own.ok) continue;
+        own_rms[v] = own.rms_px;
+        by_camera[v->camera].push_back(own.rms_px);
+      }
+    }
+    std::vector<double> bound(rig.num_cameras(), 0.0);
+    for (int c = 0; c < rig.num_cameras(); ++c) {
+      std::vector<double>& r = by_camera[c];
+      double median = 0;
+      if (!r.empty()) {
+        std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
+        median = r[r.size() / 2];
+      }
+      bound[c] = kOwnFitBound * std::max(in.sigma_px[c], median);
+    }
+    for (auto& [capture, vs] : in.by_capture) {
+      std::vector<const BoardObservation*> kept;
+      for (const BoardObservation* v : vs) {
+        const auto it = own_rms.find(v);
+        if (it != own_rms.end() && it->second > bound[v->camera]) {
+          result.views_set_aside.push_back({capture, v->camera, it->second, bound[v->camera]});
+        } else {
+          kept.push_back(v);
+        }
+      }
+      vs.swap(kept);
+    }
+  }
+
   // Outlier corners (a detector's occasional slip) are set aside as the
   // calibration's own outlier rejection did, so that the noise it measured
   // applies. Each view's residuals under the all-camera pose are compared with
@@ -257,7 +308,6 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
       if (dof[c] > 0) in.sigma_px[c] = std::max(in.sigma_px[c], std::sqrt(ss[c] / dof[c]));
   }
 
-  CheckResult result;
   const double k = options.k_sigma;
 
   // --- Cameras: each one's corners through the pose the others imply. ---

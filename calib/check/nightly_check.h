@@ -47,8 +47,18 @@ struct CheckFigure {
   int samples = 0;  // corners or captures behind the figure
 };
 
+// A view the check set aside whole: its corners do not fit even their own
+// board pose (RunNightlyCheck).
+struct SetAsideView {
+  int capture = -1;
+  int camera = -1;
+  double own_fit_rms_px = 0;  // per axis, the view fitted with its own pose
+  double bound_px = 0;        // what it had to be within
+};
+
 struct CheckResult {
   std::vector<CheckFigure> figures;
+  std::vector<SetAsideView> views_set_aside;
   // One per camera named by elimination (its module's cameras disagree and
   // it also disagrees with the other modules), in the order named: what
   // explains its corners, a new pose, a new lens, either (the check cannot
