@@ -157,11 +157,11 @@ int RunCheck(int argc, char** argv) {
     const auto name = detected.capture_names.find(v.capture);
     const std::string capture = name != detected.capture_names.end() ? name->second : std::to_string(v.capture);
     std::printf(
-        "set aside: capture %s cam%d: its corners fit even their own board pose only to %.3f px (bound %.3f px): "
-        "a detection slip, not a change\n",
-        capture.c_str(), v.camera, v.own_fit_rms_px, v.bound_px);
+        "set aside: capture %s cam%d: its corners jump about their own board pose by %.3f px (bound %.3f px): "
+        "corners taken for the wrong squares, not used\n",
+        capture.c_str(), v.camera, v.jump_rms_px, v.bound_px);
     report["views_set_aside"].push_back(
-        {{"capture", capture}, {"camera", v.camera}, {"own_fit_rms_px", v.own_fit_rms_px}, {"bound_px", v.bound_px}});
+        {{"capture", capture}, {"camera", v.camera}, {"jump_rms_px", v.jump_rms_px}, {"bound_px", v.bound_px}});
   }
   std::printf("verdict: %s (%s)\n", result.Verdict().c_str(), result.Explanation().c_str());
   report["verdict"] = result.Verdict();

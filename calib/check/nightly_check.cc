@@ -1,5 +1,6 @@
 #include "calib/check/nightly_check.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -109,6 +110,29 @@ struct Consistency {
 
 // Camera c's corners through board poses estimated from the cameras in
 // `trusted` other than c.
+// How much a view's residuals about its own board pose jump from a corner
+// to its grid neighbours: per axis, sqrt(sum |e_i - e_j|^2 / (4 pairs)) over
+// the pairs of neighbouring corners the view holds, which reads sigma for
+// independent noise of sigma per axis. A changed lens, or a moved camera,
+// leaves a smooth field that barely differs between neighbours; corners
+// taken for the wrong squares jump. 0 when the view holds no neighbours.
+double JumpRmsPx(const BoardObservation& v, const std::vector<Eigen::Vector2d>& residuals_px, int corners_x) {
+  std::map<int, int> at;  // corner id -> index in the view
+  for (size_t k = 0; k < v.corner_ids.size(); ++k) at[v.corner_ids[k]] = static_cast<int>(k);
+  double ss = 0;
+  int pairs = 0;
+  for (const auto& [id, k] : at) {
+    const bool row_end = (id + 1) % corners_x == 0;
+    for (int next : {row_end ? -1 : id + 1, id + corners_x}) {
+      const auto it = at.find(next);
+      if (next < 0 || it == at.end()) continue;
+      ss += (residuals_px[k] - residuals_px[it->second]).squaredNorm();
+      ++pairs;
+    }
+  }
+  return pairs > 0 ? std::sqrt(ss / (4.0 * pairs)) : 0.0;
+}
+
 Consistency CameraConsistency(const Inputs& in, int c, const std::set<int>& trusted) {
   Consistency out;
   double ss = 0, expected_ss = 0, var_ss = 0;
@@ -194,48 +218,56 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   }
 
   CheckResult result;
-  // Views whose corners do not fit even their own board pose are set aside
-  // whole, before anything else uses them: a detection slip, corners taken
-  // for the wrong squares where the board is seen nearly edge-on (a ring of
-  // modules sees it so; measured on a three-module ring: 0.44-0.81 px per
-  // axis at 78-87 deg incidence, 13-33 corners, against 0.014-0.038 px for
-  // every other view of the same night). Such a view fits no pose, and
-  // through the all-camera pose it spoiled every other view of its capture
-  // (0.2-1.0 px), which the check read as cameras moved: 8 of 10 unmoved
-  // nights flagged. A moved camera's view, and one whose lens drifted, still
-  // fit their own pose (it absorbs the motion), so nothing the check must
-  // see is set aside. The bound: kOwnFitBound times the larger of the
-  // camera's calibration RMS and the median of its views' tonight (noisier
-  // images than the calibration's raise it for all views alike).
+  // Views whose corners do not fit even their own board pose, nor any
+  // smooth field about it, are set aside whole, before anything else uses
+  // them: a detection slip, corners taken for the wrong squares where the
+  // board is seen nearly edge-on (a ring of modules sees it so; measured on
+  // a three-module ring: 0.44-0.81 px per axis at 78-87 deg incidence, 13-33
+  // corners, against 0.014-0.038 px for every other view of the same night).
+  // Such a view fits no pose, and through the all-camera pose it spoiled
+  // every other view of its capture (0.2-1.0 px), which the check read as
+  // cameras moved: 8 of 10 unmoved nights flagged. A moved camera's view
+  // fits its own pose (the pose absorbs the motion); a changed lens leaves a
+  // smooth field of residuals about it, so only jumps from a corner to its
+  // grid neighbours count (JumpRmsPx; the own-pose RMS alone set a
+  // distortion change aside as a slip, a second reading found).
+  // The bound: kSlipBound times the larger of the camera's calibration RMS
+  // and the lower median of its other views' tonight (noisier images than
+  // the calibration's raise it for all views alike; a camera with one view
+  // tonight has the calibration's alone).
   {
-    constexpr double kOwnFitBound = 3.0;
-    std::map<const BoardObservation*, double> own_rms;
-    std::vector<std::vector<double>> by_camera(rig.num_cameras());
+    constexpr double kSlipBound = 3.0;
+    std::map<const BoardObservation*, double> slip_rms;  // JumpRmsPx
+    std::vector<std::vector<std::pair<const BoardObservation*, double>>> by_camera(rig.num_cameras());
     for (auto& [capture, vs] : in.by_capture) {
       const BoardPoseEstimate all = EstimateBoardPose(rig, target, vs);
       for (const BoardObservation* v : vs) {
         const BoardPoseEstimate own = EstimateBoardPose(rig, target, {v}, all.ok ? &all.ref_from_front : nullptr);
         if (!own.ok) continue;
-        own_rms[v] = own.rms_px;
-        by_camera[v->camera].push_back(own.rms_px);
+        const double rms = JumpRmsPx(*v, ReprojectionErrors(rig, target, *v, own.ref_from_front), target.corners_x());
+        slip_rms[v] = rms;
+        by_camera[v->camera].push_back({v, rms});
       }
-    }
-    std::vector<double> bound(rig.num_cameras(), 0.0);
-    for (int c = 0; c < rig.num_cameras(); ++c) {
-      std::vector<double>& r = by_camera[c];
-      double median = 0;
-      if (!r.empty()) {
-        std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
-        median = r[r.size() / 2];
-      }
-      bound[c] = kOwnFitBound * std::max(in.sigma_px[c], median);
     }
     for (auto& [capture, vs] : in.by_capture) {
       std::vector<const BoardObservation*> kept;
       for (const BoardObservation* v : vs) {
-        const auto it = own_rms.find(v);
-        if (it != own_rms.end() && it->second > bound[v->camera]) {
-          result.views_set_aside.push_back({capture, v->camera, it->second, bound[v->camera]});
+        const auto it = slip_rms.find(v);
+        if (it == slip_rms.end()) {
+          kept.push_back(v);
+          continue;
+        }
+        std::vector<double> others;
+        for (const auto& [w, rms] : by_camera[v->camera])
+          if (w != v) others.push_back(rms);
+        double median = 0;
+        if (!others.empty()) {
+          std::nth_element(others.begin(), others.begin() + (others.size() - 1) / 2, others.end());
+          median = others[(others.size() - 1) / 2];
+        }
+        const double bound = kSlipBound * std::max(in.sigma_px[v->camera], median);
+        if (it->second > bound) {
+          result.views_set_aside.push_back({capture, v->camera, it->second, bound});
         } else {
           kept.push_back(v);
         }
@@ -334,13 +366,20 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   // reading found). Bad input: the captures must show the board to each
   // camera with another camera in the same capture.
   std::string unchecked;
-  for (int c = 0; c < rig.num_cameras(); ++c)
-    if (!camera_figures.count(c)) unchecked += (unchecked.empty() ? "" : ", ") + std::to_string(c);
+  int unchecked_set_aside = 0;
+  for (int c = 0; c < rig.num_cameras(); ++c) {
+    if (camera_figures.count(c)) continue;
+    unchecked += (unchecked.empty() ? "" : ", ") + std::to_string(c);
+    for (const SetAsideView& v : result.views_set_aside) unchecked_set_aside += v.camera == c;
+  }
   if (!unchecked.empty()) {
-    throw InputError(where, "camera(s) " + unchecked +
-                                " saw the board in no capture where another camera saw it too, so the check cannot "
-                                "tell whether they moved: take captures that show the board to every camera with "
-                                "another one");
+    throw InputError(where, "camera(s) " + unchecked + " saw the board in no capture where another camera saw it too" +
+                                (unchecked_set_aside > 0 ? " (" + std::to_string(unchecked_set_aside) +
+                                                               " of their views were set aside: corners taken for "
+                                                               "the wrong squares)"
+                                                         : std::string()) +
+                                ", so the check cannot tell whether they moved: take captures that show the board "
+                                "to every camera with another one");
   }
   for (auto& [c, f] : camera_figures) result.figures.push_back(f);
 

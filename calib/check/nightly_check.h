@@ -47,13 +47,13 @@ struct CheckFigure {
   int samples = 0;  // corners or captures behind the figure
 };
 
-// A view the check set aside whole: its corners do not fit even their own
-// board pose (RunNightlyCheck).
+// A view the check set aside whole: its corners jump about their own board
+// pose, beyond any smooth field a lens change leaves (RunNightlyCheck).
 struct SetAsideView {
   int capture = -1;
   int camera = -1;
-  double own_fit_rms_px = 0;  // per axis, the view fitted with its own pose
-  double bound_px = 0;        // what it had to be within
+  double jump_rms_px = 0;  // per axis: residuals about its own pose, a quadratic field taken out
+  double bound_px = 0;     // what it had to be within
 };
 
 struct CheckResult {
