@@ -158,7 +158,7 @@ int RunCheck(int argc, char** argv) {
     const std::string capture = name != detected.capture_names.end() ? name->second : std::to_string(v.capture);
     std::printf(
         "set aside: capture %s cam%d: its corners jump about their own board pose by %.3f px (bound %.3f px): "
-        "corners taken for the wrong squares, not used\n",
+        "misplaced (taken for the wrong squares, or far noisier than the camera's other views), not used\n",
         capture.c_str(), v.camera, v.jump_rms_px, v.bound_px);
     report["views_set_aside"].push_back(
         {{"capture", capture}, {"camera", v.camera}, {"jump_rms_px", v.jump_rms_px}, {"bound_px", v.bound_px}});
