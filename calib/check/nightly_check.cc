@@ -1,6 +1,5 @@
 #include "calib/check/nightly_check.h"
 
-#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -218,8 +217,8 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   }
 
   CheckResult result;
-  // Views whose corners do not fit even their own board pose, nor any
-  // smooth field about it, are set aside whole, before anything else uses
+  // Views whose corners jump about their own board pose (from a corner to
+  // its grid neighbours) are set aside whole, before anything else uses
   // them: a detection slip, corners taken for the wrong squares where the
   // board is seen nearly edge-on (a ring of modules sees it so; measured on
   // a three-module ring: 0.44-0.81 px per axis at 78-87 deg incidence, 13-33
