@@ -127,7 +127,8 @@ int RunVerify(int argc, char** argv) {
       "fit and the figures; up to 0.3% of those (the largest residuals) may be excluded, as the standard allows. "
       "What is found must be the artifact: a sphere whose captured points fit a diameter more than 10% off the "
       "certified one, or a plane whose dense part (a few stray points do not count) spans less than half of the "
-      "plate's length or width or more than the plate, is refused (exit 2). Points added by hole filling (PLY module "
+      "plate's length or width or more than the plate, is refused (that position not evaluated, below). Points added "
+      "by hole filling (PLY module "
       "255) are not measured and are skipped: the fit never uses the reconstruction's own shape prior. A position "
       "whose points leave P_S (sphere) or SD (ball bar) "
       "undetermined cannot pass: it is not judged (exit 2) when the figure's standard uncertainty is over "
@@ -138,8 +139,11 @@ int RunVerify(int argc, char** argv) {
       "column '-' and a NOT JUDGED line saying why; the summary takes the judged positions' worst. If a judged "
       "position fails, the verdict is FAIL (exit 1) and the report lists the positions not judged (judged false, "
       "pass null, not_judged_reason); otherwise the verdict is NOT JUDGED and the run exits 2 with the reason on "
-      "stderr, writing no report, as for bad input. Bad input in any cloud stops the run before anything is "
-      "printed or written. The artifact file's uncertainties are its certificate's expanded ones, U at "
+      "stderr, writing no report, as for bad input. A cloud that cannot be read stops the run before anything is "
+      "printed or written. A cloud read whose points are not the artifact (too few on it, or none of the certified "
+      "size, above) is a position not evaluated: its row shows '-' and its NOT JUDGED line the reason, the other "
+      "positions are evaluated and shown all the same, and it counts as a position not judged (report: evaluated "
+      "false, no figures). The artifact file's uncertainties are its certificate's expanded ones, U at "
       "k = 2 (or its uncertainty_coverage_factor): U / k enters P_S (diameter), SD (centre distance) and F (flatness) "
       "in quadrature with the fit's, and the rules above read the combined u. A sphere's form_uncertainty_mm "
       "(the U of its certified form) is P_F's, as a plate's flatness_uncertainty_mm is F's.\n\n"
@@ -200,9 +204,17 @@ int RunVerify(int argc, char** argv) {
   std::vector<ArtifactEvaluation> positions;
   std::vector<int> filled_skipped;
   for (const std::string& cloud : clouds) {
-    const MeasuredPoints measured = ReadMeasuredPlyPoints(cloud);
+    const MeasuredPoints measured = ReadMeasuredPlyPoints(cloud);  // unreadable: bad input, nothing printed
     filled_skipped.push_back(measured.filled_skipped);
-    positions.push_back(EvaluateArtifact(artifact, measured.points, options, cloud));
+    try {
+      positions.push_back(EvaluateArtifact(artifact, measured.points, options, cloud));
+    } catch (const InputError& refused) {
+      // The cloud read, but its points are not the artifact (too few on it,
+      // none of the certified size): this position is not evaluated, and
+      // the others are still shown; any other error is the run's.
+      if (refused.where() != cloud) throw;
+      positions.push_back(NotEvaluated(artifact, options, static_cast<int>(measured.points.size()), refused.problem()));
+    }
   }
   // A position left not judged (a figure the points or the certificate leave
   // undetermined) is still printed in full, marked so. A judged position that
@@ -236,8 +248,17 @@ int RunVerify(int argc, char** argv) {
                          {"capture_band_mm", e.capture_band_mm},
                          {"residual_mean_abs_mm", e.residual_mean_abs_mm},
                          {"residual_std_mm", e.residual_std_mm},
+                         {"evaluated", e.evaluated},
                          {"judged", e.judged()},
-                         {"pass", nullptr}};
+                         {"pass", nullptr},
+                         {"figures", nlohmann::json::array()}};
+    if (!e.evaluated) {  // nothing was fitted: no counts on the artifact, no residuals
+      for (const char* key :
+           {"points_on_artifact", "points_excluded", "points_used", "residual_mean_abs_mm", "residual_std_mm"})
+        pj[key] = nullptr;
+      std::printf("%-8zu %-6s %10s %8s %7s %4s %8d %7d %8s %8s %8s %10s\n", i + 1, "-", "-", "-", "-", "-",
+                  e.points_total + filled_skipped[i], filled_skipped[i], "-", "-", "-", "-");
+    }
     if (e.judged()) {
       pj["pass"] = e.pass();
     } else {
@@ -262,7 +283,7 @@ int RunVerify(int argc, char** argv) {
     }
     PrintSpheres(i + 1, e);
     if (!e.sphere_centers_mm.empty()) pj["spheres"] = SpheresJson(e);
-    if (e.type == ArtifactType::kPlate) {
+    if (e.type == ArtifactType::kPlate && e.evaluated) {
       std::printf("%-8zu plate face: outline %.1f x %.1f mm (its dense part; %d captured points outside it)\n", i + 1,
                   e.plate_outline_length_mm, e.plate_outline_width_mm, e.plate_points_off_outline);
       pj["plate_outline_mm"] = {e.plate_outline_length_mm, e.plate_outline_width_mm};
@@ -311,9 +332,19 @@ int RunVerify(int argc, char** argv) {
     report["summary"]["positions_not_judged"].push_back(k + 1);  // numbered as in the table
     std::printf("%s%d", k == summary.not_judged_positions.front() ? " (position " : ", ", k + 1);
   }
-  std::printf("%s\n", all_judged       ? ""
-                      : judged_failure ? " not judged: a figure left undetermined)"
-                                       : ": a figure left undetermined; exit 2, no report written)");
+  const auto not_evaluated =
+      std::count_if(positions.begin(), positions.end(), [](const ArtifactEvaluation& e) { return !e.evaluated; });
+  const char* why = not_evaluated == 0 ? "a figure left undetermined"
+                    : static_cast<size_t>(not_evaluated) == summary.not_judged_positions.size()
+                        ? "a cloud not evaluated"
+                        : "a figure left undetermined or a cloud not evaluated";
+  if (all_judged) {
+    std::printf("\n");
+  } else if (judged_failure) {
+    std::printf(" not judged: %s)\n", why);
+  } else {
+    std::printf(": %s; exit 2, no report written)\n", why);
+  }
   if (!report_path.empty() && (all_judged || judged_failure)) WriteFileAtomically(report_path, report.dump(2) + "\n");
   if (!all_judged && !judged_failure) {
     // One line on stderr, as for bad input: the first position's reason.

@@ -318,8 +318,8 @@ TEST(VerifyCli, ACapTooSmallToFitTheDiameterIsNotJudgedButShownAndAGoodOneReport
 // no report. A judged position that fails fails the test whatever the
 // others say: FAIL, exit 1, the report written with the position not judged
 // listed (it read NOT JUDGED, exit 2, at first: a second reading found it).
-// Bad input in any cloud still stops the run before anything is printed or
-// written. Truth: the certified sphere exact (P_S 0 within rounding), the
+// A cloud that cannot be read still stops the run before anything is
+// printed or written. Truth: the certified sphere exact (P_S 0 within rounding), the
 // same 2 mm too large in diameter (P_S +2.0 against the 1.5 mm MPE), and the
 // 15-degree cap above.
 TEST(VerifyCli, APositionNotJudgedAmongJudgedOnesIsShownAndAJudgedFailureStillFails) {
@@ -367,15 +367,82 @@ TEST(VerifyCli, APositionNotJudgedAmongJudgedOnesIsShownAndAJudgedFailureStillFa
     EXPECT_EQ(p_s_rows, 1);
   }
   std::filesystem::remove(report);
-  const std::string tiny = ::testing::TempDir() + "/tiny_nj.ply";
-  std::ofstream(tiny) << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                         "property float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
-  r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + cap + " --cloud " + tiny + " --report " +
-             report);
+  const std::string unreadable = ::testing::TempDir() + "/unreadable_nj.ply";
+  std::ofstream(unreadable) << "not a ply\n";
+  r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + cap + " --cloud " + unreadable +
+             " --report " + report);
   EXPECT_EQ(r.code, 2) << r.out << r.err;
   EXPECT_EQ(r.out, "");
-  EXPECT_NE(r.err.find("tiny_nj.ply"), std::string::npos) << r.err;
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("unreadable_nj.ply: not a PLY file"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(report));
+}
+
+// A cloud that reads but is not the artifact (too few points on it, or a
+// sphere whose points fit a diameter beyond the certified one's 10%) is a
+// position not evaluated: the other positions are evaluated and shown, it
+// is listed with its reason, and, like a position not judged, it keeps a
+// passing run from passing (exit 2, no report) but not a failing one from
+// failing (exit 1, the report written with it: evaluated false, no
+// figures). Before, its InputError ended the whole run with one line and no
+// table. Truth: the certified sphere exact (P_S 0), the same 2 mm too large
+// (P_S +2.0 against the 1.5 mm MPE), the same at 0.8 of its radius (its
+// exact points fit 30.48 mm, 20% under 38.1 mm: refused whatever the fit's
+// noise), and a 3-point cloud (under --min-points 200).
+TEST(VerifyCli, ACloudThatIsNotTheArtifactIsNotEvaluatedAndTheOtherPositionsAreStillShown) {
+  const std::string good = WriteSphere("good_ne.ply", 19.05);
+  const std::string large = WriteSphere("large_ne.ply", 19.05 + 1.0);
+  const std::string small = WriteSphere("small_ne.ply", 0.8 * 19.05);
+  const std::string tiny = ::testing::TempDir() + "/tiny_ne.ply";
+  std::ofstream(tiny) << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                         "property float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+  const std::string report = ::testing::TempDir() + "/verify_ne_" + std::to_string(getpid()) + ".json";
+  std::filesystem::remove(report);
+
+  auto r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + good + " --cloud " + small +
+                  " --report " + report);
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(small + ": not evaluated: no sphere of the certified size found in the cloud"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.out.find("1        P_S "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("2        P_S "), std::string::npos) << r.out;  // no figure for it
+  EXPECT_NE(r.out.find("2        -  "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("2        NOT JUDGED: not evaluated: no sphere of the certified size found"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("not the certified 38.1 mm"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("verdict: NOT JUDGED (position 2: a cloud not evaluated; exit 2, no report written)"),
+            std::string::npos)
+      << r.out;
+  EXPECT_FALSE(std::filesystem::exists(report));
+
+  r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + large + " --cloud " + small + " --cloud " +
+             tiny + " --report " + report);
+  EXPECT_EQ(r.code, 1) << r.out << r.err;
+  EXPECT_NE(r.out.find("3        NOT JUDGED: not evaluated: only 3 points"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("verdict: FAIL (position 2, 3 not judged: a cloud not evaluated)"), std::string::npos) << r.out;
+  {
+    std::ifstream f(report);
+    ASSERT_TRUE(f.good());
+    const auto written = nlohmann::json::parse(f);
+    ASSERT_EQ(written["positions"].size(), 3u);
+    EXPECT_TRUE(written["positions"][0]["evaluated"].get<bool>());
+    EXPECT_FALSE(written["positions"][0]["pass"].get<bool>());
+    for (int k : {1, 2}) {
+      const auto& p = written["positions"][k];
+      EXPECT_FALSE(p["evaluated"].get<bool>()) << p;
+      EXPECT_FALSE(p["judged"].get<bool>()) << p;
+      EXPECT_TRUE(p["pass"].is_null()) << p;
+      EXPECT_TRUE(p["figures"].is_array() && p["figures"].empty()) << p;
+      EXPECT_TRUE(p["points_used"].is_null()) << p;
+      EXPECT_EQ(p["not_judged_reason"].get<std::string>().rfind("not evaluated: ", 0), 0u) << p;
+    }
+    EXPECT_EQ(written["positions"][2]["points_total"], 3);
+    EXPECT_EQ(written["summary"]["verdict"], "FAIL");
+    EXPECT_EQ(written["summary"]["positions_not_judged"], nlohmann::json::array({2, 3}));
+  }
+  std::filesystem::remove(report);
 }
 
 // --decision-rule (ISO 14253-1). Truth: the exact sphere 1.4 mm and 1.6 mm

@@ -231,6 +231,19 @@ double LocateBandMm(const VerifyOptions& o, double mpe_mm) { return o.locate_ban
 // beyond the MPE is cut off before the figures see it.
 double CaptureBandMm(const VerifyOptions& o, double mpe_mm) { return std::max(o.capture_band_mm, 2 * mpe_mm); }
 
+// The MPE the band must not cut an error of: the artifact type's figures'.
+double BandMpeMm(const Artifact& a) {
+  switch (a.type) {
+    case ArtifactType::kSphere:
+      return std::max(a.mpe.probing_form_mm, a.mpe.probing_size_mm);
+    case ArtifactType::kBallBar:
+      return a.mpe.sphere_spacing_mm;
+    case ArtifactType::kPlate:
+      return a.mpe.flatness_mm;
+  }
+  return 0;
+}
+
 std::vector<int> WithinSphereShell(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& center_mm,
                                    double radius_mm, double band_mm) {
   std::vector<int> in;
@@ -499,8 +512,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
   };
   switch (a.type) {
     case ArtifactType::kSphere: {
-      const double mpe = std::max(a.mpe.probing_form_mm, a.mpe.probing_size_mm);
-      e.capture_band_mm = CaptureBandMm(o, mpe);
+      e.capture_band_mm = CaptureBandMm(o, BandMpeMm(a));
       const ArtifactSphereFit found = FitArtifactSphere(pts, 0.5 * a.sphere_diameter_mm,
                                                         LocateBandMm(o, a.mpe.probing_form_mm), e.capture_band_mm, o);
       if (!found.located) {
@@ -532,7 +544,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       break;
     }
     case ArtifactType::kBallBar: {
-      const double band = CaptureBandMm(o, a.mpe.sphere_spacing_mm);
+      const double band = CaptureBandMm(o, BandMpeMm(a));
       e.capture_band_mm = band;
       const double r = 0.5 * a.sphere_diameter_mm;
       std::vector<double> all_residuals;
@@ -650,7 +662,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       break;
     }
     case ArtifactType::kPlate: {
-      e.capture_band_mm = CaptureBandMm(o, a.mpe.flatness_mm);
+      e.capture_band_mm = CaptureBandMm(o, BandMpeMm(a));
       PlaneFitOptions po;
       po.inlier_threshold_mm = LocateBandMm(o, a.mpe.flatness_mm);
       po.seed = o.seed;
@@ -697,6 +709,18 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       break;
     }
   }
+  return e;
+}
+
+ArtifactEvaluation NotEvaluated(const Artifact& a, const VerifyOptions& o, int points_total,
+                                const std::string& reason) {
+  ArtifactEvaluation e;
+  e.type = a.type;
+  e.decision_rule = o.decision_rule;
+  e.points_total = points_total;
+  e.capture_band_mm = CaptureBandMm(o, BandMpeMm(a));
+  e.evaluated = false;
+  e.not_judged_reason = "not evaluated: " + reason;
   return e;
 }
 

@@ -158,7 +158,10 @@ struct ArtifactEvaluation {
   // otherwise pass (VerifyOptions::max_uncertainty_fraction_of_mpe; the text
   // names the figure, its uncertainty and what would help). Its figures are
   // all filled in, to be reported, not judged.
+  // A position not evaluated at all (NotEvaluated below) has no figures and
+  // no fitted geometry; not_judged_reason then says why.
   std::string not_judged_reason;
+  bool evaluated = true;
   bool judged() const { return not_judged_reason.empty(); }
   bool pass() const;  // judged, and every figure within its MPE
 };
@@ -173,6 +176,14 @@ struct ArtifactEvaluation {
 // and not_judged_reason set.
 ArtifactEvaluation EvaluateArtifact(const Artifact& artifact, const std::vector<Eigen::Vector3d>& points_mm,
                                     const VerifyOptions& options, const std::string& where);
+
+// A position whose cloud EvaluateArtifact refused (its InputError's
+// problem: too few points on the artifact, no artifact of the certified
+// size in it): no figures, evaluated false, not_judged_reason "not
+// evaluated: <reason>", so that one such cloud among several neither hides
+// the others' figures nor passes (verify, several --cloud).
+ArtifactEvaluation NotEvaluated(const Artifact& artifact, const VerifyOptions& options, int points_total,
+                                const std::string& reason);
 
 // Several positions of the same artifact: per figure, the judged position
 // nearest to failing under the decision rule they were evaluated with (the

@@ -330,6 +330,21 @@ TEST(Vdi2634, FailsAgainstTheMpeAndSummarisesPositions) {
   const VerifySummary sum = Summarise({good, bad});
   EXPECT_FALSE(sum.pass);
   EXPECT_TRUE(Summarise({good, good}).pass);
+
+  // A cloud that is not the artifact: not evaluated, no figures, and it
+  // keeps the summary from passing without entering its worst figures.
+  const ArtifactEvaluation none = NotEvaluated(SphereArtifact(), VerifyOptions(), 3, "only 3 points");
+  EXPECT_FALSE(none.evaluated);
+  EXPECT_FALSE(none.judged());
+  EXPECT_FALSE(none.pass());
+  EXPECT_TRUE(none.figures.empty());
+  EXPECT_EQ(none.not_judged_reason, "not evaluated: only 3 points");
+  EXPECT_DOUBLE_EQ(none.capture_band_mm, good.capture_band_mm);  // the header's band, as an evaluated one's
+  const VerifySummary with_none = Summarise({good, none});
+  EXPECT_FALSE(with_none.pass);
+  EXPECT_EQ(with_none.not_judged_positions, std::vector<int>({1}));
+  ASSERT_EQ(with_none.worst.size(), good.figures.size());
+  for (const Figure& f : with_none.worst) EXPECT_LE(std::abs(f.value_mm), 1.5) << f.name;  // good's own
 }
 
 // --- (4) The runtime's known gross error: a patch one grid period off. ---
