@@ -44,7 +44,7 @@ void RejectCamerasBeyondTheRig(const std::string& captures, int num_cameras) {
 
 int PrintHistory(const std::string& db) {
   const auto runs = ReadHistoryRuns(db);
-  std::fputs(FormatTrends(runs, ReadHistoryTrends(db)).c_str(), stdout);
+  std::fputs(FormatTrends(runs, ReadHistoryTrends(db), ReadHistorySetAside(db)).c_str(), stdout);
   return kExitOk;
 }
 
@@ -197,7 +197,7 @@ int RunCheck(int argc, char** argv) {
   report["split_modules"] = result.split_modules;
 
   if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
-  AppendToHistory(history_db, {0, report["date_utc"], rig_path, captures, "", ""}, result);
+  AppendToHistory(history_db, {0, report["date_utc"], rig_path, captures, "", ""}, result, detected.capture_names);
   std::printf("history: appended to %s\n", history_db.c_str());
   return result.ok() ? kExitOk : kExitCheckFailed;
 }

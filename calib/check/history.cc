@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <set>
 
 #include "calib/core/input_error.h"
 
@@ -29,7 +30,10 @@ constexpr const char* kSchema =
     "  captures TEXT NOT NULL, verdict TEXT NOT NULL, explanation TEXT NOT NULL);"
     "CREATE TABLE IF NOT EXISTS stereorig_check_figures ("
     "  run_id INTEGER NOT NULL REFERENCES stereorig_check_runs(id), name TEXT NOT NULL,"
-    "  value REAL NOT NULL, threshold REAL NOT NULL, pass INTEGER NOT NULL, samples INTEGER NOT NULL);";
+    "  value REAL NOT NULL, threshold REAL NOT NULL, pass INTEGER NOT NULL, samples INTEGER NOT NULL);"
+    "CREATE TABLE IF NOT EXISTS stereorig_check_views_set_aside ("
+    "  run_id INTEGER NOT NULL REFERENCES stereorig_check_runs(id), capture TEXT NOT NULL,"
+    "  camera INTEGER NOT NULL, jump_rms_px REAL NOT NULL, bound_px REAL NOT NULL);";
 
 Db Open(const std::string& path, bool create) {
   if (!create && !std::filesystem::exists(path)) throw InputError(path, "no such history database");
@@ -68,7 +72,8 @@ std::string Text(sqlite3_stmt* s, int col) {
 
 }  // namespace
 
-long long AppendToHistory(const std::string& path, const HistoryRun& run, const CheckResult& result) {
+long long AppendToHistory(const std::string& path, const HistoryRun& run, const CheckResult& result,
+                          const std::map<int, std::string>& capture_names) {
   Db db = Open(path, true);
   Exec(db.get(), "BEGIN IMMEDIATE;", path);
   try {
@@ -99,6 +104,23 @@ long long AppendToHistory(const std::string& path, const HistoryRun& run, const 
       sqlite3_bind_int(fig.get(), 5, f.pass ? 1 : 0);
       sqlite3_bind_int(fig.get(), 6, f.samples);
       if (sqlite3_step(fig.get()) != SQLITE_DONE) {
+        throw InputError(path, std::string("history: ") + sqlite3_errmsg(db.get()));
+      }
+    }
+    Stmt aside = Prepare(db.get(),
+                         "INSERT INTO stereorig_check_views_set_aside (run_id, capture, camera, jump_rms_px, bound_px) "
+                         "VALUES (?, ?, ?, ?, ?);",
+                         path);
+    for (const SetAsideView& v : result.views_set_aside) {
+      const auto name = capture_names.find(v.capture);
+      const std::string capture = name != capture_names.end() ? name->second : std::to_string(v.capture);
+      sqlite3_reset(aside.get());
+      sqlite3_bind_int64(aside.get(), 1, id);
+      sqlite3_bind_text(aside.get(), 2, capture.c_str(), -1, SQLITE_TRANSIENT);
+      sqlite3_bind_int(aside.get(), 3, v.camera);
+      sqlite3_bind_double(aside.get(), 4, v.jump_rms_px);
+      sqlite3_bind_double(aside.get(), 5, v.bound_px);
+      if (sqlite3_step(aside.get()) != SQLITE_DONE) {
         throw InputError(path, std::string("history: ") + sqlite3_errmsg(db.get()));
       }
     }
@@ -141,7 +163,32 @@ std::vector<FigureTrend> ReadHistoryTrends(const std::string& path) {
   return trends;
 }
 
-std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<FigureTrend>& trends) {
+std::vector<HistorySetAside> ReadHistorySetAside(const std::string& path) {
+  Db db = Open(path, false);
+  {
+    // A database from before views set aside were stored has no such table.
+    Stmt exists = Prepare(db.get(),
+                          "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = "
+                          "'stereorig_check_views_set_aside';",
+                          path);
+    if (sqlite3_step(exists.get()) != SQLITE_ROW) return {};
+  }
+  Stmt s = Prepare(db.get(),
+                   "SELECT r.id, r.date_utc, v.capture, v.camera, v.jump_rms_px, v.bound_px "
+                   "FROM stereorig_check_views_set_aside v JOIN stereorig_check_runs r ON r.id = v.run_id "
+                   "ORDER BY r.id, v.camera, v.capture;",
+                   path);
+  std::vector<HistorySetAside> rows;
+  while (sqlite3_step(s.get()) == SQLITE_ROW) {
+    rows.push_back({sqlite3_column_int64(s.get(), 0), Text(s.get(), 1), Text(s.get(), 2),
+                    sqlite3_column_int(s.get(), 3), sqlite3_column_double(s.get(), 4),
+                    sqlite3_column_double(s.get(), 5)});
+  }
+  return rows;
+}
+
+std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<FigureTrend>& trends,
+                         const std::vector<HistorySetAside>& set_aside) {
   std::string out;
   char line[256];
   std::snprintf(line, sizeof line, "%zu run(s)", runs.size());
@@ -164,6 +211,29 @@ std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<
     std::snprintf(line, sizeof line, "%-40s %5zu %10.4f %10.4f %10.4f %10.4f %10.4f %6d\n", t.name.c_str(),
                   t.points.size(), t.points.front().value, t.points.back().value, lo, hi, t.points.back().threshold,
                   fails);
+    out += line;
+  }
+  // Per camera: how many views were set aside, on how many runs, the last
+  // run and the largest jump against its bound.
+  std::map<int, std::vector<const HistorySetAside*>> by_camera;
+  for (const HistorySetAside& v : set_aside) by_camera[v.camera].push_back(&v);
+  if (by_camera.empty()) {
+    std::snprintf(line, sizeof line, "views set aside: none in %zu run(s)\n", runs.size());
+    out += line;
+  }
+  for (const auto& [camera, views] : by_camera) {
+    std::set<long long> run_ids;
+    const HistorySetAside* worst = views.front();
+    for (const HistorySetAside* v : views) {
+      run_ids.insert(v->run_id);
+      if (v->jump_rms_px / v->bound_px > worst->jump_rms_px / worst->bound_px) worst = v;
+    }
+    std::snprintf(line, sizeof line,
+                  "views set aside: cam%d %zu view(s) on %zu of %zu run(s), last run %lld (%s); the largest jump "
+                  "%.3f px (bound %.3f px, capture %s, run %lld)\n",
+                  camera, views.size(), run_ids.size(), runs.size(), views.back()->run_id,
+                  views.back()->date_utc.c_str(), worst->jump_rms_px, worst->bound_px, worst->capture.c_str(),
+                  worst->run_id);
     out += line;
   }
   return out;

@@ -3,6 +3,7 @@
 // transaction: a crash or a full disk leaves the database as it was.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,17 @@ struct HistoryPoint {
   bool pass = true;
 };
 
+// One view the check set aside whole on one run (CheckResult's
+// views_set_aside): its corners jumped about their own board pose.
+struct HistorySetAside {
+  long long run_id = 0;
+  std::string date_utc;
+  std::string capture;  // the capture's name as the run printed it (its index if it had none)
+  int camera = -1;
+  double jump_rms_px = 0;
+  double bound_px = 0;
+};
+
 struct FigureTrend {
   std::string name;
   std::vector<HistoryPoint> points;  // oldest first
@@ -35,13 +47,23 @@ struct FigureTrend {
 // Appends one run. Creates the database (and its tables) if missing. Throws
 // InputError naming `db_path` if it is not an SQLite database of ours or
 // cannot be written.
-long long AppendToHistory(const std::string& db_path, const HistoryRun& run, const CheckResult& result);
+// The views the run set aside are stored with it, each capture named by
+// capture_names (CheckResult's capture index -> name; the index where it has
+// none).
+long long AppendToHistory(const std::string& db_path, const HistoryRun& run, const CheckResult& result,
+                          const std::map<int, std::string>& capture_names = {});
 
 std::vector<HistoryRun> ReadHistoryRuns(const std::string& db_path);
 std::vector<FigureTrend> ReadHistoryTrends(const std::string& db_path);
+// Oldest run first; none from a database written before views set aside
+// were stored (its table missing).
+std::vector<HistorySetAside> ReadHistorySetAside(const std::string& db_path);
 
 // A readable table: one row per figure, its first and last values, the
-// extremes, the last threshold and how many runs failed it.
-std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<FigureTrend>& trends);
+// extremes, the last threshold and how many runs failed it; then, per
+// camera, the views set aside and on how many runs (a camera that loses
+// views night after night: a slipping detection, a dirty or loose lens).
+std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<FigureTrend>& trends,
+                         const std::vector<HistorySetAside>& set_aside = {});
 
 }  // namespace stereorig

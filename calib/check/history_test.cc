@@ -1,6 +1,7 @@
 #include "calib/check/history.h"
 
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 
 #include <filesystem>
 #include <fstream>
@@ -41,6 +42,72 @@ TEST(History, AppendsRunsAndReadsTrendsBack) {
   const std::string table = FormatTrends(runs, trends);
   EXPECT_NE(table.find("cam0_consistency_rms_px"), std::string::npos);
   EXPECT_NE(table.find("3 run(s)"), std::string::npos);
+}
+
+// The views a run set aside are kept with it, so a camera that loses views
+// night after night shows in the history, not only in each night's report.
+TEST(History, KeepsTheViewsSetAsideAndCountsThemPerCamera) {
+  const std::string db = ::testing::TempDir() + "/history_set_aside.sqlite";
+  std::filesystem::remove(db);
+  CheckResult night1 = Result(0.20, true), night2 = Result(0.21, true), night3 = Result(0.22, true);
+  night1.views_set_aside = {{3, 1, 0.52, 0.06}};
+  night3.views_set_aside = {{7, 1, 0.31, 0.05}, {2, 2, 0.09, 0.07}};
+  AppendToHistory(db, {0, "2026-11-20T02:00:00Z", "rig.yaml", "night1", "", ""}, night1, {{3, "0003"}});
+  AppendToHistory(db, {0, "2026-11-21T02:00:00Z", "rig.yaml", "night2", "", ""}, night2);
+  AppendToHistory(db, {0, "2026-11-22T02:00:00Z", "rig.yaml", "night3", "", ""}, night3, {{7, "0007"}});
+  const auto aside = ReadHistorySetAside(db);
+  ASSERT_EQ(aside.size(), 3u);
+  EXPECT_EQ(aside[0].run_id, 1);
+  EXPECT_EQ(aside[0].capture, "0003");
+  EXPECT_EQ(aside[0].camera, 1);
+  EXPECT_DOUBLE_EQ(aside[0].jump_rms_px, 0.52);
+  EXPECT_DOUBLE_EQ(aside[0].bound_px, 0.06);
+  EXPECT_EQ(aside[0].date_utc, "2026-11-20T02:00:00Z");
+  EXPECT_EQ(aside[1].run_id, 3);  // run 3, cameras in order
+  EXPECT_EQ(aside[1].camera, 1);
+  EXPECT_EQ(aside[1].capture, "0007");
+  EXPECT_EQ(aside[2].camera, 2);
+  EXPECT_EQ(aside[2].capture, "2");  // no name given: its index
+  const std::string table = FormatTrends(ReadHistoryRuns(db), ReadHistoryTrends(db), aside);
+  EXPECT_NE(table.find("views set aside: cam1 2 view(s) on 2 of 3 run(s), last run 3 (2026-11-22T02:00:00Z); the "
+                       "largest jump 0.520 px (bound 0.060 px, capture 0003, run 1)"),
+            std::string::npos)
+      << table;
+  EXPECT_NE(table.find("views set aside: cam2 1 view(s) on 1 of 3 run(s)"), std::string::npos) << table;
+  EXPECT_EQ(table.find("cam0 "), std::string::npos) << table;  // none of camera 0's
+  EXPECT_NE(FormatTrends(ReadHistoryRuns(db), ReadHistoryTrends(db), {}).find("views set aside: none in 3 run(s)"),
+            std::string::npos);
+}
+
+// A database written before views set aside were stored has no such table:
+// read as none, and the next append adds it.
+TEST(History, ReadsAnOlderDatabaseWithoutTheSetAsideTable) {
+  const std::string db = ::testing::TempDir() + "/history_old.sqlite";
+  std::filesystem::remove(db);
+  {
+    sqlite3* raw = nullptr;
+    ASSERT_EQ(sqlite3_open(db.c_str(), &raw), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(raw,
+                           "CREATE TABLE stereorig_check_runs (id INTEGER PRIMARY KEY AUTOINCREMENT, date_utc TEXT "
+                           "NOT NULL, rig_file TEXT NOT NULL, captures TEXT NOT NULL, verdict TEXT NOT NULL, "
+                           "explanation TEXT NOT NULL);"
+                           "CREATE TABLE stereorig_check_figures (run_id INTEGER NOT NULL, name TEXT NOT NULL, value "
+                           "REAL NOT NULL, threshold REAL NOT NULL, pass INTEGER NOT NULL, samples INTEGER NOT NULL);"
+                           "INSERT INTO stereorig_check_runs (date_utc, rig_file, captures, verdict, explanation) "
+                           "VALUES ('2026-11-01T02:00:00Z', 'rig.yaml', 'old', 'ok', 'every figure within its "
+                           "threshold');",
+                           nullptr, nullptr, nullptr),
+              SQLITE_OK);
+    sqlite3_close(raw);
+  }
+  EXPECT_TRUE(ReadHistorySetAside(db).empty());
+  CheckResult night = Result(0.2, true);
+  night.views_set_aside = {{1, 0, 0.4, 0.05}};
+  AppendToHistory(db, {0, "2026-11-02T02:00:00Z", "rig.yaml", "new", "", ""}, night);
+  const auto aside = ReadHistorySetAside(db);
+  ASSERT_EQ(aside.size(), 1u);
+  EXPECT_EQ(aside[0].run_id, 2);
+  EXPECT_EQ(ReadHistoryRuns(db).size(), 2u);
 }
 
 TEST(History, RejectsAFileThatIsNotADatabaseAndLeavesItAlone) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <set>
 #include <sstream>
@@ -324,6 +325,24 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   in.by_capture.clear();
   for (const BoardObservation& v : trimmed)
     if (in.seed.count(v.capture)) in.by_capture[v.capture].push_back(&v);
+  // min_captures again, on what is left: views set aside (or a capture whose
+  // corners fit no pose) can take whole captures away, and the thresholds
+  // assume at least that many.
+  if (static_cast<int>(in.by_capture.size()) < options.min_captures) {
+    std::string aside;
+    for (const SetAsideView& v : result.views_set_aside) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "%scam%d of capture %d (jump %.3f px, bound %.3f px)", aside.empty() ? "" : ", ",
+                    v.camera, v.capture, v.jump_rms_px, v.bound_px);
+      aside += buf;
+    }
+    throw InputError(where, "only " + std::to_string(in.by_capture.size()) +
+                                " captures keep a view of the target once views whose corners jump about their own "
+                                "board pose are set aside (" +
+                                (aside.empty() ? std::string("none") : aside) +
+                                ") and outlier corners trimmed; the check needs " +
+                                std::to_string(options.min_captures) + ": take more captures");
+  }
 
   // Tonight's corner noise, per camera: each view fitted with its own pose.
   // A camera that moved is fitted just as well (its own pose absorbs any

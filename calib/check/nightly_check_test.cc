@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include <array>
 #include <functional>
 #include <limits>
@@ -486,6 +488,41 @@ TEST(NightlyCheck, BadInputIsRefused) {
     ADD_FAILURE() << "captures camera 3 never saw were judged";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("camera(s) 3 saw"), std::string::npos) << e.what();
+  }
+}
+
+// min_captures holds for the captures left once views are set aside, not
+// only for those given: five captures, one of which shows the board to
+// camera 1 alone in a view with every other corner slipped 2 px along the
+// row (a jump far beyond any bound), was judged on four before.
+TEST(NightlyCheck, TooFewCapturesLeftOnceAViewIsSetAsideIsRefused) {
+  const SimulatedRig truth = MakeDefaultRig();
+  const Target target = DefaultTarget();
+  std::vector<BoardObservation> views;
+  std::set<int> captures;
+  for (const BoardObservation& v : Observe(truth, target, {}, 4)) {
+    if (!captures.count(v.capture) && captures.size() == 5) continue;
+    captures.insert(v.capture);
+    views.push_back(v);
+  }
+  ASSERT_EQ(captures.size(), 5u);
+  const int lone = *captures.rbegin();
+  std::erase_if(views, [&](const BoardObservation& v) { return v.capture == lone && v.camera != 1; });
+  ASSERT_EQ(std::count_if(views.begin(), views.end(), [&](const BoardObservation& v) { return v.capture == lone; }), 1);
+  // Unslipped, the five captures are enough.
+  EXPECT_NO_THROW(RunNightlyCheck(StoredRig(truth), target, views, CheckOptions(), "captures"));
+  for (BoardObservation& v : views) {
+    if (v.capture != lone) continue;
+    for (size_t k = 0; k < v.q_px.size(); k += 2) v.q_px[k].x() += 2.0;
+  }
+  try {
+    RunNightlyCheck(StoredRig(truth), target, views, CheckOptions(), "captures");
+    ADD_FAILURE() << "four captures were judged";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("only 4 captures keep a view of the target"), std::string::npos) << what;
+    EXPECT_NE(what.find("cam1 of capture " + std::to_string(lone)), std::string::npos) << what;
+    EXPECT_NE(what.find("the check needs 5"), std::string::npos) << what;
   }
 }
 
