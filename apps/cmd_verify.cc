@@ -143,7 +143,8 @@ int RunVerify(int argc, char** argv) {
       "printed or written. A cloud read whose points are not the artifact (too few on it, or none of the certified "
       "size, above) is a position not evaluated: its row shows '-' and its NOT JUDGED line the reason, the other "
       "positions are evaluated and shown all the same, and it counts as a position not judged (report: evaluated "
-      "false, no figures). The artifact file's uncertainties are its certificate's expanded ones, U at "
+      "false, figures empty, its counts on the artifact null). The artifact file's uncertainties are its certificate's "
+      "expanded ones, U at "
       "k = 2 (or its uncertainty_coverage_factor): U / k enters P_S (diameter), SD (centre distance) and F (flatness) "
       "in quadrature with the fit's, and the rules above read the combined u. A sphere's form_uncertainty_mm "
       "(the U of its certified form) is P_F's, as a plate's flatness_uncertainty_mm is F's.\n\n"
@@ -166,8 +167,7 @@ int RunVerify(int argc, char** argv) {
       "on a ball bar reported, not judged: a patch one grid period off on one ball shows there); per plate the "
       "outline of its face's dense part.\n\n"
       "Exit codes: 0 every figure passes; 1 a figure of a judged position fails (under the decision rule); 2 bad "
-      "input, or a "
-      "position not judged (and none failed).\n\n"
+      "input, or a position not judged or not evaluated (and none failed).\n\n"
       "Example:\n  stereorig verify --artifact datasets/artifacts/sphere_38mm.yaml --cloud sphere_pos1.ply "
       "--cloud sphere_pos2.ply --report verify.json",
       "stereorig verify"};
@@ -208,11 +208,10 @@ int RunVerify(int argc, char** argv) {
     filled_skipped.push_back(measured.filled_skipped);
     try {
       positions.push_back(EvaluateArtifact(artifact, measured.points, options, cloud));
-    } catch (const InputError& refused) {
+    } catch (const NotTheArtifactError& refused) {
       // The cloud read, but its points are not the artifact (too few on it,
       // none of the certified size): this position is not evaluated, and
       // the others are still shown; any other error is the run's.
-      if (refused.where() != cloud) throw;
       positions.push_back(NotEvaluated(artifact, options, static_cast<int>(measured.points.size()), refused.problem()));
     }
   }

@@ -85,14 +85,16 @@ TEST(VerifyCli, BadInputExitsTwoAndWritesNoReport) {
   EXPECT_EQ(Lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("center_distance_mm: missing key"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(report));
-  // A cloud with too few points on the artifact.
+  // A cloud with too few points on the artifact: not evaluated, its row
+  // shown, exit 2, no report.
   const std::string tiny = ::testing::TempDir() + "/tiny.ply";
   std::ofstream(tiny) << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
                          "property float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
   r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + tiny + " --report " + report);
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(Lines(r.err), 1) << r.err;
-  EXPECT_NE(r.err.find("tiny.ply"), std::string::npos);
+  EXPECT_NE(r.err.find("tiny.ply: not evaluated: only 3 points"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("1        NOT JUDGED: not evaluated: only 3 points"), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(report));
 }
 
@@ -120,8 +122,8 @@ TEST(VerifyCli, AReportWithoutAFolderOrOverACloudIsRefusedBeforeTheVerdict) {
 
 // The rest of issue 6's bad input: every artifact type with a field
 // missing, and a large cloud with only a few points on the artifact (a plane
-// of 6000 points and a 60-point patch of the sphere). Each: exit 2, one line
-// naming the file, no report.
+// of 6000 points and a 60-point patch of the sphere: not evaluated). Each:
+// exit 2, one line naming the file, no report.
 TEST(VerifyCli, MissingFieldsOfEveryTypeAndTooFewPointsOnTheArtifactExitTwo) {
   const std::string good = WriteSphere("good3.ply", 19.05);
   const std::string report = ::testing::TempDir() + "/verify_bad3.json";
@@ -158,7 +160,10 @@ TEST(VerifyCli, MissingFieldsOfEveryTypeAndTooFewPointsOnTheArtifactExitTwo) {
   const auto r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + sparse + " --report " + report);
   EXPECT_EQ(r.code, 2) << r.out << r.err;
   EXPECT_EQ(Lines(r.err), 1) << r.err;
-  EXPECT_NE(r.err.find("sparse_sphere.ply"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("sparse_sphere.ply: not evaluated: "), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("verdict: NOT JUDGED (position 1: a cloud not evaluated; exit 2, no report written)"),
+            std::string::npos)
+      << r.out;
   EXPECT_FALSE(std::filesystem::exists(report));
 }
 
@@ -435,7 +440,10 @@ TEST(VerifyCli, ACloudThatIsNotTheArtifactIsNotEvaluatedAndTheOtherPositionsAreS
       EXPECT_FALSE(p["judged"].get<bool>()) << p;
       EXPECT_TRUE(p["pass"].is_null()) << p;
       EXPECT_TRUE(p["figures"].is_array() && p["figures"].empty()) << p;
-      EXPECT_TRUE(p["points_used"].is_null()) << p;
+      for (const char* key :
+           {"points_on_artifact", "points_excluded", "points_used", "residual_mean_abs_mm", "residual_std_mm"})
+        EXPECT_TRUE(p[key].is_null()) << key << " " << p;
+      EXPECT_FALSE(p.contains("spheres")) << p;
       EXPECT_EQ(p["not_judged_reason"].get<std::string>().rfind("not evaluated: ", 0), 0u) << p;
     }
     EXPECT_EQ(written["positions"][2]["points_total"], 3);
@@ -443,6 +451,26 @@ TEST(VerifyCli, ACloudThatIsNotTheArtifactIsNotEvaluatedAndTheOtherPositionsAreS
     EXPECT_EQ(written["summary"]["positions_not_judged"], nlohmann::json::array({2, 3}));
   }
   std::filesystem::remove(report);
+
+  // Beside a figure left undetermined (the 15-degree cap) the verdict names
+  // both kinds.
+  r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + large + " --cloud " +
+             WriteCap("cap15_ne", 15, 13) + " --cloud " + small);
+  EXPECT_EQ(r.code, 1) << r.out << r.err;
+  EXPECT_NE(r.out.find("verdict: FAIL (position 2, 3 not judged: a figure left undetermined or a cloud not "
+                       "evaluated)"),
+            std::string::npos)
+      << r.out;
+
+  // A plate's position not evaluated prints no outline (there is none): the
+  // sphere's cloud given for the 130 x 120 mm plate.
+  r = RunCli("verify --artifact " +
+             WriteArtifact("format: stereorig-artifact\nversion: 1\nunits: mm\nname: p\ntype: plate\n"
+                           "length_mm: 130\nwidth_mm: 120\n") +
+             " --cloud " + good);
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_NE(r.out.find("1        NOT JUDGED: not evaluated: "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("plate face"), std::string::npos) << r.out;
 }
 
 // --decision-rule (ISO 14253-1). Truth: the exact sphere 1.4 mm and 1.6 mm

@@ -482,12 +482,13 @@ void RequirePlateCoverage(const PlaneOutline& e, const Artifact& a, const Verify
   const std::string found = "the plane found spans " + Mm(e.length_mm()) + " x " + Mm(e.width_mm()) +
                             " mm, the plate is " + Mm(longer) + " x " + Mm(shorter) + " mm";
   if (e.length_mm() < o.plate_min_coverage * longer || e.width_mm() < o.plate_min_coverage * shorter) {
-    throw InputError(where, found + ": not the plate, or too little of it seen (at least " +
-                                std::to_string(static_cast<int>(std::lround(100 * o.plate_min_coverage))) +
-                                "% of its length and width must be)");
+    throw NotTheArtifactError(where, found + ": not the plate, or too little of it seen (at least " +
+                                         std::to_string(static_cast<int>(std::lround(100 * o.plate_min_coverage))) +
+                                         "% of its length and width must be)");
   }
   if (e.length_mm() > longer + 2 * capture_band_mm || e.width_mm() > shorter + 2 * capture_band_mm) {
-    throw InputError(where, found + ": another surface than the plate lies in its plane (crop the cloud to the plate)");
+    throw NotTheArtifactError(
+        where, found + ": another surface than the plate lies in its plane (crop the cloud to the plate)");
   }
 }
 
@@ -501,13 +502,13 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
   e.type = a.type;
   e.points_total = static_cast<int>(pts.size());
   if (e.points_total < o.min_points) {
-    throw InputError(where, "only " + std::to_string(e.points_total) + " points; at least " +
-                                std::to_string(o.min_points) + " are needed on the artifact");
+    throw NotTheArtifactError(where, "only " + std::to_string(e.points_total) + " points; at least " +
+                                         std::to_string(o.min_points) + " are needed on the artifact");
   }
   auto require_points = [&](int n, const char* what) {
     if (n < o.min_points) {
-      throw InputError(where, std::string("only ") + std::to_string(n) + " points lie on the " + what + "; at least " +
-                                  std::to_string(o.min_points) + " are needed");
+      throw NotTheArtifactError(where, std::string("only ") + std::to_string(n) + " points lie on the " + what +
+                                           "; at least " + std::to_string(o.min_points) + " are needed");
     }
   };
   switch (a.type) {
@@ -516,9 +517,9 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       const ArtifactSphereFit found = FitArtifactSphere(pts, 0.5 * a.sphere_diameter_mm,
                                                         LocateBandMm(o, a.mpe.probing_form_mm), e.capture_band_mm, o);
       if (!found.located) {
-        throw InputError(where, "no sphere of the certified size found in the cloud: " + found.fit.message);
+        throw NotTheArtifactError(where, "no sphere of the certified size found in the cloud: " + found.fit.message);
       }
-      if (!found.fit.ok) throw InputError(where, "the sphere: " + found.fit.message);
+      if (!found.fit.ok) throw NotTheArtifactError(where, "the sphere: " + found.fit.message);
       const SphereFit& fit = found.fit;
       const int excluded = found.excluded;
       require_points(static_cast<int>(fit.inliers.size()) + excluded, "sphere");
@@ -558,19 +559,20 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       auto require_certified_size = [&](int ball, const std::vector<int>& indices, const SphereFit& fit,
                                         double other_ball_radius_mm) {
         if (!LeftCertifiedSize(fit, r, tolerance_mm)) return;
-        throw InputError(where, BallText(ball, located_centers_mm[ball]) + ": " +
-                                    LeftCertifiedSizeText(pts, indices, located_centers_mm[ball], fit, r, tolerance_mm,
-                                                          band, other_ball_radius_mm / r));
+        throw NotTheArtifactError(where, BallText(ball, located_centers_mm[ball]) + ": " +
+                                             LeftCertifiedSizeText(pts, indices, located_centers_mm[ball], fit, r,
+                                                                   tolerance_mm, band, other_ball_radius_mm / r));
       };
       for (int ball = 0; ball < 2; ++ball) {
         const ArtifactSphereFit found =
             FitArtifactSphere(remaining, r, LocateBandMm(o, a.mpe.sphere_spacing_mm), band, o,
                               ball == 0 ? std::nullopt : std::optional<double>(0.5 * e.sphere_diameters_mm[0] / r));
         if (!found.located) {
-          throw InputError(where,
-                           "ball " + std::to_string(ball + 1) + " of the ball bar not found: " + found.fit.message);
+          throw NotTheArtifactError(
+              where, "ball " + std::to_string(ball + 1) + " of the ball bar not found: " + found.fit.message);
         }
-        if (!found.fit.ok) throw InputError(where, BallText(ball, found.located_center_mm) + ": " + found.fit.message);
+        if (!found.fit.ok)
+          throw NotTheArtifactError(where, BallText(ball, found.located_center_mm) + ": " + found.fit.message);
         const SphereFit& fit = found.fit;
         const int excluded = found.excluded;
         located_centers_mm.push_back(found.located_center_mm);
@@ -667,7 +669,7 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       po.inlier_threshold_mm = LocateBandMm(o, a.mpe.flatness_mm);
       po.seed = o.seed;
       PlaneFit fit = FitPlaneRobust(pts, po);
-      if (!fit.ok) throw InputError(where, "no plane found in the cloud: " + fit.message);
+      if (!fit.ok) throw NotTheArtifactError(where, "no plane found in the cloud: " + fit.message);
       // The face: the points within the capture band of the plane, inside
       // the outline of their dense part (plate_outline.h: a few stray points
       // do not widen it) eroded by the edge margin; the set and the
@@ -686,7 +688,8 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
         if (round > 0 && next == face) break;
         face.swap(next);
         fit = FitPlaneLeastSquares(pts, face);
-        if (!fit.ok) throw InputError(where, "the plate's face is too small after the edge margin: " + fit.message);
+        if (!fit.ok)
+          throw NotTheArtifactError(where, "the plate's face is too small after the edge margin: " + fit.message);
       }
       require_points(static_cast<int>(fit.inliers.size()), "plate");
       int excluded = 0;

@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "calib/core/input_error.h"
 #include "reconstruct/metrology/artifact.h"
 #include "reconstruct/metrology/decision_rule.h"
 
@@ -44,7 +45,7 @@ struct VerifyOptions {
   // (~3.5 mm) with room for the fit's shift, and stays clear of the far face
   // of the simulator's 8 mm plate.
   double capture_band_mm = 5.0;
-  int min_points = 200;  // fewer points on the artifact: bad input
+  int min_points = 200;  // fewer points on the artifact: not the artifact (verify: that position not evaluated)
   // Ball bar: each ball's points within this angle of the bar axis (towards
   // the other ball) belong to the shaft's neighbourhood and are not used.
   double ballbar_shaft_cone_deg = 60.0;
@@ -166,7 +167,15 @@ struct ArtifactEvaluation {
   bool pass() const;  // judged, and every figure within its MPE
 };
 
-// Throws InputError(`where`, ...) when the cloud has too few points on the
+// A cloud that reads but is not the artifact (EvaluateArtifact below):
+// verify shows it as a position not evaluated, where any other InputError
+// stops the run.
+class NotTheArtifactError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
+// Throws NotTheArtifactError(`where`, ...) when the cloud has too few points on the
 // artifact, the artifact cannot be found in it, what is found does not
 // cover the certified artifact plausibly (a sphere or ball whose free-radius
 // fit leaves the certified size or does not converge: the message names the
@@ -177,7 +186,7 @@ struct ArtifactEvaluation {
 ArtifactEvaluation EvaluateArtifact(const Artifact& artifact, const std::vector<Eigen::Vector3d>& points_mm,
                                     const VerifyOptions& options, const std::string& where);
 
-// A position whose cloud EvaluateArtifact refused (its InputError's
+// A position whose cloud EvaluateArtifact refused (its NotTheArtifactError's
 // problem: too few points on the artifact, no artifact of the certified
 // size in it): no figures, evaluated false, not_judged_reason "not
 // evaluated: <reason>", so that one such cloud among several neither hides
