@@ -52,8 +52,9 @@ int PrintHistory(const std::string& db) {
 
 int RunCheck(int argc, char** argv) {
   CLI::App app{
-      "The nightly recalibration check. Take 5 to 10 fresh captures of the double-sided target (lasers off, the "
-      "target in different poses between the modules) and run this against the stored rig file. The calibration "
+      "The nightly recalibration check. Take 8 to 10 fresh captures of the double-sided target (lasers off, the "
+      "target in different poses between the modules; at least 5 must keep a view once views whose corners "
+      "are misplaced are set aside, or the night is refused) and run this against the stored rig file. The calibration "
       "is held fixed; only the board poses are re-estimated. It reports each camera's consistency with the others, "
       "each module's stereo consistency and rectified-row error, and each module pair's closure through the "
       "target, each next to a threshold derived from the stored calibration's own residuals and uncertainties. "
@@ -140,7 +141,8 @@ int RunCheck(int argc, char** argv) {
   }
   std::fprintf(stderr, "check: %d captures, %zu views; re-estimating board poses\n", detected.num_captures,
                detected.observations.size());
-  const CheckResult result = RunNightlyCheck(rig, target, detected.observations, options, captures);
+  const CheckResult result =
+      RunNightlyCheck(rig, target, detected.observations, options, captures, detected.capture_names);
 
   std::printf("%-44s %10s %10s %6s %8s\n", "figure", "value", "threshold", "pass", "samples");
   nlohmann::json report = {{"rig", rig_path}, {"captures", captures}, {"date_utc", NowUtcIso8601()}};

@@ -33,7 +33,11 @@ constexpr const char* kSchema =
     "  value REAL NOT NULL, threshold REAL NOT NULL, pass INTEGER NOT NULL, samples INTEGER NOT NULL);"
     "CREATE TABLE IF NOT EXISTS stereorig_check_views_set_aside ("
     "  run_id INTEGER NOT NULL REFERENCES stereorig_check_runs(id), capture TEXT NOT NULL,"
-    "  camera INTEGER NOT NULL, jump_rms_px REAL NOT NULL, bound_px REAL NOT NULL);";
+    "  camera INTEGER NOT NULL, jump_rms_px REAL NOT NULL, bound_px REAL NOT NULL);"
+    "CREATE TABLE IF NOT EXISTS stereorig_check_meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);";
+
+constexpr const char* kSetAsideTable = "stereorig_check_views_set_aside";
+constexpr const char* kSetAsideSinceKey = "views_set_aside_since_run";
 
 Db Open(const std::string& path, bool create) {
   if (!create && !std::filesystem::exists(path)) throw InputError(path, "no such history database");
@@ -70,6 +74,12 @@ std::string Text(sqlite3_stmt* s, int col) {
   return t ? reinterpret_cast<const char*>(t) : "";
 }
 
+bool HasTable(sqlite3* db, const char* table, const std::string& path) {
+  Stmt s = Prepare(db, "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = ?;", path);
+  sqlite3_bind_text(s.get(), 1, table, -1, SQLITE_TRANSIENT);
+  return sqlite3_step(s.get()) == SQLITE_ROW;
+}
+
 }  // namespace
 
 long long AppendToHistory(const std::string& path, const HistoryRun& run, const CheckResult& result,
@@ -77,6 +87,7 @@ long long AppendToHistory(const std::string& path, const HistoryRun& run, const 
   Db db = Open(path, true);
   Exec(db.get(), "BEGIN IMMEDIATE;", path);
   try {
+    const bool kept_set_aside = HasTable(db.get(), kSetAsideTable, path);
     Exec(db.get(), kSchema, path);
     Stmt ins = Prepare(db.get(),
                        "INSERT INTO stereorig_check_runs (date_utc, rig_file, captures, verdict, explanation) "
@@ -106,6 +117,14 @@ long long AppendToHistory(const std::string& path, const HistoryRun& run, const 
       if (sqlite3_step(fig.get()) != SQLITE_DONE) {
         throw InputError(path, std::string("history: ") + sqlite3_errmsg(db.get()));
       }
+    }
+    if (!kept_set_aside) {  // this run is the first to keep them: the earlier ones did not
+      Stmt since = Prepare(db.get(), "INSERT OR IGNORE INTO stereorig_check_meta (key, value) VALUES (?, ?);", path);
+      const std::string id_text = std::to_string(id);
+      sqlite3_bind_text(since.get(), 1, kSetAsideSinceKey, -1, SQLITE_TRANSIENT);
+      sqlite3_bind_text(since.get(), 2, id_text.c_str(), -1, SQLITE_TRANSIENT);
+      if (sqlite3_step(since.get()) != SQLITE_DONE)
+        throw InputError(path, std::string("history: ") + sqlite3_errmsg(db.get()));
     }
     Stmt aside = Prepare(db.get(),
                          "INSERT INTO stereorig_check_views_set_aside (run_id, capture, camera, jump_rms_px, bound_px) "
@@ -163,32 +182,31 @@ std::vector<FigureTrend> ReadHistoryTrends(const std::string& path) {
   return trends;
 }
 
-std::vector<HistorySetAside> ReadHistorySetAside(const std::string& path) {
+HistorySetAsideLog ReadHistorySetAside(const std::string& path) {
   Db db = Open(path, false);
-  {
-    // A database from before views set aside were stored has no such table.
-    Stmt exists = Prepare(db.get(),
-                          "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = "
-                          "'stereorig_check_views_set_aside';",
-                          path);
-    if (sqlite3_step(exists.get()) != SQLITE_ROW) return {};
+  HistorySetAsideLog log;
+  if (!HasTable(db.get(), kSetAsideTable, path)) return log;  // written before views set aside were kept
+  log.since_run_id = 1;
+  if (HasTable(db.get(), "stereorig_check_meta", path)) {
+    Stmt since = Prepare(db.get(), "SELECT value FROM stereorig_check_meta WHERE key = ?;", path);
+    sqlite3_bind_text(since.get(), 1, kSetAsideSinceKey, -1, SQLITE_TRANSIENT);
+    if (sqlite3_step(since.get()) == SQLITE_ROW) log.since_run_id = sqlite3_column_int64(since.get(), 0);
   }
   Stmt s = Prepare(db.get(),
                    "SELECT r.id, r.date_utc, v.capture, v.camera, v.jump_rms_px, v.bound_px "
                    "FROM stereorig_check_views_set_aside v JOIN stereorig_check_runs r ON r.id = v.run_id "
                    "ORDER BY r.id, v.camera, v.capture;",
                    path);
-  std::vector<HistorySetAside> rows;
   while (sqlite3_step(s.get()) == SQLITE_ROW) {
-    rows.push_back({sqlite3_column_int64(s.get(), 0), Text(s.get(), 1), Text(s.get(), 2),
-                    sqlite3_column_int(s.get(), 3), sqlite3_column_double(s.get(), 4),
-                    sqlite3_column_double(s.get(), 5)});
+    log.views.push_back({sqlite3_column_int64(s.get(), 0), Text(s.get(), 1), Text(s.get(), 2),
+                         sqlite3_column_int(s.get(), 3), sqlite3_column_double(s.get(), 4),
+                         sqlite3_column_double(s.get(), 5)});
   }
-  return rows;
+  return log;
 }
 
 std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<FigureTrend>& trends,
-                         const std::vector<HistorySetAside>& set_aside) {
+                         const HistorySetAsideLog& set_aside) {
   std::string out;
   char line[256];
   std::snprintf(line, sizeof line, "%zu run(s)", runs.size());
@@ -213,14 +231,22 @@ std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<
                   fails);
     out += line;
   }
-  // Per camera: how many views were set aside, on how many runs, the last
-  // run and the largest jump against its bound.
-  std::map<int, std::vector<const HistorySetAside*>> by_camera;
-  for (const HistorySetAside& v : set_aside) by_camera[v.camera].push_back(&v);
-  if (by_camera.empty()) {
-    std::snprintf(line, sizeof line, "views set aside: none in %zu run(s)\n", runs.size());
-    out += line;
+  // Per camera: how many views were set aside, on how many of the runs that
+  // kept them, the last run, and the view worst against its bound.
+  if (set_aside.since_run_id == 0) {
+    out += "views set aside: not kept (these runs were written by a version that did not keep them)\n";
+    return out;
   }
+  size_t kept_runs = 0;
+  std::string since;
+  for (const HistoryRun& r : runs) {
+    if (r.id < set_aside.since_run_id) continue;
+    if (kept_runs++ == 0 && r.id != runs.front().id)
+      since = " since run " + std::to_string(r.id) + " (" + r.date_utc + ")";
+  }
+  std::map<int, std::vector<const HistorySetAside*>> by_camera;
+  for (const HistorySetAside& v : set_aside.views) by_camera[v.camera].push_back(&v);
+  if (by_camera.empty()) out += "views set aside: none in " + std::to_string(kept_runs) + " run(s)" + since + "\n";
   for (const auto& [camera, views] : by_camera) {
     std::set<long long> run_ids;
     const HistorySetAside* worst = views.front();
@@ -228,13 +254,14 @@ std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<
       run_ids.insert(v->run_id);
       if (v->jump_rms_px / v->bound_px > worst->jump_rms_px / worst->bound_px) worst = v;
     }
-    std::snprintf(line, sizeof line,
-                  "views set aside: cam%d %zu view(s) on %zu of %zu run(s), last run %lld (%s); the largest jump "
-                  "%.3f px (bound %.3f px, capture %s, run %lld)\n",
-                  camera, views.size(), run_ids.size(), runs.size(), views.back()->run_id,
-                  views.back()->date_utc.c_str(), worst->jump_rms_px, worst->bound_px, worst->capture.c_str(),
-                  worst->run_id);
-    out += line;
+    std::snprintf(line, sizeof line, "views set aside: cam%d %zu view(s) on %zu of %zu run(s)", camera, views.size(),
+                  run_ids.size(), kept_runs);
+    out += line + since;
+    std::snprintf(line, sizeof line, ", last run %lld (", views.back()->run_id);
+    out += line + views.back()->date_utc;
+    std::snprintf(line, sizeof line, "); the worst against its bound: %.3f px, %.1fx its %.3f px (capture ",
+                  worst->jump_rms_px, worst->jump_rms_px / worst->bound_px, worst->bound_px);
+    out += line + worst->capture + ", run " + std::to_string(worst->run_id) + ")\n";
   }
   return out;
 }

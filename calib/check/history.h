@@ -39,6 +39,14 @@ struct HistorySetAside {
   double bound_px = 0;
 };
 
+// The views set aside as the history holds them, and since which run they
+// are kept (the runs before were written by a version that did not keep
+// them, which set views aside all the same).
+struct HistorySetAsideLog {
+  long long since_run_id = 0;  // 0: not kept at all (no run written by a version that keeps them)
+  std::vector<HistorySetAside> views;
+};
+
 struct FigureTrend {
   std::string name;
   std::vector<HistoryPoint> points;  // oldest first
@@ -55,15 +63,15 @@ long long AppendToHistory(const std::string& db_path, const HistoryRun& run, con
 
 std::vector<HistoryRun> ReadHistoryRuns(const std::string& db_path);
 std::vector<FigureTrend> ReadHistoryTrends(const std::string& db_path);
-// Oldest run first; none from a database written before views set aside
-// were stored (its table missing).
-std::vector<HistorySetAside> ReadHistorySetAside(const std::string& db_path);
+// Oldest run first, cameras in order within a run.
+HistorySetAsideLog ReadHistorySetAside(const std::string& db_path);
 
 // A readable table: one row per figure, its first and last values, the
 // extremes, the last threshold and how many runs failed it; then, per
-// camera, the views set aside and on how many runs (a camera that loses
-// views night after night: a slipping detection, a dirty or loose lens).
+// camera, the views set aside and on how many of the runs that kept them (a
+// camera that loses views night after night: a slipping detection, a dirty
+// or loose lens).
 std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<FigureTrend>& trends,
-                         const std::vector<HistorySetAside>& set_aside = {});
+                         const HistorySetAsideLog& set_aside = {});
 
 }  // namespace stereorig

@@ -51,37 +51,44 @@ TEST(History, KeepsTheViewsSetAsideAndCountsThemPerCamera) {
   std::filesystem::remove(db);
   CheckResult night1 = Result(0.20, true), night2 = Result(0.21, true), night3 = Result(0.22, true);
   night1.views_set_aside = {{3, 1, 0.52, 0.06}};
-  night3.views_set_aside = {{7, 1, 0.31, 0.05}, {2, 2, 0.09, 0.07}};
+  // Camera 2 before camera 1, as a run may list them; camera 1's second view
+  // jumps further (0.90 px) but is less far beyond its bound (1.8x, against
+  // the first night's 8.7x).
+  night3.views_set_aside = {{2, 2, 0.09, 0.07}, {7, 1, 0.90, 0.50}};
   AppendToHistory(db, {0, "2026-11-20T02:00:00Z", "rig.yaml", "night1", "", ""}, night1, {{3, "0003"}});
   AppendToHistory(db, {0, "2026-11-21T02:00:00Z", "rig.yaml", "night2", "", ""}, night2);
   AppendToHistory(db, {0, "2026-11-22T02:00:00Z", "rig.yaml", "night3", "", ""}, night3, {{7, "0007"}});
-  const auto aside = ReadHistorySetAside(db);
-  ASSERT_EQ(aside.size(), 3u);
-  EXPECT_EQ(aside[0].run_id, 1);
-  EXPECT_EQ(aside[0].capture, "0003");
-  EXPECT_EQ(aside[0].camera, 1);
-  EXPECT_DOUBLE_EQ(aside[0].jump_rms_px, 0.52);
-  EXPECT_DOUBLE_EQ(aside[0].bound_px, 0.06);
-  EXPECT_EQ(aside[0].date_utc, "2026-11-20T02:00:00Z");
-  EXPECT_EQ(aside[1].run_id, 3);  // run 3, cameras in order
-  EXPECT_EQ(aside[1].camera, 1);
-  EXPECT_EQ(aside[1].capture, "0007");
-  EXPECT_EQ(aside[2].camera, 2);
-  EXPECT_EQ(aside[2].capture, "2");  // no name given: its index
+  const HistorySetAsideLog aside = ReadHistorySetAside(db);
+  EXPECT_EQ(aside.since_run_id, 1);  // a new database keeps them from its first run
+  ASSERT_EQ(aside.views.size(), 3u);
+  EXPECT_EQ(aside.views[0].run_id, 1);
+  EXPECT_EQ(aside.views[0].capture, "0003");
+  EXPECT_EQ(aside.views[0].camera, 1);
+  EXPECT_DOUBLE_EQ(aside.views[0].jump_rms_px, 0.52);
+  EXPECT_DOUBLE_EQ(aside.views[0].bound_px, 0.06);
+  EXPECT_EQ(aside.views[0].date_utc, "2026-11-20T02:00:00Z");
+  EXPECT_EQ(aside.views[1].run_id, 3);  // run 3, cameras in order, though given camera 2 first
+  EXPECT_EQ(aside.views[1].camera, 1);
+  EXPECT_EQ(aside.views[1].capture, "0007");
+  EXPECT_EQ(aside.views[2].camera, 2);
+  EXPECT_EQ(aside.views[2].capture, "2");  // no name given: its index
   const std::string table = FormatTrends(ReadHistoryRuns(db), ReadHistoryTrends(db), aside);
   EXPECT_NE(table.find("views set aside: cam1 2 view(s) on 2 of 3 run(s), last run 3 (2026-11-22T02:00:00Z); the "
-                       "largest jump 0.520 px (bound 0.060 px, capture 0003, run 1)"),
+                       "worst against its bound: 0.520 px, 8.7x its 0.060 px (capture 0003, run 1)"),
             std::string::npos)
       << table;
-  EXPECT_NE(table.find("views set aside: cam2 1 view(s) on 1 of 3 run(s)"), std::string::npos) << table;
+  EXPECT_NE(table.find("views set aside: cam2 1 view(s) on 1 of 3 run(s), last run 3"), std::string::npos) << table;
   EXPECT_EQ(table.find("cam0 "), std::string::npos) << table;  // none of camera 0's
-  EXPECT_NE(FormatTrends(ReadHistoryRuns(db), ReadHistoryTrends(db), {}).find("views set aside: none in 3 run(s)"),
+  HistorySetAsideLog none = aside;
+  none.views.clear();
+  EXPECT_NE(FormatTrends(ReadHistoryRuns(db), ReadHistoryTrends(db), none).find("views set aside: none in 3 run(s)\n"),
             std::string::npos);
 }
 
-// A database written before views set aside were stored has no such table:
-// read as none, and the next append adds it.
-TEST(History, ReadsAnOlderDatabaseWithoutTheSetAsideTable) {
+// A database written before views set aside were kept has no such table:
+// read as not kept, and the next append adds it, counting from that run
+// only (the earlier runs set views aside too, unrecorded).
+TEST(History, CountsTheViewsSetAsideOnlySinceTheRunThatFirstKeptThem) {
   const std::string db = ::testing::TempDir() + "/history_old.sqlite";
   std::filesystem::remove(db);
   {
@@ -100,14 +107,37 @@ TEST(History, ReadsAnOlderDatabaseWithoutTheSetAsideTable) {
               SQLITE_OK);
     sqlite3_close(raw);
   }
-  EXPECT_TRUE(ReadHistorySetAside(db).empty());
+  const HistorySetAsideLog before = ReadHistorySetAside(db);
+  EXPECT_EQ(before.since_run_id, 0);
+  EXPECT_TRUE(before.views.empty());
+  EXPECT_NE(FormatTrends(ReadHistoryRuns(db), ReadHistoryTrends(db), before).find("views set aside: not kept"),
+            std::string::npos);
   CheckResult night = Result(0.2, true);
   night.views_set_aside = {{1, 0, 0.4, 0.05}};
   AppendToHistory(db, {0, "2026-11-02T02:00:00Z", "rig.yaml", "new", "", ""}, night);
-  const auto aside = ReadHistorySetAside(db);
-  ASSERT_EQ(aside.size(), 1u);
-  EXPECT_EQ(aside[0].run_id, 2);
-  EXPECT_EQ(ReadHistoryRuns(db).size(), 2u);
+  AppendToHistory(db, {0, "2026-11-03T02:00:00Z", "rig.yaml", "newer", "", ""}, Result(0.2, true));
+  const HistorySetAsideLog after = ReadHistorySetAside(db);
+  EXPECT_EQ(after.since_run_id, 2);  // not moved by the later append
+  ASSERT_EQ(after.views.size(), 1u);
+  EXPECT_EQ(after.views[0].run_id, 2);
+  EXPECT_EQ(ReadHistoryRuns(db).size(), 3u);
+  EXPECT_NE(
+      FormatTrends(ReadHistoryRuns(db), ReadHistoryTrends(db), after)
+          .find("views set aside: cam0 1 view(s) on 1 of 2 run(s) since run 2 (2026-11-02T02:00:00Z), last run 2"),
+      std::string::npos)
+      << FormatTrends(ReadHistoryRuns(db), ReadHistoryTrends(db), after);
+}
+
+// A capture's name of any length is kept whole on its line.
+TEST(History, KeepsALongCaptureNameWhole) {
+  const std::string db = ::testing::TempDir() + "/history_long_name.sqlite";
+  std::filesystem::remove(db);
+  const std::string name(300, 'n');
+  CheckResult night = Result(0.2, true);
+  night.views_set_aside = {{4, 3, 0.4, 0.05}};
+  AppendToHistory(db, {0, "2026-11-02T02:00:00Z", "rig.yaml", "c", "", ""}, night, {{4, name}});
+  const std::string table = FormatTrends(ReadHistoryRuns(db), ReadHistoryTrends(db), ReadHistorySetAside(db));
+  EXPECT_NE(table.find("(capture " + name + ", run 1)\n"), std::string::npos) << table;
 }
 
 TEST(History, RejectsAFileThatIsNotADatabaseAndLeavesItAlone) {

@@ -198,7 +198,8 @@ void RequireCalibrationResiduals(const Rig& rig, const std::string& where) {
 }
 
 CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vector<BoardObservation>& views,
-                            const CheckOptions& options, const std::string& where) {
+                            const CheckOptions& options, const std::string& where,
+                            const std::map<int, std::string>& capture_names) {
   options.Check();
   RequireCalibrationResiduals(rig, where);
   Inputs in{rig, target, options, {}, {}, {}, {}};
@@ -216,6 +217,10 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
     throw InputError(where, "only " + std::to_string(in.by_capture.size()) +
                                 " captures show the target; the check needs " + std::to_string(options.min_captures));
   }
+
+  // The captures with a usable view, and how many, before anything is set aside.
+  std::map<int, size_t> given_captures;
+  for (const auto& [capture, vs] : in.by_capture) given_captures[capture] = vs.size();
 
   CheckResult result;
   // Views whose corners jump about their own board pose (from a corner to
@@ -325,23 +330,41 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   in.by_capture.clear();
   for (const BoardObservation& v : trimmed)
     if (in.seed.count(v.capture)) in.by_capture[v.capture].push_back(&v);
-  // min_captures again, on what is left: views set aside (or a capture whose
-  // corners fit no pose) can take whole captures away, and the thresholds
-  // assume at least that many.
+  // min_captures again, on what is left: views set aside, outlier corners
+  // trimmed below min_corners_per_view or no pose that fits can take whole
+  // captures away, and the thresholds assume at least that many. Each
+  // capture lost is named with why, since on such a night this message is
+  // all the user sees.
   if (static_cast<int>(in.by_capture.size()) < options.min_captures) {
-    std::string aside;
-    for (const SetAsideView& v : result.views_set_aside) {
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "%scam%d of capture %d (jump %.3f px, bound %.3f px)", aside.empty() ? "" : ", ",
-                    v.camera, v.capture, v.jump_rms_px, v.bound_px);
-      aside += buf;
+    std::string lost;
+    for (const auto& [capture, num_views] : given_captures) {
+      if (in.by_capture.count(capture)) continue;
+      const auto name = capture_names.find(capture);
+      std::string why;
+      size_t num_set_aside = 0;
+      for (const SetAsideView& v : result.views_set_aside) {
+        if (v.capture != capture) continue;
+        ++num_set_aside;
+        char buf[128];
+        std::snprintf(buf, sizeof buf, "%scam%d's corners jump %.3f px about its own pose (bound %.3f px)",
+                      why.empty() ? "" : ", ", v.camera, v.jump_rms_px, v.bound_px);
+        why += buf;
+      }
+      const char* rest = in.seed.count(capture) ? "too few corners left once outlier corners were trimmed"
+                                                : "no board pose fits its views";
+      if (why.empty()) {
+        why = rest;
+      } else if (num_set_aside < num_views) {
+        why += std::string(" (set aside); the rest: ") + rest;
+      } else {
+        why += " (set aside)";
+      }
+      lost += std::string(lost.empty() ? "" : "; ") + "capture " +
+              (name != capture_names.end() ? name->second : std::to_string(capture)) + ": " + why;
     }
-    throw InputError(where, "only " + std::to_string(in.by_capture.size()) +
-                                " captures keep a view of the target once views whose corners jump about their own "
-                                "board pose are set aside (" +
-                                (aside.empty() ? std::string("none") : aside) +
-                                ") and outlier corners trimmed; the check needs " +
-                                std::to_string(options.min_captures) + ": take more captures");
+    throw InputError(where, "only " + std::to_string(in.by_capture.size()) + " of " +
+                                std::to_string(given_captures.size()) + " captures are left to check: " + lost +
+                                "; the check needs " + std::to_string(options.min_captures) + ": take more captures");
   }
 
   // Tonight's corner noise, per camera: each view fitted with its own pose.

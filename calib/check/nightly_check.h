@@ -110,10 +110,14 @@ ClosureNaming NameClosureModules(const std::map<int, int>& failed_pairs_of);
 void RequireCalibrationResiduals(const Rig& rig, const std::string& where);
 
 // Throws InputError(`where`, ...) when the rig file lacks the calibration
-// residuals the thresholds need (RequireCalibrationResiduals), when there are too few captures, when a view
-// names a camera the rig does not have, or when the captures do not fit the
-// rig at all (another rig's captures).
+// residuals the thresholds need (RequireCalibrationResiduals), when there
+// are too few captures (given, or left once views are set aside, corners
+// trimmed and poses fitted: the message names each capture lost and why, by
+// capture_names where given, else by index), when a view names a camera the
+// rig does not have, or when the captures do not fit the rig at all (another
+// rig's captures).
 CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vector<BoardObservation>& views,
-                            const CheckOptions& options, const std::string& where);
+                            const CheckOptions& options, const std::string& where,
+                            const std::map<int, std::string>& capture_names = {});
 
 }  // namespace stereorig

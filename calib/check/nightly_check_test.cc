@@ -12,13 +12,13 @@
 
 #include <gtest/gtest.h>
 
-#include <set>
-
+#include <algorithm>
 #include <array>
 #include <functional>
 #include <limits>
 #include <map>
 #include <random>
+#include <set>
 
 #include "calib/core/input_error.h"
 #include "datasets/default_rig.h"
@@ -520,9 +520,18 @@ TEST(NightlyCheck, TooFewCapturesLeftOnceAViewIsSetAsideIsRefused) {
     ADD_FAILURE() << "four captures were judged";
   } catch (const InputError& e) {
     const std::string what = e.what();
-    EXPECT_NE(what.find("only 4 captures keep a view of the target"), std::string::npos) << what;
-    EXPECT_NE(what.find("cam1 of capture " + std::to_string(lone)), std::string::npos) << what;
-    EXPECT_NE(what.find("the check needs 5"), std::string::npos) << what;
+    EXPECT_NE(
+        what.find("only 4 of 5 captures are left to check: capture " + std::to_string(lone) + ": cam1's corners jump "),
+        std::string::npos)
+        << what;
+    EXPECT_NE(what.find("(set aside); the check needs 5"), std::string::npos) << what;
+  }
+  // Named by its folder's name where the caller gives one.
+  try {
+    RunNightlyCheck(StoredRig(truth), target, views, CheckOptions(), "captures", {{lone, "night-capture-x"}});
+    ADD_FAILURE() << "four captures were judged";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("capture night-capture-x: cam1's"), std::string::npos) << e.what();
   }
 }
 
