@@ -371,19 +371,33 @@ std::string LeftCertifiedSizeText(const std::vector<Eigen::Vector3d>& pts, const
 // When no sphere of the certified size is found: whether the cloud holds a
 // sphere of another size (RANSAC with the radius free, within half to twice
 // the certified one, at least min_points points within the band), and the
-// scale that would make it the artifact's; empty if it holds none.
+// scale that would make it the artifact's; empty if it holds none. On a
+// ball bar's first ball (first_of_ball_bar) the scale is named only if the
+// cloud holds a second sphere off the same way (ScaleText): a single sphere
+// given for a ball bar is the wrong artifact file, not a scale (it read
+// "+50% off", a user's walkthrough found).
 std::string OtherSizeText(const std::vector<Eigen::Vector3d>& pts, double nominal_radius_mm, double locate_band_mm,
-                          std::optional<double> other_ball_scale, const VerifyOptions& o) {
+                          std::optional<double> other_ball_scale, const VerifyOptions& o,
+                          bool first_of_ball_bar = false) {
   SphereFitOptions so;
   so.inlier_threshold_mm = locate_band_mm;
   so.expected_radius_mm = 1.25 * nominal_radius_mm;  // hypotheses in [0.5, 2] x the certified radius
   so.radius_tolerance_mm = 0.75 * nominal_radius_mm;
   so.ransac_iterations = 1000;
   so.seed = o.seed;
+  auto plausible = [&](const SphereFit& f) {
+    return f.ok && f.converged && static_cast<int>(f.inliers.size()) >= o.min_points &&
+           f.radius_mm >= 0.5 * nominal_radius_mm && f.radius_mm <= 2 * nominal_radius_mm;
+  };
   const SphereFit other = FitSphereRobust(pts, so);
-  if (!other.ok || !other.converged || static_cast<int>(other.inliers.size()) < o.min_points ||
-      !(other.radius_mm >= 0.5 * nominal_radius_mm && other.radius_mm <= 2 * nominal_radius_mm)) {
-    return "";
+  if (!plausible(other)) return "";
+  if (first_of_ball_bar) {
+    other_ball_scale = std::numeric_limits<double>::quiet_NaN();  // no second sphere: no scale named
+    std::vector<Eigen::Vector3d> rest;
+    for (const auto& p : pts)
+      if ((p - other.center_mm).norm() > other.radius_mm + locate_band_mm) rest.push_back(p);
+    if (const SphereFit second = FitSphereRobust(rest, so); plausible(second))
+      other_ball_scale = second.radius_mm / nominal_radius_mm;
   }
   char buf[256];
   std::snprintf(buf, sizeof buf,
@@ -413,10 +427,12 @@ std::string BallText(int ball, const Eigen::Vector3d& center_mm) {
 // certified size (RANSAC's own tolerance) or does not converge is reported
 // as such.
 // other_ball_scale: on a ball bar's second ball, the first's fitted radius
-// over the certified one (ScaleText).
+// over the certified one (ScaleText); first_of_ball_bar: the ball bar's
+// first ball, whose other is not known yet.
 ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, double nominal_radius,
                                     double locate_band_mm, double capture_band_mm, const VerifyOptions& o,
-                                    std::optional<double> other_ball_scale = std::nullopt) {
+                                    std::optional<double> other_ball_scale = std::nullopt,
+                                    bool first_of_ball_bar = false) {
   SphereFitOptions so;
   so.inlier_threshold_mm = locate_band_mm;
   so.expected_radius_mm = nominal_radius;
@@ -428,9 +444,13 @@ ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, dou
   const SphereFit located = FitSphereRobust(pts, so);
   if (!located.ok) {
     out.fit = located;
-    out.fit.message += OtherSizeText(pts, nominal_radius, locate_band_mm, other_ball_scale, o);
+    out.fit.message += OtherSizeText(pts, nominal_radius, locate_band_mm, other_ball_scale, o, first_of_ball_bar);
     return out;
   }
+  // Found at the certified size, a ball bar's first ball that then leaves it
+  // names no scale: the other ball, which would have to be off the same way,
+  // is not fitted yet.
+  if (first_of_ball_bar) other_ball_scale = std::numeric_limits<double>::quiet_NaN();
   out.located = true;
   out.located_center_mm = located.center_mm;
   // The artifact's points are those within the capture band of the fitted
@@ -566,7 +586,8 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
       for (int ball = 0; ball < 2; ++ball) {
         const ArtifactSphereFit found =
             FitArtifactSphere(remaining, r, LocateBandMm(o, a.mpe.sphere_spacing_mm), band, o,
-                              ball == 0 ? std::nullopt : std::optional<double>(0.5 * e.sphere_diameters_mm[0] / r));
+                              ball == 0 ? std::nullopt : std::optional<double>(0.5 * e.sphere_diameters_mm[0] / r),
+                              /*first_of_ball_bar=*/ball == 0);
         if (!found.located) {
           throw NotTheArtifactError(
               where, "ball " + std::to_string(ball + 1) + " of the ball bar not found: " + found.fit.message);

@@ -1129,6 +1129,33 @@ TEST(Vdi2634, ACloudAFewPercentTooLargeFailsAndOneFarOffNamesTheScale) {
     EXPECT_NE(what.find("not the artifact, or not of its certified size"), std::string::npos) << what;
     EXPECT_EQ(what.find("scale"), std::string::npos) << what;
   }
+  // The whole ball bar 1.3x too large (balls and their distance): no ball of
+  // the certified size, and the second sphere the cloud holds is off the
+  // same way, so the scale is named.
+  std::vector<Eigen::Vector3d> scaled = BallSeenFromBothSides({-50 * 1.3, 0, 0}, 12.7 * 1.3, 0, &rng);
+  const auto scaled_2 = BallSeenFromBothSides({50 * 1.3, 0, 0}, 12.7 * 1.3, 0, &rng);
+  scaled.insert(scaled.end(), scaled_2.begin(), scaled_2.end());
+  try {
+    EvaluateArtifact(BallBarArtifact(), scaled, VerifyOptions(), "bar.ply");
+    ADD_FAILURE() << "a ball bar 1.3x too large was judged";
+  } catch (const NotTheArtifactError& error) {
+    const std::string what = error.what();
+    EXPECT_NE(what.find("ball 1 of the ball bar not found"), std::string::npos) << what;
+    EXPECT_NE(what.find("or measured at a scale +30% off"), std::string::npos) << what;
+  }
+  // A single sphere given for the ball bar (the wrong artifact file: a
+  // 34.3 mm sphere against 25.4 mm balls, 1.35x) is not blamed on the scale,
+  // though 1.35 is within the 50% it is named for: there is no second sphere
+  // off the same way. It read "+35% off" (a user's walkthrough found; the
+  // demo's 38.1 mm sphere, exactly 1.5x, read "+50% off").
+  try {
+    EvaluateArtifact(BallBarArtifact(), ExactSphere(0.9 * 38.1), VerifyOptions(), "sphere.ply");
+    ADD_FAILURE() << "a sphere was judged as the ball bar";
+  } catch (const NotTheArtifactError& error) {
+    const std::string what = error.what();
+    EXPECT_NE(what.find("it holds one 34.3 mm in diameter"), std::string::npos) << what;
+    EXPECT_EQ(what.find("scale"), std::string::npos) << what;
+  }
 }
 
 // --- (7) Stray points in the plate's plane. ---
