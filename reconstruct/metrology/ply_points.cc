@@ -57,7 +57,8 @@ PlyVertices ReadPlyVertices(const std::string& path) {
   if (!std::getline(in, line) || line.rfind("ply", 0) != 0) throw InputError(path, "not a PLY file");
   Encoding enc = Encoding::kAscii;
   long long num_vertices = -1;
-  bool in_vertex = false, seen_vertex = false;
+  bool in_vertex = false, seen_vertex = false, after_vertex = false;
+  std::string element_before_vertex;  // a vertex element that is not the first: its data would be misread
   std::vector<Property> props;
   while (true) {
     if (!std::getline(in, line)) throw InputError(path, "PLY header has no end_header");
@@ -81,15 +82,20 @@ PlyVertices ReadPlyVertices(const std::string& path) {
       std::string name;
       long long count;
       s >> name >> count;
-      if (seen_vertex && !in_vertex) {
-        // an element after the vertices: ignored
-      }
+      after_vertex = seen_vertex;  // an element after the vertices: its data is not read
       in_vertex = name == "vertex";
       if (in_vertex) {
         if (seen_vertex) throw InputError(path, "two vertex elements");
-        if (!props.empty() || !s) throw InputError(path, "vertex must be the first element");
+        if (!element_before_vertex.empty()) {
+          throw InputError(path, "its vertex element comes after '" + element_before_vertex +
+                                     "'; this reader needs the vertices first (as every PLY writer of point clouds "
+                                     "puts them)");
+        }
+        if (!s) throw InputError(path, "malformed vertex element line '" + line + "'");
         seen_vertex = true;
         num_vertices = count;
+      } else if (!seen_vertex && element_before_vertex.empty()) {
+        element_before_vertex = name;
       }
     } else if (word == "property" && in_vertex) {
       Property p;
@@ -150,6 +156,16 @@ PlyVertices ReadPlyVertices(const std::string& path) {
     if (!p.allFinite()) throw InputError(path, "vertex " + std::to_string(k) + " is not finite");
     out.points.push_back(p);
     if (imodule >= 0) out.module.push_back(static_cast<int>(v[imodule]));
+  }
+  // With nothing declared after the vertices, anything more is data the
+  // header does not count: a vertex count too small would drop points
+  // unseen. (Trailing white space of an ASCII file is no data.)
+  if (!after_vertex) {
+    if (enc == Encoding::kAscii) in >> std::ws;
+    if (in.peek() != std::char_traits<char>::eof()) {
+      throw InputError(path, "holds more data after its " + std::to_string(num_vertices) +
+                                 " vertices than its header declares (a wrong vertex count?)");
+    }
   }
   return out;
 }
