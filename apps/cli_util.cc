@@ -93,4 +93,31 @@ int NotBuiltYet(const char* name, const char* what, int argc, char** argv) {
   return kExitBadInput;
 }
 
+namespace {
+
+// A validator of the number the text reads as: `ok` says whether it is
+// allowed, `rule` what is.
+CLI::Validator NumberValidator(bool (*ok)(double), const char* rule, const char* name) {
+  return CLI::Validator(
+      [ok, rule](const std::string& text) {
+        double value = 0;
+        if (!CLI::detail::lexical_cast(text, value)) return "not a number: '" + text + "'";
+        if (!ok(value)) return std::string("must be ") + rule + ", got " + text;
+        return std::string();
+      },
+      "", name);
+}
+
+}  // namespace
+
+const CLI::Validator& PositiveValue() {
+  static const CLI::Validator v = NumberValidator([](double x) { return x > 0; }, "positive", "Positive");
+  return v;
+}
+
+const CLI::Validator& NonNegativeValue() {
+  static const CLI::Validator v = NumberValidator([](double x) { return x >= 0; }, ">= 0", "NonNegative");
+  return v;
+}
+
 }  // namespace stereorig

@@ -41,6 +41,12 @@ std::vector<std::string> ScenesToRun(const std::string& dataset, const std::vect
 // such, not as a missing DATASET/truth/rig.yaml.
 void CheckDatasetFolder(const std::string& dataset, bool need_truth);
 
+// Checks of a number option with a short message ("must be positive, got
+// 0"): CLI11's PositiveNumber and NonNegativeNumber name their range with
+// DBL_MAX's 309 digits.
+const CLI::Validator& PositiveValue();
+const CLI::Validator& NonNegativeValue();
+
 // For subcommands a later issue fills in: prints what it will do and exits 2.
 int NotBuiltYet(const char* name, const char* what, int argc, char** argv);
 

@@ -53,13 +53,13 @@ int RunCalibrate(int argc, char** argv) {
                  "range of the points whose projection uncertainty is reported (and the nightly check's thresholds "
                  "come from), mm; 0: each camera's median distance to the board in its views, where the rig measures")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegativeValue());
   app.add_option("--max-rms-px", options.intrinsics.max_rms_px,
                  "a stage whose reprojection rms is over this did not converge, px: stage 1 then solves again from its "
                  "other seeds, and no rig file is written while a stage stays over it (a converged camera shows its "
                  "corners' noise, a few tenths of a px at most)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveValue());
   app.add_option("--huber", options.system.huber_px, "stage 3 robust loss scale, px")->capture_default_str();
   app.add_flag("--fixed-intrinsics", fixed_intrinsics, "hold the intrinsics at stage 2's values in stage 3");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;

@@ -127,11 +127,13 @@ int RunVerify(int argc, char** argv) {
       "fit and the figures; up to 0.3% of those (the largest residuals) may be excluded, as the standard allows. "
       "What is found must be the artifact: a sphere whose captured points fit a diameter more than 10% off the "
       "certified one, or a plane whose dense part (a few stray points do not count) spans less than half of the "
-      "plate's length or width or more than the plate, is refused (that position not evaluated, below). Points added "
+      "plate's length or width or more than the plate plus twice the capture band, is refused (that position not "
+      "evaluated, below). Points added "
       "by hole filling (PLY module "
       "255) are not measured and are skipped: the fit never uses the reconstruction's own shape prior. A position "
-      "whose points leave P_S (sphere) or SD (ball bar) "
-      "undetermined cannot pass: it is not judged (exit 2) when the figure's standard uncertainty is over "
+      "whose points or certificate leave a figure (P_S, SD; F, P_F by a "
+      "large certified flatness or form uncertainty) undetermined cannot pass: it is not judged (exit 2) when the "
+      "figure's standard uncertainty is over "
       "10% of its MPE (a sphere's cap of ~18 deg half-angle at the demo's density fits its diameter to ~0.15 mm), "
       "unless the position fails beyond doubt anyway (another figure fails, or, under the default simple rule, this "
       "one by more than twice its uncertainty: then FAIL, exit 1; the guarded rules differ, below). A position not "
@@ -184,7 +186,7 @@ int RunVerify(int argc, char** argv) {
                  "twice the figure's MPE is used (narrower, an error beyond the MPE would be cut off). Widen it for a "
                  "projector whose grid-period-off error is deeper than ~3.5 mm")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveValue());
   std::string rule_name = DecisionRuleName(options.decision_rule);
   app.add_option("--decision-rule", rule_name,
                  "simple (|value| <= MPE), guarded-acceptance (|value| + 2u <= MPE) or guarded-rejection (fail only "

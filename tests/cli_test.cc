@@ -54,6 +54,29 @@ TEST(Cli, UnknownCommandAndBadFlagsExitTwoWithOneLine) {
   EXPECT_EQ(Lines(r.err), 1) << r.err;
 }
 
+// A binary file given where YAML is expected put its raw bytes into the
+// error line (yaml-cpp quotes the character it stopped at): they are
+// written as \xNN, while a path's valid UTF-8 ('å') stays as it is.
+TEST(Cli, AnErrorLineHoldsNoRawBinaryBytes) {
+  const std::string dir = ::testing::TempDir() + "/kåsa_" + std::to_string(getpid());
+  std::filesystem::create_directories(dir);
+  const std::string binary = dir + "/artifact.yaml";
+  {
+    std::ofstream f(binary, std::ios::binary);
+    f << "format: \"\\\xAB\x01\"\n";  // an escape YAML does not know, then a control byte
+  }
+  const Result r = RunCli("verify --artifact " + binary + " --cloud " + binary);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("kåsa_"), std::string::npos) << r.err;  // UTF-8 kept
+  EXPECT_NE(r.err.find("\\xAB"), std::string::npos) << r.err;
+  for (size_t i = 0; i + 1 < r.err.size(); ++i) {
+    const auto c = static_cast<unsigned char>(r.err[i]);
+    EXPECT_FALSE(c < 0x20 || c == 0x7F || c == 0xAB) << "byte " << i << " of " << r.err;
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Cli, GoodRigFileIsAccepted) {
   const std::string path = ::testing::TempDir() + "/good_rig.yaml";
   std::ofstream(path) << GoodRigText();

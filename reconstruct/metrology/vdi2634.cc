@@ -75,7 +75,9 @@ std::string UndeterminedText(const Figure& f, const ArtifactEvaluation& e, const
   char buf[320];
   std::string text = f.name + " is not determined: ";
   if (f.fit_standard_uncertainty_mm) {
-    std::snprintf(buf, sizeof buf, "%s and scatter by %.3f mm (residual std), which fits it to +-%.3f mm (1 sigma)",
+    // Significant digits: beside a certificate's large part the fit's can be
+    // 0.0004 mm, which %.3f printed as "+-0.000".
+    std::snprintf(buf, sizeof buf, "%s and scatter by %.3f mm (residual std), which fits it to +-%.3g mm (1 sigma)",
                   coverage.c_str(), e.residual_std_mm, fit_mm);
     text += buf;
   }
