@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
 
 #include "calib/check/board_pose.h"
+#include "calib/check/board_scale.h"
 #include "calib/core/input_error.h"
 
 namespace stereorig {
@@ -216,6 +218,41 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   if (static_cast<int>(in.by_capture.size()) < options.min_captures) {
     throw InputError(where, "only " + std::to_string(in.by_capture.size()) +
                                 " captures show the target; the check needs " + std::to_string(options.min_captures));
+  }
+
+  // The board against the target file. A target file that is not the
+  // board's (another square size) scales the board as every module measures
+  // it alike; a camera turned, a module shifted or a lens drifted moves one
+  // module's reading (BoardScale tests: see kMaxBoardScaleOff). Judged
+  // against the wrong board, every camera read as changed, and the false
+  // alarm went into the history (a user's walkthrough: a target file 2% too
+  // large). With one module the two cannot be told apart: not tested.
+  if (rig.num_modules() >= 2) {
+    const std::vector<ModuleBoardScale> scales = MeasureBoardScale(rig, target, views, options.min_corners_per_view);
+    bool all_off = static_cast<int>(scales.size()) == rig.num_modules();
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const ModuleBoardScale& m : scales) {
+      all_off = all_off && m.captures >= 3 && std::abs(m.scale - 1) > kMaxBoardScaleOff;
+      lo = std::min(lo, m.scale - 1);
+      hi = std::max(hi, m.scale - 1);
+    }
+    // Off the same way, and by the same within half the smaller.
+    if (all_off && lo * hi > 0 && hi - lo <= 0.5 * std::min(std::abs(lo), std::abs(hi))) {
+      std::string each;
+      for (const ModuleBoardScale& m : scales) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "%smodule %d %+.2f%% (%d captures)", each.empty() ? "" : ", ", m.module,
+                      100 * (m.scale - 1), m.captures);
+        each += buf;
+      }
+      char square[64];
+      std::snprintf(square, sizeof square, "%.3f mm", target.square_size_mm());
+      throw InputError(where, std::string("every module measures the board ") + (lo > 0 ? "larger" : "smaller") +
+                                  " than the target file (--target) says (" + each + "; its squares " + square +
+                                  "): the target file is not the board's the captures show, or the rig was "
+                                  "calibrated with another; no change of a camera or module scales every module "
+                                  "alike, so nothing is judged");
+    }
   }
 
   // The captures with a usable view, and how many, before anything is set aside.

@@ -20,6 +20,7 @@
 #include <random>
 #include <set>
 
+#include "calib/check/board_scale.h"
 #include "calib/core/input_error.h"
 #include "datasets/default_rig.h"
 #include "datasets/lens_drift.h"
@@ -488,6 +489,73 @@ TEST(NightlyCheck, BadInputIsRefused) {
     ADD_FAILURE() << "captures camera 3 never saw were judged";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("camera(s) 3 saw"), std::string::npos) << e.what();
+  }
+}
+
+// The board against the target file (board_scale.h). Truth: the default
+// board (9 mm squares) observed by the true rig; the check given a target
+// file with 9.18 mm squares (2% larger: the board measures 9 / 9.18 - 1 =
+// -1.96%) or 8.91 mm (+1.01%) refuses the night, naming each module's
+// reading; given the right file, every module reads the board within 0.1%
+// of its size (noise 0.2 px over ~8 captures of ~99 corners: the scale's
+// scatter is a few 0.01%). A camera turned 0.5 deg, a module shifted 1 mm
+// or a lens drifted 1% moves one module's reading, and the check judges
+// (recalibrate), never refuses. Before, the wrong target file read as
+// every camera changed and went into the history (a user's walkthrough).
+TEST(NightlyCheck, AWrongTargetFileIsRefusedAndABumpIsNot) {
+  const SimulatedRig truth = MakeDefaultRig();
+  const Target board = DefaultTarget();
+  const Rig stored = StoredRig(truth);
+  double worst_right = 0;
+  for (unsigned seed = 1; seed <= 5; ++seed) {
+    const std::vector<BoardObservation> views = Observe(truth, board, {}, seed);
+    for (const ModuleBoardScale& m : MeasureBoardScale(stored, board, views)) {
+      worst_right = std::max(worst_right, std::abs(m.scale - 1));
+      EXPECT_GE(m.captures, 3) << "seed " << seed;
+    }
+    for (const auto& [square_mm, expected] : {std::pair{9.18, "smaller"}, std::pair{8.91, "larger"}}) {
+      const Target file = DoubleSidedTarget(11, 9, square_mm);
+      for (const ModuleBoardScale& m : MeasureBoardScale(stored, file, views))
+        EXPECT_NEAR(m.scale, 9.0 / square_mm, 0.001) << "seed " << seed << " module " << m.module;
+      try {
+        RunNightlyCheck(stored, file, views, CheckOptions(), "captures");
+        ADD_FAILURE() << "seed " << seed << ": judged against a target file of " << square_mm << " mm squares";
+      } catch (const InputError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find(std::string("every module measures the board ") + expected), std::string::npos) << what;
+        // Each module's reading as printed, within 0.1% of 9 / square_mm - 1.
+        for (const char* module : {"module 0 ", "module 1 "}) {
+          const size_t at = what.find(module);
+          ASSERT_NE(at, std::string::npos) << what;
+          EXPECT_NEAR(std::stod(what.substr(at + 9)), 100 * (9.0 / square_mm - 1), 0.1) << what;
+        }
+      }
+    }
+  }
+  EXPECT_LT(worst_right, 0.001);
+  std::printf("board scale, right target file: worst |s - 1| %.4f%%\n", 100 * worst_right);
+  const std::vector<Bump> bumps = [&] {
+    Bump turned, shifted, lens;
+    turned.camera = 1;
+    turned.rotation_deg = 0.5;
+    shifted.module = 1;
+    shifted.translation_mm = 1.0;
+    lens.camera = 2;
+    lens.lens.focal_percent = 1.0;
+    return std::vector<Bump>{turned, shifted, lens};
+  }();
+  for (const Bump& bump : bumps) {
+    for (unsigned seed = 1; seed <= 3; ++seed) {
+      const std::vector<BoardObservation> views = Observe(truth, board, bump, seed);
+      std::string readings;
+      for (const ModuleBoardScale& m : MeasureBoardScale(stored, board, views))
+        readings += " module " + std::to_string(m.module) + " " + std::to_string(100 * (m.scale - 1)) + "%";
+      std::printf("bump camera %d module %d focal %.1f%%, seed %u:%s\n", bump.camera, bump.module,
+                  bump.lens.focal_percent, seed, readings.c_str());
+      CheckResult r;
+      EXPECT_NO_THROW(r = RunNightlyCheck(stored, board, views, CheckOptions(), "captures")) << readings;
+      EXPECT_FALSE(r.ok()) << readings;
+    }
   }
 }
 
