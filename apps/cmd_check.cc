@@ -165,6 +165,16 @@ int RunCheck(int argc, char** argv) {
     report["views_set_aside"].push_back(
         {{"capture", capture}, {"camera", v.camera}, {"jump_rms_px", v.jump_rms_px}, {"bound_px", v.bound_px}});
   }
+  // The board's size as each module measures it, over the target file's
+  // (board_scale.h): a wrong --target reads off alike on every module.
+  report["board_scale"] = nlohmann::json::array();
+  for (const ModuleBoardScale& m : result.board_scales) {
+    std::printf("board size: module %d measures it %+.3f%% against the target file (median of %d captures)\n", m.module,
+                100 * (m.scale - 1), m.captures);
+    report["board_scale"].push_back({{"module", m.module}, {"scale", m.scale}, {"captures", m.captures}});
+  }
+  report["board_size_note"] = nullptr;
+  if (!result.board_size_note.empty()) report["board_size_note"] = result.board_size_note;
   std::printf("verdict: %s (%s)\n", result.Verdict().c_str(), result.Explanation().c_str());
   report["verdict"] = result.Verdict();
   report["explanation"] = result.Explanation();

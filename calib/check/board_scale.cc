@@ -50,8 +50,9 @@ std::vector<ModuleBoardScale> MeasureBoardScale(const Rig& rig, const Target& ta
       scales.push_back(similarity.block<3, 1>(0, 0).norm());
     }
     if (scales.empty()) continue;
-    std::nth_element(scales.begin(), scales.begin() + scales.size() / 2, scales.end());
-    out.push_back({m, scales[scales.size() / 2], static_cast<int>(scales.size())});
+    const size_t mid = (scales.size() - 1) / 2;  // the lower median, as the check's other medians
+    std::nth_element(scales.begin(), scales.begin() + mid, scales.end());
+    out.push_back({m, scales[mid], static_cast<int>(scales.size())});
   }
   return out;
 }

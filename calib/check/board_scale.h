@@ -1,10 +1,11 @@
 // The board's size as the stored rig's stereo modules measure it, over the
-// size the target file gives. A rig's own change (a camera turned, a module
-// shifted, a lens drifted) moves one module's reading; a target file that is
-// not the board's (another square size) scales every module's alike. The
-// nightly check refuses the latter (RunNightlyCheck): judged against the
-// wrong board, every camera read as changed and a false alarm went into the
-// history (a user's walkthrough: a target file 2% too large).
+// size the target file gives. A target file that is not the board's
+// (another square size) scales every module's reading alike; a camera
+// turned moves its own module's (0.5 deg: +1.1 to +1.3%), a lens drift or a
+// module's shift barely any. The nightly check says so when every module
+// reads the board off alike (CheckResult::board_size_note): judged against
+// the wrong board every camera read as changed, with no word of the board
+// (a user's walkthrough: a target file 2% too large).
 #pragma once
 
 #include <vector>
@@ -16,14 +17,15 @@
 namespace stereorig {
 
 // How far every module's reading must be off (the same way) for the check
-// to refuse the target file: 0.5%, well above what a rig's own change puts
-// on one module (measured in board_scale_test.cc) and what its frame's
-// thermal expansion puts on all (aluminium: 0.0023% per kelvin).
+// to name the board: 0.5%, 25 times the scatter with the right file (0.02%
+// on the default rig, NightlyCheck.AWrongTargetFileIsNamedAndABumpIsNot)
+// and far beyond a frame's thermal expansion (aluminium: 0.0023% per
+// kelvin). One camera turned 0.2 deg reads so too, on its own module only.
 constexpr double kMaxBoardScaleOff = 0.005;
 
 struct ModuleBoardScale {
   int module = -1;
-  double scale = 1.0;  // measured size over the target file's: the median over the captures
+  double scale = 1.0;  // measured size over the target file's: the (lower) median over the captures
   int captures = 0;    // captures in which both cameras saw one face with >= min_corners common corners
 };
 

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "calib/check/board_scale.h"
 #include "calib/check/camera_change.h"
 #include "calib/core/rig.h"
 #include "calib/observations.h"
@@ -77,6 +78,12 @@ struct CheckResult {
   // other modules (or there are none): something in the module changed, a
   // camera's pose or lens, not the module as a whole.
   std::vector<int> split_modules;
+  // The board's size as each module measures it over the target file's
+  // (board_scale.h), and, when every module (at least two) reads it off the
+  // same way by more than kMaxBoardScaleOff, what that says: the end of the
+  // explanation (a wrong --target, or every module's cameras changed alike).
+  std::vector<ModuleBoardScale> board_scales;
+  std::string board_size_note;
   bool ok() const;
   std::string Verdict() const { return ok() ? "ok" : "recalibrate"; }
   std::string Explanation() const;  // one line: what changed, in no more words than the figures support
