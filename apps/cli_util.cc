@@ -1,6 +1,7 @@
 #include "apps/cli_util.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -10,6 +11,48 @@
 
 namespace stereorig {
 
+// The message with every byte a terminal would not show as text written as
+// \xNN: control bytes, and bytes that are not valid UTF-8 (a binary file
+// given where YAML or text was expected puts its bytes into the parser's
+// message). Valid UTF-8 (a path with 'å') passes unchanged.
+std::string PrintableText(const std::string& message) {
+  std::string out;
+  auto escape = [&out](unsigned char c) {
+    char buf[8];
+    std::snprintf(buf, sizeof buf, "\\x%02X", c);
+    out += buf;
+  };
+  for (size_t i = 0; i < message.size();) {
+    const auto c = static_cast<unsigned char>(message[i]);
+    if (c < 0x20 || c == 0x7F) {
+      escape(c);
+      ++i;
+      continue;
+    }
+    if (c < 0x80) {
+      out += message[i++];
+      continue;
+    }
+    // A UTF-8 sequence: its lead byte says how many continuation bytes
+    // (10xxxxxx) follow; overlong and surrogate forms are not told apart.
+    const size_t n = c >= 0xC2 && c <= 0xDF ? 1 : c >= 0xE0 && c <= 0xEF ? 2 : c >= 0xF0 && c <= 0xF4 ? 3 : 0;
+    bool valid = n > 0;
+    for (size_t k = 1; valid && k <= n; ++k)
+      valid = i + k < message.size() && (static_cast<unsigned char>(message[i + k]) & 0xC0) == 0x80;
+    // C1 controls (U+0080..U+009F: C2 80..C2 9F) act on some terminals
+    // (U+009B is CSI): escaped too.
+    if (valid && c == 0xC2 && static_cast<unsigned char>(message[i + 1]) < 0xA0) valid = false;
+    if (!valid) {
+      escape(c);
+      ++i;
+      continue;
+    }
+    out.append(message, i, n + 1);
+    i += n + 1;
+  }
+  return out;
+}
+
 std::optional<int> ParseArgs(CLI::App& app, int argc, char** argv) {
   try {
     app.parse(argc, argv);
@@ -17,7 +60,7 @@ std::optional<int> ParseArgs(CLI::App& app, int argc, char** argv) {
     std::fputs(app.help().c_str(), stdout);
     return kExitOk;
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "%s: %s (see --help)\n", app.get_name().c_str(), e.what());
+    std::fprintf(stderr, "%s: %s (see --help)\n", app.get_name().c_str(), PrintableText(e.what()).c_str());
     return kExitBadInput;
   }
   return std::nullopt;
@@ -111,12 +154,14 @@ CLI::Validator NumberValidator(bool (*ok)(double), const char* rule, const char*
 }  // namespace
 
 const CLI::Validator& PositiveValue() {
-  static const CLI::Validator v = NumberValidator([](double x) { return x > 0; }, "positive", "Positive");
+  static const CLI::Validator v =
+      NumberValidator([](double x) { return std::isfinite(x) && x > 0; }, "positive and finite", "Positive");
   return v;
 }
 
 const CLI::Validator& NonNegativeValue() {
-  static const CLI::Validator v = NumberValidator([](double x) { return x >= 0; }, ">= 0", "NonNegative");
+  static const CLI::Validator v =
+      NumberValidator([](double x) { return std::isfinite(x) && x >= 0; }, ">= 0 and finite", "NonNegative");
   return v;
 }
 

@@ -41,6 +41,13 @@ std::vector<std::string> ScenesToRun(const std::string& dataset, const std::vect
 // such, not as a missing DATASET/truth/rig.yaml.
 void CheckDatasetFolder(const std::string& dataset, bool need_truth);
 
+// `message` with every byte a terminal would not show as text written as
+// \xNN: control bytes (C0, DEL, C1), and bytes that are not valid UTF-8 (a
+// binary file given where YAML or text was expected puts its bytes into the
+// parser's message). Valid UTF-8 (a path with 'å') passes unchanged. Every
+// error line goes through it (RunCommand, ParseArgs, main).
+std::string PrintableText(const std::string& message);
+
 // Checks of a number option with a short message ("must be positive, got
 // 0"): CLI11's PositiveNumber and NonNegativeNumber name their range with
 // DBL_MAX's 309 digits.

@@ -3,6 +3,7 @@
 #include <cstring>
 #include <string>
 
+#include "apps/cli_util.h"
 #include "apps/command.h"
 #include "reconstruct/heap_retention.h"
 
@@ -41,6 +42,7 @@ int main(int argc, char** argv) {
   for (const auto& c : stereorig::Commands()) {
     if (name == c.name) return stereorig::RunCommand(c, argc - 1, argv + 1);
   }
-  std::fprintf(stderr, "stereorig: unknown command '%s' (stereorig --help lists them)\n", name.c_str());
+  std::fprintf(stderr, "stereorig: unknown command '%s' (stereorig --help lists them)\n",
+               stereorig::PrintableText(name).c_str());
   return stereorig::kExitBadInput;
 }

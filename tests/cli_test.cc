@@ -75,6 +75,19 @@ TEST(Cli, AnErrorLineHoldsNoRawBinaryBytes) {
     EXPECT_FALSE(c < 0x20 || c == 0x7F || c == 0xAB) << "byte " << i << " of " << r.err;
   }
   std::filesystem::remove_all(dir);
+  // An option's own error echoes the user's text, and an unknown command its
+  // name: a C1 control (U+009B, CSI: C2 9B) and an ESC in them are escaped
+  // too (a second reading: they bypassed the escaping at first).
+  for (const std::string& args : {std::string("verify --capture-band-mm 'x\xC2\x9B\x1B' --artifact a --cloud b"),
+                                  std::string("'no-such-command\xC2\x9B\x1B'")}) {
+    const Result bad = RunCli(args);
+    EXPECT_EQ(bad.code, 2);
+    EXPECT_NE(bad.err.find("\\xC2\\x9B\\x1B"), std::string::npos) << bad.err;
+    for (size_t i = 0; i + 1 < bad.err.size(); ++i) {
+      const auto c = static_cast<unsigned char>(bad.err[i]);
+      EXPECT_FALSE(c < 0x20 || c == 0x9B || c == 0xC2) << "byte " << i << " of " << bad.err;
+    }
+  }
 }
 
 TEST(Cli, GoodRigFileIsAccepted) {

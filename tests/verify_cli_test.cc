@@ -96,12 +96,14 @@ TEST(VerifyCli, BadInputExitsTwoAndWritesNoReport) {
   EXPECT_NE(r.err.find("tiny.ply: not evaluated: only 3 points"), std::string::npos) << r.err;
   EXPECT_NE(r.out.find("1        NOT JUDGED: not evaluated: only 3 points"), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(report));
-  // A band that is not positive: one short line (CLI11's own check printed
-  // DBL_MAX's 309 digits as the range's end).
-  for (const std::string band : {"0", "-1"}) {
+  // A band that is not positive and finite: one short line (CLI11's own
+  // check printed DBL_MAX's 309 digits as the range's end; inf, which it
+  // refused, passed the first version of ours, a second reading found).
+  for (const std::string band : {"0", "-1", "inf", "nan"}) {
     r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + good + " --capture-band-mm " + band);
     EXPECT_EQ(r.code, 2);
-    EXPECT_EQ(r.err, "stereorig verify: --capture-band-mm: must be positive, got " + band + " (see --help)\n");
+    EXPECT_EQ(r.err,
+              "stereorig verify: --capture-band-mm: must be positive and finite, got " + band + " (see --help)\n");
   }
 }
 

@@ -82,7 +82,7 @@ PlyVertices ReadPlyVertices(const std::string& path) {
       std::string name;
       long long count;
       s >> name >> count;
-      after_vertex = seen_vertex;  // an element after the vertices: its data is not read
+      if (seen_vertex && count > 0) after_vertex = true;  // data after the vertices, not read
       in_vertex = name == "vertex";
       if (in_vertex) {
         if (seen_vertex) throw InputError(path, "two vertex elements");
@@ -94,8 +94,8 @@ PlyVertices ReadPlyVertices(const std::string& path) {
         if (!s) throw InputError(path, "malformed vertex element line '" + line + "'");
         seen_vertex = true;
         num_vertices = count;
-      } else if (!seen_vertex && element_before_vertex.empty()) {
-        element_before_vertex = name;
+      } else if (!seen_vertex && element_before_vertex.empty() && count > 0) {
+        element_before_vertex = name;  // an empty one holds no data to misread
       }
     } else if (word == "property" && in_vertex) {
       Property p;
@@ -161,8 +161,20 @@ PlyVertices ReadPlyVertices(const std::string& path) {
   // header does not count: a vertex count too small would drop points
   // unseen. (Trailing white space of an ASCII file is no data.)
   if (!after_vertex) {
-    if (enc == Encoding::kAscii) in >> std::ws;
-    if (in.peek() != std::char_traits<char>::eof()) {
+    bool more = false;
+    if (enc == Encoding::kAscii) {
+      in >> std::ws;
+      more = in.peek() != std::char_traits<char>::eof();
+    } else {
+      // A whole vertex record or more; a stray byte or two (a newline some
+      // writers end with) is not a vertex.
+      size_t record = 0;
+      for (const Property& p : props) record += p.count_type.empty() ? SizeOf(p.type) : SizeOf(p.count_type);
+      const std::streamoff at = in.tellg();
+      in.seekg(0, std::ios::end);
+      more = at >= 0 && in.tellg() - at >= static_cast<std::streamoff>(record);
+    }
+    if (more) {
       throw InputError(path, "holds more data after its " + std::to_string(num_vertices) +
                                  " vertices than its header declares (a wrong vertex count?)");
     }

@@ -124,6 +124,29 @@ TEST(PlyPoints, RefusesAnElementBeforeTheVerticesAndDataTheHeaderDoesNotCount) {
   }
   EXPECT_NE(ErrorOf(dir + "/extra_binary.ply").find("holds more data after its 2 vertices"), std::string::npos)
       << ErrorOf(dir + "/extra_binary.ply");
+  // Less than a vertex record after the last one (a final newline): no
+  // vertex, read. An empty element before the vertices holds nothing to
+  // misread, and an empty one after them no data: both read (a second
+  // reading found the first version refused them).
+  {
+    std::ofstream f(dir + "/newline_binary.ply", std::ios::binary);
+    f << "ply\nformat binary_little_endian 1.0\n" << vertex_header << "end_header\n";
+    const float xyz[6] = {1, 2, 3, 4, 5, 6};
+    f.write(reinterpret_cast<const char*>(xyz), sizeof xyz);
+    f << "\n";
+  }
+  EXPECT_EQ(ReadPlyPoints(dir + "/newline_binary.ply").size(), 2u) << ErrorOf(dir + "/newline_binary.ply");
+  std::ofstream(dir + "/empty_face_first.ply") << "ply\nformat ascii 1.0\nelement face 0\n"
+                                               << "property list uchar int vertex_indices\n"
+                                               << vertex_header << "end_header\n1 2 3\n4 5 6\n";
+  EXPECT_EQ(ReadPlyPoints(dir + "/empty_face_first.ply").size(), 2u) << ErrorOf(dir + "/empty_face_first.ply");
+  std::ofstream(dir + "/empty_face_after_extra.ply")
+      << "ply\nformat ascii 1.0\n"
+      << vertex_header << "element face 0\n"
+      << "property list uchar int vertex_indices\nend_header\n1 2 3\n4 5 6\n7 8 9\n";
+  EXPECT_NE(ErrorOf(dir + "/empty_face_after_extra.ply").find("holds more data after its 2 vertices"),
+            std::string::npos)
+      << ErrorOf(dir + "/empty_face_after_extra.ply");
 }
 
 }  // namespace
