@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "apps/cli_util.h"
 #include "apps/command.h"
 #include "apps/module_summary.h"
 #include "apps/reconstruct_json.h"
@@ -61,8 +62,10 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
     std::snprintf(buf, sizeof buf, "%sm%d %.1f%%", fills.empty() ? "" : ", ", m.module, 100 * m.fill_rate());
     fills += buf;
   }
-  std::printf("%s %s: %zu points (fill %s), %.0f ms -> %s\n", progress.c_str(), dir.c_str(), rec.cloud.size(),
-              fills.c_str(), wall_ms, outputs.cloud.c_str());
+  // A stream's folder is a line of standard input: escaped as every error
+  // line is (PrintableText).
+  std::printf("%s %s: %zu points (fill %s), %.0f ms -> %s\n", progress.c_str(), PrintableText(dir).c_str(),
+              rec.cloud.size(), fills.c_str(), wall_ms, PrintableText(outputs.cloud).c_str());
   // The one-capture summary's warning (module_summary.h), in a line per
   // module: a batch or a stream is what a line runs.
   for (const ModuleReport& m : rec.modules) {
@@ -79,7 +82,7 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
 
 nlohmann::json FailedCapture(const std::string& dir, const std::string& name, const CaptureOutputs& outputs,
                              const std::string& progress, const std::string& why) {
-  std::fprintf(stderr, "stereorig reconstruct: %s %s\n", progress.c_str(), why.c_str());
+  std::fprintf(stderr, "stereorig reconstruct: %s %s\n", progress.c_str(), PrintableText(why).c_str());
   std::error_code ec;
   for (const std::string& path : {outputs.cloud, outputs.report, outputs.mesh})
     if (!path.empty()) fs::remove(path, ec);

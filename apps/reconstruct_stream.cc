@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "apps/cli_util.h"
 #include "apps/command.h"
 #include "apps/output_paths.h"
 #include "apps/reconstruct_capture.h"
@@ -169,13 +170,13 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
     const nlohmann::json entry = FailedCapture(dir, name, outputs, progress, error);
     // On stdout too: a caller reading each capture's line there gets one for
     // every capture.
-    std::printf("%s %s: no output (%s)\n", progress, dir.c_str(), error.c_str());
+    std::printf("%s %s: no output (%s)\n", progress, PrintableText(dir).c_str(), PrintableText(error).c_str());
     std::fflush(stdout);
     if (++failed <= kMaxFailuresListed) summary["failed_captures"].push_back(entry);
   }
   if (!input.error().empty()) {  // the input ends here: what was read is done, the summary written
     std::fprintf(stderr, "stereorig reconstruct: standard input could not be read further: %s\n",
-                 input.error().c_str());
+                 PrintableText(input.error()).c_str());
     summary["input_error"] = input.error();
   }
   const int stop = input.stop_signal();

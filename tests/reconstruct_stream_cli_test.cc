@@ -233,6 +233,16 @@ TEST_F(ReconstructStreamCli, ReconstructsEachFolderAsItsLineArrives) {
   EXPECT_EQ(again.code, 2) << again.err;
   EXPECT_NE(again.out.find("[1] " + dir_ + "/line/0001: no output"), std::string::npos) << again.out;
   EXPECT_EQ(Bytes(out + "/0001.ply"), "an earlier run's cloud");
+  // A line with a terminal's control bytes (ESC, and C1's CSI) reaches
+  // stdout and stderr escaped, as every error line is (a second reading:
+  // the stream printed its folder raw).
+  WriteFileAtomically(list, dir_ + "/no\x1B[2J\xC2\x9Bsuch\n");
+  const testing::Result escaped =
+      testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture - --out-dir " + out + " < " + list);
+  EXPECT_EQ(escaped.code, 2) << escaped.err;
+  EXPECT_NE(escaped.out.find("[1] " + dir_ + "/no\\x1B[2J\\xC2\\x9Bsuch: no output"), std::string::npos) << escaped.out;
+  for (const std::string& text : {escaped.out, escaped.err})
+    EXPECT_EQ(text.find_first_of("\x1B\x9B"), std::string::npos) << text;
 }
 
 // A stop signal (systemd's stop sends SIGTERM, a terminal's Ctrl-C SIGINT)

@@ -1,7 +1,7 @@
 // The board's size as the stored rig's stereo modules measure it, over the
 // size the target file gives. A target file that is not the board's
 // (another square size) scales every module's reading alike; a camera
-// turned moves its own module's (0.5 deg: +1.1 to +1.3%), a lens drift or a
+// turned moves its own module's (0.5 deg: +1.0 to +1.3%), a lens drift or a
 // module's shift barely any. The nightly check says so when every module
 // reads the board off alike (CheckResult::board_size_note): judged against
 // the wrong board every camera read as changed, with no word of the board

@@ -373,7 +373,7 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   // The board against the target file, on the views kept. A target file
   // that is not the board's (another square size) scales the board as every
   // module measures it alike; a camera turned moves its own module's reading
-  // (0.5 deg: +1.1 to +1.3%), a lens drift or a module's shift barely any.
+  // (0.5 deg: +1.0 to +1.3%), a lens drift or a module's shift barely any.
   // Judged against the wrong board, every camera read as changed, with no
   // word of the board (a user's walkthrough: a target file 2% too large).
   // Said, not refused: the cameras of every module turned alike (a common
@@ -399,7 +399,7 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
       char square[32];
       std::snprintf(square, sizeof square, "%.3f mm", target.square_size_mm());
       result.board_size_note = std::string("every module measures the board ") + (lo > 0 ? "larger" : "smaller") +
-                               " than the target file says (" + each + "; its squares " + square +
+                               " than the target file says (" + each + ", squares of " + square +
                                "): if it is not the board's file, the figures are not the rig's";
     }
   }
@@ -442,7 +442,8 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   if (!camera_figures.empty() && fitted == 0) {
     throw InputError(where,
                      "the captures do not fit this rig at all (every camera is off by > 2 px): "
-                     "captures of another rig, or the wrong rig file or target file?");
+                     "captures of another rig, or the wrong rig file or target file?" +
+                         (result.board_size_note.empty() ? std::string() : " (" + result.board_size_note + ")"));
   }
   // A camera with no figure is not checked: the check would call the rig
   // ok with it moved (8 captures only camera 0 saw, it turned 1 degree:

@@ -80,8 +80,9 @@ PlyVertices ReadPlyVertices(const std::string& path) {
         throw InputError(path, "unknown PLY format '" + f + "'");
     } else if (word == "element") {
       std::string name;
-      long long count;
+      long long count = 0;
       s >> name >> count;
+      if (!s || count < 0) throw InputError(path, "malformed element line '" + line + "'");
       if (seen_vertex && count > 0) after_vertex = true;  // data after the vertices, not read
       in_vertex = name == "vertex";
       if (in_vertex) {
@@ -91,7 +92,6 @@ PlyVertices ReadPlyVertices(const std::string& path) {
                                      "'; this reader needs the vertices first (as every PLY writer of point clouds "
                                      "puts them)");
         }
-        if (!s) throw InputError(path, "malformed vertex element line '" + line + "'");
         seen_vertex = true;
         num_vertices = count;
       } else if (!seen_vertex && element_before_vertex.empty() && count > 0) {

@@ -63,6 +63,10 @@ TEST(PlyPoints, RejectsBrokenFiles) {
   std::ofstream(dir + "/e.ply") << "ply\nformat ascii 1.0\nelement vertex 1\nproperty float a\nend_header\n1\n";
   EXPECT_THROW(ReadPlyPoints(dir + "/e.ply"), InputError);  // no xyz
   EXPECT_THROW(ReadPlyPoints(dir + "/missing.ply"), InputError);
+  // An element line without a count (it was read uninitialised).
+  std::ofstream(dir + "/f.ply") << "ply\nformat ascii 1.0\nelement face\nelement vertex 1\nproperty float x\n"
+                                   "property float y\nproperty float z\nend_header\n1 2 3\n";
+  EXPECT_THROW(ReadPlyPoints(dir + "/f.ply"), InputError);
 }
 
 std::string ErrorOf(const std::string& path) {
