@@ -5,6 +5,7 @@
 // judged (printed all the same; no report written).
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "apps/cli_util.h"
@@ -231,6 +232,20 @@ int RunVerify(int argc, char** argv) {
   std::printf("artifact: %s (%s); capture band %.1f mm\n", artifact.name.c_str(), ArtifactTypeName(artifact.type),
               positions.front().capture_band_mm);
   std::printf("decision rule: %s\n", DecisionRuleText(options.decision_rule));
+  // The same cloud given twice is one position, not two (the standard asks
+  // for positions that differ): said, not refused (a test may repeat one).
+  for (size_t i = 1; i < clouds.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      std::error_code ec;
+      if (std::filesystem::equivalent(clouds[i], clouds[j], ec)) {
+        std::printf(
+            "note: position %zu is the same cloud as position %zu (%s): the standard asks for positions "
+            "that differ\n",
+            i + 1, j + 1, PrintableText(clouds[i]).c_str());
+        break;
+      }
+    }
+  }
   std::printf("%-8s %-6s %10s %8s %7s %4s %8s %7s %8s %8s %8s %10s\n", "position", "figure", "value_mm", "u_mm",
               "mpe_mm", "pass", "cloud", "filled", "artifact", "excluded", "used", "mean|e|_mm");
   nlohmann::json report = {{"artifact", artifact.name},

@@ -59,6 +59,8 @@ TEST(VerifyCli, PassFailAndReport) {
   std::filesystem::remove(report);
   auto r = RunCli("verify --artifact " + artifact + " --cloud " + good + " --cloud " + good + " --report " + report);
   EXPECT_EQ(r.code, 0) << r.out << r.err;
+  // The same cloud twice is said to be one position (not refused).
+  EXPECT_NE(r.out.find("note: position 2 is the same cloud as position 1"), std::string::npos) << r.out;
   std::ifstream f(report);
   const auto j = nlohmann::json::parse(f);
   EXPECT_TRUE(j["summary"]["pass"].get<bool>());
@@ -67,9 +69,10 @@ TEST(VerifyCli, PassFailAndReport) {
 
   // 1.6 mm too large in diameter: P_S = 1.6 > MPE 1.5 -> exit 1.
   const std::string big = WriteSphere("big.ply", 19.05 + 0.8);
-  r = RunCli("verify --artifact " + artifact + " --cloud " + big);
+  r = RunCli("verify --artifact " + artifact + " --cloud " + big + " --cloud " + good);
   EXPECT_EQ(r.code, 1) << r.out << r.err;
   EXPECT_NE(r.out.find("FAIL"), std::string::npos);
+  EXPECT_EQ(r.out.find("note: position"), std::string::npos) << r.out;  // two clouds that differ
 }
 
 TEST(VerifyCli, BadInputExitsTwoAndWritesNoReport) {
