@@ -2,6 +2,9 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
 #include <map>
 #include <utility>
 
@@ -55,6 +58,29 @@ std::vector<ModuleBoardScale> MeasureBoardScale(const Rig& rig, const Target& ta
     out.push_back({m, scales[mid], static_cast<int>(scales.size())});
   }
   return out;
+}
+
+std::string BoardSizeNote(const std::vector<ModuleBoardScale>& scales, int num_modules, double square_size_mm) {
+  if (num_modules < 2 || static_cast<int>(scales.size()) != num_modules) return "";
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const ModuleBoardScale& m : scales) {
+    if (m.captures < 3 || !(std::abs(m.scale - 1) > kMaxBoardScaleOff)) return "";
+    lo = std::min(lo, m.scale - 1);
+    hi = std::max(hi, m.scale - 1);
+  }
+  // Off the same way, and by the same within half the smaller.
+  if (!(lo * hi > 0 && hi - lo <= 0.5 * std::min(std::abs(lo), std::abs(hi)))) return "";
+  std::string each;
+  for (const ModuleBoardScale& m : scales) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%smodule %d %+.2f%%", each.empty() ? "" : ", ", m.module, 100 * (m.scale - 1));
+    each += buf;
+  }
+  char square[32];
+  std::snprintf(square, sizeof square, "%.3f mm", square_size_mm);
+  return std::string("every module measures the board ") + (lo > 0 ? "larger" : "smaller") +
+         " than the target file says (" + each + ", squares of " + square +
+         "): if it is not the board's file, the figures are not the rig's";
 }
 
 }  // namespace stereorig

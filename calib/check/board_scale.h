@@ -8,6 +8,7 @@
 // (a user's walkthrough: a target file 2% too large).
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "calib/core/rig.h"
@@ -36,5 +37,14 @@ struct ModuleBoardScale {
 // over the captures. Modules without such a capture are left out.
 std::vector<ModuleBoardScale> MeasureBoardScale(const Rig& rig, const Target& target,
                                                 const std::vector<BoardObservation>& views, int min_corners = 6);
+
+// What the readings say of the board: when every module of the rig (at
+// least two, each read from 3 captures or more) reads it off the same way by
+// more than kMaxBoardScaleOff, and by the same within half the smaller, "every
+// module measures the board smaller than the target file says (module 0
+// -1.96%, module 1 -1.96%, squares of 9.180 mm): ..."; otherwise empty. With
+// one module a board of another size cannot be told from the module's own
+// change: empty.
+std::string BoardSizeNote(const std::vector<ModuleBoardScale>& scales, int num_modules, double square_size_mm);
 
 }  // namespace stereorig

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -111,8 +110,6 @@ struct Consistency {
   std::vector<PosedView> views;  // the camera's views behind the figure, each with the pose the others imply
 };
 
-// Camera c's corners through board poses estimated from the cameras in
-// `trusted` other than c.
 // How much a view's residuals about its own board pose jump from a corner
 // to its grid neighbours: per axis, sqrt(sum |e_i - e_j|^2 / (4 pairs)) over
 // the pairs of neighbouring corners the view holds, which reads sigma for
@@ -136,6 +133,43 @@ double JumpRmsPx(const BoardObservation& v, const std::vector<Eigen::Vector2d>& 
   return pairs > 0 ? std::sqrt(ss / (4.0 * pairs)) : 0.0;
 }
 
+// Each capture given (with its number of views) that `in` no longer holds,
+// named (capture_names, else its index) with why: its views set aside, too
+// few corners left after trimming, or no board pose.
+std::string LostCapturesText(const std::map<int, size_t>& given_captures, const Inputs& in,
+                             const std::vector<SetAsideView>& set_aside,
+                             const std::map<int, std::string>& capture_names) {
+  std::string lost;
+  for (const auto& [capture, num_views] : given_captures) {
+    if (in.by_capture.count(capture)) continue;
+    const auto name = capture_names.find(capture);
+    std::string why;
+    size_t num_set_aside = 0;
+    for (const SetAsideView& v : set_aside) {
+      if (v.capture != capture) continue;
+      ++num_set_aside;
+      char buf[128];
+      std::snprintf(buf, sizeof buf, "%scam%d's corners jump %.3f px about its own pose (bound %.3f px)",
+                    why.empty() ? "" : ", ", v.camera, v.jump_rms_px, v.bound_px);
+      why += buf;
+    }
+    const char* rest = in.seed.count(capture) ? "too few corners left once outlier corners were trimmed"
+                                              : "no board pose fits its views";
+    if (why.empty()) {
+      why = rest;
+    } else if (num_set_aside < num_views) {
+      why += std::string(" (set aside); the rest: ") + rest;
+    } else {
+      why += " (set aside)";
+    }
+    lost += std::string(lost.empty() ? "" : "; ") + "capture " +
+            (name != capture_names.end() ? name->second : std::to_string(capture)) + ": " + why;
+  }
+  return lost;
+}
+
+// Camera c's corners through board poses estimated from the cameras in
+// `trusted` other than c.
 Consistency CameraConsistency(const Inputs& in, int c, const std::set<int>& trusted) {
   Consistency out;
   double ss = 0, expected_ss = 0, var_ss = 0;
@@ -339,34 +373,9 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   // capture lost is named with why, since on such a night this message is
   // all the user sees.
   if (static_cast<int>(in.by_capture.size()) < options.min_captures) {
-    std::string lost;
-    for (const auto& [capture, num_views] : given_captures) {
-      if (in.by_capture.count(capture)) continue;
-      const auto name = capture_names.find(capture);
-      std::string why;
-      size_t num_set_aside = 0;
-      for (const SetAsideView& v : result.views_set_aside) {
-        if (v.capture != capture) continue;
-        ++num_set_aside;
-        char buf[128];
-        std::snprintf(buf, sizeof buf, "%scam%d's corners jump %.3f px about its own pose (bound %.3f px)",
-                      why.empty() ? "" : ", ", v.camera, v.jump_rms_px, v.bound_px);
-        why += buf;
-      }
-      const char* rest = in.seed.count(capture) ? "too few corners left once outlier corners were trimmed"
-                                                : "no board pose fits its views";
-      if (why.empty()) {
-        why = rest;
-      } else if (num_set_aside < num_views) {
-        why += std::string(" (set aside); the rest: ") + rest;
-      } else {
-        why += " (set aside)";
-      }
-      lost += std::string(lost.empty() ? "" : "; ") + "capture " +
-              (name != capture_names.end() ? name->second : std::to_string(capture)) + ": " + why;
-    }
     throw InputError(where, "only " + std::to_string(in.by_capture.size()) + " of " +
-                                std::to_string(given_captures.size()) + " captures are left to check: " + lost +
+                                std::to_string(given_captures.size()) + " captures are left to check: " +
+                                LostCapturesText(given_captures, in, result.views_set_aside, capture_names) +
                                 "; the check needs " + std::to_string(options.min_captures) + ": take more captures");
   }
 
@@ -380,29 +389,7 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   // bar bent) read the same, and must not be hidden (a second reading).
   // With one module the two cannot be told apart: nothing said.
   result.board_scales = MeasureBoardScale(rig, target, trimmed, options.min_corners_per_view);
-  if (rig.num_modules() >= 2) {
-    bool all_off = static_cast<int>(result.board_scales.size()) == rig.num_modules();
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const ModuleBoardScale& m : result.board_scales) {
-      all_off = all_off && m.captures >= 3 && std::abs(m.scale - 1) > kMaxBoardScaleOff;
-      lo = std::min(lo, m.scale - 1);
-      hi = std::max(hi, m.scale - 1);
-    }
-    // Off the same way, and by the same within half the smaller.
-    if (all_off && lo * hi > 0 && hi - lo <= 0.5 * std::min(std::abs(lo), std::abs(hi))) {
-      std::string each;
-      for (const ModuleBoardScale& m : result.board_scales) {
-        char buf[64];
-        std::snprintf(buf, sizeof buf, "%smodule %d %+.2f%%", each.empty() ? "" : ", ", m.module, 100 * (m.scale - 1));
-        each += buf;
-      }
-      char square[32];
-      std::snprintf(square, sizeof square, "%.3f mm", target.square_size_mm());
-      result.board_size_note = std::string("every module measures the board ") + (lo > 0 ? "larger" : "smaller") +
-                               " than the target file says (" + each + ", squares of " + square +
-                               "): if it is not the board's file, the figures are not the rig's";
-    }
-  }
+  result.board_size_note = BoardSizeNote(result.board_scales, rig.num_modules(), target.square_size_mm());
 
   // Tonight's corner noise, per camera: each view fitted with its own pose.
   // A camera that moved is fitted just as well (its own pose absorbs any
