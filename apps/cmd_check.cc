@@ -9,6 +9,7 @@
 #include "apps/command.h"
 #include "apps/output_paths.h"
 #include "calib/capture_folder.h"
+#include "calib/check/check_target.h"
 #include "calib/check/history.h"
 #include "calib/check/nightly_check.h"
 #include "calib/core/atomic_file.h"
@@ -73,7 +74,10 @@ int RunCheck(int argc, char** argv) {
   app.add_option("--captures", captures,
                  "folder of captures: one sub-folder per capture with camK.png per camera (or a simulated "
                  "dataset, whose calibration/ folder is used)");
-  app.add_option("--target", target_path, "the target file (YAML) of the board in the captures");
+  app.add_option("--target", target_path,
+                 "the target file (YAML) of the board in the captures: the board the rig was calibrated with (the rig "
+                 "file records it, and the plate's back_from_front as calibrated, which the check uses; another board "
+                 "is refused)");
   app.add_option("--history-db", history_db, "SQLite history (default: check-history.sqlite beside the rig file)");
   app.add_option("--report", report_path, "write the figures as JSON here");
   app.add_option("--k-sigma", options.k_sigma,
@@ -121,7 +125,10 @@ int RunCheck(int argc, char** argv) {
 
   const Rig rig = ReadRigFile(rig_path);
   RequireCalibrationResiduals(rig, rig_path);  // named by the rig file, before minutes of detection
-  const Target target = ReadTargetFile(target_path);
+  // The board with the back_from_front the calibration ended with (S holds
+  // with it); a board other than the calibration's is refused here.
+  const CheckTarget check_target = TargetForCheck(rig, ReadTargetFile(target_path), target_path);
+  const Target& target = check_target.target;
   RejectCamerasBeyondTheRig(captures, rig.num_cameras());
   // A history that is not ours is refused before any work, so a failed run
   // leaves neither a report nor a half-recorded night.
@@ -173,6 +180,18 @@ int RunCheck(int argc, char** argv) {
                 100 * (m.scale - 1), m.captures);
     report["board_scale"].push_back({{"module", m.module}, {"scale", m.scale}, {"captures", m.captures}});
   }
+  // The board measured with (check_target.h).
+  if (check_target.as_calibrated && target.double_sided())
+    std::printf("target: back_from_front as calibrated (the rig file's), %.4f mm and %.4f deg from the target file's\n",
+                check_target.calibrated_vs_file_mm, check_target.calibrated_vs_file_deg);
+  if (!check_target.note.empty()) std::printf("note: %s\n", check_target.note.c_str());
+  report["target"] = {{"as_calibrated", check_target.as_calibrated},
+                      {"calibrated_with", nullptr},
+                      {"calibrated_vs_file_mm", check_target.calibrated_vs_file_mm},
+                      {"calibrated_vs_file_deg", check_target.calibrated_vs_file_deg},
+                      {"note", nullptr}};
+  if (check_target.as_calibrated) report["target"]["calibrated_with"] = check_target.calibrated_with;
+  if (!check_target.note.empty()) report["target"]["note"] = check_target.note;
   report["board_size_note"] = nullptr;
   if (!result.board_size_note.empty()) report["board_size_note"] = result.board_size_note;
   std::printf("verdict: %s (%s)\n", result.Verdict().c_str(), result.Explanation().c_str());

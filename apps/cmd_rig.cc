@@ -35,6 +35,21 @@ void PrintRigSummary(const Rig& rig, FILE* out) {
                    rig.S(i, j).AngleDeg());
     }
   }
+  // The board it was calibrated with, which stereorig check measures with.
+  if (const auto& t = rig.provenance().target) {
+    std::fprintf(out, "  calibrated with: %dx%d inner corners of %.6g mm, %s (target file %s)\n", t->corners_x,
+                 t->corners_y, t->square_size_mm, t->double_sided ? "double-sided" : "one-sided",
+                 PrintableText(t->file).c_str());
+    if (t->double_sided) {
+      const Pose moved = t->back_from_front_file.Inverse() * t->back_from_front;
+      std::fprintf(out, "  back_from_front as calibrated: %.4f mm, %.4f deg from the target file's\n",
+                   (t->back_from_front.translation_mm() - t->back_from_front_file.translation_mm()).norm(),
+                   moved.AngleDeg());
+    }
+  } else {
+    std::fprintf(out,
+                 "  calibration target: not recorded (a simulator's truth, or a rig file from an older stereorig)\n");
+  }
 }
 
 namespace {

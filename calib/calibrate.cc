@@ -269,6 +269,15 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
   pv.tool = std::string("stereorig ") + STEREORIG_VERSION;
   pv.date_utc = NowUtc();
   pv.input = in.source;
+  {  // The board as calibrated: stereorig check measures with it (calib/check/check_target.h).
+    CalibrationTarget& t = pv.target.emplace();
+    t.corners_x = in.target.corners_x;
+    t.corners_y = in.target.corners_y;
+    t.square_size_mm = in.target.square_size_mm;
+    t.double_sided = in.target.double_sided;
+    t.back_from_front_file = in.target.back_from_front;
+    t.back_from_front = M > 1 ? rep.system.back_from_front : in.target.back_from_front;
+  }
   // Keys as docs/formats.md fixes them (stereorig check reads them).
   for (const IntrinsicsReport& r : rep.intrinsics) {
     pv.residuals["cam" + std::to_string(r.camera) + "_rms_px"] = r.rms_px;

@@ -162,6 +162,8 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
     std::fprintf(stderr, "calibrate: %d captures, %d accepted views\n", out.num_captures, out.num_views);
   }
   out.result = Calibrate(input, options);
+  // Calibrate records the board (in the rig it built), not its file's name.
+  if (std::optional<CalibrationTarget>& board = out.result.rig.provenance().target) board->file = target_path;
   return out;
 }
 

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "calib/core/rig_file.h"
+#include "targets/target_file.h"
 #include "tests/cli_runner.h"
 
 namespace stereorig {
@@ -77,11 +78,18 @@ DbState ReadDb(const std::string& path) {
 
 // The simulator's truth rig as a calibration would have stored it: every
 // camera's residual RMS set to `rms_px` (the check's thresholds derive
-// from it). Returns it.
-Rig WriteStoredRig(const std::string& truth_path, double rms_px, const std::string& out_path) {
+// from it), and the board it was calibrated with, the dataset's
+// `target_path` as it is (back_from_front as calibrated = the file's: the
+// simulator's file is its truth). Returns it.
+Rig WriteStoredRig(const std::string& truth_path, double rms_px, const std::string& out_path,
+                   const std::string& target_path) {
   Rig rig = ReadRigFile(truth_path);
   for (int c = 0; c < rig.num_cameras(); ++c)
     rig.provenance().residuals["cam" + std::to_string(c) + "_rms_px"] = rms_px;
+  const Target board = ReadTargetFile(target_path);
+  rig.provenance().target =
+      CalibrationTarget{target_path,          board.corners_x(),       board.corners_y(),      board.square_size_mm(),
+                        board.double_sided(), board.back_from_front(), board.back_from_front()};
   WriteRigFile(rig, out_path);
   return rig;
 }
@@ -95,7 +103,7 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
   ASSERT_EQ(r.code, 0) << r.err;
   // The stored rig: the true rig with the residuals a calibration would have
   // written (the check derives its thresholds from them).
-  const Rig rig = WriteStoredRig(dir + "/ds/truth/rig.yaml", 0.2, dir + "/rig.yaml");
+  const Rig rig = WriteStoredRig(dir + "/ds/truth/rig.yaml", 0.2, dir + "/rig.yaml", dir + "/ds/target.yaml");
   const std::string db = dir + "/history.sqlite", report = dir + "/check.json";
   auto check = [&](const std::string& captures, const std::string& rig_path) {
     return RunCli("check --rig " + rig_path + " --captures " + captures + " --target " + dir +
@@ -159,6 +167,27 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     Result no_captures = check(dir + "/no_such_captures", dir + "/rig.yaml");
     expect_refused(no_captures, dir + "/no_such_captures: no such captures folder", "no captures folder");
     EXPECT_EQ(Lines(no_captures.err), 1) << no_captures.err;
+  }
+  {  // Another board's target file (squares of 9.18 mm; the rig was
+     // calibrated with the 9 mm one): refused before the detection, in one
+     // line naming both boards. Before, it read as every module measuring
+     // the board 2 % small, and every camera changed.
+    std::ifstream in(dir + "/ds/target.yaml");
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string other = text.str();
+    const size_t at = other.find("square_size_mm: 9\n");
+    ASSERT_NE(at, std::string::npos) << other;
+    other.replace(at, 17, "square_size_mm: 9.18");
+    const std::string other_path = dir + "/other_board.yaml";
+    std::ofstream(other_path) << other;
+    const Result r = RunCli("check --rig " + dir + "/rig.yaml --captures " + dir + "/ds --target " + other_path +
+                            " --history-db " + db + " --report " + report);
+    expect_refused(r,
+                   other_path + ": a board of 11x9 inner corners of 9.18 mm, double-sided, but " + dir +
+                       "/rig.yaml was calibrated with one of 11x9 inner corners of 9 mm, double-sided",
+                   "another board");
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
   }
   {  // A coverage factor that is not finite, or so large it would pass any
      // drift (inf was accepted, a verdict "ok" with infinite thresholds
@@ -296,7 +325,7 @@ TEST(CheckCli, TheReportListsEveryNamedCameraAndModuleAndWhatExplainsEach) {
   fs::create_directories(dir);
   Result r = RunCli("simulate --out " + dir + "/unmoved --seed 21 --calibration-captures 1 --no-scenes");
   ASSERT_EQ(r.code, 0) << r.err;
-  WriteStoredRig(dir + "/unmoved/truth/rig.yaml", 0.03, dir + "/rig.yaml");
+  WriteStoredRig(dir + "/unmoved/truth/rig.yaml", 0.03, dir + "/rig.yaml", dir + "/unmoved/target.yaml");
   // A night of 8 captures after `bump`, checked: its report.
   auto night = [&](const std::string& name, const std::string& bump) {
     const std::string captures = dir + "/" + name, report = dir + "/" + name + ".json";
@@ -314,6 +343,12 @@ TEST(CheckCli, TheReportListsEveryNamedCameraAndModuleAndWhatExplainsEach) {
   EXPECT_EQ(lens["moved_cameras"], nlohmann::json::array({2})) << lens.dump(2);
   ASSERT_EQ(lens["camera_changes"].size(), 1u) << lens.dump(2);
   EXPECT_EQ(lens["camera_changes"][0]["kind"], "lens");
+  // The board measured with: the rig file's record (check_target.h), here
+  // the dataset's own file.
+  EXPECT_EQ(lens["target"]["as_calibrated"], true) << lens.dump(2);
+  EXPECT_EQ(lens["target"]["calibrated_with"], dir + "/unmoved/target.yaml") << lens.dump(2);
+  EXPECT_EQ(lens["target"]["calibrated_vs_file_mm"], 0.0) << lens.dump(2);
+  EXPECT_TRUE(lens["target"]["note"].is_null()) << lens.dump(2);
   const nlohmann::json turned = night("turned", "--bump-camera 2 --bump-rotation-deg 0.05");
   ASSERT_TRUE(turned.is_object());
   EXPECT_EQ(turned["flagged_cameras"], nlohmann::json::array({2})) << turned.dump(2);

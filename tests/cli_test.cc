@@ -96,6 +96,27 @@ TEST(Cli, GoodRigFileIsAccepted) {
   const Result r = RunCli("rig --rig " + path);
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("2 module(s)"), std::string::npos);
+  EXPECT_NE(r.out.find("calibration target: not recorded"), std::string::npos) << r.out;
+  // One that records its board says which, and how far stage 3 moved the
+  // faces' transform from the file's.
+  stereorig::Rig rig = stereorig::MakeDefaultRig().rig;
+  const stereorig::Pose file_pose = stereorig::Pose::FromRotationVector({0, M_PI, 0}, {90, 0, 5});
+  rig.provenance().target = stereorig::CalibrationTarget{
+      "lab/board.yaml",
+      11,
+      9,
+      9,
+      true,
+      stereorig::Pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0.003, 0.004)) * file_pose,
+      file_pose};
+  std::ofstream(path) << stereorig::RigToYaml(rig);
+  const Result recorded = RunCli("rig --rig " + path);
+  EXPECT_EQ(recorded.code, 0) << recorded.err;
+  EXPECT_NE(recorded.out.find("calibrated with: 11x9 inner corners of 9 mm, double-sided (target file lab/board.yaml)"),
+            std::string::npos)
+      << recorded.out;
+  EXPECT_NE(recorded.out.find("back_from_front as calibrated: 0.0050 mm, 0.0000 deg"), std::string::npos)
+      << recorded.out;
 }
 
 // An image `match` cannot read is named in one line: a missing file without

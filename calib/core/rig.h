@@ -9,6 +9,7 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,20 @@ struct StereoModule {
   Pose right_from_left;   // right camera from left camera (= module) frame, mm
 };
 
+// The board a rig was calibrated with, as the calibration used it: what the
+// nightly check must measure with again (calib/check/check_target.h). Stage 3
+// refines the target file's back_from_front under the file's stated sigma
+// jointly with S, so S holds with that estimate, not with the file's.
+struct CalibrationTarget {
+  std::string file;             // the target file as calibrate was given it
+  int corners_x = 0;            // inner corners along a row
+  int corners_y = 0;            // inner corners along a column
+  double square_size_mm = 0.0;  // printed square edge
+  bool double_sided = false;
+  Pose back_from_front;       // as calibrated: stage 3's estimate (the file's where it was held, or one module)
+  Pose back_from_front_file;  // as the target file gave it
+};
+
 // Where a rig came from. The same structure serves a calibration result and
 // the simulator's ground truth.
 struct Provenance {
@@ -34,6 +49,9 @@ struct Provenance {
   std::map<std::string, double> residuals;
   // 1-sigma uncertainties, e.g. {"S_0_1_translation_mm": 0.01, ...}.
   std::map<std::string, double> uncertainties;
+  // The calibration's board; absent in the simulator's truth and in rig
+  // files written before stereorig recorded it.
+  std::optional<CalibrationTarget> target;
 };
 
 // Tolerances of the S invariants. A rig file written with %.17g and composed

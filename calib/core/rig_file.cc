@@ -55,6 +55,23 @@ std::map<std::string, double> ReadNumberMap(YamlMap map) {
   return out;
 }
 
+CalibrationTarget ReadCalibrationTarget(YamlMap t) {
+  CalibrationTarget out;
+  out.file = t.GetString("file");
+  out.corners_x = t.GetInt("corners_x");
+  out.corners_y = t.GetInt("corners_y");
+  for (const auto& [key, n] : {std::pair{"corners_x", out.corners_x}, std::pair{"corners_y", out.corners_y}})
+    if (n < 2) throw InputError(t.Where(key), "must be at least 2 inner corners, got " + std::to_string(n));
+  out.square_size_mm = t.GetDouble("square_size_mm");
+  if (!(out.square_size_mm > 0))
+    throw InputError(t.Where("square_size_mm"), "must be positive, got " + NumberText(out.square_size_mm, 6));
+  out.double_sided = t.GetBool("double_sided");
+  out.back_from_front = ReadRigidPose(t.GetNode("back_from_front"), t.Where("back_from_front"));
+  out.back_from_front_file = ReadRigidPose(t.GetNode("back_from_front_file"), t.Where("back_from_front_file"));
+  t.Finish();
+  return out;
+}
+
 Rig ParseRig(YamlMap root) {
   const std::string format = root.GetString("format");
   if (format != "stereorig-rig")
@@ -75,6 +92,7 @@ Rig ParseRig(YamlMap root) {
     prov.input = p.GetString("input");
     prov.residuals = ReadNumberMap(p.GetMap("residuals"));
     prov.uncertainties = ReadNumberMap(p.GetMap("uncertainties"));
+    if (p.Has("target")) prov.target = ReadCalibrationTarget(p.GetMap("target"));
     p.Finish();
   }
 
@@ -156,6 +174,18 @@ std::string RigToYaml(const Rig& rig) {
     if (section->empty()) o << " {}";
     o << "\n";
     for (const auto& [k, v] : *section) o << "    " << Quote(k) << ": " << FormatDouble(v) << "\n";
+  }
+  if (p.target) {
+    const CalibrationTarget& t = *p.target;
+    o << "  target:  # the board calibrated with; stereorig check measures with it\n"
+      << "    file: " << Quote(t.file) << "\n"
+      << "    corners_x: " << t.corners_x << "\n"
+      << "    corners_y: " << t.corners_y << "\n"
+      << "    square_size_mm: " << FormatDouble(t.square_size_mm) << "\n"
+      << "    double_sided: " << (t.double_sided ? "true" : "false") << "\n"
+      << "    back_from_front: " << Matrix4ToYaml(t.back_from_front.ToMatrix4()) << "  # as calibrated (stage 3)\n"
+      << "    back_from_front_file: " << Matrix4ToYaml(t.back_from_front_file.ToMatrix4())
+      << "  # as the target file gave it\n";
   }
   o << "cameras:\n";
   for (int i = 0; i < rig.num_cameras(); ++i) {

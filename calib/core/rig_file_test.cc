@@ -35,7 +35,20 @@ Rig MakeRandomRig(unsigned seed) {
                       "2026-11-23T00:00:00Z",
                       "a \"quoted\" input\\path",
                       {{"stage1_rms_px", 0.1 + u(rng)}},
-                      {{"S_0_1_mm", 1e-3 * (2 + u(rng))}}};
+                      {{"S_0_1_mm", 1e-3 * (2 + u(rng))}},
+                      std::nullopt};
+  if (seed % 2) {  // half of them record the board they were calibrated with
+    CalibrationTarget t;
+    t.file = "boards/\"plate 7\".yaml";
+    t.corners_x = 11;
+    t.corners_y = 9;
+    t.square_size_mm = 9 + 1e-3 * u(rng);
+    t.double_sided = seed % 4 == 1;
+    t.back_from_front_file = Pose::FromRotationVector({0, M_PI, 0}, {90, 0, 5});
+    t.back_from_front = Pose::FromRotationVector({1e-4 * u(rng), M_PI + 1e-4 * u(rng), 1e-4 * u(rng)},
+                                                 {90 + 0.01 * u(rng), 0.01 * u(rng), 5 + 0.01 * u(rng)});
+    rig.provenance().target = t;
+  }
   return rig;
 }
 
@@ -53,6 +66,61 @@ TEST(RigFile, WriteReadWriteIsBitIdentical) {
     EXPECT_EQ(back.module(1).right_from_left.ToMatrix4(), rig.module(1).right_from_left.ToMatrix4());
     EXPECT_EQ(back.provenance().input, rig.provenance().input);
     EXPECT_EQ(back.provenance().residuals, rig.provenance().residuals);
+    ASSERT_EQ(back.provenance().target.has_value(), rig.provenance().target.has_value()) << seed;
+    if (const auto& t = rig.provenance().target) {
+      const CalibrationTarget& b = *back.provenance().target;
+      EXPECT_EQ(b.file, t->file);
+      EXPECT_EQ(b.corners_x, t->corners_x);
+      EXPECT_EQ(b.corners_y, t->corners_y);
+      EXPECT_EQ(b.square_size_mm, t->square_size_mm);
+      EXPECT_EQ(b.double_sided, t->double_sided);
+      EXPECT_EQ(b.back_from_front.ToMatrix4(), t->back_from_front.ToMatrix4());
+      EXPECT_EQ(b.back_from_front_file.ToMatrix4(), t->back_from_front_file.ToMatrix4());
+    }
+  }
+}
+
+// provenance.target is optional (a rig file written before it was, and the
+// simulator's truth, have none), but when present every key is required
+// and checked, each error naming the key.
+TEST(RigFile, TheCalibrationTargetIsOptionalAndCheckedWhenPresent) {
+  Rig rig = MakeRandomRig(1);
+  ASSERT_TRUE(rig.provenance().target.has_value());
+  const std::string with = RigToYaml(rig);
+  rig.provenance().target.reset();
+  const std::string without = RigToYaml(rig);
+  ASSERT_EQ(without.find("  target:"), std::string::npos);
+  EXPECT_FALSE(ParseRigYaml(without, "old.yaml").provenance().target.has_value());
+  ASSERT_TRUE(ParseRigYaml(with, "new.yaml").provenance().target.has_value());
+  auto edited = [&](const std::string& from, const std::string& to) {
+    const size_t at = with.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    std::string s = with;
+    return at == std::string::npos ? s : s.replace(at, from.size(), to);
+  };
+  const std::string square = "    square_size_mm: ";
+  const std::string square_line =
+      with.substr(with.find(square), with.find('\n', with.find(square)) + 1 - with.find(square));
+  const std::pair<std::string, std::string> bad[] = {
+      {"    corners_x: 11\n", "    corners_x: 1\n"},
+      {"    corners_y: 9\n", ""},
+      {square_line, square + "0\n"},
+      {square_line, square + "-9\n"},
+      {"    double_sided: true\n", "    double_sided: maybe\n"},
+      {"    back_from_front: [[", "    back_from_front: [[2, "},
+      {"    file: ", "    colour: \"red\"\n    file: "},
+  };
+  const char* key[] = {"provenance.target.corners_x",      "provenance.target.corners_y",
+                       "provenance.target.square_size_mm", "provenance.target.square_size_mm",
+                       "provenance.target.double_sided",   "provenance.target.back_from_front",
+                       "provenance.target.colour"};
+  for (size_t i = 0; i < std::size(bad); ++i) {
+    try {
+      ParseRigYaml(edited(bad[i].first, bad[i].second), "rig.yaml");
+      ADD_FAILURE() << "accepted: " << bad[i].second;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(key[i]), std::string::npos) << e.what();
+    }
   }
 }
 

@@ -136,6 +136,10 @@ bool YamlMap::GetBool(const std::string& key, bool default_value) {
     read_.insert(key);
     return default_value;
   }
+  return GetBool(key);
+}
+
+bool YamlMap::GetBool(const std::string& key) {
   YAML::Node n = Require(key);
   try {
     if (n.IsScalar()) return n.as<bool>();

@@ -32,6 +32,7 @@ class YamlMap {
   double GetDouble(const std::string& key, double default_value);
   int GetInt(const std::string& key);
   int GetInt(const std::string& key, int default_value);
+  bool GetBool(const std::string& key);
   bool GetBool(const std::string& key, bool default_value);
   // An optional key read into *value, which holds its default and keeps it
   // when the key is absent: the field is named once, so a key cannot be read
