@@ -190,7 +190,7 @@ int RunCheck(int argc, char** argv) {
                       {"calibrated_vs_file_mm", check_target.calibrated_vs_file_mm},
                       {"calibrated_vs_file_deg", check_target.calibrated_vs_file_deg},
                       {"note", nullptr}};
-  if (check_target.as_calibrated) report["target"]["calibrated_with"] = check_target.calibrated_with;
+  if (!check_target.calibrated_with.empty()) report["target"]["calibrated_with"] = check_target.calibrated_with;
   if (!check_target.note.empty()) report["target"]["note"] = check_target.note;
   report["board_size_note"] = nullptr;
   if (!result.board_size_note.empty()) report["board_size_note"] = result.board_size_note;

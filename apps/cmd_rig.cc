@@ -9,6 +9,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/cameramodel_export.h"
 #include "calib/core/input_error.h"
+#include "calib/core/number_text.h"
 #include "calib/core/rig_file.h"
 #include "calib/rig_compare.h"
 #include "reconstruct/runtime.h"
@@ -37,9 +38,9 @@ void PrintRigSummary(const Rig& rig, FILE* out) {
   }
   // The board it was calibrated with, which stereorig check measures with.
   if (const auto& t = rig.provenance().target) {
-    std::fprintf(out, "  calibrated with: %dx%d inner corners of %.6g mm, %s (target file %s)\n", t->corners_x,
-                 t->corners_y, t->square_size_mm, t->double_sided ? "double-sided" : "one-sided",
-                 PrintableText(t->file).c_str());
+    std::fprintf(out, "  calibrated with: %dx%d inner corners of %s mm, %s (target file %s)\n", t->corners_x,
+                 t->corners_y, NumberText(t->square_size_mm, 12).c_str(),
+                 t->double_sided ? "double-sided" : "one-sided", PrintableText(t->file).c_str());
     if (t->double_sided) {
       const Pose moved = t->back_from_front_file.Inverse() * t->back_from_front;
       std::fprintf(out, "  back_from_front as calibrated: %.4f mm, %.4f deg from the target file's\n",

@@ -188,6 +188,24 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
                        "/rig.yaml was calibrated with one of 11x9 inner corners of 9 mm, double-sided",
                    "another board");
     EXPECT_EQ(Lines(r.err), 1) << r.err;
+    // A rig file without the record (an older stereorig's) cannot tell: the
+    // night is judged (the board's size said, docs/verify-and-check.md), with
+    // the target file's back_from_front, and a note says so. Its own history.
+    Rig old = rig;
+    old.provenance().target.reset();
+    WriteRigFile(old, dir + "/old_rig.yaml");
+    const std::string old_report = dir + "/old_check.json";
+    const Result judged = RunCli("check --rig " + dir + "/old_rig.yaml --captures " + dir + "/ds --target " +
+                                 other_path + " --history-db " + dir + "/old_history.sqlite --report " + old_report);
+    EXPECT_NE(judged.code, 2) << judged.err;
+    EXPECT_NE(judged.out.find("note: the rig file records no calibration target"), std::string::npos) << judged.out;
+    std::ifstream f(old_report);
+    const nlohmann::json j = nlohmann::json::parse(f, nullptr, false);
+    ASSERT_TRUE(j.is_object()) << old_report;
+    EXPECT_EQ(j["target"]["as_calibrated"], false) << j.dump(2);
+    EXPECT_TRUE(j["target"]["calibrated_with"].is_null()) << j.dump(2);
+    EXPECT_TRUE(j["target"]["note"].is_string()) << j.dump(2);
+    EXPECT_FALSE(j["board_size_note"].is_null()) << j.dump(2);
   }
   {  // A coverage factor that is not finite, or so large it would pass any
      // drift (inf was accepted, a verdict "ok" with infinite thresholds

@@ -279,7 +279,7 @@ TEST(Cli, EveryMalformedRigFileExitsTwoNamingTheKey) {
                "[[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 2.5], [0, 0, 0, 1]]  # module1_from_module1"),
        "S[1][1] is not the identity"},
       {"not YAML", "format: [unclosed\n", "not valid YAML"},
-      {"wrong version", Replace(good, "version: 1", "version: 99"), "unsupported version 99"},
+      {"wrong version", Replace(good, "version: 2", "version: 99"), "unsupported version 99"},
   };
   for (const Case& c : cases) {
     const std::string path = ::testing::TempDir() + "/bad_rig.yaml";

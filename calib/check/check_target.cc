@@ -1,5 +1,6 @@
 #include "calib/check/check_target.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -25,7 +26,8 @@ CheckTarget TargetForCheck(const Rig& rig, const Target& file_target, const std:
   const std::optional<CalibrationTarget>& rec = rig.provenance().target;
   if (!rec) {
     out.note =
-        "the rig file records no calibration target (written by an older stereorig): the modules' closures "
+        "the rig file records no calibration target (a rig file from an older stereorig, or a simulator's truth): "
+        "the modules' closures "
         "use the target file's back_from_front, which the calibration may have refined (its report's "
         "back_from_front_change_mm); a calibration by this version records it";
     return out;

@@ -122,7 +122,10 @@ void RequireCalibrationResiduals(const Rig& rig, const std::string& where);
 // trimmed and poses fitted: the message names each capture lost and why, by
 // capture_names where given, else by index), when a view names a camera the
 // rig does not have, or when the captures do not fit the rig at all (another
-// rig's captures).
+// rig's captures). `target` is measured with as given: pass
+// TargetForCheck(rig, file's board, path).target (check_target.h), the
+// board with the back_from_front S was calibrated with; the target file's
+// own reads its error as the modules disagreeing.
 CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vector<BoardObservation>& views,
                             const CheckOptions& options, const std::string& where,
                             const std::map<int, std::string>& capture_names = {});

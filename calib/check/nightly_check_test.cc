@@ -128,14 +128,15 @@ TEST(NightlyCheck, NoFalseAlarmOnTheUnbumpedRigOverTwentySeeds) {
 // refines the target file's jointly with S; check_target.h). A target file
 // off by 1.5 of its own stated sigma in each axis (0.015 mm of the default's
 // 0.01 mm; 0.026 mm in all), the rig stored as a calibration that refined it
-// to the truth (as `stereorig calibrate` does on the simulator's captures:
-// to 0.0003 mm), corners at the 0.03 px the simulator's rendered ones read
-// (at 0.2 px the closure's threshold is wide enough to hide the file's error
-// on 13 of 20 nights). Measured with the file's, the unmoved rig's closure
-// reads the file's error beyond its threshold on every night (20 of 20;
-// `stereorig check` on the demo's unmoved night: 0.019 mm against 0.015);
-// with the rig file's record it reads the noise: no false alarm over 20
-// seeds, as the unbumped rig above.
+// to the truth (`stereorig calibrate` on the demo's captures recovered a file
+// off by 0.022 mm to 0.0003 mm; CalibrateE2E.DefaultTargetOfTheTargetsLibrary
+// one off by 0.026 mm to 0.004-0.010 mm at 0.2 px corners), corners at the
+// 0.03 px the simulator's rendered ones read (at 0.2 px the closure's
+// threshold is wide enough to hide the file's error on 13 of 20 nights).
+// Measured with the file's, the unmoved rig's closure reads the file's error
+// beyond its threshold on every night (20 of 20; `stereorig check` on the
+// demo's unmoved night: 0.019 mm against 0.015); with the rig file's record
+// it reads the noise: no false alarm over 20 seeds, as the unbumped rig above.
 TEST(NightlyCheck, TheClosureUsesTheBoardAsCalibratedNotTheTargetFile) {
   const SimulatedRig truth = MakeDefaultRig();
   const Target board = DefaultTarget();

@@ -77,9 +77,10 @@ Rig ParseRig(YamlMap root) {
   if (format != "stereorig-rig")
     throw InputError(root.Where("format"), "expected 'stereorig-rig', got '" + format + "'");
   const int version = root.GetInt("version");
-  if (version != kRigFileVersion) {
+  if (version < 1 || version > kRigFileVersion) {
     throw InputError(root.Where("version"), "unsupported version " + std::to_string(version) +
-                                                " (this build reads version " + std::to_string(kRigFileVersion) + ")");
+                                                " (this build reads versions 1 to " + std::to_string(kRigFileVersion) +
+                                                ")");
   }
   const std::string units = root.GetString("units");
   if (units != "mm") throw InputError(root.Where("units"), "expected 'mm', got '" + units + "'");
@@ -92,7 +93,8 @@ Rig ParseRig(YamlMap root) {
     prov.input = p.GetString("input");
     prov.residuals = ReadNumberMap(p.GetMap("residuals"));
     prov.uncertainties = ReadNumberMap(p.GetMap("uncertainties"));
-    if (p.Has("target")) prov.target = ReadCalibrationTarget(p.GetMap("target"));
+    // Version 1 has no target: Finish() refuses it there as an unknown key.
+    if (version >= 2 && p.Has("target")) prov.target = ReadCalibrationTarget(p.GetMap("target"));
     p.Finish();
   }
 

@@ -12,7 +12,9 @@
 
 namespace stereorig {
 
-inline constexpr int kRigFileVersion = 1;
+// Written: 2. Read: 1 and 2 (2 adds provenance.target, the board calibrated
+// with; a build that reads only 1 refuses a version 2 file by its version).
+inline constexpr int kRigFileVersion = 2;
 
 // Throws InputError naming the file and key on: a missing file, bad YAML,
 // unknown or missing keys, wrong types, NaN/Inf, non-orthonormal rotations,

@@ -91,6 +91,19 @@ TEST(RigFile, TheCalibrationTargetIsOptionalAndCheckedWhenPresent) {
   const std::string without = RigToYaml(rig);
   ASSERT_EQ(without.find("  target:"), std::string::npos);
   EXPECT_FALSE(ParseRigYaml(without, "old.yaml").provenance().target.has_value());
+  // A version 1 file (before the record) reads; one with a record is not one.
+  ASSERT_NE(without.find("version: 2\n"), std::string::npos);
+  std::string v1 = without;
+  v1.replace(v1.find("version: 2\n"), 11, "version: 1\n");
+  EXPECT_FALSE(ParseRigYaml(v1, "v1.yaml").provenance().target.has_value());
+  std::string v1_with = with;
+  v1_with.replace(v1_with.find("version: 2\n"), 11, "version: 1\n");
+  try {
+    ParseRigYaml(v1_with, "v1.yaml");
+    ADD_FAILURE() << "a version 1 file with provenance.target was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("v1.yaml: provenance.target: unknown key"), std::string::npos) << e.what();
+  }
   ASSERT_TRUE(ParseRigYaml(with, "new.yaml").provenance().target.has_value());
   auto edited = [&](const std::string& from, const std::string& to) {
     const size_t at = with.find(from);
