@@ -148,8 +148,8 @@ int RunCheck(int argc, char** argv) {
   }
   std::fprintf(stderr, "check: %d captures, %zu views; re-estimating board poses\n", detected.num_captures,
                detected.observations.size());
-  const CheckResult result =
-      RunNightlyCheck(rig, target, detected.observations, options, captures, detected.capture_names);
+  CheckResult result = RunNightlyCheck(rig, target, detected.observations, options, captures, detected.capture_names);
+  result.target_note = check_target.note;  // said with a failing closure (the explanation's end)
 
   std::printf("%-44s %10s %10s %6s %8s\n", "figure", "value", "threshold", "pass", "samples");
   nlohmann::json report = {{"rig", rig_path}, {"captures", captures}, {"date_utc", NowUtcIso8601()}};
@@ -181,14 +181,17 @@ int RunCheck(int argc, char** argv) {
     report["board_scale"].push_back({{"module", m.module}, {"scale", m.scale}, {"captures", m.captures}});
   }
   // The board measured with (check_target.h).
-  if (check_target.as_calibrated && target.double_sided())
+  if (check_target.back_from_front_as_calibrated)
     std::printf("target: back_from_front as calibrated (the rig file's), %.4f mm and %.4f deg from the target file's\n",
                 check_target.calibrated_vs_file_mm, check_target.calibrated_vs_file_deg);
-  if (!check_target.note.empty()) std::printf("note: %s\n", check_target.note.c_str());
+  if (!check_target.note.empty()) std::printf("note: %s\n", PrintableText(check_target.note).c_str());
   report["target"] = {{"as_calibrated", check_target.as_calibrated},
                       {"calibrated_with", nullptr},
+                      {"back_from_front_as_calibrated", check_target.back_from_front_as_calibrated},
                       {"calibrated_vs_file_mm", check_target.calibrated_vs_file_mm},
                       {"calibrated_vs_file_deg", check_target.calibrated_vs_file_deg},
+                      {"file_vs_filed_mm", check_target.file_vs_filed_mm},
+                      {"file_vs_filed_deg", check_target.file_vs_filed_deg},
                       {"note", nullptr}};
   if (!check_target.calibrated_with.empty()) report["target"]["calibrated_with"] = check_target.calibrated_with;
   if (!check_target.note.empty()) report["target"]["note"] = check_target.note;

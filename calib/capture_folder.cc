@@ -163,7 +163,9 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
   }
   out.result = Calibrate(input, options);
   // Calibrate records the board (in the rig it built), not its file's name.
-  if (std::optional<CalibrationTarget>& board = out.result.rig.provenance().target) board->file = target_path;
+  // Absolute, so that the check's messages name it from wherever they run.
+  if (std::optional<CalibrationTarget>& board = out.result.rig.provenance().target)
+    board->file = std::filesystem::absolute(target_path).lexically_normal().string();
   return out;
 }
 

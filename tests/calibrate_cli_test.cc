@@ -116,9 +116,9 @@ TEST(CalibrateCli, RenderedCapturesToRigFileAndReport) {
   ASSERT_EQ(rig.num_modules(), 2);
   EXPECT_TRUE(fs::exists(set.dir + "/report.json"));
   // The board it was calibrated with, for the nightly check (its file by
-  // the name given; the sizes are the rendered set's, 11x9 of 9 mm).
+  // its absolute path; the sizes are the rendered set's, 11x9 of 9 mm).
   ASSERT_TRUE(rig.provenance().target.has_value());
-  EXPECT_EQ(rig.provenance().target->file, set.dir + "/target.yaml");
+  EXPECT_EQ(rig.provenance().target->file, fs::absolute(set.dir + "/target.yaml").lexically_normal().string());
   EXPECT_EQ(rig.provenance().target->corners_x, 11);
   EXPECT_EQ(rig.provenance().target->square_size_mm, 9.0);
   const auto points = VolumePoints(set.ref_from_volume, Eigen::Vector3d(75, 75, 50), 500, 3);

@@ -203,6 +203,7 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     const nlohmann::json j = nlohmann::json::parse(f, nullptr, false);
     ASSERT_TRUE(j.is_object()) << old_report;
     EXPECT_EQ(j["target"]["as_calibrated"], false) << j.dump(2);
+    EXPECT_EQ(j["target"]["back_from_front_as_calibrated"], false) << j.dump(2);
     EXPECT_TRUE(j["target"]["calibrated_with"].is_null()) << j.dump(2);
     EXPECT_TRUE(j["target"]["note"].is_string()) << j.dump(2);
     EXPECT_FALSE(j["board_size_note"].is_null()) << j.dump(2);
@@ -365,7 +366,9 @@ TEST(CheckCli, TheReportListsEveryNamedCameraAndModuleAndWhatExplainsEach) {
   // the dataset's own file.
   EXPECT_EQ(lens["target"]["as_calibrated"], true) << lens.dump(2);
   EXPECT_EQ(lens["target"]["calibrated_with"], dir + "/unmoved/target.yaml") << lens.dump(2);
+  EXPECT_EQ(lens["target"]["back_from_front_as_calibrated"], true) << lens.dump(2);
   EXPECT_EQ(lens["target"]["calibrated_vs_file_mm"], 0.0) << lens.dump(2);
+  EXPECT_EQ(lens["target"]["file_vs_filed_mm"], 0.0) << lens.dump(2);
   EXPECT_TRUE(lens["target"]["note"].is_null()) << lens.dump(2);
   const nlohmann::json turned = night("turned", "--bump-camera 2 --bump-rotation-deg 0.05");
   ASSERT_TRUE(turned.is_object());

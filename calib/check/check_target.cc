@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "calib/core/input_error.h"
 #include "calib/core/number_text.h"
@@ -15,9 +16,8 @@ std::string Describe(int corners_x, int corners_y, double square_size_mm, bool d
          NumberText(square_size_mm, 12) + " mm, " + (double_sided ? "double-sided" : "one-sided");
 }
 
-// The same number as a file prints it: equal to 1e-12 of the size (a file
-// written by another tool may print fewer digits than ours).
-bool SameSize(double a, double b) { return std::abs(a - b) <= 1e-12 * std::max(std::abs(a), std::abs(b)); }
+// What %.4f prints as 0, mm or deg: a difference not worth a note.
+constexpr double kUnchangedInPrint = 5e-5;
 
 }  // namespace
 
@@ -26,14 +26,14 @@ CheckTarget TargetForCheck(const Rig& rig, const Target& file_target, const std:
   const std::optional<CalibrationTarget>& rec = rig.provenance().target;
   if (!rec) {
     out.note =
-        "the rig file records no calibration target (a rig file from an older stereorig, or a simulator's truth): "
-        "the modules' closures "
-        "use the target file's back_from_front, which the calibration may have refined (its report's "
-        "back_from_front_change_mm); a calibration by this version records it";
+        "the rig file records no calibration target (it is from an older stereorig): the modules' closures use the "
+        "target file's back_from_front, which the calibration may have refined (its report's "
+        "stage3_system.back_from_front_change_mm); a calibration by this version records it";
     return out;
   }
+  const double square_off = file_target.square_size_mm() / rec->square_size_mm - 1;
   if (rec->corners_x != file_target.corners_x() || rec->corners_y != file_target.corners_y() ||
-      !SameSize(rec->square_size_mm, file_target.square_size_mm()) || rec->double_sided != file_target.double_sided()) {
+      std::abs(square_off) > kSameBoardSquareOff || rec->double_sided != file_target.double_sided()) {
     throw InputError(target_path,
                      "a board of " +
                          Describe(file_target.corners_x(), file_target.corners_y(), file_target.square_size_mm(),
@@ -46,26 +46,59 @@ CheckTarget TargetForCheck(const Rig& rig, const Target& file_target, const std:
   }
   out.as_calibrated = true;
   out.calibrated_with = rec->file;
-  if (!rec->double_sided) return out;  // one face: back_from_front plays no part
+  std::vector<std::string> notes;
   Target::Layout layout = file_target.layout();
-  layout.back_from_front = rec->back_from_front;
-  out.target = Target(layout, target_path);
-  const Pose moved = file_target.back_from_front().Inverse() * rec->back_from_front;
-  out.calibrated_vs_file_deg = moved.AngleDeg();
-  out.calibrated_vs_file_mm =
-      (rec->back_from_front.translation_mm() - file_target.back_from_front().translation_mm()).norm();
-  const Pose refiled = rec->back_from_front_file.Inverse() * file_target.back_from_front();
-  const double refiled_mm =
-      (file_target.back_from_front().translation_mm() - rec->back_from_front_file.translation_mm()).norm();
-  // Printed to 17 digits on both sides, an unchanged file reads back exactly;
-  // these bounds admit another tool's 12 digits.
-  if (refiled_mm > 1e-9 || refiled.AngleDeg() > 1e-9) {
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "%.4f mm and %.4f deg", refiled_mm, refiled.AngleDeg());
-    out.note = std::string("the target file's back_from_front is ") + buf +
-               " from the one the rig was calibrated with (a re-measured plate, or another board of the same "
-               "print): the check uses the calibrated one; if this is another board, calibrate again with it";
+  if (square_off != 0) {  // the same board, its squares re-measured (or printed with more digits)
+    layout.square_size_mm = rec->square_size_mm;
+    if (std::abs(square_off) >= 5e-7)  // a difference 6 printed digits show
+      notes.push_back("the target file's squares are " + NumberText(file_target.square_size_mm(), 12) +
+                      " mm, the rig was calibrated with " + NumberText(rec->square_size_mm, 12) +
+                      " mm: measured with " + NumberText(rec->square_size_mm, 12) +
+                      " mm, on which the rig's scale rests (the file's " + (square_off > 0 ? "+" : "") +
+                      NumberText(100 * square_off, 3) + " %); calibrate again to take the new size");
   }
+  if (rec->double_sided) {
+    // Tonight's file against the one filed at calibration: the same plate
+    // re-measured lands within kSamePlateSigmas of its stated sigma on
+    // every axis (an axis held, sigma 0, must not move); another plate of
+    // the same print need not.
+    const Pose& file = file_target.back_from_front();
+    const Eigen::Vector3d turn_deg =
+        Pose(file.rotation() * rec->back_from_front_file.rotation().transpose(), Eigen::Vector3d::Zero())
+            .RotationVector() *
+        180.0 / M_PI;
+    const Eigen::Vector3d shift_mm = file.translation_mm() - rec->back_from_front_file.translation_mm();
+    out.file_vs_filed_deg = turn_deg.norm();
+    out.file_vs_filed_mm = shift_mm.norm();
+    const Eigen::Matrix<double, 6, 1>& sigma = file_target.back_from_front_sigma();
+    bool same_plate = true;
+    for (int k = 0; k < 6; ++k) {
+      const double off = k < 3 ? turn_deg(k) : shift_mm(k - 3);
+      if (std::abs(off) > std::max(kSamePlateSigmas * sigma(k), kUnchangedInPrint)) same_plate = false;
+    }
+    char moved[96];
+    std::snprintf(moved, sizeof moved, "%.4f mm and %.4f deg", out.file_vs_filed_mm, out.file_vs_filed_deg);
+    if (same_plate) {
+      layout.back_from_front = rec->back_from_front;
+      out.back_from_front_as_calibrated = true;
+      if (out.file_vs_filed_mm >= kUnchangedInPrint || out.file_vs_filed_deg >= kUnchangedInPrint)
+        notes.push_back(std::string("the target file's back_from_front is ") + moved +
+                        " from the one filed when the rig was calibrated, within " + NumberText(kSamePlateSigmas, 2) +
+                        " of its stated sigma: the same plate re-measured; measured with the calibration's estimate");
+    } else {
+      notes.push_back(std::string("the target file's back_from_front is ") + moved +
+                      " from the one filed when the rig was calibrated, beyond " + NumberText(kSamePlateSigmas, 2) +
+                      " of its stated sigma: another plate? measured with the target file's; if it is the plate the "
+                      "rig was calibrated with, its file is wrong");
+    }
+    const Pose used_vs_file = file.Inverse() * layout.back_from_front;
+    out.calibrated_vs_file_deg = out.back_from_front_as_calibrated ? used_vs_file.AngleDeg() : 0.0;
+    out.calibrated_vs_file_mm = out.back_from_front_as_calibrated
+                                    ? (layout.back_from_front.translation_mm() - file.translation_mm()).norm()
+                                    : 0.0;
+  }
+  out.target = Target(layout, target_path);
+  for (size_t k = 0; k < notes.size(); ++k) out.note += (k ? "; " : "") + notes[k];
   return out;
 }
 

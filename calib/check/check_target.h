@@ -20,24 +20,43 @@
 
 namespace stereorig {
 
+// A target file whose squares are within this of the record's is the same
+// board, re-measured: 0.5 %, the board-size reading that names the wrong
+// board (kMaxBoardScaleOff, board_scale.h); a print's scale is good to
+// ~0.1 %. Beyond, another board.
+inline constexpr double kSameBoardSquareOff = 0.005;
+// A target file whose back_from_front is within this many of its stated
+// sigma of the one filed at calibration, on every axis, is the same plate
+// re-measured; beyond, another plate of the same print.
+inline constexpr double kSamePlateSigmas = 3.0;
+
 struct CheckTarget {
   explicit CheckTarget(Target board) : target(std::move(board)) {}
-  Target target;                // the target file's board; back_from_front the calibration's where recorded
-  bool as_calibrated = false;   // false: the rig file records no board (an older rig file); the file's back_from_front
-  std::string calibrated_with;  // the record's target file (as calibrate was given it); empty without a record
-  // The calibration's back_from_front against tonight's target file's: how
-  // far stage 3 moved it (0 without a record or on a one-sided board).
+  Target target;                // the board measured with (below)
+  bool as_calibrated = false;   // false: the rig file records no board (an older rig file): the target file as it is
+  std::string calibrated_with;  // the record's target file (its absolute path); empty without a record
+  // back_from_front is the calibration's (the same plate); false: the target
+  // file's (no record, one side, or another plate).
+  bool back_from_front_as_calibrated = false;
+  // The back_from_front measured with against tonight's target file's: how
+  // far stage 3 moved it (0 when it is the file's).
   double calibrated_vs_file_mm = 0.0;
   double calibrated_vs_file_deg = 0.0;
+  // Tonight's target file's back_from_front against the one filed at
+  // calibration (0 without a record or on a one-sided board).
+  double file_vs_filed_mm = 0.0;
+  double file_vs_filed_deg = 0.0;
   std::string note;  // what the user should know, for stdout and the report; empty when nothing
 };
 
 // Refuses (InputError naming `target_path` and the rig file) a board whose
-// corners, square size or sides differ from the rig file's record: the
-// rig's scale rests on the square size it was calibrated with, and its S on
-// that board's faces. A target file whose back_from_front is not the one
-// calibrated with (a re-measured plate, or another of the same print) is
-// said in the note, not refused: the calibrated one is used either way.
+// corners or sides differ from the rig file's record, or whose squares do
+// by more than kSameBoardSquareOff: the rig's scale rests on the squares it
+// was calibrated with, and its S on that board's faces. The same board's
+// squares re-measured are measured with the record's size (the rig's
+// scale), said in the note. Its plate re-measured (back_from_front within
+// kSamePlateSigmas of the one filed at calibration) is measured with the
+// calibration's estimate; another plate (beyond) with its file's, said.
 CheckTarget TargetForCheck(const Rig& rig, const Target& file_target, const std::string& target_path);
 
 }  // namespace stereorig

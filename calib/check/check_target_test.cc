@@ -42,6 +42,8 @@ TEST(CheckTarget, UsesTheBackFromFrontAsCalibrated) {
   const Rig rig = CalibratedRig();
   const CheckTarget used = TargetForCheck(rig, Board(), "tonight/board.yaml");
   EXPECT_TRUE(used.as_calibrated);
+  EXPECT_TRUE(used.back_from_front_as_calibrated);
+  EXPECT_EQ(used.file_vs_filed_mm, 0.0);
   EXPECT_EQ(used.calibrated_with, "lab/board.yaml");
   EXPECT_EQ(used.target.back_from_front().ToMatrix4(), rig.provenance().target->back_from_front.ToMatrix4());
   EXPECT_NEAR(used.calibrated_vs_file_mm, 0.02, 1e-12);
@@ -64,26 +66,73 @@ TEST(CheckTarget, ARigFileWithoutARecordUsesTheFileAndSaysSo) {
   EXPECT_NE(used.note.find("records no calibration target"), std::string::npos) << used.note;
 }
 
-TEST(CheckTarget, ARefiledBackFromFrontIsSaidNotRefused) {
+// The plate re-measured (0.01 mm, its stated 1 sigma per axis) is the
+// plate calibrated with: measured with the calibration's estimate, said; a
+// change no print shows (1e-6 mm) is not said.
+TEST(CheckTarget, ARemeasuredPlateIsMeasuredAsCalibratedAndSaid) {
   const Rig rig = CalibratedRig();
   const CheckTarget used = TargetForCheck(rig, Board(Eigen::Vector3d(0, 0, 0.01)), "tonight/board.yaml");
   EXPECT_TRUE(used.as_calibrated);
+  EXPECT_TRUE(used.back_from_front_as_calibrated);
   EXPECT_EQ(used.target.back_from_front().ToMatrix4(), rig.provenance().target->back_from_front.ToMatrix4());
-  EXPECT_NE(used.note.find("0.0100 mm"), std::string::npos) << used.note;
-  EXPECT_NE(used.note.find("calibrate again"), std::string::npos) << used.note;
+  EXPECT_NEAR(used.file_vs_filed_mm, 0.01, 1e-12);
+  EXPECT_NE(used.note.find("0.0100 mm and 0.0000 deg from the one filed when the rig was calibrated, within 3"),
+            std::string::npos)
+      << used.note;
+  EXPECT_NE(used.note.find("the same plate re-measured"), std::string::npos) << used.note;
+  const CheckTarget tiny = TargetForCheck(rig, Board(Eigen::Vector3d(1e-6, 0, 0)), "tonight/board.yaml");
+  EXPECT_TRUE(tiny.back_from_front_as_calibrated);
+  EXPECT_TRUE(tiny.note.empty()) << tiny.note;
+}
+
+// Another plate of the same print (0.5 mm thicker, 50 of its stated sigma;
+// a user's walkthrough: measured with the calibration's estimate, every
+// camera and the closure read as changed): measured with its file's, said.
+// Just beyond 3 sigma on one axis (0.031 mm) is another plate too.
+TEST(CheckTarget, AnotherPlateIsMeasuredWithItsFile) {
+  const Rig rig = CalibratedRig();
+  for (const Eigen::Vector3d& t : {Eigen::Vector3d(0, 0, 0.5), Eigen::Vector3d(0.031, 0, 0)}) {
+    const Target file = Board(t);
+    const CheckTarget used = TargetForCheck(rig, file, "tonight/board.yaml");
+    EXPECT_TRUE(used.as_calibrated);
+    EXPECT_FALSE(used.back_from_front_as_calibrated);
+    EXPECT_EQ(used.target.back_from_front().ToMatrix4(), file.back_from_front().ToMatrix4());
+    EXPECT_EQ(used.calibrated_vs_file_mm, 0.0);
+    EXPECT_NEAR(used.file_vs_filed_mm, t.norm(), 1e-12);
+    EXPECT_NE(used.note.find("beyond 3 of its stated sigma: another plate? measured with the target file's"),
+              std::string::npos)
+        << used.note;
+  }
+  // A plate whose sigma says it is held (0) has no room: any change is another plate.
+  Target::Layout held = Board().layout();
+  held.back_from_front_sigma.setZero();
+  held.back_from_front = Pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.001, 0, 0)) * held.back_from_front;
+  EXPECT_FALSE(TargetForCheck(rig, Target(held, "held"), "tonight/board.yaml").back_from_front_as_calibrated);
 }
 
 // Another board is refused, naming both boards, the target file, the rig
-// file and the record's file; the same size printed to 12 digits is not.
+// file and the record's file: other corners, sides, or squares more than
+// 0.5 % off. The same board's squares re-measured (0.01 %) are measured
+// with the record's size, on which the rig's scale rests, and said; a
+// digit more in print (9.000000000001) is not said.
 TEST(CheckTarget, AnotherBoardIsRefused) {
   const Rig rig = CalibratedRig();
-  EXPECT_EQ(Refusal(rig, Board(Eigen::Vector3d::Zero(), 11, 9, 9.000000000001)), "");
+  const CheckTarget printed = TargetForCheck(rig, Board(Eigen::Vector3d::Zero(), 11, 9, 9.000000000001), "t.yaml");
+  EXPECT_EQ(printed.target.square_size_mm(), 9.0);
+  EXPECT_TRUE(printed.note.empty()) << printed.note;
+  const CheckTarget remeasured = TargetForCheck(rig, Board(Eigen::Vector3d::Zero(), 11, 9, 9.0009), "t.yaml");
+  EXPECT_EQ(remeasured.target.square_size_mm(), 9.0);
+  EXPECT_NE(remeasured.note.find("the target file's squares are 9.0009 mm, the rig was calibrated with 9 mm"),
+            std::string::npos)
+      << remeasured.note;
+  EXPECT_EQ(Refusal(rig, Board(Eigen::Vector3d::Zero(), 11, 9, 9.0449)), "");  // 0.499 %
   struct Case {
     Target file;
     const char* says;
   };
   const Case cases[] = {{Board(Eigen::Vector3d::Zero(), 11, 9, 9.18), "11x9 inner corners of 9.18 mm, double-sided"},
-                        {Board(Eigen::Vector3d::Zero(), 11, 9, 9.0001), "11x9 inner corners of 9.0001 mm"},
+                        {Board(Eigen::Vector3d::Zero(), 11, 9, 9.0451), "11x9 inner corners of 9.0451 mm"},
+                        {Board(Eigen::Vector3d::Zero(), 11, 9, 8.9549), "11x9 inner corners of 8.9549 mm"},
                         {Board(Eigen::Vector3d::Zero(), 12, 9, 9.0), "12x9 inner corners of 9 mm"},
                         {Board(Eigen::Vector3d::Zero(), 11, 8, 9.0), "11x8 inner corners of 9 mm"},
                         {PlainTarget(11, 9, 9.0), "11x9 inner corners of 9 mm, one-sided"}};

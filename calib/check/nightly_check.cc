@@ -69,7 +69,8 @@ std::string CheckResult::Explanation() const {
   if (camera_changes.empty() && split_modules.empty() && closure_modules.empty())
     s << "figures exceed their thresholds; ";
   std::string out = s.str();
-  return out.substr(0, out.size() - 2) + board;
+  const std::string target = closure_modules.empty() || target_note.empty() ? "" : "; " + target_note;
+  return out.substr(0, out.size() - 2) + board + target;
 }
 
 namespace {

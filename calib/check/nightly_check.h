@@ -84,6 +84,11 @@ struct CheckResult {
   // explanation (a wrong --target, or every module's cameras changed alike).
   std::vector<ModuleBoardScale> board_scales;
   std::string board_size_note;
+  // What the board measured with says (check_target.h: the rig file records
+  // no board, or the target file's back_from_front is not the one calibrated
+  // with), set by the caller: the end of the explanation when a closure
+  // names modules, which a plate other than the one calibrated with fails.
+  std::string target_note;
   bool ok() const;
   std::string Verdict() const { return ok() ? "ok" : "recalibrate"; }
   std::string Explanation() const;  // one line: what changed, in no more words than the figures support

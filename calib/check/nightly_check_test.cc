@@ -435,9 +435,13 @@ TEST(NightlyCheck, ExplanationSaysNoMoreThanTheFiguresTell) {
   r.closure_which_unknown = true;
   EXPECT_EQ(r.Explanation(), "module 0 and module 1 disagree: one moved or a lens changed");
   EXPECT_EQ(r.FlaggedModules(), (std::vector<int>{0, 1}));
+  // What the board measured with says ends a failing closure's explanation
+  // (a plate other than the one calibrated with fails it), and nothing else.
+  r.target_note = "the target file's back_from_front is 1.0000 mm and 0.0000 deg from the one ...";
+  EXPECT_EQ(r.Explanation(), "module 0 and module 1 disagree: one moved or a lens changed; " + r.target_note);
   r.closure_modules = {2};  // three or more: the module in the most failing pairs
   r.closure_which_unknown = false;
-  EXPECT_EQ(r.Explanation(), "module 2 moved or a lens changed");
+  EXPECT_EQ(r.Explanation(), "module 2 moved or a lens changed; " + r.target_note);
   r.closure_modules.clear();
   r.split_modules = {1};
   EXPECT_EQ(r.Explanation(), "module 1's cameras disagree: one moved or its lens changed");
@@ -465,6 +469,9 @@ TEST(NightlyCheck, ExplanationSaysNoMoreThanTheFiguresTell) {
   EXPECT_EQ(r.Explanation(), "camera 2 changed: too few corners (4) to fit a new pose or a new lens");
   r.camera_changes[0].kind = CameraChangeKind::kMoved;
   EXPECT_EQ(r.Explanation(), "camera 2 moved");
+  r.figures[0].pass = true;  // and not on a night that passes
+  r.camera_changes.clear();
+  EXPECT_EQ(r.Explanation(), "every figure within its threshold");
 }
 
 // Which modules failing closures name, from each module's count of failing

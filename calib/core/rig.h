@@ -30,7 +30,7 @@ struct StereoModule {
 // refines the target file's back_from_front under the file's stated sigma
 // jointly with S, so S holds with that estimate, not with the file's.
 struct CalibrationTarget {
-  std::string file;             // the target file as calibrate was given it
+  std::string file;             // the target file calibrate was given, its absolute path (empty if none)
   int corners_x = 0;            // inner corners along a row
   int corners_y = 0;            // inner corners along a column
   double square_size_mm = 0.0;  // printed square edge

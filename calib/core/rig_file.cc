@@ -93,8 +93,11 @@ Rig ParseRig(YamlMap root) {
     prov.input = p.GetString("input");
     prov.residuals = ReadNumberMap(p.GetMap("residuals"));
     prov.uncertainties = ReadNumberMap(p.GetMap("uncertainties"));
-    // Version 1 has no target: Finish() refuses it there as an unknown key.
-    if (version >= 2 && p.Has("target")) prov.target = ReadCalibrationTarget(p.GetMap("target"));
+    if (p.Has("target")) {
+      if (version < 2)
+        throw InputError(p.Where("target"), "is not in a version 1 rig file (version 2 added it): set version: 2");
+      prov.target = ReadCalibrationTarget(p.GetMap("target"));
+    }
     p.Finish();
   }
 
