@@ -15,6 +15,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/capture_image_name.h"
 #include "calib/core/input_error.h"
+#include "calib/core/number_text.h"
 #include "calib/core/rig_file.h"
 #include "targets/target_file.h"
 
@@ -149,7 +150,7 @@ int RunCheck(int argc, char** argv) {
   std::fprintf(stderr, "check: %d captures, %zu views; re-estimating board poses\n", detected.num_captures,
                detected.observations.size());
   CheckResult result = RunNightlyCheck(rig, target, detected.observations, options, captures, detected.capture_names);
-  result.target_note = check_target.note;  // said with a failing closure (the explanation's end)
+  result.target_note = check_target.note;  // said with a failing night (the explanation's end)
 
   std::printf("%-44s %10s %10s %6s %8s\n", "figure", "value", "threshold", "pass", "samples");
   nlohmann::json report = {{"rig", rig_path}, {"captures", captures}, {"date_utc", NowUtcIso8601()}};
@@ -172,12 +173,13 @@ int RunCheck(int argc, char** argv) {
     report["views_set_aside"].push_back(
         {{"capture", capture}, {"camera", v.camera}, {"jump_rms_px", v.jump_rms_px}, {"bound_px", v.bound_px}});
   }
-  // The board's size as each module measures it, over the target file's
-  // (board_scale.h): a wrong --target reads off alike on every module.
+  // The board's size as each module measures it, over the squares measured
+  // with (the target file's, or the record's where it re-measured them;
+  // board_scale.h): a wrong --target reads off alike on every module.
   report["board_scale"] = nlohmann::json::array();
   for (const ModuleBoardScale& m : result.board_scales) {
-    std::printf("board size: module %d measures it %+.3f%% against the target file (median of %d captures)\n", m.module,
-                100 * (m.scale - 1), m.captures);
+    std::printf("board size: module %d measures it %+.3f%% against squares of %s mm (median of %d captures)\n",
+                m.module, 100 * (m.scale - 1), NumberText(target.square_size_mm(), 12).c_str(), m.captures);
     report["board_scale"].push_back({{"module", m.module}, {"scale", m.scale}, {"captures", m.captures}});
   }
   // The board measured with (check_target.h).

@@ -276,6 +276,7 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
     t.square_size_mm = in.target.square_size_mm;
     t.double_sided = in.target.double_sided;
     t.back_from_front_file = in.target.back_from_front;
+    t.back_from_front_sigma_file = in.target.back_from_front_sigma;
     t.back_from_front = M > 1 ? rep.system.back_from_front : in.target.back_from_front;
   }
   // Keys as docs/formats.md fixes them (stereorig check reads them).

@@ -87,9 +87,9 @@ Rig WriteStoredRig(const std::string& truth_path, double rms_px, const std::stri
   for (int c = 0; c < rig.num_cameras(); ++c)
     rig.provenance().residuals["cam" + std::to_string(c) + "_rms_px"] = rms_px;
   const Target board = ReadTargetFile(target_path);
-  rig.provenance().target =
-      CalibrationTarget{target_path,          board.corners_x(),       board.corners_y(),      board.square_size_mm(),
-                        board.double_sided(), board.back_from_front(), board.back_from_front()};
+  rig.provenance().target = CalibrationTarget{
+      target_path,          board.corners_x(),       board.corners_y(),       board.square_size_mm(),
+      board.double_sided(), board.back_from_front(), board.back_from_front(), board.back_from_front_sigma()};
   WriteRigFile(rig, out_path);
   return rig;
 }
@@ -188,6 +188,17 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
                        "/rig.yaml was calibrated with one of 11x9 inner corners of 9 mm, double-sided",
                    "another board");
     EXPECT_EQ(Lines(r.err), 1) << r.err;
+    // Another plate (0.5 mm thicker): refused too, in one line.
+    std::string plate = text.str();
+    const size_t tz = plate.find("[0, 0, -1, 5]");
+    ASSERT_NE(tz, std::string::npos) << plate;
+    plate.replace(tz, 13, "[0, 0, -1, 5.5]");
+    std::ofstream(dir + "/other_plate.yaml") << plate;
+    const Result p = RunCli("check --rig " + dir + "/rig.yaml --captures " + dir + "/ds --target " + dir +
+                            "/other_plate.yaml --history-db " + db + " --report " + report);
+    expect_refused(p, dir + "/other_plate.yaml: its back_from_front is 0.5000 mm and 0.0000 deg from the one filed",
+                   "another plate");
+    EXPECT_EQ(Lines(p.err), 1) << p.err;
     // A rig file without the record (an older stereorig's) cannot tell: the
     // night is judged (the board's size said, docs/verify-and-check.md), with
     // the target file's back_from_front, and a note says so. Its own history.

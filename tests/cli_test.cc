@@ -108,7 +108,8 @@ TEST(Cli, GoodRigFileIsAccepted) {
       9,
       true,
       stereorig::Pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0.003, 0.004)) * file_pose,
-      file_pose};
+      file_pose,
+      Eigen::Matrix<double, 6, 1>::Constant(0.01)};
   std::ofstream(path) << stereorig::RigToYaml(rig);
   const Result recorded = RunCli("rig --rig " + path);
   EXPECT_EQ(recorded.code, 0) << recorded.err;

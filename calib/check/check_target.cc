@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <utility>
 #include <vector>
 
 #include "calib/core/input_error.h"
@@ -58,44 +60,59 @@ CheckTarget TargetForCheck(const Rig& rig, const Target& file_target, const std:
                       NumberText(100 * square_off, 3) + " %); calibrate again to take the new size");
   }
   if (rec->double_sided) {
-    // Tonight's file against the one filed at calibration: the same plate
-    // re-measured lands within kSamePlateSigmas of its stated sigma on
-    // every axis (an axis held, sigma 0, must not move); another plate of
-    // the same print need not.
+    // Tonight's file against the one filed at calibration: two
+    // measurements of one plate differ per axis with sigma^2 the sum of the
+    // two files' (the rotation vector of R_file R_filed^T in deg, as stage 3
+    // perturbs it, then the translation in mm). An axis whose sigma is 0 in
+    // both is held: it must not move. Where the squares were re-measured,
+    // the file's translation is read both as written and at the record's
+    // square size (the back face's offset scales with the print; a user may
+    // have updated it or not), and the nearer taken.
     const Pose& file = file_target.back_from_front();
     const Eigen::Vector3d turn_deg =
         Pose(file.rotation() * rec->back_from_front_file.rotation().transpose(), Eigen::Vector3d::Zero())
             .RotationVector() *
         180.0 / M_PI;
-    const Eigen::Vector3d shift_mm = file.translation_mm() - rec->back_from_front_file.translation_mm();
-    out.file_vs_filed_deg = turn_deg.norm();
-    out.file_vs_filed_mm = shift_mm.norm();
-    const Eigen::Matrix<double, 6, 1>& sigma = file_target.back_from_front_sigma();
-    bool same_plate = true;
-    for (int k = 0; k < 6; ++k) {
-      const double off = k < 3 ? turn_deg(k) : shift_mm(k - 3);
-      if (std::abs(off) > std::max(kSamePlateSigmas * sigma(k), kUnchangedInPrint)) same_plate = false;
+    double chi_square = std::numeric_limits<double>::infinity();
+    bool held_axis_moved = true;
+    for (const double scale : {1.0, rec->square_size_mm / file_target.square_size_mm()}) {
+      const Eigen::Vector3d shift_mm = file.translation_mm() * scale - rec->back_from_front_file.translation_mm();
+      double chi = 0;
+      bool held_moved = false;
+      for (int k = 0; k < 6; ++k) {
+        const double off = k < 3 ? turn_deg(k) : shift_mm(k - 3);
+        const double s2 =
+            std::pow(file_target.back_from_front_sigma()(k), 2) + std::pow(rec->back_from_front_sigma_file(k), 2);
+        if (s2 > 0)
+          chi += off * off / s2;
+        else if (std::abs(off) >= kUnchangedInPrint)
+          held_moved = true;
+      }
+      if (std::make_pair(held_moved, chi) < std::make_pair(held_axis_moved, chi_square)) {
+        held_axis_moved = held_moved;
+        chi_square = chi;
+        out.file_vs_filed_mm = shift_mm.norm();
+      }
     }
+    out.file_vs_filed_deg = turn_deg.norm();
     char moved[96];
     std::snprintf(moved, sizeof moved, "%.4f mm and %.4f deg", out.file_vs_filed_mm, out.file_vs_filed_deg);
-    if (same_plate) {
-      layout.back_from_front = rec->back_from_front;
-      out.back_from_front_as_calibrated = true;
-      if (out.file_vs_filed_mm >= kUnchangedInPrint || out.file_vs_filed_deg >= kUnchangedInPrint)
-        notes.push_back(std::string("the target file's back_from_front is ") + moved +
-                        " from the one filed when the rig was calibrated, within " + NumberText(kSamePlateSigmas, 2) +
-                        " of its stated sigma: the same plate re-measured; measured with the calibration's estimate");
-    } else {
-      notes.push_back(std::string("the target file's back_from_front is ") + moved +
-                      " from the one filed when the rig was calibrated, beyond " + NumberText(kSamePlateSigmas, 2) +
-                      " of its stated sigma: another plate? measured with the target file's; if it is the plate the "
-                      "rig was calibrated with, its file is wrong");
+    if (chi_square > kSamePlateChiSquare || held_axis_moved) {
+      throw InputError(target_path,
+                       std::string("its back_from_front is ") + moved + " from the one filed when " + rig.Where() +
+                           " was calibrated (from " + (rec->file.empty() ? "no file" : rec->file) +
+                           "), more than two measurements of one plate differ by (their stated sigma): another "
+                           "plate, or not this plate's file; the check's figures rest on the plate calibrated "
+                           "with: check with that plate and its file, or calibrate again with this one");
     }
-    const Pose used_vs_file = file.Inverse() * layout.back_from_front;
-    out.calibrated_vs_file_deg = out.back_from_front_as_calibrated ? used_vs_file.AngleDeg() : 0.0;
-    out.calibrated_vs_file_mm = out.back_from_front_as_calibrated
-                                    ? (layout.back_from_front.translation_mm() - file.translation_mm()).norm()
-                                    : 0.0;
+    layout.back_from_front = rec->back_from_front;
+    out.back_from_front_as_calibrated = true;
+    if (out.file_vs_filed_mm >= kUnchangedInPrint || out.file_vs_filed_deg >= kUnchangedInPrint)
+      notes.push_back(std::string("the target file's back_from_front is ") + moved +
+                      " from the one filed when the rig was calibrated, as two measurements of one plate may "
+                      "differ: measured with the calibration's estimate");
+    out.calibrated_vs_file_deg = (file.Inverse() * rec->back_from_front).AngleDeg();
+    out.calibrated_vs_file_mm = (rec->back_from_front.translation_mm() - file.translation_mm()).norm();
   }
   out.target = Target(layout, target_path);
   for (size_t k = 0; k < notes.size(); ++k) out.note += (k ? "; " : "") + notes[k];

@@ -25,10 +25,13 @@ namespace stereorig {
 // board (kMaxBoardScaleOff, board_scale.h); a print's scale is good to
 // ~0.1 %. Beyond, another board.
 inline constexpr double kSameBoardSquareOff = 0.005;
-// A target file whose back_from_front is within this many of its stated
-// sigma of the one filed at calibration, on every axis, is the same plate
-// re-measured; beyond, another plate of the same print.
-inline constexpr double kSamePlateSigmas = 3.0;
+// A target file whose back_from_front differs from the one filed at
+// calibration by no more than this chi-square (6 axes, each over the two
+// files' sigmas combined) is the same plate: the 99.73 % quantile of
+// chi-square with 6 degrees of freedom (3 sigma's two-sided coverage), so
+// 3 of 1000 honest re-measurements are taken for another plate. Beyond,
+// another plate (or not the plate's file): refused.
+inline constexpr double kSamePlateChiSquare = 20.06;
 
 struct CheckTarget {
   explicit CheckTarget(Target board) : target(std::move(board)) {}
@@ -36,14 +39,15 @@ struct CheckTarget {
   bool as_calibrated = false;   // false: the rig file records no board (an older rig file): the target file as it is
   std::string calibrated_with;  // the record's target file (its absolute path); empty without a record
   // back_from_front is the calibration's (the same plate); false: the target
-  // file's (no record, one side, or another plate).
+  // file's (no record, or one side).
   bool back_from_front_as_calibrated = false;
   // The back_from_front measured with against tonight's target file's: how
   // far stage 3 moved it (0 when it is the file's).
   double calibrated_vs_file_mm = 0.0;
   double calibrated_vs_file_deg = 0.0;
-  // Tonight's target file's back_from_front against the one filed at
-  // calibration (0 without a record or on a one-sided board).
+  // Tonight's target file's back_from_front (its translation at the
+  // record's square size) against the one filed at calibration (0 without a
+  // record or on a one-sided board).
   double file_vs_filed_mm = 0.0;
   double file_vs_filed_deg = 0.0;
   std::string note;  // what the user should know, for stdout and the report; empty when nothing
@@ -52,11 +56,13 @@ struct CheckTarget {
 // Refuses (InputError naming `target_path` and the rig file) a board whose
 // corners or sides differ from the rig file's record, or whose squares do
 // by more than kSameBoardSquareOff: the rig's scale rests on the squares it
-// was calibrated with, and its S on that board's faces. The same board's
-// squares re-measured are measured with the record's size (the rig's
-// scale), said in the note. Its plate re-measured (back_from_front within
-// kSamePlateSigmas of the one filed at calibration) is measured with the
-// calibration's estimate; another plate (beyond) with its file's, said.
+// was calibrated with, and its S on that board's faces; and a plate whose
+// back_from_front differs from the one filed at calibration beyond
+// kSamePlateChiSquare: the check's thresholds (a few um) are finer than a
+// plate's file (0.01 mm), and the calibration's estimate is of its own
+// plate. The same board's squares re-measured are measured with the
+// record's size (the rig's scale); its plate re-measured with the
+// calibration's estimate; each said in the note.
 CheckTarget TargetForCheck(const Rig& rig, const Target& file_target, const std::string& target_path);
 
 }  // namespace stereorig

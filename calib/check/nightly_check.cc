@@ -69,8 +69,7 @@ std::string CheckResult::Explanation() const {
   if (camera_changes.empty() && split_modules.empty() && closure_modules.empty())
     s << "figures exceed their thresholds; ";
   std::string out = s.str();
-  const std::string target = closure_modules.empty() || target_note.empty() ? "" : "; " + target_note;
-  return out.substr(0, out.size() - 2) + board + target;
+  return out.substr(0, out.size() - 2) + board + (target_note.empty() ? "" : "; " + target_note);
 }
 
 namespace {

@@ -85,9 +85,9 @@ struct CheckResult {
   std::vector<ModuleBoardScale> board_scales;
   std::string board_size_note;
   // What the board measured with says (check_target.h: the rig file records
-  // no board, or the target file's back_from_front is not the one calibrated
-  // with), set by the caller: the end of the explanation when a closure
-  // names modules, which a plate other than the one calibrated with fails.
+  // no board, or the target file was re-measured), set by the caller: the
+  // end of a failing night's explanation (a file off its plate fails the
+  // cameras' consistency and the closures alike).
   std::string target_note;
   bool ok() const;
   std::string Verdict() const { return ok() ? "ok" : "recalibrate"; }

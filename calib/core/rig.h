@@ -37,6 +37,8 @@ struct CalibrationTarget {
   bool double_sided = false;
   Pose back_from_front;       // as calibrated: stage 3's estimate (the file's where it was held, or one module)
   Pose back_from_front_file;  // as the target file gave it
+  // The file's 1-sigma of back_from_front_file: [rx, ry, rz] deg, [tx, ty, tz] mm.
+  Eigen::Matrix<double, 6, 1> back_from_front_sigma_file = Eigen::Matrix<double, 6, 1>::Zero();
 };
 
 // Where a rig came from. The same structure serves a calibration result and

@@ -68,6 +68,12 @@ CalibrationTarget ReadCalibrationTarget(YamlMap t) {
   out.double_sided = t.GetBool("double_sided");
   out.back_from_front = ReadRigidPose(t.GetNode("back_from_front"), t.Where("back_from_front"));
   out.back_from_front_file = ReadRigidPose(t.GetNode("back_from_front_file"), t.Where("back_from_front_file"));
+  const std::vector<double> sigma = t.GetDoubles("back_from_front_sigma_file", 6);
+  for (int k = 0; k < 6; ++k) {
+    if (!(sigma[k] >= 0))
+      throw InputError(t.Where("back_from_front_sigma_file"), "must be >= 0, got " + NumberText(sigma[k], 6));
+    out.back_from_front_sigma_file(k) = sigma[k];
+  }
   t.Finish();
   return out;
 }
@@ -190,7 +196,10 @@ std::string RigToYaml(const Rig& rig) {
       << "    double_sided: " << (t.double_sided ? "true" : "false") << "\n"
       << "    back_from_front: " << Matrix4ToYaml(t.back_from_front.ToMatrix4()) << "  # as calibrated (stage 3)\n"
       << "    back_from_front_file: " << Matrix4ToYaml(t.back_from_front_file.ToMatrix4())
-      << "  # as the target file gave it\n";
+      << "  # as the target file gave it\n"
+      << "    back_from_front_sigma_file: [";
+    for (int k = 0; k < 6; ++k) o << (k ? ", " : "") << FormatDouble(t.back_from_front_sigma_file(k));
+    o << "]  # its 1-sigma: rx, ry, rz (deg), tx, ty, tz (mm)\n";
   }
   o << "cameras:\n";
   for (int i = 0; i < rig.num_cameras(); ++i) {

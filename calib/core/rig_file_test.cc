@@ -47,6 +47,7 @@ Rig MakeRandomRig(unsigned seed) {
     t.back_from_front_file = Pose::FromRotationVector({0, M_PI, 0}, {90, 0, 5});
     t.back_from_front = Pose::FromRotationVector({1e-4 * u(rng), M_PI + 1e-4 * u(rng), 1e-4 * u(rng)},
                                                  {90 + 0.01 * u(rng), 0.01 * u(rng), 5 + 0.01 * u(rng)});
+    for (int k = 0; k < 6; ++k) t.back_from_front_sigma_file(k) = 0.01 + 1e-3 * u(rng);
     rig.provenance().target = t;
   }
   return rig;
@@ -76,6 +77,7 @@ TEST(RigFile, WriteReadWriteIsBitIdentical) {
       EXPECT_EQ(b.double_sided, t->double_sided);
       EXPECT_EQ(b.back_from_front.ToMatrix4(), t->back_from_front.ToMatrix4());
       EXPECT_EQ(b.back_from_front_file.ToMatrix4(), t->back_from_front_file.ToMatrix4());
+      EXPECT_EQ(b.back_from_front_sigma_file, t->back_from_front_sigma_file);
     }
   }
 }
@@ -124,11 +126,12 @@ TEST(RigFile, TheCalibrationTargetIsOptionalAndCheckedWhenPresent) {
       {"    double_sided: true\n", "    double_sided: maybe\n"},
       {"    back_from_front: [[", "    back_from_front: [[2, "},
       {"    file: ", "    colour: \"red\"\n    file: "},
+      {"    back_from_front_sigma_file: [", "    back_from_front_sigma_file: [-1, "},
   };
   const char* key[] = {"provenance.target.corners_x",      "provenance.target.corners_y",
                        "provenance.target.square_size_mm", "provenance.target.square_size_mm",
                        "provenance.target.double_sided",   "provenance.target.back_from_front",
-                       "provenance.target.colour"};
+                       "provenance.target.colour",         "provenance.target.back_from_front_sigma_file"};
   for (size_t i = 0; i < std::size(bad); ++i) {
     try {
       ParseRigYaml(edited(bad[i].first, bad[i].second), "rig.yaml");
