@@ -65,45 +65,70 @@ CheckTarget TargetForCheck(const Rig& rig, const Target& file_target, const std:
     // two files' (the rotation vector of R_file R_filed^T in deg, as stage 3
     // perturbs it, then the translation in mm). An axis whose sigma is 0 in
     // both is held: it must not move. Where the squares were re-measured,
-    // the file's translation is read both as written and at the record's
-    // square size (the back face's offset scales with the print; a user may
-    // have updated it or not), and the nearer taken.
+    // the file's in-plane offset (tx, ty) is read both as written and at the
+    // record's square size (it scales with the print, the plate's thickness
+    // tz does not; a user may have updated it or not), the nearer taken.
+    static const char* const kAxis[6] = {"rx", "ry", "rz", "tx", "ty", "tz"};
     const Pose& file = file_target.back_from_front();
     const Eigen::Vector3d turn_deg =
         Pose(file.rotation() * rec->back_from_front_file.rotation().transpose(), Eigen::Vector3d::Zero())
             .RotationVector() *
         180.0 / M_PI;
-    double chi_square = std::numeric_limits<double>::infinity();
-    bool held_axis_moved = true;
+    struct Reading {
+      double chi_square = 0;
+      int held_moved = -1;  // an axis both files hold that moved, or -1
+      int worst = 0;        // the axis adding most to chi_square
+      double worst_off = 0, worst_sigma = 0;
+      Eigen::Vector3d shift_mm = Eigen::Vector3d::Zero();
+    };
+    Reading best;
+    best.chi_square = std::numeric_limits<double>::infinity();
+    best.held_moved = 0;
     for (const double scale : {1.0, rec->square_size_mm / file_target.square_size_mm()}) {
-      const Eigen::Vector3d shift_mm = file.translation_mm() * scale - rec->back_from_front_file.translation_mm();
-      double chi = 0;
-      bool held_moved = false;
+      Reading r;
+      r.shift_mm = file.translation_mm() - rec->back_from_front_file.translation_mm();
+      r.shift_mm.head<2>() =
+          file.translation_mm().head<2>() * scale - rec->back_from_front_file.translation_mm().head<2>();
+      double worst_chi = -1;
       for (int k = 0; k < 6; ++k) {
-        const double off = k < 3 ? turn_deg(k) : shift_mm(k - 3);
+        const double off = k < 3 ? turn_deg(k) : r.shift_mm(k - 3);
         const double s2 =
             std::pow(file_target.back_from_front_sigma()(k), 2) + std::pow(rec->back_from_front_sigma_file(k), 2);
-        if (s2 > 0)
-          chi += off * off / s2;
-        else if (std::abs(off) >= kUnchangedInPrint)
-          held_moved = true;
+        if (s2 == 0) {
+          if (std::abs(off) >= kUnchangedInPrint && r.held_moved < 0) r.held_moved = k;
+          continue;
+        }
+        r.chi_square += off * off / s2;
+        if (off * off / s2 > worst_chi) {
+          worst_chi = off * off / s2;
+          r.worst = k;
+          r.worst_off = off;
+          r.worst_sigma = std::sqrt(s2);
+        }
       }
-      if (std::make_pair(held_moved, chi) < std::make_pair(held_axis_moved, chi_square)) {
-        held_axis_moved = held_moved;
-        chi_square = chi;
-        out.file_vs_filed_mm = shift_mm.norm();
-      }
+      if (std::make_pair(r.held_moved >= 0, r.chi_square) < std::make_pair(best.held_moved >= 0, best.chi_square))
+        best = r;
     }
+    out.file_vs_filed_mm = best.shift_mm.norm();
     out.file_vs_filed_deg = turn_deg.norm();
     char moved[96];
     std::snprintf(moved, sizeof moved, "%.4f mm and %.4f deg", out.file_vs_filed_mm, out.file_vs_filed_deg);
-    if (chi_square > kSamePlateChiSquare || held_axis_moved) {
-      throw InputError(target_path,
-                       std::string("its back_from_front is ") + moved + " from the one filed when " + rig.Where() +
-                           " was calibrated (from " + (rec->file.empty() ? "no file" : rec->file) +
-                           "), more than two measurements of one plate differ by (their stated sigma): another "
-                           "plate, or not this plate's file; the check's figures rest on the plate calibrated "
-                           "with: check with that plate and its file, or calibrate again with this one");
+    if (best.chi_square > kSamePlateChiSquare || best.held_moved >= 0) {
+      char why[200];
+      const char* unit = best.worst < 3 ? "deg" : "mm";
+      if (best.held_moved >= 0)
+        std::snprintf(why, sizeof why, "its %s moved, which both files hold (sigma 0)", kAxis[best.held_moved]);
+      else
+        std::snprintf(why, sizeof why,
+                      "chi-square %.1f over both files' sigmas, above %.2f, which two measurements of one plate "
+                      "exceed 3 times in 1000 (most on %s: %+.4f %s against a sigma of %.4f)",
+                      best.chi_square, kSamePlateChiSquare, kAxis[best.worst], best.worst_off, unit, best.worst_sigma);
+      throw InputError(target_path, std::string("its back_from_front is ") + moved + " from the one filed when " +
+                                        rig.Where() + " was calibrated (from " +
+                                        (rec->file.empty() ? "no file" : rec->file) + "): " + why +
+                                        ": another plate, or not this plate's file; the check's figures rest on "
+                                        "the plate calibrated with: check with that plate and its file, or "
+                                        "calibrate again with this one");
     }
     layout.back_from_front = rec->back_from_front;
     out.back_from_front_as_calibrated = true;

@@ -41,13 +41,13 @@ struct CheckTarget {
   // back_from_front is the calibration's (the same plate); false: the target
   // file's (no record, or one side).
   bool back_from_front_as_calibrated = false;
-  // The back_from_front measured with against tonight's target file's: how
-  // far stage 3 moved it (0 when it is the file's).
+  // The back_from_front measured with against tonight's target file's as
+  // written: how far stage 3 moved it (0 when it is the file's).
   double calibrated_vs_file_mm = 0.0;
   double calibrated_vs_file_deg = 0.0;
-  // Tonight's target file's back_from_front (its translation at the
-  // record's square size) against the one filed at calibration (0 without a
-  // record or on a one-sided board).
+  // Tonight's target file's back_from_front (its in-plane offset as written
+  // or at the record's square size, the nearer) against the one filed at
+  // calibration (0 without a record or on a one-sided board).
   double file_vs_filed_mm = 0.0;
   double file_vs_filed_deg = 0.0;
   std::string note;  // what the user should know, for stdout and the report; empty when nothing
