@@ -4,12 +4,14 @@
 // Stage 3 of the calibration refines the target file's back_from_front (the
 // plate's thickness and the faces' register) under the file's stated sigma,
 // jointly with S, so S holds with that estimate and not with the file's. A
-// module pair's closure composes S with back_from_front; measured with the
-// file's, a board whose file is off by its own stated 1 sigma (0.01 mm per
-// axis, the default's) read 0.019 mm against a threshold of 0.015 mm on an
-// unmoved rig: "recalibrate" every night, the alarm nobody believes. The rig
-// file records the board as calibrated (provenance.target, calib/core/rig.h),
-// and the check uses that record.
+// module pair's closure and the cameras' consistency compose S with
+// back_from_front; measured with the file's, a board whose file is off by
+// its own stated 1 sigma (0.01 mm per axis, the default's) read 0.019 mm
+// against a threshold of 0.015 mm on an unmoved rig: "recalibrate" every
+// night, the alarm nobody believes. The rig file records the board as
+// calibrated (provenance.target, calib/core/rig.h), and the check measures
+// with that record while tonight's file is the same board and plate, and
+// refuses another (TargetForCheck, below).
 #pragma once
 
 #include <string>
