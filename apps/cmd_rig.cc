@@ -41,12 +41,10 @@ void PrintRigSummary(const Rig& rig, FILE* out) {
     std::fprintf(out, "  calibrated with: %dx%d inner corners of %s mm, %s (target file %s)\n", t->corners_x,
                  t->corners_y, NumberText(t->square_size_mm, 12).c_str(),
                  t->double_sided ? "double-sided" : "one-sided", PrintableText(t->file).c_str());
-    if (t->double_sided) {
-      const Pose moved = t->back_from_front_file.Inverse() * t->back_from_front;
+    if (t->double_sided)
       std::fprintf(out, "  back_from_front as calibrated: %.4f mm, %.4f deg from the target file's\n",
-                   (t->back_from_front.translation_mm() - t->back_from_front_file.translation_mm()).norm(),
-                   moved.AngleDeg());
-    }
+                   TranslationBetweenMm(t->back_from_front_file, t->back_from_front),
+                   AngleBetweenDeg(t->back_from_front_file, t->back_from_front));
   } else {
     std::fprintf(out,
                  "  calibration target: not recorded (a simulator's truth, or a rig file from an older stereorig)\n");

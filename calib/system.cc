@@ -363,10 +363,8 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
     }
   }
   rep.back_from_front = bff_block.ToPose();
-  const Pose change = target.back_from_front.Inverse() * rep.back_from_front;
-  rep.back_from_front_change_deg = change.AngleDeg();
-  rep.back_from_front_change_mm =
-      (rep.back_from_front.translation_mm() - target.back_from_front.translation_mm()).norm();
+  rep.back_from_front_change_deg = AngleBetweenDeg(target.back_from_front, rep.back_from_front);
+  rep.back_from_front_change_mm = TranslationBetweenMm(target.back_from_front, rep.back_from_front);
 
   // 1 sigma of S[0][k], of each free right_from_left and of each camera's
   // free intrinsics, from the covariance of the adjustment, scaled by the

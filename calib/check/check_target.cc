@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <limits>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -28,11 +28,12 @@ CheckTarget TargetForCheck(const Rig& rig, const Target& file_target, const std:
   const std::optional<CalibrationTarget>& rec = rig.provenance().target;
   if (!rec) {
     out.note =
-        "the rig file records no calibration target (it is from an older stereorig): the modules' closures use the "
+        "the rig file records no calibration target (it is from an older stereorig): the check uses the "
         "target file's back_from_front, which the calibration may have refined (its report's "
         "stage3_system.back_from_front_change_mm); a calibration by this version records it";
     return out;
   }
+  const std::string recorded_file = rec->file.empty() ? "no file" : rec->file;
   const double square_off = file_target.square_size_mm() / rec->square_size_mm - 1;
   if (rec->corners_x != file_target.corners_x() || rec->corners_y != file_target.corners_y() ||
       std::abs(square_off) > kSameBoardSquareOff || rec->double_sided != file_target.double_sided()) {
@@ -42,7 +43,7 @@ CheckTarget TargetForCheck(const Rig& rig, const Target& file_target, const std:
                                   file_target.double_sided()) +
                          ", but " + rig.Where() + " was calibrated with one of " +
                          Describe(rec->corners_x, rec->corners_y, rec->square_size_mm, rec->double_sided) +
-                         " (its provenance.target, from " + (rec->file.empty() ? "no file" : rec->file) +
+                         " (its provenance.target, from " + recorded_file +
                          "): the rig's scale rests on that board's squares and its S on that board's faces; check "
                          "with its target file, or calibrate again with this board");
   }
@@ -81,9 +82,7 @@ CheckTarget TargetForCheck(const Rig& rig, const Target& file_target, const std:
       double worst_off = 0, worst_sigma = 0;
       Eigen::Vector3d shift_mm = Eigen::Vector3d::Zero();
     };
-    Reading best;
-    best.chi_square = std::numeric_limits<double>::infinity();
-    best.held_moved = 0;
+    std::optional<Reading> nearer;  // of the two readings below
     for (const double scale : {1.0, rec->square_size_mm / file_target.square_size_mm()}) {
       Reading r;
       r.shift_mm = file.translation_mm() - rec->back_from_front_file.translation_mm();
@@ -106,9 +105,11 @@ CheckTarget TargetForCheck(const Rig& rig, const Target& file_target, const std:
           r.worst_sigma = std::sqrt(s2);
         }
       }
-      if (std::make_pair(r.held_moved >= 0, r.chi_square) < std::make_pair(best.held_moved >= 0, best.chi_square))
-        best = r;
+      if (!nearer ||
+          std::make_pair(r.held_moved >= 0, r.chi_square) < std::make_pair(nearer->held_moved >= 0, nearer->chi_square))
+        nearer = r;
     }
+    const Reading& best = *nearer;
     out.file_vs_filed_mm = best.shift_mm.norm();
     out.file_vs_filed_deg = turn_deg.norm();
     char moved[96];
@@ -124,8 +125,7 @@ CheckTarget TargetForCheck(const Rig& rig, const Target& file_target, const std:
                       "exceed 3 times in 1000 (most on %s: %+.4f %s against a sigma of %.4f)",
                       best.chi_square, kSamePlateChiSquare, kAxis[best.worst], best.worst_off, unit, best.worst_sigma);
       throw InputError(target_path, std::string("its back_from_front is ") + moved + " from the one filed when " +
-                                        rig.Where() + " was calibrated (from " +
-                                        (rec->file.empty() ? "no file" : rec->file) + "): " + why +
+                                        rig.Where() + " was calibrated (from " + recorded_file + "): " + why +
                                         ": another plate, or not this plate's file; the check's figures rest on "
                                         "the plate calibrated with: check with that plate and its file, or "
                                         "calibrate again with this one");
@@ -136,8 +136,8 @@ CheckTarget TargetForCheck(const Rig& rig, const Target& file_target, const std:
       notes.push_back(std::string("the target file's back_from_front is ") + moved +
                       " from the one filed when the rig was calibrated, as two measurements of one plate may "
                       "differ: measured with the calibration's estimate");
-    out.calibrated_vs_file_deg = (file.Inverse() * rec->back_from_front).AngleDeg();
-    out.calibrated_vs_file_mm = (rec->back_from_front.translation_mm() - file.translation_mm()).norm();
+    out.calibrated_vs_file_deg = AngleBetweenDeg(file, rec->back_from_front);
+    out.calibrated_vs_file_mm = TranslationBetweenMm(file, rec->back_from_front);
   }
   out.target = Target(layout, target_path);
   for (size_t k = 0; k < notes.size(); ++k) out.note += (k ? "; " : "") + notes[k];

@@ -67,4 +67,8 @@ bool IsRigid(const Eigen::Matrix4d& m, double tol, std::string* why) {
   return true;
 }
 
+double AngleBetweenDeg(const Pose& a, const Pose& b) { return (a.Inverse() * b).AngleDeg(); }
+
+double TranslationBetweenMm(const Pose& a, const Pose& b) { return (b.translation_mm() - a.translation_mm()).norm(); }
+
 }  // namespace stereorig

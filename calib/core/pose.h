@@ -48,6 +48,13 @@ class Pose {
   Eigen::Vector3d translation_mm_;
 };
 
+// How far `b` is from `a`, two estimates of one transform: the angle of
+// a^-1 b (deg) and the distance between their translations (mm; not a^-1 b's
+// translation, which mixes in the rotation). As calibrate reports
+// back_from_front's change.
+double AngleBetweenDeg(const Pose& a, const Pose& b);
+double TranslationBetweenMm(const Pose& a, const Pose& b);
+
 // True if `m` is a rigid transform: bottom row (0 0 0 1), R^T R = I and
 // det R = +1, each within `tol`. On failure `why` says which.
 bool IsRigid(const Eigen::Matrix4d& m, double tol, std::string* why);
