@@ -1,0 +1,40 @@
+#include "apps/cli_util.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace stereorig {
+namespace {
+
+// What a terminal is handed of an error line: well-formed UTF-8 as it is,
+// every other byte as \xNN. The well-formed sequences are those of
+// RFC 3629's table (section 4): the first continuation byte's range
+// depends on the lead byte.
+TEST(PrintableText, KeepsWellFormedUtf8) {
+  for (const std::string s : {"plain ascii", "k\xC3\xA5sa", "\xC2\xA0", "\xE0\xA0\x80", "\xE2\x82\xAC", "\xED\x9F\xBF",
+                              "\xEF\xBF\xBD", "\xF0\x90\x80\x80", "\xF4\x8F\xBF\xBF"})
+    EXPECT_EQ(PrintableText(s), s) << s;
+}
+
+TEST(PrintableText, EscapesControlBytes) {
+  EXPECT_EQ(PrintableText("a\x1B[2Jb\x7F"), "a\\x1B[2Jb\\x7F");
+  EXPECT_EQ(PrintableText("\xC2\x9B"), "\\xC2\\x9B");  // U+009B, CSI: a C1 control
+}
+
+// Forms a strict decoder refuses: each byte written as \xNN, so that the
+// line shows what the file held rather than a character it never meant.
+TEST(PrintableText, EscapesIllFormedSequencesByteByByte) {
+  EXPECT_EQ(PrintableText("\xC0\xAF"), "\\xC0\\xAF");           // overlong '/'
+  EXPECT_EQ(PrintableText("\xE0\x80\xAF"), "\\xE0\\x80\\xAF");  // overlong, 3 bytes
+  EXPECT_EQ(PrintableText("\xF0\x80\x80\xAF"), "\\xF0\\x80\\x80\\xAF");
+  EXPECT_EQ(PrintableText("\xED\xA0\x80"), "\\xED\\xA0\\x80");           // a UTF-16 surrogate
+  EXPECT_EQ(PrintableText("\xF4\x90\x80\x80"), "\\xF4\\x90\\x80\\x80");  // past U+10FFFF
+  EXPECT_EQ(PrintableText("\xF5\x80\x80\x80"), "\\xF5\\x80\\x80\\x80");
+  EXPECT_EQ(PrintableText("\xAB"), "\\xAB");             // a lone continuation byte
+  EXPECT_EQ(PrintableText("x\xE2\x82"), "x\\xE2\\x82");  // cut short at the end
+  EXPECT_EQ(PrintableText("\xE2\x82x"), "\\xE2\\x82x");  // cut short by a character
+}
+
+}  // namespace
+}  // namespace stereorig
