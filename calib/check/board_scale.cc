@@ -78,9 +78,11 @@ std::string BoardSizeNote(const std::vector<ModuleBoardScale>& scales, int num_m
   }
   char square[32];
   std::snprintf(square, sizeof square, "%.3f mm", square_size_mm);
-  return std::string("every module measures the board ") + (lo > 0 ? "larger" : "smaller") +
-         " than the target file says (" + each + ", squares of " + square +
-         "): if it is not the board's file, the figures are not the rig's";
+  // The squares are those the check measured with: the target file's, or
+  // the rig file's record of the board (check_target.h) where the two agree
+  // within 0.5 %; so the note names the squares, not where they came from.
+  return std::string("every module measures the board ") + (lo > 0 ? "larger" : "smaller") + " than squares of " +
+         square + " (" + each + "): if these are not the board's squares, the figures are not the rig's";
 }
 
 }  // namespace stereorig

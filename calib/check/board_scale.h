@@ -41,8 +41,10 @@ std::vector<ModuleBoardScale> MeasureBoardScale(const Rig& rig, const Target& ta
 // What the readings say of the board: when every module of the rig (at
 // least two, each read from 3 captures or more) reads it off the same way by
 // more than kMaxBoardScaleOff, and by the same within half the smaller, "every
-// module measures the board smaller than the target file says (module 0
-// -1.96%, module 1 -1.96%, squares of 9.180 mm): ..."; otherwise empty. With
+// module measures the board smaller than squares of 9.180 mm (module 0
+// -1.96%, module 1 -1.96%): ..."; otherwise empty. square_size_mm: the
+// squares the check measured with (the target file's or the rig file's
+// record of them, check_target.h). With
 // one module a board of another size cannot be told from the module's own
 // change: empty.
 std::string BoardSizeNote(const std::vector<ModuleBoardScale>& scales, int num_modules, double square_size_mm);

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <map>
@@ -586,6 +587,9 @@ TEST(NightlyCheck, AWrongTargetFileIsNamedAndABumpIsNot) {
       const CheckResult r = RunNightlyCheck(stored, DoubleSidedTarget(11, 9, square_mm), views, CheckOptions(), "c");
       const std::string note = r.board_size_note;
       EXPECT_NE(note.find(std::string("every module measures the board ") + expected), std::string::npos) << note;
+      char squares[48];  // the squares it measured with: the target file's here (the stored rig has no record)
+      std::snprintf(squares, sizeof squares, "than squares of %.3f mm (", square_mm);
+      EXPECT_NE(note.find(squares), std::string::npos) << note;
       EXPECT_EQ(r.Explanation().substr(r.Explanation().size() - note.size()), note) << r.Explanation();
       // Each module's reading as printed, within 0.1% of 9 / square_mm - 1.
       for (const char* module : {"module 0 ", "module 1 "}) {
