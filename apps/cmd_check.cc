@@ -133,7 +133,10 @@ int RunCheck(int argc, char** argv) {
   RejectCamerasBeyondTheRig(captures, rig.num_cameras());
   // A history that is not ours is refused before any work, so a failed run
   // leaves neither a report nor a half-recorded night.
-  if (std::filesystem::exists(history_db)) ReadHistoryRuns(history_db);
+  if (std::filesystem::exists(history_db)) {
+    ReadHistoryRuns(history_db);
+    RequireHistoryWritable(history_db);
+  }
   RequireCapturesFolder(captures);  // before the progress line
   std::fprintf(stderr, "check: detecting the target in %s\n", captures.c_str());
   const DetectedCaptures detected = DetectCaptureFolder(captures, target, rig.num_cameras(), DetectOptions(), true);
@@ -232,8 +235,11 @@ int RunCheck(int argc, char** argv) {
   report["closure_which_unknown"] = result.closure_which_unknown;
   report["split_modules"] = result.split_modules;
 
-  if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
+  // The history first: if it refuses the run after all (checked writable
+  // above, but another process may have changed it since), the exit is 2
+  // and no report claims a recorded night.
   AppendToHistory(history_db, {0, report["date_utc"], rig_path, captures, "", ""}, result, detected.capture_names);
+  if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
   std::printf("history: appended to %s\n", history_db.c_str());
   return result.ok() ? kExitOk : kExitCheckFailed;
 }

@@ -307,6 +307,20 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     EXPECT_NE(LastLine(r.err).find(not_db), std::string::npos) << r.err;
     EXPECT_EQ(Bytes(not_db), "not a database\n");
   }
+  {  // A history another process holds (a write lock: what root, as in CI,
+     // can make of the read-only file a user's walkthrough tried as nobody):
+     // refused before the detection, no report, the history as it was.
+     // Before, the night ran, printed its verdict, wrote its report, and
+     // then failed to record it: exit 2 with a report on disk.
+    sqlite3* other = nullptr;
+    ASSERT_EQ(sqlite3_open(db.c_str(), &other), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(other, "BEGIN IMMEDIATE;", nullptr, nullptr, nullptr), SQLITE_OK);
+    r = check(dir + "/ds", dir + "/rig.yaml");
+    sqlite3_exec(other, "ROLLBACK;", nullptr, nullptr, nullptr);
+    sqlite3_close(other);
+    expect_refused(r, "cannot be written", "a history another process holds");
+    EXPECT_EQ(r.err.find("detecting"), std::string::npos) << r.err;
+  }
   {  // A report named as the rig file (it would replace the rig file with
      // JSON), or into a folder that is not there (it failed after the
      // detection): refused before any work, the rig file and history intact.

@@ -151,6 +151,26 @@ long long AppendToHistory(const std::string& path, const HistoryRun& run, const 
   }
 }
 
+void RequireHistoryWritable(const std::string& path) {
+  Db db = Open(path, true);
+  // SQLITE_OPEN_READWRITE opens a file the system write-protects read-only,
+  // without an error.
+  if (sqlite3_db_readonly(db.get(), "main") == 1)
+    throw InputError(path,
+                     "the history database is read-only: tonight's run could not be recorded (make it "
+                     "writable, or give another with --history-db)");
+  // A first page changed opens the rollback journal beside the file: a
+  // read-only folder fails here, as it would at the append.
+  try {
+    Exec(db.get(), "BEGIN IMMEDIATE; CREATE TABLE stereorig_check_write_probe (x);", path);
+  } catch (const InputError& e) {
+    sqlite3_exec(db.get(), "ROLLBACK;", nullptr, nullptr, nullptr);
+    throw InputError(
+        path, "the history database cannot be written (" + e.problem() + "): tonight's run could not be recorded");
+  }
+  Exec(db.get(), "ROLLBACK;", path);
+}
+
 std::vector<HistoryRun> ReadHistoryRuns(const std::string& path) {
   Db db = Open(path, false);
   Stmt s = Prepare(db.get(),

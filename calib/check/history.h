@@ -61,6 +61,14 @@ struct FigureTrend {
 long long AppendToHistory(const std::string& db_path, const HistoryRun& run, const CheckResult& result,
                           const std::map<int, std::string>& capture_names = {});
 
+// Throws InputError naming `db_path` unless an existing history can be
+// written: the file read-only, or its folder (SQLite's journal goes beside
+// it), or another process holding it. Run before the check's work, so that
+// a night's verdict is not lost to a history that refuses it at the end
+// (exit 2 after "verdict: recalibrate", a user's walkthrough found). Writes
+// nothing (a table created and rolled back).
+void RequireHistoryWritable(const std::string& db_path);
+
 std::vector<HistoryRun> ReadHistoryRuns(const std::string& db_path);
 std::vector<FigureTrend> ReadHistoryTrends(const std::string& db_path);
 // Oldest run first, cameras in order within a run.

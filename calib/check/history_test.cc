@@ -44,6 +44,42 @@ TEST(History, AppendsRunsAndReadsTrendsBack) {
   EXPECT_NE(table.find("3 run(s)"), std::string::npos);
 }
 
+// A history the night cannot be written to is found before the check's
+// work: here another process holds it (a write lock), the case a test run
+// as root can make (root writes a read-only file; the read-only file and
+// folder were tried as user nobody). A writable one passes and is left as
+// it was: the probe's table is rolled back.
+TEST(History, AHistoryThatCannotBeWrittenIsFoundBeforeTheNight) {
+  const std::string db = ::testing::TempDir() + "/history_writable.sqlite";
+  std::filesystem::remove(db);
+  AppendToHistory(db, {0, "2026-11-20T02:00:00Z", "rig.yaml", "night1", "", ""}, Result(0.20, true));
+  EXPECT_NO_THROW(RequireHistoryWritable(db));
+  sqlite3* other = nullptr;
+  ASSERT_EQ(sqlite3_open(db.c_str(), &other), SQLITE_OK);
+  auto tables = [&] {
+    sqlite3_stmt* s = nullptr;
+    sqlite3_prepare_v2(other, "SELECT count(*) FROM sqlite_master WHERE type = 'table';", -1, &s, nullptr);
+    sqlite3_step(s);
+    const int n = sqlite3_column_int(s, 0);
+    sqlite3_finalize(s);
+    return n;
+  };
+  const int before = tables();
+  EXPECT_NO_THROW(RequireHistoryWritable(db));
+  EXPECT_EQ(tables(), before);
+  ASSERT_EQ(sqlite3_exec(other, "BEGIN IMMEDIATE;", nullptr, nullptr, nullptr), SQLITE_OK);  // the other process
+  try {
+    RequireHistoryWritable(db);
+    ADD_FAILURE() << "a history another process holds passed";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot be written"), std::string::npos) << e.what();
+    EXPECT_EQ(e.where(), db);
+  }
+  sqlite3_exec(other, "ROLLBACK;", nullptr, nullptr, nullptr);
+  sqlite3_close(other);
+  EXPECT_EQ(ReadHistoryRuns(db).size(), 1u);
+}
+
 // The views a run set aside are kept with it, so a camera that loses views
 // night after night shows in the history, not only in each night's report.
 TEST(History, KeepsTheViewsSetAsideAndCountsThemPerCamera) {
