@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "apps/cli_util.h"
@@ -18,6 +19,8 @@
 #include "calib/core/number_text.h"
 #include "calib/core/rig_file.h"
 #include "targets/target_file.h"
+
+#include <zlib.h>
 
 namespace stereorig {
 
@@ -42,6 +45,21 @@ void RejectCamerasBeyondTheRig(const std::string& captures, int num_cameras) {
                            ", but the rig has " + std::to_string(num_cameras) + " cameras: captures from another rig?");
     }
   }
+}
+
+// The CRC-32 of a file's bytes as 8 hex digits (zlib's): what tells the rig
+// file a night used from another written to the same path. Not a guard
+// against tampering, only a fingerprint.
+std::string FileCrc32Hex(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "cannot be read");
+  uLong crc = crc32(0L, Z_NULL, 0);
+  char buffer[1 << 16];
+  while (in.read(buffer, sizeof buffer) || in.gcount() > 0)
+    crc = crc32(crc, reinterpret_cast<const Bytef*>(buffer), static_cast<uInt>(in.gcount()));
+  char hex[16];
+  std::snprintf(hex, sizeof hex, "%08lx", static_cast<unsigned long>(crc));
+  return hex;
 }
 
 int PrintHistory(const std::string& db) {
@@ -125,7 +143,8 @@ int RunCheck(int argc, char** argv) {
                                           : "the history database (by default beside the rig file, updated in place)");
 
   const Rig rig = ReadRigFile(rig_path);
-  RequireCalibrationResiduals(rig, rig_path);  // named by the rig file, before minutes of detection
+  const std::string rig_crc32 = FileCrc32Hex(rig_path);  // the bytes read, not those there at the end
+  RequireCalibrationResiduals(rig, rig_path);            // named by the rig file, before minutes of detection
   // The board with the back_from_front the calibration ended with (S holds
   // with it); a board other than the calibration's is refused here.
   const CheckTarget check_target = TargetForCheck(rig, ReadTargetFile(target_path), target_path);
@@ -156,7 +175,8 @@ int RunCheck(int argc, char** argv) {
   result.target_note = check_target.note;  // said with a failing night (the explanation's end)
 
   std::printf("%-44s %10s %10s %6s %8s\n", "figure", "value", "threshold", "pass", "samples");
-  nlohmann::json report = {{"rig", rig_path}, {"captures", captures}, {"date_utc", NowUtcIso8601()}};
+  nlohmann::json report = {
+      {"rig", rig_path}, {"rig_crc32", rig_crc32}, {"captures", captures}, {"date_utc", NowUtcIso8601()}};
   for (const CheckFigure& f : result.figures) {
     std::printf("%-44s %10.4f %10.4f %6s %8d\n", f.name.c_str(), f.value, f.threshold, f.pass ? "yes" : "NO",
                 f.samples);
@@ -238,7 +258,12 @@ int RunCheck(int argc, char** argv) {
   // The history first: if it refuses the run after all (checked writable
   // above, but another process may have changed it since), the exit is 2
   // and no report claims a recorded night.
-  AppendToHistory(history_db, {0, report["date_utc"], rig_path, captures, "", ""}, result, detected.capture_names);
+  HistoryRun run{0, report["date_utc"], rig_path, captures, "", ""};
+  run.rig_path = std::filesystem::absolute(rig_path).lexically_normal().string();
+  run.rig_crc32 = rig_crc32;
+  run.target_path = std::filesystem::absolute(target_path).lexically_normal().string();
+  run.board = check_target.back_from_front_as_calibrated ? "as calibrated" : "the target file's";
+  AppendToHistory(history_db, run, result, detected.capture_names);
   if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
   std::printf("history: appended to %s\n", history_db.c_str());
   return result.ok() ? kExitOk : kExitCheckFailed;

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 #include <sys/stat.h>
+#include <zlib.h>
 
 #include <filesystem>
 #include <fstream>
@@ -53,6 +54,7 @@ int Occurrences(const std::string& text, const std::string& what) {
 struct DbState {
   std::string integrity;
   int runs = -1;
+  std::string last_rig_path, last_rig_crc32, last_board;  // the last run's inputs
 };
 DbState ReadDb(const std::string& path) {
   DbState s;
@@ -72,6 +74,9 @@ DbState ReadDb(const std::string& path) {
   s.integrity = one("PRAGMA integrity_check");
   const std::string n = one("SELECT COUNT(*) FROM stereorig_check_runs");
   s.runs = n.empty() ? -1 : std::stoi(n);
+  s.last_rig_path = one("SELECT rig_path FROM stereorig_check_run_inputs ORDER BY run_id DESC LIMIT 1");
+  s.last_rig_crc32 = one("SELECT rig_crc32 FROM stereorig_check_run_inputs ORDER BY run_id DESC LIMIT 1");
+  s.last_board = one("SELECT board FROM stereorig_check_run_inputs ORDER BY run_id DESC LIMIT 1");
   sqlite3_close(db);
   return s;
 }
@@ -114,6 +119,18 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
   ASSERT_NE(r.code, 2) << r.err;
   ASSERT_EQ(ReadDb(db).integrity, "ok");
   ASSERT_EQ(ReadDb(db).runs, 1);
+  {  // What the night used: the rig file by absolute path and by zlib's
+     // CRC-32 of its bytes, and the board as calibrated (the stored rig
+     // records it).
+    const std::string bytes = Bytes(dir + "/rig.yaml");
+    char crc[16];
+    std::snprintf(crc, sizeof crc, "%08lx",
+                  crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(bytes.data()), uInt(bytes.size())));
+    const DbState s = ReadDb(db);
+    EXPECT_EQ(s.last_rig_path, fs::absolute(dir + "/rig.yaml").lexically_normal().string());
+    EXPECT_EQ(s.last_rig_crc32, crc);
+    EXPECT_EQ(s.last_board, "as calibrated");
+  }
   const std::string db_bytes = Bytes(db);
   fs::remove(report);
 

@@ -34,7 +34,12 @@ constexpr const char* kSchema =
     "CREATE TABLE IF NOT EXISTS stereorig_check_views_set_aside ("
     "  run_id INTEGER NOT NULL REFERENCES stereorig_check_runs(id), capture TEXT NOT NULL,"
     "  camera INTEGER NOT NULL, jump_rms_px REAL NOT NULL, bound_px REAL NOT NULL);"
-    "CREATE TABLE IF NOT EXISTS stereorig_check_meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);";
+    "CREATE TABLE IF NOT EXISTS stereorig_check_meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);"
+    "CREATE TABLE IF NOT EXISTS stereorig_check_run_inputs ("
+    "  run_id INTEGER NOT NULL REFERENCES stereorig_check_runs(id), rig_path TEXT NOT NULL,"
+    "  rig_crc32 TEXT NOT NULL, target_path TEXT NOT NULL, board TEXT NOT NULL);";
+
+constexpr const char* kRunInputsTable = "stereorig_check_run_inputs";
 
 constexpr const char* kSetAsideTable = "stereorig_check_views_set_aside";
 constexpr const char* kSetAsideSinceKey = "views_set_aside_since_run";
@@ -102,6 +107,17 @@ long long AppendToHistory(const std::string& path, const HistoryRun& run, const 
     if (sqlite3_step(ins.get()) != SQLITE_DONE)
       throw InputError(path, std::string("history: ") + sqlite3_errmsg(db.get()));
     const long long id = sqlite3_last_insert_rowid(db.get());
+    Stmt inputs = Prepare(db.get(),
+                          "INSERT INTO stereorig_check_run_inputs (run_id, rig_path, rig_crc32, target_path, board) "
+                          "VALUES (?, ?, ?, ?, ?);",
+                          path);
+    sqlite3_bind_int64(inputs.get(), 1, id);
+    sqlite3_bind_text(inputs.get(), 2, run.rig_path.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(inputs.get(), 3, run.rig_crc32.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(inputs.get(), 4, run.target_path.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(inputs.get(), 5, run.board.c_str(), -1, SQLITE_TRANSIENT);
+    if (sqlite3_step(inputs.get()) != SQLITE_DONE)
+      throw InputError(path, std::string("history: ") + sqlite3_errmsg(db.get()));
     Stmt fig = Prepare(db.get(),
                        "INSERT INTO stereorig_check_figures (run_id, name, value, threshold, pass, samples) "
                        "VALUES (?, ?, ?, ?, ?, ?);",
@@ -173,14 +189,28 @@ void RequireHistoryWritable(const std::string& path) {
 
 std::vector<HistoryRun> ReadHistoryRuns(const std::string& path) {
   Db db = Open(path, false);
+  // Histories written before the inputs were kept have no such table.
+  const bool inputs = HasTable(db.get(), kRunInputsTable, path);
   Stmt s = Prepare(db.get(),
-                   "SELECT id, date_utc, rig_file, captures, verdict, explanation FROM stereorig_check_runs "
-                   "ORDER BY id;",
+                   inputs ? "SELECT r.id, r.date_utc, r.rig_file, r.captures, r.verdict, r.explanation, i.rig_path, "
+                            "i.rig_crc32, i.target_path, i.board FROM stereorig_check_runs r LEFT JOIN "
+                            "stereorig_check_run_inputs i ON i.run_id = r.id ORDER BY r.id;"
+                          : "SELECT id, date_utc, rig_file, captures, verdict, explanation FROM stereorig_check_runs "
+                            "ORDER BY id;",
                    path);
   std::vector<HistoryRun> runs;
   while (sqlite3_step(s.get()) == SQLITE_ROW) {
-    runs.push_back({sqlite3_column_int64(s.get(), 0), Text(s.get(), 1), Text(s.get(), 2), Text(s.get(), 3),
-                    Text(s.get(), 4), Text(s.get(), 5)});
+    HistoryRun run{sqlite3_column_int64(s.get(), 0),
+                   Text(s.get(), 1),
+                   Text(s.get(), 2),
+                   Text(s.get(), 3),
+                   Text(s.get(), 4),
+                   Text(s.get(), 5)};
+    if (inputs) {
+      run.rig_path = Text(s.get(), 6), run.rig_crc32 = Text(s.get(), 7);
+      run.target_path = Text(s.get(), 8), run.board = Text(s.get(), 9);
+    }
+    runs.push_back(run);
   }
   return runs;
 }
@@ -235,6 +265,29 @@ std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<
     out += ", " + runs.front().date_utc + " .. " + runs.back().date_utc + "; last verdict: " + runs.back().verdict +
            " (" + runs.back().explanation + ")";
   out += "\n";
+  // The rig files the runs were measured with, in runs of the same one.
+  struct Span {
+    long long first, last;
+    const HistoryRun* run;
+  };
+  std::vector<Span> spans;
+  std::set<std::string> crcs;
+  for (const HistoryRun& r : runs) {
+    if (r.rig_crc32.empty()) continue;
+    crcs.insert(r.rig_crc32);
+    if (!spans.empty() && spans.back().run->rig_crc32 == r.rig_crc32)
+      spans.back().last = r.id;
+    else
+      spans.push_back({r.id, r.id, &r});
+  }
+  if (crcs.size() > 1) {
+    out += "rig files: " + std::to_string(crcs.size()) +
+           " different ones over these runs (a trend across a recalibration is not one rig's):\n";
+    for (const Span& sp : spans) {
+      std::snprintf(line, sizeof line, "  runs %lld..%lld: ", sp.first, sp.last);
+      out += line + sp.run->rig_path + " (crc32 " + sp.run->rig_crc32 + ", back_from_front " + sp.run->board + ")\n";
+    }
+  }
   std::snprintf(line, sizeof line, "%-40s %5s %10s %10s %10s %10s %10s %6s\n", "figure", "runs", "first", "last", "min",
                 "max", "threshold", "fails");
   out += line;

@@ -18,6 +18,14 @@ struct HistoryRun {
   std::string captures;
   std::string verdict;  // "ok" or "recalibrate"
   std::string explanation;
+  // What the night was measured with (empty in runs written before they were
+  // kept): the rig file's absolute path and a CRC-32 of its bytes (a rig
+  // recalibrated into the same path reads as another), the target file's
+  // absolute path, and which back_from_front the closures used.
+  std::string rig_path = "";
+  std::string rig_crc32 = "";  // 8 hex digits
+  std::string target_path = "";
+  std::string board = "";  // "as calibrated" (the rig file's record) or "the target file's"
 };
 
 struct HistoryPoint {
@@ -74,7 +82,10 @@ std::vector<FigureTrend> ReadHistoryTrends(const std::string& db_path);
 // Oldest run first, cameras in order within a run.
 HistorySetAsideLog ReadHistorySetAside(const std::string& db_path);
 
-// A readable table: one row per figure, its first and last values, the
+// A readable table: first, when the runs were measured with more than one
+// rig file (by CRC-32; the runs that kept none are left out), the runs of
+// each, since a trend across a recalibration is not one rig's; one row per
+// figure, its first and last values, the
 // extremes, the last threshold and how many runs failed it; then, per
 // camera, the views set aside and on how many of the runs that kept them (a
 // camera that loses views night after night: a slipping detection, a dirty

@@ -44,6 +44,35 @@ TEST(History, AppendsRunsAndReadsTrendsBack) {
   EXPECT_NE(table.find("3 run(s)"), std::string::npos);
 }
 
+// Each run keeps what it was measured with, so a trend across a
+// recalibration written to the same path is not read as one rig's (a user's
+// walkthrough merged two rig files' runs into one trend, unsaid).
+TEST(History, KeepsTheRigFileEachRunUsedAndSaysWhenItChanged) {
+  const std::string db = ::testing::TempDir() + "/history_inputs.sqlite";
+  std::filesystem::remove(db);
+  auto run = [](const char* date, const char* crc) {
+    HistoryRun r{0, date, "rig.yaml", "night", "", ""};
+    r.rig_path = "/line/rig.yaml", r.rig_crc32 = crc, r.target_path = "/line/target.yaml", r.board = "as calibrated";
+    return r;
+  };
+  AppendToHistory(db, run("2026-11-20T02:00:00Z", "0badc0de"), Result(0.20, true));
+  AppendToHistory(db, run("2026-11-21T02:00:00Z", "0badc0de"), Result(0.21, true));
+  AppendToHistory(db, run("2026-11-22T02:00:00Z", "12345678"), Result(0.20, true));
+  const auto runs = ReadHistoryRuns(db);
+  ASSERT_EQ(runs.size(), 3u);
+  EXPECT_EQ(runs[0].rig_path, "/line/rig.yaml");
+  EXPECT_EQ(runs[2].rig_crc32, "12345678");
+  EXPECT_EQ(runs[1].target_path, "/line/target.yaml");
+  EXPECT_EQ(runs[1].board, "as calibrated");
+  const std::string table = FormatTrends(runs, ReadHistoryTrends(db));
+  EXPECT_NE(table.find("rig files: 2 different ones"), std::string::npos) << table;
+  EXPECT_NE(table.find("runs 1..2: /line/rig.yaml (crc32 0badc0de"), std::string::npos) << table;
+  EXPECT_NE(table.find("runs 3..3: /line/rig.yaml (crc32 12345678"), std::string::npos) << table;
+  // One rig file throughout: nothing said.
+  std::vector<HistoryRun> same(runs.begin(), runs.begin() + 2);
+  EXPECT_EQ(FormatTrends(same, ReadHistoryTrends(db)).find("rig files:"), std::string::npos);
+}
+
 // A history the night cannot be written to is found before the check's
 // work: here another process holds it (a write lock), the case a test run
 // as root can make (root writes a read-only file; the read-only file and
