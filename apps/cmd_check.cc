@@ -1,6 +1,7 @@
 // `stereorig check`: the nightly recalibration check. Fresh target captures
 // + the stored rig file -> ok / recalibrate, what moved, and history.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -244,8 +245,14 @@ int RunCheck(int argc, char** argv) {
                                         {"moved_fit_rms_px", c.moved_rms_px},
                                         {"lens_fit_rms_px", c.lens_rms_px},
                                         {"threshold_px", c.threshold_px},
+                                        {"turned_deg", c.turned_deg},
+                                        {"shifted_mm", c.shifted_mm},
                                         {"focal_percent", c.focal_percent},
                                         {"principal_point_px", {c.principal_point_px.x(), c.principal_point_px.y()}}});
+    if (!std::isfinite(c.turned_deg)) {  // no pose fit, or its solve failed: no motion to report
+      report["camera_changes"].back()["turned_deg"] = nullptr;
+      report["camera_changes"].back()["shifted_mm"] = nullptr;
+    }
     if (c.kind == CameraChangeKind::kNotFitted) {  // no estimate, not an estimate of no change
       report["camera_changes"].back()["focal_percent"] = nullptr;
       report["camera_changes"].back()["principal_point_px"] = nullptr;

@@ -27,7 +27,9 @@ const char* CameraChangeKindName(CameraChangeKind kind) {
   return "not_fitted";
 }
 
-std::string CameraChange::Describe() const {
+std::string CameraChange::Describe() const { return DescribeChange() + (role.empty() ? "" : " [" + role + "]"); }
+
+std::string CameraChange::DescribeChange() const {
   // Printed as rounded: no "-0.00".
   auto shown = [](double x, double step) { return std::abs(x) < step / 2 ? 0.0 : x; };
   // "0.079 px with a new pose"; a pose fit whose solve failed has none.
@@ -38,8 +40,15 @@ std::string CameraChange::Describe() const {
   };
   std::string out = "camera " + std::to_string(camera);
   switch (kind) {
-    case CameraChangeKind::kMoved:
-      return out + " moved";
+    case CameraChangeKind::kMoved: {
+      // The pose fit's motion, so that the night's reader knows a knock
+      // from a creep (0.1 to 3 degrees read to 0.001 degree on simulated
+      // nights, docs/verify-and-check.md).
+      char text[96];
+      std::snprintf(text, sizeof text, " moved: turned %.3f deg, shifted %.3f mm", shown(turned_deg, 0.001),
+                    shown(shifted_mm, 0.001));
+      return out + text;
+    }
     case CameraChangeKind::kLens: {
       char text[160];
       std::snprintf(text, sizeof text, "'s lens changed: focal length %+.3f %%, principal point %+.2f, %+.2f px",
@@ -104,7 +113,10 @@ struct MovedResidual {
 
 double RmsPerAxis(double sum_of_squares, size_t corners) { return std::sqrt(sum_of_squares / (2.0 * corners)); }
 
-double MovedFitRms(const Camera& camera, const Pose& cam_from_ref, const std::vector<Corner>& corners) {
+// The pose fit's per-axis RMS; *new_from_old its motion (unset if the
+// solve failed).
+double MovedFitRms(const Camera& camera, const Pose& cam_from_ref, const std::vector<Corner>& corners,
+                   Pose* new_from_old) {
   double rt[6] = {0, 0, 0, 0, 0, 0};
   ceres::Problem problem;
   for (const Corner& c : corners)
@@ -116,6 +128,7 @@ double MovedFitRms(const Camera& camera, const Pose& cam_from_ref, const std::ve
   ceres::Solve(options, &problem, &summary);
   // A solve that failed explains nothing (its final cost is not a cost).
   if (!summary.IsSolutionUsable()) return std::numeric_limits<double>::infinity();
+  *new_from_old = Pose::FromRotationVector({rt[0], rt[1], rt[2]}, {rt[3], rt[4], rt[5]});
   return RmsPerAxis(2.0 * summary.final_cost, corners.size());
 }
 
@@ -132,7 +145,12 @@ CameraChange ExplainCameraChange(const Rig& rig, const Target& target, int camer
           {pv.ref_from_front * CornerInFront(target, pv.view->face, pv.view->corner_ids[k]), pv.view->q_px[k]});
   CameraChange change;
   change.camera = camera;
+  for (int m = 0; m < rig.num_modules(); ++m) {
+    if (rig.module(m).left_camera == camera) change.role = "module " + std::to_string(m) + "'s left camera";
+    if (rig.module(m).right_camera == camera) change.role = "module " + std::to_string(m) + "'s right camera";
+  }
   change.threshold_px = threshold_px;
+  change.turned_deg = change.shifted_mm = std::numeric_limits<double>::quiet_NaN();
   change.corners = static_cast<int>(corners.size());
   if (change.corners < kMinCornersToFit) {  // no fit, not a perfect one (null in the report)
     change.kind = CameraChangeKind::kNotFitted;
@@ -159,7 +177,14 @@ CameraChange ExplainCameraChange(const Rig& rig, const Target& target, int camer
   change.focal_percent = 100.0 * x[0];
   change.principal_point_px = x.tail<2>();
   change.lens_rms_px = RmsPerAxis((a * x - b).squaredNorm(), corners.size());
-  change.moved_rms_px = MovedFitRms(cam, cam_from_ref, corners);
+  Pose new_from_old;
+  change.moved_rms_px = MovedFitRms(cam, cam_from_ref, corners, &new_from_old);
+  if (std::isfinite(change.moved_rms_px)) {
+    change.turned_deg = AngleBetweenDeg(new_from_old, Pose::Identity());
+    // The camera centre's move, in the reference frame.
+    change.shifted_mm =
+        ((new_from_old * cam_from_ref).Inverse().translation_mm() - cam_from_ref.Inverse().translation_mm()).norm();
+  }
 
   const bool moved_fits = change.moved_rms_px <= threshold_px, lens_fits = change.lens_rms_px <= threshold_px;
   change.kind = moved_fits && lens_fits ? CameraChangeKind::kMovedOrLens

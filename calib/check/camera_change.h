@@ -55,11 +55,22 @@ struct CameraChange {
   // (cx, cy) moved by principal_point_px.
   double focal_percent = 0;
   Eigen::Vector2d principal_point_px = Eigen::Vector2d::Zero();
-  // "camera 2 moved", "camera 2's lens changed: ...", "camera 2 moved or its
-  // lens changed (either explains its corners)", "camera 2 changed: neither
-  // a new pose nor a new lens alone explains its corners (...)", "camera 2
-  // changed: too few corners (N) to fit a new pose or a new lens".
+  // The pose fit's estimate: how far the camera turned (deg) and shifted
+  // (mm) from its stored pose; NaN when not fitted or the solve failed.
+  double turned_deg = 0;
+  double shifted_mm = 0;
+  // Where it sits: "module 0's right camera" (the rig's modules).
+  std::string role;
+  // "camera 2 moved: turned 0.050 deg, shifted 0.004 mm", "camera 2's lens
+  // changed: ...", "camera 2 moved or its lens changed (either explains its
+  // corners)", "camera 2 changed: neither a new pose nor a new lens alone
+  // explains its corners (...)", "camera 2 changed: too few corners (N) to
+  // fit a new pose or a new lens"; each followed by the role, " [module 1's
+  // left camera]", where it has one.
   std::string Describe() const;
+
+ private:
+  std::string DescribeChange() const;  // Describe() without the role
 };
 
 // One view of camera `camera` with the board pose the other cameras imply.

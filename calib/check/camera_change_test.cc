@@ -95,7 +95,17 @@ TEST(CameraChange, ATurnAboutTheAxisIsAMotion) {
   change.rotation_deg = {0, 0, 0.1};
   const CameraChange c = Explain(change);
   EXPECT_EQ(c.kind, CameraChangeKind::kMoved);
-  EXPECT_EQ(c.Describe(), "camera 0 moved");
+  // The pose fit's motion: the turn about the camera's own centre. At
+  // 0.03 px on 792 corners ~1000 px focal length its standard error is
+  // ~0.03 / (1000 sqrt(792)) rad, 6e-5 deg, and the centre's ~200 mm times
+  // that over the turn/shift correlation, a few um: bounds of 0.001 deg and
+  // 0.01 mm.
+  EXPECT_NEAR(c.turned_deg, 0.1, 0.001);
+  EXPECT_NEAR(c.shifted_mm, 0.0, 0.01);
+  char expected[128];
+  std::snprintf(expected, sizeof expected, "camera 0 moved: turned %.3f deg, shifted %.3f mm [module 0's left camera]",
+                c.turned_deg, c.shifted_mm);
+  EXPECT_EQ(c.Describe(), expected);
   EXPECT_STREQ(CameraChangeKindName(c.kind), "moved");
 }
 
@@ -118,7 +128,7 @@ TEST(CameraChange, APrincipalPointShiftIsAMotionOrALensChange) {
   change.lens.principal_point_px = {0.2, 0};
   const CameraChange c = Explain(change);
   EXPECT_EQ(c.kind, CameraChangeKind::kMovedOrLens);
-  EXPECT_EQ(c.Describe(), "camera 0 moved or its lens changed (either explains its corners)");
+  EXPECT_EQ(c.Describe(), "camera 0 moved or its lens changed (either explains its corners) [module 0's left camera]");
   EXPECT_STREQ(CameraChangeKindName(c.kind), "moved_or_lens");
 }
 
@@ -136,7 +146,7 @@ TEST(CameraChange, NeitherAloneIsSaidSoWhenItMovedAndItsLensChanged) {
   char expected[256];
   std::snprintf(expected, sizeof expected,
                 "camera 0 changed: neither a new pose nor a new lens alone explains its corners (residual %.3f px "
-                "with a new pose, %.3f px with a new lens, against 0.036 px)",
+                "with a new pose, %.3f px with a new lens, against 0.036 px) [module 0's left camera]",
                 c.moved_rms_px, c.lens_rms_px);
   EXPECT_EQ(c.Describe(), expected);
   EXPECT_STREQ(CameraChangeKindName(c.kind), "unexplained");
@@ -164,7 +174,9 @@ TEST(CameraChange, TooFewCornersAreNotFitted) {
   EXPECT_EQ(c.corners, kMinCornersToFit - 1);
   EXPECT_TRUE(std::isnan(c.moved_rms_px));
   EXPECT_TRUE(std::isnan(c.lens_rms_px));
-  EXPECT_EQ(c.Describe(), "camera 0 changed: too few corners (5) to fit a new pose or a new lens");
+  EXPECT_EQ(c.Describe(),
+            "camera 0 changed: too few corners (5) to fit a new pose or a new lens [module 0's left camera]");
+  EXPECT_TRUE(std::isnan(c.turned_deg));  // no fit, no motion
   EXPECT_STREQ(CameraChangeKindName(c.kind), "not_fitted");
 }
 

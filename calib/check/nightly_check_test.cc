@@ -496,9 +496,12 @@ TEST(NightlyCheck, ExplanationSaysNoMoreThanTheFiguresTell) {
   r.camera_changes[0].corners = 4;
   EXPECT_EQ(r.Explanation(), "camera 2 changed: too few corners (4) to fit a new pose or a new lens");
   r.camera_changes[0].kind = CameraChangeKind::kMoved;
-  EXPECT_EQ(r.Explanation(), "camera 2 moved");
+  r.camera_changes[0].turned_deg = 0.0504, r.camera_changes[0].shifted_mm = 0.0031;
+  r.camera_changes[0].role = "module 1's left camera";
+  EXPECT_EQ(r.Explanation(), "camera 2 moved: turned 0.050 deg, shifted 0.003 mm [module 1's left camera]");
   r.target_note = "the target file's back_from_front is ...";  // any failing night's
-  EXPECT_EQ(r.Explanation(), "camera 2 moved; " + r.target_note);
+  EXPECT_EQ(r.Explanation(),
+            "camera 2 moved: turned 0.050 deg, shifted 0.003 mm [module 1's left camera]; " + r.target_note);
   r.figures[0].pass = true;  // and not a night that passes
   r.camera_changes.clear();
   EXPECT_EQ(r.Explanation(), "every figure within its threshold");
