@@ -31,7 +31,8 @@ int RunCalibrate(int argc, char** argv) {
       "that module is refused).\n\n"
       "Refuses with exit 2: too few views, all views fronto-parallel, a camera that never sees the board, images "
       "of the wrong size, a face seen by the wrong module; and, after the solve (the summary and the report written, "
-      "the rig file not), a stage that did not converge (rms over --max-rms-px) or a lens no camera has.\n\n"
+      "the rig file not), a stage that did not converge (rms over --max-rms-px), a lens no camera has, or a plate "
+      "whose back_from_front stage 3 moved far beyond the target file's stated sigma (the target file named).\n\n"
       "Example:\n  stereorig calibrate --captures data/calibration --target target.yaml --layout layout.yaml "
       "--out rig.yaml --report report.json",
       "stereorig calibrate"};
