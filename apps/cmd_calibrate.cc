@@ -12,6 +12,7 @@
 #include "apps/output_paths.h"
 #include "calib/calibrate.h"
 #include "calib/capture_folder.h"
+#include "calib/core/input_error.h"
 #include "calib/layout_file.h"
 
 namespace stereorig {
@@ -31,7 +32,8 @@ int RunCalibrate(int argc, char** argv) {
       "that module is refused).\n\n"
       "Refuses with exit 2: too few views, all views fronto-parallel, a camera that never sees the board, images "
       "of the wrong size, a face seen by the wrong module; and, after the solve (the summary and the report written, "
-      "the rig file not), a stage that did not converge (rms over --max-rms-px) or a lens no camera has.\n\n"
+      "the rig file not), a stage that did not converge (rms over --max-rms-px), a lens no camera has, or a plate "
+      "whose back_from_front stage 3 moved far beyond the target file's stated sigma (the target file named).\n\n"
       "Example:\n  stereorig calibrate --captures data/calibration --target target.yaml --layout layout.yaml "
       "--out rig.yaml --report report.json",
       "stereorig calibrate"};
@@ -50,7 +52,8 @@ int RunCalibrate(int argc, char** argv) {
                  "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=.._Ny=.._fov_x_deg=.. (both keep mrcal's regularisation)")
       ->capture_default_str();
   app.add_option("--focal", options.intrinsics.seed_focal_px, "rough focal length for the PnP seed, px (0: estimate)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(NonNegativeValue());
   app.add_option("--uncertainty-range", options.intrinsics.uncertainty_range_mm,
                  "range of the points whose projection uncertainty is reported (and the nightly check's thresholds "
                  "come from), mm; 0: each camera's median distance to the board in its views, where the rig measures")
@@ -62,11 +65,20 @@ int RunCalibrate(int argc, char** argv) {
                  "corners' noise, a few tenths of a px at most)")
       ->capture_default_str()
       ->check(PositiveValue());
-  app.add_option("--huber", options.system.huber_px, "stage 3 robust loss scale, px")->capture_default_str();
+  app.add_option("--huber", options.system.huber_px, "stage 3 robust loss scale, px")
+      ->capture_default_str()
+      ->check(PositiveValue());
   app.add_flag("--fixed-intrinsics", fixed_intrinsics, "hold the intrinsics at stage 2's values in stage 3");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
   options.system.refine_intrinsics = !fixed_intrinsics;
-  options.Check();
+  try {
+    options.Check();
+  } catch (const InputError& e) {
+    // The library names its options' fields; the user gave them as flags.
+    // The flags' own checks (above) catch the rest before this.
+    if (e.where() != "options.lensmodel") throw;
+    throw InputError("--lensmodel", e.problem());
+  }
   // Checked before the calibration runs (minutes): a rig file and a report
   // at one path, or in a folder that is not there, would fail only at the end.
   OutputPaths outputs;

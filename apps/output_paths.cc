@@ -27,8 +27,13 @@ void OutputPaths::Claim(const std::string& path, const std::string& what, bool c
   if (const auto it = folders_.find(key); it != folders_.end())
     throw InputError(path, "is a folder this command creates for " + it->second + ", not a file to write");
   std::vector<fs::path> missing;
-  CheckNamesFit(path, "write " + what, DeepestExistingPart(key, &missing), missing);
-  if (check_folder && !fs::is_directory(key.parent_path())) throw InputError(path, "its folder does not exist");
+  const fs::path existing = DeepestExistingPart(key, &missing);
+  CheckNamesFit(path, "write " + what, existing, missing);
+  if (check_folder && !fs::is_directory(key.parent_path())) {
+    // A file where the folder should be (--out rig.yaml/x) is named as one.
+    const bool under_file = !existing.empty() && existing != key && !fs::is_directory(existing);
+    throw InputError(path, under_file ? existing.string() + " is a file, not a folder" : "its folder does not exist");
+  }
   // Found now, not when the file is written after the command's work. The
   // folder the path names, not its link's target's: the file is written
   // there (a temporary file renamed over the path, calib/core/atomic_file.h).

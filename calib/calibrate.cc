@@ -7,6 +7,7 @@
 #include <ctime>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <set>
 
 #include "calib/convergence.h"
@@ -190,6 +191,26 @@ SystemExclusions EarlierStageVerdicts(const CalibrationInput& in, const std::vec
   return ex;
 }
 
+// "" if stage 3's back_from_front is within its file's sigma (or was
+// held), else the line refusing the file. The bound is the same plate's
+// (kSamePlateChiSquare): a right file's chi-square is at most as wide as
+// chi-square with 6 degrees of freedom (SystemReport), so fewer than 3 in
+// 1000 right files are refused; a thickness typed in metres (tz 0.005 for
+// 5 mm, the file's sigma 0.01 mm) reads ~70000.
+std::string WrongPlateProblem(const PlateDifference& d) {
+  if (d.SamePlate()) return "";
+  char b[400];
+  std::snprintf(b, sizeof b,
+                "back_from_front: stage 3 moved its %s by %+.4f %s, against a sigma of %.4f %s from the file's "
+                "back_from_front_sigma (with its rotation's lever arm on a translation) (chi-square %.1f over the 6 "
+                "axes, above %.2f, which a right file exceeds fewer than 3 times in 1000)",
+                PlateAxisName(d.worst), d.worst_off, PlateAxisUnit(d.worst), d.worst_sigma, PlateAxisUnit(d.worst),
+                d.chi_square, kSamePlateChiSquare);
+  return std::string(b) +
+         ": the target file's back_from_front is not this plate's: measure the plate again or fix "
+         "the file";
+}
+
 }  // namespace
 
 CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions& options) {
@@ -252,6 +273,7 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
   }
 
   rep.not_converged = NotConvergedProblem(rep, rep.max_rms_px);
+  if (M > 1) rep.wrong_plate = WrongPlateProblem(rep.system.back_from_front_vs_file);
 
   // The rig.
   std::vector<Camera> cameras(nc, Camera("LENSMODEL_PINHOLE", {1, 1, 0, 0}, 1, 1));
@@ -449,6 +471,7 @@ std::string CalibrationReport::ToJson() const {
     WritePose(j, "back_from_front_refined", s.back_from_front);
     j.Number("back_from_front_change_deg", s.back_from_front_change_deg);
     j.Number("back_from_front_change_mm", s.back_from_front_change_mm);
+    j.Number("back_from_front_chi_square", s.back_from_front_vs_file.chi_square).String("wrong_plate", wrong_plate);
     j.String("solver", s.solver_summary).EndObject();
   }
   j.EndObject();
@@ -588,6 +611,7 @@ std::string SummaryText(const CalibrationReport& rep) {
     }
     AppendLine(&out, "  back_from_front refined: moved %.4f deg, %.4f mm from the measured",
                s.back_from_front_change_deg, s.back_from_front_change_mm);
+    if (!rep.wrong_plate.empty()) AppendLine(&out, "  REFUSED: %s", rep.wrong_plate.c_str());
   }
   return out;
 }
@@ -599,6 +623,12 @@ void WriteCalibrationOutputs(const CalibrationResult& result, const std::string&
   if (!result.report.not_converged.empty()) {
     WriteFileAtomically(report_path, result.report.ToJson());
     throw InputError(rig_path, "not written: " + result.report.not_converged + "; the report is in " + report_path);
+  }
+  if (!result.report.wrong_plate.empty()) {
+    WriteFileAtomically(report_path, result.report.ToJson());
+    const std::optional<CalibrationTarget>& board = result.rig.provenance().target;
+    throw InputError(board && !board->file.empty() ? board->file : "the target file",
+                     result.report.wrong_plate + "; " + rig_path + " not written; the report is in " + report_path);
   }
   // A rig file its readers would refuse (ReadRigFile checks every lens) is
   // not written: a solve that diverged says so now, not at the next

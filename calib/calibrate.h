@@ -42,6 +42,11 @@ struct CalibrationReport {
   // "" if all converged). Stage 1 over it: stages 2 and 3 are not run.
   double max_rms_px = 0.0;
   std::string not_converged;
+  // Stage 3's refined back_from_front far beyond the target file's stated
+  // sigma (SystemReport::back_from_front_vs_file over kSamePlateChiSquare):
+  // one line saying by how much and on which axis, for the message refusing
+  // the rig file; "" if within, or not refined (one module, a sigma of 0).
+  std::string wrong_plate;
   // The capture's folder name where known, else its index in decimal: how
   // the summary names a capture (the JSON keeps the index and adds the name).
   std::string CaptureName(int capture) const;
@@ -78,7 +83,10 @@ std::string SummaryText(const CalibrationReport& report);
 // camera no lens could be (lens_plausibility.h), or a stage that did not
 // converge (report.not_converged, convergence.h), writes the report alone
 // and throws InputError naming the rig file: its readers would refuse the
-// first, and the second would measure nothing to its figures.
+// first, and the second would measure nothing to its figures. A plate far
+// from its file (report.wrong_plate) writes the report alone and throws
+// InputError naming the target file (the rig's record of it, "the target
+// file" without one): S rests on a back_from_front the file contradicts.
 void WriteCalibrationOutputs(const CalibrationResult& result, const std::string& rig_path,
                              const std::string& report_path, const std::string& cameramodels_dir = "");
 

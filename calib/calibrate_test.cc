@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "calib/calib_test_util.h"
@@ -108,6 +109,9 @@ TEST(CalibrateE2E, DefaultTargetOfTheTargetsLibrary) {
   // noise: 0.0037-0.0099 mm off the truth, against the file's 0.026 mm):
   // the record is nearer the truth than the file by more than half its error.
   EXPECT_LT(rec_off_mm, 0.5 * file_off_mm);
+  // 1.5 sigma off on each axis is the same plate (a chi-square of at most
+  // 6 x 1.5^2 = 13.5 over the file's sigma, under 20.06): written.
+  EXPECT_EQ(r.report.wrong_plate, "");
 }
 
 TEST(CalibrateE2E, OneModuleRig) { CheckRig(testing::MakeOneModuleRig(), 7); }
@@ -250,6 +254,52 @@ TEST(CalibrateConvergence, AModuleThatMovedBetweenCapturesIsNamedByStageThree) {
               unmoved.report.system.refined_reprojection_rms_px);
   EXPECT_EQ(r.report.not_converged.rfind("stage 3 did not converge: half its corners are off by more than ", 0), 0u)
       << r.report.not_converged;
+}
+
+// A target file whose back_from_front is not the plate's: its thickness
+// typed in metres (tz 0.003 for the 3 mm plate; a user's file said 0.005 for
+// 5 mm). Stage 3 finds the plate from the corners (tz 2.9 mm, the file's
+// stated sigma 0.05 mm, with the lever arm of its rotation sigma 0.1 mm):
+// ~30 sigma on tz, a chi-square ~900, far over the bound of 20.06. The summary says so, the report is written, the rig
+// file is not, and the message names the target file, the axis, the move and its sigma. The same captures with the file
+// as drawn (within its sigma) pass.
+TEST(CalibrateRefuses, ABackFromFrontThatIsNotThePlates) {
+  auto s = testing::MakeDefaultScene(66, 12, kNoisePx);
+  const CalibrationResult right = Calibrate(s.data.input, CalibrationOptions());
+  EXPECT_EQ(right.report.wrong_plate, "");
+  EXPECT_LE(right.report.system.back_from_front_vs_file.chi_square, kSamePlateChiSquare);
+  TargetGeometry& t = s.data.input.target;
+  Eigen::Vector3d metres = t.back_from_front.translation_mm();
+  metres.z() /= 1000;
+  t.back_from_front = Pose(t.back_from_front.rotation(), metres);
+  CalibrationResult r = Calibrate(s.data.input, CalibrationOptions());
+  const PlateDifference& d = r.report.system.back_from_front_vs_file;
+  std::printf("plate typed in metres: chi-square %.1f, %s %+.4f\n", d.chi_square, PlateAxisName(d.worst), d.worst_off);
+  EXPECT_GT(d.chi_square, kSamePlateChiSquare);
+  EXPECT_STREQ(PlateAxisName(d.worst), "tz");
+  // Most of the 3 mm recovered (the prior still pulls: 2.90 mm on seed 66).
+  EXPECT_GT(d.worst_off, 2.5);
+  EXPECT_LT(d.worst_off, 3.0);
+  EXPECT_EQ(r.report.wrong_plate.rfind("back_from_front: stage 3 moved its tz by +2.", 0), 0u) << r.report.wrong_plate;
+  EXPECT_NE(r.report.wrong_plate.find(" mm, against a sigma of 0.0"), std::string::npos);
+  EXPECT_NE(SummaryText(r.report).find("  REFUSED: back_from_front: stage 3 moved its tz"), std::string::npos);
+
+  const std::string dir = ::testing::TempDir() + "/calibrate_wrong_plate";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  r.rig.provenance().target->file = dir + "/target.yaml";
+  const std::string e =
+      testing::InputErrorMessage([&] { WriteCalibrationOutputs(r, dir + "/rig.yaml", dir + "/report.json"); });
+  EXPECT_EQ(e.rfind(dir + "/target.yaml: back_from_front: stage 3 moved its tz by +2.", 0), 0u) << e;
+  EXPECT_NE(e.find("the target file's back_from_front is not this plate's: measure the plate again or fix the file; " +
+                   dir + "/rig.yaml not written; the report is in " + dir + "/report.json"),
+            std::string::npos)
+      << e;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/rig.yaml"));
+  std::ifstream report(dir + "/report.json");
+  const nlohmann::json j = nlohmann::json::parse(report);
+  EXPECT_GT(j.at("stage3_system").at("back_from_front_chi_square").get<double>(), kSamePlateChiSquare);
+  EXPECT_EQ(j.at("stage3_system").at("wrong_plate").get<std::string>(), r.report.wrong_plate);
 }
 
 TEST(CalibrateRefuses, CameraThatNeverSeesTheBoard) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <opencv2/core.hpp>
 #include <optional>
 
@@ -110,7 +111,7 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
         r.reason = RejectReason::kNoChessboard;
         r.message = std::string("detector failed: ") + e.what();
       }
-      ImageDetectionLog log{capture, c, image.string(), false, Face::kFront, 0, 0, r.message};
+      ImageDetectionLog log{capture, c, image.string(), false, Face::kFront, 0, 0, r.message, r.reason};
       if (r.reason == RejectReason::kNone && !r.faces.empty()) {
         const FaceDetection& f = r.faces[0];
         // A corner reported outside the image cannot be a real detection
@@ -129,6 +130,7 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
         log.face = f.face;
         log.num_corners = static_cast<int>(obs.corner_ids.size());
         log.reason.clear();
+        log.reject = RejectReason::kNone;
         line += " cam" + std::to_string(c) + " " + FaceName(f.face) + " " + std::to_string(log.num_corners);
         if (log.num_outside) line += " (" + std::to_string(log.num_outside) + " outside the image dropped)";
         out.observations.push_back(std::move(obs));
@@ -140,6 +142,28 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
     if (progress) std::fprintf(stderr, "%s\n", line.c_str());
   }
   return out;
+}
+
+std::string RejectedViewsNote(const DetectedCaptures& detected, const Target& target, const std::string& target_path) {
+  std::map<std::string, int> by_reason;
+  int rejected = 0;
+  for (const ImageDetectionLog& log : detected.log) {
+    if (log.accepted) continue;
+    ++rejected;
+    ++by_reason[RejectReasonName(log.reject)];
+  }
+  const int images = static_cast<int>(detected.log.size());
+  int off_layout = 0;
+  for (const RejectReason r : {RejectReason::kAmbiguous, RejectReason::kGridMismatch})
+    if (const auto it = by_reason.find(RejectReasonName(r)); it != by_reason.end()) off_layout += it->second;
+  if (2 * rejected <= images || 10 * off_layout < images) return "";
+  std::string reasons;
+  for (const auto& [reason, n] : by_reason) reasons += (reasons.empty() ? "" : ", ") + std::to_string(n) + " " + reason;
+  return std::to_string(rejected) + " of " + std::to_string(images) + " images rejected (" + reasons + "): is " +
+         target_path + " this board's target file? It says corners_x " + std::to_string(target.corners_x()) +
+         ", corners_y " + std::to_string(target.corners_y()) +
+         " (inner corners along a row, along a column); a board whose grid differs (or the two swapped) fits no "
+         "single orientation";
 }
 
 FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const std::string& target_path,
@@ -161,7 +185,14 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
   if (options.progress) {
     std::fprintf(stderr, "calibrate: %d captures, %d accepted views\n", out.num_captures, out.num_views);
   }
-  out.result = Calibrate(input, options);
+  const std::string rejected_note = RejectedViewsNote(detected, target, target_path);
+  if (!rejected_note.empty()) std::fprintf(stderr, "calibrate: warning: %s\n", rejected_note.c_str());
+  try {
+    out.result = Calibrate(input, options);
+  } catch (const InputError& e) {
+    if (rejected_note.empty()) throw;
+    throw InputError(e.where(), e.problem() + "; " + rejected_note);
+  }
   // Calibrate records the board (in the rig it built), not its file's name.
   // Absolute, so that the check's messages name it from wherever they run.
   if (std::optional<CalibrationTarget>& board = out.result.rig.provenance().target)

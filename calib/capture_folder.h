@@ -24,8 +24,9 @@ struct ImageDetectionLog {
   bool accepted = false;
   Face face = Face::kFront;
   int num_corners = 0;
-  int num_outside = 0;  // corners the detector placed outside the image, dropped here
-  std::string reason;   // why it was rejected (empty if accepted)
+  int num_outside = 0;                        // corners the detector placed outside the image, dropped here
+  std::string reason;                         // why it was rejected (empty if accepted)
+  RejectReason reject = RejectReason::kNone;  // its kind (kNone if accepted)
 };
 
 struct DetectedCaptures {
@@ -54,10 +55,22 @@ void RequireCapturesFolder(const std::string& dir);
 DetectedCaptures DetectCaptureFolder(const std::string& dir, const Target& target, int num_cameras,
                                      const DetectOptions& options, bool progress);
 
+// "" unless most images were rejected (more than half) and at least one in
+// ten as not fitting the target's layout (ambiguous: no single orientation
+// of the grid fits; grid_mismatch): then one line counting the rejections
+// by reason and asking whether `target_path` describes this board, its
+// corners_x and corners_y named. A board of 11 x 9 inner corners read with a
+// file of 9 x 11 (the corners swapped) left 29 of 200 images, 59 of them
+// rejected as ambiguous, and the calibration ended on "too few views"; a
+// right file rejects 13 of the same 200, none as ambiguous.
+std::string RejectedViewsNote(const DetectedCaptures& detected, const Target& target, const std::string& target_path);
+
 // The whole of `stereorig calibrate`: reads the target file, detects the
 // target in every capture and runs the three stages on the modules of
 // `modules` (the layout file, ReadLayoutFile in calib/layout_file.h, read
 // by the caller, which needs its cameras before: the files it will write).
+// A refusal after most images were rejected (RejectedViewsNote) carries the
+// note: the likely cause is the target file, not the stage that failed.
 struct FolderCalibration {
   CalibrationResult result;
   int num_captures = 0;

@@ -15,11 +15,19 @@
 namespace stereorig {
 
 void IntrinsicsOptions::Check() const {
-  if (Camera::NumIntrinsics(lensmodel) < 0)
-    throw InputError("options.lensmodel", "unknown lens model '" + lensmodel + "'");
+  // The models calibrate solves, by mrcal's names, for every refusal below.
+  const std::string models =
+      "LENSMODEL_OPENCV5, LENSMODEL_OPENCV8 or LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=.._Ny=.._fov_x_deg=..";
+  if (Camera::NumIntrinsics(lensmodel) < 0) {
+    // "OPENCV8" for LENSMODEL_OPENCV8: the prefix is part of mrcal's name.
+    const bool unprefixed = Camera::NumIntrinsics("LENSMODEL_" + lensmodel) >= 0;
+    throw InputError("options.lensmodel", "unknown lens model '" + lensmodel + "'" +
+                                              (unprefixed ? " (LENSMODEL_" + lensmodel + "?)" : "") + "; use " +
+                                              models);
+  }
   if (lensmodel.rfind("LENSMODEL_OPENCV", 0) != 0 && lensmodel.rfind("LENSMODEL_SPLINED_STEREOGRAPHIC", 0) != 0 &&
       lensmodel != "LENSMODEL_PINHOLE") {
-    throw InputError("options.lensmodel", "use LENSMODEL_OPENCV5, LENSMODEL_OPENCV8 or a splined stereographic model");
+    throw InputError("options.lensmodel", "'" + lensmodel + "' is not calibrated here; use " + models);
   }
   if (seed_focal_px < 0) throw InputError("options.seed_focal_px", "must be >= 0");
   if (min_corners_per_view < 4) throw InputError("options.min_corners_per_view", "must be >= 4");

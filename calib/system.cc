@@ -365,6 +365,26 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   rep.back_from_front = bff_block.ToPose();
   rep.back_from_front_change_deg = AngleBetweenDeg(target.back_from_front, rep.back_from_front);
   rep.back_from_front_change_mm = TranslationBetweenMm(target.back_from_front, rep.back_from_front);
+  if (bff_free) {
+    Eigen::Matrix<double, 6, 1> off;
+    off << PlateTurnDeg(rep.back_from_front, target.back_from_front),
+        rep.back_from_front.translation_mm() - target.back_from_front.translation_mm();
+    // The file's rotation sigma is about the front face's origin, |t| (~100
+    // mm) from the back's: a rotation error of the file (or a measurement
+    // that turned the plate about its middle) moves t by the lever arm,
+    // d t = d r x t, which the translation sigma alone does not hold (the
+    // engine's tests draw such files: a 0.05 deg turn moved ty 0.08 mm per
+    // sigma, chi-square 28 for an honest file). The translation's variance
+    // takes that term too.
+    const Eigen::Matrix<double, 6, 1>& sg = target.back_from_front_sigma;
+    const Eigen::Vector3d r2 = (sg.head<3>() * M_PI / 180.0).array().square();
+    const Eigen::Vector3d t = target.back_from_front.translation_mm();
+    Eigen::Matrix<double, 6, 1> variance = sg.array().square();
+    variance(3) += r2.y() * t.z() * t.z() + r2.z() * t.y() * t.y();
+    variance(4) += r2.z() * t.x() * t.x() + r2.x() * t.z() * t.z();
+    variance(5) += r2.x() * t.y() * t.y() + r2.y() * t.x() * t.x();
+    rep.back_from_front_vs_file = ComparePlates(off, variance);
+  }
 
   // 1 sigma of S[0][k], of each free right_from_left and of each camera's
   // free intrinsics, from the covariance of the adjustment, scaled by the

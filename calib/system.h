@@ -27,6 +27,7 @@
 #include "calib/core/camera.h"
 #include "calib/core/pose.h"
 #include "calib/observations.h"
+#include "calib/plate_difference.h"
 
 namespace stereorig {
 
@@ -121,6 +122,13 @@ struct SystemReport {
   Pose back_from_front;                                  // as refined
   double back_from_front_change_deg = 0.0;               // refined vs measured
   double back_from_front_change_mm = 0.0;
+  // The refined back_from_front against the target file's, per axis over the
+  // file's stated sigma (calib/plate_difference.h). The refined value is the
+  // file's (the prior) updated by the corners, so for a file that is right
+  // it moves by less than the prior's spread: chi-square at most as wide as
+  // chi-square with 6 degrees of freedom. Zero where it was held (a sigma
+  // of 0, no back face seen, or refine_back_from_front false).
+  PlateDifference back_from_front_vs_file;
   std::string solver_summary;  // Ceres BriefReport
 };
 

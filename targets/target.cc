@@ -5,8 +5,20 @@
 #include <set>
 
 #include "calib/core/input_error.h"
+#include "calib/core/number_text.h"
 
 namespace stereorig {
+
+namespace {
+
+// The smallest square a target may have, mm. A target's squares span
+// several pixels in its views (at 200 mm with a 1000 px focal length, 1 mm
+// is 5 px), and a size under this is a value typed in metres (a 9 mm square
+// as 0.009), which the tags' placement in mm would otherwise reject as "tag 0
+// must lie in the margin".
+constexpr double kMinSquareSizeMm = 1.0;
+
+}  // namespace
 
 const char* FaceName(Face face) { return face == Face::kFront ? "front" : "back"; }
 
@@ -16,6 +28,13 @@ Target::Target(Layout layout, const std::string& where) : layout_(std::move(layo
   // A square board is rotationally symmetric, so corner order is ambiguous
   // without tags; even x odd dimensions break the 180-degree symmetry too.
   if (l.square_size_mm <= 0) throw InputError(where, "square_size_mm must be positive");
+  // Said before the tags' placement, which fails against squares of
+  // micrometres.
+  if (l.square_size_mm < kMinSquareSizeMm) {
+    throw InputError(where, "square_size_mm " + NumberText(l.square_size_mm) + ": squares of " +
+                                NumberText(1000 * l.square_size_mm) + " um, under the " + NumberText(kMinSquareSizeMm) +
+                                " mm a camera resolves; is it in metres? the unit is mm");
+  }
   if (l.margin_mm < 0) throw InputError(where, "margin_mm must not be negative");
   if (l.flatness_allowance_mm < 0) throw InputError(where, "flatness_allowance_mm must not be negative");
   std::string why;

@@ -5,6 +5,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
+#include "calib/core/typed_pose.h"
 #include "calib/core/yaml_reader.h"
 
 namespace stereorig {
@@ -33,10 +34,7 @@ Target ParseTarget(YamlMap root) {
         t.Finish();
       }
     }
-    const Eigen::Matrix4d m = root.GetMatrix4("back_from_front");
-    std::string why;
-    if (!IsRigid(m, 1e-9, &why)) throw InputError(root.Where("back_from_front"), why);
-    l.back_from_front = Pose::FromMatrix4(m);
+    l.back_from_front = TypedRigidPose(root.GetMatrix4("back_from_front"), root.Where("back_from_front"));
     const std::vector<double> sigma = root.GetDoubles("back_from_front_sigma", 6);
     for (int i = 0; i < 6; ++i) {
       if (sigma[i] < 0) throw InputError(root.Where("back_from_front_sigma"), "must not be negative");

@@ -98,5 +98,25 @@ TEST(TargetFile, RoundTripsExactlyAndRejectsUnknownKeys) {
   EXPECT_EQ(plain_back.num_corners(), 54);
 }
 
+// A square size typed in metres (9 mm as 0.009) is named as such, at the
+// value and the unit, not as tags off the margin (their placement is in mm,
+// against squares of 9 um). The smallest square accepted is 1 mm.
+TEST(TargetFile, ASquareSizeInMetresIsNamedAsSuch) {
+  std::string text = TargetToYaml(DefaultTarget());
+  const std::string key = "square_size_mm: 9\n";
+  ASSERT_NE(text.find(key), std::string::npos) << text;
+  text.replace(text.find(key), key.size(), "square_size_mm: 0.009\n");
+  try {
+    ParseTargetYaml(text, "t_m.yaml");
+    ADD_FAILURE() << "squares of 9 um accepted";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "t_m.yaml: square_size_mm 0.009: squares of 9 um, under the 1 mm a camera resolves; is it in "
+                 "metres? the unit is mm");
+  }
+  EXPECT_NO_THROW(PlainTarget(9, 6, 1.0));
+  EXPECT_THROW(PlainTarget(9, 6, 0.999), InputError);
+}
+
 }  // namespace
 }  // namespace stereorig

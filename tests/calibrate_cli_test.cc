@@ -336,6 +336,34 @@ TEST(CalibrateCli, OutputsThatCollideOrHaveNoFolderAreRefusedBeforeAnyWork) {
   // calibration would have failed naming those.)
 }
 
+// Options are named by their flags, not the library's fields
+// ("options.lensmodel", "options.seed_focal_px"), with the valid values;
+// an output under a file says that it is a file, not that its folder is
+// missing. Refused before any work (the captures given do not exist).
+TEST(CalibrateCli, OptionsAreNamedByTheirFlags) {
+  const std::string dir = ::testing::TempDir() + "/calib_cli_flags";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir + "/layout.yaml") << "modules:\n  - {name: module0, left: 0, right: 1}\n";
+  std::ofstream(dir + "/rig.yaml") << "a file, not a folder\n";
+  const std::string inputs = "calibrate --captures " + dir + "/no_captures --target " + dir + "/target.yaml --layout " +
+                             dir + "/layout.yaml --report " + dir + "/report.json";
+  testing::Result r = testing::RunCli(inputs + " --out " + dir + "/out.yaml --lensmodel OPENCV8");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--lensmodel: unknown lens model 'OPENCV8' (LENSMODEL_OPENCV8?); use LENSMODEL_OPENCV5, "
+                       "LENSMODEL_OPENCV8 or LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=.._Ny=.._fov_x_deg=.."),
+            std::string::npos)
+      << r.err;
+  r = testing::RunCli(inputs + " --out " + dir + "/out.yaml --focal -5");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--focal"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("options."), std::string::npos) << r.err;
+  r = testing::RunCli(inputs + " --out " + dir + "/rig.yaml/x");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("rig.yaml/x: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("/rig.yaml is a file, not a folder"), std::string::npos) << r.err;
+}
+
 // The capture images are inputs too (calib/capture_folder.h,
 // CaptureFolderImages): --out, --report or --export-cameramodels named like
 // one of them, in a captures folder or a dataset's calibration/, would

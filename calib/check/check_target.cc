@@ -18,9 +18,6 @@ std::string Describe(int corners_x, int corners_y, double square_size_mm, bool d
          NumberText(square_size_mm, 12) + " mm, " + (double_sided ? "double-sided" : "one-sided");
 }
 
-// What %.4f prints as 0, mm or deg: a difference not worth a note.
-constexpr double kUnchangedInPrint = 5e-5;
-
 }  // namespace
 
 CheckTarget TargetForCheck(const Rig& rig, const Target& file_target, const std::string& target_path) {
@@ -69,17 +66,14 @@ CheckTarget TargetForCheck(const Rig& rig, const Target& file_target, const std:
     // the file's in-plane offset (tx, ty) is read both as written and at the
     // record's square size (it scales with the print, the plate's thickness
     // tz does not; a user may have updated it or not), the nearer taken.
-    static const char* const kAxis[6] = {"rx", "ry", "rz", "tx", "ty", "tz"};
     const Pose& file = file_target.back_from_front();
-    const Eigen::Vector3d turn_deg =
-        Pose(file.rotation() * rec->back_from_front_file.rotation().transpose(), Eigen::Vector3d::Zero())
-            .RotationVector() *
-        180.0 / M_PI;
+    const Eigen::Vector3d turn_deg = PlateTurnDeg(file, rec->back_from_front_file);
+    Eigen::Matrix<double, 6, 1> variance;
+    for (int k = 0; k < 6; ++k)
+      variance(k) =
+          std::pow(file_target.back_from_front_sigma()(k), 2) + std::pow(rec->back_from_front_sigma_file(k), 2);
     struct Reading {
-      double chi_square = 0;
-      int held_moved = -1;  // an axis both files hold that moved, or -1
-      int worst = 0;        // the axis adding most to chi_square
-      double worst_off = 0, worst_sigma = 0;
+      PlateDifference d;
       Eigen::Vector3d shift_mm = Eigen::Vector3d::Zero();
     };
     std::optional<Reading> nearer;  // of the two readings below
@@ -88,42 +82,29 @@ CheckTarget TargetForCheck(const Rig& rig, const Target& file_target, const std:
       r.shift_mm = file.translation_mm() - rec->back_from_front_file.translation_mm();
       r.shift_mm.head<2>() =
           file.translation_mm().head<2>() * scale - rec->back_from_front_file.translation_mm().head<2>();
-      double worst_chi = -1;
-      for (int k = 0; k < 6; ++k) {
-        const double off = k < 3 ? turn_deg(k) : r.shift_mm(k - 3);
-        const double s2 =
-            std::pow(file_target.back_from_front_sigma()(k), 2) + std::pow(rec->back_from_front_sigma_file(k), 2);
-        if (s2 == 0) {
-          if (std::abs(off) >= kUnchangedInPrint && r.held_moved < 0) r.held_moved = k;
-          continue;
-        }
-        r.chi_square += off * off / s2;
-        if (off * off / s2 > worst_chi) {
-          worst_chi = off * off / s2;
-          r.worst = k;
-          r.worst_off = off;
-          r.worst_sigma = std::sqrt(s2);
-        }
-      }
-      if (!nearer ||
-          std::make_pair(r.held_moved >= 0, r.chi_square) < std::make_pair(nearer->held_moved >= 0, nearer->chi_square))
+      Eigen::Matrix<double, 6, 1> off;
+      off << turn_deg, r.shift_mm;
+      r.d = ComparePlates(off, variance);
+      if (!nearer || std::make_pair(r.d.held_moved >= 0, r.d.chi_square) <
+                         std::make_pair(nearer->d.held_moved >= 0, nearer->d.chi_square))
         nearer = r;
     }
-    const Reading& best = *nearer;
-    out.file_vs_filed_mm = best.shift_mm.norm();
+    const Reading& reading = *nearer;
+    const PlateDifference& best = reading.d;
+    out.file_vs_filed_mm = reading.shift_mm.norm();
     out.file_vs_filed_deg = turn_deg.norm();
     char moved[96];
     std::snprintf(moved, sizeof moved, "%.4f mm and %.4f deg", out.file_vs_filed_mm, out.file_vs_filed_deg);
-    if (best.chi_square > kSamePlateChiSquare || best.held_moved >= 0) {
+    if (!best.SamePlate()) {
       char why[200];
-      const char* unit = best.worst < 3 ? "deg" : "mm";
       if (best.held_moved >= 0)
-        std::snprintf(why, sizeof why, "its %s moved, which both files hold (sigma 0)", kAxis[best.held_moved]);
+        std::snprintf(why, sizeof why, "its %s moved, which both files hold (sigma 0)", PlateAxisName(best.held_moved));
       else
         std::snprintf(why, sizeof why,
                       "chi-square %.1f over both files' sigmas, above %.2f, which two measurements of one plate "
                       "exceed 3 times in 1000 (most on %s: %+.4f %s against a sigma of %.4f)",
-                      best.chi_square, kSamePlateChiSquare, kAxis[best.worst], best.worst_off, unit, best.worst_sigma);
+                      best.chi_square, kSamePlateChiSquare, PlateAxisName(best.worst), best.worst_off,
+                      PlateAxisUnit(best.worst), best.worst_sigma);
       throw InputError(target_path, std::string("its back_from_front is ") + moved + " from the one filed when " +
                                         rig.Where() + " was calibrated (from " + recorded_file + "): " + why +
                                         ": another plate, or not this plate's file; the check's figures rest on "
@@ -132,7 +113,7 @@ CheckTarget TargetForCheck(const Rig& rig, const Target& file_target, const std:
     }
     layout.back_from_front = rec->back_from_front;
     out.back_from_front_as_calibrated = true;
-    if (out.file_vs_filed_mm >= kUnchangedInPrint || out.file_vs_filed_deg >= kUnchangedInPrint)
+    if (out.file_vs_filed_mm >= kPlateUnchangedInPrint || out.file_vs_filed_deg >= kPlateUnchangedInPrint)
       notes.push_back(std::string("the target file's back_from_front is ") + moved +
                       " from the one filed when the rig was calibrated, as two measurements of one plate may "
                       "differ: measured with the calibration's estimate");

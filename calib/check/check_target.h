@@ -18,6 +18,7 @@
 #include <utility>
 
 #include "calib/core/rig.h"
+#include "calib/plate_difference.h"
 #include "targets/target.h"
 
 namespace stereorig {
@@ -28,12 +29,9 @@ namespace stereorig {
 // ~0.1 %. Beyond, another board.
 inline constexpr double kSameBoardSquareOff = 0.005;
 // A target file whose back_from_front differs from the one filed at
-// calibration by no more than this chi-square (6 axes, each over the two
-// files' sigmas combined) is the same plate: the 99.73 % quantile of
-// chi-square with 6 degrees of freedom (3 sigma's two-sided coverage), so
-// 3 of 1000 honest re-measurements are taken for another plate. Beyond,
-// another plate (or not the plate's file): refused.
-inline constexpr double kSamePlateChiSquare = 20.06;
+// calibration by no more than kSamePlateChiSquare (calib/plate_difference.h;
+// 6 axes, each over the two files' sigmas combined) is the same plate.
+// Beyond, another plate (or not the plate's file): refused.
 
 struct CheckTarget {
   explicit CheckTarget(Target board) : target(std::move(board)) {}

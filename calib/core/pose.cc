@@ -1,6 +1,7 @@
 #include "pose.h"
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 namespace stereorig {
@@ -57,7 +58,12 @@ bool IsRigid(const Eigen::Matrix4d& m, double tol, std::string* why) {
   const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
   const double orth = (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (orth > tol) {
-    if (why) *why = "rotation is not orthonormal (max |R^T R - I| = " + std::to_string(orth) + ")";
+    if (why) {
+      char b[120];
+      std::snprintf(b, sizeof b, "rotation is not orthonormal (max |R^T R - I| = %.1e, over the %.0e allowed)", orth,
+                    tol);
+      *why = b;
+    }
     return false;
   }
   if (r.determinant() < 0) {

@@ -8,6 +8,7 @@
 #include "input_error.h"
 #include "lens_plausibility.h"
 #include "number_text.h"
+#include "typed_pose.h"
 #include "yaml_reader.h"
 
 namespace stereorig {
@@ -43,10 +44,7 @@ std::string Matrix4ToYaml(const Eigen::Matrix4d& m) {
 }
 
 Pose ReadRigidPose(const YAML::Node& n, const std::string& where) {
-  const Eigen::Matrix4d m = YamlMap::ToMatrix4(n, where);
-  std::string why;
-  if (!IsRigid(m, kSRotationTolerance, &why)) throw InputError(where, why);
-  return Pose::FromMatrix4(m);
+  return TypedRigidPose(YamlMap::ToMatrix4(n, where), where);
 }
 
 std::map<std::string, double> ReadNumberMap(YamlMap map) {

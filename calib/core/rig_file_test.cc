@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "calib/core/input_error.h"
+#include "calib/core/number_text.h"
 
 namespace stereorig {
 namespace {
@@ -79,6 +80,53 @@ TEST(RigFile, WriteReadWriteIsBitIdentical) {
       EXPECT_EQ(b.back_from_front_file.ToMatrix4(), t->back_from_front_file.ToMatrix4());
       EXPECT_EQ(b.back_from_front_sigma_file, t->back_from_front_sigma_file);
     }
+  }
+}
+
+// A rotation copied by hand with 8 significant digits (a user's
+// right_from_left: max |R^T R - I| 1e-9, just over the 1e-9 a written file
+// meets) is read, made orthonormal again; one off by 4.5e-5 (wrong numbers,
+// not rounding) is refused, the deviation and the tolerance printed (it
+// printed "max |R^T R - I| = 0.000000").
+TEST(RigFile, ARotationTypedWithEightDigitsIsReadAndAWrongOneRefused) {
+  const Rig rig = MakeRandomRig(0);
+  const std::string text = RigToYaml(rig);
+  const Eigen::Matrix4d m = rig.module(0).right_from_left.ToMatrix4();
+  const size_t line = text.find("right_from_left: [[");
+  ASSERT_NE(line, std::string::npos) << text;
+  // The rig file as written, module 0's rotation typed as `typed` (its
+  // elements replaced in the order they are printed, row by row).
+  auto with = [&](const Eigen::Matrix4d& typed) {
+    std::string t = text;
+    size_t at = line;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) {
+        const std::string was = FormatDouble(m(r, c)), now = FormatDouble(typed(r, c));
+        at = t.find(was, at);
+        t.replace(at, was.size(), now);
+        at += now.size();
+      }
+    return t;
+  };
+  Eigen::Matrix4d eight = m;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) eight(r, c) = std::stod(NumberText(m(r, c), 8));
+  std::string why;
+  ASSERT_FALSE(IsRigid(eight, 1e-9, &why)) << "8 digits must miss the strict tolerance for this test";
+  const Rig back = ParseRigYaml(with(eight), "rig_8dig.yaml");
+  const Eigen::Matrix3d r = back.module(0).right_from_left.rotation();
+  EXPECT_LT((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), 1e-15);
+  // The nearest rotation: within the typed digits' rounding (5e-9 on 0.1).
+  EXPECT_LT((r - m.topLeftCorner<3, 3>()).cwiseAbs().maxCoeff(), 1e-8);
+  Eigen::Matrix4d wrong = m;
+  wrong(0, 0) += 4.5e-5 / 2;  // |R^T R - I| grows by twice the change
+  try {
+    ParseRigYaml(with(wrong), "rig_nonortho.yaml");
+    ADD_FAILURE() << "a rotation 4.5e-5 off orthonormal accepted";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "rig_nonortho.yaml: modules[0].right_from_left: rotation is not orthonormal (max |R^T R - I| = "
+                 "4.5e-05, over the 1e-06 allowed)");
   }
 }
 

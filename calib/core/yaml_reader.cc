@@ -90,8 +90,21 @@ YAML::Node YamlMap::Require(const std::string& key) {
   return n;
 }
 
+namespace {
+
+// A scalar written in quotes ("2", '11'): YAML's string, whatever it
+// holds. yaml-cpp converts one to a number on request all the same; the
+// readers do not, as the docs promise a wrong type is an error (a quoted
+// number is a string in every other YAML reader). yaml-cpp tags a quoted
+// scalar "!", a plain one "?".
+bool IsQuoted(const YAML::Node& n) { return n.Tag() == "!"; }
+
+}  // namespace
+
 double YamlMap::ToDouble(const YAML::Node& n, const std::string& where) {
   if (!n.IsScalar()) throw InputError(where, "expected a number");
+  if (IsQuoted(n))
+    throw InputError(where, "expected a number, got the string \"" + n.Scalar() + "\" (drop the quotes)");
   double v;
   try {
     v = n.as<double>();
@@ -121,6 +134,8 @@ double YamlMap::GetDouble(const std::string& key, double default_value) {
 
 int YamlMap::GetInt(const std::string& key) {
   YAML::Node n = Require(key);
+  if (n.IsScalar() && IsQuoted(n))
+    throw InputError(Where(key), "expected an integer, got the string \"" + n.Scalar() + "\" (drop the quotes)");
   try {
     if (n.IsScalar()) return n.as<int>();
   } catch (const YAML::Exception&) {
@@ -139,13 +154,19 @@ bool YamlMap::GetBool(const std::string& key, bool default_value) {
   return GetBool(key);
 }
 
+// YAML 1.2's booleans only (true, false, and their True / TRUE forms):
+// yaml-cpp also takes YAML 1.1's yes/no/on/off/y/n, which YAML 1.2 readers
+// (Python's ruamel, Go's yaml.v3) read as strings: a file must mean the same
+// to every reader, and the docs say `true` or `false`.
 bool YamlMap::GetBool(const std::string& key) {
   YAML::Node n = Require(key);
-  try {
-    if (n.IsScalar()) return n.as<bool>();
-  } catch (const YAML::Exception&) {
+  if (n.IsScalar() && !IsQuoted(n)) {
+    const std::string& v = n.Scalar();
+    if (v == "true" || v == "True" || v == "TRUE") return true;
+    if (v == "false" || v == "False" || v == "FALSE") return false;
   }
-  throw InputError(Where(key), "expected true or false");
+  throw InputError(Where(key),
+                   "expected true or false" + (n.IsScalar() ? ", got '" + n.Scalar() + "'" : std::string()));
 }
 
 std::string YamlMap::GetString(const std::string& key) {
@@ -178,6 +199,8 @@ std::vector<int> YamlMap::GetInts(const std::string& key, int expected_size) {
   }
   std::vector<int> out;
   for (const auto& x : n) {
+    if (x.IsScalar() && IsQuoted(x))
+      throw InputError(Where(key), "expected integers, got the string \"" + x.Scalar() + "\" (drop the quotes)");
     try {
       out.push_back(x.as<int>());
     } catch (const YAML::Exception&) {

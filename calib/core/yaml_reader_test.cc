@@ -25,6 +25,35 @@ TEST(YamlMap, NamesFileAndKeyInEveryError) {
   EXPECT_EQ(InputErrorMessage([&] { m.GetDouble("zz"); }), "f.yaml: zz: missing key");
 }
 
+// A wrong type is an error (docs/formats.md): a quoted number is a string
+// (a rig file's `version: "2"`, a target file's `corners_x: "11"`), and
+// YAML 1.1's yes/no/on/off are not the documented true/false (a target
+// file's `double_sided: yes`). yaml-cpp converts all of them on request;
+// the reader did too. Plain numbers and YAML 1.2's booleans still read.
+TEST(YamlMap, QuotedNumbersAndYamlOneOneBooleansAreWrongTypes) {
+  YamlMap m = YamlMap::LoadString(
+      "version: \"2\"\ncorners_x: '11'\nsize: \"9.5\"\nids: [1, \"2\"]\ndouble_sided: yes\nb2: off\nb3: \"true\"\n"
+      "n: 2\nx: 9.5\nt: true\nf: False\nname: \"12\"\n",
+      "f.yaml");
+  EXPECT_EQ(InputErrorMessage([&] { m.GetInt("version"); }),
+            "f.yaml: version: expected an integer, got the string \"2\" (drop the quotes)");
+  EXPECT_EQ(InputErrorMessage([&] { m.GetInt("corners_x"); }),
+            "f.yaml: corners_x: expected an integer, got the string \"11\" (drop the quotes)");
+  EXPECT_EQ(InputErrorMessage([&] { m.GetDouble("size"); }),
+            "f.yaml: size: expected a number, got the string \"9.5\" (drop the quotes)");
+  EXPECT_EQ(InputErrorMessage([&] { m.GetInts("ids"); }),
+            "f.yaml: ids: expected integers, got the string \"2\" (drop the quotes)");
+  EXPECT_EQ(InputErrorMessage([&] { m.GetBool("double_sided"); }),
+            "f.yaml: double_sided: expected true or false, got 'yes'");
+  EXPECT_EQ(InputErrorMessage([&] { m.GetBool("b2"); }), "f.yaml: b2: expected true or false, got 'off'");
+  EXPECT_EQ(InputErrorMessage([&] { m.GetBool("b3"); }), "f.yaml: b3: expected true or false, got 'true'");
+  EXPECT_EQ(m.GetInt("n"), 2);
+  EXPECT_EQ(m.GetDouble("x"), 9.5);
+  EXPECT_TRUE(m.GetBool("t"));
+  EXPECT_FALSE(m.GetBool("f"));
+  EXPECT_EQ(m.GetString("name"), "12");  // a string may look like a number
+}
+
 TEST(YamlMap, FinishRejectsKeysNobodyRead) {
   YamlMap m = YamlMap::LoadString("known: 1\ntypo_key: 2\n", "f.yaml");
   m.GetInt("known");
@@ -60,7 +89,8 @@ TEST(YamlMap, ReadKeepsTheDefaultOfAnAbsentKeyAndNamesABadOne) {
   int bad_int = 3;
   bool bad_bool = true;
   EXPECT_EQ(InputErrorMessage([&] { m.Read("bad_int", &bad_int); }), "f.yaml: bad_int: expected an integer");
-  EXPECT_EQ(InputErrorMessage([&] { m.Read("bad_bool", &bad_bool); }), "f.yaml: bad_bool: expected true or false");
+  EXPECT_EQ(InputErrorMessage([&] { m.Read("bad_bool", &bad_bool); }),
+            "f.yaml: bad_bool: expected true or false, got 'maybe'");
   EXPECT_EQ(bad_int, 3);  // a value that does not parse leaves the field as it was
   EXPECT_TRUE(bad_bool);
   EXPECT_NO_THROW(m.Finish());  // the file's keys were all read, the two bad ones included

@@ -1,0 +1,41 @@
+#include "calib/capture_folder.h"
+
+#include <gtest/gtest.h>
+
+namespace stereorig {
+namespace {
+
+// A log of `images` images, `accepted` of them accepted and the rest
+// rejected for the reasons given, in order.
+DetectedCaptures Log(int accepted, const std::vector<std::pair<RejectReason, int>>& rejected) {
+  DetectedCaptures d;
+  for (int k = 0; k < accepted; ++k) d.log.push_back({k, 0, "", true, Face::kFront, 50, 0, "", RejectReason::kNone});
+  for (const auto& [reason, n] : rejected)
+    for (int k = 0; k < n; ++k) d.log.push_back({k, 1, "", false, Face::kFront, 0, 0, "why", reason});
+  return d;
+}
+
+// The user's swapped corners (a 9 x 11 file for an 11 x 9 board): 29 of 200
+// images accepted, 59 rejected as ambiguous. Named, with the file's
+// corners_x and corners_y. A right file's 13 rejections of 200 (none
+// ambiguous), or most rejected with the board out of view (no_chessboard
+// only), say nothing of the layout.
+TEST(RejectedViewsNote, MostImagesRejectedAsOffTheLayoutNameTheTargetFile) {
+  const Target swapped = PlainTarget(9, 11, 9.0);
+  const DetectedCaptures d =
+      Log(29, {{RejectReason::kNoChessboard, 93}, {RejectReason::kAmbiguous, 59}, {RejectReason::kTooFewCorners, 19}});
+  EXPECT_EQ(RejectedViewsNote(d, swapped, "t_swap.yaml"),
+            "171 of 200 images rejected (59 ambiguous, 93 no_chessboard, 19 too_few_corners): is t_swap.yaml this "
+            "board's target file? It says corners_x 9, corners_y 11 (inner corners along a row, along a column); a "
+            "board whose grid differs (or the two swapped) fits no single orientation");
+  EXPECT_EQ(
+      RejectedViewsNote(Log(187, {{RejectReason::kNoTags, 11}, {RejectReason::kTooFewCorners, 2}}), swapped, "t.yaml"),
+      "");
+  EXPECT_EQ(RejectedViewsNote(Log(29, {{RejectReason::kNoChessboard, 171}}), swapped, "t.yaml"), "");
+  // Half rejected is not most.
+  EXPECT_EQ(RejectedViewsNote(Log(100, {{RejectReason::kAmbiguous, 100}}), swapped, "t.yaml"), "");
+  EXPECT_NE(RejectedViewsNote(Log(99, {{RejectReason::kGridMismatch, 101}}), swapped, "t.yaml"), "");
+}
+
+}  // namespace
+}  // namespace stereorig
