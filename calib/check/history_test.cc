@@ -18,6 +18,7 @@ CheckResult Result(double value, bool pass) {
     CameraChange moved;
     moved.camera = 0;
     moved.kind = CameraChangeKind::kMoved;
+    moved.turned_deg = 0.05, moved.shifted_mm = 0.002;
     r.camera_changes = {moved};
   }
   return r;
@@ -32,7 +33,7 @@ TEST(History, AppendsRunsAndReadsTrendsBack) {
   const auto runs = ReadHistoryRuns(db);
   ASSERT_EQ(runs.size(), 3u);
   EXPECT_EQ(runs[2].verdict, "recalibrate");
-  EXPECT_EQ(runs[2].explanation, "camera 0 moved");
+  EXPECT_EQ(runs[2].explanation, "camera 0 moved: turned 0.050 deg, shifted 0.002 mm");
   const auto trends = ReadHistoryTrends(db);
   ASSERT_EQ(trends.size(), 2u);
   EXPECT_EQ(trends[0].name, "cam0_consistency_rms_px");
