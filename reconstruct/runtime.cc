@@ -524,10 +524,9 @@ std::vector<cv::Mat> LoadCapture(const std::string& dir, const Rig& rig) {
   return images;
 }
 
-ModuleReport::RangeEnds ModuleReport::RangeEndsReached() const {
-  if (occupied_end_disparity_px <= occupied_min_disparity_px || num_disparities <= 0) return {};
-  return {.near = min_disparity_px + num_disparities - occupied_end_disparity_px <= kBandBinPx,
-          .far = occupied_min_disparity_px - min_disparity_px <= kBandBinPx};
+RangeEnds ModuleReport::RangeEndsReached() const {
+  return stereorig::RangeEndsReached(min_disparity_px, num_disparities, occupied_min_disparity_px,
+                                     occupied_end_disparity_px);
 }
 
 }  // namespace stereorig

@@ -61,6 +61,27 @@ TEST(MatchCli, WritesAPfmThatMatchesTheTruth) {
   EXPECT_TRUE(std::isinf(disp.at<float>(100, 0)));
 }
 
+// A pair with nothing to match (flat grey) gives no valid disparity: match
+// said only "0 valid disparities", exit 0; now a hint that the range may
+// miss the scene. (The range-end warning: ReconstructCli.
+// MatchWarnsOfARangeThatMissesTheObject, on a rendered capture's
+// rectified pair: on this small synthetic pair, a perfectly periodic grid,
+// the band pass keeps period-off copies to the far end of any range.)
+TEST(MatchCli, NoValidDisparityHintsThatTheRangeMayMissTheScene) {
+  const std::string dir = ::testing::TempDir() + "/match_cli_flat";
+  std::filesystem::create_directories(dir);
+  ASSERT_TRUE(cv::imwrite(dir + "/flat.png", cv::Mat(240, 320, CV_8UC1, cv::Scalar(100))));
+  const testing::Result none =
+      testing::RunCli("match --left " + dir + "/flat.png --right " + dir +
+                      "/flat.png --min-disparity 24 --num-disparities 64 --out " + dir + "/d.pfm");
+  ASSERT_EQ(none.code, 0) << none.err;
+  EXPECT_NE(none.out.find(" 0 valid disparities"), std::string::npos) << none.out;
+  EXPECT_NE(none.err.find("stereorig match: hint: no valid disparity: the range [24, 88) px (--min-disparity, "
+                          "--num-disparities) may miss the scene"),
+            std::string::npos)
+      << none.err;
+}
+
 // score: a dataset folder without a rig is bad input (exit 2), not a crash.
 // (An unusable --diagnose folder, and bad input beside a usable one:
 // ReconstructCli.ScoreBadInputLeavesNoDiagnoseFolder.)
