@@ -51,9 +51,16 @@ int RunMatch(int argc, char** argv) {
   CLI::App app{
       "The correspondence stage alone (dense matching, filtering, sub-pixel refinement) on an already rectified "
       "8-bit grey pair. Writes the left view's disparity (x_right = x_left - d) as PFM: little-endian, rows "
-      "bottom to top, invalid pixels = +inf.\n\n"
-      "Example:\n  stereorig match --left L.png --right R.png --min-disparity 380 --num-disparities 160 "
-      "--out disp.pfm",
+      "bottom to top, invalid pixels = +inf.\n"
+      "A module's rectified pair, and the disparity range and ROI the runtime searches in it, come from "
+      "`stereorig reconstruct ... --rectified-out DIR`, which writes DIR/moduleM_left.png and "
+      "DIR/moduleM_right.png and prints this command for each module. Matches piling up at an end of the range "
+      "(the range misses the object: the laser grid matched whole periods off) are warned of on stderr.\n\n"
+      "Example (the demo rig's module 0 under the default measurement volume):\n"
+      "  stereorig reconstruct --rig demo/rig.yaml --capture demo/dataset/scenes/cup/active --out cup.ply "
+      "--rectified-out rect\n"
+      "  stereorig match --left rect/module0_left.png --right rect/module0_right.png --min-disparity -100 "
+      "--num-disparities 274 --roi 0 0 752 582 --out disp.pfm",
       "stereorig match"};
   std::string left_path, right_path, out_path, matcher = "census_sgm";
   MatchOptions options;
@@ -134,12 +141,13 @@ int RunMatch(int argc, char** argv) {
     std::fprintf(stderr,
                  "stereorig match: warning: the disparities pile up at %s of the range %s: the range likely misses "
                  "the object (its surface goes on past the range, or the laser grid was matched whole periods off, "
-                 "every such disparity wrong); widen or move the range\n",
+                 "every such disparity wrong); widen or move the range (`stereorig reconstruct --rectified-out` "
+                 "prints the range a rig's module needs)\n",
                  ends.c_str(), range.c_str());
   else if (valid == 0)
     std::fprintf(stderr,
                  "stereorig match: hint: no valid disparity: the range %s may miss the scene, or the images hold no "
-                 "texture to match\n",
+                 "texture to match (`stereorig reconstruct --rectified-out` prints the range a rig's module needs)\n",
                  range.c_str());
   return kExitOk;
 }

@@ -199,6 +199,11 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
 namespace stereorig {
 namespace {
 
+std::string ReadFileBytes(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
 // `stereorig args` exits 2 with one line on stderr that says `says`.
 void ExpectRefusedInOneLine(const std::string& args, const std::string& says) {
   const testing::Result r = testing::RunCli(args);
@@ -369,6 +374,83 @@ TEST_F(ReconstructCli, MatchesReachingAnEndOfTheVolumesRangeAreWarnedOf) {
   EXPECT_TRUE(std::regex_search(batch.out, std::regex("\n  warning: module [01]'s matches reach the far end of the "
                                                       "measurement volume's disparity range")))
       << batch.out;
+}
+
+// `match` takes a rectified pair and a disparity range, and no command gave
+// either: --rectified-out writes each module's pair as the runtime
+// rectifies it and prints the match command that searches it with the
+// runtime's range and ROI. That command, run as printed, matches the sphere
+// with no range warning; the cloud is the one written without the option.
+TEST_F(ReconstructCli, RectifiedOutWritesEachModulesPairAndTheMatchCommandForIt) {
+  ASSERT_EQ(RunCli(Args(dir_ + "/capture")), 0);
+  const std::string plain_cloud = ReadFileBytes(dir_ + "/out.ply");
+  const std::string rect = dir_ + "/rect/new";
+  std::filesystem::remove_all(dir_ + "/rect");
+  const testing::Result r = testing::RunCli(Args(dir_ + "/capture", "--rectified-out " + rect));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(ReadFileBytes(dir_ + "/out.ply"), plain_cloud);
+  for (int m = 0; m < 2; ++m) {
+    const std::string left = rect + "/module" + std::to_string(m) + "_left.png";
+    const cv::Mat image = cv::imread(left, cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(image.type(), CV_8UC1) << left;
+    EXPECT_GT(cv::countNonZero(image), image.total() / 10) << left;
+    const std::string says = "module " + std::to_string(m) + ": rectified pair " + left + ", ";
+    const size_t at = r.out.find(says);
+    ASSERT_NE(at, std::string::npos) << r.out;
+    const size_t command = r.out.find("stereorig match ", at);
+    ASSERT_NE(command, std::string::npos) << r.out;
+    const std::string args = r.out.substr(command + 10, r.out.find('\n', command) - command - 10);
+    EXPECT_NE(args.find(" --min-disparity "), std::string::npos) << args;
+    EXPECT_NE(args.find(" --roi "), std::string::npos) << args;
+    const testing::Result match = testing::RunCli(args);
+    ASSERT_EQ(match.code, 0) << args << ": " << match.err;
+    EXPECT_EQ(match.err, "") << args;
+    EXPECT_TRUE(std::filesystem::exists(rect + "/module" + std::to_string(m) + "_disparity.pfm"));
+  }
+  // One capture only: a batch has many pairs per module.
+  ExpectRefusedInOneLine("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture --out-dir " + dir_ +
+                             "/rect_batch --rectified-out " + rect,
+                         "--out-dir excludes --rectified-out");
+}
+
+// match on a module's rectified pair of the rendered sphere, its range
+// ending halfway into the sphere's disparities (the walkthrough's: true
+// 472-549 px searched in [300, 500), 63 568 disparities, ~99 % a grid
+// period or more off, exit 0 and no word): the laser grid matches at a
+// copy of itself inside the range and the band pass's matches pile up at
+// its near end. match now warns as reconstruct warns of a module
+// (range_end_reached), on stderr and in its summary line; on the
+// runtime's own range it does not.
+TEST_F(ReconstructCli, MatchWarnsOfARangeThatMissesTheObject) {
+  const std::string rect = dir_ + "/rect_miss";
+  std::filesystem::remove_all(rect);
+  ASSERT_EQ(RunCli(Args(dir_ + "/capture", "--rectified-out " + rect)), 0);
+  std::ifstream f(dir_ + "/out.json");
+  const nlohmann::json module0 = nlohmann::json::parse(f)["modules"][0];
+  ASSERT_TRUE(module0.contains("occupied_disparity_px")) << module0.dump();
+  const int middle_px =
+      (module0["occupied_disparity_px"][0].get<int>() + module0["occupied_disparity_px"][1].get<int>()) / 2;
+  const auto match = [&](int min_px, int end_px) {
+    return testing::RunCli("match --left " + rect + "/module0_left.png --right " + rect +
+                           "/module0_right.png --min-disparity " + std::to_string(min_px) + " --num-disparities " +
+                           std::to_string(end_px - min_px) + " --out " + rect + "/d.pfm");
+  };
+  const int range_min_px = module0["disparity_range_px"][0], range_end_px = module0["disparity_range_px"][1];
+  const testing::Result right = match(range_min_px, range_end_px);
+  ASSERT_EQ(right.code, 0) << right.err;
+  EXPECT_EQ(right.err, "");
+  EXPECT_EQ(right.out.find("warning"), std::string::npos) << right.out;
+  const testing::Result missing = match(middle_px - 200, middle_px);
+  ASSERT_EQ(missing.code, 0) << missing.err;
+  EXPECT_NE(missing.err.find("stereorig match: warning: the disparities pile up at the near end (largest "
+                             "disparities) of the range [" +
+                             std::to_string(middle_px - 200) + ", " + std::to_string(middle_px) +
+                             ") px (--min-disparity, --num-disparities): the range likely misses the object"),
+            std::string::npos)
+      << missing.err;
+  EXPECT_NE(missing.out.find("; warning: they reach the near end (largest disparities) of the range\n"),
+            std::string::npos)
+      << missing.out;
 }
 
 TEST_F(ReconstructCli, MissingCameraExitsTwoAndWritesNothing) {
