@@ -168,6 +168,15 @@ RuntimeOptions FromYaml(YamlMap& y) {
     m.Read("grid_half_period_px", &mo.grid_half_period_px);
     m.Finish();
   }
+  // The docs name the matcher's keys `match.min_zncc`; written so, YAML
+  // reads one top-level key with a dot in its name. Say how it nests, not
+  // only "unknown key" (a hint: it is still refused).
+  for (const std::string& key : y.Keys())
+    if (key.rfind("match.", 0) == 0 && key.size() > 6)
+      throw InputError(y.Where(key),
+                       "unknown key: the matcher's keys nest under a `match:` mapping: write it as "
+                       "`match:` then, on the next line, `  " +
+                           key.substr(6) + ": ...`");
   y.Finish();
   try {
     o.Check();

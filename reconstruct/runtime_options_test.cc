@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
 #include <utility>
 
 #include "calib/core/input_error.h"
@@ -234,6 +235,26 @@ TEST(RuntimeOptions, ReadsAndChecksTheStrongSpeckleKeys) {
       {"match:\n  line_index_seam_spread_px: 0\n", "line_index_seam_spread_px"},
       {"match:\n  line_index_seam_spread_px: 5\n", "line_index_seam_spread_px"}};
   ExpectEachRejectedNamingItsKey(bad);
+}
+
+// The message of the InputError `text` is refused with ("" if accepted).
+std::string RefusalOf(const std::string& text, const std::string& where = "o.yaml") {
+  try {
+    ParseRuntimeOptions(text, where);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The docs name the matcher's keys `match.min_zncc`; written so, the key was
+// refused as "unknown key" with no word of the nesting. Still refused, now
+// with how to write it.
+TEST(RuntimeOptions, AMatchKeyWrittenDottedIsRefusedWithHowItNests) {
+  EXPECT_EQ(RefusalOf("match.min_zncc: 0.7\n"),
+            "o.yaml: match.min_zncc: unknown key: the matcher's keys nest under a `match:` mapping: write it as "
+            "`match:` then, on the next line, `  min_zncc: ...`");
+  EXPECT_EQ(ParseRuntimeOptions("match:\n  min_zncc: 0.7\n", "o.yaml").match.min_zncc, 0.7);
 }
 
 }  // namespace
