@@ -329,8 +329,9 @@ TEST_F(ReconstructCli, AModuleWithNoLitPixelInTheVolumeSaysWhy) {
        std::regex("\n  no point: [1-9][0-9]* px of the left camera's image are grid-lit, none where the measurement "
                   "volume projects: the volume is beside the object; set working_distance_mm \\(or "
                   "volume_center_mm, volume_size_mm\\) to where it is")},
-      {Args(dark), std::regex("\n  no point: no pixel of the left camera's image is grid-lit \\(9x9 std above "
-                              "lit_contrast_dn\\): a dark or flat image")}};
+      {Args(dark), std::regex("\n  no point: no lit pixels: is the projector on, or is this a passive capture\\? No "
+                              "pixel of the left camera's image is grid-lit \\(9x9 std above lit_contrast_dn\\): a "
+                              "dark or flat image")}};
   for (const auto& [args, says] : cases) {
     const testing::Result r = testing::RunCli(args);
     ASSERT_EQ(r.code, 0) << args << ": " << r.err;
