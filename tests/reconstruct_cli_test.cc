@@ -414,6 +414,28 @@ TEST_F(ReconstructCli, RectifiedOutWritesEachModulesPairAndTheMatchCommandForIt)
                          "--out-dir excludes --rectified-out");
 }
 
+// A grey PNG of 1, 2 or 4 bits decodes to 8 bits (0/255 for 1 bit): a 1-bit
+// capture gave 0 points and a 4-bit one fewer, exit 0 both. Refused now as
+// formats.md says (8-bit grey only), naming the file and its depth; so is
+// such an image given to match.
+TEST_F(ReconstructCli, GreyImagesOfFewerThan8BitsAreRefusedNamingTheirDepth) {
+  for (const int bits : {1, 2, 4}) {
+    const std::string capture = BrokenCapture("bits" + std::to_string(bits));
+    const std::string image = capture + "/cam3.png";
+    std::string raw;  // 8 x 2 px: per row a filter byte and 8 samples packed
+    for (int row = 0; row < 2; ++row) raw += '\0' + std::string(size_t(bits), '\x5a');
+    std::ofstream(image, std::ios::binary)
+        << testing::kPngSignature + testing::Chunk("IHDR", testing::Ihdr(8, 2, bits, 0)) +
+               testing::Chunk("IDAT", testing::Deflate(raw, 9)) + testing::Chunk("IEND", "");
+    const std::string says = image + ": is a " + std::to_string(bits) + "-bit grey PNG: captures must be 8-bit grey";
+    ExpectRefusedInOneLine(Args(capture), says);
+    ExpectNoOutput();
+    ExpectRefusedInOneLine("match --left " + image + " --right " + image +
+                               " --min-disparity 0 --num-disparities 16 --out " + dir_ + "/bits.pfm",
+                           says);
+  }
+}
+
 // match on a module's rectified pair of the rendered sphere, its range
 // ending halfway into the sphere's disparities (the walkthrough's: true
 // 472-549 px searched in [300, 500), 63 568 disparities, ~99 % a grid
