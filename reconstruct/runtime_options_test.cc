@@ -257,5 +257,24 @@ TEST(RuntimeOptions, AMatchKeyWrittenDottedIsRefusedWithHowItNests) {
   EXPECT_EQ(ParseRuntimeOptions("match:\n  min_zncc: 0.7\n", "o.yaml").match.min_zncc, 0.7);
 }
 
+// Values no rig can use were taken: object_size_mm 0.001 wrote an empty
+// cloud (exit 0), 1e9 and fill_spacing_mm 1e6 turned their steps off
+// unsaid, lit_contrast_dn 300 lit nothing (an 8-bit window's std is at
+// most 127.5). Each is refused naming the file and key; the bounds
+// themselves are taken.
+TEST(RuntimeOptions, ValuesPastWhatTheRigCanMeasureAreRefused) {
+  for (const char* bad :
+       {"object_size_mm: 0.001\n", "object_size_mm: 1e9\n", "object_size_mm: 235\n", "lit_contrast_dn: 300\n",
+        "lit_contrast_dn: 127.5\n", "fill_spacing_mm: 1e6\n", "object_size_mm: 50\nfill_spacing_mm: 51\n"}) {
+    const std::string key = std::string(bad).substr(std::string(bad).rfind('\n', std::string(bad).size() - 2) + 1);
+    const std::string says = "o.yaml: " + key.substr(0, key.find(':')) + ": must be in ";
+    EXPECT_EQ(RefusalOf(bad).rfind(says, 0), 0u) << bad << " -> " << RefusalOf(bad);
+  }
+  // The default volume's diagonal: sqrt(150^2 + 150^2 + 100^2) = 234.5 mm.
+  EXPECT_EQ(RefusalOf("object_size_mm: 1\nfill_spacing_mm: 1\n"), "");
+  EXPECT_EQ(RefusalOf("object_size_mm: 234.5\nlit_contrast_dn: 127\n"), "");
+  EXPECT_EQ(RefusalOf("object_size_mm: 400\nvolume_size_mm: [300, 300, 200]\n"), "");
+}
+
 }  // namespace
 }  // namespace stereorig
