@@ -276,5 +276,18 @@ TEST(RuntimeOptions, ValuesPastWhatTheRigCanMeasureAreRefused) {
   EXPECT_EQ(RefusalOf("object_size_mm: 400\nvolume_size_mm: [300, 300, 200]\n"), "");
 }
 
+// yaml-cpp reads the first document only: a second one's keys, typos too,
+// were never checked. The options file is one mapping: a second document
+// is refused naming the file and the line it starts on; a lone trailing
+// `---` (an empty document) is no setting and passes.
+TEST(RuntimeOptions, ASecondYamlDocumentIsRefused) {
+  EXPECT_EQ(RefusalOf("object_size_mm: 50\n---\nbogus_key: 1\n"),
+            "o.yaml: line 3: a second YAML document (after `---`): the runtime options are one mapping; remove the "
+            "`---`, or merge its keys into the first document");
+  EXPECT_NE(RefusalOf("object_size_mm: 50\n---\n[: bad\n").find("o.yaml: line "), std::string::npos);
+  EXPECT_EQ(RefusalOf("---\nobject_size_mm: 50\n"), "");
+  EXPECT_EQ(RefusalOf("object_size_mm: 50\n---\n"), "");
+}
+
 }  // namespace
 }  // namespace stereorig
