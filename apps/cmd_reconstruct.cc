@@ -22,6 +22,21 @@
 
 namespace stereorig {
 
+namespace {
+
+// Hole filling runs on the joined mesh: with shape_model set and no mesh
+// asked for, nothing is filled, which the run did without a word.
+void NoteShapeModelWithoutMesh(const RuntimeOptions& options, bool mesh) {
+  if (options.shape_model == ShapeModel::kNone || mesh) return;
+  std::printf(
+      "note: shape_model %s fills holes only with a mesh (--mesh; --mesh-format for many captures): nothing will "
+      "be filled\n",
+      ShapeModelName(options.shape_model));
+  std::fflush(stdout);
+}
+
+}  // namespace
+
 int RunReconstruct(int argc, char** argv) {
   CLI::App app{
       "One capture in, a measured 3D model out: rectify each module, match (census SGM tuned to the laser grid, "
@@ -120,6 +135,7 @@ int RunReconstruct(int argc, char** argv) {
           {.path = report_path, .rig_path = rig_path, .options_path = options_path, .check_folder = false});
     const Rig rig = ReadRigFile(rig_path);
     const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
+    NoteShapeModelWithoutMesh(options, !mesh_format.empty());
     if (stream)
       return ReconstructStream(
           rig, options,
@@ -154,6 +170,7 @@ int RunReconstruct(int argc, char** argv) {
     }
   }
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
+  NoteShapeModelWithoutMesh(options, !mesh_path.empty());
   const std::vector<cv::Mat> images = LoadCapture(capture_dir, rig);
   const Runtime runtime(rig, options);
   const Reconstruction rec = runtime.Process(images, !mesh_path.empty());
@@ -173,6 +190,7 @@ int RunReconstruct(int argc, char** argv) {
   std::printf("%zu points (%d from the shape model) in %.1f ms; wrote %s", rec.cloud.size(), rec.filled_points,
               rec.times_ms.at("total_point_cloud"), out_path.c_str());
   if (!mesh_path.empty()) std::printf(", %s (%zu triangles)", mesh_path.c_str(), rec.mesh.triangles.size());
+  if (!report_path.empty()) std::printf(", %s", report_path.c_str());
   std::printf("\n");
   if (!mesh_path.empty()) std::printf("shape model: %s\n", rec.shape_fit.c_str());
   for (size_t m = 0; m < rectified_paths.size(); ++m)

@@ -436,6 +436,26 @@ TEST_F(ReconstructCli, GreyImagesOfFewerThan8BitsAreRefusedNamingTheirDepth) {
   }
 }
 
+// shape_model fills holes only from a mesh: without --mesh nothing was
+// filled and nothing said. Now one note; with --mesh none. The summary's
+// "wrote" names every file written, the report too (it left it out).
+TEST_F(ReconstructCli, AShapeModelWithoutAMeshIsNotedAndTheSummaryNamesEveryOutput) {
+  WriteFileAtomically(dir_ + "/sphere_model.yaml", "shape_model: sphere\n");
+  const testing::Result r = testing::RunCli(Args(dir_ + "/capture", "--options " + dir_ + "/sphere_model.yaml"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string note = "note: shape_model sphere fills holes only with a mesh (--mesh";
+  EXPECT_NE(r.out.find(note), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find(note), r.out.rfind(note)) << r.out;
+  EXPECT_NE(r.out.find("; wrote " + dir_ + "/out.ply, " + dir_ + "/out.json\n"), std::string::npos) << r.out;
+  const testing::Result meshed =
+      testing::RunCli(Args(dir_ + "/capture", "--options " + dir_ + "/sphere_model.yaml --mesh " + dir_ + "/out.stl"));
+  ASSERT_EQ(meshed.code, 0) << meshed.err;
+  EXPECT_EQ(meshed.out.find("note: shape_model"), std::string::npos) << meshed.out;
+  EXPECT_TRUE(std::regex_search(meshed.out, std::regex("; wrote [^\n]*/out\\.ply, [^\n]*/out\\.stl \\([0-9]+ "
+                                                       "triangles\\), [^\n]*/out\\.json\n")))
+      << meshed.out;
+}
+
 // match on a module's rectified pair of the rendered sphere, its range
 // ending halfway into the sphere's disparities (the walkthrough's: true
 // 472-549 px searched in [300, 500), 63 568 disparities, ~99 % a grid
