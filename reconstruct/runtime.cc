@@ -494,12 +494,17 @@ void CheckCaptureFiles(const std::string& dir, const Rig& rig) {
   namespace fs = std::filesystem;
   if (fs::exists(dir) && !fs::is_directory(dir)) throw InputError(dir, "is a file, not a capture folder");
   if (!fs::is_directory(dir)) throw InputError(dir, "capture folder not found");
-  for (const auto& entry : fs::directory_iterator(dir)) {
-    const std::optional<int> camera = CameraIndexOfImageName(entry.path().filename().string());
+  // Listed with an error code: std::filesystem's own exception read
+  // "filesystem error: directory iterator cannot open directory: Permission
+  // denied [DIR]", in no words of the command's.
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::optional<int> camera = CameraIndexOfImageName(it->path().filename().string());
     if (camera && *camera >= rig.num_cameras())
-      throw InputError(entry.path().string(), "the rig has only " + std::to_string(rig.num_cameras()) +
-                                                  " cameras: this capture does not match the rig");
+      throw InputError(it->path().string(), "the rig has only " + std::to_string(rig.num_cameras()) +
+                                                " cameras: this capture does not match the rig");
   }
+  if (ec) throw InputError(dir, "the capture folder cannot be read: " + ec.message());
   const std::vector<std::string> paths = CaptureImagePaths(dir, rig);
   for (size_t k = 0; k < paths.size(); ++k)
     if (!fs::exists(paths[k]))

@@ -456,6 +456,36 @@ TEST_F(ReconstructCli, AShapeModelWithoutAMeshIsNotedAndTheSummaryNamesEveryOutp
       << meshed.out;
 }
 
+// A capture folder or image this process may not read was named in
+// std::filesystem's words ("filesystem error: directory iterator cannot
+// open directory: Permission denied [DIR]") or without the reason ("cannot
+// be opened"). Now the folder is named as a capture folder that cannot be
+// read, and the image's reason is given. Root reads any folder: the folder
+// is then read as the unprivileged user `nobody`; a sysctl file open for
+// writing only refuses reading even to root.
+TEST_F(ReconstructCli, AFolderOrImageThatCannotBeReadSaysWhy) {
+  const std::string locked = BrokenCapture("locked");
+  std::filesystem::permissions(locked, std::filesystem::perms::none);
+  const std::string as_nobody = geteuid() == 0 ? "--reuid=65534 --regid=65534 --clear-groups " : "";
+  const std::string out = "/tmp/stereorig_locked_" + std::to_string(getpid()) + ".ply";
+  const std::string command = (as_nobody.empty() ? kBin : "setpriv " + as_nobody + kBin) + " reconstruct --rig " +
+                              dir_ + "/rig.yaml --capture " + locked + " --out " + out + " 2>&1 >/dev/null";
+  FILE* p = popen(command.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  std::string err;
+  for (char buf[256]; std::fgets(buf, sizeof buf, p);) err += buf;
+  const int status = pclose(p);
+  std::filesystem::permissions(locked, std::filesystem::perms::owner_all);
+  EXPECT_EQ(WEXITSTATUS(status), 2) << err;
+  EXPECT_EQ(err, "stereorig reconstruct: " + locked + ": the capture folder cannot be read: Permission denied\n");
+  EXPECT_FALSE(std::filesystem::exists(out));
+  const std::string write_only = "/proc/sys/vm/drop_caches";
+  if (access(write_only.c_str(), R_OK) == 0) GTEST_SKIP() << write_only << " is readable here";
+  ExpectRefusedInOneLine("match --left " + write_only + " --right " + write_only +
+                             " --min-disparity 0 --num-disparities 16 --out " + dir_ + "/locked.pfm",
+                         write_only + ": cannot be opened: Permission denied");
+}
+
 // match on a module's rectified pair of the rendered sphere, its range
 // ending halfway into the sphere's disparities (the walkthrough's: true
 // 472-549 px searched in [300, 500), 63 568 disparities, ~99 % a grid
