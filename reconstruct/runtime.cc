@@ -95,6 +95,23 @@ Eigen::Vector3d PointAhead(const Rig& rig, int m, double distance_mm) {
   return rig.S(0, m) * (midpoint + distance_mm * axis);
 }
 
+namespace {
+
+// How to move the volume farther from module m's cameras. working_distance_mm
+// moves it along module 0's axis: farther from a module that looks the same
+// way, but nearer to one facing module 0 (a larger working_distance_mm on a
+// facing rig made module 1's range worse), so the advice names the
+// direction only where it holds.
+std::string FartherAdvice(const Rig& rig, int m) {
+  const Eigen::Vector3d axis0 = PointAhead(rig, 0, 1) - PointAhead(rig, 0, 0);
+  const Eigen::Vector3d axis_m = PointAhead(rig, m, 1) - PointAhead(rig, m, 0);
+  if (axis0.dot(axis_m) > 0) return "move it farther from the cameras (working_distance_mm, volume_center_mm)";
+  return "move it farther from " + rig.module(m).name + "'s cameras, which face module 0's: volume_center_mm (a " +
+         "larger working_distance_mm moves it away from module 0, nearer to " + rig.module(m).name + ")";
+}
+
+}  // namespace
+
 Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), options_(options) {
   options_.Check();
   // As many threads as the loops below can use at once: each module's row
@@ -162,8 +179,8 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
                       plan.min_disparity_px + plan.num_disparities - 1);
         throw InputError(options_.Where(), "the measurement volume needs " + std::string(range) + " in " + mod.name +
                                                ", which the matcher cannot search (" + e.what() +
-                                               "): make the volume shallower (volume_size_mm's depth) or move it "
-                                               "farther from the cameras (working_distance_mm, volume_center_mm)");
+                                               "): make the volume shallower (volume_size_mm's depth) or " +
+                                               FartherAdvice(rig_, m));
       }
     }
     plans_.push_back(std::move(plan));

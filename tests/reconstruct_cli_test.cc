@@ -486,6 +486,23 @@ TEST_F(ReconstructCli, AFolderOrImageThatCannotBeReadSaysWhy) {
                          write_only + ": cannot be opened: Permission denied");
 }
 
+// working_distance_mm: 300 on the facing rig puts the volume ~100 mm from
+// module 1, which then needs more than 1024 disparities. The refusal said
+// "move it farther from the cameras (working_distance_mm, ...)": a larger
+// working distance brings it nearer still to module 1. Now it says which
+// way moves it away from module 1; module 0, looking along its own axis,
+// keeps the plain advice.
+TEST_F(ReconstructCli, AVolumeTooNearAFacingModuleIsNotToldToGoFarther) {
+  WriteFileAtomically(dir_ + "/far.yaml", "working_distance_mm: 300\n");
+  const testing::Result r = testing::RunCli(Args(dir_ + "/capture", "--options " + dir_ + "/far.yaml"));
+  ASSERT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("module1's cameras, which face module 0's: volume_center_mm (a larger working_distance_mm "
+                       "moves it away from module 0, nearer to module1)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("farther from the cameras"), std::string::npos) << r.err;
+}
+
 // match on a module's rectified pair of the rendered sphere, its range
 // ending halfway into the sphere's disparities (the walkthrough's: true
 // 472-549 px searched in [300, 500), 63 568 disparities, ~99 % a grid
