@@ -2,12 +2,16 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <optional>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
 #include "apps/output_paths.h"
 #include "calib/core/input_error.h"
+#include "reconstruct/disparity_band.h"
 #include "reconstruct/elapsed_ms.h"
 #include "reconstruct/grey_image.h"
 #include "reconstruct/matcher.h"
@@ -16,13 +20,47 @@
 
 namespace stereorig {
 
+namespace {
+
+// Which ends of the searched range the matches reach, as `reconstruct`
+// judges a module's (ModuleReport::RangeEndsReached): from the band the
+// half-resolution pass kept; without one (pyramid_levels, the OpenCV
+// matchers), from the same clusters of the final disparities. The band, not
+// the final disparities alone: on the walkthrough's pair (true 472-549 px in
+// [300, 500)) the final ones lay mostly at 332-392 px, a copy of the grid
+// ~22 periods off, and only ~1 % at the range's end, where the band pass's
+// matches piled up.
+RangeEnds RangeEndsOf(const MatchResult& result, const MatchOptions& options, const std::vector<float>& valid_px) {
+  int occupied_min_px = result.occupied_min_disparity_px, occupied_end_px = result.occupied_end_disparity_px;
+  if (occupied_end_px <= occupied_min_px)
+    if (const std::optional<DisparityBand> band = OccupiedDisparityBand(valid_px, 0))
+      occupied_min_px = band->min_px, occupied_end_px = band->max_px;
+  return RangeEndsReached(options.min_disparity_px, options.num_disparities, occupied_min_px, occupied_end_px);
+}
+
+std::string RangeEndsNamed(RangeEnds ends) {
+  return ends.near && ends.far ? "both ends"
+         : ends.near           ? "the near end (largest disparities)"
+         : ends.far            ? "the far end (smallest disparities)"
+                               : "";
+}
+
+}  // namespace
+
 int RunMatch(int argc, char** argv) {
   CLI::App app{
       "The correspondence stage alone (dense matching, filtering, sub-pixel refinement) on an already rectified "
       "8-bit grey pair. Writes the left view's disparity (x_right = x_left - d) as PFM: little-endian, rows "
-      "bottom to top, invalid pixels = +inf.\n\n"
-      "Example:\n  stereorig match --left L.png --right R.png --min-disparity 380 --num-disparities 160 "
-      "--out disp.pfm",
+      "bottom to top, invalid pixels = +inf.\n"
+      "A module's rectified pair, and the disparity range and ROI the runtime searches in it, come from "
+      "`stereorig reconstruct ... --rectified-out DIR`, which writes DIR/moduleM_left.png and "
+      "DIR/moduleM_right.png and prints this command for each module. Matches piling up at an end of the range "
+      "(the range misses the object: the laser grid matched whole periods off) are warned of on stderr.\n\n"
+      "Example (the demo rig's module 0 under the default measurement volume):\n"
+      "  stereorig reconstruct --rig demo/rig.yaml --capture demo/dataset/scenes/cup/active --out cup.ply "
+      "--rectified-out rect\n"
+      "  stereorig match --left rect/module0_left.png --right rect/module0_right.png --min-disparity -100 "
+      "--num-disparities 274 --roi 0 0 752 582 --out disp.pfm",
       "stereorig match"};
   std::string left_path, right_path, out_path, matcher = "census_sgm";
   MatchOptions options;
@@ -87,13 +125,30 @@ int RunMatch(int argc, char** argv) {
   const MatchResult result = WorkerPool(options.num_threads).Run([&] { return Match(left, right, options); });
   const double ms = MsSince(t0);
   WritePfm(result.disparity_px, out_path);
-  int valid = 0;  // in the matched region: outside it nothing is
+  std::vector<float> valid_px;  // in the matched region: outside it nothing is
   for (int y = matched.y; y < matched.y + matched.height; ++y)
     for (int x = matched.x; x < matched.x + matched.width; ++x)
-      valid += std::isfinite(result.disparity_px.at<float>(y, x));
-  std::printf("%s: %d valid disparities of %d px%s (%.1f%%) in %.1f ms; wrote %s\n", MatcherKindName(options.matcher),
+      if (const float d = result.disparity_px.at<float>(y, x); std::isfinite(d)) valid_px.push_back(d);
+  const int valid = int(valid_px.size());
+  const std::string ends = RangeEndsNamed(RangeEndsOf(result, options, valid_px));
+  std::printf("%s: %d valid disparities of %d px%s (%.1f%%) in %.1f ms; wrote %s%s\n", MatcherKindName(options.matcher),
               valid, matched.area(), roi.empty() ? "" : " in --roi", 100.0 * valid / matched.area(), ms,
-              out_path.c_str());
+              out_path.c_str(), ends.empty() ? "" : ("; warning: they reach " + ends + " of the range").c_str());
+  const std::string range = "[" + std::to_string(options.min_disparity_px) + ", " +
+                            std::to_string(options.min_disparity_px + options.num_disparities) +
+                            ") px (--min-disparity, --num-disparities)";
+  if (!ends.empty())
+    std::fprintf(stderr,
+                 "stereorig match: warning: the disparities pile up at %s of the range %s: the range likely misses "
+                 "the object (its surface goes on past the range, or the laser grid was matched whole periods off, "
+                 "every such disparity wrong); widen or move the range (`stereorig reconstruct --rectified-out` "
+                 "prints the range a rig's module needs)\n",
+                 ends.c_str(), range.c_str());
+  else if (valid == 0)
+    std::fprintf(stderr,
+                 "stereorig match: hint: no valid disparity: the range %s may miss the scene, or the images hold no "
+                 "texture to match (`stereorig reconstruct --rectified-out` prints the range a rig's module needs)\n",
+                 range.c_str());
   return kExitOk;
 }
 

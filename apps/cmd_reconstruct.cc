@@ -13,6 +13,7 @@
 #include "apps/reconstruct_batch.h"
 #include "apps/reconstruct_json.h"
 #include "apps/reconstruct_stream.h"
+#include "apps/rectified_pairs.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
@@ -20,6 +21,21 @@
 #include "reconstruct/runtime.h"
 
 namespace stereorig {
+
+namespace {
+
+// Hole filling runs on the joined mesh: with shape_model set and no mesh
+// asked for, nothing is filled, which the run did without a word.
+void NoteShapeModelWithoutMesh(const RuntimeOptions& options, bool mesh) {
+  if (options.shape_model == ShapeModel::kNone || mesh) return;
+  std::printf(
+      "note: shape_model %s fills holes only with a mesh (--mesh; --mesh-format for many captures): nothing will "
+      "be filled\n",
+      ShapeModelName(options.shape_model));
+  std::fflush(stdout);
+}
+
+}  // namespace
 
 int RunReconstruct(int argc, char** argv) {
   CLI::App app{
@@ -70,7 +86,12 @@ int RunReconstruct(int argc, char** argv) {
                  "one capture: its per-step times, point counts and fill rates as JSON; many: the batch's summary; "
                  "--capture -: the stream's totals and failed captures, written when the input ends");
   app.add_option("--options", options_path, "runtime options YAML (default: the built-in defaults)");
-  std::string warm_up_dir, capture_root;
+  std::string warm_up_dir, capture_root, rectified_dir;
+  auto* rectified = app.add_option(
+      "--rectified-out", rectified_dir,
+      "one capture: also write each module's rectified pair here (moduleM_left.png, moduleM_right.png, created "
+      "if needed) and print the `stereorig match` command that searches it with the range and ROI the runtime "
+      "derives from the measurement volume");
   app.add_option("--capture-root", capture_root,
                  "with --capture -: name each capture by its folder's path below this folder, joined with '_' "
                  "(root line: line/2026-12-06/0001 -> 2026-12-06_0001) instead of its last name; folders not below "
@@ -81,6 +102,7 @@ int RunReconstruct(int argc, char** argv) {
                  "capture of a typical object)");
   out->excludes(dir);
   mesh->excludes(dir);
+  rectified->excludes(dir);
   format->needs(dir);
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
   // In any case, as --mesh's suffix (STL, Ply): the files are named in lower case.
@@ -113,6 +135,7 @@ int RunReconstruct(int argc, char** argv) {
           {.path = report_path, .rig_path = rig_path, .options_path = options_path, .check_folder = false});
     const Rig rig = ReadRigFile(rig_path);
     const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
+    NoteShapeModelWithoutMesh(options, !mesh_format.empty());
     if (stream)
       return ReconstructStream(
           rig, options,
@@ -136,7 +159,18 @@ int RunReconstruct(int argc, char** argv) {
     outputs.Claim(mesh_path, "the mesh (--mesh)");
   }
   if (!report_path.empty()) outputs.Claim(report_path, "the report (--report)");
+  FolderToCreate rectified_folder;  // made once the capture is read
+  std::vector<RectifiedPairPaths> rectified_paths;
+  if (!rectified_dir.empty()) {
+    rectified_folder = outputs.ClaimFolder(rectified_dir, "the rectified pairs (--rectified-out)");
+    rectified_paths = RectifiedPairPathsIn(rectified_dir, rig.num_modules());
+    for (const RectifiedPairPaths& pair : rectified_paths) {
+      outputs.Claim(pair.left, "a rectified left image (--rectified-out)", false);
+      outputs.Claim(pair.right, "a rectified right image (--rectified-out)", false);
+    }
+  }
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
+  NoteShapeModelWithoutMesh(options, !mesh_path.empty());
   const std::vector<cv::Mat> images = LoadCapture(capture_dir, rig);
   const Runtime runtime(rig, options);
   const Reconstruction rec = runtime.Process(images, !mesh_path.empty());
@@ -147,13 +181,20 @@ int RunReconstruct(int argc, char** argv) {
   written.Add(out_path, EncodeCloudPly(rec.cloud));
   if (!mesh_path.empty()) written.Add(mesh_path, EncodeMesh(rec.mesh, mesh_path));
   if (!report_path.empty()) written.Add(report_path, ReconstructionJson(rec).dump(2) + "\n");
+  if (!rectified_paths.empty()) {
+    rectified_folder.Create();
+    AddRectifiedPairs(runtime, images, rectified_paths, &written);
+  }
   written.Commit();
   for (const ModuleReport& m : rec.modules) std::printf("%s\n", ModuleSummary(m).c_str());
   std::printf("%zu points (%d from the shape model) in %.1f ms; wrote %s", rec.cloud.size(), rec.filled_points,
               rec.times_ms.at("total_point_cloud"), out_path.c_str());
   if (!mesh_path.empty()) std::printf(", %s (%zu triangles)", mesh_path.c_str(), rec.mesh.triangles.size());
+  if (!report_path.empty()) std::printf(", %s", report_path.c_str());
   std::printf("\n");
   if (!mesh_path.empty()) std::printf("shape model: %s\n", rec.shape_fit.c_str());
+  for (size_t m = 0; m < rectified_paths.size(); ++m)
+    std::printf("%s\n", RectifiedPairLine(runtime.plans()[m], rectified_paths[m]).c_str());
   return kExitOk;
 }
 

@@ -30,25 +30,75 @@ constexpr const char* kSetTheVolume =
     "set working_distance_mm (or volume_center_mm, volume_size_mm) to where it is (docs/reconstruct.md, \"When the "
     "fill rate is low\")";
 
+constexpr const char* kPassiveOptions =
+    "a capture without the laser grid (passive) needs crop_to_lit_region: false and match: {min_distinctness: 0, "
+    "grid_line_test: false, line_index: false} (`stereorig demo` writes them, passive_options.yaml)";
+
+// What the status most of a module's lit pixels ended with says of a module
+// with no point, and what to do. Before, every such module was told to move
+// the measurement volume, also when the volume was right and another test
+// took every pixel (object_size, a passive capture's grid tests, a swapped
+// module's images, which no search can match).
+std::string AdviceFor(PixelStatus status) {
+  switch (status) {
+    case PixelStatus::kOutsideVolume:
+      return std::string("they were matched outside the measurement volume: if the object is not in it, ") +
+             kSetTheVolume;
+    case PixelStatus::kObjectSize:
+      return "they lie farther than object_size_mm from the module's median point: set object_size_mm to at least "
+             "the object's largest dimension";
+    case PixelStatus::kLowConfidence:
+      return "their matches' confidence is below min_confidence: lower it";
+    case PixelStatus::kSeenThrough:
+    case PixelStatus::kSeenThroughSurface:
+      return "the free-space test found other modules' surfaces in front of them: check the modules' poses in the "
+             "rig file (`stereorig check`), or set free_space_test: false to see what it removed";
+    case PixelStatus::kNotDistinct:
+    case PixelStatus::kWrongLine:
+    case PixelStatus::kNoGridLine:
+      return std::string("the laser grid's own tests refused their matches: ") + kPassiveOptions +
+             "; with the grid, its period may not be the options' (`stereorig tune`)";
+    case PixelStatus::kNoSgmMatch:
+    case PixelStatus::kNoPlane:
+    case PixelStatus::kOffPlaneCoarse:
+    case PixelStatus::kOutOfRange:
+      return std::string("the search found no consistent match: the object may not be in the measurement volume (") +
+             kSetTheVolume +
+             "), the module's two images may not be a stereo pair of this rig (its cameras swapped or moved: check "
+             "the rig file, `stereorig check`), or " +
+             kPassiveOptions;
+    default:
+      return "see docs/reconstruct.md, \"When the fill rate is low\", for what that test refuses";
+  }
+}
+
 // The line a module with no point gets, "" for one with a point. With lit
-// pixels and none kept, most often the object is not in the measurement
-// volume (a rig used at another distance than the defaults' 200 mm finds
-// nothing, and exit 0 alone would not say why). With none lit where the
-// volume projects (lit_pixels counts only its ROI), the left image is lit
-// elsewhere (the volume is beside the object) or nowhere (a dark or flat
-// image): camera_lit_pixels tells which (-1: not counted).
+// pixels and none kept, the advice follows the status most of them ended
+// with (AdviceFor). With none lit where the volume projects (lit_pixels
+// counts only its ROI), the left image is lit elsewhere (the volume is
+// beside the object) or nowhere (no grid: a dark or flat image, the
+// projector off, or a passive capture): camera_lit_pixels tells which (-1:
+// not counted).
 std::string NoPointHint(const ModuleReport& m) {
   if (m.points > 0) return "";
-  if (m.lit_pixels > 0)
-    return std::string("\n  no point: if the object is not in the measurement volume, ") + kSetTheVolume;
+  if (m.lit_pixels > 0) {
+    size_t top = size_t(PixelStatus::kNotSearched);
+    for (size_t k = 0; k < m.lit_by_status.size(); ++k)
+      if (k != size_t(PixelStatus::kPoint) && m.lit_by_status[k] > m.lit_by_status[top]) top = k;
+    char share[96];
+    std::snprintf(share, sizeof share, "%s %.1f%% of the lit pixels: ", PixelStatusName(PixelStatus(top)),
+                  100.0 * m.lit_by_status[top] / m.lit_pixels);
+    return "\n  no point: " + std::string(share) + AdviceFor(PixelStatus(top));
+  }
   if (m.camera_lit_pixels > 0)
     return "\n  no point: " + std::to_string(m.camera_lit_pixels) +
            " px of the left camera's image are grid-lit, none where the measurement volume projects: the volume is "
            "beside the object; " +
            kSetTheVolume;
   if (m.camera_lit_pixels == 0)
-    return "\n  no point: no pixel of the left camera's image is grid-lit (9x9 std above lit_contrast_dn): a dark or "
-           "flat image (the grid off or out of view, too short an exposure); check the capture";
+    return "\n  no point: no lit pixels: is the projector on, or is this a passive capture? No pixel of the left "
+           "camera's image is grid-lit (9x9 std above lit_contrast_dn): a dark or flat image (the grid off or out of "
+           "view, too short an exposure); check the capture";
   return std::string(
              "\n  no point: no grid-lit pixel where the measurement volume projects: if the object is not in "
              "the volume, ") +

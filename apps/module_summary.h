@@ -22,10 +22,12 @@ std::string LossLine(std::span<const int> counts_by_status, int total_px, int ma
 //     searched d [-21, 43) of [-100, 173) px; lit px without a point: no_sgm_match 29.8%, off_plane_coarse 18.7%, ...
 // The reasons are LossLine's `max_reasons` largest over the lit pixels;
 // "none" when every lit pixel has a point. A module with no point gets one
-// more line, after the free-space test's: where to set the measurement
-// volume; with no lit pixel in the volume's ROI, whether the left image is
-// lit elsewhere (the volume is beside the object: the same advice) or
-// nowhere (a dark or flat image: check the capture), from
+// more line, after the free-space test's: the status most of its lit
+// pixels ended with and what to do about it (the measurement volume,
+// object_size_mm, the passive options, the rig file, ...); with no lit
+// pixel in the volume's ROI, whether the left image is lit elsewhere (the
+// volume is beside the object: where to set it) or nowhere (no lit pixels:
+// the projector off, a passive capture, a dark or flat image), from
 // ModuleReport::camera_lit_pixels.
 std::string ModuleSummary(const ModuleReport& m, int max_reasons = 3);
 

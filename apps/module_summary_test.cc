@@ -41,15 +41,39 @@ TEST(ModuleSummary, SaysNoneWhenEveryLitPixelHasAPoint) {
   EXPECT_EQ(s.substr(s.find('\n') + 1), "  searched d [35, 120) of [-100, 174) px; lit px without a point: none");
 }
 
-// A module whose lit pixels all went without a point (the walkthrough's
-// 300 mm rig under the default 200 mm volume: no_sgm_match 85.6 %) says
-// where to look; one with a point does not.
-TEST(ModuleSummary, NoPointAtAllNamesTheMeasurementVolume) {
+// A module whose lit pixels all went without a point says where to look,
+// after the status most of them ended with: the walkthrough's 300 mm rig
+// under the default 200 mm volume (no_sgm_match 85.6 %) names the volume;
+// a module whose points object_size took (78 %) names object_size_mm, not
+// the volume, which was right; a passive capture (not_distinct) the
+// passive options. Before, every one was told to move the volume. One with
+// a point gets no hint.
+TEST(ModuleSummary, NoPointAtAllFollowsTheLitPixelsTopStatus) {
   ModuleReport m = Report();
   m.points = m.lit_filled = 0;
-  m.lit_by_status[size_t(PixelStatus::kNoSgmMatch)] = 1000;
-  const std::string s = ModuleSummary(m);
-  EXPECT_NE(s.find("\n  no point: if the object is not in the measurement volume, set working_distance_mm"),
+  m.lit_by_status[size_t(PixelStatus::kNoSgmMatch)] = 856;
+  m.lit_by_status[size_t(PixelStatus::kNoPlane)] = 144;
+  std::string s = ModuleSummary(m);
+  EXPECT_NE(s.find("\n  no point: no_sgm_match 85.6% of the lit pixels: the search found no consistent match: the "
+                   "object may not be in the measurement volume (set working_distance_mm"),
+            std::string::npos)
+      << s;
+  EXPECT_NE(s.find("its cameras swapped or moved"), std::string::npos) << s;
+  m.lit_by_status = {};
+  m.lit_by_status[size_t(PixelStatus::kObjectSize)] = 780;
+  m.lit_by_status[size_t(PixelStatus::kLowZncc)] = 220;
+  s = ModuleSummary(m);
+  EXPECT_NE(s.find("\n  no point: object_size 78.0% of the lit pixels: they lie farther than object_size_mm from the "
+                   "module's median point: set object_size_mm"),
+            std::string::npos)
+      << s;
+  EXPECT_EQ(s.find("working_distance_mm"), std::string::npos) << s;
+  m.lit_by_status = {};
+  m.lit_by_status[size_t(PixelStatus::kNotDistinct)] = 600;
+  m.lit_by_status[size_t(PixelStatus::kNoSgmMatch)] = 400;
+  s = ModuleSummary(m);
+  EXPECT_NE(s.find("no point: not_distinct 60.0% of the lit pixels: the laser grid's own tests refused their "
+                   "matches: a capture without the laser grid (passive) needs crop_to_lit_region: false"),
             std::string::npos)
       << s;
   m.points = 1;
@@ -70,8 +94,9 @@ TEST(ModuleSummary, NoLitPixelInTheVolumeSaysWhetherTheImageIsLitElsewhere) {
             std::string::npos)
       << ModuleSummary(m);
   m.camera_lit_pixels = 0;
-  EXPECT_NE(ModuleSummary(m).find("\n  no point: no pixel of the left camera's image is grid-lit (9x9 std above "
-                                  "lit_contrast_dn): a dark or flat image"),
+  EXPECT_NE(ModuleSummary(m).find("\n  no point: no lit pixels: is the projector on, or is this a passive capture? "
+                                  "No pixel of the left camera's image is grid-lit (9x9 std above lit_contrast_dn): "
+                                  "a dark or flat image"),
             std::string::npos)
       << ModuleSummary(m);
   EXPECT_EQ(ModuleSummary(m).find("working_distance_mm"), std::string::npos) << ModuleSummary(m);

@@ -45,4 +45,10 @@ std::optional<DisparityBand> OccupiedDisparityBand(const std::vector<float>& dis
   return band;
 }
 
+RangeEnds RangeEndsReached(int min_disparity_px, int num_disparities, int occupied_min_px, int occupied_end_px) {
+  if (occupied_end_px <= occupied_min_px || num_disparities <= 0) return {};
+  return {.near = min_disparity_px + num_disparities - occupied_end_px <= kBandBinPx,
+          .far = occupied_min_px - min_disparity_px <= kBandBinPx};
+}
+
 }  // namespace stereorig

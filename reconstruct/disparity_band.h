@@ -38,4 +38,17 @@ inline constexpr double kCoarseSpeckleRangePx = 1.0;  // neighbours within this 
 // if there are fewer than kMinBandMatches matches.
 std::optional<DisparityBand> OccupiedDisparityBand(const std::vector<float>& disparities_px, int margin_px);
 
+// Which ends of a searched range [min_disparity_px, min_disparity_px +
+// num_disparities) the band's kept bins [occupied_min_px, occupied_end_px)
+// (before their margin) reach, within one bin (kBandBinPx); near = the
+// largest disparities. Neither when there is no band (end <= min). Reached,
+// the surface may go on past the range, or the laser grid was matched whole
+// periods off, a copy of itself inside the range: the range likely misses
+// the object. `reconstruct` reports it per module (ModuleReport), `match`
+// for its --min-disparity / --num-disparities.
+struct RangeEnds {
+  bool near = false, far = false;
+};
+RangeEnds RangeEndsReached(int min_disparity_px, int num_disparities, int occupied_min_px, int occupied_end_px);
+
 }  // namespace stereorig

@@ -11,7 +11,9 @@ namespace stereorig {
 
 // The image at `path`, CV_8UC1. Throws InputError if ReadImageFile
 // (reconstruct/image_file.h) does (the file missing, a PNG cut short or
-// damaged, one that cannot be decoded), or if it is not 8-bit single-channel.
+// damaged, one that cannot be decoded), or if it is not 8-bit single-channel,
+// a grey PNG of 1, 2 or 4 bits included (decoded scaled to 8 bits, but with
+// 2-16 grey levels: the message names the file's depth).
 cv::Mat ReadGreyImage(const std::string& path);
 
 }  // namespace stereorig

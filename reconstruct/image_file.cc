@@ -1,5 +1,8 @@
 #include "reconstruct/image_file.h"
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <optional>
 
@@ -25,6 +28,12 @@ std::string FirstBytes(const std::string& path, size_t count) {
 
 cv::Mat ReadImageFile(const std::string& path) {
   RequireInputFile(path);
+  // Opened once here for the reason alone: the PNG reader's "cannot be
+  // opened" leaves out why (permission denied, too many open files).
+  if (FILE* f = std::fopen(path.c_str(), "rb"))
+    std::fclose(f);
+  else
+    throw InputError(path, std::string("cannot be opened: ") + std::strerror(errno));
   // A PNG (every capture, the truth maps' id and lit maps) is decoded once,
   // by libpng, into the Mat imread would give.
   if (std::optional<PngReader> png = PngReader::Open(path)) {

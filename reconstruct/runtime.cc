@@ -95,6 +95,23 @@ Eigen::Vector3d PointAhead(const Rig& rig, int m, double distance_mm) {
   return rig.S(0, m) * (midpoint + distance_mm * axis);
 }
 
+namespace {
+
+// How to move the volume farther from module m's cameras. working_distance_mm
+// moves it along module 0's axis: farther from a module that looks the same
+// way, but nearer to one facing module 0 (a larger working_distance_mm on a
+// facing rig made module 1's range worse), so the advice names the
+// direction only where it holds.
+std::string FartherAdvice(const Rig& rig, int m) {
+  const Eigen::Vector3d axis0 = PointAhead(rig, 0, 1) - PointAhead(rig, 0, 0);
+  const Eigen::Vector3d axis_m = PointAhead(rig, m, 1) - PointAhead(rig, m, 0);
+  if (axis0.dot(axis_m) > 0) return "move it farther from the cameras (working_distance_mm, volume_center_mm)";
+  return "move it farther from " + rig.module(m).name + "'s cameras, which face module 0's: volume_center_mm (a " +
+         "larger working_distance_mm moves it away from module 0, nearer to " + rig.module(m).name + ")";
+}
+
+}  // namespace
+
 Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), options_(options) {
   options_.Check();
   // As many threads as the loops below can use at once: each module's row
@@ -162,8 +179,8 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
                       plan.min_disparity_px + plan.num_disparities - 1);
         throw InputError(options_.Where(), "the measurement volume needs " + std::string(range) + " in " + mod.name +
                                                ", which the matcher cannot search (" + e.what() +
-                                               "): make the volume shallower (volume_size_mm's depth) or move it "
-                                               "farther from the cameras (working_distance_mm, volume_center_mm)");
+                                               "): make the volume shallower (volume_size_mm's depth) or " +
+                                               FartherAdvice(rig_, m));
       }
     }
     plans_.push_back(std::move(plan));
@@ -494,12 +511,17 @@ void CheckCaptureFiles(const std::string& dir, const Rig& rig) {
   namespace fs = std::filesystem;
   if (fs::exists(dir) && !fs::is_directory(dir)) throw InputError(dir, "is a file, not a capture folder");
   if (!fs::is_directory(dir)) throw InputError(dir, "capture folder not found");
-  for (const auto& entry : fs::directory_iterator(dir)) {
-    const std::optional<int> camera = CameraIndexOfImageName(entry.path().filename().string());
+  // Listed with an error code: std::filesystem's own exception read
+  // "filesystem error: directory iterator cannot open directory: Permission
+  // denied [DIR]", in no words of the command's.
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::optional<int> camera = CameraIndexOfImageName(it->path().filename().string());
     if (camera && *camera >= rig.num_cameras())
-      throw InputError(entry.path().string(), "the rig has only " + std::to_string(rig.num_cameras()) +
-                                                  " cameras: this capture does not match the rig");
+      throw InputError(it->path().string(), "the rig has only " + std::to_string(rig.num_cameras()) +
+                                                " cameras: this capture does not match the rig");
   }
+  if (ec) throw InputError(dir, "the capture folder cannot be read: " + ec.message());
   const std::vector<std::string> paths = CaptureImagePaths(dir, rig);
   for (size_t k = 0; k < paths.size(); ++k)
     if (!fs::exists(paths[k]))
@@ -524,10 +546,9 @@ std::vector<cv::Mat> LoadCapture(const std::string& dir, const Rig& rig) {
   return images;
 }
 
-ModuleReport::RangeEnds ModuleReport::RangeEndsReached() const {
-  if (occupied_end_disparity_px <= occupied_min_disparity_px || num_disparities <= 0) return {};
-  return {.near = min_disparity_px + num_disparities - occupied_end_disparity_px <= kBandBinPx,
-          .far = occupied_min_disparity_px - min_disparity_px <= kBandBinPx};
+RangeEnds ModuleReport::RangeEndsReached() const {
+  return stereorig::RangeEndsReached(min_disparity_px, num_disparities, occupied_min_disparity_px,
+                                     occupied_end_disparity_px);
 }
 
 }  // namespace stereorig

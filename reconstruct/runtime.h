@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "calib/core/rig.h"
+#include "reconstruct/disparity_band.h"
 #include "reconstruct/parallel_for.h"
 #include "reconstruct/point_cloud.h"
 #include "reconstruct/rectify.h"
@@ -72,9 +73,7 @@ struct ModuleReport {
   // front plate's module 0: 25 px). Against the truth (`score --diagnose`):
   // the front cup's module 0 all 185 px off, the 120 mm cup's module 1 95 %
   // more than 2 mm off. Neither end without a band.
-  struct RangeEnds {
-    bool near = false, far = false;
-  };
+  using RangeEnds = stereorig::RangeEnds;  // disparity_band.h
   RangeEnds RangeEndsReached() const;
   int points = 0;                // points kept
   int seen_through = 0;          // of the module's points, those the free-space test removed (free_space.h)

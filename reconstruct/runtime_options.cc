@@ -1,8 +1,11 @@
 #include "reconstruct/runtime_options.h"
 
+#include <cstdio>
 #include <string>
+#include <vector>
 
 #include "calib/core/input_error.h"
+#include "calib/core/input_file.h"
 #include "calib/core/yaml_reader.h"
 
 namespace stereorig {
@@ -32,12 +35,30 @@ void RuntimeOptions::Check() const {
   if (volume_center_mm && !volume_center_mm->allFinite()) throw InputError("volume_center_mm", "must be finite");
   if (!(volume_size_mm.minCoeff() > 0)) throw InputError("volume_size_mm", "every side must be > 0 mm");
   if (!(working_distance_mm > 0)) throw InputError("working_distance_mm", "must be > 0 mm");
-  if (!(object_size_mm > 0)) throw InputError("object_size_mm", "must be > 0 mm");
-  if (!(lit_contrast_dn > 0)) throw InputError("lit_contrast_dn", "must be > 0");
+  // An object under 1 mm spans ~5 px at the default 200 mm (~0.2 mm a
+  // pixel): less than one laser-grid period (8 px), nothing to match; every
+  // point would be dropped (0.001 wrote an empty cloud, exit 0). One longer
+  // than the volume's diagonal cannot lie in the volume, whose filter
+  // already cuts every point to it, so this filter and the shape model's
+  // refusal would never bite: a unit slip (m for mm, or 1e9 for "off").
+  const double volume_diagonal_mm = volume_size_mm.norm();
+  if (!(object_size_mm >= 1 && object_size_mm <= volume_diagonal_mm)) {
+    char range[96];
+    std::snprintf(range, sizeof range, "must be in [1, %.1f] mm (the measurement volume's diagonal)",
+                  volume_diagonal_mm);
+    throw InputError("object_size_mm", range);
+  }
+  // A 9x9 window of 8-bit grey levels has a std of at most 127.5 (half its
+  // pixels 0, half 255): a threshold at or above it lights nothing.
+  if (!(lit_contrast_dn > 0 && lit_contrast_dn < 127.5))
+    throw InputError("lit_contrast_dn", "must be in (0, 127.5) grey levels (an 8-bit window's std cannot reach 127.5)");
   if (!(min_confidence >= 0 && min_confidence <= 1)) throw InputError("min_confidence", "must be in [0, 1]");
   if (normal_step_px < 1 || normal_step_px > 10) throw InputError("normal_step_px", "must be in [1, 10]");
   if (!(mesh_max_edge_mm > 0)) throw InputError("mesh_max_edge_mm", "must be > 0");
-  if (!(fill_spacing_mm > 0.05)) throw InputError("fill_spacing_mm", "must be > 0.05 mm");
+  // Filled samples farther apart than the object's largest dimension leave
+  // at most one on it: nothing filled.
+  if (!(fill_spacing_mm > 0.05 && fill_spacing_mm <= object_size_mm))
+    throw InputError("fill_spacing_mm", "must be in (0.05, object_size_mm] mm (a wider spacing fills nothing)");
   if (!(fill_residual_length_mm == 0 || (fill_residual_length_mm >= 1 && fill_residual_length_mm <= 1000)))
     throw InputError("fill_residual_length_mm", "must be 0 (chosen from the data) or in [1, 1000] mm");
   if (!(free_space.margin_px > 0 && free_space.margin_px <= 100))
@@ -62,6 +83,27 @@ void RuntimeOptions::Check() const {
 }
 
 namespace {
+
+// yaml-cpp's Load reads the first document and ignores any after a `---`:
+// `object_size_mm: 50\n---\nbogus_key: 1` read as the first alone, its
+// second document's keys, typos included, never checked. The options are
+// one mapping: a later document is refused, naming the file and its line.
+// (An empty one, a lone trailing `---`, is no setting: allowed.)
+void RefuseSecondDocument(const std::string& text, const std::string& where) {
+  std::vector<YAML::Node> documents;
+  try {
+    documents = YAML::LoadAll(text);
+  } catch (const YAML::Exception& e) {  // the first parsed (LoadString): the error is in a later document
+    throw InputError(where, "line " + std::to_string(e.mark.line + 1) +
+                                ": a second YAML document (after `---`) that is not valid YAML: the runtime options "
+                                "are one mapping; remove the `---` and what follows, or merge it into the first");
+  }
+  for (size_t k = 1; k < documents.size(); ++k)
+    if (!documents[k].IsNull())
+      throw InputError(where, "line " + std::to_string(documents[k].Mark().line + 1) +
+                                  ": a second YAML document (after `---`): the runtime options are one mapping; "
+                                  "remove the `---`, or merge its keys into the first document");
+}
 
 RuntimeOptions FromYaml(YamlMap& y) {
   RuntimeOptions o;
@@ -168,6 +210,15 @@ RuntimeOptions FromYaml(YamlMap& y) {
     m.Read("grid_half_period_px", &mo.grid_half_period_px);
     m.Finish();
   }
+  // The docs name the matcher's keys `match.min_zncc`; written so, YAML
+  // reads one top-level key with a dot in its name. Say how it nests, not
+  // only "unknown key" (a hint: it is still refused).
+  for (const std::string& key : y.Keys())
+    if (key.rfind("match.", 0) == 0 && key.size() > 6)
+      throw InputError(y.Where(key),
+                       "unknown key: the matcher's keys nest under a `match:` mapping: write it as "
+                       "`match:` then, on the next line, `  " +
+                           key.substr(6) + ": ...`");
   y.Finish();
   try {
     o.Check();
@@ -188,14 +239,14 @@ RuntimeOptions PassiveOptions(RuntimeOptions active) {
 }
 
 RuntimeOptions ReadRuntimeOptions(const std::string& path) {
-  YamlMap y = YamlMap::LoadFile(path);
-  RuntimeOptions o = FromYaml(y);
-  o.source = path;
-  return o;
+  // The text read once (a pipe too, as YamlMap::LoadFile reads), then parsed
+  // as ParseRuntimeOptions parses it, so both refuse a second document.
+  return ParseRuntimeOptions(ReadInputText(path), path);
 }
 
 RuntimeOptions ParseRuntimeOptions(const std::string& text, const std::string& where) {
-  YamlMap y = YamlMap::LoadString(text, where);
+  YamlMap y = YamlMap::LoadString(text, where);  // the first document: a syntax error in it named as ever
+  RefuseSecondDocument(text, where);
   RuntimeOptions o = FromYaml(y);
   o.source = where;
   return o;

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
 #include <utility>
 
 #include "calib/core/input_error.h"
@@ -234,6 +235,58 @@ TEST(RuntimeOptions, ReadsAndChecksTheStrongSpeckleKeys) {
       {"match:\n  line_index_seam_spread_px: 0\n", "line_index_seam_spread_px"},
       {"match:\n  line_index_seam_spread_px: 5\n", "line_index_seam_spread_px"}};
   ExpectEachRejectedNamingItsKey(bad);
+}
+
+// The message of the InputError `text` is refused with ("" if accepted).
+std::string RefusalOf(const std::string& text, const std::string& where = "o.yaml") {
+  try {
+    ParseRuntimeOptions(text, where);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The docs name the matcher's keys `match.min_zncc`; written so, the key was
+// refused as "unknown key" with no word of the nesting. Still refused, now
+// with how to write it.
+TEST(RuntimeOptions, AMatchKeyWrittenDottedIsRefusedWithHowItNests) {
+  EXPECT_EQ(RefusalOf("match.min_zncc: 0.7\n"),
+            "o.yaml: match.min_zncc: unknown key: the matcher's keys nest under a `match:` mapping: write it as "
+            "`match:` then, on the next line, `  min_zncc: ...`");
+  EXPECT_EQ(ParseRuntimeOptions("match:\n  min_zncc: 0.7\n", "o.yaml").match.min_zncc, 0.7);
+}
+
+// Values no rig can use were taken: object_size_mm 0.001 wrote an empty
+// cloud (exit 0), 1e9 and fill_spacing_mm 1e6 turned their steps off
+// unsaid, lit_contrast_dn 300 lit nothing (an 8-bit window's std is at
+// most 127.5). Each is refused naming the file and key; the bounds
+// themselves are taken.
+TEST(RuntimeOptions, ValuesPastWhatTheRigCanMeasureAreRefused) {
+  for (const char* bad :
+       {"object_size_mm: 0.001\n", "object_size_mm: 1e9\n", "object_size_mm: 235\n", "lit_contrast_dn: 300\n",
+        "lit_contrast_dn: 127.5\n", "fill_spacing_mm: 1e6\n", "object_size_mm: 50\nfill_spacing_mm: 51\n"}) {
+    const std::string key = std::string(bad).substr(std::string(bad).rfind('\n', std::string(bad).size() - 2) + 1);
+    const std::string says = "o.yaml: " + key.substr(0, key.find(':')) + ": must be in ";
+    EXPECT_EQ(RefusalOf(bad).rfind(says, 0), 0u) << bad << " -> " << RefusalOf(bad);
+  }
+  // The default volume's diagonal: sqrt(150^2 + 150^2 + 100^2) = 234.5 mm.
+  EXPECT_EQ(RefusalOf("object_size_mm: 1\nfill_spacing_mm: 1\n"), "");
+  EXPECT_EQ(RefusalOf("object_size_mm: 234.5\nlit_contrast_dn: 127\n"), "");
+  EXPECT_EQ(RefusalOf("object_size_mm: 400\nvolume_size_mm: [300, 300, 200]\n"), "");
+}
+
+// yaml-cpp reads the first document only: a second one's keys, typos too,
+// were never checked. The options file is one mapping: a second document
+// is refused naming the file and the line it starts on; a lone trailing
+// `---` (an empty document) is no setting and passes.
+TEST(RuntimeOptions, ASecondYamlDocumentIsRefused) {
+  EXPECT_EQ(RefusalOf("object_size_mm: 50\n---\nbogus_key: 1\n"),
+            "o.yaml: line 3: a second YAML document (after `---`): the runtime options are one mapping; remove the "
+            "`---`, or merge its keys into the first document");
+  EXPECT_NE(RefusalOf("object_size_mm: 50\n---\n[: bad\n").find("o.yaml: line "), std::string::npos);
+  EXPECT_EQ(RefusalOf("---\nobject_size_mm: 50\n"), "");
+  EXPECT_EQ(RefusalOf("object_size_mm: 50\n---\n"), "");
 }
 
 }  // namespace

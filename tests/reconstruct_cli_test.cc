@@ -61,6 +61,27 @@ TEST(MatchCli, WritesAPfmThatMatchesTheTruth) {
   EXPECT_TRUE(std::isinf(disp.at<float>(100, 0)));
 }
 
+// A pair with nothing to match (flat grey) gives no valid disparity: match
+// said only "0 valid disparities", exit 0; now a hint that the range may
+// miss the scene. (The range-end warning: ReconstructCli.
+// MatchWarnsOfARangeThatMissesTheObject, on a rendered capture's
+// rectified pair: on this small synthetic pair, a perfectly periodic grid,
+// the band pass keeps period-off copies to the far end of any range.)
+TEST(MatchCli, NoValidDisparityHintsThatTheRangeMayMissTheScene) {
+  const std::string dir = ::testing::TempDir() + "/match_cli_flat";
+  std::filesystem::create_directories(dir);
+  ASSERT_TRUE(cv::imwrite(dir + "/flat.png", cv::Mat(240, 320, CV_8UC1, cv::Scalar(100))));
+  const testing::Result none =
+      testing::RunCli("match --left " + dir + "/flat.png --right " + dir +
+                      "/flat.png --min-disparity 24 --num-disparities 64 --out " + dir + "/d.pfm");
+  ASSERT_EQ(none.code, 0) << none.err;
+  EXPECT_NE(none.out.find(" 0 valid disparities"), std::string::npos) << none.out;
+  EXPECT_NE(none.err.find("stereorig match: hint: no valid disparity: the range [24, 88) px (--min-disparity, "
+                          "--num-disparities) may miss the scene"),
+            std::string::npos)
+      << none.err;
+}
+
 // score: a dataset folder without a rig is bad input (exit 2), not a crash.
 // (An unusable --diagnose folder, and bad input beside a usable one:
 // ReconstructCli.ScoreBadInputLeavesNoDiagnoseFolder.)
@@ -177,6 +198,11 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
 
 namespace stereorig {
 namespace {
+
+std::string ReadFileBytes(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
 
 // `stereorig args` exits 2 with one line on stderr that says `says`.
 void ExpectRefusedInOneLine(const std::string& args, const std::string& says) {
@@ -303,8 +329,9 @@ TEST_F(ReconstructCli, AModuleWithNoLitPixelInTheVolumeSaysWhy) {
        std::regex("\n  no point: [1-9][0-9]* px of the left camera's image are grid-lit, none where the measurement "
                   "volume projects: the volume is beside the object; set working_distance_mm \\(or "
                   "volume_center_mm, volume_size_mm\\) to where it is")},
-      {Args(dark), std::regex("\n  no point: no pixel of the left camera's image is grid-lit \\(9x9 std above "
-                              "lit_contrast_dn\\): a dark or flat image")}};
+      {Args(dark), std::regex("\n  no point: no lit pixels: is the projector on, or is this a passive capture\\? No "
+                              "pixel of the left camera's image is grid-lit \\(9x9 std above lit_contrast_dn\\): a "
+                              "dark or flat image")}};
   for (const auto& [args, says] : cases) {
     const testing::Result r = testing::RunCli(args);
     ASSERT_EQ(r.code, 0) << args << ": " << r.err;
@@ -348,6 +375,172 @@ TEST_F(ReconstructCli, MatchesReachingAnEndOfTheVolumesRangeAreWarnedOf) {
   EXPECT_TRUE(std::regex_search(batch.out, std::regex("\n  warning: module [01]'s matches reach the far end of the "
                                                       "measurement volume's disparity range")))
       << batch.out;
+}
+
+// `match` takes a rectified pair and a disparity range, and no command gave
+// either: --rectified-out writes each module's pair as the runtime
+// rectifies it and prints the match command that searches it with the
+// runtime's range and ROI. That command, run as printed, matches the sphere
+// with no range warning; the cloud is the one written without the option.
+TEST_F(ReconstructCli, RectifiedOutWritesEachModulesPairAndTheMatchCommandForIt) {
+  ASSERT_EQ(RunCli(Args(dir_ + "/capture")), 0);
+  const std::string plain_cloud = ReadFileBytes(dir_ + "/out.ply");
+  const std::string rect = dir_ + "/rect/new";
+  std::filesystem::remove_all(dir_ + "/rect");
+  const testing::Result r = testing::RunCli(Args(dir_ + "/capture", "--rectified-out " + rect));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(ReadFileBytes(dir_ + "/out.ply"), plain_cloud);
+  for (int m = 0; m < 2; ++m) {
+    const std::string left = rect + "/module" + std::to_string(m) + "_left.png";
+    const cv::Mat image = cv::imread(left, cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(image.type(), CV_8UC1) << left;
+    EXPECT_GT(cv::countNonZero(image), image.total() / 10) << left;
+    const std::string says = "module " + std::to_string(m) + ": rectified pair " + left + ", ";
+    const size_t at = r.out.find(says);
+    ASSERT_NE(at, std::string::npos) << r.out;
+    const size_t command = r.out.find("stereorig match ", at);
+    ASSERT_NE(command, std::string::npos) << r.out;
+    const std::string args = r.out.substr(command + 10, r.out.find('\n', command) - command - 10);
+    EXPECT_NE(args.find(" --min-disparity "), std::string::npos) << args;
+    EXPECT_NE(args.find(" --roi "), std::string::npos) << args;
+    const testing::Result match = testing::RunCli(args);
+    ASSERT_EQ(match.code, 0) << args << ": " << match.err;
+    EXPECT_EQ(match.err, "") << args;
+    EXPECT_TRUE(std::filesystem::exists(rect + "/module" + std::to_string(m) + "_disparity.pfm"));
+  }
+  // One capture only: a batch has many pairs per module.
+  ExpectRefusedInOneLine("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture --out-dir " + dir_ +
+                             "/rect_batch --rectified-out " + rect,
+                         "--out-dir excludes --rectified-out");
+}
+
+// A grey PNG of 1, 2 or 4 bits decodes to 8 bits (0/255 for 1 bit): a 1-bit
+// capture gave 0 points and a 4-bit one fewer, exit 0 both. Refused now as
+// formats.md says (8-bit grey only), naming the file and its depth; so is
+// such an image given to match.
+TEST_F(ReconstructCli, GreyImagesOfFewerThan8BitsAreRefusedNamingTheirDepth) {
+  for (const int bits : {1, 2, 4}) {
+    const std::string capture = BrokenCapture("bits" + std::to_string(bits));
+    const std::string image = capture + "/cam3.png";
+    std::string raw;  // 8 x 2 px: per row a filter byte and 8 samples packed
+    for (int row = 0; row < 2; ++row) raw += '\0' + std::string(size_t(bits), '\x5a');
+    std::ofstream(image, std::ios::binary)
+        << testing::kPngSignature + testing::Chunk("IHDR", testing::Ihdr(8, 2, bits, 0)) +
+               testing::Chunk("IDAT", testing::Deflate(raw, 9)) + testing::Chunk("IEND", "");
+    const std::string says = image + ": is a " + std::to_string(bits) + "-bit grey PNG: captures must be 8-bit grey";
+    ExpectRefusedInOneLine(Args(capture), says);
+    ExpectNoOutput();
+    ExpectRefusedInOneLine("match --left " + image + " --right " + image +
+                               " --min-disparity 0 --num-disparities 16 --out " + dir_ + "/bits.pfm",
+                           says);
+  }
+}
+
+// shape_model fills holes only from a mesh: without --mesh nothing was
+// filled and nothing said. Now one note; with --mesh none. The summary's
+// "wrote" names every file written, the report too (it left it out).
+TEST_F(ReconstructCli, AShapeModelWithoutAMeshIsNotedAndTheSummaryNamesEveryOutput) {
+  WriteFileAtomically(dir_ + "/sphere_model.yaml", "shape_model: sphere\n");
+  const testing::Result r = testing::RunCli(Args(dir_ + "/capture", "--options " + dir_ + "/sphere_model.yaml"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string note = "note: shape_model sphere fills holes only with a mesh (--mesh";
+  EXPECT_NE(r.out.find(note), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find(note), r.out.rfind(note)) << r.out;
+  EXPECT_NE(r.out.find("; wrote " + dir_ + "/out.ply, " + dir_ + "/out.json\n"), std::string::npos) << r.out;
+  const testing::Result meshed =
+      testing::RunCli(Args(dir_ + "/capture", "--options " + dir_ + "/sphere_model.yaml --mesh " + dir_ + "/out.stl"));
+  ASSERT_EQ(meshed.code, 0) << meshed.err;
+  EXPECT_EQ(meshed.out.find("note: shape_model"), std::string::npos) << meshed.out;
+  EXPECT_TRUE(std::regex_search(meshed.out, std::regex("; wrote [^\n]*/out\\.ply, [^\n]*/out\\.stl \\([0-9]+ "
+                                                       "triangles\\), [^\n]*/out\\.json\n")))
+      << meshed.out;
+}
+
+// A capture folder or image this process may not read was named in
+// std::filesystem's words ("filesystem error: directory iterator cannot
+// open directory: Permission denied [DIR]") or without the reason ("cannot
+// be opened"). Now the folder is named as a capture folder that cannot be
+// read, and the image's reason is given. Root reads any folder: the folder
+// is then read as the unprivileged user `nobody`; a sysctl file open for
+// writing only refuses reading even to root.
+TEST_F(ReconstructCli, AFolderOrImageThatCannotBeReadSaysWhy) {
+  const std::string locked = BrokenCapture("locked");
+  std::filesystem::permissions(locked, std::filesystem::perms::none);
+  const std::string as_nobody = geteuid() == 0 ? "--reuid=65534 --regid=65534 --clear-groups " : "";
+  const std::string out = "/tmp/stereorig_locked_" + std::to_string(getpid()) + ".ply";
+  const std::string command = (as_nobody.empty() ? kBin : "setpriv " + as_nobody + kBin) + " reconstruct --rig " +
+                              dir_ + "/rig.yaml --capture " + locked + " --out " + out + " 2>&1 >/dev/null";
+  FILE* p = popen(command.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  std::string err;
+  for (char buf[256]; std::fgets(buf, sizeof buf, p);) err += buf;
+  const int status = pclose(p);
+  std::filesystem::permissions(locked, std::filesystem::perms::owner_all);
+  EXPECT_EQ(WEXITSTATUS(status), 2) << err;
+  EXPECT_EQ(err, "stereorig reconstruct: " + locked + ": the capture folder cannot be read: Permission denied\n");
+  EXPECT_FALSE(std::filesystem::exists(out));
+  const std::string write_only = "/proc/sys/vm/drop_caches";
+  if (access(write_only.c_str(), R_OK) == 0) GTEST_SKIP() << write_only << " is readable here";
+  ExpectRefusedInOneLine("match --left " + write_only + " --right " + write_only +
+                             " --min-disparity 0 --num-disparities 16 --out " + dir_ + "/locked.pfm",
+                         write_only + ": cannot be opened: Permission denied");
+}
+
+// working_distance_mm: 300 on the facing rig puts the volume ~100 mm from
+// module 1, which then needs more than 1024 disparities. The refusal said
+// "move it farther from the cameras (working_distance_mm, ...)": a larger
+// working distance brings it nearer still to module 1. Now it says which
+// way moves it away from module 1; module 0, looking along its own axis,
+// keeps the plain advice.
+TEST_F(ReconstructCli, AVolumeTooNearAFacingModuleIsNotToldToGoFarther) {
+  WriteFileAtomically(dir_ + "/far.yaml", "working_distance_mm: 300\n");
+  const testing::Result r = testing::RunCli(Args(dir_ + "/capture", "--options " + dir_ + "/far.yaml"));
+  ASSERT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("module1's cameras, which face module 0's: volume_center_mm (a larger working_distance_mm "
+                       "moves it away from module 0, nearer to module1)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("farther from the cameras"), std::string::npos) << r.err;
+}
+
+// match on a module's rectified pair of the rendered sphere, its range
+// ending halfway into the sphere's disparities (the walkthrough's: true
+// 472-549 px searched in [300, 500), 63 568 disparities, ~99 % a grid
+// period or more off, exit 0 and no word): the laser grid matches at a
+// copy of itself inside the range and the band pass's matches pile up at
+// its near end. match now warns as reconstruct warns of a module
+// (range_end_reached), on stderr and in its summary line; on the
+// runtime's own range it does not.
+TEST_F(ReconstructCli, MatchWarnsOfARangeThatMissesTheObject) {
+  const std::string rect = dir_ + "/rect_miss";
+  std::filesystem::remove_all(rect);
+  ASSERT_EQ(RunCli(Args(dir_ + "/capture", "--rectified-out " + rect)), 0);
+  std::ifstream f(dir_ + "/out.json");
+  const nlohmann::json module0 = nlohmann::json::parse(f)["modules"][0];
+  ASSERT_TRUE(module0.contains("occupied_disparity_px")) << module0.dump();
+  const int middle_px =
+      (module0["occupied_disparity_px"][0].get<int>() + module0["occupied_disparity_px"][1].get<int>()) / 2;
+  const auto match = [&](int min_px, int end_px) {
+    return testing::RunCli("match --left " + rect + "/module0_left.png --right " + rect +
+                           "/module0_right.png --min-disparity " + std::to_string(min_px) + " --num-disparities " +
+                           std::to_string(end_px - min_px) + " --out " + rect + "/d.pfm");
+  };
+  const int range_min_px = module0["disparity_range_px"][0], range_end_px = module0["disparity_range_px"][1];
+  const testing::Result right = match(range_min_px, range_end_px);
+  ASSERT_EQ(right.code, 0) << right.err;
+  EXPECT_EQ(right.err, "");
+  EXPECT_EQ(right.out.find("warning"), std::string::npos) << right.out;
+  const testing::Result missing = match(middle_px - 200, middle_px);
+  ASSERT_EQ(missing.code, 0) << missing.err;
+  EXPECT_NE(missing.err.find("stereorig match: warning: the disparities pile up at the near end (largest "
+                             "disparities) of the range [" +
+                             std::to_string(middle_px - 200) + ", " + std::to_string(middle_px) +
+                             ") px (--min-disparity, --num-disparities): the range likely misses the object"),
+            std::string::npos)
+      << missing.err;
+  EXPECT_NE(missing.out.find("; warning: they reach the near end (largest disparities) of the range\n"),
+            std::string::npos)
+      << missing.out;
 }
 
 TEST_F(ReconstructCli, MissingCameraExitsTwoAndWritesNothing) {
