@@ -99,6 +99,18 @@ TEST(VerifyCli, BadInputExitsTwoAndWritesNoReport) {
   EXPECT_NE(r.err.find("tiny.ply: not evaluated: only 3 points"), std::string::npos) << r.err;
   EXPECT_NE(r.out.find("1        NOT JUDGED: not evaluated: only 3 points"), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(report));
+  // A vertex count the file cannot hold: refused as the truncated body it
+  // is, naming the file (3000000000 ended in std::bad_alloc, exit 134).
+  const std::string huge = ::testing::TempDir() + "/huge_count.ply";
+  std::ofstream(huge) << "ply\nformat binary_little_endian 1.0\nelement vertex 3000000000\nproperty float x\n"
+                         "property float y\nproperty float z\nend_header\n0123456789ab";
+  r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + huge);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.out, "");
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("huge_count.ply: truncated PLY body: its header declares 3000000000 vertices"),
+            std::string::npos)
+      << r.err;
   // A band that is not positive and finite: one short line (CLI11's own
   // check printed DBL_MAX's 309 digits as the range's end; inf, which it
   // refused, passed the first version of ours, a second reading found).
