@@ -174,4 +174,11 @@ const CLI::Validator& NonNegativeValue() {
   return v;
 }
 
+const CLI::Validator& NonEmptyPath() {
+  static const CLI::Validator v(
+      [](const std::string& text) { return text.empty() ? std::string("an empty path") : std::string(); }, "",
+      "NonEmptyPath");
+  return v;
+}
+
 }  // namespace stereorig

@@ -177,9 +177,13 @@ int RunVerify(int argc, char** argv) {
   std::string artifact_path, report_path;
   std::vector<std::string> clouds;
   VerifyOptions options;
-  app.add_option("--artifact", artifact_path, "artifact file (YAML; docs/verify-and-check.md)")->required();
-  app.add_option("--cloud", clouds, "point cloud (PLY, mm) of one position; repeat for several")->required();
-  app.add_option("--report", report_path, "write the figures as JSON here");
+  app.add_option("--artifact", artifact_path, "artifact file (YAML; docs/verify-and-check.md)")
+      ->required()
+      ->check(NonEmptyPath());
+  app.add_option("--cloud", clouds, "point cloud (PLY, mm) of one position; repeat for several")
+      ->required()
+      ->check(NonEmptyPath());
+  app.add_option("--report", report_path, "write the figures as JSON here")->check(NonEmptyPath());
   app.add_option("--min-points", options.min_points, "fewest points that must lie on the artifact (>= 10)")
       ->capture_default_str();
   app.add_option("--capture-band-mm", options.capture_band_mm,

@@ -122,6 +122,24 @@ TEST(VerifyCli, BadInputExitsTwoAndWritesNoReport) {
   }
 }
 
+// An empty path is refused by its option's name (apps/cli_util.h
+// NonEmptyPath): `--report ""` wrote nothing and exited 0, and `--cloud ""`
+// read "cannot open", naming nothing.
+TEST(VerifyCli, AnEmptyPathIsRefusedByItsOptionsName) {
+  const std::string good = WriteSphere("good_empty.ply", 19.05);
+  const std::string artifact = WriteArtifact(kSphere);
+  for (const std::string& args : {"--artifact " + artifact + " --cloud " + good + " --report ''",
+                                  "--artifact " + artifact + " --cloud ''", "--artifact '' --cloud " + good}) {
+    const auto r = RunCli("verify " + args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(r.out, "") << args;
+    const std::string option = args.find("--report") != std::string::npos     ? "--report"
+                               : args.find("--cloud ''") != std::string::npos ? "--cloud"
+                                                                              : "--artifact";
+    EXPECT_EQ(r.err, "stereorig verify: " + option + ": an empty path (see --help)\n") << args;
+  }
+}
+
 // The report's path is checked before the clouds are judged: a missing
 // folder printed the whole verdict and then exited 2, and a report named as
 // one of the clouds would have replaced the cloud with JSON.
