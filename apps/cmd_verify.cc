@@ -21,12 +21,19 @@ namespace stereorig {
 
 namespace {
 
+// Where a figure's MPE comes from: the artifact file's mpe_mm, or the
+// default (MaximumPermissibleErrors) where the file gives none.
+const char* MpeSource(const Artifact& artifact, const std::string& figure) {
+  return artifact.mpe.Given(figure) ? "certificate" : "default";
+}
+
 // judged: false for a position not judged, whose figures are reported with
 // "pass": null.
-nlohmann::json FigureJson(const Figure& f, bool judged) {
+nlohmann::json FigureJson(const Figure& f, bool judged, const Artifact& artifact) {
   judged = judged && f.judged;  // a figure left undetermined: its pass is not claimed
-  nlohmann::json j = {
-      {"name", f.name}, {"value_mm", f.value_mm}, {"mpe_mm", f.mpe_mm}, {"judged", judged}, {"pass", nullptr}};
+  nlohmann::json j = {{"name", f.name},     {"value_mm", f.value_mm},
+                      {"mpe_mm", f.mpe_mm}, {"mpe_source", MpeSource(artifact, f.name)},
+                      {"judged", judged},   {"pass", nullptr}};
   if (judged) j["pass"] = f.pass;
   if (f.standard_uncertainty_mm) j["standard_uncertainty_mm"] = *f.standard_uncertainty_mm;
   if (f.fit_standard_uncertainty_mm) j["fit_standard_uncertainty_mm"] = *f.fit_standard_uncertainty_mm;
@@ -106,6 +113,31 @@ void PrintSpheres(size_t position, const ArtifactEvaluation& e) {
         position, k + 1, e.sphere_diameters_mm[k], e.sphere_diameter_std_mm[k], e.sphere_cap_half_angles_deg[k],
         e.sphere_form_mm[k], e.type == ArtifactType::kBallBar ? " (not judged: the ball bar's figure is SD)" : "");
   }
+}
+
+// The MPE of each figure of the artifact's type and where it comes from: a
+// file without mpe_mm (or without a figure's key in it) is judged against
+// the default, said here and in the report (mpe_source).
+void PrintMpes(const Artifact& artifact) {
+  std::vector<std::pair<const char*, double>> mpes;
+  switch (artifact.type) {
+    case ArtifactType::kSphere:
+      mpes = {{"P_F", artifact.mpe.probing_form_mm}, {"P_S", artifact.mpe.probing_size_mm}};
+      break;
+    case ArtifactType::kBallBar:
+      mpes = {{"SD", artifact.mpe.sphere_spacing_mm}};
+      break;
+    case ArtifactType::kPlate:
+      mpes = {{"F", artifact.mpe.flatness_mm}};
+      break;
+  }
+  std::printf("MPE:");
+  for (size_t k = 0; k < mpes.size(); ++k) {
+    const bool given = artifact.mpe.Given(mpes[k].first);
+    std::printf("%s %s %.4f mm (%s)", k ? "," : "", mpes[k].first, mpes[k].second,
+                given ? "the artifact file's" : "default: the artifact file's mpe_mm gives none");
+  }
+  std::printf("\n");
 }
 
 std::string UncertaintyText(const Figure& f) {
@@ -236,6 +268,7 @@ int RunVerify(int argc, char** argv) {
   std::printf("artifact: %s (%s); capture band %.1f mm\n", artifact.name.c_str(), ArtifactTypeName(artifact.type),
               positions.front().capture_band_mm);
   std::printf("decision rule: %s\n", DecisionRuleText(options.decision_rule));
+  PrintMpes(artifact);
   // The same cloud given twice is one position, not two (the standard asks
   // for positions that differ): said, not refused (a test may repeat one).
   for (size_t i = 1; i < clouds.size(); ++i) {
@@ -285,14 +318,14 @@ int RunVerify(int argc, char** argv) {
       pj["not_judged_reason"] = e.not_judged_reason;
     }
     for (const Figure& f : e.figures) {
-      std::printf("%-8zu %-6s %10.4f %8s %7.3f %4s %8d %7d %8d %8d %8d %10.4f\n", i + 1, f.name.c_str(), f.value_mm,
+      std::printf("%-8zu %-6s %10.4f %8s %7.4f %4s %8d %7d %8d %8d %8d %10.4f\n", i + 1, f.name.c_str(), f.value_mm,
                   UncertaintyText(f).c_str(), f.mpe_mm,
                   !e.judged() || !f.judged ? "-"
                   : f.pass                 ? "yes"
                                            : "NO",
                   e.points_total + filled_skipped[i], filled_skipped[i], e.points_on_artifact, e.points_excluded,
                   e.points_used(), e.residual_mean_abs_mm);
-      pj["figures"].push_back(FigureJson(f, e.judged()));
+      pj["figures"].push_back(FigureJson(f, e.judged(), artifact));
     }
     for (const Figure& f : e.figures) {
       PrintUncertainty(i + 1, f, artifact.uncertainty_coverage_factor);
@@ -329,12 +362,12 @@ int RunVerify(int argc, char** argv) {
   report["summary"]["worst"] = nlohmann::json::array();
   for (const Figure& f : summary.worst) {
     if (options.decision_rule != DecisionRule::kSimpleAcceptance && f.standard_uncertainty_mm) {
-      std::printf("  %s %.4f mm (2u %.4f, MPE %.3f) %s", f.name.c_str(), f.value_mm, f.ExpandedUncertaintyMm(),
+      std::printf("  %s %.4f mm (2u %.4f, MPE %.4f) %s", f.name.c_str(), f.value_mm, f.ExpandedUncertaintyMm(),
                   f.mpe_mm, f.pass ? "pass" : "FAIL");
     } else {
-      std::printf("  %s %.4f mm (MPE %.3f) %s", f.name.c_str(), f.value_mm, f.mpe_mm, f.pass ? "pass" : "FAIL");
+      std::printf("  %s %.4f mm (MPE %.4f) %s", f.name.c_str(), f.value_mm, f.mpe_mm, f.pass ? "pass" : "FAIL");
     }
-    report["summary"]["worst"].push_back(FigureJson(f, true));
+    report["summary"]["worst"].push_back(FigureJson(f, true, artifact));
   }
   const char* verdict = judged_failure ? "FAIL" : !all_judged ? "NOT JUDGED" : "PASS";
   std::printf("\nverdict: %s", verdict);

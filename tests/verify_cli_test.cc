@@ -140,6 +140,34 @@ TEST(VerifyCli, AnEmptyPathIsRefusedByItsOptionsName) {
   }
 }
 
+// An MPE the artifact file does not give is the default (1.5 mm), and the
+// table and the report say so (mpe_source); the file's are "certificate".
+// Before, a certificate without mpe_mm was judged against 1.5 mm with
+// nothing saying it was a default. The MPE is printed with the value's 4
+// decimals: "P_F 0.3415 mm (MPE 0.342) FAIL" read as a contradiction.
+TEST(VerifyCli, TheMpeSaysWhetherTheArtifactFileGaveItOrItIsTheDefault) {
+  const std::string good = WriteSphere("good_mpe.ply", 19.05);
+  const std::string report = ::testing::TempDir() + "/verify_mpe.json";
+  auto r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + good + " --report " + report);
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("MPE: P_F 1.5000 mm (default: the artifact file's mpe_mm gives none), P_S 1.5000 mm "
+                       "(default: the artifact file's mpe_mm gives none)\n"),
+            std::string::npos)
+      << r.out;
+  auto j = nlohmann::json::parse(std::ifstream(report));
+  for (const auto& f : j["positions"][0]["figures"]) EXPECT_EQ(f["mpe_source"], "default") << f;
+  for (const auto& f : j["summary"]["worst"]) EXPECT_EQ(f["mpe_source"], "default") << f;
+
+  r = RunCli("verify --artifact " + WriteArtifact(std::string(kSphere) + "mpe_mm: {P_F: 0.34152}\n") + " --cloud " +
+             good + " --report " + report);
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("MPE: P_F 0.3415 mm (the artifact file's), P_S 1.5000 mm (default"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(MPE 0.3415) pass"), std::string::npos) << r.out;
+  j = nlohmann::json::parse(std::ifstream(report));
+  for (const auto& f : j["positions"][0]["figures"])
+    EXPECT_EQ(f["mpe_source"], f["name"] == "P_F" ? "certificate" : "default") << f;
+}
+
 // The report's path is checked before the clouds are judged: a missing
 // folder printed the whole verdict and then exited 2, and a report named as
 // one of the clouds would have replaced the cloud with JSON.

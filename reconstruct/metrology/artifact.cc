@@ -71,6 +71,10 @@ Artifact Parse(YamlMap m) {
   }
   if (m.Has("mpe_mm")) {
     YamlMap e = m.GetMap("mpe_mm");
+    a.mpe.probing_form_given = e.Has("P_F");
+    a.mpe.probing_size_given = e.Has("P_S");
+    a.mpe.sphere_spacing_given = e.Has("SD");
+    a.mpe.flatness_given = e.Has("F");
     a.mpe.probing_form_mm = e.GetDouble("P_F", a.mpe.probing_form_mm);
     a.mpe.probing_size_mm = e.GetDouble("P_S", a.mpe.probing_size_mm);
     a.mpe.sphere_spacing_mm = e.GetDouble("SD", a.mpe.sphere_spacing_mm);
