@@ -5,12 +5,12 @@
 // judged (printed all the same; no report written).
 #include <algorithm>
 #include <cstdio>
-#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
 #include "apps/output_paths.h"
+#include "apps/verify_positions.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "reconstruct/metrology/artifact.h"
@@ -269,19 +269,19 @@ int RunVerify(int argc, char** argv) {
               positions.front().capture_band_mm);
   std::printf("decision rule: %s\n", DecisionRuleText(options.decision_rule));
   PrintMpes(artifact);
-  // The same cloud given twice is one position, not two (the standard asks
-  // for positions that differ): said, not refused (a test may repeat one).
-  for (size_t i = 1; i < clouds.size(); ++i) {
-    for (size_t j = 0; j < i; ++j) {
-      std::error_code ec;
-      if (std::filesystem::equivalent(clouds[i], clouds[j], ec)) {
-        std::printf(
-            "note: position %zu is the same cloud as position %zu (%s): the standard asks for positions "
-            "that differ\n",
-            i + 1, j + 1, PrintableText(clouds[i]).c_str());
-        break;
-      }
+  // The same cloud given twice, or a byte-identical copy of it, is one
+  // position, not two (the standard asks for positions that differ): said,
+  // not refused (a test may repeat one).
+  const std::vector<RepeatedPosition> repeated = RepeatedPositions(clouds);
+  int distinct_positions = 0;
+  for (size_t i = 0; i < clouds.size(); ++i) {
+    if (repeated[i].earlier < 0) {
+      ++distinct_positions;
+      continue;
     }
+    std::printf("note: position %zu is %s position %d (%s): the standard asks for positions that differ\n", i + 1,
+                repeated[i].same_file ? "the same cloud as" : "a byte-identical copy of the cloud of",
+                repeated[i].earlier + 1, PrintableText(clouds[i]).c_str());
   }
   std::printf("%-8s %-6s %10s %8s %7s %4s %8s %7s %8s %8s %8s %10s\n", "position", "figure", "value_mm", "u_mm",
               "mpe_mm", "pass", "cloud", "filled", "artifact", "excluded", "used", "mean|e|_mm");
@@ -397,6 +397,17 @@ int RunVerify(int argc, char** argv) {
     std::printf(" not judged: %s)\n", why);
   } else {
     std::printf(": %s; exit 2, no report written)\n", why);
+  }
+  // The verdict stands, but over fewer positions than the procedure asks
+  // for it is not its acceptance test: said under it, and in the report.
+  report["summary"]["positions_given"] = clouds.size();
+  report["summary"]["positions_distinct"] = distinct_positions;
+  report["summary"]["positions_asked"] = kPositionsAsked;
+  if (distinct_positions < kPositionsAsked) {
+    std::printf(
+        "note: %d distinct position(s) measured; the procedure asks for %d or more spread through the volume "
+        "(docs/verify-and-check.md): this verdict covers the positions measured only\n",
+        distinct_positions, kPositionsAsked);
   }
   if (!report_path.empty() && (all_judged || judged_failure)) WriteFileAtomically(report_path, report.dump(2) + "\n");
   if (!all_judged && !judged_failure) {

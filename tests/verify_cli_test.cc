@@ -168,6 +168,39 @@ TEST(VerifyCli, TheMpeSaysWhetherTheArtifactFileGaveItOrItIsTheDefault) {
     EXPECT_EQ(f["mpe_source"], f["name"] == "P_F" ? "certificate" : "default") << f;
 }
 
+// Fewer distinct positions than the procedure's 7 keep their verdict, with a
+// note under it and the counts in the report; a byte-identical copy of a
+// cloud under another name is said to be the same position, as the same
+// file is. Before, one --cloud read PASS with no word, and a copy counted
+// as a second position.
+TEST(VerifyCli, FewerPositionsThanTheProcedureAsksForAreNotedAndACopyIsNoNewPosition) {
+  const std::string good = WriteSphere("good_positions.ply", 19.05);
+  const std::string copy = ::testing::TempDir() + "/good_positions_copy.ply";
+  std::filesystem::copy_file(good, copy, std::filesystem::copy_options::overwrite_existing);
+  const std::string report = ::testing::TempDir() + "/verify_positions.json";
+  const std::string artifact = WriteArtifact(kSphere);
+  auto r = RunCli("verify --artifact " + artifact + " --cloud " + good + " --cloud " + copy + " --report " + report);
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("verdict: PASS\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("note: position 2 is a byte-identical copy of the cloud of position 1"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("note: 1 distinct position(s) measured; the procedure asks for 7 or more"), std::string::npos)
+      << r.out;
+  auto j = nlohmann::json::parse(std::ifstream(report));
+  EXPECT_EQ(j["summary"]["positions_given"], 2);
+  EXPECT_EQ(j["summary"]["positions_distinct"], 1);
+  EXPECT_EQ(j["summary"]["positions_asked"], 7);
+  // Seven clouds that differ: no note.
+  std::string args;
+  for (int k = 0; k < 7; ++k)
+    args += " --cloud " + WriteSphere("position_" + std::to_string(k) + ".ply", 19.05 + 0.001 * k);
+  r = RunCli("verify --artifact " + artifact + args + " --report " + report);
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_EQ(r.out.find("note:"), std::string::npos) << r.out;
+  j = nlohmann::json::parse(std::ifstream(report));
+  EXPECT_EQ(j["summary"]["positions_distinct"], 7);
+}
+
 // The report's path is checked before the clouds are judged: a missing
 // folder printed the whole verdict and then exited 2, and a report named as
 // one of the clouds would have replaced the cloud with JSON.
