@@ -13,6 +13,7 @@
 #include "apps/verify_positions.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
+#include "calib/core/rig_file.h"
 #include "reconstruct/metrology/artifact.h"
 #include "reconstruct/metrology/ply_points.h"
 #include "reconstruct/metrology/vdi2634.h"
@@ -113,6 +114,27 @@ void PrintSpheres(size_t position, const ArtifactEvaluation& e) {
         position, k + 1, e.sphere_diameters_mm[k], e.sphere_diameter_std_mm[k], e.sphere_cap_half_angles_deg[k],
         e.sphere_form_mm[k], e.type == ArtifactType::kBallBar ? " (not judged: the ball bar's figure is SD)" : "");
   }
+}
+
+// The certificate's values the figures are taken against, under the
+// artifact file's keys.
+nlohmann::json CertifiedJson(const Artifact& a) {
+  switch (a.type) {
+    case ArtifactType::kSphere:
+      return {{"diameter_mm", a.sphere_diameter_mm},
+              {"diameter_uncertainty_mm", a.sphere_diameter_uncertainty_mm},
+              {"form_uncertainty_mm", a.sphere_form_uncertainty_mm}};
+    case ArtifactType::kBallBar:
+      return {{"sphere_diameter_mm", a.sphere_diameter_mm},
+              {"sphere_diameter_uncertainty_mm", a.sphere_diameter_uncertainty_mm},
+              {"center_distance_mm", a.center_distance_mm},
+              {"center_distance_uncertainty_mm", a.center_distance_uncertainty_mm}};
+    case ArtifactType::kPlate:
+      return {{"length_mm", a.plate_length_mm},
+              {"width_mm", a.plate_width_mm},
+              {"flatness_uncertainty_mm", a.flatness_uncertainty_mm}};
+  }
+  return {};
 }
 
 // The MPE of each figure of the artifact's type and where it comes from: a
@@ -285,7 +307,12 @@ int RunVerify(int argc, char** argv) {
   }
   std::printf("%-8s %-6s %10s %8s %7s %4s %8s %7s %8s %8s %8s %10s\n", "position", "figure", "value_mm", "u_mm",
               "mpe_mm", "pass", "cloud", "filled", "artifact", "excluded", "used", "mean|e|_mm");
+  // Traceable: which certificate, its certified values, when and by what.
   nlohmann::json report = {{"artifact", artifact.name},
+                           {"artifact_file", artifact_path},
+                           {"certified", CertifiedJson(artifact)},
+                           {"date_utc", NowUtcIso8601()},
+                           {"tool", ToolVersion()},
                            {"type", ArtifactTypeName(artifact.type)},
                            {"uncertainty_coverage_factor", artifact.uncertainty_coverage_factor},
                            {"decision_rule", DecisionRuleName(options.decision_rule)},
@@ -360,14 +387,19 @@ int RunVerify(int argc, char** argv) {
     std::printf("summary over the %zu judged of %zu position(s):", judged, positions.size());
   }
   report["summary"]["worst"] = nlohmann::json::array();
-  for (const Figure& f : summary.worst) {
+  for (size_t k = 0; k < summary.worst.size(); ++k) {
+    const Figure& f = summary.worst[k];
+    const int at = summary.worst_positions[k] + 1;  // numbered as in the table
     if (options.decision_rule != DecisionRule::kSimpleAcceptance && f.standard_uncertainty_mm) {
       std::printf("  %s %.4f mm (2u %.4f, MPE %.4f) %s", f.name.c_str(), f.value_mm, f.ExpandedUncertaintyMm(),
                   f.mpe_mm, f.pass ? "pass" : "FAIL");
     } else {
       std::printf("  %s %.4f mm (MPE %.4f) %s", f.name.c_str(), f.value_mm, f.mpe_mm, f.pass ? "pass" : "FAIL");
     }
-    report["summary"]["worst"].push_back(FigureJson(f, true, artifact));
+    if (positions.size() > 1) std::printf(" at position %d", at);
+    nlohmann::json worst = FigureJson(f, true, artifact);
+    worst["position"] = at;
+    report["summary"]["worst"].push_back(worst);
   }
   const char* verdict = judged_failure ? "FAIL" : !all_judged ? "NOT JUDGED" : "PASS";
   std::printf("\nverdict: %s", verdict);

@@ -201,6 +201,33 @@ TEST(VerifyCli, FewerPositionsThanTheProcedureAsksForAreNotedAndACopyIsNoNewPosi
   EXPECT_EQ(j["summary"]["positions_distinct"], 7);
 }
 
+// The report is traceable: the certificate's path and its certified values,
+// when it was written and by which build, and at which position each worst
+// figure was measured (also in the terminal's summary). Before, it held the
+// artifact's name alone.
+TEST(VerifyCli, TheReportNamesItsCertificateDateToolAndWorstPosition) {
+  const std::string artifact = WriteArtifact(kSphere);
+  const std::string good = WriteSphere("good_trace.ply", 19.05);
+  const std::string larger = WriteSphere("larger_trace.ply", 19.05 + 0.3);  // P_S 0.6 mm
+  const std::string report = ::testing::TempDir() + "/verify_trace.json";
+  const auto r =
+      RunCli("verify --artifact " + artifact + " --cloud " + good + " --cloud " + larger + " --report " + report);
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  const auto j = nlohmann::json::parse(std::ifstream(report));
+  EXPECT_EQ(j["artifact_file"], artifact);
+  EXPECT_EQ(j["certified"]["diameter_mm"], 38.1);
+  EXPECT_EQ(j["certified"]["diameter_uncertainty_mm"], 0.002);
+  const std::string date = j["date_utc"];
+  EXPECT_EQ(date.size(), 20u) << date;  // 2026-11-23T00:00:00Z
+  EXPECT_EQ(date.back(), 'Z') << date;
+  EXPECT_EQ(j["tool"].get<std::string>().rfind("stereorig ", 0), 0u) << j["tool"];
+  for (const auto& f : j["summary"]["worst"])
+    if (f["name"] == "P_S") {
+      EXPECT_EQ(f["position"], 2) << f;
+    }
+  EXPECT_NE(r.out.find("P_S 0.6000 mm (MPE 1.5000) pass at position 2"), std::string::npos) << r.out;
+}
+
 // The report's path is checked before the clouds are judged: a missing
 // folder printed the whole verdict and then exited 2, and a report named as
 // one of the clouds would have replaced the cloud with JSON.

@@ -778,7 +778,7 @@ ArtifactEvaluation NotEvaluated(const Artifact& a, const VerifyOptions& o, int p
 VerifySummary Summarise(const std::vector<ArtifactEvaluation>& positions) {
   VerifySummary s;
   s.pass = !positions.empty();
-  std::map<std::string, Figure> worst;
+  std::map<std::string, std::pair<Figure, int>> worst;  // name -> the figure, its position
   for (size_t i = 0; i < positions.size(); ++i) {
     const ArtifactEvaluation& p = positions[i];
     if (!p.judged()) {
@@ -795,10 +795,14 @@ VerifySummary Summarise(const std::vector<ArtifactEvaluation>& positions) {
       // not a measurement of the system: not the worst.
       if (!f.judged) continue;
       auto it = worst.find(f.name);
-      if (it == worst.end() || judged_magnitude(f) > judged_magnitude(it->second)) worst[f.name] = f;
+      if (it == worst.end() || judged_magnitude(f) > judged_magnitude(it->second.first))
+        worst[f.name] = {f, static_cast<int>(i)};
     }
   }
-  for (const auto& [name, f] : worst) s.worst.push_back(f);
+  for (const auto& [name, at] : worst) {
+    s.worst.push_back(at.first);
+    s.worst_positions.push_back(at.second);
+  }
   return s;
 }
 

@@ -1159,6 +1159,8 @@ TEST(Vdi2634, TheSummarysWorstIsTheFigureNearestToFailingUnderTheRule) {
     ASSERT_EQ(s.worst.size(), 1u);
     const bool guarded = rule == DecisionRule::kGuardedAcceptance;
     EXPECT_EQ(s.worst[0].value_mm, guarded ? 1.25 : 1.30) << DecisionRuleName(rule);
+    // Which position it is, for the report's traceability (summary.worst).
+    EXPECT_EQ(s.worst_positions, std::vector<int>{guarded ? 1 : 0}) << DecisionRuleName(rule);
     EXPECT_EQ(s.worst[0].pass, !guarded) << DecisionRuleName(rule);
     EXPECT_EQ(s.pass, !guarded) << DecisionRuleName(rule);
   }
@@ -1175,6 +1177,7 @@ TEST(Vdi2634, TheSummarysWorstIsTheFigureNearestToFailingUnderTheRule) {
     const VerifySummary s = Summarise(p);
     ASSERT_EQ(s.worst.size(), 1u);
     EXPECT_EQ(s.worst[0].value_mm, 1.60);
+    EXPECT_EQ(s.worst_positions, std::vector<int>{swapped ? 1 : 0});
     EXPECT_FALSE(s.worst[0].pass);
     EXPECT_FALSE(s.pass);
   }
