@@ -60,6 +60,11 @@ const CLI::Validator& NonNegativeValue();
 // no report and exited 0) or as a file named "" ("cannot open").
 const CLI::Validator& NonEmptyPath();
 
+// Flushes stdout and throws InputError("standard output", ...) if anything
+// written to it was lost (a full disk, /dev/full): a command whose result is
+// its table must not exit 0 when the table was not written.
+void RequireStdoutWritten();
+
 // For subcommands a later issue fills in: prints what it will do and exits 2.
 int NotBuiltYet(const char* name, const char* what, int argc, char** argv);
 

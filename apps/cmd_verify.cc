@@ -256,6 +256,9 @@ int RunVerify(int argc, char** argv) {
                              DecisionRuleName(DecisionRule::kGuardedRejection)}));
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
   options.decision_rule = *ParseDecisionRule(rule_name);
+  // Named by the option, not as VerifyOptions::Check's min_points.
+  if (options.min_points < 10)
+    throw InputError("--min-points", "must be >= 10, got " + std::to_string(options.min_points));
   OutputPaths outputs;  // the report's path checked before the clouds are read and judged
   outputs.Protect(artifact_path, "the artifact file (--artifact)");
   for (const std::string& cloud : clouds) outputs.Protect(cloud, "a cloud (--cloud)");
@@ -441,6 +444,9 @@ int RunVerify(int argc, char** argv) {
         "(docs/verify-and-check.md): this verdict covers the positions measured only\n",
         distinct_positions, kPositionsAsked);
   }
+  // The table is the verdict: one that could not be written (a full disk,
+  // /dev/full) is an error, not exit 0, and leaves no report behind.
+  RequireStdoutWritten();
   if (!report_path.empty() && (all_judged || judged_failure)) WriteFileAtomically(report_path, report.dump(2) + "\n");
   if (!all_judged && !judged_failure) {
     // One line on stderr, as for bad input: the first position's reason.

@@ -3,6 +3,8 @@
 // JSON report's figures match the analytic truth.
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -226,6 +228,45 @@ TEST(VerifyCli, TheReportNamesItsCertificateDateToolAndWorstPosition) {
       EXPECT_EQ(f["position"], 2) << f;
     }
   EXPECT_NE(r.out.find("P_S 0.6000 mm (MPE 1.5000) pass at position 2"), std::string::npos) << r.out;
+}
+
+// Error lines that say what is wrong: a certificate that cannot be read
+// (read "not valid YAML: bad file"), a folder given as a cloud (read "not a
+// PLY file"), --min-points below 10 (named as "verify options: min_points"),
+// and a table that could not be written (to /dev/full: exit 0 before).
+TEST(VerifyCli, ErrorLinesSayWhatIsWrongAndALostTableIsNoSuccess) {
+  const std::string good = WriteSphere("good_errors.ply", 19.05);
+  const std::string artifact = WriteArtifact(kSphere);
+  auto r = RunCli("verify --artifact " + artifact + " --cloud " + ::testing::TempDir());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(": is a folder, not a file"), std::string::npos) << r.err;
+  r = RunCli("verify --artifact " + artifact + " --cloud " + good + " --min-points 5");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "stereorig verify: --min-points: must be >= 10, got 5\n");
+  const std::string report = ::testing::TempDir() + "/verify_full.json";
+  std::filesystem::remove(report);
+  const int status = std::system((stereorig::testing::kBin + " verify --artifact " + artifact + " --cloud " + good +
+                                  " --report " + report + " >/dev/full 2>/dev/null")
+                                     .c_str());
+  EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2);
+  EXPECT_FALSE(std::filesystem::exists(report));  // nothing left behind
+  // A certificate this process may not read (as root, through setpriv as
+  // nobody: root reads any file).
+  const std::string unreadable = WriteArtifact(kSphere);
+  std::filesystem::permissions(unreadable, std::filesystem::perms::none);
+  std::filesystem::permissions(good, std::filesystem::perms::others_read, std::filesystem::perm_options::add);
+  std::string as_other = geteuid() != 0 ? ""
+                         : std::system("command -v setpriv >/dev/null") == 0
+                             ? "setpriv --reuid=65534 --regid=65534 --clear-groups "
+                             : "";
+  if (geteuid() == 0 && as_other.empty()) GTEST_SKIP() << "root, and no setpriv to read as another user";
+  const std::string err = ::testing::TempDir() + "/verify_unreadable_err.txt";
+  std::system((as_other + stereorig::testing::kBin + " verify --artifact " + unreadable + " --cloud " + good +
+               " >/dev/null 2>" + err)
+                  .c_str());
+  std::ifstream f(err);
+  const std::string line((std::istreambuf_iterator<char>(f)), {});
+  EXPECT_EQ(line, "stereorig verify: " + unreadable + ": cannot be read\n");
 }
 
 // The report's path is checked before the clouds are judged: a missing

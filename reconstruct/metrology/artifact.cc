@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "calib/core/input_error.h"
+#include "calib/core/input_file.h"
 #include "calib/core/rig_file.h"
 #include "calib/core/yaml_reader.h"
 
@@ -91,7 +92,9 @@ Artifact Parse(YamlMap m) {
 
 }  // namespace
 
-Artifact ReadArtifactFile(const std::string& path) { return Parse(YamlMap::LoadFile(path)); }
+// Read here, not by yaml-cpp's LoadFile: a file it cannot open (no read
+// permission) it calls a "bad file", which read "not valid YAML: bad file".
+Artifact ReadArtifactFile(const std::string& path) { return Parse(YamlMap::LoadString(ReadInputText(path), path)); }
 Artifact ParseArtifactYaml(const std::string& text, const std::string& where) {
   return Parse(YamlMap::LoadString(text, where));
 }

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "calib/core/input_error.h"
+#include "calib/core/input_file.h"
 
 namespace stereorig {
 
@@ -52,8 +53,9 @@ double ReadBinary(std::istream& in, const std::string& t, bool swap, const std::
 }  // namespace
 
 PlyVertices ReadPlyVertices(const std::string& path) {
+  RequireInputFile(path, /*pipe_too=*/true);  // a folder is named as one, not as "not a PLY file"
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "cannot open");
+  if (!in) throw InputError(path, "cannot be read");
   std::string line;
   if (!std::getline(in, line) || line.rfind("ply", 0) != 0) throw InputError(path, "not a PLY file");
   Encoding enc = Encoding::kAscii;

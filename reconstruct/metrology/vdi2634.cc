@@ -519,10 +519,60 @@ void RequirePlateCoverage(const PlaneOutline& e, const Artifact& a, const Verify
   }
 }
 
+// The artifact's largest dimension, mm: what a cloud of it must span.
+double ArtifactSizeMm(const Artifact& a) {
+  switch (a.type) {
+    case ArtifactType::kSphere:
+      return a.sphere_diameter_mm;
+    case ArtifactType::kBallBar:
+      return a.center_distance_mm + a.sphere_diameter_mm;
+    case ArtifactType::kPlate:
+      return std::hypot(a.plate_length_mm, a.plate_width_mm);
+  }
+  return 0;
+}
+
+// "; the cloud spans 0.04 across, ..." where a cloud is over 100x smaller
+// than the artifact (its bounding box's diagonal against the artifact's
+// size), as a cloud in metres is (1000x): RANSAC finding no sphere in it
+// said nothing of why. Empty otherwise.
+std::string UnitsHint(const Artifact& a, const std::vector<Eigen::Vector3d>& pts) {
+  if (pts.empty()) return "";
+  Eigen::Vector3d lo = pts[0], hi = pts[0];
+  for (const auto& p : pts) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const double extent = (hi - lo).norm(), size_mm = ArtifactSizeMm(a);
+  if (!(extent * 100 < size_mm)) return "";
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "; the whole cloud spans only %.3g across, %.0fx less than the artifact's %.1f mm: is it in metres? "
+                "verify reads millimetres",
+                extent, extent > 0 ? size_mm / extent : std::numeric_limits<double>::infinity(), size_mm);
+  return buf;
+}
+
+ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eigen::Vector3d>& pts,
+                                        const VerifyOptions& o, const std::string& where);
+
 }  // namespace
 
 ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::Vector3d>& pts, const VerifyOptions& o,
                                     const std::string& where) {
+  try {
+    return EvaluateArtifactInMm(a, pts, o, where);
+  } catch (const NotTheArtifactError& refused) {
+    const std::string hint = UnitsHint(a, pts);
+    if (hint.empty()) throw;
+    throw NotTheArtifactError(refused.where(), refused.problem() + hint);
+  }
+}
+
+namespace {
+
+ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eigen::Vector3d>& pts,
+                                        const VerifyOptions& o, const std::string& where) {
   o.Check();
   ArtifactEvaluation e;
   e.decision_rule = o.decision_rule;
@@ -762,6 +812,8 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
   }
   return e;
 }
+
+}  // namespace
 
 ArtifactEvaluation NotEvaluated(const Artifact& a, const VerifyOptions& o, int points_total,
                                 const std::string& reason) {

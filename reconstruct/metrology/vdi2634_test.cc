@@ -1254,6 +1254,30 @@ TEST(Vdi2634, ACloudAFewPercentTooLargeFailsAndOneFarOffNamesTheScale) {
   }
 }
 
+// A cloud in metres (every coordinate 1000x too small) is not the artifact,
+// and the refusal says what it likely is: RANSAC finding no sphere in it
+// said nothing of why (a user's walkthrough). A cloud the artifact's size
+// gets no such hint.
+TEST(Vdi2634, ACloudInMetresIsNamedSo) {
+  std::vector<Eigen::Vector3d> metres = ExactSphere(38.1);
+  for (auto& p : metres) p *= 0.001;
+  try {
+    EvaluateArtifact(SphereArtifact(), metres, VerifyOptions(), "s.ply");
+    ADD_FAILURE() << "a sphere in metres was judged";
+  } catch (const NotTheArtifactError& error) {
+    const std::string what = error.what();
+    EXPECT_EQ(what.rfind("s.ply: no sphere of the certified size found in the cloud", 0), 0u) << what;
+    EXPECT_NE(what.find("than the artifact's 38.1 mm: is it in metres? verify reads millimetres"), std::string::npos)
+        << what;
+  }
+  try {
+    EvaluateArtifact(SphereArtifact(), ExactSphere(0.5 * 38.1), VerifyOptions(), "s.ply");
+    ADD_FAILURE() << "a sphere half the size was judged";
+  } catch (const NotTheArtifactError& error) {
+    EXPECT_EQ(std::string(error.what()).find("metres"), std::string::npos) << error.what();
+  }
+}
+
 // --- (7) Stray points in the plate's plane. ---
 
 TEST(Vdi2634, AStrayPointInThePlatesPlaneMovesNeitherItsOutlineNorItsFigure) {
