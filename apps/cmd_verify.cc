@@ -379,8 +379,12 @@ int RunVerify(int argc, char** argv) {
       "u_mm = the figure's standard uncertainty (k = 1): the fit's (its covariance) and the certificate's (U / k) "
       "in quadrature; points: cloud = all vertices; "
       "filled = added by hole filling (module 255), skipped; artifact = within the capture band; excluded = the "
-      "largest residuals (<= 0.3%%); used = in the figures; pass: under the decision rule, - = not judged (the line "
-      "NOT JUDGED says why)\n");
+      "largest residuals (<= 0.3%%); used = in the figures; mean|e|_mm = the mean |residual| of the points used to "
+      "the fitted shape(s); pass: under the decision rule, - = not judged (the line NOT JUDGED says why)%s\n",
+      artifact.type == ArtifactType::kPlate
+          ? ""
+          : "; cap half-angle = the cone about the points' mean direction from the sphere's centre that holds 99% of "
+            "them: 90 deg a hemisphere, over 90 more than one (near 180 a sphere seen from both sides)");
   const size_t judged = positions.size() - summary.not_judged_positions.size();
   if (all_judged) {
     std::printf("summary over %zu position(s):", positions.size());

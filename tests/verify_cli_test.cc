@@ -75,6 +75,10 @@ TEST(VerifyCli, PassFailAndReport) {
   EXPECT_EQ(r.code, 1) << r.out << r.err;
   EXPECT_NE(r.out.find("FAIL"), std::string::npos);
   EXPECT_EQ(r.out.find("note: position"), std::string::npos) << r.out;  // two clouds that differ
+  // The legend explains every column and the cap's half-angle, which reads
+  // over 90 deg for more than a hemisphere (it was explained nowhere).
+  EXPECT_NE(r.out.find("mean|e|_mm = the mean |residual| of the points used"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("over 90 more than one (near 180 a sphere seen from both sides)"), std::string::npos) << r.out;
 }
 
 TEST(VerifyCli, BadInputExitsTwoAndWritesNoReport) {
