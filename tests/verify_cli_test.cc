@@ -13,6 +13,7 @@
 #include <iterator>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <sstream>
 
 #include "tests/cli_runner.h"
 
@@ -271,6 +272,39 @@ TEST(VerifyCli, ErrorLinesSayWhatIsWrongAndALostTableIsNoSuccess) {
   std::ifstream f(err);
   const std::string line((std::istreambuf_iterator<char>(f)), {});
   EXPECT_EQ(line, "stereorig verify: " + unreadable + ": cannot be read\n");
+}
+
+// --help is wrapped (one line was ~2960 characters) and shows a minimal
+// artifact file of each kind, side by side; each one, cut from the help as
+// a user would copy it, is a valid artifact file: the sphere's verifies a
+// sphere, the ball bar's and plate's read and refuse the sphere's cloud as
+// not the artifact (not as a file missing a key).
+TEST(VerifyCli, HelpIsWrappedAndItsArtifactSkeletonsAreValidFiles) {
+  const auto help = RunCli("verify --help");
+  ASSERT_EQ(help.code, 0);
+  std::istringstream lines(help.out);
+  std::string skeletons[3];
+  bool in_skeletons = false;
+  for (std::string line; std::getline(lines, line);) {
+    EXPECT_LE(line.size(), 120u) << line;
+    if (line.rfind("  format: stereorig-artifact", 0) == 0) in_skeletons = true;
+    if (in_skeletons && line.empty()) break;
+    if (!in_skeletons) continue;
+    for (int k = 0; k < 3; ++k) {
+      std::string column = line.size() > 2 + 34u * k ? line.substr(2 + 34 * k, 34) : "";
+      column.erase(column.find_last_not_of(' ') + 1);
+      if (!column.empty()) skeletons[k] += column + "\n";
+    }
+  }
+  ASSERT_NE(skeletons[2].find("type: plate"), std::string::npos) << help.out;
+  const std::string good = WriteSphere("good_help.ply", 19.05);
+  auto r = RunCli("verify --artifact " + WriteArtifact(skeletons[0]) + " --cloud " + good);
+  EXPECT_EQ(r.code, 0) << skeletons[0] << r.err;
+  for (int k = 1; k < 3; ++k) {
+    r = RunCli("verify --artifact " + WriteArtifact(skeletons[k]) + " --cloud " + good);
+    EXPECT_EQ(r.code, 2) << skeletons[k];
+    EXPECT_NE(r.err.find("not evaluated"), std::string::npos) << skeletons[k] << r.err;
+  }
 }
 
 // The report's path is checked before the clouds are judged: a missing
