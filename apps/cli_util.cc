@@ -1,8 +1,10 @@
 #include "apps/cli_util.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <sstream>
 
@@ -171,6 +173,20 @@ const CLI::Validator& PositiveValue() {
 const CLI::Validator& NonNegativeValue() {
   static const CLI::Validator v =
       NumberValidator([](double x) { return std::isfinite(x) && x >= 0; }, ">= 0 and finite", "NonNegative");
+  return v;
+}
+
+void RequireStdoutWritten() {
+  errno = 0;
+  if (std::fflush(stdout) == 0 && !std::ferror(stdout)) return;
+  throw InputError("standard output",
+                   std::string("cannot be written") + (errno ? std::string(": ") + std::strerror(errno) : ""));
+}
+
+const CLI::Validator& NonEmptyPath() {
+  static const CLI::Validator v(
+      [](const std::string& text) { return text.empty() ? std::string("an empty path") : std::string(); }, "",
+      "NonEmptyPath");
   return v;
 }
 

@@ -54,6 +54,17 @@ std::string PrintableText(const std::string& message);
 const CLI::Validator& PositiveValue();
 const CLI::Validator& NonNegativeValue();
 
+// Check of a path option (every file or folder a command writes, and
+// verify's inputs): an empty one ("--report ''", a shell variable left unset)
+// is refused as "an empty path". Before, it read as not given (verify wrote
+// no report and exited 0) or as a file named "" ("cannot open").
+const CLI::Validator& NonEmptyPath();
+
+// Flushes stdout and throws InputError("standard output", ...) if anything
+// written to it was lost (a full disk, /dev/full): a command whose result is
+// its table must not exit 0 when the table was not written.
+void RequireStdoutWritten();
+
 // For subcommands a later issue fills in: prints what it will do and exits 2.
 int NotBuiltYet(const char* name, const char* what, int argc, char** argv);
 

@@ -44,9 +44,12 @@ int RunCalibrate(int argc, char** argv) {
   app.add_option("--captures", captures, "captures folder: NNN/camK.png")->required();
   app.add_option("--target", target_path, "target file (YAML, docs/targets.md)")->required();
   app.add_option("--layout", layout_path, "layout file (YAML): the modules and their cameras")->required();
-  app.add_option("--out", out_path, "rig file to write (YAML)")->required();
-  app.add_option("--report", report_path, "JSON report to write (every figure of every stage)")->required();
-  app.add_option("--export-cameramodels", cameramodels_dir, "also write DIR/camK.cameramodel (mrcal format)");
+  app.add_option("--out", out_path, "rig file to write (YAML)")->required()->check(NonEmptyPath());
+  app.add_option("--report", report_path, "JSON report to write (every figure of every stage)")
+      ->required()
+      ->check(NonEmptyPath());
+  app.add_option("--export-cameramodels", cameramodels_dir, "also write DIR/camK.cameramodel (mrcal format)")
+      ->check(NonEmptyPath());
   app.add_option("--lensmodel", options.intrinsics.lensmodel,
                  "LENSMODEL_OPENCV5 (solved without regularisation), or LENSMODEL_OPENCV8 or "
                  "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=.._Ny=.._fov_x_deg=.. (both keep mrcal's regularisation)")

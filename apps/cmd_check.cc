@@ -99,7 +99,7 @@ int RunCheck(int argc, char** argv) {
                  "file records it, and the plate's back_from_front as calibrated, which the check uses; another board "
                  "is refused)");
   app.add_option("--history-db", history_db, "SQLite history (default: check-history.sqlite beside the rig file)");
-  app.add_option("--report", report_path, "write the figures as JSON here");
+  app.add_option("--report", report_path, "write the figures as JSON here")->check(NonEmptyPath());
   app.add_option("--k-sigma", options.k_sigma,
                  "coverage factor of every threshold, in (0, 10]: each is k times its figure's sigma")
       ->capture_default_str();

@@ -54,7 +54,9 @@ int RunDemo(int argc, char** argv) {
       "stereorig demo"};
   std::string out = "stereorig-demo";
   unsigned seed = 1;
-  app.add_option("--out", out, "folder for everything the demo writes (created if missing)")->capture_default_str();
+  app.add_option("--out", out, "folder for everything the demo writes (created if missing)")
+      ->capture_default_str()
+      ->check(NonEmptyPath());
   app.add_option("--seed", seed, "simulator seed")->capture_default_str();
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 

@@ -71,7 +71,7 @@ int RunMatch(int argc, char** argv) {
       ->required();
   app.add_option("--num-disparities", options.num_disparities, "number of disparities searched, in [2, 1024]")
       ->required();
-  app.add_option("--out", out_path, "output disparity map (.pfm)")->required();
+  app.add_option("--out", out_path, "output disparity map (.pfm)")->required()->check(NonEmptyPath());
   app.add_option("--roi", roi, "left-image region to match: x y width height, inside the image (default: whole image)")
       ->expected(4);
   app.add_option("--matcher", matcher,

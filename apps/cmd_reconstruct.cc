@@ -78,13 +78,16 @@ int RunReconstruct(int argc, char** argv) {
          "capture folder(s) with camK.png per camera; several (or repeated) need --out-dir; '-' reads them from "
          "standard input, one per line, as they come")
       ->required();
-  auto* out = app.add_option("--out", out_path, "one capture: the point cloud (binary PLY)");
-  auto* dir = app.add_option("--out-dir", out_dir, "many captures: write <name>.ply, <name>.json here");
-  auto* mesh = app.add_option("--mesh", mesh_path, "one capture: also write the joined mesh (.ply or .stl)");
+  auto* out = app.add_option("--out", out_path, "one capture: the point cloud (binary PLY)")->check(NonEmptyPath());
+  auto* dir =
+      app.add_option("--out-dir", out_dir, "many captures: write <name>.ply, <name>.json here")->check(NonEmptyPath());
+  auto* mesh = app.add_option("--mesh", mesh_path, "one capture: also write the joined mesh (.ply or .stl)")
+                   ->check(NonEmptyPath());
   auto* format = app.add_option("--mesh-format", mesh_format, "many captures: also write <name>.mesh.<ply|stl>");
   app.add_option("--report", report_path,
                  "one capture: its per-step times, point counts and fill rates as JSON; many: the batch's summary; "
-                 "--capture -: the stream's totals and failed captures, written when the input ends");
+                 "--capture -: the stream's totals and failed captures, written when the input ends")
+      ->check(NonEmptyPath());
   app.add_option("--options", options_path, "runtime options YAML (default: the built-in defaults)");
   std::string warm_up_dir, capture_root, rectified_dir;
   auto* rectified = app.add_option(

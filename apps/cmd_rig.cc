@@ -124,8 +124,8 @@ int RunRig(int argc, char** argv) {
   double distance_mm = 200.0;
   std::vector<double> size_mm = {75, 75, 50};
   app.add_option("--rig", rig_path, "rig file (YAML, docs/formats.md)")->required();
-  app.add_option("--export-cameramodels", export_dir,
-                 "folder to write camN.cameramodel files into (created if needed)");
+  app.add_option("--export-cameramodels", export_dir, "folder to write camN.cameramodel files into (created if needed)")
+      ->check(NonEmptyPath());
   app.add_option("--truth", truth_path, "true rig file to judge this one against (a simulated dataset's)");
   app.add_option("--distance", distance_mm, "with --truth: the volume's centre ahead of module 0, mm")
       ->capture_default_str();

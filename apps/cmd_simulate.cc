@@ -34,7 +34,8 @@ int RunSimulate(int argc, char** argv) {
   app.add_option("--spec", spec_path, "rig spec YAML (default: the embedded default rig)")->check(CLI::ExistingFile);
   app.add_option("--out", o.out_dir,
                  "dataset folder to write; if it already holds a dataset, the whole folder is replaced atomically, "
-                 "anything else in it included");
+                 "anything else in it included")
+      ->check(NonEmptyPath());
   // Checked on the text: a negative seed would wrap round to 2^64 - 1
   // (CLI11's NonNegativeNumber prints DBL_MAX's 309 digits as its bound).
   app.add_option("--seed", o.seed, "random seed: poses, scenes, noise (>= 0)")

@@ -65,7 +65,7 @@ int RunTarget(int argc, char** argv) {
              "the default's design on a plate this thick, mm (default 5): the back face's depth behind the front")
           ->check(CLI::Range(0.1, 100.0))
           ->excludes(target_option);
-  app.add_option("--out", out_path, "SVG to write (atomically)")->required();
+  app.add_option("--out", out_path, "SVG to write (atomically)")->required()->check(NonEmptyPath());
   app.add_option("--face", faces, "which faces to draw: both, front or back")
       ->check(CLI::IsMember({"both", "front", "back"}))
       ->capture_default_str();

@@ -68,7 +68,8 @@ int RunTune(int argc, char** argv) {
   app.add_option("--capture", capture_dir, "capture folder (camK.png per camera) of a flat plate, lasers on")
       ->required();
   app.add_option("--options", options_path, "runtime options YAML to start from (default: the built-in defaults)");
-  app.add_option("--out", out_path, "write the tuned runtime options here (.yaml); without it, only print them");
+  app.add_option("--out", out_path, "write the tuned runtime options here (.yaml); without it, only print them")
+      ->check(NonEmptyPath());
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 
   const Rig rig = ReadRigFile(rig_path);

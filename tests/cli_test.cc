@@ -328,6 +328,37 @@ TEST(Cli, EverySubcommandsHelpTeachesWithAnExample) {
   }
 }
 
+// Every file or folder a command writes, given as an empty path (a shell
+// variable left unset): refused by the option's name, exit 2, before any
+// work. Before, `verify --report ""` wrote nothing and exited 0, and other
+// commands read "" as not given or as a file of no name.
+TEST(Cli, AnEmptyOutputPathIsRefusedByItsOptionsName) {
+  const std::pair<const char*, const char*> options[] = {{"verify", "--report"},
+                                                         {"check", "--report"},
+                                                         {"bench", "--report"},
+                                                         {"score", "--report"},
+                                                         {"score", "--diagnose"},
+                                                         {"reconstruct", "--out"},
+                                                         {"reconstruct", "--mesh"},
+                                                         {"reconstruct", "--report"},
+                                                         {"reconstruct", "--out-dir"},
+                                                         {"calibrate", "--out"},
+                                                         {"calibrate", "--report"},
+                                                         {"calibrate", "--export-cameramodels"},
+                                                         {"rig", "--export-cameramodels"},
+                                                         {"tune", "--out"},
+                                                         {"demo", "--out"},
+                                                         {"simulate", "--out"},
+                                                         {"target", "--out"},
+                                                         {"match", "--out"}};
+  for (const auto& [command, option] : options) {
+    const Result r = RunCli(std::string(command) + " " + option + " ''");
+    EXPECT_EQ(r.code, 2) << command << " " << option;
+    EXPECT_EQ(r.err, std::string("stereorig ") + command + ": " + option + ": an empty path (see --help)\n");
+    EXPECT_EQ(r.out, "") << command << " " << option;
+  }
+}
+
 // demo's --out is made before any step: under a file it is refused naming
 // the file, and one that cannot be made (a name longer than the file
 // system's 255 characters) leaves no folder above it (it used to leave

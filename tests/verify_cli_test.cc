@@ -3,6 +3,8 @@
 // JSON report's figures match the analytic truth.
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -11,6 +13,7 @@
 #include <iterator>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <sstream>
 
 #include "tests/cli_runner.h"
 
@@ -73,6 +76,10 @@ TEST(VerifyCli, PassFailAndReport) {
   EXPECT_EQ(r.code, 1) << r.out << r.err;
   EXPECT_NE(r.out.find("FAIL"), std::string::npos);
   EXPECT_EQ(r.out.find("note: position"), std::string::npos) << r.out;  // two clouds that differ
+  // The legend explains every column and the cap's half-angle, which reads
+  // over 90 deg for more than a hemisphere (it was explained nowhere).
+  EXPECT_NE(r.out.find("mean|e|_mm = the mean |residual| of the points used"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("over 90 more than one (near 180 a sphere seen from both sides)"), std::string::npos) << r.out;
 }
 
 TEST(VerifyCli, BadInputExitsTwoAndWritesNoReport) {
@@ -99,6 +106,18 @@ TEST(VerifyCli, BadInputExitsTwoAndWritesNoReport) {
   EXPECT_NE(r.err.find("tiny.ply: not evaluated: only 3 points"), std::string::npos) << r.err;
   EXPECT_NE(r.out.find("1        NOT JUDGED: not evaluated: only 3 points"), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(report));
+  // A vertex count the file cannot hold: refused as the truncated body it
+  // is, naming the file (3000000000 ended in std::bad_alloc, exit 134).
+  const std::string huge = ::testing::TempDir() + "/huge_count.ply";
+  std::ofstream(huge) << "ply\nformat binary_little_endian 1.0\nelement vertex 3000000000\nproperty float x\n"
+                         "property float y\nproperty float z\nend_header\n0123456789ab";
+  r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + huge);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.out, "");
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("huge_count.ply: truncated PLY body: its header declares 3000000000 vertices"),
+            std::string::npos)
+      << r.err;
   // A band that is not positive and finite: one short line (CLI11's own
   // check printed DBL_MAX's 309 digits as the range's end; inf, which it
   // refused, passed the first version of ours, a second reading found).
@@ -107,6 +126,184 @@ TEST(VerifyCli, BadInputExitsTwoAndWritesNoReport) {
     EXPECT_EQ(r.code, 2);
     EXPECT_EQ(r.err,
               "stereorig verify: --capture-band-mm: must be positive and finite, got " + band + " (see --help)\n");
+  }
+}
+
+// An empty path is refused by its option's name (apps/cli_util.h
+// NonEmptyPath): `--report ""` wrote nothing and exited 0, and `--cloud ""`
+// read "cannot open", naming nothing.
+TEST(VerifyCli, AnEmptyPathIsRefusedByItsOptionsName) {
+  const std::string good = WriteSphere("good_empty.ply", 19.05);
+  const std::string artifact = WriteArtifact(kSphere);
+  for (const std::string& args : {"--artifact " + artifact + " --cloud " + good + " --report ''",
+                                  "--artifact " + artifact + " --cloud ''", "--artifact '' --cloud " + good}) {
+    const auto r = RunCli("verify " + args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(r.out, "") << args;
+    const std::string option = args.find("--report") != std::string::npos     ? "--report"
+                               : args.find("--cloud ''") != std::string::npos ? "--cloud"
+                                                                              : "--artifact";
+    EXPECT_EQ(r.err, "stereorig verify: " + option + ": an empty path (see --help)\n") << args;
+  }
+}
+
+// An MPE the artifact file does not give is the default (1.5 mm), and the
+// table and the report say so (mpe_source); the file's are "certificate".
+// Before, a certificate without mpe_mm was judged against 1.5 mm with
+// nothing saying it was a default. The MPE is printed with the value's 4
+// decimals: "P_F 0.3415 mm (MPE 0.342) FAIL" read as a contradiction.
+TEST(VerifyCli, TheMpeSaysWhetherTheArtifactFileGaveItOrItIsTheDefault) {
+  const std::string good = WriteSphere("good_mpe.ply", 19.05);
+  const std::string report = ::testing::TempDir() + "/verify_mpe.json";
+  auto r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + good + " --report " + report);
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("MPE: P_F 1.5000 mm (default: the artifact file's mpe_mm gives none), P_S 1.5000 mm "
+                       "(default: the artifact file's mpe_mm gives none)\n"),
+            std::string::npos)
+      << r.out;
+  auto j = nlohmann::json::parse(std::ifstream(report));
+  for (const auto& f : j["positions"][0]["figures"]) EXPECT_EQ(f["mpe_source"], "default") << f;
+  for (const auto& f : j["summary"]["worst"]) EXPECT_EQ(f["mpe_source"], "default") << f;
+
+  r = RunCli("verify --artifact " + WriteArtifact(std::string(kSphere) + "mpe_mm: {P_F: 0.34152}\n") + " --cloud " +
+             good + " --report " + report);
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("MPE: P_F 0.3415 mm (the artifact file's), P_S 1.5000 mm (default"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(MPE 0.3415) pass"), std::string::npos) << r.out;
+  j = nlohmann::json::parse(std::ifstream(report));
+  for (const auto& f : j["positions"][0]["figures"])
+    EXPECT_EQ(f["mpe_source"], f["name"] == "P_F" ? "certificate" : "default") << f;
+}
+
+// Fewer distinct positions than the procedure's 7 keep their verdict, with a
+// note under it and the counts in the report; a byte-identical copy of a
+// cloud under another name is said to be the same position, as the same
+// file is. Before, one --cloud read PASS with no word, and a copy counted
+// as a second position.
+TEST(VerifyCli, FewerPositionsThanTheProcedureAsksForAreNotedAndACopyIsNoNewPosition) {
+  const std::string good = WriteSphere("good_positions.ply", 19.05);
+  const std::string copy = ::testing::TempDir() + "/good_positions_copy.ply";
+  std::filesystem::copy_file(good, copy, std::filesystem::copy_options::overwrite_existing);
+  const std::string report = ::testing::TempDir() + "/verify_positions.json";
+  const std::string artifact = WriteArtifact(kSphere);
+  auto r = RunCli("verify --artifact " + artifact + " --cloud " + good + " --cloud " + copy + " --report " + report);
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("verdict: PASS\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("note: position 2 is a byte-identical copy of the cloud of position 1"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("note: 1 distinct position(s) measured; the procedure asks for 7 or more"), std::string::npos)
+      << r.out;
+  auto j = nlohmann::json::parse(std::ifstream(report));
+  EXPECT_EQ(j["summary"]["positions_given"], 2);
+  EXPECT_EQ(j["summary"]["positions_distinct"], 1);
+  EXPECT_EQ(j["summary"]["positions_asked"], 7);
+  // Seven clouds that differ: no note.
+  std::string args;
+  for (int k = 0; k < 7; ++k)
+    args += " --cloud " + WriteSphere("position_" + std::to_string(k) + ".ply", 19.05 + 0.001 * k);
+  r = RunCli("verify --artifact " + artifact + args + " --report " + report);
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_EQ(r.out.find("note:"), std::string::npos) << r.out;
+  j = nlohmann::json::parse(std::ifstream(report));
+  EXPECT_EQ(j["summary"]["positions_distinct"], 7);
+}
+
+// The report is traceable: the certificate's path and its certified values,
+// when it was written and by which build, and at which position each worst
+// figure was measured (also in the terminal's summary). Before, it held the
+// artifact's name alone.
+TEST(VerifyCli, TheReportNamesItsCertificateDateToolAndWorstPosition) {
+  const std::string artifact = WriteArtifact(kSphere);
+  const std::string good = WriteSphere("good_trace.ply", 19.05);
+  const std::string larger = WriteSphere("larger_trace.ply", 19.05 + 0.3);  // P_S 0.6 mm
+  const std::string report = ::testing::TempDir() + "/verify_trace.json";
+  const auto r =
+      RunCli("verify --artifact " + artifact + " --cloud " + good + " --cloud " + larger + " --report " + report);
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  const auto j = nlohmann::json::parse(std::ifstream(report));
+  EXPECT_EQ(j["artifact_file"], artifact);
+  EXPECT_EQ(j["certified"]["diameter_mm"], 38.1);
+  EXPECT_EQ(j["certified"]["diameter_uncertainty_mm"], 0.002);
+  const std::string date = j["date_utc"];
+  EXPECT_EQ(date.size(), 20u) << date;  // 2026-11-23T00:00:00Z
+  EXPECT_EQ(date.back(), 'Z') << date;
+  EXPECT_EQ(j["tool"].get<std::string>().rfind("stereorig ", 0), 0u) << j["tool"];
+  for (const auto& f : j["summary"]["worst"])
+    if (f["name"] == "P_S") {
+      EXPECT_EQ(f["position"], 2) << f;
+    }
+  EXPECT_NE(r.out.find("P_S 0.6000 mm (MPE 1.5000) pass at position 2"), std::string::npos) << r.out;
+}
+
+// Error lines that say what is wrong: a certificate that cannot be read
+// (read "not valid YAML: bad file"), a folder given as a cloud (read "not a
+// PLY file"), --min-points below 10 (named as "verify options: min_points"),
+// and a table that could not be written (to /dev/full: exit 0 before).
+TEST(VerifyCli, ErrorLinesSayWhatIsWrongAndALostTableIsNoSuccess) {
+  const std::string good = WriteSphere("good_errors.ply", 19.05);
+  const std::string artifact = WriteArtifact(kSphere);
+  auto r = RunCli("verify --artifact " + artifact + " --cloud " + ::testing::TempDir());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(": is a folder, not a file"), std::string::npos) << r.err;
+  r = RunCli("verify --artifact " + artifact + " --cloud " + good + " --min-points 5");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "stereorig verify: --min-points: must be >= 10, got 5\n");
+  const std::string report = ::testing::TempDir() + "/verify_full.json";
+  std::filesystem::remove(report);
+  const int status = std::system((stereorig::testing::kBin + " verify --artifact " + artifact + " --cloud " + good +
+                                  " --report " + report + " >/dev/full 2>/dev/null")
+                                     .c_str());
+  EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2);
+  EXPECT_FALSE(std::filesystem::exists(report));  // nothing left behind
+  // A certificate this process may not read (as root, through setpriv as
+  // nobody: root reads any file).
+  const std::string unreadable = WriteArtifact(kSphere);
+  std::filesystem::permissions(unreadable, std::filesystem::perms::none);
+  std::filesystem::permissions(good, std::filesystem::perms::others_read, std::filesystem::perm_options::add);
+  std::string as_other = geteuid() != 0 ? ""
+                         : std::system("command -v setpriv >/dev/null") == 0
+                             ? "setpriv --reuid=65534 --regid=65534 --clear-groups "
+                             : "";
+  if (geteuid() == 0 && as_other.empty()) GTEST_SKIP() << "root, and no setpriv to read as another user";
+  const std::string err = ::testing::TempDir() + "/verify_unreadable_err.txt";
+  std::system((as_other + stereorig::testing::kBin + " verify --artifact " + unreadable + " --cloud " + good +
+               " >/dev/null 2>" + err)
+                  .c_str());
+  std::ifstream f(err);
+  const std::string line((std::istreambuf_iterator<char>(f)), {});
+  EXPECT_EQ(line, "stereorig verify: " + unreadable + ": cannot be read\n");
+}
+
+// --help is wrapped (one line was ~2960 characters) and shows a minimal
+// artifact file of each kind, side by side; each one, cut from the help as
+// a user would copy it, is a valid artifact file: the sphere's verifies a
+// sphere, the ball bar's and plate's read and refuse the sphere's cloud as
+// not the artifact (not as a file missing a key).
+TEST(VerifyCli, HelpIsWrappedAndItsArtifactSkeletonsAreValidFiles) {
+  const auto help = RunCli("verify --help");
+  ASSERT_EQ(help.code, 0);
+  std::istringstream lines(help.out);
+  std::string skeletons[3];
+  bool in_skeletons = false;
+  for (std::string line; std::getline(lines, line);) {
+    EXPECT_LE(line.size(), 120u) << line;
+    if (line.rfind("  format: stereorig-artifact", 0) == 0) in_skeletons = true;
+    if (in_skeletons && line.empty()) break;
+    if (!in_skeletons) continue;
+    for (int k = 0; k < 3; ++k) {
+      std::string column = line.size() > 2 + 34u * k ? line.substr(2 + 34 * k, 34) : "";
+      column.erase(column.find_last_not_of(' ') + 1);
+      if (!column.empty()) skeletons[k] += column + "\n";
+    }
+  }
+  ASSERT_NE(skeletons[2].find("type: plate"), std::string::npos) << help.out;
+  const std::string good = WriteSphere("good_help.ply", 19.05);
+  auto r = RunCli("verify --artifact " + WriteArtifact(skeletons[0]) + " --cloud " + good);
+  EXPECT_EQ(r.code, 0) << skeletons[0] << r.err;
+  for (int k = 1; k < 3; ++k) {
+    r = RunCli("verify --artifact " + WriteArtifact(skeletons[k]) + " --cloud " + good);
+    EXPECT_EQ(r.code, 2) << skeletons[k];
+    EXPECT_NE(r.err.find("not evaluated"), std::string::npos) << skeletons[k] << r.err;
   }
 }
 

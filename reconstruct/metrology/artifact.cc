@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "calib/core/input_error.h"
+#include "calib/core/input_file.h"
 #include "calib/core/rig_file.h"
 #include "calib/core/yaml_reader.h"
 
@@ -71,6 +72,10 @@ Artifact Parse(YamlMap m) {
   }
   if (m.Has("mpe_mm")) {
     YamlMap e = m.GetMap("mpe_mm");
+    a.mpe.probing_form_given = e.Has("P_F");
+    a.mpe.probing_size_given = e.Has("P_S");
+    a.mpe.sphere_spacing_given = e.Has("SD");
+    a.mpe.flatness_given = e.Has("F");
     a.mpe.probing_form_mm = e.GetDouble("P_F", a.mpe.probing_form_mm);
     a.mpe.probing_size_mm = e.GetDouble("P_S", a.mpe.probing_size_mm);
     a.mpe.sphere_spacing_mm = e.GetDouble("SD", a.mpe.sphere_spacing_mm);
@@ -87,7 +92,9 @@ Artifact Parse(YamlMap m) {
 
 }  // namespace
 
-Artifact ReadArtifactFile(const std::string& path) { return Parse(YamlMap::LoadFile(path)); }
+// Read here, not by yaml-cpp's LoadFile: a file it cannot open (no read
+// permission) it calls a "bad file", which read "not valid YAML: bad file".
+Artifact ReadArtifactFile(const std::string& path) { return Parse(YamlMap::LoadString(ReadInputText(path), path)); }
 Artifact ParseArtifactYaml(const std::string& text, const std::string& where) {
   return Parse(YamlMap::LoadString(text, where));
 }

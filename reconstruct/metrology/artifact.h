@@ -16,6 +16,17 @@ struct MaximumPermissibleErrors {
   double probing_size_mm = 1.5;    // |P_S|
   double sphere_spacing_mm = 1.5;  // |SD|
   double flatness_mm = 1.5;        // F
+  // Which of them the artifact file's mpe_mm gives; the others are the
+  // default above, which verify says (a certificate without mpe_mm was
+  // judged against 1.5 mm with nothing saying so).
+  bool probing_form_given = false, probing_size_given = false, sphere_spacing_given = false, flatness_given = false;
+  // Whether the MPE of `figure` ("P_F", "P_S", "SD", "F") is the file's.
+  bool Given(const std::string& figure) const {
+    if (figure == "P_F") return probing_form_given;
+    if (figure == "P_S") return probing_size_given;
+    if (figure == "SD") return sphere_spacing_given;
+    return figure == "F" && flatness_given;
+  }
 };
 
 // The certificate's uncertainties (*_uncertainty_mm) are expanded

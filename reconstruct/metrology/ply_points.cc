@@ -1,5 +1,6 @@
 #include "reconstruct/metrology/ply_points.h"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -8,6 +9,7 @@
 #include <sstream>
 
 #include "calib/core/input_error.h"
+#include "calib/core/input_file.h"
 
 namespace stereorig {
 
@@ -51,8 +53,9 @@ double ReadBinary(std::istream& in, const std::string& t, bool swap, const std::
 }  // namespace
 
 PlyVertices ReadPlyVertices(const std::string& path) {
+  RequireInputFile(path, /*pipe_too=*/true);  // a folder is named as one, not as "not a PLY file"
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "cannot open");
+  if (!in) throw InputError(path, "cannot be read");
   std::string line;
   if (!std::getline(in, line) || line.rfind("ply", 0) != 0) throw InputError(path, "not a PLY file");
   Encoding enc = Encoding::kAscii;
@@ -81,8 +84,9 @@ PlyVertices ReadPlyVertices(const std::string& path) {
     } else if (word == "element") {
       std::string name;
       long long count = 0;
+      std::string rest;  // "element vertex 1e12" read a count of 1 and stopped at "e12"
       s >> name >> count;
-      if (!s || count < 0) throw InputError(path, "malformed element line '" + line + "'");
+      if (!s || count < 0 || s >> rest) throw InputError(path, "malformed element line '" + line + "'");
       if (seen_vertex && count > 0) after_vertex = true;  // data after the vertices, not read
       in_vertex = name == "vertex";
       if (in_vertex) {
@@ -124,9 +128,39 @@ PlyVertices ReadPlyVertices(const std::string& path) {
   }
   if (ix < 0 || iy < 0 || iz < 0) throw InputError(path, "PLY vertices have no x, y, z");
   const bool swap = (enc == Encoding::kBig) == (std::endian::native == std::endian::little);
+  // The declared count against what the file can hold, before anything is
+  // allocated for it: a header declaring 3000000000 vertices ended in
+  // std::bad_alloc and an abort (exit 134), not in the truncated body it is.
+  // A vertex takes at least its scalars' bytes (a list at least its count),
+  // or in ASCII one character and a separator per property. A pipe, whose
+  // size is unknown, is read as it comes, with no more reserved than a
+  // million points.
+  size_t min_record_bytes = 0;
+  for (const Property& p : props)
+    min_record_bytes += enc == Encoding::kAscii ? 2 : SizeOf(p.count_type.empty() ? p.type : p.count_type);
+  const std::streamoff body_at = in.tellg();
+  std::streamoff end_at = -1;
+  if (body_at >= 0) {
+    in.seekg(0, std::ios::end);
+    end_at = in.tellg();
+    in.clear();
+    in.seekg(body_at);
+  }
+  size_t reserve = std::min<size_t>(static_cast<size_t>(num_vertices), 1 << 20);
+  if (body_at >= 0 && end_at >= body_at) {
+    // +1: the last ASCII value needs no separator after it.
+    const auto body_bytes = static_cast<unsigned long long>(end_at - body_at) + (enc == Encoding::kAscii ? 1 : 0);
+    if (static_cast<unsigned long long>(num_vertices) > body_bytes / min_record_bytes) {
+      throw InputError(path, "truncated PLY body: its header declares " + std::to_string(num_vertices) +
+                                 " vertices, at least " + std::to_string(min_record_bytes) +
+                                 " bytes each, and the file holds " + std::to_string(end_at - body_at) +
+                                 " bytes after its header");
+    }
+    reserve = static_cast<size_t>(num_vertices);
+  }
   PlyVertices out;
-  out.points.reserve(static_cast<size_t>(num_vertices));
-  if (imodule >= 0) out.module.reserve(static_cast<size_t>(num_vertices));
+  out.points.reserve(reserve);
+  if (imodule >= 0) out.module.reserve(reserve);
   std::vector<double> v(props.size());
   for (long long k = 0; k < num_vertices; ++k) {
     if (enc == Encoding::kAscii) {

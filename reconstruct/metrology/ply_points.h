@@ -20,7 +20,7 @@ struct PlyVertices {
   std::vector<int> module;  // each vertex's `module` property; empty when the file has none
 };
 
-// Throws InputError naming the file on a missing file, a malformed header, no
+// Throws InputError naming the file on a missing file, a folder, a malformed header, no
 // x/y/z, a truncated body or non-finite coordinates.
 PlyVertices ReadPlyVertices(const std::string& path);
 std::vector<Eigen::Vector3d> ReadPlyPoints(const std::string& path);  // ReadPlyVertices(path).points

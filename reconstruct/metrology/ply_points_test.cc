@@ -153,5 +153,28 @@ TEST(PlyPoints, RefusesAnElementBeforeTheVerticesAndDataTheHeaderDoesNotCount) {
       << ErrorOf(dir + "/empty_face_after_extra.ply");
 }
 
+// A vertex count the file cannot hold is a truncated body, named as such
+// before anything is allocated for it: 3000000000 vertices ended in
+// std::bad_alloc and an abort (exit 134; a user's walkthrough found), where
+// 200000000 already read "truncated PLY body". A count written as 1e12 is
+// malformed (it read as 1, the rest ignored).
+TEST(PlyPoints, AVertexCountTheFileCannotHoldIsATruncatedBody) {
+  const std::string dir = ::testing::TempDir();
+  for (const char* format : {"ascii", "binary_little_endian"}) {
+    for (const char* count : {"3000000000", "1000000000000", "9223372036854775807"}) {
+      const std::string path = dir + "/huge_" + format + ".ply";
+      std::ofstream(path, std::ios::binary) << "ply\nformat " << format << " 1.0\nelement vertex " << count
+                                            << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+                                            << std::string(12, '1');
+      const std::string what = ErrorOf(path);
+      EXPECT_EQ(what.rfind(path + ": truncated PLY body: its header declares " + count + " vertices", 0), 0u) << what;
+    }
+  }
+  const std::string path = dir + "/exponent.ply";
+  std::ofstream(path) << "ply\nformat ascii 1.0\nelement vertex 1e12\nproperty float x\nproperty float y\n"
+                         "property float z\nend_header\n1 2 3\n";
+  EXPECT_NE(ErrorOf(path).find("malformed element line 'element vertex 1e12'"), std::string::npos) << ErrorOf(path);
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -200,6 +200,7 @@ ArtifactEvaluation NotEvaluated(const Artifact& artifact, const VerifyOptions& o
 // of the figures judged. No PASS is claimed while a position is not judged.
 struct VerifySummary {
   std::vector<Figure> worst;              // one per figure name
+  std::vector<int> worst_positions;       // parallel to worst: the index of its position
   std::vector<int> not_judged_positions;  // indices into the positions given
   bool pass = false;                      // every position judged, and every figure of each within its MPE
 };
