@@ -51,7 +51,10 @@ void RejectCamerasBeyondTheRig(const std::string& captures, int num_cameras) {
 // The CRC-32 of a file's bytes as 8 hex digits (zlib's): what tells the rig
 // file a night used from another written to the same path. Not a guard
 // against tampering, only a fingerprint.
+// Empty for what is not a regular file (a pipe, as `--rig <(...)`: read
+// once, by the rig file's reader, and gone).
 std::string FileCrc32Hex(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) return "";
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "cannot be read");
   uLong crc = crc32(0L, Z_NULL, 0);
@@ -98,7 +101,8 @@ int RunCheck(int argc, char** argv) {
                  "the target file (YAML) of the board in the captures: the board the rig was calibrated with (the rig "
                  "file records it, and the plate's back_from_front as calibrated, which the check uses; another board "
                  "is refused)");
-  app.add_option("--history-db", history_db, "SQLite history (default: check-history.sqlite beside the rig file)");
+  app.add_option("--history-db", history_db, "SQLite history (default: check-history.sqlite beside the rig file)")
+      ->check(NonEmptyPath());  // '' fell back to the default: another database than the one named
   app.add_option("--report", report_path, "write the figures as JSON here")->check(NonEmptyPath());
   app.add_option("--k-sigma", options.k_sigma,
                  "coverage factor of every threshold, in (0, 10]: each is k times its figure's sigma")
@@ -144,8 +148,10 @@ int RunCheck(int argc, char** argv) {
                                           : "the history database (by default beside the rig file, updated in place)");
 
   const Rig rig = ReadRigFile(rig_path);
-  const std::string rig_crc32 = FileCrc32Hex(rig_path);  // the bytes read, not those there at the end
-  RequireCalibrationResiduals(rig, rig_path);            // named by the rig file, before minutes of detection
+  // Read again for the CRC, a moment after the reader: a rig file replaced
+  // in between reads as the new one's.
+  const std::string rig_crc32 = FileCrc32Hex(rig_path);
+  RequireCalibrationResiduals(rig, rig_path);  // named by the rig file, before minutes of detection
   // The board with the back_from_front the calibration ended with (S holds
   // with it); a board other than the calibration's is refused here.
   const CheckTarget check_target = TargetForCheck(rig, ReadTargetFile(target_path), target_path);
@@ -262,16 +268,20 @@ int RunCheck(int argc, char** argv) {
   report["closure_which_unknown"] = result.closure_which_unknown;
   report["split_modules"] = result.split_modules;
 
-  // The history first: if it refuses the run after all (checked writable
-  // above, but another process may have changed it since), the exit is 2
-  // and no report claims a recorded night.
+  // The report staged in its temporary file, the history appended, then the
+  // report renamed in: a history that refuses the run after all (checked
+  // writable above, but another process may have changed it since) leaves
+  // no report, and a report that cannot be written (a full disk) leaves the
+  // history without the night.
+  AtomicOutputSet staged_report;
+  if (!report_path.empty()) staged_report.Add(report_path, report.dump(2) + "\n");
   HistoryRun run{0, report["date_utc"], rig_path, captures, "", ""};
   run.rig_path = std::filesystem::absolute(rig_path).lexically_normal().string();
   run.rig_crc32 = rig_crc32;
   run.target_path = std::filesystem::absolute(target_path).lexically_normal().string();
   run.board = check_target.back_from_front_as_calibrated ? "as calibrated" : "the target file's";
   AppendToHistory(history_db, run, result, detected.capture_names);
-  if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
+  staged_report.Commit();
   std::printf("history: appended to %s\n", history_db.c_str());
   return result.ok() ? kExitOk : kExitCheckFailed;
 }

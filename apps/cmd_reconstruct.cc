@@ -90,11 +90,13 @@ int RunReconstruct(int argc, char** argv) {
       ->check(NonEmptyPath());
   app.add_option("--options", options_path, "runtime options YAML (default: the built-in defaults)");
   std::string warm_up_dir, capture_root, rectified_dir;
-  auto* rectified = app.add_option(
-      "--rectified-out", rectified_dir,
-      "one capture: also write each module's rectified pair here (moduleM_left.png, moduleM_right.png, created "
-      "if needed) and print the `stereorig match` command that searches it with the range and ROI the runtime "
-      "derives from the measurement volume");
+  auto* rectified =
+      app.add_option(
+             "--rectified-out", rectified_dir,
+             "one capture: also write each module's rectified pair here (moduleM_left.png, moduleM_right.png, created "
+             "if needed) and print the `stereorig match` command that searches it with the range and ROI the runtime "
+             "derives from the measurement volume")
+          ->check(NonEmptyPath());
   app.add_option("--capture-root", capture_root,
                  "with --capture -: name each capture by its folder's path below this folder, joined with '_' "
                  "(root line: line/2026-12-06/0001 -> 2026-12-06_0001) instead of its last name; folders not below "

@@ -342,6 +342,8 @@ TEST(Cli, AnEmptyOutputPathIsRefusedByItsOptionsName) {
                                                          {"reconstruct", "--mesh"},
                                                          {"reconstruct", "--report"},
                                                          {"reconstruct", "--out-dir"},
+                                                         {"reconstruct", "--rectified-out"},
+                                                         {"check", "--history-db"},
                                                          {"calibrate", "--out"},
                                                          {"calibrate", "--report"},
                                                          {"calibrate", "--export-cameramodels"},
