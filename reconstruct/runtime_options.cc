@@ -37,15 +37,17 @@ void RuntimeOptions::Check() const {
   if (!(working_distance_mm > 0)) throw InputError("working_distance_mm", "must be > 0 mm");
   // An object under 1 mm spans ~5 px at the default 200 mm (~0.2 mm a
   // pixel): less than one laser-grid period (8 px), nothing to match; every
-  // point would be dropped (0.001 wrote an empty cloud, exit 0). One longer
-  // than the volume's diagonal cannot lie in the volume, whose filter
-  // already cuts every point to it, so this filter and the shape model's
-  // refusal would never bite: a unit slip (m for mm, or 1e9 for "off").
+  // point would be dropped (0.001 wrote an empty cloud, exit 0). Above, an
+  // object larger than the volume is harmless (the volume's own filter cuts
+  // every point to it first, so this one never bites), and the default 100
+  // mm exceeds a small volume's diagonal (60 x 60 x 40 mm: 94 mm), so only
+  // a size no object in the volume could have is refused: ten times its
+  // diagonal, a unit slip (um for mm, or 1e9 for "off").
   const double volume_diagonal_mm = volume_size_mm.norm();
-  if (!(object_size_mm >= 1 && object_size_mm <= volume_diagonal_mm)) {
-    char range[96];
-    std::snprintf(range, sizeof range, "must be in [1, %.1f] mm (the measurement volume's diagonal)",
-                  volume_diagonal_mm);
+  if (!(object_size_mm >= 1 && object_size_mm <= 10 * volume_diagonal_mm)) {
+    char range[128];
+    std::snprintf(range, sizeof range, "must be in [1, %.1f] mm (ten times the measurement volume's diagonal)",
+                  10 * volume_diagonal_mm);
     throw InputError("object_size_mm", range);
   }
   // A 9x9 window of 8-bit grey levels has a std of at most 127.5 (half its

@@ -264,15 +264,20 @@ TEST(RuntimeOptions, AMatchKeyWrittenDottedIsRefusedWithHowItNests) {
 // themselves are taken.
 TEST(RuntimeOptions, ValuesPastWhatTheRigCanMeasureAreRefused) {
   for (const char* bad :
-       {"object_size_mm: 0.001\n", "object_size_mm: 1e9\n", "object_size_mm: 235\n", "lit_contrast_dn: 300\n",
+       {"object_size_mm: 0.001\n", "object_size_mm: 1e9\n", "object_size_mm: 2346\n", "lit_contrast_dn: 300\n",
         "lit_contrast_dn: 127.5\n", "fill_spacing_mm: 1e6\n", "object_size_mm: 50\nfill_spacing_mm: 51\n"}) {
     const std::string key = std::string(bad).substr(std::string(bad).rfind('\n', std::string(bad).size() - 2) + 1);
     const std::string says = "o.yaml: " + key.substr(0, key.find(':')) + ": must be in ";
     EXPECT_EQ(RefusalOf(bad).rfind(says, 0), 0u) << bad << " -> " << RefusalOf(bad);
   }
-  // The default volume's diagonal: sqrt(150^2 + 150^2 + 100^2) = 234.5 mm.
+  // The default volume's diagonal: sqrt(150^2 + 150^2 + 100^2) = 234.5 mm,
+  // ten times it 2345 mm.
   EXPECT_EQ(RefusalOf("object_size_mm: 1\nfill_spacing_mm: 1\n"), "");
-  EXPECT_EQ(RefusalOf("object_size_mm: 234.5\nlit_contrast_dn: 127\n"), "");
+  EXPECT_EQ(RefusalOf("object_size_mm: 2345\nlit_contrast_dn: 127\n"), "");
+  // A small volume with the default object size (100 mm, over its 94 mm
+  // diagonal): the user set no object_size_mm, and none is refused (a second
+  // reading: the bound was the diagonal itself).
+  EXPECT_EQ(RefusalOf("volume_size_mm: [60, 60, 40]\n"), "");
   EXPECT_EQ(RefusalOf("object_size_mm: 400\nvolume_size_mm: [300, 300, 200]\n"), "");
 }
 
