@@ -118,6 +118,13 @@ TEST(RigFile, ARotationTypedWithEightDigitsIsReadAndAWrongOneRefused) {
   EXPECT_LT((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), 1e-15);
   // The nearest rotation: within the typed digits' rounding (5e-9 on 0.1).
   EXPECT_LT((r - m.topLeftCorner<3, 3>()).cwiseAbs().maxCoeff(), 1e-8);
+  // Six digits, the fewest the reader promises (typed_pose.h's bound):
+  // read, and as near the rotation as the digits are.
+  Eigen::Matrix4d six = m;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) six(r, c) = std::stod(NumberText(m(r, c), 6));
+  const Eigen::Matrix3d r6 = ParseRigYaml(with(six), "rig_6dig.yaml").module(0).right_from_left.rotation();
+  EXPECT_LT((r6 - m.topLeftCorner<3, 3>()).cwiseAbs().maxCoeff(), 1e-6);
   Eigen::Matrix4d wrong = m;
   wrong(0, 0) += 4.5e-5 / 2;  // |R^T R - I| grows by twice the change
   try {
@@ -126,7 +133,7 @@ TEST(RigFile, ARotationTypedWithEightDigitsIsReadAndAWrongOneRefused) {
   } catch (const InputError& e) {
     EXPECT_STREQ(e.what(),
                  "rig_nonortho.yaml: modules[0].right_from_left: rotation is not orthonormal (max |R^T R - I| = "
-                 "4.5e-05, over the 1e-06 allowed)");
+                 "4.5e-05, over the 2e-06 allowed)");
   }
 }
 

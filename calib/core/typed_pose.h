@@ -18,9 +18,12 @@
 namespace stereorig {
 
 // |R^T R - I| (max element) up to which a typed rotation is taken as
-// rounded, and replaced by the nearest rotation: 1e-6, what 6 significant
-// digits still meet (an element's rounding 5e-7).
-inline constexpr double kTypedRotationTolerance = 1e-6;
+// rounded, and replaced by the nearest rotation: 2e-6, what every rotation
+// typed with 6 significant digits meets. Each element of R is at most 1,
+// so 6 digits round it by at most e = 5e-7; an element of R^T R - I then
+// moves by at most 2 (|r_1| + |r_2| + |r_3|) e + 3 e^2 <= 2 sqrt(3) e =
+// 1.73e-6 for a unit column (1e-6, the first bound, refused some).
+inline constexpr double kTypedRotationTolerance = 2e-6;
 
 // `m` as a Pose: as it is where it is rigid to 1e-9 (so that a file written
 // by the project reads back bit for bit); the nearest rotation (SVD) to its
