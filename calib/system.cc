@@ -369,13 +369,17 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
     Eigen::Matrix<double, 6, 1> off;
     off << PlateTurnDeg(rep.back_from_front, target.back_from_front),
         rep.back_from_front.translation_mm() - target.back_from_front.translation_mm();
-    // The file's rotation sigma is about the front face's origin, |t| (~100
-    // mm) from the back's: a rotation error of the file (or a measurement
-    // that turned the plate about its middle) moves t by the lever arm,
-    // d t = d r x t, which the translation sigma alone does not hold (the
-    // engine's tests draw such files: a 0.05 deg turn moved ty 0.08 mm per
-    // sigma, chi-square 28 for an honest file). The translation's variance
-    // takes that term too.
+    // The error model of a file: its rotation error a turn of the back
+    // print about the FRONT face's origin, |t| (~100 mm) from the back's, so
+    // that t moves by the lever arm d t = d r x t besides its own error. The
+    // simulator's misaligned print (datasets/target_render.cc) and the
+    // tests' files (calib_test_util.cc, MakeScene) are drawn so; the
+    // translation sigma alone does not hold it (an honest test file read
+    // chi-square 28 without the term). Stage 3's prior (BackFromFrontPrior)
+    // treats the rotation and t as independent instead, a turn about the
+    // back's origin: the judgement's variance is the wider of the two models,
+    // so that an honest file under either is not refused. Not measured: the
+    // refusal rate on honest files (the 3 in 1000 is chi-square theory).
     const Eigen::Matrix<double, 6, 1>& sg = target.back_from_front_sigma;
     const Eigen::Vector3d r2 = (sg.head<3>() * M_PI / 180.0).array().square();
     const Eigen::Vector3d t = target.back_from_front.translation_mm();
