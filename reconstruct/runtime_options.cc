@@ -86,27 +86,6 @@ void RuntimeOptions::Check() const {
 
 namespace {
 
-// yaml-cpp's Load reads the first document and ignores any after a `---`:
-// `object_size_mm: 50\n---\nbogus_key: 1` read as the first alone, its
-// second document's keys, typos included, never checked. The options are
-// one mapping: a later document is refused, naming the file and its line.
-// (An empty one, a lone trailing `---`, is no setting: allowed.)
-void RefuseSecondDocument(const std::string& text, const std::string& where) {
-  std::vector<YAML::Node> documents;
-  try {
-    documents = YAML::LoadAll(text);
-  } catch (const YAML::Exception& e) {  // the first parsed (LoadString): the error is in a later document
-    throw InputError(where, "line " + std::to_string(e.mark.line + 1) +
-                                ": a second YAML document (after `---`) that is not valid YAML: the runtime options "
-                                "are one mapping; remove the `---` and what follows, or merge it into the first");
-  }
-  for (size_t k = 1; k < documents.size(); ++k)
-    if (!documents[k].IsNull())
-      throw InputError(where, "line " + std::to_string(documents[k].Mark().line + 1) +
-                                  ": a second YAML document (after `---`): the runtime options are one mapping; "
-                                  "remove the `---`, or merge its keys into the first document");
-}
-
 RuntimeOptions FromYaml(YamlMap& y) {
   RuntimeOptions o;
   if (y.Has("volume_center_mm")) {
@@ -247,8 +226,7 @@ RuntimeOptions ReadRuntimeOptions(const std::string& path) {
 }
 
 RuntimeOptions ParseRuntimeOptions(const std::string& text, const std::string& where) {
-  YamlMap y = YamlMap::LoadString(text, where);  // the first document: a syntax error in it named as ever
-  RefuseSecondDocument(text, where);
+  YamlMap y = YamlMap::LoadString(text, where);  // one document: a second is refused (yaml_reader.h)
   RuntimeOptions o = FromYaml(y);
   o.source = where;
   return o;

@@ -287,9 +287,9 @@ TEST(RuntimeOptions, ValuesPastWhatTheRigCanMeasureAreRefused) {
 // `---` (an empty document) is no setting and passes.
 TEST(RuntimeOptions, ASecondYamlDocumentIsRefused) {
   EXPECT_EQ(RefusalOf("object_size_mm: 50\n---\nbogus_key: 1\n"),
-            "o.yaml: line 3: a second YAML document (after `---`): the runtime options are one mapping; remove the "
-            "`---`, or merge its keys into the first document");
-  EXPECT_NE(RefusalOf("object_size_mm: 50\n---\n[: bad\n").find("o.yaml: line "), std::string::npos);
+            "o.yaml: line 3: a second YAML document (after `---`): the file is one mapping; remove the `---`, or "
+            "merge its keys into the first document");
+  EXPECT_NE(RefusalOf("object_size_mm: 50\n---\n[: bad\n").find("o.yaml: not valid YAML"), std::string::npos);
   EXPECT_EQ(RefusalOf("---\nobject_size_mm: 50\n"), "");
   EXPECT_EQ(RefusalOf("object_size_mm: 50\n---\n"), "");
 }

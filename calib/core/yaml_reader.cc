@@ -1,8 +1,13 @@
 #include "yaml_reader.h"
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <set>
+#include <sstream>
+#include <vector>
 
 #include "input_error.h"
 #include "input_file.h"
@@ -23,23 +28,33 @@ InputError SyntaxError(const std::string& where, const YAML::Exception& e) {
 
 YamlMap YamlMap::LoadFile(const std::string& path) {
   RequireInputFile(path, /*pipe_too=*/true);  // read once, start to end
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::Exception& e) {
-    throw SyntaxError(path, e);
-  }
-  return FromDocument(root, path);
+  // Read here, not by yaml-cpp's LoadFile, whose error for a file it cannot
+  // open is "bad file" (an unreadable file read "not valid YAML: bad file").
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, std::string("cannot be read: ") + std::strerror(errno));
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw InputError(path, "cannot be read to its end");
+  return LoadString(text.str(), path);
 }
 
 YamlMap YamlMap::LoadString(const std::string& text, const std::string& where) {
-  YAML::Node root;
+  // Every document, not yaml-cpp's Load (the first alone): a file's keys
+  // after a `---` were never read nor checked, typos included, in every
+  // strict reader (rig, target, layout, simulator spec, certificates). A
+  // file is one mapping; an empty later document (a trailing `---`) is none.
+  std::vector<YAML::Node> documents;
   try {
-    root = YAML::Load(text);
+    documents = YAML::LoadAll(text);
   } catch (const YAML::Exception& e) {
     throw SyntaxError(where, e);
   }
-  return FromDocument(root, where);
+  for (size_t k = 1; k < documents.size(); ++k)
+    if (!documents[k].IsNull())
+      throw InputError(where, "line " + std::to_string(documents[k].Mark().line + 1) +
+                                  ": a second YAML document (after `---`): the file is one mapping; remove the "
+                                  "`---`, or merge its keys into the first document");
+  return FromDocument(documents.empty() ? YAML::Node() : documents[0], where);
 }
 
 YamlMap YamlMap::FromDocument(YAML::Node root, const std::string& where) {

@@ -54,6 +54,23 @@ TEST(YamlMap, QuotedNumbersAndYamlOneOneBooleansAreWrongTypes) {
   EXPECT_EQ(m.GetString("name"), "12");  // a string may look like a number
 }
 
+// yaml-cpp's Load reads the first document alone: a rig or target file's
+// keys after a `---` were never read nor checked. Refused, naming the line;
+// a lone trailing `---` (an empty document) passes.
+TEST(YamlMap, ASecondYamlDocumentIsRefusedNamingItsLine) {
+  try {
+    YamlMap::LoadString("version: 2\n---\nbogus_key: 1\n", "rig.yaml");
+    ADD_FAILURE() << "a second document was read past";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "rig.yaml: line 3: a second YAML document (after `---`): the file is one mapping; remove the "
+                 "`---`, or merge its keys into the first document");
+  }
+  EXPECT_NO_THROW(YamlMap::LoadString("version: 2\n---\n", "rig.yaml"));
+  EXPECT_NO_THROW(YamlMap::LoadString("---\nversion: 2\n", "rig.yaml"));
+  EXPECT_NO_THROW(YamlMap::LoadString("", "rig.yaml"));  // an empty file: a mapping with no keys
+}
+
 TEST(YamlMap, FinishRejectsKeysNobodyRead) {
   YamlMap m = YamlMap::LoadString("known: 1\ntypo_key: 2\n", "f.yaml");
   m.GetInt("known");
