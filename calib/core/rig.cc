@@ -73,7 +73,10 @@ void Rig::CheckTopology(const std::string& where) const {
     }
   }
   if (static_cast<int>(used.size()) != num_cameras()) {
-    throw InputError(where, "every camera must belong to exactly one module");
+    std::string unused;  // named, so that a module left out of a hand-edited file is found
+    for (int c = 0; c < num_cameras(); ++c)
+      if (!used.count(c)) unused += (unused.empty() ? "" : ", ") + std::to_string(c);
+    throw InputError(where, "every camera must belong to exactly one module: camera(s) " + unused + " in none");
   }
 }
 

@@ -67,6 +67,20 @@ TEST(Rig, RejectsModulesThatNameMissingCameras) {
   EXPECT_THROW(Rig(good.cameras(), good.camera_names(), mods, good.S(), "test"), InputError);
 }
 
+// A module left out of a hand-edited rig file leaves its cameras in none:
+// the refusal names them.
+TEST(Rig, NamesTheCamerasNoModuleHolds) {
+  const Rig good = MakeRig(2);
+  auto mods = good.modules();
+  mods.pop_back();
+  try {
+    Rig(good.cameras(), good.camera_names(), mods, std::vector<std::vector<Pose>>{{Pose::Identity()}}, "rig.yaml");
+    ADD_FAILURE() << "cameras in no module accepted";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "rig.yaml: every camera must belong to exactly one module: camera(s) 2, 3 in none");
+  }
+}
+
 TEST(Rig, CamFromReferenceChainsModuleAndStereoPoses) {
   const Rig rig = MakeRig(2);
   const Pose expected = rig.module(1).right_from_left * rig.S(1, 0);
