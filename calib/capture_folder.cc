@@ -82,14 +82,16 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
       // header, before decoding: imread's own conversion to grey would take
       // a 16-bit image's high byte (a 12-bit camera's image in the low bits
       // turns nearly black, and then no board is found) and let a colour
-      // capture through that `reconstruct` refuses. The channels and bits
-      // are imread's (IMREAD_UNCHANGED), as png_reader.h gives them.
-      if (png->channels() != 1 || png->bit_depth() != 8)
+      // capture through that `reconstruct` refuses. The channels are
+      // imread's (IMREAD_UNCHANGED), as png_reader.h gives them; the bits the
+      // file's own, so that 1-, 2- and 4-bit grey (which the decoder scales
+      // to 8) is refused here as by the runtime.
+      if (png->channels() != 1 || png->stored_bit_depth() != 8)
         throw InputError(image.string(),
                          "must be an 8-bit single-channel (grey) image, as `stereorig reconstruct` "
                          "reads too (this one has " +
-                             std::to_string(png->channels()) + " channel(s) of " + std::to_string(png->bit_depth()) +
-                             " bits)");
+                             std::to_string(png->channels()) + " channel(s) of " +
+                             std::to_string(png->stored_bit_depth()) + " bits)");
       cv::Mat grey(int(png->height_px()), int(png->width_px()), CV_8UC1);
       png->Read(grey.data, grey.step);
       CameraImager& spec = out.cameras[c];

@@ -26,7 +26,7 @@ std::string FirstBytes(const std::string& path, size_t count) {
 
 }  // namespace
 
-cv::Mat ReadImageFile(const std::string& path) {
+cv::Mat ReadImageFile(const std::string& path, int* stored_bit_depth) {
   RequireInputFile(path);
   // Opened once here for the reason alone: the PNG reader's "cannot be
   // opened" leaves out why (permission denied, too many open files).
@@ -40,6 +40,7 @@ cv::Mat ReadImageFile(const std::string& path) {
     cv::Mat image(int(png->height_px()), int(png->width_px()),
                   CV_MAKETYPE(png->bit_depth() == 16 ? CV_16U : CV_8U, png->channels()));
     png->Read(image.data, image.step);
+    if (stored_bit_depth) *stored_bit_depth = png->stored_bit_depth();
     return image;
   }
   if (EndsWithIgnoringCase(path, ".png")) throw InputError(path, "is not a PNG file, though named .png");
@@ -48,6 +49,7 @@ cv::Mat ReadImageFile(const std::string& path) {
     FloatImage depth = ReadFloatTiff(path);
     cv::Mat image(int(depth.height_px), int(depth.width_px), CV_32FC1);
     std::copy(depth.values.begin(), depth.values.end(), image.ptr<float>());
+    if (stored_bit_depth) *stored_bit_depth = 32;
     return image;
   }
   throw InputError(path,

@@ -18,6 +18,9 @@ namespace stereorig {
 // the file is missing or not a file, is a PNG cut short, damaged or too
 // large (png_reader.h), is named .png but is not one, is a TIFF of another
 // kind or damaged, or is neither.
-cv::Mat ReadImageFile(const std::string& path);
+// *stored_bit_depth, if given: the PNG's own bit depth (PngReader::
+// stored_bit_depth: 1, 2 or 4 for grey the decoder scaled to 8 bits); the
+// TIFF's 32.
+cv::Mat ReadImageFile(const std::string& path, int* stored_bit_depth = nullptr);
 
 }  // namespace stereorig

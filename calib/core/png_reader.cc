@@ -267,6 +267,7 @@ std::optional<PngReader> PngReader::FromBytes(const std::string& path, std::stri
   reader.width_px_ = width_px;
   reader.height_px_ = height_px;
   reader.bit_depth_ = bit_depth == 16 ? 16 : 8;
+  reader.stored_bit_depth_ = bit_depth;
   // OpenCV's PngDecoder::readHeader: a tRNS chunk makes colour and palette
   // images 4-channel; one on a grey image is dropped (png_set_strip_alpha).
   png_bytep trans_alpha = nullptr;

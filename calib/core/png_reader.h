@@ -68,6 +68,9 @@ class PngReader {
   uint32_t height_px() const { return height_px_; }
   int channels() const { return channels_; }
   int bit_depth() const { return bit_depth_; }
+  // The file's own bit depth (IHDR: 1, 2, 4, 8 or 16), before the scaling
+  // above: what tells a 1-, 2- or 4-bit grey capture from an 8-bit one.
+  int stored_bit_depth() const { return stored_bit_depth_; }
 
   // Decodes the image into `pixels`: height_px() rows, each of width_px() x
   // channels() samples (uint8_t, or uint16_t in the machine's byte order),
@@ -82,7 +85,7 @@ class PngReader {
 
   std::unique_ptr<PngDecoding> decoding_;
   uint32_t width_px_ = 0, height_px_ = 0;
-  int channels_ = 0, bit_depth_ = 0;
+  int channels_ = 0, bit_depth_ = 0, stored_bit_depth_ = 0;
 };
 
 }  // namespace stereorig

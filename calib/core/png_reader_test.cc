@@ -106,6 +106,21 @@ TEST(PngReader, AWholePngIsReadAndOneCutShortIsNamed) {
 // found first by zlib, as the data inflates (or by the image data's
 // Adler-32) and a flip in its CRC by the CRC; a CRC that fails at an
 // ancillary chunk too, where libpng only warns and drops the chunk.
+// Grey of 1, 2 or 4 bits decodes as 8-bit (bit_depth() 8, as imread gives
+// it); stored_bit_depth() keeps the file's own depth, which the capture
+// readers (reconstruct's and calibrate's) refuse below 8.
+TEST(PngReader, KeepsTheFilesOwnBitDepthBesideTheDecodedOne) {
+  for (const int bits : {1, 2, 4, 8}) {
+    std::string raw;  // 8 x 2 px: per row a filter byte and 8 samples packed
+    for (int row = 0; row < 2; ++row) raw += '\0' + std::string(size_t(bits), '\x5a');
+    const std::string png = kPngSignature + Chunk("IHDR", Ihdr(8, 2, bits, 0)) + Chunk("IDAT", Deflate(raw, 9)) + kIend;
+    std::optional<PngReader> reader = PngReader::FromBytes("x.png", png);
+    ASSERT_TRUE(reader.has_value()) << bits;
+    EXPECT_EQ(reader->bit_depth(), 8) << bits;
+    EXPECT_EQ(reader->stored_bit_depth(), bits);
+  }
+}
+
 TEST(PngReader, ADamagedPngIsNamedWithTheChunk) {
   const std::pair<size_t, std::string> flips[] = {
       {41, "its image data (IDAT chunk at byte 33): incorrect header check"},  // zlib's header
