@@ -275,10 +275,12 @@ int RunCheck(int argc, char** argv) {
   // history without the night.
   AtomicOutputSet staged_report;
   if (!report_path.empty()) staged_report.Add(report_path, report.dump(2) + "\n");
+  // Paths as typed: the history keeps them absolute and canonical
+  // (HistoryPathOf), rig_file and rig_path alike.
   HistoryRun run{0, report["date_utc"], rig_path, captures, "", ""};
-  run.rig_path = std::filesystem::absolute(rig_path).lexically_normal().string();
+  run.rig_path = rig_path;
   run.rig_crc32 = rig_crc32;
-  run.target_path = std::filesystem::absolute(target_path).lexically_normal().string();
+  run.target_path = target_path;
   run.board = check_target.back_from_front_as_calibrated ? "as calibrated" : "the target file's";
   AppendToHistory(history_db, run, result, detected.capture_names);
   staged_report.Commit();

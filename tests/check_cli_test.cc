@@ -55,6 +55,7 @@ struct DbState {
   std::string integrity;
   int runs = -1;
   std::string last_rig_path, last_rig_crc32, last_board;  // the last run's inputs
+  std::string last_rig_file;                              // the last run's rig_file (stereorig_check_runs)
 };
 DbState ReadDb(const std::string& path) {
   DbState s;
@@ -77,6 +78,7 @@ DbState ReadDb(const std::string& path) {
   s.last_rig_path = one("SELECT rig_path FROM stereorig_check_run_inputs ORDER BY run_id DESC LIMIT 1");
   s.last_rig_crc32 = one("SELECT rig_crc32 FROM stereorig_check_run_inputs ORDER BY run_id DESC LIMIT 1");
   s.last_board = one("SELECT board FROM stereorig_check_run_inputs ORDER BY run_id DESC LIMIT 1");
+  s.last_rig_file = one("SELECT rig_file FROM stereorig_check_runs ORDER BY id DESC LIMIT 1");
   sqlite3_close(db);
   return s;
 }
@@ -127,7 +129,8 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     std::snprintf(crc, sizeof crc, "%08lx",
                   crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(bytes.data()), uInt(bytes.size())));
     const DbState s = ReadDb(db);
-    EXPECT_EQ(s.last_rig_path, fs::absolute(dir + "/rig.yaml").lexically_normal().string());
+    EXPECT_EQ(s.last_rig_path, fs::canonical(dir + "/rig.yaml").string());
+    EXPECT_EQ(s.last_rig_file, s.last_rig_path);  // one path for one file, in both tables
     EXPECT_EQ(s.last_rig_crc32, crc);
     EXPECT_EQ(s.last_board, "as calibrated");
   }

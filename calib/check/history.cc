@@ -87,6 +87,19 @@ bool HasTable(sqlite3* db, const char* table, const std::string& path) {
 
 }  // namespace
 
+std::string HistoryPathOf(const std::string& path) {
+  namespace fs = std::filesystem;
+  if (path.empty()) return path;
+  std::error_code ec;
+  const fs::path absolute = fs::absolute(path, ec);
+  if (ec) return path;
+  if (fs::is_regular_file(absolute, ec)) {
+    const fs::path canonical = fs::canonical(absolute, ec);
+    if (!ec) return canonical.string();
+  }
+  return absolute.lexically_normal().string();
+}
+
 long long AppendToHistory(const std::string& path, const HistoryRun& run, const CheckResult& result,
                           const std::map<int, std::string>& capture_names) {
   Db db = Open(path, true);
@@ -99,8 +112,10 @@ long long AppendToHistory(const std::string& path, const HistoryRun& run, const 
                        "VALUES (?, ?, ?, ?, ?);",
                        path);
     const std::string verdict = result.Verdict(), explanation = result.Explanation();
+    const std::string rig_file = HistoryPathOf(run.rig_file), rig_path = HistoryPathOf(run.rig_path);
+    const std::string target_path = HistoryPathOf(run.target_path);
     sqlite3_bind_text(ins.get(), 1, run.date_utc.c_str(), -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(ins.get(), 2, run.rig_file.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(ins.get(), 2, rig_file.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(ins.get(), 3, run.captures.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(ins.get(), 4, verdict.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(ins.get(), 5, explanation.c_str(), -1, SQLITE_TRANSIENT);
@@ -112,9 +127,9 @@ long long AppendToHistory(const std::string& path, const HistoryRun& run, const 
                           "VALUES (?, ?, ?, ?, ?);",
                           path);
     sqlite3_bind_int64(inputs.get(), 1, id);
-    sqlite3_bind_text(inputs.get(), 2, run.rig_path.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(inputs.get(), 2, rig_path.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(inputs.get(), 3, run.rig_crc32.c_str(), -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(inputs.get(), 4, run.target_path.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(inputs.get(), 4, target_path.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(inputs.get(), 5, run.board.c_str(), -1, SQLITE_TRANSIENT);
     if (sqlite3_step(inputs.get()) != SQLITE_DONE)
       throw InputError(path, std::string("history: ") + sqlite3_errmsg(db.get()));
@@ -210,6 +225,10 @@ std::vector<HistoryRun> ReadHistoryRuns(const std::string& path) {
       run.rig_path = Text(s.get(), 6), run.rig_crc32 = Text(s.get(), 7);
       run.target_path = Text(s.get(), 8), run.board = Text(s.get(), 9);
     }
+    // Runs written before rig_file was kept absolute hold it as typed,
+    // relative to a folder the history does not know; their rig_path (the
+    // same file, made absolute by the same run) says which file it was.
+    if (!run.rig_path.empty() && !std::filesystem::path(run.rig_file).is_absolute()) run.rig_file = run.rig_path;
     runs.push_back(run);
   }
   return runs;

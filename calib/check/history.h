@@ -14,12 +14,17 @@ namespace stereorig {
 struct HistoryRun {
   long long id = 0;
   std::string date_utc;
+  // The rig file: AppendToHistory keeps it as HistoryPathOf's (absolute,
+  // canonical), as rig_path below. Runs written before were kept as typed
+  // (a relative path, relative to a folder not recorded): read back as
+  // their rig_path where they have one, as typed where not.
   std::string rig_file;
   std::string captures;
   std::string verdict;  // "ok" or "recalibrate"
   std::string explanation;
   // What the night was measured with (empty in runs written before they were
-  // kept): the rig file's absolute path and a CRC-32 of its bytes (a rig
+  // kept; paths kept as HistoryPathOf's): the rig file's absolute path and a
+  // CRC-32 of its bytes (a rig
   // recalibrated into the same path reads as another), the target file's
   // absolute path, and which back_from_front the closures used.
   std::string rig_path = "";
@@ -60,7 +65,15 @@ struct FigureTrend {
   std::vector<HistoryPoint> points;  // oldest first
 };
 
-// Appends one run. Creates the database (and its tables) if missing. Throws
+// The path a history keeps for a file, so that one file reads as one path
+// whichever folder the check ran from and however it was typed: absolute,
+// and canonical (links, "." and ".." resolved) for a regular file; absolute
+// and lexically normal for anything else (a pipe, /dev/fd/N, or a path not
+// there: what it names cannot be resolved).
+std::string HistoryPathOf(const std::string& path);
+
+// Appends one run, its paths (rig_file, rig_path, target_path) kept as
+// HistoryPathOf's. Creates the database (and its tables) if missing. Throws
 // InputError naming `db_path` if it is not an SQLite database of ours or
 // cannot be written.
 // The views the run set aside are stored with it, each capture named by

@@ -24,6 +24,22 @@ CheckResult Result(double value, bool pass) {
   return r;
 }
 
+// A history as an older version wrote it: the runs and figures tables
+// alone, then `sql` (more tables, rows). True when it was made.
+bool MakeOldHistory(const std::string& path, const std::string& sql) {
+  sqlite3* raw = nullptr;
+  const bool opened = sqlite3_open(path.c_str(), &raw) == SQLITE_OK;
+  const std::string all =
+      "CREATE TABLE stereorig_check_runs (id INTEGER PRIMARY KEY AUTOINCREMENT, date_utc TEXT NOT NULL, rig_file TEXT "
+      "NOT NULL, captures TEXT NOT NULL, verdict TEXT NOT NULL, explanation TEXT NOT NULL);"
+      "CREATE TABLE stereorig_check_figures (run_id INTEGER NOT NULL, name TEXT NOT NULL, value REAL NOT NULL, "
+      "threshold REAL NOT NULL, pass INTEGER NOT NULL, samples INTEGER NOT NULL);" +
+      sql;
+  const bool made = opened && sqlite3_exec(raw, all.c_str(), nullptr, nullptr, nullptr) == SQLITE_OK;
+  sqlite3_close(raw);
+  return made;
+}
+
 TEST(History, AppendsRunsAndReadsTrendsBack) {
   const std::string db = ::testing::TempDir() + "/history_test.sqlite";
   std::filesystem::remove(db);
@@ -72,6 +88,75 @@ TEST(History, KeepsTheRigFileEachRunUsedAndSaysWhenItChanged) {
   // One rig file throughout: nothing said.
   std::vector<HistoryRun> same(runs.begin(), runs.begin() + 2);
   EXPECT_EQ(FormatTrends(same, ReadHistoryTrends(db)).find("rig files:"), std::string::npos);
+}
+
+// The rig file as the history keeps it: one path per file, absolute and
+// canonical, in the runs table as in the inputs table. It was kept as typed
+// ("rig.yaml", "../line/rig.yaml"), relative to a folder the history does
+// not record, beside the inputs table's absolute path: the same file under
+// two names in one run. A history written so is still read, each such
+// run's rig file taken from its inputs row (the same run made it absolute).
+TEST(History, KeepsTheRigFileAbsoluteAndCanonicalAndReadsOlderRunsAsTyped) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::absolute(::testing::TempDir()) / "history_paths";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "line");
+  fs::create_directories(dir / "other");
+  std::ofstream(dir / "line" / "rig.yaml") << "format: stereorig-rig\n";
+  fs::create_symlink(dir / "line" / "rig.yaml", dir / "current-rig.yaml");
+  const std::string rig = fs::canonical(dir / "line" / "rig.yaml").string();
+  const std::string db = (dir / "history.sqlite").string();
+  // Typed three ways, from the test's folder: relative, through "..", and
+  // through a link. One path kept, in both tables.
+  for (const fs::path& typed : {fs::relative(dir / "line" / "rig.yaml"), dir / "other" / ".." / "line" / "rig.yaml",
+                                dir / "current-rig.yaml"}) {
+    HistoryRun r{0, "2026-11-20T02:00:00Z", typed.string(), "night", "", ""};
+    r.rig_path = typed.string(), r.rig_crc32 = "0badc0de", r.target_path = typed.string();
+    AppendToHistory(db, r, Result(0.20, true));
+  }
+  const auto runs = ReadHistoryRuns(db);
+  ASSERT_EQ(runs.size(), 3u);
+  for (const HistoryRun& r : runs) {
+    EXPECT_EQ(r.rig_file, rig) << "run " << r.id;
+    EXPECT_EQ(r.rig_path, rig) << "run " << r.id;
+    EXPECT_EQ(r.target_path, rig) << "run " << r.id;
+  }
+  {
+    sqlite3* raw = nullptr;
+    ASSERT_EQ(sqlite3_open(db.c_str(), &raw), SQLITE_OK);
+    sqlite3_stmt* s = nullptr;
+    ASSERT_EQ(sqlite3_prepare_v2(raw, "SELECT rig_file FROM stereorig_check_runs;", -1, &s, nullptr), SQLITE_OK);
+    while (sqlite3_step(s) == SQLITE_ROW) EXPECT_EQ(reinterpret_cast<const char*>(sqlite3_column_text(s, 0)), rig);
+    sqlite3_finalize(s);
+    sqlite3_close(raw);
+  }
+
+  // Older histories: a run with an inputs row and rig_file as typed reads
+  // its rig_path; a run from before the inputs were kept reads as typed
+  // (nothing says from which folder); both are still read, and appended to.
+  const std::string old_db = (dir / "old.sqlite").string();
+  ASSERT_TRUE(
+      MakeOldHistory(old_db,
+                     "CREATE TABLE stereorig_check_run_inputs (run_id INTEGER NOT NULL, rig_path TEXT NOT NULL, "
+                     "rig_crc32 TEXT NOT NULL, target_path TEXT NOT NULL, board TEXT NOT NULL);"
+                     "INSERT INTO stereorig_check_runs (date_utc, rig_file, captures, verdict, explanation) "
+                     "VALUES ('2026-11-01T02:00:00Z', 'rig.yaml', 'n1', 'ok', 'every figure within its "
+                     "threshold');"
+                     "INSERT INTO stereorig_check_runs (date_utc, rig_file, captures, verdict, explanation) "
+                     "VALUES ('2026-11-02T02:00:00Z', '../line/rig.yaml', 'n2', 'ok', 'every figure within its "
+                     "threshold');"
+                     "INSERT INTO stereorig_check_run_inputs VALUES (2, '/line/rig.yaml', '0badc0de', "
+                     "'/line/target.yaml', 'as calibrated');"));
+  HistoryRun next{0, "2026-11-03T02:00:00Z", rig, "n3", "", ""};
+  next.rig_path = rig;
+  AppendToHistory(old_db, next, Result(0.20, true));
+  const auto old_runs = ReadHistoryRuns(old_db);
+  ASSERT_EQ(old_runs.size(), 3u);
+  EXPECT_EQ(old_runs[0].rig_file, "rig.yaml");  // no inputs row: as typed
+  EXPECT_EQ(old_runs[1].rig_file, "/line/rig.yaml");
+  EXPECT_EQ(old_runs[1].rig_path, "/line/rig.yaml");
+  EXPECT_EQ(old_runs[2].rig_file, rig);
+  EXPECT_NE(FormatTrends(old_runs, ReadHistoryTrends(old_db)).find("3 run(s)"), std::string::npos);
 }
 
 // A history the night cannot be written to is found before the check's
@@ -157,22 +242,10 @@ TEST(History, KeepsTheViewsSetAsideAndCountsThemPerCamera) {
 TEST(History, CountsTheViewsSetAsideOnlySinceTheRunThatFirstKeptThem) {
   const std::string db = ::testing::TempDir() + "/history_old.sqlite";
   std::filesystem::remove(db);
-  {
-    sqlite3* raw = nullptr;
-    ASSERT_EQ(sqlite3_open(db.c_str(), &raw), SQLITE_OK);
-    ASSERT_EQ(sqlite3_exec(raw,
-                           "CREATE TABLE stereorig_check_runs (id INTEGER PRIMARY KEY AUTOINCREMENT, date_utc TEXT "
-                           "NOT NULL, rig_file TEXT NOT NULL, captures TEXT NOT NULL, verdict TEXT NOT NULL, "
-                           "explanation TEXT NOT NULL);"
-                           "CREATE TABLE stereorig_check_figures (run_id INTEGER NOT NULL, name TEXT NOT NULL, value "
-                           "REAL NOT NULL, threshold REAL NOT NULL, pass INTEGER NOT NULL, samples INTEGER NOT NULL);"
-                           "INSERT INTO stereorig_check_runs (date_utc, rig_file, captures, verdict, explanation) "
-                           "VALUES ('2026-11-01T02:00:00Z', 'rig.yaml', 'old', 'ok', 'every figure within its "
-                           "threshold');",
-                           nullptr, nullptr, nullptr),
-              SQLITE_OK);
-    sqlite3_close(raw);
-  }
+  ASSERT_TRUE(MakeOldHistory(db,
+                             "INSERT INTO stereorig_check_runs (date_utc, rig_file, captures, verdict, explanation) "
+                             "VALUES ('2026-11-01T02:00:00Z', 'rig.yaml', 'old', 'ok', 'every figure within its "
+                             "threshold');"));
   const HistorySetAsideLog before = ReadHistorySetAside(db);
   EXPECT_EQ(before.since_run_id, 0);
   EXPECT_TRUE(before.views.empty());
