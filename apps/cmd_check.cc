@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "apps/cli_util.h"
@@ -48,19 +47,18 @@ void RejectCamerasBeyondTheRig(const std::string& captures, int num_cameras) {
   }
 }
 
-// The CRC-32 of a file's bytes as 8 hex digits (zlib's): what tells the rig
-// file a night used from another written to the same path. Not a guard
-// against tampering, only a fingerprint.
-// Empty for what is not a regular file (a pipe, as `--rig <(...)`: read
-// once, by the rig file's reader, and gone).
-std::string FileCrc32Hex(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) return "";
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "cannot be read");
+// The CRC-32 of the rig file's bytes as 8 hex digits (zlib's): what tells
+// the rig file a night used from another written to the same path. Not a
+// guard against tampering, only a fingerprint. Of the bytes the rig was
+// parsed from (ReadRigFile's, one read): a second read a moment later took
+// the fingerprint of a file replaced in between, and of a pipe none.
+std::string Crc32Hex(const std::string& bytes) {
   uLong crc = crc32(0L, Z_NULL, 0);
-  char buffer[1 << 16];
-  while (in.read(buffer, sizeof buffer) || in.gcount() > 0)
-    crc = crc32(crc, reinterpret_cast<const Bytef*>(buffer), static_cast<uInt>(in.gcount()));
+  for (size_t done = 0; done < bytes.size();) {  // uInt lengths: in pieces
+    const size_t piece = std::min<size_t>(bytes.size() - done, 1u << 30);
+    crc = crc32(crc, reinterpret_cast<const Bytef*>(bytes.data() + done), static_cast<uInt>(piece));
+    done += piece;
+  }
   char hex[16];
   std::snprintf(hex, sizeof hex, "%08lx", static_cast<unsigned long>(crc));
   return hex;
@@ -147,11 +145,10 @@ int RunCheck(int argc, char** argv) {
   outputs.Claim(history_db, history_given ? "the history database (--history-db, updated in place)"
                                           : "the history database (by default beside the rig file, updated in place)");
 
-  const Rig rig = ReadRigFile(rig_path);
-  // Read again for the CRC, a moment after the reader: a rig file replaced
-  // in between reads as the new one's.
-  const std::string rig_crc32 = FileCrc32Hex(rig_path);
-  RequireCalibrationResiduals(rig, rig_path);  // named by the rig file, before minutes of detection
+  std::string rig_bytes;
+  const Rig rig = ReadRigFile(rig_path, &rig_bytes);
+  const std::string rig_crc32 = Crc32Hex(rig_bytes);  // of the bytes parsed
+  RequireCalibrationResiduals(rig, rig_path);         // named by the rig file, before minutes of detection
   // The board with the back_from_front the calibration ended with (S holds
   // with it); a board other than the calibration's is refused here.
   const CheckTarget check_target = TargetForCheck(rig, ReadTargetFile(target_path), target_path);

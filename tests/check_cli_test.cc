@@ -4,10 +4,14 @@
 // same number of runs). The cases: a corrupt image, an image of the wrong
 // size, captures from another rig (other cameras, more cameras, another
 // camera model), and a history path that is not a database.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include <zlib.h>
+
+#include <chrono>
 
 #include <filesystem>
 #include <fstream>
@@ -15,6 +19,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
+#include <thread>
 
 #include "calib/core/rig_file.h"
 #include "targets/target_file.h"
@@ -133,6 +138,37 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     EXPECT_EQ(s.last_rig_file, s.last_rig_path);  // one path for one file, in both tables
     EXPECT_EQ(s.last_rig_crc32, crc);
     EXPECT_EQ(s.last_board, "as calibrated");
+
+    // The CRC is of the bytes the rig was parsed from, read once: it was
+    // taken by a second read a moment after the parse, so a rig file
+    // replaced in between was fingerprinted as the new one, and a rig given
+    // as a pipe (read once, then gone) had none. A pipe shows it: its one
+    // read is both the rig and the CRC.
+    const std::string fifo = dir + "/rig_once.fifo", pipe_db = dir + "/history_pipe.sqlite";
+    ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+    std::thread writer([&] {
+      // Non-blocking open until the check opens the pipe to read it (a
+      // check that never does must not hang the test).
+      int fd = -1;
+      for (int tries = 0; tries < 1200 && fd < 0; ++tries) {
+        fd = open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+        if (fd < 0) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      }
+      if (fd < 0) return;
+      fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+      for (size_t done = 0; done < bytes.size();) {
+        const ssize_t n = write(fd, bytes.data() + done, bytes.size() - done);
+        if (n <= 0) break;
+        done += static_cast<size_t>(n);
+      }
+      close(fd);
+    });
+    const Result piped = RunCli("check --rig " + fifo + " --captures " + dir + "/ds --target " + dir +
+                                "/ds/target.yaml --history-db " + pipe_db);
+    writer.join();
+    EXPECT_NE(piped.code, 2) << piped.err;
+    EXPECT_EQ(ReadDb(pipe_db).last_rig_crc32, crc);
+    fs::remove(fifo);
   }
   const std::string db_bytes = Bytes(db);
   fs::remove(report);

@@ -160,7 +160,9 @@ std::string NowUtcIso8601() {
 
 std::string ToolVersion() { return std::string("stereorig ") + STEREORIG_VERSION; }
 
-Rig ReadRigFile(const std::string& path) { return ParseRig(YamlMap::LoadFile(path)); }
+Rig ReadRigFile(const std::string& path, std::string* bytes_read) {
+  return ParseRig(YamlMap::LoadFile(path, bytes_read));
+}
 
 Rig ParseRigYaml(const std::string& text, const std::string& where) {
   return ParseRig(YamlMap::LoadString(text, where));

@@ -26,7 +26,7 @@ InputError SyntaxError(const std::string& where, const YAML::Exception& e) {
 
 }  // namespace
 
-YamlMap YamlMap::LoadFile(const std::string& path) {
+YamlMap YamlMap::LoadFile(const std::string& path, std::string* text_read) {
   RequireInputFile(path, /*pipe_too=*/true);  // read once, start to end
   // Read here, not by yaml-cpp's LoadFile, whose error for a file it cannot
   // open is "bad file" (an unreadable file read "not valid YAML: bad file").
@@ -35,7 +35,9 @@ YamlMap YamlMap::LoadFile(const std::string& path) {
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw InputError(path, "cannot be read to its end");
-  return LoadString(text.str(), path);
+  if (text_read == nullptr) return LoadString(text.str(), path);
+  *text_read = text.str();
+  return LoadString(*text_read, path);
 }
 
 YamlMap YamlMap::LoadString(const std::string& text, const std::string& where) {

@@ -21,8 +21,10 @@ class YamlMap {
   // An empty document (an empty file, comments only, as an options file
   // with every key commented out, or a bare `null` / `~`) is a mapping
   // with no keys: every optional key takes its default, and a required one
-  // is reported missing.
-  static YamlMap LoadFile(const std::string& path);
+  // is reported missing. With `text_read`, the bytes parsed are kept there:
+  // the file is read once, so a caller that fingerprints it (stereorig
+  // check's CRC-32) fingerprints what was parsed, not a file replaced since.
+  static YamlMap LoadFile(const std::string& path, std::string* text_read = nullptr);
   static YamlMap LoadString(const std::string& text, const std::string& where);
   // `node` must be a mapping; `where` is "file: key.path" for messages.
   YamlMap(const YAML::Node& node, std::string file, std::string key_path);
