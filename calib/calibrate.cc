@@ -202,10 +202,10 @@ std::string WrongPlateProblem(const PlateDifference& d) {
   char b[400];
   std::snprintf(b, sizeof b,
                 "back_from_front: stage 3 moved its %s by %+.4f %s, against a sigma of %.4f %s from the file's "
-                "back_from_front_sigma (with its rotation's lever arm on a translation) (chi-square %.1f over the 6 "
-                "axes, above %.2f, which a right file exceeds fewer than 3 times in 1000)",
+                "back_from_front_sigma (with its rotation's lever arm on a translation) (chi-square %.1f over the %d "
+                "axes it refined, above %.2f, which a right file exceeds fewer than 3 times in 1000)",
                 PlateAxisName(d.worst), d.worst_off, PlateAxisUnit(d.worst), d.worst_sigma, PlateAxisUnit(d.worst),
-                d.chi_square, kSamePlateChiSquare);
+                d.chi_square, d.axes, d.Bound());
   return std::string(b) +
          ": the target file's back_from_front is not this plate's: measure the plate again or fix "
          "the file";

@@ -302,6 +302,45 @@ TEST(CalibrateRefuses, ABackFromFrontThatIsNotThePlates) {
   EXPECT_EQ(j.at("stage3_system").at("wrong_plate").get<std::string>(), r.report.wrong_plate);
 }
 
+// A target file whose back_from_front_sigma has a 0 on one axis: that axis
+// is known exactly, held at the file's value, and the other five are still
+// refined and judged (over 5 degrees of freedom, bound 18.21). A single 0
+// held all six unrefined and unjudged: the thickness typed in metres beside
+// tx's sigma of 0 gave a rig file (exit 0) and no word of the plate. Here tx
+// is given as the truth (so its 0 is honest): the right file passes,
+// refined (tz moves from the file's; the chi-square is the 5 axes', within
+// its bound on this seed as on 2697 of 2700 right files), and tx stays the
+// file's to the last bit; typed in metres, tz is refused as with six sigmas.
+TEST(CalibrateRefuses, ASigmaOfZeroHoldsItsAxisAndTheOthersAreStillJudged) {
+  auto s = testing::MakeDefaultScene(66, 12, kNoisePx);
+  TargetGeometry& t = s.data.input.target;
+  Eigen::Vector3d exact_tx = t.back_from_front.translation_mm();
+  exact_tx.x() = s.true_back_from_front.translation_mm().x();
+  t.back_from_front = Pose(t.back_from_front.rotation(), exact_tx);
+  t.back_from_front_sigma(3) = 0;  // tx
+  const CalibrationResult right = Calibrate(s.data.input, CalibrationOptions());
+  const PlateDifference& rd = right.report.system.back_from_front_vs_file;
+  EXPECT_EQ(right.report.wrong_plate, "");
+  EXPECT_EQ(rd.axes, 5);
+  EXPECT_GT(rd.chi_square, 0.0);  // judged
+  EXPECT_LE(rd.chi_square, SamePlateChiSquare(5));
+  EXPECT_EQ(right.report.system.back_from_front.translation_mm().x(), t.back_from_front.translation_mm().x());
+  EXPECT_NE(right.report.system.back_from_front.translation_mm().z(), t.back_from_front.translation_mm().z());
+
+  Eigen::Vector3d metres = t.back_from_front.translation_mm();
+  metres.z() /= 1000;
+  t.back_from_front = Pose(t.back_from_front.rotation(), metres);
+  const CalibrationResult r = Calibrate(s.data.input, CalibrationOptions());
+  const PlateDifference& d = r.report.system.back_from_front_vs_file;
+  EXPECT_EQ(d.axes, 5);
+  EXPECT_GT(d.chi_square, SamePlateChiSquare(5));
+  EXPECT_STREQ(PlateAxisName(d.worst), "tz");
+  EXPECT_EQ(r.report.system.back_from_front.translation_mm().x(), t.back_from_front.translation_mm().x());
+  EXPECT_EQ(r.report.wrong_plate.rfind("back_from_front: stage 3 moved its tz by +2.", 0), 0u) << r.report.wrong_plate;
+  EXPECT_NE(r.report.wrong_plate.find("over the 5 axes it refined, above 18.21"), std::string::npos)
+      << r.report.wrong_plate;
+}
+
 TEST(CalibrateRefuses, CameraThatNeverSeesTheBoard) {
   auto s = testing::MakeDefaultScene(61, 10, kNoisePx);
   auto& obs = s.data.input.observations;

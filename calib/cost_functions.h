@@ -71,12 +71,16 @@ class CornerReprojectionCost : public ceres::CostFunction {
 // the covariance right when it is scaled by the pixel variance.
 struct BackFromFrontPrior {
   Eigen::Vector3d t_measured_mm;
-  Eigen::Matrix<double, 6, 1> sigma;  // [rx, ry, rz (deg), tx, ty, tz (mm)]
+  // [rx, ry, rz (deg), tx, ty, tz (mm)]; 0: the axis is known exactly, held
+  // at the file's value by the caller (a SubsetManifold), its residual 0.
+  Eigen::Matrix<double, 6, 1> sigma;
   double corner_sigma_px;
   template <typename T>
   bool operator()(const T* bff, T* r) const {
-    for (int i = 0; i < 3; ++i) r[i] = T(corner_sigma_px) * bff[i] * T(180.0 / M_PI) / T(sigma(i));
-    for (int i = 0; i < 3; ++i) r[3 + i] = T(corner_sigma_px) * (bff[3 + i] - T(t_measured_mm(i))) / T(sigma(3 + i));
+    for (int i = 0; i < 3; ++i)
+      r[i] = sigma(i) > 0 ? T(corner_sigma_px) * bff[i] * T(180.0 / M_PI) / T(sigma(i)) : T(0);
+    for (int i = 0; i < 3; ++i)
+      r[3 + i] = sigma(3 + i) > 0 ? T(corner_sigma_px) * (bff[3 + i] - T(t_measured_mm(i))) / T(sigma(3 + i)) : T(0);
     return true;
   }
   static ceres::CostFunction* Create(const Eigen::Vector3d& t_measured_mm, const Eigen::Matrix<double, 6, 1>& sigma,

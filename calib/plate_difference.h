@@ -20,6 +20,11 @@ namespace stereorig {
 // plate.
 inline constexpr double kSamePlateChiSquare = 20.06;
 
+// The same quantile over `axes` (0..6) judged axes: an axis held (sigma 0,
+// known exactly) adds nothing to the chi-square, so the bound is the one of
+// the axes left (1: 9.00 ... 6: kSamePlateChiSquare); 0 with none.
+double SamePlateChiSquare(int axes);
+
 // What %.4f prints as 0, mm or deg: an axis both sigmas hold (0) may move
 // by less and still count as held.
 inline constexpr double kPlateUnchangedInPrint = 5e-5;
@@ -37,12 +42,14 @@ Eigen::Vector3d PlateTurnDeg(const Pose& a, const Pose& b);
 // variance: (6,) its variance per axis (deg^2, mm^2), 0 for an axis held.
 struct PlateDifference {
   double chi_square = 0;   // over the axes whose variance is > 0
+  int axes = 0;            // how many: the chi-square's degrees of freedom
   int held_moved = -1;     // the first held axis that moved (>= kPlateUnchangedInPrint), or -1
   int worst = 0;           // the axis adding most to chi_square
   double worst_off = 0;    // its difference (deg or mm)
   double worst_sigma = 0;  // its sigma, the square root of its variance
-  // Within kSamePlateChiSquare and no held axis moved.
-  bool SamePlate() const { return held_moved < 0 && chi_square <= kSamePlateChiSquare; }
+  // Within SamePlateChiSquare(axes) and no held axis moved.
+  bool SamePlate() const { return held_moved < 0 && chi_square <= Bound(); }
+  double Bound() const { return SamePlateChiSquare(axes); }
 };
 PlateDifference ComparePlates(const Eigen::Matrix<double, 6, 1>& off, const Eigen::Matrix<double, 6, 1>& variance);
 

@@ -283,12 +283,23 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   for (PoseBlock* p : {&identity_module, &identity_bff, &identity_rl}) {
     if (problem.HasParameterBlock(p->params)) problem.SetParameterBlockConstant(p->params);
   }
-  const bool bff_free = any_back && options.refine_back_from_front && target.double_sided &&
-                        (target.back_from_front_sigma.array() > 0).all();
-  if (any_back && bff_free) {
+  // back_from_front is refined under the target file's prior, axis by axis:
+  // an axis whose sigma is 0 is known exactly (the limit of a prior whose
+  // sigma goes to 0) and held at the file's value, the others refined and
+  // judged (back_from_front_vs_file). Only a file whose every sigma is 0
+  // holds it whole. Before, a single 0 held all six, and the file went
+  // unjudged: a thickness typed in metres passed, unrefined, beside a
+  // rotation sigma of 0.
+  std::vector<int> bff_held;
+  for (int i = 0; i < 6; ++i)
+    if (!(target.back_from_front_sigma(i) > 0)) bff_held.push_back(i);
+  const bool bff_free = any_back && options.refine_back_from_front && target.double_sided && bff_held.size() < 6;
+  if (bff_free) {
     problem.AddResidualBlock(BackFromFrontPrior::Create(target.back_from_front.translation_mm(),
                                                         target.back_from_front_sigma, corner_sigma_px),
                              nullptr, bff_block.params);
+    // Held at the file's: dr = 0 (R0 is the file's rotation), t the file's.
+    if (!bff_held.empty()) problem.SetManifold(bff_block.params, new ceres::SubsetManifold(6, bff_held));
   }
 
   auto set_free = [&](bool s, bool rl, bool bff, bool intr) {
@@ -387,6 +398,8 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
     variance(3) += r2.y() * t.z() * t.z() + r2.z() * t.y() * t.y();
     variance(4) += r2.z() * t.x() * t.x() + r2.x() * t.z() * t.z();
     variance(5) += r2.x() * t.y() * t.y() + r2.y() * t.x() * t.x();
+    // A held axis did not move and is not judged: no degree of freedom.
+    for (int i : bff_held) variance(i) = 0;
     rep.back_from_front_vs_file = ComparePlates(off, variance);
   }
 

@@ -103,7 +103,7 @@ CheckTarget TargetForCheck(const Rig& rig, const Target& file_target, const std:
         std::snprintf(why, sizeof why,
                       "chi-square %.1f over both files' sigmas, above %.2f, which two measurements of one plate "
                       "exceed 3 times in 1000 (most on %s: %+.4f %s against a sigma of %.4f)",
-                      best.chi_square, kSamePlateChiSquare, PlateAxisName(best.worst), best.worst_off,
+                      best.chi_square, best.Bound(), PlateAxisName(best.worst), best.worst_off,
                       PlateAxisUnit(best.worst), best.worst_sigma);
       throw InputError(target_path, std::string("its back_from_front is ") + moved + " from the one filed when " +
                                         rig.Where() + " was calibrated (from " + recorded_file + "): " + why +
