@@ -151,6 +151,7 @@ CameraChange ExplainCameraChange(const Rig& rig, const Target& target, int camer
   }
   change.threshold_px = threshold_px;
   change.turned_deg = change.shifted_mm = std::numeric_limits<double>::quiet_NaN();
+  change.shift_mm = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   change.corners = static_cast<int>(corners.size());
   if (change.corners < kMinCornersToFit) {  // no fit, not a perfect one (null in the report)
     change.kind = CameraChangeKind::kNotFitted;
@@ -182,8 +183,9 @@ CameraChange ExplainCameraChange(const Rig& rig, const Target& target, int camer
   if (std::isfinite(change.moved_rms_px)) {
     change.turned_deg = AngleBetweenDeg(new_from_old, Pose::Identity());
     // The camera centre's move, in the reference frame.
-    change.shifted_mm =
-        ((new_from_old * cam_from_ref).Inverse().translation_mm() - cam_from_ref.Inverse().translation_mm()).norm();
+    change.shift_mm =
+        (new_from_old * cam_from_ref).Inverse().translation_mm() - cam_from_ref.Inverse().translation_mm();
+    change.shifted_mm = change.shift_mm.norm();
   }
 
   const bool moved_fits = change.moved_rms_px <= threshold_px, lens_fits = change.lens_rms_px <= threshold_px;

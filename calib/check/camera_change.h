@@ -59,6 +59,9 @@ struct CameraChange {
   // (mm) from its stored pose; NaN when not fitted or the solve failed.
   double turned_deg = 0;
   double shifted_mm = 0;
+  // The centre's shift as a vector in the reference frame (shifted_mm is
+  // its length); NaN where shifted_mm is.
+  Eigen::Vector3d shift_mm = Eigen::Vector3d::Zero();
   // Where it sits: "module 0's right camera" (the rig's modules).
   std::string role;
   // "camera 2 moved: turned 0.050 deg, shifted 0.004 mm", "camera 2's lens
