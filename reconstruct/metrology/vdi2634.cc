@@ -627,6 +627,7 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       require_points(static_cast<int>(fit.inliers.size()) + excluded, "sphere");
       e.points_on_artifact = static_cast<int>(fit.inliers.size()) + excluded;
       e.points_excluded = excluded;
+      e.points_off_artifact = e.points_total - e.points_on_artifact;  // outside the capture band
       e.sphere_centers_mm = {fit.center_mm};
       e.sphere_diameters_mm = {2 * fit.radius_mm};
       const SphereFitUncertainty u = SphereUncertainty(pts, fit);
@@ -777,6 +778,7 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       }
       e.points_on_artifact = on_artifact;
       e.points_excluded = excluded_total;
+      e.points_off_artifact = e.points_total - e.points_on_artifact;  // outside both balls' bands, or in the cone
       const Eigen::Vector3d bar_mm = e.sphere_centers_mm[0] - e.sphere_centers_mm[1];
       e.figures = {MakeFigure("SD", bar_mm.norm() - a.center_distance_mm, a.mpe.sphere_spacing_mm)};
       // The two centres' errors are independent (disjoint points); the
@@ -804,14 +806,14 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       // the outline of their dense part (plate_outline.h: a few stray points
       // do not widen it) eroded by the edge margin; the set and the
       // least-squares plane iterated to their fixed point.
-      std::vector<int> face;
+      std::vector<int> face, captured;
+      PlaneOutline extent;  // of `captured`, whose points inside it eroded are `face`
       for (int round = 0; round < kMaxSegmentationRounds; ++round) {
-        const std::vector<int> captured = WithinPlaneBand(pts, fit, e.capture_band_mm);
-        const PlaneOutline extent = OutlineOfDensePart(pts, captured, fit.normal);
+        captured = WithinPlaneBand(pts, fit, e.capture_band_mm);
+        extent = OutlineOfDensePart(pts, captured, fit.normal);
         RequirePlateCoverage(extent, a, o, e.capture_band_mm, where);
         e.plate_outline_length_mm = extent.length_mm();
         e.plate_outline_width_mm = extent.width_mm();
-        e.plate_points_off_outline = extent.points_outside;
         std::vector<int> next;
         for (int i : captured)
           if (extent.InsideEroded(pts[i], o.plate_edge_margin_mm)) next.push_back(i);
@@ -822,6 +824,21 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
           throw NotTheArtifactError(where, "the plate's face is too small after the edge margin: " + fit.message);
       }
       require_points(static_cast<int>(fit.inliers.size()), "plate");
+      // Where the captured points off the face are: outside the outline, or
+      // in the edge margin inside it (face and captured are both ascending).
+      // The outline's sides pass through its outermost points: on it is in
+      // (1 um, for rounding).
+      e.plate_points_off_outline = 0;
+      for (size_t k = 0, f = 0; k < captured.size(); ++k) {
+        if (f < face.size() && face[f] == captured[k]) {
+          ++f;
+        } else if (extent.InsideEroded(pts[captured[k]], -1e-3)) {
+          ++e.points_in_edge_margin;
+        } else {
+          ++e.plate_points_off_outline;
+        }
+      }
+      e.points_off_artifact = e.points_total - static_cast<int>(captured.size()) + e.plate_points_off_outline;
       int excluded = 0;
       const std::vector<int> kept = ExcludeWorst(fit.inliers, fit.residuals_mm, o.excluded_fraction_max, &excluded);
       fit = FitPlaneLeastSquares(pts, kept);

@@ -1407,6 +1407,67 @@ TEST(Vdi2634, AGapAcrossThePlateKeepsBothSidesInTheFigures) {
   EXPECT_FALSE(split.pass()) << "the warped strip beyond the gap left the figures";
 }
 
+// Every given point is counted once, in exactly one of off the artifact,
+// the plate's edge margin, excluded and used. Truth: the 130 mm plate at
+// 1 mm (noise 0.05 mm along its normal only), 400 points of a table 20 mm
+// below it (outside the 5 mm capture band) and 2 strays in its plane 10 mm
+// beyond a side (in the band, off the outline). Every 3 mm cell of the plate
+// is full, so its outline passes through its outermost points exactly, and
+// an edge margin of 5.5 mm puts the eroded border half-way between two rows
+// of points: the face is the 119 x 119 points within 59.5 mm of the centre,
+// the edge margin the other 131^2 - 119^2 = 3000, with no rounding to allow
+// for, and off the artifact exactly the 402 others. Before, the edge
+// margin's points were in no count (the columns summed to 3000 fewer than
+// the cloud). A sphere and a ball bar, with outliers and the shaft's cone,
+// sum alike (they have no edge margin).
+TEST(Vdi2634, EveryPointIsCountedOnceOffTheArtifactInTheEdgeMarginExcludedOrUsed) {
+  std::mt19937 rng(41);
+  const Eigen::Vector3d c(0, 0, 5), normal(0, 0, 1);
+  const Eigen::Vector3d x = normal.unitOrthogonal();
+  std::vector<Eigen::Vector3d> cloud = PlatePoints(c, normal, 130, 1.0, 0.05, &rng);
+  ASSERT_EQ(cloud.size(), 131u * 131u);
+  std::uniform_real_distribution<double> across(-60, 60);
+  const Eigen::Vector3d y = normal.cross(x);
+  for (int k = 0; k < 400; ++k) cloud.push_back(c - 20 * normal + across(rng) * x + across(rng) * y);
+  cloud.push_back(c + 75 * x);
+  cloud.push_back(c + 75 * x + 3 * y);
+  auto sums = [](const ArtifactEvaluation& e) {
+    EXPECT_EQ(e.points_off_artifact + e.points_in_edge_margin + e.points_excluded + e.points_used(), e.points_total);
+    EXPECT_EQ(e.points_excluded + e.points_used(), e.points_on_artifact);
+  };
+  VerifyOptions margin;
+  margin.plate_edge_margin_mm = 5.5;
+  const ArtifactEvaluation plate = EvaluateArtifact(PlateArtifact(), cloud, margin, "plate.ply");
+  EXPECT_EQ(plate.points_total, static_cast<int>(cloud.size()));
+  sums(plate);
+  EXPECT_EQ(plate.points_off_artifact, 402);
+  EXPECT_EQ(plate.plate_points_off_outline, 2);
+  EXPECT_EQ(plate.points_in_edge_margin, 131 * 131 - 119 * 119);
+  EXPECT_EQ(plate.points_on_artifact, 119 * 119);
+
+  testing::NoiseSpec noise;
+  noise.points = 20000;
+  const testing::NoisyCloud sphere = testing::SeenByTwoFacingCameras(
+      [](double a, double b, Eigen::Vector3d* n) {
+        const double z = 2 * a - 1, phi = 2 * kPi * b, s = std::sqrt(1 - z * z);
+        *n = Eigen::Vector3d(s * std::cos(phi), s * std::sin(phi), z);
+        return Eigen::Vector3d(Eigen::Vector3d(0, 0, 200) + 19.05 * *n);
+      },
+      Eigen::Vector3d(0, 0, 200), noise);
+  const ArtifactEvaluation e_sphere = EvaluateArtifact(SphereArtifact(), sphere.points, VerifyOptions(), "s.ply");
+  sums(e_sphere);
+  EXPECT_EQ(e_sphere.points_in_edge_margin, 0);
+  EXPECT_GE(e_sphere.points_off_artifact, sphere.outliers / 2);  // most of the box's outliers lie off the band
+
+  auto bar = BallSeenFromBothSides({-50, 0, 0}, 12.7, 0.05, &rng);
+  const auto ball_2 = BallSeenFromBothSides({50, 0, 0}, 12.7, 0.05, &rng);
+  bar.insert(bar.end(), ball_2.begin(), ball_2.end());
+  const ArtifactEvaluation e_bar = EvaluateArtifact(BallBarArtifact(), bar, VerifyOptions(), "bar.ply");
+  sums(e_bar);
+  EXPECT_EQ(e_bar.points_in_edge_margin, 0);
+  EXPECT_GT(e_bar.points_off_artifact, 0);  // the caps' points within 60 deg of the bar axis
+}
+
 TEST(Vdi2634, StrayPointsDoNotMakeTooLittleOfThePlateEnough) {
   // Truth: 60 x 60 mm of the 130 mm plate seen (46%: under the half that
   // must be), and two stray points in its plane at (40, 40) and (-40, -40) mm
