@@ -718,8 +718,8 @@ TEST(VerifyCli, ACloudThatIsNotTheArtifactIsNotEvaluatedAndTheOtherPositionsAreS
       EXPECT_FALSE(p["judged"].get<bool>()) << p;
       EXPECT_TRUE(p["pass"].is_null()) << p;
       EXPECT_TRUE(p["figures"].is_array() && p["figures"].empty()) << p;
-      for (const char* key :
-           {"points_on_artifact", "points_excluded", "points_used", "residual_mean_abs_mm", "residual_std_mm"})
+      for (const char* key : {"points_off_artifact", "points_in_edge_margin", "points_on_artifact", "points_excluded",
+                              "points_used", "residual_mean_abs_mm", "residual_std_mm"})
         EXPECT_TRUE(p[key].is_null()) << key << " " << p;
       EXPECT_FALSE(p.contains("spheres")) << p;
       EXPECT_EQ(p["not_judged_reason"].get<std::string>().rfind("not evaluated: ", 0), 0u) << p;
