@@ -660,11 +660,15 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       std::vector<Eigen::Vector3d> located_centers_mm;
       const double tolerance_mm = RadiusToleranceMm(LocateBandMm(o, a.mpe.sphere_spacing_mm), r);
       // other_fit: the other ball's free fit, whose size says whether a
-      // scale error is plausible (ScaleText; none named if it failed).
+      // scale error is plausible (ScaleText; none named if it failed, or if
+      // the two fits overlap: two balls cannot, so they are one sphere found
+      // twice, and its agreeing with itself is no evidence).
       auto require_certified_size = [&](int ball, const std::vector<int>& indices, const SphereFit& fit,
                                         const SphereFit& other_fit) {
         if (!LeftCertifiedSize(fit, r, tolerance_mm)) return;
-        const double other_scale = other_fit.ok && other_fit.converged ? other_fit.radius_mm / r : NAN;
+        const bool two_balls =
+            (fit.center_mm - other_fit.center_mm).norm() >= std::abs(fit.radius_mm) + std::abs(other_fit.radius_mm);
+        const double other_scale = other_fit.ok && other_fit.converged && two_balls ? other_fit.radius_mm / r : NAN;
         throw NotTheArtifactError(where, BallText(ball, located_centers_mm[ball]) + ": " +
                                              LeftCertifiedSizeText(pts, indices, located_centers_mm[ball], fit, r,
                                                                    tolerance_mm, band, other_scale));
