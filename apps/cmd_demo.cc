@@ -46,10 +46,12 @@ int RunDemo(int argc, char** argv) {
   CLI::App app{
       "The whole product on the embedded default rig (2 facing modules, 752x582 cameras, 90 mm baseline, "
       "200 mm working distance, 51x51 laser grids): simulate a dataset, calibrate the rig from its target "
-      "captures, reconstruct the cup (active and passive), verify the sphere and the ball bar (VDI/VDE 2634-2), "
-      "and run the nightly check on fresh captures of the unmoved rig and of a bumped one. Every step prints the "
-      "command it runs, so each can be repeated by hand.\n\n"
-      "Exit code 0 when every step behaved as expected (including the check flagging the bump).\n\n"
+      "captures, reconstruct the cup (active and passive) and score it against the simulator's truth, verify the "
+      "sphere and the ball bar (VDI/VDE 2634-2), and run the nightly check on fresh captures of the unmoved rig "
+      "and of a bumped one. Every step prints the command it runs, so each can be repeated by hand.\n\n"
+      "Exit codes: 0 every step behaved as expected (including the check flagging the bump); 1 a step did not "
+      "(a line 'demo: STEP: exit N, expected M' names it; a failed simulate or calibrate ends the demo there); 2 "
+      "bad usage, or an --out that cannot be made.\n\n"
       "Example:\n  stereorig demo --out /tmp/stereorig-demo",
       "stereorig demo"};
   std::string out = "stereorig-demo";

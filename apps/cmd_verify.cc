@@ -256,8 +256,10 @@ int RunVerify(int argc, char** argv) {
                 repeated[i].same_file ? "the same cloud as" : "a byte-identical copy of the cloud of",
                 repeated[i].earlier + 1, PrintableText(clouds[i]).c_str());
   }
-  std::printf("%-8s %-6s %10s %8s %7s %4s %8s %7s %8s %8s %8s %10s\n", "position", "figure", "value_mm", "u_mm",
-              "mpe_mm", "pass", "cloud", "filled", "artifact", "excluded", "used", "mean|e|_mm");
+  // The point counts: cloud, then where each of its points went, each in
+  // exactly one column (cloud = filled + off + edge + excluded + used).
+  std::printf("%-8s %-6s %10s %8s %7s %4s %8s %7s %8s %7s %8s %8s %10s\n", "position", "figure", "value_mm", "u_mm",
+              "mpe_mm", "pass", "cloud", "filled", "off", "edge", "excluded", "used", "mean|e|_mm");
   // Traceable: which certificate, its certified values, when and by what.
   nlohmann::json report = {{"artifact", artifact.name},
                            {"artifact_file", artifact_path},
@@ -273,6 +275,8 @@ int RunVerify(int argc, char** argv) {
     nlohmann::json pj = {{"cloud", clouds[i]},
                          {"points_total", e.points_total + filled_skipped[i]},
                          {"points_filled_skipped", filled_skipped[i]},
+                         {"points_off_artifact", e.points_off_artifact},
+                         {"points_in_edge_margin", e.points_in_edge_margin},
                          {"points_on_artifact", e.points_on_artifact},
                          {"points_excluded", e.points_excluded},
                          {"points_used", e.points_used()},
@@ -284,25 +288,27 @@ int RunVerify(int argc, char** argv) {
                          {"pass", nullptr},
                          {"figures", nlohmann::json::array()}};
     if (!e.evaluated) {  // nothing was fitted: no counts on the artifact, no residuals
-      for (const char* key :
-           {"points_on_artifact", "points_excluded", "points_used", "residual_mean_abs_mm", "residual_std_mm"})
+      for (const char* key : {"points_off_artifact", "points_in_edge_margin", "points_on_artifact", "points_excluded",
+                              "points_used", "residual_mean_abs_mm", "residual_std_mm"})
         pj[key] = nullptr;
-      std::printf("%-8zu %-6s %10s %8s %7s %4s %8d %7d %8s %8s %8s %10s\n", i + 1, "-", "-", "-", "-", "-",
-                  e.points_total + filled_skipped[i], filled_skipped[i], "-", "-", "-", "-");
+      std::printf("%-8zu %-6s %10s %8s %7s %4s %8d %7d %8s %7s %8s %8s %10s\n", i + 1, "-", "-", "-", "-", "-",
+                  e.points_total + filled_skipped[i], filled_skipped[i], "-", "-", "-", "-", "-");
     }
     if (e.judged()) {
       pj["pass"] = e.pass();
     } else {
       pj["not_judged_reason"] = e.not_judged_reason;
     }
+    // The edge margin is the plate's alone: '-' for the others.
+    const std::string edge = e.type == ArtifactType::kPlate ? std::to_string(e.points_in_edge_margin) : "-";
     for (const Figure& f : e.figures) {
-      std::printf("%-8zu %-6s %10.4f %8s %7.4f %4s %8d %7d %8d %8d %8d %10.4f\n", i + 1, f.name.c_str(), f.value_mm,
+      std::printf("%-8zu %-6s %10.4f %8s %7.4f %4s %8d %7d %8d %7s %8d %8d %10.4f\n", i + 1, f.name.c_str(), f.value_mm,
                   UncertaintyText(f).c_str(), f.mpe_mm,
                   !e.judged() || !f.judged ? "-"
                   : f.pass                 ? "yes"
                                            : "NO",
-                  e.points_total + filled_skipped[i], filled_skipped[i], e.points_on_artifact, e.points_excluded,
-                  e.points_used(), e.residual_mean_abs_mm);
+                  e.points_total + filled_skipped[i], filled_skipped[i], e.points_off_artifact, edge.c_str(),
+                  e.points_excluded, e.points_used(), e.residual_mean_abs_mm);
       pj["figures"].push_back(FigureJson(f, e.judged(), artifact));
     }
     for (const Figure& f : e.figures) {
@@ -315,8 +321,9 @@ int RunVerify(int argc, char** argv) {
     PrintSpheres(i + 1, e);
     if (!e.sphere_centers_mm.empty()) pj["spheres"] = SpheresJson(e);
     if (e.type == ArtifactType::kPlate && e.evaluated) {
-      std::printf("%-8zu plate face: outline %.1f x %.1f mm (its dense part; %d captured points outside it)\n", i + 1,
-                  e.plate_outline_length_mm, e.plate_outline_width_mm, e.plate_points_off_outline);
+      std::printf(
+          "%-8zu plate face: outline %.1f x %.1f mm (its dense part; %d captured points outside it, counted in off)\n",
+          i + 1, e.plate_outline_length_mm, e.plate_outline_width_mm, e.plate_points_off_outline);
       pj["plate_outline_mm"] = {e.plate_outline_length_mm, e.plate_outline_width_mm};
       pj["plate_points_off_outline"] = e.plate_points_off_outline;
     }
@@ -325,10 +332,16 @@ int RunVerify(int argc, char** argv) {
   }
   std::printf(
       "u_mm = the figure's standard uncertainty (k = 1): the fit's (its covariance) and the certificate's (U / k) "
-      "in quadrature; points: cloud = all vertices; "
-      "filled = added by hole filling (module 255), skipped; artifact = within the capture band; excluded = the "
-      "largest residuals (<= 0.3%%); used = in the figures; mean|e|_mm = the mean |residual| of the points used to "
+      "in quadrature; points: cloud = all vertices = filled + off + edge + excluded + used; "
+      "filled = added by hole filling (module 255), skipped; off = not the artifact's (outside the capture band%s); "
+      "edge = in the plate's %.0f mm edge margin, not evaluated (- for other artifacts); excluded = the "
+      "largest residuals (<= 0.3%% of those on the artifact); used = in the figures; mean|e|_mm = the mean |residual| "
+      "of the points used to "
       "the fitted shape(s); pass: under the decision rule, - = not judged (the line NOT JUDGED says why)%s\n",
+      artifact.type == ArtifactType::kBallBar ? ", or in the shaft's cone"
+      : artifact.type == ArtifactType::kPlate ? ", or outside the face's outline"
+                                              : "",
+      options.plate_edge_margin_mm,
       artifact.type == ArtifactType::kPlate
           ? ""
           : "; cap half-angle = the cone about the points' mean direction from the sphere's centre that holds 99% of "

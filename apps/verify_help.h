@@ -6,7 +6,8 @@
 
 namespace stereorig {
 
-inline constexpr const char* kVerifyDescription = R"(Accuracy of a reconstruction against a reference artifact with certified dimensions, as VDI/VDE 2634
+inline constexpr const char* kVerifyDescription =
+    R"(Accuracy of a reconstruction against a reference artifact with certified dimensions, as VDI/VDE 2634
 Part 2 defines it: probing error form P_F and size P_S (sphere), sphere-spacing error SD (ball bar),
 flatness F (plate). Give one --cloud per position of the artifact; the procedure asks for 7 or more
 spread through the volume (fewer keep their verdict, with a note under it). Each figure is judged
@@ -60,17 +61,19 @@ any failure (a larger u only widens the guard band); under guarded-rejection nev
 undo it). Otherwise it is shown with '-' in the pass column and has no zone.
 
 The table gives, per position, each figure's standard uncertainty (u_mm; both parts on a line of
-their own), the points in the cloud, the filled ones skipped, those on the artifact, those excluded
-and those used, and per sphere its diameter, the diameter's standard uncertainty, the half-angle of
-the cap its points cover and its form (the range of its residuals; on a ball bar reported, not
-judged: a patch one grid period off on one ball shows there); per plate the outline of its face's
-dense part.
+their own), the points in the cloud and where each of them went, in exactly one column: filled
+(skipped), off (not the artifact's: outside the capture band, in a ball bar's shaft cone, off a
+plate's outline), edge (in a plate's 5 mm edge margin), excluded and used; per sphere its diameter,
+the diameter's standard uncertainty, the half-angle of the cap its points cover and its form (the
+range of its residuals; on a ball bar reported, not judged: a patch one grid period off on one ball
+shows there); per plate the outline of its face's dense part.
 
 Exit codes: 0 every figure passes; 1 a figure of a judged position fails (under the decision rule);
 2 bad input, or a position not judged or not evaluated (and none failed).
 )";
 
-inline constexpr const char* kVerifyFooter = R"(Artifact files (YAML, mm; docs/verify-and-check.md; examples in datasets/artifacts/). The keys each
+inline constexpr const char* kVerifyFooter =
+    R"(Artifact files (YAML, mm; docs/verify-and-check.md; examples in datasets/artifacts/). The keys each
 kind requires; *_uncertainty_mm (the certificate's expanded U, default 0), uncertainty_coverage_factor
 (its k, default 2), name and mpe_mm (default 1.5 mm each) are optional:
 

@@ -319,13 +319,27 @@ TEST(Cli, AnInconsistentOffDiagonalSIsRejected) {
 }
 
 TEST(Cli, EverySubcommandsHelpTeachesWithAnExample) {
-  for (const char* c :
-       {"simulate", "target", "calibrate", "reconstruct", "match", "verify", "check", "bench", "rig", "demo"}) {
+  for (const char* c : {"simulate", "target", "calibrate", "reconstruct", "match", "verify", "check", "bench", "score",
+                        "tune", "rig", "demo"}) {
     const Result r = RunCli(std::string(c) + " --help");
     EXPECT_EQ(r.code, 0) << c;
     EXPECT_NE(r.out.find("xample"), std::string::npos) << c << " --help has no example";
     EXPECT_NE(r.out.find("--"), std::string::npos) << c << " --help lists no options";
   }
+}
+
+// The commands whose exit 1 means something other than bad input say what
+// in their help, 2 included: demo's said only when it exits 0 (and left out
+// the score step it runs), though it exits 1 on a step that misbehaves and
+// 2 on bad usage (docs/formats.md, "CLI").
+TEST(Cli, TheHelpOfEveryCommandThatExitsOneSaysWhen) {
+  for (const auto& [command, one] : {std::pair{"verify", "1 a figure of a judged position fails"},
+                                     std::pair{"check", "1 recalibrate"}, std::pair{"demo", "1 a step did not"}}) {
+    const Result r = RunCli(std::string(command) + " --help");
+    EXPECT_NE(r.out.find(one), std::string::npos) << command << ": " << r.out;
+    EXPECT_NE(r.out.find("2 bad"), std::string::npos) << command << ": " << r.out;
+  }
+  EXPECT_NE(RunCli("demo --help").out.find("score it against the simulator's truth"), std::string::npos);
 }
 
 // Every file or folder a command writes, given as an empty path (a shell

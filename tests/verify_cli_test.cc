@@ -5,6 +5,7 @@
 
 #include <sys/wait.h>
 #include <unistd.h>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -430,6 +431,74 @@ TEST(VerifyCli, HoleFillingsPointsAreSkippedAndCounted) {
   EXPECT_LT(std::abs(j["figures"][1]["value_mm"].get<double>()), 0.005);
 }
 
+// Every vertex of the cloud lands in exactly one of the table's count
+// columns after `cloud` (filled, off, edge, excluded, used) and of the
+// report's counts: a 130 x 120 mm plate at 1 mm (noise 0.05 mm), 300 points
+// of a table 20 mm below it, 2 strays in its plane beyond a side, and 500
+// points of hole filling (module 255) over its middle. Before, the points in
+// the plate's 5 mm edge margin (~2400 here) were in no column: cloud
+// exceeded the columns by as many, and the report had no count of them.
+TEST(VerifyCli, EveryPointOfAPlateLandsInExactlyOneColumnOfTheTableAndTheReport) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0, 0.05);
+  std::uniform_real_distribution<double> across(-50, 50);
+  const std::string cloud = ::testing::TempDir() + "/plate_counts_" + std::to_string(getpid()) + ".ply";
+  int vertices = 0;
+  {
+    std::ostringstream body;
+    body.precision(17);
+    for (int u = -65; u <= 65; ++u)
+      for (int v = -60; v <= 60; ++v, ++vertices) body << u << " " << v << " " << 200 + noise(rng) << " 0\n";
+    for (int k = 0; k < 300; ++k, ++vertices) body << across(rng) << " " << across(rng) << " 180 0\n";
+    body << "80 0 200 0\n80 5 200 0\n";
+    vertices += 2;
+    for (int k = 0; k < 500; ++k, ++vertices) body << across(rng) << " " << across(rng) << " 200.5 255\n";
+    std::ofstream f(cloud);
+    f << "ply\nformat ascii 1.0\nelement vertex " << vertices
+      << "\nproperty double x\nproperty double y\nproperty double z\nproperty uchar module\nend_header\n"
+      << body.str();
+  }
+  const std::string report = ::testing::TempDir() + "/plate_counts_" + std::to_string(getpid()) + ".json";
+  const auto r = RunCli("verify --artifact " +
+                        WriteArtifact("format: stereorig-artifact\nversion: 1\nunits: mm\nname: p\ntype: plate\n"
+                                      "length_mm: 130\nwidth_mm: 120\n") +
+                        " --cloud " + cloud + " --report " + report);
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  // The table's header and the position's row, by column name.
+  std::istringstream lines(r.out);
+  std::vector<std::string> header, row;
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream words(line);
+    std::vector<std::string> w{std::istream_iterator<std::string>(words), {}};
+    if (!w.empty() && w[0] == "position") header = w;
+    if (w.size() == header.size() && w.size() > 1 && w[0] == "1" && w[1] == "F") row = w;
+  }
+  ASSERT_FALSE(row.empty()) << r.out;
+  auto column = [&](const std::string& name) {
+    const auto at = std::find(header.begin(), header.end(), name);
+    EXPECT_NE(at, header.end()) << name << " in " << r.out;
+    return at == header.end() ? -1 : std::stoi(row[at - header.begin()]);
+  };
+  EXPECT_EQ(column("cloud"), vertices);
+  EXPECT_EQ(column("filled"), 500);
+  EXPECT_EQ(column("off"), 302);
+  // The 5 mm border: the plate's points outside 121 x 111 of them, and those
+  // on the eroded border itself (at 60 and 55 mm) either way by rounding.
+  EXPECT_GE(column("edge"), 131 * 121 - 121 * 111);
+  EXPECT_LE(column("edge"), 131 * 121 - 119 * 109);
+  EXPECT_EQ(column("filled") + column("off") + column("edge") + column("excluded") + column("used"), vertices) << r.out;
+  std::ifstream f(report);
+  const auto j = nlohmann::json::parse(f)["positions"][0];
+  EXPECT_EQ(j["points_total"].get<int>(), vertices);
+  EXPECT_EQ(j["points_filled_skipped"].get<int>() + j["points_off_artifact"].get<int>() +
+                j["points_in_edge_margin"].get<int>() + j["points_excluded"].get<int>() + j["points_used"].get<int>(),
+            vertices)
+      << j.dump();
+  EXPECT_EQ(j["points_in_edge_margin"].get<int>(), column("edge"));
+  EXPECT_EQ(j["points_on_artifact"].get<int>(), j["points_excluded"].get<int>() + j["points_used"].get<int>());
+  EXPECT_EQ(j["plate_points_off_outline"].get<int>(), 2);
+}
+
 // A cap of the certified sphere, `half_angle_deg` of it, 2000 points with the
 // runtime's noise (0.05 mm, radial), uniform in area: an ascii PLY.
 std::string WriteCap(const std::string& name, double half_angle_deg, unsigned seed) {
@@ -649,8 +718,8 @@ TEST(VerifyCli, ACloudThatIsNotTheArtifactIsNotEvaluatedAndTheOtherPositionsAreS
       EXPECT_FALSE(p["judged"].get<bool>()) << p;
       EXPECT_TRUE(p["pass"].is_null()) << p;
       EXPECT_TRUE(p["figures"].is_array() && p["figures"].empty()) << p;
-      for (const char* key :
-           {"points_on_artifact", "points_excluded", "points_used", "residual_mean_abs_mm", "residual_std_mm"})
+      for (const char* key : {"points_off_artifact", "points_in_edge_margin", "points_on_artifact", "points_excluded",
+                              "points_used", "residual_mean_abs_mm", "residual_std_mm"})
         EXPECT_TRUE(p[key].is_null()) << key << " " << p;
       EXPECT_FALSE(p.contains("spheres")) << p;
       EXPECT_EQ(p["not_judged_reason"].get<std::string>().rfind("not evaluated: ", 0), 0u) << p;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -275,9 +276,6 @@ struct ArtifactSphereFit {
   Eigen::Vector3d located_center_mm = Eigen::Vector3d::Zero();  // of the sphere of the certified size
   SphereFit fit;
   int excluded = 0;
-  // Where fit.ok is false because a converged free fit left the certified
-  // size: its radius over the certified one (the scale ScaleText may name).
-  std::optional<double> left_size_scale;
 };
 
 // How far a free fit's radius may leave the certified one: RANSAC's own
@@ -373,6 +371,27 @@ std::string LeftCertifiedSizeText(const std::vector<Eigen::Vector3d>& pts, const
   return text + buf;
 }
 
+// On a ball bar's second ball: the first ball's fitted radius over the
+// certified one, measured as the second pass measures it once this ball's
+// centre (the argument, mm) gives the bar's axis: NaN where that fit fails.
+// Empty for a sphere, or a ball bar's first ball (no other ball yet).
+using OtherBallScaleAt = std::function<double(const Eigen::Vector3d& center_mm)>;
+
+// A ball's points: those within the capture band of its sphere and outside
+// the shaft's cone about the bar axis (towards the other ball's centre).
+std::vector<int> BallPointsOffShaft(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& center_mm,
+                                    double radius_mm, double band_mm, const Eigen::Vector3d& other_center_mm,
+                                    double cos_cone) {
+  const Eigen::Vector3d axis = (other_center_mm - center_mm).normalized();
+  std::vector<int> in;
+  for (int i = 0; i < static_cast<int>(pts.size()); ++i) {
+    const Eigen::Vector3d d = pts[i] - center_mm;
+    if (std::abs(d.norm() - radius_mm) >= band_mm || d.norm() < 1e-9 || d.normalized().dot(axis) > cos_cone) continue;
+    in.push_back(i);
+  }
+  return in;
+}
+
 // When no sphere of the certified size is found: whether the cloud holds a
 // sphere of another size (RANSAC with the radius free, within half to twice
 // the certified one, at least min_points points within the band), and the
@@ -380,9 +399,11 @@ std::string LeftCertifiedSizeText(const std::vector<Eigen::Vector3d>& pts, const
 // ball bar's first ball (first_of_ball_bar) the scale is named only if the
 // cloud holds a second sphere off the same way (ScaleText): a single sphere
 // given for a ball bar is the wrong artifact file, not a scale (it read
-// "+50% off", a user's walkthrough found).
+// "+50% off", a user's walkthrough found). On its second ball, only if the
+// first, measured without the rod towards the sphere found
+// (other_ball_scale_at), is off the same way.
 std::string OtherSizeText(const std::vector<Eigen::Vector3d>& pts, double nominal_radius_mm, double locate_band_mm,
-                          std::optional<double> other_ball_scale, const VerifyOptions& o,
+                          const OtherBallScaleAt& other_ball_scale_at, const VerifyOptions& o,
                           bool first_of_ball_bar = false) {
   SphereFitOptions so;
   so.inlier_threshold_mm = locate_band_mm;
@@ -396,6 +417,8 @@ std::string OtherSizeText(const std::vector<Eigen::Vector3d>& pts, double nomina
   };
   const SphereFit other = FitSphereRobust(pts, so);
   if (!plausible(other)) return "";
+  std::optional<double> other_ball_scale;
+  if (other_ball_scale_at) other_ball_scale = other_ball_scale_at(other.center_mm);
   if (first_of_ball_bar) {
     other_ball_scale = std::numeric_limits<double>::quiet_NaN();  // no second sphere: no scale named
     std::vector<Eigen::Vector3d> rest;
@@ -431,13 +454,12 @@ std::string BallText(int ball, const Eigen::Vector3d& center_mm) {
 // locating: P_S and SD are measured, not assumed; a free fit that leaves the
 // certified size (RANSAC's own tolerance) or does not converge is reported
 // as such.
-// other_ball_scale: on a ball bar's second ball, the first's fitted radius
-// over the certified one (ScaleText); first_of_ball_bar: the ball bar's
+// other_ball_scale_at: on a ball bar's second ball, the first's size
+// (OtherBallScaleAt, for ScaleText); first_of_ball_bar: the ball bar's
 // first ball, whose other is not known yet.
 ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, double nominal_radius,
                                     double locate_band_mm, double capture_band_mm, const VerifyOptions& o,
-                                    std::optional<double> other_ball_scale = std::nullopt,
-                                    bool first_of_ball_bar = false) {
+                                    const OtherBallScaleAt& other_ball_scale_at = {}, bool first_of_ball_bar = false) {
   SphereFitOptions so;
   so.inlier_threshold_mm = locate_band_mm;
   so.expected_radius_mm = nominal_radius;
@@ -449,13 +471,18 @@ ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, dou
   const SphereFit located = FitSphereRobust(pts, so);
   if (!located.ok) {
     out.fit = located;
-    out.fit.message += OtherSizeText(pts, nominal_radius, locate_band_mm, other_ball_scale, o, first_of_ball_bar);
+    out.fit.message += OtherSizeText(pts, nominal_radius, locate_band_mm, other_ball_scale_at, o, first_of_ball_bar);
     return out;
   }
   // Found at the certified size, a ball bar's first ball that then leaves it
   // names no scale: the other ball, which would have to be off the same way,
   // is not fitted yet.
-  if (first_of_ball_bar) other_ball_scale = std::numeric_limits<double>::quiet_NaN();
+  std::optional<double> other_ball_scale;
+  if (first_of_ball_bar) {
+    other_ball_scale = std::numeric_limits<double>::quiet_NaN();
+  } else if (other_ball_scale_at) {
+    other_ball_scale = other_ball_scale_at(located.center_mm);
+  }
   out.located = true;
   out.located_center_mm = located.center_mm;
   // The artifact's points are those within the capture band of the fitted
@@ -473,7 +500,6 @@ ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, dou
       out.fit.ok = false;
       out.fit.message = LeftCertifiedSizeText(pts, in, located.center_mm, fit, nominal_radius, so.radius_tolerance_mm,
                                               capture_band_mm, other_ball_scale);
-      if (fit.ok && fit.converged) out.left_size_scale = fit.radius_mm / nominal_radius;
       return out;
     }
     std::vector<int> next = WithinSphereShell(pts, fit.center_mm, fit.radius_mm, capture_band_mm);
@@ -485,7 +511,6 @@ ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, dou
   if (LeftCertifiedSize(out.fit, nominal_radius, so.radius_tolerance_mm)) {
     out.fit.message = LeftCertifiedSizeText(pts, kept, located.center_mm, out.fit, nominal_radius,
                                             so.radius_tolerance_mm, capture_band_mm, other_ball_scale);
-    if (out.fit.ok && out.fit.converged) out.left_size_scale = out.fit.radius_mm / nominal_radius;
     out.fit.ok = false;
   }
   return out;
@@ -602,6 +627,7 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       require_points(static_cast<int>(fit.inliers.size()) + excluded, "sphere");
       e.points_on_artifact = static_cast<int>(fit.inliers.size()) + excluded;
       e.points_excluded = excluded;
+      e.points_off_artifact = e.points_total - e.points_on_artifact;  // outside the capture band
       e.sphere_centers_mm = {fit.center_mm};
       e.sphere_diameters_mm = {2 * fit.radius_mm};
       const SphereFitUncertainty u = SphereUncertainty(pts, fit);
@@ -634,19 +660,24 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       std::vector<Eigen::Vector3d> located_centers_mm;
       const double tolerance_mm = RadiusToleranceMm(LocateBandMm(o, a.mpe.sphere_spacing_mm), r);
       // other_fit: the other ball's free fit, whose size says whether a
-      // scale error is plausible (ScaleText; none named if it failed).
+      // scale error is plausible (ScaleText; none named if it failed, or if
+      // the two fits overlap: two balls cannot, so they are one sphere found
+      // twice, and its agreeing with itself is no evidence).
       auto require_certified_size = [&](int ball, const std::vector<int>& indices, const SphereFit& fit,
                                         const SphereFit& other_fit) {
         if (!LeftCertifiedSize(fit, r, tolerance_mm)) return;
-        const double other_scale = other_fit.ok && other_fit.converged ? other_fit.radius_mm / r : NAN;
+        const bool two_balls =
+            (fit.center_mm - other_fit.center_mm).norm() >= std::abs(fit.radius_mm) + std::abs(other_fit.radius_mm);
+        const double other_scale = other_fit.ok && other_fit.converged && two_balls ? other_fit.radius_mm / r : NAN;
         throw NotTheArtifactError(where, BallText(ball, located_centers_mm[ball]) + ": " +
                                              LeftCertifiedSizeText(pts, indices, located_centers_mm[ball], fit, r,
                                                                    tolerance_mm, band, other_scale));
       };
-      std::optional<double> first_ball_scale;  // ball 1's free fit over the certified radius, for ball 2's search
+      const double cos_cone = std::cos(o.ballbar_shaft_cone_deg * M_PI / 180.0);
+      OtherBallScaleAt first_ball_scale_at;  // for ball 2's search
       for (int ball = 0; ball < 2; ++ball) {
         const ArtifactSphereFit found = FitArtifactSphere(remaining, r, LocateBandMm(o, a.mpe.sphere_spacing_mm), band,
-                                                          o, first_ball_scale, /*first_of_ball_bar=*/ball == 0);
+                                                          o, first_ball_scale_at, /*first_of_ball_bar=*/ball == 0);
         if (!found.located) {
           throw NotTheArtifactError(
               where, "ball " + std::to_string(ball + 1) + " of the ball bar not found: " + found.fit.message);
@@ -662,7 +693,20 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
                                   : SphereAt(remaining, WithinSphereShell(remaining, found.located_center_mm, r, band),
                                              found.located_center_mm, r);
         const int excluded = found.fit.ok ? found.excluded : 0;
-        if (ball == 0) first_ball_scale = found.fit.ok ? fit.radius_mm / r : found.left_size_scale.value_or(NAN);
+        // Ball 1's size as evidence of a scale error for ball 2's search
+        // (ScaleText): its free fit outside the shaft cone towards where
+        // ball 2 is, as the second pass fits it. Not its first fit: that
+        // held the rod's points in its band, which pulled the demo's
+        // 25.4 mm balls (one module's view) to 30.1 mm, and a truly larger
+        // ball 2 then read as the same scale error.
+        if (ball == 0) {
+          first_ball_scale_at = [&pts, center = fit.center_mm, radius = fit.radius_mm, r, band,
+                                 cos_cone](const Eigen::Vector3d& ball_2_center_mm) {
+            const std::vector<int> own = BallPointsOffShaft(pts, center, radius, band, ball_2_center_mm, cos_cone);
+            const SphereFit f = RefineSphere(pts, own, center, radius, kRefineIterations);
+            return f.ok && f.converged ? f.radius_mm / r : std::numeric_limits<double>::quiet_NaN();
+          };
+        }
         located_centers_mm.push_back(found.located_center_mm);
         require_points(static_cast<int>(fit.inliers.size()) + excluded, "ball bar's spheres");
         excluded_total += excluded;
@@ -681,7 +725,6 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       // bar axis; the sets and fits are iterated to their fixed point, then
       // the worst points are excluded and each ball is refitted.
       {
-        const double cos_cone = std::cos(o.ballbar_shaft_cone_deg * M_PI / 180.0);
         std::vector<Eigen::Vector3d> centers = e.sphere_centers_mm;
         std::vector<double> radii = {0.5 * e.sphere_diameters_mm[0], 0.5 * e.sphere_diameters_mm[1]};
         std::vector<int> idx[2];
@@ -689,13 +732,7 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
           bool changed = false;
           std::vector<int> next[2];
           for (int ball = 0; ball < 2; ++ball) {
-            const Eigen::Vector3d axis = (centers[1 - ball] - centers[ball]).normalized();
-            for (int i = 0; i < static_cast<int>(pts.size()); ++i) {
-              const Eigen::Vector3d d = pts[i] - centers[ball];
-              if (std::abs(d.norm() - radii[ball]) >= band || d.norm() < 1e-9 || d.normalized().dot(axis) > cos_cone)
-                continue;
-              next[ball].push_back(i);
-            }
+            next[ball] = BallPointsOffShaft(pts, centers[ball], radii[ball], band, centers[1 - ball], cos_cone);
             require_points(static_cast<int>(next[ball].size()), "ball bar's spheres (outside the shaft cone)");
             changed = changed || next[ball] != idx[ball];
           }
@@ -745,6 +782,7 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       }
       e.points_on_artifact = on_artifact;
       e.points_excluded = excluded_total;
+      e.points_off_artifact = e.points_total - e.points_on_artifact;  // outside both balls' bands, or in the cone
       const Eigen::Vector3d bar_mm = e.sphere_centers_mm[0] - e.sphere_centers_mm[1];
       e.figures = {MakeFigure("SD", bar_mm.norm() - a.center_distance_mm, a.mpe.sphere_spacing_mm)};
       // The two centres' errors are independent (disjoint points); the
@@ -772,14 +810,14 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       // the outline of their dense part (plate_outline.h: a few stray points
       // do not widen it) eroded by the edge margin; the set and the
       // least-squares plane iterated to their fixed point.
-      std::vector<int> face;
+      std::vector<int> face, captured;
+      PlaneOutline extent;  // of `captured`, whose points inside it eroded are `face`
       for (int round = 0; round < kMaxSegmentationRounds; ++round) {
-        const std::vector<int> captured = WithinPlaneBand(pts, fit, e.capture_band_mm);
-        const PlaneOutline extent = OutlineOfDensePart(pts, captured, fit.normal);
+        captured = WithinPlaneBand(pts, fit, e.capture_band_mm);
+        extent = OutlineOfDensePart(pts, captured, fit.normal);
         RequirePlateCoverage(extent, a, o, e.capture_band_mm, where);
         e.plate_outline_length_mm = extent.length_mm();
         e.plate_outline_width_mm = extent.width_mm();
-        e.plate_points_off_outline = extent.points_outside;
         std::vector<int> next;
         for (int i : captured)
           if (extent.InsideEroded(pts[i], o.plate_edge_margin_mm)) next.push_back(i);
@@ -790,6 +828,21 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
           throw NotTheArtifactError(where, "the plate's face is too small after the edge margin: " + fit.message);
       }
       require_points(static_cast<int>(fit.inliers.size()), "plate");
+      // Where the captured points off the face are: outside the outline, or
+      // in the edge margin inside it (face and captured are both ascending).
+      // The outline's sides pass through its outermost points: on it is in
+      // (1 um, for rounding).
+      e.plate_points_off_outline = 0;
+      for (size_t k = 0, f = 0; k < captured.size(); ++k) {
+        if (f < face.size() && face[f] == captured[k]) {
+          ++f;
+        } else if (extent.InsideEroded(pts[captured[k]], -1e-3)) {
+          ++e.points_in_edge_margin;
+        } else {
+          ++e.plate_points_off_outline;
+        }
+      }
+      e.points_off_artifact = e.points_total - static_cast<int>(captured.size()) + e.plate_points_off_outline;
       int excluded = 0;
       const std::vector<int> kept = ExcludeWorst(fit.inliers, fit.residuals_mm, o.excluded_fraction_max, &excluded);
       fit = FitPlaneLeastSquares(pts, kept);

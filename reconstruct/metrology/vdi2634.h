@@ -127,9 +127,18 @@ struct Figure {
 
 struct ArtifactEvaluation {
   ArtifactType type = ArtifactType::kSphere;
+  // Every given point is counted once: points_total = points_off_artifact +
+  // points_in_edge_margin + points_on_artifact, and points_on_artifact =
+  // points_excluded + points_used().
   int points_total = 0;        // given (the measured points of the cloud)
   int points_on_artifact = 0;  // within the capture band (and, plate, the eroded outline; ball bar, off the shaft)
   int points_excluded = 0;     // the standard's <= 0.3% of points_on_artifact
+  // Not the artifact's: outside the capture band; ball bar: also those in
+  // the shaft's cone; plate: also those captured but outside its outline.
+  int points_off_artifact = 0;
+  // Plate: captured, inside its outline but within plate_edge_margin_mm of
+  // it (the sides and chamfers, not evaluated). 0 for the others.
+  int points_in_edge_margin = 0;
   double capture_band_mm = 0;  // the band used (VerifyOptions::capture_band_mm, at least 2 * MPE)
   int points_used() const { return points_on_artifact - points_excluded; }
   std::vector<Figure> figures;
@@ -149,7 +158,8 @@ struct ArtifactEvaluation {
   // grid period off on one ball shows here, where SD may not show it.
   std::vector<double> sphere_form_mm;
   // Plate: the outline of the face's dense part (plate_outline.h), before the
-  // edge margin, and the captured points left outside it (strays, sparse edges).
+  // edge margin, and the captured points outside that rectangle (strays,
+  // sparse edges; part of points_off_artifact).
   double plate_outline_length_mm = 0, plate_outline_width_mm = 0;
   int plate_points_off_outline = 0;
   Eigen::Vector3d plane_normal = Eigen::Vector3d::Zero();

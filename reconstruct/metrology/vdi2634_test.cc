@@ -781,40 +781,82 @@ TEST(Vdi2634, ASmallCapBallThatLeavesTheCertifiedSizeIsNamedNotLost) {
 // cone fits SD to 0.0041 mm and each diameter to 0.009 mm (1 sigma: the
 // fit's covariance, which sphere_uncertainty_test.cc holds to the scatter),
 // so 0.02 and 0.045 mm.
-TEST(Vdi2634, ABallBarSeenByOneModuleIsJudgedWithoutItsRod) {
-  const double sigma_mm = 0.05, r_mm = 12.7, rod_r_mm = 4.0;
-  const Eigen::Vector3d c1(-50, 0, 300), c2(50, 0, 300), camera(-50, -150, 0);
-  std::mt19937 rng(31);
+// A ball bar seen by one module (the camera below the bar, each ball's cap
+// within 70 degrees of its line of sight), with its rod (4 mm radius, the
+// simulator's): each ball's own points in own[ball]. Ball 2 (centre c2) is
+// measured at ball2_scale times its size about its centre: 1 for the
+// artifact, otherwise another ball than the certified one. The rod is seen
+// from ball 1's centre rod_seen_mm along the bar (its whole length: the
+// centre distance).
+// The radius, mm, that a sphere's points within the 5 mm capture band fit
+// (the independent Newton fit from the truth), rod and all: what a ball's
+// first fit reads.
+double CaptureBandRadiusMm(const std::vector<Eigen::Vector3d>& cloud, const Eigen::Vector3d& c, double r_mm) {
+  std::vector<Eigen::Vector3d> band;
+  for (const auto& p : cloud)
+    if (std::abs((p - c).norm() - r_mm) < 5.0) band.push_back(p);
+  Eigen::Vector3d c_band = c;
+  double r_band = r_mm;
+  ReferenceSphereNewton(band, &c_band, &r_band);
+  return r_band;
+}
+
+// Why the evaluation of `cloud` refuses it as not the artifact (its
+// NotTheArtifactError's text); a failure and "" if it is judged.
+std::string RefusalOf(const Artifact& artifact, const std::vector<Eigen::Vector3d>& cloud) {
+  try {
+    EvaluateArtifact(artifact, cloud, VerifyOptions(), "bar.ply");
+  } catch (const NotTheArtifactError& error) {
+    return error.what();
+  }
+  ADD_FAILURE() << "judged";
+  return "";
+}
+
+struct BallBarWithRod {
   std::vector<Eigen::Vector3d> bar, own[2];
+  int rod_points = 0;
+};
+BallBarWithRod BallBarSeenByOneModule(const Eigen::Vector3d& c1, const Eigen::Vector3d& c2, double ball2_scale,
+                                      double rod_seen_mm, std::mt19937* rng) {
+  const double sigma_mm = 0.05, r_mm = 12.7, rod_r_mm = 4.0;
+  const Eigen::Vector3d camera(-50, -150, 0);
+  BallBarWithRod out;
   for (int ball = 0; ball < 2; ++ball) {
     const Eigen::Vector3d c = ball == 0 ? c1 : c2;
-    own[ball] = testing::NoisySurfaceSamples(testing::SphereCapSurface(c, camera - c, r_mm, 70), 3000, sigma_mm, &rng);
-    bar.insert(bar.end(), own[ball].begin(), own[ball].end());
+    const double r = ball == 0 ? r_mm : ball2_scale * r_mm;
+    out.own[ball] = testing::NoisySurfaceSamples(testing::SphereCapSurface(c, camera - c, r, 70), 3000, sigma_mm, rng);
+    out.bar.insert(out.bar.end(), out.own[ball].begin(), out.own[ball].end());
   }
   // The rod's side that faces the camera (within 70 degrees, as the caps),
   // outside the balls: ~8 points per mm^2, twice the caps' ~4.5 (it faces
   // the camera, where a cap's flanks are seen obliquely).
-  const auto rod = testing::CylinderSurface(0.5 * (c1 + c2), c2 - c1, rod_r_mm, 100);
+  const Eigen::Vector3d axis = (c2 - c1).normalized();
+  const auto rod = testing::CylinderSurface(c1 + 0.5 * rod_seen_mm * axis, axis, rod_r_mm, rod_seen_mm);
   std::uniform_real_distribution<double> uniform(0, 1);
   std::normal_distribution<double> noise(0, sigma_mm);
-  int rod_points = 0;
   for (int k = 0; k < 20000; ++k) {
     Eigen::Vector3d n;
-    const Eigen::Vector3d p = rod(uniform(rng), uniform(rng), &n);
+    const Eigen::Vector3d p = rod(uniform(*rng), uniform(*rng), &n);
     if (n.dot((camera - p).normalized()) < std::cos(70 * kPi / 180)) continue;
-    if ((p - c1).norm() < r_mm || (p - c2).norm() < r_mm) continue;
-    bar.push_back(p + noise(rng) * n);
-    ++rod_points;
+    if ((p - c1).norm() < r_mm || (p - c2).norm() < ball2_scale * r_mm) continue;
+    out.bar.push_back(p + noise(*rng) * n);
+    ++out.rod_points;
   }
+  return out;
+}
+
+TEST(Vdi2634, ABallBarSeenByOneModuleIsJudgedWithoutItsRod) {
+  const double r_mm = 12.7;
+  const Eigen::Vector3d c1(-50, 0, 300), c2(50, 0, 300);
+  std::mt19937 rng(31);
+  BallBarWithRod scene = BallBarSeenByOneModule(c1, c2, 1.0, (c2 - c1).norm(), &rng);
+  std::vector<Eigen::Vector3d>& bar = scene.bar;
+  const std::vector<Eigen::Vector3d>* own = scene.own;
+  const int rod_points = scene.rod_points;
   // What refused it: with the rod's points, a ball's capture band fits a
   // diameter beyond RANSAC's tolerance (22.4-28.4 mm).
-  std::vector<Eigen::Vector3d> band_1;
-  for (const auto& p : bar)
-    if (std::abs((p - c1).norm() - r_mm) < 5.0) band_1.push_back(p);
-  Eigen::Vector3d c_band = c1;
-  double r_band = r_mm;
-  ReferenceSphereNewton(band_1, &c_band, &r_band);
-  ASSERT_GT(std::abs(2 * r_band - 2 * r_mm), 3.0) << rod_points << " rod points";
+  ASSERT_GT(std::abs(2 * CaptureBandRadiusMm(bar, c1, r_mm) - 2 * r_mm), 3.0) << rod_points << " rod points";
 
   const ArtifactEvaluation e = EvaluateArtifact(BallBarArtifact(), bar, VerifyOptions(), "bar.ply");
   ASSERT_TRUE(e.evaluated);
@@ -858,6 +900,71 @@ TEST(Vdi2634, ABallBarSeenByOneModuleIsJudgedWithoutItsRod) {
     const std::string what = error.what();
     EXPECT_NE(what.find("or measured at a scale +20% off"), std::string::npos) << what;
   }
+}
+
+// A scale hint rests on honest evidence. Ball 1 of the certified size seen
+// by one module with the rod's near end (17 mm of it from ball 1's centre,
+// as above), and ball 2 a ball 1.3 or 1.4x too large seen all round (1000
+// points on each of two 85-degree caps): not of the certified size, so
+// RANSAC locates no ball 2 and the refusal names the sphere the cloud holds
+// there. Ball 1's first fit, rod and all, reads a ball ~21% too large (the
+// check below measures it: more than half of ball 2's 30 or 40%, which is
+// what ScaleText asks of the other ball), so it is kept as located. A scale
+// error would show on both balls, and ball 1 measured without its rod
+// (outside the shaft cone, as the second pass fits it) is its certified
+// size within noise (0.05 mm on ~2000 points: ~0.01 mm in diameter, 0.04%
+// of scale): no scale may be named. Before, ball 1's rod-inflated size was
+// taken as its scale and the refusal said "or measured at a scale +30% off"
+// (+40%), in all three cases below.
+TEST(Vdi2634, ARodInflatedBallIsNoEvidenceOfAScaleError) {
+  const double r_mm = 12.7;
+  const Eigen::Vector3d c1(-50, 0, 300), c2(50, 0, 300);
+  for (const auto& [scale, seed] : {std::pair{1.3, 31u}, std::pair{1.4, 31u}, std::pair{1.4, 32u}}) {
+    SCOPED_TRACE(::testing::Message() << "ball 2 " << scale << "x, seed " << seed);
+    std::mt19937 rng(seed);
+    const BallBarWithRod scene = BallBarSeenByOneModule(c1, c2, 1.0, 17.0, &rng);
+    // Ball 1 and the rod's near end (scene.bar: ball 1's cap, ball 2's, the rod).
+    std::vector<Eigen::Vector3d> bar = scene.own[0];
+    bar.insert(bar.end(), scene.bar.begin() + scene.own[0].size() + scene.own[1].size(), scene.bar.end());
+    for (const double side : {-1.0, 1.0}) {
+      const auto cap =
+          testing::NoisySurfaceSamples(testing::SphereCapSurface(c2, {0, 0, side}, scale * r_mm, 85), 1000, 0.05, &rng);
+      bar.insert(bar.end(), cap.begin(), cap.end());
+    }
+    ASSERT_GT(CaptureBandRadiusMm(bar, c1, r_mm) / r_mm - 1, 0.5 * (scale - 1)) << scene.rod_points << " rod points";
+    const std::string what = RefusalOf(BallBarArtifact(), bar);
+    char holds[64];
+    std::snprintf(holds, sizeof holds, "it holds one %.1f mm in diameter", 2 * scale * r_mm);
+    EXPECT_NE(what.find("ball 2 of the ball bar not found"), std::string::npos) << what;
+    EXPECT_NE(what.find(holds), std::string::npos) << what;
+    EXPECT_EQ(what.find("scale"), std::string::npos) << what;
+  }
+}
+
+// Nor is one ball found twice. Ball 1 of the certified size seen by one
+// module with the rod's near end (16 mm from its centre), and ball 2 1.25x
+// too large seen from both sides (BallSeenFromBothSides). RANSAC locates a
+// sphere of the certified size inside the large ball, off its centre; its
+// free fit leaves the size, so it is kept as located, and the points within
+// the capture band of that located sphere are removed before ball 2 is
+// looked for: the large ball's far side stays, and "ball 2" is located in
+// it again (seed 32). Both passes' free fits are then one sphere, 31.75 mm
+// across, and each agreed with the other as evidence of a +25% scale error.
+// Two balls cannot overlap: the other's size says nothing of a scale when
+// the two fits do. Before, the refusal said "or measured at a scale +25%
+// off" though ball 1 is its certified size.
+TEST(Vdi2634, OneBallFoundTwiceIsNoEvidenceOfAScaleError) {
+  const double r_mm = 12.7;
+  const Eigen::Vector3d c1(-50, 0, 300), c2(50, 0, 300);
+  std::mt19937 rng(32);
+  const BallBarWithRod scene = BallBarSeenByOneModule(c1, c2, 1.0, 16.0, &rng);
+  std::vector<Eigen::Vector3d> bar = scene.own[0];
+  bar.insert(bar.end(), scene.bar.begin() + scene.own[0].size() + scene.own[1].size(), scene.bar.end());
+  const auto large = BallSeenFromBothSides(c2, 1.25 * r_mm, 0.05, &rng);
+  bar.insert(bar.end(), large.begin(), large.end());
+  const std::string what = RefusalOf(BallBarArtifact(), bar);
+  EXPECT_NE(what.find("a sphere 31.7 mm in diameter, not the certified 25.4 mm"), std::string::npos) << what;
+  EXPECT_EQ(what.find("scale"), std::string::npos) << what;
 }
 
 // The certificate's uncertainty U (expanded, k = 2 unless the file says
@@ -1331,6 +1438,67 @@ TEST(Vdi2634, AGapAcrossThePlateKeepsBothSidesInTheFigures) {
   EXPECT_NEAR(FigureOf(split, "F"), FigureOf(whole, "F"), 0.5);
   EXPECT_TRUE(split.judged()) << split.not_judged_reason;  // FAIL, not "not judged"
   EXPECT_FALSE(split.pass()) << "the warped strip beyond the gap left the figures";
+}
+
+// Every given point is counted once, in exactly one of off the artifact,
+// the plate's edge margin, excluded and used. Truth: the 130 mm plate at
+// 1 mm (noise 0.05 mm along its normal only), 400 points of a table 20 mm
+// below it (outside the 5 mm capture band) and 2 strays in its plane 10 mm
+// beyond a side (in the band, off the outline). Every 3 mm cell of the plate
+// is full, so its outline passes through its outermost points exactly, and
+// an edge margin of 5.5 mm puts the eroded border half-way between two rows
+// of points: the face is the 119 x 119 points within 59.5 mm of the centre,
+// the edge margin the other 131^2 - 119^2 = 3000, with no rounding to allow
+// for, and off the artifact exactly the 402 others. Before, the edge
+// margin's points were in no count (the columns summed to 3000 fewer than
+// the cloud). A sphere and a ball bar, with outliers and the shaft's cone,
+// sum alike (they have no edge margin).
+TEST(Vdi2634, EveryPointIsCountedOnceOffTheArtifactInTheEdgeMarginExcludedOrUsed) {
+  std::mt19937 rng(41);
+  const Eigen::Vector3d c(0, 0, 5), normal(0, 0, 1);
+  const Eigen::Vector3d x = normal.unitOrthogonal();
+  std::vector<Eigen::Vector3d> cloud = PlatePoints(c, normal, 130, 1.0, 0.05, &rng);
+  ASSERT_EQ(cloud.size(), 131u * 131u);
+  std::uniform_real_distribution<double> across(-60, 60);
+  const Eigen::Vector3d y = normal.cross(x);
+  for (int k = 0; k < 400; ++k) cloud.push_back(c - 20 * normal + across(rng) * x + across(rng) * y);
+  cloud.push_back(c + 75 * x);
+  cloud.push_back(c + 75 * x + 3 * y);
+  auto sums = [](const ArtifactEvaluation& e) {
+    EXPECT_EQ(e.points_off_artifact + e.points_in_edge_margin + e.points_excluded + e.points_used(), e.points_total);
+    EXPECT_EQ(e.points_excluded + e.points_used(), e.points_on_artifact);
+  };
+  VerifyOptions margin;
+  margin.plate_edge_margin_mm = 5.5;
+  const ArtifactEvaluation plate = EvaluateArtifact(PlateArtifact(), cloud, margin, "plate.ply");
+  EXPECT_EQ(plate.points_total, static_cast<int>(cloud.size()));
+  sums(plate);
+  EXPECT_EQ(plate.points_off_artifact, 402);
+  EXPECT_EQ(plate.plate_points_off_outline, 2);
+  EXPECT_EQ(plate.points_in_edge_margin, 131 * 131 - 119 * 119);
+  EXPECT_EQ(plate.points_on_artifact, 119 * 119);
+
+  testing::NoiseSpec noise;
+  noise.points = 20000;
+  const testing::NoisyCloud sphere = testing::SeenByTwoFacingCameras(
+      [](double a, double b, Eigen::Vector3d* n) {
+        const double z = 2 * a - 1, phi = 2 * kPi * b, s = std::sqrt(1 - z * z);
+        *n = Eigen::Vector3d(s * std::cos(phi), s * std::sin(phi), z);
+        return Eigen::Vector3d(Eigen::Vector3d(0, 0, 200) + 19.05 * *n);
+      },
+      Eigen::Vector3d(0, 0, 200), noise);
+  const ArtifactEvaluation e_sphere = EvaluateArtifact(SphereArtifact(), sphere.points, VerifyOptions(), "s.ply");
+  sums(e_sphere);
+  EXPECT_EQ(e_sphere.points_in_edge_margin, 0);
+  EXPECT_GE(e_sphere.points_off_artifact, sphere.outliers / 2);  // most of the box's outliers lie off the band
+
+  auto bar = BallSeenFromBothSides({-50, 0, 0}, 12.7, 0.05, &rng);
+  const auto ball_2 = BallSeenFromBothSides({50, 0, 0}, 12.7, 0.05, &rng);
+  bar.insert(bar.end(), ball_2.begin(), ball_2.end());
+  const ArtifactEvaluation e_bar = EvaluateArtifact(BallBarArtifact(), bar, VerifyOptions(), "bar.ply");
+  sums(e_bar);
+  EXPECT_EQ(e_bar.points_in_edge_margin, 0);
+  EXPECT_GT(e_bar.points_off_artifact, 0);  // the caps' points within 60 deg of the bar axis
 }
 
 TEST(Vdi2634, StrayPointsDoNotMakeTooLittleOfThePlateEnough) {
