@@ -32,7 +32,7 @@ void NoteShapeModelWithoutMesh(const RuntimeOptions& options, bool mesh) {
       "note: shape_model %s fills holes only with a mesh (--mesh; --mesh-format for many captures): nothing will "
       "be filled\n",
       ShapeModelName(options.shape_model));
-  std::fflush(stdout);
+  FlushStdout();
 }
 
 }  // namespace

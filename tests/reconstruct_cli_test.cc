@@ -738,6 +738,26 @@ TEST_F(ReconstructCli, AReportThatCannotBeWrittenLeavesTheEarlierCloud) {
   EXPECT_EQ(names, std::vector<std::string>{"out.ply"});  // no mesh or temporary file
 }
 
+// A stdout that cannot be written (/dev/full) makes a run that printed its
+// summary there exit 2, in one line saying so (exit 0 before): the caller did
+// not get the summary. The outputs are committed before the summary is
+// printed, so they are whole: the cloud the same bytes as a run whose stdout
+// is written, the report there too (docs/formats.md, "CLI").
+TEST_F(ReconstructCli, AStdoutThatCannotBeWrittenExitsTwoWithTheOutputsWhole) {
+  const std::string dir = dir_ + "/stdout_full";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string args = "reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture --out " + dir;
+  ASSERT_EQ(testing::RunCli(args + "/written.ply").code, 0);
+  const std::string err = dir + "/err.txt";
+  const int status =
+      std::system((kBin + " " + args + "/full.ply --report " + dir + "/full.json >/dev/full 2>" + err).c_str());
+  EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2);
+  EXPECT_EQ(ReadFileBytes(err), "stereorig reconstruct: standard output: cannot be written: No space left on device\n");
+  EXPECT_EQ(ReadFileBytes(dir + "/full.ply"), ReadFileBytes(dir + "/written.ply"));
+  EXPECT_TRUE(std::filesystem::exists(dir + "/full.json"));
+}
+
 // A report whose name takes the file system's whole 255 bytes is written
 // beside the cloud, nothing else left. (Before, any name over about 235
 // bytes failed: its temporary file's name, ".tmp-<pid>-<n>-<name>", passed
