@@ -176,11 +176,35 @@ const CLI::Validator& NonNegativeValue() {
   return v;
 }
 
-void RequireStdoutWritten() {
+namespace {
+
+int g_stdout_errno = 0;  // why the first flush of stdout that failed failed
+
+}  // namespace
+
+void FlushStdout() {
   errno = 0;
-  if (std::fflush(stdout) == 0 && !std::ferror(stdout)) return;
-  throw InputError("standard output",
-                   std::string("cannot be written") + (errno ? std::string(": ") + std::strerror(errno) : ""));
+  if (std::fflush(stdout) != 0 && g_stdout_errno == 0) g_stdout_errno = errno;
+}
+
+std::string StdoutWriteError() {
+  FlushStdout();
+  if (!std::ferror(stdout)) return "";
+  // An earlier write that failed (a printf that filled the buffer) left
+  // only the stream's error flag.
+  return g_stdout_errno != 0 ? std::strerror(g_stdout_errno) : "a write failed";
+}
+
+void RequireStdoutWritten() {
+  const std::string error = StdoutWriteError();
+  if (!error.empty()) throw InputError("standard output", "cannot be written: " + error);
+}
+
+int ExitCodeWithStdout(int code, const std::string& program) {
+  const std::string error = StdoutWriteError();
+  if (error.empty() || code == kExitBadInput) return code;
+  std::fprintf(stderr, "%s: standard output: cannot be written: %s\n", program.c_str(), error.c_str());
+  return kExitBadInput;
 }
 
 const CLI::Validator& NonEmptyPath() {

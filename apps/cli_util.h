@@ -65,6 +65,28 @@ const CLI::Validator& NonEmptyPath();
 // its table must not exit 0 when the table was not written.
 void RequireStdoutWritten();
 
+// fflush(stdout), keeping the reason of the first flush that fails for
+// StdoutWriteError (a later flush finds the stream's error flag set, not why).
+// The commands flush through it after each line a caller may wait for.
+void FlushStdout();
+
+// "" if everything written to stdout so far reached it (flushed now), else
+// why not ("No space left on device", "Broken pipe"; "a write failed" where
+// a printf that filled the buffer failed and its reason is gone). A stream
+// checks it after each capture's line (reconstruct_stream.h).
+std::string StdoutWriteError();
+
+// The process's exit code once `program` ("stereorig reconstruct") returned
+// `code`: where stdout lost anything it printed (a full disk, /dev/full, a
+// closed descriptor, a reader gone with SIGPIPE ignored), a run that
+// returned 0 or 1 returns 2 after one line on stderr, "<program>: standard
+// output: cannot be written: <why>", since the caller did not get what the
+// run printed (its table, verdict, each capture's line). A run that returned
+// 2 keeps it and its own error line. Called once, by main, for every command
+// (and --help, --version), after the command has ended: files it wrote are
+// complete and stay (docs/formats.md, "CLI").
+int ExitCodeWithStdout(int code, const std::string& program);
+
 // For subcommands a later issue fills in: prints what it will do and exits 2.
 int NotBuiltYet(const char* name, const char* what, int argc, char** argv);
 

@@ -301,7 +301,7 @@ int RunBench(int argc, char** argv) {
       "peak memory of our runtime: %.0f MB (the process holding only the libraries and captures, %.0f MB, then our "
       "runtime built and run once on each capture)\n",
       runtime_peak_mb, libraries_mb);
-  std::fflush(stdout);
+  FlushStdout();
   if (!dataset.empty()) {
     namespace fs = std::filesystem;
     for (Scene& s : scenes) {

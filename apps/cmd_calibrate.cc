@@ -112,7 +112,7 @@ int RunCalibrate(int argc, char** argv) {
   // The summary first: a calibration whose rig file is refused (a lens no
   // camera has) still shows what it found.
   std::printf("%s", SummaryText(result.report).c_str());
-  std::fflush(stdout);
+  FlushStdout();
   WriteCalibrationOutputs(result, out_path, report_path, cameramodels_dir);
   std::printf("wrote %s and %s\n", out_path.c_str(), report_path.c_str());
   return 0;

@@ -21,7 +21,7 @@ int Step(const std::vector<std::string>& args) {
   std::string line = "$ stereorig";
   for (const std::string& a : args) line += " " + a;
   std::printf("\n%s\n", line.c_str());
-  std::fflush(stdout);
+  FlushStdout();
   for (const Command& c : Commands()) {
     if (args[0] != c.name) continue;
     std::vector<std::string> storage = args;
@@ -29,7 +29,7 @@ int Step(const std::vector<std::string>& args) {
     std::vector<char*> argv;
     for (std::string& s : storage) argv.push_back(s.data());
     const int rc = RunCommand(c, static_cast<int>(argv.size()), argv.data());
-    std::fflush(stdout);
+    FlushStdout();
     return rc;
   }
   STEREORIG_CHECK(false && "demo names an unknown subcommand");

@@ -32,7 +32,7 @@ void NoteShapeModelWithoutMesh(const RuntimeOptions& options, bool mesh) {
       "note: shape_model %s fills holes only with a mesh (--mesh; --mesh-format for many captures): nothing will "
       "be filled\n",
       ShapeModelName(options.shape_model));
-  std::fflush(stdout);
+  FlushStdout();
 }
 
 }  // namespace
@@ -59,10 +59,15 @@ int RunReconstruct(int argc, char** argv) {
       "from standard input, one path per line, sent once the folder is complete (a pipe, or a FIFO: see "
       "docs/reconstruct.md, 'Captures as they come'), and reconstructs each as its line arrives, with one runtime "
       "built at the start; each capture writes <name>.ply and <name>.json, <name> its folder's last name, and "
-      "prints one line '[k] DIR: ...' on stdout at once. An output that exists is never replaced. A bad capture (a "
+      "prints one line on stdout at once, before it reads the next folder: '[k] DIR: N points (fill m0 x%, m1 y%), T "
+      "ms "
+      "-> OUT/<name>.ply' or '[k] DIR: no output (<why>)' (lines after it that start with two spaces are warnings). An "
+      "output that exists is never replaced. A bad capture (a "
       "missing camera, bad images, an output name that exists already) is named on stderr and on its line, gets no "
       "output, and the stream goes on; the end of the input ends the run (exit 2 if any capture failed), and so "
-      "does SIGTERM or Ctrl-C, once the capture in progress is written (its summary says so).\n\n"
+      "does SIGTERM, SIGHUP or Ctrl-C, once the capture in progress is written (exit as at the end; its summary "
+      "says so), and so does a stdout that cannot be written (a reader gone: exit 2). A batch or a single capture "
+      "dies of those signals at once, leaving no partial file.\n\n"
       "Examples:\n  stereorig reconstruct --rig rig.yaml --capture data/scenes/cup/active --out cup.ply "
       "--mesh cup.stl --report cup.json\n"
       "  stereorig reconstruct --rig rig.yaml --capture line/0001 line/0002 line/0003 --out-dir clouds "

@@ -216,7 +216,7 @@ int RunScore(int argc, char** argv) {
       }
     }
     report["scenes"].push_back(sj);
-    std::fflush(stdout);  // each scene's lines as it is done (~3 s a scene), also into a pipe or a log file
+    FlushStdout();  // each scene's lines as it is done (~3 s a scene), also into a pipe or a log file
   }
   if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
   if (!rig_given) WarnOfTruthRig("score", rig_path);

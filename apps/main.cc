@@ -26,6 +26,10 @@ int main(int argc, char** argv) {
   // Capture after capture (reconstruct, bench, score, demo) the runtime
   // reuses its freed maps instead of faulting them in again (heap_retention.h).
   stereorig::RetainFreedHeapMemory();
+  // Every exit goes through ExitCodeWithStdout: a run whose stdout lost what
+  // it printed (a full disk, /dev/full) exits 2, not 0 (cli_util.h). Here,
+  // not in RunCommand, so that --help and --version are covered and demo's
+  // in-process steps (RunCommand each) do not each report it.
   if (argc < 2) {
     PrintUsage(stderr);
     return stereorig::kExitBadInput;
@@ -33,14 +37,15 @@ int main(int argc, char** argv) {
   const std::string name = argv[1];
   if (name == "--help" || name == "-h" || name == "help") {
     PrintUsage(stdout);
-    return stereorig::kExitOk;
+    return stereorig::ExitCodeWithStdout(stereorig::kExitOk, "stereorig");
   }
   if (name == "--version") {
     std::printf("stereorig %s\n", STEREORIG_VERSION);
-    return stereorig::kExitOk;
+    return stereorig::ExitCodeWithStdout(stereorig::kExitOk, "stereorig");
   }
   for (const auto& c : stereorig::Commands()) {
-    if (name == c.name) return stereorig::RunCommand(c, argc - 1, argv + 1);
+    if (name == c.name)
+      return stereorig::ExitCodeWithStdout(stereorig::RunCommand(c, argc - 1, argv + 1), "stereorig " + name);
   }
   std::fprintf(stderr, "stereorig: unknown command '%s' (stereorig --help lists them)\n",
                stereorig::PrintableText(name).c_str());

@@ -8,6 +8,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "apps/cli_util.h"
 #include "apps/command.h"
 #include "apps/output_paths.h"
 #include "apps/reconstruct_capture.h"
@@ -117,7 +118,7 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
   if (!request.summary_path.empty()) fs::remove(request.summary_path, ec);
   std::printf("runtime built in %.0f ms (%d modules); %zu captures -> %s\n", build_ms, rig.num_modules(), dirs.size(),
               request.out_dir.c_str());
-  std::fflush(stdout);
+  FlushStdout();
 
   nlohmann::json summary;
   summary["runtime_build_ms"] = build_ms;

@@ -76,7 +76,7 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
           "range_end_reached): its points may lie where nothing is; check the volume\n",
           m.module, which.c_str(), outputs.report.c_str());
   }
-  std::fflush(stdout);
+  FlushStdout();
   return entry;
 }
 
@@ -103,7 +103,7 @@ int FinishRun(nlohmann::json* summary, int total, int failed, double wall_ms, co
   (*summary)["objects_per_s"] = done > 0 ? 1000.0 * done / wall_ms : 0.0;
   std::printf("%d of %d captures in %.2f s: %.1f objects/s (%s)\n", done, total, wall_ms / 1000,
               (*summary)["objects_per_s"].get<double>(), timed.c_str());
-  std::fflush(stdout);
+  FlushStdout();
   if (!summary_path.empty()) WriteFileAtomically(summary_path, summary->dump(2) + "\n");
   if (failed == 0) return kExitOk;
   std::fprintf(stderr,

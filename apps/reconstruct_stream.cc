@@ -53,6 +53,17 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// True, with *why set, once stdout has lost something written to it: a
+// full disk or /dev/full, a terminal gone (EIO), a reader gone (EPIPE: the
+// stream ignores SIGPIPE, so that a supervisor that died does not kill it
+// between a capture's outputs and its summary). Each capture's line is the
+// caller's answer, sent before the next folder is read: a stream that can
+// no longer give them stops, as at the end of its input.
+bool StdoutLost(std::string* why) {
+  *why = StdoutWriteError();
+  return !why->empty();
+}
+
 // At most this many failed captures are listed in the summary (the count is
 // always whole): a stream may run for days, and its memory must not grow
 // with it. Reconstructed captures are not listed; each has its own report.
@@ -123,13 +134,16 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
   if (!request.warm_up_dir.empty())
     std::printf(", warmed up on %s in %.0f ms (not written)", request.warm_up_dir.c_str(), warm_up_ms);
   std::printf("; reading capture folders from standard input, one per line -> %s\n", request.out_dir.c_str());
-  std::fflush(stdout);
+  // A caller that cannot be answered is told before any capture: exit 2, no
+  // new --out-dir, the earlier summary left.
+  RequireStdoutWritten();
 
   nlohmann::json summary;
   summary["runtime_build_ms"] = build_ms;
   if (!request.warm_up_dir.empty()) summary["warm_up_ms"] = warm_up_ms;
   summary["failed_captures"] = nlohmann::json::array();  // the first kMaxFailuresListed
   int total = 0, failed = 0;
+  std::string output_error;  // why stdout lost a capture's line: the stream stops
   const auto t_all = Clock::now();
   std::string line;
   while (input.Next(&line)) {
@@ -161,6 +175,7 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
       outputs = planned;
       const std::vector<cv::Mat> images = LoadCaptureOrInputError(dir, rig);
       ReconstructCapture(runtime, images, dir, name, outputs, progress, t);
+      if (StdoutLost(&output_error)) break;
       continue;
     } catch (const InputError& e) {  // the capture's files, images or outputs
       error = e.what();
@@ -171,8 +186,17 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
     // On stdout too: a caller reading each capture's line there gets one for
     // every capture.
     std::printf("%s %s: no output (%s)\n", progress, PrintableText(dir).c_str(), PrintableText(error).c_str());
-    std::fflush(stdout);
+    FlushStdout();
     if (++failed <= kMaxFailuresListed) summary["failed_captures"].push_back(entry);
+    if (StdoutLost(&output_error)) break;
+  }
+  if (!output_error.empty()) {  // the captures' lines are the stream's answers: none can be given any more
+    std::fprintf(stderr,
+                 "stereorig reconstruct: standard output: cannot be written: %s; the stream stops after %d "
+                 "capture%s, reading no further line ([%d]'s line was lost; its outputs, if it has any, are "
+                 "written)\n",
+                 output_error.c_str(), total, total == 1 ? "" : "s", total);
+    summary["output_error"] = output_error;
   }
   if (!input.error().empty()) {  // the input ends here: what was read is done, the summary written
     std::fprintf(stderr, "stereorig reconstruct: standard input could not be read further: %s\n",
@@ -185,7 +209,7 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
         "stopped by %s after %d capture%s; no further line read (a capture in progress when it came was finished "
         "and written)\n",
         SignalName(stop).c_str(), total, total == 1 ? "" : "s");
-    std::fflush(stdout);
+    FlushStdout();
     summary["stopped_by"] = SignalName(stop);
   }
   if (total == 0) {
@@ -197,7 +221,7 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
                              "the stream's wall time: waiting for the input, reading, reconstructing and writing",
                              request.summary_path);
   if (failed > 0) out_folder.RemoveIfEmpty();  // as a batch: nothing written, no new folder
-  return code;
+  return output_error.empty() ? code : kExitBadInput;
 }
 
 }  // namespace stereorig

@@ -45,10 +45,12 @@ struct StreamRequest {
 };
 
 // Builds the runtime, then reads `input_fd` (standard input) to its end, or
-// until SIGTERM or SIGINT stops it (stream_input.h: the capture in progress
-// is finished and written, no further line read, the summary written with
-// `stopped_by`; a stop before the first capture returns 0 and writes no
-// summary). Each line (a trailing '\r'
+// until SIGTERM, SIGINT or SIGHUP stops it (stream_input.h: the capture in
+// progress is finished and written, no further line read, the summary
+// written with `stopped_by`; a stop before the first capture returns 0 and
+// writes no summary), or until stdout cannot be written (a capture's line
+// lost: the stream stops after that capture, summary written with
+// `output_error`, exit 2). Each line (a trailing '\r'
 // dropped; blank lines skipped) names a capture folder, reconstructed and
 // written as out_dir/<name>.ply, <name>.json and <name>.mesh.<format>, each
 // atomically, with one line on stdout, flushed (reconstruct_capture.h). An

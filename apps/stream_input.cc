@@ -14,6 +14,11 @@ namespace stereorig {
 
 namespace {
 
+// SIGHUP too: a terminal that hangs up, and systemd's SendSIGHUP=yes right
+// after its SIGTERM, would otherwise kill the stream mid-capture (its
+// temporary files removed, no summary) where SIGTERM lets it finish.
+constexpr int kStopSignals[] = {SIGTERM, SIGINT, SIGHUP};
+
 volatile std::sig_atomic_t g_stop_signal = 0;
 int g_wake_fd = -1;     // the self-pipe's write end: the handler wakes Next()'s wait from any thread
 bool g_active = false;  // a StreamInput exists (the handlers, the flag and the pipe are the process's)
@@ -51,8 +56,11 @@ StreamInput::StreamInput(int fd) : fd_(fd) {
   g_stop_signal = 0;
   g_wake_fd = wake_[1];
   sigemptyset(&handled_);
-  Install(SIGTERM, &handled_);
-  Install(SIGINT, &handled_);
+  for (int s : kStopSignals) Install(s, &handled_);
+  // A reader of stdout that went away (the supervisor died) makes the
+  // capture's line fail with EPIPE, which ends the stream with its summary
+  // (reconstruct_stream.cc), instead of SIGPIPE killing it.
+  std::signal(SIGPIPE, SIG_IGN);
   // One that comes between its handler and its mask sets the flag and
   // wakes the first wait: it stops the stream all the same.
   pthread_sigmask(SIG_BLOCK, &handled_, &old_mask_);
@@ -84,7 +92,7 @@ bool StreamInput::Next(std::string* line) {
   // had before (one that blocked them blocks them no longer: a stream must
   // be stoppable).
   sigset_t wait_mask = old_mask_;
-  for (int s : {SIGTERM, SIGINT})
+  for (int s : kStopSignals)
     if (sigismember(&handled_, s)) sigdelset(&wait_mask, s);
   for (;;) {
     // One sent while a capture was done is pending (blocked): it is taken
@@ -132,6 +140,7 @@ bool StreamInput::Next(std::string* line) {
 std::string SignalName(int signal) {
   if (signal == SIGTERM) return "SIGTERM";
   if (signal == SIGINT) return "SIGINT";
+  if (signal == SIGHUP) return "SIGHUP";
   return "signal " + std::to_string(signal);
 }
 

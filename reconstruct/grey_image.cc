@@ -5,18 +5,23 @@
 
 namespace stereorig {
 
-cv::Mat ReadGreyImage(const std::string& path) {
-  int bits = 0;  // as stored: the decoder scales 1-, 2- and 4-bit grey to 8 bits
-  cv::Mat image = ReadImageFile(path, &bits);
-  if (image.type() != CV_8UC1) throw InputError(path, "must be an 8-bit single-channel (grey) image");
-  // A 1-, 2- or 4-bit grey image holds 2-16 grey levels: the sub-pixel fit
-  // and the lit test read steps, not the laser lines' profile (a 1-bit
-  // capture gave 0 points, a 4-bit one silently fewer). Refused, as
-  // docs/formats.md says: 8-bit grey only.
-  if (bits < 8)
-    throw InputError(path, "is a " + std::to_string(bits) + "-bit grey PNG: captures must be 8-bit grey (2^" +
-                               std::to_string(bits) + " grey levels cannot carry the laser lines' profile)");
-  return image;
+cv::Mat ReadGreyImage(const std::string& path, std::optional<cv::Size> rig_size_px) {
+  return ReadImageFile(path, [&](const ImageHeader& header) {
+    if (header.channels != 1 || header.bit_depth != 8)
+      throw InputError(path, "must be an 8-bit single-channel (grey) image");
+    // A 1-, 2- or 4-bit grey image (the decoder scales it to 8 bits) holds
+    // 2-16 grey levels: the sub-pixel fit and the lit test read steps, not
+    // the laser lines' profile (a 1-bit capture gave 0 points, a 4-bit one
+    // silently fewer). Refused, as docs/formats.md says: 8-bit grey only.
+    const int bits = header.stored_bit_depth;
+    if (bits < 8)
+      throw InputError(path, "is a " + std::to_string(bits) + "-bit grey PNG: captures must be 8-bit grey (2^" +
+                                 std::to_string(bits) + " grey levels cannot carry the laser lines' profile)");
+    if (rig_size_px && (header.width_px != rig_size_px->width || header.height_px != rig_size_px->height))
+      throw InputError(path, "is " + std::to_string(header.width_px) + "x" + std::to_string(header.height_px) +
+                                 ", the rig says " + std::to_string(rig_size_px->width) + "x" +
+                                 std::to_string(rig_size_px->height));
+  });
 }
 
 }  // namespace stereorig

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 
 namespace stereorig {
@@ -13,7 +14,11 @@ namespace stereorig {
 // (reconstruct/image_file.h) does (the file missing, a PNG cut short or
 // damaged, one that cannot be decoded), or if it is not 8-bit single-channel,
 // a grey PNG of 1, 2 or 4 bits included (decoded scaled to 8 bits, but with
-// 2-16 grey levels: the message names the file's depth).
-cv::Mat ReadGreyImage(const std::string& path);
+// 2-16 grey levels: the message names the file's depth), or, given
+// `rig_size_px` (its camera's imager), if it is of another size ("is
+// 16000x16000, the rig says 752x582"). All three are read from a PNG's
+// header, before its pixels are allocated or decoded: a capture costs at
+// most its camera's size in memory, whatever its header declares.
+cv::Mat ReadGreyImage(const std::string& path, std::optional<cv::Size> rig_size_px = std::nullopt);
 
 }  // namespace stereorig

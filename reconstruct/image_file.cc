@@ -27,6 +27,12 @@ std::string FirstBytes(const std::string& path, size_t count) {
 }  // namespace
 
 cv::Mat ReadImageFile(const std::string& path, int* stored_bit_depth) {
+  return ReadImageFile(path, [stored_bit_depth](const ImageHeader& header) {
+    if (stored_bit_depth) *stored_bit_depth = header.stored_bit_depth;
+  });
+}
+
+cv::Mat ReadImageFile(const std::string& path, const std::function<void(const ImageHeader&)>& check) {
   RequireInputFile(path);
   // Opened once here for the reason alone: the PNG reader's "cannot be
   // opened" leaves out why (permission denied, too many open files).
@@ -37,10 +43,10 @@ cv::Mat ReadImageFile(const std::string& path, int* stored_bit_depth) {
   // A PNG (every capture, the truth maps' id and lit maps) is decoded once,
   // by libpng, into the Mat imread would give.
   if (std::optional<PngReader> png = PngReader::Open(path)) {
+    check({int(png->width_px()), int(png->height_px()), png->channels(), png->bit_depth(), png->stored_bit_depth()});
     cv::Mat image(int(png->height_px()), int(png->width_px()),
                   CV_MAKETYPE(png->bit_depth() == 16 ? CV_16U : CV_8U, png->channels()));
     png->Read(image.data, image.step);
-    if (stored_bit_depth) *stored_bit_depth = png->stored_bit_depth();
     return image;
   }
   if (EndsWithIgnoringCase(path, ".png")) throw InputError(path, "is not a PNG file, though named .png");
@@ -49,7 +55,7 @@ cv::Mat ReadImageFile(const std::string& path, int* stored_bit_depth) {
     FloatImage depth = ReadFloatTiff(path);
     cv::Mat image(int(depth.height_px), int(depth.width_px), CV_32FC1);
     std::copy(depth.values.begin(), depth.values.end(), image.ptr<float>());
-    if (stored_bit_depth) *stored_bit_depth = 32;
+    check({image.cols, image.rows, 1, 32, 32});
     return image;
   }
   throw InputError(path,

@@ -19,6 +19,7 @@
 
 #include "calib/core/input_error.h"
 #include "calib/core/png_testing.h"
+#include "reconstruct/grey_image.h"
 
 namespace stereorig {
 namespace {
@@ -233,6 +234,45 @@ TEST(ReadImageFile, FloatTiffsAreReadAndOtherFormatsRefused) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.problem(), "is not a PNG file, though named .png");
   }
+}
+
+// The header is checked before a pixel is allocated or decoded: a header
+// declaring 16000 x 16000 px over image data of one row is refused by the
+// check (ReadGreyImage's size, given the camera's), not found damaged by
+// decoding it (which allocated 256 MB first); the TIFF's header is checked
+// too, once read.
+TEST(ReadImageFile, TheHeaderIsCheckedBeforeDecoding) {
+  const std::string row(1 + 16000, '\0');
+  const std::string path =
+      Write(kPngSignature + Chunk("IHDR", Ihdr(16000, 16000)) + Chunk("IDAT", Deflate(row, 9)) + Chunk("IEND", ""),
+            "image_file_test_declared.png");
+  ImageHeader seen;
+  try {
+    ReadImageFile(path, [&seen](const ImageHeader& header) {
+      seen = header;
+      throw InputError("check", "refused");
+    });
+    ADD_FAILURE() << "read";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problem(), "refused");
+  }
+  EXPECT_EQ(seen.width_px, 16000);
+  EXPECT_EQ(seen.height_px, 16000);
+  EXPECT_EQ(seen.channels, 1);
+  EXPECT_EQ(seen.bit_depth, 8);
+  EXPECT_EQ(seen.stored_bit_depth, 8);
+  try {
+    ReadGreyImage(path, cv::Size(752, 582));
+    ADD_FAILURE() << "read";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problem(), "is 16000x16000, the rig says 752x582");
+  }
+  const std::string tiff = ::testing::TempDir() + "/image_file_test_header.tiff";
+  ASSERT_TRUE(cv::imwrite(tiff, cv::Mat(23, 42, CV_32FC1, cv::Scalar(1.0f))));
+  ReadImageFile(tiff, [&seen](const ImageHeader& header) { seen = header; });
+  EXPECT_EQ(seen.width_px, 42);
+  EXPECT_EQ(seen.height_px, 23);
+  EXPECT_EQ(seen.bit_depth, 32);
 }
 
 }  // namespace

@@ -535,13 +535,9 @@ std::vector<cv::Mat> LoadCapture(const std::string& dir, const Rig& rig) {
   const std::vector<std::string> paths = CaptureImagePaths(dir, rig);
   std::vector<cv::Mat> images;
   for (int k = 0; k < rig.num_cameras(); ++k) {
-    const std::string& path = paths[k];
-    cv::Mat img = ReadGreyImage(path);
+    // Its size checked from its header, before it is decoded.
     const Camera& cam = rig.camera(k);
-    if (img.cols != cam.imager_width_px() || img.rows != cam.imager_height_px())
-      throw InputError(path, "is " + std::to_string(img.cols) + "x" + std::to_string(img.rows) + ", the rig says " +
-                                 std::to_string(cam.imager_width_px()) + "x" + std::to_string(cam.imager_height_px()));
-    images.push_back(std::move(img));
+    images.push_back(ReadGreyImage(paths[k], cv::Size(cam.imager_width_px(), cam.imager_height_px())));
   }
   return images;
 }

@@ -167,8 +167,9 @@ void CheckCaptureFiles(const std::string& dir, const Rig& rig);
 
 // Loads a capture folder: DIR/camK.png for every camera K of the rig, 8-bit
 // grey, the rig's imager size. Throws InputError naming the file on a
-// missing camera, a wrong size or type, or a camK.png beyond the rig's
-// cameras (CheckCaptureFiles).
+// missing camera, a wrong size or type (from a PNG's header, before it is
+// decoded: grey_image.h), or a camK.png beyond the rig's cameras
+// (CheckCaptureFiles).
 std::vector<cv::Mat> LoadCapture(const std::string& dir, const Rig& rig);
 
 // The point `distance_mm` in front of module `m`'s baseline midpoint along

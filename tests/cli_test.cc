@@ -120,6 +120,44 @@ TEST(Cli, GoodRigFileIsAccepted) {
       << recorded.out;
 }
 
+// `stereorig <args>` with its stdout going to `stdout_to` (a shell
+// redirection's target: "/dev/full", "&-"): its exit code and stderr.
+Result RunWithStdout(const std::string& args, const std::string& stdout_to) {
+  const std::string err = ::testing::TempDir() + "/cli_stdout_err_" + std::to_string(getpid()) + ".txt";
+  const int status = std::system((stereorig::testing::kBin + " " + args + " >" + stdout_to + " 2>" + err).c_str());
+  std::ifstream f(err);
+  Result r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, "", std::string(std::istreambuf_iterator<char>(f), {})};
+  std::filesystem::remove(err);
+  return r;
+}
+
+// Every command whose stdout cannot be written (a full disk, /dev/full, a
+// closed descriptor) exits 2 with one line saying so: what it printed (a
+// table, a verdict, the help) did not reach the caller. Only verify did
+// before; the others, --help and --version exited 0.
+TEST(Cli, AStdoutThatCannotBeWrittenIsNoSuccess) {
+  const std::string rig = ::testing::TempDir() + "/stdout_rig.yaml";
+  std::ofstream(rig) << GoodRigText();
+  Result r = RunWithStdout("rig --rig " + rig, "/dev/full");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "stereorig rig: standard output: cannot be written: No space left on device\n");
+  r = RunWithStdout("--help", "/dev/full");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "stereorig: standard output: cannot be written: No space left on device\n");
+  r = RunWithStdout("reconstruct --help", "/dev/full");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("stereorig reconstruct: standard output: cannot be written", 0), 0u) << r.err;
+  r = RunWithStdout("--version", "&-");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "stereorig: standard output: cannot be written: Bad file descriptor\n");
+  // Bad input keeps its own exit code and line.
+  r = RunWithStdout("rig --rig " + rig + ".missing", "/dev/full");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_EQ(r.err.find("standard output"), std::string::npos) << r.err;
+}
+
 // An image `match` cannot read is named in one line: a missing file without
 // OpenCV's own warning above it (imread of a missing file warns on stderr;
 // reconstruct and score check that their files exist first, and now match

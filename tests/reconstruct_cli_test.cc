@@ -557,6 +557,27 @@ TEST_F(ReconstructCli, WrongImageSizeExitsTwoAndWritesNothing) {
   ExpectNoOutput();
 }
 
+// A capture image whose header declares another size than its camera's is
+// refused from the header, before its pixels are allocated or decoded: here
+// 16000 x 16000 px (256 MB decoded) in a 70-byte file whose image data
+// holds one row. Before, the whole image was allocated and decoded first:
+// this file was refused as damaged ("its image data ends before the image
+// does"), and a whole one of that size took 2.7 s and 270 MB before "is
+// 16000x16000". So is a 16-bit colour header (2 GiB decoded).
+TEST_F(ReconstructCli, AnImageHeaderOfAnotherSizeIsRefusedBeforeDecoding) {
+  const std::string d = BrokenCapture("declared_size");
+  const std::string row(1 + 16000, '\0');  // a filter byte and one row
+  WriteFileAtomically(d + "/cam1.png", testing::kPngSignature + testing::Chunk("IHDR", testing::Ihdr(16000, 16000)) +
+                                           testing::Chunk("IDAT", testing::Deflate(row, 9)) +
+                                           testing::Chunk("IEND", ""));
+  ExpectRefusedInOneLine(Args(d), d + "/cam1.png: is 16000x16000, the rig says 752x582");
+  WriteFileAtomically(d + "/cam1.png",
+                      testing::kPngSignature + testing::Chunk("IHDR", testing::Ihdr(16384, 16384, 16, 6)) +
+                          testing::Chunk("IDAT", testing::Deflate(row, 9)) + testing::Chunk("IEND", ""));
+  ExpectRefusedInOneLine(Args(d), d + "/cam1.png: must be an 8-bit single-channel (grey) image");
+  ExpectNoOutput();
+}
+
 // A capture image cut short (a camera still writing it) is named in one
 // line; libpng used to print its own "libpng error: Read Error" line first.
 // So is one with a byte flipped in its image data (a disk's or a copy's
@@ -736,6 +757,26 @@ TEST_F(ReconstructCli, AReportThatCannotBeWrittenLeavesTheEarlierCloud) {
   std::vector<std::string> names;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) names.push_back(entry.path().filename());
   EXPECT_EQ(names, std::vector<std::string>{"out.ply"});  // no mesh or temporary file
+}
+
+// A stdout that cannot be written (/dev/full) makes a run that printed its
+// summary there exit 2, in one line saying so (exit 0 before): the caller did
+// not get the summary. The outputs are committed before the summary is
+// printed, so they are whole: the cloud the same bytes as a run whose stdout
+// is written, the report there too (docs/formats.md, "CLI").
+TEST_F(ReconstructCli, AStdoutThatCannotBeWrittenExitsTwoWithTheOutputsWhole) {
+  const std::string dir = dir_ + "/stdout_full";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string args = "reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture --out " + dir;
+  ASSERT_EQ(testing::RunCli(args + "/written.ply").code, 0);
+  const std::string err = dir + "/err.txt";
+  const int status =
+      std::system((kBin + " " + args + "/full.ply --report " + dir + "/full.json >/dev/full 2>" + err).c_str());
+  EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2);
+  EXPECT_EQ(ReadFileBytes(err), "stereorig reconstruct: standard output: cannot be written: No space left on device\n");
+  EXPECT_EQ(ReadFileBytes(dir + "/full.ply"), ReadFileBytes(dir + "/written.ply"));
+  EXPECT_TRUE(std::filesystem::exists(dir + "/full.json"));
 }
 
 // A report whose name takes the file system's whole 255 bytes is written

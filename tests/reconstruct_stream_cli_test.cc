@@ -88,6 +88,11 @@ class Child {
     close(to_child_);
     to_child_ = -1;
   }
+  // As a supervisor that died: the child's stdout has no reader left.
+  void CloseOutput() {
+    close(from_child_);
+    from_child_ = -1;
+  }
   // Reads stdout until it holds `n` lines or `timeout_s` pass; returns all
   // read so far.
   const std::string& ReadLines(int n, double timeout_s) {
@@ -152,6 +157,30 @@ class ReconstructStreamCli : public ::testing::Test {
     const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ +
                                               "/line/0001 --out " + dir_ + "/single.ply");
     ASSERT_EQ(r.code, 0) << r.err;
+  }
+  // A stream writing to `out` (removed first) with its summary there, its
+  // stderr to out_err.txt.
+  static std::unique_ptr<Child> StartStream(const std::string& out) {
+    fs::remove_all(out);
+    return std::make_unique<Child>(
+        std::vector<std::string>{testing::kBin, "reconstruct", "--rig", dir_ + "/rig.yaml", "--capture", "-",
+                                 "--out-dir", out, "--report", out + "/summary.json"},
+        out + "_err.txt");
+  }
+  // A stream (StartStream) that has answered its first capture, line/0001;
+  // null (a failure added) if it did not.
+  static std::unique_ptr<Child> StreamPastOneCapture(const std::string& out) {
+    std::unique_ptr<Child> child = StartStream(out);
+    if (!child->started()) {
+      ADD_FAILURE() << "not started";
+      return nullptr;
+    }
+    child->Send(dir_ + "/line/0001");
+    if (testing::Lines(child->ReadLines(2, 120)) != 2) {
+      ADD_FAILURE() << "no line for the first capture: " << child->ReadLines(2, 0);
+      return nullptr;
+    }
+    return child;
   }
   static std::string dir_;
 };
@@ -252,16 +281,9 @@ TEST_F(ReconstructStreamCli, ReconstructsEachFolderAsItsLineArrives) {
 // process and the summary was never written.
 TEST_F(ReconstructStreamCli, AStopSignalEndsTheStreamAsTheEndOfItsInputDoes) {
   const double timeout_s = 120;  // a liveness bound, as above: the input stays open, only the signal ends the run
-  auto start = [&](const std::string& out) {
-    fs::remove_all(out);
-    return std::make_unique<Child>(
-        std::vector<std::string>{testing::kBin, "reconstruct", "--rig", dir_ + "/rig.yaml", "--capture", "-",
-                                 "--out-dir", out, "--report", out + "/summary.json"},
-        out + "_err.txt");
-  };
-  {  // Between captures: the stream waits for its next line.
+  {                              // Between captures: the stream waits for its next line.
     const std::string out = dir_ + "/stop_idle";
-    const auto child = start(out);
+    const auto child = StartStream(out);
     ASSERT_TRUE(child->started());
     child->Send(dir_ + "/line/0001");
     ASSERT_EQ(testing::Lines(child->ReadLines(2, timeout_s)), 2) << child->ReadLines(2, 0);
@@ -279,7 +301,7 @@ TEST_F(ReconstructStreamCli, AStopSignalEndsTheStreamAsTheEndOfItsInputDoes) {
      // once, the signal right after: at most the first is reconstructed,
      // however the scheduler orders the read and the signal).
     const std::string out = dir_ + "/stop_queued";
-    const auto child = start(out);
+    const auto child = StartStream(out);
     ASSERT_TRUE(child->started());
     ASSERT_EQ(testing::Lines(child->ReadLines(1, timeout_s)), 1);  // the runtime is built
     fs::remove_all(dir_ + "/queued");
@@ -299,7 +321,7 @@ TEST_F(ReconstructStreamCli, AStopSignalEndsTheStreamAsTheEndOfItsInputDoes) {
      // absent, its line and the summary say which, and no temporary file is
      // left.
     const std::string out = dir_ + "/stop_busy";
-    const auto child = start(out);
+    const auto child = StartStream(out);
     ASSERT_TRUE(child->started());
     ASSERT_EQ(testing::Lines(child->ReadLines(1, timeout_s)), 1);  // the runtime is built
     child->Send(dir_ + "/line/0001");
@@ -323,6 +345,77 @@ TEST_F(ReconstructStreamCli, AStopSignalEndsTheStreamAsTheEndOfItsInputDoes) {
       EXPECT_FALSE(fs::exists(out)) << "a stream stopped before its first capture left its new output folder";
     }
   }
+}
+
+// SIGHUP (a terminal that hangs up; systemd sends it right after SIGTERM
+// with SendSIGHUP=yes) stops the stream as SIGTERM does: the capture in
+// progress is finished and written, or not begun, never cut short; the
+// summary says `stopped_by: SIGHUP`; exit 0. Before, it killed the process
+// mid-capture: that capture abandoned, no summary, death by the signal.
+TEST_F(ReconstructStreamCli, AHangUpStopsTheStreamAsSigtermDoes) {
+  const double timeout_s = 120;
+  const std::string out = dir_ + "/stop_hangup";
+  const auto started = StreamPastOneCapture(out);
+  ASSERT_TRUE(started);
+  Child& child = *started;
+  // The second capture most often in progress when the signal comes.
+  child.Send(dir_ + "/line/0002");
+  usleep(20000);
+  child.Signal(SIGHUP);
+  EXPECT_EQ(child.Wait(), 0) << Bytes(out + "_err.txt");
+  const std::string all = child.ReadLines(5, timeout_s);
+  EXPECT_NE(all.find("stopped by SIGHUP after "), std::string::npos) << all;
+  const bool second = fs::exists(out + "/0002.ply");
+  EXPECT_EQ(all.find("[2] " + dir_ + "/line/0002: ") != std::string::npos, second) << all;
+  EXPECT_EQ(Bytes(out + "/0001.ply"), Bytes(dir_ + "/single.ply"));
+  if (second) {
+    EXPECT_EQ(Bytes(out + "/0002.ply"), Bytes(dir_ + "/single.ply"));
+  }
+  const nlohmann::json summary = nlohmann::json::parse(Bytes(out + "/summary.json"));
+  EXPECT_EQ(summary["reconstructed"], second ? 2 : 1);
+  EXPECT_EQ(summary["stopped_by"], "SIGHUP");
+  for (const auto& entry : fs::directory_iterator(out)) {  // no temporary file
+    const std::string name = entry.path().filename().string();
+    EXPECT_NE(name.rfind(".tmp-", 0), 0u) << name;
+  }
+}
+
+// Each capture's line on stdout is the caller's answer: a stdout that
+// cannot be written stops the stream. At the start (/dev/full): exit 2 in
+// one line before any capture, no new --out-dir. Mid-stream (the
+// supervisor reading stdout went away: EPIPE, SIGPIPE being ignored): the
+// capture whose line was lost keeps its outputs, no further line is read,
+// the summary says `output_error`, exit 2. Before, the stream went on
+// answering no one (/dev/full, exit 0 at the end) or died of SIGPIPE with
+// no summary.
+TEST_F(ReconstructStreamCli, AStdoutThatCannotBeWrittenStopsTheStream) {
+  const std::string list = dir_ + "/stdout_list.txt", full = dir_ + "/stdout_full";
+  fs::remove_all(full);
+  WriteFileAtomically(list, dir_ + "/line/0001\n");
+  const std::string err = dir_ + "/stdout_full_err.txt";
+  const int status = std::system((testing::kBin + " reconstruct --rig " + dir_ + "/rig.yaml --capture - --out-dir " +
+                                  full + " < " + list + " >/dev/full 2>" + err)
+                                     .c_str());
+  EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2);
+  EXPECT_EQ(Bytes(err), "stereorig reconstruct: standard output: cannot be written: No space left on device\n");
+  EXPECT_FALSE(fs::exists(full));
+
+  const std::string out = dir_ + "/stdout_gone";
+  const auto started = StreamPastOneCapture(out);
+  ASSERT_TRUE(started);
+  Child& child = *started;
+  child.CloseOutput();
+  child.Send(dir_ + "/line/0002");
+  EXPECT_EQ(child.Wait(), 2) << Bytes(out + "_err.txt");
+  EXPECT_EQ(Bytes(out + "/0002.ply"), Bytes(dir_ + "/single.ply"));
+  const nlohmann::json summary = nlohmann::json::parse(Bytes(out + "/summary.json"));
+  EXPECT_EQ(summary["reconstructed"], 2);
+  EXPECT_EQ(summary["output_error"], "Broken pipe");
+  EXPECT_NE(Bytes(out + "_err.txt")
+                .find("standard output: cannot be written: Broken pipe; the stream stops after 2 "
+                      "captures"),
+            std::string::npos)
+      << Bytes(out + "_err.txt");
 }
 
 // --capture-root names each capture by its path below the root, so folders

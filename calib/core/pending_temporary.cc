@@ -27,7 +27,9 @@ struct Slot {
 static_assert(std::atomic<int>::is_always_lock_free);
 Slot g_slots[PendingTemporary::kMaxPending];
 
-constexpr int kSignals[] = {SIGTERM, SIGINT, SIGHUP};
+// SIGPIPE too: a run whose stdout or stderr reader went away (simulate
+// reports its progress on stderr while it writes its temporary dataset).
+constexpr int kSignals[] = {SIGTERM, SIGINT, SIGHUP, SIGPIPE};
 
 extern "C" void RemovePendingAndDie(int signal) {
   for (Slot& slot : g_slots) {

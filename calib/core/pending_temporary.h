@@ -3,10 +3,10 @@
 // leave hidden .tmp-* files beside its outputs (atomic_file.h), or a
 // simulated dataset's temporary folder of hundreds of images
 // (datasets/simulate.cc): harmless to the outputs, but they pile up. While
-// a PendingTemporary lives, SIGTERM, SIGINT or SIGHUP removes its file, or
-// its folder and all in it (signal_safe_removal.h: links not followed, at
-// most kMaxRemovalDepth levels), then the process dies of the signal as it
-// would have.
+// a PendingTemporary lives, SIGTERM, SIGINT, SIGHUP or SIGPIPE removes its
+// file, or its folder and all in it (signal_safe_removal.h: links not
+// followed, at most kMaxRemovalDepth levels), then the process dies of the
+// signal as it would have.
 //
 // A folder the process made (kEmptyFolder: FolderToCreate's, folder_to_create.h)
 // is removed only while empty (rmdir), after the files and trees, innermost

@@ -38,7 +38,7 @@ int StatusOfAChildSignalledMidWrite(const std::string& dir, int signal, void (*o
 }
 
 TEST(PendingTemporary, ATerminationSignalMidWriteRemovesTheTemporaryFile) {
-  for (const int signal : {SIGTERM, SIGINT, SIGHUP}) {
+  for (const int signal : {SIGTERM, SIGINT, SIGHUP, SIGPIPE}) {
     const std::string dir = testing::ScratchFolder("pending_temporary_" + std::to_string(signal));
     const int status = StatusOfAChildSignalledMidWrite(dir, signal, nullptr);
     ASSERT_TRUE(testing::DiedOf(status, signal));  // it still dies of the signal
@@ -63,7 +63,7 @@ TEST(PendingTemporary, AProgramsOwnHandlerIsKept) {
 // link points to. The child fills the folder once it is registered, as
 // simulate does, then the signal comes.
 TEST(PendingTemporary, ATerminationSignalRemovesAPendingFolderButNotWhatItsLinksPointTo) {
-  for (const int signal : {SIGTERM, SIGINT, SIGHUP}) {
+  for (const int signal : {SIGTERM, SIGINT, SIGHUP, SIGPIPE}) {
     const std::string dir = testing::ScratchFolder("pending_folder_" + std::to_string(signal));
     const std::string tree = dir + "/.ds.tmp-1";
     std::filesystem::create_directory(dir + "/outside");

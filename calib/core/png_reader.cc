@@ -39,6 +39,10 @@ struct PngDecoding {
   std::string warnings;
   size_t warnings_at = 0;
   bool refused = false, read = false;
+  // Set once the image's last row is decoded, at byte `image_end_at`: image
+  // data read past it beyond kMaxBytesAfterImage sets `too_much_data`.
+  bool image_done = false, too_much_data = false;
+  size_t image_end_at = 0;
   png_structp png = nullptr;
   png_infop info = nullptr;
 
@@ -77,10 +81,35 @@ void Keep(PngDecoding::Said& said, png_structp png, const PngDecoding& d, std::s
   }
 }
 
+// Image data read after the image's last row is decoded: libpng inflates
+// it to the stream's end ("Too much image data", below) at ~2.5 ms a MiB
+// inflated, and deflate packs up to ~1032 bytes into one. A capture-sized
+// file (1 MB) of zeros after a 752 x 582 image took 4.4 s, a cycle's time
+// twenty times over: more than this is refused instead. A whole image's
+// stream has a few bytes left at its last row (its end code, Adler-32);
+// libpng has read ahead at most 8 KiB (PNG_IDAT_READ_SIZE) by then.
+constexpr size_t kMaxBytesAfterImage = 16 * 1024;
+
 void ReadFromBytes(png_structp png, png_bytep out, size_t length) {
   PngDecoding& d = DecodingOf(png);
   const bool chunk_header = (png_get_io_state(png) & PNG_IO_MASK_LOC) == PNG_IO_CHUNK_HDR;
   if (chunk_header) d.chunk_at = d.at;
+  if (d.read && !chunk_header && png_get_io_chunk_type(png) == kIdat) {
+    // Every row decoded: libpng is inflating the stream's rest, from within
+    // its last row's read (png_read_finish_IDAT), so this is the one place
+    // that sees it. Interlaced, the passes end at 7.
+    const bool rows_done = png_get_interlace_type(png, d.info) == PNG_INTERLACE_NONE
+                               ? png_get_current_row_number(png) >= png_get_image_height(png, d.info)
+                               : png_get_current_pass_number(png) >= 7;
+    if (rows_done && !d.image_done) {
+      d.image_done = true;
+      d.image_end_at = d.at;
+    }
+    if (d.image_done && d.at + length - d.image_end_at > kMaxBytesAfterImage) {
+      d.too_much_data = true;
+      png_error(png, "too much image data");
+    }
+  }
   if (length > d.bytes.size() - d.at) {
     d.cut_short = true;
     d.between_chunks = chunk_header;
@@ -115,9 +144,9 @@ void ReadFromBytes(png_structp png, png_bytep out, size_t length) {
 // image, which libpng reads whole, ignoring the rest, as imread always has:
 // - "Extra compressed data": bytes after the deflate stream's end;
 // - "Too much image data": a stream that inflates to more than the image
-//   (inflated to its end, 1 KB at a time, which no callback can stop: a
-//   deflate bomb costs its time, 165 ms for 64 MiB of zeros in a 64 KB
-//   file, where the predecessor stopped one byte past the image);
+//   (inflated to its end, 1 KB at a time; 165 ms for 64 MiB of zeros in a
+//   64 KB file), up to kMaxBytesAfterImage of image data past the image's
+//   last row: ReadFromBytes stops a deflate bomb there;
 // - "..Too many IDATs found": an IDAT after the stream's end, or after a
 //   chunk that followed the IDATs (refused by this reader's predecessor,
 //   though the image is whole).
@@ -209,6 +238,11 @@ bool GuardedReadImage(png_structp png, png_infop info, png_bytepp rows) {
 
 // The one line for what went wrong, libpng having stopped or warned.
 [[noreturn]] void Refuse(const PngDecoding& d) {
+  if (d.too_much_data)
+    throw InputError(d.path, "a PNG whose image data goes on for more than " +
+                                 std::to_string(kMaxBytesAfterImage / 1024) + " KiB past its image's end (at byte " +
+                                 std::to_string(d.image_end_at) +
+                                 "): a decompression bomb or a faulty encoder, refused rather than inflated");
   if (d.cut_short) {
     if (d.between_chunks) throw InputError(d.path, "a PNG cut short (no IEND chunk at its end: still being written?)");
     throw InputError(d.path, "a PNG cut short or damaged (its " + d.error.chunk_type + " chunk at byte " +

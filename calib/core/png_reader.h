@@ -76,8 +76,10 @@ class PngReader {
   // channels() samples (uint8_t, or uint16_t in the machine's byte order),
   // row y starting at pixels + y * row_stride_bytes. Once only. Throws
   // InputError naming the file if the image data is cut short or damaged
-  // (see png_reader.cc for which of libpng's warnings are taken as damage);
-  // the pixels are then not to be used.
+  // (see png_reader.cc for which of libpng's warnings are taken as damage),
+  // or goes on for more than 16 KiB past the image's last row (a deflate
+  // bomb, which libpng would inflate to its end: png_reader.cc,
+  // kMaxBytesAfterImage); the pixels are then not to be used.
   void Read(void* pixels, size_t row_stride_bytes);
 
  private:
