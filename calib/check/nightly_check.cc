@@ -154,6 +154,26 @@ struct OwnLensFit {
   double NoisePx2() const { return jumps.pairs > 0 ? jumps.ss_px2 / (4.0 * jumps.pairs) : 0.0; }
 };
 
+// `t` scaled by `s` in the board's plane (squares, margins, tags and the
+// faces' in-plane offset; the plate's thickness kept): the board another
+// print of the same design would be. nullopt when no such target is valid.
+std::optional<Target> ScaledBoard(const Target& t, double s) {
+  Target::Layout l = t.layout();
+  l.square_size_mm *= s;
+  l.margin_mm *= s;
+  l.tag_size_mm *= s;
+  for (TargetFace& face : l.faces)
+    for (TagPlacement& tag : face.tags) tag.center_x_mm *= s, tag.center_y_mm *= s;
+  Eigen::Vector3d offset = l.back_from_front.translation_mm();
+  offset.x() *= s, offset.y() *= s;
+  l.back_from_front = Pose(l.back_from_front.rotation(), offset);
+  try {
+    return Target(l, "scaled board");
+  } catch (const InputError&) {
+    return std::nullopt;
+  }
+}
+
 // Each capture given (with its number of views) that `in` no longer holds,
 // named (capture_names, else its index) with why: its views set aside, too
 // few corners left after trimming, or no board pose.
@@ -295,6 +315,47 @@ std::optional<CameraChange> TurnedCameraOfModule(const Inputs& in, const StereoM
   const Reading& named = left.turn_alone ? left : right;
   if (!explained_by_pose(named.change)) return std::nullopt;
   return named.change;
+}
+
+// A lone module's captures of a board whose squares are not the target
+// file's. Each view's own board pose absorbs a pure similarity, so every
+// view fits its camera's lens as a knock's do (fits_own_lens), while each
+// camera is off through its partner's poses: the stored baseline makes the
+// pair measure the board's size absolutely. Refitted with the stored
+// right_from_left and one free board scale, the size the module measures
+// (MeasureBoardScale: each capture's triangulated corners against the
+// file's grid, the median over the captures), such a board leaves each
+// camera within its consistency threshold through its partner's poses; a
+// turned or shifted camera is not explained by a scale and leaves them off.
+// The text to refuse with, or nullopt.
+std::optional<std::string> BoardOfAnotherSize(const Inputs& in, const std::vector<ModuleBoardScale>& scales) {
+  const StereoModule& mod = in.rig.module(0);
+  const auto it = std::find_if(scales.begin(), scales.end(), [](const ModuleBoardScale& m) { return m.module == 0; });
+  if (it == scales.end() || it->captures < 3) return std::nullopt;
+  const std::optional<Target> board = ScaledBoard(in.target, it->scale);
+  if (!board) return std::nullopt;
+  Inputs scaled{in.rig, *board, in.options, in.by_capture, in.sigma_px, in.u_px, {}};
+  // Each seed pose moved as a board of that size would be to look the same
+  // from the reference frame's origin.
+  for (const auto& [capture, pose] : in.seed)
+    scaled.seed[capture] = Pose(pose.rotation(), it->scale * pose.translation_mm());
+  std::string each;
+  for (auto [c, partner] :
+       {std::pair{mod.left_camera, mod.right_camera}, std::pair{mod.right_camera, mod.left_camera}}) {
+    const Consistency con = CameraConsistency(scaled, c, {partner});
+    if (con.corners == 0 || !(con.rms_px <= con.threshold_px)) return std::nullopt;
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "%scam%d %.3f px within %.3f px", each.empty() ? "" : ", ", c, con.rms_px,
+                  con.threshold_px);
+    each += buf;
+  }
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "module 0 measures the board %.2f%% %s than squares of %.3f mm, and on a board of that size both "
+                "cameras agree through each other's board poses (%s)",
+                100 * std::abs(it->scale - 1), it->scale > 1 ? "larger" : "smaller", in.target.square_size_mm(),
+                each.c_str());
+  return std::string(text);
 }
 
 }  // namespace
@@ -561,7 +622,9 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   // sqrt(4 / p) (each corner in up to four pairs: twice the independent
   // pairs' variance, a bound, not measured). So the rule cannot tell a knock
   // from another rig whose cameras have this rig's lenses: that night reads
-  // recalibrate.
+  // recalibrate; nor from a board of another size (each view's own pose
+  // absorbs a similarity), which the pair's fixed baseline does tell:
+  // BoardOfAnotherSize, below.
   auto fits_own_lens = [&](int c) {
     const auto it = own_lens.find(c);
     if (it == own_lens.end() || it->second.dof <= 0 || it->second.jumps.pairs == 0) return false;
@@ -573,6 +636,14 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   if (!any_fits && rig.num_cameras() == 2 && !camera_figures.empty()) {
     any_fits = true;
     for (const auto& [c, f] : camera_figures) any_fits = any_fits && fits_own_lens(c);
+    // A board whose squares are not the target file's fits every view's own
+    // lens too: refused, as before the own-lens rule, naming the board.
+    if (any_fits) {
+      if (const std::optional<std::string> board = BoardOfAnotherSize(in, result.board_scales)) {
+        throw InputError(where, "the captures do not fit this rig's board: " + *board +
+                                    ": a board other than the target file's, or the wrong target file?");
+      }
+    }
   }
   if (!camera_figures.empty() && !any_fits) {
     std::string why = "every camera is off by > 2 px, whichever other camera or module is left out";

@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <limits>
 #include <map>
@@ -486,6 +487,46 @@ TEST(NightlyCheck, AKnockOfAOneModuleRigIsNamedAndAnotherRigsCapturesAreStillRef
                                              "by > 2 px through the other's board poses; cam"),
                   std::string::npos)
             << e.what();
+      }
+    }
+  }
+}
+
+SimulatedRig OneModuleRig() {
+  const SimulatedRig two = MakeDefaultRig();
+  return {Rig({two.rig.camera(0), two.rig.camera(1)}, {"cam0", "cam1"}, {two.rig.module(0)}, {Pose::Identity()}),
+          two.world_from_module0};
+}
+
+// A one-module rig's captures of a board whose squares are not the target
+// file's (2 % larger or smaller, each view's own board pose absorbing the
+// similarity) fit every camera's lens about the views' own poses as a
+// knock's do, and read "module 0's cameras disagree" (exit 1, a history
+// row) once the own-lens rule judged them. Refused again, as before it,
+// naming the board: the pair's stored baseline measures the board's size,
+// and on a board of that size both cameras agree. Seeds 1-3 each way.
+TEST(NightlyCheck, AOneModuleRigsCapturesOfABoardOfAnotherSizeAreRefusedNamingTheBoard) {
+  const SimulatedRig one = OneModuleRig();
+  const Target target = DefaultTarget();
+  const Rig stored = StoredRig(one);
+  for (double square_mm : {9.18, 8.82}) {
+    const Target board = DoubleSidedTarget(11, 9, square_mm);
+    for (unsigned seed = 1; seed <= 3; ++seed) {
+      try {
+        const CheckResult r =
+            RunNightlyCheck(stored, target, Observe(one, board, {}, seed), CheckOptions(), "captures");
+        ADD_FAILURE() << "squares of " << square_mm << " mm, seed " << seed << ", judged: " << r.Explanation();
+      } catch (const InputError& e) {
+        if (seed == 1) std::printf("squares of %g mm: %s\n", square_mm, e.what());
+        const std::string what = e.what();
+        const std::string head = "captures: the captures do not fit this rig's board: module 0 measures the board ";
+        ASSERT_EQ(what.substr(0, head.size()), head) << what;
+        // The size as printed, within 0.1 % of the truth (noise 0.2 px over
+        // 8 captures reads the size to a few 0.01 %: AWrongTargetFileIsNamed...).
+        EXPECT_NEAR(std::stod(what.substr(head.size())), 100 * std::abs(square_mm / 9.0 - 1), 0.1) << what;
+        EXPECT_NE(what.find(std::string(square_mm > 9 ? "% larger" : "% smaller") + " than squares of 9.000 mm"),
+                  std::string::npos)
+            << what;
       }
     }
   }
