@@ -154,6 +154,21 @@ struct OwnLensFit {
   double NoisePx2() const { return jumps.pairs > 0 ? jumps.ss_px2 / (4.0 * jumps.pairs) : 0.0; }
 };
 
+// p times the relative variance of OwnLensFit::NoisePx2 over p neighbour
+// pairs, for independent noise. Each pair's |e_i - e_j|^2 / (4 sigma^2) is
+// chi2_2 / 2 (mean 1, variance 1); two pairs sharing a corner correlate by
+// 1/4 (cov((e_i - e_j)^2, (e_i - e_k)^2) = 2 sigma^4 per axis against a
+// variance of 8 sigma^4), and a pair inside the grid shares a corner with 6
+// others: 1 + 6 / 4 = 2.5, the value used. Border pairs share fewer, so a
+// whole grid reads less: a Monte Carlo of this estimator (200 000 draws)
+// gave 2.35 on the 11x9 default board, 2.33 on 10x8, 2.20 on 6x5.
+constexpr double kJumpNoiseRelVarTimesPairs = 2.5;
+
+// The own-lens gate's coverage factor, fixed: a test of bad input (another
+// rig's lenses), not of a drift, so not the user's --k-sigma (up to 10,
+// which would let a lens 5 % off through).
+constexpr double kOwnLensK = 3.0;
+
 // `t` scaled by `s` in the board's plane (squares, margins, tags and the
 // faces' in-plane offset; the plate's thickness kept): the board another
 // print of the same design would be. nullopt when no such target is valid.
@@ -530,6 +545,9 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   result.board_size_note = BoardSizeNote(result.board_scales, rig.num_modules(), target.square_size_mm());
 
   std::map<int, OwnLensFit> own_lens;  // per camera, from the block below
+  // The calibration's RMS per camera (its lens model's misfit included),
+  // before tonight's noise raises in.sigma_px.
+  const std::vector<double> calibration_rms_px = in.sigma_px;
   // Tonight's corner noise, per camera: each view fitted with its own pose.
   // A camera that moved is fitted just as well (its own pose absorbs any
   // motion), so this sees noise only: how sharp tonight's views are, which
@@ -614,14 +632,16 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   // off: 0.60-0.80 px about its own poses against 0.25-0.29 px of noise
   // read from the jumps; 5 % off: 0.25-0.27 px against 0.20-0.21 px; 0.2 px
   // injected, seed 1 of NightlyCheck.AKnockOfAOneModuleRigIsNamed...; its
-  // seeds 1-5 all refused). Tested on
-  // the mean square: its H0 expectation is tonight's noise (neighbour
-  // jumps, which a lens's smooth misfit barely raises) plus the camera's
-  // projection uncertainty at k sigma; its relative spread over dof
-  // residuals sqrt(2 / dof), and the noise's over p neighbour pairs
-  // sqrt(4 / p) (each corner in up to four pairs: twice the independent
-  // pairs' variance, a bound, not measured). So the rule cannot tell a knock
-  // from another rig whose cameras have this rig's lenses: that night reads
+  // seeds 1-5 all refused). Tested on the mean square: its H0 expectation
+  // is the larger of tonight's noise (neighbour jumps, which a lens's smooth
+  // misfit barely raises) and the calibration's own RMS of that camera (its
+  // provenance residual: the lens model's misfit to the real lens, which
+  // tonight's views show again), plus the camera's projection uncertainty;
+  // its relative spread over dof residuals sqrt(2 / dof), and the noise's
+  // over p neighbour pairs sqrt(2.5 / p) (kJumpNoiseRelVarTimesPairs). At a
+  // fixed 3 sigma (kOwnLensK), not --k-sigma: this gate tells bad input from
+  // a rig, not a drift from noise. So the rule cannot tell a knock from
+  // another rig whose cameras have this rig's lenses: that night reads
   // recalibrate; nor from a board of another size (each view's own pose
   // absorbs a similarity), which the pair's fixed baseline does tell:
   // BoardOfAnotherSize, below.
@@ -629,9 +649,9 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
     const auto it = own_lens.find(c);
     if (it == own_lens.end() || it->second.dof <= 0 || it->second.jumps.pairs == 0) return false;
     const OwnLensFit& fit = it->second;
-    const double spread = std::sqrt(2.0 / fit.dof + 4.0 / fit.jumps.pairs);
-    return fit.MeanSquarePx2() <=
-           fit.NoisePx2() * (1 + options.k_sigma * spread) + std::pow(options.k_sigma * in.u_px[c], 2);
+    const double spread = std::sqrt(2.0 / fit.dof + kJumpNoiseRelVarTimesPairs / fit.jumps.pairs);
+    const double expected = std::max(fit.NoisePx2(), std::pow(calibration_rms_px[c], 2));
+    return fit.MeanSquarePx2() <= expected * (1 + kOwnLensK * spread) + std::pow(kOwnLensK * in.u_px[c], 2);
   };
   if (!any_fits && rig.num_cameras() == 2 && !camera_figures.empty()) {
     any_fits = true;
@@ -652,12 +672,18 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
       why = "each camera is off by > 2 px through the other's board poses";
       for (const auto& [c, f] : camera_figures) {
         if (fits_own_lens(c)) continue;
-        const OwnLensFit& fit = own_lens[c];
-        char text[160];
+        const auto it = own_lens.find(c);
+        if (it == own_lens.end() || it->second.dof <= 0 || it->second.jumps.pairs == 0) {
+          why += "; cam" + std::to_string(c) +
+                 "'s lens could not be tried: no view of it with a board pose of its own and neighbouring corners";
+          continue;
+        }
+        const OwnLensFit& fit = it->second;
+        char text[200];
         std::snprintf(text, sizeof text,
                       "; cam%d's corners fit its lens to %.3f px about their own board poses against %.3f px "
-                      "of noise",
-                      c, std::sqrt(fit.MeanSquarePx2()), std::sqrt(fit.NoisePx2()));
+                      "of noise (%.3f px at calibration)",
+                      c, std::sqrt(fit.MeanSquarePx2()), std::sqrt(fit.NoisePx2()), calibration_rms_px[c]);
         why += text;
       }
     }
