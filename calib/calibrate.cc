@@ -193,10 +193,11 @@ SystemExclusions EarlierStageVerdicts(const CalibrationInput& in, const std::vec
 
 // "" if stage 3's back_from_front is within its file's sigma (or was
 // held), else the line refusing the file. The bound is the same plate's
-// (kSamePlateChiSquare): a right file's chi-square is at most as wide as
-// chi-square with 6 degrees of freedom (SystemReport), so fewer than 3 in
-// 1000 right files are refused; a thickness typed in metres (tz 0.005 for
-// 5 mm, the file's sigma 0.01 mm) reads ~70000.
+// over the axes refined (SamePlateChiSquare(axes); an axis whose sigma is 0
+// is held and not judged): a right file's chi-square is at most as wide as
+// chi-square with that many degrees of freedom (SystemReport), so fewer
+// than 3 in 1000 right files are refused; a thickness typed in metres (tz
+// 0.005 for 5 mm, the file's sigma 0.01 mm) reads ~70000.
 std::string WrongPlateProblem(const PlateDifference& d) {
   if (d.SamePlate()) return "";
   char b[400];

@@ -276,23 +276,25 @@ Consistency CameraConsistency(const Inputs& in, int c, const std::set<int>& trus
   return out;
 }
 
-// The camera of a lone module (no other module to agree with) whose change
-// is a turn about its own centre, or none. Each camera's corners are fitted
-// with a new pose (ExplainCameraChange) through the board poses its partner
+// The camera of a lone module (no other module to agree with) whose change is
+// a turn about its own centre, or none. Each camera's corners are fitted with
+// a new pose (ExplainCameraChange) through the board poses its partner
 // implies. Either camera's new pose explains a change of the pair, but a
 // camera turned by theta about its own centre reads as a turn alone, while
 // read as its partner's motion it needs the same turn and a shift of the
-// partner's centre by the baseline times theta (1.6 mm per degree at 90 mm:
-// turned 1 and 3 degrees, 1.3-4.0 mm against 0.02-0.09 mm). So the camera
-// named is the one whose fitted shift is within its error of none while its
-// partner's is not: the error, the spread of the shift fitted capture by
+// partner's centre by |theta x b| (theta the rotation vector, b the baseline:
+// up to 1.6 mm per degree at 90 mm; turned 1 and 3 degrees about random axes,
+// 1.3-4.0 mm against 0.02-0.09 mm). A turn about the baseline has no lever: it
+// cannot be attributed to either camera, and the module is named. So the
+// camera named is the one whose fitted shift is within its error of none while
+// its partner's is not: the error, the spread of the shift fitted capture by
 // capture (a standard error over the captures, with the closures' Student-t
-// inflation), at the closures' chi bound. A camera shifted, or turned about
-// a pivot far from its centre, shifts in both readings, and a turn too small
-// for its lever to show (0.05 deg: 0.08 mm, within the error) in neither:
-// the module is named then, its two cameras disagreeing. That its partner
-// turned and shifted by just the lever arm is the other reading, which this
-// takes for the less likely.
+// inflation), at the closures' chi bound. A camera shifted, or turned about a
+// pivot far from its centre, shifts in both readings, and a turn too small for
+// its lever to show (0.05 deg: 0.08 mm, within the error) in neither: the
+// module is named then, its two cameras disagreeing. That its partner turned
+// and shifted by just the lever arm is the other reading, which this takes for
+// the less likely.
 std::optional<CameraChange> TurnedCameraOfModule(const Inputs& in, const StereoModule& mod) {
   struct Reading {
     CameraChange change;

@@ -393,8 +393,8 @@ TEST(NightlyCheck, AKnockOfDegreesOrMillimetresIsNamedNotRefusedAsAnotherRig) {
 // seeds. Judged now: each camera's corners still fit its own lens about
 // board poses of their own (nightly_check.cc, fits_own_lens), and the turned
 // camera is named, since read as its partner's motion the same night needs
-// a shift of the partner by the baseline times the turn (1.6 mm per
-// degree; TurnedCameraOfModule). Another rig's captures are still refused:
+// a shift of the partner by |turn x baseline| (up to 1.6 mm per degree;
+// TurnedCameraOfModule). Another rig's captures are still refused:
 // its right camera 30 mm and 5 degrees elsewhere and both focal lengths
 // 20 % off (on seed 1, about their own poses 0.60-0.80 px against 0.25-0.29
 // px of noise read from neighbour jumps), or only 5 % off (0.25-0.27 px against
