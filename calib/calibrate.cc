@@ -472,7 +472,9 @@ std::string CalibrationReport::ToJson() const {
     WritePose(j, "back_from_front_refined", s.back_from_front);
     j.Number("back_from_front_change_deg", s.back_from_front_change_deg);
     j.Number("back_from_front_change_mm", s.back_from_front_change_mm);
-    j.Number("back_from_front_chi_square", s.back_from_front_vs_file.chi_square).String("wrong_plate", wrong_plate);
+    j.Number("back_from_front_chi_square", s.back_from_front_vs_file.chi_square);
+    j.Int("back_from_front_axes", s.back_from_front_vs_file.axes);
+    j.Number("back_from_front_chi_square_bound", s.back_from_front_vs_file.Bound()).String("wrong_plate", wrong_plate);
     j.String("solver", s.solver_summary).EndObject();
   }
   j.EndObject();
