@@ -148,10 +148,15 @@ int RunCheck(int argc, char** argv) {
   std::string rig_bytes;
   const Rig rig = ReadRigFile(rig_path, &rig_bytes);
   const std::string rig_crc32 = Crc32Hex(rig_bytes);  // of the bytes parsed
-  RequireCalibrationResiduals(rig, rig_path);         // named by the rig file, before minutes of detection
+  // The files as the history keeps them, resolved as they are read: a link
+  // re-pointed during the minutes of detection would name another file.
+  const std::string rig_kept_as = HistoryPathOf(rig_path);
+  RequireCalibrationResiduals(rig, rig_path);  // named by the rig file, before minutes of detection
   // The board with the back_from_front the calibration ended with (S holds
   // with it); a board other than the calibration's is refused here.
   const CheckTarget check_target = TargetForCheck(rig, ReadTargetFile(target_path), target_path);
+  const std::string target_kept_as = HistoryPathOf(target_path);
+  const std::string captures_kept_as = HistoryPathOf(captures);
   const Target& target = check_target.target;
   RejectCamerasBeyondTheRig(captures, rig.num_cameras());
   // A history that is not ours is refused before any work, so a failed run
@@ -272,12 +277,12 @@ int RunCheck(int argc, char** argv) {
   // history without the night.
   AtomicOutputSet staged_report;
   if (!report_path.empty()) staged_report.Add(report_path, report.dump(2) + "\n");
-  // Paths as typed: the history keeps them absolute and canonical
-  // (HistoryPathOf), rig_file and rig_path alike.
-  HistoryRun run{0, report["date_utc"], rig_path, captures, "", ""};
-  run.rig_path = rig_path;
+  // Paths as resolved when the files were read (HistoryPathOf), rig_file
+  // and rig_path alike.
+  HistoryRun run{0, report["date_utc"], rig_kept_as, captures_kept_as, "", ""};
+  run.rig_path = rig_kept_as;
   run.rig_crc32 = rig_crc32;
-  run.target_path = target_path;
+  run.target_path = target_kept_as;
   run.board = check_target.back_from_front_as_calibrated ? "as calibrated" : "the target file's";
   AppendToHistory(history_db, run, result, detected.capture_names);
   staged_report.Commit();

@@ -193,10 +193,11 @@ SystemExclusions EarlierStageVerdicts(const CalibrationInput& in, const std::vec
 
 // "" if stage 3's back_from_front is within its file's sigma (or was
 // held), else the line refusing the file. The bound is the same plate's
-// (kSamePlateChiSquare): a right file's chi-square is at most as wide as
-// chi-square with 6 degrees of freedom (SystemReport), so fewer than 3 in
-// 1000 right files are refused; a thickness typed in metres (tz 0.005 for
-// 5 mm, the file's sigma 0.01 mm) reads ~70000.
+// over the axes refined (SamePlateChiSquare(axes); an axis whose sigma is 0
+// is held and not judged): a right file's chi-square is at most as wide as
+// chi-square with that many degrees of freedom (SystemReport), so fewer
+// than 3 in 1000 right files are refused; a thickness typed in metres (tz
+// 0.005 for 5 mm, the file's sigma 0.01 mm) reads ~70000.
 std::string WrongPlateProblem(const PlateDifference& d) {
   if (d.SamePlate()) return "";
   char b[400];
@@ -471,7 +472,9 @@ std::string CalibrationReport::ToJson() const {
     WritePose(j, "back_from_front_refined", s.back_from_front);
     j.Number("back_from_front_change_deg", s.back_from_front_change_deg);
     j.Number("back_from_front_change_mm", s.back_from_front_change_mm);
-    j.Number("back_from_front_chi_square", s.back_from_front_vs_file.chi_square).String("wrong_plate", wrong_plate);
+    j.Number("back_from_front_chi_square", s.back_from_front_vs_file.chi_square);
+    j.Int("back_from_front_axes", s.back_from_front_vs_file.axes);
+    j.Number("back_from_front_chi_square_bound", s.back_from_front_vs_file.Bound()).String("wrong_plate", wrong_plate);
     j.String("solver", s.solver_summary).EndObject();
   }
   j.EndObject();

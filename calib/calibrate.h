@@ -43,9 +43,10 @@ struct CalibrationReport {
   double max_rms_px = 0.0;
   std::string not_converged;
   // Stage 3's refined back_from_front far beyond the target file's stated
-  // sigma (SystemReport::back_from_front_vs_file over kSamePlateChiSquare):
-  // one line saying by how much and on which axis, for the message refusing
-  // the rig file; "" if within, or not refined (one module, a sigma of 0).
+  // sigma (SystemReport::back_from_front_vs_file over
+  // SamePlateChiSquare(axes), the axes refined): one line saying by how
+  // much and on which axis, for the message refusing the rig file; "" if
+  // within, or not refined (one module, every sigma 0).
   std::string wrong_plate;
   // The capture's folder name where known, else its index in decimal: how
   // the summary names a capture (the JSON keeps the index and adds the name).

@@ -299,6 +299,9 @@ TEST(CalibrateRefuses, ABackFromFrontThatIsNotThePlates) {
   std::ifstream report(dir + "/report.json");
   const nlohmann::json j = nlohmann::json::parse(report);
   EXPECT_GT(j.at("stage3_system").at("back_from_front_chi_square").get<double>(), kSamePlateChiSquare);
+  // The axes judged and their bound beside it: all six here (every sigma 0.01).
+  EXPECT_EQ(j.at("stage3_system").at("back_from_front_axes").get<int>(), 6);
+  EXPECT_DOUBLE_EQ(j.at("stage3_system").at("back_from_front_chi_square_bound").get<double>(), kSamePlateChiSquare);
   EXPECT_EQ(j.at("stage3_system").at("wrong_plate").get<std::string>(), r.report.wrong_plate);
 }
 

@@ -126,8 +126,10 @@ struct SystemReport {
   // file's stated sigma (calib/plate_difference.h). The refined value is the
   // file's (the prior) updated by the corners, so for a file that is right
   // it moves by less than the prior's spread: chi-square at most as wide as
-  // chi-square with 6 degrees of freedom. Zero where it was held (a sigma
-  // of 0, no back face seen, or refine_back_from_front false).
+  // chi-square with as many degrees of freedom as axes refined (axes; an
+  // axis whose sigma is 0 is held and not judged). Zero where it was held
+  // whole (every sigma 0, no back face seen, or refine_back_from_front
+  // false).
   PlateDifference back_from_front_vs_file;
   std::string solver_summary;  // Ceres BriefReport
 };

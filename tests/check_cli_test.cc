@@ -61,6 +61,7 @@ struct DbState {
   int runs = -1;
   std::string last_rig_path, last_rig_crc32, last_board;  // the last run's inputs
   std::string last_rig_file;                              // the last run's rig_file (stereorig_check_runs)
+  std::string last_captures;                              // the last run's captures (stereorig_check_runs)
 };
 DbState ReadDb(const std::string& path) {
   DbState s;
@@ -84,6 +85,7 @@ DbState ReadDb(const std::string& path) {
   s.last_rig_crc32 = one("SELECT rig_crc32 FROM stereorig_check_run_inputs ORDER BY run_id DESC LIMIT 1");
   s.last_board = one("SELECT board FROM stereorig_check_run_inputs ORDER BY run_id DESC LIMIT 1");
   s.last_rig_file = one("SELECT rig_file FROM stereorig_check_runs ORDER BY id DESC LIMIT 1");
+  s.last_captures = one("SELECT captures FROM stereorig_check_runs ORDER BY id DESC LIMIT 1");
   sqlite3_close(db);
   return s;
 }
@@ -135,7 +137,8 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
                   crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(bytes.data()), uInt(bytes.size())));
     const DbState s = ReadDb(db);
     EXPECT_EQ(s.last_rig_path, fs::canonical(dir + "/rig.yaml").string());
-    EXPECT_EQ(s.last_rig_file, s.last_rig_path);  // one path for one file, in both tables
+    EXPECT_EQ(s.last_rig_file, s.last_rig_path);                      // one path for one file, in both tables
+    EXPECT_EQ(s.last_captures, fs::canonical(dir + "/ds").string());  // as typed: "<TempDir>/" + "/check_cli_..."
     EXPECT_EQ(s.last_rig_crc32, crc);
     EXPECT_EQ(s.last_board, "as calibrated");
 

@@ -29,9 +29,10 @@ namespace stereorig {
 // ~0.1 %. Beyond, another board.
 inline constexpr double kSameBoardSquareOff = 0.005;
 // A target file whose back_from_front differs from the one filed at
-// calibration by no more than kSamePlateChiSquare (calib/plate_difference.h;
-// 6 axes, each over the two files' sigmas combined) is the same plate.
-// Beyond, another plate (or not the plate's file): refused.
+// calibration by no more than SamePlateChiSquare(axes)
+// (calib/plate_difference.h; the axes judged, each over the two files'
+// sigmas combined; an axis both hold at sigma 0 must not move) is the same
+// plate. Beyond, another plate (or not the plate's file): refused.
 
 struct CheckTarget {
   explicit CheckTarget(Target board) : target(std::move(board)) {}

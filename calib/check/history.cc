@@ -97,6 +97,15 @@ std::string HistoryPathOf(const std::string& path) {
     const fs::path canonical = fs::canonical(absolute, ec);
     if (!ec) return canonical.string();
   }
+  // Anything else (a folder, a pipe, a path not there): the part that
+  // exists resolved, the rest appended. Not lexically_normal: it collapses
+  // "link/.." to the folder holding the link, not the one the link names.
+  const fs::path weakly = fs::weakly_canonical(absolute, ec);
+  if (!ec && !weakly.empty()) return weakly.string();
+  // What cannot be resolved (/dev/fd/N names a pipe, not a path): absolute,
+  // normalised only where that cannot cross a link.
+  for (const fs::path& part : absolute)
+    if (part == "..") return absolute.string();
   return absolute.lexically_normal().string();
 }
 
@@ -113,10 +122,10 @@ long long AppendToHistory(const std::string& path, const HistoryRun& run, const 
                        path);
     const std::string verdict = result.Verdict(), explanation = result.Explanation();
     const std::string rig_file = HistoryPathOf(run.rig_file), rig_path = HistoryPathOf(run.rig_path);
-    const std::string target_path = HistoryPathOf(run.target_path);
+    const std::string target_path = HistoryPathOf(run.target_path), captures = HistoryPathOf(run.captures);
     sqlite3_bind_text(ins.get(), 1, run.date_utc.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(ins.get(), 2, rig_file.c_str(), -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(ins.get(), 3, run.captures.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(ins.get(), 3, captures.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(ins.get(), 4, verdict.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(ins.get(), 5, explanation.c_str(), -1, SQLITE_TRANSIENT);
     if (sqlite3_step(ins.get()) != SQLITE_DONE)

@@ -19,14 +19,16 @@ struct HistoryRun {
   // (a relative path, relative to a folder not recorded): read back as
   // their rig_path where they have one, as typed where not.
   std::string rig_file;
+  // The captures folder, kept as HistoryPathOf's too; runs written before
+  // hold it as typed, and read back so (nothing says from which folder).
   std::string captures;
   std::string verdict;  // "ok" or "recalibrate"
   std::string explanation;
   // What the night was measured with (empty in runs written before they were
   // kept; paths kept as HistoryPathOf's): the rig file's absolute path and a
-  // CRC-32 of its bytes (a rig
-  // recalibrated into the same path reads as another), the target file's
-  // absolute path, and which back_from_front the closures used.
+  // CRC-32 of its bytes (a rig recalibrated into the same path reads as
+  // another), the target file's absolute path, and which back_from_front the
+  // closures used.
   std::string rig_path = "";
   std::string rig_crc32 = "";  // 8 hex digits
   std::string target_path = "";
@@ -67,18 +69,21 @@ struct FigureTrend {
 
 // The path a history keeps for a file, so that one file reads as one path
 // whichever folder the check ran from and however it was typed: absolute,
-// and canonical (links, "." and ".." resolved) for a regular file; absolute
-// and lexically normal for anything else (a pipe, /dev/fd/N, or a path not
-// there: what it names cannot be resolved).
+// and canonical (links, "." and ".." resolved) for a regular file; for
+// anything else (a folder, a pipe, a path not there) the part that exists
+// resolved so (weakly canonical: "link/.." is the folder the link names
+// is in, not the link's); what cannot be resolved at all (/dev/fd/N)
+// absolute, as typed. A caller resolves each file when it reads it (the
+// check: right after reading the rig and target files), not minutes later
+// when the run is appended: a link re-pointed meanwhile would name another
+// file.
 std::string HistoryPathOf(const std::string& path);
 
-// Appends one run, its paths (rig_file, rig_path, target_path) kept as
-// HistoryPathOf's. Creates the database (and its tables) if missing. Throws
-// InputError naming `db_path` if it is not an SQLite database of ours or
-// cannot be written.
-// The views the run set aside are stored with it, each capture named by
-// capture_names (CheckResult's capture index -> name; the index where it has
-// none).
+// Appends one run, its paths (rig_file, captures, rig_path, target_path)
+// kept as HistoryPathOf's (a no-op on paths the caller already resolved). Creates the database (and its tables) if
+// missing. Throws InputError naming `db_path` if it is not an SQLite database of ours or cannot be written. The views
+// the run set aside are stored with it, each capture named by capture_names (CheckResult's capture index -> name; the
+// index where it has none).
 long long AppendToHistory(const std::string& db_path, const HistoryRun& run, const CheckResult& result,
                           const std::map<int, std::string>& capture_names = {});
 

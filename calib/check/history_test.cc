@@ -153,10 +153,36 @@ TEST(History, KeepsTheRigFileAbsoluteAndCanonicalAndReadsOlderRunsAsTyped) {
   const auto old_runs = ReadHistoryRuns(old_db);
   ASSERT_EQ(old_runs.size(), 3u);
   EXPECT_EQ(old_runs[0].rig_file, "rig.yaml");  // no inputs row: as typed
+  EXPECT_EQ(old_runs[0].captures, "n1");        // as typed, as written
   EXPECT_EQ(old_runs[1].rig_file, "/line/rig.yaml");
   EXPECT_EQ(old_runs[1].rig_path, "/line/rig.yaml");
   EXPECT_EQ(old_runs[2].rig_file, rig);
   EXPECT_NE(FormatTrends(old_runs, ReadHistoryTrends(old_db)).find("3 run(s)"), std::string::npos);
+}
+
+// The captures folder is kept as the rig file is (HistoryPathOf): it was
+// kept as typed, relative to a folder the history does not record, so one
+// folder read as many. A path that is not a regular file (a folder, or
+// one not there) is resolved through the part that exists: lexically
+// normal, "link/../x" read as the folder holding the link, where the link
+// names a folder elsewhere. Older runs' captures read back as typed.
+TEST(History, KeepsTheCapturesFolderAbsoluteAndResolvesPathsThroughLinks) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::absolute(::testing::TempDir()) / "history_captures";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "line" / "nights" / "tonight");
+  fs::create_symlink(dir / "line" / "nights", dir / "nights");
+  const std::string nights = fs::canonical(dir / "line" / "nights").string();
+  // Through the link and "..": the folder the link names is in line/.
+  EXPECT_EQ(HistoryPathOf((dir / "nights" / ".." / "nights" / "tonight").string()), nights + "/tonight");
+  EXPECT_EQ(HistoryPathOf((dir / "nights" / ".." / "not-there.yaml").string()),
+            fs::canonical(dir / "line").string() + "/not-there.yaml");
+  const std::string db = (dir / "history.sqlite").string();
+  HistoryRun r{0, "2026-11-20T02:00:00Z", "rig.yaml", (dir / "nights" / "." / "tonight").string(), "", ""};
+  AppendToHistory(db, r, Result(0.20, true));
+  const auto runs = ReadHistoryRuns(db);
+  ASSERT_EQ(runs.size(), 1u);
+  EXPECT_EQ(runs[0].captures, nights + "/tonight");
 }
 
 // A history the night cannot be written to is found before the check's

@@ -154,6 +154,41 @@ struct OwnLensFit {
   double NoisePx2() const { return jumps.pairs > 0 ? jumps.ss_px2 / (4.0 * jumps.pairs) : 0.0; }
 };
 
+// p times the relative variance of OwnLensFit::NoisePx2 over p neighbour
+// pairs, for independent noise. Each pair's |e_i - e_j|^2 / (4 sigma^2) is
+// chi2_2 / 2 (mean 1, variance 1); two pairs sharing a corner correlate by
+// 1/4 (cov((e_i - e_j)^2, (e_i - e_k)^2) = 2 sigma^4 per axis against a
+// variance of 8 sigma^4), and a pair inside the grid shares a corner with 6
+// others: 1 + 6 / 4 = 2.5, the value used. Border pairs share fewer, so a
+// whole grid reads less: a Monte Carlo of this estimator (200 000 draws)
+// gave 2.35 on the 11x9 default board, 2.33 on 10x8, 2.20 on 6x5.
+constexpr double kJumpNoiseRelVarTimesPairs = 2.5;
+
+// The own-lens gate's coverage factor, fixed: a test of bad input (another
+// rig's lenses), not of a drift, so not the user's --k-sigma (up to 10,
+// which would let a lens 5 % off through).
+constexpr double kOwnLensK = 3.0;
+
+// `t` scaled by `s` in the board's plane (squares, margins, tags and the
+// faces' in-plane offset; the plate's thickness kept): the board another
+// print of the same design would be. nullopt when no such target is valid.
+std::optional<Target> ScaledBoard(const Target& t, double s) {
+  Target::Layout l = t.layout();
+  l.square_size_mm *= s;
+  l.margin_mm *= s;
+  l.tag_size_mm *= s;
+  for (TargetFace& face : l.faces)
+    for (TagPlacement& tag : face.tags) tag.center_x_mm *= s, tag.center_y_mm *= s;
+  Eigen::Vector3d offset = l.back_from_front.translation_mm();
+  offset.x() *= s, offset.y() *= s;
+  l.back_from_front = Pose(l.back_from_front.rotation(), offset);
+  try {
+    return Target(l, "scaled board");
+  } catch (const InputError&) {
+    return std::nullopt;
+  }
+}
+
 // Each capture given (with its number of views) that `in` no longer holds,
 // named (capture_names, else its index) with why: its views set aside, too
 // few corners left after trimming, or no board pose.
@@ -241,23 +276,25 @@ Consistency CameraConsistency(const Inputs& in, int c, const std::set<int>& trus
   return out;
 }
 
-// The camera of a lone module (no other module to agree with) whose change
-// is a turn about its own centre, or none. Each camera's corners are fitted
-// with a new pose (ExplainCameraChange) through the board poses its partner
+// The camera of a lone module (no other module to agree with) whose change is
+// a turn about its own centre, or none. Each camera's corners are fitted with
+// a new pose (ExplainCameraChange) through the board poses its partner
 // implies. Either camera's new pose explains a change of the pair, but a
 // camera turned by theta about its own centre reads as a turn alone, while
 // read as its partner's motion it needs the same turn and a shift of the
-// partner's centre by the baseline times theta (1.6 mm per degree at 90 mm:
-// turned 1 and 3 degrees, 1.3-4.0 mm against 0.02-0.09 mm). So the camera
-// named is the one whose fitted shift is within its error of none while its
-// partner's is not: the error, the spread of the shift fitted capture by
+// partner's centre by |theta x b| (theta the rotation vector, b the baseline:
+// up to 1.6 mm per degree at 90 mm; turned 1 and 3 degrees about random axes,
+// 1.3-4.0 mm against 0.02-0.09 mm). A turn about the baseline has no lever: it
+// cannot be attributed to either camera, and the module is named. So the
+// camera named is the one whose fitted shift is within its error of none while
+// its partner's is not: the error, the spread of the shift fitted capture by
 // capture (a standard error over the captures, with the closures' Student-t
-// inflation), at the closures' chi bound. A camera shifted, or turned about
-// a pivot far from its centre, shifts in both readings, and a turn too small
-// for its lever to show (0.05 deg: 0.08 mm, within the error) in neither:
-// the module is named then, its two cameras disagreeing. That its partner
-// turned and shifted by just the lever arm is the other reading, which this
-// takes for the less likely.
+// inflation), at the closures' chi bound. A camera shifted, or turned about a
+// pivot far from its centre, shifts in both readings, and a turn too small for
+// its lever to show (0.05 deg: 0.08 mm, within the error) in neither: the
+// module is named then, its two cameras disagreeing. That its partner turned
+// and shifted by just the lever arm is the other reading, which this takes for
+// the less likely.
 std::optional<CameraChange> TurnedCameraOfModule(const Inputs& in, const StereoModule& mod) {
   struct Reading {
     CameraChange change;
@@ -295,6 +332,47 @@ std::optional<CameraChange> TurnedCameraOfModule(const Inputs& in, const StereoM
   const Reading& named = left.turn_alone ? left : right;
   if (!explained_by_pose(named.change)) return std::nullopt;
   return named.change;
+}
+
+// A lone module's captures of a board whose squares are not the target
+// file's. Each view's own board pose absorbs a pure similarity, so every
+// view fits its camera's lens as a knock's do (fits_own_lens), while each
+// camera is off through its partner's poses: the stored baseline makes the
+// pair measure the board's size absolutely. Refitted with the stored
+// right_from_left and one free board scale, the size the module measures
+// (MeasureBoardScale: each capture's triangulated corners against the
+// file's grid, the median over the captures), such a board leaves each
+// camera within its consistency threshold through its partner's poses; a
+// turned or shifted camera is not explained by a scale and leaves them off.
+// The text to refuse with, or nullopt.
+std::optional<std::string> BoardOfAnotherSize(const Inputs& in, const std::vector<ModuleBoardScale>& scales) {
+  const StereoModule& mod = in.rig.module(0);
+  const auto it = std::find_if(scales.begin(), scales.end(), [](const ModuleBoardScale& m) { return m.module == 0; });
+  if (it == scales.end() || it->captures < 3) return std::nullopt;
+  const std::optional<Target> board = ScaledBoard(in.target, it->scale);
+  if (!board) return std::nullopt;
+  Inputs scaled{in.rig, *board, in.options, in.by_capture, in.sigma_px, in.u_px, {}};
+  // Each seed pose moved as a board of that size would be to look the same
+  // from the reference frame's origin.
+  for (const auto& [capture, pose] : in.seed)
+    scaled.seed[capture] = Pose(pose.rotation(), it->scale * pose.translation_mm());
+  std::string each;
+  for (auto [c, partner] :
+       {std::pair{mod.left_camera, mod.right_camera}, std::pair{mod.right_camera, mod.left_camera}}) {
+    const Consistency con = CameraConsistency(scaled, c, {partner});
+    if (con.corners == 0 || !(con.rms_px <= con.threshold_px)) return std::nullopt;
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "%scam%d %.3f px within %.3f px", each.empty() ? "" : ", ", c, con.rms_px,
+                  con.threshold_px);
+    each += buf;
+  }
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "module 0 measures the board %.2f%% %s than squares of %.3f mm, and on a board of that size both "
+                "cameras agree through each other's board poses (%s)",
+                100 * std::abs(it->scale - 1), it->scale > 1 ? "larger" : "smaller", in.target.square_size_mm(),
+                each.c_str());
+  return std::string(text);
 }
 
 }  // namespace
@@ -469,6 +547,9 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   result.board_size_note = BoardSizeNote(result.board_scales, rig.num_modules(), target.square_size_mm());
 
   std::map<int, OwnLensFit> own_lens;  // per camera, from the block below
+  // The calibration's RMS per camera (its lens model's misfit included),
+  // before tonight's noise raises in.sigma_px.
+  const std::vector<double> calibration_rms_px = in.sigma_px;
   // Tonight's corner noise, per camera: each view fitted with its own pose.
   // A camera that moved is fitted just as well (its own pose absorbs any
   // motion), so this sees noise only: how sharp tonight's views are, which
@@ -553,26 +634,38 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   // off: 0.60-0.80 px about its own poses against 0.25-0.29 px of noise
   // read from the jumps; 5 % off: 0.25-0.27 px against 0.20-0.21 px; 0.2 px
   // injected, seed 1 of NightlyCheck.AKnockOfAOneModuleRigIsNamed...; its
-  // seeds 1-5 all refused). Tested on
-  // the mean square: its H0 expectation is tonight's noise (neighbour
-  // jumps, which a lens's smooth misfit barely raises) plus the camera's
-  // projection uncertainty at k sigma; its relative spread over dof
-  // residuals sqrt(2 / dof), and the noise's over p neighbour pairs
-  // sqrt(4 / p) (each corner in up to four pairs: twice the independent
-  // pairs' variance, a bound, not measured). So the rule cannot tell a knock
-  // from another rig whose cameras have this rig's lenses: that night reads
-  // recalibrate.
+  // seeds 1-5 all refused). Tested on the mean square: its H0 expectation
+  // is the larger of tonight's noise (neighbour jumps, which a lens's smooth
+  // misfit barely raises) and the calibration's own RMS of that camera (its
+  // provenance residual: the lens model's misfit to the real lens, which
+  // tonight's views show again), plus the camera's projection uncertainty;
+  // its relative spread over dof residuals sqrt(2 / dof), and the noise's
+  // over p neighbour pairs sqrt(2.5 / p) (kJumpNoiseRelVarTimesPairs). At a
+  // fixed 3 sigma (kOwnLensK), not --k-sigma: this gate tells bad input from
+  // a rig, not a drift from noise. So the rule cannot tell a knock from
+  // another rig whose cameras have this rig's lenses: that night reads
+  // recalibrate; nor from a board of another size (each view's own pose
+  // absorbs a similarity), which the pair's fixed baseline does tell:
+  // BoardOfAnotherSize, below.
   auto fits_own_lens = [&](int c) {
     const auto it = own_lens.find(c);
     if (it == own_lens.end() || it->second.dof <= 0 || it->second.jumps.pairs == 0) return false;
     const OwnLensFit& fit = it->second;
-    const double spread = std::sqrt(2.0 / fit.dof + 4.0 / fit.jumps.pairs);
-    return fit.MeanSquarePx2() <=
-           fit.NoisePx2() * (1 + options.k_sigma * spread) + std::pow(options.k_sigma * in.u_px[c], 2);
+    const double spread = std::sqrt(2.0 / fit.dof + kJumpNoiseRelVarTimesPairs / fit.jumps.pairs);
+    const double expected = std::max(fit.NoisePx2(), std::pow(calibration_rms_px[c], 2));
+    return fit.MeanSquarePx2() <= expected * (1 + kOwnLensK * spread) + std::pow(kOwnLensK * in.u_px[c], 2);
   };
   if (!any_fits && rig.num_cameras() == 2 && !camera_figures.empty()) {
     any_fits = true;
     for (const auto& [c, f] : camera_figures) any_fits = any_fits && fits_own_lens(c);
+    // A board whose squares are not the target file's fits every view's own
+    // lens too: refused, as before the own-lens rule, naming the board.
+    if (any_fits) {
+      if (const std::optional<std::string> board = BoardOfAnotherSize(in, result.board_scales)) {
+        throw InputError(where, "the captures do not fit this rig's board: " + *board +
+                                    ": a board other than the target file's, or the wrong target file?");
+      }
+    }
   }
   if (!camera_figures.empty() && !any_fits) {
     std::string why = "every camera is off by > 2 px, whichever other camera or module is left out";
@@ -581,12 +674,18 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
       why = "each camera is off by > 2 px through the other's board poses";
       for (const auto& [c, f] : camera_figures) {
         if (fits_own_lens(c)) continue;
-        const OwnLensFit& fit = own_lens[c];
-        char text[160];
+        const auto it = own_lens.find(c);
+        if (it == own_lens.end() || it->second.dof <= 0 || it->second.jumps.pairs == 0) {
+          why += "; cam" + std::to_string(c) +
+                 "'s lens could not be tried: no view of it with a board pose of its own and neighbouring corners";
+          continue;
+        }
+        const OwnLensFit& fit = it->second;
+        char text[200];
         std::snprintf(text, sizeof text,
                       "; cam%d's corners fit its lens to %.3f px about their own board poses against %.3f px "
-                      "of noise",
-                      c, std::sqrt(fit.MeanSquarePx2()), std::sqrt(fit.NoisePx2()));
+                      "of noise (%.3f px at calibration)",
+                      c, std::sqrt(fit.MeanSquarePx2()), std::sqrt(fit.NoisePx2()), calibration_rms_px[c]);
         why += text;
       }
     }
