@@ -832,17 +832,18 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       // in the edge margin inside it (face and captured are both ascending).
       // The outline's sides pass through its outermost points: on it is in
       // (1 um, for rounding).
-      e.plate_points_off_outline = 0;
+      e.plate_points_off_outline = extent.points_outside;
+      e.plate_points_outside_rectangle = 0;
       for (size_t k = 0, f = 0; k < captured.size(); ++k) {
         if (f < face.size() && face[f] == captured[k]) {
           ++f;
         } else if (extent.InsideEroded(pts[captured[k]], -1e-3)) {
           ++e.points_in_edge_margin;
         } else {
-          ++e.plate_points_off_outline;
+          ++e.plate_points_outside_rectangle;
         }
       }
-      e.points_off_artifact = e.points_total - static_cast<int>(captured.size()) + e.plate_points_off_outline;
+      e.points_off_artifact = e.points_total - static_cast<int>(captured.size()) + e.plate_points_outside_rectangle;
       int excluded = 0;
       const std::vector<int> kept = ExcludeWorst(fit.inliers, fit.residuals_mm, o.excluded_fraction_max, &excluded);
       fit = FitPlaneLeastSquares(pts, kept);

@@ -158,10 +158,13 @@ struct ArtifactEvaluation {
   // grid period off on one ball shows here, where SD may not show it.
   std::vector<double> sphere_form_mm;
   // Plate: the outline of the face's dense part (plate_outline.h), before the
-  // edge margin, and the captured points outside that rectangle (strays,
-  // sparse edges; part of points_off_artifact).
+  // edge margin; the captured points not in that dense part (strays, sparse
+  // edges: PlaneOutline::points_outside; some of them inside the rectangle,
+  // so in the edge margin or the figures); and the captured points outside
+  // the rectangle itself (part of points_off_artifact).
   double plate_outline_length_mm = 0, plate_outline_width_mm = 0;
   int plate_points_off_outline = 0;
+  int plate_points_outside_rectangle = 0;
   Eigen::Vector3d plane_normal = Eigen::Vector3d::Zero();
   double plane_offset_mm = 0;
   // Empty when the position is judged. Otherwise why it is not: a figure the

@@ -1474,7 +1474,10 @@ TEST(Vdi2634, EveryPointIsCountedOnceOffTheArtifactInTheEdgeMarginExcludedOrUsed
   EXPECT_EQ(plate.points_total, static_cast<int>(cloud.size()));
   sums(plate);
   EXPECT_EQ(plate.points_off_artifact, 402);
-  EXPECT_EQ(plate.plate_points_off_outline, 2);
+  EXPECT_EQ(plate.plate_points_outside_rectangle, 2);
+  // Off the dense part: the 2, and edge cells the density grid (at the
+  // fitted plane's arbitrary in-plane axes) cuts thin.
+  EXPECT_GE(plate.plate_points_off_outline, 2);
   EXPECT_EQ(plate.points_in_edge_margin, 131 * 131 - 119 * 119);
   EXPECT_EQ(plate.points_on_artifact, 119 * 119);
 
@@ -1499,6 +1502,42 @@ TEST(Vdi2634, EveryPointIsCountedOnceOffTheArtifactInTheEdgeMarginExcludedOrUsed
   sums(e_bar);
   EXPECT_EQ(e_bar.points_in_edge_margin, 0);
   EXPECT_GT(e_bar.points_off_artifact, 0);  // the caps' points within 60 deg of the bar axis
+}
+
+// plate_points_off_outline keeps its meaning, the captured points not in the
+// face's dense part (PlaneOutline::points_outside), and
+// plate_points_outside_rectangle counts those outside the outline itself.
+// Truth: the 130 mm plate at 1 mm, without noise (so the fitted plane is
+// z = 5 exactly and the 3 mm density cells, fixed about the world's origin,
+// lie along the grid: its points at half-millimetres, none on a cell's
+// side, and every cell at the plate's edge at least 2 x 2 points, dense: a
+// quarter of the median's 9 is 2.25), with a hole 11 x 11 points wide at
+// its centre (|u|, |v| <= 5 mm: nine cells left empty) holding 4 points,
+// each alone in a cell (not dense), and 2 strays in its plane 10 mm beyond
+// a side. The 4 lie inside the rectangle, in the face (on the artifact);
+// the 2 outside it (off). So 6 off the dense part, 2 outside the rectangle.
+// The two counts were one key whose meaning changed in place.
+TEST(Vdi2634, ThePlatesPointsOffItsDensePartAndOutsideItsOutlineAreCountedApart) {
+  std::mt19937 rng(45);
+  const Eigen::Vector3d c(0.5, 0.5, 5), normal(0, 0, 1);
+  const Eigen::Vector3d x = normal.unitOrthogonal(), y = normal.cross(x);
+  std::vector<Eigen::Vector3d> cloud;
+  for (const auto& p : PlatePoints(c, normal, 130, 1.0, 0.0, &rng))
+    if (std::abs((p - c).dot(x)) > 5.5 || std::abs((p - c).dot(y)) > 5.5) cloud.push_back(p);
+  ASSERT_EQ(cloud.size(), 131u * 131u - 11u * 11u);
+  for (const double u : {-1.5, 1.5})
+    for (const double v : {-1.5, 1.5}) cloud.push_back(c + u * x + v * y);
+  cloud.push_back(c + 75 * x);
+  cloud.push_back(c + 75 * x + 3 * y);
+  const ArtifactEvaluation e = EvaluateArtifact(PlateArtifact(), cloud, VerifyOptions(), "plate.ply");
+  EXPECT_EQ(e.plate_points_off_outline, 6);
+  EXPECT_EQ(e.plate_points_outside_rectangle, 2);
+  EXPECT_EQ(e.points_off_artifact, 2);
+  // The plate's 131^2 - 121^2 points within 5 mm of its sides in the edge
+  // margin, or by rounding also the rows on the eroded border (5 mm in).
+  EXPECT_GE(e.points_in_edge_margin, 131 * 131 - 121 * 121);
+  EXPECT_LE(e.points_in_edge_margin, 131 * 131 - 119 * 119);
+  EXPECT_EQ(e.points_on_artifact + e.points_in_edge_margin, 131 * 131 - 11 * 11 + 4);
 }
 
 TEST(Vdi2634, StrayPointsDoNotMakeTooLittleOfThePlateEnough) {
