@@ -812,6 +812,12 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       // least-squares plane iterated to their fixed point.
       std::vector<int> face, captured;
       PlaneOutline extent;  // of `captured`, whose points inside it eroded are `face`
+      // The outline's sides pass through its outermost points: on it is in
+      // (1 um, for rounding). With no edge margin the face is every captured
+      // point inside the outline so taken, and none is in the margin (the
+      // strict erosion by 0 left the outermost points in it).
+      constexpr double kOnOutlineMm = 1e-3;
+      const double face_margin_mm = o.plate_edge_margin_mm > 0 ? o.plate_edge_margin_mm : -kOnOutlineMm;
       for (int round = 0; round < kMaxSegmentationRounds; ++round) {
         captured = WithinPlaneBand(pts, fit, e.capture_band_mm);
         extent = OutlineOfDensePart(pts, captured, fit.normal);
@@ -820,7 +826,7 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
         e.plate_outline_width_mm = extent.width_mm();
         std::vector<int> next;
         for (int i : captured)
-          if (extent.InsideEroded(pts[i], o.plate_edge_margin_mm)) next.push_back(i);
+          if (extent.InsideEroded(pts[i], face_margin_mm)) next.push_back(i);
         if (round > 0 && next == face) break;
         face.swap(next);
         fit = FitPlaneLeastSquares(pts, face);
@@ -830,14 +836,12 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       require_points(static_cast<int>(fit.inliers.size()), "plate");
       // Where the captured points off the face are: outside the outline, or
       // in the edge margin inside it (face and captured are both ascending).
-      // The outline's sides pass through its outermost points: on it is in
-      // (1 um, for rounding).
       e.plate_points_off_outline = extent.points_outside;
       e.plate_points_outside_rectangle = 0;
       for (size_t k = 0, f = 0; k < captured.size(); ++k) {
         if (f < face.size() && face[f] == captured[k]) {
           ++f;
-        } else if (extent.InsideEroded(pts[captured[k]], -1e-3)) {
+        } else if (extent.InsideEroded(pts[captured[k]], -kOnOutlineMm)) {
           ++e.points_in_edge_margin;
         } else {
           ++e.plate_points_outside_rectangle;

@@ -1504,6 +1504,28 @@ TEST(Vdi2634, EveryPointIsCountedOnceOffTheArtifactInTheEdgeMarginExcludedOrUsed
   EXPECT_GT(e_bar.points_off_artifact, 0);  // the caps' points within 60 deg of the bar axis
 }
 
+// With no edge margin no point is in it: the face is every captured point
+// inside the outline, its outermost rows included. Truth: the 130 mm plate
+// at 1 mm (131 x 131 points, every 3 mm cell full, so the outline passes
+// through the outermost rows exactly) and 2 strays in its plane 10 mm
+// beyond a side (off the outline). Before, the erosion by 0 was strict and
+// left the 4 x 130 points on the outline's sides in the edge margin.
+TEST(Vdi2634, NoEdgeMarginPutsNoPointInIt) {
+  std::mt19937 rng(44);
+  const Eigen::Vector3d c(0, 0, 5), normal(0, 0, 1);
+  const Eigen::Vector3d x = normal.unitOrthogonal();
+  std::vector<Eigen::Vector3d> cloud = PlatePoints(c, normal, 130, 1.0, 0.05, &rng);
+  cloud.push_back(c + 75 * x);
+  cloud.push_back(c + 75 * x + 3 * normal.cross(x));
+  VerifyOptions no_margin;
+  no_margin.plate_edge_margin_mm = 0;
+  const ArtifactEvaluation e = EvaluateArtifact(PlateArtifact(), cloud, no_margin, "plate.ply");
+  EXPECT_EQ(e.points_in_edge_margin, 0);
+  EXPECT_EQ(e.points_on_artifact, 131 * 131);
+  EXPECT_EQ(e.points_off_artifact, 2);
+  EXPECT_EQ(e.plate_points_outside_rectangle, 2);
+}
+
 // plate_points_off_outline keeps its meaning, the captured points not in the
 // face's dense part (PlaneOutline::points_outside), and
 // plate_points_outside_rectangle counts those outside the outline itself.
