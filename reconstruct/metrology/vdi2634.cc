@@ -373,9 +373,10 @@ std::string LeftCertifiedSizeText(const std::vector<Eigen::Vector3d>& pts, const
 
 // On a ball bar's second ball: the first ball's fitted radius over the
 // certified one, measured as the second pass measures it once this ball's
-// centre (the argument, mm) gives the bar's axis: NaN where that fit fails.
-// Empty for a sphere, or a ball bar's first ball (no other ball yet).
-using OtherBallScaleAt = std::function<double(const Eigen::Vector3d& center_mm)>;
+// sphere as found (its centre and radius, mm) gives the bar's axis
+// (internal::BallScaleOffShaft): NaN where that fit fails or overlaps this
+// ball. Empty for a sphere, or a ball bar's first ball (no other ball yet).
+using OtherBallScaleAt = std::function<double(const Eigen::Vector3d& center_mm, double radius_mm)>;
 
 // A ball's points: those within the capture band of its sphere and outside
 // the shaft's cone about the bar axis (towards the other ball's centre).
@@ -391,6 +392,26 @@ std::vector<int> BallPointsOffShaft(const std::vector<Eigen::Vector3d>& pts, con
   }
   return in;
 }
+
+}  // namespace
+
+namespace internal {
+
+double BallScaleOffShaft(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& center_mm, double radius_mm,
+                         double nominal_radius_mm, double band_mm, double cos_cone,
+                         const Eigen::Vector3d& other_center_mm, double other_radius_mm) {
+  const std::vector<int> own = BallPointsOffShaft(pts, center_mm, radius_mm, band_mm, other_center_mm, cos_cone);
+  const SphereFit f = RefineSphere(pts, own, center_mm, radius_mm, kRefineIterations);
+  if (!f.ok || !f.converged) return std::numeric_limits<double>::quiet_NaN();
+  // Two balls cannot overlap: where they do, they are one ball found twice.
+  if ((f.center_mm - other_center_mm).norm() < std::abs(f.radius_mm) + std::abs(other_radius_mm))
+    return std::numeric_limits<double>::quiet_NaN();
+  return f.radius_mm / nominal_radius_mm;
+}
+
+}  // namespace internal
+
+namespace {
 
 // When no sphere of the certified size is found: whether the cloud holds a
 // sphere of another size (RANSAC with the radius free, within half to twice
@@ -418,7 +439,7 @@ std::string OtherSizeText(const std::vector<Eigen::Vector3d>& pts, double nomina
   const SphereFit other = FitSphereRobust(pts, so);
   if (!plausible(other)) return "";
   std::optional<double> other_ball_scale;
-  if (other_ball_scale_at) other_ball_scale = other_ball_scale_at(other.center_mm);
+  if (other_ball_scale_at) other_ball_scale = other_ball_scale_at(other.center_mm, other.radius_mm);
   if (first_of_ball_bar) {
     other_ball_scale = std::numeric_limits<double>::quiet_NaN();  // no second sphere: no scale named
     std::vector<Eigen::Vector3d> rest;
@@ -476,13 +497,13 @@ ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, dou
   }
   // Found at the certified size, a ball bar's first ball that then leaves it
   // names no scale: the other ball, which would have to be off the same way,
-  // is not fitted yet.
-  std::optional<double> other_ball_scale;
-  if (first_of_ball_bar) {
-    other_ball_scale = std::numeric_limits<double>::quiet_NaN();
-  } else if (other_ball_scale_at) {
-    other_ball_scale = other_ball_scale_at(located.center_mm);
-  }
+  // is not fitted yet. Asked only where this ball's free fit leaves the
+  // size, the one place the answer is used.
+  auto other_ball_scale = [&]() -> std::optional<double> {
+    if (first_of_ball_bar) return std::numeric_limits<double>::quiet_NaN();
+    if (other_ball_scale_at) return other_ball_scale_at(located.center_mm, located.radius_mm);
+    return std::nullopt;
+  };
   out.located = true;
   out.located_center_mm = located.center_mm;
   // The artifact's points are those within the capture band of the fitted
@@ -499,7 +520,7 @@ ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, dou
     if (LeftCertifiedSize(fit, nominal_radius, so.radius_tolerance_mm)) {
       out.fit.ok = false;
       out.fit.message = LeftCertifiedSizeText(pts, in, located.center_mm, fit, nominal_radius, so.radius_tolerance_mm,
-                                              capture_band_mm, other_ball_scale);
+                                              capture_band_mm, other_ball_scale());
       return out;
     }
     std::vector<int> next = WithinSphereShell(pts, fit.center_mm, fit.radius_mm, capture_band_mm);
@@ -510,7 +531,7 @@ ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, dou
   out.fit = RefineSphere(pts, kept, fit.center_mm, fit.radius_mm, kRefineIterations);
   if (LeftCertifiedSize(out.fit, nominal_radius, so.radius_tolerance_mm)) {
     out.fit.message = LeftCertifiedSizeText(pts, kept, located.center_mm, out.fit, nominal_radius,
-                                            so.radius_tolerance_mm, capture_band_mm, other_ball_scale);
+                                            so.radius_tolerance_mm, capture_band_mm, other_ball_scale());
     out.fit.ok = false;
   }
   return out;
@@ -700,11 +721,10 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
         // 25.4 mm balls (one module's view) to 30.1 mm, and a truly larger
         // ball 2 then read as the same scale error.
         if (ball == 0) {
-          first_ball_scale_at = [&pts, center = fit.center_mm, radius = fit.radius_mm, r, band,
-                                 cos_cone](const Eigen::Vector3d& ball_2_center_mm) {
-            const std::vector<int> own = BallPointsOffShaft(pts, center, radius, band, ball_2_center_mm, cos_cone);
-            const SphereFit f = RefineSphere(pts, own, center, radius, kRefineIterations);
-            return f.ok && f.converged ? f.radius_mm / r : std::numeric_limits<double>::quiet_NaN();
+          first_ball_scale_at = [&pts, center = fit.center_mm, radius = fit.radius_mm, r, band, cos_cone](
+                                    const Eigen::Vector3d& ball_2_center_mm, double ball_2_radius_mm) {
+            return internal::BallScaleOffShaft(pts, center, radius, r, band, cos_cone, ball_2_center_mm,
+                                               ball_2_radius_mm);
           };
         }
         located_centers_mm.push_back(found.located_center_mm);

@@ -219,4 +219,22 @@ struct VerifySummary {
 };
 VerifySummary Summarise(const std::vector<ArtifactEvaluation>& positions);
 
+namespace internal {
+
+// A ball bar's ball 1 as evidence of a scale error for ball 2 (which ball 2
+// cannot be found at, or fitted to, the certified size): ball 1's radius over
+// the certified nominal_radius_mm, fitted with a free radius from
+// (center_mm, radius_mm) to its points within band_mm of that sphere and
+// outside the shaft's cone towards ball 2 (cos_cone: the cone's half-angle's
+// cosine), as the second pass fits it; not the points of its first fit, whose
+// band holds the rod's near end and reads the ball too large. NaN where that
+// fit fails or does not converge, or where it overlaps ball 2 as found
+// (other_center_mm, other_radius_mm): two balls cannot, so that is one ball
+// found twice, and its agreeing with itself is no evidence.
+double BallScaleOffShaft(const std::vector<Eigen::Vector3d>& points_mm, const Eigen::Vector3d& center_mm,
+                         double radius_mm, double nominal_radius_mm, double band_mm, double cos_cone,
+                         const Eigen::Vector3d& other_center_mm, double other_radius_mm);
+
+}  // namespace internal
+
 }  // namespace stereorig

@@ -949,7 +949,9 @@ TEST(Vdi2634, ARodInflatedBallIsNoEvidenceOfAScaleError) {
 // the capture band of that located sphere are removed before ball 2 is
 // looked for: the large ball's far side stays, and "ball 2" is located in
 // it again (seed 32). Both passes' free fits are then one sphere, 31.75 mm
-// across, and each agreed with the other as evidence of a +25% scale error.
+// across, and each agreed with the other as evidence of a +25% scale error
+// (internal::BallScaleOffShaft, for ball 2's search, gives no evidence
+// either where the two overlap).
 // Two balls cannot overlap: the other's size says nothing of a scale when
 // the two fits do. Before, the refusal said "or measured at a scale +25%
 // off" though ball 1 is its certified size.
@@ -965,6 +967,84 @@ TEST(Vdi2634, OneBallFoundTwiceIsNoEvidenceOfAScaleError) {
   const std::string what = RefusalOf(BallBarArtifact(), bar);
   EXPECT_NE(what.find("a sphere 31.7 mm in diameter, not the certified 25.4 mm"), std::string::npos) << what;
   EXPECT_EQ(what.find("scale"), std::string::npos) << what;
+}
+
+// The standard deviation, mm, of the radius a least-squares sphere fits to
+// `points` about the true sphere (c, r) with radial noise sigma_mm: the
+// linearised fit's covariance, sigma^2 (J^T J)^-1 with J's rows
+// [u^T, 1] (u the unit direction from c), taken at the truth.
+double RadiusStdMm(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& c, double sigma_mm) {
+  Eigen::Matrix4d jtj = Eigen::Matrix4d::Zero();
+  for (const auto& p : points) {
+    Eigen::Vector4d row;
+    row << (p - c).normalized(), 1.0;
+    jtj += row * row.transpose();
+  }
+  return sigma_mm * std::sqrt(jtj.inverse()(3, 3));
+}
+
+// internal::BallScaleOffShaft, the size of ball 1 that ball 2's search takes
+// as evidence of a scale error. Truth: a ball 1.2x the certified 25.4 mm
+// (15.24 mm in radius) seen by one module, 3000 points with 0.05 mm radial
+// noise, and the rod's near end (4 mm in radius, its points within 25 mm of
+// the ball's centre: BallBarSeenByOneModule with the roles swapped, the
+// scaled ball its ball 2 and the rod running to it). Its first fit, the
+// capture band's (5 mm) with the rod, reads the ball too large (1.29); the
+// helper, started from that fit, fits the ball's points outside the
+// 60-degree shaft cone and reads 1.2. Tolerance: 5 sigma of the radius
+// fitted to the ball's points outside the cone (RadiusStdMm: 0.0046 mm on
+// its ~2060 points of a one-sided cap, 0.00036 of scale; 5 sigma 0.0018).
+// With the cone off (0 degrees) the rod is back in the fit (1.34). Ball 2 found
+// where it overlaps that fit (|c1 - c2| < r1 + r2, 0.5 mm either side of
+// touching) gives NaN: one ball found twice. A mutant returning NaN always,
+// or the first fit's size, fails here.
+TEST(Vdi2634, BallOnesScaleOffTheShaftIsItsOwnSizeNotTheRodsNorAnOverlappingBalls) {
+  const double r_mm = 12.7, scale = 1.2, sigma_mm = 0.05, band_mm = 5.0;
+  const double cos_cone = std::cos(VerifyOptions().ballbar_shaft_cone_deg * kPi / 180);
+  const Eigen::Vector3d c(50, 0, 300), other(-50, 0, 300);
+  const Eigen::Vector3d towards_other = (other - c).normalized();
+  std::mt19937 rng(33);
+  const BallBarWithRod scene = BallBarSeenByOneModule(other, c, scale, (c - other).norm(), &rng);
+  std::vector<Eigen::Vector3d> cloud = scene.own[1];
+  int rod_near = 0;
+  for (size_t k = scene.own[0].size() + scene.own[1].size(); k < scene.bar.size(); ++k) {
+    if ((scene.bar[k] - c).norm() < 25.0) {
+      cloud.push_back(scene.bar[k]);
+      ++rod_near;
+    }
+  }
+  ASSERT_GT(rod_near, 300);
+  // The ball's own points outside the cone: what the helper must fit.
+  std::vector<Eigen::Vector3d> off_cone;
+  for (const auto& p : scene.own[1])
+    if ((p - c).normalized().dot(towards_other) <= cos_cone) off_cone.push_back(p);
+  const double tolerance = 5 * RadiusStdMm(off_cone, c, sigma_mm) / r_mm;
+  ASSERT_LT(tolerance, 0.005) << off_cone.size() << " points outside the cone";
+
+  // The first fit: the capture band of the ball's true sphere, rod and all.
+  std::vector<Eigen::Vector3d> band;
+  for (const auto& p : cloud)
+    if (std::abs((p - c).norm() - scale * r_mm) < band_mm) band.push_back(p);
+  Eigen::Vector3d c_band = c;
+  double r_band = scale * r_mm;
+  ReferenceSphereNewton(band, &c_band, &r_band);
+  EXPECT_GT(r_band / r_mm - scale, 10 * tolerance) << "the rod does not inflate the first fit";
+
+  const double s = internal::BallScaleOffShaft(cloud, c_band, r_band, r_mm, band_mm, cos_cone, other, r_mm);
+  EXPECT_NEAR(s, scale, tolerance) << r_band / r_mm << " from the capture band";
+  const double with_rod = internal::BallScaleOffShaft(cloud, c_band, r_band, r_mm, band_mm, 1.0, other, r_mm);
+  EXPECT_GT(with_rod - scale, 10 * tolerance);
+
+  // Ball 2 found along the axis at touching distance +-0.5 mm.
+  const double touching_mm = scale * r_mm + r_mm;
+  const double apart = internal::BallScaleOffShaft(cloud, c_band, r_band, r_mm, band_mm, cos_cone,
+                                                   c + (touching_mm + 0.5) * towards_other, r_mm);
+  EXPECT_NEAR(apart, scale, tolerance);
+  EXPECT_TRUE(std::isnan(internal::BallScaleOffShaft(cloud, c_band, r_band, r_mm, band_mm, cos_cone,
+                                                     c + (touching_mm - 0.5) * towards_other, r_mm)));
+  // Ball 2 found inside it (the far side of the same ball).
+  EXPECT_TRUE(std::isnan(
+      internal::BallScaleOffShaft(cloud, c_band, r_band, r_mm, band_mm, cos_cone, c + 3.0 * towards_other, r_mm)));
 }
 
 // The certificate's uncertainty U (expanded, k = 2 unless the file says
