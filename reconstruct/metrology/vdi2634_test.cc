@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <random>
 
 #include "calib/core/input_error.h"
@@ -1529,10 +1530,10 @@ TEST(Vdi2634, AGapAcrossThePlateKeepsBothSidesInTheFigures) {
 // an edge margin of 5.5 mm puts the eroded border half-way between two rows
 // of points: the face is the 119 x 119 points within 59.5 mm of the centre,
 // the edge margin the other 131^2 - 119^2 = 3000, with no rounding to allow
-// for, and off the artifact exactly the 402 others. Before, the edge
-// margin's points were in no count (the columns summed to 3000 fewer than
-// the cloud). A sphere and a ball bar, with outliers and the shaft's cone,
-// sum alike (they have no edge margin).
+// for, and off the artifact exactly the 402 others. Before, the edge margin's
+// points were in no count (the columns summed to 3000 fewer than the cloud).
+// The sphere and the ball bar: Vdi2634.CountedOnceOnASphereOffTheArtifactAsTheTruthSays and
+// Vdi2634.CountedOnceOnABallBarOffTheArtifactAsTheTruthSays.
 TEST(Vdi2634, EveryPointIsCountedOnceOffTheArtifactInTheEdgeMarginExcludedOrUsed) {
   std::mt19937 rng(41);
   const Eigen::Vector3d c(0, 0, 5), normal(0, 0, 1);
@@ -1544,15 +1545,13 @@ TEST(Vdi2634, EveryPointIsCountedOnceOffTheArtifactInTheEdgeMarginExcludedOrUsed
   for (int k = 0; k < 400; ++k) cloud.push_back(c - 20 * normal + across(rng) * x + across(rng) * y);
   cloud.push_back(c + 75 * x);
   cloud.push_back(c + 75 * x + 3 * y);
-  auto sums = [](const ArtifactEvaluation& e) {
-    EXPECT_EQ(e.points_off_artifact + e.points_in_edge_margin + e.points_excluded + e.points_used(), e.points_total);
-    EXPECT_EQ(e.points_excluded + e.points_used(), e.points_on_artifact);
-  };
   VerifyOptions margin;
   margin.plate_edge_margin_mm = 5.5;
   const ArtifactEvaluation plate = EvaluateArtifact(PlateArtifact(), cloud, margin, "plate.ply");
   EXPECT_EQ(plate.points_total, static_cast<int>(cloud.size()));
-  sums(plate);
+  EXPECT_EQ(plate.points_off_artifact + plate.points_in_edge_margin + plate.points_excluded + plate.points_used(),
+            plate.points_total);
+  EXPECT_EQ(plate.points_excluded + plate.points_used(), plate.points_on_artifact);
   EXPECT_EQ(plate.points_off_artifact, 402);
   EXPECT_EQ(plate.plate_points_outside_rectangle, 2);
   // Off the dense part: the 2, and edge cells the density grid (at the
@@ -1560,28 +1559,119 @@ TEST(Vdi2634, EveryPointIsCountedOnceOffTheArtifactInTheEdgeMarginExcludedOrUsed
   EXPECT_GE(plate.plate_points_off_outline, 2);
   EXPECT_EQ(plate.points_in_edge_margin, 131 * 131 - 119 * 119);
   EXPECT_EQ(plate.points_on_artifact, 119 * 119);
+}
 
-  testing::NoiseSpec noise;
-  noise.points = 20000;
-  const testing::NoisyCloud sphere = testing::SeenByTwoFacingCameras(
-      [](double a, double b, Eigen::Vector3d* n) {
-        const double z = 2 * a - 1, phi = 2 * kPi * b, s = std::sqrt(1 - z * z);
-        *n = Eigen::Vector3d(s * std::cos(phi), s * std::sin(phi), z);
-        return Eigen::Vector3d(Eigen::Vector3d(0, 0, 200) + 19.05 * *n);
-      },
-      Eigen::Vector3d(0, 0, 200), noise);
-  const ArtifactEvaluation e_sphere = EvaluateArtifact(SphereArtifact(), sphere.points, VerifyOptions(), "s.ply");
-  sums(e_sphere);
-  EXPECT_EQ(e_sphere.points_in_edge_margin, 0);
-  EXPECT_GE(e_sphere.points_off_artifact, sphere.outliers / 2);  // most of the box's outliers lie off the band
+// Points at random directions about c, `count` of them, at a distance drawn
+// uniformly in [r0, r1] mm; those whose direction is within [cone0, cone1]
+// degrees of `axis` (its angle to it) only.
+std::vector<Eigen::Vector3d> PointsInShell(const Eigen::Vector3d& c, double r0, double r1, const Eigen::Vector3d& axis,
+                                           double cone0_deg, double cone1_deg, int count, std::mt19937* rng) {
+  std::normal_distribution<double> g(0, 1);
+  std::uniform_real_distribution<double> radius(r0, r1);
+  std::vector<Eigen::Vector3d> out;
+  while (static_cast<int>(out.size()) < count) {
+    const Eigen::Vector3d d = Eigen::Vector3d(g(*rng), g(*rng), g(*rng)).normalized();
+    const double angle_deg = std::acos(std::clamp(d.dot(axis.normalized()), -1.0, 1.0)) * 180 / kPi;
+    if (angle_deg < cone0_deg || angle_deg > cone1_deg) continue;
+    out.push_back(c + radius(*rng) * d);
+  }
+  return out;
+}
 
-  auto bar = BallSeenFromBothSides({-50, 0, 0}, 12.7, 0.05, &rng);
-  const auto ball_2 = BallSeenFromBothSides({50, 0, 0}, 12.7, 0.05, &rng);
-  bar.insert(bar.end(), ball_2.begin(), ball_2.end());
-  const ArtifactEvaluation e_bar = EvaluateArtifact(BallBarArtifact(), bar, VerifyOptions(), "bar.ply");
-  sums(e_bar);
-  EXPECT_EQ(e_bar.points_in_edge_margin, 0);
-  EXPECT_GT(e_bar.points_off_artifact, 0);  // the caps' points within 60 deg of the bar axis
+// A sphere's counts, from the construction. Truth: the certified sphere
+// (r = 19.05 mm) seen from both sides (BallSeenFromBothSides: noise 0.05 mm),
+// 30 outliers 1-4 mm off its surface (inside the 5 mm capture band: on the
+// artifact, among the excluded or used), 100 points within 12 mm of its
+// centre and 300 points 26-60 mm from it (outside the band either way: off).
+// Every point lies at least 1 mm from the band's edges, and the fitted
+// sphere is within ~0.01 mm of the truth, so the counts are exact: on the
+// artifact those within the band of the true sphere, off the others, each
+// counted from the truth. Before the columns were made to add up there was
+// no count off the artifact; points_off_artifact = points_total -
+// points_on_artifact cannot fail a sum, so each is checked against the truth.
+TEST(Vdi2634, CountedOnceOnASphereOffTheArtifactAsTheTruthSays) {
+  std::mt19937 rng(42);
+  const double r_mm = 19.05, band_mm = 5.0;
+  const Eigen::Vector3d c(0, 0, 200), z(0, 0, 1);
+  std::vector<Eigen::Vector3d> cloud = BallSeenFromBothSides(c, r_mm, 0.05, &rng);
+  const int surface = static_cast<int>(cloud.size());
+  for (const auto& part :
+       {PointsInShell(c, r_mm - 4, r_mm - 1, z, 0, 180, 15, &rng),
+        PointsInShell(c, r_mm + 1, r_mm + 4, z, 0, 180, 15, &rng), PointsInShell(c, 0, 12, z, 0, 180, 100, &rng),
+        PointsInShell(c, 26, 60, z, 0, 180, 300, &rng)})
+    cloud.insert(cloud.end(), part.begin(), part.end());
+  int on = 0, off = 0;
+  for (const auto& p : cloud) ((std::abs((p - c).norm() - r_mm) < band_mm) ? on : off)++;
+  ASSERT_EQ(on, surface + 30);
+  ASSERT_EQ(off, 400);
+  const ArtifactEvaluation e = EvaluateArtifact(SphereArtifact(), cloud, VerifyOptions(), "s.ply");
+  EXPECT_EQ(e.points_total, static_cast<int>(cloud.size()));
+  EXPECT_EQ(e.points_on_artifact, on);
+  EXPECT_EQ(e.points_off_artifact, off);
+  EXPECT_EQ(e.points_in_edge_margin, 0);
+  EXPECT_EQ(e.points_excluded + e.points_used(), on);
+}
+
+// A ball bar's counts, from the construction. Truth: the certified balls
+// (r = 12.7 mm, centres 100 mm apart) seen from both sides, less their
+// points within 1 degree of the 60-degree shaft cone's edge (so the fitted
+// centres, ~0.01 mm off, cannot move a point across it); the rod (4 mm in
+// radius) between them, outside the balls (each of its points in a ball's
+// cone, or outside its band: off either way); per ball 20 outliers 1-4 mm
+// off its surface outside the cone (on the artifact) and 20 inside it (off);
+// and 300 points more than 6 mm outside both balls' bands (off). A ball's
+// points on the artifact are those within the 5 mm band of its true sphere
+// and outside its cone, counted from the truth; the two sets are disjoint
+// (no point is counted for both), and every other point is off.
+TEST(Vdi2634, CountedOnceOnABallBarOffTheArtifactAsTheTruthSays) {
+  std::mt19937 rng(43);
+  const double r_mm = 12.7, band_mm = 5.0, cone_deg = VerifyOptions().ballbar_shaft_cone_deg;
+  const Eigen::Vector3d centres[2] = {{-50, 0, 300}, {50, 0, 300}};
+  auto towards_other = [&](int ball) { return Eigen::Vector3d((centres[1 - ball] - centres[ball]).normalized()); };
+  auto angle_deg = [&](int ball, const Eigen::Vector3d& p) {
+    return std::acos(std::clamp((p - centres[ball]).normalized().dot(towards_other(ball)), -1.0, 1.0)) * 180 / kPi;
+  };
+  std::vector<Eigen::Vector3d> cloud;
+  for (int ball = 0; ball < 2; ++ball) {
+    for (const auto& p : BallSeenFromBothSides(centres[ball], r_mm, 0.05, &rng))
+      if (std::abs(angle_deg(ball, p) - cone_deg) > 1.0) cloud.push_back(p);
+    for (const auto& part :
+         {PointsInShell(centres[ball], r_mm + 1, r_mm + 4, towards_other(ball), cone_deg + 1, 180, 10, &rng),
+          PointsInShell(centres[ball], r_mm - 4, r_mm - 1, towards_other(ball), cone_deg + 1, 180, 10, &rng),
+          PointsInShell(centres[ball], r_mm - 4, r_mm + 4, towards_other(ball), 0, cone_deg - 1, 20, &rng)})
+      cloud.insert(cloud.end(), part.begin(), part.end());
+  }
+  for (double x = -50; x <= 50; x += 0.5) {
+    for (int k = 0; k < 12; ++k) {
+      const Eigen::Vector3d p(x, 4 * std::cos(k * kPi / 6), 300 + 4 * std::sin(k * kPi / 6));
+      if ((p - centres[0]).norm() > r_mm + 0.2 && (p - centres[1]).norm() > r_mm + 0.2) cloud.push_back(p);
+    }
+  }
+  std::uniform_real_distribution<double> box(-90, 90);
+  for (int added = 0; added < 300;) {
+    const Eigen::Vector3d p(box(rng), box(rng), 300 + box(rng));
+    if ((p - centres[0]).norm() < r_mm + band_mm + 6 || (p - centres[1]).norm() < r_mm + band_mm + 6) continue;
+    cloud.push_back(p);
+    ++added;
+  }
+  int on[2] = {0, 0}, both = 0, off = 0;
+  for (const auto& p : cloud) {
+    bool on_ball[2];
+    for (int ball = 0; ball < 2; ++ball) {
+      on_ball[ball] = std::abs((p - centres[ball]).norm() - r_mm) < band_mm && angle_deg(ball, p) > cone_deg;
+      on[ball] += on_ball[ball];
+    }
+    both += on_ball[0] && on_ball[1];
+    off += !on_ball[0] && !on_ball[1];
+  }
+  ASSERT_EQ(both, 0) << "the balls' points on the artifact overlap";
+  ASSERT_GT(off, 300 + 2 * 20);  // the rod's points besides
+  const ArtifactEvaluation e = EvaluateArtifact(BallBarArtifact(), cloud, VerifyOptions(), "bar.ply");
+  EXPECT_EQ(e.points_total, static_cast<int>(cloud.size()));
+  EXPECT_EQ(e.points_on_artifact, on[0] + on[1]);
+  EXPECT_EQ(e.points_off_artifact, off);
+  EXPECT_EQ(e.points_in_edge_margin, 0);
+  EXPECT_EQ(e.points_excluded + e.points_used(), on[0] + on[1]);
 }
 
 // With no edge margin no point is in it: the face is every captured point
