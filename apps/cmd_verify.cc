@@ -322,10 +322,14 @@ int RunVerify(int argc, char** argv) {
     if (!e.sphere_centers_mm.empty()) pj["spheres"] = SpheresJson(e);
     if (e.type == ArtifactType::kPlate && e.evaluated) {
       std::printf(
-          "%-8zu plate face: outline %.1f x %.1f mm (its dense part; %d captured points outside it, counted in off)\n",
-          i + 1, e.plate_outline_length_mm, e.plate_outline_width_mm, e.plate_points_off_outline);
+          "%-8zu plate face: outline %.1f x %.1f mm (of its dense part; %d captured points not in the dense part, "
+          "%d of them outside the outline, counted in off)\n",
+          i + 1, e.plate_outline_length_mm, e.plate_outline_width_mm, e.plate_points_off_outline,
+          e.plate_points_outside_rectangle);
       pj["plate_outline_mm"] = {e.plate_outline_length_mm, e.plate_outline_width_mm};
+      // Its meaning since it came: the captured points not in the dense part.
       pj["plate_points_off_outline"] = e.plate_points_off_outline;
+      pj["plate_points_outside_rectangle"] = e.plate_points_outside_rectangle;
     }
     if (!e.judged()) std::printf("%-8zu NOT JUDGED: %s\n", i + 1, e.not_judged_reason.c_str());
     report["positions"].push_back(pj);

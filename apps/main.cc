@@ -16,7 +16,8 @@ void PrintUsage(FILE* out) {
                "Commands:\n");
   for (const auto& c : stereorig::Commands()) std::fprintf(out, "  %-12s %s\n", c.name, c.summary);
   std::fprintf(out,
-               "\nExit codes: 0 ok; 1 a check that ran and failed (verify, check); 2 bad usage or input.\n"
+               "\nExit codes: 0 ok; 1 a check that ran and failed (verify, check), or a demo step that did not exit "
+               "as expected; 2 bad usage or input.\n"
                "Start with:  stereorig demo --out /tmp/stereorig-demo\n");
 }
 

@@ -378,6 +378,12 @@ TEST(Cli, TheHelpOfEveryCommandThatExitsOneSaysWhen) {
     EXPECT_NE(r.out.find("2 bad"), std::string::npos) << command << ": " << r.out;
   }
   EXPECT_NE(RunCli("demo --help").out.find("score it against the simulator's truth"), std::string::npos);
+  // The top-level help's exit codes say demo's 1 too (they named only verify
+  // and check).
+  const Result top = RunCli("--help");
+  EXPECT_NE(top.out.find("1 a check that ran and failed (verify, check), or a demo step that did not exit as expected"),
+            std::string::npos)
+      << top.out;
 }
 
 // Every file or folder a command writes, given as an empty path (a shell

@@ -433,14 +433,23 @@ TEST(VerifyCli, HoleFillingsPointsAreSkippedAndCounted) {
 
 // Every vertex of the cloud lands in exactly one of the table's count
 // columns after `cloud` (filled, off, edge, excluded, used) and of the
-// report's counts: a 130 x 120 mm plate at 1 mm (noise 0.05 mm), 300 points
-// of a table 20 mm below it, 2 strays in its plane beyond a side, and 500
-// points of hole filling (module 255) over its middle. Before, the points in
-// the plate's 5 mm edge margin (~2400 here) were in no column: cloud
-// exceeded the columns by as many, and the report had no count of them.
+// report's counts: a 130 x 120 mm plate at 1 mm with a hole 11 x 11 points
+// wide at its centre holding 4 points (each alone in a 3 mm density cell:
+// not the dense part, but inside the outline and on the artifact). Without
+// noise the fitted plane is z = 200 exactly, so the density cells, fixed
+// about the world's origin, lie along the grid; its points sit 0.5 and
+// 1.5 mm off the cells' sides, and every cell at the plate's edge holds at
+// least 2 x 2 of them (dense: a quarter of the median's 9 is 2.25). Also
+// 300 points of a table 20 mm below it, 2 strays in its plane beyond a side,
+// and 500 points of hole filling (module 255) over its middle. Before, the
+// points in the plate's 5 mm edge margin (~2400 here) were in no column:
+// cloud exceeded the columns by as many, and the report had no count of
+// them. The report's plate_points_off_outline keeps its meaning (the
+// captured points not in the dense part: the 4 and the 2 strays) beside
+// plate_points_outside_rectangle (the 2 strays, counted in off): its
+// meaning had changed in place to the latter.
 TEST(VerifyCli, EveryPointOfAPlateLandsInExactlyOneColumnOfTheTableAndTheReport) {
   std::mt19937 rng(7);
-  std::normal_distribution<double> noise(0, 0.05);
   std::uniform_real_distribution<double> across(-50, 50);
   const std::string cloud = ::testing::TempDir() + "/plate_counts_" + std::to_string(getpid()) + ".ply";
   int vertices = 0;
@@ -448,7 +457,13 @@ TEST(VerifyCli, EveryPointOfAPlateLandsInExactlyOneColumnOfTheTableAndTheReport)
     std::ostringstream body;
     body.precision(17);
     for (int u = -65; u <= 65; ++u)
-      for (int v = -60; v <= 60; ++v, ++vertices) body << u << " " << v << " " << 200 + noise(rng) << " 0\n";
+      for (int v = -60; v <= 60; ++v) {
+        if (std::abs(u) <= 5 && std::abs(v) <= 5) continue;  // the hole
+        body << u + 0.5 << " " << v + 1.5 << " 200 0\n";
+        ++vertices;
+      }
+    body << "-1 -1 200 0\n-1 2 200 0\n2 -1 200 0\n2 2 200 0\n";  // in the hole, each alone in a cell
+    vertices += 4;
     for (int k = 0; k < 300; ++k, ++vertices) body << across(rng) << " " << across(rng) << " 180 0\n";
     body << "80 0 200 0\n80 5 200 0\n";
     vertices += 2;
@@ -483,7 +498,7 @@ TEST(VerifyCli, EveryPointOfAPlateLandsInExactlyOneColumnOfTheTableAndTheReport)
   EXPECT_EQ(column("filled"), 500);
   EXPECT_EQ(column("off"), 302);
   // The 5 mm border: the plate's points outside 121 x 111 of them, and those
-  // on the eroded border itself (at 60 and 55 mm) either way by rounding.
+  // on the eroded border itself (5 mm in from the outline) either way by rounding.
   EXPECT_GE(column("edge"), 131 * 121 - 121 * 111);
   EXPECT_LE(column("edge"), 131 * 121 - 119 * 109);
   EXPECT_EQ(column("filled") + column("off") + column("edge") + column("excluded") + column("used"), vertices) << r.out;
@@ -496,7 +511,8 @@ TEST(VerifyCli, EveryPointOfAPlateLandsInExactlyOneColumnOfTheTableAndTheReport)
       << j.dump();
   EXPECT_EQ(j["points_in_edge_margin"].get<int>(), column("edge"));
   EXPECT_EQ(j["points_on_artifact"].get<int>(), j["points_excluded"].get<int>() + j["points_used"].get<int>());
-  EXPECT_EQ(j["plate_points_off_outline"].get<int>(), 2);
+  EXPECT_EQ(j["plate_points_off_outline"].get<int>(), 6);
+  EXPECT_EQ(j["plate_points_outside_rectangle"].get<int>(), 2);
 }
 
 // A cap of the certified sphere, `half_angle_deg` of it, 2000 points with the

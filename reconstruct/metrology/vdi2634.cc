@@ -373,9 +373,10 @@ std::string LeftCertifiedSizeText(const std::vector<Eigen::Vector3d>& pts, const
 
 // On a ball bar's second ball: the first ball's fitted radius over the
 // certified one, measured as the second pass measures it once this ball's
-// centre (the argument, mm) gives the bar's axis: NaN where that fit fails.
-// Empty for a sphere, or a ball bar's first ball (no other ball yet).
-using OtherBallScaleAt = std::function<double(const Eigen::Vector3d& center_mm)>;
+// sphere as found (its centre and radius, mm) gives the bar's axis
+// (internal::BallScaleOffShaft): NaN where that fit fails or overlaps this
+// ball. Empty for a sphere, or a ball bar's first ball (no other ball yet).
+using OtherBallScaleAt = std::function<double(const Eigen::Vector3d& center_mm, double radius_mm)>;
 
 // A ball's points: those within the capture band of its sphere and outside
 // the shaft's cone about the bar axis (towards the other ball's centre).
@@ -391,6 +392,26 @@ std::vector<int> BallPointsOffShaft(const std::vector<Eigen::Vector3d>& pts, con
   }
   return in;
 }
+
+}  // namespace
+
+namespace internal {
+
+double BallScaleOffShaft(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& center_mm, double radius_mm,
+                         double nominal_radius_mm, double band_mm, double cos_cone,
+                         const Eigen::Vector3d& other_center_mm, double other_radius_mm) {
+  const std::vector<int> own = BallPointsOffShaft(pts, center_mm, radius_mm, band_mm, other_center_mm, cos_cone);
+  const SphereFit f = RefineSphere(pts, own, center_mm, radius_mm, kRefineIterations);
+  if (!f.ok || !f.converged) return std::numeric_limits<double>::quiet_NaN();
+  // Two balls cannot overlap: where they do, they are one ball found twice.
+  if ((f.center_mm - other_center_mm).norm() < std::abs(f.radius_mm) + std::abs(other_radius_mm))
+    return std::numeric_limits<double>::quiet_NaN();
+  return f.radius_mm / nominal_radius_mm;
+}
+
+}  // namespace internal
+
+namespace {
 
 // When no sphere of the certified size is found: whether the cloud holds a
 // sphere of another size (RANSAC with the radius free, within half to twice
@@ -418,7 +439,7 @@ std::string OtherSizeText(const std::vector<Eigen::Vector3d>& pts, double nomina
   const SphereFit other = FitSphereRobust(pts, so);
   if (!plausible(other)) return "";
   std::optional<double> other_ball_scale;
-  if (other_ball_scale_at) other_ball_scale = other_ball_scale_at(other.center_mm);
+  if (other_ball_scale_at) other_ball_scale = other_ball_scale_at(other.center_mm, other.radius_mm);
   if (first_of_ball_bar) {
     other_ball_scale = std::numeric_limits<double>::quiet_NaN();  // no second sphere: no scale named
     std::vector<Eigen::Vector3d> rest;
@@ -476,13 +497,13 @@ ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, dou
   }
   // Found at the certified size, a ball bar's first ball that then leaves it
   // names no scale: the other ball, which would have to be off the same way,
-  // is not fitted yet.
-  std::optional<double> other_ball_scale;
-  if (first_of_ball_bar) {
-    other_ball_scale = std::numeric_limits<double>::quiet_NaN();
-  } else if (other_ball_scale_at) {
-    other_ball_scale = other_ball_scale_at(located.center_mm);
-  }
+  // is not fitted yet. Asked only where this ball's free fit leaves the
+  // size, the one place the answer is used.
+  auto other_ball_scale = [&]() -> std::optional<double> {
+    if (first_of_ball_bar) return std::numeric_limits<double>::quiet_NaN();
+    if (other_ball_scale_at) return other_ball_scale_at(located.center_mm, located.radius_mm);
+    return std::nullopt;
+  };
   out.located = true;
   out.located_center_mm = located.center_mm;
   // The artifact's points are those within the capture band of the fitted
@@ -499,7 +520,7 @@ ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, dou
     if (LeftCertifiedSize(fit, nominal_radius, so.radius_tolerance_mm)) {
       out.fit.ok = false;
       out.fit.message = LeftCertifiedSizeText(pts, in, located.center_mm, fit, nominal_radius, so.radius_tolerance_mm,
-                                              capture_band_mm, other_ball_scale);
+                                              capture_band_mm, other_ball_scale());
       return out;
     }
     std::vector<int> next = WithinSphereShell(pts, fit.center_mm, fit.radius_mm, capture_band_mm);
@@ -510,7 +531,7 @@ ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, dou
   out.fit = RefineSphere(pts, kept, fit.center_mm, fit.radius_mm, kRefineIterations);
   if (LeftCertifiedSize(out.fit, nominal_radius, so.radius_tolerance_mm)) {
     out.fit.message = LeftCertifiedSizeText(pts, kept, located.center_mm, out.fit, nominal_radius,
-                                            so.radius_tolerance_mm, capture_band_mm, other_ball_scale);
+                                            so.radius_tolerance_mm, capture_band_mm, other_ball_scale());
     out.fit.ok = false;
   }
   return out;
@@ -700,11 +721,10 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
         // 25.4 mm balls (one module's view) to 30.1 mm, and a truly larger
         // ball 2 then read as the same scale error.
         if (ball == 0) {
-          first_ball_scale_at = [&pts, center = fit.center_mm, radius = fit.radius_mm, r, band,
-                                 cos_cone](const Eigen::Vector3d& ball_2_center_mm) {
-            const std::vector<int> own = BallPointsOffShaft(pts, center, radius, band, ball_2_center_mm, cos_cone);
-            const SphereFit f = RefineSphere(pts, own, center, radius, kRefineIterations);
-            return f.ok && f.converged ? f.radius_mm / r : std::numeric_limits<double>::quiet_NaN();
+          first_ball_scale_at = [&pts, center = fit.center_mm, radius = fit.radius_mm, r, band, cos_cone](
+                                    const Eigen::Vector3d& ball_2_center_mm, double ball_2_radius_mm) {
+            return internal::BallScaleOffShaft(pts, center, radius, r, band, cos_cone, ball_2_center_mm,
+                                               ball_2_radius_mm);
           };
         }
         located_centers_mm.push_back(found.located_center_mm);
@@ -812,6 +832,12 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       // least-squares plane iterated to their fixed point.
       std::vector<int> face, captured;
       PlaneOutline extent;  // of `captured`, whose points inside it eroded are `face`
+      // The outline's sides pass through its outermost points: on it is in
+      // (1 um, for rounding). With no edge margin the face is every captured
+      // point inside the outline so taken, and none is in the margin (the
+      // strict erosion by 0 left the outermost points in it).
+      constexpr double kOnOutlineMm = 1e-3;
+      const double face_margin_mm = o.plate_edge_margin_mm > 0 ? o.plate_edge_margin_mm : -kOnOutlineMm;
       for (int round = 0; round < kMaxSegmentationRounds; ++round) {
         captured = WithinPlaneBand(pts, fit, e.capture_band_mm);
         extent = OutlineOfDensePart(pts, captured, fit.normal);
@@ -820,7 +846,7 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
         e.plate_outline_width_mm = extent.width_mm();
         std::vector<int> next;
         for (int i : captured)
-          if (extent.InsideEroded(pts[i], o.plate_edge_margin_mm)) next.push_back(i);
+          if (extent.InsideEroded(pts[i], face_margin_mm)) next.push_back(i);
         if (round > 0 && next == face) break;
         face.swap(next);
         fit = FitPlaneLeastSquares(pts, face);
@@ -830,19 +856,18 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       require_points(static_cast<int>(fit.inliers.size()), "plate");
       // Where the captured points off the face are: outside the outline, or
       // in the edge margin inside it (face and captured are both ascending).
-      // The outline's sides pass through its outermost points: on it is in
-      // (1 um, for rounding).
-      e.plate_points_off_outline = 0;
+      e.plate_points_off_outline = extent.points_outside;
+      e.plate_points_outside_rectangle = 0;
       for (size_t k = 0, f = 0; k < captured.size(); ++k) {
         if (f < face.size() && face[f] == captured[k]) {
           ++f;
-        } else if (extent.InsideEroded(pts[captured[k]], -1e-3)) {
+        } else if (extent.InsideEroded(pts[captured[k]], -kOnOutlineMm)) {
           ++e.points_in_edge_margin;
         } else {
-          ++e.plate_points_off_outline;
+          ++e.plate_points_outside_rectangle;
         }
       }
-      e.points_off_artifact = e.points_total - static_cast<int>(captured.size()) + e.plate_points_off_outline;
+      e.points_off_artifact = e.points_total - static_cast<int>(captured.size()) + e.plate_points_outside_rectangle;
       int excluded = 0;
       const std::vector<int> kept = ExcludeWorst(fit.inliers, fit.residuals_mm, o.excluded_fraction_max, &excluded);
       fit = FitPlaneLeastSquares(pts, kept);

@@ -158,10 +158,13 @@ struct ArtifactEvaluation {
   // grid period off on one ball shows here, where SD may not show it.
   std::vector<double> sphere_form_mm;
   // Plate: the outline of the face's dense part (plate_outline.h), before the
-  // edge margin, and the captured points outside that rectangle (strays,
-  // sparse edges; part of points_off_artifact).
+  // edge margin; the captured points not in that dense part (strays, sparse
+  // edges: PlaneOutline::points_outside; some of them inside the rectangle,
+  // so in the edge margin or the figures); and the captured points outside
+  // the rectangle itself (part of points_off_artifact).
   double plate_outline_length_mm = 0, plate_outline_width_mm = 0;
   int plate_points_off_outline = 0;
+  int plate_points_outside_rectangle = 0;
   Eigen::Vector3d plane_normal = Eigen::Vector3d::Zero();
   double plane_offset_mm = 0;
   // Empty when the position is judged. Otherwise why it is not: a figure the
@@ -215,5 +218,23 @@ struct VerifySummary {
   bool pass = false;                      // every position judged, and every figure of each within its MPE
 };
 VerifySummary Summarise(const std::vector<ArtifactEvaluation>& positions);
+
+namespace internal {
+
+// A ball bar's ball 1 as evidence of a scale error for ball 2 (which ball 2
+// cannot be found at, or fitted to, the certified size): ball 1's radius over
+// the certified nominal_radius_mm, fitted with a free radius from
+// (center_mm, radius_mm) to its points within band_mm of that sphere and
+// outside the shaft's cone towards ball 2 (cos_cone: the cone's half-angle's
+// cosine), as the second pass fits it; not the points of its first fit, whose
+// band holds the rod's near end and reads the ball too large. NaN where that
+// fit fails or does not converge, or where it overlaps ball 2 as found
+// (other_center_mm, other_radius_mm): two balls cannot, so that is one ball
+// found twice, and its agreeing with itself is no evidence.
+double BallScaleOffShaft(const std::vector<Eigen::Vector3d>& points_mm, const Eigen::Vector3d& center_mm,
+                         double radius_mm, double nominal_radius_mm, double band_mm, double cos_cone,
+                         const Eigen::Vector3d& other_center_mm, double other_radius_mm);
+
+}  // namespace internal
 
 }  // namespace stereorig

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <random>
 
 #include "calib/core/input_error.h"
@@ -949,7 +950,9 @@ TEST(Vdi2634, ARodInflatedBallIsNoEvidenceOfAScaleError) {
 // the capture band of that located sphere are removed before ball 2 is
 // looked for: the large ball's far side stays, and "ball 2" is located in
 // it again (seed 32). Both passes' free fits are then one sphere, 31.75 mm
-// across, and each agreed with the other as evidence of a +25% scale error.
+// across, and each agreed with the other as evidence of a +25% scale error
+// (internal::BallScaleOffShaft, for ball 2's search, gives no evidence
+// either where the two overlap).
 // Two balls cannot overlap: the other's size says nothing of a scale when
 // the two fits do. Before, the refusal said "or measured at a scale +25%
 // off" though ball 1 is its certified size.
@@ -963,8 +966,99 @@ TEST(Vdi2634, OneBallFoundTwiceIsNoEvidenceOfAScaleError) {
   const auto large = BallSeenFromBothSides(c2, 1.25 * r_mm, 0.05, &rng);
   bar.insert(bar.end(), large.begin(), large.end());
   const std::string what = RefusalOf(BallBarArtifact(), bar);
-  EXPECT_NE(what.find("a sphere 31.7 mm in diameter, not the certified 25.4 mm"), std::string::npos) << what;
+  // The diameter the refusal names, against the truth (1.25 x 25.4 =
+  // 31.75 mm, on the rounding boundary of its one decimal): within half the
+  // last digit (0.05 mm) and 5 sigma of the fit, its ~6900 points' 0.05 mm
+  // noise over a cap of ~130 degrees (0.002 mm in diameter, 1 sigma, the
+  // refusal itself says): 0.06 mm. Before, "31.7" was looked for, which the
+  // noise may print as 31.8.
+  const std::string sphere = "fit, with a free radius, a sphere ";
+  const size_t at = what.find(sphere);
+  ASSERT_NE(at, std::string::npos) << what;
+  size_t digits = 0;
+  const double diameter_mm = std::stod(what.substr(at + sphere.size()), &digits);
+  const std::string rest = " mm in diameter, not the certified 25.4 mm";
+  EXPECT_EQ(what.substr(at + sphere.size() + digits, rest.size()), rest) << what;
+  EXPECT_NEAR(diameter_mm, 2 * 1.25 * r_mm, 0.05 + 5 * 0.002) << what;
   EXPECT_EQ(what.find("scale"), std::string::npos) << what;
+}
+
+// The standard deviation, mm, of the radius a least-squares sphere fits to
+// `points` about the true sphere (c, r) with radial noise sigma_mm: the
+// linearised fit's covariance, sigma^2 (J^T J)^-1 with J's rows
+// [u^T, 1] (u the unit direction from c), taken at the truth.
+double RadiusStdMm(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& c, double sigma_mm) {
+  Eigen::Matrix4d jtj = Eigen::Matrix4d::Zero();
+  for (const auto& p : points) {
+    Eigen::Vector4d row;
+    row << (p - c).normalized(), 1.0;
+    jtj += row * row.transpose();
+  }
+  return sigma_mm * std::sqrt(jtj.inverse()(3, 3));
+}
+
+// internal::BallScaleOffShaft, the size of ball 1 that ball 2's search takes
+// as evidence of a scale error. Truth: a ball 1.2x the certified 25.4 mm
+// (15.24 mm in radius) seen by one module, 3000 points with 0.05 mm radial
+// noise, and the rod's near end (4 mm in radius, its points within 25 mm of
+// the ball's centre: BallBarSeenByOneModule with the roles swapped, the
+// scaled ball its ball 2 and the rod running to it). Its first fit, the
+// capture band's (5 mm) with the rod, reads the ball too large (1.29); the
+// helper, started from that fit, fits the ball's points outside the
+// 60-degree shaft cone and reads 1.2. Tolerance: 5 sigma of the radius
+// fitted to the ball's points outside the cone (RadiusStdMm: 0.0046 mm on
+// its ~2060 points of a one-sided cap, 0.00036 of scale; 5 sigma 0.0018).
+// With the cone off (0 degrees) the rod is back in the fit (1.34). Ball 2 found
+// where it overlaps that fit (|c1 - c2| < r1 + r2, 0.5 mm either side of
+// touching) gives NaN: one ball found twice. A mutant returning NaN always,
+// or the first fit's size, fails here.
+TEST(Vdi2634, BallOnesScaleOffTheShaftIsItsOwnSizeNotTheRodsNorAnOverlappingBalls) {
+  const double r_mm = 12.7, scale = 1.2, sigma_mm = 0.05, band_mm = 5.0;
+  const double cos_cone = std::cos(VerifyOptions().ballbar_shaft_cone_deg * kPi / 180);
+  const Eigen::Vector3d c(50, 0, 300), other(-50, 0, 300);
+  const Eigen::Vector3d towards_other = (other - c).normalized();
+  std::mt19937 rng(33);
+  const BallBarWithRod scene = BallBarSeenByOneModule(other, c, scale, (c - other).norm(), &rng);
+  std::vector<Eigen::Vector3d> cloud = scene.own[1];
+  int rod_near = 0;
+  for (size_t k = scene.own[0].size() + scene.own[1].size(); k < scene.bar.size(); ++k) {
+    if ((scene.bar[k] - c).norm() < 25.0) {
+      cloud.push_back(scene.bar[k]);
+      ++rod_near;
+    }
+  }
+  ASSERT_GT(rod_near, 300);
+  // The ball's own points outside the cone: what the helper must fit.
+  std::vector<Eigen::Vector3d> off_cone;
+  for (const auto& p : scene.own[1])
+    if ((p - c).normalized().dot(towards_other) <= cos_cone) off_cone.push_back(p);
+  const double tolerance = 5 * RadiusStdMm(off_cone, c, sigma_mm) / r_mm;
+  ASSERT_LT(tolerance, 0.005) << off_cone.size() << " points outside the cone";
+
+  // The first fit: the capture band of the ball's true sphere, rod and all.
+  std::vector<Eigen::Vector3d> band;
+  for (const auto& p : cloud)
+    if (std::abs((p - c).norm() - scale * r_mm) < band_mm) band.push_back(p);
+  Eigen::Vector3d c_band = c;
+  double r_band = scale * r_mm;
+  ReferenceSphereNewton(band, &c_band, &r_band);
+  EXPECT_GT(r_band / r_mm - scale, 10 * tolerance) << "the rod does not inflate the first fit";
+
+  const double s = internal::BallScaleOffShaft(cloud, c_band, r_band, r_mm, band_mm, cos_cone, other, r_mm);
+  EXPECT_NEAR(s, scale, tolerance) << r_band / r_mm << " from the capture band";
+  const double with_rod = internal::BallScaleOffShaft(cloud, c_band, r_band, r_mm, band_mm, 1.0, other, r_mm);
+  EXPECT_GT(with_rod - scale, 10 * tolerance);
+
+  // Ball 2 found along the axis at touching distance +-0.5 mm.
+  const double touching_mm = scale * r_mm + r_mm;
+  const double apart = internal::BallScaleOffShaft(cloud, c_band, r_band, r_mm, band_mm, cos_cone,
+                                                   c + (touching_mm + 0.5) * towards_other, r_mm);
+  EXPECT_NEAR(apart, scale, tolerance);
+  EXPECT_TRUE(std::isnan(internal::BallScaleOffShaft(cloud, c_band, r_band, r_mm, band_mm, cos_cone,
+                                                     c + (touching_mm - 0.5) * towards_other, r_mm)));
+  // Ball 2 found inside it (the far side of the same ball).
+  EXPECT_TRUE(std::isnan(
+      internal::BallScaleOffShaft(cloud, c_band, r_band, r_mm, band_mm, cos_cone, c + 3.0 * towards_other, r_mm)));
 }
 
 // The certificate's uncertainty U (expanded, k = 2 unless the file says
@@ -1449,10 +1543,10 @@ TEST(Vdi2634, AGapAcrossThePlateKeepsBothSidesInTheFigures) {
 // an edge margin of 5.5 mm puts the eroded border half-way between two rows
 // of points: the face is the 119 x 119 points within 59.5 mm of the centre,
 // the edge margin the other 131^2 - 119^2 = 3000, with no rounding to allow
-// for, and off the artifact exactly the 402 others. Before, the edge
-// margin's points were in no count (the columns summed to 3000 fewer than
-// the cloud). A sphere and a ball bar, with outliers and the shaft's cone,
-// sum alike (they have no edge margin).
+// for, and off the artifact exactly the 402 others. Before, the edge margin's
+// points were in no count (the columns summed to 3000 fewer than the cloud).
+// The sphere and the ball bar: Vdi2634.CountedOnceOnASphereOffTheArtifactAsTheTruthSays and
+// Vdi2634.CountedOnceOnABallBarOffTheArtifactAsTheTruthSays.
 TEST(Vdi2634, EveryPointIsCountedOnceOffTheArtifactInTheEdgeMarginExcludedOrUsed) {
   std::mt19937 rng(41);
   const Eigen::Vector3d c(0, 0, 5), normal(0, 0, 1);
@@ -1464,41 +1558,191 @@ TEST(Vdi2634, EveryPointIsCountedOnceOffTheArtifactInTheEdgeMarginExcludedOrUsed
   for (int k = 0; k < 400; ++k) cloud.push_back(c - 20 * normal + across(rng) * x + across(rng) * y);
   cloud.push_back(c + 75 * x);
   cloud.push_back(c + 75 * x + 3 * y);
-  auto sums = [](const ArtifactEvaluation& e) {
-    EXPECT_EQ(e.points_off_artifact + e.points_in_edge_margin + e.points_excluded + e.points_used(), e.points_total);
-    EXPECT_EQ(e.points_excluded + e.points_used(), e.points_on_artifact);
-  };
   VerifyOptions margin;
   margin.plate_edge_margin_mm = 5.5;
   const ArtifactEvaluation plate = EvaluateArtifact(PlateArtifact(), cloud, margin, "plate.ply");
   EXPECT_EQ(plate.points_total, static_cast<int>(cloud.size()));
-  sums(plate);
+  EXPECT_EQ(plate.points_off_artifact + plate.points_in_edge_margin + plate.points_excluded + plate.points_used(),
+            plate.points_total);
+  EXPECT_EQ(plate.points_excluded + plate.points_used(), plate.points_on_artifact);
   EXPECT_EQ(plate.points_off_artifact, 402);
-  EXPECT_EQ(plate.plate_points_off_outline, 2);
+  EXPECT_EQ(plate.plate_points_outside_rectangle, 2);
+  // Off the dense part: the 2, and edge cells the density grid (at the
+  // fitted plane's arbitrary in-plane axes) cuts thin.
+  EXPECT_GE(plate.plate_points_off_outline, 2);
   EXPECT_EQ(plate.points_in_edge_margin, 131 * 131 - 119 * 119);
   EXPECT_EQ(plate.points_on_artifact, 119 * 119);
+}
 
-  testing::NoiseSpec noise;
-  noise.points = 20000;
-  const testing::NoisyCloud sphere = testing::SeenByTwoFacingCameras(
-      [](double a, double b, Eigen::Vector3d* n) {
-        const double z = 2 * a - 1, phi = 2 * kPi * b, s = std::sqrt(1 - z * z);
-        *n = Eigen::Vector3d(s * std::cos(phi), s * std::sin(phi), z);
-        return Eigen::Vector3d(Eigen::Vector3d(0, 0, 200) + 19.05 * *n);
-      },
-      Eigen::Vector3d(0, 0, 200), noise);
-  const ArtifactEvaluation e_sphere = EvaluateArtifact(SphereArtifact(), sphere.points, VerifyOptions(), "s.ply");
-  sums(e_sphere);
-  EXPECT_EQ(e_sphere.points_in_edge_margin, 0);
-  EXPECT_GE(e_sphere.points_off_artifact, sphere.outliers / 2);  // most of the box's outliers lie off the band
+// Points at random directions about c, `count` of them, at a distance drawn
+// uniformly in [r0, r1] mm; those whose direction is within [cone0, cone1]
+// degrees of `axis` (its angle to it) only.
+std::vector<Eigen::Vector3d> PointsInShell(const Eigen::Vector3d& c, double r0, double r1, const Eigen::Vector3d& axis,
+                                           double cone0_deg, double cone1_deg, int count, std::mt19937* rng) {
+  std::normal_distribution<double> g(0, 1);
+  std::uniform_real_distribution<double> radius(r0, r1);
+  std::vector<Eigen::Vector3d> out;
+  while (static_cast<int>(out.size()) < count) {
+    const Eigen::Vector3d d = Eigen::Vector3d(g(*rng), g(*rng), g(*rng)).normalized();
+    const double angle_deg = std::acos(std::clamp(d.dot(axis.normalized()), -1.0, 1.0)) * 180 / kPi;
+    if (angle_deg < cone0_deg || angle_deg > cone1_deg) continue;
+    out.push_back(c + radius(*rng) * d);
+  }
+  return out;
+}
 
-  auto bar = BallSeenFromBothSides({-50, 0, 0}, 12.7, 0.05, &rng);
-  const auto ball_2 = BallSeenFromBothSides({50, 0, 0}, 12.7, 0.05, &rng);
-  bar.insert(bar.end(), ball_2.begin(), ball_2.end());
-  const ArtifactEvaluation e_bar = EvaluateArtifact(BallBarArtifact(), bar, VerifyOptions(), "bar.ply");
-  sums(e_bar);
-  EXPECT_EQ(e_bar.points_in_edge_margin, 0);
-  EXPECT_GT(e_bar.points_off_artifact, 0);  // the caps' points within 60 deg of the bar axis
+// A sphere's counts, from the construction. Truth: the certified sphere
+// (r = 19.05 mm) seen from both sides (BallSeenFromBothSides: noise 0.05 mm),
+// 30 outliers 1-4 mm off its surface (inside the 5 mm capture band: on the
+// artifact, among the excluded or used), 100 points within 12 mm of its
+// centre and 300 points 26-60 mm from it (outside the band either way: off).
+// Every point lies at least 1 mm from the band's edges, and the fitted
+// sphere is within ~0.01 mm of the truth, so the counts are exact: on the
+// artifact those within the band of the true sphere, off the others, each
+// counted from the truth. Before the columns were made to add up there was
+// no count off the artifact; points_off_artifact = points_total -
+// points_on_artifact cannot fail a sum, so each is checked against the truth.
+TEST(Vdi2634, CountedOnceOnASphereOffTheArtifactAsTheTruthSays) {
+  std::mt19937 rng(42);
+  const double r_mm = 19.05, band_mm = 5.0;
+  const Eigen::Vector3d c(0, 0, 200), z(0, 0, 1);
+  std::vector<Eigen::Vector3d> cloud = BallSeenFromBothSides(c, r_mm, 0.05, &rng);
+  const int surface = static_cast<int>(cloud.size());
+  for (const auto& part :
+       {PointsInShell(c, r_mm - 4, r_mm - 1, z, 0, 180, 15, &rng),
+        PointsInShell(c, r_mm + 1, r_mm + 4, z, 0, 180, 15, &rng), PointsInShell(c, 0, 12, z, 0, 180, 100, &rng),
+        PointsInShell(c, 26, 60, z, 0, 180, 300, &rng)})
+    cloud.insert(cloud.end(), part.begin(), part.end());
+  int on = 0, off = 0;
+  for (const auto& p : cloud) ((std::abs((p - c).norm() - r_mm) < band_mm) ? on : off)++;
+  ASSERT_EQ(on, surface + 30);
+  ASSERT_EQ(off, 400);
+  const ArtifactEvaluation e = EvaluateArtifact(SphereArtifact(), cloud, VerifyOptions(), "s.ply");
+  EXPECT_EQ(e.points_total, static_cast<int>(cloud.size()));
+  EXPECT_EQ(e.points_on_artifact, on);
+  EXPECT_EQ(e.points_off_artifact, off);
+  EXPECT_EQ(e.points_in_edge_margin, 0);
+  EXPECT_EQ(e.points_excluded + e.points_used(), on);
+}
+
+// A ball bar's counts, from the construction. Truth: the certified balls
+// (r = 12.7 mm, centres 100 mm apart) seen from both sides, less their
+// points within 1 degree of the 60-degree shaft cone's edge (so the fitted
+// centres, ~0.01 mm off, cannot move a point across it); the rod (4 mm in
+// radius) between them, outside the balls (each of its points in a ball's
+// cone, or outside its band: off either way); per ball 20 outliers 1-4 mm
+// off its surface outside the cone (on the artifact) and 20 inside it (off);
+// and 300 points more than 6 mm outside both balls' bands (off). A ball's
+// points on the artifact are those within the 5 mm band of its true sphere
+// and outside its cone, counted from the truth; the two sets are disjoint
+// (no point is counted for both), and every other point is off.
+TEST(Vdi2634, CountedOnceOnABallBarOffTheArtifactAsTheTruthSays) {
+  std::mt19937 rng(43);
+  const double r_mm = 12.7, band_mm = 5.0, cone_deg = VerifyOptions().ballbar_shaft_cone_deg;
+  const Eigen::Vector3d centres[2] = {{-50, 0, 300}, {50, 0, 300}};
+  auto towards_other = [&](int ball) { return Eigen::Vector3d((centres[1 - ball] - centres[ball]).normalized()); };
+  auto angle_deg = [&](int ball, const Eigen::Vector3d& p) {
+    return std::acos(std::clamp((p - centres[ball]).normalized().dot(towards_other(ball)), -1.0, 1.0)) * 180 / kPi;
+  };
+  std::vector<Eigen::Vector3d> cloud;
+  for (int ball = 0; ball < 2; ++ball) {
+    for (const auto& p : BallSeenFromBothSides(centres[ball], r_mm, 0.05, &rng))
+      if (std::abs(angle_deg(ball, p) - cone_deg) > 1.0) cloud.push_back(p);
+    for (const auto& part :
+         {PointsInShell(centres[ball], r_mm + 1, r_mm + 4, towards_other(ball), cone_deg + 1, 180, 10, &rng),
+          PointsInShell(centres[ball], r_mm - 4, r_mm - 1, towards_other(ball), cone_deg + 1, 180, 10, &rng),
+          PointsInShell(centres[ball], r_mm - 4, r_mm + 4, towards_other(ball), 0, cone_deg - 1, 20, &rng)})
+      cloud.insert(cloud.end(), part.begin(), part.end());
+  }
+  for (double x = -50; x <= 50; x += 0.5) {
+    for (int k = 0; k < 12; ++k) {
+      const Eigen::Vector3d p(x, 4 * std::cos(k * kPi / 6), 300 + 4 * std::sin(k * kPi / 6));
+      if ((p - centres[0]).norm() > r_mm + 0.2 && (p - centres[1]).norm() > r_mm + 0.2) cloud.push_back(p);
+    }
+  }
+  std::uniform_real_distribution<double> box(-90, 90);
+  for (int added = 0; added < 300;) {
+    const Eigen::Vector3d p(box(rng), box(rng), 300 + box(rng));
+    if ((p - centres[0]).norm() < r_mm + band_mm + 6 || (p - centres[1]).norm() < r_mm + band_mm + 6) continue;
+    cloud.push_back(p);
+    ++added;
+  }
+  int on[2] = {0, 0}, both = 0, off = 0;
+  for (const auto& p : cloud) {
+    bool on_ball[2];
+    for (int ball = 0; ball < 2; ++ball) {
+      on_ball[ball] = std::abs((p - centres[ball]).norm() - r_mm) < band_mm && angle_deg(ball, p) > cone_deg;
+      on[ball] += on_ball[ball];
+    }
+    both += on_ball[0] && on_ball[1];
+    off += !on_ball[0] && !on_ball[1];
+  }
+  ASSERT_EQ(both, 0) << "the balls' points on the artifact overlap";
+  ASSERT_GT(off, 300 + 2 * 20);  // the rod's points besides
+  const ArtifactEvaluation e = EvaluateArtifact(BallBarArtifact(), cloud, VerifyOptions(), "bar.ply");
+  EXPECT_EQ(e.points_total, static_cast<int>(cloud.size()));
+  EXPECT_EQ(e.points_on_artifact, on[0] + on[1]);
+  EXPECT_EQ(e.points_off_artifact, off);
+  EXPECT_EQ(e.points_in_edge_margin, 0);
+  EXPECT_EQ(e.points_excluded + e.points_used(), on[0] + on[1]);
+}
+
+// With no edge margin no point is in it: the face is every captured point
+// inside the outline, its outermost rows included. Truth: the 130 mm plate
+// at 1 mm (131 x 131 points, every 3 mm cell full, so the outline passes
+// through the outermost rows exactly) and 2 strays in its plane 10 mm
+// beyond a side (off the outline). Before, the erosion by 0 was strict and
+// left the 4 x 130 points on the outline's sides in the edge margin.
+TEST(Vdi2634, NoEdgeMarginPutsNoPointInIt) {
+  std::mt19937 rng(44);
+  const Eigen::Vector3d c(0, 0, 5), normal(0, 0, 1);
+  const Eigen::Vector3d x = normal.unitOrthogonal();
+  std::vector<Eigen::Vector3d> cloud = PlatePoints(c, normal, 130, 1.0, 0.05, &rng);
+  cloud.push_back(c + 75 * x);
+  cloud.push_back(c + 75 * x + 3 * normal.cross(x));
+  VerifyOptions no_margin;
+  no_margin.plate_edge_margin_mm = 0;
+  const ArtifactEvaluation e = EvaluateArtifact(PlateArtifact(), cloud, no_margin, "plate.ply");
+  EXPECT_EQ(e.points_in_edge_margin, 0);
+  EXPECT_EQ(e.points_on_artifact, 131 * 131);
+  EXPECT_EQ(e.points_off_artifact, 2);
+  EXPECT_EQ(e.plate_points_outside_rectangle, 2);
+}
+
+// plate_points_off_outline keeps its meaning, the captured points not in the
+// face's dense part (PlaneOutline::points_outside), and
+// plate_points_outside_rectangle counts those outside the outline itself.
+// Truth: the 130 mm plate at 1 mm, without noise (so the fitted plane is
+// z = 5 exactly and the 3 mm density cells, fixed about the world's origin,
+// lie along the grid: its points at half-millimetres, none on a cell's
+// side, and every cell at the plate's edge at least 2 x 2 points, dense: a
+// quarter of the median's 9 is 2.25), with a hole 11 x 11 points wide at
+// its centre (|u|, |v| <= 5 mm: nine cells left empty) holding 4 points,
+// each alone in a cell (not dense), and 2 strays in its plane 10 mm beyond
+// a side. The 4 lie inside the rectangle, in the face (on the artifact);
+// the 2 outside it (off). So 6 off the dense part, 2 outside the rectangle.
+// The two counts were one key whose meaning changed in place.
+TEST(Vdi2634, ThePlatesPointsOffItsDensePartAndOutsideItsOutlineAreCountedApart) {
+  std::mt19937 rng(45);
+  const Eigen::Vector3d c(0.5, 0.5, 5), normal(0, 0, 1);
+  const Eigen::Vector3d x = normal.unitOrthogonal(), y = normal.cross(x);
+  std::vector<Eigen::Vector3d> cloud;
+  for (const auto& p : PlatePoints(c, normal, 130, 1.0, 0.0, &rng))
+    if (std::abs((p - c).dot(x)) > 5.5 || std::abs((p - c).dot(y)) > 5.5) cloud.push_back(p);
+  ASSERT_EQ(cloud.size(), 131u * 131u - 11u * 11u);
+  for (const double u : {-1.5, 1.5})
+    for (const double v : {-1.5, 1.5}) cloud.push_back(c + u * x + v * y);
+  cloud.push_back(c + 75 * x);
+  cloud.push_back(c + 75 * x + 3 * y);
+  const ArtifactEvaluation e = EvaluateArtifact(PlateArtifact(), cloud, VerifyOptions(), "plate.ply");
+  EXPECT_EQ(e.plate_points_off_outline, 6);
+  EXPECT_EQ(e.plate_points_outside_rectangle, 2);
+  EXPECT_EQ(e.points_off_artifact, 2);
+  // The plate's 131^2 - 121^2 points within 5 mm of its sides in the edge
+  // margin, or by rounding also the rows on the eroded border (5 mm in).
+  EXPECT_GE(e.points_in_edge_margin, 131 * 131 - 121 * 121);
+  EXPECT_LE(e.points_in_edge_margin, 131 * 131 - 119 * 119);
+  EXPECT_EQ(e.points_on_artifact + e.points_in_edge_margin, 131 * 131 - 11 * 11 + 4);
 }
 
 TEST(Vdi2634, StrayPointsDoNotMakeTooLittleOfThePlateEnough) {
