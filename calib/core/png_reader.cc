@@ -40,9 +40,11 @@ struct PngDecoding {
   size_t warnings_at = 0;
   bool refused = false, read = false;
   // Set once the image's last row is decoded, at byte `image_end_at`: image
-  // data read past it beyond kMaxBytesAfterImage sets `too_much_data`.
+  // data read past it (IDAT bytes only, `idat_bytes_after_image`: not the
+  // chunks between, which are not inflated) beyond kMaxBytesAfterImage sets
+  // `too_much_data`.
   bool image_done = false, too_much_data = false;
-  size_t image_end_at = 0;
+  size_t image_end_at = 0, idat_bytes_after_image = 0;
   png_structp png = nullptr;
   png_infop info = nullptr;
 
@@ -105,7 +107,8 @@ void ReadFromBytes(png_structp png, png_bytep out, size_t length) {
       d.image_done = true;
       d.image_end_at = d.at;
     }
-    if (d.image_done && d.at + length - d.image_end_at > kMaxBytesAfterImage) {
+    if (d.image_done) d.idat_bytes_after_image += length;
+    if (d.idat_bytes_after_image > kMaxBytesAfterImage) {
       d.too_much_data = true;
       png_error(png, "too much image data");
     }

@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
-#include <chrono>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -218,6 +217,11 @@ TEST(PngReader, ImageDataHoldingMoreThanTheImageIsRead) {
   EXPECT_EQ(Read(kHead + Chunk("IDAT", Deflate(Rows(100000), 9)) + kIend), whole);
   EXPECT_EQ(Read(kHead + Chunk("IDAT", kImageData) + Chunk("tEXt", "abc") + Chunk("IDAT", "") + kIend), whole);
   EXPECT_EQ(Read(kHead + Chunk("IDAT", kImageData) + Chunk("tEXt", "abc") + Chunk("IDAT", "xy") + kIend), whole);
+  // A text chunk longer than the bomb limit (16 KiB) between the image and
+  // a later empty IDAT: its bytes are not inflated, so they do not count.
+  EXPECT_EQ(
+      Read(kHead + Chunk("IDAT", kImageData) + Chunk("tEXt", std::string(20000, 'a')) + Chunk("IDAT", "") + kIend),
+      whole);
 }
 
 // The stream may be split anywhere across consecutive IDATs, empty ones
@@ -278,14 +282,13 @@ TEST(PngReader, AStreamFarLongerThanTheImageIsRefused) {
   ASSERT_EQ(deflateEnd(&z), Z_OK);
   bomb.resize(used);
   ASSERT_LT(bomb.size(), 100000u);
-  const auto start = std::chrono::steady_clock::now();
   ExpectRefused(kPngSignature + Chunk("IHDR", Ihdr(1, 1)) + Chunk("IDAT", bomb) + kIend,
                 "a PNG whose image data goes on for more than 16 KiB past its image's end (at byte " +
                     std::to_string(8192 + 41) +
                     "): a decompression bomb or a faulty encoder, refused rather than inflated");
-  // Under 25 MiB inflated (libpng's 8 KiB read ahead and the 16 KiB past
-  // the image): ~60 ms on this machine, against 165 ms for the whole.
-  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 0.5);
+  // How fast is the bench's business, not this test's: the refusal's
+  // byte says it stopped 8 KiB (libpng's read ahead) into the stream, under
+  // 25 MiB inflated of the 64 MiB (165 ms whole, ~60 ms refused here).
 }
 
 // Headers beyond this reader's limits are refused from the header alone,
