@@ -50,8 +50,8 @@ class Child {
     if (pid_ == 0) {
       // The signals as a supervisor starts a service: default actions,
       // none blocked (a test run as a shell's background job inherits SIGINT
-      // ignored, and SIGPIPE is ignored above).
-      for (int s : {SIGINT, SIGTERM, SIGPIPE}) signal(s, SIG_DFL);
+      // ignored, a run under nohup SIGHUP, and SIGPIPE is ignored above).
+      for (int s : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) signal(s, SIG_DFL);
       sigset_t none;
       sigemptyset(&none);
       sigprocmask(SIG_SETMASK, &none, nullptr);
