@@ -204,7 +204,9 @@ int ExitCodeWithStdout(int code, const std::string& program) {
   const std::string error = StdoutWriteError();
   if (error.empty() || code == kExitBadInput) return code;
   std::fprintf(stderr, "%s: standard output: cannot be written: %s\n", program.c_str(), error.c_str());
-  return kExitBadInput;
+  // A check that ran and failed keeps its 1: its verdict is in its report
+  // and history, and "bad input" would hide the drift from a supervisor.
+  return code == kExitCheckFailed ? kExitCheckFailed : kExitBadInput;
 }
 
 const CLI::Validator& NonEmptyPath() {

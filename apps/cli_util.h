@@ -79,10 +79,11 @@ std::string StdoutWriteError();
 // The process's exit code once `program` ("stereorig reconstruct") returned
 // `code`: where stdout lost anything it printed (a full disk, /dev/full, a
 // closed descriptor, a reader gone with SIGPIPE ignored), a run that
-// returned 0 or 1 returns 2 after one line on stderr, "<program>: standard
+// returned 0 returns 2 after one line on stderr, "<program>: standard
 // output: cannot be written: <why>", since the caller did not get what the
-// run printed (its table, verdict, each capture's line). A run that returned
-// 2 keeps it and its own error line. Called once, by main, for every command
+// run printed (its table, each capture's line). A check that returned 1 (it
+// ran and failed: check's history and report hold the verdict) keeps its 1
+// after the same line. A run that returned 2 keeps it and its own line. Called once, by main, for every command
 // (and --help, --version), after the command has ended: files it wrote are
 // complete and stay (docs/formats.md, "CLI").
 int ExitCodeWithStdout(int code, const std::string& program);

@@ -22,6 +22,11 @@ int Step(const std::vector<std::string>& args) {
   for (const std::string& a : args) line += " " + a;
   std::printf("\n%s\n", line.c_str());
   FlushStdout();
+  // The demo's output is its point: with stdout lost (a full disk,
+  // /dev/full) no further step runs, and the demo ends in one line, exit 2.
+  if (const std::string lost = StdoutWriteError(); !lost.empty())
+    throw InputError("standard output",
+                     "cannot be written: " + lost + "; the demo stops before `" + line.substr(2) + "`");
   for (const Command& c : Commands()) {
     if (args[0] != c.name) continue;
     std::vector<std::string> storage = args;

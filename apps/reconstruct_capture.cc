@@ -104,6 +104,10 @@ int FinishRun(nlohmann::json* summary, int total, int failed, double wall_ms, co
   std::printf("%d of %d captures in %.2f s: %.1f objects/s (%s)\n", done, total, wall_ms / 1000,
               (*summary)["objects_per_s"].get<double>(), timed.c_str());
   FlushStdout();
+  // Stdout lost on the last lines (a terminal's hang-up): the summary says
+  // so, as for a capture's line, and main exits 2 (cli_util.h).
+  const std::string lost = StdoutWriteError();
+  if (!lost.empty() && !summary->contains("output_error")) (*summary)["output_error"] = lost;
   if (!summary_path.empty()) WriteFileAtomically(summary_path, summary->dump(2) + "\n");
   if (failed == 0) return kExitOk;
   std::fprintf(stderr,

@@ -17,8 +17,9 @@ namespace stereorig {
 // 2-16 grey levels: the message names the file's depth), or, given
 // `rig_size_px` (its camera's imager), if it is of another size ("is
 // 16000x16000, the rig says 752x582"). All three are read from a PNG's
-// header, before its pixels are allocated or decoded: a capture costs at
-// most its camera's size in memory, whatever its header declares.
+// header, before its pixels are allocated or decoded: a capture's decoded
+// pixels cost at most its camera's size in memory, whatever its header
+// declares (the file itself is read whole first: its bytes, not more).
 cv::Mat ReadGreyImage(const std::string& path, std::optional<cv::Size> rig_size_px = std::nullopt);
 
 }  // namespace stereorig

@@ -29,6 +29,7 @@ namespace stereorig {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::kBin;
 using testing::Lines;
 using testing::Result;
 using testing::RunCli;
@@ -473,6 +474,20 @@ TEST(CheckCli, TheReportListsEveryNamedCameraAndModuleAndWhatExplainsEach) {
       << turned.dump(2);
   EXPECT_TRUE(lens["camera_changes"][0]["turned_deg"].is_number()) << lens.dump(2);  // fitted, if not what changed
   EXPECT_EQ(turned["flagged_modules"], nlohmann::json::array());
+  {
+    // The same night with its stdout lost (a full log disk): the drift still
+    // reads as a failed check (1), not as bad input (2), after one line
+    // saying the output was lost; its report is written.
+    const std::string err = dir + "/full.err", report = dir + "/full.json";
+    const int status = std::system((kBin + " check --rig " + dir + "/rig.yaml --captures " + dir + "/turned --target " +
+                                    dir + "/turned/target.yaml --history-db " + dir + "/history.sqlite --report " +
+                                    report + " >/dev/full 2>" + err)
+                                       .c_str());
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 1) << Bytes(err);
+    EXPECT_EQ(LastLine(Bytes(err)), "stereorig check: standard output: cannot be written: No space left on device");
+    EXPECT_TRUE(fs::exists(report));
+  }
   const nlohmann::json shifted = night("shifted", "--bump-module 0 --bump-translation-mm 0.1");
   ASSERT_TRUE(shifted.is_object());
   EXPECT_EQ(shifted["explanation"], "module 0 and module 1 disagree: one moved or a lens changed");

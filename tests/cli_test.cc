@@ -151,6 +151,19 @@ TEST(Cli, AStdoutThatCannotBeWrittenIsNoSuccess) {
   r = RunWithStdout("--version", "&-");
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.err, "stereorig: standard output: cannot be written: Bad file descriptor\n");
+  // The demo stops before its first step, in one line (its steps would each
+  // have failed on the lost stdout and run for minutes), its --out not left.
+  const std::string demo_out = ::testing::TempDir() + "/stdout_demo_" + std::to_string(getpid());
+  std::filesystem::remove_all(demo_out);
+  r = RunWithStdout("demo --out " + demo_out, "/dev/full");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("stereorig demo: standard output: cannot be written: No space left on device; the demo stops "
+                        "before `stereorig simulate",
+                        0),
+            0u)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(demo_out));
   // Bad input keeps its own exit code and line.
   r = RunWithStdout("rig --rig " + rig + ".missing", "/dev/full");
   EXPECT_EQ(r.code, 2);
