@@ -83,9 +83,10 @@ std::string StdoutWriteError();
 // output: cannot be written: <why>", since the caller did not get what the
 // run printed (its table, each capture's line). A check that returned 1 (it
 // ran and failed: check's history and report hold the verdict) keeps its 1
-// after the same line. A run that returned 2 keeps it and its own line. Called once, by main, for every command
-// (and --help, --version), after the command has ended: files it wrote are
-// complete and stay (docs/formats.md, "CLI").
+// after the same line. A run that returned 2 keeps it and its own line.
+// Called once, by main, for every command (and --help, --version), after
+// the command has ended: files it wrote are complete and stay
+// (docs/formats.md, "CLI").
 int ExitCodeWithStdout(int code, const std::string& program);
 
 // For subcommands a later issue fills in: prints what it will do and exits 2.

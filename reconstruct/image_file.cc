@@ -26,10 +26,8 @@ std::string FirstBytes(const std::string& path, size_t count) {
 
 }  // namespace
 
-cv::Mat ReadImageFile(const std::string& path, int* stored_bit_depth) {
-  return ReadImageFile(path, [stored_bit_depth](const ImageHeader& header) {
-    if (stored_bit_depth) *stored_bit_depth = header.stored_bit_depth;
-  });
+cv::Mat ReadImageFile(const std::string& path) {
+  return ReadImageFile(path, [](const ImageHeader&) {});
 }
 
 cv::Mat ReadImageFile(const std::string& path, const std::function<void(const ImageHeader&)>& check) {

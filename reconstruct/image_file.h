@@ -18,11 +18,9 @@ namespace stereorig {
 // not link OpenCV's imgcodecs (png_writer.h says why). Throws InputError if
 // the file is missing or not a file, is a PNG cut short, damaged or too
 // large (png_reader.h), is named .png but is not one, is a TIFF of another
-// kind or damaged, or is neither.
-// *stored_bit_depth, if given: the PNG's own bit depth (PngReader::
-// stored_bit_depth: 1, 2 or 4 for grey the decoder scaled to 8 bits); the
-// TIFF's 32.
-cv::Mat ReadImageFile(const std::string& path, int* stored_bit_depth = nullptr);
+// kind or damaged, or is neither. (The file's own bit depth, e.g. a grey
+// PNG of 1, 2 or 4 bits the decoder scales to 8: the overload below.)
+cv::Mat ReadImageFile(const std::string& path);
 
 // What an image file's header says, before any pixel is decoded.
 struct ImageHeader {
