@@ -92,18 +92,22 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
                          "reads too (this one has " +
                              std::to_string(png->channels()) + " channel(s) of " +
                              std::to_string(png->stored_bit_depth()) + " bits)");
-      cv::Mat grey(int(png->height_px()), int(png->width_px()), CV_8UC1);
-      png->Read(grey.data, grey.step);
+      // The size from the header too, before the pixels are allocated and
+      // decoded: an image of another camera, or a huge one, is refused
+      // without paying for it.
+      const int width_px = int(png->width_px()), height_px = int(png->height_px());
       CameraImager& spec = out.cameras[c];
       if (spec.width_px == 0) {
-        spec.width_px = grey.cols;
-        spec.height_px = grey.rows;
-      } else if (spec.width_px != grey.cols || spec.height_px != grey.rows) {
-        throw InputError(image.string(), "image of the wrong size: " + std::to_string(grey.cols) + "x" +
-                                             std::to_string(grey.rows) + ", but cam" + std::to_string(c) +
+        spec.width_px = width_px;
+        spec.height_px = height_px;
+      } else if (spec.width_px != width_px || spec.height_px != height_px) {
+        throw InputError(image.string(), "image of the wrong size: " + std::to_string(width_px) + "x" +
+                                             std::to_string(height_px) + ", but cam" + std::to_string(c) +
                                              "'s other images are " + std::to_string(spec.width_px) + "x" +
                                              std::to_string(spec.height_px));
       }
+      cv::Mat grey(height_px, width_px, CV_8UC1);
+      png->Read(grey.data, grey.step);
       DetectResult r;
       try {
         r = detector.Detect(grey);

@@ -262,13 +262,34 @@ TEST(CalibrateCli, AStageOverTheRmsLimitWritesNoRigFile) {
 
 TEST(CalibrateCli, RefusesImagesOfTheWrongSize) {
   const RenderedSet set = Render("calib_cli_size", 2, 6);
-  cv::imwrite(set.dir + "/captures/001/cam1.png", cv::Mat(480, 640, CV_8UC1, cv::Scalar(128)));
+  cv::Mat noise(480, 640, CV_8UC1);  // noise: its image data far longer than the 200 bytes kept below
+  cv::randu(noise, 0, 256);
+  cv::imwrite(set.dir + "/captures/001/cam1.png", noise);
   const testing::Result r =
       testing::RunCli("calibrate --captures " + set.dir + "/captures --target " + set.dir + "/target.yaml --layout " +
                       set.dir + "/layout.yaml --out " + set.dir + "/rig.yaml --report " + set.dir + "/report.json");
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(testing::Lines(r.err.substr(r.err.rfind("stereorig calibrate:"))), 1) << r.err;
   EXPECT_NE(r.err.find("wrong size"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(set.dir + "/rig.yaml"));
+
+  // The size is read from the header, before the pixels are decoded: the
+  // same wrong-size image cut short after its first 200 bytes (its header
+  // whole, its image data not) is refused for its size, not for the
+  // damage a decode would have met first.
+  const std::string cut = set.dir + "/captures/001/cam1.png";
+  std::string bytes;
+  {
+    std::ifstream in(cut, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  ASSERT_GT(bytes.size(), 200u);
+  std::ofstream(cut, std::ios::binary | std::ios::trunc) << bytes.substr(0, 200);
+  const testing::Result cut_run =
+      testing::RunCli("calibrate --captures " + set.dir + "/captures --target " + set.dir + "/target.yaml --layout " +
+                      set.dir + "/layout.yaml --out " + set.dir + "/rig.yaml --report " + set.dir + "/report.json");
+  EXPECT_EQ(cut_run.code, 2);
+  EXPECT_NE(cut_run.err.find("cam1.png: image of the wrong size: 640x480"), std::string::npos) << cut_run.err;
   EXPECT_FALSE(fs::exists(set.dir + "/rig.yaml"));
 }
 
