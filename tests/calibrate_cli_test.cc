@@ -265,9 +265,10 @@ TEST(CalibrateCli, RefusesImagesOfTheWrongSize) {
   cv::Mat noise(480, 640, CV_8UC1);  // noise: its image data far longer than the 200 bytes kept below
   cv::randu(noise, 0, 256);
   cv::imwrite(set.dir + "/captures/001/cam1.png", noise);
-  const testing::Result r =
-      testing::RunCli("calibrate --captures " + set.dir + "/captures --target " + set.dir + "/target.yaml --layout " +
-                      set.dir + "/layout.yaml --out " + set.dir + "/rig.yaml --report " + set.dir + "/report.json");
+  const std::string calibrate = "calibrate --captures " + set.dir + "/captures --target " + set.dir +
+                                "/target.yaml --layout " + set.dir + "/layout.yaml --out " + set.dir +
+                                "/rig.yaml --report " + set.dir + "/report.json";
+  const testing::Result r = testing::RunCli(calibrate);
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(testing::Lines(r.err.substr(r.err.rfind("stereorig calibrate:"))), 1) << r.err;
   EXPECT_NE(r.err.find("wrong size"), std::string::npos) << r.err;
@@ -285,9 +286,7 @@ TEST(CalibrateCli, RefusesImagesOfTheWrongSize) {
   }
   ASSERT_GT(bytes.size(), 200u);
   std::ofstream(cut, std::ios::binary | std::ios::trunc) << bytes.substr(0, 200);
-  const testing::Result cut_run =
-      testing::RunCli("calibrate --captures " + set.dir + "/captures --target " + set.dir + "/target.yaml --layout " +
-                      set.dir + "/layout.yaml --out " + set.dir + "/rig.yaml --report " + set.dir + "/report.json");
+  const testing::Result cut_run = testing::RunCli(calibrate);
   EXPECT_EQ(cut_run.code, 2);
   EXPECT_NE(cut_run.err.find("cam1.png: image of the wrong size: 640x480"), std::string::npos) << cut_run.err;
   EXPECT_FALSE(fs::exists(set.dir + "/rig.yaml"));
