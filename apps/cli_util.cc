@@ -64,7 +64,33 @@ std::string PrintableText(const std::string& message) {
   return out;
 }
 
+namespace {
+
+const CLI::Validator& NonEmptyValue() {
+  static const CLI::Validator v(
+      [](const std::string& text) { return text.empty() ? std::string("an empty value") : std::string(); }, "",
+      "NonEmptyValue");
+  return v;
+}
+
+// Every option that takes a value refuses an empty one; NonEmptyPath's own
+// message stands where an option has it.
+void RefuseEmptyValues(CLI::App& app) {
+  for (CLI::Option* option : app.get_options()) {
+    if (option->get_type_size() == 0) continue;  // a flag
+    try {
+      option->get_validator("NonEmptyPath");
+      continue;
+    } catch (const CLI::OptionNotFound&) {
+    }
+    option->check(NonEmptyValue());
+  }
+}
+
+}  // namespace
+
 std::optional<int> ParseArgs(CLI::App& app, int argc, char** argv) {
+  RefuseEmptyValues(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {

@@ -12,7 +12,12 @@ namespace stereorig {
 
 // Parses argv into `app`. Returns an exit code when the command must stop now
 // (0 after printing --help to stdout; 2 after one line on stderr for a usage
-// error), or std::nullopt when it should run.
+// error), or std::nullopt when it should run. An option given an empty
+// value ("--target ''", "--rig $UNSET") is a usage error, "--target: an
+// empty value" (or NonEmptyPath's "an empty path" where the option has that
+// check): before, an input read as not given (target drew the built-in
+// board, score scored the truth rig, rig skipped --truth) and the run
+// exited 0.
 std::optional<int> ParseArgs(CLI::App& app, int argc, char** argv);
 
 // The scene names of a --scenes argument, "cup,sphere" -> {cup, sphere}.

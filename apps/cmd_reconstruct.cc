@@ -119,8 +119,6 @@ int RunReconstruct(int argc, char** argv) {
   const bool stream = std::find(capture_dirs.begin(), capture_dirs.end(), "-") != capture_dirs.end();
   if (stream && capture_dirs.size() > 1)
     throw InputError("--capture", "'-' (the capture folders read from standard input) must be the only --capture");
-  if (app.count("--warm-up") > 0 && warm_up_dir.empty())
-    throw InputError("--warm-up", "names no capture folder (an empty path)");
   if (app.count("--capture-root") > 0 && !stream)
     throw InputError("--capture-root",
                      "is for a stream of captures (--capture -): a batch names its captures after "

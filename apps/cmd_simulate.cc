@@ -31,7 +31,7 @@ int RunSimulate(int argc, char** argv) {
   std::string spec_path, write_spec;
   SimulateOptions o;
   bool no_scenes = false;
-  app.add_option("--spec", spec_path, "rig spec YAML (default: the embedded default rig)")->check(CLI::ExistingFile);
+  app.add_option("--spec", spec_path, "rig spec YAML (default: the embedded default rig)");
   app.add_option("--out", o.out_dir,
                  "dataset folder to write; if it already holds a dataset, the whole folder is replaced atomically, "
                  "anything else in it included")

@@ -432,6 +432,44 @@ TEST(Cli, AnEmptyOutputPathIsRefusedByItsOptionsName) {
   }
 }
 
+// Every other option that takes a value refuses an empty one too, by name,
+// before any work and with nothing on stdout: an input path given as ''
+// read as not given and the run went on with exit 0 (target drew the
+// built-in board, score scored the truth rig, reconstruct and tune ran on
+// the built-in options, rig skipped --truth, bench benched the built-in
+// sphere, a stream's --capture-root named captures by their last folder).
+TEST(Cli, AnEmptyValueIsRefusedByItsOptionsName) {
+  const std::pair<const char*, const char*> options[] = {{"target", "--target"},
+                                                         {"check", "--rig"},
+                                                         {"rig", "--rig"},
+                                                         {"rig", "--truth"},
+                                                         {"score", "--dataset"},
+                                                         {"score", "--rig"},
+                                                         {"score", "--options"},
+                                                         {"tune", "--options"},
+                                                         {"tune", "--capture"},
+                                                         {"reconstruct", "--rig"},
+                                                         {"reconstruct", "--capture"},
+                                                         {"reconstruct", "--options"},
+                                                         {"reconstruct", "--warm-up"},
+                                                         {"reconstruct", "--capture-root"},
+                                                         {"bench", "--dataset"},
+                                                         {"bench", "--rig"},
+                                                         {"match", "--left"},
+                                                         {"check", "--target"},
+                                                         {"check", "--captures"},
+                                                         {"calibrate", "--captures"},
+                                                         {"calibrate", "--lensmodel"},
+                                                         {"simulate", "--spec"},
+                                                         {"demo", "--seed"}};
+  for (const auto& [command, option] : options) {
+    const Result r = RunCli(std::string(command) + " " + option + " ''");
+    EXPECT_EQ(r.code, 2) << command << " " << option;
+    EXPECT_EQ(r.err, std::string("stereorig ") + command + ": " + option + ": an empty value (see --help)\n");
+    EXPECT_EQ(r.out, "") << command << " " << option;
+  }
+}
+
 // demo's --out is made before any step: under a file it is refused naming
 // the file, and one that cannot be made (a name longer than the file
 // system's 255 characters) leaves no folder above it (it used to leave

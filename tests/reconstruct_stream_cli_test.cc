@@ -487,7 +487,7 @@ TEST_F(ReconstructStreamCli, BadUseExitsTwoInOneLine) {
   const testing::Result empty_warm =
       testing::RunCli("reconstruct" + rig + " --capture - --out-dir " + dir_ + "/o4 --warm-up '' < /dev/null");
   EXPECT_EQ(empty_warm.code, 2);
-  EXPECT_NE(empty_warm.err.find("--warm-up: names no capture folder"), std::string::npos) << empty_warm.err;
+  EXPECT_NE(empty_warm.err.find("--warm-up: an empty value"), std::string::npos) << empty_warm.err;
   const testing::Result root_batch = testing::RunCli("reconstruct" + rig + " --capture " + dir_ +
                                                      "/line/0001 --out-dir " + dir_ + "/o5 --capture-root " + dir_);
   EXPECT_EQ(root_batch.code, 2);
