@@ -51,8 +51,9 @@ int RunCalibrate(int argc, char** argv) {
   app.add_option("--export-cameramodels", cameramodels_dir, "also write DIR/camK.cameramodel (mrcal format)")
       ->check(NonEmptyPath());
   app.add_option("--lensmodel", options.intrinsics.lensmodel,
-                 "LENSMODEL_OPENCV5 (solved without regularisation), or LENSMODEL_OPENCV8 or "
-                 "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=.._Ny=.._fov_x_deg=.. (both keep mrcal's regularisation)")
+                 "LENSMODEL_OPENCV5 or LENSMODEL_OPENCV4 (solved without regularisation), or LENSMODEL_OPENCV8, "
+                 "LENSMODEL_OPENCV12 or LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=.._Ny=.._fov_x_deg=.. (these keep "
+                 "mrcal's regularisation); not LENSMODEL_PINHOLE (docs/calibration.md)")
       ->capture_default_str();
   app.add_option("--focal", options.intrinsics.seed_focal_px, "rough focal length for the PnP seed, px (0: estimate)")
       ->capture_default_str()
