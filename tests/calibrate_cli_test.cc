@@ -292,6 +292,31 @@ TEST(CalibrateCli, RefusesImagesOfTheWrongSize) {
   EXPECT_FALSE(fs::exists(set.dir + "/rig.yaml"));
 }
 
+// A simulated dataset without target captures (`simulate
+// --calibration-captures 0`: spec.yaml and truth/, no calibration/) is
+// named as such; its truth/ and scenes/ were taken for capture folders
+// ("truth/cam0.png: missing (each capture needs camK.png ...)").
+TEST(CalibrateCli, ADatasetWithoutCapturesIsNamedSo) {
+  const std::string dir = ::testing::TempDir() + "/calib_cli_no_captures_" + std::to_string(getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir + "/ds/truth");
+  fs::create_directories(dir + "/ds/scenes/sphere/active");
+  std::ofstream(dir + "/ds/spec.yaml") << "a spec\n";
+  WriteTargetFile(DefaultTarget(), dir + "/ds/target.yaml");
+  std::ofstream(dir + "/ds/layout.yaml") << "modules:\n  - {name: module0, left: 0, right: 1}\n";
+  const testing::Result r =
+      testing::RunCli("calibrate --captures " + dir + "/ds --target " + dir + "/ds/target.yaml --layout " + dir +
+                      "/ds/layout.yaml --out " + dir + "/rig.yaml --report " + dir + "/report.json");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("stereorig calibrate: " + dir +
+                       "/ds: is a simulated dataset (spec.yaml, truth/) with no target captures: a dataset's are in "
+                       "its calibration/ folder, which this one lacks"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
+  fs::remove_all(dir);
+}
+
 TEST(CalibrateCli, RefusesAFaceSeenByTheWrongModule) {
   const RenderedSet set = Render("calib_cli_face", 2, 7);
   std::ofstream(set.dir + "/layout.yaml") << "modules:\n  - {name: module0, left: 0, right: 1, face: back}\n"
