@@ -115,7 +115,13 @@ int RunCalibrate(int argc, char** argv) {
   std::printf("%s", SummaryText(result.report).c_str());
   FlushStdout();
   WriteCalibrationOutputs(result, out_path, report_path, cameramodels_dir);
-  std::printf("wrote %s and %s\n", out_path.c_str(), report_path.c_str());
+  // Every file written is named: the models too, by their folder (their
+  // names are camK.cameramodel, one per camera of the layout).
+  if (cameramodels_dir.empty())
+    std::printf("wrote %s and %s\n", out_path.c_str(), report_path.c_str());
+  else
+    std::printf("wrote %s, %s and %d camera models (camK.cameramodel) in %s\n", out_path.c_str(), report_path.c_str(),
+                LayoutCameraCount(layout), cameramodels_dir.c_str());
   return 0;
 }
 

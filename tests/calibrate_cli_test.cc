@@ -110,6 +110,12 @@ TEST(CalibrateCli, RenderedCapturesToRigFileAndReport) {
   const testing::Result r = testing::RunCli(args + " --export-cameramodels " + set.dir + "/new/models");
   ASSERT_EQ(r.code, 0) << r.err;
   for (int k = 0; k < 4; ++k) EXPECT_TRUE(fs::exists(set.dir + "/new/models/cam" + std::to_string(k) + ".cameramodel"));
+  // The success line names every output, the models by their folder (it
+  // named only the rig file and the report).
+  EXPECT_NE(r.out.find("wrote " + set.dir + "/rig.yaml, " + set.dir + "/report.json and 4 camera models " +
+                       "(camK.cameramodel) in " + set.dir + "/new/models\n"),
+            std::string::npos)
+      << r.out;
   std::printf("%s", r.out.c_str());
   EXPECT_NE(r.err.find("detect 000"), std::string::npos);  // progress
   const Rig rig = ReadRigFile(set.dir + "/rig.yaml");
