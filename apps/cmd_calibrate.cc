@@ -51,8 +51,9 @@ int RunCalibrate(int argc, char** argv) {
   app.add_option("--export-cameramodels", cameramodels_dir, "also write DIR/camK.cameramodel (mrcal format)")
       ->check(NonEmptyPath());
   app.add_option("--lensmodel", options.intrinsics.lensmodel,
-                 "LENSMODEL_OPENCV5 (solved without regularisation), or LENSMODEL_OPENCV8 or "
-                 "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=.._Ny=.._fov_x_deg=.. (both keep mrcal's regularisation)")
+                 "LENSMODEL_OPENCV5 or LENSMODEL_OPENCV4 (solved without regularisation), or LENSMODEL_OPENCV8, "
+                 "LENSMODEL_OPENCV12 or LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=.._Ny=.._fov_x_deg=.. (these keep "
+                 "mrcal's regularisation); not LENSMODEL_PINHOLE (docs/calibration.md)")
       ->capture_default_str();
   app.add_option("--focal", options.intrinsics.seed_focal_px, "rough focal length for the PnP seed, px (0: estimate)")
       ->capture_default_str()
@@ -114,7 +115,13 @@ int RunCalibrate(int argc, char** argv) {
   std::printf("%s", SummaryText(result.report).c_str());
   FlushStdout();
   WriteCalibrationOutputs(result, out_path, report_path, cameramodels_dir);
-  std::printf("wrote %s and %s\n", out_path.c_str(), report_path.c_str());
+  // Every file written is named: the models too, by their folder (their
+  // names are camK.cameramodel, one per camera of the layout).
+  if (cameramodels_dir.empty())
+    std::printf("wrote %s and %s\n", out_path.c_str(), report_path.c_str());
+  else
+    std::printf("wrote %s, %s and %d camera models (camK.cameramodel) in %s\n", out_path.c_str(), report_path.c_str(),
+                LayoutCameraCount(layout), cameramodels_dir.c_str());
   return 0;
 }
 

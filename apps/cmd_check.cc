@@ -167,17 +167,14 @@ int RunCheck(int argc, char** argv) {
   }
   RequireCapturesFolder(captures);  // before the progress line
   std::fprintf(stderr, "check: detecting the target in %s\n", captures.c_str());
-  const DetectedCaptures detected = DetectCaptureFolder(captures, target, rig.num_cameras(), DetectOptions(), true);
-  for (int c = 0; c < rig.num_cameras(); ++c) {
-    const CameraImager& seen = detected.cameras[c];
-    const Camera& cam = rig.camera(c);
-    if (seen.width_px != cam.imager_width_px() || seen.height_px != cam.imager_height_px()) {
-      throw InputError(captures, "cam" + std::to_string(c) + " images are " + std::to_string(seen.width_px) + "x" +
-                                     std::to_string(seen.height_px) + " but the rig's camera " + std::to_string(c) +
-                                     " is " + std::to_string(cam.imager_width_px()) + "x" +
-                                     std::to_string(cam.imager_height_px()) + ": captures from another rig?");
-    }
-  }
+  // Every image held to the rig's size for its camera, as reconstruct
+  // does: against the first capture's instead, an odd-sized image there
+  // got the right ones after it blamed.
+  std::vector<CameraImager> rig_cameras(rig.num_cameras());
+  for (int c = 0; c < rig.num_cameras(); ++c)
+    rig_cameras[c] = {"cam" + std::to_string(c), rig.camera(c).imager_width_px(), rig.camera(c).imager_height_px()};
+  const DetectedCaptures detected =
+      DetectCaptureFolder(captures, target, rig.num_cameras(), DetectOptions(), true, rig_cameras);
   std::fprintf(stderr, "check: %d captures, %zu views; re-estimating board poses\n", detected.num_captures,
                detected.observations.size());
   CheckResult result = RunNightlyCheck(rig, target, detected.observations, options, captures, detected.capture_names);

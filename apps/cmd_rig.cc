@@ -2,6 +2,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
@@ -66,13 +67,18 @@ std::vector<Eigen::Vector3d> VolumeGrid(const Rig& truth, double distance_mm, co
   return points;
 }
 
-// The figures docs/calibration.md judges a calibration by, against a true
-// rig (a simulated dataset's truth/rig.yaml).
-void PrintAgainstTruth(const Rig& rig, const Rig& truth, double distance_mm, const Eigen::Vector3d& size_mm) {
+// Throws InputError unless `truth` has the rig's modules and cameras, so
+// that it can judge it.
+void RequireTruthMatches(const Rig& rig, const Rig& truth) {
   if (truth.num_modules() != rig.num_modules() || truth.num_cameras() != rig.num_cameras())
     throw InputError("--truth", "has " + std::to_string(truth.num_modules()) + " module(s) and " +
                                     std::to_string(truth.num_cameras()) + " camera(s), the rig has " +
                                     std::to_string(rig.num_modules()) + " and " + std::to_string(rig.num_cameras()));
+}
+
+// The figures docs/calibration.md judges a calibration by, against a true
+// rig (a simulated dataset's truth/rig.yaml; RequireTruthMatches passed).
+void PrintAgainstTruth(const Rig& rig, const Rig& truth, double distance_mm, const Eigen::Vector3d& size_mm) {
   const std::vector<Eigen::Vector3d> points = VolumeGrid(truth, distance_mm, size_mm);
   std::printf("against the truth, over a %.0f x %.0f x %.0f mm volume %.0f mm ahead of module 0 (%zu points):\n",
               size_mm.x(), size_mm.y(), size_mm.z(), distance_mm, points.size());
@@ -126,10 +132,17 @@ int RunRig(int argc, char** argv) {
   app.add_option("--rig", rig_path, "rig file (YAML, docs/formats.md)")->required();
   app.add_option("--export-cameramodels", export_dir, "folder to write camN.cameramodel files into (created if needed)")
       ->check(NonEmptyPath());
-  app.add_option("--truth", truth_path, "true rig file to judge this one against (a simulated dataset's)");
+  CLI::Option* truth_option =
+      app.add_option("--truth", truth_path, "true rig file to judge this one against (a simulated dataset's)");
+  // Refused without --truth (exit 2): a --distance that judged nothing
+  // used to be ignored, exit 0, as if it had been applied.
   app.add_option("--distance", distance_mm, "with --truth: the volume's centre ahead of module 0, mm")
-      ->capture_default_str();
-  app.add_option("--volume", size_mm, "with --truth: the volume's size x y z, mm")->expected(3)->capture_default_str();
+      ->capture_default_str()
+      ->needs(truth_option);
+  app.add_option("--volume", size_mm, "with --truth: the volume's size x y z, mm")
+      ->expected(3)
+      ->capture_default_str()
+      ->needs(truth_option);
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
   if (!(distance_mm > 0)) throw InputError("--distance", "must be > 0 mm");
   for (double v : size_mm)
@@ -157,14 +170,22 @@ int RunRig(int argc, char** argv) {
     model_paths.push_back((std::filesystem::path(export_dir) / (name + ".cameramodel")).string());
     outputs.Claim(model_paths.back(), "camera " + std::to_string(i) + "'s model (--export-cameramodels)", false);
   }
-  PrintRigSummary(rig, stdout);
-  if (!truth_path.empty())
-    PrintAgainstTruth(rig, ReadRigFile(truth_path), distance_mm, Eigen::Vector3d(size_mm[0], size_mm[1], size_mm[2]));
+  // Every input read and every model written before the first line is
+  // printed: a failure after a printed summary (a --truth that is no rig
+  // file, a models' folder that cannot be made) left a valid-looking
+  // summary on stdout next to exit 2.
+  std::optional<Rig> truth;
+  if (!truth_path.empty()) {
+    truth = ReadRigFile(truth_path);
+    RequireTruthMatches(rig, *truth);
+  }
   models_folder.Create();
   AtomicOutputSet written;  // every model or none
   for (int i = 0; i < int(model_paths.size()); ++i)
     written.Add(model_paths[i], CameramodelText(rig.camera(i), rig.CamFromReference(i)));
   written.Commit();
+  PrintRigSummary(rig, stdout);
+  if (truth) PrintAgainstTruth(rig, *truth, distance_mm, Eigen::Vector3d(size_mm[0], size_mm[1], size_mm[2]));
   for (const std::string& path : model_paths) std::printf("wrote %s\n", path.c_str());
   return kExitOk;
 }

@@ -86,6 +86,10 @@ int RunTarget(int argc, char** argv) {
                                                    square_option->count() ? square_mm : 9.0,
                                                    thickness_option->count() ? thickness_mm : 5.0)
                             : DefaultTarget();
+  // Named by the flag and the file here: the SVG writer's own refusal
+  // ("board svg: ...") named neither.
+  if (faces == "back" && !target.double_sided())
+    throw InputError("--face", "back: " + target_path + " is a plain (one-sided) board, with no back face");
   BoardSvgOptions options;
   options.faces = faces == "front" ? SvgFaces::kFront : faces == "back" ? SvgFaces::kBack : SvgFaces::kBoth;
   const BoardSvg svg = MakeBoardSvg(target, options);

@@ -24,6 +24,14 @@ namespace {
 // sub-folder if it has one (a dataset written by `stereorig simulate`).
 fs::path CapturesRoot(const fs::path& dir) { return fs::is_directory(dir / "calibration") ? dir / "calibration" : dir; }
 
+// A dataset written by `stereorig simulate` without a calibration/ folder
+// (--calibration-captures 0): its spec.yaml and truth/ say what it is
+// (docs/formats.md "Datasets"). Its sub-folders (scenes/, truth/) are no
+// captures: taken as such, the run stopped on "truth/cam0.png: missing".
+bool IsDatasetWithoutCaptures(const fs::path& dir) {
+  return !fs::exists(dir / "calibration") && fs::is_regular_file(dir / "spec.yaml") && fs::is_directory(dir / "truth");
+}
+
 // The capture sub-folders of `root` (a folder), sorted by name.
 std::vector<fs::path> CaptureSubfolders(const fs::path& root) {
   std::vector<fs::path> captures;
@@ -37,7 +45,7 @@ std::vector<fs::path> CaptureSubfolders(const fs::path& root) {
 
 std::vector<std::string> CaptureFolderImages(const std::string& dir) {
   std::vector<std::string> images;
-  if (!fs::is_directory(dir)) return images;
+  if (!fs::is_directory(dir) || IsDatasetWithoutCaptures(dir)) return images;
   for (const fs::path& capture : CaptureSubfolders(CapturesRoot(dir))) {
     for (const auto& e : fs::directory_iterator(capture)) {
       if (CameraIndexOfImageName(e.path().filename().string())) images.push_back(e.path().string());
@@ -53,8 +61,14 @@ void RequireCapturesFolder(const std::string& dir) {
 }
 
 DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& target, int num_cameras,
-                                     const DetectOptions& options, bool progress) {
+                                     const DetectOptions& options, bool progress,
+                                     const std::vector<CameraImager>& rig_cameras) {
+  STEREORIG_CHECK(rig_cameras.empty() || int(rig_cameras.size()) == num_cameras);
   RequireCapturesFolder(dir_in);
+  if (IsDatasetWithoutCaptures(dir_in))
+    throw InputError(dir_in,
+                     "is a simulated dataset (spec.yaml, truth/) with no target captures: a dataset's are in its "
+                     "calibration/ folder, which this one lacks (simulated with --calibration-captures 0?)");
   const fs::path dir = CapturesRoot(dir_in);
   const std::vector<fs::path> captures = CaptureSubfolders(dir);
   if (captures.empty()) throw InputError(dir.string(), "holds no capture folders (expected NNN/camK.png)");
@@ -62,7 +76,13 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
   DetectedCaptures out;
   out.num_captures = static_cast<int>(captures.size());
   out.cameras.resize(num_cameras);
-  for (int c = 0; c < num_cameras; ++c) out.cameras[c].name = "cam" + std::to_string(c);
+  for (int c = 0; c < num_cameras; ++c) {
+    out.cameras[c].name = "cam" + std::to_string(c);
+    if (!rig_cameras.empty()) {
+      out.cameras[c].width_px = rig_cameras[c].width_px;
+      out.cameras[c].height_px = rig_cameras[c].height_px;
+    }
+  }
   const TargetDetector detector(target, options);
   for (size_t n = 0; n < captures.size(); ++n) {
     const std::string name = captures[n].filename().string();
@@ -101,10 +121,13 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
         spec.width_px = width_px;
         spec.height_px = height_px;
       } else if (spec.width_px != width_px || spec.height_px != height_px) {
-        throw InputError(image.string(), "image of the wrong size: " + std::to_string(width_px) + "x" +
-                                             std::to_string(height_px) + ", but cam" + std::to_string(c) +
-                                             "'s other images are " + std::to_string(spec.width_px) + "x" +
-                                             std::to_string(spec.height_px));
+        const std::string size = std::to_string(width_px) + "x" + std::to_string(height_px);
+        const std::string expected = std::to_string(spec.width_px) + "x" + std::to_string(spec.height_px);
+        if (!rig_cameras.empty())
+          throw InputError(image.string(), size + ", but the rig's cam" + std::to_string(c) + " is " + expected +
+                                               " (an image of another camera, or captures from another rig?)");
+        throw InputError(image.string(), "image of the wrong size: " + size + ", but cam" + std::to_string(c) +
+                                             "'s other images are " + expected);
       }
       cv::Mat grey(height_px, width_px, CV_8UC1);
       png->Read(grey.data, grey.step);

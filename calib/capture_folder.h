@@ -4,7 +4,8 @@
 // numeric name such as 007 is the capture's index), each with one 8-bit grey
 // image per camera named camK.png (K = global camera index), as
 // docs/formats.md fixes. A dataset folder written by `stereorig simulate`
-// works too: its calibration/ sub-folder is used.
+// works too: its calibration/ sub-folder is used (one without is refused,
+// saying so).
 #pragma once
 
 #include <map>
@@ -50,10 +51,14 @@ std::vector<std::string> CaptureFolderImages(const std::string& dir);
 void RequireCapturesFolder(const std::string& dir);
 
 // Detects the target in every image. Throws InputError (naming the file) on
-// a missing folder or image, an unreadable image, or images of one camera
-// with different sizes. `progress`: one line per capture on stderr.
+// a missing folder or image, an unreadable image, an image of the wrong
+// size, or a dataset folder without calibration/ captures. `progress`: one
+// line per capture on stderr. `rig_cameras`: (num_cameras,) the sizes a
+// rig file gives each camera's images (check), every image held to them;
+// empty (calibrate: no rig yet): each camera's first image sets its size.
 DetectedCaptures DetectCaptureFolder(const std::string& dir, const Target& target, int num_cameras,
-                                     const DetectOptions& options, bool progress);
+                                     const DetectOptions& options, bool progress,
+                                     const std::vector<CameraImager>& rig_cameras = {});
 
 // "" unless most images were rejected (more than half) and at least one in
 // ten as not fitting the target's layout (ambiguous: no single orientation

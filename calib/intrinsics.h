@@ -20,9 +20,10 @@
 namespace stereorig {
 
 struct IntrinsicsOptions {
-  // Lens model as mrcal spells it: LENSMODEL_OPENCV5, LENSMODEL_OPENCV8, or a
+  // Lens model as mrcal spells it: LENSMODEL_OPENCV4, 5, 8 or 12, or a
   // splined stereographic one such as
-  // LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=16_Ny=12_fov_x_deg=50.
+  // LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=16_Ny=12_fov_x_deg=50; not
+  // LENSMODEL_PINHOLE (Check() says why).
   // Default LENSMODEL_OPENCV5: it holds a mild lens such as the default
   // rig's, and it is the richest model that needs no regularisation (see
   // LensmodelNeedsRegularization), so its fit and its sigma are unbiased.

@@ -308,6 +308,15 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     cv::imwrite(d + "/005/cam2.png", cv::Mat(480, 640, CV_8UC1, cv::Scalar(40)));
     expect_refused(check(d, dir + "/rig.yaml"), "005/cam2.png", "wrong-size image");
   }
+  {  // The wrong-size image in the first capture: held to the rig's size,
+     // it is the one named (held to the first capture's, the right image
+     // of the next capture was blamed: "001/cam2.png: ... 752x582, but
+     // cam2's other images are 640x480").
+    const std::string d = copy("wrong_size_first");
+    cv::imwrite(d + "/000/cam2.png", cv::Mat(480, 640, CV_8UC1, cv::Scalar(40)));
+    expect_refused(check(d, dir + "/rig.yaml"), "000/cam2.png: 640x480, but the rig's cam2 is 752x582",
+                   "wrong-size first image");
+  }
   {  // A 16-bit image (a 12-bit camera's, in the low bits): imread's grey
      // conversion took its high byte, a nearly black image.
     const std::string d = copy("sixteen_bit");

@@ -90,6 +90,22 @@ TEST(CliTarget, BadTargetFileExitsTwoAndWritesNothing) {
   EXPECT_EQ(RunStereorig("target").code, 2);  // --out is required
 }
 
+// --face back of a plain (one-sided) board is refused naming the flag and
+// the target file (the SVG writer's "board svg: ..." named neither).
+TEST(CliTarget, BackFaceOfAPlainBoardNamesTheFlagAndTheFile) {
+  const std::string dir = ::testing::TempDir() + "/cli_target_plain";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/plain.yaml") << "format: stereorig-target\nversion: 1\nunits: mm\ncorners_x: 8\n"
+                                        "corners_y: 6\nsquare_size_mm: 20\ndouble_sided: false\n";
+  ASSERT_EQ(RunStereorig("target --target " + dir + "/plain.yaml --out " + dir + "/front.svg").code, 0);
+  const Result r = RunStereorig("target --target " + dir + "/plain.yaml --face back --out " + dir + "/b.svg");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err,
+            "stereorig target: --face: back: " + dir + "/plain.yaml is a plain (one-sided) board, with no back face\n");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/b.svg"));
+}
+
 // Both outputs or neither: a target file that cannot be written (in a
 // folder where no file can be created, UnwritablePath, as a full disk would
 // fail it after the SVG's temporary file is written) leaves an earlier run's

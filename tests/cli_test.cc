@@ -305,6 +305,48 @@ TEST(Cli, RigAgainstTruthGivesZeroForItselfAndTheShiftOfAMovedModule) {
       << r.out;
 }
 
+// `rig` reads --truth and makes the models' folder before it prints: a
+// --truth that is no rig file (a layout file), or a folder that cannot be
+// made, printed the whole summary to stdout, then exited 2.
+TEST(Cli, RigPrintsNothingWhenAnInputOrTheModelsFolderFails) {
+  const std::string dir = ::testing::TempDir() + "/cli_rig_late_" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/rig.yaml") << GoodRigText();
+  std::ofstream(dir + "/layout.yaml") << "modules:\n  - {name: module0, left: 0, right: 1}\n";
+  Result r = RunCli("rig --rig " + dir + "/rig.yaml --truth " + dir + "/layout.yaml");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(dir + "/layout.yaml"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out, "");
+  r = RunCli("rig --rig " + dir + "/rig.yaml --export-cameramodels " + stereorig::testing::UnwritablePath("models"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_EQ(r.out, "");
+  std::filesystem::remove_all(dir);
+}
+
+// The options that only shape the --truth judgement are refused without it
+// (they were ignored, exit 0), and the help says so.
+TEST(Cli, RigRefusesTruthOnlyOptionsWithoutTruth) {
+  const std::string rig = ::testing::TempDir() + "/truth_only_rig.yaml";
+  std::ofstream(rig) << GoodRigText();
+  for (const char* option : {"--distance 500", "--volume 10 10 10"}) {
+    const Result r = RunCli("rig --rig " + rig + " " + std::string(option));
+    EXPECT_EQ(r.code, 2) << option;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("--truth"), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "") << option;
+  }
+  const Result help = RunCli("rig --help");
+  EXPECT_EQ(help.code, 0);
+  int needs = 0;  // one per truth-only option
+  for (size_t at = help.out.find("Needs: --truth"); at != std::string::npos;
+       at = help.out.find("Needs: --truth", at + 1))
+    ++needs;
+  EXPECT_EQ(needs, 2) << help.out;
+}
+
 // Every malformed case of the rig-file contract: exit 2, one line on stderr
 // naming the file and the offending key.
 TEST(Cli, EveryMalformedRigFileExitsTwoNamingTheKey) {
