@@ -66,6 +66,12 @@ int RunSimulate(int argc, char** argv) {
           "--bump-rotation-deg", "--bump-translation-mm", "--bump-focal-percent", "--bump-principal-point-px"})
       if (app.count(flag) > 0)
         throw InputError(flag, "does not apply with --write-default-spec (it writes the spec and stops)");
+  // -1 is the options' "none": given, it named no camera, and the bump read
+  // as "every amount given is 0" whatever the amount.
+  if (app.count("--bump-camera") > 0 && o.bump.camera < 0)
+    throw InputError("--bump-camera", "no camera " + std::to_string(o.bump.camera));
+  if (app.count("--bump-module") > 0 && o.bump.module < 0)
+    throw InputError("--bump-module", "no module " + std::to_string(o.bump.module));
   // A bump needs what to move and by how much: either alone used to render
   // an undisturbed rig without a word. A lens drift needs its camera.
   const bool bump_what = app.count("--bump-camera") + app.count("--bump-module") > 0;

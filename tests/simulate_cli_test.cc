@@ -21,6 +21,19 @@ namespace {
 
 using namespace sim_cli;
 
+// Each `simulate ARGS` exits 2 with one line that holds SAYS, and nothing
+// is written into `dir` (the folder its --out is in).
+void ExpectEachRefusedBeforeAnyWork(const std::vector<std::pair<std::string, std::string>>& cases,
+                                    const std::string& dir) {
+  for (const auto& [args, says] : cases) {
+    const Result r = RunCli("simulate" + args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
+  }
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
 TEST(SimulateCli, DefaultSpecFileRoundTripsAndBadKeysExitTwo) {
   const std::string dir = ::testing::TempDir();
   const std::string spec = dir + "/sim_default_spec.yaml";
@@ -226,7 +239,7 @@ TEST(SimulateCli, OptionsThatWouldBeIgnoredAreRefused) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string out = " --out " + dir + "/ds";
-  const std::pair<std::string, std::string> cases[] = {
+  const std::vector<std::pair<std::string, std::string>> cases = {
       {out + " --bump-rotation-deg 0.1", "--bump-rotation-deg: needs --bump-camera or --bump-module"},
       {out + " --bump-camera 1",
        "--bump-camera: needs --bump-rotation-deg, --bump-translation-mm, --bump-focal-percent or "
@@ -235,13 +248,29 @@ TEST(SimulateCli, OptionsThatWouldBeIgnoredAreRefused) {
       {" --write-default-spec " + dir + "/s.yaml" + out, "--out: does not apply with --write-default-spec"},
       {" --write-default-spec " + dir + "/s.yaml --bump-camera 1", "--bump-camera: does not apply with"},
       {out + " --seed -1", "--seed: must be >= 0"}};
-  for (const auto& [args, says] : cases) {
-    const Result r = RunCli("simulate" + args);
-    EXPECT_EQ(r.code, 2) << args;
-    EXPECT_EQ(Lines(r.err), 1) << r.err;
-    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
-  }
-  EXPECT_TRUE(fs::is_empty(dir));
+  ExpectEachRefusedBeforeAnyWork(cases, dir);
+}
+
+// A bump names a camera or module that exists and moves it by a finite
+// amount within +-10, or exits 2 before any work naming the flag. -1 (the
+// library's "none") used to read as no bump at all ("every amount given is
+// 0" although the amount was 1), and a NaN amount got through to the rig's
+// own check ("rig: module 1 right_from_left: contains NaN or Inf").
+TEST(SimulateCli, BumpIndexAndAmountAreRefusedByTheFlagsName) {
+  const std::string dir = ::testing::TempDir() + "/sim_bump_refused";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string out = " --out " + dir + "/ds --calibration-captures 0 --no-scenes";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {out + " --bump-camera -1 --bump-rotation-deg 1", "--bump-camera: no camera -1"},
+      {out + " --bump-camera -2 --bump-translation-mm 1", "--bump-camera: no camera -2"},
+      {out + " --bump-module -1 --bump-rotation-deg 1", "--bump-module: no module -1"},
+      {out + " --bump-module 1 --bump-rotation-deg nan", "--bump-rotation-deg: must be within +-10"},
+      {out + " --bump-module 1 --bump-translation-mm nan", "--bump-translation-mm: must be within +-10"},
+      {out + " --bump-camera 1 --bump-rotation-deg -nan", "--bump-rotation-deg: must be within +-10"},
+      {out + " --bump-camera 1 --bump-rotation-deg 11", "--bump-rotation-deg: must be within +-10"},
+      {out + " --bump-camera 1 --bump-translation-mm -inf", "--bump-translation-mm: must be within +-10"}};
+  ExpectEachRefusedBeforeAnyWork(cases, dir);
 }
 
 // A lens drift (--bump-focal-percent, --bump-principal-point-px) belongs to
@@ -253,7 +282,7 @@ TEST(SimulateCli, LensDriftIsValidatedAndRecordedInTheTruth) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string out = " --out " + dir + "/ds";
-  const std::pair<std::string, std::string> cases[] = {
+  const std::vector<std::pair<std::string, std::string>> cases = {
       {out + " --bump-focal-percent 0.1", "--bump-focal-percent: needs --bump-camera"},
       {out + " --bump-principal-point-px 1 0", "--bump-principal-point-px: needs --bump-camera"},
       {out + " --bump-module 1 --bump-focal-percent 0.1", "--bump-focal-percent: needs --bump-camera"},
@@ -270,13 +299,7 @@ TEST(SimulateCli, LensDriftIsValidatedAndRecordedInTheTruth) {
       {out + " --bump-camera 9 --bump-focal-percent 0.1 --calibration-captures 0 --no-scenes",
        "--bump-camera: no camera 9"},
       {" --write-default-spec " + dir + "/s.yaml --bump-focal-percent 1", "--bump-focal-percent: does not apply with"}};
-  for (const auto& [args, says] : cases) {
-    const Result r = RunCli("simulate" + args);
-    EXPECT_EQ(r.code, 2) << args;
-    EXPECT_EQ(Lines(r.err), 1) << r.err;
-    EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
-  }
-  EXPECT_TRUE(fs::is_empty(dir));
+  ExpectEachRefusedBeforeAnyWork(cases, dir);
 
   const Result r = RunCli("simulate" + out +
                           " --bump-camera 1 --bump-focal-percent 0.5 --bump-principal-point-px 1.5 -2"
