@@ -49,8 +49,10 @@ int RunSimulate(int argc, char** argv) {
   app.add_option("--write-default-spec", write_spec, "write the embedded default spec to this file and exit");
   app.add_option("--bump-camera", o.bump.camera, "disturb this camera (global index) before rendering");
   app.add_option("--bump-module", o.bump.module, "move this module (cameras and projector) as a whole");
-  app.add_option("--bump-rotation-deg", o.bump.rotation_deg, "bump: rotation angle, about a seeded random axis");
-  app.add_option("--bump-translation-mm", o.bump.translation_mm, "bump: shift, along a seeded random direction");
+  app.add_option("--bump-rotation-deg", o.bump.rotation_deg,
+                 "bump: rotation angle, about a seeded random axis; within +-10");
+  app.add_option("--bump-translation-mm", o.bump.translation_mm,
+                 "bump: shift, along a seeded random direction; within +-10");
   app.add_option("--bump-focal-percent", o.bump.lens.focal_percent,
                  "bump the camera's lens: fx and fy scaled by 1 + P/100 (a focus ring turned, thermal drift); "
                  "within +-10");

@@ -273,6 +273,22 @@ TEST(SimulateCli, BumpIndexAndAmountAreRefusedByTheFlagsName) {
   ExpectEachRefusedBeforeAnyWork(cases, dir);
 }
 
+// Every bump amount's limit is in --help, on its flag's line, as the checks
+// refuse it (docs/simulator.md says the same): the rotation and shift limits
+// used to be found only by tripping over them.
+TEST(SimulateCli, TheHelpGivesEveryBumpAmountsLimit) {
+  const Result r = RunCli("simulate --help");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const auto& [flag, limit] :
+       {std::pair{"--bump-rotation-deg", "within +-10"}, std::pair{"--bump-translation-mm", "within +-10"},
+        std::pair{"--bump-focal-percent", "within +-10"}, std::pair{"--bump-principal-point-px", "within +-50"}}) {
+    const size_t at = r.out.find(std::string("\n  ") + flag + " ");
+    ASSERT_NE(at, std::string::npos) << flag << ": " << r.out;
+    const size_t next_flag = r.out.find("\n  --", at + 1);
+    EXPECT_NE(r.out.substr(at, next_flag - at).find(limit), std::string::npos) << flag << ": " << r.out;
+  }
+}
+
 // A lens drift (--bump-focal-percent, --bump-principal-point-px) belongs to
 // one camera and has a plausible size: anything else exits 2 before any
 // work, one line naming the flag. A good one renders, and truth/rig.yaml and
