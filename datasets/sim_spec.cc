@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <filesystem>
 #include <set>
 #include <sstream>
 
@@ -15,6 +16,8 @@
 namespace stereorig {
 
 namespace {
+
+namespace fs = std::filesystem;
 
 constexpr double kDegToRad = M_PI / 180.0;
 
@@ -259,7 +262,23 @@ SimSpec ParseSimSpecYaml(const std::string& text, const std::string& where) {
   return s;
 }
 
-SimSpec ReadSimSpecFile(const std::string& path) { return ParseSimSpecYaml(ReadInputText(path), path); }
+SimSpec ReadSimSpecFile(const std::string& path) {
+  SimSpec spec = ParseSimSpecYaml(ReadInputText(path), path);
+  // A spec and its board go together: a relative target was read from the
+  // current folder, so the spec rendered only from its own folder, and a
+  // missing board was reported without the key that named it.
+  std::string& target = spec.calibration.target;
+  if (target != "default") {
+    const bool relative = fs::path(target).is_relative();
+    target = (fs::path(path).parent_path() / target).string();
+    std::error_code ec;
+    if (!fs::is_regular_file(target, ec)) {
+      throw InputError(path + ": calibration.target",
+                       "no file " + target + (relative ? " (a relative target is read from the spec's folder)" : ""));
+    }
+  }
+  return spec;
+}
 
 std::string SimSpecToYaml(const SimSpec& s) {
   std::ostringstream o;
@@ -312,7 +331,7 @@ std::string SimSpecToYaml(const SimSpec& s) {
   const CalibrationSpec& c = s.calibration;
   o << "calibration:\n"
     << "  captures: " << c.captures << "\n"
-    << "  target: " << c.target << "          # 'default' or a target file\n"
+    << "  target: " << c.target << "          # 'default' or a target file (a relative path: from this file's folder)\n"
     << "  tilt_max_deg: " << FormatDouble(c.tilt_max_deg) << "\n"
     << "  roll_max_deg: " << FormatDouble(c.roll_max_deg) << "\n"
     << "  volume_mm: " << Vec(c.volume_mm) << "\n"

@@ -395,7 +395,12 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
   });
 
   // --- the small files
-  WriteText(tmp / "spec.yaml", SimSpecToYaml(spec));
+  // The dataset renders again from its own spec: a target file is named as
+  // the copy written beside it (a relative target is read from the spec's
+  // folder), not as the path it was read from, which may not travel with it.
+  SimSpec written = spec;
+  if (written.calibration.target != "default") written.calibration.target = "target.yaml";
+  WriteText(tmp / "spec.yaml", SimSpecToYaml(written));
   WriteTargetFile(target, (tmp / "target.yaml").string());
   {
     std::ostringstream o;

@@ -63,6 +63,48 @@ TEST(SimulateCli, DefaultSpecFileRoundTripsAndBadKeysExitTwo) {
   EXPECT_NE(r.err.find("captures"), std::string::npos) << r.err;
 }
 
+// A spec's relative calibration.target is its neighbour, read from the
+// spec file's folder wherever simulate runs: it was read from the current
+// folder ("board12.yaml: no such file", naming no key), and the dataset's
+// spec.yaml kept the name without the board, so it did not render again.
+// Now the dataset's spec names the target.yaml written beside it, and
+// renders the same images from there.
+TEST(SimulateCli, ASpecsRelativeTargetIsReadFromItsFolderAndTheDatasetRendersAgain) {
+  const std::string dir = ::testing::TempDir() + "/sim_relative_target";
+  fs::remove_all(dir);
+  fs::create_directories(dir + "/specdir");
+  ASSERT_EQ(RunCli("target --corners 9 7 --square-mm 10 --out " + dir + "/board12.svg --write-target " + dir +
+                   "/specdir/board12.yaml")
+                .code,
+            0);
+  ASSERT_EQ(RunCli("simulate --write-default-spec " + dir + "/specdir/spec.yaml").code, 0);
+  std::string spec = Slurp(dir + "/specdir/spec.yaml");
+  const size_t at = spec.find("target: default");
+  ASSERT_NE(at, std::string::npos) << "the default spec changed: " << spec;
+  spec.replace(at, 15, "target: board12.yaml");
+  std::ofstream(dir + "/specdir/spec.yaml") << spec;
+  // The test runs in another folder than specdir.
+  ASSERT_FALSE(fs::exists("board12.yaml"));
+  const std::string one = " --calibration-captures 1 --no-scenes --threads 2";
+  Result r = RunCli("simulate --spec " + dir + "/specdir/spec.yaml --out " + dir + "/a" + one);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(Slurp(dir + "/a/target.yaml"), Slurp(dir + "/specdir/board12.yaml"));
+  r = RunCli("simulate --spec " + dir + "/a/spec.yaml --out " + dir + "/b" + one);
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* file : {"spec.yaml", "target.yaml", "calibration/000/cam0.png", "calibration/000/cam3.png"})
+    EXPECT_EQ(Slurp(dir + "/b/" + file), Slurp(dir + "/a/" + file)) << file;
+  // A target that is not there: exit 2, one line naming the spec, the key
+  // and where it looked.
+  fs::remove(dir + "/specdir/board12.yaml");
+  r = RunCli("simulate --spec " + dir + "/specdir/spec.yaml --out " + dir + "/c" + one);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(dir + "/specdir/spec.yaml: calibration.target: no file " + dir + "/specdir/board12.yaml"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/c"));
+}
+
 // An --out with a trailing slash (as a shell's completion writes it) names
 // the same folder as without one. simulate used to render the whole dataset
 // and then fail to rename it into place ("cannot replace: Invalid
