@@ -49,8 +49,10 @@ int RunSimulate(int argc, char** argv) {
   app.add_option("--write-default-spec", write_spec, "write the embedded default spec to this file and exit");
   app.add_option("--bump-camera", o.bump.camera, "disturb this camera (global index) before rendering");
   app.add_option("--bump-module", o.bump.module, "move this module (cameras and projector) as a whole");
-  app.add_option("--bump-rotation-deg", o.bump.rotation_deg, "bump: rotation angle, about a seeded random axis");
-  app.add_option("--bump-translation-mm", o.bump.translation_mm, "bump: shift, along a seeded random direction");
+  app.add_option("--bump-rotation-deg", o.bump.rotation_deg,
+                 "bump: rotation angle, about a seeded random axis; within +-10");
+  app.add_option("--bump-translation-mm", o.bump.translation_mm,
+                 "bump: shift, along a seeded random direction; within +-10");
   app.add_option("--bump-focal-percent", o.bump.lens.focal_percent,
                  "bump the camera's lens: fx and fy scaled by 1 + P/100 (a focus ring turned, thermal drift); "
                  "within +-10");
@@ -66,6 +68,12 @@ int RunSimulate(int argc, char** argv) {
           "--bump-rotation-deg", "--bump-translation-mm", "--bump-focal-percent", "--bump-principal-point-px"})
       if (app.count(flag) > 0)
         throw InputError(flag, "does not apply with --write-default-spec (it writes the spec and stops)");
+  // -1 is the options' "none": given, it named no camera, and the bump read
+  // as "every amount given is 0" whatever the amount.
+  if (app.count("--bump-camera") > 0 && o.bump.camera < 0)
+    throw InputError("--bump-camera", "no camera " + std::to_string(o.bump.camera));
+  if (app.count("--bump-module") > 0 && o.bump.module < 0)
+    throw InputError("--bump-module", "no module " + std::to_string(o.bump.module));
   // A bump needs what to move and by how much: either alone used to render
   // an undisturbed rig without a word. A lens drift needs its camera.
   const bool bump_what = app.count("--bump-camera") + app.count("--bump-module") > 0;

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <filesystem>
 #include <set>
 #include <sstream>
 
@@ -9,6 +10,7 @@
 #include "calib/core/input_error.h"
 #include "calib/core/input_file.h"
 #include "calib/core/lens_plausibility.h"
+#include "calib/core/number_text.h"
 #include "calib/core/rig_file.h"
 #include "calib/core/yaml_reader.h"
 
@@ -16,15 +18,21 @@ namespace stereorig {
 
 namespace {
 
+namespace fs = std::filesystem;
+
 constexpr double kDegToRad = M_PI / 180.0;
 
 void Require(bool ok, const std::string& where, const std::string& key, const std::string& problem) {
   if (!ok) throw InputError(where + (key.empty() ? "" : ": " + key), problem);
 }
 
+// The spec file is for editing: 0.6, not %.17g's 0.59999999999999998, and
+// still the same double read back.
+std::string Num(double x) { return ShortestNumberText(x); }
+
 std::string Vec(const Eigen::Vector3d& v) {
   std::ostringstream o;
-  o << '[' << FormatDouble(v.x()) << ", " << FormatDouble(v.y()) << ", " << FormatDouble(v.z()) << ']';
+  o << '[' << Num(v.x()) << ", " << Num(v.y()) << ", " << Num(v.z()) << ']';
   return o.str();
 }
 
@@ -259,7 +267,23 @@ SimSpec ParseSimSpecYaml(const std::string& text, const std::string& where) {
   return s;
 }
 
-SimSpec ReadSimSpecFile(const std::string& path) { return ParseSimSpecYaml(ReadInputText(path), path); }
+SimSpec ReadSimSpecFile(const std::string& path) {
+  SimSpec spec = ParseSimSpecYaml(ReadInputText(path), path);
+  // A spec and its board go together: a relative target was read from the
+  // current folder, so the spec rendered only from its own folder, and a
+  // missing board was reported without the key that named it.
+  std::string& target = spec.calibration.target;
+  if (target != "default") {
+    const bool relative = fs::path(target).is_relative();
+    target = (fs::path(path).parent_path() / target).string();
+    std::error_code ec;
+    if (!fs::is_regular_file(target, ec)) {
+      throw InputError(path + ": calibration.target",
+                       "no file " + target + (relative ? " (a relative target is read from the spec's folder)" : ""));
+    }
+  }
+  return spec;
+}
 
 std::string SimSpecToYaml(const SimSpec& s) {
   std::ostringstream o;
@@ -271,7 +295,7 @@ std::string SimSpecToYaml(const SimSpec& s) {
     o << "    " << key << ":\n"
       << "      lensmodel: " << c.lensmodel << "\n"
       << "      intrinsics: [";
-    for (size_t i = 0; i < c.intrinsics.size(); ++i) o << (i ? ", " : "") << FormatDouble(c.intrinsics[i]);
+    for (size_t i = 0; i < c.intrinsics.size(); ++i) o << (i ? ", " : "") << Num(c.intrinsics[i]);
     o << "]\n      imager_size: [" << c.width_px << ", " << c.height_px << "]\n";
   };
   for (const ModuleSpec& m : s.modules) {
@@ -279,8 +303,8 @@ std::string SimSpecToYaml(const SimSpec& s) {
       << "    center_mm: " << Vec(m.center_mm) << "     # nominal centre (midway between the cameras)\n"
       << "    look_at_mm: " << Vec(m.look_at_mm) << "\n"
       << "    up: " << Vec(m.up) << "             # world direction seen as up in the images\n"
-      << "    baseline_mm: " << FormatDouble(m.baseline_mm) << "\n"
-      << "    verging_deg: " << FormatDouble(m.verging_deg) << "   # angle between the optical axes\n";
+      << "    baseline_mm: " << Num(m.baseline_mm) << "\n"
+      << "    verging_deg: " << Num(m.verging_deg) << "   # angle between the optical axes\n";
     camera("left_camera", m.left);
     camera("right_camera", m.right);
     const ProjectorSpec& p = m.projector;
@@ -288,58 +312,58 @@ std::string SimSpecToYaml(const SimSpec& s) {
       << "      enabled: " << (p.enabled ? "true" : "false") << "\n"
       << "      offset_mm: " << Vec(p.offset_mm) << "   # from the nominal centre, module frame\n"
       << "      lines: " << p.lines << "              # N x N grid\n"
-      << "      fan_angle_deg: " << FormatDouble(p.fan_angle_deg) << "\n"
-      << "      rotation_deg: " << FormatDouble(p.rotation_deg) << "     # about its axis, against the rows\n"
-      << "      line_sigma_mrad: " << FormatDouble(p.line_sigma_mrad) << "    # Gaussian 1-sigma of a line\n"
-      << "      power_dn: " << FormatDouble(p.power_dn) << "   # line centre, albedo 1, facing, at working distance\n";
+      << "      fan_angle_deg: " << Num(p.fan_angle_deg) << "\n"
+      << "      rotation_deg: " << Num(p.rotation_deg) << "     # about its axis, against the rows\n"
+      << "      line_sigma_mrad: " << Num(p.line_sigma_mrad) << "    # Gaussian 1-sigma of a line\n"
+      << "      power_dn: " << Num(p.power_dn) << "   # line centre, albedo 1, facing, at working distance\n";
   }
   const RenderSpec& r = s.render;
   o << "render:\n"
     << "  samples_per_axis: " << r.samples_per_axis << "        # n x n rays per pixel (scenes)\n"
     << "  edge_samples_per_axis: " << r.edge_samples_per_axis << "   # n x n on target print edges\n"
-    << "  ambient_dn: " << FormatDouble(r.ambient_dn) << "\n"
-    << "  ambient_directional: " << FormatDouble(r.ambient_directional) << "\n"
-    << "  background_dn: " << FormatDouble(r.background_dn) << "\n"
-    << "  stray_light_dn: " << FormatDouble(r.stray_light_dn) << "\n"
-    << "  psf_sigma_px: " << FormatDouble(r.psf_sigma_px) << "\n"
+    << "  ambient_dn: " << Num(r.ambient_dn) << "\n"
+    << "  ambient_directional: " << Num(r.ambient_directional) << "\n"
+    << "  background_dn: " << Num(r.background_dn) << "\n"
+    << "  stray_light_dn: " << Num(r.stray_light_dn) << "\n"
+    << "  psf_sigma_px: " << Num(r.psf_sigma_px) << "\n"
     << "  noise: " << (r.noise ? "true" : "false") << "\n"
-    << "  full_well_e: " << FormatDouble(r.full_well_e) << "\n"
-    << "  read_noise_e: " << FormatDouble(r.read_noise_e) << "\n"
-    << "  speckle_contrast: " << FormatDouble(r.speckle_contrast) << "\n"
-    << "  speckle_grain_px: " << FormatDouble(r.speckle_grain_px) << "\n"
-    << "  texture_contrast: " << FormatDouble(r.texture_contrast) << "\n"
-    << "  texture_wavelength_mm: " << FormatDouble(r.texture_wavelength_mm) << "\n";
+    << "  full_well_e: " << Num(r.full_well_e) << "\n"
+    << "  read_noise_e: " << Num(r.read_noise_e) << "\n"
+    << "  speckle_contrast: " << Num(r.speckle_contrast) << "\n"
+    << "  speckle_grain_px: " << Num(r.speckle_grain_px) << "\n"
+    << "  texture_contrast: " << Num(r.texture_contrast) << "\n"
+    << "  texture_wavelength_mm: " << Num(r.texture_wavelength_mm) << "\n";
   const CalibrationSpec& c = s.calibration;
   o << "calibration:\n"
     << "  captures: " << c.captures << "\n"
-    << "  target: " << c.target << "          # 'default' or a target file\n"
-    << "  tilt_max_deg: " << FormatDouble(c.tilt_max_deg) << "\n"
-    << "  roll_max_deg: " << FormatDouble(c.roll_max_deg) << "\n"
+    << "  target: " << c.target << "          # 'default' or a target file (a relative path: from this file's folder)\n"
+    << "  tilt_max_deg: " << Num(c.tilt_max_deg) << "\n"
+    << "  roll_max_deg: " << Num(c.roll_max_deg) << "\n"
     << "  volume_mm: " << Vec(c.volume_mm) << "\n"
-    << "  scale_error_ppm: " << FormatDouble(c.scale_error_ppm) << "\n"
-    << "  back_misalignment_deg: " << FormatDouble(c.back_misalignment_deg) << "\n"
-    << "  back_misalignment_mm: " << FormatDouble(c.back_misalignment_mm) << "\n"
-    << "  nonflatness_mm: " << FormatDouble(c.nonflatness_mm) << "\n"
-    << "  white_albedo: " << FormatDouble(c.white_albedo) << "\n"
-    << "  black_albedo: " << FormatDouble(c.black_albedo) << "\n"
+    << "  scale_error_ppm: " << Num(c.scale_error_ppm) << "\n"
+    << "  back_misalignment_deg: " << Num(c.back_misalignment_deg) << "\n"
+    << "  back_misalignment_mm: " << Num(c.back_misalignment_mm) << "\n"
+    << "  nonflatness_mm: " << Num(c.nonflatness_mm) << "\n"
+    << "  white_albedo: " << Num(c.white_albedo) << "\n"
+    << "  black_albedo: " << Num(c.black_albedo) << "\n"
     << "  min_corners_per_camera: " << c.min_corners_per_camera << "\n";
   const ScenesSpec& n = s.scenes;
   o << "scenes:\n  names: [";
   for (size_t i = 0; i < n.names.size(); ++i) o << (i ? ", " : "") << n.names[i];
   o << "]\n"
-    << "  wobble_shift_mm: " << FormatDouble(n.wobble_shift_mm) << "\n"
-    << "  wobble_tilt_deg: " << FormatDouble(n.wobble_tilt_deg) << "\n"
-    << "  cup_diameter_mm: " << FormatDouble(n.cup_diameter_mm) << "\n"
-    << "  cup_height_mm: " << FormatDouble(n.cup_height_mm) << "\n"
-    << "  cup_albedo: " << FormatDouble(n.cup_albedo) << "\n"
-    << "  sphere_diameter_mm: " << FormatDouble(n.sphere_diameter_mm) << "\n"
-    << "  ballbar_sphere_diameter_mm: " << FormatDouble(n.ballbar_sphere_diameter_mm) << "\n"
-    << "  ballbar_distance_mm: " << FormatDouble(n.ballbar_distance_mm) << "\n"
+    << "  wobble_shift_mm: " << Num(n.wobble_shift_mm) << "\n"
+    << "  wobble_tilt_deg: " << Num(n.wobble_tilt_deg) << "\n"
+    << "  cup_diameter_mm: " << Num(n.cup_diameter_mm) << "\n"
+    << "  cup_height_mm: " << Num(n.cup_height_mm) << "\n"
+    << "  cup_albedo: " << Num(n.cup_albedo) << "\n"
+    << "  sphere_diameter_mm: " << Num(n.sphere_diameter_mm) << "\n"
+    << "  ballbar_sphere_diameter_mm: " << Num(n.ballbar_sphere_diameter_mm) << "\n"
+    << "  ballbar_distance_mm: " << Num(n.ballbar_distance_mm) << "\n"
     << "  plate_size_mm: " << Vec(n.plate_size_mm) << "\n"
     << "  tuber_semi_axes_mm: " << Vec(n.tuber_semi_axes_mm) << "\n"
-    << "  tuber_bump: " << FormatDouble(n.tuber_bump) << "\n"
-    << "  artifact_albedo: " << FormatDouble(n.artifact_albedo) << "\n"
-    << "  tuber_albedo: " << FormatDouble(n.tuber_albedo) << "\n";
+    << "  tuber_bump: " << Num(n.tuber_bump) << "\n"
+    << "  artifact_albedo: " << Num(n.artifact_albedo) << "\n"
+    << "  tuber_albedo: " << Num(n.tuber_albedo) << "\n";
   return o.str();
 }
 

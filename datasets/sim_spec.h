@@ -73,7 +73,8 @@ struct RenderSpec {
 
 struct CalibrationSpec {
   int captures = 50;                                           // target poses, lasers off
-  std::string target = "default";                              // "default" = DefaultTarget(), or a target file path
+  std::string target = "default";                              // "default" = DefaultTarget(), or a target file;
+                                                               // relative: from the spec file's folder
   double tilt_max_deg = 40.0;                                  // board tilt out of the view plane
   double roll_max_deg = 30.0;                                  // board rotation in its plane
   Eigen::Vector3d volume_mm = Eigen::Vector3d(150, 150, 100);  // where the board centre may go (x, y, z)
@@ -122,6 +123,9 @@ SimSpec DefaultSimSpec();
 
 // Strict reading: unknown keys, wrong types and bad values throw InputError
 // naming the file and key. Missing optional keys keep the defaults above.
+// ReadSimSpecFile reads a relative calibration.target from the spec file's
+// folder (the returned spec holds that path) and refuses one that is not a
+// file; ParseSimSpecYaml, with no file, leaves it as written.
 SimSpec ReadSimSpecFile(const std::string& path);
 SimSpec ParseSimSpecYaml(const std::string& text, const std::string& where);
 std::string SimSpecToYaml(const SimSpec& spec);

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <regex>
+
 #include "calib/core/input_error.h"
 #include "calib/core/input_error_testing.h"
 #include "datasets/default_rig.h"
@@ -19,6 +21,31 @@ std::string Replace(std::string text, const std::string& from, const std::string
   EXPECT_NE(at, std::string::npos) << from;
   if (at != std::string::npos) text.replace(at, from.size(), to);
   return text;
+}
+
+// --write-default-spec's file is for editing: each number is the shortest
+// text that reads back to the same double (0.6, not %.17g's
+// 0.59999999999999998), and the file reads back to the very same spec.
+TEST(SimSpec, TheWrittenDefaultSpecHasShortNumbersAndReadsBackIdentically) {
+  const SimSpec spec = DefaultSimSpec();
+  const std::string text = SimSpecToYaml(spec);
+  EXPECT_NE(text.find("psf_sigma_px: 0.6\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("sphere_diameter_mm: 38.1\n"), std::string::npos) << text;
+  // %.17g's tails: a run of 0s or 9s before the last digit.
+  std::smatch tail;
+  EXPECT_FALSE(std::regex_search(text, tail, std::regex("\\.[0-9]*(0{6,}|9{6,})[0-9]"))) << tail.str();
+  const SimSpec read = ParseSimSpecYaml(text, "spec.yaml");
+  // Shortest texts are equal exactly when the doubles are.
+  EXPECT_EQ(SimSpecToYaml(read), text);
+  ASSERT_EQ(read.modules.size(), spec.modules.size());
+  for (size_t m = 0; m < spec.modules.size(); ++m) {
+    EXPECT_EQ(read.modules[m].left.intrinsics, spec.modules[m].left.intrinsics);
+    EXPECT_EQ(read.modules[m].right.intrinsics, spec.modules[m].right.intrinsics);
+    EXPECT_EQ(read.modules[m].center_mm, spec.modules[m].center_mm);
+  }
+  EXPECT_EQ(read.render.psf_sigma_px, spec.render.psf_sigma_px);
+  EXPECT_EQ(read.calibration.white_albedo, spec.calibration.white_albedo);
+  EXPECT_EQ(read.scenes.tuber_semi_axes_mm, spec.scenes.tuber_semi_axes_mm);
 }
 
 TEST(SimSpec, DefaultSpecBuildsExactlyTheDefaultRig) {

@@ -182,9 +182,15 @@ void SimulateOptions::Check() const {
   if (!(surface_spacing_mm > 0 && surface_spacing_mm <= 0.2)) {
     throw InputError("surface_spacing_mm", "must be in (0, 0.2]");
   }
+  // -1 is "none"; below it, Any() would drop the bump without a word. The
+  // upper bounds need the rig: Simulate checks them.
+  if (bump.camera < -1) throw InputError("--bump-camera", "no camera " + std::to_string(bump.camera));
+  if (bump.module < -1) throw InputError("--bump-module", "no module " + std::to_string(bump.module));
   if (bump.camera >= 0 && bump.module >= 0) throw InputError("--bump-camera", "bump a camera or a module, not both");
-  if (std::abs(bump.rotation_deg) > 10) throw InputError("--bump-rotation-deg", "must be within +-10");
-  if (std::abs(bump.translation_mm) > 10) throw InputError("--bump-translation-mm", "must be within +-10");
+  // Written so that NaN fails too: it used to reach the rig's own check,
+  // which named neither the flag nor the bump.
+  if (!(std::abs(bump.rotation_deg) <= 10)) throw InputError("--bump-rotation-deg", "must be within +-10");
+  if (!(std::abs(bump.translation_mm) <= 10)) throw InputError("--bump-translation-mm", "must be within +-10");
   // A lens belongs to one camera; a whole module's lenses do not drift as one.
   if (bump.lens.Any() && bump.camera < 0) {
     throw InputError(bump.lens.focal_percent != 0 ? "--bump-focal-percent" : "--bump-principal-point-px",
@@ -389,7 +395,12 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
   });
 
   // --- the small files
-  WriteText(tmp / "spec.yaml", SimSpecToYaml(spec));
+  // The dataset renders again from its own spec: a target file is named as
+  // the copy written beside it (a relative target is read from the spec's
+  // folder), not as the path it was read from, which may not travel with it.
+  SimSpec written = spec;
+  if (written.calibration.target != "default") written.calibration.target = "target.yaml";
+  WriteText(tmp / "spec.yaml", SimSpecToYaml(written));
   WriteTargetFile(target, (tmp / "target.yaml").string());
   {
     std::ostringstream o;

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/core.hpp>
@@ -10,6 +11,7 @@
 #include <unordered_map>
 
 #include "calib/core/input_error.h"
+#include "calib/core/input_error_testing.h"
 #include "calib/core/rig_file.h"
 #include "calib/core/yaml_reader.h"
 #include "datasets/sim_test_util.h"
@@ -123,6 +125,33 @@ TEST(Simulate, BumpsMoveTheTruthByTheRequestedAmount) {
   EXPECT_NEAR(m.DistanceMm(), 0.1, 1e-9);
   EXPECT_LT(m.AngleDeg(), 1e-9);
   EXPECT_LT((before.module(1).right_from_left.Inverse() * after_mod.module(1).right_from_left).DistanceMm(), 1e-9);
+}
+
+// The options' check refuses, naming the flag, a bump that Any() would drop
+// (an index below -1, "none") and a NaN amount (which reached the rig's own
+// check, naming neither).
+TEST(Simulate, OptionsRefuseABumpIndexBelowNoneAndANanAmount) {
+  auto message = [](const RigBump& bump) {
+    SimulateOptions o;
+    o.out_dir = "unused";
+    o.bump = bump;
+    return testing::InputErrorMessage([&] { o.Check(); });
+  };
+  RigBump b;
+  b.camera = -2;
+  b.rotation_deg = 1;
+  EXPECT_EQ(message(b), "--bump-camera: no camera -2");
+  b = {};
+  b.module = -3;
+  b.translation_mm = 1;
+  EXPECT_EQ(message(b), "--bump-module: no module -3");
+  b = {};
+  b.module = 1;
+  b.rotation_deg = std::nan("");
+  EXPECT_EQ(message(b), "--bump-rotation-deg: must be within +-10");
+  b.rotation_deg = 0;
+  b.translation_mm = -std::nan("");
+  EXPECT_EQ(message(b), "--bump-translation-mm: must be within +-10");
 }
 
 // A drifted lens: truth/rig.yaml holds exactly the drifted intrinsics of that

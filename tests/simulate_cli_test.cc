@@ -21,6 +21,19 @@ namespace {
 
 using namespace sim_cli;
 
+// Each `simulate ARGS` exits 2 with one line that holds SAYS, and nothing
+// is written into `dir` (the folder its --out is in).
+void ExpectEachRefusedBeforeAnyWork(const std::vector<std::pair<std::string, std::string>>& cases,
+                                    const std::string& dir) {
+  for (const auto& [args, says] : cases) {
+    const Result r = RunCli("simulate" + args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
+  }
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
 TEST(SimulateCli, DefaultSpecFileRoundTripsAndBadKeysExitTwo) {
   const std::string dir = ::testing::TempDir();
   const std::string spec = dir + "/sim_default_spec.yaml";
@@ -48,6 +61,48 @@ TEST(SimulateCli, DefaultSpecFileRoundTripsAndBadKeysExitTwo) {
   r = RunCli("simulate --spec " + dir + "/sim_bad_spec2.yaml --out " + dir + "/sim_cli_bad");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("captures"), std::string::npos) << r.err;
+}
+
+// A spec's relative calibration.target is its neighbour, read from the
+// spec file's folder wherever simulate runs: it was read from the current
+// folder ("board12.yaml: no such file", naming no key), and the dataset's
+// spec.yaml kept the name without the board, so it did not render again.
+// Now the dataset's spec names the target.yaml written beside it, and
+// renders the same images from there.
+TEST(SimulateCli, ASpecsRelativeTargetIsReadFromItsFolderAndTheDatasetRendersAgain) {
+  const std::string dir = ::testing::TempDir() + "/sim_relative_target";
+  fs::remove_all(dir);
+  fs::create_directories(dir + "/specdir");
+  ASSERT_EQ(RunCli("target --corners 9 7 --square-mm 10 --out " + dir + "/board12.svg --write-target " + dir +
+                   "/specdir/board12.yaml")
+                .code,
+            0);
+  ASSERT_EQ(RunCli("simulate --write-default-spec " + dir + "/specdir/spec.yaml").code, 0);
+  std::string spec = Slurp(dir + "/specdir/spec.yaml");
+  const size_t at = spec.find("target: default");
+  ASSERT_NE(at, std::string::npos) << "the default spec changed: " << spec;
+  spec.replace(at, 15, "target: board12.yaml");
+  std::ofstream(dir + "/specdir/spec.yaml") << spec;
+  // The test runs in another folder than specdir.
+  ASSERT_FALSE(fs::exists("board12.yaml"));
+  const std::string one = " --calibration-captures 1 --no-scenes --threads 2";
+  Result r = RunCli("simulate --spec " + dir + "/specdir/spec.yaml --out " + dir + "/a" + one);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(Slurp(dir + "/a/target.yaml"), Slurp(dir + "/specdir/board12.yaml"));
+  r = RunCli("simulate --spec " + dir + "/a/spec.yaml --out " + dir + "/b" + one);
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* file : {"spec.yaml", "target.yaml", "calibration/000/cam0.png", "calibration/000/cam3.png"})
+    EXPECT_EQ(Slurp(dir + "/b/" + file), Slurp(dir + "/a/" + file)) << file;
+  // A target that is not there: exit 2, one line naming the spec, the key
+  // and where it looked.
+  fs::remove(dir + "/specdir/board12.yaml");
+  r = RunCli("simulate --spec " + dir + "/specdir/spec.yaml --out " + dir + "/c" + one);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(dir + "/specdir/spec.yaml: calibration.target: no file " + dir + "/specdir/board12.yaml"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/c"));
 }
 
 // An --out with a trailing slash (as a shell's completion writes it) names
@@ -226,7 +281,7 @@ TEST(SimulateCli, OptionsThatWouldBeIgnoredAreRefused) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string out = " --out " + dir + "/ds";
-  const std::pair<std::string, std::string> cases[] = {
+  const std::vector<std::pair<std::string, std::string>> cases = {
       {out + " --bump-rotation-deg 0.1", "--bump-rotation-deg: needs --bump-camera or --bump-module"},
       {out + " --bump-camera 1",
        "--bump-camera: needs --bump-rotation-deg, --bump-translation-mm, --bump-focal-percent or "
@@ -235,13 +290,45 @@ TEST(SimulateCli, OptionsThatWouldBeIgnoredAreRefused) {
       {" --write-default-spec " + dir + "/s.yaml" + out, "--out: does not apply with --write-default-spec"},
       {" --write-default-spec " + dir + "/s.yaml --bump-camera 1", "--bump-camera: does not apply with"},
       {out + " --seed -1", "--seed: must be >= 0"}};
-  for (const auto& [args, says] : cases) {
-    const Result r = RunCli("simulate" + args);
-    EXPECT_EQ(r.code, 2) << args;
-    EXPECT_EQ(Lines(r.err), 1) << r.err;
-    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+  ExpectEachRefusedBeforeAnyWork(cases, dir);
+}
+
+// A bump names a camera or module that exists and moves it by a finite
+// amount within +-10, or exits 2 before any work naming the flag. -1 (the
+// library's "none") used to read as no bump at all ("every amount given is
+// 0" although the amount was 1), and a NaN amount got through to the rig's
+// own check ("rig: module 1 right_from_left: contains NaN or Inf").
+TEST(SimulateCli, BumpIndexAndAmountAreRefusedByTheFlagsName) {
+  const std::string dir = ::testing::TempDir() + "/sim_bump_refused";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string out = " --out " + dir + "/ds --calibration-captures 0 --no-scenes";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {out + " --bump-camera -1 --bump-rotation-deg 1", "--bump-camera: no camera -1"},
+      {out + " --bump-camera -2 --bump-translation-mm 1", "--bump-camera: no camera -2"},
+      {out + " --bump-module -1 --bump-rotation-deg 1", "--bump-module: no module -1"},
+      {out + " --bump-module 1 --bump-rotation-deg nan", "--bump-rotation-deg: must be within +-10"},
+      {out + " --bump-module 1 --bump-translation-mm nan", "--bump-translation-mm: must be within +-10"},
+      {out + " --bump-camera 1 --bump-rotation-deg -nan", "--bump-rotation-deg: must be within +-10"},
+      {out + " --bump-camera 1 --bump-rotation-deg 11", "--bump-rotation-deg: must be within +-10"},
+      {out + " --bump-camera 1 --bump-translation-mm -inf", "--bump-translation-mm: must be within +-10"}};
+  ExpectEachRefusedBeforeAnyWork(cases, dir);
+}
+
+// Every bump amount's limit is in --help, on its flag's line, as the checks
+// refuse it (docs/simulator.md says the same): the rotation and shift limits
+// used to be found only by tripping over them.
+TEST(SimulateCli, TheHelpGivesEveryBumpAmountsLimit) {
+  const Result r = RunCli("simulate --help");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const auto& [flag, limit] :
+       {std::pair{"--bump-rotation-deg", "within +-10"}, std::pair{"--bump-translation-mm", "within +-10"},
+        std::pair{"--bump-focal-percent", "within +-10"}, std::pair{"--bump-principal-point-px", "within +-50"}}) {
+    const size_t at = r.out.find(std::string("\n  ") + flag + " ");
+    ASSERT_NE(at, std::string::npos) << flag << ": " << r.out;
+    const size_t next_flag = r.out.find("\n  --", at + 1);
+    EXPECT_NE(r.out.substr(at, next_flag - at).find(limit), std::string::npos) << flag << ": " << r.out;
   }
-  EXPECT_TRUE(fs::is_empty(dir));
 }
 
 // A lens drift (--bump-focal-percent, --bump-principal-point-px) belongs to
@@ -253,7 +340,7 @@ TEST(SimulateCli, LensDriftIsValidatedAndRecordedInTheTruth) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string out = " --out " + dir + "/ds";
-  const std::pair<std::string, std::string> cases[] = {
+  const std::vector<std::pair<std::string, std::string>> cases = {
       {out + " --bump-focal-percent 0.1", "--bump-focal-percent: needs --bump-camera"},
       {out + " --bump-principal-point-px 1 0", "--bump-principal-point-px: needs --bump-camera"},
       {out + " --bump-module 1 --bump-focal-percent 0.1", "--bump-focal-percent: needs --bump-camera"},
@@ -270,13 +357,7 @@ TEST(SimulateCli, LensDriftIsValidatedAndRecordedInTheTruth) {
       {out + " --bump-camera 9 --bump-focal-percent 0.1 --calibration-captures 0 --no-scenes",
        "--bump-camera: no camera 9"},
       {" --write-default-spec " + dir + "/s.yaml --bump-focal-percent 1", "--bump-focal-percent: does not apply with"}};
-  for (const auto& [args, says] : cases) {
-    const Result r = RunCli("simulate" + args);
-    EXPECT_EQ(r.code, 2) << args;
-    EXPECT_EQ(Lines(r.err), 1) << r.err;
-    EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
-  }
-  EXPECT_TRUE(fs::is_empty(dir));
+  ExpectEachRefusedBeforeAnyWork(cases, dir);
 
   const Result r = RunCli("simulate" + out +
                           " --bump-camera 1 --bump-focal-percent 0.5 --bump-principal-point-px 1.5 -2"
