@@ -183,10 +183,6 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
       error = dir + ": " + e.code().message();
     }
     const nlohmann::json entry = FailedCapture(dir, name, outputs, progress, error);
-    // On stdout too: a caller reading each capture's line there gets one for
-    // every capture.
-    std::printf("%s %s: no output (%s)\n", progress, PrintableText(dir).c_str(), PrintableText(error).c_str());
-    FlushStdout();
     if (++failed <= kMaxFailuresListed) summary["failed_captures"].push_back(entry);
     if (StdoutLost(&output_error)) break;
   }

@@ -1114,6 +1114,24 @@ TEST_F(ReconstructCli, ABatchWhoseEveryCaptureFailsLeavesNoNewFolder) {
   EXPECT_TRUE(std::filesystem::is_directory(existing)) << "a folder that was there before was removed";
 }
 
+// A batch's failed capture has its line on stdout too, as the stream's has
+// ("[k/N] DIR: no output (<why>)"), beside stderr's: docs/reconstruct.md
+// promises one line per capture there, and a failed one used to have none.
+TEST_F(ReconstructCli, ABatchPrintsALineOnStdoutForEachFailedCapture) {
+  const std::string junk = BrokenCapture("batch_line_junk"), cut = BrokenCapture("batch_line_cut");
+  WriteFileAtomically(junk + "/cam1.png", "not a png");
+  WriteFileAtomically(cut + "/cam2.png", ReadFileBytes(dir_ + "/capture/cam2.png").substr(0, 1000));
+  const std::string out = dir_ + "/batch_line_out";
+  std::filesystem::remove_all(out);
+  const testing::Result r =
+      testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + junk + " " + cut + " --out-dir " + out);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.out.find("[1/2] " + junk + ": no output (" + junk + "/cam1.png: is not a PNG file"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("[2/2] " + cut + ": no output (" + cut + "/cam2.png: "), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("stereorig reconstruct: [1/2] " + junk + "/cam1.png"), std::string::npos) << r.err;
+}
+
 // An --out-dir that cannot be made (a name longer than the file system's
 // 255 characters) exits 2 in one line naming it, and leaves no folder above
 // it: refused when claimed (OutputPaths::ClaimFolder), before the runtime
