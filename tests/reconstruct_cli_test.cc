@@ -436,6 +436,36 @@ TEST_F(ReconstructCli, GreyImagesOfFewerThan8BitsAreRefusedNamingTheirDepth) {
   }
 }
 
+// An image of another type says what it is, as calibrate and check say it
+// (calib/capture_folder.cc): reconstruct and match answered "must be an
+// 8-bit single-channel (grey) image" alike for 16-bit, RGB, grey with alpha
+// and palette PNGs. Channels as decoded (png_reader.h: grey with alpha as
+// G, G, G, A); refused from the header, so the image data is a stand-in.
+TEST_F(ReconstructCli, ImagesOfAnotherTypeAreRefusedSayingWhatTheyAre) {
+  struct Kind {
+    const char* name;
+    int bit_depth, colour_type;
+    const char* says;
+  };
+  for (const Kind& kind :
+       {Kind{"grey16", 16, 0, "1 channel(s) of 16 bits"}, Kind{"rgb", 8, 2, "3 channel(s) of 8 bits"},
+        Kind{"grey_alpha", 8, 4, "4 channel(s) of 8 bits"}, Kind{"palette", 8, 3, "3 channel(s) of 8 bits"}}) {
+    const std::string capture = BrokenCapture(std::string("type_") + kind.name);
+    const std::string image = capture + "/cam2.png";
+    const std::string palette = kind.colour_type == 3 ? testing::Chunk("PLTE", std::string(3, '\x40')) : "";
+    std::ofstream(image, std::ios::binary)
+        << testing::kPngSignature + testing::Chunk("IHDR", testing::Ihdr(8, 2, kind.bit_depth, kind.colour_type)) +
+               palette + testing::Chunk("IDAT", testing::Deflate("", 9)) + testing::Chunk("IEND", "");
+    const std::string says =
+        image + ": must be an 8-bit single-channel (grey) image (this one has " + std::string(kind.says) + ")";
+    ExpectRefusedInOneLine(Args(capture), says);
+    ExpectNoOutput();
+    ExpectRefusedInOneLine("match --left " + image + " --right " + image +
+                               " --min-disparity 0 --num-disparities 16 --out " + dir_ + "/type.pfm",
+                           says);
+  }
+}
+
 // shape_model fills holes only from a mesh: without --mesh nothing was
 // filled and nothing said. Now one note; with --mesh none. The summary's
 // "wrote" names every file written, the report too (it left it out).
