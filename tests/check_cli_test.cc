@@ -296,6 +296,13 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     std::ofstream(d + "/003/cam1.png", std::ios::binary | std::ios::trunc) << "\xff\xd8\xff\xe0 a JPEG's start";
     expect_refused(check(d, dir + "/rig.yaml"), "003/cam1.png: is not a PNG file, though named .png", "JPEG bytes");
   }
+  {  // An empty image (a camera has only just created it): named so, not
+     // as another format (png_reader.h).
+    const std::string d = copy("empty_image");
+    std::ofstream(d + "/003/cam1.png", std::ios::binary | std::ios::trunc).close();
+    expect_refused(check(d, dir + "/rig.yaml"), "003/cam1.png: is empty (0 bytes: still being written?)",
+                   "an empty image");
+  }
   {  // A corrupt (truncated, unreadable) image.
     const std::string d = copy("corrupt");
     const std::string bad = d + "/003/cam1.png";

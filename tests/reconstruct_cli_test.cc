@@ -691,6 +691,8 @@ TEST_F(ReconstructCli, InputsOfTheWrongKindAreNamedInOneLine) {
                                                                testing::Chunk("IHDR", testing::Ihdr(60000, 60000)) +
                                                                testing::Chunk("IDAT", "") + testing::Chunk("IEND", "");
   }
+  const std::string empty = BrokenCapture("empty_image");  // a file the camera has only just created
+  std::ofstream(empty + "/cam1.png", std::ios::binary | std::ios::trunc).close();
   const std::string folder = BrokenCapture("folder_for_image");
   std::filesystem::remove(folder + "/cam1.png");
   std::filesystem::create_directory(folder + "/cam1.png");
@@ -698,6 +700,8 @@ TEST_F(ReconstructCli, InputsOfTheWrongKindAreNamedInOneLine) {
   const std::pair<std::string, std::string> cases[] = {
       {base + "--rig " + dir_ + "/rig.yaml --capture " + jpeg,
        jpeg + "/cam1.png: is not a PNG file, though named .png"},
+      {base + "--rig " + dir_ + "/rig.yaml --capture " + empty,
+       empty + "/cam1.png: is empty (0 bytes: still being written?)"},
       {base + "--rig " + dir_ + "/rig.yaml --capture " + huge,
        huge + "/cam1.png: a PNG too large to read (its IHDR gives an image of 60000 x 60000 px; this reader takes "
               "up to 1000000 px a side and 268435456 px in all)"},
