@@ -289,6 +289,14 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
                      "--k-sigma: must be in (0, 10]", k);
     expect_refused(RunCli("check --history --history-db " + db + " --report " + report),
                    "--report: does not apply with --history", "--history with --report");
+    // A --rig that is not there, with --history: it printed the history
+    // found beside it (or at --history-db) and exited 0.
+    fs::copy_file(db, dir + "/check-history.sqlite", fs::copy_options::overwrite_existing);
+    expect_refused(RunCli("check --history --rig " + dir + "/no_such_rig.yaml"), dir + "/no_such_rig.yaml",
+                   "--history with a missing --rig");
+    expect_refused(RunCli("check --history --rig " + dir + "/no_such_rig.yaml --history-db " + db),
+                   dir + "/no_such_rig.yaml", "--history with a missing --rig and --history-db");
+    fs::remove(dir + "/check-history.sqlite");
   }
   {  // Bytes of another format (a JPEG's start) named cam1.png: named so, in
      // one line (before, the decoder's own complaint could come first).
