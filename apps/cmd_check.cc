@@ -16,6 +16,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/capture_image_name.h"
 #include "calib/core/input_error.h"
+#include "calib/core/input_file.h"
 #include "calib/core/number_text.h"
 #include "calib/core/rig_file.h"
 #include "targets/target_file.h"
@@ -109,6 +110,10 @@ int RunCheck(int argc, char** argv) {
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 
   const bool history_given = !history_db.empty();
+  // --history reads no rig, but a rig given is where it looks for the
+  // history by default: a mistyped one (or one beside a history, with
+  // --history-db) printed a history and exited 0, the slip unnoticed.
+  if (history_only && !rig_path.empty()) RequireInputFile(rig_path, /*pipe_too=*/true);
   if (history_db.empty()) {
     if (rig_path.empty()) throw InputError("", "give --rig or --history-db");
     // The history lives beside the rig file: a rig given as a pipe

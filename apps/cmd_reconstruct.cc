@@ -90,7 +90,8 @@ int RunReconstruct(int argc, char** argv) {
   auto* format = app.add_option("--mesh-format", mesh_format, "many captures: also write <name>.mesh.<ply|stl>");
   app.add_option("--report", report_path,
                  "one capture: its per-step times, point counts and fill rates as JSON; many: the batch's summary; "
-                 "--capture -: the stream's totals and failed captures, written when the input ends")
+                 "--capture -: the stream's totals and failed captures, written when the input ends or a stop signal "
+                 "(SIGTERM, SIGHUP, Ctrl-C) ends the stream, once a capture has come")
       ->check(NonEmptyPath());
   app.add_option("--options", options_path, "runtime options YAML (default: the built-in defaults)");
   std::string warm_up_dir, capture_root, rectified_dir;

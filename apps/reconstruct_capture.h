@@ -45,8 +45,9 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
 
 // A capture that failed (bad images, outputs that could not be written, a
 // name already used): it has no output, not a partial one nor a stale one
-// from an earlier run (every file of `outputs` that exists is removed), and
-// "stereorig reconstruct: <progress> <why>" goes to stderr. Returns its entry
+// from an earlier run (every file of `outputs` that exists is removed),
+// "stereorig reconstruct: <progress> <why>" goes to stderr and
+// "<progress> <dir>: no output (<why>)" to stdout, flushed. Returns its entry
 // of the summary (capture, name, ok false, error).
 nlohmann::json FailedCapture(const std::string& dir, const std::string& name, const CaptureOutputs& outputs,
                              const std::string& progress, const std::string& why);

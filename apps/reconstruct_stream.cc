@@ -183,10 +183,6 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
       error = dir + ": " + e.code().message();
     }
     const nlohmann::json entry = FailedCapture(dir, name, outputs, progress, error);
-    // On stdout too: a caller reading each capture's line there gets one for
-    // every capture.
-    std::printf("%s %s: no output (%s)\n", progress, PrintableText(dir).c_str(), PrintableText(error).c_str());
-    FlushStdout();
     if (++failed <= kMaxFailuresListed) summary["failed_captures"].push_back(entry);
     if (StdoutLost(&output_error)) break;
   }
@@ -205,10 +201,11 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
   }
   const int stop = input.stop_signal();
   if (stop != 0) {
-    std::printf(
-        "stopped by %s after %d capture%s; no further line read (a capture in progress when it came was finished "
-        "and written)\n",
-        SignalName(stop).c_str(), total, total == 1 ? "" : "s");
+    // No capture done: none was in progress either, and saying one was
+    // finished would be false.
+    std::printf("stopped by %s after %d capture%s; no further line read%s\n", SignalName(stop).c_str(), total,
+                total == 1 ? "" : "s",
+                total == 0 ? "" : " (a capture in progress when it came was finished and written)");
     FlushStdout();
     summary["stopped_by"] = SignalName(stop);
   }

@@ -7,8 +7,13 @@ namespace stereorig {
 
 cv::Mat ReadGreyImage(const std::string& path, std::optional<cv::Size> rig_size_px) {
   return ReadImageFile(path, [&](const ImageHeader& header) {
+    // Says what the image is (a 16-bit grey, an RGB, a palette one), in
+    // calibrate's and check's words (calib/capture_folder.cc), so that the
+    // camera's setting to change is plain.
     if (header.channels != 1 || header.bit_depth != 8)
-      throw InputError(path, "must be an 8-bit single-channel (grey) image");
+      throw InputError(path, "must be an 8-bit single-channel (grey) image (this one has " +
+                                 std::to_string(header.channels) + " channel(s) of " +
+                                 std::to_string(header.stored_bit_depth) + " bits)");
     // A 1-, 2- or 4-bit grey image (the decoder scales it to 8 bits) holds
     // 2-16 grey levels: the sub-pixel fit and the lit test read steps, not
     // the laser lines' profile (a 1-bit capture gave 0 points, a 4-bit one

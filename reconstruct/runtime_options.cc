@@ -96,6 +96,14 @@ RuntimeOptions FromYaml(YamlMap& y) {
     const auto v = y.GetDoubles("volume_size_mm", 3);
     o.volume_size_mm = Eigen::Vector3d(v[0], v[1], v[2]);
   }
+  // working_distance_mm only places the default centre: beside
+  // volume_center_mm it was read and then ignored, unsaid, where a user
+  // meant one of the two. Refused, naming both, as a key that does not
+  // apply is elsewhere.
+  if (y.Has("working_distance_mm") && y.Has("volume_center_mm"))
+    throw InputError(y.file(),
+                     "working_distance_mm and volume_center_mm are both given: working_distance_mm only places the "
+                     "default volume centre, which volume_center_mm replaces; keep one of them");
   y.Read("working_distance_mm", &o.working_distance_mm);
   y.Read("object_size_mm", &o.object_size_mm);
   y.Read("crop_to_lit_region", &o.crop_to_lit_region);

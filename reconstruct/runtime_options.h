@@ -23,7 +23,9 @@ struct RuntimeOptions {
   // front of module 0's baseline midpoint, along the mean of its two
   // optical axes.
   std::optional<Eigen::Vector3d> volume_center_mm;  // default: see working_distance_mm
-  double working_distance_mm = 200.0;  // only used to place the default volume centre; default 200 (the seed's)
+  // Only used to place the default volume centre; default 200 (the seed's).
+  // An options file giving it with volume_center_mm is refused.
+  double working_distance_mm = 200.0;
   Eigen::Vector3d volume_size_mm = Eigen::Vector3d(150, 150, 100);  // default 150 x 150 x 100 (the seed's)
   // Largest dimension of the objects measured (the largest distance between
   // two of their points), mm. Used against two different lengths:

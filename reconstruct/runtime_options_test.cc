@@ -281,6 +281,19 @@ TEST(RuntimeOptions, ValuesPastWhatTheRigCanMeasureAreRefused) {
   EXPECT_EQ(RefusalOf("object_size_mm: 400\nvolume_size_mm: [300, 300, 200]\n"), "");
 }
 
+// working_distance_mm only places the default volume centre: given with
+// volume_center_mm it was silently ignored (5000 mm beside a centre at 200
+// mm, accepted). The pair is refused naming the file and both keys; each
+// alone is read.
+TEST(RuntimeOptions, AWorkingDistanceBesideAVolumeCentreIsRefused) {
+  EXPECT_EQ(RefusalOf("working_distance_mm: 5000\nvolume_center_mm: [0, 0, 200]\n"),
+            "o.yaml: working_distance_mm and volume_center_mm are both given: working_distance_mm only places the "
+            "default volume centre, which volume_center_mm replaces; keep one of them");
+  EXPECT_EQ(ParseRuntimeOptions("working_distance_mm: 5000\n", "o.yaml").working_distance_mm, 5000);
+  EXPECT_EQ(ParseRuntimeOptions("volume_center_mm: [0, 0, 200]\n", "o.yaml").volume_center_mm,
+            Eigen::Vector3d(0, 0, 200));
+}
+
 // yaml-cpp reads the first document only: a second one's keys, typos too,
 // were never checked. The options file is one mapping: a second document
 // is refused naming the file and the line it starts on; a lone trailing

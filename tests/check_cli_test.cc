@@ -289,12 +289,27 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
                      "--k-sigma: must be in (0, 10]", k);
     expect_refused(RunCli("check --history --history-db " + db + " --report " + report),
                    "--report: does not apply with --history", "--history with --report");
+    // A --rig that is not there, with --history: it printed the history
+    // found beside it (or at --history-db) and exited 0.
+    fs::copy_file(db, dir + "/check-history.sqlite", fs::copy_options::overwrite_existing);
+    expect_refused(RunCli("check --history --rig " + dir + "/no_such_rig.yaml"), dir + "/no_such_rig.yaml",
+                   "--history with a missing --rig");
+    expect_refused(RunCli("check --history --rig " + dir + "/no_such_rig.yaml --history-db " + db),
+                   dir + "/no_such_rig.yaml", "--history with a missing --rig and --history-db");
+    fs::remove(dir + "/check-history.sqlite");
   }
   {  // Bytes of another format (a JPEG's start) named cam1.png: named so, in
      // one line (before, the decoder's own complaint could come first).
     const std::string d = copy("jpeg_named_png");
     std::ofstream(d + "/003/cam1.png", std::ios::binary | std::ios::trunc) << "\xff\xd8\xff\xe0 a JPEG's start";
     expect_refused(check(d, dir + "/rig.yaml"), "003/cam1.png: is not a PNG file, though named .png", "JPEG bytes");
+  }
+  {  // An empty image (a camera has only just created it): named so, not
+     // as another format (png_reader.h).
+    const std::string d = copy("empty_image");
+    std::ofstream(d + "/003/cam1.png", std::ios::binary | std::ios::trunc).close();
+    expect_refused(check(d, dir + "/rig.yaml"), "003/cam1.png: is empty (0 bytes: still being written?)",
+                   "an empty image");
   }
   {  // A corrupt (truncated, unreadable) image.
     const std::string d = copy("corrupt");

@@ -436,6 +436,36 @@ TEST_F(ReconstructCli, GreyImagesOfFewerThan8BitsAreRefusedNamingTheirDepth) {
   }
 }
 
+// An image of another type says what it is, as calibrate and check say it
+// (calib/capture_folder.cc): reconstruct and match answered "must be an
+// 8-bit single-channel (grey) image" alike for 16-bit, RGB, grey with alpha
+// and palette PNGs. Channels as decoded (png_reader.h: grey with alpha as
+// G, G, G, A); refused from the header, so the image data is a stand-in.
+TEST_F(ReconstructCli, ImagesOfAnotherTypeAreRefusedSayingWhatTheyAre) {
+  struct Kind {
+    const char* name;
+    int bit_depth, colour_type;
+    const char* says;
+  };
+  for (const Kind& kind :
+       {Kind{"grey16", 16, 0, "1 channel(s) of 16 bits"}, Kind{"rgb", 8, 2, "3 channel(s) of 8 bits"},
+        Kind{"grey_alpha", 8, 4, "4 channel(s) of 8 bits"}, Kind{"palette", 8, 3, "3 channel(s) of 8 bits"}}) {
+    const std::string capture = BrokenCapture(std::string("type_") + kind.name);
+    const std::string image = capture + "/cam2.png";
+    const std::string palette = kind.colour_type == 3 ? testing::Chunk("PLTE", std::string(3, '\x40')) : "";
+    std::ofstream(image, std::ios::binary)
+        << testing::kPngSignature + testing::Chunk("IHDR", testing::Ihdr(8, 2, kind.bit_depth, kind.colour_type)) +
+               palette + testing::Chunk("IDAT", testing::Deflate("", 9)) + testing::Chunk("IEND", "");
+    const std::string says =
+        image + ": must be an 8-bit single-channel (grey) image (this one has " + std::string(kind.says) + ")";
+    ExpectRefusedInOneLine(Args(capture), says);
+    ExpectNoOutput();
+    ExpectRefusedInOneLine("match --left " + image + " --right " + image +
+                               " --min-disparity 0 --num-disparities 16 --out " + dir_ + "/type.pfm",
+                           says);
+  }
+}
+
 // shape_model fills holes only from a mesh: without --mesh nothing was
 // filled and nothing said. Now one note; with --mesh none. The summary's
 // "wrote" names every file written, the report too (it left it out).
@@ -661,6 +691,8 @@ TEST_F(ReconstructCli, InputsOfTheWrongKindAreNamedInOneLine) {
                                                                testing::Chunk("IHDR", testing::Ihdr(60000, 60000)) +
                                                                testing::Chunk("IDAT", "") + testing::Chunk("IEND", "");
   }
+  const std::string empty = BrokenCapture("empty_image");  // a file the camera has only just created
+  std::ofstream(empty + "/cam1.png", std::ios::binary | std::ios::trunc).close();
   const std::string folder = BrokenCapture("folder_for_image");
   std::filesystem::remove(folder + "/cam1.png");
   std::filesystem::create_directory(folder + "/cam1.png");
@@ -668,6 +700,8 @@ TEST_F(ReconstructCli, InputsOfTheWrongKindAreNamedInOneLine) {
   const std::pair<std::string, std::string> cases[] = {
       {base + "--rig " + dir_ + "/rig.yaml --capture " + jpeg,
        jpeg + "/cam1.png: is not a PNG file, though named .png"},
+      {base + "--rig " + dir_ + "/rig.yaml --capture " + empty,
+       empty + "/cam1.png: is empty (0 bytes: still being written?)"},
       {base + "--rig " + dir_ + "/rig.yaml --capture " + huge,
        huge + "/cam1.png: a PNG too large to read (its IHDR gives an image of 60000 x 60000 px; this reader takes "
               "up to 1000000 px a side and 268435456 px in all)"},
@@ -1112,6 +1146,24 @@ TEST_F(ReconstructCli, ABatchWhoseEveryCaptureFailsLeavesNoNewFolder) {
   std::filesystem::create_directories(existing);
   EXPECT_EQ(RunCli(head + existing), 2);
   EXPECT_TRUE(std::filesystem::is_directory(existing)) << "a folder that was there before was removed";
+}
+
+// A batch's failed capture has its line on stdout too, as the stream's has
+// ("[k/N] DIR: no output (<why>)"), beside stderr's: docs/reconstruct.md
+// promises one line per capture there, and a failed one used to have none.
+TEST_F(ReconstructCli, ABatchPrintsALineOnStdoutForEachFailedCapture) {
+  const std::string junk = BrokenCapture("batch_line_junk"), cut = BrokenCapture("batch_line_cut");
+  WriteFileAtomically(junk + "/cam1.png", "not a png");
+  WriteFileAtomically(cut + "/cam2.png", ReadFileBytes(dir_ + "/capture/cam2.png").substr(0, 1000));
+  const std::string out = dir_ + "/batch_line_out";
+  std::filesystem::remove_all(out);
+  const testing::Result r =
+      testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + junk + " " + cut + " --out-dir " + out);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.out.find("[1/2] " + junk + ": no output (" + junk + "/cam1.png: is not a PNG file"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("[2/2] " + cut + ": no output (" + cut + "/cam2.png: "), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("stereorig reconstruct: [1/2] " + junk + "/cam1.png"), std::string::npos) << r.err;
 }
 
 // An --out-dir that cannot be made (a name longer than the file system's

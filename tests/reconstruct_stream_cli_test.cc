@@ -347,6 +347,28 @@ TEST_F(ReconstructStreamCli, AStopSignalEndsTheStreamAsTheEndOfItsInputDoes) {
   }
 }
 
+// Stopped before its first capture, the stream's last line says so and no
+// more: it said "(a capture in progress when it came was finished and
+// written)" though there was none.
+TEST_F(ReconstructStreamCli, AStopBeforeAnyCaptureClaimsNoneWasFinished) {
+  const double timeout_s = 120;
+  const std::string out = dir_ + "/stop_before_any";
+  const auto child = StartStream(out);
+  ASSERT_TRUE(child->started());
+  ASSERT_EQ(testing::Lines(child->ReadLines(1, timeout_s)), 1);  // the runtime is built
+  child->Signal(SIGTERM);
+  EXPECT_EQ(child->Wait(), 0) << Bytes(out + "_err.txt");
+  const std::string all = child->ReadLines(2, timeout_s);
+  EXPECT_NE(all.find("\nstopped by SIGTERM after 0 captures; no further line read\n"), std::string::npos) << all;
+  EXPECT_FALSE(fs::exists(out)) << "a stream stopped before its first capture left its new output folder";
+  // The help's --report says the summary is written on a stop too (it said
+  // only "when the input ends").
+  const testing::Result help = testing::RunCli("reconstruct --help");
+  EXPECT_NE(help.out.find("written when the input ends or a stop signal (SIGTERM, SIGHUP, Ctrl-C) ends the stream"),
+            std::string::npos)
+      << help.out;
+}
+
 // SIGHUP (a terminal that hangs up; systemd sends it right after SIGTERM
 // with SendSIGHUP=yes) stops the stream as SIGTERM does: the capture in
 // progress is finished and written, or not begun, never cut short; the

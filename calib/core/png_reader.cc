@@ -280,6 +280,10 @@ std::optional<PngReader> PngReader::Open(const std::string& path) {
 }
 
 std::optional<PngReader> PngReader::FromBytes(const std::string& path, std::string bytes) {
+  // A camera creates its image's file before it writes it: named so here,
+  // not as another format, for every caller (reconstruct's, calibrate's and
+  // check's readers would each say "is not a PNG file").
+  if (bytes.empty()) throw InputError(path, "is empty (0 bytes: still being written?)");
   if (bytes.compare(0, kSignature.size(), kSignature) != 0) return std::nullopt;
   auto d = std::make_unique<PngDecoding>();
   d->path = path;

@@ -48,7 +48,8 @@ class PngReader {
 
   // The PNG at `path`, read up to its image data; nullopt if the file does
   // not start with PNG's signature (another format, or no image). Throws
-  // InputError naming the file if it cannot be read, or if what comes
+  // InputError naming the file if it cannot be read, is empty ("is empty (0
+  // bytes: still being written?)", whatever its name), or if what comes
   // before the image data is cut short, damaged (a chunk's CRC, a header
   // PNG does not define) or gives an image over kMaxSidePx a side or
   // kMaxPixels.

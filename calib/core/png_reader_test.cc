@@ -364,9 +364,23 @@ TEST(PngReader, TheLayoutIsImreadsFromTheHeader) {
   }
 }
 
+// A file a camera has only just created is named as that, not as another
+// format ("is not a PNG file, though named .png", its callers said).
+TEST(PngReader, AnEmptyFileIsNamedEmpty) {
+  const std::string path = ::testing::TempDir() + "/png_reader_test_empty.png";
+  std::ofstream(path, std::ios::binary | std::ios::trunc).close();
+  for (const bool from_file : {true, false}) {
+    try {
+      from_file ? PngReader::Open(path) : PngReader::FromBytes(path, "");
+      ADD_FAILURE() << "read";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()), path + ": is empty (0 bytes: still being written?)");
+    }
+  }
+}
+
 TEST(PngReader, OtherFilesAreNotPngs) {
   EXPECT_FALSE(PngReader::FromBytes("junk.png", "not a png"));
-  EXPECT_FALSE(PngReader::FromBytes("empty.png", ""));
   EXPECT_FALSE(PngReader::FromBytes("short.png", kPngSignature.substr(0, 7)));
   EXPECT_FALSE(PngReader::FromBytes("x.tif", std::string("II*\0", 4) + std::string(100, 'x')));
   const std::string path = ::testing::TempDir() + "/png_reader_test.png";
