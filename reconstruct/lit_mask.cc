@@ -3,6 +3,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <opencv2/imgproc.hpp>
+
 #include "calib/core/input_error.h"
 
 #if defined(__AVX2__)
@@ -17,7 +19,7 @@ namespace stereorig {
 // arithmetic, which it would otherwise contract).
 cv::Mat LitMask(const cv::Mat& grey, double contrast_dn) {
   STEREORIG_CHECK(grey.type() == CV_8UC1);
-  constexpr int kHalf = 4;  // the 9x9 window
+  constexpr int kHalf = kLitWindowHalfPx;
   const int w = grey.cols, h = grey.rows;
   cv::Mat lit(grey.size(), CV_8UC1, cv::Scalar(0));
   if (w == 0 || h == 0) return lit;
@@ -80,6 +82,15 @@ cv::Mat LitMask(const cv::Mat& grey, double contrast_dn) {
     for (; x < w; ++x) out[x] = lit_at(x) ? 255 : 0;
   }
   return lit;
+}
+
+cv::Mat LitWindowOnData(const cv::Mat& valid) {
+  STEREORIG_CHECK(valid.type() == CV_8UC1);
+  cv::Mat on_data;
+  // erode's default border is the largest value: outside the image is data.
+  cv::erode(valid != 0, on_data,
+            cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kLitWindowHalfPx + 1, 2 * kLitWindowHalfPx + 1)));
+  return on_data;
 }
 
 }  // namespace stereorig

@@ -19,4 +19,16 @@ namespace stereorig {
 // are integers (< 81 * 255^2), added exactly here in one pass.
 cv::Mat LitMask(const cv::Mat& grey, double contrast_dn);
 
+// Half the side of LitMask's window, px (9x9).
+inline constexpr int kLitWindowHalfPx = 4;
+
+// valid: CV_8UC1, 0 where a rectified view has no sensor data (its remap's
+// zero fill; ModulePlan::left_valid). Returns CV_8UC1 of its size: 255
+// where LitMask's whole window lies on sensor data (beyond the image's own
+// edge counts as data: LitMask reflects there). A window over the step
+// from the image to the zero fill has contrast of its own: a capture with
+// the lasers off read as thousands of "grid-lit" pixels along the view's
+// edge, and its summary blamed the refinement instead of the projector.
+cv::Mat LitWindowOnData(const cv::Mat& valid);
+
 }  // namespace stereorig

@@ -53,5 +53,30 @@ TEST(LitMask, LitWhereTheGridIsAndNotOnUniformDark) {
   EXPECT_EQ(lit.at<uint8_t>(55, 75), 0);
 }
 
+// A view whose right part is the remap's zero fill (no sensor data): a
+// window reaching it is not on data, one 5 px away (beyond the 9x9
+// window's half of 4) is; the image's own edges count as data (LitMask
+// reflects there, no step). And on a flat grey view, where LitMask's only
+// contrast is that step, nothing is left lit once masked.
+TEST(LitWindowOnData, ExcludesWindowsOverTheZeroFillOnly) {
+  cv::Mat valid(40, 60, CV_8UC1, cv::Scalar(255));
+  valid(cv::Rect(50, 0, 10, 40)).setTo(0);  // columns 50..59: no data
+  const cv::Mat on_data = LitWindowOnData(valid);
+  ASSERT_EQ(on_data.size(), valid.size());
+  for (int y : {0, 20, 39}) {
+    EXPECT_EQ(on_data.at<uint8_t>(y, 45), 255) << y;  // window columns 41..49
+    EXPECT_EQ(on_data.at<uint8_t>(y, 46), 0) << y;    // reaches column 50
+    EXPECT_EQ(on_data.at<uint8_t>(y, 55), 0) << y;
+    EXPECT_EQ(on_data.at<uint8_t>(y, 0), 255) << y;  // the image's edge is no step
+  }
+  cv::Mat flat(40, 60, CV_8UC1, cv::Scalar(128));
+  flat.setTo(0, valid == 0);
+  const cv::Mat lit = LitMask(flat, 5.0);
+  EXPECT_GT(cv::countNonZero(lit), 0);  // the step alone reads as lit
+  cv::Mat masked;
+  cv::bitwise_and(lit, on_data, masked);
+  EXPECT_EQ(cv::countNonZero(masked), 0);
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -144,6 +144,7 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
       plan.right_valid = ViewValidMask(map_x, map_y, cv::Size(right.imager_width_px(), right.imager_height_px()));
       BuildRectifyMap(plan.geometry, left, RectifiedView::kLeft, &map_x, &map_y);
       plan.left_valid = ViewValidMask(map_x, map_y, cv::Size(left.imager_width_px(), left.imager_height_px()));
+      plan.lit_window_on_data = LitWindowOnData(plan.left_valid);
     }
     // The volume's image: a box's central projection is bounded by its
     // corners' (all in front), and Z, so the disparity, is extreme at corners.
@@ -215,10 +216,16 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
   const cv::Size size = plan.geometry.size;
   const int margin = kWindowMarginPx;
   t = Clock::now();
-  const cv::Mat lit = LitMask(left(plan.roi), options_.lit_contrast_dn);
+  const cv::Mat lit_or_edge = LitMask(left(plan.roi), options_.lit_contrast_dn);
+  // The grid-lit pixels the fill counts: not those whose window straddles
+  // the step to the remap's zero fill (lit_mask.h). The crop keeps them, so
+  // the match region (and every point) is as before; they only widened it
+  // by a few columns where the lit region reaches the view's edge.
+  cv::Mat lit;
+  cv::bitwise_and(lit_or_edge, plan.lit_window_on_data(plan.roi), lit);
   cv::Rect match_roi = plan.roi;
   if (options_.crop_to_lit_region) {
-    const cv::Rect box = cv::boundingRect(lit);
+    const cv::Rect box = cv::boundingRect(lit_or_edge);
     match_roi = box.area() > 0 ? cv::Rect(box.x + plan.roi.x - margin, box.y + plan.roi.y - margin,
                                           box.width + 2 * margin, box.height + 2 * margin) &
                                      plan.roi

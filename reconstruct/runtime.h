@@ -40,10 +40,11 @@ struct ModulePlan {
   int module = 0;
   RectifiedGeometry geometry;
   RectifyMaps maps;
-  cv::Mat right_valid;       // CV_8UC1: rectified right px with sensor data (right_occlusion.h)
-  cv::Mat left_valid;        // CV_8UC1: rectified left px with sensor data (left_view_edge.h)
-  cv::Rect roi;              // rectified left px covered by the measurement volume
-  int min_disparity_px = 0;  // image disparity range of the volume (rectify.h), with 2 px margin
+  cv::Mat right_valid;         // CV_8UC1: rectified right px with sensor data (right_occlusion.h)
+  cv::Mat left_valid;          // CV_8UC1: rectified left px with sensor data (left_view_edge.h)
+  cv::Mat lit_window_on_data;  // CV_8UC1: left px whose lit-mask window is all sensor data (lit_mask.h)
+  cv::Rect roi;                // rectified left px covered by the measurement volume
+  int min_disparity_px = 0;    // image disparity range of the volume (rectify.h), with 2 px margin
   int num_disparities = 0;
   Pose reference_from_module;                  // S[0][module]
   Eigen::Vector3d camera_centre_reference_mm;  // the module's left camera centre
