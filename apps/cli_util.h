@@ -15,7 +15,8 @@ namespace stereorig {
 // error), or std::nullopt when it should run. An option given an empty
 // value ("--target ''", "--rig $UNSET") is a usage error, "--target: an
 // empty value" (or NonEmptyPath's "an empty path" where the option has that
-// check): before, an input read as not given (target drew the built-in
+// check; an option with another check of its own, a choice or a range,
+// answers with that one's message, which runs first): before, an input read as not given (target drew the built-in
 // board, score scored the truth rig, rig skipped --truth) and the run
 // exited 0.
 std::optional<int> ParseArgs(CLI::App& app, int argc, char** argv);

@@ -7,6 +7,7 @@
 #include "apps/output_paths.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
+#include "calib/core/input_file.h"
 #include "datasets/sim_spec.h"
 #include "datasets/simulate.h"
 
@@ -95,6 +96,10 @@ int RunSimulate(int argc, char** argv) {
     throw InputError(app.count("--bump-camera") ? "--bump-camera" : "--bump-module",
                      "every amount given is 0: the rig would render undisturbed; give a nonzero amount");
 
+  // A --spec given is read below, or, beside --write-default-spec, only
+  // protected from being overwritten: checked here either way, so that a
+  // missing one is not passed over with exit 0.
+  if (!spec_path.empty()) RequireInputFile(spec_path);
   if (!write_spec.empty()) {
     // Checked like every other command's outputs (apps/output_paths.h): its
     // folder exists, it is not a folder, and it is not the --spec file given

@@ -39,7 +39,9 @@ std::optional<GridPeriodMeasurement> MeasureModule(const Runtime& runtime, const
                                                    const std::vector<cv::Mat>& images) {
   const cv::Mat left = runtime.Rectify(plan, images).first;
   cv::Mat lit = cv::Mat::zeros(left.size(), CV_8UC1);
-  LitMask(left(plan.roi), runtime.options().lit_contrast_dn).copyTo(lit(plan.roi));
+  // Not the step to the view's zero fill (lit_mask.h): no grid there.
+  cv::bitwise_and(LitMask(left(plan.roi), runtime.options().lit_contrast_dn), plan.lit_window_on_data(plan.roi),
+                  lit(plan.roi));
   return MeasureGridPeriodPx(left, lit);
 }
 

@@ -201,11 +201,12 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
   }
   const int stop = input.stop_signal();
   if (stop != 0) {
-    // No capture done: none was in progress either, and saying one was
-    // finished would be false.
+    // No capture done: none was in progress either. After one, the signal
+    // may have come while the stream waited for a line (nothing in
+    // progress) or during a capture that then failed (nothing written):
+    // the line claims no more than that a capture in progress was finished.
     std::printf("stopped by %s after %d capture%s; no further line read%s\n", SignalName(stop).c_str(), total,
-                total == 1 ? "" : "s",
-                total == 0 ? "" : " (a capture in progress when it came was finished and written)");
+                total == 1 ? "" : "s", total == 0 ? "" : " (a capture in progress when it came, if any, was finished)");
     FlushStdout();
     summary["stopped_by"] = SignalName(stop);
   }

@@ -110,7 +110,8 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
 
 // Shared helpers for the mrcal problems of stages 1 and 2.
 // False for the lens models whose every parameter the boards determine
-// (PINHOLE, OPENCV4, OPENCV5): their final solve runs without
+// (PINHOLE, which IntrinsicsOptions::Check refuses to calibrate, OPENCV4,
+// OPENCV5): their final solve runs without
 // regularisation, so the result is the plain least-squares optimum (as
 // OpenCV's) and its covariance has no regularisation bias. True for the
 // others: a spline's knots outside the observed region, and the rational

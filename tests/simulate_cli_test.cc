@@ -390,7 +390,11 @@ TEST(SimulateCli, WriteDefaultSpecRefusesTheSpecItWasGivenAndAFolder) {
       {"--spec " + spec + " --write-default-spec " + spec, spec + ": is the spec file (--spec)"},
       {"--spec " + spec + " --write-default-spec " + dir + "/link.yaml", dir + "/link.yaml: is the spec file (--spec)"},
       {"--write-default-spec " + dir + "/a_folder", dir + "/a_folder: is a folder"},
-      {"--write-default-spec " + dir + "/missing/s.yaml", dir + "/missing/s.yaml: its folder does not exist"}};
+      {"--write-default-spec " + dir + "/missing/s.yaml", dir + "/missing/s.yaml: its folder does not exist"},
+      // A --spec beside it that is missing or a folder: refused as when it is
+      // read (it was passed over, the default written, exit 0).
+      {"--spec " + dir + "/no_spec.yaml --write-default-spec " + dir + "/w.yaml", dir + "/no_spec.yaml: no such file"},
+      {"--spec " + dir + "/a_folder --write-default-spec " + dir + "/w.yaml", dir + "/a_folder: is a folder"}};
   for (const auto& [args, says] : cases) {
     const Result r = RunCli("simulate " + args);
     EXPECT_EQ(r.code, 2) << args;
@@ -400,6 +404,7 @@ TEST(SimulateCli, WriteDefaultSpecRefusesTheSpecItWasGivenAndAFolder) {
   EXPECT_EQ(Slurp(spec), edited);
   EXPECT_TRUE(fs::is_empty(dir + "/a_folder"));
   EXPECT_FALSE(fs::exists(dir + "/missing"));
+  EXPECT_FALSE(fs::exists(dir + "/w.yaml"));
 }
 
 }  // namespace
