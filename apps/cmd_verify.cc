@@ -224,7 +224,14 @@ int RunVerify(int argc, char** argv) {
       // The cloud read, but its points are not the artifact (too few on it,
       // none of the certified size): this position is not evaluated, and
       // the others are still shown; any other error is the run's.
-      positions.push_back(NotEvaluated(artifact, options, static_cast<int>(measured.points.size()), refused.problem()));
+      // Too few points where the cloud holds hole filling's: say that
+      // those are skipped ("only 0 points" of a cloud of thousands read as
+      // a broken file).
+      std::string problem = refused.problem();
+      if (measured.filled_skipped > 0 && static_cast<int>(measured.points.size()) < options.min_points)
+        problem += " (" + std::to_string(measured.filled_skipped) +
+                   " more were added by hole filling, module 255: not measurements, skipped)";
+      positions.push_back(NotEvaluated(artifact, options, static_cast<int>(measured.points.size()), problem));
     }
   }
   // A position left not judged (a figure the points or the certificate leave

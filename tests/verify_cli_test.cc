@@ -429,6 +429,24 @@ TEST(VerifyCli, HoleFillingsPointsAreSkippedAndCounted) {
   EXPECT_LT(j["figures"][0]["value_mm"].get<double>(), 10 * sigma_mm);
   EXPECT_EQ(j["figures"][1]["name"], "P_S");
   EXPECT_LT(std::abs(j["figures"][1]["value_mm"].get<double>()), 0.005);
+
+  // A cloud of hole filling only: not judged (exit 2), and the reason says
+  // its points were skipped as filled, not just "only 0 points".
+  const std::string all_filled = ::testing::TempDir() + "/all_filled_" + std::to_string(getpid()) + ".ply";
+  {
+    std::ofstream g(all_filled);
+    g << "ply\nformat ascii 1.0\nelement vertex " << vertices.size()
+      << "\nproperty double x\nproperty double y\nproperty double z\nproperty uchar module\nend_header\n";
+    g.precision(17);
+    for (const Vertex& v : vertices) g << v.x << " " << v.y << " " << v.z << " 255\n";
+  }
+  const auto r_filled = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + all_filled);
+  EXPECT_EQ(r_filled.code, 2) << r_filled.out << r_filled.err;
+  EXPECT_NE((r_filled.out + r_filled.err)
+                .find("only 0 points; at least 200 are needed on the artifact (" + std::to_string(vertices.size()) +
+                      " more were added by hole filling, module 255: not measurements, skipped)"),
+            std::string::npos)
+      << r_filled.out << r_filled.err;
 }
 
 // Every vertex of the cloud lands in exactly one of the table's count
