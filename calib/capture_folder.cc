@@ -195,6 +195,19 @@ std::string RejectedViewsNote(const DetectedCaptures& detected, const Target& ta
          "single orientation";
 }
 
+std::string NoBoardFoundNote(const DetectedCaptures& detected, const Target& target, const std::string& target_path) {
+  const int images = static_cast<int>(detected.log.size());
+  const int no_board = static_cast<int>(std::count_if(detected.log.begin(), detected.log.end(), [](const auto& log) {
+    return !log.accepted && log.reject == RejectReason::kNoChessboard;
+  }));
+  if (2 * no_board <= images) return "";
+  return std::to_string(no_board) + " of " + std::to_string(images) + " images show no board of " + target_path +
+         "'s grid (corners_x " + std::to_string(target.corners_x()) + ", corners_y " +
+         std::to_string(target.corners_y()) +
+         ", inner corners along a row, along a column): is the board in view and lit, and is that file this "
+         "board's target file?";
+}
+
 FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const std::string& target_path,
                                          const std::vector<ModuleLayout>& modules, const CalibrationOptions& options) {
   options.Check();
@@ -219,8 +232,9 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
   try {
     out.result = Calibrate(input, options);
   } catch (const InputError& e) {
-    if (rejected_note.empty()) throw;
-    throw InputError(e.where(), e.problem() + "; " + rejected_note);
+    const std::string note = rejected_note.empty() ? NoBoardFoundNote(detected, target, target_path) : rejected_note;
+    if (note.empty()) throw;
+    throw InputError(e.where(), e.problem() + "; " + note);
   }
   // Calibrate records the board (in the rig it built), not its file's name.
   // Absolute, so that the check's messages name it from wherever they run.

@@ -70,6 +70,15 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir, const Target& targe
 // right file rejects 13 of the same 200, none as ambiguous.
 std::string RejectedViewsNote(const DetectedCaptures& detected, const Target& target, const std::string& target_path);
 
+// For a calibration that was refused, where RejectedViewsNote said nothing:
+// "" unless most images (more than half) were rejected as showing no board
+// of the target file's grid (no_chessboard). Then the board was out of view
+// or too dark, or the file gives another grid: a plain 9 x 6 file against
+// the 11 x 9 board read "too few views: 1 usable" and nothing more. Not a
+// warning on its own: the same rejections come of a board that most
+// cameras see in few captures, and such a calibration can succeed.
+std::string NoBoardFoundNote(const DetectedCaptures& detected, const Target& target, const std::string& target_path);
+
 // The whole of `stereorig calibrate`: reads the target file, detects the
 // target in every capture and runs the three stages on the modules of
 // `modules` (the layout file, ReadLayoutFile in calib/layout_file.h, read

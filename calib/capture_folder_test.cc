@@ -37,5 +37,19 @@ TEST(RejectedViewsNote, MostImagesRejectedAsOffTheLayoutNameTheTargetFile) {
   EXPECT_NE(RejectedViewsNote(Log(99, {{RejectReason::kGridMismatch, 101}}), swapped, "t.yaml"), "");
 }
 
+// Most images with no board of the file's grid: for a refused calibration,
+// the note asks whether the board was seen and whether the file is its
+// (a plain 9 x 6 file against the 11 x 9 board: "too few views: 1 usable"
+// and nothing more). Half is not most; other reasons do not count.
+TEST(NoBoardFoundNote, MostImagesWithNoBoardAskAboutTheViewAndTheFile) {
+  const Target plain = PlainTarget(9, 6, 9.0);
+  EXPECT_EQ(NoBoardFoundNote(Log(2, {{RejectReason::kNoChessboard, 198}}), plain, "t9x6.yaml"),
+            "198 of 200 images show no board of t9x6.yaml's grid (corners_x 9, corners_y 6, inner corners along a "
+            "row, along a column): is the board in view and lit, and is that file this board's target file?");
+  EXPECT_EQ(NoBoardFoundNote(Log(100, {{RejectReason::kNoChessboard, 100}}), plain, "t.yaml"), "");
+  EXPECT_EQ(NoBoardFoundNote(Log(10, {{RejectReason::kNoTags, 190}}), plain, "t.yaml"), "");
+  EXPECT_NE(NoBoardFoundNote(Log(99, {{RejectReason::kNoChessboard, 101}}), plain, "t.yaml"), "");
+}
+
 }  // namespace
 }  // namespace stereorig

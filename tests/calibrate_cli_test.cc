@@ -323,6 +323,27 @@ TEST(CalibrateCli, ADatasetWithoutCapturesIsNamedSo) {
   fs::remove_all(dir);
 }
 
+// A target file of another grid (a plain 9 x 6 board's) against captures of
+// the default 11 x 9 board: next to no image shows a board of the file's
+// grid, and the refusal asks whether the board was seen and whether the file
+// is its; it said "too few views" and nothing more.
+TEST(CalibrateCli, ATargetFileOfAnotherGridIsQuestionedWhenNoBoardIsFound) {
+  const RenderedSet set = Render("calib_cli_plain", 2, 8);
+  WriteTargetFile(PlainTarget(9, 6, 9.0), set.dir + "/plain_9x6.yaml");
+  const testing::Result r = testing::RunCli("calibrate --captures " + set.dir + "/captures --target " + set.dir +
+                                            "/plain_9x6.yaml --layout " + set.dir + "/layout.yaml --out " + set.dir +
+                                            "/rig.yaml --report " + set.dir + "/report.json");
+  EXPECT_EQ(r.code, 2);
+  const std::string last = r.err.substr(r.err.rfind("stereorig calibrate:"));
+  EXPECT_EQ(testing::Lines(last), 1) << r.err;
+  EXPECT_NE(last.find("images show no board of " + set.dir +
+                      "/plain_9x6.yaml's grid (corners_x 9, corners_y 6, inner corners along a row, along a column): "
+                      "is the board in view and lit, and is that file this board's target file?"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(set.dir + "/rig.yaml"));
+}
+
 TEST(CalibrateCli, RefusesAFaceSeenByTheWrongModule) {
   const RenderedSet set = Render("calib_cli_face", 2, 7);
   std::ofstream(set.dir + "/layout.yaml") << "modules:\n  - {name: module0, left: 0, right: 1, face: back}\n"
