@@ -83,13 +83,14 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
 nlohmann::json FailedCapture(const std::string& dir, const std::string& name, const CaptureOutputs& outputs,
                              const std::string& progress, const std::string& why) {
   std::fprintf(stderr, "stereorig reconstruct: %s %s\n", progress.c_str(), PrintableText(why).c_str());
-  // On stdout too: a caller reading each capture's line there (a batch's or
-  // a stream's) gets one for every capture, not only for those written.
-  std::printf("%s %s: no output (%s)\n", progress.c_str(), PrintableText(dir).c_str(), PrintableText(why).c_str());
-  FlushStdout();
   std::error_code ec;
   for (const std::string& path : {outputs.cloud, outputs.report, outputs.mesh})
     if (!path.empty()) fs::remove(path, ec);
+  // On stdout too, once the capture's files are as they stay: a caller
+  // reading each capture's line there (a batch's or a stream's) gets one for
+  // every capture, not only for those written, and acts on it at once.
+  std::printf("%s %s: no output (%s)\n", progress.c_str(), PrintableText(dir).c_str(), PrintableText(why).c_str());
+  FlushStdout();
   nlohmann::json entry;
   entry["capture"] = dir;
   entry["name"] = name;
