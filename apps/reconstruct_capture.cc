@@ -82,20 +82,31 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
 
 nlohmann::json FailedCapture(const std::string& dir, const std::string& name, const CaptureOutputs& outputs,
                              const std::string& progress, const std::string& why) {
-  std::fprintf(stderr, "stereorig reconstruct: %s %s\n", progress.c_str(), PrintableText(why).c_str());
-  std::error_code ec;
-  for (const std::string& path : {outputs.cloud, outputs.report, outputs.mesh})
-    if (!path.empty()) fs::remove(path, ec);
+  // An earlier run's files of this name removed first (a batch's: it
+  // replaces them), so that the lines below are true when printed; one that
+  // cannot be removed is named in them and in the entry, not passed over.
+  std::string left_behind;
+  nlohmann::json left = nlohmann::json::array();
+  for (const std::string& path : {outputs.cloud, outputs.report, outputs.mesh}) {
+    std::error_code ec;
+    if (path.empty() || fs::remove(path, ec) || !ec) continue;
+    left_behind += "; " + path + " (an earlier output) could not be removed: " + ec.message();
+    left.push_back(path);
+  }
+  std::fprintf(stderr, "stereorig reconstruct: %s %s%s\n", progress.c_str(), PrintableText(why).c_str(),
+               PrintableText(left_behind).c_str());
   // On stdout too, once the capture's files are as they stay: a caller
   // reading each capture's line there (a batch's or a stream's) gets one for
   // every capture, not only for those written, and acts on it at once.
-  std::printf("%s %s: no output (%s)\n", progress.c_str(), PrintableText(dir).c_str(), PrintableText(why).c_str());
+  std::printf("%s %s: no output (%s%s)\n", progress.c_str(), PrintableText(dir).c_str(), PrintableText(why).c_str(),
+              PrintableText(left_behind).c_str());
   FlushStdout();
   nlohmann::json entry;
   entry["capture"] = dir;
   entry["name"] = name;
   entry["ok"] = false;
   entry["error"] = why;
+  if (!left.empty()) entry["left_behind"] = left;
   return entry;
 }
 

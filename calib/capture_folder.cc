@@ -197,15 +197,22 @@ std::string RejectedViewsNote(const DetectedCaptures& detected, const Target& ta
 
 std::string NoBoardFoundNote(const DetectedCaptures& detected, const Target& target, const std::string& target_path) {
   const int images = static_cast<int>(detected.log.size());
+  // No board of the file's: no chessboard of its grid (a plain target), or
+  // none of its tags (a double-sided one: targets/detect.h).
   const int no_board = static_cast<int>(std::count_if(detected.log.begin(), detected.log.end(), [](const auto& log) {
-    return !log.accepted && log.reject == RejectReason::kNoChessboard;
+    return !log.accepted && (log.reject == RejectReason::kNoChessboard || log.reject == RejectReason::kNoTags);
   }));
   if (2 * no_board <= images) return "";
-  return std::to_string(no_board) + " of " + std::to_string(images) + " images show no board of " + target_path +
-         "'s grid (corners_x " + std::to_string(target.corners_x()) + ", corners_y " +
-         std::to_string(target.corners_y()) +
-         ", inner corners along a row, along a column): is the board in view and lit, and is that file this "
-         "board's target file?";
+  return std::to_string(no_board) + " of " + std::to_string(images) + " images show no board as " + target_path +
+         " describes it (corners_x " + std::to_string(target.corners_x()) + ", corners_y " +
+         std::to_string(target.corners_y()) + ", inner corners along a row, along a column" +
+         (target.double_sided() ? ", and its tags" : "") +
+         "): is the board in view and lit, and is that file this board's target file?";
+}
+
+bool IsTooFewViewsProblem(const std::string& problem) {
+  return problem.find("never sees the board") != std::string::npos ||
+         problem.find("too few views") != std::string::npos;
 }
 
 FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const std::string& target_path,
@@ -232,7 +239,9 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
   try {
     out.result = Calibrate(input, options);
   } catch (const InputError& e) {
-    const std::string note = rejected_note.empty() ? NoBoardFoundNote(detected, target, target_path) : rejected_note;
+    const std::string note = !rejected_note.empty()              ? rejected_note
+                             : IsTooFewViewsProblem(e.problem()) ? NoBoardFoundNote(detected, target, target_path)
+                                                                 : "";
     if (note.empty()) throw;
     throw InputError(e.where(), e.problem() + "; " + note);
   }

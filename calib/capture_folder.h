@@ -70,14 +70,22 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir, const Target& targe
 // right file rejects 13 of the same 200, none as ambiguous.
 std::string RejectedViewsNote(const DetectedCaptures& detected, const Target& target, const std::string& target_path);
 
-// For a calibration that was refused, where RejectedViewsNote said nothing:
-// "" unless most images (more than half) were rejected as showing no board
-// of the target file's grid (no_chessboard). Then the board was out of view
-// or too dark, or the file gives another grid: a plain 9 x 6 file against
+// For a calibration refused for too few views, where RejectedViewsNote
+// said nothing: "" unless most images (more than half) were rejected as
+// showing no board the target file describes (no_chessboard: none of its
+// grid; no_tags: none of a double-sided target's tags). Then the board was
+// out of view or too dark, or the file gives another grid or tags: a plain 9 x 6 file against
 // the 11 x 9 board read "too few views: 1 usable" and nothing more. Not a
 // warning on its own: the same rejections come of a board that most
 // cameras see in few captures, and such a calibration can succeed.
 std::string NoBoardFoundNote(const DetectedCaptures& detected, const Target& target, const std::string& target_path);
+
+// Whether a refusal's problem is one of too few views (stages 1 and 2:
+// "never sees the board", "too few views ..."; calib/intrinsics.cc,
+// calib/stereo.cc), which NoBoardFoundNote may explain; not one that shows
+// the board was seen (a face seen by the wrong module, a corner outside
+// the imager), where the note would send the user after the wrong cause.
+bool IsTooFewViewsProblem(const std::string& problem);
 
 // The whole of `stereorig calibrate`: reads the target file, detects the
 // target in every capture and runs the three stages on the modules of

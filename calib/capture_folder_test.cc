@@ -44,11 +44,30 @@ TEST(RejectedViewsNote, MostImagesRejectedAsOffTheLayoutNameTheTargetFile) {
 TEST(NoBoardFoundNote, MostImagesWithNoBoardAskAboutTheViewAndTheFile) {
   const Target plain = PlainTarget(9, 6, 9.0);
   EXPECT_EQ(NoBoardFoundNote(Log(2, {{RejectReason::kNoChessboard, 198}}), plain, "t9x6.yaml"),
-            "198 of 200 images show no board of t9x6.yaml's grid (corners_x 9, corners_y 6, inner corners along a "
-            "row, along a column): is the board in view and lit, and is that file this board's target file?");
+            "198 of 200 images show no board as t9x6.yaml describes it (corners_x 9, corners_y 6, inner corners "
+            "along a row, along a column): is the board in view and lit, and is that file this board's target "
+            "file?");
+  // A double-sided target whose tags are none of the board's: no_tags.
+  EXPECT_EQ(NoBoardFoundNote(Log(0, {{RejectReason::kNoTags, 200}}), DefaultTarget(), "tags.yaml"),
+            "200 of 200 images show no board as tags.yaml describes it (corners_x 11, corners_y 9, inner corners "
+            "along a row, along a column, and its tags): is the board in view and lit, and is that file this "
+            "board's target file?");
   EXPECT_EQ(NoBoardFoundNote(Log(100, {{RejectReason::kNoChessboard, 100}}), plain, "t.yaml"), "");
-  EXPECT_EQ(NoBoardFoundNote(Log(10, {{RejectReason::kNoTags, 190}}), plain, "t.yaml"), "");
+  EXPECT_EQ(NoBoardFoundNote(Log(10, {{RejectReason::kTooFewCorners, 190}}), plain, "t.yaml"), "");
   EXPECT_NE(NoBoardFoundNote(Log(99, {{RejectReason::kNoChessboard, 101}}), plain, "t.yaml"), "");
+}
+
+// The note goes only with refusals for too few views, as stages 1 and 2
+// word them; a refusal that shows the board was seen gets none.
+TEST(NoBoardFoundNote, OnlyRefusalsForTooFewViewsTakeIt) {
+  for (const char* problem :
+       {"never sees the board (no view with enough corners)", "too few views: 1 usable, need at least 5",
+        "too few views with a board pose: 2", "too few views left after outlier rejection: 3",
+        "too few views shared by both cameras: 1"})
+    EXPECT_TRUE(IsTooFewViewsProblem(problem)) << problem;
+  for (const char* problem :
+       {"face seen by the wrong module: module1 sees the front face", "corner 12 outside the imager", "observed twice"})
+    EXPECT_FALSE(IsTooFewViewsProblem(problem)) << problem;
 }
 
 }  // namespace

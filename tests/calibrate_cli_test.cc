@@ -336,9 +336,9 @@ TEST(CalibrateCli, ATargetFileOfAnotherGridIsQuestionedWhenNoBoardIsFound) {
   EXPECT_EQ(r.code, 2);
   const std::string last = r.err.substr(r.err.rfind("stereorig calibrate:"));
   EXPECT_EQ(testing::Lines(last), 1) << r.err;
-  EXPECT_NE(last.find("images show no board of " + set.dir +
-                      "/plain_9x6.yaml's grid (corners_x 9, corners_y 6, inner corners along a row, along a column): "
-                      "is the board in view and lit, and is that file this board's target file?"),
+  EXPECT_NE(last.find("images show no board as " + set.dir +
+                      "/plain_9x6.yaml describes it (corners_x 9, corners_y 6, inner corners along a row, along a "
+                      "column): is the board in view and lit, and is that file this board's target file?"),
             std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(set.dir + "/rig.yaml"));
