@@ -226,11 +226,12 @@ int RunVerify(int argc, char** argv) {
       // the others are still shown; any other error is the run's.
       // Too few points where the cloud holds hole filling's: say that
       // those are skipped ("only 0 points" of a cloud of thousands read as
-      // a broken file).
+      // a broken file), as a sentence of its own after any hint the
+      // refusal carries (metres).
       std::string problem = refused.problem();
       if (measured.filled_skipped > 0 && static_cast<int>(measured.points.size()) < options.min_points)
-        problem += " (" + std::to_string(measured.filled_skipped) +
-                   " more were added by hole filling, module 255: not measurements, skipped)";
+        problem += "; " + std::to_string(measured.filled_skipped) +
+                   " more were added by hole filling (module 255), not measured: skipped";
       positions.push_back(NotEvaluated(artifact, options, static_cast<int>(measured.points.size()), problem));
     }
   }

@@ -443,8 +443,8 @@ TEST(VerifyCli, HoleFillingsPointsAreSkippedAndCounted) {
   const auto r_filled = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + all_filled);
   EXPECT_EQ(r_filled.code, 2) << r_filled.out << r_filled.err;
   EXPECT_NE((r_filled.out + r_filled.err)
-                .find("only 0 points; at least 200 are needed on the artifact (" + std::to_string(vertices.size()) +
-                      " more were added by hole filling, module 255: not measurements, skipped)"),
+                .find("only 0 points; at least 200 are needed on the artifact; " + std::to_string(vertices.size()) +
+                      " more were added by hole filling (module 255), not measured: skipped"),
             std::string::npos)
       << r_filled.out << r_filled.err;
 }
