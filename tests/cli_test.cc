@@ -441,6 +441,18 @@ TEST(Cli, TheHelpOfEveryCommandThatExitsOneSaysWhen) {
       << top.out;
 }
 
+// Each (command, option) given '' exits 2 with one line naming the option
+// and `why`, before any work (nothing on stdout).
+template <size_t N>
+void ExpectEachEmptyRefused(const std::pair<const char*, const char*> (&options)[N], const std::string& why) {
+  for (const auto& [command, option] : options) {
+    const Result r = RunCli(std::string(command) + " " + option + " ''");
+    EXPECT_EQ(r.code, 2) << command << " " << option;
+    EXPECT_EQ(r.err, std::string("stereorig ") + command + ": " + option + ": " + why + " (see --help)\n");
+    EXPECT_EQ(r.out, "") << command << " " << option;
+  }
+}
+
 // Every file or folder a command writes, given as an empty path (a shell
 // variable left unset): refused by the option's name, exit 2, before any
 // work. Before, `verify --report ""` wrote nothing and exited 0, and other
@@ -466,12 +478,7 @@ TEST(Cli, AnEmptyOutputPathIsRefusedByItsOptionsName) {
                                                          {"simulate", "--out"},
                                                          {"target", "--out"},
                                                          {"match", "--out"}};
-  for (const auto& [command, option] : options) {
-    const Result r = RunCli(std::string(command) + " " + option + " ''");
-    EXPECT_EQ(r.code, 2) << command << " " << option;
-    EXPECT_EQ(r.err, std::string("stereorig ") + command + ": " + option + ": an empty path (see --help)\n");
-    EXPECT_EQ(r.out, "") << command << " " << option;
-  }
+  ExpectEachEmptyRefused(options, "an empty path");
 }
 
 // Every other option that takes a value refuses an empty one too, by name,
@@ -504,12 +511,7 @@ TEST(Cli, AnEmptyValueIsRefusedByItsOptionsName) {
                                                          {"calibrate", "--lensmodel"},
                                                          {"simulate", "--spec"},
                                                          {"demo", "--seed"}};
-  for (const auto& [command, option] : options) {
-    const Result r = RunCli(std::string(command) + " " + option + " ''");
-    EXPECT_EQ(r.code, 2) << command << " " << option;
-    EXPECT_EQ(r.err, std::string("stereorig ") + command + ": " + option + ": an empty value (see --help)\n");
-    EXPECT_EQ(r.out, "") << command << " " << option;
-  }
+  ExpectEachEmptyRefused(options, "an empty value");
 }
 
 // demo's --out is made before any step: under a file it is refused naming
