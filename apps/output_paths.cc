@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cstring>
 
+#include "calib/core/atomic_file.h"
 #include "calib/core/capture_image_name.h"
 #include "calib/core/input_error.h"
 #include "reconstruct/runtime.h"
@@ -45,6 +46,7 @@ void OutputPaths::Claim(const std::string& path, const std::string& what, bool c
                      "cannot write " + what + " in its folder " + folder.lexically_normal().string() + ": " + why);
   }
   if (fs::is_directory(key)) throw InputError(path, "is a folder, not a file to write");
+  RequireReplaceableOutput(path);
   claimed_.emplace(key, what);
 }
 

@@ -29,7 +29,8 @@ class OutputPaths {
   // system allows (NAME_MAX), or, with
   // check_folder, if its folder does not exist or this process may not
   // write in it (access W_OK|X_OK; off for files in a folder the command
-  // creates itself, which ClaimFolder checks).
+  // creates itself, which ClaimFolder checks), or if it is "-", a device, a
+  // pipe or a socket (RequireReplaceableOutput, calib/core/atomic_file.h).
   void Claim(const std::string& path, const std::string& what, bool check_folder = true);
   // Records an input the command reads, `what` naming it ("the rig file
   // (--rig)"): a Claim of the same file throws InputError. Call before the

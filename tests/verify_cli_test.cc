@@ -2,6 +2,7 @@
 // certified sphere, 1 on a sphere outside the MPE, 2 on bad input, and the
 // JSON report's figures match the analytic truth.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -328,6 +329,23 @@ TEST(VerifyCli, AReportWithoutAFolderOrOverACloudIsRefusedBeforeTheVerdict) {
   EXPECT_NE(r.err.find("is a cloud (--cloud)"), std::string::npos) << r.err;
   std::ifstream f(good, std::ios::binary);
   EXPECT_EQ(std::string(std::istreambuf_iterator<char>(f), {}), before);
+  // A pipe as the report (as a device would be: /dev/null, which a rename
+  // over it replaced with a regular file, as root) and "-" (read as standard
+  // output, written as a file of that name): refused before any work, the
+  // pipe left a pipe.
+  const std::string fifo = ::testing::TempDir() + "/verify_report_fifo";
+  std::filesystem::remove(fifo);
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  for (const std::string& report : {fifo, std::string("-")}) {
+    r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + good + " --report " + report);
+    EXPECT_EQ(r.code, 2) << report;
+    EXPECT_EQ(r.out, "") << report;
+    EXPECT_NE(r.err.find(report + (report == "-" ? ": outputs are files" : ": is a pipe (FIFO), not a file")),
+              std::string::npos)
+        << r.err;
+  }
+  EXPECT_TRUE(std::filesystem::is_fifo(fifo));
+  EXPECT_FALSE(std::filesystem::exists("-"));
 }
 
 // The rest of issue 6's bad input: every artifact type with a field

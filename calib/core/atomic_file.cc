@@ -27,8 +27,24 @@ std::string MakeTempPath(const std::string& path) {
 
 }  // namespace
 
+void RequireReplaceableOutput(const std::string& path) {
+  if (path == "-")
+    throw InputError(path, "outputs are files, not standard output: name the file (./- for a file called '-')");
+  struct stat st {};
+  if (lstat(path.c_str(), &st) != 0) return;  // nothing there yet (or not looked up: the write names why)
+  const char* what = S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
+                     : S_ISFIFO(st.st_mode)                     ? "a pipe (FIFO)"
+                     : S_ISSOCK(st.st_mode)                     ? "a socket"
+                                                                : nullptr;
+  if (what != nullptr)
+    throw InputError(path, std::string("is ") + what +
+                               ", not a file: an output is written beside its path and renamed over it, which "
+                               "would replace it; name a regular file");
+}
+
 AtomicOutput::AtomicOutput(const std::string& path)
     : path_(path), temp_path_(MakeTempPath(path)), pending_(temp_path_) {
+  RequireReplaceableOutput(path);
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();
   if (!parent.empty() && !std::filesystem::is_directory(parent)) {
     throw InputError(path, "output folder '" + parent.string() + "' does not exist");

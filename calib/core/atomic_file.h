@@ -11,8 +11,17 @@
 
 namespace stereorig {
 
+// Throws InputError naming `path` if an output there cannot be written by
+// a rename over it: "-" (a file of that name, where a user means standard
+// output) and an existing device, pipe or socket (/dev/null, a FIFO: the
+// rename would replace the node itself, as root a system device, with a
+// regular file). A symbolic link is no problem: the rename replaces the
+// link, its target is left as it was. AtomicOutput checks this; commands
+// check it up front too (apps/output_paths.h), before their work.
+void RequireReplaceableOutput(const std::string& path);
+
 // Writes `bytes` to `path` atomically. Throws InputError naming `path` if the
-// folder is missing or not writable.
+// folder is missing or not writable, or as RequireReplaceableOutput.
 void WriteFileAtomically(const std::string& path, const std::string& bytes);
 
 // For writers that need a path of their own (cv::imwrite, sqlite, ...):

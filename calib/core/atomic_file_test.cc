@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -124,6 +126,37 @@ TEST(WriteFileAtomically, ANameLongerThan255BytesIsRefused) {
             }).find(path + ": cannot write: File name too long"),
             std::string::npos);
   EXPECT_TRUE(Names(dir).empty());
+}
+
+// A FIFO (or a device: /dev/null as an output) at an output path is refused,
+// and left a FIFO: the temporary file renamed over it would have replaced the
+// node with a regular file (as root, a system device). "-" is refused too
+// (a file of that name, where standard output is meant).
+TEST(WriteFileAtomically, ADevicePipeOrDashIsRefusedAndLeftAsItWas) {
+  const std::string dir = testing::ScratchFolder("atomic_fifo");
+  const std::string fifo = dir + "/report.json";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const std::string message = testing::InputErrorMessage([&] { WriteFileAtomically(fifo, "{}"); });
+  EXPECT_NE(message.find(fifo + ": is a pipe (FIFO), not a file"), std::string::npos) << message;
+  EXPECT_TRUE(std::filesystem::is_fifo(fifo));
+  EXPECT_EQ(Names(dir), (std::vector<std::string>{"report.json"}));  // no temporary file left
+  EXPECT_NE(testing::InputErrorMessage([&] { RequireReplaceableOutput("/dev/null"); }).find("/dev/null: is a device"),
+            std::string::npos);
+  EXPECT_NE(testing::InputErrorMessage([&] { RequireReplaceableOutput("-"); }).find("-: outputs are files"),
+            std::string::npos);
+  EXPECT_EQ(testing::InputErrorMessage([&] { RequireReplaceableOutput(dir + "/new.json"); }), "");
+}
+
+// A symbolic link at an output path is replaced by the file (the rename's
+// way); the file it pointed to is left as it was.
+TEST(WriteFileAtomically, ALinkIsReplacedAndItsTargetLeftAsItWas) {
+  const std::string dir = testing::ScratchFolder("atomic_link");
+  { std::ofstream(dir + "/target.json") << "old"; }
+  std::filesystem::create_symlink("target.json", dir + "/link.json");
+  WriteFileAtomically(dir + "/link.json", "new");
+  EXPECT_FALSE(std::filesystem::is_symlink(dir + "/link.json"));
+  EXPECT_EQ(Contents(dir + "/link.json"), "new");
+  EXPECT_EQ(Contents(dir + "/target.json"), "old");
 }
 
 }  // namespace
