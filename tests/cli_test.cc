@@ -361,6 +361,9 @@ TEST(Cli, EveryMalformedRigFileExitsTwoNamingTheKey) {
       {"unknown key", Replace(good, "units: mm\n", "units: mm\ncolour: blue\n"), "colour: unknown key"},
       {"unknown nested key", Replace(good, "    left: 0\n", "    left: 0\n    lefty: 1\n"), "lefty: unknown key"},
       {"missing key", Replace(good, "units: mm\n", ""), "units: missing key"},
+      // named by what it is missing as: a typo of a key was reported as the key missing alone
+      {"misspelt key", Replace(good, "    right_from_left: ", "    right_from_lef: "),
+       "modules[0].right_from_left: missing key (this map has right_from_lef instead: a typo?)"},
       {"missing camera key", Replace(good, "    imagersize: [752, 582]\n", "\n"), "imagersize: missing key"},
       {"wrong type", Replace(good, "    left: 0\n", "    left: zero\n"), "left: expected an integer"},
       {"NaN", Replace(good, cam0_intr, cam0_intr + std::string(".nan, ")), "NaN or Inf"},

@@ -1,5 +1,7 @@
 #include "yaml_reader.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -100,10 +102,58 @@ std::vector<std::string> YamlMap::Keys() const {
   return keys;
 }
 
+namespace {
+
+// The optimal string alignment distance of `a` and `b`, letter case aside:
+// the insertions, deletions, substitutions and swaps of two neighbours that
+// make one the other (a typed key's usual slips).
+size_t TypingDistance(const std::string& a, const std::string& b) {
+  auto same = [](char x, char y) {
+    return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y));
+  };
+  std::vector<std::vector<size_t>> d(a.size() + 1, std::vector<size_t>(b.size() + 1));
+  for (size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+  for (size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+  for (size_t i = 1; i <= a.size(); ++i)
+    for (size_t j = 1; j <= b.size(); ++j) {
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (same(a[i - 1], b[j - 1]) ? 0 : 1)});
+      if (i > 1 && j > 1 && same(a[i - 1], b[j - 2]) && same(a[i - 2], b[j - 1]))
+        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+    }
+  return d[a.size()][b.size()];
+}
+
+}  // namespace
+
+std::string YamlMap::MisspeltAs(const std::string& key) const {
+  // One slip in a short key, up to one in four letters in a long one
+  // (right_from_lef for right_from_left: 1 of 15).
+  const size_t most = std::max<size_t>(1, key.size() / 4);
+  std::string closest;
+  size_t closest_distance = most + 1;
+  for (const auto& kv : node_) {
+    const std::string& other = kv.first.Scalar();
+    if (read_.count(other)) continue;
+    const size_t d = TypingDistance(key, other);
+    if (d < closest_distance) {
+      closest = other;
+      closest_distance = d;
+    }
+  }
+  return closest;
+}
+
 YAML::Node YamlMap::Require(const std::string& key) {
   read_.insert(key);
   YAML::Node n = node_[key];
-  if (!n) throw InputError(Where(key), "missing key");
+  if (!n) {
+    // A misspelt key is missing under its right name; its own name, which
+    // Finish() would call unknown, is never reached. Only a key near the
+    // missing one is named: one not read yet may be a key read later.
+    const std::string typo = MisspeltAs(key);
+    throw InputError(Where(key),
+                     typo.empty() ? "missing key" : "missing key (this map has " + typo + " instead: a typo?)");
+  }
   return n;
 }
 

@@ -72,6 +72,9 @@ class YamlMap {
   // document: one with no keys); `where` names it in errors.
   static YamlMap FromDocument(YAML::Node root, const std::string& where);
   YAML::Node Require(const std::string& key);
+  // The key of this mapping, not read so far, that is a likely misspelling
+  // of `key` (a slip or two of typing from it), or "" if none is.
+  std::string MisspeltAs(const std::string& key) const;
 
   YAML::Node node_;
   std::string file_;

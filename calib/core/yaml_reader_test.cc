@@ -71,6 +71,41 @@ TEST(YamlMap, ASecondYamlDocumentIsRefusedNamingItsLine) {
   EXPECT_NO_THROW(YamlMap::LoadString("", "rig.yaml"));  // an empty file: a mapping with no keys
 }
 
+// A misspelt required key is missing under its right name, and Finish(),
+// which would name the misspelling, is never reached: the message named
+// the key the reader wanted alone. A key of the map not read so far and a
+// slip or two of typing from the missing one (a letter left out, two
+// swapped, the case) is named; one further off is not (it may be a key
+// read later: `left`, `right` below), nor one read already.
+TEST(YamlMap, AMissingKeyNamesAKeyOfTheMapThatIsAMisspellingOfIt) {
+  YamlMap m = YamlMap::LoadString("name: a\nleft: 0\nright: 1\nright_from_lef: 2\n", "f.yaml");
+  m.GetString("name");
+  m.GetInt("left");
+  m.GetInt("right");
+  EXPECT_EQ(InputErrorMessage([&] { m.GetDouble("right_from_left"); }),
+            "f.yaml: right_from_left: missing key (this map has right_from_lef instead: a typo?)");
+  EXPECT_EQ(InputErrorMessage([&] { m.GetInt("rihgt"); }), "f.yaml: rihgt: missing key");  // right is read
+
+  YamlMap first = YamlMap::LoadString("nam: a\nleft: 0\nright: 1\n", "f.yaml");
+  EXPECT_EQ(InputErrorMessage([&] { first.GetString("name"); }),
+            "f.yaml: name: missing key (this map has nam instead: a typo?)");
+  YamlMap swapped = YamlMap::LoadString("fromat: x\nUnits: mm\n", "f.yaml");
+  EXPECT_EQ(InputErrorMessage([&] { swapped.GetString("format"); }),
+            "f.yaml: format: missing key (this map has fromat instead: a typo?)");
+  EXPECT_EQ(InputErrorMessage([&] { swapped.GetString("units"); }),
+            "f.yaml: units: missing key (this map has Units instead: a typo?)");
+
+  YamlMap far = YamlMap::LoadString("baseline: 90\nrfl: 1\n", "f.yaml");
+  EXPECT_EQ(InputErrorMessage([&] { far.GetDouble("right_from_left"); }), "f.yaml: right_from_left: missing key");
+  EXPECT_EQ(InputErrorMessage([&] { far.Finish(); }), "f.yaml: baseline: unknown key");
+  // In a nested mapping, as every reader's: the path and the misspelling.
+  YamlMap nested = YamlMap::LoadString("modules:\n  - {name: m, right_from_lef: 1}\n", "rig.yaml");
+  YamlMap module = nested.GetMaps("modules")[0];
+  module.GetString("name");
+  EXPECT_EQ(InputErrorMessage([&] { module.GetNode("right_from_left"); }),
+            "rig.yaml: modules[0].right_from_left: missing key (this map has right_from_lef instead: a typo?)");
+}
+
 TEST(YamlMap, FinishRejectsKeysNobodyRead) {
   YamlMap m = YamlMap::LoadString("known: 1\ntypo_key: 2\n", "f.yaml");
   m.GetInt("known");
