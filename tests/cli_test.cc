@@ -392,6 +392,23 @@ TEST(Cli, EveryMalformedRigFileExitsTwoNamingTheKey) {
   EXPECT_NE(missing.err.find("no such file"), std::string::npos);
 }
 
+// A module's translation typed in metres (a 90 mm baseline as 0.09) was
+// read: exit 0, "baseline 0.0900 mm". Refused like a square size in metres.
+TEST(Cli, RigRefusesABaselineTypedInMetres) {
+  stereorig::SimulatedRig sim = stereorig::MakeDefaultRig();
+  std::vector<stereorig::StereoModule> modules = sim.rig.modules();
+  modules[0].right_from_left = stereorig::Pose(modules[0].right_from_left.rotation(), Eigen::Vector3d(-0.09, 0, 0));
+  const stereorig::Rig metres(sim.rig.cameras(), sim.rig.camera_names(), modules, sim.rig.S(), "test");
+  const std::string path = ::testing::TempDir() + "/rig_metres.yaml";
+  std::ofstream(path) << stereorig::RigToYaml(metres);
+  const Result r = RunCli("rig --rig " + path);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "stereorig rig: " + path +
+                       ": modules[0].right_from_left: baseline 0.09 mm, under the 1 mm two cameras' centres stand "
+                       "apart at the least; is it in metres? the unit is mm\n");
+  EXPECT_EQ(r.out, "");
+}
+
 TEST(Cli, AnInconsistentOffDiagonalSIsRejected) {
   // Shift S[0][1]'s translation by 1 mm while S[1][0] stays: S_10 != S_01^-1.
   const std::string good = GoodRigText();

@@ -47,6 +47,27 @@ Pose ReadRigidPose(const YAML::Node& n, const std::string& where) {
   return TypedRigidPose(YamlMap::ToMatrix4(n, where), where);
 }
 
+// The least distance, mm, between the centres of two cameras of a rig: a
+// module's baseline, and two modules' reference cameras (S). Two camera
+// bodies stand further apart; stereo modules have baselines of tens of mm.
+// A distance under it is a translation typed in metres (a 90 mm baseline as
+// 0.09), which the rig file read as a module of sub-millimetre baseline
+// (stereorig rig: "baseline 0.0900 mm", exit 0), or none at all.
+constexpr double kMinCameraSpacingMm = 1.0;
+
+// Throws InputError at `where` if `pose`'s translation, two camera centres'
+// distance, is under kMinCameraSpacingMm; the message says it as
+// `before` distance `after` ("baseline ", " mm").
+void CheckCameraSpacing(const Pose& pose, const std::string& before, const std::string& after,
+                        const std::string& where) {
+  const double distance_mm = pose.DistanceMm();
+  if (distance_mm >= kMinCameraSpacingMm) return;
+  std::string why = before + NumberText(distance_mm) + after + ", under the " + NumberText(kMinCameraSpacingMm) +
+                    " mm two cameras' centres stand apart at the least";
+  why += distance_mm > 0 ? "; is it in metres? the unit is mm" : ": they share one centre";
+  throw InputError(where, why);
+}
+
 std::map<std::string, double> ReadNumberMap(YamlMap map) {
   std::map<std::string, double> out;
   for (const std::string& key : map.Keys()) out[key] = map.GetDouble(key);
@@ -124,6 +145,7 @@ Rig ParseRig(YamlMap root) {
     mod.left_camera = m.GetInt("left");
     mod.right_camera = m.GetInt("right");
     mod.right_from_left = ReadRigidPose(m.GetNode("right_from_left"), m.Where("right_from_left"));
+    CheckCameraSpacing(mod.right_from_left, "baseline ", " mm", m.Where("right_from_left"));
     m.Finish();
     modules.push_back(mod);
   }
@@ -136,7 +158,11 @@ Rig ParseRig(YamlMap root) {
     if (!s[i].IsSequence()) throw InputError(where_s, "expected M rows of M 4x4 matrices");
     S.emplace_back();
     for (size_t j = 0; j < s[i].size(); ++j) {
-      S.back().push_back(ReadRigidPose(s[i][j], where_s + "[" + std::to_string(i) + "][" + std::to_string(j) + "]"));
+      const std::string where_ij = where_s + "[" + std::to_string(i) + "][" + std::to_string(j) + "]";
+      S.back().push_back(ReadRigidPose(s[i][j], where_ij));
+      if (i != j)
+        CheckCameraSpacing(S.back().back(), "modules " + std::to_string(i) + " and " + std::to_string(j) + " stand ",
+                           " mm apart", where_ij);
     }
   }
   root.Finish();

@@ -18,7 +18,8 @@ inline constexpr int kRigFileVersion = 2;
 
 // Throws InputError naming the file and key on: a missing file, bad YAML,
 // unknown or missing keys, wrong types, NaN/Inf, non-orthonormal rotations,
-// an unknown lens model, the wrong number of intrinsics, an inconsistent S.
+// an unknown lens model, the wrong number of intrinsics, an inconsistent S,
+// a baseline or two modules' distance under 1 mm (typed in metres).
 // With `bytes_read`, the file's bytes as parsed: read once, so that what
 // is fingerprinted (stereorig check's CRC-32) is the rig that was parsed.
 Rig ReadRigFile(const std::string& path, std::string* bytes_read = nullptr);

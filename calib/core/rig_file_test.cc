@@ -8,10 +8,13 @@
 #include <sstream>
 
 #include "calib/core/input_error.h"
+#include "calib/core/input_error_testing.h"
 #include "calib/core/number_text.h"
 
 namespace stereorig {
 namespace {
+
+using testing::InputErrorMessage;
 
 Rig MakeRandomRig(unsigned seed) {
   std::mt19937 rng(seed);
@@ -214,6 +217,44 @@ TEST(RigFile, WindowedCamerasAreRead) {
   const Rig back = ReadRigFile(path);
   EXPECT_EQ(back.camera(0).intrinsics(), corner);
   EXPECT_EQ(back.camera(1).intrinsics(), strip);
+}
+
+// A translation typed in metres (a 90 mm baseline as 0.09) was read as a
+// module of 0.09 mm baseline (stereorig rig: "baseline 0.0900 mm", exit 0).
+// A baseline, or two modules' distance in S, under 1 mm is refused naming
+// the key, the value and the unit; 1 mm is read.
+TEST(RigFile, ABaselineOrModulesDistanceUnderOneMillimetreIsRefused) {
+  const Rig rig = MakeRandomRig(0);
+  // `rig` with module 0's right_from_left and S[0][1] translated by the two,
+  // as its file reads.
+  auto read_with = [&](const Eigen::Vector3d& baseline_mm, const Eigen::Vector3d& module0_to_1_mm) {
+    std::vector<StereoModule> modules = rig.modules();
+    modules[0].right_from_left = Pose(modules[0].right_from_left.rotation(), baseline_mm);
+    const Rig edited(rig.cameras(), rig.camera_names(), modules,
+                     {Pose::Identity(), Pose(rig.S(0, 1).rotation(), module0_to_1_mm)});
+    return ParseRigYaml(RigToYaml(edited), "rig.yaml");
+  };
+  const Eigen::Vector3d s_mm(0, 0, 400);
+  EXPECT_EQ(InputErrorMessage([&] {
+              read_with({-0.09, 0, 0}, s_mm);
+            }),
+            "rig.yaml: modules[0].right_from_left: baseline 0.09 mm, under the 1 mm two cameras' centres stand apart "
+            "at the least; is it in metres? the unit is mm");
+  EXPECT_EQ(InputErrorMessage([&] {
+              read_with({0, 0, 0}, s_mm);
+            }),
+            "rig.yaml: modules[0].right_from_left: baseline 0 mm, under the 1 mm two cameras' centres stand apart at "
+            "the least: they share one centre");
+  EXPECT_EQ(InputErrorMessage([&] {
+              read_with({-90, 0, 5}, s_mm / 1000);
+            }),
+            "rig.yaml: S[0][1]: modules 0 and 1 stand 0.4 mm apart, under the 1 mm two cameras' centres stand "
+            "apart at the least; is it in metres? the unit is mm");
+  EXPECT_EQ(InputErrorMessage([&] {
+              read_with({-0.999, 0, 0}, s_mm);
+            }).substr(0, 60),
+            "rig.yaml: modules[0].right_from_left: baseline 0.999 mm, und");
+  EXPECT_EQ(read_with({-1, 0, 0}, {0, 0, 1}).module(0).right_from_left.DistanceMm(), 1.0);
 }
 
 TEST(RigFile, IsPlainYamlWithoutCustomTags) {
