@@ -31,9 +31,13 @@ Target::Target(Layout layout, const std::string& where) : layout_(std::move(layo
   // Said before the tags' placement, which fails against squares of
   // micrometres.
   if (l.square_size_mm < kMinSquareSizeMm) {
+    // The unit it most likely is in: in centimetres, 0.1 to 1 is a square of
+    // 1 to 10 mm, a board's usual; in metres, one of 100 mm to 1 m. Under
+    // 0.1, centimetres would be under 1 mm, and metres are the slip.
+    const char* unit = l.square_size_mm >= 0.1 ? "centimetres" : "metres";
     throw InputError(where, "square_size_mm " + NumberText(l.square_size_mm) + ": squares of " +
                                 NumberText(1000 * l.square_size_mm) + " um, under the " + NumberText(kMinSquareSizeMm) +
-                                " mm a camera resolves; is it in metres? the unit is mm");
+                                " mm a camera resolves; is it in " + unit + "? the unit is mm");
   }
   if (l.margin_mm < 0) throw InputError(where, "margin_mm must not be negative");
   if (l.flatness_allowance_mm < 0) throw InputError(where, "flatness_allowance_mm must not be negative");

@@ -114,6 +114,15 @@ TEST(TargetFile, ASquareSizeInMetresIsNamedAsSuch) {
                  "t_m.yaml: square_size_mm 0.009: squares of 9 um, under the 1 mm a camera resolves; is it in "
                  "metres? the unit is mm");
   }
+  // 0.9 in metres would be squares of 900 mm; in centimetres, of 9 mm.
+  try {
+    PlainTarget(9, 6, 0.9);
+    ADD_FAILURE() << "squares of 900 um accepted";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "plain target: square_size_mm 0.9: squares of 900 um, under the 1 mm a camera resolves; is it in "
+                 "centimetres? the unit is mm");
+  }
   EXPECT_NO_THROW(PlainTarget(9, 6, 1.0));
   EXPECT_THROW(PlainTarget(9, 6, 0.999), InputError);
 }
