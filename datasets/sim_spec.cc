@@ -92,7 +92,9 @@ ModuleSpec ParseModule(YamlMap m) {
     s.projector.enabled = false;
   }
   m.Finish();
-  Require(s.baseline_mm > 0, m.Where(), "baseline_mm", "must be positive");
+  // The rig file refuses cameras closer than 1 mm (calib/core/rig_file.h): a
+  // spec under it would render a dataset whose truth rig cannot be read.
+  Require(s.baseline_mm >= 1, m.Where(), "baseline_mm", "must be at least 1 mm (is it in metres? the unit is mm)");
   Require(std::abs(s.verging_deg) < 90, m.Where(), "verging_deg", "must be within +-90");
   const Eigen::Vector3d z = s.look_at_mm - s.center_mm;
   Require(z.norm() > 1e-6, m.Where(), "look_at_mm", "must differ from center_mm");

@@ -94,6 +94,10 @@ TEST(SimSpec, BadSpecsNameTheKey) {
   EXPECT_NE(ErrorOf(Replace(good, "intrinsics: [1024.98", "intrinsics: [1, 1024.98")).find("left_camera"),
             std::string::npos);
   EXPECT_NE(ErrorOf(Replace(good, "format: stereorig-sim-spec", "format: other")).find("format"), std::string::npos);
+  // A baseline in metres (0.09 for 90 mm) would render a truth rig the rig
+  // file reader refuses (cameras closer than 1 mm).
+  EXPECT_NE(ErrorOf(Replace(good, "baseline_mm: 90", "baseline_mm: 0.09")).find("baseline_mm: must be at least 1 mm"),
+            std::string::npos);
   // A camera no lens could be (fx 100x fy: calib/core/lens_plausibility.h),
   // refused as a rig file's would be, naming the camera.
   const std::string e = ErrorOf(Replace(good, "intrinsics: [1024.98", "intrinsics: [102498"));
