@@ -395,9 +395,11 @@ TEST_F(ReconstructCli, MatchesReachingAnEndOfTheVolumesRangeAreWarnedOf) {
 TEST_F(ReconstructCli, RectifiedOutWritesEachModulesPairAndTheMatchCommandForIt) {
   ASSERT_EQ(RunCli(Args(dir_ + "/capture")), 0);
   const std::string plain_cloud = ReadFileBytes(dir_ + "/out.ply");
-  const std::string rect = dir_ + "/rect/new";
+  // A space in the folder: the printed command quotes the paths (it split
+  // them in two, and the command failed as pasted).
+  const std::string rect = dir_ + "/rect/new pairs";
   std::filesystem::remove_all(dir_ + "/rect");
-  const testing::Result r = testing::RunCli(Args(dir_ + "/capture", "--rectified-out " + rect));
+  const testing::Result r = testing::RunCli(Args(dir_ + "/capture", "--rectified-out '" + rect + "'"));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(ReadFileBytes(dir_ + "/out.ply"), plain_cloud);
   for (int m = 0; m < 2; ++m) {
@@ -413,6 +415,7 @@ TEST_F(ReconstructCli, RectifiedOutWritesEachModulesPairAndTheMatchCommandForIt)
     const std::string args = r.out.substr(command + 10, r.out.find('\n', command) - command - 10);
     EXPECT_NE(args.find(" --min-disparity "), std::string::npos) << args;
     EXPECT_NE(args.find(" --roi "), std::string::npos) << args;
+    EXPECT_NE(args.find("--left '" + left + "' --right '"), std::string::npos) << args;
     const testing::Result match = testing::RunCli(args);
     ASSERT_EQ(match.code, 0) << args << ": " << match.err;
     EXPECT_EQ(match.err, "") << args;
@@ -420,7 +423,7 @@ TEST_F(ReconstructCli, RectifiedOutWritesEachModulesPairAndTheMatchCommandForIt)
   }
   // One capture only: a batch has many pairs per module.
   ExpectRefusedInOneLine("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture --out-dir " + dir_ +
-                             "/rect_batch --rectified-out " + rect,
+                             "/rect_batch --rectified-out '" + rect + "'",
                          "--out-dir excludes --rectified-out");
 }
 
