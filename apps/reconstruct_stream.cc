@@ -125,8 +125,14 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
     // (the heap's pages faulted in, the worker threads started) before the
     // line's first object comes.
     const auto t_warm = Clock::now();
-    CheckCaptureFiles(request.warm_up_dir, rig);
-    runtime.Process(LoadCaptureOrInputError(request.warm_up_dir, rig), !request.mesh_format.empty());
+    try {
+      CheckCaptureFiles(request.warm_up_dir, rig);
+      runtime.Process(LoadCaptureOrInputError(request.warm_up_dir, rig), !request.mesh_format.empty());
+    } catch (const InputError& e) {  // named by its flag: "nope: capture folder not found" did not say which
+      throw InputError("--warm-up", e.what());
+    } catch (const fs::filesystem_error& e) {  // a path the file system cannot look up (a link loop)
+      throw InputError("--warm-up", request.warm_up_dir + ": " + e.code().message());
+    }
     warm_up_ms = MsSince(t_warm);
   }
   out_folder.Create();

@@ -494,6 +494,13 @@ TEST_F(ReconstructStreamCli, BadUseExitsTwoInOneLine) {
   EXPECT_EQ(testing::Lines(bad_warm.err), 1) << bad_warm.err;
   EXPECT_NE(bad_warm.err.find(dir_ + "/line/0003/cam1.png"), std::string::npos) << bad_warm.err;
   EXPECT_FALSE(fs::exists(dir_ + "/o3")) << "a bad warm-up capture left the output folder behind";
+  // A warm-up folder that is not there is named by its flag (the line said
+  // only "nope: capture folder not found").
+  const testing::Result no_warm = testing::RunCli("reconstruct" + rig + " --capture - --out-dir " + dir_ +
+                                                  "/o6 --warm-up " + dir_ + "/nope < /dev/null");
+  EXPECT_EQ(no_warm.code, 2);
+  EXPECT_EQ(no_warm.err, "stereorig reconstruct: --warm-up: " + dir_ + "/nope: capture folder not found\n");
+  EXPECT_FALSE(fs::exists(dir_ + "/o6"));
   const std::string fresh = dir_ + "/empty_run/out";
   fs::remove_all(dir_ + "/empty_run");
   const testing::Result empty =
