@@ -22,13 +22,16 @@ namespace fs = std::filesystem;
 
 std::vector<std::string> BatchOutputNames(const std::vector<std::string>& capture_dirs) {
   std::vector<std::vector<std::string>> parts;
-  std::map<fs::path, std::string> seen;  // normal absolute path -> as given
+  std::map<fs::path, std::string> seen;  // the folder (links followed) -> as given
   for (const std::string& dir : capture_dirs) {
     fs::path p = fs::absolute(fs::path(dir)).lexically_normal();
     if (!p.has_filename()) p = p.parent_path();  // "caps/0001/" names 0001
-    if (const auto it = seen.find(p); it != seen.end())
+    // One folder through two paths ("nm/q", "link_to_nm/q") would be
+    // reconstructed twice: compared as the file system finds them.
+    const fs::path folder = ResolvedFolder(dir);
+    if (const auto it = seen.find(folder); it != seen.end())
       throw InputError("--capture", dir + " is given twice (as " + it->second + ")");
-    seen.emplace(p, dir);
+    seen.emplace(folder, dir);
     std::vector<std::string> components;
     for (const fs::path& c : p.relative_path()) components.push_back(c.string());
     if (components.empty()) throw InputError(dir, "a capture folder cannot be the file system's root");

@@ -17,7 +17,8 @@ namespace stereorig {
 // '_', keeping at least the last component. "caps/0001", "caps/0002" give
 // "0001", "0002"; "scenes/cup/active", "scenes/sphere/active" give
 // "cup_active", "sphere_active". Throws InputError if a folder is given
-// twice or two names collide ("a_b" and "a/b").
+// twice (also through a link: folders compared as the file system resolves
+// them, ResolvedFolder) or two names collide ("a_b" and "a/b").
 std::vector<std::string> BatchOutputNames(const std::vector<std::string>& capture_dirs);
 
 struct BatchRequest {

@@ -22,6 +22,14 @@ CaptureOutputs CaptureOutputsNamed(const std::string& out_dir, const std::string
   return {stem + ".ply", stem + ".json", mesh_format.empty() ? "" : stem + ".mesh." + mesh_format};
 }
 
+fs::path ResolvedFolder(const std::string& dir) {
+  std::error_code ec;
+  fs::path p = fs::weakly_canonical(fs::absolute(fs::path(dir)), ec);
+  if (ec) p = fs::absolute(fs::path(dir)).lexically_normal();
+  if (!p.has_filename()) p = p.parent_path();
+  return p;
+}
+
 std::vector<cv::Mat> LoadCaptureOrInputError(const std::string& dir, const Rig& rig) {
   try {
     return LoadCapture(dir, rig);

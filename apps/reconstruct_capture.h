@@ -5,6 +5,7 @@
 #pragma once
 
 #include <chrono>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <string>
@@ -23,6 +24,14 @@ struct CaptureOutputs {
 // The outputs of the capture named `name` in `out_dir`: <name>.ply,
 // <name>.json and, unless mesh_format is "", <name>.mesh.<mesh_format>.
 CaptureOutputs CaptureOutputsNamed(const std::string& out_dir, const std::string& name, const std::string& mesh_format);
+
+// The folder `dir` as the file system finds it: absolute, links followed
+// (std::filesystem::weakly_canonical: a part that does not exist is kept as
+// written), no trailing separator; a path it cannot resolve (a link loop)
+// absolute and normal, as written, for the capture's own check to name. A
+// batch's "given twice" and a stream's --capture-root compare folders so, not
+// their paths' text ("nm/q" and "link_to_nm/q" are one folder).
+std::filesystem::path ResolvedFolder(const std::string& dir);
 
 // LoadCapture (runtime.h), any failure as bad input naming the folder: a
 // folder removed or made unreadable after its files were checked throws a

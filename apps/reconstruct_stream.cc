@@ -22,11 +22,17 @@ namespace fs = std::filesystem;
 namespace {
 
 // Absolute and normal, without a trailing separator ("caps/0001/" is
-// "caps/0001"); links not followed, as a batch compares its folders.
+// "caps/0001"); links not followed.
 fs::path FolderPath(const std::string& dir) {
   fs::path p = fs::absolute(fs::path(dir)).lexically_normal();
   if (!p.has_filename()) p = p.parent_path();
   return p;
+}
+
+// `p` below `root` ("" if it is not): a path holding no ".." and not ".".
+fs::path PathBelow(const fs::path& p, const fs::path& root) {
+  const fs::path below = p.lexically_relative(root);
+  return below.empty() || below == "." || *below.begin() == ".." ? fs::path() : below;
 }
 
 }  // namespace
@@ -38,8 +44,12 @@ std::string StreamOutputName(const std::string& dir, const std::string& root) {
     if (name.empty()) throw InputError(dir, "a capture folder cannot be the file system's root");
     return name;
   }
-  const fs::path below = p.lexically_relative(FolderPath(root));
-  if (below.empty() || below == "." || *below.begin() == "..")
+  // As written first (a capture folder that is itself a link below the root
+  // stays below it); else as the file system resolves both, so that a root
+  // given through a link (or a folder sent through one) still holds it.
+  fs::path below = PathBelow(p, FolderPath(root));
+  if (below.empty()) below = PathBelow(ResolvedFolder(dir), ResolvedFolder(root));
+  if (below.empty())
     throw InputError(dir, "is not a folder below --capture-root " + root + ", which names the captures");
   std::string name;
   for (const fs::path& c : below) {

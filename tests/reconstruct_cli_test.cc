@@ -1300,5 +1300,22 @@ TEST_F(ReconstructCli, ABatchWithAMissingCameraOrARepeatedFolderWritesNothing) {
   ExpectNoOutput();
 }
 
+// One folder given through two paths (a link to its parent) is given twice:
+// refused before anything is written, as the same path twice is. Before,
+// the paths' text was compared, and the folder reconstructed twice.
+TEST_F(ReconstructCli, ABatchRefusesOneFolderGivenThroughALinkToo) {
+  const std::string link = dir_ + "/link_to_dir", out = dir_ + "/batch_link_out";
+  std::filesystem::remove(link);
+  std::filesystem::create_directory_symlink(dir_, link);
+  std::filesystem::remove_all(out);
+  const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture " +
+                                            link + "/capture --out-dir " + out);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("--capture: " + link + "/capture is given twice (as " + dir_ + "/capture)"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -460,6 +460,25 @@ TEST_F(ReconstructStreamCli, ACaptureRootNamesCapturesByTheirPathBelowIt) {
   EXPECT_NE(r.err.find("[3] " + dir_ + "/line/0002: is not a folder below --capture-root " + root), std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(out + "/0002.ply"));
+  // A root given through a link holds the folders below the one it names,
+  // and a folder sent through a link lies below the root it resolves into
+  // (the paths' text was compared: "is not a folder below --capture-root").
+  const std::string link = dir_ + "/days_link", linked_out = dir_ + "/days_link_out";
+  fs::remove(link);
+  fs::create_directory_symlink(root, link);
+  fs::remove_all(linked_out);
+  WriteFileAtomically(list, root + "/2026-12-06/0001\n" + link + "/2026-12-07/0001\n");
+  const testing::Result linked = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture - --out-dir " +
+                                                 linked_out + " --capture-root " + link + " < " + list);
+  EXPECT_EQ(linked.code, 0) << linked.err;
+  EXPECT_EQ(Bytes(linked_out + "/2026-12-06_0001.ply"), Bytes(dir_ + "/single.ply")) << linked.out;
+  EXPECT_EQ(Bytes(linked_out + "/2026-12-07_0001.ply"), Bytes(dir_ + "/single.ply")) << linked.out;
+  WriteFileAtomically(list, link + "/2026-12-06/0001\n");
+  fs::remove_all(linked_out);
+  const testing::Result through = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture - --out-dir " +
+                                                  linked_out + " --capture-root " + root + " < " + list);
+  EXPECT_EQ(through.code, 0) << through.err;
+  EXPECT_TRUE(fs::exists(linked_out + "/2026-12-06_0001.ply")) << through.out;
   const testing::Result missing = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture - --out-dir " +
                                                   out + " --capture-root " + dir_ + "/no_such_root < " + list);
   EXPECT_EQ(missing.code, 2);
