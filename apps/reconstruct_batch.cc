@@ -126,7 +126,7 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
   nlohmann::json summary;
   summary["runtime_build_ms"] = build_ms;
   summary["captures"] = nlohmann::json::array();
-  int failed = 0;
+  int failed = 0, without_points = 0;
   const auto t_all = Clock::now();
   for (size_t i = 0; i < dirs.size(); ++i) {
     const auto t = Clock::now();
@@ -142,7 +142,9 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
     if (i + 1 < dirs.size()) next = std::async(std::launch::async, load, dirs[i + 1]);
     if (error.empty()) {
       try {
-        summary["captures"].push_back(ReconstructCapture(runtime, images, dirs[i], names[i], outputs[i], progress, t));
+        const nlohmann::json entry = ReconstructCapture(runtime, images, dirs[i], names[i], outputs[i], progress, t);
+        without_points += !entry["modules_without_points"].empty();
+        summary["captures"].push_back(entry);
         continue;
       } catch (const InputError& e) {  // the writers' failures (atomic_file.h)
         error = e.what();
@@ -153,8 +155,8 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
     ++failed;
     summary["captures"].push_back(FailedCapture(dirs[i], names[i], outputs[i], progress, error));
   }
-  const int code = FinishRun(&summary, int(dirs.size()), failed, MsSince(t_all), "reading, reconstructing and writing",
-                             request.summary_path);
+  const int code = FinishRun(&summary, int(dirs.size()), failed, without_points, MsSince(t_all),
+                             "reading, reconstructing and writing", request.summary_path);
   // Every capture failed and nothing was written in it (no summary there):
   // a new output folder goes again, as bad input found earlier leaves none.
   if (failed > 0) out_folder.RemoveIfEmpty();

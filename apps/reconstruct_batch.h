@@ -35,8 +35,9 @@ struct BatchRequest {
 // out_dir/<name>.ply, <name>.json (its report) and <name>.mesh.<format>,
 // each atomically, printing one line per capture. A capture whose images
 // turn out bad (undecodable, wrong size or type) is reported on stderr and
-// gets no output; the others go on. Returns the exit code: 0, or 2 when any
-// capture was bad input. Throws InputError for bad input found before the
+// gets no output; the others go on. A module that gives no point is warned
+// of and counted (reconstruct_capture.h), not failed. Returns the exit code:
+// 0, or 2 when any capture was bad input. Throws InputError for bad input found before the
 // first capture (nothing written then).
 int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchRequest& request);
 

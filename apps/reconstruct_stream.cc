@@ -158,7 +158,7 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
   summary["runtime_build_ms"] = build_ms;
   if (!request.warm_up_dir.empty()) summary["warm_up_ms"] = warm_up_ms;
   summary["failed_captures"] = nlohmann::json::array();  // the first kMaxFailuresListed
-  int total = 0, failed = 0;
+  int total = 0, failed = 0, without_points = 0;
   std::string output_error;  // why stdout lost a capture's line: the stream stops
   const auto t_all = Clock::now();
   std::string line;
@@ -190,7 +190,8 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
       // only what this capture may have written.
       outputs = planned;
       const std::vector<cv::Mat> images = LoadCaptureOrInputError(dir, rig);
-      ReconstructCapture(runtime, images, dir, name, outputs, progress, t);
+      without_points +=
+          !ReconstructCapture(runtime, images, dir, name, outputs, progress, t)["modules_without_points"].empty();
       if (StdoutLost(&output_error)) break;
       continue;
     } catch (const InputError& e) {  // the capture's files, images or outputs
@@ -231,7 +232,7 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
     if (stop != 0) return kExitOk;  // stopped before the line's first object: nothing to sum up
     throw InputError("--capture -", "standard input held no capture folder (one folder's path per line)");
   }
-  const int code = FinishRun(&summary, total, failed, MsSince(t_all),
+  const int code = FinishRun(&summary, total, failed, without_points, MsSince(t_all),
                              "the stream's wall time: waiting for the input, reading, reconstructing and writing",
                              request.summary_path);
   if (failed > 0) out_folder.RemoveIfEmpty();  // as a batch: nothing written, no new folder

@@ -1300,6 +1300,60 @@ TEST_F(ReconstructCli, ABatchWithAMissingCameraOrARepeatedFolderWritesNothing) {
   ExpectNoOutput();
 }
 
+// A capture in which a module gives no point (its lasers off, a camera not
+// triggered, its cables swapped) is no measurement there: a batch, as a
+// line runs it, warns of each such module on the capture's own lines, on
+// stdout and on stderr, and its summary and last line count those captures;
+// the exit code stays 0 (the captures were reconstructed and written:
+// docs/formats.md). Before, an all-black capture gave "0 points (fill m0
+// 0.0%, m1 0.0%)", "2 of 2 captures" and not a word; a single capture's
+// hint was on stdout only.
+TEST_F(ReconstructCli, ABatchWarnsOfEachModuleThatGaveNoPointAndCountsThem) {
+  const std::string dark = BrokenCapture("batch_dark"), half = BrokenCapture("batch_half_dark");
+  for (int k = 0; k < 4; ++k) {
+    const std::string image = "/cam" + std::to_string(k) + ".png";
+    const cv::Mat black = cv::Mat::zeros(cv::imread(dark + image).size(), CV_8UC1);
+    ASSERT_TRUE(cv::imwrite(dark + image, black));
+    if (k >= 2) {
+      ASSERT_TRUE(cv::imwrite(half + image, black));  // module 1's cameras
+    }
+  }
+  const std::string out = dir_ + "/batch_dark_out";
+  std::filesystem::remove_all(out);
+  const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture " +
+                                            dark + " " + half + " --out-dir " + out + " --report " + out + "/run.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string no_lit = "gave no point (" + out + "/batch_dark.json): no lit pixels: is the projector on";
+  for (const std::string& says : std::vector<std::string>{
+           "[2/3] " + dark + ": 0 points (fill m0 0.0%, m1 0.0%), ", "\n  warning: module 0 " + no_lit,
+           "\n  warning: module 1 " + no_lit,
+           "\n  warning: module 1 gave no point (" + out + "/batch_half_dark.json): ", "3 of 3 captures in ",
+           "; 2 with a module that gave no point\n"})
+    EXPECT_NE(r.out.find(says), std::string::npos) << says << "\n" << r.out;
+  EXPECT_EQ(r.out.find("module 0 gave no point (" + out + "/batch_half_dark.json)"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("(" + out + "/capture.json): "), std::string::npos) << r.out;  // the lit capture: no warning
+  for (const std::string& says :
+       std::vector<std::string>{"stereorig reconstruct: [2/3] " + dark + ": warning: module 0 gave no point: no lit",
+                                "stereorig reconstruct: [3/3] " + half + ": warning: module 1 gave no point: ",
+                                "stereorig reconstruct: warning: 2 of 3 captures written have a module that gave no "
+                                "point"})
+    EXPECT_NE(r.err.find(says), std::string::npos) << says << "\n" << r.err;
+  std::ifstream f(out + "/run.json");
+  const nlohmann::json summary = nlohmann::json::parse(f);
+  EXPECT_EQ(summary["reconstructed"], 3);
+  EXPECT_EQ(summary["with_modules_without_points"], 2);
+  EXPECT_EQ(summary["captures"][0]["modules_without_points"], nlohmann::json::array());
+  EXPECT_EQ(summary["captures"][1]["modules_without_points"], nlohmann::json({0, 1}));
+  EXPECT_EQ(summary["captures"][2]["modules_without_points"], nlohmann::json({1}));
+  // One capture: its hint on stderr too, exit 0.
+  const testing::Result single = testing::RunCli(Args(dark));
+  EXPECT_EQ(single.code, 0) << single.err;
+  EXPECT_NE(single.err.find("stereorig reconstruct: warning: module 1 gave no point: no lit pixels: is the projector "
+                            "on"),
+            std::string::npos)
+      << single.err;
+}
+
 // One folder given through two paths (a link to its parent) is given twice:
 // refused before anything is written, as the same path twice is. Before,
 // the paths' text was compared, and the folder reconstructed twice.

@@ -486,6 +486,41 @@ TEST_F(ReconstructStreamCli, ACaptureRootNamesCapturesByTheirPathBelowIt) {
   EXPECT_NE(missing.err.find("no_such_root: is not a folder"), std::string::npos) << missing.err;
 }
 
+// A module that gives no point (here every camera black: the lasers off, the
+// cameras not triggered) is warned of on the capture's own lines, stdout
+// and stderr, and the summary and the last line count the captures with
+// one; the exit code stays 0, as the capture was reconstructed and written.
+// Before, the stream answered "0 points (fill m0 0.0%, m1 0.0%)" and no more.
+TEST_F(ReconstructStreamCli, AModuleThatGaveNoPointIsWarnedOfAndCounted) {
+  const std::string dark = dir_ + "/dark", out = dir_ + "/dark_out", list = dir_ + "/dark.txt";
+  fs::remove_all(dark);
+  fs::copy(dir_ + "/line/0001", dark);
+  for (int k = 0; k < 4; ++k) {
+    const std::string image = dark + "/cam" + std::to_string(k) + ".png";
+    ASSERT_TRUE(cv::imwrite(image, cv::Mat::zeros(cv::imread(image).size(), CV_8UC1)));
+  }
+  fs::remove_all(out);
+  WriteFileAtomically(list, dir_ + "/line/0001\n" + dark + "\n");
+  const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture - --out-dir " + out +
+                                            " --report " + out + "/summary.json < " + list);
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const std::string& says : std::vector<std::string>{
+           "[2] " + dark + ": 0 points (fill m0 0.0%, m1 0.0%), ",
+           "\n  warning: module 0 gave no point (" + out + "/dark.json): no lit pixels: is the projector on",
+           "\n  warning: module 1 gave no point (" + out + "/dark.json): no lit pixels", "2 of 2 captures in ",
+           "; 1 with a module that gave no point\n"})
+    EXPECT_NE(r.out.find(says), std::string::npos) << says << "\n" << r.out;
+  EXPECT_NE(r.err.find("stereorig reconstruct: [2] " + dark + ": warning: module 0 gave no point: no lit pixels"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("stereorig reconstruct: warning: 1 of 2 captures written have a module that gave no point"),
+            std::string::npos)
+      << r.err;
+  const nlohmann::json summary = nlohmann::json::parse(Bytes(out + "/summary.json"));
+  EXPECT_EQ(summary["reconstructed"], 2);
+  EXPECT_EQ(summary["with_modules_without_points"], 1);
+}
+
 // Bad use is refused before any work, in one line: '-' beside other
 // folders, '-' without --out-dir, --warm-up or --capture-root without '-',
 // an empty --warm-up, a warm-up capture whose images are bad; an input
