@@ -54,6 +54,13 @@ void CheckDatasetFolder(const std::string& dataset, bool need_truth);
 // error line goes through it (RunCommand, ParseArgs, main).
 std::string PrintableText(const std::string& message);
 
+// `word` as a POSIX shell reads it back as one word: as it is when it
+// holds only letters, digits and _@%+=:,./- (most paths), else in single
+// quotes, each ' written '\'' ("a b" -> 'a b', "" -> ''). For a command
+// line printed to be pasted (reconstruct --rectified-out's match command):
+// a path with a space split into two arguments there.
+std::string ShellQuoted(const std::string& word);
+
 // Checks of a number option with a short message ("must be positive, got
 // 0"): CLI11's PositiveNumber and NonNegativeNumber name their range with
 // DBL_MAX's 309 digits.

@@ -17,6 +17,17 @@ TEST(PrintableText, KeepsWellFormedUtf8) {
     EXPECT_EQ(PrintableText(s), s) << s;
 }
 
+// A printed command line pasted into a shell gives each path as one
+// argument: a plain path as it is, one with a space, a quote or another
+// character the shell reads in single quotes (each ' closed, escaped, reopened).
+TEST(ShellQuoted, QuotesOnlyWhatTheShellWouldSplitOrExpand) {
+  EXPECT_EQ(ShellQuoted("/tmp/rect/module0_left.png"), "/tmp/rect/module0_left.png");
+  EXPECT_EQ(ShellQuoted("sp ace/m.png"), "'sp ace/m.png'");
+  EXPECT_EQ(ShellQuoted("it's"), "'it'\\''s'");
+  EXPECT_EQ(ShellQuoted(""), "''");
+  EXPECT_EQ(ShellQuoted("$HOME*"), "'$HOME*'");
+}
+
 TEST(PrintableText, EscapesControlBytes) {
   EXPECT_EQ(PrintableText("a\x1B[2Jb\x7F"), "a\\x1B[2Jb\\x7F");
   EXPECT_EQ(PrintableText("\xC2\x9B"), "\\xC2\\x9B");  // U+009B, CSI: a C1 control

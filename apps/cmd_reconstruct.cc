@@ -195,6 +195,12 @@ int RunReconstruct(int argc, char** argv) {
   }
   written.Commit();
   for (const ModuleReport& m : rec.modules) std::printf("%s\n", ModuleSummary(m).c_str());
+  // On stderr too: a script that keeps only stderr, or a log, must not take
+  // a module that measured nothing (lasers off, a camera not triggered) for
+  // a measurement; the exit code stays 0 (the capture was reconstructed).
+  for (const ModuleReport& m : rec.modules)
+    if (const std::string why = NoPointReason(m); !why.empty())
+      std::fprintf(stderr, "stereorig reconstruct: warning: module %d gave no point: %s\n", m.module, why.c_str());
   std::printf("%zu points (%d from the shape model) in %.1f ms; wrote %s", rec.cloud.size(), rec.filled_points,
               rec.times_ms.at("total_point_cloud"), out_path.c_str());
   if (!mesh_path.empty()) std::printf(", %s (%zu triangles)", mesh_path.c_str(), rec.mesh.triangles.size());

@@ -72,14 +72,15 @@ std::string AdviceFor(PixelStatus status) {
   }
 }
 
-// The line a module with no point gets, "" for one with a point. With lit
-// pixels and none kept, the advice follows the status most of them ended
-// with (AdviceFor). With none lit where the volume projects (lit_pixels
+}  // namespace
+
+// With lit pixels and none kept, the advice follows the status most of them
+// ended with (AdviceFor). With none lit where the volume projects (lit_pixels
 // counts only its ROI), the left image is lit elsewhere (the volume is
 // beside the object) or nowhere (no grid: a dark or flat image, the
 // projector off, or a passive capture): camera_lit_pixels tells which (-1:
 // not counted).
-std::string NoPointHint(const ModuleReport& m) {
+std::string NoPointReason(const ModuleReport& m) {
   if (m.points > 0) return "";
   if (m.lit_pixels > 0) {
     size_t top = size_t(PixelStatus::kNotSearched);
@@ -88,22 +89,22 @@ std::string NoPointHint(const ModuleReport& m) {
     char share[96];
     std::snprintf(share, sizeof share, "%s %.1f%% of the lit pixels: ", PixelStatusName(PixelStatus(top)),
                   100.0 * m.lit_by_status[top] / m.lit_pixels);
-    return "\n  no point: " + std::string(share) + AdviceFor(PixelStatus(top));
+    return share + AdviceFor(PixelStatus(top));
   }
   if (m.camera_lit_pixels > 0)
-    return "\n  no point: " + std::to_string(m.camera_lit_pixels) +
+    return std::to_string(m.camera_lit_pixels) +
            " px of the left camera's image are grid-lit, none where the measurement volume projects: the volume is "
            "beside the object; " +
            kSetTheVolume;
   if (m.camera_lit_pixels == 0)
-    return "\n  no point: no lit pixels: is the projector on, or is this a passive capture? No pixel of the left "
+    return "no lit pixels: is the projector on, or is this a passive capture? No pixel of the left "
            "camera's image is grid-lit (9x9 std above lit_contrast_dn): a dark or flat image (the grid off or out of "
-           "view, too short an exposure); check the capture";
-  return std::string(
-             "\n  no point: no grid-lit pixel where the measurement volume projects: if the object is not in "
-             "the volume, ") +
+           "view, a camera not triggered, too short an exposure); check the capture";
+  return std::string("no grid-lit pixel where the measurement volume projects: if the object is not in the volume, ") +
          kSetTheVolume;
 }
+
+namespace {
 
 // A module whose matches reach an end of the volume's disparity range
 // (ModuleReport::RangeEndsReached): its points may be a copy of the grid
@@ -142,7 +143,9 @@ std::string ModuleSummary(const ModuleReport& m, int max_reasons) {
                                      " points removed, seen through (free_space_test; " +
                                      std::to_string(m.seen_through_surface) + " of them with their surface)"
                                : "";
-  return buf + (losses.empty() ? "none" : losses) + seen + RangeEndWarning(m) + NoPointHint(m);
+  const std::string no_point = NoPointReason(m);
+  return buf + (losses.empty() ? "none" : losses) + seen + RangeEndWarning(m) +
+         (no_point.empty() ? "" : "\n  no point: " + no_point);
 }
 
 }  // namespace stereorig

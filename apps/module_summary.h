@@ -31,6 +31,15 @@ std::string LossLine(std::span<const int> counts_by_status, int total_px, int ma
 // ModuleReport::camera_lit_pixels.
 std::string ModuleSummary(const ModuleReport& m, int max_reasons = 3);
 
+// Why a module gave no point and what to do, "" for one with a point:
+// ModuleSummary's last line without its "no point: " (the status most of its
+// lit pixels ended with and its advice, or, with no lit pixel in the ROI,
+// whether the left image is lit elsewhere or nowhere). A batch's and a
+// stream's warning line and a single capture's stderr give it too: a module
+// that gives no point (lasers off, a camera not triggered, its cables
+// swapped) must not pass as a measurement.
+std::string NoPointReason(const ModuleReport& m);
+
 // The ends of the volume's disparity range a module with points is warned
 // of (ModuleReport::RangeEndsReached): "both ends", "the near end", "the far
 // end", or "" (none reached, or no point). ModuleSummary's warning line and

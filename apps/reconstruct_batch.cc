@@ -22,13 +22,16 @@ namespace fs = std::filesystem;
 
 std::vector<std::string> BatchOutputNames(const std::vector<std::string>& capture_dirs) {
   std::vector<std::vector<std::string>> parts;
-  std::map<fs::path, std::string> seen;  // normal absolute path -> as given
+  std::map<fs::path, std::string> seen;  // the folder (links followed) -> as given
   for (const std::string& dir : capture_dirs) {
     fs::path p = fs::absolute(fs::path(dir)).lexically_normal();
     if (!p.has_filename()) p = p.parent_path();  // "caps/0001/" names 0001
-    if (const auto it = seen.find(p); it != seen.end())
+    // One folder through two paths ("nm/q", "link_to_nm/q") would be
+    // reconstructed twice: compared as the file system finds them.
+    const fs::path folder = ResolvedFolder(dir);
+    if (const auto it = seen.find(folder); it != seen.end())
       throw InputError("--capture", dir + " is given twice (as " + it->second + ")");
-    seen.emplace(p, dir);
+    seen.emplace(folder, dir);
     std::vector<std::string> components;
     for (const fs::path& c : p.relative_path()) components.push_back(c.string());
     if (components.empty()) throw InputError(dir, "a capture folder cannot be the file system's root");
@@ -123,7 +126,7 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
   nlohmann::json summary;
   summary["runtime_build_ms"] = build_ms;
   summary["captures"] = nlohmann::json::array();
-  int failed = 0;
+  int failed = 0, without_points = 0;
   const auto t_all = Clock::now();
   for (size_t i = 0; i < dirs.size(); ++i) {
     const auto t = Clock::now();
@@ -139,7 +142,9 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
     if (i + 1 < dirs.size()) next = std::async(std::launch::async, load, dirs[i + 1]);
     if (error.empty()) {
       try {
-        summary["captures"].push_back(ReconstructCapture(runtime, images, dirs[i], names[i], outputs[i], progress, t));
+        const nlohmann::json entry = ReconstructCapture(runtime, images, dirs[i], names[i], outputs[i], progress, t);
+        without_points += !entry["modules_without_points"].empty();
+        summary["captures"].push_back(entry);
         continue;
       } catch (const InputError& e) {  // the writers' failures (atomic_file.h)
         error = e.what();
@@ -150,8 +155,8 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
     ++failed;
     summary["captures"].push_back(FailedCapture(dirs[i], names[i], outputs[i], progress, error));
   }
-  const int code = FinishRun(&summary, int(dirs.size()), failed, MsSince(t_all), "reading, reconstructing and writing",
-                             request.summary_path);
+  const int code = FinishRun(&summary, int(dirs.size()), failed, without_points, MsSince(t_all),
+                             "reading, reconstructing and writing", request.summary_path);
   // Every capture failed and nothing was written in it (no summary there):
   // a new output folder goes again, as bad input found earlier leaves none.
   if (failed > 0) out_folder.RemoveIfEmpty();

@@ -17,7 +17,8 @@ namespace stereorig {
 // '_', keeping at least the last component. "caps/0001", "caps/0002" give
 // "0001", "0002"; "scenes/cup/active", "scenes/sphere/active" give
 // "cup_active", "sphere_active". Throws InputError if a folder is given
-// twice or two names collide ("a_b" and "a/b").
+// twice (also through a link: folders compared as the file system resolves
+// them, ResolvedFolder) or two names collide ("a_b" and "a/b").
 std::vector<std::string> BatchOutputNames(const std::vector<std::string>& capture_dirs);
 
 struct BatchRequest {
@@ -34,8 +35,9 @@ struct BatchRequest {
 // out_dir/<name>.ply, <name>.json (its report) and <name>.mesh.<format>,
 // each atomically, printing one line per capture. A capture whose images
 // turn out bad (undecodable, wrong size or type) is reported on stderr and
-// gets no output; the others go on. Returns the exit code: 0, or 2 when any
-// capture was bad input. Throws InputError for bad input found before the
+// gets no output; the others go on. A module that gives no point is warned
+// of and counted (reconstruct_capture.h), not failed. Returns the exit code:
+// 0, or 2 when any capture was bad input. Throws InputError for bad input found before the
 // first capture (nothing written then).
 int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchRequest& request);
 

@@ -22,6 +22,14 @@ CaptureOutputs CaptureOutputsNamed(const std::string& out_dir, const std::string
   return {stem + ".ply", stem + ".json", mesh_format.empty() ? "" : stem + ".mesh." + mesh_format};
 }
 
+fs::path ResolvedFolder(const std::string& dir) {
+  std::error_code ec;
+  fs::path p = fs::weakly_canonical(fs::absolute(fs::path(dir)), ec);
+  if (ec) p = fs::absolute(fs::path(dir)).lexically_normal();
+  if (!p.has_filename()) p = p.parent_path();
+  return p;
+}
+
 std::vector<cv::Mat> LoadCaptureOrInputError(const std::string& dir, const Rig& rig) {
   try {
     return LoadCapture(dir, rig);
@@ -31,6 +39,30 @@ std::vector<cv::Mat> LoadCaptureOrInputError(const std::string& dir, const Rig& 
     throw InputError(dir, std::string("cannot read the capture: ") + e.what());
   }
 }
+
+namespace {
+
+// A module that gave no point (its lasers off, a camera not triggered, its
+// cables swapped) is a capture that measured nothing there, not a
+// measurement: a warning line after the capture's own on stdout, where the
+// line's controller reads each capture's answer, and on stderr, where a
+// log keeps the problems. Returns the modules', for the run's summary.
+nlohmann::json WarnOfModulesWithoutPoints(const Reconstruction& rec, const std::string& dir,
+                                          const CaptureOutputs& outputs, const std::string& progress) {
+  nlohmann::json modules = nlohmann::json::array();
+  for (const ModuleReport& m : rec.modules) {
+    const std::string why = NoPointReason(m);
+    if (why.empty()) continue;
+    modules.push_back(m.module);
+    std::printf("  warning: module %d gave no point (%s): %s\n", m.module, PrintableText(outputs.report).c_str(),
+                why.c_str());
+    std::fprintf(stderr, "stereorig reconstruct: %s %s: warning: module %d gave no point: %s\n", progress.c_str(),
+                 PrintableText(dir).c_str(), m.module, why.c_str());
+  }
+  return modules;
+}
+
+}  // namespace
 
 nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::Mat>& images, const std::string& dir,
                                   const std::string& name, const CaptureOutputs& outputs, const std::string& progress,
@@ -76,6 +108,7 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
           "range_end_reached): its points may lie where nothing is; check the volume\n",
           m.module, which.c_str(), outputs.report.c_str());
   }
+  entry["modules_without_points"] = WarnOfModulesWithoutPoints(rec, dir, outputs, progress);
   FlushStdout();
   return entry;
 }
@@ -110,16 +143,24 @@ nlohmann::json FailedCapture(const std::string& dir, const std::string& name, co
   return entry;
 }
 
-int FinishRun(nlohmann::json* summary, int total, int failed, double wall_ms, const std::string& timed,
-              const std::string& summary_path) {
+int FinishRun(nlohmann::json* summary, int total, int failed, int without_points, double wall_ms,
+              const std::string& timed, const std::string& summary_path) {
   const int done = total - failed;
   (*summary)["reconstructed"] = done;
   (*summary)["failed"] = failed;
+  (*summary)["with_modules_without_points"] = without_points;
   (*summary)["wall_ms"] = wall_ms;
   (*summary)["objects_per_s"] = done > 0 ? 1000.0 * done / wall_ms : 0.0;
-  std::printf("%d of %d captures in %.2f s: %.1f objects/s (%s)\n", done, total, wall_ms / 1000,
+  std::printf("%d of %d captures in %.2f s: %.1f objects/s (%s)", done, total, wall_ms / 1000,
               (*summary)["objects_per_s"].get<double>(), timed.c_str());
+  if (without_points > 0) std::printf("; %d with a module that gave no point", without_points);
+  std::printf("\n");
   FlushStdout();
+  if (without_points > 0)
+    std::fprintf(stderr,
+                 "stereorig reconstruct: warning: %d of %d captures written have a module that gave no point (each "
+                 "named above, with why)\n",
+                 without_points, done);
   // Stdout lost on the last lines (a terminal's hang-up): the summary says
   // so, as for a capture's line, and main exits 2 (cli_util.h).
   const std::string lost = StdoutWriteError();

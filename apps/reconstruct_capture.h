@@ -5,6 +5,7 @@
 #pragma once
 
 #include <chrono>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <string>
@@ -24,6 +25,14 @@ struct CaptureOutputs {
 // <name>.json and, unless mesh_format is "", <name>.mesh.<mesh_format>.
 CaptureOutputs CaptureOutputsNamed(const std::string& out_dir, const std::string& name, const std::string& mesh_format);
 
+// The folder `dir` as the file system finds it: absolute, links followed
+// (std::filesystem::weakly_canonical: a part that does not exist is kept as
+// written), no trailing separator; a path it cannot resolve (a link loop)
+// absolute and normal, as written, for the capture's own check to name. A
+// batch's "given twice" and a stream's --capture-root compare folders so, not
+// their paths' text ("nm/q" and "link_to_nm/q" are one folder).
+std::filesystem::path ResolvedFolder(const std::string& dir);
+
 // LoadCapture (runtime.h), any failure as bad input naming the folder: a
 // folder removed or made unreadable after its files were checked throws a
 // std::filesystem error, here an InputError.
@@ -35,9 +44,12 @@ std::vector<cv::Mat> LoadCaptureOrInputError(const std::string& dir, const Rig& 
 // m1 y%), T ms -> <cloud>" (T: the wall time since `started`, when the
 // capture's turn began: waiting for its images, reconstructing, writing),
 // then a warning line per module whose matches reach an end of the volume's
-// disparity range (module_summary.h RangeEndsWarnedOf). Returns the capture's
-// entry of the run's summary (capture, name, ok, cloud, mesh, report, points,
-// point_cloud_ms, wall_ms). Throws InputError if an output cannot be written
+// disparity range (module_summary.h RangeEndsWarnedOf), and one per module
+// that gave no point ("  warning: module M gave no point (<report>): <why>",
+// module_summary.h NoPointReason; also on stderr, "stereorig reconstruct:
+// <progress> <dir>: warning: ..."). Returns the capture's entry of the run's
+// summary (capture, name, ok, cloud, mesh, report, points, point_cloud_ms,
+// wall_ms, modules_without_points). Throws InputError if an output cannot be written
 // (the writers', atomic_file.h); the caller then calls FailedCapture.
 nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::Mat>& images, const std::string& dir,
                                   const std::string& name, const CaptureOutputs& outputs, const std::string& progress,
@@ -53,12 +65,16 @@ nlohmann::json FailedCapture(const std::string& dir, const std::string& name, co
                              const std::string& progress, const std::string& why);
 
 // The run's end: "<done> of <total> captures in S s: R objects/s (<timed>)"
-// on stdout (`timed`: what the wall time holds), the summary's totals
-// (reconstructed, failed, wall_ms, objects_per_s) set and the summary
-// written atomically to summary_path (unless ""); with failures, the stderr
-// line that counts them. Returns the exit code: kExitOk, or kExitBadInput
-// when any capture failed.
-int FinishRun(nlohmann::json* summary, int total, int failed, double wall_ms, const std::string& timed,
-              const std::string& summary_path);
+// on stdout (`timed`: what the wall time holds), followed by "; K with a
+// module that gave no point" when `without_points` (of the captures written)
+// is not 0; the summary's totals (reconstructed, failed,
+// with_modules_without_points, wall_ms, objects_per_s) set and the summary
+// written atomically to summary_path (unless ""); with failures, or captures
+// with a module that gave no point, a stderr line that counts them. Returns
+// the exit code: kExitOk, or kExitBadInput when any capture failed. A module
+// with no point does not change it: the capture was measured and written, and
+// 1 is a check's failure (docs/formats.md); the count is the controller's.
+int FinishRun(nlohmann::json* summary, int total, int failed, int without_points, double wall_ms,
+              const std::string& timed, const std::string& summary_path);
 
 }  // namespace stereorig

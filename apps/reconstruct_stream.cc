@@ -22,11 +22,17 @@ namespace fs = std::filesystem;
 namespace {
 
 // Absolute and normal, without a trailing separator ("caps/0001/" is
-// "caps/0001"); links not followed, as a batch compares its folders.
+// "caps/0001"); links not followed.
 fs::path FolderPath(const std::string& dir) {
   fs::path p = fs::absolute(fs::path(dir)).lexically_normal();
   if (!p.has_filename()) p = p.parent_path();
   return p;
+}
+
+// `p` below `root` ("" if it is not): a path holding no ".." and not ".".
+fs::path PathBelow(const fs::path& p, const fs::path& root) {
+  const fs::path below = p.lexically_relative(root);
+  return below.empty() || below == "." || *below.begin() == ".." ? fs::path() : below;
 }
 
 }  // namespace
@@ -38,8 +44,12 @@ std::string StreamOutputName(const std::string& dir, const std::string& root) {
     if (name.empty()) throw InputError(dir, "a capture folder cannot be the file system's root");
     return name;
   }
-  const fs::path below = p.lexically_relative(FolderPath(root));
-  if (below.empty() || below == "." || *below.begin() == "..")
+  // As written first (a capture folder that is itself a link below the root
+  // stays below it); else as the file system resolves both, so that a root
+  // given through a link (or a folder sent through one) still holds it.
+  fs::path below = PathBelow(p, FolderPath(root));
+  if (below.empty()) below = PathBelow(ResolvedFolder(dir), ResolvedFolder(root));
+  if (below.empty())
     throw InputError(dir, "is not a folder below --capture-root " + root + ", which names the captures");
   std::string name;
   for (const fs::path& c : below) {
@@ -125,8 +135,14 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
     // (the heap's pages faulted in, the worker threads started) before the
     // line's first object comes.
     const auto t_warm = Clock::now();
-    CheckCaptureFiles(request.warm_up_dir, rig);
-    runtime.Process(LoadCaptureOrInputError(request.warm_up_dir, rig), !request.mesh_format.empty());
+    try {
+      CheckCaptureFiles(request.warm_up_dir, rig);
+      runtime.Process(LoadCaptureOrInputError(request.warm_up_dir, rig), !request.mesh_format.empty());
+    } catch (const InputError& e) {  // named by its flag: "nope: capture folder not found" did not say which
+      throw InputError("--warm-up", e.what());
+    } catch (const fs::filesystem_error& e) {  // a path the file system cannot look up (a link loop)
+      throw InputError("--warm-up", request.warm_up_dir + ": " + e.code().message());
+    }
     warm_up_ms = MsSince(t_warm);
   }
   out_folder.Create();
@@ -142,7 +158,7 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
   summary["runtime_build_ms"] = build_ms;
   if (!request.warm_up_dir.empty()) summary["warm_up_ms"] = warm_up_ms;
   summary["failed_captures"] = nlohmann::json::array();  // the first kMaxFailuresListed
-  int total = 0, failed = 0;
+  int total = 0, failed = 0, without_points = 0;
   std::string output_error;  // why stdout lost a capture's line: the stream stops
   const auto t_all = Clock::now();
   std::string line;
@@ -174,7 +190,8 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
       // only what this capture may have written.
       outputs = planned;
       const std::vector<cv::Mat> images = LoadCaptureOrInputError(dir, rig);
-      ReconstructCapture(runtime, images, dir, name, outputs, progress, t);
+      without_points +=
+          !ReconstructCapture(runtime, images, dir, name, outputs, progress, t)["modules_without_points"].empty();
       if (StdoutLost(&output_error)) break;
       continue;
     } catch (const InputError& e) {  // the capture's files, images or outputs
@@ -215,7 +232,7 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
     if (stop != 0) return kExitOk;  // stopped before the line's first object: nothing to sum up
     throw InputError("--capture -", "standard input held no capture folder (one folder's path per line)");
   }
-  const int code = FinishRun(&summary, total, failed, MsSince(t_all),
+  const int code = FinishRun(&summary, total, failed, without_points, MsSince(t_all),
                              "the stream's wall time: waiting for the input, reading, reconstructing and writing",
                              request.summary_path);
   if (failed > 0) out_folder.RemoveIfEmpty();  // as a batch: nothing written, no new folder

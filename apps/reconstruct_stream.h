@@ -26,8 +26,10 @@ namespace stereorig {
 // joined with '_' (root "line": "line/2026-12-06/0001" ->
 // "2026-12-06_0001"), as a batch names its folders after the part all share:
 // folders numbered afresh each day keep their names apart. Paths compared
-// absolute and normal, links not followed. Throws InputError(dir) for the
-// file system's root, or a folder that is not below `root`.
+// absolute and normal as written, else (a root or a folder given through a
+// link) as the file system resolves them (ResolvedFolder). Throws
+// InputError(dir) for the file system's root, or a folder that is below
+// `root` neither way.
 std::string StreamOutputName(const std::string& dir, const std::string& root = "");
 
 struct StreamRequest {

@@ -395,9 +395,11 @@ TEST_F(ReconstructCli, MatchesReachingAnEndOfTheVolumesRangeAreWarnedOf) {
 TEST_F(ReconstructCli, RectifiedOutWritesEachModulesPairAndTheMatchCommandForIt) {
   ASSERT_EQ(RunCli(Args(dir_ + "/capture")), 0);
   const std::string plain_cloud = ReadFileBytes(dir_ + "/out.ply");
-  const std::string rect = dir_ + "/rect/new";
+  // A space in the folder: the printed command quotes the paths (it split
+  // them in two, and the command failed as pasted).
+  const std::string rect = dir_ + "/rect/new pairs";
   std::filesystem::remove_all(dir_ + "/rect");
-  const testing::Result r = testing::RunCli(Args(dir_ + "/capture", "--rectified-out " + rect));
+  const testing::Result r = testing::RunCli(Args(dir_ + "/capture", "--rectified-out '" + rect + "'"));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(ReadFileBytes(dir_ + "/out.ply"), plain_cloud);
   for (int m = 0; m < 2; ++m) {
@@ -413,6 +415,7 @@ TEST_F(ReconstructCli, RectifiedOutWritesEachModulesPairAndTheMatchCommandForIt)
     const std::string args = r.out.substr(command + 10, r.out.find('\n', command) - command - 10);
     EXPECT_NE(args.find(" --min-disparity "), std::string::npos) << args;
     EXPECT_NE(args.find(" --roi "), std::string::npos) << args;
+    EXPECT_NE(args.find("--left '" + left + "' --right '"), std::string::npos) << args;
     const testing::Result match = testing::RunCli(args);
     ASSERT_EQ(match.code, 0) << args << ": " << match.err;
     EXPECT_EQ(match.err, "") << args;
@@ -420,7 +423,7 @@ TEST_F(ReconstructCli, RectifiedOutWritesEachModulesPairAndTheMatchCommandForIt)
   }
   // One capture only: a batch has many pairs per module.
   ExpectRefusedInOneLine("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture --out-dir " + dir_ +
-                             "/rect_batch --rectified-out " + rect,
+                             "/rect_batch --rectified-out '" + rect + "'",
                          "--out-dir excludes --rectified-out");
 }
 
@@ -1298,6 +1301,77 @@ TEST_F(ReconstructCli, ABatchWithAMissingCameraOrARepeatedFolderWritesNothing) {
   EXPECT_EQ(std::string(std::istreambuf_iterator<char>(f), {}), "not a folder\n");
   EXPECT_FALSE(std::filesystem::exists(out));
   ExpectNoOutput();
+}
+
+// A capture in which a module gives no point (its lasers off, a camera not
+// triggered, its cables swapped) is no measurement there: a batch, as a
+// line runs it, warns of each such module on the capture's own lines, on
+// stdout and on stderr, and its summary and last line count those captures;
+// the exit code stays 0 (the captures were reconstructed and written:
+// docs/formats.md). Before, an all-black capture gave "0 points (fill m0
+// 0.0%, m1 0.0%)", "2 of 2 captures" and not a word; a single capture's
+// hint was on stdout only.
+TEST_F(ReconstructCli, ABatchWarnsOfEachModuleThatGaveNoPointAndCountsThem) {
+  const std::string dark = BrokenCapture("batch_dark"), half = BrokenCapture("batch_half_dark");
+  for (int k = 0; k < 4; ++k) {
+    const std::string image = "/cam" + std::to_string(k) + ".png";
+    const cv::Mat black = cv::Mat::zeros(cv::imread(dark + image).size(), CV_8UC1);
+    ASSERT_TRUE(cv::imwrite(dark + image, black));
+    if (k >= 2) {
+      ASSERT_TRUE(cv::imwrite(half + image, black));  // module 1's cameras
+    }
+  }
+  const std::string out = dir_ + "/batch_dark_out";
+  std::filesystem::remove_all(out);
+  const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture " +
+                                            dark + " " + half + " --out-dir " + out + " --report " + out + "/run.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string no_lit = "gave no point (" + out + "/batch_dark.json): no lit pixels: is the projector on";
+  for (const std::string& says : std::vector<std::string>{
+           "[2/3] " + dark + ": 0 points (fill m0 0.0%, m1 0.0%), ", "\n  warning: module 0 " + no_lit,
+           "\n  warning: module 1 " + no_lit,
+           "\n  warning: module 1 gave no point (" + out + "/batch_half_dark.json): ", "3 of 3 captures in ",
+           "; 2 with a module that gave no point\n"})
+    EXPECT_NE(r.out.find(says), std::string::npos) << says << "\n" << r.out;
+  EXPECT_EQ(r.out.find("module 0 gave no point (" + out + "/batch_half_dark.json)"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("(" + out + "/capture.json): "), std::string::npos) << r.out;  // the lit capture: no warning
+  for (const std::string& says :
+       std::vector<std::string>{"stereorig reconstruct: [2/3] " + dark + ": warning: module 0 gave no point: no lit",
+                                "stereorig reconstruct: [3/3] " + half + ": warning: module 1 gave no point: ",
+                                "stereorig reconstruct: warning: 2 of 3 captures written have a module that gave no "
+                                "point"})
+    EXPECT_NE(r.err.find(says), std::string::npos) << says << "\n" << r.err;
+  std::ifstream f(out + "/run.json");
+  const nlohmann::json summary = nlohmann::json::parse(f);
+  EXPECT_EQ(summary["reconstructed"], 3);
+  EXPECT_EQ(summary["with_modules_without_points"], 2);
+  EXPECT_EQ(summary["captures"][0]["modules_without_points"], nlohmann::json::array());
+  EXPECT_EQ(summary["captures"][1]["modules_without_points"], nlohmann::json({0, 1}));
+  EXPECT_EQ(summary["captures"][2]["modules_without_points"], nlohmann::json({1}));
+  // One capture: its hint on stderr too, exit 0.
+  const testing::Result single = testing::RunCli(Args(dark));
+  EXPECT_EQ(single.code, 0) << single.err;
+  EXPECT_NE(single.err.find("stereorig reconstruct: warning: module 1 gave no point: no lit pixels: is the projector "
+                            "on"),
+            std::string::npos)
+      << single.err;
+}
+
+// One folder given through two paths (a link to its parent) is given twice:
+// refused before anything is written, as the same path twice is. Before,
+// the paths' text was compared, and the folder reconstructed twice.
+TEST_F(ReconstructCli, ABatchRefusesOneFolderGivenThroughALinkToo) {
+  const std::string link = dir_ + "/link_to_dir", out = dir_ + "/batch_link_out";
+  std::filesystem::remove(link);
+  std::filesystem::create_directory_symlink(dir_, link);
+  std::filesystem::remove_all(out);
+  const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture " + dir_ + "/capture " +
+                                            link + "/capture --out-dir " + out);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("--capture: " + link + "/capture is given twice (as " + dir_ + "/capture)"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 }  // namespace

@@ -460,11 +460,65 @@ TEST_F(ReconstructStreamCli, ACaptureRootNamesCapturesByTheirPathBelowIt) {
   EXPECT_NE(r.err.find("[3] " + dir_ + "/line/0002: is not a folder below --capture-root " + root), std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(out + "/0002.ply"));
+  // A root given through a link holds the folders below the one it names,
+  // and a folder sent through a link lies below the root it resolves into
+  // (the paths' text was compared: "is not a folder below --capture-root").
+  const std::string link = dir_ + "/days_link", linked_out = dir_ + "/days_link_out";
+  fs::remove(link);
+  fs::create_directory_symlink(root, link);
+  fs::remove_all(linked_out);
+  WriteFileAtomically(list, root + "/2026-12-06/0001\n" + link + "/2026-12-07/0001\n");
+  const testing::Result linked = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture - --out-dir " +
+                                                 linked_out + " --capture-root " + link + " < " + list);
+  EXPECT_EQ(linked.code, 0) << linked.err;
+  EXPECT_EQ(Bytes(linked_out + "/2026-12-06_0001.ply"), Bytes(dir_ + "/single.ply")) << linked.out;
+  EXPECT_EQ(Bytes(linked_out + "/2026-12-07_0001.ply"), Bytes(dir_ + "/single.ply")) << linked.out;
+  WriteFileAtomically(list, link + "/2026-12-06/0001\n");
+  fs::remove_all(linked_out);
+  const testing::Result through = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture - --out-dir " +
+                                                  linked_out + " --capture-root " + root + " < " + list);
+  EXPECT_EQ(through.code, 0) << through.err;
+  EXPECT_TRUE(fs::exists(linked_out + "/2026-12-06_0001.ply")) << through.out;
   const testing::Result missing = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture - --out-dir " +
                                                   out + " --capture-root " + dir_ + "/no_such_root < " + list);
   EXPECT_EQ(missing.code, 2);
   EXPECT_EQ(testing::Lines(missing.err), 1) << missing.err;
   EXPECT_NE(missing.err.find("no_such_root: is not a folder"), std::string::npos) << missing.err;
+}
+
+// A module that gives no point (here every camera black: the lasers off, the
+// cameras not triggered) is warned of on the capture's own lines, stdout
+// and stderr, and the summary and the last line count the captures with
+// one; the exit code stays 0, as the capture was reconstructed and written.
+// Before, the stream answered "0 points (fill m0 0.0%, m1 0.0%)" and no more.
+TEST_F(ReconstructStreamCli, AModuleThatGaveNoPointIsWarnedOfAndCounted) {
+  const std::string dark = dir_ + "/dark", out = dir_ + "/dark_out", list = dir_ + "/dark.txt";
+  fs::remove_all(dark);
+  fs::copy(dir_ + "/line/0001", dark);
+  for (int k = 0; k < 4; ++k) {
+    const std::string image = dark + "/cam" + std::to_string(k) + ".png";
+    ASSERT_TRUE(cv::imwrite(image, cv::Mat::zeros(cv::imread(image).size(), CV_8UC1)));
+  }
+  fs::remove_all(out);
+  WriteFileAtomically(list, dir_ + "/line/0001\n" + dark + "\n");
+  const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --capture - --out-dir " + out +
+                                            " --report " + out + "/summary.json < " + list);
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const std::string& says : std::vector<std::string>{
+           "[2] " + dark + ": 0 points (fill m0 0.0%, m1 0.0%), ",
+           "\n  warning: module 0 gave no point (" + out + "/dark.json): no lit pixels: is the projector on",
+           "\n  warning: module 1 gave no point (" + out + "/dark.json): no lit pixels", "2 of 2 captures in ",
+           "; 1 with a module that gave no point\n"})
+    EXPECT_NE(r.out.find(says), std::string::npos) << says << "\n" << r.out;
+  EXPECT_NE(r.err.find("stereorig reconstruct: [2] " + dark + ": warning: module 0 gave no point: no lit pixels"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("stereorig reconstruct: warning: 1 of 2 captures written have a module that gave no point"),
+            std::string::npos)
+      << r.err;
+  const nlohmann::json summary = nlohmann::json::parse(Bytes(out + "/summary.json"));
+  EXPECT_EQ(summary["reconstructed"], 2);
+  EXPECT_EQ(summary["with_modules_without_points"], 1);
 }
 
 // Bad use is refused before any work, in one line: '-' beside other
@@ -494,6 +548,13 @@ TEST_F(ReconstructStreamCli, BadUseExitsTwoInOneLine) {
   EXPECT_EQ(testing::Lines(bad_warm.err), 1) << bad_warm.err;
   EXPECT_NE(bad_warm.err.find(dir_ + "/line/0003/cam1.png"), std::string::npos) << bad_warm.err;
   EXPECT_FALSE(fs::exists(dir_ + "/o3")) << "a bad warm-up capture left the output folder behind";
+  // A warm-up folder that is not there is named by its flag (the line said
+  // only "nope: capture folder not found").
+  const testing::Result no_warm = testing::RunCli("reconstruct" + rig + " --capture - --out-dir " + dir_ +
+                                                  "/o6 --warm-up " + dir_ + "/nope < /dev/null");
+  EXPECT_EQ(no_warm.code, 2);
+  EXPECT_EQ(no_warm.err, "stereorig reconstruct: --warm-up: " + dir_ + "/nope: capture folder not found\n");
+  EXPECT_FALSE(fs::exists(dir_ + "/o6"));
   const std::string fresh = dir_ + "/empty_run/out";
   fs::remove_all(dir_ + "/empty_run");
   const testing::Result empty =
