@@ -90,6 +90,7 @@ TEST(HoleFill, TheMeshPlyKeepsEachVertexsModuleAndHoleFillingsAre255) {
   std::remove(path.c_str());
   ASSERT_EQ(read.points.size(), out.size());
   ASSERT_EQ(read.module.size(), out.size());
+  EXPECT_EQ(read.faces, static_cast<long long>(mesh.triangles.size()));
   int filled = 0;
   for (size_t i = 0; i < out.size(); ++i) {
     EXPECT_EQ(read.module[i], int(out.module[i])) << i;  // the cloud's module, vertex for point
