@@ -215,9 +215,11 @@ int RunVerify(int argc, char** argv) {
   const Artifact artifact = ReadArtifactFile(artifact_path);
   std::vector<ArtifactEvaluation> positions;
   std::vector<int> filled_skipped;
+  std::vector<std::string> read_notes;  // MeasuredPoints::note: a mesh without module
   for (const std::string& cloud : clouds) {
     const MeasuredPoints measured = ReadMeasuredPlyPoints(cloud);  // unreadable: bad input, nothing printed
     filled_skipped.push_back(measured.filled_skipped);
+    read_notes.push_back(measured.note);
     try {
       positions.push_back(EvaluateArtifact(artifact, measured.points, options, cloud));
     } catch (const NotTheArtifactError& refused) {
@@ -264,6 +266,9 @@ int RunVerify(int argc, char** argv) {
                 repeated[i].same_file ? "the same cloud as" : "a byte-identical copy of the cloud of",
                 repeated[i].earlier + 1, PrintableText(clouds[i]).c_str());
   }
+  for (size_t i = 0; i < clouds.size(); ++i)
+    if (!read_notes[i].empty())
+      std::printf("note: position %zu (%s) is %s\n", i + 1, PrintableText(clouds[i]).c_str(), read_notes[i].c_str());
   // The point counts: cloud, then where each of its points went, each in
   // exactly one column (cloud = filled + off + edge + excluded + used).
   std::printf("%-8s %-6s %10s %8s %7s %4s %8s %7s %8s %7s %8s %8s %10s\n", "position", "figure", "value_mm", "u_mm",

@@ -88,9 +88,10 @@ bool FitModel(const std::vector<Eigen::Vector3d>& pts, const std::vector<Eigen::
         *foot = c + r / rho * v;
         return rho - r;
       };
-      std::snprintf(buf, sizeof buf,
-                    "sphere centre (%.3f, %.3f, %.3f) mm, radius %.3f mm, fit rms %.3f mm, %zu of %zu fitted points inliers", c.x(), c.y(),
-                    c.z(), r, fit.rms_mm, fit.inliers.size(), pts.size());
+      std::snprintf(
+          buf, sizeof buf,
+          "sphere centre (%.3f, %.3f, %.3f) mm, radius %.3f mm, fit rms %.3f mm, %zu of %zu fitted points inliers",
+          c.x(), c.y(), c.z(), r, fit.rms_mm, fit.inliers.size(), pts.size());
       break;
     }
     case ShapeModel::kCylinder: {
@@ -288,17 +289,19 @@ HoleFillResult FillHolesFromModel(const PointCloud& measured, const RuntimeOptio
     });
   }
   std::vector<int> vertex(samples, -1);
-  const int first_vertex = int(mesh->vertices_mm.size());
+  const int first_vertex = int(mesh->vertices.size());
   int added = 0;
   for (size_t k = 0; k < samples; ++k) {
     if (!keep[k]) continue;
     vertex[k] = first_vertex + added;
-    cloud->xyz_mm.push_back(point[k].cast<float>());
-    cloud->normal.push_back(normal[k].cast<float>());
-    cloud->intensity.push_back(0);
-    cloud->module.push_back(kFilledModule);
-    cloud->confidence.push_back(0.0f);
-    mesh->vertices_mm.push_back(point[k].cast<float>());
+    // The same point in the cloud and as a mesh vertex: marked filled in both.
+    for (PointCloud* out : {cloud, &mesh->vertices}) {
+      out->xyz_mm.push_back(point[k].cast<float>());
+      out->normal.push_back(normal[k].cast<float>());
+      out->intensity.push_back(0);
+      out->module.push_back(kFilledModule);
+      out->confidence.push_back(0.0f);
+    }
     ++added;
   }
   for (int i = 0; i < rows; ++i)

@@ -4,34 +4,46 @@
 #include "reconstruct/hole_fill.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <functional>
 #include <random>
+#include <string>
 
+#include "reconstruct/metrology/ply_points.h"
 #include "reconstruct/metrology/synthetic_shapes.h"
+#include "reconstruct/ply_io.h"
 
 namespace stereorig {
 namespace {
 
-TEST(HoleFill, SphereClosesTheUnseenHalfOnTheTrueSurface) {
-  const Eigen::Vector3d c(10, -5, 200);
-  const double r = 19.05;
-  std::mt19937 rng(5);
-  std::normal_distribution<double> noise(0, 0.05);  // 0.05 mm radial noise, like a good module
+// `points` random points of the half of a sphere (centre c, radius r) facing a
+// camera at z = 0, 0.05 mm radial noise (like a good module); module 0 on
+// the side x < 0, 1 on the other.
+PointCloud SeenHalfOfSphere(const Eigen::Vector3d& c, double r, size_t points, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0, 0.05);
   std::uniform_real_distribution<double> u(-1, 1);
   PointCloud cloud;
-  while (cloud.size() < 20000) {
+  while (cloud.size() < points) {
     Eigen::Vector3d v(u(rng), u(rng), u(rng));
     if (v.norm() > 1 || v.norm() < 0.1) continue;
     v.normalize();
-    if (v.z() > 0) continue;  // only the half facing a camera at z = 0
+    if (v.z() > 0) continue;
     cloud.xyz_mm.push_back((c + (r + noise(rng)) * v).cast<float>());
     cloud.normal.push_back(v.cast<float>());
     cloud.intensity.push_back(100);
-    cloud.module.push_back(0);
+    cloud.module.push_back(v.x() < 0 ? 0 : 1);
     cloud.confidence.push_back(1);
   }
+  return cloud;
+}
+
+TEST(HoleFill, SphereClosesTheUnseenHalfOnTheTrueSurface) {
+  const Eigen::Vector3d c(10, -5, 200);
+  const double r = 19.05;
+  const PointCloud cloud = SeenHalfOfSphere(c, r, 20000, 5);
   RuntimeOptions o;
   o.shape_model = ShapeModel::kSphere;
   PointCloud out = cloud;
@@ -54,6 +66,43 @@ TEST(HoleFill, SphereClosesTheUnseenHalfOnTheTrueSurface) {
   EXPECT_LT(worst, 0.02);
   EXPECT_GT(behind, 0.9 * fill.added_points);  // it fills the unseen side
   EXPECT_GT(mesh.triangles.size(), size_t(fill.added_points));
+}
+
+// The mesh PLY keeps each vertex's module, hole filling's as 255, so
+// `stereorig verify` skips the same filled points in the mesh as in the
+// cloud: the mesh held x, y, z only, and verify took every vertex of it as
+// measured (the shape model's points entered the fit).
+TEST(HoleFill, TheMeshPlyKeepsEachVertexsModuleAndHoleFillingsAre255) {
+  const PointCloud cloud = SeenHalfOfSphere(Eigen::Vector3d(10, -5, 200), 19.05, 2000, 7);
+  RuntimeOptions o;
+  o.shape_model = ShapeModel::kSphere;
+  PointCloud out = cloud;
+  Mesh mesh;
+  mesh.vertices = cloud;  // as the runtime's organised mesh: a vertex per point
+  mesh.triangles.emplace_back(0, 1, 2);
+  const HoleFillResult fill = FillHolesFromModel(cloud, o, &out, &mesh);
+  ASSERT_TRUE(fill.ok) << fill.message;
+  ASSERT_GT(fill.added_points, 1000);
+
+  const std::string path = ::testing::TempDir() + "/hole_fill_mesh_" + std::to_string(getpid()) + ".ply";
+  WriteMesh(mesh, path);
+  const PlyVertices read = ReadPlyVertices(path);  // the metrology reader, as verify reads it
+  std::remove(path.c_str());
+  ASSERT_EQ(read.points.size(), out.size());
+  ASSERT_EQ(read.module.size(), out.size());
+  EXPECT_EQ(read.faces, static_cast<long long>(mesh.triangles.size()));
+  int filled = 0;
+  for (size_t i = 0; i < out.size(); ++i) {
+    EXPECT_EQ(read.module[i], int(out.module[i])) << i;  // the cloud's module, vertex for point
+    EXPECT_EQ(read.module[i] == kPlyFilledModule, i >= cloud.size()) << i;
+    filled += read.module[i] == kPlyFilledModule;
+  }
+  EXPECT_EQ(filled, fill.added_points);
+  // The same records as the cloud PLY's vertices: every field, not only the module.
+  const std::string cloud_bytes = EncodeCloudPly(out), mesh_bytes = EncodeMesh(mesh, path);
+  const std::string cloud_body = cloud_bytes.substr(cloud_bytes.find("end_header\n") + 11);
+  const std::string mesh_body = mesh_bytes.substr(mesh_bytes.find("end_header\n") + 11);
+  EXPECT_EQ(mesh_body.substr(0, cloud_body.size()), cloud_body);
 }
 
 PointCloud ToCloud(const testing::NoisyCloud& noisy) {
@@ -87,7 +136,7 @@ Fill FillWith(ShapeModel model, const PointCloud& measured, double object_size_m
     f.points.push_back(out.xyz_mm[i].cast<double>());
   }
   EXPECT_EQ(f.result.added_points, static_cast<int>(f.points.size()));
-  EXPECT_EQ(f.mesh.vertices_mm.size(), f.points.size());
+  EXPECT_EQ(f.mesh.vertices.size(), f.points.size());
   return f;
 }
 
@@ -96,8 +145,8 @@ Fill FillWith(ShapeModel model, const PointCloud& measured, double object_size_m
 int InwardTriangles(const Mesh& mesh, const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& inside) {
   int inward = 0;
   for (const auto& t : mesh.triangles) {
-    const Eigen::Vector3d a = mesh.vertices_mm[t[0]].cast<double>(), b = mesh.vertices_mm[t[1]].cast<double>(),
-                          c = mesh.vertices_mm[t[2]].cast<double>();
+    const Eigen::Vector3d a = mesh.vertices.xyz_mm[t[0]].cast<double>(), b = mesh.vertices.xyz_mm[t[1]].cast<double>(),
+                          c = mesh.vertices.xyz_mm[t[2]].cast<double>();
     const Eigen::Vector3d centroid = (a + b + c) / 3;
     inward += (b - a).cross(c - a).dot(centroid - inside(centroid)) < 0;
   }

@@ -26,16 +26,17 @@ void Put(std::string& out, T v) {
   out.append(b, sizeof(T));
 }
 
-}  // namespace
+// The vertex element's header lines and records, the same in the cloud and
+// the mesh PLY: a mesh's vertices keep their module (255: hole filling's),
+// so `stereorig verify` skips the filled ones in either file.
+std::string VertexHeader(const PointCloud& c) {
+  return "element vertex " + std::to_string(c.size()) +
+         "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar intensity\n"
+         "property float nx\nproperty float ny\nproperty float nz\nproperty uchar module\n"
+         "property float confidence\n";
+}
 
-std::string EncodeCloudPly(const PointCloud& c) {
-  std::string out =
-      "ply\nformat binary_little_endian 1.0\ncomment stereorig point cloud, reference frame (module 0), mm\n"
-      "element vertex " +
-      std::to_string(c.size()) +
-      "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar intensity\n"
-      "property float nx\nproperty float ny\nproperty float nz\nproperty uchar module\n"
-      "property float confidence\nend_header\n";
+void PutVertices(const PointCloud& c, std::string& out) {
   out.reserve(out.size() + c.size() * 34);
   for (size_t i = 0; i < c.size(); ++i) {
     for (int k = 0; k < 3; ++k) Put(out, c.xyz_mm[i][k]);
@@ -44,6 +45,15 @@ std::string EncodeCloudPly(const PointCloud& c) {
     Put(out, c.module[i]);
     Put(out, c.confidence[i]);
   }
+}
+
+}  // namespace
+
+std::string EncodeCloudPly(const PointCloud& c) {
+  std::string out =
+      "ply\nformat binary_little_endian 1.0\ncomment stereorig point cloud, reference frame (module 0), mm\n" +
+      VertexHeader(c) + "end_header\n";
+  PutVertices(c, out);
   return out;
 }
 
@@ -69,8 +79,9 @@ std::string EncodeMesh(const Mesh& m, const std::string& path) {
     out.assign(80, ' ');
     out.replace(0, 40, "stereorig mesh, reference frame, mm     ");
     Put(out, uint32_t(m.triangles.size()));
+    const std::vector<Eigen::Vector3f>& v_mm = m.vertices.xyz_mm;
     for (const Eigen::Vector3i& t : m.triangles) {
-      const Eigen::Vector3f a = m.vertices_mm[t[0]], b = m.vertices_mm[t[1]], c = m.vertices_mm[t[2]];
+      const Eigen::Vector3f a = v_mm[t[0]], b = v_mm[t[1]], c = v_mm[t[2]];
       Eigen::Vector3f n = (b - a).cross(c - a);
       if (n.norm() > 0) n.normalize();
       for (int k = 0; k < 3; ++k) Put(out, n[k]);
@@ -79,13 +90,10 @@ std::string EncodeMesh(const Mesh& m, const std::string& path) {
       Put(out, uint16_t(0));
     }
   } else {
-    out =
-        "ply\nformat binary_little_endian 1.0\ncomment stereorig mesh, reference frame (module 0), mm\n"
-        "element vertex " +
-        std::to_string(m.vertices_mm.size()) + "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
-        std::to_string(m.triangles.size()) + "\nproperty list uchar int vertex_indices\nend_header\n";
-    for (const Eigen::Vector3f& v : m.vertices_mm)
-      for (int k = 0; k < 3; ++k) Put(out, v[k]);
+    out = "ply\nformat binary_little_endian 1.0\ncomment stereorig mesh, reference frame (module 0), mm\n" +
+          VertexHeader(m.vertices) + "element face " + std::to_string(m.triangles.size()) +
+          "\nproperty list uchar int vertex_indices\nend_header\n";
+    PutVertices(m.vertices, out);
     for (const Eigen::Vector3i& t : m.triangles) {
       Put(out, uint8_t(3));
       for (int k = 0; k < 3; ++k) Put(out, int32_t(t[k]));

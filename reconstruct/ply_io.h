@@ -3,8 +3,10 @@
 // Cloud PLY, binary little-endian, one vertex element with the properties
 //   float x, y, z (mm); uchar intensity; float nx, ny, nz; uchar module;
 //   float confidence.
-// Mesh: PLY (float x y z; face list uchar/int vertex_indices) or binary STL
-// (chosen by the extension). All writes are atomic.
+// Mesh: PLY (the cloud's vertex element, then face list uchar/int
+// vertex_indices) or binary STL (triangles only: no module, so hole
+// filling's vertices cannot be told apart), chosen by the extension. All
+// writes are atomic.
 #pragma once
 
 #include <string>

@@ -27,13 +27,13 @@ void PointCloud::Append(const PointCloud& o) {
 }
 
 void Mesh::Reserve(size_t num_vertices, size_t num_triangles) {
-  vertices_mm.reserve(num_vertices);
+  vertices.Reserve(num_vertices);
   triangles.reserve(num_triangles);
 }
 
 void Mesh::Append(const Mesh& o) {
-  const int offset = int(vertices_mm.size());
-  vertices_mm.insert(vertices_mm.end(), o.vertices_mm.begin(), o.vertices_mm.end());
+  const int offset = int(vertices.size());
+  vertices.Append(o.vertices);
   for (const Eigen::Vector3i& t : o.triangles) triangles.push_back(t + Eigen::Vector3i::Constant(offset));
 }
 

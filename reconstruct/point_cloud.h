@@ -24,9 +24,12 @@ struct PointCloud {
   void Append(const PointCloud& other);
 };
 
+// The vertices carry the cloud's per-point fields, so a mesh file keeps each
+// vertex's module: `stereorig verify` must tell hole filling's vertices
+// (kFilledModule) from measured ones in a mesh as in a cloud.
 struct Mesh {
-  std::vector<Eigen::Vector3f> vertices_mm;
-  std::vector<Eigen::Vector3i> triangles;  // indices into vertices_mm, counter-clockwise seen from outside
+  PointCloud vertices;
+  std::vector<Eigen::Vector3i> triangles;  // indices into vertices, counter-clockwise seen from outside
   void Reserve(size_t vertices, size_t triangles);
   void Append(const Mesh& other);
 };

@@ -74,9 +74,9 @@ void RemoveRefuted(const ModulePlan& plan, const std::vector<uint8_t>& refuted, 
   }
   report->points = int(kept.size());
   *cloud = std::move(kept);
-  if (mesh->vertices_mm.empty()) return;
+  if (mesh->vertices.size() == 0) return;
   Mesh out;
-  out.vertices_mm = cloud->xyz_mm;
+  out.vertices = *cloud;
   for (const Eigen::Vector3i& tri : mesh->triangles) {
     const Eigen::Vector3i m(new_index[tri[0]], new_index[tri[1]], new_index[tri[2]]);
     if (m.minCoeff() >= 0) out.triangles.push_back(m);
@@ -409,7 +409,7 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
   // longer than mesh_max_edge_mm (a depth jump between surfaces). Vertex
   // order makes them counter-clockwise seen from the camera.
   t = Clock::now();
-  mesh->vertices_mm = cloud->xyz_mm;
+  mesh->vertices = *cloud;                   // with the points' fields: the mesh PLY keeps each vertex's module
   mesh->triangles.reserve(2 * kept.size());  // two per point inside a surface
   const float max_edge2 = float(options_.mesh_max_edge_mm * options_.mesh_max_edge_mm);
   auto short_edge = [&](int a, int b) { return (cloud->xyz_mm[a] - cloud->xyz_mm[b]).squaredNorm() <= max_edge2; };
@@ -490,7 +490,7 @@ Reconstruction Runtime::ProcessInPool(const std::vector<cv::Mat>& images, bool b
   if (!build_mesh) return out;
   t = Clock::now();
   size_t total_vertices = 0, total_triangles = 0;
-  for (const Mesh& mesh : meshes) total_vertices += mesh.vertices_mm.size(), total_triangles += mesh.triangles.size();
+  for (const Mesh& mesh : meshes) total_vertices += mesh.vertices.size(), total_triangles += mesh.triangles.size();
   out.mesh.Reserve(total_vertices, total_triangles);
   for (int m = 0; m < nm; ++m) out.mesh.Append(meshes[m]), meshes[m] = Mesh();
   out.times_ms["mesh_join"] = MsSince(t);

@@ -499,6 +499,40 @@ TEST_F(ReconstructCli, AShapeModelWithoutAMeshIsNotedAndTheSummaryNamesEveryOutp
       << meshed.out;
 }
 
+// `stereorig verify`'s filled column (the table's row of position 1).
+int VerifyFilledCount(const std::string& out) {
+  std::smatch m;
+  // position figure value_mm u_mm mpe_mm pass cloud filled
+  if (!std::regex_search(out, m, std::regex("\n1 +[^ ]+ +[^ ]+ +[^ ]+ +[^ ]+ +[^ ]+ +[0-9]+ +([0-9]+) "))) return -1;
+  return std::stoi(m[1]);
+}
+
+// A mesh PLY written with hole filling keeps each vertex's module: verify
+// skips as many filled points in it as in the cloud (the filled count
+// reconstruct reports). The mesh held x, y, z only, and verify took all its
+// vertices as measured ("filled 0"): the shape model's points entered the fit.
+TEST_F(ReconstructCli, AMeshKeepsHoleFillingsModuleSoVerifySkipsItsFilledPointsAsInTheCloud) {
+  WriteFileAtomically(dir_ + "/sphere_fill.yaml", "shape_model: sphere\n");
+  const std::string mesh = dir_ + "/fill_mesh.ply";
+  const testing::Result r =
+      testing::RunCli(Args(dir_ + "/capture", "--options " + dir_ + "/sphere_fill.yaml --mesh " + mesh));
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream report_file(dir_ + "/out.json");
+  const int filled = nlohmann::json::parse(report_file)["filled_points"].get<int>();
+  ASSERT_GT(filled, 100) << r.out;  // two modules leave the sphere's sides and back to the model
+  const std::string artifact = dir_ + "/sphere_artifact.yaml";
+  WriteFileAtomically(artifact,
+                      "format: stereorig-artifact\nversion: 1\nunits: mm\nname: rendered sphere\ntype: sphere\n"
+                      "diameter_mm: 50\ndiameter_uncertainty_mm: 0.002\n");
+  const testing::Result of_cloud = testing::RunCli("verify --artifact " + artifact + " --cloud " + dir_ + "/out.ply");
+  const testing::Result of_mesh = testing::RunCli("verify --artifact " + artifact + " --cloud " + mesh);
+  EXPECT_EQ(VerifyFilledCount(of_cloud.out), filled) << of_cloud.out << of_cloud.err;
+  EXPECT_EQ(VerifyFilledCount(of_mesh.out), filled) << of_mesh.out << of_mesh.err;
+  EXPECT_EQ(of_mesh.code, of_cloud.code) << of_mesh.out << of_cloud.out;
+  EXPECT_EQ(of_mesh.out.find("note: position 1"), std::string::npos) << of_mesh.out;  // it has its modules
+  std::filesystem::remove(mesh);
+}
+
 // A capture folder or image this process may not read was named in
 // std::filesystem's words ("filesystem error: directory iterator cannot
 // open directory: Permission denied [DIR]") or without the reason ("cannot

@@ -15,6 +15,7 @@
 #include <iterator>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <regex>
 #include <sstream>
 
 #include "tests/cli_runner.h"
@@ -465,6 +466,48 @@ TEST(VerifyCli, HoleFillingsPointsAreSkippedAndCounted) {
                       " more were added by hole filling (module 255), not measured: skipped"),
             std::string::npos)
       << r_filled.out << r_filled.err;
+}
+
+// A mesh of another tool (a PLY with faces and no per-vertex module) is
+// taken as measured throughout, as before, but now said in one note: it
+// read "filled 0" and PASS on a stereorig mesh whose hole filling's
+// vertices entered the fit. A cloud without module is no mesh: no note. An
+// STL, which cannot carry a module, is refused saying so (it read "not a
+// PLY file").
+TEST(VerifyCli, AMeshWithoutModuleIsNotedAsAllMeasuredAndAnStlIsRefusedSayingWhy) {
+  const std::string cloud = WriteSphere("no_module_cloud.ply", 19.05);
+  const auto r_cloud = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + cloud);
+  EXPECT_EQ(r_cloud.code, 0) << r_cloud.out << r_cloud.err;
+  EXPECT_EQ(r_cloud.out.find("without a per-vertex module"), std::string::npos) << r_cloud.out;
+
+  // The same vertices with one face after them, as a mesh tool writes it.
+  std::ifstream in(cloud);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  text.replace(text.find("end_header\n"), 11, "element face 1\nproperty list uchar int vertex_indices\nend_header\n");
+  text += "3 0 1 2\n";
+  const std::string mesh = ::testing::TempDir() + "/no_module_mesh_" + std::to_string(getpid()) + ".ply";
+  std::ofstream(mesh) << text;
+  const auto r_mesh = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + mesh);
+  EXPECT_EQ(r_mesh.code, 0) << r_mesh.out << r_mesh.err;
+  std::smatch vertices;
+  ASSERT_TRUE(std::regex_search(text, vertices, std::regex("element vertex ([0-9]+)")));
+  EXPECT_NE(r_mesh.out.find("note: position 1 (" + mesh + ") is a mesh without a per-vertex module: all " +
+                            vertices[1].str() +
+                            " vertices are taken as measured (a stereorig mesh written before its vertices kept their "
+                            "module may hold hole filling's: verify the cloud, reconstruct --out)\n"),
+            std::string::npos)
+      << r_mesh.out;
+
+  const std::string stl = ::testing::TempDir() + "/mesh_" + std::to_string(getpid()) + ".stl";
+  std::ofstream(stl, std::ios::binary) << std::string(80, ' ') << std::string(4, '\0');
+  const auto r_stl = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + stl);
+  EXPECT_EQ(r_stl.code, 2);
+  EXPECT_EQ(Lines(r_stl.err), 1) << r_stl.err;
+  EXPECT_NE(
+      r_stl.err.find(stl + ": not a PLY file: an STL mesh holds no per-vertex module, so hole filling's points (module "
+                           "255) cannot be told from measured ones; give the cloud (reconstruct --out) or a PLY mesh"),
+      std::string::npos)
+      << r_stl.err;
 }
 
 // Every vertex of the cloud lands in exactly one of the table's count

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "calib/core/file_suffix.h"
 #include "calib/core/input_error.h"
 #include "calib/core/input_file.h"
 
@@ -57,7 +58,16 @@ PlyVertices ReadPlyVertices(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "cannot be read");
   std::string line;
-  if (!std::getline(in, line) || line.rfind("ply", 0) != 0) throw InputError(path, "not a PLY file");
+  if (!std::getline(in, line) || line.rfind("ply", 0) != 0) {
+    if (EndsWithIgnoringCase(path, ".stl")) {
+      throw InputError(path,
+                       "not a PLY file: an STL mesh holds no per-vertex module, so hole filling's points "
+                       "(module 255) cannot be told from measured ones; give the cloud (reconstruct --out) or a PLY "
+                       "mesh");
+    }
+    throw InputError(path, "not a PLY file");
+  }
+  PlyVertices out;
   Encoding enc = Encoding::kAscii;
   long long num_vertices = -1;
   bool in_vertex = false, seen_vertex = false, after_vertex = false;
@@ -89,6 +99,7 @@ PlyVertices ReadPlyVertices(const std::string& path) {
       if (!s || count < 0 || s >> rest) throw InputError(path, "malformed element line '" + line + "'");
       if (seen_vertex && count > 0) after_vertex = true;  // data after the vertices, not read
       in_vertex = name == "vertex";
+      if (name == "face") out.faces = count;
       if (in_vertex) {
         if (seen_vertex) throw InputError(path, "two vertex elements");
         if (!element_before_vertex.empty()) {
@@ -158,7 +169,6 @@ PlyVertices ReadPlyVertices(const std::string& path) {
     }
     reserve = static_cast<size_t>(num_vertices);
   }
-  PlyVertices out;
   out.points.reserve(reserve);
   if (imodule >= 0) out.module.reserve(reserve);
   std::vector<double> v(props.size());
@@ -222,6 +232,12 @@ MeasuredPoints ReadMeasuredPlyPoints(const std::string& path) {
   PlyVertices all = ReadPlyVertices(path);
   MeasuredPoints measured;
   if (all.module.empty()) {
+    if (all.faces > 0) {
+      measured.note =
+          "a mesh without a per-vertex module: all " + std::to_string(all.points.size()) +
+          " vertices are taken as measured (a stereorig mesh written before its vertices kept their module may hold "
+          "hole filling's: verify the cloud, reconstruct --out)";
+    }
     measured.points = std::move(all.points);
     return measured;
   }

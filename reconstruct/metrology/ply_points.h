@@ -18,10 +18,13 @@ inline constexpr int kPlyFilledModule = 255;
 struct PlyVertices {
   std::vector<Eigen::Vector3d> points;
   std::vector<int> module;  // each vertex's `module` property; empty when the file has none
+  long long faces = 0;      // the count of its `face` element: > 0 for a mesh
 };
 
 // Throws InputError naming the file on a missing file, a folder, a malformed header, no
-// x/y/z, a truncated body or non-finite coordinates.
+// x/y/z, a truncated body or non-finite coordinates; on a file named .stl
+// that is not PLY, it says that an STL mesh holds no module and names the
+// cloud to give instead.
 PlyVertices ReadPlyVertices(const std::string& path);
 std::vector<Eigen::Vector3d> ReadPlyPoints(const std::string& path);  // ReadPlyVertices(path).points
 
@@ -31,6 +34,11 @@ std::vector<Eigen::Vector3d> ReadPlyPoints(const std::string& path);  // ReadPly
 struct MeasuredPoints {
   std::vector<Eigen::Vector3d> points;
   int filled_skipped = 0;
+  // Non-empty for a mesh (faces) without `module`: why every vertex was
+  // taken as measured, for a note. A mesh from another tool has none; a
+  // stereorig mesh written before its vertices kept their module may hold
+  // hole filling's, which no reader can tell apart.
+  std::string note;
 };
 MeasuredPoints ReadMeasuredPlyPoints(const std::string& path);
 
