@@ -250,6 +250,14 @@ int RunVerify(int argc, char** argv) {
 
   std::printf("artifact: %s (%s); capture band %.1f mm\n", artifact.name.c_str(), ArtifactTypeName(artifact.type),
               positions.front().capture_band_mm);
+  // A band asked for below the floor is raised to it: said, or a band of
+  // 1 mm read as used while 3 mm was.
+  if (positions.front().capture_band_mm > options.capture_band_mm) {
+    std::printf(
+        "note: --capture-band-mm %g raised to %.1f mm, twice the MPE: a narrower band would cut off an error "
+        "beyond the MPE before the figures see it\n",
+        options.capture_band_mm, positions.front().capture_band_mm);
+  }
   std::printf("decision rule: %s\n", DecisionRuleText(options.decision_rule));
   PrintMpes(artifact);
   // The same cloud given twice, or a byte-identical copy of it, is one

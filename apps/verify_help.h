@@ -75,7 +75,7 @@ Exit codes: 0 every figure passes; 1 a figure of a judged position fails (under 
 inline constexpr const char* kVerifyFooter =
     R"(Artifact files (YAML, mm; docs/verify-and-check.md; examples in datasets/artifacts/). The keys each
 kind requires; *_uncertainty_mm (the certificate's expanded U, default 0), uncertainty_coverage_factor
-(its k, default 2), name and mpe_mm (default 1.5 mm each) are optional:
+(its k, default 2), name (default: the file's stem) and mpe_mm (default 1.5 mm each) are optional:
 
   format: stereorig-artifact        format: stereorig-artifact        format: stereorig-artifact
   version: 1                        version: 1                        version: 1

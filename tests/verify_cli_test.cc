@@ -462,7 +462,8 @@ TEST(VerifyCli, HoleFillingsPointsAreSkippedAndCounted) {
   const auto r_filled = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + all_filled);
   EXPECT_EQ(r_filled.code, 2) << r_filled.out << r_filled.err;
   EXPECT_NE((r_filled.out + r_filled.err)
-                .find("only 0 points; at least 200 are needed on the artifact; " + std::to_string(vertices.size()) +
+                .find("only 0 points in the whole cloud; at least 200 are needed on the artifact; " +
+                      std::to_string(vertices.size()) +
                       " more were added by hole filling (module 255), not measured: skipped"),
             std::string::npos)
       << r_filled.out << r_filled.err;
@@ -910,3 +911,127 @@ TEST(VerifyCli, TheDecisionRuleJudgesTheUncertaintyRangeAndTheReportSaysWhichRul
 }
 
 }  // namespace
+
+namespace {
+
+// An ascii PLY of a square plate's face, `size_mm` at 1 mm, and where
+// thickness_mm > 0 its far face that far behind it at 1.5 mm (fewer points:
+// RANSAC locates the near face): a plate seen from both sides. Exact.
+std::string WritePlate(const std::string& name, double size_mm, double thickness_mm) {
+  const std::string path = ::testing::TempDir() + "/" + name + "_" + std::to_string(getpid()) + ".ply";
+  std::vector<std::array<double, 3>> pts;
+  for (double u = -size_mm / 2; u <= size_mm / 2; u += 1.0)
+    for (double v = -size_mm / 2; v <= size_mm / 2; v += 1.0) pts.push_back({u, v, 200});
+  if (thickness_mm > 0)
+    for (double u = -size_mm / 2; u <= size_mm / 2; u += 1.5)
+      for (double v = -size_mm / 2; v <= size_mm / 2; v += 1.5) pts.push_back({u, v, 200 + thickness_mm});
+  std::ofstream f(path);
+  f << "ply\nformat ascii 1.0\nelement vertex " << pts.size()
+    << "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
+  for (const auto& q : pts) f << q[0] << " " << q[1] << " " << q[2] << "\n";
+  return path;
+}
+
+const char* kPlate =
+    "format: stereorig-artifact\nversion: 1\nunits: mm\nname: test plate\ntype: plate\nlength_mm: 130\n"
+    "width_mm: 130\n";
+
+}  // namespace
+
+// A 3 mm plate seen from both sides: its far face lies in the capture band,
+// and F read the thickness (FAIL, no hint why). Now F is not judged and the
+// line names the far face, 3.0 mm behind (exact points: the faces' medians
+// are 3.0 mm apart), and its points inside the face's outline eroded by the
+// 5 mm edge margin (|u|, |v| <= 60 mm at 1.5 mm: 80 x 80). A band asked for under the floor (2 x MPE) is raised,
+// and said so (--capture-band-mm 1 read as taken).
+TEST(VerifyCli, AThinPlatesFarFaceIsNamedAndARaisedCaptureBandIsSaid) {
+  const std::string thin = WritePlate("thin_plate", 130, 3.0);
+  auto r = RunCli("verify --artifact " + WriteArtifact(kPlate) + " --cloud " + thin);
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_NE(r.out.find("1        NOT JUDGED: F is not judged: the face's points hold two parallel faces 3.0 mm apart "
+                       "(6400 points on the second,"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("the plate's far face, seen by modules on its other side (a plate thinner than the 5.0 mm "
+                       "capture band)"),
+            std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.find("note: --capture-band-mm"), std::string::npos) << r.out;
+  // One face alone: judged, and F 0 exactly.
+  r = RunCli("verify --artifact " + WriteArtifact(kPlate) + " --cloud " + WritePlate("one_face", 130, 0) +
+             " --capture-band-mm 1");
+  EXPECT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("artifact: test plate (plate); capture band 3.0 mm\nnote: --capture-band-mm 1 raised to 3.0 "
+                       "mm, twice the MPE: a narrower band would cut off an error beyond the MPE before the figures "
+                       "see it\n"),
+            std::string::npos)
+      << r.out;
+}
+
+// Certified sizes no artifact has are refused where the file is read, naming
+// the file and key, with the unit the value looks like: 1e300 was accepted
+// (and its hint cut mid-number), 38100 (um for 38.1 mm) read as a 38 m sphere
+// whose refusal blamed the cloud ("is it in metres?").
+TEST(VerifyCli, ImplausibleCertifiedSizesAreRefusedNamingTheKeyAndTheUnit) {
+  const std::string good = WriteSphere("good_bounds.ply", 19.05);
+  const std::string head = "format: stereorig-artifact\nversion: 1\nunits: mm\nname: s\ntype: sphere\n";
+  const struct {
+    std::string line, message;
+  } cases[] = {
+      {"diameter_mm: 1e300\n", "diameter_mm: 1e+300 mm is not a plausible sphere diameter (1 to 1000 mm)\n"},
+      {"diameter_mm: 38100\n",
+       "diameter_mm: 38100 mm is not a plausible sphere diameter (1 to 1000 mm): in micrometres it would be 38.1 mm "
+       "(the file's units are mm)\n"},
+      {"diameter_mm: 0.0381\n",
+       "diameter_mm: 0.0381 mm is not a plausible sphere diameter (1 to 1000 mm): in metres it would be 38.1 mm (the "
+       "file's units are mm)\n"},
+  };
+  for (const auto& c : cases) {
+    const std::string artifact = WriteArtifact(head + c.line);
+    const auto r = RunCli("verify --artifact " + artifact + " --cloud " + good);
+    EXPECT_EQ(r.code, 2) << c.line << r.out << r.err;
+    EXPECT_EQ(r.out, "") << c.line;
+    EXPECT_NE(r.err.find(artifact), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.size() - r.err.rfind(c.message), c.message.size()) << r.err;
+  }
+  // A plate's side and a ball bar's length have their own, wider bound.
+  const auto r = RunCli("verify --artifact " +
+                        WriteArtifact("format: stereorig-artifact\nversion: 1\nunits: mm\ntype: plate\n"
+                                      "length_mm: 130000\nwidth_mm: 120\n") +
+                        " --cloud " + good);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("length_mm: 130000 mm is not a plausible artifact length (1 to 10000 mm): in micrometres it "
+                       "would be 130 mm (the file's units are mm)"),
+            std::string::npos)
+      << r.err;
+}
+
+// --min-points over the whole cloud: the count said is the cloud's, not the
+// artifact's ("only 6474 points; at least 60000 are needed on the artifact"
+// read as those found on it). WriteSphere's cloud: two caps of 65 x 126
+// points.
+TEST(VerifyCli, TooFewPointsInTheWholeCloudSaysItIsTheWholeClouds) {
+  const std::string good = WriteSphere("good_min.ply", 19.05);
+  const auto r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + good + " --min-points 60000");
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("good_min.ply: not evaluated: only 16380 points in the whole cloud; at least 60000 are needed "
+                       "on the artifact"),
+            std::string::npos)
+      << r.err;
+}
+
+// An artifact file without `name` (optional: --help) is named by its file's
+// stem in the table and the report: they read "artifact:  (sphere)" and
+// "artifact": "".
+TEST(VerifyCli, AnArtifactWithoutANameIsNamedByItsFile) {
+  const std::string good = WriteSphere("good_name.ply", 19.05);
+  const std::string artifact = ::testing::TempDir() + "/sphere_SN77_" + std::to_string(getpid()) + ".yaml";
+  std::ofstream(artifact) << "format: stereorig-artifact\nversion: 1\nunits: mm\ntype: sphere\ndiameter_mm: 38.1\n";
+  const std::string report = ::testing::TempDir() + "/name_" + std::to_string(getpid()) + ".json";
+  const auto r = RunCli("verify --artifact " + artifact + " --cloud " + good + " --report " + report);
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  const std::string stem = "sphere_SN77_" + std::to_string(getpid());
+  EXPECT_EQ(r.out.rfind("artifact: " + stem + " (sphere); capture band 5.0 mm\n", 0), 0u) << r.out;
+  std::ifstream f(report);
+  EXPECT_EQ(nlohmann::json::parse(f)["artifact"].get<std::string>(), stem);
+}

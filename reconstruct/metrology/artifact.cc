@@ -1,6 +1,9 @@
 #include "reconstruct/metrology/artifact.h"
 
+#include <cstdio>
+#include <filesystem>
 #include <sstream>
+#include <utility>
 
 #include "calib/core/input_error.h"
 #include "calib/core/input_file.h"
@@ -35,6 +38,36 @@ double NonNegative(YamlMap& m, const std::string& key) {
   return v;
 }
 
+// The plausible range of a certified size, mm: a sphere a rig like this
+// measures (VDI/VDE 2634-2 sizes it at 0.1-0.2 of the volume's diagonal), and
+// a ball bar's length or a plate's side. Outside it the value is a typo or
+// another unit: 38100 (um for 38.1 mm) read as a 38 m sphere, and 1e300 was
+// judged against a 61.6 mm cloud, whose refusal then blamed the cloud.
+struct PlausibleMm {
+  double min_mm, max_mm;
+  const char* what;
+};
+constexpr PlausibleMm kSphereDiameter{1, 1000, "sphere diameter"};
+constexpr PlausibleMm kArtifactLength{1, 10000, "artifact length"};
+
+// A positive size within `range`; outside it, refused naming the file and
+// key, with the unit it looks like when one makes it plausible.
+double Size(YamlMap& m, const std::string& key, const PlausibleMm& range) {
+  const double v = Positive(m, key);
+  if (v >= range.min_mm && v <= range.max_mm) return v;
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "%g mm is not a plausible %s (%g to %g mm)", v, range.what, range.min_mm,
+                range.max_mm);
+  std::string problem = buf;
+  for (const auto& [unit, to_mm] : {std::pair<const char*, double>{"micrometres", 1e-3}, {"metres", 1e3}}) {
+    if (v * to_mm >= range.min_mm && v * to_mm <= range.max_mm) {
+      std::snprintf(buf, sizeof buf, ": in %s it would be %g mm (the file's units are mm)", unit, v * to_mm);
+      problem += buf;
+    }
+  }
+  throw InputError(m.Where(key), problem);
+}
+
 Artifact Parse(YamlMap m) {
   if (m.GetString("format") != "stereorig-artifact")
     throw InputError(m.Where("format"), "expected 'stereorig-artifact'");
@@ -45,22 +78,22 @@ Artifact Parse(YamlMap m) {
   const std::string type = m.GetString("type");
   if (type == "sphere") {
     a.type = ArtifactType::kSphere;
-    a.sphere_diameter_mm = Positive(m, "diameter_mm");
+    a.sphere_diameter_mm = Size(m, "diameter_mm", kSphereDiameter);
     a.sphere_diameter_uncertainty_mm = NonNegative(m, "diameter_uncertainty_mm");
     a.sphere_form_uncertainty_mm = NonNegative(m, "form_uncertainty_mm");
   } else if (type == "ballbar") {
     a.type = ArtifactType::kBallBar;
-    a.sphere_diameter_mm = Positive(m, "sphere_diameter_mm");
+    a.sphere_diameter_mm = Size(m, "sphere_diameter_mm", kSphereDiameter);
     a.sphere_diameter_uncertainty_mm = NonNegative(m, "sphere_diameter_uncertainty_mm");
-    a.center_distance_mm = Positive(m, "center_distance_mm");
+    a.center_distance_mm = Size(m, "center_distance_mm", kArtifactLength);
     a.center_distance_uncertainty_mm = NonNegative(m, "center_distance_uncertainty_mm");
     if (a.center_distance_mm <= a.sphere_diameter_mm) {
       throw InputError(m.Where("center_distance_mm"), "must exceed the sphere diameter (the balls would overlap)");
     }
   } else if (type == "plate") {
     a.type = ArtifactType::kPlate;
-    a.plate_length_mm = Positive(m, "length_mm");
-    a.plate_width_mm = Positive(m, "width_mm");
+    a.plate_length_mm = Size(m, "length_mm", kArtifactLength);
+    a.plate_width_mm = Size(m, "width_mm", kArtifactLength);
     a.flatness_uncertainty_mm = NonNegative(m, "flatness_uncertainty_mm");
   } else {
     throw InputError(m.Where("type"), "expected sphere, ballbar or plate, got '" + type + "'");
@@ -94,7 +127,13 @@ Artifact Parse(YamlMap m) {
 
 // Read here, not by yaml-cpp's LoadFile: a file it cannot open (no read
 // permission) it calls a "bad file", which read "not valid YAML: bad file".
-Artifact ReadArtifactFile(const std::string& path) { return Parse(YamlMap::LoadString(ReadInputText(path), path)); }
+// Without a name (it is optional), the file's stem names the artifact: the
+// table read "artifact:  (sphere)" and the report "artifact": "".
+Artifact ReadArtifactFile(const std::string& path) {
+  Artifact a = Parse(YamlMap::LoadString(ReadInputText(path), path));
+  if (a.name.empty()) a.name = std::filesystem::path(path).stem().string();
+  return a;
+}
 Artifact ParseArtifactYaml(const std::string& text, const std::string& where) {
   return Parse(YamlMap::LoadString(text, where));
 }

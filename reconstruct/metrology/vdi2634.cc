@@ -314,6 +314,59 @@ std::string ScaleText(double scale, std::optional<double> other_ball_scale) {
   return buf;
 }
 
+double Median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// The median |radial residual|, mm, of the points within band_mm of a
+// sphere: how well they lie on it. The artifact at another scale lies on its
+// fitted sphere to the measurement's noise (0.05 mm on the demo's); a ball
+// with its rod, or a patch of a plane, fitted as one sphere does not (a
+// walkthrough's ball bar read "-10% off" against a sphere file, a plate
+// "+16% off").
+double MedianAbsResidualMm(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& center_mm, double radius_mm,
+                           double band_mm) {
+  std::vector<double> r;
+  for (int i : WithinSphereShell(pts, center_mm, radius_mm, band_mm))
+    r.push_back(std::abs((pts[i] - center_mm).norm() - radius_mm));
+  return r.empty() ? std::numeric_limits<double>::infinity() : Median(r);
+}
+
+// "; most of the cloud (N of M points) lies within 1.5 mm of a plane: a
+// plate?" where RANSAC's plane holds over half of it; empty otherwise.
+std::string PlaneLikeText(const std::vector<Eigen::Vector3d>& pts, double locate_band_mm) {
+  PlaneFitOptions po;
+  po.inlier_threshold_mm = locate_band_mm;
+  const PlaneFit plane = FitPlaneRobust(pts, po);
+  if (!plane.ok || 2 * plane.inliers.size() <= pts.size()) return "";
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "; most of the cloud (%zu of %zu points) lies within %.1f mm of a plane: a plate?",
+                plane.inliers.size(), pts.size(), locate_band_mm);
+  return buf;
+}
+
+// ScaleText for a sphere found at another size (centre, radius), named only
+// where its points within band_mm lie on it to within a quarter of the
+// locating band (MedianAbsResidualMm): the artifact at another scale does,
+// to its noise. Otherwise the cloud is said not to look like the artifact,
+// and what it looks like where that is cheap to tell (PlaneLikeText).
+std::string ScaleOrShapeText(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& center_mm,
+                             double radius_mm, double nominal_radius_mm, double band_mm, double locate_band_mm,
+                             std::optional<double> other_ball_scale) {
+  const std::string scale = ScaleText(radius_mm / nominal_radius_mm, other_ball_scale);
+  if (scale.empty()) return "";
+  const double median_mm = MedianAbsResidualMm(pts, center_mm, radius_mm, band_mm);
+  if (median_mm <= 0.25 * locate_band_mm) return scale;
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "; its points lie on that sphere only to %.2f mm (median |residual|; the artifact at another scale "
+                "would to its noise, under a quarter of the %.1f mm locating band): the cloud does not look like "
+                "this artifact",
+                median_mm, locate_band_mm);
+  return buf + PlaneLikeText(pts, locate_band_mm);
+}
+
 // Why a located sphere's free-radius fit is not the artifact's: the cap its
 // points cover, the diameter they fit against the certified one, and how well
 // a cap like this fits a diameter at all, so the reader can tell a cap too
@@ -323,7 +376,7 @@ std::string ScaleText(double scale, std::optional<double> other_ball_scale) {
 std::string LeftCertifiedSizeText(const std::vector<Eigen::Vector3d>& pts, const std::vector<int>& captured,
                                   const Eigen::Vector3d& located_center_mm, const SphereFit& free_fit,
                                   double nominal_radius_mm, double tolerance_mm, double capture_band_mm,
-                                  std::optional<double> other_ball_scale) {
+                                  double locate_band_mm, std::optional<double> other_ball_scale) {
   SphereFitUncertainty u{180.0, std::numeric_limits<double>::infinity(), {}};
   if (captured.size() > 4) {
     SphereFit at = SphereAt(pts, captured, located_center_mm, nominal_radius_mm);
@@ -365,7 +418,10 @@ std::string LeftCertifiedSizeText(const std::vector<Eigen::Vector3d>& pts, const
                   "size",
                   u.diameter_std_mm);
     text += buf;
-    if (free_fit.ok && free_fit.converged) text += ScaleText(free_fit.radius_mm / nominal_radius_mm, other_ball_scale);
+    if (free_fit.ok && free_fit.converged) {
+      text += ScaleOrShapeText(pts, free_fit.center_mm, free_fit.radius_mm, nominal_radius_mm, capture_band_mm,
+                               locate_band_mm, other_ball_scale);
+    }
     return text;
   }
   return text + buf;
@@ -453,7 +509,8 @@ std::string OtherSizeText(const std::vector<Eigen::Vector3d>& pts, double nomina
                 "; it holds one %.1f mm in diameter (%zu points within %.1f mm of it), not the certified %.1f mm: not "
                 "the artifact, or not of its certified size",
                 2 * other.radius_mm, other.inliers.size(), locate_band_mm, 2 * nominal_radius_mm);
-  return buf + ScaleText(other.radius_mm / nominal_radius_mm, other_ball_scale);
+  return buf + ScaleOrShapeText(pts, other.center_mm, other.radius_mm, nominal_radius_mm, locate_band_mm,
+                                locate_band_mm, other_ball_scale);
 }
 
 // "ball 2 of the ball bar (centre near (50.0, 0.0, 150.0) mm)": which one
@@ -520,7 +577,7 @@ ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, dou
     if (LeftCertifiedSize(fit, nominal_radius, so.radius_tolerance_mm)) {
       out.fit.ok = false;
       out.fit.message = LeftCertifiedSizeText(pts, in, located.center_mm, fit, nominal_radius, so.radius_tolerance_mm,
-                                              capture_band_mm, other_ball_scale());
+                                              capture_band_mm, locate_band_mm, other_ball_scale());
       return out;
     }
     std::vector<int> next = WithinSphereShell(pts, fit.center_mm, fit.radius_mm, capture_band_mm);
@@ -530,8 +587,9 @@ ArtifactSphereFit FitArtifactSphere(const std::vector<Eigen::Vector3d>& pts, dou
   const std::vector<int> kept = ExcludeWorst(fit.inliers, fit.residuals_mm, o.excluded_fraction_max, &out.excluded);
   out.fit = RefineSphere(pts, kept, fit.center_mm, fit.radius_mm, kRefineIterations);
   if (LeftCertifiedSize(out.fit, nominal_radius, so.radius_tolerance_mm)) {
-    out.fit.message = LeftCertifiedSizeText(pts, kept, located.center_mm, out.fit, nominal_radius,
-                                            so.radius_tolerance_mm, capture_band_mm, other_ball_scale());
+    out.fit.message =
+        LeftCertifiedSizeText(pts, kept, located.center_mm, out.fit, nominal_radius, so.radius_tolerance_mm,
+                              capture_band_mm, locate_band_mm, other_ball_scale());
     out.fit.ok = false;
   }
   return out;
@@ -542,6 +600,72 @@ std::vector<int> WithinPlaneBand(const std::vector<Eigen::Vector3d>& pts, const 
   for (int i = 0; i < static_cast<int>(pts.size()); ++i)
     if (std::abs(plane.normal.dot(pts[i]) - plane.offset_mm) < band_mm) in.push_back(i);
   return in;
+}
+
+// Where the face's points (inside the eroded outline) hold two faces
+// parallel to the fitted plane `plane`: their distances along its normal fall
+// in two clusters (1-D two-means) apart by more than kFacesApartInSpreads
+// times their pooled spread, and the smaller one's dense part spans at least
+// VerifyOptions::plate_min_coverage of the plate as the face must. Then why F
+// is not judged, naming them; empty otherwise. The plate's far face, seen by
+// modules on its other side, lies in the capture band when the plate is
+// thinner than the band (the walkthrough's 3 mm plate read F 3.47 mm, its
+// thickness). Points carry no normals here (ply_points.h reads positions), so
+// it cannot be told from a module measuring the plate that far off: neither
+// is left out, and neither is judged. A patch one grid period off is a
+// patch, not a face: it spans too little, and F shows it. One face splits
+// into halves only 2.7 spreads apart (noise), a bowed one ~3.5 (uniform).
+constexpr double kFacesApartInSpreads = 8;
+
+std::string SecondFaceText(const std::vector<Eigen::Vector3d>& pts, const std::vector<int>& face, const PlaneFit& plane,
+                           const PlaneOutline& extent, const Artifact& a, const VerifyOptions& o) {
+  std::vector<double> d_mm;
+  for (int i : face) d_mm.push_back(plane.normal.dot(pts[i]) - plane.offset_mm);
+  if (d_mm.empty()) return "";
+  double split_mm = std::accumulate(d_mm.begin(), d_mm.end(), 0.0) / d_mm.size();
+  double mean_mm[2] = {0, 0}, ss_mm2[2] = {0, 0};
+  size_t n[2] = {0, 0};
+  for (int round = 0; round < kMaxSegmentationRounds; ++round) {
+    double sum_mm[2] = {0, 0};
+    n[0] = n[1] = 0;
+    for (double d : d_mm) {
+      sum_mm[d >= split_mm] += d;
+      ++n[d >= split_mm];
+    }
+    if (n[0] == 0 || n[1] == 0) return "";
+    mean_mm[0] = sum_mm[0] / n[0];
+    mean_mm[1] = sum_mm[1] / n[1];
+    const double next_mm = 0.5 * (mean_mm[0] + mean_mm[1]);
+    if (next_mm == split_mm) break;
+    split_mm = next_mm;
+  }
+  for (double d : d_mm) {
+    const int k = d >= split_mm;
+    ss_mm2[k] += (d - mean_mm[k]) * (d - mean_mm[k]);
+  }
+  const double spread_mm = std::sqrt((ss_mm2[0] + ss_mm2[1]) / d_mm.size());
+  const double apart_mm = mean_mm[1] - mean_mm[0];
+  if (!(apart_mm > kFacesApartInSpreads * spread_mm)) return "";
+  const int smaller = n[1] < n[0] ? 1 : 0;
+  std::vector<int> second_face;
+  for (size_t k = 0; k < face.size(); ++k)
+    if ((d_mm[k] >= split_mm) == (smaller == 1)) second_face.push_back(face[k]);
+  if (static_cast<int>(second_face.size()) < std::max(o.min_points, 3)) return "";
+  const PlaneOutline second = OutlineOfDensePart(pts, second_face, plane.normal);
+  const double longer = std::max(a.plate_length_mm, a.plate_width_mm);
+  const double shorter = std::min(a.plate_length_mm, a.plate_width_mm);
+  if (second.length_mm() < o.plate_min_coverage * longer || second.width_mm() < o.plate_min_coverage * shorter)
+    return "";
+  char buf[640];
+  std::snprintf(buf, sizeof buf,
+                "F is not judged: the face's points hold two parallel faces %.1f mm apart (%zu points on the "
+                "second, over %.1f x %.1f mm of the face's %.1f x %.1f mm outline): the plate's far face, seen by "
+                "modules on its other side (a plate thinner than the %.1f mm capture band), or a module measuring it "
+                "%.1f mm off; their range is not the flatness. Give verify the points of the modules on one side of "
+                "the plate only (the cloud's module property)",
+                apart_mm, second_face.size(), second.length_mm(), second.width_mm(), extent.length_mm(),
+                extent.width_mm(), CaptureBandMm(o, a.mpe.flatness_mm), apart_mm);
+  return buf;
 }
 
 // The plane found must be the plate: it spans at least `min_coverage` of the
@@ -578,10 +702,13 @@ double ArtifactSizeMm(const Artifact& a) {
   return 0;
 }
 
-// "; the cloud spans 0.04 across, ..." where a cloud is over 100x smaller
-// than the artifact (its bounding box's diagonal against the artifact's
-// size), as a cloud in metres is (1000x): RANSAC finding no sphere in it
-// said nothing of why. Empty otherwise.
+// "; the whole cloud spans only 0.04 mm across, ..." where a cloud is over
+// 100x smaller than the artifact (its bounding box's diagonal against the
+// artifact's size), as a cloud in metres is (1000x): RANSAC finding no
+// sphere in it said nothing of why. The certificate's sizes are plausible
+// (artifact.cc refuses others), so the cloud is the side named: in metres
+// where 1000x makes it the artifact's size (within 10x), otherwise not this
+// artifact or in another unit. Empty otherwise.
 std::string UnitsHint(const Artifact& a, const std::vector<Eigen::Vector3d>& pts) {
   if (pts.empty()) return "";
   Eigen::Vector3d lo = pts[0], hi = pts[0];
@@ -589,14 +716,20 @@ std::string UnitsHint(const Artifact& a, const std::vector<Eigen::Vector3d>& pts
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
-  const double extent = (hi - lo).norm(), size_mm = ArtifactSizeMm(a);
-  if (!(extent * 100 < size_mm)) return "";
+  const double extent_mm = (hi - lo).norm(), size_mm = ArtifactSizeMm(a);
+  if (!(extent_mm * 100 < size_mm)) return "";
+  const double ratio = extent_mm > 0 ? size_mm / extent_mm : std::numeric_limits<double>::infinity();
+  const bool metres = ratio >= 100 && ratio <= 10000;
+  // Sized to any double (%g keeps each to a few characters): never cut.
   char buf[256];
   std::snprintf(buf, sizeof buf,
-                "; the whole cloud spans only %.3g across, %.0fx less than the artifact's %.1f mm: is it in metres? "
-                "verify reads millimetres",
-                extent, extent > 0 ? size_mm / extent : std::numeric_limits<double>::infinity(), size_mm);
-  return buf;
+                ratio < 1e6 ? "; the whole cloud spans only %.3g mm across, %.0fx less than the "
+                              "artifact's %.4g mm: "
+                            : "; the whole cloud spans only %.3g mm across, %.3gx less than the "
+                              "artifact's %.4g mm: ",
+                extent_mm, ratio, size_mm);
+  return buf + std::string(metres ? "is the cloud in metres? verify reads millimetres"
+                                  : "the cloud is not of this artifact, or not in millimetres");
 }
 
 ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eigen::Vector3d>& pts,
@@ -625,8 +758,11 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
   e.type = a.type;
   e.points_total = static_cast<int>(pts.size());
   if (e.points_total < o.min_points) {
-    throw NotTheArtifactError(where, "only " + std::to_string(e.points_total) + " points; at least " +
-                                         std::to_string(o.min_points) + " are needed on the artifact");
+    // The whole cloud's count (its measured points), before any is found on
+    // the artifact: said so, or it read as the artifact's.
+    throw NotTheArtifactError(where, "only " + std::to_string(e.points_total) +
+                                         " points in the whole cloud; at least " + std::to_string(o.min_points) +
+                                         " are needed on the artifact");
   }
   auto require_points = [&](int n, const char* what) {
     if (n < o.min_points) {
@@ -690,9 +826,10 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
         const bool two_balls =
             (fit.center_mm - other_fit.center_mm).norm() >= std::abs(fit.radius_mm) + std::abs(other_fit.radius_mm);
         const double other_scale = other_fit.ok && other_fit.converged && two_balls ? other_fit.radius_mm / r : NAN;
-        throw NotTheArtifactError(where, BallText(ball, located_centers_mm[ball]) + ": " +
-                                             LeftCertifiedSizeText(pts, indices, located_centers_mm[ball], fit, r,
-                                                                   tolerance_mm, band, other_scale));
+        throw NotTheArtifactError(
+            where, BallText(ball, located_centers_mm[ball]) + ": " +
+                       LeftCertifiedSizeText(pts, indices, located_centers_mm[ball], fit, r, tolerance_mm, band,
+                                             LocateBandMm(o, a.mpe.sphere_spacing_mm), other_scale));
       };
       const double cos_cone = std::cos(o.ballbar_shaft_cone_deg * M_PI / 180.0);
       OtherBallScaleAt first_ball_scale_at;  // for ball 2's search
@@ -885,6 +1022,13 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       ResidualStats(fit.residuals_mm, &e);
       JudgeFigures(o.decision_rule, o, &e.figures);
       e.not_judged_reason = NotJudgedReason(e, "", a.uncertainty_coverage_factor, o);
+      // Two faces in the band (a plate thinner than it, seen from both
+      // sides): their range is the plate's thickness, not its flatness, and
+      // F judges neither face, whatever it reads.
+      if (const std::string second = SecondFaceText(pts, face, fit, extent, a, o); !second.empty()) {
+        e.figures[0].judged = false;
+        e.not_judged_reason = second;
+      }
       break;
     }
   }

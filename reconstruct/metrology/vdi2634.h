@@ -170,7 +170,9 @@ struct ArtifactEvaluation {
   // Empty when the position is judged. Otherwise why it is not: a figure the
   // points or the certificate leave undetermined where the position would
   // otherwise pass (VerifyOptions::max_uncertainty_fraction_of_mpe; the text
-  // names the figure, its uncertainty and what would help). Its figures are
+  // names the figure, its uncertainty and what would help), or, on a plate, a
+  // second face parallel to the face among its points (a thin plate's far
+  // face, seen from its other side: F spans both). Its figures are
   // all filled in, to be reported, not judged.
   // A position not evaluated at all (NotEvaluated below) has no figures and
   // no fitted geometry; not_judged_reason then says why.
