@@ -459,6 +459,44 @@ TEST(CalibrateCli, OptionsAreNamedByTheirFlags) {
   EXPECT_NE(r.err.find("/rig.yaml is a file, not a folder"), std::string::npos) << r.err;
 }
 
+// A splined model's configuration is judged with the options: mrcal parsed
+// it and judged it only at its first projection, after the whole detection
+// pass (Nx=4_Ny=3 aborted there, SIGABRT, exit 134), or never (fov_x_deg=400
+// wrote a rig, fov_x_deg=0 ran the whole solve). Refused before any work:
+// the captures given do not exist, and the refusal is not theirs.
+TEST(CalibrateCli, ASplinedModelMrcalCannotBuildIsRefused) {
+  const std::string dir = ::testing::TempDir() + "/calib_cli_spline";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir + "/layout.yaml") << "modules:\n  - {name: module0, left: 0, right: 1}\n";
+  const std::string inputs = "calibrate --captures " + dir + "/no_captures --target " + dir + "/target.yaml --layout " +
+                             dir + "/layout.yaml --out " + dir + "/out.yaml --report " + dir + "/report.json";
+  const std::string spline = "LENSMODEL_SPLINED_STEREOGRAPHIC_";
+  const std::string fov = ", the horizontal field of view the stereographic projection can span, deg";
+  const std::pair<std::string, std::string> refused[] = {
+      {"order=3_Nx=4_Ny=3_fov_x_deg=50", "Nx=4 Ny=3: an order 3 spline needs Nx and Ny >= 4 (mrcal's minimum)"},
+      {"order=3_Nx=3_Ny=8_fov_x_deg=50", "Nx=3 Ny=8: an order 3 spline needs Nx and Ny >= 4 (mrcal's minimum)"},
+      {"order=2_Nx=2_Ny=6_fov_x_deg=50", "Nx=2 Ny=6: an order 2 spline needs Nx and Ny >= 3 (mrcal's minimum)"},
+      {"order=4_Nx=8_Ny=6_fov_x_deg=50", "order=4: mrcal's splines are of order 2 or 3"},
+      {"order=1_Nx=8_Ny=6_fov_x_deg=50", "order=1: mrcal's splines are of order 2 or 3"},
+      {"order=3_Nx=8_Ny=6_fov_x_deg=0", "fov_x_deg=0: must be in (0, 360)" + fov},
+      {"order=3_Nx=8_Ny=6_fov_x_deg=360", "fov_x_deg=360: must be in (0, 360)" + fov},
+      {"order=3_Nx=8_Ny=6_fov_x_deg=400", "fov_x_deg=400: must be in (0, 360)" + fov}};
+  for (const auto& [config, says] : refused) {
+    const testing::Result r = testing::RunCli(inputs + " --lensmodel " + spline + config);
+    EXPECT_EQ(r.code, 2) << config;
+    EXPECT_EQ(r.err, "stereorig calibrate: --lensmodel: '" + spline + config + "': " + says + "\n") << r.err;
+  }
+  // Each limit's edge is accepted (the run then stops at the missing target).
+  for (const char* config : {"order=3_Nx=4_Ny=4_fov_x_deg=1", "order=2_Nx=3_Ny=3_fov_x_deg=359"}) {
+    const testing::Result r = testing::RunCli(inputs + " --lensmodel " + spline + config);
+    EXPECT_EQ(r.code, 2) << config;
+    EXPECT_NE(r.err.find("target.yaml: no such file"), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir + "/out.yaml"));
+  EXPECT_FALSE(fs::exists(dir + "/report.json"));
+}
+
 // The capture images are inputs too (calib/capture_folder.h,
 // CaptureFolderImages): --out, --report or --export-cameramodels named like
 // one of them, in a captures folder or a dataset's calibration/, would
