@@ -513,6 +513,35 @@ TEST(CalibrateCli, OptionsAreNamedByTheirFlags) {
   EXPECT_NE(r.err.find("/rig.yaml is a file, not a folder"), std::string::npos) << r.err;
 }
 
+// A target file hand-edited to corners_x 12 for the rendered 11 x 9 board
+// (its tags where they were): the tags place the board, each view keeps the
+// corners it finds, and the calibration succeeds with the 12th column never
+// seen and the rig recording a board of 12 x 9. A warning names the file
+// and the column; the rendered set's own file gives none.
+TEST(CalibrateCli, ACornerColumnNoViewShowedIsWarnedOf) {
+  const RenderedSet& set = Rendered();
+  const std::string dir = set.dir + "/t12";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ifstream in(set.dir + "/target.yaml");
+  std::string text(std::istreambuf_iterator<char>(in), {});
+  const size_t at = text.find("corners_x: 11");
+  ASSERT_NE(at, std::string::npos) << text;
+  text.replace(at, 13, "corners_x: 12");
+  std::ofstream(dir + "/target.yaml") << text;
+  const std::string args = "calibrate --captures " + set.dir + "/captures --layout " + set.dir + "/layout.yaml --out " +
+                           dir + "/rig.yaml --report " + dir + "/report.json --lensmodel LENSMODEL_OPENCV5 --target ";
+  const testing::Result r = testing::RunCli(args + dir + "/target.yaml");
+  EXPECT_NE(r.err.find("calibrate: warning: " + dir +
+                       "/target.yaml says corners_x 12, corners_y 9 (inner corners along a row, along a column), but "
+                       "its column 12 of corners (1-based) never showed in any of the "),
+            std::string::npos)
+      << r.err;
+  const testing::Result right = testing::RunCli(args + set.dir + "/target.yaml");
+  EXPECT_EQ(right.code, 0) << right.err;
+  EXPECT_EQ(right.err.find("never showed"), std::string::npos) << right.err;
+}
+
 // A splined model's configuration is judged with the options: mrcal parsed
 // it and judged it only at its first projection, after the whole detection
 // pass (Nx=4_Ny=3 aborted there, SIGABRT, exit 134), or never (fov_x_deg=400
