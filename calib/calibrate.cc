@@ -274,7 +274,11 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
   }
 
   rep.not_converged = NotConvergedProblem(rep, rep.max_rms_px);
-  if (M > 1) rep.wrong_plate = WrongPlateProblem(rep.system.back_from_front_vs_file);
+  // The plate is judged only by a stage 3 that converged: one that did not
+  // moves back_from_front with everything else (a capture whose module 1
+  // images were another's moved its tx 0.2 mm, and the target file was
+  // blamed).
+  if (M > 1 && rep.not_converged.empty()) rep.wrong_plate = WrongPlateProblem(rep.system.back_from_front_vs_file);
 
   // The rig.
   std::vector<Camera> cameras(nc, Camera("LENSMODEL_PINHOLE", {1, 1, 0, 0}, 1, 1));
@@ -434,7 +438,13 @@ std::string CalibrationReport::ToJson() const {
     j.BeginObject("refined")
         .Number("reprojection_rms_px", s.refined_reprojection_rms_px)
         .Number("median_corner_residual_px", s.refined_median_corner_residual_px)
-        .BeginArray("module0_from_module");
+        .BeginArray("capture_rms");
+    for (const SystemReport::CaptureRms& c : s.refined_capture_rms) {
+      j.BeginObject().Int("capture", c.capture);
+      if (auto it = capture_names.find(c.capture); it != capture_names.end()) j.String("capture_name", it->second);
+      j.Number("rms_px", c.rms_px).Int("corners", c.corners).EndObject();
+    }
+    j.EndArray().BeginArray("module0_from_module");
     for (const Pose& p : s.module0_from_module) {
       j.BeginObject();
       WritePose(j, "pose", p);
@@ -590,6 +600,11 @@ std::string SummaryText(const CalibrationReport& rep) {
     }
     AppendLine(&out, "  reprojection rms: Horn only %.3f px, refined %.3f px", s.horn_reprojection_rms_px,
                s.refined_reprojection_rms_px);
+    if (!s.refined_capture_rms.empty()) {
+      const SystemReport::CaptureRms& w = s.refined_capture_rms[0];
+      AppendLine(&out, "  worst capture: %s, rms %.3f px over %d corners", rep.CaptureName(w.capture).c_str(), w.rms_px,
+                 w.corners);
+    }
     for (size_t k = 1; k < s.module0_from_module.size(); ++k) {
       const Pose d = s.module0_from_module_horn[k].Inverse() * s.module0_from_module[k];
       const Eigen::Vector3d& t = s.module0_from_module[k].translation_mm();
@@ -615,6 +630,8 @@ std::string SummaryText(const CalibrationReport& rep) {
     AppendLine(&out, "  back_from_front refined: moved %.4f deg, %.4f mm from the measured",
                s.back_from_front_change_deg, s.back_from_front_change_mm);
     if (!rep.wrong_plate.empty()) AppendLine(&out, "  REFUSED: %s", rep.wrong_plate.c_str());
+    if (!rep.not_converged.empty())
+      AppendLine(&out, "  not judged against the target file's back_from_front: stage 3 did not converge");
   }
   return out;
 }

@@ -210,6 +210,46 @@ std::string NoBoardFoundNote(const DetectedCaptures& detected, const Target& tar
          "): is the board in view and lit, and is that file this board's target file?";
 }
 
+namespace {
+
+// "" if every index in [0, n) was seen, else "column 12" or "columns 1, 12"
+// (1-based).
+std::string NeverSeen(const std::vector<bool>& seen, const std::string& what) {
+  std::vector<int> never;
+  for (size_t i = 0; i < seen.size(); ++i)
+    if (!seen[i]) never.push_back(static_cast<int>(i) + 1);
+  if (never.empty()) return "";
+  std::string out = what + (never.size() > 1 ? "s " : " ");
+  for (size_t i = 0; i < never.size(); ++i) out += (i ? ", " : "") + std::to_string(never[i]);
+  return out;
+}
+
+}  // namespace
+
+std::string NeverSeenCornersNote(const std::vector<BoardObservation>& observations, const Target& target,
+                                 const std::string& target_path) {
+  const int nx = target.corners_x(), ny = target.corners_y();
+  std::vector<bool> column_seen(nx, false), row_seen(ny, false);
+  int views = 0;
+  for (const BoardObservation& o : observations) {
+    if (o.corner_ids.empty()) continue;
+    ++views;
+    for (int id : o.corner_ids) {
+      if (id < 0 || id >= nx * ny) continue;
+      column_seen[id % nx] = true;
+      row_seen[id / nx] = true;
+    }
+  }
+  if (views == 0) return "";
+  const std::string columns = NeverSeen(column_seen, "column"), rows = NeverSeen(row_seen, "row");
+  if (columns.empty() && rows.empty()) return "";
+  const std::string never = columns + (columns.empty() || rows.empty() ? "" : " and ") + rows;
+  return target_path + " says corners_x " + std::to_string(nx) + ", corners_y " + std::to_string(ny) +
+         " (inner corners along a row, along a column), but its " + never + " of corners (1-based) never showed in " +
+         "any of the " + std::to_string(views) +
+         " accepted views: does the board have that many? (the rig records the file's grid)";
+}
+
 bool IsTooFewViewsProblem(const std::string& problem) {
   return problem.find("never sees the board") != std::string::npos ||
          problem.find("too few views") != std::string::npos;
@@ -236,6 +276,8 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
   }
   const std::string rejected_note = RejectedViewsNote(detected, target, target_path);
   if (!rejected_note.empty()) std::fprintf(stderr, "calibrate: warning: %s\n", rejected_note.c_str());
+  const std::string never_seen_note = NeverSeenCornersNote(input.observations, target, target_path);
+  if (!never_seen_note.empty()) std::fprintf(stderr, "calibrate: warning: %s\n", never_seen_note.c_str());
   try {
     out.result = Calibrate(input, options);
   } catch (const InputError& e) {

@@ -80,6 +80,18 @@ std::string RejectedViewsNote(const DetectedCaptures& detected, const Target& ta
 // cameras see in few captures, and such a calibration can succeed.
 std::string NoBoardFoundNote(const DetectedCaptures& detected, const Target& target, const std::string& target_path);
 
+// "" unless a row or a column of the target file's grid was never detected
+// in any accepted view (`observations`, at least one): then one line naming
+// `target_path`, its corners_x and corners_y and the rows or columns
+// (1-based) never seen. A double-sided target is found by its tags, and a
+// view keeps the corners it finds: a file hand-edited to corners_x 12 for
+// the 11 x 9 board calibrated, its 12th column never seen, and the rig
+// recorded a board of 12 x 9. A plain target's detector finds the whole
+// grid or nothing, so it never says so. A warning, not a refusal: a board
+// held every time with one edge out of view gives the same.
+std::string NeverSeenCornersNote(const std::vector<BoardObservation>& observations, const Target& target,
+                                 const std::string& target_path);
+
 // Whether a refusal's problem is one of too few views (stages 1 and 2:
 // "never sees the board", "too few views ..."; calib/intrinsics.cc,
 // calib/stereo.cc), which NoBoardFoundNote may explain; not one that shows

@@ -37,6 +37,36 @@ TEST(RejectedViewsNote, MostImagesRejectedAsOffTheLayoutNameTheTargetFile) {
   EXPECT_NE(RejectedViewsNote(Log(99, {{RejectReason::kGridMismatch, 101}}), swapped, "t.yaml"), "");
 }
 
+// A target file hand-edited to corners_x 12 for the 11 x 9 board: its 12th
+// column is never among the corners any view found (a double-sided target
+// keeps the corners its tags place). Named, with the file's counts. A row
+// and a column both; a file whose every row and column showed somewhere,
+// or no accepted view, says nothing.
+TEST(NeverSeenCornersNote, ARowOrColumnNoViewShowedNamesTheTargetFile) {
+  const Target t12 = DoubleSidedTarget(12, 9, 9.0);
+  BoardObservation a, b;
+  for (int row = 0; row < 9; ++row)
+    for (int col = 0; col < 11; ++col) (row < 5 ? a : b).corner_ids.push_back(row * 12 + col);
+  const std::vector<BoardObservation> views = {a, b, BoardObservation()};
+  EXPECT_EQ(NeverSeenCornersNote(views, t12, "t12.yaml"),
+            "t12.yaml says corners_x 12, corners_y 9 (inner corners along a row, along a column), but its column 12 "
+            "of corners (1-based) never showed in any of the 2 accepted views: does the board have that many? (the "
+            "rig records the file's grid)");
+  const Target t12x10 = DoubleSidedTarget(12, 10, 9.0);
+  BoardObservation c;  // ids in the 12 x 10 grid: rows 1..9, columns 1..11 seen
+  for (int row = 0; row < 9; ++row)
+    for (int col = 0; col < 11; ++col) c.corner_ids.push_back(row * 12 + col);
+  EXPECT_NE(NeverSeenCornersNote({c}, t12x10, "t.yaml").find("its column 12 and row 10 of corners"), std::string::npos);
+  b.corner_ids.push_back(4 * 12 + 11);  // column 12 seen once
+  EXPECT_EQ(NeverSeenCornersNote({a, b}, t12, "t12.yaml"), "");
+  EXPECT_EQ(NeverSeenCornersNote({BoardObservation()}, t12, "t12.yaml"), "");
+  const Target t11 = DoubleSidedTarget(11, 9, 9.0);
+  BoardObservation d;
+  for (int id = 0; id < 99; id += 12) d.corner_ids.push_back(id);  // the diagonal: every row, every column
+  for (int col = 0; col < 11; ++col) d.corner_ids.push_back(col);
+  EXPECT_EQ(NeverSeenCornersNote({d}, t11, "t11.yaml"), "");
+}
+
 // Most images with no board of the file's grid: for a refused calibration,
 // the note asks whether the board was seen and whether the file is its
 // (a plain 9 x 6 file against the 11 x 9 board: "too few views: 1 usable"

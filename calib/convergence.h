@@ -24,9 +24,10 @@
 namespace stereorig {
 
 // "" if every stage is within `max_rms_px`: each camera's stage 1 RMS
-// (inlier corners), each module's stage 2 RMS, and stage 3's median corner
-// residual (with more than one module, once stage 2 ran). Else one line
-// naming the earliest stage over it, each of its cameras or modules, its
+// (inlier corners), each module's stage 2 RMS, and stage 3's RMS and its
+// median corner residual (with more than one module, once stage 2 ran).
+// Else one line naming the earliest stage over it, each of its cameras or
+// modules (stage 3: its worst captures against the median capture), its
 // figure and what usually causes it, for the message refusing the rig file.
 std::string NotConvergedProblem(const CalibrationReport& report, double max_rms_px);
 

@@ -63,6 +63,23 @@ RefinedStereoSigma RightFromLeftSigma(int module, const PoseBlock& block, const 
   return s;
 }
 
+// Each capture's RMS over its corners' residual coordinates, worst first.
+// `residuals`: (du, dv) per corner; `capture_of`: each corner's capture.
+std::vector<SystemReport::CaptureRms> CaptureRmsOf(const std::vector<double>& residuals,
+                                                   const std::vector<int>& capture_of) {
+  std::map<int, std::pair<double, int>> sum_of_squares;  // capture -> (sum du^2 + dv^2, corners)
+  for (size_t i = 0; i < capture_of.size() && 2 * i + 1 < residuals.size(); ++i) {
+    auto& [s2, n] = sum_of_squares[capture_of[i]];
+    s2 += residuals[2 * i] * residuals[2 * i] + residuals[2 * i + 1] * residuals[2 * i + 1];
+    ++n;
+  }
+  std::vector<SystemReport::CaptureRms> out;
+  for (const auto& [capture, s] : sum_of_squares)
+    out.push_back({capture, std::sqrt(s.first / (2.0 * s.second)), s.second});
+  std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.rms_px > b.rms_px; });
+  return out;
+}
+
 }  // namespace
 
 std::vector<std::map<int, ModuleCaptureView>> PoseBoardsByTriangulation(const CalibrationInput& input,
@@ -226,6 +243,7 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   // face misread by the detector looks the same, and the module posed no
   // board there to check them against.
   std::vector<ceres::ResidualBlockId> corner_blocks;
+  std::vector<int> corner_capture;  // per corner block
   bool any_back = false;
   for (const BoardObservation& o : input.observations) {
     auto b = boards.find(o.capture);
@@ -265,6 +283,7 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
           CornerReprojectionCost::Create(g, *camera_of[o.camera], o.q_px[i]), new ceres::HuberLoss(options.huber_px),
           std::vector<double*>{b->second.params, module_block->params, bff->params, rl->params,
                                intrinsics[o.camera].data()}));
+      corner_capture.push_back(o.capture);
     }
   }
   rep.num_residual_corners = static_cast<int>(corner_blocks.size());
@@ -360,6 +379,7 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
     std::nth_element(distances_px.begin(), mid, distances_px.end());
     rep.refined_median_corner_residual_px = *mid;
   }
+  rep.refined_capture_rms = CaptureRmsOf(refined, corner_capture);
   rep.solver_summary = summary.BriefReport();
 
   for (int k = 0; k < M; ++k) result.module0_from_module.push_back(k == 0 ? Pose::Identity() : s_blocks[k].ToPose());

@@ -108,6 +108,15 @@ struct SystemReport {
   // the few corners the Huber loss leaves out by design.
   double refined_median_corner_residual_px = 0.0;
   int num_residual_corners = 0;
+  // Each capture's RMS over its corners' residual coordinates after the
+  // adjustment (as refined_reprojection_rms_px over all), worst first: the
+  // convergence check names the captures that raise stage 3's RMS.
+  struct CaptureRms {
+    int capture = 0;
+    double rms_px = 0.0;
+    int corners = 0;
+  };
+  std::vector<CaptureRms> refined_capture_rms;
   // Left out as the earlier stages judged (SystemExclusions), counted among
   // the views and corners the adjustment would otherwise have used:
   int num_skipped_views = 0;                             // views stage 1 dropped
