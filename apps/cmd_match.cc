@@ -29,13 +29,20 @@ namespace {
 // the final disparities alone: on the walkthrough's pair (true 472-549 px in
 // [300, 500)) the final ones lay mostly at 332-392 px, a copy of the grid
 // ~22 periods off, and only ~1 % at the range's end, where the band pass's
-// matches piled up.
+// matches piled up. Only an end the final disparities reach too
+// (RangeEndsHeld): the band pass also matches what `reconstruct` crops
+// away, the unlit background, and piled up there at an end the object lay
+// well clear of (the demo cup's module 0 in [-20, 140): final disparities
+// 43-105 px, warned of the far end).
 RangeEnds RangeEndsOf(const MatchResult& result, const MatchOptions& options, const std::vector<float>& valid_px) {
   int occupied_min_px = result.occupied_min_disparity_px, occupied_end_px = result.occupied_end_disparity_px;
   if (occupied_end_px <= occupied_min_px)
     if (const std::optional<DisparityBand> band = OccupiedDisparityBand(valid_px, 0))
       occupied_min_px = band->min_px, occupied_end_px = band->max_px;
-  return RangeEndsReached(options.min_disparity_px, options.num_disparities, occupied_min_px, occupied_end_px);
+  const RangeEnds band =
+      RangeEndsReached(options.min_disparity_px, options.num_disparities, occupied_min_px, occupied_end_px);
+  const RangeEnds held = RangeEndsHeld(valid_px, options.min_disparity_px, options.num_disparities);
+  return {.near = band.near && held.near, .far = band.far && held.far};
 }
 
 std::string RangeEndsNamed(RangeEnds ends) {

@@ -21,6 +21,8 @@
 #include "reconstruct/lit_mask.h"
 #include "reconstruct/runtime.h"
 
+#include <Eigen/Eigenvalues>
+
 namespace stereorig {
 namespace {
 
@@ -45,6 +47,38 @@ std::optional<GridPeriodMeasurement> MeasureModule(const Runtime& runtime, const
   return MeasureGridPeriodPx(left, lit);
 }
 
+// A module's points lying farther than this RMS off their plane say the
+// capture is not a flat plate: the period, stretched by the foreshortening
+// where the surface turns, is not the grid's own. The blocks' spread does
+// not show it: each block's period is summed along whole rows, so a surface
+// curved along them (or turned as a whole) reads alike in every block. On
+// the demo scenes (each module): plate 0.07 mm; sphere 2.9, ball bar 3.4,
+// cup 3.4-3.6, tuber 4.1 mm, whose P read 8.21-8.46 px against the plate's
+// 8.07 while their spreads stayed 0.03-0.29 px. 0.5 mm is 7x the plate's
+// noise and a sixth of the nearest curved scene.
+constexpr double kMaxPlaneRmsMm = 0.5;
+// A module's points, fitted with a plane: the RMS of their distances to
+// it, mm (the smallest eigenvalue of their covariance). Nothing with fewer
+// than kMinPlanePoints points.
+constexpr int kMinPlanePoints = 1000;
+std::optional<double> PlaneRmsMm(const PointCloud& cloud, int module) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d sum_sq = Eigen::Matrix3d::Zero();
+  int n = 0;
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    if (cloud.module[i] != module) continue;
+    const Eigen::Vector3d p = cloud.xyz_mm[i].cast<double>();
+    sum += p;
+    sum_sq += p * p.transpose();
+    ++n;
+  }
+  if (n < kMinPlanePoints) return std::nullopt;
+  const Eigen::Vector3d mean = sum / n;
+  const Eigen::Matrix3d covariance = sum_sq / n - mean * mean.transpose();
+  const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues()(0);
+  return std::sqrt(std::max(0.0, smallest));
+}
+
 }  // namespace
 
 int RunTune(int argc, char** argv) {
@@ -59,8 +93,10 @@ int RunTune(int argc, char** argv) {
       "another projector, lens or working distance (docs/reconstruct.md, 'Another projector'). A P within 0.1 px "
       "of a half pixel is warned of: another capture may round it the other way.\n"
       "Capture a flat matte plate facing the modules, lasers on, filling the measurement volume's middle: on a "
-      "curved or turned surface the period is stretched by the foreshortening, and the spread printed per "
-      "module says so. The other keys of --options are kept; --out writes them with the new ones (YAML comments "
+      "curved or turned surface the period is stretched by the foreshortening. Per module it reconstructs the "
+      "capture and prints how far its points lie off a plane (RMS), and warns above 0.5 mm: not a flat plate; "
+      "a plate turned away from the module is not detected (its period is stretched alike everywhere). The other keys "
+      "of --options are kept; --out writes them with the new ones (YAML comments "
       "of --options are not carried over).\n\n"
       "Example:\n  stereorig tune --rig rig.yaml --capture plate --options line.yaml --out line_tuned.yaml\n"
       "  stereorig reconstruct --rig rig.yaml --capture part1 --options line_tuned.yaml --out part1.ply",
@@ -87,6 +123,7 @@ int RunTune(int argc, char** argv) {
   const std::vector<cv::Mat> images = LoadCapture(capture_dir, rig);
   const Runtime runtime(rig, options);
 
+  const Reconstruction reconstruction = runtime.Process(images, false);
   std::vector<double> periods;
   std::string measured;  // "module 0 8.07 px (spread 0.04 px, turned 2.53 deg), ...": the file's header
   for (const ModulePlan& plan : runtime.plans()) {
@@ -102,6 +139,17 @@ int RunTune(int argc, char** argv) {
                    "tune: warning: module %d's period varies by more than %.0f %% over its image: a curved or turned "
                    "surface; measure on a flat plate facing the module\n",
                    plan.module, 100 * kMaxRelativeSpread);
+    if (const std::optional<double> rms_mm = PlaneRmsMm(reconstruction.cloud, plan.module)) {
+      std::printf("  its points lie %.2f mm RMS off a plane\n", *rms_mm);
+      if (*rms_mm > kMaxPlaneRmsMm)
+        std::fprintf(stderr,
+                     "tune: warning: module %d's points in %s lie %.2f mm RMS off a plane (more than %.1f mm): not a "
+                     "flat plate, and the period is stretched where the surface turns; measure on a flat plate "
+                     "facing the module\n",
+                     plan.module, capture_dir.c_str(), *rms_mm, kMaxPlaneRmsMm);
+    } else {
+      std::printf("  its flatness was not read (fewer than %d points)\n", kMinPlanePoints);
+    }
     if (std::isnan(m->shift_per_row_px)) {
       std::printf(
           "  its turn against the rows was not read: check the line index's vernier by hand "

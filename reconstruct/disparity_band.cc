@@ -51,4 +51,15 @@ RangeEnds RangeEndsReached(int min_disparity_px, int num_disparities, int occupi
           .far = occupied_min_px - min_disparity_px <= kBandBinPx};
 }
 
+RangeEnds RangeEndsHeld(const std::vector<float>& disparities_px, int min_disparity_px, int num_disparities) {
+  const int end_px = min_disparity_px + num_disparities;
+  int at_near = 0, at_far = 0;
+  for (float d : disparities_px) {
+    at_near += d >= end_px - kBandBinPx;
+    at_far += d < min_disparity_px + kBandBinPx;
+  }
+  const int enough = std::max(2, int(std::ceil(kSparseShare * disparities_px.size())));
+  return {.near = at_near >= enough, .far = at_far >= enough};
+}
+
 }  // namespace stereorig

@@ -51,4 +51,13 @@ struct RangeEnds {
 };
 RangeEnds RangeEndsReached(int min_disparity_px, int num_disparities, int occupied_min_px, int occupied_end_px);
 
+// Which ends of the same range a map's final disparities reach: at least
+// kSparseShare of them (and 2) within one bin (kBandBinPx) of the end. The
+// band alone can reach an end the output does not: its half-resolution
+// pass also matches the unlit background and the region's edges (on the
+// demo cup's module 0, a cluster at -16..0 px, 99 % unlit, where every
+// final disparity lay at 43-105 px), so `match` warns only of an end both
+// reach.
+RangeEnds RangeEndsHeld(const std::vector<float>& disparities_px, int min_disparity_px, int num_disparities);
+
 }  // namespace stereorig
