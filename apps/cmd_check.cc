@@ -195,17 +195,26 @@ int RunCheck(int argc, char** argv) {
         {{"name", f.name}, {"value", f.value}, {"threshold", f.threshold}, {"pass", f.pass}, {"samples", f.samples}});
   }
   // Views set aside whole: their corners fit no board pose, not even their
-  // own (a detection slip where the board is seen nearly edge-on).
+  // own (a detection slip where the board is seen nearly edge-on), or they
+  // disagree with their capture's other views in that capture only (an
+  // image taken at another moment).
   report["views_set_aside"] = nlohmann::json::array();
   for (const SetAsideView& v : result.views_set_aside) {
     const auto name = detected.capture_names.find(v.capture);
     const std::string capture = name != detected.capture_names.end() ? name->second : std::to_string(v.capture);
-    std::printf(
-        "set aside: capture %s cam%d: its corners jump about their own board pose by %.3f px (bound %.3f px): "
-        "misplaced (taken for the wrong squares, or far noisier than the camera's other views), not used\n",
-        capture.c_str(), v.camera, v.jump_rms_px, v.bound_px);
-    report["views_set_aside"].push_back(
-        {{"capture", capture}, {"camera", v.camera}, {"jump_rms_px", v.jump_rms_px}, {"bound_px", v.bound_px}});
+    const bool other_moment = v.why == SetAsideWhy::kOtherMoment;
+    std::printf(other_moment ? "set aside: capture %s cam%d: off the capture's other views by %.3f px (bound %.3f "
+                               "px), in this capture only: taken at another moment than the capture's other "
+                               "views?, not used\n"
+                             : "set aside: capture %s cam%d: its corners jump about their own board pose by %.3f px "
+                               "(bound %.3f px): misplaced (taken for the wrong squares, or far noisier than the "
+                               "camera's other views), not used\n",
+                capture.c_str(), v.camera, v.FigurePx(), v.bound_px);
+    report["views_set_aside"].push_back({{"capture", capture},
+                                         {"camera", v.camera},
+                                         {"why", other_moment ? "other_moment" : "corners_jump"},
+                                         {other_moment ? "off_px" : "jump_rms_px", v.FigurePx()},
+                                         {"bound_px", v.bound_px}});
   }
   // The board's size as each module measures it, over the squares measured
   // with (the target file's, or the record's where it re-measured them;

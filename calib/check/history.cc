@@ -177,7 +177,7 @@ long long AppendToHistory(const std::string& path, const HistoryRun& run, const 
       sqlite3_bind_int64(aside.get(), 1, id);
       sqlite3_bind_text(aside.get(), 2, capture.c_str(), -1, SQLITE_TRANSIENT);
       sqlite3_bind_int(aside.get(), 3, v.camera);
-      sqlite3_bind_double(aside.get(), 4, v.jump_rms_px);
+      sqlite3_bind_double(aside.get(), 4, v.FigurePx());  // the figure that set it aside
       sqlite3_bind_double(aside.get(), 5, v.bound_px);
       if (sqlite3_step(aside.get()) != SQLITE_DONE) {
         throw InputError(path, std::string("history: ") + sqlite3_errmsg(db.get()));

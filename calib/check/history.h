@@ -44,7 +44,9 @@ struct HistoryPoint {
 };
 
 // One view the check set aside whole on one run (CheckResult's
-// views_set_aside): its corners jumped about their own board pose.
+// views_set_aside): its corners jumped about their own board pose
+// (jump_rms_px), or it was off its capture's other views in that capture
+// only (jump_rms_px holds that figure, SetAsideView::FigurePx).
 struct HistorySetAside {
   long long run_id = 0;
   std::string date_utc;

@@ -48,13 +48,21 @@ struct CheckFigure {
   int samples = 0;  // corners or captures behind the figure
 };
 
-// A view the check set aside whole: its corners jump about their own board
-// pose, beyond any smooth field a lens change leaves (RunNightlyCheck).
+// Why a view was set aside (RunNightlyCheck): its corners jump about their
+// own board pose, beyond any smooth field a lens change leaves; or it
+// disagrees with the rest of its capture, in that capture only (taken at
+// another moment than the capture's other views?).
+enum class SetAsideWhy { kCornersJump, kOtherMoment };
+
+// A view the check set aside whole.
 struct SetAsideView {
   int capture = -1;
   int camera = -1;
-  double jump_rms_px = 0;  // per axis: residuals about its own pose, a quadratic field taken out
-  double bound_px = 0;     // what it had to be within
+  double jump_rms_px = 0;  // kCornersJump: per axis, neighbour jumps of its residuals about its own pose
+  double bound_px = 0;     // what jump_rms_px, or off_px, had to be within
+  SetAsideWhy why = SetAsideWhy::kCornersJump;
+  double off_px = 0;  // kOtherMoment: median corner error through the pose its capture's other views imply
+  double FigurePx() const { return why == SetAsideWhy::kOtherMoment ? off_px : jump_rms_px; }
 };
 
 struct CheckResult {
