@@ -895,6 +895,33 @@ TEST(NightlyCheck, AWrongTargetFileIsNamedAndABumpIsNot) {
 // only for those given: five captures, one of which shows the board to
 // camera 1 alone in a view with every other corner slipped 2 px along the
 // row (a jump far beyond any bound), was judged on four before.
+// A camera loose in its mount, its rows off by a different amount in every
+// capture (1, 2, ... 8 px: module 1's right camera): the rectified-row
+// figure's spread term once took the captures' spread as it came, and that
+// spread (per-capture mean squares 1 to 64 px^2) raised the threshold above
+// the figure itself (~5 px read against ~5.6 px: "yes"). Capped at the most
+// an unchanged rig's noise and calibration error allow (every error of a
+// capture one shared draw: sqrt(2 / 8) of ~0.08 px^2 at 0.2 px corners), it
+// stays near the noise (under 1 px) and the figure fails.
+TEST(NightlyCheck, ASpreadBetweenCapturesNoNoiseExplainsDoesNotLoosenTheRowFigure) {
+  const SimulatedRig truth = MakeDefaultRig();
+  const Target target = DefaultTarget();
+  const Rig stored = StoredRig(truth);
+  const int loose = stored.module(1).right_camera;
+  std::vector<BoardObservation> views = Observe(truth, target, {}, 5);
+  for (BoardObservation& v : views)
+    if (v.camera == loose)
+      for (Eigen::Vector2d& q : v.q_px) q.y() += 1.0 + v.capture;
+  const CheckResult r = RunNightlyCheck(stored, target, views, CheckOptions(), "test");
+  const auto row = std::find_if(r.figures.begin(), r.figures.end(),
+                                [](const CheckFigure& f) { return f.name == "module1_rectified_row_rms_px"; });
+  ASSERT_NE(row, r.figures.end());
+  EXPECT_GT(row->value, 3.0);  // the rows' 1-8 px offsets
+  EXPECT_LT(row->threshold, 1.0) << "the captures' spread loosened the threshold";
+  EXPECT_FALSE(row->pass);
+  EXPECT_FALSE(r.ok());
+}
+
 TEST(NightlyCheck, TooFewCapturesLeftOnceAViewIsSetAsideIsRefused) {
   const SimulatedRig truth = MakeDefaultRig();
   const Target target = DefaultTarget();
