@@ -88,6 +88,10 @@ std::vector<std::pair<std::string, std::string>> DatasetInputs(const std::string
 }
 
 FolderToCreate OutputPaths::ClaimFolder(const std::string& path, const std::string& what) {
+  if (path == "-")  // as a file output's (RequireReplaceableOutput): "-" read as standard output
+    throw InputError(path,
+                     "outputs are folders and files, not standard output: name the folder (./- for one "
+                     "called '-')");
   const fs::path key = NormalPath(path);
   if (const auto it = inputs_.find(key); it != inputs_.end())
     throw InputError(path, "is " + it->second + ", not a folder for " + what);

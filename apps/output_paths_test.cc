@@ -120,6 +120,19 @@ std::string ClaimAsUnprivileged(const std::function<void()>& claim) {
 // create there, is refused when claimed, naming the path and the reason,
 // not after the command's work when the file is written. The same claims
 // in a folder anyone may write in pass (the control).
+// "-" as an output folder (reconstruct --out-dir -, --rectified-out -) made
+// a folder of that name, where standard output is the usual reading, as a
+// file output's "-" is refused (RequireReplaceableOutput).
+TEST(OutputPaths, ADashIsRefusedAsAFolderAsAsAFile) {
+  EXPECT_NE(InputErrorMessage([] {
+              (void)OutputPaths().ClaimFolder("-", "the output folder");
+            }).find("-: outputs are folders and files, not standard output"),
+            std::string::npos);
+  EXPECT_NE(InputErrorMessage([] { OutputPaths().Claim("-", "the report"); }).find("-: outputs are files"),
+            std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists("-"));
+}
+
 TEST(OutputPaths, AFolderThisProcessMayNotWriteInIsRefusedWhenClaimed) {
   // In /tmp, not the build tree: user 65534 must be able to reach the
   // folders, and a checkout may lie below a folder only root may enter

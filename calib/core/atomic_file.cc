@@ -30,14 +30,23 @@ std::string MakeTempPath(const std::string& path) {
 void RequireReplaceableOutput(const std::string& path) {
   if (path == "-")
     throw InputError(path, "outputs are files, not standard output: name the file (./- for a file called '-')");
+  auto kind = [](const struct stat& st) -> const char* {
+    return S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
+           : S_ISFIFO(st.st_mode)                     ? "a pipe (FIFO)"
+           : S_ISSOCK(st.st_mode)                     ? "a socket"
+                                                      : nullptr;
+  };
   struct stat st {};
   if (lstat(path.c_str(), &st) != 0) return;  // nothing there yet (or not looked up: the write names why)
-  const char* what = S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
-                     : S_ISFIFO(st.st_mode)                     ? "a pipe (FIFO)"
-                     : S_ISSOCK(st.st_mode)                     ? "a socket"
-                                                                : nullptr;
+  const char* what = kind(st);
+  // A link to one (/dev/stdout, /proc/self/fd/1) means that stream: the
+  // rename would replace the link, a system one in /dev.
+  struct stat target {};
+  const bool link_to_stream =
+      what == nullptr && S_ISLNK(st.st_mode) && stat(path.c_str(), &target) == 0 && kind(target) != nullptr;
+  if (link_to_stream) what = kind(target);
   if (what != nullptr)
-    throw InputError(path, std::string("is ") + what +
+    throw InputError(path, std::string(link_to_stream ? "is a link to " : "is ") + what +
                                ", not a file: an output is written beside its path and renamed over it, which "
                                "would replace it; name a regular file");
 }

@@ -15,8 +15,9 @@ namespace stereorig {
 // a rename over it: "-" (a file of that name, where a user means standard
 // output) and an existing device, pipe or socket (/dev/null, a FIFO: the
 // rename would replace the node itself, as root a system device, with a
-// regular file). A symbolic link is no problem: the rename replaces the
-// link, its target is left as it was. AtomicOutput checks this; commands
+// regular file), or a symbolic link to one (/dev/stdout). A link to a file
+// or to nothing is no problem: the rename replaces the link, its target is
+// left as it was. AtomicOutput checks this; commands
 // check it up front too (apps/output_paths.h), before their work.
 void RequireReplaceableOutput(const std::string& path);
 
