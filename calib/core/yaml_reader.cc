@@ -123,6 +123,24 @@ size_t TypingDistance(const std::string& a, const std::string& b) {
   return d[a.size()][b.size()];
 }
 
+// Keys that differ in one axis letter or one digit, in the same place
+// (corners_x / corners_y, fx / fy, cam0 / cam1): siblings a reader reads
+// both of, not one misspelt as the other (corners_y named as a typo for a
+// missing corners_x sent the user to rename the right one).
+bool SiblingKeys(const std::string& a, const std::string& b) {
+  if (a.size() != b.size()) return false;
+  auto axis = [](char c) { return c == 'x' || c == 'y' || c == 'z'; };
+  auto digit = [](char c) { return c >= '0' && c <= '9'; };
+  int differ = 0;
+  bool siblings = true;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (a[i] == b[i]) continue;
+    ++differ;
+    siblings = (axis(a[i]) && axis(b[i])) || (digit(a[i]) && digit(b[i]));
+  }
+  return differ == 1 && siblings;
+}
+
 }  // namespace
 
 std::string YamlMap::MisspeltAs(const std::string& key) const {
@@ -133,7 +151,7 @@ std::string YamlMap::MisspeltAs(const std::string& key) const {
   size_t closest_distance = most + 1;
   for (const auto& kv : node_) {
     const std::string& other = kv.first.Scalar();
-    if (read_.count(other)) continue;
+    if (read_.count(other) || SiblingKeys(key, other)) continue;
     const size_t d = TypingDistance(key, other);
     if (d < closest_distance) {
       closest = other;

@@ -95,6 +95,15 @@ TEST(YamlMap, AMissingKeyNamesAKeyOfTheMapThatIsAMisspellingOfIt) {
   EXPECT_EQ(InputErrorMessage([&] { swapped.GetString("units"); }),
             "f.yaml: units: missing key (this map has Units instead: a typo?)");
 
+  // A sibling key (another axis, another index) is not named: the reader
+  // reads it too, under its own name.
+  YamlMap sibling = YamlMap::LoadString("corners_y: 8\nfx: 1000\ncam1: 0\ncorners_z: 1\n", "t.yaml");
+  EXPECT_EQ(InputErrorMessage([&] { sibling.GetInt("corners_x"); }), "t.yaml: corners_x: missing key");
+  EXPECT_EQ(InputErrorMessage([&] { sibling.GetDouble("fy"); }), "t.yaml: fy: missing key");
+  EXPECT_EQ(InputErrorMessage([&] { sibling.GetInt("cam0"); }), "t.yaml: cam0: missing key");
+  EXPECT_EQ(InputErrorMessage([&] { sibling.GetInt("corner_y"); }),
+            "t.yaml: corner_y: missing key (this map has corners_y instead: a typo?)");
+
   YamlMap far = YamlMap::LoadString("baseline: 90\nrfl: 1\n", "f.yaml");
   EXPECT_EQ(InputErrorMessage([&] { far.GetDouble("right_from_left"); }), "f.yaml: right_from_left: missing key");
   EXPECT_EQ(InputErrorMessage([&] { far.Finish(); }), "f.yaml: baseline: unknown key");
