@@ -450,31 +450,47 @@ void SetAsideViewsOfAnotherMoment(Inputs& in, std::vector<SetAsideView>* set_asi
       by_camera[v->camera].push_back({capture, off});
     }
   }
-  for (auto& [capture, vs] : in.by_capture) {
-    std::vector<const BoardObservation*> kept;
+  // The views over their bound, and in how many captures each camera has
+  // one.
+  std::map<const BoardObservation*, double> over;  // view -> its bound
+  std::vector<int> captures_over(in.rig.num_cameras(), 0);
+  for (const auto& [capture, vs] : in.by_capture) {
     for (const BoardObservation* v : vs) {
       const auto it = off_px.find(v);
+      if (it == off_px.end()) continue;
       std::vector<double> camera_elsewhere, capture_others;
-      if (it != off_px.end()) {
-        for (const auto& [c, off] : by_camera[v->camera])
-          if (c != capture) camera_elsewhere.push_back(off);
-        for (const BoardObservation* w : vs)
-          if (w != v && off_px.count(w)) capture_others.push_back(off_px.at(w));
-      }
-      if (camera_elsewhere.size() < 2 || capture_others.size() < 2) {
-        kept.push_back(v);
-        continue;
-      }
+      for (const auto& [c, off] : by_camera[v->camera])
+        if (c != capture) camera_elsewhere.push_back(off);
+      for (const BoardObservation* w : vs)
+        if (w != v && off_px.count(w)) capture_others.push_back(off_px.at(w));
+      if (camera_elsewhere.size() < 2 || capture_others.size() < 2) continue;
       const double bound = kOtherMomentFactor * std::max({LowerMedian(camera_elsewhere), LowerMedian(capture_others),
                                                           in.sigma_px[v->camera]});
       if (it->second > bound) {
-        SetAsideView aside{capture, v->camera, 0, bound};
-        aside.why = SetAsideWhy::kOtherMoment;
-        aside.off_px = it->second;
-        set_aside->push_back(aside);
-      } else {
-        kept.push_back(v);
+        over[v] = bound;
+        ++captures_over[v->camera];
       }
+    }
+  }
+  // Only a camera's one such view of the night is set aside. A camera off
+  // in two or more captures moved during the night (a knock after the
+  // first captures: its later views agree with each other, and the lower
+  // median of its readings is still the unmoved captures'), or its frames
+  // slip again and again: either must be judged, not set aside until the
+  // night reads "ok" (a reviewer's night: camera 1 turned 0.05 deg in the
+  // last 3 of 8 captures, each set aside, verdict ok).
+  for (auto& [capture, vs] : in.by_capture) {
+    std::vector<const BoardObservation*> kept;
+    for (const BoardObservation* v : vs) {
+      const auto it = over.find(v);
+      if (it == over.end() || captures_over[v->camera] > 1) {
+        kept.push_back(v);
+        continue;
+      }
+      SetAsideView aside{capture, v->camera, 0, it->second};
+      aside.why = SetAsideWhy::kOtherMoment;
+      aside.off_px = off_px.at(v);
+      set_aside->push_back(aside);
     }
     vs.swap(kept);
   }

@@ -145,6 +145,16 @@ TEST(WriteFileAtomically, ADevicePipeOrDashIsRefusedAndLeftAsItWas) {
   EXPECT_NE(testing::InputErrorMessage([&] { RequireReplaceableOutput("-"); }).find("-: outputs are files"),
             std::string::npos);
   EXPECT_EQ(testing::InputErrorMessage([&] { RequireReplaceableOutput(dir + "/new.json"); }), "");
+  // A link to the FIFO means that stream (as /dev/stdout does): the rename
+  // would replace the link. A link to nothing is a file to write.
+  std::filesystem::create_symlink(fifo, dir + "/stdout");
+  EXPECT_NE(testing::InputErrorMessage([&] {
+              WriteFileAtomically(dir + "/stdout", "{}");
+            }).find("/stdout: is a link to a pipe (FIFO), not a file"),
+            std::string::npos);
+  EXPECT_TRUE(std::filesystem::is_symlink(dir + "/stdout"));
+  std::filesystem::create_symlink(dir + "/nothing.json", dir + "/dangling");
+  EXPECT_EQ(testing::InputErrorMessage([&] { RequireReplaceableOutput(dir + "/dangling"); }), "");
 }
 
 // A symbolic link at an output path is replaced by the file (the rename's
