@@ -631,7 +631,8 @@ std::string SummaryText(const CalibrationReport& rep) {
                s.back_from_front_change_deg, s.back_from_front_change_mm);
     if (!rep.wrong_plate.empty()) AppendLine(&out, "  REFUSED: %s", rep.wrong_plate.c_str());
     if (!rep.not_converged.empty())
-      AppendLine(&out, "  not judged against the target file's back_from_front: stage 3 did not converge");
+      AppendLine(&out, "  not judged against the target file's back_from_front: %s",  // "stage K did not converge"
+                 rep.not_converged.substr(0, rep.not_converged.find(':')).c_str());
   }
   return out;
 }

@@ -408,6 +408,27 @@ TEST(CalibrateReport, ExportsCameramodelsThatMrcalReads) {
 // it in the summary, as the detection lines name it; the JSON keeps the
 // index and adds the name beside it. Without a name (observations from
 // elsewhere) the index stands, as before.
+// The summary's stage-3 section says which stage did not converge: a
+// refusal by stage 2 (stage 3 runs after it all the same) was summarised
+// as "stage 3 did not converge" (a review).
+TEST(CalibrateReport, TheStageThatDidNotConvergeIsTheOneSummarised) {
+  CalibrationReport rep;
+  rep.num_modules = 2;
+  StereoReport module;
+  module.module_name = "module0";
+  rep.stereo = {module, module};  // stages 2 and 3 ran
+  rep.not_converged = "stage 2 did not converge: module0, rms 0.03 px over --max-rms-px 0.02";
+  std::string text = SummaryText(rep);
+  EXPECT_NE(text.find("not judged against the target file's back_from_front: stage 2 did not converge\n"),
+            std::string::npos)
+      << text;
+  rep.not_converged = "stage 3 did not converge: rms 24.38 px";
+  text = SummaryText(rep);
+  EXPECT_NE(text.find("not judged against the target file's back_from_front: stage 3 did not converge\n"),
+            std::string::npos)
+      << text;
+}
+
 TEST(CalibrateReport, NamesCapturesByTheirFoldersWhereKnown) {
   CalibrationReport rep;
   rep.num_modules = 1;
