@@ -221,7 +221,7 @@ int RunVerify(int argc, char** argv) {
     filled_skipped.push_back(measured.filled_skipped);
     read_notes.push_back(measured.note);
     try {
-      positions.push_back(EvaluateArtifact(artifact, measured.points, options, cloud));
+      positions.push_back(EvaluateArtifact(artifact, measured.points, options, cloud, measured.normals));
     } catch (const NotTheArtifactError& refused) {
       // The cloud read, but its points are not the artifact (too few on it,
       // none of the certified size): this position is not evaluated, and
@@ -351,7 +351,10 @@ int RunVerify(int argc, char** argv) {
       // Its meaning since it came: the captured points not in the dense part.
       pj["plate_points_off_outline"] = e.plate_points_off_outline;
       pj["plate_points_outside_rectangle"] = e.plate_points_outside_rectangle;
+      pj["plate_points_far_face"] = e.plate_points_far_face;
     }
+    for (const std::string& note : e.notes) std::printf("%-8zu note: %s\n", i + 1, note.c_str());
+    if (!e.notes.empty()) pj["notes"] = e.notes;
     if (!e.judged()) std::printf("%-8zu NOT JUDGED: %s\n", i + 1, e.not_judged_reason.c_str());
     report["positions"].push_back(pj);
   }
@@ -364,7 +367,7 @@ int RunVerify(int argc, char** argv) {
       "of the points used to "
       "the fitted shape(s); pass: under the decision rule, - = not judged (the line NOT JUDGED says why)%s\n",
       artifact.type == ArtifactType::kBallBar ? ", or in the shaft's cone"
-      : artifact.type == ArtifactType::kPlate ? ", or outside the face's outline"
+      : artifact.type == ArtifactType::kPlate ? ", or outside the face's outline, or on its far face"
                                               : "",
       options.plate_edge_margin_mm,
       artifact.type == ArtifactType::kPlate

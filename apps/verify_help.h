@@ -21,7 +21,11 @@ allows. What is found must be the artifact: a sphere whose captured points fit a
 10% off the certified one, or a plane whose dense part (a few stray points do not count) spans less
 than half of the plate's length or width or more than the plate plus twice the capture band, is
 refused (that position not evaluated, below). Points added by hole filling (PLY module 255) are not
-measured and are skipped: the fit never uses the reconstruction's own shape prior.
+measured and are skipped: the fit never uses the reconstruction's own shape prior. A plate's face
+holding two parallel layers in the band is told apart by the cloud's normals (nx ny nz, facing the
+measuring module's camera): measured from opposite sides, the smaller is a thin plate's far face, left
+out of F (counted in off); from the same side, a module measuring the face off, kept in F (which it
+fails); without normals F spans both. A note line says which.
 
 A position whose points or certificate leave a figure (P_S, SD; F, P_F by a large certified flatness
 or form uncertainty) undetermined cannot pass: it is not judged (exit 2) when the figure's standard
@@ -63,7 +67,7 @@ undo it). Otherwise it is shown with '-' in the pass column and has no zone.
 The table gives, per position, each figure's standard uncertainty (u_mm; both parts on a line of
 their own), the points in the cloud and where each of them went, in exactly one column: filled
 (skipped), off (not the artifact's: outside the capture band, in a ball bar's shaft cone, off a
-plate's outline), edge (in a plate's 5 mm edge margin), excluded and used; per sphere its diameter,
+plate's outline or on its far face), edge (in a plate's 5 mm edge margin), excluded and used; per sphere its diameter,
 the diameter's standard uncertainty, the half-angle of the cap its points cover and its form (the
 range of its residuals; on a ball bar reported, not judged: a patch one grid period off on one ball
 shows there); per plate the outline of its face's dense part.

@@ -914,22 +914,46 @@ TEST(VerifyCli, TheDecisionRuleJudgesTheUncertaintyRangeAndTheReportSaysWhichRul
 
 namespace {
 
-// An ascii PLY of a square plate's face, `size_mm` at 1 mm, and where
-// thickness_mm > 0 its far face that far behind it at 1.5 mm (fewer points:
-// RANSAC locates the near face): a plate seen from both sides. Exact.
-std::string WritePlate(const std::string& name, double size_mm, double thickness_mm) {
+// How WritePlate's points carry normals (nx ny nz, facing the camera of the
+// module that measured each point, as a stereorig cloud's: docs/formats.md).
+enum class PlateNormals {
+  kNone,           // no nx ny nz: a cloud from another tool
+  kFarFaceBehind,  // the second layer measured from the other side: a thin plate's far face
+  kSameSide,       // both layers measured from the face's side: a module measuring the face off
+};
+
+// An ascii PLY of a square plate's face at z = 200, `size_mm` at 1 mm, and
+// where layer_mm > 0 a second layer that far behind it (z = 200 + layer_mm)
+// at 1.5 mm (fewer points: RANSAC locates the face). Exact. The face is seen
+// from below (its normals -z); the second layer as `normals` says.
+std::string WritePlate(const std::string& name, double size_mm, double layer_mm,
+                       PlateNormals normals = PlateNormals::kNone) {
   const std::string path = ::testing::TempDir() + "/" + name + "_" + std::to_string(getpid()) + ".ply";
-  std::vector<std::array<double, 3>> pts;
+  std::vector<std::array<double, 4>> pts;  // x, y, z, nz
   for (double u = -size_mm / 2; u <= size_mm / 2; u += 1.0)
-    for (double v = -size_mm / 2; v <= size_mm / 2; v += 1.0) pts.push_back({u, v, 200});
-  if (thickness_mm > 0)
+    for (double v = -size_mm / 2; v <= size_mm / 2; v += 1.0) pts.push_back({u, v, 200, -1});
+  const double layer_nz = normals == PlateNormals::kFarFaceBehind ? 1 : -1;
+  if (layer_mm > 0)
     for (double u = -size_mm / 2; u <= size_mm / 2; u += 1.5)
-      for (double v = -size_mm / 2; v <= size_mm / 2; v += 1.5) pts.push_back({u, v, 200 + thickness_mm});
+      for (double v = -size_mm / 2; v <= size_mm / 2; v += 1.5) pts.push_back({u, v, 200 + layer_mm, layer_nz});
   std::ofstream f(path);
   f << "ply\nformat ascii 1.0\nelement vertex " << pts.size()
-    << "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
-  for (const auto& q : pts) f << q[0] << " " << q[1] << " " << q[2] << "\n";
+    << "\nproperty double x\nproperty double y\nproperty double z\n"
+    << (normals == PlateNormals::kNone ? "" : "property float nx\nproperty float ny\nproperty float nz\n")
+    << "end_header\n";
+  for (const auto& q : pts) {
+    f << q[0] << " " << q[1] << " " << q[2];
+    if (normals != PlateNormals::kNone) f << " 0 0 " << q[3];
+    f << "\n";
+  }
   return path;
+}
+
+// The F row's value in verify's table (NaN without one).
+double FValue(const std::string& out) {
+  const std::string row = "\n1        F ";
+  const size_t at = out.find(row);
+  return at == std::string::npos ? NAN : std::stod(out.substr(at + row.size()));
 }
 
 const char* kPlate =
@@ -939,23 +963,30 @@ const char* kPlate =
 }  // namespace
 
 // A 3 mm plate seen from both sides: its far face lies in the capture band,
-// and F read the thickness (FAIL, no hint why). Now F is not judged and the
-// line names the far face, 3.0 mm behind (exact points: the faces' medians
-// are 3.0 mm apart), and its points inside the face's outline eroded by the
-// 5 mm edge margin (|u|, |v| <= 60 mm at 1.5 mm: 80 x 80). A band asked for under the floor (2 x MPE) is raised,
-// and said so (--capture-band-mm 1 read as taken).
-TEST(VerifyCli, AThinPlatesFarFaceIsNamedAndARaisedCaptureBandIsSaid) {
-  const std::string thin = WritePlate("thin_plate", 130, 3.0);
-  auto r = RunCli("verify --artifact " + WriteArtifact(kPlate) + " --cloud " + thin);
-  EXPECT_EQ(r.code, 2) << r.out << r.err;
-  EXPECT_NE(r.out.find("1        NOT JUDGED: F is not judged: the face's points hold two parallel faces 3.0 mm apart "
-                       "(6400 points on the second,"),
+// and F read the thickness (FAIL, no hint why); 6dd433e then left F not
+// judged (exit 2). Its normals face the other side: it is left out, F is the
+// face's alone (exact points: 0) and passes, and a note names the far face,
+// 3.0 mm behind (exact points), and its points inside the face's outline
+// eroded by the 5 mm edge margin (|u|, |v| <= 60 mm at 1.5 mm: 80 x 80),
+// counted in off. A band asked for under the floor (2 x MPE) is raised, and
+// said so (--capture-band-mm 1 read as taken).
+TEST(VerifyCli, AThinPlatesFarFaceIsLeftOutAndNamedAndARaisedCaptureBandIsSaid) {
+  const std::string thin = WritePlate("thin_plate", 130, 3.0, PlateNormals::kFarFaceBehind);
+  const std::string report = ::testing::TempDir() + "/thin_plate_" + std::to_string(getpid()) + ".json";
+  auto r = RunCli("verify --artifact " + WriteArtifact(kPlate) + " --cloud " + thin + " --report " + report);
+  EXPECT_EQ(r.code, 0) << r.out << r.err;
+  {
+    std::ifstream f(report);
+    const nlohmann::json position = nlohmann::json::parse(f)["positions"][0];
+    EXPECT_EQ(position["plate_points_far_face"].get<int>(), 6400);
+    EXPECT_EQ(position["notes"][0].get<std::string>().rfind("the plate's far face, 3.0 mm behind the face", 0), 0u);
+  }
+  EXPECT_NE(r.out.find("1        F          0.0000        -  1.5000  yes"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1        note: the plate's far face, 3.0 mm behind the face (6400 points, measured from its "
+                       "other side: their normals face away from the face's), left out of F and counted in off\n"),
             std::string::npos)
       << r.out;
-  EXPECT_NE(r.out.find("the plate's far face, seen by modules on its other side (a plate thinner than the 5.0 mm "
-                       "capture band)"),
-            std::string::npos)
-      << r.out;
+  EXPECT_NE(r.out.find("verdict: PASS"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("note: --capture-band-mm"), std::string::npos) << r.out;
   // One face alone: judged, and F 0 exactly.
   r = RunCli("verify --artifact " + WriteArtifact(kPlate) + " --cloud " + WritePlate("one_face", 130, 0) +
@@ -964,6 +995,40 @@ TEST(VerifyCli, AThinPlatesFarFaceIsNamedAndARaisedCaptureBandIsSaid) {
   EXPECT_NE(r.out.find("artifact: test plate (plate); capture band 3.0 mm\nnote: --capture-band-mm 1 raised to 3.0 "
                        "mm, twice the MPE: a narrower band would cut off an error beyond the MPE before the figures "
                        "see it\n"),
+            std::string::npos)
+      << r.out;
+}
+
+// A module measuring the face 0.6 mm off, from the face's side (normals the
+// same way): the miscalibration F must catch. It FAILS, exit 1 (6dd433e read
+// it as a far face: NOT JUDGED, exit 2), F at least the offset (exact points;
+// the least-squares plane of two layers of unequal extent tilts a little:
+// more), and the note says what the two layers likely are. Without normals the
+// layers cannot be told apart: F spans both (a 3 mm plate's far face fails
+// it, exit 1, not NOT JUDGED), and the note says a stereorig cloud tells
+// them apart.
+TEST(VerifyCli, AModuleMeasuringTheFaceOffFailsAndWithoutNormalsTheNoteSaysWhatCouldTell) {
+  const std::string artifact = WriteArtifact(std::string(kPlate) + "mpe_mm: {P_F: 1.5, P_S: 1.5, SD: 1.5, F: 0.3}\n");
+  auto r = RunCli("verify --artifact " + artifact + " --cloud " +
+                  WritePlate("module_off", 130, 0.6, PlateNormals::kSameSide));
+  EXPECT_EQ(r.code, 1) << r.out << r.err;
+  EXPECT_GE(FValue(r.out), 0.6) << r.out;
+  EXPECT_NE(r.out.find("        -  0.3000   NO "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1        note: F's points form two parallel layers 0.6 mm apart (6400 points on the "
+                       "smaller), both measured from the same side (their normals face the same way): not the "
+                       "plate's far face; a module measuring the face 0.6 mm off?\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("verdict: FAIL"), std::string::npos) << r.out;
+  r = RunCli("verify --artifact " + artifact + " --cloud " + WritePlate("no_normals", 130, 3.0));
+  EXPECT_EQ(r.code, 1) << r.out << r.err;
+  EXPECT_GE(FValue(r.out), 3.0) << r.out;
+  EXPECT_NE(r.out.find("        -  0.3000   NO "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1        note: F's points form two parallel layers 3.0 mm apart (6400 points on the "
+                       "smaller): a plate thinner than the 5.0 mm capture band seen from both sides (its far face), "
+                       "or a module measuring the face 3.0 mm off; the cloud has no normals to tell which, so F spans "
+                       "both. A stereorig cloud (reconstruct --out: nx ny nz per point) lets verify tell them apart "
+                       "and leave a far face out\n"),
             std::string::npos)
       << r.out;
 }

@@ -129,15 +129,24 @@ PlyVertices ReadPlyVertices(const std::string& path) {
     }
   }
   if (!seen_vertex || num_vertices < 0) throw InputError(path, "PLY has no vertex element");
-  int ix = -1, iy = -1, iz = -1, imodule = -1;
+  int ix = -1, iy = -1, iz = -1, imodule = -1, inx = -1, iny = -1, inz = -1;
   for (int i = 0; i < static_cast<int>(props.size()); ++i) {
     if (!props[i].count_type.empty()) continue;
     if (props[i].name == "x") ix = i;
     if (props[i].name == "y") iy = i;
     if (props[i].name == "z") iz = i;
     if (props[i].name == "module") imodule = i;
+    if (props[i].name == "nx") inx = i;
+    if (props[i].name == "ny") iny = i;
+    if (props[i].name == "nz") inz = i;
   }
   if (ix < 0 || iy < 0 || iz < 0) throw InputError(path, "PLY vertices have no x, y, z");
+  // Normals are all three or none: one or two of them is a broken writer,
+  // not a cloud whose normals verify could read.
+  const int normal_components = (inx >= 0) + (iny >= 0) + (inz >= 0);
+  if (normal_components != 0 && normal_components != 3)
+    throw InputError(path, "PLY vertices have some of nx, ny, nz but not all three");
+  const bool has_normals = normal_components == 3;
   const bool swap = (enc == Encoding::kBig) == (std::endian::native == std::endian::little);
   // The declared count against what the file can hold, before anything is
   // allocated for it: a header declaring 3000000000 vertices ended in
@@ -171,6 +180,7 @@ PlyVertices ReadPlyVertices(const std::string& path) {
   }
   out.points.reserve(reserve);
   if (imodule >= 0) out.module.reserve(reserve);
+  if (has_normals) out.normals.reserve(reserve);
   std::vector<double> v(props.size());
   for (long long k = 0; k < num_vertices; ++k) {
     if (enc == Encoding::kAscii) {
@@ -200,6 +210,11 @@ PlyVertices ReadPlyVertices(const std::string& path) {
     if (!p.allFinite()) throw InputError(path, "vertex " + std::to_string(k) + " is not finite");
     out.points.push_back(p);
     if (imodule >= 0) out.module.push_back(static_cast<int>(v[imodule]));
+    if (has_normals) {
+      const Eigen::Vector3d n(v[inx], v[iny], v[inz]);
+      if (!n.allFinite()) throw InputError(path, "vertex " + std::to_string(k) + "'s normal is not finite");
+      out.normals.push_back(n);
+    }
   }
   // With nothing declared after the vertices, anything more is data the
   // header does not count: a vertex count too small would drop points
@@ -239,6 +254,7 @@ MeasuredPoints ReadMeasuredPlyPoints(const std::string& path) {
           "hole filling's: verify the cloud, reconstruct --out)";
     }
     measured.points = std::move(all.points);
+    measured.normals = std::move(all.normals);
     return measured;
   }
   for (size_t k = 0; k < all.points.size(); ++k) {
@@ -246,6 +262,7 @@ MeasuredPoints ReadMeasuredPlyPoints(const std::string& path) {
       ++measured.filled_skipped;
     } else {
       measured.points.push_back(all.points[k]);
+      if (!all.normals.empty()) measured.normals.push_back(all.normals[k]);
     }
   }
   return measured;

@@ -18,11 +18,16 @@ inline constexpr int kPlyFilledModule = 255;
 struct PlyVertices {
   std::vector<Eigen::Vector3d> points;
   std::vector<int> module;  // each vertex's `module` property; empty when the file has none
-  long long faces = 0;      // the count of its `face` element: > 0 for a mesh
+  // Each vertex's nx, ny, nz (a stereorig cloud's face the camera of the
+  // module that measured the point: docs/formats.md); empty when the file
+  // has none. As written: not normalised, a zero one is no direction.
+  std::vector<Eigen::Vector3d> normals;
+  long long faces = 0;  // the count of its `face` element: > 0 for a mesh
 };
 
 // Throws InputError naming the file on a missing file, a folder, a malformed header, no
-// x/y/z, a truncated body or non-finite coordinates; on a file named .stl
+// x/y/z, some of nx/ny/nz but not all, a truncated body or non-finite
+// coordinates or normals; on a file named .stl
 // that is not PLY, it says that an STL mesh holds no module and names the
 // cloud to give instead.
 PlyVertices ReadPlyVertices(const std::string& path);
@@ -33,6 +38,7 @@ std::vector<Eigen::Vector3d> ReadPlyPoints(const std::string& path);  // ReadPly
 // filled ones were left out.
 struct MeasuredPoints {
   std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector3d> normals;  // parallel to points; empty when the file has none
   int filled_skipped = 0;
   // Non-empty for a mesh (faces) without `module`: why every vertex was
   // taken as measured, for a note. A mesh from another tool has none; a

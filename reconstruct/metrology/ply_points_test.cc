@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <limits>
 
 #include "calib/core/input_error.h"
 
@@ -76,6 +77,37 @@ std::string ErrorOf(const std::string& path) {
     return e.what();
   }
   return "";
+}
+
+// A stereorig cloud's normals (nx ny nz, facing the measuring module's
+// camera) are read, parallel to the measured points (hole filling's left out
+// with theirs); a PLY without them still reads, with none. One or two of the
+// three, or a non-finite one, is refused naming the file.
+TEST(PlyPoints, ReadsNormalsWhenPresentAndRefusesPartialOnes) {
+  const std::string path = ::testing::TempDir() + "/normals.ply";
+  std::ofstream(path) << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                         "property float z\nproperty float nx\nproperty float ny\nproperty float nz\n"
+                         "property uchar module\nend_header\n1 2 3 0 0 1 0\n4 5 6 0 1 0 255\n7 8 9 0 0 -1 1\n";
+  EXPECT_EQ(ReadPlyVertices(path).normals.size(), 3u);
+  const MeasuredPoints measured = ReadMeasuredPlyPoints(path);
+  ASSERT_EQ(measured.normals.size(), 2u);
+  EXPECT_EQ(measured.normals[0], Eigen::Vector3d(0, 0, 1));
+  EXPECT_EQ(measured.normals[1], Eigen::Vector3d(0, 0, -1));
+  std::ofstream(path) << "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                         "property float z\nend_header\n1 2 3\n";
+  EXPECT_TRUE(ReadPlyVertices(path).normals.empty());
+  EXPECT_TRUE(ReadMeasuredPlyPoints(path).normals.empty());
+  std::ofstream(path) << "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                         "property float z\nproperty float nx\nproperty float nz\nend_header\n1 2 3 0 1\n";
+  EXPECT_EQ(ErrorOf(path), path + ": PLY vertices have some of nx, ny, nz but not all three");
+  {
+    std::ofstream f(path, std::ios::binary);
+    f << "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+         "property float z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n";
+    const float v[6] = {1, 2, 3, 0, std::numeric_limits<float>::quiet_NaN(), 1};
+    f.write(reinterpret_cast<const char*>(v), sizeof v);
+  }
+  EXPECT_NE(ErrorOf(path).find("vertex 0's normal is not finite"), std::string::npos) << ErrorOf(path);
 }
 
 // An element before the vertices: its data was read as vertices, one token

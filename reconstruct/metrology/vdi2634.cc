@@ -8,6 +8,7 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <stdexcept>
 #include <tuple>
 
 #include "calib/core/input_error.h"
@@ -602,26 +603,33 @@ std::vector<int> WithinPlaneBand(const std::vector<Eigen::Vector3d>& pts, const 
   return in;
 }
 
-// Where the face's points (inside the eroded outline) hold two faces
+// Where the face's points (inside the eroded outline) lie in two layers
 // parallel to the fitted plane `plane`: their distances along its normal fall
 // in two clusters (1-D two-means) apart by more than kFacesApartInSpreads
 // times their pooled spread, and the smaller one's dense part spans at least
-// VerifyOptions::plate_min_coverage of the plate as the face must. Then why F
-// is not judged, naming them; empty otherwise. The plate's far face, seen by
-// modules on its other side, lies in the capture band when the plate is
-// thinner than the band (the walkthrough's 3 mm plate read F 3.47 mm, its
-// thickness). Points carry no normals here (ply_points.h reads positions), so
-// it cannot be told from a module measuring the plate that far off: neither
-// is left out, and neither is judged. A patch one grid period off is a
-// patch, not a face: it spans too little, and F shows it. One face splits
-// into halves only 2.7 spreads apart (noise), a bowed one ~3.5 (uniform).
+// VerifyOptions::plate_min_coverage of the plate as the face must. The
+// plate's far face, seen by modules on its other side, lies in the capture
+// band when the plate is thinner than the band (the walkthrough's 3 mm plate
+// read F 3.47 mm, its thickness); so does the face as a miscalibrated module
+// measures it, that far off, which F must fail. Positions alone cannot tell
+// them apart; the points' normals can (LayersFacing). A patch one grid period
+// off is a patch, not a layer: it spans too little, and F shows it. One face
+// splits into halves only 2.7 spreads apart (noise), a bowed one ~3.5
+// (uniform).
 constexpr double kFacesApartInSpreads = 8;
 
-std::string SecondFaceText(const std::vector<Eigen::Vector3d>& pts, const std::vector<int>& face, const PlaneFit& plane,
-                           const PlaneOutline& extent, const Artifact& a, const VerifyOptions& o) {
+struct TwoLayers {
+  bool found = false;
+  double apart_mm = 0;
+  std::vector<int> larger, smaller;  // indices into the points, ascending as `face` is
+  PlaneOutline smaller_outline;
+};
+
+TwoLayers FindTwoLayers(const std::vector<Eigen::Vector3d>& pts, const std::vector<int>& face, const PlaneFit& plane,
+                        const Artifact& a, const VerifyOptions& o) {
   std::vector<double> d_mm;
   for (int i : face) d_mm.push_back(plane.normal.dot(pts[i]) - plane.offset_mm);
-  if (d_mm.empty()) return "";
+  if (d_mm.empty()) return {};
   double split_mm = std::accumulate(d_mm.begin(), d_mm.end(), 0.0) / d_mm.size();
   double mean_mm[2] = {0, 0}, ss_mm2[2] = {0, 0};
   size_t n[2] = {0, 0};
@@ -632,7 +640,7 @@ std::string SecondFaceText(const std::vector<Eigen::Vector3d>& pts, const std::v
       sum_mm[d >= split_mm] += d;
       ++n[d >= split_mm];
     }
-    if (n[0] == 0 || n[1] == 0) return "";
+    if (n[0] == 0 || n[1] == 0) return {};
     mean_mm[0] = sum_mm[0] / n[0];
     mean_mm[1] = sum_mm[1] / n[1];
     const double next_mm = 0.5 * (mean_mm[0] + mean_mm[1]);
@@ -644,27 +652,82 @@ std::string SecondFaceText(const std::vector<Eigen::Vector3d>& pts, const std::v
     ss_mm2[k] += (d - mean_mm[k]) * (d - mean_mm[k]);
   }
   const double spread_mm = std::sqrt((ss_mm2[0] + ss_mm2[1]) / d_mm.size());
-  const double apart_mm = mean_mm[1] - mean_mm[0];
-  if (!(apart_mm > kFacesApartInSpreads * spread_mm)) return "";
+  TwoLayers two;
+  two.apart_mm = mean_mm[1] - mean_mm[0];
+  if (!(two.apart_mm > kFacesApartInSpreads * spread_mm)) return {};
   const int smaller = n[1] < n[0] ? 1 : 0;
-  std::vector<int> second_face;
   for (size_t k = 0; k < face.size(); ++k)
-    if ((d_mm[k] >= split_mm) == (smaller == 1)) second_face.push_back(face[k]);
-  if (static_cast<int>(second_face.size()) < std::max(o.min_points, 3)) return "";
-  const PlaneOutline second = OutlineOfDensePart(pts, second_face, plane.normal);
+    ((d_mm[k] >= split_mm) == (smaller == 1) ? two.smaller : two.larger).push_back(face[k]);
+  if (static_cast<int>(two.smaller.size()) < std::max(o.min_points, 3)) return {};
+  two.smaller_outline = OutlineOfDensePart(pts, two.smaller, plane.normal);
   const double longer = std::max(a.plate_length_mm, a.plate_width_mm);
   const double shorter = std::min(a.plate_length_mm, a.plate_width_mm);
-  if (second.length_mm() < o.plate_min_coverage * longer || second.width_mm() < o.plate_min_coverage * shorter)
-    return "";
+  if (two.smaller_outline.length_mm() < o.plate_min_coverage * longer ||
+      two.smaller_outline.width_mm() < o.plate_min_coverage * shorter)
+    return {};
+  two.found = true;
+  return two;
+}
+
+// Which side of the plane a layer's points were measured from: the mean of
+// their unit normals (a stereorig cloud's face the measuring module's camera,
+// docs/formats.md) along the plane's normal, +1 or -1; 0 where the points
+// carry no normals or their mean lies within 60 degrees of the plane (no side
+// stands out).
+int SideMeasuredFrom(const std::vector<Eigen::Vector3d>& normals, const std::vector<int>& layer,
+                     const Eigen::Vector3d& plane_normal) {
+  if (normals.empty()) return 0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (int i : layer) {
+    if (normals[i].norm() == 0) continue;  // written as no direction
+    sum += normals[i].normalized();
+    ++n;
+  }
+  if (n == 0) return 0;
+  const double along = plane_normal.dot(sum / n);
+  return along >= 0.5 ? 1 : along <= -0.5 ? -1 : 0;
+}
+
+enum class LayersFacing { kUnknown, kOppositeSides, kSameSide };
+
+LayersFacing FacingOf(const std::vector<Eigen::Vector3d>& normals, const TwoLayers& two,
+                      const Eigen::Vector3d& plane_normal) {
+  const int larger = SideMeasuredFrom(normals, two.larger, plane_normal);
+  const int smaller = SideMeasuredFrom(normals, two.smaller, plane_normal);
+  if (larger == 0 || smaller == 0) return LayersFacing::kUnknown;
+  return larger == smaller ? LayersFacing::kSameSide : LayersFacing::kOppositeSides;
+}
+
+// The note for two layers: the far face left out of F, or F judged over both
+// (a module that far off; or, the points not saying which side they were
+// measured from, either).
+std::string TwoLayersNote(const TwoLayers& two, LayersFacing facing, bool has_normals, double capture_band_mm) {
   char buf[640];
-  std::snprintf(buf, sizeof buf,
-                "F is not judged: the face's points hold two parallel faces %.1f mm apart (%zu points on the "
-                "second, over %.1f x %.1f mm of the face's %.1f x %.1f mm outline): the plate's far face, seen by "
-                "modules on its other side (a plate thinner than the %.1f mm capture band), or a module measuring it "
-                "%.1f mm off; their range is not the flatness. Give verify the points of the modules on one side of "
-                "the plate only (the cloud's module property)",
-                apart_mm, second_face.size(), second.length_mm(), second.width_mm(), extent.length_mm(),
-                extent.width_mm(), CaptureBandMm(o, a.mpe.flatness_mm), apart_mm);
+  switch (facing) {
+    case LayersFacing::kOppositeSides:
+      std::snprintf(buf, sizeof buf,
+                    "the plate's far face, %.1f mm behind the face (%zu points, measured from its other side: their "
+                    "normals face away from the face's), left out of F and counted in off",
+                    two.apart_mm, two.smaller.size());
+      break;
+    case LayersFacing::kSameSide:
+      std::snprintf(buf, sizeof buf,
+                    "F's points form two parallel layers %.1f mm apart (%zu points on the smaller), both measured "
+                    "from the same side (their normals face the same way): not the plate's far face; a module "
+                    "measuring the face %.1f mm off?",
+                    two.apart_mm, two.smaller.size(), two.apart_mm);
+      break;
+    case LayersFacing::kUnknown:
+      std::snprintf(buf, sizeof buf,
+                    "F's points form two parallel layers %.1f mm apart (%zu points on the smaller): a plate thinner "
+                    "than the %.1f mm capture band seen from both sides (its far face), or a module measuring the "
+                    "face %.1f mm off; %s, so F spans both. A stereorig cloud (reconstruct --out: nx ny nz per "
+                    "point) lets verify tell them apart and leave a far face out",
+                    two.apart_mm, two.smaller.size(), capture_band_mm, two.apart_mm,
+                    has_normals ? "their normals face no side clearly" : "the cloud has no normals to tell which");
+      break;
+  }
   return buf;
 }
 
@@ -733,14 +796,17 @@ std::string UnitsHint(const Artifact& a, const std::vector<Eigen::Vector3d>& pts
 }
 
 ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eigen::Vector3d>& pts,
-                                        const VerifyOptions& o, const std::string& where);
+                                        const VerifyOptions& o, const std::string& where,
+                                        const std::vector<Eigen::Vector3d>& normals);
 
 }  // namespace
 
 ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::Vector3d>& pts, const VerifyOptions& o,
-                                    const std::string& where) {
+                                    const std::string& where, const std::vector<Eigen::Vector3d>& normals) {
+  if (!normals.empty() && normals.size() != pts.size())
+    throw std::invalid_argument("EvaluateArtifact: normals not parallel to the points");
   try {
-    return EvaluateArtifactInMm(a, pts, o, where);
+    return EvaluateArtifactInMm(a, pts, o, where, normals);
   } catch (const NotTheArtifactError& refused) {
     const std::string hint = UnitsHint(a, pts);
     if (hint.empty()) throw;
@@ -751,7 +817,8 @@ ArtifactEvaluation EvaluateArtifact(const Artifact& a, const std::vector<Eigen::
 namespace {
 
 ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eigen::Vector3d>& pts,
-                                        const VerifyOptions& o, const std::string& where) {
+                                        const VerifyOptions& o, const std::string& where,
+                                        const std::vector<Eigen::Vector3d>& normals) {
   o.Check();
   ArtifactEvaluation e;
   e.decision_rule = o.decision_rule;
@@ -991,20 +1058,41 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
           throw NotTheArtifactError(where, "the plate's face is too small after the edge margin: " + fit.message);
       }
       require_points(static_cast<int>(fit.inliers.size()), "plate");
-      // Where the captured points off the face are: outside the outline, or
-      // in the edge margin inside it (face and captured are both ascending).
+      // Two layers in the band: the far face of a plate thinner than it,
+      // measured from the other side, is left out and F judged on the face
+      // (the larger layer); otherwise F spans both, and fails a module that
+      // far off, as it must. Either way a note says what was found.
+      std::vector<int> far_face;  // ascending
+      if (const TwoLayers two = FindTwoLayers(pts, face, fit, a, o); two.found) {
+        const LayersFacing facing = FacingOf(normals, two, fit.normal);
+        e.notes.push_back(TwoLayersNote(two, facing, !normals.empty(), e.capture_band_mm));
+        if (facing == LayersFacing::kOppositeSides) {
+          far_face = two.smaller;
+          face = two.larger;
+          fit = FitPlaneLeastSquares(pts, face);
+          if (!fit.ok) throw NotTheArtifactError(where, "the plate's face without its far face: " + fit.message);
+          require_points(static_cast<int>(fit.inliers.size()), "plate (its far face left out)");
+        }
+      }
+      e.plate_points_far_face = static_cast<int>(far_face.size());
+      // Where the captured points off the face are: on its far face, outside
+      // the outline, or in the edge margin inside it (face, far_face and
+      // captured are all ascending).
       e.plate_points_off_outline = extent.points_outside;
       e.plate_points_outside_rectangle = 0;
-      for (size_t k = 0, f = 0; k < captured.size(); ++k) {
+      for (size_t k = 0, f = 0, g = 0; k < captured.size(); ++k) {
         if (f < face.size() && face[f] == captured[k]) {
           ++f;
+        } else if (g < far_face.size() && far_face[g] == captured[k]) {
+          ++g;
         } else if (extent.InsideEroded(pts[captured[k]], -kOnOutlineMm)) {
           ++e.points_in_edge_margin;
         } else {
           ++e.plate_points_outside_rectangle;
         }
       }
-      e.points_off_artifact = e.points_total - static_cast<int>(captured.size()) + e.plate_points_outside_rectangle;
+      e.points_off_artifact = e.points_total - static_cast<int>(captured.size()) + e.plate_points_outside_rectangle +
+                              e.plate_points_far_face;
       int excluded = 0;
       const std::vector<int> kept = ExcludeWorst(fit.inliers, fit.residuals_mm, o.excluded_fraction_max, &excluded);
       fit = FitPlaneLeastSquares(pts, kept);
@@ -1022,13 +1110,6 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       ResidualStats(fit.residuals_mm, &e);
       JudgeFigures(o.decision_rule, o, &e.figures);
       e.not_judged_reason = NotJudgedReason(e, "", a.uncertainty_coverage_factor, o);
-      // Two faces in the band (a plate thinner than it, seen from both
-      // sides): their range is the plate's thickness, not its flatness, and
-      // F judges neither face, whatever it reads.
-      if (const std::string second = SecondFaceText(pts, face, fit, extent, a, o); !second.empty()) {
-        e.figures[0].judged = false;
-        e.not_judged_reason = second;
-      }
       break;
     }
   }

@@ -165,14 +165,20 @@ struct ArtifactEvaluation {
   double plate_outline_length_mm = 0, plate_outline_width_mm = 0;
   int plate_points_off_outline = 0;
   int plate_points_outside_rectangle = 0;
+  // Plate: the points of its far face left out of F (part of
+  // points_off_artifact): a second layer in the capture band whose normals
+  // face the other side (a plate thinner than the band seen from both sides).
+  int plate_points_far_face = 0;
+  // What the figures are not, to be said with them (verify prints each as a
+  // note): on a plate, two parallel layers in the band, and whether the far
+  // one was left out as the plate's far face or F spans both.
+  std::vector<std::string> notes;
   Eigen::Vector3d plane_normal = Eigen::Vector3d::Zero();
   double plane_offset_mm = 0;
   // Empty when the position is judged. Otherwise why it is not: a figure the
   // points or the certificate leave undetermined where the position would
   // otherwise pass (VerifyOptions::max_uncertainty_fraction_of_mpe; the text
-  // names the figure, its uncertainty and what would help), or, on a plate, a
-  // second face parallel to the face among its points (a thin plate's far
-  // face, seen from its other side: F spans both). Its figures are
+  // names the figure, its uncertainty and what would help). Its figures are
   // all filled in, to be reported, not judged.
   // A position not evaluated at all (NotEvaluated below) has no figures and
   // no fitted geometry; not_judged_reason then says why.
@@ -198,8 +204,17 @@ class NotTheArtifactError : public InputError {
 // certificate that leave P_S, SD or F undetermined where the position would
 // otherwise pass are no error: the evaluation comes back with every figure
 // and not_judged_reason set.
+//
+// normals: parallel to points_mm, or empty (a cloud without nx ny nz): each
+// point's normal facing the camera of the module that measured it, as a
+// stereorig cloud carries (docs/formats.md). On a plate they tell a thin
+// plate's far face (a second layer in the capture band measured from the
+// other side: left out of F) from a module measuring the face off (measured
+// from the same side: in F, which it fails); without them F spans both
+// layers (ArtifactEvaluation::notes says which was found).
 ArtifactEvaluation EvaluateArtifact(const Artifact& artifact, const std::vector<Eigen::Vector3d>& points_mm,
-                                    const VerifyOptions& options, const std::string& where);
+                                    const VerifyOptions& options, const std::string& where,
+                                    const std::vector<Eigen::Vector3d>& normals = {});
 
 // A position whose cloud EvaluateArtifact refused (its NotTheArtifactError's
 // problem: too few points on the artifact, no artifact of the certified

@@ -458,34 +458,108 @@ TEST(Vdi2634, APatchAGridPeriodOffShowsInTheFlatnessAsTheTruthPredicts) {
   EXPECT_FALSE(e.pass());
 }
 
+// Each point's normal facing its module's camera, as a stereorig cloud's:
+// `toward` for every point.
+std::vector<Eigen::Vector3d> Facing(size_t n, const Eigen::Vector3d& toward) { return {n, toward.normalized()}; }
+
 // A 3 mm plate seen from both sides (a walkthrough's rig): its far face lies
 // in the 5 mm capture band, and the range over both faces (~3 mm, the
-// thickness) failed F with nothing saying why. Truth: the 130 mm plate's face
-// at 1 mm, its far face 2 or 3 mm behind it at 1.5 mm (fewer points: RANSAC
-// finds the near one; at 2 mm, under twice the 1.5 mm locating band, a plane
-// between them holds both), noise sigma = 0.05 mm along the normal. Nothing
-// in the positions tells the far face from a module measuring 3 mm off, so
-// F is not judged, and the reason names the second face and its distance
-// (the clusters' means, to sigma / sqrt(N) ~ 0.001 mm: printed to 0.1 mm).
-TEST(Vdi2634, AThinPlatesFarFaceInTheCaptureBandLeavesFNotJudgedAndIsNamed) {
+// thickness) failed F. Truth: the 130 mm plate's face at 1 mm, its far face
+// 2 or 3 mm behind it at 1.5 mm (fewer points: RANSAC finds the near one; at
+// 2 mm, under twice the 1.5 mm locating band, a plane between them holds
+// both), noise sigma = 0.05 mm along the normal; the face's normals face its
+// side (+normal), the far face's the other. The far face is left out: F is
+// the near face's alone, exactly as for a cloud of it alone (the same points
+// inside the same outline: the far face spans no more), and passes; the note
+// names its distance (the clusters' means, to sigma / sqrt(N) ~ 0.001 mm:
+// printed to 0.1 mm). Its points inside the eroded outline are counted off.
+TEST(Vdi2634, AThinPlatesFarFaceMeasuredFromItsOtherSideIsLeftOutOfF) {
   const double sigma_mm = 0.05;
   for (const double thickness_mm : {2.0, 3.0}) {
     std::mt19937 rng(9);
     const Eigen::Vector3d normal = Eigen::Vector3d(0.1, -0.2, 1).normalized();
-    auto plate = PlatePoints({0, 0, 5}, normal, 130, 1.0, sigma_mm, &rng);
+    const auto near = PlatePoints({0, 0, 5}, normal, 130, 1.0, sigma_mm, &rng);
     const auto far = PlatePoints(Eigen::Vector3d(0, 0, 5) - thickness_mm * normal, normal, 130, 1.5, sigma_mm, &rng);
+    auto plate = near;
     plate.insert(plate.end(), far.begin(), far.end());
-    const ArtifactEvaluation e = EvaluateArtifact(PlateArtifact(), plate, VerifyOptions(), "test");
-    EXPECT_FALSE(FigureOf(e, "F") < thickness_mm);  // the range spans both faces
-    EXPECT_FALSE(e.figures[0].judged);
-    const std::string reason = NotJudgedReason(e);
-    char apart[96];
-    std::snprintf(apart, sizeof apart, "F is not judged: the face's points hold two parallel faces %.1f mm apart (",
-                  thickness_mm);
-    EXPECT_EQ(reason.rfind(apart, 0), 0u) << reason;
-    EXPECT_NE(reason.find("the plate's far face, seen by modules on its other side"), std::string::npos) << reason;
+    auto normals = Facing(near.size(), normal);
+    const auto far_normals = Facing(far.size(), -normal);
+    normals.insert(normals.end(), far_normals.begin(), far_normals.end());
+    const ArtifactEvaluation e = EvaluateArtifact(PlateArtifact(), plate, VerifyOptions(), "test", normals);
+    const ArtifactEvaluation alone = EvaluateArtifact(PlateArtifact(), near, VerifyOptions(), "test");
+    ASSERT_TRUE(e.judged()) << e.not_judged_reason;
+    EXPECT_TRUE(e.pass());
+    EXPECT_EQ(FigureOf(e, "F"), FigureOf(alone, "F"));
+    EXPECT_EQ(e.points_used(), alone.points_used());
+    EXPECT_GT(e.plate_points_far_face, 0);
+    EXPECT_EQ(e.points_off_artifact, alone.points_off_artifact + e.plate_points_far_face);
+    ASSERT_EQ(e.notes.size(), 1u);
+    char behind[96];
+    std::snprintf(behind, sizeof behind, "the plate's far face, %.1f mm behind the face (%d points,", thickness_mm,
+                  e.plate_points_far_face);
+    EXPECT_EQ(e.notes[0].rfind(behind, 0), 0u) << e.notes[0];
+    EXPECT_NE(e.notes[0].find("left out of F and counted in off"), std::string::npos) << e.notes[0];
+  }
+}
+
+// A module measuring the face 0.6 or 2 mm off: the miscalibration F must
+// catch. Its layer lies in the capture band as a thin plate's far face would,
+// but it was measured from the same side (its normals face the same way): F
+// spans both layers and fails (6dd433e left it not judged, exit 2). Truth:
+// the face at 1 mm and the other module's at 1.5 mm, noise sigma = 0.02 mm
+// (the face alone ranges ~8 sigma = 0.16 mm: within the 0.3 mm MPE, as the
+// first check shows), so F is at least the offset.
+TEST(Vdi2634, AModuleMeasuringTheFaceOffFromTheSameSideFailsF) {
+  Artifact plate = PlateArtifact();
+  plate.mpe.flatness_mm = 0.3;
+  const Eigen::Vector3d normal = Eigen::Vector3d(0.1, -0.2, 1).normalized();
+  std::mt19937 rng(9);
+  const auto face = PlatePoints({0, 0, 5}, normal, 130, 1.0, 0.02, &rng);
+  ASSERT_TRUE(EvaluateArtifact(plate, face, VerifyOptions(), "test", Facing(face.size(), normal)).pass());
+  for (const double offset_mm : {0.6, 2.0}) {
+    const auto off = PlatePoints(Eigen::Vector3d(0, 0, 5) - offset_mm * normal, normal, 130, 1.5, 0.02, &rng);
+    auto cloud = face;
+    cloud.insert(cloud.end(), off.begin(), off.end());
+    const ArtifactEvaluation e = EvaluateArtifact(plate, cloud, VerifyOptions(), "test", Facing(cloud.size(), normal));
+    ASSERT_TRUE(e.judged()) << e.not_judged_reason;
+    EXPECT_FALSE(e.pass());
+    EXPECT_GE(FigureOf(e, "F"), offset_mm);
+    EXPECT_EQ(e.plate_points_far_face, 0);
+    ASSERT_EQ(e.notes.size(), 1u);
+    char layers[160];
+    std::snprintf(layers, sizeof layers, "F's points form two parallel layers %.1f mm apart (", offset_mm);
+    EXPECT_EQ(e.notes[0].rfind(layers, 0), 0u) << e.notes[0];
+    std::snprintf(layers, sizeof layers, "not the plate's far face; a module measuring the face %.1f mm off?",
+                  offset_mm);
+    EXPECT_NE(e.notes[0].find(layers), std::string::npos) << e.notes[0];
     EXPECT_FALSE(Summarise({e}).pass);
   }
+}
+
+// Without normals (a cloud from another tool) a far face cannot be told from
+// a module that far off: F spans both layers and is judged (it fails a 3 mm
+// plate's, whose thickness it reads), and the note says the layers may be
+// either, and that a stereorig cloud's normals tell them apart. Truth as for
+// the far face above.
+TEST(Vdi2634, TwoLayersWithoutNormalsAreJudgedTogetherAndTheNoteSaysWhatWouldTellThemApart) {
+  std::mt19937 rng(9);
+  const Eigen::Vector3d normal = Eigen::Vector3d(0.1, -0.2, 1).normalized();
+  auto plate = PlatePoints({0, 0, 5}, normal, 130, 1.0, 0.05, &rng);
+  const auto far = PlatePoints(Eigen::Vector3d(0, 0, 5) - 3.0 * normal, normal, 130, 1.5, 0.05, &rng);
+  plate.insert(plate.end(), far.begin(), far.end());
+  const ArtifactEvaluation e = EvaluateArtifact(PlateArtifact(), plate, VerifyOptions(), "test");
+  ASSERT_TRUE(e.judged()) << e.not_judged_reason;
+  EXPECT_FALSE(e.pass());
+  EXPECT_GE(FigureOf(e, "F"), 3.0);
+  EXPECT_EQ(e.plate_points_far_face, 0);
+  ASSERT_EQ(e.notes.size(), 1u);
+  EXPECT_EQ(e.notes[0].rfind("F's points form two parallel layers 3.0 mm apart (", 0), 0u) << e.notes[0];
+  EXPECT_NE(e.notes[0].find("a plate thinner than the 5.0 mm capture band seen from both sides (its far face), or a "
+                            "module measuring the face 3.0 mm off; the cloud has no normals to tell which, so F spans "
+                            "both. A stereorig cloud (reconstruct --out: nx ny nz per point) lets verify tell them "
+                            "apart and leave a far face out"),
+            std::string::npos)
+      << e.notes[0];
 }
 
 // A ball bar whose ball 1 has a patch one grid period off. Truth: balls of
