@@ -164,6 +164,16 @@ TEST(Cli, AStdoutThatCannotBeWrittenIsNoSuccess) {
             0u)
       << r.err;
   EXPECT_FALSE(std::filesystem::exists(demo_out));
+  // Its command lines are shell-quoted, to be pasted as they are: an --out
+  // with a space was printed bare before, two arguments in a shell.
+  const std::string spaced_out = ::testing::TempDir() + "/stdout demo " + std::to_string(getpid());
+  r = RunWithStdout("demo --out '" + spaced_out + "'", "/dev/full");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err,
+            "stereorig demo: standard output: cannot be written: No space left on device; the demo stops "
+            "before `stereorig simulate --out '" +
+                spaced_out + "/dataset' --seed 1`\n");
+  EXPECT_FALSE(std::filesystem::exists(spaced_out));
   // Bad input keeps its own exit code and line.
   r = RunWithStdout("rig --rig " + rig + ".missing", "/dev/full");
   EXPECT_EQ(r.code, 2);
