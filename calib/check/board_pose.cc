@@ -88,10 +88,9 @@ Eigen::Matrix<double, 2, 6> PoseJacobian(const Camera& camera, const Pose& cam_f
 
 }  // namespace
 
-PredictionStatistics PredictionErrorStatistics(const Rig& rig, const Target& target,
-                                               const std::vector<const BoardObservation*>& pose_views,
-                                               const std::vector<double>& sigma_px, const BoardObservation& view,
-                                               const Pose& ref_from_front) {
+Eigen::Matrix<double, 6, 6> BoardPoseCovariance(const Rig& rig, const Target& target,
+                                                const std::vector<const BoardObservation*>& pose_views,
+                                                const std::vector<double>& sigma_px, const Pose& ref_from_front) {
   // Information of the pose from the views it came from, each corner
   // weighted by its camera's noise.
   Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
@@ -104,7 +103,14 @@ PredictionStatistics PredictionErrorStatistics(const Rig& rig, const Target& tar
       information += w * j.transpose() * j;
     }
   }
-  const Eigen::Matrix<double, 6, 6> covariance = information.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
+  return information.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
+}
+
+PredictionStatistics PredictionErrorStatistics(const Rig& rig, const Target& target,
+                                               const std::vector<const BoardObservation*>& pose_views,
+                                               const std::vector<double>& sigma_px, const BoardObservation& view,
+                                               const Pose& ref_from_front) {
+  const Eigen::Matrix<double, 6, 6> covariance = BoardPoseCovariance(rig, target, pose_views, sigma_px, ref_from_front);
   const Camera& cam = rig.camera(view.camera);
   const Pose cam_from_ref = rig.CamFromReference(view.camera);
   Eigen::Matrix<double, 6, 6> a = Eigen::Matrix<double, 6, 6>::Zero();

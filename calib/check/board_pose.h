@@ -30,6 +30,14 @@ BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target,
 std::vector<Eigen::Vector2d> ReprojectionErrors(const Rig& rig, const Target& target, const BoardObservation& view,
                                                 const Pose& ref_from_front);
 
+// The linearised covariance of a board pose estimated from `pose_views`,
+// each corner with its camera's per-axis noise sigma_px[camera]: the inverse
+// of sum_k J_k^T J_k / sigma^2 (J_k the 2x6 Jacobian of corner k's pixel by
+// the pose's rotation vector, rad, and translation, mm, of ref_from_front).
+Eigen::Matrix<double, 6, 6> BoardPoseCovariance(const Rig& rig, const Target& target,
+                                                const std::vector<const BoardObservation*>& pose_views,
+                                                const std::vector<double>& sigma_px, const Pose& ref_from_front);
+
 // Linearised statistics of the prediction error that a pose's own
 // uncertainty puts on the corners of `view`. The pose was estimated from
 // `pose_views`, each corner with its camera's per-axis noise sigma_px[camera].
