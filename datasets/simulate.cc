@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -15,8 +16,10 @@
 #include <fstream>
 #include <mutex>
 #include <sstream>
+#include <system_error>
 #include <thread>
 
+#include "calib/core/capture_image_name.h"
 #include "calib/core/float_tiff.h"
 #include "calib/core/folder_to_create.h"
 #include "calib/core/input_error.h"
@@ -99,7 +102,10 @@ void WritePly(const fs::path& path, const std::vector<Eigen::Vector3d>& points) 
   if (!f) throw InputError(path.string(), "cannot write");
 }
 
-// Runs f(0..n-1) on `threads` threads; rethrows the first exception.
+// Runs f(0..n-1) on up to `threads` threads, never more than n (a thread
+// with no job is only a cost); rethrows the first exception. A thread the
+// system refuses to start leaves the work to those already running (to
+// this one, if none started).
 void ParallelFor(int n, int threads, const std::function<void(int)>& f) {
   std::atomic<int> next{0};
   std::exception_ptr error;
@@ -116,9 +122,73 @@ void ParallelFor(int n, int threads, const std::function<void(int)>& f) {
     }
   };
   std::vector<std::thread> pool;
-  for (int t = 0; t < std::max(1, threads); ++t) pool.emplace_back(worker);
+  for (int t = 0; t < std::min(std::max(1, threads), n); ++t) {
+    try {
+      pool.emplace_back(worker);
+    } catch (const std::system_error&) {
+      break;
+    }
+  }
+  if (pool.empty()) worker();
   for (std::thread& t : pool) t.join();
   if (error) std::rethrow_exception(error);
+}
+
+// Whether the simulator writes `relative` (a path inside a dataset, as
+// simulate.h's layout gives it) as a folder (`folder`) or as a file.
+bool SimulatorWrites(const fs::path& relative, bool folder) {
+  std::vector<std::string> p;
+  for (const fs::path& part : relative) p.push_back(part.string());
+  const std::vector<std::string> scene_names = ScenesSpec().names;  // every scene there is
+  const auto scene = [&](const std::string& name) {
+    return std::find(scene_names.begin(), scene_names.end(), name) != scene_names.end();
+  };
+  const auto camera_png = [](const std::string& name, const std::string& prefix) {
+    return name.starts_with(prefix) && CameraIndexOfImageName(name.substr(prefix.size())).has_value();
+  };
+  const auto one_of = [](const std::string& name, std::initializer_list<const char*> names) {
+    return std::find(names.begin(), names.end(), name) != names.end();
+  };
+  const size_t n = p.size();
+  if (n == 1)
+    return folder ? one_of(p[0], {"artifacts", "calibration", "scenes", "truth"})
+                  : one_of(p[0], {"spec.yaml", "target.yaml", "layout.yaml"});
+  if (p[0] == "artifacts") return n == 2 && !folder && one_of(p[1], {"sphere.yaml", "ballbar.yaml", "plate.yaml"});
+  if (p[0] == "calibration") {
+    const bool capture = p[1].size() == 3 && std::all_of(p[1].begin(), p[1].end(), ::isdigit);
+    return capture && (n == 2 ? folder : n == 3 && !folder && camera_png(p[2], ""));
+  }
+  if (p[0] == "scenes") {
+    if (!scene(p[1])) return false;
+    if (n == 2) return folder;
+    if (!one_of(p[2], {"active", "passive"})) return false;
+    return n == 3 ? folder : n == 4 && !folder && camera_png(p[3], "");
+  }
+  STEREORIG_CHECK(p[0] == "truth");  // n >= 2 below a top-level name of the first test
+  if (n == 2)
+    return folder ? p[1] == "scenes" : one_of(p[1], {"rig.yaml", "calibration_poses.yaml", "simulation.yaml"});
+  if (p[1] != "scenes" || !scene(p[2])) return false;
+  if (n == 3) return folder;
+  return n == 4 && !folder &&
+         (one_of(p[3], {"object.yaml", "surface.ply"}) || camera_png(p[3], "id_") || camera_png(p[3], "lit_") ||
+          (p[3].starts_with("depth_") && p[3].ends_with(".tiff") &&
+           camera_png(p[3].substr(0, p[3].size() - 5) + ".png", "depth_")));
+}
+
+// Throws InputError naming `typed` if `out` is one of `inputs`, or holds one:
+// replacing the folder would delete it.
+void RequireNoInputIn(const std::string& typed, const fs::path& out,
+                      const std::vector<std::pair<std::string, std::string>>& inputs) {
+  const fs::path folder = NormalPath(out);
+  for (const auto& [path, what] : inputs) {
+    if (path.empty()) continue;
+    const fs::path input = NormalPath(path);
+    const auto [end, unused] = std::mismatch(folder.begin(), folder.end(), input.begin(), input.end());
+    if (end != folder.end()) continue;  // not below `folder`
+    throw InputError(typed, input == folder ? "is " + what + ", not a folder for the dataset (--out)"
+                                            : "holds " + what + " " + path +
+                                                  ": replacing the folder with the dataset would delete it");
+  }
 }
 
 // The true rig from its cameras and each one's world pose (module frame =
@@ -173,9 +243,44 @@ class Progress {
 
 }  // namespace
 
+void CheckReplaceableOut(const std::string& typed, const fs::path& out) {
+  if (!fs::exists(out)) return;
+  if (!fs::is_directory(out)) throw InputError(typed, "exists and is not a folder");
+  if (fs::is_empty(out)) return;
+  if (!fs::exists(out / "spec.yaml"))
+    throw InputError(typed, "exists and is not a stereorig dataset (no spec.yaml); refusing to replace it");
+  // A spec.yaml alone is a project folder as often as a dataset (a user's
+  // own spec, next to their board and notes): the simulator's info file
+  // tells an earlier dataset apart.
+  std::ifstream info(out / "truth" / "simulation.yaml");
+  std::string line;
+  bool ours = false;
+  while (!ours && std::getline(info, line)) ours = line == "format: stereorig-sim-info";
+  if (!ours)
+    throw InputError(typed,
+                     "exists and is not a stereorig dataset (no truth/simulation.yaml of format stereorig-sim-info); "
+                     "refusing to replace it");
+  // The folder is replaced whole: anything kept in it that the simulator
+  // does not write (notes, scores, a calibrated rig) would go with it.
+  std::vector<fs::path> foreign;
+  for (auto it = fs::recursive_directory_iterator(out); it != fs::recursive_directory_iterator(); ++it) {
+    const fs::file_status status = it->symlink_status();
+    const bool folder = fs::is_directory(status);
+    if ((folder || fs::is_regular_file(status)) && SimulatorWrites(it->path().lexically_relative(out), folder))
+      continue;
+    foreign.push_back(it->path().lexically_relative(out));
+    if (folder) it.disable_recursion_pending();
+  }
+  if (!foreign.empty())
+    throw InputError(typed, "holds " + std::min_element(foreign.begin(), foreign.end())->string() +
+                                ", which the simulator does not write; refusing to replace the dataset and delete it "
+                                "(move it out, or choose another --out)");
+}
+
 void SimulateOptions::Check() const {
   if (out_dir.empty()) throw InputError("--out", "an output folder is required");
-  if (threads < 0) throw InputError("--threads", "must not be negative");
+  if (threads < 0 || threads > kMaxSimulateThreads)
+    throw InputError("--threads", "must be in [0, " + std::to_string(kMaxSimulateThreads) + "] (0 = every core)");
   if (calibration_captures < -1 || calibration_captures > 999) {
     throw InputError("--calibration-captures", "must be in [0, 999]");
   }
@@ -210,8 +315,9 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
   if (options.calibration_captures >= 0) spec.calibration.captures = options.calibration_captures;
   if (!options.scenes) spec.scenes.names.clear();
   spec.Check();
-  const int threads =
-      options.threads > 0 ? options.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int threads = options.threads > 0
+                          ? options.threads
+                          : std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, kMaxSimulateThreads);
   auto say = [&](const std::string& s) {
     if (options.progress) options.progress(s);
   };
@@ -282,6 +388,13 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
   std::vector<fs::path> missing;
   CheckNamesFit(typed, "create this folder for the dataset (--out)", DeepestExistingPart(NormalPath(out), &missing),
                 missing);
+  // Before any folder is made: an input inside `out`, or a folder that is
+  // not an earlier dataset, is refused with nothing created.
+  std::vector<std::pair<std::string, std::string>> inputs = options.inputs;
+  if (spec.calibration.target != "default")
+    inputs.push_back({spec.calibration.target, "the spec's target file (calibration.target)"});
+  RequireNoInputIn(typed, out, inputs);
+  CheckReplaceableOut(typed, out);
   // Made now, and removed again while empty if the run fails after this (a
   // folder that cannot be made, part way too): no new empty folder left.
   FolderToCreate parent_folder(parent.string(), "the dataset (--out)");
@@ -291,12 +404,6 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
     throw InputError(typed, e.problem());
   }
   std::error_code ec;
-  if (fs::exists(out)) {
-    if (!fs::is_directory(out)) throw InputError(typed, "exists and is not a folder");
-    if (!fs::is_empty(out) && !fs::exists(out / "spec.yaml")) {
-      throw InputError(typed, "exists and is not a stereorig dataset (no spec.yaml); refusing to replace it");
-    }
-  }
   const std::string pid = std::to_string(getpid());
   const fs::path tmp = parent / TemporaryName(".", out.filename().string(), ".tmp-" + pid);
   fs::remove_all(tmp, ec);
