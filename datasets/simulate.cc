@@ -241,6 +241,47 @@ class Progress {
   std::mutex mutex_;
 };
 
+// A spec can place a camera where the board never reaches (a module
+// looking away): MakeCalibrationPoses keeps its best draw, and the dataset
+// then holds captures no calibration can use for that camera. Said on the
+// progress sink, "warning: ...", for each camera that sees fewer than
+// min_corners_per_camera corners in every capture (truth/
+// calibration_poses.yaml gives the count per capture). Not a refusal: a ring
+// of 3 modules at 120° keeps some captures below the minimum by design.
+void WarnOfCamerasTheBoardMisses(const CalibrationSpec& calibration, const PhysicalBoard& board, const Rig& rig,
+                                 const std::vector<Pose>& world_from_camera, const std::vector<Pose>& poses,
+                                 const std::function<void(const std::string&)>& say) {
+  if (poses.empty()) return;
+  for (const StereoModule& m : rig.modules()) {
+    for (const int cam : {m.left_camera, m.right_camera}) {
+      int most = 0;
+      for (const Pose& world_from_front : poses)
+        most = std::max(most, CornersInView(rig.camera(cam), world_from_camera[cam], world_from_front, board));
+      if (most >= calibration.min_corners_per_camera) continue;
+      say("warning: cam" + std::to_string(cam) + " (" + m.name + "'s " + (cam == m.left_camera ? "left" : "right") +
+          " camera) sees at most " + std::to_string(most) + " target corners in any of the " +
+          std::to_string(poses.size()) + " calibration captures, fewer than calibration.min_corners_per_camera (" +
+          std::to_string(calibration.min_corners_per_camera) + "): check the module's center_mm and look_at_mm");
+    }
+  }
+}
+
+// Likewise a projector that lights no pixel of any camera in any scene (one
+// past the volume, or turned away): the active images are its module's
+// passive ones. Said for each enabled projector (the `lit` bits, in module
+// order) whose count is 0.
+void WarnOfProjectorsLightingNothing(const SimSpec& spec, const std::vector<std::atomic<int64_t>>& lit_px,
+                                     const std::function<void(const std::string&)>& say) {
+  size_t k = 0;
+  for (size_t m = 0; m < spec.modules.size(); ++m) {
+    const ProjectorSpec& p = spec.modules[m].projector;
+    if (!p.enabled || p.power_dn <= 0) continue;  // as MakeProjectors
+    if (lit_px[k++] == 0)
+      say("warning: modules[" + std::to_string(m) + "] (" + spec.modules[m].name +
+          ")'s projector lights no pixel of any camera in any scene: check its offset_mm and the module's look_at_mm");
+  }
+}
+
 }  // namespace
 
 void CheckReplaceableOut(const std::string& typed, const fs::path& out) {
@@ -440,6 +481,7 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
   const int captures = spec.calibration.captures;
   const std::vector<Pose> poses =
       MakeCalibrationPoses(spec.calibration, board, rig.cameras(), sr.world_from_camera, StreamKey({seed, kKeyPoses}));
+  WarnOfCamerasTheBoardMisses(spec.calibration, board, rig, sr.world_from_camera, poses, say);
   std::vector<Scene> scenes;
   for (size_t s = 0; s < spec.scenes.names.size(); ++s) {
     scenes.push_back(MakeScene(spec.scenes.names[s], spec.scenes, spec.render,
@@ -459,6 +501,8 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
   say("rendering " + std::to_string(captures) + " calibration captures and " + std::to_string(scenes.size()) +
       " scenes x " + std::to_string(num_cameras) + " cameras on " + std::to_string(threads) + " threads");
   Progress progress(options.progress, num_jobs);
+  std::vector<std::atomic<int64_t>> lit_px(
+      projectors.size());  // per projector: pixels it lights, every scene and camera
   std::atomic<int> images{0};
   ParallelFor(num_jobs, threads, [&](int job) {
     if (job < num_scene_jobs) {
@@ -487,6 +531,7 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
       WriteImage(truth / ("depth_" + name + ".tiff"), rad.depth);
       WriteImage(truth / ("id_" + name + ".png"), rad.id);
       WriteImage(truth / ("lit_" + name + ".png"), rad.lit);
+      for (size_t k = 0; k < projectors.size(); ++k) lit_px[k] += cv::countNonZero(rad.lit & (1 << k));
       images += 2;
       progress.Done(scene.name + " " + name);
       return;
@@ -500,6 +545,8 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
     ++images;
     progress.Done("calibration " + Num3(k));
   });
+
+  if (!scenes.empty()) WarnOfProjectorsLightingNothing(spec, lit_px, say);
 
   // --- the small files
   // The dataset renders again from its own spec: a target file is named as

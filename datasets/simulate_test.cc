@@ -171,6 +171,45 @@ TEST(Simulate, RefusesAnOutHoldingItsInputs) {
   EXPECT_TRUE(fs::exists(dir / "empty" / "board.yaml"));
 }
 
+// The warnings a run of `spec` gives on its progress sink.
+std::vector<std::string> Warnings(const SimSpec& spec, const std::string& name) {
+  SimulateOptions o;
+  o.out_dir = ::testing::TempDir() + "/simtest_" + name;
+  fs::remove_all(o.out_dir);
+  std::vector<std::string> warnings;
+  o.progress = [&](const std::string& line) {
+    if (line.starts_with("warning: ")) warnings.push_back(line);
+  };
+  Simulate(spec, o);
+  return warnings;
+}
+
+// A geometry that cannot work renders, but says so: a module looking away
+// from the volume has cameras the board never reaches, and a projector past
+// the volume lights nothing. Both rendered without a word. The sound rig
+// gives no warning.
+TEST(Simulate, CamerasTheBoardMissesAndProjectorsLightingNothingAreWarnedOf) {
+  SimSpec spec = SmallRingSpec(2, 4, 2);
+  spec.calibration.min_corners_per_camera = 12;
+  spec.scenes.names = {"sphere"};
+  EXPECT_EQ(Warnings(spec, "warn_none"), std::vector<std::string>{});
+  SimSpec away = spec;
+  away.scenes.names.clear();
+  away.modules[0].look_at_mm = away.modules[0].center_mm + Eigen::Vector3d(0, 0, -800);
+  const std::string misses =
+      " target corners in any of the 2 calibration captures, fewer than "
+      "calibration.min_corners_per_camera (12): check the module's center_mm and look_at_mm";
+  EXPECT_EQ(Warnings(away, "warn_away"),
+            (std::vector<std::string>{"warning: cam0 (module0's left camera) sees at most 0" + misses,
+                                      "warning: cam1 (module0's right camera) sees at most 0" + misses}));
+  SimSpec far = spec;
+  far.calibration.captures = 0;
+  far.modules[1].projector.offset_mm = Eigen::Vector3d(0, 0, 500);  // 300 mm past the centre, facing away from it
+  EXPECT_EQ(Warnings(far, "warn_far"),
+            (std::vector<std::string>{"warning: modules[1] (module1)'s projector lights no pixel of any camera in any "
+                                      "scene: check its offset_mm and the module's look_at_mm"}));
+}
+
 // truth/rig.yaml of a small two-module rig (no scenes, seed 3), bumped.
 Rig BumpedTruth(const std::string& name, const RigBump& bump) {
   SimSpec spec = SmallRingSpec(2, 4, 1);
