@@ -1,5 +1,7 @@
 // `stereorig simulate`: render a rig spec into a dataset with ground truth.
+#include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <vector>
 
 #include "apps/cli_util.h"
@@ -34,18 +36,29 @@ int RunSimulate(int argc, char** argv) {
   bool no_scenes = false;
   app.add_option("--spec", spec_path, "rig spec YAML (default: the embedded default rig)");
   app.add_option("--out", o.out_dir,
-                 "dataset folder to write; if it already holds a dataset, the whole folder is replaced atomically, "
-                 "anything else in it included")
+                 "dataset folder to write; an earlier dataset there is replaced whole, atomically, and only if it "
+                 "holds nothing the simulator does not write (else exit 2, naming the file)")
       ->check(NonEmptyPath());
   // Checked on the text: a negative seed would wrap round to 2^64 - 1
-  // (CLI11's NonNegativeNumber prints DBL_MAX's 309 digits as its bound).
-  app.add_option("--seed", o.seed, "random seed: poses, scenes, noise (>= 0)")
+  // (CLI11's NonNegativeNumber prints DBL_MAX's 309 digits as its bound),
+  // and one above 2^64 - 1 was saturated to it without a word. strtoull
+  // reads the same decimal, 0x and 0 forms as CLI11.
+  app.add_option("--seed", o.seed, "random seed: poses, scenes, noise (0 to 18446744073709551615)")
       ->check(CLI::Validator(
-          [](const std::string& text) { return text.starts_with('-') ? std::string("must be >= 0") : std::string(); },
+          [](const std::string& text) {
+            if (text.starts_with('-')) return std::string("must be >= 0");
+            errno = 0;
+            std::strtoull(text.c_str(), nullptr, 0);
+            return errno == ERANGE ? std::string("must be at most 18446744073709551615 (2^64 - 1)") : std::string();
+          },
           "", "NonNegative"))
       ->capture_default_str();
-  app.add_option("--threads", o.threads, "worker threads (0 = all cores)")->capture_default_str();
-  app.add_option("--calibration-captures", o.calibration_captures, "override the spec's number of target captures");
+  app.add_option("--threads", o.threads,
+                 "worker threads, in [0, " + std::to_string(kMaxSimulateThreads) +
+                     "] (0 = all cores; never more than the jobs)")
+      ->capture_default_str();
+  app.add_option("--calibration-captures", o.calibration_captures,
+                 "override the spec's number of target captures, in [0, 999]");
   app.add_flag("--no-scenes", no_scenes, "render the calibration captures only");
   app.add_option("--write-default-spec", write_spec, "write the embedded default spec to this file and exit");
   app.add_option("--bump-camera", o.bump.camera, "disturb this camera (global index) before rendering");
@@ -75,6 +88,10 @@ int RunSimulate(int argc, char** argv) {
     throw InputError("--bump-camera", "no camera " + std::to_string(o.bump.camera));
   if (app.count("--bump-module") > 0 && o.bump.module < 0)
     throw InputError("--bump-module", "no module " + std::to_string(o.bump.module));
+  // Likewise -1 is the options' "the spec's count": given, it rendered the
+  // spec's captures as if the flag were absent.
+  if (app.count("--calibration-captures") > 0 && o.calibration_captures < 0)
+    throw InputError("--calibration-captures", "must be in [0, 999]");
   // A bump needs what to move and by how much: either alone used to render
   // an undisturbed rig without a word. A lens drift needs its camera.
   const bool bump_what = app.count("--bump-camera") + app.count("--bump-module") > 0;
@@ -113,6 +130,9 @@ int RunSimulate(int argc, char** argv) {
   }
   o.scenes = !no_scenes;
   const SimSpec spec = spec_path.empty() ? DefaultSimSpec() : ReadSimSpecFile(spec_path);
+  // Replacing --out whole would delete the spec inside it (its target
+  // file Simulate protects itself).
+  if (!spec_path.empty()) o.inputs.push_back({spec_path, "the spec file (--spec)"});
   o.progress = [](const std::string& s) { std::fprintf(stderr, "simulate: %s\n", s.c_str()); };
   const SimulateSummary s = Simulate(spec, o);
   std::printf("wrote %s: %d images in %.1f s (ray tables %.1f s)\n", o.out_dir.c_str(), s.images, s.seconds,

@@ -22,9 +22,9 @@ CameraRays::CameraRays(const Camera& camera, int threads)
       }
     }
   };
-  threads = std::max(1, threads);
-  std::vector<std::thread> pool;
   const int rows = height_ + 1;
+  threads = std::clamp(threads, 1, rows);  // a thread without a row is only a cost
+  std::vector<std::thread> pool;
   for (int t = 0; t < threads; ++t) pool.emplace_back(work, rows * t / threads, rows * (t + 1) / threads);
   for (std::thread& t : pool) t.join();
 }

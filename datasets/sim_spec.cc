@@ -160,8 +160,19 @@ void ScenesSpec::Check(const std::string& where) const {
 void SimSpec::Check(const std::string& where) const {
   Require(!modules.empty(), where, "modules", "needs at least one module");
   std::set<std::string> names;
-  for (const ModuleSpec& m : modules) {
+  for (size_t k = 0; k < modules.size(); ++k) {
+    const ModuleSpec& m = modules[k];
     Require(names.insert(m.name).second, where, "modules", "module name '" + m.name + "' used twice");
+    // The runtime matches a module's two images row by row and refuses a
+    // rig whose module has two imager sizes (reconstruct/runtime.cc): a
+    // dataset rendered from such a spec could never be reconstructed.
+    const auto size = [](const CameraSpec& c) {
+      return std::to_string(c.width_px) + "x" + std::to_string(c.height_px);
+    };
+    Require(m.left.width_px == m.right.width_px && m.left.height_px == m.right.height_px, where,
+            "modules[" + std::to_string(k) + "]: right_camera: imager_size",
+            size(m.right) + " differs from left_camera's " + size(m.left) +
+                ": a module's two cameras need one imager size (window both alike)");
   }
   render.Check(where + ": render");
   calibration.Check(where + ": calibration");

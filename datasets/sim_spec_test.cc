@@ -105,14 +105,28 @@ TEST(SimSpec, BadSpecsNameTheKey) {
   EXPECT_NE(e.find("pixels that far from square"), std::string::npos) << e;
 }
 
-// The first camera read out in its top 100 rows, a window its principal
-// point (cy = 293 px) lies below: a real sensor mode, which the spec's lens
-// check (as a rig file's) admits.
+// Module 0's cameras read out in their top 100 rows, a window their
+// principal points (cy = 293 px) lie below: a real sensor mode, which the
+// spec's lens check (as a rig file's) admits.
 TEST(SimSpec, AWindowedCameraIsAccepted) {
   const std::string good = SimSpecToYaml(DefaultSimSpec());
-  const std::string windowed = Replace(good, "imager_size: [752, 582]", "imager_size: [752, 100]");
+  const std::string windowed = Replace(Replace(good, "imager_size: [752, 582]", "imager_size: [752, 100]"),
+                                       "imager_size: [752, 582]", "imager_size: [752, 100]");
   EXPECT_EQ(ErrorOf(windowed), "");
   EXPECT_EQ(ParseSimSpecYaml(windowed, "spec.yaml").modules[0].left.height_px, 100);
+  EXPECT_EQ(ParseSimSpecYaml(windowed, "spec.yaml").modules[0].right.height_px, 100);
+}
+
+// One camera of a module windowed and not the other: the runtime refuses
+// such a rig ("its two cameras' imagers differ in size"), so the spec is
+// refused before any rendering, naming the module. It used to render a
+// dataset no command could reconstruct.
+TEST(SimSpec, AModuleWithTwoImagerSizesIsRefused) {
+  const std::string good = SimSpecToYaml(DefaultSimSpec());
+  const std::string one_windowed = Replace(good, "imager_size: [752, 582]", "imager_size: [400, 300]");
+  EXPECT_EQ(ErrorOf(one_windowed),
+            "spec.yaml: modules[0]: right_camera: imager_size: 752x582 differs from left_camera's 400x300: a "
+            "module's two cameras need one imager size (window both alike)");
 }
 
 TEST(SimSpec, RingsOfOneTwoThreeModulesBuild) {

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -15,8 +16,10 @@
 #include <fstream>
 #include <mutex>
 #include <sstream>
+#include <system_error>
 #include <thread>
 
+#include "calib/core/capture_image_name.h"
 #include "calib/core/float_tiff.h"
 #include "calib/core/folder_to_create.h"
 #include "calib/core/input_error.h"
@@ -99,7 +102,10 @@ void WritePly(const fs::path& path, const std::vector<Eigen::Vector3d>& points) 
   if (!f) throw InputError(path.string(), "cannot write");
 }
 
-// Runs f(0..n-1) on `threads` threads; rethrows the first exception.
+// Runs f(0..n-1) on up to `threads` threads, never more than n (a thread
+// with no job is only a cost); rethrows the first exception. A thread the
+// system refuses to start leaves the work to those already running (to
+// this one, if none started).
 void ParallelFor(int n, int threads, const std::function<void(int)>& f) {
   std::atomic<int> next{0};
   std::exception_ptr error;
@@ -116,9 +122,73 @@ void ParallelFor(int n, int threads, const std::function<void(int)>& f) {
     }
   };
   std::vector<std::thread> pool;
-  for (int t = 0; t < std::max(1, threads); ++t) pool.emplace_back(worker);
+  for (int t = 0; t < std::min(std::max(1, threads), n); ++t) {
+    try {
+      pool.emplace_back(worker);
+    } catch (const std::system_error&) {
+      break;
+    }
+  }
+  if (pool.empty()) worker();
   for (std::thread& t : pool) t.join();
   if (error) std::rethrow_exception(error);
+}
+
+// Whether the simulator writes `relative` (a path inside a dataset, as
+// simulate.h's layout gives it) as a folder (`folder`) or as a file.
+bool SimulatorWrites(const fs::path& relative, bool folder) {
+  std::vector<std::string> p;
+  for (const fs::path& part : relative) p.push_back(part.string());
+  const std::vector<std::string> scene_names = ScenesSpec().names;  // every scene there is
+  const auto scene = [&](const std::string& name) {
+    return std::find(scene_names.begin(), scene_names.end(), name) != scene_names.end();
+  };
+  const auto camera_png = [](const std::string& name, const std::string& prefix) {
+    return name.starts_with(prefix) && CameraIndexOfImageName(name.substr(prefix.size())).has_value();
+  };
+  const auto one_of = [](const std::string& name, std::initializer_list<const char*> names) {
+    return std::find(names.begin(), names.end(), name) != names.end();
+  };
+  const size_t n = p.size();
+  if (n == 1)
+    return folder ? one_of(p[0], {"artifacts", "calibration", "scenes", "truth"})
+                  : one_of(p[0], {"spec.yaml", "target.yaml", "layout.yaml"});
+  if (p[0] == "artifacts") return n == 2 && !folder && one_of(p[1], {"sphere.yaml", "ballbar.yaml", "plate.yaml"});
+  if (p[0] == "calibration") {
+    const bool capture = p[1].size() == 3 && std::all_of(p[1].begin(), p[1].end(), ::isdigit);
+    return capture && (n == 2 ? folder : n == 3 && !folder && camera_png(p[2], ""));
+  }
+  if (p[0] == "scenes") {
+    if (!scene(p[1])) return false;
+    if (n == 2) return folder;
+    if (!one_of(p[2], {"active", "passive"})) return false;
+    return n == 3 ? folder : n == 4 && !folder && camera_png(p[3], "");
+  }
+  STEREORIG_CHECK(p[0] == "truth");  // n >= 2 below a top-level name of the first test
+  if (n == 2)
+    return folder ? p[1] == "scenes" : one_of(p[1], {"rig.yaml", "calibration_poses.yaml", "simulation.yaml"});
+  if (p[1] != "scenes" || !scene(p[2])) return false;
+  if (n == 3) return folder;
+  return n == 4 && !folder &&
+         (one_of(p[3], {"object.yaml", "surface.ply"}) || camera_png(p[3], "id_") || camera_png(p[3], "lit_") ||
+          (p[3].starts_with("depth_") && p[3].ends_with(".tiff") &&
+           camera_png(p[3].substr(0, p[3].size() - 5) + ".png", "depth_")));
+}
+
+// Throws InputError naming `typed` if `out` is one of `inputs`, or holds one:
+// replacing the folder would delete it.
+void RequireNoInputIn(const std::string& typed, const fs::path& out,
+                      const std::vector<std::pair<std::string, std::string>>& inputs) {
+  const fs::path folder = NormalPath(out);
+  for (const auto& [path, what] : inputs) {
+    if (path.empty()) continue;
+    const fs::path input = NormalPath(path);
+    const auto [end, unused] = std::mismatch(folder.begin(), folder.end(), input.begin(), input.end());
+    if (end != folder.end()) continue;  // not below `folder`
+    throw InputError(typed, input == folder ? "is " + what + ", not a folder for the dataset (--out)"
+                                            : "holds " + what + " " + path +
+                                                  ": replacing the folder with the dataset would delete it");
+  }
 }
 
 // The true rig from its cameras and each one's world pose (module frame =
@@ -171,11 +241,87 @@ class Progress {
   std::mutex mutex_;
 };
 
+// A spec can place a camera where the board never reaches (a module
+// looking away): MakeCalibrationPoses keeps its best draw, and the dataset
+// then holds captures no calibration can use for that camera. Said on the
+// progress sink, "warning: ...", for each camera that sees fewer than
+// min_corners_per_camera corners in every capture (truth/
+// calibration_poses.yaml gives the count per capture). Not a refusal: a ring
+// of 3 modules at 120° keeps some captures below the minimum by design.
+void WarnOfCamerasTheBoardMisses(const CalibrationSpec& calibration, const PhysicalBoard& board, const Rig& rig,
+                                 const std::vector<Pose>& world_from_camera, const std::vector<Pose>& poses,
+                                 const std::function<void(const std::string&)>& say) {
+  if (poses.empty()) return;
+  for (const StereoModule& m : rig.modules()) {
+    for (const int cam : {m.left_camera, m.right_camera}) {
+      int most = 0;
+      for (const Pose& world_from_front : poses)
+        most = std::max(most, CornersInView(rig.camera(cam), world_from_camera[cam], world_from_front, board));
+      if (most >= calibration.min_corners_per_camera) continue;
+      say("warning: cam" + std::to_string(cam) + " (" + m.name + "'s " + (cam == m.left_camera ? "left" : "right") +
+          " camera) sees at most " + std::to_string(most) + " target corners in any of the " +
+          std::to_string(poses.size()) + " calibration captures, fewer than calibration.min_corners_per_camera (" +
+          std::to_string(calibration.min_corners_per_camera) + "): check the module's center_mm and look_at_mm");
+    }
+  }
+}
+
+// Likewise a projector that lights no pixel of any camera in any scene (one
+// past the volume, or turned away): the active images are its module's
+// passive ones. Said for each enabled projector (the `lit` bits, in module
+// order) whose count is 0.
+void WarnOfProjectorsLightingNothing(const SimSpec& spec, const std::vector<std::atomic<int64_t>>& lit_px,
+                                     const std::function<void(const std::string&)>& say) {
+  size_t k = 0;
+  for (size_t m = 0; m < spec.modules.size(); ++m) {
+    const ProjectorSpec& p = spec.modules[m].projector;
+    if (!p.enabled || p.power_dn <= 0) continue;  // as MakeProjectors
+    if (lit_px[k++] == 0)
+      say("warning: modules[" + std::to_string(m) + "] (" + spec.modules[m].name +
+          ")'s projector lights no pixel of any camera in any scene: check its offset_mm and the module's look_at_mm");
+  }
+}
+
 }  // namespace
+
+void CheckReplaceableOut(const std::string& typed, const fs::path& out) {
+  if (!fs::exists(out)) return;
+  if (!fs::is_directory(out)) throw InputError(typed, "exists and is not a folder");
+  if (fs::is_empty(out)) return;
+  if (!fs::exists(out / "spec.yaml"))
+    throw InputError(typed, "exists and is not a stereorig dataset (no spec.yaml); refusing to replace it");
+  // A spec.yaml alone is a project folder as often as a dataset (a user's
+  // own spec, next to their board and notes): the simulator's info file
+  // tells an earlier dataset apart.
+  std::ifstream info(out / "truth" / "simulation.yaml");
+  std::string line;
+  bool ours = false;
+  while (!ours && std::getline(info, line)) ours = line == "format: stereorig-sim-info";
+  if (!ours)
+    throw InputError(typed,
+                     "exists and is not a stereorig dataset (no truth/simulation.yaml of format stereorig-sim-info); "
+                     "refusing to replace it");
+  // The folder is replaced whole: anything kept in it that the simulator
+  // does not write (notes, scores, a calibrated rig) would go with it.
+  std::vector<fs::path> foreign;
+  for (auto it = fs::recursive_directory_iterator(out); it != fs::recursive_directory_iterator(); ++it) {
+    const fs::file_status status = it->symlink_status();
+    const bool folder = fs::is_directory(status);
+    if ((folder || fs::is_regular_file(status)) && SimulatorWrites(it->path().lexically_relative(out), folder))
+      continue;
+    foreign.push_back(it->path().lexically_relative(out));
+    if (folder) it.disable_recursion_pending();
+  }
+  if (!foreign.empty())
+    throw InputError(typed, "holds " + std::min_element(foreign.begin(), foreign.end())->string() +
+                                ", which the simulator does not write; refusing to replace the dataset and delete it "
+                                "(move it out, or choose another --out)");
+}
 
 void SimulateOptions::Check() const {
   if (out_dir.empty()) throw InputError("--out", "an output folder is required");
-  if (threads < 0) throw InputError("--threads", "must not be negative");
+  if (threads < 0 || threads > kMaxSimulateThreads)
+    throw InputError("--threads", "must be in [0, " + std::to_string(kMaxSimulateThreads) + "] (0 = every core)");
   if (calibration_captures < -1 || calibration_captures > 999) {
     throw InputError("--calibration-captures", "must be in [0, 999]");
   }
@@ -210,8 +356,9 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
   if (options.calibration_captures >= 0) spec.calibration.captures = options.calibration_captures;
   if (!options.scenes) spec.scenes.names.clear();
   spec.Check();
-  const int threads =
-      options.threads > 0 ? options.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int threads = options.threads > 0
+                          ? options.threads
+                          : std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, kMaxSimulateThreads);
   auto say = [&](const std::string& s) {
     if (options.progress) options.progress(s);
   };
@@ -282,6 +429,13 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
   std::vector<fs::path> missing;
   CheckNamesFit(typed, "create this folder for the dataset (--out)", DeepestExistingPart(NormalPath(out), &missing),
                 missing);
+  // Before any folder is made: an input inside `out`, or a folder that is
+  // not an earlier dataset, is refused with nothing created.
+  std::vector<std::pair<std::string, std::string>> inputs = options.inputs;
+  if (spec.calibration.target != "default")
+    inputs.push_back({spec.calibration.target, "the spec's target file (calibration.target)"});
+  RequireNoInputIn(typed, out, inputs);
+  CheckReplaceableOut(typed, out);
   // Made now, and removed again while empty if the run fails after this (a
   // folder that cannot be made, part way too): no new empty folder left.
   FolderToCreate parent_folder(parent.string(), "the dataset (--out)");
@@ -291,12 +445,6 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
     throw InputError(typed, e.problem());
   }
   std::error_code ec;
-  if (fs::exists(out)) {
-    if (!fs::is_directory(out)) throw InputError(typed, "exists and is not a folder");
-    if (!fs::is_empty(out) && !fs::exists(out / "spec.yaml")) {
-      throw InputError(typed, "exists and is not a stereorig dataset (no spec.yaml); refusing to replace it");
-    }
-  }
   const std::string pid = std::to_string(getpid());
   const fs::path tmp = parent / TemporaryName(".", out.filename().string(), ".tmp-" + pid);
   fs::remove_all(tmp, ec);
@@ -333,6 +481,7 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
   const int captures = spec.calibration.captures;
   const std::vector<Pose> poses =
       MakeCalibrationPoses(spec.calibration, board, rig.cameras(), sr.world_from_camera, StreamKey({seed, kKeyPoses}));
+  WarnOfCamerasTheBoardMisses(spec.calibration, board, rig, sr.world_from_camera, poses, say);
   std::vector<Scene> scenes;
   for (size_t s = 0; s < spec.scenes.names.size(); ++s) {
     scenes.push_back(MakeScene(spec.scenes.names[s], spec.scenes, spec.render,
@@ -352,6 +501,8 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
   say("rendering " + std::to_string(captures) + " calibration captures and " + std::to_string(scenes.size()) +
       " scenes x " + std::to_string(num_cameras) + " cameras on " + std::to_string(threads) + " threads");
   Progress progress(options.progress, num_jobs);
+  std::vector<std::atomic<int64_t>> lit_px(
+      projectors.size());  // per projector: pixels it lights, every scene and camera
   std::atomic<int> images{0};
   ParallelFor(num_jobs, threads, [&](int job) {
     if (job < num_scene_jobs) {
@@ -380,6 +531,7 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
       WriteImage(truth / ("depth_" + name + ".tiff"), rad.depth);
       WriteImage(truth / ("id_" + name + ".png"), rad.id);
       WriteImage(truth / ("lit_" + name + ".png"), rad.lit);
+      for (size_t k = 0; k < projectors.size(); ++k) lit_px[k] += cv::countNonZero(rad.lit & (1 << k));
       images += 2;
       progress.Done(scene.name + " " + name);
       return;
@@ -393,6 +545,8 @@ SimulateSummary Simulate(const SimSpec& spec_in, const SimulateOptions& options)
     ++images;
     progress.Done("calibration " + Num3(k));
   });
+
+  if (!scenes.empty()) WarnOfProjectorsLightingNothing(spec, lit_px, say);
 
   // --- the small files
   // The dataset renders again from its own spec: a target file is named as

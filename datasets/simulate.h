@@ -15,8 +15,11 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "datasets/lens_drift.h"
 #include "datasets/sim_spec.h"
@@ -34,15 +37,27 @@ struct RigBump {
   bool Any() const { return (camera >= 0 || module >= 0) && (rotation_deg != 0 || translation_mm != 0 || lens.Any()); }
 };
 
+// At most this many worker threads: more than any machine's hardware threads
+// today (two 128-core sockets give 512), and far below the per-user thread
+// limits at which spawning fails (--threads 100000 died of an uncaught
+// std::system_error, leaving its temporary folder behind).
+constexpr int kMaxSimulateThreads = 1024;
+
 struct SimulateOptions {
-  std::string out_dir;  // the dataset folder; replaced only if it is empty or a dataset
+  // The dataset folder; replaced only if it is empty or an earlier dataset
+  // holding nothing the simulator does not write (CheckReplaceableOut).
+  std::string out_dir;
   uint64_t seed = 1;
-  int threads = 0;                // 0 = every hardware thread
+  int threads = 0;                // 0 = every hardware thread; at most kMaxSimulateThreads
   bool scenes = true;             // false: calibration captures only
   int calibration_captures = -1;  // -1 = the spec's count
   RigBump bump;
   double surface_spacing_mm = 0.2;                   // ground-truth surface samples (<= 0.2)
   std::function<void(const std::string&)> progress;  // may be empty
+  // Files the run reads besides the spec's target (which Simulate protects
+  // itself), as (path, what): `stereorig simulate` gives its --spec file.
+  // out_dir may not be one of them nor hold one: replacing it would delete it.
+  std::vector<std::pair<std::string, std::string>> inputs;
 
   void Check() const;
 };
@@ -53,8 +68,17 @@ struct SimulateSummary {
   double rays_seconds = 0;  // of which: unprojecting the ray tables
 };
 
-// Throws InputError on a bad spec or option, or if the output folder cannot
-// be written.
+// Throws InputError naming `typed` (--out as given) unless the folder `out`
+// (absolute, normalised) may be replaced by a new dataset: it does not
+// exist, or is an empty folder, or is an earlier dataset (spec.yaml and
+// truth/simulation.yaml of format stereorig-sim-info) holding only files and
+// folders the simulator writes (the layout above). A file it does not
+// write (notes, scores, a hand-written spec) is named, not deleted.
+void CheckReplaceableOut(const std::string& typed, const std::filesystem::path& out);
+
+// Throws InputError on a bad spec or option, if the output folder cannot
+// be written or may not be replaced (CheckReplaceableOut), or if it is or
+// holds an input (options.inputs, the spec's target file).
 SimulateSummary Simulate(const SimSpec& spec, const SimulateOptions& options);
 
 }  // namespace stereorig

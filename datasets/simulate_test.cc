@@ -15,6 +15,7 @@
 #include "calib/core/rig_file.h"
 #include "calib/core/yaml_reader.h"
 #include "datasets/sim_test_util.h"
+#include "targets/target_file.h"
 
 namespace stereorig {
 namespace {
@@ -98,6 +99,115 @@ TEST(Simulate, RefusesToReplaceAFolderThatIsNotADatasetAndLeavesNoTemporaries) {
   for (const auto& e : fs::directory_iterator(dir.parent_path())) {
     EXPECT_EQ(e.path().filename().string().find(".simtest_precious.tmp"), std::string::npos);
   }
+}
+
+// An existing folder is replaced whole, so only an earlier dataset holding
+// nothing else is: an earlier dataset (every file and folder the simulator
+// wrote, scenes and artifacts included) is replaced; one with a file the
+// simulator does not write, or a folder with a spec.yaml but no
+// truth/simulation.yaml (a user's project), is refused naming it, and
+// nothing in it is lost. Before, a spec.yaml was enough and the notes went
+// with the folder.
+TEST(Simulate, ReplacesAnEarlierDatasetOnlyIfItHoldsNothingElse) {
+  SimSpec spec = SmallRingSpec(1, 4, 1);
+  spec.scenes.names = {"sphere", "plate"};  // artifacts/ too
+  const fs::path dir = RunSim(spec, "replace", 1, 2);
+  SimulateOptions o;
+  o.out_dir = dir.string();
+  EXPECT_EQ(testing::InputErrorMessage([&] { Simulate(spec, o); }), "");  // every file the simulator's own
+  const std::string refusal =
+      ", which the simulator does not write; refusing to replace the dataset and delete it "
+      "(move it out, or choose another --out)";
+  std::ofstream(dir / "truth" / "scenes" / "sphere" / "notes.txt") << "keep";
+  EXPECT_EQ(testing::InputErrorMessage([&] { Simulate(spec, o); }),
+            dir.string() + ": holds truth/scenes/sphere/notes.txt" + refusal);
+  fs::remove(dir / "truth" / "scenes" / "sphere" / "notes.txt");
+  fs::create_directories(dir / "scores");
+  std::ofstream(dir / "scores" / "cup.json") << "{}";
+  std::ofstream(dir / "scenes" / "sphere" / "active" / "cam0.jpg") << "";
+  EXPECT_EQ(testing::InputErrorMessage([&] { Simulate(spec, o); }),
+            dir.string() + ": holds scenes/sphere/active/cam0.jpg" + refusal);  // the first by name
+  EXPECT_EQ(Slurp(dir / "scores" / "cup.json"), "{}");
+  // A project folder: its own spec, no truth/.
+  const fs::path project = ::testing::TempDir() + "/simtest_project";
+  fs::remove_all(project);
+  fs::create_directories(project);
+  std::ofstream(project / "spec.yaml") << SimSpecToYaml(spec);
+  o.out_dir = project.string();
+  EXPECT_EQ(testing::InputErrorMessage([&] { Simulate(spec, o); }),
+            project.string() +
+                ": exists and is not a stereorig dataset (no truth/simulation.yaml of format stereorig-sim-info); "
+                "refusing to replace it");
+  EXPECT_EQ(Slurp(project / "spec.yaml"), SimSpecToYaml(spec));
+}
+
+// The files a run reads may not be in --out, which is replaced whole: the
+// spec's target file (and, from the command, its --spec file) is refused by
+// name, before any folder is made.
+TEST(Simulate, RefusesAnOutHoldingItsInputs) {
+  const fs::path dir = ::testing::TempDir() + "/simtest_inputs";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "empty");
+  WriteTargetFile(DefaultTarget(), (dir / "empty" / "board.yaml").string());
+  SimSpec spec = SmallRingSpec(1, 4, 0);
+  spec.scenes.names.clear();
+  spec.calibration.target = (dir / "empty" / "board.yaml").string();
+  SimulateOptions o;
+  o.out_dir = (dir / "empty").string();
+  EXPECT_EQ(testing::InputErrorMessage([&] { Simulate(spec, o); }),
+            o.out_dir + ": holds the spec's target file (calibration.target) " + spec.calibration.target +
+                ": replacing the folder with the dataset would delete it");
+  o.out_dir = spec.calibration.target;
+  EXPECT_EQ(testing::InputErrorMessage([&] { Simulate(spec, o); }),
+            o.out_dir + ": is the spec's target file (calibration.target), not a folder for the dataset (--out)");
+  spec.calibration.target = "default";
+  o.out_dir = (dir / "new").string();
+  o.inputs = {{(dir / "new" / "spec.yaml").string(), "the spec file (--spec)"}};
+  fs::create_directories(dir / "new");
+  std::ofstream(dir / "new" / "spec.yaml") << SimSpecToYaml(spec);
+  EXPECT_NE(testing::InputErrorMessage([&] { Simulate(spec, o); }).find("new: holds the spec file (--spec)"),
+            std::string::npos);
+  EXPECT_EQ(Slurp(dir / "new" / "spec.yaml"), SimSpecToYaml(spec));
+  EXPECT_TRUE(fs::exists(dir / "empty" / "board.yaml"));
+}
+
+// The warnings a run of `spec` gives on its progress sink.
+std::vector<std::string> Warnings(const SimSpec& spec, const std::string& name) {
+  SimulateOptions o;
+  o.out_dir = ::testing::TempDir() + "/simtest_" + name;
+  fs::remove_all(o.out_dir);
+  std::vector<std::string> warnings;
+  o.progress = [&](const std::string& line) {
+    if (line.starts_with("warning: ")) warnings.push_back(line);
+  };
+  Simulate(spec, o);
+  return warnings;
+}
+
+// A geometry that cannot work renders, but says so: a module looking away
+// from the volume has cameras the board never reaches, and a projector past
+// the volume lights nothing. Both rendered without a word. The sound rig
+// gives no warning.
+TEST(Simulate, CamerasTheBoardMissesAndProjectorsLightingNothingAreWarnedOf) {
+  SimSpec spec = SmallRingSpec(2, 4, 2);
+  spec.calibration.min_corners_per_camera = 12;
+  spec.scenes.names = {"sphere"};
+  EXPECT_EQ(Warnings(spec, "warn_none"), std::vector<std::string>{});
+  SimSpec away = spec;
+  away.scenes.names.clear();
+  away.modules[0].look_at_mm = away.modules[0].center_mm + Eigen::Vector3d(0, 0, -800);
+  const std::string misses =
+      " target corners in any of the 2 calibration captures, fewer than "
+      "calibration.min_corners_per_camera (12): check the module's center_mm and look_at_mm";
+  EXPECT_EQ(Warnings(away, "warn_away"),
+            (std::vector<std::string>{"warning: cam0 (module0's left camera) sees at most 0" + misses,
+                                      "warning: cam1 (module0's right camera) sees at most 0" + misses}));
+  SimSpec far = spec;
+  far.calibration.captures = 0;
+  far.modules[1].projector.offset_mm = Eigen::Vector3d(0, 0, 500);  // 300 mm past the centre, facing away from it
+  EXPECT_EQ(Warnings(far, "warn_far"),
+            (std::vector<std::string>{"warning: modules[1] (module1)'s projector lights no pixel of any camera in any "
+                                      "scene: check its offset_mm and the module's look_at_mm"}));
 }
 
 // truth/rig.yaml of a small two-module rig (no scenes, seed 3), bumped.

@@ -293,6 +293,86 @@ TEST(SimulateCli, OptionsThatWouldBeIgnoredAreRefused) {
   ExpectEachRefusedBeforeAnyWork(cases, dir);
 }
 
+// Numbers out of their range are refused by the flag's name before any
+// work: --calibration-captures -1 (the options' "the spec's count") rendered
+// the spec's captures, a seed above 2^64 - 1 was saturated to it, and
+// --threads had no bound (100000 died of an uncaught std::system_error,
+// exit 134, its temporary folder left behind; 1025 is the first refused,
+// and is harmless to try on the unfixed binary).
+TEST(SimulateCli, OutOfRangeNumbersAreRefusedByTheFlagsName) {
+  const std::string dir = ::testing::TempDir() + "/sim_out_of_range";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string out = " --out " + dir + "/ds --no-scenes";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {out + " --calibration-captures -1", "--calibration-captures: must be in [0, 999]"},
+      {out + " --calibration-captures 1000", "--calibration-captures: must be in [0, 999]"},
+      {out + " --calibration-captures 0 --seed 18446744073709551616",
+       "--seed: must be at most 18446744073709551615 (2^64 - 1)"},
+      {out + " --calibration-captures 0 --seed 0x1ffffffffffffffff", "--seed: must be at most 18446744073709551615"},
+      {out + " --calibration-captures 0 --threads 1025", "--threads: must be in [0, 1024] (0 = every core)"},
+      {out + " --calibration-captures 0 --threads -1", "--threads: must be in [0, 1024]"}};
+  ExpectEachRefusedBeforeAnyWork(cases, dir);
+  // The largest seed is a seed, and recorded as given.
+  const Result r = RunCli("simulate" + out + " --calibration-captures 0 --seed 18446744073709551615 --threads 1024");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(Slurp(dir + "/ds/truth/simulation.yaml").find("\nseed: 18446744073709551615\n"), std::string::npos);
+}
+
+// A project folder holding the user's own spec, its board and notes, given
+// as --out: exit 2 before any work, naming the input it holds, every file
+// as it was. It used to pass for an earlier dataset (it has a spec.yaml)
+// and was replaced whole: the spec, the board and the notes were deleted.
+// A folder with a spec.yaml that is not an input is refused as no dataset
+// (no truth/simulation.yaml); an earlier dataset with a file the simulator
+// does not write is refused naming it.
+TEST(SimulateCli, AProjectFolderIsNotReplaced) {
+  const std::string dir = ::testing::TempDir() + "/sim_project";
+  fs::remove_all(dir);
+  fs::create_directories(dir + "/proj");
+  ASSERT_EQ(RunCli("target --corners 9 7 --square-mm 10 --out " + dir + "/board.svg --write-target " + dir +
+                   "/proj/myboard.yaml")
+                .code,
+            0);
+  ASSERT_EQ(RunCli("simulate --write-default-spec " + dir + "/proj/spec.yaml").code, 0);
+  std::string spec = Slurp(dir + "/proj/spec.yaml");
+  const size_t at = spec.find("target: default");
+  ASSERT_NE(at, std::string::npos);
+  spec.replace(at, 15, "target: myboard.yaml");
+  std::ofstream(dir + "/proj/spec.yaml") << spec;
+  std::ofstream(dir + "/proj/notes.txt") << "notes\n";
+  const std::string board = Slurp(dir + "/proj/myboard.yaml");
+  const std::string run = " --calibration-captures 0 --no-scenes";
+  const std::pair<std::string, std::string> cases[] = {
+      {"--spec " + dir + "/proj/spec.yaml --out " + dir + "/proj",
+       dir + "/proj: holds the spec file (--spec) " + dir + "/proj/spec.yaml: replacing the folder"},
+      {"--spec " + dir + "/proj/spec.yaml --out " + dir + "/proj/spec.yaml",
+       dir + "/proj/spec.yaml: is the spec file (--spec), not a folder for the dataset (--out)"},
+      {"--spec " + dir + "/proj/spec.yaml --out " + dir + "/proj/myboard.yaml",
+       dir + "/proj/myboard.yaml: is the spec's target file (calibration.target)"},
+      {"--out " + dir + "/proj",
+       dir + "/proj: exists and is not a stereorig dataset (no truth/simulation.yaml of format stereorig-sim-info)"}};
+  for (const auto& [args, says] : cases) {
+    const Result r = RunCli("simulate " + args + run);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_EQ(r.err.rfind("stereorig simulate: " + says, 0), 0u) << r.err;
+  }
+  EXPECT_EQ(Slurp(dir + "/proj/spec.yaml"), spec);
+  EXPECT_EQ(Slurp(dir + "/proj/myboard.yaml"), board);
+  EXPECT_EQ(Slurp(dir + "/proj/notes.txt"), "notes\n");
+  // An earlier dataset is replaced, unless it holds a file of the user's.
+  ASSERT_EQ(RunCli("simulate --out " + dir + "/ds" + run).code, 0);
+  ASSERT_EQ(RunCli("simulate --out " + dir + "/ds" + run).code, 0);
+  std::ofstream(dir + "/ds/score.json") << "{}";
+  const Result r = RunCli("simulate --out " + dir + "/ds" + run);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "stereorig simulate: " + dir +
+                       "/ds: holds score.json, which the simulator does not write; refusing to replace the dataset "
+                       "and delete it (move it out, or choose another --out)\n");
+  EXPECT_EQ(Slurp(dir + "/ds/score.json"), "{}");
+}
+
 // A bump names a camera or module that exists and moves it by a finite
 // amount within +-10, or exits 2 before any work naming the flag. -1 (the
 // library's "none") used to read as no bump at all ("every amount given is
