@@ -100,7 +100,7 @@ int RunReconstruct(int argc, char** argv) {
              "--rectified-out", rectified_dir,
              "one capture: also write each module's rectified pair here (moduleM_left.png, moduleM_right.png, created "
              "if needed) and print the `stereorig match` command that searches it with the range and ROI the runtime "
-             "derives from the measurement volume")
+             "derives from the measurement volume (before its lit-region crop and band pass)")
           ->check(NonEmptyPath());
   app.add_option("--capture-root", capture_root,
                  "with --capture -: name each capture by its folder's path below this folder, joined with '_' "

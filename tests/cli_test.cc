@@ -441,6 +441,24 @@ TEST(Cli, EverySubcommandsHelpTeachesWithAnExample) {
   }
 }
 
+// The match command `reconstruct --rectified-out` prints searches the range
+// and ROI the measurement volume gives, which the runtime narrows per capture
+// (the demo cup's module 0: ROI [148, 8, 428, 535] and d [35, 120) searched
+// of the printed 0 0 752 582 and [-100, 174)); match's help said it held
+// "the disparity range and ROI the runtime searches".
+TEST(Cli, MatchsHelpSaysThePrintedRangeIsTheVolumesBeforeTheRuntimeNarrowsIt) {
+  const Result match = RunCli("match --help");
+  EXPECT_EQ(match.out.find("the runtime searches in it"), std::string::npos) << match.out;
+  EXPECT_NE(match.out.find("the runtime derives for it from the measurement volume (before its per-capture "
+                           "lit-region crop and band pass, which search less)"),
+            std::string::npos)
+      << match.out;
+  EXPECT_NE(RunCli("reconstruct --help")
+                .out.find("derives from the measurement volume (before its lit-region crop "
+                          "and band pass)"),
+            std::string::npos);
+}
+
 // The commands whose exit 1 means something other than bad input say what
 // in their help, 2 included: demo's said only when it exits 0 (and left out
 // the score step it runs), though it exits 1 on a step that misbehaves and

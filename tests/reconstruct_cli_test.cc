@@ -413,6 +413,10 @@ TEST_F(ReconstructCli, RectifiedOutWritesEachModulesPairAndTheMatchCommandForIt)
     ASSERT_NE(at, std::string::npos) << r.out;
     const size_t command = r.out.find("stereorig match ", at);
     ASSERT_NE(command, std::string::npos) << r.out;
+    // The volume's range and ROI, not what the runtime searched in this
+    // capture after its lit-region crop and band pass: not "the runtime's".
+    const std::string intro = "; the volume's search: ";
+    EXPECT_EQ(r.out.substr(command - intro.size(), intro.size()), intro) << r.out;
     const std::string args = r.out.substr(command + 10, r.out.find('\n', command) - command - 10);
     EXPECT_NE(args.find(" --min-disparity "), std::string::npos) << args;
     EXPECT_NE(args.find(" --roi "), std::string::npos) << args;
