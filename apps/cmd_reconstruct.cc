@@ -194,7 +194,9 @@ int RunReconstruct(int argc, char** argv) {
     AddRectifiedPairs(runtime, images, rectified_paths, &written);
   }
   written.Commit();
-  for (const ModuleReport& m : rec.modules) std::printf("%s\n", ModuleSummary(m).c_str());
+  for (const ModuleReport& m : rec.modules)
+    std::printf("%s\n",
+                ModuleSummary(m, {.passive = IsPassive(options), .say_whose = &m == &rec.modules.front()}).c_str());
   // On stderr too: a script that keeps only stderr, or a log, must not take
   // a module that measured nothing (lasers off, a camera not triggered) for
   // a measurement; the exit code stays 0 (the capture was reconstructed).
