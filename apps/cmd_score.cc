@@ -168,7 +168,7 @@ int RunScore(int argc, char** argv) {
                                {"fill", FillJson(s.fill[m])},
                                {"points_seen_through", rec.modules[m].seen_through},
                                {"points_on_seen_through_surfaces", rec.modules[m].seen_through_surface}});
-      std::printf("; m%zu fill %5.1f%% %s", m, 100 * s.fill[m].fill(), ErrorText(e).c_str());
+      std::printf("; m%zu fill %5.1f%% %s", m, 100 * s.fill[m].fill(), ErrorText(e, " mm").c_str());
     }
     if (!no_passive && fs::is_directory(scene_dir / "passive")) {
       const Reconstruction passive = passive_runtime.Process(LoadCapture((scene_dir / "passive").string(), rig), false);

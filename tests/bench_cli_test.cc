@@ -222,6 +222,22 @@ TEST(BenchCli, BenchAndScoreWithoutScenesTakeTheDefaultScenesTheDatasetHolds) {
   fs::remove_all(dataset);
 }
 
+// score's per-module figures carry their unit as the merged ones do: they
+// read "m0 fill 94.1% |e| 0.0346 std 0.0443; m1 ..." with "mm" only on the
+// merged figures. The sphere under the default volume, one module's figures
+// each: any numbers (a few seconds).
+TEST(BenchCli, ScoresPerModuleFiguresSayTheirUnit) {
+  const std::string dataset = testing::SimulateOneScene("sphere", 1, "score_units");
+  const testing::Result r =
+      RunCli("score --no-passive --dataset " + dataset + " --scenes sphere --rig " + dataset + "/truth/rig.yaml");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* module : {"m0", "m1"})
+    EXPECT_TRUE(std::regex_search(
+        r.out, std::regex(std::string("; ") + module + " fill +[0-9.]+% \\|e\\| [0-9.]+ std [0-9.]+ mm[;\n]")))
+        << module << ": " << r.out;
+  std::filesystem::remove_all(dataset);
+}
+
 // A damaged truth map is bad input named in one line, by bench and score
 // alike: they read the simulator's truth maps through the checked reader
 // (reconstruct/image_file.h) as every image input. A lit map cut short used
