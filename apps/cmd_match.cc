@@ -64,6 +64,7 @@ int RunMatch(int argc, char** argv) {
       "`stereorig reconstruct ... --rectified-out DIR`, which writes DIR/moduleM_left.png and "
       "DIR/moduleM_right.png and prints this command for each module. Matches piling up at an end of the range "
       "(the range misses the object: the laser grid matched whole periods off) are warned of on stderr.\n\n"
+      "Exit codes: 0 ok (with a range warning too); 2 bad usage or input.\n\n"
       "Example (the demo rig's module 0 under the default measurement volume):\n"
       "  stereorig reconstruct --rig demo/rig.yaml --capture demo/dataset/scenes/cup/active --out cup.ply "
       "--rectified-out rect\n"

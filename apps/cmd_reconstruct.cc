@@ -67,6 +67,8 @@ int RunReconstruct(int argc, char** argv) {
       "does SIGTERM, SIGHUP or Ctrl-C, once the capture in progress is written (exit as at the end; its summary "
       "says so), and so does a stdout that cannot be written (a reader gone: exit 2). A batch or a single capture "
       "dies of those signals at once, leaving no partial file.\n\n"
+      "Exit codes: 0 ok (a module that gave no point too: warned of on stderr); 2 bad usage or input, or a capture "
+      "of a batch or stream that failed (it has no output; the others' outputs are written).\n\n"
       "Examples:\n  stereorig reconstruct --rig rig.yaml --capture data/scenes/cup/active --out cup.ply "
       "--mesh cup.stl --report cup.json\n"
       "  stereorig reconstruct --rig rig.yaml --capture line/0001 line/0002 line/0003 --out-dir clouds "

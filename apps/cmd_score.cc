@@ -61,6 +61,7 @@ int RunScore(int argc, char** argv) {
       "overall and by their distance to the nearest measured point (0-5, 5-15, >= 15 mm). Judge with the rig file "
       "from `stereorig calibrate`, as the line will run: without --rig the dataset's truth rig is used (and said "
       "so), which leaves out the calibration's own error.\n\n"
+      "Exit codes: 0 ok (score judges nothing: no figure fails); 2 bad usage or input.\n\n"
       "Example:\n  stereorig score --dataset demo/dataset --rig demo/rig.yaml --report score.json",
       "stereorig score"};
   std::string dataset, rig_path, options_path, report_path, diagnose_dir, scenes_arg = "cup,sphere,ballbar,plate,tuber";

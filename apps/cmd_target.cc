@@ -40,6 +40,7 @@ int RunTarget(int argc, char** argv) {
       "IDs 100-107, a 5 mm plate), or its design at another size (--corners, --square-mm, --thickness-mm): the same "
       "tags and margins, the back face in register with the front. --write-target saves the target file used, to "
       "edit and measure against: its back_from_front and flatness are the design's until you measure the board.\n\n"
+      "Exit codes: 0 ok; 2 bad usage or input.\n\n"
       "Examples:\n"
       "  stereorig target --out board.svg --write-target board.yaml\n"
       "  stereorig target --corners 13 10 --square-mm 12 --thickness-mm 6 --out b12.svg --write-target b12.yaml\n"
