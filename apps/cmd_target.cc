@@ -29,6 +29,19 @@ Target ResizedDefaultTarget(int corners_x, int corners_y, double square_mm, doub
   }
 }
 
+// --square-mm under 1 mm, refused as the target file's square_size_mm is:
+// with the unit it was likely typed in (SmallSquareHint).
+CLI::Validator SmallSquareUnitHint() {
+  return CLI::Validator(
+      [](const std::string& text) {
+        double square_mm = 0;
+        if (!CLI::detail::lexical_cast(text, square_mm)) return std::string();  // the range check refuses it
+        const std::string hint = SmallSquareHint(square_mm);
+        return hint.empty() ? hint : text + ": " + hint;
+      },
+      "", "SmallSquareUnitHint");
+}
+
 }  // namespace
 
 int RunTarget(int argc, char** argv) {
@@ -58,6 +71,7 @@ int RunTarget(int argc, char** argv) {
           ->excludes(target_option);
   CLI::Option* square_option =
       app.add_option("--square-mm", square_mm, "the default's design with squares of this edge, mm (default 9)")
+          ->check(SmallSquareUnitHint())  // before the range: its "not in range 1 to 500" names no unit
           ->check(CLI::Range(1.0, 500.0))
           ->excludes(target_option);
   CLI::Option* thickness_option =
