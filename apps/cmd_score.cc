@@ -73,7 +73,9 @@ int RunScore(int argc, char** argv) {
                  "exits 2 before any scoring; by default, those of the five the dataset holds "
                  "(cup,sphere,ballbar,plate,tuber)");
   app.add_option("--options", options_path, "runtime options YAML");
-  app.add_option("--report", report_path, "write everything as JSON here")->check(NonEmptyPath());
+  app.add_option("--report", report_path,
+                 "write everything as JSON here (its keys and units: docs/reconstruct.md, \"Score report JSON\")")
+      ->check(NonEmptyPath());
   app.add_option("--diagnose", diagnose_dir,
                  "write where and why fill is lost here: per scene and module, PNGs of the pixel status, the lost "
                  "target pixels (green: the truth disparity passes the tests, red: not) and |disparity - truth| "
