@@ -220,6 +220,7 @@ int RunBench(int argc, char** argv) {
       "truth and the baselines; and the whole bench process's), the speed ratio, and both pipelines' accuracy "
       "(after one best rigid alignment to the truth surface) and fill rate. Without --dataset it renders a "
       "built-in scene: a 50 mm sphere with the laser grids on the embedded default rig.\n\n"
+      "Exit codes: 0 ok; 2 bad usage or input.\n\n"
       "Examples:\n  stereorig bench --runs 20\n"
       "  stereorig bench --dataset sim --scenes cup,sphere --rig calibrated.yaml --report bench.json",
       "stereorig bench"};

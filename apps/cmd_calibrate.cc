@@ -34,6 +34,7 @@ int RunCalibrate(int argc, char** argv) {
       "of the wrong size, a face seen by the wrong module; and, after the solve (the summary and the report written, "
       "the rig file not), a stage that did not converge (rms over --max-rms-px), a lens no camera has, or a plate "
       "whose back_from_front stage 3 moved far beyond the target file's stated sigma (the target file named).\n\n"
+      "Exit codes: 0 ok (the rig file written); 2 bad usage or input, or a calibration refused as above.\n\n"
       "Example:\n  stereorig calibrate --captures data/calibration --target target.yaml --layout layout.yaml "
       "--out rig.yaml --report report.json",
       "stereorig calibrate"};

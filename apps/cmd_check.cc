@@ -84,7 +84,7 @@ int RunCheck(int argc, char** argv) {
       "It names the camera or module that changed, says whether a new pose or a new lens (focal length, principal "
       "point) explains a named camera's corners, either (it cannot tell) or neither alone, and appends the run to "
       "an SQLite history.\n\n"
-      "Exit codes: 0 ok; 1 recalibrate; 2 bad input.\n\n"
+      "Exit codes: 0 ok; 1 recalibrate; 2 bad usage or input.\n\n"
       "Examples:\n"
       "  stereorig check --rig rig.yaml --captures tonight/ --target target.yaml --report tonight/check.json\n"
       "  stereorig check --history --rig rig.yaml          (the trend of every figure)",
@@ -92,14 +92,16 @@ int RunCheck(int argc, char** argv) {
   std::string rig_path, captures, target_path, report_path, history_db;
   bool history_only = false;
   CheckOptions options;
-  app.add_option("--rig", rig_path, "the stored rig file (from stereorig calibrate)");
+  app.add_option("--rig", rig_path,
+                 "the stored rig file (from stereorig calibrate); required, but with --history only where the history "
+                 "is looked for by default (give it or --history-db)");
   app.add_option("--captures", captures,
                  "folder of captures: one sub-folder per capture with camK.png per camera (or a simulated "
-                 "dataset, whose calibration/ folder is used)");
+                 "dataset, whose calibration/ folder is used); required unless --history");
   app.add_option("--target", target_path,
                  "the target file (YAML) of the board in the captures: the board the rig was calibrated with (the rig "
                  "file records it, and the plate's back_from_front as calibrated, which the check uses; another board "
-                 "is refused)");
+                 "is refused); required unless --history");
   app.add_option("--history-db", history_db, "SQLite history (default: check-history.sqlite beside the rig file)")
       ->check(NonEmptyPath());  // '' fell back to the default: another database than the one named
   app.add_option("--report", report_path, "write the figures as JSON here")->check(NonEmptyPath());

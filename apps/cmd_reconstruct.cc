@@ -67,6 +67,8 @@ int RunReconstruct(int argc, char** argv) {
       "does SIGTERM, SIGHUP or Ctrl-C, once the capture in progress is written (exit as at the end; its summary "
       "says so), and so does a stdout that cannot be written (a reader gone: exit 2). A batch or a single capture "
       "dies of those signals at once, leaving no partial file.\n\n"
+      "Exit codes: 0 ok (a module that gave no point too: warned of on stderr); 2 bad usage or input, or a capture "
+      "of a batch or stream that failed (it has no output; the others' outputs are written).\n\n"
       "Examples:\n  stereorig reconstruct --rig rig.yaml --capture data/scenes/cup/active --out cup.ply "
       "--mesh cup.stl --report cup.json\n"
       "  stereorig reconstruct --rig rig.yaml --capture line/0001 line/0002 line/0003 --out-dir clouds "
@@ -100,7 +102,7 @@ int RunReconstruct(int argc, char** argv) {
              "--rectified-out", rectified_dir,
              "one capture: also write each module's rectified pair here (moduleM_left.png, moduleM_right.png, created "
              "if needed) and print the `stereorig match` command that searches it with the range and ROI the runtime "
-             "derives from the measurement volume")
+             "derives from the measurement volume (before its lit-region crop and band pass)")
           ->check(NonEmptyPath());
   app.add_option("--capture-root", capture_root,
                  "with --capture -: name each capture by its folder's path below this folder, joined with '_' "
@@ -194,7 +196,9 @@ int RunReconstruct(int argc, char** argv) {
     AddRectifiedPairs(runtime, images, rectified_paths, &written);
   }
   written.Commit();
-  for (const ModuleReport& m : rec.modules) std::printf("%s\n", ModuleSummary(m).c_str());
+  for (const ModuleReport& m : rec.modules)
+    std::printf("%s\n",
+                ModuleSummary(m, {.passive = IsPassive(options), .say_whose = &m == &rec.modules.front()}).c_str());
   // On stderr too: a script that keeps only stderr, or a log, must not take
   // a module that measured nothing (lasers off, a camera not triggered) for
   // a measurement; the exit code stays 0 (the capture was reconstructed).

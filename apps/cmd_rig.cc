@@ -123,6 +123,8 @@ int RunRig(int argc, char** argv) {
       "With --truth (a simulated dataset's truth/rig.yaml) it also judges the rig by what users measure with: "
       "each module's 3D error (points of the volume projected through the true cameras, triangulated with this "
       "rig's module, RMS after the best rigid alignment) and each module pair's agreement through S.\n\n"
+      "Exit codes: 0 ok (the rig file valid; --truth's figures judge nothing); 2 bad usage or input (an invalid "
+      "rig file included).\n\n"
       "Examples:\n  stereorig rig --rig out/rig.yaml --export-cameramodels out/models/\n"
       "  stereorig rig --rig out/rig.yaml --truth sim/truth/rig.yaml",
       "stereorig rig"};

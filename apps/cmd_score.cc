@@ -61,6 +61,7 @@ int RunScore(int argc, char** argv) {
       "overall and by their distance to the nearest measured point (0-5, 5-15, >= 15 mm). Judge with the rig file "
       "from `stereorig calibrate`, as the line will run: without --rig the dataset's truth rig is used (and said "
       "so), which leaves out the calibration's own error.\n\n"
+      "Exit codes: 0 ok (score judges nothing: no figure fails); 2 bad usage or input.\n\n"
       "Example:\n  stereorig score --dataset demo/dataset --rig demo/rig.yaml --report score.json",
       "stereorig score"};
   std::string dataset, rig_path, options_path, report_path, diagnose_dir, scenes_arg = "cup,sphere,ballbar,plate,tuber";
@@ -72,7 +73,9 @@ int RunScore(int argc, char** argv) {
                  "exits 2 before any scoring; by default, those of the five the dataset holds "
                  "(cup,sphere,ballbar,plate,tuber)");
   app.add_option("--options", options_path, "runtime options YAML");
-  app.add_option("--report", report_path, "write everything as JSON here")->check(NonEmptyPath());
+  app.add_option("--report", report_path,
+                 "write everything as JSON here (its keys and units: docs/reconstruct.md, \"Score report JSON\")")
+      ->check(NonEmptyPath());
   app.add_option("--diagnose", diagnose_dir,
                  "write where and why fill is lost here: per scene and module, PNGs of the pixel status, the lost "
                  "target pixels (green: the truth disparity passes the tests, red: not) and |disparity - truth| "
@@ -168,7 +171,7 @@ int RunScore(int argc, char** argv) {
                                {"fill", FillJson(s.fill[m])},
                                {"points_seen_through", rec.modules[m].seen_through},
                                {"points_on_seen_through_surfaces", rec.modules[m].seen_through_surface}});
-      std::printf("; m%zu fill %5.1f%% %s", m, 100 * s.fill[m].fill(), ErrorText(e).c_str());
+      std::printf("; m%zu fill %5.1f%% %s", m, 100 * s.fill[m].fill(), ErrorText(e, " mm").c_str());
     }
     if (!no_passive && fs::is_directory(scene_dir / "passive")) {
       const Reconstruction passive = passive_runtime.Process(LoadCapture((scene_dir / "passive").string(), rig), false);

@@ -29,6 +29,19 @@ Target ResizedDefaultTarget(int corners_x, int corners_y, double square_mm, doub
   }
 }
 
+// --square-mm under 1 mm, refused as the target file's square_size_mm is:
+// with the unit it was likely typed in (SmallSquareHint).
+CLI::Validator SmallSquareUnitHint() {
+  return CLI::Validator(
+      [](const std::string& text) {
+        double square_mm = 0;
+        if (!CLI::detail::lexical_cast(text, square_mm)) return std::string();  // the range check refuses it
+        const std::string hint = SmallSquareHint(square_mm);
+        return hint.empty() ? hint : text + ": " + hint;
+      },
+      "", "SmallSquareUnitHint");
+}
+
 }  // namespace
 
 int RunTarget(int argc, char** argv) {
@@ -40,6 +53,7 @@ int RunTarget(int argc, char** argv) {
       "IDs 100-107, a 5 mm plate), or its design at another size (--corners, --square-mm, --thickness-mm): the same "
       "tags and margins, the back face in register with the front. --write-target saves the target file used, to "
       "edit and measure against: its back_from_front and flatness are the design's until you measure the board.\n\n"
+      "Exit codes: 0 ok; 2 bad usage or input.\n\n"
       "Examples:\n"
       "  stereorig target --out board.svg --write-target board.yaml\n"
       "  stereorig target --corners 13 10 --square-mm 12 --thickness-mm 6 --out b12.svg --write-target b12.yaml\n"
@@ -57,6 +71,7 @@ int RunTarget(int argc, char** argv) {
           ->excludes(target_option);
   CLI::Option* square_option =
       app.add_option("--square-mm", square_mm, "the default's design with squares of this edge, mm (default 9)")
+          ->check(SmallSquareUnitHint())  // before the range: its "not in range 1 to 500" names no unit
           ->check(CLI::Range(1.0, 500.0))
           ->excludes(target_option);
   CLI::Option* thickness_option =

@@ -98,6 +98,7 @@ int RunTune(int argc, char** argv) {
       "a plate turned away from the module is not detected (its period is stretched alike everywhere). The other keys "
       "of --options are kept; --out writes them with the new ones (YAML comments "
       "of --options are not carried over).\n\n"
+      "Exit codes: 0 ok (its warnings too); 2 bad usage or input (a capture that shows no grid period included).\n\n"
       "Example:\n  stereorig tune --rig rig.yaml --capture plate --options line.yaml --out line_tuned.yaml\n"
       "  stereorig reconstruct --rig rig.yaml --capture part1 --options line_tuned.yaml --out part1.ply",
       "stereorig tune"};

@@ -387,10 +387,10 @@ int RunVerify(int argc, char** argv) {
     const Figure& f = summary.worst[k];
     const int at = summary.worst_positions[k] + 1;  // numbered as in the table
     if (options.decision_rule != DecisionRule::kSimpleAcceptance && f.standard_uncertainty_mm) {
-      std::printf("  %s %.4f mm (2u %.4f, MPE %.4f) %s", f.name.c_str(), f.value_mm, f.ExpandedUncertaintyMm(),
+      std::printf("  %s %.4f mm (2u %.4f mm, MPE %.4f mm) %s", f.name.c_str(), f.value_mm, f.ExpandedUncertaintyMm(),
                   f.mpe_mm, f.pass ? "pass" : "FAIL");
     } else {
-      std::printf("  %s %.4f mm (MPE %.4f) %s", f.name.c_str(), f.value_mm, f.mpe_mm, f.pass ? "pass" : "FAIL");
+      std::printf("  %s %.4f mm (MPE %.4f mm) %s", f.name.c_str(), f.value_mm, f.mpe_mm, f.pass ? "pass" : "FAIL");
     }
     if (positions.size() > 1) std::printf(" at position %d", at);
     nlohmann::json worst = FigureJson(f, true, artifact);

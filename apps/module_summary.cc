@@ -128,15 +128,18 @@ std::string RangeEndsWarnedOf(const ModuleReport& m) {
   return ends.near && ends.far ? "both ends" : ends.near ? "the near end" : "the far end";
 }
 
-std::string ModuleSummary(const ModuleReport& m, int max_reasons) {
+std::string ModuleSummary(const ModuleReport& m, FillWording wording, int max_reasons) {
   const auto match = m.times_ms.find("match");
-  char buf[256];
-  std::snprintf(buf, sizeof buf,
-                "module %d: %d points, fill %.1f%% of %d grid-lit px, match %.1f ms\n"
-                "  searched d [%d, %d) of [%d, %d) px; lit px without a point: ",
-                m.module, m.points, 100 * m.fill_rate(), m.lit_pixels, match == m.times_ms.end() ? 0.0 : match->second,
-                m.searched_min_disparity_px, m.searched_min_disparity_px + m.searched_num_disparities,
-                m.min_disparity_px, m.min_disparity_px + m.num_disparities);
+  char buf[384];
+  std::snprintf(
+      buf, sizeof buf,
+      "module %d: %d points, fill %.1f%% of %d %s px%s, match %.1f ms\n"
+      "  searched d [%d, %d) of [%d, %d) px; lit px without a point: ",
+      m.module, m.points, 100 * m.fill_rate(), m.lit_pixels, wording.passive ? "lit" : "grid-lit",
+      wording.say_whose ? " (the runtime's own estimate; `stereorig score` measures fill against the truth)" : "",
+      match == m.times_ms.end() ? 0.0 : match->second, m.searched_min_disparity_px,
+      m.searched_min_disparity_px + m.searched_num_disparities, m.min_disparity_px,
+      m.min_disparity_px + m.num_disparities);
   const std::string losses = LossLine(m.lit_by_status, m.lit_pixels, std::max(1, max_reasons));
   const std::string seen = m.seen_through > 0
                                ? "\n  " + std::to_string(m.seen_through) +

@@ -30,7 +30,7 @@ TEST(ModuleSummary, NamesTheBandAndTheLargestLossesLargestFirst) {
             "module 1: 600 points, fill 60.0% of 1000 grid-lit px, match 82.8 ms\n"
             "  searched d [35, 120) of [-100, 174) px; lit px without a point: no_sgm_match 20.0%, wrong_line 12.5%, "
             "low_zncc 5.0%, ...");
-  EXPECT_EQ(ModuleSummary(m, 4).substr(ModuleSummary(m, 4).rfind(',') + 1), " speckle 2.5%");
+  EXPECT_EQ(ModuleSummary(m, {}, 4).substr(ModuleSummary(m, {}, 4).rfind(',') + 1), " speckle 2.5%");
 }
 
 TEST(ModuleSummary, SaysNoneWhenEveryLitPixelHasAPoint) {

@@ -42,7 +42,7 @@ void AddRectifiedPairs(const Runtime& runtime, const std::vector<cv::Mat>& image
 std::string RectifiedPairLine(const ModulePlan& plan, const RectifiedPairPaths& paths) {
   const cv::Rect& roi = plan.roi;
   return "module " + std::to_string(plan.module) + ": rectified pair " + paths.left + ", " + paths.right +
-         "; the runtime's search: stereorig match --left " + ShellQuoted(paths.left) + " --right " +
+         "; the volume's search: stereorig match --left " + ShellQuoted(paths.left) + " --right " +
          ShellQuoted(paths.right) + " --min-disparity " + std::to_string(plan.min_disparity_px) +
          " --num-disparities " + std::to_string(plan.num_disparities) + " --roi " + std::to_string(roi.x) + " " +
          std::to_string(roi.y) + " " + std::to_string(roi.width) + " " + std::to_string(roi.height) + " --out " +

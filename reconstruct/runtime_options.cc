@@ -227,6 +227,14 @@ RuntimeOptions PassiveOptions(RuntimeOptions active) {
   return active;
 }
 
+bool IsPassive(const RuntimeOptions& options) {
+  const RuntimeOptions passive = PassiveOptions(options);
+  return options.crop_to_lit_region == passive.crop_to_lit_region &&
+         options.match.min_distinctness == passive.match.min_distinctness &&
+         options.match.grid_line.enabled == passive.match.grid_line.enabled &&
+         options.match.line_index.enabled == passive.match.line_index.enabled;
+}
+
 RuntimeOptions ReadRuntimeOptions(const std::string& path) {
   // The text read once (a pipe too, as YamlMap::LoadFile reads), then parsed
   // as ParseRuntimeOptions parses it, so both refuse a second document.

@@ -92,6 +92,10 @@ RuntimeOptions ReadRuntimeOptions(const std::string& path);
 // which: without lines its vernier reads noise, and on the demo cup it
 // dropped a third of module 0's pixels as wrong_line, every point).
 RuntimeOptions PassiveOptions(RuntimeOptions active);
+// Whether the grid's own steps are all off, as PassiveOptions sets them: the
+// options of a capture without the laser grid, whose "lit" pixels are those
+// the ambient light gives contrast (9x9 std above lit_contrast_dn), no grid.
+bool IsPassive(const RuntimeOptions& options);
 RuntimeOptions ParseRuntimeOptions(const std::string& text, const std::string& where);
 
 }  // namespace stereorig

@@ -22,6 +22,16 @@ constexpr double kMinSquareSizeMm = 1.0;
 
 const char* FaceName(Face face) { return face == Face::kFront ? "front" : "back"; }
 
+std::string SmallSquareHint(double square_size_mm) {
+  if (!(square_size_mm > 0 && square_size_mm < kMinSquareSizeMm)) return "";
+  // The unit it most likely is in: in centimetres, 0.1 to 1 is a square of
+  // 1 to 10 mm, a board's usual; in metres, one of 100 mm to 1 m. Under
+  // 0.1, centimetres would be under 1 mm, and metres are the slip.
+  const char* unit = square_size_mm >= 0.1 ? "centimetres" : "metres";
+  return "squares of " + NumberText(1000 * square_size_mm) + " um, under the " + NumberText(kMinSquareSizeMm) +
+         " mm a camera resolves; is it in " + unit + "? the unit is mm";
+}
+
 Target::Target(Layout layout, const std::string& where) : layout_(std::move(layout)) {
   const Layout& l = layout_;
   if (l.corners_x < 2 || l.corners_y < 2) throw InputError(where, "a chessboard needs at least 2x2 inner corners");
@@ -30,15 +40,8 @@ Target::Target(Layout layout, const std::string& where) : layout_(std::move(layo
   if (l.square_size_mm <= 0) throw InputError(where, "square_size_mm must be positive");
   // Said before the tags' placement, which fails against squares of
   // micrometres.
-  if (l.square_size_mm < kMinSquareSizeMm) {
-    // The unit it most likely is in: in centimetres, 0.1 to 1 is a square of
-    // 1 to 10 mm, a board's usual; in metres, one of 100 mm to 1 m. Under
-    // 0.1, centimetres would be under 1 mm, and metres are the slip.
-    const char* unit = l.square_size_mm >= 0.1 ? "centimetres" : "metres";
-    throw InputError(where, "square_size_mm " + NumberText(l.square_size_mm) + ": squares of " +
-                                NumberText(1000 * l.square_size_mm) + " um, under the " + NumberText(kMinSquareSizeMm) +
-                                " mm a camera resolves; is it in " + unit + "? the unit is mm");
-  }
+  if (const std::string hint = SmallSquareHint(l.square_size_mm); !hint.empty())
+    throw InputError(where, "square_size_mm " + NumberText(l.square_size_mm) + ": " + hint);
   if (l.margin_mm < 0) throw InputError(where, "margin_mm must not be negative");
   if (l.flatness_allowance_mm < 0) throw InputError(where, "flatness_allowance_mm must not be negative");
   std::string why;

@@ -87,6 +87,13 @@ class Target {
 // The embedded default: 11x9 inner corners of 9 mm, tag36h11 in the margins
 // (front IDs 0-7, back IDs 100-107), 5 mm plate. docs/simulator.md says why.
 Target DefaultTarget();
+
+// Why squares of this edge make no target, naming the unit the size was
+// likely typed in ("squares of 900 um, under the 1 mm a camera resolves; is
+// it in centimetres? the unit is mm"); "" for a size of at least 1 mm or one
+// not positive (refused as such). The target file's square_size_mm and
+// `stereorig target --square-mm` say the same.
+std::string SmallSquareHint(double square_size_mm);
 // The default's design at another size: corners_x x corners_y inner corners
 // of square_size_mm, the same tags, margins, plate and measured sigma.
 Target DoubleSidedTarget(int corners_x, int corners_y, double square_size_mm);

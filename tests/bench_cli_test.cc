@@ -8,8 +8,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <set>
 #include <string>
 #include <thread>
 #include <utility>
@@ -220,6 +222,55 @@ TEST(BenchCli, BenchAndScoreWithoutScenesTakeTheDefaultScenesTheDatasetHolds) {
         << command << ": " << r.err;
   }
   fs::remove_all(dataset);
+}
+
+// The key paths of a JSON value ("scenes[].merged.std_mm"), arrays by their
+// first element; an object keyed by PixelStatus names (target_px_lost_by)
+// is one key.
+void KeyPaths(const nlohmann::json& j, const std::string& path, std::set<std::string>* paths) {
+  if (j.is_array() && !j.empty() && j[0].is_structured()) return KeyPaths(j[0], path + "[]", paths);
+  if (!path.empty()) paths->insert(path);
+  if (!j.is_object() || path.ends_with("target_px_lost_by")) return;
+  for (const auto& [key, value] : j.items()) KeyPaths(value, path.empty() ? key : path + "." + key, paths);
+}
+
+// score's per-module figures carry their unit as the merged ones do: they
+// read "m0 fill 94.1% |e| 0.0346 std 0.0443; m1 ..." with "mm" only on the
+// merged figures. And every key of its --report is in docs/reconstruct.md's
+// table ("Score report JSON"), which it had none of ("write everything as
+// JSON"). The sphere under the default volume: any numbers (a few seconds).
+TEST(BenchCli, ScoresPerModuleFiguresSayTheirUnitAndEveryKeyOfItsReportIsDocumented) {
+  const std::string dataset = testing::SimulateOneScene("sphere", 1, "score_units");
+  const std::string report = dataset + "/score.json";
+  const testing::Result r =
+      RunCli("score --dataset " + dataset + " --scenes sphere --rig " + dataset + "/truth/rig.yaml --report " + report);
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* module : {"m0", "m1"})
+    EXPECT_TRUE(std::regex_search(
+        r.out, std::regex(std::string("; ") + module + " fill +[0-9.]+% \\|e\\| [0-9.]+ std [0-9.]+ mm[;\n]")))
+        << module << ": " << r.out;
+  std::set<std::string> written;
+  KeyPaths(nlohmann::json::parse(std::ifstream(report)), "", &written);
+  ASSERT_TRUE(written.contains("scenes[].modules[].accuracy.std_mm")) << "the run wrote no module figures";
+  std::ifstream docs(std::string(STEREORIG_SOURCE_DIR) + "/docs/reconstruct.md");
+  const std::string text(std::istreambuf_iterator<char>(docs), {});
+  const size_t from = text.find("### Score report JSON"), to = text.find("\n#", from + 1);
+  ASSERT_NE(from, std::string::npos);
+  const std::string table = text.substr(from, to - from);
+  for (const std::string& key : written) {
+    // A row documents its key and, by "keys as merged's / the scene's
+    // fill", the same figures under accuracy, filled and modules[].fill.
+    const std::string row = "| `" + key + "` |";
+    const std::string as_merged = std::regex_replace(
+        key, std::regex("^scenes\\[\\]\\.(modules\\[\\]\\.accuracy|filled(\\.by_distance_to_measured\\[\\])?)\\."),
+        "scenes[].merged.");
+    const std::string as_fill =
+        std::regex_replace(key, std::regex("^scenes\\[\\]\\.modules\\[\\]\\.fill\\."), "scenes[].fill.");
+    EXPECT_TRUE(table.find(row) != std::string::npos || table.find("| `" + as_merged + "` |") != std::string::npos ||
+                table.find("| `" + as_fill + "` |") != std::string::npos)
+        << key << " is not in docs/reconstruct.md's score report table";
+  }
+  std::filesystem::remove_all(dataset);
 }
 
 // A damaged truth map is bad input named in one line, by bench and score

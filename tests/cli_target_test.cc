@@ -72,6 +72,20 @@ TEST(CliTarget, TheDefaultsDesignAtAnotherSize) {
   EXPECT_EQ(std::count(tiny.err.begin(), tiny.err.end(), '\n'), 1) << tiny.err;
   EXPECT_NE(tiny.err.find("--corners, --square-mm: "), std::string::npos) << tiny.err;
   EXPECT_FALSE(std::filesystem::exists(dir + "/tiny.svg"));
+  // A size under 1 mm names the unit it was likely typed in, as the target
+  // file's square_size_mm does (it read "Value 0.9 not in range 1.000000 to
+  // 500.000000"); above the range, CLI11's words still.
+  for (const auto& [size, unit] : {std::pair{"0.9", "centimetres"}, std::pair{"0.009", "metres"}}) {
+    const Result small = RunStereorig(std::string("target --square-mm ") + size + " --out " + dir + "/small.svg");
+    EXPECT_EQ(small.code, 2) << size;
+    EXPECT_EQ(small.err, std::string("stereorig target: --square-mm: ") + size + ": squares of " +
+                             (unit == std::string("metres") ? "9" : "900") +
+                             " um, under the 1 mm a camera resolves; is it in " + unit +
+                             "? the unit is mm (see --help)\n");
+    EXPECT_FALSE(std::filesystem::exists(dir + "/small.svg"));
+  }
+  EXPECT_NE(RunStereorig("target --square-mm 600 --out " + dir + "/large.svg").err.find("not in range"),
+            std::string::npos);
   const Result both = RunStereorig("target --target " + dir + "/b.yaml --square-mm 12 --out " + dir + "/x.svg");
   EXPECT_EQ(both.code, 2);
   EXPECT_NE(both.err.find("--target excludes --square-mm"), std::string::npos) << both.err;

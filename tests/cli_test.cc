@@ -451,6 +451,24 @@ TEST(Cli, EverySubcommandsHelpTeachesWithAnExample) {
   }
 }
 
+// The match command `reconstruct --rectified-out` prints searches the range
+// and ROI the measurement volume gives, which the runtime narrows per capture
+// (the demo cup's module 0: ROI [148, 8, 428, 535] and d [35, 120) searched
+// of the printed 0 0 752 582 and [-100, 174)); match's help said it held
+// "the disparity range and ROI the runtime searches".
+TEST(Cli, MatchsHelpSaysThePrintedRangeIsTheVolumesBeforeTheRuntimeNarrowsIt) {
+  const Result match = RunCli("match --help");
+  EXPECT_EQ(match.out.find("the runtime searches in it"), std::string::npos) << match.out;
+  EXPECT_NE(match.out.find("the runtime derives for it from the measurement volume (before its per-capture "
+                           "lit-region crop and band pass, which search less)"),
+            std::string::npos)
+      << match.out;
+  EXPECT_NE(RunCli("reconstruct --help")
+                .out.find("derives from the measurement volume (before its lit-region crop "
+                          "and band pass)"),
+            std::string::npos);
+}
+
 // The commands whose exit 1 means something other than bad input say what
 // in their help, 2 included: demo's said only when it exits 0 (and left out
 // the score step it runs), though it exits 1 on a step that misbehaves and
@@ -469,6 +487,51 @@ TEST(Cli, TheHelpOfEveryCommandThatExitsOneSaysWhen) {
   EXPECT_NE(top.out.find("1 a check that ran and failed (verify, check), or a demo step that did not exit as expected"),
             std::string::npos)
       << top.out;
+}
+
+// Every command's help gives its exit codes in the top-level help's words:
+// only check, verify and demo said theirs, and reconstruct's batch, which
+// exits 2 with the other captures' outputs written, said it nowhere a user
+// would look. Those that never exit 1 say 0 and 2 only.
+TEST(Cli, EveryCommandsHelpGivesItsExitCodes) {
+  for (const auto& [command, codes] :
+       {std::pair{"calibrate",
+                  "Exit codes: 0 ok (the rig file written); 2 bad usage or input, or a calibration "
+                  "refused as above."},
+        std::pair{"reconstruct",
+                  "Exit codes: 0 ok (a module that gave no point too: warned of on stderr); 2 bad usage "
+                  "or input, or a capture of a batch or stream that failed (it has no output; the "
+                  "others' outputs are written)."},
+        std::pair{"score", "Exit codes: 0 ok (score judges nothing: no figure fails); 2 bad usage or input."},
+        std::pair{"bench", "Exit codes: 0 ok; 2 bad usage or input."},
+        std::pair{"tune",
+                  "Exit codes: 0 ok (its warnings too); 2 bad usage or input (a capture that shows no grid "
+                  "period included)."},
+        std::pair{"match", "Exit codes: 0 ok (with a range warning too); 2 bad usage or input."},
+        std::pair{"rig",
+                  "Exit codes: 0 ok (the rig file valid; --truth's figures judge nothing); 2 bad usage or "
+                  "input (an invalid rig file included)."},
+        std::pair{"target", "Exit codes: 0 ok; 2 bad usage or input."},
+        std::pair{"check", "Exit codes: 0 ok; 1 recalibrate; 2 bad usage or input."}}) {
+    const Result r = RunCli(std::string(command) + " --help");
+    EXPECT_NE(r.out.find(std::string("\n") + codes + "\n"), std::string::npos) << command << ": " << r.out;
+  }
+}
+
+// check's --rig, --captures and --target are required unless --history, as
+// its refusal says ("--rig, --captures and --target are required"); its
+// help showed them as optional.
+TEST(Cli, ChecksHelpSaysWhichOptionsAreRequired) {
+  const Result r = RunCli("check --help");
+  EXPECT_NE(r.out.find("the stored rig file (from stereorig calibrate); required, but with --history only where the "
+                       "history is looked for by default (give it or --history-db)"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("whose calibration/ folder is used); required unless --history"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("another board is refused); required unless --history"), std::string::npos) << r.out;
+  const Result refused = RunCli("check --rig r.yaml");
+  EXPECT_EQ(refused.code, 2);
+  EXPECT_NE(refused.err.find("--rig, --captures and --target are required"), std::string::npos) << refused.err;
 }
 
 // Each (command, option) given '' exits 2 with one line naming the option

@@ -312,6 +312,31 @@ TEST_F(ReconstructCli, PrintsPerModuleTheBandSearchedAndWhereFillWent) {
   }
 }
 
+// The fill a capture prints is the runtime's own, over the pixels it finds
+// lit; `score`'s is over the truth's object pixels, and the two differ with
+// no word why (the demo cup's module 0: 76.5 % against 94.1 %). The run's
+// first module line says so, once. Under passive options there is no grid:
+// the pixels are "lit px", not "grid-lit px" (the demo's passive cup read
+// "fill 3.6% of 15056 grid-lit px" with the lasers off).
+TEST_F(ReconstructCli, TheFillIsCalledTheRuntimesOwnOnceAndItsPixelsAsTheOptionsLightThem) {
+  const std::string says_whose = " (the runtime's own estimate; `stereorig score` measures fill against the truth)";
+  const testing::Result active = testing::RunCli(Args(dir_ + "/capture"));
+  ASSERT_EQ(active.code, 0) << active.err;
+  const std::string first_line = active.out.substr(0, active.out.find('\n'));
+  EXPECT_EQ(first_line.rfind("module 0: ", 0), 0u) << first_line;
+  EXPECT_NE(first_line.find(" grid-lit px" + says_whose + ", match "), std::string::npos) << first_line;
+  EXPECT_EQ(active.out.find(says_whose), active.out.rfind(says_whose)) << "said more than once: " << active.out;
+  const std::string passive_options = dir_ + "/passive_options.yaml";
+  std::ofstream(passive_options) << "crop_to_lit_region: false\nmatch:\n  min_distinctness: 0\n  grid_line_test: "
+                                    "false\n  line_index: false\n";
+  const testing::Result passive = testing::RunCli(Args(dir_ + "/capture", "--options " + passive_options));
+  ASSERT_EQ(passive.code, 0) << passive.err;
+  EXPECT_EQ(passive.out.find("grid-lit"), std::string::npos) << passive.out;
+  EXPECT_TRUE(std::regex_search(passive.out, std::regex("\nmodule 1: [0-9]+ points, fill [0-9.]+% of [0-9]+ lit px, "
+                                                        "match ")))
+      << passive.out;
+}
+
 // A module that ends with no point says why, also with no grid-lit pixel
 // where the measurement volume projects: the hint used to need lit pixels
 // there, so a volume beside the object (its ROI, cropped to nothing lit,
@@ -413,6 +438,10 @@ TEST_F(ReconstructCli, RectifiedOutWritesEachModulesPairAndTheMatchCommandForIt)
     ASSERT_NE(at, std::string::npos) << r.out;
     const size_t command = r.out.find("stereorig match ", at);
     ASSERT_NE(command, std::string::npos) << r.out;
+    // The volume's range and ROI, not what the runtime searched in this
+    // capture after its lit-region crop and band pass: not "the runtime's".
+    const std::string intro = "; the volume's search: ";
+    EXPECT_EQ(r.out.substr(command - intro.size(), intro.size()), intro) << r.out;
     const std::string args = r.out.substr(command + 10, r.out.find('\n', command) - command - 10);
     EXPECT_NE(args.find(" --min-disparity "), std::string::npos) << args;
     EXPECT_NE(args.find(" --roi "), std::string::npos) << args;

@@ -172,7 +172,7 @@ TEST(VerifyCli, TheMpeSaysWhetherTheArtifactFileGaveItOrItIsTheDefault) {
              good + " --report " + report);
   ASSERT_EQ(r.code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("MPE: P_F 0.3415 mm (the artifact file's), P_S 1.5000 mm (default"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("(MPE 0.3415) pass"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(MPE 0.3415 mm) pass"), std::string::npos) << r.out;
   j = nlohmann::json::parse(std::ifstream(report));
   for (const auto& f : j["positions"][0]["figures"])
     EXPECT_EQ(f["mpe_source"], f["name"] == "P_F" ? "certificate" : "default") << f;
@@ -235,7 +235,7 @@ TEST(VerifyCli, TheReportNamesItsCertificateDateToolAndWorstPosition) {
     if (f["name"] == "P_S") {
       EXPECT_EQ(f["position"], 2) << f;
     }
-  EXPECT_NE(r.out.find("P_S 0.6000 mm (MPE 1.5000) pass at position 2"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("P_S 0.6000 mm (MPE 1.5000 mm) pass at position 2"), std::string::npos) << r.out;
 }
 
 // Error lines that say what is wrong: a certificate that cannot be read
@@ -880,6 +880,10 @@ TEST(VerifyCli, TheDecisionRuleJudgesTheUncertaintyRangeAndTheReportSaysWhichRul
                     std::string::npos,
                 simple)
           << r.out;
+      // The summary's 2u and MPE carry their unit as the value does.
+      if (!simple) {
+        EXPECT_NE(r.out.find(" mm (2u 0.2800 mm, MPE 1.5000 mm) "), std::string::npos) << r.out;
+      }
       if (expected_exit == 0 && !simple) {
         EXPECT_NE(
             r.out.find(std::string("verdict: PASS (") +
