@@ -22,6 +22,7 @@ int RunSimulate(int argc, char** argv) {
       "analytic objects and dense surfaces. Without --spec, the embedded default rig (2 facing modules, "
       "752x582 cameras, 90 mm baseline, 200 mm working distance, 51x51 laser grid). The same spec and seed "
       "give the same bytes. docs/simulator.md describes every knob.\n\n"
+      "Exit codes: 0 ok (its warnings too); 2 bad usage or input (a folder it refuses to replace included).\n\n"
       "Examples:\n"
       "  stereorig simulate --out data/default --seed 1\n"
       "  stereorig simulate --write-default-spec my_rig.yaml     # edit it, then:\n"
@@ -46,7 +47,10 @@ int RunSimulate(int argc, char** argv) {
   app.add_option("--seed", o.seed, "random seed: poses, scenes, noise (0 to 18446744073709551615)")
       ->check(CLI::Validator(
           [](const std::string& text) {
-            if (text.starts_with('-')) return std::string("must be >= 0");
+            // strtoull skips leading white space, then wraps "-1" round.
+            if (text.find_first_not_of(" \t\n\v\f\r") != std::string::npos &&
+                text[text.find_first_not_of(" \t\n\v\f\r")] == '-')
+              return std::string("must be >= 0");
             errno = 0;
             std::strtoull(text.c_str(), nullptr, 0);
             return errno == ERANGE ? std::string("must be at most 18446744073709551615 (2^64 - 1)") : std::string();

@@ -512,9 +512,20 @@ TEST(Cli, EveryCommandsHelpGivesItsExitCodes) {
                   "Exit codes: 0 ok (the rig file valid; --truth's figures judge nothing); 2 bad usage or "
                   "input (an invalid rig file included)."},
         std::pair{"target", "Exit codes: 0 ok; 2 bad usage or input."},
-        std::pair{"check", "Exit codes: 0 ok; 1 recalibrate; 2 bad usage or input."}}) {
+        std::pair{"check", "Exit codes: 0 ok; 1 recalibrate; 2 bad usage or input."},
+        std::pair{"simulate",
+                  "Exit codes: 0 ok (its warnings too); 2 bad usage or input (a folder it refuses to replace "
+                  "included)."}}) {
     const Result r = RunCli(std::string(command) + " --help");
     EXPECT_NE(r.out.find(std::string("\n") + codes + "\n"), std::string::npos) << command << ": " << r.out;
+  }
+  // And every command the top-level help lists (verify's and demo's own
+  // wording aside): simulate's had none while this test's list lacked it.
+  const std::string top = RunCli("--help").out;
+  for (const char* command : {"simulate", "target", "calibrate", "reconstruct", "match", "verify", "check", "bench",
+                              "score", "tune", "rig", "demo"}) {
+    ASSERT_NE(top.find(std::string("\n  ") + command + " "), std::string::npos) << command;
+    EXPECT_NE(RunCli(std::string(command) + " --help").out.find("\nExit codes: "), std::string::npos) << command;
   }
 }
 

@@ -289,7 +289,9 @@ TEST(SimulateCli, OptionsThatWouldBeIgnoredAreRefused) {
       {out + " --bump-module 1", "--bump-module: needs --bump-rotation-deg or --bump-translation-mm"},
       {" --write-default-spec " + dir + "/s.yaml" + out, "--out: does not apply with --write-default-spec"},
       {" --write-default-spec " + dir + "/s.yaml --bump-camera 1", "--bump-camera: does not apply with"},
-      {out + " --seed -1", "--seed: must be >= 0"}};
+      {out + " --seed -1", "--seed: must be >= 0"},
+      // Leading space: strtoull skips it and wrapped "-1" round to 2^64 - 1.
+      {out + " --seed ' -1'", "--seed: must be >= 0"}};
   ExpectEachRefusedBeforeAnyWork(cases, dir);
 }
 
