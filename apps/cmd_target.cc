@@ -71,6 +71,7 @@ int RunTarget(int argc, char** argv) {
           ->excludes(target_option);
   CLI::Option* square_option =
       app.add_option("--square-mm", square_mm, "the default's design with squares of this edge, mm (default 9)")
+          ->check(PositiveValue())        // NaN passes CLI11's range (its comparisons fail)
           ->check(SmallSquareUnitHint())  // before the range: its "not in range 1 to 500" names no unit
           ->check(CLI::Range(1.0, 500.0))
           ->excludes(target_option);
@@ -78,6 +79,7 @@ int RunTarget(int argc, char** argv) {
       app.add_option(
              "--thickness-mm", thickness_mm,
              "the default's design on a plate this thick, mm (default 5): the back face's depth behind the front")
+          ->check(PositiveValue())  // NaN passes CLI11's range
           ->check(CLI::Range(0.1, 100.0))
           ->excludes(target_option);
   app.add_option("--out", out_path, "SVG to write (atomically)")->required()->check(NonEmptyPath());

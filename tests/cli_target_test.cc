@@ -84,6 +84,13 @@ TEST(CliTarget, TheDefaultsDesignAtAnotherSize) {
                              "? the unit is mm (see --help)\n");
     EXPECT_FALSE(std::filesystem::exists(dir + "/small.svg"));
   }
+  // NaN passed CLI11's range checks (its comparisons fail) and was refused
+  // later as "back_from_front: contains NaN or Inf", naming no flag's value.
+  for (const char* flag : {"--square-mm", "--thickness-mm"}) {
+    const Result nan = RunStereorig(std::string("target ") + flag + " nan --out " + dir + "/nan.svg");
+    EXPECT_EQ(nan.code, 2) << flag;
+    EXPECT_NE(nan.err.find(std::string(flag) + ": must be positive and finite, got nan"), std::string::npos) << nan.err;
+  }
   EXPECT_NE(RunStereorig("target --square-mm 600 --out " + dir + "/large.svg").err.find("not in range"),
             std::string::npos);
   const Result both = RunStereorig("target --target " + dir + "/b.yaml --square-mm 12 --out " + dir + "/x.svg");
