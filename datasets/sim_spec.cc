@@ -1,6 +1,7 @@
 #include "datasets/sim_spec.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <set>
@@ -209,6 +210,13 @@ SimSpec ParseSimSpecYaml(const std::string& text, const std::string& where) {
   Require(root.GetString("units") == "mm", root.Where("units"), "", "expected 'mm'");
   SimSpec s;
   for (YamlMap m : root.GetMaps("modules")) s.modules.push_back(ParseModule(m));
+  // The truth's lit maps hold one bit per projector, 8 to a pixel
+  // (render.h): a ninth would light the scenes but never the lit maps that
+  // fill and the projector warnings are judged by.
+  const auto projectors =
+      std::count_if(s.modules.begin(), s.modules.end(), [](const ModuleSpec& m) { return m.projector.enabled; });
+  Require(projectors <= 8, root.Where("modules"), "",
+          std::to_string(projectors) + " modules have a projector; the truth's lit maps hold 8 (one bit each)");
   if (root.Has("render")) {
     YamlMap r = root.GetMap("render");
     RenderSpec& d = s.render;

@@ -117,6 +117,25 @@ TEST(SimSpec, AWindowedCameraIsAccepted) {
   EXPECT_EQ(ParseSimSpecYaml(windowed, "spec.yaml").modules[0].right.height_px, 100);
 }
 
+// The truth's lit maps hold 8 projectors (a bit each): a ninth would light
+// its scenes but no lit map, so fill and the projector warnings could not
+// judge its module. Eight are read; nine refused, naming the count.
+TEST(SimSpec, MoreProjectorsThanTheLitMapsHoldAreRefused) {
+  SimSpec spec = DefaultSimSpec();
+  while (spec.modules.size() < 8) {
+    spec.modules.push_back(spec.modules[0]);
+    spec.modules.back().name = "extra" + std::to_string(spec.modules.size());
+  }
+  EXPECT_EQ(ErrorOf(SimSpecToYaml(spec)), "");
+  spec.modules.push_back(spec.modules[0]);
+  spec.modules.back().name = "ninth";
+  EXPECT_NE(ErrorOf(SimSpecToYaml(spec)).find("9 modules have a projector; the truth's lit maps hold 8"),
+            std::string::npos)
+      << ErrorOf(SimSpecToYaml(spec));
+  spec.modules.back().projector.enabled = false;  // a ninth module without one is fine
+  EXPECT_EQ(ErrorOf(SimSpecToYaml(spec)), "");
+}
+
 // One camera of a module windowed and not the other: the runtime refuses
 // such a rig ("its two cameras' imagers differ in size"), so the spec is
 // refused before any rendering, naming the module. It used to render a
