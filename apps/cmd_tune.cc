@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numeric>
 #include <string>
 #include <vector>
 
@@ -19,9 +20,8 @@
 #include "reconstruct/grid_period.h"
 #include "reconstruct/grid_period_options.h"
 #include "reconstruct/lit_mask.h"
+#include "reconstruct/metrology/plane_fit.h"
 #include "reconstruct/runtime.h"
-
-#include <Eigen/Eigenvalues>
 
 namespace stereorig {
 namespace {
@@ -57,26 +57,19 @@ std::optional<GridPeriodMeasurement> MeasureModule(const Runtime& runtime, const
 // 8.07 while their spreads stayed 0.03-0.29 px. 0.5 mm is 7x the plate's
 // noise and a sixth of the nearest curved scene.
 constexpr double kMaxPlaneRmsMm = 0.5;
-// A module's points, fitted with a plane: the RMS of their distances to
-// it, mm (the smallest eigenvalue of their covariance). Nothing with fewer
-// than kMinPlanePoints points.
+// A module's points, fitted with a plane (FitPlaneLeastSquares): the RMS of
+// their distances to it, mm. Nothing with fewer than kMinPlanePoints points.
 constexpr int kMinPlanePoints = 1000;
 std::optional<double> PlaneRmsMm(const PointCloud& cloud, int module) {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d sum_sq = Eigen::Matrix3d::Zero();
-  int n = 0;
-  for (size_t i = 0; i < cloud.size(); ++i) {
-    if (cloud.module[i] != module) continue;
-    const Eigen::Vector3d p = cloud.xyz_mm[i].cast<double>();
-    sum += p;
-    sum_sq += p * p.transpose();
-    ++n;
-  }
-  if (n < kMinPlanePoints) return std::nullopt;
-  const Eigen::Vector3d mean = sum / n;
-  const Eigen::Matrix3d covariance = sum_sq / n - mean * mean.transpose();
-  const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues()(0);
-  return std::sqrt(std::max(0.0, smallest));
+  std::vector<Eigen::Vector3d> points;
+  for (size_t i = 0; i < cloud.size(); ++i)
+    if (cloud.module[i] == module) points.push_back(cloud.xyz_mm[i].cast<double>());
+  if (points.size() < kMinPlanePoints) return std::nullopt;
+  std::vector<int> all(points.size());
+  std::iota(all.begin(), all.end(), 0);
+  const PlaneFit fit = FitPlaneLeastSquares(points, all);
+  if (!fit.ok) return std::nullopt;
+  return fit.rms_mm;
 }
 
 }  // namespace
