@@ -8,6 +8,7 @@
 #include "apps/module_summary.h"
 #include "apps/reconstruct_json.h"
 #include "calib/core/atomic_file.h"
+#include "calib/core/folder_to_create.h"
 #include "calib/core/input_error.h"
 #include "reconstruct/elapsed_ms.h"
 #include "reconstruct/ply_io.h"
@@ -23,9 +24,7 @@ CaptureOutputs CaptureOutputsNamed(const std::string& out_dir, const std::string
 }
 
 fs::path ResolvedFolder(const std::string& dir) {
-  std::error_code ec;
-  fs::path p = fs::weakly_canonical(fs::absolute(fs::path(dir)), ec);
-  if (ec) p = fs::absolute(fs::path(dir)).lexically_normal();
+  fs::path p = NormalPath(dir);  // links followed as far as they resolve (calib/core/folder_to_create.h)
   if (!p.has_filename()) p = p.parent_path();
   return p;
 }

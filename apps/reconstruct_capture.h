@@ -25,10 +25,10 @@ struct CaptureOutputs {
 // <name>.json and, unless mesh_format is "", <name>.mesh.<mesh_format>.
 CaptureOutputs CaptureOutputsNamed(const std::string& out_dir, const std::string& name, const std::string& mesh_format);
 
-// The folder `dir` as the file system finds it: absolute, links followed
-// (std::filesystem::weakly_canonical: a part that does not exist is kept as
-// written), no trailing separator; a path it cannot resolve (a link loop)
-// absolute and normal, as written, for the capture's own check to name. A
+// The folder `dir` as the file system finds it (NormalPath,
+// calib/core/folder_to_create.h: absolute, links followed; a part that does
+// not exist or cannot be looked up, such as a link loop, kept as written
+// below the part that resolves), no trailing separator. A
 // batch's "given twice" and a stream's --capture-root compare folders so, not
 // their paths' text ("nm/q" and "link_to_nm/q" are one folder).
 std::filesystem::path ResolvedFolder(const std::string& dir);
