@@ -189,7 +189,7 @@ int RunReconstruct(int argc, char** argv) {
   // earlier run's cloud and mesh as they were, not a new cloud beside them.
   AtomicOutputSet written;
   written.Add(out_path, EncodeCloudPly(rec.cloud));
-  if (!mesh_path.empty()) written.Add(mesh_path, EncodeMesh(rec.mesh, mesh_path));
+  if (!mesh_path.empty()) written.Add(mesh_path, EncodeMesh(rec.cloud, rec.mesh, mesh_path));
   if (!report_path.empty()) written.Add(report_path, ReconstructionJson(rec).dump(2) + "\n");
   if (!rectified_paths.empty()) {
     rectified_folder.Create();

@@ -73,7 +73,7 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
   // them new beside an earlier run's others.
   AtomicOutputSet written;
   written.Add(outputs.cloud, EncodeCloudPly(rec.cloud));
-  if (mesh) written.Add(outputs.mesh, EncodeMesh(rec.mesh, outputs.mesh));
+  if (mesh) written.Add(outputs.mesh, EncodeMesh(rec.cloud, rec.mesh, outputs.mesh));
   written.Add(outputs.report, ReconstructionJson(rec).dump(2) + "\n");
   written.Commit();
   nlohmann::json entry;

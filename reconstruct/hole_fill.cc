@@ -288,20 +288,19 @@ HoleFillResult FillHolesFromModel(const PointCloud& measured, const RuntimeOptio
       }
     });
   }
+  // The mesh's vertices are the cloud's points: the fill's triangles index
+  // the points appended here.
   std::vector<int> vertex(samples, -1);
-  const int first_vertex = int(mesh->vertices.size());
+  const int first_vertex = int(cloud->size());
   int added = 0;
   for (size_t k = 0; k < samples; ++k) {
     if (!keep[k]) continue;
     vertex[k] = first_vertex + added;
-    // The same point in the cloud and as a mesh vertex: marked filled in both.
-    for (PointCloud* out : {cloud, &mesh->vertices}) {
-      out->xyz_mm.push_back(point[k].cast<float>());
-      out->normal.push_back(normal[k].cast<float>());
-      out->intensity.push_back(0);
-      out->module.push_back(kFilledModule);
-      out->confidence.push_back(0.0f);
-    }
+    cloud->xyz_mm.push_back(point[k].cast<float>());
+    cloud->normal.push_back(normal[k].cast<float>());
+    cloud->intensity.push_back(0);
+    cloud->module.push_back(kFilledModule);
+    cloud->confidence.push_back(0.0f);
     ++added;
   }
   for (int i = 0; i < rows; ++i)

@@ -39,8 +39,9 @@ struct HoleFillResult {
   std::string message;  // the fitted model and the residual field, or why nothing was filled
 };
 
-// Fits the model to `measured`, appends the fill to *cloud and *mesh (either
-// may be the same object as `measured`'s owner; `measured` is read first).
+// Fits the model to `measured`, appends the fill's points to *cloud and its
+// triangles, over those points (indices into *cloud), to *mesh. `measured`
+// may be *cloud itself (it is read first).
 HoleFillResult FillHolesFromModel(const PointCloud& measured, const RuntimeOptions& options, PointCloud* cloud,
                                   Mesh* mesh);
 

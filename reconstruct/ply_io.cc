@@ -72,14 +72,15 @@ void CheckMeshPath(const std::string& path) {
     throw InputError(path, "mesh output must end in .ply or .stl");
 }
 
-std::string EncodeMesh(const Mesh& m, const std::string& path) {
+std::string EncodeMesh(const PointCloud& vertices, const Mesh& m, const std::string& path) {
   CheckMeshPath(path);
+  CheckMeshOver(vertices, m);
   std::string out;
   if (EndsWithIgnoringCase(path, ".stl")) {
     out.assign(80, ' ');
     out.replace(0, 40, "stereorig mesh, reference frame, mm     ");
     Put(out, uint32_t(m.triangles.size()));
-    const std::vector<Eigen::Vector3f>& v_mm = m.vertices.xyz_mm;
+    const std::vector<Eigen::Vector3f>& v_mm = vertices.xyz_mm;
     for (const Eigen::Vector3i& t : m.triangles) {
       const Eigen::Vector3f a = v_mm[t[0]], b = v_mm[t[1]], c = v_mm[t[2]];
       Eigen::Vector3f n = (b - a).cross(c - a);
@@ -91,9 +92,9 @@ std::string EncodeMesh(const Mesh& m, const std::string& path) {
     }
   } else {
     out = "ply\nformat binary_little_endian 1.0\ncomment stereorig mesh, reference frame (module 0), mm\n" +
-          VertexHeader(m.vertices) + "element face " + std::to_string(m.triangles.size()) +
+          VertexHeader(vertices) + "element face " + std::to_string(m.triangles.size()) +
           "\nproperty list uchar int vertex_indices\nend_header\n";
-    PutVertices(m.vertices, out);
+    PutVertices(vertices, out);
     for (const Eigen::Vector3i& t : m.triangles) {
       Put(out, uint8_t(3));
       for (int k = 0; k < 3; ++k) Put(out, int32_t(t[k]));
@@ -102,6 +103,8 @@ std::string EncodeMesh(const Mesh& m, const std::string& path) {
   return out;
 }
 
-void WriteMesh(const Mesh& m, const std::string& path) { WriteFileAtomically(path, EncodeMesh(m, path)); }
+void WriteMesh(const PointCloud& vertices, const Mesh& m, const std::string& path) {
+  WriteFileAtomically(path, EncodeMesh(vertices, m, path));
+}
 
 }  // namespace stereorig

@@ -1,5 +1,9 @@
 #include "reconstruct/point_cloud.h"
 
+#include <limits>
+
+#include "calib/core/input_error.h"
+
 namespace stereorig {
 
 void PointCloud::Reserve(size_t points) {
@@ -26,15 +30,15 @@ void PointCloud::Append(const PointCloud& o) {
   confidence.insert(confidence.end(), o.confidence.begin(), o.confidence.end());
 }
 
-void Mesh::Reserve(size_t num_vertices, size_t num_triangles) {
-  vertices.Reserve(num_vertices);
-  triangles.reserve(num_triangles);
+void Mesh::Append(const Mesh& o, size_t vertex_offset) {
+  STEREORIG_CHECK(vertex_offset <= size_t(std::numeric_limits<int>::max()));
+  const Eigen::Vector3i offset = Eigen::Vector3i::Constant(int(vertex_offset));
+  for (const Eigen::Vector3i& t : o.triangles) triangles.push_back(t + offset);
 }
 
-void Mesh::Append(const Mesh& o) {
-  const int offset = int(vertices.size());
-  vertices.Append(o.vertices);
-  for (const Eigen::Vector3i& t : o.triangles) triangles.push_back(t + Eigen::Vector3i::Constant(offset));
+void CheckMeshOver(const PointCloud& vertices, const Mesh& mesh) {
+  const int n = int(vertices.size());
+  for (const Eigen::Vector3i& t : mesh.triangles) STEREORIG_CHECK(t.minCoeff() >= 0 && t.maxCoeff() < n);
 }
 
 }  // namespace stereorig

@@ -1,5 +1,5 @@
 // The runtime's outputs: a point cloud with per-point attributes and a
-// triangle mesh, both in the reference frame (module 0), mm.
+// triangle mesh over its points, in the reference frame (module 0), mm.
 #pragma once
 
 #include <Eigen/Core>
@@ -24,14 +24,23 @@ struct PointCloud {
   void Append(const PointCloud& other);
 };
 
-// The vertices carry the cloud's per-point fields, so a mesh file keeps each
+// A triangle mesh over a point cloud: its vertices are the cloud's points,
+// so a mesh is only its triangles, and is written with the cloud it indexes
+// (EncodeMesh(cloud, mesh, path), ply_io.h). The mesh PLY so keeps each
 // vertex's module: `stereorig verify` must tell hole filling's vertices
-// (kFilledModule) from measured ones in a mesh as in a cloud.
+// (kFilledModule) from measured ones in a mesh as in a cloud. Who holds a
+// Mesh holds the cloud beside it (Reconstruction::cloud) and keeps the two
+// consistent: a point removed reindexes the triangles (CheckMeshOver).
 struct Mesh {
-  PointCloud vertices;
-  std::vector<Eigen::Vector3i> triangles;  // indices into vertices, counter-clockwise seen from outside
-  void Reserve(size_t vertices, size_t triangles);
-  void Append(const Mesh& other);
+  std::vector<Eigen::Vector3i> triangles;  // indices into the cloud, counter-clockwise seen from outside
+  // Appends `other`'s triangles, whose indices are into a cloud appended
+  // to this mesh's at `vertex_offset` (its size before PointCloud::Append;
+  // the caller reserves the joined triangles).
+  void Append(const Mesh& other, size_t vertex_offset);
 };
+
+// A triangle indexing no point of `vertices` is a programming error (the
+// cloud and the mesh went out of step): STEREORIG_CHECK fails on it.
+void CheckMeshOver(const PointCloud& vertices, const Mesh& mesh);
 
 }  // namespace stereorig

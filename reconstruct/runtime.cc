@@ -72,16 +72,17 @@ void RemoveRefuted(const ModulePlan& plan, const std::vector<uint8_t>& refuted, 
       ++report->lit_by_status[size_t(st)];
     }
   }
+  CheckMeshOver(*cloud, *mesh);  // new_index is read at every vertex of every triangle
   report->points = int(kept.size());
   *cloud = std::move(kept);
-  if (mesh->vertices.size() == 0) return;
-  Mesh out;
-  out.vertices = *cloud;
+  // The mesh's triangles over the kept points: a triangle with a removed
+  // vertex goes, the others take their vertices' new indices.
+  size_t n = 0;
   for (const Eigen::Vector3i& tri : mesh->triangles) {
     const Eigen::Vector3i m(new_index[tri[0]], new_index[tri[1]], new_index[tri[2]]);
-    if (m.minCoeff() >= 0) out.triangles.push_back(m);
+    if (m.minCoeff() >= 0) mesh->triangles[n++] = m;
   }
-  *mesh = std::move(out);
+  mesh->triangles.resize(n);
 }
 
 }  // namespace
@@ -407,9 +408,9 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
   if (!build_mesh) return;
   // Organised mesh: two triangles per 2x2 cell of points, unless an edge is
   // longer than mesh_max_edge_mm (a depth jump between surfaces). Vertex
-  // order makes them counter-clockwise seen from the camera.
+  // order makes them counter-clockwise seen from the camera. Its vertices
+  // are the cloud's points (indices into *cloud), not a copy of them.
   t = Clock::now();
-  mesh->vertices = *cloud;                   // with the points' fields: the mesh PLY keeps each vertex's module
   mesh->triangles.reserve(2 * kept.size());  // two per point inside a surface
   const float max_edge2 = float(options_.mesh_max_edge_mm * options_.mesh_max_edge_mm);
   auto short_edge = [&](int a, int b) { return (cloud->xyz_mm[a] - cloud->xyz_mm[b]).squaredNorm() <= max_edge2; };
@@ -484,15 +485,18 @@ Reconstruction Runtime::ProcessInPool(const std::vector<cv::Mat>& images, bool b
   size_t total_points = 0;
   for (const PointCloud& c : clouds) total_points += c.size();
   out.cloud.Reserve(total_points);
-  for (int m = 0; m < nm; ++m) out.cloud.Append(clouds[m]), clouds[m] = PointCloud();
+  // Where each module's points begin in the merged cloud: its triangles'
+  // offset in the joined mesh.
+  std::vector<size_t> first_point(nm);
+  for (int m = 0; m < nm; ++m) first_point[m] = out.cloud.size(), out.cloud.Append(clouds[m]), clouds[m] = PointCloud();
   out.times_ms["merge"] = MsSince(t);
   out.times_ms["total_point_cloud"] = MsSince(t_total);
   if (!build_mesh) return out;
   t = Clock::now();
-  size_t total_vertices = 0, total_triangles = 0;
-  for (const Mesh& mesh : meshes) total_vertices += mesh.vertices.size(), total_triangles += mesh.triangles.size();
-  out.mesh.Reserve(total_vertices, total_triangles);
-  for (int m = 0; m < nm; ++m) out.mesh.Append(meshes[m]), meshes[m] = Mesh();
+  size_t total_triangles = 0;
+  for (const Mesh& mesh : meshes) total_triangles += mesh.triangles.size();
+  out.mesh.triangles.reserve(total_triangles);
+  for (int m = 0; m < nm; ++m) out.mesh.Append(meshes[m], first_point[m]), meshes[m] = Mesh();
   out.times_ms["mesh_join"] = MsSince(t);
   t = Clock::now();
   if (options_.shape_model != ShapeModel::kNone) {

@@ -104,7 +104,7 @@ struct ModuleReport {
 
 struct Reconstruction {
   PointCloud cloud;  // all modules, then filled points; reference frame
-  Mesh mesh;         // empty unless requested
+  Mesh mesh;         // over cloud's points (filled ones too); empty unless requested
   std::vector<ModuleReport> modules;
   std::map<std::string, double> times_ms;  // modules (wall), free_space, merge, mesh_join, hole_fill, total_point_cloud
   int filled_points = 0;                   // points added by hole filling
@@ -139,7 +139,7 @@ class Runtime {
   std::pair<cv::Mat, cv::Mat> Rectify(const ModulePlan& plan, const std::vector<cv::Mat>& images) const;
 
   // The per-module work of Process(), exposed for tests: the module's cloud
-  // (reference frame) and its organised mesh (if build_mesh); and, if
+  // (reference frame) and its organised mesh over it (if build_mesh); and, if
   // `rectified` is given, the rectified pair it matched (left, right).
   void ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& images, bool build_mesh, PointCloud* cloud,
                      Mesh* mesh, ModuleReport* report, std::pair<cv::Mat, cv::Mat>* rectified = nullptr) const;
