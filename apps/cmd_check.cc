@@ -97,6 +97,43 @@ std::string CapturesCrc32Hex(const std::string& captures) {
 // The runs --history lists one a line: a month of nights.
 constexpr size_t kHistoryRunsListed = 31;
 
+// --history --json: every run with its inputs, its figures and the views it
+// set aside, for a line controller or a plot; a text kept empty ("" where a
+// run from before did not keep it) reads null.
+int PrintHistoryJson(const std::string& db) {
+  const auto runs = ReadHistoryRuns(db);
+  const HistorySetAsideLog set_aside = ReadHistorySetAside(db);
+  std::map<long long, nlohmann::json> figures, views;
+  for (const FigureTrend& t : ReadHistoryTrends(db))
+    for (const HistoryPoint& p : t.points)
+      figures[p.run_id][t.name] = {{"value", p.value}, {"threshold", p.threshold}, {"pass", p.pass}};
+  for (const HistorySetAside& v : set_aside.views)
+    views[v.run_id].push_back(
+        {{"capture", v.capture}, {"camera", v.camera}, {"jump_rms_px", v.jump_rms_px}, {"bound_px", v.bound_px}});
+  auto text = [](const std::string& t) { return t.empty() ? nlohmann::json() : nlohmann::json(t); };
+  nlohmann::json out = {{"db", db}, {"runs", nlohmann::json::array()}};
+  for (const HistoryRun& r : runs) {
+    const bool views_kept = set_aside.since_run_id > 0 && r.id >= set_aside.since_run_id;
+    out["runs"].push_back({{"id", r.id},
+                           {"date_utc", r.date_utc},
+                           {"verdict", r.verdict},
+                           {"explanation", r.explanation},
+                           {"k_sigma", r.k_sigma ? nlohmann::json(*r.k_sigma) : nlohmann::json()},
+                           {"rig_file", r.rig_file},
+                           {"rig_crc32", text(r.rig_crc32)},
+                           {"captures", r.captures},
+                           {"captures_crc32", text(r.captures_crc32)},
+                           {"target_path", text(r.target_path)},
+                           {"board", text(r.board)},
+                           {"figures", figures.count(r.id) ? figures[r.id] : nlohmann::json::object()},
+                           {"views_set_aside", !views_kept         ? nlohmann::json()
+                                               : views.count(r.id) ? views[r.id]
+                                                                   : nlohmann::json::array()}});
+  }
+  std::printf("%s\n", out.dump(2).c_str());
+  return kExitOk;
+}
+
 int PrintHistory(const std::string& db) {
   const auto runs = ReadHistoryRuns(db);
   if (runs.empty()) {  // an empty file provisioned for it, or a history no run was appended to
@@ -128,7 +165,7 @@ int RunCheck(int argc, char** argv) {
       "  stereorig check --history --rig rig.yaml          (the trend of every figure)",
       "stereorig check"};
   std::string rig_path, captures, target_path, report_path, history_db;
-  bool history_only = false;
+  bool history_only = false, history_json = false;
   CheckOptions options;
   app.add_option("--rig", rig_path,
                  "the stored rig file (from stereorig calibrate); required, but with --history only where the history "
@@ -148,8 +185,12 @@ int RunCheck(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--history", history_only,
                "print the trend of every figure from the history, then its last runs one a line, and stop");
+  app.add_flag("--json", history_json,
+               "with --history: print every run as JSON instead (its inputs, k_sigma, figures and views set aside)");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 
+  if (history_json && !history_only)
+    throw InputError("--json", "applies only with --history (a check's own JSON is its --report)");
   const bool history_given = !history_db.empty();
   // --history reads no rig, but a rig given is where it looks for the
   // history by default: a mistyped one (or one beside a history, with
@@ -169,7 +210,7 @@ int RunCheck(int argc, char** argv) {
     // It reads the history alone: options for a check would be ignored.
     for (const char* flag : {"--captures", "--target", "--report", "--k-sigma"})
       if (app.count(flag) > 0) throw InputError(flag, "does not apply with --history (it prints the trend and stops)");
-    return PrintHistory(history_db);
+    return history_json ? PrintHistoryJson(history_db) : PrintHistory(history_db);
   }
   if (rig_path.empty() || captures.empty() || target_path.empty()) {
     throw InputError("", "--rig, --captures and --target are required (see --help)");

@@ -748,7 +748,8 @@ TEST_F(CheckHistoryCli, AnEmptyHistoryFileIsMadeOursAndAnotherDatabaseRefused) {
 
 // --k-sigma sets every threshold: the report says which (key k_sigma), the
 // history keeps it (stereorig_check_run_inputs.k_sigma), and `check
-// --history` says when its runs were not all at one k, and each run's k.
+// --history` says when its runs were not all at one k, and each run's k
+// (in its per-run list and in --history --json).
 // Before, neither kept it: a night at k 0.5 sat in the trend among nights at
 // 3.5, its fails counted with theirs.
 TEST_F(CheckHistoryCli, KSigmaIsInTheReportTheHistoryAndItsListing) {
@@ -774,6 +775,24 @@ TEST_F(CheckHistoryCli, KSigmaIsInTheReportTheHistoryAndItsListing) {
       r.out.find("\n     2  " + Report(report)["date_utc"].get<std::string>() + "        5  ok               0  "),
       std::string::npos)
       << r.out;
+  // --history --json: every run, its k, inputs and figures, for a line
+  // controller; --json alone is refused (a check's JSON is its --report).
+  r = RunCli("check --history --json --history-db " + db);
+  EXPECT_EQ(r.code, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out, nullptr, false);
+  ASSERT_TRUE(j.is_object()) << r.out;
+  ASSERT_EQ(j["runs"].size(), 2u) << r.out;
+  EXPECT_EQ(j["runs"][0]["k_sigma"], 3.5);
+  EXPECT_EQ(j["runs"][1]["k_sigma"], 5.0);
+  EXPECT_EQ(j["runs"][1]["id"], 2);
+  EXPECT_EQ(j["runs"][1]["captures_crc32"], Report(report)["captures_crc32"]);
+  EXPECT_EQ(j["runs"][1]["figures"].size(), Report(report)["figures"].size()) << r.out;
+  EXPECT_EQ(j["runs"][1]["figures"]["cam0_consistency_rms_px"]["pass"], true) << r.out;
+  EXPECT_EQ(j["runs"][1]["views_set_aside"], nlohmann::json::array()) << r.out;
+  r = RunCli("check --json --history-db " + db);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(LastLine(r.err),
+            "stereorig check: --json: applies only with --history (a check's own JSON is its --report)");
 }
 
 // The same night checked again (the same captures, by a CRC-32 of their
