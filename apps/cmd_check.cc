@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "apps/cli_util.h"
@@ -53,21 +54,95 @@ void RejectCamerasBeyondTheRig(const std::string& captures, int num_cameras) {
 // guard against tampering, only a fingerprint. Of the bytes the rig was
 // parsed from (ReadRigFile's, one read): a second read a moment later took
 // the fingerprint of a file replaced in between, and of a pipe none.
-std::string Crc32Hex(const std::string& bytes) {
-  uLong crc = crc32(0L, Z_NULL, 0);
-  for (size_t done = 0; done < bytes.size();) {  // uInt lengths: in pieces
-    const size_t piece = std::min<size_t>(bytes.size() - done, 1u << 30);
-    crc = crc32(crc, reinterpret_cast<const Bytef*>(bytes.data() + done), static_cast<uInt>(piece));
+uLong Crc32Update(uLong crc, const char* bytes, size_t size) {
+  for (size_t done = 0; done < size;) {  // uInt lengths: in pieces
+    const size_t piece = std::min<size_t>(size - done, 1u << 30);
+    crc = crc32(crc, reinterpret_cast<const Bytef*>(bytes + done), static_cast<uInt>(piece));
     done += piece;
   }
+  return crc;
+}
+
+std::string Crc32Text(uLong crc) {
   char hex[16];
   std::snprintf(hex, sizeof hex, "%08lx", static_cast<unsigned long>(crc));
   return hex;
 }
 
+std::string Crc32Hex(const std::string& bytes) {
+  return Crc32Text(Crc32Update(crc32(0L, Z_NULL, 0), bytes.data(), bytes.size()));
+}
+
+// A CRC-32 of the capture images, each one's name within its capture
+// ("000/cam0.png") and its bytes, in CaptureFolderImages' order: the same
+// night checked again (or a copy of it elsewhere) reads as the same, an
+// image taken again as another night. What the history tells a night
+// appended twice by. An image that cannot be read counts by its name (the
+// detection names it).
+std::string CapturesCrc32Hex(const std::string& captures) {
+  namespace fs = std::filesystem;
+  uLong crc = crc32(0L, Z_NULL, 0);
+  std::vector<char> buffer(1 << 20);
+  for (const std::string& image : CaptureFolderImages(captures)) {
+    const fs::path path(image);
+    const std::string name = (path.parent_path().filename() / path.filename()).string();
+    crc = Crc32Update(crc, name.c_str(), name.size() + 1);  // with its '\0': names and bytes do not run together
+    std::ifstream in(image, std::ios::binary);
+    while (in.read(buffer.data(), std::streamsize(buffer.size())) || in.gcount() > 0)
+      crc = Crc32Update(crc, buffer.data(), size_t(in.gcount()));
+  }
+  return Crc32Text(crc);
+}
+
+// The runs --history lists one a line: a month of nights.
+constexpr size_t kHistoryRunsListed = 31;
+
+// --history --json: every run with its inputs, its figures and the views it
+// set aside, for a line controller or a plot; a text kept empty ("" where a
+// run from before did not keep it) reads null.
+int PrintHistoryJson(const std::string& db) {
+  const auto runs = ReadHistoryRuns(db);
+  const HistorySetAsideLog set_aside = ReadHistorySetAside(db);
+  std::map<long long, nlohmann::json> figures, views;
+  for (const FigureTrend& t : ReadHistoryTrends(db))
+    for (const HistoryPoint& p : t.points)
+      figures[p.run_id][t.name] = {{"value", p.value}, {"threshold", p.threshold}, {"pass", p.pass}};
+  for (const HistorySetAside& v : set_aside.views)
+    views[v.run_id].push_back(
+        {{"capture", v.capture}, {"camera", v.camera}, {"jump_rms_px", v.jump_rms_px}, {"bound_px", v.bound_px}});
+  auto text = [](const std::string& t) { return t.empty() ? nlohmann::json() : nlohmann::json(t); };
+  nlohmann::json out = {{"db", db}, {"runs", nlohmann::json::array()}};
+  for (const HistoryRun& r : runs) {
+    const bool views_kept = set_aside.since_run_id > 0 && r.id >= set_aside.since_run_id;
+    out["runs"].push_back({{"id", r.id},
+                           {"date_utc", r.date_utc},
+                           {"verdict", r.verdict},
+                           {"explanation", r.explanation},
+                           {"k_sigma", r.k_sigma ? nlohmann::json(*r.k_sigma) : nlohmann::json()},
+                           {"rig_file", r.rig_file},
+                           {"rig_crc32", text(r.rig_crc32)},
+                           {"captures", r.captures},
+                           {"captures_crc32", text(r.captures_crc32)},
+                           {"target_path", text(r.target_path)},
+                           {"board", text(r.board)},
+                           {"figures", figures.count(r.id) ? figures[r.id] : nlohmann::json::object()},
+                           {"views_set_aside", !views_kept         ? nlohmann::json()
+                                               : views.count(r.id) ? views[r.id]
+                                                                   : nlohmann::json::array()}});
+  }
+  std::printf("%s\n", out.dump(2).c_str());
+  return kExitOk;
+}
+
 int PrintHistory(const std::string& db) {
   const auto runs = ReadHistoryRuns(db);
-  std::fputs(FormatTrends(runs, ReadHistoryTrends(db), ReadHistorySetAside(db)).c_str(), stdout);
+  if (runs.empty()) {  // an empty file provisioned for it, or a history no run was appended to
+    std::printf("0 runs: %s holds none yet (each check appends one)\n", db.c_str());
+    return kExitOk;
+  }
+  const auto trends = ReadHistoryTrends(db);
+  std::fputs(FormatTrends(runs, trends, ReadHistorySetAside(db)).c_str(), stdout);
+  std::fputs(FormatRunSeries(runs, trends, kHistoryRunsListed).c_str(), stdout);
   return kExitOk;
 }
 
@@ -83,14 +158,14 @@ int RunCheck(int argc, char** argv) {
       "target, each next to a threshold derived from the stored calibration's own residuals and uncertainties. "
       "It names the camera or module that changed, says whether a new pose or a new lens (focal length, principal "
       "point) explains a named camera's corners, either (it cannot tell) or neither alone, and appends the run to "
-      "an SQLite history.\n\n"
+      "an SQLite history (once: the same captures checked again with the same rig file are not appended twice).\n\n"
       "Exit codes: 0 ok; 1 recalibrate; 2 bad usage or input.\n\n"
       "Examples:\n"
       "  stereorig check --rig rig.yaml --captures tonight/ --target target.yaml --report tonight/check.json\n"
       "  stereorig check --history --rig rig.yaml          (the trend of every figure)",
       "stereorig check"};
   std::string rig_path, captures, target_path, report_path, history_db;
-  bool history_only = false;
+  bool history_only = false, history_json = false;
   CheckOptions options;
   app.add_option("--rig", rig_path,
                  "the stored rig file (from stereorig calibrate); required, but with --history only where the history "
@@ -108,9 +183,14 @@ int RunCheck(int argc, char** argv) {
   app.add_option("--k-sigma", options.k_sigma,
                  "coverage factor of every threshold, in (0, 10]: each is k times its figure's sigma")
       ->capture_default_str();
-  app.add_flag("--history", history_only, "print the trend of every figure from the history, and stop");
+  app.add_flag("--history", history_only,
+               "print the trend of every figure from the history, then its last runs one a line, and stop");
+  app.add_flag("--json", history_json,
+               "with --history: print every run as JSON instead (its inputs, k_sigma, figures and views set aside)");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 
+  if (history_json && !history_only)
+    throw InputError("--json", "applies only with --history (a check's own JSON is its --report)");
   const bool history_given = !history_db.empty();
   // --history reads no rig, but a rig given is where it looks for the
   // history by default: a mistyped one (or one beside a history, with
@@ -130,7 +210,7 @@ int RunCheck(int argc, char** argv) {
     // It reads the history alone: options for a check would be ignored.
     for (const char* flag : {"--captures", "--target", "--report", "--k-sigma"})
       if (app.count(flag) > 0) throw InputError(flag, "does not apply with --history (it prints the trend and stops)");
-    return PrintHistory(history_db);
+    return history_json ? PrintHistoryJson(history_db) : PrintHistory(history_db);
   }
   if (rig_path.empty() || captures.empty() || target_path.empty()) {
     throw InputError("", "--rig, --captures and --target are required (see --help)");
@@ -164,6 +244,7 @@ int RunCheck(int argc, char** argv) {
   const CheckTarget check_target = TargetForCheck(rig, ReadTargetFile(target_path), target_path);
   const std::string target_kept_as = HistoryPathOf(target_path);
   const std::string captures_kept_as = HistoryPathOf(captures);
+  const std::string captures_crc32 = CapturesCrc32Hex(captures);  // as read now, as the rig's
   const Target& target = check_target.target;
   RejectCamerasBeyondTheRig(captures, rig.num_cameras());
   // A history that is not ours is refused before any work, so a failed run
@@ -188,8 +269,12 @@ int RunCheck(int argc, char** argv) {
   result.target_note = check_target.note;  // said with a failing night (the explanation's end)
 
   std::printf("%-44s %10s %10s %6s %8s\n", "figure", "value", "threshold", "pass", "samples");
-  nlohmann::json report = {
-      {"rig", rig_path}, {"rig_crc32", rig_crc32}, {"captures", captures}, {"date_utc", NowUtcIso8601()}};
+  nlohmann::json report = {{"rig", rig_path},
+                           {"rig_crc32", rig_crc32},
+                           {"captures", captures},
+                           {"captures_crc32", captures_crc32},
+                           {"date_utc", NowUtcIso8601()},
+                           {"k_sigma", options.k_sigma}};
   for (const CheckFigure& f : result.figures) {
     std::printf("%-44s %10.4f %10.4f %6s %8d\n", f.name.c_str(), f.value, f.threshold, f.pass ? "yes" : "NO",
                 f.samples);
@@ -283,13 +368,14 @@ int RunCheck(int argc, char** argv) {
   report["closure_which_unknown"] = result.closure_which_unknown;
   report["split_modules"] = result.split_modules;
 
-  // The report staged in its temporary file, the history appended, then the
-  // report renamed in: a history that refuses the run after all (checked
-  // writable above, but another process may have changed it since) leaves
-  // no report, and a report that cannot be written (a full disk) leaves the
-  // history without the night.
-  AtomicOutputSet staged_report;
-  if (!report_path.empty()) staged_report.Add(report_path, report.dump(2) + "\n");
+  // The history appended, the report staged in its temporary file within
+  // the append's transaction (with what became of the run: its id, or the
+  // run of the same night it repeats), then the report renamed in: a report
+  // that cannot be written (a full disk) leaves the history without the
+  // night. A history that refuses the run after all (checked writable
+  // above, but another process may hold it now) does not cost the night its
+  // verdict: the report says why the run is not in the history, a warning
+  // too, and the exit code is the verdict's.
   // Paths as resolved when the files were read (HistoryPathOf), rig_file
   // and rig_path alike.
   HistoryRun run{0, report["date_utc"], rig_kept_as, captures_kept_as, "", ""};
@@ -297,9 +383,68 @@ int RunCheck(int argc, char** argv) {
   run.rig_crc32 = rig_crc32;
   run.target_path = target_kept_as;
   run.board = check_target.back_from_front_as_calibrated ? "as calibrated" : "the target file's";
-  AppendToHistory(history_db, run, result, detected.capture_names);
+  run.k_sigma = options.k_sigma;
+  run.captures_crc32 = captures_crc32;
+  AtomicOutputSet staged_report;
+  bool report_failed = false;
+  auto stage_report = [&](const nlohmann::json& history) {
+    if (report_path.empty()) return;
+    report["history"] = history;
+    try {
+      staged_report = AtomicOutputSet();  // what a failed commit staged before, removed
+      staged_report.Add(report_path, report.dump(2) + "\n");
+    } catch (...) {
+      report_failed = true;
+      throw;
+    }
+  };
+  nlohmann::json history = {{"db", history_db},
+                            {"appended", false},
+                            {"run_id", nullptr},
+                            {"same_night_as_run", nullptr},
+                            {"not_appended_why", nullptr}};
+  std::string not_appended, not_appended_why;  // short (stdout) and whole (the warning, the report)
+  try {
+    AppendToHistory(history_db, run, result, detected.capture_names, [&](const HistoryAppend& outcome) {
+      if (outcome.same_night) {
+        const HistoryRun& same = *outcome.same_night;
+        not_appended =
+            "the same night as run " + std::to_string(same.id) + " (" + same.date_utc + ", " + same.verdict + ")";
+        not_appended_why = not_appended + ": these captures (crc32 " + captures_crc32 + ") with this rig file (crc32 " +
+                           rig_crc32 + ") were checked then; the history keeps each night once";
+        if (same.k_sigma != options.k_sigma)
+          not_appended_why +=
+              " (that run's k_sigma: " + (same.k_sigma ? NumberText(*same.k_sigma) : std::string("unknown")) +
+              ", tonight's: " + NumberText(options.k_sigma) + ")";
+        history["same_night_as_run"] = same.id;
+        history["not_appended_why"] = not_appended_why;
+      } else {
+        history["appended"] = true;
+        history["run_id"] = outcome.run_id;
+      }
+      stage_report(history);
+    });
+  } catch (const InputError& e) {
+    if (report_failed) throw;  // the report's failure: the history rolled back, exit 2
+    // The database's own problem (the line names it), or another file's
+    // (its journal beside it) with its path. Not appended, so these
+    // captures checked again are no repeat: they add the night.
+    not_appended = "it could not be written";
+    not_appended_why = "the history could not be written (" + (e.where() == history_db ? e.problem() : e.what()) +
+                       "): check these captures again to add the night";
+    history["appended"] = false, history["run_id"] = nullptr, history["same_night_as_run"] = nullptr;
+    history["not_appended_why"] = not_appended_why;
+    stage_report(history);
+  }
   staged_report.Commit();
-  std::printf("history: appended to %s\n", history_db.c_str());
+  if (history["appended"] == true) {
+    std::printf("history: appended to %s (run %lld)\n", history_db.c_str(), history["run_id"].get<long long>());
+  } else {
+    std::printf("history: not appended to %s: %s\n", history_db.c_str(), PrintableText(not_appended).c_str());
+    FlushStdout();  // before the warning, where both go to one log
+    std::fprintf(stderr, "stereorig check: warning: tonight's run is not in the history %s: %s; the verdict stands\n",
+                 history_db.c_str(), PrintableText(not_appended_why).c_str());
+  }
   return result.ok() ? kExitOk : kExitCheckFailed;
 }
 

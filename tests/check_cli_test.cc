@@ -589,5 +589,252 @@ TEST(CheckCli, AnOutputOverACaptureImageIsRefused) {
   fs::remove_all(dir);
 }
 
+// ---- The history as a line runs it (cron, a line controller): a history
+// locked at the append, one provisioned empty, k_sigma kept, the same night
+// checked twice, the per-run list. Three simulated nights shared by the
+// cases: seed 21 unmoved, seed 22 unmoved (another night of the same rig),
+// seed 21 with camera 2 turned 0.05 deg; the stored rig with 0.03 px
+// residuals, as TheReportListsEveryNamedCamera... has it (the turned night
+// reads recalibrate there by a factor of 2.3 or more, the unmoved ones ok).
+class CheckHistoryCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = ::testing::TempDir() + "/check_cli_history_" + std::to_string(getpid());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    for (const auto& [name, args] : std::vector<std::pair<std::string, std::string>>{
+             {"night1", "--seed 21"},
+             {"night2", "--seed 22"},
+             {"turned", "--seed 21 --bump-camera 2 --bump-rotation-deg 0.05"}}) {
+      const Result r = RunCli("simulate --out " + dir_ + "/" + name + " --calibration-captures 8 --no-scenes " + args);
+      ASSERT_EQ(r.code, 0) << r.err;
+    }
+    WriteStoredRig(dir_ + "/night1/truth/rig.yaml", 0.03, dir_ + "/rig.yaml", dir_ + "/night1/target.yaml");
+  }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
+
+  // `check` of the night `captures` (a folder under dir_) into `db`.
+  static Result Check(const std::string& captures, const std::string& db, const std::string& more = "") {
+    return RunCli("check --rig " + dir_ + "/rig.yaml --captures " + dir_ + "/" + captures + " --target " + dir_ +
+                  "/night1/target.yaml --history-db " + db + " " + more);
+  }
+  static nlohmann::json Report(const std::string& path) {
+    std::ifstream f(path);
+    return nlohmann::json::parse(f, nullptr, false);
+  }
+  // The report's "history" (what became of the run), an empty object where
+  // there is none (a report of a version before it, or no report).
+  static nlohmann::json HistoryOf(const std::string& report_path) {
+    const nlohmann::json j = Report(report_path);
+    return j.is_object() && j.contains("history") ? j["history"] : nlohmann::json::object();
+  }
+  // One value an SQL query reads from `db` ("" where none, "NULL" for null).
+  static std::string Query(const std::string& db, const std::string& sql) {
+    sqlite3* raw = nullptr;
+    std::string v;
+    sqlite3_stmt* st = nullptr;
+    if (sqlite3_open_v2(db.c_str(), &raw, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK &&
+        sqlite3_prepare_v2(raw, sql.c_str(), -1, &st, nullptr) == SQLITE_OK && sqlite3_step(st) == SQLITE_ROW)
+      v = sqlite3_column_type(st, 0) == SQLITE_NULL ? "NULL"
+                                                    : reinterpret_cast<const char*>(sqlite3_column_text(st, 0));
+    sqlite3_finalize(st);
+    sqlite3_close(raw);
+    return v;
+  }
+  static int Runs(const std::string& db) {
+    const std::string n = Query(db, "SELECT COUNT(*) FROM stereorig_check_runs");
+    return n.empty() ? -1 : std::stoi(n);
+  }
+  static std::string dir_;
+};
+std::string CheckHistoryCli::dir_;
+
+// Another process holds the history's write lock at the moment of the
+// append (after the check's up-front writability test passed): the night's
+// verdict stands. Before, a turned night printed "verdict: recalibrate",
+// then exited 2 ("database is locked") with no report: the night lost. Now:
+// exit 1, the report written and saying why the run is not in the history,
+// a warning on stderr; and, not appended, the same captures checked again
+// are no repeat: they add the night. The lock is taken once the check says
+// it is detecting (its up-front test is done by then) and held until the
+// check exits, past its 5 s wait for a lock.
+TEST_F(CheckHistoryCli, AHistoryLockedAtTheAppendKeepsTheVerdictAndTheReport) {
+  const std::string db = dir_ + "/locked.sqlite", report = dir_ + "/locked.json";
+  ASSERT_EQ(Check("night1", db).code, 0);  // the history made, one run
+  const std::string out = dir_ + "/locked.out", err = dir_ + "/locked.err";
+  fs::remove(err);
+  int status = -1;
+  std::thread check([&] {
+    status = std::system((kBin + " check --rig " + dir_ + "/rig.yaml --captures " + dir_ + "/turned --target " + dir_ +
+                          "/night1/target.yaml --history-db " + db + " --report " + report + " >" + out + " 2>" + err)
+                             .c_str());
+  });
+  sqlite3* other = nullptr;
+  ASSERT_EQ(sqlite3_open(db.c_str(), &other), SQLITE_OK);
+  bool locked = false;
+  for (int tries = 0; tries < 1200 && !locked; ++tries) {  // up to a minute
+    if (Bytes(err).find("check: detecting the target") != std::string::npos)
+      locked = sqlite3_exec(other, "BEGIN EXCLUSIVE;", nullptr, nullptr, nullptr) == SQLITE_OK;
+    else
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  check.join();
+  sqlite3_exec(other, "ROLLBACK;", nullptr, nullptr, nullptr);
+  sqlite3_close(other);
+  ASSERT_TRUE(locked) << Bytes(err);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1) << Bytes(out) << Bytes(err);  // the verdict's: recalibrate
+  EXPECT_NE(Bytes(out).find("verdict: recalibrate"), std::string::npos) << Bytes(out);
+  EXPECT_NE(Bytes(out).find("history: not appended to " + db + ": it could not be written"), std::string::npos)
+      << Bytes(out);
+  EXPECT_NE(LastLine(Bytes(err)).find("stereorig check: warning: tonight's run is not in the history " + db),
+            std::string::npos)
+      << Bytes(err);
+  EXPECT_NE(LastLine(Bytes(err)).find("database is locked"), std::string::npos) << Bytes(err);
+  const nlohmann::json j = Report(report);
+  ASSERT_TRUE(j.is_object()) << "no report";
+  EXPECT_EQ(j["verdict"], "recalibrate");
+  nlohmann::json history = HistoryOf(report);
+  EXPECT_EQ(history["appended"], false) << history;
+  EXPECT_TRUE(history.contains("run_id") && history["run_id"].is_null()) << history;
+  EXPECT_NE(history.value("not_appended_why", std::string()).find("database is locked"), std::string::npos) << history;
+  EXPECT_EQ(Runs(db), 1);
+  EXPECT_EQ(Query(db, "PRAGMA integrity_check"), "ok");
+  // Checked again, free: appended, as run 2.
+  const Result again = Check("turned", db, "--report " + report);
+  EXPECT_EQ(again.code, 1) << again.err;
+  EXPECT_NE(again.out.find("history: appended to " + db + " (run 2)"), std::string::npos) << again.out;
+  EXPECT_EQ(HistoryOf(report)["appended"], true);
+  EXPECT_EQ(HistoryOf(report)["run_id"], 2);
+  EXPECT_EQ(Runs(db), 2);
+}
+
+// A history file created empty (`install -m 664 /dev/null FILE`, to give a
+// service user the file) is an empty database to SQLite: the first night
+// makes it ours. Before, every night exited 2 ("no such table:
+// stereorig_check_runs"), and `check --history` too. Another program's
+// SQLite database is still refused, before any work, and left as it was.
+TEST_F(CheckHistoryCli, AnEmptyHistoryFileIsMadeOursAndAnotherDatabaseRefused) {
+  const std::string db = dir_ + "/provisioned.sqlite";
+  { std::ofstream(db, std::ios::binary); }
+  ASSERT_EQ(fs::file_size(db), 0u);
+  Result r = RunCli("check --history --history-db " + db);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out, "0 runs: " + db + " holds none yet (each check appends one)\n");
+  EXPECT_EQ(fs::file_size(db), 0u);  // reading it wrote nothing
+  r = Check("night1", db, "--report " + dir_ + "/provisioned.json");
+  EXPECT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_EQ(Runs(db), 1);
+  EXPECT_EQ(HistoryOf(dir_ + "/provisioned.json")["run_id"], 1);
+  r = RunCli("check --history --history-db " + db);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("1 run(s), ", 0), 0u) << r.out;
+
+  const std::string foreign = dir_ + "/foreign.sqlite";
+  sqlite3* raw = nullptr;
+  ASSERT_EQ(sqlite3_open(foreign.c_str(), &raw), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(raw, "CREATE TABLE parts (id INTEGER);", nullptr, nullptr, nullptr), SQLITE_OK);
+  sqlite3_close(raw);
+  const std::string before = Bytes(foreign);
+  for (const Result& refused : {Check("night1", foreign), RunCli("check --history --history-db " + foreign)}) {
+    EXPECT_EQ(refused.code, 2) << refused.out << refused.err;
+    EXPECT_EQ(LastLine(refused.err), "stereorig check: " + foreign +
+                                         ": an SQLite database, but not a stereorig check history (it has no table "
+                                         "stereorig_check_runs): give another with --history-db");
+    EXPECT_EQ(refused.err.find("detecting"), std::string::npos) << "refused only after the work: " << refused.err;
+  }
+  EXPECT_EQ(Bytes(foreign), before);
+}
+
+// --k-sigma sets every threshold: the report says which (key k_sigma), the
+// history keeps it (stereorig_check_run_inputs.k_sigma), and `check
+// --history` says when its runs were not all at one k, and each run's k
+// (in its per-run list and in --history --json).
+// Before, neither kept it: a night at k 0.5 sat in the trend among nights at
+// 3.5, its fails counted with theirs.
+TEST_F(CheckHistoryCli, KSigmaIsInTheReportTheHistoryAndItsListing) {
+  const std::string db = dir_ + "/k.sqlite", report = dir_ + "/k.json";
+  Result r = Check("night1", db, "--report " + report);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(Report(report).value("k_sigma", 0.0), 3.5);
+  r = Check("night2", db, "--report " + report + " --k-sigma 5");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(Report(report).value("k_sigma", 0.0), 5.0);
+  EXPECT_EQ(Query(db,
+                  "SELECT group_concat(k_sigma, ' ') FROM (SELECT k_sigma FROM stereorig_check_run_inputs ORDER "
+                  "BY run_id)"),
+            "3.5 5.0");
+  r = RunCli("check --history --history-db " + db);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("k_sigma varied over these runs (each run's thresholds and fails are at its own k): 3.5 in "
+                       "run(s) 1; 5 in run(s) 2\n"),
+            std::string::npos)
+      << r.out;
+  // The per-run list: run 2's row, at k 5.
+  EXPECT_NE(
+      r.out.find("\n     2  " + Report(report)["date_utc"].get<std::string>() + "        5  ok               0  "),
+      std::string::npos)
+      << r.out;
+  // --history --json: every run, its k, inputs and figures, for a line
+  // controller; --json alone is refused (a check's JSON is its --report).
+  r = RunCli("check --history --json --history-db " + db);
+  EXPECT_EQ(r.code, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out, nullptr, false);
+  ASSERT_TRUE(j.is_object()) << r.out;
+  ASSERT_EQ(j["runs"].size(), 2u) << r.out;
+  EXPECT_EQ(j["runs"][0]["k_sigma"], 3.5);
+  EXPECT_EQ(j["runs"][1]["k_sigma"], 5.0);
+  EXPECT_EQ(j["runs"][1]["id"], 2);
+  EXPECT_EQ(j["runs"][1]["captures_crc32"], Report(report)["captures_crc32"]);
+  EXPECT_EQ(j["runs"][1]["figures"].size(), Report(report)["figures"].size()) << r.out;
+  EXPECT_EQ(j["runs"][1]["figures"]["cam0_consistency_rms_px"]["pass"], true) << r.out;
+  EXPECT_EQ(j["runs"][1]["views_set_aside"], nlohmann::json::array()) << r.out;
+  r = RunCli("check --json --history-db " + db);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(LastLine(r.err),
+            "stereorig check: --json: applies only with --history (a check's own JSON is its --report)");
+}
+
+// The same night checked again (the same captures, by a CRC-32 of their
+// images, with the same rig file) is not appended again: it would count
+// twice in every trend and every "fails". Before, three checks of one night
+// made three runs ("fails 3"). The verdict, its exit code and the report
+// are as on the first check; the report and a warning name the run it
+// repeats. A copy of the night in another folder is the same night; another
+// night is appended.
+TEST_F(CheckHistoryCli, TheSameNightCheckedAgainIsNotAppendedTwice) {
+  const std::string db = dir_ + "/twice.sqlite", report = dir_ + "/twice.json";
+  Result r = Check("turned", db, "--report " + report);
+  ASSERT_EQ(r.code, 1) << r.err;
+  const std::string crc = Report(report).value("captures_crc32", std::string());
+  EXPECT_EQ(crc.size(), 8u);
+  EXPECT_EQ(Query(db, "SELECT captures_crc32 FROM stereorig_check_run_inputs"), crc);
+  fs::copy(dir_ + "/turned/calibration", dir_ + "/turned_copy", fs::copy_options::recursive);
+  for (const std::string& captures : {std::string("turned"), std::string("turned_copy")}) {
+    fs::remove(report);
+    r = Check(captures, db, "--report " + report);
+    EXPECT_EQ(r.code, 1) << captures << ": " << r.err;
+    EXPECT_NE(r.out.find("verdict: recalibrate"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("history: not appended to " + db + ": the same night as run 1 ("), std::string::npos) << r.out;
+    EXPECT_NE(LastLine(r.err).find("stereorig check: warning: tonight's run is not in the history " + db +
+                                   ": the same night as run 1 ("),
+              std::string::npos)
+        << r.err;
+    const nlohmann::json j = Report(report);
+    ASSERT_TRUE(j.is_object()) << captures << ": no report";
+    EXPECT_EQ(j["captures_crc32"], crc) << captures;
+    EXPECT_EQ(HistoryOf(report)["appended"], false);
+    EXPECT_EQ(HistoryOf(report)["same_night_as_run"], 1);
+    EXPECT_EQ(Runs(db), 1) << captures;
+  }
+  r = Check("night1", db);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("history: appended to " + db + " (run 2)"), std::string::npos) << r.out;
+  EXPECT_EQ(Runs(db), 2);
+  r = RunCli("check --history --history-db " + db);
+  EXPECT_NE(r.out.find("runs:\n"), std::string::npos) << r.out;
+  EXPECT_EQ(Occurrences(r.out, "  recalibrate  "), 1) << r.out;  // run 1's row, once
+}
+
 }  // namespace
 }  // namespace stereorig

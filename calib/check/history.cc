@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 
 #include "calib/core/input_error.h"
@@ -85,6 +86,88 @@ bool HasTable(sqlite3* db, const char* table, const std::string& path) {
   return sqlite3_step(s.get()) == SQLITE_ROW;
 }
 
+bool HasColumn(sqlite3* db, const char* table, const char* column, const std::string& path) {
+  Stmt s = Prepare(db, "SELECT 1 FROM pragma_table_info(?) WHERE name = ?;", path);
+  sqlite3_bind_text(s.get(), 1, table, -1, SQLITE_TRANSIENT);
+  sqlite3_bind_text(s.get(), 2, column, -1, SQLITE_TRANSIENT);
+  return sqlite3_step(s.get()) == SQLITE_ROW;
+}
+
+// True for a history of ours, false for a database that holds nothing at
+// all (an empty file, as `install -m 664 /dev/null` provisions one for a
+// service user: SQLite reads it as an empty database), which the first
+// append makes ours. Anything else is refused: tables of ours added to
+// another program's database would mix the two.
+bool IsOurHistory(sqlite3* db, const std::string& path) {
+  if (HasTable(db, "stereorig_check_runs", path)) return true;
+  Stmt s = Prepare(db, "SELECT 1 FROM sqlite_master;", path);
+  if (sqlite3_step(s.get()) == SQLITE_ROW)
+    throw InputError(path,
+                     "an SQLite database, but not a stereorig check history (it has no table stereorig_check_runs): "
+                     "give another with --history-db");
+  return false;
+}
+
+// Columns added to a table after it was first written: a history from
+// before gets them at its next append (ALTER TABLE ADD COLUMN), its earlier
+// rows reading NULL (unknown).
+struct AddedColumn {
+  const char* table;
+  const char* column;
+  const char* type;
+};
+constexpr AddedColumn kAddedColumns[] = {{"stereorig_check_run_inputs", "k_sigma", "REAL"},
+                                         {"stereorig_check_run_inputs", "captures_crc32", "TEXT"}};
+
+void AddMissingColumns(sqlite3* db, const std::string& path) {
+  for (const AddedColumn& c : kAddedColumns)
+    if (!HasColumn(db, c.table, c.column, path))
+      Exec(db, std::string("ALTER TABLE ") + c.table + " ADD COLUMN " + c.column + " " + c.type + ";", path);
+}
+
+std::optional<double> OptionalDouble(sqlite3_stmt* s, int col) {
+  if (sqlite3_column_type(s, col) == SQLITE_NULL) return std::nullopt;
+  return sqlite3_column_double(s, col);
+}
+
+// The first run of the same night (the same captures with the same rig
+// file), if the history holds one.
+std::optional<HistoryRun> SameNight(sqlite3* db, const HistoryRun& run, const std::string& path) {
+  if (run.captures_crc32.empty()) return std::nullopt;
+  Stmt s = Prepare(db,
+                   "SELECT r.id, r.date_utc, r.verdict, r.explanation, i.k_sigma FROM stereorig_check_runs r JOIN "
+                   "stereorig_check_run_inputs i ON i.run_id = r.id WHERE i.captures_crc32 = ? AND i.rig_crc32 = ? "
+                   "ORDER BY r.id LIMIT 1;",
+                   path);
+  sqlite3_bind_text(s.get(), 1, run.captures_crc32.c_str(), -1, SQLITE_TRANSIENT);
+  sqlite3_bind_text(s.get(), 2, run.rig_crc32.c_str(), -1, SQLITE_TRANSIENT);
+  if (sqlite3_step(s.get()) != SQLITE_ROW) return std::nullopt;
+  HistoryRun same;
+  same.id = sqlite3_column_int64(s.get(), 0);
+  same.date_utc = Text(s.get(), 1), same.verdict = Text(s.get(), 2), same.explanation = Text(s.get(), 3);
+  same.k_sigma = OptionalDouble(s.get(), 4);
+  same.captures_crc32 = run.captures_crc32, same.rig_crc32 = run.rig_crc32;
+  return same;
+}
+
+std::string KSigmaText(double k) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", k);
+  return text;
+}
+
+// Run ids as ranges: "1..3, 7, 9..12".
+std::string RunRanges(const std::vector<long long>& ids) {
+  std::string out;
+  for (size_t i = 0; i < ids.size();) {
+    size_t j = i;
+    while (j + 1 < ids.size() && ids[j + 1] == ids[j] + 1) ++j;
+    out += (out.empty() ? "" : ", ") + std::to_string(ids[i]) + (j > i ? ".." + std::to_string(ids[j]) : "");
+    i = j + 1;
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string HistoryPathOf(const std::string& path) {
@@ -109,13 +192,23 @@ std::string HistoryPathOf(const std::string& path) {
   return absolute.lexically_normal().string();
 }
 
-long long AppendToHistory(const std::string& path, const HistoryRun& run, const CheckResult& result,
-                          const std::map<int, std::string>& capture_names) {
+HistoryAppend AppendToHistory(const std::string& path, const HistoryRun& run, const CheckResult& result,
+                              const std::map<int, std::string>& capture_names,
+                              const std::function<void(const HistoryAppend&)>& before_commit) {
   Db db = Open(path, true);
   Exec(db.get(), "BEGIN IMMEDIATE;", path);
   try {
+    IsOurHistory(db.get(), path);  // refuses another program's database
     const bool kept_set_aside = HasTable(db.get(), kSetAsideTable, path);
     Exec(db.get(), kSchema, path);
+    AddMissingColumns(db.get(), path);
+    HistoryAppend outcome;
+    outcome.same_night = SameNight(db.get(), run, path);
+    if (outcome.same_night) {  // nothing appended, nothing changed
+      if (before_commit) before_commit(outcome);
+      Exec(db.get(), "ROLLBACK;", path);
+      return outcome;
+    }
     Stmt ins = Prepare(db.get(),
                        "INSERT INTO stereorig_check_runs (date_utc, rig_file, captures, verdict, explanation) "
                        "VALUES (?, ?, ?, ?, ?);",
@@ -132,14 +225,18 @@ long long AppendToHistory(const std::string& path, const HistoryRun& run, const 
       throw InputError(path, std::string("history: ") + sqlite3_errmsg(db.get()));
     const long long id = sqlite3_last_insert_rowid(db.get());
     Stmt inputs = Prepare(db.get(),
-                          "INSERT INTO stereorig_check_run_inputs (run_id, rig_path, rig_crc32, target_path, board) "
-                          "VALUES (?, ?, ?, ?, ?);",
+                          "INSERT INTO stereorig_check_run_inputs (run_id, rig_path, rig_crc32, target_path, board, "
+                          "k_sigma, captures_crc32) VALUES (?, ?, ?, ?, ?, ?, ?);",
                           path);
     sqlite3_bind_int64(inputs.get(), 1, id);
     sqlite3_bind_text(inputs.get(), 2, rig_path.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(inputs.get(), 3, run.rig_crc32.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(inputs.get(), 4, target_path.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(inputs.get(), 5, run.board.c_str(), -1, SQLITE_TRANSIENT);
+    // Either unknown: left unbound, NULL, as in the runs from before they were kept.
+    if (run.k_sigma) sqlite3_bind_double(inputs.get(), 6, *run.k_sigma);
+    if (!run.captures_crc32.empty())
+      sqlite3_bind_text(inputs.get(), 7, run.captures_crc32.c_str(), -1, SQLITE_TRANSIENT);
     if (sqlite3_step(inputs.get()) != SQLITE_DONE)
       throw InputError(path, std::string("history: ") + sqlite3_errmsg(db.get()));
     Stmt fig = Prepare(db.get(),
@@ -183,8 +280,10 @@ long long AppendToHistory(const std::string& path, const HistoryRun& run, const 
         throw InputError(path, std::string("history: ") + sqlite3_errmsg(db.get()));
       }
     }
+    outcome.run_id = id;
+    if (before_commit) before_commit(outcome);
     Exec(db.get(), "COMMIT;", path);
-    return id;
+    return outcome;
   } catch (...) {
     sqlite3_exec(db.get(), "ROLLBACK;", nullptr, nullptr, nullptr);
     throw;
@@ -213,15 +312,20 @@ void RequireHistoryWritable(const std::string& path) {
 
 std::vector<HistoryRun> ReadHistoryRuns(const std::string& path) {
   Db db = Open(path, false);
-  // Histories written before the inputs were kept have no such table.
+  if (!IsOurHistory(db.get(), path)) return {};  // empty: no run yet
+  // Histories written before the inputs were kept have no such table, and
+  // before k_sigma and the captures' CRC were kept, no such columns.
   const bool inputs = HasTable(db.get(), kRunInputsTable, path);
-  Stmt s = Prepare(db.get(),
-                   inputs ? "SELECT r.id, r.date_utc, r.rig_file, r.captures, r.verdict, r.explanation, i.rig_path, "
-                            "i.rig_crc32, i.target_path, i.board FROM stereorig_check_runs r LEFT JOIN "
-                            "stereorig_check_run_inputs i ON i.run_id = r.id ORDER BY r.id;"
-                          : "SELECT id, date_utc, rig_file, captures, verdict, explanation FROM stereorig_check_runs "
-                            "ORDER BY id;",
-                   path);
+  const std::string sql =
+      inputs ? std::string(
+                   "SELECT r.id, r.date_utc, r.rig_file, r.captures, r.verdict, r.explanation, i.rig_path, "
+                   "i.rig_crc32, i.target_path, i.board, ") +
+                   (HasColumn(db.get(), kRunInputsTable, "k_sigma", path) ? "i.k_sigma" : "NULL") + ", " +
+                   (HasColumn(db.get(), kRunInputsTable, "captures_crc32", path) ? "i.captures_crc32" : "NULL") +
+                   " FROM stereorig_check_runs r LEFT JOIN stereorig_check_run_inputs i ON i.run_id = r.id ORDER BY "
+                   "r.id;"
+             : "SELECT id, date_utc, rig_file, captures, verdict, explanation FROM stereorig_check_runs ORDER BY id;";
+  Stmt s = Prepare(db.get(), sql.c_str(), path);
   std::vector<HistoryRun> runs;
   while (sqlite3_step(s.get()) == SQLITE_ROW) {
     HistoryRun run{sqlite3_column_int64(s.get(), 0),
@@ -233,6 +337,7 @@ std::vector<HistoryRun> ReadHistoryRuns(const std::string& path) {
     if (inputs) {
       run.rig_path = Text(s.get(), 6), run.rig_crc32 = Text(s.get(), 7);
       run.target_path = Text(s.get(), 8), run.board = Text(s.get(), 9);
+      run.k_sigma = OptionalDouble(s.get(), 10), run.captures_crc32 = Text(s.get(), 11);
     }
     // Runs written before rig_file was kept absolute hold it as typed,
     // relative to a folder the history does not know; their rig_path (the
@@ -245,6 +350,7 @@ std::vector<HistoryRun> ReadHistoryRuns(const std::string& path) {
 
 std::vector<FigureTrend> ReadHistoryTrends(const std::string& path) {
   Db db = Open(path, false);
+  if (!IsOurHistory(db.get(), path)) return {};
   Stmt s = Prepare(db.get(),
                    "SELECT f.name, r.id, r.date_utc, f.value, f.threshold, f.pass FROM stereorig_check_figures f "
                    "JOIN stereorig_check_runs r ON r.id = f.run_id ORDER BY f.name, r.id;",
@@ -263,6 +369,7 @@ std::vector<FigureTrend> ReadHistoryTrends(const std::string& path) {
 HistorySetAsideLog ReadHistorySetAside(const std::string& path) {
   Db db = Open(path, false);
   HistorySetAsideLog log;
+  if (!IsOurHistory(db.get(), path)) return log;
   if (!HasTable(db.get(), kSetAsideTable, path)) return log;  // written before views set aside were kept
   log.since_run_id = 1;
   if (HasTable(db.get(), "stereorig_check_meta", path)) {
@@ -316,6 +423,21 @@ std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<
       out += line + sp.run->rig_path + " (crc32 " + sp.run->rig_crc32 + ", back_from_front " + sp.run->board + ")\n";
     }
   }
+  // Each threshold is k_sigma times its figure's sigma: runs at another k
+  // failed (or passed) against other thresholds, so the fails counted below
+  // are not one k's.
+  std::map<std::string, std::vector<long long>> runs_at_k;  // k (or "unknown") -> its runs
+  for (const HistoryRun& r : runs) runs_at_k[r.k_sigma ? KSigmaText(*r.k_sigma) : "unknown"].push_back(r.id);
+  if (runs_at_k.size() > 1) {
+    out += "k_sigma varied over these runs (each run's thresholds and fails are at its own k):";
+    for (const auto& [k, ids] : runs_at_k)
+      out += std::string(" ") + (k == "unknown" ? "unknown (written before it was kept)" : k) + " in run(s) " +
+             RunRanges(ids) + ";";
+    out.back() = '\n';
+  } else if (!runs.empty()) {
+    out += runs.front().k_sigma ? "k_sigma: " + KSigmaText(*runs.front().k_sigma) + " in every run\n"
+                                : "k_sigma: not kept (these runs were written by a version that did not keep it)\n";
+  }
   std::snprintf(line, sizeof line, "%-40s %5s %10s %10s %10s %10s %10s %6s\n", "figure", "runs", "first", "last", "min",
                 "max", "threshold", "fails");
   out += line;
@@ -363,6 +485,46 @@ std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<
     std::snprintf(line, sizeof line, "); the worst against its bound: %.3f px, %.1fx its %.3f px (capture ",
                   worst->jump_rms_px, worst->jump_rms_px / worst->bound_px, worst->bound_px);
     out += line + worst->capture + ", run " + std::to_string(worst->run_id) + ")\n";
+  }
+  return out;
+}
+
+std::string FormatRunSeries(const std::vector<HistoryRun>& runs, const std::vector<FigureTrend>& trends,
+                            size_t last_runs) {
+  // Per run: how many figures failed, and the figure nearest its threshold
+  // (or furthest beyond it).
+  struct Worst {
+    int fails = 0;
+    double ratio = -1;
+    std::string name;
+  };
+  std::map<long long, Worst> worst;
+  for (const FigureTrend& t : trends)
+    for (const HistoryPoint& p : t.points) {
+      Worst& w = worst[p.run_id];
+      w.fails += !p.pass;
+      const double ratio = p.threshold > 0 ? p.value / p.threshold : 0;
+      if (ratio > w.ratio) w.ratio = ratio, w.name = t.name;
+    }
+  const size_t first = runs.size() > last_runs ? runs.size() - last_runs : 0;
+  std::string out = "runs" + (first > 0 ? " (the last " + std::to_string(last_runs) + ")" : std::string()) + ":\n";
+  char line[256];
+  std::snprintf(line, sizeof line, "%6s  %-20s  %7s  %-11s  %5s  %s\n", "run", "date_utc", "k_sigma", "verdict",
+                "fails", "nearest its threshold (value / threshold); why, where not ok");
+  out += line;
+  for (size_t i = first; i < runs.size(); ++i) {
+    const HistoryRun& r = runs[i];
+    const auto w = worst.find(r.id);
+    std::snprintf(line, sizeof line, "%6lld  %-20s  %7s  %-11s  %5d  ", r.id, r.date_utc.c_str(),
+                  r.k_sigma ? KSigmaText(*r.k_sigma).c_str() : "?", r.verdict.c_str(),
+                  w != worst.end() ? w->second.fails : 0);
+    out += line;
+    if (w != worst.end()) {
+      std::snprintf(line, sizeof line, "%.2fx ", w->second.ratio);
+      out += line + w->second.name;
+    }
+    if (r.verdict != "ok") out += "; " + r.explanation;
+    out += "\n";
   }
   return out;
 }

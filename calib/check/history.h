@@ -3,7 +3,9 @@
 // transaction: a crash or a full disk leaves the database as it was.
 #pragma once
 
+#include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,6 +35,21 @@ struct HistoryRun {
   std::string rig_crc32 = "";  // 8 hex digits
   std::string target_path = "";
   std::string board = "";  // "as calibrated" (the rig file's record) or "the target file's"
+  // The coverage factor every threshold was k times its sigma with
+  // (--k-sigma); unknown in runs written before it was kept.
+  std::optional<double> k_sigma = std::nullopt;
+  // A CRC-32 of the capture images (their names within their capture and
+  // their bytes, 8 hex digits): the same night checked again reads as the
+  // same; empty in runs written before it was kept.
+  std::string captures_crc32 = "";
+};
+
+// What became of a run given to AppendToHistory: appended as run_id, or not
+// appended because the history already holds the same night (the same
+// captures_crc32 with the same rig_crc32) as same_night.
+struct HistoryAppend {
+  long long run_id = 0;  // 0: not appended
+  std::optional<HistoryRun> same_night = std::nullopt;
 };
 
 struct HistoryPoint {
@@ -83,11 +100,16 @@ std::string HistoryPathOf(const std::string& path);
 
 // Appends one run, its paths (rig_file, captures, rig_path, target_path)
 // kept as HistoryPathOf's (a no-op on paths the caller already resolved). Creates the database (and its tables) if
-// missing. Throws InputError naming `db_path` if it is not an SQLite database of ours or cannot be written. The views
-// the run set aside are stored with it, each capture named by capture_names (CheckResult's capture index -> name; the
-// index where it has none).
-long long AppendToHistory(const std::string& db_path, const HistoryRun& run, const CheckResult& result,
-                          const std::map<int, std::string>& capture_names = {});
+// missing or empty (an empty file: provisioned for the service user). Throws InputError naming `db_path` if it is not
+// an SQLite database of ours or cannot be written. The views the run set aside are stored with it, each capture named
+// by capture_names (CheckResult's capture index -> name; the index where it has none). A run whose captures_crc32 and
+// rig_crc32 a run in the history already has is not appended (the same night checked again would count twice in
+// every trend): the outcome names that run. `before_commit`, if given, is called with the outcome inside the
+// transaction: what it throws rolls the run back (the check stages its report there, so that a report that cannot be
+// written leaves the history without the night).
+HistoryAppend AppendToHistory(const std::string& db_path, const HistoryRun& run, const CheckResult& result,
+                              const std::map<int, std::string>& capture_names = {},
+                              const std::function<void(const HistoryAppend&)>& before_commit = {});
 
 // Throws InputError naming `db_path` unless an existing history can be
 // written: the file read-only, or its folder (SQLite's journal goes beside
@@ -104,7 +126,8 @@ HistorySetAsideLog ReadHistorySetAside(const std::string& db_path);
 
 // A readable table: first, when the runs were measured with more than one
 // rig file (by CRC-32; the runs that kept none are left out), the runs of
-// each, since a trend across a recalibration is not one rig's; one row per
+// each, since a trend across a recalibration is not one rig's; the k_sigma
+// of the runs (the runs at each where it varied); one row per
 // figure, its first and last values, the
 // extremes, the last threshold and how many runs failed it; then, per
 // camera, the views set aside and on how many of the runs that kept them (a
@@ -112,5 +135,12 @@ HistorySetAsideLog ReadHistorySetAside(const std::string& db_path);
 // or loose lens).
 std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<FigureTrend>& trends,
                          const HistorySetAsideLog& set_aside = {});
+
+// The runs one a line, the last `last_runs` of them: date, k_sigma, verdict,
+// how many figures failed, the figure nearest its threshold (value over
+// threshold), and why where not ok. Tells when a figure began to drift or a
+// verdict changed, which the trend's extremes do not.
+std::string FormatRunSeries(const std::vector<HistoryRun>& runs, const std::vector<FigureTrend>& trends,
+                            size_t last_runs);
 
 }  // namespace stereorig

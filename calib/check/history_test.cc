@@ -316,5 +316,136 @@ TEST(History, RejectsAFileThatIsNotADatabaseAndLeavesItAlone) {
   EXPECT_THROW(ReadHistoryRuns(::testing::TempDir() + "/missing.sqlite"), InputError);
 }
 
+// An empty file (provisioned for a service user with `install -m 664
+// /dev/null`) is an empty database: no runs, and the first append makes it
+// ours. Another program's database is refused, and left as it was.
+TEST(History, AnEmptyFileIsAnEmptyHistoryAndAnotherDatabaseIsRefused) {
+  const std::string db = ::testing::TempDir() + "/history_empty.sqlite";
+  std::filesystem::remove(db);
+  { std::ofstream(db, std::ios::binary); }
+  EXPECT_TRUE(ReadHistoryRuns(db).empty());
+  EXPECT_TRUE(ReadHistoryTrends(db).empty());
+  EXPECT_TRUE(ReadHistorySetAside(db).views.empty());
+  EXPECT_EQ(std::filesystem::file_size(db), 0u);  // reading writes nothing
+  EXPECT_NO_THROW(RequireHistoryWritable(db));
+  EXPECT_EQ(AppendToHistory(db, {0, "2026-11-20T02:00:00Z", "rig.yaml", "night1", "", ""}, Result(0.2, true)).run_id,
+            1);
+  EXPECT_EQ(ReadHistoryRuns(db).size(), 1u);
+  EXPECT_EQ(ReadHistorySetAside(db).since_run_id, 1);
+
+  const std::string foreign = ::testing::TempDir() + "/history_foreign.sqlite";
+  std::filesystem::remove(foreign);
+  sqlite3* raw = nullptr;
+  ASSERT_EQ(sqlite3_open(foreign.c_str(), &raw), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(raw, "CREATE TABLE parts (id INTEGER);", nullptr, nullptr, nullptr), SQLITE_OK);
+  sqlite3_close(raw);
+  const auto size = std::filesystem::file_size(foreign);
+  for (int reader = 0; reader < 2; ++reader) {
+    try {
+      if (reader == 0)
+        ReadHistoryRuns(foreign);
+      else
+        AppendToHistory(foreign, {0, "d", "r", "c", "", ""}, Result(0.2, true));
+      ADD_FAILURE() << "another program's database was taken";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.where(), foreign);
+      EXPECT_EQ(e.problem(),
+                "an SQLite database, but not a stereorig check history (it has no table stereorig_check_runs): give "
+                "another with --history-db");
+    }
+  }
+  EXPECT_EQ(std::filesystem::file_size(foreign), size);
+}
+
+// k_sigma and the captures' CRC are columns added to
+// stereorig_check_run_inputs after it was first written: a history from
+// before gets them at its next append, its earlier runs reading unknown,
+// and the trend says the runs were not all at one k.
+TEST(History, KeepsKSigmaAndAddsItsColumnToAnOlderHistory) {
+  const std::string db = ::testing::TempDir() + "/history_k.sqlite";
+  std::filesystem::remove(db);
+  ASSERT_TRUE(MakeOldHistory(db,
+                             "CREATE TABLE stereorig_check_run_inputs (run_id INTEGER NOT NULL, rig_path TEXT NOT "
+                             "NULL, rig_crc32 TEXT NOT NULL, target_path TEXT NOT NULL, board TEXT NOT NULL);"
+                             "INSERT INTO stereorig_check_runs (date_utc, rig_file, captures, verdict, explanation) "
+                             "VALUES ('2026-11-01T02:00:00Z', '/r.yaml', '/old', 'ok', 'every figure within its "
+                             "threshold');"
+                             "INSERT INTO stereorig_check_run_inputs VALUES (1, '/r.yaml', '0000abcd', '/t.yaml', "
+                             "'as calibrated');"));
+  ASSERT_EQ(ReadHistoryRuns(db).size(), 1u);  // read before the columns exist
+  EXPECT_FALSE(ReadHistoryRuns(db)[0].k_sigma);
+  HistoryRun run{0, "2026-11-02T02:00:00Z", "/r.yaml", "/new", "", ""};
+  run.rig_crc32 = "0000abcd", run.k_sigma = 2.5, run.captures_crc32 = "12345678";
+  EXPECT_EQ(AppendToHistory(db, run, Result(0.2, true)).run_id, 2);
+  const auto runs = ReadHistoryRuns(db);
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_FALSE(runs[0].k_sigma);
+  EXPECT_EQ(runs[0].captures_crc32, "");
+  ASSERT_TRUE(runs[1].k_sigma);
+  EXPECT_EQ(*runs[1].k_sigma, 2.5);
+  EXPECT_EQ(runs[1].captures_crc32, "12345678");
+  EXPECT_NE(FormatTrends(runs, ReadHistoryTrends(db))
+                .find("k_sigma varied over these runs (each run's thresholds and fails are at its own k): 2.5 in "
+                      "run(s) 2; unknown (written before it was kept) in run(s) 1\n"),
+            std::string::npos)
+      << FormatTrends(runs, ReadHistoryTrends(db));
+  EXPECT_NE(FormatTrends({runs[1]}, {}).find("k_sigma: 2.5 in every run\n"), std::string::npos);
+}
+
+// The same captures with the same rig file a second time: not appended,
+// the outcome naming the run it repeats; what before_commit throws rolls the
+// run back.
+TEST(History, TheSameNightIsNotAppendedTwice) {
+  const std::string db = ::testing::TempDir() + "/history_twice.sqlite";
+  std::filesystem::remove(db);
+  HistoryRun run{0, "2026-11-02T02:00:00Z", "/r.yaml", "/night", "", ""};
+  run.rig_crc32 = "0000abcd", run.captures_crc32 = "12345678", run.k_sigma = 3.5;
+  EXPECT_EQ(AppendToHistory(db, run, Result(0.9, false)).run_id, 1);
+  HistoryAppend seen;
+  const HistoryAppend again =
+      AppendToHistory(db, run, Result(0.9, false), {}, [&](const HistoryAppend& a) { seen = a; });
+  EXPECT_EQ(again.run_id, 0);
+  ASSERT_TRUE(again.same_night && seen.same_night);
+  EXPECT_EQ(again.same_night->id, 1);
+  EXPECT_EQ(seen.same_night->id, 1);
+  EXPECT_EQ(again.same_night->verdict, "recalibrate");
+  EXPECT_EQ(again.same_night->date_utc, "2026-11-02T02:00:00Z");
+  EXPECT_EQ(ReadHistoryRuns(db).size(), 1u);
+  HistoryRun other_rig = run, other_night = run;
+  other_rig.rig_crc32 = "0000abce";  // recalibrated: the same captures are another check
+  other_night.captures_crc32 = "12345679";
+  EXPECT_EQ(AppendToHistory(db, other_rig, Result(0.2, true)).run_id, 2);
+  EXPECT_THROW(AppendToHistory(db, other_night, Result(0.2, true), {},
+                               [](const HistoryAppend&) { throw InputError("report.json", "cannot be written"); }),
+               InputError);
+  EXPECT_EQ(ReadHistoryRuns(db).size(), 2u);  // rolled back
+  EXPECT_EQ(AppendToHistory(db, other_night, Result(0.2, true)).run_id, 3);
+}
+
+// One run a line, the last N: date, k, verdict, fails, the figure nearest
+// its threshold, and why where not ok.
+TEST(History, ListsTheLastRunsOneALine) {
+  const std::string db = ::testing::TempDir() + "/history_series.sqlite";
+  std::filesystem::remove(db);
+  HistoryRun run{0, "2026-11-01T02:00:00Z", "/r.yaml", "/n", "", ""};
+  run.k_sigma = 3.5;
+  AppendToHistory(db, run, Result(0.20, true));
+  run.date_utc = "2026-11-02T02:00:00Z";
+  AppendToHistory(db, run, Result(0.21, true));
+  run.date_utc = "2026-11-03T02:00:00Z";
+  AppendToHistory(db, run, Result(0.90, false));
+  const std::string series = FormatRunSeries(ReadHistoryRuns(db), ReadHistoryTrends(db), 2);
+  // Run 2's nearest is the closure's 0.021 mm against 0.02 mm (1.05x, passed
+  // as Result() sets it), not cam0's 0.21 px against 0.25 px (0.84x).
+  EXPECT_EQ(
+      series,
+      "runs (the last 2):\n"
+      "   run  date_utc              k_sigma  verdict      fails  nearest its threshold (value / threshold); why, "
+      "where not ok\n"
+      "     2  2026-11-02T02:00:00Z      3.5  ok               0  1.05x pair_0_1_closure_mm\n"
+      "     3  2026-11-03T02:00:00Z      3.5  recalibrate      1  4.50x pair_0_1_closure_mm; camera 0 moved: "
+      "turned 0.050 deg, shifted 0.002 mm\n");
+}
+
 }  // namespace
 }  // namespace stereorig
