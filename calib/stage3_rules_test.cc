@@ -6,6 +6,7 @@
 #include <ceres/ceres.h>
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -89,6 +90,13 @@ TEST(Stage3Rules, ASolveThatStoppedShortIsNotConverged) {
   const std::string p = NotConvergedProblem(r, 1.0);
   EXPECT_EQ(p.rfind("stage 3 did not converge: Ceres ended at NO_CONVERGENCE after 101 iterations", 0), 0u) << p;
   EXPECT_NE(p.find("at rms 0.2 px"), std::string::npos) << p;
+  // Residuals that could not be evaluated read NaN: named as such, not as
+  // an RMS of nan.
+  r.system.solver_problem = "its residuals could not be evaluated (a projection failed)";
+  r.system.refined_reprojection_rms_px = std::numeric_limits<double>::quiet_NaN();
+  r.system.refined_median_corner_residual_px = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(NotConvergedProblem(r, 1.0).rfind("stage 3 did not converge: its residuals could not be evaluated", 0), 0u)
+      << NotConvergedProblem(r, 1.0);
   r.num_modules = 1;  // no stage 3
   EXPECT_EQ(NotConvergedProblem(r, 1.0), "");
 }
