@@ -63,15 +63,18 @@ SeedFigures RunSeed(unsigned seed, CalibrationResult* out = nullptr) {
                                    face_from_front.Inverse());
     }
     const PixelUncertainty& u = s1.report.uncertainty.at(0);
+    // The actual error at the range the predicted sigma is reported at (the
+    // camera's median board distance, ~205-215 mm here), not a fixed 200 mm.
+    const double range_mm = s1.report.uncertainty_range_mm;
     const Eigen::Vector2d e = testing::MeanFramesProjectionError(truth.camera(cam), true_cam_from_face, s1.camera,
-                                                                 s1.cam_from_face, u.q_px, 200.0);
+                                                                 s1.cam_from_face, u.q_px, range_mm);
     f.e2_centre.push_back(e.squaredNorm() / 2.0);
     f.s2_centre.push_back(u.rms_stdev_px * u.rms_stdev_px);
     // The four image corners too (extrapolated beyond most of the corners seen).
     for (size_t k = 1; k < s1.report.uncertainty.size(); ++k) {
       const PixelUncertainty& uk = s1.report.uncertainty[k];
       const Eigen::Vector2d ek = testing::MeanFramesProjectionError(truth.camera(cam), true_cam_from_face, s1.camera,
-                                                                    s1.cam_from_face, uk.q_px, 200.0);
+                                                                    s1.cam_from_face, uk.q_px, range_mm);
       f.e2_corners.push_back(ek.squaredNorm() / 2.0);
       f.s2_corners.push_back(uk.rms_stdev_px * uk.rms_stdev_px);
     }

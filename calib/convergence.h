@@ -25,7 +25,11 @@ namespace stereorig {
 
 // "" if every stage is within `max_rms_px`: each camera's stage 1 RMS
 // (inlier corners), each module's stage 2 RMS, and stage 3's RMS and its
-// median corner residual (with more than one module, once stage 2 ran).
+// median corner residual distance (against sqrt(2 ln 2) max_rms_px, the
+// median distance of Gaussian residuals of that RMS per coordinate), and
+// stage 3's solve ended at Ceres's CONVERGENCE with its residuals evaluated
+// (SystemReport::solver_problem; with more than one module, once stage 2
+// ran).
 // Else one line naming the earliest stage over it, each of its cameras or
 // modules (stage 3: its worst captures against the median capture), its
 // figure and what usually causes it, for the message refusing the rig file.

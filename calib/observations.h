@@ -35,8 +35,9 @@ struct TargetGeometry {
   bool double_sided = false;    // false: a plain board, front face only
   Pose back_from_front;         // front-face frame -> back-face frame, mm
   // 1-sigma of back_from_front as measured: [rx, ry, rz (deg), tx, ty, tz (mm)].
-  // All > 0: stage 3 refines back_from_front under this prior; any 0: it is
-  // held as given.
+  // Stage 3 refines back_from_front under this prior axis by axis: an axis
+  // whose sigma is 0 is held at the given value, the others refined (all 0:
+  // held whole).
   Eigen::Matrix<double, 6, 1> back_from_front_sigma = Eigen::Matrix<double, 6, 1>::Constant(1e-3);
 
   int num_corners() const { return corners_x * corners_y; }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include "calib/core/input_error.h"
@@ -128,6 +129,24 @@ std::vector<std::map<int, ModuleCaptureView>> PoseBoardsByTriangulation(const Ca
     }
   }
   return views;
+}
+
+std::vector<int> Stage3HeldIntrinsics(const std::string& lensmodel, int num_intrinsics) {
+  int first_held = num_intrinsics;  // none
+  if (LensmodelNeedsRegularization(lensmodel)) first_held = lensmodel.rfind("LENSMODEL_OPENCV", 0) == 0 ? 9 : 4;
+  std::vector<int> held;
+  for (int i = first_held; i < num_intrinsics; ++i) held.push_back(i);
+  return held;
+}
+
+ceres::Covariance::Options Stage3CovarianceOptions(int num_free) {
+  ceres::Covariance::Options copt;
+  // SPARSE_QR fails on a rank-deficient Jacobian whatever null_space_rank
+  // says; DENSE_SVD with 0 does too (-1 would truncate instead).
+  copt.algorithm_type = num_free <= 3000 ? ceres::DENSE_SVD : ceres::SPARSE_QR;
+  copt.null_space_rank = 0;
+  copt.num_threads = 1;
+  return copt;
 }
 
 SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<ModuleCameras>& modules,
@@ -288,16 +307,12 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   }
   rep.num_residual_corners = static_cast<int>(corner_blocks.size());
   // Without mrcal's regularisation, only the well-determined intrinsics are
-  // freed: the core and OPENCV's k1..k3, p1, p2. OPENCV8's rational k4..k6 and
-  // a spline's control points stay at their stage-2 values.
+  // freed (Stage3HeldIntrinsics); the others stay at their stage-2 values.
   for (auto& [cam, v] : intrinsics) {
     if (!problem.HasParameterBlock(v.data())) continue;
-    const std::string& model = camera_of[cam]->lensmodel_name();
-    std::vector<int> fixed;
     const int n = static_cast<int>(v.size());
-    const int first_fixed = model == "LENSMODEL_OPENCV8" ? 9 : model.rfind("LENSMODEL_OPENCV", 0) == 0 ? n : 4;
-    for (int i = first_fixed; i < n; ++i) fixed.push_back(i);
-    if (!fixed.empty()) problem.SetManifold(v.data(), new ceres::SubsetManifold(n, fixed));
+    const std::vector<int> held = Stage3HeldIntrinsics(camera_of[cam]->lensmodel_name(), n);
+    if (!held.empty()) problem.SetManifold(v.data(), new ceres::SubsetManifold(n, held));
   }
   for (PoseBlock* p : {&identity_module, &identity_bff, &identity_rl}) {
     if (problem.HasParameterBlock(p->params)) problem.SetParameterBlockConstant(p->params);
@@ -341,12 +356,17 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
       }
   };
   // The corners' residuals, each block's (du, dv), px, without the loss.
+  // An evaluation that failed would leave them unread (zeros, a small RMS):
+  // they read NaN, and the solve is reported as one that did not converge.
   auto corner_residuals = [&]() {
     ceres::Problem::EvaluateOptions eo;
     eo.residual_blocks = corner_blocks;
     eo.apply_loss_function = false;
     std::vector<double> r;
-    problem.Evaluate(eo, nullptr, &r, nullptr, nullptr);
+    if (!problem.Evaluate(eo, nullptr, &r, nullptr, nullptr)) {
+      rep.solver_problem = "its residuals could not be evaluated (a projection failed)";
+      r.assign(2 * corner_blocks.size(), std::numeric_limits<double>::quiet_NaN());
+    }
     return r;
   };
   auto rms = [](const std::vector<double>& r) {
@@ -370,6 +390,14 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   // The full adjustment.
   set_free(true, options.refine_stereo, bff_free, options.refine_intrinsics);
   ceres::Solve(sopt, &problem, &summary);
+  // Only CONVERGENCE is a solution: NO_CONVERGENCE (the iteration limit),
+  // FAILURE and USER_FAILURE leave the parameters wherever the solve
+  // stopped, whatever their RMS reads (OPENCV12 with its k4..k6 freed: 101
+  // iterations, an RMS at the noise, S 2.95 mm off the truth).
+  if (summary.termination_type != ceres::CONVERGENCE)
+    rep.solver_problem = "Ceres ended at " + std::string(ceres::TerminationTypeToString(summary.termination_type)) +
+                         " after " + std::to_string(summary.iterations.size()) + " iterations (" + summary.message +
+                         ")";
   const std::vector<double> refined = corner_residuals();
   rep.refined_reprojection_rms_px = rms(refined);
   std::vector<double> distances_px;
@@ -401,16 +429,17 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
     off << PlateTurnDeg(rep.back_from_front, target.back_from_front),
         rep.back_from_front.translation_mm() - target.back_from_front.translation_mm();
     // The error model of a file: its rotation error a turn of the back
-    // print about the FRONT face's origin, |t| (~100 mm) from the back's, so
-    // that t moves by the lever arm d t = d r x t besides its own error. The
-    // simulator's misaligned print (datasets/target_render.cc) and the
-    // tests' files (calib_test_util.cc, MakeScene) are drawn so; the
-    // translation sigma alone does not hold it (an honest test file read
-    // chi-square 28 without the term). Stage 3's prior (BackFromFrontPrior)
-    // treats the rotation and t as independent instead, a turn about the
-    // back's origin: the judgement's variance is the wider of the two models,
-    // so that an honest file under either is not refused. Not measured: the
-    // refusal rate on honest files (the 3 in 1000 is chi-square theory).
+    // print about the BACK face's origin, |t| (~100 mm) from the front's, so
+    // that t (the front's origin in the back's frame) moves by the lever arm
+    // d t = d r x t besides its own error. The simulator's misaligned print
+    // (datasets/target_render.cc) and the tests' files (calib_test_util.cc,
+    // MakeScene) are drawn so; the translation sigma alone does not hold it
+    // (an honest test file read chi-square 28 without the term). Stage 3's
+    // prior (BackFromFrontPrior) treats the rotation and t as independent
+    // instead, a turn about the FRONT face's origin (which leaves t alone):
+    // the judgement's variance is the wider of the two models, so that an
+    // honest file under either is not refused. Not measured: the refusal
+    // rate on honest files (the 3 in 1000 is chi-square theory).
     const Eigen::Matrix<double, 6, 1>& sg = target.back_from_front_sigma;
     const Eigen::Vector3d r2 = (sg.head<3>() * M_PI / 180.0).array().square();
     const Eigen::Vector3d t = target.back_from_front.translation_mm();
@@ -430,25 +459,19 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   // Gauge: the problem has none left. Module 0's pose is a constant identity
   // and its left camera's frame is the reference, every other block is tied
   // to the corners, and back_from_front has its prior. The intrinsics blocks
-  // hold OPENCV8's k4..k6 (and a spline's knots) through a SubsetManifold, so
-  // their covariance is computed in the manifold's tangent space and returned
-  // in the ambient space with zero rows/columns for the held parameters.
-  // DENSE_SVD with null_space_rank = -1 would still return the pseudo-inverse
-  // (dropping directions whose eigenvalue ratio is below
-  // min_reciprocal_condition_number) if a data set left a direction
-  // undetermined, rather than failing.
+  // hold OPENCV8/12's k4.. (and a spline's knots) through a SubsetManifold,
+  // so their covariance is computed in the manifold's tangent space and
+  // returned in the ambient space with zero rows/columns for the held
+  // parameters. A data set that leaves a direction undetermined gets no
+  // sigma (Stage3CovarianceOptions), not a pseudo-inverse's.
   rep.covariance_status = "not computed";
   if (options.compute_covariance) {
-    ceres::Covariance::Options copt;
     int num_free = 0;
     std::vector<double*> blocks;
     problem.GetParameterBlocks(&blocks);
     for (double* b : blocks)
       if (!problem.IsParameterBlockConstant(b)) num_free += problem.ParameterBlockTangentSize(b);
-    copt.algorithm_type = num_free <= 3000 ? ceres::DENSE_SVD : ceres::SPARSE_QR;
-    copt.null_space_rank = -1;
-    copt.num_threads = 1;
-    ceres::Covariance cov(copt);
+    ceres::Covariance cov(Stage3CovarianceOptions(num_free));
     auto is_free = [&](const double* b) {
       return problem.HasParameterBlock(b) && !problem.IsParameterBlockConstant(const_cast<double*>(b));
     };
@@ -496,7 +519,10 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
       }
       rep.covariance_status = "ok";
     } else if (!pairs.empty()) {
-      rep.covariance_status = "ceres::Covariance failed (rank-deficient problem)";
+      rep.covariance_status =
+          "not computed: the adjustment leaves a direction of its parameters undetermined (ceres::Covariance found "
+          "its Jacobian rank-deficient, or nearly), so no 1 sigma of S, of the refined stereo pairs or of the "
+          "intrinsics is given";
     }
   }
   return result;

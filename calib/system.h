@@ -18,6 +18,7 @@
 //     refined right_from_left and intrinsics (those the rig file holds).
 #pragma once
 
+#include <ceres/covariance.h>
 #include <map>
 #include <set>
 #include <string>
@@ -35,7 +36,8 @@ struct SystemOptions {
   double huber_px = 1.0;      // Huber loss scale, px; default 1
   bool refine_stereo = true;  // free each module's right_from_left in the adjustment; default true
   // Free every camera's intrinsics: the core and OPENCV's k1..k3, p1, p2 (not
-  // OPENCV8's k4..k6 nor spline knots, which need mrcal's regularisation).
+  // OPENCV8/12's k4..k6, s1..s4 nor spline knots, which need mrcal's
+  // regularisation: Stage3HeldIntrinsics).
   // With them free, the covariance of S includes the lens uncertainty, which
   // moves each module's frame (a calibrated camera's frame trades rotation
   // against its centre). Default true.
@@ -128,8 +130,12 @@ struct SystemReport {
   std::vector<RefinedStereoSigma> stereo_sigma;          // (M,) when refine_stereo, else empty
   std::vector<RefinedIntrinsicsSigma> intrinsics_sigma;  // (cameras,) when refine_intrinsics, else empty
   std::string covariance_status;                         // "ok" or why it is missing
-  Pose back_from_front;                                  // as refined
-  double back_from_front_change_deg = 0.0;               // refined vs measured
+  // "" if the adjustment converged; else why not (Ceres stopped short of
+  // convergence, or the residuals could not be evaluated), for the
+  // convergence check (calib/convergence.h), which then refuses the rig.
+  std::string solver_problem;
+  Pose back_from_front;                     // as refined
+  double back_from_front_change_deg = 0.0;  // refined vs measured
   double back_from_front_change_mm = 0.0;
   // The refined back_from_front against the target file's, per axis over the
   // file's stated sigma (calib/plate_difference.h). The refined value is the
@@ -162,6 +168,25 @@ struct SystemResult {
 // module posed the board).
 SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<ModuleCameras>& modules,
                              double corner_sigma_px, const SystemOptions& options, const SystemExclusions& excluded);
+
+// The intrinsics (indices in mrcal's order) stage 3 holds at stage 2's
+// values for a camera of `lensmodel` with `num_intrinsics` parameters: none
+// for a model whose every parameter the boards determine
+// (!LensmodelNeedsRegularization: OPENCV4, OPENCV5); OPENCV8's and
+// OPENCV12's k4..k6 and s1..s4 (index 9 on); everything but the core (fx,
+// fy, cx, cy) for the others (a spline's knots). Ceres has none of mrcal's
+// regularisation to tie them down: OPENCV12's, freed, drifted to a pole-zero
+// pair inside the image (k1..k6 in the hundreds), Ceres stopped at its
+// iteration limit and S moved 2.95 mm off the truth.
+std::vector<int> Stage3HeldIntrinsics(const std::string& lensmodel, int num_intrinsics);
+
+// How stage 3 computes its covariance from `num_free` tangent parameters:
+// a problem that leaves a direction undetermined (a singular value of its
+// Jacobian below sqrt(min_reciprocal_condition_number) of the largest) makes
+// Compute fail. With null_space_rank = -1, Ceres dropped such directions
+// and returned the pseudo-inverse, with no word: OPENCV12's cx sigma came out
+// 0.0002-0.01 px where OPENCV5's, a subset of it, is 0.05 px.
+ceres::Covariance::Options Stage3CovarianceOptions(int num_free);
 
 // Board poses: for each capture, module_from_front of one module, from its
 // triangulated corners (Horn). Also the triangulated points themselves.
