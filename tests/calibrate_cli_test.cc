@@ -645,8 +645,8 @@ TEST(CalibrateCli, ALayoutWithTwoModulesOfOneNameIsRefused) {
   fs::remove_all(dir);
 }
 
-// Captures holding cameras no module of the layout names: calibrate used
-// them not and said nothing (a one-module rig from four cameras' captures).
+// Captures holding cameras no module of the layout names: calibrate left
+// them out and said nothing (a one-module rig from four cameras' captures).
 // A one-module calibration may be meant, so it goes on, with a warning on
 // stderr and in the report naming the cameras left out.
 TEST(CalibrateCli, CamerasTheLayoutLeavesOutAreWarnedOf) {
