@@ -11,6 +11,7 @@
 #include "apps/cli_util.h"
 #include "apps/command.h"
 #include "apps/demo_expectations.h"
+#include "apps/demo_out.h"
 #include "apps/output_paths.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
@@ -81,7 +82,9 @@ int RunDemo(int argc, char** argv) {
       "stereorig demo"};
   std::string out = "stereorig-demo";
   unsigned seed = 1;
-  app.add_option("--out", out, "folder for everything the demo writes (created if missing)")
+  app.add_option("--out", out,
+                 "folder for everything the demo writes (created if missing); one that is not empty must be an "
+                 "earlier demo's, holding nothing else")
       ->capture_default_str()
       ->check(NonEmptyPath());
   app.add_option("--seed", seed, "simulator seed")->capture_default_str();
@@ -90,6 +93,7 @@ int RunDemo(int argc, char** argv) {
   // Made at once (nothing after this is bad input), and, if it cannot be
   // made, none of it left (apps/output_paths.h).
   FolderToCreate out_folder = OutputPaths().ClaimFolder(out, "everything the demo writes (--out)");
+  CheckDemoOut(out);  // the user's files in it are not replaced
   out_folder.Create();
   PrintBinaryNote();
   const std::string ds = Join(out, "dataset"), rig = Join(out, "rig.yaml");

@@ -54,6 +54,14 @@ void PrintRigSummary(const Rig& rig, FILE* out) {
 
 namespace {
 
+// The largest --distance and --volume side, mm: 100 m. A module's baseline
+// is tens of mm and it measures within a metre or two, so a volume past
+// 100 m judges nothing a rig of this kind could measure; the figures,
+// printed to 1e-4 mm, keep ample precision in doubles there. Larger values
+// only overflow: --volume 1e308 1e308 1e308 printed "3D error after rigid
+// alignment inf mm", exit 0.
+constexpr double kMaxTruthVolumeMm = 100000.0;
+
 // Points filling a box centred `distance_mm` ahead of module 0 of `truth`
 // (its reference frame): a regular 11 x 11 x 7 grid over size_mm.
 std::vector<Eigen::Vector3d> VolumeGrid(const Rig& truth, double distance_mm, const Eigen::Vector3d& size_mm) {
@@ -146,9 +154,12 @@ int RunRig(int argc, char** argv) {
       ->capture_default_str()
       ->needs(truth_option);
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
-  if (!(distance_mm > 0)) throw InputError("--distance", "must be > 0 mm");
+  const std::string range = "must be > 0 mm and at most " + NumberText(kMaxTruthVolumeMm) +
+                            " mm (100 m, beyond any volume a stereo module measures)";
+  if (!(distance_mm > 0 && distance_mm <= kMaxTruthVolumeMm))
+    throw InputError("--distance", NumberText(distance_mm) + ": " + range);
   for (double v : size_mm)
-    if (!(v > 0)) throw InputError("--volume", "each size must be > 0 mm");
+    if (!(v > 0 && v <= kMaxTruthVolumeMm)) throw InputError("--volume", NumberText(v) + ": each size " + range);
 
   // The models' folder (created if needed) is checked before the rig file
   // is read: not a file, not under one, not the rig or truth file.

@@ -120,7 +120,9 @@ int RunSimulate(int argc, char** argv) {
   // A --spec given is read below, or, beside --write-default-spec, only
   // protected from being overwritten: checked here either way, so that a
   // missing one is not passed over with exit 0.
-  if (!spec_path.empty()) RequireInputFile(spec_path);
+  // A pipe too (`--spec <(...)`): ReadSimSpecFile reads it once, start to
+  // end, as a rig file or --options is read.
+  if (!spec_path.empty()) RequireInputFile(spec_path, /*pipe_too=*/true);
   if (!write_spec.empty()) {
     // Checked like every other command's outputs (apps/output_paths.h): its
     // folder exists, it is not a folder, and it is not the --spec file given

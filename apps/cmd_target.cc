@@ -7,6 +7,7 @@
 #include "apps/command.h"
 #include "apps/output_paths.h"
 #include "calib/core/atomic_file.h"
+#include "calib/core/file_suffix.h"
 #include "calib/core/input_error.h"
 #include "targets/board_svg.h"
 #include "targets/target.h"
@@ -67,7 +68,7 @@ int RunTarget(int argc, char** argv) {
   CLI::Option* corners_option =
       app.add_option("--corners", corners, "the default's design with X x Y inner corners (default 11 9)")
           ->expected(2)
-          ->check(CLI::Range(2, 200))
+          ->check(CLI::Range(2, kMaxInnerCorners))
           ->excludes(target_option);
   CLI::Option* square_option =
       app.add_option("--square-mm", square_mm, "the default's design with squares of this edge, mm (default 9)")
@@ -88,13 +89,18 @@ int RunTarget(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--write-target", write_target, "also write the target file used here (YAML)");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
-  // --write-target may name the --target file itself (it writes back what
-  // it read, defaults filled in), so it is claimed before that is
-  // protected; the SVG may not.
+  // Neither output may be the --target file. Writing it back was allowed
+  // once (what it read, defaults filled in), but a target file is edited
+  // and measured by hand: the rewrite dropped its comments ("# MEASURED
+  // with calipers") and its layout, with exit 0.
   OutputPaths outputs;
-  if (!write_target.empty()) outputs.Claim(write_target, "the target file (--write-target)");
   outputs.Protect(target_path, "the target file (--target)");
+  if (!write_target.empty()) outputs.Claim(write_target, "the target file (--write-target)");
   outputs.Claim(out_path, "the SVG (--out)");
+  // As every output named by its format (a cloud's .ply, a map's .pfm):
+  // --out board.txt wrote an SVG a viewer or print dialog would not open.
+  if (!EndsWithIgnoringCase(out_path, ".svg"))
+    throw InputError(out_path, "the target output must end in .svg (it is written as SVG)");
 
   const bool resized = corners_option->count() || square_option->count() || thickness_option->count();
   const Target target = !target_path.empty() ? ReadTargetFile(target_path)

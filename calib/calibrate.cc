@@ -378,6 +378,9 @@ std::string CalibrationReport::ToJson() const {
   j.BeginObject().String("source", source).Int("modules", num_modules);
   // The verdict calibrate acted on: a report beside no new rig file says why.
   j.BeginObject("convergence").Number("max_rms_px", max_rms_px).String("not_converged", not_converged).EndObject();
+  j.BeginArray("warnings");
+  for (const std::string& w : warnings) j.String("", w);
+  j.EndArray();
   j.BeginArray("stage1_intrinsics");
   for (const IntrinsicsReport& r : intrinsics) WriteIntrinsics(j, r, capture_names);
   j.EndArray();

@@ -48,6 +48,10 @@ struct CalibrationReport {
   // much and on which axis, for the message refusing the rig file; "" if
   // within, or not refined (one module, every sigma 0).
   std::string wrong_plate;
+  // The warnings calibrate printed on stderr ("calibrate: warning: ..."),
+  // one line each: cameras of the captures no module names, most images
+  // rejected, rows or columns of the target never seen (capture_folder.h).
+  std::vector<std::string> warnings{};
   // The capture's folder name where known, else its index in decimal: how
   // the summary names a capture (the JSON keeps the index and adds the name).
   std::string CaptureName(int capture) const;

@@ -250,6 +250,21 @@ std::string NeverSeenCornersNote(const std::vector<BoardObservation>& observatio
          " accepted views: does the board have that many? (the rig records the file's grid)";
 }
 
+std::string CamerasLeftOutNote(const std::string& dir, int num_cameras) {
+  std::map<int, int> captures_of;  // camera index -> captures holding its image
+  for (const std::string& image : CaptureFolderImages(dir)) {
+    const std::optional<int> camera = CameraIndexOfImageName(fs::path(image).filename().string());
+    if (camera && *camera >= num_cameras) ++captures_of[*camera];
+  }
+  if (captures_of.empty()) return "";
+  std::string images;
+  for (const auto& [camera, captures] : captures_of)
+    images += (images.empty() ? "" : ", ") + CameraImageName(camera) + " (in " + std::to_string(captures) +
+              (captures == 1 ? " capture)" : " captures)");
+  return dir + " holds " + images + ", but the layout names cameras 0 to " + std::to_string(num_cameras - 1) +
+         " only: the rig leaves them out (name them in a module of the layout to calibrate them)";
+}
+
 bool IsTooFewViewsProblem(const std::string& problem) {
   return problem.find("never sees the board") != std::string::npos ||
          problem.find("too few views") != std::string::npos;
@@ -278,6 +293,8 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
   if (!rejected_note.empty()) std::fprintf(stderr, "calibrate: warning: %s\n", rejected_note.c_str());
   const std::string never_seen_note = NeverSeenCornersNote(input.observations, target, target_path);
   if (!never_seen_note.empty()) std::fprintf(stderr, "calibrate: warning: %s\n", never_seen_note.c_str());
+  const std::string left_out_note = CamerasLeftOutNote(captures_dir, num_cameras);
+  if (!left_out_note.empty()) std::fprintf(stderr, "calibrate: warning: %s\n", left_out_note.c_str());
   try {
     out.result = Calibrate(input, options);
   } catch (const InputError& e) {
@@ -287,6 +304,9 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
     if (note.empty()) throw;
     throw InputError(e.where(), e.problem() + "; " + note);
   }
+  // The report keeps the warnings printed, beside the figures they qualify.
+  for (const std::string& note : {rejected_note, never_seen_note, left_out_note})
+    if (!note.empty()) out.result.report.warnings.push_back(note);
   // Calibrate records the board (in the rig it built), not its file's name.
   // Absolute, so that the check's messages name it from wherever they run.
   if (std::optional<CalibrationTarget>& board = out.result.rig.provenance().target)

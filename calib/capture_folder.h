@@ -92,6 +92,16 @@ std::string NoBoardFoundNote(const DetectedCaptures& detected, const Target& tar
 std::string NeverSeenCornersNote(const std::vector<BoardObservation>& observations, const Target& target,
                                  const std::string& target_path);
 
+// "" unless the captures of `dir` hold camK.png for cameras the layout
+// names in no module (K >= num_cameras): then one line naming them, in how
+// many captures each is, and that they are not calibrated. calibrate read
+// only the layout's cameras and wrote a rig without the others, saying
+// nothing; a one-module rig calibrated on purpose from captures of a larger
+// one is legitimate, so a warning (stderr and the report's "warnings"),
+// not a refusal. (check and reconstruct, which read a rig, refuse such
+// images: captures of another rig.)
+std::string CamerasLeftOutNote(const std::string& dir, int num_cameras);
+
 // Whether a refusal's problem is one of too few views (stages 1 and 2:
 // "never sees the board", "too few views ..."; calib/intrinsics.cc,
 // calib/stereo.cc), which NoBoardFoundNote may explain; not one that shows

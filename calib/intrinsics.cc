@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "calib/core/input_error.h"
+#include "calib/core/lensmodel_config.h"
 #include "calib/core/mrcal_c.h"
 #include "calib/core/number_text.h"
 #include "calib/pinhole_seed.h"
@@ -15,44 +16,13 @@
 
 namespace stereorig {
 
-namespace {
-
-// What is wrong with a splined model's configuration, or "" (any other
-// model: ""). mrcal parses the numbers but judges them only when it first
-// projects, after the whole detection pass, and then by assert (SIGABRT,
-// for an Nx or Ny under its minimum), or not at all (a field of view of 0
-// or 400 deg gives a spline with no extent, or a negative one).
-std::string SplineConfigProblem(const std::string& lensmodel) {
-  mrcal_lensmodel_t m;
-  if (!mrcal_lensmodel_from_name(&m, lensmodel.c_str()) || m.type != MRCAL_LENSMODEL_SPLINED_STEREOGRAPHIC) return "";
-  const mrcal_LENSMODEL_SPLINED_STEREOGRAPHIC__config_t& c = m.LENSMODEL_SPLINED_STEREOGRAPHIC__config;
-  const std::string where = "'" + lensmodel + "': ";
-  // mrcal's knot spacing (mrcal.c, _mrcal_precompute_lensmodel_data): a
-  // quadratic spline needs one knot interval past the field's edge, a cubic
-  // two; the grid must hold them and an interval inside.
-  if (c.order != 2 && c.order != 3)
-    return where + "order=" + std::to_string(c.order) + ": mrcal's splines are of order 2 or 3";
-  const int min_knots = c.order == 2 ? 3 : 4;
-  if (c.Nx < min_knots || c.Ny < min_knots)
-    return where + "Nx=" + std::to_string(c.Nx) + " Ny=" + std::to_string(c.Ny) + ": an order " +
-           std::to_string(c.order) + " spline needs Nx and Ny >= " + std::to_string(min_knots) + " (mrcal's minimum)";
-  // The spline spans the stereographic projection u = 2 tan(theta / 2) out
-  // to theta = fov_x_deg / 2 off the axis: 0 spans nothing, and u grows
-  // without bound as theta reaches 180 deg (fov_x_deg 360), past which
-  // tan turns negative.
-  if (c.fov_x_deg <= 0 || c.fov_x_deg >= 360)
-    return where + "fov_x_deg=" + std::to_string(c.fov_x_deg) +
-           ": must be in (0, 360), the horizontal field of view the stereographic projection can span, deg";
-  return "";
-}
-
-}  // namespace
-
 void IntrinsicsOptions::Check() const {
   // The models calibrate solves, by mrcal's names, for every refusal below.
   const std::string models =
       "LENSMODEL_OPENCV4, LENSMODEL_OPENCV5, LENSMODEL_OPENCV8, LENSMODEL_OPENCV12 or "
       "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=.._Ny=.._fov_x_deg=..";
+  // A splined model's bad configuration first: NumIntrinsics refuses it too.
+  if (const std::string p = LensmodelConfigProblem(lensmodel); !p.empty()) throw InputError("options.lensmodel", p);
   if (Camera::NumIntrinsics(lensmodel) < 0) {
     // "OPENCV8" for LENSMODEL_OPENCV8: the prefix is part of mrcal's name.
     const bool unprefixed = Camera::NumIntrinsics("LENSMODEL_" + lensmodel) >= 0;
@@ -74,7 +44,6 @@ void IntrinsicsOptions::Check() const {
   if (lensmodel.rfind("LENSMODEL_OPENCV", 0) != 0 && lensmodel.rfind("LENSMODEL_SPLINED_STEREOGRAPHIC", 0) != 0) {
     throw InputError("options.lensmodel", "'" + lensmodel + "' is not calibrated here; use " + models);
   }
-  if (const std::string p = SplineConfigProblem(lensmodel); !p.empty()) throw InputError("options.lensmodel", p);
   if (seed_focal_px < 0) throw InputError("options.seed_focal_px", "must be >= 0");
   if (min_corners_per_view < 4) throw InputError("options.min_corners_per_view", "must be >= 4");
   if (min_views < 2) throw InputError("options.min_views", "must be >= 2");

@@ -14,9 +14,16 @@ namespace {
 std::vector<ModuleLayout> Parse(YamlMap root) {
   std::vector<ModuleLayout> out;
   std::map<int, std::string> module_of_camera;  // camera index -> the module naming it
+  std::map<std::string, int> module_named;      // module name -> its index
   for (YamlMap m : root.GetMaps("modules")) {
     ModuleLayout l;
     l.name = m.GetString("name");
+    // The name tells modules apart in the rig file and in every report
+    // (module0_stereo_rms_px): two of one name wrote a rig of two
+    // "module0", exit 0.
+    if (const auto [it, added] = module_named.emplace(l.name, static_cast<int>(out.size())); !added)
+      throw InputError(m.Where("name"), l.name + " is used twice (modules[" + std::to_string(it->second) +
+                                            "] too): each module needs a name of its own");
     l.left_camera = m.GetInt("left");
     l.right_camera = m.GetInt("right");
     if (m.Has("face")) {

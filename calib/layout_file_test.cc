@@ -44,5 +44,15 @@ TEST(LayoutFile, EachCameraIsInExactlyOneModule) {
       ParseLayoutYaml("modules:\n  - {name: a, left: 2, right: 3}\n  - {name: b, left: 1, right: 0}\n", "t"));
 }
 
+// Two modules of one name were read, and calibrate wrote a rig of two
+// "module0" (exit 0): reports and the rig file tell modules apart by name.
+TEST(LayoutFile, EachModuleNameIsUsedOnce) {
+  EXPECT_EQ(testing::InputErrorMessage([] {
+              ParseLayoutYaml(
+                  "modules:\n  - {name: module0, left: 0, right: 1}\n  - {name: module0, left: 2, right: 3}\n", "t");
+            }),
+            "t: modules[1].name: module0 is used twice (modules[0] too): each module needs a name of its own");
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -185,5 +185,35 @@ TEST(SimSpec, TheShippedRingIsTheDefaultRigWithModuleOneCopiedTo120And240Degrees
   EXPECT_EQ(SimSpecToYaml(as_default), SimSpecToYaml(def));
 }
 
+// --- Robustness walkthrough 44 (fuzz-bounds) ---
+
+// lines: 1000000000 was read and rendered: lines that close merge into
+// nearly even light (a ripple under 3 % of it 2 sigma apart). At most those 2 line_sigma_mrad apart: 200 over the
+// default 23 deg fan at 1 mrad (2 sin(11.5 deg) = 398.7 mrad of fan; 398.7 / 199 = 2.0035 mrad, 398.7 / 200 under 2).
+TEST(SimSpec, ProjectorLinesThatMergeAreRefused) {
+  const std::string good = SimSpecToYaml(DefaultSimSpec());
+  const std::string refused = ErrorOf(Replace(good, "lines: 51", "lines: 1000000000"));
+  EXPECT_NE(refused.find("projector: lines: 1000000000 lines over the fan stand 3.99e-07 mrad apart, under 2 "
+                         "line_sigma_mrad (2): they merge into even light; at most 200 with this fan_angle_deg and "
+                         "line_sigma_mrad"),
+            std::string::npos)
+      << refused;
+  EXPECT_NE(ErrorOf(Replace(good, "lines: 51", "lines: 201")).find("at most 200"), std::string::npos);
+  EXPECT_EQ(ErrorOf(Replace(good, "lines: 51", "lines: 200")), "");
+}
+
+// A splined lens model mrcal cannot build is refused as a rig file's is
+// (calib/core/lensmodel_config.h), naming the key: the simulator's truth
+// rig would otherwise abort in mrcal (SIGABRT) at the first projection.
+TEST(SimSpec, ASplinedModelMrcalCannotBuildIsRefused) {
+  const std::string good = SimSpecToYaml(DefaultSimSpec());
+  const std::string spline = "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=1_Ny=1_fov_x_deg=100";
+  const std::string refused = ErrorOf(Replace(good, "lensmodel: LENSMODEL_OPENCV8", "lensmodel: " + spline));
+  EXPECT_NE(refused.find("left_camera.lensmodel: '" + spline +
+                         "': Nx=1 Ny=1: an order 3 spline needs Nx and Ny >= 4 (mrcal's minimum)"),
+            std::string::npos)
+      << refused;
+}
+
 }  // namespace
 }  // namespace stereorig

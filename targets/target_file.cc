@@ -1,6 +1,7 @@
 #include "targets/target_file.h"
 
 #include <sstream>
+#include <utility>
 
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
@@ -20,6 +21,12 @@ Target ParseTarget(YamlMap root) {
   Target::Layout l;
   l.corners_x = root.GetInt("corners_x");
   l.corners_y = root.GetInt("corners_y");
+  for (const auto& [key, n] : {std::pair{"corners_x", l.corners_x}, std::pair{"corners_y", l.corners_y}})
+    if (n > kMaxInnerCorners)
+      throw InputError(root.Where(key), std::to_string(n) + ": more than " + std::to_string(kMaxInnerCorners) +
+                                            ", the most inner corners a side (as `stereorig target --corners`): " +
+                                            std::to_string(kMaxInnerCorners) +
+                                            " squares across a 752 px imager leave under 4 px each");
   l.square_size_mm = root.GetDouble("square_size_mm");
   l.double_sided = root.GetBool("double_sided", true);
   l.margin_mm = root.GetDouble("margin_mm", l.double_sided ? l.margin_mm : l.square_size_mm);

@@ -16,6 +16,7 @@
 #include <random>
 
 #include "calib/calib_test_util.h"
+#include "calib/capture_folder.h"
 #include "calib/core/rig_file.h"
 #include "datasets/default_rig.h"
 #include "targets/synthetic_view.h"
@@ -619,6 +620,54 @@ TEST(CalibrateCli, AnOutputOverACaptureImageIsRefused) {
   }
   EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
   EXPECT_FALSE(fs::exists(dir + "/report.json"));
+}
+
+// --- Robustness walkthrough 44 (fuzz-bounds): the layout against the captures ---
+
+// A layout naming two modules "module0" calibrated (exit 0) a rig of two
+// "module0". Refused when the layout is read, before any work: the captures
+// given do not exist, and the refusal is not theirs.
+TEST(CalibrateCli, ALayoutWithTwoModulesOfOneNameIsRefused) {
+  const std::string dir = ::testing::TempDir() + "/calib_cli_dup_" + std::to_string(getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir + "/layout.yaml") << "modules:\n  - {name: module0, left: 0, right: 1}\n"
+                                         "  - {name: module0, left: 2, right: 3}\n";
+  const testing::Result r =
+      testing::RunCli("calibrate --captures " + dir + "/no_captures --target " + dir + "/target.yaml --layout " + dir +
+                      "/layout.yaml --out " + dir + "/rig.yaml --report " + dir + "/report.json");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "stereorig calibrate: " + dir +
+                       "/layout.yaml: modules[1].name: module0 is used twice (modules[0] too): each module needs a "
+                       "name of its own\n");
+  EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
+  EXPECT_FALSE(fs::exists(dir + "/report.json"));
+  fs::remove_all(dir);
+}
+
+// Captures holding cameras no module of the layout names: calibrate left
+// them out and said nothing (a one-module rig from four cameras' captures).
+// A one-module calibration may be meant, so it goes on, with a warning on
+// stderr and in the report naming the cameras left out.
+TEST(CalibrateCli, CamerasTheLayoutLeavesOutAreWarnedOf) {
+  const RenderedSet& set = Rendered();
+  std::ofstream(set.dir + "/one_module.yaml") << "modules:\n  - {name: module0, left: 0, right: 1, face: front}\n";
+  const testing::Result r =
+      testing::RunCli("calibrate --captures " + set.dir + "/captures --target " + set.dir + "/target.yaml --layout " +
+                      set.dir + "/one_module.yaml --out " + set.dir + "/one.yaml --report " + set.dir +
+                      "/one.json --lensmodel LENSMODEL_OPENCV5");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string warning = set.dir +
+                              "/captures holds cam2.png (in 8 captures), cam3.png (in 8 captures), but the layout "
+                              "names cameras 0 to 1 only: the rig leaves them out (name them in a module of the "
+                              "layout to calibrate them)";
+  EXPECT_NE(r.err.find("calibrate: warning: " + warning + "\n"), std::string::npos) << r.err;
+  EXPECT_EQ(ReadRigFile(set.dir + "/one.yaml").num_cameras(), 2);
+  std::ifstream report(set.dir + "/one.json");
+  const nlohmann::json json = nlohmann::json::parse(report);
+  EXPECT_EQ(json["warnings"], nlohmann::json::array({warning})) << json["warnings"].dump();
+  // The layout of every camera leaves none out.
+  EXPECT_EQ(CamerasLeftOutNote(set.dir + "/captures", 4), "");
 }
 
 }  // namespace

@@ -187,11 +187,7 @@ TEST(CliTarget, OutputsThatCollideOrOverwriteTheTargetFileAreRefused) {
   EXPECT_NE(r.err.find("board.yaml: is the target file (--target)"), std::string::npos) << r.err;
   EXPECT_EQ(Slurp(dir + "/board.yaml"), yaml);
 
-  // --write-target may write back the target file it read.
-  r = RunStereorig("target --target " + dir + "/board.yaml --out " + dir + "/second.svg --write-target " + dir +
-                   "/board.yaml");
-  EXPECT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(Slurp(dir + "/board.yaml"), yaml);
+  // --write-target over the target file: CliTarget.WriteTargetOverTheTargetFileIsRefused.
   // Through a symbolic link the SVG would still land on the target file.
   std::filesystem::create_symlink(dir + "/board.yaml", dir + "/link.yaml");
   r = RunStereorig("target --target " + dir + "/board.yaml --out " + dir + "/link.yaml");
@@ -202,6 +198,78 @@ TEST(CliTarget, OutputsThatCollideOrOverwriteTheTargetFileAreRefused) {
   r = RunStereorig("target --out " + dir + "/missing/board.svg");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("its folder does not exist"), std::string::npos) << r.err;
+}
+
+// --- Robustness walkthrough 44 (fuzz-bounds): target's outputs and sizes ---
+
+// --write-target naming the --target file rewrote it, exit 0, and the
+// user's comments ("# MEASURED with calipers") were gone. Refused as every
+// output over an input is (apps/output_paths.h), the file byte-identical.
+TEST(CliTarget, WriteTargetOverTheTargetFileIsRefused) {
+  const std::string dir = ::testing::TempDir() + "/cli_target_write_back_" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  ASSERT_EQ(RunStereorig("target --out " + dir + "/first.svg --write-target " + dir + "/board.yaml").code, 0);
+  std::ofstream(dir + "/board.yaml", std::ios::app) << "# MEASURED with calipers\n";
+  const std::string measured = Slurp(dir + "/board.yaml");
+  const Result r = RunStereorig("target --target " + dir + "/board.yaml --out " + dir + "/second.svg --write-target " +
+                                dir + "/board.yaml");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "stereorig target: " + dir +
+                       "/board.yaml: is the target file (--target): writing the target file (--write-target) there "
+                       "would overwrite an input\n");
+  EXPECT_EQ(Slurp(dir + "/board.yaml"), measured);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/second.svg"));
+  std::filesystem::remove_all(dir);
+}
+
+// The SVG's suffix: --out board.txt wrote an SVG under that name, while
+// every other output named by its format requires its suffix. Any case of
+// .svg is one.
+TEST(CliTarget, TheOutputMustBeNamedSvg) {
+  const std::string dir = ::testing::TempDir() + "/cli_target_suffix_" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  for (const char* name : {"board.txt", "board", "board.svg.pdf"}) {
+    const Result r = RunStereorig("target --out " + dir + "/" + name);
+    EXPECT_EQ(r.code, 2) << name;
+    EXPECT_EQ(r.err,
+              "stereorig target: " + dir + "/" + name + ": the target output must end in .svg (it is written as SVG)\n")
+        << name;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/" + name)) << name;
+  }
+  EXPECT_EQ(RunStereorig("target --out " + dir + "/board.SVG").code, 0);
+  std::filesystem::remove_all(dir);
+}
+
+// --corners is held to 200 a side, a target file's corners_x and corners_y
+// were not: 100000 drew a 64 MB SVG, exit 0. The same bound for both
+// (targets/target_file.h, kMaxInnerCorners); 200 itself is drawn.
+TEST(CliTarget, ATargetFilesCornersAreHeldToTheCornersOptionsBound) {
+  const std::string dir = ::testing::TempDir() + "/cli_target_corners_" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  ASSERT_EQ(RunStereorig("target --out " + dir + "/a.svg --write-target " + dir + "/board.yaml").code, 0);
+  const std::string board = Slurp(dir + "/board.yaml");
+  const size_t at = board.find("corners_x: 11");
+  ASSERT_NE(at, std::string::npos) << board;
+  for (const char* corners : {"100000", "201"}) {
+    std::string big = board;
+    big.replace(at, 13, std::string("corners_x: ") + corners);
+    std::ofstream(dir + "/big.yaml") << big;
+    const Result r = RunStereorig("target --target " + dir + "/big.yaml --out " + dir + "/big.svg");
+    EXPECT_EQ(r.code, 2) << corners;
+    EXPECT_EQ(r.err, "stereorig target: " + dir + "/big.yaml: corners_x: " + corners +
+                         ": more than 200, the most inner corners a side (as `stereorig target --corners`): 200 "
+                         "squares across a 752 px imager leave under 4 px each\n");
+    EXPECT_FALSE(std::filesystem::exists(dir + "/big.svg"));
+  }
+  std::string most = board;
+  most.replace(at, 13, "corners_x: 200");
+  std::ofstream(dir + "/most.yaml") << most;
+  const Result r = RunStereorig("target --target " + dir + "/most.yaml --out " + dir + "/most.svg");
+  EXPECT_EQ(r.code, 0) << r.err;
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

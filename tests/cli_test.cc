@@ -721,4 +721,127 @@ TEST(Cli, RigExportToAFolderThatCannotBeMadeLeavesNoFolder) {
   EXPECT_FALSE(fs::exists(dir + "/new")) << "the folder made on the way was left behind";
 }
 
+// --- Robustness walkthrough 44 (fuzz-bounds): rig files and rig's options ---
+
+// A rig file's camera with the first camera's model and `num_intrinsics`
+// intrinsics (fx, fy, cx, cy of the default's camera 0, then zeros).
+std::string RigWithCamera0Model(const std::string& lensmodel, size_t num_intrinsics) {
+  std::string text = Replace(GoodRigText(), "lensmodel: \"LENSMODEL_OPENCV8\"", "lensmodel: \"" + lensmodel + "\"");
+  const size_t from = text.find("intrinsics: [");
+  const size_t to = text.find("]", from);
+  std::string values;
+  const char* core[] = {"1025", "1025", "375.5", "290.5"};
+  for (size_t k = 0; k < num_intrinsics; ++k) values += (k ? ", " : "") + std::string(k < 4 ? core[k] : "0");
+  return text.replace(from, to - from, "intrinsics: [" + values);
+}
+
+// A splined model mrcal cannot build was judged by its intrinsics' count
+// alone, an int that wraps: Nx=1 or an order of 1 or 5 aborted in mrcal
+// (SIGABRT, exit 134) in `rig` and `reconstruct`; 65536 x 65536 knots read
+// as 0 x 0 and counted 4 intrinsics; Nx=-4 "takes -1048540 intrinsics";
+// fov_x_deg=0 was accepted and reconstructed no point. Refused as
+// `calibrate --lensmodel` refuses them (calib/core/lensmodel_config.h),
+// naming the file and cameras[0].lensmodel.
+TEST(Cli, ARigFilesSplinedModelMrcalCannotBuildIsRefused) {
+  const std::string dir = ::testing::TempDir() + "/cli_rig_spline_" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string spline = "LENSMODEL_SPLINED_STEREOGRAPHIC_";
+  struct Case {
+    std::string config;
+    size_t num_intrinsics;
+    std::string says;
+  };
+  const std::string wrapped = ": order, Nx, Ny and fov_x_deg are whole numbers from 0 to 65535, written plainly";
+  const Case cases[] = {
+      {"order=3_Nx=1_Ny=1_fov_x_deg=100", 6, "Nx=1 Ny=1: an order 3 spline needs Nx and Ny >= 4 (mrcal's minimum)"},
+      {"order=5_Nx=4_Ny=4_fov_x_deg=100", 36, "order=5: mrcal's splines are of order 2 or 3"},
+      {"order=1_Nx=4_Ny=4_fov_x_deg=100", 36, "order=1: mrcal's splines are of order 2 or 3"},
+      {"order=3_Nx=65536_Ny=65536_fov_x_deg=100", 4,
+       "mrcal reads it as '" + spline + "order=3_Nx=0_Ny=0_fov_x_deg=100'" + wrapped},
+      {"order=3_Nx=-4_Ny=-4_fov_x_deg=100", 36,
+       "mrcal reads it as '" + spline + "order=3_Nx=65532_Ny=65532_fov_x_deg=100'" + wrapped},
+      {"order=3_Nx=65535_Ny=65535_fov_x_deg=100", 4,
+       "Nx=65535 Ny=65535: 8589672454 intrinsics, more than mrcal counts (2147483647)"},
+      {"order=3_Nx=4_Ny=4_fov_x_deg=0", 36,
+       "fov_x_deg=0: must be in (0, 360), the horizontal field of view the stereographic projection can span, deg"}};
+  for (const Case& c : cases) {
+    const std::string path = dir + "/rig.yaml";
+    std::ofstream(path) << RigWithCamera0Model(spline + c.config, c.num_intrinsics);
+    const Result r = RunCli("rig --rig " + path);
+    EXPECT_EQ(r.code, 2) << c.config << ": " << r.err;
+    EXPECT_EQ(r.err, "stereorig rig: " + path + ": cameras[0].lensmodel: '" + spline + c.config + "': " + c.says + "\n")
+        << c.config;
+    EXPECT_EQ(r.out, "") << c.config;
+  }
+  // A good splined model is read (its zero spline is a plausible lens).
+  std::ofstream(dir + "/good.yaml") << RigWithCamera0Model(spline + "order=3_Nx=4_Ny=4_fov_x_deg=100", 36);
+  const Result good = RunCli("rig --rig " + dir + "/good.yaml");
+  EXPECT_EQ(good.code, 0) << good.err;
+  std::filesystem::remove_all(dir);
+}
+
+// Two modules of one name were read (a calibrate run with such a layout
+// wrote them so): every report names modules by it. Refused as the layout
+// file refuses it.
+TEST(Cli, ARigFileWithTwoModulesOfOneNameIsRefused) {
+  const std::string path = ::testing::TempDir() + "/rig_dup_module_" + std::to_string(getpid()) + ".yaml";
+  std::ofstream(path) << Replace(GoodRigText(), "name: \"module1\"", "name: \"module0\"");
+  const Result r = RunCli("rig --rig " + path);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(r.err, "stereorig rig: " + path +
+                       ": modules[1].name: module0 is used twice (modules[0] too): each module needs a name of its "
+                       "own\n");
+  EXPECT_EQ(r.out, "");
+  std::filesystem::remove(path);
+}
+
+// --volume and --distance had no upper bound: 1e308 printed "3D error
+// after rigid alignment inf mm", exit 0. At most 100 000 mm (100 m) each.
+TEST(Cli, RigRefusesATruthVolumeBeyondAHundredMetres) {
+  const std::string rig = ::testing::TempDir() + "/rig_volume_bound_" + std::to_string(getpid()) + ".yaml";
+  std::ofstream(rig) << GoodRigText();
+  const std::string range = "must be > 0 mm and at most 100000 mm (100 m, beyond any volume a stereo module measures)";
+  const std::pair<std::string, std::string> refused[] = {
+      {"--volume 1e308 1e308 1e308", "--volume: 1e+308: each size " + range},
+      {"--volume 75 75 100001", "--volume: 100001: each size " + range},
+      {"--distance 1e308", "--distance: 1e+308: " + range},
+      {"--distance 100001", "--distance: 100001: " + range}};
+  for (const auto& [options, says] : refused) {
+    const Result r = RunCli("rig --rig " + rig + " --truth " + rig + " " + options);
+    EXPECT_EQ(r.code, 2) << options;
+    EXPECT_EQ(r.err, "stereorig rig: " + says + "\n") << options;
+    EXPECT_EQ(r.out, "") << options;
+  }
+  // The bound itself is accepted, and its figures are numbers.
+  const Result edge = RunCli("rig --rig " + rig + " --truth " + rig + " --distance 100000 --volume 100000 100000 1");
+  EXPECT_EQ(edge.code, 0) << edge.err;
+  EXPECT_EQ(edge.out.find("inf"), std::string::npos) << edge.out;
+  EXPECT_EQ(edge.out.find("nan"), std::string::npos) << edge.out;
+  std::filesystem::remove(rig);
+}
+
+// `demo --out` into a folder of the user's wrote the demo's dozen files
+// beside theirs, replacing any of the same name; simulate refuses such a
+// folder (apps/demo_out.h). Exit 2, one line naming the file, no step run,
+// the folder as it was.
+TEST(Cli, DemoOutHoldingTheUsersFilesIsRefused) {
+  namespace fs = std::filesystem;
+  const std::string dir = ::testing::TempDir() + "/cli_demo_mine_" + std::to_string(getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir + "/mine.txt") << "the user's\n";
+  std::ofstream(dir + "/rig.yaml") << "the user's rig\n";
+  const Result r = RunCli("demo --out " + dir);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_EQ(r.err, "stereorig demo: " + dir +
+                       ": holds mine.txt, which the demo does not write; refusing to write into it (move it out, or "
+                       "choose another --out)\n");
+  EXPECT_EQ(r.out.find("$ stereorig"), std::string::npos) << "a step ran: " << r.out;
+  std::ifstream rig(dir + "/rig.yaml");
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(rig), {}), "the user's rig\n");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 2);
+  fs::remove_all(dir);
+}
+
 }  // namespace

@@ -12,6 +12,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "apps/demo_out.h"
+#include "calib/core/input_error_testing.h"
 #include "tests/cli_runner.h"
 
 namespace stereorig {
@@ -50,6 +52,10 @@ TEST(DemoE2e, EveryStepBehavesAndThePassiveCupIsTheScorersPassiveRun) {
   // The same pipeline on the same capture with the same options: the same points.
   EXPECT_EQ(passive["points"].get<int>(), cup["passive_points"].get<int>());
   EXPECT_EQ(active["points"].get<int>(), cup["points"].get<int>());
+  // Its folder holds only what it writes: a second demo there may replace
+  // it (apps/demo_out.h; a name the demo writes and DemoWrites misses
+  // would refuse every re-run).
+  EXPECT_EQ(testing::InputErrorMessage([&] { CheckDemoOut(out); }), "");
   std::filesystem::remove_all(out);
 }
 

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "input_error.h"
+#include "lensmodel_config.h"
 #include "mrcal_c.h"
 
 namespace stereorig {
@@ -22,7 +23,7 @@ bool ParseLensmodel(const std::string& name, mrcal_lensmodel_t* out) {
 
 int Camera::NumIntrinsics(const std::string& lensmodel_name) {
   mrcal_lensmodel_t m;
-  if (!ParseLensmodel(lensmodel_name, &m)) return -1;
+  if (!ParseLensmodel(lensmodel_name, &m) || !LensmodelConfigProblem(lensmodel_name).empty()) return -1;
   return mrcal_lensmodel_num_params(&m);
 }
 
@@ -38,6 +39,7 @@ Camera::Camera(const std::string& lensmodel_name, std::vector<double> intrinsics
                                 "' (use an mrcal name such as LENSMODEL_OPENCV8, with its "
                                 "configuration for splined models)");
   }
+  if (const std::string p = LensmodelConfigProblem(lensmodel_name_); !p.empty()) throw InputError(where, p);
   const int n = mrcal_lensmodel_num_params(&impl_->lensmodel);
   if (static_cast<int>(intrinsics_.size()) != n) {
     throw InputError(where, lensmodel_name_ + " takes " + std::to_string(n) + " intrinsics, got " +

@@ -2,11 +2,13 @@
 
 #include <cstdio>
 #include <ctime>
+#include <map>
 #include <sstream>
 
 #include "atomic_file.h"
 #include "input_error.h"
 #include "lens_plausibility.h"
+#include "lensmodel_config.h"
 #include "number_text.h"
 #include "typed_pose.h"
 #include "yaml_reader.h"
@@ -131,6 +133,8 @@ Rig ParseRig(YamlMap root) {
   for (YamlMap c : root.GetMaps("cameras")) {
     names.push_back(c.GetString("name"));
     const std::string model = c.GetString("lensmodel");
+    // The Camera refuses it too; here the message names the key.
+    if (const std::string p = LensmodelConfigProblem(model); !p.empty()) throw InputError(c.Where("lensmodel"), p);
     std::vector<double> intrinsics = c.GetDoubles("intrinsics");
     const std::vector<int> size = c.GetInts("imagersize", 2);
     cameras.emplace_back(model, std::move(intrinsics), size[0], size[1], c.Where());
@@ -139,9 +143,15 @@ Rig ParseRig(YamlMap root) {
   }
 
   std::vector<StereoModule> modules;
+  std::map<std::string, int> module_named;  // module name -> its index
   for (YamlMap m : root.GetMaps("modules")) {
     StereoModule mod;
     mod.name = m.GetString("name");
+    // As a layout file's (calib/layout_file.h): the name tells modules
+    // apart in every report.
+    if (const auto [it, added] = module_named.emplace(mod.name, static_cast<int>(modules.size())); !added)
+      throw InputError(m.Where("name"), mod.name + " is used twice (modules[" + std::to_string(it->second) +
+                                            "] too): each module needs a name of its own");
     mod.left_camera = m.GetInt("left");
     mod.right_camera = m.GetInt("right");
     mod.right_from_left = ReadRigidPose(m.GetNode("right_from_left"), m.Where("right_from_left"));
