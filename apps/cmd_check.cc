@@ -19,6 +19,7 @@
 #include "calib/core/input_file.h"
 #include "calib/core/number_text.h"
 #include "calib/core/rig_file.h"
+#include "calib/json_text.h"
 #include "targets/target_file.h"
 
 #include <zlib.h>
@@ -289,7 +290,7 @@ int RunCheck(int argc, char** argv) {
   // no report, and a report that cannot be written (a full disk) leaves the
   // history without the night.
   AtomicOutputSet staged_report;
-  if (!report_path.empty()) staged_report.Add(report_path, report.dump(2) + "\n");
+  if (!report_path.empty()) staged_report.Add(report_path, JsonReportText(report) + "\n");
   // Paths as resolved when the files were read (HistoryPathOf), rig_file
   // and rig_path alike.
   HistoryRun run{0, report["date_utc"], rig_kept_as, captures_kept_as, "", ""};

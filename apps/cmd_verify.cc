@@ -15,6 +15,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
+#include "calib/json_text.h"
 #include "reconstruct/metrology/artifact.h"
 #include "reconstruct/metrology/ply_points.h"
 #include "reconstruct/metrology/vdi2634.h"
@@ -440,7 +441,8 @@ int RunVerify(int argc, char** argv) {
   // The table is the verdict: one that could not be written (a full disk,
   // /dev/full) is an error, not exit 0, and leaves no report behind.
   RequireStdoutWritten();
-  if (!report_path.empty() && (all_judged || judged_failure)) WriteFileAtomically(report_path, report.dump(2) + "\n");
+  if (!report_path.empty() && (all_judged || judged_failure))
+    WriteFileAtomically(report_path, JsonReportText(report) + "\n");
   if (!all_judged && !judged_failure) {
     // One line on stderr, as for bad input: the first position's reason.
     const int first = summary.not_judged_positions.front();

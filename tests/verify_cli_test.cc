@@ -1104,3 +1104,35 @@ TEST(VerifyCli, AnArtifactWithoutANameIsNamedByItsFile) {
   std::ifstream f(report);
   EXPECT_EQ(nlohmann::json::parse(f)["artifact"].get<std::string>(), stem);
 }
+
+// A path or name that is not UTF-8 (a Linux folder may hold a Latin-1 'é',
+// the one byte E9) goes into the report with that byte written as \xE9
+// (calib/json_text.h), the report valid JSON: the report's writer threw
+// (nlohmann-json's type_error 316) after the verdict was printed, an abort
+// (exit 134) with no report. The artifact's name (\xFF) and the default one
+// from the file's stem (\xE8) alike.
+TEST(VerifyCli, ALatin1PathOrNameGoesIntoTheReportEscaped) {
+  const std::string dir = ::testing::TempDir() + "/latin1_d\xE9_" + std::to_string(getpid());
+  std::filesystem::create_directories(dir);
+  const std::string cloud = dir + "/s.ply";
+  std::filesystem::copy_file(WriteSphere("good_latin1.ply", 19.05), cloud,
+                             std::filesystem::copy_options::overwrite_existing);
+  const std::string named = WriteArtifact(std::regex_replace(kSphere, std::regex("test sphere"),
+                                                             "sph\xFF"
+                                                             "re"));
+  const std::string unnamed = dir + "/art_\xE8.yaml";
+  std::ofstream(unnamed) << "format: stereorig-artifact\nversion: 1\nunits: mm\ntype: sphere\ndiameter_mm: 38.1\n";
+  const std::string escaped_dir = ::testing::TempDir() + "/latin1_d\\xE9_" + std::to_string(getpid());
+  for (const auto& [artifact, name] :
+       {std::pair{named, std::string("sph\\xFFre")}, std::pair{unnamed, std::string("art_\\xE8")}}) {
+    const std::string report = dir + "/r.json";
+    std::filesystem::remove(report);
+    const auto r = RunCli("verify --artifact '" + artifact + "' --cloud '" + cloud + "' --report '" + report + "'");
+    ASSERT_EQ(r.code, 0) << r.out << r.err;
+    std::ifstream f(report);
+    ASSERT_TRUE(f) << "no report";
+    const nlohmann::json j = nlohmann::json::parse(f);  // throws on text that is not UTF-8
+    EXPECT_EQ(j["artifact"].get<std::string>(), name);
+    EXPECT_EQ(j["positions"][0]["cloud"].get<std::string>(), escaped_dir + "/s.ply");
+  }
+}
