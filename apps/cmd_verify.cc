@@ -208,6 +208,12 @@ int RunVerify(int argc, char** argv) {
   // Named by the option, not as VerifyOptions::Check's min_points.
   if (options.min_points < 10)
     throw InputError("--min-points", "must be >= 10, got " + std::to_string(options.min_points));
+  // A band wider than the largest sphere an artifact may hold takes in the
+  // scene around it: 1e308 was taken where inf is refused, and 5000 (um for
+  // 5 mm) took in a 5 m box.
+  const std::string band_problem = ImplausibleMm(
+      options.capture_band_mm, PlausibleMm{0.001, kSphereDiameter.max_mm, "capture band"}, "the option is in mm");
+  if (!band_problem.empty()) throw InputError("--capture-band-mm", band_problem);
   OutputPaths outputs;  // the report's path checked before the clouds are read and judged
   outputs.Protect(artifact_path, "the artifact file (--artifact)");
   for (const std::string& cloud : clouds) outputs.Protect(cloud, "a cloud (--cloud)");

@@ -1136,3 +1136,42 @@ TEST(VerifyCli, ALatin1PathOrNameGoesIntoTheReportEscaped) {
     EXPECT_EQ(j["positions"][0]["cloud"].get<std::string>(), escaped_dir + "/s.ply");
   }
 }
+
+// An MPE and --capture-band-mm have plausible ranges, as certified sizes
+// do (0.001 to 100 mm; at most 1000 mm), refused naming the key or flag
+// and the unit the value looks like: an MPE of 1e308 passed every figure
+// with the band "raised to inf mm", and a band of 1e308 was taken where
+// inf is refused.
+TEST(VerifyCli, ImplausibleMpeAndCaptureBandAreRefusedWithTheUnit) {
+  const std::string good = WriteSphere("good_mpe_range.ply", 19.05);
+  const auto huge = RunCli("verify --artifact " + WriteArtifact(std::string(kSphere) + "mpe_mm: {P_F: 1e308}\n") +
+                           " --cloud " + good);
+  EXPECT_EQ(huge.code, 2) << huge.out << huge.err;
+  EXPECT_NE(huge.err.find("mpe_mm.P_F: 1e+308 mm is not a plausible maximum permissible error (0.001 to 100 mm)\n"),
+            std::string::npos)
+      << huge.err;
+  const auto micrometres =
+      RunCli("verify --artifact " + WriteArtifact(std::string(kSphere) + "mpe_mm: {P_F: 1.5, P_S: 1500}\n") +
+             " --cloud " + good);
+  EXPECT_EQ(micrometres.code, 2) << micrometres.out << micrometres.err;
+  EXPECT_NE(micrometres.err.find("mpe_mm.P_S: 1500 mm is not a plausible maximum permissible error (0.001 to 100 "
+                                 "mm): in micrometres it would be 1.5 mm (the file's units are mm)"),
+            std::string::npos)
+      << micrometres.err;
+  for (const auto& [band, expected] :
+       {std::pair<std::string, std::string>{"1e308",
+                                            "--capture-band-mm: 1e+308 mm is not a plausible capture band "
+                                            "(0.001 to 1000 mm)\n"},
+        {"5000",
+         "--capture-band-mm: 5000 mm is not a plausible capture band (0.001 to 1000 mm): in micrometres it "
+         "would be 5 mm (the option is in mm)\n"}}) {
+    const auto r =
+        RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + good + " --capture-band-mm " + band);
+    EXPECT_EQ(r.code, 2) << band << ": " << r.out << r.err;
+    EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+  }
+  // Within the ranges: taken (the cloud is the certified sphere, exact).
+  const auto fine = RunCli("verify --artifact " + WriteArtifact(std::string(kSphere) + "mpe_mm: {P_F: 0.001}\n") +
+                           " --cloud " + good + " --capture-band-mm 1000");
+  EXPECT_EQ(fine.code, 0) << fine.out << fine.err;
+}
