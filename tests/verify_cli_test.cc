@@ -1175,3 +1175,38 @@ TEST(VerifyCli, ImplausibleMpeAndCaptureBandAreRefusedWithTheUnit) {
                            " --cloud " + good + " --capture-band-mm 1000");
   EXPECT_EQ(fine.code, 0) << fine.out << fine.err;
 }
+
+// What verify says of a cloud or mesh it cannot use: a mesh cut short in its
+// faces, or with a face index out of range, is refused (exit 2) naming the
+// file and the face (it passed, exit 0: the faces were never read); a NaN
+// coordinate is named as not a number (it read "truncated or malformed PLY
+// body at vertex 0"); a float `module` by its type ("vertex 23 is not
+// finite"); a cloud of one point repeated as such ("spans only 0 mm across,
+// infx less than the artifact's 38.1 mm").
+TEST(VerifyCli, NamesWhatIsWrongWithABrokenMeshOrCloud) {
+  const std::string sphere = WriteSphere("good_broken.ply", 19.05);
+  std::ifstream in(sphere);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  const size_t body = text.find("end_header\n") + 11;
+  const std::string header = text.substr(0, body), vertices = text.substr(body);
+  const std::string mesh_header = std::regex_replace(
+      header, std::regex("end_header\n"), "element face 2\nproperty list uchar int vertex_indices\nend_header\n");
+  const std::string path = ::testing::TempDir() + "/broken_" + std::to_string(getpid()) + ".ply";
+  const std::string n = std::to_string(Lines(vertices));
+  for (const auto& [content, expected] : std::vector<std::pair<std::string, std::string>>{
+           {mesh_header + vertices + "3 0 1 2\n", "truncated PLY body at face 1 of the 2 its header declares"},
+           {mesh_header + vertices + "3 0 1 2\n3 0 1 99999999\n",
+            "face 1 names vertex 99999999, not one of its " + n + " vertices"},
+           {header + "nan nan nan\n" + vertices.substr(vertices.find('\n') + 1), "vertex 0's x is not a number"},
+           {std::regex_replace(header, std::regex("end_header\n"), "property float module\nend_header\n") +
+                std::regex_replace(vertices, std::regex("\n"), " 0\n"),
+            "its vertex property 'module' is float; stereorig's module is uchar"},
+           {std::regex_replace(vertices, std::regex("[^\n]+"), "1 2 3"),
+            "every point of the cloud is at the same place: it holds no shape to find"}}) {
+    std::ofstream(path) << (content.rfind("ply", 0) == 0 ? content : header + content);
+    const auto r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + path);
+    EXPECT_EQ(r.code, 2) << expected << ": " << r.out << r.err;
+    EXPECT_NE(r.err.find(path + ": "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+  }
+}
