@@ -1,11 +1,11 @@
 // The text of a JSON report, the same for every command (calibrate, check,
-// verify, score, reconstruct, bench): indented by 2.
-// Its strings are the document's, except that bytes which are not UTF-8 (a
-// Linux path may hold a Latin-1 'é', the one byte E9) are written as the
-// four characters \xNN (docs/formats.md, "JSON reports"): JSON text must be
-// UTF-8, and nlohmann-json's dump throws on them (which ended a run in
-// std::terminate after its verdict was printed, with no report); replacing
-// them with U+FFFD would lose which file the report names.
+// verify, score, reconstruct, bench): indented by 2, its strings the
+// document's, except that bytes which are not UTF-8 (a Linux path may hold a
+// Latin-1 'é', the one byte E9) are written as the four characters \xNN
+// (docs/formats.md, "Reports"): JSON text must be UTF-8, and nlohmann-json's
+// dump throws on them (which ended a run in std::terminate after its verdict
+// was printed, with no report); replacing them with U+FFFD would lose which
+// file the report names.
 #pragma once
 
 #include <nlohmann/json.hpp>

@@ -60,8 +60,11 @@ struct Artifact {
 Artifact ReadArtifactFile(const std::string& path);
 
 // The plausible range of a length, mm, and what it is of ("sphere
-// diameter"). Outside it a value is a typo or another unit: 38100 (um for
-// 38.1 mm) read as a 38 m sphere, and an MPE of 1e308 passed every figure.
+// diameter"): a sphere a rig like this measures (VDI/VDE 2634-2 sizes it at
+// 0.1-0.2 of the volume's diagonal), a ball bar's length or a plate's side.
+// Outside it a value is a typo or another unit: 38100 (um for 38.1 mm) read
+// as a 38 m sphere, 1e300 was judged against a 61.6 mm cloud, whose refusal
+// then blamed the cloud, and an MPE of 1e308 passed every figure.
 struct PlausibleMm {
   double min_mm, max_mm;
   const char* what;
