@@ -11,6 +11,7 @@
 
 #include "apps/command.h"
 #include "calib/core/input_error.h"
+#include "calib/core/utf8_sequence.h"
 
 namespace stereorig {
 
@@ -36,31 +37,18 @@ std::string PrintableText(const std::string& message) {
       out += message[i++];
       continue;
     }
-    // A UTF-8 sequence as RFC 3629 defines it: the lead byte says how many
-    // continuation bytes (10xxxxxx) follow and bounds the first of them, so
-    // that overlong forms (E0 80..9F, F0 80..8F), surrogates (ED A0..BF)
-    // and code points past U+10FFFF (F4 90..) are escaped as the bytes they
+    // Bytes that are not well-formed UTF-8 are escaped as the bytes they
     // are. C1 controls (U+0080..U+009F: C2 80..9F) act on some terminals
     // (U+009B is CSI): escaped too.
-    const size_t n = c >= 0xC2 && c <= 0xDF ? 1 : c >= 0xE0 && c <= 0xEF ? 2 : c >= 0xF0 && c <= 0xF4 ? 3 : 0;
-    const unsigned char first_min = c == 0xC2 ? 0xA0 : c == 0xE0 ? 0xA0 : c == 0xF0 ? 0x90 : 0x80;
-    const unsigned char first_max = c == 0xED ? 0x9F : c == 0xF4 ? 0x8F : 0xBF;
-    bool valid = n > 0;
-    for (size_t k = 1; valid && k <= n; ++k) {
-      if (i + k >= message.size()) {
-        valid = false;
-        break;
-      }
-      const auto b = static_cast<unsigned char>(message[i + k]);
-      valid = k == 1 ? b >= first_min && b <= first_max : (b & 0xC0) == 0x80;
-    }
-    if (!valid) {
+    const size_t n = Utf8SequenceLength(message, i);
+    const bool c1_control = c == 0xC2 && static_cast<unsigned char>(message[i + 1]) < 0xA0;
+    if (n == 0 || c1_control) {
       escape(c);
       ++i;
       continue;
     }
-    out.append(message, i, n + 1);
-    i += n + 1;
+    out.append(message, i, n);
+    i += n;
   }
   return out;
 }

@@ -24,6 +24,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
+#include "calib/json_text.h"
 #include "datasets/default_rig.h"
 #include "reconstruct/elapsed_ms.h"
 #include "reconstruct/metrology/ply_points.h"
@@ -358,7 +359,7 @@ int RunBench(int argc, char** argv) {
       "surfaces and maps and three runtimes: %.0f MB before the baselines' runtimes were built), incl. scoring "
       "%.0f MB\n",
       runtime_peak_mb, bench_peak_mb, loaded_mb, PeakMemoryMb());
-  if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
+  if (!report_path.empty()) WriteFileAtomically(report_path, JsonReportText(report) + "\n");
   if (rig_path.empty()) WarnOfTruthRig("bench", dataset.empty() ? "the simulator's default rig" : rig_read);
   return kExitOk;
 }

@@ -20,6 +20,7 @@
 #include "calib/core/input_file.h"
 #include "calib/core/number_text.h"
 #include "calib/core/rig_file.h"
+#include "calib/json_text.h"
 #include "targets/target_file.h"
 
 #include <zlib.h>
@@ -130,7 +131,7 @@ int PrintHistoryJson(const std::string& db) {
                                                : views.count(r.id) ? views[r.id]
                                                                    : nlohmann::json::array()}});
   }
-  std::printf("%s\n", out.dump(2).c_str());
+  std::printf("%s\n", JsonReportText(out).c_str());
   return kExitOk;
 }
 
@@ -392,7 +393,7 @@ int RunCheck(int argc, char** argv) {
     report["history"] = history;
     try {
       staged_report = AtomicOutputSet();  // what a failed commit staged before, removed
-      staged_report.Add(report_path, report.dump(2) + "\n");
+      staged_report.Add(report_path, JsonReportText(report) + "\n");
     } catch (...) {
       report_failed = true;
       throw;

@@ -121,7 +121,16 @@ int RunMatch(int argc, char** argv) {
   outputs.Protect(right_path, "the right image (--right)");
   outputs.Claim(out_path, "the disparity map (--out)");
   CheckPfmPath(out_path);  // after the claim: "is the left image" says more than "not .pfm" would
-  const cv::Mat left = ReadGreyImage(left_path), right = ReadGreyImage(right_path);
+  // A cap on the pixels matched, read from the headers before any pixel is
+  // decoded: a 249 KB PNG pair declaring 16000 x 16000 px took 5.8 GB and
+  // 24 s and wrote a 1 GB PFM (the runtime holds ~23 bytes a pixel), where
+  // reconstruct, check and calibrate refuse it by the rig's image size. 50
+  // Mpx is twice the largest machine-vision stereo cameras' (~25 Mpx) and
+  // bounds match at ~1.2 GB.
+  constexpr long long kMaxMatchPixels = 50000000;
+  const std::string why_max = "match reads (twice the largest stereo camera's; crop the pair to the region to match)";
+  const cv::Mat left = ReadGreyImage(left_path, std::nullopt, kMaxMatchPixels, why_max);
+  const cv::Mat right = ReadGreyImage(right_path, std::nullopt, kMaxMatchPixels, why_max);
   if (left.size() != right.size()) throw InputError(right_path, "size differs from the left image");
   // A region partly or wholly outside the image, or empty, is a mistake to
   // name, not one to clip or widen to the whole image without a word.

@@ -17,6 +17,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
+#include "calib/json_text.h"
 #include "reconstruct/ply_io.h"
 #include "reconstruct/runtime.h"
 
@@ -190,7 +191,7 @@ int RunReconstruct(int argc, char** argv) {
   AtomicOutputSet written;
   written.Add(out_path, EncodeCloudPly(rec.cloud));
   if (!mesh_path.empty()) written.Add(mesh_path, EncodeMesh(rec.cloud, rec.mesh, mesh_path));
-  if (!report_path.empty()) written.Add(report_path, ReconstructionJson(rec).dump(2) + "\n");
+  if (!report_path.empty()) written.Add(report_path, JsonReportText(ReconstructionJson(rec)) + "\n");
   if (!rectified_paths.empty()) {
     rectified_folder.Create();
     AddRectifiedPairs(runtime, images, rectified_paths, &written);

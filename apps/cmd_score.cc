@@ -21,6 +21,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
+#include "calib/json_text.h"
 #include "reconstruct/fill_diagnosis.h"
 #include "reconstruct/runtime.h"
 #include "reconstruct/scene_score.h"
@@ -221,7 +222,7 @@ int RunScore(int argc, char** argv) {
     report["scenes"].push_back(sj);
     FlushStdout();  // each scene's lines as it is done (~3 s a scene), also into a pipe or a log file
   }
-  if (!report_path.empty()) WriteFileAtomically(report_path, report.dump(2) + "\n");
+  if (!report_path.empty()) WriteFileAtomically(report_path, JsonReportText(report) + "\n");
   if (!rig_given) WarnOfTruthRig("score", rig_path);
   return kExitOk;
 }

@@ -15,6 +15,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "calib/core/rig_file.h"
+#include "calib/json_text.h"
 #include "reconstruct/metrology/artifact.h"
 #include "reconstruct/metrology/ply_points.h"
 #include "reconstruct/metrology/vdi2634.h"
@@ -207,6 +208,12 @@ int RunVerify(int argc, char** argv) {
   // Named by the option, not as VerifyOptions::Check's min_points.
   if (options.min_points < 10)
     throw InputError("--min-points", "must be >= 10, got " + std::to_string(options.min_points));
+  // A band wider than the largest sphere an artifact may hold takes in the
+  // scene around it: 1e308 was taken where inf is refused, and 5000 (um for
+  // 5 mm) took in a 5 m box.
+  const std::string band_problem = ImplausibleMm(
+      options.capture_band_mm, PlausibleMm{0.001, kSphereDiameter.max_mm, "capture band"}, "the option is in mm");
+  if (!band_problem.empty()) throw InputError("--capture-band-mm", band_problem);
   OutputPaths outputs;  // the report's path checked before the clouds are read and judged
   outputs.Protect(artifact_path, "the artifact file (--artifact)");
   for (const std::string& cloud : clouds) outputs.Protect(cloud, "a cloud (--cloud)");
@@ -440,7 +447,8 @@ int RunVerify(int argc, char** argv) {
   // The table is the verdict: one that could not be written (a full disk,
   // /dev/full) is an error, not exit 0, and leaves no report behind.
   RequireStdoutWritten();
-  if (!report_path.empty() && (all_judged || judged_failure)) WriteFileAtomically(report_path, report.dump(2) + "\n");
+  if (!report_path.empty() && (all_judged || judged_failure))
+    WriteFileAtomically(report_path, JsonReportText(report) + "\n");
   if (!all_judged && !judged_failure) {
     // One line on stderr, as for bad input: the first position's reason.
     const int first = summary.not_judged_positions.front();

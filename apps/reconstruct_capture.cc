@@ -10,6 +10,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/folder_to_create.h"
 #include "calib/core/input_error.h"
+#include "calib/json_text.h"
 #include "reconstruct/elapsed_ms.h"
 #include "reconstruct/ply_io.h"
 
@@ -74,7 +75,7 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
   AtomicOutputSet written;
   written.Add(outputs.cloud, EncodeCloudPly(rec.cloud));
   if (mesh) written.Add(outputs.mesh, EncodeMesh(rec.cloud, rec.mesh, outputs.mesh));
-  written.Add(outputs.report, ReconstructionJson(rec).dump(2) + "\n");
+  written.Add(outputs.report, JsonReportText(ReconstructionJson(rec)) + "\n");
   written.Commit();
   nlohmann::json entry;
   entry["capture"] = dir;
@@ -164,7 +165,7 @@ int FinishRun(nlohmann::json* summary, int total, int failed, int without_points
   // so, as for a capture's line, and main exits 2 (cli_util.h).
   const std::string lost = StdoutWriteError();
   if (!lost.empty() && !summary->contains("output_error")) (*summary)["output_error"] = lost;
-  if (!summary_path.empty()) WriteFileAtomically(summary_path, summary->dump(2) + "\n");
+  if (!summary_path.empty()) WriteFileAtomically(summary_path, JsonReportText(*summary) + "\n");
   if (failed == 0) return kExitOk;
   std::fprintf(stderr,
                "stereorig reconstruct: %d of %d captures failed (bad input, or outputs that could not be "

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "calib/core/input_error.h"
+#include "calib/json_text.h"
 
 namespace stereorig {
 
@@ -73,7 +74,7 @@ JsonWriter& JsonWriter::Numbers(const std::string& key, const std::vector<double
 
 const std::string& JsonWriter::str() const {
   STEREORIG_CHECK(open_.empty());
-  text_ = root_.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
+  text_ = JsonReportText(root_);
   return text_;
 }
 

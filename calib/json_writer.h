@@ -26,7 +26,7 @@ class JsonWriter {
   JsonWriter& String(const std::string& key, const std::string& v);
   JsonWriter& Bool(const std::string& key, bool v);
   JsonWriter& Numbers(const std::string& key, const std::vector<double>& v);
-  // The document, indented by 2 (invalid UTF-8 in strings is replaced).
+  // The document as calib/json_text.h writes every report.
   const std::string& str() const;
   const nlohmann::ordered_json& document() const { return root_; }
 

@@ -5,7 +5,8 @@
 
 namespace stereorig {
 
-cv::Mat ReadGreyImage(const std::string& path, std::optional<cv::Size> rig_size_px) {
+cv::Mat ReadGreyImage(const std::string& path, std::optional<cv::Size> rig_size_px, long long max_pixels,
+                      const std::string& why_max) {
   return ReadImageFile(path, [&](const ImageHeader& header) {
     // Says what the image is (a 16-bit grey, an RGB, a palette one), in
     // calibrate's and check's words (calib/capture_folder.cc), so that the
@@ -26,6 +27,11 @@ cv::Mat ReadGreyImage(const std::string& path, std::optional<cv::Size> rig_size_
       throw InputError(path, "is " + std::to_string(header.width_px) + "x" + std::to_string(header.height_px) +
                                  ", the rig says " + std::to_string(rig_size_px->width) + "x" +
                                  std::to_string(rig_size_px->height));
+    const long long pixels = static_cast<long long>(header.width_px) * header.height_px;
+    if (max_pixels > 0 && pixels > max_pixels)
+      throw InputError(path, "is " + std::to_string(header.width_px) + "x" + std::to_string(header.height_px) + " (" +
+                                 std::to_string(pixels / 1000000) + " Mpx), over the " +
+                                 std::to_string(max_pixels / 1000000) + " Mpx " + why_max);
   });
 }
 

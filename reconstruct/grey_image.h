@@ -19,6 +19,9 @@ namespace stereorig {
 // of another size ("is 16000x16000, the rig says 752x582"). All three are read from a PNG's header, before its pixels
 // are allocated or decoded: a capture's decoded pixels cost at most its camera's size in memory, whatever its header
 // declares (the file itself is read whole first: its bytes, not more).
-cv::Mat ReadGreyImage(const std::string& path, std::optional<cv::Size> rig_size_px = std::nullopt);
+// Given `max_pixels` (> 0), one of more pixels is refused from its header
+// too, naming its size and `why_max` (what the cap is for).
+cv::Mat ReadGreyImage(const std::string& path, std::optional<cv::Size> rig_size_px = std::nullopt,
+                      long long max_pixels = 0, const std::string& why_max = "");
 
 }  // namespace stereorig

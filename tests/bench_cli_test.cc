@@ -310,5 +310,26 @@ TEST(BenchCli, ScenesWithoutADatasetIsRefused) {
   EXPECT_EQ(r.out.find("objects/s"), std::string::npos) << r.out;
 }
 
+// A dataset path that is not UTF-8 (a Latin-1 'é', the one byte E9) goes
+// into score's report with that byte written as \xE9 (calib/json_text.h),
+// the report valid JSON: the report's writer threw (nlohmann-json's
+// type_error 316) after the figures were printed, an abort (exit 134) with
+// no report.
+TEST(BenchCli, ScoreWritesALatin1DatasetPathIntoItsReportEscaped) {
+  const std::string simulated = testing::SimulateOneScene("sphere", 1, "score_latin1");
+  const std::string dataset = simulated + "_ds\xE9";
+  std::filesystem::remove_all(dataset);
+  std::filesystem::rename(simulated, dataset);
+  const std::string report = dataset + "/score.json";
+  const testing::Result r =
+      RunCli("score --dataset '" + dataset + "' --scenes sphere --no-passive --report '" + report + "'");
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  std::ifstream f(report);
+  ASSERT_TRUE(f.good()) << "no report";
+  const nlohmann::json j = nlohmann::json::parse(f);  // throws on text that is not UTF-8
+  EXPECT_EQ(j["dataset"].get<std::string>(), simulated + "_ds\\xE9");
+  std::filesystem::remove_all(dataset);
+}
+
 }  // namespace
 }  // namespace stereorig

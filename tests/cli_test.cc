@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
+#include "calib/core/png_testing.h"
 #include "calib/core/rig_file.h"
 #include "datasets/default_rig.h"
 #include "tests/cli_runner.h"
@@ -842,6 +843,34 @@ TEST(Cli, DemoOutHoldingTheUsersFilesIsRefused) {
   EXPECT_EQ(std::string(std::istreambuf_iterator<char>(rig), {}), "the user's rig\n");
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 2);
   fs::remove_all(dir);
+}
+
+// match caps the pixels of its images at 50 Mpx, read from the header
+// before any pixel is decoded: a 249 KB PNG pair declaring 16000 x 16000 px
+// took 5.8 GB and 24 s and wrote a 1 GB PFM. Here a 70-byte PNG declaring
+// 8000 x 8000 px (64 Mpx; under png_reader.h's own 268 Mpx) whose image data
+// holds one row: refused by its size, not read as the damaged file it also
+// is (what a decode would have found first), and no PFM written.
+TEST(Cli, MatchRefusesImagesOverItsPixelCapFromTheirHeader) {
+  namespace fs = std::filesystem;
+  const std::string dir = ::testing::TempDir() + "/match_cap_" + std::to_string(getpid());
+  fs::create_directories(dir);
+  const std::string big = dir + "/big.png";
+  std::ofstream(big, std::ios::binary) << stereorig::testing::kPngSignature +
+                                              stereorig::testing::Chunk("IHDR", stereorig::testing::Ihdr(8000, 8000)) +
+                                              stereorig::testing::Chunk(
+                                                  "IDAT", stereorig::testing::Deflate(std::string(1 + 8000, '\0'), 9)) +
+                                              stereorig::testing::Chunk("IEND", "");
+  cv::imwrite(dir + "/small.png", cv::Mat(64, 96, CV_8UC1, cv::Scalar(0)));
+  for (const auto& [left, right] : {std::pair{big, big}, std::pair{dir + "/small.png", big}}) {
+    const Result r = RunCli("match --left " + left + " --right " + right +
+                            " --min-disparity 0 --num-disparities 64 --roi 0 0 32 32 --out " + dir + "/d.pfm");
+    EXPECT_EQ(r.code, 2) << r.out << r.err;
+    EXPECT_EQ(r.err, "stereorig match: " + big +
+                         ": is 8000x8000 (64 Mpx), over the 50 Mpx match reads (twice the largest stereo camera's; "
+                         "crop the pair to the region to match)\n");
+    EXPECT_FALSE(fs::exists(dir + "/d.pfm"));
+  }
 }
 
 }  // namespace

@@ -1104,3 +1104,109 @@ TEST(VerifyCli, AnArtifactWithoutANameIsNamedByItsFile) {
   std::ifstream f(report);
   EXPECT_EQ(nlohmann::json::parse(f)["artifact"].get<std::string>(), stem);
 }
+
+// A path or name that is not UTF-8 (a Linux folder may hold a Latin-1 'é',
+// the one byte E9) goes into the report with that byte written as \xE9
+// (calib/json_text.h), the report valid JSON: the report's writer threw
+// (nlohmann-json's type_error 316) after the verdict was printed, an abort
+// (exit 134) with no report. The artifact's name (\xFF) and the default one
+// from the file's stem (\xE8) alike.
+TEST(VerifyCli, ALatin1PathOrNameGoesIntoTheReportEscaped) {
+  const std::string dir = ::testing::TempDir() + "/latin1_d\xE9_" + std::to_string(getpid());
+  std::filesystem::create_directories(dir);
+  const std::string cloud = dir + "/s.ply";
+  std::filesystem::copy_file(WriteSphere("good_latin1.ply", 19.05), cloud,
+                             std::filesystem::copy_options::overwrite_existing);
+  const std::string named = WriteArtifact(std::regex_replace(kSphere, std::regex("test sphere"),
+                                                             "sph\xFF"
+                                                             "re"));
+  const std::string unnamed = dir + "/art_\xE8.yaml";
+  std::ofstream(unnamed) << "format: stereorig-artifact\nversion: 1\nunits: mm\ntype: sphere\ndiameter_mm: 38.1\n";
+  const std::string escaped_dir = ::testing::TempDir() + "/latin1_d\\xE9_" + std::to_string(getpid());
+  for (const auto& [artifact, name] :
+       {std::pair{named, std::string("sph\\xFFre")}, std::pair{unnamed, std::string("art_\\xE8")}}) {
+    const std::string report = dir + "/r.json";
+    std::filesystem::remove(report);
+    const auto r = RunCli("verify --artifact '" + artifact + "' --cloud '" + cloud + "' --report '" + report + "'");
+    ASSERT_EQ(r.code, 0) << r.out << r.err;
+    std::ifstream f(report);
+    ASSERT_TRUE(f) << "no report";
+    const nlohmann::json j = nlohmann::json::parse(f);  // throws on text that is not UTF-8
+    EXPECT_EQ(j["artifact"].get<std::string>(), name);
+    EXPECT_EQ(j["positions"][0]["cloud"].get<std::string>(), escaped_dir + "/s.ply");
+  }
+}
+
+// An MPE and --capture-band-mm have plausible ranges, as certified sizes
+// do (0.001 to 100 mm; at most 1000 mm), refused naming the key or flag
+// and the unit the value looks like: an MPE of 1e308 passed every figure
+// with the band "raised to inf mm", and a band of 1e308 was taken where
+// inf is refused.
+TEST(VerifyCli, ImplausibleMpeAndCaptureBandAreRefusedWithTheUnit) {
+  const std::string good = WriteSphere("good_mpe_range.ply", 19.05);
+  const auto huge = RunCli("verify --artifact " + WriteArtifact(std::string(kSphere) + "mpe_mm: {P_F: 1e308}\n") +
+                           " --cloud " + good);
+  EXPECT_EQ(huge.code, 2) << huge.out << huge.err;
+  EXPECT_NE(huge.err.find("mpe_mm.P_F: 1e+308 mm is not a plausible maximum permissible error (0.001 to 100 mm)\n"),
+            std::string::npos)
+      << huge.err;
+  const auto micrometres =
+      RunCli("verify --artifact " + WriteArtifact(std::string(kSphere) + "mpe_mm: {P_F: 1.5, P_S: 1500}\n") +
+             " --cloud " + good);
+  EXPECT_EQ(micrometres.code, 2) << micrometres.out << micrometres.err;
+  EXPECT_NE(micrometres.err.find("mpe_mm.P_S: 1500 mm is not a plausible maximum permissible error (0.001 to 100 "
+                                 "mm): in micrometres it would be 1.5 mm (the file's units are mm)"),
+            std::string::npos)
+      << micrometres.err;
+  for (const auto& [band, expected] :
+       {std::pair<std::string, std::string>{"1e308",
+                                            "--capture-band-mm: 1e+308 mm is not a plausible capture band "
+                                            "(0.001 to 1000 mm)\n"},
+        {"5000",
+         "--capture-band-mm: 5000 mm is not a plausible capture band (0.001 to 1000 mm): in micrometres it "
+         "would be 5 mm (the option is in mm)\n"}}) {
+    const auto r =
+        RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + good + " --capture-band-mm " + band);
+    EXPECT_EQ(r.code, 2) << band << ": " << r.out << r.err;
+    EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+  }
+  // Within the ranges: taken (the cloud is the certified sphere, exact).
+  const auto fine = RunCli("verify --artifact " + WriteArtifact(std::string(kSphere) + "mpe_mm: {P_F: 0.001}\n") +
+                           " --cloud " + good + " --capture-band-mm 1000");
+  EXPECT_EQ(fine.code, 0) << fine.out << fine.err;
+}
+
+// What verify says of a cloud or mesh it cannot use: a mesh cut short in its
+// faces, or with a face index out of range, is refused (exit 2) naming the
+// file and the face (it passed, exit 0: the faces were never read); a NaN
+// coordinate is named as not a number (it read "truncated or malformed PLY
+// body at vertex 0"); a float `module` by its type ("vertex 23 is not
+// finite"); a cloud of one point repeated as such ("spans only 0 mm across,
+// infx less than the artifact's 38.1 mm").
+TEST(VerifyCli, NamesWhatIsWrongWithABrokenMeshOrCloud) {
+  const std::string sphere = WriteSphere("good_broken.ply", 19.05);
+  std::ifstream in(sphere);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  const size_t body = text.find("end_header\n") + 11;
+  const std::string header = text.substr(0, body), vertices = text.substr(body);
+  const std::string mesh_header = std::regex_replace(
+      header, std::regex("end_header\n"), "element face 2\nproperty list uchar int vertex_indices\nend_header\n");
+  const std::string path = ::testing::TempDir() + "/broken_" + std::to_string(getpid()) + ".ply";
+  const std::string n = std::to_string(Lines(vertices));
+  for (const auto& [content, expected] : std::vector<std::pair<std::string, std::string>>{
+           {mesh_header + vertices + "3 0 1 2\n", "truncated PLY body at face 1 of the 2 its header declares"},
+           {mesh_header + vertices + "3 0 1 2\n3 0 1 99999999\n",
+            "face 1 names vertex 99999999, not one of its " + n + " vertices"},
+           {header + "nan nan nan\n" + vertices.substr(vertices.find('\n') + 1), "vertex 0's x is not a number"},
+           {std::regex_replace(header, std::regex("end_header\n"), "property float module\nend_header\n") +
+                std::regex_replace(vertices, std::regex("\n"), " 0\n"),
+            "its vertex property 'module' is float; stereorig's module is uchar"},
+           {std::regex_replace(vertices, std::regex("[^\n]+"), "1 2 3"),
+            "every point of the cloud is at the same place: it holds no shape to find"}}) {
+    std::ofstream(path) << (content.rfind("ply", 0) == 0 ? content : header + content);
+    const auto r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + path);
+    EXPECT_EQ(r.code, 2) << expected << ": " << r.out << r.err;
+    EXPECT_NE(r.err.find(path + ": "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+  }
+}

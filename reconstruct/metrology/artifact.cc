@@ -24,6 +24,21 @@ const char* ArtifactTypeName(ArtifactType type) {
   return "?";
 }
 
+std::string ImplausibleMm(double v, const PlausibleMm& range, const std::string& units_note) {
+  if (v >= range.min_mm && v <= range.max_mm) return "";
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "%g mm is not a plausible %s (%g to %g mm)", v, range.what, range.min_mm,
+                range.max_mm);
+  std::string problem = buf;
+  for (const auto& [unit, to_mm] : {std::pair<const char*, double>{"micrometres", 1e-3}, {"metres", 1e3}}) {
+    if (v * to_mm >= range.min_mm && v * to_mm <= range.max_mm) {
+      std::snprintf(buf, sizeof buf, ": in %s it would be %g mm (%s)", unit, v * to_mm, units_note.c_str());
+      problem += buf;
+    }
+  }
+  return problem;
+}
+
 namespace {
 
 double Positive(YamlMap& m, const std::string& key) {
@@ -38,34 +53,13 @@ double NonNegative(YamlMap& m, const std::string& key) {
   return v;
 }
 
-// The plausible range of a certified size, mm: a sphere a rig like this
-// measures (VDI/VDE 2634-2 sizes it at 0.1-0.2 of the volume's diagonal), and
-// a ball bar's length or a plate's side. Outside it the value is a typo or
-// another unit: 38100 (um for 38.1 mm) read as a 38 m sphere, and 1e300 was
-// judged against a 61.6 mm cloud, whose refusal then blamed the cloud.
-struct PlausibleMm {
-  double min_mm, max_mm;
-  const char* what;
-};
-constexpr PlausibleMm kSphereDiameter{1, 1000, "sphere diameter"};
-constexpr PlausibleMm kArtifactLength{1, 10000, "artifact length"};
-
 // A positive size within `range`; outside it, refused naming the file and
 // key, with the unit it looks like when one makes it plausible.
 double Size(YamlMap& m, const std::string& key, const PlausibleMm& range) {
   const double v = Positive(m, key);
-  if (v >= range.min_mm && v <= range.max_mm) return v;
-  char buf[256];
-  std::snprintf(buf, sizeof buf, "%g mm is not a plausible %s (%g to %g mm)", v, range.what, range.min_mm,
-                range.max_mm);
-  std::string problem = buf;
-  for (const auto& [unit, to_mm] : {std::pair<const char*, double>{"micrometres", 1e-3}, {"metres", 1e3}}) {
-    if (v * to_mm >= range.min_mm && v * to_mm <= range.max_mm) {
-      std::snprintf(buf, sizeof buf, ": in %s it would be %g mm (the file's units are mm)", unit, v * to_mm);
-      problem += buf;
-    }
-  }
-  throw InputError(m.Where(key), problem);
+  const std::string problem = ImplausibleMm(v, range, "the file's units are mm");
+  if (!problem.empty()) throw InputError(m.Where(key), problem);
+  return v;
 }
 
 Artifact Parse(YamlMap m) {
@@ -109,12 +103,12 @@ Artifact Parse(YamlMap m) {
     a.mpe.probing_size_given = e.Has("P_S");
     a.mpe.sphere_spacing_given = e.Has("SD");
     a.mpe.flatness_given = e.Has("F");
-    a.mpe.probing_form_mm = e.GetDouble("P_F", a.mpe.probing_form_mm);
-    a.mpe.probing_size_mm = e.GetDouble("P_S", a.mpe.probing_size_mm);
-    a.mpe.sphere_spacing_mm = e.GetDouble("SD", a.mpe.sphere_spacing_mm);
-    a.mpe.flatness_mm = e.GetDouble("F", a.mpe.flatness_mm);
-    for (double v : {a.mpe.probing_form_mm, a.mpe.probing_size_mm, a.mpe.sphere_spacing_mm, a.mpe.flatness_mm})
-      if (!(v > 0)) throw InputError(e.Where(), "every MPE must be positive");
+    for (const auto& [key, mpe_mm] : {std::pair<const char*, double*>{"P_F", &a.mpe.probing_form_mm},
+                                      {"P_S", &a.mpe.probing_size_mm},
+                                      {"SD", &a.mpe.sphere_spacing_mm},
+                                      {"F", &a.mpe.flatness_mm}}) {
+      if (e.Has(key)) *mpe_mm = Size(e, key, kMaximumPermissibleError);
+    }
     e.Finish();
   } else {
     m.GetString("mpe_mm", "");  // absent: defaults; mark as read

@@ -58,6 +58,28 @@ struct Artifact {
 // Throws InputError naming the file and key (missing fields for the type,
 // unknown keys, non-positive sizes, ...).
 Artifact ReadArtifactFile(const std::string& path);
+
+// The plausible range of a length, mm, and what it is of ("sphere
+// diameter"): a sphere a rig like this measures (VDI/VDE 2634-2 sizes it at
+// 0.1-0.2 of the volume's diagonal), a ball bar's length or a plate's side.
+// Outside it a value is a typo or another unit: 38100 (um for 38.1 mm) read
+// as a 38 m sphere, 1e300 was judged against a 61.6 mm cloud, whose refusal
+// then blamed the cloud, and an MPE of 1e308 passed every figure.
+struct PlausibleMm {
+  double min_mm, max_mm;
+  const char* what;
+};
+inline constexpr PlausibleMm kSphereDiameter{1, 1000, "sphere diameter"};
+inline constexpr PlausibleMm kArtifactLength{1, 10000, "artifact length"};
+// A maximum permissible error: 1 um is below what any optical rig claims,
+// 100 mm is beyond a sphere's form error that would still be a sphere.
+inline constexpr PlausibleMm kMaximumPermissibleError{0.001, 100, "maximum permissible error"};
+
+// "" when `v` is within `range`; else why not, with the unit it looks like
+// when one makes it plausible ("130000 mm is not a plausible artifact length
+// (1 to 10000 mm): in micrometres it would be 130 mm (the file's units are
+// mm)"; `units_note` is that parenthesis).
+std::string ImplausibleMm(double v, const PlausibleMm& range, const std::string& units_note);
 Artifact ParseArtifactYaml(const std::string& text, const std::string& where);
 std::string ArtifactToYaml(const Artifact& artifact);
 

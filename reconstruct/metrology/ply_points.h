@@ -1,7 +1,9 @@
 // Reads the vertex positions of any PLY file: ascii or binary little/big
 // endian, x/y/z of any numeric type, any other vertex properties skipped
-// (lists too), other elements ignored after the vertices. This is what
-// `stereorig verify` needs from a cloud, whatever tool wrote it.
+// (lists too). The elements after the vertices are read and checked, not
+// kept: a face's vertex indices must name vertices of the file, and the file
+// must end where its header says. This is what `stereorig verify` needs
+// from a cloud or mesh, whatever tool wrote it.
 #pragma once
 
 #include <Eigen/Core>
@@ -26,8 +28,10 @@ struct PlyVertices {
 };
 
 // Throws InputError naming the file on a missing file, a folder, a malformed header, no
-// x/y/z, some of nx/ny/nz but not all, a truncated body or non-finite
-// coordinates or normals; on a file named .stl
+// x/y/z, some of nx/ny/nz but not all, a `module` that is not uchar, a
+// truncated body, non-finite coordinates or normals, a face of fewer than 3
+// vertices or naming one the file does not hold, or data after the last
+// element; on a file named .stl
 // that is not PLY, it says that an STL mesh holds no module and names the
 // cloud to give instead.
 PlyVertices ReadPlyVertices(const std::string& path);

@@ -208,5 +208,96 @@ TEST(PlyPoints, AVertexCountTheFileCannotHoldIsATruncatedBody) {
   EXPECT_NE(ErrorOf(path).find("malformed element line 'element vertex 1e12'"), std::string::npos) << ErrorOf(path);
 }
 
+// A mesh's faces are read and checked as its vertices are: one cut short,
+// a vertex index out of range (a header's list count wrong reads the
+// faces out of step into such indices), a face of fewer than 3 corners or
+// data after the last face is refused naming the face; verify passed such
+// meshes by their vertices alone (a user's walkthrough found). Well-formed
+// ones read, in ASCII and binary, a last newline after binary faces too.
+TEST(PlyPoints, RefusesAMeshWhoseFacesAreBroken) {
+  const std::string dir = ::testing::TempDir();
+  const std::string head =
+      "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 2\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string vertices = "1 2 3\n4 5 6\n7 8 10\n";
+  const std::string path = dir + "/faces.ply";
+  auto ascii = [&](const std::string& faces) {
+    std::ofstream(path) << "ply\nformat ascii 1.0\n" << head << vertices << faces;
+    return ErrorOf(path);
+  };
+  EXPECT_EQ(ascii("3 0 1 2\n4 2 1 0 0\n"), "");
+  EXPECT_EQ(ReadPlyVertices(path).faces, 2);
+  EXPECT_EQ(ascii("3 0 1 2\n"), path + ": truncated PLY body at face 1 of the 2 its header declares");
+  EXPECT_EQ(ascii("3 0 1 2\n3 0 1 3\n"), path + ": face 1 names vertex 3, not one of its 3 vertices (0 to 2)");
+  EXPECT_EQ(ascii("3 0 1 2\n3 0 -1 2\n"), path + ": face 1 names vertex -1, not one of its 3 vertices (0 to 2)");
+  EXPECT_EQ(ascii("2 0 1\n3 0 1 2\n"), path + ": face 0 has 2 vertex indices; a face needs at least 3");
+  EXPECT_EQ(ascii("3 0 1 2\n3 0 1 2\n3 0 1 2\n"),
+            path +
+                ": holds more data after its 3 vertices and 2 faces than its header declares (a wrong vertex or "
+                "face count?)");
+  EXPECT_EQ(ascii("3 0 1 2\n-3 0 1 2\n"), path +
+                                              ": malformed PLY body at face 1: its list 'vertex_indices' has a "
+                                              "count of -3");
+  auto binary = [&](const std::vector<std::pair<unsigned char, std::vector<int>>>& faces, const std::string& tail) {
+    std::ofstream f(path, std::ios::binary);
+    f << "ply\nformat binary_little_endian 1.0\n" << head;
+    const float xyz[9] = {1, 2, 3, 4, 5, 6, 7, 8, 10};
+    f.write(reinterpret_cast<const char*>(xyz), sizeof xyz);
+    for (const auto& [n, indices] : faces) {
+      f.write(reinterpret_cast<const char*>(&n), 1);
+      f.write(reinterpret_cast<const char*>(indices.data()), indices.size() * sizeof(int));
+    }
+    f << tail;
+    f.close();
+    return ErrorOf(path);
+  };
+  EXPECT_EQ(binary({{3, {0, 1, 2}}, {3, {2, 1, 0}}}, ""), "");
+  EXPECT_EQ(binary({{3, {0, 1, 2}}, {3, {2, 1, 0}}}, "\n"), "");
+  EXPECT_EQ(binary({{3, {0, 1, 2}}, {3, {2, 1}}}, ""),
+            path + ": truncated PLY body at face 1 of the 2 its header declares");
+  EXPECT_EQ(binary({{3, {0, 1, 2}}, {3, {2, 1, 1000000000}}}, ""),
+            path + ": face 1 names vertex 1000000000, not one of its 3 vertices (0 to 2)");
+  // A list count of 4 for a triangle: the next face is read out of step,
+  // its count (3) and its first index's low bytes (2, 0, 0) taken as an
+  // index, 0x000203.
+  EXPECT_EQ(binary({{4, {0, 1, 2}}, {3, {2, 1, 0}}}, ""),
+            path + ": face 0 names vertex 515, not one of its 3 vertices (0 to 2)");
+  EXPECT_EQ(binary({{3, {0, 1, 2}}, {3, {2, 1, 0}}}, std::string(40, 'x')),
+            path +
+                ": holds more data after its 3 vertices and 2 faces than its header declares (a wrong vertex or "
+                "face count?)");
+  // A face count the file cannot hold: refused at the first face missing,
+  // nothing allocated for the count.
+  std::ofstream(path) << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                         "property float z\nelement face 4000000000\nproperty list uchar int vertex_indices\n"
+                         "end_header\n"
+                      << vertices << "3 0 1 2\n";
+  EXPECT_EQ(ErrorOf(path), path + ": truncated PLY body at face 1 of the 4000000000 its header declares");
+}
+
+// A coordinate that is NaN is named as not a number (an ASCII "nan" read as
+// a "truncated or malformed PLY body"), one that is infinite as not finite,
+// a word that is no number as such; a `module` of another type than uchar
+// is named by its type (a float one read the records out of step: "vertex
+// 23 is not finite").
+TEST(PlyPoints, NamesANanCoordinateAWordThatIsNoNumberAndAModuleOfAnotherType) {
+  const std::string path = ::testing::TempDir() + "/values.ply";
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+      "property float z\n";
+  std::ofstream(path) << head << "end_header\n1 2 3\nnan 5 6\n";
+  EXPECT_EQ(ErrorOf(path), path + ": vertex 1's x is not a number");
+  std::ofstream(path) << head << "end_header\n1 2 3\n4 -inf 6\n";
+  EXPECT_EQ(ErrorOf(path), path + ": vertex 1's y is not finite (-inf)");
+  std::ofstream(path) << head << "end_header\n1 2 3\n4 5 six\n";
+  EXPECT_EQ(ErrorOf(path), path + ": malformed PLY body at vertex 1: 'six' is not a number");
+  std::ofstream(path) << head << "property float module\nend_header\n1 2 3 0\n4 5 6 255\n";
+  EXPECT_EQ(ErrorOf(path), path +
+                               ": its vertex property 'module' is float; stereorig's module is uchar (the "
+                               "measuring module, 255 for hole filling's points)");
+  std::ofstream(path) << head << "property uchar module\nend_header\n1 2 3 0\n4 5 6 255\n";
+  EXPECT_EQ(ErrorOf(path), "");
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -781,7 +781,10 @@ std::string UnitsHint(const Artifact& a, const std::vector<Eigen::Vector3d>& pts
   }
   const double extent_mm = (hi - lo).norm(), size_mm = ArtifactSizeMm(a);
   if (!(extent_mm * 100 < size_mm)) return "";
-  const double ratio = extent_mm > 0 ? size_mm / extent_mm : std::numeric_limits<double>::infinity();
+  // Every point the same: a cloud of one point repeated, no extent to
+  // compare ("spans only 0 mm across, infx less" said nothing).
+  if (extent_mm == 0) return "; every point of the cloud is at the same place: it holds no shape to find";
+  const double ratio = size_mm / extent_mm;
   const bool metres = ratio >= 100 && ratio <= 10000;
   // Sized to any double (%g keeps each to a few characters): never cut.
   char buf[256];

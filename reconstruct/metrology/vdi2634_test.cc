@@ -1589,6 +1589,22 @@ TEST(Vdi2634, ABallWithItsRodGivenAgainstASpheresFileIsNoScaleError) {
   }
 }
 
+// A cloud of one point repeated spans nothing: said so, not as "spans
+// only 0 mm across, infx less than the artifact's 38.1 mm".
+TEST(Vdi2634, ACloudOfOnePointRepeatedIsNamedSo) {
+  try {
+    EvaluateArtifact(SphereArtifact(), std::vector<Eigen::Vector3d>(5000, Eigen::Vector3d(1, 2, 3)), VerifyOptions(),
+                     "s.ply");
+    ADD_FAILURE() << "one point repeated was judged";
+  } catch (const NotTheArtifactError& error) {
+    const std::string what = error.what();
+    EXPECT_NE(what.find("; every point of the cloud is at the same place: it holds no shape to find"),
+              std::string::npos)
+        << what;
+    EXPECT_EQ(what.find("inf"), std::string::npos) << what;
+  }
+}
+
 TEST(Vdi2634, ACloudInMetresIsNamedSo) {
   std::vector<Eigen::Vector3d> metres = ExactSphere(38.1);
   for (auto& p : metres) p *= 0.001;
