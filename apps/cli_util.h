@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "calib/core/printable_text.h"  // PrintableText, for every error line
+
 namespace stereorig {
 
 // Parses argv into `app`. Returns an exit code when the command must stop now
@@ -46,13 +48,6 @@ std::vector<std::string> ScenesToRun(const std::string& dataset, const std::vect
 // truth/ in it: a file or a wrong folder given to --dataset is named as
 // such, not as a missing DATASET/truth/rig.yaml.
 void CheckDatasetFolder(const std::string& dataset, bool need_truth);
-
-// `message` with every byte a terminal would not show as text written as
-// \xNN: control bytes (C0, DEL, C1), and bytes that are not valid UTF-8 (a
-// binary file given where YAML or text was expected puts its bytes into the
-// parser's message). Valid UTF-8 (a path with 'å') passes unchanged. Every
-// error line goes through it (RunCommand, ParseArgs, main).
-std::string PrintableText(const std::string& message);
 
 // `word` as a POSIX shell reads it back as one word: as it is when it
 // holds only letters, digits and _@%+=:,./- (most paths), else in single

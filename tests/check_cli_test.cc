@@ -838,3 +838,87 @@ TEST_F(CheckHistoryCli, TheSameNightCheckedAgainIsNotAppendedTwice) {
 
 }  // namespace
 }  // namespace stereorig
+
+// ---- A corrupt history (a robustness walkthrough): a figure's value 'abc'
+// read as 0.0000, a threshold of 1e308 printed as 309 digits, a NULL name a
+// nameless figure; `check --history` exited 0 and a night was appended to
+// it. Now every row is checked as it is read: a bad one refuses with exit 2
+// naming the file, the table, the row and what is wrong, for --history,
+// --history --json, and a night (before its work, the history left as it
+// was); numbers are printed bounded; a new history's tables refuse such a
+// row themselves.
+namespace stereorig {
+namespace {
+
+// A history as a version before the CHECKs made it (its tables as they were
+// created then), with `rows`.
+bool MakeUncheckedHistory(const std::string& path, const std::string& rows) {
+  sqlite3* raw = nullptr;
+  const bool opened = sqlite3_open(path.c_str(), &raw) == SQLITE_OK;
+  const std::string sql =
+      "CREATE TABLE stereorig_check_runs (id INTEGER PRIMARY KEY AUTOINCREMENT, date_utc TEXT NOT NULL, rig_file TEXT "
+      "NOT NULL, captures TEXT NOT NULL, verdict TEXT NOT NULL, explanation TEXT NOT NULL);"
+      "CREATE TABLE stereorig_check_figures (run_id INTEGER NOT NULL REFERENCES stereorig_check_runs(id), name TEXT "
+      "NOT NULL, value REAL NOT NULL, threshold REAL NOT NULL, pass INTEGER NOT NULL, samples INTEGER NOT NULL);"
+      "INSERT INTO stereorig_check_runs (date_utc, rig_file, captures, verdict, explanation) VALUES "
+      "('2026-11-01T02:00:00Z', '/r.yaml', '/n1', 'ok', 'every figure within its threshold');" +
+      rows;
+  const bool made = opened && sqlite3_exec(raw, sql.c_str(), nullptr, nullptr, nullptr) == SQLITE_OK;
+  sqlite3_close(raw);
+  return made;
+}
+
+TEST_F(CheckHistoryCli, ABadRowInTheHistoryIsRefusedBeforeTheNight) {
+  const std::string db = dir_ + "/bad_row.sqlite", report = dir_ + "/bad_row.json";
+  ASSERT_TRUE(MakeUncheckedHistory(
+      db,
+      "INSERT INTO stereorig_check_figures VALUES (1, 'cam0_consistency_rms_px', 0.02, 0.03, 1, 500),"
+      "(1, 'pair_0_1_closure_mm', 'abc', 0.01, 1, 8);"));
+  const std::string bytes = Bytes(db);
+  const std::string refusal = "stereorig check: " + db +
+                              ": a bad row in the history: stereorig_check_figures row 2 (run 1): the value of figure "
+                              "pair_0_1_closure_mm is 'abc', not a number (mend or delete the row with sqlite3, or "
+                              "give another history with --history-db)";
+  for (const std::string json : {"", " --json"}) {
+    const Result r = RunCli("check --history" + json + " --history-db " + db);
+    EXPECT_EQ(r.code, 2) << json << ": " << r.out;
+    EXPECT_EQ(r.out, "") << json;
+    EXPECT_EQ(LastLine(r.err), refusal) << json;
+  }
+  const Result r = Check("night1", db, "--report " + report);
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_EQ(LastLine(r.err), refusal);
+  EXPECT_EQ(r.err.find("check: detecting the target"), std::string::npos) << r.err;  // before the night's work
+  EXPECT_FALSE(fs::exists(report));
+  EXPECT_EQ(Bytes(db), bytes);
+}
+
+// A finite but huge threshold (1e308) is printed as %.4g: the table keeps
+// its columns.
+TEST_F(CheckHistoryCli, AHugeNumberInTheHistoryKeepsItsTableInShape) {
+  const std::string db = dir_ + "/huge.sqlite";
+  ASSERT_TRUE(MakeUncheckedHistory(
+      db, "INSERT INTO stereorig_check_figures VALUES (1, 'cam0_consistency_rms_px', 0.02, 1e308, 1, 500);"));
+  const Result r = RunCli("check --history --history-db " + db);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("     0.0200     0.0200     0.0200     0.0200     1e+308      0\n"), std::string::npos) << r.out;
+  std::istringstream lines(r.out);
+  for (std::string line; std::getline(lines, line);) EXPECT_LT(line.size(), 160u) << line;
+}
+
+// A history the check makes refuses a bad row itself (CHECK constraints),
+// whoever writes it.
+TEST_F(CheckHistoryCli, ANewHistoryRefusesABadRowItself) {
+  const std::string db = dir_ + "/checked.sqlite";
+  ASSERT_EQ(Check("night1", db).code, 0);
+  sqlite3* raw = nullptr;
+  ASSERT_EQ(sqlite3_open(db.c_str(), &raw), SQLITE_OK);
+  for (const char* sql :
+       {"UPDATE stereorig_check_figures SET value = 'abc';", "UPDATE stereorig_check_runs SET verdict = 'banana';"})
+    EXPECT_EQ(sqlite3_exec(raw, sql, nullptr, nullptr, nullptr), SQLITE_CONSTRAINT) << sql;
+  sqlite3_close(raw);
+  EXPECT_EQ(RunCli("check --history --history-db " + db).code, 0);
+}
+
+}  // namespace
+}  // namespace stereorig

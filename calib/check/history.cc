@@ -3,14 +3,19 @@
 #include <sqlite3.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
 #include <set>
+#include <tuple>
 
 #include "calib/core/input_error.h"
+#include "calib/core/printable_text.h"
 
 namespace stereorig {
 
@@ -25,20 +30,41 @@ struct StmtFinalizer {
 };
 using Stmt = std::unique_ptr<sqlite3_stmt, StmtFinalizer>;
 
+// The tables as a new history gets them. The CHECKs let SQLite itself refuse
+// a row no check writes (a figure's value 'abc', a verdict 'banana', a date
+// that is a blob), whoever writes it; histories made before them are still
+// opened, and every row is checked as it is read (ReadHistory).
 constexpr const char* kSchema =
     "CREATE TABLE IF NOT EXISTS stereorig_check_runs ("
-    "  id INTEGER PRIMARY KEY AUTOINCREMENT, date_utc TEXT NOT NULL, rig_file TEXT NOT NULL,"
-    "  captures TEXT NOT NULL, verdict TEXT NOT NULL, explanation TEXT NOT NULL);"
+    "  id INTEGER PRIMARY KEY AUTOINCREMENT,"
+    "  date_utc TEXT NOT NULL CHECK (typeof(date_utc) = 'text' AND date_utc GLOB "
+    "'[0-9][0-9][0-9][0-9]-[0-9][0-9]-[0-9][0-9]T[0-9][0-9]:[0-9][0-9]:[0-9][0-9]Z'),"
+    "  rig_file TEXT NOT NULL CHECK (typeof(rig_file) = 'text'),"
+    "  captures TEXT NOT NULL CHECK (typeof(captures) = 'text'),"
+    "  verdict TEXT NOT NULL CHECK (verdict IN ('ok', 'recalibrate')),"
+    "  explanation TEXT NOT NULL CHECK (typeof(explanation) = 'text'));"
     "CREATE TABLE IF NOT EXISTS stereorig_check_figures ("
-    "  run_id INTEGER NOT NULL REFERENCES stereorig_check_runs(id), name TEXT NOT NULL,"
-    "  value REAL NOT NULL, threshold REAL NOT NULL, pass INTEGER NOT NULL, samples INTEGER NOT NULL);"
+    "  run_id INTEGER NOT NULL REFERENCES stereorig_check_runs(id) CHECK (typeof(run_id) = 'integer'),"
+    "  name TEXT NOT NULL CHECK (typeof(name) = 'text' AND name <> ''),"
+    "  value REAL NOT NULL CHECK (typeof(value) = 'real' AND abs(value) <= 1.7976931348623157e308),"
+    "  threshold REAL NOT NULL CHECK (typeof(threshold) = 'real' AND abs(threshold) <= 1.7976931348623157e308),"
+    "  pass INTEGER NOT NULL CHECK (pass IN (0, 1)),"
+    "  samples INTEGER NOT NULL CHECK (typeof(samples) = 'integer' AND samples >= 0));"
     "CREATE TABLE IF NOT EXISTS stereorig_check_views_set_aside ("
-    "  run_id INTEGER NOT NULL REFERENCES stereorig_check_runs(id), capture TEXT NOT NULL,"
-    "  camera INTEGER NOT NULL, jump_rms_px REAL NOT NULL, bound_px REAL NOT NULL);"
+    "  run_id INTEGER NOT NULL REFERENCES stereorig_check_runs(id) CHECK (typeof(run_id) = 'integer'),"
+    "  capture TEXT NOT NULL CHECK (typeof(capture) = 'text'),"
+    "  camera INTEGER NOT NULL CHECK (typeof(camera) = 'integer' AND camera >= 0),"
+    "  jump_rms_px REAL NOT NULL CHECK (typeof(jump_rms_px) = 'real' AND jump_rms_px BETWEEN 0 AND "
+    "1.7976931348623157e308),"
+    "  bound_px REAL NOT NULL CHECK (typeof(bound_px) = 'real' AND bound_px BETWEEN 0 AND 1.7976931348623157e308));"
     "CREATE TABLE IF NOT EXISTS stereorig_check_meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);"
     "CREATE TABLE IF NOT EXISTS stereorig_check_run_inputs ("
-    "  run_id INTEGER NOT NULL REFERENCES stereorig_check_runs(id), rig_path TEXT NOT NULL,"
-    "  rig_crc32 TEXT NOT NULL, target_path TEXT NOT NULL, board TEXT NOT NULL);";
+    "  run_id INTEGER NOT NULL REFERENCES stereorig_check_runs(id) CHECK (typeof(run_id) = 'integer'),"
+    "  rig_path TEXT NOT NULL CHECK (typeof(rig_path) = 'text'),"
+    "  rig_crc32 TEXT NOT NULL CHECK (rig_crc32 = '' OR (length(rig_crc32) = 8 AND rig_crc32 NOT GLOB "
+    "'*[^0-9a-f]*')),"
+    "  target_path TEXT NOT NULL CHECK (typeof(target_path) = 'text'),"
+    "  board TEXT NOT NULL CHECK (typeof(board) = 'text'));";
 
 constexpr const char* kRunInputsTable = "stereorig_check_run_inputs";
 
@@ -116,8 +142,13 @@ struct AddedColumn {
   const char* column;
   const char* type;
 };
-constexpr AddedColumn kAddedColumns[] = {{"stereorig_check_run_inputs", "k_sigma", "REAL"},
-                                         {"stereorig_check_run_inputs", "captures_crc32", "TEXT"}};
+constexpr AddedColumn kAddedColumns[] = {
+    {"stereorig_check_run_inputs", "k_sigma",
+     "REAL CHECK (k_sigma IS NULL OR (typeof(k_sigma) = 'real' AND k_sigma > 0 AND k_sigma <= "
+     "1.7976931348623157e308))"},
+    {"stereorig_check_run_inputs", "captures_crc32",
+     "TEXT CHECK (captures_crc32 IS NULL OR (length(captures_crc32) = 8 AND captures_crc32 NOT GLOB "
+     "'*[^0-9a-f]*'))"}};
 
 void AddMissingColumns(sqlite3* db, const std::string& path) {
   for (const AddedColumn& c : kAddedColumns)
@@ -125,36 +156,323 @@ void AddMissingColumns(sqlite3* db, const std::string& path) {
       Exec(db, std::string("ALTER TABLE ") + c.table + " ADD COLUMN " + c.column + " " + c.type + ";", path);
 }
 
-std::optional<double> OptionalDouble(sqlite3_stmt* s, int col) {
-  if (sqlite3_column_type(s, col) == SQLITE_NULL) return std::nullopt;
-  return sqlite3_column_double(s, col);
-}
-
-// The first run of the same night (the same captures with the same rig
-// file), if the history holds one.
-std::optional<HistoryRun> SameNight(sqlite3* db, const HistoryRun& run, const std::string& path) {
-  if (run.captures_crc32.empty()) return std::nullopt;
-  Stmt s = Prepare(db,
-                   "SELECT r.id, r.date_utc, r.verdict, r.explanation, i.k_sigma FROM stereorig_check_runs r JOIN "
-                   "stereorig_check_run_inputs i ON i.run_id = r.id WHERE i.captures_crc32 = ? AND i.rig_crc32 = ? "
-                   "ORDER BY r.id LIMIT 1;",
-                   path);
-  sqlite3_bind_text(s.get(), 1, run.captures_crc32.c_str(), -1, SQLITE_TRANSIENT);
-  sqlite3_bind_text(s.get(), 2, run.rig_crc32.c_str(), -1, SQLITE_TRANSIENT);
-  if (sqlite3_step(s.get()) != SQLITE_ROW) return std::nullopt;
-  HistoryRun same;
-  same.id = sqlite3_column_int64(s.get(), 0);
-  same.date_utc = Text(s.get(), 1), same.verdict = Text(s.get(), 2), same.explanation = Text(s.get(), 3);
-  same.k_sigma = OptionalDouble(s.get(), 4);
-  same.captures_crc32 = run.captures_crc32, same.rig_crc32 = run.rig_crc32;
-  return same;
-}
-
 std::string KSigmaText(double k) {
   char text[32];
   std::snprintf(text, sizeof text, "%g", k);
   return text;
 }
+
+// A value as a message shows it: text quoted (escaped, and cut where long),
+// a blob by its size, a number as SQLite holds it.
+std::string Shown(sqlite3_stmt* s, int col) {
+  switch (sqlite3_column_type(s, col)) {
+    case SQLITE_NULL:
+      return "NULL";
+    case SQLITE_BLOB:
+      return "a blob of " + std::to_string(sqlite3_column_bytes(s, col)) + " bytes";
+    case SQLITE_TEXT: {
+      const std::string text = Text(s, col);
+      return "'" + PrintableText(text.size() > 40 ? text.substr(0, 40) + "..." : text) + "'";
+    }
+    default: {
+      char number[32];
+      std::snprintf(number, sizeof number, "%.6g", sqlite3_column_double(s, col));
+      return number;
+    }
+  }
+}
+
+// A bad row: `where` is its table and rowid.
+[[noreturn]] void RefuseRow(const std::string& path, const std::string& where, const std::string& problem) {
+  throw InputError(path, "a bad row in the history: " + where + ": " + problem +
+                             " (mend or delete the row with sqlite3, or give another history with --history-db)");
+}
+
+// One row of a history table as it is read, each value checked. SQLite
+// keeps whatever was put in a column (a REAL column keeps 'abc' as text, a
+// table made by hand has no NOT NULL), and read unchecked a corrupt row was
+// a figure of 0.0000, a nameless figure, a verdict 'banana', and exit 0. A
+// bad value throws InputError naming the database, the table, the row and
+// what is wrong: the history is not read past it, nor appended to.
+class Row {
+ public:
+  // `s`'s first column is the row's rowid.
+  Row(sqlite3_stmt* s, const std::string& path, const char* table)
+      : s_(s), path_(path), where_(std::string(table) + " row " + std::to_string(sqlite3_column_int64(s, 0))) {}
+  // Said after the row in messages: "(run 3)".
+  void Within(const std::string& context) { where_ += " (" + context + ")"; }
+
+  [[noreturn]] void Refuse(const std::string& problem) const { RefuseRow(path_, where_, problem); }
+  long long Integer(int col, const std::string& what) const {
+    if (sqlite3_column_type(s_, col) != SQLITE_INTEGER) Refuse(what + " is " + Shown(s_, col) + ", not an integer");
+    return sqlite3_column_int64(s_, col);
+  }
+  double Number(int col, const std::string& what) const {
+    const int type = sqlite3_column_type(s_, col);
+    if (type != SQLITE_FLOAT && type != SQLITE_INTEGER) Refuse(what + " is " + Shown(s_, col) + ", not a number");
+    const double v = sqlite3_column_double(s_, col);
+    if (!std::isfinite(v)) Refuse(what + " is " + Shown(s_, col) + ", not a finite number");
+    return v;
+  }
+  std::optional<double> OptionalNumber(int col, const std::string& what) const {
+    if (sqlite3_column_type(s_, col) == SQLITE_NULL) return std::nullopt;
+    return Number(col, what);
+  }
+  // Text, escaped as PrintableText does: a path's bytes need not be UTF-8
+  // (nlohmann::json refuses to write them), a control byte would reach the
+  // terminal.
+  std::string String(int col, const std::string& what) const {
+    if (sqlite3_column_type(s_, col) != SQLITE_TEXT) Refuse(what + " is " + Shown(s_, col) + ", not text");
+    return PrintableText(Text(s_, col));
+  }
+  std::string OptionalString(int col, const std::string& what) const {
+    return sqlite3_column_type(s_, col) == SQLITE_NULL ? "" : String(col, what);
+  }
+
+ private:
+  sqlite3_stmt* s_;
+  const std::string& path_;
+  std::string where_;
+};
+
+bool IsCrc32Text(const std::string& text) {
+  return text.size() == 8 &&
+         std::all_of(text.begin(), text.end(), [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); });
+}
+
+// "2026-11-20T02:00:00Z", as every run was dated (NowUtcIso8601).
+bool IsDateUtcText(const std::string& text) {
+  static const char kForm[] = "dddd-dd-ddTdd:dd:ddZ";
+  if (text.size() != sizeof kForm - 1) return false;
+  for (size_t i = 0; i < text.size(); ++i)
+    if (kForm[i] == 'd' ? !std::isdigit(static_cast<unsigned char>(text[i])) : text[i] != kForm[i]) return false;
+  return true;
+}
+
+// The columns each table of ours was first written with (the ones added
+// since are kAddedColumns, a history from before reading them NULL). A table
+// without one is no history this program wrote: the read, or the append at
+// the end of a night, would fail on it ("no such column").
+struct TableColumns {
+  const char* table;
+  std::vector<const char*> columns;
+  bool required;  // false: a table added since, which a history from before lacks
+};
+const std::vector<TableColumns>& OurTables() {
+  static const std::vector<TableColumns> tables = {
+      {"stereorig_check_runs", {"id", "date_utc", "rig_file", "captures", "verdict", "explanation"}, true},
+      {"stereorig_check_figures", {"run_id", "name", "value", "threshold", "pass", "samples"}, true},
+      {kSetAsideTable, {"run_id", "capture", "camera", "jump_rms_px", "bound_px"}, false},
+      {"stereorig_check_meta", {"key", "value"}, false},
+      {kRunInputsTable, {"run_id", "rig_path", "rig_crc32", "target_path", "board"}, false}};
+  return tables;
+}
+
+void RequireOurColumns(sqlite3* db, const std::string& path) {
+  for (const TableColumns& t : OurTables()) {
+    if (!HasTable(db, t.table, path)) {
+      if (t.required) throw InputError(path, std::string("a stereorig check history without its table ") + t.table);
+      continue;
+    }
+    for (const char* column : t.columns)
+      if (!HasColumn(db, t.table, column, path))
+        throw InputError(path, std::string("the history's table ") + t.table + " has no column " + column +
+                                   ": not a history stereorig wrote (give another with --history-db)");
+  }
+}
+
+// Everything a history holds, each row checked as it is read (Row): the
+// runs with their inputs, every figure of every run, the views set aside.
+struct HistoryContents {
+  std::vector<HistoryRun> runs;
+  std::vector<FigureTrend> trends;
+  HistorySetAsideLog set_aside;
+};
+
+std::vector<HistoryRun> ReadRuns(sqlite3* db, const std::string& path) {
+  // Histories written before the inputs were kept have no such table, and
+  // before k_sigma and the captures' CRC were kept, no such columns.
+  const bool inputs = HasTable(db, kRunInputsTable, path);
+  std::map<long long, HistoryRun> runs;  // by id
+  Stmt s = Prepare(db,
+                   "SELECT rowid, id, date_utc, rig_file, captures, verdict, explanation FROM stereorig_check_runs "
+                   "ORDER BY rowid;",
+                   path);
+  while (sqlite3_step(s.get()) == SQLITE_ROW) {
+    Row row(s.get(), path, "stereorig_check_runs");
+    HistoryRun run;
+    run.id = row.Integer(1, "its id");
+    if (runs.count(run.id)) row.Refuse("a second run " + std::to_string(run.id));
+    row.Within("run " + std::to_string(run.id));
+    run.date_utc = row.String(2, "its date_utc");
+    if (!IsDateUtcText(run.date_utc))
+      row.Refuse("its date_utc '" + run.date_utc + "' is not a time as YYYY-MM-DDTHH:MM:SSZ");
+    run.rig_file = row.String(3, "its rig_file"), run.captures = row.String(4, "its captures");
+    run.verdict = row.String(5, "its verdict");
+    if (run.verdict != "ok" && run.verdict != "recalibrate")
+      row.Refuse("its verdict '" + run.verdict + "' is neither ok nor recalibrate");
+    run.explanation = row.String(6, "its explanation");
+    runs[run.id] = run;
+  }
+  if (inputs) {
+    const std::string sql = std::string("SELECT rowid, run_id, rig_path, rig_crc32, target_path, board, ") +
+                            (HasColumn(db, kRunInputsTable, "k_sigma", path) ? "k_sigma" : "NULL") + ", " +
+                            (HasColumn(db, kRunInputsTable, "captures_crc32", path) ? "captures_crc32" : "NULL") +
+                            " FROM " + kRunInputsTable + " ORDER BY rowid;";
+    Stmt in = Prepare(db, sql.c_str(), path);
+    std::set<long long> seen;
+    while (sqlite3_step(in.get()) == SQLITE_ROW) {
+      Row row(in.get(), path, kRunInputsTable);
+      const long long id = row.Integer(1, "its run_id");
+      const auto run = runs.find(id);
+      if (run == runs.end()) row.Refuse("its run_id " + std::to_string(id) + " names no run in stereorig_check_runs");
+      if (!seen.insert(id).second) row.Refuse("a second inputs row for run " + std::to_string(id));
+      row.Within("run " + std::to_string(id));
+      HistoryRun& r = run->second;
+      r.rig_path = row.String(2, "its rig_path"), r.rig_crc32 = row.String(3, "its rig_crc32");
+      if (!r.rig_crc32.empty() && !IsCrc32Text(r.rig_crc32))
+        row.Refuse("its rig_crc32 '" + r.rig_crc32 + "' is not 8 hex digits");
+      r.target_path = row.String(4, "its target_path"), r.board = row.String(5, "its board");
+      r.k_sigma = row.OptionalNumber(6, "its k_sigma");
+      if (r.k_sigma && !(*r.k_sigma > 0)) row.Refuse("its k_sigma " + KSigmaText(*r.k_sigma) + " is not positive");
+      r.captures_crc32 = row.OptionalString(7, "its captures_crc32");
+      if (!r.captures_crc32.empty() && !IsCrc32Text(r.captures_crc32))
+        row.Refuse("its captures_crc32 '" + r.captures_crc32 + "' is not 8 hex digits");
+    }
+  }
+  std::vector<HistoryRun> out;
+  for (auto& [id, run] : runs) {
+    // Runs written before rig_file was kept absolute hold it as typed,
+    // relative to a folder the history does not know; their rig_path (the
+    // same file, made absolute by the same run) says which file it was.
+    if (!run.rig_path.empty() && !std::filesystem::path(run.rig_file).is_absolute()) run.rig_file = run.rig_path;
+    out.push_back(run);
+  }
+  return out;
+}
+
+// The run a row of another table names, which must be in the history: a
+// figure of a run that is not there was left out of every trend, unsaid.
+const HistoryRun& RunOf(const Row& row, const std::map<long long, const HistoryRun*>& runs, long long id) {
+  const auto run = runs.find(id);
+  if (run == runs.end()) row.Refuse("its run_id " + std::to_string(id) + " names no run in stereorig_check_runs");
+  return *run->second;
+}
+
+HistoryContents ReadHistory(sqlite3* db, const std::string& path) {
+  RequireOurColumns(db, path);
+  HistoryContents h;
+  h.runs = ReadRuns(db, path);
+  std::map<long long, const HistoryRun*> by_id;
+  for (const HistoryRun& r : h.runs) by_id[r.id] = &r;
+
+  // Figures: by name, each one's points oldest run first, once per run.
+  std::map<std::string, std::vector<std::pair<HistoryPoint, long long>>> figures;  // name -> (point, rowid)
+  Stmt f = Prepare(db,
+                   "SELECT rowid, run_id, name, value, threshold, pass, samples FROM stereorig_check_figures "
+                   "ORDER BY rowid;",
+                   path);
+  while (sqlite3_step(f.get()) == SQLITE_ROW) {
+    Row row(f.get(), path, "stereorig_check_figures");
+    const HistoryRun& run = RunOf(row, by_id, row.Integer(1, "its run_id"));
+    row.Within("run " + std::to_string(run.id));
+    const std::string name = row.String(2, "its name");
+    if (name.empty()) row.Refuse("its name is empty");
+    HistoryPoint p;
+    p.run_id = run.id, p.date_utc = run.date_utc;
+    p.value = row.Number(3, "the value of figure " + name);
+    p.threshold = row.Number(4, "the threshold of figure " + name);
+    const long long pass = row.Integer(5, "the pass of figure " + name);
+    if (pass != 0 && pass != 1)
+      row.Refuse("the pass of figure " + name + " is " + std::to_string(pass) + ", not 0 or 1");
+    p.pass = pass == 1;
+    if (row.Integer(6, "the samples of figure " + name) < 0)
+      row.Refuse("the samples of figure " + name + " are negative");
+    figures[name].push_back({p, sqlite3_column_int64(f.get(), 0)});
+  }
+  for (auto& [name, points] : figures) {
+    std::stable_sort(points.begin(), points.end(),
+                     [](const auto& a, const auto& b) { return a.first.run_id < b.first.run_id; });
+    FigureTrend t{name, {}};
+    for (size_t i = 0; i < points.size(); ++i) {
+      if (i > 0 && points[i].first.run_id == points[i - 1].first.run_id)
+        RefuseRow(path,
+                  "stereorig_check_figures row " + std::to_string(points[i].second) + " (run " +
+                      std::to_string(points[i].first.run_id) + ")",
+                  "figure " + name + " a second time in its run (row " + std::to_string(points[i - 1].second) +
+                      " is the first)");
+      t.points.push_back(points[i].first);
+    }
+    h.trends.push_back(t);
+  }
+
+  // The views set aside, oldest run first, cameras in order within a run.
+  if (!HasTable(db, kSetAsideTable, path)) return h;  // written before views set aside were kept
+  h.set_aside.since_run_id = 1;
+  if (HasTable(db, "stereorig_check_meta", path)) {
+    Stmt since = Prepare(db, "SELECT rowid, value FROM stereorig_check_meta WHERE key = ?;", path);
+    sqlite3_bind_text(since.get(), 1, kSetAsideSinceKey, -1, SQLITE_TRANSIENT);
+    if (sqlite3_step(since.get()) == SQLITE_ROW) {
+      Row row(since.get(), path, "stereorig_check_meta");
+      row.Within(kSetAsideSinceKey);
+      // Kept as text ("12"): a TEXT column.
+      const std::string text = row.String(1, "its value");
+      const bool digits = !text.empty() && text.size() < 19 &&
+                          std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
+      if (!digits || std::stoll(text) < 1) row.Refuse("its value '" + text + "' is not a run id");
+      h.set_aside.since_run_id = std::stoll(text);
+    }
+  }
+  Stmt v = Prepare(db,
+                   "SELECT rowid, run_id, capture, camera, jump_rms_px, bound_px FROM stereorig_check_views_set_aside "
+                   "ORDER BY rowid;",
+                   path);
+  while (sqlite3_step(v.get()) == SQLITE_ROW) {
+    Row row(v.get(), path, kSetAsideTable);
+    const HistoryRun& run = RunOf(row, by_id, row.Integer(1, "its run_id"));
+    row.Within("run " + std::to_string(run.id));
+    HistorySetAside view;
+    view.run_id = run.id, view.date_utc = run.date_utc;
+    view.capture = row.String(2, "its capture");
+    const long long camera = row.Integer(3, "its camera");
+    if (camera < 0 || camera > 1000000) row.Refuse("its camera " + std::to_string(camera) + " is no camera index");
+    view.camera = static_cast<int>(camera);
+    view.jump_rms_px = row.Number(4, "its jump_rms_px"), view.bound_px = row.Number(5, "its bound_px");
+    if (view.jump_rms_px < 0 || view.bound_px < 0) row.Refuse("its jump_rms_px or bound_px is negative");
+    h.set_aside.views.push_back(view);
+  }
+  std::stable_sort(h.set_aside.views.begin(), h.set_aside.views.end(),
+                   [](const HistorySetAside& a, const HistorySetAside& b) {
+                     return std::tie(a.run_id, a.camera, a.capture) < std::tie(b.run_id, b.camera, b.capture);
+                   });
+  return h;
+}
+
+// The first run of the same night (the same captures with the same rig
+// file), if the history holds one. The history read (ReadHistory) first.
+std::optional<HistoryRun> SameNight(const std::vector<HistoryRun>& runs, const HistoryRun& run) {
+  if (run.captures_crc32.empty()) return std::nullopt;
+  for (const HistoryRun& r : runs)  // oldest first
+    if (r.captures_crc32 == run.captures_crc32 && r.rig_crc32 == run.rig_crc32) return r;
+  return std::nullopt;
+}
+
+// `v` with `decimals` decimals below `fixed_below`, from there as %.4g: a
+// threshold of 1e308 (finite, a corrupt row's) printed as 309 digits and
+// broke the table.
+std::string Bounded(double v, int decimals, double fixed_below = 1e6) {
+  char text[48];
+  if (std::fabs(v) < fixed_below)
+    std::snprintf(text, sizeof text, "%.*f", decimals, v);
+  else
+    std::snprintf(text, sizeof text, "%.4g", v);
+  return text;
+}
+// A figure in the trend table's columns, 10 wide: 99999.9999 at most fixed.
+std::string TableNumber(double v) { return Bounded(v, 4, 1e5); }
+
+// a over b, a bound of 0 read as infinitely exceeded (not a division by 0).
+double Ratio(double a, double b) { return b > 0 ? a / b : std::numeric_limits<double>::infinity(); }
 
 // Run ids as ranges: "1..3, 7, 9..12".
 std::string RunRanges(const std::vector<long long>& ids) {
@@ -198,12 +516,15 @@ HistoryAppend AppendToHistory(const std::string& path, const HistoryRun& run, co
   Db db = Open(path, true);
   Exec(db.get(), "BEGIN IMMEDIATE;", path);
   try {
-    IsOurHistory(db.get(), path);  // refuses another program's database
+    // Another program's database is refused; a history of ours is read
+    // whole, every row checked: a night is not appended to a corrupt one.
+    const std::vector<HistoryRun> runs =
+        IsOurHistory(db.get(), path) ? ReadHistory(db.get(), path).runs : std::vector<HistoryRun>{};
     const bool kept_set_aside = HasTable(db.get(), kSetAsideTable, path);
     Exec(db.get(), kSchema, path);
     AddMissingColumns(db.get(), path);
     HistoryAppend outcome;
-    outcome.same_night = SameNight(db.get(), run, path);
+    outcome.same_night = SameNight(runs, run);
     if (outcome.same_night) {  // nothing appended, nothing changed
       if (before_commit) before_commit(outcome);
       Exec(db.get(), "ROLLBACK;", path);
@@ -312,82 +633,17 @@ void RequireHistoryWritable(const std::string& path) {
 
 std::vector<HistoryRun> ReadHistoryRuns(const std::string& path) {
   Db db = Open(path, false);
-  if (!IsOurHistory(db.get(), path)) return {};  // empty: no run yet
-  // Histories written before the inputs were kept have no such table, and
-  // before k_sigma and the captures' CRC were kept, no such columns.
-  const bool inputs = HasTable(db.get(), kRunInputsTable, path);
-  const std::string sql =
-      inputs ? std::string(
-                   "SELECT r.id, r.date_utc, r.rig_file, r.captures, r.verdict, r.explanation, i.rig_path, "
-                   "i.rig_crc32, i.target_path, i.board, ") +
-                   (HasColumn(db.get(), kRunInputsTable, "k_sigma", path) ? "i.k_sigma" : "NULL") + ", " +
-                   (HasColumn(db.get(), kRunInputsTable, "captures_crc32", path) ? "i.captures_crc32" : "NULL") +
-                   " FROM stereorig_check_runs r LEFT JOIN stereorig_check_run_inputs i ON i.run_id = r.id ORDER BY "
-                   "r.id;"
-             : "SELECT id, date_utc, rig_file, captures, verdict, explanation FROM stereorig_check_runs ORDER BY id;";
-  Stmt s = Prepare(db.get(), sql.c_str(), path);
-  std::vector<HistoryRun> runs;
-  while (sqlite3_step(s.get()) == SQLITE_ROW) {
-    HistoryRun run{sqlite3_column_int64(s.get(), 0),
-                   Text(s.get(), 1),
-                   Text(s.get(), 2),
-                   Text(s.get(), 3),
-                   Text(s.get(), 4),
-                   Text(s.get(), 5)};
-    if (inputs) {
-      run.rig_path = Text(s.get(), 6), run.rig_crc32 = Text(s.get(), 7);
-      run.target_path = Text(s.get(), 8), run.board = Text(s.get(), 9);
-      run.k_sigma = OptionalDouble(s.get(), 10), run.captures_crc32 = Text(s.get(), 11);
-    }
-    // Runs written before rig_file was kept absolute hold it as typed,
-    // relative to a folder the history does not know; their rig_path (the
-    // same file, made absolute by the same run) says which file it was.
-    if (!run.rig_path.empty() && !std::filesystem::path(run.rig_file).is_absolute()) run.rig_file = run.rig_path;
-    runs.push_back(run);
-  }
-  return runs;
+  return IsOurHistory(db.get(), path) ? ReadHistory(db.get(), path).runs : std::vector<HistoryRun>{};
 }
 
 std::vector<FigureTrend> ReadHistoryTrends(const std::string& path) {
   Db db = Open(path, false);
-  if (!IsOurHistory(db.get(), path)) return {};
-  Stmt s = Prepare(db.get(),
-                   "SELECT f.name, r.id, r.date_utc, f.value, f.threshold, f.pass FROM stereorig_check_figures f "
-                   "JOIN stereorig_check_runs r ON r.id = f.run_id ORDER BY f.name, r.id;",
-                   path);
-  std::vector<FigureTrend> trends;
-  while (sqlite3_step(s.get()) == SQLITE_ROW) {
-    const std::string name = Text(s.get(), 0);
-    if (trends.empty() || trends.back().name != name) trends.push_back({name, {}});
-    trends.back().points.push_back({sqlite3_column_int64(s.get(), 1), Text(s.get(), 2),
-                                    sqlite3_column_double(s.get(), 3), sqlite3_column_double(s.get(), 4),
-                                    sqlite3_column_int(s.get(), 5) != 0});
-  }
-  return trends;
+  return IsOurHistory(db.get(), path) ? ReadHistory(db.get(), path).trends : std::vector<FigureTrend>{};
 }
 
 HistorySetAsideLog ReadHistorySetAside(const std::string& path) {
   Db db = Open(path, false);
-  HistorySetAsideLog log;
-  if (!IsOurHistory(db.get(), path)) return log;
-  if (!HasTable(db.get(), kSetAsideTable, path)) return log;  // written before views set aside were kept
-  log.since_run_id = 1;
-  if (HasTable(db.get(), "stereorig_check_meta", path)) {
-    Stmt since = Prepare(db.get(), "SELECT value FROM stereorig_check_meta WHERE key = ?;", path);
-    sqlite3_bind_text(since.get(), 1, kSetAsideSinceKey, -1, SQLITE_TRANSIENT);
-    if (sqlite3_step(since.get()) == SQLITE_ROW) log.since_run_id = sqlite3_column_int64(since.get(), 0);
-  }
-  Stmt s = Prepare(db.get(),
-                   "SELECT r.id, r.date_utc, v.capture, v.camera, v.jump_rms_px, v.bound_px "
-                   "FROM stereorig_check_views_set_aside v JOIN stereorig_check_runs r ON r.id = v.run_id "
-                   "ORDER BY r.id, v.camera, v.capture;",
-                   path);
-  while (sqlite3_step(s.get()) == SQLITE_ROW) {
-    log.views.push_back({sqlite3_column_int64(s.get(), 0), Text(s.get(), 1), Text(s.get(), 2),
-                         sqlite3_column_int(s.get(), 3), sqlite3_column_double(s.get(), 4),
-                         sqlite3_column_double(s.get(), 5)});
-  }
-  return log;
+  return IsOurHistory(db.get(), path) ? ReadHistory(db.get(), path).set_aside : HistorySetAsideLog{};
 }
 
 std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<FigureTrend>& trends,
@@ -449,8 +705,10 @@ std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<
       hi = std::max(hi, p.value);
       fails += !p.pass;
     }
-    std::snprintf(line, sizeof line, "%-40s %5zu %10.4f %10.4f %10.4f %10.4f %10.4f %6d\n", t.name.c_str(),
-                  t.points.size(), t.points.front().value, t.points.back().value, lo, hi, t.points.back().threshold,
+    out += t.name + std::string(t.name.size() < 40 ? 40 - t.name.size() : 0, ' ');  // a long name kept whole
+    std::snprintf(line, sizeof line, " %5zu %10s %10s %10s %10s %10s %6d\n", t.points.size(),
+                  TableNumber(t.points.front().value).c_str(), TableNumber(t.points.back().value).c_str(),
+                  TableNumber(lo).c_str(), TableNumber(hi).c_str(), TableNumber(t.points.back().threshold).c_str(),
                   fails);
     out += line;
   }
@@ -475,15 +733,16 @@ std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<
     const HistorySetAside* worst = views.front();
     for (const HistorySetAside* v : views) {
       run_ids.insert(v->run_id);
-      if (v->jump_rms_px / v->bound_px > worst->jump_rms_px / worst->bound_px) worst = v;
+      if (Ratio(v->jump_rms_px, v->bound_px) > Ratio(worst->jump_rms_px, worst->bound_px)) worst = v;
     }
     std::snprintf(line, sizeof line, "views set aside: cam%d %zu view(s) on %zu of %zu run(s)", camera, views.size(),
                   run_ids.size(), kept_runs);
     out += line + since;
     std::snprintf(line, sizeof line, ", last run %lld (", views.back()->run_id);
     out += line + views.back()->date_utc;
-    std::snprintf(line, sizeof line, "); the worst against its bound: %.3f px, %.1fx its %.3f px (capture ",
-                  worst->jump_rms_px, worst->jump_rms_px / worst->bound_px, worst->bound_px);
+    std::snprintf(line, sizeof line, "); the worst against its bound: %s px, %sx its %s px (capture ",
+                  Bounded(worst->jump_rms_px, 3).c_str(),
+                  Bounded(Ratio(worst->jump_rms_px, worst->bound_px), 1).c_str(), Bounded(worst->bound_px, 3).c_str());
     out += line + worst->capture + ", run " + std::to_string(worst->run_id) + ")\n";
   }
   return out;
@@ -520,8 +779,7 @@ std::string FormatRunSeries(const std::vector<HistoryRun>& runs, const std::vect
                   w != worst.end() ? w->second.fails : 0);
     out += line;
     if (w != worst.end()) {
-      std::snprintf(line, sizeof line, "%.2fx ", w->second.ratio);
-      out += line + w->second.name;
+      out += Bounded(w->second.ratio, 2) + "x " + w->second.name;
     }
     if (r.verdict != "ok") out += "; " + r.explanation;
     out += "\n";

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "calib/core/input_error.h"
 
@@ -445,6 +446,165 @@ TEST(History, ListsTheLastRunsOneALine) {
       "     2  2026-11-02T02:00:00Z      3.5  ok               0  1.05x pair_0_1_closure_mm\n"
       "     3  2026-11-03T02:00:00Z      3.5  recalibrate      1  4.50x pair_0_1_closure_mm; camera 0 moved: "
       "turned 0.050 deg, shifted 0.002 mm\n");
+}
+
+// Every row is checked as it is read: SQLite keeps whatever a column is
+// given (a REAL column keeps 'abc' as text; a table made by hand has no NOT
+// NULL), and read unchecked a corrupt row was a figure of 0.0000, a nameless
+// figure, a verdict 'banana', a run that is not there, with exit 0, and a
+// night appended to it all the same. Now each read, and the append, refuses
+// naming the database, the table, the row and what is wrong, and the file
+// is left as it was. The histories are made as an older version wrote them
+// (no CHECKs: a new history's refuse such rows, NewTablesRefuse... below).
+TEST(History, ABadRowIsRefusedNamingTheTableTheRowAndWhatIsWrong) {
+  const std::string good_runs =
+      "INSERT INTO stereorig_check_runs (date_utc, rig_file, captures, verdict, explanation) VALUES "
+      "('2026-11-01T02:00:00Z', '/r.yaml', '/n1', 'ok', 'every figure within its threshold'),"
+      "('2026-11-02T02:00:00Z', '/r.yaml', '/n2', 'ok', 'every figure within its threshold');"
+      "INSERT INTO stereorig_check_figures VALUES (1, 'cam0_x', 0.2, 0.25, 1, 700), (2, 'cam0_x', 0.21, 0.25, 1, 700);";
+  // The figures table made again by hand, without NOT NULL (as a walkthrough
+  // found one): it takes NULLs.
+  const std::string loose_figures =
+      "CREATE TABLE loose (run_id INTEGER, name TEXT, value REAL, threshold REAL, pass INTEGER, samples INTEGER);"
+      "INSERT INTO loose SELECT * FROM stereorig_check_figures; DROP TABLE stereorig_check_figures;"
+      "ALTER TABLE loose RENAME TO stereorig_check_figures;";
+  struct Case {
+    std::string sql, problem;
+  };
+  const std::vector<Case> cases = {
+      {"INSERT INTO stereorig_check_figures VALUES (2, 'cam1_x', 'abc', 0.25, 1, 700);",
+       "stereorig_check_figures row 3 (run 2): the value of figure cam1_x is 'abc', not a number"},
+      {"INSERT INTO stereorig_check_figures VALUES (2, 'cam1_x', 0.2, 9e999, 1, 700);",
+       "stereorig_check_figures row 3 (run 2): the threshold of figure cam1_x is inf, not a finite number"},
+      {loose_figures + "INSERT INTO stereorig_check_figures VALUES (2, NULL, 0.2, 0.25, 1, 700);",
+       "stereorig_check_figures row 3 (run 2): its name is NULL, not text"},
+      {loose_figures + "INSERT INTO stereorig_check_figures VALUES (2, 'cam1_x', NULL, 0.25, 1, 700);",
+       "stereorig_check_figures row 3 (run 2): the value of figure cam1_x is NULL, not a number"},
+      {"INSERT INTO stereorig_check_figures VALUES (2, 'cam1_x', 0.2, 0.25, 7, 700);",
+       "stereorig_check_figures row 3 (run 2): the pass of figure cam1_x is 7, not 0 or 1"},
+      {"INSERT INTO stereorig_check_figures VALUES (9999, 'orphan', 1.0, 1.0, 1, 1);",
+       "stereorig_check_figures row 3: its run_id 9999 names no run in stereorig_check_runs"},
+      {"INSERT INTO stereorig_check_figures VALUES (2, 'cam0_x', 0.2, 0.25, 1, 700);",
+       "stereorig_check_figures row 3 (run 2): figure cam0_x a second time in its run (row 2 is the first"},
+      {"UPDATE stereorig_check_runs SET verdict = 'banana' WHERE id = 2;",
+       "stereorig_check_runs row 2 (run 2): its verdict 'banana' is neither ok nor recalibrate"},
+      {"UPDATE stereorig_check_runs SET date_utc = X'FF00' WHERE id = 2;",
+       "stereorig_check_runs row 2 (run 2): its date_utc is a blob of 2 bytes, not text"},
+      {"CREATE TABLE stereorig_check_run_inputs (run_id INTEGER, rig_path TEXT, rig_crc32 TEXT, target_path TEXT, "
+       "board TEXT, k_sigma REAL); INSERT INTO stereorig_check_run_inputs VALUES (2, '/r.yaml', '0badc0de', "
+       "'/t.yaml', 'as calibrated', -3);",
+       "stereorig_check_run_inputs row 1 (run 2): its k_sigma -3 is not positive"},
+      {"CREATE TABLE stereorig_check_views_set_aside (run_id INTEGER, capture TEXT, camera INTEGER, jump_rms_px "
+       "REAL, bound_px REAL); INSERT INTO stereorig_check_views_set_aside VALUES (2, '003', 'one', 0.4, 0.05);",
+       "stereorig_check_views_set_aside row 1 (run 2): its camera is 'one', not an integer"},
+  };
+  namespace fs = std::filesystem;
+  for (const Case& c : cases) {
+    const std::string db = ::testing::TempDir() + "/history_bad_row.sqlite";
+    fs::remove(db);
+    ASSERT_TRUE(MakeOldHistory(db, good_runs + c.sql)) << c.sql;
+    const auto size = fs::file_size(db);
+    for (int reader = 0; reader < 4; ++reader) {
+      try {
+        if (reader == 0) ReadHistoryRuns(db);
+        if (reader == 1) ReadHistoryTrends(db);
+        if (reader == 2) ReadHistorySetAside(db);
+        if (reader == 3) AppendToHistory(db, {0, "2026-11-03T02:00:00Z", "/r.yaml", "/n3", "", ""}, Result(0.2, true));
+        ADD_FAILURE() << "reader " << reader << " took the bad row of: " << c.sql;
+      } catch (const InputError& e) {
+        EXPECT_EQ(e.where(), db);
+        EXPECT_EQ(e.problem().find("a bad row in the history: " + c.problem), 0u)
+            << "reader " << reader << ": " << e.problem();
+      }
+    }
+    EXPECT_EQ(fs::file_size(db), size) << c.sql;
+    sqlite3* raw = nullptr;
+    ASSERT_EQ(sqlite3_open_v2(db.c_str(), &raw, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+    sqlite3_stmt* s = nullptr;
+    sqlite3_prepare_v2(raw, "SELECT count(*) FROM stereorig_check_runs;", -1, &s, nullptr);
+    sqlite3_step(s);
+    EXPECT_EQ(sqlite3_column_int(s, 0), 2) << "appended to: " << c.sql;
+    sqlite3_finalize(s);
+    sqlite3_close(raw);
+  }
+
+  // A table without a column of ours (the append would fail on it at the
+  // end of the night: "no column named samples") is refused as it is read.
+  const std::string db = ::testing::TempDir() + "/history_no_column.sqlite";
+  fs::remove(db);
+  sqlite3* raw = nullptr;
+  ASSERT_EQ(sqlite3_open(db.c_str(), &raw), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(raw,
+                         "CREATE TABLE stereorig_check_runs (id INTEGER PRIMARY KEY, date_utc TEXT, rig_file TEXT, "
+                         "captures TEXT, verdict TEXT, explanation TEXT); CREATE TABLE stereorig_check_figures (run_id "
+                         "INTEGER, name TEXT, value REAL, threshold REAL, pass INTEGER);",
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(raw);
+  try {
+    ReadHistoryRuns(db);
+    ADD_FAILURE() << "a figures table without samples was read";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problem(),
+              "the history's table stereorig_check_figures has no column samples: not a history stereorig wrote (give "
+              "another with --history-db)");
+  }
+}
+
+// Text that is not UTF-8 (a path's bytes, as a folder may be named) or holds
+// a control byte is kept, read back escaped \xNN: printed raw it reached the
+// terminal, and --json could not write it.
+TEST(History, TextThatIsNotUtf8IsReadEscaped) {
+  const std::string db = ::testing::TempDir() + "/history_bytes.sqlite";
+  std::filesystem::remove(db);
+  ASSERT_TRUE(MakeOldHistory(db,
+                             "INSERT INTO stereorig_check_runs (date_utc, rig_file, captures, verdict, explanation) "
+                             "VALUES ('2026-11-01T02:00:00Z', '/r.yaml', CAST(X'2F6EFF1B5B326A' AS TEXT), 'ok', "
+                             "'every figure within its threshold');"));
+  const auto runs = ReadHistoryRuns(db);
+  ASSERT_EQ(runs.size(), 1u);
+  EXPECT_EQ(runs[0].captures, "/n\\xFF\\x1B[2j");
+}
+
+// A new history's tables refuse such rows themselves (CHECK constraints),
+// whoever writes them.
+TEST(History, NewTablesRefuseRowsNoCheckWrites) {
+  const std::string db = ::testing::TempDir() + "/history_checks.sqlite";
+  std::filesystem::remove(db);
+  HistoryRun run{0, "2026-11-01T02:00:00Z", "/r.yaml", "/n", "", ""};
+  run.rig_crc32 = "0badc0de", run.k_sigma = 3, run.captures_crc32 = "12345678";
+  AppendToHistory(db, run, Result(0.2, true));
+  sqlite3* raw = nullptr;
+  ASSERT_EQ(sqlite3_open(db.c_str(), &raw), SQLITE_OK);
+  for (const char* sql :
+       {"UPDATE stereorig_check_figures SET value = 'abc';", "UPDATE stereorig_check_figures SET threshold = 9e999;",
+        "UPDATE stereorig_check_figures SET name = '';", "UPDATE stereorig_check_figures SET pass = 7;",
+        "UPDATE stereorig_check_figures SET samples = -1;", "UPDATE stereorig_check_runs SET verdict = 'banana';",
+        "UPDATE stereorig_check_runs SET date_utc = X'FF00';",
+        "UPDATE stereorig_check_runs SET date_utc = 'yesterday';",
+        "UPDATE stereorig_check_run_inputs SET rig_crc32 = 'xyz';",
+        "UPDATE stereorig_check_run_inputs SET k_sigma = -1;",
+        "UPDATE stereorig_check_run_inputs SET captures_crc32 = 'ABCDEFGH';"})
+    EXPECT_NE(sqlite3_exec(raw, sql, nullptr, nullptr, nullptr), SQLITE_OK) << sql;
+  EXPECT_EQ(sqlite3_exec(raw, "UPDATE stereorig_check_figures SET value = 1;", nullptr, nullptr, nullptr), SQLITE_OK);
+  sqlite3_close(raw);
+  EXPECT_EQ(ReadHistoryTrends(db)[0].points[0].value, 1.0);  // an integer in a REAL column: a number
+}
+
+// A huge number (finite: 1e308, which a corrupt row held) is printed
+// bounded, not as 309 digits that broke the table.
+TEST(History, HugeNumbersKeepTheTableInShape) {
+  HistoryRun run{1, "2026-11-01T02:00:00Z", "/r.yaml", "/n", "ok", "every figure within its threshold"};
+  const std::vector<FigureTrend> trends = {{"cam0_x", {{1, run.date_utc, 1e-300, 1e308, true}}}};
+  const std::string table = FormatTrends({run}, trends) + FormatRunSeries({run}, trends, 31);
+  EXPECT_NE(table.find("cam0_x                                       1     0.0000     0.0000     0.0000     0.0000 "
+                       "    1e+308      0\n"),
+            std::string::npos)
+      << table;
+  size_t longest = 0;
+  std::istringstream lines(table);
+  for (std::string line; std::getline(lines, line);) longest = std::max(longest, line.size());
+  EXPECT_LT(longest, 120u) << table;
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// Where text is well-formed UTF-8: what error lines (apps/cli_util.h's
+// Where text is well-formed UTF-8: what error lines (calib/core/printable_text.h's
 // PrintableText) and JSON reports (calib/json_text.h) escape as \xNN is the
 // bytes that are not. A Linux path may hold any byte but '/' and NUL (a
 // Latin-1 'é' is the one byte E9), so paths are not UTF-8 as given.
