@@ -32,7 +32,8 @@ int RunCalibrate(int argc, char** argv) {
       "that module is refused).\n\n"
       "Refuses with exit 2: too few views, all views fronto-parallel, a camera that never sees the board, images "
       "of the wrong size, a face seen by the wrong module; and, after the solve (the summary and the report written, "
-      "the rig file not), a stage that did not converge (rms over --max-rms-px), a lens no camera has, or a plate "
+      "the rig file not), a stage that did not converge (rms over --max-rms-px; stage 3 also when half its corners are "
+      "off by more than sqrt(2 ln 2) x --max-rms-px, or its solver stopped short), a lens no camera has, or a plate "
       "whose back_from_front stage 3 moved far beyond the target file's stated sigma (the target file named).\n\n"
       "Exit codes: 0 ok (the rig file written); 2 bad usage or input, or a calibration refused as above.\n\n"
       "Example:\n  stereorig calibrate --captures data/calibration --target target.yaml --layout layout.yaml "
@@ -64,10 +65,12 @@ int RunCalibrate(int argc, char** argv) {
                  "come from), mm; 0: each camera's median distance to the board in its views, where the rig measures")
       ->capture_default_str()
       ->check(NonNegativeValue());
-  app.add_option("--max-rms-px", options.intrinsics.max_rms_px,
-                 "a stage whose reprojection rms is over this did not converge, px: stage 1 then solves again from its "
-                 "other seeds, and no rig file is written while a stage stays over it (a converged camera shows its "
-                 "corners' noise, a few tenths of a px at most)")
+  app.add_option(
+         "--max-rms-px", options.intrinsics.max_rms_px,
+         "a stage whose reprojection rms is over this did not converge, px: stage 1 then solves again from its "
+         "other seeds, and no rig file is written while a stage stays over it (a converged camera shows its "
+         "corners' noise, a few tenths of a px at most); stage 3's median corner distance is held to sqrt(2 ln 2) "
+         "times it, the median distance of corners whose coordinates have this rms")
       ->capture_default_str()
       ->check(PositiveValue());
   app.add_option("--huber", options.system.huber_px, "stage 3 robust loss scale, px")

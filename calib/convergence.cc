@@ -89,20 +89,31 @@ std::string NotConvergedProblem(const CalibrationReport& report, double max_rms_
       Over(s.refined_reprojection_rms_px, max_rms_px) || Over(s.refined_median_corner_residual_px, median_limit_px);
   // Residuals that could not be evaluated read NaN: the solver's line says why.
   const bool read = std::isfinite(s.refined_reprojection_rms_px) && std::isfinite(s.refined_median_corner_residual_px);
-  if (over && (read || s.solver_problem.empty()))
-    return "stage 3 did not converge: rms " + Px(s.refined_reprojection_rms_px) +
-           " (half its corners off by more than " + Px(s.refined_median_corner_residual_px) + "), " + limit +
-           WorstCaptures(report, max_rms_px) +
+  if (over && (read || s.solver_problem.empty())) {
+    // The figure that failed, against its own limit: the rms against
+    // --max-rms-px, else the median against its multiple of it (an rms
+    // within the limit must not read as over it).
+    const bool rms_over = Over(s.refined_reprojection_rms_px, max_rms_px);
+    const std::string figures =
+        rms_over ? "rms " + Px(s.refined_reprojection_rms_px) + " (half its corners off by more than " +
+                       Px(s.refined_median_corner_residual_px) + "), " + limit
+                 : "half its corners off by more than " + Px(s.refined_median_corner_residual_px) +
+                       ", over sqrt(2 ln 2) x --max-rms-px = " + Px(median_limit_px) +
+                       " (the median distance of corners whose coordinates have an rms of --max-rms-px; its rms " +
+                       Px(s.refined_reprojection_rms_px) + " is within " + NumberText(max_rms_px) + " px)";
+    return "stage 3 did not converge: " + figures + WorstCaptures(report, max_rms_px) +
            " (each module converged alone, so the modules do not see the board in one place: one capture far over "
            "the others is one whose modules' images were not taken at the same moment, to remove or take again; "
            "many, a module that moved between captures, or a target whose back face is not where the target file "
            "puts it)";
+  }
   // A solve that stopped short (Ceres's iteration limit, a failure, or
   // residuals that could not be evaluated) left S wherever it stopped,
   // whatever its RMS reads. After the RMS: captures that do not agree stop
   // it short too, and the RMS's message names them.
   if (!s.solver_problem.empty())
-    return "stage 3 did not converge: " + s.solver_problem + ", at rms " + Px(s.refined_reprojection_rms_px) +
+    return "stage 3 did not converge: " + s.solver_problem +
+           (std::isfinite(s.refined_reprojection_rms_px) ? ", at rms " + Px(s.refined_reprojection_rms_px) : "") +
            ": S, the stereo pairs and the lenses are wherever the solve stopped (a lens model whose distortions "
            "the corners do not determine: try a simpler --lensmodel or --fixed-intrinsics)";
   return "";

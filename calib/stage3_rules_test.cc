@@ -97,6 +97,7 @@ TEST(Stage3Rules, ASolveThatStoppedShortIsNotConverged) {
   r.system.refined_median_corner_residual_px = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(NotConvergedProblem(r, 1.0).rfind("stage 3 did not converge: its residuals could not be evaluated", 0), 0u)
       << NotConvergedProblem(r, 1.0);
+  EXPECT_EQ(NotConvergedProblem(r, 1.0).find("nan"), std::string::npos) << NotConvergedProblem(r, 1.0);
   r.num_modules = 1;  // no stage 3
   EXPECT_EQ(NotConvergedProblem(r, 1.0), "");
 }
