@@ -1,5 +1,8 @@
 #include "reconstruct/grey_image.h"
 
+#include <cstdio>
+#include <string>
+
 #include "calib/core/input_error.h"
 #include "reconstruct/image_file.h"
 
@@ -28,10 +31,17 @@ cv::Mat ReadGreyImage(const std::string& path, std::optional<cv::Size> rig_size_
                                  ", the rig says " + std::to_string(rig_size_px->width) + "x" +
                                  std::to_string(rig_size_px->height));
     const long long pixels = static_cast<long long>(header.width_px) * header.height_px;
+    // One decimal: 7072 x 7071 px read "50 Mpx, over the 50 Mpx" in whole
+    // megapixels.
+    auto MegapixelsText = [](long long n) {
+      char text[32];
+      std::snprintf(text, sizeof text, "%.1f", n / 1e6);
+      return std::string(text);
+    };
     if (max_pixels > 0 && pixels > max_pixels)
       throw InputError(path, "is " + std::to_string(header.width_px) + "x" + std::to_string(header.height_px) + " (" +
-                                 std::to_string(pixels / 1000000) + " Mpx), over the " +
-                                 std::to_string(max_pixels / 1000000) + " Mpx " + why_max);
+                                 MegapixelsText(pixels) + " Mpx), over the " + std::to_string(max_pixels / 1000000) +
+                                 " Mpx " + why_max);
   });
 }
 

@@ -50,10 +50,14 @@ cv::Mat ReadImageFile(const std::string& path, const std::function<void(const Im
   if (EndsWithIgnoringCase(path, ".png")) throw InputError(path, "is not a PNG file, though named .png");
   // The truth maps' depth: float32 TIFF, by libtiff.
   if (StartsAsTiff(FirstBytes(path, 4))) {
-    FloatImage depth = ReadFloatTiff(path);
+    // Checked from the header, before the samples are decoded: a 128 KB
+    // TIFF declaring 16000 x 16000 floats took 2 GB before `match` refused
+    // it as not 8-bit grey.
+    FloatImage depth = ReadFloatTiff(path, [&](uint32_t width_px, uint32_t height_px) {
+      check({int(width_px), int(height_px), 1, 32, 32});
+    });
     cv::Mat image(int(depth.height_px), int(depth.width_px), CV_32FC1);
     std::copy(depth.values.begin(), depth.values.end(), image.ptr<float>());
-    check({image.cols, image.rows, 1, 32, 32});
     return image;
   }
   throw InputError(path,

@@ -31,13 +31,12 @@ struct ImageHeader {
   int stored_bit_depth = 0;  // the file's own (PNG: 1, 2, 4, 8 or 16)
 };
 
-// ReadImageFile, with `check` called on the header before a PNG's pixels are
-// allocated and decoded; it throws (InputError) to refuse the file. A
-// capture image whose header gives another size than its camera's (a
-// header declaring 16000 x 16000 px: 256 MB decoded, 2.7 s, before the size
-// was compared) is refused in the time it takes to read its header. A TIFF
-// is checked once decoded (libtiff reads it whole; kMaxFloatTiffPixels
-// bounds it).
+// ReadImageFile, with `check` called on the header before the pixels are
+// allocated and decoded (PNG and float TIFF alike); it throws (InputError)
+// to refuse the file. A capture image whose header gives another size than
+// its camera's (a header declaring 16000 x 16000 px: 256 MB decoded, 2.7 s,
+// before the size was compared) is refused in the time it takes to read its
+// header.
 cv::Mat ReadImageFile(const std::string& path, const std::function<void(const ImageHeader&)>& check);
 
 }  // namespace stereorig

@@ -4,12 +4,15 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <array>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
+#include <vector>
 
 #include "calib/core/png_testing.h"
 #include "calib/core/rig_file.h"
@@ -764,6 +767,10 @@ TEST(Cli, ARigFilesSplinedModelMrcalCannotBuildIsRefused) {
        "mrcal reads it as '" + spline + "order=3_Nx=65532_Ny=65532_fov_x_deg=100'" + wrapped},
       {"order=3_Nx=65535_Ny=65535_fov_x_deg=100", 4,
        "Nx=65535 Ny=65535: 8589672454 intrinsics, more than mrcal counts (2147483647)"},
+      // mrcal's int count of this one wraps to 65538 (4 + 2 x 2147450415
+      // mod 2^32): a rig file giving 65538 intrinsics passes a count.
+      {"order=3_Nx=65535_Ny=32769_fov_x_deg=100", 65538,
+       "Nx=65535 Ny=32769: 4295032834 intrinsics, more than mrcal counts (2147483647)"},
       {"order=3_Nx=4_Ny=4_fov_x_deg=0", 36,
        "fov_x_deg=0: must be in (0, 360), the horizontal field of view the stereographic projection can span, deg"}};
   for (const Case& c : cases) {
@@ -867,10 +874,52 @@ TEST(Cli, MatchRefusesImagesOverItsPixelCapFromTheirHeader) {
                             " --min-disparity 0 --num-disparities 64 --roi 0 0 32 32 --out " + dir + "/d.pfm");
     EXPECT_EQ(r.code, 2) << r.out << r.err;
     EXPECT_EQ(r.err, "stereorig match: " + big +
-                         ": is 8000x8000 (64 Mpx), over the 50 Mpx match reads (twice the largest stereo camera's; "
+                         ": is 8000x8000 (64.0 Mpx), over the 50 Mpx match reads (twice the largest stereo camera's; "
                          "crop the pair to the region to match)\n");
     EXPECT_FALSE(fs::exists(dir + "/d.pfm"));
   }
+}
+
+// A TIFF is checked from its header too, before its samples are decoded: a
+// 128 KB float TIFF declaring 16000 x 16000 px made match take 2 GB before
+// it refused it as not 8-bit grey. Here a 64 KB uncompressed float32 TIFF
+// declaring 16000 x 16000 px and holding one row: refused for what it is
+// (not 8-bit grey), not read as the file cut short it also is (what decoding
+// it, 1 GB of floats allocated first, found).
+TEST(Cli, MatchRefusesAHugeTiffFromItsHeader) {
+  namespace fs = std::filesystem;
+  const std::string dir = ::testing::TempDir() + "/match_tiff_" + std::to_string(getpid());
+  fs::create_directories(dir);
+  std::string tiff = std::string("II*\0", 4);
+  auto u16 = [&](uint16_t v) { tiff += char(v & 0xFF), tiff += char(v >> 8); };
+  auto u32 = [&](uint32_t v) {
+    for (int k = 0; k < 4; ++k) tiff += char((v >> (8 * k)) & 0xFF);
+  };
+  u32(8);  // the directory follows the header
+  const uint32_t width_px = 16000, height_px = 16000, data_at = 8 + 2 + 10 * 12 + 4;
+  const std::vector<std::array<uint32_t, 3>> entries = {
+      // tag, type (3 SHORT, 4 LONG), value
+      {256, 4, width_px}, {257, 4, height_px}, {258, 3, 32},           {259, 3, 1}, {262, 3, 1}, {273, 4, data_at},
+      {277, 3, 1},        {278, 4, height_px}, {279, 4, width_px * 4}, {339, 3, 3}};
+  u16(uint16_t(entries.size()));
+  for (const auto& [tag, type, value] : entries) {
+    u16(uint16_t(tag)), u16(uint16_t(type)), u32(1);
+    if (type == 3)
+      u16(uint16_t(value)), u16(0);
+    else
+      u32(value);
+  }
+  u32(0);                                   // no next directory
+  tiff += std::string(width_px * 4, '\0');  // one row of the 16000
+  const std::string big = dir + "/big.tiff";
+  std::ofstream(big, std::ios::binary) << tiff;
+  const Result r = RunCli("match --left " + big + " --right " + big + " --min-disparity 0 --num-disparities 64 --out " +
+                          dir + "/d.pfm");
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_EQ(r.err.find("cut short"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(big + ": "), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/d.pfm"));
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -61,7 +61,8 @@ bool StartsAsTiff(const std::string& bytes) {
          bytes.compare(0, 4, std::string("II+\0", 4)) == 0 || bytes.compare(0, 4, std::string("MM\0+", 4)) == 0;
 }
 
-FloatImage ReadFloatTiff(const std::string& path) {
+FloatImage ReadFloatTiff(const std::string& path,
+                         const std::function<void(uint32_t width_px, uint32_t height_px)>& before_decoding) {
   TiffMessages messages;
   TiffFile tiff = Open(path, "r", &messages);
   if (!tiff) throw InputError(path, "cannot be read as a TIFF file" + Said(messages));
@@ -88,6 +89,7 @@ FloatImage ReadFloatTiff(const std::string& path) {
                                " px; this reader takes 1 to " + std::to_string(kMaxFloatTiffPixels) + " px");
   if (TIFFScanlineSize(tiff.get()) != tmsize_t(width_px) * tmsize_t(sizeof(float)))
     throw InputError(path, "a damaged TIFF (its rows are not " + std::to_string(width_px) + " floats)");
+  if (before_decoding) before_decoding(width_px, height_px);
   FloatImage image;
   image.width_px = width_px;
   image.height_px = height_px;

@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -26,9 +27,14 @@ bool StartsAsTiff(const std::string& bytes);
 // The float32 single-channel TIFF at `path`. Throws InputError naming the
 // file if it cannot be read or decoded, or holds another kind of image
 // (its samples' type and count named), tiles, or more than
-// kMaxFloatTiffPixels pixels.
+// kMaxFloatTiffPixels pixels. before_decoding (if given) is called with the
+// image's size once its header is read and checked, before any sample is
+// decoded or memory taken for them: a caller with a smaller limit (or one
+// that wants no float image at all) throws there, so a small file declaring
+// a huge image costs nothing.
 inline constexpr uint64_t kMaxFloatTiffPixels = uint64_t(1) << 28;  // as PngReader::kMaxPixels
-FloatImage ReadFloatTiff(const std::string& path);
+FloatImage ReadFloatTiff(const std::string& path,
+                         const std::function<void(uint32_t width_px, uint32_t height_px)>& before_decoding = {});
 
 // Writes `pixels` (height_px rows of width_px floats, row y at pixels +
 // y * row_stride_bytes) to `path` as a float32 TIFF, in place (libtiff

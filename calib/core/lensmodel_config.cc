@@ -30,8 +30,9 @@ std::string LensmodelConfigProblem(const std::string& lensmodel_name) {
     return where + "Nx=" + std::to_string(c.Nx) + " Ny=" + std::to_string(c.Ny) + ": an order " +
            std::to_string(c.order) + " spline needs Nx and Ny >= " + std::to_string(min_knots) + " (mrcal's minimum)";
   // mrcal counts a model's intrinsics, 2 per knot and the 4 of the core,
-  // in an int: a larger grid wrapped (65536 x 65536 knots counted as 4
-  // intrinsics, and a rig file giving 4 passed, then aborted in mrcal).
+  // in an int: a larger grid wraps (65535 x 32769 knots count 4 + 2 x
+  // 2147450415 = 4295032834, read as 65538 in 32 bits: a rig file giving
+  // 65538 intrinsics would pass the count, then abort in mrcal).
   const std::int64_t num_intrinsics = 4 + 2 * static_cast<std::int64_t>(c.Nx) * c.Ny;
   if (num_intrinsics > INT_MAX)
     return where + "Nx=" + std::to_string(c.Nx) + " Ny=" + std::to_string(c.Ny) + ": " +
