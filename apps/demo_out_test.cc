@@ -34,7 +34,7 @@ TEST(CheckDemoOut, WritesOnlyIntoAnEmptyFolderOrAnEarlierDemos) {
   const std::string earlier = dir + "/earlier";
   EarlierDataset(earlier + "/dataset");
   for (const char* name : {"rig.yaml", "calibration.json", "cam0.cameramodel", "cam12.cameramodel", "cup_active.ply",
-                           "check-history.sqlite", "verify_ballbar.json"})
+                           "check-history.sqlite", "check-history.sqlite-journal", "verify_ballbar.json"})
     std::ofstream(earlier + "/" + name) << "written by the demo\n";
   fs::create_directories(earlier + "/night_ok");
   EXPECT_NO_THROW(CheckDemoOut(earlier));

@@ -11,6 +11,7 @@
 #include "calib/core/input_error.h"
 #include "calib/core/input_file.h"
 #include "calib/core/png_reader.h"
+#include "calib/core/printable_text.h"
 #include "calib/layout_file.h"
 #include "targets/target_file.h"
 
@@ -168,7 +169,7 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
       }
       out.log.push_back(log);
     }
-    if (progress) std::fprintf(stderr, "%s\n", line.c_str());
+    if (progress) std::fprintf(stderr, "%s\n", PrintableText(line).c_str());
   }
   return out;
 }
@@ -289,12 +290,15 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
   if (options.progress) {
     std::fprintf(stderr, "calibrate: %d captures, %d accepted views\n", out.num_captures, out.num_views);
   }
+  // Warnings on a terminal: their paths' control bytes escaped (the report
+  // keeps the text as it is, JSON-escaped).
   const std::string rejected_note = RejectedViewsNote(detected, target, target_path);
-  if (!rejected_note.empty()) std::fprintf(stderr, "calibrate: warning: %s\n", rejected_note.c_str());
+  if (!rejected_note.empty()) std::fprintf(stderr, "calibrate: warning: %s\n", PrintableText(rejected_note).c_str());
   const std::string never_seen_note = NeverSeenCornersNote(input.observations, target, target_path);
-  if (!never_seen_note.empty()) std::fprintf(stderr, "calibrate: warning: %s\n", never_seen_note.c_str());
+  if (!never_seen_note.empty())
+    std::fprintf(stderr, "calibrate: warning: %s\n", PrintableText(never_seen_note).c_str());
   const std::string left_out_note = CamerasLeftOutNote(captures_dir, num_cameras);
-  if (!left_out_note.empty()) std::fprintf(stderr, "calibrate: warning: %s\n", left_out_note.c_str());
+  if (!left_out_note.empty()) std::fprintf(stderr, "calibrate: warning: %s\n", PrintableText(left_out_note).c_str());
   try {
     out.result = Calibrate(input, options);
   } catch (const InputError& e) {

@@ -84,12 +84,15 @@ ProjectorSpec ParseProjector(YamlMap m) {
   // (Direction cosines, mrad: the units of line_sigma_mrad in render.h.)
   const double fan_span_mrad = 2e3 * std::sin(0.5 * p.fan_angle_deg * M_PI / 180.0);
   const double spacing_mrad = fan_span_mrad / (p.lines - 1);
-  const int most_lines = 1 + static_cast<int>(std::floor(fan_span_mrad / (2 * p.line_sigma_mrad)));
-  Require(spacing_mrad >= 2 * p.line_sigma_mrad, m.Where(), "lines",
-          std::to_string(p.lines) + " lines over the fan stand " + NumberText(spacing_mrad, 3) +
-              " mrad apart, under 2 line_sigma_mrad (" + Num(2 * p.line_sigma_mrad) +
-              "): they merge into even light; at most " + std::to_string(most_lines) +
-              " with this fan_angle_deg and line_sigma_mrad");
+  if (!(spacing_mrad >= 2 * p.line_sigma_mrad)) {
+    // Only here: a line_sigma_mrad of 1e-300 would overflow the int.
+    const int most_lines = 1 + static_cast<int>(std::floor(fan_span_mrad / (2 * p.line_sigma_mrad)));
+    Require(false, m.Where(), "lines",
+            std::to_string(p.lines) + " lines over the fan stand " + NumberText(spacing_mrad, 3) +
+                " mrad apart, under 2 line_sigma_mrad (" + Num(2 * p.line_sigma_mrad) +
+                "): they merge into even light; at most " + std::to_string(most_lines) +
+                " with this fan_angle_deg and line_sigma_mrad");
+  }
   Require(p.power_dn >= 0, m.Where(), "power_dn", "must not be negative");
   return p;
 }

@@ -649,19 +649,28 @@ TEST(CalibrateCli, ALayoutWithTwoModulesOfOneNameIsRefused) {
 // them out and said nothing (a one-module rig from four cameras' captures).
 // A one-module calibration may be meant, so it goes on, with a warning on
 // stderr and in the report naming the cameras left out.
+// The captures are given through a link whose name holds an escape
+// sequence (ESC [31m): the warning on stderr shows it escaped, as error
+// lines do (it reached the terminal raw), the report keeps it as it is.
 TEST(CalibrateCli, CamerasTheLayoutLeavesOutAreWarnedOf) {
+  namespace fs = std::filesystem;
   const RenderedSet& set = Rendered();
   std::ofstream(set.dir + "/one_module.yaml") << "modules:\n  - {name: module0, left: 0, right: 1, face: front}\n";
+  const std::string captures = set.dir + "/cap\x1b[31m";
+  fs::remove(captures);
+  fs::create_directory_symlink(set.dir + "/captures", captures);
   const testing::Result r =
-      testing::RunCli("calibrate --captures " + set.dir + "/captures --target " + set.dir + "/target.yaml --layout " +
+      testing::RunCli("calibrate --captures '" + captures + "' --target " + set.dir + "/target.yaml --layout " +
                       set.dir + "/one_module.yaml --out " + set.dir + "/one.yaml --report " + set.dir +
                       "/one.json --lensmodel LENSMODEL_OPENCV5");
   ASSERT_EQ(r.code, 0) << r.err;
-  const std::string warning = set.dir +
-                              "/captures holds cam2.png (in 8 captures), cam3.png (in 8 captures), but the layout "
-                              "names cameras 0 to 1 only: the rig leaves them out (name them in a module of the "
-                              "layout to calibrate them)";
-  EXPECT_NE(r.err.find("calibrate: warning: " + warning + "\n"), std::string::npos) << r.err;
+  const std::string held =
+      " holds cam2.png (in 8 captures), cam3.png (in 8 captures), but the layout "
+      "names cameras 0 to 1 only: the rig leaves them out (name them in a module of the "
+      "layout to calibrate them)";
+  const std::string warning = captures + held;
+  EXPECT_NE(r.err.find("calibrate: warning: " + set.dir + "/cap\\x1B[31m" + held + "\n"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << "a raw ESC reached stderr";
   EXPECT_EQ(ReadRigFile(set.dir + "/one.yaml").num_cameras(), 2);
   std::ifstream report(set.dir + "/one.json");
   const nlohmann::json json = nlohmann::json::parse(report);
