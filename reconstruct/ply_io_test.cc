@@ -2,7 +2,8 @@
 // written from the cloud and the triangles. The PLY holds the cloud's vertex
 // records as the cloud PLY has them and the faces' indices into them; the
 // STL each triangle's corners from the cloud; a triangle indexing no point
-// of the cloud is refused as the programming error it is.
+// of the cloud is refused as the programming error it is; removing points
+// renumbers the triangles over those kept.
 #include "reconstruct/ply_io.h"
 
 #include <gtest/gtest.h>
@@ -94,6 +95,33 @@ TEST(Mesh, AppendOffsetsTheTrianglesByWhereTheirCloudBeginsInTheJoinedOne) {
   EXPECT_EQ(mesh.triangles[0], Eigen::Vector3i(0, 1, 2));
   EXPECT_EQ(mesh.triangles[1], Eigen::Vector3i(5, 7, 6));
   CheckMeshOver(joined, mesh);  // in range: no abort
+}
+
+// The free-space test removes a module's refuted points (runtime.cc,
+// RemoveRefuted): the others keep their order and fields, a triangle with a
+// removed vertex goes, the rest are renumbered onto the kept points.
+TEST(Mesh, RemovingPointsRenumbersTheTrianglesOverThoseKept) {
+  PointCloud cloud = FourPoints();
+  const PointCloud before = cloud;
+  Mesh mesh;
+  mesh.triangles = {Eigen::Vector3i(0, 1, 2), Eigen::Vector3i(0, 2, 3), Eigen::Vector3i(2, 3, 0)};
+  RemovePoints({0, 1, 0, 0}, &cloud, &mesh);  // point 1 goes: 0, 2, 3 become 0, 1, 2
+  ASSERT_EQ(cloud.size(), 3u);
+  const int from[3] = {0, 2, 3};
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(cloud.xyz_mm[i], before.xyz_mm[from[i]]) << i;
+    EXPECT_EQ(cloud.normal[i], before.normal[from[i]]) << i;
+    EXPECT_EQ(cloud.intensity[i], before.intensity[from[i]]) << i;
+    EXPECT_EQ(cloud.module[i], before.module[from[i]]) << i;
+    EXPECT_EQ(cloud.confidence[i], before.confidence[from[i]]) << i;
+  }
+  ASSERT_EQ(mesh.triangles.size(), 2u);  // (0, 1, 2) held point 1
+  EXPECT_EQ(mesh.triangles[0], Eigen::Vector3i(0, 1, 2));
+  EXPECT_EQ(mesh.triangles[1], Eigen::Vector3i(1, 2, 0));
+  CheckMeshOver(cloud, mesh);
+  RemovePoints({1, 1, 1}, &cloud, &mesh);
+  EXPECT_EQ(cloud.size(), 0u);
+  EXPECT_TRUE(mesh.triangles.empty());
 }
 
 }  // namespace

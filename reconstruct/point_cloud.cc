@@ -41,4 +41,28 @@ void CheckMeshOver(const PointCloud& vertices, const Mesh& mesh) {
   for (const Eigen::Vector3i& t : mesh.triangles) STEREORIG_CHECK(t.minCoeff() >= 0 && t.maxCoeff() < n);
 }
 
+void RemovePoints(const std::vector<uint8_t>& drop, PointCloud* cloud, Mesh* mesh) {
+  STEREORIG_CHECK(drop.size() == cloud->size());
+  CheckMeshOver(*cloud, *mesh);  // new_index is read at every vertex of every triangle
+  std::vector<int> new_index(cloud->size(), -1);
+  PointCloud kept;
+  kept.Reserve(cloud->size());
+  for (size_t i = 0; i < cloud->size(); ++i) {
+    if (drop[i]) continue;
+    new_index[i] = int(kept.size());
+    kept.xyz_mm.push_back(cloud->xyz_mm[i]);
+    kept.normal.push_back(cloud->normal[i]);
+    kept.intensity.push_back(cloud->intensity[i]);
+    kept.module.push_back(cloud->module[i]);
+    kept.confidence.push_back(cloud->confidence[i]);
+  }
+  *cloud = std::move(kept);
+  size_t n = 0;
+  for (const Eigen::Vector3i& tri : mesh->triangles) {
+    const Eigen::Vector3i m(new_index[tri[0]], new_index[tri[1]], new_index[tri[2]]);
+    if (m.minCoeff() >= 0) mesh->triangles[n++] = m;
+  }
+  mesh->triangles.resize(n);
+}
+
 }  // namespace stereorig

@@ -43,4 +43,10 @@ struct Mesh {
 // cloud and the mesh went out of step): STEREORIG_CHECK fails on it.
 void CheckMeshOver(const PointCloud& vertices, const Mesh& mesh);
 
+// Removes the points i with drop[i] != 0 (drop: one entry per point) from
+// *cloud, keeping the others in order, and from the mesh over it: a
+// triangle with a removed vertex goes, the others take their vertices' new
+// indices.
+void RemovePoints(const std::vector<uint8_t>& drop, PointCloud* cloud, Mesh* mesh);
+
 }  // namespace stereorig

@@ -43,19 +43,8 @@ void RemoveRefuted(const ModulePlan& plan, const std::vector<uint8_t>& refuted, 
   const Pose module_from_reference = plan.reference_from_module.Inverse();
   const Eigen::Matrix3d r = plan.geometry.rect_from_left * module_from_reference.rotation();
   const Eigen::Vector3d t = plan.geometry.rect_from_left * module_from_reference.translation_mm();
-  std::vector<int> new_index(cloud->size(), -1);
-  PointCloud kept;
-  kept.Reserve(cloud->size());
   for (size_t i = 0; i < cloud->size(); ++i) {
-    if (!refuted[i]) {
-      new_index[i] = int(kept.size());
-      kept.xyz_mm.push_back(cloud->xyz_mm[i]);
-      kept.normal.push_back(cloud->normal[i]);
-      kept.intensity.push_back(cloud->intensity[i]);
-      kept.module.push_back(cloud->module[i]);
-      kept.confidence.push_back(cloud->confidence[i]);
-      continue;
-    }
+    if (!refuted[i]) continue;
     const bool surface = refuted[i] == uint8_t(FreeSpaceVerdict::kOnSeenThroughSurface);
     ++report->seen_through;
     report->seen_through_surface += surface;
@@ -72,17 +61,8 @@ void RemoveRefuted(const ModulePlan& plan, const std::vector<uint8_t>& refuted, 
       ++report->lit_by_status[size_t(st)];
     }
   }
-  CheckMeshOver(*cloud, *mesh);  // new_index is read at every vertex of every triangle
-  report->points = int(kept.size());
-  *cloud = std::move(kept);
-  // The mesh's triangles over the kept points: a triangle with a removed
-  // vertex goes, the others take their vertices' new indices.
-  size_t n = 0;
-  for (const Eigen::Vector3i& tri : mesh->triangles) {
-    const Eigen::Vector3i m(new_index[tri[0]], new_index[tri[1]], new_index[tri[2]]);
-    if (m.minCoeff() >= 0) mesh->triangles[n++] = m;
-  }
-  mesh->triangles.resize(n);
+  RemovePoints(refuted, cloud, mesh);
+  report->points = int(cloud->size());
 }
 
 }  // namespace
