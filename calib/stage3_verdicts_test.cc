@@ -258,6 +258,35 @@ TEST(CalibrateSystemVerdicts, OpenCv12SigmaOfSHoldsItsHeldTermsUncertainty) {
   }
 }
 
+// Without stage 2's covariance of them (CalibrateSystem called with bare
+// cameras), OPENCV8's k4..k6 are held at their values, reported with sigma
+// 0, and the report says S's 1 sigma is conditional on them; with the
+// intrinsics not refined at all, on every camera's.
+TEST(CalibrateSystemVerdicts, HeldWithoutAPriorTheSigmaOfSIsSaidConditional) {
+  const auto s = testing::MakeDefaultScene(72, 12, kNoisePx);
+  std::vector<ModuleCameras> modules;
+  for (int k = 0; k < 2; ++k) {
+    const StereoModule& m = s.truth.rig.module(k);
+    modules.push_back({m.left_camera, m.right_camera, s.truth.rig.camera(m.left_camera),
+                       s.truth.rig.camera(m.right_camera), m.right_from_left});
+  }
+  ASSERT_EQ(modules[0].left.lensmodel_name(), "LENSMODEL_OPENCV8");
+  const SystemReport held = CalibrateSystem(s.data.input, modules, kNoisePx, SystemOptions(), {}).report;
+  EXPECT_EQ(held.covariance_status, "ok");
+  EXPECT_EQ(held.sigma_conditional_on.rfind("camera(s) 0, 1, 2, 3's k4..", 0), 0u) << held.sigma_conditional_on;
+  ASSERT_EQ(held.intrinsics_sigma.size(), 4u);
+  for (const RefinedIntrinsicsSigma& x : held.intrinsics_sigma) {
+    for (size_t i = 9; i < 12; ++i) {
+      EXPECT_EQ(x.sigma[i], 0.0) << "camera " << x.camera << " intrinsic " << i;
+      EXPECT_EQ(x.intrinsics[i], s.truth.rig.camera(x.camera).intrinsics()[i]);
+    }
+  }
+  SystemOptions fixed;
+  fixed.refine_intrinsics = false;
+  const SystemReport all_held = CalibrateSystem(s.data.input, modules, kNoisePx, fixed, {}).report;
+  EXPECT_EQ(all_held.sigma_conditional_on.rfind("every camera's intrinsics", 0), 0u) << all_held.sigma_conditional_on;
+}
+
 // A stage 3 whose Ceres solve stopped short (here at its iteration limit,
 // 1) did not converge, whatever its RMS: the rig file is not written. Its
 // RMS after one step from Horn is already near the noise, which alone let
