@@ -254,7 +254,8 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
                                             options.intrinsics));
     rep.stereo.push_back(result.stage2.back().report);
     const StereoResult& s = result.stage2.back();
-    modules.push_back({m.left_camera, m.right_camera, s.left, s.right, s.right_from_left});
+    modules.push_back({m.left_camera, m.right_camera, s.left, s.right, s.right_from_left,
+                       s.report.left.intrinsics_covariance, s.report.right.intrinsics_covariance});
   }
   // Stage 3.
   std::vector<Pose> module0_from_module(M);
@@ -454,7 +455,8 @@ std::string CalibrationReport::ToJson() const {
       j.EndObject();
     }
     j.EndArray().EndObject();
-    j.String("covariance", s.covariance_status).BeginArray("sigma_S_0_k");
+    j.String("covariance", s.covariance_status).String("sigma_conditional_on", s.sigma_conditional_on);
+    j.BeginArray("sigma_S_0_k");
     for (const STransformSigma& x : s.sigma) {
       j.BeginObject().Int("module", x.module);
       j.Numbers("rotation_deg", {x.rotation_deg.x(), x.rotation_deg.y(), x.rotation_deg.z()});
@@ -620,6 +622,8 @@ std::string SummaryText(const CalibrationReport& rep) {
                  x.translation_mm.y(), x.translation_mm.z());
     }
     if (s.sigma.empty()) AppendLine(&out, "  1 sigma of S: %s", s.covariance_status.c_str());
+    if (!s.sigma.empty() && !s.sigma_conditional_on.empty())
+      AppendLine(&out, "  (conditional on %s)", s.sigma_conditional_on.c_str());
     for (const RefinedStereoSigma& x : s.stereo_sigma) {
       AppendLine(&out, "  refined module %d: baseline %.4f +- %.4f mm, rotation %.4f +- %.4f deg (1 sigma)", x.module,
                  x.baseline_mm, x.baseline_sigma_mm, x.rotation_deg, x.rotation_sigma_deg);

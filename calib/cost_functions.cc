@@ -2,6 +2,10 @@
 
 #include <ceres/rotation.h>
 
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <utility>
+
 #include "calib/core/input_error.h"
 #include "calib/core/mrcal_c.h"
 
@@ -101,6 +105,45 @@ bool CornerReprojectionCost::Evaluate(double const* const* parameters, double* r
       }
   }
   if (need_intr_j) std::copy(dq_dintr.begin(), dq_dintr.end(), jacobians[4]);
+  return true;
+}
+
+ceres::CostFunction* HeldIntrinsicsPrior::Create(const std::vector<double>& theta0, const std::vector<int>& held,
+                                                 const std::vector<double>& covariance, double corner_sigma_px) {
+  const int n = static_cast<int>(theta0.size()), h = static_cast<int>(held.size());
+  if (h == 0 || covariance.size() != static_cast<size_t>(n) * n) return nullptr;
+  Eigen::MatrixXd cov_held(h, h);
+  Eigen::VectorXd theta0_held(h);
+  for (int i = 0; i < h; ++i) {
+    theta0_held(i) = theta0[held[i]];
+    for (int j = 0; j < h; ++j) cov_held(i, j) = covariance[static_cast<size_t>(held[i]) * n + held[j]];
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(cov_held);
+  if (llt.info() != Eigen::Success || !cov_held.allFinite()) return nullptr;
+  const Eigen::MatrixXd l_inverse = llt.matrixL().solve(Eigen::MatrixXd::Identity(h, h));
+  if (!l_inverse.allFinite()) return nullptr;
+  return new HeldIntrinsicsPrior(n, held, theta0_held, corner_sigma_px * l_inverse);
+}
+
+HeldIntrinsicsPrior::HeldIntrinsicsPrior(int num_intrinsics, std::vector<int> held, Eigen::VectorXd theta0_held,
+                                         Eigen::MatrixXd whiten)
+    : held_(std::move(held)), theta0_held_(std::move(theta0_held)), whiten_(std::move(whiten)) {
+  set_num_residuals(static_cast<int>(held_.size()));
+  mutable_parameter_block_sizes()->push_back(num_intrinsics);
+}
+
+bool HeldIntrinsicsPrior::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
+  const int h = static_cast<int>(held_.size());
+  Eigen::VectorXd d(h);
+  for (int i = 0; i < h; ++i) d(i) = parameters[0][held_[i]] - theta0_held_(i);
+  Eigen::Map<Eigen::VectorXd>(residuals, h) = whiten_ * d;
+  if (jacobians && jacobians[0]) {
+    // (H, N) row-major: whiten_ in the held columns, 0 elsewhere (linear).
+    const int n = parameter_block_sizes()[0];
+    std::fill(jacobians[0], jacobians[0] + h * n, 0.0);
+    for (int r = 0; r < h; ++r)
+      for (int c = 0; c < h; ++c) jacobians[0][r * n + held_[c]] = whiten_(r, c);
+  }
   return true;
 }
 

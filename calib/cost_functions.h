@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <vector>
 
 #include "calib/core/camera.h"
 #include "calib/core/pose.h"
@@ -88,6 +89,30 @@ struct BackFromFrontPrior {
     return new ceres::AutoDiffCostFunction<BackFromFrontPrior, 6, 6>(
         new BackFromFrontPrior{t_measured_mm, sigma, corner_sigma_px});
   }
+};
+
+// Prior on the intrinsics stage 3 cannot determine alone
+// (Stage3HeldIntrinsics): residual (H,) = corner_sigma_px * L^-1 (theta_h -
+// theta_h0), theta_h the block's parameters at indices `held`, theta_h0
+// their stage-2 values, L L' stage 2's covariance of them. Whitened and
+// weighed against the corner noise as BackFromFrontPrior, so that they move
+// only as far as stage 2 left them uncertain (not to a pole-zero pair) and
+// their uncertainty enters the covariance of S.
+class HeldIntrinsicsPrior : public ceres::CostFunction {
+ public:
+  // `theta0`: the block's (N,) stage-2 values; `covariance`: stage 2's (N *
+  // N,) row-major, of which the `held` rows and columns are taken. Null if it
+  // is empty or that block is not positive definite (no prior to refine
+  // under: the caller holds them).
+  static ceres::CostFunction* Create(const std::vector<double>& theta0, const std::vector<int>& held,
+                                     const std::vector<double>& covariance, double corner_sigma_px);
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
+
+ private:
+  HeldIntrinsicsPrior(int num_intrinsics, std::vector<int> held, Eigen::VectorXd theta0_held, Eigen::MatrixXd whiten);
+  std::vector<int> held_;
+  Eigen::VectorXd theta0_held_;  // (H,)
+  Eigen::MatrixXd whiten_;       // (H, H) corner_sigma_px * L^-1
 };
 
 }  // namespace stereorig

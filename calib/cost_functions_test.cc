@@ -1,12 +1,14 @@
 // The stage-3 reprojection cost: its hand-chained Jacobian (autodiff pose
 // chain x mrcal's analytic projection gradients) against central numeric
 // differences, for every parameter block, for a left and a right camera, the
-// front and the back face, and two lens models.
+// front and the back face, and two lens models. The held intrinsics' prior.
 #include "calib/cost_functions.h"
 
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <random>
+#include <vector>
 
 namespace stereorig {
 namespace {
@@ -76,6 +78,39 @@ TEST(CornerReprojectionCost, JacobiansMatchNumericSplined) {
   for (int i = 0; i < 2 * 8 * 6; ++i) intr.push_back(0.01 * u(rng));
   const Camera cam(model, intr, 752, 582);
   CheckJacobians(cam, true, true, 7);
+}
+
+// The held intrinsics' prior: residual corner_sigma_px * L^-1 (theta_h -
+// theta_h0) with L L' the held block of the covariance, so that its squared
+// norm is corner_sigma_px^2 times the Mahalanobis distance d' C^-1 d, and
+// its Jacobian that linear map in the held columns, 0 in the others.
+TEST(HeldIntrinsicsPrior, WhitensByTheHeldBlockOfTheCovariance) {
+  const std::vector<double> theta0 = {1000, 1000, 376, 291, 0.1, 0.2};
+  const std::vector<int> held = {4, 5};
+  std::vector<double> covariance(36, 0.0);
+  for (int i = 0; i < 6; ++i) covariance[i * 6 + i] = 1.0;
+  covariance[4 * 6 + 4] = 4e-4, covariance[5 * 6 + 5] = 1e-4, covariance[4 * 6 + 5] = covariance[5 * 6 + 4] = 1e-4;
+  std::unique_ptr<ceres::CostFunction> prior(HeldIntrinsicsPrior::Create(theta0, held, covariance, 0.2));
+  ASSERT_NE(prior, nullptr);
+  ASSERT_EQ(prior->num_residuals(), 2);
+  const std::vector<double> theta = {990, 1003, 370, 300, 0.13, 0.19};  // the core's moves cost nothing
+  const double* params[] = {theta.data()};
+  double r[2], j[2 * 6];
+  double* jacobians[] = {j};
+  ASSERT_TRUE(prior->Evaluate(params, r, jacobians));
+  Eigen::Matrix2d c;
+  c << 4e-4, 1e-4, 1e-4, 1e-4;
+  const Eigen::Vector2d d(0.03, -0.01);
+  EXPECT_NEAR(r[0] * r[0] + r[1] * r[1], 0.04 * d.dot(c.inverse() * d), 1e-9);
+  for (int row = 0; row < 2; ++row) {
+    for (int col = 0; col < 4; ++col) EXPECT_EQ(j[row * 6 + col], 0.0);
+    // Linear: r = J d over the held columns.
+    EXPECT_NEAR(j[row * 6 + 4] * d(0) + j[row * 6 + 5] * d(1), r[row], 1e-12);
+  }
+  // No covariance, or a held block that is not positive definite: no prior.
+  EXPECT_EQ(HeldIntrinsicsPrior::Create(theta0, held, {}, 0.2), nullptr);
+  covariance[5 * 6 + 5] = 0.0;
+  EXPECT_EQ(HeldIntrinsicsPrior::Create(theta0, held, covariance, 0.2), nullptr);
 }
 
 }  // namespace

@@ -226,6 +226,9 @@ void FillCoverageAndUncertainty(const MrcalProblem& p, int icam, const Intrinsic
   if (!eval.ok()) return;  // leaves the uncertainty empty; the caller reports it
   const Eigen::MatrixXd cov = eval.IntrinsicsCovariance(icam);
   for (int i = 0; i < np; ++i) r->intrinsics_sigma.push_back(std::sqrt(std::max(0.0, cov(i, i))));
+  const Eigen::MatrixXd posterior = eval.IntrinsicsCovariance(icam, /*regularisation_as_prior=*/true);
+  for (int i = 0; i < np; ++i)
+    for (int j = 0; j < np; ++j) r->intrinsics_covariance.push_back(posterior(i, j));
   r->observed_sigma_px = eval.observed_pixel_sigma_px();
   const std::vector<std::pair<std::string, Eigen::Vector2d>> at = {{"centre", {0.5 * (width - 1), 0.5 * (height - 1)}},
                                                                    {"top-left", {0, 0}},

@@ -87,6 +87,13 @@ struct IntrinsicsReport {
   double uncertainty_range_mm = 0.0;
   std::vector<double> intrinsics;        // (Nparams,) as solved, mrcal's order (fx fy cx cy k1 k2 p1 p2 k3 ...)
   std::vector<double> intrinsics_sigma;  // (Nparams,) their 1 sigma from the solve's covariance; empty if none
+  // (Nparams * Nparams,) row-major, in the parameters' units; empty if none:
+  // their covariance with mrcal's regularisation taken as a Gaussian prior
+  // (ProjectionUncertaintyEvaluator::Covariance, regularisation_as_prior;
+  // without regularisation intrinsics_sigma's). Stage 3 refines the
+  // parameters it cannot determine alone under their block of it
+  // (calib/system.h, ModuleCameras).
+  std::vector<double> intrinsics_covariance;
 };
 
 struct IntrinsicsResult {

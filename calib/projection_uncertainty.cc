@@ -187,7 +187,8 @@ ProjectionUncertainty ProjectionUncertaintyEvaluator::AtPoint(int icam_intrinsic
   return out;
 }
 
-Eigen::MatrixXd ProjectionUncertaintyEvaluator::Covariance(const StateGradient& dy_db_unpacked) const {
+Eigen::MatrixXd ProjectionUncertaintyEvaluator::Covariance(const StateGradient& dy_db_unpacked,
+                                                           bool regularisation_as_prior) const {
   const Impl& m = *impl_;
   STEREORIG_CHECK(m.ok);
   STEREORIG_CHECK(dy_db_unpacked.cols() == m.num_states);
@@ -212,7 +213,7 @@ Eigen::MatrixXd ProjectionUncertaintyEvaluator::Covariance(const StateGradient& 
   const Eigen::Map<const Eigen::MatrixXd> Am(static_cast<const double*>(A->x), Nstate, k);
 
   Eigen::MatrixXd var = Eigen::MatrixXd::Zero(k, k);
-  if (m.has_regularization) {
+  if (m.has_regularization && !regularisation_as_prior) {
     // Var = A' J_obs' J_obs A: sum over the observation rows of J of the
     // outer product of (J_row . A).
     const int* Jp = static_cast<const int*>(m.Jt->p);
@@ -232,7 +233,7 @@ Eigen::MatrixXd ProjectionUncertaintyEvaluator::Covariance(const StateGradient& 
   return var * (m.sigma_px * m.sigma_px);
 }
 
-Eigen::MatrixXd ProjectionUncertaintyEvaluator::IntrinsicsCovariance(int icam) const {
+Eigen::MatrixXd ProjectionUncertaintyEvaluator::IntrinsicsCovariance(int icam, bool regularisation_as_prior) const {
   const MrcalProblem& p = *impl_->problem;
   const int Nparams = p.num_params();
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(Nparams, Nparams);
@@ -245,7 +246,7 @@ Eigen::MatrixXd ProjectionUncertaintyEvaluator::IntrinsicsCovariance(int icam) c
                                                   0, p.num_observations(), p.selections, &p.lensmodel);
   StateGradient g = StateGradient::Zero(i1 - i0, impl_->num_states);
   for (int i = 0; i < i1 - i0; ++i) g(i, istate + i) = 1.0;
-  out.block(i0, i0, i1 - i0, i1 - i0) = Covariance(g);
+  out.block(i0, i0, i1 - i0, i1 - i0) = Covariance(g, regularisation_as_prior);
   return out;
 }
 

@@ -60,12 +60,19 @@ class ProjectionUncertaintyEvaluator {
 
   // Var(y) (k, k) of y = f(state) with dy/db = `dy_db` (k, Nstate, unpacked),
   // scaled by the observed noise: sigma^2 dy_db inv(J'J) dy_db' without
-  // regularisation, the sandwich above with it.
-  Eigen::MatrixXd Covariance(const StateGradient& dy_db) const;
+  // regularisation, the sandwich above with it (the corners' noise alone).
+  // `regularisation_as_prior`: sigma^2 dy_db inv(J'J) dy_db' with it too, J
+  // holding its rows: the covariance of the posterior whose Gaussian prior
+  // is the regularisation. Along a direction only the regularisation
+  // determines, the sandwich's variance goes to 0 (the corners do not move
+  // it), the posterior's to the prior's: what stage 3 refines OPENCV12's
+  // k4..k6, s1..s4 under (calib/system.h). mrcal 2.2 applies no centre-pixel
+  // term (its rows are 0): the prior is on the distortions alone.
+  Eigen::MatrixXd Covariance(const StateGradient& dy_db, bool regularisation_as_prior = false) const;
   // Covariance (Nparams, Nparams) of intrinsics camera `icam_intrinsics`'s
   // parameters, in mrcal's order and units; rows and columns of parameters
   // the solve did not optimise are 0.
-  Eigen::MatrixXd IntrinsicsCovariance(int icam_intrinsics) const;
+  Eigen::MatrixXd IntrinsicsCovariance(int icam_intrinsics, bool regularisation_as_prior = false) const;
   // Covariance (6, 6) of extrinsics camera `icam_extrinsics`'s rt_cam_ref
   // (r: rotation vector, rad; t: mm).
   Eigen::Matrix<double, 6, 6> ExtrinsicsCovariance(int icam_extrinsics) const;
