@@ -438,6 +438,9 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   // The full adjustment.
   set_free(true, options.refine_stereo, bff_free, options.refine_intrinsics);
   ceres::Solve(sopt, &problem, &summary);
+  // What the full adjustment left is judged, not the Horn-only step's
+  // evaluation above (a seed the full solve moved away from).
+  rep.solver_problem.clear();
   // Only CONVERGENCE is a solution: NO_CONVERGENCE (the iteration limit),
   // FAILURE and USER_FAILURE leave the parameters wherever the solve
   // stopped, whatever their RMS reads (OPENCV12 with its k4..k6 freed: 101
