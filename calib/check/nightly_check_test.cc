@@ -720,8 +720,12 @@ TEST(NightlyCheck, ExplanationSaysNoMoreThanTheFiguresTell) {
   r.camera_changes = {lens};
   EXPECT_EQ(r.Explanation(), "camera 2's lens changed: focal length +0.100 %, principal point +0.00, +0.25 px");
   EXPECT_EQ(r.FlaggedCameras(), std::vector<int>{2});
-  r.camera_changes[0].kind = CameraChangeKind::kMovedOrLens;
-  EXPECT_EQ(r.Explanation(), "camera 2 moved or its lens changed (either explains its corners)");
+  r.camera_changes[0].kind = CameraChangeKind::kMovedOrLens;  // both fits' sizes said
+  r.camera_changes[0].turned_deg = 0.0141;
+  r.camera_changes[0].shifted_mm = 0.0004;
+  EXPECT_EQ(r.Explanation(),
+            "camera 2 moved or its lens changed (either explains its corners): turned 0.014 deg, shifted 0.000 mm, "
+            "or focal length +0.100 %, principal point +0.00, +0.25 px");
   r.camera_changes[0].kind = CameraChangeKind::kUnexplained;
   r.camera_changes[0].moved_rms_px = std::numeric_limits<double>::infinity();  // its solve failed
   r.camera_changes[0].lens_rms_px = 0.0812;
