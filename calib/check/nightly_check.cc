@@ -1157,22 +1157,22 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   }
 
   // A module whose two cameras disagree: the camera that also disagrees with
-  // the other modules is the one that moved. With one module there is no
-  // outside view: the camera is named by how it moved (TurnedCameraOfModule),
-  // else the module.
+  // the other modules changed. Where some module agrees with itself, its
+  // cameras are the outside, and each camera that disagrees with them is
+  // named: both may have changed (module 1's baseline 90 -> 90.3 mm, each
+  // camera moved 0.15 mm, named camera 3 alone). Where every other module's
+  // cameras disagree too, their change would read as this module's: the
+  // worse camera alone is named, as before. With one module there is no
+  // outside view: the camera is named by how it moved
+  // (TurnedCameraOfModule), else the module.
+  std::vector<int> named_cameras;  // in the order named
   for (int m : inconsistent_modules) {
     const StereoModule& mod = rig.module(m);
-    std::set<int> outside;
-    for (int c = 0; c < rig.num_cameras(); ++c)
-      if (ModuleOf(rig, c) != m) outside.insert(c);
-    double best_ratio = 0;
-    int named = -1;
-    for (int c : {mod.left_camera, mod.right_camera}) {
-      const Consistency con = outside.empty() ? Consistency{} : CameraConsistency(in, c, outside);
-      if (con.corners > 0 && con.rms_px / con.threshold_px > best_ratio) {
-        best_ratio = con.rms_px / con.threshold_px;
-        named = c;
-      }
+    std::set<int> outside, agreeing;
+    for (int c = 0; c < rig.num_cameras(); ++c) {
+      if (ModuleOf(rig, c) == m) continue;
+      outside.insert(c);
+      if (!inconsistent_modules.count(ModuleOf(rig, c))) agreeing.insert(c);
     }
     if (outside.empty()) {
       if (std::optional<CameraChange> turned = TurnedCameraOfModule(in, mod)) {
@@ -1180,16 +1180,27 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
         continue;
       }
     }
-    if (named >= 0 && best_ratio > 1.0) {
-      // Moved, or a drifted lens? Its corners against the poses every other
-      // camera implies, judged by its own consistency threshold.
-      std::set<int> others = all;
-      others.erase(named);
-      const Consistency con = CameraConsistency(in, named, others);
-      result.camera_changes.push_back(ExplainCameraChange(rig, target, named, con.views, con.threshold_px));
-    } else {
-      result.split_modules.push_back(m);
+    std::vector<std::pair<double, int>> off;  // (ratio to its threshold, camera), over 1
+    for (int c : {mod.left_camera, mod.right_camera}) {
+      const Consistency con =
+          outside.empty() ? Consistency{} : CameraConsistency(in, c, agreeing.empty() ? outside : agreeing);
+      if (con.corners > 0 && con.rms_px > con.threshold_px) off.push_back({con.rms_px / con.threshold_px, c});
     }
+    std::sort(off.rbegin(), off.rend());  // the worse first
+    if (agreeing.empty() && off.size() > 1) off.resize(1);
+    for (const auto& [ratio, c] : off) named_cameras.push_back(c);
+    if (off.empty()) result.split_modules.push_back(m);
+  }
+  // Moved, or a drifted lens? Each named camera's corners against the poses
+  // every camera not named implies (a named partner's change would be read
+  // as its own), judged by its own consistency threshold.
+  std::set<int> unnamed = all;
+  for (int c : named_cameras) unnamed.erase(c);
+  for (int c : named_cameras) {
+    std::set<int> others = unnamed;
+    if (others.empty()) others = all, others.erase(c);
+    const Consistency con = CameraConsistency(in, c, others);
+    result.camera_changes.push_back(ExplainCameraChange(rig, target, c, con.views, con.threshold_px));
   }
 
   // --- Module pairs: closure through the target. ---

@@ -47,6 +47,7 @@ struct Bump {
   int module = -1;            // shift this module's cameras ...
   double translation_mm = 0;  // ... by this much in a random direction
   int shifted_camera = -1;    // or only this camera, by translation_mm
+  int opposite_camera = -1;   // and this one too, the opposite way (a baseline stretched)
   LensDrift lens;             // the bumped camera's lens drifted (focal length, principal point)
 };
 
@@ -95,6 +96,8 @@ std::vector<BoardObservation> Observe(const SimulatedRig& truth, const Target& t
     const Eigen::Vector3d dir = Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized();
     const Pose moved_from_ref(Eigen::Matrix3d::Identity(), dir * bump.translation_mm);
     cam_from_ref[bump.shifted_camera] = cam_from_ref[bump.shifted_camera] * moved_from_ref.Inverse();
+    if (bump.opposite_camera >= 0)
+      cam_from_ref[bump.opposite_camera] = cam_from_ref[bump.opposite_camera] * moved_from_ref;
   }
   const Eigen::Vector3d center((target.corners_x() - 1) * 0.5 * target.square_size_mm(),
                                (target.corners_y() - 1) * 0.5 * target.square_size_mm(), 0);
@@ -1138,6 +1141,32 @@ TEST(NightlyCheck, OneCaptureWhoseModulesWereTakenAtDifferentMomentsIsSetAsideAn
   const CheckResult moved = RunNightlyCheck(stored, target, Observe(truth, target, shifted, 8), CheckOptions(), "test");
   EXPECT_TRUE(moved.views_set_aside.empty());
   EXPECT_FALSE(moved.ok());
+}
+
+// Both cameras of module 1 moved, 0.15 mm each in opposite directions (its
+// baseline stretched or squeezed): only the worse of the two was named
+// ("camera 3 changed: neither ...", read against poses that camera 2's own
+// move spoiled), camera 2 not. Each is named, and each read against the
+// cameras not named (module 0's) is a motion of its 0.15 mm: through
+// 0.03 px corners (the rendered corners' noise) a shift reads to a few
+// hundredths of a mm, within 0.05 mm here.
+TEST(NightlyCheck, BothCamerasOfAModuleThatMovedAreNamed) {
+  const SimulatedRig truth = MakeDefaultRig();
+  const Target target = DefaultTarget();
+  Bump stretched;
+  stretched.shifted_camera = truth.rig.module(1).left_camera;
+  stretched.opposite_camera = truth.rig.module(1).right_camera;
+  stretched.translation_mm = 0.15;
+  const CheckResult r = RunNightlyCheck(StoredRig(truth, kRenderedNoisePx), target,
+                                        Observe(truth, target, stretched, 9, kRenderedNoisePx), CheckOptions(), "test");
+  EXPECT_FALSE(r.ok());
+  std::vector<int> cameras = r.FlaggedCameras();
+  std::sort(cameras.begin(), cameras.end());
+  EXPECT_EQ(cameras, (std::vector<int>{2, 3})) << r.Explanation();
+  for (const CameraChange& c : r.camera_changes) {
+    EXPECT_TRUE(c.kind == CameraChangeKind::kMoved || c.kind == CameraChangeKind::kMovedOrLens) << c.Describe();
+    EXPECT_NEAR(c.shifted_mm, 0.15, 0.05) << c.Describe();
+  }
 }
 
 }  // namespace
