@@ -69,6 +69,9 @@ std::string CheckResult::Explanation() const {
   }
   if (camera_changes.empty() && split_modules.empty() && closure_modules.empty())
     s << "figures exceed their thresholds; ";
+  if (every_camera_fails)
+    s << "every camera and every module fails its figure: a change they share (every lens drifted alike?) or "
+         "another rig's captures, with no unchanged camera to name it against; ";
   std::string out = s.str();
   return out.substr(0, out.size() - 2) + board + (target_note.empty() ? "" : "; " + target_note);
 }
@@ -1201,6 +1204,16 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
     if (others.empty()) others = all, others.erase(c);
     const Consistency con = CameraConsistency(in, c, others);
     result.camera_changes.push_back(ExplainCameraChange(rig, target, c, con.views, con.threshold_px));
+  }
+  {
+    const bool cameras_fail =
+        std::none_of(camera_figures.begin(), camera_figures.end(), [](const auto& f) { return f.second.pass; });
+    const bool unexplained =
+        std::all_of(result.camera_changes.begin(), result.camera_changes.end(),
+                    [](const CameraChange& c) { return c.kind == CameraChangeKind::kUnexplained; });
+    result.every_camera_fails = rig.num_modules() >= 2 && cameras_fail &&
+                                static_cast<int>(inconsistent_modules.size()) == rig.num_modules() &&
+                                static_cast<int>(camera_figures.size()) == rig.num_cameras() && unexplained;
   }
 
   // --- Module pairs: closure through the target. ---

@@ -99,6 +99,13 @@ struct CheckResult {
   // end of a failing night's explanation (a file off its plate fails the
   // cameras' consistency and the closures alike).
   std::string target_note;
+  // Every camera's figure fails, every module (at least two) disagrees with
+  // itself, and no named camera's change is explained by a new pose or a new
+  // lens alone: no camera is left unchanged to read the others against, so
+  // the cameras named (the worse of each module) are not all that changed.
+  // Said after them: all four focal lengths +0.1 % named cameras 0 and 3,
+  // "neither", and another rig's captures camera 1 alone.
+  bool every_camera_fails = false;
   bool ok() const;
   std::string Verdict() const { return ok() ? "ok" : "recalibrate"; }
   std::string Explanation() const;  // one line: what changed, in no more words than the figures support

@@ -49,6 +49,7 @@ struct Bump {
   int shifted_camera = -1;    // or only this camera, by translation_mm
   int opposite_camera = -1;   // and this one too, the opposite way (a baseline stretched)
   LensDrift lens;             // the bumped camera's lens drifted (focal length, principal point)
+  bool every_lens = false;    // every camera's lens drifted so, alike
 };
 
 bool ModuleOfCameraIsZero(const Rig& rig, int c) {
@@ -113,7 +114,7 @@ std::vector<BoardObservation> Observe(const SimulatedRig& truth, const Target& t
       BoardObservation v{k, c, face, {}, {}};
       const Pose face_from_front = face == Face::kFront ? Pose::Identity() : target.back_from_front();
       const Pose cam_from_face = cam_from_ref[c] * ref_from_front * face_from_front.Inverse();
-      const Camera cam = c == bump.camera ? WithLensDrift(rig.camera(c), bump.lens) : rig.camera(c);
+      const Camera cam = c == bump.camera || bump.every_lens ? WithLensDrift(rig.camera(c), bump.lens) : rig.camera(c);
       for (int id = 0; id < target.num_corners(); ++id) {
         const Eigen::Vector3d p = cam_from_face * target.CornerInFace(id);
         if (p.z() <= 0) continue;
@@ -1167,6 +1168,34 @@ TEST(NightlyCheck, BothCamerasOfAModuleThatMovedAreNamed) {
     EXPECT_TRUE(c.kind == CameraChangeKind::kMoved || c.kind == CameraChangeKind::kMovedOrLens) << c.Describe();
     EXPECT_NEAR(c.shifted_mm, 0.15, 0.05) << c.Describe();
   }
+}
+
+// Every camera's focal length +0.1 % (thermal drift): no camera is left
+// unchanged to read the others against, and the verdict named the worse
+// camera of each module, "neither", as if the others had not changed. It
+// says so now. The drift fails every figure by far (0.1 % is ~1 px at the
+// image's edge against 0.03 px corners), so this does not hang on the noise.
+TEST(NightlyCheck, EveryLensDriftedAlikeIsSaidNotNamedAsTwoCameras) {
+  const SimulatedRig truth = MakeDefaultRig();
+  const Target target = DefaultTarget();
+  Bump thermal;
+  thermal.every_lens = true;
+  thermal.lens.focal_percent = 0.1;
+  const CheckResult r = RunNightlyCheck(StoredRig(truth, kRenderedNoisePx), target,
+                                        Observe(truth, target, thermal, 10, kRenderedNoisePx), CheckOptions(), "test");
+  EXPECT_FALSE(r.ok());
+  EXPECT_TRUE(r.every_camera_fails) << r.Explanation();
+  EXPECT_NE(r.Explanation().find("; every camera and every module fails its figure: a change they share (every lens "
+                                 "drifted alike?) or another rig's captures"),
+            std::string::npos)
+      << r.Explanation();
+  // One camera's drift leaves the others to read it against: not said.
+  Bump one;
+  one.camera = 2;
+  one.lens.focal_percent = 0.1;
+  const CheckResult named = RunNightlyCheck(StoredRig(truth, kRenderedNoisePx), target,
+                                            Observe(truth, target, one, 10, kRenderedNoisePx), CheckOptions(), "test");
+  EXPECT_FALSE(named.every_camera_fails) << named.Explanation();
 }
 
 }  // namespace
