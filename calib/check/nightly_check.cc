@@ -638,7 +638,7 @@ std::optional<std::pair<int, int>> SwappedCameras(const Inputs& in, const std::v
 // module 1 disagree" (8.04 mm against 0.0153 mm on the demo's night) with no
 // capture named. A capture is set aside when, for some pair of modules, each
 // module's views are off the board pose the other's imply (the smaller of
-// the two readings, a median corner error in px) by more than
+// the two readings, each its worst view's median corner error, px) by more than
 // kOtherMomentFactor times the larger of the lower median of that pair's
 // readings in the other captures and the cameras' noise, where the other
 // captures agree (that median within kAgreeFactor times the noise: a moved
@@ -662,15 +662,21 @@ void SetAsideCapturesOfModulesAtAnotherMoment(Inputs& in, std::vector<SetAsideVi
     for (const BoardObservation* v : vs) by_module[ModuleOf(in.rig, v->camera)].push_back(v);
     const BoardPoseEstimate all = EstimateBoardPose(in.rig, in.target, vs);
     const Pose* seed = all.ok ? &all.ref_from_front : nullptr;
-    // Module `of`'s views through the pose module `from`'s imply.
+    // Module `of`'s views through the pose module `from`'s imply: the worst
+    // view's median, each camera read alone (over both cameras' corners
+    // at once, a camera turned 1 deg read off only in the captures where
+    // it held the more corners, and such a capture was set aside).
     auto off = [&](int of, int from) {
       const BoardPoseEstimate pose = EstimateBoardPose(in.rig, in.target, by_module[from], seed);
       if (!pose.ok) return -1.0;
-      std::vector<double> e;
-      for (const BoardObservation* v : by_module[of])
+      double worst = 0;
+      for (const BoardObservation* v : by_module[of]) {
+        std::vector<double> e;
         for (const Eigen::Vector2d& r : ReprojectionErrors(in.rig, in.target, *v, pose.ref_from_front))
           e.push_back(r.norm());
-      return LowerMedian(e);
+        worst = std::max(worst, LowerMedian(e));
+      }
+      return worst;
     };
     for (const auto& [i, vi] : by_module)
       for (const auto& [j, vj] : by_module) {
