@@ -56,8 +56,17 @@ std::string CameraChange::DescribeChange() const {
                     shown(principal_point_px.y(), 0.01));
       return out + text;
     }
-    case CameraChangeKind::kMovedOrLens:
-      return out + " moved or its lens changed (either explains its corners)";
+    case CameraChangeKind::kMovedOrLens: {
+      // Both fits' sizes: a knock of degrees reads otherwise as a drift of
+      // hundredths (the sizes were in the JSON report alone).
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    " moved or its lens changed (either explains its corners): turned %.3f deg, shifted %.3f mm, or "
+                    "focal length %+.3f %%, principal point %+.2f, %+.2f px",
+                    shown(turned_deg, 0.001), shown(shifted_mm, 0.001), shown(focal_percent, 0.001),
+                    shown(principal_point_px.x(), 0.01), shown(principal_point_px.y(), 0.01));
+      return out + text;
+    }
     case CameraChangeKind::kUnexplained: {
       out += " changed: neither a new pose nor a new lens alone explains its corners (";
       if (std::isfinite(moved_rms_px)) {

@@ -66,7 +66,8 @@ struct CameraChange {
   std::string role;
   // "camera 2 moved: turned 0.050 deg, shifted 0.004 mm", "camera 2's lens
   // changed: ...", "camera 2 moved or its lens changed (either explains its
-  // corners)", "camera 2 changed: neither a new pose nor a new lens alone
+  // corners): turned 0.050 deg, shifted 0.004 mm, or focal length +0.012 %,
+  // principal point +0.05, -0.01 px", "camera 2 changed: neither a new pose nor a new lens alone
   // explains its corners (...)", "camera 2 changed: too few corners (N) to
   // fit a new pose or a new lens"; each followed by the role, " [module 1's
   // left camera]", where it has one.

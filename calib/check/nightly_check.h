@@ -12,10 +12,11 @@
 //   - per module pair, the closure through the double-sided target: the board
 //     pose from module i alone against the one from module j alone, mean over
 //     captures, in mm (at the board centre) and degrees.
-// A module whose cameras disagree names the camera that also disagrees with
-// the other modules, and says whether a new pose or a new lens (focal length,
-// principal point) explains its corners, either does (the check cannot
-// tell), or neither alone does.
+// A module whose cameras disagree names each camera that also disagrees with
+// the other modules (those that agree with themselves, where any do), and
+// says whether a new pose or a new lens (focal length, principal point)
+// explains its corners, either does (the check cannot tell), or neither
+// alone does.
 #pragma once
 
 #include <map>
@@ -51,7 +52,8 @@ struct CheckFigure {
 // Why a view was set aside (RunNightlyCheck): its corners jump about their
 // own board pose, beyond any smooth field a lens change leaves; or it
 // disagrees with the rest of its capture, in that capture only (taken at
-// another moment than the capture's other views?).
+// another moment than the capture's other views?), or its capture's modules
+// disagree in that capture only (a trigger slip: the whole capture goes).
 enum class SetAsideWhy { kCornersJump, kOtherMoment };
 
 // A view the check set aside whole.
@@ -97,6 +99,13 @@ struct CheckResult {
   // end of a failing night's explanation (a file off its plate fails the
   // cameras' consistency and the closures alike).
   std::string target_note;
+  // Every camera's figure fails, every module (at least two) disagrees with
+  // itself, and no named camera's change is explained by a new pose or a new
+  // lens alone: no camera is left unchanged to read the others against, so
+  // the cameras named (the worse of each module) are not all that changed.
+  // Said after them: all four focal lengths +0.1 % named cameras 0 and 3,
+  // "neither", and another rig's captures camera 1 alone.
+  bool every_camera_fails = false;
   bool ok() const;
   std::string Verdict() const { return ok() ? "ok" : "recalibrate"; }
   std::string Explanation() const;  // one line: what changed, in no more words than the figures support
@@ -135,7 +144,8 @@ void RequireCalibrationResiduals(const Rig& rig, const std::string& where);
 // trimmed and poses fitted: the message names each capture lost and why, by
 // capture_names where given, else by index), when a view names a camera the
 // rig does not have, or when the captures do not fit the rig at all (another
-// rig's captures). `target` is measured with as given: pass
+// rig's captures), or two cameras' images look exchanged (the night fits
+// with their views swapped). `target` is measured with as given: pass
 // TargetForCheck(rig, file's board, path).target (check_target.h), the
 // board with the back_from_front S was calibrated with; the target file's
 // own reads its error as the modules disagreeing.
