@@ -613,6 +613,18 @@ std::optional<std::pair<int, int>> SwappedCameras(const Inputs& in, const std::v
         }
       std::map<int, std::vector<const BoardObservation*>> by_capture;
       for (const BoardObservation& v : exchanged) by_capture[v.capture].push_back(&v);
+      // A swap fits in every capture: first one capture holding both views
+      // is tried (a night with a knocked camera reads every camera off
+      // through the poses it spoils, and refitting the whole night for
+      // each pair tripled its check: 0.9 -> 2.5 s).
+      const auto both = std::find_if(by_capture.begin(), by_capture.end(), [&](const auto& capture) {
+        const auto& vs = capture.second;
+        auto has = [&](int c) {
+          return std::any_of(vs.begin(), vs.end(), [&](const BoardObservation* v) { return v->camera == c; });
+        };
+        return has(a) && has(b);
+      });
+      if (both != by_capture.end() && !all_fit(CameraOffRestPx(in, {*both}))) continue;
       const std::map<int, double> off = CameraOffRestPx(in, by_capture);
       if (off.size() != as_given.size() || !all_fit(off)) continue;
       double worst_given = 0, worst_exchanged = 0;
