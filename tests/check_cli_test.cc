@@ -524,6 +524,23 @@ TEST(CheckCli, TheReportListsEveryNamedCameraAndModuleAndWhatExplainsEach) {
   fs::remove_all(dir);
 }
 
+// A simulated night of the unmoved rig (seed 21, 8 captures) in dir/ds, the
+// rig as stored (0.03 px residuals) in dir/rig.yaml; its captures' names,
+// sorted (fewer than 8 if the simulation failed, which it says).
+std::vector<std::string> UnmovedNight(const std::string& dir) {
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const Result r = RunCli("simulate --out " + dir + "/ds --seed 21 --calibration-captures 8 --no-scenes");
+  EXPECT_EQ(r.code, 0) << r.err;
+  if (r.code != 0) return {};
+  WriteStoredRig(dir + "/ds/truth/rig.yaml", 0.03, dir + "/rig.yaml", dir + "/ds/target.yaml");
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir + "/ds/calibration"))
+    if (e.is_directory()) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
 // The capture images are inputs too: a --report or --history-db named like
 // one of them would replace it. Refused before any work (no rig file nor
 // target is read: neither exists), one line naming the path, the image
@@ -537,16 +554,9 @@ TEST(CheckCli, TheReportListsEveryNamedCameraAndModuleAndWhatExplainsEach) {
 // ~0.03 px, so the outcome does not hang on the simulated noise.
 TEST(CheckCli, AViewFromAnotherCaptureIsSetAsideAndTheUnmovedRigPasses) {
   const std::string dir = ::testing::TempDir() + "/check_cli_moment_" + std::to_string(getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  Result r = RunCli("simulate --out " + dir + "/ds --seed 21 --calibration-captures 8 --no-scenes");
-  ASSERT_EQ(r.code, 0) << r.err;
-  WriteStoredRig(dir + "/ds/truth/rig.yaml", 0.03, dir + "/rig.yaml", dir + "/ds/target.yaml");
-  std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(dir + "/ds/calibration"))
-    if (e.is_directory()) names.push_back(e.path().filename().string());
-  std::sort(names.begin(), names.end());
+  const std::vector<std::string> names = UnmovedNight(dir);
   ASSERT_GE(names.size(), 8u);
+  Result r;
   const std::string captures = dir + "/swapped", report = dir + "/swapped.json";
   fs::copy(dir + "/ds/calibration", captures, fs::copy_options::recursive);
   fs::copy_file(captures + "/" + names[6] + "/cam1.png", captures + "/" + names[1] + "/cam1.png",
@@ -932,16 +942,9 @@ TEST_F(CheckHistoryCli, ANewHistoryRefusesABadRowItself) {
 // simulated noise.
 TEST(CheckCli, ImagesSwappedBetweenCamerasOrAModuleFromAnotherCaptureAreNamed) {
   const std::string dir = ::testing::TempDir() + "/check_cli_swap_" + std::to_string(getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  Result r = RunCli("simulate --out " + dir + "/ds --seed 21 --calibration-captures 8 --no-scenes");
-  ASSERT_EQ(r.code, 0) << r.err;
-  WriteStoredRig(dir + "/ds/truth/rig.yaml", 0.03, dir + "/rig.yaml", dir + "/ds/target.yaml");
-  std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(dir + "/ds/calibration"))
-    if (e.is_directory()) names.push_back(e.path().filename().string());
-  std::sort(names.begin(), names.end());
+  const std::vector<std::string> names = UnmovedNight(dir);
   ASSERT_GE(names.size(), 8u);
+  Result r;
   const std::string db = dir + "/history.sqlite";
   auto check = [&](const std::string& captures, const std::string& report) {
     return RunCli("check --rig " + dir + "/rig.yaml --captures " + captures + " --target " + dir +
