@@ -40,10 +40,13 @@ void OutputPaths::Claim(const std::string& path, const std::string& what, bool c
   // there (a temporary file renamed over the path, calib/core/atomic_file.h).
   const fs::path given_folder = fs::path(path).parent_path();
   const fs::path folder = given_folder.empty() ? fs::path(".") : given_folder;
-  if (check_folder && access(folder.c_str(), W_OK | X_OK) != 0) {
-    const std::string why = std::strerror(errno);
-    throw InputError(path,
-                     "cannot write " + what + " in its folder " + folder.lexically_normal().string() + ": " + why);
+  if (check_folder) {
+    // access() first (no file made); then a file created and removed
+    // there, for what access() cannot tell (root in /sys).
+    std::string why = access(folder.c_str(), W_OK | X_OK) != 0 ? std::strerror(errno) : CannotCreateBeside(path);
+    if (!why.empty())
+      throw InputError(path,
+                       "cannot write " + what + " in its folder " + folder.lexically_normal().string() + ": " + why);
   }
   if (fs::is_directory(key)) throw InputError(path, "is a folder, not a file to write");
   RequireReplaceableOutput(path);

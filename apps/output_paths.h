@@ -28,7 +28,8 @@ class OutputPaths {
   // (the file's, or a folder's the command creates) is longer than the file
   // system allows (NAME_MAX), or, with
   // check_folder, if its folder does not exist or this process may not
-  // write in it (access W_OK|X_OK; off for files in a folder the command
+  // write in it (access W_OK|X_OK, then a file created and removed there:
+  // root passes access() in /sys; off for files in a folder the command
   // creates itself, which ClaimFolder checks), or if it is "-", a device, a
   // pipe or a socket (RequireReplaceableOutput, calib/core/atomic_file.h).
   void Claim(const std::string& path, const std::string& what, bool check_folder = true);

@@ -175,5 +175,18 @@ TEST(OutputPaths, AFolderThisProcessMayNotWriteInIsRefusedWhenClaimed) {
   EXPECT_EQ(ClaimAsUnprivileged([&] { OutputPaths().Claim(open + "/link.ply", "the cloud (--out)"); }), "");
 }
 
+// access(W_OK) says yes to root in /sys, where no file can be made: a
+// calibration with --report /sys/r.json ran its whole solve and only then
+// failed. The claim now creates (and removes) a file there, so the refusal
+// comes first, as root too; and a claim that succeeds leaves nothing behind.
+TEST(OutputPaths, AFolderNoFileCanBeMadeInIsRefusedWhenClaimedAsRootToo) {
+  ASSERT_TRUE(fs::is_directory("/sys")) << "no /sys: nothing to test";
+  const std::string says = InputErrorMessage([] { OutputPaths().Claim("/sys/report.json", "the report (--report)"); });
+  EXPECT_EQ(says.rfind("/sys/report.json: cannot write the report (--report) in its folder /sys: ", 0), 0u) << says;
+  const std::string dir = Scratch("probe_leaves_nothing");
+  OutputPaths().Claim(dir + "/cloud.ply", "the cloud (--out)");
+  EXPECT_TRUE(fs::is_empty(dir)) << "the claim's trial file was left in " << dir;
+}
+
 }  // namespace
 }  // namespace stereorig

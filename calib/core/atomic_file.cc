@@ -1,5 +1,6 @@
 #include "atomic_file.h"
 
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -26,6 +27,16 @@ std::string MakeTempPath(const std::string& path) {
 }
 
 }  // namespace
+
+std::string CannotCreateBeside(const std::string& path) {
+  const std::string probe = MakeTempPath(path);
+  const PendingTemporary pending(probe);  // a signal now removes it too
+  const int fd = open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) return std::strerror(errno);
+  close(fd);
+  std::remove(probe.c_str());
+  return "";
+}
 
 void RequireReplaceableOutput(const std::string& path) {
   if (path == "-")

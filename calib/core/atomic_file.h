@@ -21,6 +21,12 @@ namespace stereorig {
 // check it up front too (apps/output_paths.h), before their work.
 void RequireReplaceableOutput(const std::string& path);
 
+// "" if a file can be created beside `path` (the temporary file an output
+// is written to, created and removed at once), else why not (strerror).
+// access(W_OK) alone says yes to root in folders no file can be made in
+// (/sys, /proc): only trying tells, before a command's minutes of work.
+std::string CannotCreateBeside(const std::string& path);
+
 // Writes `bytes` to `path` atomically. Throws InputError naming `path` if the
 // folder is missing or not writable, or as RequireReplaceableOutput.
 void WriteFileAtomically(const std::string& path, const std::string& bytes);
