@@ -4,9 +4,12 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <sstream>
 
 #include "apps/command.h"
@@ -149,6 +152,45 @@ CLI::Validator NumberValidator(bool (*ok)(double), const char* rule, const char*
 }
 
 }  // namespace
+
+namespace {
+
+// The seed `text` names into *seed: "" if it is one (AddSeedOption's
+// forms, at most max_seed), else what is wrong with it.
+std::string ParseSeed(const std::string& text, uint64_t max_seed, uint64_t* seed) {
+  const bool hex = text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
+  const std::string digits = hex ? text.substr(2) : text;
+  if (!text.empty() && text[0] == '-') return "must be >= 0";
+  if (digits.empty() || digits.find_first_not_of(hex ? "0123456789abcdefABCDEF" : "0123456789") != std::string::npos)
+    return "must be a whole number (decimal, or hex with 0x), not '" + text + "'";
+  errno = 0;
+  const unsigned long long value = std::strtoull(digits.c_str(), nullptr, hex ? 16 : 10);
+  if (errno == ERANGE || value > max_seed) {
+    const std::string most = std::to_string(max_seed);
+    return "must be at most " + most +
+           (max_seed == std::numeric_limits<uint64_t>::max() ? std::string(" (2^64 - 1)") : std::string());
+  }
+  *seed = value;
+  return "";
+}
+
+}  // namespace
+
+CLI::Option* AddSeedOption(CLI::App& app, uint64_t* seed, uint64_t max_seed, const std::string& description) {
+  return app
+      .add_option_function<std::string>(
+          "--seed", [seed, max_seed](const std::string& text) { (void)ParseSeed(text, max_seed, seed); },
+          description + "; a whole number, 0 to " + std::to_string(max_seed) +
+              " (decimal, or hex with 0x; leading zeros are decimal: 010 is ten)")
+      ->check(CLI::Validator(
+          [max_seed](const std::string& text) {
+            uint64_t ignored = 0;
+            return ParseSeed(text, max_seed, &ignored);
+          },
+          "", "Seed"))
+      ->type_name("UINT")
+      ->default_str(std::to_string(*seed));
+}
 
 const CLI::Validator& PositiveValue() {
   static const CLI::Validator v =

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -61,6 +62,14 @@ std::string ShellQuoted(const std::string& word);
 // DBL_MAX's 309 digits.
 const CLI::Validator& PositiveValue();
 const CLI::Validator& NonNegativeValue();
+
+// A --seed option into *seed (its default shown as it is): a whole number
+// from 0 to max_seed, decimal (leading zeros are zeros) or hex with 0x,
+// nothing else. CLI11's own reading takes a leading 0 as octal: a script's
+// zero-padded seeds (seq -w: 01 .. 20) made 010 seed 8 without a word and
+// refused 08; a negative seed wrapped round to 2^64 - 1 and one above it
+// was saturated. Each is refused by the flag's name (exit 2).
+CLI::Option* AddSeedOption(CLI::App& app, uint64_t* seed, uint64_t max_seed, const std::string& description);
 
 // Check of a path option (every file or folder a command writes, and
 // verify's inputs): an empty one ("--report ''", a shell variable left unset)

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -81,13 +82,14 @@ int RunDemo(int argc, char** argv) {
       "Example:\n  stereorig demo --out /tmp/stereorig-demo",
       "stereorig demo"};
   std::string out = "stereorig-demo";
-  unsigned seed = 1;
+  uint64_t seed = 1;
   app.add_option("--out", out,
                  "folder for everything the demo writes (created if missing); one that is not empty must be an "
                  "earlier demo's, holding nothing else")
       ->capture_default_str()
       ->check(NonEmptyPath());
-  app.add_option("--seed", seed, "simulator seed")->capture_default_str();
+  // The night's and the bumped datasets take seed + 100 and seed + 200.
+  AddSeedOption(app, &seed, std::numeric_limits<uint64_t>::max() - 200, "simulator seed");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 
   // Made at once (nothing after this is bad input), and, if it cannot be

@@ -1,7 +1,10 @@
 // `stereorig simulate`: render a rig spec into a dataset with ground truth.
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
+#include <string>
 #include <vector>
 
 #include "apps/cli_util.h"
@@ -40,23 +43,7 @@ int RunSimulate(int argc, char** argv) {
                  "dataset folder to write; an earlier dataset there is replaced whole, atomically, and only if it "
                  "holds nothing the simulator does not write (else exit 2, naming the file)")
       ->check(NonEmptyPath());
-  // Checked on the text: a negative seed would wrap round to 2^64 - 1
-  // (CLI11's NonNegativeNumber prints DBL_MAX's 309 digits as its bound),
-  // and one above 2^64 - 1 was saturated to it without a word. strtoull
-  // reads the same decimal, 0x and 0 forms as CLI11.
-  app.add_option("--seed", o.seed, "random seed: poses, scenes, noise (0 to 18446744073709551615)")
-      ->check(CLI::Validator(
-          [](const std::string& text) {
-            // strtoull skips leading white space, then wraps "-1" round.
-            if (text.find_first_not_of(" \t\n\v\f\r") != std::string::npos &&
-                text[text.find_first_not_of(" \t\n\v\f\r")] == '-')
-              return std::string("must be >= 0");
-            errno = 0;
-            std::strtoull(text.c_str(), nullptr, 0);
-            return errno == ERANGE ? std::string("must be at most 18446744073709551615 (2^64 - 1)") : std::string();
-          },
-          "", "NonNegative"))
-      ->capture_default_str();
+  AddSeedOption(app, &o.seed, std::numeric_limits<uint64_t>::max(), "random seed: poses, scenes, noise");
   app.add_option("--threads", o.threads,
                  "worker threads, in [0, " + std::to_string(kMaxSimulateThreads) +
                      "] (0 = all cores; never more than the jobs)")

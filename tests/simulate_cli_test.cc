@@ -323,6 +323,32 @@ TEST(SimulateCli, OutOfRangeNumbersAreRefusedByTheFlagsName) {
   EXPECT_NE(Slurp(dir + "/ds/truth/simulation.yaml").find("\nseed: 18446744073709551615\n"), std::string::npos);
 }
 
+// A seed is read as the user wrote it: CLI11 took a leading 0 as octal, so
+// a script's zero-padded seeds (seq -w) made 010 seed 8 without a word and
+// refused 08. Leading zeros are now zeros; hex needs 0x; anything else
+// (0b101, a space, a sign) is refused by the flag's name.
+TEST(SimulateCli, ZeroPaddedSeedsAreDecimal) {
+  const std::string dir = ::testing::TempDir() + "/sim_seed_forms";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  for (const auto& [given, recorded] : std::vector<std::pair<std::string, std::string>>{
+           {"010", "10"}, {"08", "8"}, {"0x10", "16"}, {"0010", "10"}}) {
+    fs::remove_all(dir + "/ds");
+    const Result r = RunCli("simulate --out " + dir + "/ds --no-scenes --calibration-captures 0 --seed " + given);
+    ASSERT_EQ(r.code, 0) << given << ": " << r.err;
+    EXPECT_NE(Slurp(dir + "/ds/truth/simulation.yaml").find("\nseed: " + recorded + "\n"), std::string::npos)
+        << "--seed " << given << " should be seed " << recorded;
+  }
+  fs::remove_all(dir + "/ds");
+  const std::string out = " --out " + dir + "/ds --no-scenes --calibration-captures 0";
+  ExpectEachRefusedBeforeAnyWork(
+      {{out + " --seed 0b101", "--seed: must be a whole number (decimal, or hex with 0x), not '0b101'"},
+       {out + " --seed '+5'", "--seed: must be a whole number"},
+       {out + " --seed ' 5'", "--seed: must be a whole number"},
+       {out + " --seed -1", "--seed: must be >= 0"}},
+      dir);
+}
+
 // A project folder holding the user's own spec, its board and notes, given
 // as --out: exit 2 before any work, naming the input it holds, every file
 // as it was. It used to pass for an earlier dataset (it has a spec.yaml)
