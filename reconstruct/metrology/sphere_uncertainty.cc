@@ -3,7 +3,9 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <unordered_map>
 
 #include "calib/core/input_error.h"
 
@@ -31,6 +33,54 @@ double CapHalfAngleDeg(const std::vector<Eigen::Vector3d>& points, const SphereF
 }
 
 }  // namespace
+
+double NoiseVarianceInflation(const std::vector<Eigen::Vector3d>& pts, const std::vector<int>& indices,
+                              const std::vector<double>& residuals_mm, double radius_mm) {
+  STEREORIG_CHECK(indices.size() == residuals_mm.size() && radius_mm > 0);
+  const size_t n = indices.size();
+  double ss_mm2 = 0;
+  for (double e : residuals_mm) ss_mm2 += e * e;
+  if (n < 2 || !(ss_mm2 > 0) || !std::isfinite(ss_mm2)) return 1.0;
+  // Cells of radius_mm: a point's neighbours lie in its own cell and the 26
+  // about it.
+  auto cell_of = [radius_mm](const Eigen::Vector3d& p) {
+    return Eigen::Vector3i(static_cast<int>(std::floor(p.x() / radius_mm)),
+                           static_cast<int>(std::floor(p.y() / radius_mm)),
+                           static_cast<int>(std::floor(p.z() / radius_mm)));
+  };
+  auto key_of = [](const Eigen::Vector3i& c) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.x()) & 0x1FFFFF) << 42) |
+           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.y()) & 0x1FFFFF) << 21) |
+           static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.z()) & 0x1FFFFF);
+  };
+  std::unordered_map<std::uint64_t, std::vector<int>> cells;  // key -> positions k in indices
+  for (size_t k = 0; k < n; ++k) cells[key_of(cell_of(pts[indices[k]]))].push_back(static_cast<int>(k));
+  // Over pairs i < j: the weighted cross products, and the squared weights,
+  // whose sum gives the statistic's standard error under independent noise
+  // (each pair's product then has variance sigma^4, and pairs are
+  // uncorrelated): 2 sqrt(sum w^2) sigma^2 against sum e^2 ~ n sigma^2.
+  double cross_mm2 = 0, weights2 = 0;
+  for (size_t k = 0; k < n; ++k) {
+    const Eigen::Vector3d& p = pts[indices[k]];
+    const Eigen::Vector3i c = cell_of(p);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto it = cells.find(key_of(c + Eigen::Vector3i(dx, dy, dz)));
+          if (it == cells.end()) continue;
+          for (int j : it->second) {
+            if (static_cast<size_t>(j) <= k) continue;
+            const double d_mm = (pts[indices[j]] - p).norm();
+            if (d_mm >= radius_mm) continue;
+            const double w = 1 - d_mm / radius_mm;
+            cross_mm2 += w * residuals_mm[k] * residuals_mm[j];
+            weights2 += w * w;
+          }
+        }
+  }
+  const double standard_error = 2 * std::sqrt(weights2) / static_cast<double>(n);
+  return std::max(1.0, 1 + 2 * cross_mm2 / ss_mm2 - 2 * standard_error);
+}
 
 SphereFitUncertainty SphereUncertainty(const std::vector<Eigen::Vector3d>& points, const SphereFit& fit) {
   STEREORIG_CHECK(fit.ok && fit.inliers.size() > 4 && fit.residuals_mm.size() == fit.inliers.size());
@@ -60,8 +110,9 @@ SphereFitUncertainty SphereUncertainty(const std::vector<Eigen::Vector3d>& point
     u.center_covariance_mm2 = Eigen::Vector3d::Constant(kInfinite).asDiagonal();
     return u;
   }
-  const Eigen::Matrix4d covariance =
-      sigma2_mm2 * eigen.eigenvectors() * values.cwiseInverse().asDiagonal() * eigen.eigenvectors().transpose();
+  u.noise_variance_inflation = NoiseVarianceInflation(points, fit.inliers, fit.residuals_mm);
+  const Eigen::Matrix4d covariance = u.noise_variance_inflation * sigma2_mm2 * eigen.eigenvectors() *
+                                     values.cwiseInverse().asDiagonal() * eigen.eigenvectors().transpose();
   u.diameter_std_mm =
       covariance(3, 3) > 0 && std::isfinite(covariance(3, 3)) ? 2 * std::sqrt(covariance(3, 3)) : kInfinite;
   u.center_covariance_mm2 = covariance.topLeftCorner<3, 3>();
