@@ -1003,6 +1003,36 @@ const char* kPlate =
     "format: stereorig-artifact\nversion: 1\nunits: mm\nname: test plate\ntype: plate\nlength_mm: 130\n"
     "width_mm: 130\n";
 
+// A plate seen as rows, as at a grazing angle or by a line scanner's
+// profiles: rows 2 mm apart across it, points 0.15 mm apart along them. Its
+// outline's 1 mm cells held each row as a group of its own, 1/56 of the
+// points, under the 2% a group must hold, and every row was dropped: the
+// plate was refused, `not evaluated: the plane found spans 0.0 x 0.0 mm`
+// (exit 2). A 2 mm cell joins the rows. Truth: the rows span 130 x 110 mm,
+// flat (exact, z = 200): F within rounding, and an outline within a quarter
+// of a 2 mm cell a side.
+TEST(VerifyCli, APlateSeenAsRowsFurtherApartThanAnOutlineCellIsEvaluated) {
+  const std::string cloud = ::testing::TempDir() + "/plate_rows_" + std::to_string(getpid()) + ".ply";
+  {
+    std::ostringstream body;
+    int vertices = 0;
+    for (double v = -54.5; v <= 55.5; v += 2)
+      for (int i = 0; i <= 866; ++i, ++vertices) body << -65 + 0.15 * i << " " << v << " 200\n";
+    std::ofstream(cloud) << "ply\nformat ascii 1.0\nelement vertex " << vertices
+                         << "\nproperty double x\nproperty double y\nproperty double z\nend_header\n"
+                         << body.str();
+  }
+  const auto r = RunCli("verify --artifact " + WriteArtifact(kPlate) + " --cloud " + cloud);
+  EXPECT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_LT(FValue(r.out), 0.001) << r.out;
+  const size_t at = r.out.find("plate face: outline ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  double length_mm = 0, width_mm = 0;
+  ASSERT_EQ(std::sscanf(r.out.c_str() + at, "plate face: outline %lf x %lf", &length_mm, &width_mm), 2) << r.out;
+  EXPECT_NEAR(length_mm, 129.9, 1.0) << r.out;
+  EXPECT_NEAR(width_mm, 110, 1.0) << r.out;
+}
+
 }  // namespace
 
 // A 3 mm plate seen from both sides: its far face lies in the capture band,
