@@ -47,14 +47,16 @@ struct SphereFitUncertainty {
 inline constexpr double kNoiseCorrelationRadiusMm = 3.0;
 
 // The variance inflation of a least-squares fit whose residuals
-// (residuals_mm, parallel to indices into points_mm) are correlated between
-// neighbouring points: 1 + sum_{i != j} w_ij e_i e_j / sum e_i^2, w_ij = 1 -
-// d_ij / radius_mm for points closer than radius_mm (the fit's Jacobian
-// changes little over that distance, so the covariance scales by it), less
-// twice its own standard error under independent noise (so that independent
-// noise reads 1, not the estimate's scatter about it), and at least 1.
-double NoiseVarianceInflation(const std::vector<Eigen::Vector3d>& points_mm, const std::vector<int>& indices,
-                              const std::vector<double>& residuals_mm, double radius_mm = kNoiseCorrelationRadiusMm);
+// (residuals_mm) are correlated between neighbouring points, each at its
+// place on the fitted surface (surface_mm, parallel: the point moved onto
+// it, so that a residual does not move its neighbours): 1 + sum_{i != j}
+// w_ij e_i e_j / sum e_i^2, w_ij = 1 - d_ij / radius_mm for points closer
+// than radius_mm (the fit's Jacobian changes little over that distance, so
+// the covariance scales by it), less twice its own standard error under
+// independent noise (so that independent noise reads 1, not the estimate's
+// scatter about it), and at least 1.
+double NoiseVarianceInflation(const std::vector<Eigen::Vector3d>& surface_mm, const std::vector<double>& residuals_mm,
+                              double radius_mm = kNoiseCorrelationRadiusMm);
 
 // fit: a converged fit of `points` (fit.inliers index them; fit.residuals_mm
 // parallel). At least 5 inliers.
