@@ -376,7 +376,8 @@ int RunVerify(int argc, char** argv) {
     report["positions"].push_back(pj);
   }
   std::printf(
-      "u_mm = the figure's standard uncertainty (k = 1): the fit's (its covariance) and the certificate's (U / k) "
+      "u_mm = the figure's standard uncertainty (k = 1): the fit's (its covariance, with the noise neighbouring points "
+      "share) and the certificate's (U / k) "
       "in quadrature; points: cloud = all vertices = filled + off + edge + excluded + used; "
       "filled = added by hole filling (module 255), skipped; off = not the artifact's (outside the capture band%s); "
       "edge = in the plate's %.0f mm edge margin, not evaluated (- for other artifacts); excluded = the "
