@@ -29,14 +29,15 @@ fails); without normals F spans both. A note line says which.
 
 A position whose points or certificate leave a figure (P_S, SD; F, P_F by a large certified flatness
 or form uncertainty) undetermined cannot pass: it is not judged (exit 2) when the figure's standard
-uncertainty is over 10% of its MPE (a sphere's cap of ~18 deg half-angle at the demo's density fits
-its diameter to ~0.15 mm), unless the position fails beyond doubt anyway (another figure fails, or,
-under the default simple rule, this one by more than twice its uncertainty: then FAIL, exit 1; the
-guarded rules differ, below). A position not judged is still printed and reported in full, its pass
-column '-' and a NOT JUDGED line saying why; the summary takes the judged positions' worst. If a
-judged position fails, the verdict is FAIL (exit 1) and the report lists the positions not judged
-(judged false, pass null, not_judged_reason); otherwise the verdict is NOT JUDGED and the run exits
-2 with the reason on stderr, writing no report, as for bad input.
+uncertainty is over 10% of its MPE (a sphere's cap of ~36 deg half-angle at the demo's density fits
+its diameter to ~0.15 mm, its neighbouring points' shared noise counted), unless the position fails
+beyond doubt anyway (another figure fails, or, under the default simple rule, this one by more than
+twice its uncertainty: then FAIL, exit 1; the guarded rules differ, below). A position not judged is
+still printed and reported in full, its pass column '-' and a NOT JUDGED line saying why; the
+summary takes the judged positions' worst. If a judged position fails, the verdict is FAIL (exit 1)
+and the report lists the positions not judged (judged false, pass null, not_judged_reason);
+otherwise the verdict is NOT JUDGED and the run exits 2 with the reason on stderr, writing no
+report, as for bad input.
 
 A cloud that cannot be read stops the run before anything is printed or written. A cloud read whose
 points are not the artifact (too few on it, or none of the certified size, above) is a position not

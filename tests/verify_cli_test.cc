@@ -18,6 +18,7 @@
 #include <regex>
 #include <sstream>
 
+#include "reconstruct/metrology/synthetic_shapes.h"
 #include "tests/cli_runner.h"
 
 namespace {
@@ -691,6 +692,44 @@ TEST(VerifyCli, ACapTooSmallToFitTheDiameterIsNotJudgedButShownAndAGoodOneReport
   EXPECT_NEAR(j["spheres"][0]["form_mm"].get<double>(), j["figures"][0]["value_mm"].get<double>(), 1e-12);  // P_F
 }
 
+// A cap whose noise neighbouring points share, as a reconstruction's is (the
+// demo's residuals correlate up to ~2 mm, a matching window's footprint), is
+// judged on its uncertainty counted honestly. Before, the fit's covariance
+// counted every point as independent: on the demo's reconstructed sphere,
+// caps of 18-20 degrees cut from module 0's cloud fitted their diameter to a
+// stated +-0.12 mm and read P_S -1.77 mm, FAIL "beyond doubt" (exit 1),
+// while the whole sphere reads -0.02 mm and such caps scatter by +-1.1 to
+// 1.4 mm. Truth: a 20-degree cap of the certified sphere, 3000 points, a
+// field of 0.05 mm on a 1 mm lattice (correlated up to 2 mm) plus 0.01 mm
+// independent noise: its diameter scatters by 0.36 mm over 200 such caps
+// (sphere_uncertainty_test.cc), which the inflated u predicts within
+// [0.8, 1.4]x, so u lies in [0.25, 0.45] mm: over the 0.15 mm limit, not
+// judged. Before: u 0.057 mm, judged (exit 0).
+TEST(VerifyCli, ACapWhoseNoiseNeighbouringPointsShareIsJudgedOnItsWholeUncertainty) {
+  std::mt19937 rng(20);
+  const std::vector<Eigen::Vector3d> pts = stereorig::testing::CorrelatedNoiseSamples(
+      stereorig::testing::SphereCapSurface({0, 0, 150}, {0, 0, -1}, 19.05, 20), 3000, 0.05, 1.0, 0.01, &rng);
+  const std::string cap = ::testing::TempDir() + "/correlated_cap_" + std::to_string(getpid()) + ".ply";
+  {
+    std::ofstream f(cap);
+    f << "ply\nformat ascii 1.0\nelement vertex " << pts.size()
+      << "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
+    f.precision(17);
+    for (const Eigen::Vector3d& p : pts) f << p.x() << " " << p.y() << " " << p.z() << "\n";
+  }
+  const auto r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + cap);
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find(cap + ": P_S is not determined"), std::string::npos) << r.err;
+  const size_t row_at = r.out.find("\n1        P_S ");
+  ASSERT_NE(row_at, std::string::npos) << r.out;
+  double value_mm = 0, u_mm = 0;
+  ASSERT_EQ(std::sscanf(r.out.c_str() + row_at, " 1 P_S %lf %lf", &value_mm, &u_mm), 2) << r.out;
+  EXPECT_GT(u_mm, 0.25) << r.out;
+  EXPECT_LT(u_mm, 0.45) << r.out;
+  // The table says by how much the shared noise widened it.
+  EXPECT_NE(r.out.find("neighbouring points share its noise"), std::string::npos) << r.out;
+}
+
 // Several positions, one not judged: every position is printed, the summary
 // takes the judged ones' worst and says which is not. With the judged ones
 // passing the run is not judged: exit 2 with the not-judged cloud's reason,
@@ -963,6 +1002,36 @@ double FValue(const std::string& out) {
 const char* kPlate =
     "format: stereorig-artifact\nversion: 1\nunits: mm\nname: test plate\ntype: plate\nlength_mm: 130\n"
     "width_mm: 130\n";
+
+// A plate seen as rows, as at a grazing angle or by a line scanner's
+// profiles: rows 2 mm apart across it, points 0.15 mm apart along them. Its
+// outline's 1 mm cells held each row as a group of its own, 1/56 of the
+// points, under the 2% a group must hold, and every row was dropped: the
+// plate was refused, `not evaluated: the plane found spans 0.0 x 0.0 mm`
+// (exit 2). A 2 mm cell joins the rows. Truth: the rows span 130 x 110 mm,
+// flat (exact, z = 200): F within rounding, and an outline within a quarter
+// of a 2 mm cell a side.
+TEST(VerifyCli, APlateSeenAsRowsFurtherApartThanAnOutlineCellIsEvaluated) {
+  const std::string cloud = ::testing::TempDir() + "/plate_rows_" + std::to_string(getpid()) + ".ply";
+  {
+    std::ostringstream body;
+    int vertices = 0;
+    for (double v = -54.5; v <= 55.5; v += 2)
+      for (int i = 0; i <= 866; ++i, ++vertices) body << -65 + 0.15 * i << " " << v << " 200\n";
+    std::ofstream(cloud) << "ply\nformat ascii 1.0\nelement vertex " << vertices
+                         << "\nproperty double x\nproperty double y\nproperty double z\nend_header\n"
+                         << body.str();
+  }
+  const auto r = RunCli("verify --artifact " + WriteArtifact(kPlate) + " --cloud " + cloud);
+  EXPECT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_LT(FValue(r.out), 0.001) << r.out;
+  const size_t at = r.out.find("plate face: outline ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  double length_mm = 0, width_mm = 0;
+  ASSERT_EQ(std::sscanf(r.out.c_str() + at, "plate face: outline %lf x %lf", &length_mm, &width_mm), 2) << r.out;
+  EXPECT_NEAR(length_mm, 129.9, 1.0) << r.out;
+  EXPECT_NEAR(width_mm, 110, 1.0) << r.out;
+}
 
 }  // namespace
 

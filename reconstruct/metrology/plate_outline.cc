@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <tuple>
@@ -21,6 +22,10 @@ constexpr double kDenseFractionOfMedian = 0.25;
 // a cell or two of a face's hundreds.
 constexpr double kMinGroupShareOfDensePoints = 0.02;
 constexpr int kMinMedianCellPoints = 6;
+// A cell size at which the face's groups hold less of the dense points than
+// this has split the face into pieces each too small to keep (rows of
+// points further apart than a cell): the next size is tried.
+constexpr double kMinFaceShareOfDensePoints = 0.5;
 constexpr double kCellSizesMm[] = {1, 2, 3, 4, 6, 8, 12, 16};
 
 using Cell = std::pair<long, long>;
@@ -102,6 +107,16 @@ std::map<Cell, int> FaceGroups(const std::map<Cell, int>& counts) {
   return kept;
 }
 
+// The share of the dense cells' points that FaceGroups kept.
+double FaceShareOfDensePoints(const std::map<Cell, int>& counts, const std::map<Cell, int>& face) {
+  const double dense = kDenseFractionOfMedian * MedianCount(counts);
+  double dense_points = 0, face_points = 0;
+  for (const auto& [cell, n] : counts)
+    if (n >= dense) dense_points += n;
+  for (const auto& [cell, n] : face) face_points += n;
+  return dense_points > 0 ? face_points / dense_points : 0.0;
+}
+
 }  // namespace
 
 bool PlaneOutline::InsideEroded(const Eigen::Vector3d& p, double margin_mm) const {
@@ -121,13 +136,21 @@ PlaneOutline OutlineOfDensePart(const std::vector<Eigen::Vector3d>& pts, const s
   q.reserve(idx.size());
   for (int i : idx) q.emplace_back(pts[i].dot(a), pts[i].dot(b));
 
-  std::map<Cell, int> counts;
+  // The smallest cell whose median occupied cell holds enough points, and
+  // in which the face holds together: its groups of at least 2% hold most
+  // of the dense points. A face seen as rows (a plate at a grazing angle, a
+  // line scanner's profiles) rows 2 mm apart and dense along them filled
+  // every other 1 mm cell: each row its own group, under 2% once there were
+  // over 50 of them, and every one dropped ("the plane found spans 0.0 x
+  // 0.0 mm"); a larger cell joins the rows.
+  std::map<Cell, int> counts, face;
   for (double cell_mm : kCellSizesMm) {
     e.cell_mm = cell_mm;
     counts = CountPerCell(q, cell_mm);
-    if (MedianCount(counts) >= kMinMedianCellPoints) break;
+    if (MedianCount(counts) < kMinMedianCellPoints && cell_mm != kCellSizesMm[std::size(kCellSizesMm) - 1]) continue;
+    face = FaceGroups(counts);
+    if (FaceShareOfDensePoints(counts, face) >= kMinFaceShareOfDensePoints) break;
   }
-  const std::map<Cell, int> face = FaceGroups(counts);
   std::vector<Eigen::Vector2d> dense;
   dense.reserve(q.size());
   e.mean.setZero();
@@ -137,6 +160,7 @@ PlaneOutline OutlineOfDensePart(const std::vector<Eigen::Vector3d>& pts, const s
     e.mean += pts[idx[k]];
   }
   e.points_outside = static_cast<int>(q.size() - dense.size());
+  if (dense.empty()) return e;  // nothing dense: no outline (0 x 0), not NaN
   e.mean /= static_cast<double>(dense.size());
   // The rectangle's sides are measured about the dense points' mean.
   const Eigen::Vector2d mean_ab(e.mean.dot(a), e.mean.dot(b));

@@ -12,7 +12,9 @@
 // the dense points are the face (a gap across it, a shadow or a seam, splits
 // it into groups that are all the plate's; a clump of strays is not 2 %). The cell is the smallest of 1, 2, 3, 4, 6, 8,
 // 12, 16 mm whose median occupied cell holds at least 6 points, so one or two stray points in a cell are under the
-// quarter however dense or sparse the cloud, and a clump of strays dense enough is still not connected to the face. A
+// quarter however dense or sparse the cloud, and a clump of strays dense enough is still not connected to the face;
+// and whose kept groups hold at least half of the dense points, so a face seen as rows further apart than a cell
+// (a grazing view, a line scanner's profiles) is joined by a larger cell, not dropped row by row. A
 // real edge loses at most the cells less than a quarter covered: at most a quarter of a cell on each side (0.25 mm for
 // the demo plate's 1 mm cells). The cells are fixed in the plane (about the world origin), so added points cannot shift
 // them.

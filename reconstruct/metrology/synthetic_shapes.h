@@ -10,7 +10,9 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <random>
+#include <tuple>
 #include <vector>
 
 namespace stereorig::testing {
@@ -101,6 +103,42 @@ inline std::vector<Eigen::Vector3d> NoisySurfaceSamples(
     Eigen::Vector3d n;
     const Eigen::Vector3d p = surface(u(*rng), u(*rng), &n);
     points.push_back(p + noise(*rng) * n);
+  }
+  return points;
+}
+
+// Noise shared by neighbouring points, as a reconstruction's is (a matching
+// window's footprint: the demo's residuals correlate 0.87 at 0.2-0.5 mm and
+// 0.26 at 1-2 mm, none beyond 2 mm): a random field, independent N(0,
+// sigma) values on a lattice of `cell_mm` trilinearly interpolated (it
+// correlates over up to 2 cells), along each point's normal, plus
+// independent noise.
+inline std::vector<Eigen::Vector3d> CorrelatedNoiseSamples(
+    const std::function<Eigen::Vector3d(double, double, Eigen::Vector3d*)>& surface, int count, double field_mm,
+    double cell_mm, double white_mm, std::mt19937* rng) {
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> field(0, field_mm), white(0, white_mm);
+  std::map<std::tuple<long, long, long>, double> lattice;  // drawn as the points reach it
+  const Eigen::Vector3d offset_mm(u(*rng) * cell_mm, u(*rng) * cell_mm, u(*rng) * cell_mm);
+  auto at = [&](long i, long j, long k) {
+    const auto [it, fresh] = lattice.try_emplace({i, j, k}, 0.0);
+    if (fresh) it->second = field(*rng);
+    return it->second;
+  };
+  std::vector<Eigen::Vector3d> points;
+  for (int n = 0; n < count; ++n) {
+    Eigen::Vector3d normal;
+    const Eigen::Vector3d p = surface(u(*rng), u(*rng), &normal);
+    const Eigen::Vector3d q = (p + offset_mm) / cell_mm;
+    const long i = static_cast<long>(std::floor(q.x())), j = static_cast<long>(std::floor(q.y())),
+               k = static_cast<long>(std::floor(q.z()));
+    const Eigen::Vector3d f = q - Eigen::Vector3d(i, j, k);
+    double e = 0;
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b)
+        for (int c = 0; c < 2; ++c)
+          e += (a ? f.x() : 1 - f.x()) * (b ? f.y() : 1 - f.y()) * (c ? f.z() : 1 - f.z()) * at(i + a, j + b, k + c);
+    points.push_back(p + (e + white(*rng)) * normal);
   }
   return points;
 }

@@ -79,8 +79,16 @@ std::string UndeterminedText(const Figure& f, const ArtifactEvaluation& e, const
   if (f.fit_standard_uncertainty_mm) {
     // Significant digits: beside a certificate's large part the fit's can be
     // 0.0004 mm, which %.3f printed as "+-0.000".
-    std::snprintf(buf, sizeof buf, "%s and scatter by %.3f mm (residual std), which fits it to +-%.3g mm (1 sigma)",
-                  coverage.c_str(), e.residual_std_mm, fit_mm);
+    std::snprintf(buf, sizeof buf, "%s and scatter by %.3f mm (residual std)", coverage.c_str(), e.residual_std_mm);
+    text += buf;
+    // Noise that neighbouring points share fits the shape worse than as many
+    // independent points: by how much (SphereFitUncertainty).
+    const auto& inflation = e.sphere_noise_variance_inflation;
+    if (const double most = inflation.empty() ? 1.0 : *std::max_element(inflation.begin(), inflation.end()); most > 1) {
+      std::snprintf(buf, sizeof buf, ", shared by neighbouring points (u x%.1f)", std::sqrt(most));
+      text += buf;
+    }
+    std::snprintf(buf, sizeof buf, ", which fits it to +-%.3g mm (1 sigma)", fit_mm);
     text += buf;
   }
   if (certificate_mm > 0) {
@@ -860,6 +868,7 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       const SphereFitUncertainty u = SphereUncertainty(pts, fit);
       e.sphere_cap_half_angles_deg = {u.cap_half_angle_deg};
       e.sphere_diameter_std_mm = {u.diameter_std_mm};
+      e.sphere_noise_variance_inflation = {u.noise_variance_inflation};
       e.sphere_form_mm = {Range(fit.residuals_mm)};
       e.figures = {MakeFigure("P_F", e.sphere_form_mm[0], a.mpe.probing_form_mm),
                    MakeFigure("P_S", 2 * fit.radius_mm - a.sphere_diameter_mm, a.mpe.probing_size_mm)};
@@ -982,6 +991,7 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
         on_artifact = 0;
         e.sphere_cap_half_angles_deg.clear();
         e.sphere_diameter_std_mm.clear();
+        e.sphere_noise_variance_inflation.clear();
         e.sphere_form_mm.clear();
         SphereFit fits[2];
         std::vector<int> kept[2];
@@ -1000,6 +1010,7 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
           const SphereFitUncertainty u = SphereUncertainty(pts, fit);
           e.sphere_cap_half_angles_deg.push_back(u.cap_half_angle_deg);
           e.sphere_diameter_std_mm.push_back(u.diameter_std_mm);
+          e.sphere_noise_variance_inflation.push_back(u.noise_variance_inflation);
           e.sphere_form_mm.push_back(Range(fit.residuals_mm));
           centers_covariance_mm2 += u.center_covariance_mm2;
           all_residuals.insert(all_residuals.end(), fit.residuals_mm.begin(), fit.residuals_mm.end());

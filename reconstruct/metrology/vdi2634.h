@@ -153,6 +153,10 @@ struct ArtifactEvaluation {
   // fit its diameter (sphere_uncertainty.h).
   std::vector<double> sphere_cap_half_angles_deg;
   std::vector<double> sphere_diameter_std_mm;
+  // Per sphere: how many times its fit's variances exceed what independent
+  // points would give, its neighbouring points sharing their noise
+  // (SphereFitUncertainty::noise_variance_inflation; in diameter_std_mm).
+  std::vector<double> sphere_noise_variance_inflation;
   // Per sphere: the range of its residuals (what P_F is for the sphere).
   // Reported, not judged, for the ball bar, whose figure is SD: a patch one
   // grid period off on one ball shows here, where SD may not show it.
