@@ -49,6 +49,23 @@ ClosureNaming NameClosureModules(const std::map<int, int>& failed_pairs_of) {
   return named;
 }
 
+std::string WholeCaptureText(const SetAsideView& v) {
+  char text[400];
+  if (v.whole_capture == WholeCapture::kViewOrModule) {
+    std::snprintf(text, sizeof text,
+                  "cam%d is off module %d's views by %.3f px (bound %.3f px), in this capture only: cam%d's image or "
+                  "module %d's taken at another moment than the other, which the capture cannot tell (its other "
+                  "views are one module's, triggered together)",
+                  v.lone_camera, v.other_module, v.off_px, v.bound_px, v.lone_camera, v.other_module);
+  } else {
+    std::snprintf(text, sizeof text,
+                  "its modules disagree by %.3f px (bound %.3f px), in this capture only: one module's images taken "
+                  "at another moment than the other's (a trigger or sync slip?), which one the capture cannot tell",
+                  v.off_px, v.bound_px);
+  }
+  return text;
+}
+
 std::string CheckResult::Explanation() const {
   const std::string board = board_size_note.empty() ? "" : "; " + board_size_note;
   if (ok()) return "every figure within its threshold" + board;
@@ -207,6 +224,10 @@ std::string LostCapturesText(const std::map<int, size_t>& given_captures, const 
     for (const SetAsideView& v : set_aside) {
       if (v.capture != capture) continue;
       ++num_set_aside;
+      if (v.whole_capture != WholeCapture::kNo) {
+        if (num_set_aside == 1) why += "all its views: " + WholeCaptureText(v);  // once, for the whole capture
+        continue;
+      }
       char buf[160];
       if (v.why == SetAsideWhy::kOtherMoment) {
         std::snprintf(buf, sizeof buf, "%scam%d is off the capture's other views by %.3f px (bound %.3f px)",
@@ -487,7 +508,10 @@ double OffItsCapturePx(const Inputs& in, const BoardObservation& v, const std::v
 // capture's other views' readings (a capture every view of which reads
 // worse, say a hard geometry, raises it for all), and the camera's noise.
 // It needs two other views in its capture (with one, both are off alike and
-// the check cannot tell which) and two other captures of its camera.
+// the check cannot tell which) and two other captures of its camera. Where
+// those other views are all one other module's, they are one witness, not
+// two: the whole capture goes, and which was taken at another moment is
+// left unsaid (WholeCapture::kViewOrModule).
 void SetAsideViewsOfAnotherMoment(Inputs& in, std::vector<SetAsideView>* set_aside) {
   // 10: a view's median corner error through a pose of the others varies by
   // little between captures (0.022-0.036 px on the demo's unmoved four-camera
@@ -536,7 +560,35 @@ void SetAsideViewsOfAnotherMoment(Inputs& in, std::vector<SetAsideView>* set_asi
   // slip again and again: either must be judged, not set aside until the
   // night reads "ok" (a reviewer's night: camera 1 turned 0.05 deg in the
   // last 3 of 8 captures, each set aside, verdict ok).
+  std::vector<int> whole;  // captures set aside with every view
   for (auto& [capture, vs] : in.by_capture) {
+    // A view off views that are all one other module's: they agree because
+    // a module's two cameras are triggered together, so they outvote
+    // nothing. The lone camera's image or that module's pair was taken at
+    // another moment, and which the capture cannot tell (a module's pair
+    // from another capture, its partner module's second view too few
+    // corners, read as the lone camera's slip: the wrong camera named). The
+    // capture goes whole, said so.
+    const auto lone = std::find_if(vs.begin(), vs.end(), [&](const BoardObservation* v) {
+      if (!over.count(v) || captures_over[v->camera] > 1) return false;
+      std::set<int> modules;
+      for (const BoardObservation* w : vs)
+        if (w != v) modules.insert(ModuleOf(in.rig, w->camera));
+      return modules.size() == 1 && *modules.begin() != ModuleOf(in.rig, v->camera);
+    });
+    if (lone != vs.end()) {
+      for (const BoardObservation* v : vs) {
+        SetAsideView aside{capture, v->camera, 0, over.at(*lone)};
+        aside.why = SetAsideWhy::kOtherMoment;
+        aside.off_px = off_px.at(*lone);
+        aside.whole_capture = WholeCapture::kViewOrModule;
+        aside.lone_camera = (*lone)->camera;
+        aside.other_module = ModuleOf(in.rig, (*(lone == vs.begin() ? vs.begin() + 1 : vs.begin()))->camera);
+        set_aside->push_back(aside);
+      }
+      whole.push_back(capture);
+      continue;
+    }
     std::vector<const BoardObservation*> kept;
     for (const BoardObservation* v : vs) {
       const auto it = over.find(v);
@@ -551,6 +603,7 @@ void SetAsideViewsOfAnotherMoment(Inputs& in, std::vector<SetAsideView>* set_asi
     }
     vs.swap(kept);
   }
+  for (int capture : whole) in.by_capture.erase(capture);
 }
 
 // How far each camera is off the rest of the rig, on the views as given:
@@ -732,6 +785,7 @@ void SetAsideCapturesOfModulesAtAnotherMoment(Inputs& in, std::vector<SetAsideVi
     SetAsideView aside{capture, v->camera, 0, bound_of.at(capture)};
     aside.why = SetAsideWhy::kOtherMoment;
     aside.off_px = off_px;
+    aside.whole_capture = WholeCapture::kModulesDisagree;
     set_aside->push_back(aside);
   }
   in.by_capture.erase(capture);

@@ -56,6 +56,15 @@ struct CheckFigure {
 // disagree in that capture only (a trigger slip: the whole capture goes).
 enum class SetAsideWhy { kCornersJump, kOtherMoment };
 
+// Why a view went with every other view of its capture (SetAsideView's
+// whole_capture): the capture's modules disagree in it only (a module's
+// images from another moment: which module, two modules cannot tell), or
+// one view disagrees with views that are all of one other module (the
+// capture's three views: the lone camera's image or that module's pair may
+// be the one taken at another moment, and the two agreeing views are one
+// module's, not independent witnesses).
+enum class WholeCapture { kNo, kModulesDisagree, kViewOrModule };
+
 // A view the check set aside whole.
 struct SetAsideView {
   int capture = -1;
@@ -64,8 +73,16 @@ struct SetAsideView {
   double bound_px = 0;     // what jump_rms_px, or off_px, had to be within
   SetAsideWhy why = SetAsideWhy::kCornersJump;
   double off_px = 0;  // kOtherMoment: median corner error through the pose its capture's other views imply
+  WholeCapture whole_capture = WholeCapture::kNo;  // kOtherMoment: set aside with its capture's every view, and why
+  int lone_camera = -1;                            // kViewOrModule: the view that disagrees with one module's ...
+  int other_module = -1;                           // ... views: that module
   double FigurePx() const { return why == SetAsideWhy::kOtherMoment ? off_px : jump_rms_px; }
 };
+
+// Why a capture went whole (`v` any of its views, whole_capture not kNo),
+// once for the capture: "its modules disagree by ... in this capture only:
+// ...", "cam2 is off module 0's views by ...".
+std::string WholeCaptureText(const SetAsideView& v);
 
 struct CheckResult {
   std::vector<CheckFigure> figures;
