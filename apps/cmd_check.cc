@@ -384,6 +384,24 @@ int RunCheck(int argc, char** argv) {
   report["closure_modules"] = result.closure_modules;
   report["closure_which_unknown"] = result.closure_which_unknown;
   report["split_modules"] = result.split_modules;
+  // A change every camera shares, or the rig's scale against the board's,
+  // where it explains the night (nothing is then named alone).
+  report["shared_lens_change"] = nullptr;
+  if (result.shared_lens_explains) {
+    const SharedLensChange& shared = result.shared_lens_change;
+    report["shared_lens_change"] = {
+        {"focal_percent", shared.focal_percent},
+        {"principal_point_px", {shared.principal_point_px.x(), shared.principal_point_px.y()}},
+        {"turn_equivalent_deg", shared.turn_equivalent_deg}};
+  }
+  // A module that moved as a whole besides a lens of it (module_shift.h).
+  report["module_shifts"] = nlohmann::json::array();
+  for (const CheckResult::ModuleShiftNamed& m : result.module_shifts)
+    report["module_shifts"].push_back({{"module", m.module},
+                                       {"shift_mm", m.shift_mm.norm()},
+                                       {"shift_mm_xyz", {m.shift_mm.x(), m.shift_mm.y(), m.shift_mm.z()}}});
+  report["shared_scale"] = nullptr;
+  if (result.shared_scale_explains) report["shared_scale"] = result.shared_scale;
 
   // The history appended, the report staged in its temporary file within
   // the append's transaction (with what became of the run: its id, or the
