@@ -285,24 +285,40 @@ int RunCheck(int argc, char** argv) {
   // Views set aside whole: their corners fit no board pose, not even their
   // own (a detection slip where the board is seen nearly edge-on), or they
   // disagree with their capture's other views in that capture only (an
-  // image taken at another moment).
+  // image taken at another moment). A capture set aside whole is said once,
+  // with why: each of its views printed "off the capture's other views"
+  // read as if each had slipped alone.
   report["views_set_aside"] = nlohmann::json::array();
-  for (const SetAsideView& v : result.views_set_aside) {
+  for (size_t k = 0; k < result.views_set_aside.size(); ++k) {
+    const SetAsideView& v = result.views_set_aside[k];
     const auto name = detected.capture_names.find(v.capture);
     const std::string capture = name != detected.capture_names.end() ? name->second : std::to_string(v.capture);
     const bool other_moment = v.why == SetAsideWhy::kOtherMoment;
-    std::printf(other_moment ? "set aside: capture %s cam%d: off the capture's other views by %.3f px (bound %.3f "
-                               "px), in this capture only: taken at another moment than the capture's other "
-                               "views?, not used\n"
-                             : "set aside: capture %s cam%d: its corners jump about their own board pose by %.3f px "
-                               "(bound %.3f px): misplaced (taken for the wrong squares, or far noisier than the "
-                               "camera's other views), not used\n",
-                capture.c_str(), v.camera, v.FigurePx(), v.bound_px);
-    report["views_set_aside"].push_back({{"capture", capture},
-                                         {"camera", v.camera},
-                                         {"why", other_moment ? "other_moment" : "corners_jump"},
-                                         {other_moment ? "off_px" : "jump_rms_px", v.FigurePx()},
-                                         {"bound_px", v.bound_px}});
+    const bool whole = v.whole_capture != WholeCapture::kNo;
+    if (whole && (k == 0 || result.views_set_aside[k - 1].capture != v.capture)) {
+      std::string cameras;
+      for (const SetAsideView& w : result.views_set_aside)
+        if (w.capture == v.capture) cameras += (cameras.empty() ? "cam" : ", cam") + std::to_string(w.camera);
+      std::printf("set aside: capture %s whole (%s): %s; not used\n", capture.c_str(), cameras.c_str(),
+                  WholeCaptureText(v).c_str());
+    } else if (!whole) {
+      std::printf(other_moment ? "set aside: capture %s cam%d: off the capture's other views by %.3f px (bound %.3f "
+                                 "px), in this capture only: taken at another moment than the capture's other "
+                                 "views?, not used\n"
+                               : "set aside: capture %s cam%d: its corners jump about their own board pose by %.3f "
+                                 "px (bound %.3f px): misplaced (taken for the wrong squares, or far noisier than the "
+                                 "camera's other views), not used\n",
+                  capture.c_str(), v.camera, v.FigurePx(), v.bound_px);
+    }
+    report["views_set_aside"].push_back(
+        {{"capture", capture},
+         {"camera", v.camera},
+         {"why", other_moment ? "other_moment" : "corners_jump"},
+         {other_moment ? "off_px" : "jump_rms_px", v.FigurePx()},
+         {"bound_px", v.bound_px},
+         {"whole_capture", v.whole_capture == WholeCapture::kModulesDisagree ? nlohmann::json("modules_disagree")
+                           : v.whole_capture == WholeCapture::kViewOrModule  ? nlohmann::json("view_or_module")
+                                                                             : nlohmann::json()}});
   }
   // The board's size as each module measures it, over the squares measured
   // with (the target file's, or the record's where it re-measured them;
@@ -368,6 +384,24 @@ int RunCheck(int argc, char** argv) {
   report["closure_modules"] = result.closure_modules;
   report["closure_which_unknown"] = result.closure_which_unknown;
   report["split_modules"] = result.split_modules;
+  // A change every camera shares, or the rig's scale against the board's,
+  // where it explains the night (nothing is then named alone).
+  report["shared_lens_change"] = nullptr;
+  if (result.shared_lens_explains) {
+    const SharedLensChange& shared = result.shared_lens_change;
+    report["shared_lens_change"] = {
+        {"focal_percent", shared.focal_percent},
+        {"principal_point_px", {shared.principal_point_px.x(), shared.principal_point_px.y()}},
+        {"turn_equivalent_deg", shared.turn_equivalent_deg}};
+  }
+  // A module that moved as a whole besides a lens of it (module_shift.h).
+  report["module_shifts"] = nlohmann::json::array();
+  for (const CheckResult::ModuleShiftNamed& m : result.module_shifts)
+    report["module_shifts"].push_back({{"module", m.module},
+                                       {"shift_mm", m.shift_mm.norm()},
+                                       {"shift_mm_xyz", {m.shift_mm.x(), m.shift_mm.y(), m.shift_mm.z()}}});
+  report["shared_scale"] = nullptr;
+  if (result.shared_scale_explains) report["shared_scale"] = result.shared_scale;
 
   // The history appended, the report staged in its temporary file within
   // the append's transaction (with what became of the run: its id, or the

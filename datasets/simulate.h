@@ -21,7 +21,7 @@
 #include <utility>
 #include <vector>
 
-#include "datasets/lens_drift.h"
+#include "calib/core/lens_drift.h"
 #include "datasets/sim_spec.h"
 
 namespace stereorig {

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "calib/check/board_pose.h"
+#include "calib/core/lens_drift.h"
 
 namespace stereorig {
 
@@ -143,6 +144,23 @@ double MovedFitRms(const Camera& camera, const Pose& cam_from_ref, const std::ve
 
 }  // namespace
 
+bool DriftedLensResidual(const Camera& camera, const Eigen::Vector3d& p_cam, const double* lens,
+                         const Eigen::Vector2d& q, double* residual) {
+  if (p_cam.z() <= 0) return false;
+  const Eigen::Vector2d e = DriftedPixel(camera, camera.Project(p_cam), lens[0], Eigen::Vector2d(lens[1], lens[2])) - q;
+  residual[0] = e.x();
+  residual[1] = e.y();
+  return true;
+}
+
+std::string CameraRole(const Rig& rig, int camera) {
+  for (int m = 0; m < rig.num_modules(); ++m) {
+    if (rig.module(m).left_camera == camera) return "module " + std::to_string(m) + "'s left camera";
+    if (rig.module(m).right_camera == camera) return "module " + std::to_string(m) + "'s right camera";
+  }
+  return "";
+}
+
 CameraChange ExplainCameraChange(const Rig& rig, const Target& target, int camera, const std::vector<PosedView>& views,
                                  double threshold_px) {
   const Camera& cam = rig.camera(camera);
@@ -154,10 +172,7 @@ CameraChange ExplainCameraChange(const Rig& rig, const Target& target, int camer
           {pv.ref_from_front * CornerInFront(target, pv.view->face, pv.view->corner_ids[k]), pv.view->q_px[k]});
   CameraChange change;
   change.camera = camera;
-  for (int m = 0; m < rig.num_modules(); ++m) {
-    if (rig.module(m).left_camera == camera) change.role = "module " + std::to_string(m) + "'s left camera";
-    if (rig.module(m).right_camera == camera) change.role = "module " + std::to_string(m) + "'s right camera";
-  }
+  change.role = CameraRole(rig, camera);
   change.threshold_px = threshold_px;
   change.turned_deg = change.shifted_mm = std::numeric_limits<double>::quiet_NaN();
   change.shift_mm = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());

@@ -83,6 +83,17 @@ struct PosedView {
   Pose ref_from_front;
 };
 
+// The residual (px) of a corner at p_cam (the camera's frame) seen at q by
+// `camera` with its lens drifted by lens = (s, dx, dy) (DriftedPixel,
+// calib/core/lens_drift.h), for the Ceres cost functors of the check's fits
+// that free a lens; false behind the camera.
+bool DriftedLensResidual(const Camera& camera, const Eigen::Vector3d& p_cam, const double* lens,
+                         const Eigen::Vector2d& q, double* residual);
+
+// Where `camera` sits on `rig`: "module 0's right camera" (empty if no
+// module holds it).
+std::string CameraRole(const Rig& rig, int camera);
+
 // `views` are the camera's views, each with the pose from the others;
 // `threshold_px` its consistency threshold (per-axis RMS).
 CameraChange ExplainCameraChange(const Rig& rig, const Target& target, int camera, const std::vector<PosedView>& views,

@@ -18,8 +18,8 @@
 #include <cmath>
 #include <random>
 
+#include "calib/core/lens_drift.h"
 #include "datasets/default_rig.h"
-#include "datasets/lens_drift.h"
 
 namespace stereorig {
 namespace {

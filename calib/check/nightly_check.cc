@@ -10,6 +10,8 @@
 
 #include "calib/check/board_pose.h"
 #include "calib/check/board_scale.h"
+#include "calib/check/module_shift.h"
+#include "calib/check/shared_lens_change.h"
 #include "calib/core/input_error.h"
 
 namespace stereorig {
@@ -30,12 +32,14 @@ bool CheckResult::ok() const {
 std::vector<int> CheckResult::FlaggedCameras() const {
   std::vector<int> cameras;
   for (const CameraChange& c : camera_changes) cameras.push_back(c.camera);
+  for (int c = 0; shared_lens_explains && c < num_cameras; ++c) cameras.push_back(c);
   return cameras;
 }
 
 std::vector<int> CheckResult::FlaggedModules() const {
   std::set<int> modules(split_modules.begin(), split_modules.end());
   modules.insert(closure_modules.begin(), closure_modules.end());
+  for (int m = 0; shared_scale_explains && m < num_modules; ++m) modules.insert(m);
   return {modules.begin(), modules.end()};
 }
 
@@ -49,10 +53,44 @@ ClosureNaming NameClosureModules(const std::map<int, int>& failed_pairs_of) {
   return named;
 }
 
+std::string WholeCaptureText(const SetAsideView& v) {
+  char text[400];
+  if (v.whole_capture == WholeCapture::kViewOrModule) {
+    std::snprintf(text, sizeof text,
+                  "cam%d is off module %d's views by %.3f px (bound %.3f px), in this capture only: cam%d's image or "
+                  "module %d's taken at another moment than the other, which the capture cannot tell (its other "
+                  "views are one module's, triggered together)",
+                  v.lone_camera, v.other_module, v.off_px, v.bound_px, v.lone_camera, v.other_module);
+  } else {
+    std::snprintf(text, sizeof text,
+                  "its modules disagree by %.3f px (bound %.3f px), in this capture only: one module's images taken "
+                  "at another moment than the other's (a trigger or sync slip?), which one the capture cannot tell",
+                  v.off_px, v.bound_px);
+  }
+  return text;
+}
+
 std::string CheckResult::Explanation() const {
   const std::string board = board_size_note.empty() ? "" : "; " + board_size_note;
   if (ok()) return "every figure within its threshold" + board;
   std::ostringstream s;
+  if (shared_lens_explains)
+    s << shared_lens_change.Describe()
+      << " (with it every camera agrees with the others, each module's cameras with each other, and every "
+         "closure holds: a change every camera shares, as a temperature change makes, not one camera's or one "
+         "module's); ";
+  if (shared_scale_explains) {
+    char text[600];
+    std::snprintf(text, sizeof text,
+                  "the rig's scale against the board's changed: every module measures the board %.3f %% %s than "
+                  "its squares, and on a board of that size every camera agrees with the others, each module's "
+                  "cameras with each other, and every closure holds: every baseline and S %s alike, or the board is "
+                  "not its file's size (the board is the check's one length: it cannot tell which), no camera or "
+                  "module changed alone; ",
+                  100 * std::abs(shared_scale - 1), shared_scale > 1 ? "larger" : "smaller",
+                  shared_scale > 1 ? "shorter" : "longer");
+    s << text;
+  }
   for (const CameraChange& c : camera_changes) s << c.Describe() << "; ";
   for (int m : split_modules) s << "module " << m << "'s cameras disagree: one moved or its lens changed; ";
   if (closure_which_unknown && closure_modules.size() == 2) {
@@ -67,7 +105,16 @@ std::string CheckResult::Explanation() const {
   } else {
     for (int m : closure_modules) s << "module " << m << " moved or a lens changed; ";
   }
-  if (camera_changes.empty() && split_modules.empty() && closure_modules.empty())
+  for (const ModuleShiftNamed& shift : module_shifts) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "module %d's cameras are both off the other modules' by one shift of %.3f mm (the lens changes "
+                  "named aside); ",
+                  shift.module, shift.shift_mm.norm());
+    s << text;
+  }
+  if (camera_changes.empty() && split_modules.empty() && closure_modules.empty() && !shared_lens_explains &&
+      !shared_scale_explains)
     s << "figures exceed their thresholds; ";
   if (every_camera_fails)
     s << "every camera and every module fails its figure: a change they share (every lens drifted alike?) or "
@@ -174,8 +221,10 @@ constexpr double kOwnLensK = 3.0;
 
 // `t` scaled by `s` in the board's plane (squares, margins, tags and the
 // faces' in-plane offset; the plate's thickness kept): the board another
-// print of the same design would be. nullopt when no such target is valid.
-std::optional<Target> ScaledBoard(const Target& t, double s) {
+// print of the same design would be. With `thickness_too`, the plate's
+// thickness scaled as well: the whole board as a rig whose every baseline
+// and S scaled by 1 / s sees it. nullopt when no such target is valid.
+std::optional<Target> ScaledBoard(const Target& t, double s, bool thickness_too = false) {
   Target::Layout l = t.layout();
   l.square_size_mm *= s;
   l.margin_mm *= s;
@@ -184,6 +233,7 @@ std::optional<Target> ScaledBoard(const Target& t, double s) {
     for (TagPlacement& tag : face.tags) tag.center_x_mm *= s, tag.center_y_mm *= s;
   Eigen::Vector3d offset = l.back_from_front.translation_mm();
   offset.x() *= s, offset.y() *= s;
+  if (thickness_too) offset.z() *= s;
   l.back_from_front = Pose(l.back_from_front.rotation(), offset);
   try {
     return Target(l, "scaled board");
@@ -207,6 +257,10 @@ std::string LostCapturesText(const std::map<int, size_t>& given_captures, const 
     for (const SetAsideView& v : set_aside) {
       if (v.capture != capture) continue;
       ++num_set_aside;
+      if (v.whole_capture != WholeCapture::kNo) {
+        if (num_set_aside == 1) why += "all its views: " + WholeCaptureText(v);  // once, for the whole capture
+        continue;
+      }
       char buf[160];
       if (v.why == SetAsideWhy::kOtherMoment) {
         std::snprintf(buf, sizeof buf, "%scam%d is off the capture's other views by %.3f px (bound %.3f px)",
@@ -487,7 +541,10 @@ double OffItsCapturePx(const Inputs& in, const BoardObservation& v, const std::v
 // capture's other views' readings (a capture every view of which reads
 // worse, say a hard geometry, raises it for all), and the camera's noise.
 // It needs two other views in its capture (with one, both are off alike and
-// the check cannot tell which) and two other captures of its camera.
+// the check cannot tell which) and two other captures of its camera. Where
+// those other views are all one other module's, they are one witness, not
+// two: the whole capture goes, and which was taken at another moment is
+// left unsaid (WholeCapture::kViewOrModule).
 void SetAsideViewsOfAnotherMoment(Inputs& in, std::vector<SetAsideView>* set_aside) {
   // 10: a view's median corner error through a pose of the others varies by
   // little between captures (0.022-0.036 px on the demo's unmoved four-camera
@@ -536,7 +593,35 @@ void SetAsideViewsOfAnotherMoment(Inputs& in, std::vector<SetAsideView>* set_asi
   // slip again and again: either must be judged, not set aside until the
   // night reads "ok" (a reviewer's night: camera 1 turned 0.05 deg in the
   // last 3 of 8 captures, each set aside, verdict ok).
+  std::vector<int> whole;  // captures set aside with every view
   for (auto& [capture, vs] : in.by_capture) {
+    // A view off views that are all one other module's: they agree because
+    // a module's two cameras are triggered together, so they outvote
+    // nothing. The lone camera's image or that module's pair was taken at
+    // another moment, and which the capture cannot tell (a module's pair
+    // from another capture, its partner module's second view too few
+    // corners, read as the lone camera's slip: the wrong camera named). The
+    // capture goes whole, said so.
+    const auto lone = std::find_if(vs.begin(), vs.end(), [&](const BoardObservation* v) {
+      if (!over.count(v) || captures_over[v->camera] > 1) return false;
+      std::set<int> modules;
+      for (const BoardObservation* w : vs)
+        if (w != v) modules.insert(ModuleOf(in.rig, w->camera));
+      return modules.size() == 1 && *modules.begin() != ModuleOf(in.rig, v->camera);
+    });
+    if (lone != vs.end()) {
+      for (const BoardObservation* v : vs) {
+        SetAsideView aside{capture, v->camera, 0, over.at(*lone)};
+        aside.why = SetAsideWhy::kOtherMoment;
+        aside.off_px = off_px.at(*lone);
+        aside.whole_capture = WholeCapture::kViewOrModule;
+        aside.lone_camera = (*lone)->camera;
+        aside.other_module = ModuleOf(in.rig, (*(lone == vs.begin() ? vs.begin() + 1 : vs.begin()))->camera);
+        set_aside->push_back(aside);
+      }
+      whole.push_back(capture);
+      continue;
+    }
     std::vector<const BoardObservation*> kept;
     for (const BoardObservation* v : vs) {
       const auto it = over.find(v);
@@ -551,6 +636,7 @@ void SetAsideViewsOfAnotherMoment(Inputs& in, std::vector<SetAsideView>* set_asi
     }
     vs.swap(kept);
   }
+  for (int capture : whole) in.by_capture.erase(capture);
 }
 
 // How far each camera is off the rest of the rig, on the views as given:
@@ -732,9 +818,111 @@ void SetAsideCapturesOfModulesAtAnotherMoment(Inputs& in, std::vector<SetAsideVi
     SetAsideView aside{capture, v->camera, 0, bound_of.at(capture)};
     aside.why = SetAsideWhy::kOtherMoment;
     aside.off_px = off_px;
+    aside.whole_capture = WholeCapture::kModulesDisagree;
     set_aside->push_back(aside);
   }
   in.by_capture.erase(capture);
+}
+
+// The closure figures of every module pair whose modules both saw the board
+// in two captures or more (mm and deg, in that order), and in
+// `failed_pairs_of` each module's count of failing pairs, counting no pair
+// with a module in `inconsistent_modules` (a module whose cameras disagree:
+// its board pose mixes them).
+std::vector<CheckFigure> ClosureFigures(const Inputs& in, const std::set<int>& inconsistent_modules,
+                                        std::map<int, int>* failed_pairs_of) {
+  std::vector<CheckFigure> figures;
+  const double k = in.options.k_sigma;
+  const Eigen::Vector3d board_center((in.target.corners_x() - 1) * 0.5 * in.target.square_size_mm(),
+                                     (in.target.corners_y() - 1) * 0.5 * in.target.square_size_mm(), 0.0);
+  // The spread's cap needs the calibration's own error of every camera: a
+  // rig file without it (no provenance.uncertainties) gets none.
+  bool closure_bound = true;
+  for (int c = 0; c < in.rig.num_cameras(); ++c) closure_bound = closure_bound && in.u_px[c] > 0;
+  for (int i = 0; i < in.rig.num_modules(); ++i) {
+    for (int j = i + 1; j < in.rig.num_modules(); ++j) {
+      std::vector<Eigen::Vector3d> dt, dr;
+      // The most an unchanged rig lets a capture's closure scatter, per
+      // axis (variances, mm^2 and deg^2), summed over the captures.
+      double bound_var_t = 0, bound_var_r = 0;
+      for (const auto& [capture, vs] : in.by_capture) {
+        std::vector<const BoardObservation*> vi, vj;
+        for (const BoardObservation* v : vs) {
+          const int m = ModuleOf(in.rig, v->camera);
+          if (m == i) vi.push_back(v);
+          if (m == j) vj.push_back(v);
+        }
+        if (vi.empty() || vj.empty()) continue;
+        const BoardPoseEstimate pi = EstimateBoardPose(in.rig, in.target, vi, &in.seed.at(capture));
+        const BoardPoseEstimate pj = EstimateBoardPose(in.rig, in.target, vj, &in.seed.at(capture));
+        if (!pi.ok || !pj.ok) continue;
+        dt.push_back(pi.ref_from_front * board_center - pj.ref_from_front * board_center);
+        dr.push_back(
+            Pose(pi.ref_from_front.rotation() * pj.ref_from_front.rotation().transpose(), Eigen::Vector3d::Zero())
+                .RotationVector() *
+            180.0 / M_PI);
+        if (closure_bound) {
+          // Evaluated where the board is, at either module's pose (the
+          // smaller bound): an unchanged rig's two poses agree, but a module
+          // whose pose is rubbish has a covariance to match (module 0 with
+          // its cameras' images exchanged put the board 32 m away, poorly
+          // fixed), and at its own pose the cap held nothing: 1108.8 mm, and
+          // a closure of 5.84 deg passed against 15.97 deg.
+          const ClosureSpread at_i = ClosureSpreadBound(in, vi, vj, pi.ref_from_front, board_center);
+          const ClosureSpread at_j = ClosureSpreadBound(in, vi, vj, pj.ref_from_front, board_center);
+          bound_var_t += std::min(at_i.var_t_mm2, at_j.var_t_mm2);
+          bound_var_r += std::min(at_i.var_r_deg2, at_j.var_r_deg2);
+        }
+      }
+      const int n = static_cast<int>(dt.size());
+      if (n < 2) continue;
+      auto mean_and_se = [n](const std::vector<Eigen::Vector3d>& d, Eigen::Vector3d* mean) {
+        *mean = Eigen::Vector3d::Zero();
+        for (const auto& x : d) *mean += x;
+        *mean /= n;
+        double var = 0;
+        for (const auto& x : d) var += (x - *mean).squaredNorm();
+        var /= 3.0 * (n - 1);  // per axis
+        // Student-t inflation of a variance estimated from few captures.
+        const double t_inflation = n > 3 ? (n - 1.0) / (n - 3.0) : 3.0;
+        return std::sqrt(var * t_inflation / n);
+      };
+      Eigen::Vector3d mean_t, mean_r;
+      double se_t = mean_and_se(dt, &mean_t), se_r = mean_and_se(dr, &mean_r);
+      // The spread seen between captures, capped at the most an unchanged
+      // rig allows (ClosureSpreadBound): a spread beyond it is no noise (one
+      // module's views taken at another moment read 15.5 mm against a
+      // threshold of 47 mm, "yes"), so it does not loosen the test.
+      if (closure_bound) {
+        se_t = std::min(se_t, std::sqrt(bound_var_t) / n);
+        se_r = std::min(se_r, std::sqrt(bound_var_r) / n);
+      }
+      const std::string key = "S_" + std::to_string(i) + "_" + std::to_string(j);
+      const double s_t = Lookup(in.rig.provenance().uncertainties, key + "_translation_mm", 0);
+      const double s_r = Lookup(in.rig.provenance().uncertainties, key + "_rotation_deg", 0);
+      // What a closure tests is S composed with the target's back_from_front,
+      // which stage 3 estimates jointly; the marginal 1-sigma of S alone
+      // (s_t, s_r) is dominated by the board's prior and far exceeds the
+      // combination's. The combination was estimated from at least as many
+      // captures as tonight's, so its error is bounded by tonight's standard
+      // error: counted twice. s_t and s_r remain a cap, never a floor.
+      const double chi3 = ChiFactor(3, k);
+      const double comb_t = s_t > 0 ? std::min(se_t, s_t) : se_t;
+      const double comb_r = s_r > 0 ? std::min(se_r, s_r) : se_r;
+      const double thr_t = chi3 * std::sqrt(se_t * se_t + comb_t * comb_t);
+      const double thr_r = chi3 * std::sqrt(se_r * se_r + comb_r * comb_r);
+      const bool pass_t = mean_t.norm() <= thr_t, pass_r = mean_r.norm() <= thr_r;
+      figures.push_back(
+          {"pair_" + std::to_string(i) + "_" + std::to_string(j) + "_closure_mm", mean_t.norm(), thr_t, pass_t, n});
+      figures.push_back(
+          {"pair_" + std::to_string(i) + "_" + std::to_string(j) + "_closure_deg", mean_r.norm(), thr_r, pass_r, n});
+      if ((!pass_t || !pass_r) && !inconsistent_modules.count(i) && !inconsistent_modules.count(j)) {
+        ++(*failed_pairs_of)[i];
+        ++(*failed_pairs_of)[j];
+      }
+    }
+  }
+  return figures;
 }
 
 }  // namespace
@@ -1198,7 +1386,10 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   // worse camera alone is named, as before. With one module there is no
   // outside view: the camera is named by how it moved
   // (TurnedCameraOfModule), else the module.
-  std::vector<int> named_cameras;  // in the order named
+  std::vector<int> named_cameras;                 // in the order named
+  std::vector<CameraChange> module_lens_changes;  // of modules that shifted (module_shifts)
+  std::map<int, std::set<int>> shifted_against;   // module that shifted -> the modules it is read against
+  std::set<int> named_with_module;                // their cameras: no reference for the cameras named
   for (int m : inconsistent_modules) {
     const StereoModule& mod = rig.module(m);
     std::set<int> outside, agreeing;
@@ -1219,6 +1410,27 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
           outside.empty() ? Consistency{} : CameraConsistency(in, c, agreeing.empty() ? outside : agreeing);
       if (con.corners > 0 && con.rms_px > con.threshold_px) off.push_back({con.rms_px / con.threshold_px, c});
     }
+    // Both cameras off the modules that agree: the module may have moved as
+    // a whole, a lens of it changed besides (module_shift.h). Where one
+    // shift of the module and the lenses explain both cameras, and the
+    // lenses alone do not, the module's shift is named as a closure would
+    // name it, and only the cameras whose lens the shift leaves off.
+    if (!agreeing.empty() && off.size() == 2) {
+      std::vector<ModuleCameraViews> cameras;
+      for (int c : {mod.left_camera, mod.right_camera}) {
+        Consistency con = CameraConsistency(in, c, agreeing);
+        cameras.push_back({c, std::move(con.views), con.threshold_px});
+      }
+      const ModuleShift shift = ExplainModuleShift(rig, target, cameras);
+      if (shift.explains && shift.shift_needed) {
+        result.module_shifts.push_back({m, shift.shift_mm});
+        for (const CameraChange& lens : shift.lenses) module_lens_changes.push_back(lens);
+        for (int c : agreeing) shifted_against[m].insert(ModuleOf(rig, c));
+        named_with_module.insert(mod.left_camera);
+        named_with_module.insert(mod.right_camera);
+        continue;
+      }
+    }
     std::sort(off.rbegin(), off.rend());  // the worse first
     if (agreeing.empty() && off.size() > 1) off.resize(1);
     for (const auto& [ratio, c] : off) named_cameras.push_back(c);
@@ -1229,12 +1441,14 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   // as its own), judged by its own consistency threshold.
   std::set<int> unnamed = all;
   for (int c : named_cameras) unnamed.erase(c);
+  for (int c : named_with_module) unnamed.erase(c);
   for (int c : named_cameras) {
     std::set<int> others = unnamed;
     if (others.empty()) others = all, others.erase(c);
     const Consistency con = CameraConsistency(in, c, others);
     result.camera_changes.push_back(ExplainCameraChange(rig, target, c, con.views, con.threshold_px));
   }
+  for (const CameraChange& lens : module_lens_changes) result.camera_changes.push_back(lens);
   {
     const bool cameras_fail =
         std::none_of(camera_figures.begin(), camera_figures.end(), [](const auto& f) { return f.second.pass; });
@@ -1247,96 +1461,8 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   }
 
   // --- Module pairs: closure through the target. ---
-  const Eigen::Vector3d board_center((target.corners_x() - 1) * 0.5 * target.square_size_mm(),
-                                     (target.corners_y() - 1) * 0.5 * target.square_size_mm(), 0.0);
   std::map<int, int> failed_pairs_of;  // module -> number of failing pairs it is in
-  // The spread's cap needs the calibration's own error of every camera: a
-  // rig file without it (no provenance.uncertainties) gets none.
-  bool closure_bound = true;
-  for (int c = 0; c < rig.num_cameras(); ++c) closure_bound = closure_bound && in.u_px[c] > 0;
-  for (int i = 0; i < rig.num_modules(); ++i) {
-    for (int j = i + 1; j < rig.num_modules(); ++j) {
-      std::vector<Eigen::Vector3d> dt, dr;
-      // The most an unchanged rig lets a capture's closure scatter, per
-      // axis (variances, mm^2 and deg^2), summed over the captures.
-      double bound_var_t = 0, bound_var_r = 0;
-      for (const auto& [capture, vs] : in.by_capture) {
-        std::vector<const BoardObservation*> vi, vj;
-        for (const BoardObservation* v : vs) {
-          const int m = ModuleOf(rig, v->camera);
-          if (m == i) vi.push_back(v);
-          if (m == j) vj.push_back(v);
-        }
-        if (vi.empty() || vj.empty()) continue;
-        const BoardPoseEstimate pi = EstimateBoardPose(rig, target, vi, &in.seed.at(capture));
-        const BoardPoseEstimate pj = EstimateBoardPose(rig, target, vj, &in.seed.at(capture));
-        if (!pi.ok || !pj.ok) continue;
-        dt.push_back(pi.ref_from_front * board_center - pj.ref_from_front * board_center);
-        dr.push_back(
-            Pose(pi.ref_from_front.rotation() * pj.ref_from_front.rotation().transpose(), Eigen::Vector3d::Zero())
-                .RotationVector() *
-            180.0 / M_PI);
-        if (closure_bound) {
-          // Evaluated where the board is, at either module's pose (the
-          // smaller bound): an unchanged rig's two poses agree, but a module
-          // whose pose is rubbish has a covariance to match (module 0 with
-          // its cameras' images exchanged put the board 32 m away, poorly
-          // fixed), and at its own pose the cap held nothing: 1108.8 mm, and
-          // a closure of 5.84 deg passed against 15.97 deg.
-          const ClosureSpread at_i = ClosureSpreadBound(in, vi, vj, pi.ref_from_front, board_center);
-          const ClosureSpread at_j = ClosureSpreadBound(in, vi, vj, pj.ref_from_front, board_center);
-          bound_var_t += std::min(at_i.var_t_mm2, at_j.var_t_mm2);
-          bound_var_r += std::min(at_i.var_r_deg2, at_j.var_r_deg2);
-        }
-      }
-      const int n = static_cast<int>(dt.size());
-      if (n < 2) continue;
-      auto mean_and_se = [n](const std::vector<Eigen::Vector3d>& d, Eigen::Vector3d* mean) {
-        *mean = Eigen::Vector3d::Zero();
-        for (const auto& x : d) *mean += x;
-        *mean /= n;
-        double var = 0;
-        for (const auto& x : d) var += (x - *mean).squaredNorm();
-        var /= 3.0 * (n - 1);  // per axis
-        // Student-t inflation of a variance estimated from few captures.
-        const double t_inflation = n > 3 ? (n - 1.0) / (n - 3.0) : 3.0;
-        return std::sqrt(var * t_inflation / n);
-      };
-      Eigen::Vector3d mean_t, mean_r;
-      double se_t = mean_and_se(dt, &mean_t), se_r = mean_and_se(dr, &mean_r);
-      // The spread seen between captures, capped at the most an unchanged
-      // rig allows (ClosureSpreadBound): a spread beyond it is no noise (one
-      // module's views taken at another moment read 15.5 mm against a
-      // threshold of 47 mm, "yes"), so it does not loosen the test.
-      if (closure_bound) {
-        se_t = std::min(se_t, std::sqrt(bound_var_t) / n);
-        se_r = std::min(se_r, std::sqrt(bound_var_r) / n);
-      }
-      const std::string key = "S_" + std::to_string(i) + "_" + std::to_string(j);
-      const double s_t = Lookup(rig.provenance().uncertainties, key + "_translation_mm", 0);
-      const double s_r = Lookup(rig.provenance().uncertainties, key + "_rotation_deg", 0);
-      // What a closure tests is S composed with the target's back_from_front,
-      // which stage 3 estimates jointly; the marginal 1-sigma of S alone
-      // (s_t, s_r) is dominated by the board's prior and far exceeds the
-      // combination's. The combination was estimated from at least as many
-      // captures as tonight's, so its error is bounded by tonight's standard
-      // error: counted twice. s_t and s_r remain a cap, never a floor.
-      const double chi3 = ChiFactor(3, k);
-      const double comb_t = s_t > 0 ? std::min(se_t, s_t) : se_t;
-      const double comb_r = s_r > 0 ? std::min(se_r, s_r) : se_r;
-      const double thr_t = chi3 * std::sqrt(se_t * se_t + comb_t * comb_t);
-      const double thr_r = chi3 * std::sqrt(se_r * se_r + comb_r * comb_r);
-      const bool pass_t = mean_t.norm() <= thr_t, pass_r = mean_r.norm() <= thr_r;
-      result.figures.push_back(
-          {"pair_" + std::to_string(i) + "_" + std::to_string(j) + "_closure_mm", mean_t.norm(), thr_t, pass_t, n});
-      result.figures.push_back(
-          {"pair_" + std::to_string(i) + "_" + std::to_string(j) + "_closure_deg", mean_r.norm(), thr_r, pass_r, n});
-      if ((!pass_t || !pass_r) && !inconsistent_modules.count(i) && !inconsistent_modules.count(j)) {
-        ++failed_pairs_of[i];
-        ++failed_pairs_of[j];
-      }
-    }
-  }
+  for (const CheckFigure& f : ClosureFigures(in, inconsistent_modules, &failed_pairs_of)) result.figures.push_back(f);
   // Whole modules that moved, or a lens changed: their pairs fail while each
   // module is consistent in itself. A pair's closure only shows relative
   // motion, so a module is named alone only when it is in more failing pairs
@@ -1348,9 +1474,97 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   // closure alone (a 0.01 % one does, end to end: docs/verify-and-check.md).
   // failed_pairs_of counts no pair with a module whose cameras disagree, so
   // no split module is named again here.
+  // A module that shifted as a whole (module_shifts) is in a failing pair
+  // with each module it was read against: its closure, not judged (its
+  // cameras disagree), is what its shift is.
+  for (const auto& [m, against] : shifted_against)
+    for (int o : against) ++failed_pairs_of[m], ++failed_pairs_of[o];
   const ClosureNaming named = NameClosureModules(failed_pairs_of);
   result.closure_modules = named.modules;
   result.closure_which_unknown = named.which_unknown;
+
+  // Every camera's figure fails: a change they all share leaves none
+  // unchanged to read the others against, and the naming above names the
+  // worse camera of each module as if the others had not changed (all four
+  // focal lengths +0.1 %: cameras 0 and 2, "neither"; every principal point
+  // +0.5 px: cameras 0 and 1 "moved" 0.2 mm). One lens change shared by
+  // every camera is fitted; where with it every camera agrees with the
+  // rest, each module's cameras with each other, and every closure holds,
+  // that is what the night shows, and nothing is named alone. A module that
+  // moved, or one camera's change, is not explained by a change every
+  // camera shares, and is named as before.
+  result.num_cameras = rig.num_cameras();
+  result.num_modules = rig.num_modules();
+  const bool every_camera_figure_fails =
+      static_cast<int>(camera_figures.size()) == rig.num_cameras() &&
+      std::none_of(camera_figures.begin(), camera_figures.end(), [](const auto& f) { return f.second.pass; });
+  //
+  // Or the rig's scale: every baseline and S longer or shorter alike, which
+  // against the board reads as a board of another size (every module
+  // measures it off alike, board_scale.h). The board is the check's one
+  // length, so the two are one reading: a rig 0.2 % larger read cameras 1
+  // and 3 "neither", every module measuring the board -0.20 % (under the
+  // 0.5 % of the board-size note). Tried with the board at the size the
+  // modules measure, as the lens change is.
+  auto explains_night = [&](const Inputs& with) {
+    auto agrees = [&](int c, const std::set<int>& trusted) {
+      const Consistency con = CameraConsistency(with, c, trusted);
+      return con.corners == 0 || con.rms_px <= con.threshold_px;
+    };
+    for (int c = 0; c < rig.num_cameras(); ++c)
+      if (!agrees(c, all)) return false;
+    for (const StereoModule& mod : rig.modules())
+      if (!agrees(mod.left_camera, {mod.right_camera}) || !agrees(mod.right_camera, {mod.left_camera})) return false;
+    std::map<int, int> failed_with;
+    ClosureFigures(with, {}, &failed_with);
+    return failed_with.empty();
+  };
+  auto name_nothing_alone = [&] {
+    result.camera_changes.clear();
+    result.split_modules.clear();
+    result.closure_modules.clear();
+    result.closure_which_unknown = false;
+    result.every_camera_fails = false;
+  };
+  //
+  // Only where some module's cameras disagree: a module that moved as a
+  // whole leaves its cameras agreeing, and where every module's do, the
+  // closures say what the night shows ("module 0 and module 1 disagree: one
+  // moved or a lens changed"), of which every principal point moved alike
+  // is one reading: to first order a turn of each camera, so of each module
+  // (a module shifted 0.1 mm across the board read as every principal point
+  // +0.2 px on 3 of 20 synthetic nights, NightlyCheck.FlagsAModuleShifted...).
+  if (rig.num_modules() >= 2 && every_camera_figure_fails && !inconsistent_modules.empty()) {
+    const SharedLensChange shared = FitSharedLensChange(rig, target, in.by_capture, in.seed);
+    if (shared.fitted) {
+      const Rig changed = WithSharedLensChange(rig, shared);
+      if (explains_night({changed, target, options, in.by_capture, in.sigma_px, in.u_px, in.seed})) {
+        result.shared_lens_explains = true;
+        result.shared_lens_change = shared;
+        name_nothing_alone();
+      }
+    }
+    double scale = 0;
+    int modules_measured = 0;
+    for (const ModuleBoardScale& m : result.board_scales)
+      if (m.captures >= 3) scale += m.scale, ++modules_measured;
+    scale /= std::max(modules_measured, 1);
+    const std::optional<Target> board = result.shared_lens_explains || modules_measured != rig.num_modules()
+                                            ? std::nullopt
+                                            : ScaledBoard(target, scale, true);
+    if (board) {
+      Inputs with{rig, *board, options, in.by_capture, in.sigma_px, in.u_px, {}};
+      // Each seed pose moved as a board of that size would be to look the
+      // same from the reference frame's origin (as BoardOfAnotherSize).
+      for (const auto& [capture, pose] : in.seed)
+        with.seed[capture] = Pose(pose.rotation(), scale * pose.translation_mm());
+      if (explains_night(with)) {
+        result.shared_scale_explains = true;
+        result.shared_scale = scale;
+        name_nothing_alone();
+      }
+    }
+  }
   return result;
 }
 

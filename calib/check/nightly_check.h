@@ -25,6 +25,7 @@
 
 #include "calib/check/board_scale.h"
 #include "calib/check/camera_change.h"
+#include "calib/check/shared_lens_change.h"
 #include "calib/core/rig.h"
 #include "calib/observations.h"
 #include "targets/target.h"
@@ -56,6 +57,15 @@ struct CheckFigure {
 // disagree in that capture only (a trigger slip: the whole capture goes).
 enum class SetAsideWhy { kCornersJump, kOtherMoment };
 
+// Why a view went with every other view of its capture (SetAsideView's
+// whole_capture): the capture's modules disagree in it only (a module's
+// images from another moment: which module, two modules cannot tell), or
+// one view disagrees with views that are all of one other module (the
+// capture's three views: the lone camera's image or that module's pair may
+// be the one taken at another moment, and the two agreeing views are one
+// module's, not independent witnesses).
+enum class WholeCapture { kNo, kModulesDisagree, kViewOrModule };
+
 // A view the check set aside whole.
 struct SetAsideView {
   int capture = -1;
@@ -64,8 +74,16 @@ struct SetAsideView {
   double bound_px = 0;     // what jump_rms_px, or off_px, had to be within
   SetAsideWhy why = SetAsideWhy::kCornersJump;
   double off_px = 0;  // kOtherMoment: median corner error through the pose its capture's other views imply
+  WholeCapture whole_capture = WholeCapture::kNo;  // kOtherMoment: set aside with its capture's every view, and why
+  int lone_camera = -1;                            // kViewOrModule: the view that disagrees with one module's ...
+  int other_module = -1;                           // ... views: that module
   double FigurePx() const { return why == SetAsideWhy::kOtherMoment ? off_px : jump_rms_px; }
 };
+
+// Why a capture went whole (`v` any of its views, whole_capture not kNo),
+// once for the capture: "its modules disagree by ... in this capture only:
+// ...", "cam2 is off module 0's views by ...".
+std::string WholeCaptureText(const SetAsideView& v);
 
 struct CheckResult {
   std::vector<CheckFigure> figures;
@@ -84,6 +102,19 @@ struct CheckResult {
   // changed (closure_which_unknown).
   std::vector<int> closure_modules;
   bool closure_which_unknown = false;
+  // Modules whose cameras both disagree with the modules that agree with
+  // themselves, explained by one shift of the module and its lenses where
+  // the lenses alone do not (module_shift.h): the module is in closure_modules
+  // (with each module it was read against, as a failing closure), the shift
+  // here (its cameras' centres, in the reference frame), and only the
+  // cameras whose lens the shift leaves off are in camera_changes. Camera 0's
+  // principal point +1 px with module 1 0.5 mm off read cameras 0 and 1
+  // "moved" 0.5 mm, the module pair not named.
+  struct ModuleShiftNamed {
+    int module = -1;
+    Eigen::Vector3d shift_mm = Eigen::Vector3d::Zero();
+  };
+  std::vector<ModuleShiftNamed> module_shifts;
   // Modules whose own two cameras disagree while neither disagrees with the
   // other modules (or there are none): something in the module changed, a
   // camera's pose or lens, not the module as a whole.
@@ -106,17 +137,36 @@ struct CheckResult {
   // Said after them: all four focal lengths +0.1 % named cameras 0 and 3,
   // "neither", and another rig's captures camera 1 alone.
   bool every_camera_fails = false;
+  // Where every camera's figure fails (two modules or more), one lens change
+  // shared by every camera is fitted (shared_lens_change.h); where with it
+  // every camera's and module's consistency and every closure are within
+  // their thresholds, it is what the night says, and no camera or module is
+  // named alone: all four focal lengths +0.1 % named the worse camera of
+  // each module, "neither a new pose nor a new lens alone explains".
+  bool shared_lens_explains = false;
+  SharedLensChange shared_lens_change;  // as fitted, where shared_lens_explains
+  // Otherwise, where with the board at the size every module measures it
+  // (their mean, board_scales) all those figures hold: the rig's scale
+  // against the board's changed (every baseline and S alike, or a board of
+  // another size: the board is the check's one length), said so, and no
+  // camera or module named alone.
+  bool shared_scale_explains = false;
+  double shared_scale = 1;  // the board's size over its file's, where shared_scale_explains
   bool ok() const;
   std::string Verdict() const { return ok() ? "ok" : "recalibrate"; }
   std::string Explanation() const;  // one line: what changed, in no more words than the figures support
-  // Every camera named (camera_changes' cameras): the report's
+  // Every camera named (camera_changes' cameras; every camera where
+  // shared_lens_explains): the report's
   // flagged_cameras (and moved_cameras, its old name; each change's kind
   // says what explains it).
   std::vector<int> FlaggedCameras() const;
-  // Every module named (split_modules and closure_modules, sorted): the
-  // report's flagged_modules. No figure tells a module's motion from a lens
-  // change, so none is said to have moved as a whole.
+  // Every module named (split_modules and closure_modules, sorted; every
+  // module where shared_scale_explains): the report's flagged_modules. No
+  // figure tells a module's motion from a lens change, so none is said to
+  // have moved as a whole.
   std::vector<int> FlaggedModules() const;
+  int num_cameras = 0;  // the rig's, set by RunNightlyCheck (FlaggedCameras where shared_lens_explains)
+  int num_modules = 0;  // the rig's, set by RunNightlyCheck (FlaggedModules where shared_scale_explains)
 };
 
 // The modules failing closures name, from each module's count of failing

@@ -19,4 +19,13 @@ struct LensDrift {
 // stereorig uses starts with them) drifted; every other intrinsic as it was.
 Camera WithLensDrift(const Camera& camera, const LensDrift& drift);
 
+// Where pixel q of `camera` lands once its lens drifted: every mrcal model
+// stereorig uses maps its normalised (distorted) coordinates u to
+// q = f u + c, so the drifted lens sees q' = c + d + (1 + s)(q - c), s the
+// focal change as a fraction (focal_percent / 100) and d the principal
+// point's move. As WithLensDrift's camera projects, without building it
+// (fits that free the drift evaluate it at every step).
+Eigen::Vector2d DriftedPixel(const Camera& camera, const Eigen::Vector2d& q_px, double focal_fraction,
+                             const Eigen::Vector2d& principal_point_px);
+
 }  // namespace stereorig

@@ -1,4 +1,4 @@
-#include "datasets/lens_drift.h"
+#include "calib/core/lens_drift.h"
 
 namespace stereorig {
 
@@ -11,6 +11,12 @@ Camera WithLensDrift(const Camera& camera, const LensDrift& drift) {
   intrinsics[3] += drift.principal_point_px.y();
   return Camera(camera.lensmodel_name(), intrinsics, camera.imager_width_px(), camera.imager_height_px(),
                 "drifted lens");
+}
+
+Eigen::Vector2d DriftedPixel(const Camera& camera, const Eigen::Vector2d& q_px, double focal_fraction,
+                             const Eigen::Vector2d& principal_point_px) {
+  const Eigen::Vector2d c(camera.cx(), camera.cy());
+  return c + principal_point_px + (1 + focal_fraction) * (q_px - c);
 }
 
 }  // namespace stereorig
