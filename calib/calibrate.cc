@@ -448,6 +448,16 @@ std::string CalibrationReport::ToJson() const {
       if (auto it = capture_names.find(c.capture); it != capture_names.end()) j.String("capture_name", it->second);
       j.Number("rms_px", c.rms_px).Int("corners", c.corners).EndObject();
     }
+    j.EndArray().BeginArray("camera_residuals");
+    for (const SystemReport::CameraResiduals& c : s.refined_camera_residuals) {
+      j.BeginObject()
+          .Int("camera", c.camera)
+          .Int("corners", c.corners)
+          .Number("rms_px", c.rms_px)
+          .Number("median_px", c.median_px)
+          .Number("p90_px", c.p90_px)
+          .EndObject();
+    }
     j.EndArray().BeginArray("module0_from_module");
     for (const Pose& p : s.module0_from_module) {
       j.BeginObject();
@@ -609,6 +619,14 @@ std::string SummaryText(const CalibrationReport& rep) {
       const SystemReport::CaptureRms& w = s.refined_capture_rms[0];
       AppendLine(&out, "  worst capture: %s, rms %.3f px over %d corners", rep.CaptureName(w.capture).c_str(), w.rms_px,
                  w.corners);
+    }
+    // Each camera against the noise stage 2 measured on it (calib/convergence.h).
+    for (const SystemReport::CameraResiduals& c : s.refined_camera_residuals) {
+      const Stage3CameraLimits l = Stage3CameraLimitsOf(rep, c.camera, rep.max_rms_px);
+      AppendLine(&out,
+                 "  camera %d: corner distances median %.3f px, 90th percentile %.3f px (limits %.3f, %.3f px from its "
+                 "stage 2 noise %.3f px)",
+                 c.camera, c.median_px, c.p90_px, l.median_px, l.p90_px, l.sigma_px);
     }
     for (size_t k = 1; k < s.module0_from_module.size(); ++k) {
       const Pose d = s.module0_from_module_horn[k].Inverse() * s.module0_from_module[k];

@@ -82,6 +82,39 @@ std::vector<SystemReport::CaptureRms> CaptureRmsOf(const std::vector<double>& re
   return out;
 }
 
+// The q-quantile of `x` (0 <= q <= 1): the element at rank floor(q (n - 1))
+// of the sorted values. `x` is reordered.
+double QuantileOf(std::vector<double>* x, double q) {
+  if (x->empty()) return 0.0;
+  auto at = x->begin() + static_cast<std::ptrdiff_t>(q * (x->size() - 1));
+  std::nth_element(x->begin(), at, x->end());
+  return *at;
+}
+
+// Each camera's residual figures (SystemReport::CameraResiduals), in camera
+// order. `residuals`: (du, dv) per corner; `camera_of`: each corner's camera.
+std::vector<SystemReport::CameraResiduals> CameraResidualsOf(const std::vector<double>& residuals,
+                                                             const std::vector<int>& camera_of) {
+  std::map<int, std::vector<double>> distances_px;  // camera -> its corners' hypot(du, dv)
+  std::map<int, double> sum_of_squares;
+  for (size_t i = 0; i < camera_of.size() && 2 * i + 1 < residuals.size(); ++i) {
+    const double du = residuals[2 * i], dv = residuals[2 * i + 1];
+    distances_px[camera_of[i]].push_back(std::hypot(du, dv));
+    sum_of_squares[camera_of[i]] += du * du + dv * dv;
+  }
+  std::vector<SystemReport::CameraResiduals> out;
+  for (auto& [camera, d] : distances_px) {
+    SystemReport::CameraResiduals c;
+    c.camera = camera;
+    c.corners = static_cast<int>(d.size());
+    c.rms_px = std::sqrt(sum_of_squares[camera] / (2.0 * d.size()));
+    c.median_px = QuantileOf(&d, 0.5);
+    c.p90_px = QuantileOf(&d, 0.9);
+    out.push_back(c);
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<std::map<int, ModuleCaptureView>> PoseBoardsByTriangulation(const CalibrationInput& input,
@@ -276,6 +309,7 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   // board there to check them against.
   std::vector<ceres::ResidualBlockId> corner_blocks;
   std::vector<int> corner_capture;  // per corner block
+  std::vector<int> corner_camera;   // per corner block
   bool any_back = false;
   for (const BoardObservation& o : input.observations) {
     auto b = boards.find(o.capture);
@@ -316,6 +350,7 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
           std::vector<double*>{b->second.params, module_block->params, bff->params, rl->params,
                                intrinsics[o.camera].data()}));
       corner_capture.push_back(o.capture);
+      corner_camera.push_back(o.camera);
     }
   }
   rep.num_residual_corners = static_cast<int>(corner_blocks.size());
@@ -459,6 +494,7 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
     rep.refined_median_corner_residual_px = *mid;
   }
   rep.refined_capture_rms = CaptureRmsOf(refined, corner_capture);
+  rep.refined_camera_residuals = CameraResidualsOf(refined, corner_camera);
   rep.solver_summary = summary.BriefReport();
 
   for (int k = 0; k < M; ++k) result.module0_from_module.push_back(k == 0 ? Pose::Identity() : s_blocks[k].ToPose());

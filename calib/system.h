@@ -126,6 +126,19 @@ struct SystemReport {
     int corners = 0;
   };
   std::vector<CaptureRms> refined_capture_rms;
+  // Each camera's corners after the adjustment: their residual distances
+  // hypot(du, dv), px, by median and 90th percentile, and the RMS over their
+  // coordinates. In camera order. The convergence check holds each camera
+  // to them (calib/convergence.h), so that one module's corners are not
+  // diluted among the others'.
+  struct CameraResiduals {
+    int camera = -1;  // global index
+    int corners = 0;
+    double rms_px = 0.0;
+    double median_px = 0.0;
+    double p90_px = 0.0;
+  };
+  std::vector<CameraResiduals> refined_camera_residuals;
   // Left out as the earlier stages judged (SystemExclusions), counted among
   // the views and corners the adjustment would otherwise have used:
   int num_skipped_views = 0;                             // views stage 1 dropped
