@@ -5,8 +5,10 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <sstream>
 
 #include "apps/command.h"
@@ -159,6 +161,23 @@ const CLI::Validator& PositiveValue() {
 const CLI::Validator& NonNegativeValue() {
   static const CLI::Validator v =
       NumberValidator([](double x) { return std::isfinite(x) && x >= 0; }, ">= 0 and finite", "NonNegative");
+  return v;
+}
+
+const CLI::Validator& PositiveCount() {
+  static const CLI::Validator v(
+      [](const std::string& text) {
+        const char* begin = text.c_str();
+        char* end = nullptr;
+        errno = 0;
+        const long long x = std::strtoll(begin, &end, 10);
+        if (end == begin || *end != '\0') return "must be a whole number >= 1, got " + text;
+        if (x < 1) return "must be >= 1, got " + text;
+        if (errno == ERANGE || x > std::numeric_limits<int>::max())
+          return "must be at most " + std::to_string(std::numeric_limits<int>::max()) + ", got " + text;
+        return std::string();
+      },
+      "", "PositiveCount");
   return v;
 }
 

@@ -61,6 +61,9 @@ std::string ShellQuoted(const std::string& word);
 // DBL_MAX's 309 digits.
 const CLI::Validator& PositiveValue();
 const CLI::Validator& NonNegativeValue();
+// A count: a whole number in [1, 2^31 - 1] ("must be a whole number >= 1,
+// got 1.5"; CLI11's own conversion said "Could not convert").
+const CLI::Validator& PositiveCount();
 
 // Check of a path option (every file or folder a command writes, and
 // verify's inputs): an empty one ("--report ''", a shell variable left unset)

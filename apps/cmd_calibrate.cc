@@ -34,8 +34,8 @@ int RunCalibrate(int argc, char** argv) {
       "of the wrong size, a face seen by the wrong module; and, after the solve (the summary and the report written, "
       "the rig file not), a stage that did not converge (rms over --max-rms-px; stage 3 also when half its corners are "
       "off by more than sqrt(2 ln 2) x --max-rms-px, when a camera's corners are off by more than the noise stage 2 "
-      "measured on them allows (a module that moved between captures), or when its solver stopped short), a lens "
-      " no camera has, or a plate "
+      "measured on them allows (a module that moved between captures), or when its solver stopped short, at "
+      "--max-iterations or otherwise), a lens no camera has, or a plate "
       "whose back_from_front stage 3 moved far beyond the target file's stated sigma (the target file named).\n\n"
       "Exit codes: 0 ok (the rig file written); 2 bad usage or input, or a calibration refused as above.\n\n"
       "Example:\n  stereorig calibrate --captures data/calibration --target target.yaml --layout layout.yaml "
@@ -75,6 +75,11 @@ int RunCalibrate(int argc, char** argv) {
          "times it, the median distance of corners whose coordinates have this rms")
       ->capture_default_str()
       ->check(PositiveValue());
+  app.add_option("--max-iterations", options.system.max_iterations,
+                 "stage 3's Ceres iteration limit, a positive whole number (its Horn-only solve and its full "
+                 "adjustment each): a solve that reaches it did not converge, and no rig file is written")
+      ->capture_default_str()
+      ->check(PositiveCount());
   app.add_option("--huber", options.system.huber_px, "stage 3 robust loss scale, px")
       ->capture_default_str()
       ->check(PositiveValue());

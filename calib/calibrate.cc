@@ -268,6 +268,14 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
     modules = result.stage3.modules;
     module0_from_module = result.stage3.module0_from_module;
     rep.system = result.stage3.report;
+    if (!rep.system.horn_only_solver_problem.empty())
+      rep.warnings.push_back(
+          "stage 3's Horn-only solve (S and the stereo pairs held at Horn's and stage 2's, the board poses solved) "
+          "did not converge: " +
+          rep.system.horn_only_solver_problem +
+          ": its rms (the report's horn_only, the rig file's rig_horn_only_rms_px) is where it stopped, not what "
+          "Horn's S gives; the full adjustment started from there and is judged on its own (--max-iterations "
+          "raises the limit of both)");
   } else {
     result.stage3.module0_from_module = module0_from_module;
     result.stage3.module0_from_module_horn = module0_from_module;
@@ -432,6 +440,7 @@ std::string CalibrationReport::ToJson() const {
     j.EndArray();
     j.BeginObject("horn_only")
         .Number("reprojection_rms_px", s.horn_reprojection_rms_px)
+        .String("solver_problem", s.horn_only_solver_problem)
         .BeginArray("module0_from_module");
     for (const Pose& p : s.module0_from_module_horn) {
       j.BeginObject();
@@ -500,7 +509,8 @@ std::string CalibrationReport::ToJson() const {
     j.Number("back_from_front_chi_square", s.back_from_front_vs_file.chi_square);
     j.Int("back_from_front_axes", s.back_from_front_vs_file.axes);
     j.Number("back_from_front_chi_square_bound", s.back_from_front_vs_file.Bound()).String("wrong_plate", wrong_plate);
-    j.String("solver", s.solver_summary).EndObject();
+    j.String("solver", s.solver_summary).String("solver_problem", s.solver_problem);
+    j.Int("max_iterations", s.max_iterations).EndObject();
   }
   j.EndObject();
   return j.str() + "\n";
@@ -615,6 +625,8 @@ std::string SummaryText(const CalibrationReport& rep) {
     }
     AppendLine(&out, "  reprojection rms: Horn only %.3f px, refined %.3f px", s.horn_reprojection_rms_px,
                s.refined_reprojection_rms_px);
+    if (!s.horn_only_solver_problem.empty())
+      AppendLine(&out, "  (the Horn-only rms is where its solve stopped: %s)", s.horn_only_solver_problem.c_str());
     if (!s.refined_capture_rms.empty()) {
       const SystemReport::CaptureRms& w = s.refined_capture_rms[0];
       AppendLine(&out, "  worst capture: %s, rms %.3f px over %d corners", rep.CaptureName(w.capture).c_str(), w.rms_px,

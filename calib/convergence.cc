@@ -164,8 +164,13 @@ std::string NotConvergedProblem(const CalibrationReport& report, double max_rms_
   if (!s.solver_problem.empty())
     return "stage 3 did not converge: " + s.solver_problem +
            (std::isfinite(s.refined_reprojection_rms_px) ? ", at rms " + Px(s.refined_reprojection_rms_px) : "") +
-           ": S, the stereo pairs and the lenses are wherever the solve stopped (a lens model whose distortions "
-           "the corners do not determine: try a simpler --lensmodel or --fixed-intrinsics)";
+           ": S, the stereo pairs and the lenses are wherever the solve stopped (" +
+           (s.solver_at_iteration_limit
+                ? "it reached its iteration limit, --max-iterations " + std::to_string(s.max_iterations) +
+                      ": a solve still converging needs a higher one; one that does not converge, "
+                : std::string()) +
+           "a lens model whose distortions the corners do not determine: try a simpler --lensmodel or "
+           "--fixed-intrinsics)";
   // Within the limit, stage 3 must still be the noise its corners showed
   // in stage 2 (after the solver: the residuals of a solve that stopped
   // short say nothing of the rig). See kStage3ExcessFloorOfLimit.

@@ -290,7 +290,7 @@ TEST(CalibrateSystemVerdicts, HeldWithoutAPriorTheSigmaOfSIsSaidConditional) {
 // A stage 3 whose Ceres solve stopped short (here at its iteration limit,
 // 1) did not converge, whatever its RMS: the rig file is not written. Its
 // RMS after one step from Horn is already near the noise, which alone let
-// it pass before.
+// it pass before. The refusal names the limit and its flag.
 TEST(CalibrateSystemVerdicts, ASolveThatStoppedShortDidNotConverge) {
   const auto s = testing::MakeDefaultScene(74, 12, kNoisePx);
   CalibrationOptions opt;
@@ -298,6 +298,46 @@ TEST(CalibrateSystemVerdicts, ASolveThatStoppedShortDidNotConverge) {
   const CalibrationResult r = Calibrate(s.data.input, opt);
   EXPECT_EQ(r.report.not_converged.rfind("stage 3 did not converge: Ceres ", 0), 0u) << r.report.not_converged;
   EXPECT_NE(r.report.not_converged.find("NO_CONVERGENCE"), std::string::npos) << r.report.not_converged;
+  EXPECT_NE(r.report.not_converged.find("it reached its iteration limit, --max-iterations 1: "), std::string::npos)
+      << r.report.not_converged;
+}
+
+// Stage 3's first solve, Horn-only (S and the stereo pairs held at Horn's
+// and stage 2's, the board poses solved), had its ending unchecked: stopped
+// short, its rms (the report's horn_only, the rig file's
+// rig_horn_only_rms_px) is where it stopped, not what Horn's S gives. It
+// only seeds the full adjustment, which is judged on its own, so it is
+// warned of (the report's warnings, the summary), not refused for. The
+// seam: max_iterations = 1 stops it (and the full solve) short; the
+// default (100) does not.
+TEST(CalibrateSystemVerdicts, AHornOnlySolveThatStoppedShortIsWarnedOf) {
+  const auto s = testing::MakeDefaultScene(74, 12, kNoisePx);
+  const CalibrationResult ok = Calibrate(s.data.input, CalibrationOptions());
+  EXPECT_EQ(ok.report.not_converged, "");
+  EXPECT_TRUE(ok.report.warnings.empty()) << ok.report.warnings[0];
+  EXPECT_EQ(nlohmann::json::parse(ok.report.ToJson())["stage3_system"]["horn_only"]["solver_problem"], "");
+
+  CalibrationOptions opt;
+  opt.system.max_iterations = 1;
+  const CalibrationResult r = Calibrate(s.data.input, opt);
+  ASSERT_EQ(r.report.warnings.size(), 1u);
+  const std::string& w = r.report.warnings[0];
+  EXPECT_EQ(w.rfind("stage 3's Horn-only solve (S and the stereo pairs held at Horn's and stage 2's, the board poses "
+                    "solved) did not converge: Ceres ended at NO_CONVERGENCE after ",
+                    0),
+            0u)
+      << w;
+  EXPECT_NE(w.find("its rms (the report's horn_only, the rig file's rig_horn_only_rms_px) is where it stopped"),
+            std::string::npos)
+      << w;
+  const nlohmann::json j = nlohmann::json::parse(r.report.ToJson());
+  EXPECT_EQ(
+      j["stage3_system"]["horn_only"]["solver_problem"].get<std::string>().rfind("Ceres ended at NO_CONVERGENCE", 0),
+      0u);
+  EXPECT_EQ(j["warnings"][0], w);
+  EXPECT_NE(SummaryText(r.report).find("  (the Horn-only rms is where its solve stopped: Ceres ended at "
+                                       "NO_CONVERGENCE"),
+            std::string::npos);
 }
 
 }  // namespace

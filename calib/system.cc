@@ -115,6 +115,14 @@ std::vector<SystemReport::CameraResiduals> CameraResidualsOf(const std::vector<d
   return out;
 }
 
+// "" if a Ceres solve ended at CONVERGENCE; else how it ended, for
+// SystemReport's solver_problem and horn_only_solver_problem.
+std::string StoppedShort(const ceres::Solver::Summary& summary) {
+  if (summary.termination_type == ceres::CONVERGENCE) return "";
+  return "Ceres ended at " + std::string(ceres::TerminationTypeToString(summary.termination_type)) + " after " +
+         std::to_string(summary.iterations.size()) + " iterations (" + summary.message + ")";
+}
+
 }  // namespace
 
 std::vector<std::map<int, ModuleCaptureView>> PoseBoardsByTriangulation(const CalibrationInput& input,
@@ -469,21 +477,24 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   // Horn-only: S and the stereo pairs held, the board poses solved.
   set_free(false, false, false, false);
   ceres::Solve(sopt, &problem, &summary);
+  // Checked as the full solve's is, but only reported: this solve seeds the
+  // full adjustment, which is judged on its own, and gives the Horn-only
+  // RMS, which is then where it stopped, not Horn's.
+  rep.horn_only_solver_problem = StoppedShort(summary);
   rep.horn_reprojection_rms_px = rms(corner_residuals());
+  if (rep.horn_only_solver_problem.empty()) rep.horn_only_solver_problem = rep.solver_problem;  // not evaluated
   // The full adjustment.
   set_free(true, options.refine_stereo, bff_free, options.refine_intrinsics);
   ceres::Solve(sopt, &problem, &summary);
   // What the full adjustment left is judged, not the Horn-only step's
-  // evaluation above (a seed the full solve moved away from).
-  rep.solver_problem.clear();
-  // Only CONVERGENCE is a solution: NO_CONVERGENCE (the iteration limit),
+  // evaluation above (a seed the full solve moved away from): its problem
+  // replaced. Only CONVERGENCE is a solution: NO_CONVERGENCE (the iteration limit),
   // FAILURE and USER_FAILURE leave the parameters wherever the solve
   // stopped, whatever their RMS reads (OPENCV12 with its k4..k6 freed: 101
   // iterations, an RMS at the noise, S 2.95 mm off the truth).
-  if (summary.termination_type != ceres::CONVERGENCE)
-    rep.solver_problem = "Ceres ended at " + std::string(ceres::TerminationTypeToString(summary.termination_type)) +
-                         " after " + std::to_string(summary.iterations.size()) + " iterations (" + summary.message +
-                         ")";
+  rep.solver_problem = StoppedShort(summary);
+  rep.max_iterations = options.max_iterations;
+  rep.solver_at_iteration_limit = summary.termination_type == ceres::NO_CONVERGENCE;
   const std::vector<double> refined = corner_residuals();
   rep.refined_reprojection_rms_px = rms(refined);
   std::vector<double> distances_px;

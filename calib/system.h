@@ -111,7 +111,12 @@ struct SystemReport {
   std::vector<std::pair<int, int>> spanning_tree;      // (parent, child) edges used for Horn
   std::map<std::pair<int, int>, double> horn_rms_mm;   // Horn fit RMS of each tree edge
   double horn_reprojection_rms_px = 0.0;               // S and stereo held at Horn/stage 2, board poses solved
-  double refined_reprojection_rms_px = 0.0;            // after the full adjustment
+  // "" if that Horn-only solve ended at Ceres's CONVERGENCE; else how it
+  // ended (its iteration limit, a failure). Not a refusal: it only seeds the
+  // full adjustment (judged by solver_problem), but horn_reprojection_rms_px
+  // is then where it stopped (Calibrate warns of it).
+  std::string horn_only_solver_problem;
+  double refined_reprojection_rms_px = 0.0;  // after the full adjustment
   // The median of the corners' residual distances after it, px: what the
   // convergence check reads (calib/convergence.h), as the RMS counts in full
   // the few corners the Huber loss leaves out by design.
@@ -160,6 +165,11 @@ struct SystemReport {
   // convergence, or the residuals could not be evaluated), for the
   // convergence check (calib/convergence.h), which then refuses the rig.
   std::string solver_problem;
+  // The iteration limit its two solves were given (SystemOptions::
+  // max_iterations), and whether the full adjustment stopped at it (Ceres's
+  // NO_CONVERGENCE): the refusal then names the limit and how to raise it.
+  int max_iterations = 0;
+  bool solver_at_iteration_limit = false;
   Pose back_from_front;                     // as refined
   double back_from_front_change_deg = 0.0;  // refined vs measured
   double back_from_front_change_mm = 0.0;
