@@ -255,7 +255,8 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
     rep.stereo.push_back(result.stage2.back().report);
     const StereoResult& s = result.stage2.back();
     modules.push_back({m.left_camera, m.right_camera, s.left, s.right, s.right_from_left,
-                       s.report.left.intrinsics_covariance, s.report.right.intrinsics_covariance});
+                       s.report.left.intrinsics_covariance, s.report.right.intrinsics_covariance,
+                       s.report.intrinsics_cross_covariance});
   }
   // Stage 3.
   std::vector<Pose> module0_from_module(M);

@@ -61,6 +61,10 @@ struct ModuleCameras {
   // Empty: none; they are held at their values, and S's 1 sigma is
   // conditional on them (SystemReport::sigma_conditional_on).
   std::vector<double> left_intrinsics_covariance = {}, right_intrinsics_covariance = {};
+  // Stage 2's Cov(left's intrinsics, right's) ((N * N,) row-major, rows the
+  // left's; StereoReport::intrinsics_cross_covariance): with it the prior is
+  // joint over the pair. Empty: the two taken as independent.
+  std::vector<double> left_right_intrinsics_covariance = {};
 };
 
 // The earlier stages' verdicts that stage 3 honours: the views stage 1
