@@ -76,8 +76,9 @@ int RunCalibrate(int argc, char** argv) {
       ->capture_default_str()
       ->check(PositiveValue());
   app.add_option("--max-iterations", options.system.max_iterations,
-                 "stage 3's Ceres iteration limit, a positive whole number (its Horn-only solve and its full "
-                 "adjustment each): a solve that reaches it did not converge, and no rig file is written")
+                 "stage 3's Ceres iteration limit, a whole number >= 1, for each of its solves: a full adjustment "
+                 "that reaches it did not converge (no rig file is written), a Horn-only solve that does is warned "
+                 "of")
       ->capture_default_str()
       ->check(PositiveCount());
   app.add_option("--huber", options.system.huber_px, "stage 3 robust loss scale, px")
