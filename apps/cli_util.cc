@@ -204,6 +204,23 @@ const CLI::Validator& NonNegativeValue() {
   return v;
 }
 
+const CLI::Validator& PositiveCount() {
+  static const CLI::Validator v(
+      [](const std::string& text) {
+        const char* begin = text.c_str();
+        char* end = nullptr;
+        errno = 0;
+        const long long x = std::strtoll(begin, &end, 10);
+        if (end == begin || *end != '\0') return "must be a whole number >= 1, got " + text;
+        if (x < 1) return "must be >= 1, got " + text;
+        if (errno == ERANGE || x > std::numeric_limits<int>::max())
+          return "must be at most " + std::to_string(std::numeric_limits<int>::max()) + ", got " + text;
+        return std::string();
+      },
+      "", "PositiveCount");
+  return v;
+}
+
 namespace {
 
 int g_stdout_errno = 0;  // why the first flush of stdout that failed failed

@@ -62,6 +62,9 @@ std::string ShellQuoted(const std::string& word);
 // DBL_MAX's 309 digits.
 const CLI::Validator& PositiveValue();
 const CLI::Validator& NonNegativeValue();
+// A count: a whole number in [1, 2^31 - 1] ("must be a whole number >= 1,
+// got 1.5"; CLI11's own conversion said "Could not convert").
+const CLI::Validator& PositiveCount();
 
 // A --seed option into *seed (its default shown as it is): a whole number
 // from 0 to max_seed, decimal (leading zeros are zeros) or hex with 0x,

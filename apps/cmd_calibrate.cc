@@ -33,7 +33,9 @@ int RunCalibrate(int argc, char** argv) {
       "Refuses with exit 2: too few views, all views fronto-parallel, a camera that never sees the board, images "
       "of the wrong size, a face seen by the wrong module; and, after the solve (the summary and the report written, "
       "the rig file not), a stage that did not converge (rms over --max-rms-px; stage 3 also when half its corners are "
-      "off by more than sqrt(2 ln 2) x --max-rms-px, or its solver stopped short), a lens no camera has, or a plate "
+      "off by more than sqrt(2 ln 2) x --max-rms-px, when a camera's corners are off by more than the noise stage 2 "
+      "measured on them allows (a module that moved between captures), or when its solver stopped short, at "
+      "--max-iterations or otherwise), a lens no camera has, or a plate "
       "whose back_from_front stage 3 moved far beyond the target file's stated sigma (the target file named).\n\n"
       "Exit codes: 0 ok (the rig file written); 2 bad usage or input, or a calibration refused as above.\n\n"
       "Example:\n  stereorig calibrate --captures data/calibration --target target.yaml --layout layout.yaml "
@@ -73,6 +75,12 @@ int RunCalibrate(int argc, char** argv) {
          "times it, the median distance of corners whose coordinates have this rms")
       ->capture_default_str()
       ->check(PositiveValue());
+  app.add_option("--max-iterations", options.system.max_iterations,
+                 "stage 3's Ceres iteration limit, a whole number >= 1, for each of its solves: a full adjustment "
+                 "that reaches it did not converge (no rig file is written), a Horn-only solve that does is warned "
+                 "of")
+      ->capture_default_str()
+      ->check(PositiveCount());
   app.add_option("--huber", options.system.huber_px, "stage 3 robust loss scale, px")
       ->capture_default_str()
       ->check(PositiveValue());

@@ -255,7 +255,8 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
     rep.stereo.push_back(result.stage2.back().report);
     const StereoResult& s = result.stage2.back();
     modules.push_back({m.left_camera, m.right_camera, s.left, s.right, s.right_from_left,
-                       s.report.left.intrinsics_covariance, s.report.right.intrinsics_covariance});
+                       s.report.left.intrinsics_covariance, s.report.right.intrinsics_covariance,
+                       s.report.intrinsics_cross_covariance});
   }
   // Stage 3.
   std::vector<Pose> module0_from_module(M);
@@ -268,6 +269,14 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
     modules = result.stage3.modules;
     module0_from_module = result.stage3.module0_from_module;
     rep.system = result.stage3.report;
+    if (!rep.system.horn_only_solver_problem.empty())
+      rep.warnings.push_back(
+          "stage 3's Horn-only solve (S and the stereo pairs held at Horn's and stage 2's, the board poses solved) "
+          "did not converge: " +
+          rep.system.horn_only_solver_problem +
+          ": its rms (the report's horn_only, the rig file's rig_horn_only_rms_px) is where it stopped, not what "
+          "Horn's S gives; the full adjustment started from there and is judged on its own (--max-iterations "
+          "raises the limit of both)");
   } else {
     result.stage3.module0_from_module = module0_from_module;
     result.stage3.module0_from_module_horn = module0_from_module;
@@ -432,6 +441,7 @@ std::string CalibrationReport::ToJson() const {
     j.EndArray();
     j.BeginObject("horn_only")
         .Number("reprojection_rms_px", s.horn_reprojection_rms_px)
+        .String("solver_problem", s.horn_only_solver_problem)
         .BeginArray("module0_from_module");
     for (const Pose& p : s.module0_from_module_horn) {
       j.BeginObject();
@@ -447,6 +457,16 @@ std::string CalibrationReport::ToJson() const {
       j.BeginObject().Int("capture", c.capture);
       if (auto it = capture_names.find(c.capture); it != capture_names.end()) j.String("capture_name", it->second);
       j.Number("rms_px", c.rms_px).Int("corners", c.corners).EndObject();
+    }
+    j.EndArray().BeginArray("camera_residuals");
+    for (const SystemReport::CameraResiduals& c : s.refined_camera_residuals) {
+      j.BeginObject()
+          .Int("camera", c.camera)
+          .Int("corners", c.corners)
+          .Number("rms_px", c.rms_px)
+          .Number("median_px", c.median_px)
+          .Number("p90_px", c.p90_px)
+          .EndObject();
     }
     j.EndArray().BeginArray("module0_from_module");
     for (const Pose& p : s.module0_from_module) {
@@ -490,7 +510,8 @@ std::string CalibrationReport::ToJson() const {
     j.Number("back_from_front_chi_square", s.back_from_front_vs_file.chi_square);
     j.Int("back_from_front_axes", s.back_from_front_vs_file.axes);
     j.Number("back_from_front_chi_square_bound", s.back_from_front_vs_file.Bound()).String("wrong_plate", wrong_plate);
-    j.String("solver", s.solver_summary).EndObject();
+    j.String("solver", s.solver_summary).String("solver_problem", s.solver_problem);
+    j.Int("max_iterations", s.max_iterations).EndObject();
   }
   j.EndObject();
   return j.str() + "\n";
@@ -605,10 +626,20 @@ std::string SummaryText(const CalibrationReport& rep) {
     }
     AppendLine(&out, "  reprojection rms: Horn only %.3f px, refined %.3f px", s.horn_reprojection_rms_px,
                s.refined_reprojection_rms_px);
+    if (!s.horn_only_solver_problem.empty())
+      AppendLine(&out, "  (the Horn-only rms is where its solve stopped: %s)", s.horn_only_solver_problem.c_str());
     if (!s.refined_capture_rms.empty()) {
       const SystemReport::CaptureRms& w = s.refined_capture_rms[0];
       AppendLine(&out, "  worst capture: %s, rms %.3f px over %d corners", rep.CaptureName(w.capture).c_str(), w.rms_px,
                  w.corners);
+    }
+    // Each camera against the noise stage 2 measured on it (calib/convergence.h).
+    for (const SystemReport::CameraResiduals& c : s.refined_camera_residuals) {
+      const Stage3CameraLimits l = Stage3CameraLimitsOf(rep, c.camera, rep.max_rms_px);
+      AppendLine(&out,
+                 "  camera %d: corner distances median %.3f px, 90th percentile %.3f px (limits %.3f, %.3f px from its "
+                 "stage 2 noise %.3f px)",
+                 c.camera, c.median_px, c.p90_px, l.median_px, l.p90_px, l.sigma_px);
     }
     for (size_t k = 1; k < s.module0_from_module.size(); ++k) {
       const Pose d = s.module0_from_module_horn[k].Inverse() * s.module0_from_module[k];

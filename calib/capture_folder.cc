@@ -308,7 +308,11 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
     if (note.empty()) throw;
     throw InputError(e.where(), e.problem() + "; " + note);
   }
-  // The report keeps the warnings printed, beside the figures they qualify.
+  // The calibration's own warnings (a Horn-only solve that stopped short),
+  // printed as these are; the report keeps every warning printed, beside the
+  // figures they qualify.
+  for (const std::string& note : out.result.report.warnings)
+    std::fprintf(stderr, "calibrate: warning: %s\n", PrintableText(note).c_str());
   for (const std::string& note : {rejected_note, never_seen_note, left_out_note})
     if (!note.empty()) out.result.report.warnings.push_back(note);
   // Calibrate records the board (in the rig it built), not its file's name.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "calib/core/number_text.h"
 
@@ -38,7 +39,56 @@ std::string WorstCaptures(const CalibrationReport& report, double max_rms_px) {
   return out;
 }
 
+// Stage 3's cameras whose corners are not the noise stage 2 measured on
+// them (NotConvergedProblem, below), worst first by their figure's ratio to
+// its limit, at most two named and the others counted; "" if none.
+std::string CamerasOverTheirNoise(const CalibrationReport& report, double max_rms_px) {
+  struct Over {
+    double ratio = 0.0;
+    std::string text;
+  };
+  std::vector<Over> over;
+  for (const SystemReport::CameraResiduals& c : report.system.refined_camera_residuals) {
+    const Stage3CameraLimits l = Stage3CameraLimitsOf(report, c.camera, max_rms_px);
+    if (!(l.sigma_px > 0) || c.corners == 0) continue;
+    if (c.median_px <= l.median_px && c.p90_px <= l.p90_px) continue;
+    std::string name = "camera " + std::to_string(c.camera);
+    for (const StereoReport& m : report.stereo)
+      for (const IntrinsicsReport* x : {&m.left, &m.right})
+        if (x->camera == c.camera)
+          name += " (" + (x->camera_name.empty() ? "" : x->camera_name + " of ") + m.module_name + ")";
+    over.push_back({std::max(c.median_px / l.median_px, c.p90_px / l.p90_px),
+                    name + " at a median distance of " + Px(c.median_px) + " and a 90th percentile of " + Px(c.p90_px) +
+                        " over " + std::to_string(c.corners) + " corners, against " + Px(l.median_px) + " and " +
+                        Px(l.p90_px) + " for its stage 2 noise of " + Px(l.sigma_px)});
+  }
+  std::stable_sort(over.begin(), over.end(), [](const Over& a, const Over& b) { return a.ratio > b.ratio; });
+  std::string out;
+  for (size_t i = 0; i < std::min<size_t>(2, over.size()); ++i) out += (i ? "; " : "") + over[i].text;
+  if (over.size() > 2) out += "; and " + std::to_string(over.size() - 2) + " other camera(s)";
+  return out;
+}
+
 }  // namespace
+
+Stage3CameraLimits Stage3CameraLimitsOf(const CalibrationReport& report, int camera, double max_rms_px) {
+  Stage3CameraLimits l;
+  // Stage 2's noise of the camera: the RMS of its inlier corners' residual
+  // coordinates in its module's joint solve, where every capture has its own
+  // board pose for that module alone, so that a module moved between
+  // captures leaves it at the noise (the module is rigid within itself).
+  // The module's RMS where the camera's is not given.
+  for (const StereoReport& m : report.stereo)
+    for (const IntrinsicsReport* c : {&m.left, &m.right})
+      if (c->camera == camera) l.sigma_px = c->rms_px > 0 ? c->rms_px : m.rms_px;
+  // What stage 3 may add to it: as much again as the noise itself, in
+  // quadrature (its variance doubled), and at least a tenth of the limit.
+  const double excess_px = std::max(l.sigma_px, kStage3ExcessFloorOfLimit * max_rms_px);
+  const double spread_px = std::hypot(l.sigma_px, excess_px);
+  l.median_px = kRayleighMedian * spread_px;
+  l.p90_px = kRayleighP90 * spread_px;
+  return l;
+}
 
 std::string NotConvergedProblem(const CalibrationReport& report, double max_rms_px) {
   const std::string limit = "over --max-rms-px " + NumberText(max_rms_px);
@@ -114,8 +164,25 @@ std::string NotConvergedProblem(const CalibrationReport& report, double max_rms_
   if (!s.solver_problem.empty())
     return "stage 3 did not converge: " + s.solver_problem +
            (std::isfinite(s.refined_reprojection_rms_px) ? ", at rms " + Px(s.refined_reprojection_rms_px) : "") +
-           ": S, the stereo pairs and the lenses are wherever the solve stopped (a lens model whose distortions "
-           "the corners do not determine: try a simpler --lensmodel or --fixed-intrinsics)";
+           ": S, the stereo pairs and the lenses are wherever the solve stopped (" +
+           (s.solver_at_iteration_limit
+                ? "it reached its iteration limit, --max-iterations " + std::to_string(s.max_iterations) +
+                      ": a solve still converging needs a higher one; one that does not converge, "
+                : std::string()) +
+           "a lens model whose distortions the corners do not determine: try a simpler --lensmodel or "
+           "--fixed-intrinsics)";
+  // Within the limit, stage 3 must still be the noise its corners showed
+  // in stage 2 (after the solver: the residuals of a solve that stopped
+  // short say nothing of the rig). See kStage3ExcessFloorOfLimit.
+  const std::string cameras_over = CamerasOverTheirNoise(report, max_rms_px);
+  if (!cameras_over.empty())
+    return "stage 3 did not converge: its corners are off by more than the noise stage 2 measured on them: " +
+           cameras_over +
+           " (the limits: the median and 90th percentile of corner distances whose coordinates have that noise and "
+           "as much again; each module alone fits its corners at that noise, so the modules did not stay in one "
+           "place relative to each other over the captures: a module that moved between captures, modules whose "
+           "images were not taken at the same moment, or a target whose back face is not where the target file "
+           "puts it)";
   return "";
 }
 

@@ -159,3 +159,80 @@ TEST(Convergence, StageThreeIsJudgedByItsRmsAndItsMedianCornerResidual) {
 
 }  // namespace
 }  // namespace stereorig
+
+namespace stereorig {
+namespace {
+
+// Stage 3's cameras with stage 2's noise on each (stage 2's per-camera rms)
+// and their stage 3 residual distances drawn as that noise gives them
+// (Rayleigh: the median 1.1774 sigma, the 90th percentile 2.1460 sigma).
+CalibrationReport WithCameraResiduals(double stage2_sigma_px, double stage3_sigma_px) {
+  CalibrationReport r = ConvergedReport();
+  for (StereoReport& m : r.stereo) {
+    m.rms_px = stage2_sigma_px;
+    m.left.camera = 2 * m.module, m.right.camera = 2 * m.module + 1;
+    m.left.camera_name = "cam" + std::to_string(m.left.camera);
+    m.right.camera_name = "cam" + std::to_string(m.right.camera);
+    m.left.rms_px = m.right.rms_px = stage2_sigma_px;
+  }
+  for (int c = 0; c < 4; ++c)
+    r.system.refined_camera_residuals.push_back(
+        {c, 1000, stage3_sigma_px, kRayleighMedian * stage3_sigma_px, kRayleighP90 * stage3_sigma_px});
+  r.system.refined_reprojection_rms_px = stage3_sigma_px;
+  r.system.refined_median_corner_residual_px = kRayleighMedian * stage3_sigma_px;
+  return r;
+}
+
+// Each camera of stage 3 is held to the noise stage 2 measured on it: its
+// median and 90th percentile distance against the Rayleigh quantiles of
+// sqrt(sigma^2 + e^2), e = max(sigma, a tenth of the limit). A module moved
+// 1 mm between captures read stage 3 at 0.88 px (median 1.02 px), within
+// the 1 px limit, over stage 2's 0.196 px (CalibrateConvergence.
+// AModuleThatMovedOneMillimetreIsRefusedAgainstStageTwosNoise).
+TEST(Convergence, StageThreesCamerasAreHeldToTheirStageTwoNoise) {
+  // Honest: stage 3 at stage 2's noise, at any level within the limit.
+  for (double sigma : {0.02, 0.2, 0.85}) EXPECT_EQ(NotConvergedProblem(WithCameraResiduals(sigma, sigma), 1.0), "");
+  // The moved module's figures: 0.88 px against 0.196 px of noise.
+  CalibrationReport r = WithCameraResiduals(0.196, 0.88);
+  std::string p = NotConvergedProblem(r, 1.0);
+  EXPECT_TRUE(StartsWith(p,
+                         "stage 3 did not converge: its corners are off by more than the noise stage 2 measured on "
+                         "them: camera 0 (cam0 of module0) at a median distance of 1.036 px and a 90th percentile of "
+                         "1.888 px over 1000 corners, against 0.3264 px and 0.5948 px for its stage 2 noise of "
+                         "0.196 px; camera 1 (cam1 of module0) at"))
+      << p;
+  EXPECT_NE(p.find("; and 2 other camera(s) (the limits: "), std::string::npos) << p;
+  EXPECT_NE(p.find("a module that moved between captures"), std::string::npos) << p;
+  // The boundary: sqrt(2) sigma is the spread allowed, by the median and by
+  // the 90th percentile alike; the worst camera is named first.
+  const double allowed = std::sqrt(2.0) * 0.196;
+  r = WithCameraResiduals(0.196, allowed * (1 - 1e-9));
+  EXPECT_EQ(NotConvergedProblem(r, 1.0), "");
+  r.system.refined_camera_residuals[3].median_px = kRayleighMedian * allowed * (1 + 1e-9);
+  p = NotConvergedProblem(r, 1.0);
+  EXPECT_NE(p.find("them: camera 3 (cam3 of module1) at a median distance of 0.3264 px"), std::string::npos) << p;
+  EXPECT_EQ(p.find("camera 0"), std::string::npos) << p;
+  r = WithCameraResiduals(0.196, allowed * (1 - 1e-9));
+  r.system.refined_camera_residuals[2].p90_px = kRayleighP90 * allowed * (1 + 1e-9);
+  EXPECT_NE(NotConvergedProblem(r, 1.0).find("them: camera 2 (cam2 of module1)"), std::string::npos);
+  // The floor: below a tenth of the limit, the excess is not refused
+  // whatever the noise: 0.02 px of noise may reach hypot(0.02, 0.1) px.
+  const double floor_spread = std::hypot(0.02, 0.1);
+  EXPECT_EQ(NotConvergedProblem(WithCameraResiduals(0.02, floor_spread * (1 - 1e-9)), 1.0), "");
+  EXPECT_NE(NotConvergedProblem(WithCameraResiduals(0.02, floor_spread * (1 + 1e-9)), 1.0), "");
+  // ... and scales with the limit: at 1.5 px, hypot(0.02, 0.15) px.
+  EXPECT_EQ(NotConvergedProblem(WithCameraResiduals(0.02, std::hypot(0.02, 0.15) * (1 - 1e-9)), 1.5), "");
+  EXPECT_NE(NotConvergedProblem(WithCameraResiduals(0.02, std::hypot(0.02, 0.15) * (1 + 1e-9)), 1.5), "");
+  // A camera's own stage 2 rms, not its module's, where given.
+  r = WithCameraResiduals(0.196, 0.25);
+  r.stereo[1].right.rms_px = 0.1;
+  EXPECT_TRUE(StartsWith(NotConvergedProblem(r, 1.0),
+                         "stage 3 did not converge: its corners are off by more than the noise stage 2 measured on "
+                         "them: camera 3 (cam3 of module1)"))
+      << NotConvergedProblem(r, 1.0);
+  // The limit's rules come first: their message names the rms or median.
+  EXPECT_TRUE(StartsWith(NotConvergedProblem(WithCameraResiduals(0.196, 1.5), 1.0), "stage 3 did not converge: rms "));
+}
+
+}  // namespace
+}  // namespace stereorig

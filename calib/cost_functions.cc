@@ -113,36 +113,54 @@ ceres::CostFunction* HeldIntrinsicsPrior::Create(const std::vector<double>& thet
   const int n = static_cast<int>(theta0.size()), h = static_cast<int>(held.size());
   if (h == 0 || covariance.size() != static_cast<size_t>(n) * n) return nullptr;
   Eigen::MatrixXd cov_held(h, h);
-  Eigen::VectorXd theta0_held(h);
-  for (int i = 0; i < h; ++i) {
-    theta0_held(i) = theta0[held[i]];
+  for (int i = 0; i < h; ++i)
     for (int j = 0; j < h; ++j) cov_held(i, j) = covariance[static_cast<size_t>(held[i]) * n + held[j]];
-  }
-  const Eigen::LLT<Eigen::MatrixXd> llt(cov_held);
-  if (llt.info() != Eigen::Success || !cov_held.allFinite()) return nullptr;
-  const Eigen::MatrixXd l_inverse = llt.matrixL().solve(Eigen::MatrixXd::Identity(h, h));
-  if (!l_inverse.allFinite()) return nullptr;
-  return new HeldIntrinsicsPrior(n, held, theta0_held, corner_sigma_px * l_inverse);
+  return CreateJoint({theta0}, held, cov_held, corner_sigma_px);
 }
 
-HeldIntrinsicsPrior::HeldIntrinsicsPrior(int num_intrinsics, std::vector<int> held, Eigen::VectorXd theta0_held,
-                                         Eigen::MatrixXd whiten)
+ceres::CostFunction* HeldIntrinsicsPrior::CreateJoint(const std::vector<std::vector<double>>& theta0,
+                                                      const std::vector<int>& held,
+                                                      const Eigen::MatrixXd& covariance_held, double corner_sigma_px) {
+  const int blocks = static_cast<int>(theta0.size()), h = static_cast<int>(held.size());
+  if (blocks == 0 || h == 0 || covariance_held.rows() != blocks * h || covariance_held.cols() != blocks * h)
+    return nullptr;
+  const int n = static_cast<int>(theta0[0].size());
+  Eigen::VectorXd theta0_held(blocks * h);
+  for (int b = 0; b < blocks; ++b) {
+    if (static_cast<int>(theta0[b].size()) != n) return nullptr;
+    for (int i = 0; i < h; ++i) theta0_held(b * h + i) = theta0[b][held[i]];
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(covariance_held);
+  if (llt.info() != Eigen::Success || !covariance_held.allFinite()) return nullptr;
+  const Eigen::MatrixXd l_inverse = llt.matrixL().solve(Eigen::MatrixXd::Identity(blocks * h, blocks * h));
+  if (!l_inverse.allFinite()) return nullptr;
+  return new HeldIntrinsicsPrior(blocks, n, held, theta0_held, corner_sigma_px * l_inverse);
+}
+
+HeldIntrinsicsPrior::HeldIntrinsicsPrior(int num_blocks, int num_intrinsics, std::vector<int> held,
+                                         Eigen::VectorXd theta0_held, Eigen::MatrixXd whiten)
     : held_(std::move(held)), theta0_held_(std::move(theta0_held)), whiten_(std::move(whiten)) {
-  set_num_residuals(static_cast<int>(held_.size()));
-  mutable_parameter_block_sizes()->push_back(num_intrinsics);
+  set_num_residuals(static_cast<int>(theta0_held_.size()));
+  for (int b = 0; b < num_blocks; ++b) mutable_parameter_block_sizes()->push_back(num_intrinsics);
 }
 
 bool HeldIntrinsicsPrior::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
   const int h = static_cast<int>(held_.size());
-  Eigen::VectorXd d(h);
-  for (int i = 0; i < h; ++i) d(i) = parameters[0][held_[i]] - theta0_held_(i);
-  Eigen::Map<Eigen::VectorXd>(residuals, h) = whiten_ * d;
-  if (jacobians && jacobians[0]) {
-    // (H, N) row-major: whiten_ in the held columns, 0 elsewhere (linear).
-    const int n = parameter_block_sizes()[0];
-    std::fill(jacobians[0], jacobians[0] + h * n, 0.0);
-    for (int r = 0; r < h; ++r)
-      for (int c = 0; c < h; ++c) jacobians[0][r * n + held_[c]] = whiten_(r, c);
+  const int blocks = static_cast<int>(parameter_block_sizes().size());
+  const int rows = blocks * h;
+  Eigen::VectorXd d(rows);
+  for (int b = 0; b < blocks; ++b)
+    for (int i = 0; i < h; ++i) d(b * h + i) = parameters[b][held_[i]] - theta0_held_(b * h + i);
+  Eigen::Map<Eigen::VectorXd>(residuals, rows) = whiten_ * d;
+  if (!jacobians) return true;
+  // Block b's (B H, N) row-major: whiten_'s columns of block b in the held
+  // columns, 0 elsewhere (linear).
+  for (int b = 0; b < blocks; ++b) {
+    if (!jacobians[b]) continue;
+    const int n = parameter_block_sizes()[b];
+    std::fill(jacobians[b], jacobians[b] + rows * n, 0.0);
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < h; ++c) jacobians[b][r * n + held_[c]] = whiten_(r, b * h + c);
   }
   return true;
 }

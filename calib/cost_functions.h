@@ -106,13 +106,20 @@ class HeldIntrinsicsPrior : public ceres::CostFunction {
   // under: the caller holds them).
   static ceres::CostFunction* Create(const std::vector<double>& theta0, const std::vector<int>& held,
                                      const std::vector<double>& covariance, double corner_sigma_px);
+  // The same over several blocks of one lens model at once (a stereo
+  // pair's two cameras, solved jointly in stage 2): `theta0[b]` block b's
+  // (N,) values, `covariance_held` the joint covariance (B H, B H) of their
+  // `held` parameters, block by block. Null if it is not positive definite.
+  static ceres::CostFunction* CreateJoint(const std::vector<std::vector<double>>& theta0, const std::vector<int>& held,
+                                          const Eigen::MatrixXd& covariance_held, double corner_sigma_px);
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
 
  private:
-  HeldIntrinsicsPrior(int num_intrinsics, std::vector<int> held, Eigen::VectorXd theta0_held, Eigen::MatrixXd whiten);
+  HeldIntrinsicsPrior(int num_blocks, int num_intrinsics, std::vector<int> held, Eigen::VectorXd theta0_held,
+                      Eigen::MatrixXd whiten);
   std::vector<int> held_;
-  Eigen::VectorXd theta0_held_;  // (H,)
-  Eigen::MatrixXd whiten_;       // (H, H) corner_sigma_px * L^-1
+  Eigen::VectorXd theta0_held_;  // (B H,)
+  Eigen::MatrixXd whiten_;       // (B H, B H) corner_sigma_px * L^-1
 };
 
 }  // namespace stereorig

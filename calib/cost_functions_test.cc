@@ -113,5 +113,48 @@ TEST(HeldIntrinsicsPrior, WhitensByTheHeldBlockOfTheCovariance) {
   EXPECT_EQ(HeldIntrinsicsPrior::Create(theta0, held, covariance, 0.2), nullptr);
 }
 
+// The prior over a stereo pair's two cameras at once (CreateJoint): stage
+// 2 solved their lenses jointly, so their held terms are correlated. One
+// residual block over both parameter blocks: its squared norm is
+// corner_sigma_px^2 times the joint Mahalanobis distance d' C^-1 d of the
+// stacked moves, which independent priors (C's off-diagonal block
+// dropped) do not give; each block's Jacobian is that linear map in its
+// held columns.
+TEST(HeldIntrinsicsPrior, AJointPriorWhitensByTheJointCovariance) {
+  const std::vector<double> left0 = {1000, 1000, 376, 291, 0.1, 0.2}, right0 = {1010, 1010, 370, 290, -0.1, 0.3};
+  const std::vector<int> held = {4, 5};
+  Eigen::Matrix4d c;  // left's k, right's k; a correlation of 0.6 between the pair's first terms
+  c << 4e-4, 1e-4, 1.2e-4, 0, 1e-4, 1e-4, 0, 0, 1.2e-4, 0, 1e-4, 0, 0, 0, 0, 2e-4;
+  std::unique_ptr<ceres::CostFunction> prior(HeldIntrinsicsPrior::CreateJoint({left0, right0}, held, c, 0.2));
+  ASSERT_NE(prior, nullptr);
+  ASSERT_EQ(prior->num_residuals(), 4);
+  ASSERT_EQ(prior->parameter_block_sizes(), (std::vector<int32_t>{6, 6}));
+  const std::vector<double> left = {990, 1003, 370, 300, 0.13, 0.19}, right = {1000, 1000, 360, 280, -0.11, 0.32};
+  const double* params[] = {left.data(), right.data()};
+  double r[4], jl[4 * 6], jr[4 * 6];
+  double* jacobians[] = {jl, jr};
+  ASSERT_TRUE(prior->Evaluate(params, r, jacobians));
+  const Eigen::Vector4d d(0.03, -0.01, -0.01, 0.02);
+  const double joint = 0.04 * d.dot(c.inverse() * d);
+  EXPECT_NEAR(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3], joint, 1e-9);
+  Eigen::Matrix4d independent = c;
+  independent.block<2, 2>(0, 2).setZero();
+  independent.block<2, 2>(2, 0).setZero();
+  EXPECT_GT(std::abs(0.04 * d.dot(independent.inverse() * d) - joint), 0.1);  // the cross terms matter here
+  for (int row = 0; row < 4; ++row) {
+    for (int col = 0; col < 4; ++col) {
+      EXPECT_EQ(jl[row * 6 + col], 0.0);
+      EXPECT_EQ(jr[row * 6 + col], 0.0);
+    }
+    EXPECT_NEAR(jl[row * 6 + 4] * d(0) + jl[row * 6 + 5] * d(1) + jr[row * 6 + 4] * d(2) + jr[row * 6 + 5] * d(3),
+                r[row], 1e-12);
+  }
+  // A joint covariance that is not positive definite, or of the wrong size: no prior.
+  Eigen::Matrix4d singular = c;
+  singular(0, 2) = singular(2, 0) = 2.1e-4;  // correlation 1.05
+  EXPECT_EQ(HeldIntrinsicsPrior::CreateJoint({left0, right0}, held, singular, 0.2), nullptr);
+  EXPECT_EQ(HeldIntrinsicsPrior::CreateJoint({left0, right0}, held, c.topLeftCorner<2, 2>(), 0.2), nullptr);
+}
+
 }  // namespace
 }  // namespace stereorig

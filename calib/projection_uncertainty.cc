@@ -234,19 +234,31 @@ Eigen::MatrixXd ProjectionUncertaintyEvaluator::Covariance(const StateGradient& 
 }
 
 Eigen::MatrixXd ProjectionUncertaintyEvaluator::IntrinsicsCovariance(int icam, bool regularisation_as_prior) const {
+  return JointIntrinsicsCovariance({icam}, regularisation_as_prior);
+}
+
+Eigen::MatrixXd ProjectionUncertaintyEvaluator::JointIntrinsicsCovariance(const std::vector<int>& icams,
+                                                                          bool regularisation_as_prior) const {
   const MrcalProblem& p = *impl_->problem;
-  const int Nparams = p.num_params();
-  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(Nparams, Nparams);
+  const int Nparams = p.num_params(), k = static_cast<int>(icams.size());
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(k * Nparams, k * Nparams);
   const mrcal_lensmodel_metadata_t meta = mrcal_lensmodel_metadata(&p.lensmodel);
   const int Ncore = meta.has_core ? 4 : 0;
   const int i0 = (meta.has_core && !p.selections.do_optimize_intrinsics_core) ? Ncore : 0;
   const int i1 = p.selections.do_optimize_intrinsics_distortions ? Nparams : Ncore;
   if (i1 <= i0) return out;
-  const int istate = mrcal_state_index_intrinsics(icam, p.num_intrinsics_cameras, p.num_extrinsics(), p.num_frames(), 0,
-                                                  0, p.num_observations(), p.selections, &p.lensmodel);
-  StateGradient g = StateGradient::Zero(i1 - i0, impl_->num_states);
-  for (int i = 0; i < i1 - i0; ++i) g(i, istate + i) = 1.0;
-  out.block(i0, i0, i1 - i0, i1 - i0) = Covariance(g, regularisation_as_prior);
+  const int m = i1 - i0;
+  // Every camera's free parameters in one gradient: their joint covariance.
+  StateGradient g = StateGradient::Zero(k * m, impl_->num_states);
+  for (int a = 0; a < k; ++a) {
+    const int istate =
+        mrcal_state_index_intrinsics(icams[a], p.num_intrinsics_cameras, p.num_extrinsics(), p.num_frames(), 0, 0,
+                                     p.num_observations(), p.selections, &p.lensmodel);
+    for (int i = 0; i < m; ++i) g(a * m + i, istate + i) = 1.0;
+  }
+  const Eigen::MatrixXd c = Covariance(g, regularisation_as_prior);
+  for (int a = 0; a < k; ++a)
+    for (int b = 0; b < k; ++b) out.block(a * Nparams + i0, b * Nparams + i0, m, m) = c.block(a * m, b * m, m, m);
   return out;
 }
 

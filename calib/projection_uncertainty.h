@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "calib/mrcal_problem.h"
 
@@ -73,6 +74,11 @@ class ProjectionUncertaintyEvaluator {
   // parameters, in mrcal's order and units; rows and columns of parameters
   // the solve did not optimise are 0.
   Eigen::MatrixXd IntrinsicsCovariance(int icam_intrinsics, bool regularisation_as_prior = false) const;
+  // The joint covariance (K Nparams, K Nparams) of K intrinsics cameras'
+  // parameters, camera by camera, as IntrinsicsCovariance (its K = 1): a
+  // stereo pair's two lenses, solved jointly, are not independent.
+  Eigen::MatrixXd JointIntrinsicsCovariance(const std::vector<int>& icams_intrinsics,
+                                            bool regularisation_as_prior = false) const;
   // Covariance (6, 6) of extrinsics camera `icam_extrinsics`'s rt_cam_ref
   // (r: rotation vector, rad; t: mm).
   Eigen::Matrix<double, 6, 6> ExtrinsicsCovariance(int icam_extrinsics) const;

@@ -176,6 +176,9 @@ StereoResult CalibrateStereo(int module, const ModuleLayout& layout, const Intri
       const Eigen::Vector3d gt = t.normalized(), gr = rv.normalized();
       r.baseline_sigma_mm = std::sqrt(gt.dot(cov.block<3, 3>(3, 3) * gt));
       r.rotation_sigma_deg = std::sqrt(gr.dot(cov.block<3, 3>(0, 0) * gr)) * deg;
+      const Eigen::MatrixXd joint = eval.JointIntrinsicsCovariance({0, 1}, /*regularisation_as_prior=*/true);
+      for (int i = 0; i < np; ++i)
+        for (int j = 0; j < np; ++j) r.intrinsics_cross_covariance.push_back(joint(i, np + j));
     }
   }
 

@@ -46,6 +46,11 @@ struct StereoReport {
   double rectified_row_max_px = 0.0;
   int num_corner_pairs = 0;
   IntrinsicsReport left, right;  // per-camera figures of the joint solve (uncertainty, coverage)
+  // Cov(left's intrinsics, right's) of the joint solve, (N * N,) row-major,
+  // rows the left's, as left/right.intrinsics_covariance (the
+  // regularisation as a prior); empty if the covariance failed. Stage 3's
+  // prior on the terms it cannot determine alone is joint over the pair.
+  std::vector<double> intrinsics_cross_covariance = {};
 };
 
 struct StereoResult {

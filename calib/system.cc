@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <set>
 
 #include "calib/core/input_error.h"
@@ -80,6 +81,47 @@ std::vector<SystemReport::CaptureRms> CaptureRmsOf(const std::vector<double>& re
     out.push_back({capture, std::sqrt(s.first / (2.0 * s.second)), s.second});
   std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.rms_px > b.rms_px; });
   return out;
+}
+
+// The q-quantile of `x` (0 <= q <= 1): the element at rank floor(q (n - 1))
+// of the sorted values. `x` is reordered.
+double QuantileOf(std::vector<double>* x, double q) {
+  if (x->empty()) return 0.0;
+  auto at = x->begin() + static_cast<std::ptrdiff_t>(q * (x->size() - 1));
+  std::nth_element(x->begin(), at, x->end());
+  return *at;
+}
+
+// Each camera's residual figures (SystemReport::CameraResiduals), in camera
+// order. `residuals`: (du, dv) per corner; `camera_of`: each corner's camera.
+std::vector<SystemReport::CameraResiduals> CameraResidualsOf(const std::vector<double>& residuals,
+                                                             const std::vector<int>& camera_of) {
+  std::map<int, std::vector<double>> distances_px;  // camera -> its corners' hypot(du, dv)
+  std::map<int, double> sum_of_squares;
+  for (size_t i = 0; i < camera_of.size() && 2 * i + 1 < residuals.size(); ++i) {
+    const double du = residuals[2 * i], dv = residuals[2 * i + 1];
+    distances_px[camera_of[i]].push_back(std::hypot(du, dv));
+    sum_of_squares[camera_of[i]] += du * du + dv * dv;
+  }
+  std::vector<SystemReport::CameraResiduals> out;
+  for (auto& [camera, d] : distances_px) {
+    SystemReport::CameraResiduals c;
+    c.camera = camera;
+    c.corners = static_cast<int>(d.size());
+    c.rms_px = std::sqrt(sum_of_squares[camera] / (2.0 * d.size()));
+    c.median_px = QuantileOf(&d, 0.5);
+    c.p90_px = QuantileOf(&d, 0.9);
+    out.push_back(c);
+  }
+  return out;
+}
+
+// "" if a Ceres solve ended at CONVERGENCE; else how it ended, for
+// SystemReport's solver_problem and horn_only_solver_problem.
+std::string StoppedShort(const ceres::Solver::Summary& summary) {
+  if (summary.termination_type == ceres::CONVERGENCE) return "";
+  return "Ceres ended at " + std::string(ceres::TerminationTypeToString(summary.termination_type)) + " after " +
+         std::to_string(summary.iterations.size()) + " iterations (" + summary.message + ")";
 }
 
 }  // namespace
@@ -276,6 +318,7 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   // board there to check them against.
   std::vector<ceres::ResidualBlockId> corner_blocks;
   std::vector<int> corner_capture;  // per corner block
+  std::vector<int> corner_camera;   // per corner block
   bool any_back = false;
   for (const BoardObservation& o : input.observations) {
     auto b = boards.find(o.capture);
@@ -316,6 +359,7 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
           std::vector<double*>{b->second.params, module_block->params, bff->params, rl->params,
                                intrinsics[o.camera].data()}));
       corner_capture.push_back(o.capture);
+      corner_camera.push_back(o.camera);
     }
   }
   rep.num_residual_corners = static_cast<int>(corner_blocks.size());
@@ -336,12 +380,10 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
     const int n = static_cast<int>(v.size());
     const std::vector<int> held = Stage3HeldIntrinsics(camera_of[cam]->lensmodel_name(), n);
     if (held.empty()) continue;
-    ceres::CostFunction* prior = options.refine_intrinsics
-                                     ? HeldIntrinsicsPrior::Create(v, held, *stage2_covariance_of[cam], corner_sigma_px)
-                                     : nullptr;
+    std::unique_ptr<ceres::CostFunction> prior(
+        options.refine_intrinsics ? HeldIntrinsicsPrior::Create(v, held, *stage2_covariance_of[cam], corner_sigma_px)
+                                  : nullptr);
     if (prior) {
-      problem.AddResidualBlock(prior, nullptr, v.data());
-      num_prior_residuals += static_cast<int>(held.size());
       HeldPrior& hp = prior_of[cam];
       hp.held = held;
       hp.cov_held.resize(held.size(), held.size());
@@ -352,6 +394,40 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
       problem.SetManifold(v.data(), new ceres::SubsetManifold(n, held));
       held_without_prior.push_back(cam);
     }
+  }
+  // The priors: one over a module's two cameras where stage 2 gave the
+  // cross-covariance of its two lenses (solved jointly, they are not
+  // independent: ModuleCameras::left_right_intrinsics_covariance), else one
+  // per camera. cross_held[{left, right}]: the cross-covariance of their
+  // held terms, for the correction of the covariance below.
+  std::map<std::pair<int, int>, Eigen::MatrixXd> cross_held;
+  std::set<int> in_joint_prior;
+  for (const ModuleCameras& m : modules) {
+    auto pl = prior_of.find(m.left_camera), pr = prior_of.find(m.right_camera);
+    if (pl == prior_of.end() || pr == prior_of.end() || pl->second.held != pr->second.held) continue;
+    const std::vector<int>& held = pl->second.held;
+    const int n = static_cast<int>(intrinsics[m.left_camera].size()), h = static_cast<int>(held.size());
+    if (m.left_right_intrinsics_covariance.size() != static_cast<size_t>(n) * n) continue;
+    Eigen::MatrixXd cross(h, h);
+    for (int i = 0; i < h; ++i)
+      for (int j = 0; j < h; ++j) cross(i, j) = m.left_right_intrinsics_covariance[held[i] * n + held[j]];
+    Eigen::MatrixXd joint(2 * h, 2 * h);
+    joint << pl->second.cov_held, cross, cross.transpose(), pr->second.cov_held;
+    ceres::CostFunction* prior = HeldIntrinsicsPrior::CreateJoint(
+        {intrinsics[m.left_camera], intrinsics[m.right_camera]}, held, joint, corner_sigma_px);
+    if (!prior) continue;  // not positive definite: each camera's own, below
+    problem.AddResidualBlock(prior, nullptr, intrinsics[m.left_camera].data(), intrinsics[m.right_camera].data());
+    num_prior_residuals += 2 * h;
+    cross_held[{m.left_camera, m.right_camera}] = cross;
+    in_joint_prior.insert(m.left_camera);
+    in_joint_prior.insert(m.right_camera);
+  }
+  for (auto& [cam, hp] : prior_of) {
+    if (in_joint_prior.count(cam)) continue;
+    problem.AddResidualBlock(
+        HeldIntrinsicsPrior::Create(intrinsics[cam], hp.held, *stage2_covariance_of[cam], corner_sigma_px), nullptr,
+        intrinsics[cam].data());
+    num_prior_residuals += static_cast<int>(hp.held.size());
   }
   if (!options.refine_intrinsics) {
     rep.sigma_conditional_on = "every camera's intrinsics, held at stage 2's values (the intrinsics not refined)";
@@ -434,21 +510,24 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   // Horn-only: S and the stereo pairs held, the board poses solved.
   set_free(false, false, false, false);
   ceres::Solve(sopt, &problem, &summary);
+  // Checked as the full solve's is, but only reported: this solve seeds the
+  // full adjustment, which is judged on its own, and gives the Horn-only
+  // RMS, which is then where it stopped, not Horn's.
+  rep.horn_only_solver_problem = StoppedShort(summary);
   rep.horn_reprojection_rms_px = rms(corner_residuals());
+  if (rep.horn_only_solver_problem.empty()) rep.horn_only_solver_problem = rep.solver_problem;  // not evaluated
   // The full adjustment.
   set_free(true, options.refine_stereo, bff_free, options.refine_intrinsics);
   ceres::Solve(sopt, &problem, &summary);
   // What the full adjustment left is judged, not the Horn-only step's
-  // evaluation above (a seed the full solve moved away from).
-  rep.solver_problem.clear();
-  // Only CONVERGENCE is a solution: NO_CONVERGENCE (the iteration limit),
+  // evaluation above (a seed the full solve moved away from): its problem
+  // replaced. Only CONVERGENCE is a solution: NO_CONVERGENCE (the iteration limit),
   // FAILURE and USER_FAILURE leave the parameters wherever the solve
   // stopped, whatever their RMS reads (OPENCV12 with its k4..k6 freed: 101
   // iterations, an RMS at the noise, S 2.95 mm off the truth).
-  if (summary.termination_type != ceres::CONVERGENCE)
-    rep.solver_problem = "Ceres ended at " + std::string(ceres::TerminationTypeToString(summary.termination_type)) +
-                         " after " + std::to_string(summary.iterations.size()) + " iterations (" + summary.message +
-                         ")";
+  rep.solver_problem = StoppedShort(summary);
+  rep.max_iterations = options.max_iterations;
+  rep.solver_at_iteration_limit = summary.termination_type == ceres::NO_CONVERGENCE;
   const std::vector<double> refined = corner_residuals();
   rep.refined_reprojection_rms_px = rms(refined);
   std::vector<double> distances_px;
@@ -459,6 +538,7 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
     rep.refined_median_corner_residual_px = *mid;
   }
   rep.refined_capture_rms = CaptureRmsOf(refined, corner_capture);
+  rep.refined_camera_residuals = CameraResidualsOf(refined, corner_camera);
   rep.solver_summary = summary.BriefReport();
 
   for (int k = 0; k < M; ++k) result.module0_from_module.push_back(k == 0 ? Pose::Identity() : s_blocks[k].ToPose());
@@ -566,8 +646,8 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
       // C'_xh C'_h^-1, in the joint Gaussian the normal equations'
       // d x / d theta_h):
       //   C_x = C'_x + G (C_h - C'_h) G'.
-      // The cameras' C_h are taken as independent (stage 2's covariance of
-      // a module's two lenses with each other is not kept). Measured without
+      // A module's two cameras' C_h are joint where stage 2 gave their
+      // cross-covariance (cross_held), the modules' independent. Measured without
       // it, OPENCV12 on the default rig, 25 captures, 10 seeds: S's largest
       // |error| / sigma 1.2 - 5.3 (with it 1.0 - 3.7); on the demo dataset
       // S 1.84, the principal points 2.9 (with it 1.41, 2.3).
@@ -581,6 +661,11 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
         c_h_stage2.block(oi, oi, ni, ni) = hi.cov_held;
         int oj = 0;
         for (const auto& [cam_j, hj] : prior_of) {
+          const int nj = static_cast<int>(hj.held.size());
+          if (auto x = cross_held.find({cam_i, cam_j}); x != cross_held.end())
+            c_h_stage2.block(oi, oj, ni, nj) = x->second;
+          if (auto x = cross_held.find({cam_j, cam_i}); x != cross_held.end())
+            c_h_stage2.block(oi, oj, ni, nj) = x->second.transpose();
           const RowMajor c = block(intrinsics[cam_i].data(), intrinsics[cam_j].data());
           for (int a = 0; a < ni; ++a)
             for (size_t b = 0; b < hj.held.size(); ++b) c_h_stage3(oi + a, oj + b) = c(hi.held[a], hj.held[b]);

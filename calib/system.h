@@ -61,6 +61,10 @@ struct ModuleCameras {
   // Empty: none; they are held at their values, and S's 1 sigma is
   // conditional on them (SystemReport::sigma_conditional_on).
   std::vector<double> left_intrinsics_covariance = {}, right_intrinsics_covariance = {};
+  // Stage 2's Cov(left's intrinsics, right's) ((N * N,) row-major, rows the
+  // left's; StereoReport::intrinsics_cross_covariance): with it the prior is
+  // joint over the pair. Empty: the two taken as independent.
+  std::vector<double> left_right_intrinsics_covariance = {};
 };
 
 // The earlier stages' verdicts that stage 3 honours: the views stage 1
@@ -111,7 +115,12 @@ struct SystemReport {
   std::vector<std::pair<int, int>> spanning_tree;      // (parent, child) edges used for Horn
   std::map<std::pair<int, int>, double> horn_rms_mm;   // Horn fit RMS of each tree edge
   double horn_reprojection_rms_px = 0.0;               // S and stereo held at Horn/stage 2, board poses solved
-  double refined_reprojection_rms_px = 0.0;            // after the full adjustment
+  // "" if that Horn-only solve ended at Ceres's CONVERGENCE; else how it
+  // ended (its iteration limit, a failure). Not a refusal: it only seeds the
+  // full adjustment (judged by solver_problem), but horn_reprojection_rms_px
+  // is then where it stopped (Calibrate warns of it).
+  std::string horn_only_solver_problem;
+  double refined_reprojection_rms_px = 0.0;  // after the full adjustment
   // The median of the corners' residual distances after it, px: what the
   // convergence check reads (calib/convergence.h), as the RMS counts in full
   // the few corners the Huber loss leaves out by design.
@@ -126,6 +135,19 @@ struct SystemReport {
     int corners = 0;
   };
   std::vector<CaptureRms> refined_capture_rms;
+  // Each camera's corners after the adjustment: their residual distances
+  // hypot(du, dv), px, by median and 90th percentile, and the RMS over their
+  // coordinates. In camera order. The convergence check holds each camera
+  // to them (calib/convergence.h), so that one module's corners are not
+  // diluted among the others'.
+  struct CameraResiduals {
+    int camera = -1;  // global index
+    int corners = 0;
+    double rms_px = 0.0;
+    double median_px = 0.0;
+    double p90_px = 0.0;
+  };
+  std::vector<CameraResiduals> refined_camera_residuals;
   // Left out as the earlier stages judged (SystemExclusions), counted among
   // the views and corners the adjustment would otherwise have used:
   int num_skipped_views = 0;                             // views stage 1 dropped
@@ -147,6 +169,11 @@ struct SystemReport {
   // convergence, or the residuals could not be evaluated), for the
   // convergence check (calib/convergence.h), which then refuses the rig.
   std::string solver_problem;
+  // The iteration limit its two solves were given (SystemOptions::
+  // max_iterations), and whether the full adjustment stopped at it (Ceres's
+  // NO_CONVERGENCE): the refusal then names the limit and how to raise it.
+  int max_iterations = 0;
+  bool solver_at_iteration_limit = false;
   Pose back_from_front;                     // as refined
   double back_from_front_change_deg = 0.0;  // refined vs measured
   double back_from_front_change_mm = 0.0;
