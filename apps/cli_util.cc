@@ -160,7 +160,10 @@ namespace {
 std::string ParseSeed(const std::string& text, uint64_t max_seed, uint64_t* seed) {
   const bool hex = text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
   const std::string digits = hex ? text.substr(2) : text;
-  if (!text.empty() && text[0] == '-') return "must be >= 0";
+  if (text.empty()) return "an empty value";  // as every option says it (NonEmptyValue above)
+  // " -1" too: strtoull skips the space, and wrapped "-1" round to 2^64 - 1.
+  const size_t first = text.find_first_not_of(" \t\n\v\f\r");
+  if (first != std::string::npos && text[first] == '-') return "must be >= 0";
   if (digits.empty() || digits.find_first_not_of(hex ? "0123456789abcdefABCDEF" : "0123456789") != std::string::npos)
     return "must be a whole number (decimal, or hex with 0x), not '" + text + "'";
   errno = 0;
