@@ -75,12 +75,9 @@ int RunCalibrate(int argc, char** argv) {
          "times it, the median distance of corners whose coordinates have this rms")
       ->capture_default_str()
       ->check(PositiveValue());
-  app.add_option("--max-iterations", options.system.max_iterations,
-                 "stage 3's Ceres iteration limit, a whole number >= 1, for each of its solves: a full adjustment "
-                 "that reaches it did not converge (no rig file is written), a Horn-only solve that does is warned "
-                 "of")
-      ->capture_default_str()
-      ->check(PositiveCount());
+  AddCountOption(app, "--max-iterations", &options.system.max_iterations,
+                 "stage 3's Ceres iteration limit for each of its solves: a full adjustment that reaches it did not "
+                 "converge (no rig file is written), a Horn-only solve that does is warned of");
   app.add_option("--huber", options.system.huber_px, "stage 3 robust loss scale, px")
       ->capture_default_str()
       ->check(PositiveValue());

@@ -378,6 +378,15 @@ TEST(CalibrateCli, StageThreesIterationLimitIsAnOptionAndItsSolvesAreChecked) {
     EXPECT_EQ(b.err.rfind("stereorig calibrate: --max-iterations: must be ", 0), 0u) << b.err;
     EXPECT_EQ(b.err.find("detect 000"), std::string::npos) << "refused before any work: " << b.err;
   }
+  // Leading zeros are decimal, as the check reads them: CLI11's own
+  // conversion, after it, ran 010 as 8 and refused 09 ("Could not convert").
+  for (const auto& [text, count] : {std::pair<std::string, int>{"010", 10}, {"09", 9}}) {
+    fs::remove(report);
+    const testing::Result z = testing::RunCli(args + " --max-iterations " + text);
+    ASSERT_TRUE(fs::exists(report)) << text << ": " << z.err;
+    std::ifstream f(report);
+    EXPECT_EQ(nlohmann::json::parse(f).at("stage3_system").at("max_iterations").get<int>(), count) << text;
+  }
   const testing::Result help = testing::RunCli("calibrate --help");
   EXPECT_NE(help.out.find("--max-iterations INT=100"), std::string::npos) << help.out;
 }
