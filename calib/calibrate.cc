@@ -460,12 +460,16 @@ std::string CalibrationReport::ToJson() const {
     }
     j.EndArray().BeginArray("camera_residuals");
     for (const SystemReport::CameraResiduals& c : s.refined_camera_residuals) {
+      const Stage3CameraLimits l = Stage3CameraLimitsOf(*this, c.camera, max_rms_px);
       j.BeginObject()
           .Int("camera", c.camera)
           .Int("corners", c.corners)
           .Number("rms_px", c.rms_px)
           .Number("median_px", c.median_px)
           .Number("p90_px", c.p90_px)
+          .Number("stage2_sigma_px", l.sigma_px)
+          .Number("median_limit_px", l.median_px)
+          .Number("p90_limit_px", l.p90_px)
           .EndObject();
     }
     j.EndArray().BeginArray("module0_from_module");
@@ -636,10 +640,16 @@ std::string SummaryText(const CalibrationReport& rep) {
     // Each camera against the noise stage 2 measured on it (calib/convergence.h).
     for (const SystemReport::CameraResiduals& c : s.refined_camera_residuals) {
       const Stage3CameraLimits l = Stage3CameraLimitsOf(rep, c.camera, rep.max_rms_px);
+      char excess[80];
+      if (l.floor_sets_them)
+        std::snprintf(excess, sizeof excess, "the floor %.3f px, %g x --max-rms-px", l.floor_px,
+                      kStage3ExcessFloorOfLimit);
+      else
+        std::snprintf(excess, sizeof excess, "as much again");
       AppendLine(&out,
                  "  camera %d: corner distances median %.3f px, 90th percentile %.3f px (limits %.3f, %.3f px from its "
-                 "stage 2 noise %.3f px)",
-                 c.camera, c.median_px, c.p90_px, l.median_px, l.p90_px, l.sigma_px);
+                 "stage 2 noise %.3f px and %s)",
+                 c.camera, c.median_px, c.p90_px, l.median_px, l.p90_px, l.sigma_px, excess);
     }
     for (size_t k = 1; k < s.module0_from_module.size(); ++k) {
       const Pose d = s.module0_from_module_horn[k].Inverse() * s.module0_from_module[k];

@@ -220,6 +220,20 @@ TEST(Convergence, StageThreesCamerasAreHeldToTheirStageTwoNoise) {
   const double floor_spread = std::hypot(0.02, 0.1);
   EXPECT_EQ(NotConvergedProblem(WithCameraResiduals(0.02, floor_spread * (1 - 1e-9)), 1.0), "");
   EXPECT_NE(NotConvergedProblem(WithCameraResiduals(0.02, floor_spread * (1 + 1e-9)), 1.0), "");
+  // Where the floor sets the limits, the refusal says so: from 0.02 px of
+  // noise and as much again they would be 3.6 times smaller than quoted.
+  p = NotConvergedProblem(WithCameraResiduals(0.02, floor_spread * (1 + 1e-9)), 1.0);
+  EXPECT_NE(p.find("against 0.1201 px and 0.2188 px for its stage 2 noise of 0.02 px and the floor of 0.1 px "
+                   "(0.1 x --max-rms-px); camera 1"),
+            std::string::npos)
+      << p;
+  EXPECT_NE(p.find("(the limits: the median and 90th percentile of corner distances whose coordinates have that "
+                   "noise and as much again, or that noise and the floor where the noise is less than the floor; "),
+            std::string::npos)
+      << p;
+  // Where the noise sets them (0.196 px against a floor of 0.1 px), no floor is named.
+  p = NotConvergedProblem(WithCameraResiduals(0.196, 0.88), 1.0);
+  EXPECT_EQ(p.find("and the floor of"), std::string::npos) << p;
   // ... and scales with the limit: at 1.5 px, hypot(0.02, 0.15) px.
   EXPECT_EQ(NotConvergedProblem(WithCameraResiduals(0.02, std::hypot(0.02, 0.15) * (1 - 1e-9)), 1.5), "");
   EXPECT_NE(NotConvergedProblem(WithCameraResiduals(0.02, std::hypot(0.02, 0.15) * (1 + 1e-9)), 1.5), "");

@@ -8,6 +8,7 @@
 
 #include <unistd.h>
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -17,6 +18,7 @@
 
 #include "calib/calib_test_util.h"
 #include "calib/capture_folder.h"
+#include "calib/convergence.h"
 #include "calib/core/rig_file.h"
 #include "datasets/default_rig.h"
 #include "targets/synthetic_view.h"
@@ -122,6 +124,23 @@ TEST(CalibrateCli, RenderedCapturesToRigFileAndReport) {
   const Rig rig = ReadRigFile(set.dir + "/rig.yaml");
   ASSERT_EQ(rig.num_modules(), 2);
   EXPECT_TRUE(fs::exists(set.dir + "/report.json"));
+  // Stage 3's per-camera limits: the rendered corners' noise (~0.02 px) is
+  // under the floor, a tenth of --max-rms-px (0.1 px), so the floor sets
+  // them, and the summary and the report say so (calib/convergence.h).
+  EXPECT_NE(r.out.find(" px and the floor 0.100 px, 0.1 x --max-rms-px)\n"), std::string::npos) << r.out;
+  {
+    std::ifstream report_file(set.dir + "/report.json");
+    const nlohmann::json cameras =
+        nlohmann::json::parse(report_file).at("stage3_system").at("refined").at("camera_residuals");
+    ASSERT_EQ(cameras.size(), 4u);
+    for (const nlohmann::json& c : cameras) {
+      const double sigma_px = c.at("stage2_sigma_px").get<double>();
+      EXPECT_GT(sigma_px, 0.0);
+      EXPECT_LT(sigma_px, 0.1) << "rendered corners";
+      EXPECT_NEAR(c.at("median_limit_px").get<double>(), kRayleighMedian * std::hypot(sigma_px, 0.1), 1e-9);
+      EXPECT_NEAR(c.at("p90_limit_px").get<double>(), kRayleighP90 * std::hypot(sigma_px, 0.1), 1e-9);
+    }
+  }
   // The board it was calibrated with, for the nightly check (its file by
   // its absolute path; the sizes are the rendered set's, 11x9 of 9 mm).
   ASSERT_TRUE(rig.provenance().target.has_value());
