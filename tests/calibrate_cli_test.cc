@@ -412,6 +412,18 @@ TEST(CalibrateCli, StageThreesIterationLimitIsAnOptionAndItsSolvesAreChecked) {
   EXPECT_NE(help.out.find("--max-iterations INT=100"), std::string::npos) << help.out;
 }
 
+// --max-rms-px also sets the floor of stage 3's per-camera limits (a tenth
+// of it, calib/convergence.h): its help says what that floor lets through,
+// which raising the limit widens.
+TEST(CalibrateCli, MaxRmsPxHelpSaysWhatStageThreesFloorLetsThrough) {
+  const testing::Result help = testing::RunCli("calibrate --help");
+  EXPECT_NE(help.out.find("or a tenth of this where that noise is less: a floor that grows with it (at 10, a module "
+                          "moved 1 mm between captures passes) and on low-noise corners passes a bias in S of a few "
+                          "of its sigmas\n"),
+            std::string::npos)
+      << help.out;
+}
+
 TEST(CalibrateCli, RefusesImagesOfTheWrongSize) {
   const RenderedSet set = Render("calib_cli_size", 2, 6);
   cv::Mat noise(480, 640, CV_8UC1);  // noise: its image data far longer than the 200 bytes kept below
