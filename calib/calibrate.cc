@@ -269,14 +269,7 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
     modules = result.stage3.modules;
     module0_from_module = result.stage3.module0_from_module;
     rep.system = result.stage3.report;
-    if (!rep.system.horn_only_solver_problem.empty())
-      rep.warnings.push_back(
-          "stage 3's Horn-only solve (S and the stereo pairs held at Horn's and stage 2's, the board poses solved) "
-          "did not converge: " +
-          rep.system.horn_only_solver_problem +
-          ": its rms (the report's horn_only, the rig file's rig_horn_only_rms_px) is where it stopped, not what "
-          "Horn's S gives; the full adjustment started from there and is judged on its own (--max-iterations "
-          "raises the limit of both)");
+    if (const std::string w = HornOnlyWarning(rep.system); !w.empty()) rep.warnings.push_back(w);
   } else {
     result.stage3.module0_from_module = module0_from_module;
     result.stage3.module0_from_module_horn = module0_from_module;
@@ -631,7 +624,9 @@ std::string SummaryText(const CalibrationReport& rep) {
     AppendLine(&out, "  reprojection rms: Horn only %.3f px, refined %.3f px", s.horn_reprojection_rms_px,
                s.refined_reprojection_rms_px);
     if (!s.horn_only_solver_problem.empty())
-      AppendLine(&out, "  (the Horn-only rms is where its solve stopped: %s)", s.horn_only_solver_problem.c_str());
+      AppendLine(&out, "  (the Horn-only rms is %s: %s)",
+                 std::isfinite(s.horn_reprojection_rms_px) ? "where its solve stopped" : "not a number",
+                 s.horn_only_solver_problem.c_str());
     if (!s.refined_capture_rms.empty()) {
       const SystemReport::CaptureRms& w = s.refined_capture_rms[0];
       AppendLine(&out, "  worst capture: %s, rms %.3f px over %d corners", rep.CaptureName(w.capture).c_str(), w.rms_px,

@@ -529,6 +529,23 @@ TEST(CalibrateReport, StageThreesCameraLimitsAreSaidWithTheirFloor) {
   EXPECT_NEAR(j[3]["p90_limit_px"].get<double>(), kRayleighP90 * std::hypot(0.2, 0.2), 1e-12);
 }
 
+// A Horn-only solve that converged but whose residuals could not be
+// evaluated (a projection failed) left its rms NaN: the summary said that
+// NaN "is where its solve stopped", of a solve that had not stopped short.
+TEST(CalibrateReport, AHornOnlyRmsThatCouldNotBeEvaluatedIsSaidSo) {
+  CalibrationReport rep;
+  rep.num_modules = 2;
+  rep.stereo.resize(2);
+  rep.system.horn_reprojection_rms_px = std::numeric_limits<double>::quiet_NaN();
+  rep.system.horn_only_solver_problem = "its residuals could not be evaluated (a projection failed)";
+  const std::string text = SummaryText(rep);
+  EXPECT_NE(text.find("  (the Horn-only rms is not a number: its residuals could not be evaluated (a projection "
+                      "failed))\n"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(text.find("where its solve stopped"), std::string::npos) << text;
+}
+
 TEST(CalibrateReport, NamesCapturesByTheirFoldersWhereKnown) {
   CalibrationReport rep;
   rep.num_modules = 1;

@@ -191,4 +191,17 @@ std::string NotConvergedProblem(const CalibrationReport& report, double max_rms_
   return "";
 }
 
+std::string HornOnlyWarning(const SystemReport& s) {
+  if (s.horn_only_solver_problem.empty()) return "";
+  const bool evaluated = std::isfinite(s.horn_reprojection_rms_px);
+  const std::string rms = "its rms (the report's horn_only, the rig file's rig_horn_only_rms_px) is ";
+  return "stage 3's Horn-only solve (S and the stereo pairs held at Horn's and stage 2's, the board poses solved) " +
+         std::string(s.horn_only_stopped_short ? "did not converge: " : "converged, but ") +
+         s.horn_only_solver_problem + ": " + rms +
+         (evaluated ? "where it stopped, not what Horn's S gives" : "not a number") +
+         "; the full adjustment started from " + (s.horn_only_stopped_short ? "there" : "its solution") +
+         " and is judged on its own" +
+         (s.horn_only_stopped_short ? " (--max-iterations raises the limit of both)" : "");
+}
+
 }  // namespace stereorig

@@ -36,6 +36,12 @@ namespace stereorig {
 // figure and what usually causes it, for the message refusing the rig file.
 std::string NotConvergedProblem(const CalibrationReport& report, double max_rms_px);
 
+// The warning of a stage 3 whose Horn-only solve (S and the stereo pairs
+// held, the board poses solved) stopped short or whose residuals could not
+// be evaluated (SystemReport::horn_only_solver_problem), each said for what
+// happened: its rms is where it stopped, or not a number. "" if neither.
+std::string HornOnlyWarning(const SystemReport& system);
+
 // For Gaussian residuals of sigma per coordinate the distance hypot(du, dv)
 // is Rayleigh: its q-quantile is sigma sqrt(-2 ln(1 - q)). The median:
 // sqrt(2 ln 2) = 1.1774 sigma; the 90th percentile: sqrt(2 ln 10) = 2.1460

@@ -250,3 +250,39 @@ TEST(Convergence, StageThreesCamerasAreHeldToTheirStageTwoNoise) {
 
 }  // namespace
 }  // namespace stereorig
+
+namespace stereorig {
+namespace {
+
+// Stage 3's Horn-only solve is warned of for what happened to it: stopped
+// short (its rms where it stopped), converged with residuals that could not
+// be evaluated (its rms NaN: it "did not converge" and its NaN "is where it
+// stopped" before), or both.
+TEST(Convergence, AHornOnlySolveIsWarnedOfForWhatHappened) {
+  const std::string head =
+      "stage 3's Horn-only solve (S and the stereo pairs held at Horn's and stage 2's, the board poses solved) ";
+  const std::string rms = ": its rms (the report's horn_only, the rig file's rig_horn_only_rms_px) is ";
+  const std::string stopped = "Ceres ended at NO_CONVERGENCE after 1 iteration (Maximum number of iterations reached)";
+  const std::string unread = "its residuals could not be evaluated (a projection failed)";
+  SystemReport s;
+  s.horn_reprojection_rms_px = 0.2;
+  EXPECT_EQ(HornOnlyWarning(s), "");
+  s.horn_only_stopped_short = true;
+  s.horn_only_solver_problem = stopped;
+  EXPECT_EQ(HornOnlyWarning(s), head + "did not converge: " + stopped + rms +
+                                    "where it stopped, not what Horn's S gives; the full adjustment started from "
+                                    "there and is judged on its own (--max-iterations raises the limit of both)");
+  s.horn_reprojection_rms_px = std::numeric_limits<double>::quiet_NaN();
+  s.horn_only_solver_problem = stopped + "; " + unread;
+  EXPECT_EQ(HornOnlyWarning(s), head + "did not converge: " + stopped + "; " + unread + rms +
+                                    "not a number; the full adjustment started from there and is judged on its own "
+                                    "(--max-iterations raises the limit of both)");
+  s.horn_only_stopped_short = false;
+  s.horn_only_solver_problem = unread;
+  EXPECT_EQ(HornOnlyWarning(s), head + "converged, but " + unread + rms +
+                                    "not a number; the full adjustment started from its solution and is judged on "
+                                    "its own");
+}
+
+}  // namespace
+}  // namespace stereorig

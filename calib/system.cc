@@ -519,8 +519,12 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   // full adjustment, which is judged on its own, and gives the Horn-only
   // RMS, which is then where it stopped, not Horn's.
   rep.horn_only_solver_problem = StoppedShort(summary);
+  rep.horn_only_stopped_short = !rep.horn_only_solver_problem.empty();
   rep.horn_reprojection_rms_px = rms(corner_residuals());
-  if (rep.horn_only_solver_problem.empty()) rep.horn_only_solver_problem = rep.solver_problem;  // not evaluated
+  // Residuals not evaluated (corner_residuals said so in solver_problem,
+  // which the full solve's ending replaces below): said after how it ended.
+  if (!rep.solver_problem.empty())
+    rep.horn_only_solver_problem += (rep.horn_only_stopped_short ? "; " : "") + rep.solver_problem;
   // The full adjustment.
   set_free(true, options.refine_stereo, bff_free, options.refine_intrinsics);
   ceres::Solve(sopt, &problem, &summary);
