@@ -155,25 +155,54 @@ CLI::Validator NumberValidator(bool (*ok)(double), const char* rule, const char*
 
 namespace {
 
+// The whole number `digits` writes in `base` (10, or 16 after a 0x),
+// digits alone (strtoull would take a sign, spaces, and with base 0 a
+// leading 0 as octal), into *value: false if they are not. *fits: false
+// for a value past 2^64 - 1 (*value is then 2^64 - 1).
+bool ReadDigits(const std::string& digits, int base, uint64_t* value, bool* fits) {
+  if (digits.empty() ||
+      digits.find_first_not_of(base == 16 ? "0123456789abcdefABCDEF" : "0123456789") != std::string::npos)
+    return false;
+  errno = 0;
+  const unsigned long long x = std::strtoull(digits.c_str(), nullptr, base);
+  *value = x;
+  *fits = errno != ERANGE;
+  return true;
+}
+
 // The seed `text` names into *seed: "" if it is one (AddSeedOption's
 // forms, at most max_seed), else what is wrong with it.
 std::string ParseSeed(const std::string& text, uint64_t max_seed, uint64_t* seed) {
   const bool hex = text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
-  const std::string digits = hex ? text.substr(2) : text;
   if (text.empty()) return "an empty value";  // as every option says it (NonEmptyValue above)
-  // " -1" too: strtoull skips the space, and wrapped "-1" round to 2^64 - 1.
+  // " -1" too: strtoull skipped the space, and wrapped "-1" round to 2^64 - 1.
   const size_t first = text.find_first_not_of(" \t\n\v\f\r");
   if (first != std::string::npos && text[first] == '-') return "must be >= 0";
-  if (digits.empty() || digits.find_first_not_of(hex ? "0123456789abcdefABCDEF" : "0123456789") != std::string::npos)
+  uint64_t value = 0;
+  bool fits = false;
+  if (!ReadDigits(hex ? text.substr(2) : text, hex ? 16 : 10, &value, &fits))
     return "must be a whole number (decimal, or hex with 0x), not '" + text + "'";
-  errno = 0;
-  const unsigned long long value = std::strtoull(digits.c_str(), nullptr, hex ? 16 : 10);
-  if (errno == ERANGE || value > max_seed) {
+  if (!fits || value > max_seed) {
     const std::string most = std::to_string(max_seed);
     return "must be at most " + most +
            (max_seed == std::numeric_limits<uint64_t>::max() ? std::string(" (2^64 - 1)") : std::string());
   }
   *seed = value;
+  return "";
+}
+
+// The count `text` names into *count: "" if it is one (AddCountOption's
+// form), else what is wrong with it.
+std::string ParseCount(const std::string& text, int* count) {
+  uint64_t value = 0;
+  bool fits = false;
+  if (!text.empty() && text[0] == '-' && ReadDigits(text.substr(1), 10, &value, &fits))
+    return "must be >= 1, got " + text;
+  if (!ReadDigits(text, 10, &value, &fits)) return "must be a whole number >= 1, got " + text;
+  if (value < 1) return "must be >= 1, got " + text;
+  if (!fits || value > static_cast<uint64_t>(std::numeric_limits<int>::max()))
+    return "must be at most " + std::to_string(std::numeric_limits<int>::max()) + ", got " + text;
+  *count = static_cast<int>(value);
   return "";
 }
 
@@ -207,21 +236,19 @@ const CLI::Validator& NonNegativeValue() {
   return v;
 }
 
-const CLI::Validator& PositiveCount() {
-  static const CLI::Validator v(
-      [](const std::string& text) {
-        const char* begin = text.c_str();
-        char* end = nullptr;
-        errno = 0;
-        const long long x = std::strtoll(begin, &end, 10);
-        if (end == begin || *end != '\0') return "must be a whole number >= 1, got " + text;
-        if (x < 1) return "must be >= 1, got " + text;
-        if (errno == ERANGE || x > std::numeric_limits<int>::max())
-          return "must be at most " + std::to_string(std::numeric_limits<int>::max()) + ", got " + text;
-        return std::string();
-      },
-      "", "PositiveCount");
-  return v;
+CLI::Option* AddCountOption(CLI::App& app, const std::string& name, int* count, const std::string& description) {
+  return app
+      .add_option_function<std::string>(
+          name, [count](const std::string& text) { (void)ParseCount(text, count); },
+          description + "; a whole number >= 1 (decimal: 010 is ten)")
+      ->check(CLI::Validator(
+          [](const std::string& text) {
+            int ignored = 0;
+            return ParseCount(text, &ignored);
+          },
+          "", "Count"))
+      ->type_name("INT")
+      ->default_str(std::to_string(*count));
 }
 
 namespace {

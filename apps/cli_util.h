@@ -62,9 +62,13 @@ std::string ShellQuoted(const std::string& word);
 // DBL_MAX's 309 digits.
 const CLI::Validator& PositiveValue();
 const CLI::Validator& NonNegativeValue();
-// A count: a whole number in [1, 2^31 - 1] ("must be a whole number >= 1,
-// got 1.5"; CLI11's own conversion said "Could not convert").
-const CLI::Validator& PositiveCount();
+// A count option `name` into *count (its default shown as it is): a whole
+// number in [1, 2^31 - 1], decimal ("must be a whole number >= 1, got 1.5";
+// CLI11's own conversion said "Could not convert"). Read here, as
+// AddSeedOption's seed is: CLI11 took a leading 0 as octal after a check
+// that read it as decimal (010 passed as ten and ran as 8; 09 passed, then
+// "Could not convert").
+CLI::Option* AddCountOption(CLI::App& app, const std::string& name, int* count, const std::string& description);
 
 // A --seed option into *seed (its default shown as it is): a whole number
 // from 0 to max_seed, decimal (leading zeros are zeros) or hex with 0x,

@@ -269,14 +269,7 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
     modules = result.stage3.modules;
     module0_from_module = result.stage3.module0_from_module;
     rep.system = result.stage3.report;
-    if (!rep.system.horn_only_solver_problem.empty())
-      rep.warnings.push_back(
-          "stage 3's Horn-only solve (S and the stereo pairs held at Horn's and stage 2's, the board poses solved) "
-          "did not converge: " +
-          rep.system.horn_only_solver_problem +
-          ": its rms (the report's horn_only, the rig file's rig_horn_only_rms_px) is where it stopped, not what "
-          "Horn's S gives; the full adjustment started from there and is judged on its own (--max-iterations "
-          "raises the limit of both)");
+    if (const std::string w = HornOnlyWarning(rep.system); !w.empty()) rep.warnings.push_back(w);
   } else {
     result.stage3.module0_from_module = module0_from_module;
     result.stage3.module0_from_module_horn = module0_from_module;
@@ -460,12 +453,16 @@ std::string CalibrationReport::ToJson() const {
     }
     j.EndArray().BeginArray("camera_residuals");
     for (const SystemReport::CameraResiduals& c : s.refined_camera_residuals) {
+      const Stage3CameraLimits l = Stage3CameraLimitsOf(*this, c.camera, max_rms_px);
       j.BeginObject()
           .Int("camera", c.camera)
           .Int("corners", c.corners)
           .Number("rms_px", c.rms_px)
           .Number("median_px", c.median_px)
           .Number("p90_px", c.p90_px)
+          .Number("stage2_sigma_px", l.sigma_px)
+          .Number("median_limit_px", l.median_px)
+          .Number("p90_limit_px", l.p90_px)
           .EndObject();
     }
     j.EndArray().BeginArray("module0_from_module");
@@ -627,7 +624,9 @@ std::string SummaryText(const CalibrationReport& rep) {
     AppendLine(&out, "  reprojection rms: Horn only %.3f px, refined %.3f px", s.horn_reprojection_rms_px,
                s.refined_reprojection_rms_px);
     if (!s.horn_only_solver_problem.empty())
-      AppendLine(&out, "  (the Horn-only rms is where its solve stopped: %s)", s.horn_only_solver_problem.c_str());
+      AppendLine(&out, "  (the Horn-only rms is %s: %s)",
+                 std::isfinite(s.horn_reprojection_rms_px) ? "where its solve stopped" : "not a number",
+                 s.horn_only_solver_problem.c_str());
     if (!s.refined_capture_rms.empty()) {
       const SystemReport::CaptureRms& w = s.refined_capture_rms[0];
       AppendLine(&out, "  worst capture: %s, rms %.3f px over %d corners", rep.CaptureName(w.capture).c_str(), w.rms_px,
@@ -636,10 +635,16 @@ std::string SummaryText(const CalibrationReport& rep) {
     // Each camera against the noise stage 2 measured on it (calib/convergence.h).
     for (const SystemReport::CameraResiduals& c : s.refined_camera_residuals) {
       const Stage3CameraLimits l = Stage3CameraLimitsOf(rep, c.camera, rep.max_rms_px);
+      char excess[80];
+      if (l.floor_sets_them)
+        std::snprintf(excess, sizeof excess, "the floor %.3f px, %g x --max-rms-px", l.floor_px,
+                      kStage3ExcessFloorOfLimit);
+      else
+        std::snprintf(excess, sizeof excess, "as much again");
       AppendLine(&out,
                  "  camera %d: corner distances median %.3f px, 90th percentile %.3f px (limits %.3f, %.3f px from its "
-                 "stage 2 noise %.3f px)",
-                 c.camera, c.median_px, c.p90_px, l.median_px, l.p90_px, l.sigma_px);
+                 "stage 2 noise %.3f px and %s)",
+                 c.camera, c.median_px, c.p90_px, l.median_px, l.p90_px, l.sigma_px, excess);
     }
     for (size_t k = 1; k < s.module0_from_module.size(); ++k) {
       const Pose d = s.module0_from_module_horn[k].Inverse() * s.module0_from_module[k];

@@ -9,10 +9,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "calib/calib_test_util.h"
@@ -486,6 +488,62 @@ TEST(CalibrateReport, TheStageThatDidNotConvergeIsTheOneSummarised) {
   EXPECT_NE(text.find("not judged against the target file's back_from_front: stage 3 did not converge\n"),
             std::string::npos)
       << text;
+}
+
+// Stage 3's per-camera limits (calib/convergence.h) in the summary and the
+// report: from its stage 2 noise, and the floor, a tenth of --max-rms-px,
+// named where it sets them (every rendered dataset, at ~0.02 px of noise:
+// the summary quoted limits 3.3 - 3.6 times what "from its stage 2 noise" gives,
+// and the report held only the figures, not their limits).
+TEST(CalibrateReport, StageThreesCameraLimitsAreSaidWithTheirFloor) {
+  CalibrationReport rep;
+  rep.num_modules = 2;
+  rep.max_rms_px = 1.0;
+  for (int m = 0; m < 2; ++m) {
+    StereoReport module;
+    module.module = m;
+    module.module_name = "module" + std::to_string(m);
+    module.left.camera = 2 * m, module.right.camera = 2 * m + 1;
+    module.left.rms_px = module.right.rms_px = m == 0 ? 0.02 : 0.2;  // module 0 under the floor, 1 over it
+    rep.stereo.push_back(module);
+  }
+  for (int c = 0; c < 4; ++c) rep.system.refined_camera_residuals.push_back({c, 1000, 0.02, 0.024, 0.043});
+  const std::string text = SummaryText(rep);
+  // hypot(0.02, 0.1) = 0.10198 px: x 1.1774, x 2.1460.
+  EXPECT_NE(text.find("  camera 0: corner distances median 0.024 px, 90th percentile 0.043 px (limits 0.120, 0.219 px "
+                      "from its stage 2 noise 0.020 px and the floor 0.100 px, 0.1 x --max-rms-px)\n"),
+            std::string::npos)
+      << text;
+  // hypot(0.2, 0.2) = 0.28284 px.
+  EXPECT_NE(text.find("  camera 2: corner distances median 0.024 px, 90th percentile 0.043 px (limits 0.333, 0.607 px "
+                      "from its stage 2 noise 0.200 px and as much again)\n"),
+            std::string::npos)
+      << text;
+  const nlohmann::json j = nlohmann::json::parse(rep.ToJson())["stage3_system"]["refined"]["camera_residuals"];
+  ASSERT_EQ(j.size(), 4u);
+  EXPECT_DOUBLE_EQ(j[0]["stage2_sigma_px"].get<double>(), 0.02);
+  EXPECT_NEAR(j[0]["median_limit_px"].get<double>(), kRayleighMedian * std::hypot(0.02, 0.1), 1e-12);
+  EXPECT_NEAR(j[0]["p90_limit_px"].get<double>(), kRayleighP90 * std::hypot(0.02, 0.1), 1e-12);
+  EXPECT_DOUBLE_EQ(j[3]["stage2_sigma_px"].get<double>(), 0.2);
+  EXPECT_NEAR(j[3]["median_limit_px"].get<double>(), kRayleighMedian * std::hypot(0.2, 0.2), 1e-12);
+  EXPECT_NEAR(j[3]["p90_limit_px"].get<double>(), kRayleighP90 * std::hypot(0.2, 0.2), 1e-12);
+}
+
+// A Horn-only solve that converged but whose residuals could not be
+// evaluated (a projection failed) left its rms NaN: the summary said that
+// NaN "is where its solve stopped", of a solve that had not stopped short.
+TEST(CalibrateReport, AHornOnlyRmsThatCouldNotBeEvaluatedIsSaidSo) {
+  CalibrationReport rep;
+  rep.num_modules = 2;
+  rep.stereo.resize(2);
+  rep.system.horn_reprojection_rms_px = std::numeric_limits<double>::quiet_NaN();
+  rep.system.horn_only_solver_problem = "its residuals could not be evaluated (a projection failed)";
+  const std::string text = SummaryText(rep);
+  EXPECT_NE(text.find("  (the Horn-only rms is not a number: its residuals could not be evaluated (a projection "
+                      "failed))\n"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(text.find("where its solve stopped"), std::string::npos) << text;
 }
 
 TEST(CalibrateReport, NamesCapturesByTheirFoldersWhereKnown) {

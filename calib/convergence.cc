@@ -60,7 +60,10 @@ std::string CamerasOverTheirNoise(const CalibrationReport& report, double max_rm
     over.push_back({std::max(c.median_px / l.median_px, c.p90_px / l.p90_px),
                     name + " at a median distance of " + Px(c.median_px) + " and a 90th percentile of " + Px(c.p90_px) +
                         " over " + std::to_string(c.corners) + " corners, against " + Px(l.median_px) + " and " +
-                        Px(l.p90_px) + " for its stage 2 noise of " + Px(l.sigma_px)});
+                        Px(l.p90_px) + " for its stage 2 noise of " + Px(l.sigma_px) +
+                        (l.floor_sets_them ? " and the floor of " + Px(l.floor_px) + " (" +
+                                                 NumberText(kStage3ExcessFloorOfLimit) + " x --max-rms-px)"
+                                           : std::string())});
   }
   std::stable_sort(over.begin(), over.end(), [](const Over& a, const Over& b) { return a.ratio > b.ratio; });
   std::string out;
@@ -83,8 +86,9 @@ Stage3CameraLimits Stage3CameraLimitsOf(const CalibrationReport& report, int cam
       if (c->camera == camera) l.sigma_px = c->rms_px > 0 ? c->rms_px : m.rms_px;
   // What stage 3 may add to it: as much again as the noise itself, in
   // quadrature (its variance doubled), and at least a tenth of the limit.
-  const double excess_px = std::max(l.sigma_px, kStage3ExcessFloorOfLimit * max_rms_px);
-  const double spread_px = std::hypot(l.sigma_px, excess_px);
+  l.floor_px = kStage3ExcessFloorOfLimit * max_rms_px;
+  l.floor_sets_them = l.sigma_px < l.floor_px;
+  const double spread_px = std::hypot(l.sigma_px, std::max(l.sigma_px, l.floor_px));
   l.median_px = kRayleighMedian * spread_px;
   l.p90_px = kRayleighP90 * spread_px;
   return l;
@@ -179,11 +183,25 @@ std::string NotConvergedProblem(const CalibrationReport& report, double max_rms_
     return "stage 3 did not converge: its corners are off by more than the noise stage 2 measured on them: " +
            cameras_over +
            " (the limits: the median and 90th percentile of corner distances whose coordinates have that noise and "
-           "as much again; each module alone fits its corners at that noise, so the modules did not stay in one "
+           "as much again, or that noise and the floor where the noise is less than the floor; each module alone fits "
+           "its corners at that noise, so the modules did not stay in one "
            "place relative to each other over the captures: a module that moved between captures, modules whose "
            "images were not taken at the same moment, or a target whose back face is not where the target file "
            "puts it)";
   return "";
+}
+
+std::string HornOnlyWarning(const SystemReport& s) {
+  if (s.horn_only_solver_problem.empty()) return "";
+  const bool evaluated = std::isfinite(s.horn_reprojection_rms_px);
+  const std::string rms = "its rms (the report's horn_only, the rig file's rig_horn_only_rms_px) is ";
+  return "stage 3's Horn-only solve (S and the stereo pairs held at Horn's and stage 2's, the board poses solved) " +
+         std::string(s.horn_only_stopped_short ? "did not converge: " : "converged, but ") +
+         s.horn_only_solver_problem + ": " + rms +
+         (evaluated ? "where it stopped, not what Horn's S gives" : "not a number") +
+         "; the full adjustment started from " + (s.horn_only_stopped_short ? "there" : "its solution") +
+         " and is judged on its own" +
+         (s.horn_only_stopped_short ? " (--max-iterations raises the limit of both)" : "");
 }
 
 }  // namespace stereorig

@@ -36,6 +36,12 @@ namespace stereorig {
 // figure and what usually causes it, for the message refusing the rig file.
 std::string NotConvergedProblem(const CalibrationReport& report, double max_rms_px);
 
+// The warning of a stage 3 whose Horn-only solve (S and the stereo pairs
+// held, the board poses solved) stopped short or whose residuals could not
+// be evaluated (SystemReport::horn_only_solver_problem), each said for what
+// happened: its rms is where it stopped, or not a number. "" if neither.
+std::string HornOnlyWarning(const SystemReport& system);
+
 // For Gaussian residuals of sigma per coordinate the distance hypot(du, dv)
 // is Rayleigh: its q-quantile is sigma sqrt(-2 ln(1 - q)). The median:
 // sqrt(2 ln 2) = 1.1774 sigma; the 90th percentile: sqrt(2 ln 10) = 2.1460
@@ -72,11 +78,15 @@ inline constexpr double kStage3ExcessFloorOfLimit = 0.1;
 
 // One camera's stage 3 limits by that rule: its stage 2 noise sigma (0 where
 // stage 2 gave none: no limit), and the median and 90th percentile corner
-// distance allowed, px.
+// distance allowed, px. The floor, when it sets them (sigma under it), is
+// said with them: "that noise and as much again" alone quoted limits 3.3 -
+// 3.6 times what it gives on the rendered images (0.020 - 0.022 px).
 struct Stage3CameraLimits {
   double sigma_px = 0.0;
   double median_px = 0.0;
   double p90_px = 0.0;
+  double floor_px = 0.0;         // kStage3ExcessFloorOfLimit x the limit
+  bool floor_sets_them = false;  // the excess is the floor, not sigma
 };
 Stage3CameraLimits Stage3CameraLimitsOf(const CalibrationReport& report, int camera, double max_rms_px);
 

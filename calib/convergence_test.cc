@@ -220,6 +220,20 @@ TEST(Convergence, StageThreesCamerasAreHeldToTheirStageTwoNoise) {
   const double floor_spread = std::hypot(0.02, 0.1);
   EXPECT_EQ(NotConvergedProblem(WithCameraResiduals(0.02, floor_spread * (1 - 1e-9)), 1.0), "");
   EXPECT_NE(NotConvergedProblem(WithCameraResiduals(0.02, floor_spread * (1 + 1e-9)), 1.0), "");
+  // Where the floor sets the limits, the refusal says so: from 0.02 px of
+  // noise and as much again they would be 3.6 times smaller than quoted.
+  p = NotConvergedProblem(WithCameraResiduals(0.02, floor_spread * (1 + 1e-9)), 1.0);
+  EXPECT_NE(p.find("against 0.1201 px and 0.2188 px for its stage 2 noise of 0.02 px and the floor of 0.1 px "
+                   "(0.1 x --max-rms-px); camera 1"),
+            std::string::npos)
+      << p;
+  EXPECT_NE(p.find("(the limits: the median and 90th percentile of corner distances whose coordinates have that "
+                   "noise and as much again, or that noise and the floor where the noise is less than the floor; "),
+            std::string::npos)
+      << p;
+  // Where the noise sets them (0.196 px against a floor of 0.1 px), no floor is named.
+  p = NotConvergedProblem(WithCameraResiduals(0.196, 0.88), 1.0);
+  EXPECT_EQ(p.find("and the floor of"), std::string::npos) << p;
   // ... and scales with the limit: at 1.5 px, hypot(0.02, 0.15) px.
   EXPECT_EQ(NotConvergedProblem(WithCameraResiduals(0.02, std::hypot(0.02, 0.15) * (1 - 1e-9)), 1.5), "");
   EXPECT_NE(NotConvergedProblem(WithCameraResiduals(0.02, std::hypot(0.02, 0.15) * (1 + 1e-9)), 1.5), "");
@@ -232,6 +246,42 @@ TEST(Convergence, StageThreesCamerasAreHeldToTheirStageTwoNoise) {
       << NotConvergedProblem(r, 1.0);
   // The limit's rules come first: their message names the rms or median.
   EXPECT_TRUE(StartsWith(NotConvergedProblem(WithCameraResiduals(0.196, 1.5), 1.0), "stage 3 did not converge: rms "));
+}
+
+}  // namespace
+}  // namespace stereorig
+
+namespace stereorig {
+namespace {
+
+// Stage 3's Horn-only solve is warned of for what happened to it: stopped
+// short (its rms where it stopped), converged with residuals that could not
+// be evaluated (its rms NaN: it "did not converge" and its NaN "is where it
+// stopped" before), or both.
+TEST(Convergence, AHornOnlySolveIsWarnedOfForWhatHappened) {
+  const std::string head =
+      "stage 3's Horn-only solve (S and the stereo pairs held at Horn's and stage 2's, the board poses solved) ";
+  const std::string rms = ": its rms (the report's horn_only, the rig file's rig_horn_only_rms_px) is ";
+  const std::string stopped = "Ceres ended at NO_CONVERGENCE after 1 iteration (Maximum number of iterations reached)";
+  const std::string unread = "its residuals could not be evaluated (a projection failed)";
+  SystemReport s;
+  s.horn_reprojection_rms_px = 0.2;
+  EXPECT_EQ(HornOnlyWarning(s), "");
+  s.horn_only_stopped_short = true;
+  s.horn_only_solver_problem = stopped;
+  EXPECT_EQ(HornOnlyWarning(s), head + "did not converge: " + stopped + rms +
+                                    "where it stopped, not what Horn's S gives; the full adjustment started from "
+                                    "there and is judged on its own (--max-iterations raises the limit of both)");
+  s.horn_reprojection_rms_px = std::numeric_limits<double>::quiet_NaN();
+  s.horn_only_solver_problem = stopped + "; " + unread;
+  EXPECT_EQ(HornOnlyWarning(s), head + "did not converge: " + stopped + "; " + unread + rms +
+                                    "not a number; the full adjustment started from there and is judged on its own "
+                                    "(--max-iterations raises the limit of both)");
+  s.horn_only_stopped_short = false;
+  s.horn_only_solver_problem = unread;
+  EXPECT_EQ(HornOnlyWarning(s), head + "converged, but " + unread + rms +
+                                    "not a number; the full adjustment started from its solution and is judged on "
+                                    "its own");
 }
 
 }  // namespace

@@ -121,9 +121,9 @@ TEST(Stage3Rules, ASolveThatStoppedShortIsNotConverged) {
   r.system.refined_reprojection_rms_px = 0.2;
   r.system.refined_median_corner_residual_px = 0.24;
   EXPECT_EQ(NotConvergedProblem(r, 1.0), "");
-  r.system.solver_problem = "Ceres ended at NO_CONVERGENCE after 101 iterations (Maximum number of iterations reached)";
+  r.system.solver_problem = "Ceres ended at NO_CONVERGENCE after 100 iterations (Maximum number of iterations reached)";
   const std::string p = NotConvergedProblem(r, 1.0);
-  EXPECT_EQ(p.rfind("stage 3 did not converge: Ceres ended at NO_CONVERGENCE after 101 iterations", 0), 0u) << p;
+  EXPECT_EQ(p.rfind("stage 3 did not converge: Ceres ended at NO_CONVERGENCE after 100 iterations", 0), 0u) << p;
   EXPECT_NE(p.find("at rms 0.2 px"), std::string::npos) << p;
   // Residuals that could not be evaluated read NaN: named as such, not as
   // an RMS of nan.

@@ -160,7 +160,7 @@ TEST(CalibrateSystemVerdicts, ACaptureStageTwoSetAsideStaysOut) {
 // 0, 25 captures at 0.2 px). Ceres has none of mrcal's regularisation:
 // freed outright, the rational k4..k6 and the thin-prism s1..s4 were not
 // determined by the corners (on the demo dataset Ceres stopped at
-// NO_CONVERGENCE after 101 iterations, k1..k6 in the hundreds, a pole-zero
+// NO_CONVERGENCE after 100 iterations, k1..k6 in the hundreds, a pole-zero
 // pair inside the image, S[0][1] 2.95 mm off the truth against a reported
 // 1 sigma of 0.0099 mm, and the rig was written). They are refined under
 // stage 2's covariance of them (its regularisation as the prior), which
@@ -369,7 +369,7 @@ TEST(CalibrateSystemVerdicts, AHornOnlySolveThatStoppedShortIsWarnedOf) {
   ASSERT_EQ(r.report.warnings.size(), 1u);
   const std::string& w = r.report.warnings[0];
   EXPECT_EQ(w.rfind("stage 3's Horn-only solve (S and the stereo pairs held at Horn's and stage 2's, the board poses "
-                    "solved) did not converge: Ceres ended at NO_CONVERGENCE after ",
+                    "solved) did not converge: Ceres ended at NO_CONVERGENCE after 1 iteration (",
                     0),
             0u)
       << w;

@@ -117,11 +117,16 @@ std::vector<SystemReport::CameraResiduals> CameraResidualsOf(const std::vector<d
 }
 
 // "" if a Ceres solve ended at CONVERGENCE; else how it ended, for
-// SystemReport's solver_problem and horn_only_solver_problem.
+// SystemReport's solver_problem and horn_only_solver_problem. Its
+// iterations are the steps it took, the last iteration's number:
+// summary.iterations also holds Ceres's iteration 0, the starting point (a
+// solve stopped at --max-iterations 1 read "after 2 iterations"), which
+// num_successful_steps counts too.
 std::string StoppedShort(const ceres::Solver::Summary& summary) {
   if (summary.termination_type == ceres::CONVERGENCE) return "";
+  const int steps = summary.iterations.empty() ? 0 : summary.iterations.back().iteration;
   return "Ceres ended at " + std::string(ceres::TerminationTypeToString(summary.termination_type)) + " after " +
-         std::to_string(summary.iterations.size()) + " iterations (" + summary.message + ")";
+         std::to_string(steps) + (steps == 1 ? " iteration (" : " iterations (") + summary.message + ")";
 }
 
 }  // namespace
@@ -514,8 +519,12 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   // full adjustment, which is judged on its own, and gives the Horn-only
   // RMS, which is then where it stopped, not Horn's.
   rep.horn_only_solver_problem = StoppedShort(summary);
+  rep.horn_only_stopped_short = !rep.horn_only_solver_problem.empty();
   rep.horn_reprojection_rms_px = rms(corner_residuals());
-  if (rep.horn_only_solver_problem.empty()) rep.horn_only_solver_problem = rep.solver_problem;  // not evaluated
+  // Residuals not evaluated (corner_residuals said so in solver_problem,
+  // which the full solve's ending replaces below): said after how it ended.
+  if (!rep.solver_problem.empty())
+    rep.horn_only_solver_problem += (rep.horn_only_stopped_short ? "; " : "") + rep.solver_problem;
   // The full adjustment.
   set_free(true, options.refine_stereo, bff_free, options.refine_intrinsics);
   ceres::Solve(sopt, &problem, &summary);
@@ -523,7 +532,7 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
   // evaluation above (a seed the full solve moved away from): its problem
   // replaced. Only CONVERGENCE is a solution: NO_CONVERGENCE (the iteration limit),
   // FAILURE and USER_FAILURE leave the parameters wherever the solve
-  // stopped, whatever their RMS reads (OPENCV12 with its k4..k6 freed: 101
+  // stopped, whatever their RMS reads (OPENCV12 with its k4..k6 freed: 100
   // iterations, an RMS at the noise, S 2.95 mm off the truth).
   rep.solver_problem = StoppedShort(summary);
   rep.max_iterations = options.max_iterations;

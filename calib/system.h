@@ -115,11 +115,15 @@ struct SystemReport {
   std::vector<std::pair<int, int>> spanning_tree;      // (parent, child) edges used for Horn
   std::map<std::pair<int, int>, double> horn_rms_mm;   // Horn fit RMS of each tree edge
   double horn_reprojection_rms_px = 0.0;               // S and stereo held at Horn/stage 2, board poses solved
-  // "" if that Horn-only solve ended at Ceres's CONVERGENCE; else how it
-  // ended (its iteration limit, a failure). Not a refusal: it only seeds the
-  // full adjustment (judged by solver_problem), but horn_reprojection_rms_px
-  // is then where it stopped (Calibrate warns of it).
+  // "" if that Horn-only solve ended at Ceres's CONVERGENCE and its
+  // residuals were evaluated; else how it ended (its iteration limit, a
+  // failure: horn_only_stopped_short) and/or that its residuals could not be
+  // evaluated (horn_reprojection_rms_px NaN). Not a refusal: it only seeds
+  // the full adjustment (judged by solver_problem), but
+  // horn_reprojection_rms_px is then where it stopped, or not a number
+  // (Calibrate warns of it: HornOnlyWarning).
   std::string horn_only_solver_problem;
+  bool horn_only_stopped_short = false;
   double refined_reprojection_rms_px = 0.0;  // after the full adjustment
   // The median of the corners' residual distances after it, px: what the
   // convergence check reads (calib/convergence.h), as the RMS counts in full

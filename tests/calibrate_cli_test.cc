@@ -8,6 +8,7 @@
 
 #include <unistd.h>
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -17,6 +18,7 @@
 
 #include "calib/calib_test_util.h"
 #include "calib/capture_folder.h"
+#include "calib/convergence.h"
 #include "calib/core/rig_file.h"
 #include "datasets/default_rig.h"
 #include "targets/synthetic_view.h"
@@ -122,6 +124,23 @@ TEST(CalibrateCli, RenderedCapturesToRigFileAndReport) {
   const Rig rig = ReadRigFile(set.dir + "/rig.yaml");
   ASSERT_EQ(rig.num_modules(), 2);
   EXPECT_TRUE(fs::exists(set.dir + "/report.json"));
+  // Stage 3's per-camera limits: the rendered corners' noise (~0.02 px) is
+  // under the floor, a tenth of --max-rms-px (0.1 px), so the floor sets
+  // them, and the summary and the report say so (calib/convergence.h).
+  EXPECT_NE(r.out.find(" px and the floor 0.100 px, 0.1 x --max-rms-px)\n"), std::string::npos) << r.out;
+  {
+    std::ifstream report_file(set.dir + "/report.json");
+    const nlohmann::json cameras =
+        nlohmann::json::parse(report_file).at("stage3_system").at("refined").at("camera_residuals");
+    ASSERT_EQ(cameras.size(), 4u);
+    for (const nlohmann::json& c : cameras) {
+      const double sigma_px = c.at("stage2_sigma_px").get<double>();
+      EXPECT_GT(sigma_px, 0.0);
+      EXPECT_LT(sigma_px, 0.1) << "rendered corners";
+      EXPECT_NEAR(c.at("median_limit_px").get<double>(), kRayleighMedian * std::hypot(sigma_px, 0.1), 1e-9);
+      EXPECT_NEAR(c.at("p90_limit_px").get<double>(), kRayleighP90 * std::hypot(sigma_px, 0.1), 1e-9);
+    }
+  }
   // The board it was calibrated with, for the nightly check (its file by
   // its absolute path; the sizes are the rendered set's, 11x9 of 9 mm).
   ASSERT_TRUE(rig.provenance().target.has_value());
@@ -345,7 +364,7 @@ TEST(CalibrateCli, StageThreesIterationLimitIsAnOptionAndItsSolvesAreChecked) {
   const std::string last = r.err.substr(r.err.rfind("stereorig calibrate:"));
   EXPECT_EQ(last.rfind("stereorig calibrate: " + rig +
                            ": not written: stage 3 did not converge: Ceres ended at "
-                           "NO_CONVERGENCE after ",
+                           "NO_CONVERGENCE after 1 iteration (",
                        0),
             0u)
       << last;
@@ -354,9 +373,11 @@ TEST(CalibrateCli, StageThreesIterationLimitIsAnOptionAndItsSolvesAreChecked) {
             std::string::npos)
       << last;
   EXPECT_FALSE(fs::exists(rig));
-  EXPECT_NE(r.err.find("calibrate: warning: stage 3's Horn-only solve (S and the stereo pairs held at Horn's and "
-                       "stage 2's, the board poses solved) did not converge: Ceres ended at NO_CONVERGENCE"),
-            std::string::npos)
+  EXPECT_NE(
+      r.err.find(
+          "calibrate: warning: stage 3's Horn-only solve (S and the stereo pairs held at Horn's and "
+          "stage 2's, the board poses solved) did not converge: Ceres ended at NO_CONVERGENCE after 1 iteration ("),
+      std::string::npos)
       << r.err;
   EXPECT_NE(r.out.find("  (the Horn-only rms is where its solve stopped: Ceres ended at NO_CONVERGENCE"),
             std::string::npos)
@@ -378,8 +399,29 @@ TEST(CalibrateCli, StageThreesIterationLimitIsAnOptionAndItsSolvesAreChecked) {
     EXPECT_EQ(b.err.rfind("stereorig calibrate: --max-iterations: must be ", 0), 0u) << b.err;
     EXPECT_EQ(b.err.find("detect 000"), std::string::npos) << "refused before any work: " << b.err;
   }
+  // Leading zeros are decimal, as the check reads them: CLI11's own
+  // conversion, after it, ran 010 as 8 and refused 09 ("Could not convert").
+  for (const auto& [text, count] : {std::pair<std::string, int>{"010", 10}, {"09", 9}}) {
+    fs::remove(report);
+    const testing::Result z = testing::RunCli(args + " --max-iterations " + text);
+    ASSERT_TRUE(fs::exists(report)) << text << ": " << z.err;
+    std::ifstream f(report);
+    EXPECT_EQ(nlohmann::json::parse(f).at("stage3_system").at("max_iterations").get<int>(), count) << text;
+  }
   const testing::Result help = testing::RunCli("calibrate --help");
   EXPECT_NE(help.out.find("--max-iterations INT=100"), std::string::npos) << help.out;
+}
+
+// --max-rms-px also sets the floor of stage 3's per-camera limits (a tenth
+// of it, calib/convergence.h): its help says what that floor lets through,
+// which raising the limit widens.
+TEST(CalibrateCli, MaxRmsPxHelpSaysWhatStageThreesFloorLetsThrough) {
+  const testing::Result help = testing::RunCli("calibrate --help");
+  EXPECT_NE(help.out.find("or a tenth of this where that noise is less: a floor that grows with it (at 10, a module "
+                          "moved 1 mm between captures passes) and on low-noise corners passes a bias in S of a few "
+                          "of its sigmas\n"),
+            std::string::npos)
+      << help.out;
 }
 
 TEST(CalibrateCli, RefusesImagesOfTheWrongSize) {
