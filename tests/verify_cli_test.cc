@@ -692,6 +692,18 @@ TEST(VerifyCli, ACapTooSmallToFitTheDiameterIsNotJudgedButShownAndAGoodOneReport
   EXPECT_NEAR(j["spheres"][0]["form_mm"].get<double>(), j["figures"][0]["value_mm"].get<double>(), 1e-12);  // P_F
 }
 
+// An ASCII PLY of `pts` in the test's temporary folder, named by `name`
+// and the process; returns its path.
+std::string WritePoints(const std::string& name, const std::vector<Eigen::Vector3d>& pts) {
+  const std::string path = ::testing::TempDir() + "/" + name + "_" + std::to_string(getpid()) + ".ply";
+  std::ofstream f(path);
+  f << "ply\nformat ascii 1.0\nelement vertex " << pts.size()
+    << "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
+  f.precision(17);
+  for (const Eigen::Vector3d& p : pts) f << p.x() << " " << p.y() << " " << p.z() << "\n";
+  return path;
+}
+
 // A cap whose noise neighbouring points share, as a reconstruction's is (the
 // demo's residuals correlate up to ~2 mm, a matching window's footprint), is
 // judged on its uncertainty counted honestly. Before, the fit's covariance
@@ -709,14 +721,7 @@ TEST(VerifyCli, ACapWhoseNoiseNeighbouringPointsShareIsJudgedOnItsWholeUncertain
   std::mt19937 rng(20);
   const std::vector<Eigen::Vector3d> pts = stereorig::testing::CorrelatedNoiseSamples(
       stereorig::testing::SphereCapSurface({0, 0, 150}, {0, 0, -1}, 19.05, 20), 3000, 0.05, 1.0, 0.01, &rng);
-  const std::string cap = ::testing::TempDir() + "/correlated_cap_" + std::to_string(getpid()) + ".ply";
-  {
-    std::ofstream f(cap);
-    f << "ply\nformat ascii 1.0\nelement vertex " << pts.size()
-      << "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
-    f.precision(17);
-    for (const Eigen::Vector3d& p : pts) f << p.x() << " " << p.y() << " " << p.z() << "\n";
-  }
+  const std::string cap = WritePoints("correlated_cap", pts);
   const auto r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + cap);
   EXPECT_EQ(r.code, 2) << r.out << r.err;
   EXPECT_NE(r.err.find(cap + ": P_S is not determined"), std::string::npos) << r.err;
@@ -750,14 +755,7 @@ TEST(VerifyCli, APatchOffABallFailsTheBallBarNotLeftUndetermined) {
       if (ball == 1 && r_mm * (n - patch_direction).norm() < 5.0) p += 1.0 * n;
       pts.push_back(p);
     }
-  const std::string cloud = ::testing::TempDir() + "/patched_ballbar_" + std::to_string(getpid()) + ".ply";
-  {
-    std::ofstream f(cloud);
-    f << "ply\nformat ascii 1.0\nelement vertex " << pts.size()
-      << "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
-    f.precision(17);
-    for (const Eigen::Vector3d& p : pts) f << p.x() << " " << p.y() << " " << p.z() << "\n";
-  }
+  const std::string cloud = WritePoints("patched_ballbar", pts);
   const auto r = RunCli("verify --artifact " +
                         WriteArtifact("format: stereorig-artifact\nversion: 1\nunits: mm\ntype: ballbar\n"
                                       "sphere_diameter_mm: 25.4\ncenter_distance_mm: 80\n"
