@@ -692,6 +692,18 @@ TEST(VerifyCli, ACapTooSmallToFitTheDiameterIsNotJudgedButShownAndAGoodOneReport
   EXPECT_NEAR(j["spheres"][0]["form_mm"].get<double>(), j["figures"][0]["value_mm"].get<double>(), 1e-12);  // P_F
 }
 
+// An ASCII PLY of `pts` in the test's temporary folder, named by `name`
+// and the process; returns its path.
+std::string WritePoints(const std::string& name, const std::vector<Eigen::Vector3d>& pts) {
+  const std::string path = ::testing::TempDir() + "/" + name + "_" + std::to_string(getpid()) + ".ply";
+  std::ofstream f(path);
+  f << "ply\nformat ascii 1.0\nelement vertex " << pts.size()
+    << "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
+  f.precision(17);
+  for (const Eigen::Vector3d& p : pts) f << p.x() << " " << p.y() << " " << p.z() << "\n";
+  return path;
+}
+
 // A cap whose noise neighbouring points share, as a reconstruction's is (the
 // demo's residuals correlate up to ~2 mm, a matching window's footprint), is
 // judged on its uncertainty counted honestly. Before, the fit's covariance
@@ -709,14 +721,7 @@ TEST(VerifyCli, ACapWhoseNoiseNeighbouringPointsShareIsJudgedOnItsWholeUncertain
   std::mt19937 rng(20);
   const std::vector<Eigen::Vector3d> pts = stereorig::testing::CorrelatedNoiseSamples(
       stereorig::testing::SphereCapSurface({0, 0, 150}, {0, 0, -1}, 19.05, 20), 3000, 0.05, 1.0, 0.01, &rng);
-  const std::string cap = ::testing::TempDir() + "/correlated_cap_" + std::to_string(getpid()) + ".ply";
-  {
-    std::ofstream f(cap);
-    f << "ply\nformat ascii 1.0\nelement vertex " << pts.size()
-      << "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
-    f.precision(17);
-    for (const Eigen::Vector3d& p : pts) f << p.x() << " " << p.y() << " " << p.z() << "\n";
-  }
+  const std::string cap = WritePoints("correlated_cap", pts);
   const auto r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + cap);
   EXPECT_EQ(r.code, 2) << r.out << r.err;
   EXPECT_NE(r.err.find(cap + ": P_S is not determined"), std::string::npos) << r.err;
@@ -728,6 +733,43 @@ TEST(VerifyCli, ACapWhoseNoiseNeighbouringPointsShareIsJudgedOnItsWholeUncertain
   EXPECT_LT(u_mm, 0.45) << r.out;
   // The table says by how much the shared noise widened it.
   EXPECT_NE(r.out.find("neighbouring points share its noise"), std::string::npos) << r.out;
+}
+
+// A patch of a ball lying off it (a grid period off) is an error of the
+// system, which the ball bar's SD is there to show, not noise of the test:
+// it read NOT JUDGED (u x10, "measure more of the artifact, or with less
+// noise"), the patch's residuals taken for noise neighbouring points share
+// (a second reading's clouds). Truth: balls of 25.4 mm 80 mm apart, 80-degree
+// caps of 15 000 points, 0.03 mm independent noise, ball 2 with a 1 mm
+// patch 5 mm across: SD +0.34 mm against a 0.3 mm MPE, u 0.007 mm: FAIL.
+TEST(VerifyCli, APatchOffABallFailsTheBallBarNotLeftUndetermined) {
+  std::mt19937 rng(3);
+  const double r_mm = 12.7;
+  const Eigen::Vector3d centres[2] = {{-40, 0, 200}, {40, 0, 200}};
+  const Eigen::Vector3d patch_direction(std::sin(0.61), 0, -std::cos(0.61));
+  std::vector<Eigen::Vector3d> pts;
+  for (int ball = 0; ball < 2; ++ball)
+    for (Eigen::Vector3d p : stereorig::testing::NoisySurfaceSamples(
+             stereorig::testing::SphereCapSurface(centres[ball], {0, 0, -1}, r_mm, 80), 15000, 0.03, &rng)) {
+      const Eigen::Vector3d n = (p - centres[ball]).normalized();
+      if (ball == 1 && r_mm * (n - patch_direction).norm() < 5.0) p += 1.0 * n;
+      pts.push_back(p);
+    }
+  const std::string cloud = WritePoints("patched_ballbar", pts);
+  const auto r = RunCli("verify --artifact " +
+                        WriteArtifact("format: stereorig-artifact\nversion: 1\nunits: mm\ntype: ballbar\n"
+                                      "sphere_diameter_mm: 25.4\ncenter_distance_mm: 80\n"
+                                      "mpe_mm: {P_F: 1.5, P_S: 1.5, SD: 0.3, F: 1.5}\n") +
+                        " --cloud " + cloud);
+  EXPECT_EQ(r.code, 1) << r.out << r.err;
+  EXPECT_EQ(r.out.find("1        NOT JUDGED"), std::string::npos) << r.out;
+  const size_t row_at = r.out.find("\n1        SD ");
+  ASSERT_NE(row_at, std::string::npos) << r.out;
+  double value_mm = 0, u_mm = 0;
+  ASSERT_EQ(std::sscanf(r.out.c_str() + row_at, " 1 SD %lf %lf", &value_mm, &u_mm), 2) << r.out;
+  EXPECT_GT(value_mm, 0.3) << r.out;
+  EXPECT_LT(u_mm, 0.03) << r.out;  // 10% of the MPE: determined
+  std::filesystem::remove(cloud);
 }
 
 // Several positions, one not judged: every position is printed, the summary

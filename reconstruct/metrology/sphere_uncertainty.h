@@ -54,7 +54,11 @@ inline constexpr double kNoiseCorrelationRadiusMm = 3.0;
 // than radius_mm (the fit's Jacobian changes little over that distance, so
 // the covariance scales by it), less twice its own standard error under
 // independent noise (so that independent noise reads 1, not the estimate's
-// scatter about it), and at least 1.
+// scatter about it), and at least 1. A pattern on the surface (a patch a
+// grid period off, a form error) is not noise and is taken out of the sum:
+// where the products of pairs radius_mm to 2 radius_mm apart hold one
+// (their mean correlation over 0.05), a line through them against distance,
+// extrapolated over the near pairs, is its part there (the .cc says why).
 double NoiseVarianceInflation(const std::vector<Eigen::Vector3d>& surface_mm, const std::vector<double>& residuals_mm,
                               double radius_mm = kNoiseCorrelationRadiusMm);
 

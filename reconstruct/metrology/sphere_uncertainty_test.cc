@@ -144,5 +144,60 @@ TEST(SphereUncertainty, IndependentNoiseIsNotInflated) {
   }
 }
 
+// A pattern on the surface is not noise. A patch of a ball lying off it (a
+// grid period off, 5 mm across the ball's 12.7 mm radius, 0.3 or 1 mm) is
+// correlated over its whole size; taken as noise neighbouring points share
+// it multiplied the variances by ~110 (u x10), whatever its height, and a
+// ball bar failing SD by 0.04 mm read NOT JUDGED (the reviewer's clouds).
+// Truth: 15 000 points on an 80-degree cap with 0.03 mm independent noise,
+// alone or with the correlated noise of the test above (field 0.05 mm, 1 mm
+// cells), then the same cloud with the patch. What u may hold: the noise's
+// own u (the clean cloud's, inflated) and the patch's residuals as the
+// plain fit counts them (u without the inflation): u^2 ~ u_clean^2 +
+// u_white^2. Measured 1.4-2.1 times that (the line through the far
+// products, extrapolated over the near band, leaves part of the patch's
+// profile there); the defect read ~10 times. Bounds: at most 2.5 times,
+// and the noise's inflation is not taken out with the pattern (u at least
+// the clean cloud's / 1.3).
+TEST(SphereUncertainty, APatchOffTheSurfaceIsAPatternNotNoise) {
+  const double r_mm = 12.7;
+  const Eigen::Vector3d centre(40, 0, 200), axis(0, 0, -1);
+  const Eigen::Vector3d patch_direction = Eigen::Vector3d(std::sin(0.61), 0, -std::cos(0.61));
+  for (const double field_mm : {0.0, 0.05}) {
+    for (const double patch_mm : {0.3, 1.0}) {
+      std::mt19937 rng(11);
+      std::vector<Eigen::Vector3d> pts =
+          field_mm > 0
+              ? testing::CorrelatedNoiseSamples(testing::SphereCapSurface(centre, axis, r_mm, 80), 15000, field_mm, 1.0,
+                                                0.03, &rng)
+              : testing::NoisySurfaceSamples(testing::SphereCapSurface(centre, axis, r_mm, 80), 15000, 0.03, &rng);
+      std::vector<int> all(pts.size());
+      for (size_t i = 0; i < pts.size(); ++i) all[i] = static_cast<int>(i);
+      const SphereFit clean = RefineSphere(pts, all, centre, r_mm, 50);
+      ASSERT_TRUE(clean.ok) << clean.message;
+      const SphereFitUncertainty u_clean = SphereUncertainty(pts, clean);
+      const double noise_inflation = u_clean.noise_variance_inflation;
+      int on_patch = 0;
+      for (Eigen::Vector3d& p : pts) {
+        const Eigen::Vector3d n = (p - centre).normalized();
+        if (r_mm * (n - patch_direction).norm() < 5.0) p += patch_mm * n, ++on_patch;
+      }
+      const SphereFit fit = RefineSphere(pts, all, centre, r_mm, 50);
+      ASSERT_TRUE(fit.ok) << fit.message;
+      const SphereFitUncertainty u = SphereUncertainty(pts, fit);
+      const double inflation = u.noise_variance_inflation;
+      const double u_white = u.diameter_std_mm / std::sqrt(inflation);
+      const double expected = std::hypot(u_clean.diameter_std_mm, u_white);
+      std::printf(
+          "field %.2f mm, patch %.1f mm on %d points: inflation %.2f (the noise alone %.2f); u %.5f mm, "
+          "%.2f x sqrt(u_clean^2 + u_white^2)\n",
+          field_mm, patch_mm, on_patch, inflation, noise_inflation, u.diameter_std_mm, u.diameter_std_mm / expected);
+      EXPECT_GT(on_patch, 1000);
+      EXPECT_LT(u.diameter_std_mm, 2.5 * expected) << field_mm << " " << patch_mm;
+      EXPECT_GT(u.diameter_std_mm, u_clean.diameter_std_mm / 1.3) << field_mm << " " << patch_mm;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace stereorig
