@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
@@ -288,17 +289,22 @@ int RunCheck(int argc, char** argv) {
   // image taken at another moment). A capture set aside whole is said once,
   // with why: each of its views printed "off the capture's other views"
   // read as if each had slipped alone.
+  // The captures said whole are kept, not read off the entries' order: a
+  // view set aside for its corners' jumps comes before the rest of its
+  // capture going whole, and a whole line said only after another capture's
+  // entry left such a capture unsaid.
   report["views_set_aside"] = nlohmann::json::array();
-  for (size_t k = 0; k < result.views_set_aside.size(); ++k) {
-    const SetAsideView& v = result.views_set_aside[k];
+  std::set<int> said_whole;
+  for (const SetAsideView& v : result.views_set_aside) {
     const auto name = detected.capture_names.find(v.capture);
     const std::string capture = name != detected.capture_names.end() ? name->second : std::to_string(v.capture);
     const bool other_moment = v.why == SetAsideWhy::kOtherMoment;
     const bool whole = v.whole_capture != WholeCapture::kNo;
-    if (whole && (k == 0 || result.views_set_aside[k - 1].capture != v.capture)) {
-      std::string cameras;
+    if (whole && said_whole.insert(v.capture).second) {
+      std::string cameras;  // those that went with the capture (a view set aside before is said on its own)
       for (const SetAsideView& w : result.views_set_aside)
-        if (w.capture == v.capture) cameras += (cameras.empty() ? "cam" : ", cam") + std::to_string(w.camera);
+        if (w.capture == v.capture && w.whole_capture != WholeCapture::kNo)
+          cameras += (cameras.empty() ? "cam" : ", cam") + std::to_string(w.camera);
       std::printf("set aside: capture %s whole (%s): %s; not used\n", capture.c_str(), cameras.c_str(),
                   WholeCaptureText(v).c_str());
     } else if (!whole) {

@@ -1163,6 +1163,38 @@ TEST(CheckCli, ImagesSwappedBetweenCamerasOrAModuleFromAnotherCaptureAreNamed) {
                        "tell"),
             std::string::npos)
       << r.out;
+
+  // The same slip in capture 3, whose cam3's image is noisy (grey levels
+  // with a standard deviation of 25): cam3 goes first, its corners jumping
+  // about their own pose, and then the three views left go whole. The whole
+  // capture went unsaid: its whole-capture line was printed only where the
+  // entry before it was another capture's, and cam3's came first. The jump
+  // reads ~0.5 px against a bound of ~0.075 px (2.5 times ~0.03 px), the
+  // slip hundreds of px against tens of times ~0.03 px.
+  const std::string jumped = dir + "/jumped";
+  fs::copy(dir + "/ds/calibration", jumped, fs::copy_options::recursive);
+  for (const char* image : {"cam0.png", "cam1.png"})
+    fs::copy_file(jumped + "/" + names[4] + "/" + image, jumped + "/" + names[3] + "/" + image,
+                  fs::copy_options::overwrite_existing);
+  {
+    const std::string path = jumped + "/" + names[3] + "/cam3.png";
+    cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE), noise(image.size(), CV_16SC1);
+    cv::RNG rng(1);
+    rng.fill(noise, cv::RNG::NORMAL, 0, 25);
+    cv::Mat noisy;
+    cv::add(image, noise, noisy, cv::noArray(), CV_8UC1);  // saturating
+    cv::imwrite(path, noisy);
+  }
+  r = check(jumped, dir + "/jumped.json");
+  EXPECT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_EQ(Occurrences(r.out, "set aside: "), 2) << r.out;
+  EXPECT_NE(r.out.find("set aside: capture " + names[3] + " cam3: its corners jump about their own board pose by "),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(
+      r.out.find("set aside: capture " + names[3] + " whole (cam0, cam1, cam2): cam2 is off module 0's views by "),
+      std::string::npos)
+      << r.out;
   fs::remove_all(dir);
 }
 

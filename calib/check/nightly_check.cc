@@ -254,11 +254,13 @@ std::string LostCapturesText(const std::map<int, size_t>& given_captures, const 
     const auto name = capture_names.find(capture);
     std::string why;
     size_t num_set_aside = 0;
+    bool whole_said = false;  // once for the capture, wherever its entries stand (a jump's comes first)
     for (const SetAsideView& v : set_aside) {
       if (v.capture != capture) continue;
       ++num_set_aside;
       if (v.whole_capture != WholeCapture::kNo) {
-        if (num_set_aside == 1) why += "all its views: " + WholeCaptureText(v);  // once, for the whole capture
+        if (!whole_said) why += (why.empty() ? "all its views: " : ", its other views: ") + WholeCaptureText(v);
+        whole_said = true;
         continue;
       }
       char buf[160];
