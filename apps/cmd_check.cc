@@ -400,12 +400,17 @@ int RunCheck(int argc, char** argv) {
         {"principal_point_px", {shared.principal_point_px.x(), shared.principal_point_px.y()}},
         {"turn_equivalent_deg", shared.turn_equivalent_deg}};
   }
-  // A module that moved as a whole besides a lens of it (module_shift.h).
+  // A module that moved as a whole besides a lens of it (module_shift.h),
+  // against the modules it was read against: which of them moved the
+  // check can tell only where the closures name the module alone (with two
+  // modules, module 1 moved reads as module 0's shift).
   report["module_shifts"] = nlohmann::json::array();
   for (const CheckResult::ModuleShiftNamed& m : result.module_shifts)
     report["module_shifts"].push_back({{"module", m.module},
                                        {"shift_mm", m.shift_mm.norm()},
-                                       {"shift_mm_xyz", {m.shift_mm.x(), m.shift_mm.y(), m.shift_mm.z()}}});
+                                       {"shift_mm_xyz", {m.shift_mm.x(), m.shift_mm.y(), m.shift_mm.z()}},
+                                       {"relative_to", m.relative_to},
+                                       {"which_unknown", m.which_unknown}});
   report["shared_scale"] = nullptr;
   if (result.shared_scale_explains) report["shared_scale"] = result.shared_scale;
 

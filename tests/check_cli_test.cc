@@ -668,6 +668,16 @@ TEST(CheckCli, AModuleOffsetBesidesALensChangeNamesTheModulesAndTheLens) {
   EXPECT_NEAR(offset["module_shifts"][0]["shift_mm"].get<double>(), 0.5, 0.05) << offset.dump(2);
   EXPECT_NE(offset["explanation"].get<std::string>().find("module 0 and module 1 disagree"), std::string::npos)
       << offset.dump(2);
+  // Module 1 moved, and the entry is module 0's (the one whose cameras
+  // disagree, its lens): with two modules the shift is relative, and the
+  // entry says so, not that module 0 moved.
+  EXPECT_EQ(offset["module_shifts"][0]["module"], 0) << offset.dump(2);
+  EXPECT_EQ(offset["module_shifts"][0]["relative_to"], nlohmann::json::array({1})) << offset.dump(2);
+  EXPECT_EQ(offset["module_shifts"][0]["which_unknown"], true) << offset.dump(2);
+  EXPECT_NE(offset["explanation"].get<std::string>().find(
+                "module 0 moved against module 1, or module 1 against module 0, which the check cannot tell"),
+            std::string::npos)
+      << offset.dump(2);
 
   const nlohmann::json sibling = check("sibling", {.lenses = {{0, {-0.58, 3.5, 0}}, {1, {0, -4.5, 0}}},
                                                    .module1_offset_mm = Eigen::Vector3d(1.5, 0, 0)});

@@ -106,11 +106,26 @@ std::string CheckResult::Explanation() const {
     for (int m : closure_modules) s << "module " << m << " moved or a lens changed; ";
   }
   for (const ModuleShiftNamed& shift : module_shifts) {
-    char text[200];
-    std::snprintf(text, sizeof text,
-                  "module %d's cameras are both off the other modules' by one shift of %.3f mm (the lens changes "
-                  "named aside); ",
-                  shift.module, shift.shift_mm.norm());
+    std::string against;
+    for (size_t k = 0; k < shift.relative_to.size(); ++k)
+      against += (k == 0                              ? ""
+                  : k + 1 == shift.relative_to.size() ? " and "
+                                                      : ", ") +
+                 std::to_string(shift.relative_to[k]);
+    against = (shift.relative_to.size() == 1 ? "module " : "modules ") + against;
+    char text[500];
+    if (shift.which_unknown) {
+      std::snprintf(text, sizeof text,
+                    "module %d's cameras are both off %s's by one shift of %.3f mm (the lens changes named aside): "
+                    "module %d moved against %s, or %s against module %d, which the check cannot tell; ",
+                    shift.module, against.c_str(), shift.shift_mm.norm(), shift.module, against.c_str(),
+                    against.c_str(), shift.module);
+    } else {
+      std::snprintf(text, sizeof text,
+                    "module %d's cameras are both off %s's by one shift of %.3f mm, which agree with each other: "
+                    "module %d moved (the lens changes named aside); ",
+                    shift.module, against.c_str(), shift.shift_mm.norm(), shift.module);
+    }
     s << text;
   }
   if (camera_changes.empty() && split_modules.empty() && closure_modules.empty() && !shared_lens_explains &&
@@ -1425,9 +1440,10 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
       }
       const ModuleShift shift = ExplainModuleShift(rig, target, cameras);
       if (shift.explains && shift.shift_needed) {
-        result.module_shifts.push_back({m, shift.shift_mm});
         for (const CameraChange& lens : shift.lenses) module_lens_changes.push_back(lens);
         for (int c : agreeing) shifted_against[m].insert(ModuleOf(rig, c));
+        result.module_shifts.push_back(
+            {m, shift.shift_mm, {shifted_against[m].begin(), shifted_against[m].end()}, /*which_unknown=*/true});
         named_with_module.insert(mod.left_camera);
         named_with_module.insert(mod.right_camera);
         continue;
@@ -1484,6 +1500,10 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   const ClosureNaming named = NameClosureModules(failed_pairs_of);
   result.closure_modules = named.modules;
   result.closure_which_unknown = named.which_unknown;
+  // A shift is the module's own only where the closures name it alone;
+  // else the modules it was read against may have moved instead.
+  for (CheckResult::ModuleShiftNamed& shift : result.module_shifts)
+    shift.which_unknown = named.which_unknown || named.modules != std::vector<int>{shift.module};
 
   // Every camera's figure fails: a change they all share leaves none
   // unchanged to read the others against, and the naming above names the

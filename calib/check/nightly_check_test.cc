@@ -1295,6 +1295,10 @@ TEST(NightlyCheck, AModuleShiftedBesidesALensOfTheOtherIsNamedWithTheLens) {
     ASSERT_EQ(r.module_shifts.size(), 1u) << r.Explanation();
     EXPECT_EQ(r.module_shifts[0].module, 0);
     EXPECT_NEAR(r.module_shifts[0].shift_mm.norm(), 0.5, 0.05) << r.Explanation();
+    // Module 1 moved: with two modules the shift is module 0's against
+    // module 1, which moved not told.
+    EXPECT_EQ(r.module_shifts[0].relative_to, (std::vector<int>{1}));
+    EXPECT_TRUE(r.module_shifts[0].which_unknown);
     ASSERT_EQ(r.camera_changes.size(), 1u) << r.Explanation();
     // A principal point's shift reads, to first order, as a turn: "lens"
     // or "either", never "moved" alone nor "neither".
