@@ -392,6 +392,9 @@ int RunCheck(int argc, char** argv) {
   report["split_modules"] = result.split_modules;
   // A change every camera shares, or the rig's scale against the board's,
   // where it explains the night (nothing is then named alone).
+  // The cameras named besides a shared change, each in camera_changes
+  // (read against the others with the shared change applied).
+  report["shared_lens_besides"] = result.shared_lens_besides;
   report["shared_lens_change"] = nullptr;
   if (result.shared_lens_explains) {
     const SharedLensChange& shared = result.shared_lens_change;

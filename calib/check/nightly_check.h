@@ -153,6 +153,13 @@ struct CheckResult {
   // each module, "neither a new pose nor a new lens alone explains".
   bool shared_lens_explains = false;
   SharedLensChange shared_lens_change;  // as fitted, where shared_lens_explains
+  // Where a shared change explains every camera but a few (fewer than
+  // half), each of which changed besides: those cameras, each in
+  // camera_changes, read against the others with the shared change
+  // applied (shared_lens_change, fitted without them). All four focal
+  // lengths +0.1 % with camera 2's +0.13 % named camera 1 and camera 2
+  // "neither", camera 1 unchanged but for the shared change.
+  std::vector<int> shared_lens_besides;
   // Otherwise, where with the board at the size every module measures it
   // (their mean, board_scales) all those figures hold: the rig's scale
   // against the board's changed (every baseline and S alike, or a board of
