@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
@@ -288,17 +289,22 @@ int RunCheck(int argc, char** argv) {
   // image taken at another moment). A capture set aside whole is said once,
   // with why: each of its views printed "off the capture's other views"
   // read as if each had slipped alone.
+  // The captures said whole are kept, not read off the entries' order: a
+  // view set aside for its corners' jumps comes before the rest of its
+  // capture going whole, and a whole line said only after another capture's
+  // entry left such a capture unsaid.
   report["views_set_aside"] = nlohmann::json::array();
-  for (size_t k = 0; k < result.views_set_aside.size(); ++k) {
-    const SetAsideView& v = result.views_set_aside[k];
+  std::set<int> said_whole;
+  for (const SetAsideView& v : result.views_set_aside) {
     const auto name = detected.capture_names.find(v.capture);
     const std::string capture = name != detected.capture_names.end() ? name->second : std::to_string(v.capture);
     const bool other_moment = v.why == SetAsideWhy::kOtherMoment;
     const bool whole = v.whole_capture != WholeCapture::kNo;
-    if (whole && (k == 0 || result.views_set_aside[k - 1].capture != v.capture)) {
-      std::string cameras;
+    if (whole && said_whole.insert(v.capture).second) {
+      std::string cameras;  // those that went with the capture (a view set aside before is said on its own)
       for (const SetAsideView& w : result.views_set_aside)
-        if (w.capture == v.capture) cameras += (cameras.empty() ? "cam" : ", cam") + std::to_string(w.camera);
+        if (w.capture == v.capture && w.whole_capture != WholeCapture::kNo)
+          cameras += (cameras.empty() ? "cam" : ", cam") + std::to_string(w.camera);
       std::printf("set aside: capture %s whole (%s): %s; not used\n", capture.c_str(), cameras.c_str(),
                   WholeCaptureText(v).c_str());
     } else if (!whole) {
@@ -386,6 +392,9 @@ int RunCheck(int argc, char** argv) {
   report["split_modules"] = result.split_modules;
   // A change every camera shares, or the rig's scale against the board's,
   // where it explains the night (nothing is then named alone).
+  // The cameras named besides a shared change, each in camera_changes
+  // (read against the others with the shared change applied).
+  report["shared_lens_besides"] = result.shared_lens_besides;
   report["shared_lens_change"] = nullptr;
   if (result.shared_lens_explains) {
     const SharedLensChange& shared = result.shared_lens_change;
@@ -394,12 +403,17 @@ int RunCheck(int argc, char** argv) {
         {"principal_point_px", {shared.principal_point_px.x(), shared.principal_point_px.y()}},
         {"turn_equivalent_deg", shared.turn_equivalent_deg}};
   }
-  // A module that moved as a whole besides a lens of it (module_shift.h).
+  // A module that moved as a whole besides a lens of it (module_shift.h),
+  // against the modules it was read against: which of them moved the
+  // check can tell only where the closures name the module alone (with two
+  // modules, module 1 moved reads as module 0's shift).
   report["module_shifts"] = nlohmann::json::array();
   for (const CheckResult::ModuleShiftNamed& m : result.module_shifts)
     report["module_shifts"].push_back({{"module", m.module},
                                        {"shift_mm", m.shift_mm.norm()},
-                                       {"shift_mm_xyz", {m.shift_mm.x(), m.shift_mm.y(), m.shift_mm.z()}}});
+                                       {"shift_mm_xyz", {m.shift_mm.x(), m.shift_mm.y(), m.shift_mm.z()}},
+                                       {"relative_to", m.relative_to},
+                                       {"which_unknown", m.which_unknown}});
   report["shared_scale"] = nullptr;
   if (result.shared_scale_explains) report["shared_scale"] = result.shared_scale;
 

@@ -18,6 +18,7 @@
 #include <cmath>
 #include <random>
 
+#include "calib/check/shared_lens_change.h"
 #include "calib/core/lens_drift.h"
 #include "datasets/default_rig.h"
 
@@ -186,6 +187,25 @@ TEST(CameraChange, TooFewCornersAreNotFitted) {
             "camera 0 changed: too few corners (5) to fit a new pose or a new lens [module 0's left camera]");
   EXPECT_TRUE(std::isnan(c.turned_deg));  // no fit, no motion
   EXPECT_STREQ(CameraChangeKindName(c.kind), "not_fitted");
+}
+
+// A shared change's principal point printed as +0.01 px reads as a turn of
+// a few ten-thousandths of a degree: the line said "or every camera turned
+// alike by 0.000 deg". The turn is said only where it shows at the
+// precision printed.
+TEST(SharedLensChange, ATurnThatPrintsAsZeroIsNotSaid) {
+  SharedLensChange shared;
+  shared.fitted = true;
+  shared.focal_percent = 0.1;
+  shared.principal_point_px = {0.01, 0};
+  shared.turn_equivalent_deg = 0.0004;  // 0.01 px over a focal length of ~1000 px
+  EXPECT_EQ(shared.Describe(),
+            "every camera's lens changed alike: focal length +0.100 %, principal point +0.01, +0.00 px");
+  shared.principal_point_px = {0.5, 0};
+  shared.turn_equivalent_deg = 0.028;
+  EXPECT_EQ(shared.Describe(),
+            "every camera's lens changed alike: focal length +0.100 %, principal point +0.50, +0.00 px, or every "
+            "camera turned alike by 0.028 deg, as which that shift reads");
 }
 
 }  // namespace

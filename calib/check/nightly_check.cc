@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <map>
 #include <optional>
 #include <set>
@@ -31,8 +32,11 @@ bool CheckResult::ok() const {
 
 std::vector<int> CheckResult::FlaggedCameras() const {
   std::vector<int> cameras;
+  if (shared_lens_explains) {  // every camera, those named besides among them
+    for (int c = 0; c < num_cameras; ++c) cameras.push_back(c);
+    return cameras;
+  }
   for (const CameraChange& c : camera_changes) cameras.push_back(c.camera);
-  for (int c = 0; shared_lens_explains && c < num_cameras; ++c) cameras.push_back(c);
   return cameras;
 }
 
@@ -74,11 +78,23 @@ std::string CheckResult::Explanation() const {
   const std::string board = board_size_note.empty() ? "" : "; " + board_size_note;
   if (ok()) return "every figure within its threshold" + board;
   std::ostringstream s;
-  if (shared_lens_explains)
+  if (shared_lens_explains && shared_lens_besides.empty()) {
     s << shared_lens_change.Describe()
       << " (with it every camera agrees with the others, each module's cameras with each other, and every "
          "closure holds: a change every camera shares, as a temperature change makes, not one camera's or one "
          "module's); ";
+  } else if (shared_lens_explains) {
+    std::string besides;
+    for (size_t k = 0; k < shared_lens_besides.size(); ++k)
+      besides += (k == 0                                ? "camera "
+                  : k + 1 == shared_lens_besides.size() ? " and camera "
+                                                        : ", camera ") +
+                 std::to_string(shared_lens_besides[k]);
+    s << shared_lens_change.Describe() << ", and " << besides
+      << " besides (with the shared change every other camera agrees with the others, each module's cameras "
+         "with each other, and every closure between them holds; "
+      << besides << " read against them): ";
+  }
   if (shared_scale_explains) {
     char text[600];
     std::snprintf(text, sizeof text,
@@ -106,11 +122,26 @@ std::string CheckResult::Explanation() const {
     for (int m : closure_modules) s << "module " << m << " moved or a lens changed; ";
   }
   for (const ModuleShiftNamed& shift : module_shifts) {
-    char text[200];
-    std::snprintf(text, sizeof text,
-                  "module %d's cameras are both off the other modules' by one shift of %.3f mm (the lens changes "
-                  "named aside); ",
-                  shift.module, shift.shift_mm.norm());
+    std::string against;
+    for (size_t k = 0; k < shift.relative_to.size(); ++k)
+      against += (k == 0                              ? ""
+                  : k + 1 == shift.relative_to.size() ? " and "
+                                                      : ", ") +
+                 std::to_string(shift.relative_to[k]);
+    against = (shift.relative_to.size() == 1 ? "module " : "modules ") + against;
+    char text[500];
+    if (shift.which_unknown) {
+      std::snprintf(text, sizeof text,
+                    "module %d's cameras are both off %s's by one shift of %.3f mm (the lens changes named aside): "
+                    "module %d moved against %s, or %s against module %d, which the check cannot tell; ",
+                    shift.module, against.c_str(), shift.shift_mm.norm(), shift.module, against.c_str(),
+                    against.c_str(), shift.module);
+    } else {
+      std::snprintf(text, sizeof text,
+                    "module %d's cameras are both off %s's by one shift of %.3f mm, which agree with each other: "
+                    "module %d moved (the lens changes named aside); ",
+                    shift.module, against.c_str(), shift.shift_mm.norm(), shift.module);
+    }
     s << text;
   }
   if (camera_changes.empty() && split_modules.empty() && closure_modules.empty() && !shared_lens_explains &&
@@ -254,11 +285,13 @@ std::string LostCapturesText(const std::map<int, size_t>& given_captures, const 
     const auto name = capture_names.find(capture);
     std::string why;
     size_t num_set_aside = 0;
+    bool whole_said = false;  // once for the capture, wherever its entries stand (a jump's comes first)
     for (const SetAsideView& v : set_aside) {
       if (v.capture != capture) continue;
       ++num_set_aside;
       if (v.whole_capture != WholeCapture::kNo) {
-        if (num_set_aside == 1) why += "all its views: " + WholeCaptureText(v);  // once, for the whole capture
+        if (!whole_said) why += (why.empty() ? "all its views: " : ", its other views: ") + WholeCaptureText(v);
+        whole_said = true;
         continue;
       }
       char buf[160];
@@ -925,6 +958,69 @@ std::vector<CheckFigure> ClosureFigures(const Inputs& in, const std::set<int>& i
   return figures;
 }
 
+// A change every camera shares besides one camera's own (every principal
+// point +0.5 px, camera 0's +0.8 px): the shared fit, pulled by that
+// camera, explains no night, and the naming read against the unchanged rig
+// named cameras 0 and 3 "neither", camera 3 unchanged but for the shared
+// change. Each camera in turn is left out and the shared change fitted on
+// the others: where with it the others agree (each camera, each module,
+// every closure among them: `explains_night`) and the camera left out is
+// still off them, that camera changed besides. Said only where exactly one
+// camera reads so, and no camera's change alone, the others unchanged,
+// explains the night (the simpler reading, the naming's): "every camera's
+// lens changed alike ..., and camera 0 besides", camera 0 named by what
+// explains its corners against the others with the shared change applied.
+// Otherwise nothing is set: every focal length +0.1 % with camera 2's
+// +0.13 % reads camera 2 or camera 3 besides about as well (the camera
+// left out off the rest by 1.9 and 2.2 times its threshold), and is named
+// as before. (Read against the all-camera fit instead, the camera that
+// changed besides spoils its partner's poses: cameras 2 and 3 both off.)
+template <typename ExplainsNight>
+void NameCameraBesidesASharedLensChange(const Inputs& in, const ExplainsNight& explains_night, CheckResult* result) {
+  const Rig& rig = in.rig;
+  if (rig.num_cameras() < 3) return;
+  auto without = [&](int camera) {
+    std::map<int, std::vector<const BoardObservation*>> rest_by_capture;
+    for (const auto& [capture, vs] : in.by_capture)
+      for (const BoardObservation* v : vs)
+        if (v->camera != camera) rest_by_capture[capture].push_back(v);
+    return rest_by_capture;
+  };
+  // One camera's change alone, the others unchanged, is the simpler
+  // reading, and the naming's: camera 2's principal point +0.5 px read as
+  // "every principal point +0.23 px, and camera 3 besides" (1 seed of 20)
+  // before this.
+  for (int alone = 0; alone < rig.num_cameras(); ++alone)
+    if (explains_night(Inputs{rig, in.target, in.options, without(alone), in.sigma_px, in.u_px, in.seed})) return;
+  std::optional<std::pair<SharedLensChange, CameraChange>> found;
+  for (int besides = 0; besides < rig.num_cameras(); ++besides) {
+    const std::map<int, std::vector<const BoardObservation*>> rest_by_capture = without(besides);
+    std::set<int> rest;
+    for (const auto& [capture, vs] : rest_by_capture)
+      for (const BoardObservation* v : vs) rest.insert(v->camera);
+    const SharedLensChange shared = FitSharedLensChange(rig, in.target, rest_by_capture, in.seed);
+    if (!shared.fitted) continue;
+    const Rig refitted = WithSharedLensChange(rig, shared);
+    if (!explains_night(Inputs{refitted, in.target, in.options, rest_by_capture, in.sigma_px, in.u_px, in.seed}))
+      continue;
+    const Inputs with{refitted, in.target, in.options, in.by_capture, in.sigma_px, in.u_px, in.seed};
+    const Consistency con = CameraConsistency(with, besides, rest);
+    if (con.corners == 0 || con.rms_px <= con.threshold_px) continue;  // the shared change explains it too
+    if (found) return;                                                 // two readings: neither said
+    found.emplace(shared, ExplainCameraChange(refitted, in.target, besides, con.views, con.threshold_px));
+  }
+  if (!found) return;
+  result->camera_changes = {found->second};
+  result->split_modules.clear();
+  result->closure_modules.clear();
+  result->closure_which_unknown = false;
+  result->module_shifts.clear();
+  result->every_camera_fails = false;
+  result->shared_lens_explains = true;
+  result->shared_lens_change = found->first;
+  result->shared_lens_besides = {found->second.camera};
+}
+
 }  // namespace
 
 void RequireCalibrationResiduals(const Rig& rig, const std::string& where) {
@@ -1423,9 +1519,10 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
       }
       const ModuleShift shift = ExplainModuleShift(rig, target, cameras);
       if (shift.explains && shift.shift_needed) {
-        result.module_shifts.push_back({m, shift.shift_mm});
         for (const CameraChange& lens : shift.lenses) module_lens_changes.push_back(lens);
         for (int c : agreeing) shifted_against[m].insert(ModuleOf(rig, c));
+        result.module_shifts.push_back(
+            {m, shift.shift_mm, {shifted_against[m].begin(), shifted_against[m].end()}, /*which_unknown=*/true});
         named_with_module.insert(mod.left_camera);
         named_with_module.insert(mod.right_camera);
         continue;
@@ -1482,6 +1579,10 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   const ClosureNaming named = NameClosureModules(failed_pairs_of);
   result.closure_modules = named.modules;
   result.closure_which_unknown = named.which_unknown;
+  // A shift is the module's own only where the closures name it alone;
+  // else the modules it was read against may have moved instead.
+  for (CheckResult::ModuleShiftNamed& shift : result.module_shifts)
+    shift.which_unknown = named.which_unknown || named.modules != std::vector<int>{shift.module};
 
   // Every camera's figure fails: a change they all share leaves none
   // unchanged to read the others against, and the naming above names the
@@ -1542,6 +1643,8 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
         result.shared_lens_explains = true;
         result.shared_lens_change = shared;
         name_nothing_alone();
+      } else {
+        NameCameraBesidesASharedLensChange(in, explains_night, &result);
       }
     }
     double scale = 0;

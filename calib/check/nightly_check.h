@@ -109,10 +109,18 @@ struct CheckResult {
   // here (its cameras' centres, in the reference frame), and only the
   // cameras whose lens the shift leaves off are in camera_changes. Camera 0's
   // principal point +1 px with module 1 0.5 mm off read cameras 0 and 1
-  // "moved" 0.5 mm, the module pair not named.
+  // "moved" 0.5 mm, the module pair not named. The shift is relative: the
+  // module is the one whose cameras disagree with each other (its lens),
+  // read against `relative_to`, and those may be what moved, by the
+  // opposite shift. Only where the closures name the module alone (three or
+  // more modules, those it is read against agreeing) is it the one that
+  // moved; otherwise `which_unknown` (always so with two modules: module 1
+  // moved reads as module 0's shift).
   struct ModuleShiftNamed {
     int module = -1;
     Eigen::Vector3d shift_mm = Eigen::Vector3d::Zero();
+    std::vector<int> relative_to = {};
+    bool which_unknown = true;
   };
   std::vector<ModuleShiftNamed> module_shifts;
   // Modules whose own two cameras disagree while neither disagrees with the
@@ -145,6 +153,13 @@ struct CheckResult {
   // each module, "neither a new pose nor a new lens alone explains".
   bool shared_lens_explains = false;
   SharedLensChange shared_lens_change;  // as fitted, where shared_lens_explains
+  // Where a shared change explains every camera but a few (fewer than
+  // half), each of which changed besides: those cameras, each in
+  // camera_changes, read against the others with the shared change
+  // applied (shared_lens_change, fitted without them). All four focal
+  // lengths +0.1 % with camera 2's +0.13 % named camera 1 and camera 2
+  // "neither", camera 1 unchanged but for the shared change.
+  std::vector<int> shared_lens_besides;
   // Otherwise, where with the board at the size every module measures it
   // (their mean, board_scales) all those figures hold: the rig's scale
   // against the board's changed (every baseline and S alike, or a board of

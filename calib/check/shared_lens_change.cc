@@ -19,7 +19,10 @@ std::string SharedLensChange::Describe() const {
                 "every camera's lens changed alike: focal length %+.3f %%, principal point %+.2f, %+.2f px",
                 shown(focal_percent, 0.001), shown(principal_point_px.x(), 0.01), shown(principal_point_px.y(), 0.01));
   std::string out = text;
-  if (shown(principal_point_px.x(), 0.01) != 0 || shown(principal_point_px.y(), 0.01) != 0) {
+  // The turn only where it shows at the precision printed: +0.01 px reads
+  // as 0.0004 deg, and "turned alike by 0.000 deg" says nothing.
+  const bool moved = shown(principal_point_px.x(), 0.01) != 0 || shown(principal_point_px.y(), 0.01) != 0;
+  if (moved && shown(turn_equivalent_deg, 0.001) != 0) {
     std::snprintf(text, sizeof text, ", or every camera turned alike by %.3f deg, as which that shift reads",
                   turn_equivalent_deg);
     out += text;

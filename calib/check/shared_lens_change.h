@@ -34,8 +34,9 @@ struct SharedLensChange {
   // night to the check (camera_change.h).
   double turn_equivalent_deg = 0;
   // "every camera's lens changed alike: focal length +0.100 %, principal
-  // point +0.00, +0.00 px"; where the principal point moved, ", or every
-  // camera turned alike by 0.028 deg, as which its shift reads".
+  // point +0.00, +0.00 px"; where the principal point moved by enough to
+  // read as a turn at the precision printed (0.001 deg), ", or every camera
+  // turned alike by 0.028 deg, as which its shift reads".
   std::string Describe() const;
 };
 
