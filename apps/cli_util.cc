@@ -50,10 +50,35 @@ void RefuseEmptyValues(CLI::App& app) {
   }
 }
 
+// Whole-number options read a leading 0 as a decimal zero: CLI11 converts
+// with strtoll's base 0, where 010 is octal 8 and 09 "Could not convert"
+// (a script's zero-padded numbers: simulate --threads 09 refused,
+// --calibration-captures 010 rendered 8). [sign] 0... digits loses its
+// leading zeros before any conversion or check; anything else (0x10, 1.5,
+// words) is left to the option's own reading.
+void ReadLeadingZerosAsDecimal(CLI::App& app) {
+  static const CLI::Validator leading_zeros(
+      [](std::string& text) {
+        const size_t begin = !text.empty() && (text[0] == '-' || text[0] == '+') ? 1 : 0;
+        if (text.size() < begin + 2 || text.find_first_not_of("0123456789", begin) != std::string::npos)
+          return std::string();
+        size_t end = begin;
+        while (end + 1 < text.size() && text[end] == '0') ++end;
+        text.erase(begin, end - begin);
+        return std::string();
+      },
+      "", "LeadingZerosDecimal");
+  for (CLI::Option* option : app.get_options()) {
+    const std::string type = option->get_type_name();
+    if (type.rfind("INT", 0) == 0 || type.rfind("UINT", 0) == 0) option->transform(leading_zeros);
+  }
+}
+
 }  // namespace
 
 std::optional<int> ParseArgs(CLI::App& app, int argc, char** argv) {
   RefuseEmptyValues(app);
+  ReadLeadingZerosAsDecimal(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {

@@ -331,8 +331,8 @@ TEST(SimulateCli, ZeroPaddedSeedsAreDecimal) {
   const std::string dir = ::testing::TempDir() + "/sim_seed_forms";
   fs::remove_all(dir);
   fs::create_directories(dir);
-  for (const auto& [given, recorded] : std::vector<std::pair<std::string, std::string>>{
-           {"010", "10"}, {"08", "8"}, {"0x10", "16"}, {"0010", "10"}}) {
+  for (const auto& [given, recorded] :
+       std::vector<std::pair<std::string, std::string>>{{"010", "10"}, {"08", "8"}, {"0x10", "16"}, {"0010", "10"}}) {
     fs::remove_all(dir + "/ds");
     const Result r = RunCli("simulate --out " + dir + "/ds --no-scenes --calibration-captures 0 --seed " + given);
     ASSERT_EQ(r.code, 0) << given << ": " << r.err;
@@ -347,6 +347,20 @@ TEST(SimulateCli, ZeroPaddedSeedsAreDecimal) {
        {out + " --seed ' 5'", "--seed: must be a whole number"},
        {out + " --seed -1", "--seed: must be >= 0"}},
       dir);
+}
+
+// Every whole-number option reads a leading 0 as a decimal zero, as --seed
+// does: CLI11 took it as octal, so --calibration-captures 010 rendered 8
+// captures and --threads 09 was refused ("Could not convert").
+TEST(SimulateCli, ZeroPaddedCountsAreDecimal) {
+  const std::string dir = ::testing::TempDir() + "/sim_count_forms";
+  fs::remove_all(dir);
+  const Result r = RunCli("simulate --out " + dir + " --no-scenes --calibration-captures 010 --threads 02");
+  ASSERT_EQ(r.code, 0) << r.err;
+  int captures = 0;
+  for (const auto& entry : fs::directory_iterator(dir + "/calibration")) captures += entry.is_directory();
+  EXPECT_EQ(captures, 10);
+  fs::remove_all(dir);
 }
 
 // A project folder holding the user's own spec, its board and notes, given
