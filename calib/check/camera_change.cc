@@ -121,8 +121,6 @@ struct MovedResidual {
   }
 };
 
-double RmsPerAxis(double sum_of_squares, size_t corners) { return std::sqrt(sum_of_squares / (2.0 * corners)); }
-
 // The pose fit's per-axis RMS; *new_from_old its motion (unset if the
 // solve failed).
 double MovedFitRms(const Camera& camera, const Pose& cam_from_ref, const std::vector<Corner>& corners,
@@ -143,6 +141,8 @@ double MovedFitRms(const Camera& camera, const Pose& cam_from_ref, const std::ve
 }
 
 }  // namespace
+
+double RmsPerAxis(double sum_of_squares, size_t corners) { return std::sqrt(sum_of_squares / (2.0 * corners)); }
 
 bool DriftedLensResidual(const Camera& camera, const Eigen::Vector3d& p_cam, const double* lens,
                          const Eigen::Vector2d& q, double* residual) {

@@ -83,6 +83,10 @@ struct PosedView {
   Pose ref_from_front;
 };
 
+// The per-axis RMS of `corners` corners' residuals whose squares sum to
+// sum_of_squares (two axes a corner): the figure every fit here is judged by.
+double RmsPerAxis(double sum_of_squares, size_t corners);
+
 // The residual (px) of a corner at p_cam (the camera's frame) seen at q by
 // `camera` with its lens drifted by lens = (s, dx, dy) (DriftedPixel,
 // calib/core/lens_drift.h), for the Ceres cost functors of the check's fits

@@ -60,7 +60,7 @@ double TurnedFitRms(const std::vector<ShiftedResidual>& corners, const double* t
   ceres::Solve(options, &problem, &summary);
   if (!summary.IsSolutionUsable()) return std::numeric_limits<double>::infinity();
   *turned_deg = Eigen::Vector3d(r[0], r[1], r[2]).norm() * 180 / M_PI;
-  return std::sqrt(2.0 * summary.final_cost / (2.0 * corners.size()));
+  return RmsPerAxis(2.0 * summary.final_cost, corners.size());
 }
 
 }  // namespace
@@ -97,7 +97,7 @@ ModuleShift ExplainModuleShift(const Rig& rig, const Target& target, const std::
       if (!r(t, l, e)) return std::numeric_limits<double>::infinity();
       ss += e[0] * e[0] + e[1] * e[1];
     }
-    return std::sqrt(ss / (2.0 * corners[k].size()));
+    return RmsPerAxis(ss, corners[k].size());
   };
   // First the lenses alone (no shift): where they explain every camera, no
   // shift is needed, and the cameras are named one by one.
