@@ -40,13 +40,15 @@ void OutputPaths::Claim(const std::string& path, const std::string& what, bool c
   // there (a temporary file renamed over the path, calib/core/atomic_file.h).
   const fs::path given_folder = fs::path(path).parent_path();
   const fs::path folder = given_folder.empty() ? fs::path(".") : given_folder;
-  if (check_folder) {
+  // Once per folder: a stream capture's cloud, report and mesh share one.
+  if (check_folder && !writable_folders_.count(folder.lexically_normal())) {
     // access() first (no file made); then a file created and removed
     // there, for what access() cannot tell (root in /sys).
     std::string why = access(folder.c_str(), W_OK | X_OK) != 0 ? std::strerror(errno) : CannotCreateBeside(path);
     if (!why.empty())
       throw InputError(path,
                        "cannot write " + what + " in its folder " + folder.lexically_normal().string() + ": " + why);
+    writable_folders_.insert(folder.lexically_normal());
   }
   if (fs::is_directory(key)) throw InputError(path, "is a folder, not a file to write");
   RequireReplaceableOutput(path);

@@ -9,6 +9,7 @@
 
 #include <filesystem>
 #include <map>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -54,6 +55,7 @@ class OutputPaths {
   std::map<std::filesystem::path, std::string> claimed_;  // normal absolute path -> what writes it
   std::map<std::filesystem::path, std::string> inputs_;   // normal absolute path -> the input it is
   std::map<std::filesystem::path, std::string> folders_;  // folders ClaimFolder will create -> what they hold
+  std::set<std::filesystem::path> writable_folders_;      // folders a Claim found it can write in (as given)
 };
 
 // The --report of a command that reads a rig file and runtime options
