@@ -1471,5 +1471,28 @@ TEST_F(ReconstructCli, ABatchRefusesOneFolderGivenThroughALinkToo) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+// A --report that is a link to a stream (here /proc/self/fd/1, as
+// /dev/stdout is) is refused before any work even when the stream is a file
+// (cron's "--report /dev/stdout >> log"), and the link is left a link: the
+// rename replaced it with the report (as root, /dev/stdout itself). A link
+// in a scratch folder stands for /dev/stdout here.
+TEST_F(ReconstructCli, AReportLinkedToARedirectedStdoutIsRefusedAndTheLinkKept) {
+  const std::string dir = dir_ + "/stdout_link";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::filesystem::create_symlink("/proc/self/fd/1", dir + "/stdout");
+  const int status = std::system(("cd " + dir + " && " + kBin + " reconstruct --rig " + dir_ + "/rig.yaml --capture " +
+                                  dir_ + "/capture --out out.ply --report stdout >>log.txt 2>err.txt")
+                                     .c_str());
+  EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2);
+  std::ifstream err_file(dir + "/err.txt");
+  const std::string err(std::istreambuf_iterator<char>(err_file), {});
+  EXPECT_EQ(testing::Lines(err), 1) << err;
+  EXPECT_NE(err.find("stdout: leads to /proc/self/fd/1 through a symbolic link, in /dev or /proc"), std::string::npos)
+      << err;
+  EXPECT_TRUE(std::filesystem::is_symlink(dir + "/stdout"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out.ply"));
+}
+
 }  // namespace
 }  // namespace stereorig

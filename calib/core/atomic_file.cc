@@ -38,9 +38,49 @@ std::string CannotCreateBeside(const std::string& path) {
   return "";
 }
 
+namespace {
+
+// /dev and /proc hold the system's devices and each process's streams, never
+// an output. /dev/shm is the exception: a folder for files (tmpfs).
+bool InSystemFolder(const std::filesystem::path& absolute) {
+  auto part = absolute.begin();
+  if (part == absolute.end() || *part != "/" || ++part == absolute.end()) return false;
+  if (*part == "proc") return true;
+  return *part == "dev" && !(++part != absolute.end() && *part == "shm");
+}
+
+// The first place on the way from `path` to the file it names that lies in
+// /dev or /proc (InSystemFolder), "" if none: the path itself, as written or
+// with the folders above it resolved, then each symbolic link's target in
+// turn. Whatever the last link points to now does not matter: /dev/stdout,
+// /dev/fd/1 and /proc/self/fd/1 are links to what a stream is at the moment,
+// a log file too when it is redirected (cron's ">> log").
+std::string SystemPlaceOnTheWay(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path p = fs::absolute(path, ec).lexically_normal();
+  for (int hops = 0; !ec && hops < 40; ++hops) {  // 40: the kernel's own limit (ELOOP)
+    if (InSystemFolder(p)) return p.string();
+    const fs::path folder = fs::weakly_canonical(p.parent_path(), ec);
+    if (ec) break;
+    p = folder / p.filename();
+    if (InSystemFolder(p)) return p.string();
+    struct stat st {};
+    if (lstat(p.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) break;
+    const fs::path target = fs::read_symlink(p, ec);
+    p = (folder / target).lexically_normal();  // an absolute target replaces the folder
+  }
+  return "";
+}
+
+}  // namespace
+
 void RequireReplaceableOutput(const std::string& path) {
   if (path == "-")
     throw InputError(path, "outputs are files, not standard output: name the file (./- for a file called '-')");
+  const std::string replaced =
+      ", not a file: an output is written beside its path and renamed over it, which would replace it; name a "
+      "regular file";
   auto kind = [](const struct stat& st) -> const char* {
     return S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
            : S_ISFIFO(st.st_mode)                     ? "a pipe (FIFO)"
@@ -48,18 +88,33 @@ void RequireReplaceableOutput(const std::string& path) {
                                                       : nullptr;
   };
   struct stat st {};
-  if (lstat(path.c_str(), &st) != 0) return;  // nothing there yet (or not looked up: the write names why)
-  const char* what = kind(st);
-  // A link to one (/dev/stdout, /proc/self/fd/1) means that stream: the
-  // rename would replace the link, a system one in /dev.
-  struct stat target {};
-  const bool link_to_stream =
-      what == nullptr && S_ISLNK(st.st_mode) && stat(path.c_str(), &target) == 0 && kind(target) != nullptr;
-  if (link_to_stream) what = kind(target);
-  if (what != nullptr)
-    throw InputError(path, std::string(link_to_stream ? "is a link to " : "is ") + what +
-                               ", not a file: an output is written beside its path and renamed over it, which "
-                               "would replace it; name a regular file");
+  if (lstat(path.c_str(), &st) == 0) {
+    const char* what = kind(st);
+    // A link to one (/dev/stdout, /proc/self/fd/1) means that stream: the
+    // rename would replace the link, a system one in /dev.
+    struct stat target {};
+    const bool link_to_stream =
+        what == nullptr && S_ISLNK(st.st_mode) && stat(path.c_str(), &target) == 0 && kind(target) != nullptr;
+    if (link_to_stream) what = kind(target);
+    if (what != nullptr)
+      throw InputError(path, std::string(link_to_stream ? "is a link to " : "is ") + what + replaced);
+  }
+  // Nothing there yet, or a file or a link to one: refused too if it is, or
+  // leads through, a place in /dev or /proc. A stream redirected to a file
+  // is a link to that file there (/dev/stdout in a cron job's "--report
+  // /dev/stdout >> log"): the rename replaced /dev/stdout itself.
+  const std::string system_place = SystemPlaceOnTheWay(path);
+  if (!system_place.empty()) {
+    std::error_code ec;
+    const bool itself = std::filesystem::path(system_place) == std::filesystem::absolute(path, ec).lexically_normal();
+    const std::string where =
+        itself ? "is in /dev or /proc" : "leads to " + system_place + " through a symbolic link, in /dev or /proc";
+    throw InputError(path, where +
+                               ": they hold the system's devices and the processes' streams (/dev/stdout: whatever "
+                               "standard output is now, a file it is redirected to too), never an output; the rename "
+                               "that writes an output would replace " +
+                               (itself ? "it" : "the link") + ": name a regular file");
+  }
 }
 
 AtomicOutput::AtomicOutput(const std::string& path)

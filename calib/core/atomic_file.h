@@ -15,8 +15,12 @@ namespace stereorig {
 // a rename over it: "-" (a file of that name, where a user means standard
 // output) and an existing device, pipe or socket (/dev/null, a FIFO: the
 // rename would replace the node itself, as root a system device, with a
-// regular file), or a symbolic link to one (/dev/stdout). A link to a file
-// or to nothing is no problem: the rename replaces the link, its target is
+// regular file), or a symbolic link to one (/dev/stdout); and a path in
+// /dev or /proc (but /dev/shm, a folder for files), or one whose links lead
+// through one, whatever the last link points to: /dev/stdout,
+// /proc/self/fd/1 are links to a stream's file too when it is redirected,
+// and the rename replaced /dev/stdout itself. Any other link to a file or
+// to nothing is no problem: the rename replaces the link, its target is
 // left as it was. AtomicOutput checks this; commands
 // check it up front too (apps/output_paths.h), before their work.
 void RequireReplaceableOutput(const std::string& path);

@@ -2,13 +2,16 @@
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "calib/core/input_error_testing.h"
@@ -45,11 +48,12 @@ TEST(AtomicOutputSet, CommitWritesEveryOutput) {
 // they were and no temporary file: not the first output new and the others
 // old. The later output's folder is one where no file can be created, not
 // even by root (as a full disk fails a write, after the earlier output's
-// temporary file is written): /proc.
+// temporary file is written): /sys (/proc is refused before, as a place of
+// streams: RequireReplaceableOutput).
 TEST(AtomicOutputSet, AFailingOutputLeavesEveryEarlierFileAsItWas) {
   const std::string dir = testing::ScratchFolder("atomic_set_fail");
   WriteFileAtomically(dir + "/a.ply", "old cloud");
-  const std::string unwritable = "/proc/stereorig-atomic-set-test.json";
+  const std::string unwritable = "/sys/stereorig-atomic-set-test.json";
   {
     AtomicOutputSet outputs;
     outputs.Add(dir + "/a.ply", "new cloud");
@@ -167,6 +171,51 @@ TEST(WriteFileAtomically, ALinkIsReplacedAndItsTargetLeftAsItWas) {
   EXPECT_FALSE(std::filesystem::is_symlink(dir + "/link.json"));
   EXPECT_EQ(Contents(dir + "/link.json"), "new");
   EXPECT_EQ(Contents(dir + "/target.json"), "old");
+}
+
+// A link into /proc or /dev at an output path is refused whatever it points
+// to now, and left a link: /dev/stdout, /dev/fd/1 and /proc/self/fd/1 are
+// links to a stream's file too, when it is redirected to one (cron's
+// "--report /dev/stdout >> log"), and the rename replaced the link with the
+// report, as root /dev/stdout itself. Tried here on links in a scratch
+// folder to a file this test holds open (never on the real /dev/stdout);
+// a path in /dev or /proc is only checked (RequireReplaceableOutput writes
+// nothing). /dev/shm, a folder for files, is not refused.
+TEST(WriteFileAtomically, ALinkIntoProcOrDevIsRefusedWhateverItPointsTo) {
+  const std::string dir = testing::ScratchFolder("atomic_stream_link");
+  const std::string log = dir + "/log.txt";
+  WriteFileAtomically(log, "log\n");
+  const int fd = open(log.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+  ASSERT_GE(fd, 0);
+  const std::string n = std::to_string(fd);
+  std::filesystem::create_symlink("/proc/self/fd/" + n, dir + "/stdout");  // a stdout redirected to log.txt
+  std::filesystem::create_symlink("/dev/fd/" + n, dir + "/fd");
+  std::filesystem::create_symlink("stdout", dir + "/chain");       // a link to such a link
+  std::filesystem::create_symlink("/proc/self/fd", dir + "/fds");  // a folder link: fds/N
+  const std::pair<std::string, std::string> refused[] = {
+      {dir + "/stdout", "leads to /proc/self/fd/" + n + " through a symbolic link, in /dev or /proc"},
+      {dir + "/fd", "leads to /dev/fd/" + n + " through a symbolic link, in /dev or /proc"},
+      {dir + "/chain", "leads to /proc/self/fd/" + n + " through a symbolic link, in /dev or /proc"},
+      {dir + "/fds/" + n, "leads to /proc/" + std::to_string(getpid()) + "/fd/" + n + " through a symbolic link"}};
+  for (const auto& [path, says] : refused) {
+    const std::string message = testing::InputErrorMessage([&] { WriteFileAtomically(path, "{}"); });
+    EXPECT_NE(message.find(path + ": " + says), std::string::npos) << message;
+    EXPECT_NE(message.find("name a regular file"), std::string::npos) << message;
+  }
+  // The links themselves, a new name in /dev too.
+  for (const std::string& path : {"/proc/self/fd/" + n, "/dev/fd/" + n, std::string("/dev/stereorig-new-output.json")})
+    EXPECT_NE(testing::InputErrorMessage([&] { RequireReplaceableOutput(path); }).find(path + ": is in /dev or /proc"),
+              std::string::npos)
+        << path;
+  close(fd);
+  EXPECT_TRUE(std::filesystem::is_symlink(dir + "/stdout"));
+  EXPECT_TRUE(std::filesystem::is_symlink(dir + "/fd"));
+  EXPECT_TRUE(std::filesystem::is_symlink(dir + "/chain"));
+  EXPECT_EQ(Contents(log), "log\n");
+  EXPECT_EQ(Names(dir), (std::vector<std::string>{"chain", "fd", "fds", "log.txt", "stdout"}));  // no temporary file
+  if (std::filesystem::is_directory("/dev/shm") && !std::filesystem::is_symlink("/dev/shm")) {
+    EXPECT_EQ(testing::InputErrorMessage([&] { RequireReplaceableOutput("/dev/shm/stereorig-output.json"); }), "");
+  }
 }
 
 }  // namespace
