@@ -76,7 +76,7 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
   written.Add(outputs.cloud, EncodeCloudPly(rec.cloud));
   if (mesh) written.Add(outputs.mesh, EncodeMesh(rec.cloud, rec.mesh, outputs.mesh));
   written.Add(outputs.report, JsonReportText(ReconstructionJson(rec)) + "\n");
-  written.Commit();
+  written.Commit(outputs.at_existing);  // the report last: once it is there, so are the others
   nlohmann::json entry;
   entry["capture"] = dir;
   entry["name"] = name;

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "calib/core/atomic_file.h"
 #include "calib/core/rig.h"
 #include "reconstruct/runtime.h"
 
@@ -19,6 +20,10 @@ namespace stereorig {
 // Every file one capture writes: its cloud, its report, its mesh ("" if none).
 struct CaptureOutputs {
   std::string cloud, report, mesh;
+  // A batch's replace an earlier run's files; a stream's never replace a
+  // file, one made after the stream's check that the names were free
+  // included (atomic_file.h AtExisting: the capture is then refused).
+  AtExisting at_existing = AtExisting::kReplace;
 };
 
 // The outputs of the capture named `name` in `out_dir`: <name>.ply,
@@ -39,13 +44,14 @@ std::filesystem::path ResolvedFolder(const std::string& dir);
 std::vector<cv::Mat> LoadCaptureOrInputError(const std::string& dir, const Rig& rig);
 
 // Reconstructs the capture from folder `dir` (its decoded `images`) and
-// writes its outputs, all or none (atomic_file.h AtomicOutputSet; the mesh
-// only if outputs.mesh is set). Prints to stdout, flushed, "<progress> <dir>: N points (fill m0 x%,
-// m1 y%), T ms -> <cloud>" (T: the wall time since `started`, when the
-// capture's turn began: waiting for its images, reconstructing, writing),
-// then a warning line per module whose matches reach an end of the volume's
-// disparity range (module_summary.h RangeEndsWarnedOf), and one per module
-// that gave no point ("  warning: module M gave no point (<report>): <why>",
+// writes its outputs, all or none (atomic_file.h AtomicOutputSet, as
+// outputs.at_existing says; the mesh only if outputs.mesh is set). Prints
+// to stdout, flushed, "<progress> <dir>: N points (fill m0 x%, m1 y%), T ms
+// -> <cloud>" (T: the wall time since `started`, when the capture's turn
+// began: waiting for its images, reconstructing, writing), then a warning
+// line per module whose matches reach an end of the volume's disparity
+// range (module_summary.h RangeEndsWarnedOf), and one per module that gave
+// no point ("  warning: module M gave no point (<report>): <why>",
 // module_summary.h NoPointReason; also on stderr, "stereorig reconstruct:
 // <progress> <dir>: warning: ..."). Returns the capture's entry of the run's
 // summary (capture, name, ok, cloud, mesh, report, points, point_cloud_ms,
@@ -57,7 +63,8 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
 
 // A capture that failed (bad images, outputs that could not be written, a
 // name already used): it has no output, not a partial one nor a stale one
-// from an earlier run (every file of `outputs` that exists is removed),
+// from an earlier run (every file of `outputs` that exists is removed: a
+// batch's; a stream, which never replaces a file, passes none),
 // "stereorig reconstruct: <progress> <why>" goes to stderr and
 // "<progress> <dir>: no output (<why>)" to stdout, flushed. Returns its entry
 // of the summary (capture, name, ok false, error).

@@ -177,18 +177,18 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
     char progress[24];
     std::snprintf(progress, sizeof progress, "[%d]", ++total);
     std::string name;
-    CaptureOutputs outputs;  // set once they are this capture's to write (or to remove)
     std::string error;
     try {
       if (dir.find('\0') != std::string::npos)
         throw InputError("line " + std::to_string(total), "holds a NUL byte: not a folder's path");
       name = StreamOutputName(dir, request.capture_root);
-      const CaptureOutputs planned = CaptureOutputsNamed(request.out_dir, name, request.mesh_format);
-      CheckStreamCapture(dir, name, planned, rig, paths);
+      CaptureOutputs outputs = CaptureOutputsNamed(request.out_dir, name, request.mesh_format);
+      // Checked free below, and committed so that a file made meanwhile
+      // (another stream writing to this --out-dir) is not replaced either:
+      // the capture is then refused.
+      outputs.at_existing = AtExisting::kRefuse;
+      CheckStreamCapture(dir, name, outputs, rig, paths);
       CheckCaptureFiles(dir, rig);
-      // None of them exists (checked above): a failure from here on removes
-      // only what this capture may have written.
-      outputs = planned;
       const std::vector<cv::Mat> images = LoadCaptureOrInputError(dir, rig);
       without_points +=
           !ReconstructCapture(runtime, images, dir, name, outputs, progress, t)["modules_without_points"].empty();
@@ -199,7 +199,10 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
     } catch (const fs::filesystem_error& e) {  // a path the file system cannot look up (a link loop, too long)
       error = dir + ": " + e.code().message();
     }
-    const nlohmann::json entry = FailedCapture(dir, name, outputs, progress, error);
+    // A capture that failed wrote nothing (its outputs are committed all or
+    // none, none over a file): no file of its name is removed, so neither is
+    // one another run wrote there, nor an earlier one the check found.
+    const nlohmann::json entry = FailedCapture(dir, name, CaptureOutputs{}, progress, error);
     if (++failed <= kMaxFailuresListed) summary["failed_captures"].push_back(entry);
     if (StdoutLost(&output_error)) break;
   }

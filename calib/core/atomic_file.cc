@@ -131,11 +131,32 @@ AtomicOutput::~AtomicOutput() {
   pending_.Release();
 }
 
-void AtomicOutput::Commit() {
-  if (std::rename(temp_path_.c_str(), path_.c_str()) != 0) {
-    const std::string err = std::strerror(errno);
+namespace {
+
+// rename(2) that fails with EEXIST if `to` exists (a dangling link too),
+// atomically: renameat2(RENAME_NOREPLACE), or on a file system without it
+// (EINVAL), a hard link, which fails so too, then `from` removed. Returns 0
+// or the errno.
+int RenameWithoutReplacing(const char* from, const char* to) {
+  if (renameat2(AT_FDCWD, from, AT_FDCWD, to, RENAME_NOREPLACE) == 0) return 0;
+  if (errno != EINVAL && errno != ENOSYS) return errno;
+  if (link(from, to) != 0) return errno;
+  unlink(from);
+  return 0;
+}
+
+}  // namespace
+
+void AtomicOutput::Commit(AtExisting existing) {
+  const bool refuse = existing == AtExisting::kRefuse;
+  const int err = refuse ? RenameWithoutReplacing(temp_path_.c_str(), path_.c_str())
+                         : (std::rename(temp_path_.c_str(), path_.c_str()) == 0 ? 0 : errno);
+  if (err != 0) {
     std::remove(temp_path_.c_str());
-    throw InputError(path_, "cannot write: " + err);
+    throw InputError(path_, refuse && err == EEXIST
+                                ? "exists already, not replaced: made after this run found the name free (by "
+                                  "another run writing to the same folder?)"
+                                : std::string("cannot write: ") + std::strerror(err));
   }
   pending_.Release();
   committed_ = true;
@@ -167,7 +188,14 @@ void AtomicOutputSet::Add(const std::string& path, const std::string& bytes) {
   staged_.push_back(std::move(out));
 }
 
-void AtomicOutputSet::Commit() {
+void AtomicOutputSet::Commit(AtExisting existing) {
+  if (existing == AtExisting::kRefuse)
+    CommitNew();
+  else
+    CommitReplacing();
+}
+
+void AtomicOutputSet::CommitReplacing() {
   // What is at each output path now, kept under a second name until every
   // rename is done.
   struct Earlier {
@@ -205,6 +233,26 @@ void AtomicOutputSet::Commit() {
     throw;
   }
   drop_kept();
+  staged_.clear();
+}
+
+void AtomicOutputSet::CommitNew() {
+  // Each temporary file's identity: a failure removes what this set
+  // committed, and only that (not a file another process put there since).
+  std::vector<struct stat> ours(staged_.size());
+  for (size_t i = 0; i < staged_.size(); ++i) lstat(staged_[i]->temp_path().c_str(), &ours[i]);
+  size_t done = 0;
+  try {
+    for (; done < staged_.size(); ++done) staged_[done]->Commit(AtExisting::kRefuse);
+  } catch (...) {
+    for (size_t j = 0; j < done; ++j) {
+      struct stat now {};
+      const std::string& path = staged_[j]->path();
+      if (lstat(path.c_str(), &now) == 0 && now.st_dev == ours[j].st_dev && now.st_ino == ours[j].st_ino)
+        std::remove(path.c_str());
+    }
+    throw;
+  }
   staged_.clear();
 }
 

@@ -35,6 +35,18 @@ std::string CannotCreateBeside(const std::string& path);
 // folder is missing or not writable, or as RequireReplaceableOutput.
 void WriteFileAtomically(const std::string& path, const std::string& bytes);
 
+// What a commit does with a file that is at an output's path by then.
+enum class AtExisting {
+  kReplace,  // the rename's way: the output replaces it
+  // Left as it is, the output refused (InputError "exists already"): for
+  // outputs never to replace, where another process may create the same
+  // name between a check that it is free and the commit (two reconstruct
+  // streams sharing an --out-dir). Committed by renameat2(RENAME_NOREPLACE),
+  // or where the file system has no such rename, a hard link and the
+  // temporary name's removal: either fails if the name exists, atomically.
+  kRefuse,
+};
+
 // For writers that need a path of their own (cv::imwrite, sqlite, ...):
 // write to temp_path(), then Commit(). If Commit() is never called the
 // temporary file is removed.
@@ -49,7 +61,8 @@ class AtomicOutput {
   // writers still work.
   const std::string& temp_path() const { return temp_path_; }
   const std::string& path() const { return path_; }  // the final path
-  void Commit();                                     // renames; throws InputError on failure
+  // Renames; throws InputError on failure, the temporary file removed.
+  void Commit(AtExisting existing = AtExisting::kReplace);
 
  private:
   std::string path_;
@@ -71,9 +84,20 @@ class AtomicOutput {
 class AtomicOutputSet {
  public:
   void Add(const std::string& path, const std::string& bytes);
-  void Commit();  // in the order added; throws InputError on a failed rename, the earlier files put back
+  // In the order added. kReplace: throws InputError on a failed rename, the
+  // earlier files put back. kRefuse: none replaces a file; one that exists
+  // by then refuses the set ("exists already"), and what the commits before
+  // it added is removed (nothing was there before them), so the set leaves
+  // every output path as it was. The first output then decides a race
+  // between two sets of the same names in the same order: the set that
+  // commits it first writes all, the other none; and once the last (a
+  // report) is there, so are the others.
+  void Commit(AtExisting existing = AtExisting::kReplace);
 
  private:
+  void CommitReplacing();
+  void CommitNew();
+
   std::vector<std::unique_ptr<AtomicOutput>> staged_;
 };
 

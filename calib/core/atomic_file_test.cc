@@ -218,5 +218,50 @@ TEST(WriteFileAtomically, ALinkIntoProcOrDevIsRefusedWhateverItPointsTo) {
   }
 }
 
+// Committed without replacing (AtExisting::kRefuse, a reconstruct stream's
+// outputs): a name another process made between this run's check that it
+// is free and the commit is refused, "exists already", and left as it was;
+// what the set committed before it is removed again, so it leaves no output
+// of its own. (Two streams sharing an --out-dir each found a capture's
+// names free, and the later rename silently replaced the other's.)
+TEST(AtomicOutputSet, ACommitThatMustNotReplaceRefusesANameMadeMeanwhile) {
+  const std::string dir = testing::ScratchFolder("atomic_set_no_replace");
+  {
+    AtomicOutputSet outputs;
+    outputs.Add(dir + "/a.ply", "this run's cloud");
+    outputs.Add(dir + "/a.json", "this run's report");
+    WriteFileAtomically(dir + "/a.json", "the other run's report");  // after the check, before the commit
+    const std::string message = testing::InputErrorMessage([&] { outputs.Commit(AtExisting::kRefuse); });
+    EXPECT_NE(message.find(dir + "/a.json: exists already, not replaced"), std::string::npos) << message;
+    EXPECT_EQ(Contents(dir + "/a.json"), "the other run's report");
+    EXPECT_EQ(Names(dir), std::vector<std::string>{"a.json"});  // this run's cloud removed, no temporary file
+  }
+  {
+    // The first output taken: the set writes nothing, the other's files as
+    // they were; a link to nothing is a name taken too (not followed).
+    WriteFileAtomically(dir + "/b.ply", "the other run's cloud");
+    std::filesystem::create_symlink("nothing", dir + "/c.ply");
+    for (const std::string stem : {"/b", "/c"}) {
+      AtomicOutputSet outputs;
+      outputs.Add(dir + stem + ".ply", "this run's cloud");
+      outputs.Add(dir + stem + ".json", "this run's report");
+      EXPECT_NE(testing::InputErrorMessage([&] {
+                  outputs.Commit(AtExisting::kRefuse);
+                }).find(dir + stem + ".ply: exists already, not replaced"),
+                std::string::npos);
+    }
+    EXPECT_EQ(Contents(dir + "/b.ply"), "the other run's cloud");
+    EXPECT_TRUE(std::filesystem::is_symlink(dir + "/c.ply"));
+    EXPECT_EQ(Names(dir), (std::vector<std::string>{"a.json", "b.ply", "c.ply"}));
+  }
+  AtomicOutputSet outputs;  // names that are free: written
+  outputs.Add(dir + "/d.ply", "cloud");
+  outputs.Add(dir + "/d.json", "report");
+  outputs.Commit(AtExisting::kRefuse);
+  EXPECT_EQ(Contents(dir + "/d.ply"), "cloud");
+  EXPECT_EQ(Contents(dir + "/d.json"), "report");
+  EXPECT_EQ(Names(dir), (std::vector<std::string>{"a.json", "b.ply", "c.ply", "d.json", "d.ply"}));
+}
+
 }  // namespace
 }  // namespace stereorig
