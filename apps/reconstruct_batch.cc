@@ -93,6 +93,8 @@ std::vector<CaptureOutputs> PlanOutputs(const std::vector<std::string>& names, c
     const fs::path out = fs::absolute(fs::path(request.out_dir)).lexically_normal();
     if (folder != out && !fs::is_directory(folder)) throw InputError(request.summary_path, "its folder does not exist");
   }
+  AddEarlierMeshes(request.out_dir, request.mesh_format, {request.rig_path, request.options_path, request.summary_path},
+                   &outputs);
   return outputs;
 }
 

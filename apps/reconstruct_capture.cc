@@ -2,6 +2,8 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <set>
+#include <utility>
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
@@ -24,6 +26,23 @@ CaptureOutputs CaptureOutputsNamed(const std::string& out_dir, const std::string
   return {stem + ".ply", stem + ".json", mesh_format.empty() ? "" : stem + ".mesh." + mesh_format};
 }
 
+void AddEarlierMeshes(const std::string& out_dir, const std::string& mesh_format, const std::vector<std::string>& also,
+                      std::vector<CaptureOutputs>* outputs) {
+  std::set<fs::path> used;  // as the file system resolves them
+  for (const std::string& path : also)
+    if (!path.empty()) used.insert(NormalPath(path));
+  for (const CaptureOutputs& o : *outputs)
+    for (const std::string& path : {o.cloud, o.report, o.mesh})
+      if (!path.empty()) used.insert(NormalPath(path));
+  for (CaptureOutputs& o : *outputs) {
+    const std::string name = fs::path(o.cloud).stem().string();  // <name>.ply
+    for (const std::string format : {"ply", "stl"}) {
+      const std::string mesh = CaptureOutputsNamed(out_dir, name, format).mesh;
+      if (format != mesh_format && !used.count(NormalPath(mesh))) o.earlier_only.push_back(mesh);
+    }
+  }
+}
+
 fs::path ResolvedFolder(const std::string& dir) {
   fs::path p = NormalPath(dir);  // links followed as far as they resolve (calib/core/folder_to_create.h)
   if (!p.has_filename()) p = p.parent_path();
@@ -41,6 +60,18 @@ std::vector<cv::Mat> LoadCaptureOrInputError(const std::string& dir, const Rig& 
 }
 
 namespace {
+
+// Removes each of `paths` that exists ("" skipped; a folder too, which no
+// run wrote: a file only). Returns those that could not be removed, with why.
+std::vector<std::pair<std::string, std::string>> RemoveEarlierFiles(const std::vector<std::string>& paths) {
+  std::vector<std::pair<std::string, std::string>> left;
+  for (const std::string& path : paths) {
+    std::error_code ec;
+    if (path.empty() || fs::is_directory(fs::symlink_status(path, ec)) || fs::remove(path, ec) || !ec) continue;
+    left.emplace_back(path, ec.message());
+  }
+  return left;
+}
 
 // A module that gave no point (its lasers off, a camera not triggered, its
 // cables swapped) is a capture that measured nothing there, not a
@@ -77,6 +108,9 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
   if (mesh) written.Add(outputs.mesh, EncodeMesh(rec.cloud, rec.mesh, outputs.mesh));
   written.Add(outputs.report, JsonReportText(ReconstructionJson(rec)) + "\n");
   written.Commit(outputs.at_existing);  // the report last: once it is there, so are the others
+  // An earlier run's mesh of the other format would sit beside this cloud as
+  // if it were its mesh.
+  const std::vector<std::pair<std::string, std::string>> left = RemoveEarlierFiles(outputs.earlier_only);
   nlohmann::json entry;
   entry["capture"] = dir;
   entry["name"] = name;
@@ -98,6 +132,13 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
   // line is (PrintableText).
   std::printf("%s %s: %zu points (fill %s), %.0f ms -> %s\n", progress.c_str(), PrintableText(dir).c_str(),
               rec.cloud.size(), fills.c_str(), wall_ms, PrintableText(outputs.cloud).c_str());
+  for (const auto& [path, why] : left) {
+    entry["left_behind"].push_back(path);
+    std::printf("  warning: %s (an earlier run's) could not be removed: %s\n", PrintableText(path).c_str(),
+                why.c_str());
+    std::fprintf(stderr, "stereorig reconstruct: %s %s: warning: %s (an earlier run's) could not be removed: %s\n",
+                 progress.c_str(), PrintableText(dir).c_str(), PrintableText(path).c_str(), why.c_str());
+  }
   // The one-capture summary's warning (module_summary.h), in a line per
   // module: a batch or a stream is what a line runs.
   for (const ModuleReport& m : rec.modules) {
@@ -118,12 +159,12 @@ nlohmann::json FailedCapture(const std::string& dir, const std::string& name, co
   // An earlier run's files of this name removed first (a batch's: it
   // replaces them), so that the lines below are true when printed; one that
   // cannot be removed is named in them and in the entry, not passed over.
+  std::vector<std::string> paths = {outputs.cloud, outputs.report, outputs.mesh};
+  paths.insert(paths.end(), outputs.earlier_only.begin(), outputs.earlier_only.end());
   std::string left_behind;
   nlohmann::json left = nlohmann::json::array();
-  for (const std::string& path : {outputs.cloud, outputs.report, outputs.mesh}) {
-    std::error_code ec;
-    if (path.empty() || fs::remove(path, ec) || !ec) continue;
-    left_behind += "; " + path + " (an earlier output) could not be removed: " + ec.message();
+  for (const auto& [path, why] : RemoveEarlierFiles(paths)) {
+    left_behind += "; " + path + " (an earlier output) could not be removed: " + why;
     left.push_back(path);
   }
   std::fprintf(stderr, "stereorig reconstruct: %s %s%s\n", progress.c_str(), PrintableText(why).c_str(),

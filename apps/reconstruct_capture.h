@@ -24,11 +24,24 @@ struct CaptureOutputs {
   // file, one made after the stream's check that the names were free
   // included (atomic_file.h AtExisting: the capture is then refused).
   AtExisting at_existing = AtExisting::kReplace;
+  // Files of the capture's name an earlier run may have left that this run
+  // does not write (AddEarlierMeshes), removed with the capture's outputs,
+  // written or failed, so that none is taken for this run's: a batch's.
+  std::vector<std::string> earlier_only{};
 };
 
 // The outputs of the capture named `name` in `out_dir`: <name>.ply,
 // <name>.json and, unless mesh_format is "", <name>.mesh.<mesh_format>.
 CaptureOutputs CaptureOutputsNamed(const std::string& out_dir, const std::string& name, const std::string& mesh_format);
+
+// Sets each capture's earlier_only to the meshes an earlier run may have
+// written for its name (outputs[i].cloud's, in out_dir) that a run of
+// `mesh_format` does not: <name>.mesh.stl with ply, <name>.mesh.ply with
+// stl, both with "" (no mesh); but none that is a file this run writes (one
+// of `outputs`: folders "x" and "x.mesh" without --mesh-format, x.mesh.ply
+// is a cloud) or one of `also` (its inputs and summary; "" ignored). A batch's.
+void AddEarlierMeshes(const std::string& out_dir, const std::string& mesh_format, const std::vector<std::string>& also,
+                      std::vector<CaptureOutputs>* outputs);
 
 // The folder `dir` as the file system finds it (NormalPath,
 // calib/core/folder_to_create.h: absolute, links followed; a part that does
@@ -43,12 +56,15 @@ std::filesystem::path ResolvedFolder(const std::string& dir);
 // std::filesystem error, here an InputError.
 std::vector<cv::Mat> LoadCaptureOrInputError(const std::string& dir, const Rig& rig);
 
-// Reconstructs the capture from folder `dir` (its decoded `images`) and
+// Reconstructs the capture from folder `dir` (its decoded `images`),
 // writes its outputs, all or none (atomic_file.h AtomicOutputSet, as
-// outputs.at_existing says; the mesh only if outputs.mesh is set). Prints
-// to stdout, flushed, "<progress> <dir>: N points (fill m0 x%, m1 y%), T ms
-// -> <cloud>" (T: the wall time since `started`, when the capture's turn
-// began: waiting for its images, reconstructing, writing), then a warning
+// outputs.at_existing says; the mesh only if outputs.mesh is set), then
+// removes the files of outputs.earlier_only. Prints to stdout, flushed,
+// "<progress> <dir>: N points (fill m0 x%, m1 y%), T ms -> <cloud>" (T: the
+// wall time since `started`, when the capture's turn began: waiting for its
+// images, reconstructing, writing), then a line per earlier_only file that
+// could not be removed ("  warning: <path> (an earlier run's) could not be
+// removed: <why>", also on stderr; the entry's left_behind), then a warning
 // line per module whose matches reach an end of the volume's disparity
 // range (module_summary.h RangeEndsWarnedOf), and one per module that gave
 // no point ("  warning: module M gave no point (<report>): <why>",
@@ -63,8 +79,9 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
 
 // A capture that failed (bad images, outputs that could not be written, a
 // name already used): it has no output, not a partial one nor a stale one
-// from an earlier run (every file of `outputs` that exists is removed: a
-// batch's; a stream, which never replaces a file, passes none),
+// from an earlier run (every file of `outputs` that exists is removed, its
+// earlier_only too: a batch's; a stream, which never replaces a file,
+// passes none),
 // "stereorig reconstruct: <progress> <why>" goes to stderr and
 // "<progress> <dir>: no output (<why>)" to stdout, flushed. Returns its entry
 // of the summary (capture, name, ok false, error).

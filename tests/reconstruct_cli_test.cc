@@ -1494,5 +1494,51 @@ TEST_F(ReconstructCli, AReportLinkedToARedirectedStdoutIsRefusedAndTheLinkKept) 
   EXPECT_FALSE(std::filesystem::exists(dir + "/out.ply"));
 }
 
+// A batch's capture, written or failed, leaves no earlier run's mesh of its
+// name beside this run's outputs: neither one of the other format than this
+// run's --mesh-format, nor either without one. (An earlier <name>.mesh.stl
+// stayed beside the new <name>.ply, or as the only file of a failed
+// capture, although the run promises "an earlier run's files of its name
+// are removed, so none is mistaken for this run's".) A file this run writes
+// stays: folders "bad" and "bad.mesh" without --mesh-format, bad.mesh.ply is
+// a cloud.
+TEST_F(ReconstructCli, ABatchRemovesAnEarlierRunsMeshOfTheOtherFormat) {
+  const std::string root = dir_ + "/batch_mesh";
+  std::filesystem::remove_all(root);
+  std::filesystem::create_directories(root);
+  for (const char* name : {"good", "bad", "bad.mesh"}) std::filesystem::copy(dir_ + "/capture", root + "/" + name);
+  WriteFileAtomically(root + "/bad/cam1.png", "not a png");  // found only when decoded
+  const std::string out = root + "/out";
+  auto earlier_run = [&] {
+    std::filesystem::remove_all(out);
+    std::filesystem::create_directories(out);
+    for (const char* name : {"good", "bad"})
+      for (const char* ext : {".ply", ".json", ".mesh.ply", ".mesh.stl"})
+        WriteFileAtomically(out + "/" + name + ext, "earlier run");
+  };
+  auto names = [&] {
+    std::vector<std::string> found;
+    for (const auto& e : std::filesystem::directory_iterator(out)) found.push_back(e.path().filename());
+    std::sort(found.begin(), found.end());
+    return found;
+  };
+  const std::string head = "reconstruct --rig " + dir_ + "/rig.yaml --out-dir " + out + " --capture ";
+  earlier_run();
+  testing::Result r = testing::RunCli(head + root + "/good " + root + "/bad --mesh-format ply");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(names(), (std::vector<std::string>{"good.json", "good.mesh.ply", "good.ply"})) << r.out;
+  earlier_run();
+  r = testing::RunCli(head + root + "/good " + root + "/bad");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(names(), (std::vector<std::string>{"good.json", "good.ply"})) << r.out;
+  earlier_run();
+  r = testing::RunCli(head + root + "/bad.mesh " + root + "/bad");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(names(), (std::vector<std::string>{"bad.mesh.json", "bad.mesh.ply", "good.json", "good.mesh.ply",
+                                               "good.mesh.stl", "good.ply"}))
+      << r.out;
+  EXPECT_GT(std::filesystem::file_size(out + "/bad.mesh.ply"), 1000000u);  // the cloud this run wrote
+}
+
 }  // namespace
 }  // namespace stereorig
