@@ -90,6 +90,7 @@ SurfaceBeyondBand Judge(const Cells& cells, double band_mm, const std::function<
   const int n = static_cast<int>(cells.on.size());
   std::vector<char> seen(n, 0);
   out.nearest_mm = std::numeric_limits<double>::infinity();
+  std::vector<int> found;  // the points of the groups kept, with repeats
   for (int start = 0; start < n; ++start) {
     if (seen[start] || !displaced(start)) continue;
     std::vector<int> group = {start}, rim;
@@ -109,28 +110,49 @@ SurfaceBeyondBand Judge(const Cells& cells, double band_mm, const std::function<
     if (measured_around == 0 || measured_around < kMeasuredAroundFraction * static_cast<double>(rim.size()) ||
         held < kSurroundedFraction * static_cast<double>(measured_around))
       continue;
-    // The group's points, and those of its layer in the cells around it
-    // (the patch's edge runs through them, among the surface's points):
-    // within the group's range of offsets, widened by a tenth of the band
-    // for the noise's extremes (a 0.05 mm noise's are 0.25 mm out).
+    // The group's points, and those of its layer beyond it: the layer runs
+    // on through cells that also hold some surface (a patch's edge, the
+    // cells about a sphere's pole that a patch covers but for a strip),
+    // taken where they hold as many of its points as a cell of surface
+    // holds, and into the cells around those. A layer point is within the
+    // group's range of offsets, widened by a tenth of the band for the
+    // noise's extremes (a 0.05 mm noise's are 0.25 mm out).
     double lo_mm = std::numeric_limits<double>::infinity(), hi_mm = -lo_mm;
     for (int cell : group)
       for (int i : cells.beyond[cell]) {
         lo_mm = std::min(lo_mm, off_mm(i));
         hi_mm = std::max(hi_mm, off_mm(i));
       }
-    auto count = [&](int i) {
-      const double off = std::abs(off_mm(i));
-      ++out.points;
-      out.nearest_mm = std::min(out.nearest_mm, off);
-      out.farthest_mm = std::max(out.farthest_mm, off);
+    auto in_layer = [&](int i) {
+      return off_mm(i) >= lo_mm - kLayerEdgeOfBand * band_mm && off_mm(i) <= hi_mm + kLayerEdgeOfBand * band_mm;
     };
-    for (int cell : group)
-      for (int i : cells.beyond[cell]) count(i);
-    for (int cell : rim)
+    auto layer_points = [&](int cell) {
+      return std::count_if(cells.beyond[cell].begin(), cells.beyond[cell].end(), in_layer);
+    };
+    std::vector<int> region = group;
+    std::vector<char> in_region(n, 0);
+    for (int cell : group) in_region[cell] = 1;
+    for (size_t k = 0; k < region.size(); ++k)
+      for (int next : cells.Around(region[k])) {
+        if (in_region[next] || cells.ignored[next] || static_cast<double>(layer_points(next)) < enough) continue;
+        in_region[next] = 1;
+        region.push_back(next);
+      }
+    std::vector<int> around = region;
+    for (int cell : region)
+      for (int next : cells.Around(cell))
+        if (!in_region[next] && !cells.ignored[next]) around.push_back(next);
+    for (int cell : around)
       for (int i : cells.beyond[cell])
-        if (off_mm(i) >= lo_mm - kLayerEdgeOfBand * band_mm && off_mm(i) <= hi_mm + kLayerEdgeOfBand * band_mm)
-          count(i);
+        if (in_layer(i)) found.push_back(i);
+  }
+  // Each point once: two groups may share a cell around them.
+  std::sort(found.begin(), found.end());
+  found.erase(std::unique(found.begin(), found.end()), found.end());
+  out.points = static_cast<int>(found.size());
+  for (int i : found) {
+    out.nearest_mm = std::min(out.nearest_mm, std::abs(off_mm(i)));
+    out.farthest_mm = std::max(out.farthest_mm, std::abs(off_mm(i)));
   }
   if (!out.found()) out.nearest_mm = 0;
   return out;

@@ -2060,5 +2060,29 @@ TEST(Vdi2634, APatchOfThePlateBeyondTheCaptureBandIsNotPassed) {
   EXPECT_NE(reason.find("off the plate's face"), std::string::npos) << reason;
 }
 
+// On a ball bar too. Truth: balls of 25.4 mm 100 mm apart along x, each seen
+// from both sides (70-degree caps about -z and +z, 0.4 mm apart, noise
+// sigma = 0.05 mm), ball 2's points within 25 degrees of -z (outside the
+// shaft's cone about x) moved radially by 6 mm: not passed, the reason
+// naming ball 2 and every moved point.
+TEST(Vdi2634, APatchOfABallBeyondTheCaptureBandIsNotPassed) {
+  std::mt19937 rng(14);
+  const Eigen::Vector3d c1(-50, 0, 300), c2(50, 0, 300);
+  auto bar = BallSeenFromBothSides(c1, 12.7, 0.05, &rng);
+  auto ball2 = BallSeenFromBothSides(c2, 12.7, 0.05, &rng);
+  int moved = 0;
+  for (auto& p : ball2) {
+    const Eigen::Vector3d u = (p - c2).normalized();
+    if (u.dot(Eigen::Vector3d(0, 0, -1)) < std::cos(25 * kPi / 180)) continue;
+    p += 6.0 * u;
+    ++moved;
+  }
+  bar.insert(bar.end(), ball2.begin(), ball2.end());
+  const ArtifactEvaluation e = EvaluateArtifact(BallBarArtifact(), bar, VerifyOptions(), "bar.ply");
+  const std::string reason = NotJudgedReason(e);
+  EXPECT_NE(reason.find(std::to_string(moved) + " points lie "), std::string::npos) << moved << ": " << reason;
+  EXPECT_NE(reason.find("off ball 2's surface"), std::string::npos) << reason;
+}
+
 }  // namespace
 }  // namespace stereorig
