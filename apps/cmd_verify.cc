@@ -265,8 +265,10 @@ int RunVerify(int argc, char** argv) {
   const bool judged_failure = std::any_of(positions.begin(), positions.end(),
                                           [](const ArtifactEvaluation& e) { return e.judged() && !e.pass(); });
 
-  std::printf("artifact: %s (%s); capture band %.1f mm\n", artifact.name.c_str(), ArtifactTypeName(artifact.type),
-              positions.front().capture_band_mm);
+  // The name is the file's text: escaped as every error line is, so a name
+  // holding a line break cannot print a line of its own ("verdict: PASS").
+  std::printf("artifact: %s (%s); capture band %.1f mm\n", PrintableText(artifact.name).c_str(),
+              ArtifactTypeName(artifact.type), positions.front().capture_band_mm);
   // A band asked for below the floor is raised to it: said, or a band of
   // 1 mm read as used while 3 mm was.
   if (positions.front().capture_band_mm > options.capture_band_mm) {
@@ -280,11 +282,28 @@ int RunVerify(int argc, char** argv) {
   // The same cloud given twice, or a byte-identical copy of it, is one
   // position, not two (the standard asks for positions that differ): said,
   // not refused (a test may repeat one).
-  const std::vector<RepeatedPosition> repeated = RepeatedPositions(clouds);
+  // A copy re-saved in another encoding (ASCII, big-endian) has other bytes
+  // but the same fit: one measurement too (it counted as a new position).
+  std::vector<RepeatedPosition> repeated = RepeatedPositions(clouds);
+  std::vector<std::vector<double>> fitted_mm(positions.size());
+  for (size_t i = 0; i < positions.size(); ++i)
+    for (size_t k = 0; k < positions[i].sphere_centers_mm.size(); ++k) {
+      const Eigen::Vector3d& c = positions[i].sphere_centers_mm[k];
+      fitted_mm[i].insert(fitted_mm[i].end(), {c.x(), c.y(), c.z(), positions[i].sphere_diameters_mm[k]});
+    }
+  MarkSameFits(fitted_mm, &repeated);
   int distinct_positions = 0;
   for (size_t i = 0; i < clouds.size(); ++i) {
     if (repeated[i].earlier < 0) {
       ++distinct_positions;
+      continue;
+    }
+    if (repeated[i].same_fit) {
+      std::printf(
+          "note: position %zu (%s) is the same measurement as position %d: its fitted centres and diameters agree "
+          "with that one's within %g mm (the same cloud re-saved in another encoding?): the standard asks for "
+          "positions that differ\n",
+          i + 1, PrintableText(clouds[i]).c_str(), repeated[i].earlier + 1, kSameFitMm);
       continue;
     }
     std::printf("note: position %zu is %s position %d (%s): the standard asks for positions that differ\n", i + 1,

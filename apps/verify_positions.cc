@@ -1,6 +1,7 @@
 #include "apps/verify_positions.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -50,6 +51,24 @@ std::vector<RepeatedPosition> RepeatedPositions(const std::vector<std::string>& 
     }
   }
   return repeated;
+}
+
+void MarkSameFits(const std::vector<std::vector<double>>& fitted_mm, std::vector<RepeatedPosition>* repeated) {
+  auto same_fit = [&](size_t i, size_t j) {
+    if (fitted_mm[i].empty() || fitted_mm[i].size() != fitted_mm[j].size()) return false;
+    for (size_t k = 0; k < fitted_mm[i].size(); ++k)
+      if (!(std::abs(fitted_mm[i][k] - fitted_mm[j][k]) <= kSameFitMm)) return false;
+    return true;
+  };
+  for (size_t i = 1; i < fitted_mm.size() && i < repeated->size(); ++i) {
+    if ((*repeated)[i].earlier >= 0) continue;
+    for (size_t j = 0; j < i; ++j) {
+      if ((*repeated)[j].earlier >= 0 || !same_fit(i, j)) continue;
+      (*repeated)[i].earlier = static_cast<int>(j);
+      (*repeated)[i].same_fit = true;
+      break;
+    }
+  }
 }
 
 }  // namespace stereorig

@@ -1321,3 +1321,189 @@ TEST(VerifyCli, NamesWhatIsWrongWithABrokenMeshOrCloud) {
     EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
   }
 }
+
+namespace {
+
+// A ball's or sphere's points on random directions of a cap (SphereCapSurface),
+// Gaussian radial noise: what the tests below measure.
+std::vector<Eigen::Vector3d> NoisyCap(const Eigen::Vector3d& centre, const Eigen::Vector3d& axis, double r_mm,
+                                      double half_angle_deg, int count, double noise_mm, std::mt19937* rng) {
+  return stereorig::testing::NoisySurfaceSamples(
+      stereorig::testing::SphereCapSurface(centre, axis, r_mm, half_angle_deg), count, noise_mm, rng);
+}
+
+// A patch of the sphere measured beyond the 5 mm capture band did not count
+// (a user's walkthrough: the demo's sphere with its points x > cx + 10 mm
+// moved 3.5 mm read P_F 3.60 FAIL, moved 5.5 mm P_F 0.34 PASS, a larger
+// error passing). Truth: the certified sphere (r 19.05 mm) seen from both
+// sides (80-degree caps about -z and +z, 20 000 points each, noise 0.05 mm),
+// its points within 30 degrees of the x axis moved radially by h. At 3.5 mm
+// in the band: FAIL (exit 1), P_F >= 3.5. At 5.5 and 7 mm beyond it: not
+// passed: NOT JUDGED (exit 2), naming the moved points (counted from the
+// truth) and the capture band.
+TEST(VerifyCli, APatchBeyondTheCaptureBandDoesNotPass) {
+  const Eigen::Vector3d c(0, 0, 220);
+  for (const double h : {3.5, 5.5, 7.0}) {
+    std::mt19937 rng(31);
+    auto pts = NoisyCap(c, {0, 0, -1}, 19.05, 80, 20000, 0.05, &rng);
+    const auto back = NoisyCap(c, {0, 0, 1}, 19.05, 80, 20000, 0.05, &rng);
+    pts.insert(pts.end(), back.begin(), back.end());
+    int moved = 0;
+    for (Eigen::Vector3d& p : pts) {
+      const Eigen::Vector3d u = (p - c).normalized();
+      if (u.x() < std::cos(30 * M_PI / 180)) continue;
+      p += h * u;
+      ++moved;
+    }
+    const std::string cloud = WritePoints("patch_beyond_band", pts);
+    const auto r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + cloud);
+    SCOPED_TRACE(::testing::Message() << moved << " points moved " << h << " mm");
+    EXPECT_EQ(r.out.find("verdict: PASS"), std::string::npos) << r.out;
+    if (h < 5) {
+      EXPECT_EQ(r.code, 1) << r.out << r.err;
+    } else {
+      EXPECT_EQ(r.code, 2) << r.out << r.err;
+      EXPECT_NE(r.out.find("1        NOT JUDGED: " + std::to_string(moved) + " points lie "), std::string::npos)
+          << r.out;
+      EXPECT_NE(r.out.find("beyond the 5.0 mm capture band"), std::string::npos) << r.out;
+    }
+    std::filesystem::remove(cloud);
+  }
+}
+
+// A ball bar certificate whose centre distance is not the bar's is not
+// judged against it (a 200 mm certificate for the demo's 80 mm bar read SD
+// -119.97 mm "nonconformance", FAIL, exit 1): not evaluated, exit 2, both
+// distances named, as a sphere 10% off its certified size is. Within 10% an
+// SD is judged: 85 mm certified for the 80 mm bar fails SD by ~5 mm, exit 1.
+// Truth: balls of 25.4 mm 80 mm apart, 80-degree caps of 8000 points, noise
+// 0.03 mm (the centres fit to ~0.01 mm: printed to 0.01 mm, 80.00 within
+// one digit).
+TEST(VerifyCli, ACentreDistanceFarFromTheBarsIsNotJudged) {
+  std::mt19937 rng(32);
+  std::vector<Eigen::Vector3d> pts;
+  for (const Eigen::Vector3d& c : {Eigen::Vector3d(-40, 0, 200), Eigen::Vector3d(40, 0, 200)}) {
+    const auto ball = NoisyCap(c, {0, 0, -1}, 12.7, 80, 8000, 0.03, &rng);
+    pts.insert(pts.end(), ball.begin(), ball.end());
+  }
+  const std::string cloud = WritePoints("ballbar_80", pts);
+  const std::string head =
+      "format: stereorig-artifact\nversion: 1\nunits: mm\ntype: ballbar\nsphere_diameter_mm: 25.4\n";
+  auto r = RunCli("verify --artifact " + WriteArtifact(head + "center_distance_mm: 200\n") + " --cloud " + cloud);
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_EQ(r.out.find("nonconformance"), std::string::npos) << r.out;
+  EXPECT_TRUE(std::regex_search(r.err, std::regex("the balls are 80\\.0[01] mm apart \\(centre to centre\\) and the "
+                                                  "certificate says 200\\.00 mm")))
+      << r.err;
+  r = RunCli("verify --artifact " + WriteArtifact(head + "center_distance_mm: 85\n") + " --cloud " + cloud);
+  EXPECT_EQ(r.code, 1) << r.out << r.err;
+  std::filesystem::remove(cloud);
+}
+
+// A cloud of another artifact is said not to look like this one, however
+// much of it is seen: a ball bar given against a sphere's file (its ball and
+// rod fitted as one sphere over a 63-degree cap) read "a cap this small fits
+// a diameter only to +-1.94 mm: measure more of it". And both balls of the
+// right bar read against a certificate of the wrong diameter named "a scale
+// -33% off", though the centres lay 80 mm apart as certified: a scale error
+// would have moved them too. Truth: balls of 25.4 mm 80 mm apart seen by one
+// module from below (70-degree caps, 8000 points each, the demo's noise
+// shared by neighbouring points: a 0.05 mm field on a 1 mm lattice plus
+// 0.01 mm independent) and the rod (4 mm radius) between them, its lower
+// half every 0.3 mm. Before, the first read "a cap this small fits a
+// diameter only to +-1.43 mm" over a 57-degree cap, the second "a scale
+// -33% off".
+TEST(VerifyCli, AnotherArtifactIsNotAskedToBeMeasuredMoreNorBlamedOnScale) {
+  std::mt19937 rng(33);
+  std::vector<Eigen::Vector3d> pts;
+  for (const Eigen::Vector3d& c : {Eigen::Vector3d(-40, 0, 200), Eigen::Vector3d(40, 0, 200)}) {
+    const auto cap = stereorig::testing::CorrelatedNoiseSamples(
+        stereorig::testing::SphereCapSurface(c, {0, 0, -1}, 12.7, 70), 8000, 0.05, 1.0, 0.01, &rng);
+    pts.insert(pts.end(), cap.begin(), cap.end());
+  }
+  for (double x = -40 + 12; x <= 40 - 12; x += 0.3)
+    for (double t = M_PI; t < 2 * M_PI; t += 0.3 / 4) pts.push_back({x, 4 * std::cos(t), 200 + 4 * std::sin(t)});
+  const std::string cloud = WritePoints("ballbar_rod", pts);
+  auto r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + cloud);
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_EQ(r.err.find("measure more of it"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the cloud does not look like this artifact"), std::string::npos) << r.err;
+  r = RunCli("verify --artifact " +
+             WriteArtifact("format: stereorig-artifact\nversion: 1\nunits: mm\ntype: ballbar\n"
+                           "sphere_diameter_mm: 38.1\ncenter_distance_mm: 80\n") +
+             " --cloud " + cloud);
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_EQ(r.err.find("measured at a scale"), std::string::npos) << r.err;
+  std::filesystem::remove(cloud);
+}
+
+// A certificate's uncertainty has a plausible range as its sizes do (0 to
+// 100 mm), refused naming the key and the unit it looks like: 1e308 printed
+// a 300-digit figure, and 2000 (um typed as mm) was taken.
+TEST(VerifyCli, ImplausibleCertificateUncertaintiesAreRefusedWithTheUnit) {
+  const std::string good = WriteSphere("good_u_range.ply", 19.05);
+  const std::string head = "format: stereorig-artifact\nversion: 1\nunits: mm\ntype: sphere\ndiameter_mm: 38.1\n";
+  auto r = RunCli("verify --artifact " + WriteArtifact(head + "form_uncertainty_mm: 1e308\n") + " --cloud " + good);
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_EQ(r.out, "");
+  EXPECT_NE(r.err.find("form_uncertainty_mm: 1e+308 mm is not a plausible certificate's expanded uncertainty (0 "
+                       "to 100 mm)\n"),
+            std::string::npos)
+      << r.err;
+  r = RunCli("verify --artifact " + WriteArtifact(head + "diameter_uncertainty_mm: 2000\n") + " --cloud " + good);
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("diameter_uncertainty_mm: 2000 mm is not a plausible certificate's expanded uncertainty (0 "
+                       "to 100 mm): in micrometres it would be 2 mm (the file's units are mm)"),
+            std::string::npos)
+      << r.err;
+  r = RunCli("verify --artifact " + WriteArtifact(head + "diameter_uncertainty_mm: 0.002\n") + " --cloud " + good);
+  EXPECT_EQ(r.code, 0) << r.out << r.err;
+}
+
+// The artifact's name is the file's text: a line break in it printed a line
+// of its own, and `name: "S\nverdict: PASS"` put a fake verdict in a FAIL
+// table. Escaped as \xNN as every error line is.
+TEST(VerifyCli, AnArtifactNameCannotPrintALineOfItsOwn) {
+  const std::string big = WriteSphere("big_name.ply", 19.05 + 0.8);  // P_S 1.6 mm: FAIL
+  const auto r = RunCli("verify --artifact " +
+                        WriteArtifact("format: stereorig-artifact\nversion: 1\nunits: mm\nname: \"S\\nverdict: "
+                                      "PASS\"\ntype: sphere\ndiameter_mm: 38.1\n") +
+                        " --cloud " + big);
+  EXPECT_EQ(r.code, 1) << r.out << r.err;
+  EXPECT_EQ(r.out.find("\nverdict: PASS"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.rfind("artifact: S\\x0Averdict: PASS (sphere)", 0), 0u) << r.out;
+}
+
+// A cloud re-saved in another encoding has other bytes but is the same
+// measurement: its fitted centre and diameter are the first's within the
+// rounding of its coordinates (float, 9 digits: ~1e-5 mm a point at
+// 200 mm), where a second position's centre lies 10 mm away. It counted as
+// a new distinct position.
+TEST(VerifyCli, ACloudReSavedInAnotherEncodingIsTheSamePosition) {
+  std::mt19937 rng(34);
+  auto pts = NoisyCap({0, 0, 200}, {0, 0, -1}, 19.05, 80, 20000, 0.05, &rng);
+  const auto back = NoisyCap({0, 0, 200}, {0, 0, 1}, 19.05, 80, 20000, 0.05, &rng);
+  pts.insert(pts.end(), back.begin(), back.end());
+  const std::string first = WritePoints("position_first", pts);
+  const std::string resaved = ::testing::TempDir() + "/position_resaved_" + std::to_string(getpid()) + ".ply";
+  {
+    std::ofstream f(resaved);
+    f << "ply\nformat ascii 1.0\nelement vertex " << pts.size()
+      << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+    f.precision(9);
+    for (const Eigen::Vector3d& p : pts)
+      f << static_cast<float>(p.x()) << " " << static_cast<float>(p.y()) << " " << static_cast<float>(p.z()) << "\n";
+  }
+  for (Eigen::Vector3d& p : pts) p.x() += 10;
+  const std::string moved = WritePoints("position_moved", pts);
+  const auto r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + first + " --cloud " + resaved +
+                        " --cloud " + moved);
+  EXPECT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("note: position 2 (" + resaved + ") is the same measurement as position 1"), std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.find("note: position 3"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("note: 2 distinct position(s) measured"), std::string::npos) << r.out;
+  for (const std::string& f : {first, resaved, moved}) std::filesystem::remove(f);
+}
+
+}  // namespace

@@ -53,6 +53,15 @@ double NonNegative(YamlMap& m, const std::string& key) {
   return v;
 }
 
+// A certificate's expanded uncertainty: not negative, and plausible
+// (kCertificateUncertainty), refused as a size is otherwise.
+double Uncertainty(YamlMap& m, const std::string& key) {
+  const double v = NonNegative(m, key);
+  const std::string problem = ImplausibleMm(v, kCertificateUncertainty, "the file's units are mm");
+  if (!problem.empty()) throw InputError(m.Where(key), problem);
+  return v;
+}
+
 // A positive size within `range`; outside it, refused naming the file and
 // key, with the unit it looks like when one makes it plausible.
 double Size(YamlMap& m, const std::string& key, const PlausibleMm& range) {
@@ -73,14 +82,14 @@ Artifact Parse(YamlMap m) {
   if (type == "sphere") {
     a.type = ArtifactType::kSphere;
     a.sphere_diameter_mm = Size(m, "diameter_mm", kSphereDiameter);
-    a.sphere_diameter_uncertainty_mm = NonNegative(m, "diameter_uncertainty_mm");
-    a.sphere_form_uncertainty_mm = NonNegative(m, "form_uncertainty_mm");
+    a.sphere_diameter_uncertainty_mm = Uncertainty(m, "diameter_uncertainty_mm");
+    a.sphere_form_uncertainty_mm = Uncertainty(m, "form_uncertainty_mm");
   } else if (type == "ballbar") {
     a.type = ArtifactType::kBallBar;
     a.sphere_diameter_mm = Size(m, "sphere_diameter_mm", kSphereDiameter);
-    a.sphere_diameter_uncertainty_mm = NonNegative(m, "sphere_diameter_uncertainty_mm");
+    a.sphere_diameter_uncertainty_mm = Uncertainty(m, "sphere_diameter_uncertainty_mm");
     a.center_distance_mm = Size(m, "center_distance_mm", kArtifactLength);
-    a.center_distance_uncertainty_mm = NonNegative(m, "center_distance_uncertainty_mm");
+    a.center_distance_uncertainty_mm = Uncertainty(m, "center_distance_uncertainty_mm");
     if (a.center_distance_mm <= a.sphere_diameter_mm) {
       throw InputError(m.Where("center_distance_mm"), "must exceed the sphere diameter (the balls would overlap)");
     }
@@ -88,7 +97,7 @@ Artifact Parse(YamlMap m) {
     a.type = ArtifactType::kPlate;
     a.plate_length_mm = Size(m, "length_mm", kArtifactLength);
     a.plate_width_mm = Size(m, "width_mm", kArtifactLength);
-    a.flatness_uncertainty_mm = NonNegative(m, "flatness_uncertainty_mm");
+    a.flatness_uncertainty_mm = Uncertainty(m, "flatness_uncertainty_mm");
   } else {
     throw InputError(m.Where("type"), "expected sphere, ballbar or plate, got '" + type + "'");
   }

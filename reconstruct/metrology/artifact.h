@@ -74,6 +74,11 @@ inline constexpr PlausibleMm kArtifactLength{1, 10000, "artifact length"};
 // A maximum permissible error: 1 um is below what any optical rig claims,
 // 100 mm is beyond a sphere's form error that would still be a sphere.
 inline constexpr PlausibleMm kMaximumPermissibleError{0.001, 100, "maximum permissible error"};
+// A certificate's expanded uncertainty (*_uncertainty_mm): 0 is an exact
+// reference; over 100 mm it is no certificate of an artifact a rig like this
+// measures (1e308 printed a 300-digit figure, 2000 - um typed as mm - was
+// taken as 2 m).
+inline constexpr PlausibleMm kCertificateUncertainty{0, 100, "certificate's expanded uncertainty"};
 
 // "" when `v` is within `range`; else why not, with the unit it looks like
 // when one makes it plausible ("130000 mm is not a plausible artifact length

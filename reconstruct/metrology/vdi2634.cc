@@ -16,6 +16,7 @@
 #include "reconstruct/metrology/plate_outline.h"
 #include "reconstruct/metrology/sphere_fit.h"
 #include "reconstruct/metrology/sphere_uncertainty.h"
+#include "reconstruct/metrology/surface_beyond_band.h"
 
 namespace stereorig {
 
@@ -177,6 +178,29 @@ std::string NotJudgedReason(const ArtifactEvaluation& e, const std::string& cove
     return UndeterminedText(f, e, coverage, coverage_factor, o.max_uncertainty_fraction_of_mpe * f.mpe_mm, o);
   }
   return "";
+}
+
+// A part of the artifact measured beyond the capture band (`what`: "the
+// sphere's surface", "ball 2's surface", "the plate's face";
+// surface_beyond_band.h) is left out of the figures, so
+// they cannot show it: a position that would pass is not judged (a larger
+// gross error must not pass where a smaller one fails), one that fails
+// keeps its FAIL with the part named in a note.
+void JudgeSurfaceBeyondBand(const SurfaceBeyondBand& s, const std::string& what, double band_mm,
+                            ArtifactEvaluation* e) {
+  if (!s.found()) return;
+  char buf[640];
+  std::snprintf(buf, sizeof buf,
+                "%d points lie %.1f to %.1f mm off %s, beyond the %.1f mm capture band, where the band holds "
+                "none of it but all around holds it: a part of it measured that far off (a patch a grid period or "
+                "more off?), which the figures leave out. Crop it from the cloud if it is something else, or give "
+                "--capture-band-mm %.0f to judge it",
+                s.points, s.nearest_mm, s.farthest_mm, what.c_str(), band_mm, std::ceil(s.farthest_mm + 1));
+  if (e->pass()) {
+    e->not_judged_reason = buf;
+  } else {
+    e->notes.push_back(buf);
+  }
 }
 
 std::string CapsText(const std::vector<double>& cap_half_angles_deg) {
@@ -416,6 +440,30 @@ std::string LeftCertifiedSizeText(const std::vector<Eigen::Vector3d>& pts, const
         2 * free_fit.radius_mm, 2 * nominal_radius_mm, 2 * tolerance_mm);
     text += buf;
   }
+  // First whether the points lie on a sphere at all (the better of the
+  // free fit and the located one, to within a quarter of the locating band
+  // as the artifact does to its noise on any cap): points that do not are
+  // not the artifact, however much of it they cover, and u from their
+  // misfit is no measure of the cap (the demo's ball bar against its
+  // sphere's file covered 63 deg and read "a cap this small fits a diameter
+  // only to +-1.94 mm: measure more of it").
+  const bool free_fitted = free_fit.ok && free_fit.converged;
+  auto median_abs_residual_mm = [&](const Eigen::Vector3d& center_mm, double radius_mm) {
+    std::vector<double> r;
+    for (int i : captured) r.push_back(std::abs((pts[i] - center_mm).norm() - radius_mm));
+    return r.empty() ? std::numeric_limits<double>::infinity() : Median(r);
+  };
+  const double median_mm = std::min(free_fitted ? median_abs_residual_mm(free_fit.center_mm, free_fit.radius_mm)
+                                                : std::numeric_limits<double>::infinity(),
+                                    median_abs_residual_mm(located_center_mm, nominal_radius_mm));
+  if (!(median_mm <= 0.25 * locate_band_mm)) {
+    std::snprintf(buf, sizeof buf,
+                  "; its points lie on no sphere better than %.2f mm (median |residual|; the artifact would to its "
+                  "noise, under a quarter of the %.1f mm locating band, on a cap of any size): the cloud does not "
+                  "look like this artifact",
+                  median_mm, locate_band_mm);
+    return text + buf + PlaneLikeText(pts, locate_band_mm);
+  }
   // A cap that cannot pin the diameter within the tolerance (3 sigma) is too
   // small; one that can, and fits another size, is another object.
   if (!(3 * u.diameter_std_mm <= 2 * tolerance_mm)) {
@@ -427,7 +475,7 @@ std::string LeftCertifiedSizeText(const std::vector<Eigen::Vector3d>& pts, const
                   "size",
                   u.diameter_std_mm);
     text += buf;
-    if (free_fit.ok && free_fit.converged) {
+    if (free_fitted) {
       text += ScaleOrShapeText(pts, free_fit.center_mm, free_fit.radius_mm, nominal_radius_mm, capture_band_mm,
                                locate_band_mm, other_ball_scale);
     }
@@ -760,6 +808,22 @@ void RequirePlateCoverage(const PlaneOutline& e, const Artifact& a, const Verify
   }
 }
 
+// The balls found must be the certified distance apart as each must be the
+// certified size: within 10% (RadiusToleranceMm's rule; at least twice the
+// MPE, so an SD beyond the MPE is judged). Further off, the certificate is
+// not this bar's (a 200 mm certificate for an 80 mm bar read SD -119.97 mm,
+// FAIL), or the bar not the artifact: not evaluated, naming both.
+void RequireCertifiedLength(double distance_mm, const Artifact& a, const std::string& where) {
+  const double tolerance_mm = std::max(0.1 * a.center_distance_mm, 2 * a.mpe.sphere_spacing_mm);
+  if (std::abs(distance_mm - a.center_distance_mm) <= tolerance_mm) return;
+  char buf[320];
+  std::snprintf(buf, sizeof buf,
+                "the balls are %.2f mm apart (centre to centre) and the certificate says %.2f mm (+-%.1f mm "
+                "allowed): not this artifact's certificate, or not this artifact",
+                distance_mm, a.center_distance_mm, tolerance_mm);
+  throw NotTheArtifactError(where, buf);
+}
+
 // The artifact's largest dimension, mm: what a cloud of it must span.
 double ArtifactSizeMm(const Artifact& a) {
   switch (a.type) {
@@ -881,6 +945,8 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       JudgeFigures(o.decision_rule, o, &e.figures);
       e.not_judged_reason =
           NotJudgedReason(e, CapsText(e.sphere_cap_half_angles_deg), a.uncertainty_coverage_factor, o);
+      JudgeSurfaceBeyondBand(SphereSurfaceBeyondBand(pts, fit.center_mm, fit.radius_mm, e.capture_band_mm),
+                             "the sphere's surface", e.capture_band_mm, &e);
       break;
     }
     case ArtifactType::kBallBar: {
@@ -904,11 +970,36 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
         if (!LeftCertifiedSize(fit, r, tolerance_mm)) return;
         const bool two_balls =
             (fit.center_mm - other_fit.center_mm).norm() >= std::abs(fit.radius_mm) + std::abs(other_fit.radius_mm);
-        const double other_scale = other_fit.ok && other_fit.converged && two_balls ? other_fit.radius_mm / r : NAN;
+        double other_scale = other_fit.ok && other_fit.converged && two_balls ? other_fit.radius_mm / r : NAN;
+        // A scale error scales the bar's length with its balls: where both
+        // balls read off the same way but the centres lie the certified
+        // distance apart (within the locating band, where that scale would
+        // have moved them by more than twice it), the scale is not named (a
+        // 38.1 mm certificate for the demo's 25.4 mm balls read "a scale
+        // -33% off" with the centres 80.03 mm apart as certified) and the
+        // distance is. Not where the centres are merely near it: a ball
+        // not located at all leaves the other fit on the rod.
+        std::string length_text;
+        const double scale = fit.radius_mm / r;
+        const double distance_mm = (fit.center_mm - other_fit.center_mm).norm();
+        const double locate_mm = LocateBandMm(o, a.mpe.sphere_spacing_mm);
+        if (fit.ok && fit.converged && two_balls && !ScaleText(scale, other_scale).empty() &&
+            std::abs(distance_mm - a.center_distance_mm) <= locate_mm &&
+            std::abs(scale - 1) * a.center_distance_mm > 2 * locate_mm) {
+          other_scale = NAN;
+          char buf[256];
+          std::snprintf(buf, sizeof buf,
+                        "; both balls read %+.0f%% off, but their centres are %.2f mm apart, as the certificate's "
+                        "%.2f mm: no scale error, which would move them too (is the certificate's sphere diameter "
+                        "this bar's?)",
+                        100 * (scale - 1), distance_mm, a.center_distance_mm);
+          length_text = buf;
+        }
         throw NotTheArtifactError(
             where, BallText(ball, located_centers_mm[ball]) + ": " +
                        LeftCertifiedSizeText(pts, indices, located_centers_mm[ball], fit, r, tolerance_mm, band,
-                                             LocateBandMm(o, a.mpe.sphere_spacing_mm), other_scale));
+                                             LocateBandMm(o, a.mpe.sphere_spacing_mm), other_scale) +
+                       length_text);
       };
       const double cos_cone = std::cos(o.ballbar_shaft_cone_deg * M_PI / 180.0);
       OtherBallScaleAt first_ball_scale_at;  // for ball 2's search
@@ -1022,6 +1113,7 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       e.points_excluded = excluded_total;
       e.points_off_artifact = e.points_total - e.points_on_artifact;  // outside both balls' bands, or in the cone
       const Eigen::Vector3d bar_mm = e.sphere_centers_mm[0] - e.sphere_centers_mm[1];
+      RequireCertifiedLength(bar_mm.norm(), a, where);
       e.figures = {MakeFigure("SD", bar_mm.norm() - a.center_distance_mm, a.mpe.sphere_spacing_mm)};
       // The two centres' errors are independent (disjoint points); the
       // distance moves with their difference along the bar.
@@ -1035,6 +1127,12 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       JudgeFigures(o.decision_rule, o, &e.figures);
       e.not_judged_reason =
           NotJudgedReason(e, CapsText(e.sphere_cap_half_angles_deg), a.uncertainty_coverage_factor, o);
+      for (int ball = 0; ball < 2; ++ball) {
+        const Eigen::Vector3d& c = e.sphere_centers_mm[ball];
+        JudgeSurfaceBeyondBand(SphereSurfaceBeyondBand(pts, c, 0.5 * e.sphere_diameters_mm[ball], band,
+                                                       (e.sphere_centers_mm[1 - ball] - c).normalized(), cos_cone),
+                               "ball " + std::to_string(ball + 1) + "'s surface", band, &e);
+      }
       break;
     }
     case ArtifactType::kPlate: {
@@ -1124,6 +1222,10 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       ResidualStats(fit.residuals_mm, &e);
       JudgeFigures(o.decision_rule, o, &e.figures);
       e.not_judged_reason = NotJudgedReason(e, "", a.uncertainty_coverage_factor, o);
+      JudgeSurfaceBeyondBand(
+          PlateSurfaceBeyondBand(pts, normals, fit.normal, fit.offset_mm, SideMeasuredFrom(normals, face, fit.normal),
+                                 extent, std::max(0.0, o.plate_edge_margin_mm), e.capture_band_mm),
+          "the plate's face", e.capture_band_mm, &e);
       break;
     }
   }

@@ -14,7 +14,10 @@
 // artifact's, and all of them enter the least-squares fit and the figures: the
 // runtime's known gross error, a patch one laser-grid period off, is ~3.5 mm
 // deep (docs/reconstruct.md), and a band that left it out would hide exactly
-// the error the figures must show. As the standard allows, up to 0.3% of the
+// the error the figures must show. A part of the artifact measured beyond
+// the band (a patch further off, where the artifact's surface is missing
+// among measured surface: surface_beyond_band.h) leaves a position that
+// would pass not judged. As the standard allows, up to 0.3% of the
 // artifact's points - those with the largest residuals - are excluded before
 // the figures are computed; the report says how many. A shape that does not
 // cover the certified artifact plausibly (a plane much smaller or larger than
@@ -182,8 +185,10 @@ struct ArtifactEvaluation {
   // Empty when the position is judged. Otherwise why it is not: a figure the
   // points or the certificate leave undetermined where the position would
   // otherwise pass (VerifyOptions::max_uncertainty_fraction_of_mpe; the text
-  // names the figure, its uncertainty and what would help). Its figures are
-  // all filled in, to be reported, not judged.
+  // names the figure, its uncertainty and what would help), or a part of
+  // the artifact measured beyond the capture band, which the figures leave
+  // out (the text names its points and how far off they lie). Its figures
+  // are all filled in, to be reported, not judged.
   // A position not evaluated at all (NotEvaluated below) has no figures and
   // no fitted geometry; not_judged_reason then says why.
   std::string not_judged_reason;
@@ -204,7 +209,8 @@ class NotTheArtifactError : public InputError {
 // artifact, the artifact cannot be found in it, what is found does not
 // cover the certified artifact plausibly (a sphere or ball whose free-radius
 // fit leaves the certified size or does not converge: the message names the
-// ball, both diameters and the cap its points cover). Points or a
+// ball, both diameters and the cap its points cover; a ball bar whose balls
+// lie more than 10% off the certified centre distance). Points or a
 // certificate that leave P_S, SD or F undetermined where the position would
 // otherwise pass are no error: the evaluation comes back with every figure
 // and not_judged_reason set.

@@ -1584,7 +1584,7 @@ TEST(Vdi2634, ABallWithItsRodGivenAgainstASpheresFileIsNoScaleError) {
   } catch (const NotTheArtifactError& error) {
     const std::string what = error.what();
     EXPECT_EQ(what.find("measured at a scale"), std::string::npos) << what;
-    EXPECT_NE(what.find("; its points lie on that sphere only to "), std::string::npos) << what;
+    EXPECT_NE(what.find("; its points lie on no sphere better than "), std::string::npos) << what;
     EXPECT_NE(what.find("the cloud does not look like this artifact"), std::string::npos) << what;
   }
 }
@@ -1972,6 +1972,116 @@ TEST(ArtifactFile, RoundTripsAndRejectsMissingFields) {
                InputError);
   EXPECT_THROW(ParseArtifactYaml("format: stereorig-artifact\nversion: 1\nunits: mm\ntype: cube\n", "a.yaml"),
                InputError);
+}
+
+// A patch measured beyond the capture band (surface_beyond_band.h). Truth:
+// the certified sphere (r = 19.05 mm) seen from both sides (70-degree caps
+// about -z and +z, 0.4 mm apart, radial noise sigma = 0.05 mm), its points
+// within 25 degrees of -z moved radially by h. At h = 3.5 mm the patch is in
+// the band and P_F fails; at 5.5 and 7 mm it lay beyond it, the figures left
+// it out and the sphere passed: a larger error passing where a smaller one
+// failed. It must not pass: the reason names every moved point (their
+// directions, surrounded by the measured cap, hold no surface in the band)
+// and how far off they lie, h within 6 sigma of noise.
+TEST(Vdi2634, APatchBeyondTheCaptureBandIsNotPassed) {
+  const double sigma_mm = 0.05;
+  for (const double h : {5.5, 7.0, -6.0}) {
+    std::mt19937 rng(11);
+    const Eigen::Vector3d c(3, -4, 250);
+    auto s = BallSeenFromBothSides(c, 19.05, sigma_mm, &rng);
+    int patch = 0;
+    for (auto& p : s) {
+      const Eigen::Vector3d u = (p - c).normalized();
+      if (u.dot(Eigen::Vector3d(0, 0, -1)) < std::cos(25 * kPi / 180)) continue;
+      p += h * u;
+      ++patch;
+    }
+    SCOPED_TRACE(::testing::Message() << patch << " points moved " << h << " mm");
+    const ArtifactEvaluation e = EvaluateArtifact(SphereArtifact(), s, VerifyOptions(), "test");
+    EXPECT_FALSE(e.pass());
+    const std::string reason = NotJudgedReason(e);
+    EXPECT_NE(reason.find(std::to_string(patch) + " points lie "), std::string::npos) << reason;
+    EXPECT_NE(reason.find("beyond the 5.0 mm capture band"), std::string::npos) << reason;
+    const double nearest = std::stod(reason.substr(reason.find(" points lie ") + 12));
+    // The nearest moved point: |h| within 6 sigma, printed to 0.1 mm.
+    EXPECT_NEAR(nearest, std::abs(h), 6 * sigma_mm + 0.05) << reason;
+    EXPECT_EQ(e.points_off_artifact, patch);  // the figures still leave them out, as the count says
+  }
+}
+
+// A mount beyond the band where the sphere is hidden changes nothing.
+// Truth: a 100-degree cap about +z (one module's view from above; the
+// sphere below it unseen), sigma = 0.05 mm, and 3000 points of a mount
+// within 30 degrees of -z, off the shell, where the sphere has no points
+// and neither do the directions around: a blob 6 to 12 mm below the
+// surface, and a layer 6 to 6.1 mm below it (a mount's face along the
+// sphere, which only where it is seen from tells from a patch). The
+// figures, the verdict and the counts are those of the cap alone (the
+// mount is off the artifact).
+TEST(Vdi2634, AMountBeyondTheBandWhereTheSphereIsHiddenChangesNothing) {
+  std::mt19937 rng(12);
+  const Eigen::Vector3d c(0, 10, 300);
+  const auto cap = SphereCap(c, 19.05, {0, 0, 1}, 100, 0.4, 0.05, &rng);
+  const ArtifactEvaluation alone = EvaluateArtifact(SphereArtifact(), cap, VerifyOptions(), "test");
+  ASSERT_TRUE(alone.pass()) << alone.not_judged_reason;
+  for (const double thickness_mm : {6.0, 0.1}) {
+    SCOPED_TRACE(::testing::Message() << "mount " << thickness_mm << " mm thick");
+    auto with_mount = cap;
+    const auto mount = PointsInShell(c, 19.05 + 6, 19.05 + 6 + thickness_mm, {0, 0, -1}, 0, 30, 3000, &rng);
+    with_mount.insert(with_mount.end(), mount.begin(), mount.end());
+    const ArtifactEvaluation e = EvaluateArtifact(SphereArtifact(), with_mount, VerifyOptions(), "test");
+    EXPECT_TRUE(e.pass()) << e.not_judged_reason;
+    EXPECT_TRUE(e.notes.empty());
+    EXPECT_EQ(e.points_on_artifact, alone.points_on_artifact);
+    EXPECT_EQ(e.points_off_artifact, 3000);
+    EXPECT_EQ(FigureOf(e, "P_F"), FigureOf(alone, "P_F"));
+    EXPECT_EQ(FigureOf(e, "P_S"), FigureOf(alone, "P_S"));
+  }
+}
+
+// A patch of the plate's face measured beyond the capture band is not
+// passed either. Truth: the 130 mm plate at 0.5 mm, noise sigma = 0.05 mm,
+// its points within 15 mm of the centre (a 30 mm square) moved along the
+// normal by 6 mm: beyond the 5 mm band, inside the face's eroded outline.
+TEST(Vdi2634, APatchOfThePlateBeyondTheCaptureBandIsNotPassed) {
+  std::mt19937 rng(13);
+  const Eigen::Vector3d c(0, 0, 400), normal(0, 0.2, 1);
+  auto plate = PlatePoints(c, normal, 130, 0.5, 0.05, &rng);
+  int moved = 0;
+  for (auto& p : plate) {
+    const Eigen::Vector3d d = p - c;
+    if (std::abs(d.x()) >= 15 || std::abs(d.y()) >= 15) continue;
+    p += 6.0 * normal.normalized();
+    ++moved;
+  }
+  const ArtifactEvaluation e = EvaluateArtifact(PlateArtifact(), plate, VerifyOptions(), "plate.ply");
+  const std::string reason = NotJudgedReason(e);
+  EXPECT_NE(reason.find(std::to_string(moved) + " points lie "), std::string::npos) << moved << ": " << reason;
+  EXPECT_NE(reason.find("off the plate's face"), std::string::npos) << reason;
+}
+
+// On a ball bar too. Truth: balls of 25.4 mm 100 mm apart along x, each seen
+// from both sides (70-degree caps about -z and +z, 0.4 mm apart, noise
+// sigma = 0.05 mm), ball 2's points within 25 degrees of -z (outside the
+// shaft's cone about x) moved radially by 6 mm: not passed, the reason
+// naming ball 2 and every moved point.
+TEST(Vdi2634, APatchOfABallBeyondTheCaptureBandIsNotPassed) {
+  std::mt19937 rng(14);
+  const Eigen::Vector3d c1(-50, 0, 300), c2(50, 0, 300);
+  auto bar = BallSeenFromBothSides(c1, 12.7, 0.05, &rng);
+  auto ball2 = BallSeenFromBothSides(c2, 12.7, 0.05, &rng);
+  int moved = 0;
+  for (auto& p : ball2) {
+    const Eigen::Vector3d u = (p - c2).normalized();
+    if (u.dot(Eigen::Vector3d(0, 0, -1)) < std::cos(25 * kPi / 180)) continue;
+    p += 6.0 * u;
+    ++moved;
+  }
+  bar.insert(bar.end(), ball2.begin(), ball2.end());
+  const ArtifactEvaluation e = EvaluateArtifact(BallBarArtifact(), bar, VerifyOptions(), "bar.ply");
+  const std::string reason = NotJudgedReason(e);
+  EXPECT_NE(reason.find(std::to_string(moved) + " points lie "), std::string::npos) << moved << ": " << reason;
+  EXPECT_NE(reason.find("off ball 2's surface"), std::string::npos) << reason;
 }
 
 }  // namespace

@@ -1,0 +1,234 @@
+#include "reconstruct/metrology/surface_beyond_band.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+namespace stereorig {
+
+namespace {
+
+// Cells of the shape's surface, rows x cols (columns wrapping round where
+// `wrap`: a sphere's azimuth): per cell, the points in the band (`on`) and
+// those beyond it within kBeyondBandWidths bands (`beyond`); cells
+// `ignored` are judged neither way (a ball bar's shaft).
+struct Cells {
+  int rows = 0, cols = 0;
+  bool wrap = false;
+  std::vector<int> on;
+  std::vector<std::vector<int>> beyond;
+  std::vector<char> ignored;
+  Cells(int r, int c, bool w) : rows(r), cols(c), wrap(w), on(r * c, 0), beyond(r * c), ignored(r * c, 0) {}
+  // The 8 cells around.
+  std::vector<int> Around(int cell) const {
+    std::vector<int> out;
+    const int row = cell / cols, col = cell % cols;
+    for (int dr = -1; dr <= 1; ++dr)
+      for (int dc = -1; dc <= 1; ++dc) {
+        if ((dr == 0 && dc == 0) || row + dr < 0 || row + dr >= rows) continue;
+        if (!wrap && (col + dc < 0 || col + dc >= cols)) continue;
+        out.push_back((row + dr) * cols + (col + dc + cols) % cols);
+      }
+    return out;
+  }
+};
+
+// A cell holds the surface where the band has at least a quarter of a
+// typical measured cell's points (the median over cells with any): a cap's
+// edge cells, cut by it, still count. Fewer than 3 points is no surface.
+constexpr double kSurfaceFractionOfTypical = 0.25;
+constexpr int kMinPointsPerCell = 3;
+
+// A part of the surface measured off lies along the surface, as a layer:
+// across a cell its offsets spread by the cell's width times its tilt (a
+// patch a grid period off, 7 mm along the camera's ray, by under 1 mm; the
+// demo's sphere moved radially by noise, 0.1 mm interquartile). Something
+// sticking out of it (a stand, a mount's rod) runs across the layers and
+// spreads over the whole window beyond the band: 2.8-5.5 mm interquartile
+// in the cells of a walkthrough's stand. A cell's points beyond the band
+// are a layer where their offsets' interquartile range is within this
+// fraction of the band.
+constexpr double kLayerSpreadOfBand = 0.25;
+constexpr double kLayerEdgeOfBand = 0.1;
+
+// A group of cells is surrounded by measured surface where, of the cells
+// around it, at least half are measured at all (hold points in the band:
+// a patch at the edge of what was seen borders cells nobody measured,
+// which say nothing) and at least this fraction of those hold the
+// surface. A mount where the artifact is hidden borders unmeasured cells.
+constexpr double kSurroundedFraction = 2.0 / 3.0;
+constexpr double kMeasuredAroundFraction = 0.5;
+
+double InterquartileRange(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[(3 * v.size()) / 4] - v[v.size() / 4];
+}
+
+// The points beyond the band in groups of adjacent cells that hold no
+// surface but a layer beyond it (as many points as a cell of surface holds,
+// lying along it), each group surrounded by cells that hold the surface.
+// off_mm: a point's signed distance to the surface (a layer's spread is
+// taken signed: points either side of the surface are not one layer).
+SurfaceBeyondBand Judge(const Cells& cells, double band_mm, const std::function<double(int)>& off_mm) {
+  std::vector<int> measured;
+  for (size_t c = 0; c < cells.on.size(); ++c)
+    if (cells.on[c] > 0 && !cells.ignored[c]) measured.push_back(cells.on[c]);
+  SurfaceBeyondBand out;
+  if (measured.empty()) return out;
+  std::nth_element(measured.begin(), measured.begin() + measured.size() / 2, measured.end());
+  const double enough = std::max<double>(kMinPointsPerCell, kSurfaceFractionOfTypical * measured[measured.size() / 2]);
+  auto surface = [&](int cell) { return cells.on[cell] >= enough; };
+  std::vector<char> layer(cells.on.size(), 0);
+  for (size_t c = 0; c < cells.on.size(); ++c) {
+    if (cells.ignored[c] || cells.on[c] >= enough || static_cast<double>(cells.beyond[c].size()) < enough) continue;
+    std::vector<double> offs;
+    for (int i : cells.beyond[c]) offs.push_back(off_mm(i));
+    layer[c] = InterquartileRange(offs) <= kLayerSpreadOfBand * band_mm;
+  }
+  auto displaced = [&](int cell) { return layer[cell] != 0; };
+  const int n = static_cast<int>(cells.on.size());
+  std::vector<char> seen(n, 0);
+  out.nearest_mm = std::numeric_limits<double>::infinity();
+  std::vector<int> found;  // the points of the groups kept, with repeats
+  for (int start = 0; start < n; ++start) {
+    if (seen[start] || !displaced(start)) continue;
+    std::vector<int> group = {start}, rim;
+    seen[start] = 1;
+    for (size_t k = 0; k < group.size(); ++k)
+      for (int next : cells.Around(group[k])) {
+        if (seen[next]) continue;
+        if (displaced(next)) {
+          seen[next] = 1;
+          group.push_back(next);
+        } else if (!cells.ignored[next] && std::find(rim.begin(), rim.end(), next) == rim.end()) {
+          rim.push_back(next);
+        }
+      }
+    const auto held = std::count_if(rim.begin(), rim.end(), surface);
+    const auto measured_around = std::count_if(rim.begin(), rim.end(), [&](int c) { return cells.on[c] > 0; });
+    if (measured_around == 0 || measured_around < kMeasuredAroundFraction * static_cast<double>(rim.size()) ||
+        held < kSurroundedFraction * static_cast<double>(measured_around))
+      continue;
+    // The group's points, and those of its layer beyond it: the layer runs
+    // on through cells that also hold some surface (a patch's edge, the
+    // cells about a sphere's pole that a patch covers but for a strip),
+    // taken where they hold as many of its points as a cell of surface
+    // holds, and into the cells around those. A layer point is within the
+    // group's range of offsets, widened by a tenth of the band for the
+    // noise's extremes (a 0.05 mm noise's are 0.25 mm out).
+    double lo_mm = std::numeric_limits<double>::infinity(), hi_mm = -lo_mm;
+    for (int cell : group)
+      for (int i : cells.beyond[cell]) {
+        lo_mm = std::min(lo_mm, off_mm(i));
+        hi_mm = std::max(hi_mm, off_mm(i));
+      }
+    auto in_layer = [&](int i) {
+      return off_mm(i) >= lo_mm - kLayerEdgeOfBand * band_mm && off_mm(i) <= hi_mm + kLayerEdgeOfBand * band_mm;
+    };
+    auto layer_points = [&](int cell) {
+      return std::count_if(cells.beyond[cell].begin(), cells.beyond[cell].end(), in_layer);
+    };
+    std::vector<int> region = group;
+    std::vector<char> in_region(n, 0);
+    for (int cell : group) in_region[cell] = 1;
+    for (size_t k = 0; k < region.size(); ++k)
+      for (int next : cells.Around(region[k])) {
+        if (in_region[next] || cells.ignored[next] || static_cast<double>(layer_points(next)) < enough) continue;
+        in_region[next] = 1;
+        region.push_back(next);
+      }
+    std::vector<int> around = region;
+    for (int cell : region)
+      for (int next : cells.Around(cell))
+        if (!in_region[next] && !cells.ignored[next]) around.push_back(next);
+    for (int cell : around)
+      for (int i : cells.beyond[cell])
+        if (in_layer(i)) found.push_back(i);
+  }
+  // Each point once: two groups may share a cell around them.
+  std::sort(found.begin(), found.end());
+  found.erase(std::unique(found.begin(), found.end()), found.end());
+  out.points = static_cast<int>(found.size());
+  for (int i : found) {
+    out.nearest_mm = std::min(out.nearest_mm, std::abs(off_mm(i)));
+    out.farthest_mm = std::max(out.farthest_mm, std::abs(off_mm(i)));
+  }
+  if (!out.found()) out.nearest_mm = 0;
+  return out;
+}
+
+// A sphere's directions from its centre in equal-area cells: rows equal in
+// cos(polar angle) about z, columns in azimuth; 648 cells of ~8 deg, ~7 mm^2
+// of a 38.1 mm sphere (~40 points of the demo's clouds).
+constexpr int kRows = 18, kCols = 36;
+
+int CellOf(const Eigen::Vector3d& u) {
+  const int row = std::clamp(static_cast<int>((u.z() + 1) / 2 * kRows), 0, kRows - 1);
+  const double azimuth = std::atan2(u.y(), u.x()) + M_PI;  // [0, 2 pi]
+  const int col = std::clamp(static_cast<int>(azimuth / (2 * M_PI) * kCols), 0, kCols - 1);
+  return row * kCols + col;
+}
+
+Eigen::Vector3d CellCentre(int cell) {
+  const double z = -1 + 2 * (cell / kCols + 0.5) / kRows;
+  const double azimuth = 2 * M_PI * (cell % kCols + 0.5) / kCols - M_PI;
+  const double s = std::sqrt(std::max(0.0, 1 - z * z));
+  return {s * std::cos(azimuth), s * std::sin(azimuth), z};
+}
+
+// A plate's face in square cells over its outline, this many along its
+// longer side (6.5 mm cells on the demo's 130 mm plate, ~40 points each).
+constexpr int kPlateCellsAlong = 20;
+
+}  // namespace
+
+SurfaceBeyondBand SphereSurfaceBeyondBand(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& center_mm,
+                                          double radius_mm, double band_mm, const Eigen::Vector3d& axis,
+                                          double cos_cone) {
+  Cells cells(kRows, kCols, /*wrap=*/true);
+  for (int c = 0; c < kRows * kCols; ++c) cells.ignored[c] = CellCentre(c).dot(axis) > cos_cone;
+  auto off_mm = [&](int i) { return (pts[i] - center_mm).norm() - radius_mm; };
+  for (int i = 0; i < static_cast<int>(pts.size()); ++i) {
+    const Eigen::Vector3d d = pts[i] - center_mm;
+    const double n = d.norm();
+    if (!(n > 0) || d.dot(axis) > cos_cone * n) continue;
+    const double off = std::abs(off_mm(i));
+    if (off < band_mm) {
+      ++cells.on[CellOf(d / n)];
+    } else if (off <= kBeyondBandWidths * band_mm) {
+      cells.beyond[CellOf(d / n)].push_back(i);
+    }
+  }
+  return Judge(cells, band_mm, off_mm);
+}
+
+SurfaceBeyondBand PlateSurfaceBeyondBand(const std::vector<Eigen::Vector3d>& pts,
+                                         const std::vector<Eigen::Vector3d>& normals, const Eigen::Vector3d& normal,
+                                         double offset_mm, int face_side, const PlaneOutline& outline, double margin_mm,
+                                         double band_mm) {
+  const double length_mm = outline.length_mm() - 2 * margin_mm, width_mm = outline.width_mm() - 2 * margin_mm;
+  const double cell_mm = std::max(length_mm, width_mm) / kPlateCellsAlong;
+  if (!(cell_mm > 0) || !(std::min(length_mm, width_mm) > 0)) return {};
+  const int cols = std::max(1, static_cast<int>(std::ceil(length_mm / cell_mm)));
+  const int rows = std::max(1, static_cast<int>(std::ceil(width_mm / cell_mm)));
+  Cells cells(rows, cols, /*wrap=*/false);
+  auto off_mm = [&](int i) { return normal.dot(pts[i]) - offset_mm; };
+  for (int i = 0; i < static_cast<int>(pts.size()); ++i) {
+    if (!outline.InsideEroded(pts[i], margin_mm)) continue;
+    const Eigen::Vector3d d = pts[i] - outline.mean;
+    const int col = std::clamp(static_cast<int>((outline.u.dot(d) - outline.u0_mm - margin_mm) / cell_mm), 0, cols - 1);
+    const int row = std::clamp(static_cast<int>((outline.v.dot(d) - outline.v0_mm - margin_mm) / cell_mm), 0, rows - 1);
+    const double off = std::abs(off_mm(i));
+    if (off < band_mm) {
+      ++cells.on[row * cols + col];
+    } else if (off <= kBeyondBandWidths * band_mm) {
+      // Measured from the plate's other side: its far face, not the face.
+      if (face_side != 0 && !normals.empty() && normals[i].dot(normal) * face_side < 0) continue;
+      cells.beyond[row * cols + col].push_back(i);
+    }
+  }
+  return Judge(cells, band_mm, off_mm);
+}
+
+}  // namespace stereorig
