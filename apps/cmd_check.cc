@@ -415,7 +415,11 @@ int RunCheck(int argc, char** argv) {
                                        {"relative_to", m.relative_to},
                                        {"which_unknown", m.which_unknown}});
   report["shared_scale"] = nullptr;
-  if (result.shared_scale_explains) report["shared_scale"] = result.shared_scale;
+  report["shared_scale_print_only"] = nullptr;
+  if (result.shared_scale_explains) {
+    report["shared_scale"] = result.shared_scale;
+    report["shared_scale_print_only"] = result.shared_scale_print_only;
+  }
 
   // The history appended, the report staged in its temporary file within
   // the append's transaction (with what became of the run: its id, or the
