@@ -1293,5 +1293,42 @@ TEST(CheckCli, ABoardPrintedOffItsFileIsSaidAsThePrintNotAsTwoCameras) {
   fs::remove_all(dir);
 }
 
+// A module shifted 0.1 or 0.3 mm, on the walkthrough's seed 505, whose
+// nights have captures of three views: the lone camera, read through the
+// other module's views alone, carries the whole shift, while its bound came
+// from its four-view captures where its partner's pose absorbs it, and the
+// capture was set aside as taken at another moment (the walkthrough's
+// calibrated rig, 0.1 mm: capture 001, 0.621 px against a bound of 0.608
+// px; the truth rig here, 0.3 mm: capture 005). Compared like for like,
+// nothing is set aside and the closure still fails. A trigger slip in a
+// capture of three views is still set aside
+// (NightlyCheck.ASlipInACaptureOfThreeViewsIsNotBlamedOnTheLoneModulesCamera).
+TEST(CheckCli, AModuleShiftSetsNoCaptureOfThreeViewsAsideAsTakenAtAnotherMoment) {
+  const std::string dir = ::testing::TempDir() + "/check_cli_shift3_" + std::to_string(getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // The rig as stored: the truth of a night before the shift (a bumped
+  // night's truth is the bumped rig).
+  ASSERT_EQ(RunCli("simulate --out " + dir + "/unmoved --seed 505 --calibration-captures 1 --no-scenes").code, 0);
+  WriteStoredRig(dir + "/unmoved/truth/rig.yaml", 0.03, dir + "/rig.yaml", dir + "/unmoved/target.yaml");
+  for (const std::string mm : {"0.1", "0.3"}) {
+    const std::string captures = dir + "/shifted" + mm;
+    Result r = RunCli("simulate --out " + captures + " --seed 505 --calibration-captures 8 --no-scenes " +
+                      "--bump-module 1 --bump-translation-mm " + mm);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::string report = dir + "/shifted" + mm + ".json";
+    r = RunCli("check --rig " + dir + "/rig.yaml --captures " + captures + "/calibration --target " + captures +
+               "/target.yaml --history-db " + dir + "/history.sqlite --report " + report);
+    EXPECT_EQ(r.code, 1) << r.out << r.err;
+    EXPECT_EQ(r.out.find("set aside"), std::string::npos) << mm << " mm: " << r.out;
+    std::ifstream f(report);
+    const nlohmann::json j = nlohmann::json::parse(f, nullptr, false);
+    ASSERT_TRUE(j.is_object());
+    EXPECT_EQ(j["views_set_aside"], nlohmann::json::array()) << mm << " mm: " << j["views_set_aside"].dump(2);
+    EXPECT_EQ(j["flagged_modules"], nlohmann::json::array({0, 1})) << mm << " mm: " << j["explanation"];
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -604,14 +604,30 @@ void SetAsideViewsOfAnotherMoment(Inputs& in, std::vector<SetAsideView>* set_asi
   constexpr double kOtherMomentFactor = 10;
   std::map<const BoardObservation*, double> off_px;
   std::vector<std::vector<std::pair<int, double>>> by_camera(in.rig.num_cameras());  // (capture, off)
+  // Each camera's readings through other modules' views alone (two or
+  // more): what a view whose partner is not in its capture reads, so its
+  // bound. Through its partner's views too, a camera does not carry its
+  // module's shift against the rest (the best subset takes the partner's
+  // pose); through another module's alone it carries all of it: a module
+  // shifted 0.1 mm read its lone camera 0.621 px off a capture of three
+  // views against a bound of 0.608 px from the camera's four-view
+  // captures, and set the capture aside as taken at another moment.
+  std::vector<std::vector<std::pair<int, double>>> across_by_camera(in.rig.num_cameras());  // (capture, off)
   for (const auto& [capture, vs] : in.by_capture) {
     if (vs.size() < 3) continue;
     const BoardPoseEstimate all = EstimateBoardPose(in.rig, in.target, vs);
+    const Pose* seed = all.ok ? &all.ref_from_front : nullptr;
     for (const BoardObservation* v : vs) {
-      const double off = OffItsCapturePx(in, *v, vs, all.ok ? &all.ref_from_front : nullptr);
+      const double off = OffItsCapturePx(in, *v, vs, seed);
       if (off < 0) continue;
       off_px[v] = off;
       by_camera[v->camera].push_back({capture, off});
+      std::vector<const BoardObservation*> across{v};
+      for (const BoardObservation* w : vs)
+        if (ModuleOf(in.rig, w->camera) != ModuleOf(in.rig, v->camera)) across.push_back(w);
+      if (across.size() < 3) continue;
+      const double off_across = across.size() == vs.size() ? off : OffItsCapturePx(in, *v, across, seed);
+      if (off_across >= 0) across_by_camera[v->camera].push_back({capture, off_across});
     }
   }
   // The views over their bound, and in how many captures each camera has
@@ -622,9 +638,17 @@ void SetAsideViewsOfAnotherMoment(Inputs& in, std::vector<SetAsideView>* set_asi
     for (const BoardObservation* v : vs) {
       const auto it = off_px.find(v);
       if (it == off_px.end()) continue;
-      std::vector<double> camera_elsewhere, capture_others;
+      // Read through other modules' views alone here: its readings so
+      // elsewhere, where it has two or more.
+      const bool partner_here = std::any_of(vs.begin(), vs.end(), [&](const BoardObservation* w) {
+        return w != v && ModuleOf(in.rig, w->camera) == ModuleOf(in.rig, v->camera);
+      });
+      std::vector<double> camera_elsewhere, camera_across_elsewhere, capture_others;
       for (const auto& [c, off] : by_camera[v->camera])
         if (c != capture) camera_elsewhere.push_back(off);
+      for (const auto& [c, off] : across_by_camera[v->camera])
+        if (c != capture) camera_across_elsewhere.push_back(off);
+      if (!partner_here && camera_across_elsewhere.size() >= 2) camera_elsewhere.swap(camera_across_elsewhere);
       for (const BoardObservation* w : vs)
         if (w != v && off_px.count(w)) capture_others.push_back(off_px.at(w));
       if (camera_elsewhere.size() < 2 || capture_others.size() < 2) continue;
