@@ -21,7 +21,9 @@ void CheckOptions::Check() const {
   // A coverage factor, as in GUM (2-3 usual): a huge or infinite one would
   // pass any drift and write such thresholds into the history.
   if (!(k_sigma > 0 && k_sigma <= 10))
-    throw InputError("k_sigma", "must be in (0, 10] (each threshold is k times the figure's sigma)");
+    throw InputError("k_sigma",
+                     "must be in (0, 10] (each threshold is its figure's expected value on an unchanged rig plus k "
+                     "of its standard deviations)");
   if (min_captures < 1) throw InputError("check options", "min_captures must be >= 1");
   if (min_corners_per_view < 4) throw InputError("check options", "min_corners_per_view must be >= 4");
 }
