@@ -183,7 +183,9 @@ int RunCheck(int argc, char** argv) {
       ->check(NonEmptyPath());  // '' fell back to the default: another database than the one named
   app.add_option("--report", report_path, "write the figures as JSON here")->check(NonEmptyPath());
   app.add_option("--k-sigma", options.k_sigma,
-                 "coverage factor of every threshold, in (0, 10]: each is k times its figure's sigma")
+                 "coverage factor of every threshold, in (0, 10]: each is its figure's expected value on an "
+                 "unchanged rig plus k of its standard deviations (a closure's: the chi-square quantile at that "
+                 "level)")
       ->capture_default_str();
   app.add_flag("--history", history_only,
                "print the trend of every figure from the history, then its last runs one a line, and stop");
@@ -415,7 +417,11 @@ int RunCheck(int argc, char** argv) {
                                        {"relative_to", m.relative_to},
                                        {"which_unknown", m.which_unknown}});
   report["shared_scale"] = nullptr;
-  if (result.shared_scale_explains) report["shared_scale"] = result.shared_scale;
+  report["shared_scale_print_only"] = nullptr;
+  if (result.shared_scale_explains) {
+    report["shared_scale"] = result.shared_scale;
+    report["shared_scale_print_only"] = result.shared_scale_print_only;
+  }
 
   // The history appended, the report staged in its temporary file within
   // the append's transaction (with what became of the run: its id, or the

@@ -624,6 +624,7 @@ TEST(CheckCli, EveryLensDriftedAlikeOrTheRigsScaleIsSaidNotNamedAsTwoCameras) {
   EXPECT_EQ(larger["flagged_modules"], nlohmann::json::array({0, 1})) << larger.dump(2);
   ASSERT_TRUE(larger["shared_scale"].is_number()) << larger.dump(2);
   EXPECT_NEAR(larger["shared_scale"].get<double>(), 1 / 1.002, 0.0002) << larger.dump(2);
+  EXPECT_EQ(larger["shared_scale_print_only"], false) << larger.dump(2);
   fs::remove_all(dir);
 }
 
@@ -1244,6 +1245,111 @@ TEST(CheckCli, ImagesSwappedBetweenCamerasOrAModuleFromAnotherCaptureAreNamed) {
       r.out.find("set aside: capture " + names[3] + " whole (cam0, cam1, cam2): cam2 is off module 0's views by "),
       std::string::npos)
       << r.out;
+  fs::remove_all(dir);
+}
+
+// A board printed 0.3 % large (the simulator's scale_error_ppm: each face's
+// print scaled about its first corner, the plate as the file says) against
+// its nominal file, the rig unmoved. Every module measures it +0.30 %, but
+// the board scaled as a solid leaves its back face 0.27 mm off where the
+// print puts it (the faces' first corners 90 mm apart), and the night read
+// cameras 0 and 3 "neither" (the walkthrough's seed 701). With the faces'
+// prints scaled alone every figure holds: said as the board's print, no
+// camera named (the rig's scale, which the board as a solid explains, is
+// still said so: EveryLensDriftedAlikeOrTheRigsScale...). The 0.3 % is 15
+// times the 0.02 % the modules' size reading scatters by (board_scale.h);
+// the fitted size is held to a tenth of it.
+TEST(CheckCli, ABoardPrintedOffItsFileIsSaidAsThePrintNotAsTwoCameras) {
+  const std::string dir = ::testing::TempDir() + "/check_cli_print_" + std::to_string(getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  ASSERT_EQ(RunCli("simulate --write-default-spec " + dir + "/default.yaml").code, 0);
+  std::string spec = Bytes(dir + "/default.yaml");
+  const size_t at = spec.find("scale_error_ppm: 0");
+  ASSERT_NE(at, std::string::npos) << spec;
+  spec.replace(at, std::string("scale_error_ppm: 0").size(), "scale_error_ppm: 3000");
+  std::ofstream(dir + "/print.yaml") << spec;
+  Result r = RunCli("simulate --spec " + dir + "/print.yaml --out " + dir +
+                    "/ds --seed 701 --calibration-captures 8 --no-scenes");
+  ASSERT_EQ(r.code, 0) << r.err;
+  WriteStoredRig(dir + "/ds/truth/rig.yaml", 0.03, dir + "/rig.yaml", dir + "/ds/target.yaml");
+  auto check = [&](const std::string& rig, const std::string& report) {
+    const Result c = RunCli("check --rig " + rig + " --captures " + dir + "/ds/calibration --target " + dir +
+                            "/ds/target.yaml --history-db " + dir + "/history.sqlite --report " + report);
+    EXPECT_EQ(c.code, 1) << c.out << c.err;
+    std::ifstream f(report);
+    return nlohmann::json::parse(f, nullptr, false);
+  };
+  const nlohmann::json print = check(dir + "/rig.yaml", dir + "/print.json");
+  ASSERT_TRUE(print.is_object());
+  const std::string said = print["explanation"];
+  EXPECT_EQ(said.find("the board's print is not its file's size: every module measures the board 0.30"), 0u) << said;
+  EXPECT_EQ(said.find("neither"), std::string::npos) << said;
+  EXPECT_EQ(print["flagged_cameras"], nlohmann::json::array()) << print.dump(2);
+  EXPECT_EQ(print["camera_changes"], nlohmann::json::array()) << print.dump(2);
+  ASSERT_TRUE(print["shared_scale"].is_number()) << print.dump(2);
+  EXPECT_NEAR(print["shared_scale"].get<double>(), 1.003, 0.0003) << print.dump(2);
+  EXPECT_EQ(print["shared_scale_print_only"], true) << print.dump(2);
+  fs::remove_all(dir);
+}
+
+// A module shifted 0.1 or 0.3 mm, on the walkthrough's seed 505, whose
+// nights have captures of three views: the lone camera, read through the
+// other module's views alone, carries the whole shift, while its bound came
+// from its four-view captures where its partner's pose absorbs it, and the
+// capture was set aside as taken at another moment (the walkthrough's
+// calibrated rig, 0.1 mm: capture 001, 0.621 px against a bound of 0.608
+// px; the truth rig here, 0.3 mm: capture 005). Compared like for like,
+// nothing is set aside and the closure still fails. A trigger slip in a
+// capture of three views is still set aside
+// (NightlyCheck.ASlipInACaptureOfThreeViewsIsNotBlamedOnTheLoneModulesCamera).
+TEST(CheckCli, AModuleShiftSetsNoCaptureOfThreeViewsAsideAsTakenAtAnotherMoment) {
+  const std::string dir = ::testing::TempDir() + "/check_cli_shift3_" + std::to_string(getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // The rig as stored: the truth of a night before the shift (a bumped
+  // night's truth is the bumped rig).
+  ASSERT_EQ(RunCli("simulate --out " + dir + "/unmoved --seed 505 --calibration-captures 1 --no-scenes").code, 0);
+  WriteStoredRig(dir + "/unmoved/truth/rig.yaml", 0.03, dir + "/rig.yaml", dir + "/unmoved/target.yaml");
+  for (const std::string mm : {"0.1", "0.3"}) {
+    const std::string captures = dir + "/shifted" + mm;
+    Result r = RunCli("simulate --out " + captures + " --seed 505 --calibration-captures 8 --no-scenes " +
+                      "--bump-module 1 --bump-translation-mm " + mm);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::string report = dir + "/shifted" + mm + ".json";
+    r = RunCli("check --rig " + dir + "/rig.yaml --captures " + captures + "/calibration --target " + captures +
+               "/target.yaml --history-db " + dir + "/history.sqlite --report " + report);
+    EXPECT_EQ(r.code, 1) << r.out << r.err;
+    EXPECT_EQ(r.out.find("set aside"), std::string::npos) << mm << " mm: " << r.out;
+    std::ifstream f(report);
+    const nlohmann::json j = nlohmann::json::parse(f, nullptr, false);
+    ASSERT_TRUE(j.is_object());
+    EXPECT_EQ(j["views_set_aside"], nlohmann::json::array()) << mm << " mm: " << j["views_set_aside"].dump(2);
+    EXPECT_EQ(j["flagged_modules"], nlohmann::json::array({0, 1})) << mm << " mm: " << j["explanation"];
+  }
+  fs::remove_all(dir);
+}
+
+// --k-sigma's help and its refusal said "k times its figure's sigma", but
+// a threshold is the figure's expected value on an unchanged rig plus k
+// standard deviations (a mean square's expectation is not zero): they say
+// so now.
+TEST(CheckCli, KSigmaIsSaidAsStandardDeviationsAboveTheExpectedValue) {
+  const Result help = RunCli("check --help");
+  EXPECT_EQ(help.code, 0) << help.err;
+  EXPECT_NE(help.out.find("expected value on an unchanged rig plus k of its standard deviations"), std::string::npos)
+      << help.out;
+  EXPECT_EQ(help.out.find("k times"), std::string::npos) << help.out;
+  const std::string dir = ::testing::TempDir() + "/check_cli_ksigma_" + std::to_string(getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const Result refused =
+      RunCli("check --rig " + dir + "/rig.yaml --captures " + dir + " --target " + dir + "/target.yaml --k-sigma 11");
+  EXPECT_EQ(refused.code, 2) << refused.out << refused.err;
+  EXPECT_NE(refused.err.find("--k-sigma: must be in (0, 10] (each threshold is its figure's expected value on an "
+                             "unchanged rig plus k of its standard deviations)"),
+            std::string::npos)
+      << refused.err;
   fs::remove_all(dir);
 }
 

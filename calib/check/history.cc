@@ -679,9 +679,9 @@ std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<
       out += line + sp.run->rig_path + " (crc32 " + sp.run->rig_crc32 + ", back_from_front " + sp.run->board + ")\n";
     }
   }
-  // Each threshold is k_sigma times its figure's sigma: runs at another k
-  // failed (or passed) against other thresholds, so the fails counted below
-  // are not one k's.
+  // Each threshold is its figure's expectation plus k_sigma of its standard
+  // deviations: runs at another k failed (or passed) against other
+  // thresholds, so the fails counted below are not one k's.
   std::map<std::string, std::vector<long long>> runs_at_k;  // k (or "unknown") -> its runs
   for (const HistoryRun& r : runs) runs_at_k[r.k_sigma ? KSigmaText(*r.k_sigma) : "unknown"].push_back(r.id);
   if (runs_at_k.size() > 1) {

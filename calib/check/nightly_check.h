@@ -167,6 +167,11 @@ struct CheckResult {
   // camera or module named alone.
   bool shared_scale_explains = false;
   double shared_scale = 1;  // the board's size over its file's, where shared_scale_explains
+  // Where shared_scale_explains: the board as a solid (the plate's
+  // thickness scaled too) did not explain the night, its faces' prints
+  // scaled alone did. No change of the rig's scale reads so (a rig scaled
+  // sees the solid): the board's print is not its file's size.
+  bool shared_scale_print_only = false;
   bool ok() const;
   std::string Verdict() const { return ok() ? "ok" : "recalibrate"; }
   std::string Explanation() const;  // one line: what changed, in no more words than the figures support
