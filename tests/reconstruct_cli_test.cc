@@ -1471,5 +1471,28 @@ TEST_F(ReconstructCli, ABatchRefusesOneFolderGivenThroughALinkToo) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+// Module 0's right camera (cam1) not triggered: its image black, the left's
+// grid-lit. The left's pixels all end no_sgm_match, and the summary used to
+// send the user to the measurement volume; it names the dark right image.
+TEST_F(ReconstructCli, ADarkRightImageIsNamedNotTheVolume) {
+  const std::string capture = BrokenCapture("dark_right");
+  const std::string image = capture + "/cam1.png";
+  ASSERT_TRUE(cv::imwrite(image, cv::Mat::zeros(cv::imread(image).size(), CV_8UC1)));
+  const testing::Result r = testing::RunCli(Args(capture));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string says =
+      "no point: no pixel of the right camera's image (cam1.png) is grid-lit (9x9 std above "
+      "lit_contrast_dn), while the left camera's (cam0.png) is: a dark or flat right image";
+  const size_t at = r.out.find("module 0: 0 points"), next = r.out.find("\nmodule 1: ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  ASSERT_NE(next, std::string::npos) << r.out;
+  const std::string summary = r.out.substr(at, next - at);
+  EXPECT_NE(summary.find("\n  " + says), std::string::npos) << summary;
+  EXPECT_EQ(summary.find("working_distance_mm"), std::string::npos) << summary;
+  EXPECT_NE(r.err.find("stereorig reconstruct: warning: module 0 gave no point: " + says.substr(10)), std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.out.find("module 1: 0 points"), std::string::npos) << r.out;  // module 1's cameras are lit
+}
+
 }  // namespace
 }  // namespace stereorig
