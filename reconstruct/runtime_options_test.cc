@@ -307,5 +307,17 @@ TEST(RuntimeOptions, ASecondYamlDocumentIsRefused) {
   EXPECT_EQ(RefusalOf("object_size_mm: 50\n---\n"), "");
 }
 
+// docs/formats.md: a file with every key commented out reads as the
+// defaults. `match:` with every key under it commented out is YAML's null,
+// and was refused ("match: expected a mapping"); it reads as a `match`
+// section with no keys: the matcher's defaults.
+TEST(RuntimeOptions, AMatchSectionWithEveryKeyCommentedOutIsTheDefaults) {
+  const RuntimeOptions o = ParseRuntimeOptions("object_size_mm: 60\nmatch:\n#  min_zncc: 0.7\n", "cm.yaml");
+  EXPECT_EQ(o.object_size_mm, 60);
+  EXPECT_EQ(o.match.min_zncc, MatchOptions{}.min_zncc);
+  EXPECT_EQ(ParseRuntimeOptions("match: ~\n", "cm.yaml").match.min_zncc, MatchOptions{}.min_zncc);
+  EXPECT_EQ(RefusalOf("match: 3\n"), "o.yaml: match: expected a mapping");
+}
+
 }  // namespace
 }  // namespace stereorig
