@@ -319,5 +319,18 @@ TEST(RuntimeOptions, AMatchSectionWithEveryKeyCommentedOutIsTheDefaults) {
   EXPECT_EQ(RefusalOf("match: 3\n"), "o.yaml: match: expected a mapping");
 }
 
+// A one-row vernier window (line_index_window_half_height_px 0) cannot read
+// the row offset the line index tests, and was accepted: every point of 8
+// of the demo's 10 modules went (wrong_line). Refused, saying why; 1, the
+// smallest that works on the demo scenes, is read.
+TEST(RuntimeOptions, AOneRowVernierWindowIsRefused) {
+  EXPECT_EQ(RefusalOf("match:\n  line_index_window_half_height_px: 0\n"),
+            "o.yaml: match.line_index_window_half_height_px: must be in [1, 30] (3 to 61 rows): the vernier fits a "
+            "row offset between the views, which a window of one row (0) cannot read");
+  EXPECT_EQ(ParseRuntimeOptions("match:\n  line_index_window_half_height_px: 1\n", "o.yaml")
+                .match.line_index.window_half_height_px,
+            1);
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -1547,5 +1547,15 @@ TEST_F(ReconstructCli, AnOptionsSectionWithEveryKeyCommentedOutIsTheDefaults) {
   EXPECT_TRUE(std::filesystem::exists(dir_ + "/out.ply"));
 }
 
+// A one-row vernier window was accepted, and module 1 of the sphere lost
+// every point (wrong_line): refused before any work, saying why.
+TEST_F(ReconstructCli, AOneRowVernierWindowIsRefused) {
+  WriteFileAtomically(dir_ + "/one_row.yaml", "match:\n  line_index_window_half_height_px: 0\n");
+  ExpectRefusedInOneLine(Args(dir_ + "/capture", "--options " + dir_ + "/one_row.yaml"),
+                         "one_row.yaml: match.line_index_window_half_height_px: must be in [1, 30] (3 to 61 rows): "
+                         "the vernier fits a row offset between the views, which a window of one row (0) cannot read");
+  ExpectNoOutput();
+}
+
 }  // namespace
 }  // namespace stereorig
