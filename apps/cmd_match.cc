@@ -132,6 +132,11 @@ int RunMatch(int argc, char** argv) {
   const cv::Mat left = ReadGreyImage(left_path, std::nullopt, kMaxMatchPixels, why_max);
   const cv::Mat right = ReadGreyImage(right_path, std::nullopt, kMaxMatchPixels, why_max);
   if (left.size() != right.size()) throw InputError(right_path, "size differs from the left image");
+  // Smaller, the coarse level has no pixel (OpenCV's resize aborted: exit 134).
+  if (const MinMatchImage min = MinMatchImageSize(options); left.cols < min.size.width || left.rows < min.size.height)
+    throw InputError(left_path, "is " + std::to_string(left.cols) + "x" + std::to_string(left.rows) +
+                                    " px (the right image too), smaller than the " + std::to_string(min.size.width) +
+                                    "x" + std::to_string(min.size.height) + " px match needs " + min.why);
   // A region partly or wholly outside the image, or empty, is a mistake to
   // name, not one to clip or widen to the whole image without a word.
   const cv::Rect image(0, 0, left.cols, left.rows);

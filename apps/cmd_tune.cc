@@ -119,11 +119,13 @@ int RunTune(int argc, char** argv) {
 
   const Reconstruction reconstruction = runtime.Process(images, false);
   std::vector<double> periods;
-  std::string measured;  // "module 0 8.07 px (spread 0.04 px, turned 2.53 deg), ...": the file's header
+  std::string measured;    // "module 0 8.07 px (spread 0.04 px, turned 2.53 deg), ...": the file's header
+  std::string unmeasured;  // "module 1, module 2": those with no period, warned of and named in the header
   for (const ModulePlan& plan : runtime.plans()) {
     const auto m = MeasureModule(runtime, plan, images);
     if (!m) {
       std::printf("module %d: no grid period found in its lit region (too few lit rows, or no lines)\n", plan.module);
+      unmeasured += (unmeasured.empty() ? "module " : ", module ") + std::to_string(plan.module);
       continue;
     }
     std::printf("module %d: grid period %.2f px along the rows, spread %.2f px over %d blocks of %d rows\n",
@@ -198,6 +200,14 @@ int RunTune(int argc, char** argv) {
                          NumberText(kMaxGridPeriodPx) +
                          " px along the rows): are the lasers on, and the plate inside the measurement volume? (a "
                          "passive capture has no grid)");
+  // The keys then come from the other modules alone: said on stderr and in
+  // the file, not only in a stdout line that a script drops.
+  if (!unmeasured.empty())
+    std::fprintf(stderr,
+                 "tune: warning: no grid period was found for %s in %s (too few lit rows, or no lines: its lasers "
+                 "off, or the plate outside its view): the keys are set from the other modules only; capture the "
+                 "plate with every module's lasers on\n",
+                 unmeasured.c_str(), capture_dir.c_str());
   std::vector<double> sorted = periods;
   std::sort(sorted.begin(), sorted.end());
   const double period_px = 0.5 * (sorted[(sorted.size() - 1) / 2] + sorted[sorted.size() / 2]);
@@ -244,7 +254,11 @@ int RunTune(int argc, char** argv) {
   const std::string header = "Runtime options from `stereorig tune --capture " + capture_dir + "` with the rig " +
                              rig_path + ".\nThe laser grid's period along the rectified rows: " + measured +
                              ".\nThe match keys tied to it were set from P = " + NumberText(period_px) +
-                             " px (docs/reconstruct.md, \"Another projector\").";
+                             " px (docs/reconstruct.md, \"Another projector\")." +
+                             (unmeasured.empty() ? ""
+                                                 : "\nNo grid period was found for " + unmeasured +
+                                                       " (its lasers off, or the plate outside its view): these keys "
+                                                       "are the other modules' only.");
   const std::string text = TunedOptionsYaml(options_text, keys, header);
   ParseRuntimeOptions(text, out_path).Check();  // what a later --options will read: the same keys, valid
   WriteFileAtomically(out_path, text);

@@ -5,6 +5,8 @@
 #include <utility>
 #include <vector>
 
+#include "calib/core/capture_image_name.h"
+
 namespace stereorig {
 
 std::string LossLine(std::span<const int> counts_by_status, int total_px, int max_reasons) {
@@ -79,9 +81,16 @@ std::string AdviceFor(PixelStatus status) {
 // counts only its ROI), the left image is lit elsewhere (the volume is
 // beside the object) or nowhere (no grid: a dark or flat image, the
 // projector off, or a passive capture): camera_lit_pixels tells which (-1:
-// not counted).
+// not counted). A right image grid-lit nowhere while the left is lit comes
+// first: whatever status the left's pixels ended with, no search could match
+// them, and the volume's advice would send the user the wrong way.
 std::string NoPointReason(const ModuleReport& m) {
   if (m.points > 0) return "";
+  if (m.right_camera_lit_pixels == 0 && (m.lit_pixels > 0 || m.camera_lit_pixels > 0))
+    return "no pixel of the right camera's image (" + CameraImageName(m.right_camera) +
+           ") is grid-lit (9x9 std above lit_contrast_dn), while the left camera's (" + CameraImageName(m.left_camera) +
+           ") is: a dark or flat right image (that camera not triggered, too short an exposure, the grid out of its "
+           "view), which no search can match; check the capture";
   if (m.lit_pixels > 0) {
     size_t top = size_t(PixelStatus::kNotSearched);
     for (size_t k = 0; k < m.lit_by_status.size(); ++k)

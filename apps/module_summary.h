@@ -40,13 +40,16 @@ struct FillWording {
 // pixel in the volume's ROI, whether the left image is lit elsewhere (the
 // volume is beside the object: where to set it) or nowhere (no lit pixels:
 // the projector off, a passive capture, a dark or flat image), from
-// ModuleReport::camera_lit_pixels.
+// ModuleReport::camera_lit_pixels; a right image lit nowhere while the left
+// is lit (ModuleReport::right_camera_lit_pixels) is named before any of
+// those: that camera not triggered, not the volume.
 std::string ModuleSummary(const ModuleReport& m, FillWording wording = {}, int max_reasons = 3);
 
 // Why a module gave no point and what to do, "" for one with a point:
 // ModuleSummary's last line without its "no point: " (the status most of its
 // lit pixels ended with and its advice, or, with no lit pixel in the ROI,
-// whether the left image is lit elsewhere or nowhere). A batch's and a
+// whether the left image is lit elsewhere or nowhere; a dark right image
+// first). A batch's and a
 // stream's warning line and a single capture's stderr give it too: a module
 // that gives no point (lasers off, a camera not triggered, its cables
 // swapped) must not pass as a measurement.

@@ -145,5 +145,41 @@ TEST(ModuleSummary, MatchesReachingAnEndOfTheRangeAreWarnedOf) {
   EXPECT_EQ(ends(), "");
 }
 
+// A right camera not triggered (its image dark) while the left is lit: the
+// left's pixels end as no_sgm_match, which was put down to the volume. The
+// dark right image is named first, with no word of the volume; lit, or
+// not counted (-1), the advice is as before.
+TEST(ModuleSummary, ADarkRightImageIsNamedNotTheVolume) {
+  ModuleReport m = Report();
+  m.points = m.lit_filled = 0;
+  m.left_camera = 2;
+  m.right_camera = 3;
+  m.lit_by_status[size_t(PixelStatus::kNoSgmMatch)] = 1000;
+  m.right_camera_lit_pixels = 0;
+  const std::string dark = ModuleSummary(m);
+  EXPECT_NE(dark.find("\n  no point: no pixel of the right camera's image (cam3.png) is grid-lit (9x9 std above "
+                      "lit_contrast_dn), while the left camera's (cam2.png) is: a dark or flat right image (that "
+                      "camera not triggered"),
+            std::string::npos)
+      << dark;
+  EXPECT_EQ(dark.find("working_distance_mm"), std::string::npos) << dark;
+  m.lit_pixels = 0;  // the left lit only beside the volume: still the right camera
+  m.camera_lit_pixels = 5000;
+  EXPECT_NE(ModuleSummary(m).find("no point: no pixel of the right camera's image (cam3.png)"), std::string::npos)
+      << ModuleSummary(m);
+  m.camera_lit_pixels = 0;  // both dark: the projector, as before
+  EXPECT_NE(ModuleSummary(m).find("no point: no lit pixels: is the projector on"), std::string::npos)
+      << ModuleSummary(m);
+  m.lit_pixels = 1000;
+  m.camera_lit_pixels = -1;
+  for (const int right_lit : {-1, 4000}) {
+    m.right_camera_lit_pixels = right_lit;
+    EXPECT_NE(ModuleSummary(m).find("no point: no_sgm_match 100.0% of the lit pixels: the search found no consistent "
+                                    "match: the object may not be in the measurement volume"),
+              std::string::npos)
+        << ModuleSummary(m);
+  }
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -535,10 +535,34 @@ RefineAcceptance AcceptanceFor(const MatchOptions& o) {
   return accept;
 }
 
+MinMatchImage MinMatchImageSize(const MatchOptions& o) {
+  if (o.matcher != MatcherKind::kCensusSgm) return {cv::Size(1, 1), "(it matches at full resolution only)"};
+  const cv::Size window(2 * o.census_half_width_px + 1, 2 * o.census_half_height_px + 1);
+  const std::string census = "a census window of " + std::to_string(window.width) + "x" +
+                             std::to_string(window.height) + " px (census_half_width_px, census_half_height_px)";
+  if (o.pyramid_levels > 0) {
+    const int f = 1 << o.pyramid_levels;
+    return {cv::Size(f * window.width, f * window.height),
+            "with these options: its coarsest level, the images halved " + std::to_string(o.pyramid_levels) +
+                " times (pyramid_levels), must hold " + census};
+  }
+  if (o.narrow_range) {
+    const int fy = 2 * o.band_row_step;
+    return {cv::Size(2 * window.width, fy * window.height),
+            "with these options: the band pass's images, at half the columns and 1/" + std::to_string(fy) +
+                " of the rows (narrow_range, band_row_step), must hold " + census};
+  }
+  return {window, "with these options: the images must hold " + census};
+}
+
 MatchResult Match(const cv::Mat& left, const cv::Mat& right, const MatchOptions& options) {
   options.Check();
   if (left.type() != CV_8UC1 || right.type() != CV_8UC1) throw InputError("match", "images must be 8-bit grey");
   if (left.size() != right.size()) throw InputError("match", "left and right images differ in size");
+  if (const MinMatchImage min = MinMatchImageSize(options); left.cols < min.size.width || left.rows < min.size.height)
+    throw InputError("match", "images of " + std::to_string(left.cols) + "x" + std::to_string(left.rows) +
+                                  " px are smaller than the " + std::to_string(min.size.width) + "x" +
+                                  std::to_string(min.size.height) + " px the matcher needs " + min.why);
   if (!options.right_valid.empty() && options.right_valid.size() != right.size())
     throw InputError("right_valid", "differs in size from the right image");
   if (!options.left_valid.empty() && options.left_valid.size() != left.size())

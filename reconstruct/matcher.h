@@ -227,7 +227,21 @@ struct MatchResult {
 // set them: the matcher's and anything that re-judges its matches.
 RefineAcceptance AcceptanceFor(const MatchOptions& options);
 
-// left, right: CV_8UC1, same size, rectified. Stateless and thread-safe.
+// The smallest images Match takes with `options`, and why ("its coarsest
+// level ... must hold a census window of 5x7 px"). census_sgm matches first
+// at a coarser resolution (the images halved pyramid_levels times, or the
+// band pass's half columns and 1 / (2 band_row_step) rows), whose images
+// must still hold one census window: smaller, no pixel there has a window
+// in the image (and below one pixel OpenCV's resize aborted the process).
+// The OpenCV matchers work at full resolution only: 1x1.
+struct MinMatchImage {
+  cv::Size size;
+  std::string why;
+};
+MinMatchImage MinMatchImageSize(const MatchOptions& options);
+
+// left, right: CV_8UC1, same size (at least MinMatchImageSize), rectified.
+// Stateless and thread-safe.
 MatchResult Match(const cv::Mat& left, const cv::Mat& right, const MatchOptions& options);
 
 }  // namespace stereorig

@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 #include <utility>
 
+#include "calib/core/input_error.h"
 #include "reconstruct/synthetic_pair.h"
 
 namespace stereorig {
@@ -367,6 +368,34 @@ TEST(Matcher, SkippedColumnsDoNotReachPastASilhouette) {
     // the margins' rows: ~141 x 216 px.
     EXPECT_GT(inside, 0.97 * 141 * (pair.left.rows - 2 * kMargin)) << step;
   }
+}
+
+// The smallest images follow the options (a census window at the coarsest
+// level), and smaller ones are refused as input: a 1-row pair used to reach
+// OpenCV's resize to 0 px, a cv::Exception that aborted the process.
+TEST(Matcher, ImagesSmallerThanTheCoarseLevelNeedsAreRefused) {
+  MatchOptions o;
+  o.num_disparities = 16;
+  EXPECT_EQ(MinMatchImageSize(o).size, cv::Size(10, 14));  // the band pass halves columns and rows
+  o.band_row_step = 2;
+  EXPECT_EQ(MinMatchImageSize(o).size, cv::Size(10, 28));
+  o.band_row_step = 1;
+  o.narrow_range = false;
+  EXPECT_EQ(MinMatchImageSize(o).size, cv::Size(5, 7));
+  o.pyramid_levels = 2;
+  o.census_half_width_px = 4;
+  EXPECT_EQ(MinMatchImageSize(o).size, cv::Size(36, 28));
+  o.matcher = MatcherKind::kOpenCvSgbm3Way;  // full resolution only
+  EXPECT_EQ(MinMatchImageSize(o).size, cv::Size(1, 1));
+  const MatchOptions defaults = [] {
+    MatchOptions d;
+    d.num_disparities = 16;
+    return d;
+  }();
+  const cv::Mat row(1, 100, CV_8UC1, cv::Scalar(7));
+  EXPECT_THROW(Match(row, row, defaults), InputError);
+  const cv::Mat smallest(14, 10, CV_8UC1, cv::Scalar(7));
+  EXPECT_NO_THROW(Match(smallest, smallest, defaults));
 }
 
 }  // namespace

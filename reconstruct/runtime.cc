@@ -190,6 +190,8 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
                             PointCloud* cloud, Mesh* mesh, ModuleReport* report,
                             std::pair<cv::Mat, cv::Mat>* rectified) const {
   report->module = plan.module;
+  report->left_camera = rig_.module(plan.module).left_camera;
+  report->right_camera = rig_.module(plan.module).right_camera;
   auto t = Clock::now();
   const auto [left, right] = Rectify(plan, images);
   if (rectified) *rectified = {left, right};  // shared, not copied
@@ -380,9 +382,11 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
       report->lit_filled += in && unsigned(xi) < unsigned(r.width) && in[xi] >= 0;
     }
   }
-  if (report->lit_pixels == 0)  // an empty module's why (module_summary.h); a few ms, only then
-    report->camera_lit_pixels =
-        cv::countNonZero(LitMask(images[rig_.module(plan.module).left_camera], options_.lit_contrast_dn));
+  // An empty module's why (module_summary.h); a few ms, only then.
+  if (report->lit_pixels == 0)
+    report->camera_lit_pixels = cv::countNonZero(LitMask(images[report->left_camera], options_.lit_contrast_dn));
+  if (report->points == 0)
+    report->right_camera_lit_pixels = cv::countNonZero(LitMask(images[report->right_camera], options_.lit_contrast_dn));
   report->times_ms["normals"] = MsSince(t);
 
   if (!build_mesh) return;

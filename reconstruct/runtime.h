@@ -85,6 +85,12 @@ struct ModuleReport {
   // camera's whole image, unrectified. Tells a volume beside what the grid
   // lights (> 0) from a capture it lights nowhere (0: dark, no grid).
   int camera_lit_pixels = -1;
+  // Only when the module kept no point (else -1): the grid-lit pixels of the
+  // right camera's whole image, unrectified. 0 while the left is lit: the
+  // right camera saw no grid (not triggered, a dark or flat image), so no
+  // search could match, wherever the volume is.
+  int right_camera_lit_pixels = -1;
+  int left_camera = -1, right_camera = -1;  // the module's cameras (Rig indices: capture images camK.png)
   // The lit pixels by their final PixelStatus (disparity_state.h): kPoint
   // counts lit_filled, the others name the test that refused the rest. The
   // runtime's own account of where fill goes, with no truth needed.

@@ -123,7 +123,7 @@ RuntimeOptions FromYaml(YamlMap& y) {
   y.Read("free_space_min_facing_cos", &o.free_space.min_facing_cos);
   y.Read("free_space_surface_fraction", &o.free_space.surface_fraction);
   if (y.Has("match")) {
-    YamlMap m = y.GetMap("match");
+    YamlMap m = y.GetMapOrEmpty("match");  // `match:` with every key commented out: the defaults
     MatchOptions& mo = o.match;
     mo.matcher = ParseMatcherKind(m.GetString("matcher", "census_sgm"), m.Where("matcher"));
     m.Read("pyramid_levels", &mo.pyramid_levels);

@@ -307,5 +307,30 @@ TEST(RuntimeOptions, ASecondYamlDocumentIsRefused) {
   EXPECT_EQ(RefusalOf("object_size_mm: 50\n---\n"), "");
 }
 
+// docs/formats.md: a file with every key commented out reads as the
+// defaults. `match:` with every key under it commented out is YAML's null,
+// and was refused ("match: expected a mapping"); it reads as a `match`
+// section with no keys: the matcher's defaults.
+TEST(RuntimeOptions, AMatchSectionWithEveryKeyCommentedOutIsTheDefaults) {
+  const RuntimeOptions o = ParseRuntimeOptions("object_size_mm: 60\nmatch:\n#  min_zncc: 0.7\n", "cm.yaml");
+  EXPECT_EQ(o.object_size_mm, 60);
+  EXPECT_EQ(o.match.min_zncc, MatchOptions{}.min_zncc);
+  EXPECT_EQ(ParseRuntimeOptions("match: ~\n", "cm.yaml").match.min_zncc, MatchOptions{}.min_zncc);
+  EXPECT_EQ(RefusalOf("match: 3\n"), "o.yaml: match: expected a mapping");
+}
+
+// A one-row vernier window (line_index_window_half_height_px 0) cannot read
+// the row offset the line index tests, and was accepted: every point of 8
+// of the demo's 10 modules went (wrong_line). Refused, saying why; 1, the
+// smallest that works on the demo scenes, is read.
+TEST(RuntimeOptions, AOneRowVernierWindowIsRefused) {
+  EXPECT_EQ(RefusalOf("match:\n  line_index_window_half_height_px: 0\n"),
+            "o.yaml: match.line_index_window_half_height_px: must be in [1, 30] (3 to 61 rows): the vernier fits a "
+            "row offset between the views, which a window of one row (0) cannot read");
+  EXPECT_EQ(ParseRuntimeOptions("match:\n  line_index_window_half_height_px: 1\n", "o.yaml")
+                .match.line_index.window_half_height_px,
+            1);
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -186,6 +186,7 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
 #include <iterator>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <tuple>
 
 #include "calib/core/png_testing.h"
 #include "calib/core/rig_file.h"
@@ -1538,6 +1539,91 @@ TEST_F(ReconstructCli, ABatchRemovesAnEarlierRunsMeshOfTheOtherFormat) {
                                                "good.mesh.stl", "good.ply"}))
       << r.out;
   EXPECT_GT(std::filesystem::file_size(out + "/bad.mesh.ply"), 1000000u);  // the cloud this run wrote
+}
+
+// Module 0's right camera (cam1) not triggered: its image black, the left's
+// grid-lit. The left's pixels all end no_sgm_match, and the summary used to
+// send the user to the measurement volume; it names the dark right image.
+TEST_F(ReconstructCli, ADarkRightImageIsNamedNotTheVolume) {
+  const std::string capture = BrokenCapture("dark_right");
+  const std::string image = capture + "/cam1.png";
+  ASSERT_TRUE(cv::imwrite(image, cv::Mat::zeros(cv::imread(image).size(), CV_8UC1)));
+  const testing::Result r = testing::RunCli(Args(capture));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string says =
+      "no point: no pixel of the right camera's image (cam1.png) is grid-lit (9x9 std above "
+      "lit_contrast_dn), while the left camera's (cam0.png) is: a dark or flat right image";
+  const size_t at = r.out.find("module 0: 0 points"), next = r.out.find("\nmodule 1: ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  ASSERT_NE(next, std::string::npos) << r.out;
+  const std::string summary = r.out.substr(at, next - at);
+  EXPECT_NE(summary.find("\n  " + says), std::string::npos) << summary;
+  EXPECT_EQ(summary.find("working_distance_mm"), std::string::npos) << summary;
+  EXPECT_NE(r.err.find("stereorig reconstruct: warning: module 0 gave no point: " + says.substr(10)), std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.out.find("module 1: 0 points"), std::string::npos) << r.out;  // module 1's cameras are lit
+}
+
+// Images too small for the matcher's coarse level (1 px high; narrower than
+// its halvings): OpenCV's resize to 0 px aborted the process (exit 134).
+// Now exit 2 naming the image and the smallest size the options allow: a
+// census window (5x7 px by default) at the coarsest level, so 10x14 px with
+// the band pass's halving, 40x56 with 3 pyramid levels; at that size it
+// matches.
+TEST(MatchCli, ImagesTooSmallForTheCoarseLevelExitTwoNamingTheMinimum) {
+  const std::string dir = ::testing::TempDir() + "/match_cli_tiny";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  cv::Mat ramp(1, 100, CV_8UC1);
+  for (int x = 0; x < ramp.cols; ++x) ramp.at<uint8_t>(0, x) = uint8_t(x);
+  ASSERT_TRUE(cv::imwrite(dir + "/row.png", ramp));
+  ASSERT_TRUE(cv::imwrite(dir + "/column.png", ramp.t()));
+  ASSERT_TRUE(cv::imwrite(dir + "/32.png", cv::Mat(32, 32, CV_8UC1, cv::Scalar(100))));
+  ASSERT_TRUE(cv::imwrite(dir + "/10x14.png", cv::Mat(14, 10, CV_8UC1, cv::Scalar(100))));
+  const std::string out = dir + "/d.pfm";
+  auto match = [&](const std::string& image, const std::string& extra = "") {
+    return testing::RunCli("match --left " + dir + "/" + image + " --right " + dir + "/" + image +
+                           " --min-disparity 0 --num-disparities 16 --out " + out + extra);
+  };
+  const std::tuple<std::string, std::string, std::string> refused[] = {
+      {"row.png", "", "row.png: is 100x1 px (the right image too), smaller than the 10x14 px match needs"},
+      {"column.png", "", "column.png: is 1x100 px (the right image too), smaller than the 10x14 px match needs"},
+      {"32.png", " --pyramid-levels 3",
+       "32.png: is 32x32 px (the right image too), smaller than the 40x56 px match needs with these options: its "
+       "coarsest level, the images halved 3 times (pyramid_levels), must hold a census window of 5x7 px"}};
+  for (const auto& [image, extra, says] : refused) {
+    const testing::Result r = match(image, extra);
+    EXPECT_EQ(r.code, 2) << image << extra << ": " << r.err;
+    EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(out)) << image;
+  }
+  for (const auto& [image, extra] : {std::pair{"10x14.png", ""}, {"32.png", " --pyramid-levels 1"}}) {
+    std::filesystem::remove(out);
+    const testing::Result r = match(image, extra);
+    EXPECT_EQ(r.code, 0) << image << extra << ": " << r.err;
+    EXPECT_TRUE(std::filesystem::exists(out)) << image;
+  }
+}
+
+// An options file whose `match:` keys are all commented out was refused
+// ("match: expected a mapping"), though docs/formats.md says a file with
+// every key commented out reads as the defaults. It reconstructs as they do.
+TEST_F(ReconstructCli, AnOptionsSectionWithEveryKeyCommentedOutIsTheDefaults) {
+  WriteFileAtomically(dir_ + "/commented_match.yaml", "object_size_mm: 60\nmatch:\n#  min_zncc: 0.7\n");
+  const testing::Result r = testing::RunCli(Args(dir_ + "/capture", "--options " + dir_ + "/commented_match.yaml"));
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(dir_ + "/out.ply"));
+}
+
+// A one-row vernier window was accepted, and module 1 of the sphere lost
+// every point (wrong_line): refused before any work, saying why.
+TEST_F(ReconstructCli, AOneRowVernierWindowIsRefused) {
+  WriteFileAtomically(dir_ + "/one_row.yaml", "match:\n  line_index_window_half_height_px: 0\n");
+  ExpectRefusedInOneLine(Args(dir_ + "/capture", "--options " + dir_ + "/one_row.yaml"),
+                         "one_row.yaml: match.line_index_window_half_height_px: must be in [1, 30] (3 to 61 rows): "
+                         "the vernier fits a row offset between the views, which a window of one row (0) cannot read");
+  ExpectNoOutput();
 }
 
 }  // namespace

@@ -322,5 +322,33 @@ TEST_F(TuneCli, OutputsOverInputsOrNotYamlAreRefused) {
   EXPECT_FALSE(fs::exists(dir_ + "/tuned.ply"));
 }
 
+// Module 1's images without the grid (the passive capture's), module 0's
+// with it: the keys come from module 0 alone, which used to be said only in
+// a stdout line. It is warned of on stderr and noted in the file's header.
+TEST_F(TuneCli, AModuleWithNoPeriodIsWarnedOfAndNotedInTheFile) {
+  const std::string capture = dir_ + "/half_passive", out = dir_ + "/half_passive.yaml";
+  fs::remove_all(capture);
+  fs::create_directories(capture);
+  for (int k = 0; k < 4; ++k) {
+    const std::string image = "/cam" + std::to_string(k) + ".png";
+    fs::copy_file(dir_ + "/fine/scenes/plate/" + (k < 2 ? "active" : "passive") + image, capture + image);
+  }
+  fs::remove(out);
+  const testing::Result r =
+      testing::RunCli("tune --rig " + dir_ + "/fine/truth/rig.yaml --capture " + capture + " --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(Periods(r.out).size(), 1u) << r.out;
+  EXPECT_NE(r.err.find("tune: warning: no grid period was found for module 1 in " + capture), std::string::npos)
+      << r.err;
+  std::ifstream in(out);
+  const std::string text(std::istreambuf_iterator<char>(in), {});
+  EXPECT_NE(text.find("\n# No grid period was found for module 1 (its lasers off, or the plate outside its view): "
+                      "these keys are the other modules' only.\n"),
+            std::string::npos)
+      << text;
+  const testing::Result both = testing::RunCli(Tune("fine"));  // both modules with their grid: no such warning
+  EXPECT_EQ(both.err.find("no grid period"), std::string::npos) << both.err;
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -303,6 +303,12 @@ YamlMap YamlMap::GetMap(const std::string& key) {
   return YamlMap(n, file_, key_path_.empty() ? key : key_path_ + "." + key);
 }
 
+YamlMap YamlMap::GetMapOrEmpty(const std::string& key) {
+  if (Has(key) && Require(key).IsNull())
+    return YamlMap(YAML::Node(YAML::NodeType::Map), file_, key_path_.empty() ? key : key_path_ + "." + key);
+  return GetMap(key);
+}
+
 std::vector<YamlMap> YamlMap::GetMaps(const std::string& key) {
   YAML::Node n = Require(key);
   if (!n.IsSequence()) throw InputError(Where(key), "expected a list");

@@ -50,6 +50,12 @@ class YamlMap {
   // A 4x4 matrix as four rows of four numbers.
   Eigen::Matrix4d GetMatrix4(const std::string& key);
   YamlMap GetMap(const std::string& key);
+  // The same, but a key with no value (YAML's null: `match:` with every key
+  // under it commented out, or `~`) reads as a mapping with no keys, as an
+  // empty document does. Only for sections whose keys all have defaults
+  // (the runtime options): in the rig file, target file and the others an
+  // empty section is a mistake, and GetMap names it.
+  YamlMap GetMapOrEmpty(const std::string& key);
   std::vector<YamlMap> GetMaps(const std::string& key);  // a sequence of mappings
   // The raw node, for shapes the getters above do not cover.
   YAML::Node GetNode(const std::string& key);

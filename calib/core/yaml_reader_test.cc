@@ -220,5 +220,27 @@ TEST(YamlMap, SyntaxErrorsAreInputErrors) {
   EXPECT_THROW(YamlMap::LoadFile("/nonexistent/f.yaml"), InputError);
 }
 
+// A section with every key commented out is YAML's null, not a mapping:
+// GetMapOrEmpty (the options file's sections) reads it, and `~`, as a
+// mapping with no keys; GetMap (the rig file, target file and the others,
+// whose sections are required) still refuses it, as both refuse a scalar.
+TEST(YamlMap, AnEmptySectionIsAMappingOnlyWhereAskedFor) {
+  YamlMap y = YamlMap::LoadString("a:\n#  k: 1\nb: ~\nc: 3\n", "f.yaml");
+  YamlMap a = y.GetMapOrEmpty("a");
+  EXPECT_TRUE(a.Keys().empty());
+  EXPECT_EQ(a.GetInt("k", 5), 5);
+  EXPECT_NO_THROW(a.Finish());
+  EXPECT_EQ(a.Where("k"), "f.yaml: a.k");
+  EXPECT_TRUE(y.GetMapOrEmpty("b").Keys().empty());
+  EXPECT_EQ(InputErrorMessage([&] { y.GetMapOrEmpty("c"); }), "f.yaml: c: expected a mapping");
+  EXPECT_NO_THROW(y.Finish());
+}
+
+TEST(YamlMap, GetMapStillRefusesAnEmptySection) {
+  YamlMap y = YamlMap::LoadString("cameras:\n#  - name: cam0\ntarget: ~\n", "rig.yaml");
+  EXPECT_EQ(InputErrorMessage([&] { y.GetMap("cameras"); }), "rig.yaml: cameras: expected a mapping");
+  EXPECT_EQ(InputErrorMessage([&] { y.GetMap("target"); }), "rig.yaml: target: expected a mapping");
+}
+
 }  // namespace
 }  // namespace stereorig
