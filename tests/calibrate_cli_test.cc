@@ -782,5 +782,54 @@ TEST(CalibrateCli, CamerasTheLayoutLeavesOutAreWarnedOf) {
   EXPECT_EQ(CamerasLeftOutNote(set.dir + "/captures", 4), "");
 }
 
+// Copies of one capture (a trigger delivering one frame again, or the board
+// left still) count as one board pose: eight copies calibrated, exit 0,
+// with a baseline 10.8 mm off and sigmas shrunk by sqrt(8). Five copies
+// (the default's minimum of views) are refused, naming the camera and the
+// captures; a copy among enough poses calibrates, with a warning naming it
+// by its folder.
+TEST(CalibrateCli, CopiesOfOneCaptureAreOneBoardPose) {
+  const RenderedSet& set = Rendered();
+  std::ofstream(set.dir + "/one_module.yaml") << "modules:\n  - {name: module0, left: 0, right: 1, face: front}\n";
+  const std::string copies = set.dir + "/copies";
+  fs::remove_all(copies);
+  for (int c = 1; c <= 5; ++c)
+    for (const std::string image : {"cam0.png", "cam1.png"}) {
+      fs::create_directories(copies + "/00" + std::to_string(c));
+      fs::copy_file(set.dir + "/captures/000/" + image, copies + "/00" + std::to_string(c) + "/" + image);
+    }
+  const std::string args = " --target " + set.dir + "/target.yaml --layout " + set.dir + "/one_module.yaml --out " +
+                           set.dir + "/copies.yaml --report " + set.dir + "/copies.json";
+  const testing::Result r = testing::RunCli("calibrate --captures " + copies + args);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(copies + ": camera 0 (cam0): too few distinct board poses: its 5 usable views show 1, need at "
+                                "least 5; repeated: captures 1, 2, 3, 4 and 5 (corners within 1.41 px RMS"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(set.dir + "/copies.yaml"));
+  EXPECT_FALSE(fs::exists(set.dir + "/copies.json"));
+
+  // The set's 8 captures and capture 000 again as 008.
+  const std::string again = set.dir + "/again";
+  fs::remove_all(again);
+  fs::create_directories(again);
+  for (int c = 0; c < 8; ++c)
+    for (const std::string image : {"cam0.png", "cam1.png"}) {
+      fs::create_directories(again + "/00" + std::to_string(c));
+      fs::copy_file(set.dir + "/captures/00" + std::to_string(c) + "/" + image,
+                    again + "/00" + std::to_string(c) + "/" + image);
+    }
+  fs::copy(again + "/000", again + "/008");
+  const testing::Result a = testing::RunCli("calibrate --captures " + again + args);
+  ASSERT_EQ(a.code, 0) << a.err;
+  for (const std::string camera : {"camera 0 (cam0)", "camera 1 (cam1)"})
+    EXPECT_NE(a.err.find("calibrate: warning: " + camera + " sees one board pose again in captures 000, 008"),
+              std::string::npos)
+        << a.err;
+  std::ifstream report(set.dir + "/copies.json");
+  const nlohmann::json json = nlohmann::json::parse(report);
+  EXPECT_EQ(json["warnings"].size(), 2u) << json["warnings"].dump();
+}
+
 }  // namespace
 }  // namespace stereorig
