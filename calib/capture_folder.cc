@@ -43,6 +43,67 @@ std::vector<fs::path> CaptureSubfolders(const fs::path& root) {
   return captures;
 }
 
+std::string SizeText(const std::pair<int, int>& size_px) {
+  return std::to_string(size_px.first) + "x" + std::to_string(size_px.second);
+}
+
+// Throws InputError unless each camera's images in `captures` (of `dir`)
+// are of one size, naming the odd ones out: those of a size other than
+// most of the camera's images have, or, where no size has most, every size
+// with its files. Read from the headers only; an image that is missing or no PNG is
+// left to the detection loop, which names it. The first image read used to
+// set the size, and a first image of the wrong size had the error name a
+// right one.
+void RefuseOddImageSizes(const std::string& dir, const std::vector<fs::path>& captures, int num_cameras) {
+  for (int c = 0; c < num_cameras; ++c) {
+    std::map<std::pair<int, int>, std::vector<std::string>> images_of_size;
+    int images = 0;
+    for (const fs::path& capture : captures) {
+      const fs::path image = capture / CameraImageName(c);
+      if (!fs::is_regular_file(image)) continue;
+      std::optional<PngReader> png;
+      try {
+        png = PngReader::Open(image.string());
+      } catch (const InputError&) {
+      }
+      if (!png) continue;
+      images_of_size[{int(png->width_px()), int(png->height_px())}].push_back(image.string());
+      ++images;
+    }
+    if (images_of_size.size() < 2) continue;
+    const auto most = std::max_element(images_of_size.begin(), images_of_size.end(),
+                                       [](const auto& a, const auto& b) { return a.second.size() < b.second.size(); });
+    const std::string camera = "cam" + std::to_string(c);
+    if (2 * most->second.size() > size_t(images)) {
+      // The first image not of the majority's size is the error's file;
+      // the others are listed after it.
+      std::string first_path, first_size, others;
+      for (const auto& [size, paths] : images_of_size) {
+        if (size == most->first) continue;
+        for (const std::string& path : paths) {
+          if (first_path.empty()) {
+            first_path = path;
+            first_size = SizeText(size);
+          } else {
+            others += (others.empty() ? "" : ", ") + path + " " + SizeText(size);
+          }
+        }
+      }
+      throw InputError(first_path, "image of the wrong size: " + first_size + ", but " +
+                                       std::to_string(most->second.size()) + " of " + camera + "'s " +
+                                       std::to_string(images) + " images are " + SizeText(most->first) +
+                                       (others.empty() ? "" : " (also of another size: " + others + ")"));
+    }
+    std::string sizes;
+    for (const auto& [size, paths] : images_of_size) {
+      sizes += (sizes.empty() ? "" : "; ") + SizeText(size) + ":";
+      for (const std::string& path : paths) sizes += " " + path;
+    }
+    throw InputError(dir, camera + "'s images differ in size, and no size is most of them: " + sizes +
+                              " (images of another camera among them?)");
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> CaptureFolderImages(const std::string& dir) {
@@ -74,6 +135,8 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
   const fs::path dir = CapturesRoot(dir_in);
   const std::vector<fs::path> captures = CaptureSubfolders(dir);
   if (captures.empty()) throw InputError(dir.string(), "holds no capture folders (expected NNN/camK.png)");
+
+  if (rig_cameras.empty()) RefuseOddImageSizes(dir.string(), captures, num_cameras);
 
   DetectedCaptures out;
   out.num_captures = static_cast<int>(captures.size());

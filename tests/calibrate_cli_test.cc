@@ -435,7 +435,9 @@ TEST(CalibrateCli, RefusesImagesOfTheWrongSize) {
   const testing::Result r = testing::RunCli(calibrate);
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(testing::Lines(r.err.substr(r.err.rfind("stereorig calibrate:"))), 1) << r.err;
-  EXPECT_NE(r.err.find("wrong size"), std::string::npos) << r.err;
+  // One image of each size: neither is the odd one out, both are named.
+  EXPECT_NE(r.err.find("cam1's images differ in size, and no size is most of them: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("640x480: " + set.dir + "/captures/001/cam1.png"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(set.dir + "/rig.yaml"));
 
   // The size is read from the header, before the pixels are decoded: the
@@ -452,7 +454,7 @@ TEST(CalibrateCli, RefusesImagesOfTheWrongSize) {
   std::ofstream(cut, std::ios::binary | std::ios::trunc) << bytes.substr(0, 200);
   const testing::Result cut_run = testing::RunCli(calibrate);
   EXPECT_EQ(cut_run.code, 2);
-  EXPECT_NE(cut_run.err.find("cam1.png: image of the wrong size: 640x480"), std::string::npos) << cut_run.err;
+  EXPECT_NE(cut_run.err.find("640x480: " + set.dir + "/captures/001/cam1.png"), std::string::npos) << cut_run.err;
   EXPECT_FALSE(fs::exists(set.dir + "/rig.yaml"));
 }
 
@@ -829,6 +831,41 @@ TEST(CalibrateCli, CopiesOfOneCaptureAreOneBoardPose) {
   std::ifstream report(set.dir + "/copies.json");
   const nlohmann::json json = nlohmann::json::parse(report);
   EXPECT_EQ(json["warnings"].size(), 2u) << json["warnings"].dump();
+}
+
+// The rendered set's captures 000..`count - 1`, cameras 0 and 1 only (module
+// 0 of the layout one_module.yaml), copied into a fresh folder `dir`.
+void CopyModuleZeroCaptures(const RenderedSet& set, const std::string& dir, int count) {
+  fs::remove_all(dir);
+  for (int c = 0; c < count; ++c) {
+    const std::string capture = "/00" + std::to_string(c);
+    fs::create_directories(dir + capture);
+    for (const std::string image : {"/cam0.png", "/cam1.png"})
+      fs::copy_file(set.dir + "/captures" + capture + image, dir + capture + image);
+  }
+  std::ofstream(set.dir + "/one_module.yaml") << "modules:\n  - {name: module0, left: 0, right: 1, face: front}\n";
+}
+
+// An image of the wrong size in the first capture: the first image read set
+// the size, and the error named a right one (001/cam1.png). The odd one
+// out is named, against the size most of the camera's images have.
+TEST(CalibrateCli, AWrongSizedImageInTheFirstCaptureIsTheOneNamed) {
+  const RenderedSet& set = Rendered();
+  const std::string dir = set.dir + "/odd_first";
+  CopyModuleZeroCaptures(set, dir, 3);
+  cv::Mat noise(480, 640, CV_8UC1);
+  cv::randu(noise, 0, 256);
+  cv::imwrite(dir + "/000/cam1.png", noise);
+  const testing::Result r =
+      testing::RunCli("calibrate --captures " + dir + " --target " + set.dir + "/target.yaml --layout " + set.dir +
+                      "/one_module.yaml --out " + dir + "/rig.yaml --report " + dir + "/report.json");
+  EXPECT_EQ(r.code, 2);
+  const Camera& cam1 = set.truth.camera(1);
+  EXPECT_EQ(r.err, "stereorig calibrate: " + dir +
+                       "/000/cam1.png: image of the wrong size: 640x480, but 2 of cam1's 3 "
+                       "images are " +
+                       std::to_string(cam1.imager_width_px()) + "x" + std::to_string(cam1.imager_height_px()) + "\n");
+  EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
 }
 
 }  // namespace
