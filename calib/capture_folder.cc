@@ -34,12 +34,32 @@ bool IsDatasetWithoutCaptures(const fs::path& dir) {
   return !fs::exists(dir / "calibration") && fs::is_regular_file(dir / "spec.yaml") && fs::is_directory(dir / "truth");
 }
 
-// The capture sub-folders of `root` (a folder), sorted by name.
-std::vector<fs::path> CaptureSubfolders(const fs::path& root) {
+// Whether `folder` holds a camK.png (any K).
+bool HoldsCameraImage(const fs::path& folder) {
+  for (const auto& e : fs::directory_iterator(folder))
+    if (CameraIndexOfImageName(e.path().filename().string())) return true;
+  return false;
+}
+
+// The capture sub-folders of `root` (a folder), sorted by name. Not a
+// hidden folder (.thumbs, a viewer's), nor one holding no camK.png at all
+// (the camera models calibrate --export-cameramodels wrote beside the
+// captures): each was taken for a capture and stopped a re-run on
+// "models/cam0.png: missing". Those are added to `skipped`, if given,
+// sorted; a folder holding some cameras' images but not all is a capture
+// still, refused for the missing ones.
+std::vector<fs::path> CaptureSubfolders(const fs::path& root, std::vector<fs::path>* skipped = nullptr) {
   std::vector<fs::path> captures;
-  for (const auto& e : fs::directory_iterator(root))
-    if (e.is_directory()) captures.push_back(e.path());
+  for (const auto& e : fs::directory_iterator(root)) {
+    if (!e.is_directory()) continue;
+    const bool hidden = e.path().filename().string().rfind('.', 0) == 0;
+    if (!hidden && HoldsCameraImage(e.path()))
+      captures.push_back(e.path());
+    else if (skipped)
+      skipped->push_back(e.path());
+  }
   std::sort(captures.begin(), captures.end());
+  if (skipped) std::sort(skipped->begin(), skipped->end());
   return captures;
 }
 
@@ -133,12 +153,14 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
                      "is a simulated dataset (spec.yaml, truth/) with no target captures: a dataset's are in its "
                      "calibration/ folder, which this one lacks (simulated with --calibration-captures 0?)");
   const fs::path dir = CapturesRoot(dir_in);
-  const std::vector<fs::path> captures = CaptureSubfolders(dir);
+  std::vector<fs::path> skipped;
+  const std::vector<fs::path> captures = CaptureSubfolders(dir, &skipped);
   if (captures.empty()) throw InputError(dir.string(), "holds no capture folders (expected NNN/camK.png)");
 
   if (rig_cameras.empty()) RefuseOddImageSizes(dir.string(), captures, num_cameras);
 
   DetectedCaptures out;
+  for (const fs::path& folder : skipped) out.skipped_folders.push_back(folder.string());
   out.num_captures = static_cast<int>(captures.size());
   out.cameras.resize(num_cameras);
   for (int c = 0; c < num_cameras; ++c) {
@@ -378,6 +400,7 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
   input.capture_names = std::move(detected.capture_names);
   FolderCalibration out;
   out.num_captures = detected.num_captures;
+  out.skipped_folders = detected.skipped_folders;
   out.num_views = static_cast<int>(input.observations.size());
   if (options.progress) {
     std::fprintf(stderr, "calibrate: %d captures, %d accepted views\n", out.num_captures, out.num_views);

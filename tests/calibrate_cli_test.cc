@@ -868,5 +868,37 @@ TEST(CalibrateCli, AWrongSizedImageInTheFirstCaptureIsTheOneNamed) {
   EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
 }
 
+// Sub-folders of the captures that are no captures: the camera models an
+// earlier run wrote beside them (--export-cameramodels DIR/models), and a
+// viewer's hidden .thumbs. Each was taken for a capture ("models/cam0.png:
+// missing"); they are skipped and named on stdout. A folder holding some
+// cameras' images but not all is still a capture, refused for the missing.
+TEST(CalibrateCli, FoldersHoldingNoCaptureAreSkippedAndNamed) {
+  const RenderedSet& set = Rendered();
+  const std::string dir = set.dir + "/beside";
+  CopyModuleZeroCaptures(set, dir, 8);
+  fs::create_directories(dir + "/.thumbs");
+  fs::copy_file(dir + "/000/cam0.png", dir + "/.thumbs/cam0.png");
+  const std::string args = " --target " + set.dir + "/target.yaml --layout " + set.dir + "/one_module.yaml --out " +
+                           dir + "/rig.yaml --report " + dir + "/report.json";
+  testing::Result r =
+      testing::RunCli("calibrate --captures " + dir + args + " --export-cameramodels " + dir + "/models");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("skipped " + dir + "/.thumbs: not a capture (a hidden folder, or one holding no camK.png)\n"),
+            std::string::npos)
+      << r.out;
+  ASSERT_TRUE(fs::exists(dir + "/models/cam0.cameramodel"));
+  // Run again, the models now among the captures.
+  r = testing::RunCli("calibrate --captures " + dir + args);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("skipped " + dir + "/models: not a capture"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("calibrate: 8 captures, "), std::string::npos) << r.err;
+  // Some cameras' images but not all: a capture that lacks one.
+  fs::remove(dir + "/003/cam1.png");
+  r = testing::RunCli("calibrate --captures " + dir + args);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(dir + "/003/cam1.png: missing"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace stereorig
