@@ -406,6 +406,7 @@ std::string CalibrationReport::ToJson() const {
     j.Numbers("right_from_left_translation_mm",
               {s.right_from_left_translation_mm.x(), s.right_from_left_translation_mm.y(),
                s.right_from_left_translation_mm.z()});
+    j.String("covariance", s.covariance_status);  // "ok", or why the sigmas are null
     j.Number("baseline_sigma_mm", s.baseline_sigma_mm).Number("rotation_sigma_deg", s.rotation_sigma_deg);
     j.Numbers("right_from_left_rotation_vector_sigma_deg",
               {s.right_from_left_rotation_vector_sigma_deg.x(), s.right_from_left_rotation_vector_sigma_deg.y(),
@@ -590,12 +591,20 @@ std::string SummaryText(const CalibrationReport& rep) {
   }
   AppendLine(&out, "stage 2: stereo extrinsics per module");
   for (const StereoReport& s : rep.stereo) {
+    // A covariance that failed gives no sigma, said so (it printed +- 0.0000).
+    char figures[160];
+    if (s.covariance_status == "ok")
+      std::snprintf(figures, sizeof figures, "baseline %.4f +- %.4f mm, rotation %.4f +- %.4f deg (1 sigma)",
+                    s.baseline_mm, s.baseline_sigma_mm, s.rotation_deg, s.rotation_sigma_deg);
+    else
+      std::snprintf(figures, sizeof figures, "baseline %.4f mm, rotation %.4f deg (no sigma)", s.baseline_mm,
+                    s.rotation_deg);
     AppendLine(&out,
-               "  %s: baseline %.4f +- %.4f mm, rotation %.4f +- %.4f deg (1 sigma), rms %.3f px, %d outliers, "
-               "rectified-row error %.3f px rms (max %.3f) over %d corner pairs, %d shared views",
-               s.module_name.c_str(), s.baseline_mm, s.baseline_sigma_mm, s.rotation_deg, s.rotation_sigma_deg,
-               s.rms_px, s.num_outliers, s.rectified_row_rms_px, s.rectified_row_max_px, s.num_corner_pairs,
-               s.num_shared_views);
+               "  %s: %s, rms %.3f px, %d outliers, rectified-row error %.3f px rms (max %.3f) over %d corner pairs, "
+               "%d shared views",
+               s.module_name.c_str(), figures, s.rms_px, s.num_outliers, s.rectified_row_rms_px, s.rectified_row_max_px,
+               s.num_corner_pairs, s.num_shared_views);
+    if (s.covariance_status != "ok") AppendLine(&out, "    no sigma: %s", s.covariance_status.c_str());
     if (!s.different_face_captures.empty()) {
       std::string list;
       for (size_t i = 0; i < s.different_face_captures.size(); ++i) {

@@ -681,5 +681,36 @@ TEST(CalibrateReport, NoRefinedSigmaForHeldParameters) {
   EXPECT_EQ(r.report.system.covariance_status, "ok");
 }
 
+// A stage 2 whose covariance failed printed its sigmas as exactly 0
+// ("baseline 89.9957 +- 0.0000 mm") and wrote baseline_sigma_mm 0.0: the
+// summary says "no sigma" and why, the report writes null and why.
+TEST(CalibrateReport, AStageTwoCovarianceThatFailedGivesNoSigma) {
+  CalibrationReport rep;
+  rep.num_modules = 1;
+  StereoReport module;
+  module.module_name = "module0";
+  module.baseline_mm = 89.9957;
+  module.rotation_deg = 6.0;
+  module.covariance_status = "CHOLMOD could not factorise J'J (is every frame observed?)";
+  module.baseline_sigma_mm = module.rotation_sigma_deg = std::numeric_limits<double>::quiet_NaN();
+  rep.stereo = {module};
+  const std::string text = SummaryText(rep);
+  EXPECT_NE(text.find("  module0: baseline 89.9957 mm, rotation 6.0000 deg (no sigma), rms "), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("\n    no sigma: CHOLMOD could not factorise J'J (is every frame observed?)\n"),
+            std::string::npos)
+      << text;
+  const nlohmann::json stereo = nlohmann::json::parse(rep.ToJson()).at("stage2_stereo").at(0);
+  EXPECT_EQ(stereo.at("covariance"), module.covariance_status);
+  EXPECT_TRUE(stereo.at("baseline_sigma_mm").is_null()) << stereo.dump();
+  // One that succeeded prints its sigma.
+  rep.stereo[0].covariance_status = "ok";
+  rep.stereo[0].baseline_sigma_mm = 0.0123;
+  rep.stereo[0].rotation_sigma_deg = 0.001;
+  EXPECT_NE(SummaryText(rep).find("  module0: baseline 89.9957 +- 0.0123 mm, rotation 6.0000 +- 0.0010 deg (1 sigma)"),
+            std::string::npos)
+      << SummaryText(rep);
+}
+
 }  // namespace
 }  // namespace stereorig

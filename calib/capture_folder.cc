@@ -383,6 +383,22 @@ std::vector<std::string> RepeatedPosesNotes(const CalibrationReport& report) {
   return notes;
 }
 
+// One line per module whose joint solve left views out
+// (StereoReport::views_left_out), naming them by folder and camera.
+std::vector<std::string> StereoViewsLeftOutNotes(const CalibrationReport& report) {
+  std::vector<std::string> notes;
+  for (const StereoReport& s : report.stereo) {
+    if (s.views_left_out.empty()) continue;
+    std::string views;
+    for (const auto& [capture, camera] : s.views_left_out)
+      views += (views.empty() ? "" : ", ") + report.CaptureName(capture) + "/" + CameraImageName(camera);
+    notes.push_back("module " + std::to_string(s.module) + " (" + s.module_name + "): stage 2 left out " + views +
+                    ": outlier rejection left too few of their corners to fix the board's pose (images of another "
+                    "camera or capture, such as a module's left and right swapped?)");
+  }
+  return notes;
+}
+
 }  // namespace
 
 FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const std::string& target_path,
@@ -430,7 +446,9 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
     std::fprintf(stderr, "calibrate: warning: %s\n", PrintableText(note).c_str());
   for (const std::string& note : {rejected_note, never_seen_note, left_out_note})
     if (!note.empty()) out.result.report.warnings.push_back(note);
-  for (const std::string& note : RepeatedPosesNotes(out.result.report)) {
+  std::vector<std::string> stage_notes = RepeatedPosesNotes(out.result.report);
+  for (const std::string& note : StereoViewsLeftOutNotes(out.result.report)) stage_notes.push_back(note);
+  for (const std::string& note : stage_notes) {
     std::fprintf(stderr, "calibrate: warning: %s\n", PrintableText(note).c_str());
     out.result.report.warnings.push_back(note);
   }
