@@ -833,6 +833,24 @@ TEST(CalibrateCli, CopiesOfOneCaptureAreOneBoardPose) {
   EXPECT_EQ(json["warnings"].size(), 2u) << json["warnings"].dump();
 }
 
+// A module of an empty name was accepted (exit 0, a rig whose module has
+// no name); refused when the layout is read, before any image.
+TEST(CalibrateCli, ALayoutModuleWithAnEmptyNameIsRefused) {
+  const std::string dir = ::testing::TempDir() + "/calib_cli_empty_name_" + std::to_string(getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir + "/layout.yaml") << "modules:\n  - {name: \"\", left: 0, right: 1}\n";
+  const testing::Result r =
+      testing::RunCli("calibrate --captures " + dir + "/no_captures --target " + dir + "/target.yaml --layout " + dir +
+                      "/layout.yaml --out " + dir + "/rig.yaml --report " + dir + "/report.json");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "stereorig calibrate: " + dir +
+                       "/layout.yaml: modules[0].name: is empty: each module needs a name of its own\n");
+  EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
+  EXPECT_FALSE(fs::exists(dir + "/report.json"));
+  fs::remove_all(dir);
+}
+
 // The rendered set's captures 000..`count - 1`, cameras 0 and 1 only (module
 // 0 of the layout one_module.yaml), copied into a fresh folder `dir`.
 void CopyModuleZeroCaptures(const RenderedSet& set, const std::string& dir, int count) {
