@@ -56,6 +56,16 @@ void IntrinsicsOptions::Check() const {
   if (worst_views_reported < 0) throw InputError("options.worst_views_reported", "must be >= 0");
 }
 
+MrcalProblem BoardProblem(const std::string& lensmodel, const TargetGeometry& target, int num_cameras) {
+  MrcalProblem p;
+  STEREORIG_CHECK(p.SetLensmodel(lensmodel));
+  p.corners_x = target.corners_x;
+  p.corners_y = target.corners_y;
+  p.spacing_mm = target.square_size_mm;
+  p.num_intrinsics_cameras = num_cameras;
+  return p;
+}
+
 void FillPoolBlock(const BoardObservation& obs, const TargetGeometry& target, mrcal_point3_t* block) {
   const int n = target.num_corners();
   for (int i = 0; i < n; ++i) block[i] = {.xyz = {0.0, 0.0, -1.0}};
@@ -378,12 +388,7 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
     // Solves for `views` from `seeds` (board poses; the lens from `intrinsics`
     // when given, else the pinhole seed).
     auto solve = [&](const std::vector<double>& intrinsics) {
-      p = MrcalProblem();
-      STEREORIG_CHECK(p.SetLensmodel(options.lensmodel));
-      p.corners_x = target.corners_x;
-      p.corners_y = target.corners_y;
-      p.spacing_mm = target.square_size_mm;
-      p.num_intrinsics_cameras = 1;
+      p = BoardProblem(options.lensmodel, target, 1);
       p.imagersizes = {spec.width_px, spec.height_px};
       if (intrinsics.empty()) {
         p.intrinsics.assign(p.num_params(), 0.0);

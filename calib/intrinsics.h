@@ -138,6 +138,9 @@ std::vector<std::vector<int>> BoardPoseGroups(const std::vector<const BoardObser
 double SamePoseRmsPx(double max_rms_px);
 
 // Shared helpers for the mrcal problems of stages 1 and 2.
+// An empty problem of `num_cameras` cameras of `lensmodel` (mrcal's name,
+// IntrinsicsOptions::Check passed) observing `target`'s board.
+MrcalProblem BoardProblem(const std::string& lensmodel, const TargetGeometry& target, int num_cameras);
 // False for the lens models whose every parameter the boards determine
 // (PINHOLE, which IntrinsicsOptions::Check refuses to calibrate, OPENCV4,
 // OPENCV5): their final solve runs without

@@ -108,12 +108,7 @@ StereoResult CalibrateStereo(int module, const ModuleLayout& layout, const Intri
   // Solves from stage 1's intrinsics and board poses, every view but those
   // left out.
   auto solve = [&] {
-    p = MrcalProblem();
-    STEREORIG_CHECK(p.SetLensmodel(iopt.lensmodel));
-    p.corners_x = target.corners_x;
-    p.corners_y = target.corners_y;
-    p.spacing_mm = target.square_size_mm;
-    p.num_intrinsics_cameras = 2;
+    p = BoardProblem(iopt.lensmodel, target, 2);
     p.intrinsics = left.camera.intrinsics();
     p.intrinsics.insert(p.intrinsics.end(), right.camera.intrinsics().begin(), right.camera.intrinsics().end());
     p.imagersizes = {left.camera.imager_width_px(), left.camera.imager_height_px(), right.camera.imager_width_px(),
