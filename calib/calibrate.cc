@@ -142,7 +142,10 @@ void Progress(bool on, const std::string& msg) {
 
 // What stages 1 and 2 rejected, for stage 3 to leave out (SystemExclusions):
 //  - the views stage 1 dropped (too few corners, collinear, no PnP seed, or
-//    left without a determined board pose by the outlier rejection);
+//    left without a determined board pose by the outlier rejection), and
+//    those stage 2 left out for the latter (StereoReport::views_left_out:
+//    a capture whose left and right images were swapped, its corners
+//    otherwise back in stage 3 at 149 px, and the rig refused);
 //  - the corners mrcal's outlier rejection flagged in stage 1, the camera's
 //    own solve: one that does not fit its camera's intrinsics, with a board
 //    pose of its own per view, has no business steering the joint solve;
@@ -181,6 +184,7 @@ SystemExclusions EarlierStageVerdicts(const CalibrationInput& in, const std::vec
   for (size_t m = 0; m < stage2.size(); ++m) {
     const StereoResult& s2 = stage2[m];
     for (int c : s2.report.different_face_captures) ex.module_captures.insert({c, static_cast<int>(m)});
+    for (const std::pair<int, int>& view : s2.report.views_left_out) ex.views.insert(view);
     const int cams[2] = {in.modules[m].left_camera, in.modules[m].right_camera};
     for (int o = 0; o < s2.problem.num_observations(); ++o) {
       const mrcal_observation_board_t& ob = s2.problem.observations[o];
@@ -625,10 +629,11 @@ std::string SummaryText(const CalibrationReport& rep) {
     AppendLine(&out, "stage 3: the S matrix (%d captures, %d corner residuals)", s.num_captures,
                s.num_residual_corners);
     if (s.num_skipped_views > 0 || s.num_skipped_outlier_corners > 0) {
-      AppendLine(&out,
-                 "  left out as stages 1-2 judged: %d view(s) stage 1 dropped (%d corners), %d outlier corner(s) of "
-                 "stage 1 or 2",
-                 s.num_skipped_views, s.num_skipped_view_corners, s.num_skipped_outlier_corners);
+      AppendLine(
+          &out,
+          "  left out as stages 1-2 judged: %d view(s) stage 1 or 2 dropped (%d corners), %d outlier corner(s) of "
+          "stage 1 or 2",
+          s.num_skipped_views, s.num_skipped_view_corners, s.num_skipped_outlier_corners);
     }
     AppendLine(&out, "  reprojection rms: Horn only %.3f px, refined %.3f px", s.horn_reprojection_rms_px,
                s.refined_reprojection_rms_px);
