@@ -13,6 +13,7 @@
 #include "calib/calibrate.h"
 #include "calib/capture_folder.h"
 #include "calib/core/input_error.h"
+#include "calib/core/printable_text.h"
 #include "calib/layout_file.h"
 
 namespace stereorig {
@@ -26,11 +27,14 @@ int RunCalibrate(int argc, char** argv) {
       "the target file's stated sigma). A plain one-sided chessboard works for a single module. The rig file "
       "records the board (its corners, squares, and back_from_front as calibrated), which stereorig check measures "
       "with.\n\n"
-      "Captures: DIR/NNN/camK.png (or a dataset folder holding calibration/NNN/camK.png). Layout: which cameras "
+      "Captures: DIR/NNN/camK.png (or a dataset folder holding calibration/NNN/camK.png); hidden sub-folders and "
+      "those holding no camK.png (camera models written beside the captures) are skipped, and named. Layout: which "
+      "cameras "
       "form each module, e.g.\n  modules:\n    - {name: module0, left: 0, right: 1, face: front}\n    - {name: "
       "module1, left: 2, right: 3, face: back}\n('face' is optional; if given, a detection of the other face by "
       "that module is refused).\n\n"
-      "Refuses with exit 2: too few views, all views fronto-parallel, a camera that never sees the board, images "
+      "Refuses with exit 2: too few views (or distinct board poses among them), all views fronto-parallel, a camera "
+      "that never sees the board, images "
       "of the wrong size, a face seen by the wrong module; and, after the solve (the summary and the report written, "
       "the rig file not), a stage that did not converge (rms over --max-rms-px; stage 3 also when half its corners are "
       "off by more than sqrt(2 ln 2) x --max-rms-px, when a camera's corners are off by more than the noise stage 2 "
@@ -122,6 +126,11 @@ int RunCalibrate(int argc, char** argv) {
   // The models' folder first: one that cannot be made leaves no rig file
   // or report behind either.
   models_folder.Create();
+  // Sub-folders taken for no capture are named, that a capture hidden or
+  // left without its images by mistake is noticed.
+  for (const std::string& skipped : folder.skipped_folders)
+    std::printf("skipped %s: not a capture (a hidden folder, or one holding no camK.png)\n",
+                PrintableText(skipped).c_str());
   // The summary first: a calibration whose rig file is refused (a lens no
   // camera has) still shows what it found.
   std::printf("%s", SummaryText(result.report).c_str());

@@ -75,21 +75,31 @@ std::vector<Eigen::Vector3d> VolumeGrid(const Rig& truth, double distance_mm, co
   return points;
 }
 
-// Throws InputError unless `truth` has the rig's modules and cameras, so
-// that it can judge it.
-void RequireTruthMatches(const Rig& rig, const Rig& truth) {
-  if (truth.num_modules() != rig.num_modules() || truth.num_cameras() != rig.num_cameras())
-    throw InputError("--truth", "has " + std::to_string(truth.num_modules()) + " module(s) and " +
-                                    std::to_string(truth.num_cameras()) + " camera(s), the rig has " +
-                                    std::to_string(rig.num_modules()) + " and " + std::to_string(rig.num_cameras()));
+// Throws InputError unless `truth` can judge `rig` (TruthModuleMismatch);
+// returns it with its modules in the rig's order (matched by their cameras),
+// each printed as the truth's own where that order differs.
+Rig TruthMatching(const Rig& rig, const Rig& truth) {
+  if (const std::string mismatch = TruthModuleMismatch(rig, truth); !mismatch.empty())
+    throw InputError("--truth", mismatch);
+  return TruthInModuleOrderOf(rig, truth);
 }
 
 // The figures docs/calibration.md judges a calibration by, against a true
-// rig (a simulated dataset's truth/rig.yaml; RequireTruthMatches passed).
-void PrintAgainstTruth(const Rig& rig, const Rig& truth, double distance_mm, const Eigen::Vector3d& size_mm) {
+// rig (a simulated dataset's truth/rig.yaml, in the rig's module order:
+// TruthMatching). `truth_file`: as read, which names its modules.
+void PrintAgainstTruth(const Rig& rig, const Rig& truth, const Rig& truth_file, double distance_mm,
+                       const Eigen::Vector3d& size_mm) {
   const std::vector<Eigen::Vector3d> points = VolumeGrid(truth, distance_mm, size_mm);
   std::printf("against the truth, over a %.0f x %.0f x %.0f mm volume %.0f mm ahead of module 0 (%zu points):\n",
               size_mm.x(), size_mm.y(), size_mm.z(), distance_mm, points.size());
+  // Modules are compared by their cameras: a layout listing them in
+  // another order than the truth's is judged like with like, and says so.
+  for (int k = 0; k < rig.num_modules(); ++k)
+    for (int j = 0; j < truth_file.num_modules(); ++j)
+      if (j != k && truth_file.module(j).left_camera == rig.module(k).left_camera &&
+          truth_file.module(j).right_camera == rig.module(k).right_camera)
+        std::printf("  (module %d is compared with the truth's module %d, %s: the same cameras %d,%d)\n", k, j,
+                    truth_file.module(j).name.c_str(), rig.module(k).left_camera, rig.module(k).right_camera);
   for (int k = 0; k < rig.num_modules(); ++k) {
     std::vector<Eigen::Vector3d> p_cal, p_true;
     TriangulateThroughModule(truth, rig, k, points, &p_cal, &p_true);
@@ -187,10 +197,10 @@ int RunRig(int argc, char** argv) {
   // printed: a failure after a printed summary (a --truth that is no rig
   // file, a models' folder that cannot be made) left a valid-looking
   // summary on stdout next to exit 2.
-  std::optional<Rig> truth;
+  std::optional<Rig> truth_file, truth;
   if (!truth_path.empty()) {
-    truth = ReadRigFile(truth_path);
-    RequireTruthMatches(rig, *truth);
+    truth_file = ReadRigFile(truth_path);
+    truth = TruthMatching(rig, *truth_file);
   }
   models_folder.Create();
   AtomicOutputSet written;  // every model or none
@@ -198,7 +208,8 @@ int RunRig(int argc, char** argv) {
     written.Add(model_paths[i], CameramodelText(rig.camera(i), rig.CamFromReference(i)));
   written.Commit();
   PrintRigSummary(rig, stdout);
-  if (truth) PrintAgainstTruth(rig, *truth, distance_mm, Eigen::Vector3d(size_mm[0], size_mm[1], size_mm[2]));
+  if (truth)
+    PrintAgainstTruth(rig, *truth, *truth_file, distance_mm, Eigen::Vector3d(size_mm[0], size_mm[1], size_mm[2]));
   for (const std::string& path : model_paths) std::printf("wrote %s\n", path.c_str());
   return kExitOk;
 }

@@ -142,7 +142,10 @@ void Progress(bool on, const std::string& msg) {
 
 // What stages 1 and 2 rejected, for stage 3 to leave out (SystemExclusions):
 //  - the views stage 1 dropped (too few corners, collinear, no PnP seed, or
-//    left without a determined board pose by the outlier rejection);
+//    left without a determined board pose by the outlier rejection), and
+//    those stage 2 left out for the latter (StereoReport::views_left_out:
+//    a capture whose left and right images were swapped, its corners
+//    otherwise back in stage 3 at 149 px, and the rig refused);
 //  - the corners mrcal's outlier rejection flagged in stage 1, the camera's
 //    own solve: one that does not fit its camera's intrinsics, with a board
 //    pose of its own per view, has no business steering the joint solve;
@@ -181,6 +184,7 @@ SystemExclusions EarlierStageVerdicts(const CalibrationInput& in, const std::vec
   for (size_t m = 0; m < stage2.size(); ++m) {
     const StereoResult& s2 = stage2[m];
     for (int c : s2.report.different_face_captures) ex.module_captures.insert({c, static_cast<int>(m)});
+    for (const std::pair<int, int>& view : s2.report.views_left_out) ex.views.insert(view);
     const int cams[2] = {in.modules[m].left_camera, in.modules[m].right_camera};
     for (int o = 0; o < s2.problem.num_observations(); ++o) {
       const mrcal_observation_board_t& ob = s2.problem.observations[o];
@@ -406,6 +410,7 @@ std::string CalibrationReport::ToJson() const {
     j.Numbers("right_from_left_translation_mm",
               {s.right_from_left_translation_mm.x(), s.right_from_left_translation_mm.y(),
                s.right_from_left_translation_mm.z()});
+    j.String("covariance", s.covariance_status);  // "ok", or why the sigmas are null
     j.Number("baseline_sigma_mm", s.baseline_sigma_mm).Number("rotation_sigma_deg", s.rotation_sigma_deg);
     j.Numbers("right_from_left_rotation_vector_sigma_deg",
               {s.right_from_left_rotation_vector_sigma_deg.x(), s.right_from_left_rotation_vector_sigma_deg.y(),
@@ -590,12 +595,20 @@ std::string SummaryText(const CalibrationReport& rep) {
   }
   AppendLine(&out, "stage 2: stereo extrinsics per module");
   for (const StereoReport& s : rep.stereo) {
+    // A covariance that failed gives no sigma, said so (it printed +- 0.0000).
+    char figures[160];
+    if (s.covariance_status == "ok")
+      std::snprintf(figures, sizeof figures, "baseline %.4f +- %.4f mm, rotation %.4f +- %.4f deg (1 sigma)",
+                    s.baseline_mm, s.baseline_sigma_mm, s.rotation_deg, s.rotation_sigma_deg);
+    else
+      std::snprintf(figures, sizeof figures, "baseline %.4f mm, rotation %.4f deg (no sigma)", s.baseline_mm,
+                    s.rotation_deg);
     AppendLine(&out,
-               "  %s: baseline %.4f +- %.4f mm, rotation %.4f +- %.4f deg (1 sigma), rms %.3f px, %d outliers, "
-               "rectified-row error %.3f px rms (max %.3f) over %d corner pairs, %d shared views",
-               s.module_name.c_str(), s.baseline_mm, s.baseline_sigma_mm, s.rotation_deg, s.rotation_sigma_deg,
-               s.rms_px, s.num_outliers, s.rectified_row_rms_px, s.rectified_row_max_px, s.num_corner_pairs,
-               s.num_shared_views);
+               "  %s: %s, rms %.3f px, %d outliers, rectified-row error %.3f px rms (max %.3f) over %d corner pairs, "
+               "%d shared views",
+               s.module_name.c_str(), figures, s.rms_px, s.num_outliers, s.rectified_row_rms_px, s.rectified_row_max_px,
+               s.num_corner_pairs, s.num_shared_views);
+    if (s.covariance_status != "ok") AppendLine(&out, "    no sigma: %s", s.covariance_status.c_str());
     if (!s.different_face_captures.empty()) {
       std::string list;
       for (size_t i = 0; i < s.different_face_captures.size(); ++i) {
@@ -616,10 +629,11 @@ std::string SummaryText(const CalibrationReport& rep) {
     AppendLine(&out, "stage 3: the S matrix (%d captures, %d corner residuals)", s.num_captures,
                s.num_residual_corners);
     if (s.num_skipped_views > 0 || s.num_skipped_outlier_corners > 0) {
-      AppendLine(&out,
-                 "  left out as stages 1-2 judged: %d view(s) stage 1 dropped (%d corners), %d outlier corner(s) of "
-                 "stage 1 or 2",
-                 s.num_skipped_views, s.num_skipped_view_corners, s.num_skipped_outlier_corners);
+      AppendLine(
+          &out,
+          "  left out as stages 1-2 judged: %d view(s) stage 1 or 2 dropped (%d corners), %d outlier corner(s) of "
+          "stage 1 or 2",
+          s.num_skipped_views, s.num_skipped_view_corners, s.num_skipped_outlier_corners);
     }
     AppendLine(&out, "  reprojection rms: Horn only %.3f px, refined %.3f px", s.horn_reprojection_rms_px,
                s.refined_reprojection_rms_px);

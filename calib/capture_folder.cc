@@ -10,6 +10,7 @@
 #include "calib/core/capture_image_name.h"
 #include "calib/core/input_error.h"
 #include "calib/core/input_file.h"
+#include "calib/core/number_text.h"
 #include "calib/core/png_reader.h"
 #include "calib/core/printable_text.h"
 #include "calib/layout_file.h"
@@ -33,13 +34,94 @@ bool IsDatasetWithoutCaptures(const fs::path& dir) {
   return !fs::exists(dir / "calibration") && fs::is_regular_file(dir / "spec.yaml") && fs::is_directory(dir / "truth");
 }
 
-// The capture sub-folders of `root` (a folder), sorted by name.
-std::vector<fs::path> CaptureSubfolders(const fs::path& root) {
+// Whether `folder` holds a camK.png (any K).
+bool HoldsCameraImage(const fs::path& folder) {
+  for (const auto& e : fs::directory_iterator(folder))
+    if (CameraIndexOfImageName(e.path().filename().string())) return true;
+  return false;
+}
+
+// The capture sub-folders of `root` (a folder), sorted by name. Not a
+// hidden folder (.thumbs, a viewer's), nor one holding no camK.png at all
+// (the camera models calibrate --export-cameramodels wrote beside the
+// captures): each was taken for a capture and stopped a re-run on
+// "models/cam0.png: missing". Those are added to `skipped`, if given,
+// sorted; a folder holding some cameras' images but not all is a capture
+// still, refused for the missing ones.
+std::vector<fs::path> CaptureSubfolders(const fs::path& root, std::vector<fs::path>* skipped = nullptr) {
   std::vector<fs::path> captures;
-  for (const auto& e : fs::directory_iterator(root))
-    if (e.is_directory()) captures.push_back(e.path());
+  for (const auto& e : fs::directory_iterator(root)) {
+    if (!e.is_directory()) continue;
+    const bool hidden = e.path().filename().string().rfind('.', 0) == 0;
+    if (!hidden && HoldsCameraImage(e.path()))
+      captures.push_back(e.path());
+    else if (skipped)
+      skipped->push_back(e.path());
+  }
   std::sort(captures.begin(), captures.end());
+  if (skipped) std::sort(skipped->begin(), skipped->end());
   return captures;
+}
+
+std::string SizeText(const std::pair<int, int>& size_px) {
+  return std::to_string(size_px.first) + "x" + std::to_string(size_px.second);
+}
+
+// Throws InputError unless each camera's images in `captures` (of `dir`)
+// are of one size, naming the odd ones out: those of a size other than
+// most of the camera's images have, or, where no size has most, every size
+// with its files. Read from the headers only; an image that is missing or no PNG is
+// left to the detection loop, which names it. The first image read used to
+// set the size, and a first image of the wrong size had the error name a
+// right one.
+void RefuseOddImageSizes(const std::string& dir, const std::vector<fs::path>& captures, int num_cameras) {
+  for (int c = 0; c < num_cameras; ++c) {
+    std::map<std::pair<int, int>, std::vector<std::string>> images_of_size;
+    int images = 0;
+    for (const fs::path& capture : captures) {
+      const fs::path image = capture / CameraImageName(c);
+      if (!fs::is_regular_file(image)) continue;
+      std::optional<PngReader> png;
+      try {
+        png = PngReader::Open(image.string());
+      } catch (const InputError&) {
+      }
+      if (!png) continue;
+      images_of_size[{int(png->width_px()), int(png->height_px())}].push_back(image.string());
+      ++images;
+    }
+    if (images_of_size.size() < 2) continue;
+    const auto most = std::max_element(images_of_size.begin(), images_of_size.end(),
+                                       [](const auto& a, const auto& b) { return a.second.size() < b.second.size(); });
+    const std::string camera = "cam" + std::to_string(c);
+    if (2 * most->second.size() > size_t(images)) {
+      // The first image not of the majority's size is the error's file;
+      // the others are listed after it.
+      std::string first_path, first_size, others;
+      for (const auto& [size, paths] : images_of_size) {
+        if (size == most->first) continue;
+        for (const std::string& path : paths) {
+          if (first_path.empty()) {
+            first_path = path;
+            first_size = SizeText(size);
+          } else {
+            others += (others.empty() ? "" : ", ") + path + " " + SizeText(size);
+          }
+        }
+      }
+      throw InputError(first_path, "image of the wrong size: " + first_size + ", but " +
+                                       std::to_string(most->second.size()) + " of " + camera + "'s " +
+                                       std::to_string(images) + " images are " + SizeText(most->first) +
+                                       (others.empty() ? "" : " (also of another size: " + others + ")"));
+    }
+    std::string sizes;
+    for (const auto& [size, paths] : images_of_size) {
+      sizes += (sizes.empty() ? "" : "; ") + SizeText(size) + ":";
+      for (const std::string& path : paths) sizes += " " + path;
+    }
+    throw InputError(dir, camera + "'s images differ in size, and no size is most of them: " + sizes +
+                              " (images of another camera among them?)");
+  }
 }
 
 }  // namespace
@@ -71,10 +153,14 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
                      "is a simulated dataset (spec.yaml, truth/) with no target captures: a dataset's are in its "
                      "calibration/ folder, which this one lacks (simulated with --calibration-captures 0?)");
   const fs::path dir = CapturesRoot(dir_in);
-  const std::vector<fs::path> captures = CaptureSubfolders(dir);
+  std::vector<fs::path> skipped;
+  const std::vector<fs::path> captures = CaptureSubfolders(dir, &skipped);
   if (captures.empty()) throw InputError(dir.string(), "holds no capture folders (expected NNN/camK.png)");
 
+  if (rig_cameras.empty()) RefuseOddImageSizes(dir.string(), captures, num_cameras);
+
   DetectedCaptures out;
+  for (const fs::path& folder : skipped) out.skipped_folders.push_back(folder.string());
   out.num_captures = static_cast<int>(captures.size());
   out.cameras.resize(num_cameras);
   for (int c = 0; c < num_cameras; ++c) {
@@ -271,6 +357,50 @@ bool IsTooFewViewsProblem(const std::string& problem) {
          problem.find("too few views") != std::string::npos;
 }
 
+namespace {
+
+// One line per camera whose views stage 1 found repeating a board pose
+// (IntrinsicsReport::repeated_pose_captures), naming them by folder: they
+// count as views of their own, the sigmas taking them as independent.
+// Eight copies of one capture calibrated, exit 0, a baseline 10.8 mm off;
+// stage 1 refuses too few distinct poses, and a few repeats among enough
+// are legitimate (a board left still between two captures), so a warning.
+std::vector<std::string> RepeatedPosesNotes(const CalibrationReport& report) {
+  std::vector<std::string> notes;
+  for (const IntrinsicsReport& r : report.intrinsics) {
+    if (r.repeated_pose_captures.empty()) continue;
+    std::string groups;
+    for (const std::vector<int>& captures : r.repeated_pose_captures) {
+      groups += groups.empty() ? "" : "; ";
+      for (size_t i = 0; i < captures.size(); ++i) groups += (i ? ", " : "") + report.CaptureName(captures[i]);
+    }
+    notes.push_back("camera " + std::to_string(r.camera) + " (" + r.camera_name +
+                    ") sees one board pose again in captures " + groups + " (corners within " +
+                    NumberText(SamePoseRmsPx(report.max_rms_px), 3) +
+                    " px RMS): a frame delivered again, or the board left still? Each counts as a view of its own, "
+                    "and the sigmas take their corners as independent: too small");
+  }
+  return notes;
+}
+
+// One line per module whose joint solve left views out
+// (StereoReport::views_left_out), naming them by folder and camera.
+std::vector<std::string> StereoViewsLeftOutNotes(const CalibrationReport& report) {
+  std::vector<std::string> notes;
+  for (const StereoReport& s : report.stereo) {
+    if (s.views_left_out.empty()) continue;
+    std::string views;
+    for (const auto& [capture, camera] : s.views_left_out)
+      views += (views.empty() ? "" : ", ") + report.CaptureName(capture) + "/" + CameraImageName(camera);
+    notes.push_back("module " + std::to_string(s.module) + " (" + s.module_name + "): stage 2 left out " + views +
+                    ": outlier rejection left too few of their corners to fix the board's pose (images of another "
+                    "camera or capture, such as a module's left and right swapped?)");
+  }
+  return notes;
+}
+
+}  // namespace
+
 FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const std::string& target_path,
                                          const std::vector<ModuleLayout>& modules, const CalibrationOptions& options) {
   options.Check();
@@ -286,6 +416,7 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
   input.capture_names = std::move(detected.capture_names);
   FolderCalibration out;
   out.num_captures = detected.num_captures;
+  out.skipped_folders = detected.skipped_folders;
   out.num_views = static_cast<int>(input.observations.size());
   if (options.progress) {
     std::fprintf(stderr, "calibrate: %d captures, %d accepted views\n", out.num_captures, out.num_views);
@@ -315,6 +446,12 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
     std::fprintf(stderr, "calibrate: warning: %s\n", PrintableText(note).c_str());
   for (const std::string& note : {rejected_note, never_seen_note, left_out_note})
     if (!note.empty()) out.result.report.warnings.push_back(note);
+  std::vector<std::string> stage_notes = RepeatedPosesNotes(out.result.report);
+  for (const std::string& note : StereoViewsLeftOutNotes(out.result.report)) stage_notes.push_back(note);
+  for (const std::string& note : stage_notes) {
+    std::fprintf(stderr, "calibrate: warning: %s\n", PrintableText(note).c_str());
+    out.result.report.warnings.push_back(note);
+  }
   // Calibrate records the board (in the rig it built), not its file's name.
   // Absolute, so that the check's messages name it from wherever they run.
   if (std::optional<CalibrationTarget>& board = out.result.rig.provenance().target)

@@ -36,6 +36,10 @@ struct DetectedCaptures {
   std::vector<ImageDetectionLog> log;  // one entry per image
   int num_captures = 0;
   std::map<int, std::string> capture_names;  // capture index -> its sub-folder's name (CalibrationInput's)
+  // Sub-folders taken for no capture, sorted: hidden ones (.thumbs), and
+  // those holding no camK.png at all (camera models written beside the
+  // captures). The command says which it skipped.
+  std::vector<std::string> skipped_folders{};
 };
 
 // The images a captures folder holds: every file named camK.png (any K) in
@@ -118,7 +122,8 @@ bool IsTooFewViewsProblem(const std::string& problem);
 struct FolderCalibration {
   CalibrationResult result;
   int num_captures = 0;
-  int num_views = 0;  // images with an accepted detection
+  std::vector<std::string> skipped_folders{};  // DetectedCaptures::skipped_folders
+  int num_views = 0;                           // images with an accepted detection
 };
 FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const std::string& target_path,
                                          const std::vector<ModuleLayout>& modules, const CalibrationOptions& options);

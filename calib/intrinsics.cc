@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <optional>
@@ -55,6 +56,16 @@ void IntrinsicsOptions::Check() const {
   if (worst_views_reported < 0) throw InputError("options.worst_views_reported", "must be >= 0");
 }
 
+MrcalProblem BoardProblem(const std::string& lensmodel, const TargetGeometry& target, int num_cameras) {
+  MrcalProblem p;
+  STEREORIG_CHECK(p.SetLensmodel(lensmodel));
+  p.corners_x = target.corners_x;
+  p.corners_y = target.corners_y;
+  p.spacing_mm = target.square_size_mm;
+  p.num_intrinsics_cameras = num_cameras;
+  return p;
+}
+
 void FillPoolBlock(const BoardObservation& obs, const TargetGeometry& target, mrcal_point3_t* block) {
   const int n = target.num_corners();
   for (int i = 0; i < n; ++i) block[i] = {.xyz = {0.0, 0.0, -1.0}};
@@ -68,7 +79,49 @@ double TiltDeg(const Pose& cam_from_face) {
   return std::acos(std::min(1.0, std::abs(n.z()))) * 180.0 / M_PI;
 }
 
+double SamePoseRmsPx(double max_rms_px) { return std::sqrt(2.0) * max_rms_px; }
+
+std::vector<std::vector<int>> BoardPoseGroups(const std::vector<const BoardObservation*>& views,
+                                              double same_pose_rms_px) {
+  // Fewer shared corners than this do not fix a board pose (PnP's minimum).
+  constexpr int kMinSharedCorners = 4;
+  auto same_pose = [&](const BoardObservation& a, const BoardObservation& b) {
+    if (a.face != b.face) return false;
+    std::map<int, Eigen::Vector2d> q_a;
+    for (size_t i = 0; i < a.corner_ids.size(); ++i) q_a.emplace(a.corner_ids[i], a.q_px[i]);
+    double s2 = 0;
+    int shared = 0;
+    for (size_t i = 0; i < b.corner_ids.size(); ++i) {
+      const auto it = q_a.find(b.corner_ids[i]);
+      if (it == q_a.end()) continue;
+      s2 += (it->second - b.q_px[i]).squaredNorm();
+      ++shared;
+    }
+    return shared >= kMinSharedCorners && std::sqrt(s2 / (2.0 * shared)) <= same_pose_rms_px;
+  };
+  // Each view joins the first group whose first view shows its pose: poses
+  // apart by more than the threshold do not chain into one group.
+  std::vector<std::vector<int>> groups;
+  for (int k = 0; k < static_cast<int>(views.size()); ++k) {
+    auto g = std::find_if(groups.begin(), groups.end(),
+                          [&](const std::vector<int>& group) { return same_pose(*views[group[0]], *views[k]); });
+    if (g == groups.end())
+      groups.push_back({k});
+    else
+      g->push_back(k);
+  }
+  return groups;
+}
+
 namespace {
+
+// "1, 2 and 5": capture indices (a numeric capture folder's number).
+std::string CaptureList(const std::vector<int>& captures) {
+  std::string out;
+  for (size_t i = 0; i < captures.size(); ++i)
+    out += (i == 0 ? "" : i + 1 == captures.size() ? " and " : ", ") + std::to_string(captures[i]);
+  return out;
+}
 
 // Of two solves of one camera from different seeds, the one that fits its
 // corners better: the lower RMS; one that is not a number never wins. Each
@@ -264,6 +317,30 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
     throw InputError(cam_where, "too few views: " + std::to_string(views.size()) + " usable, need at least " +
                                     std::to_string(options.min_views));
   }
+  // Copies of one view count as one: eight copies of one capture passed as
+  // eight views, exit 0, with fx 7 % and a baseline 10.8 mm off and sigmas
+  // shrunk by sqrt(8) (a trigger delivering one frame again, or the board
+  // left still, gives the same).
+  const double same_pose_rms_px = SamePoseRmsPx(options.max_rms_px);
+  std::vector<std::vector<int>> repeated_pose_captures;
+  const std::vector<std::vector<int>> pose_groups = BoardPoseGroups(views, same_pose_rms_px);
+  for (const std::vector<int>& group : pose_groups) {
+    if (group.size() < 2) continue;
+    repeated_pose_captures.emplace_back();
+    for (int k : group) repeated_pose_captures.back().push_back(views[k]->capture);
+    std::sort(repeated_pose_captures.back().begin(), repeated_pose_captures.back().end());
+  }
+  if (static_cast<int>(pose_groups.size()) < options.min_views) {
+    std::string repeats;
+    for (const std::vector<int>& captures : repeated_pose_captures)
+      repeats += (repeats.empty() ? "" : "; ") + std::string("captures ") + CaptureList(captures);
+    throw InputError(cam_where, "too few distinct board poses: its " + std::to_string(views.size()) +
+                                    " usable views show " + std::to_string(pose_groups.size()) + ", need at least " +
+                                    std::to_string(options.min_views) + "; repeated: " + repeats + " (corners within " +
+                                    NumberText(same_pose_rms_px, 3) +
+                                    " px RMS, sqrt(2) x --max-rms-px: a frame delivered again, or the board left "
+                                    "still? move the board between captures)");
+  }
 
   // Stage 1 from one pinhole seed (`views` and `dropped` its own copies).
   // Throws InputError where the seed's board poses leave too few views, or
@@ -311,12 +388,7 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
     // Solves for `views` from `seeds` (board poses; the lens from `intrinsics`
     // when given, else the pinhole seed).
     auto solve = [&](const std::vector<double>& intrinsics) {
-      p = MrcalProblem();
-      STEREORIG_CHECK(p.SetLensmodel(options.lensmodel));
-      p.corners_x = target.corners_x;
-      p.corners_y = target.corners_y;
-      p.spacing_mm = target.square_size_mm;
-      p.num_intrinsics_cameras = 1;
+      p = BoardProblem(options.lensmodel, target, 1);
       p.imagersizes = {spec.width_px, spec.height_px};
       if (intrinsics.empty()) {
         p.intrinsics.assign(p.num_params(), 0.0);
@@ -398,6 +470,7 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
     std::sort(per_view.begin(), per_view.end(), [](const auto& a, const auto& b) { return a.rms_px > b.rms_px; });
     per_view.resize(std::min<size_t>(per_view.size(), options.worst_views_reported));
     r.worst_views = per_view;
+    r.repeated_pose_captures = repeated_pose_captures;
     FillCoverageAndUncertainty(p, 0, options, spec.width_px, spec.height_px, &r);
     result.problem = std::move(p);
     return result;

@@ -30,7 +30,7 @@ struct IntrinsicsOptions {
   std::string lensmodel = "LENSMODEL_OPENCV5";
   double seed_focal_px = 0.0;    // rough focal length for the PnP seed, px; 0 (default): from the views' homographies
   int min_corners_per_view = 8;  // views with fewer corners are not used; default 8
-  int min_views = 5;             // fewer usable views is an input error; default 5
+  int min_views = 5;             // fewer usable views or distinct board poses is an input error; default 5
   double min_tilt_deg = 10.0;    // if no view tilts the board more than this, the set is degenerate; default 10 deg
   // A solve whose RMS is over this did not converge: stage 1 tries the next
   // seed candidate (calib/pinhole_seed.h), and calibrate writes no rig file
@@ -94,6 +94,12 @@ struct IntrinsicsReport {
   // parameters it cannot determine alone under their block of it
   // (calib/system.h, ModuleCameras).
   std::vector<double> intrinsics_covariance;
+  // Captures whose views repeat one board pose (BoardPoseGroups), one group
+  // per pose seen more than once, its captures ascending: repeated frames,
+  // or the board left still. Each still counts as a view, and the solve
+  // takes their corners as independent, its sigmas shrinking as if the pose
+  // had been seen afresh; calibrate warns of them (capture_folder.h).
+  std::vector<std::vector<int>> repeated_pose_captures{};
 };
 
 struct IntrinsicsResult {
@@ -115,7 +121,26 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
                                      const IntrinsicsOptions& options, const std::string& where,
                                      const std::function<void(const std::string&)>& progress = {});
 
+// The views of one camera grouped by board pose: two views show one pose if
+// they saw the same face and the corners both saw (at least 4) lie within
+// `same_pose_rms_px` RMS of each other (x and y pooled). Returns the groups
+// in the order of their first view, each group's indices into `views`
+// ascending. Stage 1 counts the groups, not the views, against
+// IntrinsicsOptions::min_views (SamePoseRmsPx says why the threshold).
+std::vector<std::vector<int>> BoardPoseGroups(const std::vector<const BoardObservation*>& views,
+                                              double same_pose_rms_px);
+// Two detections of a board that did not move differ only by the corners'
+// noise: sqrt(2) sigma per coordinate. A calibration accepts corners whose
+// noise is up to `max_rms_px` (IntrinsicsOptions::max_rms_px: a converged
+// camera's residual RMS is its corners' noise), so views closer than
+// sqrt(2) x max_rms_px RMS are one pose as far as the corners can tell:
+// a board moved less adds nothing the noise does not swamp.
+double SamePoseRmsPx(double max_rms_px);
+
 // Shared helpers for the mrcal problems of stages 1 and 2.
+// An empty problem of `num_cameras` cameras of `lensmodel` (mrcal's name,
+// IntrinsicsOptions::Check passed) observing `target`'s board.
+MrcalProblem BoardProblem(const std::string& lensmodel, const TargetGeometry& target, int num_cameras);
 // False for the lens models whose every parameter the boards determine
 // (PINHOLE, which IntrinsicsOptions::Check refuses to calibrate, OPENCV4,
 // OPENCV5): their final solve runs without

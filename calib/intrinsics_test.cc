@@ -383,3 +383,94 @@ TEST(Intrinsics, CollinearCornersDoNotSpanAPlane) {
 
 }  // namespace
 }  // namespace stereorig
+
+namespace stereorig {
+namespace {
+
+// A copy of `view` as capture `capture`.
+BoardObservation Renumbered(const BoardObservation& view, int capture) {
+  BoardObservation copy = view;
+  copy.capture = capture;
+  return copy;
+}
+
+// Copies of one view (a trigger delivering one frame again) count as one
+// board pose: eight copies of one capture calibrated, exit 0, with fx 7 %
+// and the baseline 10.8 mm off, as if eight poses had been seen.
+TEST(Intrinsics, RefusesCopiesOfOneViewAsTooFewDistinctPoses) {
+  const auto s = testing::MakeDefaultScene(61, 20, 0.2);
+  const std::vector<const BoardObservation*> views = testing::ViewsOf(s.data.input, 0);
+  std::vector<BoardObservation> copies;
+  for (int c = 0; c < 8; ++c) copies.push_back(Renumbered(*views[0], c));
+  std::vector<const BoardObservation*> copy_views;
+  for (const BoardObservation& v : copies) copy_views.push_back(&v);
+  try {
+    CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, copy_views, IntrinsicsOptions(), "test");
+    FAIL() << "eight copies of one view calibrated";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("camera 0 (" + s.data.input.cameras[0].name +
+                        "): too few distinct board poses: its 8 usable "
+                        "views show 1, need at least 5; repeated: captures 0, 1, 2, 3, 4, 5, 6 and 7"),
+              std::string::npos)
+        << what;
+  }
+}
+
+// A board left still between two captures is seen again with fresh noise:
+// two detections then differ by sqrt(2) x the noise per coordinate (0.28 px
+// here), well within SamePoseRmsPx (1.41 px at the default max_rms_px). Each
+// of 20 poses seen twice so: enough distinct poses to calibrate, and the
+// report names the 20 pairs (calibrate warns of them); the scene alone
+// repeats none.
+TEST(Intrinsics, ReportsViewsThatRepeatAPoseWithFreshNoise) {
+  const double noise_px = 0.2;
+  const auto s = testing::MakeDefaultScene(62, 20, noise_px);
+  const std::vector<const BoardObservation*> views = testing::ViewsOf(s.data.input, 0);
+  ASSERT_GE(views.size(), 10u);
+  const IntrinsicsOptions options;
+  const auto alone = CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, views, options, "test");
+  EXPECT_TRUE(alone.report.repeated_pose_captures.empty());
+
+  std::mt19937 rng(62);
+  std::normal_distribution<double> again(0.0, std::sqrt(2.0) * noise_px);  // the difference of two detections
+  std::vector<BoardObservation> twice;
+  for (const BoardObservation* v : views) twice.push_back(*v);
+  const int first_copy = 1000;
+  for (const BoardObservation* v : views) {
+    BoardObservation copy = Renumbered(*v, first_copy + v->capture);
+    for (Eigen::Vector2d& q : copy.q_px) q += Eigen::Vector2d(again(rng), again(rng));
+    twice.push_back(copy);
+  }
+  std::vector<const BoardObservation*> twice_views;
+  for (const BoardObservation& v : twice) twice_views.push_back(&v);
+  const auto r = CalibrateIntrinsics(0, s.data.input.cameras[0], s.data.input.target, twice_views, options, "test");
+  ASSERT_EQ(r.report.repeated_pose_captures.size(), views.size());
+  for (size_t k = 0; k < views.size(); ++k)
+    EXPECT_EQ(r.report.repeated_pose_captures[k],
+              (std::vector<int>{views[k]->capture, first_copy + views[k]->capture}));
+}
+
+// The threshold itself, on noise-free copies moved by a known amount: every
+// corner moved by (d, d) px is d px RMS per coordinate from the original.
+TEST(Intrinsics, ViewsWithinSamePoseRmsAreOnePose) {
+  const auto s = testing::MakeDefaultScene(63, 2, 0.2);
+  const BoardObservation& view = *testing::ViewsOf(s.data.input, 0)[0];
+  const double threshold_px = SamePoseRmsPx(1.0);
+  EXPECT_DOUBLE_EQ(threshold_px, std::sqrt(2.0));
+  auto moved = [&](double d_px) {
+    BoardObservation copy = Renumbered(view, 1);
+    for (Eigen::Vector2d& q : copy.q_px) q += Eigen::Vector2d(d_px, d_px);
+    return copy;
+  };
+  const BoardObservation near = moved(0.9 * threshold_px), far = moved(1.1 * threshold_px);
+  EXPECT_EQ(BoardPoseGroups({&view, &near}, threshold_px).size(), 1u);
+  EXPECT_EQ(BoardPoseGroups({&view, &far}, threshold_px).size(), 2u);
+  // The other face at the same pixels is another pose.
+  BoardObservation back = Renumbered(view, 2);
+  back.face = view.face == Face::kFront ? Face::kBack : Face::kFront;
+  EXPECT_EQ(BoardPoseGroups({&view, &back}, threshold_px).size(), 2u);
+}
+
+}  // namespace
+}  // namespace stereorig

@@ -18,6 +18,9 @@ std::vector<ModuleLayout> Parse(YamlMap root) {
   for (YamlMap m : root.GetMaps("modules")) {
     ModuleLayout l;
     l.name = m.GetString("name");
+    // An empty name tells no module apart (the rig file's modules, the
+    // report's module_stereo_rms_px), and was accepted.
+    if (l.name.empty()) throw InputError(m.Where("name"), "is empty: each module needs a name of its own");
     // The name tells modules apart in the rig file and in every report
     // (module0_stereo_rms_px): two of one name wrote a rig of two
     // "module0", exit 0.

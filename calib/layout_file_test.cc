@@ -54,5 +54,11 @@ TEST(LayoutFile, EachModuleNameIsUsedOnce) {
             "t: modules[1].name: module0 is used twice (modules[0] too): each module needs a name of its own");
 }
 
+// An empty name tells no module apart, yet was accepted.
+TEST(LayoutFile, AnEmptyModuleNameIsRefused) {
+  EXPECT_EQ(testing::InputErrorMessage([] { ParseLayoutYaml("modules:\n  - {name: \"\", left: 0, right: 1}\n", "t"); }),
+            "t: modules[0].name: is empty: each module needs a name of its own");
+}
+
 }  // namespace
 }  // namespace stereorig

@@ -4,9 +4,72 @@
 #include <cmath>
 #include <map>
 
+#include "calib/core/input_error.h"
+
 #include "calib/triangulation.h"
 
 namespace stereorig {
+
+namespace {
+
+// "module 0 (m0)".
+std::string ModuleName(const Rig& rig, int k) {
+  return "module " + std::to_string(k) + " (" + rig.module(k).name + ")";
+}
+
+// "cameras 2,3" (left, right).
+std::string Cameras(const StereoModule& m) {
+  return "cameras " + std::to_string(m.left_camera) + "," + std::to_string(m.right_camera);
+}
+
+// The truth's module with `m`'s left and right cameras; -1 if none.
+int TruthModuleOf(const StereoModule& m, const Rig& truth) {
+  for (int j = 0; j < truth.num_modules(); ++j)
+    if (truth.module(j).left_camera == m.left_camera && truth.module(j).right_camera == m.right_camera) return j;
+  return -1;
+}
+
+}  // namespace
+
+std::string TruthModuleMismatch(const Rig& calibrated, const Rig& truth) {
+  if (truth.num_modules() != calibrated.num_modules() || truth.num_cameras() != calibrated.num_cameras())
+    return "has " + std::to_string(truth.num_modules()) + " module(s) and " + std::to_string(truth.num_cameras()) +
+           " camera(s), the rig has " + std::to_string(calibrated.num_modules()) + " and " +
+           std::to_string(calibrated.num_cameras());
+  for (int k = 0; k < calibrated.num_modules(); ++k) {
+    const StereoModule& m = calibrated.module(k);
+    if (TruthModuleOf(m, truth) >= 0) continue;
+    for (int j = 0; j < truth.num_modules(); ++j) {
+      const StereoModule& t = truth.module(j);
+      if (t.left_camera == m.right_camera && t.right_camera == m.left_camera)
+        return "the rig's " + ModuleName(calibrated, k) + " has left camera " + std::to_string(m.left_camera) +
+               " and right camera " + std::to_string(m.right_camera) + ", the truth's " + ModuleName(truth, j) +
+               " the same two the other way round (left " + std::to_string(t.left_camera) + ", right " +
+               std::to_string(t.right_camera) + "): left and right swapped in the layout it was calibrated with?";
+    }
+    std::string truths;
+    for (int j = 0; j < truth.num_modules(); ++j)
+      truths += (j ? "; " : "") + ModuleName(truth, j) + " " + Cameras(truth.module(j));
+    return "the rig's " + ModuleName(calibrated, k) + " uses " + Cameras(m) + " (left, right), which no module of " +
+           "the truth does (" + truths + "): a rig of other cameras?";
+  }
+  return "";
+}
+
+Rig TruthInModuleOrderOf(const Rig& calibrated, const Rig& truth) {
+  std::vector<int> order;  // the truth's module for each of calibrated's
+  for (const StereoModule& m : calibrated.modules()) {
+    order.push_back(TruthModuleOf(m, truth));
+    STEREORIG_CHECK(order.back() >= 0);
+  }
+  std::vector<StereoModule> modules;
+  std::vector<Pose> first_from_module;
+  for (int j : order) {
+    modules.push_back(truth.module(j));
+    first_from_module.push_back(truth.S(order[0], j));
+  }
+  return Rig(truth.cameras(), truth.camera_names(), modules, first_from_module);
+}
 
 void TriangulateThroughModule(const Rig& truth, const Rig& calibrated, int k, const std::vector<Eigen::Vector3d>& p_ref,
                               std::vector<Eigen::Vector3d>* p_cal, std::vector<Eigen::Vector3d>* p_true,

@@ -9,12 +9,29 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 #include "calib/core/pose.h"
 #include "calib/core/rig.h"
 
 namespace stereorig {
+
+// Why `truth` cannot judge `calibrated` module by module, or "" if it can:
+// the two need as many modules and cameras, and each module of `calibrated`
+// a module of `truth` with the same left and right cameras (in any order of
+// the modules: a layout may list them in another). Names the first module
+// whose cameras no module of the truth has, and says so where the truth's
+// has them with left and right swapped. Compared index by index, a layout's
+// reordered modules were judged against each other's truth (3D errors of
+// 1 mm for a right rig), and a swapped pair saw no point of the volume.
+std::string TruthModuleMismatch(const Rig& calibrated, const Rig& truth);
+
+// `truth` with its modules in `calibrated`'s order, each matched by its
+// cameras (TruthModuleMismatch passed), S expressed for that order: its
+// reference is then the module `calibrated` lists first. The figures below
+// compare module k with module k, so they take a truth in this order.
+Rig TruthInModuleOrderOf(const Rig& calibrated, const Rig& truth);
 
 // Triangulates each true point (reference frame) with module k of `calibrated`
 // from its noise-free projections through the TRUE cameras of module k of

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -91,53 +92,86 @@ StereoResult CalibrateStereo(int module, const ModuleLayout& layout, const Intri
   const Pose right_from_left_seed = AveragePoses(rl);
 
   // The joint problem: camera 0 = left (reference), camera 1 = right.
-  MrcalProblem p;
-  STEREORIG_CHECK(p.SetLensmodel(iopt.lensmodel));
-  p.corners_x = target.corners_x;
-  p.corners_y = target.corners_y;
-  p.spacing_mm = target.square_size_mm;
-  p.num_intrinsics_cameras = 2;
-  p.intrinsics = left.camera.intrinsics();
-  p.intrinsics.insert(p.intrinsics.end(), right.camera.intrinsics().begin(), right.camera.intrinsics().end());
-  p.imagersizes = {left.camera.imager_width_px(), left.camera.imager_height_px(), right.camera.imager_width_px(),
-                   right.camera.imager_height_px()};
-  p.extrinsics_fromref = {MrcalProblem::ToMrcal(right_from_left_seed)};
-
   StereoResult result{left.camera, right.camera, {}, {}, {}, {}, {}, {}};
   std::map<int, const BoardObservation*> lobs, robs;
   for (const BoardObservation* o : left_views) lobs[o->capture] = o;
   for (const BoardObservation* o : right_views) robs[o->capture] = o;
-  std::vector<int> captures;
-  for (const auto& kv : left_view) captures.push_back(kv.first);
-  for (const auto& kv : right_view)
-    if (!left_view.count(kv.first)) captures.push_back(kv.first);
-  std::sort(captures.begin(), captures.end());
   const int n = target.num_corners();
-  for (int capture : captures) {
-    const int iframe = p.num_frames();
-    auto il = left_view.find(capture);
-    auto ir = right_view.find(capture);
-    const Pose left_from_face = il != left_view.end()
-                                    ? left.cam_from_face[il->second]
-                                    : right_from_left_seed.Inverse() * right.cam_from_face[ir->second];
-    p.frames_toref.push_back(MrcalProblem::ToMrcal(left_from_face));
-    result.captures.push_back(capture);
-    result.faces.push_back(il != left_view.end() ? left.faces[il->second] : right.faces[ir->second]);
-    for (int cam = 0; cam < 2; ++cam) {
-      const auto& seen = cam == 0 ? left_view : right_view;
-      if (!seen.count(capture)) continue;
-      const BoardObservation* o = (cam == 0 ? lobs : robs).at(capture);
-      p.observations.push_back({.icam = {.intrinsics = cam, .extrinsics = cam - 1}, .iframe = iframe});
-      p.pool.resize(p.pool.size() + n);
-      FillPoolBlock(*o, target, &p.pool[p.pool.size() - n]);
+  // Views (capture, camera 0 left / 1 right) left out of the joint solve:
+  // those whose inlier corners no longer fix a board pose (below).
+  std::set<std::pair<int, int>> left_out;
+  auto seen = [&](int capture, int cam) {
+    return (cam == 0 ? left_view : right_view).count(capture) && !left_out.count({capture, cam});
+  };
+  MrcalProblem p;
+  int missing = 0, non_positive = 0;
+  // Solves from stage 1's intrinsics and board poses, every view but those
+  // left out.
+  auto solve = [&] {
+    p = BoardProblem(iopt.lensmodel, target, 2);
+    p.intrinsics = left.camera.intrinsics();
+    p.intrinsics.insert(p.intrinsics.end(), right.camera.intrinsics().begin(), right.camera.intrinsics().end());
+    p.imagersizes = {left.camera.imager_width_px(), left.camera.imager_height_px(), right.camera.imager_width_px(),
+                     right.camera.imager_height_px()};
+    p.extrinsics_fromref = {MrcalProblem::ToMrcal(right_from_left_seed)};
+    result.captures.clear();
+    result.faces.clear();
+    std::set<int> captures;
+    for (const auto& kv : left_view)
+      if (seen(kv.first, 0)) captures.insert(kv.first);
+    for (const auto& kv : right_view)
+      if (seen(kv.first, 1)) captures.insert(kv.first);
+    for (int capture : captures) {
+      const int iframe = p.num_frames();
+      const bool by_left = seen(capture, 0);
+      const Pose left_from_face = by_left
+                                      ? left.cam_from_face[left_view.at(capture)]
+                                      : right_from_left_seed.Inverse() * right.cam_from_face[right_view.at(capture)];
+      p.frames_toref.push_back(MrcalProblem::ToMrcal(left_from_face));
+      result.captures.push_back(capture);
+      result.faces.push_back(by_left ? left.faces[left_view.at(capture)] : right.faces[right_view.at(capture)]);
+      for (int cam = 0; cam < 2; ++cam) {
+        if (!seen(capture, cam)) continue;
+        const BoardObservation* o = (cam == 0 ? lobs : robs).at(capture);
+        p.observations.push_back({.icam = {.intrinsics = cam, .extrinsics = cam - 1}, .iframe = iframe});
+        p.pool.resize(p.pool.size() + n);
+        FillPoolBlock(*o, target, &p.pool[p.pool.size() - n]);
+      }
     }
+    missing = p.CountNonPositiveWeights();
+    p.SelectPosesOnly();
+    p.Optimize(options.verbose);
+    p.selections.do_optimize_intrinsics_core = true;
+    p.selections.do_optimize_intrinsics_distortions = true;
+    non_positive = SolveFinal(&p, options.verbose);
+  };
+  solve();
+  // A view whose inlier corners no longer fix its board pose (outlier
+  // rejection left fewer than min_corners_per_view, or one row or column)
+  // is left out and the rest solved again, as stage 1 does: a capture whose
+  // left and right images were swapped had every corner of both its views
+  // rejected, its board pose undetermined, J'J singular, and the module's
+  // sigmas printed as 0 (baseline 89.9957 +- 0.0000 mm).
+  for (;;) {
+    std::vector<std::pair<int, int>> undetermined;
+    for (int o = 0; o < p.num_observations(); ++o) {
+      std::vector<int> inliers;
+      for (int i = 0; i < n; ++i)
+        if (p.pool[o * n + i].z > 0) inliers.push_back(i);
+      if (static_cast<int>(inliers.size()) < iopt.min_corners_per_view || !CornersSpanAPlane(inliers, target.corners_x))
+        undetermined.push_back({result.captures[p.observations[o].iframe], p.observations[o].icam.intrinsics});
+    }
+    if (undetermined.empty()) break;
+    left_out.insert(undetermined.begin(), undetermined.end());
+    int shared = 0;
+    for (const auto& kv : left_view) shared += seen(kv.first, 0) && seen(kv.first, 1);
+    if (shared < options.min_shared_views)
+      throw InputError(where, "too few views shared by both cameras after outlier rejection: " +
+                                  std::to_string(shared) + ", need " + std::to_string(options.min_shared_views));
+    solve();
   }
-  const int missing = p.CountNonPositiveWeights();
-  p.SelectPosesOnly();
-  p.Optimize(options.verbose);
-  p.selections.do_optimize_intrinsics_core = true;
-  p.selections.do_optimize_intrinsics_distortions = true;
-  const int non_positive = SolveFinal(&p, options.verbose);
+  for (const auto& [capture, cam] : left_out)
+    result.report.views_left_out.push_back({capture, cam == 0 ? layout.left_camera : layout.right_camera});
 
   const int np = p.num_params();
   result.left = Camera(iopt.lensmodel, std::vector<double>(p.intrinsics.begin(), p.intrinsics.begin() + np),
@@ -150,7 +184,8 @@ StereoResult CalibrateStereo(int module, const ModuleLayout& layout, const Intri
   StereoReport& r = result.report;
   r.module = module;
   r.module_name = layout.name;
-  r.num_shared_views = static_cast<int>(rl.size());
+  r.num_shared_views = 0;
+  for (const auto& kv : left_view) r.num_shared_views += seen(kv.first, 0) && seen(kv.first, 1);
   r.different_face_captures = different_faces;
   r.num_frames = p.num_frames();
   const std::vector<double> x = p.Residuals();
@@ -163,7 +198,15 @@ StereoResult CalibrateStereo(int module, const ModuleLayout& layout, const Intri
   {
     // right_from_left is mrcal's rt_cam_ref of the right camera (extrinsics 0).
     const ProjectionUncertaintyEvaluator eval(p);
-    if (eval.ok()) {
+    r.covariance_status = eval.ok() ? "ok" : eval.message();
+    if (!eval.ok()) {
+      // Not a number, not 0: a 0 read as an exact baseline ("89.9957 +-
+      // 0.0000 mm"); the report writes null, the summary "no sigma".
+      const double none = std::numeric_limits<double>::quiet_NaN();
+      r.baseline_sigma_mm = r.rotation_sigma_deg = none;
+      r.right_from_left_rotation_vector_sigma_deg.setConstant(none);
+      r.right_from_left_translation_sigma_mm.setConstant(none);
+    } else {
       const Eigen::Matrix<double, 6, 6> cov = eval.ExtrinsicsCovariance(0);
       const Eigen::Vector3d rv(p.extrinsics_fromref[0].r.x, p.extrinsics_fromref[0].r.y, p.extrinsics_fromref[0].r.z);
       const Eigen::Vector3d t = r.right_from_left_translation_mm;

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "calib/intrinsics.h"
@@ -25,7 +26,7 @@ struct StereoOptions {
 struct StereoReport {
   int module = -1;
   std::string module_name;
-  int num_shared_views = 0;  // captures both cameras saw (the same face), used for right_from_left
+  int num_shared_views = 0;  // captures both cameras saw (the same face) in the joint solve
   // Captures in which the two cameras saw different faces (the board's plane
   // between them, or a face misread): set aside here and in stage 3.
   std::vector<int> different_face_captures;
@@ -37,7 +38,10 @@ struct StereoReport {
   Eigen::Vector3d right_from_left_rotation_vector_deg = Eigen::Vector3d::Zero();
   Eigen::Vector3d right_from_left_translation_mm = Eigen::Vector3d::Zero();
   // 1 sigma of the above from the joint solve's covariance (mrcal's J'J,
-  // scaled by the observed corner noise); 0 if the covariance failed.
+  // scaled by the observed corner noise); NaN if the covariance failed
+  // (covariance_status says why; the report writes null, the summary "no
+  // sigma").
+  std::string covariance_status = "not computed";  // "ok" or why the covariance failed
   double baseline_sigma_mm = 0.0;
   double rotation_sigma_deg = 0.0;
   Eigen::Vector3d right_from_left_rotation_vector_sigma_deg = Eigen::Vector3d::Zero();
@@ -45,6 +49,11 @@ struct StereoReport {
   double rectified_row_rms_px = 0.0;  // over corners both cameras saw
   double rectified_row_max_px = 0.0;
   int num_corner_pairs = 0;
+  // Views left out of the joint solve, (capture, global camera index):
+  // outlier rejection left them too few corners to fix a board pose (a
+  // capture whose left and right images were swapped). Calibrate warns of
+  // them (capture_folder.h).
+  std::vector<std::pair<int, int>> views_left_out = {};
   IntrinsicsReport left, right;  // per-camera figures of the joint solve (uncertainty, coverage)
   // Cov(left's intrinsics, right's) of the joint solve, (N * N,) row-major,
   // rows the left's, as left/right.intrinsics_covariance (the

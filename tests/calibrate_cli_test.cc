@@ -435,7 +435,9 @@ TEST(CalibrateCli, RefusesImagesOfTheWrongSize) {
   const testing::Result r = testing::RunCli(calibrate);
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(testing::Lines(r.err.substr(r.err.rfind("stereorig calibrate:"))), 1) << r.err;
-  EXPECT_NE(r.err.find("wrong size"), std::string::npos) << r.err;
+  // One image of each size: neither is the odd one out, both are named.
+  EXPECT_NE(r.err.find("cam1's images differ in size, and no size is most of them: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("640x480: " + set.dir + "/captures/001/cam1.png"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(set.dir + "/rig.yaml"));
 
   // The size is read from the header, before the pixels are decoded: the
@@ -452,7 +454,7 @@ TEST(CalibrateCli, RefusesImagesOfTheWrongSize) {
   std::ofstream(cut, std::ios::binary | std::ios::trunc) << bytes.substr(0, 200);
   const testing::Result cut_run = testing::RunCli(calibrate);
   EXPECT_EQ(cut_run.code, 2);
-  EXPECT_NE(cut_run.err.find("cam1.png: image of the wrong size: 640x480"), std::string::npos) << cut_run.err;
+  EXPECT_NE(cut_run.err.find("640x480: " + set.dir + "/captures/001/cam1.png"), std::string::npos) << cut_run.err;
   EXPECT_FALSE(fs::exists(set.dir + "/rig.yaml"));
 }
 
@@ -780,6 +782,140 @@ TEST(CalibrateCli, CamerasTheLayoutLeavesOutAreWarnedOf) {
   EXPECT_EQ(json["warnings"], nlohmann::json::array({warning})) << json["warnings"].dump();
   // The layout of every camera leaves none out.
   EXPECT_EQ(CamerasLeftOutNote(set.dir + "/captures", 4), "");
+}
+
+// Copies of one capture (a trigger delivering one frame again, or the board
+// left still) count as one board pose: eight copies calibrated, exit 0,
+// with a baseline 10.8 mm off and sigmas shrunk by sqrt(8). Five copies
+// (the default's minimum of views) are refused, naming the camera and the
+// captures; a copy among enough poses calibrates, with a warning naming it
+// by its folder.
+TEST(CalibrateCli, CopiesOfOneCaptureAreOneBoardPose) {
+  const RenderedSet& set = Rendered();
+  std::ofstream(set.dir + "/one_module.yaml") << "modules:\n  - {name: module0, left: 0, right: 1, face: front}\n";
+  const std::string copies = set.dir + "/copies";
+  fs::remove_all(copies);
+  for (int c = 1; c <= 5; ++c)
+    for (const std::string image : {"cam0.png", "cam1.png"}) {
+      fs::create_directories(copies + "/00" + std::to_string(c));
+      fs::copy_file(set.dir + "/captures/000/" + image, copies + "/00" + std::to_string(c) + "/" + image);
+    }
+  const std::string args = " --target " + set.dir + "/target.yaml --layout " + set.dir + "/one_module.yaml --out " +
+                           set.dir + "/copies.yaml --report " + set.dir + "/copies.json";
+  const testing::Result r = testing::RunCli("calibrate --captures " + copies + args);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(copies + ": camera 0 (cam0): too few distinct board poses: its 5 usable views show 1, need at "
+                                "least 5; repeated: captures 1, 2, 3, 4 and 5 (corners within 1.41 px RMS"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(set.dir + "/copies.yaml"));
+  EXPECT_FALSE(fs::exists(set.dir + "/copies.json"));
+
+  // The set's 8 captures and capture 000 again as 008.
+  const std::string again = set.dir + "/again";
+  fs::remove_all(again);
+  fs::create_directories(again);
+  for (int c = 0; c < 8; ++c)
+    for (const std::string image : {"cam0.png", "cam1.png"}) {
+      fs::create_directories(again + "/00" + std::to_string(c));
+      fs::copy_file(set.dir + "/captures/00" + std::to_string(c) + "/" + image,
+                    again + "/00" + std::to_string(c) + "/" + image);
+    }
+  fs::copy(again + "/000", again + "/008");
+  const testing::Result a = testing::RunCli("calibrate --captures " + again + args);
+  ASSERT_EQ(a.code, 0) << a.err;
+  for (const std::string camera : {"camera 0 (cam0)", "camera 1 (cam1)"})
+    EXPECT_NE(a.err.find("calibrate: warning: " + camera + " sees one board pose again in captures 000, 008"),
+              std::string::npos)
+        << a.err;
+  std::ifstream report(set.dir + "/copies.json");
+  const nlohmann::json json = nlohmann::json::parse(report);
+  EXPECT_EQ(json["warnings"].size(), 2u) << json["warnings"].dump();
+}
+
+// A module of an empty name was accepted (exit 0, a rig whose module has
+// no name); refused when the layout is read, before any image.
+TEST(CalibrateCli, ALayoutModuleWithAnEmptyNameIsRefused) {
+  const std::string dir = ::testing::TempDir() + "/calib_cli_empty_name_" + std::to_string(getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir + "/layout.yaml") << "modules:\n  - {name: \"\", left: 0, right: 1}\n";
+  const testing::Result r =
+      testing::RunCli("calibrate --captures " + dir + "/no_captures --target " + dir + "/target.yaml --layout " + dir +
+                      "/layout.yaml --out " + dir + "/rig.yaml --report " + dir + "/report.json");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "stereorig calibrate: " + dir +
+                       "/layout.yaml: modules[0].name: is empty: each module needs a name of its own\n");
+  EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
+  EXPECT_FALSE(fs::exists(dir + "/report.json"));
+  fs::remove_all(dir);
+}
+
+// The rendered set's captures 000..`count - 1`, cameras 0 and 1 only (module
+// 0 of the layout one_module.yaml), copied into a fresh folder `dir`.
+void CopyModuleZeroCaptures(const RenderedSet& set, const std::string& dir, int count) {
+  fs::remove_all(dir);
+  for (int c = 0; c < count; ++c) {
+    const std::string capture = "/00" + std::to_string(c);
+    fs::create_directories(dir + capture);
+    for (const std::string image : {"/cam0.png", "/cam1.png"})
+      fs::copy_file(set.dir + "/captures" + capture + image, dir + capture + image);
+  }
+  std::ofstream(set.dir + "/one_module.yaml") << "modules:\n  - {name: module0, left: 0, right: 1, face: front}\n";
+}
+
+// An image of the wrong size in the first capture: the first image read set
+// the size, and the error named a right one (001/cam1.png). The odd one
+// out is named, against the size most of the camera's images have.
+TEST(CalibrateCli, AWrongSizedImageInTheFirstCaptureIsTheOneNamed) {
+  const RenderedSet& set = Rendered();
+  const std::string dir = set.dir + "/odd_first";
+  CopyModuleZeroCaptures(set, dir, 3);
+  cv::Mat noise(480, 640, CV_8UC1);
+  cv::randu(noise, 0, 256);
+  cv::imwrite(dir + "/000/cam1.png", noise);
+  const testing::Result r =
+      testing::RunCli("calibrate --captures " + dir + " --target " + set.dir + "/target.yaml --layout " + set.dir +
+                      "/one_module.yaml --out " + dir + "/rig.yaml --report " + dir + "/report.json");
+  EXPECT_EQ(r.code, 2);
+  const Camera& cam1 = set.truth.camera(1);
+  EXPECT_EQ(r.err, "stereorig calibrate: " + dir +
+                       "/000/cam1.png: image of the wrong size: 640x480, but 2 of cam1's 3 "
+                       "images are " +
+                       std::to_string(cam1.imager_width_px()) + "x" + std::to_string(cam1.imager_height_px()) + "\n");
+  EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
+}
+
+// Sub-folders of the captures that are no captures: the camera models an
+// earlier run wrote beside them (--export-cameramodels DIR/models), and a
+// viewer's hidden .thumbs. Each was taken for a capture ("models/cam0.png:
+// missing"); they are skipped and named on stdout. A folder holding some
+// cameras' images but not all is still a capture, refused for the missing.
+TEST(CalibrateCli, FoldersHoldingNoCaptureAreSkippedAndNamed) {
+  const RenderedSet& set = Rendered();
+  const std::string dir = set.dir + "/beside";
+  CopyModuleZeroCaptures(set, dir, 8);
+  fs::create_directories(dir + "/.thumbs");
+  fs::copy_file(dir + "/000/cam0.png", dir + "/.thumbs/cam0.png");
+  const std::string args = " --target " + set.dir + "/target.yaml --layout " + set.dir + "/one_module.yaml --out " +
+                           dir + "/rig.yaml --report " + dir + "/report.json";
+  testing::Result r =
+      testing::RunCli("calibrate --captures " + dir + args + " --export-cameramodels " + dir + "/models");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("skipped " + dir + "/.thumbs: not a capture (a hidden folder, or one holding no camK.png)\n"),
+            std::string::npos)
+      << r.out;
+  ASSERT_TRUE(fs::exists(dir + "/models/cam0.cameramodel"));
+  // Run again, the models now among the captures.
+  r = testing::RunCli("calibrate --captures " + dir + args);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("skipped " + dir + "/models: not a capture"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("calibrate: 8 captures, "), std::string::npos) << r.err;
+  // Some cameras' images but not all: a capture that lacks one.
+  fs::remove(dir + "/003/cam1.png");
+  r = testing::RunCli("calibrate --captures " + dir + args);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(dir + "/003/cam1.png: missing"), std::string::npos) << r.err;
 }
 
 }  // namespace

@@ -922,4 +922,66 @@ TEST(Cli, MatchRefusesAHugeTiffFromItsHeader) {
   fs::remove_all(dir);
 }
 
+// `rig --truth` compares the truth's modules by their cameras, not their
+// place in the file: a rig calibrated with a layout listing the modules in
+// the other order is right, and was judged against the other module's
+// truth ("3D error 1.0172 / 1.0846 mm, agreement through S 2.4395 mm").
+// The same rig so reordered is judged like with like (every figure 0, as
+// against itself), and says which truth module each is compared with. A
+// module whose left and right are swapped, or whose cameras no truth
+// module has, cannot be compared: exit 2, naming it (a swapped one read
+// "sees fewer than 3 points of the volume").
+TEST(Cli, RigAgainstTruthMatchesModulesByTheirCameras) {
+  const std::string dir = ::testing::TempDir() + "/truth_by_cameras";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string truth_path = dir + "/truth.yaml";
+  std::ofstream(truth_path) << GoodRigText();
+  const stereorig::Rig t = stereorig::MakeDefaultRig().rig;
+  auto named = [](stereorig::StereoModule m, const std::string& name) {
+    m.name = name;
+    return m;
+  };
+  const stereorig::Rig reordered(t.cameras(), t.camera_names(), {named(t.module(1), "m0"), named(t.module(0), "m1")},
+                                 {stereorig::Pose(), t.S(1, 0)});
+  stereorig::WriteRigFile(reordered, dir + "/reordered.yaml");
+  Result r = RunCli("rig --rig " + dir + "/reordered.yaml --truth " + truth_path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("  (module 0 is compared with the truth's module 1, module1: the same cameras 2,3)\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("module 0: 3D error after rigid alignment 0.0000 mm"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("module 1: 3D error after rigid alignment 0.0000 mm"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("agreement through S 0.0000 mm"), std::string::npos) << r.out;
+
+  // Module 0's left and right swapped: its frame is camera 1's.
+  stereorig::StereoModule swapped = t.module(0);
+  std::swap(swapped.left_camera, swapped.right_camera);
+  swapped.right_from_left = t.module(0).right_from_left.Inverse();
+  const stereorig::Rig lr(t.cameras(), t.camera_names(), {swapped, t.module(1)},
+                          {stereorig::Pose(), t.module(0).right_from_left * t.S(0, 1)});
+  stereorig::WriteRigFile(lr, dir + "/swapped.yaml");
+  r = RunCli("rig --rig " + dir + "/swapped.yaml --truth " + truth_path);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err,
+            "stereorig rig: --truth: the rig's module 0 (module0) has left camera 1 and right camera 0, the truth's "
+            "module 0 (module0) the same two the other way round (left 0, right 1): left and right swapped in the "
+            "layout it was calibrated with?\n");
+  EXPECT_EQ(r.out, "");
+
+  // Modules of other camera pairs: (0, 2) and (1, 3).
+  stereorig::StereoModule a = t.module(0), b = t.module(1);
+  a.right_camera = 2;
+  b.left_camera = 1;
+  const stereorig::Rig other(t.cameras(), t.camera_names(), {a, b}, {stereorig::Pose(), t.S(0, 1)});
+  stereorig::WriteRigFile(other, dir + "/other.yaml");
+  r = RunCli("rig --rig " + dir + "/other.yaml --truth " + truth_path);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err,
+            "stereorig rig: --truth: the rig's module 0 (module0) uses cameras 0,2 (left, right), which no module of "
+            "the truth does (module 0 (module0) cameras 0,1; module 1 (module1) cameras 2,3): a rig of other "
+            "cameras?\n");
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
