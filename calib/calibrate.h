@@ -50,8 +50,9 @@ struct CalibrationReport {
   std::string wrong_plate;
   // The warnings calibrate printed on stderr ("calibrate: warning: ..."),
   // one line each: cameras of the captures no module names, most images
-  // rejected, rows or columns of the target never seen (capture_folder.h);
-  // and Calibrate's own: a stage 3 Horn-only solve that stopped short
+  // rejected, rows or columns of the target never seen, views that repeat a
+  // board pose, views stage 2 left out (capture_folder.h); and Calibrate's
+  // own: a stage 3 Horn-only solve that stopped short
   // (SystemReport::horn_only_solver_problem).
   std::vector<std::string> warnings{};
   // The capture's folder name where known, else its index in decimal: how

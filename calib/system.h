@@ -154,7 +154,7 @@ struct SystemReport {
   std::vector<CameraResiduals> refined_camera_residuals;
   // Left out as the earlier stages judged (SystemExclusions), counted among
   // the views and corners the adjustment would otherwise have used:
-  int num_skipped_views = 0;                             // views stage 1 dropped
+  int num_skipped_views = 0;                             // views stage 1 or 2 dropped
   int num_skipped_view_corners = 0;                      // their corners
   int num_skipped_outlier_corners = 0;                   // single corners stage 1 or 2 flagged as outliers
   std::vector<Pose> module0_from_module_horn;            // (M,)
