@@ -49,26 +49,39 @@ bool InSystemFolder(const std::filesystem::path& absolute) {
   return *part == "dev" && !(++part != absolute.end() && *part == "shm");
 }
 
+// True if `p` has a ".." part: what it names is known only once the links
+// before it are resolved (the kernel's order: "link/.." is the link
+// target's parent, not the link's folder).
+bool HasParentStep(const std::filesystem::path& p) {
+  for (const auto& part : p)
+    if (part == "..") return true;
+  return false;
+}
+
 // The first place on the way from `path` to the file it names that lies in
-// /dev or /proc (InSystemFolder), "" if none: the path itself, as written or
-// with the folders above it resolved, then each symbolic link's target in
-// turn. Whatever the last link points to now does not matter: /dev/stdout,
-// /dev/fd/1 and /proc/self/fd/1 are links to what a stream is at the moment,
-// a log file too when it is redirected (cron's ">> log").
+// /dev or /proc (InSystemFolder), "" if none: the path itself, as written
+// (where no ".." makes that differ from what it names) and with the folders
+// above it resolved, then each symbolic link's target in turn. Whatever the
+// last link points to now does not matter: /dev/stdout, /dev/fd/1 and
+// /proc/self/fd/1 are links to what a stream is at the moment, a log file
+// too when it is redirected (cron's ">> log"). Never collapsed lexically
+// before its links are resolved: with a -> /dev/shm, "a/../stdout" is
+// /dev/stdout, not "./stdout".
 std::string SystemPlaceOnTheWay(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  fs::path p = fs::absolute(path, ec).lexically_normal();
+  fs::path p = fs::absolute(path, ec);
   for (int hops = 0; !ec && hops < 40; ++hops) {  // 40: the kernel's own limit (ELOOP)
-    if (InSystemFolder(p)) return p.string();
-    const fs::path folder = fs::weakly_canonical(p.parent_path(), ec);
+    if (!HasParentStep(p) && InSystemFolder(p.lexically_normal())) return p.lexically_normal().string();
+    if (p.filename() == ".." || p.filename() == ".") p = fs::weakly_canonical(p, ec);  // no link at its end
+    if (ec) break;
+    const fs::path folder = fs::weakly_canonical(p.parent_path(), ec);  // links resolved as the kernel does
     if (ec) break;
     p = folder / p.filename();
     if (InSystemFolder(p)) return p.string();
     struct stat st {};
     if (lstat(p.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) break;
-    const fs::path target = fs::read_symlink(p, ec);
-    p = (folder / target).lexically_normal();  // an absolute target replaces the folder
+    p = folder / fs::read_symlink(p, ec);  // an absolute target replaces the folder
   }
   return "";
 }

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -216,6 +217,43 @@ TEST(WriteFileAtomically, ALinkIntoProcOrDevIsRefusedWhateverItPointsTo) {
   if (std::filesystem::is_directory("/dev/shm") && !std::filesystem::is_symlink("/dev/shm")) {
     EXPECT_EQ(testing::InputErrorMessage([&] { RequireReplaceableOutput("/dev/shm/stereorig-output.json"); }), "");
   }
+}
+
+// A ".." after a link is the link target's parent, as the kernel takes it:
+// not collapsed with the link before the link is resolved. With a link to
+// /proc/self (or /dev/fd, /dev/shm), "link/../name" is in /proc (or /dev),
+// where "name" beside the link is not; it was checked as the latter and
+// written, the rename replacing what was there. Only the check is called
+// here: nothing in /proc or /dev is written.
+TEST(RequireReplaceableOutput, AParentStepAfterALinkIsTakenWhereTheLinkLeads) {
+  const std::string dir = testing::ScratchFolder("atomic_link_parent_step");
+  std::filesystem::create_symlink("/proc/self", dir + "/self");
+  std::filesystem::create_symlink("/dev/fd", dir + "/fd");  // -> /proc/self/fd: its parent is /proc/<pid>
+  const std::string pid = std::to_string(getpid());
+  const std::pair<std::string, std::string> refused[] = {
+      {dir + "/self/../stereorig-new-output.json", "leads to /proc/stereorig-new-output.json through a symbolic link"},
+      {dir + "/fd/../stdout", "leads to /proc/" + pid + "/stdout through a symbolic link"}};
+  for (const auto& [path, says] : refused) {
+    const std::string message = testing::InputErrorMessage([&] { RequireReplaceableOutput(path); });
+    EXPECT_NE(message.find(path + ": " + says), std::string::npos) << message;
+  }
+  if (std::filesystem::is_directory("/dev/shm") && !std::filesystem::is_symlink("/dev/shm")) {
+    std::filesystem::create_symlink("/dev/shm", dir + "/shm");
+    const std::string path = dir + "/shm/../stereorig-new-output.json";
+    EXPECT_NE(testing::InputErrorMessage([&] {
+                RequireReplaceableOutput(path);
+              }).find(path + ": leads to /dev/stereorig-new-output.json through a symbolic link"),
+              std::string::npos);
+  }
+  // A scratch folder standing in: "link/../x.json" is written in the link
+  // target's parent, where the check looked; a ".." written in /dev that
+  // leaves it is no refusal.
+  std::filesystem::create_directories(dir + "/real/deeper");
+  std::filesystem::create_symlink("real/deeper", dir + "/link");
+  WriteFileAtomically(dir + "/link/../x.json", "{}");
+  EXPECT_EQ(Contents(dir + "/real/x.json"), "{}");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.json"));
+  EXPECT_EQ(testing::InputErrorMessage([&] { RequireReplaceableOutput("/dev/.." + dir + "/y.json"); }), "");
 }
 
 // Committed without replacing (AtExisting::kRefuse, a reconstruct stream's
