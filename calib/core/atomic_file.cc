@@ -146,19 +146,36 @@ AtomicOutput::~AtomicOutput() {
 
 namespace {
 
-// rename(2) that fails with EEXIST if `to` exists (a dangling link too),
-// atomically: renameat2(RENAME_NOREPLACE), or on a file system without it
-// (EINVAL), a hard link, which fails so too, then `from` removed. Returns 0
-// or the errno.
-int RenameWithoutReplacing(const char* from, const char* to) {
-  if (renameat2(AT_FDCWD, from, AT_FDCWD, to, RENAME_NOREPLACE) == 0) return 0;
-  if (errno != EINVAL && errno != ENOSYS) return errno;
-  if (link(from, to) != 0) return errno;
-  unlink(from);
-  return 0;
+// The errors of a file system that has no such call (FUSE mounts: sshfs,
+// SMB, WSL's drvfs), not of this call on these paths.
+bool NotSupported(int err) { return err == ENOSYS || err == EOPNOTSUPP || err == ENOTSUP; }
+
+int RenameNoReplace(const char* from, const char* to) {
+  return renameat2(AT_FDCWD, from, AT_FDCWD, to, RENAME_NOREPLACE);
 }
 
 }  // namespace
+
+int RenameWithoutReplacing(const char* from, const char* to, PathCall rename_noreplace, PathCall hard_link) {
+  if (rename_noreplace == nullptr) rename_noreplace = RenameNoReplace;
+  if (hard_link == nullptr) hard_link = link;
+  if (rename_noreplace(from, to) == 0) return 0;
+  if (errno != EINVAL && !NotSupported(errno)) return errno;  // EINVAL: the file system takes no flags
+  if (hard_link(from, to) == 0) {
+    unlink(from);
+    return 0;
+  }
+  // EPERM: "the file system does not support hard links" (link(2)); EXDEV:
+  // some FUSE file systems say so for any link.
+  if (errno != EPERM && errno != EXDEV && !NotSupported(errno)) return errno;
+  // Neither atomic way: the name checked free, then the rename. A file
+  // another process makes in the moment between would be replaced; on such
+  // a file system a line keeps measuring rather than every capture failing.
+  struct stat st {};
+  if (lstat(to, &st) == 0) return EEXIST;
+  if (errno != ENOENT) return errno;
+  return std::rename(from, to) == 0 ? 0 : errno;
+}
 
 void AtomicOutput::Commit(AtExisting existing) {
   const bool refuse = existing == AtExisting::kRefuse;

@@ -256,6 +256,54 @@ TEST(RequireReplaceableOutput, AParentStepAfterALinkIsTakenWhereTheLinkLeads) {
   EXPECT_EQ(testing::InputErrorMessage([&] { RequireReplaceableOutput("/dev/.." + dir + "/y.json"); }), "");
 }
 
+// Stand-ins for a file system with neither renameat2's flags nor hard links
+// (some FUSE mounts: sshfs, SMB, WSL's drvfs): a call failing with `kErrno`.
+template <int kErrno>
+int FailsWith(const char*, const char*) {
+  errno = kErrno;
+  return -1;
+}
+constexpr PathCall NoFlags = FailsWith<EINVAL>;
+constexpr PathCall NoHardLinks = FailsWith<EPERM>;
+constexpr PathCall NoLinksAcrossFuse = FailsWith<EXDEV>;
+constexpr PathCall NotSupported = FailsWith<EOPNOTSUPP>;
+constexpr PathCall NoAccess = FailsWith<EACCES>;
+
+// There a commit that must not replace checks the name free, then renames:
+// every capture of a stream on such a mount failed "cannot write:
+// Operation not permitted" instead.
+TEST(RenameWithoutReplacing, WithoutItsAtomicWaysAFreeNameIsStillWrittenATakenOneNot) {
+  const std::string dir = testing::ScratchFolder("atomic_no_replace_fallback");
+  const std::string from = dir + "/.tmp-new";
+  for (PathCall no_link : {NoHardLinks, NoLinksAcrossFuse, NotSupported}) {
+    WriteFileAtomically(from, "new");
+    const std::string to = dir + "/free-" + std::to_string(Names(dir).size()) + ".json";
+    EXPECT_EQ(RenameWithoutReplacing(from.c_str(), to.c_str(), NoFlags, no_link), 0);
+    EXPECT_EQ(Contents(to), "new");
+    EXPECT_FALSE(std::filesystem::exists(from));
+  }
+  for (PathCall no_rename : {NoFlags, NotSupported}) {  // and a dangling link is a name taken
+    WriteFileAtomically(dir + "/taken.json", "theirs");
+    std::filesystem::remove(dir + "/dangling.json");
+    std::filesystem::create_symlink("nothing", dir + "/dangling.json");
+    WriteFileAtomically(from, "new");
+    for (const std::string& to : {dir + "/taken.json", dir + "/dangling.json"})
+      EXPECT_EQ(RenameWithoutReplacing(from.c_str(), to.c_str(), no_rename, NoHardLinks), EEXIST) << to;
+    EXPECT_EQ(Contents(dir + "/taken.json"), "theirs");
+    EXPECT_TRUE(std::filesystem::is_symlink(dir + "/dangling.json"));
+    EXPECT_EQ(Contents(from), "new");
+  }
+  // Any other error is this call's: returned, nothing renamed.
+  EXPECT_EQ(RenameWithoutReplacing(from.c_str(), (dir + "/other.json").c_str(), NoFlags, NoAccess), EACCES);
+  EXPECT_EQ(RenameWithoutReplacing(from.c_str(), (dir + "/other.json").c_str(), NoAccess, NoHardLinks), EACCES);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/other.json"));
+  EXPECT_EQ(Contents(from), "new");
+  // The system's own calls, here (tmpfs or ext4) atomic.
+  EXPECT_EQ(RenameWithoutReplacing(from.c_str(), (dir + "/taken.json").c_str()), EEXIST);
+  EXPECT_EQ(RenameWithoutReplacing(from.c_str(), (dir + "/other.json").c_str()), 0);
+  EXPECT_EQ(Contents(dir + "/other.json"), "new");
+}
+
 // Committed without replacing (AtExisting::kRefuse, a reconstruct stream's
 // outputs): a name another process made between this run's check that it
 // is free and the commit is refused, "exists already", and left as it was;
