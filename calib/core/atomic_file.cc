@@ -49,26 +49,39 @@ bool InSystemFolder(const std::filesystem::path& absolute) {
   return *part == "dev" && !(++part != absolute.end() && *part == "shm");
 }
 
+// True if `p` has a ".." part: what it names is known only once the links
+// before it are resolved (the kernel's order: "link/.." is the link
+// target's parent, not the link's folder).
+bool HasParentStep(const std::filesystem::path& p) {
+  for (const auto& part : p)
+    if (part == "..") return true;
+  return false;
+}
+
 // The first place on the way from `path` to the file it names that lies in
-// /dev or /proc (InSystemFolder), "" if none: the path itself, as written or
-// with the folders above it resolved, then each symbolic link's target in
-// turn. Whatever the last link points to now does not matter: /dev/stdout,
-// /dev/fd/1 and /proc/self/fd/1 are links to what a stream is at the moment,
-// a log file too when it is redirected (cron's ">> log").
+// /dev or /proc (InSystemFolder), "" if none: the path itself, as written
+// (where no ".." makes that differ from what it names) and with the folders
+// above it resolved, then each symbolic link's target in turn. Whatever the
+// last link points to now does not matter: /dev/stdout, /dev/fd/1 and
+// /proc/self/fd/1 are links to what a stream is at the moment, a log file
+// too when it is redirected (cron's ">> log"). Never collapsed lexically
+// before its links are resolved: with a -> /dev/shm, "a/../stdout" is
+// /dev/stdout, not "./stdout".
 std::string SystemPlaceOnTheWay(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  fs::path p = fs::absolute(path, ec).lexically_normal();
+  fs::path p = fs::absolute(path, ec);
   for (int hops = 0; !ec && hops < 40; ++hops) {  // 40: the kernel's own limit (ELOOP)
-    if (InSystemFolder(p)) return p.string();
-    const fs::path folder = fs::weakly_canonical(p.parent_path(), ec);
+    if (!HasParentStep(p) && InSystemFolder(p.lexically_normal())) return p.lexically_normal().string();
+    if (p.filename() == ".." || p.filename() == ".") p = fs::weakly_canonical(p, ec);  // no link at its end
+    if (ec) break;
+    const fs::path folder = fs::weakly_canonical(p.parent_path(), ec);  // links resolved as the kernel does
     if (ec) break;
     p = folder / p.filename();
     if (InSystemFolder(p)) return p.string();
     struct stat st {};
     if (lstat(p.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) break;
-    const fs::path target = fs::read_symlink(p, ec);
-    p = (folder / target).lexically_normal();  // an absolute target replaces the folder
+    p = folder / fs::read_symlink(p, ec);  // an absolute target replaces the folder
   }
   return "";
 }
@@ -133,19 +146,36 @@ AtomicOutput::~AtomicOutput() {
 
 namespace {
 
-// rename(2) that fails with EEXIST if `to` exists (a dangling link too),
-// atomically: renameat2(RENAME_NOREPLACE), or on a file system without it
-// (EINVAL), a hard link, which fails so too, then `from` removed. Returns 0
-// or the errno.
-int RenameWithoutReplacing(const char* from, const char* to) {
-  if (renameat2(AT_FDCWD, from, AT_FDCWD, to, RENAME_NOREPLACE) == 0) return 0;
-  if (errno != EINVAL && errno != ENOSYS) return errno;
-  if (link(from, to) != 0) return errno;
-  unlink(from);
-  return 0;
+// The errors of a file system that has no such call (FUSE mounts: sshfs,
+// SMB, WSL's drvfs), not of this call on these paths.
+bool NotSupported(int err) { return err == ENOSYS || err == EOPNOTSUPP || err == ENOTSUP; }
+
+int RenameNoReplace(const char* from, const char* to) {
+  return renameat2(AT_FDCWD, from, AT_FDCWD, to, RENAME_NOREPLACE);
 }
 
 }  // namespace
+
+int RenameWithoutReplacing(const char* from, const char* to, PathCall rename_noreplace, PathCall hard_link) {
+  if (rename_noreplace == nullptr) rename_noreplace = RenameNoReplace;
+  if (hard_link == nullptr) hard_link = link;
+  if (rename_noreplace(from, to) == 0) return 0;
+  if (errno != EINVAL && !NotSupported(errno)) return errno;  // EINVAL: the file system takes no flags
+  if (hard_link(from, to) == 0) {
+    unlink(from);
+    return 0;
+  }
+  // EPERM: "the file system does not support hard links" (link(2)); EXDEV:
+  // some FUSE file systems say so for any link.
+  if (errno != EPERM && errno != EXDEV && !NotSupported(errno)) return errno;
+  // Neither atomic way: the name checked free, then the rename. A file
+  // another process makes in the moment between would be replaced; on such
+  // a file system a line keeps measuring rather than every capture failing.
+  struct stat st {};
+  if (lstat(to, &st) == 0) return EEXIST;
+  if (errno != ENOENT) return errno;
+  return std::rename(from, to) == 0 ? 0 : errno;
+}
 
 void AtomicOutput::Commit(AtExisting existing) {
   const bool refuse = existing == AtExisting::kRefuse;

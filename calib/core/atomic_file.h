@@ -41,11 +41,24 @@ enum class AtExisting {
   // Left as it is, the output refused (InputError "exists already"): for
   // outputs never to replace, where another process may create the same
   // name between a check that it is free and the commit (two reconstruct
-  // streams sharing an --out-dir). Committed by renameat2(RENAME_NOREPLACE),
-  // or where the file system has no such rename, a hard link and the
-  // temporary name's removal: either fails if the name exists, atomically.
+  // streams sharing an --out-dir). Committed by RenameWithoutReplacing.
   kRefuse,
 };
+
+// A call taking two paths, as rename(2): 0, or -1 with errno set.
+using PathCall = int (*)(const char* from, const char* to);
+
+// Renames `from` to `to` unless a file is at `to` (a dangling link too):
+// returns 0, or the errno (EEXIST: one is there; `from` is then left).
+// By renameat2(RENAME_NOREPLACE), or where the file system has no such
+// rename, a hard link and `from`'s removal: either fails if the name
+// exists, atomically. Where it makes no hard links either (some FUSE
+// mounts: sshfs, SMB, WSL's drvfs), the name is checked free, then renamed:
+// a file made in the moment between is replaced, but the output is
+// written. `rename_noreplace` and `hard_link`, null for the system's, are
+// for tests standing in such a file system.
+int RenameWithoutReplacing(const char* from, const char* to, PathCall rename_noreplace = nullptr,
+                           PathCall hard_link = nullptr);
 
 // For writers that need a path of their own (cv::imwrite, sqlite, ...):
 // write to temp_path(), then Commit(). If Commit() is never called the

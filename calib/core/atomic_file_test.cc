@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -216,6 +217,91 @@ TEST(WriteFileAtomically, ALinkIntoProcOrDevIsRefusedWhateverItPointsTo) {
   if (std::filesystem::is_directory("/dev/shm") && !std::filesystem::is_symlink("/dev/shm")) {
     EXPECT_EQ(testing::InputErrorMessage([&] { RequireReplaceableOutput("/dev/shm/stereorig-output.json"); }), "");
   }
+}
+
+// A ".." after a link is the link target's parent, as the kernel takes it:
+// not collapsed with the link before the link is resolved. With a link to
+// /proc/self (or /dev/fd, /dev/shm), "link/../name" is in /proc (or /dev),
+// where "name" beside the link is not; it was checked as the latter and
+// written, the rename replacing what was there. Only the check is called
+// here: nothing in /proc or /dev is written.
+TEST(RequireReplaceableOutput, AParentStepAfterALinkIsTakenWhereTheLinkLeads) {
+  const std::string dir = testing::ScratchFolder("atomic_link_parent_step");
+  std::filesystem::create_symlink("/proc/self", dir + "/self");
+  std::filesystem::create_symlink("/dev/fd", dir + "/fd");  // -> /proc/self/fd: its parent is /proc/<pid>
+  const std::string pid = std::to_string(getpid());
+  const std::pair<std::string, std::string> refused[] = {
+      {dir + "/self/../stereorig-new-output.json", "leads to /proc/stereorig-new-output.json through a symbolic link"},
+      {dir + "/fd/../stdout", "leads to /proc/" + pid + "/stdout through a symbolic link"}};
+  for (const auto& [path, says] : refused) {
+    const std::string message = testing::InputErrorMessage([&] { RequireReplaceableOutput(path); });
+    EXPECT_NE(message.find(path + ": " + says), std::string::npos) << message;
+  }
+  if (std::filesystem::is_directory("/dev/shm") && !std::filesystem::is_symlink("/dev/shm")) {
+    std::filesystem::create_symlink("/dev/shm", dir + "/shm");
+    const std::string path = dir + "/shm/../stereorig-new-output.json";
+    EXPECT_NE(testing::InputErrorMessage([&] {
+                RequireReplaceableOutput(path);
+              }).find(path + ": leads to /dev/stereorig-new-output.json through a symbolic link"),
+              std::string::npos);
+  }
+  // A scratch folder standing in: "link/../x.json" is written in the link
+  // target's parent, where the check looked; a ".." written in /dev that
+  // leaves it is no refusal.
+  std::filesystem::create_directories(dir + "/real/deeper");
+  std::filesystem::create_symlink("real/deeper", dir + "/link");
+  WriteFileAtomically(dir + "/link/../x.json", "{}");
+  EXPECT_EQ(Contents(dir + "/real/x.json"), "{}");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.json"));
+  EXPECT_EQ(testing::InputErrorMessage([&] { RequireReplaceableOutput("/dev/.." + dir + "/y.json"); }), "");
+}
+
+// Stand-ins for a file system with neither renameat2's flags nor hard links
+// (some FUSE mounts: sshfs, SMB, WSL's drvfs): a call failing with `kErrno`.
+template <int kErrno>
+int FailsWith(const char*, const char*) {
+  errno = kErrno;
+  return -1;
+}
+constexpr PathCall NoFlags = FailsWith<EINVAL>;
+constexpr PathCall NoHardLinks = FailsWith<EPERM>;
+constexpr PathCall NoLinksAcrossFuse = FailsWith<EXDEV>;
+constexpr PathCall NotSupported = FailsWith<EOPNOTSUPP>;
+constexpr PathCall NoAccess = FailsWith<EACCES>;
+
+// There a commit that must not replace checks the name free, then renames:
+// every capture of a stream on such a mount failed "cannot write:
+// Operation not permitted" instead.
+TEST(RenameWithoutReplacing, WithoutItsAtomicWaysAFreeNameIsStillWrittenATakenOneNot) {
+  const std::string dir = testing::ScratchFolder("atomic_no_replace_fallback");
+  const std::string from = dir + "/.tmp-new";
+  for (PathCall no_link : {NoHardLinks, NoLinksAcrossFuse, NotSupported}) {
+    WriteFileAtomically(from, "new");
+    const std::string to = dir + "/free-" + std::to_string(Names(dir).size()) + ".json";
+    EXPECT_EQ(RenameWithoutReplacing(from.c_str(), to.c_str(), NoFlags, no_link), 0);
+    EXPECT_EQ(Contents(to), "new");
+    EXPECT_FALSE(std::filesystem::exists(from));
+  }
+  for (PathCall no_rename : {NoFlags, NotSupported}) {  // and a dangling link is a name taken
+    WriteFileAtomically(dir + "/taken.json", "theirs");
+    std::filesystem::remove(dir + "/dangling.json");
+    std::filesystem::create_symlink("nothing", dir + "/dangling.json");
+    WriteFileAtomically(from, "new");
+    for (const std::string& to : {dir + "/taken.json", dir + "/dangling.json"})
+      EXPECT_EQ(RenameWithoutReplacing(from.c_str(), to.c_str(), no_rename, NoHardLinks), EEXIST) << to;
+    EXPECT_EQ(Contents(dir + "/taken.json"), "theirs");
+    EXPECT_TRUE(std::filesystem::is_symlink(dir + "/dangling.json"));
+    EXPECT_EQ(Contents(from), "new");
+  }
+  // Any other error is this call's: returned, nothing renamed.
+  EXPECT_EQ(RenameWithoutReplacing(from.c_str(), (dir + "/other.json").c_str(), NoFlags, NoAccess), EACCES);
+  EXPECT_EQ(RenameWithoutReplacing(from.c_str(), (dir + "/other.json").c_str(), NoAccess, NoHardLinks), EACCES);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/other.json"));
+  EXPECT_EQ(Contents(from), "new");
+  // The system's own calls, here (tmpfs or ext4) atomic.
+  EXPECT_EQ(RenameWithoutReplacing(from.c_str(), (dir + "/taken.json").c_str()), EEXIST);
+  EXPECT_EQ(RenameWithoutReplacing(from.c_str(), (dir + "/other.json").c_str()), 0);
+  EXPECT_EQ(Contents(dir + "/other.json"), "new");
 }
 
 // Committed without replacing (AtExisting::kRefuse, a reconstruct stream's
