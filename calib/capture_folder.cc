@@ -468,10 +468,9 @@ std::vector<std::string> RepeatedPosesNotes(const CalibrationReport& report) {
       for (size_t i = 0; i < captures.size(); ++i) groups += (i ? ", " : "") + report.CaptureName(captures[i]);
     }
     notes.push_back("camera " + std::to_string(r.camera) + " (" + r.camera_name +
-                    ") sees one board pose again in captures " + groups + " (corners within " +
-                    NumberText(SamePoseRmsPx(report.max_rms_px), 3) +
-                    " px RMS): a frame delivered again, or the board left still? Each counts as a view of its own, "
-                    "and the sigmas take their corners as independent: too small");
+                    ") sees one board pose again in captures " + groups +
+                    " (corners apart by their noise alone): a frame delivered again, or the board left still? "
+                    "Each counts as a view of its own, and the sigmas take their corners as independent: too small");
   }
   return notes;
 }
