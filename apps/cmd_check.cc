@@ -267,6 +267,11 @@ int RunCheck(int argc, char** argv) {
     rig_cameras[c] = {"cam" + std::to_string(c), rig.camera(c).imager_width_px(), rig.camera(c).imager_height_px()};
   const DetectedCaptures detected =
       DetectCaptureFolder(captures, target, rig.num_cameras(), DetectOptions(), true, rig_cameras);
+  // Sub-folders taken for no capture are named, as calibrate does: a
+  // capture hidden by mistake (.005) lost a night's views without a word.
+  for (const std::string& skipped : detected.skipped_folders)
+    std::printf("skipped %s: not a capture (a hidden folder, or one holding no image)\n",
+                PrintableText(skipped).c_str());
   std::fprintf(stderr, "check: %d captures, %zu views; re-estimating board poses\n", detected.num_captures,
                detected.observations.size());
   CheckResult result = RunNightlyCheck(rig, target, detected.observations, options, captures, detected.capture_names);
@@ -278,7 +283,8 @@ int RunCheck(int argc, char** argv) {
                            {"captures", captures},
                            {"captures_crc32", captures_crc32},
                            {"date_utc", NowUtcIso8601()},
-                           {"k_sigma", options.k_sigma}};
+                           {"k_sigma", options.k_sigma},
+                           {"skipped_folders", detected.skipped_folders}};
   for (const CheckFigure& f : result.figures) {
     std::printf("%-44s %10.4f %10.4f %6s %8d\n", f.name.c_str(), f.value, f.threshold, f.pass ? "yes" : "NO",
                 f.samples);

@@ -1,6 +1,7 @@
 #include "calib/capture_folder.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -41,27 +42,111 @@ bool HoldsCameraImage(const fs::path& folder) {
   return false;
 }
 
+std::string Lower(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
+  return text;
+}
+
+// Whether a file's name is a capture image's, however misnamed: a picture
+// (.png, .jpg, .tif, .bmp, .pgm in any case) or a name starting with "cam" in
+// any case (Cam0.png, cam_0.png, cam00.png); not a camera model
+// (camK.cameramodel, which --export-cameramodels writes).
+bool LooksLikeCaptureImage(const std::string& file_name) {
+  const std::string name = Lower(file_name);
+  const std::string ext = fs::path(name).extension().string();
+  if (ext == ".cameramodel") return false;
+  for (const char* picture : {".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp", ".pgm"})
+    if (ext == picture) return true;
+  return name.rfind("cam", 0) == 0;
+}
+
+// The files of `folder` that look like capture images (LooksLikeCaptureImage),
+// and those one sub-folder deeper ("sub/cam0.png"), sorted by name.
+std::vector<std::string> CaptureImageLikeFiles(const fs::path& folder) {
+  std::vector<std::string> files;
+  for (const auto& e : fs::directory_iterator(folder)) {
+    const std::string name = e.path().filename().string();
+    if (e.is_directory()) {
+      for (const auto& f : fs::directory_iterator(e.path()))
+        if (!f.is_directory() && LooksLikeCaptureImage(f.path().filename().string()))
+          files.push_back(name + "/" + f.path().filename().string());
+    } else if (LooksLikeCaptureImage(name)) {
+      files.push_back(name);
+    }
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// A sub-folder of the captures holding images, none named camK.png
+// (Cam0.png, cam0.PNG, left.png, or images one folder deeper).
+struct MisnamedCapture {
+  fs::path folder;
+  std::vector<std::string> files;  // its image-like files (CaptureImageLikeFiles)
+};
+
 // The capture sub-folders of `root` (a folder), sorted by name. Not a
-// hidden folder (.thumbs, a viewer's), nor one holding no camK.png at all
+// hidden folder (.thumbs, a viewer's), nor one holding no image at all
 // (the camera models calibrate --export-cameramodels wrote beside the
 // captures): each was taken for a capture and stopped a re-run on
 // "models/cam0.png: missing". Those are added to `skipped`, if given,
-// sorted; a folder holding some cameras' images but not all is a capture
-// still, refused for the missing ones.
-std::vector<fs::path> CaptureSubfolders(const fs::path& root, std::vector<fs::path>* skipped = nullptr) {
+// sorted. A folder holding images but no camK.png (Cam0.png) is added to
+// `misnamed`, if given, for the caller to refuse: skipped, it silently
+// lost a night's capture. A folder holding some cameras' images but not
+// all is a capture still, refused for the missing ones.
+std::vector<fs::path> CaptureSubfolders(const fs::path& root, std::vector<fs::path>* skipped = nullptr,
+                                        std::vector<MisnamedCapture>* misnamed = nullptr) {
   std::vector<fs::path> captures;
   for (const auto& e : fs::directory_iterator(root)) {
     if (!e.is_directory()) continue;
     const bool hidden = e.path().filename().string().rfind('.', 0) == 0;
-    if (!hidden && HoldsCameraImage(e.path()))
+    if (!hidden && HoldsCameraImage(e.path())) {
       captures.push_back(e.path());
-    else if (skipped)
+      continue;
+    }
+    std::vector<std::string> files = hidden ? std::vector<std::string>{} : CaptureImageLikeFiles(e.path());
+    if (!files.empty()) {
+      if (misnamed) misnamed->push_back({e.path(), std::move(files)});
+    } else if (skipped) {
       skipped->push_back(e.path());
+    }
   }
   std::sort(captures.begin(), captures.end());
   if (skipped) std::sort(skipped->begin(), skipped->end());
+  if (misnamed)
+    std::sort(misnamed->begin(), misnamed->end(), [](const auto& a, const auto& b) { return a.folder < b.folder; });
   return captures;
 }
+
+// Throws InputError naming the first of `misnamed` (CaptureSubfolders) and
+// its files, and the others' folders, unless it is empty.
+void RefuseMisnamedCaptures(const std::vector<MisnamedCapture>& misnamed) {
+  if (misnamed.empty()) return;
+  constexpr size_t kFilesNamed = 6;
+  const MisnamedCapture& first = misnamed.front();
+  std::string files;
+  for (size_t i = 0; i < first.files.size() && i < kFilesNamed; ++i) files += (i ? ", " : "") + first.files[i];
+  if (first.files.size() > kFilesNamed) files += " and " + std::to_string(first.files.size() - kFilesNamed) + " more";
+  std::string others;
+  for (size_t i = 1; i < misnamed.size(); ++i) others += (i > 1 ? ", " : "") + misnamed[i].folder.string();
+  throw InputError(first.folder.string(),
+                   "holds " + files +
+                       " but no camK.png: each capture holds one image per camera named cam0.png, cam1.png, ... "
+                       "(lower case, no leading zero, in the capture's own folder); rename them, or move the "
+                       "folder out of the captures" +
+                       (others.empty() ? "" : " (so too: " + others + ")"));
+}
+
+}  // namespace
+
+std::string SkippedFoldersNote(const std::vector<std::string>& skipped_folders) {
+  if (skipped_folders.empty()) return "";
+  std::string folders;
+  for (const std::string& folder : skipped_folders) folders += (folders.empty() ? "" : ", ") + folder;
+  return "skipped: " + folders + " (not captures: hidden, or holding no image)";
+}
+
+namespace {
 
 std::string SizeText(const std::pair<int, int>& size_px) {
   return std::to_string(size_px.first) + "x" + std::to_string(size_px.second);
@@ -154,8 +239,16 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
                      "calibration/ folder, which this one lacks (simulated with --calibration-captures 0?)");
   const fs::path dir = CapturesRoot(dir_in);
   std::vector<fs::path> skipped;
-  const std::vector<fs::path> captures = CaptureSubfolders(dir, &skipped);
-  if (captures.empty()) throw InputError(dir.string(), "holds no capture folders (expected NNN/camK.png)");
+  std::vector<MisnamedCapture> misnamed;
+  const std::vector<fs::path> captures = CaptureSubfolders(dir, &skipped, &misnamed);
+  RefuseMisnamedCaptures(misnamed);
+  if (captures.empty()) {
+    std::vector<std::string> skipped_names;
+    for (const fs::path& folder : skipped) skipped_names.push_back(folder.string());
+    const std::string note = SkippedFoldersNote(skipped_names);
+    throw InputError(dir.string(),
+                     "holds no capture folders (expected NNN/camK.png)" + (note.empty() ? "" : "; " + note));
+  }
 
   if (rig_cameras.empty()) RefuseOddImageSizes(dir.string(), captures, num_cameras);
 
@@ -375,10 +468,9 @@ std::vector<std::string> RepeatedPosesNotes(const CalibrationReport& report) {
       for (size_t i = 0; i < captures.size(); ++i) groups += (i ? ", " : "") + report.CaptureName(captures[i]);
     }
     notes.push_back("camera " + std::to_string(r.camera) + " (" + r.camera_name +
-                    ") sees one board pose again in captures " + groups + " (corners within " +
-                    NumberText(SamePoseRmsPx(report.max_rms_px), 3) +
-                    " px RMS): a frame delivered again, or the board left still? Each counts as a view of its own, "
-                    "and the sigmas take their corners as independent: too small");
+                    ") sees one board pose again in captures " + groups +
+                    " (corners apart by their noise alone): a frame delivered again, or the board left still? "
+                    "Each counts as a view of its own, and the sigmas take their corners as independent: too small");
   }
   return notes;
 }
@@ -436,15 +528,24 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
     const std::string note = !rejected_note.empty()              ? rejected_note
                              : IsTooFewViewsProblem(e.problem()) ? NoBoardFoundNote(detected, target, target_path)
                                                                  : "";
-    if (note.empty()) throw;
-    throw InputError(e.where(), e.problem() + "; " + note);
+    // The folders skipped too: a capture hidden by mistake (.005) is
+    // likely why the views were too few.
+    const std::string skipped_note = SkippedFoldersNote(out.skipped_folders);
+    if (note.empty() && skipped_note.empty()) throw;
+    std::string problem = e.problem();
+    for (const std::string& n : {note, skipped_note})
+      if (!n.empty()) problem += "; " + n;
+    throw InputError(e.where(), problem);
   }
   // The calibration's own warnings (a Horn-only solve that stopped short),
   // printed as these are; the report keeps every warning printed, beside the
   // figures they qualify.
   for (const std::string& note : out.result.report.warnings)
     std::fprintf(stderr, "calibrate: warning: %s\n", PrintableText(note).c_str());
-  for (const std::string& note : {rejected_note, never_seen_note, left_out_note})
+  // The skipped folders as the command named them on stdout: the report
+  // says what the rig was calibrated without.
+  for (const std::string& note :
+       {rejected_note, never_seen_note, left_out_note, SkippedFoldersNote(out.skipped_folders)})
     if (!note.empty()) out.result.report.warnings.push_back(note);
   std::vector<std::string> stage_notes = RepeatedPosesNotes(out.result.report);
   for (const std::string& note : StereoViewsLeftOutNotes(out.result.report)) stage_notes.push_back(note);

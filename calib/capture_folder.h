@@ -37,8 +37,11 @@ struct DetectedCaptures {
   int num_captures = 0;
   std::map<int, std::string> capture_names;  // capture index -> its sub-folder's name (CalibrationInput's)
   // Sub-folders taken for no capture, sorted: hidden ones (.thumbs), and
-  // those holding no camK.png at all (camera models written beside the
-  // captures). The command says which it skipped.
+  // those holding no image at all (camera models written beside the
+  // captures). The command says which it skipped (SkippedFoldersNote). One
+  // holding images but no camK.png (Cam0.png, left.png, images a folder
+  // deeper) is refused instead: skipped, a misnamed capture was lost
+  // without a word.
   std::vector<std::string> skipped_folders{};
 };
 
@@ -54,8 +57,13 @@ std::vector<std::string> CaptureFolderImages(const std::string& dir);
 // it first; a command calls it before announcing the detection.
 void RequireCapturesFolder(const std::string& dir);
 
+// "" if `skipped_folders` (DetectedCaptures') is empty, else "skipped: A, B
+// (not captures: ...)": for a refusal or a report to name them.
+std::string SkippedFoldersNote(const std::vector<std::string>& skipped_folders);
+
 // Detects the target in every image. Throws InputError (naming the file) on
-// a missing folder or image, an unreadable image, an image of the wrong
+// a missing folder or image, a capture sub-folder holding images none of
+// which is named camK.png (naming it and them), an unreadable image, an image of the wrong
 // size, or a dataset folder without calibration/ captures. `progress`: one
 // line per capture on stderr. `rig_cameras`: (num_cameras,) the sizes a
 // rig file gives each camera's images (check), every image held to them;

@@ -122,19 +122,23 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
                                      const std::function<void(const std::string&)>& progress = {});
 
 // The views of one camera grouped by board pose: two views show one pose if
-// they saw the same face and the corners both saw (at least 4) lie within
-// `same_pose_rms_px` RMS of each other (x and y pooled). Returns the groups
-// in the order of their first view, each group's indices into `views`
-// ascending. Stage 1 counts the groups, not the views, against
-// IntrinsicsOptions::min_views (SamePoseRmsPx says why the threshold).
-std::vector<std::vector<int>> BoardPoseGroups(const std::vector<const BoardObservation*>& views,
-                                              double same_pose_rms_px);
-// Two detections of a board that did not move differ only by the corners'
-// noise: sqrt(2) sigma per coordinate. A calibration accepts corners whose
-// noise is up to `max_rms_px` (IntrinsicsOptions::max_rms_px: a converged
-// camera's residual RMS is its corners' noise), so views closer than
-// sqrt(2) x max_rms_px RMS are one pose as far as the corners can tell:
-// a board moved less adds nothing the noise does not swamp.
+// they saw the same face and the corners both saw (at least 4) differ by
+// their noise alone: the difference, less its smooth part over the board
+// (a quadratic in the grid position, `corners_x` a row's corners: how a
+// moved board's corners move), measures the noise, and the whole is within
+// 1.5 x that (intrinsics.cc, DifferenceIsNoise, says why); or within 0.005
+// px RMS (one frame again), and never beyond `max_same_pose_rms_px` RMS (x
+// and y pooled). Returns the groups in the order of their first view, each
+// group's indices into `views` ascending. Stage 1 counts the groups, not
+// the views, against IntrinsicsOptions::min_views.
+std::vector<std::vector<int>> BoardPoseGroups(const std::vector<const BoardObservation*>& views, int corners_x,
+                                              double max_same_pose_rms_px);
+// The most two views of one pose may differ: two detections of a board that
+// did not move differ only by the corners' noise, sqrt(2) sigma per
+// coordinate, and a calibration accepts corners whose noise is up to
+// `max_rms_px` (IntrinsicsOptions::max_rms_px), so sqrt(2) x max_rms_px. A
+// ceiling only: alone, it merged distinct tilts of a small board
+// (BoardPoseGroups measures the noise itself).
 double SamePoseRmsPx(double max_rms_px);
 
 // Shared helpers for the mrcal problems of stages 1 and 2.

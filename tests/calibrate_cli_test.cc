@@ -805,7 +805,7 @@ TEST(CalibrateCli, CopiesOfOneCaptureAreOneBoardPose) {
   const testing::Result r = testing::RunCli("calibrate --captures " + copies + args);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find(copies + ": camera 0 (cam0): too few distinct board poses: its 5 usable views show 1, need at "
-                                "least 5; repeated: captures 1, 2, 3, 4 and 5 (corners within 1.41 px RMS"),
+                                "least 5; repeated: captures 1, 2, 3, 4 and 5 (corners apart by their noise alone"),
             std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(set.dir + "/copies.yaml"));
@@ -916,6 +916,48 @@ TEST(CalibrateCli, FoldersHoldingNoCaptureAreSkippedAndNamed) {
   r = testing::RunCli("calibrate --captures " + dir + args);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find(dir + "/003/cam1.png: missing"), std::string::npos) << r.err;
+}
+
+// Folders holding images, none named camK.png (Cam0.png, cam00.png,
+// left.png, or images a folder deeper), were skipped as "no capture": a
+// night lost captures without a word. They are refused, naming the folder
+// and its files; a hidden folder is still skipped, and named in a refusal
+// ("too few views" is likely its doing) and in the report's warnings.
+TEST(CalibrateCli, AMisnamedCaptureIsRefusedAndASkippedOneNamedInRefusalAndReport) {
+  const RenderedSet& set = Rendered();
+  const std::string dir = set.dir + "/misnamed";
+  const std::string args = " --target " + set.dir + "/target.yaml --layout " + set.dir + "/one_module.yaml --out " +
+                           dir + "/rig.yaml --report " + dir + "/report.json";
+  for (const std::vector<std::string>& names : std::vector<std::vector<std::string>>{
+           {"Cam0.png", "Cam1.png"}, {"cam0.PNG", "cam1.PNG"}, {"cam00.png", "cam01.png"}, {"left.png", "right.png"}}) {
+    CopyModuleZeroCaptures(set, dir, 8);
+    fs::rename(dir + "/003/cam0.png", dir + "/003/" + names[0]);
+    fs::rename(dir + "/003/cam1.png", dir + "/003/" + names[1]);
+    const testing::Result r = testing::RunCli("calibrate --captures " + dir + args);
+    EXPECT_EQ(r.code, 2) << names[0];
+    EXPECT_NE(r.err.find(dir + "/003: holds " + names[0] + ", " + names[1] + " but no camK.png"), std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
+  }
+  // Eight captures, one hidden: calibrated, the report naming it.
+  CopyModuleZeroCaptures(set, dir, 8);
+  fs::rename(dir + "/005", dir + "/.005");
+  testing::Result r = testing::RunCli("calibrate --captures " + dir + args);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream f(dir + "/report.json");
+  const nlohmann::json j = nlohmann::json::parse(f, nullptr, false);
+  ASSERT_TRUE(j.is_object());
+  bool named = false;
+  for (const auto& w : j.at("warnings")) named |= w.get<std::string>().find("skipped: " + dir + "/.005") == 0;
+  EXPECT_TRUE(named) << j.at("warnings").dump();
+  // Five, one hidden: too few views, and the refusal names the hidden one.
+  CopyModuleZeroCaptures(set, dir, 5);
+  fs::rename(dir + "/004", dir + "/.004");
+  r = testing::RunCli("calibrate --captures " + dir + args);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("too few views"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("; skipped: " + dir + "/.004 (not captures"), std::string::npos) << r.err;
+  fs::remove_all(dir);
 }
 
 }  // namespace

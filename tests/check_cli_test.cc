@@ -1353,5 +1353,50 @@ TEST(CheckCli, KSigmaIsSaidAsStandardDeviationsAboveTheExpectedValue) {
   fs::remove_all(dir);
 }
 
+// A night copied with one capture's images renamed Cam0.png ... and another
+// capture's folder renamed .005: check skipped both without a word and
+// judged "6 captures, 24 views, verdict: ok", two of the 8 captures lost.
+// A folder holding images none named camK.png is refused (exit 2, naming
+// it and its files); a hidden folder is still skipped, but named on stdout
+// and in the report's "skipped_folders".
+TEST(CheckCli, AMisnamedCaptureIsRefusedAndAHiddenOneNamed) {
+  const std::string dir = ::testing::TempDir() + "/check_cli_skipped_" + std::to_string(getpid());
+  const std::vector<std::string> names = UnmovedNight(dir);
+  ASSERT_GE(names.size(), 8u);
+  const std::string captures = dir + "/night", report = dir + "/night.json";
+  fs::copy(dir + "/ds/calibration", captures, fs::copy_options::recursive);
+  const std::string misnamed = captures + "/" + names[3];
+  for (int c = 0; c < 4; ++c)
+    fs::rename(misnamed + "/cam" + std::to_string(c) + ".png", misnamed + "/Cam" + std::to_string(c) + ".png");
+  const std::string hidden = captures + "/." + names[5];
+  fs::rename(captures + "/" + names[5], hidden);
+  const std::string args =
+      " --target " + dir + "/ds/target.yaml --history-db " + dir + "/history.sqlite --report " + report;
+  Result r = RunCli("check --rig " + dir + "/rig.yaml --captures " + captures + args);
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find(misnamed + ": holds Cam0.png, Cam1.png, Cam2.png, Cam3.png but no camK.png"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(report));
+  // Its images moved a folder deeper: refused as well.
+  fs::create_directories(misnamed + "/images");
+  for (int c = 0; c < 4; ++c)
+    fs::rename(misnamed + "/Cam" + std::to_string(c) + ".png", misnamed + "/images/cam" + std::to_string(c) + ".png");
+  r = RunCli("check --rig " + dir + "/rig.yaml --captures " + captures + args);
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find(misnamed + ": holds images/cam0.png, "), std::string::npos) << r.err;
+  // Named right, the hidden one is skipped and said.
+  for (int c = 0; c < 4; ++c)
+    fs::rename(misnamed + "/images/cam" + std::to_string(c) + ".png", misnamed + "/cam" + std::to_string(c) + ".png");
+  fs::remove(misnamed + "/images");
+  r = RunCli("check --rig " + dir + "/rig.yaml --captures " + captures + args);
+  EXPECT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("skipped " + hidden + ": not a capture"), std::string::npos) << r.out;
+  std::ifstream f(report);
+  const nlohmann::json j = nlohmann::json::parse(f, nullptr, false);
+  ASSERT_TRUE(j.is_object());
+  EXPECT_EQ(j["skipped_folders"], nlohmann::json::array({hidden})) << j.dump(2);
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace stereorig
