@@ -185,7 +185,7 @@ int RunCheck(int argc, char** argv) {
   app.add_option("--k-sigma", options.k_sigma,
                  "coverage factor of every threshold, in (0, 10]: each is its figure's expected value on an "
                  "unchanged rig plus k of its standard deviations (a closure's: the chi-square quantile at that "
-                 "level)")
+                 "level), and the calibration's own projection uncertainty at k")
       ->capture_default_str();
   app.add_flag("--history", history_only,
                "print the trend of every figure from the history, then its last runs one a line, and stop");

@@ -1332,13 +1332,15 @@ TEST(CheckCli, AModuleShiftSetsNoCaptureOfThreeViewsAsideAsTakenAtAnotherMoment)
 
 // --k-sigma's help and its refusal said "k times its figure's sigma", but
 // a threshold is the figure's expected value on an unchanged rig plus k
-// standard deviations (a mean square's expectation is not zero): they say
-// so now.
+// standard deviations (a mean square's expectation is not zero), and the
+// calibration's own projection uncertainty at k (the consistency figures'
+// (k u_px)^2): they say both now.
 TEST(CheckCli, KSigmaIsSaidAsStandardDeviationsAboveTheExpectedValue) {
   const Result help = RunCli("check --help");
   EXPECT_EQ(help.code, 0) << help.err;
   EXPECT_NE(help.out.find("expected value on an unchanged rig plus k of its standard deviations"), std::string::npos)
       << help.out;
+  EXPECT_NE(help.out.find("and the calibration's own projection uncertainty at k"), std::string::npos) << help.out;
   EXPECT_EQ(help.out.find("k times"), std::string::npos) << help.out;
   const std::string dir = ::testing::TempDir() + "/check_cli_ksigma_" + std::to_string(getpid());
   fs::remove_all(dir);
@@ -1347,7 +1349,8 @@ TEST(CheckCli, KSigmaIsSaidAsStandardDeviationsAboveTheExpectedValue) {
       RunCli("check --rig " + dir + "/rig.yaml --captures " + dir + " --target " + dir + "/target.yaml --k-sigma 11");
   EXPECT_EQ(refused.code, 2) << refused.out << refused.err;
   EXPECT_NE(refused.err.find("--k-sigma: must be in (0, 10] (each threshold is its figure's expected value on an "
-                             "unchanged rig plus k of its standard deviations)"),
+                             "unchanged rig plus k of its standard deviations, and the calibration's own "
+                             "projection uncertainty at k)"),
             std::string::npos)
       << refused.err;
   fs::remove_all(dir);

@@ -23,7 +23,7 @@ void CheckOptions::Check() const {
   if (!(k_sigma > 0 && k_sigma <= 10))
     throw InputError("k_sigma",
                      "must be in (0, 10] (each threshold is its figure's expected value on an unchanged rig plus k "
-                     "of its standard deviations)");
+                     "of its standard deviations, and the calibration's own projection uncertainty at k)");
   if (min_captures < 1) throw InputError("check options", "min_captures must be >= 1");
   if (min_corners_per_view < 4) throw InputError("check options", "min_corners_per_view must be >= 4");
 }
