@@ -614,6 +614,13 @@ void SetAsideViewsOfAnotherMoment(Inputs& in, std::vector<SetAsideView>* set_asi
   // shifted 0.1 mm read its lone camera 0.621 px off a capture of three
   // views against a bound of 0.608 px from the camera's four-view
   // captures, and set the capture aside as taken at another moment.
+  // The trade-off: those readings carry the shift, so the bound is 10 times
+  // it (~6 px at 0.1 mm, ~19 px at 0.3 mm), and a lone camera's own slip of
+  // a few px on a shifted module's night stays in (the night fails on the
+  // shift either way, that camera maybe named besides); a slip of a capture's
+  // time reads tens to hundreds of px. Bounded by its four-view bound plus
+  // the shift as read there, a capture whose board pose reads the shift
+  // larger than the median does would be set aside as a slip.
   std::vector<std::vector<std::pair<int, double>>> across_by_camera(in.rig.num_cameras());  // (capture, off)
   for (const auto& [capture, vs] : in.by_capture) {
     if (vs.size() < 3) continue;
