@@ -271,6 +271,11 @@ int RunCheck(int argc, char** argv) {
                detected.observations.size());
   CheckResult result = RunNightlyCheck(rig, target, detected.observations, options, captures, detected.capture_names);
   result.target_note = check_target.note;  // said with a failing night (the explanation's end)
+  // A board printed off its file: the rig agrees with itself, but its scale
+  // cannot be checked against a board of unknown size. Neither ok nor
+  // recalibrate (against this file every baseline and S would take the
+  // print's error): bad input, exit 2, nothing written.
+  if (result.shared_scale_print_only) throw InputError(target_path, result.Explanation());
 
   std::printf("%-44s %10s %10s %6s %8s\n", "figure", "value", "threshold", "pass", "samples");
   nlohmann::json report = {{"rig", rig_path},
