@@ -261,15 +261,28 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     expect_refused(p, dir + "/other_plate.yaml: its back_from_front is 0.5000 mm and 0.0000 deg from the one filed",
                    "another plate");
     EXPECT_EQ(Lines(p.err), 1) << p.err;
-    // A rig file without the record (an older stereorig's) cannot tell: the
-    // night is judged (the board's size said, docs/verify-and-check.md), with
-    // the target file's back_from_front, and a note says so. Its own history.
+    // A rig file without the record (an older stereorig's) cannot tell
+    // another board from the record. Against this file every figure holds
+    // with the board's print at the size every module measures it, 2 %
+    // off the file, and the board as a solid misses: refused as the
+    // board's print in one line naming the file, with the board's size and
+    // the note (it was judged "recalibrate", exit 1, every module flagged:
+    // recalibrated against this file, the rig would take the 2 %).
     Rig old = rig;
     old.provenance().target.reset();
     WriteRigFile(old, dir + "/old_rig.yaml");
     const std::string old_report = dir + "/old_check.json";
-    const Result judged = RunCli("check --rig " + dir + "/old_rig.yaml --captures " + dir + "/ds --target " +
-                                 other_path + " --history-db " + dir + "/old_history.sqlite --report " + old_report);
+    const Result print = RunCli("check --rig " + dir + "/old_rig.yaml --captures " + dir + "/ds --target " +
+                                other_path + " --history-db " + dir + "/old_history.sqlite --report " + old_report);
+    expect_refused(print,
+                   other_path + ": the board's print is not its file's size: every module measures the board 1.9",
+                   "an older rig's night against another board's file");
+    EXPECT_NE(print.err.find("the rig file records no calibration target"), std::string::npos) << print.err;
+    EXPECT_FALSE(fs::exists(old_report));
+    // With the board's own file the night is judged, with the target
+    // file's back_from_front, and a note says so. Its own history.
+    const Result judged = RunCli("check --rig " + dir + "/old_rig.yaml --captures " + dir + "/ds --target " + dir +
+                                 "/ds/target.yaml --history-db " + dir + "/old_history.sqlite --report " + old_report);
     EXPECT_NE(judged.code, 2) << judged.err;
     EXPECT_NE(judged.out.find("note: the rig file records no calibration target"), std::string::npos) << judged.out;
     std::ifstream f(old_report);
@@ -279,7 +292,7 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     EXPECT_EQ(j["target"]["back_from_front_as_calibrated"], false) << j.dump(2);
     EXPECT_TRUE(j["target"]["calibrated_with"].is_null()) << j.dump(2);
     EXPECT_TRUE(j["target"]["note"].is_string()) << j.dump(2);
-    EXPECT_FALSE(j["board_size_note"].is_null()) << j.dump(2);
+    EXPECT_TRUE(j["board_size_note"].is_null()) << j.dump(2);
   }
   {  // A coverage factor that is not finite, or so large it would pass any
      // drift (inf was accepted, a verdict "ok" with infinite thresholds
