@@ -185,7 +185,7 @@ int RunCheck(int argc, char** argv) {
   app.add_option("--k-sigma", options.k_sigma,
                  "coverage factor of every threshold, in (0, 10]: each is its figure's expected value on an "
                  "unchanged rig plus k of its standard deviations (a closure's: the chi-square quantile at that "
-                 "level)")
+                 "level), and the calibration's own projection uncertainty at k")
       ->capture_default_str();
   app.add_flag("--history", history_only,
                "print the trend of every figure from the history, then its last runs one a line, and stop");
@@ -276,6 +276,11 @@ int RunCheck(int argc, char** argv) {
                detected.observations.size());
   CheckResult result = RunNightlyCheck(rig, target, detected.observations, options, captures, detected.capture_names);
   result.target_note = check_target.note;  // said with a failing night (the explanation's end)
+  // A board printed off its file: the rig agrees with itself, but its scale
+  // cannot be checked against a board of unknown size. Neither ok nor
+  // recalibrate (against this file every baseline and S would take the
+  // print's error): bad input, exit 2, nothing written.
+  if (result.shared_scale_print_only) throw InputError(target_path, result.Explanation());
 
   std::printf("%-44s %10s %10s %6s %8s\n", "figure", "value", "threshold", "pass", "samples");
   nlohmann::json report = {{"rig", rig_path},

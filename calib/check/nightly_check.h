@@ -168,9 +168,13 @@ struct CheckResult {
   bool shared_scale_explains = false;
   double shared_scale = 1;  // the board's size over its file's, where shared_scale_explains
   // Where shared_scale_explains: the board as a solid (the plate's
-  // thickness scaled too) did not explain the night, its faces' prints
-  // scaled alone did. No change of the rig's scale reads so (a rig scaled
-  // sees the solid): the board's print is not its file's size.
+  // thickness scaled too) missed the night by far (twice a threshold), its
+  // faces' prints scaled alone, on the plate as it was, explained it. No
+  // change of the rig's scale reads so (a rig scaled sees the solid): the
+  // board's print is not its file's size. A print on a plate scaled in its
+  // plane differs from the solid by the thickness scaled alone (15 um at
+  // 0.3 %), within the closures' noise: said as the rig's scale, which
+  // cannot be told from the board's.
   bool shared_scale_print_only = false;
   bool ok() const;
   std::string Verdict() const { return ok() ? "ok" : "recalibrate"; }
@@ -181,7 +185,9 @@ struct CheckResult {
   // says what explains it).
   std::vector<int> FlaggedCameras() const;
   // Every module named (split_modules and closure_modules, sorted; every
-  // module where shared_scale_explains): the report's flagged_modules. No
+  // module where shared_scale_explains, none where shared_scale_print_only:
+  // recalibrated against the file, every module would take the print's
+  // error): the report's flagged_modules. No
   // figure tells a module's motion from a lens change, so none is said to
   // have moved as a whole.
   std::vector<int> FlaggedModules() const;

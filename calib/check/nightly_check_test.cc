@@ -1425,8 +1425,40 @@ TEST(NightlyCheck, ABoardPrintedOffItsFileIsSaidAsItsPrintNotAsCameras) {
     EXPECT_TRUE(r.shared_scale_print_only) << seed << ": " << r.Explanation();
     EXPECT_NEAR(r.shared_scale, kPrint, 0.0003) << seed << ": " << r.Explanation();
     EXPECT_TRUE(r.camera_changes.empty()) << seed << ": " << r.Explanation();
+    // No module named: recalibrated against the file, every baseline and S
+    // would take the print's error.
+    EXPECT_TRUE(r.FlaggedModules().empty()) << seed << ": " << r.Explanation();
+    EXPECT_TRUE(r.FlaggedCameras().empty()) << seed << ": " << r.Explanation();
     EXPECT_EQ(r.Explanation().find("the board's print is not its file's size"), 0u) << seed << ": " << r.Explanation();
+    EXPECT_NE(r.Explanation().find("the rig's scale unchecked (measure the board"), std::string::npos)
+        << seed << ": " << r.Explanation();
   }
+}
+
+// The rig's scale changed 0.3 % (every baseline and S) and the plate
+// 15 um thicker than its file (5 mm x 0.3 %, within a plate's file's 0.01 mm
+// sigma per axis, 1.5 of them): the board as a solid misses the night by
+// its thickness alone, 15 um against closure thresholds of 3.5-12 um, and
+// the same print on a plate scaled in its plane, thick as the file says,
+// explains it. Read "the board's print is not its file's size", the night
+// would have told a user not to recalibrate a rig whose scale changed: the
+// in-plane print is the rig's scale's reading, "cannot tell which".
+TEST(NightlyCheck, ARigScaleChangeTheSolidMissesByAHairIsNotSaidAsTheBoardsPrint) {
+  const SimulatedRig truth = MakeDefaultRig();
+  const Target file = DefaultTarget();
+  constexpr double kRigScale = 1.003;
+  Target::Layout layout = file.layout();
+  layout.back_from_front = IdealBackFromFront(layout.corners_x, layout.square_size_mm, 5.0 * kRigScale);
+  const Target thicker(layout, "thicker");
+  const Rig stored = StoredRig(truth, kRenderedNoisePx);
+  const CheckResult r = RunNightlyCheck(
+      stored, file, Observe(Scaled(truth, kRigScale), thicker, {}, 10, kRenderedNoisePx), CheckOptions(), "test");
+  EXPECT_FALSE(r.ok());
+  EXPECT_TRUE(r.shared_scale_explains) << r.Explanation();
+  EXPECT_FALSE(r.shared_scale_print_only) << r.Explanation();
+  EXPECT_EQ(r.Explanation().find("the rig's scale against the board's changed"), 0u) << r.Explanation();
+  EXPECT_NE(r.Explanation().find("it cannot tell which"), std::string::npos) << r.Explanation();
+  EXPECT_EQ(r.FlaggedModules(), (std::vector<int>{0, 1})) << r.Explanation();
 }
 
 }  // namespace
