@@ -1366,6 +1366,10 @@ TEST(VerifyCli, APatchBeyondTheCaptureBandDoesNotPass) {
       EXPECT_NE(r.out.find("1        NOT JUDGED: " + std::to_string(moved) + " points lie "), std::string::npos)
           << r.out;
       EXPECT_NE(r.out.find("beyond the 5.0 mm capture band"), std::string::npos) << r.out;
+      // The verdict says why (it read "a figure left undetermined").
+      EXPECT_NE(r.out.find("verdict: NOT JUDGED (position 1: a part measured beyond the capture band; exit 2"),
+                std::string::npos)
+          << r.out;
     }
     std::filesystem::remove(cloud);
   }

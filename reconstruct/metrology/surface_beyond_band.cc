@@ -151,6 +151,7 @@ SurfaceBeyondBand Judge(const Cells& cells, double band_mm, const std::function<
   found.erase(std::unique(found.begin(), found.end()), found.end());
   out.points = static_cast<int>(found.size());
   for (int i : found) {
+    out.mean_off_mm += off_mm(i) / static_cast<double>(found.size());
     out.nearest_mm = std::min(out.nearest_mm, std::abs(off_mm(i)));
     out.farthest_mm = std::max(out.farthest_mm, std::abs(off_mm(i)));
   }

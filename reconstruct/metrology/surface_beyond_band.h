@@ -22,6 +22,7 @@ namespace stereorig {
 struct SurfaceBeyondBand {
   int points = 0;                          // beyond the band, where the surface is missing among measured directions
   double nearest_mm = 0, farthest_mm = 0;  // their distance to the shape's surface
+  double mean_off_mm = 0;                  // their mean signed offset (a plate's: along its normal)
   bool found() const { return points > 0; }
 };
 

@@ -198,6 +198,37 @@ void JudgeSurfaceBeyondBand(const SurfaceBeyondBand& s, const std::string& what,
                 s.points, s.nearest_mm, s.farthest_mm, what.c_str(), band_mm, std::ceil(s.farthest_mm + 1));
   if (e->pass()) {
     e->not_judged_reason = buf;
+    e->beyond_band_not_judged = true;
+  } else {
+    e->notes.push_back(buf);
+  }
+}
+
+// On the plate a layer where the face is missing is either the face measured
+// off or an object on it whose sides were not captured (a clamp's top 8 mm
+// above the face): where it lies tells them apart only on one side. An
+// object on the face lies on the side the face was measured from (behind
+// it the plate would hide it), so a layer there is left out with a note;
+// behind the face, or where the side is unknown (a cloud without normals),
+// nothing but the face measured off can lie, and the plate is not passed.
+// Widening the band is no way to judge an object: it would put it in F.
+void JudgePlateFaceBeyondBand(const SurfaceBeyondBand& s, int face_side, double band_mm, ArtifactEvaluation* e) {
+  if (!s.found()) return;
+  const bool on_measured_side = face_side != 0 && s.mean_off_mm * face_side > 0;
+  char buf[640];
+  std::snprintf(buf, sizeof buf,
+                "%d points lie %.1f to %.1f mm %s the plate's face, beyond the %.1f mm capture band, where the band "
+                "holds none of the face but all around holds it: %s, which the figures leave out. Crop it away if "
+                "it is not the plate; if it is the plate's surface measured off, the rig measured it wrongly "
+                "(--capture-band-mm %.0f shows its figure)",
+                s.points, s.nearest_mm, s.farthest_mm, on_measured_side ? "in front of" : "off", band_mm,
+                on_measured_side ? "an object on the face (a clamp?) whose sides were not captured, or a part of the "
+                                   "face measured that far off"
+                                 : "a part of the face measured that far off (a patch a grid period or more off?)",
+                std::ceil(s.farthest_mm + 1));
+  if (e->pass() && !on_measured_side) {
+    e->not_judged_reason = buf;
+    e->beyond_band_not_judged = true;
   } else {
     e->notes.push_back(buf);
   }
@@ -1240,10 +1271,10 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       ResidualStats(fit.residuals_mm, &e);
       JudgeFigures(o.decision_rule, o, &e.figures);
       e.not_judged_reason = NotJudgedReason(e, "", a.uncertainty_coverage_factor, o);
-      JudgeSurfaceBeyondBand(
-          PlateSurfaceBeyondBand(pts, normals, fit.normal, fit.offset_mm, SideMeasuredFrom(normals, face, fit.normal),
-                                 extent, std::max(0.0, o.plate_edge_margin_mm), e.capture_band_mm),
-          "the plate's face", e.capture_band_mm, &e);
+      const int face_side = SideMeasuredFrom(normals, face, fit.normal);
+      JudgePlateFaceBeyondBand(PlateSurfaceBeyondBand(pts, normals, fit.normal, fit.offset_mm, face_side, extent,
+                                                      std::max(0.0, o.plate_edge_margin_mm), e.capture_band_mm),
+                               face_side, e.capture_band_mm, &e);
       break;
     }
   }

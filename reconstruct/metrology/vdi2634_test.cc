@@ -2084,5 +2084,54 @@ TEST(Vdi2634, APatchOfABallBeyondTheCaptureBandIsNotPassed) {
   EXPECT_NE(reason.find("off ball 2's surface"), std::string::npos) << reason;
 }
 
+// An object on the plate whose sides are not captured (a clamp's top 8 or
+// 12 mm in front of the face) is not the face measured off: the good plate
+// passes, the object is left out with a note that says to crop it, not to
+// widen the band (which put it in F: F 8.25, FAIL). It read NOT JUDGED
+// "... give --capture-band-mm 10 to judge it". The same layer behind the
+// face (nothing there can be seen through the plate) is still the face
+// measured off: not passed. Truth: the 130 x 120 mm plate at z = 400 on a
+// 1 mm grid, noise sigma = 0.05 mm along z, normals +z (measured from +z);
+// the clamp's square footprint holds no face point, its top the same grid
+// at +h (-h behind). F of the face alone is ~8 sigma = 0.4 mm, within the
+// 1.5 mm MPE.
+TEST(Vdi2634, AClampOnThePlateIsNotItsFaceMeasuredOff) {
+  struct Clamp {
+    double x0_mm, y0_mm, side_mm, height_mm;
+  };
+  for (const Clamp& clamp :
+       {Clamp{-10, -10, 20, 8}, Clamp{-65, -10, 20, 8}, Clamp{-65, -60, 25, 12}, Clamp{-10, -10, 20, -8}}) {
+    SCOPED_TRACE(::testing::Message() << "clamp at " << clamp.x0_mm << ", " << clamp.y0_mm << ", " << clamp.height_mm
+                                      << " mm");
+    std::mt19937 rng(15);
+    std::normal_distribution<double> noise(0, 0.05);
+    std::vector<Eigen::Vector3d> pts;
+    int top = 0;
+    for (double x = -65; x <= 65; x += 1)
+      for (double y = -60; y <= 60; y += 1) {
+        const bool under = x >= clamp.x0_mm && x <= clamp.x0_mm + clamp.side_mm && y >= clamp.y0_mm &&
+                           y <= clamp.y0_mm + clamp.side_mm;
+        pts.emplace_back(x, y, 400 + (under ? clamp.height_mm : 0) + noise(rng));
+        top += under;
+      }
+    Artifact plate = PlateArtifact();
+    plate.plate_width_mm = 120;
+    const ArtifactEvaluation e =
+        EvaluateArtifact(plate, pts, VerifyOptions(), "plate.ply", Facing(pts.size(), {0, 0, 1}));
+    if (clamp.height_mm > 0) {
+      EXPECT_TRUE(e.pass()) << e.not_judged_reason;
+      ASSERT_EQ(e.notes.size(), 1u);
+      EXPECT_NE(e.notes[0].find("mm in front of the plate's face"), std::string::npos) << e.notes[0];
+      EXPECT_NE(e.notes[0].find("Crop it away if it is not the plate"), std::string::npos) << e.notes[0];
+      EXPECT_EQ(e.notes[0].find("to judge it"), std::string::npos) << e.notes[0];
+    } else {
+      const std::string reason = NotJudgedReason(e);
+      EXPECT_TRUE(e.beyond_band_not_judged);
+      EXPECT_NE(reason.find(std::to_string(top) + " points lie "), std::string::npos) << top << ": " << reason;
+      EXPECT_NE(reason.find("mm off the plate's face"), std::string::npos) << reason;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace stereorig
