@@ -1489,8 +1489,9 @@ TEST(VerifyCli, AnArtifactNameCannotPrintALineOfItsOwn) {
 // A cloud re-saved in another encoding has other bytes but is the same
 // measurement: its fitted centre and diameter are the first's within the
 // rounding of its coordinates (float, 9 digits: ~1e-5 mm a point at
-// 200 mm), where a second position's centre lies 10 mm away. It counted as
-// a new distinct position.
+// 200 mm), where a second position's centre lies 10 mm away and a third's
+// 10 um (distinct: the tolerance is 1 um). It counted as a new distinct
+// position.
 TEST(VerifyCli, ACloudReSavedInAnotherEncodingIsTheSamePosition) {
   std::mt19937 rng(34);
   auto pts = NoisyCap({0, 0, 200}, {0, 0, -1}, 19.05, 80, 20000, 0.05, &rng);
@@ -1506,16 +1507,23 @@ TEST(VerifyCli, ACloudReSavedInAnotherEncodingIsTheSamePosition) {
     for (const Eigen::Vector3d& p : pts)
       f << static_cast<float>(p.x()) << " " << static_cast<float>(p.y()) << " " << static_cast<float>(p.z()) << "\n";
   }
+  // 10 um: 10x the 1 um the same measurement is allowed, 1000x the
+  // rounding of the re-saved one's centre (float's ~1e-5 mm a point,
+  // averaged over 40 000): distinct.
+  auto nudged_pts = pts;
+  for (Eigen::Vector3d& p : nudged_pts) p.x() += 0.01;
+  const std::string nudged = WritePoints("position_nudged", nudged_pts);
   for (Eigen::Vector3d& p : pts) p.x() += 10;
   const std::string moved = WritePoints("position_moved", pts);
   const auto r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + first + " --cloud " + resaved +
-                        " --cloud " + moved);
+                        " --cloud " + moved + " --cloud " + nudged);
   EXPECT_EQ(r.code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("note: position 2 (" + resaved + ") is the same measurement as position 1"), std::string::npos)
       << r.out;
   EXPECT_EQ(r.out.find("note: position 3"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("note: 2 distinct position(s) measured"), std::string::npos) << r.out;
-  for (const std::string& f : {first, resaved, moved}) std::filesystem::remove(f);
+  EXPECT_EQ(r.out.find("note: position 4"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("note: 3 distinct position(s) measured"), std::string::npos) << r.out;
+  for (const std::string& f : {first, resaved, moved, nudged}) std::filesystem::remove(f);
 }
 
 // A bar whose balls lie further from the certificate than 10% is judged,

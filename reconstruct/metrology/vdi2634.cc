@@ -192,7 +192,8 @@ void JudgeSurfaceBeyondBand(const SurfaceBeyondBand& s, const std::string& what,
   char buf[640];
   std::snprintf(buf, sizeof buf,
                 "%d points lie %.1f to %.1f mm off %s, beyond the %.1f mm capture band, where the band holds "
-                "none of it but all around holds it: a part of it measured that far off (a patch a grid period or "
+                "none of it (or another module's points there) but all around holds it: a part of it measured that far "
+                "off (a patch a grid period or "
                 "more off?), which the figures leave out. Crop it from the cloud if it is something else, or give "
                 "--capture-band-mm %.0f to judge it",
                 s.points, s.nearest_mm, s.farthest_mm, what.c_str(), band_mm, std::ceil(s.farthest_mm + 1));
