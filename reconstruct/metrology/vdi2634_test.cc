@@ -2229,5 +2229,30 @@ TEST(Vdi2634, ASparseCloudsClumpsOfFalseMatchesAreNoPartMeasuredOff) {
   EXPECT_TRUE(e.beyond_band_not_judged) << moved << ": " << reason;
 }
 
+// On the plate too: a second module's patch measured 6 mm behind the face
+// where the first module holds the face passed. Truth: the 130 mm plate at
+// z = 400 on a 1 mm grid (module 1), a second module's points on the same
+// grid over the 30 mm square about the centre moved 6 mm along -z (behind
+// the face, seen from +z: normals +z for both), noise sigma = 0.05 mm. Not
+// passed, every moved point named.
+TEST(Vdi2634, APlatePatchOneModuleMeasuredOffWhereTheOtherHoldsTheFaceIsNotPassed) {
+  std::mt19937 rng(18);
+  std::normal_distribution<double> noise(0, 0.05);
+  std::vector<Eigen::Vector3d> pts;
+  int moved = 0;
+  for (double x = -65; x <= 65; x += 1)
+    for (double y = -65; y <= 65; y += 1) {
+      pts.emplace_back(x, y, 400 + noise(rng));
+      if (std::abs(x) >= 15 || std::abs(y) >= 15) continue;
+      pts.emplace_back(x + 0.5, y + 0.5, 400 - 6 + noise(rng));
+      ++moved;
+    }
+  const ArtifactEvaluation e =
+      EvaluateArtifact(PlateArtifact(), pts, VerifyOptions(), "plate.ply", Facing(pts.size(), {0, 0, 1}));
+  const std::string reason = NotJudgedReason(e);
+  EXPECT_TRUE(e.beyond_band_not_judged);
+  EXPECT_NE(reason.find(std::to_string(moved) + " points lie "), std::string::npos) << moved << ": " << reason;
+}
+
 }  // namespace
 }  // namespace stereorig
