@@ -2232,21 +2232,19 @@ TEST(Vdi2634, ASparseCloudsClumpsOfFalseMatchesAreNoPartMeasuredOff) {
 // On the plate too: a second module's patch measured 6 mm behind the face
 // where the first module holds the face passed. Truth: the 130 mm plate at
 // z = 400 on a 1 mm grid (module 1), a second module's points on the same
-// grid over the 30 mm square about the centre moved 6 mm along -z (behind
+// grid (offset by half a step) over the 29 mm square about the centre
+// moved 6 mm along -z (behind
 // the face, seen from +z: normals +z for both), noise sigma = 0.05 mm. Not
 // passed, every moved point named.
 TEST(Vdi2634, APlatePatchOneModuleMeasuredOffWhereTheOtherHoldsTheFaceIsNotPassed) {
   std::mt19937 rng(18);
-  std::normal_distribution<double> noise(0, 0.05);
-  std::vector<Eigen::Vector3d> pts;
+  const Eigen::Vector3d c(0, 0, 400), normal(0, 0, 1);
+  auto pts = PlatePoints(c, normal, 130, 1.0, 0.05, &rng);
   int moved = 0;
-  for (double x = -65; x <= 65; x += 1)
-    for (double y = -65; y <= 65; y += 1) {
-      pts.emplace_back(x, y, 400 + noise(rng));
-      if (std::abs(x) >= 15 || std::abs(y) >= 15) continue;
-      pts.emplace_back(x + 0.5, y + 0.5, 400 - 6 + noise(rng));
-      ++moved;
-    }
+  for (const Eigen::Vector3d& p : PlatePoints(c - 6 * normal, normal, 29, 1.0, 0.05, &rng)) {
+    pts.push_back(p + Eigen::Vector3d(0.5, 0.5, 0));
+    ++moved;
+  }
   const ArtifactEvaluation e =
       EvaluateArtifact(PlateArtifact(), pts, VerifyOptions(), "plate.ply", Facing(pts.size(), {0, 0, 1}));
   const std::string reason = NotJudgedReason(e);
