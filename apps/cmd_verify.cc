@@ -450,18 +450,23 @@ int RunVerify(int argc, char** argv) {
     report["summary"]["positions_not_judged"].push_back(k + 1);  // numbered as in the table
     std::printf("%s%d", k == summary.not_judged_positions.front() ? " (position " : ", ", k + 1);
   }
-  const auto not_evaluated =
-      std::count_if(positions.begin(), positions.end(), [](const ArtifactEvaluation& e) { return !e.evaluated; });
-  const char* why = not_evaluated == 0 ? "a figure left undetermined"
-                    : static_cast<size_t>(not_evaluated) == summary.not_judged_positions.size()
-                        ? "a cloud not evaluated"
-                        : "a figure left undetermined or a cloud not evaluated";
+  // Why the positions not judged are not, each reason once in this order.
+  bool not_evaluated = false, beyond_band = false, undetermined = false;
+  for (int k : summary.not_judged_positions) {
+    const ArtifactEvaluation& e = positions[k];
+    (!e.evaluated ? not_evaluated : e.beyond_band_not_judged ? beyond_band : undetermined) = true;
+  }
+  std::string why;
+  for (const auto& [given, text] : {std::pair{undetermined, "a figure left undetermined"},
+                                    std::pair{beyond_band, "a part measured beyond the capture band"},
+                                    std::pair{not_evaluated, "a cloud not evaluated"}})
+    if (given) why += (why.empty() ? "" : " or ") + std::string(text);
   if (all_judged) {
     std::printf("\n");
   } else if (judged_failure) {
-    std::printf(" not judged: %s)\n", why);
+    std::printf(" not judged: %s)\n", why.c_str());
   } else {
-    std::printf(": %s; exit 2, no report written)\n", why);
+    std::printf(": %s; exit 2, no report written)\n", why.c_str());
   }
   // The verdict stands, but over fewer positions than the procedure asks
   // for it is not its acceptance test: said under it, and in the report.

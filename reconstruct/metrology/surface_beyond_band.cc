@@ -60,6 +60,15 @@ constexpr double kLayerEdgeOfBand = 0.1;
 constexpr double kSurroundedFraction = 2.0 / 3.0;
 constexpr double kMeasuredAroundFraction = 0.5;
 
+// A part measured off is a piece of the surface: many points. False matches
+// come in clumps of a few (a correlation window's neighbours: 4 in a
+// walkthrough's cloud), and in a sparse cloud (a 2500-point cap, ~5 points a
+// cell) a clump is as many points as a cell of surface holds: 200 such
+// outliers left 5 of 6 clouds NOT JUDGED for 4 points. A part has at least
+// this many, five clumps; the demo's cells hold ~40, so a part one cell
+// wide is still found.
+constexpr int kMinPointsPerPart = 20;
+
 double InterquartileRange(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v[(3 * v.size()) / 4] - v[v.size() / 4];
@@ -70,7 +79,7 @@ double InterquartileRange(std::vector<double> v) {
 // lying along it), each group surrounded by cells that hold the surface.
 // off_mm: a point's signed distance to the surface (a layer's spread is
 // taken signed: points either side of the surface are not one layer).
-SurfaceBeyondBand Judge(const Cells& cells, double band_mm, const std::function<double(int)>& off_mm) {
+SurfaceBeyondBand Judge(const Cells& cells, double band_mm, const std::function<double(int)>& off_mm, bool overlaid) {
   std::vector<int> measured;
   for (size_t c = 0; c < cells.on.size(); ++c)
     if (cells.on[c] > 0 && !cells.ignored[c]) measured.push_back(cells.on[c]);
@@ -79,12 +88,22 @@ SurfaceBeyondBand Judge(const Cells& cells, double band_mm, const std::function<
   std::nth_element(measured.begin(), measured.begin() + measured.size() / 2, measured.end());
   const double enough = std::max<double>(kMinPointsPerCell, kSurfaceFractionOfTypical * measured[measured.size() / 2]);
   auto surface = [&](int cell) { return cells.on[cell] >= enough; };
+  // `overlaid`: a layer counts over cells that hold the surface too. One
+  // module's part measured off where another module holds the surface
+  // (their overlap) passed; an object seen there would hide the surface
+  // from the module that sees it, so a thin layer as dense as a cell of
+  // surface is a module's surface measured off.
   std::vector<char> layer(cells.on.size(), 0);
+  std::vector<double> median_off_mm(cells.on.size(), 0);
   for (size_t c = 0; c < cells.on.size(); ++c) {
-    if (cells.ignored[c] || cells.on[c] >= enough || static_cast<double>(cells.beyond[c].size()) < enough) continue;
+    if (cells.ignored[c] || (!overlaid && cells.on[c] >= enough) ||
+        static_cast<double>(cells.beyond[c].size()) < enough)
+      continue;
     std::vector<double> offs;
     for (int i : cells.beyond[c]) offs.push_back(off_mm(i));
     layer[c] = InterquartileRange(offs) <= kLayerSpreadOfBand * band_mm;
+    std::nth_element(offs.begin(), offs.begin() + offs.size() / 2, offs.end());
+    median_off_mm[c] = offs[offs.size() / 2];
   }
   auto displaced = [&](int cell) { return layer[cell] != 0; };
   const int n = static_cast<int>(cells.on.size());
@@ -98,7 +117,11 @@ SurfaceBeyondBand Judge(const Cells& cells, double band_mm, const std::function<
     for (size_t k = 0; k < group.size(); ++k)
       for (int next : cells.Around(group[k])) {
         if (seen[next]) continue;
-        if (displaced(next)) {
+        // One layer runs on continuously: a neighbour's offset within a
+        // cell's spread (clumps of false matches at other offsets in
+        // adjacent cells are not one part).
+        if (displaced(next) &&
+            std::abs(median_off_mm[next] - median_off_mm[group[k]]) <= kLayerSpreadOfBand * band_mm) {
           seen[next] = 1;
           group.push_back(next);
         } else if (!cells.ignored[next] && std::find(rim.begin(), rim.end(), next) == rim.end()) {
@@ -142,15 +165,21 @@ SurfaceBeyondBand Judge(const Cells& cells, double band_mm, const std::function<
     for (int cell : region)
       for (int next : cells.Around(cell))
         if (!in_region[next] && !cells.ignored[next]) around.push_back(next);
+    std::vector<int> part;
     for (int cell : around)
       for (int i : cells.beyond[cell])
-        if (in_layer(i)) found.push_back(i);
+        if (in_layer(i)) part.push_back(i);
+    std::sort(part.begin(), part.end());
+    part.erase(std::unique(part.begin(), part.end()), part.end());
+    if (static_cast<int>(part.size()) < kMinPointsPerPart) continue;
+    found.insert(found.end(), part.begin(), part.end());
   }
   // Each point once: two groups may share a cell around them.
   std::sort(found.begin(), found.end());
   found.erase(std::unique(found.begin(), found.end()), found.end());
   out.points = static_cast<int>(found.size());
   for (int i : found) {
+    out.mean_off_mm += off_mm(i) / static_cast<double>(found.size());
     out.nearest_mm = std::min(out.nearest_mm, std::abs(off_mm(i)));
     out.farthest_mm = std::max(out.farthest_mm, std::abs(off_mm(i)));
   }
@@ -200,7 +229,7 @@ SurfaceBeyondBand SphereSurfaceBeyondBand(const std::vector<Eigen::Vector3d>& pt
       cells.beyond[CellOf(d / n)].push_back(i);
     }
   }
-  return Judge(cells, band_mm, off_mm);
+  return Judge(cells, band_mm, off_mm, /*overlaid=*/true);
 }
 
 SurfaceBeyondBand PlateSurfaceBeyondBand(const std::vector<Eigen::Vector3d>& pts,
@@ -228,7 +257,10 @@ SurfaceBeyondBand PlateSurfaceBeyondBand(const std::vector<Eigen::Vector3d>& pts
       cells.beyond[row * cols + col].push_back(i);
     }
   }
-  return Judge(cells, band_mm, off_mm);
+  // Without normals a plate thicker than the band seen from both sides puts
+  // its far face over the face's cells: a layer over them counts only where
+  // the normals leave that far face out.
+  return Judge(cells, band_mm, off_mm, /*overlaid=*/face_side != 0 && !normals.empty());
 }
 
 }  // namespace stereorig

@@ -9,7 +9,10 @@
 // in directions where the artifact's own surface is missing while the
 // directions around are measured; a mount or a stand lies where the
 // artifact is hidden, so the directions around it are not measured either
-// (the artifact's far side, below it).
+// (the artifact's far side, below it). A thin layer as dense as a cell of
+// surface over cells that hold the surface too is one module's part
+// measured off where another module holds it (their overlap). A part is
+// one continuous layer of at least 20 points (a few false matches are not).
 #pragma once
 
 #include <Eigen/Core>
@@ -22,6 +25,7 @@ namespace stereorig {
 struct SurfaceBeyondBand {
   int points = 0;                          // beyond the band, where the surface is missing among measured directions
   double nearest_mm = 0, farthest_mm = 0;  // their distance to the shape's surface
+  double mean_off_mm = 0;                  // their mean signed offset (a plate's: along its normal)
   bool found() const { return points > 0; }
 };
 

@@ -192,6 +192,7 @@ struct ArtifactEvaluation {
   // A position not evaluated at all (NotEvaluated below) has no figures and
   // no fitted geometry; not_judged_reason then says why.
   std::string not_judged_reason;
+  bool beyond_band_not_judged = false;  // not judged for a part measured beyond the capture band
   bool evaluated = true;
   bool judged() const { return not_judged_reason.empty(); }
   bool pass() const;  // judged, and every figure within its MPE

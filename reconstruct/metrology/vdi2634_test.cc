@@ -2037,6 +2037,18 @@ TEST(Vdi2634, AMountBeyondTheBandWhereTheSphereIsHiddenChangesNothing) {
     EXPECT_EQ(FigureOf(e, "P_F"), FigureOf(alone, "P_F"));
     EXPECT_EQ(FigureOf(e, "P_S"), FigureOf(alone, "P_S"));
   }
+  // A mount right against the cap's edge (its face a layer 6 to 6.1 mm out,
+  // 100 to 140 degrees off +z within 30 degrees of azimuth of +x): the
+  // measured cap borders it on one side only, its other sides unmeasured,
+  // so it rests on the half-measured rule, which the mount 50 degrees away
+  // does not reach. (A ring all round the cap's edge is half bordered by it
+  // and taken for a patch at the edge of what was seen: that rule's case.)
+  auto with_mount = cap;
+  for (const Eigen::Vector3d& p : PointsInShell(c, 19.05 + 6, 19.05 + 6.1, {0, 0, -1}, 40, 80, 20000, &rng))
+    if (std::abs(std::atan2(p.y() - c.y(), p.x() - c.x())) < 30 * kPi / 180) with_mount.push_back(p);
+  const ArtifactEvaluation e = EvaluateArtifact(SphereArtifact(), with_mount, VerifyOptions(), "test");
+  EXPECT_TRUE(e.pass()) << e.not_judged_reason;
+  EXPECT_EQ(FigureOf(e, "P_F"), FigureOf(alone, "P_F"));
 }
 
 // A patch of the plate's face measured beyond the capture band is not
@@ -2082,6 +2094,162 @@ TEST(Vdi2634, APatchOfABallBeyondTheCaptureBandIsNotPassed) {
   const std::string reason = NotJudgedReason(e);
   EXPECT_NE(reason.find(std::to_string(moved) + " points lie "), std::string::npos) << moved << ": " << reason;
   EXPECT_NE(reason.find("off ball 2's surface"), std::string::npos) << reason;
+}
+
+// An object on the plate whose sides are not captured (a clamp's top 8 or
+// 12 mm in front of the face) is not the face measured off: the good plate
+// passes, the object is left out with a note that says to crop it, not to
+// widen the band (which put it in F: F 8.25, FAIL). It read NOT JUDGED
+// "... give --capture-band-mm 10 to judge it". The same layer behind the
+// face (nothing there can be seen through the plate) is still the face
+// measured off: not passed. Truth: the 130 x 120 mm plate at z = 400 on a
+// 1 mm grid, noise sigma = 0.05 mm along z, normals +z (measured from +z);
+// the clamp's square footprint holds no face point, its top the same grid
+// at +h (-h behind). F of the face alone is ~8 sigma = 0.4 mm, within the
+// 1.5 mm MPE.
+TEST(Vdi2634, AClampOnThePlateIsNotItsFaceMeasuredOff) {
+  struct Clamp {
+    double x0_mm, y0_mm, side_mm, height_mm;
+  };
+  for (const Clamp& clamp :
+       {Clamp{-10, -10, 20, 8}, Clamp{-65, -10, 20, 8}, Clamp{-65, -60, 25, 12}, Clamp{-10, -10, 20, -8}}) {
+    SCOPED_TRACE(::testing::Message() << "clamp at " << clamp.x0_mm << ", " << clamp.y0_mm << ", " << clamp.height_mm
+                                      << " mm");
+    std::mt19937 rng(15);
+    std::normal_distribution<double> noise(0, 0.05);
+    std::vector<Eigen::Vector3d> pts;
+    int top = 0;
+    for (double x = -65; x <= 65; x += 1)
+      for (double y = -60; y <= 60; y += 1) {
+        const bool under = x >= clamp.x0_mm && x <= clamp.x0_mm + clamp.side_mm && y >= clamp.y0_mm &&
+                           y <= clamp.y0_mm + clamp.side_mm;
+        pts.emplace_back(x, y, 400 + (under ? clamp.height_mm : 0) + noise(rng));
+        top += under;
+      }
+    Artifact plate = PlateArtifact();
+    plate.plate_width_mm = 120;
+    const ArtifactEvaluation e =
+        EvaluateArtifact(plate, pts, VerifyOptions(), "plate.ply", Facing(pts.size(), {0, 0, 1}));
+    if (clamp.height_mm > 0) {
+      EXPECT_TRUE(e.pass()) << e.not_judged_reason;
+      ASSERT_EQ(e.notes.size(), 1u);
+      EXPECT_NE(e.notes[0].find("mm in front of the plate's face"), std::string::npos) << e.notes[0];
+      EXPECT_NE(e.notes[0].find("Crop it away if it is not the plate"), std::string::npos) << e.notes[0];
+      EXPECT_EQ(e.notes[0].find("to judge it"), std::string::npos) << e.notes[0];
+    } else {
+      const std::string reason = NotJudgedReason(e);
+      EXPECT_TRUE(e.beyond_band_not_judged);
+      EXPECT_NE(reason.find(std::to_string(top) + " points lie "), std::string::npos) << top << ": " << reason;
+      EXPECT_NE(reason.find("mm off the plate's face"), std::string::npos) << reason;
+    }
+  }
+}
+
+// A patch one module measured beyond the band where the other module holds
+// the surface (their overlap) was left out and the sphere passed (6 and 9 mm
+// off: PASS; 3.5 mm, in the band: FAIL). Its cells hold the surface, but a
+// thin layer as dense as a cell of surface lying over it is the patch: not
+// passed, every moved point named. Truth: the certified sphere seen by two
+// modules from -x and +x (110-degree caps, 0.4 mm apart, noise sigma =
+// 0.05 mm radially), the +x module's points within 12 degrees of the yz
+// plane and y > 0.6 r moved radially by h; the -x module's hold the
+// surface there. The nearest moved point within 6 sigma of h.
+TEST(Vdi2634, APatchOneModuleMeasuredOffWhereTheOtherHoldsTheSurfaceIsNotPassed) {
+  const double sigma_mm = 0.05, r_mm = 19.05;
+  for (const double h : {6.0, 9.0}) {
+    std::mt19937 rng(16);
+    const Eigen::Vector3d c(0, 0, 250);
+    auto s = SphereCap(c, r_mm, {-1, 0, 0}, 110, 0.4, sigma_mm, &rng);
+    auto b = SphereCap(c, r_mm, {1, 0, 0}, 110, 0.4, sigma_mm, &rng);
+    int moved = 0;
+    for (auto& p : b) {
+      const Eigen::Vector3d u = (p - c).normalized();
+      if (std::abs(u.x()) >= std::sin(12 * kPi / 180) || u.y() <= 0.6) continue;
+      p += h * u;
+      ++moved;
+    }
+    s.insert(s.end(), b.begin(), b.end());
+    SCOPED_TRACE(::testing::Message() << moved << " points moved " << h << " mm");
+    const ArtifactEvaluation e = EvaluateArtifact(SphereArtifact(), s, VerifyOptions(), "test");
+    const std::string reason = NotJudgedReason(e);
+    EXPECT_TRUE(e.beyond_band_not_judged);
+    EXPECT_NE(reason.find(std::to_string(moved) + " points lie "), std::string::npos) << reason;
+    const double nearest = std::stod(reason.substr(reason.find(" points lie ") + 12));
+    EXPECT_NEAR(nearest, h, 6 * sigma_mm + 0.05) << reason;
+  }
+}
+
+// A sparse cloud's false matches, in clumps of a few points, are no part
+// measured off: a 2500-point cap with 200 outliers in clumps of 4 was NOT
+// JUDGED on 5 of 6 seeds for 4 points (a clump is as many points as a cell
+// of so sparse a cloud holds). A part needs 20 points: the cap passes, and a
+// patch of it (~130 points) moved beyond the band is still not passed. Truth: the certified
+// sphere's 100-degree cap about -z, ~1 mm apart (~2600 points), noise
+// sigma = 0.08 mm; 50 clumps of 4 points at random directions in the cap,
+// 5.2 to 14.8 mm outside the surface (each clump's points within 0.02 rad
+// and 0.3 mm of each other); then instead the cap's points within 20
+// degrees of -z moved out by 6 mm.
+TEST(Vdi2634, ASparseCloudsClumpsOfFalseMatchesAreNoPartMeasuredOff) {
+  std::mt19937 rng(17);
+  const Eigen::Vector3d c(2, -3, 250);
+  const double r_mm = 19.05;
+  const auto cap = SphereCap(c, r_mm, {0, 0, -1}, 100, 1.0, 0.08, &rng);
+  std::uniform_real_distribution<double> uniform(-1, 1), offset(5.2, 14.8);
+  std::normal_distribution<double> jitter(0, 0.02), spread(0, 0.3);
+  for (int seed = 0; seed < 6; ++seed) {
+    SCOPED_TRACE(::testing::Message() << "clumps " << seed);
+    rng.seed(100 + seed);
+    auto cloud = cap;
+    for (int clump = 0; clump < 50;) {
+      const Eigen::Vector3d u = Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
+      if (u.norm() > 1 || u.norm() < 0.1 || u.normalized().z() > std::cos(80 * kPi / 180)) continue;
+      const double off = offset(rng);
+      for (int k = 0; k < 4; ++k) {
+        const Eigen::Vector3d d =
+            (u.normalized() + Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng))).normalized();
+        cloud.push_back(c + (r_mm + off + spread(rng)) * d);
+      }
+      ++clump;
+    }
+    const ArtifactEvaluation e = EvaluateArtifact(SphereArtifact(), cloud, VerifyOptions(), "sparse.ply");
+    EXPECT_TRUE(e.pass()) << e.not_judged_reason;
+  }
+  auto patched = cap;
+  int moved = 0;
+  for (auto& p : patched) {
+    const Eigen::Vector3d u = (p - c).normalized();
+    if (u.z() > -std::cos(20 * kPi / 180)) continue;
+    p += 6.0 * u;
+    ++moved;
+  }
+  const ArtifactEvaluation e = EvaluateArtifact(SphereArtifact(), patched, VerifyOptions(), "sparse.ply");
+  // Not passed; not all its points named: in so sparse a cloud some of the
+  // patch's cells hold fewer points than a cell of surface.
+  const std::string reason = NotJudgedReason(e);
+  EXPECT_TRUE(e.beyond_band_not_judged) << moved << ": " << reason;
+}
+
+// On the plate too: a second module's patch measured 6 mm behind the face
+// where the first module holds the face passed. Truth: the 130 mm plate at
+// z = 400 on a 1 mm grid (module 1), a second module's points on the same
+// grid (offset by half a step) over the 29 mm square about the centre
+// moved 6 mm along -z (behind
+// the face, seen from +z: normals +z for both), noise sigma = 0.05 mm. Not
+// passed, every moved point named.
+TEST(Vdi2634, APlatePatchOneModuleMeasuredOffWhereTheOtherHoldsTheFaceIsNotPassed) {
+  std::mt19937 rng(18);
+  const Eigen::Vector3d c(0, 0, 400), normal(0, 0, 1);
+  auto pts = PlatePoints(c, normal, 130, 1.0, 0.05, &rng);
+  int moved = 0;
+  for (const Eigen::Vector3d& p : PlatePoints(c - 6 * normal, normal, 29, 1.0, 0.05, &rng)) {
+    pts.push_back(p + Eigen::Vector3d(0.5, 0.5, 0));
+    ++moved;
+  }
+  const ArtifactEvaluation e =
+      EvaluateArtifact(PlateArtifact(), pts, VerifyOptions(), "plate.ply", Facing(pts.size(), {0, 0, 1}));
+  const std::string reason = NotJudgedReason(e);
+  EXPECT_TRUE(e.beyond_band_not_judged);
+  EXPECT_NE(reason.find(std::to_string(moved) + " points lie "), std::string::npos) << moved << ": " << reason;
 }
 
 }  // namespace
