@@ -38,6 +38,7 @@ struct Cells {
 // typical measured cell's points (the median over cells with any): a cap's
 // edge cells, cut by it, still count. Fewer than 3 points is no surface.
 constexpr double kSurfaceFractionOfTypical = 0.25;
+constexpr double kOverlaidFractionOfTypical = 0.5;
 constexpr int kMinPointsPerCell = 3;
 
 // A part of the surface measured off lies along the surface, as a layer:
@@ -90,14 +91,20 @@ SurfaceBeyondBand Judge(const Cells& cells, double band_mm, const std::function<
   auto surface = [&](int cell) { return cells.on[cell] >= enough; };
   // `overlaid`: a layer counts over cells that hold the surface too. One
   // module's part measured off where another module holds the surface
-  // (their overlap) passed; an object seen there would hide the surface
-  // from the module that sees it, so a thin layer as dense as a cell of
-  // surface is a module's surface measured off.
+  // (their overlap) passed. The caller passes it only where the points
+  // beyond the band face as the surface does (their normals), so clutter
+  // facing otherwise (a table under a sphere) is not among them; over the
+  // surface a layer is a part where it is at least half as dense as a
+  // typical cell of surface (a patch a module measured off holds as many
+  // points as the cells it left; the surface's quarter bar would take a
+  // sparse strip of clutter).
+  const double overlaid_enough = std::max(enough, kOverlaidFractionOfTypical * measured[measured.size() / 2]);
   std::vector<char> layer(cells.on.size(), 0);
   std::vector<double> median_off_mm(cells.on.size(), 0);
   for (size_t c = 0; c < cells.on.size(); ++c) {
-    if (cells.ignored[c] || (!overlaid && cells.on[c] >= enough) ||
-        static_cast<double>(cells.beyond[c].size()) < enough)
+    const bool over_surface = cells.on[c] >= enough;
+    if (cells.ignored[c] || (over_surface && !overlaid) ||
+        static_cast<double>(cells.beyond[c].size()) < (over_surface ? overlaid_enough : enough))
       continue;
     std::vector<double> offs;
     for (int i : cells.beyond[c]) offs.push_back(off_mm(i));
@@ -172,6 +179,9 @@ SurfaceBeyondBand Judge(const Cells& cells, double band_mm, const std::function<
     std::sort(part.begin(), part.end());
     part.erase(std::unique(part.begin(), part.end()), part.end());
     if (static_cast<int>(part.size()) < kMinPointsPerPart) continue;
+    double mean_mm = 0;
+    for (int i : part) mean_mm += off_mm(i) / static_cast<double>(part.size());
+    out.part_mean_off_mm.push_back(mean_mm);
     found.insert(found.end(), part.begin(), part.end());
   }
   // Each point once: two groups may share a cell around them.
@@ -179,7 +189,6 @@ SurfaceBeyondBand Judge(const Cells& cells, double band_mm, const std::function<
   found.erase(std::unique(found.begin(), found.end()), found.end());
   out.points = static_cast<int>(found.size());
   for (int i : found) {
-    out.mean_off_mm += off_mm(i) / static_cast<double>(found.size());
     out.nearest_mm = std::min(out.nearest_mm, std::abs(off_mm(i)));
     out.farthest_mm = std::max(out.farthest_mm, std::abs(off_mm(i)));
   }
@@ -210,9 +219,18 @@ Eigen::Vector3d CellCentre(int cell) {
 // longer side (6.5 mm cells on the demo's 130 mm plate, ~40 points each).
 constexpr int kPlateCellsAlong = 20;
 
+// A part of a sphere measured off keeps the surface's orientation to within
+// its slope error (a patch a grid period off is the surface shifted along
+// the camera's ray: a few degrees), so its normals lie within this angle of
+// the radial direction; a table below the sphere, where it lands in the
+// window (within ~35 degrees of the nadir), faces up: 145 degrees or more
+// from radial.
+constexpr double kCosFacingOut = 0.866;  // 30 degrees
+
 }  // namespace
 
-SurfaceBeyondBand SphereSurfaceBeyondBand(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& center_mm,
+SurfaceBeyondBand SphereSurfaceBeyondBand(const std::vector<Eigen::Vector3d>& pts,
+                                          const std::vector<Eigen::Vector3d>& normals, const Eigen::Vector3d& center_mm,
                                           double radius_mm, double band_mm, const Eigen::Vector3d& axis,
                                           double cos_cone) {
   Cells cells(kRows, kCols, /*wrap=*/true);
@@ -226,10 +244,18 @@ SurfaceBeyondBand SphereSurfaceBeyondBand(const std::vector<Eigen::Vector3d>& pt
     if (off < band_mm) {
       ++cells.on[CellOf(d / n)];
     } else if (off <= kBeyondBandWidths * band_mm) {
+      // Facing otherwise than out of the sphere (a table, a stand's side;
+      // no direction written): not the sphere's surface measured off.
+      if (!normals.empty() && !(normals[i].norm() > 0 && normals[i].dot(d / n) >= kCosFacingOut * normals[i].norm()))
+        continue;
       cells.beyond[CellOf(d / n)].push_back(i);
     }
   }
-  return Judge(cells, band_mm, off_mm, /*overlaid=*/true);
+  // Without normals a layer over the surface may be anything facing any
+  // way (a table below the sphere, in the cells ~30 degrees from the nadir
+  // that the sphere's own surface holds too): such cells count only where
+  // the normals left it out.
+  return Judge(cells, band_mm, off_mm, /*overlaid=*/!normals.empty());
 }
 
 SurfaceBeyondBand PlateSurfaceBeyondBand(const std::vector<Eigen::Vector3d>& pts,

@@ -212,10 +212,13 @@ void JudgeSurfaceBeyondBand(const SurfaceBeyondBand& s, const std::string& what,
 // it the plate would hide it), so a layer there is left out with a note;
 // behind the face, or where the side is unknown (a cloud without normals),
 // nothing but the face measured off can lie, and the plate is not passed.
+// Each part is placed on its own: a clamp in front does not vouch for a
+// patch behind (one mean over both called all of them in front, PASS).
 // Widening the band is no way to judge an object: it would put it in F.
 void JudgePlateFaceBeyondBand(const SurfaceBeyondBand& s, int face_side, double band_mm, ArtifactEvaluation* e) {
   if (!s.found()) return;
-  const bool on_measured_side = face_side != 0 && s.mean_off_mm * face_side > 0;
+  const bool on_measured_side = face_side != 0 && std::all_of(s.part_mean_off_mm.begin(), s.part_mean_off_mm.end(),
+                                                              [&](double off_mm) { return off_mm * face_side > 0; });
   char buf[640];
   std::snprintf(buf, sizeof buf,
                 "%d points lie %.1f to %.1f mm %s the plate's face, beyond the %.1f mm capture band, where the band "
@@ -995,7 +998,7 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       JudgeFigures(o.decision_rule, o, &e.figures);
       e.not_judged_reason =
           NotJudgedReason(e, CapsText(e.sphere_cap_half_angles_deg), a.uncertainty_coverage_factor, o);
-      JudgeSurfaceBeyondBand(SphereSurfaceBeyondBand(pts, fit.center_mm, fit.radius_mm, e.capture_band_mm),
+      JudgeSurfaceBeyondBand(SphereSurfaceBeyondBand(pts, normals, fit.center_mm, fit.radius_mm, e.capture_band_mm),
                              "the sphere's surface", e.capture_band_mm, &e);
       break;
     }
@@ -1179,7 +1182,7 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
           NotJudgedReason(e, CapsText(e.sphere_cap_half_angles_deg), a.uncertainty_coverage_factor, o);
       for (int ball = 0; ball < 2; ++ball) {
         const Eigen::Vector3d& c = e.sphere_centers_mm[ball];
-        JudgeSurfaceBeyondBand(SphereSurfaceBeyondBand(pts, c, 0.5 * e.sphere_diameters_mm[ball], band,
+        JudgeSurfaceBeyondBand(SphereSurfaceBeyondBand(pts, normals, c, 0.5 * e.sphere_diameters_mm[ball], band,
                                                        (e.sphere_centers_mm[1 - ball] - c).normalized(), cos_cone),
                                "ball " + std::to_string(ball + 1) + "'s surface", band, &e);
       }

@@ -2148,12 +2148,14 @@ TEST(Vdi2634, AClampOnThePlateIsNotItsFaceMeasuredOff) {
 // A patch one module measured beyond the band where the other module holds
 // the surface (their overlap) was left out and the sphere passed (6 and 9 mm
 // off: PASS; 3.5 mm, in the band: FAIL). Its cells hold the surface, but a
-// thin layer as dense as a cell of surface lying over it is the patch: not
-// passed, every moved point named. Truth: the certified sphere seen by two
-// modules from -x and +x (110-degree caps, 0.4 mm apart, noise sigma =
-// 0.05 mm radially), the +x module's points within 12 degrees of the yz
-// plane and y > 0.6 r moved radially by h; the -x module's hold the
-// surface there. The nearest moved point within 6 sigma of h.
+// thin layer at least half as dense as a cell of surface lying over it,
+// facing out of the sphere, is the patch: not passed, every moved point
+// named. Truth: the certified sphere seen by two modules from -x and +x
+// (110-degree caps, 0.4 mm apart, noise sigma = 0.05 mm radially, normals
+// radial: a patch measured off keeps the surface's orientation), the +x
+// module's points within 12 degrees of the yz plane and y > 0.6 r moved
+// radially by h; the -x module's hold the surface there. The nearest moved
+// point within 6 sigma of h.
 TEST(Vdi2634, APatchOneModuleMeasuredOffWhereTheOtherHoldsTheSurfaceIsNotPassed) {
   const double sigma_mm = 0.05, r_mm = 19.05;
   for (const double h : {6.0, 9.0}) {
@@ -2169,8 +2171,10 @@ TEST(Vdi2634, APatchOneModuleMeasuredOffWhereTheOtherHoldsTheSurfaceIsNotPassed)
       ++moved;
     }
     s.insert(s.end(), b.begin(), b.end());
+    std::vector<Eigen::Vector3d> normals;
+    for (const Eigen::Vector3d& p : s) normals.push_back((p - c).normalized());
     SCOPED_TRACE(::testing::Message() << moved << " points moved " << h << " mm");
-    const ArtifactEvaluation e = EvaluateArtifact(SphereArtifact(), s, VerifyOptions(), "test");
+    const ArtifactEvaluation e = EvaluateArtifact(SphereArtifact(), s, VerifyOptions(), "test", normals);
     const std::string reason = NotJudgedReason(e);
     EXPECT_TRUE(e.beyond_band_not_judged);
     EXPECT_NE(reason.find(std::to_string(moved) + " points lie "), std::string::npos) << reason;
@@ -2222,7 +2226,13 @@ TEST(Vdi2634, ASparseCloudsClumpsOfFalseMatchesAreNoPartMeasuredOff) {
     p += 6.0 * u;
     ++moved;
   }
-  const ArtifactEvaluation e = EvaluateArtifact(SphereArtifact(), patched, VerifyOptions(), "sparse.ply");
+  // Its normals radial (a patch measured off keeps the surface's
+  // orientation): the patch lies within the cells' first row about the
+  // pole, whose rim of surface (20 to 27 degrees) is there too, so only a
+  // layer over the surface facing out of the sphere shows it.
+  std::vector<Eigen::Vector3d> normals;
+  for (const Eigen::Vector3d& p : patched) normals.push_back((p - c).normalized());
+  const ArtifactEvaluation e = EvaluateArtifact(SphereArtifact(), patched, VerifyOptions(), "sparse.ply", normals);
   // Not passed; not all its points named: in so sparse a cloud some of the
   // patch's cells hold fewer points than a cell of surface.
   const std::string reason = NotJudgedReason(e);
@@ -2250,6 +2260,96 @@ TEST(Vdi2634, APlatePatchOneModuleMeasuredOffWhereTheOtherHoldsTheFaceIsNotPasse
   const std::string reason = NotJudgedReason(e);
   EXPECT_TRUE(e.beyond_band_not_judged);
   EXPECT_NE(reason.find(std::to_string(moved) + " points lie "), std::string::npos) << moved << ": " << reason;
+}
+
+// A table under a sphere is no part measured off (a walkthrough: a sphere
+// 6 or 9 mm above a table, four cameras 200 mm out and 80 or 120 mm up, read
+// NOT JUDGED "1771 points lie 11.9 to 15.0 mm off", P_F 0.30, P_S 0). The
+// table lands in the window beyond the band within ~35 degrees of the
+// nadir, in cells the sphere's own surface holds (the cameras see it to
+// ~22 degrees of the nadir): the overlaid rule took it for a module's
+// patch. Its normals face up, not out of the sphere: it is no part. (A
+// cloud without normals still reads NOT JUDGED: the table also lands in
+// cells at the edge of what the cameras see of the sphere, which hold
+// almost none of it.) Truth:
+// the certified sphere 9 or 6 mm above the table (z = c - r - gap), what the
+// four cameras at (200 cos a, 200 sin a, 80) from the centre see of it (a
+// point is seen where it faces a camera whose ray misses the sphere), every
+// 0.5 mm on the sphere (radial noise and normals) and the table's 1 mm
+// grid within 60 mm (noise along z, normals +z), noise sigma = 0.05 mm. The
+// good sphere passes, the table off the artifact.
+TEST(Vdi2634, ATableUnderASphereIsNoPartMeasuredOff) {
+  const double r_mm = 19.05, sigma_mm = 0.05;
+  const Eigen::Vector3d c(0, 0, 300);
+  std::vector<Eigen::Vector3d> cameras;
+  for (int k = 0; k < 4; ++k)
+    cameras.push_back(c + Eigen::Vector3d(200 * std::cos(k * kPi / 2), 200 * std::sin(k * kPi / 2), 80));
+  auto seen = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
+    for (const Eigen::Vector3d& cam : cameras) {
+      const Eigen::Vector3d ray = cam - p;
+      if (ray.dot(n) <= 0.05 * ray.norm()) continue;
+      // The ray from p (just off its surface) to the camera misses the sphere.
+      const Eigen::Vector3d u = ray.normalized(), m = p + 1e-3 * n - c;
+      const double b = m.dot(u), disc = b * b - (m.squaredNorm() - r_mm * r_mm);
+      if (disc <= 0 || -b + std::sqrt(disc) <= 0) return true;
+    }
+    return false;
+  };
+  for (const double gap_mm : {9.0, 6.0}) {
+    SCOPED_TRACE(::testing::Message() << "table " << gap_mm << " mm below");
+    std::mt19937 rng(19);
+    std::normal_distribution<double> noise(0, sigma_mm);
+    std::vector<Eigen::Vector3d> pts, normals;
+    for (const Eigen::Vector3d& p : SphereCap(c, r_mm, {0, 0, 1}, 180, 0.5, 0, &rng)) {
+      const Eigen::Vector3d n = (p - c).normalized();
+      if (!seen(p, n)) continue;
+      pts.push_back(p + noise(rng) * n);
+      normals.push_back(n);
+    }
+    const double table_z = c.z() - r_mm - gap_mm;
+    int table = 0;
+    for (double x = -60; x <= 60; x += 1)
+      for (double y = -60; y <= 60; y += 1) {
+        const Eigen::Vector3d p(c.x() + x, c.y() + y, table_z);
+        if (std::hypot(x, y) > 60 || !seen(p, {0, 0, 1})) continue;
+        pts.push_back(p + Eigen::Vector3d(0, 0, noise(rng)));
+        normals.emplace_back(0, 0, 1);
+        ++table;
+      }
+    const ArtifactEvaluation e = EvaluateArtifact(SphereArtifact(), pts, VerifyOptions(), "stem.ply", normals);
+    EXPECT_TRUE(e.pass()) << e.not_judged_reason;
+    EXPECT_FALSE(e.beyond_band_not_judged);
+    EXPECT_GE(e.points_off_artifact, table / 2);  // the table is off the artifact
+  }
+}
+
+// A clamp in front of the plate does not vouch for a patch of the face
+// measured behind it: one mean offset over both (the clamp's top 8 mm in
+// front, the patch 7 mm behind) called all their points in front, and the
+// plate passed with a note (the patch alone: NOT JUDGED). Truth: the 130 x
+// 120 mm plate at z = 400 on a 1 mm grid, noise sigma = 0.05 mm along z,
+// normals +z; the clamp's top over [-50, -30]^2 at +8 mm, the patch over
+// [20, 40]^2 at -7 mm. Not passed, the reason saying the points lie off the
+// face (not in front of it).
+TEST(Vdi2634, AClampInFrontDoesNotVouchForAPatchBehindThePlate) {
+  std::mt19937 rng(20);
+  std::normal_distribution<double> noise(0, 0.05);
+  std::vector<Eigen::Vector3d> pts;
+  int off_face = 0;
+  for (double x = -65; x <= 65; x += 1)
+    for (double y = -60; y <= 60; y += 1) {
+      const bool clamp = x >= -50 && x <= -30 && y >= -50 && y <= -30, patch = x >= 20 && x <= 40 && y >= 20 && y <= 40;
+      pts.emplace_back(x, y, 400 + (clamp ? 8 : patch ? -7 : 0) + noise(rng));
+      off_face += clamp || patch;
+    }
+  Artifact plate = PlateArtifact();
+  plate.plate_width_mm = 120;
+  const ArtifactEvaluation e =
+      EvaluateArtifact(plate, pts, VerifyOptions(), "plate.ply", Facing(pts.size(), {0, 0, 1}));
+  const std::string reason = NotJudgedReason(e);
+  EXPECT_TRUE(e.beyond_band_not_judged);
+  EXPECT_NE(reason.find(std::to_string(off_face) + " points lie "), std::string::npos) << off_face << ": " << reason;
+  EXPECT_NE(reason.find("mm off the plate's face"), std::string::npos) << reason;
 }
 
 }  // namespace
