@@ -275,9 +275,24 @@ class LineIndexer {
   // Whether Move or Drop has changed the map.
   bool changed() const { return changed_; }
 
+  // The reading at the alignment the last TestComponent left its component
+  // on; fits == 0 when it read none or dropped the component.
+  const VernierReading& last_reading() const { return last_reading_; }
+
   // One component's vernier test.
   // offset_px: the row offset a correct match reads (0 on a well rectified pair).
   Outcome TestComponent(const std::vector<int>& pixels, double offset_px) {
+    last_reading_ = VernierReading{};
+    const Outcome outcome = TestComponentReading(pixels, offset_px);
+    if (outcome == Outcome::kDropped) last_reading_ = VernierReading{};
+    if (last_reading_.fits > 0) last_reading_.pixels = int(pixels.size());
+    return outcome;
+  }
+
+ private:
+  void Note(const Vernier& v) { last_reading_ = {v.mean_row_offset_px, v.standard_error_px, v.fits, 0}; }
+
+  Outcome TestComponentReading(const std::vector<int>& pixels, double offset_px) {
     std::vector<Start> sample = Sample(pixels);
     // On the lattice, with area_per_sample_px, the whole footprint is read
     // from the start (the matcher sets it only where growing's noise floor
@@ -290,6 +305,7 @@ class LineIndexer {
     Vernier here = Read(sample, 0.0);
     here.mean_row_offset_px -= offset_px;
     if (here.fits < 4) return Outcome::kKept;
+    Note(here);
     // Read as right without the other alignments: within max_row_offset_px
     // and, with ambiguity_sigmas, by that many standard errors; without it,
     // also anything within 3 standard errors (as before session 6: at
@@ -312,6 +328,7 @@ class LineIndexer {
         if (whole_here.fits >= 4) {
           sample = std::move(whole);
           here = whole_here;
+          Note(here);
           if (read_as_right()) return Outcome::kKept;
         }
       }
@@ -377,10 +394,10 @@ class LineIndexer {
     if (k == 0) return Outcome::kKept;
     if (points[k + 1]->fits < 4) return unreadable();
     Move(pixels, points[k + 1]->mean_shift_px);
+    Note(*points[k + 1]);
     return Outcome::kMoved;
   }
 
- private:
   float SlopeX(int i) const { return state_->slope_x.at<float>(i / cols_, i % cols_); }
   float SlopeY(int i) const { return state_->slope_y.at<float>(i / cols_, i % cols_); }
 
@@ -393,6 +410,7 @@ class LineIndexer {
   SubpixelOptions tall_;
   FootprintSampler sampler_;
   bool changed_ = false;
+  VernierReading last_reading_;
 };
 
 }  // namespace
@@ -438,7 +456,8 @@ std::map<std::pair<int, int>, std::vector<float>> SeamDifferences(const cv::Mat&
 }
 
 int CorrectLineIndex(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const LineIndexOptions& o,
-                     const RefineAcceptance& accept, DisparityState* state, DisparityComponents* labelled) {
+                     const RefineAcceptance& accept, DisparityState* state, DisparityComponents* labelled,
+                     std::vector<VernierReading>* readings) {
   if (!o.enabled) return 0;
   DisparityComponents own;
   if (!labelled) labelled = &own;
@@ -453,6 +472,8 @@ int CorrectLineIndex(const cv::Mat& left, const cv::Mat& right, const cv::Rect& 
       if (indexer.TestComponent(pixels, 0.0) != LineIndexer::Outcome::kMoved) break;
       ++moved;
     }
+    // The last test's reading: after two moves, the alignment moved to.
+    if (readings && indexer.last_reading().fits > 0) readings->push_back(indexer.last_reading());
   }
   labelled->matches_disparity = !indexer.changed();
   return moved;

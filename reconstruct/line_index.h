@@ -141,12 +141,28 @@ struct DisparityComponents {
   bool matches_disparity = false;        // labels the disparity map as it is now
 };
 
+// What one component's vernier read at the alignment the test left it on
+// (kept or moved to; dropped components give none): the mean row offset of
+// its tall-window fits. On a well rectified pair every component reads ~0
+// there; a module whose rows are off (a camera turned since calibration,
+// the capture of another module) reads that offset, modulo the vernier's
+// step per period (row_drift.h).
+struct VernierReading {
+  double row_offset_px = 0;
+  double standard_error_px = 0;
+  int fits = 0;    // successful fits the mean is over
+  int pixels = 0;  // the component's valid pixels
+};
+
 // Revises `state` (disparity, confidence, status) inside `roi`. Returns the
 // number of components moved (dropped ones not counted). left, right: CV_8UC1 rectified.
 // components: if not null, receives the components it tested, marked as
 // matching the map if it left the map unchanged.
+// readings: if not null, receives a VernierReading per tested component
+// that was kept or moved (appended).
 int CorrectLineIndex(const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi, const LineIndexOptions& options,
-                     const RefineAcceptance& accept, DisparityState* state, DisparityComponents* components = nullptr);
+                     const RefineAcceptance& accept, DisparityState* state, DisparityComponents* components = nullptr,
+                     std::vector<VernierReading>* readings = nullptr);
 
 // Which line is which, by continuity: two components that meet along a seam
 // with a jump of about one grid period (a smooth surface has none, and a

@@ -434,7 +434,7 @@ MatchResult MatchRefineFilter(const cv::Mat& left, const cv::Mat& right, const c
     const bool floor_bites = o.grow.noise_zncc_factor > 0 && grow_accept.min_zncc < accept.min_zncc;
     if (o.grow.noise_zncc_factor > 0 && !floor_bites) line_index.area_per_sample_px = 0;
     if (floor_bites && line_index.lattice_sampling) line_index.quick_keep = false;
-    CorrectLineIndex(left, right, roi, line_index, accept, &state);
+    CorrectLineIndex(left, right, roi, line_index, accept, &state, nullptr, &result.vernier_readings);
     lap("line_index");
     // Shared by both passes: the second does not repeat the first's failed tries.
     std::optional<GrowMemory> grow_memory;

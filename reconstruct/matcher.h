@@ -221,6 +221,10 @@ struct MatchResult {
   int occupied_end_disparity_px = 0;
   // The local surface fit's window and misfit, if it ran (MatchOptions::surface_fit).
   std::optional<SurfaceFitSummary> surface_fit;
+  // The line index's first pass: each kept or moved component's vernier
+  // reading at its alignment (line_index.h), for the module's row drift
+  // (row_drift.h). Empty without the line index.
+  std::vector<VernierReading> vernier_readings;
 };
 
 // The sub-pixel step's acceptance tests (disparity_state.h) as the options

@@ -232,6 +232,8 @@ void Runtime::ProcessModule(const ModulePlan& plan, const std::vector<cv::Mat>& 
     match = Match(left, right, mo);
     for (const auto& [step, ms] : match.times_ms) report->times_ms["match." + step] = ms;
     report->surface_fit = match.surface_fit;
+    report->row_drift = ReadRowDrift(match.vernier_readings);
+    report->row_drift.warned = RowDriftWarned(report->row_drift, options_.match.line_index.max_row_offset_px);
     report->searched_min_disparity_px = match.searched_min_disparity_px;
     report->searched_num_disparities = match.searched_num_disparities;
     report->occupied_min_disparity_px = match.occupied_min_disparity_px;

@@ -27,6 +27,7 @@
 #include "reconstruct/parallel_for.h"
 #include "reconstruct/point_cloud.h"
 #include "reconstruct/rectify.h"
+#include "reconstruct/row_drift.h"
 #include "reconstruct/runtime_options.h"
 
 namespace stereorig {
@@ -106,6 +107,9 @@ struct ModuleReport {
   cv::Mat lit;
   std::map<std::string, double> times_ms;        // rectify, lit_region, match, triangulate, normals, mesh
   std::optional<SurfaceFitSummary> surface_fit;  // the matcher's (matcher.h), if the fit ran
+  // How far the module's rectified rows read off at the laser grid's
+  // vernier (row_drift.h); not read without the line index (passive).
+  RowDrift row_drift;
 };
 
 struct Reconstruction {

@@ -82,10 +82,12 @@ SyntheticPair RenderSyntheticPair(const SyntheticPairSpec& s) {
       for (int q = 0; q < 8; ++q) {
         const double v = y + kGlX[q];
         l += kGlW[q] * radiance.IntegrateRow(x - 0.5, x + 0.5, v);
-        // Right pixel X sees left u with X = u - d(u, v) = u (1 - du) - d0 - dv v.
-        const double ua = (x - 0.5 + s.d0_px + s.dv * v) / (1 - s.du);
-        const double ub = (x + 0.5 + s.d0_px + s.dv * v) / (1 - s.du);
-        r += kGlW[q] * radiance.IntegrateRow(ua, ub, v) / (ub - ua);
+        // Right pixel X sees left u with X = u - d(u, v) = u (1 - du) - d0 - dv v,
+        // on the left's row v = its own less the right view's row offset.
+        const double vr = v - s.right_row_offset_px;
+        const double ua = (x - 0.5 + s.d0_px + s.dv * vr) / (1 - s.du);
+        const double ub = (x + 0.5 + s.d0_px + s.dv * vr) / (1 - s.du);
+        r += kGlW[q] * radiance.IntegrateRow(ua, ub, vr) / (ub - ua);
       }
       out.left_clean.at<double>(y, x) = l;
       right_clean.at<double>(y, x) = r;

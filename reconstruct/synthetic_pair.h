@@ -31,6 +31,9 @@ struct SyntheticPairSpec {
   double texture_contrast = 0.15;    // relative amplitude of the albedo texture
   bool laser_on = true;              // false: passive (ambient only)
   double noise_sigma_dn = 2.0;       // sensor noise, grey levels (1 sigma)
+  // The right view's rows moved down by this (a rectification off by a
+  // fraction of a row): right row y + offset sees what left row y sees.
+  double right_row_offset_px = 0.0;
   uint64_t seed = 1;
 };
 
