@@ -129,6 +129,16 @@ std::string RangeEndWarning(const ModuleReport& m) {
          kSetTheVolume;
 }
 
+// A module whose rows read off at the grid's vernier (row_drift.h).
+std::string RowDriftWarning(const ModuleReport& m) {
+  if (!m.row_drift.warned) return "";
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%+.3f px (standard error %.3f, %d component%s)", m.row_drift.row_offset_px,
+                m.row_drift.standard_error_px, m.row_drift.components, m.row_drift.components == 1 ? "" : "s");
+  return std::string("\n  warning: its rectified rows read ") + buf +
+         " off at the laser grid's vernier (row_drift): " + kRowDriftAdvice;
+}
+
 }  // namespace
 
 std::string RangeEndsWarnedOf(const ModuleReport& m) {
@@ -156,7 +166,7 @@ std::string ModuleSummary(const ModuleReport& m, FillWording wording, int max_re
                                      std::to_string(m.seen_through_surface) + " of them with their surface)"
                                : "";
   const std::string no_point = NoPointReason(m);
-  return buf + (losses.empty() ? "none" : losses) + seen + RangeEndWarning(m) +
+  return buf + (losses.empty() ? "none" : losses) + seen + RangeEndWarning(m) + RowDriftWarning(m) +
          (no_point.empty() ? "" : "\n  no point: " + no_point);
 }
 

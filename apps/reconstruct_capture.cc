@@ -148,6 +148,10 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
           "  warning: module %d's matches reach %s of the measurement volume's disparity range (%s: "
           "range_end_reached): its points may lie where nothing is; check the volume\n",
           m.module, which.c_str(), outputs.report.c_str());
+    if (m.row_drift.warned)
+      std::printf(
+          "  warning: module %d's rectified rows read %+.3f px off at the laser grid's vernier (%s: row_drift): %s\n",
+          m.module, m.row_drift.row_offset_px, outputs.report.c_str(), kRowDriftAdvice);
   }
   entry["modules_without_points"] = WarnOfModulesWithoutPoints(rec, dir, outputs, progress);
   FlushStdout();

@@ -32,6 +32,13 @@ nlohmann::json ReconstructionJson(const Reconstruction& rec) {
       mj["surface_fit"] = {{"window_px", {2 * m.surface_fit->half_width_px + 1, 2 * m.surface_fit->half_height_px + 1}},
                            {"median_misfit_px", m.surface_fit->median_misfit_px},
                            {"pixels_fitted", m.surface_fit->replaced}};
+    mj["row_drift"] = nullptr;
+    if (m.row_drift.read)
+      mj["row_drift"] = {{"row_offset_px", m.row_drift.row_offset_px},
+                         {"standard_error_px", m.row_drift.standard_error_px},
+                         {"components", m.row_drift.components},
+                         {"pixels", m.row_drift.pixels},
+                         {"warned", m.row_drift.warned}};
     j["modules"].push_back(mj);
     lit += m.lit_pixels;
     filled += m.lit_filled;

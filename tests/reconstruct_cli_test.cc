@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -1624,6 +1625,77 @@ TEST_F(ReconstructCli, AOneRowVernierWindowIsRefused) {
                          "one_row.yaml: match.line_index_window_half_height_px: must be in [1, 30] (3 to 61 rows): "
                          "the vernier fits a row offset between the views, which a window of one row (0) cannot read");
   ExpectNoOutput();
+}
+
+}  // namespace
+}  // namespace stereorig
+
+namespace stereorig {
+namespace {
+
+// A camera turned since calibration: module 0's right camera turned about
+// its x axis by an angle that moves its rows 0.12 px (fx * angle), written
+// as a rig file that still says where it was. The capture is the sphere
+// rendered with the true rig. Rectifying with the old pose, the right view's
+// rows come out fx * angle lower: the vernier reads +0.12 px (-0.12 turned
+// back). Below the ~0.18 px where the line index goes a period off, so the
+// points stay on their lines: a warning, exit 0. Tolerance on the reading:
+// 3 standard errors of the difference (the report's own) plus the vernier's
+// cubic sawtooth, 0.02 px (row_drift_test.cc).
+TEST_F(ReconstructCli, ACameraTurnedSinceCalibrationIsWarnedOfByItsRowDrift) {
+  auto drift_of = [&](const std::string& rig_path, testing::Result* r) {
+    *r = testing::RunCli("reconstruct --rig " + rig_path + " --capture " + dir_ + "/capture --out " + dir_ +
+                         "/out.ply --report " + dir_ + "/out.json");
+    std::ifstream f(dir_ + "/out.json");
+    return nlohmann::json::parse(f)["modules"];
+  };
+  testing::Result r;
+  const nlohmann::json right = drift_of(dir_ + "/rig.yaml", &r);
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const auto& m : right) {
+    ASSERT_TRUE(m["row_drift"].is_object()) << m.dump();
+    EXPECT_GE(m["row_drift"]["components"].get<int>(), 1) << m.dump();
+    EXPECT_FALSE(m["row_drift"]["warned"].get<bool>()) << m.dump();
+  }
+  EXPECT_EQ(r.out.find("rectified rows read"), std::string::npos) << r.out;
+
+  const SimulatedRig sim = MakeDefaultRig();
+  const int right_camera = sim.rig.module(0).right_camera;
+  const double turn_rad = 0.12 / sim.rig.camera(right_camera).fx();
+  double reading[2], se[2];
+  for (int k = 0; k < 2; ++k) {
+    const double sign = k == 0 ? 1 : -1;
+    std::vector<StereoModule> modules = sim.rig.modules();
+    const Pose turn = Pose::FromRotationVector(Eigen::Vector3d(sign * turn_rad, 0, 0), Eigen::Vector3d::Zero());
+    modules[0].right_from_left = turn * modules[0].right_from_left;
+    const Rig turned(sim.rig.cameras(), sim.rig.camera_names(), modules, sim.rig.S(), "test");
+    const std::string path = dir_ + "/turned" + std::to_string(k) + ".yaml";
+    WriteRigFile(turned, path);
+    const nlohmann::json modules_json = drift_of(path, &r);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const nlohmann::json& drift = modules_json[0]["row_drift"];
+    ASSERT_TRUE(drift.is_object()) << modules_json.dump();
+    EXPECT_TRUE(drift["warned"].get<bool>()) << drift.dump();
+    reading[k] = drift["row_offset_px"].get<double>() - right[0]["row_drift"]["row_offset_px"].get<double>();
+    se[k] =
+        std::hypot(drift["standard_error_px"].get<double>(), right[0]["row_drift"]["standard_error_px"].get<double>());
+    EXPECT_NE(r.out.find("\n  warning: its rectified rows read " + std::string(sign > 0 ? "+" : "-")),
+              std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("run `stereorig check` on the rig"), std::string::npos) << r.out;
+    EXPECT_FALSE(modules_json[1]["row_drift"]["warned"].get<bool>()) << modules_json.dump();  // not turned
+  }
+  std::printf("turned +-0.12 px: read %+.4f (se %.4f), %+.4f (se %.4f) px over the true rig's\n", reading[0], se[0],
+              reading[1], se[1]);
+  EXPECT_NEAR(reading[0], 0.12, 3 * se[0] + 0.02);
+  EXPECT_NEAR(reading[1], -0.12, 3 * se[1] + 0.02);
+
+  // A batch (what a line runs) says it in a line naming the module.
+  r = testing::RunCli("reconstruct --rig " + dir_ + "/turned0.yaml --capture " + dir_ + "/capture --out-dir " + dir_ +
+                      "/batch_turned");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\n  warning: module 0's rectified rows read +"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("warning: module 1's rectified rows"), std::string::npos) << r.out;
 }
 
 }  // namespace
