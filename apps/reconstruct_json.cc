@@ -32,6 +32,11 @@ nlohmann::json ReconstructionJson(const Reconstruction& rec) {
       mj["surface_fit"] = {{"window_px", {2 * m.surface_fit->half_width_px + 1, 2 * m.surface_fit->half_height_px + 1}},
                            {"median_misfit_px", m.surface_fit->median_misfit_px},
                            {"pixels_fitted", m.surface_fit->replaced}};
+    // Counted only where they tell why a module is empty (ModuleReport):
+    // the left image's whole grid-lit area when none lies in the volume's
+    // ROI, the right image's when the module kept no point.
+    if (m.camera_lit_pixels >= 0) mj["left_camera_lit_pixels"] = m.camera_lit_pixels;
+    if (m.right_camera_lit_pixels >= 0) mj["right_camera_lit_pixels"] = m.right_camera_lit_pixels;
     mj["row_drift"] = nullptr;
     if (m.row_drift.read)
       mj["row_drift"] = {{"row_offset_px", m.row_drift.row_offset_px},

@@ -379,6 +379,12 @@ TEST_F(ReconstructCli, AModuleWithNoLitPixelInTheVolumeSaysWhy) {
       const std::string summary = r.out.substr(at, next == std::string::npos ? std::string::npos : next - at);
       EXPECT_TRUE(std::regex_search(summary, says)) << args << ":\n" << summary;
     }
+    // The report holds the count the line reads: > 0 beside the object, 0 dark or flat.
+    std::ifstream f(dir_ + "/out.json");
+    for (const nlohmann::json& m : nlohmann::json::parse(f)["modules"]) {
+      ASSERT_TRUE(m.contains("left_camera_lit_pixels")) << m.dump();
+      EXPECT_EQ(m["left_camera_lit_pixels"].get<int>() > 0, args.find("beside") != std::string::npos) << m.dump();
+    }
   }
 }
 
@@ -1563,6 +1569,12 @@ TEST_F(ReconstructCli, ADarkRightImageIsNamedNotTheVolume) {
   EXPECT_NE(r.err.find("stereorig reconstruct: warning: module 0 gave no point: " + says.substr(10)), std::string::npos)
       << r.err;
   EXPECT_EQ(r.out.find("module 1: 0 points"), std::string::npos) << r.out;  // module 1's cameras are lit
+  // The report says it too: a line reading only the JSON must not blame the volume.
+  std::ifstream f(dir_ + "/out.json");
+  const nlohmann::json modules = nlohmann::json::parse(f)["modules"];
+  EXPECT_EQ(modules[0]["right_camera_lit_pixels"], 0) << modules[0].dump();
+  EXPECT_FALSE(modules[0].contains("left_camera_lit_pixels")) << modules[0].dump();   // lit in the volume's ROI
+  EXPECT_FALSE(modules[1].contains("right_camera_lit_pixels")) << modules[1].dump();  // it kept points
 }
 
 // Images too small for the matcher's coarse level (1 px high; narrower than
