@@ -129,6 +129,7 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
   summary["runtime_build_ms"] = build_ms;
   summary["captures"] = nlohmann::json::array();
   int failed = 0, without_points = 0;
+  RowDriftWatch row_drift(runtime.options().match.line_index.max_row_offset_px);
   const auto t_all = Clock::now();
   for (size_t i = 0; i < dirs.size(); ++i) {
     const auto t = Clock::now();
@@ -144,7 +145,8 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
     if (i + 1 < dirs.size()) next = std::async(std::launch::async, load, dirs[i + 1]);
     if (error.empty()) {
       try {
-        const nlohmann::json entry = ReconstructCapture(runtime, images, dirs[i], names[i], outputs[i], progress, t);
+        const nlohmann::json entry =
+            ReconstructCapture(runtime, images, dirs[i], names[i], outputs[i], progress, t, &row_drift);
         without_points += !entry["modules_without_points"].empty();
         summary["captures"].push_back(entry);
         continue;

@@ -97,9 +97,10 @@ nlohmann::json WarnOfModulesWithoutPoints(const Reconstruction& rec, const std::
 
 nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::Mat>& images, const std::string& dir,
                                   const std::string& name, const CaptureOutputs& outputs, const std::string& progress,
-                                  std::chrono::steady_clock::time_point started) {
+                                  std::chrono::steady_clock::time_point started, RowDriftWatch* row_drift) {
   const bool mesh = !outputs.mesh.empty();
   const Reconstruction rec = runtime.Process(images, mesh);
+  const std::vector<RowDrift> recent_drift = row_drift->Add(rec.modules);
   // All or none: written beside their paths, then renamed in together, so a
   // failure (a full disk) or a signal while they are written leaves none of
   // them new beside an earlier run's others.
@@ -141,17 +142,24 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
   }
   // The one-capture summary's warning (module_summary.h), in a line per
   // module: a batch or a stream is what a line runs.
-  for (const ModuleReport& m : rec.modules) {
+  entry["modules_with_row_drift"] = nlohmann::json::array();
+  for (size_t k = 0; k < rec.modules.size(); ++k) {
+    const ModuleReport& m = rec.modules[k];
     const std::string which = RangeEndsWarnedOf(m);
     if (!which.empty())
       std::printf(
           "  warning: module %d's matches reach %s of the measurement volume's disparity range (%s: "
           "range_end_reached): its points may lie where nothing is; check the volume\n",
           m.module, which.c_str(), outputs.report.c_str());
-    if (m.row_drift.warned)
+    const RowDrift& drift = recent_drift[k];
+    if (drift.warned) {
       std::printf(
-          "  warning: module %d's rectified rows read %+.3f px off at the laser grid's vernier (%s: row_drift): %s\n",
-          m.module, m.row_drift.row_offset_px, outputs.report.c_str(), kRowDriftAdvice);
+          "  warning: module %d's rectified rows read %+.3f px off at the laser grid's vernier, the mean of its last "
+          "%d capture%s (standard error %.3f; this one's in %s: row_drift): %s\n",
+          m.module, drift.row_offset_px, drift.captures, drift.captures == 1 ? "" : "s", drift.standard_error_px,
+          outputs.report.c_str(), kRowDriftAdvice);
+      entry["modules_with_row_drift"].push_back(m.module);
+    }
   }
   entry["modules_without_points"] = WarnOfModulesWithoutPoints(rec, dir, outputs, progress);
   FlushStdout();

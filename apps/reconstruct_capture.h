@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/row_drift_watch.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/rig.h"
 #include "reconstruct/runtime.h"
@@ -66,16 +67,18 @@ std::vector<cv::Mat> LoadCaptureOrInputError(const std::string& dir, const Rig& 
 // could not be removed ("  warning: <path> (an earlier run's) could not be
 // removed: <why>", also on stderr; the entry's left_behind), then a warning
 // line per module whose matches reach an end of the volume's disparity
-// range (module_summary.h RangeEndsWarnedOf), and one per module that gave
+// range (module_summary.h RangeEndsWarnedOf), one per module whose rows read
+// off over the run's recent captures (`row_drift`: the mean of its last
+// readings, RowDriftWatch, to which this capture's are added), and one per module that gave
 // no point ("  warning: module M gave no point (<report>): <why>",
 // module_summary.h NoPointReason; also on stderr, "stereorig reconstruct:
 // <progress> <dir>: warning: ..."). Returns the capture's entry of the run's
 // summary (capture, name, ok, cloud, mesh, report, points, point_cloud_ms,
-// wall_ms, modules_without_points). Throws InputError if an output cannot be written
+// wall_ms, modules_without_points, modules_with_row_drift). Throws InputError if an output cannot be written
 // (the writers', atomic_file.h); the caller then calls FailedCapture.
 nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::Mat>& images, const std::string& dir,
                                   const std::string& name, const CaptureOutputs& outputs, const std::string& progress,
-                                  std::chrono::steady_clock::time_point started);
+                                  std::chrono::steady_clock::time_point started, RowDriftWatch* row_drift);
 
 // A capture that failed (bad images, outputs that could not be written, a
 // name already used): it has no output, not a partial one nor a stale one

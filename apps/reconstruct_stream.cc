@@ -159,6 +159,7 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
   if (!request.warm_up_dir.empty()) summary["warm_up_ms"] = warm_up_ms;
   summary["failed_captures"] = nlohmann::json::array();  // the first kMaxFailuresListed
   int total = 0, failed = 0, without_points = 0;
+  RowDriftWatch row_drift(runtime.options().match.line_index.max_row_offset_px);
   std::string output_error;  // why stdout lost a capture's line: the stream stops
   const auto t_all = Clock::now();
   std::string line;
@@ -191,7 +192,8 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
       CheckCaptureFiles(dir, rig);
       const std::vector<cv::Mat> images = LoadCaptureOrInputError(dir, rig);
       without_points +=
-          !ReconstructCapture(runtime, images, dir, name, outputs, progress, t)["modules_without_points"].empty();
+          !ReconstructCapture(runtime, images, dir, name, outputs, progress, t, &row_drift)["modules_without_points"]
+               .empty();
       if (StdoutLost(&output_error)) break;
       continue;
     } catch (const InputError& e) {  // the capture's files, images or outputs

@@ -31,12 +31,31 @@ RowDrift ReadRowDrift(std::span<const VernierReading> readings) {
   }
   drift.read = true;
   drift.components = int(sorted.size());
+  drift.captures = 1;
   return drift;
+}
+
+RowDrift MeanRowDrift(std::span<const RowDrift> drifts) {
+  RowDrift mean;
+  double sum = 0, sum_var = 0;
+  for (const RowDrift& d : drifts) {
+    if (!d.read) continue;
+    sum += d.row_offset_px;
+    sum_var += d.standard_error_px * d.standard_error_px;
+    mean.components += d.components;
+    mean.pixels += d.pixels;
+    ++mean.captures;
+  }
+  if (mean.captures == 0) return RowDrift{};
+  mean.read = true;
+  mean.row_offset_px = sum / mean.captures;
+  mean.standard_error_px = std::sqrt(sum_var) / mean.captures;
+  return mean;
 }
 
 bool RowDriftWarned(const RowDrift& drift, double max_row_offset_px) {
   const double off = std::abs(drift.row_offset_px);
-  return drift.read && off > 0.75 * max_row_offset_px && off > 3 * drift.standard_error_px;
+  return drift.read && off > max_row_offset_px && off > 4 * drift.standard_error_px;
 }
 
 }  // namespace stereorig

@@ -24,9 +24,10 @@ namespace stereorig {
 
 struct RowDrift {
   bool read = false;               // some component gave a reading
-  double row_offset_px = 0;        // the pixel-weighted median reading
+  double row_offset_px = 0;        // the pixel-weighted median reading (MeanRowDrift: the readings' mean)
   double standard_error_px = 0;    // that reading's own standard error
   int components = 0, pixels = 0;  // the readings it is over
+  int captures = 0;                // the captures it is over: 1, or MeanRowDrift's count
   bool warned = false;             // RowDriftWarned, as the runtime's options set it
 };
 
@@ -35,11 +36,20 @@ struct RowDrift {
 // surface decides, a few small wrong components do not.
 RowDrift ReadRowDrift(std::span<const VernierReading> readings);
 
-// Whether a module's rows read off enough to warn of: beyond 3/4 of the
-// offset the line index keeps a component within (max_row_offset_px) and
-// beyond 3 of the reading's standard errors. On the demo's five scenes with
-// the calibrated rig every module reads within 0.046 px (standard errors
-// 0.017-0.034); turned by 0.1 px every turned module reads 0.086-0.144 px.
+// The mean of several captures' drifts (those read), with the standard
+// error of that mean: a line's recent captures, where a drift persists and
+// a capture's noise does not. Not read when none is.
+RowDrift MeanRowDrift(std::span<const RowDrift> drifts);
+
+// Whether a module's rows read off enough to warn of: beyond the offset the
+// line index keeps a component within (max_row_offset_px, 0.1 px) and
+// beyond 4 of the reading's standard errors. A calibrated module's reading
+// scatters with its standard error (0.017-0.034 px on the demo's five
+// scenes, 0.013-0.054 at speckle 0.4) about a small offset of its
+// calibration's (about -0.02 px for the demo rig's module 1 over 15
+// scenes): a capture of noise alone passes 0.1 px and 4 standard errors
+// less than once in 1 000 (3.2 sigma at 0.025 px). Turned by 0.1 px, the
+// demo's modules read 0.086-0.144 px, by 0.15 px 0.138 (the cup).
 bool RowDriftWarned(const RowDrift& drift, double max_row_offset_px);
 
 }  // namespace stereorig

@@ -38,18 +38,36 @@ TEST(RowDrift, IsTheReadingHoldingTheMiddlePixel) {
   EXPECT_FALSE(ReadRowDrift(std::vector{empty}).read);
 }
 
-TEST(RowDrift, IsWarnedBeyondThreeQuartersOfTheKeptOffsetAndThreeStandardErrors) {
+TEST(RowDrift, IsWarnedBeyondTheKeptOffsetAndFourStandardErrors) {
   RowDrift d;
   d.read = true;
   d.standard_error_px = 0.02;
-  d.row_offset_px = 0.074;
+  d.row_offset_px = 0.099;
   EXPECT_FALSE(RowDriftWarned(d, 0.1));
-  d.row_offset_px = -0.076;
+  d.row_offset_px = -0.101;
   EXPECT_TRUE(RowDriftWarned(d, 0.1));
-  d.standard_error_px = 0.03;  // 3 standard errors = 0.09
+  d.standard_error_px = 0.03;  // 4 standard errors = 0.12
   EXPECT_FALSE(RowDriftWarned(d, 0.1));
   d.row_offset_px = 0.2, d.read = false;
   EXPECT_FALSE(RowDriftWarned(d, 0.1));
+}
+
+// The mean of several captures' readings, with the standard error of the
+// mean; those not read count for nothing.
+TEST(RowDrift, TheMeanOfCapturesHasTheStandardErrorOfAMean) {
+  std::vector<RowDrift> drifts(4);
+  const double offsets[] = {0.1, 0.2, 0.3, 9.0};
+  for (int k = 0; k < 4; ++k) {
+    drifts[size_t(k)] = RowDrift{k < 3, offsets[k], 0.03, 2, 100, 1, false};
+  }
+  const RowDrift mean = MeanRowDrift(drifts);
+  EXPECT_TRUE(mean.read);
+  EXPECT_NEAR(mean.row_offset_px, 0.2, 1e-15);
+  EXPECT_NEAR(mean.standard_error_px, 0.03 / std::sqrt(3.0), 1e-15);
+  EXPECT_EQ(mean.captures, 3);
+  EXPECT_EQ(mean.components, 6);
+  EXPECT_EQ(mean.pixels, 300);
+  EXPECT_FALSE(MeanRowDrift(std::vector<RowDrift>(2)).read);
 }
 
 // A fronto-parallel plane at 40 px, grid period 8 px turned 2.6 deg: one

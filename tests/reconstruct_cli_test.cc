@@ -1702,11 +1702,27 @@ TEST_F(ReconstructCli, ACameraTurnedSinceCalibrationIsWarnedOfByItsRowDrift) {
   EXPECT_NEAR(reading[0], 0.12, 3 * se[0] + 0.02);
   EXPECT_NEAR(reading[1], -0.12, 3 * se[1] + 0.02);
 
-  // A batch (what a line runs) says it in a line naming the module.
-  r = testing::RunCli("reconstruct --rig " + dir_ + "/turned0.yaml --capture " + dir_ + "/capture --out-dir " + dir_ +
-                      "/batch_turned");
+  // A batch (what a line runs) says it in a line naming the module, from the
+  // mean of the module's readings over its last captures (three copies of
+  // the capture here: the same reading thrice), and lists it in the capture's
+  // entry of the summary.
+  std::vector<std::string> copies;
+  for (const char* name : {"/turned_a", "/turned_b", "/turned_c"}) {
+    std::filesystem::remove_all(dir_ + name);
+    std::filesystem::copy(dir_ + "/capture", dir_ + name);
+    copies.push_back(dir_ + name);
+  }
+  r = testing::RunCli("reconstruct --rig " + dir_ + "/turned0.yaml --capture " + copies[0] + " " + copies[1] + " " +
+                      copies[2] + " --out-dir " + dir_ + "/batch_turned --report " + dir_ + "/batch_turned.json");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("\n  warning: module 0's rectified rows read +"), std::string::npos) << r.out;
+  for (const std::string last : {"1 capture", "2 captures", "3 captures"})
+    EXPECT_NE(r.out.find("the mean of its last " + last + " (standard error "), std::string::npos) << r.out;
+  std::ifstream summary_file(dir_ + "/batch_turned.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  ASSERT_EQ(summary["captures"].size(), 3u) << summary.dump();
+  for (const auto& c : summary["captures"])
+    EXPECT_EQ(c["modules_with_row_drift"], nlohmann::json::array({0})) << c.dump();
   EXPECT_EQ(r.out.find("warning: module 1's rectified rows"), std::string::npos) << r.out;
 }
 

@@ -658,3 +658,36 @@ TEST_F(ReconstructStreamCli, AnOutputMadeAfterTheCheckIsNotReplaced) {
 
 }  // namespace
 }  // namespace stereorig
+
+namespace stereorig {
+namespace {
+
+// A stream keeps each module's recent row-drift readings across its
+// captures (apps/row_drift_watch.h): module 0's right camera turned 0.12 px
+// of rows since the rig file, two captures, a warning on each that says
+// over how many captures its mean is.
+TEST_F(ReconstructStreamCli, ARowDriftIsJudgedOverTheStreamsRecentCaptures) {
+  const SimulatedRig sim = MakeDefaultRig();
+  std::vector<StereoModule> modules = sim.rig.modules();
+  const double turn_rad = 0.12 / sim.rig.camera(modules[0].right_camera).fx();
+  modules[0].right_from_left =
+      Pose::FromRotationVector(Eigen::Vector3d(turn_rad, 0, 0), Eigen::Vector3d::Zero()) * modules[0].right_from_left;
+  WriteRigFile(Rig(sim.rig.cameras(), sim.rig.camera_names(), modules, sim.rig.S(), "test"), dir_ + "/turned.yaml");
+  const std::string out = dir_ + "/turned_out", list = dir_ + "/turned.txt";
+  fs::remove_all(out);
+  WriteFileAtomically(list, dir_ + "/line/0001\n" + dir_ + "/line/0002\n");
+  const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/turned.yaml --capture - --out-dir " + out +
+                                            " --report " + out + "/summary.json < " + list);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const size_t first = r.out.find("the mean of its last 1 capture (standard error ");
+  const size_t second = r.out.find("the mean of its last 2 captures (standard error ");
+  ASSERT_NE(first, std::string::npos) << r.out;
+  ASSERT_NE(second, std::string::npos) << r.out;
+  EXPECT_LT(r.out.find("[1] "), first);
+  EXPECT_LT(r.out.find("[2] "), second);
+  EXPECT_LT(first, r.out.find("[2] "));
+  EXPECT_EQ(r.out.find("module 1's rectified rows"), std::string::npos) << r.out;
+}
+
+}  // namespace
+}  // namespace stereorig
