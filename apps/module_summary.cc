@@ -129,15 +129,6 @@ std::string RangeEndWarning(const ModuleReport& m) {
          kSetTheVolume;
 }
 
-// ", rows read +0.011 px": every run shows its module's row drift (a health
-// figure for commissioning and for the line, row_drift.h); "" when not read.
-std::string RowsRead(const ModuleReport& m) {
-  if (!m.row_drift.read) return "";
-  char buf[40];
-  std::snprintf(buf, sizeof buf, ", rows read %+.3f px", m.row_drift.row_offset_px);
-  return buf;
-}
-
 // A module whose rows read off at the grid's vernier (row_drift.h).
 std::string RowDriftWarning(const ModuleReport& m) {
   if (!m.row_drift.warned) return "";
@@ -161,11 +152,11 @@ std::string ModuleSummary(const ModuleReport& m, FillWording wording, int max_re
   char buf[384];
   std::snprintf(
       buf, sizeof buf,
-      "module %d: %d points, fill %.1f%% of %d %s px%s, match %.1f ms%s\n"
+      "module %d: %d points, fill %.1f%% of %d %s px%s, match %.1f ms\n"
       "  searched d [%d, %d) of [%d, %d) px; lit px without a point: ",
       m.module, m.points, 100 * m.fill_rate(), m.lit_pixels, wording.passive ? "lit" : "grid-lit",
       wording.say_whose ? " (the runtime's own estimate; `stereorig score` measures fill against the truth)" : "",
-      match == m.times_ms.end() ? 0.0 : match->second, RowsRead(m).c_str(), m.searched_min_disparity_px,
+      match == m.times_ms.end() ? 0.0 : match->second, m.searched_min_disparity_px,
       m.searched_min_disparity_px + m.searched_num_disparities, m.min_disparity_px,
       m.min_disparity_px + m.num_disparities);
   const std::string losses = LossLine(m.lit_by_status, m.lit_pixels, std::max(1, max_reasons));

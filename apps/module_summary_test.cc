@@ -183,33 +183,3 @@ TEST(ModuleSummary, ADarkRightImageIsNamedNotTheVolume) {
 
 }  // namespace
 }  // namespace stereorig
-
-namespace stereorig {
-namespace {
-
-// Every run shows each module's row drift on its first line (a health
-// figure); past the line index's tolerance and 4 standard errors a warning
-// line says what it means and to run the check; not read (passive), neither.
-TEST(ModuleSummary, ShowsTheRowDriftAndWarnsPastTheTolerance) {
-  ModuleReport m = Report();
-  m.points = m.lit_filled = 1000;
-  m.lit_by_status[size_t(PixelStatus::kPoint)] = 1000;
-  EXPECT_EQ(ModuleSummary(m).find("rows read"), std::string::npos);
-  m.row_drift = RowDrift{true, 0.0114, 0.024, 2, 120000, 1, false};
-  std::string s = ModuleSummary(m);
-  EXPECT_EQ(s.substr(0, s.find('\n')),
-            "module 1: 1000 points, fill 100.0% of 1000 grid-lit px, match 82.8 ms, rows "
-            "read +0.011 px");
-  EXPECT_EQ(s.find("warning"), std::string::npos) << s;
-  m.row_drift = RowDrift{true, -0.133, 0.020, 3, 110000, 1, true};
-  s = ModuleSummary(m);
-  EXPECT_NE(s.find(", rows read -0.133 px\n"), std::string::npos) << s;
-  EXPECT_NE(s.find("\n  warning: its rectified rows read -0.133 px (standard error 0.020, 3 components) off at the "
-                   "laser grid's vernier (row_drift): a well calibrated module reads within about +-0.05 px;"),
-            std::string::npos)
-      << s;
-  EXPECT_NE(s.find("run `stereorig check` on the rig"), std::string::npos) << s;
-}
-
-}  // namespace
-}  // namespace stereorig
