@@ -55,8 +55,15 @@ std::string AdviceFor(PixelStatus status) {
     case PixelStatus::kSeenThroughSurface:
       return "the free-space test found other modules' surfaces in front of them: check the modules' poses in the "
              "rig file (`stereorig check`), or set free_space_test: false to see what it removed";
-    case PixelStatus::kNotDistinct:
     case PixelStatus::kWrongLine:
+      // A module whose rows drifted past ~0.18 px loses most of its pixels
+      // so (docs/reconstruct.md, "Row drift": 0.2 px of rows the other way
+      // left the demo cup's module 0 at 1 % fill, 78 % wrong_line).
+      return std::string(
+                 "the line index could not tell which laser line they are on: the rig's rows may be off (a "
+                 "camera turned since calibration: run `stereorig check`), or ") +
+             kPassiveOptions + "; with the grid, its period may not be the options' (`stereorig tune`)";
+    case PixelStatus::kNotDistinct:
     case PixelStatus::kNoGridLine:
       return std::string("the laser grid's own tests refused their matches: ") + kPassiveOptions +
              "; with the grid, its period may not be the options' (`stereorig tune`)";

@@ -64,9 +64,11 @@ std::string RangeEndsWarnedOf(const ModuleReport& m);
 // What a module whose rows read off (RowDrift::warned) means and what to do:
 // ModuleSummary's warning line and a batch's per-module line end with it.
 inline constexpr const char* kRowDriftAdvice =
-    "a well calibrated module reads within about +-0.05 px; a camera turned or shifted since calibration (0.011 "
-    "deg is 0.2 px of rows at f ~1000 px) or a capture that is not this module's (cables swapped) reads more, and "
-    "from ~0.18 px the line index puts whole surfaces one grid period (~3.5 mm at 200 mm) off with no fill lost; "
-    "run `stereorig check` on the rig (docs/reconstruct.md, \"Row drift\")";
+    "a well calibrated module reads within about +-0.05 px; a camera turned or shifted since calibration reads more "
+    "(0.011 deg is 0.2 px of rows at f ~1000 px), and from ~0.15-0.2 px the line index puts whole surfaces one grid "
+    "period (~3.5 mm at 200 mm) off, often with the fill still high, or drops most of the module. Treat this "
+    "module's points as suspect until the rig is checked: capture the calibration board as for a nightly check (8 or "
+    "more views) and run `stereorig check --rig RIG --captures DIR --target BOARD`, recalibrating if it says so; "
+    "`stereorig verify` on a reference artifact shows whether points are off (docs/reconstruct.md, \"Row drift\")";
 
 }  // namespace stereorig

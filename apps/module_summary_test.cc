@@ -183,3 +183,25 @@ TEST(ModuleSummary, ADarkRightImageIsNamedNotTheVolume) {
 
 }  // namespace
 }  // namespace stereorig
+
+namespace stereorig {
+namespace {
+
+// A module whose lit pixels mostly ended wrong_line (the line index could
+// not tell the lines apart: 0.2 px of rows off left the demo cup's module 0
+// at 1 % fill, 78 % wrong_line) is told the rig's rows may be off and to run
+// the check, besides the grid's own options.
+TEST(ModuleSummary, NoPointMostlyWrongLineNamesTheRowsAndTheCheck) {
+  ModuleReport m = Report();
+  m.points = m.lit_filled = 0;
+  m.lit_by_status[size_t(PixelStatus::kWrongLine)] = 780;
+  m.lit_by_status[size_t(PixelStatus::kNoSgmMatch)] = 220;
+  const std::string s = ModuleSummary(m);
+  EXPECT_NE(s.find("\n  no point: wrong_line 78.0% of the lit pixels: the line index could not tell which laser line "
+                   "they are on: the rig's rows may be off (a camera turned since calibration: run `stereorig check`)"),
+            std::string::npos)
+      << s;
+}
+
+}  // namespace
+}  // namespace stereorig

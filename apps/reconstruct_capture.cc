@@ -100,7 +100,7 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
                                   std::chrono::steady_clock::time_point started, RowDriftWatch* row_drift) {
   const bool mesh = !outputs.mesh.empty();
   const Reconstruction rec = runtime.Process(images, mesh);
-  const std::vector<RowDrift> recent_drift = row_drift->Add(rec.modules);
+  const std::vector<WatchedRowDrift> recent_drift = row_drift->Add(rec.modules);
   // All or none: written beside their paths, then renamed in together, so a
   // failure (a full disk) or a signal while they are written leaves none of
   // them new beside an earlier run's others.
@@ -151,13 +151,14 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
           "  warning: module %d's matches reach %s of the measurement volume's disparity range (%s: "
           "range_end_reached): its points may lie where nothing is; check the volume\n",
           m.module, which.c_str(), outputs.report.c_str());
-    const RowDrift& drift = recent_drift[k];
+    const WatchedRowDrift& drift = recent_drift[k];
     if (drift.warned) {
       std::printf(
-          "  warning: module %d's rectified rows read %+.3f px off at the laser grid's vernier, the mean of its last "
-          "%d capture%s (standard error %.3f; this one's in %s: row_drift): %s\n",
-          m.module, drift.row_offset_px, drift.captures, drift.captures == 1 ? "" : "s", drift.standard_error_px,
-          outputs.report.c_str(), kRowDriftAdvice);
+          "  warning: module %d's rectified rows read %.3f px off at the laser grid's vernier, the mean size of its "
+          "last %d capture%s readings (standard error %.3f; this capture's in %s: row_drift); warned since this "
+          "run's capture %d, and it stays: past ~0.2 px a module reads small again, a whole grid period off: %s\n",
+          m.module, drift.recent.row_offset_px, drift.recent.captures, drift.recent.captures == 1 ? "'s" : "s'",
+          drift.recent.standard_error_px, outputs.report.c_str(), drift.warned_since, kRowDriftAdvice);
       entry["modules_with_row_drift"].push_back(m.module);
     }
   }

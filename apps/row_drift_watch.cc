@@ -1,23 +1,31 @@
 #include "apps/row_drift_watch.h"
 
+#include <cmath>
 #include <vector>
 
 namespace stereorig {
 
-std::vector<RowDrift> RowDriftWatch::Add(const std::vector<ModuleReport>& modules) {
-  std::vector<RowDrift> means;
+std::vector<WatchedRowDrift> RowDriftWatch::Add(const std::vector<ModuleReport>& modules) {
+  ++captures_;
+  std::vector<WatchedRowDrift> states;
   for (const ModuleReport& m : modules) {
     std::deque<RowDrift>& recent = recent_[m.module];
     if (m.row_drift.read) {
-      recent.push_back(m.row_drift);
+      RowDrift size = m.row_drift;
+      size.row_offset_px = std::abs(size.row_offset_px);
+      recent.push_back(size);
       if (int(recent.size()) > kCaptures) recent.pop_front();
     }
-    const std::vector<RowDrift> window(recent.begin(), recent.end());
-    RowDrift mean = MeanRowDrift(window);
-    mean.warned = RowDriftWarned(mean, max_row_offset_px_);
-    means.push_back(mean);
+    WatchedRowDrift state;
+    state.recent = MeanRowDrift(std::vector<RowDrift>(recent.begin(), recent.end()));
+    state.recent.warned = RowDriftWarned(state.recent, max_row_offset_px_);
+    int& since = warned_since_[m.module];
+    if (state.recent.warned && since == 0) since = captures_;
+    state.warned = since > 0;
+    state.warned_since = since;
+    states.push_back(state);
   }
-  return means;
+  return states;
 }
 
 }  // namespace stereorig

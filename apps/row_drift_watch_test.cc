@@ -23,42 +23,73 @@ std::vector<ModuleReport> Capture(double module0_px, double module1_px, double s
 
 // A calibrated module's readings scatter with their standard error about a
 // small offset of its calibration's: here -0.02 px, +-0.05 px (2 standard
-// errors) in turn, and once -0.09 (3.6 standard errors, a capture's noise).
-// Its mean over the last 20 stays near -0.02: never warned.
+// errors) in turn, and once -0.09 (2.8 standard errors about -0.02, a
+// capture's noise). The mean size of the last 20 stays near 0.05: never
+// warned.
 TEST(RowDriftWatch, NoiseAboutACalibrationOffsetIsNeverWarned) {
   RowDriftWatch watch(0.1);
+  std::vector<double> sizes;
   for (int i = 0; i < 60; ++i) {
-    const double noise = i == 30 ? -0.07 : (i % 2 ? 0.05 : -0.05);
-    const std::vector<RowDrift> means = watch.Add(Capture(-0.02 + noise, 0.0));
-    ASSERT_EQ(means.size(), 2u);
-    EXPECT_FALSE(means[0].warned) << i;
-    EXPECT_TRUE(means[0].read);
-    EXPECT_EQ(means[0].captures, std::min(i + 1, RowDriftWatch::kCaptures));
+    const double reading = -0.02 + (i == 30 ? -0.07 : (i % 2 ? 0.05 : -0.05));
+    sizes.push_back(std::abs(reading));
+    const std::vector<WatchedRowDrift> states = watch.Add(Capture(reading, 0.0));
+    ASSERT_EQ(states.size(), 2u);
+    EXPECT_FALSE(states[0].warned) << i;
+    EXPECT_TRUE(states[0].recent.read);
+    // The mean size of the last 20 (or fewer, at the start): 0.03 and 0.07 in turn, once 0.09.
+    const size_t n = std::min<size_t>(sizes.size(), RowDriftWatch::kCaptures);
+    double sum = 0;
+    for (size_t k = sizes.size() - n; k < sizes.size(); ++k) sum += sizes[k];
+    EXPECT_EQ(states[0].recent.captures, int(n));
+    EXPECT_NEAR(states[0].recent.row_offset_px, sum / double(n), 1e-12) << i;
   }
 }
 
-// A module turned 0.15 px at capture 20 (its readings then 0.15, each with
-// a standard error of 0.025): the mean of the last 20 passes 0.1 px once 14
-// of them are turned (14 x 0.15 / 20 = 0.105; its standard error 0.025 /
-// sqrt(20) = 0.0056); the other module is never warned. Turned back, the
-// warning ends when fewer than 14 of the last 20 are turned.
-TEST(RowDriftWatch, APersistentDriftIsWarnedOnceTheMeanOfTheLastCapturesPassesTheTolerance) {
+// A module turned 0.15 px at capture 21 (its readings then 0.15, each with
+// a standard error of 0.025): the mean size of the last 20 passes 0.1 px
+// once 14 of them are turned (14 x 0.15 / 20 = 0.105; its standard error
+// 0.025 / sqrt(20) = 0.0056), at capture 34; the other module is never
+// warned. Turned back, the warning stays: a module past ~0.2 px reads small.
+TEST(RowDriftWatch, APersistentDriftIsWarnedOnceTheMeanOfTheLastCapturesPassesTheToleranceAndStays) {
   RowDriftWatch watch(0.1);
   for (int i = 0; i < 20; ++i) watch.Add(Capture(0.0, 0.0));
   for (int k = 1; k <= 20; ++k) {
-    const std::vector<RowDrift> means = watch.Add(Capture(0.15, 0.0));
-    EXPECT_EQ(means[0].warned, k >= 14) << k;
-    EXPECT_NEAR(means[0].row_offset_px, k * 0.15 / 20, 1e-12);
-    EXPECT_NEAR(means[0].standard_error_px, 0.025 / std::sqrt(20.0), 1e-12);
-    EXPECT_FALSE(means[1].warned);
+    const std::vector<WatchedRowDrift> states = watch.Add(Capture(0.15, 0.0));
+    EXPECT_EQ(states[0].warned, k >= 14) << k;
+    EXPECT_EQ(states[0].warned_since, k >= 14 ? 34 : 0) << k;
+    EXPECT_NEAR(states[0].recent.row_offset_px, k * 0.15 / 20, 1e-12);
+    EXPECT_NEAR(states[0].recent.standard_error_px, 0.025 / std::sqrt(20.0), 1e-12);
+    EXPECT_FALSE(states[1].warned);
   }
-  for (int k = 1; k <= 10; ++k) EXPECT_EQ(watch.Add(Capture(0.0, 0.0))[0].warned, k <= 6) << k;
+  for (int k = 1; k <= 30; ++k) {
+    const WatchedRowDrift state = watch.Add(Capture(0.0, 0.0))[0];
+    EXPECT_TRUE(state.warned) << k;
+    EXPECT_EQ(state.warned_since, 34);
+    EXPECT_EQ(RowDriftWarned(state.recent, 0.1), k <= 6) << k;  // the mean itself falls back
+  }
+}
+
+// Past half the vernier's step the readings wrap and change sign from
+// capture to capture (a second reading's, 0.25 px of rows on the demo's
+// five scenes): signed they average -0.054, under the tolerance; their
+// sizes average 0.139 and are warned of from the first.
+TEST(RowDriftWatch, ReadingsThatWrapAreJudgedByTheirSizes) {
+  RowDriftWatch watch(0.1);
+  const double readings[] = {-0.111, -0.098, +0.261, -0.081, -0.142};
+  double sum_size = 0;
+  for (int k = 0; k < 5; ++k) {
+    sum_size += std::abs(readings[k]);
+    const WatchedRowDrift state = watch.Add(Capture(readings[k], 0.0))[0];
+    EXPECT_TRUE(state.warned) << k;
+    EXPECT_EQ(state.warned_since, 1);
+    EXPECT_NEAR(state.recent.row_offset_px, sum_size / (k + 1), 1e-12);
+  }
 }
 
 // One capture alone is judged as RowDriftWarned judges it: 0.12 px is past
 // 0.1 and 4 x 0.025; with a standard error of 0.04, 4 of them are 0.16.
 TEST(RowDriftWatch, TheFirstCaptureIsJudgedAlone) {
-  EXPECT_TRUE(RowDriftWatch(0.1).Add(Capture(0.12, 0.0))[0].warned);
+  EXPECT_TRUE(RowDriftWatch(0.1).Add(Capture(-0.12, 0.0))[0].warned);
   EXPECT_FALSE(RowDriftWatch(0.1).Add(Capture(0.12, 0.0, 0.04))[0].warned);
 }
 
@@ -68,11 +99,11 @@ TEST(RowDriftWatch, AModuleNotReadAddsNothing) {
   RowDriftWatch watch(0.1);
   std::vector<ModuleReport> modules = Capture(0.3, 0.3);
   modules[1].row_drift = RowDrift{};
-  const std::vector<RowDrift> means = watch.Add(modules);
-  EXPECT_TRUE(means[0].warned);
-  EXPECT_FALSE(means[1].read);
-  EXPECT_FALSE(means[1].warned);
-  EXPECT_EQ(means[1].captures, 0);
+  const std::vector<WatchedRowDrift> states = watch.Add(modules);
+  EXPECT_TRUE(states[0].warned);
+  EXPECT_FALSE(states[1].recent.read);
+  EXPECT_FALSE(states[1].warned);
+  EXPECT_EQ(states[1].recent.captures, 0);
 }
 
 }  // namespace

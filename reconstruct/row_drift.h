@@ -5,15 +5,19 @@
 // per period (8 px x tan 2.6 deg) and keeps a component that reads within
 // max_row_offset_px (0.1 px) of 0. That is a tolerance on the calibration
 // too: a camera turned by 0.011 deg since calibration (0.2 px of rows at
-// f = 1025 px) makes every correct match read 0.2 px, past half a period's
-// step, and the line index then puts whole surfaces one period off (~3.5 mm
-// at 200 mm) with no fill lost. Measured on the demo's cup, module 0's right
-// camera turned about its x axis: mean |error| 0.035 mm at 0.1 px, 0.037 mm at
-// 0.15 px, 2.17 mm at 0.2 px and 2.15 mm at 0.5 px (docs/reconstruct-log.md,
-// "Session 47"). So the readings are worth reporting on every capture: the
-// components the line index kept or moved read the module's row offset (or
-// that offset less a whole number of steps: the vernier cannot tell a drift
-// of s from one of s - 0.36 px, so a drift near a whole step reads ~0).
+// f = 1025 px) makes every correct match read 0.2 px, past about half a
+// period's step, and the line index then puts whole surfaces one period off
+// (~2-3.5 mm at 200 mm), often with the fill still high, or drops most of
+// the module. Measured on the demo's cup, module 0's right camera turned
+// about its x axis: mean |error| 0.035 mm at 0.1 px, 0.037 mm at 0.15 px,
+// 2.17 mm at 0.2 px and 2.15 mm at 0.5 px (docs/reconstruct-log.md,
+// "Session 47"). The components the line index kept or moved read the
+// module's row offset while it is under ~0.2 px: an early warning of a drift
+// that grows. Not a guard against a module already broken: past ~0.2 px the
+// reading wraps (the vernier cannot tell a drift of s from one of s - 0.36
+// px) and reads small on most scenes; a roll reads ~0 at the image's centre;
+// a turn that moves columns reads nothing (docs/reconstruct.md, "Row
+// drift"; the nightly check is that guard).
 #pragma once
 
 #include <span>

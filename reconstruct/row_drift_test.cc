@@ -117,16 +117,16 @@ Read ReadShifted(double shift_px) {
 
 // Tolerance: 3 standard errors of the difference, each reading's own (the
 // scatter of its fits over its samples: the 2 DN sensor noise and the
-// texture), plus the fit's interpolation error: it blends the right rows
-// with a cubic convolution, whose sawtooth on the ~1 px wide laser lines
-// is up to +-0.02 px (subpixel_refine.h, measured along the row; here the
-// same kernel across rows, on lines of the same width, reads 0.092 px for a
-// shift of 0.08 and 0.167 for 0.15). The standard errors alone are ~0.0016
-// px: without the sawtooth the test would judge the interpolator, not the
-// drift reading.
-double Tolerance(const VernierReading& a, const VernierReading& b) {
-  constexpr double kCubicSawtoothPx = 0.02;
-  return 3 * std::hypot(a.standard_error_px, b.standard_error_px) + kCubicSawtoothPx;
+// texture), plus the fit's gain: it blends the right rows with a cubic
+// convolution, which over-reads a sub-row shift of the ~1 px wide laser
+// lines by 7-15 % (measured: 0.092 px here for 0.08, 0.167 for 0.15; 0.113
+// for 0.1 px on the demo cup; +0.138 / -0.128 for +-0.12 on the CLI's
+// sphere); docs/reconstruct.md states 20 % as the bound. The standard
+// errors alone are ~0.0016 px: without the gain the test would judge the
+// interpolator, not the drift reading.
+double Tolerance(const VernierReading& a, const VernierReading& b, double truth_px) {
+  constexpr double kMaxGainError = 0.2;
+  return 3 * std::hypot(a.standard_error_px, b.standard_error_px) + kMaxGainError * std::abs(truth_px);
 }
 
 TEST(RowDrift, TheVernierReadsARowShiftOfTheRightView) {
@@ -139,7 +139,7 @@ TEST(RowDrift, TheVernierReadsARowShiftOfTheRightView) {
     const Read shifted = ReadShifted(shift_px);
     ASSERT_GT(shifted.reading.fits, 0);
     EXPECT_NEAR(shifted.reading.row_offset_px - zero.reading.row_offset_px, shift_px,
-                Tolerance(shifted.reading, zero.reading));
+                Tolerance(shifted.reading, zero.reading, shift_px));
     EXPECT_GE(shifted.right_line, 0.98 * 40000);  // still on its line
   }
 }
@@ -153,7 +153,7 @@ TEST(RowDrift, PastHalfAStepTheSurfaceGoesAPeriodOffAndReadsAStepLess) {
   ASSERT_GT(shifted.reading.fits, 0);
   const double step_px = 8 * std::tan(2.6 * M_PI / 180);
   EXPECT_NEAR(shifted.reading.row_offset_px - zero.reading.row_offset_px, 0.25 - step_px,
-              Tolerance(shifted.reading, zero.reading));
+              Tolerance(shifted.reading, zero.reading, 0.25 - step_px));
   EXPECT_GE(shifted.period_off, 0.98 * 40000);
   EXPECT_TRUE(RowDriftWarned(ReadRowDrift(std::vector{shifted.reading}), LineIndexOptions{}.max_row_offset_px));
 }

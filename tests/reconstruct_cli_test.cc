@@ -1652,8 +1652,9 @@ namespace {
 // rows come out fx * angle lower: the vernier reads +0.12 px (-0.12 turned
 // back). Below the ~0.18 px where the line index goes a period off, so the
 // points stay on their lines: a warning, exit 0. Tolerance on the reading:
-// 3 standard errors of the difference (the report's own) plus the vernier's
-// cubic sawtooth, 0.02 px (row_drift_test.cc).
+// 3 standard errors of the difference (the report's own) plus 20 % of the
+// turn, the bound docs/reconstruct.md states for the vernier's gain (its
+// cubic row blend over-reads sub-row shifts by 7-15 %: row_drift_test.cc).
 TEST_F(ReconstructCli, ACameraTurnedSinceCalibrationIsWarnedOfByItsRowDrift) {
   auto drift_of = [&](const std::string& rig_path, testing::Result* r) {
     *r = testing::RunCli("reconstruct --rig " + rig_path + " --capture " + dir_ + "/capture --out " + dir_ +
@@ -1694,13 +1695,13 @@ TEST_F(ReconstructCli, ACameraTurnedSinceCalibrationIsWarnedOfByItsRowDrift) {
     EXPECT_NE(r.out.find("\n  warning: its rectified rows read " + std::string(sign > 0 ? "+" : "-")),
               std::string::npos)
         << r.out;
-    EXPECT_NE(r.out.find("run `stereorig check` on the rig"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("run `stereorig check --rig RIG --captures DIR --target BOARD`"), std::string::npos) << r.out;
     EXPECT_FALSE(modules_json[1]["row_drift"]["warned"].get<bool>()) << modules_json.dump();  // not turned
   }
   std::printf("turned +-0.12 px: read %+.4f (se %.4f), %+.4f (se %.4f) px over the true rig's\n", reading[0], se[0],
               reading[1], se[1]);
-  EXPECT_NEAR(reading[0], 0.12, 3 * se[0] + 0.02);
-  EXPECT_NEAR(reading[1], -0.12, 3 * se[1] + 0.02);
+  EXPECT_NEAR(reading[0], 0.12, 3 * se[0] + 0.2 * 0.12);
+  EXPECT_NEAR(reading[1], -0.12, 3 * se[1] + 0.2 * 0.12);
 
   // A batch (what a line runs) says it in a line naming the module, from the
   // mean of the module's readings over its last captures (three copies of
@@ -1715,9 +1716,10 @@ TEST_F(ReconstructCli, ACameraTurnedSinceCalibrationIsWarnedOfByItsRowDrift) {
   r = testing::RunCli("reconstruct --rig " + dir_ + "/turned0.yaml --capture " + copies[0] + " " + copies[1] + " " +
                       copies[2] + " --out-dir " + dir_ + "/batch_turned --report " + dir_ + "/batch_turned.json");
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("\n  warning: module 0's rectified rows read +"), std::string::npos) << r.out;
-  for (const std::string last : {"1 capture", "2 captures", "3 captures"})
-    EXPECT_NE(r.out.find("the mean of its last " + last + " (standard error "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\n  warning: module 0's rectified rows read 0."), std::string::npos) << r.out;
+  for (const std::string last : {"1 capture's", "2 captures'", "3 captures'"})
+    EXPECT_NE(r.out.find("the mean size of its last " + last + " readings (standard error "), std::string::npos)
+        << r.out;
   std::ifstream summary_file(dir_ + "/batch_turned.json");
   const nlohmann::json summary = nlohmann::json::parse(summary_file);
   ASSERT_EQ(summary["captures"].size(), 3u) << summary.dump();

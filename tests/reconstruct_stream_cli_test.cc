@@ -679,8 +679,8 @@ TEST_F(ReconstructStreamCli, ARowDriftIsJudgedOverTheStreamsRecentCaptures) {
   const testing::Result r = testing::RunCli("reconstruct --rig " + dir_ + "/turned.yaml --capture - --out-dir " + out +
                                             " --report " + out + "/summary.json < " + list);
   ASSERT_EQ(r.code, 0) << r.err;
-  const size_t first = r.out.find("the mean of its last 1 capture (standard error ");
-  const size_t second = r.out.find("the mean of its last 2 captures (standard error ");
+  const size_t first = r.out.find("the mean size of its last 1 capture's readings (standard error ");
+  const size_t second = r.out.find("the mean size of its last 2 captures' readings (standard error ");
   ASSERT_NE(first, std::string::npos) << r.out;
   ASSERT_NE(second, std::string::npos) << r.out;
   EXPECT_LT(r.out.find("[1] "), first);
