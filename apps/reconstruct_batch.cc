@@ -128,7 +128,7 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
   nlohmann::json summary;
   summary["runtime_build_ms"] = build_ms;
   summary["captures"] = nlohmann::json::array();
-  int failed = 0, without_points = 0;
+  int failed = 0, without_points = 0, with_row_drift = 0;
   RowDriftWatch row_drift(runtime.options().match.line_index.max_row_offset_px);
   const auto t_all = Clock::now();
   for (size_t i = 0; i < dirs.size(); ++i) {
@@ -148,6 +148,7 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
         const nlohmann::json entry =
             ReconstructCapture(runtime, images, dirs[i], names[i], outputs[i], progress, t, &row_drift);
         without_points += !entry["modules_without_points"].empty();
+        with_row_drift += !entry["modules_with_row_drift"].empty();
         summary["captures"].push_back(entry);
         continue;
       } catch (const InputError& e) {  // the writers' failures (atomic_file.h)
@@ -159,7 +160,7 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
     ++failed;
     summary["captures"].push_back(FailedCapture(dirs[i], names[i], outputs[i], progress, error));
   }
-  const int code = FinishRun(&summary, int(dirs.size()), failed, without_points, MsSince(t_all),
+  const int code = FinishRun(&summary, int(dirs.size()), failed, without_points, with_row_drift, MsSince(t_all),
                              "reading, reconstructing and writing", request.summary_path);
   // Every capture failed and nothing was written in it (no summary there):
   // a new output folder goes again, as bad input found earlier leaves none.

@@ -197,17 +197,19 @@ nlohmann::json FailedCapture(const std::string& dir, const std::string& name, co
   return entry;
 }
 
-int FinishRun(nlohmann::json* summary, int total, int failed, int without_points, double wall_ms,
+int FinishRun(nlohmann::json* summary, int total, int failed, int without_points, int with_row_drift, double wall_ms,
               const std::string& timed, const std::string& summary_path) {
   const int done = total - failed;
   (*summary)["reconstructed"] = done;
   (*summary)["failed"] = failed;
   (*summary)["with_modules_without_points"] = without_points;
+  (*summary)["with_row_drift"] = with_row_drift;
   (*summary)["wall_ms"] = wall_ms;
   (*summary)["objects_per_s"] = done > 0 ? 1000.0 * done / wall_ms : 0.0;
   std::printf("%d of %d captures in %.2f s: %.1f objects/s (%s)", done, total, wall_ms / 1000,
               (*summary)["objects_per_s"].get<double>(), timed.c_str());
   if (without_points > 0) std::printf("; %d with a module that gave no point", without_points);
+  if (with_row_drift > 0) std::printf("; %d with a module whose rows read off (row_drift)", with_row_drift);
   std::printf("\n");
   FlushStdout();
   if (without_points > 0)
@@ -215,6 +217,11 @@ int FinishRun(nlohmann::json* summary, int total, int failed, int without_points
                  "stereorig reconstruct: warning: %d of %d captures written have a module that gave no point (each "
                  "named above, with why)\n",
                  without_points, done);
+  if (with_row_drift > 0)
+    std::fprintf(stderr,
+                 "stereorig reconstruct: warning: %d of %d captures written have a module whose rectified rows read "
+                 "off (each named above): run `stereorig check` on the rig before trusting that module's points\n",
+                 with_row_drift, done);
   // Stdout lost on the last lines (a terminal's hang-up): the summary says
   // so, as for a capture's line, and main exits 2 (cli_util.h).
   const std::string lost = StdoutWriteError();

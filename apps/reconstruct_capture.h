@@ -94,14 +94,17 @@ nlohmann::json FailedCapture(const std::string& dir, const std::string& name, co
 // The run's end: "<done> of <total> captures in S s: R objects/s (<timed>)"
 // on stdout (`timed`: what the wall time holds), followed by "; K with a
 // module that gave no point" when `without_points` (of the captures written)
-// is not 0; the summary's totals (reconstructed, failed,
-// with_modules_without_points, wall_ms, objects_per_s) set and the summary
+// is not 0, and "; K with a module whose rows read off (row_drift)" when
+// `with_row_drift` is not 0 (captures whose entry lists
+// modules_with_row_drift); the summary's totals (reconstructed, failed,
+// with_modules_without_points, with_row_drift, wall_ms, objects_per_s) set and the summary
 // written atomically to summary_path (unless ""); with failures, or captures
-// with a module that gave no point, a stderr line that counts them. Returns
+// with a module that gave no point or whose rows read off, a stderr line
+// that counts them. Returns
 // the exit code: kExitOk, or kExitBadInput when any capture failed. A module
 // with no point does not change it: the capture was measured and written, and
 // 1 is a check's failure (docs/formats.md); the count is the controller's.
-int FinishRun(nlohmann::json* summary, int total, int failed, int without_points, double wall_ms,
+int FinishRun(nlohmann::json* summary, int total, int failed, int without_points, int with_row_drift, double wall_ms,
               const std::string& timed, const std::string& summary_path);
 
 }  // namespace stereorig

@@ -158,7 +158,7 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
   summary["runtime_build_ms"] = build_ms;
   if (!request.warm_up_dir.empty()) summary["warm_up_ms"] = warm_up_ms;
   summary["failed_captures"] = nlohmann::json::array();  // the first kMaxFailuresListed
-  int total = 0, failed = 0, without_points = 0;
+  int total = 0, failed = 0, without_points = 0, with_row_drift = 0;
   RowDriftWatch row_drift(runtime.options().match.line_index.max_row_offset_px);
   std::string output_error;  // why stdout lost a capture's line: the stream stops
   const auto t_all = Clock::now();
@@ -191,9 +191,9 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
       CheckStreamCapture(dir, name, outputs, rig, paths);
       CheckCaptureFiles(dir, rig);
       const std::vector<cv::Mat> images = LoadCaptureOrInputError(dir, rig);
-      without_points +=
-          !ReconstructCapture(runtime, images, dir, name, outputs, progress, t, &row_drift)["modules_without_points"]
-               .empty();
+      const nlohmann::json entry = ReconstructCapture(runtime, images, dir, name, outputs, progress, t, &row_drift);
+      without_points += !entry["modules_without_points"].empty();
+      with_row_drift += !entry["modules_with_row_drift"].empty();
       if (StdoutLost(&output_error)) break;
       continue;
     } catch (const InputError& e) {  // the capture's files, images or outputs
@@ -237,7 +237,7 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
     if (stop != 0) return kExitOk;  // stopped before the line's first object: nothing to sum up
     throw InputError("--capture -", "standard input held no capture folder (one folder's path per line)");
   }
-  const int code = FinishRun(&summary, total, failed, without_points, MsSince(t_all),
+  const int code = FinishRun(&summary, total, failed, without_points, with_row_drift, MsSince(t_all),
                              "the stream's wall time: waiting for the input, reading, reconstructing and writing",
                              request.summary_path);
   if (failed > 0) out_folder.RemoveIfEmpty();  // as a batch: nothing written, no new folder

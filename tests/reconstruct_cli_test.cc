@@ -1723,6 +1723,7 @@ TEST_F(ReconstructCli, ACameraTurnedSinceCalibrationIsWarnedOfByItsRowDrift) {
   std::ifstream summary_file(dir_ + "/batch_turned.json");
   const nlohmann::json summary = nlohmann::json::parse(summary_file);
   ASSERT_EQ(summary["captures"].size(), 3u) << summary.dump();
+  EXPECT_EQ(summary["with_row_drift"], 3);
   for (const auto& c : summary["captures"])
     EXPECT_EQ(c["modules_with_row_drift"], nlohmann::json::array({0})) << c.dump();
   EXPECT_EQ(r.out.find("warning: module 1's rectified rows"), std::string::npos) << r.out;

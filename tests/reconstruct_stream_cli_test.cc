@@ -687,6 +687,13 @@ TEST_F(ReconstructStreamCli, ARowDriftIsJudgedOverTheStreamsRecentCaptures) {
   EXPECT_LT(r.out.find("[2] "), second);
   EXPECT_LT(first, r.out.find("[2] "));
   EXPECT_EQ(r.out.find("module 1's rectified rows"), std::string::npos) << r.out;
+  // Counted at the end, for the line's controller: both captures.
+  EXPECT_NE(r.out.find("; 2 with a module whose rows read off (row_drift)\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("stereorig reconstruct: warning: 2 of 2 captures written have a module whose rectified rows "
+                       "read off"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(nlohmann::json::parse(Bytes(out + "/summary.json"))["with_row_drift"], 2);
 }
 
 }  // namespace
