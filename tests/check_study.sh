@@ -30,6 +30,11 @@
 # happened ("moved" for a rotation, "lens changed" for a drift).
 set -euo pipefail
 bin=$1; work=$2; nights=${3:-20}
+# BIN as given (build/stereorig, say) is relative to where the study was
+# started, not to WORKDIR, where it runs: a relative BIN ended the study at
+# its first command with no word and no line printed.
+[ -x "$bin" ] || { echo "check_study.sh: $bin: no such executable (BIN)" >&2; exit 2; }
+bin=$(realpath "$bin")
 shift $(( $# < 3 ? $# : 3 ))
 kinds=("$@")
 spec=()
