@@ -49,6 +49,32 @@ std::vector<Eigen::Vector3d> PlatePoints(const Eigen::Vector3d& c, const Eigen::
   return out;
 }
 
+// The 130 x 120 mm plate at z = 400 on a 1 mm grid (x in [-65, 65], y in
+// [-60, 60]), noise sigma = 0.05 mm along z (seeded), with squares of it
+// raised by their heights (negative: sunk behind the face); *on_squares
+// counts the points on them.
+struct PlateSquare {
+  double x0_mm, y0_mm, side_mm, height_mm;
+};
+std::vector<Eigen::Vector3d> PlateWithSquares(unsigned seed, const std::vector<PlateSquare>& squares, int* on_squares) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0, 0.05);
+  std::vector<Eigen::Vector3d> pts;
+  *on_squares = 0;
+  for (double x = -65; x <= 65; x += 1)
+    for (double y = -60; y <= 60; y += 1) {
+      double h = 0;
+      for (const PlateSquare& q : squares)
+        if (x >= q.x0_mm && x <= q.x0_mm + q.side_mm && y >= q.y0_mm && y <= q.y0_mm + q.side_mm) {
+          h = q.height_mm;
+          ++*on_squares;
+          break;
+        }
+      pts.emplace_back(x, y, 400 + h + noise(rng));
+    }
+  return pts;
+}
+
 Artifact SphereArtifact() {
   Artifact a;
   a.type = ArtifactType::kSphere;
@@ -2108,24 +2134,12 @@ TEST(Vdi2634, APatchOfABallBeyondTheCaptureBandIsNotPassed) {
 // at +h (-h behind). F of the face alone is ~8 sigma = 0.4 mm, within the
 // 1.5 mm MPE.
 TEST(Vdi2634, AClampOnThePlateIsNotItsFaceMeasuredOff) {
-  struct Clamp {
-    double x0_mm, y0_mm, side_mm, height_mm;
-  };
-  for (const Clamp& clamp :
-       {Clamp{-10, -10, 20, 8}, Clamp{-65, -10, 20, 8}, Clamp{-65, -60, 25, 12}, Clamp{-10, -10, 20, -8}}) {
+  for (const PlateSquare& clamp : {PlateSquare{-10, -10, 20, 8}, PlateSquare{-65, -10, 20, 8},
+                                   PlateSquare{-65, -60, 25, 12}, PlateSquare{-10, -10, 20, -8}}) {
     SCOPED_TRACE(::testing::Message() << "clamp at " << clamp.x0_mm << ", " << clamp.y0_mm << ", " << clamp.height_mm
                                       << " mm");
-    std::mt19937 rng(15);
-    std::normal_distribution<double> noise(0, 0.05);
-    std::vector<Eigen::Vector3d> pts;
     int top = 0;
-    for (double x = -65; x <= 65; x += 1)
-      for (double y = -60; y <= 60; y += 1) {
-        const bool under = x >= clamp.x0_mm && x <= clamp.x0_mm + clamp.side_mm && y >= clamp.y0_mm &&
-                           y <= clamp.y0_mm + clamp.side_mm;
-        pts.emplace_back(x, y, 400 + (under ? clamp.height_mm : 0) + noise(rng));
-        top += under;
-      }
+    const std::vector<Eigen::Vector3d> pts = PlateWithSquares(15, {clamp}, &top);
     Artifact plate = PlateArtifact();
     plate.plate_width_mm = 120;
     const ArtifactEvaluation e =
@@ -2332,16 +2346,8 @@ TEST(Vdi2634, ATableUnderASphereIsNoPartMeasuredOff) {
 // [20, 40]^2 at -7 mm. Not passed, the reason saying the points lie off the
 // face (not in front of it).
 TEST(Vdi2634, AClampInFrontDoesNotVouchForAPatchBehindThePlate) {
-  std::mt19937 rng(20);
-  std::normal_distribution<double> noise(0, 0.05);
-  std::vector<Eigen::Vector3d> pts;
   int off_face = 0;
-  for (double x = -65; x <= 65; x += 1)
-    for (double y = -60; y <= 60; y += 1) {
-      const bool clamp = x >= -50 && x <= -30 && y >= -50 && y <= -30, patch = x >= 20 && x <= 40 && y >= 20 && y <= 40;
-      pts.emplace_back(x, y, 400 + (clamp ? 8 : patch ? -7 : 0) + noise(rng));
-      off_face += clamp || patch;
-    }
+  const std::vector<Eigen::Vector3d> pts = PlateWithSquares(20, {{-50, -50, 20, 8}, {20, 20, 20, -7}}, &off_face);
   Artifact plate = PlateArtifact();
   plate.plate_width_mm = 120;
   const ArtifactEvaluation e =
