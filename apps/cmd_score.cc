@@ -126,12 +126,20 @@ int RunScore(int argc, char** argv) {
   for (const std::string& name : scenes) {
     const fs::path scene_dir = fs::path(dataset) / "scenes" / name;
     CheckCaptureFiles((scene_dir / "active").string(), rig);
+    if (!no_passive && fs::is_directory(scene_dir / "passive"))
+      CheckCaptureFiles((scene_dir / "passive").string(), rig);
     const fs::path surface = fs::path(dataset) / "truth" / "scenes" / name / "surface.ply";
     if (!fs::is_regular_file(surface)) throw InputError(surface.string(), "no such file (the scene's truth)");
   }
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
   const Runtime runtime(rig, options), passive_runtime(rig, PassiveOptions(options));
   diagnose.Create();
+  // The diagnosis images and the report, all or none (calib/core/atomic_file.h):
+  // a later scene's bad input (a damaged truth map, a passive capture image)
+  // used to leave the earlier scenes' images written, in a new --diagnose
+  // folder or over an earlier run's among its others. Declared after
+  // `diagnose`: their temporary files go before the folder made for them.
+  AtomicOutputSet written;
   nlohmann::json report = {{"dataset", dataset}, {"rig", rig_path}};
   {
     std::ifstream spec(fs::path(dataset) / "spec.yaml");
@@ -215,14 +223,16 @@ int RunScore(int argc, char** argv) {
       for (size_t m = 0; m < s.fill.size(); ++m) {
         const FillDiagnosis d = DiagnoseFill(runtime, int(m), images, rec, truth.fill_target[m],
                                              maps[truth_rig.module(int(m)).left_camera].depth_mm);
-        WriteFillDiagnosisImages(d, FillDiagnosisPrefix(diagnose_dir, name, int(m)));
+        for (const auto& [path, bytes] : EncodeFillDiagnosisImages(d, FillDiagnosisPrefix(diagnose_dir, name, int(m))))
+          written.Add(path, bytes);
         std::printf("  m%zu diagnosis: %s", m, d.Summary().c_str());
       }
     }
     report["scenes"].push_back(sj);
     FlushStdout();  // each scene's lines as it is done (~3 s a scene), also into a pipe or a log file
   }
-  if (!report_path.empty()) WriteFileAtomically(report_path, JsonReportText(report) + "\n");
+  if (!report_path.empty()) written.Add(report_path, JsonReportText(report) + "\n");
+  written.Commit();
   if (!rig_given) WarnOfTruthRig("score", rig_path);
   return kExitOk;
 }

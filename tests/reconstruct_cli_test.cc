@@ -198,6 +198,7 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
 #include "reconstruct/pfm.h"
 #include "reconstruct/synthetic_scene.h"
 #include "tests/cli_runner.h"
+#include "tests/sim_scene.h"
 
 namespace stereorig {
 namespace {
@@ -1129,6 +1130,55 @@ TEST_F(ReconstructCli, ScoreChecksEverySceneBeforeScoringAny) {
   EXPECT_NE(r.err.find("scenes/spher: no such scene in the dataset (--scenes)"), std::string::npos) << r.err;
   EXPECT_EQ(r.out.find("points"), std::string::npos) << "a scene was scored: " << r.out;
   EXPECT_FALSE(std::filesystem::exists(diag)) << "bad input left the --diagnose folder behind";
+}
+
+// A later scene whose input fails only once read (a truth map cut short):
+// score exits 2 in one line, and neither its report nor the earlier scene's
+// diagnosis images are written: not in a new --diagnose folder (gone again),
+// nor over an earlier run's images in an existing one. They used to be
+// written as each scene was scored, and stayed. A passive capture image
+// missing is found before any scene is scored.
+TEST_F(ReconstructCli, ScoreThatFailsOnALaterSceneWritesNoDiagnosisImageNorReport) {
+  namespace fs = std::filesystem;
+  const std::string d = testing::SimulateOneScene("sphere", 1, "score_later");
+  // A second scene, the sphere's copy, with a lit map cut short.
+  fs::copy(d + "/scenes/sphere", d + "/scenes/later", fs::copy_options::recursive);
+  fs::copy(d + "/truth/scenes/sphere", d + "/truth/scenes/later", fs::copy_options::recursive);
+  const std::string lit = d + "/truth/scenes/later/lit_cam1.png";
+  fs::resize_file(lit, fs::file_size(lit) / 2);
+  const std::string report = dir_ + "/score_later.json";
+  WriteFileAtomically(report, "an earlier run's\n");
+  const std::string score = "score --dataset " + d + " --scenes sphere,later --no-passive --report " + report;
+
+  const std::string new_diag = dir_ + "/score_later_new_diag";
+  fs::remove_all(new_diag);
+  testing::Result r = testing::RunCli(score + " --diagnose " + new_diag + "/deeper");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(lit + ": a PNG cut short or damaged"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(new_diag)) << "the failed run left its --diagnose folder";
+
+  const std::string old_diag = dir_ + "/score_later_old_diag";
+  fs::remove_all(old_diag);
+  fs::create_directories(old_diag);
+  WriteFileAtomically(old_diag + "/sphere_m0_left.png", "an earlier run's\n");
+  r = testing::RunCli(score + " --diagnose " + old_diag);
+  EXPECT_EQ(r.code, 2) << r.err;
+  std::vector<std::string> left;
+  for (const fs::directory_entry& e : fs::directory_iterator(old_diag)) left.push_back(e.path().filename());
+  EXPECT_EQ(left, std::vector<std::string>{"sphere_m0_left.png"}) << "the failed run wrote diagnosis images";
+  EXPECT_EQ(ReadFileBytes(old_diag + "/sphere_m0_left.png"), "an earlier run's\n");
+  EXPECT_EQ(ReadFileBytes(report), "an earlier run's\n");
+
+  fs::copy_file(d + "/truth/scenes/sphere/lit_cam1.png", lit, fs::copy_options::overwrite_existing);
+  fs::remove(d + "/scenes/later/passive/cam2.png");
+  r = testing::RunCli("score --dataset " + d + " --scenes sphere,later --diagnose " + new_diag);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(d + "/scenes/later/passive/cam2.png: missing camera image"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find("points"), std::string::npos) << "a scene was scored: " << r.out;
+  EXPECT_FALSE(fs::exists(new_diag));
+  fs::remove_all(d);
 }
 
 // A measurement volume deeper than the matcher can search (150 x 150 x 300
