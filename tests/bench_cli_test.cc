@@ -115,7 +115,8 @@ TEST(BenchCli, AMissingSceneNamedInScenesExitsTwoBeforeAnyRun) {
       {" --scenes spher,cup,ballbal", dataset + "/scenes: no such scenes in the dataset (--scenes): spher, ballbal"},
       {" --scenes cup,,sphere", "--scenes cup,,sphere: an empty scene name"},
       {" --scenes cup,", "--scenes cup,: an empty scene name"},
-      {" --scenes cup,cup", "--scenes cup,cup: names 'cup' twice"}};
+      {" --scenes cup,cup", "--scenes cup,cup: names 'cup' twice"},
+      {" --scenes cup/", "--scenes cup/: 'cup/' is not a scene name"}};
   for (const auto& [scenes, says] : refused) {
     const testing::Result r = RunCli(bench + scenes);
     EXPECT_EQ(r.code, 2) << scenes;

@@ -1091,6 +1091,8 @@ TEST_F(ReconstructCli, ScoreBadInputLeavesNoDiagnoseFolder) {
       {score + " --scenes cup --report " + diag + "/deeper", "is a folder --diagnose creates"},
       {score + " --scenes cup --report " + diag, "is a folder --diagnose creates"},
       {score + " --scenes no_such_scene", "scenes/no_such_scene: no such scene in the dataset"},
+      // A path, not a scene's name: its images would go under DIR/cup/.
+      {score + " --scenes cup/", "--scenes cup/: 'cup/' is not a scene name"},
       {score + " --scenes broken", "broken/surface.ply"},
       // Too long a name for the file system: refused when claimed.
       {"score --dataset " + d + " --no-passive --scenes broken --diagnose " + diag + "/" + std::string(300, 'x'),
