@@ -1064,6 +1064,34 @@ TEST_F(ReconstructCli, ScoreAndBatchOutputsOverTheirInputsAreRefused) {
   EXPECT_FALSE(std::filesystem::exists(dir_ + "/batch_opts/capture.ply"));
 }
 
+// score takes the truth rig's module m (its fill target, its left camera's
+// depth) for the cloud's module m. A --rig pairing other cameras in its
+// modules (another layout's: module 0 on cameras 2 and 3) was scored
+// against the wrong module's truth, exit 0. Refused before any scoring,
+// naming both rigs; the truth rig's own layout goes on (to the capture here,
+// which holds cam0.png alone).
+TEST_F(ReconstructCli, ScoreRefusesARigWhoseModulesPairOtherCameras) {
+  const std::string d = ScoreDataset("score_other_layout");
+  const SimulatedRig sim = MakeDefaultRig();
+  std::vector<Camera> cameras;
+  std::vector<std::string> names;
+  for (int k : {2, 3, 0, 1}) {  // the cameras relabelled: module 0's pair is cameras 2 and 3
+    cameras.push_back(sim.rig.cameras()[k]);
+    names.push_back(sim.rig.camera_names()[k]);
+  }
+  std::vector<StereoModule> modules = sim.rig.modules();
+  modules[0].left_camera = 2, modules[0].right_camera = 3;
+  modules[1].left_camera = 0, modules[1].right_camera = 1;
+  WriteRigFile(Rig(cameras, names, modules, sim.rig.S(), "test"), dir_ + "/other_layout.yaml");
+  const std::string score = "score --dataset " + d + " --scenes cup --no-passive --rig ";
+  ExpectRefusedInOneLine(score + dir_ + "/other_layout.yaml",
+                         dir_ + "/other_layout.yaml: its module 0 has cameras 2 and 3, the dataset's truth rig's (" +
+                             d + "/truth/rig.yaml) cameras 0 and 1");
+  const testing::Result same = testing::RunCli(score + dir_ + "/rig.yaml");
+  EXPECT_EQ(same.code, 2);
+  EXPECT_NE(same.err.find("cam1.png: missing camera image"), std::string::npos) << same.err;
+}
+
 // score creates its --diagnose folder, but only once the input is known
 // good: a refused --report, a --diagnose under a file, a scene the dataset
 // lacks each exit 2 in one line and leave no folder behind (score used to
