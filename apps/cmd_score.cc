@@ -159,6 +159,7 @@ int RunScore(int argc, char** argv) {
   // folder or over an earlier run's among its others. Declared after
   // `diagnose`: their temporary files go before the folder made for them.
   AtomicOutputSet written;
+  std::vector<std::string> earlier_images;  // of modules that make none: removed once the run's are written
   nlohmann::json report = {{"dataset", dataset}, {"rig", rig_path}};
   {
     std::ifstream spec(fs::path(dataset) / "spec.yaml");
@@ -242,8 +243,15 @@ int RunScore(int argc, char** argv) {
       for (size_t m = 0; m < s.fill.size(); ++m) {
         const FillDiagnosis d = DiagnoseFill(runtime, int(m), images, rec, truth.fill_target[m],
                                              maps[truth_rig.module(int(m)).left_camera].depth_mm);
-        for (const auto& [path, bytes] : EncodeFillDiagnosisImages(d, FillDiagnosisPrefix(diagnose_dir, name, int(m))))
-          written.Add(path, bytes);
+        const std::string prefix = FillDiagnosisPrefix(diagnose_dir, name, int(m));
+        const std::vector<std::pair<std::string, std::string>> images_made = EncodeFillDiagnosisImages(d, prefix);
+        for (const auto& [path, bytes] : images_made) written.Add(path, bytes);
+        if (images_made.empty()) {
+          // No match ROI (no lit pixel): an earlier run's images of the
+          // module, left in DIR, would stand beside this run's as its own.
+          for (const std::string& path : FillDiagnosisImagePaths(prefix)) earlier_images.push_back(path);
+          std::printf("  m%zu diagnosis images: none (the module searched no pixel)\n", m);
+        }
         std::printf("  m%zu diagnosis: %s", m, d.Summary().c_str());
       }
     }
@@ -252,6 +260,12 @@ int RunScore(int argc, char** argv) {
   }
   if (!report_path.empty()) written.Add(report_path, JsonReportText(report) + "\n");
   written.Commit();
+  for (const std::string& path : earlier_images) {
+    std::error_code ec;
+    if (!fs::remove(path, ec) && ec)
+      std::fprintf(stderr, "score: warning: %s (an earlier run's) could not be removed: %s\n", path.c_str(),
+                   ec.message().c_str());
+  }
   if (!rig_given) WarnOfTruthRig("score", rig_path);
   return kExitOk;
 }

@@ -1211,6 +1211,32 @@ TEST_F(ReconstructCli, ScoreThatFailsOnALaterSceneWritesNoDiagnosisImageNorRepor
   fs::remove_all(d);
 }
 
+// Module 0's left image dark: no lit pixel, no match ROI, so no diagnosis
+// image of it. An earlier run's four images of the module, left in the
+// --diagnose folder, stayed beside this run's as if they were its own; they
+// are removed, and the run says the module has none.
+TEST_F(ReconstructCli, ScoreRemovesAnEarlierRunsImagesOfAModuleThatMakesNone) {
+  namespace fs = std::filesystem;
+  const std::string d = testing::SimulateOneScene("sphere", 1, "score_dark_module");
+  const std::string left = d + "/scenes/sphere/active/cam0.png";
+  cv::imwrite(left, cv::Mat::zeros(cv::imread(left, cv::IMREAD_UNCHANGED).size(), CV_8UC1));
+  const std::string diag = dir_ + "/score_dark_module_diag";
+  fs::remove_all(diag);
+  fs::create_directories(diag);
+  for (const char* image : {"left", "status", "lost", "error"})
+    WriteFileAtomically(diag + "/sphere_m0_" + image + ".png", "an earlier run's\n");
+  const testing::Result r =
+      testing::RunCli("score --dataset " + d + " --scenes sphere --no-passive --diagnose " + diag);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("  m0 diagnosis images: none (the module searched no pixel)\n"), std::string::npos) << r.out;
+  std::vector<std::string> images;
+  for (const fs::directory_entry& e : fs::directory_iterator(diag)) images.push_back(e.path().filename());
+  std::sort(images.begin(), images.end());
+  EXPECT_EQ(images, (std::vector<std::string>{"sphere_m1_error.png", "sphere_m1_left.png", "sphere_m1_lost.png",
+                                              "sphere_m1_status.png"}));
+  fs::remove_all(d);
+}
+
 // A measurement volume deeper than the matcher can search (150 x 150 x 300
 // mm at 200 mm: disparities -203 to 1535 px on this rig, past its 1024)
 // is refused when the runtime is built, naming the volume. It used to reach
