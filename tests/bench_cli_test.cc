@@ -302,6 +302,24 @@ TEST(BenchCli, BenchAndScoreNameADamagedTruthMapInOneLine) {
   fs::remove_all(dataset);
 }
 
+// --runs is a count: each value that is not one is refused by the flag's
+// name and what it must be, before any run ("Could not convert: --runs =
+// 1.5" was CLI11's word for a fraction or a number past an int).
+TEST(BenchCli, RunsThatAreNoCountAreRefusedByTheFlag) {
+  const std::pair<std::string, std::string> refused[] = {
+      {"0", "must be >= 1, got 0"},
+      {"-3", "must be >= 1, got -3"},
+      {"1.5", "must be a whole number >= 1, got 1.5"},
+      {"99999999999", "must be at most 2147483647, got 99999999999"}};
+  for (const auto& [runs, says] : refused) {
+    const testing::Result r = RunCli("bench --runs " + runs);
+    EXPECT_EQ(r.code, 2) << runs;
+    EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("stereorig bench: --runs: " + says), std::string::npos) << r.err;
+    EXPECT_EQ(r.out.find("objects/s"), std::string::npos) << r.out;
+  }
+}
+
 // --scenes picks scenes of a --dataset; without one (the built-in sphere)
 // it would be ignored: refused instead.
 TEST(BenchCli, ScenesWithoutADatasetIsRefused) {
