@@ -96,6 +96,12 @@ std::vector<std::string> SplitSceneList(const std::string& list) {
   std::stringstream in(list);
   for (std::string name; std::getline(in, name, ',');) {
     if (name.empty()) throw InputError("--scenes " + list, "an empty scene name (two commas, or one at an end)");
+    // A path ("cup/", as a shell completes the folder) passed the dataset's
+    // check, then named its outputs after it: score's --diagnose images
+    // went under a folder DIR/cup/ that does not exist, found only once the
+    // scene was scored.
+    if (name.find('/') != std::string::npos)
+      throw InputError("--scenes " + list, "'" + name + "' is not a scene name (a folder's name in scenes/, no '/')");
     if (std::find(scenes.begin(), scenes.end(), name) != scenes.end())
       throw InputError("--scenes " + list, "names '" + name + "' twice");
     scenes.push_back(name);

@@ -25,8 +25,8 @@ namespace stereorig {
 std::optional<int> ParseArgs(CLI::App& app, int argc, char** argv);
 
 // The scene names of a --scenes argument, "cup,sphere" -> {cup, sphere}.
-// Throws InputError on an empty name ("cup,,sphere", "cup,") or one named
-// twice.
+// Throws InputError on an empty name ("cup,,sphere", "cup,"), one named
+// twice, or one holding a '/' ("cup/": a path, not a scene's name).
 std::vector<std::string> SplitSceneList(const std::string& list);
 
 // Throws InputError unless every scene of `scenes` is in the simulator

@@ -236,10 +236,10 @@ int RunBench(int argc, char** argv) {
       ->needs(dataset_option);
   app.add_option("--rig", rig_path, "rig file to reconstruct with (default: the dataset's truth/rig.yaml)");
   app.add_option("--options", options_path, "runtime options YAML");
-  app.add_option("--runs", runs, "passes over the scenes per pipeline")->capture_default_str();
+  // Read as a count (cli_util.h): 1.5 or 99999999999 said "Could not convert".
+  AddCountOption(app, "--runs", &runs, "passes over the scenes per pipeline");
   app.add_option("--report", report_path, "write everything as JSON here")->check(NonEmptyPath());
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
-  if (runs < 1) throw InputError("--runs", "must be >= 1");
   // Before minutes of runs; with a dataset and no --rig, its truth rig is
   // the input to protect.
   namespace fs = std::filesystem;

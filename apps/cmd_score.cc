@@ -109,6 +109,25 @@ int RunScore(int argc, char** argv) {
        .more_inputs = DatasetInputs(dataset)});
   CheckDatasetFolder(dataset, true);  // named as what it is, not as a missing truth/rig.yaml
   const Rig rig = ReadRigFile(rig_path);
+  // The truth's fill target and depth are the truth rig's module m's, taken
+  // for the cloud's module m: a --rig pairing other cameras in a module (its
+  // layout another's) was scored against the wrong truth, exit 0.
+  if (rig_given) {
+    const std::string truth_path = (fs::path(dataset) / "truth" / "rig.yaml").string();
+    const Rig truth = ReadRigFile(truth_path);
+    for (int m = 0; m < std::max(rig.num_modules(), truth.num_modules()); ++m) {
+      auto cameras = [m](const Rig& r) {
+        return m < r.num_modules() ? "cameras " + std::to_string(r.module(m).left_camera) + " and " +
+                                         std::to_string(r.module(m).right_camera)
+                                   : std::string("no module");
+      };
+      if (cameras(rig) != cameras(truth))
+        throw InputError(rig_path, "its module " + std::to_string(m) + " has " + cameras(rig) +
+                                       ", the dataset's truth rig's (" + truth_path + ") " + cameras(truth) +
+                                       ": score compares each module with the truth's of its number; calibrate with "
+                                       "the dataset's layout");
+    }
+  }
   // Every scene named is in the dataset, before any is scored: a scene
   // misnamed after others in --scenes used to be found only once they were
   // scored, their diagnosis images left in a new --diagnose folder. The
@@ -126,12 +145,21 @@ int RunScore(int argc, char** argv) {
   for (const std::string& name : scenes) {
     const fs::path scene_dir = fs::path(dataset) / "scenes" / name;
     CheckCaptureFiles((scene_dir / "active").string(), rig);
+    if (!no_passive && fs::is_directory(scene_dir / "passive"))
+      CheckCaptureFiles((scene_dir / "passive").string(), rig);
     const fs::path surface = fs::path(dataset) / "truth" / "scenes" / name / "surface.ply";
     if (!fs::is_regular_file(surface)) throw InputError(surface.string(), "no such file (the scene's truth)");
   }
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
   const Runtime runtime(rig, options), passive_runtime(rig, PassiveOptions(options));
   diagnose.Create();
+  // The diagnosis images and the report, all or none (calib/core/atomic_file.h):
+  // a later scene's bad input (a damaged truth map, a passive capture image)
+  // used to leave the earlier scenes' images written, in a new --diagnose
+  // folder or over an earlier run's among its others. Declared after
+  // `diagnose`: their temporary files go before the folder made for them.
+  AtomicOutputSet written;
+  std::vector<std::string> earlier_images;  // of modules that make none: removed once the run's are written
   nlohmann::json report = {{"dataset", dataset}, {"rig", rig_path}};
   {
     std::ifstream spec(fs::path(dataset) / "spec.yaml");
@@ -215,14 +243,29 @@ int RunScore(int argc, char** argv) {
       for (size_t m = 0; m < s.fill.size(); ++m) {
         const FillDiagnosis d = DiagnoseFill(runtime, int(m), images, rec, truth.fill_target[m],
                                              maps[truth_rig.module(int(m)).left_camera].depth_mm);
-        WriteFillDiagnosisImages(d, FillDiagnosisPrefix(diagnose_dir, name, int(m)));
+        const std::string prefix = FillDiagnosisPrefix(diagnose_dir, name, int(m));
+        const std::vector<std::pair<std::string, std::string>> images_made = EncodeFillDiagnosisImages(d, prefix);
+        for (const auto& [path, bytes] : images_made) written.Add(path, bytes);
+        if (images_made.empty()) {
+          // No match ROI (no lit pixel): an earlier run's images of the
+          // module, left in DIR, would stand beside this run's as its own.
+          for (const std::string& path : FillDiagnosisImagePaths(prefix)) earlier_images.push_back(path);
+          std::printf("  m%zu diagnosis images: none (the module searched no pixel)\n", m);
+        }
         std::printf("  m%zu diagnosis: %s", m, d.Summary().c_str());
       }
     }
     report["scenes"].push_back(sj);
     FlushStdout();  // each scene's lines as it is done (~3 s a scene), also into a pipe or a log file
   }
-  if (!report_path.empty()) WriteFileAtomically(report_path, JsonReportText(report) + "\n");
+  if (!report_path.empty()) written.Add(report_path, JsonReportText(report) + "\n");
+  written.Commit();
+  for (const std::string& path : earlier_images) {
+    std::error_code ec;
+    if (!fs::remove(path, ec) && ec)
+      std::fprintf(stderr, "score: warning: %s (an earlier run's) could not be removed: %s\n", path.c_str(),
+                   ec.message().c_str());
+  }
   if (!rig_given) WarnOfTruthRig("score", rig_path);
   return kExitOk;
 }

@@ -144,7 +144,15 @@ int RunTune(int argc, char** argv) {
                      "facing the module\n",
                      plan.module, capture_dir.c_str(), *rms_mm, kMaxPlaneRmsMm);
     } else {
+      // Said on stderr too, as a surface found curved is: its period counts
+      // as much, and only this line said the plate was never checked (its
+      // right camera dark, or its matches failing, on a plate or a cup).
       std::printf("  its flatness was not read (fewer than %d points)\n", kMinPlanePoints);
+      std::fprintf(stderr,
+                   "tune: warning: module %d's flatness was not read in %s (fewer than %d points: its right image "
+                   "dark, or few matches): its period is from a surface not known to be a flat plate; check the "
+                   "capture\n",
+                   plan.module, capture_dir.c_str(), kMinPlanePoints);
     }
     if (std::isnan(m->shift_per_row_px)) {
       std::printf(

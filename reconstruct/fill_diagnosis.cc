@@ -8,7 +8,6 @@
 #include <opencv2/imgproc.hpp>
 #include <tuple>
 
-#include "calib/core/atomic_file.h"
 #include "calib/core/input_error.h"
 #include "calib/core/png_writer.h"
 #include "reconstruct/matcher.h"
@@ -286,13 +285,12 @@ cv::Vec3b DiagnosisColour(PixelStatus status) {
 
 namespace {
 
-void Write(const std::string& path, const cv::Mat& image) {
+std::string Encode(const cv::Mat& image) {
   cv::Mat big;
   cv::resize(image, big, image.size() * 2, 0, 0, cv::INTER_NEAREST);
   STEREORIG_CHECK(big.depth() == CV_8U);
-  WriteFileAtomically(
-      path, EncodePng({uint32_t(big.cols), uint32_t(big.rows), big.channels(), 8, big.data, big.step},
-                      1));  // deflate level 1, imwrite's default level (same pixels; imwrite's filter choice differed)
+  return EncodePng({uint32_t(big.cols), uint32_t(big.rows), big.channels(), 8, big.data, big.step},
+                   1);  // deflate level 1, imwrite's default level (same pixels; imwrite's filter choice differed)
 }
 
 }  // namespace
@@ -305,12 +303,12 @@ std::string FillDiagnosisPrefix(const std::string& dir, const std::string& scene
   return (std::filesystem::path(dir) / (scene + "_m" + std::to_string(module))).string();
 }
 
-void WriteFillDiagnosisImages(const FillDiagnosis& d, const std::string& prefix) {
+std::vector<std::pair<std::string, std::string>> EncodeFillDiagnosisImages(const FillDiagnosis& d,
+                                                                           const std::string& prefix) {
   const std::vector<std::string> paths = FillDiagnosisImagePaths(prefix);
   const cv::Rect r = d.match_roi;
-  if (r.area() == 0) return;
+  if (r.area() == 0) return {};
   cv::Mat grey = d.left(r).clone();
-  Write(paths[0], grey);
   cv::Mat status(r.size(), CV_8UC3), lost(r.size(), CV_8UC3), error(r.size(), CV_8UC3);
   for (int y = 0; y < r.height; ++y)
     for (int x = 0; x < r.width; ++x) {
@@ -340,9 +338,7 @@ void WriteFillDiagnosisImages(const FillDiagnosis& d, const std::string& prefix)
       }
       error.at<cv::Vec3b>(y, x) = e;
     }
-  Write(paths[1], status);
-  Write(paths[2], lost);
-  Write(paths[3], error);
+  return {{paths[0], Encode(grey)}, {paths[1], Encode(status)}, {paths[2], Encode(lost)}, {paths[3], Encode(error)}};
 }
 
 }  // namespace stereorig

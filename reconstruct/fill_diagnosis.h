@@ -19,6 +19,7 @@
 #include <array>
 #include <opencv2/core.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "reconstruct/disparity_state.h"
@@ -112,10 +113,14 @@ struct FillDiagnosis {
 FillDiagnosis DiagnoseFill(const Runtime& runtime, int module, const std::vector<cv::Mat>& images,
                            const Reconstruction& rec, const cv::Mat& target_original, const cv::Mat& left_depth_mm);
 
-// Writes `prefix`_{left,status,lost,error}.png cropped to the match ROI:
+// The PNG files `prefix`_{left,status,lost,error}.png, cropped to the match
+// ROI, as (path, bytes) for the caller to write (none for an empty ROI):
 // status = colour per PixelStatus over the grey image (targets outlined);
 // lost = lost targets, green where reachable, red where not; error = |d - truth|.
-void WriteFillDiagnosisImages(const FillDiagnosis& d, const std::string& prefix);
+// Encoded, not written: `stereorig score` writes every scene's with its
+// report, all or none, so that a later scene's bad input leaves none.
+std::vector<std::pair<std::string, std::string>> EncodeFillDiagnosisImages(const FillDiagnosis& d,
+                                                                           const std::string& prefix);
 
 // The BGR colour of `status` in the status image (docs/reconstruct.md,
 // `--diagnose`): each loss its own, except off_plane_coarse drawn with
@@ -123,7 +128,7 @@ void WriteFillDiagnosisImages(const FillDiagnosis& d, const std::string& prefix)
 // (not_searched, out_of_range, low_confidence, outside_volume, object_size).
 cv::Vec3b DiagnosisColour(PixelStatus status);
 
-// The files WriteFillDiagnosisImages writes for `prefix` (a command claims
+// The files EncodeFillDiagnosisImages encodes for `prefix` (a command claims
 // them before any work): prefix_left.png, _status.png, _lost.png, _error.png.
 std::vector<std::string> FillDiagnosisImagePaths(const std::string& prefix);
 

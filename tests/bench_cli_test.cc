@@ -115,7 +115,8 @@ TEST(BenchCli, AMissingSceneNamedInScenesExitsTwoBeforeAnyRun) {
       {" --scenes spher,cup,ballbal", dataset + "/scenes: no such scenes in the dataset (--scenes): spher, ballbal"},
       {" --scenes cup,,sphere", "--scenes cup,,sphere: an empty scene name"},
       {" --scenes cup,", "--scenes cup,: an empty scene name"},
-      {" --scenes cup,cup", "--scenes cup,cup: names 'cup' twice"}};
+      {" --scenes cup,cup", "--scenes cup,cup: names 'cup' twice"},
+      {" --scenes cup/", "--scenes cup/: 'cup/' is not a scene name"}};
   for (const auto& [scenes, says] : refused) {
     const testing::Result r = RunCli(bench + scenes);
     EXPECT_EQ(r.code, 2) << scenes;
@@ -299,6 +300,24 @@ TEST(BenchCli, BenchAndScoreNameADamagedTruthMapInOneLine) {
   fs::create_directory(truth + "depth_cam2.tiff");
   expect_named(truth + "depth_cam2.tiff: is a folder, not a file");
   fs::remove_all(dataset);
+}
+
+// --runs is a count: each value that is not one is refused by the flag's
+// name and what it must be, before any run ("Could not convert: --runs =
+// 1.5" was CLI11's word for a fraction or a number past an int).
+TEST(BenchCli, RunsThatAreNoCountAreRefusedByTheFlag) {
+  const std::pair<std::string, std::string> refused[] = {
+      {"0", "must be >= 1, got 0"},
+      {"-3", "must be >= 1, got -3"},
+      {"1.5", "must be a whole number >= 1, got 1.5"},
+      {"99999999999", "must be at most 2147483647, got 99999999999"}};
+  for (const auto& [runs, says] : refused) {
+    const testing::Result r = RunCli("bench --runs " + runs);
+    EXPECT_EQ(r.code, 2) << runs;
+    EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("stereorig bench: --runs: " + says), std::string::npos) << r.err;
+    EXPECT_EQ(r.out.find("objects/s"), std::string::npos) << r.out;
+  }
 }
 
 // --scenes picks scenes of a --dataset; without one (the built-in sphere)

@@ -198,6 +198,7 @@ TEST(MatchCli, BadInputExitsTwoAndWritesNothing) {
 #include "reconstruct/pfm.h"
 #include "reconstruct/synthetic_scene.h"
 #include "tests/cli_runner.h"
+#include "tests/sim_scene.h"
 
 namespace stereorig {
 namespace {
@@ -1063,6 +1064,34 @@ TEST_F(ReconstructCli, ScoreAndBatchOutputsOverTheirInputsAreRefused) {
   EXPECT_FALSE(std::filesystem::exists(dir_ + "/batch_opts/capture.ply"));
 }
 
+// score takes the truth rig's module m (its fill target, its left camera's
+// depth) for the cloud's module m. A --rig pairing other cameras in its
+// modules (another layout's: module 0 on cameras 2 and 3) was scored
+// against the wrong module's truth, exit 0. Refused before any scoring,
+// naming both rigs; the truth rig's own layout goes on (to the capture here,
+// which holds cam0.png alone).
+TEST_F(ReconstructCli, ScoreRefusesARigWhoseModulesPairOtherCameras) {
+  const std::string d = ScoreDataset("score_other_layout");
+  const SimulatedRig sim = MakeDefaultRig();
+  std::vector<Camera> cameras;
+  std::vector<std::string> names;
+  for (int k : {2, 3, 0, 1}) {  // the cameras relabelled: module 0's pair is cameras 2 and 3
+    cameras.push_back(sim.rig.cameras()[k]);
+    names.push_back(sim.rig.camera_names()[k]);
+  }
+  std::vector<StereoModule> modules = sim.rig.modules();
+  modules[0].left_camera = 2, modules[0].right_camera = 3;
+  modules[1].left_camera = 0, modules[1].right_camera = 1;
+  WriteRigFile(Rig(cameras, names, modules, sim.rig.S(), "test"), dir_ + "/other_layout.yaml");
+  const std::string score = "score --dataset " + d + " --scenes cup --no-passive --rig ";
+  ExpectRefusedInOneLine(score + dir_ + "/other_layout.yaml",
+                         dir_ + "/other_layout.yaml: its module 0 has cameras 2 and 3, the dataset's truth rig's (" +
+                             d + "/truth/rig.yaml) cameras 0 and 1");
+  const testing::Result same = testing::RunCli(score + dir_ + "/rig.yaml");
+  EXPECT_EQ(same.code, 2);
+  EXPECT_NE(same.err.find("cam1.png: missing camera image"), std::string::npos) << same.err;
+}
+
 // score creates its --diagnose folder, but only once the input is known
 // good: a refused --report, a --diagnose under a file, a scene the dataset
 // lacks each exit 2 in one line and leave no folder behind (score used to
@@ -1090,6 +1119,8 @@ TEST_F(ReconstructCli, ScoreBadInputLeavesNoDiagnoseFolder) {
       {score + " --scenes cup --report " + diag + "/deeper", "is a folder --diagnose creates"},
       {score + " --scenes cup --report " + diag, "is a folder --diagnose creates"},
       {score + " --scenes no_such_scene", "scenes/no_such_scene: no such scene in the dataset"},
+      // A path, not a scene's name: its images would go under DIR/cup/.
+      {score + " --scenes cup/", "--scenes cup/: 'cup/' is not a scene name"},
       {score + " --scenes broken", "broken/surface.ply"},
       // Too long a name for the file system: refused when claimed.
       {"score --dataset " + d + " --no-passive --scenes broken --diagnose " + diag + "/" + std::string(300, 'x'),
@@ -1129,6 +1160,81 @@ TEST_F(ReconstructCli, ScoreChecksEverySceneBeforeScoringAny) {
   EXPECT_NE(r.err.find("scenes/spher: no such scene in the dataset (--scenes)"), std::string::npos) << r.err;
   EXPECT_EQ(r.out.find("points"), std::string::npos) << "a scene was scored: " << r.out;
   EXPECT_FALSE(std::filesystem::exists(diag)) << "bad input left the --diagnose folder behind";
+}
+
+// A later scene whose input fails only once read (a truth map cut short):
+// score exits 2 in one line, and neither its report nor the earlier scene's
+// diagnosis images are written: not in a new --diagnose folder (gone again),
+// nor over an earlier run's images in an existing one. They used to be
+// written as each scene was scored, and stayed. A passive capture image
+// missing is found before any scene is scored.
+TEST_F(ReconstructCli, ScoreThatFailsOnALaterSceneWritesNoDiagnosisImageNorReport) {
+  namespace fs = std::filesystem;
+  const std::string d = testing::SimulateOneScene("sphere", 1, "score_later");
+  // A second scene, the sphere's copy, with a lit map cut short.
+  fs::copy(d + "/scenes/sphere", d + "/scenes/later", fs::copy_options::recursive);
+  fs::copy(d + "/truth/scenes/sphere", d + "/truth/scenes/later", fs::copy_options::recursive);
+  const std::string lit = d + "/truth/scenes/later/lit_cam1.png";
+  fs::resize_file(lit, fs::file_size(lit) / 2);
+  const std::string report = dir_ + "/score_later.json";
+  WriteFileAtomically(report, "an earlier run's\n");
+  const std::string score = "score --dataset " + d + " --scenes sphere,later --no-passive --report " + report;
+
+  const std::string new_diag = dir_ + "/score_later_new_diag";
+  fs::remove_all(new_diag);
+  testing::Result r = testing::RunCli(score + " --diagnose " + new_diag + "/deeper");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(lit + ": a PNG cut short or damaged"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(new_diag)) << "the failed run left its --diagnose folder";
+
+  const std::string old_diag = dir_ + "/score_later_old_diag";
+  fs::remove_all(old_diag);
+  fs::create_directories(old_diag);
+  WriteFileAtomically(old_diag + "/sphere_m0_left.png", "an earlier run's\n");
+  r = testing::RunCli(score + " --diagnose " + old_diag);
+  EXPECT_EQ(r.code, 2) << r.err;
+  std::vector<std::string> left;
+  for (const fs::directory_entry& e : fs::directory_iterator(old_diag)) left.push_back(e.path().filename());
+  EXPECT_EQ(left, std::vector<std::string>{"sphere_m0_left.png"}) << "the failed run wrote diagnosis images";
+  EXPECT_EQ(ReadFileBytes(old_diag + "/sphere_m0_left.png"), "an earlier run's\n");
+  EXPECT_EQ(ReadFileBytes(report), "an earlier run's\n");
+
+  fs::copy_file(d + "/truth/scenes/sphere/lit_cam1.png", lit, fs::copy_options::overwrite_existing);
+  fs::remove(d + "/scenes/later/passive/cam2.png");
+  r = testing::RunCli("score --dataset " + d + " --scenes sphere,later --diagnose " + new_diag);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(d + "/scenes/later/passive/cam2.png: missing camera image"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find("points"), std::string::npos) << "a scene was scored: " << r.out;
+  EXPECT_FALSE(fs::exists(new_diag));
+  fs::remove_all(d);
+}
+
+// Module 0's left image dark: no lit pixel, no match ROI, so no diagnosis
+// image of it. An earlier run's four images of the module, left in the
+// --diagnose folder, stayed beside this run's as if they were its own; they
+// are removed, and the run says the module has none.
+TEST_F(ReconstructCli, ScoreRemovesAnEarlierRunsImagesOfAModuleThatMakesNone) {
+  namespace fs = std::filesystem;
+  const std::string d = testing::SimulateOneScene("sphere", 1, "score_dark_module");
+  const std::string left = d + "/scenes/sphere/active/cam0.png";
+  cv::imwrite(left, cv::Mat::zeros(cv::imread(left, cv::IMREAD_UNCHANGED).size(), CV_8UC1));
+  const std::string diag = dir_ + "/score_dark_module_diag";
+  fs::remove_all(diag);
+  fs::create_directories(diag);
+  for (const char* image : {"left", "status", "lost", "error"})
+    WriteFileAtomically(diag + "/sphere_m0_" + image + ".png", "an earlier run's\n");
+  const testing::Result r =
+      testing::RunCli("score --dataset " + d + " --scenes sphere --no-passive --diagnose " + diag);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("  m0 diagnosis images: none (the module searched no pixel)\n"), std::string::npos) << r.out;
+  std::vector<std::string> images;
+  for (const fs::directory_entry& e : fs::directory_iterator(diag)) images.push_back(e.path().filename());
+  std::sort(images.begin(), images.end());
+  EXPECT_EQ(images, (std::vector<std::string>{"sphere_m1_error.png", "sphere_m1_left.png", "sphere_m1_lost.png",
+                                              "sphere_m1_status.png"}));
+  fs::remove_all(d);
 }
 
 // A measurement volume deeper than the matcher can search (150 x 150 x 300

@@ -350,5 +350,28 @@ TEST_F(TuneCli, AModuleWithNoPeriodIsWarnedOfAndNotedInTheFile) {
   EXPECT_EQ(both.err.find("no grid period"), std::string::npos) << both.err;
 }
 
+// Module 0's right image without the grid (the passive capture's): its left
+// image gives the period, but the module gives no point, so the plate's
+// flatness there is never read. That used to be said only in a stdout line,
+// the run as quiet on stderr as on a plate checked flat; it is warned of.
+TEST_F(TuneCli, AModuleWhoseFlatnessIsNotReadIsWarnedOf) {
+  const std::string capture = dir_ + "/right_passive";
+  fs::remove_all(capture);
+  fs::create_directories(capture);
+  for (int k = 0; k < 4; ++k) {
+    const std::string image = "/cam" + std::to_string(k) + ".png";
+    fs::copy_file(dir_ + "/fine/scenes/plate/" + (k == 1 ? "passive" : "active") + image, capture + image);
+  }
+  const testing::Result r = testing::RunCli("tune --rig " + dir_ + "/fine/truth/rig.yaml --capture " + capture);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(Periods(r.out).size(), 2u) << r.out;
+  EXPECT_NE(r.err.find("tune: warning: module 0's flatness was not read in " + capture + " (fewer than 1000 points"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("module 1's flatness"), std::string::npos) << r.err;
+  const testing::Result both = testing::RunCli(Tune("fine"));  // both modules' points read: no such warning
+  EXPECT_EQ(both.err.find("flatness was not read"), std::string::npos) << both.err;
+}
+
 }  // namespace
 }  // namespace stereorig
