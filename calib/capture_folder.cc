@@ -209,6 +209,36 @@ void RefuseOddImageSizes(const std::string& dir, const std::vector<fs::path>& ca
   }
 }
 
+// The capture index of each of `captures` (sorted, CaptureSubfolders): a
+// numeric name's number (007 is 7), another name its place in the list.
+// Throws InputError for a number past an int (a time stamp, 20261207153000:
+// std::stoi aborted the run), and for two folders of one index (003 and
+// 0003, or 7 and a name that is the eighth): their views were merged into
+// one capture, a board pose each camera saw twice ("observed twice", or a
+// night checked as one capture fewer).
+std::vector<int> CaptureIndices(const std::vector<fs::path>& captures) {
+  std::vector<int> indices;
+  std::map<int, fs::path> folder_of;
+  for (size_t n = 0; n < captures.size(); ++n) {
+    const std::string name = captures[n].filename().string();
+    const bool numeric = std::all_of(name.begin(), name.end(), [](unsigned char c) { return std::isdigit(c) != 0; });
+    const std::string digits = name.substr(std::min(name.find_first_not_of('0'), name.size()));
+    constexpr size_t kMaxDigits = 9;  // any number of 9 digits fits an int
+    if (numeric && digits.size() > kMaxDigits)
+      throw InputError(captures[n].string(), "a capture folder's number must be under 10^" +
+                                                 std::to_string(kMaxDigits) +
+                                                 " (it is the capture's index): rename it (000, 001, ...)");
+    const int index = numeric ? (digits.empty() ? 0 : std::stoi(digits)) : static_cast<int>(n);
+    if (const auto [it, added] = folder_of.emplace(index, captures[n]); !added)
+      throw InputError(captures[n].string(),
+                       "is capture " + std::to_string(index) + ", as " + it->second.string() +
+                           " is (a number names a capture's index, 003 and 0003 alike; another name, its place "
+                           "among the folders sorted): rename one (000, 001, ...)");
+    indices.push_back(index);
+  }
+  return indices;
+}
+
 }  // namespace
 
 std::vector<std::string> CaptureFolderImages(const std::string& dir) {
@@ -250,6 +280,7 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
                      "holds no capture folders (expected NNN/camK.png)" + (note.empty() ? "" : "; " + note));
   }
 
+  const std::vector<int> indices = CaptureIndices(captures);
   if (rig_cameras.empty()) RefuseOddImageSizes(dir.string(), captures, num_cameras);
 
   DetectedCaptures out;
@@ -266,8 +297,7 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
   const TargetDetector detector(target, options);
   for (size_t n = 0; n < captures.size(); ++n) {
     const std::string name = captures[n].filename().string();
-    const bool numeric = !name.empty() && std::all_of(name.begin(), name.end(), ::isdigit);
-    const int capture = numeric ? std::stoi(name) : static_cast<int>(n);
+    const int capture = indices[n];
     out.capture_names[capture] = name;
     std::string line = "detect " + name + ":";
     for (int c = 0; c < num_cameras; ++c) {

@@ -960,5 +960,35 @@ TEST(CalibrateCli, AMisnamedCaptureIsRefusedAndASkippedOneNamedInRefusalAndRepor
   fs::remove_all(dir);
 }
 
+// A capture folder's name is its index when it is a number. A time stamp
+// (20261207153000) no int holds aborted the run (std::stoi's out_of_range,
+// exit 134); two folders of one index (003 and 0003) were merged into one
+// capture, refused as "capture 3, camera 0: observed twice", no folder
+// named. Each is refused before any detection, naming the folders.
+TEST(CalibrateCli, ACaptureFolderNumberPastAnIntOrTakenTwiceIsRefused) {
+  const RenderedSet& set = Rendered();
+  const std::string dir = set.dir + "/indices";
+  const std::string args = " --target " + set.dir + "/target.yaml --layout " + set.dir + "/one_module.yaml --out " +
+                           dir + "/rig.yaml --report " + dir + "/report.json";
+  CopyModuleZeroCaptures(set, dir, 8);
+  fs::rename(dir + "/007", dir + "/20261207153000");
+  testing::Result r = testing::RunCli("calibrate --captures " + dir + args);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(r.err, "stereorig calibrate: " + dir +
+                       "/20261207153000: a capture folder's number must be under 10^9 (it is the capture's index): "
+                       "rename it (000, 001, ...)\n");
+  EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
+  EXPECT_FALSE(fs::exists(dir + "/report.json"));
+  fs::rename(dir + "/20261207153000", dir + "/0003");
+  r = testing::RunCli("calibrate --captures " + dir + args);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(r.err, "stereorig calibrate: " + dir + "/003: is capture 3, as " + dir +
+                       "/0003 is (a number names a capture's index, 003 and 0003 alike; another name, its place "
+                       "among the folders sorted): rename one (000, 001, ...)\n");
+  EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
+  EXPECT_FALSE(fs::exists(dir + "/report.json"));
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace stereorig
