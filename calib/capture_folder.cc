@@ -521,6 +521,24 @@ std::vector<std::string> StereoViewsLeftOutNotes(const CalibrationReport& report
   return notes;
 }
 
+// Throws InputError if a module of `modules` pairs cameras whose images
+// (`cameras`, from the captures in `dir`) differ in size. Calibrated, such
+// a rig was written, exit 0, and refused by every reconstruction after
+// ("its two cameras' imagers differ in size (not supported)": the runtime
+// matches a module's rows), as the simulator refuses such a spec.
+void RefuseModulesOfTwoImagerSizes(const std::string& dir, const std::vector<ModuleLayout>& modules,
+                                   const std::vector<CameraImager>& cameras) {
+  for (const ModuleLayout& m : modules) {
+    const CameraImager &left = cameras[m.left_camera], &right = cameras[m.right_camera];
+    if (left.width_px == right.width_px && left.height_px == right.height_px) continue;
+    throw InputError(dir, m.name + "'s cameras differ in imager size: " + left.name + "'s images are " +
+                              SizeText({left.width_px, left.height_px}) + ", " + right.name + "'s " +
+                              SizeText({right.width_px, right.height_px}) +
+                              "; a module's two cameras need one (stereorig reconstruct matches their rows): window "
+                              "both alike, or images of another camera among them?");
+  }
+}
+
 }  // namespace
 
 FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const std::string& target_path,
@@ -533,6 +551,7 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
   input.source = captures_dir;
   const int num_cameras = LayoutCameraCount(input.modules);
   DetectedCaptures detected = DetectCaptureFolder(captures_dir, target, num_cameras, DetectOptions(), options.progress);
+  RefuseModulesOfTwoImagerSizes(CapturesRoot(captures_dir).string(), input.modules, detected.cameras);
   input.cameras = detected.cameras;
   input.observations = std::move(detected.observations);
   input.capture_names = std::move(detected.capture_names);
