@@ -804,6 +804,30 @@ TEST(Cli, ARigFileWithTwoModulesOfOneNameIsRefused) {
   std::filesystem::remove(path);
 }
 
+// Two cameras of one name were read, exit 0 (two modules of one name were
+// refused): the check names the camera that moved by it. Refused alike.
+// So is a negative residual or uncertainty: an RMS and a standard
+// deviation are >= 0, and the check squares them into its thresholds (-1
+// px read as 1 px, a threshold no night could fail).
+TEST(Cli, ARigFileWithTwoCamerasOfOneNameOrANegativeUncertaintyIsRefused) {
+  const std::string path = ::testing::TempDir() + "/rig_dup_camera_" + std::to_string(getpid()) + ".yaml";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {Replace(GoodRigText(), "name: \"cam2\"", "name: \"cam1\""),
+       "cameras[2].name: cam1 is used twice (cameras[1] too): each camera needs a name of its own"},
+      {Replace(GoodRigText(), "uncertainties: {}", "uncertainties: {cam0_projection_center_px: -1}"),
+       "provenance.uncertainties.cam0_projection_center_px: must be >= 0, got -1"},
+      {Replace(GoodRigText(), "residuals: {}", "residuals: {cam0_rms_px: -0.02}"),
+       "provenance.residuals.cam0_rms_px: must be >= 0, got -0.02"}};
+  for (const auto& [text, says] : cases) {
+    std::ofstream(path) << text;
+    const Result r = RunCli("rig --rig " + path);
+    EXPECT_EQ(r.code, 2) << says;
+    EXPECT_EQ(r.err, "stereorig rig: " + path + ": " + says + "\n");
+    EXPECT_EQ(r.out, "");
+  }
+  std::filesystem::remove(path);
+}
+
 // --volume and --distance had no upper bound: 1e308 printed "3D error
 // after rigid alignment inf mm", exit 0. At most 100 000 mm (100 m) each.
 TEST(Cli, RigRefusesATruthVolumeBeyondAHundredMetres) {

@@ -137,8 +137,14 @@ Rig ParseRig(YamlMap root) {
 
   std::vector<Camera> cameras;
   std::vector<std::string> names;
+  std::map<std::string, int> camera_named;  // camera name -> its index
   for (YamlMap c : root.GetMaps("cameras")) {
     names.push_back(c.GetString("name"));
+    // As a module's (below): the check names the camera that moved by it,
+    // and two of one name were read, exit 0.
+    if (const auto [it, added] = camera_named.emplace(names.back(), static_cast<int>(cameras.size())); !added)
+      throw InputError(c.Where("name"), names.back() + " is used twice (cameras[" + std::to_string(it->second) +
+                                            "] too): each camera needs a name of its own");
     const std::string model = c.GetString("lensmodel");
     // The Camera refuses it too; here the message names the key.
     if (const std::string p = LensmodelConfigProblem(model); !p.empty()) throw InputError(c.Where("lensmodel"), p);
