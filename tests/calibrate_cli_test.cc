@@ -960,6 +960,30 @@ TEST(CalibrateCli, AMisnamedCaptureIsRefusedAndASkippedOneNamedInRefusalAndRepor
   fs::remove_all(dir);
 }
 
+// Models of another rig in the --export-cameramodels folder (cam2 and cam3
+// of an earlier two-module calibration) stayed beside this one-module
+// calibration's cam0 and cam1 without a word. Warned of, naming them.
+TEST(CalibrateCli, ModelsOfAnotherRigInTheModelsFolderAreWarnedOf) {
+  const RenderedSet& set = Rendered();
+  const std::string dir = set.dir + "/other_models";
+  CopyModuleZeroCaptures(set, dir + "/captures", 8);
+  fs::create_directories(dir + "/models");
+  for (const char* name : {"cam2.cameramodel", "cam3.cameramodel"})
+    std::ofstream(dir + "/models/" + name) << "another rig's\n";
+  const testing::Result r =
+      testing::RunCli("calibrate --captures " + dir + "/captures --target " + set.dir + "/target.yaml --layout " +
+                      set.dir + "/one_module.yaml --out " + dir + "/rig.yaml --report " + dir +
+                      "/report.json --export-cameramodels " + dir + "/models");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("calibrate: warning: " + dir +
+                       "/models also holds cam2.cameramodel, cam3.cameramodel, not written by this run: another "
+                       "rig's models?"),
+            std::string::npos)
+      << r.err;
+  EXPECT_TRUE(fs::exists(dir + "/models/cam0.cameramodel"));
+  fs::remove_all(dir);
+}
+
 // A module whose right camera's images are all of another size (cam1 read
 // out in a smaller window): calibrated, the rig file written, exit 0, and
 // every reconstruction refused it after ("its two cameras' imagers differ

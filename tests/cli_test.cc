@@ -654,6 +654,27 @@ TEST(Cli, RigExportWritesCameramodelsThatRoundTrip) {
   const Result r = RunCli("rig --rig " + path + " --export-cameramodels " + dir);
   EXPECT_EQ(r.code, 0) << r.err;
   for (int i = 0; i < 4; ++i) EXPECT_TRUE(std::filesystem::exists(dir + "/cam" + std::to_string(i) + ".cameramodel"));
+  EXPECT_EQ(r.err, "");
+}
+
+// Models of another rig in the folder (a 3-module rig's cam4 and cam5, the
+// folder exported into before) stayed beside this rig's fresh ones without
+// a word: a folder of two rigs' models. Warned of on stderr, naming them;
+// left as they are (the user's files).
+TEST(Cli, RigExportWarnsOfOtherModelsInItsFolder) {
+  const std::string dir = ::testing::TempDir() + "/cli_export_others_" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir + "/models");
+  std::ofstream(dir + "/rig.yaml") << GoodRigText();
+  for (const char* name : {"cam5.cameramodel", "cam4.cameramodel", "notes.txt"})
+    std::ofstream(dir + "/models/" + name) << "another rig's\n";
+  const Result r = RunCli("rig --rig " + dir + "/rig.yaml --export-cameramodels " + dir + "/models");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "rig: warning: " + dir +
+                       "/models also holds cam4.cameramodel, cam5.cameramodel, not written by this run: another "
+                       "rig's models? (remove them, or export into a folder of its own)\n");
+  EXPECT_TRUE(std::filesystem::exists(dir + "/models/cam4.cameramodel"));
+  std::filesystem::remove_all(dir);
 }
 
 // `rig --export-cameramodels` checks its folder (created if needed) before
