@@ -138,11 +138,16 @@ int RunCalibrate(int argc, char** argv) {
   WriteCalibrationOutputs(result, out_path, report_path, cameramodels_dir);
   // Every file written is named: the models too, by their folder (their
   // names are camK.cameramodel, one per camera of the layout).
-  if (cameramodels_dir.empty())
+  if (cameramodels_dir.empty()) {
     std::printf("wrote %s and %s\n", out_path.c_str(), report_path.c_str());
-  else
+  } else {
     std::printf("wrote %s, %s and %d camera models (camK.cameramodel) in %s\n", out_path.c_str(), report_path.c_str(),
                 LayoutCameraCount(layout), cameramodels_dir.c_str());
+    std::vector<std::string> models;
+    for (int k = 0, n = LayoutCameraCount(layout); k < n; ++k)
+      models.push_back("cam" + std::to_string(k) + ".cameramodel");
+    WarnOfOtherCameramodels("calibrate", cameramodels_dir, models);
+  }
   return 0;
 }
 

@@ -209,6 +209,36 @@ void RefuseOddImageSizes(const std::string& dir, const std::vector<fs::path>& ca
   }
 }
 
+// The capture index of each of `captures` (sorted, CaptureSubfolders): a
+// numeric name's number (007 is 7), another name its place in the list.
+// Throws InputError for a number past an int (a time stamp, 20261207153000:
+// std::stoi aborted the run), and for two folders of one index (003 and
+// 0003, or 7 and a name that is the eighth): their views were merged into
+// one capture, a board pose each camera saw twice ("observed twice", or a
+// night checked as one capture fewer).
+std::vector<int> CaptureIndices(const std::vector<fs::path>& captures) {
+  std::vector<int> indices;
+  std::map<int, fs::path> folder_of;
+  for (size_t n = 0; n < captures.size(); ++n) {
+    const std::string name = captures[n].filename().string();
+    const bool numeric = std::all_of(name.begin(), name.end(), [](unsigned char c) { return std::isdigit(c) != 0; });
+    const std::string digits = name.substr(std::min(name.find_first_not_of('0'), name.size()));
+    constexpr size_t kMaxDigits = 9;  // any number of 9 digits fits an int
+    if (numeric && digits.size() > kMaxDigits)
+      throw InputError(captures[n].string(), "a capture folder's number must be under 10^" +
+                                                 std::to_string(kMaxDigits) +
+                                                 " (it is the capture's index): rename it (000, 001, ...)");
+    const int index = numeric ? (digits.empty() ? 0 : std::stoi(digits)) : static_cast<int>(n);
+    if (const auto [it, added] = folder_of.emplace(index, captures[n]); !added)
+      throw InputError(captures[n].string(),
+                       "is capture " + std::to_string(index) + ", as " + it->second.string() +
+                           " is (a number names a capture's index, 003 and 0003 alike; another name, its place "
+                           "among the folders sorted): rename one (000, 001, ...)");
+    indices.push_back(index);
+  }
+  return indices;
+}
+
 }  // namespace
 
 std::vector<std::string> CaptureFolderImages(const std::string& dir) {
@@ -250,6 +280,7 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
                      "holds no capture folders (expected NNN/camK.png)" + (note.empty() ? "" : "; " + note));
   }
 
+  const std::vector<int> indices = CaptureIndices(captures);
   if (rig_cameras.empty()) RefuseOddImageSizes(dir.string(), captures, num_cameras);
 
   DetectedCaptures out;
@@ -266,8 +297,7 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
   const TargetDetector detector(target, options);
   for (size_t n = 0; n < captures.size(); ++n) {
     const std::string name = captures[n].filename().string();
-    const bool numeric = !name.empty() && std::all_of(name.begin(), name.end(), ::isdigit);
-    const int capture = numeric ? std::stoi(name) : static_cast<int>(n);
+    const int capture = indices[n];
     out.capture_names[capture] = name;
     std::string line = "detect " + name + ":";
     for (int c = 0; c < num_cameras; ++c) {
@@ -491,6 +521,24 @@ std::vector<std::string> StereoViewsLeftOutNotes(const CalibrationReport& report
   return notes;
 }
 
+// Throws InputError if a module of `modules` pairs cameras whose images
+// (`cameras`, from the captures in `dir`) differ in size. Calibrated, such
+// a rig was written, exit 0, and refused by every reconstruction after
+// ("its two cameras' imagers differ in size (not supported)": the runtime
+// matches a module's rows), as the simulator refuses such a spec.
+void RefuseModulesOfTwoImagerSizes(const std::string& dir, const std::vector<ModuleLayout>& modules,
+                                   const std::vector<CameraImager>& cameras) {
+  for (const ModuleLayout& m : modules) {
+    const CameraImager &left = cameras[m.left_camera], &right = cameras[m.right_camera];
+    if (left.width_px == right.width_px && left.height_px == right.height_px) continue;
+    throw InputError(dir, m.name + "'s cameras differ in imager size: " + left.name + "'s images are " +
+                              SizeText({left.width_px, left.height_px}) + ", " + right.name + "'s " +
+                              SizeText({right.width_px, right.height_px}) +
+                              "; a module's two cameras need one (stereorig reconstruct matches their rows): window "
+                              "both alike, or images of another camera among them?");
+  }
+}
+
 }  // namespace
 
 FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const std::string& target_path,
@@ -503,6 +551,7 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
   input.source = captures_dir;
   const int num_cameras = LayoutCameraCount(input.modules);
   DetectedCaptures detected = DetectCaptureFolder(captures_dir, target, num_cameras, DetectOptions(), options.progress);
+  RefuseModulesOfTwoImagerSizes(CapturesRoot(captures_dir).string(), input.modules, detected.cameras);
   input.cameras = detected.cameras;
   input.observations = std::move(detected.observations);
   input.capture_names = std::move(detected.capture_names);

@@ -173,6 +173,23 @@ void ScenesSpec::Check(const std::string& where) const {
   Require(plate_size_mm.minCoeff() > 0, where, "plate_size_mm", "must be positive");
   Require(tuber_semi_axes_mm.minCoeff() > 0, where, "tuber_semi_axes_mm", "must be positive");
   Require(tuber_bump >= 0 && tuber_bump < 0.3, where, "tuber_bump", "must be in [0, 0.3)");
+  // The scenes are objects on the belt, their truth surface sampled every
+  // 0.2 mm (SimulateOptions::surface_spacing_mm): a 300 mm cube is 1.4e7
+  // points. A cup 100 m across (75 mm typed in micrometres, say) rendered
+  // for minutes, then aborted in std::bad_alloc (exit 134).
+  constexpr double kMaxSizeMm = 300;
+  const std::pair<const char*, double> sizes_mm[] = {{"cup_diameter_mm", cup_diameter_mm},
+                                                     {"cup_height_mm", cup_height_mm},
+                                                     {"sphere_diameter_mm", sphere_diameter_mm},
+                                                     {"ballbar_sphere_diameter_mm", ballbar_sphere_diameter_mm},
+                                                     {"ballbar_distance_mm", ballbar_distance_mm},
+                                                     {"plate_size_mm", plate_size_mm.maxCoeff()},
+                                                     {"tuber_semi_axes_mm", 2 * tuber_semi_axes_mm.maxCoeff()}};
+  for (const auto& [key, size_mm] : sizes_mm)
+    Require(size_mm <= kMaxSizeMm, where, key,
+            "the object is " + ShortestNumberText(size_mm) + " mm across, over the " + ShortestNumberText(kMaxSizeMm) +
+                " mm a scene on the belt may be (its truth surface is sampled every 0.2 mm); is it in "
+                "micrometres? the unit is mm");
   for (double a : {cup_albedo, artifact_albedo, tuber_albedo}) {
     Require(a > 0 && a <= 1, where, "albedo", "albedos must be in (0, 1]");
   }

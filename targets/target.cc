@@ -1,5 +1,6 @@
 #include "targets/target.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <set>
@@ -46,6 +47,16 @@ Target::Target(Layout layout, const std::string& where) : layout_(std::move(layo
   if (l.flatness_allowance_mm < 0) throw InputError(where, "flatness_allowance_mm must not be negative");
   std::string why;
   if (!IsRigid(l.back_from_front.ToMatrix4(), 1e-9, &why)) throw InputError(where, "back_from_front: " + why);
+  // A back face faces away from the front: each face's z points into the
+  // plate, so the two z axes are opposite (a turn of about 180 deg about y,
+  // IdealBackFromFront), within a misaligned print's degrees. A rotation
+  // left at the identity (z kept) was read, and calibrate refused only
+  // after its whole solve ("stage 3 did not converge: rms 21 px").
+  const double z_turn_deg = std::acos(std::clamp(l.back_from_front.rotation()(2, 2), -1.0, 1.0)) * 180 / M_PI;
+  if (l.double_sided && !(z_turn_deg > 90))
+    throw InputError(where, "back_from_front: its rotation turns the back face's z axis " + NumberText(z_turn_deg, 3) +
+                                " deg from the front's: a back face faces away from the front (z into the plate on "
+                                "each face), turned about 180 deg (about y: diag(-1, 1, -1))");
   const int faces = l.double_sided ? 2 : 1;
   if (!l.double_sided && (!l.faces[0].tags.empty() || !l.faces[1].tags.empty())) {
     throw InputError(where, "a plain (one-sided) board carries no tags");

@@ -960,5 +960,90 @@ TEST(CalibrateCli, AMisnamedCaptureIsRefusedAndASkippedOneNamedInRefusalAndRepor
   fs::remove_all(dir);
 }
 
+// Models of another rig in the --export-cameramodels folder (cam2 and cam3
+// of an earlier two-module calibration) stayed beside this one-module
+// calibration's cam0 and cam1 without a word. Warned of, naming them.
+TEST(CalibrateCli, ModelsOfAnotherRigInTheModelsFolderAreWarnedOf) {
+  const RenderedSet& set = Rendered();
+  const std::string dir = set.dir + "/other_models";
+  CopyModuleZeroCaptures(set, dir + "/captures", 8);
+  fs::create_directories(dir + "/models");
+  for (const char* name : {"cam2.cameramodel", "cam3.cameramodel"})
+    std::ofstream(dir + "/models/" + name) << "another rig's\n";
+  const testing::Result r =
+      testing::RunCli("calibrate --captures " + dir + "/captures --target " + set.dir + "/target.yaml --layout " +
+                      set.dir + "/one_module.yaml --out " + dir + "/rig.yaml --report " + dir +
+                      "/report.json --export-cameramodels " + dir + "/models");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("calibrate: warning: " + dir +
+                       "/models also holds cam2.cameramodel, cam3.cameramodel, not written by this run: another "
+                       "rig's models?"),
+            std::string::npos)
+      << r.err;
+  EXPECT_TRUE(fs::exists(dir + "/models/cam0.cameramodel"));
+  fs::remove_all(dir);
+}
+
+// A module whose right camera's images are all of another size (cam1 read
+// out in a smaller window): calibrated, the rig file written, exit 0, and
+// every reconstruction refused it after ("its two cameras' imagers differ
+// in size (not supported)"). Refused before the solve, naming the module
+// and both sizes; nothing written.
+TEST(CalibrateCli, AModuleOfTwoImagerSizesIsRefused) {
+  const RenderedSet& set = Rendered();
+  const std::string dir = set.dir + "/two_sizes";
+  CopyModuleZeroCaptures(set, dir, 8);
+  const Camera& cam1 = set.truth.camera(1);
+  const int width_px = cam1.imager_width_px() - 40, height_px = cam1.imager_height_px() - 30;
+  for (int c = 0; c < 8; ++c) {  // the window's corner at the sensor's: cx, cy unchanged
+    const std::string image = dir + "/00" + std::to_string(c) + "/cam1.png";
+    cv::imwrite(image, cv::imread(image, cv::IMREAD_GRAYSCALE)(cv::Rect(0, 0, width_px, height_px)).clone());
+  }
+  const testing::Result r =
+      testing::RunCli("calibrate --captures " + dir + " --target " + set.dir + "/target.yaml --layout " + set.dir +
+                      "/one_module.yaml --out " + dir + "/rig.yaml --report " + dir + "/report.json");
+  EXPECT_EQ(r.code, 2) << r.err;
+  const Camera& cam0 = set.truth.camera(0);
+  EXPECT_NE(r.err.find("stereorig calibrate: " + dir + ": module0's cameras differ in imager size: cam0's images are " +
+                       std::to_string(cam0.imager_width_px()) + "x" + std::to_string(cam0.imager_height_px()) +
+                       ", cam1's " + std::to_string(width_px) + "x" + std::to_string(height_px) + "; "),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("stage 1"), std::string::npos) << r.err;  // before any solve
+  EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
+  EXPECT_FALSE(fs::exists(dir + "/report.json"));
+  fs::remove_all(dir);
+}
+
+// A capture folder's name is its index when it is a number. A time stamp
+// (20261207153000) no int holds aborted the run (std::stoi's out_of_range,
+// exit 134); two folders of one index (003 and 0003) were merged into one
+// capture, refused as "capture 3, camera 0: observed twice", no folder
+// named. Each is refused before any detection, naming the folders.
+TEST(CalibrateCli, ACaptureFolderNumberPastAnIntOrTakenTwiceIsRefused) {
+  const RenderedSet& set = Rendered();
+  const std::string dir = set.dir + "/indices";
+  const std::string args = " --target " + set.dir + "/target.yaml --layout " + set.dir + "/one_module.yaml --out " +
+                           dir + "/rig.yaml --report " + dir + "/report.json";
+  CopyModuleZeroCaptures(set, dir, 8);
+  fs::rename(dir + "/007", dir + "/20261207153000");
+  testing::Result r = testing::RunCli("calibrate --captures " + dir + args);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(r.err, "stereorig calibrate: " + dir +
+                       "/20261207153000: a capture folder's number must be under 10^9 (it is the capture's index): "
+                       "rename it (000, 001, ...)\n");
+  EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
+  EXPECT_FALSE(fs::exists(dir + "/report.json"));
+  fs::rename(dir + "/20261207153000", dir + "/0003");
+  r = testing::RunCli("calibrate --captures " + dir + args);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(r.err, "stereorig calibrate: " + dir + "/003: is capture 3, as " + dir +
+                       "/0003 is (a number names a capture's index, 003 and 0003 alike; another name, its place "
+                       "among the folders sorted): rename one (000, 001, ...)\n");
+  EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
+  EXPECT_FALSE(fs::exists(dir + "/report.json"));
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace stereorig

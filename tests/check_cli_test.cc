@@ -381,6 +381,37 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     expect_refused(check(d, dir + "/rig.yaml"), "a camera index beyond any rig, but the rig has 4 cameras",
                    "a camera index beyond any rig");
   }
+  {  // A capture folder named by a time stamp, a number no int holds:
+     // std::stoi threw out_of_range, and the process aborted (exit 134).
+    const std::string d = copy("stamped_capture");
+    fs::rename(d + "/007", d + "/20261207153000");
+    expect_refused(check(d, dir + "/rig.yaml"), d + "/20261207153000: a capture folder's number must be under 10^9",
+                   "a time-stamped capture");
+  }
+  {  // Two folders of one capture index (003 and 0003): their views were
+     // merged into one capture of two board poses, and the night judged
+     // "ok" on one capture fewer than it has.
+    const std::string d = copy("one_index_twice");
+    fs::rename(d + "/007", d + "/0003");
+    expect_refused(check(d, dir + "/rig.yaml"), d + "/003: is capture 3, as " + d + "/0003 is",
+                   "two folders of one capture");
+  }
+  {  // A negative projection uncertainty in the rig file (a standard
+     // deviation, >= 0): squared into cam0's threshold, it made it 3.5 px
+     // against 0.03, a check that could not fail, exit 0. Refused as the
+     // rig file's; so is a negative residual RMS (it was said missing).
+    for (const char* key : {"cam0_projection_center_px", "cam0_rms_px"}) {
+      Rig bad = rig;
+      auto& section = std::string(key) == "cam0_rms_px" ? bad.provenance().residuals : bad.provenance().uncertainties;
+      section[key] = -1;
+      WriteRigFile(bad, dir + "/negative_rig.yaml");
+      expect_refused(check(dir + "/ds", dir + "/negative_rig.yaml"),
+                     "/negative_rig.yaml: provenance." +
+                         std::string(std::string(key) == "cam0_rms_px" ? "residuals." : "uncertainties.") + key +
+                         ": must be >= 0, got -1",
+                     key);
+    }
+  }
   {  // The right images with the rig file of another rig: every camera's
      // focal length 20% longer and its centre 40 px away.
     std::vector<Camera> cameras;

@@ -111,6 +111,33 @@ TEST(CliTarget, BadTargetFileExitsTwoAndWritesNothing) {
   EXPECT_EQ(RunStereorig("target").code, 2);  // --out is required
 }
 
+// A double-sided board whose back_from_front keeps z (the rotation left at
+// the identity: a back face facing the way the front does) was drawn, exit
+// 0, and calibrate refused it only after its whole solve. Refused when read.
+TEST(CliTarget, ABackFaceFacingTheWayTheFrontDoesIsRefused) {
+  const std::string dir = ::testing::TempDir() + "/cli_target_back_" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  ASSERT_EQ(RunStereorig("target --out " + dir + "/default.svg --write-target " + dir + "/t.yaml").code, 0);
+  std::ifstream in(dir + "/t.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string flat = text.str();
+  const size_t at = flat.find("\nback_from_front: ");
+  ASSERT_NE(at, std::string::npos) << flat;
+  flat.replace(at, flat.find('\n', at + 1) - at,
+               "\nback_from_front: [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 5], [0, 0, 0, 1]]");
+  std::ofstream(dir + "/flat.yaml") << flat;
+  const Result r = RunStereorig("target --target " + dir + "/flat.yaml --out " + dir + "/board.svg");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "stereorig target: " + dir +
+                       "/flat.yaml: back_from_front: its rotation turns the back face's z axis 0 deg from the "
+                       "front's: a back face faces away from the front (z into the plate on each face), turned about "
+                       "180 deg (about y: diag(-1, 1, -1))\n");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/board.svg"));
+  std::filesystem::remove_all(dir);
+}
+
 // --face back of a plain (one-sided) board is refused naming the flag and
 // the target file (the SVG writer's "board svg: ..." named neither).
 TEST(CliTarget, BackFaceOfAPlainBoardNamesTheFlagAndTheFile) {

@@ -654,6 +654,27 @@ TEST(Cli, RigExportWritesCameramodelsThatRoundTrip) {
   const Result r = RunCli("rig --rig " + path + " --export-cameramodels " + dir);
   EXPECT_EQ(r.code, 0) << r.err;
   for (int i = 0; i < 4; ++i) EXPECT_TRUE(std::filesystem::exists(dir + "/cam" + std::to_string(i) + ".cameramodel"));
+  EXPECT_EQ(r.err, "");
+}
+
+// Models of another rig in the folder (a 3-module rig's cam4 and cam5, the
+// folder exported into before) stayed beside this rig's fresh ones without
+// a word: a folder of two rigs' models. Warned of on stderr, naming them;
+// left as they are (the user's files).
+TEST(Cli, RigExportWarnsOfOtherModelsInItsFolder) {
+  const std::string dir = ::testing::TempDir() + "/cli_export_others_" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir + "/models");
+  std::ofstream(dir + "/rig.yaml") << GoodRigText();
+  for (const char* name : {"cam5.cameramodel", "cam4.cameramodel", "notes.txt"})
+    std::ofstream(dir + "/models/" + name) << "another rig's\n";
+  const Result r = RunCli("rig --rig " + dir + "/rig.yaml --export-cameramodels " + dir + "/models");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "rig: warning: " + dir +
+                       "/models also holds cam4.cameramodel, cam5.cameramodel, not written by this run: another "
+                       "rig's models? (remove them, or export into a folder of its own)\n");
+  EXPECT_TRUE(std::filesystem::exists(dir + "/models/cam4.cameramodel"));
+  std::filesystem::remove_all(dir);
 }
 
 // `rig --export-cameramodels` checks its folder (created if needed) before
@@ -801,6 +822,30 @@ TEST(Cli, ARigFileWithTwoModulesOfOneNameIsRefused) {
                        ": modules[1].name: module0 is used twice (modules[0] too): each module needs a name of its "
                        "own\n");
   EXPECT_EQ(r.out, "");
+  std::filesystem::remove(path);
+}
+
+// Two cameras of one name were read, exit 0 (two modules of one name were
+// refused): the check names the camera that moved by it. Refused alike.
+// So is a negative residual or uncertainty: an RMS and a standard
+// deviation are >= 0, and the check squares them into its thresholds (-1
+// px read as 1 px, a threshold no night could fail).
+TEST(Cli, ARigFileWithTwoCamerasOfOneNameOrANegativeUncertaintyIsRefused) {
+  const std::string path = ::testing::TempDir() + "/rig_dup_camera_" + std::to_string(getpid()) + ".yaml";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {Replace(GoodRigText(), "name: \"cam2\"", "name: \"cam1\""),
+       "cameras[2].name: cam1 is used twice (cameras[1] too): each camera needs a name of its own"},
+      {Replace(GoodRigText(), "uncertainties: {}", "uncertainties: {cam0_projection_center_px: -1}"),
+       "provenance.uncertainties.cam0_projection_center_px: must be >= 0, got -1"},
+      {Replace(GoodRigText(), "residuals: {}", "residuals: {cam0_rms_px: -0.02}"),
+       "provenance.residuals.cam0_rms_px: must be >= 0, got -0.02"}};
+  for (const auto& [text, says] : cases) {
+    std::ofstream(path) << text;
+    const Result r = RunCli("rig --rig " + path);
+    EXPECT_EQ(r.code, 2) << says;
+    EXPECT_EQ(r.err, "stereorig rig: " + path + ": " + says + "\n");
+    EXPECT_EQ(r.out, "");
+  }
   std::filesystem::remove(path);
 }
 

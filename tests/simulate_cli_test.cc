@@ -15,6 +15,7 @@
 #include <functional>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "tests/sim_cli_util.h"
@@ -556,6 +557,33 @@ TEST(SimulateCli, AProjectorWhoseLinesMergeIsRefused) {
   ExpectEachRefusedBeforeAnyWork({{" --spec " + spec + " --out " + dir + "/out/ds --calibration-captures 0 --no-scenes",
                                    spec + ": modules[0].projector: lines: 1000000000 lines over the fan stand"}},
                                  dir + "/out");
+  fs::remove_all(dir);
+}
+
+// A cup 75 mm across typed in micrometres (75000) rendered for minutes,
+// then aborted in std::bad_alloc (exit 134) sampling its truth surface
+// every 0.2 mm. Each scene's size is held to 300 mm, refused naming the
+// key before any work (here with --no-scenes, which read the spec whole
+// and wrote the dataset).
+TEST(SimulateCli, ASceneObjectLargerThanTheBeltTakesIsRefused) {
+  const std::string dir = ::testing::TempDir() + "/sim_cli_sizes_" + std::to_string(getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir + "/out");
+  std::vector<std::pair<std::string, std::string>> cases;
+  for (const auto& [from, to, says] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"cup_diameter_mm: 75", "cup_diameter_mm: 75000",
+            "cup_diameter_mm: the object is 75000 mm across, over "
+            "the 300 mm a scene on the belt may be"},
+           {"plate_size_mm: [130, 120, 8]", "plate_size_mm: [130, 301, 8]", "plate_size_mm: the object is 301 mm"},
+           {"tuber_semi_axes_mm: [42, 30, 27]", "tuber_semi_axes_mm: [42, 151, 27]",
+            "tuber_semi_axes_mm: the object is 302 mm"}}) {
+    const std::string spec = dir + "/" + std::to_string(cases.size()) + ".yaml";
+    const std::string text = EditedDefaultSpec(spec, from, to);  // before the stream opens it
+    std::ofstream(spec) << text;
+    cases.push_back({" --spec " + spec + " --out " + dir + "/out/ds --calibration-captures 0 --no-scenes",
+                     spec + ": scenes: " + says});
+  }
+  ExpectEachRefusedBeforeAnyWork(cases, dir + "/out");
   fs::remove_all(dir);
 }
 

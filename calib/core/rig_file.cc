@@ -70,9 +70,16 @@ void CheckCameraSpacing(const Pose& pose, const std::string& before, const std::
   throw InputError(where, why);
 }
 
-std::map<std::string, double> ReadNumberMap(YamlMap map) {
+// provenance.residuals and .uncertainties: RMS values and standard
+// deviations, each >= 0. The check squares them into its thresholds: a
+// negative one (-1 px) read as a large one, a threshold no night could
+// fail.
+std::map<std::string, double> ReadNonNegativeNumberMap(YamlMap map) {
   std::map<std::string, double> out;
-  for (const std::string& key : map.Keys()) out[key] = map.GetDouble(key);
+  for (const std::string& key : map.Keys()) {
+    out[key] = map.GetDouble(key);
+    if (!(out[key] >= 0)) throw InputError(map.Where(key), "must be >= 0, got " + NumberText(out[key], 6));
+  }
   return out;
 }
 
@@ -118,8 +125,8 @@ Rig ParseRig(YamlMap root) {
     prov.tool = p.GetString("tool");
     prov.date_utc = p.GetString("date_utc");
     prov.input = p.GetString("input");
-    prov.residuals = ReadNumberMap(p.GetMap("residuals"));
-    prov.uncertainties = ReadNumberMap(p.GetMap("uncertainties"));
+    prov.residuals = ReadNonNegativeNumberMap(p.GetMap("residuals"));
+    prov.uncertainties = ReadNonNegativeNumberMap(p.GetMap("uncertainties"));
     if (p.Has("target")) {
       if (version < 2)
         throw InputError(p.Where("target"), "is not in a version 1 rig file (version 2 added it): set version: 2");
@@ -130,8 +137,14 @@ Rig ParseRig(YamlMap root) {
 
   std::vector<Camera> cameras;
   std::vector<std::string> names;
+  std::map<std::string, int> camera_named;  // camera name -> its index
   for (YamlMap c : root.GetMaps("cameras")) {
     names.push_back(c.GetString("name"));
+    // As a module's (below): the check names the camera that moved by it,
+    // and two of one name were read, exit 0.
+    if (const auto [it, added] = camera_named.emplace(names.back(), static_cast<int>(cameras.size())); !added)
+      throw InputError(c.Where("name"), names.back() + " is used twice (cameras[" + std::to_string(it->second) +
+                                            "] too): each camera needs a name of its own");
     const std::string model = c.GetString("lensmodel");
     // The Camera refuses it too; here the message names the key.
     if (const std::string p = LensmodelConfigProblem(model); !p.empty()) throw InputError(c.Where("lensmodel"), p);

@@ -38,7 +38,7 @@ Rig MakeRandomRig(unsigned seed) {
   rig.provenance() = {"stereorig test",
                       "2026-11-23T00:00:00Z",
                       "a \"quoted\" input\\path",
-                      {{"stage1_rms_px", 0.1 + u(rng)}},
+                      {{"stage1_rms_px", 1.1 + u(rng)}},  // an RMS, >= 0 (the reader refuses less)
                       {{"S_0_1_mm", 1e-3 * (2 + u(rng))}},
                       std::nullopt};
   if (seed % 2) {  // half of them record the board they were calibrated with
