@@ -210,32 +210,39 @@ void RefuseOddImageSizes(const std::string& dir, const std::vector<fs::path>& ca
 }
 
 // The capture index of each of `captures` (sorted, CaptureSubfolders): a
-// numeric name's number (007 is 7), another name its place in the list.
+// numeric name's number (007 is 7); the other names, in their sorted order,
+// the indices after the largest number (all of them from 0 when no name is
+// a number). A named folder among numbered ones (a retake `003b`, a
+// `final_pose` beside `001`..`007`) is so a capture of its own: its place
+// among all the folders used to be its index and often a numbered folder's.
 // Throws InputError for a number past an int (a time stamp, 20261207153000:
-// std::stoi aborted the run), and for two folders of one index (003 and
-// 0003, or 7 and a name that is the eighth): their views were merged into
-// one capture, a board pose each camera saw twice ("observed twice", or a
-// night checked as one capture fewer).
+// std::stoi aborted the run), and for two folders of one number (003 and
+// 0003): their views were merged into one capture, a board pose each camera
+// saw twice ("observed twice", or a night checked as one capture fewer).
 std::vector<int> CaptureIndices(const std::vector<fs::path>& captures) {
-  std::vector<int> indices;
+  constexpr size_t kMaxDigits = 9;  // any number of 9 digits fits an int, and so does it plus the named folders
+  std::vector<int> indices(captures.size(), -1);
   std::map<int, fs::path> folder_of;
+  int largest_number = -1;
   for (size_t n = 0; n < captures.size(); ++n) {
     const std::string name = captures[n].filename().string();
-    const bool numeric = std::all_of(name.begin(), name.end(), [](unsigned char c) { return std::isdigit(c) != 0; });
+    if (!std::all_of(name.begin(), name.end(), [](unsigned char c) { return std::isdigit(c) != 0; })) continue;
     const std::string digits = name.substr(std::min(name.find_first_not_of('0'), name.size()));
-    constexpr size_t kMaxDigits = 9;  // any number of 9 digits fits an int
-    if (numeric && digits.size() > kMaxDigits)
+    if (digits.size() > kMaxDigits)
       throw InputError(captures[n].string(), "a capture folder's number must be under 10^" +
                                                  std::to_string(kMaxDigits) +
                                                  " (it is the capture's index): rename it (000, 001, ...)");
-    const int index = numeric ? (digits.empty() ? 0 : std::stoi(digits)) : static_cast<int>(n);
+    const int index = digits.empty() ? 0 : std::stoi(digits);
     if (const auto [it, added] = folder_of.emplace(index, captures[n]); !added)
-      throw InputError(captures[n].string(),
-                       "is capture " + std::to_string(index) + ", as " + it->second.string() +
-                           " is (a number names a capture's index, 003 and 0003 alike; another name, its place "
-                           "among the folders sorted): rename one (000, 001, ...)");
-    indices.push_back(index);
+      throw InputError(captures[n].string(), "is capture " + std::to_string(index) + ", as " + it->second.string() +
+                                                 " is (a folder's number is its capture's index, 003 and 0003 "
+                                                 "alike): rename one (000, 001, ...)");
+    indices[n] = index;
+    largest_number = std::max(largest_number, index);
   }
+  int next = largest_number + 1;
+  for (int& index : indices)
+    if (index < 0) index = next++;
   return indices;
 }
 

@@ -11,10 +11,13 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
+#include <set>
 
 #include "calib/calib_test_util.h"
 #include "calib/capture_folder.h"
@@ -1038,10 +1041,44 @@ TEST(CalibrateCli, ACaptureFolderNumberPastAnIntOrTakenTwiceIsRefused) {
   r = testing::RunCli("calibrate --captures " + dir + args);
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_EQ(r.err, "stereorig calibrate: " + dir + "/003: is capture 3, as " + dir +
-                       "/0003 is (a number names a capture's index, 003 and 0003 alike; another name, its place "
-                       "among the folders sorted): rename one (000, 001, ...)\n");
+                       "/0003 is (a folder's number is its capture's index, 003 and 0003 alike): rename one (000, "
+                       "001, ...)\n");
   EXPECT_FALSE(fs::exists(dir + "/rig.yaml"));
   EXPECT_FALSE(fs::exists(dir + "/report.json"));
+  fs::remove_all(dir);
+}
+
+// A named folder among numbered ones is a capture of its own: numbered from
+// 001 with a `retake` beside them, the retake's place among the sorted
+// folders (7) was its index and 007's too, refused as two folders of one
+// index (before: "observed twice"). It takes the index after the largest
+// number (8), and the eight captures calibrate.
+TEST(CalibrateCli, ANamedFolderAmongNumberedOnesIsACaptureOfItsOwn) {
+  const RenderedSet& set = Rendered();
+  const std::string dir = set.dir + "/named_among";
+  CopyModuleZeroCaptures(set, dir, 8);
+  fs::rename(dir + "/000", dir + "/retake");  // 001..007 and retake
+  const testing::Result r =
+      testing::RunCli("calibrate --captures " + dir + " --target " + set.dir + "/target.yaml --layout " + set.dir +
+                      "/one_module.yaml --out " + dir + "/rig.yaml --report " + dir + "/report.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("detect retake:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("calibrate: 8 captures, "), std::string::npos) << r.err;
+  std::ifstream f(dir + "/report.json");
+  const nlohmann::json j = nlohmann::json::parse(f, nullptr, false);
+  ASSERT_TRUE(j.is_object());
+  // Every (capture, capture_name) pair the report holds (the views stage 1
+  // and stage 2 list): retake is capture 8 wherever it is named, 007 is 7.
+  std::map<std::string, std::set<int>> indices_of;
+  std::function<void(const nlohmann::json&)> walk = [&](const nlohmann::json& v) {
+    if (v.is_object() && v.contains("capture") && v.contains("capture_name"))
+      indices_of[v.at("capture_name").get<std::string>()].insert(v.at("capture").get<int>());
+    if (v.is_structured())
+      for (const auto& child : v) walk(child);
+  };
+  walk(j);
+  EXPECT_EQ(indices_of["retake"], std::set<int>{8});
+  EXPECT_EQ(indices_of["007"], std::set<int>{7});
   fs::remove_all(dir);
 }
 
