@@ -44,14 +44,15 @@ void RuntimeOptions::Check() const {
   // a size no object in the volume could have is refused: ten times its
   // diagonal, a unit slip (um for mm, or 1e9 for "off").
   const double volume_diagonal_mm = volume_size_mm.norm();
-  // A volume whose diagonal is under 0.1 mm leaves that range empty: the
-  // volume is wrong, not object_size_mm ("must be in [1, 0.2] mm" named
-  // the key the user had not set).
-  if (!(10 * volume_diagonal_mm >= 1)) {
+  // A volume whose diagonal is under 1 mm holds no object of the smallest
+  // size (its sides typed in metres: the default's [0.15, 0.15, 0.1] is a
+  // 0.235 mm diagonal): the volume is wrong, not object_size_mm ("must be in
+  // [1, 2.3] mm" named a key the user had not set).
+  if (!(volume_diagonal_mm >= 1)) {
     char why[160];
     std::snprintf(why, sizeof why,
-                  "its diagonal, %.3g mm, holds no object (object_size_mm: at least 1 mm, at most ten times the "
-                  "diagonal): its sides are in mm",
+                  "its diagonal, %.3g mm, is under the smallest object (object_size_mm: at least 1 mm): its sides "
+                  "are in mm",
                   volume_diagonal_mm);
     throw InputError("volume_size_mm", why);
   }

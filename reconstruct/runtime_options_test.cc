@@ -279,13 +279,18 @@ TEST(RuntimeOptions, ValuesPastWhatTheRigCanMeasureAreRefused) {
   // reading: the bound was the diagonal itself).
   EXPECT_EQ(RefusalOf("volume_size_mm: [60, 60, 40]\n"), "");
   EXPECT_EQ(RefusalOf("object_size_mm: 400\nvolume_size_mm: [300, 300, 200]\n"), "");
-  // A volume too small for the 1 mm object size at least (a diagonal under
-  // 0.1 mm: sides given in m) is named as the volume, not as the object
-  // size it leaves no range for ("object_size_mm: must be in [1, 0.2] mm").
+  // A volume smaller than the smallest object (a diagonal under 1 mm: sides
+  // given in m, the default's [0.15, 0.15, 0.1] a 0.235 mm diagonal) is
+  // named as the volume, not as the object size it leaves no room for
+  // ("object_size_mm: must be in [1, 2.3] mm", a key the user never set).
+  EXPECT_EQ(RefusalOf("volume_size_mm: [0.15, 0.15, 0.1]\n"),
+            "o.yaml: volume_size_mm: its diagonal, 0.235 mm, is under the smallest object (object_size_mm: at least "
+            "1 mm): its sides are in mm");
   EXPECT_EQ(RefusalOf("volume_size_mm: [0.015, 0.015, 0.01]\n"),
-            "o.yaml: volume_size_mm: its diagonal, 0.0235 mm, holds no object (object_size_mm: at least 1 mm, at most "
-            "ten times the diagonal): its sides are in mm");
-  EXPECT_EQ(RefusalOf("volume_size_mm: [0.06, 0.06, 0.06]\nobject_size_mm: 1\n"), "");  // ten times 0.104 mm: 1.04
+            "o.yaml: volume_size_mm: its diagonal, 0.0235 mm, is under the smallest object (object_size_mm: at least "
+            "1 mm): its sides are in mm");
+  // Just over 1 mm (sqrt(3) x 0.6 = 1.04 mm) holds the 1 mm object.
+  EXPECT_EQ(RefusalOf("volume_size_mm: [0.6, 0.6, 0.6]\nobject_size_mm: 1\n"), "");
 }
 
 // working_distance_mm only places the default volume centre: given with
