@@ -158,26 +158,24 @@ std::vector<std::string> ScenesToRun(const std::string& dataset, const std::vect
   return held;
 }
 
-void WarnOfOtherCameramodels(const std::string& command, const std::string& dir,
-                             const std::vector<std::string>& written) {
+std::string OtherCameramodelsNote(const std::string& dir, const std::vector<std::string>& written) {
   namespace fs = std::filesystem;
   std::vector<std::string> written_names, others;
   for (const std::string& path : written) written_names.push_back(fs::path(path).filename().string());
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
-    if (e.path().extension() == ".cameramodel" &&
+    // Hidden files are no rig's models (an interrupted write's .tmp-*).
+    if (name.front() != '.' && e.path().extension() == ".cameramodel" &&
         std::find(written_names.begin(), written_names.end(), name) == written_names.end())
       others.push_back(name);
   }
-  if (others.empty()) return;
+  if (others.empty()) return "";
   std::sort(others.begin(), others.end());
   std::string list;
   for (const std::string& name : others) list += (list.empty() ? "" : ", ") + name;
-  std::fprintf(stderr,
-               "%s: warning: %s also holds %s, not written by this run: another rig's models? (remove them, "
-               "or export into a folder of its own)\n",
-               command.c_str(), PrintableText(dir).c_str(), PrintableText(list).c_str());
+  return dir + " also holds " + list +
+         ", not written by this run: another rig's models? (remove them, or export into a folder of its own)";
 }
 
 int NotBuiltYet(const char* name, const char* what, int argc, char** argv) {

@@ -113,12 +113,13 @@ std::string StdoutWriteError();
 // (docs/formats.md, "CLI").
 int ExitCodeWithStdout(int code, const std::string& program);
 
-// Warns on stderr ("<command>: warning: ...") if the folder `dir` holds
-// .cameramodel files other than `written` (the paths --export-cameramodels
-// just wrote there): a 3-module rig's cam4 and cam5 stayed silently beside
-// a 2-module rig's fresh cam0..cam3, a folder of models of two rigs.
-void WarnOfOtherCameramodels(const std::string& command, const std::string& dir,
-                             const std::vector<std::string>& written);
+// The warning, without its "<command>: warning: " (its caller prints it
+// and keeps it in its report), if the folder `dir` holds .cameramodel files
+// other than `written` (the paths or names --export-cameramodels just wrote
+// there), else "": a 3-module rig's cam4 and cam5 stayed silently beside a
+// 2-module rig's fresh cam0..cam3, a folder of models of two rigs. Hidden
+// files are not counted.
+std::string OtherCameramodelsNote(const std::string& dir, const std::vector<std::string>& written);
 
 // For subcommands a later issue fills in: prints what it will do and exits 2.
 int NotBuiltYet(const char* name, const char* what, int argc, char** argv);

@@ -113,16 +113,26 @@ int RunCalibrate(int argc, char** argv) {
   // Read once, here: the calibration's modules, and the cameras whose models
   // --export-cameramodels writes.
   const std::vector<ModuleLayout> layout = ReadLayoutFile(layout_path);
+  std::vector<std::string> model_paths;  // camK.cameramodel for every camera of the layout
   if (!cameramodels_dir.empty()) {
-    // Each model file too (camK.cameramodel for every camera of the layout):
-    // a rig file named DIR/cam0.cameramodel would be replaced by a model.
-    for (int k = 0, n = LayoutCameraCount(layout); k < n; ++k)
-      outputs.Claim((std::filesystem::path(cameramodels_dir) / ("cam" + std::to_string(k) + ".cameramodel")).string(),
-                    "camera " + std::to_string(k) + "'s model (--export-cameramodels)", false);
+    // Each model file too: a rig file named DIR/cam0.cameramodel would be
+    // replaced by a model.
+    for (int k = 0, n = LayoutCameraCount(layout); k < n; ++k) {
+      model_paths.push_back(
+          (std::filesystem::path(cameramodels_dir) / ("cam" + std::to_string(k) + ".cameramodel")).string());
+      outputs.Claim(model_paths.back(), "camera " + std::to_string(k) + "'s model (--export-cameramodels)", false);
+    }
   }
 
-  const FolderCalibration folder = CalibrateCaptureFolder(captures, target_path, layout, options);
+  FolderCalibration folder = CalibrateCaptureFolder(captures, target_path, layout, options);
   const CalibrationResult& result = folder.result;
+  // Models of another rig in the models' folder: warned of and kept in the
+  // report's warnings, as every warning calibrate prints is.
+  if (const std::string note = cameramodels_dir.empty() ? "" : OtherCameramodelsNote(cameramodels_dir, model_paths);
+      !note.empty()) {
+    std::fprintf(stderr, "calibrate: warning: %s\n", PrintableText(note).c_str());
+    folder.result.report.warnings.push_back(note);
+  }
   // The models' folder first: one that cannot be made leaves no rig file
   // or report behind either.
   models_folder.Create();
@@ -143,10 +153,6 @@ int RunCalibrate(int argc, char** argv) {
   } else {
     std::printf("wrote %s, %s and %d camera models (camK.cameramodel) in %s\n", out_path.c_str(), report_path.c_str(),
                 LayoutCameraCount(layout), cameramodels_dir.c_str());
-    std::vector<std::string> models;
-    for (int k = 0, n = LayoutCameraCount(layout); k < n; ++k)
-      models.push_back("cam" + std::to_string(k) + ".cameramodel");
-    WarnOfOtherCameramodels("calibrate", cameramodels_dir, models);
   }
   return 0;
 }

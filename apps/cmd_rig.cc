@@ -211,7 +211,8 @@ int RunRig(int argc, char** argv) {
   if (truth)
     PrintAgainstTruth(rig, *truth, *truth_file, distance_mm, Eigen::Vector3d(size_mm[0], size_mm[1], size_mm[2]));
   for (const std::string& path : model_paths) std::printf("wrote %s\n", path.c_str());
-  if (!export_dir.empty()) WarnOfOtherCameramodels("rig", export_dir, model_paths);
+  if (const std::string note = export_dir.empty() ? "" : OtherCameramodelsNote(export_dir, model_paths); !note.empty())
+    std::fprintf(stderr, "rig: warning: %s\n", PrintableText(note).c_str());
   return kExitOk;
 }
 

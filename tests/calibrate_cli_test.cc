@@ -973,6 +973,7 @@ TEST(CalibrateCli, ModelsOfAnotherRigInTheModelsFolderAreWarnedOf) {
   fs::create_directories(dir + "/models");
   for (const char* name : {"cam2.cameramodel", "cam3.cameramodel"})
     std::ofstream(dir + "/models/" + name) << "another rig's\n";
+  std::ofstream(dir + "/models/.tmp-999-0-cam0.cameramodel") << "an interrupted write's\n";  // hidden: not a model
   const testing::Result r =
       testing::RunCli("calibrate --captures " + dir + "/captures --target " + set.dir + "/target.yaml --layout " +
                       set.dir + "/one_module.yaml --out " + dir + "/rig.yaml --report " + dir +
@@ -984,6 +985,16 @@ TEST(CalibrateCli, ModelsOfAnotherRigInTheModelsFolderAreWarnedOf) {
             std::string::npos)
       << r.err;
   EXPECT_TRUE(fs::exists(dir + "/models/cam0.cameramodel"));
+  // Kept in the report, as every warning calibrate prints is (docs/formats.md).
+  std::ifstream f(dir + "/report.json");
+  const nlohmann::json j = nlohmann::json::parse(f, nullptr, false);
+  ASSERT_TRUE(j.is_object());
+  int kept = 0;
+  for (const auto& w : j.at("warnings"))
+    kept += w.get<std::string>() == dir +
+                                        "/models also holds cam2.cameramodel, cam3.cameramodel, not written by this "
+                                        "run: another rig's models? (remove them, or export into a folder of its own)";
+  EXPECT_EQ(kept, 1) << j.at("warnings").dump();
   fs::remove_all(dir);
 }
 
