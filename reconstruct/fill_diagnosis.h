@@ -13,7 +13,8 @@
 //     pixels were lost by the search or the growing, the others by the image
 //     (or by a test that is too strict there);
 //   - for every point, its disparity error against the truth.
-// WriteFillDiagnosisImages() writes PNGs of these for viewing.
+// EncodeFillDiagnosisImages() encodes PNGs of these for viewing (`stereorig
+// score --diagnose` writes them with its report, all or none).
 #pragma once
 
 #include <array>

@@ -29,7 +29,11 @@ enum class TemporaryKind {
 
 class PendingTemporary {
  public:
-  static constexpr int kMaxPending = 128;
+  // score --diagnose holds four images per scene and module until its
+  // report is written, all or none (~130 on the ring of three modules with
+  // 11 scenes): 1024 slots of PATH_MAX are 4 MB of address space, touched
+  // only as far as they are used.
+  static constexpr int kMaxPending = 1024;
 
   explicit PendingTemporary(const std::string& path, TemporaryKind kind = TemporaryKind::kFile);
   ~PendingTemporary() { Release(); }

@@ -10,7 +10,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "calib/core/atomic_file.h"
 #include "calib/core/input_error_testing.h"
@@ -44,6 +46,26 @@ TEST(PendingTemporary, ATerminationSignalMidWriteRemovesTheTemporaryFile) {
     ASSERT_TRUE(testing::DiedOf(status, signal));  // it still dies of the signal
     EXPECT_EQ(FileCount(dir), 0) << "the temporary file was left";
   }
+}
+
+// Many at once: `score --diagnose` holds four images per scene and module
+// until its report is written (AtomicOutputSet), 132 on the ring of three
+// modules with 11 scenes, beyond the 128 slots there were: the rest stayed
+// as hidden .tmp-* files. 300 temporaries, all removed.
+TEST(PendingTemporary, ATerminationSignalRemovesHundredsOfPendingFiles) {
+  const std::string dir = testing::ScratchFolder("pending_temporary_many");
+  constexpr int kFiles = 300;
+  const int status = testing::StatusOfAChild([&] {
+    std::vector<std::unique_ptr<AtomicOutput>> outs;
+    for (int i = 0; i < kFiles; ++i) {
+      outs.push_back(std::make_unique<AtomicOutput>(dir + "/image" + std::to_string(i) + ".png"));
+      std::ofstream(outs.back()->temp_path()) << "an image";
+    }
+    if (FileCount(dir) != kFiles) _exit(3);  // every temporary written
+    raise(SIGTERM);
+  });
+  ASSERT_TRUE(testing::DiedOf(status, SIGTERM)) << status;
+  EXPECT_EQ(FileCount(dir), 0) << "temporary files were left";
 }
 
 // A program's own handler is left alone (it decides what a signal does);
