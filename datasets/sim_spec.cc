@@ -178,16 +178,25 @@ void ScenesSpec::Check(const std::string& where) const {
   // points. A cup 100 m across (75 mm typed in micrometres, say) rendered
   // for minutes, then aborted in std::bad_alloc (exit 134).
   constexpr double kMaxSizeMm = 300;
-  const std::pair<const char*, double> sizes_mm[] = {{"cup_diameter_mm", cup_diameter_mm},
-                                                     {"cup_height_mm", cup_height_mm},
-                                                     {"sphere_diameter_mm", sphere_diameter_mm},
-                                                     {"ballbar_sphere_diameter_mm", ballbar_sphere_diameter_mm},
-                                                     {"ballbar_distance_mm", ballbar_distance_mm},
-                                                     {"plate_size_mm", plate_size_mm.maxCoeff()},
-                                                     {"tuber_semi_axes_mm", 2 * tuber_semi_axes_mm.maxCoeff()}};
-  for (const auto& [key, size_mm] : sizes_mm)
-    Require(size_mm <= kMaxSizeMm, where, key,
-            "the object is " + ShortestNumberText(size_mm) + " mm across, over the " + ShortestNumberText(kMaxSizeMm) +
+  struct Extent {
+    const char* key;     // the key that sets it
+    const char* object;  // what is that large
+    double size_mm;
+  };
+  const Extent extents[] = {
+      {"cup_diameter_mm", "cup", cup_diameter_mm},
+      {"cup_height_mm", "cup", cup_height_mm},
+      {"sphere_diameter_mm", "sphere", sphere_diameter_mm},
+      // One entry for the bar, named by the larger of its two keys.
+      {ballbar_distance_mm >= ballbar_sphere_diameter_mm ? "ballbar_distance_mm" : "ballbar_sphere_diameter_mm",
+       "ball bar (its distance plus a ball)", ballbar_distance_mm + ballbar_sphere_diameter_mm},
+      {"plate_size_mm", "plate", plate_size_mm.maxCoeff()},
+      {"tuber_semi_axes_mm", "tuber (its longest axis with its bumps)",
+       2 * tuber_semi_axes_mm.maxCoeff() * (1 + tuber_bump)}};
+  for (const Extent& e : extents)
+    Require(e.size_mm <= kMaxSizeMm, where, e.key,
+            std::string("the ") + e.object + " is " + ShortestNumberText(e.size_mm) + " mm across, over the " +
+                ShortestNumberText(kMaxSizeMm) +
                 " mm a scene on the belt may be (its truth surface is sampled every 0.2 mm); is it in "
                 "micrometres? the unit is mm");
   for (double a : {cup_albedo, artifact_albedo, tuber_albedo}) {

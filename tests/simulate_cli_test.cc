@@ -572,11 +572,15 @@ TEST(SimulateCli, ASceneObjectLargerThanTheBeltTakesIsRefused) {
   std::vector<std::pair<std::string, std::string>> cases;
   for (const auto& [from, to, says] : std::vector<std::tuple<std::string, std::string, std::string>>{
            {"cup_diameter_mm: 75", "cup_diameter_mm: 75000",
-            "cup_diameter_mm: the object is 75000 mm across, over "
+            "cup_diameter_mm: the cup is 75000 mm across, over "
             "the 300 mm a scene on the belt may be"},
-           {"plate_size_mm: [130, 120, 8]", "plate_size_mm: [130, 301, 8]", "plate_size_mm: the object is 301 mm"},
-           {"tuber_semi_axes_mm: [42, 30, 27]", "tuber_semi_axes_mm: [42, 151, 27]",
-            "tuber_semi_axes_mm: the object is 302 mm"}}) {
+           {"plate_size_mm: [130, 120, 8]", "plate_size_mm: [130, 301, 8]", "plate_size_mm: the plate is 301 mm"},
+           // The bar's length is its distance plus a ball (25.4 mm): 280 + 25.4.
+           {"ballbar_distance_mm: 80", "ballbar_distance_mm: 280",
+            "ballbar_distance_mm: the ball bar (its distance plus a ball) is 305.4 mm"},
+           // The longest axis with its bumps (0.05 by default): 2 x 143 x 1.05.
+           {"tuber_semi_axes_mm: [42, 30, 27]", "tuber_semi_axes_mm: [143, 30, 27]",
+            "tuber_semi_axes_mm: the tuber (its longest axis with its bumps) is 300.3 mm"}}) {
     const std::string spec = dir + "/" + std::to_string(cases.size()) + ".yaml";
     const std::string text = EditedDefaultSpec(spec, from, to);  // before the stream opens it
     std::ofstream(spec) << text;
@@ -584,6 +588,12 @@ TEST(SimulateCli, ASceneObjectLargerThanTheBeltTakesIsRefused) {
                      spec + ": scenes: " + says});
   }
   ExpectEachRefusedBeforeAnyWork(cases, dir + "/out");
+  // At the bound itself the spec is read and the dataset written.
+  const std::string spec = dir + "/at_bound.yaml";
+  const std::string text = EditedDefaultSpec(spec, "plate_size_mm: [130, 120, 8]", "plate_size_mm: [130, 300, 8]");
+  std::ofstream(spec) << text;
+  const Result r = RunCli("simulate --spec " + spec + " --out " + dir + "/out/ds --calibration-captures 0 --no-scenes");
+  EXPECT_EQ(r.code, 0) << r.err;
   fs::remove_all(dir);
 }
 
