@@ -14,6 +14,7 @@
 
 #include "apps/command.h"
 #include "calib/core/input_error.h"
+#include "calib/core/rig_file.h"
 
 namespace stereorig {
 
@@ -135,6 +136,24 @@ void CheckScenesInDataset(const std::string& dataset, const std::vector<std::str
     std::string names;
     for (const std::string& name : missing) names += (names.empty() ? "" : ", ") + name;
     throw InputError(scenes_dir.string(), "no such scenes in the dataset (--scenes): " + names);
+  }
+}
+
+void RequireTruthRigLayout(const Rig& rig, const std::string& rig_path, const std::string& truth_rig_path,
+                           const std::string& command) {
+  const Rig truth = ReadRigFile(truth_rig_path);
+  for (int m = 0; m < std::max(rig.num_modules(), truth.num_modules()); ++m) {
+    auto cameras = [m](const Rig& r) {
+      return m < r.num_modules() ? "cameras " + std::to_string(r.module(m).left_camera) + " and " +
+                                       std::to_string(r.module(m).right_camera)
+                                 : std::string("no module");
+    };
+    if (cameras(rig) != cameras(truth))
+      throw InputError(rig_path, "its module " + std::to_string(m) + " has " + cameras(rig) +
+                                     ", the dataset's truth rig's (" + truth_rig_path + ") " + cameras(truth) + ": " +
+                                     command +
+                                     " compares each module with the truth's of its number; calibrate with the "
+                                     "dataset's layout");
   }
 }
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "calib/core/printable_text.h"  // PrintableText, for every error line
+#include "calib/core/rig.h"
 
 namespace stereorig {
 
@@ -49,6 +50,16 @@ std::vector<std::string> ScenesToRun(const std::string& dataset, const std::vect
 // truth/ in it: a file or a wrong folder given to --dataset is named as
 // such, not as a missing DATASET/truth/rig.yaml.
 void CheckDatasetFolder(const std::string& dataset, bool need_truth);
+
+// Throws InputError naming `rig_path` unless `rig`'s modules pair the same
+// cameras, module by module, as the dataset's truth rig at `truth_rig_path`
+// (read here), and are as many. `command` ("score", "bench") judges the
+// cloud's module m against the truth's module m (its fill target, its left
+// camera's depth): a rig of another layout (module 0 on cameras 2 and 3) was
+// judged against the wrong module's truth, and its figures judged nothing.
+// The message names both rig files and the first module that differs.
+void RequireTruthRigLayout(const Rig& rig, const std::string& rig_path, const std::string& truth_rig_path,
+                           const std::string& command);
 
 // `word` as a POSIX shell reads it back as one word: as it is when it
 // holds only letters, digits and _@%+=:,./- (most paths), else in single

@@ -273,6 +273,12 @@ int RunBench(int argc, char** argv) {
         {"sphere(builtin)", RenderSphereCapture(sim.rig, spec), SampleSphere(spec.centre_mm, spec.radius_mm, 0.2), {}});
   } else {
     rig = ReadRigFile(rig_read);
+    // The truth fill and accuracy take the truth rig's module m for the
+    // cloud's module m, as score does: a --rig of another layout was judged
+    // against the wrong module's truth, exit 0. A line's own captures with
+    // no truth rig have nothing to compare.
+    const fs::path truth_rig = fs::path(dataset) / "truth" / "rig.yaml";
+    if (!rig_path.empty() && fs::exists(truth_rig)) RequireTruthRigLayout(rig, rig_path, truth_rig.string(), "bench");
     for (const std::string& name : scene_names) {
       const fs::path capture = fs::path(dataset) / "scenes" / name / "active";
       scenes.push_back(Scene{name, LoadCapture(capture.string(), rig), {}, {}});

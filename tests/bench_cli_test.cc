@@ -16,6 +16,8 @@
 #include <thread>
 #include <utility>
 
+#include "calib/core/rig_file.h"
+#include "datasets/default_rig.h"
 #include "tests/cli_runner.h"
 #include "tests/sim_scene.h"
 
@@ -143,6 +145,42 @@ TEST(BenchCli, AMissingSceneNamedInScenesExitsTwoBeforeAnyRun) {
   EXPECT_NE(no_truth.err.find(dataset + ": is not a simulator dataset: it has no truth/ folder"), std::string::npos)
       << no_truth.err;
   std::filesystem::remove_all(dataset);
+}
+
+// bench, as score, takes the truth rig's module m (its fill target and
+// depth) for the cloud's module m: a --rig pairing other cameras in its
+// modules (another layout's: module 0 on cameras 2 and 3) had its truth
+// fill and accuracy taken against the wrong module's truth, exit 0. Refused
+// before any run, naming both rigs, with score's check (cli_util.h). The
+// truth rig's own layout, and any layout on a line's own captures (no
+// truth/rig.yaml), go on: to the capture here, an empty folder.
+TEST(BenchCli, ARigWhoseModulesPairOtherCamerasThanTheTruthsIsRefusedBeforeAnyRun) {
+  namespace fs = std::filesystem;
+  const std::string dataset = ::testing::TempDir() + "/bench_other_layout_" + std::to_string(getpid());
+  fs::remove_all(dataset);
+  fs::create_directories(dataset + "/scenes/cup/active");
+  fs::create_directories(dataset + "/truth");
+  WriteRigFile(MakeDefaultRig().rig, dataset + "/truth/rig.yaml");
+  const std::string other = dataset + "/other_layout.yaml";
+  WriteRigFile(testing::DefaultRigInAnotherLayout(), other);
+  const std::string bench = "bench --runs 1 --dataset " + dataset + " --scenes cup --rig ";
+  const testing::Result r = RunCli(bench + other);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(other + ": its module 0 has cameras 2 and 3, the dataset's truth rig's (" + dataset +
+                       "/truth/rig.yaml) cameras 0 and 1: bench compares each module with the truth's of its number"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.out.find("objects/s"), std::string::npos) << r.out;
+  const std::string to_capture = dataset + "/scenes/cup/active/cam0.png: missing camera image";
+  const testing::Result same = RunCli(bench + dataset + "/truth/rig.yaml");
+  EXPECT_EQ(same.code, 2);
+  EXPECT_NE(same.err.find(to_capture), std::string::npos) << same.err;
+  fs::remove_all(dataset + "/truth");
+  const testing::Result own = RunCli(bench + other);
+  EXPECT_EQ(own.code, 2);
+  EXPECT_NE(own.err.find(to_capture), std::string::npos) << own.err;
+  fs::remove_all(dataset);
 }
 
 // A measurement volume that misses a scene, and a run without --rig (the

@@ -1072,17 +1072,7 @@ TEST_F(ReconstructCli, ScoreAndBatchOutputsOverTheirInputsAreRefused) {
 // which holds cam0.png alone).
 TEST_F(ReconstructCli, ScoreRefusesARigWhoseModulesPairOtherCameras) {
   const std::string d = ScoreDataset("score_other_layout");
-  const SimulatedRig sim = MakeDefaultRig();
-  std::vector<Camera> cameras;
-  std::vector<std::string> names;
-  for (int k : {2, 3, 0, 1}) {  // the cameras relabelled: module 0's pair is cameras 2 and 3
-    cameras.push_back(sim.rig.cameras()[k]);
-    names.push_back(sim.rig.camera_names()[k]);
-  }
-  std::vector<StereoModule> modules = sim.rig.modules();
-  modules[0].left_camera = 2, modules[0].right_camera = 3;
-  modules[1].left_camera = 0, modules[1].right_camera = 1;
-  WriteRigFile(Rig(cameras, names, modules, sim.rig.S(), "test"), dir_ + "/other_layout.yaml");
+  WriteRigFile(testing::DefaultRigInAnotherLayout(), dir_ + "/other_layout.yaml");
   const std::string score = "score --dataset " + d + " --scenes cup --no-passive --rig ";
   ExpectRefusedInOneLine(score + dir_ + "/other_layout.yaml",
                          dir_ + "/other_layout.yaml: its module 0 has cameras 2 and 3, the dataset's truth rig's (" +
