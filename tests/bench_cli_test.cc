@@ -223,6 +223,36 @@ TEST(BenchCli, BenchAndScoreWarnOnStderrOfAVolumeThatMissesAScenesTruthAndOfTheT
   std::filesystem::remove_all(dataset);
 }
 
+// A dataset scene without truth (truth/scenes/<scene>/: a line's own
+// captures benched with their rig), or without its truth maps, is benched,
+// and its line says what it lacks: the accuracy and the truth fill used to
+// be left out without a word, as if the scene had none to give. Each
+// pipeline's line says it. The volume beside the scene keeps the run to
+// empty clouds: a few seconds.
+TEST(BenchCli, ASceneWithoutTruthSaysSoOnItsLine) {
+  namespace fs = std::filesystem;
+  const std::string dataset = testing::SimulateOneScene("sphere", 1, "bench_no_truth");
+  const std::string options = dataset + "/volume_beside.yaml";
+  { std::ofstream(options) << "volume_center_mm: [200, 0, 200]\n"; }
+  const std::string bench = "bench --runs 1 --dataset " + dataset + " --scenes sphere --options " + options;
+  auto times_said = [](const std::string& out, const std::string& says) {
+    int n = 0;
+    for (size_t at = out.find(says); at != std::string::npos; at = out.find(says, at + 1)) ++n;
+    return n;
+  };
+  const std::string truth = dataset + "/truth/scenes/sphere";
+  fs::remove(truth + "/lit_cam0.png");
+  const testing::Result no_maps = RunCli(bench);
+  ASSERT_EQ(no_maps.code, 0) << no_maps.err;
+  EXPECT_EQ(times_said(no_maps.out, "; no truth maps (" + truth + "/lit_cam0.png): no truth fill"), 3) << no_maps.out;
+  EXPECT_EQ(times_said(no_maps.out, ", merged "), 3) << no_maps.out;  // its surface is there: accuracy
+  fs::remove_all(truth);
+  const testing::Result none = RunCli(bench);
+  ASSERT_EQ(none.code, 0) << none.err;
+  EXPECT_EQ(times_said(none.out, "; no truth (" + truth + "/): no accuracy, no truth fill; mesh+fill"), 3) << none.out;
+  fs::remove_all(dataset);
+}
+
 // Without --scenes, score and bench take those of the five default scenes
 // the dataset holds: score used to require all five, and refused a dataset
 // of one scene with "no such scenes in the dataset (--scenes): cup, ballbar,
