@@ -1266,15 +1266,36 @@ TEST_F(ReconstructCli, ADegenerateModuleOrAVolumeBehindItNamesTheFileAndModule) 
       << r.err;
   ExpectNoOutput();
 
-  // The reference frame is module 0's left camera: z < 0 is behind it.
+  // The reference frame is module 0's left camera: z < 0 is behind it. The
+  // message names the option and its value, and how far off the module's
+  // view the centre is.
   WriteFileAtomically(dir_ + "/behind.yaml", "volume_center_mm: [0, 0, -300]\n");
   r = testing::RunCli(Args(dir_ + "/capture", "--options " + dir_ + "/behind.yaml"));
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
-  EXPECT_NE(r.err.find(dir_ + "/behind.yaml (runtime options): the measurement volume's centre is behind " +
-                       sim.rig.module(0).name + ": check volume_center_mm / working_distance_mm\n"),
-            std::string::npos)
+  EXPECT_TRUE(std::regex_search(
+      r.err, std::regex(dir_ +
+                        "/behind.yaml \\(runtime options\\): the measurement volume's centre \\(volume_center_mm "
+                        "\\[0, 0, -300\\]\\) is not in front of " +
+                        sim.rig.module(0).name +
+                        ": it lies 1[4-8][0-9] deg off the module's viewing direction \\(behind it; its view reaches "
+                        "about [0-9]+ deg either side\\); check volume_center_mm\n")))
       << r.err;  // module 0's pose is the reference frame itself: nothing more to check
+  ExpectNoOutput();
+
+  // Far to the side, in front of the cameras' plane but past the side of
+  // their view (the modules are verged): it was "behind module0" too.
+  WriteFileAtomically(dir_ + "/side.yaml", "volume_center_mm: [5000, 0, 200]\n");
+  r = testing::RunCli(Args(dir_ + "/capture", "--options " + dir_ + "/side.yaml"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_TRUE(std::regex_search(
+      r.err,
+      std::regex("the measurement volume's centre \\(volume_center_mm \\[5000, 0, 200\\]\\) is not in front of " +
+                 sim.rig.module(0).name +
+                 ": it lies (9|1[0-3])[0-9] deg off the module's viewing direction \\(to its side; its view "
+                 "reaches about [0-9]+ deg either side\\); check volume_center_mm\n")))
+      << r.err;
   ExpectNoOutput();
 
   // Module 1 turned about its own vertical axis to face away, in a rig file
@@ -1288,9 +1309,14 @@ TEST_F(ReconstructCli, ADegenerateModuleOrAVolumeBehindItNamesTheFileAndModule) 
                       "/out.ply --report " + dir_ + "/out.json");
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
-  EXPECT_NE(r.err.find("the measurement volume's centre is behind " + sim.rig.module(1).name +
-                       ": check volume_center_mm / working_distance_mm, or " + sim.rig.module(1).name + "'s pose in " +
-                       dir_ + "/turned.yaml (the volume is set in module 0's frame)\n"),
+  EXPECT_NE(r.err.find("the measurement volume's centre (working_distance_mm 200, ahead of module 0) is not in "
+                       "front of " +
+                       sim.rig.module(1).name + ": it lies "),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find(" (behind it; its view reaches about "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("; check working_distance_mm, or " + sim.rig.module(1).name + "'s pose in " + dir_ +
+                       "/turned.yaml (the volume is set in module 0's frame)\n"),
             std::string::npos)
       << r.err;
   ExpectNoOutput();
