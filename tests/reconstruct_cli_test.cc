@@ -466,6 +466,41 @@ TEST_F(ReconstructCli, RectifiedOutWritesEachModulesPairAndTheMatchCommandForIt)
                          "--out-dir excludes --rectified-out");
 }
 
+// --rectified-out creates its folder; the cloud, mesh and report may go in
+// it (--rectified-out r --out r/x.ply was refused, "its folder does not
+// exist", though the run makes it). A folder below it that nobody makes is
+// still refused, and so is the folder itself as a file; a capture found
+// bad after the claims leaves no folder behind.
+TEST_F(ReconstructCli, OutputsMayGoInTheFolderRectifiedOutCreates) {
+  namespace fs = std::filesystem;
+  ASSERT_EQ(RunCli(Args(dir_ + "/capture")), 0);
+  const std::string plain_cloud = ReadFileBytes(dir_ + "/out.ply");
+  const std::string rect = dir_ + "/rect_outputs/pairs";
+  fs::remove_all(dir_ + "/rect_outputs");
+  const std::string reconstruct = "reconstruct --rig " + dir_ + "/rig.yaml --capture ";
+  const testing::Result r = testing::RunCli(reconstruct + dir_ + "/capture --rectified-out " + rect + " --out " + rect +
+                                            "/x.ply --mesh " + rect + "/x.stl --report " + rect + "/x.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(ReadFileBytes(rect + "/x.ply"), plain_cloud);
+  EXPECT_TRUE(fs::is_regular_file(rect + "/x.stl"));
+  EXPECT_TRUE(fs::is_regular_file(rect + "/x.json"));
+  EXPECT_TRUE(fs::is_regular_file(rect + "/module1_right.png"));
+  fs::remove_all(dir_ + "/rect_outputs");
+  ExpectRefusedInOneLine(reconstruct + dir_ + "/capture --rectified-out " + rect + " --out " + rect + "/sub/x.ply",
+                         rect + "/sub/x.ply: its folder does not exist");
+  ExpectRefusedInOneLine(reconstruct + dir_ + "/capture --rectified-out " + rect + " --out " + rect,
+                         rect +
+                             ": is a folder this command creates for the rectified pairs (--rectified-out), not a "
+                             "file to write");
+  const std::string broken = BrokenCapture("rect_outputs_broken");
+  WriteFileAtomically(broken + "/cam1.png", "not a png");  // found only when decoded
+  const testing::Result bad =
+      testing::RunCli(reconstruct + broken + " --rectified-out " + rect + " --out " + rect + "/x.ply");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find(broken + "/cam1.png"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir_ + "/rect_outputs"));
+}
+
 // A grey PNG of 1, 2 or 4 bits decodes to 8 bits (0/255 for 1 bit): a 1-bit
 // capture gave 0 points and a 4-bit one fewer, exit 0 both. Refused now as
 // formats.md says (8-bit grey only), naming the file and its depth; so is
