@@ -80,6 +80,16 @@ const CLI::Validator& NonNegativeValue();
 // that read it as decimal (010 passed as ten and ran as 8; 09 passed, then
 // "Could not convert").
 CLI::Option* AddCountOption(CLI::App& app, const std::string& name, int* count, const std::string& description);
+// A whole-number option `name` into *value (its default shown as it is), in
+// [min, max], decimal, a sign before it or none; refused by the flag's
+// name, its rule and the value given ("must be a whole number in [2, 1024],
+// got 1.5", "must be in [2, 1024], got 99999999999"), where CLI11 said
+// "Could not convert". AddCountOption is one, in [1, 2^31 - 1].
+CLI::Option* AddWholeNumberOption(CLI::App& app, const std::string& name, int* value, int min, int max,
+                                  const std::string& description);
+// Its check alone, for an option of several whole numbers (match --roi):
+// each value is checked so, before CLI11 converts it.
+CLI::Validator WholeNumberIn(int min, int max);
 
 // A --seed option into *seed (its default shown as it is): a whole number
 // from 0 to max_seed, decimal (leading zeros are zeros) or hex with 0x,
