@@ -14,6 +14,7 @@
 
 #include "apps/command.h"
 #include "calib/core/input_error.h"
+#include "calib/core/rig_file.h"
 
 namespace stereorig {
 
@@ -138,6 +139,24 @@ void CheckScenesInDataset(const std::string& dataset, const std::vector<std::str
   }
 }
 
+void RequireTruthRigLayout(const Rig& rig, const std::string& rig_path, const std::string& truth_rig_path,
+                           const std::string& command) {
+  const Rig truth = ReadRigFile(truth_rig_path);
+  for (int m = 0; m < std::max(rig.num_modules(), truth.num_modules()); ++m) {
+    auto cameras = [m](const Rig& r) {
+      return m < r.num_modules() ? "cameras " + std::to_string(r.module(m).left_camera) + " and " +
+                                       std::to_string(r.module(m).right_camera)
+                                 : std::string("no module");
+    };
+    if (cameras(rig) != cameras(truth))
+      throw InputError(rig_path, "its module " + std::to_string(m) + " has " + cameras(rig) +
+                                     ", the dataset's truth rig's (" + truth_rig_path + ") " + cameras(truth) + ": " +
+                                     command +
+                                     " compares each module with the truth's of its number; calibrate with the "
+                                     "dataset's layout");
+  }
+}
+
 std::vector<std::string> ScenesToRun(const std::string& dataset, const std::vector<std::string>& scenes, bool named) {
   if (named) {
     CheckScenesInDataset(dataset, scenes);
@@ -242,18 +261,39 @@ std::string ParseSeed(const std::string& text, uint64_t max_seed, uint64_t* seed
   return "";
 }
 
-// The count `text` names into *count: "" if it is one (AddCountOption's
-// form), else what is wrong with it.
-std::string ParseCount(const std::string& text, int* count) {
-  uint64_t value = 0;
+// The rule of a whole-number option, as its messages say it: "a whole
+// number in [2, 1024]", "a whole number >= 1" where the top is an int's,
+// "a whole number" for any int (match --roi, whose own check follows).
+std::string RangeText(int min, int max) {
+  if (max != std::numeric_limits<int>::max()) return "in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
+  return min != std::numeric_limits<int>::min() ? ">= " + std::to_string(min) : "";
+}
+std::string WholeNumberRule(int min, int max) {
+  const std::string range = RangeText(min, max);
+  return "a whole number" + (range.empty() ? "" : " " + range);
+}
+
+// The whole number in [min, max] `text` names into *value: "" if it is one
+// (decimal digits, a '-' or '+' before them), else what is
+// wrong with it, the value given said.
+std::string ParseWholeNumber(const std::string& text, int min, int max, int* value) {
+  if (text.empty()) return "an empty value";  // as every option says it (NonEmptyValue above)
+  const bool negative = text[0] == '-', sign = negative || text[0] == '+';
+  uint64_t magnitude = 0;
   bool fits = false;
-  if (!text.empty() && text[0] == '-' && ReadDigits(text.substr(1), 10, &value, &fits))
-    return "must be >= 1, got " + text;
-  if (!ReadDigits(text, 10, &value, &fits)) return "must be a whole number >= 1, got " + text;
-  if (value < 1) return "must be >= 1, got " + text;
-  if (!fits || value > static_cast<uint64_t>(std::numeric_limits<int>::max()))
-    return "must be at most " + std::to_string(std::numeric_limits<int>::max()) + ", got " + text;
-  *count = static_cast<int>(value);
+  if (!ReadDigits(sign ? text.substr(1) : text, 10, &magnitude, &fits))
+    return "must be " + WholeNumberRule(min, max) + ", got " + text;
+  // Past an int's range is past [min, max]: compared as int64 below that.
+  const bool huge = !fits || magnitude > static_cast<uint64_t>(std::numeric_limits<int>::max()) + 1;
+  const int64_t number = huge ? 0 : negative ? -static_cast<int64_t>(magnitude) : static_cast<int64_t>(magnitude);
+  const bool above = huge ? !negative : number > max, below = huge ? negative : number < min;
+  if (above || below) {
+    if (max != std::numeric_limits<int>::max()) return "must be " + RangeText(min, max) + ", got " + text;
+    // An int's own top (a count's range, --roi's): the end it missed.
+    const std::string rule = below ? ">= " + std::to_string(min) : "at most " + std::to_string(max);
+    return "must be " + rule + ", got " + text;
+  }
+  *value = static_cast<int>(number);
   return "";
 }
 
@@ -287,19 +327,28 @@ const CLI::Validator& NonNegativeValue() {
   return v;
 }
 
-CLI::Option* AddCountOption(CLI::App& app, const std::string& name, int* count, const std::string& description) {
+CLI::Validator WholeNumberIn(int min, int max) {
+  return CLI::Validator(
+      [min, max](const std::string& text) {
+        int ignored = 0;
+        return ParseWholeNumber(text, min, max, &ignored);
+      },
+      "", "WholeNumber");
+}
+
+CLI::Option* AddWholeNumberOption(CLI::App& app, const std::string& name, int* value, int min, int max,
+                                  const std::string& description) {
   return app
       .add_option_function<std::string>(
-          name, [count](const std::string& text) { (void)ParseCount(text, count); },
-          description + "; a whole number >= 1 (decimal: 010 is ten)")
-      ->check(CLI::Validator(
-          [](const std::string& text) {
-            int ignored = 0;
-            return ParseCount(text, &ignored);
-          },
-          "", "Count"))
+          name, [value, min, max](const std::string& text) { (void)ParseWholeNumber(text, min, max, value); },
+          description + "; " + WholeNumberRule(min, max) + " (decimal: 010 is ten)")
+      ->check(WholeNumberIn(min, max))
       ->type_name("INT")
-      ->default_str(std::to_string(*count));
+      ->default_str(std::to_string(*value));
+}
+
+CLI::Option* AddCountOption(CLI::App& app, const std::string& name, int* count, const std::string& description) {
+  return AddWholeNumberOption(app, name, count, 1, std::numeric_limits<int>::max(), description);
 }
 
 namespace {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "calib/core/printable_text.h"  // PrintableText, for every error line
+#include "calib/core/rig.h"
 
 namespace stereorig {
 
@@ -50,6 +51,16 @@ std::vector<std::string> ScenesToRun(const std::string& dataset, const std::vect
 // such, not as a missing DATASET/truth/rig.yaml.
 void CheckDatasetFolder(const std::string& dataset, bool need_truth);
 
+// Throws InputError naming `rig_path` unless `rig`'s modules pair the same
+// cameras, module by module, as the dataset's truth rig at `truth_rig_path`
+// (read here), and are as many. `command` ("score", "bench") judges the
+// cloud's module m against the truth's module m (its fill target, its left
+// camera's depth): a rig of another layout (module 0 on cameras 2 and 3) was
+// judged against the wrong module's truth, and its figures judged nothing.
+// The message names both rig files and the first module that differs.
+void RequireTruthRigLayout(const Rig& rig, const std::string& rig_path, const std::string& truth_rig_path,
+                           const std::string& command);
+
 // `word` as a POSIX shell reads it back as one word: as it is when it
 // holds only letters, digits and _@%+=:,./- (most paths), else in single
 // quotes, each ' written '\'' ("a b" -> 'a b', "" -> ''). For a command
@@ -69,6 +80,16 @@ const CLI::Validator& NonNegativeValue();
 // that read it as decimal (010 passed as ten and ran as 8; 09 passed, then
 // "Could not convert").
 CLI::Option* AddCountOption(CLI::App& app, const std::string& name, int* count, const std::string& description);
+// A whole-number option `name` into *value (its default shown as it is), in
+// [min, max], decimal, a sign before it or none; refused by the flag's
+// name, its rule and the value given ("must be a whole number in [2, 1024],
+// got 1.5", "must be in [2, 1024], got 99999999999"), where CLI11 said
+// "Could not convert". AddCountOption is one, in [1, 2^31 - 1].
+CLI::Option* AddWholeNumberOption(CLI::App& app, const std::string& name, int* value, int min, int max,
+                                  const std::string& description);
+// Its check alone, for an option of several whole numbers (match --roi):
+// each value is checked so, before CLI11 converts it.
+CLI::Validator WholeNumberIn(int min, int max);
 
 // A --seed option into *seed (its default shown as it is): a whole number
 // from 0 to max_seed, decimal (leading zeros are zeros) or hex with 0x,

@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <limits>
 #include <string>
+#include <vector>
 
 namespace stereorig {
 namespace {
@@ -45,6 +48,41 @@ TEST(PrintableText, EscapesIllFormedSequencesByteByByte) {
   EXPECT_EQ(PrintableText("\xAB"), "\\xAB");             // a lone continuation byte
   EXPECT_EQ(PrintableText("x\xE2\x82"), "x\\xE2\\x82");  // cut short at the end
   EXPECT_EQ(PrintableText("\xE2\x82x"), "\\xE2\\x82x");  // cut short by a character
+}
+
+// A whole-number option takes every int of its range, down to the ends,
+// and refuses the numbers just past them by its rule and the value (an int's
+// ends: no wrap-around of 2^31 or -2^31 - 1 into range).
+TEST(AddWholeNumberOption, TakesItsRangesEndsAndRefusesPastThem) {
+  constexpr int kMin = std::numeric_limits<int>::min(), kMax = std::numeric_limits<int>::max();
+  auto parse = [](int min, int max, const std::string& text, int* value) -> std::string {
+    CLI::App app;
+    AddWholeNumberOption(app, "--n", value, min, max, "n");
+    std::vector<std::string> args = {"--n", text};
+    std::reverse(args.begin(), args.end());  // CLI11 takes a vector in reverse order
+    try {
+      app.parse(args);
+    } catch (const CLI::ParseError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  int value = 7;
+  EXPECT_EQ(parse(kMin, kMax, "-2147483648", &value), "");
+  EXPECT_EQ(value, kMin);
+  EXPECT_EQ(parse(kMin, kMax, "2147483647", &value), "");
+  EXPECT_EQ(value, kMax);
+  EXPECT_EQ(parse(kMin, kMax, "2147483648", &value), "--n: must be at most 2147483647, got 2147483648");
+  EXPECT_EQ(parse(kMin, kMax, "-2147483649", &value), "--n: must be >= -2147483648, got -2147483649");
+  EXPECT_EQ(parse(kMin, kMax, "1.0", &value), "--n: must be a whole number, got 1.0");
+  EXPECT_EQ(parse(-4, 4, "-4", &value), "");
+  EXPECT_EQ(value, -4);
+  EXPECT_EQ(parse(-4, 4, "-5", &value), "--n: must be in [-4, 4], got -5");
+  EXPECT_EQ(parse(-4, 4, "18446744073709551617", &value), "--n: must be in [-4, 4], got 18446744073709551617");
+  EXPECT_EQ(parse(-4, 4, "- 3", &value), "--n: must be a whole number in [-4, 4], got - 3");
+  EXPECT_EQ(value, -4);  // left as it was by each refusal
+  EXPECT_EQ(parse(1, kMax, "+3", &value), "");
+  EXPECT_EQ(value, 3);
 }
 
 }  // namespace

@@ -45,6 +45,10 @@ struct Scene {
   // A dataset scene's truth maps (grid-lit, depth, ids): the truth fill, as
   // `stereorig score` measures it. Absent for the built-in scene.
   std::optional<SceneTruth> truth_maps;
+  // What of its truth a dataset scene lacks, said on its line (a line's own
+  // captures have none): its accuracy or truth fill used to be left out
+  // without a word. Empty: it lacks nothing (or is the built-in scene).
+  std::string truth_missing{};
 };
 
 double Median(std::vector<double> v) {
@@ -165,7 +169,7 @@ nlohmann::json PipelineJson(const Pipeline& p, const Rig& rig, const std::vector
   return j;
 }
 
-void PrintPipeline(const nlohmann::json& j) {
+void PrintPipeline(const nlohmann::json& j, const std::vector<Scene>& scenes) {
   std::printf(
       "%-17s %6.1f objects/s, %.0f CPU ms/object, %.2f cores busy, %.0f page faults/object  (median: total %.1f ms, "
       "modules %.1f ms, match m0 %.1f ms)\n",
@@ -185,7 +189,8 @@ void PrintPipeline(const nlohmann::json& j) {
     if (j["median_time_ms"].contains(key)) std::printf(" %s %.1f", step, j["median_time_ms"][key].get<double>());
   }
   std::printf("\n");
-  for (const auto& s : j["scenes"]) {
+  for (size_t k = 0; k < scenes.size(); ++k) {
+    const nlohmann::json& s = j["scenes"][k];
     std::printf("  %-10s %7d points, fill %.1f%%", s["scene"].get<std::string>().c_str(), s["points"].get<int>(),
                 100 * s["fill_rate"].get<double>());
     if (s.contains("truth_fill")) std::printf(" (truth fill %.1f%%)", 100 * s["truth_fill"].get<double>());
@@ -198,6 +203,7 @@ void PrintPipeline(const nlohmann::json& j) {
                              a["alignment_truth_from_cloud"]["translation_mm"][1].get<double>(),
                              a["alignment_truth_from_cloud"]["translation_mm"][2].get<double>()));
     }
+    if (!scenes[k].truth_missing.empty()) std::printf("; %s", scenes[k].truth_missing.c_str());
     std::printf("; mesh+fill %.1f ms\n", s["time_ms"]["mesh_join"].get<double>() +
                                              s["time_ms"]["hole_fill"].get<double>() +
                                              s["modules"][0]["time_ms"].value("mesh", 0.0));
@@ -273,6 +279,12 @@ int RunBench(int argc, char** argv) {
         {"sphere(builtin)", RenderSphereCapture(sim.rig, spec), SampleSphere(spec.centre_mm, spec.radius_mm, 0.2), {}});
   } else {
     rig = ReadRigFile(rig_read);
+    // The truth fill and accuracy take the truth rig's module m for the
+    // cloud's module m, as score does: a --rig of another layout was judged
+    // against the wrong module's truth, exit 0. A line's own captures with
+    // no truth rig have nothing to compare.
+    const fs::path truth_rig = fs::path(dataset) / "truth" / "rig.yaml";
+    if (!rig_path.empty() && fs::exists(truth_rig)) RequireTruthRigLayout(rig, rig_path, truth_rig.string(), "bench");
     for (const std::string& name : scene_names) {
       const fs::path capture = fs::path(dataset) / "scenes" / name / "active";
       scenes.push_back(Scene{name, LoadCapture(capture.string(), rig), {}, {}});
@@ -307,10 +319,17 @@ int RunBench(int argc, char** argv) {
   if (!dataset.empty()) {
     namespace fs = std::filesystem;
     for (Scene& s : scenes) {
-      const fs::path truth = fs::path(dataset) / "truth" / "scenes" / s.name / "surface.ply";
+      const fs::path truth_dir = fs::path(dataset) / "truth" / "scenes" / s.name;
+      const fs::path truth = truth_dir / "surface.ply";
       if (fs::exists(truth)) s.truth = ReadPlyPoints(truth.string());
-      if (fs::exists(fs::path(dataset) / "truth" / "scenes" / s.name / "lit_cam0.png"))
-        s.truth_maps = ReadSceneTruth(dataset, s.name);
+      if (fs::exists(truth_dir / "lit_cam0.png")) s.truth_maps = ReadSceneTruth(dataset, s.name);
+      // (Truth maps without the surface are refused by ReadSceneTruth.)
+      if (!fs::exists(truth))
+        s.truth_missing = "no truth (" + truth_dir.string() + "/): no accuracy, no truth fill";
+      else if (s.truth.empty())
+        s.truth_missing = "no point in the truth surface (" + truth.string() + "): no accuracy";
+      else if (!s.truth_maps)
+        s.truth_missing = "no truth maps (" + (truth_dir / "lit_cam0.png").string() + "): no truth fill";
       // A volume that misses the scene benches empty clouds: said as score says it.
       WarnIfVolumeMissesTruth("bench", s.name, s.truth, pipelines[0].runtime->volume_center_mm(),
                               options.volume_size_mm);
@@ -323,11 +342,11 @@ int RunBench(int argc, char** argv) {
   const double bench_peak_mb = PeakMemoryMb();  // before scoring builds its k-d trees
   nlohmann::json report;
   report["ours"] = PipelineJson(pipelines[0], rig, scenes);
-  PrintPipeline(report["ours"]);
+  PrintPipeline(report["ours"], scenes);
   report["baseline"] = PipelineJson(pipelines[1], rig, scenes);
-  PrintPipeline(report["baseline"]);
+  PrintPipeline(report["baseline"], scenes);
   report["baseline_standalone"] = PipelineJson(pipelines[2], rig, scenes);
-  PrintPipeline(report["baseline_standalone"]);
+  PrintPipeline(report["baseline_standalone"], scenes);
   auto objects_ratio = [&](const char* key) {
     return report["ours"]["objects_per_s"].get<double>() / report[key]["objects_per_s"].get<double>();
   };

@@ -2,6 +2,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -76,23 +77,27 @@ int RunMatch(int argc, char** argv) {
   std::vector<int> roi;
   app.add_option("--left", left_path, "rectified left image (8-bit grey PNG)")->required();
   app.add_option("--right", right_path, "rectified right image (8-bit grey PNG, same size)")->required();
-  app.add_option("--min-disparity", options.min_disparity_px, "smallest disparity searched, px, in [-1024, 2048]")
-      ->required();
-  app.add_option("--num-disparities", options.num_disparities, "number of disparities searched, in [2, 1024]")
-      ->required();
+  // Whole numbers read by the flag's rule (cli_util.h), in MatchOptions::
+  // Check's ranges: 1.5 or 99999999999 said CLI11's bare "Could not convert".
+  AddWholeNumberOption(app, "--min-disparity", &options.min_disparity_px, -1024, 2048,
+                       "smallest disparity searched, px")
+      ->required()
+      ->default_str("");  // required: no default to show
+  AddWholeNumberOption(app, "--num-disparities", &options.num_disparities, 2, 1024, "number of disparities searched")
+      ->required()
+      ->default_str("");
   app.add_option("--out", out_path, "output disparity map (.pfm)")->required()->check(NonEmptyPath());
   app.add_option("--roi", roi, "left-image region to match: x y width height, inside the image (default: whole image)")
-      ->expected(4);
+      ->expected(4)
+      ->check(WholeNumberIn(std::numeric_limits<int>::min(), std::numeric_limits<int>::max()));  // each of the four
   app.add_option("--matcher", matcher,
                  "census_sgm (ours), opencv_sgbm_3way (OpenCV's SGBM, then our filters and sub-pixel fit: the "
                  "bench's baseline) or opencv_sgbm_3way_standalone (SGBM with its own sub-pixel fit only)")
       ->capture_default_str();
-  app.add_option("--pyramid-levels", options.pyramid_levels,
-                 "census_sgm: halvings before the full-range SGM (0 = full-resolution SGM)")
-      ->capture_default_str();
-  app.add_option("--threads", options.num_threads,
-                 "threads the matching may use at once, in [1, 64] (1 = this one only)")
-      ->capture_default_str();
+  AddWholeNumberOption(app, "--pyramid-levels", &options.pyramid_levels, 0, 3,
+                       "census_sgm: halvings before the full-range SGM (0 = full-resolution SGM)");
+  AddWholeNumberOption(app, "--threads", &options.num_threads, 1, 64,
+                       "threads the matching may use at once (1 = this one only)");
   if (auto rc = ParseArgs(app, argc, argv)) return *rc;
 
   options.matcher = ParseMatcherKind(matcher, "--matcher");

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "apps/cli_util.h"
@@ -163,14 +164,10 @@ int RunReconstruct(int argc, char** argv) {
   const Rig rig = ReadRigFile(rig_path);
   OutputPaths outputs;
   ProtectCaptureInputs(rig_path, options_path, capture_dir, rig, &outputs);
-  outputs.Claim(out_path, "the cloud (--out)");
-  CheckCloudPath(out_path);  // after the claim: "is an input" says more than "not .ply" would
-  if (!mesh_path.empty()) {
-    CheckMeshPath(mesh_path);
-    outputs.Claim(mesh_path, "the mesh (--mesh)");
-  }
-  if (!report_path.empty()) outputs.Claim(report_path, "the report (--report)");
-  FolderToCreate rectified_folder;  // made once the capture is read
+  // The folder --rectified-out creates first: the cloud, mesh or report may
+  // go in it (--rectified-out r --out r/x.ply was refused as "its folder
+  // does not exist", r being the folder the run makes).
+  FolderToCreate rectified_folder;  // made once the capture is reconstructed
   std::vector<RectifiedPairPaths> rectified_paths;
   if (!rectified_dir.empty()) {
     rectified_folder = outputs.ClaimFolder(rectified_dir, "the rectified pairs (--rectified-out)");
@@ -180,22 +177,34 @@ int RunReconstruct(int argc, char** argv) {
       outputs.Claim(pair.right, "a rectified right image (--rectified-out)", false);
     }
   }
+  auto claim = [&](const std::string& path, const std::string& what) {
+    namespace fs = std::filesystem;
+    outputs.Claim(path, what, !rectified_folder.WillCreate(fs::absolute(path).parent_path()));
+  };
+  claim(out_path, "the cloud (--out)");
+  CheckCloudPath(out_path);  // after the claim: "is an input" says more than "not .ply" would
+  if (!mesh_path.empty()) {
+    CheckMeshPath(mesh_path);
+    claim(mesh_path, "the mesh (--mesh)");
+  }
+  if (!report_path.empty()) claim(report_path, "the report (--report)");
   const RuntimeOptions options = options_path.empty() ? RuntimeOptions{} : ReadRuntimeOptions(options_path);
   NoteShapeModelWithoutMesh(options, !mesh_path.empty());
   const std::vector<cv::Mat> images = LoadCapture(capture_dir, rig);
   const Runtime runtime(rig, options);
   const Reconstruction rec = runtime.Process(images, !mesh_path.empty());
 
+  // Before any output is staged: the cloud's temporary file may go in it.
+  rectified_folder.Create();
   // All or none: a report that cannot be written (a full disk) leaves an
   // earlier run's cloud and mesh as they were, not a new cloud beside them.
+  // Declared after `rectified_folder`: its temporary files go before the
+  // folder made for them, which is removed while empty if the run fails.
   AtomicOutputSet written;
   written.Add(out_path, EncodeCloudPly(rec.cloud));
   if (!mesh_path.empty()) written.Add(mesh_path, EncodeMesh(rec.cloud, rec.mesh, mesh_path));
   if (!report_path.empty()) written.Add(report_path, JsonReportText(ReconstructionJson(rec)) + "\n");
-  if (!rectified_paths.empty()) {
-    rectified_folder.Create();
-    AddRectifiedPairs(runtime, images, rectified_paths, &written);
-  }
+  if (!rectified_paths.empty()) AddRectifiedPairs(runtime, images, rectified_paths, &written);
   written.Commit();
   for (const ModuleReport& m : rec.modules)
     std::printf("%s\n",

@@ -112,22 +112,7 @@ int RunScore(int argc, char** argv) {
   // The truth's fill target and depth are the truth rig's module m's, taken
   // for the cloud's module m: a --rig pairing other cameras in a module (its
   // layout another's) was scored against the wrong truth, exit 0.
-  if (rig_given) {
-    const std::string truth_path = (fs::path(dataset) / "truth" / "rig.yaml").string();
-    const Rig truth = ReadRigFile(truth_path);
-    for (int m = 0; m < std::max(rig.num_modules(), truth.num_modules()); ++m) {
-      auto cameras = [m](const Rig& r) {
-        return m < r.num_modules() ? "cameras " + std::to_string(r.module(m).left_camera) + " and " +
-                                         std::to_string(r.module(m).right_camera)
-                                   : std::string("no module");
-      };
-      if (cameras(rig) != cameras(truth))
-        throw InputError(rig_path, "its module " + std::to_string(m) + " has " + cameras(rig) +
-                                       ", the dataset's truth rig's (" + truth_path + ") " + cameras(truth) +
-                                       ": score compares each module with the truth's of its number; calibrate with "
-                                       "the dataset's layout");
-    }
-  }
+  if (rig_given) RequireTruthRigLayout(rig, rig_path, (fs::path(dataset) / "truth" / "rig.yaml").string(), "score");
   // Every scene named is in the dataset, before any is scored: a scene
   // misnamed after others in --scenes used to be found only once they were
   // scored, their diagnosis images left in a new --diagnose folder. The

@@ -22,11 +22,15 @@ void OutputPaths::Claim(const std::string& path, const std::string& what, bool c
   const fs::path key = NormalPath(path);
   if (const auto it = inputs_.find(key); it != inputs_.end())
     throw InputError(path, "is " + it->second + ": writing " + what + " there would overwrite an input");
-  if (const auto it = claimed_.find(key); it != claimed_.end())
-    throw InputError(
-        path, "would be written twice (" + it->second + " and " + what + ")" + (remedy_.empty() ? "" : ": " + remedy_));
+  // A folder claimed before (ClaimFolder) is named as one: the claims of a
+  // command that puts its files in that folder come after it.
   if (const auto it = folders_.find(key); it != folders_.end())
     throw InputError(path, "is a folder this command creates for " + it->second + ", not a file to write");
+  if (const auto it = claimed_.find(key); it != claimed_.end()) {
+    if (fs::is_directory(key)) throw InputError(path, "is the folder for " + it->second + ", not a file to write");
+    throw InputError(
+        path, "would be written twice (" + it->second + " and " + what + ")" + (remedy_.empty() ? "" : ": " + remedy_));
+  }
   std::vector<fs::path> missing;
   const fs::path existing = DeepestExistingPart(key, &missing);
   CheckNamesFit(path, "write " + what, existing, missing);

@@ -25,7 +25,7 @@ class OutputPaths {
   explicit OutputPaths(std::string remedy = "") : remedy_(std::move(remedy)) {}
   // Records `path`, written as `what` (for the message). Throws InputError if
   // another output already claimed the same file, if it is a folder a
-  // ClaimFolder before will create, if a name in it that does not exist yet
+  // ClaimFolder before will create or claimed (named as that folder), if a name in it that does not exist yet
   // (the file's, or a folder's the command creates) is longer than the file
   // system allows (NAME_MAX), or, with
   // check_folder, if its folder does not exist or this process may not

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdio>
 #include <opencv2/imgproc.hpp>
 
 #include "calib/core/input_error.h"
@@ -41,10 +42,24 @@ RectifiedGeometry ComputeRectification(const Camera& left, const Camera& right, 
   g.focal_px = std::min(0.5 * (left.fx() + left.fy()), 0.5 * (right.fx() + right.fy()));
   g.size = cv::Size(left.imager_width_px(), left.imager_height_px());
   const Eigen::Vector3d c = g.rect_from_left * look_at_left_mm;
-  if (!(c.z() > 0))
-    throw InputError(names.options, "the measurement volume's centre is behind " + names.module +
-                                        ": check volume_center_mm / working_distance_mm" +
-                                        (names.also_check.empty() ? "" : ", or " + names.also_check));
+  if (!(c.z() > 0)) {
+    // "Behind" alone misled where the centre lies far to the side (x 5000
+    // mm at z 200 mm is 91 deg off a verged module's axis): the angle says
+    // which, the view's half width what would be in front. atan2 and hypot:
+    // a centre 1e300 mm away squared to inf in norm().
+    const double off_deg = std::atan2(std::hypot(c.x(), c.y()), c.z()) * 180 / M_PI;
+    const double half_view_deg = std::atan(0.5 * g.size.width / g.focal_px) * 180 / M_PI;
+    char where[160];
+    std::snprintf(
+        where, sizeof where,
+        "it lies %.0f deg off the module's viewing direction (%s; its view reaches about %.0f deg either side)",
+        off_deg, off_deg >= 135 ? "behind it" : "to its side", half_view_deg);
+    const std::string given = names.volume_key + (names.volume_value.empty() ? "" : " " + names.volume_value);
+    throw InputError(names.options,
+                     "the measurement volume's centre (" + given + ") is not in front of " + names.module + ": " +
+                         (c != Eigen::Vector3d::Zero() ? std::string(where) : "it is at its left camera's centre") +
+                         "; check " + names.volume_key + (names.also_check.empty() ? "" : ", or " + names.also_check));
+  }
   // Centre pixel of the image ((W-1)/2 in mrcal's pixel-centre convention).
   g.cx_left_px = 0.5 * (g.size.width - 1) - g.focal_px * c.x() / c.z();
   g.cy_px = 0.5 * (g.size.height - 1) - g.focal_px * c.y() / c.z();

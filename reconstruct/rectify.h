@@ -43,8 +43,11 @@ struct RectifiedGeometry {
 // The focal length is the smaller mean focal length of the two cameras, so
 // no view is magnified beyond its native sampling.
 // Throws InputError on a degenerate module (zero baseline, baseline along
-// the optical axes: where `names.rig`) or a look-at point behind it (where
-// `names.options`); the messages name the module as `names.module`.
+// the optical axes: where `names.rig`) or a look-at point not in front of it
+// (behind the plane through its cameras' centres that the rectified views
+// look away from, so beside them too: where `names.options`, the angle off
+// the module's viewing direction said); the messages name the module as
+// `names.module`.
 struct RectificationNames {
   std::string rig = "rig";                  // the rig file
   std::string options = "runtime options";  // where the measurement volume was set
@@ -53,6 +56,10 @@ struct RectificationNames {
   // "or ...": for a module other than the reference one, its pose in the
   // rig file (the volume is set in the reference frame). Empty: nothing.
   std::string also_check;
+  // The option that put the volume's centre where it is, and its value as
+  // the message gives it ("volume_center_mm", "[5000, 0, 200]").
+  std::string volume_key = "volume_center_mm / working_distance_mm";
+  std::string volume_value;
 };
 RectifiedGeometry ComputeRectification(const Camera& left, const Camera& right, const Pose& right_from_left,
                                        const Eigen::Vector3d& look_at_left_mm, const RectificationNames& names = {});

@@ -101,6 +101,15 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
   volume_center_mm_ =
       options_.volume_center_mm ? *options_.volume_center_mm : PointAhead(rig_, 0, options_.working_distance_mm);
   const std::vector<Eigen::Vector3d> corners_ref = VolumeCorners(volume_center_mm_, options_.volume_size_mm);
+  // The option that set the centre, named in the messages below with what
+  // it was given: the one to change, not a list of both.
+  const std::string volume_key = options_.volume_center_mm ? "volume_center_mm" : "working_distance_mm";
+  char volume_value[160];
+  if (options_.volume_center_mm)
+    std::snprintf(volume_value, sizeof volume_value, "[%g, %g, %g]", options_.volume_center_mm->x(),
+                  options_.volume_center_mm->y(), options_.volume_center_mm->z());
+  else
+    std::snprintf(volume_value, sizeof volume_value, "%g, ahead of module 0", options_.working_distance_mm);
   for (int m = 0; m < rig_.num_modules(); ++m) {
     const StereoModule& mod = rig_.module(m);
     const Camera& left = rig_.camera(mod.left_camera);
@@ -116,8 +125,9 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
     // pose in the rig file can put it behind too.
     const std::string pose_check =
         m == 0 ? "" : mod.name + "'s pose in " + rig_.Where() + " (the volume is set in module 0's frame)";
-    plan.geometry = ComputeRectification(left, right, mod.right_from_left, module_from_reference * volume_center_mm_,
-                                         RectificationNames{rig_.Where(), options_.Where(), mod.name, pose_check});
+    plan.geometry = ComputeRectification(
+        left, right, mod.right_from_left, module_from_reference * volume_center_mm_,
+        RectificationNames{rig_.Where(), options_.Where(), mod.name, pose_check, volume_key, volume_value});
     plan.maps = BuildRectifyMaps(plan.geometry, left, right);
     {  // the exact float tables, only for the masks (the runtime keeps the fixed-point ones)
       cv::Mat map_x, map_y;
@@ -133,8 +143,8 @@ Runtime::Runtime(const Rig& rig, const RuntimeOptions& options) : rig_(rig), opt
     for (const Eigen::Vector3d& c : corners_ref) {
       const Eigen::Vector3d p_rect = plan.geometry.rect_from_left * (module_from_reference * c);
       if (!(p_rect.z() > 1.0))
-        throw InputError(options_.Where(), "the measurement volume reaches behind " + mod.name +
-                                               "'s cameras: check volume_center_mm / volume_size_mm" +
+        throw InputError(options_.Where(), "the measurement volume reaches behind " + mod.name + "'s cameras: check " +
+                                               volume_key + " / volume_size_mm" +
                                                (pose_check.empty() ? "" : ", or " + pose_check));
       const Eigen::Vector3d q = plan.geometry.PixelAndDisparity(p_rect);
       u0 = std::min(u0, q.x()), u1 = std::max(u1, q.x());

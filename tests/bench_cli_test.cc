@@ -16,6 +16,8 @@
 #include <thread>
 #include <utility>
 
+#include "calib/core/rig_file.h"
+#include "datasets/default_rig.h"
 #include "tests/cli_runner.h"
 #include "tests/sim_scene.h"
 
@@ -145,6 +147,42 @@ TEST(BenchCli, AMissingSceneNamedInScenesExitsTwoBeforeAnyRun) {
   std::filesystem::remove_all(dataset);
 }
 
+// bench, as score, takes the truth rig's module m (its fill target and
+// depth) for the cloud's module m: a --rig pairing other cameras in its
+// modules (another layout's: module 0 on cameras 2 and 3) had its truth
+// fill and accuracy taken against the wrong module's truth, exit 0. Refused
+// before any run, naming both rigs, with score's check (cli_util.h). The
+// truth rig's own layout, and any layout on a line's own captures (no
+// truth/rig.yaml), go on: to the capture here, an empty folder.
+TEST(BenchCli, ARigWhoseModulesPairOtherCamerasThanTheTruthsIsRefusedBeforeAnyRun) {
+  namespace fs = std::filesystem;
+  const std::string dataset = ::testing::TempDir() + "/bench_other_layout_" + std::to_string(getpid());
+  fs::remove_all(dataset);
+  fs::create_directories(dataset + "/scenes/cup/active");
+  fs::create_directories(dataset + "/truth");
+  WriteRigFile(MakeDefaultRig().rig, dataset + "/truth/rig.yaml");
+  const std::string other = dataset + "/other_layout.yaml";
+  WriteRigFile(testing::DefaultRigInAnotherLayout(), other);
+  const std::string bench = "bench --runs 1 --dataset " + dataset + " --scenes cup --rig ";
+  const testing::Result r = RunCli(bench + other);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(other + ": its module 0 has cameras 2 and 3, the dataset's truth rig's (" + dataset +
+                       "/truth/rig.yaml) cameras 0 and 1: bench compares each module with the truth's of its number"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.out.find("objects/s"), std::string::npos) << r.out;
+  const std::string to_capture = dataset + "/scenes/cup/active/cam0.png: missing camera image";
+  const testing::Result same = RunCli(bench + dataset + "/truth/rig.yaml");
+  EXPECT_EQ(same.code, 2);
+  EXPECT_NE(same.err.find(to_capture), std::string::npos) << same.err;
+  fs::remove_all(dataset + "/truth");
+  const testing::Result own = RunCli(bench + other);
+  EXPECT_EQ(own.code, 2);
+  EXPECT_NE(own.err.find(to_capture), std::string::npos) << own.err;
+  fs::remove_all(dataset);
+}
+
 // A measurement volume that misses a scene, and a run without --rig (the
 // truth rig read): bench and score warn of each in one line on stderr. The
 // volume's line names the scene and both distances, on stderr (a warning:
@@ -183,6 +221,36 @@ TEST(BenchCli, BenchAndScoreWarnOnStderrOfAVolumeThatMissesAScenesTruthAndOfTheT
     EXPECT_EQ(given.err.find("no --rig"), std::string::npos) << command << ": " << given.err;
   }
   std::filesystem::remove_all(dataset);
+}
+
+// A dataset scene without truth (truth/scenes/<scene>/: a line's own
+// captures benched with their rig), or without its truth maps, is benched,
+// and its line says what it lacks: the accuracy and the truth fill used to
+// be left out without a word, as if the scene had none to give. Each
+// pipeline's line says it. The volume beside the scene keeps the run to
+// empty clouds: a few seconds.
+TEST(BenchCli, ASceneWithoutTruthSaysSoOnItsLine) {
+  namespace fs = std::filesystem;
+  const std::string dataset = testing::SimulateOneScene("sphere", 1, "bench_no_truth");
+  const std::string options = dataset + "/volume_beside.yaml";
+  { std::ofstream(options) << "volume_center_mm: [200, 0, 200]\n"; }
+  const std::string bench = "bench --runs 1 --dataset " + dataset + " --scenes sphere --options " + options;
+  auto times_said = [](const std::string& out, const std::string& says) {
+    int n = 0;
+    for (size_t at = out.find(says); at != std::string::npos; at = out.find(says, at + 1)) ++n;
+    return n;
+  };
+  const std::string truth = dataset + "/truth/scenes/sphere";
+  fs::remove(truth + "/lit_cam0.png");
+  const testing::Result no_maps = RunCli(bench);
+  ASSERT_EQ(no_maps.code, 0) << no_maps.err;
+  EXPECT_EQ(times_said(no_maps.out, "; no truth maps (" + truth + "/lit_cam0.png): no truth fill"), 3) << no_maps.out;
+  EXPECT_EQ(times_said(no_maps.out, ", merged "), 3) << no_maps.out;  // its surface is there: accuracy
+  fs::remove_all(truth);
+  const testing::Result none = RunCli(bench);
+  ASSERT_EQ(none.code, 0) << none.err;
+  EXPECT_EQ(times_said(none.out, "; no truth (" + truth + "/): no accuracy, no truth fill; mesh+fill"), 3) << none.out;
+  fs::remove_all(dataset);
 }
 
 // Without --scenes, score and bench take those of the five default scenes

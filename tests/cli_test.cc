@@ -247,6 +247,38 @@ TEST(Cli, MatchRefusesARegionNotInsideTheImage) {
   EXPECT_NE(part.out.find(" of 200 px in --roi ("), std::string::npos) << part.out;
 }
 
+// match's whole-number flags name themselves, their rule and the value
+// given: a fraction or a number past an int said CLI11's bare "Could not
+// convert: --min-disparity = 1.5". Refused before the images are read (the
+// left one is missing here), nothing written; a zero-padded value is
+// decimal and goes on to the images.
+TEST(Cli, MatchNamesAWholeNumberFlagItsRuleAndTheValue) {
+  const std::string dir = MatchScratch("cli_match_whole_numbers");
+  const std::string base = "match --left " + dir + "/missing.png --right " + dir + "/l.png --out " + dir + "/d.pfm";
+  const std::pair<std::string, std::string> refused[] = {
+      {"--min-disparity 1.5 --num-disparities 16", "--min-disparity: must be a whole number in [-1024, 2048], got 1.5"},
+      {"--min-disparity 0 --num-disparities 99999999999", "--num-disparities: must be in [2, 1024], got 99999999999"},
+      {"--min-disparity -99999999999999999999 --num-disparities 16",
+       "--min-disparity: must be in [-1024, 2048], got -99999999999999999999"},
+      {"--min-disparity 0 --num-disparities 2000", "--num-disparities: must be in [2, 1024], got 2000"},
+      {"--min-disparity 0 --num-disparities 16 --threads x", "--threads: must be a whole number in [1, 64], got x"},
+      {"--min-disparity 0 --num-disparities 16 --pyramid-levels 0.5",
+       "--pyramid-levels: must be a whole number in [0, 3], got 0.5"},
+      {"--min-disparity 0 --num-disparities 16 --roi 0 0 32 1e3", "--roi: must be a whole number, got 1e3"},
+      {"--min-disparity 0 --num-disparities 16 --roi 0 0 32 4294967312",
+       "--roi: must be at most 2147483647, got 4294967312"}};
+  for (const auto& [args, says] : refused) {
+    const Result r = RunCli(base + " " + args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("stereorig match: " + says), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/d.pfm")) << args;
+  }
+  const Result padded = RunCli(base + " --min-disparity -010 --num-disparities 016");
+  EXPECT_EQ(padded.code, 2);
+  EXPECT_NE(padded.err.find(dir + "/missing.png"), std::string::npos) << padded.err;
+}
+
 // The disparity map is always PFM: `--out d.png` would hold PFM bytes an
 // image viewer cannot open. (Before, it was written there and match exited
 // 0.) Refused before the matching, in one line naming the path.

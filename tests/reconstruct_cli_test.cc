@@ -466,6 +466,41 @@ TEST_F(ReconstructCli, RectifiedOutWritesEachModulesPairAndTheMatchCommandForIt)
                          "--out-dir excludes --rectified-out");
 }
 
+// --rectified-out creates its folder; the cloud, mesh and report may go in
+// it (--rectified-out r --out r/x.ply was refused, "its folder does not
+// exist", though the run makes it). A folder below it that nobody makes is
+// still refused, and so is the folder itself as a file; a capture found
+// bad after the claims leaves no folder behind.
+TEST_F(ReconstructCli, OutputsMayGoInTheFolderRectifiedOutCreates) {
+  namespace fs = std::filesystem;
+  ASSERT_EQ(RunCli(Args(dir_ + "/capture")), 0);
+  const std::string plain_cloud = ReadFileBytes(dir_ + "/out.ply");
+  const std::string rect = dir_ + "/rect_outputs/pairs";
+  fs::remove_all(dir_ + "/rect_outputs");
+  const std::string reconstruct = "reconstruct --rig " + dir_ + "/rig.yaml --capture ";
+  const testing::Result r = testing::RunCli(reconstruct + dir_ + "/capture --rectified-out " + rect + " --out " + rect +
+                                            "/x.ply --mesh " + rect + "/x.stl --report " + rect + "/x.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(ReadFileBytes(rect + "/x.ply"), plain_cloud);
+  EXPECT_TRUE(fs::is_regular_file(rect + "/x.stl"));
+  EXPECT_TRUE(fs::is_regular_file(rect + "/x.json"));
+  EXPECT_TRUE(fs::is_regular_file(rect + "/module1_right.png"));
+  fs::remove_all(dir_ + "/rect_outputs");
+  ExpectRefusedInOneLine(reconstruct + dir_ + "/capture --rectified-out " + rect + " --out " + rect + "/sub/x.ply",
+                         rect + "/sub/x.ply: its folder does not exist");
+  ExpectRefusedInOneLine(reconstruct + dir_ + "/capture --rectified-out " + rect + " --out " + rect,
+                         rect +
+                             ": is a folder this command creates for the rectified pairs (--rectified-out), not a "
+                             "file to write");
+  const std::string broken = BrokenCapture("rect_outputs_broken");
+  WriteFileAtomically(broken + "/cam1.png", "not a png");  // found only when decoded
+  const testing::Result bad =
+      testing::RunCli(reconstruct + broken + " --rectified-out " + rect + " --out " + rect + "/x.ply");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find(broken + "/cam1.png"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir_ + "/rect_outputs"));
+}
+
 // A grey PNG of 1, 2 or 4 bits decodes to 8 bits (0/255 for 1 bit): a 1-bit
 // capture gave 0 points and a 4-bit one fewer, exit 0 both. Refused now as
 // formats.md says (8-bit grey only), naming the file and its depth; so is
@@ -1072,17 +1107,7 @@ TEST_F(ReconstructCli, ScoreAndBatchOutputsOverTheirInputsAreRefused) {
 // which holds cam0.png alone).
 TEST_F(ReconstructCli, ScoreRefusesARigWhoseModulesPairOtherCameras) {
   const std::string d = ScoreDataset("score_other_layout");
-  const SimulatedRig sim = MakeDefaultRig();
-  std::vector<Camera> cameras;
-  std::vector<std::string> names;
-  for (int k : {2, 3, 0, 1}) {  // the cameras relabelled: module 0's pair is cameras 2 and 3
-    cameras.push_back(sim.rig.cameras()[k]);
-    names.push_back(sim.rig.camera_names()[k]);
-  }
-  std::vector<StereoModule> modules = sim.rig.modules();
-  modules[0].left_camera = 2, modules[0].right_camera = 3;
-  modules[1].left_camera = 0, modules[1].right_camera = 1;
-  WriteRigFile(Rig(cameras, names, modules, sim.rig.S(), "test"), dir_ + "/other_layout.yaml");
+  WriteRigFile(testing::DefaultRigInAnotherLayout(), dir_ + "/other_layout.yaml");
   const std::string score = "score --dataset " + d + " --scenes cup --no-passive --rig ";
   ExpectRefusedInOneLine(score + dir_ + "/other_layout.yaml",
                          dir_ + "/other_layout.yaml: its module 0 has cameras 2 and 3, the dataset's truth rig's (" +
@@ -1276,15 +1301,36 @@ TEST_F(ReconstructCli, ADegenerateModuleOrAVolumeBehindItNamesTheFileAndModule) 
       << r.err;
   ExpectNoOutput();
 
-  // The reference frame is module 0's left camera: z < 0 is behind it.
+  // The reference frame is module 0's left camera: z < 0 is behind it. The
+  // message names the option and its value, and how far off the module's
+  // view the centre is.
   WriteFileAtomically(dir_ + "/behind.yaml", "volume_center_mm: [0, 0, -300]\n");
   r = testing::RunCli(Args(dir_ + "/capture", "--options " + dir_ + "/behind.yaml"));
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
-  EXPECT_NE(r.err.find(dir_ + "/behind.yaml (runtime options): the measurement volume's centre is behind " +
-                       sim.rig.module(0).name + ": check volume_center_mm / working_distance_mm\n"),
-            std::string::npos)
+  EXPECT_TRUE(std::regex_search(
+      r.err, std::regex(dir_ +
+                        "/behind.yaml \\(runtime options\\): the measurement volume's centre \\(volume_center_mm "
+                        "\\[0, 0, -300\\]\\) is not in front of " +
+                        sim.rig.module(0).name +
+                        ": it lies 1[4-8][0-9] deg off the module's viewing direction \\(behind it; its view reaches "
+                        "about [0-9]+ deg either side\\); check volume_center_mm\n")))
       << r.err;  // module 0's pose is the reference frame itself: nothing more to check
+  ExpectNoOutput();
+
+  // Far to the side, in front of the cameras' plane but past the side of
+  // their view (the modules are verged): it was "behind module0" too.
+  WriteFileAtomically(dir_ + "/side.yaml", "volume_center_mm: [5000, 0, 200]\n");
+  r = testing::RunCli(Args(dir_ + "/capture", "--options " + dir_ + "/side.yaml"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_TRUE(std::regex_search(
+      r.err,
+      std::regex("the measurement volume's centre \\(volume_center_mm \\[5000, 0, 200\\]\\) is not in front of " +
+                 sim.rig.module(0).name +
+                 ": it lies (9|1[0-3])[0-9] deg off the module's viewing direction \\(to its side; its view "
+                 "reaches about [0-9]+ deg either side\\); check volume_center_mm\n")))
+      << r.err;
   ExpectNoOutput();
 
   // Module 1 turned about its own vertical axis to face away, in a rig file
@@ -1298,9 +1344,14 @@ TEST_F(ReconstructCli, ADegenerateModuleOrAVolumeBehindItNamesTheFileAndModule) 
                       "/out.ply --report " + dir_ + "/out.json");
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
-  EXPECT_NE(r.err.find("the measurement volume's centre is behind " + sim.rig.module(1).name +
-                       ": check volume_center_mm / working_distance_mm, or " + sim.rig.module(1).name + "'s pose in " +
-                       dir_ + "/turned.yaml (the volume is set in module 0's frame)\n"),
+  EXPECT_NE(r.err.find("the measurement volume's centre (working_distance_mm 200, ahead of module 0) is not in "
+                       "front of " +
+                       sim.rig.module(1).name + ": it lies "),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find(" (behind it; its view reaches about "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("; check working_distance_mm, or " + sim.rig.module(1).name + "'s pose in " + dir_ +
+                       "/turned.yaml (the volume is set in module 0's frame)\n"),
             std::string::npos)
       << r.err;
   ExpectNoOutput();
