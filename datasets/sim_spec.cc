@@ -168,8 +168,6 @@ void ScenesSpec::Check(const std::string& where) const {
   Require(cup_diameter_mm > 10 && cup_height_mm > 10, where, "cup_diameter_mm", "cup must be larger than 10 mm");
   Require(sphere_diameter_mm > 0, where, "sphere_diameter_mm", "must be positive");
   Require(ballbar_sphere_diameter_mm > 0, where, "ballbar_sphere_diameter_mm", "must be positive");
-  Require(ballbar_distance_mm > ballbar_sphere_diameter_mm, where, "ballbar_distance_mm",
-          "must exceed the sphere diameter");
   Require(plate_size_mm.minCoeff() > 0, where, "plate_size_mm", "must be positive");
   Require(tuber_semi_axes_mm.minCoeff() > 0, where, "tuber_semi_axes_mm", "must be positive");
   Require(tuber_bump >= 0 && tuber_bump < 0.3, where, "tuber_bump", "must be in [0, 0.3)");
@@ -199,6 +197,10 @@ void ScenesSpec::Check(const std::string& where) const {
                 ShortestNumberText(kMaxSizeMm) +
                 " mm a scene on the belt may be (its truth surface is sampled every 0.2 mm); is it in "
                 "micrometres? the unit is mm");
+  // After the sizes: a ball typed in micrometres is named as the ball (its
+  // bar over 300 mm), not as a distance short of it.
+  Require(ballbar_distance_mm > ballbar_sphere_diameter_mm, where, "ballbar_distance_mm",
+          "must exceed the sphere diameter");
   for (double a : {cup_albedo, artifact_albedo, tuber_albedo}) {
     Require(a > 0 && a <= 1, where, "albedo", "albedos must be in (0, 1]");
   }

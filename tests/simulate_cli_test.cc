@@ -578,6 +578,10 @@ TEST(SimulateCli, ASceneObjectLargerThanTheBeltTakesIsRefused) {
            // The bar's length is its distance plus a ball (25.4 mm): 280 + 25.4.
            {"ballbar_distance_mm: 80", "ballbar_distance_mm: 280",
             "ballbar_distance_mm: the ball bar (its distance plus a ball) is 305.4 mm"},
+           // A ball typed in micrometres is named as the ball, not as a
+           // distance (80 mm) short of it.
+           {"ballbar_sphere_diameter_mm: 25.4", "ballbar_sphere_diameter_mm: 25400",
+            "ballbar_sphere_diameter_mm: the ball bar (its distance plus a ball) is 25480 mm"},
            // The longest axis with its bumps (0.05 by default): 2 x 143 x 1.05.
            {"tuber_semi_axes_mm: [42, 30, 27]", "tuber_semi_axes_mm: [143, 30, 27]",
             "tuber_semi_axes_mm: the tuber (its longest axis with its bumps) is 300.3 mm"}}) {
@@ -588,12 +592,20 @@ TEST(SimulateCli, ASceneObjectLargerThanTheBeltTakesIsRefused) {
                      spec + ": scenes: " + says});
   }
   ExpectEachRefusedBeforeAnyWork(cases, dir + "/out");
-  // At the bound itself the spec is read and the dataset written.
-  const std::string spec = dir + "/at_bound.yaml";
-  const std::string text = EditedDefaultSpec(spec, "plate_size_mm: [130, 120, 8]", "plate_size_mm: [130, 300, 8]");
-  std::ofstream(spec) << text;
-  const Result r = RunCli("simulate --spec " + spec + " --out " + dir + "/out/ds --calibration-captures 0 --no-scenes");
-  EXPECT_EQ(r.code, 0) << r.err;
+  // At the bound itself each is read and the dataset written: a plate 300 mm
+  // long, a bar of 274.6 + 25.4 mm, a tuber of 2 x 142 x 1.05 = 298.2 mm.
+  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
+           {"plate_size_mm: [130, 120, 8]", "plate_size_mm: [130, 300, 8]"},
+           {"ballbar_distance_mm: 80", "ballbar_distance_mm: 274.6"},
+           {"tuber_semi_axes_mm: [42, 30, 27]", "tuber_semi_axes_mm: [142, 30, 27]"}}) {
+    const std::string spec = dir + "/at_bound.yaml";
+    const std::string text = EditedDefaultSpec(spec, from, to);
+    std::ofstream(spec) << text;
+    fs::remove_all(dir + "/out/ds");
+    const Result r =
+        RunCli("simulate --spec " + spec + " --out " + dir + "/out/ds --calibration-captures 0 --no-scenes");
+    EXPECT_EQ(r.code, 0) << to << ": " << r.err;
+  }
   fs::remove_all(dir);
 }
 
