@@ -56,6 +56,18 @@ void RuntimeOptions::Check() const {
                   volume_diagonal_mm);
     throw InputError("volume_size_mm", why);
   }
+  // A volume under 10 mm across that the object size outgrows is a volume
+  // typed in metres (a 1 m belt's [1, 1, 0.5], 1.5 mm) far more likely than
+  // objects of that size: named as the volume, object_size_mm (100 mm unless
+  // set) said beside it. Above 10 mm, the object size is the one to check.
+  if (object_size_mm > 10 * volume_diagonal_mm && volume_diagonal_mm < 10) {
+    char why[240];
+    std::snprintf(why, sizeof why,
+                  "its diagonal, %.3g mm, is under a tenth of object_size_mm (%g mm; 100 unless set): its sides are "
+                  "in mm (for objects that small, set object_size_mm too)",
+                  volume_diagonal_mm, object_size_mm);
+    throw InputError("volume_size_mm", why);
+  }
   if (!(object_size_mm >= 1 && object_size_mm <= 10 * volume_diagonal_mm)) {
     char range[128];
     std::snprintf(range, sizeof range, "must be in [1, %.1f] mm (ten times the measurement volume's diagonal)",

@@ -289,6 +289,13 @@ TEST(RuntimeOptions, ValuesPastWhatTheRigCanMeasureAreRefused) {
   EXPECT_EQ(RefusalOf("volume_size_mm: [0.015, 0.015, 0.01]\n"),
             "o.yaml: volume_size_mm: its diagonal, 0.0235 mm, is under the smallest object (object_size_mm: at least "
             "1 mm): its sides are in mm");
+  // A 1 m belt's volume typed in metres (a 1.5 mm diagonal) with the default
+  // object size (100 mm) named object_size_mm too: named as the volume.
+  EXPECT_EQ(RefusalOf("volume_size_mm: [1, 1, 0.5]\n"),
+            "o.yaml: volume_size_mm: its diagonal, 1.5 mm, is under a tenth of object_size_mm (100 mm; 100 unless "
+            "set): its sides are in mm (for objects that small, set object_size_mm too)");
+  // A volume over 10 mm across: the object size is the one named (1e5 for 100 mm in um).
+  EXPECT_EQ(RefusalOf("object_size_mm: 100000\n").rfind("o.yaml: object_size_mm: must be in [1, 2345", 0), 0u);
   // Just over 1 mm (sqrt(3) x 0.6 = 1.04 mm) holds the 1 mm object.
   EXPECT_EQ(RefusalOf("volume_size_mm: [0.6, 0.6, 0.6]\nobject_size_mm: 1\n"), "");
 }
