@@ -143,16 +143,17 @@ void RequireTruthRigLayout(const Rig& rig, const std::string& rig_path, const st
                            const std::string& command) {
   const Rig truth = ReadRigFile(truth_rig_path);
   for (int m = 0; m < std::max(rig.num_modules(), truth.num_modules()); ++m) {
-    // "cameras 2 and 3", or "no module 1" where the rig has fewer.
-    auto cameras = [m](const Rig& r) {
-      return m < r.num_modules() ? "cameras " + std::to_string(r.module(m).left_camera) + " and " +
-                                       std::to_string(r.module(m).right_camera)
-                                 : "no module " + std::to_string(m);
+    // Each side a whole clause: "module 1 has cameras 2 and 3" or "there is
+    // no module 1" (the message starts with the rig file's path).
+    auto side = [m](const Rig& r) {
+      return m < r.num_modules()
+                 ? "module " + std::to_string(m) + " has cameras " + std::to_string(r.module(m).left_camera) + " and " +
+                       std::to_string(r.module(m).right_camera)
+                 : "there is no module " + std::to_string(m);
     };
-    if (cameras(rig) != cameras(truth))
-      throw InputError(rig_path, (m < rig.num_modules() ? "its module " + std::to_string(m) + " has " : "it has ") +
-                                     cameras(rig) + ", the dataset's truth rig's (" + truth_rig_path + ") " +
-                                     cameras(truth) + ": " + command +
+    if (side(rig) != side(truth))
+      throw InputError(rig_path, side(rig) + "; in the dataset's truth rig (" + truth_rig_path + ") " + side(truth) +
+                                     ": " + command +
                                      " compares each module with the truth's of its number; calibrate with the "
                                      "dataset's layout");
   }

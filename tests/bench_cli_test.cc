@@ -167,8 +167,9 @@ TEST(BenchCli, ARigWhoseModulesPairOtherCamerasThanTheTruthsIsRefusedBeforeAnyRu
   const testing::Result r = RunCli(bench + other);
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
-  EXPECT_NE(r.err.find(other + ": its module 0 has cameras 2 and 3, the dataset's truth rig's (" + dataset +
-                       "/truth/rig.yaml) cameras 0 and 1: bench compares each module with the truth's of its number"),
+  EXPECT_NE(r.err.find(other + ": module 0 has cameras 2 and 3; in the dataset's truth rig (" + dataset +
+                       "/truth/rig.yaml) module 0 has cameras 0 and 1: bench compares each module with the truth's "
+                       "of its number"),
             std::string::npos)
       << r.err;
   EXPECT_EQ(r.out.find("objects/s"), std::string::npos) << r.out;

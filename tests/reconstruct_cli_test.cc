@@ -1110,8 +1110,20 @@ TEST_F(ReconstructCli, ScoreRefusesARigWhoseModulesPairOtherCameras) {
   WriteRigFile(testing::DefaultRigInAnotherLayout(), dir_ + "/other_layout.yaml");
   const std::string score = "score --dataset " + d + " --scenes cup --no-passive --rig ";
   ExpectRefusedInOneLine(score + dir_ + "/other_layout.yaml",
-                         dir_ + "/other_layout.yaml: its module 0 has cameras 2 and 3, the dataset's truth rig's (" +
-                             d + "/truth/rig.yaml) cameras 0 and 1");
+                         dir_ + "/other_layout.yaml: module 0 has cameras 2 and 3; in the dataset's truth rig (" + d +
+                             "/truth/rig.yaml) module 0 has cameras 0 and 1: score compares each module with the "
+                             "truth's of its number");
+  // Fewer modules than the truth's: said as a whole clause too.
+  {
+    const SimulatedRig sim = MakeDefaultRig();
+    const Rig one(std::vector<Camera>(sim.rig.cameras().begin(), sim.rig.cameras().begin() + 2),
+                  std::vector<std::string>(sim.rig.camera_names().begin(), sim.rig.camera_names().begin() + 2),
+                  std::vector<StereoModule>{sim.rig.modules()[0]}, {{sim.rig.S()[0][0]}}, "test");
+    WriteRigFile(one, dir_ + "/one_module.yaml");
+  }
+  ExpectRefusedInOneLine(score + dir_ + "/one_module.yaml",
+                         dir_ + "/one_module.yaml: there is no module 1; in the dataset's truth rig (" + d +
+                             "/truth/rig.yaml) module 1 has cameras 2 and 3");
   const testing::Result same = testing::RunCli(score + dir_ + "/rig.yaml");
   EXPECT_EQ(same.code, 2);
   EXPECT_NE(same.err.find("cam1.png: missing camera image"), std::string::npos) << same.err;
