@@ -128,7 +128,10 @@ int RunCalibrate(int argc, char** argv) {
   const CalibrationResult& result = folder.result;
   // Models of another rig in the models' folder: warned of and kept in the
   // report's warnings, as every warning calibrate prints is.
-  if (const std::string note = cameramodels_dir.empty() ? "" : OtherCameramodelsNote(cameramodels_dir, model_paths);
+  // Only on a run that writes its models: a refused one writes none there.
+  const bool writes = result.report.not_converged.empty() && result.report.wrong_plate.empty();
+  if (const std::string note =
+          cameramodels_dir.empty() || !writes ? "" : OtherCameramodelsNote(cameramodels_dir, model_paths);
       !note.empty()) {
     std::fprintf(stderr, "calibrate: warning: %s\n", PrintableText(note).c_str());
     folder.result.report.warnings.push_back(note);

@@ -995,6 +995,15 @@ TEST(CalibrateCli, ModelsOfAnotherRigInTheModelsFolderAreWarnedOf) {
                                         "/models also holds cam2.cameramodel, cam3.cameramodel, not written by this "
                                         "run: another rig's models? (remove them, or export into a folder of its own)";
   EXPECT_EQ(kept, 1) << j.at("warnings").dump();
+  // A run refused after its solve (every stage over a 0.001 px limit) writes
+  // no model there: no warning of the others.
+  const testing::Result refused =
+      testing::RunCli("calibrate --captures " + dir + "/captures --target " + set.dir + "/target.yaml --layout " +
+                      set.dir + "/one_module.yaml --out " + dir + "/rig2.yaml --report " + dir +
+                      "/report2.json --max-rms-px 0.001 --export-cameramodels " + dir + "/models");
+  EXPECT_EQ(refused.code, 2) << refused.err;
+  EXPECT_NE(refused.err.find("not written: "), std::string::npos) << refused.err;  // refused after the solve
+  EXPECT_EQ(refused.err.find("also holds"), std::string::npos) << refused.err;
   fs::remove_all(dir);
 }
 

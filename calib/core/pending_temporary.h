@@ -30,9 +30,11 @@ enum class TemporaryKind {
 class PendingTemporary {
  public:
   // score --diagnose holds four images per scene and module until its
-  // report is written, all or none (~130 on the ring of three modules with
-  // 11 scenes): 1024 slots of PATH_MAX are 4 MB of address space, touched
-  // only as far as they are used.
+  // report is written, all or none, and on a re-run over an earlier folder
+  // a kept link per replaced file as well (AtomicOutputSet): ~2 x 4 x
+  // scenes x modules, 264 on the ring of three modules with 11 scenes.
+  // 1024 slots of PATH_MAX are 4 MB of address space, touched only as far
+  // as they are used (the constructor takes the first free slot).
   static constexpr int kMaxPending = 1024;
 
   explicit PendingTemporary(const std::string& path, TemporaryKind kind = TemporaryKind::kFile);
