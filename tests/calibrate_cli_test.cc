@@ -286,6 +286,44 @@ TEST(CalibrateCli, AStageOverTheRmsLimitWritesNoRigFile) {
   EXPECT_EQ(zero.err.find("detect 000"), std::string::npos) << "refused before any work: " << zero.err;
 }
 
+// A target file whose back face is 100 mm behind the front (the plate is
+// 5 mm): stage 3 does not converge and leaves a direction undetermined, so
+// ceres::Covariance fails. Ceres said so through glog, raw lines on stderr
+// ("WARNING: Logging before InitGoogleLogging() ..." and "E...
+// covariance_impl.cc:772] Error: Covariance matrix is near rank deficient
+// ...") beside our own refusal; now stderr holds no Ceres line, and the
+// report says why no sigma is given.
+TEST(CalibrateCli, AnUndeterminedStageThreeSaysSoWithoutCeresLogLines) {
+  const RenderedSet& set = Rendered();
+  const std::string dir = set.dir + "/thick_plate";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ifstream in(set.dir + "/target.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  const std::string plate = "[0, 0, -1, 5]";
+  ASSERT_NE(text.find(plate), std::string::npos) << text;
+  text.replace(text.find(plate), plate.size(), "[0, 0, -1, 100]");
+  std::ofstream(dir + "/target.yaml") << text;
+  const std::string rig = dir + "/rig.yaml", report = dir + "/report.json";
+  const testing::Result r =
+      testing::RunCli("calibrate --captures " + set.dir + "/captures --target " + dir + "/target.yaml --layout " +
+                      set.dir + "/layout.yaml --out " + rig + " --report " + report);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("stereorig calibrate: " + rig + ": not written: stage 3 did not converge"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(rig));
+  for (const char* ceres : {"InitGoogleLogging", "covariance_impl", "rank deficient"})
+    EXPECT_EQ(r.err.find(ceres), std::string::npos) << ceres << ": " << r.err;
+  std::ifstream report_file(report);
+  const nlohmann::json j = nlohmann::json::parse(report_file);
+  EXPECT_EQ(j.at("stage3_system")
+                .at("covariance")
+                .get<std::string>()
+                .rfind("not computed: the adjustment leaves a direction of its parameters undetermined", 0),
+            0u)
+      << j.at("stage3_system").at("covariance");
+}
+
 // One capture whose module 1 images are another capture's (as the
 // commissioning walkthrough made it: cp 007/cam{2,3}.png 003/): each module
 // converges alone, stage 3 cannot put the board in one place in capture 003
