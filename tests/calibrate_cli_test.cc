@@ -104,6 +104,23 @@ const RenderedSet& Rendered() {
   return set;
 }
 
+// A fresh folder `name` in the rendered set, holding the set's target file
+// with its text `from` (which must be there) edited to `to`: a hand-edited
+// target file. Returns the folder.
+std::string EditedTargetFolder(const std::string& name, const std::string& from, const std::string& to) {
+  const RenderedSet& set = Rendered();
+  const std::string dir = set.dir + "/" + name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ifstream in(set.dir + "/target.yaml");
+  std::string text(std::istreambuf_iterator<char>(in), {});
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from << " not in " << text;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  std::ofstream(dir + "/target.yaml") << text;
+  return dir;
+}
+
 TEST(CalibrateCli, RenderedCapturesToRigFileAndReport) {
   const RenderedSet& set = Rendered();
   const std::string args = "calibrate --captures " + set.dir + "/captures --target " + set.dir +
@@ -295,15 +312,7 @@ TEST(CalibrateCli, AStageOverTheRmsLimitWritesNoRigFile) {
 // report says why no sigma is given.
 TEST(CalibrateCli, AnUndeterminedStageThreeSaysSoWithoutCeresLogLines) {
   const RenderedSet& set = Rendered();
-  const std::string dir = set.dir + "/thick_plate";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  std::ifstream in(set.dir + "/target.yaml");
-  std::string text((std::istreambuf_iterator<char>(in)), {});
-  const std::string plate = "[0, 0, -1, 5]";
-  ASSERT_NE(text.find(plate), std::string::npos) << text;
-  text.replace(text.find(plate), plate.size(), "[0, 0, -1, 100]");
-  std::ofstream(dir + "/target.yaml") << text;
+  const std::string dir = EditedTargetFolder("thick_plate", "[0, 0, -1, 5]", "[0, 0, -1, 100]");
   const std::string rig = dir + "/rig.yaml", report = dir + "/report.json";
   const testing::Result r =
       testing::RunCli("calibrate --captures " + set.dir + "/captures --target " + dir + "/target.yaml --layout " +
@@ -664,15 +673,7 @@ TEST(CalibrateCli, OptionsAreNamedByTheirFlags) {
 // and the column; the rendered set's own file gives none.
 TEST(CalibrateCli, ACornerColumnNoViewShowedIsWarnedOf) {
   const RenderedSet& set = Rendered();
-  const std::string dir = set.dir + "/t12";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  std::ifstream in(set.dir + "/target.yaml");
-  std::string text(std::istreambuf_iterator<char>(in), {});
-  const size_t at = text.find("corners_x: 11");
-  ASSERT_NE(at, std::string::npos) << text;
-  text.replace(at, 13, "corners_x: 12");
-  std::ofstream(dir + "/target.yaml") << text;
+  const std::string dir = EditedTargetFolder("t12", "corners_x: 11", "corners_x: 12");
   const std::string args = "calibrate --captures " + set.dir + "/captures --layout " + set.dir + "/layout.yaml --out " +
                            dir + "/rig.yaml --report " + dir + "/report.json --lensmodel LENSMODEL_OPENCV5 --target ";
   const testing::Result r = testing::RunCli(args + dir + "/target.yaml");
