@@ -1,10 +1,13 @@
 #include "calib/system.h"
 
+#include <glog/logging.h>
+
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <set>
 
 #include "calib/core/input_error.h"
@@ -24,6 +27,23 @@ void SystemOptions::Check() const {
 namespace {
 
 using ObsIndex = std::map<std::pair<int, int>, const BoardObservation*>;  // (capture, camera)
+
+// Ceres says a rank-deficient J'J through glog (LOG(ERROR): "Covariance
+// matrix is near rank deficient ..."), a raw line on stderr beside our own
+// words. Compute's false already says it: the report's covariance status
+// names it, and a refusal that follows is ours (not glog's, so not hidden).
+// glog is held at FATAL for the one call (a FATAL still aborts), then given
+// back; the mutex keeps two threads' calls from restoring each other's level.
+bool ComputeCovarianceQuietly(ceres::Covariance* cov, const std::vector<std::pair<const double*, const double*>>& pairs,
+                              ceres::Problem* problem) {
+  static std::mutex glog_level_mutex;
+  std::lock_guard<std::mutex> lock(glog_level_mutex);
+  const int32_t level = FLAGS_minloglevel;
+  FLAGS_minloglevel = google::GLOG_FATAL;
+  const bool ok = cov->Compute(pairs, problem);
+  FLAGS_minloglevel = level;
+  return ok;
+}
 
 ObsIndex IndexObservations(const CalibrationInput& input) {
   ObsIndex index;
@@ -634,7 +654,7 @@ SystemResult CalibrateSystem(const CalibrationInput& input, const std::vector<Mo
       }
     }
     const std::vector<std::pair<const double*, const double*>> pairs(pair_set.begin(), pair_set.end());
-    if (!pairs.empty() && cov.Compute(pairs, &problem)) {
+    if (!pairs.empty() && ComputeCovarianceQuietly(&cov, pairs, &problem)) {
       // The held intrinsics' prior residuals count as observations of them.
       const double n_res = 2.0 * corner_blocks.size() + num_prior_residuals;
       const double rms = rep.refined_reprojection_rms_px;

@@ -107,6 +107,23 @@ const RenderedSet& Rendered() {
   return set;
 }
 
+// A fresh folder `name` in the rendered set, holding the set's target file
+// with its text `from` (which must be there) edited to `to`: a hand-edited
+// target file. Returns the folder.
+std::string EditedTargetFolder(const std::string& name, const std::string& from, const std::string& to) {
+  const RenderedSet& set = Rendered();
+  const std::string dir = set.dir + "/" + name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ifstream in(set.dir + "/target.yaml");
+  std::string text(std::istreambuf_iterator<char>(in), {});
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from << " not in " << text;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  std::ofstream(dir + "/target.yaml") << text;
+  return dir;
+}
+
 TEST(CalibrateCli, RenderedCapturesToRigFileAndReport) {
   const RenderedSet& set = Rendered();
   const std::string args = "calibrate --captures " + set.dir + "/captures --target " + set.dir +
@@ -287,6 +304,36 @@ TEST(CalibrateCli, AStageOverTheRmsLimitWritesNoRigFile) {
   EXPECT_EQ(zero.code, 2) << zero.err;
   EXPECT_NE(zero.err.find("--max-rms-px"), std::string::npos) << zero.err;
   EXPECT_EQ(zero.err.find("detect 000"), std::string::npos) << "refused before any work: " << zero.err;
+}
+
+// A target file whose back face is 100 mm behind the front (the plate is
+// 5 mm): stage 3 does not converge and leaves a direction undetermined, so
+// ceres::Covariance fails. Ceres said so through glog, raw lines on stderr
+// ("WARNING: Logging before InitGoogleLogging() ..." and "E...
+// covariance_impl.cc:772] Error: Covariance matrix is near rank deficient
+// ...") beside our own refusal; now stderr holds no Ceres line, and the
+// report says why no sigma is given.
+TEST(CalibrateCli, AnUndeterminedStageThreeSaysSoWithoutCeresLogLines) {
+  const RenderedSet& set = Rendered();
+  const std::string dir = EditedTargetFolder("thick_plate", "[0, 0, -1, 5]", "[0, 0, -1, 100]");
+  const std::string rig = dir + "/rig.yaml", report = dir + "/report.json";
+  const testing::Result r =
+      testing::RunCli("calibrate --captures " + set.dir + "/captures --target " + dir + "/target.yaml --layout " +
+                      set.dir + "/layout.yaml --out " + rig + " --report " + report);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("stereorig calibrate: " + rig + ": not written: stage 3 did not converge"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(rig));
+  for (const char* ceres : {"InitGoogleLogging", "covariance_impl", "rank deficient"})
+    EXPECT_EQ(r.err.find(ceres), std::string::npos) << ceres << ": " << r.err;
+  std::ifstream report_file(report);
+  const nlohmann::json j = nlohmann::json::parse(report_file);
+  EXPECT_EQ(j.at("stage3_system")
+                .at("covariance")
+                .get<std::string>()
+                .rfind("not computed: the adjustment leaves a direction of its parameters undetermined", 0),
+            0u)
+      << j.at("stage3_system").at("covariance");
 }
 
 // One capture whose module 1 images are another capture's (as the
@@ -629,15 +676,7 @@ TEST(CalibrateCli, OptionsAreNamedByTheirFlags) {
 // and the column; the rendered set's own file gives none.
 TEST(CalibrateCli, ACornerColumnNoViewShowedIsWarnedOf) {
   const RenderedSet& set = Rendered();
-  const std::string dir = set.dir + "/t12";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  std::ifstream in(set.dir + "/target.yaml");
-  std::string text(std::istreambuf_iterator<char>(in), {});
-  const size_t at = text.find("corners_x: 11");
-  ASSERT_NE(at, std::string::npos) << text;
-  text.replace(at, 13, "corners_x: 12");
-  std::ofstream(dir + "/target.yaml") << text;
+  const std::string dir = EditedTargetFolder("t12", "corners_x: 11", "corners_x: 12");
   const std::string args = "calibrate --captures " + set.dir + "/captures --layout " + set.dir + "/layout.yaml --out " +
                            dir + "/rig.yaml --report " + dir + "/report.json --lensmodel LENSMODEL_OPENCV5 --target ";
   const testing::Result r = testing::RunCli(args + dir + "/target.yaml");

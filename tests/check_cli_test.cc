@@ -412,6 +412,19 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
                      key);
     }
   }
+  {  // A residual RMS of exactly 0 (valid in the file, >= 0): the check
+     // weights corners by 1 / rms^2, so it cannot use it, and says so, in one
+     // line before the detection. Before, the rig file was said to have no
+     // such residual, which it has.
+    Rig zero = rig;
+    zero.provenance().residuals["cam0_rms_px"] = 0;
+    const std::string zero_path = dir + "/zero_rms_rig.yaml";
+    WriteRigFile(zero, zero_path);
+    const Result res = check(dir + "/ds", zero_path);
+    expect_refused(res, zero_path + ": the rig file's provenance.residuals.cam0_rms_px is 0 px", "a zero RMS");
+    EXPECT_EQ(Lines(res.err), 1) << res.err;
+    EXPECT_EQ(res.err.find("has no"), std::string::npos) << res.err;
+  }
   {  // The right images with the rig file of another rig: every camera's
      // focal length 20% longer and its centre 40 px away.
     std::vector<Camera> cameras;

@@ -1313,7 +1313,13 @@ TEST(VerifyCli, NamesWhatIsWrongWithABrokenMeshOrCloud) {
                 std::regex_replace(vertices, std::regex("\n"), " 0\n"),
             "its vertex property 'module' is float; stereorig's module is uchar"},
            {std::regex_replace(vertices, std::regex("[^\n]+"), "1 2 3"),
-            "every point of the cloud is at the same place: it holds no shape to find"}}) {
+            "every point of the cloud is at the same place: it holds no shape to find"},
+           // Another PLY version was read as 1.0, silently, and measured.
+           {std::regex_replace(header, std::regex(" 1\\.0\n"), " 2.0\n") + vertices,
+            "its format line 'format ascii 2.0' gives PLY version 2.0; this reader reads PLY 1.0 only"},
+           // x declared twice (in y's place) was refused as "no x, y, z".
+           {std::regex_replace(header, std::regex("property double y\n"), "property double x\n") + vertices,
+            "its vertex property 'x' is declared twice"}}) {
     std::ofstream(path) << (content.rfind("ply", 0) == 0 ? content : header + content);
     const auto r = RunCli("verify --artifact " + WriteArtifact(kSphere) + " --cloud " + path);
     EXPECT_EQ(r.code, 2) << expected << ": " << r.out << r.err;

@@ -14,6 +14,7 @@
 #include "calib/check/module_shift.h"
 #include "calib/check/shared_lens_change.h"
 #include "calib/core/input_error.h"
+#include "calib/core/number_text.h"
 
 namespace stereorig {
 
@@ -1138,10 +1139,19 @@ void RequireCalibrationResiduals(const Rig& rig, const std::string& where) {
   for (int c = 0; c < rig.num_cameras(); ++c) {
     const std::string key = "cam" + std::to_string(c) + "_rms_px";
     auto it = rig.provenance().residuals.find(key);
-    if (it == rig.provenance().residuals.end() || !(it->second > 0)) {
+    if (it == rig.provenance().residuals.end()) {
       throw InputError(where, "the rig file has no provenance.residuals." + key +
                                   "; the check sets its thresholds from a calibration's residuals "
                                   "(use a rig written by stereorig calibrate)");
+    }
+    // Present but 0: each corner is weighted by 1 / rms^2 in the board pose
+    // fit and every threshold scales with it, so a zero RMS is an infinite
+    // weight and a threshold no real night could meet.
+    if (!(it->second > 0)) {
+      throw InputError(where, "the rig file's provenance.residuals." + key + " is " + NumberText(it->second) +
+                                  " px; the check weights corners by 1 / rms^2 and scales its thresholds by it, "
+                                  "so it needs a calibration's residual above 0 (a calibration from real or "
+                                  "noisy images has one)");
     }
   }
 }

@@ -208,10 +208,11 @@ struct ClosureNaming {
 };
 ClosureNaming NameClosureModules(const std::map<int, int>& failed_pairs_of);
 
-// Throws InputError(`where`, ...) unless the rig file holds the
-// calibration residuals the thresholds need (provenance.residuals.camK_rms_px,
-// > 0, for every camera): a rig stereorig calibrate did not write. Commands
-// call it with the rig file's path before the target is detected.
+// Throws InputError(`where`, ...) when the rig file lacks a calibration
+// residual the thresholds need (provenance.residuals.camK_rms_px for every
+// camera: a rig stereorig calibrate did not write), or holds one of 0 (the
+// check weights corners by 1 / rms^2). Commands call it with the rig file's
+// path before the target is detected.
 void RequireCalibrationResiduals(const Rig& rig, const std::string& where);
 
 // Throws InputError(`where`, ...) when the rig file lacks the calibration

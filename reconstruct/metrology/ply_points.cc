@@ -190,6 +190,14 @@ PlyVertices ReadPlyVertices(const std::string& path) {
         enc = Encoding::kBig;
       else
         throw InputError(path, "unknown PLY format '" + f + "'");
+      // 1.0 is the only PLY version there is: a file claiming another is
+      // one this reader cannot vouch for, not one to read as 1.0 and measure.
+      std::string version;
+      s >> version;
+      if (version != "1.0") {
+        const std::string gives = version.empty() ? "no PLY version" : "PLY version " + version;
+        throw InputError(path, "its format line '" + line + "' gives " + gives + "; this reader reads PLY 1.0 only");
+      }
     } else if (word == "element") {
       Element e;
       std::string rest;  // "element vertex 1e12" read a count of 1 and stopped at "e12"
@@ -228,6 +236,14 @@ PlyVertices ReadPlyVertices(const std::string& path) {
   const long long num_vertices = elements[vertex_element].count;
   const std::vector<Property>& props = elements[vertex_element].props;
   int ix = -1, iy = -1, iz = -1, imodule = -1, inx = -1, iny = -1, inz = -1;
+  // A property declared twice is a broken header (which column is x?):
+  // named as such, not as the coordinate that is then missing beside it.
+  for (int i = 0; i < static_cast<int>(props.size()); ++i) {
+    for (int j = 0; j < i; ++j) {
+      if (props[j].name == props[i].name)
+        throw InputError(path, "its vertex property '" + props[i].name + "' is declared twice");
+    }
+  }
   for (int i = 0; i < static_cast<int>(props.size()); ++i) {
     if (!props[i].count_type.empty()) continue;
     if (props[i].name == "x") ix = i;

@@ -79,6 +79,29 @@ std::string ErrorOf(const std::string& path) {
   return "";
 }
 
+// A header claiming another PLY version (or none) was read as 1.0, silently;
+// one declaring x twice was refused as having no x, y, z. Each is refused
+// saying what it is; PLY 1.0 reads as before (the tests above).
+TEST(PlyPoints, RefusesAnotherVersionAndAPropertyDeclaredTwiceSayingSo) {
+  const std::string path = ::testing::TempDir() + "/version.ply";
+  const std::string vertex = "element vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  {
+    std::ofstream f(path, std::ios::binary);
+    f << "ply\nformat binary_little_endian 2.0\n" << vertex;
+    const float v[3] = {1, 2, 3};
+    f.write(reinterpret_cast<const char*>(v), sizeof v);
+  }
+  EXPECT_EQ(ErrorOf(path), path +
+                               ": its format line 'format binary_little_endian 2.0' gives PLY version 2.0; this "
+                               "reader reads PLY 1.0 only");
+  std::ofstream(path) << "ply\nformat ascii\n" << vertex << "1 2 3\n";
+  EXPECT_EQ(ErrorOf(path),
+            path + ": its format line 'format ascii' gives no PLY version; this reader reads PLY 1.0 only");
+  std::ofstream(path) << "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float x\n"
+                         "property float z\nend_header\n1 2 3\n";
+  EXPECT_EQ(ErrorOf(path), path + ": its vertex property 'x' is declared twice");
+}
+
 // A stereorig cloud's normals (nx ny nz, facing the measuring module's
 // camera) are read, parallel to the measured points (hole filling's left out
 // with theirs); a PLY without them still reads, with none. One or two of the
