@@ -238,9 +238,9 @@ CalibrationResult Calibrate(const CalibrationInput& in, const CalibrationOptions
   for (int c = 0; c < nc; ++c) {
     Progress(options.progress, "stage 1: intrinsics of camera " + std::to_string(c) + " (" +
                                    std::to_string(by_camera[c].size()) + " views)");
-    result.stage1.push_back(
-        CalibrateIntrinsics(c, in.cameras[c], in.target, by_camera[c], options.intrinsics, in.source,
-                            [&](const std::string& message) { Progress(options.progress, message); }));
+    result.stage1.push_back(CalibrateIntrinsics(
+        c, in.cameras[c], in.target, by_camera[c], options.intrinsics, in.source,
+        [&](const std::string& message) { Progress(options.progress, message); }, in.capture_names));
     rep.intrinsics.push_back(result.stage1.back().report);
   }
   // A camera that did not converge ends the calibration here: stages 2 and 3

@@ -169,11 +169,19 @@ std::vector<std::vector<int>> BoardPoseGroups(const std::vector<const BoardObser
 
 namespace {
 
-// "1, 2 and 5": capture indices (a numeric capture folder's number).
-std::string CaptureList(const std::vector<int>& captures) {
+// "001, 002 and retake": each capture by its folder's name where `names`
+// has it, else by its index ("1, 2 and 5"). A named folder's index is the
+// one after the largest number (capture_folder.cc): by it, a folder that
+// does not exist.
+std::string CaptureList(const std::vector<int>& captures, const std::map<int, std::string>& names) {
   std::string out;
-  for (size_t i = 0; i < captures.size(); ++i)
-    out += (i == 0 ? "" : i + 1 == captures.size() ? " and " : ", ") + std::to_string(captures[i]);
+  for (size_t i = 0; i < captures.size(); ++i) {
+    const auto it = names.find(captures[i]);
+    out += (i == 0                     ? ""
+            : i + 1 == captures.size() ? " and "
+                                       : ", ") +
+           (it != names.end() ? it->second : std::to_string(captures[i]));
+  }
   return out;
 }
 
@@ -351,7 +359,8 @@ void FillCoverageAndUncertainty(const MrcalProblem& p, int icam, const Intrinsic
 IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const TargetGeometry& target,
                                      const std::vector<const BoardObservation*>& all_views,
                                      const IntrinsicsOptions& options, const std::string& where,
-                                     const std::function<void(const std::string&)>& progress) {
+                                     const std::function<void(const std::string&)>& progress,
+                                     const std::map<int, std::string>& capture_names) {
   const std::string cam_where = where + ": camera " + std::to_string(camera) + " (" + spec.name + ")";
   std::vector<const BoardObservation*> views;
   int dropped = 0;
@@ -387,7 +396,7 @@ IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const
   if (static_cast<int>(pose_groups.size()) < options.min_views) {
     std::string repeats;
     for (const std::vector<int>& captures : repeated_pose_captures)
-      repeats += (repeats.empty() ? "" : "; ") + std::string("captures ") + CaptureList(captures);
+      repeats += (repeats.empty() ? "" : "; ") + std::string("captures ") + CaptureList(captures, capture_names);
     throw InputError(cam_where, "too few distinct board poses: its " + std::to_string(views.size()) +
                                     " usable views show " + std::to_string(pose_groups.size()) + ", need at least " +
                                     std::to_string(options.min_views) + "; repeated: " + repeats +

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -116,10 +117,13 @@ struct IntrinsicsResult {
 // Solved from the first of RankedPinholeSeeds (calib/pinhole_seed.h); where
 // that solve's RMS is over options.max_rms_px, from every candidate, the
 // lowest RMS kept (`progress`, if given, is told so: that takes seconds).
+// capture_names (capture index -> its folder's name, CalibrationInput's):
+// how a refusal names the captures, by index where it has none.
 IntrinsicsResult CalibrateIntrinsics(int camera, const CameraImager& spec, const TargetGeometry& target,
                                      const std::vector<const BoardObservation*>& views,
                                      const IntrinsicsOptions& options, const std::string& where,
-                                     const std::function<void(const std::string&)>& progress = {});
+                                     const std::function<void(const std::string&)>& progress = {},
+                                     const std::map<int, std::string>& capture_names = {});
 
 // The views of one camera grouped by board pose: two views show one pose if
 // they saw the same face and the corners both saw (at least 4) differ by

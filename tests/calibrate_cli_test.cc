@@ -847,11 +847,19 @@ TEST(CalibrateCli, CopiesOfOneCaptureAreOneBoardPose) {
   const testing::Result r = testing::RunCli("calibrate --captures " + copies + args);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find(copies + ": camera 0 (cam0): too few distinct board poses: its 5 usable views show 1, need at "
-                                "least 5; repeated: captures 1, 2, 3, 4 and 5 (corners apart by their noise alone"),
+                                "least 5; repeated: captures 001, 002, 003, 004 and 005 (corners apart by their noise "
+                                "alone"),
             std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(set.dir + "/copies.yaml"));
   EXPECT_FALSE(fs::exists(set.dir + "/copies.json"));
+  // A named folder among them is named by its name, not by its index (6,
+  // the one after the largest number: a folder that does not exist).
+  fs::rename(copies + "/005", copies + "/retake");
+  const testing::Result named = testing::RunCli("calibrate --captures " + copies + args);
+  EXPECT_EQ(named.code, 2);
+  EXPECT_NE(named.err.find("repeated: captures 001, 002, 003, 004 and retake (corners"), std::string::npos)
+      << named.err;
 
   // The set's 8 captures and capture 000 again as 008.
   const std::string again = set.dir + "/again";
