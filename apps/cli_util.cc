@@ -14,7 +14,7 @@
 
 #include "apps/command.h"
 #include "calib/core/input_error.h"
-#include "calib/core/rig_file.h"
+#include "calib/core/rig.h"
 
 namespace stereorig {
 
@@ -139,9 +139,8 @@ void CheckScenesInDataset(const std::string& dataset, const std::vector<std::str
   }
 }
 
-void RequireTruthRigLayout(const Rig& rig, const std::string& rig_path, const std::string& truth_rig_path,
-                           const std::string& command) {
-  const Rig truth = ReadRigFile(truth_rig_path);
+void RequireTruthRigLayout(const Rig& rig, const std::string& rig_path, const Rig& truth,
+                           const std::string& truth_rig_path, const std::string& command) {
   for (int m = 0; m < std::max(rig.num_modules(), truth.num_modules()); ++m) {
     // Each side a whole clause: "module 1 has cameras 2 and 3" or "there is
     // no module 1" (the message starts with the rig file's path).

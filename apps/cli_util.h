@@ -53,13 +53,13 @@ void CheckDatasetFolder(const std::string& dataset, bool need_truth);
 
 // Throws InputError naming `rig_path` unless `rig`'s modules pair the same
 // cameras, module by module, as the dataset's truth rig at `truth_rig_path`
-// (read here), and are as many. `command` ("score", "bench") judges the
+// (`truth`), and are as many. `command` ("score", "bench") judges the
 // cloud's module m against the truth's module m (its fill target, its left
 // camera's depth): a rig of another layout (module 0 on cameras 2 and 3) was
 // judged against the wrong module's truth, and its figures judged nothing.
 // The message names both rig files and the first module that differs.
-void RequireTruthRigLayout(const Rig& rig, const std::string& rig_path, const std::string& truth_rig_path,
-                           const std::string& command);
+void RequireTruthRigLayout(const Rig& rig, const std::string& rig_path, const Rig& truth,
+                           const std::string& truth_rig_path, const std::string& command);
 
 // `word` as a POSIX shell reads it back as one word: as it is when it
 // holds only letters, digits and _@%+=:,./- (most paths), else in single

@@ -284,7 +284,8 @@ int RunBench(int argc, char** argv) {
     // against the wrong module's truth, exit 0. A line's own captures with
     // no truth rig have nothing to compare.
     const fs::path truth_rig = fs::path(dataset) / "truth" / "rig.yaml";
-    if (!rig_path.empty() && fs::exists(truth_rig)) RequireTruthRigLayout(rig, rig_path, truth_rig.string(), "bench");
+    if (!rig_path.empty() && fs::exists(truth_rig))
+      RequireTruthRigLayout(rig, rig_path, ReadRigFile(truth_rig.string()), truth_rig.string(), "bench");
     for (const std::string& name : scene_names) {
       const fs::path capture = fs::path(dataset) / "scenes" / name / "active";
       scenes.push_back(Scene{name, LoadCapture(capture.string(), rig), {}, {}});

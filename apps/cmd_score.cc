@@ -112,7 +112,10 @@ int RunScore(int argc, char** argv) {
   // The truth's fill target and depth are the truth rig's module m's, taken
   // for the cloud's module m: a --rig pairing other cameras in a module (its
   // layout another's) was scored against the wrong truth, exit 0.
-  if (rig_given) RequireTruthRigLayout(rig, rig_path, (fs::path(dataset) / "truth" / "rig.yaml").string(), "score");
+  // Read once: the diagnosis takes each module's left camera from it too.
+  const std::string truth_rig_path = (fs::path(dataset) / "truth" / "rig.yaml").string();
+  const Rig truth_rig = rig_given ? ReadRigFile(truth_rig_path) : rig;
+  if (rig_given) RequireTruthRigLayout(rig, rig_path, truth_rig, truth_rig_path, "score");
   // Every scene named is in the dataset, before any is scored: a scene
   // misnamed after others in --scenes used to be found only once they were
   // scored, their diagnosis images left in a new --diagnose folder. The
@@ -222,7 +225,6 @@ int RunScore(int argc, char** argv) {
       }
     }
     if (!diagnose_dir.empty()) {
-      const Rig truth_rig = ReadRigFile((fs::path(dataset) / "truth" / "rig.yaml").string());
       const std::vector<CameraTruthMaps> maps =
           ReadCameraTruthMaps((fs::path(dataset) / "truth" / "scenes" / name).string(), truth_rig.num_cameras());
       for (size_t m = 0; m < s.fill.size(); ++m) {

@@ -57,6 +57,16 @@ Pose ReadRigidPose(const YAML::Node& n, const std::string& where) {
 // (stereorig rig: "baseline 0.0900 mm", exit 0), or none at all.
 constexpr double kMinCameraSpacingMm = 1.0;
 
+// Records `name` as list[index]'s in *named (name -> index); throws
+// InputError at `where` if an earlier entry of `list` ("cameras",
+// "modules") has it: the check and every report tell them apart by name.
+void RequireNameOfItsOwn(std::map<std::string, int>* named, const std::string& name, int index, const std::string& list,
+                         const std::string& where) {
+  if (const auto [it, added] = named->emplace(name, index); !added)
+    throw InputError(where, name + " is used twice (" + list + "[" + std::to_string(it->second) + "] too): each " +
+                                list.substr(0, list.size() - 1) + " needs a name of its own");
+}
+
 // Throws InputError at `where` if `pose`'s translation, two camera centres'
 // distance, is under kMinCameraSpacingMm; the message says it as
 // `before` distance `after` ("baseline ", " mm").
@@ -142,9 +152,7 @@ Rig ParseRig(YamlMap root) {
     names.push_back(c.GetString("name"));
     // As a module's (below): the check names the camera that moved by it,
     // and two of one name were read, exit 0.
-    if (const auto [it, added] = camera_named.emplace(names.back(), static_cast<int>(cameras.size())); !added)
-      throw InputError(c.Where("name"), names.back() + " is used twice (cameras[" + std::to_string(it->second) +
-                                            "] too): each camera needs a name of its own");
+    RequireNameOfItsOwn(&camera_named, names.back(), static_cast<int>(cameras.size()), "cameras", c.Where("name"));
     const std::string model = c.GetString("lensmodel");
     // The Camera refuses it too; here the message names the key.
     if (const std::string p = LensmodelConfigProblem(model); !p.empty()) throw InputError(c.Where("lensmodel"), p);
@@ -162,9 +170,7 @@ Rig ParseRig(YamlMap root) {
     mod.name = m.GetString("name");
     // As a layout file's (calib/layout_file.h): the name tells modules
     // apart in every report.
-    if (const auto [it, added] = module_named.emplace(mod.name, static_cast<int>(modules.size())); !added)
-      throw InputError(m.Where("name"), mod.name + " is used twice (modules[" + std::to_string(it->second) +
-                                            "] too): each module needs a name of its own");
+    RequireNameOfItsOwn(&module_named, mod.name, static_cast<int>(modules.size()), "modules", m.Where("name"));
     mod.left_camera = m.GetInt("left");
     mod.right_camera = m.GetInt("right");
     mod.right_from_left = ReadRigidPose(m.GetNode("right_from_left"), m.Where("right_from_left"));
