@@ -13,6 +13,9 @@ namespace {
 
 // Pairs whose nearest truth sample is farther are left out of the alignment.
 constexpr double kMaxPairDistanceMm = 2.0;
+// Points whose nearest truth sample is farther are scored by that distance,
+// not by the local plane's (ScoreAligned).
+constexpr double kPlaneReachMm = 1.0;
 
 // Plane through the k nearest truth samples of q: (centroid, unit normal).
 bool LocalPlane(const KdTree3& tree, const Eigen::Vector3d& q, Eigen::Vector3d* c, Eigen::Vector3d* n,
@@ -52,11 +55,13 @@ ErrorFigures Figures(std::vector<double> e) {
   return f;
 }
 
+// The figures of `cloud` moved by `truth_from_cloud`, against the truth
+// samples in `tree`.
+CloudScore ScoreAligned(const PointCloud& cloud, const KdTree3& tree, const Pose& truth_from_cloud, int num_modules);
+
 }  // namespace
 
 CloudScore ScoreAgainstTruth(const PointCloud& cloud, const std::vector<Eigen::Vector3d>& truth, int num_modules) {
-  CloudScore score;
-  score.per_module.resize(num_modules);
   const KdTree3 tree(truth);
   // ICP, point-to-plane, on up to 20k measured points.
   std::vector<Eigen::Vector3d> sample;
@@ -115,7 +120,25 @@ CloudScore ScoreAgainstTruth(const PointCloud& cloud, const std::vector<Eigen::V
     t = dr * t + x.tail<3>();
     if (w.norm() < 1e-9 && x.tail<3>().norm() < 1e-7) break;
   }
-  score.truth_from_cloud = Pose(r, t);
+  return ScoreAligned(cloud, tree, Pose(r, t), num_modules);
+}
+
+CloudScore ScoreUnderAlignment(const PointCloud& cloud, const std::vector<Eigen::Vector3d>& truth,
+                               const Pose& truth_from_cloud, int num_modules) {
+  return ScoreAligned(cloud, KdTree3(truth), truth_from_cloud, num_modules);
+}
+
+namespace {
+
+CloudScore ScoreAligned(const PointCloud& cloud, const KdTree3& tree, const Pose& truth_from_cloud, int num_modules) {
+  CloudScore score;
+  score.per_module.resize(num_modules);
+  score.truth_from_cloud = truth_from_cloud;
+  const Eigen::Matrix3d r = truth_from_cloud.rotation();
+  const Eigen::Vector3d t = truth_from_cloud.translation_mm();
+  std::vector<size_t> measured;
+  for (size_t i = 0; i < cloud.size(); ++i)
+    if (cloud.module[i] != kFilledModule) measured.push_back(i);
   std::vector<double> all, filled;
   std::vector<std::vector<double>> per(num_modules);
   // Filled points by distance to the nearest measured point (a rigid motion
@@ -135,7 +158,13 @@ CloudScore ScoreAgainstTruth(const PointCloud& cloud, const std::vector<Eigen::V
     if (!LocalPlane(tree, p, &c, &n, &nearest)) continue;
     // Sign: positive on the side the cloud's normal points to (outwards).
     const double sign = n.dot(r * cloud.normal[i].cast<double>()) >= 0 ? 1.0 : -1.0;
-    const double e = sign * (p - c).dot(n);
+    const double plane_mm = (p - c).dot(n);
+    // The plane stands for the surface only near its samples: a gross
+    // mismatch beside an edge (a passive cloud's, 50 mm off) projects onto
+    // the plane's extension within a few mm. Beyond kPlaneReachMm the nearest
+    // sample's distance is the error (the samples <= 0.2 mm apart: within
+    // ~0.1 mm of the surface's).
+    const double e = sign * (nearest > kPlaneReachMm ? std::copysign(nearest, plane_mm) : plane_mm);
     if (cloud.module[i] == kFilledModule) {
       filled.push_back(e);
       const double d = measured_tree ? measured_tree->NearestDistance(cloud.xyz_mm[i].cast<double>())
@@ -154,6 +183,8 @@ CloudScore ScoreAgainstTruth(const PointCloud& cloud, const std::vector<Eigen::V
   for (int m = 0; m < num_modules; ++m) score.per_module[m] = Figures(std::move(per[m]));
   return score;
 }
+
+}  // namespace
 
 double ShareInsideBox(const std::vector<Eigen::Vector3d>& points_mm, const Eigen::Vector3d& centre_mm,
                       const Eigen::Vector3d& size_mm) {

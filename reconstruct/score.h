@@ -49,6 +49,13 @@ struct CloudScore {
 // `truth`: (N) samples in mm. `num_modules`: size of per_module.
 CloudScore ScoreAgainstTruth(const PointCloud& cloud, const std::vector<Eigen::Vector3d>& truth, int num_modules);
 
+// The same figures under a given alignment, found for another cloud of the
+// same rig and scene (CloudScore::truth_from_cloud): score judges the passive
+// capture's points under the active cloud's alignment, which a cloud of
+// gross mismatches would pull off its own.
+CloudScore ScoreUnderAlignment(const PointCloud& cloud, const std::vector<Eigen::Vector3d>& truth,
+                               const Pose& truth_from_cloud, int num_modules);
+
 // The share, in [0, 1], of `points_mm` inside the axis-aligned box of size
 // `size_mm` centred on `centre_mm` (faces included); 0 for no point. Score
 // uses it on a scene's truth surface and the measurement volume: a volume

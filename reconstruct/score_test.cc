@@ -381,6 +381,46 @@ TEST(ScoreAgainstTruth, FilledPointsAreScoredApart) {
   }
 }
 
+// Another cloud of the same scene judged under a motion found elsewhere
+// (score's passive cloud under the active cloud's alignment): given the exact
+// inverse of the motion applied, the figures are the injected distances up
+// to the plane's error alone, and the motion is reported as given.
+TEST(ScoreUnderAlignment, ScoresUnderTheGivenMotion) {
+  const Ellipsoid e;
+  const std::vector<Eigen::Vector3d> truth = TruthSamples(e);
+  std::mt19937 rng(11);
+  std::vector<Sample> samples;
+  AddSamples(e, RandomPositions(e, 4000, 0, 65, 0, 360, rng), 0, 0.02, kSigma, rng, &samples);
+  const Pose motion = Pose::FromRotationVector(Eigen::Vector3d(1, 2, -1.5).normalized() * 0.3 * kDeg,
+                                               Eigen::Vector3d(0.08, -0.05, 0.1));
+  const CloudScore score = ScoreUnderAlignment(ToCloud(samples, motion), truth, motion.Inverse(), 1);
+  EXPECT_TRUE(score.truth_from_cloud.ToMatrix4() == motion.Inverse().ToMatrix4());
+  ASSERT_EQ(score.per_module.size(), 1u);
+  // The motion undone to rounding (float storage: ~1e-5 mm at 200 mm).
+  const double plane = PlaneErrorBound(e, samples, false) + 1e-4;
+  ExpectFiguresNear(score.all, InjectedFigures(samples, -1), plane, "all");
+  ExpectFiguresNear(score.per_module[0], InjectedFigures(samples, 0), plane, "module 0");
+}
+
+// A gross mismatch beside the surface's edge: a flat patch, z = 200 mm over
+// x, y in [0, 20] mm, and a point 10 mm past its corner in its plane, where
+// the 8 nearest samples (around the corner: not on one line) fit the patch's
+// plane, which holds the point. Scored by that plane it read 0 mm; its distance to the truth is
+// 10 mm, to within the samples' spacing.
+TEST(ScoreUnderAlignment, APointFarFromEverySampleIsScoredByItsDistance) {
+  std::vector<Eigen::Vector3d> truth;
+  for (int i = 0; i <= 100; ++i)
+    for (int j = 0; j <= 100; ++j) truth.emplace_back(i * kSpacing, j * kSpacing, 200);
+  const std::vector<Sample> far = {
+      {Eigen::Vector3d(20 + 10 / std::sqrt(2.0), 20 + 10 / std::sqrt(2.0), 200), Eigen::Vector3d::UnitZ(), 0, 0}};
+  const PointCloud cloud = ToCloud(far, Pose());
+  for (const CloudScore& score : {ScoreUnderAlignment(cloud, truth, Pose(), 1), ScoreAgainstTruth(cloud, truth, 1)}) {
+    ASSERT_EQ(score.all.points, 1);
+    EXPECT_NEAR(score.all.max_abs_mm, 10.0, kSpacing);
+    EXPECT_EQ(score.all.within_0_5_mm, 0.0);
+  }
+}
+
 // Points on a 10 x 10 x 10 lattice of 1 mm pitch, 0..9 on each axis, and
 // boxes whose share is counted by hand: faces count as inside.
 TEST(ShareInsideBox, CountsThePointsOnAndInTheBox) {

@@ -309,6 +309,7 @@ void KeyPaths(const nlohmann::json& j, const std::string& path, std::set<std::st
 // merged figures. And every key of its --report is in docs/reconstruct.md's
 // table ("Score report JSON"), which it had none of ("write everything as
 // JSON"). The sphere under the default volume: any numbers (a few seconds).
+// Its passive points are scored, not only counted.
 TEST(BenchCli, ScoresPerModuleFiguresSayTheirUnitAndEveryKeyOfItsReportIsDocumented) {
   const std::string dataset = testing::SimulateOneScene("sphere", 1, "score_units");
   const std::string report = dataset + "/score.json";
@@ -319,8 +320,16 @@ TEST(BenchCli, ScoresPerModuleFiguresSayTheirUnitAndEveryKeyOfItsReportIsDocumen
     EXPECT_TRUE(std::regex_search(
         r.out, std::regex(std::string("; ") + module + " fill +[0-9.]+% \\|e\\| [0-9.]+ std [0-9.]+ mm[;\n]")))
         << module << ": " << r.out;
+  // The passive cloud's points are scored too, every one of them (the ratio
+  // counts points, right or wrong).
+  EXPECT_TRUE(std::regex_search(
+      r.out, std::regex("; passive [0-9]+ points \\([0-9]+% within 0.5 mm, \\|e\\| [0-9.]+ mm; active/passive ")))
+      << r.out;
+  const nlohmann::json j = nlohmann::json::parse(std::ifstream(report));
+  ASSERT_GT(j["scenes"][0]["passive_points"].get<int>(), 0) << "the sphere's passive capture made no point";
+  EXPECT_EQ(j["scenes"][0]["passive"]["points"], j["scenes"][0]["passive_points"]);
   std::set<std::string> written;
-  KeyPaths(nlohmann::json::parse(std::ifstream(report)), "", &written);
+  KeyPaths(j, "", &written);
   ASSERT_TRUE(written.contains("scenes[].modules[].accuracy.std_mm")) << "the run wrote no module figures";
   std::ifstream docs(std::string(STEREORIG_SOURCE_DIR) + "/docs/reconstruct.md");
   const std::string text(std::istreambuf_iterator<char>(docs), {});
@@ -329,10 +338,12 @@ TEST(BenchCli, ScoresPerModuleFiguresSayTheirUnitAndEveryKeyOfItsReportIsDocumen
   const std::string table = text.substr(from, to - from);
   for (const std::string& key : written) {
     // A row documents its key and, by "keys as merged's / the scene's
-    // fill", the same figures under accuracy, filled and modules[].fill.
+    // fill", the same figures under accuracy, passive, filled and
+    // modules[].fill.
     const std::string row = "| `" + key + "` |";
     const std::string as_merged = std::regex_replace(
-        key, std::regex("^scenes\\[\\]\\.(modules\\[\\]\\.accuracy|filled(\\.by_distance_to_measured\\[\\])?)\\."),
+        key,
+        std::regex("^scenes\\[\\]\\.(modules\\[\\]\\.accuracy|passive|filled(\\.by_distance_to_measured\\[\\])?)\\."),
         "scenes[].merged.");
     const std::string as_fill =
         std::regex_replace(key, std::regex("^scenes\\[\\]\\.modules\\[\\]\\.fill\\."), "scenes[].fill.");

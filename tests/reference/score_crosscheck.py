@@ -8,8 +8,10 @@ clouds `stereorig reconstruct` writes for the same scenes, rig and options.
 For each scene in the report: reads the cloud and the simulator's dense truth
 (DATASET/truth/scenes/<scene>/surface.ply), aligns the cloud by its own
 point-to-plane ICP from the identity, then takes each measured point's
-distance to the plane through its 8 nearest truth samples, signed by the
-cloud's normal (the definition in reconstruct/score.h; none of its code).
+distance to the plane through its 8 nearest truth samples (or, for a point
+whose nearest sample is more than 1 mm away, that sample's distance), signed
+by the cloud's normal (the definition in reconstruct/score.h; none of its
+code).
 Compares per module and merged: the point count exactly, mean |e| and std
 within TOLERANCE_MM (default 0.001). Prints one line per figure; exit 0 if all
 agree, 1 if not, 2 on bad arguments.
@@ -37,6 +39,7 @@ from scipy.spatial import cKDTree
 FILLED_MODULE = 255  # hole-filling points (reconstruct/point_cloud.h): not scored as measured
 MAX_PAIR_MM = 2.0    # ICP pairs whose nearest truth sample is farther are left out (score.h)
 K = 8                # truth samples per local plane (score.h)
+PLANE_REACH_MM = 1.0  # a point whose nearest truth sample is farther is scored by that distance (score.h)
 
 PLY_TYPES = {'float': '<f4', 'double': '<f8', 'uchar': 'u1', 'char': 'i1', 'ushort': '<u2', 'short': '<i2',
              'uint': '<u4', 'int': '<i4'}
@@ -140,9 +143,10 @@ def score_scene(cloud, truth):
     if not converged:
         raise RuntimeError('the alignment did not converge')
     p = xyz @ r.T + t
-    c, n, _ = local_planes(tree, truth, p)
+    c, n, nearest = local_planes(tree, truth, p)
     sign = np.where(np.einsum('ni,ni->n', n, normal @ r.T) >= 0, 1.0, -1.0)
-    e = sign * np.einsum('ni,ni->n', p - c, n)
+    plane = np.einsum('ni,ni->n', p - c, n)
+    e = sign * np.where(nearest > PLANE_REACH_MM, np.copysign(nearest, plane), plane)
     return figures(e), {int(m): figures(e[module == m]) for m in np.unique(module)}
 
 
