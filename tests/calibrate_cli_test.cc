@@ -141,6 +141,10 @@ TEST(CalibrateCli, RenderedCapturesToRigFileAndReport) {
       << r.out;
   std::printf("%s", r.out.c_str());
   EXPECT_NE(r.err.find("detect 000"), std::string::npos);  // progress
+  // stderr carries our words only: libmrcal's outlier loop printed "mrcal.c(5351): Threw out some outliers (have a
+  // total of 1737 now); going again" there, its total the unseen corners too, beside the summary's outlier count.
+  EXPECT_EQ(r.err.find("mrcal.c("), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find(" outliers, coverage "), std::string::npos) << r.out;
   const Rig rig = ReadRigFile(set.dir + "/rig.yaml");
   ASSERT_EQ(rig.num_modules(), 2);
   EXPECT_TRUE(fs::exists(set.dir + "/report.json"));
