@@ -8,6 +8,7 @@
 #include <iostream>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 namespace stereorig {
 namespace {
@@ -33,6 +34,19 @@ TEST(ScopedStderrCapture, DropsThePickedLinesAndWritesBackTheRestUnchanged) {
   std::fprintf(stderr, "after\n");
   EXPECT_EQ(::testing::internal::GetCapturedStderr(),
             "before\nkept: a real error\nkept: by write(2)\nkept: by std::cerr\nafter\n");
+}
+
+// Another thread's line meanwhile lands in the capture too (one fd 2 per
+// process): it comes out unchanged at the scope's end, not lost.
+TEST(ScopedStderrCapture, AnotherThreadsLineMeanwhileComesOutUnchanged) {
+  ::testing::internal::CaptureStderr();
+  {
+    ScopedStderrCapture capture(IsNoise);
+    std::thread other([] { std::fprintf(stderr, "kept: another thread's progress\n"); });
+    other.join();
+    std::fprintf(stderr, "noise: going again\n");
+  }
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "kept: another thread's progress\n");
 }
 
 // Held until the scope's end: nothing reaches fd 2 meanwhile, so a dropped
