@@ -7,6 +7,7 @@
 #include <map>
 #include <opencv2/core.hpp>
 #include <optional>
+#include <tuple>
 
 #include "calib/core/capture_image_name.h"
 #include "calib/core/input_error.h"
@@ -152,15 +153,19 @@ std::string SizeText(const std::pair<int, int>& size_px) {
   return std::to_string(size_px.first) + "x" + std::to_string(size_px.second);
 }
 
-// Throws InputError unless each camera's images in `captures` (of `dir`)
-// are of one size, naming the odd ones out: those of a size other than
-// most of the camera's images have, or, where no size has most, every size
-// with its files. Read from the headers only; an image that is missing or no PNG is
-// left to the detection loop, which names it. The first image read used to
-// set the size, and a first image of the wrong size had the error name a
-// right one.
-void RefuseOddImageSizes(const std::string& dir, const std::vector<fs::path>& captures, int num_cameras) {
+// Each camera's image size (cameras[c] named camC, 0x0 if none of its
+// images could be read), from the headers of its images in `captures` (of
+// `dir`). Throws InputError unless each camera's images are of one size,
+// naming the odd ones out: those of a size other than most of the camera's
+// images have, or, where no size has most, every size with its files. An
+// image that is missing or no PNG is left to the detection loop, which
+// names it. The first image read used to set the size, and a first image
+// of the wrong size had the error name a right one.
+std::vector<CameraImager> CameraImageSizes(const std::string& dir, const std::vector<fs::path>& captures,
+                                           int num_cameras) {
+  std::vector<CameraImager> cameras(num_cameras);
   for (int c = 0; c < num_cameras; ++c) {
+    cameras[c].name = "cam" + std::to_string(c);
     std::map<std::pair<int, int>, std::vector<std::string>> images_of_size;
     int images = 0;
     for (const fs::path& capture : captures) {
@@ -175,6 +180,7 @@ void RefuseOddImageSizes(const std::string& dir, const std::vector<fs::path>& ca
       images_of_size[{int(png->width_px()), int(png->height_px())}].push_back(image.string());
       ++images;
     }
+    if (images_of_size.size() == 1) std::tie(cameras[c].width_px, cameras[c].height_px) = images_of_size.begin()->first;
     if (images_of_size.size() < 2) continue;
     const auto most = std::max_element(images_of_size.begin(), images_of_size.end(),
                                        [](const auto& a, const auto& b) { return a.second.size() < b.second.size(); });
@@ -206,6 +212,28 @@ void RefuseOddImageSizes(const std::string& dir, const std::vector<fs::path>& ca
     }
     throw InputError(dir, camera + "'s images differ in size, and no size is most of them: " + sizes +
                               " (images of another camera among them?)");
+  }
+  return cameras;
+}
+
+// Throws InputError if a module of `modules` pairs cameras whose images
+// (`cameras`, from the captures in `dir`; 0x0 not known) differ in size.
+// Calibrated, such a rig was written, exit 0, and refused by every
+// reconstruction after ("its two cameras' imagers differ in size (not
+// supported)": the runtime matches a module's rows), as the simulator
+// refuses such a spec. From the headers, before the detection (minutes on a
+// real rig), which it used to follow.
+void RefuseModulesOfTwoImagerSizes(const std::string& dir, const std::vector<ModuleLayout>& modules,
+                                   const std::vector<CameraImager>& cameras) {
+  for (const ModuleLayout& m : modules) {
+    const CameraImager &left = cameras[m.left_camera], &right = cameras[m.right_camera];
+    if (left.width_px == 0 || right.width_px == 0) continue;  // no image read: the detection loop names it
+    if (left.width_px == right.width_px && left.height_px == right.height_px) continue;
+    throw InputError(dir, m.name + "'s cameras differ in imager size: " + left.name + "'s images are " +
+                              SizeText({left.width_px, left.height_px}) + ", " + right.name + "'s " +
+                              SizeText({right.width_px, right.height_px}) +
+                              "; a module's two cameras need one (stereorig reconstruct matches their rows): window "
+                              "both alike, or images of another camera among them?");
   }
 }
 
@@ -267,7 +295,8 @@ void RequireCapturesFolder(const std::string& dir) {
 
 DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& target, int num_cameras,
                                      const DetectOptions& options, bool progress,
-                                     const std::vector<CameraImager>& rig_cameras) {
+                                     const std::vector<CameraImager>& rig_cameras,
+                                     const std::vector<ModuleLayout>& modules) {
   STEREORIG_CHECK(rig_cameras.empty() || int(rig_cameras.size()) == num_cameras);
   RequireCapturesFolder(dir_in);
   if (IsDatasetWithoutCaptures(dir_in))
@@ -288,7 +317,8 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
   }
 
   const std::vector<int> indices = CaptureIndices(captures);
-  if (rig_cameras.empty()) RefuseOddImageSizes(dir.string(), captures, num_cameras);
+  if (rig_cameras.empty())
+    RefuseModulesOfTwoImagerSizes(dir.string(), modules, CameraImageSizes(dir.string(), captures, num_cameras));
 
   DetectedCaptures out;
   for (const fs::path& folder : skipped) out.skipped_folders.push_back(folder.string());
@@ -528,24 +558,6 @@ std::vector<std::string> StereoViewsLeftOutNotes(const CalibrationReport& report
   return notes;
 }
 
-// Throws InputError if a module of `modules` pairs cameras whose images
-// (`cameras`, from the captures in `dir`) differ in size. Calibrated, such
-// a rig was written, exit 0, and refused by every reconstruction after
-// ("its two cameras' imagers differ in size (not supported)": the runtime
-// matches a module's rows), as the simulator refuses such a spec.
-void RefuseModulesOfTwoImagerSizes(const std::string& dir, const std::vector<ModuleLayout>& modules,
-                                   const std::vector<CameraImager>& cameras) {
-  for (const ModuleLayout& m : modules) {
-    const CameraImager &left = cameras[m.left_camera], &right = cameras[m.right_camera];
-    if (left.width_px == right.width_px && left.height_px == right.height_px) continue;
-    throw InputError(dir, m.name + "'s cameras differ in imager size: " + left.name + "'s images are " +
-                              SizeText({left.width_px, left.height_px}) + ", " + right.name + "'s " +
-                              SizeText({right.width_px, right.height_px}) +
-                              "; a module's two cameras need one (stereorig reconstruct matches their rows): window "
-                              "both alike, or images of another camera among them?");
-  }
-}
-
 }  // namespace
 
 FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const std::string& target_path,
@@ -557,8 +569,8 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
   input.modules = modules;
   input.source = captures_dir;
   const int num_cameras = LayoutCameraCount(input.modules);
-  DetectedCaptures detected = DetectCaptureFolder(captures_dir, target, num_cameras, DetectOptions(), options.progress);
-  RefuseModulesOfTwoImagerSizes(CapturesRoot(captures_dir).string(), input.modules, detected.cameras);
+  DetectedCaptures detected =
+      DetectCaptureFolder(captures_dir, target, num_cameras, DetectOptions(), options.progress, {}, input.modules);
   input.cameras = detected.cameras;
   input.observations = std::move(detected.observations);
   input.capture_names = std::move(detected.capture_names);

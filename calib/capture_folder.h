@@ -67,10 +67,13 @@ std::string SkippedFoldersNote(const std::vector<std::string>& skipped_folders);
 // size, or a dataset folder without calibration/ captures. `progress`: one
 // line per capture on stderr. `rig_cameras`: (num_cameras,) the sizes a
 // rig file gives each camera's images (check), every image held to them;
-// empty (calibrate: no rig yet): each camera's first image sets its size.
+// empty (calibrate: no rig yet): each camera's images are held to one size,
+// and each module of `modules` to one size for its two cameras, both read
+// from the PNG headers and refused before any detection.
 DetectedCaptures DetectCaptureFolder(const std::string& dir, const Target& target, int num_cameras,
                                      const DetectOptions& options, bool progress,
-                                     const std::vector<CameraImager>& rig_cameras = {});
+                                     const std::vector<CameraImager>& rig_cameras = {},
+                                     const std::vector<ModuleLayout>& modules = {});
 
 // "" unless most images were rejected (more than half) and at least one in
 // ten as not fitting the target's layout (ambiguous: no single orientation

@@ -1,10 +1,25 @@
 #include "calib/mrcal_problem.h"
 
 #include <algorithm>
+#include <optional>
+#include <string_view>
 
 #include "calib/core/input_error.h"
+#include "calib/scoped_stderr_capture.h"
 
 namespace stereorig {
+namespace {
+
+// mrcal_optimize prints each pass of its outlier loop to stderr whatever its
+// verbose flag: "mrcal.c(5351): Threw out some outliers (have a total of 1737
+// now); going again". Its total counts every pool entry of weight < 0, the
+// corners a view did not see among them, so beside our summary's "6 outliers"
+// (the outliers alone, which the report gives) it only misleads.
+bool IsOutlierLoopLine(std::string_view line) {
+  return line.rfind("mrcal.c(", 0) == 0 && line.find("Threw out some outliers") != std::string_view::npos;
+}
+
+}  // namespace
 
 bool MrcalProblem::SetLensmodel(const std::string& name) {
   if (!mrcal_lensmodel_from_name(&lensmodel, name.c_str())) return false;
@@ -31,6 +46,10 @@ mrcal_stats_t MrcalProblem::Optimize(bool verbose) {
   STEREORIG_CHECK(static_cast<int>(intrinsics.size()) == num_intrinsics_cameras * num_params());
   STEREORIG_CHECK(static_cast<int>(pool.size()) == num_observations() * corners_x * corners_y);
   const mrcal_problem_constants_t constants = {.point_min_range = -1.0, .point_max_range = -1.0};
+  // Verbose asks for mrcal's own account, whole; anything else it prints
+  // (an error) comes through unchanged.
+  std::optional<ScopedStderrCapture> quiet;
+  if (!verbose) quiet.emplace(IsOutlierLoopLine);
   return mrcal_optimize(nullptr, 0, nullptr, 0, intrinsics.data(), extrinsics_fromref.data(), frames_toref.data(),
                         nullptr, nullptr, num_intrinsics_cameras, num_extrinsics(), num_frames(), 0, 0,
                         observations.data(), nullptr, num_observations(), 0, pool.data(), &lensmodel,

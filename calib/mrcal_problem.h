@@ -45,7 +45,9 @@ struct MrcalProblem {
   // outlier rejection. Sets `selections` to that.
   void SelectPosesOnly();
   // Runs mrcal_optimize with the current selections. Updates the state and
-  // marks new outliers in the pool (weight < 0).
+  // marks new outliers in the pool (weight < 0). Unless `verbose`, mrcal's
+  // outlier-loop lines are kept off stderr (their total counts the unseen
+  // corners too); its other lines pass.
   mrcal_stats_t Optimize(bool verbose = false);
   // Residuals x (Nmeasurements,) at the current state (board ones first:
   // (Nobservations, corners_y, corners_x, 2), weighted, 0 for outliers).

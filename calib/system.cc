@@ -28,23 +28,6 @@ namespace {
 
 using ObsIndex = std::map<std::pair<int, int>, const BoardObservation*>;  // (capture, camera)
 
-// Ceres says a rank-deficient J'J through glog (LOG(ERROR): "Covariance
-// matrix is near rank deficient ..."), a raw line on stderr beside our own
-// words. Compute's false already says it: the report's covariance status
-// names it, and a refusal that follows is ours (not glog's, so not hidden).
-// glog is held at FATAL for the one call (a FATAL still aborts), then given
-// back; the mutex keeps two threads' calls from restoring each other's level.
-bool ComputeCovarianceQuietly(ceres::Covariance* cov, const std::vector<std::pair<const double*, const double*>>& pairs,
-                              ceres::Problem* problem) {
-  static std::mutex glog_level_mutex;
-  std::lock_guard<std::mutex> lock(glog_level_mutex);
-  const int32_t level = FLAGS_minloglevel;
-  FLAGS_minloglevel = google::GLOG_FATAL;
-  const bool ok = cov->Compute(pairs, problem);
-  FLAGS_minloglevel = level;
-  return ok;
-}
-
 ObsIndex IndexObservations(const CalibrationInput& input) {
   ObsIndex index;
   for (const BoardObservation& o : input.observations) index[{o.capture, o.camera}] = &o;
@@ -205,6 +188,23 @@ std::vector<int> Stage3HeldIntrinsics(const std::string& lensmodel, int num_intr
   std::vector<int> held;
   for (int i = first_held; i < num_intrinsics; ++i) held.push_back(i);
   return held;
+}
+
+// Ceres says a rank-deficient J'J through glog (LOG(ERROR): "Covariance
+// matrix is near rank deficient ..."), a raw line on stderr beside our own
+// words. Compute's false already says it: the report's covariance status
+// names it, and a refusal that follows is ours (not glog's, so not hidden).
+// glog is held at FATAL for the one call (a FATAL still aborts), then given
+// back; the mutex keeps two threads' calls from restoring each other's level.
+bool ComputeCovarianceQuietly(ceres::Covariance* cov, const std::vector<std::pair<const double*, const double*>>& pairs,
+                              ceres::Problem* problem) {
+  static std::mutex glog_level_mutex;
+  std::lock_guard<std::mutex> lock(glog_level_mutex);
+  const int32_t level = FLAGS_minloglevel;
+  FLAGS_minloglevel = google::GLOG_FATAL;
+  const bool ok = cov->Compute(pairs, problem);
+  FLAGS_minloglevel = level;
+  return ok;
 }
 
 ceres::Covariance::Options Stage3CovarianceOptions(int num_free) {

@@ -237,6 +237,12 @@ std::vector<int> Stage3HeldIntrinsics(const std::string& lensmodel, int num_intr
 // 0.0002-0.01 px where OPENCV5's, a subset of it, is 0.05 px.
 ceres::Covariance::Options Stage3CovarianceOptions(int num_free);
 
+// cov->Compute(pairs, problem) without Ceres's glog line on a rank-deficient
+// J'J ("Covariance matrix is near rank deficient ..."): the false it returns
+// says so already, in our words where it matters (calib/system.cc).
+bool ComputeCovarianceQuietly(ceres::Covariance* cov, const std::vector<std::pair<const double*, const double*>>& pairs,
+                              ceres::Problem* problem);
+
 // Board poses: for each capture, module_from_front of one module, from its
 // triangulated corners (Horn). Also the triangulated points themselves.
 struct ModuleCaptureView {
