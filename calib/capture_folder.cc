@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -542,23 +543,41 @@ std::vector<std::string> RepeatedPosesNotes(const CalibrationReport& report) {
   return notes;
 }
 
-// One line per module whose joint solve left views out
-// (StereoReport::views_left_out), naming them by folder and camera.
+}  // namespace
+
 std::vector<std::string> StereoViewsLeftOutNotes(const CalibrationReport& report) {
   std::vector<std::string> notes;
   for (const StereoReport& s : report.stereo) {
     if (s.views_left_out.empty()) continue;
     std::string views;
-    for (const auto& [capture, camera] : s.views_left_out)
+    int edge_on = 0;
+    for (size_t k = 0; k < s.views_left_out.size(); ++k) {
+      const auto& [capture, camera] = s.views_left_out[k];
       views += (views.empty() ? "" : ", ") + report.CaptureName(capture) + "/" + CameraImageName(camera);
+      const double tilt_deg = k < s.views_left_out_tilt_deg.size() ? s.views_left_out_tilt_deg[k] : std::nan("");
+      if (std::isfinite(tilt_deg)) {
+        char text[48];
+        std::snprintf(text, sizeof text, " (board tilted %.0f deg)", tilt_deg);
+        views += text;
+        edge_on += tilt_deg >= kEdgeOnTiltDeg;
+      }
+    }
+    const int n = int(s.views_left_out.size());
+    // A swapped pair's images show ordinary tilts (each is a real view, of
+    // the other camera); a ring's side views show the board nearly edge-on.
+    const std::string why =
+        edge_on == n ? "boards seen nearly edge-on, their corners foreshortened: usual where a module sees the "
+                       "board from the side, as in a ring; the module's other views fix it"
+        : edge_on == 0
+            ? "images of another camera or capture, such as a module's left and right swapped?"
+            : "those tilted past " + std::to_string(int(kEdgeOnTiltDeg)) +
+                  " deg seen nearly edge-on; the others images of another camera or capture, such as a module's "
+                  "left and right swapped?";
     notes.push_back("module " + std::to_string(s.module) + " (" + s.module_name + "): stage 2 left out " + views +
-                    ": outlier rejection left too few of their corners to fix the board's pose (images of another "
-                    "camera or capture, such as a module's left and right swapped?)");
+                    ": outlier rejection left too few of their corners to fix the board's pose (" + why + ")");
   }
   return notes;
 }
-
-}  // namespace
 
 FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const std::string& target_path,
                                          const std::vector<ModuleLayout>& modules, const CalibrationOptions& options) {

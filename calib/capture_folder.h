@@ -117,6 +117,19 @@ std::string NeverSeenCornersNote(const std::vector<BoardObservation>& observatio
 // images: captures of another rig.)
 std::string CamerasLeftOutNote(const std::string& dir, int num_cameras);
 
+// A board stage 1 solved tilted at least this far from facing the camera
+// (TiltDeg) is seen nearly edge-on: 1 / cos 70 deg = 2.9x foreshortened.
+inline constexpr double kEdgeOnTiltDeg = 70.0;
+
+// One warning per module whose joint solve left views out
+// (StereoReport::views_left_out), naming them by folder and camera, with
+// the board's tilt in each as stage 1 solved it, and the likely cause: a
+// board seen nearly edge-on (normal in a ring, whose modules see the board
+// from the side), or an image of another camera or capture (a module's left
+// and right swapped: each such image is an ordinary view of the other
+// camera, at an ordinary tilt). The notes used to blame a swap alone.
+std::vector<std::string> StereoViewsLeftOutNotes(const CalibrationReport& report);
+
 // Whether a refusal's problem is one of too few views (stages 1 and 2:
 // "never sees the board", "too few views ..."; calib/intrinsics.cc,
 // calib/stereo.cc), which NoBoardFoundNote may explain; not one that shows

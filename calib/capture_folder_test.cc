@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <string>
+#include <vector>
+
 namespace stereorig {
 namespace {
 
@@ -98,6 +102,48 @@ TEST(NoBoardFoundNote, OnlyRefusalsForTooFewViewsTakeIt) {
   for (const char* problem :
        {"face seen by the wrong module: module1 sees the front face", "corner 12 outside the imager", "observed twice"})
     EXPECT_FALSE(IsTooFewViewsProblem(problem)) << problem;
+}
+
+// Stage 2's views left out, named with the board's tilt in each. A ring's
+// side views (the commissioning audit's: 85, 74 and 80 deg) read as boards
+// seen nearly edge-on; they used to read as "a module's left and right
+// swapped?", which a swapped pair's ordinary tilts still do. A mix says
+// which is which; a view stage 1 had no pose for gives no tilt.
+TEST(StereoViewsLeftOutNotes, NameTheBoardsTiltAndTellEdgeOnViewsFromSwappedImages) {
+  CalibrationReport report;
+  report.capture_names = {{31, "031"}, {45, "045"}};
+  StereoReport module;
+  module.module = 1;
+  module.module_name = "module1";
+  module.views_left_out = {{31, 3}, {45, 2}, {45, 3}};
+  module.views_left_out_tilt_deg = {85.2, 74.4, 80.0};
+  report.stereo = {module};
+  const std::string edge_on =
+      "module 1 (module1): stage 2 left out 031/cam3.png (board tilted 85 deg), 045/cam2.png (board tilted 74 deg), "
+      "045/cam3.png (board tilted 80 deg): outlier rejection left too few of their corners to fix the board's pose "
+      "(boards seen nearly edge-on, their corners foreshortened: usual where a module sees the board from the side, "
+      "as in a ring; the module's other views fix it)";
+  EXPECT_EQ(StereoViewsLeftOutNotes(report), std::vector<std::string>{edge_on});
+
+  report.stereo[0].views_left_out_tilt_deg = {31.0, 28.5, 40.0};
+  const std::vector<std::string> swapped = StereoViewsLeftOutNotes(report);
+  ASSERT_EQ(swapped.size(), 1u);
+  EXPECT_NE(swapped[0].find("(images of another camera or capture, such as a module's left and right swapped?)"),
+            std::string::npos)
+      << swapped[0];
+  EXPECT_EQ(swapped[0].find("edge-on"), std::string::npos) << swapped[0];
+
+  report.stereo[0].views_left_out_tilt_deg = {85.2, 28.5, std::nan("")};
+  const std::vector<std::string> mixed = StereoViewsLeftOutNotes(report);
+  ASSERT_EQ(mixed.size(), 1u);
+  EXPECT_NE(mixed[0].find("045/cam3.png:"), std::string::npos) << mixed[0];  // no tilt to give
+  EXPECT_NE(mixed[0].find("(those tilted past 70 deg seen nearly edge-on; the others images of another camera"),
+            std::string::npos)
+      << mixed[0];
+
+  report.stereo[0].views_left_out.clear();
+  report.stereo[0].views_left_out_tilt_deg.clear();
+  EXPECT_TRUE(StereoViewsLeftOutNotes(report).empty());
 }
 
 }  // namespace

@@ -170,8 +170,14 @@ StereoResult CalibrateStereo(int module, const ModuleLayout& layout, const Intri
                                   std::to_string(shared) + ", need " + std::to_string(options.min_shared_views));
     solve();
   }
-  for (const auto& [capture, cam] : left_out)
+  for (const auto& [capture, cam] : left_out) {
     result.report.views_left_out.push_back({capture, cam == 0 ? layout.left_camera : layout.right_camera});
+    const std::map<int, int>& views = cam == 0 ? left_view : right_view;
+    const IntrinsicsResult& stage1 = cam == 0 ? left : right;
+    const auto view = views.find(capture);
+    result.report.views_left_out_tilt_deg.push_back(view == views.end() ? std::numeric_limits<double>::quiet_NaN()
+                                                                        : TiltDeg(stage1.cam_from_face[view->second]));
+  }
 
   const int np = p.num_params();
   result.left = Camera(iopt.lensmodel, std::vector<double>(p.intrinsics.begin(), p.intrinsics.begin() + np),

@@ -54,6 +54,10 @@ struct StereoReport {
   // capture whose left and right images were swapped). Calibrate warns of
   // them (capture_folder.h).
   std::vector<std::pair<int, int>> views_left_out = {};
+  // The board's tilt in each of those views as stage 1 solved it (TiltDeg;
+  // NaN where stage 1 had no pose): a board seen nearly edge-on is left out
+  // for its foreshortened corners, not for being another camera's image.
+  std::vector<double> views_left_out_tilt_deg = {};
   IntrinsicsReport left, right;  // per-camera figures of the joint solve (uncertainty, coverage)
   // Cov(left's intrinsics, right's) of the joint solve, (N * N,) row-major,
   // rows the left's, as left/right.intrinsics_covariance (the
