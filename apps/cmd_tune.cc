@@ -72,6 +72,16 @@ std::optional<double> PlaneRmsMm(const PointCloud& cloud, int module) {
   return fit.rms_mm;
 }
 
+// The share of a module's grid-lit pixels that the grid-line test refused
+// (no_grid_line, as `reconstruct --report`'s lit_pixels_by_status counts
+// them), in %; nullopt for a module with no lit pixel.
+std::optional<double> NoGridLinePercent(const Reconstruction& reconstruction, int module) {
+  for (const ModuleReport& m : reconstruction.modules)
+    if (m.module == module && m.lit_pixels > 0)
+      return 100.0 * m.lit_by_status[size_t(PixelStatus::kNoGridLine)] / m.lit_pixels;
+  return std::nullopt;
+}
+
 }  // namespace
 
 int RunTune(int argc, char** argv) {
@@ -81,10 +91,13 @@ int RunTune(int argc, char** argv) {
       "the nearest pixel: match.grid_half_period_px (P / 2, at most 4: the distinctness test's shift; longer, its "
       "probes pass mismatches at rims), match.line_index_max_shift_px (1.5 P), "
       "match.line_index_window_half_height_px (at least (P - 1) / 2), match.line_index_footprint_gap_px (P, at "
-      "most 16) and match.grid_line_radius_px (P / 2 rounded up, + 1). The defaults are these rules at the "
-      "default grid's 8 px, so on a rig like the default nothing changes. Use it when commissioning a rig with "
-      "another projector, lens or working distance (docs/reconstruct.md, 'Another projector'). A P within 0.1 px "
-      "of a half pixel is warned of: another capture may round it the other way.\n"
+      "most 16) and match.grid_line_radius_px (P / 2 rounded up, + 1), but not wider than --options has it: a wider "
+      "window also keeps matches on objects' outlines beyond the grid's envelope, and can raise the std, so a wider "
+      "value is printed as a suggestion to verify, with the share of each module's grid-lit pixels the grid-line "
+      "test refused (no_grid_line; on the plate it did not tell where widening helps). The defaults are these "
+      "rules at the default grid's 8 px, so on a rig like the default nothing changes. Use it when commissioning "
+      "a rig with another projector, lens or working distance (docs/reconstruct.md, 'Another projector'). A P "
+      "within 0.1 px of a half pixel is warned of: another capture may round it the other way.\n"
       "Capture a flat matte plate facing the modules, lasers on, filling the measurement volume's middle: on a "
       "curved or turned surface the period is stretched by the foreshortening. Per module it reconstructs the "
       "capture and prints how far its points lie off a plane (RMS), and warns above 0.5 mm: not a flat plate; "
@@ -119,8 +132,10 @@ int RunTune(int argc, char** argv) {
 
   const Reconstruction reconstruction = runtime.Process(images, false);
   std::vector<double> periods;
-  std::string measured;    // "module 0 8.07 px (spread 0.04 px, turned 2.53 deg), ...": the file's header
-  std::string unmeasured;  // "module 1, module 2": those with no period, warned of and named in the header
+  std::string measured;      // "module 0 8.07 px (spread 0.04 px, turned 2.53 deg), ...": the file's header
+  std::string unmeasured;    // "module 1, module 2": those with no period, warned of and named in the header
+  std::string no_grid_line;  // "module 0 1.99 %, ...": the grid-lit pixels the grid-line test refused
+  double max_no_grid_line_percent = 0;
   for (const ModulePlan& plan : runtime.plans()) {
     const auto m = MeasureModule(runtime, plan, images);
     if (!m) {
@@ -153,6 +168,14 @@ int RunTune(int argc, char** argv) {
                    "dark, or few matches): its period is from a surface not known to be a flat plate; check the "
                    "capture\n",
                    plan.module, capture_dir.c_str(), kMinPlanePoints);
+    }
+    if (const std::optional<double> percent = NoGridLinePercent(reconstruction, plan.module)) {
+      std::printf("  the grid-line test refused %.2f %% of its grid-lit pixels (no_grid_line)\n", *percent);
+      char share[48];
+      std::snprintf(share, sizeof share, "%smodule %d %.2f %%", no_grid_line.empty() ? "" : ", ", plan.module,
+                    *percent);
+      no_grid_line += share;
+      max_no_grid_line_percent = std::max(max_no_grid_line_percent, *percent);
     }
     if (std::isnan(m->shift_per_row_px)) {
       std::printf(
@@ -244,14 +267,35 @@ int RunTune(int argc, char** argv) {
         "tune: warning: P lies within %.1f px of the half pixel, so another capture of this rig may read it as %d px "
         "and set other keys: measure the plate in a second position, and keep the set that verifies better\n",
         kRoundingMarginPx, other_px);
+  std::string not_applied;  // the file header's note on the rules not applied
+  for (const GridPeriodKey& k : keys) {
+    if (k.rule_not_applied == 0) {
+      std::printf("  match.%-34s %g%s\n", k.key.c_str(), k.value,
+                  k.value == k.before ? "  (unchanged)" : ("  (was " + NumberText(k.before) + ")").c_str());
+      continue;
+    }
+    std::printf("  match.%-34s %g  (kept: the rule gives %g, not applied)\n", k.key.c_str(), k.value,
+                k.rule_not_applied);
+    not_applied += "\nmatch." + k.key + " was kept at " + NumberText(k.value) + ": the rule gives " +
+                   NumberText(k.rule_not_applied) + ", not applied (docs/reconstruct.md, \"Another projector\").";
+  }
   for (const GridPeriodKey& k : keys)
-    std::printf("  match.%-34s %g%s\n", k.key.c_str(), k.value,
-                k.value == k.before ? "  (unchanged)" : ("  (was " + NumberText(k.before) + ")").c_str());
-  const bool all_default =
-      std::all_of(keys.begin(), keys.end(), [](const GridPeriodKey& k) { return k.value == k.before; });
-  if (all_default)
+    if (k.rule_not_applied != 0 && k.key == "grid_line_radius_px")
+      // docs/reconstruct.md's condition, with the share it names (printed
+      // per module above): read on the plate, it did not tell the rigs
+      // where widening helped from those where it hurt.
+      std::printf(
+          "grid_line_radius_px: the rule's %g px (P / 2 rounded up, + 1) widens the grid-line test's window, which "
+          "also keeps matches on objects' outlines beyond the grid's envelope and can raise the std; the plate's "
+          "no_grid_line share (here at most %.2f %% of a module's grid-lit pixels) does not tell whether it helps "
+          "(docs/reconstruct.md, \"Another projector\"), so the radius is kept. To try it, set "
+          "match.grid_line_radius_px: %g and verify on the sphere and the ball bar in several positions\n",
+          k.rule_not_applied, max_no_grid_line_percent, k.rule_not_applied);
+  const bool any_changed =
+      std::any_of(keys.begin(), keys.end(), [](const GridPeriodKey& k) { return k.value != k.before; });
+  if (!any_changed && not_applied.empty())
     std::printf("the keys already fit this grid\n");
-  else
+  else if (any_changed)
     std::printf(
         "check the accuracy with the new keys: stereorig verify on the sphere and the ball bar, several "
         "positions (docs/reconstruct.md, \"Another projector\")\n");
@@ -259,14 +303,18 @@ int RunTune(int argc, char** argv) {
     std::printf("no --out: nothing written\n");
     return kExitOk;
   }
-  const std::string header = "Runtime options from `stereorig tune --capture " + capture_dir + "` with the rig " +
-                             rig_path + ".\nThe laser grid's period along the rectified rows: " + measured +
-                             ".\nThe match keys tied to it were set from P = " + NumberText(period_px) +
-                             " px (docs/reconstruct.md, \"Another projector\")." +
-                             (unmeasured.empty() ? ""
-                                                 : "\nNo grid period was found for " + unmeasured +
-                                                       " (its lasers off, or the plate outside its view): these keys "
-                                                       "are the other modules' only.");
+  const std::string header =
+      "Runtime options from `stereorig tune --capture " + capture_dir + "` with the rig " + rig_path +
+      ".\nThe laser grid's period along the rectified rows: " + measured +
+      ".\nThe match keys tied to it were set from P = " + NumberText(period_px) +
+      " px (docs/reconstruct.md, \"Another projector\")." + not_applied +
+      (no_grid_line.empty()
+           ? ""
+           : "\nThe grid-lit pixels the grid-line test refused (no_grid_line): " + no_grid_line + ".") +
+      (unmeasured.empty() ? ""
+                          : "\nNo grid period was found for " + unmeasured +
+                                " (its lasers off, or the plate outside its view): these keys "
+                                "are the other modules' only.");
   const std::string text = TunedOptionsYaml(options_text, keys, header);
   ParseRuntimeOptions(text, out_path).Check();  // what a later --options will read: the same keys, valid
   WriteFileAtomically(out_path, text);

@@ -29,7 +29,12 @@ std::vector<GridPeriodKey> SetGridPeriodKeys(double period_px, MatchOptions* o) 
   set("line_index_window_half_height_px", &o->line_index.window_half_height_px,
       std::max(defaults.line_index.window_half_height_px, p / 2));
   set("line_index_footprint_gap_px", &o->line_index.footprint_gap_px, std::min(16, p));
-  set("grid_line_radius_px", &o->grid_line.radius_px, (p + 1) / 2 + 1);  // ceil(p / 2) + 1
+  const int radius_rule_px = (p + 1) / 2 + 1;   // ceil(p / 2) + 1
+  if (radius_rule_px > o->grid_line.radius_px)  // widening: only suggested (why: grid_period_options.h)
+    keys.push_back({"grid_line_radius_px", double(o->grid_line.radius_px), double(o->grid_line.radius_px),
+                    double(radius_rule_px)});
+  else
+    set("grid_line_radius_px", &o->grid_line.radius_px, radius_rule_px);
   return keys;
 }
 

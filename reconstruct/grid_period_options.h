@@ -68,6 +68,9 @@ struct GridPeriodKey {
   std::string key;  // as the options file names it: match.<key>
   double value = 0;
   double before = 0;  // the options' value before the change
+  // The rule's value where it was not applied (value is then `before`), 0
+  // where it was: printed as a suggestion, to be verified by hand.
+  double rule_not_applied = 0;
 };
 
 // Sets the keys tied to the period in *o and returns them, each with its
@@ -83,7 +86,17 @@ struct GridPeriodKey {
 //  - line_index_footprint_gap_px = P, at most 16 (its limit: one period of
 //    empty pixels between the lines belongs to the footprint);
 //  - grid_line_radius_px = ceil(P / 2) + 1 (inside the grid's envelope
-//    every pixel is within half a period of a line).
+//    every pixel is within half a period of a line), but only where that
+//    does not widen it: a wider window also keeps matches on an object's
+//    outline beyond the envelope. docs/reconstruct.md widens it only where
+//    the grid-line test (no_grid_line) takes a visible share of the lit
+//    pixels, and that share, read on the plate tune measures, did not tell
+//    where widening helps: 0.01-0.03 % of the lit pixels per module on a
+//    34-line grating (seeds 1 and 2), where the rule's 7-8 px gained fill at
+//    the same std, against 0.23-1.99 % on a 3-module ring (P 11.4 px), where
+//    its 7 px raised a ball bar's std from 0.20 to 0.26 mm (session 49). So
+//    a wider value is left as rule_not_applied, the current one kept
+//    (docs/reconstruct.md, "Another projector", step 2).
 std::vector<GridPeriodKey> SetGridPeriodKeys(double period_px, MatchOptions* o);
 
 // How near a measured period may lie to a half pixel, px, before another

@@ -15,7 +15,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -200,7 +202,7 @@ TEST(GridPeriodKeys, ALongerPeriodScalesTheKeysByTheDocumentedRules) {
   EXPECT_EQ(o.line_index.max_shift_px, 18);                              // 1.5 P
   EXPECT_EQ(o.line_index.window_half_height_px, 6);                      // ceil((P - 1) / 2)
   EXPECT_EQ(o.line_index.footprint_gap_px, 12);                          // P
-  EXPECT_EQ(o.grid_line.radius_px, 7);                                   // ceil(P / 2) + 1
+  EXPECT_EQ(o.grid_line.radius_px, 5);  // ceil(P / 2) + 1 = 7 widens it: not applied (below)
   EXPECT_EQ(keys[1].key, "line_index_max_shift_px");
   EXPECT_EQ(keys[1].before, 12);
   EXPECT_NO_THROW(o.Check());
@@ -224,6 +226,40 @@ TEST(GridPeriodKeys, TheHalfPeriodKeyStopsAtTheDefaultGrids) {
     MatchOptions o;
     SetGridPeriodKeys(period_px, &o);
     EXPECT_EQ(o.grid_half_period_px, half_px) << period_px << " px";
+  }
+}
+
+// grid_line_radius_px follows ceil(P / 2) + 1 only where that does not
+// widen it: the plate's no_grid_line share did not tell where widening
+// helps (grid_period_options.h), so a wider value is only suggested.
+TEST(GridPeriodKeys, TheGridLineRadiusIsNarrowedByTheRuleButNotWidened) {
+  const auto radius_key = [](const std::vector<GridPeriodKey>& keys) {
+    const auto it =
+        std::find_if(keys.begin(), keys.end(), [](const GridPeriodKey& k) { return k.key == "grid_line_radius_px"; });
+    EXPECT_NE(it, keys.end());
+    return it == keys.end() ? GridPeriodKey{} : *it;
+  };
+  struct Case {
+    double period_px;
+    int radius_before_px;
+    int radius_after_px;
+    double suggested_px;  // rule_not_applied
+  };
+  for (const Case& c : std::vector<Case>{{12.15, 5, 5, 7},  // the 34-line grating: 7 suggested, 5 kept
+                                         {11.37, 5, 5, 7},  // the ring's median period
+                                         {12.7, 6, 6, 8},   // widening by any step is withheld
+                                         {12.15, 7, 7, 0},  // the rule's own value: unchanged
+                                         {12.15, 9, 7, 0},  // wider than the rule: narrowed to it
+                                         {8.07, 5, 5, 0},   // the default grid: the default
+                                         {kMaxGridPeriodPx, 5, 5, 22}}) {
+    MatchOptions o;
+    o.grid_line.radius_px = c.radius_before_px;
+    const GridPeriodKey k = radius_key(SetGridPeriodKeys(c.period_px, &o));
+    const std::string at = std::to_string(c.period_px) + " px from " + std::to_string(c.radius_before_px);
+    EXPECT_EQ(o.grid_line.radius_px, c.radius_after_px) << at;
+    EXPECT_EQ(k.value, c.radius_after_px) << at;
+    EXPECT_EQ(k.before, c.radius_before_px) << at;
+    EXPECT_EQ(k.rule_not_applied, c.suggested_px) << at;
   }
 }
 

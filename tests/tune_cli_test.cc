@@ -25,8 +25,11 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <regex>
 #include <thread>
+
+#include <nlohmann/json.hpp>
 
 #include "datasets/simulate.h"
 #include "reconstruct/grid_period_options.h"
@@ -198,8 +201,9 @@ TEST_F(TuneCli, ACurvedCaptureIsWarnedOfAndThePlateIsNot) {
 }
 
 // A coarser grating: the keys follow docs/reconstruct.md's rules from P to
-// the nearest pixel, the other keys of --options stay, and `reconstruct`
-// takes the file.
+// the nearest pixel (grid_line_radius_px only where that does not widen it:
+// WideningTheGridLineRadiusIsOnlySuggested), the other keys of --options
+// stay, and `reconstruct` takes the file.
 TEST_F(TuneCli, ACoarserGridSetsTheKeysByTheRulesAndKeepsTheOthers) {
   const std::string base = dir_ + "/base.yaml", out = dir_ + "/coarse.yaml";
   std::ofstream(base) << "# the line's own settings\nobject_size_mm: 80\nmatch:\n  min_zncc: 0.85\n";
@@ -215,7 +219,7 @@ TEST_F(TuneCli, ACoarserGridSetsTheKeysByTheRulesAndKeepsTheOthers) {
   EXPECT_EQ(read.match.line_index.max_shift_px, std::lround(1.5 * p));
   EXPECT_EQ(read.match.line_index.window_half_height_px, std::ceil((p - 1) / 2.0));
   EXPECT_EQ(read.match.line_index.footprint_gap_px, p);
-  EXPECT_EQ(read.match.grid_line.radius_px, std::ceil(p / 2.0) + 1);
+  EXPECT_EQ(read.match.grid_line.radius_px, MatchOptions{}.grid_line.radius_px);
   std::ifstream in(out);
   std::string first;
   std::getline(in, first);
@@ -224,6 +228,57 @@ TEST_F(TuneCli, ACoarserGridSetsTheKeysByTheRulesAndKeepsTheOthers) {
       testing::RunCli("reconstruct --rig " + dir_ + "/coarse/truth/rig.yaml --capture " + dir_ +
                       "/coarse/scenes/plate/active --options " + out + " --out " + dir_ + "/coarse.ply");
   EXPECT_EQ(rec.code, 0) << rec.err;
+}
+
+// The rule's grid_line_radius_px, ceil(P / 2) + 1, is 7-8 px on the 34-line
+// plate (P 12.7-12.8 px), wider than the default 5: on a 3-module ring such
+// a radius raised a ball bar's std, and the plate's no_grid_line share did
+// not tell where it helps (grid_period_options.h). So tune keeps the
+// radius of --options, prints the rule's value and why, names it in the
+// file's header, and prints each module's no_grid_line share: the same
+// count `reconstruct --report` gives for the capture with the same options
+// (lit_pixels_by_status), to the 0.005 % its two decimals round to. A radius
+// of --options wider than the rule's is narrowed to it, as before.
+TEST_F(TuneCli, WideningTheGridLineRadiusIsOnlySuggested) {
+  const std::string out = dir_ + "/coarse_radius.yaml", report = dir_ + "/coarse_plate.json";
+  const testing::Result r = testing::RunCli(Tune("coarse", "--out " + out));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const long p = std::lround(P(r.out));
+  const std::string rule = std::to_string((p + 1) / 2 + 1);
+  const MatchOptions defaults;
+  ASSERT_GT(std::stol(rule), defaults.grid_line.radius_px) << "the rule would widen it";
+  EXPECT_EQ(ReadRuntimeOptions(out).match.grid_line.radius_px, defaults.grid_line.radius_px);
+  EXPECT_TRUE(std::regex_search(
+      r.out, std::regex(R"(match\.grid_line_radius_px +5  \(kept: the rule gives )" + rule + R"(, not applied\))")))
+      << r.out;
+  EXPECT_NE(r.out.find("set match.grid_line_radius_px: " + rule + " and verify"), std::string::npos) << r.out;
+  std::ifstream in(out);
+  const std::string file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(file.find("# match.grid_line_radius_px was kept at 5: the rule gives " + rule + ", not applied"),
+            std::string::npos)
+      << file;
+
+  const std::vector<double> shares =
+      Numbers(r.out, R"(the grid-line test refused ([0-9.]+) % of its grid-lit pixels \(no_grid_line\))");
+  ASSERT_EQ(shares.size(), 2u) << r.out;
+  const testing::Result rec =
+      testing::RunCli("reconstruct --rig " + dir_ + "/coarse/truth/rig.yaml --capture " + dir_ +
+                      "/coarse/scenes/plate/active --out " + dir_ + "/coarse_plate.ply --report " + report);
+  ASSERT_EQ(rec.code, 0) << rec.err;
+  const nlohmann::json modules = nlohmann::json::parse(std::ifstream(report))["modules"];
+  ASSERT_EQ(modules.size(), 2u);
+  for (size_t m = 0; m < 2; ++m) {
+    const nlohmann::json& by_status = modules[m]["lit_pixels_by_status"];
+    const double refused = by_status.contains("no_grid_line") ? by_status["no_grid_line"].get<double>() : 0;
+    EXPECT_NEAR(shares[m], 100 * refused / modules[m]["lit_pixels"].get<double>(), 0.005) << "module " << m;
+  }
+
+  const std::string wide = dir_ + "/wide_radius.yaml", narrowed = dir_ + "/coarse_narrowed.yaml";
+  std::ofstream(wide) << "match:\n  grid_line_radius_px: 11\n";
+  const testing::Result n = testing::RunCli(Tune("coarse", "--options " + wide + " --out " + narrowed));
+  ASSERT_EQ(n.code, 0) << n.err;
+  EXPECT_EQ(ReadRuntimeOptions(narrowed).match.grid_line.radius_px, std::stol(rule));
+  EXPECT_NE(n.out.find("(was 11)"), std::string::npos) << n.out;
 }
 
 // --options as a pipe (`<(printf ...)`, /dev/stdin) is read once: its keys
