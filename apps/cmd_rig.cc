@@ -113,13 +113,16 @@ void PrintAgainstTruth(const Rig& rig, const Rig& truth, const Rig& truth_file, 
     std::printf("  module %d: 3D error after rigid alignment %.4f mm over %zu points; baseline %.4f mm (truth %.4f)\n",
                 k, RigidAlignedRms(p_true, p_cal), p_cal.size(), rig.module(k).right_from_left.DistanceMm(),
                 truth.module(k).right_from_left.DistanceMm());
-    // A volume mostly outside the module's view judges it where it does not
+    // A volume partly outside the module's view judges it where it does not
     // measure (a rig working at 300 mm judged at the default 200 mm: 185 of
-    // 847 points), and those few points are the view's edge.
-    if (2 * p_cal.size() < points.size())
+    // 847 points), and those points are the view's edge: the 3D error reads
+    // higher there (a ring's side modules, 561 and 594 of 847 points: 0.0027
+    // mm against 0.0018 mm in their own volume). Within its working volume a
+    // module sees nearly all (the demo's calibrated rig: 776 and 799).
+    if (5 * p_cal.size() < 4 * points.size())
       std::printf(
-          "    (module %d's two cameras see only %zu of the %zu points: is --distance, %.0f mm, where this rig "
-          "measures?)\n",
+          "    (module %d's two cameras see only %zu of the %zu points: the volume is centred --distance, %.0f mm, "
+          "ahead of module 0: is that where this rig measures?)\n",
           k, p_cal.size(), points.size(), distance_mm);
   }
   for (int i = 0; i < rig.num_modules(); ++i)
