@@ -121,9 +121,9 @@ void PrintAgainstTruth(const Rig& rig, const Rig& truth, const Rig& truth_file, 
     // module sees nearly all (the demo's calibrated rig: 776 and 799).
     if (5 * p_cal.size() < 4 * points.size())
       std::printf(
-          "    (module %d's two cameras see only %zu of the %zu points: the volume is centred --distance, %.0f mm, "
-          "ahead of module 0: is that where this rig measures?)\n",
-          k, p_cal.size(), points.size(), distance_mm);
+          "    (module %d's two cameras see only %zu of the %zu points of the %.0f x %.0f x %.0f mm volume centred "
+          "%.0f mm ahead of module 0: are --distance and --volume where this rig measures?)\n",
+          k, p_cal.size(), points.size(), size_mm.x(), size_mm.y(), size_mm.z(), distance_mm);
   }
   for (int i = 0; i < rig.num_modules(); ++i)
     for (int j = i + 1; j < rig.num_modules(); ++j) {

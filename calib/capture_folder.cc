@@ -559,20 +559,20 @@ std::vector<std::string> StereoViewsLeftOutNotes(const CalibrationReport& report
         char text[48];
         std::snprintf(text, sizeof text, " (board tilted %.0f deg)", tilt_deg);
         views += text;
-        edge_on += tilt_deg >= kEdgeOnTiltDeg;
+        // Judged as printed: a tilt that reads "70 deg" is edge-on.
+        edge_on += std::round(tilt_deg) >= kEdgeOnTiltDeg;
       }
     }
     const int n = int(s.views_left_out.size());
     // A swapped pair's images show ordinary tilts (each is a real view, of
     // the other camera); a ring's side views show the board nearly edge-on.
     const std::string why =
-        edge_on == n ? "boards seen nearly edge-on, their corners foreshortened: usual where a module sees the "
-                       "board from the side, as in a ring; the module's other views fix it"
-        : edge_on == 0
-            ? "images of another camera or capture, such as a module's left and right swapped?"
-            : "those tilted past " + std::to_string(int(kEdgeOnTiltDeg)) +
-                  " deg seen nearly edge-on; the others images of another camera or capture, such as a module's "
-                  "left and right swapped?";
+        edge_on == n   ? "boards seen nearly edge-on, their corners foreshortened: usual where a module sees the "
+                         "board from the side, as in a ring; the module's other views fix it"
+        : edge_on == 0 ? "images of another camera or capture, such as a module's left and right swapped?"
+                       : "those tilted " + std::to_string(int(kEdgeOnTiltDeg)) + " deg or more" +
+                             " seen nearly edge-on; the others images of another camera or capture, such as a module's "
+                             "left and right swapped?";
     notes.push_back("module " + std::to_string(s.module) + " (" + s.module_name + "): stage 2 left out " + views +
                     ": outlier rejection left too few of their corners to fix the board's pose (" + why + ")");
   }

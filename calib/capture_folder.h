@@ -118,7 +118,8 @@ std::string NeverSeenCornersNote(const std::vector<BoardObservation>& observatio
 std::string CamerasLeftOutNote(const std::string& dir, int num_cameras);
 
 // A board stage 1 solved tilted at least this far from facing the camera
-// (TiltDeg) is seen nearly edge-on: 1 / cos 70 deg = 2.9x foreshortened.
+// (TiltDeg, rounded to the degree the note prints) is seen nearly edge-on:
+// 1 / cos 70 deg = 2.9x foreshortened.
 inline constexpr double kEdgeOnTiltDeg = 70.0;
 
 // One warning per module whose joint solve left views out

@@ -137,9 +137,17 @@ TEST(StereoViewsLeftOutNotes, NameTheBoardsTiltAndTellEdgeOnViewsFromSwappedImag
   const std::vector<std::string> mixed = StereoViewsLeftOutNotes(report);
   ASSERT_EQ(mixed.size(), 1u);
   EXPECT_NE(mixed[0].find("045/cam3.png:"), std::string::npos) << mixed[0];  // no tilt to give
-  EXPECT_NE(mixed[0].find("(those tilted past 70 deg seen nearly edge-on; the others images of another camera"),
+  EXPECT_NE(mixed[0].find("(those tilted 70 deg or more seen nearly edge-on; the others images of another camera"),
             std::string::npos)
       << mixed[0];
+
+  // Judged as printed: 69.6 deg reads "70 deg", and is edge-on.
+  report.stereo[0].views_left_out = {{31, 3}};
+  report.stereo[0].views_left_out_tilt_deg = {69.6};
+  const std::vector<std::string> at_the_bound = StereoViewsLeftOutNotes(report);
+  ASSERT_EQ(at_the_bound.size(), 1u);
+  EXPECT_NE(at_the_bound[0].find("031/cam3.png (board tilted 70 deg): "), std::string::npos) << at_the_bound[0];
+  EXPECT_NE(at_the_bound[0].find("(boards seen nearly edge-on"), std::string::npos) << at_the_bound[0];
 
   report.stereo[0].views_left_out.clear();
   report.stereo[0].views_left_out_tilt_deg.clear();

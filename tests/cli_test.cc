@@ -345,8 +345,8 @@ TEST(Cli, RigAgainstTruthGivesZeroForItselfAndTheShiftOfAMovedModule) {
   EXPECT_EQ(r.out.find("see only"), std::string::npos) << r.out;
   r = RunCli("rig --rig " + truth_path + " --truth " + truth_path + " --distance 100");
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("(module 0's two cameras see only 36 of the 847 points: the volume is centred --distance, 100 "
-                       "mm, ahead of module 0: is that where this rig measures?)"),
+  EXPECT_NE(r.out.find("(module 0's two cameras see only 36 of the 847 points of the 75 x 75 x 50 mm volume centred "
+                       "100 mm ahead of module 0: are --distance and --volume where this rig measures?)"),
             std::string::npos)
       << r.out;
   // Two thirds seen (572 of 847 points, measured, 170 mm ahead) is said too:
