@@ -2,9 +2,14 @@
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <functional>
 #include <iostream>
 #include <stdexcept>
 #include <string>
@@ -110,6 +115,119 @@ TEST(ScopedStderrCapture, GivesStderrBackOnAnExceptionAndKeepsAnUnfinishedLine) 
   }
   std::fprintf(stderr, "|after\n");
   EXPECT_EQ(::testing::internal::GetCapturedStderr(), "kept: no newline|after\n");
+}
+
+struct ChildEnd {
+  std::string err;  // all the child wrote on fd 2
+  int status = 0;   // as waitpid gives it
+};
+
+// Runs `body` in a forked child whose fd 2 is a pipe read here, as a
+// terminal would see it: the child ends inside `body` (exit, abort, a
+// signal), so whatever its stderr shows was written before it went.
+ChildEnd RunChild(const std::function<void()>& body) {
+  ChildEnd end;
+  int fds[2];
+  if (pipe(fds) != 0) return end;
+  std::fflush(nullptr);  // nothing of ours written twice
+  const pid_t pid = fork();
+  if (pid == 0) {
+    close(fds[0]);
+    dup2(fds[1], STDERR_FILENO);
+    close(fds[1]);
+    body();
+    _exit(99);  // body did not end the child
+  }
+  close(fds[1]);
+  char buf[4096];
+  for (ssize_t n; (n = read(fds[0], buf, sizeof buf)) != 0;) {
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) break;
+    end.err.append(buf, static_cast<size_t>(n));
+  }
+  close(fds[0]);
+  waitpid(pid, &end.status, 0);
+  return end;
+}
+
+// A library that ends the process inside the scope (libdogleg calls exit(),
+// libmrcal asserts) or a Ctrl-C meanwhile: the held lines are what says why,
+// so they come out, all of them (no filter runs there), and the process ends
+// as it would have without the scope.
+void PrintsThenEnds(const std::function<void()>& end) {
+  ScopedStderrCapture capture(IsNoise);
+  std::fprintf(stderr, "noise: going again\n");
+  std::fprintf(stderr, "kept: ASSERTION FAILED: isfinite(ctx->lambda) is not true\n");
+  end();
+}
+
+constexpr char kHeld[] = "noise: going again\nkept: ASSERTION FAILED: isfinite(ctx->lambda) is not true\n";
+
+TEST(ScopedStderrCapture, ExitInsideTheScopeWritesTheHeldLinesAndKeepsTheExitCode) {
+  const ChildEnd end = RunChild([] { PrintsThenEnds([] { std::exit(3); }); });
+  EXPECT_EQ(end.err, kHeld);
+  ASSERT_TRUE(WIFEXITED(end.status)) << end.status;
+  EXPECT_EQ(WEXITSTATUS(end.status), 3);
+}
+
+TEST(ScopedStderrCapture, AbortInsideTheScopeWritesTheHeldLinesAndStillAborts) {
+  const ChildEnd end = RunChild([] { PrintsThenEnds([] { std::abort(); }); });
+  EXPECT_EQ(end.err, kHeld);
+  ASSERT_TRUE(WIFSIGNALED(end.status)) << end.status;
+  EXPECT_EQ(WTERMSIG(end.status), SIGABRT);
+}
+
+TEST(ScopedStderrCapture, InterruptOrTerminateInsideTheScopeWritesTheHeldLinesAndStillEnds) {
+  for (const int signal : {SIGINT, SIGTERM}) {
+    const ChildEnd end = RunChild([signal] { PrintsThenEnds([signal] { std::raise(signal); }); });
+    EXPECT_EQ(end.err, kHeld) << signal;
+    ASSERT_TRUE(WIFSIGNALED(end.status)) << signal << " " << end.status;
+    EXPECT_EQ(WTERMSIG(end.status), signal);
+  }
+}
+
+// A process that ignores Ctrl-C (started under nohup, say) goes on ignoring it
+// inside the scope: no handler of the scope's takes its place (one would give
+// the held lines out there and then, the noise too).
+TEST(ScopedStderrCapture, AnIgnoredSignalStaysIgnored) {
+  const ChildEnd end = RunChild([] {
+    std::signal(SIGINT, SIG_IGN);
+    {
+      ScopedStderrCapture capture(IsNoise);
+      std::fprintf(stderr, "noise: going again\nkept: solved\n");
+      std::raise(SIGINT);
+    }
+    std::exit(5);
+  });
+  EXPECT_EQ(end.err, "kept: solved\n");
+  ASSERT_TRUE(WIFEXITED(end.status)) << end.status;
+  EXPECT_EQ(WEXITSTATUS(end.status), 5);
+}
+
+// Nested, the inner scope's lines go to the outer's file first, then all of
+// it out, in the order written.
+TEST(ScopedStderrCapture, ExitInsideNestedScopesWritesBothScopesLinesInOrder) {
+  const ChildEnd end = RunChild([] {
+    ScopedStderrCapture outer(IsNoise);
+    std::fprintf(stderr, "kept: outer\n");
+    ScopedStderrCapture inner(IsNoise);
+    std::fprintf(stderr, "kept: inner\n");
+    std::exit(1);
+  });
+  EXPECT_EQ(end.err, "kept: outer\nkept: inner\n");
+  ASSERT_TRUE(WIFEXITED(end.status)) << end.status;
+  EXPECT_EQ(WEXITSTATUS(end.status), 1);
+}
+
+// Outside any scope the handlers are gone again: a Ctrl-C after a solve ends
+// the process the way it would have (here: the test's own handler runs).
+TEST(ScopedStderrCapture, LeavesTheSignalDispositionsAsItFoundThem) {
+  struct sigaction before {};
+  sigaction(SIGINT, nullptr, &before);
+  { ScopedStderrCapture capture(IsNoise); }
+  struct sigaction after {};
+  sigaction(SIGINT, nullptr, &after);
+  EXPECT_EQ(after.sa_handler, before.sa_handler);
 }
 
 }  // namespace

@@ -141,8 +141,9 @@ TEST(CalibrateCli, RenderedCapturesToRigFileAndReport) {
       << r.out;
   std::printf("%s", r.out.c_str());
   EXPECT_NE(r.err.find("detect 000"), std::string::npos);  // progress
-  // stderr carries our words only: libmrcal's outlier loop printed "mrcal.c(5351): Threw out some outliers (have a
-  // total of 1737 now); going again" there, its total the unseen corners too, beside the summary's outlier count.
+  // libmrcal's outlier-loop lines are kept off stderr: "mrcal.c(5351): Threw out some outliers (have a total of 1737
+  // now); going again", its total the unseen corners too, beside the summary's outlier count. (Anything else the
+  // libraries print, a libdogleg CHOLMOD warning say, still comes through.)
   EXPECT_EQ(r.err.find("mrcal.c("), std::string::npos) << r.err;
   EXPECT_NE(r.out.find(" outliers, coverage "), std::string::npos) << r.out;
   const Rig rig = ReadRigFile(set.dir + "/rig.yaml");
