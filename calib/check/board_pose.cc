@@ -1,8 +1,5 @@
 #include "calib/check/board_pose.h"
 
-#include <algorithm>
-#include <cmath>
-
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
@@ -124,26 +121,12 @@ PredictionStatistics PredictionErrorStatistics(const Rig& rig, const Target& tar
     a += j.transpose() * j;
   }
   const Eigen::Matrix<double, 6, 6> a_sigma = a * covariance;
-  const Eigen::Matrix<double, 6, 6> a_sigma_2 = a_sigma * a_sigma;
-  return {a_sigma.trace(), 2.0 * a_sigma_2.trace(), 8.0 * (a_sigma_2 * a_sigma).trace()};
+  return {a_sigma.trace(), 2.0 * (a_sigma * a_sigma).trace()};
 }
 
-double SumOfSquaresCumulants::UpperQuantilePx2(double z) const {
-  const double sd = std::sqrt(std::max(var_px4, 0.0));
-  if (!(third_px6 > 0) || !(sd > 0)) return mean_px2 + z * sd;
-  // mean + sd (chi2_h - h) / sqrt(2 h) has these three cumulants.
-  const double h = 8.0 * std::pow(var_px4, 3) / (third_px6 * third_px6);
-  const double a = 2.0 / (9.0 * h);
-  const double chi2_h = h * std::pow(std::max(0.0, 1.0 - a + z * std::sqrt(a)), 3.0);
-  return mean_px2 + sd * (chi2_h - h) / std::sqrt(2.0 * h);
-}
-
-SumOfSquaresCumulants ViewPredictionCumulants(int num_corners, double noise_px, const PredictionStatistics& pose) {
+PredictionStatistics ViewPredictionStatistics(int num_corners, double noise_px, const PredictionStatistics& pose) {
   const double s2 = noise_px * noise_px, m = 2.0 * num_corners;
-  // tr((A Sigma)^p) for p = 1, 2, 3.
-  const double mu1 = pose.mean_ss_px2, mu2 = pose.var_ss_px4 / 2, mu3 = pose.third_ss_px6 / 8;
-  return {m * s2 + mu1, 2.0 * (m * s2 * s2 + 2 * s2 * mu1 + mu2),
-          8.0 * (m * s2 * s2 * s2 + 3 * s2 * s2 * mu1 + 3 * s2 * mu2 + mu3)};
+  return {m * s2 + pose.mean_ss_px2, 2 * m * s2 * s2 + 4 * s2 * pose.mean_ss_px2 + pose.var_ss_px4};
 }
 
 std::vector<Eigen::Vector2d> ReprojectionErrors(const Rig& rig, const Target& target, const BoardObservation& view,

@@ -45,49 +45,29 @@ Eigen::Matrix<double, 6, 6> BoardPoseCovariance(const Rig& rig, const Target& ta
 // covariance Sigma is the sum of each source's (BoardPoseCovariance). With
 // J_k the 2x6 Jacobian of corner k's pixel by the pose and A = sum_k J_k^T
 // J_k, the sum over the view's corners of |prediction error|^2 is a
-// quadratic form in a 6-D Gaussian, sum_i mu_i chi2_1 with mu_i the
-// eigenvalues of A Sigma:
-//   mean = tr(A Sigma),  variance = 2 tr((A Sigma)^2),
-//   third cumulant = 8 tr((A Sigma)^3).
+// quadratic form in a 6-D Gaussian:
+//   mean = tr(A Sigma),  variance = 2 tr((A Sigma)^2).
 // All corners share one pose error, so this variance is far larger than that
-// of independent per-corner errors, and the sum is skewed as a chi-square of
-// few degrees of freedom is. The sources add in the pose, not in the sum:
-// two of them, each a variance v, give a sum of variance 4 v, not 2 v.
-// Jacobians are numeric (central differences on the pose's rotation vector
-// and translation).
+// of independent per-corner errors. The sources add in the pose, not in the
+// sum: two of them, each alone a variance v, give a sum of variance 4 v, not
+// 2 v (the cross term 4 tr(A Sigma_1 A Sigma_2)). Jacobians are numeric
+// (central differences on the pose's rotation vector and translation).
 struct PredictionStatistics {
   double mean_ss_px2 = 0;
   double var_ss_px4 = 0;
-  double third_ss_px6 = 0;  // third cumulant
 };
 PredictionStatistics PredictionErrorStatistics(const Rig& rig, const Target& target,
                                                const std::vector<const BoardObservation*>& pose_views,
                                                const std::vector<std::vector<double>>& sigma_px_sources,
                                                const BoardObservation& view, const Pose& ref_from_front);
 
-// The cumulants of a sum of squares of Gaussians (px^2, its mean, variance
-// and third cumulant; those of independent sums add), and the value it
-// exceeds with the one-sided tail probability of a Gaussian z-score. A sum
-// that one shared pose error dominates is skewed: mean + z standard
-// deviations is exceeded far more often than the Gaussian tail says (a
-// chi-square of 2 degrees of freedom: 3.5 standard deviations above its
-// mean with probability 1.1e-2, not 2.3e-4). The quantile matches the three
-// cumulants with a shifted and scaled chi-square of h = 8 k2^3 / k3^2
-// degrees of freedom (Pearson's approximation for quadratic forms), its
-// quantile by Wilson-Hilferty; with no skew, mean + z standard deviations.
-struct SumOfSquaresCumulants {
-  double mean_px2 = 0;
-  double var_px4 = 0;
-  double third_px6 = 0;
-  void Add(const SumOfSquaresCumulants& o) { mean_px2 += o.mean_px2, var_px4 += o.var_px4, third_px6 += o.third_px6; }
-  double UpperQuantilePx2(double z) const;
-};
-
-// The cumulants of sum_k |e_k + J_k delta|^2 over `num_corners` corners:
-// e_k each axis independent noise of variance noise_px^2, delta the pose
-// error of `pose` (independent of e). Its covariance's eigenvalues are
-// noise^2 + mu_i (the 6 of A Sigma) and noise^2 (2 n - 6 times).
-SumOfSquaresCumulants ViewPredictionCumulants(int num_corners, double noise_px, const PredictionStatistics& pose);
+// The mean and variance of sum_k |e_k + J_k delta|^2 over the `num_corners`
+// corners of a view: e_k each axis independent noise of variance
+// noise_px^2, delta the error of the pose it is predicted through
+// (`pose`, independent of e):
+//   mean = 2 n noise^2 + tr(A Sigma),
+//   variance = 4 n noise^4 + 4 noise^2 tr(A Sigma) + 2 tr((A Sigma)^2).
+PredictionStatistics ViewPredictionStatistics(int num_corners, double noise_px, const PredictionStatistics& pose);
 
 // A face's corner in the front-face frame.
 Eigen::Vector3d CornerInFront(const Target& target, Face face, int id);

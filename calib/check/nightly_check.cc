@@ -391,8 +391,7 @@ std::string LostCapturesText(const std::map<int, size_t>& given_captures, const 
 // share of a pose's error below keeps the camera's sigma.
 Consistency CameraConsistency(const Inputs& in, int c, const std::set<int>& trusted) {
   Consistency out;
-  double ss = 0;
-  SumOfSquaresCumulants expected;  // of ss on an unchanged rig
+  double ss = 0, expected_ss = 0, var_ss = 0;
   for (const auto& [capture, views] : in.by_capture) {
     std::vector<const BoardObservation*> mine, others;
     for (const BoardObservation* v : views) {
@@ -436,7 +435,9 @@ Consistency CameraConsistency(const Inputs& in, int c, const std::set<int>& trus
       // times its variance: seed 1016).
       const PredictionStatistics pose_error =
           PredictionErrorStatistics(in.rig, in.target, others, {pose_noise_px, in.sigma_px}, *v, pose.ref_from_front);
-      expected.Add(ViewPredictionCumulants(n, s_v, pose_error));
+      const PredictionStatistics view = ViewPredictionStatistics(n, s_v, pose_error);
+      expected_ss += view.mean_ss_px2;
+      var_ss += view.var_ss_px4;
     }
   }
   if (out.corners == 0) return out;
@@ -445,15 +446,10 @@ Consistency CameraConsistency(const Inputs& in, int c, const std::set<int>& trus
   // calibration) enters at k sigma.
   const double k = in.options.k_sigma;
   const double systematic = in.u_px[c];
-  // Threshold on the mean square: the value its H0 distribution exceeds
-  // with the tail probability of k standard deviations of a Gaussian, plus
-  // the systematic terms at k sigma. Not mean + k standard deviations: a
-  // figure one weak pose dominates is as skewed as a chi-square of 2 or 3
-  // degrees of freedom, which exceeds that ~1e-2 of the time, not 2.3e-4
-  // (module 1's stereo figure of seed 1016: 0.0537 px against 0.0512 on an
-  // unchanged rig, one view through a 31-corner pose holding 90 % of the
-  // figure's variance).
-  out.threshold_px = std::sqrt(expected.UpperQuantilePx2(k) / (2.0 * out.corners) + std::pow(k * systematic, 2));
+  // Threshold on the mean square: its H0 expectation plus k standard
+  // deviations, plus the systematic terms at k sigma.
+  out.threshold_px =
+      std::sqrt((expected_ss + k * std::sqrt(var_ss)) / (2.0 * out.corners) + std::pow(k * systematic, 2));
   return out;
 }
 
