@@ -108,9 +108,11 @@ Eigen::Matrix<double, 6, 6> BoardPoseCovariance(const Rig& rig, const Target& ta
 
 PredictionStatistics PredictionErrorStatistics(const Rig& rig, const Target& target,
                                                const std::vector<const BoardObservation*>& pose_views,
-                                               const std::vector<double>& sigma_px, const BoardObservation& view,
-                                               const Pose& ref_from_front) {
-  const Eigen::Matrix<double, 6, 6> covariance = BoardPoseCovariance(rig, target, pose_views, sigma_px, ref_from_front);
+                                               const std::vector<std::vector<double>>& sigma_px_sources,
+                                               const BoardObservation& view, const Pose& ref_from_front) {
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  for (const std::vector<double>& sigma_px : sigma_px_sources)
+    covariance += BoardPoseCovariance(rig, target, pose_views, sigma_px, ref_from_front);
   const Camera& cam = rig.camera(view.camera);
   const Pose cam_from_ref = rig.CamFromReference(view.camera);
   Eigen::Matrix<double, 6, 6> a = Eigen::Matrix<double, 6, 6>::Zero();
@@ -120,6 +122,11 @@ PredictionStatistics PredictionErrorStatistics(const Rig& rig, const Target& tar
   }
   const Eigen::Matrix<double, 6, 6> a_sigma = a * covariance;
   return {a_sigma.trace(), 2.0 * (a_sigma * a_sigma).trace()};
+}
+
+PredictionStatistics ViewPredictionStatistics(int num_corners, double noise_px, const PredictionStatistics& pose) {
+  const double s2 = noise_px * noise_px, m = 2.0 * num_corners;
+  return {m * s2 + pose.mean_ss_px2, 2 * m * s2 * s2 + 4 * s2 * pose.mean_ss_px2 + pose.var_ss_px4};
 }
 
 std::vector<Eigen::Vector2d> ReprojectionErrors(const Rig& rig, const Target& target, const BoardObservation& view,

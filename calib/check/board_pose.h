@@ -39,23 +39,35 @@ Eigen::Matrix<double, 6, 6> BoardPoseCovariance(const Rig& rig, const Target& ta
                                                 const std::vector<double>& sigma_px, const Pose& ref_from_front);
 
 // Linearised statistics of the prediction error that a pose's own
-// uncertainty puts on the corners of `view`. The pose was estimated from
-// `pose_views`, each corner with its camera's per-axis noise sigma_px[camera].
-// With J_k the 2x6 Jacobian of corner k's pixel by the pose, Sigma the pose
-// covariance and A = sum_k J_k^T J_k, the sum over the view's corners of
-// |prediction error|^2 is a quadratic form in a 6-D Gaussian:
+// uncertainty puts on the corners of `view`. The pose errs by independent
+// sources (tonight's corner noise, the calibration's own error), each a
+// per-camera noise sigma_px[camera] on the corners of `pose_views`: its
+// covariance Sigma is the sum of each source's (BoardPoseCovariance). With
+// J_k the 2x6 Jacobian of corner k's pixel by the pose and A = sum_k J_k^T
+// J_k, the sum over the view's corners of |prediction error|^2 is a
+// quadratic form in a 6-D Gaussian:
 //   mean = tr(A Sigma),  variance = 2 tr((A Sigma)^2).
 // All corners share one pose error, so this variance is far larger than that
-// of independent per-corner errors. Jacobians are numeric (central
-// differences on the pose's rotation vector and translation).
+// of independent per-corner errors. The sources add in the pose, not in the
+// sum: two of them, each alone a variance v, give a sum of variance 4 v, not
+// 2 v (the cross term 4 tr(A Sigma_1 A Sigma_2)). Jacobians are numeric
+// (central differences on the pose's rotation vector and translation).
 struct PredictionStatistics {
   double mean_ss_px2 = 0;
   double var_ss_px4 = 0;
 };
 PredictionStatistics PredictionErrorStatistics(const Rig& rig, const Target& target,
                                                const std::vector<const BoardObservation*>& pose_views,
-                                               const std::vector<double>& sigma_px, const BoardObservation& view,
-                                               const Pose& ref_from_front);
+                                               const std::vector<std::vector<double>>& sigma_px_sources,
+                                               const BoardObservation& view, const Pose& ref_from_front);
+
+// The mean and variance of sum_k |e_k + J_k delta|^2 over the `num_corners`
+// corners of a view: e_k each axis independent noise of variance
+// noise_px^2, delta the error of the pose it is predicted through
+// (`pose`, independent of e):
+//   mean = 2 n noise^2 + tr(A Sigma),
+//   variance = 4 n noise^4 + 4 noise^2 tr(A Sigma) + 2 tr((A Sigma)^2).
+PredictionStatistics ViewPredictionStatistics(int num_corners, double noise_px, const PredictionStatistics& pose);
 
 // A face's corner in the front-face frame.
 Eigen::Vector3d CornerInFront(const Target& target, Face face, int id);

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
@@ -1527,6 +1528,71 @@ TEST(NightlyCheck, ARigScaleChangeTheSolidMissesByAHairIsNotSaidAsTheBoardsPrint
   EXPECT_EQ(r.Explanation().find("the rig's scale against the board's changed"), 0u) << r.Explanation();
   EXPECT_NE(r.Explanation().find("it cannot tell which"), std::string::npos) << r.Explanation();
   EXPECT_EQ(r.FlaggedModules(), (std::vector<int>{0, 1})) << r.Explanation();
+}
+
+// The consistency figures' statistics for a view predicted through a weak
+// pose (board_pose.h): module 0's cam1 sees the board's first three rows (33
+// corners), cam0 all of it, read through cam1's pose (as seed 1016 of the
+// rendered nights: 99 corners through a 31-corner pose). The pose errs by
+// two independent sources (tonight's noise, the calibration's error), each
+// a noise on cam1's corners: drawn here as one noise of their summed
+// variance. 20 000 draws of the sum of squares of cam0's prediction errors:
+// its mean and variance are the statistics' (within 4 standard errors; the
+// variance's own from the draws' fourth moment: 1.06 px^4 against 1.05),
+// where the two sources' variances added as sums of their own, as the check
+// did, read 0.61 px^4.
+TEST(NightlyCheck, AWeakPosesPredictionErrorHasTheVarianceOfItsSourcesAddedInThePose) {
+  const SimulatedRig truth = MakeDefaultRig();
+  const Target target = DefaultTarget();
+  const Rig& rig = truth.rig;
+  const Eigen::Vector3d center((target.corners_x() - 1) * 0.5 * target.square_size_mm(),
+                               (target.corners_y() - 1) * 0.5 * target.square_size_mm(), 0);
+  const Pose ref_from_front = truth.world_from_module0.Inverse() *
+                              Pose::FromRotationVector(Eigen::Vector3d(0.2, -0.15, 0.1), Eigen::Vector3d(5, -5, 0)) *
+                              Pose(Eigen::Matrix3d::Identity(), -center);
+  auto ideal = [&](int c, int rows) {
+    BoardObservation v{0, c, Face::kFront, {}, {}};
+    const Pose cam_from_front = rig.CamFromReference(c) * ref_from_front;
+    for (int id = 0; id < rows * target.corners_x(); ++id) {
+      v.corner_ids.push_back(id);
+      v.q_px.push_back(rig.camera(c).Project(cam_from_front * target.CornerInFace(id)));
+    }
+    return v;
+  };
+  const BoardObservation pose_view = ideal(1, 3), view = ideal(0, target.corners_y());
+  const double tonight_px = 0.03, calibration_px = 0.02, view_px = 0.03;
+  const int n = static_cast<int>(view.corner_ids.size());
+  const std::vector<double> tonight(rig.num_cameras(), tonight_px), calibration(rig.num_cameras(), calibration_px);
+  const PredictionStatistics expected = ViewPredictionStatistics(
+      n, view_px, PredictionErrorStatistics(rig, target, {&pose_view}, {tonight, calibration}, view, ref_from_front));
+  // As the check summed them before: each source's sum of squares alone.
+  const PredictionStatistics t = PredictionErrorStatistics(rig, target, {&pose_view}, {tonight}, view, ref_from_front);
+  const PredictionStatistics c =
+      PredictionErrorStatistics(rig, target, {&pose_view}, {calibration}, view, ref_from_front);
+  const double summed_var = 2 * n * 2 * std::pow(view_px, 4) + t.var_ss_px4 + c.var_ss_px4 +
+                            4 * view_px * view_px * (t.mean_ss_px2 + c.mean_ss_px2);
+
+  std::mt19937 rng(7);
+  std::normal_distribution<double> pose_noise(0, std::hypot(tonight_px, calibration_px)), noise(0, view_px);
+  const int draws = 20000;
+  std::vector<double> ss_drawn;
+  for (int d = 0; d < draws; ++d) {
+    BoardObservation p = pose_view, v = view;
+    for (Eigen::Vector2d& q : p.q_px) q += Eigen::Vector2d(pose_noise(rng), pose_noise(rng));
+    for (Eigen::Vector2d& q : v.q_px) q += Eigen::Vector2d(noise(rng), noise(rng));
+    const BoardPoseEstimate fit = EstimateBoardPose(rig, target, {&p}, &ref_from_front);
+    ASSERT_TRUE(fit.ok);
+    double ss = 0;
+    for (const Eigen::Vector2d& e : ReprojectionErrors(rig, target, v, fit.ref_from_front)) ss += e.squaredNorm();
+    ss_drawn.push_back(ss);
+  }
+  double mean = 0, sum2 = 0, sum4 = 0;
+  for (double ss : ss_drawn) mean += ss / draws;
+  for (double ss : ss_drawn) sum2 += std::pow(ss - mean, 2), sum4 += std::pow(ss - mean, 4);
+  const double var = sum2 / (draws - 1), var_se = std::sqrt((sum4 / draws - var * var) / draws);
+  EXPECT_NEAR(mean, expected.mean_ss_px2, 4 * std::sqrt(var / draws));
+  EXPECT_NEAR(var, expected.var_ss_px4, 4 * var_se);
+  EXPECT_LT(summed_var, var - 4 * var_se);
 }
 
 }  // namespace
