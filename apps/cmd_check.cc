@@ -12,6 +12,7 @@
 #include "apps/command.h"
 #include "apps/output_paths.h"
 #include "calib/capture_folder.h"
+#include "calib/check/board_pose.h"
 #include "calib/check/check_target.h"
 #include "calib/check/history.h"
 #include "calib/check/nightly_check.h"
@@ -43,10 +44,14 @@ void RejectCamerasBeyondTheRig(const std::string& captures, int num_cameras) {
     if (it.depth() >= 2) it.disable_recursion_pending();
     const std::optional<int> camera = CameraIndexOfImageName(it->path().filename().string());
     if (camera && *camera >= num_cameras) {
+      // The rig's cameras are numbered from 0: "camera 4, but the rig has 4
+      // cameras" read as a contradiction.
       throw InputError(it->path().string(),
                        (*camera == kCameraIndexBeyondAnyRig ? std::string("a camera index beyond any rig")
                                                             : "camera " + std::to_string(*camera)) +
-                           ", but the rig has " + std::to_string(num_cameras) + " cameras: captures from another rig?");
+                           ", but the rig has " + std::to_string(num_cameras) + " cameras, cam0.png" +
+                           (num_cameras > 1 ? " to cam" + std::to_string(num_cameras - 1) + ".png" : "") +
+                           " (numbered from 0): captures from another rig?");
     }
   }
 }
@@ -94,6 +99,90 @@ std::string CapturesCrc32Hex(const std::string& captures) {
       crc = Crc32Update(crc, buffer.data(), size_t(in.gcount()));
   }
   return Crc32Text(crc);
+}
+
+// RunNightlyCheck, and where the captures fit the rig not at all, whether
+// they fit it with the cameras' images exchanged: a module's cables swapped
+// with another's (cam0<->cam2, cam1<->cam3) or cameras rotated three ways
+// read "captures of another rig, or the wrong rig file or target file?",
+// while the detection showed each module seeing the other's face of the
+// board. On that refusal only, the exchanges of the cameras' images (up to 4
+// cameras: 23; more are not tried) that leave each module's two cameras on
+// one face of the board in every capture both see it are ranked by how well
+// each capture then fits one board pose, the best two checked, and one under
+// which every figure is within its threshold named instead of the guess. SwappedCameras (nightly_check.cc) names two
+// cameras exchanged before this.
+CheckResult RunCheckNamingExchangedImages(const Rig& rig, const Target& target, const DetectedCaptures& detected,
+                                          const CheckOptions& options, const std::string& captures) {
+  try {
+    return RunNightlyCheck(rig, target, detected.observations, options, captures, detected.capture_names);
+  } catch (const InputError& e) {
+    const int n = rig.num_cameras();
+    const size_t guess = e.problem().find(": captures of another rig");
+    if (e.problem().rfind("the captures do not fit this rig at all", 0) != 0 || guess == std::string::npos || n > 4)
+      throw;
+    std::map<std::pair<int, int>, Face> face;  // (capture, camera) -> the face it saw
+    std::vector<int> fronts(n, 0), backs(n, 0);
+    for (const BoardObservation& v : detected.observations) {
+      face[{v.capture, v.camera}] = v.face;
+      ++(v.face == Face::kFront ? fronts : backs)[v.camera];
+    }
+    std::vector<int> module_of(n, -1);
+    for (int m = 0; m < rig.num_modules(); ++m)
+      module_of[rig.module(m).left_camera] = module_of[rig.module(m).right_camera] = m;
+    // The exchanges in order of how well each capture's views, so
+    // exchanged, fit one board pose (the median of the captures' RMS): only
+    // the best two are checked whole.
+    std::vector<std::pair<double, std::vector<int>>> candidates;
+    std::vector<int> as(n);  // camera c's images are camera as[c]'s
+    for (int c = 0; c < n; ++c) as[c] = c;
+    while (std::next_permutation(as.begin(), as.end())) {
+      bool one_face = true;  // each module's two cameras, as exchanged, on one face
+      for (int a = 0; a < n && one_face; ++a)
+        for (int b = 0; b < n && one_face; ++b)
+          for (int capture = 0; a != b && capture < detected.num_captures && one_face; ++capture)
+            if (module_of[as[a]] == module_of[as[b]] && face.count({capture, a}) && face.count({capture, b}))
+              one_face = face.at({capture, a}) == face.at({capture, b});
+      if (!one_face) continue;
+      std::vector<BoardObservation> views = detected.observations;
+      for (BoardObservation& v : views) v.camera = as[v.camera];
+      std::map<int, std::vector<const BoardObservation*>> by_capture;
+      for (const BoardObservation& v : views) by_capture[v.capture].push_back(&v);
+      std::vector<double> rms_px;
+      for (const auto& [capture, vs] : by_capture) {
+        if (vs.size() < 2) continue;
+        const BoardPoseEstimate pose = EstimateBoardPose(rig, target, vs);
+        rms_px.push_back(pose.ok ? pose.rms_px : 1e9);
+      }
+      if (rms_px.empty()) continue;
+      std::nth_element(rms_px.begin(), rms_px.begin() + rms_px.size() / 2, rms_px.end());
+      candidates.push_back({rms_px[rms_px.size() / 2], as});
+    }
+    std::sort(candidates.begin(), candidates.end());
+    for (size_t k = 0; k < std::min<size_t>(candidates.size(), 2); ++k) {
+      as = candidates[k].second;
+      std::vector<BoardObservation> views = detected.observations;
+      for (BoardObservation& v : views) v.camera = as[v.camera];
+      try {
+        if (!RunNightlyCheck(rig, target, views, options, captures, detected.capture_names).ok()) continue;
+      } catch (const InputError&) {
+        continue;
+      }
+      std::string exchanged, seen;
+      for (int c = 0; c < n; ++c) {
+        if (as[c] != c)
+          exchanged += (exchanged.empty() ? "" : ", ") + CameraImageName(c) + " is cam" + std::to_string(as[c]) + "'s";
+        if (fronts[c] + backs[c] > 0)
+          seen += (seen.empty() ? "cam" : ", cam") + std::to_string(c) + (fronts[c] >= backs[c] ? " front" : " back");
+      }
+      throw InputError(e.where(), e.problem().substr(0, guess) + ", but with the cameras' images exchanged (" +
+                                      exchanged +
+                                      ") every figure is within its threshold: cables or image folders mixed up? "
+                                      "(the faces of the board seen: " +
+                                      seen + ")");
+    }
+    throw;
+  }
 }
 
 // The runs --history lists one a line: a month of nights.
@@ -161,6 +250,9 @@ int RunCheck(int argc, char** argv) {
       "It names the camera or module that changed, says whether a new pose or a new lens (focal length, principal "
       "point) explains a named camera's corners, either (it cannot tell) or neither alone, and appends the run to "
       "an SQLite history (once: the same captures checked again with the same rig file are not appended twice).\n\n"
+      "A night that cannot say ok though every figure is within its threshold (a view set aside as taken at "
+      "another moment in its camera's last capture, where a knock reads the same; or images many times noisier "
+      "than the calibration's) reads recapture: capture again before production, exit 1 as recalibrate.\n\n"
       "Exit codes: 0 ok; 1 recalibrate; 2 bad usage or input.\n\n"
       "Examples:\n"
       "  stereorig check --rig rig.yaml --captures tonight/ --target target.yaml --report tonight/check.json\n"
@@ -266,15 +358,38 @@ int RunCheck(int argc, char** argv) {
   for (int c = 0; c < rig.num_cameras(); ++c)
     rig_cameras[c] = {"cam" + std::to_string(c), rig.camera(c).imager_width_px(), rig.camera(c).imager_height_px()};
   const DetectedCaptures detected =
-      DetectCaptureFolder(captures, target, rig.num_cameras(), DetectOptions(), true, rig_cameras);
+      DetectCaptureFolder(captures, target, rig.num_cameras(), DetectOptions(), true, rig_cameras, {}, true);
   // Sub-folders taken for no capture are named, as calibrate does: a
   // capture hidden by mistake (.005) lost a night's views without a word.
   for (const std::string& skipped : detected.skipped_folders)
     std::printf("skipped %s: not a capture (a hidden folder, or one holding no image)\n",
                 PrintableText(skipped).c_str());
+  // A capture missing a camera's image is set aside whole, as an empty one
+  // is skipped: 8 to 10 captures leave room for one lost (refused, it cost
+  // the night). Said on stdout with the set-aside views, and warned: the
+  // camera's cable or its trigger may be what failed. Too few left: refused
+  // naming the files, as every missing image was before.
+  if (!detected.missing_images.empty() && detected.num_captures < options.min_captures) {
+    std::string all;
+    for (const std::string& missing : detected.missing_images) all += (all.empty() ? "" : ", ") + missing;
+    throw InputError(detected.missing_images.front(),
+                     "missing (each capture needs camK.png for every camera; " +
+                         std::to_string(detected.missing_images.size()) + " missing: " + all + "): only " +
+                         std::to_string(detected.num_captures) + " captures are complete, the check needs " +
+                         std::to_string(options.min_captures));
+  }
+  for (const std::string& missing : detected.missing_images) {
+    const std::filesystem::path path(missing);
+    std::printf("set aside: capture %s whole: %s missing; not used\n",
+                PrintableText(path.parent_path().filename().string()).c_str(),
+                PrintableText(path.filename().string()).c_str());
+    FlushStdout();
+    std::fprintf(stderr, "stereorig check: warning: %s: missing; its capture set aside, the night judged without it\n",
+                 PrintableText(missing).c_str());
+  }
   std::fprintf(stderr, "check: %d captures, %zu views; re-estimating board poses\n", detected.num_captures,
                detected.observations.size());
-  CheckResult result = RunNightlyCheck(rig, target, detected.observations, options, captures, detected.capture_names);
+  CheckResult result = RunCheckNamingExchangedImages(rig, target, detected, options, captures);
   result.target_note = check_target.note;  // said with a failing night (the explanation's end)
   // A board printed off its file: the rig agrees with itself, but its scale
   // cannot be checked against a board of unknown size. Neither ok nor
@@ -289,7 +404,8 @@ int RunCheck(int argc, char** argv) {
                            {"captures_crc32", captures_crc32},
                            {"date_utc", NowUtcIso8601()},
                            {"k_sigma", options.k_sigma},
-                           {"skipped_folders", detected.skipped_folders}};
+                           {"skipped_folders", detected.skipped_folders},
+                           {"missing_images", detected.missing_images}};
   for (const CheckFigure& f : result.figures) {
     std::printf("%-44s %10.4f %10.4f %6s %8d\n", f.name.c_str(), f.value, f.threshold, f.pass ? "yes" : "NO",
                 f.samples);
@@ -335,6 +451,7 @@ int RunCheck(int argc, char** argv) {
          {"why", other_moment ? "other_moment" : "corners_jump"},
          {other_moment ? "off_px" : "jump_rms_px", v.FigurePx()},
          {"bound_px", v.bound_px},
+         {"left_open", v.left_open},
          {"whole_capture", v.whole_capture == WholeCapture::kModulesDisagree ? nlohmann::json("modules_disagree")
                            : v.whole_capture == WholeCapture::kViewOrModule  ? nlohmann::json("view_or_module")
                                                                              : nlohmann::json()}});
@@ -365,6 +482,18 @@ int RunCheck(int argc, char** argv) {
   if (!check_target.note.empty()) report["target"]["note"] = check_target.note;
   report["board_size_note"] = nullptr;
   if (!result.board_size_note.empty()) report["board_size_note"] = result.board_size_note;
+  // Tonight's noise against the calibration's, and where it is many times
+  // that, why the thresholds then see little (the verdict reads recapture).
+  report["corner_noise"] = nlohmann::json::array();
+  for (const CameraNoise& n : result.corner_noise)
+    report["corner_noise"].push_back(
+        {{"camera", n.camera}, {"tonight_px", n.tonight_px}, {"calibration_px", n.calibration_px}});
+  const std::string noise_warning = result.NoiseWarning();
+  report["noise_warning"] = noise_warning.empty() ? nlohmann::json() : nlohmann::json(noise_warning);
+  if (!noise_warning.empty()) {
+    FlushStdout();  // before the warning, where both go to one log
+    std::fprintf(stderr, "stereorig check: warning: %s\n", noise_warning.c_str());
+  }
   std::printf("verdict: %s (%s)\n", result.Verdict().c_str(), result.Explanation().c_str());
   report["verdict"] = result.Verdict();
   report["explanation"] = result.Explanation();
@@ -511,7 +640,8 @@ int RunCheck(int argc, char** argv) {
     std::fprintf(stderr, "stereorig check: warning: tonight's run is not in the history %s: %s; the verdict stands\n",
                  history_db.c_str(), PrintableText(not_appended_why).c_str());
   }
-  return result.ok() ? kExitOk : kExitCheckFailed;
+  // recapture as recalibrate: exit 1, the rig not to be trusted until a night says ok.
+  return result.Verdict() == "ok" ? kExitOk : kExitCheckFailed;
 }
 
 }  // namespace stereorig

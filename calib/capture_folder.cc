@@ -297,7 +297,7 @@ void RequireCapturesFolder(const std::string& dir) {
 DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& target, int num_cameras,
                                      const DetectOptions& options, bool progress,
                                      const std::vector<CameraImager>& rig_cameras,
-                                     const std::vector<ModuleLayout>& modules) {
+                                     const std::vector<ModuleLayout>& modules, bool incomplete_set_aside) {
   STEREORIG_CHECK(rig_cameras.empty() || int(rig_cameras.size()) == num_cameras);
   RequireCapturesFolder(dir_in);
   if (IsDatasetWithoutCaptures(dir_in))
@@ -336,6 +336,19 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
   for (size_t n = 0; n < captures.size(); ++n) {
     const std::string name = captures[n].filename().string();
     const int capture = indices[n];
+    if (incomplete_set_aside) {
+      std::vector<std::string> missing;
+      for (int c = 0; c < num_cameras; ++c)
+        if (!fs::exists(captures[n] / CameraImageName(c)))
+          missing.push_back((captures[n] / CameraImageName(c)).string());
+      if (!missing.empty()) {
+        out.missing_images.insert(out.missing_images.end(), missing.begin(), missing.end());
+        --out.num_captures;
+        if (progress)
+          std::fprintf(stderr, "%s\n", PrintableText("detect " + name + ": set aside, an image missing").c_str());
+        continue;
+      }
+    }
     out.capture_names[capture] = name;
     std::string line = "detect " + name + ":";
     for (int c = 0; c < num_cameras; ++c) {

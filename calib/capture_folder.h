@@ -43,6 +43,10 @@ struct DetectedCaptures {
   // deeper) is refused instead: skipped, a misnamed capture was lost
   // without a word.
   std::vector<std::string> skipped_folders{};
+  // With incomplete_set_aside (DetectCaptureFolder): the camK.png files
+  // missing from captures that were set aside whole for it, sorted by
+  // capture; those captures are in neither num_captures nor capture_names.
+  std::vector<std::string> missing_images{};
 };
 
 // The images a captures folder holds: every file named camK.png (any K) in
@@ -70,10 +74,13 @@ std::string SkippedFoldersNote(const std::vector<std::string>& skipped_folders);
 // empty (calibrate: no rig yet): each camera's images are held to one size,
 // and each module of `modules` to one size for its two cameras, both read
 // from the PNG headers and refused before any detection.
+// `incomplete_set_aside`: a capture missing a camera's image is set aside
+// whole (missing_images), not refused: the nightly check, whose 8 to 10
+// captures leave room for one lost (calibrate refuses it).
 DetectedCaptures DetectCaptureFolder(const std::string& dir, const Target& target, int num_cameras,
                                      const DetectOptions& options, bool progress,
                                      const std::vector<CameraImager>& rig_cameras = {},
-                                     const std::vector<ModuleLayout>& modules = {});
+                                     const std::vector<ModuleLayout>& modules = {}, bool incomplete_set_aside = false);
 
 // "" unless most images were rejected (more than half) and at least one in
 // ten as not fitting the target's layout (ambiguous: no single orientation
@@ -147,8 +154,12 @@ bool IsTooFewViewsProblem(const std::string& problem);
 struct FolderCalibration {
   CalibrationResult result;
   int num_captures = 0;
-  std::vector<std::string> skipped_folders{};  // DetectedCaptures::skipped_folders
-  int num_views = 0;                           // images with an accepted detection
+  std::vector<std::string> skipped_folders{};
+  // With incomplete_set_aside (DetectCaptureFolder): the camK.png files
+  // missing from captures that were set aside whole for it, sorted by
+  // capture; those captures are in neither num_captures nor capture_names.
+  std::vector<std::string> missing_images{};  // DetectedCaptures::skipped_folders
+  int num_views = 0;                          // images with an accepted detection
 };
 FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const std::string& target_path,
                                          const std::vector<ModuleLayout>& modules, const CalibrationOptions& options);

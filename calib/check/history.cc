@@ -41,7 +41,7 @@ constexpr const char* kSchema =
     "'[0-9][0-9][0-9][0-9]-[0-9][0-9]-[0-9][0-9]T[0-9][0-9]:[0-9][0-9]:[0-9][0-9]Z'),"
     "  rig_file TEXT NOT NULL CHECK (typeof(rig_file) = 'text'),"
     "  captures TEXT NOT NULL CHECK (typeof(captures) = 'text'),"
-    "  verdict TEXT NOT NULL CHECK (verdict IN ('ok', 'recalibrate')),"
+    "  verdict TEXT NOT NULL CHECK (verdict IN ('ok', 'recalibrate', 'recapture')),"
     "  explanation TEXT NOT NULL CHECK (typeof(explanation) = 'text'));"
     "CREATE TABLE IF NOT EXISTS stereorig_check_figures ("
     "  run_id INTEGER NOT NULL REFERENCES stereorig_check_runs(id) CHECK (typeof(run_id) = 'integer'),"
@@ -154,6 +154,26 @@ void AddMissingColumns(sqlite3* db, const std::string& path) {
   for (const AddedColumn& c : kAddedColumns)
     if (!HasColumn(db, c.table, c.column, path))
       Exec(db, std::string("ALTER TABLE ") + c.table + " ADD COLUMN " + c.column + " " + c.type + ";", path);
+}
+
+// A history from before the verdict recapture refuses it (its runs table's
+// CHECK lists ok and recalibrate alone): the table is rebuilt with kSchema's
+// (SQLite cannot alter a CHECK), its rows and ids kept, at the append.
+void AllowRecaptureVerdict(sqlite3* db, const std::string& path) {
+  Stmt s = Prepare(db, "SELECT sql FROM sqlite_master WHERE type = 'table' AND name = 'stereorig_check_runs';", path);
+  if (sqlite3_step(s.get()) != SQLITE_ROW || Text(s.get(), 0).find("'recapture'") != std::string::npos) return;
+  s.reset();
+  // legacy_alter_table: the other tables' REFERENCES keep naming
+  // stereorig_check_runs, not the old table renamed and dropped.
+  Exec(db,
+       "PRAGMA legacy_alter_table = ON;"
+       "ALTER TABLE stereorig_check_runs RENAME TO stereorig_check_runs_before_recapture;" +
+           std::string(kSchema) +
+           "INSERT INTO stereorig_check_runs (id, date_utc, rig_file, captures, verdict, explanation) SELECT id, "
+           "date_utc, rig_file, captures, verdict, explanation FROM stereorig_check_runs_before_recapture;"
+           "DROP TABLE stereorig_check_runs_before_recapture;"
+           "PRAGMA legacy_alter_table = OFF;",
+       path);
 }
 
 std::string KSigmaText(double k) {
@@ -309,8 +329,8 @@ std::vector<HistoryRun> ReadRuns(sqlite3* db, const std::string& path) {
       row.Refuse("its date_utc '" + run.date_utc + "' is not a time as YYYY-MM-DDTHH:MM:SSZ");
     run.rig_file = row.String(3, "its rig_file"), run.captures = row.String(4, "its captures");
     run.verdict = row.String(5, "its verdict");
-    if (run.verdict != "ok" && run.verdict != "recalibrate")
-      row.Refuse("its verdict '" + run.verdict + "' is neither ok nor recalibrate");
+    if (run.verdict != "ok" && run.verdict != "recalibrate" && run.verdict != "recapture")
+      row.Refuse("its verdict '" + run.verdict + "' is neither ok, recalibrate nor recapture");
     run.explanation = row.String(6, "its explanation");
     runs[run.id] = run;
   }
@@ -523,6 +543,7 @@ HistoryAppend AppendToHistory(const std::string& path, const HistoryRun& run, co
     const bool kept_set_aside = HasTable(db.get(), kSetAsideTable, path);
     Exec(db.get(), kSchema, path);
     AddMissingColumns(db.get(), path);
+    AllowRecaptureVerdict(db.get(), path);
     HistoryAppend outcome;
     outcome.same_night = SameNight(runs, run);
     if (outcome.same_night) {  // nothing appended, nothing changed

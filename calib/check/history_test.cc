@@ -487,7 +487,7 @@ TEST(History, ABadRowIsRefusedNamingTheTableTheRowAndWhatIsWrong) {
       {"INSERT INTO stereorig_check_figures VALUES (2, 'cam0_x', 0.2, 0.25, 1, 700);",
        "stereorig_check_figures row 3 (run 2): figure cam0_x a second time in its run (row 2 is the first"},
       {"UPDATE stereorig_check_runs SET verdict = 'banana' WHERE id = 2;",
-       "stereorig_check_runs row 2 (run 2): its verdict 'banana' is neither ok nor recalibrate"},
+       "stereorig_check_runs row 2 (run 2): its verdict 'banana' is neither ok, recalibrate nor recapture"},
       {"UPDATE stereorig_check_runs SET date_utc = X'FF00' WHERE id = 2;",
        "stereorig_check_runs row 2 (run 2): its date_utc is a blob of 2 bytes, not text"},
       {"CREATE TABLE stereorig_check_run_inputs (run_id INTEGER, rig_path TEXT, rig_crc32 TEXT, target_path TEXT, "

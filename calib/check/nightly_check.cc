@@ -79,8 +79,80 @@ std::string WholeCaptureText(const SetAsideView& v) {
   return text;
 }
 
+std::vector<SetAsideView> CheckResult::OpenViews() const {
+  std::vector<SetAsideView> open;
+  for (const SetAsideView& v : views_set_aside)
+    if (v.left_open) open.push_back(v);
+  return open;
+}
+
+std::string CheckResult::NoiseWarning() const {
+  std::string cameras;
+  for (const CameraNoise& n : corner_noise) {
+    if (!(n.tonight_px >= kNoisyNightFactor * n.calibration_px)) continue;
+    char text[160];
+    std::snprintf(text, sizeof text, "%scam%d %.3f px against %.3f px (%.1f times)", cameras.empty() ? "" : ", ",
+                  n.camera, n.tonight_px, n.calibration_px, n.tonight_px / n.calibration_px);
+    cameras += text;
+  }
+  if (cameras.empty()) return "";
+  // What the thresholds can still see: the closures' (a module's shift or
+  // turn), else each camera's own.
+  std::string sees;
+  for (const bool closures : {true, false}) {
+    for (const CheckFigure& f : figures) {
+      const bool closure = f.name.find("_closure_") != std::string::npos;
+      if (closure != closures || (!closure && f.name.find("_consistency_") == std::string::npos)) continue;
+      const char* unit = f.name.size() > 3 && f.name.compare(f.name.size() - 3, 3, "_mm") == 0    ? "mm"
+                         : f.name.size() > 4 && f.name.compare(f.name.size() - 4, 4, "_deg") == 0 ? "deg"
+                                                                                                  : "px";
+      char text[160];
+      std::snprintf(text, sizeof text, "%s%s %.4f %s", sees.empty() ? "" : ", ", f.name.c_str(), f.threshold, unit);
+      sees += text;
+    }
+    if (!sees.empty()) break;
+  }
+  return "tonight's corner noise is many times the calibration's (" + cameras +
+         "): the thresholds rise with it, and a change below them goes unseen tonight (" +
+         (sees.empty() ? std::string("no figure") : sees) +
+         "): capture again with sharp images (focus, exposure, lighting, a clean board) before production";
+}
+
+namespace {
+
+// Why the night cannot say ok (CheckResult::Inconclusive): each capture with
+// a view set aside left open, and tonight's noise.
+std::string InconclusiveText(const CheckResult& r) {
+  std::string out;
+  std::set<int> said;
+  const std::vector<SetAsideView> open = r.OpenViews();
+  for (const SetAsideView& v : open) {
+    if (!said.insert(v.capture).second) continue;
+    std::string cameras;
+    for (const SetAsideView& w : open)
+      if (w.capture == v.capture) cameras += (cameras.empty() ? "cam" : ", cam") + std::to_string(w.camera);
+    char text[300];
+    if (v.whole_capture == WholeCapture::kNo) {
+      std::snprintf(text, sizeof text, "capture %s %s is off its capture's other views by %.3f px (bound %.3f px)",
+                    v.capture_name.c_str(), cameras.c_str(), v.off_px, v.bound_px);
+    } else {
+      std::snprintf(text, sizeof text, "capture %s went whole (%s)", v.capture_name.c_str(),
+                    WholeCaptureText(v).c_str());
+    }
+    out += std::string(out.empty() ? "" : "; ") + text + " and no later capture shows " + cameras +
+           ": knocked during that capture (it stays so) or an image taken at another moment (it does not), which the "
+           "night cannot tell: capture again before production";
+  }
+  const std::string noise = r.NoiseWarning();
+  if (!noise.empty()) out += (out.empty() ? "" : "; ") + noise;
+  return out;
+}
+
+}  // namespace
+
 std::string CheckResult::Explanation() const {
   const std::string board = board_size_note.empty() ? "" : "; " + board_size_note;
+  if (ok() && Inconclusive()) return InconclusiveText(*this) + " (every figure within its threshold)" + board;
   if (ok()) return "every figure within its threshold" + board;
   std::ostringstream s;
   if (shared_lens_explains && shared_lens_besides.empty()) {
@@ -167,7 +239,8 @@ std::string CheckResult::Explanation() const {
     s << "every camera and every module fails its figure: a change they share (every lens drifted alike?) or "
          "another rig's captures, with no unchanged camera to name it against; ";
   std::string out = s.str();
-  return out.substr(0, out.size() - 2) + board + (target_note.empty() ? "" : "; " + target_note);
+  return out.substr(0, out.size() - 2) + board + (target_note.empty() ? "" : "; " + target_note) +
+         (Inconclusive() ? "; " + InconclusiveText(*this) : "");
 }
 
 namespace {
@@ -785,6 +858,24 @@ void SetAsideViewsOfAnotherMoment(Inputs& in, std::vector<SetAsideView>* set_asi
   for (int capture : whole) in.by_capture.erase(capture);
 }
 
+// Each view set aside named as the night names its capture, and those of
+// another moment left open where no later capture kept a view of their
+// camera (SetAsideView::left_open): a camera knocked during the night's last
+// capture reads as that capture's image of another moment (camera 2 turned 3
+// deg in capture 007 of 8: 12.952 px off against a bound of 0.293 px), and
+// only a later view tells the two apart. Captures are in the order taken.
+void MarkViewsSetAsideLeftOpen(const Inputs& in, const std::map<int, std::string>& capture_names,
+                               std::vector<SetAsideView>* set_aside) {
+  for (SetAsideView& v : *set_aside) {
+    const auto name = capture_names.find(v.capture);
+    v.capture_name = name != capture_names.end() ? name->second : std::to_string(v.capture);
+    if (v.why != SetAsideWhy::kOtherMoment) continue;
+    v.left_open = true;
+    for (auto it = in.by_capture.upper_bound(v.capture); v.left_open && it != in.by_capture.end(); ++it)
+      for (const BoardObservation* w : it->second) v.left_open = v.left_open && w->camera != v.camera;
+  }
+}
+
 // How far each camera is off the rest of the rig, on the views as given:
 // per view, the median corner error (px) through the board pose its
 // capture's other views imply; per camera, the lower median over its views.
@@ -1306,6 +1397,7 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   in.by_capture.clear();
   for (const BoardObservation& v : trimmed)
     if (in.seed.count(v.capture)) in.by_capture[v.capture].push_back(&v);
+  MarkViewsSetAsideLeftOpen(in, capture_names, &result.views_set_aside);
   // min_captures again, on what is left: views set aside, outlier corners
   // trimmed below min_corners_per_view or no pose that fits can take whole
   // captures away, and the thresholds assume at least that many. Each
@@ -1362,6 +1454,8 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
     for (auto& [c, fit] : own_lens) fit.ss_px2 = ss[c], fit.dof = dof[c];
     for (int c = 0; c < rig.num_cameras(); ++c)
       if (dof[c] > 0) in.sigma_px[c] = std::max(in.sigma_px[c], std::sqrt(ss[c] / dof[c]));
+    for (int c = 0; c < rig.num_cameras(); ++c)
+      if (dof[c] > 0) result.corner_noise.push_back({c, std::sqrt(ss[c] / dof[c]), calibration_rms_px[c]});
   }
 
   const double k = options.k_sigma;
@@ -1479,9 +1573,22 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
         why += text;
       }
     }
+    // Every module reading the board off alike is its squares or every
+    // baseline: a rig of 60 mm baselines checked against a file of 90 mm
+    // measures the board +50 %, which the note alone blamed on the squares.
+    std::string board;
+    if (!result.board_size_note.empty()) {
+      double scale = 0;
+      for (const ModuleBoardScale& m : result.board_scales) scale += m.scale / result.board_scales.size();
+      char text[300];
+      std::snprintf(text, sizeof text,
+                    "; or the captures' rig has every baseline %.3f times the rig file's (the board measured through "
+                    "the file's baselines reads %.3f times its size): another rig's captures",
+                    1 / scale, scale);
+      board = " (" + result.board_size_note + text + ")";
+    }
     throw InputError(where, "the captures do not fit this rig at all (" + why +
-                                "): captures of another rig, or the wrong rig file or target file?" +
-                                (result.board_size_note.empty() ? std::string() : " (" + result.board_size_note + ")"));
+                                "): captures of another rig, or the wrong rig file or target file?" + board);
   }
   // A camera with no figure is not checked: the check would call the rig
   // ok with it moved (8 captures only camera 0 saw, it turned 1 degree:

@@ -77,8 +77,33 @@ struct SetAsideView {
   WholeCapture whole_capture = WholeCapture::kNo;  // kOtherMoment: set aside with its capture's every view, and why
   int lone_camera = -1;                            // kViewOrModule: the view that disagrees with one module's ...
   int other_module = -1;                           // ... views: that module
+  // kOtherMoment: no later capture of the night kept a view of this camera,
+  // so nothing tells a knock during this capture (which stays) from an
+  // image of another moment (which does not): the night reads "recapture"
+  // (CheckResult::Verdict). A camera whose later views agree with their
+  // captures was not knocked there: a slip of that image, the night judged.
+  bool left_open = false;
+  std::string capture_name = {};  // as the night names it (RunNightlyCheck's capture_names), else its index
   double FigurePx() const { return why == SetAsideWhy::kOtherMoment ? off_px : jump_rms_px; }
 };
+
+// Tonight's corner noise against the calibration's, per camera: each view's
+// residuals about its own board pose (RunNightlyCheck), the thresholds'
+// noise the larger of the two.
+struct CameraNoise {
+  int camera = -1;
+  double tonight_px = 0;      // per axis, over every view of the camera kept
+  double calibration_px = 0;  // provenance.residuals.camK_rms_px
+};
+
+// Tonight's corner noise this many times the calibration's, or more, on a
+// camera: the thresholds rise with it until a change the check exists to see
+// passes under them. Such a night is no evidence: it reads "recapture". On
+// the demo's rig (docs/verify-and-check.md) unmoved nights read 0.9-1.4
+// times; at 4 times the closure's threshold rose 2.4-fold (0.0064 to 0.015
+// mm) and module 1 shifted 0.05 mm was still named; at 20 times 13-fold
+// (0.082 mm), and that shift read ok.
+constexpr double kNoisyNightFactor = 5;
 
 // Why a capture went whole (`v` any of its views, whole_capture not kNo),
 // once for the capture: "its modules disagree by ... in this capture only:
@@ -176,9 +201,25 @@ struct CheckResult {
   // 0.3 %), within the closures' noise: said as the rig's scale, which
   // cannot be told from the board's.
   bool shared_scale_print_only = false;
+  // Every camera's corner noise tonight and at calibration (the figures'
+  // noise is the larger): the report's corner_noise.
+  std::vector<CameraNoise> corner_noise;
+  // Every figure within its threshold (the figures alone: see Verdict).
   bool ok() const;
-  std::string Verdict() const { return ok() ? "ok" : "recalibrate"; }
-  std::string Explanation() const;  // one line: what changed, in no more words than the figures support
+  // A view set aside left open (SetAsideView::left_open), or tonight's
+  // noise kNoisyNightFactor times the calibration's on some camera: the
+  // night cannot say ok, whatever its figures.
+  bool Inconclusive() const { return !OpenViews().empty() || !NoiseWarning().empty(); }
+  // "recalibrate" where a figure fails; else "recapture" where the night is
+  // inconclusive (capture again before production: exit 1 as recalibrate);
+  // else "ok".
+  std::string Verdict() const { return !ok() ? "recalibrate" : Inconclusive() ? "recapture" : "ok"; }
+  std::string Explanation() const;              // one line: what changed, in no more words than the figures support
+  std::vector<SetAsideView> OpenViews() const;  // views_set_aside left open, one per capture
+  // "" or why tonight's noise hides a change: the cameras many times noisier
+  // than at calibration, and what the thresholds can still see (the
+  // closures' in mm and deg); said on standard error and in the report.
+  std::string NoiseWarning() const;
   // Every camera named (camera_changes' cameras; every camera where
   // shared_lens_explains): the report's
   // flagged_cameras (and moved_cameras, its old name; each change's kind
