@@ -1,5 +1,5 @@
 // `stereorig check`: the nightly recalibration check. Fresh target captures
-// + the stored rig file -> ok / recalibrate, what moved, and history.
+// + the stored rig file -> ok / recalibrate / recapture, what moved, and history.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -138,11 +138,14 @@ CheckResult RunCheckNamingExchangedImages(const Rig& rig, const Target& target, 
     for (int c = 0; c < n; ++c) as[c] = c;
     while (std::next_permutation(as.begin(), as.end())) {
       bool one_face = true;  // each module's two cameras, as exchanged, on one face
+      // Over the captures' own indices: folder numbers (100..107), not 0..N-1.
       for (int a = 0; a < n && one_face; ++a)
         for (int b = 0; b < n && one_face; ++b)
-          for (int capture = 0; a != b && capture < detected.num_captures && one_face; ++capture)
-            if (module_of[as[a]] == module_of[as[b]] && face.count({capture, a}) && face.count({capture, b}))
-              one_face = face.at({capture, a}) == face.at({capture, b});
+          for (auto it = face.begin(); a != b && it != face.end() && one_face; ++it) {
+            const int capture = it->first.first;
+            if (it->first.second == a && module_of[as[a]] == module_of[as[b]] && face.count({capture, b}))
+              one_face = it->second == face.at({capture, b});
+          }
       if (!one_face) continue;
       std::vector<BoardObservation> views = detected.observations;
       for (BoardObservation& v : views) v.camera = as[v.camera];
@@ -164,7 +167,9 @@ CheckResult RunCheckNamingExchangedImages(const Rig& rig, const Target& target, 
       std::vector<BoardObservation> views = detected.observations;
       for (BoardObservation& v : views) v.camera = as[v.camera];
       try {
-        if (!RunNightlyCheck(rig, target, views, options, captures, detected.capture_names).ok()) continue;
+        // The verdict, not the figures alone: images read through the wrong
+        // lenses can raise tonight's noise, and every threshold with it.
+        if (RunNightlyCheck(rig, target, views, options, captures, detected.capture_names).Verdict() != "ok") continue;
       } catch (const InputError&) {
         continue;
       }
@@ -253,7 +258,7 @@ int RunCheck(int argc, char** argv) {
       "A night that cannot say ok though every figure is within its threshold (a view set aside as taken at "
       "another moment in its camera's last capture, where a knock reads the same; or images many times noisier "
       "than the calibration's) reads recapture: capture again before production, exit 1 as recalibrate.\n\n"
-      "Exit codes: 0 ok; 1 recalibrate; 2 bad usage or input.\n\n"
+      "Exit codes: 0 ok; 1 recalibrate or recapture; 2 bad usage or input.\n\n"
       "Examples:\n"
       "  stereorig check --rig rig.yaml --captures tonight/ --target target.yaml --report tonight/check.json\n"
       "  stereorig check --history --rig rig.yaml          (the trend of every figure)",

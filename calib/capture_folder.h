@@ -155,11 +155,7 @@ struct FolderCalibration {
   CalibrationResult result;
   int num_captures = 0;
   std::vector<std::string> skipped_folders{};
-  // With incomplete_set_aside (DetectCaptureFolder): the camK.png files
-  // missing from captures that were set aside whole for it, sorted by
-  // capture; those captures are in neither num_captures nor capture_names.
-  std::vector<std::string> missing_images{};  // DetectedCaptures::skipped_folders
-  int num_views = 0;                          // images with an accepted detection
+  int num_views = 0;  // images with an accepted detection
 };
 FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const std::string& target_path,
                                          const std::vector<ModuleLayout>& modules, const CalibrationOptions& options);

@@ -1592,8 +1592,8 @@ TEST(CheckCli, AViewSetAsideInItsLastCaptureOrANightFarNoisierThanItsCalibration
                 fs::copy_options::overwrite_existing);
   r = RunCli("check --rig " + dir + "/rig.yaml --captures " + knocked + target + " --report " + dir + "/knocked.json");
   EXPECT_EQ(r.code, 1) << r.out << r.err;
-  EXPECT_NE(r.out.find("verdict: recapture (capture " + names.back() + " cam2 is off its capture's other views by "),
-            std::string::npos)
+  EXPECT_NE(r.out.find("verdict: recapture (capture " + names.back() + ": cam2 by "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(" px) off its capture's other views and no later capture shows cam2"), std::string::npos)
       << r.out;
   EXPECT_NE(r.out.find("and no later capture shows cam2: knocked during that capture (it stays so) or an image "
                        "taken at another moment (it does not), which the night cannot tell: capture again before "

@@ -555,7 +555,7 @@ TEST(Cli, EveryCommandsHelpGivesItsExitCodes) {
                   "Exit codes: 0 ok (the rig file valid; --truth's figures judge nothing); 2 bad usage or "
                   "input (an invalid rig file included)."},
         std::pair{"target", "Exit codes: 0 ok; 2 bad usage or input."},
-        std::pair{"check", "Exit codes: 0 ok; 1 recalibrate; 2 bad usage or input."},
+        std::pair{"check", "Exit codes: 0 ok; 1 recalibrate or recapture; 2 bad usage or input."},
         std::pair{"simulate",
                   "Exit codes: 0 ok (its warnings too); 2 bad usage or input (a folder it refuses to replace "
                   "included)."}}) {

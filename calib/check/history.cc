@@ -163,6 +163,22 @@ void AllowRecaptureVerdict(sqlite3* db, const std::string& path) {
   Stmt s = Prepare(db, "SELECT sql FROM sqlite_master WHERE type = 'table' AND name = 'stereorig_check_runs';", path);
   if (sqlite3_step(s.get()) != SQLITE_ROW || Text(s.get(), 0).find("'recapture'") != std::string::npos) return;
   s.reset();
+  // What a plant added to the table (an index, a trigger that raises an
+  // alert on a verdict not ok) goes with the old table when it is dropped,
+  // and the AUTOINCREMENT counter would restart at the largest id kept (a
+  // deleted last run's id reused): both read first, put back after.
+  std::vector<std::string> attached;
+  Stmt a = Prepare(db,
+                   "SELECT sql FROM sqlite_master WHERE tbl_name = 'stereorig_check_runs' AND type IN ('index', "
+                   "'trigger') AND sql IS NOT NULL ORDER BY type, name;",
+                   path);
+  while (sqlite3_step(a.get()) == SQLITE_ROW) attached.push_back(Text(a.get(), 0));
+  a.reset();
+  sqlite3_int64 last_id = 0;
+  if (HasTable(db, "sqlite_sequence", path)) {
+    Stmt q = Prepare(db, "SELECT seq FROM sqlite_sequence WHERE name = 'stereorig_check_runs';", path);
+    if (sqlite3_step(q.get()) == SQLITE_ROW) last_id = sqlite3_column_int64(q.get(), 0);
+  }
   // legacy_alter_table: the other tables' REFERENCES keep naming
   // stereorig_check_runs, not the old table renamed and dropped.
   Exec(db,
@@ -173,6 +189,15 @@ void AllowRecaptureVerdict(sqlite3* db, const std::string& path) {
            "date_utc, rig_file, captures, verdict, explanation FROM stereorig_check_runs_before_recapture;"
            "DROP TABLE stereorig_check_runs_before_recapture;"
            "PRAGMA legacy_alter_table = OFF;",
+       path);
+  for (const std::string& sql : attached) Exec(db, sql + ";", path);
+  const std::string id = std::to_string(last_id);
+  Exec(db,
+       "UPDATE sqlite_sequence SET seq = max(seq, " + id +
+           ") WHERE name = 'stereorig_check_runs';"
+           "INSERT INTO sqlite_sequence (name, seq) SELECT 'stereorig_check_runs', " +
+           id + " WHERE " + id +
+           " > 0 AND NOT EXISTS (SELECT 1 FROM sqlite_sequence WHERE name = 'stereorig_check_runs');",
        path);
 }
 

@@ -24,7 +24,7 @@ struct HistoryRun {
   // The captures folder, kept as HistoryPathOf's too; runs written before
   // hold it as typed, and read back so (nothing says from which folder).
   std::string captures;
-  std::string verdict;  // "ok" or "recalibrate"
+  std::string verdict;  // "ok", "recalibrate" or "recapture"
   std::string explanation;
   // What the night was measured with (empty in runs written before they were
   // kept; paths kept as HistoryPathOf's): the rig file's absolute path and a

@@ -393,6 +393,47 @@ TEST(History, KeepsKSigmaAndAddsItsColumnToAnOlderHistory) {
   EXPECT_NE(FormatTrends({runs[1]}, {}).find("k_sigma: 2.5 in every run\n"), std::string::npos);
 }
 
+// A history from before the verdict recapture has its runs table rebuilt
+// at the next append (SQLite cannot alter a CHECK). What a plant added to
+// that table, an index and a trigger raising an alert on a verdict not ok,
+// went with the old table, silently, and the AUTOINCREMENT counter restarted
+// at the largest id kept: a deleted last run's id was given again.
+TEST(History, TheRebuildForRecaptureKeepsAPlantsTriggerIndexAndRunIds) {
+  const std::string db = ::testing::TempDir() + "/history_rebuild.sqlite";
+  std::filesystem::remove(db);
+  ASSERT_TRUE(MakeOldHistory(
+      db,
+      "CREATE TABLE plant_alerts (run_id INTEGER, verdict TEXT);"
+      "CREATE INDEX plant_runs_by_date ON stereorig_check_runs (date_utc);"
+      "CREATE TRIGGER plant_alert AFTER INSERT ON stereorig_check_runs WHEN NEW.verdict <> 'ok' BEGIN INSERT INTO "
+      "plant_alerts VALUES (NEW.id, NEW.verdict); END;"
+      "INSERT INTO stereorig_check_runs (date_utc, rig_file, captures, verdict, explanation) VALUES "
+      "('2026-11-01T02:00:00Z', '/r.yaml', '/n1', 'ok', 'every figure within its threshold'),"
+      "('2026-11-02T02:00:00Z', '/r.yaml', '/n2', 'ok', 'every figure within its threshold'),"
+      "('2026-11-03T02:00:00Z', '/r.yaml', '/n3', 'ok', 'every figure within its threshold');"
+      "DELETE FROM stereorig_check_runs WHERE id = 3;"));
+  EXPECT_EQ(AppendToHistory(db, {0, "2026-11-04T02:00:00Z", "/r.yaml", "/n4", "", ""}, Result(0.3, false)).run_id, 4);
+  sqlite3* raw = nullptr;
+  ASSERT_EQ(sqlite3_open(db.c_str(), &raw), SQLITE_OK);
+  auto count = [&](const std::string& sql) {
+    sqlite3_stmt* s = nullptr;
+    int n = -1;
+    if (sqlite3_prepare_v2(raw, sql.c_str(), -1, &s, nullptr) == SQLITE_OK && sqlite3_step(s) == SQLITE_ROW)
+      n = sqlite3_column_int(s, 0);
+    sqlite3_finalize(s);
+    return n;
+  };
+  EXPECT_EQ(count("SELECT count(*) FROM sqlite_master WHERE sql LIKE '%''recapture''%' AND name = "
+                  "'stereorig_check_runs'"),
+            1);  // rebuilt
+  EXPECT_EQ(count("SELECT count(*) FROM sqlite_master WHERE name IN ('plant_runs_by_date', 'plant_alert') AND "
+                  "tbl_name = 'stereorig_check_runs'"),
+            2);
+  EXPECT_EQ(count("SELECT count(*) FROM plant_alerts WHERE run_id = 4 AND verdict = 'recalibrate'"), 1);
+  sqlite3_close(raw);
+  EXPECT_EQ(ReadHistoryRuns(db).size(), 3u);
+}
+
 // The same captures with the same rig file a second time: not appended,
 // the outcome naming the run it repeats; what before_commit throws rolls the
 // run back.

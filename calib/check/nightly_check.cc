@@ -128,16 +128,20 @@ std::string InconclusiveText(const CheckResult& r) {
   const std::vector<SetAsideView> open = r.OpenViews();
   for (const SetAsideView& v : open) {
     if (!said.insert(v.capture).second) continue;
-    std::string cameras;
-    for (const SetAsideView& w : open)
-      if (w.capture == v.capture) cameras += (cameras.empty() ? "cam" : ", cam") + std::to_string(w.camera);
-    char text[300];
+    std::string cameras, offs;  // each view with its own figure
+    for (const SetAsideView& w : open) {
+      if (w.capture != v.capture) continue;
+      cameras += (cameras.empty() ? "cam" : ", cam") + std::to_string(w.camera);
+      char off[96];
+      std::snprintf(off, sizeof off, "%scam%d by %.3f px (bound %.3f px)", offs.empty() ? "" : ", ", w.camera, w.off_px,
+                    w.bound_px);
+      offs += off;
+    }
+    std::string text;
     if (v.whole_capture == WholeCapture::kNo) {
-      std::snprintf(text, sizeof text, "capture %s %s is off its capture's other views by %.3f px (bound %.3f px)",
-                    v.capture_name.c_str(), cameras.c_str(), v.off_px, v.bound_px);
+      text = "capture " + v.capture_name + ": " + offs + " off its capture's other views";
     } else {
-      std::snprintf(text, sizeof text, "capture %s went whole (%s)", v.capture_name.c_str(),
-                    WholeCaptureText(v).c_str());
+      text = "capture " + v.capture_name + " went whole (" + WholeCaptureText(v) + ")";
     }
     out += std::string(out.empty() ? "" : "; ") + text + " and no later capture shows " + cameras +
            ": knocked during that capture (it stays so) or an image taken at another moment (it does not), which the "

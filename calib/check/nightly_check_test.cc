@@ -1595,5 +1595,26 @@ TEST(NightlyCheck, AWeakPosesPredictionErrorHasTheVarianceOfItsSourcesAddedInThe
   EXPECT_LT(summed_var, var - 4 * var_se);
 }
 
+// Two views of one capture left open (knocked in the last capture, or two
+// images of another moment): the verdict gives each its own figure. It
+// printed the first view's for both ("capture 007 cam1, cam2 is off ... by
+// 1.300 px").
+TEST(NightlyCheck, TwoOpenViewsOfOneCaptureEachGiveTheirOwnFigure) {
+  CheckResult r;
+  SetAsideView a;
+  a.capture = 7, a.camera = 1, a.why = SetAsideWhy::kOtherMoment, a.off_px = 1.3, a.bound_px = 0.29;
+  a.left_open = true, a.capture_name = "007";
+  SetAsideView b = a;
+  b.camera = 2, b.off_px = 4.27, b.bound_px = 0.31;
+  r.views_set_aside = {a, b};
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r.Verdict(), "recapture");
+  const std::string text = r.Explanation();
+  EXPECT_NE(text.find("capture 007: cam1 by 1.300 px (bound 0.290 px), cam2 by 4.270 px (bound 0.310 px) off its "
+                      "capture's other views and no later capture shows cam1, cam2"),
+            std::string::npos)
+      << text;
+}
+
 }  // namespace
 }  // namespace stereorig
