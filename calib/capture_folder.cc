@@ -338,20 +338,14 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
     const int capture = indices[n];
     if (incomplete_set_aside) {
       std::vector<std::string> missing;
-      for (int c = 0; c < num_cameras; ++c) {
-        // Empty counts as missing: a trigger or a write that failed leaves
-        // a file of 0 bytes as often as none (it refused the night).
-        const fs::path image = captures[n] / CameraImageName(c);
-        std::error_code error;
-        if (!fs::exists(image) || (fs::is_regular_file(image) && fs::file_size(image, error) == 0 && !error))
-          missing.push_back(image.string());
-      }
+      for (int c = 0; c < num_cameras; ++c)
+        if (!fs::exists(captures[n] / CameraImageName(c)))
+          missing.push_back((captures[n] / CameraImageName(c)).string());
       if (!missing.empty()) {
         out.missing_images.insert(out.missing_images.end(), missing.begin(), missing.end());
         --out.num_captures;
         if (progress)
-          std::fprintf(stderr, "%s\n",
-                       PrintableText("detect " + name + ": set aside, an image missing or empty").c_str());
+          std::fprintf(stderr, "%s\n", PrintableText("detect " + name + ": set aside, an image missing").c_str());
         continue;
       }
     }

@@ -44,9 +44,8 @@ struct DetectedCaptures {
   // without a word.
   std::vector<std::string> skipped_folders{};
   // With incomplete_set_aside (DetectCaptureFolder): the camK.png files
-  // missing (or empty: 0 bytes) from captures that were set aside whole for
-  // it, sorted by capture; those captures are in neither num_captures nor
-  // capture_names.
+  // missing from captures that were set aside whole for it, sorted by
+  // capture; those captures are in neither num_captures nor capture_names.
   std::vector<std::string> missing_images{};
 };
 
