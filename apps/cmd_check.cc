@@ -359,11 +359,13 @@ int RunCheck(int argc, char** argv) {
   // Every image held to the rig's size for its camera, as reconstruct
   // does: against the first capture's instead, an odd-sized image there
   // got the right ones after it blamed.
-  std::vector<CameraImager> rig_cameras(rig.num_cameras());
+  CaptureFolderOptions per_folder;
+  per_folder.progress = true;
   for (int c = 0; c < rig.num_cameras(); ++c)
-    rig_cameras[c] = {"cam" + std::to_string(c), rig.camera(c).imager_width_px(), rig.camera(c).imager_height_px()};
-  const DetectedCaptures detected =
-      DetectCaptureFolder(captures, target, rig.num_cameras(), DetectOptions(), true, rig_cameras, {}, true);
+    per_folder.rig_cameras.push_back(
+        {"cam" + std::to_string(c), rig.camera(c).imager_width_px(), rig.camera(c).imager_height_px()});
+  per_folder.incomplete_set_aside = true;  // 8 to 10 captures leave room for one lost
+  const DetectedCaptures detected = DetectCaptureFolder(captures, target, rig.num_cameras(), per_folder);
   // Sub-folders taken for no capture are named, as calibrate does: a
   // capture hidden by mistake (.005) lost a night's views without a word.
   for (const std::string& skipped : detected.skipped_folders)
@@ -378,20 +380,29 @@ int RunCheck(int argc, char** argv) {
     std::string all;
     for (const std::string& missing : detected.missing_images) all += (all.empty() ? "" : ", ") + missing;
     throw InputError(detected.missing_images.front(),
-                     "missing (each capture needs camK.png for every camera; " +
+                     "missing or empty (each capture needs camK.png for every camera; " +
                          std::to_string(detected.missing_images.size()) + " missing: " + all + "): only " +
                          std::to_string(detected.num_captures) + " captures are complete, the check needs " +
                          std::to_string(options.min_captures));
   }
-  for (const std::string& missing : detected.missing_images) {
-    const std::filesystem::path path(missing);
-    std::printf("set aside: capture %s whole: %s missing; not used\n",
-                PrintableText(path.parent_path().filename().string()).c_str(),
-                PrintableText(path.filename().string()).c_str());
-    FlushStdout();
-    std::fprintf(stderr, "stereorig check: warning: %s: missing; its capture set aside, the night judged without it\n",
-                 PrintableText(missing).c_str());
+  // One line a capture, each of its files missing or empty (0 bytes).
+  auto state = [](const std::string& image) { return std::filesystem::exists(image) ? "empty (0 bytes)" : "missing"; };
+  for (size_t i = 0; i < detected.missing_images.size();) {
+    const std::filesystem::path capture = std::filesystem::path(detected.missing_images[i]).parent_path();
+    std::string files;
+    for (; i < detected.missing_images.size() &&
+           std::filesystem::path(detected.missing_images[i]).parent_path() == capture;
+         ++i)
+      files += (files.empty() ? "" : ", ") +
+               PrintableText(std::filesystem::path(detected.missing_images[i]).filename().string()) + " " +
+               state(detected.missing_images[i]);
+    std::printf("set aside: capture %s whole: %s; not used\n", PrintableText(capture.filename().string()).c_str(),
+                files.c_str());
   }
+  FlushStdout();
+  for (const std::string& missing : detected.missing_images)
+    std::fprintf(stderr, "stereorig check: warning: %s: %s; its capture set aside, the night judged without it\n",
+                 PrintableText(missing).c_str(), state(missing));
   std::fprintf(stderr, "check: %d captures, %zu views; re-estimating board poses\n", detected.num_captures,
                detected.observations.size());
   CheckResult result = RunCheckNamingExchangedImages(rig, target, detected, options, captures);

@@ -295,10 +295,8 @@ void RequireCapturesFolder(const std::string& dir) {
 }
 
 DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& target, int num_cameras,
-                                     const DetectOptions& options, bool progress,
-                                     const std::vector<CameraImager>& rig_cameras,
-                                     const std::vector<ModuleLayout>& modules, bool incomplete_set_aside) {
-  STEREORIG_CHECK(rig_cameras.empty() || int(rig_cameras.size()) == num_cameras);
+                                     const CaptureFolderOptions& per_folder) {
+  STEREORIG_CHECK(per_folder.rig_cameras.empty() || int(per_folder.rig_cameras.size()) == num_cameras);
   RequireCapturesFolder(dir_in);
   if (IsDatasetWithoutCaptures(dir_in))
     throw InputError(dir_in,
@@ -318,8 +316,9 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
   }
 
   const std::vector<int> indices = CaptureIndices(captures);
-  if (rig_cameras.empty())
-    RefuseModulesOfTwoImagerSizes(dir.string(), modules, CameraImageSizes(dir.string(), captures, num_cameras));
+  if (per_folder.rig_cameras.empty())
+    RefuseModulesOfTwoImagerSizes(dir.string(), per_folder.modules,
+                                  CameraImageSizes(dir.string(), captures, num_cameras));
 
   DetectedCaptures out;
   for (const fs::path& folder : skipped) out.skipped_folders.push_back(folder.string());
@@ -327,25 +326,31 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
   out.cameras.resize(num_cameras);
   for (int c = 0; c < num_cameras; ++c) {
     out.cameras[c].name = "cam" + std::to_string(c);
-    if (!rig_cameras.empty()) {
-      out.cameras[c].width_px = rig_cameras[c].width_px;
-      out.cameras[c].height_px = rig_cameras[c].height_px;
+    if (!per_folder.rig_cameras.empty()) {
+      out.cameras[c].width_px = per_folder.rig_cameras[c].width_px;
+      out.cameras[c].height_px = per_folder.rig_cameras[c].height_px;
     }
   }
-  const TargetDetector detector(target, options);
+  const TargetDetector detector(target, per_folder.detect);
   for (size_t n = 0; n < captures.size(); ++n) {
     const std::string name = captures[n].filename().string();
     const int capture = indices[n];
-    if (incomplete_set_aside) {
+    if (per_folder.incomplete_set_aside) {
       std::vector<std::string> missing;
-      for (int c = 0; c < num_cameras; ++c)
-        if (!fs::exists(captures[n] / CameraImageName(c)))
-          missing.push_back((captures[n] / CameraImageName(c)).string());
+      for (int c = 0; c < num_cameras; ++c) {
+        // Empty counts as missing: a trigger or a write that failed leaves
+        // a file of 0 bytes as often as none (it refused the night).
+        const fs::path image = captures[n] / CameraImageName(c);
+        std::error_code error;
+        if (!fs::exists(image) || (fs::is_regular_file(image) && fs::file_size(image, error) == 0 && !error))
+          missing.push_back(image.string());
+      }
       if (!missing.empty()) {
         out.missing_images.insert(out.missing_images.end(), missing.begin(), missing.end());
         --out.num_captures;
-        if (progress)
-          std::fprintf(stderr, "%s\n", PrintableText("detect " + name + ": set aside, an image missing").c_str());
+        if (per_folder.progress)
+          std::fprintf(stderr, "%s\n",
+                       PrintableText("detect " + name + ": set aside, an image missing or empty").c_str());
         continue;
       }
     }
@@ -384,7 +389,7 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
       } else if (spec.width_px != width_px || spec.height_px != height_px) {
         const std::string size = std::to_string(width_px) + "x" + std::to_string(height_px);
         const std::string expected = std::to_string(spec.width_px) + "x" + std::to_string(spec.height_px);
-        if (!rig_cameras.empty())
+        if (!per_folder.rig_cameras.empty())
           throw InputError(image.string(), size + ", but the rig's cam" + std::to_string(c) + " is " + expected +
                                                " (an image of another camera, or captures from another rig?)");
         throw InputError(image.string(), "image of the wrong size: " + size + ", but cam" + std::to_string(c) +
@@ -429,7 +434,7 @@ DetectedCaptures DetectCaptureFolder(const std::string& dir_in, const Target& ta
       }
       out.log.push_back(log);
     }
-    if (progress) std::fprintf(stderr, "%s\n", PrintableText(line).c_str());
+    if (per_folder.progress) std::fprintf(stderr, "%s\n", PrintableText(line).c_str());
   }
   return out;
 }
@@ -601,8 +606,10 @@ FolderCalibration CalibrateCaptureFolder(const std::string& captures_dir, const 
   input.modules = modules;
   input.source = captures_dir;
   const int num_cameras = LayoutCameraCount(input.modules);
-  DetectedCaptures detected =
-      DetectCaptureFolder(captures_dir, target, num_cameras, DetectOptions(), options.progress, {}, input.modules);
+  CaptureFolderOptions per_folder;  // calibrate's: no rig yet
+  per_folder.progress = options.progress;
+  per_folder.modules = input.modules;
+  DetectedCaptures detected = DetectCaptureFolder(captures_dir, target, num_cameras, per_folder);
   input.cameras = detected.cameras;
   input.observations = std::move(detected.observations);
   input.capture_names = std::move(detected.capture_names);

@@ -43,9 +43,10 @@ struct DetectedCaptures {
   // deeper) is refused instead: skipped, a misnamed capture was lost
   // without a word.
   std::vector<std::string> skipped_folders{};
-  // With incomplete_set_aside (DetectCaptureFolder): the camK.png files
-  // missing from captures that were set aside whole for it, sorted by
-  // capture; those captures are in neither num_captures nor capture_names.
+  // With incomplete_set_aside (CaptureFolderOptions): the camK.png files
+  // missing (or empty: 0 bytes) from captures that were set aside whole for
+  // it, sorted by capture; those captures are in neither num_captures nor
+  // capture_names.
   std::vector<std::string> missing_images{};
 };
 
@@ -65,22 +66,31 @@ void RequireCapturesFolder(const std::string& dir);
 // (not captures: ...)": for a refusal or a report to name them.
 std::string SkippedFoldersNote(const std::vector<std::string>& skipped_folders);
 
+// How DetectCaptureFolder reads a captures folder: calibrate's way (no rig
+// yet) and check's (held to the rig) differ in every field but `detect`.
+struct CaptureFolderOptions {
+  DetectOptions detect{};
+  bool progress = false;  // one line per capture on stderr
+  // (num_cameras,) the sizes a rig file gives each camera's images (check),
+  // every image held to them; empty (calibrate: no rig yet): each camera's
+  // images are held to one size, and each module of `modules` to one size
+  // for its two cameras, both read from the PNG headers and refused before
+  // any detection.
+  std::vector<CameraImager> rig_cameras{};
+  std::vector<ModuleLayout> modules{};
+  // A capture missing a camera's image, or holding it empty (0 bytes), is
+  // set aside whole (missing_images), not refused: the nightly check, whose
+  // 8 to 10 captures leave room for one lost (calibrate refuses it).
+  bool incomplete_set_aside = false;
+};
+
 // Detects the target in every image. Throws InputError (naming the file) on
 // a missing folder or image, a capture sub-folder holding images none of
-// which is named camK.png (naming it and them), an unreadable image, an image of the wrong
-// size, or a dataset folder without calibration/ captures. `progress`: one
-// line per capture on stderr. `rig_cameras`: (num_cameras,) the sizes a
-// rig file gives each camera's images (check), every image held to them;
-// empty (calibrate: no rig yet): each camera's images are held to one size,
-// and each module of `modules` to one size for its two cameras, both read
-// from the PNG headers and refused before any detection.
-// `incomplete_set_aside`: a capture missing a camera's image is set aside
-// whole (missing_images), not refused: the nightly check, whose 8 to 10
-// captures leave room for one lost (calibrate refuses it).
+// which is named camK.png (naming it and them), an unreadable image, an
+// image of the wrong size (CaptureFolderOptions), or a dataset folder
+// without calibration/ captures.
 DetectedCaptures DetectCaptureFolder(const std::string& dir, const Target& target, int num_cameras,
-                                     const DetectOptions& options, bool progress,
-                                     const std::vector<CameraImager>& rig_cameras = {},
-                                     const std::vector<ModuleLayout>& modules = {}, bool incomplete_set_aside = false);
+                                     const CaptureFolderOptions& per_folder);
 
 // "" unless most images were rejected (more than half) and at least one in
 // ten as not fitting the target's layout (ambiguous: no single orientation

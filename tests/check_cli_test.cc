@@ -319,12 +319,15 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     std::ofstream(d + "/003/cam1.png", std::ios::binary | std::ios::trunc) << "\xff\xd8\xff\xe0 a JPEG's start";
     expect_refused(check(d, dir + "/rig.yaml"), "003/cam1.png: is not a PNG file, though named .png", "JPEG bytes");
   }
-  {  // An empty image (a camera has only just created it): named so, not
-     // as another format (png_reader.h).
-    const std::string d = copy("empty_image");
-    std::ofstream(d + "/003/cam1.png", std::ios::binary | std::ios::trunc).close();
-    expect_refused(check(d, dir + "/rig.yaml"), "003/cam1.png: is empty (0 bytes: still being written?)",
-                   "an empty image");
+  {  // Empty images (0 bytes: a failed write) in more captures than the
+     // night can spare: each costs its capture, as a missing one does
+     // (ExchangedCables...AMissingImage...), and the refusal names them.
+     // Before, the first empty one refused the night as unreadable.
+    const std::string d = copy("empty_images");
+    for (const char* capture : {"001", "002", "003", "004", "005", "006"})
+      std::ofstream(d + "/" + capture + "/cam1.png", std::ios::binary | std::ios::trunc).close();
+    expect_refused(check(d, dir + "/rig.yaml"), "001/cam1.png: missing or empty (each capture needs camK.png",
+                   "empty images");
   }
   {  // A corrupt (truncated, unreadable) image.
     const std::string d = copy("corrupt");
@@ -1684,6 +1687,12 @@ TEST(CheckCli, ExchangedCablesABaselineOffAndAnExtraCameraAreNamedAndAMissingIma
 
   const std::string missing = copy("missing");
   fs::remove(missing + "/" + names[3] + "/cam2.png");
+  // An empty image (a failed write leaves 0 bytes) costs its capture too:
+  // it refused the night ("is empty (0 bytes: still being written?)").
+  // One line a capture.
+  std::ofstream(missing + "/" + names[4] + "/cam0.png", std::ios::trunc).close();
+  fs::remove(missing + "/" + names[4] + "/cam1.png");
+  std::ofstream(missing + "/" + names[5] + "/cam3.png", std::ios::trunc).close();
   r = RunCli("check --rig " + dir + "/rig.yaml --captures " + missing + target + " --report " + dir + "/missing.json");
   EXPECT_EQ(r.code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("set aside: capture " + names[3] + " whole: cam2.png missing; not used"), std::string::npos)
@@ -1692,10 +1701,25 @@ TEST(CheckCli, ExchangedCablesABaselineOffAndAnExtraCameraAreNamedAndAMissingIma
                        "/cam2.png: missing; its capture set aside, the night judged without it"),
             std::string::npos)
       << r.err;
+  EXPECT_NE(r.out.find("set aside: capture " + names[4] +
+                       " whole: cam0.png empty (0 bytes), cam1.png missing; not "
+                       "used"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.err.find("stereorig check: warning: " + missing + "/" + names[4] +
+                       "/cam0.png: empty (0 bytes); its capture set aside"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.out.find("set aside: capture " + names[5] + " whole: cam3.png empty (0 bytes); not used"),
+            std::string::npos)
+      << r.out;
   EXPECT_NE(r.out.find("verdict: ok"), std::string::npos) << r.out;
   const nlohmann::json j = ReadReport(dir + "/missing.json");
   ASSERT_TRUE(j.is_object());
-  EXPECT_EQ(j["missing_images"], nlohmann::json::array({missing + "/" + names[3] + "/cam2.png"})) << j.dump(2);
+  EXPECT_EQ(j["missing_images"],
+            nlohmann::json::array({missing + "/" + names[3] + "/cam2.png", missing + "/" + names[4] + "/cam0.png",
+                                   missing + "/" + names[4] + "/cam1.png", missing + "/" + names[5] + "/cam3.png"}))
+      << j.dump(2);
   fs::remove_all(dir);
 }
 
