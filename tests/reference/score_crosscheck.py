@@ -4,7 +4,9 @@
 usage: score_crosscheck.py SCORE_JSON DATASET CLOUD_DIR [TOLERANCE_MM]
 
 SCORE_JSON: `stereorig score --report` of DATASET; CLOUD_DIR/<scene>.ply: the
-clouds `stereorig reconstruct` writes for the same scenes, rig and options.
+clouds `stereorig reconstruct` writes for the same scenes, rig and options;
+CLOUD_DIR/<scene>_passive.ply, where the report scored a scene's passive
+capture: its cloud with score's passive options.
 For each scene in the report: reads the cloud and the simulator's dense truth
 (DATASET/truth/scenes/<scene>/surface.ply), aligns the cloud by its own
 point-to-plane ICP from the identity, then takes each measured point's
@@ -13,8 +15,13 @@ whose nearest sample is more than 1 mm away, that sample's distance), signed
 by the cloud's normal (the definition in reconstruct/score.h; none of its
 code).
 Compares per module and merged: the point count exactly, mean |e| and std
-within TOLERANCE_MM (default 0.001). Prints one line per figure; exit 0 if all
-agree, 1 if not, 2 on bad arguments.
+within TOLERANCE_MM (default 0.001). The passive cloud is scored under the
+active cloud's alignment (score's rule: its mismatches would pull their own)
+and compared the same way, and so are the counts within 0.5 mm (active
+merged and passive) and active_over_passive_within_0_5_mm: a count may differ
+by the points whose |e| lies within TOLERANCE_MM of 0.5 mm (the distances'
+own tolerance, carried to the count), the ratio by what those allow. Prints
+one line per figure; exit 0 if all agree, 1 if not, 2 on bad arguments.
 
 Why 0.001 mm: the two alignments differ by design only where the surface
 hardly fixes the motion (score.cc damps those directions, this script leaves
@@ -128,26 +135,52 @@ def align(tree, truth, points, iterations=40):
     return r, t, False
 
 
-def figures(e):
-    return {'points': len(e), 'mean_abs_mm': float(np.mean(np.abs(e))) if len(e) else 0.0,
-            'std_mm': float(np.std(e)) if len(e) else 0.0}
+def figures(e, tolerance=0.0):
+    """Count, mean |e|, std; the count within 0.5 mm and how many of those
+    could flip with a change of `tolerance` mm in |e| (the points that near
+    the bound)."""
+    a = np.abs(e)
+    return {'points': len(e), 'mean_abs_mm': float(np.mean(a)) if len(e) else 0.0,
+            'std_mm': float(np.std(e)) if len(e) else 0.0, 'within': int(np.count_nonzero(a <= 0.5)),
+            'within_slack': int(np.count_nonzero(np.abs(a - 0.5) <= tolerance))}
 
 
-def score_scene(cloud, truth):
-    tree = cKDTree(truth)
+def measured_points(cloud):
     measured = cloud['module'] != FILLED_MODULE
     xyz = np.stack([cloud['x'], cloud['y'], cloud['z']], axis=1).astype(np.float64)[measured]
     normal = np.stack([cloud['nx'], cloud['ny'], cloud['nz']], axis=1).astype(np.float64)[measured]
-    module = cloud['module'][measured]
-    r, t, converged = align(tree, truth, xyz)
-    if not converged:
-        raise RuntimeError('the alignment did not converge')
+    return xyz, normal, cloud['module'][measured]
+
+
+def errors(tree, truth, xyz, normal, r, t):
+    """Each point's signed distance to the truth under truth_from_cloud (r, t)."""
     p = xyz @ r.T + t
     c, n, nearest = local_planes(tree, truth, p)
     sign = np.where(np.einsum('ni,ni->n', n, normal @ r.T) >= 0, 1.0, -1.0)
     plane = np.einsum('ni,ni->n', p - c, n)
-    e = sign * np.where(nearest > PLANE_REACH_MM, np.copysign(nearest, plane), plane)
-    return figures(e), {int(m): figures(e[module == m]) for m in np.unique(module)}
+    return sign * np.where(nearest > PLANE_REACH_MM, np.copysign(nearest, plane), plane)
+
+
+def score_scene(cloud, truth, tolerance, passive=None):
+    """Merged and per-module figures of `cloud`, and (None without `passive`)
+    the passive cloud's merged figures under the active cloud's alignment."""
+    tree = cKDTree(truth)
+    xyz, normal, module = measured_points(cloud)
+    r, t, converged = align(tree, truth, xyz)
+    if not converged:
+        raise RuntimeError('the alignment did not converge')
+    e = errors(tree, truth, xyz, normal, r, t)
+    passive_figures = None
+    if passive is not None:
+        pxyz, pnormal, _ = measured_points(passive)
+        passive_figures = figures(errors(tree, truth, pxyz, pnormal, r, t), tolerance)
+    return (figures(e, tolerance), {int(m): figures(e[module == m]) for m in np.unique(module)}, passive_figures)
+
+
+def within_agrees(theirs, ours):
+    """score's within_0_5_mm count against ours, up to the points near 0.5 mm."""
+    count = round(theirs['within_0_5_mm'] * theirs['points'])
+    return abs(count - ours['within']) <= ours['within_slack'], count
 
 
 def main():
@@ -165,10 +198,30 @@ def main():
         name = scene['scene']
         truth_ply = read_ply(os.path.join(dataset, 'truth', 'scenes', name, 'surface.ply'))
         truth = np.stack([truth_ply['x'], truth_ply['y'], truth_ply['z']], axis=1).astype(np.float64)
-        merged, per_module = score_scene(read_ply(os.path.join(cloud_dir, name + '.ply')), truth)
+        passive_ply = os.path.join(cloud_dir, name + '_passive.ply')
+        passive_scored = isinstance(scene.get('passive'), dict) and scene['passive'].get('points', 0) > 0
+        if passive_scored and not os.path.exists(passive_ply):
+            print(f'{passive_ply}: missing (the report scored the passive capture)', file=sys.stderr)
+            return 2
+        merged, per_module, passive = score_scene(read_ply(os.path.join(cloud_dir, name + '.ply')), truth,
+                                                  tolerance, read_ply(passive_ply) if passive_scored else None)
         rows = [('merged', scene['merged'], merged)]
         rows += [(f"m{m['module']}", m['accuracy'], per_module.get(m['module'], figures([])))
                  for m in scene['modules']]
+        if passive is not None:
+            rows.append(('passive', scene['passive'], passive))
+            active_ok, active_count = within_agrees(scene['merged'], merged)
+            passive_ok, passive_count = within_agrees(scene['passive'], passive)
+            # The ratio's range over the counts the slack allows.
+            low = (merged['within'] - merged['within_slack']) / (passive['within'] + passive['within_slack'])
+            high = (merged['within'] + merged['within_slack']) / max(1, passive['within'] - passive['within_slack'])
+            ratio = scene['active_over_passive_within_0_5_mm']
+            ok = active_ok and passive_ok and ratio is not None and low - 1e-9 <= ratio <= high + 1e-9
+            bad += not ok
+            print(f"{name:8s} within 0.5 mm: active {active_count} / {merged['within']}, passive {passive_count} / "
+                  f"{passive['within']} (+-{merged['within_slack']}, +-{passive['within_slack']} near the bound); "
+                  f"active/passive {ratio} / [{low:.4f}, {high:.4f}] (stereorig score / scipy)"
+                  f"{'' if ok else '  DIFFERS'}")
         for label, theirs, ours in rows:
             if theirs['points'] == 0 or ours['points'] == 0:
                 # No point: score's figures are null (JSON), nothing to compare but the count.
