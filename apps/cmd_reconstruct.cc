@@ -213,7 +213,7 @@ int RunReconstruct(int argc, char** argv) {
   // a module that measured nothing (lasers off, a camera not triggered) for
   // a measurement; the exit code stays 0 (the capture was reconstructed).
   for (const ModuleReport& m : rec.modules)
-    if (const std::string why = NoPointReason(m); !why.empty())
+    if (const std::string why = NoPointReason(m, IsPassive(options)); !why.empty())
       std::fprintf(stderr, "stereorig reconstruct: warning: module %d gave no point: %s\n", m.module, why.c_str());
   std::printf("%zu points (%d from the shape model) in %.1f ms; wrote %s", rec.cloud.size(), rec.filled_points,
               rec.times_ms.at("total_point_cloud"), out_path.c_str());

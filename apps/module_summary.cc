@@ -41,7 +41,7 @@ constexpr const char* kPassiveOptions =
 // the measurement volume, also when the volume was right and another test
 // took every pixel (object_size, a passive capture's grid tests, a swapped
 // module's images, which no search can match).
-std::string AdviceFor(PixelStatus status) {
+std::string AdviceFor(PixelStatus status, bool passive) {
   switch (status) {
     case PixelStatus::kOutsideVolume:
       return std::string("they were matched outside the measurement volume: if the object is not in it, ") +
@@ -71,6 +71,16 @@ std::string AdviceFor(PixelStatus status) {
     case PixelStatus::kNoPlane:
     case PixelStatus::kOffPlaneCoarse:
     case PixelStatus::kOutOfRange:
+      // Passive options already: telling the user to set them sent them in
+      // a circle (a passive plain plate, which no search matches).
+      if (passive)
+        return std::string(
+                   "the search found no consistent match: without the laser grid (these options are passive) a "
+                   "weakly textured surface (a plain plate, a glaze) gives few matches or none, which is what the "
+                   "grid is for; or the object may not be in the measurement volume (") +
+               kSetTheVolume +
+               "), or the module's two images may not be a stereo pair of this rig (its cameras swapped or moved: "
+               "check the rig file, `stereorig check`)";
       return std::string("the search found no consistent match: the object may not be in the measurement volume (") +
              kSetTheVolume +
              "), the module's two images may not be a stereo pair of this rig (its cameras swapped or moved: check "
@@ -91,7 +101,7 @@ std::string AdviceFor(PixelStatus status) {
 // not counted). A right image grid-lit nowhere while the left is lit comes
 // first: whatever status the left's pixels ended with, no search could match
 // them, and the volume's advice would send the user the wrong way.
-std::string NoPointReason(const ModuleReport& m) {
+std::string NoPointReason(const ModuleReport& m, bool passive) {
   if (m.points > 0) return "";
   if (m.right_camera_lit_pixels == 0 && (m.lit_pixels > 0 || m.camera_lit_pixels > 0))
     return "no pixel of the right camera's image (" + CameraImageName(m.right_camera) +
@@ -105,7 +115,7 @@ std::string NoPointReason(const ModuleReport& m) {
     char share[96];
     std::snprintf(share, sizeof share, "%s %.1f%% of the lit pixels: ", PixelStatusName(PixelStatus(top)),
                   100.0 * m.lit_by_status[top] / m.lit_pixels);
-    return share + AdviceFor(PixelStatus(top));
+    return share + AdviceFor(PixelStatus(top), passive);
   }
   if (m.camera_lit_pixels > 0)
     return std::to_string(m.camera_lit_pixels) +
@@ -172,7 +182,7 @@ std::string ModuleSummary(const ModuleReport& m, FillWording wording, int max_re
                                      " points removed, seen through (free_space_test; " +
                                      std::to_string(m.seen_through_surface) + " of them with their surface)"
                                : "";
-  const std::string no_point = NoPointReason(m);
+  const std::string no_point = NoPointReason(m, wording.passive);
   return buf + (losses.empty() ? "none" : losses) + seen + RangeEndWarning(m) + RowDriftWarning(m) +
          (no_point.empty() ? "" : "\n  no point: " + no_point);
 }

@@ -52,8 +52,9 @@ std::string ModuleSummary(const ModuleReport& m, FillWording wording = {}, int m
 // first). A batch's and a
 // stream's warning line and a single capture's stderr give it too: a module
 // that gives no point (lasers off, a camera not triggered, its cables
-// swapped) must not pass as a measurement.
-std::string NoPointReason(const ModuleReport& m);
+// swapped) must not pass as a measurement. `passive`: the run's options are
+// passive (IsPassive): the advice does not ask for them.
+std::string NoPointReason(const ModuleReport& m, bool passive);
 
 // The ends of the volume's disparity range a module with points is warned
 // of (ModuleReport::RangeEndsReached): "both ends", "the near end", "the far

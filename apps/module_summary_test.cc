@@ -80,6 +80,30 @@ TEST(ModuleSummary, NoPointAtAllFollowsTheLitPixelsTopStatus) {
   EXPECT_EQ(ModuleSummary(m).find("no point:"), std::string::npos);
 }
 
+// A passive run (the demo's passive_options.yaml) of a plain plate matches
+// nothing: the advice told the user to set the passive options they had
+// set. With passive options it says what a passive capture of weak texture
+// gives instead, and still names the volume and a swapped pair.
+TEST(ModuleSummary, NoPointUnderPassiveOptionsDoesNotAskForThem) {
+  ModuleReport m = Report();
+  m.points = m.lit_filled = 0;
+  m.lit_by_status[size_t(PixelStatus::kNoSgmMatch)] = 698;
+  m.lit_by_status[size_t(PixelStatus::kNoPlane)] = 302;
+  const std::string passive = NoPointReason(m, true);
+  EXPECT_EQ(passive.find("crop_to_lit_region"), std::string::npos) << passive;
+  EXPECT_NE(passive.find("no_sgm_match 69.8% of the lit pixels: the search found no consistent match: without the "
+                         "laser grid (these options are passive) a weakly textured surface"),
+            std::string::npos)
+      << passive;
+  EXPECT_NE(passive.find("set working_distance_mm"), std::string::npos) << passive;
+  EXPECT_NE(passive.find("its cameras swapped or moved"), std::string::npos) << passive;
+  EXPECT_EQ(ModuleSummary(m, {.passive = true}).find("crop_to_lit_region"), std::string::npos);
+  // Active options: the passive ones are still the hint (a passive capture
+  // run with the active options).
+  EXPECT_NE(NoPointReason(m, false).find("needs crop_to_lit_region: false"), std::string::npos);
+  EXPECT_NE(ModuleSummary(m).find("needs crop_to_lit_region: false"), std::string::npos);
+}
+
 // No lit pixel where the volume projects: the hint used to need lit pixels,
 // so a volume beside the object gave an empty module and no word. Now the
 // left camera's whole image tells a volume beside the object (lit

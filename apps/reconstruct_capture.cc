@@ -78,11 +78,11 @@ std::vector<std::pair<std::string, std::string>> RemoveEarlierFiles(const std::v
 // measurement: a warning line after the capture's own on stdout, where the
 // line's controller reads each capture's answer, and on stderr, where a
 // log keeps the problems. Returns the modules', for the run's summary.
-nlohmann::json WarnOfModulesWithoutPoints(const Reconstruction& rec, const std::string& dir,
+nlohmann::json WarnOfModulesWithoutPoints(const Reconstruction& rec, bool passive, const std::string& dir,
                                           const CaptureOutputs& outputs, const std::string& progress) {
   nlohmann::json modules = nlohmann::json::array();
   for (const ModuleReport& m : rec.modules) {
-    const std::string why = NoPointReason(m);
+    const std::string why = NoPointReason(m, passive);
     if (why.empty()) continue;
     modules.push_back(m.module);
     std::printf("  warning: module %d gave no point (%s): %s\n", m.module, PrintableText(outputs.report).c_str(),
@@ -162,7 +162,8 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
       entry["modules_with_row_drift"].push_back(m.module);
     }
   }
-  entry["modules_without_points"] = WarnOfModulesWithoutPoints(rec, dir, outputs, progress);
+  entry["modules_without_points"] =
+      WarnOfModulesWithoutPoints(rec, IsPassive(runtime.options()), dir, outputs, progress);
   FlushStdout();
   return entry;
 }
