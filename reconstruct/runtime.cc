@@ -531,9 +531,21 @@ void CheckCaptureFiles(const std::string& dir, const Rig& rig) {
   if (ec) throw InputError(dir, "the capture folder cannot be read: " + ec.message());
   const std::vector<std::string> paths = CaptureImagePaths(dir, rig);
   for (size_t k = 0; k < paths.size(); ++k)
-    if (!fs::exists(paths[k]))
-      throw InputError(paths[k], "missing camera image (camera " + std::to_string(k) + ")");
-    else if (fs::is_directory(paths[k]))
+    if (!fs::exists(paths[k])) {
+      // Every image from here on missing too: a capture of a rig with fewer
+      // cameras (or the wrong rig file), said so; the camera's own line
+      // read like a camera fault (the reverse case names the rig).
+      bool rest_missing = k > 0;
+      for (size_t j = k + 1; j < paths.size() && rest_missing; ++j) rest_missing = !fs::exists(paths[j]);
+      throw InputError(paths[k], "missing camera image (camera " + std::to_string(k) + ")" +
+                                     (rest_missing ? "; the capture holds cam0.png" +
+                                                         (k > 1 ? " to " + CameraImageName(int(k) - 1) : "") +
+                                                         " only and the rig has " + std::to_string(rig.num_cameras()) +
+                                                         " cameras (" + std::to_string(rig.num_modules()) +
+                                                         " modules): a capture of another rig, the wrong rig file, "
+                                                         "or the last cameras not triggered"
+                                                   : ""));
+    } else if (fs::is_directory(paths[k]))
       throw InputError(paths[k], "is a folder, not camera " + std::to_string(k) + "'s image");
 }
 

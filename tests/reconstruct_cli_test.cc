@@ -733,6 +733,30 @@ TEST_F(ReconstructCli, MissingCameraExitsTwoAndWritesNothing) {
   ExpectNoOutput();
 }
 
+// A capture of a rig with fewer cameras (the ring's six-camera rig file on a
+// two-module capture, or this rig on a one-module one): said so. Before, the
+// first absent image's line read like that camera's fault; a missing
+// camera among the others still reads so (above).
+TEST_F(ReconstructCli, ACaptureOfFewerCamerasThanTheRigIsSaidSo) {
+  const std::string d = BrokenCapture("fewer_cameras");
+  std::filesystem::remove(d + "/cam2.png");
+  std::filesystem::remove(d + "/cam3.png");
+  const testing::Result r = testing::RunCli(Args(d));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(testing::Lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(d + "/cam2.png: missing camera image (camera 2); the capture holds cam0.png to cam1.png only "
+                           "and the rig has 4 cameras (2 modules): a capture of another rig, the wrong rig file"),
+            std::string::npos)
+      << r.err;
+  ExpectNoOutput();
+  std::filesystem::remove(d + "/cam1.png");
+  std::filesystem::copy_file(dir_ + "/capture/cam3.png", d + "/cam3.png");
+  const testing::Result one_missing = testing::RunCli(Args(d));
+  EXPECT_EQ(one_missing.code, 2);
+  EXPECT_NE(one_missing.err.find(d + "/cam1.png: missing camera image (camera 1)\n"), std::string::npos)
+      << one_missing.err;
+}
+
 TEST_F(ReconstructCli, WrongImageSizeExitsTwoAndWritesNothing) {
   const std::string d = BrokenCapture("wrong_size");
   cv::imwrite(d + "/cam1.png", cv::Mat(480, 640, CV_8UC1, cv::Scalar(10)));
