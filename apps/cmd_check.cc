@@ -84,8 +84,9 @@ std::string Crc32Hex(const std::string& bytes) {
 // ("000/cam0.png") and its bytes, in CaptureFolderImages' order: the same
 // night checked again (or a copy of it elsewhere) reads as the same, an
 // image taken again as another night. What the history tells a night
-// appended twice by. An image that cannot be read counts by its name (the
-// detection names it).
+// appended twice by. An image that cannot be read, or is no regular file (a
+// pipe, a link to /dev/zero: opened here, it blocked or never ended), counts
+// by its name (the detection refuses it).
 std::string CapturesCrc32Hex(const std::string& captures) {
   namespace fs = std::filesystem;
   uLong crc = crc32(0L, Z_NULL, 0);
@@ -94,6 +95,8 @@ std::string CapturesCrc32Hex(const std::string& captures) {
     const fs::path path(image);
     const std::string name = (path.parent_path().filename() / path.filename()).string();
     crc = Crc32Update(crc, name.c_str(), name.size() + 1);  // with its '\0': names and bytes do not run together
+    std::error_code error;
+    if (!fs::is_regular_file(path, error)) continue;
     std::ifstream in(image, std::ios::binary);
     while (in.read(buffer.data(), std::streamsize(buffer.size())) || in.gcount() > 0)
       crc = Crc32Update(crc, buffer.data(), size_t(in.gcount()));

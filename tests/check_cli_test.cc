@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 
 #include <filesystem>
@@ -318,6 +319,28 @@ TEST(CheckCli, BadInputExitsTwoWithOneLineAndLeavesTheHistoryIntact) {
     const std::string d = copy("jpeg_named_png");
     std::ofstream(d + "/003/cam1.png", std::ios::binary | std::ios::trunc) << "\xff\xd8\xff\xe0 a JPEG's start";
     expect_refused(check(d, dir + "/rig.yaml"), "003/cam1.png: is not a PNG file, though named .png", "JPEG bytes");
+  }
+  {  // A pipe named cam1.png (a capture tool writing through one): refused
+     // in one line, never opened. Before, the CRC of the night's images
+     // opened it first and blocked until a writer came, so a nightly timer
+     // hung. A watchdog opening the pipe to write, which succeeds only while
+     // a reader holds it open, tells a check that opened it (and lets it go
+     // on) from one that did not.
+    const std::string d = copy("pipe_image"), pipe = d + "/003/cam1.png";
+    fs::remove(pipe);
+    ASSERT_EQ(mkfifo(pipe.c_str(), 0600), 0);
+    std::atomic<bool> done{false}, opened{false};
+    std::thread watchdog([&] {
+      while (!done) {
+        if (const int fd = open(pipe.c_str(), O_WRONLY | O_NONBLOCK); fd >= 0) opened = true, close(fd);
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      }
+    });
+    const Result r = check(d, dir + "/rig.yaml");
+    done = true;
+    watchdog.join();
+    EXPECT_FALSE(opened) << "the check opened the pipe to read it";
+    expect_refused(r, "003/cam1.png: is not a regular file", "a pipe as an image");
   }
   {  // Empty images (0 bytes: a failed write) in more captures than the
      // night can spare: each costs its capture, as a missing one does
