@@ -215,6 +215,15 @@ int RunReconstruct(int argc, char** argv) {
   for (const ModuleReport& m : rec.modules)
     if (const std::string why = NoPointReason(m, IsPassive(options)); !why.empty())
       std::fprintf(stderr, "stereorig reconstruct: warning: module %d gave no point: %s\n", m.module, why.c_str());
+  // So is a module whose rows read off: its points may be a grid period off
+  // while the fill looks right (docs/reconstruct.md, "Row drift").
+  for (const ModuleReport& m : rec.modules)
+    if (m.row_drift.warned)
+      std::fprintf(stderr,
+                   "stereorig reconstruct: warning: module %d's rectified rows read %+.3f px off at the laser grid's "
+                   "vernier (standard error %.3f; its summary above): run `stereorig check` on the rig before "
+                   "trusting that module's points\n",
+                   m.module, m.row_drift.row_offset_px, m.row_drift.standard_error_px);
   std::printf("%zu points (%d from the shape model) in %.1f ms; wrote %s", rec.cloud.size(), rec.filled_points,
               rec.times_ms.at("total_point_cloud"), out_path.c_str());
   if (!mesh_path.empty()) std::printf(", %s (%zu triangles)", mesh_path.c_str(), rec.mesh.triangles.size());

@@ -60,7 +60,10 @@ std::vector<cv::Mat> LoadCaptureOrInputError(const std::string& dir, const Rig& 
 // Reconstructs the capture from folder `dir` (its decoded `images`),
 // writes its outputs, all or none (atomic_file.h AtomicOutputSet, as
 // outputs.at_existing says; the mesh only if outputs.mesh is set), then
-// removes the files of outputs.earlier_only. Prints to stdout, flushed,
+// removes the files of outputs.earlier_only. The report's modules each get
+// `row_drift_run`, the run's verdict at this capture (RowDriftWatch: counted,
+// not_counted, captures, mean_size_px, standard_error_px, warned,
+// warned_since, stays, withdrawn_since). Prints to stdout, flushed,
 // "<progress> <dir>: N points (fill m0 x%, m1 y%), T ms -> <cloud>" (T: the
 // wall time since `started`, when the capture's turn began: waiting for its
 // images, reconstructing, writing), then a line per earlier_only file that
@@ -69,7 +72,9 @@ std::vector<cv::Mat> LoadCaptureOrInputError(const std::string& dir, const Rig& 
 // line per module whose matches reach an end of the volume's disparity
 // range (module_summary.h RangeEndsWarnedOf), one per module whose rows read
 // off over the run's recent captures (`row_drift`: the mean of its last
-// readings, RowDriftWatch, to which this capture's are added), and one per module that gave
+// sound readings, RowDriftWatch, to which this capture's are added; on
+// stderr too when the warning begins, and a note on both when it is
+// withdrawn), and one per module that gave
 // no point ("  warning: module M gave no point (<report>): <why>",
 // module_summary.h NoPointReason; also on stderr, "stereorig reconstruct:
 // <progress> <dir>: warning: ..."). Returns the capture's entry of the run's
