@@ -8,6 +8,7 @@
 #include "apps/cli_util.h"
 #include "apps/command.h"
 #include "apps/module_summary.h"
+#include "apps/ply_cloud_file.h"
 #include "apps/reconstruct_json.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/folder_to_create.h"
@@ -71,6 +72,18 @@ std::vector<std::pair<std::string, std::string>> RemoveEarlierFiles(const std::v
     left.emplace_back(path, ec.message());
   }
   return left;
+}
+
+// Of an earlier run's files of a capture's name (CaptureOutputs::
+// earlier_only), those that are meshes: not a PLY cloud (IsPlyCloudFile).
+// A capture "x.mesh" of an earlier run (or of another batch into this
+// --out-dir) has its cloud at x.mesh.ply, where capture x's mesh would be:
+// removing it for x left x.mesh.json without its cloud.
+std::vector<std::string> EarlierMeshes(const std::vector<std::string>& earlier_only) {
+  std::vector<std::string> meshes;
+  for (const std::string& path : earlier_only)
+    if (!IsPlyCloudFile(path)) meshes.push_back(path);
+  return meshes;
 }
 
 // A module that gave no point (its lasers off, a camera not triggered, its
@@ -180,8 +193,8 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
   written.Add(outputs.report, JsonReportText(report) + "\n");
   written.Commit(outputs.at_existing);  // the report last: once it is there, so are the others
   // An earlier run's mesh of the other format would sit beside this cloud as
-  // if it were its mesh.
-  const std::vector<std::pair<std::string, std::string>> left = RemoveEarlierFiles(outputs.earlier_only);
+  // if it were its mesh; an earlier cloud of that name is another capture's.
+  const std::vector<std::pair<std::string, std::string>> left = RemoveEarlierFiles(EarlierMeshes(outputs.earlier_only));
   nlohmann::json entry;
   entry["capture"] = dir;
   entry["name"] = name;
@@ -236,7 +249,8 @@ nlohmann::json FailedCapture(const std::string& dir, const std::string& name, co
   // replaces them), so that the lines below are true when printed; one that
   // cannot be removed is named in them and in the entry, not passed over.
   std::vector<std::string> paths = {outputs.cloud, outputs.report, outputs.mesh};
-  paths.insert(paths.end(), outputs.earlier_only.begin(), outputs.earlier_only.end());
+  const std::vector<std::string> meshes = EarlierMeshes(outputs.earlier_only);
+  paths.insert(paths.end(), meshes.begin(), meshes.end());
   std::string left_behind;
   nlohmann::json left = nlohmann::json::array();
   for (const auto& [path, why] : RemoveEarlierFiles(paths)) {
