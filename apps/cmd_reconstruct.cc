@@ -69,7 +69,8 @@ int RunReconstruct(int argc, char** argv) {
       "does SIGTERM, SIGHUP or Ctrl-C, once the capture in progress is written (exit as at the end; its summary "
       "says so), and so does a stdout that cannot be written (a reader gone: exit 2). A batch or a single capture "
       "dies of those signals at once, leaving no partial file.\n\n"
-      "Exit codes: 0 ok (a module that gave no point too: warned of on stderr); 2 bad usage or input, or a capture "
+      "Exit codes: 0 ok (a module that gave no point or whose rows read off too: warned of on stderr); 2 bad usage or "
+      "input, or a capture "
       "of a batch or stream that failed (it has no output; the others' outputs are written).\n\n"
       "Examples:\n  stereorig reconstruct --rig rig.yaml --capture data/scenes/cup/active --out cup.ply "
       "--mesh cup.stl --report cup.json\n"
@@ -215,6 +216,15 @@ int RunReconstruct(int argc, char** argv) {
   for (const ModuleReport& m : rec.modules)
     if (const std::string why = NoPointReason(m, IsPassive(options)); !why.empty())
       std::fprintf(stderr, "stereorig reconstruct: warning: module %d gave no point: %s\n", m.module, why.c_str());
+  // So is a module whose rows read off: its points may be a grid period off
+  // while the fill looks right (docs/reconstruct.md, "Row drift").
+  for (const ModuleReport& m : rec.modules)
+    if (m.row_drift.warned)
+      std::fprintf(stderr,
+                   "stereorig reconstruct: warning: module %d's rectified rows read %+.3f px off at the laser grid's "
+                   "vernier (standard error %.3f; its summary above): run `stereorig check` on the rig before "
+                   "trusting that module's points\n",
+                   m.module, m.row_drift.row_offset_px, m.row_drift.standard_error_px);
   std::printf("%zu points (%d from the shape model) in %.1f ms; wrote %s", rec.cloud.size(), rec.filled_points,
               rec.times_ms.at("total_point_cloud"), out_path.c_str());
   if (!mesh_path.empty()) std::printf(", %s (%zu triangles)", mesh_path.c_str(), rec.mesh.triangles.size());

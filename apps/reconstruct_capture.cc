@@ -8,6 +8,7 @@
 #include "apps/cli_util.h"
 #include "apps/command.h"
 #include "apps/module_summary.h"
+#include "apps/ply_cloud_file.h"
 #include "apps/reconstruct_json.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/folder_to_create.h"
@@ -73,6 +74,18 @@ std::vector<std::pair<std::string, std::string>> RemoveEarlierFiles(const std::v
   return left;
 }
 
+// Of an earlier run's files of a capture's name (CaptureOutputs::
+// earlier_only), those that are meshes: not a PLY cloud (IsPlyCloudFile).
+// A capture "x.mesh" of an earlier run (or of another batch into this
+// --out-dir) has its cloud at x.mesh.ply, where capture x's mesh would be:
+// removing it for x left x.mesh.json without its cloud.
+std::vector<std::string> EarlierMeshes(const std::vector<std::string>& earlier_only) {
+  std::vector<std::string> meshes;
+  for (const std::string& path : earlier_only)
+    if (!IsPlyCloudFile(path)) meshes.push_back(path);
+  return meshes;
+}
+
 // A module that gave no point (its lasers off, a camera not triggered, its
 // cables swapped) is a capture that measured nothing there, not a
 // measurement: a warning line after the capture's own on stdout, where the
@@ -93,6 +106,73 @@ nlohmann::json WarnOfModulesWithoutPoints(const Reconstruction& rec, bool passiv
   return modules;
 }
 
+// The run's verdict on a module's rows (RowDriftWatch) in the capture's
+// report beside the capture's own `row_drift`, which judges this capture's
+// reading alone: a report read on its own must not say "not warned" where
+// the run warned of the module at that capture.
+nlohmann::json RowDriftRunJson(const ModuleReport& m, const WatchedRowDrift& drift) {
+  nlohmann::json j;
+  j["counted"] = m.row_drift.read && drift.not_counted.empty();
+  if (!drift.not_counted.empty()) j["not_counted"] = drift.not_counted;
+  j["captures"] = drift.recent.captures;
+  if (drift.recent.read) {
+    j["mean_size_px"] = drift.recent.row_offset_px;
+    j["standard_error_px"] = drift.recent.standard_error_px;
+  }
+  j["warned"] = drift.warned;
+  j["warned_since"] = drift.warned_since;
+  j["stays"] = drift.stays;
+  if (drift.withdrawn_since != 0) j["withdrawn_since"] = drift.withdrawn_since;
+  return j;
+}
+
+// A module's rows read off over the run's recent captures: a line under the
+// capture's on stdout at every capture it holds (the controller's answer),
+// and on stderr, where a log keeps the problems, when it begins and when it
+// is withdrawn (a warning may hold for days of captures: a line each would
+// bury the log; the run's last stderr line counts the captures).
+void SayRowDrift(int module, const WatchedRowDrift& drift, const std::string& dir, const CaptureOutputs& outputs,
+                 const std::string& progress) {
+  const int n = drift.recent.captures;
+  const char* readings = n == 1 ? "'s" : "s'";
+  const std::string not_counted =
+      drift.not_counted.empty() ? "" : ", not counted: its matches reach an end of the volume's disparity range";
+  if (drift.warned) {
+    std::printf(
+        "  warning: module %d's rectified rows read %.3f px off at the laser grid's vernier, the mean size of its "
+        "last %d capture%s readings (standard error %.3f; this capture's in %s: row_drift%s); warned since this "
+        "run's capture %d, %s: %s\n",
+        module, drift.recent.row_offset_px, n, readings, drift.recent.standard_error_px,
+        PrintableText(outputs.report).c_str(), not_counted.c_str(), drift.warned_since,
+        drift.stays ? "and it stays for the run (given on a full window of readings): past ~0.2 px a module reads "
+                      "small again, a whole grid period off"
+                    : "on fewer readings than a full window (20): withdrawn if later ones bring the mean back",
+        kRowDriftAdvice);
+  }
+  if (drift.started)
+    std::fprintf(stderr,
+                 "stereorig reconstruct: %s %s: warning: module %d's rectified rows read %.3f px off at the laser "
+                 "grid's vernier (the mean size of its last %d capture%s readings, standard error %.3f): warned "
+                 "under each capture from here while it holds; run `stereorig check` on the rig before trusting "
+                 "that module's points\n",
+                 progress.c_str(), PrintableText(dir).c_str(), module, drift.recent.row_offset_px, n, readings,
+                 drift.recent.standard_error_px);
+  if (drift.withdrawn_since != 0) {
+    char mean[96] = "no reading counted";
+    if (drift.recent.read)
+      std::snprintf(mean, sizeof mean, "%.3f px (standard error %.3f)", drift.recent.row_offset_px,
+                    drift.recent.standard_error_px);
+    const std::string why = "module " + std::to_string(module) + "'s row-drift warning (since this run's capture " +
+                            std::to_string(drift.withdrawn_since) + ") is withdrawn: the mean size of its last " +
+                            std::to_string(n) + " capture" + readings + " readings is " + mean +
+                            ", within tolerance; it rested on fewer readings than a full window (20), and one "
+                            "capture can read a whole vernier step (0.36 px) off";
+    std::printf("  note: %s (%s: row_drift_run)\n", why.c_str(), PrintableText(outputs.report).c_str());
+    std::fprintf(stderr, "stereorig reconstruct: %s %s: note: %s\n", progress.c_str(), PrintableText(dir).c_str(),
+                 why.c_str());
+  }
+}
+
 }  // namespace
 
 nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::Mat>& images, const std::string& dir,
@@ -107,11 +187,14 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
   AtomicOutputSet written;
   written.Add(outputs.cloud, EncodeCloudPly(rec.cloud));
   if (mesh) written.Add(outputs.mesh, EncodeMesh(rec.cloud, rec.mesh, outputs.mesh));
-  written.Add(outputs.report, JsonReportText(ReconstructionJson(rec)) + "\n");
+  nlohmann::json report = ReconstructionJson(rec);
+  for (size_t k = 0; k < rec.modules.size(); ++k)
+    report["modules"][k]["row_drift_run"] = RowDriftRunJson(rec.modules[k], recent_drift[k]);
+  written.Add(outputs.report, JsonReportText(report) + "\n");
   written.Commit(outputs.at_existing);  // the report last: once it is there, so are the others
   // An earlier run's mesh of the other format would sit beside this cloud as
-  // if it were its mesh.
-  const std::vector<std::pair<std::string, std::string>> left = RemoveEarlierFiles(outputs.earlier_only);
+  // if it were its mesh; an earlier cloud of that name is another capture's.
+  const std::vector<std::pair<std::string, std::string>> left = RemoveEarlierFiles(EarlierMeshes(outputs.earlier_only));
   nlohmann::json entry;
   entry["capture"] = dir;
   entry["name"] = name;
@@ -151,16 +234,8 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
           "  warning: module %d's matches reach %s of the measurement volume's disparity range (%s: "
           "range_end_reached): its points may lie where nothing is; check the volume\n",
           m.module, which.c_str(), outputs.report.c_str());
-    const WatchedRowDrift& drift = recent_drift[k];
-    if (drift.warned) {
-      std::printf(
-          "  warning: module %d's rectified rows read %.3f px off at the laser grid's vernier, the mean size of its "
-          "last %d capture%s readings (standard error %.3f; this capture's in %s: row_drift); warned since this "
-          "run's capture %d, and it stays: past ~0.2 px a module reads small again, a whole grid period off: %s\n",
-          m.module, drift.recent.row_offset_px, drift.recent.captures, drift.recent.captures == 1 ? "'s" : "s'",
-          drift.recent.standard_error_px, outputs.report.c_str(), drift.warned_since, kRowDriftAdvice);
-      entry["modules_with_row_drift"].push_back(m.module);
-    }
+    if (recent_drift[k].warned) entry["modules_with_row_drift"].push_back(m.module);
+    SayRowDrift(m.module, recent_drift[k], dir, outputs, progress);
   }
   entry["modules_without_points"] =
       WarnOfModulesWithoutPoints(rec, IsPassive(runtime.options()), dir, outputs, progress);
@@ -174,7 +249,8 @@ nlohmann::json FailedCapture(const std::string& dir, const std::string& name, co
   // replaces them), so that the lines below are true when printed; one that
   // cannot be removed is named in them and in the entry, not passed over.
   std::vector<std::string> paths = {outputs.cloud, outputs.report, outputs.mesh};
-  paths.insert(paths.end(), outputs.earlier_only.begin(), outputs.earlier_only.end());
+  const std::vector<std::string> meshes = EarlierMeshes(outputs.earlier_only);
+  paths.insert(paths.end(), meshes.begin(), meshes.end());
   std::string left_behind;
   nlohmann::json left = nlohmann::json::array();
   for (const auto& [path, why] : RemoveEarlierFiles(paths)) {

@@ -27,7 +27,9 @@ struct CaptureOutputs {
   AtExisting at_existing = AtExisting::kReplace;
   // Files of the capture's name an earlier run may have left that this run
   // does not write (AddEarlierMeshes), removed with the capture's outputs,
-  // written or failed, so that none is taken for this run's: a batch's.
+  // written or failed, so that none is taken for this run's: a batch's. One
+  // that is a PLY cloud (ply_cloud_file.h) is another capture's cloud (an
+  // earlier run's folder "x.mesh"), not a mesh, and is left.
   std::vector<std::string> earlier_only{};
 };
 
@@ -60,7 +62,11 @@ std::vector<cv::Mat> LoadCaptureOrInputError(const std::string& dir, const Rig& 
 // Reconstructs the capture from folder `dir` (its decoded `images`),
 // writes its outputs, all or none (atomic_file.h AtomicOutputSet, as
 // outputs.at_existing says; the mesh only if outputs.mesh is set), then
-// removes the files of outputs.earlier_only. Prints to stdout, flushed,
+// removes the files of outputs.earlier_only that are meshes (not a PLY
+// cloud: another capture's, ply_cloud_file.h). The report's modules each get
+// `row_drift_run`, the run's verdict at this capture (RowDriftWatch: counted,
+// not_counted, captures, mean_size_px, standard_error_px, warned,
+// warned_since, stays, withdrawn_since). Prints to stdout, flushed,
 // "<progress> <dir>: N points (fill m0 x%, m1 y%), T ms -> <cloud>" (T: the
 // wall time since `started`, when the capture's turn began: waiting for its
 // images, reconstructing, writing), then a line per earlier_only file that
@@ -69,7 +75,9 @@ std::vector<cv::Mat> LoadCaptureOrInputError(const std::string& dir, const Rig& 
 // line per module whose matches reach an end of the volume's disparity
 // range (module_summary.h RangeEndsWarnedOf), one per module whose rows read
 // off over the run's recent captures (`row_drift`: the mean of its last
-// readings, RowDriftWatch, to which this capture's are added), and one per module that gave
+// sound readings, RowDriftWatch, to which this capture's are added; on
+// stderr too when the warning begins, and a note on both when it is
+// withdrawn), and one per module that gave
 // no point ("  warning: module M gave no point (<report>): <why>",
 // module_summary.h NoPointReason; also on stderr, "stereorig reconstruct:
 // <progress> <dir>: warning: ..."). Returns the capture's entry of the run's
@@ -83,7 +91,7 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
 // A capture that failed (bad images, outputs that could not be written, a
 // name already used): it has no output, not a partial one nor a stale one
 // from an earlier run (every file of `outputs` that exists is removed, its
-// earlier_only too: a batch's; a stream, which never replaces a file,
+// earlier_only's meshes too: a batch's; a stream, which never replaces a file,
 // passes none),
 // "stereorig reconstruct: <progress> <why>" goes to stderr and
 // "<progress> <dir>: no output (<why>)" to stdout, flushed. Returns its entry

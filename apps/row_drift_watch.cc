@@ -9,20 +9,30 @@ std::vector<WatchedRowDrift> RowDriftWatch::Add(const std::vector<ModuleReport>&
   ++captures_;
   std::vector<WatchedRowDrift> states;
   for (const ModuleReport& m : modules) {
-    std::deque<RowDrift>& recent = recent_[m.module];
-    if (m.row_drift.read) {
+    Module& watched = modules_[m.module];
+    WatchedRowDrift state;
+    const ModuleReport::RangeEnds ends = m.RangeEndsReached();
+    if (m.row_drift.read && (ends.near || ends.far)) {
+      state.not_counted = "range_end_reached";
+    } else if (m.row_drift.read) {
       RowDrift size = m.row_drift;
       size.row_offset_px = std::abs(size.row_offset_px);
-      recent.push_back(size);
-      if (int(recent.size()) > kCaptures) recent.pop_front();
+      watched.recent.push_back(size);
+      if (int(watched.recent.size()) > kCaptures) watched.recent.pop_front();
     }
-    WatchedRowDrift state;
-    state.recent = MeanRowDrift(std::vector<RowDrift>(recent.begin(), recent.end()));
+    state.recent = MeanRowDrift(std::vector<RowDrift>(watched.recent.begin(), watched.recent.end()));
     state.recent.warned = RowDriftWarned(state.recent, max_row_offset_px_);
-    int& since = warned_since_[m.module];
-    if (state.recent.warned && since == 0) since = captures_;
-    state.warned = since > 0;
-    state.warned_since = since;
+    if (state.recent.warned && state.recent.captures >= kCaptures) watched.stays = true;
+    state.stays = watched.stays;
+    state.warned = state.recent.warned || watched.stays;
+    if (state.warned && watched.warned_since == 0) {
+      watched.warned_since = captures_;
+      state.started = true;
+    } else if (!state.warned && watched.warned_since != 0) {
+      state.withdrawn_since = watched.warned_since;
+      watched.warned_since = 0;
+    }
+    state.warned_since = watched.warned_since;
     states.push_back(state);
   }
   return states;

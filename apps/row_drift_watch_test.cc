@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 namespace stereorig {
@@ -104,6 +105,116 @@ TEST(RowDriftWatch, AModuleNotReadAddsNothing) {
   EXPECT_FALSE(states[1].recent.read);
   EXPECT_FALSE(states[1].warned);
   EXPECT_EQ(states[1].recent.captures, 0);
+}
+
+// A module whose matches reach `ends` of its disparity range [0, 200) px:
+// its band's kept bins [0, 200) for both, [100, 200) near, [0, 100) far.
+ModuleReport Reading(int module, double row_offset_px, double se_px, const char* ends = "none") {
+  ModuleReport m;
+  m.module = module;
+  m.min_disparity_px = 0, m.num_disparities = 200;
+  const std::string e = ends;
+  m.occupied_min_disparity_px = e == "both" || e == "far" ? 0 : 100;
+  m.occupied_end_disparity_px = e == "both" || e == "near" ? 200 : e == "far" ? 100 : 150;
+  RowDrift& d = m.row_drift;
+  d.read = true, d.captures = 1, d.components = 5, d.pixels = 10000;
+  d.row_offset_px = row_offset_px;
+  d.standard_error_px = se_px;
+  return m;
+}
+
+// Module 0's readings in a stream of the tuber then the line's other
+// objects, the volume at 210 mm (measured, reports of `reconstruct
+// --capture -`): the tuber partly outside the volume, 1.4 % fill, its
+// matches reaching both ends of the range, read -0.409 px (standard error
+// 0.016): the grid matched a period off reads a whole step (0.36 px) off.
+// The captures after it read 0.001, -0.002 (its matches reaching the near
+// end) and -0.067 px in turn.
+struct Measured {
+  double row_offset_px, se_px;
+  const char* ends;
+};
+constexpr Measured kTuberOutsideTheVolume = {-0.409, 0.016, "both"};
+constexpr Measured kLineAfterIt[] = {{0.0013, 0.019, "none"}, {-0.0017, 0.024, "near"}, {-0.0666, 0.022, "none"}};
+
+// Not counted: the reading from a module reaching an end of its range says
+// nothing of its rows. Before, that one reading warned (the mean of one)
+// and the warning stayed for all 19 captures.
+TEST(RowDriftWatch, AReadingFromAModuleReachingAnEndOfItsRangeIsNotCounted) {
+  RowDriftWatch watch(0.1);
+  WatchedRowDrift state =
+      watch.Add({Reading(0, kTuberOutsideTheVolume.row_offset_px, kTuberOutsideTheVolume.se_px, "both")})[0];
+  EXPECT_EQ(state.not_counted, "range_end_reached");
+  EXPECT_FALSE(state.recent.read);
+  EXPECT_FALSE(state.warned);
+  for (int k = 0; k < 18; ++k) {
+    const Measured& r = kLineAfterIt[k % 3];
+    state = watch.Add({Reading(0, r.row_offset_px, r.se_px, r.ends)})[0];
+    EXPECT_FALSE(state.warned) << k;
+    EXPECT_EQ(state.not_counted, std::string(r.ends) == "none" ? "" : "range_end_reached") << k;
+  }
+  EXPECT_EQ(state.recent.captures, 12);  // the near end's six not counted
+}
+
+// The same readings with the first one's range end not seen (a reading a
+// step off that no flag catches): warned while the mean of the few
+// readings there are passes 0.1 px and 4 standard errors, withdrawn at the
+// first capture where it does not, and not warned after: on fewer than 20
+// readings a warning is not for the run.
+TEST(RowDriftWatch, AWarningOnFewerReadingsThanAWindowIsWithdrawnWhenTheirMeanFallsBack) {
+  RowDriftWatch watch(0.1);
+  std::vector<double> sizes = {std::abs(kTuberOutsideTheVolume.row_offset_px)};
+  std::vector<double> variances = {kTuberOutsideTheVolume.se_px * kTuberOutsideTheVolume.se_px};
+  WatchedRowDrift state =
+      watch.Add({Reading(0, kTuberOutsideTheVolume.row_offset_px, kTuberOutsideTheVolume.se_px)})[0];
+  EXPECT_TRUE(state.warned);
+  EXPECT_TRUE(state.started);
+  EXPECT_FALSE(state.stays);
+  int withdrawn_at = 0;
+  for (int k = 0; k < 18; ++k) {
+    const Measured& r = kLineAfterIt[k % 3];
+    state = watch.Add({Reading(0, r.row_offset_px, r.se_px, r.ends)})[0];
+    if (std::string(r.ends) == "none") {
+      sizes.push_back(std::abs(r.row_offset_px));
+      variances.push_back(r.se_px * r.se_px);
+    }
+    double sum = 0, var = 0;
+    for (size_t i = 0; i < sizes.size(); ++i) sum += sizes[i], var += variances[i];
+    const double mean = sum / double(sizes.size()), se = std::sqrt(var) / double(sizes.size());
+    const bool expect = withdrawn_at == 0 && mean > 0.1 && mean > 4 * se;
+    EXPECT_EQ(state.warned, expect) << k;
+    EXPECT_FALSE(state.stays) << k;
+    if (state.withdrawn_since != 0) {
+      EXPECT_EQ(withdrawn_at, 0) << k;
+      EXPECT_EQ(state.withdrawn_since, 1);
+      withdrawn_at = k + 2;
+    }
+  }
+  EXPECT_GT(withdrawn_at, 2);  // warned over a few captures first: 0.409 and 0.001 average 0.205
+  EXPECT_FALSE(state.warned);
+}
+
+// The docs' camera turned 0.15 px, reading +0.138 (standard error 0.025)
+// at every capture from the run's first, after the tuber outside the
+// volume: warned from the first counted reading (capture 2), for the run
+// once the mean of a full window of 20 warns (capture 21), and then it
+// stays with its readings coming back small (past ~0.2 px a module reads
+// small again).
+TEST(RowDriftWatch, ATurnedCameraIsWarnedFromItsFirstReadingAndForTheRunOnceAWindowIsFull) {
+  RowDriftWatch watch(0.1);
+  EXPECT_FALSE(watch.Add({Reading(0, kTuberOutsideTheVolume.row_offset_px, 0.016, "both")})[0].warned);
+  for (int capture = 2; capture <= 40; ++capture) {
+    const WatchedRowDrift state = watch.Add({Reading(0, 0.138, 0.025)})[0];
+    EXPECT_TRUE(state.warned) << capture;
+    EXPECT_EQ(state.started, capture == 2) << capture;
+    EXPECT_EQ(state.warned_since, 2) << capture;
+    EXPECT_EQ(state.stays, capture >= 21) << capture;
+  }
+  for (int k = 0; k < 30; ++k) {
+    const WatchedRowDrift state = watch.Add({Reading(0, 0.02, 0.025)})[0];
+    EXPECT_TRUE(state.warned) << k;
+    EXPECT_EQ(state.withdrawn_since, 0) << k;
+  }
 }
 
 }  // namespace

@@ -542,7 +542,8 @@ TEST(Cli, EveryCommandsHelpGivesItsExitCodes) {
                   "Exit codes: 0 ok (the rig file written); 2 bad usage or input, or a calibration "
                   "refused as above."},
         std::pair{"reconstruct",
-                  "Exit codes: 0 ok (a module that gave no point too: warned of on stderr); 2 bad usage "
+                  "Exit codes: 0 ok (a module that gave no point or whose rows read off too: warned of on "
+                  "stderr); 2 bad usage "
                   "or input, or a capture of a batch or stream that failed (it has no output; the "
                   "others' outputs are written)."},
         std::pair{"score", "Exit codes: 0 ok (score judges nothing: no figure fails); 2 bad usage or input."},

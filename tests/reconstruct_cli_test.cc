@@ -1741,6 +1741,44 @@ TEST_F(ReconstructCli, ABatchRemovesAnEarlierRunsMeshOfTheOtherFormat) {
   EXPECT_GT(std::filesystem::file_size(out + "/bad.mesh.ply"), 1000000u);  // the cloud this run wrote
 }
 
+// An earlier run's cloud is not a mesh, whatever its name: folders nm/x.mesh
+// and caps/a are named nm_x.mesh and caps_a, so the cloud of the first is
+// nm_x.mesh.ply, where a later batch's capture nm/x (named nm_x) would put
+// its PLY mesh. That batch, with no --mesh-format, removed nm_x.mesh.ply as
+// an earlier mesh of nm_x, exit 0, leaving nm_x.mesh.json without its
+// cloud. A real mesh of that name (the PLY header's face element) is still
+// removed by a batch that writes none of that format.
+TEST_F(ReconstructCli, ABatchKeepsAnEarlierRunsCloudNamedLikeAMesh) {
+  const std::string root = dir_ + "/batch_cloud_named_mesh";
+  std::filesystem::remove_all(root);
+  for (const char* name : {"nm/x.mesh", "nm/x", "caps/a", "caps/b"}) {
+    std::filesystem::create_directories(std::filesystem::path(root + "/" + name).parent_path());
+    std::filesystem::copy(dir_ + "/capture", root + "/" + name);
+  }
+  const std::string out = root + "/out", head = "reconstruct --rig " + dir_ + "/rig.yaml --out-dir " + out;
+  testing::Result r = testing::RunCli(head + " --capture " + root + "/nm/x.mesh " + root + "/caps/a");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string cloud = ReadFileBytes(out + "/nm_x.mesh.ply");
+  ASSERT_GT(cloud.size(), 1000000u);  // the capture's cloud, not an empty file
+  r = testing::RunCli(head + " --capture " + root + "/nm/x " + root + "/caps/b");
+  ASSERT_EQ(r.code, 0) << r.err;
+  ASSERT_TRUE(std::filesystem::exists(out + "/nm_x.mesh.ply")) << r.out;
+  EXPECT_EQ(ReadFileBytes(out + "/nm_x.mesh.ply"), cloud);
+  EXPECT_TRUE(std::filesystem::exists(out + "/nm_x.mesh.json"));
+  EXPECT_TRUE(std::filesystem::exists(out + "/nm_x.ply"));
+
+  // A PLY mesh of nm_x, then a batch writing STL meshes: the PLY one goes.
+  const std::string meshes = root + "/meshes",
+                    mesh_head = "reconstruct --rig " + dir_ + "/rig.yaml --out-dir " + meshes;
+  r = testing::RunCli(mesh_head + " --mesh-format ply --capture " + root + "/nm/x " + root + "/caps/b");
+  ASSERT_EQ(r.code, 0) << r.err;
+  ASSERT_TRUE(std::filesystem::exists(meshes + "/nm_x.mesh.ply"));
+  r = testing::RunCli(mesh_head + " --mesh-format stl --capture " + root + "/nm/x " + root + "/caps/b");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(meshes + "/nm_x.mesh.ply")) << r.out;
+  EXPECT_TRUE(std::filesystem::exists(meshes + "/nm_x.mesh.stl")) << r.out;
+}
+
 // Module 0's right camera (cam1) not triggered: its image black, the left's
 // grid-lit. The left's pixels all end no_sgm_match, and the summary used to
 // send the user to the measurement volume; it names the dark right image.
@@ -1864,6 +1902,7 @@ TEST_F(ReconstructCli, ACameraTurnedSinceCalibrationIsWarnedOfByItsRowDrift) {
     EXPECT_FALSE(m["row_drift"]["warned"].get<bool>()) << m.dump();
   }
   EXPECT_EQ(r.out.find("rectified rows read"), std::string::npos) << r.out;
+  EXPECT_EQ(r.err.find("rectified rows read"), std::string::npos) << r.err;
 
   const SimulatedRig sim = MakeDefaultRig();
   const int right_camera = sim.rig.module(0).right_camera;
@@ -1889,6 +1928,12 @@ TEST_F(ReconstructCli, ACameraTurnedSinceCalibrationIsWarnedOfByItsRowDrift) {
               std::string::npos)
         << r.out;
     EXPECT_NE(r.out.find("run `stereorig check --rig RIG --captures DIR --target BOARD`"), std::string::npos) << r.out;
+    // On stderr too, as a module with no point is: a log keeps the problems.
+    EXPECT_NE(r.err.find("stereorig reconstruct: warning: module 0's rectified rows read " +
+                         std::string(sign > 0 ? "+" : "-")),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(r.err.find("module 1's rectified rows"), std::string::npos) << r.err;
     EXPECT_FALSE(modules_json[1]["row_drift"]["warned"].get<bool>()) << modules_json.dump();  // not turned
   }
   std::printf("turned +-0.12 px: read %+.4f (se %.4f), %+.4f (se %.4f) px over the true rig's\n", reading[0], se[0],

@@ -665,7 +665,8 @@ namespace {
 // A stream keeps each module's recent row-drift readings across its
 // captures (apps/row_drift_watch.h): module 0's right camera turned 0.12 px
 // of rows since the rig file, two captures, a warning on each that says
-// over how many captures its mean is.
+// over how many captures its mean is, on stderr where it begins, and the
+// run's verdict in each capture's report (row_drift_run).
 TEST_F(ReconstructStreamCli, ARowDriftIsJudgedOverTheStreamsRecentCaptures) {
   const SimulatedRig sim = MakeDefaultRig();
   std::vector<StereoModule> modules = sim.rig.modules();
@@ -694,6 +695,25 @@ TEST_F(ReconstructStreamCli, ARowDriftIsJudgedOverTheStreamsRecentCaptures) {
             std::string::npos)
       << r.err;
   EXPECT_EQ(nlohmann::json::parse(Bytes(out + "/summary.json"))["with_row_drift"], 2);
+  // On stderr where it begins, as a log keeps the problems (not at each
+  // capture: a warning may hold for days of captures).
+  const std::string begins =
+      "stereorig reconstruct: [1] " + dir_ + "/line/0001: warning: module 0's rectified rows read 0.";
+  EXPECT_NE(r.err.find(begins), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("[2] " + dir_ + "/line/0002: warning: module 0's"), std::string::npos) << r.err;
+  // Each capture's report holds the run's verdict beside its own reading's:
+  // read alone it must not say "not warned" where the stream warned.
+  for (const std::string name : {"0001", "0002"}) {
+    const nlohmann::json modules = nlohmann::json::parse(Bytes(out + "/" + name + ".json"))["modules"];
+    ASSERT_TRUE(modules[0].contains("row_drift_run")) << modules[0].dump();
+    ASSERT_TRUE(modules[1].contains("row_drift_run")) << modules[1].dump();
+    const nlohmann::json& run = modules[0]["row_drift_run"];
+    EXPECT_EQ(run["warned"], true) << run.dump();
+    EXPECT_EQ(run["warned_since"], 1) << run.dump();
+    EXPECT_EQ(run["counted"], true) << run.dump();
+    EXPECT_EQ(run["captures"], name == "0001" ? 1 : 2) << run.dump();
+    EXPECT_EQ(modules[1]["row_drift_run"]["warned"], false) << modules[1].dump();
+  }
 }
 
 }  // namespace
