@@ -121,11 +121,17 @@ void PrintSpheres(size_t position, const ArtifactEvaluation& e) {
       std::snprintf(shared, sizeof shared, " (x%.1f: neighbouring points share its noise)",
                     std::sqrt(e.sphere_noise_variance_inflation[k]));
     }
+    // A sphere's form is its P_F: printed with the table's digits for it
+    // (0.34153 there read 0.3415 here).
+    const auto p_f = std::find_if(e.figures.begin(), e.figures.end(), [](const Figure& f) { return f.name == "P_F"; });
+    const std::string form = e.type == ArtifactType::kSphere && p_f != e.figures.end()
+                                 ? ValueBesideLimitText(e.sphere_form_mm[k], p_f->mpe_mm)
+                                 : FixedText(e.sphere_form_mm[k], 4);
     std::printf(
         "%-8zu sphere %zu: diameter %.4f mm, standard uncertainty %.4f mm%s, cap half-angle %.0f deg, form (residual "
-        "range) %.4f mm%s\n",
+        "range) %s mm%s\n",
         position, k + 1, e.sphere_diameters_mm[k], e.sphere_diameter_std_mm[k], shared, e.sphere_cap_half_angles_deg[k],
-        e.sphere_form_mm[k], e.type == ArtifactType::kBallBar ? " (not judged: the ball bar's figure is SD)" : "");
+        form.c_str(), e.type == ArtifactType::kBallBar ? " (not judged: the ball bar's figure is SD)" : "");
   }
 }
 

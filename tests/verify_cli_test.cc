@@ -224,6 +224,7 @@ TEST(VerifyCli, AFigureJustOverItsMpeNeverPrintsEqualToIt) {
       << r.out;
   EXPECT_NE(r.out.find("P_F 0.34154 mm (MPE 0.34152 mm) FAIL"), std::string::npos) << r.out;
   EXPECT_TRUE(std::regex_search(r.out, std::regex("\\n1 +P_F +0\\.34154 +- +0\\.34152 +NO "))) << r.out;
+  EXPECT_NE(r.out.find("form (residual range) 0.34154 mm"), std::string::npos) << r.out;  // P_F, as in the table
   EXPECT_NE(r.out.find("P_S 0.0000 mm (MPE 1.5000 mm) pass"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("-0.0000"), std::string::npos) << r.out;
   // The report holds the values unrounded.
