@@ -10,6 +10,7 @@
 
 #include "apps/cli_util.h"
 #include "apps/command.h"
+#include "apps/limit_text.h"
 #include "apps/output_paths.h"
 #include "apps/verify_help.h"
 #include "apps/verify_positions.h"
@@ -120,11 +121,17 @@ void PrintSpheres(size_t position, const ArtifactEvaluation& e) {
       std::snprintf(shared, sizeof shared, " (x%.1f: neighbouring points share its noise)",
                     std::sqrt(e.sphere_noise_variance_inflation[k]));
     }
+    // A sphere's form is its P_F: printed with the table's digits for it
+    // (0.34153 there read 0.3415 here).
+    const auto p_f = std::find_if(e.figures.begin(), e.figures.end(), [](const Figure& f) { return f.name == "P_F"; });
+    const std::string form = e.type == ArtifactType::kSphere && p_f != e.figures.end()
+                                 ? ValueBesideLimitText(e.sphere_form_mm[k], p_f->mpe_mm)
+                                 : FixedText(e.sphere_form_mm[k], 4);
     std::printf(
         "%-8zu sphere %zu: diameter %.4f mm, standard uncertainty %.4f mm%s, cap half-angle %.0f deg, form (residual "
-        "range) %.4f mm%s\n",
+        "range) %s mm%s\n",
         position, k + 1, e.sphere_diameters_mm[k], e.sphere_diameter_std_mm[k], shared, e.sphere_cap_half_angles_deg[k],
-        e.sphere_form_mm[k], e.type == ArtifactType::kBallBar ? " (not judged: the ball bar's figure is SD)" : "");
+        form.c_str(), e.type == ArtifactType::kBallBar ? " (not judged: the ball bar's figure is SD)" : "");
   }
 }
 
@@ -168,7 +175,8 @@ void PrintMpes(const Artifact& artifact) {
   std::printf("MPE:");
   for (size_t k = 0; k < mpes.size(); ++k) {
     const bool given = artifact.mpe.Given(mpes[k].first);
-    std::printf("%s %s %.4f mm (%s)", k ? "," : "", mpes[k].first, mpes[k].second,
+    // As the certificate gives it: 0.34152 printed 0.3415.
+    std::printf("%s %s %s mm (%s)", k ? "," : "", mpes[k].first, LimitText(mpes[k].second).c_str(),
                 given ? "the artifact file's" : "default: the artifact file's mpe_mm gives none");
   }
   std::printf("\n");
@@ -176,9 +184,7 @@ void PrintMpes(const Artifact& artifact) {
 
 std::string UncertaintyText(const Figure& f) {
   if (!f.standard_uncertainty_mm) return "-";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4f", *f.standard_uncertainty_mm);
-  return buf;
+  return FixedText(*f.standard_uncertainty_mm, 4);
 }
 
 }  // namespace
@@ -359,13 +365,15 @@ int RunVerify(int argc, char** argv) {
     // The edge margin is the plate's alone: '-' for the others.
     const std::string edge = e.type == ArtifactType::kPlate ? std::to_string(e.points_in_edge_margin) : "-";
     for (const Figure& f : e.figures) {
-      std::printf("%-8zu %-6s %10.4f %8s %7.4f %4s %8d %7d %8d %7s %8d %8d %10.4f\n", i + 1, f.name.c_str(), f.value_mm,
-                  UncertaintyText(f).c_str(), f.mpe_mm,
+      // The value with the digits that order it against the MPE as the verdict does.
+      std::printf("%-8zu %-6s %10s %8s %7s %4s %8d %7d %8d %7s %8d %8d %10s\n", i + 1, f.name.c_str(),
+                  ValueBesideLimitText(f.value_mm, f.mpe_mm).c_str(), UncertaintyText(f).c_str(),
+                  LimitText(f.mpe_mm).c_str(),
                   !e.judged() || !f.judged ? "-"
                   : f.pass                 ? "yes"
                                            : "NO",
                   e.points_total + filled_skipped[i], filled_skipped[i], e.points_off_artifact, edge.c_str(),
-                  e.points_excluded, e.points_used(), e.residual_mean_abs_mm);
+                  e.points_excluded, e.points_used(), FixedText(e.residual_mean_abs_mm, 4).c_str());
       pj["figures"].push_back(FigureJson(f, e.judged(), artifact));
     }
     for (const Figure& f : e.figures) {
@@ -423,11 +431,12 @@ int RunVerify(int argc, char** argv) {
   for (size_t k = 0; k < summary.worst.size(); ++k) {
     const Figure& f = summary.worst[k];
     const int at = summary.worst_positions[k] + 1;  // numbered as in the table
+    const std::string value = ValueBesideLimitText(f.value_mm, f.mpe_mm), mpe = LimitText(f.mpe_mm);
     if (options.decision_rule != DecisionRule::kSimpleAcceptance && f.standard_uncertainty_mm) {
-      std::printf("  %s %.4f mm (2u %.4f mm, MPE %.4f mm) %s", f.name.c_str(), f.value_mm, f.ExpandedUncertaintyMm(),
-                  f.mpe_mm, f.pass ? "pass" : "FAIL");
+      std::printf("  %s %s mm (2u %s mm, MPE %s mm) %s", f.name.c_str(), value.c_str(),
+                  FixedText(f.ExpandedUncertaintyMm(), 4).c_str(), mpe.c_str(), f.pass ? "pass" : "FAIL");
     } else {
-      std::printf("  %s %.4f mm (MPE %.4f mm) %s", f.name.c_str(), f.value_mm, f.mpe_mm, f.pass ? "pass" : "FAIL");
+      std::printf("  %s %s mm (MPE %s mm) %s", f.name.c_str(), value.c_str(), mpe.c_str(), f.pass ? "pass" : "FAIL");
     }
     if (positions.size() > 1) std::printf(" at position %d", at);
     nlohmann::json worst = FigureJson(f, true, artifact);

@@ -154,8 +154,8 @@ TEST(VerifyCli, AnEmptyPathIsRefusedByItsOptionsName) {
 // An MPE the artifact file does not give is the default (1.5 mm), and the
 // table and the report say so (mpe_source); the file's are "certificate".
 // Before, a certificate without mpe_mm was judged against 1.5 mm with
-// nothing saying it was a default. The MPE is printed with the value's 4
-// decimals: "P_F 0.3415 mm (MPE 0.342) FAIL" read as a contradiction.
+// nothing saying it was a default. The MPE is printed as the file gives it
+// (AFigureJustOverItsMpeNeverPrintsEqualToIt, below).
 TEST(VerifyCli, TheMpeSaysWhetherTheArtifactFileGaveItOrItIsTheDefault) {
   const std::string good = WriteSphere("good_mpe.ply", 19.05);
   const std::string report = ::testing::TempDir() + "/verify_mpe.json";
@@ -172,11 +172,69 @@ TEST(VerifyCli, TheMpeSaysWhetherTheArtifactFileGaveItOrItIsTheDefault) {
   r = RunCli("verify --artifact " + WriteArtifact(std::string(kSphere) + "mpe_mm: {P_F: 0.34152}\n") + " --cloud " +
              good + " --report " + report);
   ASSERT_EQ(r.code, 0) << r.out << r.err;
-  EXPECT_NE(r.out.find("MPE: P_F 0.3415 mm (the artifact file's), P_S 1.5000 mm (default"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("(MPE 0.3415 mm) pass"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("MPE: P_F 0.34152 mm (the artifact file's), P_S 1.5000 mm (default"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("(MPE 0.34152 mm) pass"), std::string::npos) << r.out;
   j = nlohmann::json::parse(std::ifstream(report));
   for (const auto& f : j["positions"][0]["figures"])
     EXPECT_EQ(f["mpe_source"], f["name"] == "P_F" ? "certificate" : "default") << f;
+}
+
+// An ascii PLY of a whole sphere about (10, -5, 0) whose form is known
+// exactly: points in antipodal pairs (the set is symmetric about the centre,
+// so the fit's centre is it), half the pairs form_mm / 2 outside the
+// radius and half inside (so the fit's radius is radius_mm): every residual
+// is +-form_mm / 2 and P_F, their range, is form_mm. 332 points: verify
+// excludes the worst floor(0.3% of n), none under 334, which would break
+// the symmetry (4000 points read P_F 0.342003 for 0.341536).
+std::string WriteSphereWithForm(const std::string& name, double radius_mm, double form_mm) {
+  const std::string path = ::testing::TempDir() + "/" + name;
+  const Eigen::Vector3d center(10, -5, 0);
+  std::vector<Eigen::Vector3d> pts;
+  const int pairs = 166;
+  for (int i = 0; i < pairs; ++i) {
+    const double z = (i + 0.5) / pairs, rho = std::sqrt(1 - z * z), phi = 2.39996322972865332 * i;  // golden angle
+    const Eigen::Vector3d d(rho * std::cos(phi), rho * std::sin(phi), z);
+    const double r = radius_mm + (i % 2 ? -0.5 : 0.5) * form_mm;
+    pts.push_back(center + r * d);
+    pts.push_back(center - r * d);
+  }
+  std::ofstream f(path);
+  f << "ply\nformat ascii 1.0\nelement vertex " << pts.size()
+    << "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
+  f.precision(17);
+  for (const auto& q : pts) f << q.x() << " " << q.y() << " " << q.z() << "\n";
+  return path;
+}
+
+// A figure just over its MPE never prints equal to it: the MPE as the
+// certificate gives it (0.34152, not 0.3415), the value with the digits that
+// order it so. Before, P_F 0.341536 against 0.34152 printed "P_F 0.3415 mm
+// (MPE 0.3415 mm) FAIL" (the audit's demo sphere, P_F 0.341527). And a P_S
+// of -2e-6 mm printed "-0.0000". Truth: P_F 0.341536 and P_S -0.000002 by
+// construction (WriteSphereWithForm; the fit's convergence, 1e-6 mm steps,
+// leaves them within ~1e-9: far inside the 1.6e-5 mm to either tie).
+TEST(VerifyCli, AFigureJustOverItsMpeNeverPrintsEqualToIt) {
+  const std::string cloud = WriteSphereWithForm("form_0341536.ply", 19.05 - 1e-6, 0.341536);
+  const std::string report = ::testing::TempDir() + "/verify_tie.json";
+  const auto r = RunCli("verify --artifact " + WriteArtifact(std::string(kSphere) + "mpe_mm: {P_F: 0.34152}\n") +
+                        " --cloud " + cloud + " --report " + report);
+  ASSERT_EQ(r.code, 1) << r.out << r.err;
+  EXPECT_NE(r.out.find("MPE: P_F 0.34152 mm (the artifact file's), P_S 1.5000 mm (default"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("P_F 0.34154 mm (MPE 0.34152 mm) FAIL"), std::string::npos) << r.out;
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("\\n1 +P_F +0\\.34154 +- +0\\.34152 +NO "))) << r.out;
+  EXPECT_NE(r.out.find("form (residual range) 0.34154 mm"), std::string::npos) << r.out;  // P_F, as in the table
+  EXPECT_NE(r.out.find("P_S 0.0000 mm (MPE 1.5000 mm) pass"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("-0.0000"), std::string::npos) << r.out;
+  // The report holds the values unrounded.
+  const auto j = nlohmann::json::parse(std::ifstream(report));
+  for (const auto& f : j["positions"][0]["figures"])
+    if (f["name"] == "P_F") {
+      EXPECT_NEAR(f["value_mm"].get<double>(), 0.341536, 1e-9) << f;
+      EXPECT_EQ(f["mpe_mm"].get<double>(), 0.34152) << f;
+      EXPECT_EQ(f["pass"], false) << f;
+    }
 }
 
 // Fewer distinct positions than the procedure's 7 keep their verdict, with a

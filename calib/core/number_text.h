@@ -1,6 +1,6 @@
 // A number as text for messages and files: printf's %g to a number of
-// significant digits (17 round-trips a double; rig_file.h's FormatDouble),
-// or the shortest text that round-trips, for files people edit.
+// significant digits (17 round-trips a double), or the shortest text that
+// round-trips, for files people edit (rig_file.h's FormatDouble).
 #pragma once
 
 #include <charconv>

@@ -202,7 +202,7 @@ Rig ParseRig(YamlMap root) {
 
 }  // namespace
 
-std::string FormatDouble(double x) { return NumberText(x, 17); }
+std::string FormatDouble(double x) { return ShortestNumberText(x); }
 
 std::string NowUtcIso8601() {
   const std::time_t t = std::time(nullptr);

@@ -29,7 +29,10 @@ std::string RigToYaml(const Rig& rig);
 // Atomic: temp file and rename.
 void WriteRigFile(const Rig& rig, const std::string& path);
 
-// "%.17g": the shortest printf format that round-trips every double.
+// The shortest text that reads back as the same double (ShortestNumberText,
+// number_text.h): 38.1, where %.17g wrote 38.100000000000001. For every file
+// stereorig writes for people to read: rig, target, artifact, simulator
+// files and exported camera models.
 std::string FormatDouble(double x);
 // Current UTC time as ISO 8601 ("2026-11-23T13:00:00Z"), for provenance.
 std::string NowUtcIso8601();

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -55,6 +57,22 @@ Rig MakeRandomRig(unsigned seed) {
     rig.provenance().target = t;
   }
   return rig;
+}
+
+// Files people read hold the numbers they would type: 38.1, not %.17g's
+// 38.100000000000001 (the simulator's certificates read so), and the text
+// still reads back as the very same double.
+TEST(RigFile, DoublesAreWrittenAsTheShortestTextThatReadsBackTheSame) {
+  EXPECT_EQ(FormatDouble(38.1), "38.1");
+  EXPECT_EQ(FormatDouble(25.4), "25.4");
+  EXPECT_EQ(FormatDouble(0.1 + 0.2), "0.30000000000000004");
+  EXPECT_EQ(FormatDouble(-1e-17), "-1e-17");
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1000, 1000);
+  for (int k = 0; k < 1000; ++k) {
+    const double x = u(rng) * std::pow(10.0, k % 40 - 20);
+    EXPECT_EQ(std::strtod(FormatDouble(x).c_str(), nullptr), x) << FormatDouble(x);
+  }
 }
 
 TEST(RigFile, WriteReadWriteIsBitIdentical) {
