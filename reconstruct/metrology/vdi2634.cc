@@ -822,6 +822,58 @@ std::string TwoLayersNote(const TwoLayers& two, LayersFacing facing, bool has_no
   return buf;
 }
 
+// A thin plate's face without its far face (both in the capture band,
+// measured from opposite sides: FindTwoLayers, FacingOf): the captured
+// points on the face's side of the midway plane between the two layers are
+// its own, and its outline, the face inside it eroded by the margin and its
+// plane are taken from them alone, iterated to their fixed point as the
+// plate's first segmentation is. far_face: the far layer's captured points
+// inside that eroded outline (those in the margin stay in the edge count).
+struct OwnFace {
+  PlaneFit fit;
+  PlaneOutline outline;
+  std::vector<int> face, far_face;  // ascending
+};
+
+void RequirePlateCoverage(const PlaneOutline& e, const Artifact& a, const VerifyOptions& o, double capture_band_mm,
+                          const std::string& where);
+
+OwnFace SegmentOwnFace(const std::vector<Eigen::Vector3d>& pts, const std::vector<int>& captured,
+                       const std::vector<int>& far_layer, const PlaneFit& face_fit, double margin_mm, const Artifact& a,
+                       const VerifyOptions& o, double capture_band_mm, const std::string& where) {
+  OwnFace out;
+  out.fit = face_fit;
+  // A point on the far layer (its mean): its distance along each round's
+  // normal places the far layer whichever sign a refit gives the normal.
+  Eigen::Vector3d far_mean_mm = Eigen::Vector3d::Zero();
+  for (int i : far_layer) far_mean_mm += pts[i];
+  far_mean_mm /= static_cast<double>(far_layer.size());
+  for (int round = 0; round < kMaxSegmentationRounds; ++round) {
+    const double far_mm = out.fit.normal.dot(far_mean_mm) - out.fit.offset_mm;
+    std::vector<int> own, other;
+    for (int i : captured) {
+      const double d_mm = out.fit.normal.dot(pts[i]) - out.fit.offset_mm;
+      (std::abs(d_mm) < std::abs(d_mm - far_mm) ? own : other).push_back(i);
+    }
+    if (own.size() < 3) throw NotTheArtifactError(where, "the plate's face without its far face holds too few points");
+    out.outline = OutlineOfDensePart(pts, own, out.fit.normal);
+    RequirePlateCoverage(out.outline, a, o, capture_band_mm, where);
+    std::vector<int> next, far_next;
+    for (int i : own)
+      if (out.outline.InsideEroded(pts[i], margin_mm)) next.push_back(i);
+    for (int i : other)
+      if (out.outline.InsideEroded(pts[i], margin_mm)) far_next.push_back(i);
+    out.far_face.swap(far_next);
+    if (round > 0 && next == out.face) break;
+    out.face.swap(next);
+    out.fit = FitPlaneLeastSquares(pts, out.face);
+    if (!out.fit.ok)
+      throw NotTheArtifactError(where,
+                                "the plate's face without its far face, after the edge margin: " + out.fit.message);
+  }
+  return out;
+}
+
 // The plane found must be the plate: it spans at least `min_coverage` of the
 // certified length and width, and no more than the certified size plus twice
 // the capture band (what the plate's sides can add). A sphere's cap or a
@@ -1228,16 +1280,28 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       // (the larger layer); otherwise F spans both, and fails a module that
       // far off, as it must. Either way a note says what was found.
       std::vector<int> far_face;  // ascending
-      if (const TwoLayers two = FindTwoLayers(pts, face, fit, a, o); two.found) {
+      if (TwoLayers two = FindTwoLayers(pts, face, fit, a, o); two.found) {
         const LayersFacing facing = FacingOf(normals, two, fit.normal);
-        e.notes.push_back(TwoLayersNote(two, facing, !normals.empty(), e.capture_band_mm));
         if (facing == LayersFacing::kOppositeSides) {
-          far_face = two.smaller;
-          face = two.larger;
-          fit = FitPlaneLeastSquares(pts, face);
+          // The face alone, segmented again: its outline, edge margin and
+          // plane from its own points. The outline of both faces' points is
+          // the larger of the two, and its erosion left the face's own edge
+          // (its chamfer, its sides) in F: F read 0.45 mm for a face whose
+          // own eroded outline holds 0.41 mm, and changed with the band.
+          fit = FitPlaneLeastSquares(pts, two.larger);
           if (!fit.ok) throw NotTheArtifactError(where, "the plate's face without its far face: " + fit.message);
+          const OwnFace own =
+              SegmentOwnFace(pts, captured, two.smaller, fit, face_margin_mm, a, o, e.capture_band_mm, where);
+          fit = own.fit;
+          face = own.face;
+          far_face = own.far_face;
+          extent = own.outline;
+          e.plate_outline_length_mm = extent.length_mm();
+          e.plate_outline_width_mm = extent.width_mm();
+          two.smaller = far_face;
           require_points(static_cast<int>(fit.inliers.size()), "plate (its far face left out)");
         }
+        e.notes.push_back(TwoLayersNote(two, facing, !normals.empty(), e.capture_band_mm));
       }
       e.plate_points_far_face = static_cast<int>(far_face.size());
       // Where the captured points off the face are: on its far face, outside

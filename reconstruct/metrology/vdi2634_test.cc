@@ -528,6 +528,57 @@ TEST(Vdi2634, AThinPlatesFarFaceMeasuredFromItsOtherSideIsLeftOutOfF) {
   }
 }
 
+// A thin plate whose far face reaches beyond the face's own outline (the
+// demo's plate: the far face, seen by other modules, spans a few mm more on
+// one side). The face's edge margin is its own: taken from the outline of
+// both faces' points, the margin left the face's chamfer in F (the demo read
+// F 0.45 mm for a face whose own eroded outline holds 0.41 mm, and F moved
+// with the capture band). Truth: the 130 mm face at z = 0 on a 1 mm grid,
+// noise uniform in +-0.05 mm along z, chamfered over its outer 3 mm (down
+// 0.5 mm at the edge), so inside its own outline eroded by 5 mm its
+// residuals range at most 0.1 mm (the noise's width; the plane fitted to
+// 15 000 such points tilts by ~1e-5, 0.001 mm over the plate); the chamfer
+// up to 0.5 mm. The far face 3 mm behind, on a 1.5 mm grid, shifted 8 mm
+// along x (the outline of both faces' points, 138 mm, eroded by 5 mm, held
+// the face's whole chamfer on that side), its normals facing -z. F must be the
+// face's alone, at the default band and at 9 mm (where the far face is no
+// less in the band).
+TEST(Vdi2634, AThinPlatesFaceIsJudgedInsideItsOwnOutlineNotBothFaces) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> noise_mm(-0.05, 0.05);
+  std::vector<Eigen::Vector3d> cloud, normals;
+  for (double x = -65; x <= 65; x += 1.0)
+    for (double y = -65; y <= 65; y += 1.0) {
+      const double edge_mm = std::min(65 - std::abs(x), 65 - std::abs(y));
+      const double chamfer_mm = edge_mm < 3 ? -0.5 * (3 - edge_mm) / 3 : 0.0;
+      cloud.emplace_back(x, y, chamfer_mm + noise_mm(rng));
+      normals.emplace_back(0, 0, 1);
+    }
+  const size_t face_points = cloud.size();
+  for (double x = -57; x <= 73; x += 1.5)
+    for (double y = -65; y <= 65; y += 1.5) {
+      cloud.emplace_back(x, y, -3 + noise_mm(rng));
+      normals.emplace_back(0, 0, -1);
+    }
+  const std::vector<Eigen::Vector3d> face(cloud.begin(), cloud.begin() + face_points);
+  for (const double band_mm : {5.0, 9.0}) {
+    VerifyOptions o;
+    o.capture_band_mm = band_mm;
+    const ArtifactEvaluation e = EvaluateArtifact(PlateArtifact(), cloud, o, "test", normals);
+    ASSERT_TRUE(e.judged()) << e.not_judged_reason;
+    ASSERT_GT(e.plate_points_far_face, 0)
+        << "band " << band_mm << " F " << FigureOf(e, "F") << " notes " << (e.notes.empty() ? "" : e.notes[0]) << " on "
+        << e.points_on_artifact << " outline " << e.plate_outline_length_mm;
+    EXPECT_LE(FigureOf(e, "F"), 0.1 + 0.005) << "band " << band_mm;
+    // The outline is the face's own (130 mm, to a quarter cell each side),
+    // not both faces' (138 mm).
+    EXPECT_NEAR(e.plate_outline_length_mm, 130, 0.5) << "band " << band_mm;
+    // As for the face alone.
+    const ArtifactEvaluation alone = EvaluateArtifact(PlateArtifact(), face, o, "test");
+    EXPECT_EQ(FigureOf(e, "F"), FigureOf(alone, "F")) << "band " << band_mm;
+  }
+}
+
 // A module measuring the face 0.6 or 2 mm off: the miscalibration F must
 // catch. Its layer lies in the capture band as a thin plate's far face would,
 // but it was measured from the same side (its normals face the same way): F
