@@ -18,7 +18,8 @@ RANSAC locates the artifact; every point within the capture band of it (--captur
 patch one laser-grid period off, ~3.5 mm, stays in) is the artifact's and enters the least-squares
 fit and the figures; up to 0.3% of those (the largest residuals) may be excluded, as the standard
 allows. What is found must be the artifact: a sphere whose captured points fit a diameter more than
-10% off the certified one, or a plane whose dense part (a few stray points do not count) spans less
+10% off the certified one (or than its locating MPE, P_F or a ball bar's SD, where larger, but
+never more than 12.5%, whatever the MPE), or a plane whose dense part (a few stray points do not count) spans less
 than half of the plate's length or width or more than the plate plus twice the capture band, is
 refused (that position not evaluated, below). Points added by hole filling (PLY module 255) are not
 measured and are skipped: the fit never uses the reconstruction's own shape prior. A plate's face

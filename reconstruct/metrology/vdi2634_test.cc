@@ -1387,6 +1387,31 @@ std::vector<Eigen::Vector3d> ExactSphere(double diameter_mm) {
   return s;
 }
 
+// An MPE of the sphere's own size does not make another object the artifact.
+// The P_F MPE is the locating band, which widened RANSAC's radius tolerance
+// and the "lies on a sphere" check with it: with P_F and P_S 50 mm a cup
+// 84 mm across was judged as the 38.1 mm sphere, and passed. Truth: exact
+// spheres (ExactSphere) 2.2x and 1.15x the certified diameter: off by more
+// than 10% and than the 12.5% a locating band may widen it to, so refused
+// whatever the MPE; 1.098x is within 10% and is judged, P_S 3.7 mm, at the
+// default MPE (FAIL) and at 50 mm (PASS) alike.
+TEST(Vdi2634, ALooseMpeDoesNotMakeASphereOfAnotherSizeTheArtifact) {
+  Artifact loose = SphereArtifact();
+  loose.mpe.probing_form_mm = loose.mpe.probing_size_mm = 50;
+  for (const double scale : {2.2, 1.15}) {
+    try {
+      const ArtifactEvaluation e = EvaluateArtifact(loose, ExactSphere(38.1 * scale), VerifyOptions(), "s.ply");
+      ADD_FAILURE() << "a sphere " << scale << "x the certified diameter was judged: P_S " << FigureOf(e, "P_S");
+    } catch (const NotTheArtifactError&) {
+    }
+  }
+  for (const Artifact& a : {SphereArtifact(), loose}) {
+    const ArtifactEvaluation e = EvaluateArtifact(a, ExactSphere(38.1 * 1.098), VerifyOptions(), "s.ply");
+    EXPECT_TRUE(e.judged()) << e.not_judged_reason;
+    EXPECT_NEAR(FigureOf(e, "P_S"), 0.098 * 38.1, 0.005);
+  }
+}
+
 TEST(Vdi2634, EachDecisionRuleJudgesTheUncertaintyRangeItsOwnWay) {
   Artifact a = SphereArtifact();
   a.sphere_diameter_uncertainty_mm = 0.28;
