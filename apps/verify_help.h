@@ -61,10 +61,12 @@ Each figure's zone (conformance, uncertainty range, nonconformance) is printed a
 every judged figure that has a u, whatever the rule; u is the fit's covariance and the
 certificate's, a floor rather than the whole error. A figure without u (P_F or F against an exact
 certificate) has no zone, and every rule judges it with 2u = 0. A figure whose u is over 10% of its
-MPE is judged only where its failure stands without it: under simple acceptance, which reads the
-value alone, when the value is beyond the MPE by more than its stated 2u; under guarded-acceptance
-any failure (a larger u only widens the guard band); under guarded-rejection never (a larger u could
-undo it). Otherwise it is shown with '-' in the pass column and has no zone.
+MPE is judged only where its failure stands: under simple acceptance, which reads the value
+alone, when the value is beyond the MPE by more than its stated 2u; under guarded-acceptance any
+failure (a larger u only widens the guard band); under guarded-rejection when it is beyond the MPE
+by more than 2u and u is over the limit by the certificate's stated U (not where the fit's own part
+is over it: that u is a floor, and a larger one could undo the failure). Otherwise it is shown with
+'-' in the pass column, and with no zone where its u is a floor.
 
 The table gives, per position, each figure's standard uncertainty (u_mm; both parts on a line of
 their own), the points in the cloud and where each of them went, in exactly one column: filled

@@ -133,13 +133,29 @@ bool Determined(const Figure& f, const VerifyOptions& o) {
   return fit_determined && *f.standard_uncertainty_mm <= o.max_uncertainty_fraction_of_mpe * f.mpe_mm;
 }
 
-// Whether an undetermined figure's FAIL stands all the same. Its u is a
-// floor (the fit counts its points as independent). Simple acceptance reads
-// the value alone, so its failure stands where the value itself is beyond
-// doubt: beyond the MPE by more than its stated 2u (the nonconformance zone:
-// more than its noise). Under guarded acceptance any failure stands (a
-// larger u only widens the guard band); under guarded rejection none (a
-// larger u could pull the value out of the nonconformance zone).
+// Whether figure f's stated u is a floor, not its error: its fit's part is
+// itself undetermined (over the limit, or non-finite or non-positive: a cap
+// too small to fit a diameter, whose covariance counts its points as
+// independent and its misfit as noise). A certificate's part is not: U is the
+// calibration's stated expanded uncertainty, and a fit's part within the
+// limit stands as a determined figure's does. A figure undetermined only by
+// its certificate (its fit within the limit, or no fit part: P_F, F) has a u
+// to judge with, too large to pass on.
+bool UncertaintyIsAFloor(const Figure& f, const VerifyOptions& o) {
+  if (!f.fit_standard_uncertainty_mm) return false;
+  const double fit_mm = *f.fit_standard_uncertainty_mm;
+  return !(fit_mm > 0 && fit_mm <= o.max_uncertainty_fraction_of_mpe * f.mpe_mm);
+}
+
+// Whether an undetermined figure's FAIL stands all the same. Simple
+// acceptance reads the value alone, so its failure stands where the value
+// itself is beyond doubt: beyond the MPE by more than its stated 2u (the
+// nonconformance zone: more than its noise). Under guarded acceptance any
+// failure stands (a larger u only widens the guard band). Under guarded
+// rejection a failure is already in the nonconformance zone: it stands where
+// u is the figure's (a certificate's U that dominates it), not where u is a
+// floor (UncertaintyIsAFloor: a larger u could pull the value out of that
+// zone).
 bool FailureStands(DecisionRule rule, const Figure& f) {
   if (f.pass) return false;
   switch (rule) {
@@ -148,7 +164,7 @@ bool FailureStands(DecisionRule rule, const Figure& f) {
     case DecisionRule::kGuardedAcceptance:
       return true;
     case DecisionRule::kGuardedRejection:
-      break;
+      return !f.uncertainty_is_floor && f.zone() == ConformanceZone::kNonconformance;
   }
   return false;
 }
@@ -159,7 +175,9 @@ bool FailureStands(DecisionRule rule, const Figure& f) {
 void JudgeFigures(DecisionRule rule, const VerifyOptions& o, std::vector<Figure>* figures) {
   for (Figure& f : *figures) {
     f.pass = Passes(rule, f.value_mm, f.ExpandedUncertaintyMm(), f.mpe_mm);
-    f.judged = Determined(f, o) || FailureStands(rule, f);
+    const bool determined = Determined(f, o);
+    f.uncertainty_is_floor = !determined && UncertaintyIsAFloor(f, o);
+    f.judged = determined || FailureStands(rule, f);
   }
 }
 

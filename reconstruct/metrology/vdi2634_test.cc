@@ -1448,14 +1448,15 @@ TEST(Vdi2634, EachDecisionRuleJudgesTheUncertaintyRangeItsOwnWay) {
   }
 }
 
-// A figure the refusal leaves undetermined (u over 10% of the MPE) has a u
-// that is a floor, not its error: its verdict stands only where a larger u
-// would not undo it. Truth: the exact sphere 1.0, 1.4 and 2.0 mm too large,
-// certified to U 0.4 mm (k = 2): u 0.2 mm (over 0.15 mm), 2u 0.4 mm, so the
-// zones are conformance, uncertainty range and nonconformance. No PASS is
-// claimed from it under any rule; a FAIL stands under simple acceptance only
-// beyond 2u (2.0), under guarded acceptance always (a larger U only widens
-// the guard band), under guarded rejection never (a larger U could undo it).
+// A figure the refusal leaves undetermined (u over 10% of the MPE) by its
+// certificate: its verdict stands only where the stated U does not undo it.
+// Truth: the exact sphere 1.0, 1.4 and 2.0 mm too large, certified to U
+// 0.4 mm (k = 2): u 0.2 mm (over 0.15 mm; the fit's part is rounding), 2u
+// 0.4 mm, so the zones are conformance, uncertainty range and
+// nonconformance. No PASS is claimed from it under any rule; a FAIL stands
+// under simple acceptance only beyond 2u (2.0), under guarded acceptance
+// always (a larger U only widens the guard band), under guarded rejection
+// beyond 2u (2.0: the certificate's U is stated, not a floor; before, never).
 TEST(Vdi2634, AnUndeterminedFigureIsJudgedOnlyWhereALargerUncertaintyWouldNotUndoItsVerdict) {
   Artifact a = SphereArtifact();
   a.sphere_diameter_uncertainty_mm = 0.4;
@@ -1463,7 +1464,7 @@ TEST(Vdi2634, AnUndeterminedFigureIsJudgedOnlyWhereALargerUncertaintyWouldNotUnd
     double size_error_mm;
     bool judged_simple, judged_guarded_acceptance, judged_guarded_rejection;
   };
-  for (const Case& c : {Case{1.0, false, false, false}, Case{1.4, false, true, false}, Case{2.0, true, true, false}}) {
+  for (const Case& c : {Case{1.0, false, false, false}, Case{1.4, false, true, false}, Case{2.0, true, true, true}}) {
     const auto points = ExactSphere(38.1 + c.size_error_mm);
     for (auto [rule, judged] : {std::pair{DecisionRule::kSimpleAcceptance, c.judged_simple},
                                 std::pair{DecisionRule::kGuardedAcceptance, c.judged_guarded_acceptance},
@@ -1481,6 +1482,32 @@ TEST(Vdi2634, AnUndeterminedFigureIsJudgedOnlyWhereALargerUncertaintyWouldNotUnd
         EXPECT_EQ(NotJudgedReason(e).rfind("P_S is not determined", 0), 0u) << what;
       }
     }
+  }
+}
+
+// Where the fit's own part is over the limit, u is a floor (a cap too small
+// to fit a diameter: its covariance counts its points as independent), and a
+// larger u could pull the value out of the nonconformance zone: guarded
+// rejection judges no failure on it, simple acceptance one beyond the stated
+// 2u. Truth: a 15-degree cap of a sphere 3.0 mm too large in diameter, 2000
+// points with noise sigma 0.05 mm (u of the diameter ~0.3 mm, over the
+// 0.15 mm limit; checked), so |P_S| - 2u > 1.5 (checked) while u is the
+// fit's alone.
+TEST(Vdi2634, GuardedRejectionJudgesNoFailureOnAFitWhoseOwnUncertaintyIsOverTheLimit) {
+  const Eigen::Vector3d c(1, 2, 150), view(0.1, 0, -1);
+  std::mt19937 rng(3);
+  const auto cap = testing::NoisySurfaceSamples(testing::SphereCapSurface(c, view, 19.05 + 1.5, 15), 2000, 0.05, &rng);
+  for (auto [rule, judged] :
+       {std::pair{DecisionRule::kSimpleAcceptance, true}, std::pair{DecisionRule::kGuardedRejection, false}}) {
+    VerifyOptions o;
+    o.decision_rule = rule;
+    const ArtifactEvaluation e = EvaluateArtifact(SphereArtifact(), cap, o, "cap15.ply");
+    const Figure& p_s = e.figures[1];
+    ASSERT_GT(p_s.fit_standard_uncertainty_mm.value(), 0.15) << DecisionRuleName(rule);
+    ASSERT_GT(std::abs(p_s.value_mm) - p_s.ExpandedUncertaintyMm(), 1.5) << DecisionRuleName(rule);
+    EXPECT_TRUE(p_s.uncertainty_is_floor) << DecisionRuleName(rule);
+    EXPECT_EQ(p_s.judged, judged) << DecisionRuleName(rule);
+    EXPECT_FALSE(p_s.pass) << DecisionRuleName(rule);
   }
 }
 
