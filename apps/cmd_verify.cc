@@ -88,7 +88,12 @@ void PrintUncertainty(size_t position, const Figure& f, double coverage_factor) 
   const double certificate_mm = f.certificate_standard_uncertainty_mm.value_or(0.0);
   char fit[64] = "no fit part: a range of residuals";  // P_F, F
   if (f.fit_standard_uncertainty_mm) std::snprintf(fit, sizeof fit, "fit %.4f mm", *f.fit_standard_uncertainty_mm);
-  const std::string zone = f.judged ? ZoneText(*f.zone()) : "no zone: u over the limit is a floor, not the error";
+  // Not judged: where u is a floor (the fit's part over the limit) no zone
+  // is claimed; where the certificate's stated U puts it over, the zone is
+  // the figure's, too wide to pass on.
+  const std::string zone = f.judged                 ? ZoneText(*f.zone())
+                           : f.uncertainty_is_floor ? "no zone: u over the limit is a floor, not the error"
+                                                    : ZoneText(*f.zone()) + ", but u is over the limit: not judged";
   std::printf("%-8zu %s: u %.4f mm = %s (+) certificate %.4f mm (U %.4f mm / k %g); 2u %.4f mm: %s\n", position,
               f.name.c_str(), *f.standard_uncertainty_mm, fit, certificate_mm, certificate_mm * coverage_factor,
               coverage_factor, f.ExpandedUncertaintyMm(), zone.c_str());

@@ -18,7 +18,8 @@ RANSAC locates the artifact; every point within the capture band of it (--captur
 patch one laser-grid period off, ~3.5 mm, stays in) is the artifact's and enters the least-squares
 fit and the figures; up to 0.3% of those (the largest residuals) may be excluded, as the standard
 allows. What is found must be the artifact: a sphere whose captured points fit a diameter more than
-10% off the certified one, or a plane whose dense part (a few stray points do not count) spans less
+10% off the certified one (or than its locating MPE, P_F or a ball bar's SD, where larger, but
+never more than 12.5%, whatever the MPE), or a plane whose dense part (a few stray points do not count) spans less
 than half of the plate's length or width or more than the plate plus twice the capture band, is
 refused (that position not evaluated, below). Points added by hole filling (PLY module 255) are not
 measured and are skipped: the fit never uses the reconstruction's own shape prior. A plate's face
@@ -60,10 +61,12 @@ Each figure's zone (conformance, uncertainty range, nonconformance) is printed a
 every judged figure that has a u, whatever the rule; u is the fit's covariance and the
 certificate's, a floor rather than the whole error. A figure without u (P_F or F against an exact
 certificate) has no zone, and every rule judges it with 2u = 0. A figure whose u is over 10% of its
-MPE is judged only where its failure stands without it: under simple acceptance, which reads the
-value alone, when the value is beyond the MPE by more than its stated 2u; under guarded-acceptance
-any failure (a larger u only widens the guard band); under guarded-rejection never (a larger u could
-undo it). Otherwise it is shown with '-' in the pass column and has no zone.
+MPE is judged only where its failure stands: under simple acceptance, which reads the value
+alone, when the value is beyond the MPE by more than its stated 2u; under guarded-acceptance any
+failure (a larger u only widens the guard band); under guarded-rejection when it is beyond the MPE
+by more than 2u and u is over the limit by the certificate's stated U (not where the fit's own part
+is over it: that u is a floor, and a larger one could undo the failure). Otherwise it is shown with
+'-' in the pass column, and with no zone where its u is a floor.
 
 The table gives, per position, each figure's standard uncertainty (u_mm; both parts on a line of
 their own), the points in the cloud and where each of them went, in exactly one column: filled

@@ -1053,6 +1053,34 @@ TEST(VerifyCli, TheDecisionRuleJudgesTheUncertaintyRangeAndTheReportSaysWhichRul
   EXPECT_FALSE(std::filesystem::exists(report));
 }
 
+// A certificate's U is its stated expanded uncertainty, not a floor: where it
+// alone puts u over 10% of the MPE and the fit's part is within it, guarded
+// rejection judges the failure the nonconformance zone shows. Truth: the
+// exact sphere 2.0 mm too large in diameter, certified to U 0.4 mm (k = 2):
+// u 0.2 mm (the fit's part is rounding on exact samples), over the 0.15 mm
+// limit; 2.0 - 0.4 = 1.6 > 1.5, nonconformance: FAIL, exit 1 (it read `no
+// zone: u over the limit is a floor, not the error`, NOT JUDGED, exit 2). At
+// 1.6 mm too large (the uncertainty range: 1.6 - 0.4 < 1.5) guarded rejection
+// would pass it, which a u that large cannot claim: not judged, exit 2, its
+// zone printed.
+TEST(VerifyCli, GuardedRejectionFailsWhereTheCertificatesUAloneIsOverTheLimit) {
+  const std::string artifact = WriteArtifact(
+      "format: stereorig-artifact\nversion: 1\nunits: mm\nname: test sphere\ntype: sphere\n"
+      "diameter_mm: 38.1\ndiameter_uncertainty_mm: 0.4\n");
+  const auto beyond = RunCli("verify --artifact " + artifact + " --cloud " +
+                             WriteSphere("certificate_u_20.ply", 19.05 + 1.0) + " --decision-rule guarded-rejection");
+  EXPECT_EQ(beyond.code, 1) << beyond.out << beyond.err;
+  EXPECT_NE(beyond.out.find("verdict: FAIL"), std::string::npos) << beyond.out;
+  EXPECT_NE(beyond.out.find("2u 0.4000 mm: nonconformance zone"), std::string::npos) << beyond.out;
+  const auto within = RunCli("verify --artifact " + artifact + " --cloud " +
+                             WriteSphere("certificate_u_16.ply", 19.05 + 0.8) + " --decision-rule guarded-rejection");
+  EXPECT_EQ(within.code, 2) << within.out << within.err;
+  EXPECT_NE(within.out.find("2u 0.4000 mm: uncertainty range (within 2u of the MPE), but u is over the limit: not "
+                            "judged"),
+            std::string::npos)
+      << within.out;
+}
+
 }  // namespace
 
 namespace {

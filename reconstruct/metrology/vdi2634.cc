@@ -133,13 +133,29 @@ bool Determined(const Figure& f, const VerifyOptions& o) {
   return fit_determined && *f.standard_uncertainty_mm <= o.max_uncertainty_fraction_of_mpe * f.mpe_mm;
 }
 
-// Whether an undetermined figure's FAIL stands all the same. Its u is a
-// floor (the fit counts its points as independent). Simple acceptance reads
-// the value alone, so its failure stands where the value itself is beyond
-// doubt: beyond the MPE by more than its stated 2u (the nonconformance zone:
-// more than its noise). Under guarded acceptance any failure stands (a
-// larger u only widens the guard band); under guarded rejection none (a
-// larger u could pull the value out of the nonconformance zone).
+// Whether figure f's stated u is a floor, not its error: its fit's part is
+// itself undetermined (over the limit, or non-finite or non-positive: a cap
+// too small to fit a diameter, whose covariance counts its points as
+// independent and its misfit as noise). A certificate's part is not: U is the
+// calibration's stated expanded uncertainty, and a fit's part within the
+// limit stands as a determined figure's does. A figure undetermined only by
+// its certificate (its fit within the limit, or no fit part: P_F, F) has a u
+// to judge with, too large to pass on.
+bool UncertaintyIsAFloor(const Figure& f, const VerifyOptions& o) {
+  if (!f.fit_standard_uncertainty_mm) return false;
+  const double fit_mm = *f.fit_standard_uncertainty_mm;
+  return !(fit_mm > 0 && fit_mm <= o.max_uncertainty_fraction_of_mpe * f.mpe_mm);
+}
+
+// Whether an undetermined figure's FAIL stands all the same. Simple
+// acceptance reads the value alone, so its failure stands where the value
+// itself is beyond doubt: beyond the MPE by more than its stated 2u (the
+// nonconformance zone: more than its noise). Under guarded acceptance any
+// failure stands (a larger u only widens the guard band). Under guarded
+// rejection a failure is already in the nonconformance zone: it stands where
+// u is the figure's (a certificate's U that dominates it), not where u is a
+// floor (UncertaintyIsAFloor: a larger u could pull the value out of that
+// zone).
 bool FailureStands(DecisionRule rule, const Figure& f) {
   if (f.pass) return false;
   switch (rule) {
@@ -148,7 +164,7 @@ bool FailureStands(DecisionRule rule, const Figure& f) {
     case DecisionRule::kGuardedAcceptance:
       return true;
     case DecisionRule::kGuardedRejection:
-      break;
+      return !f.uncertainty_is_floor && f.zone() == ConformanceZone::kNonconformance;
   }
   return false;
 }
@@ -159,7 +175,9 @@ bool FailureStands(DecisionRule rule, const Figure& f) {
 void JudgeFigures(DecisionRule rule, const VerifyOptions& o, std::vector<Figure>* figures) {
   for (Figure& f : *figures) {
     f.pass = Passes(rule, f.value_mm, f.ExpandedUncertaintyMm(), f.mpe_mm);
-    f.judged = Determined(f, o) || FailureStands(rule, f);
+    const bool determined = Determined(f, o);
+    f.uncertainty_is_floor = !determined && UncertaintyIsAFloor(f, o);
+    f.judged = determined || FailureStands(rule, f);
   }
 }
 
@@ -297,6 +315,22 @@ std::string Mm(double v) {
 
 // RANSAC's band, which only locates the shape.
 double LocateBandMm(const VerifyOptions& o, double mpe_mm) { return o.locate_band_mm > 0 ? o.locate_band_mm : mpe_mm; }
+
+// A sphere's or ball's locating band: the figure's MPE (LocateBandMm), but
+// never more than an eighth of the certified radius. The band locates the
+// sphere, widens RANSAC's radius tolerance (RadiusToleranceMm) and scales the
+// check that the points lie on a sphere (a quarter of it), so an MPE of the
+// sphere's own size made them all vacuous: with P_F 50 mm a cup 84 mm across
+// was judged as the 38.1 mm sphere, and passed. An eighth lets the band widen
+// the 10% tolerance to 12.5% at most, and holds the demo ball bar's default
+// 1.5 mm on its 12.7 mm balls (11.8%); the sphere's 1.5 mm is under its
+// 2.4 mm. The capture band is not capped: it still takes every point within
+// twice the MPE, as the figures must see an error up to it.
+constexpr double kMaxLocateBandOfRadius = 0.125;
+
+double SphereLocateBandMm(const VerifyOptions& o, double mpe_mm, double nominal_radius_mm) {
+  return std::min(LocateBandMm(o, mpe_mm), kMaxLocateBandOfRadius * nominal_radius_mm);
+}
 
 // The band whose points are the artifact's: never so narrow that an error
 // beyond the MPE is cut off before the figures see it.
@@ -822,6 +856,58 @@ std::string TwoLayersNote(const TwoLayers& two, LayersFacing facing, bool has_no
   return buf;
 }
 
+// A thin plate's face without its far face (both in the capture band,
+// measured from opposite sides: FindTwoLayers, FacingOf): the captured
+// points on the face's side of the midway plane between the two layers are
+// its own, and its outline, the face inside it eroded by the margin and its
+// plane are taken from them alone, iterated to their fixed point as the
+// plate's first segmentation is. far_face: the far layer's captured points
+// inside that eroded outline (those in the margin stay in the edge count).
+struct OwnFace {
+  PlaneFit fit;
+  PlaneOutline outline;
+  std::vector<int> face, far_face;  // ascending
+};
+
+void RequirePlateCoverage(const PlaneOutline& e, const Artifact& a, const VerifyOptions& o, double capture_band_mm,
+                          const std::string& where);
+
+OwnFace SegmentOwnFace(const std::vector<Eigen::Vector3d>& pts, const std::vector<int>& captured,
+                       const std::vector<int>& far_layer, const PlaneFit& face_fit, double margin_mm, const Artifact& a,
+                       const VerifyOptions& o, double capture_band_mm, const std::string& where) {
+  OwnFace out;
+  out.fit = face_fit;
+  // A point on the far layer (its mean): its distance along each round's
+  // normal places the far layer whichever sign a refit gives the normal.
+  Eigen::Vector3d far_mean_mm = Eigen::Vector3d::Zero();
+  for (int i : far_layer) far_mean_mm += pts[i];
+  far_mean_mm /= static_cast<double>(far_layer.size());
+  for (int round = 0; round < kMaxSegmentationRounds; ++round) {
+    const double far_mm = out.fit.normal.dot(far_mean_mm) - out.fit.offset_mm;
+    std::vector<int> own, other;
+    for (int i : captured) {
+      const double d_mm = out.fit.normal.dot(pts[i]) - out.fit.offset_mm;
+      (std::abs(d_mm) < std::abs(d_mm - far_mm) ? own : other).push_back(i);
+    }
+    if (own.size() < 3) throw NotTheArtifactError(where, "the plate's face without its far face holds too few points");
+    out.outline = OutlineOfDensePart(pts, own, out.fit.normal);
+    RequirePlateCoverage(out.outline, a, o, capture_band_mm, where);
+    std::vector<int> next, far_next;
+    for (int i : own)
+      if (out.outline.InsideEroded(pts[i], margin_mm)) next.push_back(i);
+    for (int i : other)
+      if (out.outline.InsideEroded(pts[i], margin_mm)) far_next.push_back(i);
+    out.far_face.swap(far_next);
+    if (round > 0 && next == out.face) break;
+    out.face.swap(next);
+    out.fit = FitPlaneLeastSquares(pts, out.face);
+    if (!out.fit.ok)
+      throw NotTheArtifactError(where,
+                                "the plate's face without its far face, after the edge margin: " + out.fit.message);
+  }
+  return out;
+}
+
 // The plane found must be the plate: it spans at least `min_coverage` of the
 // certified length and width, and no more than the certified size plus twice
 // the capture band (what the plate's sides can add). A sphere's cap or a
@@ -968,8 +1054,9 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
   switch (a.type) {
     case ArtifactType::kSphere: {
       e.capture_band_mm = CaptureBandMm(o, BandMpeMm(a));
-      const ArtifactSphereFit found = FitArtifactSphere(pts, 0.5 * a.sphere_diameter_mm,
-                                                        LocateBandMm(o, a.mpe.probing_form_mm), e.capture_band_mm, o);
+      const ArtifactSphereFit found = FitArtifactSphere(
+          pts, 0.5 * a.sphere_diameter_mm, SphereLocateBandMm(o, a.mpe.probing_form_mm, 0.5 * a.sphere_diameter_mm),
+          e.capture_band_mm, o);
       if (!found.located) {
         throw NotTheArtifactError(where, "no sphere of the certified size found in the cloud: " + found.fit.message);
       }
@@ -1013,7 +1100,7 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       // The balls as located (certified size), for a second-pass fit that
       // leaves it: what cap it saw and how well such a cap fits a diameter.
       std::vector<Eigen::Vector3d> located_centers_mm;
-      const double tolerance_mm = RadiusToleranceMm(LocateBandMm(o, a.mpe.sphere_spacing_mm), r);
+      const double tolerance_mm = RadiusToleranceMm(SphereLocateBandMm(o, a.mpe.sphere_spacing_mm, r), r);
       // other_fit: the other ball's free fit, whose size says whether a
       // scale error is plausible (ScaleText; none named if it failed, or if
       // the two fits overlap: two balls cannot, so they are one sphere found
@@ -1035,7 +1122,7 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
         std::string length_text;
         const double scale = fit.radius_mm / r;
         const double distance_mm = (fit.center_mm - other_fit.center_mm).norm();
-        const double locate_mm = LocateBandMm(o, a.mpe.sphere_spacing_mm);
+        const double locate_mm = SphereLocateBandMm(o, a.mpe.sphere_spacing_mm, r);
         if (fit.ok && fit.converged && two_balls && !ScaleText(scale, other_scale).empty() &&
             std::abs(distance_mm - a.center_distance_mm) <= locate_mm &&
             std::abs(scale - 1) * a.center_distance_mm > 2 * locate_mm) {
@@ -1051,14 +1138,15 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
         throw NotTheArtifactError(
             where, BallText(ball, located_centers_mm[ball]) + ": " +
                        LeftCertifiedSizeText(pts, indices, located_centers_mm[ball], fit, r, tolerance_mm, band,
-                                             LocateBandMm(o, a.mpe.sphere_spacing_mm), other_scale) +
+                                             SphereLocateBandMm(o, a.mpe.sphere_spacing_mm, r), other_scale) +
                        length_text);
       };
       const double cos_cone = std::cos(o.ballbar_shaft_cone_deg * M_PI / 180.0);
       OtherBallScaleAt first_ball_scale_at;  // for ball 2's search
       for (int ball = 0; ball < 2; ++ball) {
-        const ArtifactSphereFit found = FitArtifactSphere(remaining, r, LocateBandMm(o, a.mpe.sphere_spacing_mm), band,
-                                                          o, first_ball_scale_at, /*first_of_ball_bar=*/ball == 0);
+        const ArtifactSphereFit found =
+            FitArtifactSphere(remaining, r, SphereLocateBandMm(o, a.mpe.sphere_spacing_mm, r), band, o,
+                              first_ball_scale_at, /*first_of_ball_bar=*/ball == 0);
         if (!found.located) {
           throw NotTheArtifactError(
               where, "ball " + std::to_string(ball + 1) + " of the ball bar not found: " + found.fit.message);
@@ -1228,16 +1316,28 @@ ArtifactEvaluation EvaluateArtifactInMm(const Artifact& a, const std::vector<Eig
       // (the larger layer); otherwise F spans both, and fails a module that
       // far off, as it must. Either way a note says what was found.
       std::vector<int> far_face;  // ascending
-      if (const TwoLayers two = FindTwoLayers(pts, face, fit, a, o); two.found) {
+      if (TwoLayers two = FindTwoLayers(pts, face, fit, a, o); two.found) {
         const LayersFacing facing = FacingOf(normals, two, fit.normal);
-        e.notes.push_back(TwoLayersNote(two, facing, !normals.empty(), e.capture_band_mm));
         if (facing == LayersFacing::kOppositeSides) {
-          far_face = two.smaller;
-          face = two.larger;
-          fit = FitPlaneLeastSquares(pts, face);
+          // The face alone, segmented again: its outline, edge margin and
+          // plane from its own points. The outline of both faces' points is
+          // the larger of the two, and its erosion left the face's own edge
+          // (its chamfer, its sides) in F: F read 0.45 mm for a face whose
+          // own eroded outline holds 0.41 mm, and changed with the band.
+          fit = FitPlaneLeastSquares(pts, two.larger);
           if (!fit.ok) throw NotTheArtifactError(where, "the plate's face without its far face: " + fit.message);
+          const OwnFace own =
+              SegmentOwnFace(pts, captured, two.smaller, fit, face_margin_mm, a, o, e.capture_band_mm, where);
+          fit = own.fit;
+          face = own.face;
+          far_face = own.far_face;
+          extent = own.outline;
+          e.plate_outline_length_mm = extent.length_mm();
+          e.plate_outline_width_mm = extent.width_mm();
+          two.smaller = far_face;
           require_points(static_cast<int>(fit.inliers.size()), "plate (its far face left out)");
         }
+        e.notes.push_back(TwoLayersNote(two, facing, !normals.empty(), e.capture_band_mm));
       }
       e.plate_points_far_face = static_cast<int>(far_face.size());
       // Where the captured points off the face are: on its far face, outside

@@ -79,10 +79,12 @@ struct VerifyOptions {
   // rejection (fail only if |value| - U > MPE). A figure without u (P_F
   // without the certificate's form_uncertainty_mm, F without its
   // flatness_uncertainty_mm) is judged with U = 0 by every rule. A figure
-  // the refusal above leaves undetermined has a u that is a floor, not its
-  // error: it is judged only where its failure stands however large u is
-  // (simple acceptance: |value| - 2u > MPE; guarded acceptance: any failure;
-  // guarded rejection: never), and its pass never.
+  // the refusal above leaves undetermined is judged only where its failure
+  // stands (simple acceptance: |value| - 2u > MPE; guarded acceptance: any
+  // failure; guarded rejection: |value| - 2u > MPE where u is the figure's,
+  // its fit's part within the limit and the certificate's stated U putting
+  // it over; never where the fit's part is over the limit itself, a floor
+  // that a larger u could undo), and its pass never.
   DecisionRule decision_rule = DecisionRule::kSimpleAcceptance;
   unsigned seed = 1;
   void Check() const;
@@ -97,9 +99,15 @@ struct Figure {
   // VerifyOptions::max_uncertainty_fraction_of_mpe of its MPE, or it has no
   // u), or its failure stands without it (vdi2634.cc, FailureStands: under
   // simple acceptance beyond the MPE by more than its stated 2u, under
-  // guarded acceptance any failure, under guarded rejection none). A figure
-  // not judged is reported, its pass not claimed.
+  // guarded acceptance any failure, under guarded rejection beyond it by
+  // more than 2u unless u is a floor). A figure not judged is reported, its
+  // pass not claimed.
   bool judged = true;
+  // A figure left undetermined whose u is a floor, not its error: its fit's
+  // part is itself over the limit, or not positive and finite (vdi2634.cc,
+  // UncertaintyIsAFloor). False where the certificate's stated U puts u over
+  // the limit, and for a determined figure.
+  bool uncertainty_is_floor = false;
   // value_mm's standard uncertainty (k = 1): its two parts below combined in
   // quadrature, u = sqrt(u_fit^2 + u_certificate^2) (independent sources:
   // the measurement's noise, the reference's calibration; VDI/VDE 2634-2 and

@@ -528,6 +528,57 @@ TEST(Vdi2634, AThinPlatesFarFaceMeasuredFromItsOtherSideIsLeftOutOfF) {
   }
 }
 
+// A thin plate whose far face reaches beyond the face's own outline (the
+// demo's plate: the far face, seen by other modules, spans a few mm more on
+// one side). The face's edge margin is its own: taken from the outline of
+// both faces' points, the margin left the face's chamfer in F (the demo read
+// F 0.45 mm for a face whose own eroded outline holds 0.41 mm, and F moved
+// with the capture band). Truth: the 130 mm face at z = 0 on a 1 mm grid,
+// noise uniform in +-0.05 mm along z, chamfered over its outer 3 mm (down
+// 0.5 mm at the edge), so inside its own outline eroded by 5 mm its
+// residuals range at most 0.1 mm (the noise's width; the plane fitted to
+// 15 000 such points tilts by ~1e-5, 0.001 mm over the plate); the chamfer
+// up to 0.5 mm. The far face 3 mm behind, on a 1.5 mm grid, shifted 8 mm
+// along x (the outline of both faces' points, 138 mm, eroded by 5 mm, held
+// the face's whole chamfer on that side), its normals facing -z. F must be the
+// face's alone, at the default band and at 9 mm (where the far face is no
+// less in the band).
+TEST(Vdi2634, AThinPlatesFaceIsJudgedInsideItsOwnOutlineNotBothFaces) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> noise_mm(-0.05, 0.05);
+  std::vector<Eigen::Vector3d> cloud, normals;
+  for (double x = -65; x <= 65; x += 1.0)
+    for (double y = -65; y <= 65; y += 1.0) {
+      const double edge_mm = std::min(65 - std::abs(x), 65 - std::abs(y));
+      const double chamfer_mm = edge_mm < 3 ? -0.5 * (3 - edge_mm) / 3 : 0.0;
+      cloud.emplace_back(x, y, chamfer_mm + noise_mm(rng));
+      normals.emplace_back(0, 0, 1);
+    }
+  const size_t face_points = cloud.size();
+  for (double x = -57; x <= 73; x += 1.5)
+    for (double y = -65; y <= 65; y += 1.5) {
+      cloud.emplace_back(x, y, -3 + noise_mm(rng));
+      normals.emplace_back(0, 0, -1);
+    }
+  const std::vector<Eigen::Vector3d> face(cloud.begin(), cloud.begin() + face_points);
+  for (const double band_mm : {5.0, 9.0}) {
+    VerifyOptions o;
+    o.capture_band_mm = band_mm;
+    const ArtifactEvaluation e = EvaluateArtifact(PlateArtifact(), cloud, o, "test", normals);
+    ASSERT_TRUE(e.judged()) << e.not_judged_reason;
+    ASSERT_GT(e.plate_points_far_face, 0)
+        << "band " << band_mm << " F " << FigureOf(e, "F") << " notes " << (e.notes.empty() ? "" : e.notes[0]) << " on "
+        << e.points_on_artifact << " outline " << e.plate_outline_length_mm;
+    EXPECT_LE(FigureOf(e, "F"), 0.1 + 0.005) << "band " << band_mm;
+    // The outline is the face's own (130 mm, to a quarter cell each side),
+    // not both faces' (138 mm).
+    EXPECT_NEAR(e.plate_outline_length_mm, 130, 0.5) << "band " << band_mm;
+    // As for the face alone.
+    const ArtifactEvaluation alone = EvaluateArtifact(PlateArtifact(), face, o, "test");
+    EXPECT_EQ(FigureOf(e, "F"), FigureOf(alone, "F")) << "band " << band_mm;
+  }
+}
+
 // A module measuring the face 0.6 or 2 mm off: the miscalibration F must
 // catch. Its layer lies in the capture band as a thin plate's far face would,
 // but it was measured from the same side (its normals face the same way): F
@@ -1336,6 +1387,31 @@ std::vector<Eigen::Vector3d> ExactSphere(double diameter_mm) {
   return s;
 }
 
+// An MPE of the sphere's own size does not make another object the artifact.
+// The P_F MPE is the locating band, which widened RANSAC's radius tolerance
+// and the "lies on a sphere" check with it: with P_F and P_S 50 mm a cup
+// 84 mm across was judged as the 38.1 mm sphere, and passed. Truth: exact
+// spheres (ExactSphere) 2.2x and 1.15x the certified diameter: off by more
+// than 10% and than the 12.5% a locating band may widen it to, so refused
+// whatever the MPE; 1.098x is within 10% and is judged, P_S 3.7 mm, at the
+// default MPE (FAIL) and at 50 mm (PASS) alike.
+TEST(Vdi2634, ALooseMpeDoesNotMakeASphereOfAnotherSizeTheArtifact) {
+  Artifact loose = SphereArtifact();
+  loose.mpe.probing_form_mm = loose.mpe.probing_size_mm = 50;
+  for (const double scale : {2.2, 1.15}) {
+    try {
+      const ArtifactEvaluation e = EvaluateArtifact(loose, ExactSphere(38.1 * scale), VerifyOptions(), "s.ply");
+      ADD_FAILURE() << "a sphere " << scale << "x the certified diameter was judged: P_S " << FigureOf(e, "P_S");
+    } catch (const NotTheArtifactError&) {
+    }
+  }
+  for (const Artifact& a : {SphereArtifact(), loose}) {
+    const ArtifactEvaluation e = EvaluateArtifact(a, ExactSphere(38.1 * 1.098), VerifyOptions(), "s.ply");
+    EXPECT_TRUE(e.judged()) << e.not_judged_reason;
+    EXPECT_NEAR(FigureOf(e, "P_S"), 0.098 * 38.1, 0.005);
+  }
+}
+
 TEST(Vdi2634, EachDecisionRuleJudgesTheUncertaintyRangeItsOwnWay) {
   Artifact a = SphereArtifact();
   a.sphere_diameter_uncertainty_mm = 0.28;
@@ -1372,14 +1448,15 @@ TEST(Vdi2634, EachDecisionRuleJudgesTheUncertaintyRangeItsOwnWay) {
   }
 }
 
-// A figure the refusal leaves undetermined (u over 10% of the MPE) has a u
-// that is a floor, not its error: its verdict stands only where a larger u
-// would not undo it. Truth: the exact sphere 1.0, 1.4 and 2.0 mm too large,
-// certified to U 0.4 mm (k = 2): u 0.2 mm (over 0.15 mm), 2u 0.4 mm, so the
-// zones are conformance, uncertainty range and nonconformance. No PASS is
-// claimed from it under any rule; a FAIL stands under simple acceptance only
-// beyond 2u (2.0), under guarded acceptance always (a larger U only widens
-// the guard band), under guarded rejection never (a larger U could undo it).
+// A figure the refusal leaves undetermined (u over 10% of the MPE) by its
+// certificate: its verdict stands only where the stated U does not undo it.
+// Truth: the exact sphere 1.0, 1.4 and 2.0 mm too large, certified to U
+// 0.4 mm (k = 2): u 0.2 mm (over 0.15 mm; the fit's part is rounding), 2u
+// 0.4 mm, so the zones are conformance, uncertainty range and
+// nonconformance. No PASS is claimed from it under any rule; a FAIL stands
+// under simple acceptance only beyond 2u (2.0), under guarded acceptance
+// always (a larger U only widens the guard band), under guarded rejection
+// beyond 2u (2.0: the certificate's U is stated, not a floor; before, never).
 TEST(Vdi2634, AnUndeterminedFigureIsJudgedOnlyWhereALargerUncertaintyWouldNotUndoItsVerdict) {
   Artifact a = SphereArtifact();
   a.sphere_diameter_uncertainty_mm = 0.4;
@@ -1387,7 +1464,7 @@ TEST(Vdi2634, AnUndeterminedFigureIsJudgedOnlyWhereALargerUncertaintyWouldNotUnd
     double size_error_mm;
     bool judged_simple, judged_guarded_acceptance, judged_guarded_rejection;
   };
-  for (const Case& c : {Case{1.0, false, false, false}, Case{1.4, false, true, false}, Case{2.0, true, true, false}}) {
+  for (const Case& c : {Case{1.0, false, false, false}, Case{1.4, false, true, false}, Case{2.0, true, true, true}}) {
     const auto points = ExactSphere(38.1 + c.size_error_mm);
     for (auto [rule, judged] : {std::pair{DecisionRule::kSimpleAcceptance, c.judged_simple},
                                 std::pair{DecisionRule::kGuardedAcceptance, c.judged_guarded_acceptance},
@@ -1405,6 +1482,32 @@ TEST(Vdi2634, AnUndeterminedFigureIsJudgedOnlyWhereALargerUncertaintyWouldNotUnd
         EXPECT_EQ(NotJudgedReason(e).rfind("P_S is not determined", 0), 0u) << what;
       }
     }
+  }
+}
+
+// Where the fit's own part is over the limit, u is a floor (a cap too small
+// to fit a diameter: its covariance counts its points as independent), and a
+// larger u could pull the value out of the nonconformance zone: guarded
+// rejection judges no failure on it, simple acceptance one beyond the stated
+// 2u. Truth: a 15-degree cap of a sphere 3.0 mm too large in diameter, 2000
+// points with noise sigma 0.05 mm (u of the diameter ~0.3 mm, over the
+// 0.15 mm limit; checked), so |P_S| - 2u > 1.5 (checked) while u is the
+// fit's alone.
+TEST(Vdi2634, GuardedRejectionJudgesNoFailureOnAFitWhoseOwnUncertaintyIsOverTheLimit) {
+  const Eigen::Vector3d c(1, 2, 150), view(0.1, 0, -1);
+  std::mt19937 rng(3);
+  const auto cap = testing::NoisySurfaceSamples(testing::SphereCapSurface(c, view, 19.05 + 1.5, 15), 2000, 0.05, &rng);
+  for (auto [rule, judged] :
+       {std::pair{DecisionRule::kSimpleAcceptance, true}, std::pair{DecisionRule::kGuardedRejection, false}}) {
+    VerifyOptions o;
+    o.decision_rule = rule;
+    const ArtifactEvaluation e = EvaluateArtifact(SphereArtifact(), cap, o, "cap15.ply");
+    const Figure& p_s = e.figures[1];
+    ASSERT_GT(p_s.fit_standard_uncertainty_mm.value(), 0.15) << DecisionRuleName(rule);
+    ASSERT_GT(std::abs(p_s.value_mm) - p_s.ExpandedUncertaintyMm(), 1.5) << DecisionRuleName(rule);
+    EXPECT_TRUE(p_s.uncertainty_is_floor) << DecisionRuleName(rule);
+    EXPECT_EQ(p_s.judged, judged) << DecisionRuleName(rule);
+    EXPECT_FALSE(p_s.pass) << DecisionRuleName(rule);
   }
 }
 
