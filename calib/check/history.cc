@@ -495,7 +495,7 @@ HistoryContents ReadHistory(sqlite3* db, const std::string& path) {
     if (view.jump_rms_px < 0 || view.bound_px < 0) row.Refuse("its jump_rms_px or bound_px is negative");
     view.tilt_deg = row.OptionalNumber(6, "its tilt_deg");
     if (view.tilt_deg && (*view.tilt_deg < 0 || *view.tilt_deg > 90))
-      row.Refuse("its tilt_deg " + std::to_string(*view.tilt_deg) + " is no tilt from face-on (0 to 90 deg)");
+      row.Refuse("its tilt_deg " + KSigmaText(*view.tilt_deg) + " is no tilt from face-on (0 to 90 deg)");
     h.set_aside.views.push_back(view);
   }
   std::stable_sort(h.set_aside.views.begin(), h.set_aside.views.end(),

@@ -586,6 +586,10 @@ TEST(History, ABadRowIsRefusedNamingTheTableTheRowAndWhatIsWrong) {
       {"CREATE TABLE stereorig_check_views_set_aside (run_id INTEGER, capture TEXT, camera INTEGER, jump_rms_px "
        "REAL, bound_px REAL); INSERT INTO stereorig_check_views_set_aside VALUES (2, '003', 'one', 0.4, 0.05);",
        "stereorig_check_views_set_aside row 1 (run 2): its camera is 'one', not an integer"},
+      {"CREATE TABLE stereorig_check_views_set_aside (run_id INTEGER, capture TEXT, camera INTEGER, jump_rms_px "
+       "REAL, bound_px REAL, tilt_deg REAL); INSERT INTO stereorig_check_views_set_aside VALUES (2, '006', 5, 0.04, "
+       "0.06, 95);",
+       "stereorig_check_views_set_aside row 1 (run 2): its tilt_deg 95 is no tilt from face-on (0 to 90 deg)"},
   };
   namespace fs = std::filesystem;
   for (const Case& c : cases) {
@@ -673,7 +677,9 @@ TEST(History, NewTablesRefuseRowsNoCheckWrites) {
         "UPDATE stereorig_check_runs SET date_utc = 'yesterday';",
         "UPDATE stereorig_check_run_inputs SET rig_crc32 = 'xyz';",
         "UPDATE stereorig_check_run_inputs SET k_sigma = -1;",
-        "UPDATE stereorig_check_run_inputs SET captures_crc32 = 'ABCDEFGH';"})
+        "UPDATE stereorig_check_run_inputs SET captures_crc32 = 'ABCDEFGH';",
+        "INSERT INTO stereorig_check_views_set_aside VALUES (1, '006', 5, 0.04, 0.06, 95.0);",
+        "INSERT INTO stereorig_check_views_set_aside VALUES (1, '006', 5, 0.04, 0.06, 'steep');"})
     EXPECT_NE(sqlite3_exec(raw, sql, nullptr, nullptr, nullptr), SQLITE_OK) << sql;
   EXPECT_EQ(sqlite3_exec(raw, "UPDATE stereorig_check_figures SET value = 1;", nullptr, nullptr, nullptr), SQLITE_OK);
   sqlite3_close(raw);
