@@ -207,8 +207,11 @@ int PrintHistoryJson(const std::string& db) {
     for (const HistoryPoint& p : t.points)
       figures[p.run_id][t.name] = {{"value", p.value}, {"threshold", p.threshold}, {"pass", p.pass}};
   for (const HistorySetAside& v : set_aside.views)
-    views[v.run_id].push_back(
-        {{"capture", v.capture}, {"camera", v.camera}, {"jump_rms_px", v.jump_rms_px}, {"bound_px", v.bound_px}});
+    views[v.run_id].push_back({{"capture", v.capture},
+                               {"camera", v.camera},
+                               {"jump_rms_px", v.jump_rms_px},
+                               {"bound_px", v.bound_px},
+                               {"tilt_deg", v.tilt_deg ? nlohmann::json(*v.tilt_deg) : nlohmann::json()}});
   auto text = [](const std::string& t) { return t.empty() ? nlohmann::json() : nlohmann::json(t); };
   nlohmann::json out = {{"db", db}, {"runs", nlohmann::json::array()}};
   for (const HistoryRun& r : runs) {
@@ -250,7 +253,8 @@ int PrintHistory(const std::string& db) {
 int RunCheck(int argc, char** argv) {
   CLI::App app{
       "The nightly recalibration check. Take 8 to 10 fresh captures of the double-sided target (lasers off, the "
-      "target in different poses between the modules; at least 5 must keep a view once views whose corners "
+      "target in different poses between the modules, within ~65 deg of facing each camera: a view seen 70 deg or "
+      "more from face-on is set aside; at least 5 must keep a view once views whose corners "
       "are misplaced are set aside, or the night is refused) and run this against the stored rig file. The calibration "
       "is held fixed; only the board poses are re-estimated. It reports each camera's consistency with the others, "
       "each module's stereo consistency and rectified-row error, and each module pair's closure through the "
@@ -431,8 +435,9 @@ int RunCheck(int argc, char** argv) {
     report["figures"].push_back(
         {{"name", f.name}, {"value", f.value}, {"threshold", f.threshold}, {"pass", f.pass}, {"samples", f.samples}});
   }
-  // Views set aside whole: their corners fit no board pose, not even their
-  // own (a detection slip where the board is seen nearly edge-on), or they
+  // Views set aside whole: their board seen nearly edge-on (its corners can
+  // share one error no noise of their own shows), their corners fit no board
+  // pose, not even their own (a detection slip), or they
   // disagree with their capture's other views in that capture only (an
   // image taken at another moment). A capture set aside whole is said once,
   // with why: each of its views printed "off the capture's other views"
@@ -447,6 +452,7 @@ int RunCheck(int argc, char** argv) {
     const auto name = detected.capture_names.find(v.capture);
     const std::string capture = name != detected.capture_names.end() ? name->second : std::to_string(v.capture);
     const bool other_moment = v.why == SetAsideWhy::kOtherMoment;
+    const bool edge_on = v.why == SetAsideWhy::kEdgeOn;
     const bool whole = v.whole_capture != WholeCapture::kNo;
     if (whole && said_whole.insert(v.capture).second) {
       std::string cameras;  // those that went with the capture (a view set aside before is said on its own)
@@ -455,6 +461,11 @@ int RunCheck(int argc, char** argv) {
           cameras += (cameras.empty() ? "cam" : ", cam") + std::to_string(w.camera);
       std::printf("set aside: capture %s whole (%s): %s; not used\n", capture.c_str(), cameras.c_str(),
                   WholeCaptureText(v).c_str());
+    } else if (edge_on) {
+      std::printf(
+          "set aside: capture %s cam%d: board seen %.0f deg from face-on (edge-on: its corners can share one "
+          "error), not used\n",
+          capture.c_str(), v.camera, v.tilt_deg);
     } else if (!whole) {
       std::printf(other_moment ? "set aside: capture %s cam%d: off the capture's other views by %.3f px (bound %.3f "
                                  "px), in this capture only: taken at another moment than the capture's other "
@@ -464,16 +475,22 @@ int RunCheck(int argc, char** argv) {
                                  "camera's other views), not used\n",
                   capture.c_str(), v.camera, v.FigurePx(), v.bound_px);
     }
-    report["views_set_aside"].push_back(
-        {{"capture", capture},
-         {"camera", v.camera},
-         {"why", other_moment ? "other_moment" : "corners_jump"},
-         {other_moment ? "off_px" : "jump_rms_px", v.FigurePx()},
-         {"bound_px", v.bound_px},
-         {"left_open", v.left_open},
-         {"whole_capture", v.whole_capture == WholeCapture::kModulesDisagree ? nlohmann::json("modules_disagree")
-                           : v.whole_capture == WholeCapture::kViewOrModule  ? nlohmann::json("view_or_module")
-                                                                             : nlohmann::json()}});
+    nlohmann::json entry = {
+        {"capture", capture},
+        {"camera", v.camera},
+        {"why", other_moment ? "other_moment"
+                : edge_on    ? "edge_on"
+                             : "corners_jump"},
+        {other_moment ? "off_px" : "jump_rms_px", v.FigurePx()},
+        {"bound_px", v.bound_px},
+        {"left_open", v.left_open},
+        {"whole_capture", v.whole_capture == WholeCapture::kModulesDisagree ? nlohmann::json("modules_disagree")
+                          : v.whole_capture == WholeCapture::kViewOrModule  ? nlohmann::json("view_or_module")
+                                                                            : nlohmann::json()}};
+    // An edge-on view: its tilt and the tilt that set it aside; its
+    // jump_rms_px and bound_px are the jump screen's reading of it.
+    if (edge_on) entry["tilt_deg"] = v.tilt_deg, entry["bound_deg"] = kEdgeOnTiltDeg;
+    report["views_set_aside"].push_back(entry);
   }
   // The board's size as each module measures it, over the squares measured
   // with (the target file's, or the record's where it re-measured them;

@@ -577,8 +577,7 @@ std::vector<std::string> StereoViewsLeftOutNotes(const CalibrationReport& report
         char text[48];
         std::snprintf(text, sizeof text, " (board tilted %.0f deg)", tilt_deg);
         views += text;
-        // Judged as printed: a tilt that reads "70 deg" is edge-on.
-        edge_on += std::round(tilt_deg) >= kEdgeOnTiltDeg;
+        edge_on += SeenEdgeOn(tilt_deg);
       }
     }
     const int n = int(s.views_left_out.size());

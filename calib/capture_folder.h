@@ -8,6 +8,7 @@
 // saying so).
 #pragma once
 
+#include <cmath>
 #include <map>
 #include <string>
 #include <vector>
@@ -138,6 +139,11 @@ std::string CamerasLeftOutNote(const std::string& dir, int num_cameras);
 // (TiltDeg, rounded to the degree the note prints) is seen nearly edge-on:
 // 1 / cos 70 deg = 2.9x foreshortened.
 inline constexpr double kEdgeOnTiltDeg = 70.0;
+// Whether a board tilted `tilt_deg` (TiltDeg) is seen nearly edge-on, judged
+// as printed (to the degree): 69.6 deg reads "70 deg", and is. The
+// calibration's notes and the nightly check's screen of such views
+// (calib/check/nightly_check.cc) both judge by it.
+inline bool SeenEdgeOn(double tilt_deg) { return std::round(tilt_deg) >= kEdgeOnTiltDeg; }
 
 // One warning per module whose joint solve left views out
 // (StereoReport::views_left_out), naming them by folder and camera, with

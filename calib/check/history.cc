@@ -148,7 +148,11 @@ constexpr AddedColumn kAddedColumns[] = {
      "1.7976931348623157e308))"},
     {"stereorig_check_run_inputs", "captures_crc32",
      "TEXT CHECK (captures_crc32 IS NULL OR (length(captures_crc32) = 8 AND captures_crc32 NOT GLOB "
-     "'*[^0-9a-f]*'))"}};
+     "'*[^0-9a-f]*'))"},
+    // A view set aside as seen edge-on: its board's tilt from face-on, deg
+    // (NULL: set aside for another reason; every view of a run from before).
+    {kSetAsideTable, "tilt_deg",
+     "REAL CHECK (tilt_deg IS NULL OR (typeof(tilt_deg) = 'real' AND tilt_deg BETWEEN 0 AND 90))"}};
 
 void AddMissingColumns(sqlite3* db, const std::string& path) {
   for (const AddedColumn& c : kAddedColumns)
@@ -468,9 +472,14 @@ HistoryContents ReadHistory(sqlite3* db, const std::string& path) {
       h.set_aside.since_run_id = std::stoll(text);
     }
   }
+  // A history from before edge-on views were set aside has no tilt_deg
+  // column: its views were all set aside for other reasons (NULL).
+  const bool tilts = HasColumn(db, kSetAsideTable, "tilt_deg", path);
   Stmt v = Prepare(db,
-                   "SELECT rowid, run_id, capture, camera, jump_rms_px, bound_px FROM stereorig_check_views_set_aside "
-                   "ORDER BY rowid;",
+                   tilts ? "SELECT rowid, run_id, capture, camera, jump_rms_px, bound_px, tilt_deg FROM "
+                           "stereorig_check_views_set_aside ORDER BY rowid;"
+                         : "SELECT rowid, run_id, capture, camera, jump_rms_px, bound_px, NULL FROM "
+                           "stereorig_check_views_set_aside ORDER BY rowid;",
                    path);
   while (sqlite3_step(v.get()) == SQLITE_ROW) {
     Row row(v.get(), path, kSetAsideTable);
@@ -484,6 +493,9 @@ HistoryContents ReadHistory(sqlite3* db, const std::string& path) {
     view.camera = static_cast<int>(camera);
     view.jump_rms_px = row.Number(4, "its jump_rms_px"), view.bound_px = row.Number(5, "its bound_px");
     if (view.jump_rms_px < 0 || view.bound_px < 0) row.Refuse("its jump_rms_px or bound_px is negative");
+    view.tilt_deg = row.OptionalNumber(6, "its tilt_deg");
+    if (view.tilt_deg && (*view.tilt_deg < 0 || *view.tilt_deg > 90))
+      row.Refuse("its tilt_deg " + KSigmaText(*view.tilt_deg) + " is no tilt from face-on (0 to 90 deg)");
     h.set_aside.views.push_back(view);
   }
   std::stable_sort(h.set_aside.views.begin(), h.set_aside.views.end(),
@@ -631,8 +643,8 @@ HistoryAppend AppendToHistory(const std::string& path, const HistoryRun& run, co
         throw InputError(path, std::string("history: ") + sqlite3_errmsg(db.get()));
     }
     Stmt aside = Prepare(db.get(),
-                         "INSERT INTO stereorig_check_views_set_aside (run_id, capture, camera, jump_rms_px, bound_px) "
-                         "VALUES (?, ?, ?, ?, ?);",
+                         "INSERT INTO stereorig_check_views_set_aside (run_id, capture, camera, jump_rms_px, bound_px, "
+                         "tilt_deg) VALUES (?, ?, ?, ?, ?, ?);",
                          path);
     for (const SetAsideView& v : result.views_set_aside) {
       const auto name = capture_names.find(v.capture);
@@ -643,6 +655,11 @@ HistoryAppend AppendToHistory(const std::string& path, const HistoryRun& run, co
       sqlite3_bind_int(aside.get(), 3, v.camera);
       sqlite3_bind_double(aside.get(), 4, v.FigurePx());  // the figure that set it aside
       sqlite3_bind_double(aside.get(), 5, v.bound_px);
+      // NULL where set aside for another reason (bound every row: sqlite3_reset keeps the last one's).
+      if (v.why == SetAsideWhy::kEdgeOn)
+        sqlite3_bind_double(aside.get(), 6, v.tilt_deg);
+      else
+        sqlite3_bind_null(aside.get(), 6);
       if (sqlite3_step(aside.get()) != SQLITE_DONE) {
         throw InputError(path, std::string("history: ") + sqlite3_errmsg(db.get()));
       }
@@ -776,20 +793,37 @@ std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<
   if (by_camera.empty()) out += "views set aside: none in " + std::to_string(kept_runs) + " run(s)" + since + "\n";
   for (const auto& [camera, views] : by_camera) {
     std::set<long long> run_ids;
-    const HistorySetAside* worst = views.front();
+    // The worst against its bound among the views set aside for their
+    // corners (jumps, another moment); those seen edge-on are counted apart:
+    // set aside for the board's pose, their jumps within bound or not.
+    const HistorySetAside* worst = nullptr;
+    int edge_on = 0;
+    double most_tilt_deg = 0;
     for (const HistorySetAside* v : views) {
       run_ids.insert(v->run_id);
-      if (Ratio(v->jump_rms_px, v->bound_px) > Ratio(worst->jump_rms_px, worst->bound_px)) worst = v;
+      if (v->tilt_deg) {
+        ++edge_on, most_tilt_deg = std::max(most_tilt_deg, *v->tilt_deg);
+        continue;
+      }
+      if (!worst || Ratio(v->jump_rms_px, v->bound_px) > Ratio(worst->jump_rms_px, worst->bound_px)) worst = v;
     }
     std::snprintf(line, sizeof line, "views set aside: cam%d %zu view(s) on %zu of %zu run(s)", camera, views.size(),
                   run_ids.size(), kept_runs);
     out += line + since;
     std::snprintf(line, sizeof line, ", last run %lld (", views.back()->run_id);
-    out += line + views.back()->date_utc;
-    std::snprintf(line, sizeof line, "); the worst against its bound: %s px, %sx its %s px (capture ",
-                  Bounded(worst->jump_rms_px, 3).c_str(),
-                  Bounded(Ratio(worst->jump_rms_px, worst->bound_px), 1).c_str(), Bounded(worst->bound_px, 3).c_str());
-    out += line + worst->capture + ", run " + std::to_string(worst->run_id) + ")\n";
+    out += line + views.back()->date_utc + ")";
+    if (edge_on > 0) {
+      std::snprintf(line, sizeof line, "; %d seen edge-on (up to %.0f deg from face-on)", edge_on, most_tilt_deg);
+      out += line;
+    }
+    if (worst) {
+      std::snprintf(line, sizeof line, "; the worst against its bound: %s px, %sx its %s px (capture ",
+                    Bounded(worst->jump_rms_px, 3).c_str(),
+                    Bounded(Ratio(worst->jump_rms_px, worst->bound_px), 1).c_str(),
+                    Bounded(worst->bound_px, 3).c_str());
+      out += line + worst->capture + ", run " + std::to_string(worst->run_id) + ")";
+    }
+    out += "\n";
   }
   return out;
 }

@@ -63,7 +63,9 @@ struct HistoryPoint {
 // One view the check set aside whole on one run (CheckResult's
 // views_set_aside): its corners jumped about their own board pose
 // (jump_rms_px), or it was off its capture's other views in that capture
-// only (jump_rms_px holds that figure, SetAsideView::FigurePx).
+// only (jump_rms_px holds that figure, SetAsideView::FigurePx), or its board
+// was seen nearly edge-on (tilt_deg; jump_rms_px and bound_px then hold the
+// jump screen's reading of it, which did not set it aside).
 struct HistorySetAside {
   long long run_id = 0;
   std::string date_utc;
@@ -71,6 +73,10 @@ struct HistorySetAside {
   int camera = -1;
   double jump_rms_px = 0;
   double bound_px = 0;
+  // Set aside as seen edge-on, this far from face-on; none for the other
+  // reasons, and for every view of a run written before edge-on views were
+  // set aside (no version before did so).
+  std::optional<double> tilt_deg = std::nullopt;
 };
 
 // The views set aside as the history holds them, and since which run they
@@ -132,7 +138,8 @@ HistorySetAsideLog ReadHistorySetAside(const std::string& db_path);
 // extremes, the last threshold and how many runs failed it; then, per
 // camera, the views set aside and on how many of the runs that kept them (a
 // camera that loses views night after night: a slipping detection, a dirty
-// or loose lens).
+// or loose lens), how many of them were seen edge-on (the board's poses, not
+// the camera), and the worst of the others against its bound.
 std::string FormatTrends(const std::vector<HistoryRun>& runs, const std::vector<FigureTrend>& trends,
                          const HistorySetAsideLog& set_aside = {});
 

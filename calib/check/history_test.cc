@@ -294,6 +294,54 @@ TEST(History, CountsTheViewsSetAsideOnlySinceTheRunThatFirstKeptThem) {
       << FormatTrends(ReadHistoryRuns(db), ReadHistoryTrends(db), after);
 }
 
+// A view set aside as seen edge-on keeps its tilt (tilt_deg) beside its
+// jump figure, which did not set it aside, so its camera's line counts it
+// apart and takes the worst against its bound over the others. A history
+// whose views-set-aside table is from before (no tilt_deg) still reads,
+// every earlier view NULL (none was set aside for its tilt), and gets the
+// column at its next append.
+TEST(History, KeepsTheTiltOfAViewSetAsideAsSeenEdgeOnAndReadsAnOlderTableWithout) {
+  const std::string db = ::testing::TempDir() + "/history_edge_on.sqlite";
+  std::filesystem::remove(db);
+  ASSERT_TRUE(MakeOldHistory(db,
+                             "CREATE TABLE stereorig_check_views_set_aside (run_id INTEGER NOT NULL, capture TEXT NOT "
+                             "NULL, camera INTEGER NOT NULL, jump_rms_px REAL NOT NULL, bound_px REAL NOT NULL);"
+                             "INSERT INTO stereorig_check_runs (date_utc, rig_file, captures, verdict, explanation) "
+                             "VALUES ('2026-11-01T02:00:00Z', 'rig.yaml', 'old', 'ok', 'every figure within its "
+                             "threshold');"
+                             "INSERT INTO stereorig_check_views_set_aside VALUES (1, '0002', 5, 0.52, 0.06);"));
+  HistorySetAsideLog before = ReadHistorySetAside(db);
+  ASSERT_EQ(before.views.size(), 1u);
+  EXPECT_FALSE(before.views[0].tilt_deg);
+  CheckResult night = Result(0.2, true);
+  SetAsideView edge_on{6, 5, 0.040, 0.061};
+  edge_on.why = SetAsideWhy::kEdgeOn, edge_on.tilt_deg = 80.4;
+  night.views_set_aside = {edge_on, {7, 5, 0.30, 0.06}};
+  AppendToHistory(db, {0, "2026-11-02T02:00:00Z", "rig.yaml", "new", "", ""}, night, {{6, "006"}, {7, "007"}});
+  const HistorySetAsideLog after = ReadHistorySetAside(db);
+  ASSERT_EQ(after.views.size(), 3u);
+  EXPECT_FALSE(after.views[0].tilt_deg);  // the older run's
+  EXPECT_EQ(after.views[1].capture, "006");
+  ASSERT_TRUE(after.views[1].tilt_deg);
+  EXPECT_DOUBLE_EQ(*after.views[1].tilt_deg, 80.4);
+  EXPECT_DOUBLE_EQ(after.views[1].jump_rms_px, 0.040);
+  EXPECT_FALSE(after.views[2].tilt_deg);  // a jump, in the same run
+  const std::string table = FormatTrends(ReadHistoryRuns(db), ReadHistoryTrends(db), after);
+  EXPECT_NE(table.find("views set aside: cam5 3 view(s) on 2 of 2 run(s), last run 2 (2026-11-02T02:00:00Z); 1 seen "
+                       "edge-on (up to 80 deg from face-on); the worst against its bound: 0.520 px, 8.7x its 0.060 px "
+                       "(capture 0002, run 1)"),
+            std::string::npos)
+      << table;
+  // A camera whose views went for their tilt alone has no worst to give.
+  HistorySetAsideLog only_edge_on = after;
+  only_edge_on.views = {after.views[1]};
+  EXPECT_NE(FormatTrends(ReadHistoryRuns(db), ReadHistoryTrends(db), only_edge_on)
+                .find("views set aside: cam5 1 view(s) on 1 of 2 run(s), last run 2 (2026-11-02T02:00:00Z); 1 seen "
+                      "edge-on (up to 80 deg from face-on)\n"),
+            std::string::npos)
+      << FormatTrends(ReadHistoryRuns(db), ReadHistoryTrends(db), only_edge_on);
+}
+
 // A capture's name of any length is kept whole on its line.
 TEST(History, KeepsALongCaptureNameWhole) {
   const std::string db = ::testing::TempDir() + "/history_long_name.sqlite";
@@ -538,6 +586,10 @@ TEST(History, ABadRowIsRefusedNamingTheTableTheRowAndWhatIsWrong) {
       {"CREATE TABLE stereorig_check_views_set_aside (run_id INTEGER, capture TEXT, camera INTEGER, jump_rms_px "
        "REAL, bound_px REAL); INSERT INTO stereorig_check_views_set_aside VALUES (2, '003', 'one', 0.4, 0.05);",
        "stereorig_check_views_set_aside row 1 (run 2): its camera is 'one', not an integer"},
+      {"CREATE TABLE stereorig_check_views_set_aside (run_id INTEGER, capture TEXT, camera INTEGER, jump_rms_px "
+       "REAL, bound_px REAL, tilt_deg REAL); INSERT INTO stereorig_check_views_set_aside VALUES (2, '006', 5, 0.04, "
+       "0.06, 95);",
+       "stereorig_check_views_set_aside row 1 (run 2): its tilt_deg 95 is no tilt from face-on (0 to 90 deg)"},
   };
   namespace fs = std::filesystem;
   for (const Case& c : cases) {
@@ -625,7 +677,9 @@ TEST(History, NewTablesRefuseRowsNoCheckWrites) {
         "UPDATE stereorig_check_runs SET date_utc = 'yesterday';",
         "UPDATE stereorig_check_run_inputs SET rig_crc32 = 'xyz';",
         "UPDATE stereorig_check_run_inputs SET k_sigma = -1;",
-        "UPDATE stereorig_check_run_inputs SET captures_crc32 = 'ABCDEFGH';"})
+        "UPDATE stereorig_check_run_inputs SET captures_crc32 = 'ABCDEFGH';",
+        "INSERT INTO stereorig_check_views_set_aside VALUES (1, '006', 5, 0.04, 0.06, 95.0);",
+        "INSERT INTO stereorig_check_views_set_aside VALUES (1, '006', 5, 0.04, 0.06, 'steep');"})
     EXPECT_NE(sqlite3_exec(raw, sql, nullptr, nullptr, nullptr), SQLITE_OK) << sql;
   EXPECT_EQ(sqlite3_exec(raw, "UPDATE stereorig_check_figures SET value = 1;", nullptr, nullptr, nullptr), SQLITE_OK);
   sqlite3_close(raw);

@@ -50,12 +50,14 @@ struct CheckFigure {
   int samples = 0;  // corners or captures behind the figure
 };
 
-// Why a view was set aside (RunNightlyCheck): its corners jump about their
+// Why a view was set aside (RunNightlyCheck): its board is seen nearly
+// edge-on (SeenEdgeOn, calib/capture_folder.h: its corners can share one
+// error that its own noise does not show); its corners jump about their
 // own board pose, beyond any smooth field a lens change leaves; or it
 // disagrees with the rest of its capture, in that capture only (taken at
 // another moment than the capture's other views?), or its capture's modules
 // disagree in that capture only (a trigger slip: the whole capture goes).
-enum class SetAsideWhy { kCornersJump, kOtherMoment };
+enum class SetAsideWhy { kCornersJump, kOtherMoment, kEdgeOn };
 
 // Why a view went with every other view of its capture (SetAsideView's
 // whole_capture): the capture's modules disagree in it only (a module's
@@ -70,8 +72,10 @@ enum class WholeCapture { kNo, kModulesDisagree, kViewOrModule };
 struct SetAsideView {
   int capture = -1;
   int camera = -1;
-  double jump_rms_px = 0;  // kCornersJump: per axis, neighbour jumps of its residuals about its own pose
-  double bound_px = 0;     // what jump_rms_px, or off_px, had to be within
+  // kCornersJump (and kEdgeOn, where it is the reading the jump screen
+  // would have judged): per axis, neighbour jumps of its residuals about its own pose
+  double jump_rms_px = 0;
+  double bound_px = 0;  // what jump_rms_px, or off_px, had to be within (kEdgeOn: the jump's bound)
   SetAsideWhy why = SetAsideWhy::kCornersJump;
   double off_px = 0;  // kOtherMoment: median corner error through the pose its capture's other views imply
   WholeCapture whole_capture = WholeCapture::kNo;  // kOtherMoment: set aside with its capture's every view, and why
@@ -84,6 +88,9 @@ struct SetAsideView {
   // captures was not knocked there: a slip of that image, the night judged.
   bool left_open = false;
   std::string capture_name = {};  // as the night names it (RunNightlyCheck's capture_names), else its index
+  // kEdgeOn: the board's tilt from face-on in this view (TiltDeg of its own
+  // board pose), at least kEdgeOnTiltDeg as printed.
+  double tilt_deg = 0;
   double FigurePx() const { return why == SetAsideWhy::kOtherMoment ? off_px : jump_rms_px; }
 };
 
