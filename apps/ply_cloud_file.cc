@@ -1,5 +1,6 @@
 #include "apps/ply_cloud_file.h"
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -7,6 +8,9 @@ namespace stereorig {
 
 bool IsPlyCloudFile(const std::string& path) {
   constexpr std::streamsize kMaxHeaderBytes = 4096;
+  // A pipe would block the open until a writer came (check's CRC hung so).
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) return false;
   std::ifstream in(path, std::ios::binary);
   if (!in) return false;
   std::string head(size_t(kMaxHeaderBytes), '\0');

@@ -179,6 +179,13 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
                                   const std::string& name, const CaptureOutputs& outputs, const std::string& progress,
                                   std::chrono::steady_clock::time_point started, RowDriftWatch* row_drift) {
   const bool mesh = !outputs.mesh.empty();
+  // The mesh's name may be an earlier run's cloud of a capture named like
+  // it (`x.mesh` beside `x`, --mesh-format ply): replaced, another
+  // capture's measurement was lost without a word.
+  if (mesh && IsPlyCloudFile(outputs.mesh))
+    throw InputError(outputs.mesh,
+                     "is an earlier run's point cloud (of a capture named like this one's mesh): not replaced by this "
+                     "capture's mesh; move it, or give another --out-dir");
   const Reconstruction rec = runtime.Process(images, mesh);
   const std::vector<WatchedRowDrift> recent_drift = row_drift->Add(rec.modules);
   // All or none: written beside their paths, then renamed in together, so a
@@ -248,7 +255,10 @@ nlohmann::json FailedCapture(const std::string& dir, const std::string& name, co
   // An earlier run's files of this name removed first (a batch's: it
   // replaces them), so that the lines below are true when printed; one that
   // cannot be removed is named in them and in the entry, not passed over.
-  std::vector<std::string> paths = {outputs.cloud, outputs.report, outputs.mesh};
+  // Not the mesh's name where it holds an earlier run's cloud of another
+  // capture (ReconstructCapture refuses to replace it).
+  std::vector<std::string> paths = {outputs.cloud, outputs.report,
+                                    IsPlyCloudFile(outputs.mesh) ? std::string() : outputs.mesh};
   const std::vector<std::string> meshes = EarlierMeshes(outputs.earlier_only);
   paths.insert(paths.end(), meshes.begin(), meshes.end());
   std::string left_behind;

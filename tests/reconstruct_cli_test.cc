@@ -1766,6 +1766,18 @@ TEST_F(ReconstructCli, ABatchKeepsAnEarlierRunsCloudNamedLikeAMesh) {
   EXPECT_EQ(ReadFileBytes(out + "/nm_x.mesh.ply"), cloud);
   EXPECT_TRUE(std::filesystem::exists(out + "/nm_x.mesh.json"));
   EXPECT_TRUE(std::filesystem::exists(out + "/nm_x.ply"));
+  // With --mesh-format ply, nm_x's mesh would be written over that cloud
+  // (second reading: it replaced it, or its capture failing removed it):
+  // the capture fails naming it, and the cloud and its report stay.
+  r = testing::RunCli(head + " --mesh-format ply --capture " + root + "/nm/x " + root + "/caps/b");
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find(out + "/nm_x.mesh.ply: is an earlier run's point cloud (of a capture named like this one's "
+                             "mesh): not replaced"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(ReadFileBytes(out + "/nm_x.mesh.ply"), cloud);
+  EXPECT_TRUE(std::filesystem::exists(out + "/nm_x.mesh.json"));
+  EXPECT_TRUE(std::filesystem::exists(out + "/caps_b.mesh.ply")) << r.out;  // the other capture goes on
 
   // A PLY mesh of nm_x, then a batch writing STL meshes: the PLY one goes.
   const std::string meshes = root + "/meshes",

@@ -39,7 +39,10 @@ namespace stereorig {
 struct VerifyOptions {
   double excluded_fraction_max = 0.003;  // the standard's 0.3%
   // RANSAC's inlier band, mm, which only locates the shape; <= 0 means "the
-  // MPE of the figure" (a consensus of points measured within the MPE).
+  // MPE of the figure" (a consensus of points measured within the MPE). For a
+  // sphere or a ball bar's balls either is capped at an eighth of the
+  // certified radius (vdi2634.cc, kMaxLocateBandOfRadius), this value too:
+  // wider, another object passed for the artifact.
   double locate_band_mm = 0;
   // The artifact's points: those within this distance of the located shape,
   // mm, iterated with the least-squares fit to a fixed point. Used as

@@ -212,11 +212,16 @@ def main():
             rows.append(('passive', scene['passive'], passive))
             active_ok, active_count = within_agrees(scene['merged'], merged)
             passive_ok, passive_count = within_agrees(scene['passive'], passive)
-            # The ratio's range over the counts the slack allows.
-            low = (merged['within'] - merged['within_slack']) / (passive['within'] + passive['within_slack'])
-            high = (merged['within'] + merged['within_slack']) / max(1, passive['within'] - passive['within_slack'])
+            # The ratio's range over the counts the slack allows; score writes
+            # null where no passive point lies within 0.5 mm.
             ratio = scene['active_over_passive_within_0_5_mm']
-            ok = active_ok and passive_ok and ratio is not None and low - 1e-9 <= ratio <= high + 1e-9
+            if passive['within'] + passive['within_slack'] == 0:
+                low = high = float('nan')
+                ok = active_ok and passive_ok and ratio is None
+            else:
+                low = (merged['within'] - merged['within_slack']) / (passive['within'] + passive['within_slack'])
+                high = (merged['within'] + merged['within_slack']) / max(1, passive['within'] - passive['within_slack'])
+                ok = active_ok and passive_ok and ratio is not None and low - 1e-9 <= ratio <= high + 1e-9
             bad += not ok
             print(f"{name:8s} within 0.5 mm: active {active_count} / {merged['within']}, passive {passive_count} / "
                   f"{passive['within']} (+-{merged['within_slack']}, +-{passive['within_slack']} near the bound); "
