@@ -221,18 +221,19 @@ int RunReconstruct(int argc, char** argv) {
   // A module whose matches reach an end of the range may read a whole
   // vernier step off whatever its rows are (row_drift_watch.h, which leaves
   // such readings out): the volume first, then the rig.
-  for (const ModuleReport& m : rec.modules)
-    if (m.row_drift.warned)
-      std::fprintf(stderr,
-                   "stereorig reconstruct: warning: module %d's rectified rows read %+.3f px off at the laser grid's "
-                   "vernier (standard error %.3f; its summary above): %s\n",
-                   m.module, m.row_drift.row_offset_px, m.row_drift.standard_error_px,
-                   RangeEndsWarnedOf(m).empty()
-                       ? "run `stereorig check` on the rig before trusting that module's points"
-                       : ("its matches reach " + RangeEndsWarnedOf(m) +
-                          " of the range, where the grid can be matched a period off and the reading a vernier step: "
-                          "check the volume first, then run `stereorig check` on the rig")
-                             .c_str());
+  for (const ModuleReport& m : rec.modules) {
+    if (!m.row_drift.warned) continue;
+    const std::string ends = RangeEndsWarnedOf(m);
+    std::fprintf(stderr,
+                 "stereorig reconstruct: warning: module %d's rectified rows read %+.3f px off at the laser grid's "
+                 "vernier (standard error %.3f; its summary above): %s\n",
+                 m.module, m.row_drift.row_offset_px, m.row_drift.standard_error_px,
+                 ends.empty() ? "run `stereorig check` on the rig before trusting that module's points"
+                              : ("its matches reach " + ends +
+                                 " of the range, where the grid can be matched a period off and the reading a vernier "
+                                 "step: check the volume first, then run `stereorig check` on the rig")
+                                    .c_str());
+  }
   std::printf("%zu points (%d from the shape model) in %.1f ms; wrote %s", rec.cloud.size(), rec.filled_points,
               rec.times_ms.at("total_point_cloud"), out_path.c_str());
   if (!mesh_path.empty()) std::printf(", %s (%zu triangles)", mesh_path.c_str(), rec.mesh.triangles.size());
