@@ -28,10 +28,6 @@ std::string LossLine(std::span<const int> counts_by_status, int total_px, int ma
 
 namespace {
 
-constexpr const char* kSetTheVolume =
-    "set working_distance_mm (or volume_center_mm, volume_size_mm) to where it is (docs/reconstruct.md, \"When the "
-    "fill rate is low\")";
-
 constexpr const char* kPassiveOptions =
     "a capture without the laser grid (passive) needs crop_to_lit_region: false and match: {min_distinctness: 0, "
     "grid_line_test: false, line_index: false} (`stereorig demo` writes them, passive_options.yaml)";

@@ -62,6 +62,12 @@ std::string NoPointReason(const ModuleReport& m, bool passive);
 // a batch's per-module line both name them so.
 std::string RangeEndsWarnedOf(const ModuleReport& m);
 
+// What to do where the object is not in the measurement volume: the
+// no-point reasons and the range-end warnings end with it.
+inline constexpr const char* kSetTheVolume =
+    "set working_distance_mm (or volume_center_mm, volume_size_mm) to where it is (docs/reconstruct.md, \"When the "
+    "fill rate is low\")";
+
 // What a module whose rows read off (RowDrift::warned) means and what to do:
 // ModuleSummary's warning line and a batch's per-module line end with it.
 inline constexpr const char* kRowDriftAdvice =

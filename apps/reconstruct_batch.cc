@@ -160,8 +160,8 @@ int ReconstructBatch(const Rig& rig, const RuntimeOptions& options, const BatchR
     ++failed;
     summary["captures"].push_back(FailedCapture(dirs[i], names[i], outputs[i], progress, error));
   }
-  const int code = FinishRun(&summary, int(dirs.size()), failed, without_points, with_row_drift, MsSince(t_all),
-                             "reading, reconstructing and writing", request.summary_path);
+  const int code = FinishRun(&summary, int(dirs.size()), failed, without_points, with_row_drift, row_drift,
+                             MsSince(t_all), "reading, reconstructing and writing", request.summary_path);
   // Every capture failed and nothing was written in it (no summary there):
   // a new output folder goes again, as bad input found earlier leaves none.
   if (failed > 0) out_folder.RemoveIfEmpty();

@@ -126,6 +126,18 @@ nlohmann::json RowDriftRunJson(const ModuleReport& m, const WatchedRowDrift& dri
   return j;
 }
 
+// Why a module's drift went unjudged (RowDriftWatch::Unjudged) and what to
+// do, after "module M's row drift is not watched: ..." on stderr: in the
+// words of a single capture's row-drift line where the matches reach an end.
+std::string UnjudgedRowDriftAdvice() {
+  return std::string(
+             "its matches reaching an end of the measurement volume's disparity range at each capture "
+             "(row_drift_run.not_counted: range_end_reached), where the grid can be matched a period off and the "
+             "reading a vernier step; if the object is not well inside the volume, ") +
+         kSetTheVolume + ", or check the part's position on the line (said once a run; the summary's " +
+         "row_drift_unjudged_modules)";
+}
+
 // A module's rows read off over the run's recent captures: a line under the
 // capture's on stdout at every capture it holds (the controller's answer),
 // and on stderr, where a log keeps the problems, when it begins and when it
@@ -157,6 +169,16 @@ void SayRowDrift(int module, const WatchedRowDrift& drift, const std::string& di
                  "that module's points\n",
                  progress.c_str(), PrintableText(dir).c_str(), module, drift.recent.row_offset_px, n, readings,
                  drift.recent.standard_error_px);
+  // A module none of whose last readings counted: told once a run, on
+  // stderr (its captures' lines under each name the range end already).
+  if (drift.unjudged)
+    std::fprintf(stderr,
+                 "stereorig reconstruct: %s %s: warning: module %d's row drift is not watched: its last %d readings "
+                 "were not counted (%s), %s\n",
+                 progress.c_str(), PrintableText(dir).c_str(), module, drift.not_counted_in_a_row,
+                 drift.counted_before == 0 ? "none counted in this run"
+                                           : (std::to_string(drift.counted_before) + " counted before them").c_str(),
+                 UnjudgedRowDriftAdvice().c_str());
   if (drift.withdrawn_since != 0) {
     char mean[96] = "no reading counted";
     if (drift.recent.read)
@@ -284,13 +306,16 @@ nlohmann::json FailedCapture(const std::string& dir, const std::string& name, co
   return entry;
 }
 
-int FinishRun(nlohmann::json* summary, int total, int failed, int without_points, int with_row_drift, double wall_ms,
-              const std::string& timed, const std::string& summary_path) {
+int FinishRun(nlohmann::json* summary, int total, int failed, int without_points, int with_row_drift,
+              const RowDriftWatch& row_drift, double wall_ms, const std::string& timed,
+              const std::string& summary_path) {
   const int done = total - failed;
   (*summary)["reconstructed"] = done;
   (*summary)["failed"] = failed;
   (*summary)["with_modules_without_points"] = without_points;
   (*summary)["with_row_drift"] = with_row_drift;
+  (*summary)["row_drift_unjudged_modules"] = nlohmann::json::array();
+  for (const UnjudgedRowDrift& u : row_drift.Unjudged()) (*summary)["row_drift_unjudged_modules"].push_back(u.module);
   (*summary)["wall_ms"] = wall_ms;
   (*summary)["objects_per_s"] = done > 0 ? 1000.0 * done / wall_ms : 0.0;
   std::printf("%d of %d captures in %.2f s: %.1f objects/s (%s)", done, total, wall_ms / 1000,
@@ -309,6 +334,14 @@ int FinishRun(nlohmann::json* summary, int total, int failed, int without_points
                  "stereorig reconstruct: warning: %d of %d captures written have a module whose rectified rows read "
                  "off (each named above): run `stereorig check` on the rig before trusting that module's points\n",
                  with_row_drift, done);
+  // A run too short for a module's uncounted readings to fill a window
+  // (RowDriftWatch) still tells one none of whose readings counted.
+  for (const UnjudgedRowDrift& u : row_drift.Unjudged())
+    if (u.unjudged_since == 0)
+      std::fprintf(stderr,
+                   "stereorig reconstruct: warning: module %d's row drift was not watched in this run: none of its %d "
+                   "reading%s was counted, %s\n",
+                   u.module, u.not_counted, u.not_counted == 1 ? "" : "s", UnjudgedRowDriftAdvice().c_str());
   // Stdout lost on the last lines (a terminal's hang-up): the summary says
   // so, as for a capture's line, and main exits 2 (cli_util.h).
   const std::string lost = StdoutWriteError();

@@ -77,7 +77,9 @@ std::vector<cv::Mat> LoadCaptureOrInputError(const std::string& dir, const Rig& 
 // off over the run's recent captures (`row_drift`: the mean of its last
 // sound readings, RowDriftWatch, to which this capture's are added; on
 // stderr too when the warning begins, and a note on both when it is
-// withdrawn), and one per module that gave
+// withdrawn; on stderr once a run, "module M's row drift is not watched",
+// where its readings have gone a window, RowDriftWatch::kCaptures, in a row
+// not counted for a range end), and one per module that gave
 // no point ("  warning: module M gave no point (<report>): <why>",
 // module_summary.h NoPointReason; also on stderr, "stereorig reconstruct:
 // <progress> <dir>: warning: ..."). Returns the capture's entry of the run's
@@ -105,14 +107,19 @@ nlohmann::json FailedCapture(const std::string& dir, const std::string& name, co
 // is not 0, and "; K with a module whose rows read off (row_drift)" when
 // `with_row_drift` is not 0 (captures whose entry lists
 // modules_with_row_drift); the summary's totals (reconstructed, failed,
-// with_modules_without_points, with_row_drift, wall_ms, objects_per_s) set and the summary
+// with_modules_without_points, with_row_drift, wall_ms, objects_per_s) set,
+// with row_drift_unjudged_modules (the run's RowDriftWatch::Unjudged: the
+// modules whose drift went unjudged, their readings not counted, told on
+// stderr at the capture that made a window of them, or here, for a module
+// none of whose readings counted in a shorter run) and the summary
 // written atomically to summary_path (unless ""); with failures, or captures
 // with a module that gave no point or whose rows read off, a stderr line
 // that counts them. Returns
 // the exit code: kExitOk, or kExitBadInput when any capture failed. A module
 // with no point does not change it: the capture was measured and written, and
 // 1 is a check's failure (docs/formats.md); the count is the controller's.
-int FinishRun(nlohmann::json* summary, int total, int failed, int without_points, int with_row_drift, double wall_ms,
-              const std::string& timed, const std::string& summary_path);
+int FinishRun(nlohmann::json* summary, int total, int failed, int without_points, int with_row_drift,
+              const RowDriftWatch& row_drift, double wall_ms, const std::string& timed,
+              const std::string& summary_path);
 
 }  // namespace stereorig

@@ -237,7 +237,7 @@ int ReconstructStream(const Rig& rig, const RuntimeOptions& options, const Strea
     if (stop != 0) return kExitOk;  // stopped before the line's first object: nothing to sum up
     throw InputError("--capture -", "standard input held no capture folder (one folder's path per line)");
   }
-  const int code = FinishRun(&summary, total, failed, without_points, with_row_drift, MsSince(t_all),
+  const int code = FinishRun(&summary, total, failed, without_points, with_row_drift, row_drift, MsSince(t_all),
                              "the stream's wall time: waiting for the input, reading, reconstructing and writing",
                              request.summary_path);
   if (failed > 0) out_folder.RemoveIfEmpty();  // as a batch: nothing written, no new folder

@@ -31,6 +31,17 @@
 // readings (the run's first captures) is judged anew at each capture, as
 // the mean of what there is, and withdrawn once that mean no longer warns:
 // a false alarm from the run's first capture must not last the run.
+//
+// A module none of whose readings count is not watched at all: the part
+// outside the volume for the whole run, or a volume set wrong, and each
+// capture's report alone (row_drift_run.counted false) says so. The watch
+// tells it once per run (WatchedRowDrift::unjudged), when the module's
+// readings have gone kCaptures in a row not counted: as many captures as
+// fill a window, where a module read at each would have been judged on a
+// full one, warned for the run if it drifted. A line whose parts reach a
+// range end now and then (the tuber, one capture in three, above) does not
+// go 20 in a row. A run that ends before that with a module never counted
+// is told at its end (Unjudged).
 #pragma once
 
 #include <deque>
@@ -56,6 +67,22 @@ struct WatchedRowDrift {
   int warned_since = 0;     // the run's capture (1 = its first) at which this warning began; 0 = not warned
   bool started = false;     // warned at this capture and not at the one before
   int withdrawn_since = 0;  // not warned now, warned at the capture before since this capture; else 0
+  // The module's readings not counted in a row up to this capture's, since
+  // its last counted one or the run's start (a capture where it read
+  // nothing is passed over), and those counted in the run before them.
+  int not_counted_in_a_row = 0;
+  int counted_before = 0;
+  // This capture's reading made kCaptures not counted in a row, the first
+  // time in the run: the module's drift has gone unjudged (said once a run).
+  bool unjudged = false;
+};
+
+// A module whose drift went unjudged in a run (RowDriftWatch::Unjudged).
+struct UnjudgedRowDrift {
+  int module = 0;
+  int unjudged_since = 0;  // the run's capture at which WatchedRowDrift::unjudged was given; 0 = not given
+  int counted = 0;         // its readings counted in the run
+  int not_counted = 0;     // and not counted (range_end_reached)
 };
 
 class RowDriftWatch {
@@ -69,11 +96,20 @@ class RowDriftWatch {
   // of `modules`.
   std::vector<WatchedRowDrift> Add(const std::vector<ModuleReport>& modules);
 
+  // The modules whose drift went unjudged in the run so far, by module:
+  // those given WatchedRowDrift::unjudged, and those none of whose readings
+  // was counted (at least one read; unjudged_since 0 where the run has been
+  // too short to give it: its end tells them).
+  std::vector<UnjudgedRowDrift> Unjudged() const;
+
  private:
   struct Module {
     std::deque<RowDrift> recent;  // readings with row_offset_px made a size
     int warned_since = 0;
     bool stays = false;
+    int counted = 0, not_counted = 0;  // readings in the run
+    int not_counted_in_a_row = 0;
+    int unjudged_since = 0;
   };
   double max_row_offset_px_;
   int captures_ = 0;

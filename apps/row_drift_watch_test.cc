@@ -217,5 +217,91 @@ TEST(RowDriftWatch, ATurnedCameraIsWarnedFromItsFirstReadingAndForTheRunOnceAWin
   }
 }
 
+// The tuber outside the volume for the whole run (its readings measured
+// above, each reaching both ends): none counted, so the module's drift is
+// never judged. Told once, at the 20th such reading (a full window's
+// captures), not before nor after; module 1, counted at each capture, never.
+TEST(RowDriftWatch, AModuleWhoseReadingsAllReachARangeEndIsToldUnjudgedOnceAtAFullWindow) {
+  RowDriftWatch watch(0.1);
+  for (int capture = 1; capture <= 45; ++capture) {
+    const std::vector<WatchedRowDrift> states =
+        watch.Add({Reading(0, kTuberOutsideTheVolume.row_offset_px, kTuberOutsideTheVolume.se_px, "both"),
+                   Reading(1, 0.01, 0.02)});
+    EXPECT_EQ(states[0].unjudged, capture == RowDriftWatch::kCaptures) << capture;
+    EXPECT_EQ(states[0].not_counted_in_a_row, capture) << capture;
+    EXPECT_EQ(states[0].counted_before, 0);
+    EXPECT_FALSE(states[0].warned) << capture;
+    EXPECT_FALSE(states[1].unjudged) << capture;
+    EXPECT_EQ(states[1].not_counted_in_a_row, 0);
+    // Before the 20th, the run's end would tell it (a run that short).
+    const std::vector<UnjudgedRowDrift> unjudged = watch.Unjudged();
+    ASSERT_EQ(unjudged.size(), 1u) << capture;
+    EXPECT_EQ(unjudged[0].module, 0);
+    EXPECT_EQ(unjudged[0].unjudged_since, capture >= RowDriftWatch::kCaptures ? RowDriftWatch::kCaptures : 0);
+    EXPECT_EQ(unjudged[0].counted, 0);
+    EXPECT_EQ(unjudged[0].not_counted, capture);
+  }
+}
+
+// The measured line after the tuber: one capture in three reaching the
+// near end, not counted. Its streaks of uncounted readings are one long:
+// never told, over 60 captures, and not at the run's end either.
+TEST(RowDriftWatch, AModuleReachingARangeEndNowAndThenIsNotToldUnjudged) {
+  RowDriftWatch watch(0.1);
+  for (int k = 0; k < 60; ++k) {
+    const Measured& r = kLineAfterIt[k % 3];
+    const WatchedRowDrift state = watch.Add({Reading(0, r.row_offset_px, r.se_px, r.ends)})[0];
+    EXPECT_FALSE(state.unjudged) << k;
+    EXPECT_LE(state.not_counted_in_a_row, 1) << k;
+  }
+  EXPECT_TRUE(watch.Unjudged().empty());
+}
+
+// A module counted at the run's first 5 captures, then its matches reaching
+// an end at every capture (the part moved, or it stopped reading): told at
+// the 20th uncounted reading in a row, 5 counted before them; a capture
+// where it read nothing (no component kept) neither breaks the run of
+// uncounted readings nor adds to it. Counted again, the count starts anew,
+// and it is not told a second time in the run.
+TEST(RowDriftWatch, ACountedModuleThatStopsBeingCountedIsToldUnjudgedOnce) {
+  RowDriftWatch watch(0.1);
+  for (int k = 0; k < 5; ++k) watch.Add({Reading(0, 0.02, 0.02)});
+  int told_at = 0, capture = 5;
+  for (int k = 1; k <= 20; ++k) {
+    ++capture;
+    if (k == 10) {
+      ModuleReport unread = Reading(0, 0.0, 0.0, "far");
+      unread.row_drift = RowDrift{};
+      const WatchedRowDrift state = watch.Add({unread})[0];
+      EXPECT_FALSE(state.unjudged);
+      EXPECT_EQ(state.not_counted_in_a_row, 9);
+      ++capture;
+    }
+    const WatchedRowDrift state = watch.Add({Reading(0, 0.3, 0.02, "far")})[0];
+    EXPECT_EQ(state.not_counted_in_a_row, k);
+    EXPECT_EQ(state.counted_before, 5);
+    if (state.unjudged) told_at = capture;
+  }
+  EXPECT_EQ(told_at, 26);  // 5 counted, 20 not, one not read
+  ASSERT_EQ(watch.Unjudged().size(), 1u);
+  EXPECT_EQ(watch.Unjudged()[0].unjudged_since, 26);
+  EXPECT_EQ(watch.Unjudged()[0].counted, 5);
+  EXPECT_EQ(watch.Unjudged()[0].not_counted, 20);
+  EXPECT_EQ(watch.Add({Reading(0, 0.02, 0.02)})[0].not_counted_in_a_row, 0);
+  for (int k = 0; k < 30; ++k) EXPECT_FALSE(watch.Add({Reading(0, 0.3, 0.02, "near")})[0].unjudged) << k;
+  EXPECT_EQ(watch.Unjudged()[0].unjudged_since, 26);  // still listed: the run had the gap
+}
+
+// A module that read nothing in the run (passive options: no line index)
+// is not unjudged for a range end: it is not listed.
+TEST(RowDriftWatch, AModuleThatReadNothingIsNotListedUnjudged) {
+  RowDriftWatch watch(0.1);
+  std::vector<ModuleReport> modules = Capture(0.0, 0.0);
+  modules[0].row_drift = RowDrift{};
+  modules[1].row_drift = RowDrift{};
+  for (int k = 0; k < 30; ++k) EXPECT_FALSE(watch.Add(modules)[0].unjudged);
+  EXPECT_TRUE(watch.Unjudged().empty());
+}
+
 }  // namespace
 }  // namespace stereorig

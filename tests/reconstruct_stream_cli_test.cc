@@ -695,6 +695,9 @@ TEST_F(ReconstructStreamCli, ARowDriftIsJudgedOverTheStreamsRecentCaptures) {
             std::string::npos)
       << r.err;
   EXPECT_EQ(nlohmann::json::parse(Bytes(out + "/summary.json"))["with_row_drift"], 2);
+  EXPECT_EQ(nlohmann::json::parse(Bytes(out + "/summary.json"))["row_drift_unjudged_modules"], nlohmann::json::array());
+  EXPECT_EQ(r.err.find("row drift is not watched"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("row drift was not watched"), std::string::npos) << r.err;
   // On stderr where it begins, as a log keeps the problems (not at each
   // capture: a warning may hold for days of captures).
   const std::string begins =
@@ -714,6 +717,48 @@ TEST_F(ReconstructStreamCli, ARowDriftIsJudgedOverTheStreamsRecentCaptures) {
     EXPECT_EQ(run["captures"], name == "0001" ? 1 : 2) << run.dump();
     EXPECT_EQ(modules[1]["row_drift_run"]["warned"], false) << modules[1].dump();
   }
+}
+
+// A volume that holds only the sphere's front cap (20 mm deep, 25 to 5 mm in
+// front of its centre, as tests/reconstruct_cli_test.cc's range-end test):
+// module 0's matches reach the far end at every capture, so none of its
+// readings is counted and its drift is never judged (module 1, facing
+// away, gives no point and reads nothing). A stream of two ends before a
+// window (20) of them: its end says so once on stderr, naming the module
+// and what to do, and the summary lists it.
+TEST_F(ReconstructStreamCli, AModuleWhoseReadingsAllReachARangeEndIsToldItsDriftWasNotWatched) {
+  const SimulatedRig sim = MakeDefaultRig();
+  const Eigen::Vector3d centre_mm = sim.world_from_module0.Inverse() * Eigen::Vector3d::Zero();
+  const Eigen::Vector3d cap_centre_mm = centre_mm - 15.0 * centre_mm.normalized();
+  WriteFileAtomically(dir_ + "/cap.yaml", "volume_center_mm: [" + std::to_string(cap_centre_mm.x()) + ", " +
+                                              std::to_string(cap_centre_mm.y()) + ", " +
+                                              std::to_string(cap_centre_mm.z()) +
+                                              "]\nvolume_size_mm: [150, 150, 20]\n");
+  const std::string out = dir_ + "/cap_out", list = dir_ + "/cap.txt";
+  fs::remove_all(out);
+  WriteFileAtomically(list, dir_ + "/line/0001\n" + dir_ + "/line/0002\n");
+  const testing::Result r =
+      testing::RunCli("reconstruct --rig " + dir_ + "/rig.yaml --options " + dir_ + "/cap.yaml --capture - --out-dir " +
+                      out + " --report " + out + "/summary.json < " + list);
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const std::string name : {"0001", "0002"}) {
+    const nlohmann::json module0 = nlohmann::json::parse(Bytes(out + "/" + name + ".json"))["modules"][0];
+    ASSERT_NE(module0["range_end_reached"], "none") << module0.dump();
+    EXPECT_EQ(module0["row_drift_run"]["not_counted"], "range_end_reached") << module0.dump();
+  }
+  const std::string told =
+      "stereorig reconstruct: warning: module 0's row drift was not watched in this run: none of its 2 readings was "
+      "counted, its matches reaching an end of the measurement volume's disparity range at each capture";
+  const size_t at = r.err.find(told);
+  ASSERT_NE(at, std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("set working_distance_mm (or volume_center_mm, volume_size_mm) to where it is", at),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("or check the part's position on the line", at), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("row drift was not watched", at + told.size()), std::string::npos) << r.err;  // once
+  EXPECT_EQ(r.err.find("module 1's row drift"), std::string::npos) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(Bytes(out + "/summary.json"))["row_drift_unjudged_modules"],
+            nlohmann::json::array({0}));
 }
 
 }  // namespace
