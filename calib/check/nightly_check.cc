@@ -54,13 +54,42 @@ std::vector<int> CheckResult::FlaggedModules() const {
   return {modules.begin(), modules.end()};
 }
 
-ClosureNaming NameClosureModules(const std::map<int, int>& failed_pairs_of) {
+ClosureNaming NameClosureModules(const std::map<int, int>& failed_pairs_of,
+                                 const std::map<std::pair<int, int>, JudgedClosure>& judged_pairs) {
   int most = 0;
   for (const auto& [m, count] : failed_pairs_of) most = std::max(most, count);
   ClosureNaming named;
   for (const auto& [m, count] : failed_pairs_of)
     if (count == most && count > 0) named.modules.push_back(m);
   named.which_unknown = most == 1 || named.modules.size() > 1;
+  if (most != 1 || named.modules.size() != 2) return named;
+  // One failing pair (a, b): a third module that agrees with one of them,
+  // its pair with the other not judged, leaves the other the odd one.
+  const int a = named.modules[0], b = named.modules[1];
+  auto judged = [&](int x, int y) -> const JudgedClosure* {
+    const auto it = judged_pairs.find({std::min(x, y), std::max(x, y)});
+    return it == judged_pairs.end() ? nullptr : &it->second;
+  };
+  const JudgedClosure* failing = judged(a, b);
+  if (!failing) return named;  // a shifted module's pair (module_shifts): no closure to size the change by
+  // Would `holding` have failed, had its module in the failing pair made the
+  // failing pair's change? Past twice its threshold, its own noise would
+  // have to cancel more than a threshold (3.5 sigma) of it.
+  auto would_have_seen = [&](const JudgedClosure& holding) {
+    return (failing->mm > failing->threshold_mm && failing->mm > 2 * holding.threshold_mm) ||
+           (failing->deg > failing->threshold_deg && failing->deg > 2 * holding.threshold_deg);
+  };
+  std::set<int> third, odd;
+  for (const auto& [pair, closure] : judged_pairs) third.insert({pair.first, pair.second});
+  third.erase(a), third.erase(b);
+  for (int c : third) {
+    const JudgedClosure *ac = judged(a, c), *bc = judged(b, c);
+    const bool a_agrees = ac && ac->Holds(), b_agrees = bc && bc->Holds();
+    if (a_agrees && b_agrees) return named;  // c agrees with both: which one changed is not told
+    if (a_agrees && !bc && would_have_seen(*ac)) odd.insert(b);
+    if (b_agrees && !ac && would_have_seen(*bc)) odd.insert(a);
+  }
+  if (odd.size() == 1) named = {{*odd.begin()}, false};
   return named;
 }
 
@@ -1074,9 +1103,11 @@ void SetAsideCapturesOfModulesAtAnotherMoment(Inputs& in, std::vector<SetAsideVi
 // in two captures or more (mm and deg, in that order), and in
 // `failed_pairs_of` each module's count of failing pairs, counting no pair
 // with a module in `inconsistent_modules` (a module whose cameras disagree:
-// its board pose mixes them).
+// its board pose mixes them), and in `judged_pairs` (may be null) each
+// pair's (i < j) closure, but none with such a module.
 std::vector<CheckFigure> ClosureFigures(const Inputs& in, const std::set<int>& inconsistent_modules,
-                                        std::map<int, int>* failed_pairs_of) {
+                                        std::map<int, int>* failed_pairs_of,
+                                        std::map<std::pair<int, int>, JudgedClosure>* judged_pairs = nullptr) {
   std::vector<CheckFigure> figures;
   const double k = in.options.k_sigma;
   const Eigen::Vector3d board_center((in.target.corners_x() - 1) * 0.5 * in.target.square_size_mm(),
@@ -1162,10 +1193,9 @@ std::vector<CheckFigure> ClosureFigures(const Inputs& in, const std::set<int>& i
           {"pair_" + std::to_string(i) + "_" + std::to_string(j) + "_closure_mm", mean_t.norm(), thr_t, pass_t, n});
       figures.push_back(
           {"pair_" + std::to_string(i) + "_" + std::to_string(j) + "_closure_deg", mean_r.norm(), thr_r, pass_r, n});
-      if ((!pass_t || !pass_r) && !inconsistent_modules.count(i) && !inconsistent_modules.count(j)) {
-        ++(*failed_pairs_of)[i];
-        ++(*failed_pairs_of)[j];
-      }
+      if (inconsistent_modules.count(i) || inconsistent_modules.count(j)) continue;
+      if (!pass_t || !pass_r) ++(*failed_pairs_of)[i], ++(*failed_pairs_of)[j];
+      if (judged_pairs) (*judged_pairs)[{i, j}] = {mean_t.norm(), thr_t, mean_r.norm(), thr_r};
     }
   }
   return figures;
@@ -1846,14 +1876,21 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   }
 
   // --- Module pairs: closure through the target. ---
-  std::map<int, int> failed_pairs_of;  // module -> number of failing pairs it is in
-  for (const CheckFigure& f : ClosureFigures(in, inconsistent_modules, &failed_pairs_of)) result.figures.push_back(f);
+  std::map<int, int> failed_pairs_of;                         // module -> number of failing pairs it is in
+  std::map<std::pair<int, int>, JudgedClosure> judged_pairs;  // (i < j), neither module split
+  for (const CheckFigure& f : ClosureFigures(in, inconsistent_modules, &failed_pairs_of, &judged_pairs))
+    result.figures.push_back(f);
   // Whole modules that moved, or a lens changed: their pairs fail while each
   // module is consistent in itself. A pair's closure only shows relative
   // motion, so a module is named alone only when it is in more failing pairs
   // than any other (NameClosureModules); a single failing pair (always so
   // with two modules: module 0 defines the reference frame, nothing more) or
-  // a tie names the modules and says they disagree. Either way the verdict
+  // a tie names the modules and says they disagree; but a single failing
+  // pair one of whose modules agrees with a third, the other's pair with it
+  // not judged, names the other alone (a ring's side modules rarely see the
+  // board together under 70 deg: module 1 shifted read "module 0 and module
+  // 1 disagree" on 4 of 10 study nights, its pair with module 2 not
+  // judged). Either way the verdict
   // says "moved or a lens changed": a focal drift of one camera too small for
   // any camera figure still scales its module's board pose, and fails the
   // closure alone (a 0.01 % one does, end to end: docs/verify-and-check.md).
@@ -1864,7 +1901,7 @@ CheckResult RunNightlyCheck(const Rig& rig, const Target& target, const std::vec
   // cameras disagree), is what its shift is.
   for (const auto& [m, against] : shifted_against)
     for (int o : against) ++failed_pairs_of[m], ++failed_pairs_of[o];
-  const ClosureNaming named = NameClosureModules(failed_pairs_of);
+  const ClosureNaming named = NameClosureModules(failed_pairs_of, judged_pairs);
   result.closure_modules = named.modules;
   result.closure_which_unknown = named.which_unknown;
   // A shift is the module's own only where the closures name it alone;

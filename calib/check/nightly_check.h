@@ -21,6 +21,7 @@
 
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "calib/check/board_scale.h"
@@ -250,11 +251,32 @@ struct CheckResult {
 // top, and which_unknown: a single failing pair (always so with two modules:
 // module 0 only defines the reference frame), or a tie (a ring whose every
 // pair fails) tells that they disagree, not which one changed.
+//
+// `judged_pairs` holds each pair's (i < j) closure where it was judged,
+// neither module's cameras disagreeing; a pair absent was not judged (too
+// few captures where both saw the board). A single failing pair (a, b)
+// names b alone where a third module c agrees with a, b's pair with c was
+// not judged, and the failing closure is past twice (a, c)'s threshold (had
+// a made that change, (a, c) would have failed): a agrees with the rest, b
+// is the odd one. A ring whose side modules rarely see the board together
+// under 70 deg: module 1 shifted fails (0, 1), passes (0, 2), and (1, 2) is
+// not judged. So read where one module changed and its change moves its
+// board pose alike in every capture: a motion does; a lens change does only
+// roughly (its error moves with where the board is in the image), and one
+// that shows in (a, b)'s captures past twice what (a, c)'s let pass would
+// name b (docs/verify-and-check.md). Not where c agrees with both, or
+// thirds point at a and at b: which_unknown as before.
+struct JudgedClosure {
+  double mm = 0, threshold_mm = 0;    // the board centre's mean offset between the two modules' poses
+  double deg = 0, threshold_deg = 0;  // and the poses' mean turn
+  bool Holds() const { return mm <= threshold_mm && deg <= threshold_deg; }
+};
 struct ClosureNaming {
   std::vector<int> modules;  // ascending
   bool which_unknown = false;
 };
-ClosureNaming NameClosureModules(const std::map<int, int>& failed_pairs_of);
+ClosureNaming NameClosureModules(const std::map<int, int>& failed_pairs_of,
+                                 const std::map<std::pair<int, int>, JudgedClosure>& judged_pairs = {});
 
 // Throws InputError(`where`, ...) when the rig file lacks a calibration
 // residual the thresholds need (provenance.residuals.camK_rms_px for every
