@@ -219,15 +219,30 @@ TEST(ScopedStderrCapture, ExitInsideNestedScopesWritesBothScopesLinesInOrder) {
   EXPECT_EQ(WEXITSTATUS(end.status), 1);
 }
 
-// Outside any scope the handlers are gone again: a Ctrl-C after a solve ends
-// the process the way it would have (here: the test's own handler runs).
+// A handler the program had installed before the scope is its handler again
+// after it (here a no-op one on SIGINT and SIGTERM, so a scope that reset
+// them to SIG_DFL would fail), and inside the scope it is not (the scope's
+// own handler is installed).
+void DoNothingOnSignal(int) {}
+
 TEST(ScopedStderrCapture, LeavesTheSignalDispositionsAsItFoundThem) {
-  struct sigaction before {};
-  sigaction(SIGINT, nullptr, &before);
-  { ScopedStderrCapture capture(IsNoise); }
-  struct sigaction after {};
-  sigaction(SIGINT, nullptr, &after);
-  EXPECT_EQ(after.sa_handler, before.sa_handler);
+  for (const int signal : {SIGINT, SIGTERM}) {
+    struct sigaction original {};
+    struct sigaction no_op {};
+    no_op.sa_handler = DoNothingOnSignal;
+    sigemptyset(&no_op.sa_mask);
+    ASSERT_EQ(sigaction(signal, &no_op, &original), 0) << signal;
+    {
+      ScopedStderrCapture capture(IsNoise);
+      struct sigaction inside {};
+      sigaction(signal, nullptr, &inside);
+      EXPECT_NE(inside.sa_handler, &DoNothingOnSignal) << signal;
+    }
+    struct sigaction after {};
+    sigaction(signal, nullptr, &after);
+    EXPECT_EQ(after.sa_handler, &DoNothingOnSignal) << signal;
+    sigaction(signal, &original, nullptr);
+  }
 }
 
 }  // namespace

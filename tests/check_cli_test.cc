@@ -15,6 +15,7 @@
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 
 #include <filesystem>
 #include <fstream>
@@ -1590,9 +1591,12 @@ TEST(CheckCli, AMisnamedCaptureIsRefusedAndAHiddenOneNamed) {
 // gave the view 0.59 times its variance: 0.0537 px against 0.0501, "module
 // 1's cameras disagree" (1 of 100 unmoved default nights). With the
 // variance of the summed pose error, 0.0537 against 0.0538 (this truth rig
-// at the demo's RMS; 0.0548 with the demo's calibrated rig): the night is a
-// tail event of its own pose error (cam2's pose off the truth by chi-square
-// 17.3 on 6 degrees of freedom, p ~ 0.008), passed but not by much. And
+// at the demo's RMS): the night is a tail event of its own pose error
+// (cam2's pose off the truth by chi-square 17.3 on 6 degrees of freedom,
+// p ~ 0.008), passed but not by much. The test reads the figure and its
+// threshold from the report and asks that the night passes by under 5 %
+// (0.998 of the threshold when written): the "ok" is this margin's, and a
+// night that passed by far would no longer test the weak pose. And
 // camera 1 turned 0.01 deg on the same night, the smallest turn the audit
 // tried, is named alone (it named camera 2 too, "turned 0.001 deg").
 TEST(CheckCli, AnUnmovedNightsViewThroughAWeakPoseIsNoAlarmAndASmallTurnIsNamedAlone) {
@@ -1602,9 +1606,23 @@ TEST(CheckCli, AnUnmovedNightsViewThroughAWeakPoseIsNoAlarmAndASmallTurnIsNamedA
   ASSERT_EQ(RunCli("simulate --out " + dir + "/unmoved --seed 1016 --calibration-captures 8 --no-scenes").code, 0);
   WriteStoredRig(dir + "/unmoved/truth/rig.yaml", 0.0215, dir + "/rig.yaml", dir + "/unmoved/target.yaml");
   const std::string args = " --target " + dir + "/unmoved/target.yaml --history-db " + dir + "/history.sqlite";
-  Result r = RunCli("check --rig " + dir + "/rig.yaml --captures " + dir + "/unmoved/calibration" + args);
+  Result r = RunCli("check --rig " + dir + "/rig.yaml --captures " + dir + "/unmoved/calibration" + args +
+                    " --report " + dir + "/unmoved.json");
   EXPECT_EQ(r.code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("verdict: ok"), std::string::npos) << r.out;
+  {
+    std::ifstream unmoved(dir + "/unmoved.json");
+    const nlohmann::json u = nlohmann::json::parse(unmoved, nullptr, false);
+    ASSERT_TRUE(u.is_object());
+    double ratio = NAN;
+    for (const nlohmann::json& fig : u["figures"])
+      if (fig["name"] == "module1_stereo_consistency_rms_px")
+        ratio = fig["value"].get<double>() / fig["threshold"].get<double>();
+    EXPECT_TRUE(ratio > 0.95 && ratio <= 1)
+        << "module 1's stereo figure is " << ratio
+        << " of its threshold: this test is of a night that passes by a hair (0.998 when written)\n"
+        << u["figures"].dump(2);
+  }
   ASSERT_EQ(RunCli("simulate --out " + dir + "/turned --seed 1016 --calibration-captures 8 --no-scenes " +
                    "--bump-camera 1 --bump-rotation-deg 0.01")
                 .code,
@@ -1631,14 +1649,16 @@ nlohmann::json ReadReport(const std::string& path) {
 // A camera knocked during the night's last capture reads as that capture's
 // image of another moment: set aside, the rest of the night within every
 // threshold, and the night read "ok", exit 0 (camera 2 turned 3 deg in the
-// last of 8 captures: 12.952 px off against a bound of 0.293 px). No later
+// last of 8 captures: 12.952 px off against a bound of 0.293 px in the
+// audit that asked for this test; not measured here). No later
 // view of the camera tells a knock (it stays) from a slip (it does not): the
 // night reads recapture, exit 1, naming the capture and the camera. Here the
 // last capture's cam2.png is another capture's (off by hundreds of px, as
 // the knock, far over its bound): the night cannot tell it from a knock.
 // A night far noisier than the calibration (its thresholds rise with the
-// noise until a change passes under them: module 1 shifted 0.05 mm read ok
-// at 20 times) reads recapture too, with a warning saying what the
+// noise until a change passes under them: the audit that asked for this
+// test read module 1 shifted 0.05 mm ok at 20 times; not measured here)
+// reads recapture too, with a warning saying what the
 // thresholds still see. The stored rig claims a calibration RMS a sixth of
 // the smallest noise the unmoved night reads on any camera, so every camera
 // reads 6 times its calibration's or more, over kNoisyNightFactor (5); the

@@ -682,6 +682,13 @@ TEST(History, NewTablesRefuseRowsNoCheckWrites) {
         "INSERT INTO stereorig_check_views_set_aside VALUES (1, '006', 5, 0.04, 0.06, 'steep');"})
     EXPECT_NE(sqlite3_exec(raw, sql, nullptr, nullptr, nullptr), SQLITE_OK) << sql;
   EXPECT_EQ(sqlite3_exec(raw, "UPDATE stereorig_check_figures SET value = 1;", nullptr, nullptr, nullptr), SQLITE_OK);
+  // The positive control of the tilt rows above: a view set aside 80 deg
+  // from face-on (within 0-90 deg, a number) is a row the table takes, so
+  // the 95.0 and 'steep' rows were refused for their tilt alone.
+  EXPECT_EQ(sqlite3_exec(raw, "INSERT INTO stereorig_check_views_set_aside VALUES (1, '006', 5, 0.04, 0.06, 80.0);",
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK)
+      << sqlite3_errmsg(raw);
   sqlite3_close(raw);
   EXPECT_EQ(ReadHistoryTrends(db)[0].points[0].value, 1.0);  // an integer in a REAL column: a number
 }

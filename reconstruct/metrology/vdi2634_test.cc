@@ -1405,10 +1405,14 @@ TEST(Vdi2634, ALooseMpeDoesNotMakeASphereOfAnotherSizeTheArtifact) {
     } catch (const NotTheArtifactError&) {
     }
   }
-  for (const Artifact& a : {SphereArtifact(), loose}) {
+  const Artifact tight = SphereArtifact();
+  for (const auto& [a, passes] : {std::pair<Artifact, bool>{tight, false}, {loose, true}}) {
     const ArtifactEvaluation e = EvaluateArtifact(a, ExactSphere(38.1 * 1.098), VerifyOptions(), "s.ply");
     EXPECT_TRUE(e.judged()) << e.not_judged_reason;
     EXPECT_NEAR(FigureOf(e, "P_S"), 0.098 * 38.1, 0.005);
+    // P_S 3.7 mm: over the default MPE (FAIL), under 50 mm (PASS).
+    EXPECT_EQ(e.pass(), passes) << "P_S " << FigureOf(e, "P_S") << " mm against an MPE of " << a.mpe.probing_size_mm
+                                << " mm";
   }
 }
 

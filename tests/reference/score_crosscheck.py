@@ -6,7 +6,8 @@ usage: score_crosscheck.py SCORE_JSON DATASET CLOUD_DIR [TOLERANCE_MM]
 SCORE_JSON: `stereorig score --report` of DATASET; CLOUD_DIR/<scene>.ply: the
 clouds `stereorig reconstruct` writes for the same scenes, rig and options;
 CLOUD_DIR/<scene>_passive.ply, where the report scored a scene's passive
-capture: its cloud with score's passive options.
+capture: its cloud with score's passive options (where the report gives it
+no point, the cloud must hold no measured point).
 For each scene in the report: reads the cloud and the simulator's dense truth
 (DATASET/truth/scenes/<scene>/surface.ply), aligns the cloud by its own
 point-to-plane ICP from the identity, then takes each measured point's
@@ -18,8 +19,9 @@ Compares per module and merged: the point count exactly, mean |e| and std
 within TOLERANCE_MM (default 0.001). The passive cloud is scored under the
 active cloud's alignment (score's rule: its mismatches would pull their own)
 and compared the same way, and so are the counts within 0.5 mm (active
-merged and passive) and active_over_passive_within_0_5_mm: a count may differ
-by the points whose |e| lies within TOLERANCE_MM of 0.5 mm (the distances'
+merged, whether or not a passive cloud was scored, and passive) and
+active_over_passive_within_0_5_mm: a count may differ by the points whose
+|e| lies within TOLERANCE_MM of 0.5 mm (the distances'
 own tolerance, carried to the count), the ratio by what those allow. Prints
 one line per figure; exit 0 if all agree, 1 if not, 2 on bad arguments.
 
@@ -200,17 +202,35 @@ def main():
         truth = np.stack([truth_ply['x'], truth_ply['y'], truth_ply['z']], axis=1).astype(np.float64)
         passive_ply = os.path.join(cloud_dir, name + '_passive.ply')
         passive_scored = isinstance(scene.get('passive'), dict) and scene['passive'].get('points', 0) > 0
-        if passive_scored and not os.path.exists(passive_ply):
-            print(f'{passive_ply}: missing (the report scored the passive capture)', file=sys.stderr)
+        # The report counts the passive capture's points but scores none (no
+        # "passive" figures) where it gave none: the plate.
+        passive_empty = not passive_scored and scene.get('passive_points') == 0
+        if (passive_scored or passive_empty) and not os.path.exists(passive_ply):
+            print(f'{passive_ply}: missing (the report read the passive capture)', file=sys.stderr)
             return 2
         merged, per_module, passive = score_scene(read_ply(os.path.join(cloud_dir, name + '.ply')), truth,
                                                   tolerance, read_ply(passive_ply) if passive_scored else None)
         rows = [('merged', scene['merged'], merged)]
         rows += [(f"m{m['module']}", m['accuracy'], per_module.get(m['module'], figures([])))
                  for m in scene['modules']]
+        # The active cloud's count within 0.5 mm, whether or not a passive
+        # one was scored (the plate's passive cloud holds no point).
+        active_ok, active_count = within_agrees(scene['merged'], merged)
+        if not passive_scored and not passive_empty:
+            bad += not active_ok
+            print(f"{name:8s} within 0.5 mm: active {active_count} / {merged['within']} "
+                  f"(+-{merged['within_slack']} near the bound) (stereorig score / scipy)"
+                  f"{'' if active_ok else '  DIFFERS'}")
+        elif passive_empty:
+            # The report says the passive capture gave no point: so must its cloud.
+            passive_points = len(measured_points(read_ply(passive_ply))[0])
+            ok = active_ok and passive_points == 0
+            bad += not ok
+            print(f"{name:8s} within 0.5 mm: active {active_count} / {merged['within']} "
+                  f"(+-{merged['within_slack']} near the bound); passive points 0 / {passive_points} "
+                  f"(stereorig score / scipy){'' if ok else '  DIFFERS'}")
         if passive is not None:
             rows.append(('passive', scene['passive'], passive))
-            active_ok, active_count = within_agrees(scene['merged'], merged)
             passive_ok, passive_count = within_agrees(scene['passive'], passive)
             # The ratio's range over the counts the slack allows; score writes
             # null where no passive point lies within 0.5 mm.
