@@ -12,30 +12,59 @@ Eigen::Vector3d CornerInFront(const Target& target, Face face, int id) {
   return face == Face::kFront ? p : target.back_from_front().Inverse() * p;
 }
 
-namespace {
-
-// Residual of one corner: Project(cam_from_ref * ref_from_front(params) * p_front) - q.
-// mrcal's projection is not templated, so Ceres differentiates numerically
-// (central differences; 6 parameters, ~1e-9 px accuracy is plenty).
-struct CornerResidual {
-  const Camera* camera;
-  Pose cam_from_ref;
-  Eigen::Vector3d p_front;
-  Eigen::Vector2d q;
-  bool operator()(const double* rt, double* residual) const {
-    const Pose ref_from_front = Pose::FromRotationVector({rt[0], rt[1], rt[2]}, {rt[3], rt[4], rt[5]});
-    const Eigen::Vector3d p_cam = cam_from_ref * (ref_from_front * p_front);
-    if (p_cam.z() <= 0) return false;
-    const Eigen::Vector2d e = camera->Project(p_cam) - q;
-    residual[0] = e.x();
-    residual[1] = e.y();
+bool ProjectBoardCorner(const Camera& camera, const Pose& cam_from_ref, const double* rt,
+                        const Eigen::Vector3d& p_front, Eigen::Vector2d* q, Eigen::Matrix<double, 2, 6>* dq_drt) {
+  using Jet3 = ceres::Jet<double, 3>;
+  const Jet3 r[3] = {Jet3(rt[0], 0), Jet3(rt[1], 1), Jet3(rt[2], 2)};
+  const Jet3 p[3] = {Jet3(p_front.x()), Jet3(p_front.y()), Jet3(p_front.z())};
+  Jet3 rotated[3];
+  ceres::AngleAxisRotatePoint(r, p, rotated);
+  const Eigen::Vector3d p_ref(rotated[0].a + rt[3], rotated[1].a + rt[4], rotated[2].a + rt[5]);
+  const Eigen::Vector3d p_cam = cam_from_ref * p_ref;
+  if (p_cam.z() <= 0) return false;
+  if (!dq_drt) {
+    *q = camera.Project(p_cam);
     return true;
   }
-  static ceres::CostFunction* Create(const Camera* camera, const Pose& cam_from_ref, const Eigen::Vector3d& p_front,
-                                     const Eigen::Vector2d& q) {
-    return new ceres::NumericDiffCostFunction<CornerResidual, ceres::CENTRAL, 2, 6>(
-        new CornerResidual{camera, cam_from_ref, p_front, q});
+  Eigen::Matrix<double, 2, 3> dq_dp_cam;
+  *q = camera.Project(p_cam, &dq_dp_cam);
+  Eigen::Matrix3d dp_ref_dr;
+  for (int i = 0; i < 3; ++i) dp_ref_dr.row(i) = rotated[i].v.transpose();
+  const Eigen::Matrix<double, 2, 3> dq_dp_ref = dq_dp_cam * cam_from_ref.rotation();
+  dq_drt->leftCols<3>() = dq_dp_ref * dp_ref_dr;
+  dq_drt->rightCols<3>() = dq_dp_ref;
+  return true;
+}
+
+namespace {
+
+// Residual of one corner: its projection (ProjectBoardCorner) minus where it was
+// seen.
+class CornerResidual : public ceres::SizedCostFunction<2, 6> {
+ public:
+  CornerResidual(const Camera* camera, const Pose& cam_from_ref, const Eigen::Vector3d& p_front,
+                 const Eigen::Vector2d& q)
+      : camera_(camera), cam_from_ref_(cam_from_ref), p_front_(p_front), q_(q) {}
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    Eigen::Vector2d q;
+    Eigen::Matrix<double, 2, 6> dq_drt;
+    const bool want_jacobian = jacobians && jacobians[0];
+    if (!ProjectBoardCorner(*camera_, cam_from_ref_, parameters[0], p_front_, &q, want_jacobian ? &dq_drt : nullptr))
+      return false;
+    residuals[0] = q.x() - q_.x();
+    residuals[1] = q.y() - q_.y();
+    if (want_jacobian) {
+      Eigen::Map<Eigen::Matrix<double, 2, 6, Eigen::RowMajor>> drt(jacobians[0]);
+      drt = dq_drt;
+    }
+    return true;
   }
+
+ private:
+  const Camera* camera_;
+  Pose cam_from_ref_;
+  Eigen::Vector3d p_front_;
+  Eigen::Vector2d q_;
 };
 
 bool SeedWithPnp(const Rig& rig, const Target& target, const BoardObservation& view, Pose* ref_from_front) {
@@ -64,25 +93,16 @@ bool SeedWithPnp(const Rig& rig, const Target& target, const BoardObservation& v
   return true;
 }
 
-// d q / d (r, t) of ref_from_front for one corner seen by `camera`. (2x6)
+// d q / d (r, t) of ref_from_front for one corner seen by `camera`. (2x6;
+// zero behind the camera, where the corner is not seen)
 Eigen::Matrix<double, 2, 6> PoseJacobian(const Camera& camera, const Pose& cam_from_ref, const Pose& ref_from_front,
                                          const Eigen::Vector3d& p_front) {
   const Eigen::Vector3d r = ref_from_front.RotationVector();
   const Eigen::Vector3d t = ref_from_front.translation_mm();
-  Eigen::Matrix<double, 2, 6> j;
-  for (int k = 0; k < 6; ++k) {
-    const double h = k < 3 ? 1e-7 : 1e-5;  // rad, mm
-    Eigen::Matrix<double, 6, 1> plus, minus;
-    plus << r, t;
-    minus = plus;
-    plus[k] += h;
-    minus[k] -= h;
-    const auto project = [&](const Eigen::Matrix<double, 6, 1>& x) {
-      const Pose pose = Pose::FromRotationVector(x.head<3>(), x.tail<3>());
-      return camera.Project(cam_from_ref * (pose * p_front));
-    };
-    j.col(k) = (project(plus) - project(minus)) / (2 * h);
-  }
+  const double rt[6] = {r.x(), r.y(), r.z(), t.x(), t.y(), t.z()};
+  Eigen::Vector2d q;
+  Eigen::Matrix<double, 2, 6> j = Eigen::Matrix<double, 2, 6>::Zero();
+  ProjectBoardCorner(camera, cam_from_ref, rt, p_front, &q, &j);
   return j;
 }
 
@@ -159,8 +179,8 @@ BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target,
   for (const BoardObservation* v : views) {
     const Pose cam_from_ref = rig.CamFromReference(v->camera);
     for (size_t k = 0; k < v->corner_ids.size(); ++k) {
-      problem.AddResidualBlock(CornerResidual::Create(&rig.camera(v->camera), cam_from_ref,
-                                                      CornerInFront(target, v->face, v->corner_ids[k]), v->q_px[k]),
+      problem.AddResidualBlock(new CornerResidual(&rig.camera(v->camera), cam_from_ref,
+                                                  CornerInFront(target, v->face, v->corner_ids[k]), v->q_px[k]),
                                nullptr, rt);
     }
   }

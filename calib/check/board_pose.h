@@ -25,6 +25,16 @@ struct BoardPoseEstimate {
 BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target,
                                     const std::vector<const BoardObservation*>& views, const Pose* seed = nullptr);
 
+// One corner's projection q = Project(cam_from_ref * ref_from_front(rt) *
+// p_front) and, if `dq_drt` is given, d q / d rt (2x6; rt = ref_from_front's
+// rotation vector (rad) and translation (mm)). Analytic: mrcal's d q / d
+// p_cam chained with d (R(r) p) / d r from Ceres' Jets; it replaced central
+// differences (13 poses and projections a corner and evaluation, two thirds
+// of a nightly check's time; board_pose_test.cc holds it to them). False
+// (q, dq_drt untouched) where the corner is behind the camera.
+bool ProjectBoardCorner(const Camera& camera, const Pose& cam_from_ref, const double* rt,
+                        const Eigen::Vector3d& p_front, Eigen::Vector2d* q, Eigen::Matrix<double, 2, 6>* dq_drt);
+
 // Reprojection residuals q_predicted - q (px, per corner) of `view` for a
 // given board pose.
 std::vector<Eigen::Vector2d> ReprojectionErrors(const Rig& rig, const Target& target, const BoardObservation& view,
