@@ -143,6 +143,22 @@ std::string UnjudgedRowDriftAdvice() {
 // and on stderr, where a log keeps the problems, when it begins and when it
 // is withdrawn (a warning may hold for days of captures: a line each would
 // bury the log; the run's last stderr line counts the captures).
+// A module none of whose last readings counted: told once a run, on stderr
+// (its captures' lines under each name the range end already), as soon as
+// the watch has read the capture: a capture whose outputs then fail to be
+// written must not take the run's only telling with it.
+void SayRowDriftUnjudged(int module, const WatchedRowDrift& drift, const std::string& dir,
+                         const std::string& progress) {
+  if (!drift.unjudged) return;
+  std::fprintf(stderr,
+               "stereorig reconstruct: %s %s: warning: module %d's row drift is not watched: its last %d readings "
+               "were not counted (%s), %s\n",
+               progress.c_str(), PrintableText(dir).c_str(), module, drift.not_counted_in_a_row,
+               drift.counted_before == 0 ? "none counted in this run"
+                                         : (std::to_string(drift.counted_before) + " counted before them").c_str(),
+               UnjudgedRowDriftAdvice().c_str());
+}
+
 void SayRowDrift(int module, const WatchedRowDrift& drift, const std::string& dir, const CaptureOutputs& outputs,
                  const std::string& progress) {
   const int n = drift.recent.captures;
@@ -169,16 +185,6 @@ void SayRowDrift(int module, const WatchedRowDrift& drift, const std::string& di
                  "that module's points\n",
                  progress.c_str(), PrintableText(dir).c_str(), module, drift.recent.row_offset_px, n, readings,
                  drift.recent.standard_error_px);
-  // A module none of whose last readings counted: told once a run, on
-  // stderr (its captures' lines under each name the range end already).
-  if (drift.unjudged)
-    std::fprintf(stderr,
-                 "stereorig reconstruct: %s %s: warning: module %d's row drift is not watched: its last %d readings "
-                 "were not counted (%s), %s\n",
-                 progress.c_str(), PrintableText(dir).c_str(), module, drift.not_counted_in_a_row,
-                 drift.counted_before == 0 ? "none counted in this run"
-                                           : (std::to_string(drift.counted_before) + " counted before them").c_str(),
-                 UnjudgedRowDriftAdvice().c_str());
   if (drift.withdrawn_since != 0) {
     char mean[96] = "no reading counted";
     if (drift.recent.read)
@@ -210,6 +216,8 @@ nlohmann::json ReconstructCapture(const Runtime& runtime, const std::vector<cv::
                      "capture's mesh; move it, or give another --out-dir");
   const Reconstruction rec = runtime.Process(images, mesh);
   const std::vector<WatchedRowDrift> recent_drift = row_drift->Add(rec.modules);
+  for (size_t k = 0; k < rec.modules.size(); ++k)
+    SayRowDriftUnjudged(rec.modules[k].module, recent_drift[k], dir, progress);
   // All or none: written beside their paths, then renamed in together, so a
   // failure (a full disk) or a signal while they are written leaves none of
   // them new beside an earlier run's others.

@@ -1375,8 +1375,9 @@ std::vector<BoardObservation> StudyRingNight(const SimulatedRig& ring, const Tar
 // A side module of the ring shifted 0.1 mm (issue 6's module bump, the ring
 // study's module:1 and module:2) on 10 nights: its closure with module 0
 // fails, module 0's with the other side module holds, and the side modules'
-// pair is judged on few nights (too few captures see the board under 70 deg
-// from both). Named alone only where it was in two failing pairs, the
+// pair is not judged on some nights (3 of 10 for each here: too few captures
+// see the board under 70 deg from both). Named alone only where it was in
+// two failing pairs, the
 // shifted module read "module 0 and module 1 disagree" (or 2) on the others:
 // on 3 of 10 nights each before. Named alone now on every night: module 0
 // agrees with the third module, whose pair with the shifted one is not
@@ -1415,6 +1416,8 @@ TEST(NightlyCheck, ARingsShiftedSideModuleIsNamedAloneWhereItsPairWithTheOtherSi
                 kNights, alone, kNights, side_pair_judged);
     EXPECT_EQ(flagged, static_cast<int>(kNights)) << "module " << module;
     EXPECT_EQ(alone, static_cast<int>(kNights)) << "module " << module;
+    // Some nights leave the side pair unjudged, or the rule is not exercised.
+    EXPECT_LT(side_pair_judged, static_cast<int>(kNights)) << "module " << module;
   }
 }
 
