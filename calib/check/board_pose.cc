@@ -4,6 +4,7 @@
 #include <ceres/rotation.h>
 
 #include <opencv2/calib3d.hpp>
+#include <utility>
 
 namespace stereorig {
 
@@ -12,14 +13,37 @@ Eigen::Vector3d CornerInFront(const Target& target, Face face, int id) {
   return face == Face::kFront ? p : target.back_from_front().Inverse() * p;
 }
 
-bool ProjectBoardCorner(const Camera& camera, const Pose& cam_from_ref, const double* rt,
-                        const Eigen::Vector3d& p_front, Eigen::Vector2d* q, Eigen::Matrix<double, 2, 6>* dq_drt) {
+namespace {
+
+// R(r) of a rotation vector r (rad), and d R / d r_k for k = 0, 1, 2: each
+// unit vector turned by Ceres' AngleAxisRotatePoint on Jets. Once per pose
+// and evaluation, not per corner.
+struct TurnAndDerivative {
+  Eigen::Matrix3d r;
+  Eigen::Matrix3d dr[3];
+};
+
+TurnAndDerivative Turn(const double* r_rad) {
   using Jet3 = ceres::Jet<double, 3>;
-  const Jet3 r[3] = {Jet3(rt[0], 0), Jet3(rt[1], 1), Jet3(rt[2], 2)};
-  const Jet3 p[3] = {Jet3(p_front.x()), Jet3(p_front.y()), Jet3(p_front.z())};
-  Jet3 rotated[3];
-  ceres::AngleAxisRotatePoint(r, p, rotated);
-  const Eigen::Vector3d p_ref(rotated[0].a + rt[3], rotated[1].a + rt[4], rotated[2].a + rt[5]);
+  const Jet3 r[3] = {Jet3(r_rad[0], 0), Jet3(r_rad[1], 1), Jet3(r_rad[2], 2)};
+  TurnAndDerivative turn;
+  for (int j = 0; j < 3; ++j) {
+    const Jet3 unit[3] = {Jet3(j == 0 ? 1.0 : 0.0), Jet3(j == 1 ? 1.0 : 0.0), Jet3(j == 2 ? 1.0 : 0.0)};
+    Jet3 column[3];
+    ceres::AngleAxisRotatePoint(r, unit, column);
+    for (int i = 0; i < 3; ++i) {
+      turn.r(i, j) = column[i].a;
+      for (int k = 0; k < 3; ++k) turn.dr[k](i, j) = column[i].v[k];
+    }
+  }
+  return turn;
+}
+
+// ProjectBoardCorner with the pose's turn made already.
+bool ProjectTurnedCorner(const Camera& camera, const Pose& cam_from_ref, const TurnAndDerivative& turn,
+                         const double* t_mm, const Eigen::Vector3d& p_front, Eigen::Vector2d* q,
+                         Eigen::Matrix<double, 2, 6>* dq_drt) {
+  const Eigen::Vector3d p_ref = turn.r * p_front + Eigen::Vector3d(t_mm[0], t_mm[1], t_mm[2]);
   const Eigen::Vector3d p_cam = cam_from_ref * p_ref;
   if (p_cam.z() <= 0) return false;
   if (!dq_drt) {
@@ -29,33 +53,48 @@ bool ProjectBoardCorner(const Camera& camera, const Pose& cam_from_ref, const do
   Eigen::Matrix<double, 2, 3> dq_dp_cam;
   *q = camera.Project(p_cam, &dq_dp_cam);
   Eigen::Matrix3d dp_ref_dr;
-  for (int i = 0; i < 3; ++i) dp_ref_dr.row(i) = rotated[i].v.transpose();
+  for (int k = 0; k < 3; ++k) dp_ref_dr.col(k) = turn.dr[k] * p_front;
   const Eigen::Matrix<double, 2, 3> dq_dp_ref = dq_dp_cam * cam_from_ref.rotation();
   dq_drt->leftCols<3>() = dq_dp_ref * dp_ref_dr;
   dq_drt->rightCols<3>() = dq_dp_ref;
   return true;
 }
 
+}  // namespace
+
+bool ProjectBoardCorner(const Camera& camera, const Pose& cam_from_ref, const double* rt,
+                        const Eigen::Vector3d& p_front, Eigen::Vector2d* q, Eigen::Matrix<double, 2, 6>* dq_drt) {
+  return ProjectTurnedCorner(camera, cam_from_ref, Turn(rt), rt + 3, p_front, q, dq_drt);
+}
+
 namespace {
 
-// Residual of one corner: its projection (ProjectBoardCorner) minus where it was
-// seen.
-class CornerResidual : public ceres::SizedCostFunction<2, 6> {
+// Residuals of one view's corners: their projections (ProjectBoardCorner)
+// minus where they were seen, x and y of each in turn. One block a view, so
+// the pose's turn is made once an evaluation.
+class ViewResidual : public ceres::CostFunction {
  public:
-  CornerResidual(const Camera* camera, const Pose& cam_from_ref, const Eigen::Vector3d& p_front,
-                 const Eigen::Vector2d& q)
-      : camera_(camera), cam_from_ref_(cam_from_ref), p_front_(p_front), q_(q) {}
+  ViewResidual(const Camera* camera, const Pose& cam_from_ref, std::vector<Eigen::Vector3d> p_front,
+               std::vector<Eigen::Vector2d> q)
+      : camera_(camera), cam_from_ref_(cam_from_ref), p_front_(std::move(p_front)), q_(std::move(q)) {
+    set_num_residuals(static_cast<int>(2 * p_front_.size()));
+    mutable_parameter_block_sizes()->push_back(6);
+  }
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    Eigen::Vector2d q;
-    Eigen::Matrix<double, 2, 6> dq_drt;
+    const double* rt = parameters[0];
+    const TurnAndDerivative turn = Turn(rt);
     const bool want_jacobian = jacobians && jacobians[0];
-    if (!ProjectBoardCorner(*camera_, cam_from_ref_, parameters[0], p_front_, &q, want_jacobian ? &dq_drt : nullptr))
-      return false;
-    residuals[0] = q.x() - q_.x();
-    residuals[1] = q.y() - q_.y();
-    if (want_jacobian) {
-      Eigen::Map<Eigen::Matrix<double, 2, 6, Eigen::RowMajor>> drt(jacobians[0]);
-      drt = dq_drt;
+    Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>> jacobian(
+        want_jacobian ? jacobians[0] : nullptr, want_jacobian ? num_residuals() : 0, 6);
+    for (size_t k = 0; k < p_front_.size(); ++k) {
+      Eigen::Vector2d q;
+      Eigen::Matrix<double, 2, 6> dq_drt;
+      if (!ProjectTurnedCorner(*camera_, cam_from_ref_, turn, rt + 3, p_front_[k], &q,
+                               want_jacobian ? &dq_drt : nullptr))
+        return false;
+      residuals[2 * k] = q.x() - q_[k].x();
+      residuals[2 * k + 1] = q.y() - q_[k].y();
+      if (want_jacobian) jacobian.middleRows<2>(static_cast<Eigen::Index>(2 * k)) = dq_drt;
     }
     return true;
   }
@@ -63,8 +102,8 @@ class CornerResidual : public ceres::SizedCostFunction<2, 6> {
  private:
   const Camera* camera_;
   Pose cam_from_ref_;
-  Eigen::Vector3d p_front_;
-  Eigen::Vector2d q_;
+  std::vector<Eigen::Vector3d> p_front_;
+  std::vector<Eigen::Vector2d> q_;
 };
 
 bool SeedWithPnp(const Rig& rig, const Target& target, const BoardObservation& view, Pose* ref_from_front) {
@@ -177,12 +216,12 @@ BoardPoseEstimate EstimateBoardPose(const Rig& rig, const Target& target,
   double rt[6] = {r0.x(), r0.y(), r0.z(), t0.x(), t0.y(), t0.z()};
   ceres::Problem problem;
   for (const BoardObservation* v : views) {
-    const Pose cam_from_ref = rig.CamFromReference(v->camera);
-    for (size_t k = 0; k < v->corner_ids.size(); ++k) {
-      problem.AddResidualBlock(new CornerResidual(&rig.camera(v->camera), cam_from_ref,
-                                                  CornerInFront(target, v->face, v->corner_ids[k]), v->q_px[k]),
-                               nullptr, rt);
-    }
+    if (v->corner_ids.empty()) continue;
+    std::vector<Eigen::Vector3d> p_front;
+    for (int id : v->corner_ids) p_front.push_back(CornerInFront(target, v->face, id));
+    problem.AddResidualBlock(
+        new ViewResidual(&rig.camera(v->camera), rig.CamFromReference(v->camera), std::move(p_front), v->q_px), nullptr,
+        rt);
   }
   ceres::Solver::Options options;
   options.max_num_iterations = 100;
