@@ -28,6 +28,7 @@
 #include "calib/core/rig_file.h"
 #include "targets/target_file.h"
 #include "tests/cli_runner.h"
+#include "tests/made_once.h"
 
 namespace stereorig {
 namespace {
@@ -942,14 +943,18 @@ class CheckHistoryCli : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = ::testing::TempDir() + "/check_cli_history_" + std::to_string(getpid());
     fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    for (const auto& [name, args] : std::vector<std::pair<std::string, std::string>>{
-             {"night1", "--seed 21"},
-             {"night2", "--seed 22"},
-             {"turned", "--seed 21 --bump-camera 2 --bump-rotation-deg 0.05"}}) {
-      const Result r = RunCli("simulate --out " + dir_ + "/" + name + " --calibration-captures 8 --no-scenes " + args);
-      ASSERT_EQ(r.code, 0) << r.err;
-    }
+    // The nights are rendered once for every case (MadeOnce) and copied in:
+    // each case writes beside them.
+    const std::string nights = testing::MadeOnce("check_cli_history_nights", [](const std::string& dir) {
+      for (const auto& [name, args] : std::vector<std::pair<std::string, std::string>>{
+               {"night1", "--seed 21"},
+               {"night2", "--seed 22"},
+               {"turned", "--seed 21 --bump-camera 2 --bump-rotation-deg 0.05"}}) {
+        const Result r = RunCli("simulate --out " + dir + "/" + name + " --calibration-captures 8 --no-scenes " + args);
+        ASSERT_EQ(r.code, 0) << r.err;
+      }
+    });
+    fs::copy(nights, dir_, fs::copy_options::recursive);
     WriteStoredRig(dir_ + "/night1/truth/rig.yaml", 0.03, dir_ + "/rig.yaml", dir_ + "/night1/target.yaml");
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }

@@ -35,6 +35,7 @@
 #include "reconstruct/grid_period_options.h"
 #include "reconstruct/runtime_options.h"
 #include "tests/cli_runner.h"
+#include "tests/made_once.h"
 
 namespace stereorig {
 namespace {
@@ -48,25 +49,29 @@ class TuneCli : public ::testing::Test {
   // The plate alone at seed 1, with the default grating (51 lines) and
   // coarser ones (34; 41, whose period, 8.4 px x 50 / 40 = 10.5, lies on a
   // half pixel), the default turned, and the default with lines twice as
-  // wide: folders fine/, coarse/, half/, turned/, square/ and wide/.
+  // wide: folders fine/, coarse/, half/, turned/, square/ and wide/ of data_,
+  // rendered once for every case (MadeOnce). Each case writes in dir_, its own.
   static void SetUpTestSuite() {
     dir_ = ::testing::TempDir() + "/tune_cli";
     fs::remove_all(dir_);
-    struct Grating {
-      const char* name;
-      int lines;
-      double turn_deg;  // about the projector's axis
-      double line_sigma_mrad = 1;
-    };
-    for (const Grating& g : {Grating{"fine", 51, 2.6}, Grating{"coarse", 34, 2.6}, Grating{"turned", 51, 4.6},
-                             Grating{"square", 51, 0.6}, Grating{"half", 41, 2.6}, Grating{"wide", 51, 2.6, 2}}) {
-      SimSpec spec = DefaultSimSpec();
-      spec.scenes.names = {"plate"};
-      for (ModuleSpec& m : spec.modules)
-        m.projector.lines = g.lines, m.projector.rotation_deg = g.turn_deg,
-        m.projector.line_sigma_mrad = g.line_sigma_mrad;
-      SimulateAtSeed1(spec, dir_ + "/" + g.name);
-    }
+    fs::create_directories(dir_);
+    data_ = testing::MadeOnce("tune_cli_plates", [](const std::string& dir) {
+      struct Grating {
+        const char* name;
+        int lines;
+        double turn_deg;  // about the projector's axis
+        double line_sigma_mrad = 1;
+      };
+      for (const Grating& g : {Grating{"fine", 51, 2.6}, Grating{"coarse", 34, 2.6}, Grating{"turned", 51, 4.6},
+                               Grating{"square", 51, 0.6}, Grating{"half", 41, 2.6}, Grating{"wide", 51, 2.6, 2}}) {
+        SimSpec spec = DefaultSimSpec();
+        spec.scenes.names = {"plate"};
+        for (ModuleSpec& m : spec.modules)
+          m.projector.lines = g.lines, m.projector.rotation_deg = g.turn_deg,
+          m.projector.line_sigma_mrad = g.line_sigma_mrad;
+        SimulateAtSeed1(spec, dir + "/" + g.name);
+      }
+    });
   }
   // The scenes of `spec` at seed 1, without calibration captures, in out_dir.
   static void SimulateAtSeed1(const SimSpec& spec, const std::string& out_dir) {
@@ -77,7 +82,7 @@ class TuneCli : public ::testing::Test {
     Simulate(spec, o);
   }
   static std::string Tune(const std::string& dataset, const std::string& extra = "") {
-    return "tune --rig " + dir_ + "/" + dataset + "/truth/rig.yaml --capture " + dir_ + "/" + dataset +
+    return "tune --rig " + data_ + "/" + dataset + "/truth/rig.yaml --capture " + data_ + "/" + dataset +
            "/scenes/plate/active " + extra;
   }
   // The numbers `tune` printed in the lines `pattern` (a regex whose first
@@ -109,9 +114,9 @@ class TuneCli : public ::testing::Test {
     EXPECT_TRUE(std::regex_search(out, m, std::regex(R"(P = ([0-9.]+) px)"))) << out;
     return m.empty() ? 0 : std::stod(m[1]);
   }
-  static std::string dir_;
+  static std::string dir_, data_;
 };
-std::string TuneCli::dir_;
+std::string TuneCli::dir_, TuneCli::data_;
 
 TEST_F(TuneCli, ThePeriodsRatioIsTheGratingsRatio) {
   const auto [f, c] = BothModules("fine", "coarse", Periods);
@@ -225,7 +230,7 @@ TEST_F(TuneCli, ACoarserGridSetsTheKeysByTheRulesAndKeepsTheOthers) {
   std::getline(in, first);
   EXPECT_EQ(first.rfind("# Runtime options from `stereorig tune", 0), 0u) << first;
   const testing::Result rec =
-      testing::RunCli("reconstruct --rig " + dir_ + "/coarse/truth/rig.yaml --capture " + dir_ +
+      testing::RunCli("reconstruct --rig " + data_ + "/coarse/truth/rig.yaml --capture " + data_ +
                       "/coarse/scenes/plate/active --options " + out + " --out " + dir_ + "/coarse.ply");
   EXPECT_EQ(rec.code, 0) << rec.err;
 }
@@ -262,7 +267,7 @@ TEST_F(TuneCli, WideningTheGridLineRadiusIsOnlySuggested) {
       Numbers(r.out, R"(the grid-line test refused ([0-9.]+) % of its grid-lit pixels \(no_grid_line\))");
   ASSERT_EQ(shares.size(), 2u) << r.out;
   const testing::Result rec =
-      testing::RunCli("reconstruct --rig " + dir_ + "/coarse/truth/rig.yaml --capture " + dir_ +
+      testing::RunCli("reconstruct --rig " + data_ + "/coarse/truth/rig.yaml --capture " + data_ +
                       "/coarse/scenes/plate/active --out " + dir_ + "/coarse_plate.ply --report " + report);
   ASSERT_EQ(rec.code, 0) << rec.err;
   const nlohmann::json modules = nlohmann::json::parse(std::ifstream(report))["modules"];
@@ -353,7 +358,7 @@ TEST_F(TuneCli, LinesTooWideForTheirPeriodAreWarnedOf) {
 
 TEST_F(TuneCli, APassiveCaptureHasNoPeriodExitsTwoAndWritesNothing) {
   const std::string out = dir_ + "/passive.yaml";
-  const testing::Result r = testing::RunCli("tune --rig " + dir_ + "/fine/truth/rig.yaml --capture " + dir_ +
+  const testing::Result r = testing::RunCli("tune --rig " + data_ + "/fine/truth/rig.yaml --capture " + data_ +
                                             "/fine/scenes/plate/passive --out " + out);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("no module's left image shows a laser grid's period (3-42 px along the rows)"),
@@ -386,11 +391,11 @@ TEST_F(TuneCli, AModuleWithNoPeriodIsWarnedOfAndNotedInTheFile) {
   fs::create_directories(capture);
   for (int k = 0; k < 4; ++k) {
     const std::string image = "/cam" + std::to_string(k) + ".png";
-    fs::copy_file(dir_ + "/fine/scenes/plate/" + (k < 2 ? "active" : "passive") + image, capture + image);
+    fs::copy_file(data_ + "/fine/scenes/plate/" + (k < 2 ? "active" : "passive") + image, capture + image);
   }
   fs::remove(out);
   const testing::Result r =
-      testing::RunCli("tune --rig " + dir_ + "/fine/truth/rig.yaml --capture " + capture + " --out " + out);
+      testing::RunCli("tune --rig " + data_ + "/fine/truth/rig.yaml --capture " + capture + " --out " + out);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(Periods(r.out).size(), 1u) << r.out;
   EXPECT_NE(r.err.find("tune: warning: no grid period was found for module 1 in " + capture), std::string::npos)
@@ -415,9 +420,9 @@ TEST_F(TuneCli, AModuleWhoseFlatnessIsNotReadIsWarnedOf) {
   fs::create_directories(capture);
   for (int k = 0; k < 4; ++k) {
     const std::string image = "/cam" + std::to_string(k) + ".png";
-    fs::copy_file(dir_ + "/fine/scenes/plate/" + (k == 1 ? "passive" : "active") + image, capture + image);
+    fs::copy_file(data_ + "/fine/scenes/plate/" + (k == 1 ? "passive" : "active") + image, capture + image);
   }
-  const testing::Result r = testing::RunCli("tune --rig " + dir_ + "/fine/truth/rig.yaml --capture " + capture);
+  const testing::Result r = testing::RunCli("tune --rig " + data_ + "/fine/truth/rig.yaml --capture " + capture);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(Periods(r.out).size(), 2u) << r.out;
   EXPECT_NE(r.err.find("tune: warning: module 0's flatness was not read in " + capture + " (fewer than 1000 points"),
