@@ -138,11 +138,6 @@ std::string UnjudgedRowDriftAdvice() {
          "row_drift_unjudged_modules)";
 }
 
-// A module's rows read off over the run's recent captures: a line under the
-// capture's on stdout at every capture it holds (the controller's answer),
-// and on stderr, where a log keeps the problems, when it begins and when it
-// is withdrawn (a warning may hold for days of captures: a line each would
-// bury the log; the run's last stderr line counts the captures).
 // A module none of whose last readings counted: told once a run, on stderr
 // (its captures' lines under each name the range end already), as soon as
 // the watch has read the capture: a capture whose outputs then fail to be
@@ -159,6 +154,11 @@ void SayRowDriftUnjudged(int module, const WatchedRowDrift& drift, const std::st
                UnjudgedRowDriftAdvice().c_str());
 }
 
+// A module's rows read off over the run's recent captures: a line under the
+// capture's on stdout at every capture it holds (the controller's answer),
+// and on stderr, where a log keeps the problems, when it begins and when it
+// is withdrawn (a warning may hold for days of captures: a line each would
+// bury the log; the run's last stderr line counts the captures).
 void SayRowDrift(int module, const WatchedRowDrift& drift, const std::string& dir, const CaptureOutputs& outputs,
                  const std::string& progress) {
   const int n = drift.recent.captures;
@@ -322,8 +322,9 @@ int FinishRun(nlohmann::json* summary, int total, int failed, int without_points
   (*summary)["failed"] = failed;
   (*summary)["with_modules_without_points"] = without_points;
   (*summary)["with_row_drift"] = with_row_drift;
+  const std::vector<UnjudgedRowDrift> unjudged = row_drift.Unjudged();
   (*summary)["row_drift_unjudged_modules"] = nlohmann::json::array();
-  for (const UnjudgedRowDrift& u : row_drift.Unjudged()) (*summary)["row_drift_unjudged_modules"].push_back(u.module);
+  for (const UnjudgedRowDrift& u : unjudged) (*summary)["row_drift_unjudged_modules"].push_back(u.module);
   (*summary)["wall_ms"] = wall_ms;
   (*summary)["objects_per_s"] = done > 0 ? 1000.0 * done / wall_ms : 0.0;
   std::printf("%d of %d captures in %.2f s: %.1f objects/s (%s)", done, total, wall_ms / 1000,
@@ -344,7 +345,7 @@ int FinishRun(nlohmann::json* summary, int total, int failed, int without_points
                  with_row_drift, done);
   // A run too short for a module's uncounted readings to fill a window
   // (RowDriftWatch) still tells one none of whose readings counted.
-  for (const UnjudgedRowDrift& u : row_drift.Unjudged())
+  for (const UnjudgedRowDrift& u : unjudged)
     if (u.unjudged_since == 0)
       std::fprintf(stderr,
                    "stereorig reconstruct: warning: module %d's row drift was not watched in this run: none of its %d "
